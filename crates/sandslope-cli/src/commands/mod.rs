@@ -1,0 +1,5 @@
+//! One module per subcommand; each parses its arguments, calls the library and writes.
+
+pub mod common;
+pub mod predict;
+pub mod presets;

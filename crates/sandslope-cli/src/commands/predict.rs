@@ -1,0 +1,73 @@
+//! `sandslope predict`: every model quantity for one robot, terrain and slope.
+
+use anyhow::Result;
+use clap::Args;
+
+use super::common::{warn_extrapolated, OverrideArgs, PredictionRecord, RobotArgs, Scenario, TerrainArgs};
+use crate::output::{csv_string, num, print_json, sci, table, Format, FormatArgs};
+
+/// Arguments of `sandslope predict`.
+#[derive(Debug, Args)]
+pub struct PredictArgs {
+    /// Slope along the direction of travel, degrees (negative: descending, evaluated as |slope|).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub slope: f64,
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    pub terrain: TerrainArgs,
+    #[command(flatten)]
+    pub over: OverrideArgs,
+    #[command(flatten)]
+    pub format: FormatArgs,
+}
+
+/// Runs `sandslope predict`.
+pub fn run(args: PredictArgs) -> Result<()> {
+    let scenario = Scenario::load(&args.robot, &args.terrain, &args.over)?;
+    let e = scenario.evaluate(args.slope)?;
+    if e.extrapolated {
+        warn_extrapolated(&scenario.terrain, &[args.slope]);
+    }
+    if args.slope < 0.0 {
+        eprintln!(
+            "note: descending {} deg is evaluated as climbing {} deg (MODEL.md section 8)",
+            -args.slope,
+            args.slope.abs()
+        );
+    }
+    let record = PredictionRecord::from(&e);
+    match args.format.format() {
+        Format::Json => print_json(&record),
+        Format::Csv => {
+            print!("{}", csv_string(&[record])?);
+            Ok(())
+        }
+        Format::Table => {
+            let p = &e.prediction;
+            let mm = |x: Option<f64>| num(x.map(|v| v * 1e3), 2);
+            let mut t = table(&["quantity", "value", "unit"]);
+            let rows: Vec<[String; 3]> = vec![
+                ["slope".into(), format!("{}", args.slope), "deg".into()],
+                ["normal resistance k_n".into(), sci(p.k_n), "N/m^3".into()],
+                ["shear strength k_s".into(), sci(p.k_s), "N/m^3".into()],
+                ["normal equilibrium depth d_n".into(), mm(p.normal_depth), "mm".into()],
+                ["level-sand step s*".into(), mm(Some(p.level_step)), "mm".into()],
+                ["shear-equilibrium depth d_s".into(), mm(p.shear_depth), "mm".into()],
+                ["anchoring time t1".into(), num(p.anchoring_time.map(|t| t * 1e3), 1), "ms".into()],
+                ["backward slip s1".into(), mm(p.slip), "mm".into()],
+                ["propulsion s2".into(), mm(p.propulsion), "mm".into()],
+                ["net step s".into(), mm(p.step), "mm".into()],
+                ["speed v".into(), num(p.speed.map(|v| v * 100.0), 2), "cm/s".into()],
+                ["k_s margin (k_s / critical k_s)".into(), num(e.k_s_margin, 2), "".into()],
+                ["regime".into(), p.regime.name().into(), "".into()],
+            ];
+            for r in rows {
+                t.add_row(r);
+            }
+            println!("{t}");
+            println!("{}: {}", p.regime, p.cause.explain());
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,48 @@
+//! `sandslope`: whether, how fast and by which route a legged robot climbs a sand slope.
+//!
+//! A thin binary over the `sandslope` library: it parses files and flags into validated
+//! library types, runs the model, and writes tables, JSON, CSV and figures.
+
+mod commands;
+mod error;
+mod inputs;
+mod output;
+mod plot;
+mod presets;
+
+use clap::{Parser, Subcommand};
+
+/// Whether, how fast and why a legged robot climbs a sand slope (the shear-anchoring model of
+/// Liao and Qian, arXiv:2603.06928).
+#[derive(Debug, Parser)]
+#[command(name = "sandslope", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Every model quantity (d_n, s*, d_s, t1, slip, step, speed, regime) at one slope.
+    Predict(commands::predict::PredictArgs),
+    /// List built-in robots and terrains, or print one as TOML.
+    Presets(commands::presets::PresetsArgs),
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Predict(a) => commands::predict::run(a),
+        Command::Presets(a) => commands::presets::run(a),
+    }
+}
+
+fn main() {
+    let cli = Cli::parse();
+    if let Err(e) = run(cli) {
+        eprintln!("error: {e}");
+        for cause in e.chain().skip(1) {
+            eprintln!("  caused by: {cause}");
+        }
+        std::process::exit(error::EXIT_USAGE);
+    }
+}

@@ -1,0 +1,100 @@
+//! Figures: PNG or SVG by file extension, with an embedded font so plots render on machines
+//! without system fonts.
+//!
+//! A figure implements [`Figure`] once, generically over the plotters backend; [`save`] picks
+//! the backend from the file name, draws into a temporary file and renames it into place.
+
+use std::path::Path;
+use std::sync::Once;
+
+use anyhow::{bail, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::output::write_via_temp;
+
+/// Font family name under which the embedded DejaVu Sans is registered.
+pub const FONT: &str = "sans-serif";
+
+static REGISTER: Once = Once::new();
+
+/// Registers DejaVu Sans (regular and bold) with plotters, once per process.
+pub fn register_fonts() {
+    REGISTER.call_once(|| {
+        // The bytes are a valid TrueType font shipped by the `dejavu` crate.
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
+        let _ = plotters::style::register_font(FONT, FontStyle::Bold, dejavu::sans::bold());
+    });
+}
+
+/// Something that can draw itself on any plotters backend.
+pub trait Figure {
+    /// Pixel size (width, height).
+    fn size(&self) -> (u32, u32) {
+        (1000, 700)
+    }
+    /// Draws the whole figure on `root`.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static;
+}
+
+/// Output image format, from the file extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// Portable Network Graphics.
+    Png,
+    /// Scalable Vector Graphics.
+    Svg,
+}
+
+/// The image format for `path`, or an error naming the accepted extensions.
+pub fn format_of(path: &Path) -> Result<ImageFormat> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("png") => Ok(ImageFormat::Png),
+        Some("svg") => Ok(ImageFormat::Svg),
+        _ => bail!("plot file {} must end in .png or .svg", path.display()),
+    }
+}
+
+/// Draws `figure` into `path` (PNG or SVG by extension), atomically.
+pub fn save(path: &Path, figure: &impl Figure) -> Result<()> {
+    register_fonts();
+    let format = format_of(path)?;
+    let size = figure.size();
+    write_via_temp(path, |tmp| {
+        match format {
+            ImageFormat::Png => {
+                let root = BitMapBackend::new(tmp, size).into_drawing_area();
+                root.fill(&WHITE).map_err(crate::error::plot_err)?;
+                figure.draw(&root)?;
+                root.present().map_err(crate::error::plot_err)?;
+            }
+            ImageFormat::Svg => {
+                let root = SVGBackend::new(tmp, size).into_drawing_area();
+                root.fill(&WHITE).map_err(crate::error::plot_err)?;
+                figure.draw(&root)?;
+                root.present().map_err(crate::error::plot_err)?;
+            }
+        }
+        Ok(())
+    })
+}
+
+/// A text style in the embedded font.
+pub fn font(size: f64) -> TextStyle<'static> {
+    (FONT, size).into_font().into()
+}
+
+/// Padded `(min, max)` of finite values, or `fallback` if there are none.
+pub fn range(values: impl IntoIterator<Item = f64>, fallback: (f64, f64)) -> (f64, f64) {
+    let (lo, hi) = values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    if !lo.is_finite() {
+        return fallback;
+    }
+    let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.05 * lo.abs().max(1e-9) };
+    (lo - pad, hi + pad)
+}

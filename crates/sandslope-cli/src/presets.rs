@@ -1,0 +1,58 @@
+//! Built-in robots and terrains, embedded in the binary so they work from any directory.
+//!
+//! Each preset is a TOML file under `crates/sandslope-cli/presets/`, in exactly the format a
+//! user would write, and is parsed by the same code as a user's file.
+
+/// What a preset describes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PresetKind {
+    /// A robot file (MODEL.md section 2).
+    Robot,
+    /// A terrain file (MODEL.md section 7).
+    Terrain,
+}
+
+/// One built-in file.
+#[derive(Debug, Clone, Copy)]
+pub struct Preset {
+    /// Name used on the command line.
+    pub name: &'static str,
+    /// Robot or terrain.
+    pub kind: PresetKind,
+    /// One-line description.
+    pub summary: &'static str,
+    /// The TOML text.
+    pub toml: &'static str,
+}
+
+/// Default robot when `--robot` is omitted.
+pub const DEFAULT_ROBOT: &str = "paper-hexapod";
+/// Default terrain when `--terrain` is omitted.
+pub const DEFAULT_TERRAIN: &str = "glass-beads-300um";
+
+/// All built-in presets.
+pub const PRESETS: &[Preset] = &[
+    Preset {
+        name: "paper-hexapod",
+        kind: PresetKind::Robot,
+        summary: "0.35 kg C-leg hexapod of the paper (hip height 0.03 m and contact area W*R assumed)",
+        toml: include_str!("../presets/paper-hexapod.toml"),
+    },
+    Preset {
+        name: "glass-beads-300um",
+        kind: PresetKind::Terrain,
+        summary:
+            "300 um glass beads: k_n = 7e5 N/m^3 assumed, k_s calibrated on the paper's speeds (linear law)",
+        toml: include_str!("../presets/glass-beads-300um.toml"),
+    },
+];
+
+/// The preset called `name` of kind `kind`.
+pub fn find(name: &str, kind: PresetKind) -> Option<&'static Preset> {
+    PRESETS.iter().find(|p| p.name == name && p.kind == kind)
+}
+
+/// Names of the presets of one kind, comma-separated, for error messages.
+pub fn names(kind: PresetKind) -> String {
+    PRESETS.iter().filter(|p| p.kind == kind).map(|p| p.name).collect::<Vec<_>>().join(", ")
+}

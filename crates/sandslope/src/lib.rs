@@ -1,0 +1,50 @@
+//! # sandslope
+//!
+//! Whether, how fast and why a C-legged robot climbs a sand slope: the shear-anchoring model of
+//! Liao and Qian, "Failure Mechanisms and Risk Estimation for Legged Robot Locomotion on
+//! Granular Slopes" (arXiv:2603.06928), implemented exactly as the project's `MODEL.md`
+//! specifies, with the analysis around it.
+//!
+//! Slope weakens the sand's shear strength `k_s`, so each leg must dig deeper (to the
+//! shear-equilibrium depth `d_s`) before it anchors; the robot slips back until then
+//! (anchoring time `t1`), and its step and speed fall. Too weak in shear and the robot slips
+//! back (`Regime::Slippage`); too weak in normal support `k_n` and its legs sink
+//! (`Regime::Sinkage`).
+//!
+//! This crate is pure physics and analysis: no file formats, no plotting, no CLI. Types are
+//! validated once when built ([`Robot::new`], [`Terrain::new`], [`Slope::from_degrees`]) and
+//! trusted after.
+//!
+//! ```
+//! use sandslope::{predict, Ground, Regime, Robot, RobotSpec, Slope};
+//! let robot = Robot::new(RobotSpec {
+//!     mass_kg: 0.35, leg_radius_m: 0.04, leg_width_m: 0.01, hip_height_m: 0.03,
+//!     leg_speed_rad_s: std::f64::consts::TAU, stance_legs: 3, response_time_s: 0.2,
+//!     leg_contact_area_m2: None, level_step_m: None, min_step_m: None,
+//! }).unwrap();
+//! let p = predict(&robot, Slope::from_degrees(20.0).unwrap(), &Ground::new(7e5, 1e6).unwrap());
+//! assert_eq!(p.regime, Regime::Metastable);
+//! assert!(p.speed.unwrap() > 0.0);
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod calibrate;
+pub mod critical;
+pub mod error;
+pub mod model;
+pub mod regime;
+pub mod risk;
+pub mod robot;
+pub mod slope;
+pub mod terrain;
+
+pub use calibrate::{calibrate, Calibration, CalibrationError, LawParams, ShearLaw, SpeedObservation};
+pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
+pub use error::ParamError;
+pub use model::{predict, Prediction, G};
+pub use regime::{Cause, Regime};
+pub use risk::{regime_probabilities, RegimeProbabilities, Uncertainty};
+pub use robot::{Robot, RobotSpec};
+pub use slope::Slope;
+pub use terrain::{Ground, Terrain, TerrainPoint, TerrainSample, TerrainSpec};

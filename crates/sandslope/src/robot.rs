@@ -1,0 +1,213 @@
+//! The legged robot: C-leg geometry, gait and mass (MODEL.md section 2).
+//!
+//! A [`Robot`] can only hold values the model accepts; it is built from a [`RobotSpec`] (the
+//! plain, serialisable form with the exact file keys of MODEL.md) by [`Robot::new`], which
+//! checks every range once. The physics then trusts it.
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+use crate::error::{positive, ParamError};
+
+/// The robot as written in a file: the keys of MODEL.md section 2, unknown keys rejected.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RobotSpec {
+    /// Total mass m, kg.
+    pub mass_kg: f64,
+    /// C-leg radius R, m.
+    pub leg_radius_m: f64,
+    /// Leg width W, m.
+    pub leg_width_m: f64,
+    /// Hip height h: leg axle above the undisturbed sand surface when the body rests on it, m.
+    pub hip_height_m: f64,
+    /// Leg angular speed omega, rad/s.
+    pub leg_speed_rad_s: f64,
+    /// Legs in stance at once, n.
+    pub stance_legs: u32,
+    /// Characteristic elastic response time dt, s.
+    pub response_time_s: f64,
+    /// Effective leg area A_c for normal support, m^2; default `W * R` (a MODEL.md choice).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leg_contact_area_m2: Option<f64>,
+    /// Measured level-sand step length s*, m; derived from the geometry when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub level_step_m: Option<f64>,
+    /// Step length s_min that counts as robust progress, m; default `R`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_step_m: Option<f64>,
+}
+
+/// A validated robot. Build it with [`Robot::new`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Robot {
+    spec: RobotSpec,
+    contact_area: f64,
+    min_step: f64,
+}
+
+impl Robot {
+    /// Validates `spec` (MODEL.md section 2): m, R, W, omega, dt, A_c > 0; n >= 1;
+    /// `0 <= h <= 2R`; `level_step_m` and `min_step_m`, when given, > 0.
+    pub fn new(spec: RobotSpec) -> Result<Robot, ParamError> {
+        positive("mass_kg", spec.mass_kg)?;
+        let r = positive("leg_radius_m", spec.leg_radius_m)?;
+        positive("leg_width_m", spec.leg_width_m)?;
+        positive("leg_speed_rad_s", spec.leg_speed_rad_s)?;
+        positive("response_time_s", spec.response_time_s)?;
+        if spec.stance_legs < 1 {
+            return Err(ParamError::new(
+                "stance_legs",
+                f64::from(spec.stance_legs),
+                "a whole number of at least 1",
+            ));
+        }
+        let h = spec.hip_height_m;
+        if !(h.is_finite() && (0.0..=2.0 * r).contains(&h)) {
+            return Err(ParamError::new(
+                "hip_height_m",
+                h,
+                format!("between 0 and 2 * leg_radius_m = {}", 2.0 * r),
+            ));
+        }
+        let contact_area = match spec.leg_contact_area_m2 {
+            Some(a) => positive("leg_contact_area_m2", a)?,
+            None => spec.leg_width_m * r,
+        };
+        if let Some(s) = spec.level_step_m {
+            positive("level_step_m", s)?;
+        }
+        let min_step = match spec.min_step_m {
+            Some(s) => positive("min_step_m", s)?,
+            None => r,
+        };
+        Ok(Robot { spec, contact_area, min_step })
+    }
+
+    /// The same robot with another total mass (e.g. carrying a payload).
+    pub fn with_mass(&self, mass_kg: f64) -> Result<Robot, ParamError> {
+        Robot::new(RobotSpec { mass_kg, ..self.spec.clone() })
+    }
+
+    /// The plain, serialisable form of this robot (as it was given, defaults not filled in).
+    pub fn spec(&self) -> &RobotSpec {
+        &self.spec
+    }
+
+    /// Total mass m, kg.
+    pub fn mass(&self) -> f64 {
+        self.spec.mass_kg
+    }
+    /// C-leg radius R, m.
+    pub fn leg_radius(&self) -> f64 {
+        self.spec.leg_radius_m
+    }
+    /// Leg width W, m.
+    pub fn leg_width(&self) -> f64 {
+        self.spec.leg_width_m
+    }
+    /// Hip height h, m.
+    pub fn hip_height(&self) -> f64 {
+        self.spec.hip_height_m
+    }
+    /// Leg angular speed omega, rad/s.
+    pub fn leg_speed(&self) -> f64 {
+        self.spec.leg_speed_rad_s
+    }
+    /// Legs in stance at once, n.
+    pub fn stance_legs(&self) -> u32 {
+        self.spec.stance_legs
+    }
+    /// Elastic response time dt, s.
+    pub fn response_time(&self) -> f64 {
+        self.spec.response_time_s
+    }
+    /// Effective contact area A_c, m^2 (`W * R` unless given).
+    pub fn contact_area(&self) -> f64 {
+        self.contact_area
+    }
+    /// Measured level-sand step s*, m, if the file gives one.
+    pub fn measured_level_step(&self) -> Option<f64> {
+        self.spec.level_step_m
+    }
+    /// Robust-progress step length s_min, m (`R` unless given).
+    pub fn min_step(&self) -> f64 {
+        self.min_step
+    }
+
+    /// Stride period `T = 2 pi / omega`, s.
+    pub fn stride_period(&self) -> f64 {
+        2.0 * PI / self.spec.leg_speed_rad_s
+    }
+
+    /// Stance duration of one tripod, `T / 2`, s: one step.
+    pub fn stance_duration(&self) -> f64 {
+        0.5 * self.stride_period()
+    }
+
+    /// Deepest reach of a leg below the surface, `d_max = 2R - h`, m.
+    pub fn max_depth(&self) -> f64 {
+        2.0 * self.spec.leg_radius_m - self.spec.hip_height_m
+    }
+
+    /// Touchdown angle `phi0 = asin((h - R) / R)`, rad, so that the leg depth is 0 at touchdown.
+    pub fn touchdown_angle(&self) -> f64 {
+        let r = self.spec.leg_radius_m;
+        ((self.spec.hip_height_m - r) / r).clamp(-1.0, 1.0).asin()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn paper_spec() -> RobotSpec {
+        RobotSpec {
+            mass_kg: 0.35,
+            leg_radius_m: 0.04,
+            leg_width_m: 0.01,
+            hip_height_m: 0.03,
+            leg_speed_rad_s: 2.0 * PI,
+            stance_legs: 3,
+            response_time_s: 0.2,
+            leg_contact_area_m2: None,
+            level_step_m: None,
+            min_step_m: None,
+        }
+    }
+
+    #[test]
+    fn derived_quantities() {
+        let r = Robot::new(paper_spec()).unwrap();
+        assert!((r.stride_period() - 1.0).abs() < 1e-12);
+        assert!((r.max_depth() - 0.05).abs() < 1e-12);
+        assert!((r.contact_area() - 4e-4).abs() < 1e-15);
+        assert_eq!(r.min_step(), 0.04);
+        // asin(-0.25) = -0.252680...
+        assert!((r.touchdown_angle() + 0.252_680_255_142_078_6).abs() < 1e-12);
+    }
+
+    #[test]
+    fn hip_height_message_names_range() {
+        let e = Robot::new(RobotSpec { hip_height_m: 0.09, ..paper_spec() }).unwrap_err();
+        assert_eq!(e.to_string(), "hip_height_m = 0.09 must be between 0 and 2 * leg_radius_m = 0.08");
+    }
+
+    #[test]
+    fn rejects_each_non_positive_parameter() {
+        let bad = [
+            RobotSpec { mass_kg: 0.0, ..paper_spec() },
+            RobotSpec { leg_radius_m: -0.04, ..paper_spec() },
+            RobotSpec { leg_width_m: f64::NAN, ..paper_spec() },
+            RobotSpec { leg_speed_rad_s: 0.0, ..paper_spec() },
+            RobotSpec { response_time_s: f64::INFINITY, ..paper_spec() },
+            RobotSpec { stance_legs: 0, ..paper_spec() },
+            RobotSpec { leg_contact_area_m2: Some(0.0), ..paper_spec() },
+            RobotSpec { level_step_m: Some(-1.0), ..paper_spec() },
+            RobotSpec { min_step_m: Some(0.0), ..paper_spec() },
+        ];
+        for spec in bad {
+            assert!(Robot::new(spec.clone()).is_err(), "{spec:?} accepted");
+        }
+    }
+}

@@ -1,0 +1,82 @@
+//! The inclination of the sand surface along the direction of travel (MODEL.md section 1).
+//!
+//! Angles are degrees only at the edges of the program; inside, a [`Slope`] carries radians.
+//! The model covers climbing, so a `Slope` is in `[0, 90)` degrees; descending travel is
+//! mapped onto it by the caller (MODEL.md section 8 evaluates descent with `|theta|`).
+
+use crate::error::ParamError;
+
+/// An inclination in `[0, 90)` degrees, stored in radians.
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
+pub struct Slope {
+    radians: f64,
+}
+
+impl Slope {
+    /// Level ground.
+    pub const LEVEL: Slope = Slope { radians: 0.0 };
+
+    /// A slope from degrees; fails unless `0 <= degrees < 90`.
+    pub fn from_degrees(degrees: f64) -> Result<Slope, ParamError> {
+        if degrees.is_finite() && (0.0..90.0).contains(&degrees) {
+            Ok(Slope { radians: degrees.to_radians() })
+        } else {
+            Err(ParamError::new("slope_deg", degrees, "between 0 and 90 degrees (90 excluded)"))
+        }
+    }
+
+    /// A slope from radians; fails unless `0 <= radians < pi/2`.
+    pub fn from_radians(radians: f64) -> Result<Slope, ParamError> {
+        Slope::from_degrees(radians.to_degrees()).map(|_| Slope { radians }).map_err(|e| ParamError {
+            value: radians,
+            expected: "between 0 and pi/2 radians (pi/2 excluded)".into(),
+            ..e
+        })
+    }
+
+    /// The slope felt when travelling with signed inclination `degrees`: descending
+    /// (`degrees < 0`) is evaluated as climbing `|degrees|` (MODEL.md section 8, a choice).
+    pub fn from_signed_degrees(degrees: f64) -> Result<Slope, ParamError> {
+        Slope::from_degrees(degrees.abs()).map_err(|e| ParamError {
+            value: degrees,
+            expected: "strictly between -90 and 90 degrees".into(),
+            ..e
+        })
+    }
+
+    /// The inclination in radians.
+    pub fn radians(self) -> f64 {
+        self.radians
+    }
+
+    /// The inclination in degrees.
+    pub fn degrees(self) -> f64 {
+        self.radians.to_degrees()
+    }
+
+    /// `sin(theta)`.
+    pub fn sin(self) -> f64 {
+        self.radians.sin()
+    }
+
+    /// `cos(theta)`.
+    pub fn cos(self) -> f64 {
+        self.radians.cos()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn degrees_round_trip_and_range() {
+        let s = Slope::from_degrees(30.0).unwrap();
+        assert!((s.sin() - 0.5).abs() < 1e-12);
+        assert!((s.degrees() - 30.0).abs() < 1e-12);
+        assert!(Slope::from_degrees(-1.0).is_err());
+        assert!(Slope::from_degrees(90.0).is_err());
+        assert!(Slope::from_degrees(f64::NAN).is_err());
+        assert_eq!(Slope::from_signed_degrees(-12.0).unwrap(), Slope::from_degrees(12.0).unwrap());
+    }
+}

@@ -1,0 +1,268 @@
+//! Terrain resistance as a function of slope (MODEL.md section 7).
+//!
+//! A terrain is a table of measured points `(slope_deg, k_n, k_s)` with optional standard
+//! deviations, an optional angle of repose and an optional name. Between points values are
+//! interpolated linearly in degrees; below the first point the first point holds; above the
+//! last point the last segment is extended linearly and floored at zero, and the sample says
+//! it was extrapolated so the caller can warn (a MODEL.md choice).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{positive, ParamError};
+use crate::slope::Slope;
+
+/// One measured point as written in a terrain file; unknown keys rejected.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TerrainPoint {
+    /// Slope at which the point was measured, degrees.
+    pub slope_deg: f64,
+    /// Normal penetration resistance k_n, N/m^3.
+    pub k_n: f64,
+    /// Shear strength k_s, N/m^3.
+    pub k_s: f64,
+    /// Standard deviation of k_n across trials, N/m^3.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k_n_sd: Option<f64>,
+    /// Standard deviation of k_s across trials, N/m^3.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k_s_sd: Option<f64>,
+}
+
+/// A terrain file: the keys of MODEL.md section 7, unknown keys rejected.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TerrainSpec {
+    /// A human-readable name.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Angle of repose, degrees: at or above it the surface yields (regime slippage).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repose_deg: Option<f64>,
+    /// Measured points, at distinct slopes.
+    pub points: Vec<TerrainPoint>,
+}
+
+/// The ground under the robot at one slope: the inputs of the model besides robot and slope.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ground {
+    /// Normal penetration resistance k_n, N/m^3 (0 means no support at any depth).
+    pub k_n: f64,
+    /// Shear strength k_s, N/m^3 (0 means no anchoring at any depth).
+    pub k_s: f64,
+    /// Angle of repose of the terrain, if known.
+    pub repose: Option<Slope>,
+}
+
+impl Ground {
+    /// Ground with resistances `k_n`, `k_s` (finite, >= 0) and no known angle of repose.
+    pub fn new(k_n: f64, k_s: f64) -> Result<Ground, ParamError> {
+        crate::error::non_negative("k_n", k_n)?;
+        crate::error::non_negative("k_s", k_s)?;
+        Ok(Ground { k_n, k_s, repose: None })
+    }
+
+    /// The same ground with an angle of repose.
+    pub fn with_repose(self, repose: Option<Slope>) -> Ground {
+        Ground { repose, ..self }
+    }
+
+    /// Whether `slope` is at or above the angle of repose.
+    pub fn beyond_repose(&self, slope: Slope) -> bool {
+        self.repose.is_some_and(|r| slope.radians() >= r.radians())
+    }
+}
+
+/// The terrain looked up at one slope.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TerrainSample {
+    /// Resistances (and repose) at this slope.
+    pub ground: Ground,
+    /// Interpolated standard deviation of k_n, if the table has them.
+    pub k_n_sd: Option<f64>,
+    /// Interpolated standard deviation of k_s, if the table has them.
+    pub k_s_sd: Option<f64>,
+    /// True when the slope is above the last measured point (values extrapolated).
+    pub extrapolated: bool,
+}
+
+/// A validated terrain table, points sorted by slope. Build it with [`Terrain::new`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Terrain {
+    spec: TerrainSpec,
+    repose: Option<Slope>,
+}
+
+impl Terrain {
+    /// Validates a terrain: at least one point; slopes in `[0, 90)` and distinct; k_n, k_s > 0;
+    /// SDs >= 0; `repose_deg` in `(0, 90)`. Points are sorted by slope.
+    pub fn new(mut spec: TerrainSpec) -> Result<Terrain, ParamError> {
+        if spec.points.is_empty() {
+            return Err(ParamError::new("points", 0.0, "at least one [[points]] entry"));
+        }
+        for (i, p) in spec.points.iter().enumerate() {
+            let key = |k: &str| format!("points[{i}].{k}");
+            Slope::from_degrees(p.slope_deg).map_err(|e| e.renamed(key("slope_deg")))?;
+            positive(&key("k_n"), p.k_n)?;
+            positive(&key("k_s"), p.k_s)?;
+            for (name, sd) in [("k_n_sd", p.k_n_sd), ("k_s_sd", p.k_s_sd)] {
+                if let Some(sd) = sd {
+                    crate::error::non_negative(&key(name), sd)?;
+                }
+            }
+        }
+        spec.points.sort_by(|a, b| a.slope_deg.total_cmp(&b.slope_deg));
+        for w in spec.points.windows(2) {
+            if w[0].slope_deg == w[1].slope_deg {
+                return Err(ParamError::new(
+                    "points.slope_deg",
+                    w[1].slope_deg,
+                    "distinct: two points share this slope",
+                ));
+            }
+        }
+        let repose = match spec.repose_deg {
+            None => None,
+            Some(r) => match Slope::from_degrees(r) {
+                Ok(s) if r > 0.0 => Some(s),
+                _ => return Err(ParamError::new("repose_deg", r, "strictly between 0 and 90 degrees")),
+            },
+        };
+        Ok(Terrain { spec, repose })
+    }
+
+    /// One point everywhere: constant k_n and k_s at every slope.
+    pub fn constant(k_n: f64, k_s: f64) -> Result<Terrain, ParamError> {
+        Terrain::new(TerrainSpec {
+            name: None,
+            repose_deg: None,
+            points: vec![TerrainPoint { slope_deg: 0.0, k_n, k_s, k_n_sd: None, k_s_sd: None }],
+        })
+    }
+
+    /// The plain, serialisable form (points sorted by slope).
+    pub fn spec(&self) -> &TerrainSpec {
+        &self.spec
+    }
+
+    /// The terrain's name, if it has one.
+    pub fn name(&self) -> Option<&str> {
+        self.spec.name.as_deref()
+    }
+
+    /// The angle of repose, if known.
+    pub fn repose(&self) -> Option<Slope> {
+        self.repose
+    }
+
+    /// The measured points, sorted by slope.
+    pub fn points(&self) -> &[TerrainPoint] {
+        &self.spec.points
+    }
+
+    /// Whether every point carries both standard deviations.
+    pub fn has_uncertainty(&self) -> bool {
+        self.spec.points.iter().all(|p| p.k_n_sd.is_some() && p.k_s_sd.is_some())
+    }
+
+    /// The terrain at `slope`, by the interpolation rule of MODEL.md section 7.
+    pub fn sample(&self, slope: Slope) -> TerrainSample {
+        let pts = &self.spec.points;
+        let deg = slope.degrees();
+        let first = &pts[0];
+        let last = &pts[pts.len() - 1];
+        // Pick the segment (a, b) and whether we are extrapolating beyond the last point.
+        let (a, b, extrapolated) = if pts.len() == 1 || deg <= first.slope_deg {
+            (first, first, false)
+        } else if deg > last.slope_deg {
+            (&pts[pts.len() - 2], last, true)
+        } else {
+            let i = pts.partition_point(|p| p.slope_deg < deg).max(1);
+            (&pts[i - 1], &pts[i], false)
+        };
+        let frac =
+            if b.slope_deg > a.slope_deg { (deg - a.slope_deg) / (b.slope_deg - a.slope_deg) } else { 0.0 };
+        let lerp = |x: f64, y: f64| (x + frac * (y - x)).max(0.0);
+        let lerp_opt = |x: Option<f64>, y: Option<f64>| match (x, y) {
+            (Some(x), Some(y)) => Some(lerp(x, y)),
+            _ => None,
+        };
+        TerrainSample {
+            ground: Ground { k_n: lerp(a.k_n, b.k_n), k_s: lerp(a.k_s, b.k_s), repose: self.repose },
+            k_n_sd: lerp_opt(a.k_n_sd, b.k_n_sd),
+            k_s_sd: lerp_opt(a.k_s_sd, b.k_s_sd),
+            extrapolated: extrapolated && pts.len() > 1,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pt(slope_deg: f64, k_n: f64, k_s: f64) -> TerrainPoint {
+        TerrainPoint { slope_deg, k_n, k_s, k_n_sd: None, k_s_sd: None }
+    }
+
+    fn two_point() -> Terrain {
+        Terrain::new(TerrainSpec {
+            name: None,
+            repose_deg: Some(25.0),
+            points: vec![pt(20.0, 6e5, 1e6), pt(0.0, 7e5, 2e6)],
+        })
+        .unwrap()
+    }
+
+    fn at(t: &Terrain, deg: f64) -> TerrainSample {
+        t.sample(Slope::from_degrees(deg).unwrap())
+    }
+
+    #[test]
+    fn interpolates_linearly_in_degrees() {
+        let t = two_point();
+        // Halfway: (2e6 + 1e6)/2 and (7e5 + 6e5)/2.
+        let s = at(&t, 10.0);
+        assert!((s.ground.k_s - 1.5e6).abs() < 1e-6);
+        assert!((s.ground.k_n - 6.5e5).abs() < 1e-6);
+        assert!(!s.extrapolated);
+    }
+
+    #[test]
+    fn holds_first_point_below_and_extrapolates_above_with_floor() {
+        let t = Terrain::new(TerrainSpec {
+            name: None,
+            repose_deg: None,
+            points: vec![pt(5.0, 7e5, 2e6), pt(15.0, 7e5, 1e6)],
+        })
+        .unwrap();
+        assert_eq!(at(&t, 0.0).ground.k_s, 2e6);
+        // Slope of -1e5 per degree beyond 15: at 20 deg 5e5, flagged.
+        let s = at(&t, 20.0);
+        assert!((s.ground.k_s - 5e5).abs() < 1e-6);
+        assert!(s.extrapolated);
+        // At 40 deg the line is negative: floored at zero.
+        assert_eq!(at(&t, 40.0).ground.k_s, 0.0);
+    }
+
+    #[test]
+    fn single_point_is_constant() {
+        let t = Terrain::constant(7e5, 2e6).unwrap();
+        for d in [0.0, 10.0, 60.0] {
+            let s = at(&t, d);
+            assert_eq!((s.ground.k_n, s.ground.k_s, s.extrapolated), (7e5, 2e6, false));
+        }
+    }
+
+    #[test]
+    fn rejects_bad_tables() {
+        let none = TerrainSpec { name: None, repose_deg: None, points: vec![] };
+        assert!(Terrain::new(none).is_err());
+        let dup =
+            TerrainSpec { name: None, repose_deg: None, points: vec![pt(5.0, 1.0, 1.0), pt(5.0, 2.0, 2.0)] };
+        assert!(Terrain::new(dup).is_err());
+        let neg = TerrainSpec { name: None, repose_deg: None, points: vec![pt(5.0, -1.0, 1.0)] };
+        assert_eq!(Terrain::new(neg).unwrap_err().key, "points[0].k_n");
+        let rep = TerrainSpec { name: None, repose_deg: Some(0.0), points: vec![pt(5.0, 1.0, 1.0)] };
+        assert_eq!(Terrain::new(rep).unwrap_err().key, "repose_deg");
+    }
+}

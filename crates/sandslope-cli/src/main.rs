@@ -25,6 +25,10 @@ struct Cli {
 enum Command {
     /// Every model quantity (d_n, s*, d_s, t1, slip, step, speed, regime) at one slope.
     Predict(commands::predict::PredictArgs),
+    /// The model over a range of slopes (table, JSON, CSV, or a three-panel figure).
+    Sweep(commands::sweep::SweepArgs),
+    /// Fit k_s(theta) so the model's speeds match observed ones; write a terrain file.
+    Calibrate(commands::calibrate::CalibrateArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
 }
@@ -32,6 +36,8 @@ enum Command {
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Predict(a) => commands::predict::run(a),
+        Command::Sweep(a) => commands::sweep::run(a),
+        Command::Calibrate(a) => commands::calibrate::run(a),
         Command::Presets(a) => commands::presets::run(a),
     }
 }

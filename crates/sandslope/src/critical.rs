@@ -92,7 +92,7 @@ pub fn critical_shear_strength(
 ) -> Result<f64, NoShearSuffices> {
     let d_n = normal_equilibrium_depth(robot, slope, k_n);
     let d_max = robot.max_depth();
-    if !(d_n < d_max) {
+    if d_n >= d_max {
         return Err(NoShearSuffices::Sinkage { d_n, d_max });
     }
     if beyond_repose {

@@ -84,7 +84,7 @@ pub fn leg_depth(robot: &Robot, t: f64) -> f64 {
 ///
 /// `None` when `d_s > d_max`: the leg never reaches shear equilibrium in this stance.
 pub fn anchoring_time(robot: &Robot, d_s: f64) -> Option<f64> {
-    if !(d_s <= robot.max_depth()) {
+    if d_s > robot.max_depth() || d_s.is_nan() {
         return None;
     }
     let r = robot.leg_radius();

@@ -1,25 +1,28 @@
 //! The inclination of the sand surface along the direction of travel (MODEL.md section 1).
 //!
-//! Angles are degrees only at the edges of the program; inside, a [`Slope`] carries radians.
+//! Angles are degrees only at the edges of the program; a [`Slope`] is built
+//! from degrees and gives radians, sine and cosine to the physics.
 //! The model covers climbing, so a `Slope` is in `[0, 90)` degrees; descending travel is
 //! mapped onto it by the caller (MODEL.md section 8 evaluates descent with `|theta|`).
 
 use crate::error::ParamError;
 
-/// An inclination in `[0, 90)` degrees, stored in radians.
+/// An inclination in `[0, 90)` degrees.
+///
+/// Stored in degrees, the unit users give, so that a slope prints back exactly as entered.
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
 pub struct Slope {
-    radians: f64,
+    degrees: f64,
 }
 
 impl Slope {
     /// Level ground.
-    pub const LEVEL: Slope = Slope { radians: 0.0 };
+    pub const LEVEL: Slope = Slope { degrees: 0.0 };
 
     /// A slope from degrees; fails unless `0 <= degrees < 90`.
     pub fn from_degrees(degrees: f64) -> Result<Slope, ParamError> {
         if degrees.is_finite() && (0.0..90.0).contains(&degrees) {
-            Ok(Slope { radians: degrees.to_radians() })
+            Ok(Slope { degrees })
         } else {
             Err(ParamError::new("slope_deg", degrees, "between 0 and 90 degrees (90 excluded)"))
         }
@@ -27,7 +30,7 @@ impl Slope {
 
     /// A slope from radians; fails unless `0 <= radians < pi/2`.
     pub fn from_radians(radians: f64) -> Result<Slope, ParamError> {
-        Slope::from_degrees(radians.to_degrees()).map(|_| Slope { radians }).map_err(|e| ParamError {
+        Slope::from_degrees(radians.to_degrees()).map_err(|e| ParamError {
             value: radians,
             expected: "between 0 and pi/2 radians (pi/2 excluded)".into(),
             ..e
@@ -46,22 +49,22 @@ impl Slope {
 
     /// The inclination in radians.
     pub fn radians(self) -> f64 {
-        self.radians
+        self.degrees.to_radians()
     }
 
     /// The inclination in degrees.
     pub fn degrees(self) -> f64 {
-        self.radians.to_degrees()
+        self.degrees
     }
 
     /// `sin(theta)`.
     pub fn sin(self) -> f64 {
-        self.radians.sin()
+        self.radians().sin()
     }
 
     /// `cos(theta)`.
     pub fn cos(self) -> f64 {
-        self.radians.cos()
+        self.radians().cos()
     }
 }
 

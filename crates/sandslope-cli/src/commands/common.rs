@@ -17,7 +17,7 @@ pub struct RobotArgs {
     #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_ROBOT)]
     pub robot: String,
     /// Override the robot's total mass, kg.
-    #[arg(long, value_name = "KG")]
+    #[arg(long, value_name = "KG", allow_negative_numbers = true)]
     pub mass: Option<f64>,
 }
 
@@ -51,10 +51,10 @@ impl TerrainArgs {
 #[derive(Debug, Clone, Copy, Args)]
 pub struct OverrideArgs {
     /// Normal penetration resistance k_n, N/m^3, instead of the terrain's.
-    #[arg(long = "k-n", value_name = "N/M^3")]
+    #[arg(long = "k-n", value_name = "N/M^3", allow_negative_numbers = true)]
     pub k_n: Option<f64>,
     /// Shear strength k_s, N/m^3, instead of the terrain's.
-    #[arg(long = "k-s", value_name = "N/M^3")]
+    #[arg(long = "k-s", value_name = "N/M^3", allow_negative_numbers = true)]
     pub k_s: Option<f64>,
 }
 

@@ -71,7 +71,14 @@ pub fn run(args: SweepArgs) -> Result<()> {
         warn_extrapolated(&scenario.terrain, &extrapolated);
     }
     if let Some(path) = &args.plot {
-        plot::save(path, &SweepFigure { evals: &evals, observed: observed.as_deref().unwrap_or(&[]) })?;
+        let observed = observed.as_deref().unwrap_or(&[]);
+        let figure = SweepFigure {
+            evals: &evals,
+            observed,
+            min_step_m: scenario.robot.min_step(),
+            repose_deg: scenario.terrain.repose().map(|r| r.degrees()),
+        };
+        plot::save(path, &figure)?;
     }
     let records: Vec<PredictionRecord> = evals.iter().map(PredictionRecord::from).collect();
     match args.format.format() {
@@ -114,6 +121,8 @@ pub fn run(args: SweepArgs) -> Result<()> {
 struct SweepFigure<'a> {
     evals: &'a [Evaluation],
     observed: &'a [SpeedObservation],
+    min_step_m: f64,
+    repose_deg: Option<f64>,
 }
 
 impl Figure for SweepFigure<'_> {
@@ -144,42 +153,67 @@ impl Figure for SweepFigure<'_> {
                 .chain([0.0]),
             (0.0, 16.0),
         );
-        draw_panel(
-            &panels[0],
-            "Step-averaged speed",
-            "speed v (cm/s)",
-            x_range,
-            speed_range,
-            &x,
-            &speed,
-            &obs,
-        )?;
+        let upper = SeriesLabelPosition::UpperRight;
+        let panel =
+            Panel { x_range, x: &x, observed: &[], reference: None, legend: upper, repose: self.repose_deg };
+        let speed_panel = Panel { observed: &obs, ..panel.clone() };
+        draw_panel(&panels[0], "Step-averaged speed", "speed v (cm/s)", speed_range, &speed, &speed_panel)?;
         let t1: Vec<Option<f64>> =
             self.evals.iter().map(|e| e.prediction.anchoring_time.map(|t| t * 1e3)).collect();
         let t1_range = plot::range(t1.iter().flatten().copied().chain([0.0]), (0.0, 500.0));
-        draw_panel(&panels[1], "Anchoring time", "anchoring time t1 (ms)", x_range, t1_range, &x, &t1, &[])?;
+        let lower = SeriesLabelPosition::LowerRight;
+        draw_panel(
+            &panels[1],
+            "Anchoring time",
+            "anchoring time t1 (ms)",
+            t1_range,
+            &t1,
+            &Panel { legend: lower, ..panel.clone() },
+        )?;
         let step: Vec<Option<f64>> = self.evals.iter().map(|e| e.prediction.step.map(|s| s * 1e3)).collect();
-        let step_range = plot::range(step.iter().flatten().copied().chain([0.0]), (0.0, 80.0));
-        draw_panel(&panels[2], "Net step length", "net step s (mm)", x_range, step_range, &x, &step, &[])?;
+        let s_min = self.min_step_m * 1e3;
+        let step_range = plot::range(step.iter().flatten().copied().chain([0.0, s_min]), (0.0, 80.0));
+        let reference = Some((s_min, "s_min: success above, metastable below"));
+        draw_panel(
+            &panels[2],
+            "Net step length",
+            "net step s (mm)",
+            step_range,
+            &step,
+            &Panel { reference, ..panel },
+        )?;
         Ok(())
     }
 }
 
-/// One panel: the model curve (gaps where undefined) and optional observations with error bars.
-#[allow(clippy::too_many_arguments)]
+/// What the three panels share, and what each may add.
+#[derive(Clone)]
+struct Panel<'a> {
+    x_range: (f64, f64),
+    x: &'a [f64],
+    /// Observations `(slope, value, sd)` drawn with error bars.
+    observed: &'a [(f64, f64, f64)],
+    /// A dashed horizontal reference line and its label.
+    reference: Option<(f64, &'a str)>,
+    legend: SeriesLabelPosition,
+    /// The terrain's angle of repose: slopes at or above it are shaded (regime slippage).
+    repose: Option<f64>,
+}
+
+/// One panel: the model curve (gaps where undefined), an optional reference line and optional
+/// observations with error bars.
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     title: &str,
     y_label: &str,
-    x_range: (f64, f64),
     y_range: (f64, f64),
-    x: &[f64],
     y: &[Option<f64>],
-    observed: &[(f64, f64, f64)],
+    panel: &Panel<'_>,
 ) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
+    let (x_range, x, observed) = (panel.x_range, panel.x, panel.observed);
     let mut chart = ChartBuilder::on(area)
         .caption(title, font(22.0))
         .margin(12)
@@ -204,6 +238,30 @@ where
             None if !segments.last().expect("non-empty").is_empty() => segments.push(Vec::new()),
             None => {}
         }
+    }
+    if let Some(repose) = panel.repose.filter(|r| *r < x_range.1) {
+        let shade = RGBColor(200, 200, 200).mix(0.45);
+        chart
+            .draw_series([Rectangle::new(
+                [(repose.max(x_range.0), y_range.0), (x_range.1, y_range.1)],
+                shade.filled(),
+            )])
+            .map_err(plot_err)?
+            .label("at or above the angle of repose: slippage")
+            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+    }
+    if let Some((level, label)) = panel.reference {
+        let grey = RGBColor(90, 90, 90);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x_range.0, level), (x_range.1, level)],
+                8,
+                5,
+                grey.stroke_width(2),
+            ))
+            .map_err(plot_err)?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(2)));
     }
     let mut first = true;
     for seg in segments.into_iter().filter(|s| !s.is_empty()) {
@@ -236,7 +294,7 @@ where
         .label_font(font(15.0))
         .border_style(BLACK)
         .background_style(WHITE.mix(0.85))
-        .position(SeriesLabelPosition::UpperRight)
+        .position(panel.legend.clone())
         .draw()
         .map_err(plot_err)?;
     Ok(())

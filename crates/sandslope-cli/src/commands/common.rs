@@ -5,7 +5,9 @@ use anyhow::{anyhow, Result};
 use clap::Args;
 use serde::Serialize;
 
-use sandslope::{critical_shear_strength, predict, Ground, Prediction, Robot, Slope, StepTarget, Terrain};
+use sandslope::{
+    critical_shear_strength, predict, Ground, NoShearSuffices, Prediction, Robot, Slope, StepTarget, Terrain,
+};
 
 use crate::inputs::{check_positive, load_robot, load_terrain};
 use crate::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
@@ -92,24 +94,23 @@ impl Scenario {
         let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
         let (ground, extrapolated) = self.ground_at(slope);
         let prediction = predict(&self.robot, slope, &ground);
-        let critical = critical_shear_strength(
-            &self.robot,
-            slope,
-            ground.k_n,
-            ground.beyond_repose(slope),
-            StepTarget::Progress,
-        );
+        let critical = |target| {
+            critical_shear_strength(&self.robot, slope, ground.k_n, ground.beyond_repose(slope), target)
+        };
+        let (progress, robust) = (critical(StepTarget::Progress), critical(StepTarget::Robust));
         Ok(Evaluation {
             slope_deg,
             prediction,
-            k_s_margin: critical.ok().map(|k| ground.k_s / k),
+            k_s_margin: progress.as_ref().ok().map(|k| ground.k_s / k),
+            critical_progress: progress,
+            critical_robust: robust,
             extrapolated,
         })
     }
 }
 
 /// The model's answer at one slope, with what the CLI reports beside it.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Evaluation {
     /// The slope as the user gave it (negative: descending).
     pub slope_deg: f64,
@@ -117,6 +118,10 @@ pub struct Evaluation {
     pub prediction: Prediction,
     /// `k_s / critical k_s for s > 0`; `None` when no k_s is enough.
     pub k_s_margin: Option<f64>,
+    /// Smallest k_s giving progress (`s > 0`), or why none does.
+    pub critical_progress: Result<f64, NoShearSuffices>,
+    /// Smallest k_s giving robust progress (`s >= s_min`), or why none does.
+    pub critical_robust: Result<f64, NoShearSuffices>,
     /// Whether the terrain was extrapolated beyond its last point.
     pub extrapolated: bool,
 }

@@ -46,6 +46,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
         Format::Table => {
             let p = &e.prediction;
             let mm = |x: Option<f64>| num(x.map(|v| v * 1e3), 2);
+            let crit = |c: &Result<f64, _>| c.as_ref().map_or_else(|_| "none".to_string(), |k| sci(*k));
             let mut t = table(&["quantity", "value", "unit"]);
             let rows: Vec<[String; 3]> = vec![
                 ["slope".into(), format!("{}", args.slope), "deg".into()],
@@ -59,7 +60,13 @@ pub fn run(args: PredictArgs) -> Result<()> {
                 ["propulsion s2".into(), mm(p.propulsion), "mm".into()],
                 ["net step s".into(), mm(p.step), "mm".into()],
                 ["speed v".into(), num(p.speed.map(|v| v * 100.0), 2), "cm/s".into()],
-                ["k_s margin (k_s / critical k_s)".into(), num(e.k_s_margin, 2), "".into()],
+                ["critical k_s for progress (s > 0)".into(), crit(&e.critical_progress), "N/m^3".into()],
+                [
+                    "critical k_s for robust progress (s >= s_min)".into(),
+                    crit(&e.critical_robust),
+                    "N/m^3".into(),
+                ],
+                ["k_s margin (k_s / critical k_s for progress)".into(), num(e.k_s_margin, 2), "".into()],
                 ["regime".into(), p.regime.name().into(), "".into()],
             ];
             for r in rows {
@@ -67,6 +74,11 @@ pub fn run(args: PredictArgs) -> Result<()> {
             }
             println!("{t}");
             println!("{}: {}", p.regime, p.cause.explain());
+            for (what, c) in [("progress", &e.critical_progress), ("robust progress", &e.critical_robust)] {
+                if let Err(why) = c {
+                    println!("{what}: {why}");
+                }
+            }
             Ok(())
         }
     }

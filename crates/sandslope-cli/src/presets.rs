@@ -56,3 +56,27 @@ pub fn find(name: &str, kind: PresetKind) -> Option<&'static Preset> {
 pub fn names(kind: PresetKind) -> String {
     PRESETS.iter().filter(|p| p.kind == kind).map(|p| p.name).collect::<Vec<_>>().join(", ")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_preset_parses_and_validates() {
+        for p in PRESETS {
+            let source = crate::inputs::Source::Preset(p.name);
+            let ok = match p.kind {
+                PresetKind::Robot => crate::inputs::robot_from_toml(p.toml, &source).is_ok(),
+                PresetKind::Terrain => crate::inputs::terrain_from_toml(p.toml, &source).is_ok(),
+            };
+            assert!(ok, "preset {} does not load", p.name);
+        }
+    }
+
+    #[test]
+    fn paper_hexapod_preset_is_the_library_robot() {
+        let spec: sandslope::RobotSpec =
+            toml::from_str(find("paper-hexapod", PresetKind::Robot).unwrap().toml).unwrap();
+        assert_eq!(spec, sandslope::RobotSpec::paper_hexapod());
+    }
+}

@@ -193,19 +193,7 @@ pub(crate) mod tests {
     use std::f64::consts::PI;
 
     pub(crate) fn paper_robot() -> Robot {
-        Robot::new(RobotSpec {
-            mass_kg: 0.35,
-            leg_radius_m: 0.04,
-            leg_width_m: 0.01,
-            hip_height_m: 0.03,
-            leg_speed_rad_s: 2.0 * PI,
-            stance_legs: 3,
-            response_time_s: 0.2,
-            leg_contact_area_m2: None,
-            level_step_m: None,
-            min_step_m: None,
-        })
-        .unwrap()
+        Robot::new(RobotSpec::paper_hexapod()).unwrap()
     }
 
     fn deg(d: f64) -> Slope {

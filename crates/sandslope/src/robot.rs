@@ -38,6 +38,28 @@ pub struct RobotSpec {
     pub min_step_m: Option<f64>,
 }
 
+impl RobotSpec {
+    /// The six-legged C-leg robot of the paper: m = 0.35 kg, R = 0.04 m, W = 0.01 m,
+    /// omega = 2 pi rad/s, n = 3 (alternating tripod), dt = 0.2 s.
+    ///
+    /// The hip height `h = 0.03 m` is an assumption (the paper does not report it), and the
+    /// contact area is left to its default `W * R`. The CLI's `paper-hexapod` preset is this robot.
+    pub fn paper_hexapod() -> RobotSpec {
+        RobotSpec {
+            mass_kg: 0.35,
+            leg_radius_m: 0.04,
+            leg_width_m: 0.01,
+            hip_height_m: 0.03,
+            leg_speed_rad_s: 2.0 * PI,
+            stance_legs: 3,
+            response_time_s: 0.2,
+            leg_contact_area_m2: None,
+            level_step_m: None,
+            min_step_m: None,
+        }
+    }
+}
+
 /// A validated robot. Build it with [`Robot::new`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Robot {
@@ -161,19 +183,8 @@ impl Robot {
 mod tests {
     use super::*;
 
-    pub(crate) fn paper_spec() -> RobotSpec {
-        RobotSpec {
-            mass_kg: 0.35,
-            leg_radius_m: 0.04,
-            leg_width_m: 0.01,
-            hip_height_m: 0.03,
-            leg_speed_rad_s: 2.0 * PI,
-            stance_legs: 3,
-            response_time_s: 0.2,
-            leg_contact_area_m2: None,
-            level_step_m: None,
-            min_step_m: None,
-        }
+    fn paper_spec() -> RobotSpec {
+        RobotSpec::paper_hexapod()
     }
 
     #[test]

@@ -6,6 +6,7 @@
 mod commands;
 mod error;
 mod inputs;
+mod measurements;
 mod output;
 mod plot;
 mod presets;
@@ -25,6 +26,8 @@ struct Cli {
 enum Command {
     /// Every model quantity (d_n, s*, d_s, t1, slip, step, speed, regime) at one slope.
     Predict(commands::predict::PredictArgs),
+    /// Fit k_n and k_s per slope from load-cell recordings into a terrain file (MODEL.md section 10).
+    Fit(commands::fit::FitArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
 }
@@ -33,6 +36,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Predict(a) => commands::predict::run(a),
         Command::Presets(a) => commands::presets::run(a),
+        Command::Fit(a) => commands::fit::run(a),
     }
 }
 

@@ -225,7 +225,7 @@ pub fn read_recording(path: &Path, kind: Kind, counts_per_newton: Option<f64>) -
         .flexible(true)
         .from_reader(text.as_bytes());
     let header = reader.headers().with_context(|| format!("{here}: cannot read the header line"))?.clone();
-    let header_line = reader.position().line().max(1);
+    let header_line = header.position().map(|p| p.line()).unwrap_or(1).max(1);
     let names: Vec<String> = header.iter().map(|h| h.to_ascii_lowercase()).collect();
 
     // Position column: exactly one `<name>_<unit>` with a known unit.

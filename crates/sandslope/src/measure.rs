@@ -527,8 +527,8 @@ fn linear_window(x: &[f64], f: &[f64]) -> Result<(usize, usize), MeasureError> {
     }
     let within = |s: &Option<f64>| s.is_some_and(|s| (s - reference).abs() <= LINEAR_TOLERANCE * reference);
     let (mut best, mut start) = ((0, 0), None);
-    for i in 0..=n {
-        match (i < n && within(&local[i]), start) {
+    for (i, ok) in local.iter().map(within).chain([false]).enumerate() {
+        match (ok, start) {
             (true, None) => start = Some(i),
             (false, Some(s)) => {
                 if i - s > best.1 - best.0 {
@@ -609,7 +609,7 @@ pub fn fit_shear(curve: &Curve, plate: ShearPlate, from: Option<f64>) -> Result<
             let mut level = median(&mut f[mid..].to_vec());
             let mut range = (0, n);
             for _ in 0..2 {
-                if !(level > 0.0) {
+                if level.is_nan() || level <= 0.0 {
                     return Err(MeasureError::NoPlateau(level));
                 }
                 let above = |i: &usize| smooth[*i] >= PLATEAU_FRACTION * level;
@@ -628,7 +628,7 @@ pub fn fit_shear(curve: &Curve, plate: ShearPlate, from: Option<f64>) -> Result<
     let pf = &f[lo..hi];
     let mean = pf.iter().sum::<f64>() / m as f64;
     let sd = (pf.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (m as f64 - 1.0)).sqrt();
-    if !(mean > 0.0) {
+    if mean.is_nan() || mean <= 0.0 {
         return Err(MeasureError::NoPlateau(mean));
     }
     Ok(ShearFit {

@@ -101,7 +101,11 @@ impl Data<'_> {
         chart
             .configure_mesh()
             .x_desc(if shear { "shear displacement (mm)" } else { "penetration depth (mm)" })
-            .y_desc(if shear { "shear force (N)" } else { "normal force (N)" })
+            .y_desc(if shear {
+                "shear force, in-air offset removed (N)"
+            } else {
+                "normal force, in-air offset removed (N)"
+            })
             .label_style(font(15.0))
             .axis_desc_style(font(17.0))
             .light_line_style(WHITE.mix(0.0))

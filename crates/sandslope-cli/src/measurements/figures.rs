@@ -137,10 +137,9 @@ impl Data<'_> {
                 }
                 TrialFit::Air => continue,
             };
-            chart.draw_series(LineSeries::new(fitted.clone(), BLACK.stroke_width(4))).map_err(plot_err)?;
-            chart.draw_series(LineSeries::new(fitted.clone(), colour.stroke_width(2))).map_err(plot_err)?;
+            chart.draw_series(LineSeries::new(fitted.clone(), BLACK.stroke_width(1))).map_err(plot_err)?;
             chart
-                .draw_series(fitted.iter().map(|&(x, y)| Circle::new((x, y), 3, BLACK.filled())))
+                .draw_series(fitted.iter().map(|&(x, y)| Circle::new((x, y), 2, BLACK.filled())))
                 .map_err(plot_err)?;
         }
         let fit_label =
@@ -214,7 +213,7 @@ impl Data<'_> {
                 per_trial.iter().map(|&(d, k)| Circle::new((d, k), 3, RGBColor(120, 120, 120).filled())),
             )
             .map_err(plot_err)?
-            .label("single trial")
+            .label("single trials (drawn left of their slope)")
             .legend(|(x, y)| Circle::new((x + 9, y), 3, RGBColor(120, 120, 120).filled()));
         let measured: Vec<&SlopeEstimate> =
             self.points.iter().filter(|p| stat(p).origin == Origin::Measured).collect();

@@ -6,6 +6,7 @@
 mod commands;
 mod error;
 mod inputs;
+mod measurements;
 mod output;
 mod plot;
 mod presets;
@@ -29,6 +30,8 @@ enum Command {
     Sweep(commands::sweep::SweepArgs),
     /// Fit k_s(theta) so the model's speeds match observed ones; write a terrain file.
     Calibrate(commands::calibrate::CalibrateArgs),
+    /// Fit k_n and k_s per slope from load-cell recordings into a terrain file (MODEL.md section 10).
+    Fit(commands::fit::FitArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
 }
@@ -39,6 +42,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sweep(a) => commands::sweep::run(a),
         Command::Calibrate(a) => commands::calibrate::run(a),
         Command::Presets(a) => commands::presets::run(a),
+        Command::Fit(a) => commands::fit::run(a),
     }
 }
 

@@ -2,6 +2,7 @@
 
 pub mod calibrate;
 pub mod common;
+pub mod fit;
 pub mod predict;
 pub mod presets;
 pub mod sweep;

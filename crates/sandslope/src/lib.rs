@@ -32,6 +32,7 @@
 pub mod calibrate;
 pub mod critical;
 pub mod error;
+pub mod gait;
 pub mod model;
 pub mod regime;
 pub mod risk;
@@ -42,6 +43,7 @@ pub mod terrain;
 pub use calibrate::{calibrate, Calibration, CalibrationError, LawParams, ShearLaw, SpeedObservation};
 pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
 pub use error::ParamError;
+pub use gait::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording, Upslope};
 pub use model::{predict, Prediction, G};
 pub use regime::{Cause, Regime};
 pub use risk::{regime_probabilities, RegimeProbabilities, Uncertainty};

@@ -6,6 +6,7 @@
 mod commands;
 mod error;
 mod inputs;
+mod mocap;
 mod output;
 mod plot;
 mod presets;
@@ -27,12 +28,15 @@ enum Command {
     Predict(commands::predict::PredictArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
+    /// Speed, anchoring time t1 and slip per step from motion-capture recordings at one slope.
+    Track(commands::track::TrackArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Predict(a) => commands::predict::run(a),
         Command::Presets(a) => commands::presets::run(a),
+        Command::Track(a) => commands::track::run(a),
     }
 }
 

@@ -3,3 +3,4 @@
 pub mod common;
 pub mod predict;
 pub mod presets;
+pub mod track;

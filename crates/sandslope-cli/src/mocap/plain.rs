@@ -44,8 +44,11 @@ pub(crate) fn parse(rows: &Rows) -> Result<super::motive::Parsed> {
     }
     let mut steps: Vec<f64> = samples.windows(2).map(|w| w[1].1 - w[0].1).collect();
     steps.sort_by(f64::total_cmp);
-    let dt = steps[steps.len() / 2];
     let t0 = samples[0].1;
+    // The median step, refined over the whole span (times are often printed rounded).
+    let median = steps[steps.len() / 2];
+    let span = samples[samples.len() - 1].1 - t0;
+    let dt = span / (span / median).round().max(1.0);
     let mut positions = Vec::with_capacity(samples.len());
     for (line, t, p) in samples {
         let x = (t - t0) / dt;

@@ -324,7 +324,8 @@ pub fn run(args: TrackArgs) -> Result<()> {
         .collect();
     let analysis = analyse(&recordings, &options).map_err(|e| match e {
         sandslope::GaitError::Param { index, source } => {
-            anyhow!("{}: {}", captures[index].path.display(), source)
+            let source = if source.key == "cutoff_hz" { source.renamed("--cutoff") } else { source };
+            anyhow!("{}: {source} (at its frame rate {} Hz)", captures[index].path.display(), captures[index].frame_rate_hz)
         }
         other => anyhow!("{other}"),
     })?;

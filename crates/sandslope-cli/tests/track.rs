@@ -26,7 +26,14 @@ const FPS: f64 = 120.0;
 /// (time, position or None when occluded), metres.
 type Rows = Vec<(f64, Option<[f64; 3]>)>;
 
-fn trajectory(p: &StepProfile, seconds: f64, offset: f64, dir: [f64; 3], noise: f64, gaps: &[(usize, usize)]) -> Rows {
+fn trajectory(
+    p: &StepProfile,
+    seconds: f64,
+    offset: f64,
+    dir: [f64; 3],
+    noise: f64,
+    gaps: &[(usize, usize)],
+) -> Rows {
     let mut rng = rand::rngs::StdRng::seed_from_u64(11);
     let mut gauss = move || {
         let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
@@ -37,7 +44,11 @@ fn trajectory(p: &StepProfile, seconds: f64, offset: f64, dir: [f64; 3], noise: 
         .map(|i| {
             let t = i as f64 / FPS;
             let s = p.position(t - offset + 2.0 * p.step_duration());
-            let pos = [dir[0] * s + noise * gauss(), dir[1] * s + 0.3 + noise * gauss(), dir[2] * s + noise * gauss()];
+            let pos = [
+                dir[0] * s + noise * gauss(),
+                dir[1] * s + 0.3 + noise * gauss(),
+                dir[2] * s + noise * gauss(),
+            ];
             (t, (!gaps.iter().any(|&(a, b)| (a..b).contains(&i))).then_some(pos))
         })
         .collect()
@@ -92,7 +103,8 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 fn track(args: &[&str]) -> Value {
-    let out = Command::cargo_bin("sandslope").unwrap().arg("track").args(args).arg("--json").output().unwrap();
+    let out =
+        Command::cargo_bin("sandslope").unwrap().arg("track").args(args).arg("--json").output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     serde_json::from_slice(&out.stdout).unwrap()
 }
@@ -113,7 +125,12 @@ fn slope20() -> StepProfile {
 
 fn check(v: &Value, p: &StepProfile) {
     let get = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k} missing in {v}"));
-    assert!((get("speed_m_s") - p.mean_speed()).abs() < 1e-3, "speed {} vs {}", get("speed_m_s"), p.mean_speed());
+    assert!(
+        (get("speed_m_s") - p.mean_speed()).abs() < 1e-3,
+        "speed {} vs {}",
+        get("speed_m_s"),
+        p.mean_speed()
+    );
     assert!((get("t1_s") - p.anchoring_time()).abs() < 0.015, "t1 {} vs {}", get("t1_s"), p.anchoring_time());
     assert!((get("slip_m") - p.slip()).abs() < 0.2 * p.slip(), "slip {} vs {}", get("slip_m"), p.slip());
     assert!((get("step_m") - p.step()).abs() < 5e-4);
@@ -138,7 +155,9 @@ fn both_motive_versions_vicon_and_plain_recover_the_profile() {
         assert_eq!(v["interpolated_frames"], 5);
         assert_eq!(v["period_s"], 1.0);
         let u = &v["upslope"];
-        assert!((u[0].as_f64().unwrap() - up[0]).abs() < 5e-3 && (u[2].as_f64().unwrap() - up[2]).abs() < 5e-3);
+        assert!(
+            (u[0].as_f64().unwrap() - up[0]).abs() < 5e-3 && (u[2].as_f64().unwrap() - up[2]).abs() < 5e-3
+        );
         let phase = v["recordings"][0]["touchdown_phase_s"].as_f64().unwrap();
         assert!((phase - 0.2).abs() < 1.0 / 120.0, "phase {phase}");
         assert_eq!(v["per_step"].as_array().unwrap().len(), v["steps"].as_u64().unwrap() as usize);
@@ -225,7 +244,11 @@ fn malformed_files_are_named_with_their_line() {
     fails(&[f.to_str().unwrap(), "--body", "nobody"], "no body named `nobody`");
     // Rigid bodies are preferred to markers; with two rigid bodies one must be chosen.
     track(&[f.to_str().unwrap()]);
-    let f = write(dir.path(), "two.csv", &good.replace("Marker,Marker,Marker", "Rigid Body,Rigid Body,Rigid Body"));
+    let f = write(
+        dir.path(),
+        "two.csv",
+        &good.replace("Marker,Marker,Marker", "Rigid Body,Rigid Body,Rigid Body"),
+    );
     fails(&[f.to_str().unwrap()], "choose one with --body");
     let no_pos = good.replace("Position", "Rotation");
     let f = write(dir.path(), "nopos.csv", &no_pos);

@@ -194,7 +194,13 @@ fn mean_sd(s: Option<Stats>) -> (Option<f64>, Option<f64>) {
     (s.map(|s| s.mean), s.and_then(|s| s.sd))
 }
 
-fn record(captures: &[Capture], a: &GaitAnalysis, period: f64, options: &GaitOptions, slope: Option<f64>) -> TrackRecord {
+fn record(
+    captures: &[Capture],
+    a: &GaitAnalysis,
+    period: f64,
+    options: &GaitOptions,
+    slope: Option<f64>,
+) -> TrackRecord {
     let s = &a.summary;
     let (t1, t1_sd) = mean_sd(s.anchoring_time);
     let (slip, slip_sd) = mean_sd(s.slip);
@@ -311,7 +317,8 @@ pub fn run(args: TrackArgs) -> Result<()> {
     }
     let captures: Vec<Capture> =
         files.iter().map(|f| mocap::read(f, args.format, args.body.as_deref())).collect::<Result<_>>()?;
-    let touchdowns: Vec<Vec<f64>> = args.touchdowns.iter().map(|p| load_touchdowns(p)).collect::<Result<_>>()?;
+    let touchdowns: Vec<Vec<f64>> =
+        args.touchdowns.iter().map(|p| load_touchdowns(p)).collect::<Result<_>>()?;
     let recordings: Vec<Recording> = captures
         .iter()
         .enumerate()
@@ -325,7 +332,11 @@ pub fn run(args: TrackArgs) -> Result<()> {
     let analysis = analyse(&recordings, &options).map_err(|e| match e {
         sandslope::GaitError::Param { index, source } => {
             let source = if source.key == "cutoff_hz" { source.renamed("--cutoff") } else { source };
-            anyhow!("{}: {source} (at its frame rate {} Hz)", captures[index].path.display(), captures[index].frame_rate_hz)
+            anyhow!(
+                "{}: {source} (at its frame rate {} Hz)",
+                captures[index].path.display(),
+                captures[index].frame_rate_hz
+            )
         }
         other => anyhow!("{other}"),
     })?;
@@ -406,7 +417,17 @@ fn print_table(r: &TrackRecord) {
         t.add_row(row);
     }
     println!("{t}");
-    let mut f = table(&["file", "body", "fps", "frames", "segments", "interp.", "dropped", "steps", "touchdown phase"]);
+    let mut f = table(&[
+        "file",
+        "body",
+        "fps",
+        "frames",
+        "segments",
+        "interp.",
+        "dropped",
+        "steps",
+        "touchdown phase",
+    ]);
     for rec in &r.recordings {
         f.add_row([
             rec.file.clone(),

@@ -91,9 +91,11 @@ impl Rows {
     pub fn position_cell(&self, line: u64, record: &StringRecord, col: usize, what: &str) -> Result<f64> {
         match record.get(col).unwrap_or("") {
             "" => Ok(f64::NAN),
-            s => s.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
-                self.err(line, format!("column {} ({what}): `{s}` is not a number", col + 1))
-            }),
+            s => {
+                s.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+                    self.err(line, format!("column {} ({what}): `{s}` is not a number", col + 1))
+                })
+            }
         }
     }
 }
@@ -114,7 +116,9 @@ pub(crate) fn pick_body<T>(
             match hits.len() {
                 1 => Ok(hits.remove(0)),
                 0 => Err(rows.err(line, format!("no body named `{w}` (bodies with positions: {names})"))),
-                _ => Err(rows.err(line, format!("`{w}` matches several bodies ({names}); give the full name"))),
+                _ => {
+                    Err(rows.err(line, format!("`{w}` matches several bodies ({names}); give the full name")))
+                }
             }
         }
         None => {
@@ -122,7 +126,8 @@ pub(crate) fn pick_body<T>(
             if available.len() == 1 {
                 Ok(available.remove(0))
             } else {
-                Err(rows.err(line, format!("several bodies have positions ({names}); choose one with --body")))
+                Err(rows
+                    .err(line, format!("several bodies have positions ({names}); choose one with --body")))
             }
         }
     }

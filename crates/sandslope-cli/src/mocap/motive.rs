@@ -91,7 +91,9 @@ pub(crate) fn parse(rows: &Rows, body: Option<&str>) -> Result<Parsed> {
     for needed in ["type", "name", "kind"] {
         if !header.contains_key(needed) {
             let what = if needed == "kind" { "`Rotation`/`Position`" } else { needed };
-            return Err(rows.err(names_line, format!("truncated header: no {what} row before the column names")));
+            return Err(
+                rows.err(names_line, format!("truncated header: no {what} row before the column names"))
+            );
         }
     }
     let row = |k: &str| &rows.rows[header[k]].1;

@@ -12,25 +12,27 @@ pub(crate) fn parse(rows: &Rows) -> Result<super::motive::Parsed> {
     };
     let find = |name: &str| head.iter().position(|c| c == name);
     let time = find("time_s").ok_or_else(|| rows.err(*head_line, "no `time_s` column in the header"))?;
-    let (cols, scale) = match (find("x_m"), find("y_m"), find("z_m"), find("x_mm"), find("y_mm"), find("z_mm")) {
-        (Some(x), Some(y), Some(z), _, _, _) => ([x, y, z], 1.0),
-        (_, _, _, Some(x), Some(y), Some(z)) => ([x, y, z], 1e-3),
-        _ => {
-            return Err(rows.err(
+    let (cols, scale) =
+        match (find("x_m"), find("y_m"), find("z_m"), find("x_mm"), find("y_mm"), find("z_mm")) {
+            (Some(x), Some(y), Some(z), _, _, _) => ([x, y, z], 1.0),
+            (_, _, _, Some(x), Some(y), Some(z)) => ([x, y, z], 1e-3),
+            _ => return Err(rows.err(
                 *head_line,
                 "no position columns: the header needs x_m,y_m,z_m (metres) or x_mm,y_mm,z_mm (millimetres)",
-            ))
-        }
-    };
+            )),
+        };
     let mut samples: Vec<(u64, f64, [f64; 3])> = Vec::with_capacity(rows.rows.len());
     for (line, r) in &rows.rows[1..] {
         let t = r.get(time).unwrap_or("");
-        let t = t.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
-            rows.err(*line, format!("column {} (time_s): `{t}` is not a number", time + 1))
-        })?;
+        let t =
+            t.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+                rows.err(*line, format!("column {} (time_s): `{t}` is not a number", time + 1))
+            })?;
         if let Some((_, prev, _)) = samples.last() {
             if t <= *prev {
-                return Err(rows.err(*line, format!("time_s = {t} must be greater than the previous row's {prev}")));
+                return Err(
+                    rows.err(*line, format!("time_s = {t} must be greater than the previous row's {prev}"))
+                );
             }
         }
         let mut p = [0.0; 3];

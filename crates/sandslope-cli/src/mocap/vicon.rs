@@ -58,20 +58,30 @@ pub(crate) fn parse(rows: &Rows, body: Option<&str>) -> Result<super::motive::Pa
         let rate_cell = rate_row.get(0).unwrap_or("");
         let rate = match rate_cell.parse::<f64>() {
             Ok(v) if v.is_finite() && v > 0.0 => v,
-            _ => return Err(rows.err(*rate_line, format!("frame rate `{rate_cell}` must be a number greater than 0"))),
+            _ => {
+                return Err(
+                    rows.err(*rate_line, format!("frame rate `{rate_cell}` must be a number greater than 0"))
+                )
+            }
         };
         let (names, (cols_line, cols), units) = (&r[i + 2].1, &r[i + 3], &r[i + 4].1);
         if !cols.get(0).is_some_and(|c| c.eq_ignore_ascii_case("Frame")) {
-            return Err(rows.err(*cols_line, "truncated header: expected the column-name row `Frame,Sub Frame,X,Y,Z,...`"));
+            return Err(rows.err(
+                *cols_line,
+                "truncated header: expected the column-name row `Frame,Sub Frame,X,Y,Z,...`",
+            ));
         }
         let section = i;
         for c in 2..cols.len().saturating_sub(2) {
             let name = names.get(c).unwrap_or("");
-            if name.is_empty() || (cols.get(c), cols.get(c + 1), cols.get(c + 2)) != (Some("X"), Some("Y"), Some("Z")) {
+            if name.is_empty()
+                || (cols.get(c), cols.get(c + 1), cols.get(c + 2)) != (Some("X"), Some("Y"), Some("Z"))
+            {
                 continue;
             }
             if let Some(scale) = unit_scale(units.get(c).unwrap_or("")) {
-                candidates.push((name.to_string(), Candidate { section, rate, cols: [c, c + 1, c + 2], scale }));
+                candidates
+                    .push((name.to_string(), Candidate { section, rate, cols: [c, c + 1, c + 2], scale }));
             }
         }
         i += 5;
@@ -80,7 +90,9 @@ pub(crate) fn parse(rows: &Rows, body: Option<&str>) -> Result<super::motive::Pa
         return Err(rows.err(first_line, "no `Trajectories` or `Model Outputs` section"));
     }
     if candidates.is_empty() {
-        return Err(rows.err(first_line, "no position columns: no name over an `X,Y,Z` triple with units mm or m"));
+        return Err(
+            rows.err(first_line, "no position columns: no name over an `X,Y,Z` triple with units mm or m")
+        );
     }
     let (name, cand) = pick_body(rows, first_line, candidates, body, |n, w| {
         n == w || n.rsplit_once(':').is_some_and(|(_, short)| short == w)
@@ -93,9 +105,10 @@ pub(crate) fn parse(rows: &Rows, body: Option<&str>) -> Result<super::motive::Pa
         if is_section(frame) {
             break;
         }
-        let f = frame.parse::<f64>().ok().filter(|f| f.is_finite()).ok_or_else(|| {
-            rows.err(*line, format!("column 1 (Frame): `{frame}` is not a frame number"))
-        })?;
+        let f =
+            frame.parse::<f64>().ok().filter(|f| f.is_finite()).ok_or_else(|| {
+                rows.err(*line, format!("column 1 (Frame): `{frame}` is not a frame number"))
+            })?;
         first_frame.get_or_insert(f);
         let mut p = [0.0; 3];
         for (k, &c) in cand.cols.iter().enumerate() {

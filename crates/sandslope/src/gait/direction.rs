@@ -57,7 +57,7 @@ pub fn principal_direction(recordings: &[&[[f64; 3]]]) -> Option<Upslope> {
             scatter += d * d.transpose();
         }
         let first = valid().next()?;
-        let last = valid().last()?;
+        let last = positions.iter().rev().find(|p| p.iter().all(|c| c.is_finite()))?;
         net += Vector3::from(*last) - Vector3::from(*first);
         frames += n;
     }
@@ -70,7 +70,7 @@ pub fn principal_direction(recordings: &[&[[f64; 3]]]) -> Option<Upslope> {
         .iter()
         .enumerate()
         .fold((0, f64::NEG_INFINITY), |acc, (i, &l)| if l > acc.1 { (i, l) } else { acc });
-    if !(largest > 0.0) {
+    if largest.is_nan() || largest <= 0.0 {
         return None;
     }
     let mut u: Vector3<f64> = eigen.eigenvectors.column(best).into();

@@ -193,8 +193,8 @@ pub fn analyse(recordings: &[Recording<'_>], options: &GaitOptions) -> Result<Ga
     let step_s = options.step_duration();
     let mut results = Vec::with_capacity(recordings.len());
     for (index, rec) in recordings.iter().enumerate() {
-        let filter =
-            LowPass::new(rec.frame_rate_hz, options.cutoff_hz).map_err(|source| GaitError::Param { index, source })?;
+        let filter = LowPass::new(rec.frame_rate_hz, options.cutoff_hz)
+            .map_err(|source| GaitError::Param { index, source })?;
         let min_frames = (step_s * rec.frame_rate_hz).ceil() as usize + 2;
         let along = project(rec.positions, upslope);
         let seg = split_at_gaps(&along, options.max_gap_frames, min_frames);
@@ -247,10 +247,8 @@ pub fn analyse(recordings: &[Recording<'_>], options: &GaitOptions) -> Result<Ga
     let all_steps: Vec<StepMeasure> = results.iter().flat_map(|r| r.steps.iter().copied()).collect();
     let summary =
         summarize(&all_steps).ok_or(GaitError::NoSteps { step_s, max_gap: options.max_gap_frames })?;
-    let pairs: Vec<(&SmoothTrack, &[f64])> = results
-        .iter()
-        .flat_map(|r| r.tracks.iter().zip(r.touchdowns.iter().map(|v| v.as_slice())))
-        .collect();
+    let pairs: Vec<(&SmoothTrack, &[f64])> =
+        results.iter().flat_map(|r| r.tracks.iter().zip(r.touchdowns.iter().map(|v| v.as_slice()))).collect();
     let curve = stride_curve(&pairs, options.stride_period_s, options.curve_points);
     Ok(GaitAnalysis { upslope, upslope_estimated: estimated, recordings: results, summary, curve })
 }
@@ -264,7 +262,13 @@ mod tests {
     /// Positions of a body following `profile` upslope along `dir`, with touchdowns at
     /// `offset + k T/2` in the recording clock, 1 cm of lateral sway at the stride rate and
     /// Gaussian noise of `noise` m per axis (Box-Muller on a seeded generator).
-    pub(crate) fn recording(profile: &StepProfile, dir: [f64; 3], frames: usize, offset: f64, noise: f64) -> Vec<[f64; 3]> {
+    pub(crate) fn recording(
+        profile: &StepProfile,
+        dir: [f64; 3],
+        frames: usize,
+        offset: f64,
+        noise: f64,
+    ) -> Vec<[f64; 3]> {
         let mut rng = rand::rngs::StdRng::seed_from_u64(7);
         let mut gauss = move || {
             let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
@@ -321,7 +325,10 @@ mod tests {
         // The curve starts at a touchdown and dips to -V_s at t1 in its first half.
         let half = curve.time_s.iter().filter(|&&t| t < 0.5).count();
         let (jmin, vmin) =
-            curve.mean[..half].iter().enumerate().fold((0, f64::MAX), |acc, (j, &v)| if v < acc.1 { (j, v) } else { acc });
+            curve.mean[..half]
+                .iter()
+                .enumerate()
+                .fold((0, f64::MAX), |acc, (j, &v)| if v < acc.1 { (j, v) } else { acc });
         assert!((vmin + 0.12).abs() < 0.01, "{vmin}");
         assert!((curve.time_s[jmin] - 0.12).abs() < 0.02);
 

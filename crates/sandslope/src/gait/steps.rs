@@ -91,7 +91,7 @@ pub fn estimate_touchdown_phase(tracks: &[SmoothTrack], step_s: f64) -> Option<T
             count[b] += 1;
         }
     }
-    if count.iter().any(|&c| c == 0) {
+    if count.contains(&0) {
         return None;
     }
     let mean: Vec<f64> = sum.iter().zip(&count).map(|(s, &c)| s / c as f64).collect();

@@ -44,7 +44,12 @@ impl StepProfile {
         check(step_s.is_finite() && step_s > 0.0, "step_s", step_s, "greater than 0")?;
         check(t1 >= 0.0 && t1 < step_s, "t1", t1, "in [0, step_s)")?;
         check(t3 > t1 && t3 < step_s, "t3", t3, "in (t1, step_s)")?;
-        check(slip_speed >= 0.0 && (t1 > 0.0 || slip_speed == 0.0), "slip_speed", slip_speed, "at least 0, and 0 when t1 = 0")?;
+        check(
+            slip_speed >= 0.0 && (t1 > 0.0 || slip_speed == 0.0),
+            "slip_speed",
+            slip_speed,
+            "at least 0, and 0 when t1 = 0",
+        )?;
         check(peak_speed.is_finite() && peak_speed > 0.0, "peak_speed", peak_speed, "greater than 0")?;
         Ok(StepProfile { step_s, t1, t3, slip_speed, peak_speed })
     }

@@ -122,12 +122,18 @@ impl TrackFigure {
             .label("mean speed")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(3)));
         chart
-            .draw_series(std::iter::once(PathElement::new(vec![(0.0, 0.0), (self.period, 0.0)], BLACK.mix(0.5))))
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(0.0, 0.0), (self.period, 0.0)],
+                BLACK.mix(0.5),
+            )))
             .map_err(plot_err)?;
         let half = 0.5 * self.period;
         for (i, t0) in [0.0, half].into_iter().enumerate() {
             let s = chart
-                .draw_series(std::iter::once(PathElement::new(vec![(t0, y0), (t0, y1)], BLACK.stroke_width(1))))
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(t0, y0), (t0, y1)],
+                    BLACK.stroke_width(1),
+                )))
                 .map_err(plot_err)?;
             if i == 0 {
                 s.label("touchdown t0 (every T/2)")
@@ -187,7 +193,9 @@ impl TrackFigure {
             .draw()
             .map_err(plot_err)?;
         for (i, piece) in self.model.iter().enumerate() {
-            let s = chart.draw_series(LineSeries::new(piece.iter().copied(), RED.stroke_width(2))).map_err(plot_err)?;
+            let s = chart
+                .draw_series(LineSeries::new(piece.iter().copied(), RED.stroke_width(2)))
+                .map_err(plot_err)?;
             if i == 0 {
                 s.label("model (MODEL.md §3-5), robot and terrain given")
                     .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
@@ -206,7 +214,11 @@ impl TrackFigure {
             }))
             .map_err(plot_err)?;
         chart
-            .draw_series(self.measured.iter().map(|r| Circle::new((r.slope_deg, 100.0 * r.speed_m_s), 5, BLACK.filled())))
+            .draw_series(
+                self.measured
+                    .iter()
+                    .map(|r| Circle::new((r.slope_deg, 100.0 * r.speed_m_s), 5, BLACK.filled())),
+            )
             .map_err(plot_err)?
             .label("tracked mean ± SD (speeds file)")
             .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.filled()));

@@ -7,6 +7,7 @@ mod commands;
 mod error;
 mod inputs;
 mod measurements;
+mod mocap;
 mod output;
 mod plot;
 mod presets;
@@ -34,6 +35,8 @@ enum Command {
     Fit(commands::fit::FitArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
+    /// Speed, anchoring time t1 and slip per step from motion-capture recordings at one slope.
+    Track(commands::track::TrackArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -43,6 +46,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Calibrate(a) => commands::calibrate::run(a),
         Command::Presets(a) => commands::presets::run(a),
         Command::Fit(a) => commands::fit::run(a),
+        Command::Track(a) => commands::track::run(a),
     }
 }
 

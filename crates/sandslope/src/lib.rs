@@ -32,6 +32,7 @@
 pub mod calibrate;
 pub mod critical;
 pub mod error;
+pub mod gait;
 pub mod measure;
 pub mod model;
 pub mod regime;
@@ -43,6 +44,7 @@ pub mod terrain;
 pub use calibrate::{calibrate, Calibration, CalibrationError, LawParams, ShearLaw, SpeedObservation};
 pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
 pub use error::ParamError;
+pub use gait::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording, Upslope};
 pub use measure::{MeasureError, SlopeEstimate};
 pub use model::{predict, Prediction, G};
 pub use regime::{Cause, Regime};

@@ -6,3 +6,4 @@ pub mod fit;
 pub mod predict;
 pub mod presets;
 pub mod sweep;
+pub mod track;

@@ -1,0 +1,448 @@
+//! `sandslope track`: speed, anchoring time and slip from motion-capture recordings
+//! (MODEL.md section 11), pooled over the files given for one slope; optionally appends the
+//! mean speed to a speeds file for `sandslope calibrate` and draws the paper's Fig. 3b (and
+//! Fig. 3a once the speeds file holds several slopes).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+
+use sandslope::gait::{
+    analyse, GaitAnalysis, GaitOptions, Recording, Stats, Upslope, DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP,
+};
+use sandslope::Slope;
+
+use super::common::{RobotArgs, TerrainArgs};
+use crate::inputs::{check_flag, check_positive, load_speeds, read_text, SpeedRow};
+use crate::mocap::{self, Capture, MocapFormat};
+use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
+
+mod figure;
+
+/// Arguments of `sandslope track`.
+#[derive(Debug, Args)]
+pub struct TrackArgs {
+    /// Recordings at one slope (files or glob patterns such as `runs/10deg-*.csv`), pooled.
+    #[arg(required = true, value_name = "FILE|GLOB")]
+    pub files: Vec<String>,
+    /// File format; detected from the first line when omitted.
+    #[arg(long, value_enum)]
+    pub format: Option<MocapFormat>,
+    /// Rigid body, marker or model output to track (required when a file has several).
+    #[arg(long, value_name = "NAME")]
+    pub body: Option<String>,
+    /// Upslope direction in the capture frame: +x, -x, +y, -y, +z, -z or a vector such as
+    /// `0.91,0,0.41`; estimated as the principal direction of travel when omitted.
+    #[arg(long, value_name = "AXIS|X,Y,Z", value_parser = parse_upslope, allow_hyphen_values = true)]
+    pub upslope: Option<Upslope>,
+    /// Longest occlusion filled by linear interpolation, frames; longer gaps split the
+    /// recording into segments analysed separately.
+    #[arg(long, value_name = "FRAMES", default_value_t = DEFAULT_MAX_GAP)]
+    pub max_gap: usize,
+    /// Low-pass cutoff for the zero-phase speed estimate, Hz (see docs/tracking.md).
+    #[arg(long, value_name = "HZ", default_value_t = DEFAULT_CUTOFF_HZ)]
+    pub cutoff: f64,
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    pub terrain: TerrainArgs,
+    /// Leg angular speed omega, rad/s, instead of the robot's (stride period T = 2 pi / omega).
+    #[arg(long, value_name = "RAD/S")]
+    pub leg_speed: Option<f64>,
+    /// Touchdown times, s, one per line in the recording's clock (e.g. from the gait
+    /// controller's log); give it once per recording, in the same order. Estimated from the
+    /// speed signal when omitted.
+    #[arg(long, value_name = "FILE")]
+    pub touchdowns: Vec<PathBuf>,
+    /// Slope of these recordings, degrees (labels the output and the `--speeds-out` row).
+    #[arg(long, value_name = "DEG")]
+    pub slope: Option<f64>,
+    /// Append `slope_deg,speed_m_s,speed_sd_m_s` to this file (created with a header), the
+    /// format `sandslope calibrate` reads; needs --slope.
+    #[arg(long, value_name = "FILE")]
+    pub speeds_out: Option<PathBuf>,
+    /// Draw the speed within a stride (mean, SD band, t1) to this PNG or SVG; with a
+    /// --speeds-out file holding several slopes, also speed against slope with the model.
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+    #[command(flatten)]
+    pub format_args: FormatArgs,
+}
+
+/// Parses `--upslope`.
+fn parse_upslope(s: &str) -> Result<Upslope, String> {
+    let axis = |i: usize, sign: f64| {
+        let mut v = [0.0; 3];
+        v[i] = sign;
+        v
+    };
+    let v = match s.trim().to_ascii_lowercase().as_str() {
+        "+x" | "x" => axis(0, 1.0),
+        "-x" => axis(0, -1.0),
+        "+y" | "y" => axis(1, 1.0),
+        "-y" => axis(1, -1.0),
+        "+z" | "z" => axis(2, 1.0),
+        "-z" => axis(2, -1.0),
+        other => {
+            let parts: Vec<&str> = other.split(',').map(str::trim).collect();
+            let nums: Option<Vec<f64>> = parts.iter().map(|p| p.parse::<f64>().ok()).collect();
+            match nums.as_deref() {
+                Some([x, y, z]) => [*x, *y, *z],
+                _ => return Err(format!("`{s}` must be +x, -x, +y, -y, +z, -z or three numbers `x,y,z`")),
+            }
+        }
+    };
+    Upslope::new(v).map_err(|e| e.renamed("--upslope").to_string())
+}
+
+/// Expands the file arguments: existing paths as they are, anything else as a glob.
+fn expand(patterns: &[String]) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for p in patterns {
+        if Path::new(p).exists() {
+            out.push(PathBuf::from(p));
+            continue;
+        }
+        let matches = glob::glob(p).map_err(|e| anyhow!("`{p}` is not a valid glob pattern: {e}"))?;
+        let mut found: Vec<PathBuf> = matches.filter_map(|m| m.ok()).filter(|m| m.is_file()).collect();
+        if found.is_empty() {
+            bail!("{p}: no such file (and no file matches it as a glob pattern)");
+        }
+        found.sort();
+        out.append(&mut found);
+    }
+    Ok(out)
+}
+
+/// Reads a touchdowns file: one time in seconds per line; blank lines and `#` comments skipped.
+fn load_touchdowns(path: &Path) -> Result<Vec<f64>> {
+    let text = read_text(path)?;
+    let mut times = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let t = line.parse::<f64>().ok().filter(|t| t.is_finite()).ok_or_else(|| {
+            anyhow!("{}: line {}: `{line}` is not a time in seconds", path.display(), i + 1)
+        })?;
+        times.push(t);
+    }
+    if times.is_empty() {
+        bail!("{}: no touchdown times (expected one time in seconds per line)", path.display());
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(times)
+}
+
+/// One step as printed (JSON `per_step`, `--csv`).
+#[derive(Debug, Clone, Serialize)]
+struct StepRecord {
+    file: String,
+    touchdown_s: f64,
+    t1_s: Option<f64>,
+    slip_m: Option<f64>,
+    step_m: f64,
+    speed_m_s: f64,
+}
+
+/// One recording as printed.
+#[derive(Debug, Clone, Serialize)]
+struct RecordingRecord {
+    file: String,
+    format: &'static str,
+    body: String,
+    frame_rate_hz: f64,
+    frames: usize,
+    segments: usize,
+    interpolated_frames: usize,
+    dropped_frames: usize,
+    steps: usize,
+    touchdowns: &'static str,
+    touchdown_phase_s: Option<f64>,
+}
+
+/// The whole result as printed by `--json`.
+#[derive(Debug, Clone, Serialize)]
+struct TrackRecord {
+    slope_deg: Option<f64>,
+    speed_m_s: f64,
+    speed_sd_m_s: Option<f64>,
+    t1_s: Option<f64>,
+    t1_sd_s: Option<f64>,
+    slip_m: Option<f64>,
+    slip_sd_m: Option<f64>,
+    step_m: f64,
+    step_sd_m: Option<f64>,
+    steps: usize,
+    unanchored_steps: usize,
+    period_s: f64,
+    upslope: [f64; 3],
+    upslope_estimated: bool,
+    cutoff_hz: f64,
+    max_gap_frames: usize,
+    segments: usize,
+    interpolated_frames: usize,
+    dropped_frames: usize,
+    recordings: Vec<RecordingRecord>,
+    per_step: Vec<StepRecord>,
+}
+
+fn mean_sd(s: Option<Stats>) -> (Option<f64>, Option<f64>) {
+    (s.map(|s| s.mean), s.and_then(|s| s.sd))
+}
+
+fn record(
+    captures: &[Capture],
+    a: &GaitAnalysis,
+    period: f64,
+    options: &GaitOptions,
+    slope: Option<f64>,
+) -> TrackRecord {
+    let s = &a.summary;
+    let (t1, t1_sd) = mean_sd(s.anchoring_time);
+    let (slip, slip_sd) = mean_sd(s.slip);
+    let recordings: Vec<RecordingRecord> = captures
+        .iter()
+        .zip(&a.recordings)
+        .map(|(c, r)| RecordingRecord {
+            file: c.path.display().to_string(),
+            format: c.format.name(),
+            body: c.body.clone(),
+            frame_rate_hz: c.frame_rate_hz,
+            frames: c.positions.len(),
+            segments: r.tracks.len(),
+            interpolated_frames: r.interpolated_frames,
+            dropped_frames: r.dropped_frames,
+            steps: r.steps.len(),
+            touchdowns: if r.phase.is_some() || r.steps.is_empty() { "estimated" } else { "file" },
+            touchdown_phase_s: r.phase.map(|p| p.phase_s),
+        })
+        .collect();
+    let per_step = captures
+        .iter()
+        .zip(&a.recordings)
+        .flat_map(|(c, r)| {
+            r.steps.iter().map(move |st| StepRecord {
+                file: c.path.display().to_string(),
+                touchdown_s: st.touchdown_s,
+                t1_s: st.anchoring_time_s,
+                slip_m: st.slip_m,
+                step_m: st.step_m,
+                speed_m_s: st.speed_m_s,
+            })
+        })
+        .collect();
+    TrackRecord {
+        slope_deg: slope,
+        speed_m_s: s.speed.mean,
+        speed_sd_m_s: s.speed.sd,
+        t1_s: t1,
+        t1_sd_s: t1_sd,
+        slip_m: slip,
+        slip_sd_m: slip_sd,
+        step_m: s.step.mean,
+        step_sd_m: s.step.sd,
+        steps: s.speed.n,
+        unanchored_steps: s.unanchored_steps,
+        period_s: period,
+        upslope: a.upslope.vector(),
+        upslope_estimated: a.upslope_estimated,
+        cutoff_hz: options.cutoff(),
+        max_gap_frames: options.max_gap(),
+        segments: a.recordings.iter().map(|r| r.tracks.len()).sum(),
+        interpolated_frames: a.recordings.iter().map(|r| r.interpolated_frames).sum(),
+        dropped_frames: a.recordings.iter().map(|r| r.dropped_frames).sum(),
+        recordings,
+        per_step,
+    }
+}
+
+/// Appends one row to a speeds file (creating it with its header), atomically, after checking
+/// that the existing file is one `sandslope calibrate` can read; returns all rows now in it.
+fn append_speed(path: &Path, row: SpeedRow) -> Result<Vec<SpeedRow>> {
+    const HEADER: &str = "slope_deg,speed_m_s,speed_sd_m_s";
+    let existing = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+        Err(e) => return Err(anyhow!("cannot read {}: {e}", path.display())),
+    };
+    let mut text = existing.clone();
+    if existing.trim().is_empty() {
+        text = format!("{HEADER}\n");
+    } else {
+        load_speeds(path)?;
+        if !text.ends_with('\n') {
+            text.push('\n');
+        }
+    }
+    text.push_str(&format!("{},{},{}\n", row.slope_deg, row.speed_m_s, row.speed_sd_m_s));
+    write_atomic(path, text.as_bytes())?;
+    Ok(load_speeds(path)?
+        .into_iter()
+        .map(|o| SpeedRow { slope_deg: o.slope.degrees(), speed_m_s: o.speed, speed_sd_m_s: o.speed_sd })
+        .collect())
+}
+
+/// Runs `sandslope track`.
+pub fn run(args: TrackArgs) -> Result<()> {
+    let robot = args.robot.load()?;
+    let period = match args.leg_speed {
+        Some(w) => std::f64::consts::TAU / check_positive("--leg-speed", w)?,
+        None => robot.stride_period(),
+    };
+    let slope = args.slope.map(|d| check_flag("--slope", d, 0.0, 89.999)).transpose()?;
+    if args.speeds_out.is_some() && slope.is_none() {
+        bail!("--speeds-out needs --slope (the slope of these recordings, degrees)");
+    }
+    if let Some(p) = &args.plot {
+        crate::plot::format_of(p)?;
+    }
+    let mut options = GaitOptions::new(period)
+        .and_then(|o| o.with_cutoff(args.cutoff))
+        .map_err(|e| anyhow!("{}", e.renamed("--cutoff")))?
+        .with_max_gap(args.max_gap);
+    if let Some(u) = args.upslope {
+        options = options.with_upslope(u);
+    }
+    let files = expand(&args.files)?;
+    if !args.touchdowns.is_empty() && args.touchdowns.len() != files.len() {
+        bail!(
+            "--touchdowns was given {} times for {} recordings: give one touchdowns file per recording, in order",
+            args.touchdowns.len(),
+            files.len()
+        );
+    }
+    let captures: Vec<Capture> =
+        files.iter().map(|f| mocap::read(f, args.format, args.body.as_deref())).collect::<Result<_>>()?;
+    let touchdowns: Vec<Vec<f64>> =
+        args.touchdowns.iter().map(|p| load_touchdowns(p)).collect::<Result<_>>()?;
+    let recordings: Vec<Recording> = captures
+        .iter()
+        .enumerate()
+        .map(|(i, c)| Recording {
+            positions: &c.positions,
+            frame_rate_hz: c.frame_rate_hz,
+            start_time_s: c.start_time_s,
+            touchdowns_s: touchdowns.get(i).map(|t| t.as_slice()),
+        })
+        .collect();
+    let analysis = analyse(&recordings, &options).map_err(|e| match e {
+        sandslope::GaitError::Param { index, source } => {
+            let source = if source.key == "cutoff_hz" { source.renamed("--cutoff") } else { source };
+            anyhow!(
+                "{}: {source} (at its frame rate {} Hz)",
+                captures[index].path.display(),
+                captures[index].frame_rate_hz
+            )
+        }
+        other => anyhow!("{other}"),
+    })?;
+    for (c, r) in captures.iter().zip(&analysis.recordings) {
+        if r.steps.is_empty() {
+            eprintln!(
+                "warning: {}: no complete step (T/2 = {} s without a gap longer than {} frames); not used",
+                c.path.display(),
+                options.step_duration(),
+                options.max_gap()
+            );
+        }
+    }
+    let rec = record(&captures, &analysis, period, &options, slope);
+
+    let mut campaign = None;
+    if let (Some(path), Some(slope_deg)) = (&args.speeds_out, slope) {
+        let sd = match rec.speed_sd_m_s {
+            Some(sd) if sd > 0.0 => sd,
+            _ => bail!(
+                "cannot append to {}: the speed SD needs at least two steps with different speeds (found {} steps)",
+                path.display(),
+                rec.steps
+            ),
+        };
+        Slope::from_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+        let rows = append_speed(path, SpeedRow { slope_deg, speed_m_s: rec.speed_m_s, speed_sd_m_s: sd })
+            .with_context(|| format!("appending to {}", path.display()))?;
+        campaign = Some(rows);
+    }
+    if let Some(path) = &args.plot {
+        let terrain = args.terrain.load()?;
+        let overlay = campaign.filter(|rows| {
+            let mut s: Vec<f64> = rows.iter().map(|r| r.slope_deg).collect();
+            s.sort_by(f64::total_cmp);
+            s.dedup();
+            s.len() >= 2
+        });
+        let fig = figure::TrackFigure::new(&analysis, period, slope, overlay, &robot, &terrain);
+        crate::plot::save(path, &fig)?;
+    }
+
+    match args.format_args.format() {
+        Format::Json => print_json(&rec),
+        Format::Csv => {
+            print!("{}", csv_string(&rec.per_step)?);
+            Ok(())
+        }
+        Format::Table => {
+            print_table(&rec);
+            Ok(())
+        }
+    }
+}
+
+fn print_table(r: &TrackRecord) {
+    let pm = |m: Option<f64>, sd: Option<f64>, scale: f64, d: usize| match (m, sd) {
+        (Some(m), Some(sd)) => format!("{:.d$} ± {:.d$}", m * scale, sd * scale),
+        (Some(m), None) => format!("{:.d$}", m * scale),
+        _ => "-".into(),
+    };
+    let mut t = table(&["quantity", "mean ± SD across steps", "unit"]);
+    let rows: Vec<[String; 3]> = vec![
+        ["slope".into(), num(r.slope_deg, 1), "deg".into()],
+        ["step-averaged speed v".into(), pm(Some(r.speed_m_s), r.speed_sd_m_s, 100.0, 2), "cm/s".into()],
+        ["anchoring time t1".into(), pm(r.t1_s, r.t1_sd_s, 1e3, 1), "ms".into()],
+        ["backward slip s1".into(), pm(r.slip_m, r.slip_sd_m, 1e3, 2), "mm".into()],
+        ["net step s".into(), pm(Some(r.step_m), r.step_sd_m, 1e3, 2), "mm".into()],
+        ["steps (unanchored)".into(), format!("{} ({})", r.steps, r.unanchored_steps), "".into()],
+        ["stride period T".into(), format!("{:.3}", r.period_s), "s".into()],
+        [
+            format!("upslope direction{}", if r.upslope_estimated { " (estimated)" } else { "" }),
+            format!("[{:.3}, {:.3}, {:.3}]", r.upslope[0], r.upslope[1], r.upslope[2]),
+            "".into(),
+        ],
+    ];
+    for row in rows {
+        t.add_row(row);
+    }
+    println!("{t}");
+    let mut f = table(&[
+        "file",
+        "body",
+        "fps",
+        "frames",
+        "segments",
+        "interp.",
+        "dropped",
+        "steps",
+        "touchdown phase",
+    ]);
+    for rec in &r.recordings {
+        f.add_row([
+            rec.file.clone(),
+            rec.body.clone(),
+            format!("{}", rec.frame_rate_hz),
+            rec.frames.to_string(),
+            rec.segments.to_string(),
+            rec.interpolated_frames.to_string(),
+            rec.dropped_frames.to_string(),
+            rec.steps.to_string(),
+            match rec.touchdown_phase_s {
+                Some(p) => format!("{:.1} ms (estimated)", p * 1e3),
+                None => rec.touchdowns.into(),
+            },
+        ]);
+    }
+    println!("{f}");
+}

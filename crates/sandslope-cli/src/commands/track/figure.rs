@@ -1,0 +1,257 @@
+//! The figures of `sandslope track`: speed within a stride (the paper's Fig. 3b) and, for a
+//! campaign over slopes, speed against slope with the model's curve (Fig. 3a).
+
+use anyhow::Result;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use sandslope::gait::GaitAnalysis;
+use sandslope::{predict, Robot, Slope, Terrain};
+
+use crate::error::plot_err;
+use crate::inputs::SpeedRow;
+use crate::plot::{font, range, Figure};
+
+/// What the stride panel draws, in plotting units (s, cm/s).
+pub struct TrackFigure {
+    time: Vec<f64>,
+    mean: Vec<f64>,
+    sd: Vec<f64>,
+    strides: usize,
+    period: f64,
+    t1: Option<f64>,
+    slope: Option<f64>,
+    measured: Vec<SpeedRow>,
+    model: Vec<Vec<(f64, f64)>>,
+}
+
+impl TrackFigure {
+    /// Prepares the figure; `campaign` (rows of the speeds file) adds the slope panel.
+    pub fn new(
+        a: &GaitAnalysis,
+        period: f64,
+        slope: Option<f64>,
+        campaign: Option<Vec<SpeedRow>>,
+        robot: &Robot,
+        terrain: &Terrain,
+    ) -> TrackFigure {
+        let (time, mean, sd, strides) = match &a.curve {
+            Some(c) => (
+                c.time_s.clone(),
+                c.mean.iter().map(|v| v * 100.0).collect(),
+                c.sd.iter().map(|v| v * 100.0).collect(),
+                c.strides,
+            ),
+            None => (Vec::new(), Vec::new(), Vec::new(), 0),
+        };
+        let measured = campaign.unwrap_or_default();
+        let mut model = Vec::new();
+        if !measured.is_empty() {
+            let top = measured.iter().map(|r| r.slope_deg).fold(0.0, f64::max).min(89.0);
+            let mut piece = Vec::new();
+            for k in 0..=400 {
+                let deg = (top + 2.0).min(89.0) * k as f64 / 400.0;
+                let Ok(s) = Slope::from_degrees(deg) else { continue };
+                match predict(robot, s, &terrain.sample(s).ground).speed {
+                    Some(v) => piece.push((deg, v * 100.0)),
+                    None if !piece.is_empty() => model.push(std::mem::take(&mut piece)),
+                    None => {}
+                }
+            }
+            if !piece.is_empty() {
+                model.push(piece);
+            }
+        }
+        TrackFigure {
+            time,
+            mean,
+            sd,
+            strides,
+            period,
+            t1: a.summary.anchoring_time.map(|s| s.mean),
+            slope,
+            measured,
+            model,
+        }
+    }
+
+    fn draw_stride<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let lo_hi = self.mean.iter().zip(&self.sd).flat_map(|(m, s)| [m - s, m + s]).chain([0.0]);
+        let (y0, y1) = range(lo_hi, (-5.0, 20.0));
+        let title = match self.slope {
+            Some(s) => format!("Speed within a stride, {s} deg ({} strides)", self.strides),
+            None => format!("Speed within a stride ({} strides)", self.strides),
+        };
+        let mut chart = ChartBuilder::on(area)
+            .caption(title, font(22.0))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..self.period, y0..y1)
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("time since touchdown t0 (s)")
+            .y_desc("upslope speed v (cm/s)")
+            .label_style(font(15.0))
+            .axis_desc_style(font(17.0))
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(plot_err)?;
+        let band: Vec<(f64, f64)> = self
+            .time
+            .iter()
+            .zip(self.mean.iter().zip(&self.sd))
+            .map(|(t, (m, s))| (*t, m + s))
+            .chain(self.time.iter().zip(self.mean.iter().zip(&self.sd)).rev().map(|(t, (m, s))| (*t, m - s)))
+            .collect();
+        chart
+            .draw_series(std::iter::once(Polygon::new(band, BLUE.mix(0.2).filled())))
+            .map_err(plot_err)?
+            .label("± 1 SD across strides")
+            .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], BLUE.mix(0.2).filled()));
+        chart
+            .draw_series(LineSeries::new(
+                self.time.iter().copied().zip(self.mean.iter().copied()),
+                BLUE.stroke_width(3),
+            ))
+            .map_err(plot_err)?
+            .label("mean speed")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(3)));
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(0.0, 0.0), (self.period, 0.0)],
+                BLACK.mix(0.5),
+            )))
+            .map_err(plot_err)?;
+        let half = 0.5 * self.period;
+        for (i, t0) in [0.0, half].into_iter().enumerate() {
+            let s = chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(t0, y0), (t0, y1)],
+                    BLACK.stroke_width(1),
+                )))
+                .map_err(plot_err)?;
+            if i == 0 {
+                s.label("touchdown t0 (every T/2)")
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
+            }
+            if let Some(t1) = self.t1 {
+                let x = t0 + t1;
+                let dashes = (0..40).filter(|k| k % 2 == 0).map(move |k| {
+                    let a = y0 + (y1 - y0) * k as f64 / 40.0;
+                    let b = y0 + (y1 - y0) * (k + 1) as f64 / 40.0;
+                    PathElement::new(vec![(x, a), (x, b)], RED.stroke_width(2))
+                });
+                let s = chart.draw_series(dashes).map_err(plot_err)?;
+                if i == 0 {
+                    s.label(format!("mean anchoring time t1 = {:.0} ms", t1 * 1e3))
+                        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+                }
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(font(14.0))
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(plot_err)?;
+        Ok(())
+    }
+
+    fn draw_slopes<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let top = self.measured.iter().map(|r| r.slope_deg).fold(0.0, f64::max) + 2.0;
+        let ys = self
+            .measured
+            .iter()
+            .flat_map(|r| [100.0 * (r.speed_m_s - r.speed_sd_m_s), 100.0 * (r.speed_m_s + r.speed_sd_m_s)])
+            .chain(self.model.iter().flatten().map(|p| p.1))
+            .chain([0.0]);
+        let (y0, y1) = range(ys, (0.0, 20.0));
+        let mut chart = ChartBuilder::on(area)
+            .caption("Speed against slope", font(22.0))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(60)
+            .build_cartesian_2d(-1.0..top, y0..y1)
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("slope θ (deg)")
+            .y_desc("step-averaged speed (cm/s)")
+            .label_style(font(15.0))
+            .axis_desc_style(font(17.0))
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(plot_err)?;
+        for (i, piece) in self.model.iter().enumerate() {
+            let s = chart
+                .draw_series(LineSeries::new(piece.iter().copied(), RED.stroke_width(2)))
+                .map_err(plot_err)?;
+            if i == 0 {
+                s.label("model (MODEL.md §3-5), robot and terrain given")
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+            }
+        }
+        chart
+            .draw_series(self.measured.iter().map(|r| {
+                ErrorBar::new_vertical(
+                    r.slope_deg,
+                    100.0 * (r.speed_m_s - r.speed_sd_m_s),
+                    100.0 * r.speed_m_s,
+                    100.0 * (r.speed_m_s + r.speed_sd_m_s),
+                    BLACK.stroke_width(2),
+                    8,
+                )
+            }))
+            .map_err(plot_err)?;
+        chart
+            .draw_series(
+                self.measured
+                    .iter()
+                    .map(|r| Circle::new((r.slope_deg, 100.0 * r.speed_m_s), 5, BLACK.filled())),
+            )
+            .map_err(plot_err)?
+            .label("tracked mean ± SD (speeds file)")
+            .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.filled()));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(font(14.0))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(plot_err)?;
+        Ok(())
+    }
+}
+
+impl Figure for TrackFigure {
+    fn size(&self) -> (u32, u32) {
+        if self.measured.is_empty() {
+            (1000, 650)
+        } else {
+            (1800, 650)
+        }
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        if self.measured.is_empty() {
+            return self.draw_stride(root);
+        }
+        let (left, right) = root.split_horizontally(1000);
+        self.draw_stride(&left)?;
+        self.draw_slopes(&right)
+    }
+}

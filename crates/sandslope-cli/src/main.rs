@@ -7,6 +7,7 @@ mod commands;
 mod error;
 mod inputs;
 mod output;
+mod plan;
 mod plot;
 mod presets;
 
@@ -27,12 +28,15 @@ enum Command {
     Predict(commands::predict::PredictArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
+    /// Heading-aware routes (fastest, safest, shortest) and risk maps over an elevation model.
+    Plan(commands::plan::PlanArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Predict(a) => commands::predict::run(a),
         Command::Presets(a) => commands::presets::run(a),
+        Command::Plan(a) => commands::plan::run(a),
     }
 }
 

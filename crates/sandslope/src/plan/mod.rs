@@ -22,7 +22,7 @@ mod search;
 mod table;
 
 pub use grid::{Cell, ElevationGrid};
-pub use search::{heading_offsets, Planner, Route, RouteStep, HEADINGS};
+pub use search::{heading_offsets, Planner, Route, RouteStep, HEADINGS, NO_CLASS};
 pub use table::{ClassTerrain, PitchTable, MAX_PITCH_DEG, P_FAIL_STEP_DEG, TAN_STEP};
 
 use serde::{Deserialize, Serialize};

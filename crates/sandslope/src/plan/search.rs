@@ -100,7 +100,8 @@ pub struct Route {
     pub steps: Vec<RouteStep>,
     /// Length along the surface, m.
     pub length_m: f64,
-    /// Travel time, s; `None` when some step has no positive speed or exceeds the roll limit.
+    /// Travel time, s; `None` when some step fails (sinkage or slippage: no progress), has no
+    /// positive speed or exceeds the roll limit.
     pub time_s: Option<f64>,
     /// Survival probability, `prod (1 - p_fail)^(cells crossed)` (MODEL.md section 9).
     pub survival: f64,
@@ -472,7 +473,7 @@ impl Planner {
             regimes[Regime::ALL.iter().position(|&r| r == s.regime).unwrap_or(0)] += 1;
         }
         let time_s = steps.iter().try_fold(0.0, |acc, s| match s.speed {
-            Some(v) if v > 0.0 && !s.over_roll_limit => Some(acc + s.length_m / v),
+            Some(v) if v > 0.0 && !s.over_roll_limit && !s.regime.is_failure() => Some(acc + s.length_m / v),
             _ => None,
         });
         let log_survival: f64 = steps.iter().map(|s| s.cells_crossed * (-s.p_fail).ln_1p()).sum();
@@ -488,6 +489,19 @@ impl Planner {
             over_roll_limit: steps.iter().filter(|s| s.over_roll_limit).count(),
             steps,
         }
+    }
+
+    /// The regime and P(failure) of climbing `cell` head-on, straight up its fall line
+    /// (pitch `atan |grad z|`, no roll); `None` where the cell is impassable.
+    pub fn fall_line(&self, cell: Cell) -> Option<(Regime, f64)> {
+        let i = self.grid.index(cell)?;
+        let g = self.grad[i];
+        if g[0].is_nan() {
+            return None;
+        }
+        let (_, k) = self.entries(EdgeGeom { tan_pitch: g[0].hypot(g[1]), tan_roll: 0.0 })?;
+        let t = &self.tables[usize::from(self.class[i])];
+        Some((t.regime(k), t.p_fail(k)))
     }
 
     /// Per cell, the lowest P(failure) over the 16 headings (roll over the limit counts as

@@ -47,7 +47,9 @@ impl Setup {
 
 /// Writes an ESRI ASCII grid with lower-left corner (0, 0); `z(x, y)` at cell centres.
 fn write_asc(path: &Path, cols: usize, rows: usize, z: impl Fn(f64, f64) -> f64) {
-    let mut s = format!("ncols {cols}\nnrows {rows}\nxllcorner 0\nyllcorner 0\ncellsize {CELL}\nNODATA_value -9999\n");
+    let mut s = format!(
+        "ncols {cols}\nnrows {rows}\nxllcorner 0\nyllcorner 0\ncellsize {CELL}\nNODATA_value -9999\n"
+    );
     for r in 0..rows {
         let y = (rows - r) as f64 * CELL - 0.5 * CELL;
         let line: Vec<String> = (0..cols).map(|c| format!("{:.6}", z((c as f64 + 0.5) * CELL, y))).collect();
@@ -58,8 +60,13 @@ fn write_asc(path: &Path, cols: usize, rows: usize, z: impl Fn(f64, f64) -> f64)
 }
 
 /// Writes a deflate-compressed single-band GeoTIFF with lower-left corner (0, 0).
-fn write_geotiff<C: colortype::ColorType>(path: &Path, cols: usize, rows: usize, data: &[C::Inner], nodata: &str)
-where
+fn write_geotiff<C: colortype::ColorType>(
+    path: &Path,
+    cols: usize,
+    rows: usize,
+    data: &[C::Inner],
+    nodata: &str,
+) where
     [C::Inner]: tiff::encoder::TiffValue,
 {
     let mut enc = TiffEncoder::new(BufWriter::new(File::create(path).unwrap()))
@@ -67,7 +74,9 @@ where
         .with_compression(Compression::Deflate(DeflateLevel::default()));
     let mut img = enc.new_image::<C>(cols as u32, rows as u32).unwrap();
     img.encoder().write_tag(Tag::ModelPixelScaleTag, &[CELL, CELL, 0.0][..]).unwrap();
-    img.encoder().write_tag(Tag::ModelTiepointTag, &[0.0, 0.0, 0.0, 0.0, rows as f64 * CELL, 0.0][..]).unwrap();
+    img.encoder()
+        .write_tag(Tag::ModelTiepointTag, &[0.0, 0.0, 0.0, 0.0, rows as f64 * CELL, 0.0][..])
+        .unwrap();
     img.encoder().write_tag(Tag::GdalNodata, nodata).unwrap();
     img.write_data(data).unwrap();
 }
@@ -101,7 +110,8 @@ fn read_csv(path: &Path) -> Vec<Vertex> {
     let mut r = csv::Reader::from_path(path).unwrap();
     let h = r.headers().unwrap().clone();
     let col = |name: &str| h.iter().position(|c| c == name).unwrap();
-    let (o, x, y, hd, rl, rg) = (col("objective"), col("x"), col("y"), col("heading_deg"), col("roll_deg"), col("regime"));
+    let (o, x, y, hd, rl, rg) =
+        (col("objective"), col("x"), col("y"), col("heading_deg"), col("roll_deg"), col("regime"));
     r.records()
         .map(|rec| {
             let rec = rec.unwrap();
@@ -203,7 +213,12 @@ fn gentle_plane_time_route_is_as_long_as_the_straight_line() {
     assert!(len <= straight * 1.028, "{len} vs {straight}");
     assert_eq!(j["routes"]["time"]["regimes"]["success"].as_u64().unwrap() as usize, {
         // every edge succeeds on a 5-degree plane
-        j["routes"]["time"]["regimes"].as_object().unwrap().values().map(|v| v.as_u64().unwrap() as usize).sum::<usize>()
+        j["routes"]["time"]["regimes"]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|v| v.as_u64().unwrap() as usize)
+            .sum::<usize>()
     });
 }
 
@@ -213,7 +228,8 @@ fn geotiff_nodata_hole_is_avoided_and_risk_map_is_georeferenced() {
     let (cols, rows) = (40, 30);
     // Level ground with a nodata block across the straight line from start to goal.
     let hole = |c: usize, r: usize| (15..25).contains(&c) && (5..25).contains(&r);
-    let data: Vec<f32> = (0..rows * cols).map(|i| if hole(i % cols, i / cols) { -9999.0 } else { 1.0 }).collect();
+    let data: Vec<f32> =
+        (0..rows * cols).map(|i| if hole(i % cols, i / cols) { -9999.0 } else { 1.0 }).collect();
     write_geotiff::<colortype::Gray32Float>(&s.path("hole.tif"), cols, rows, &data, "-9999");
     let out = s
         .cmd("hole.tif")
@@ -240,7 +256,10 @@ fn geotiff_nodata_hole_is_avoided_and_risk_map_is_georeferenced() {
     assert_eq!(dec.dimensions().unwrap(), (cols as u32, rows as u32));
     assert_eq!(dec.get_tag_unsigned::<u16>(Tag::SamplesPerPixel).unwrap(), 2);
     assert_eq!(dec.get_tag(Tag::ModelPixelScaleTag).unwrap().into_f64_vec().unwrap()[..2], [CELL, CELL]);
-    assert_eq!(dec.get_tag(Tag::ModelTiepointTag).unwrap().into_f64_vec().unwrap()[3..5], [0.0, rows as f64 * CELL]);
+    assert_eq!(
+        dec.get_tag(Tag::ModelTiepointTag).unwrap().into_f64_vec().unwrap()[3..5],
+        [0.0, rows as f64 * CELL]
+    );
     let tiff::decoder::DecodingResult::F32(px) = dec.read_image().unwrap() else { panic!("not float32") };
     let (p_fail, climb): (Vec<f32>, Vec<f32>) = px.chunks(2).map(|c| (c[0], c[1])).unzip();
     // Level ground: best-heading p_fail 0 wherever there is a slope; the hole is NaN.
@@ -288,13 +307,18 @@ fn classes_raster_keeps_the_time_route_off_weak_sand() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("class 2"), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("class 2"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
 fn start_or_goal_in_nodata_or_outside_is_a_clear_error_without_output() {
     let s = Setup::new();
-    let mut text = String::from("ncols 10\nnrows 10\nxllcorner 100\nyllcorner 200\ncellsize 1\nNODATA_value -9999\n");
+    let mut text =
+        String::from("ncols 10\nnrows 10\nxllcorner 100\nyllcorner 200\ncellsize 1\nNODATA_value -9999\n");
     for r in 0..10 {
         let row: Vec<&str> = (0..10).map(|c| if (r, c) == (4, 4) { "-9999" } else { "0" }).collect();
         text += &row.join(" ");
@@ -323,7 +347,8 @@ fn unreachable_goal_is_reported_as_not_found() {
     // degrees, so nothing but the distance route exists.
     let tan = 40.0_f64.to_radians().tan();
     write_asc(&s.path("wall.asc"), 20, 20, |_, y| tan * y);
-    let out = s.cmd("wall.asc").args(["--start-px", "10,17", "--goal-px", "10,3", "--json"]).output().unwrap();
+    let out =
+        s.cmd("wall.asc").args(["--start-px", "10,17", "--goal-px", "10,3", "--json"]).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let j = json_of(&out.stdout);
     assert_eq!(j["routes"]["time"]["found"], false);

@@ -9,7 +9,9 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use sandslope::plan::{Cell, ClassTerrain, Descent, ElevationGrid, NoRoute, Objective, PlanSettings, Planner, Route};
+use sandslope::plan::{
+    Cell, ClassTerrain, Descent, ElevationGrid, NoRoute, Objective, PlanSettings, Planner, Route,
+};
 use sandslope::{Regime, Uncertainty};
 
 use super::common::{RobotArgs, TerrainArgs};
@@ -100,6 +102,13 @@ pub struct PlanArgs {
     /// Coefficient of variation of k_s where the terrain gives no k_s_sd (risk, MODEL.md 9).
     #[arg(long, value_name = "CV", default_value_t = 0.2)]
     pub cv_s: f64,
+    #[command(flatten)]
+    pub out: Box<OutputArgs>,
+}
+
+/// Output files of `sandslope plan`.
+#[derive(Debug, Args)]
+pub struct OutputArgs {
     /// Write the routes as GeoJSON LineStrings in map coordinates.
     #[arg(long, value_name = "FILE")]
     pub geojson: Option<PathBuf>,
@@ -225,7 +234,11 @@ fn endpoint(raster: &Raster, which: &str, map: &Option<String>, px: &Option<Stri
 }
 
 /// Loads the terrain classes: one terrain everywhere, or a class raster with its terrains.
-fn load_classes(args: &PlanArgs, dem: &Raster, fallback: Uncertainty) -> Result<(Option<Vec<u8>>, Vec<ClassTerrain>)> {
+fn load_classes(
+    args: &PlanArgs,
+    dem: &Raster,
+    fallback: Uncertainty,
+) -> Result<(Option<Vec<u8>>, Vec<ClassTerrain>)> {
     let (Some(path), Some(spec)) = (&args.classes, &args.class_terrain) else {
         return Ok((None, vec![ClassTerrain { terrain: args.terrain.load()?, fallback }]));
     };
@@ -235,7 +248,8 @@ fn load_classes(args: &PlanArgs, dem: &Raster, fallback: Uncertainty) -> Result<
         let (k, t) = item
             .split_once('=')
             .ok_or_else(|| anyhow!("--class-terrain: `{item}` must be CLASS=TERRAIN, e.g. 1=dune.toml"))?;
-        let k: i64 = k.trim().parse().map_err(|_| anyhow!("--class-terrain: class `{k}` must be an integer"))?;
+        let k: i64 =
+            k.trim().parse().map_err(|_| anyhow!("--class-terrain: class `{k}` must be an integer"))?;
         if values.contains(&k) {
             bail!("--class-terrain: class {k} is given twice");
         }
@@ -291,14 +305,18 @@ pub fn run(args: PlanArgs) -> Result<()> {
         bail!("--max-roll = {max_roll} must be strictly between 0 and 90 degrees");
     }
     let time_weight = check_flag("--time-weight", args.time_weight, 0.0, f64::MAX)?;
-    let fallback = Uncertainty::new(check_flag("--cv-n", args.cv_n, 0.0, 10.0)?, check_flag("--cv-s", args.cv_s, 0.0, 10.0)?)
-        .map_err(|e| anyhow!("{e}"))?;
+    let fallback = Uncertainty::new(
+        check_flag("--cv-n", args.cv_n, 0.0, 10.0)?,
+        check_flag("--cv-s", args.cv_s, 0.0, 10.0)?,
+    )
+    .map_err(|e| anyhow!("{e}"))?;
     let descent = match args.descent {
         DescentArg::Symmetric => Descent::Symmetric,
         DescentArg::Level => Descent::Level,
     };
-    let settings = PlanSettings::new(max_roll, descent, args.allow_metastable, time_weight).map_err(|e| anyhow!("{e}"))?;
-    for p in [&args.plot].into_iter().flatten() {
+    let settings = PlanSettings::new(max_roll, descent, args.allow_metastable, time_weight)
+        .map_err(|e| anyhow!("{e}"))?;
+    for p in [&args.out.plot].into_iter().flatten() {
         crate::plot::format_of(p)?;
     }
 
@@ -320,7 +338,8 @@ pub fn run(args: PlanArgs) -> Result<()> {
     objectives.sort();
     objectives.dedup();
 
-    let show_progress = dem.values.len() >= PROGRESS_MIN_CELLS && std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let show_progress =
+        dem.values.len() >= PROGRESS_MIN_CELLS && std::io::IsTerminal::is_terminal(&std::io::stderr());
     let multi = MultiProgress::with_draw_target(if show_progress {
         ProgressDrawTarget::stderr()
     } else {
@@ -341,21 +360,23 @@ pub fn run(args: PlanArgs) -> Result<()> {
         .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
 
     let result = PlanResult { raster: &dem, planner: &planner, routes, start, goal };
-    if let Some(p) = &args.geojson {
+    if let Some(p) = &args.out.geojson {
         writers::write_geojson(p, &result)?;
     }
-    if let Some(p) = &args.csv {
+    if let Some(p) = &args.out.csv {
         writers::write_csv(p, &result)?;
     }
-    let risk = (args.risk_map.is_some() || args.plot.is_some()).then(|| planner.risk_map());
-    if let (Some(p), Some((p_fail, climb))) = (&args.risk_map, &risk) {
+    let risk = (args.out.risk_map.is_some() || args.out.plot.is_some()).then(|| planner.risk_map());
+    if let (Some(p), Some((p_fail, climb))) = (&args.out.risk_map, &risk) {
         write_two_band_geotiff(p, dem.cols, dem.rows, &dem.geo, p_fail, climb)?;
     }
-    if let (Some(p), Some((p_fail, _))) = (&args.plot, &risk) {
+    if let (Some(p), Some((p_fail, _))) = (&args.out.plot, &risk) {
         crate::plot::save(p, &figure::PlanFigure::new(&result, p_fail))?;
     }
     for t in planner.tables() {
-        if let (Some(last), Some(r)) = (t.extrapolated_from_deg(), result.routes.iter().find_map(|(_, r)| r.as_ref().ok())) {
+        if let (Some(last), Some(r)) =
+            (t.extrapolated_from_deg(), result.routes.iter().find_map(|(_, r)| r.as_ref().ok()))
+        {
             if r.max_pitch_deg > last {
                 eprintln!(
                     "warning: routes reach {:.1} deg, above the terrain's last measured point ({last} deg); k_n and \
@@ -367,12 +388,21 @@ pub fn run(args: PlanArgs) -> Result<()> {
         }
     }
 
-    if args.json {
+    if args.out.json {
         let routes: BTreeMap<&str, RouteRecord> =
             result.routes.iter().map(|(o, r)| (o.name(), RouteRecord::from(r))).collect();
         return print_json(&serde_json::json!({ "routes": routes }));
     }
-    let mut t = table(&["route", "found", "length m", "time s", "survival", "max pitch deg", "max roll deg", "edges by regime"]);
+    let mut t = table(&[
+        "route",
+        "found",
+        "length m",
+        "time s",
+        "survival",
+        "max pitch deg",
+        "max roll deg",
+        "edges by regime",
+    ]);
     for (o, r) in &result.routes {
         match r {
             Ok(r) => {
@@ -396,7 +426,16 @@ pub fn run(args: PlanArgs) -> Result<()> {
                 ]);
             }
             Err(e) => {
-                t.add_row(vec![o.name().to_string(), "no".into(), "-".into(), "-".into(), "-".into(), "-".into(), "-".into(), e.explain().into()]);
+                t.add_row(vec![
+                    o.name().to_string(),
+                    "no".into(),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                    e.explain().into(),
+                ]);
             }
         }
     }

@@ -97,12 +97,8 @@ impl PlanFigure {
                 colours.push(colour);
             }
         }
-        let extent = [
-            geo.west,
-            geo.west + cols as f64 * geo.cell_x,
-            geo.north - rows as f64 * geo.cell_y,
-            geo.north,
-        ];
+        let extent =
+            [geo.west, geo.west + cols as f64 * geo.cell_x, geo.north - rows as f64 * geo.cell_y, geo.north];
         let routes = result
             .routes
             .iter()
@@ -180,12 +176,18 @@ impl Figure for PlanFigure {
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
         }
         chart
-            .draw_series([Circle::new(self.start, 7, WHITE.filled()), Circle::new(self.start, 7, BLACK.stroke_width(2))])
+            .draw_series([
+                Circle::new(self.start, 7, WHITE.filled()),
+                Circle::new(self.start, 7, BLACK.stroke_width(2)),
+            ])
             .map_err(plot_err)?
             .label("start")
             .legend(|(x, y)| Circle::new((x + 12, y), 6, BLACK.stroke_width(2)));
         chart
-            .draw_series([TriangleMarker::new(self.goal, 9, WHITE.filled()), TriangleMarker::new(self.goal, 8, BLACK.filled())])
+            .draw_series([
+                TriangleMarker::new(self.goal, 9, WHITE.filled()),
+                TriangleMarker::new(self.goal, 8, BLACK.filled()),
+            ])
             .map_err(plot_err)?
             .label("goal")
             .legend(|(x, y)| TriangleMarker::new((x + 12, y), 7, BLACK.filled()));
@@ -202,7 +204,10 @@ impl Figure for PlanFigure {
         let (x0, y0) = (west + 0.05 * (east - west), south + 0.05 * (north - south));
         chart
             .draw_series([Rectangle::new(
-                [(x0 - 0.015 * (east - west), y0 - 0.025 * (north - south)), (x0 + len * 1.15, y0 + 0.06 * (north - south))],
+                [
+                    (x0 - 0.015 * (east - west), y0 - 0.025 * (north - south)),
+                    (x0 + len * 1.15, y0 + 0.06 * (north - south)),
+                ],
                 WHITE.mix(0.85).filled(),
             )])
             .map_err(plot_err)?;
@@ -210,7 +215,10 @@ impl Figure for PlanFigure {
             .draw_series([
                 PathElement::new(vec![(x0, y0), (x0 + len, y0)], BLACK.stroke_width(4)),
                 PathElement::new(vec![(x0, y0), (x0, y0 + 0.012 * (north - south))], BLACK.stroke_width(2)),
-                PathElement::new(vec![(x0 + len, y0), (x0 + len, y0 + 0.012 * (north - south))], BLACK.stroke_width(2)),
+                PathElement::new(
+                    vec![(x0 + len, y0), (x0 + len, y0 + 0.012 * (north - south))],
+                    BLACK.stroke_width(2),
+                ),
             ])
             .map_err(plot_err)?;
         chart

@@ -81,7 +81,10 @@ pub fn read_raster(path: &Path) -> Result<Raster> {
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("tif" | "tiff") => read_geotiff(path),
         Some("asc") => read_asc(path),
-        _ => bail!("{}: unknown raster format; use a GeoTIFF (.tif, .tiff) or an ESRI ASCII grid (.asc)", path.display()),
+        _ => bail!(
+            "{}: unknown raster format; use a GeoTIFF (.tif, .tiff) or an ESRI ASCII grid (.asc)",
+            path.display()
+        ),
     }
 }
 
@@ -186,9 +189,10 @@ fn read_asc(path: &Path) -> Result<Raster> {
         if !key.starts_with(|c: char| c.is_ascii_alphabetic()) {
             break;
         }
-        let value = it.next().and_then(|v| v.parse::<f64>().ok()).ok_or_else(|| {
-            anyhow!("{name}: line {}: header `{key}` needs a numeric value", i + 1)
-        })?;
+        let value = it
+            .next()
+            .and_then(|v| v.parse::<f64>().ok())
+            .ok_or_else(|| anyhow!("{name}: line {}: header `{key}` needs a numeric value", i + 1))?;
         header.insert(key.to_ascii_lowercase(), value);
         lines.next();
     }
@@ -225,7 +229,8 @@ fn read_asc(path: &Path) -> Result<Raster> {
     let mut values = Vec::with_capacity(cols * rows);
     for (i, line) in lines {
         for tok in line.split_whitespace() {
-            let v = tok.parse::<f64>().map_err(|_| anyhow!("{name}: line {}: `{tok}` is not a number", i + 1))?;
+            let v =
+                tok.parse::<f64>().map_err(|_| anyhow!("{name}: line {}: `{tok}` is not a number", i + 1))?;
             values.push(v);
         }
     }

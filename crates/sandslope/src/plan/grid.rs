@@ -44,7 +44,9 @@ impl ElevationGrid {
             }
         }
         if cols < 3 || rows < 3 {
-            return Err(PlanError::Grid(format!("the grid is {cols} x {rows} cells; at least 3 x 3 are needed")));
+            return Err(PlanError::Grid(format!(
+                "the grid is {cols} x {rows} cells; at least 3 x 3 are needed"
+            )));
         }
         let n = cols.checked_mul(rows).filter(|&n| n < u32::MAX as usize).ok_or_else(|| {
             PlanError::Grid(format!("{cols} x {rows} cells is more than the planner's 4 294 967 295"))
@@ -125,16 +127,17 @@ impl ElevationGrid {
             if r == 0 || r + 1 == rows {
                 return;
             }
-            for c in 1..cols - 1 {
+            for (c, out) in out_row.iter_mut().enumerate().take(cols - 1).skip(1) {
                 let (n, m, s) = ((r - 1) * cols + c, r * cols + c, (r + 1) * cols + c);
                 let ok = [n - 1, n, n + 1, m - 1, m, m + 1, s - 1, s, s + 1].iter().all(|&i| v[i]);
                 if !ok {
                     continue;
                 }
                 let h = |i: usize| f64::from(z[i]);
-                let dzdx = ((h(n + 1) + 2.0 * h(m + 1) + h(s + 1)) - (h(n - 1) + 2.0 * h(m - 1) + h(s - 1))) * sx;
+                let dzdx =
+                    ((h(n + 1) + 2.0 * h(m + 1) + h(s + 1)) - (h(n - 1) + 2.0 * h(m - 1) + h(s - 1))) * sx;
                 let dzdy = ((h(n - 1) + 2.0 * h(n) + h(n + 1)) - (h(s - 1) + 2.0 * h(s) + h(s + 1))) * sy;
-                out_row[c] = [dzdx as f32, dzdy as f32];
+                *out = [dzdx as f32, dzdy as f32];
             }
         };
         use rayon::prelude::*;

@@ -103,10 +103,10 @@ impl PlanSettings {
         allow_metastable: bool,
         time_weight: f64,
     ) -> Result<PlanSettings, ParamError> {
-        let max_roll = Slope::from_degrees(max_roll_deg)
-            .ok()
-            .filter(|_| max_roll_deg > 0.0)
-            .ok_or_else(|| ParamError::new("max_roll_deg", max_roll_deg, "strictly between 0 and 90 degrees"))?;
+        let max_roll =
+            Slope::from_degrees(max_roll_deg).ok().filter(|_| max_roll_deg > 0.0).ok_or_else(|| {
+                ParamError::new("max_roll_deg", max_roll_deg, "strictly between 0 and 90 degrees")
+            })?;
         let time_weight = crate::error::non_negative("time_weight", time_weight)?;
         Ok(PlanSettings { max_roll, descent, allow_metastable, time_weight })
     }
@@ -181,8 +181,12 @@ impl NoRoute {
     /// A one-line explanation for users.
     pub fn explain(self) -> &'static str {
         match self {
-            NoRoute::StartImpassable => "start impassable: every heading out of the start cell is too steep or too cross-sloped",
-            NoRoute::GoalImpassable => "goal impassable: every heading into the goal cell is too steep or too cross-sloped",
+            NoRoute::StartImpassable => {
+                "start impassable: every heading out of the start cell is too steep or too cross-sloped"
+            }
+            NoRoute::GoalImpassable => {
+                "goal impassable: every heading into the goal cell is too steep or too cross-sloped"
+            }
             NoRoute::GoalUnreachable => "goal unreachable: no chain of passable edges joins start and goal",
         }
     }

@@ -92,7 +92,8 @@ impl PitchTable {
             })
             .collect();
         let last = class.terrain.points().last().map_or(0.0, |p| p.slope_deg);
-        let extrapolated_from_deg = (class.terrain.points().len() > 1 && last < MAX_PITCH_DEG).then_some(last);
+        let extrapolated_from_deg =
+            (class.terrain.points().len() > 1 && last < MAX_PITCH_DEG).then_some(last);
         let (regime, speed) = rows.into_iter().unzip();
         PitchTable { regime, speed, p_fail, extrapolated_from_deg }
     }
@@ -161,7 +162,8 @@ mod tests {
             let p = predict(&robot, slope, &Ground::new(7e5, 2e6).unwrap());
             assert_eq!(t.regime(i), p.regime);
             assert!((t.speed(i).unwrap() - p.speed.unwrap()).abs() < 1e-6);
-            let q = regime_probabilities(&robot, slope, &Ground::new(7e5, 2e6).unwrap(), class.fallback).p_fail();
+            let q =
+                regime_probabilities(&robot, slope, &Ground::new(7e5, 2e6).unwrap(), class.fallback).p_fail();
             // Linear interpolation over 0.1 degree.
             assert!((t.p_fail(i) - q).abs() < 0.02, "{deg}: {} vs {q}", t.p_fail(i));
         }

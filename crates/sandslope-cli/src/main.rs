@@ -9,6 +9,7 @@ mod inputs;
 mod measurements;
 mod mocap;
 mod output;
+mod plan;
 mod plot;
 mod presets;
 
@@ -37,6 +38,8 @@ enum Command {
     Presets(commands::presets::PresetsArgs),
     /// Speed, anchoring time t1 and slip per step from motion-capture recordings at one slope.
     Track(commands::track::TrackArgs),
+    /// Heading-aware routes (fastest, safest, shortest) and risk maps over an elevation model.
+    Plan(commands::plan::PlanArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -47,6 +50,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Presets(a) => commands::presets::run(a),
         Command::Fit(a) => commands::fit::run(a),
         Command::Track(a) => commands::track::run(a),
+        Command::Plan(a) => commands::plan::run(a),
     }
 }
 

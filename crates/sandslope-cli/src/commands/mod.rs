@@ -3,6 +3,7 @@
 pub mod calibrate;
 pub mod common;
 pub mod fit;
+pub mod plan;
 pub mod predict;
 pub mod presets;
 pub mod sweep;

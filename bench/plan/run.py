@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""Benchmark of `sandslope plan` on a 4096 x 4096 DEM, against scikit-image's MCP_Geometric.
+
+What it does (run from anywhere; takes a few minutes the first time):
+1. pip-installs numpy, tifffile and scikit-image if missing;
+2. builds the release binary (`cargo build --release -p sandslope-cli`);
+3. writes a synthetic dune field as a float32 GeoTIFF (4096 x 4096 cells of 0.25 m, heights
+   from a sum of sines with slopes up to about 30 degrees, deflate-compressed, tiled 256 x 256
+   as GDAL writes large rasters);
+4. times `sandslope plan --objective time` (the time route plus the distance route, run
+   concurrently) from near the south-west corner to near the north-east corner, under
+   /usr/bin/time -v for the peak memory (maximum resident set size);
+5. times `skimage.graph.MCP_Geometric` on the same grid with an isotropic per-cell cost
+   (1 / level speed * sec(slope) per metre: one cost per cell, no heading) between the same
+   cells, and prints the time ratio.
+
+Usage: python3 bench/plan/run.py [--size 4096]
+"""
+import argparse
+import os
+import re
+import subprocess
+import sys
+import time
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+
+
+def ensure(packages):
+    missing = []
+    for mod, pkg in packages:
+        try:
+            __import__(mod)
+        except ImportError:
+            missing.append(pkg)
+    if missing:
+        subprocess.check_call([sys.executable, "-m", "pip", "install", "--quiet", *missing])
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--size", type=int, default=4096)
+    ap.add_argument("--cell", type=float, default=0.25)
+    args = ap.parse_args()
+    ensure([("numpy", "numpy"), ("tifffile", "tifffile"), ("skimage", "scikit-image")])
+    import numpy as np
+    import tifffile
+    from skimage.graph import MCP_Geometric
+
+    subprocess.check_call(["cargo", "build", "--release", "-q", "-p", "sandslope-cli"], cwd=ROOT)
+    exe = os.path.join(ROOT, "target", "release", "sandslope")
+
+    n, cell = args.size, args.cell
+    work = os.path.join(ROOT, "target", "bench-plan")
+    os.makedirs(work, exist_ok=True)
+    dem_path = os.path.join(work, f"dunes-v2-{n}.tif")
+    x = (np.arange(n) + 0.5) * cell
+    y = (n - np.arange(n) - 0.5) * cell
+    X, Y = np.meshgrid(x, y)
+    # Dune crests every ~40 m with amplitude up to 3 m (steepest ~ 3 * 2 pi / 40 = 0.47,
+    # 25 deg), modulated along the crests, plus smaller superimposed dunes (0.25 m, 11 m):
+    # slopes up to ~30 deg, so direct climbs often fail and routes must switch back.
+    z = (3.0 * np.sin(2 * np.pi * X / 40.0 + 0.8 * np.sin(2 * np.pi * Y / 90.0)) * (0.6 + 0.4 * np.cos(2 * np.pi * Y / 130.0))
+         + 0.25 * np.sin(2 * np.pi * (X + Y) / 11.0)).astype(np.float32)
+    if not os.path.exists(dem_path):
+        tifffile.imwrite(
+            dem_path, z, tile=(256, 256), compression="zlib",
+            extratags=[(33550, "d", 3, (cell, cell, 0.0)), (33922, "d", 6, (0, 0, 0, 0.0, n * cell, 0.0)),
+                       (42113, "s", 0, "-9999", False)])
+    start = (int(0.03 * n), int(0.97 * n))  # col, row: near the south-west corner
+    goal = (int(0.97 * n), int(0.03 * n))  # near the north-east corner
+    cmd = ["/usr/bin/time", "-v", exe, "plan", "--dem", dem_path, "--start-px", f"{start[0]},{start[1]}",
+           "--goal-px", f"{goal[0]},{goal[1]}", "--objective", "time", "--json"]
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    t_ours = time.perf_counter() - t0
+    if p.returncode != 0:
+        print(p.stderr)
+        sys.exit(1)
+    rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1))
+    print(p.stdout)
+    print(f"sandslope plan ({n} x {n}, time + distance routes): {t_ours:.2f} s wall, peak RSS {rss_kb / 1024:.0f} MiB")
+
+    # Isotropic per-cell cost: seconds per metre at the cell's own slope, level-sand speed
+    # 0.15 m/s (the model's level speed for the default robot and terrain), sec(slope)
+    # for the surface length.
+    gy, gx = np.gradient(z.astype(np.float64), cell)
+    cost = np.sqrt(1.0 + gx * gx + gy * gy) / 0.15
+    t0 = time.perf_counter()
+    m = MCP_Geometric(cost, fully_connected=True, sampling=(cell, cell))
+    m.find_costs([(start[1], start[0])], [(goal[1], goal[0])], find_all_ends=True)
+    path = m.traceback((goal[1], goal[0]))
+    t_mcp = time.perf_counter() - t0
+    print(f"skimage MCP_Geometric (isotropic, 8-connected): {t_mcp:.2f} s, {len(path)} cells on its path")
+    print(f"time ratio sandslope / MCP_Geometric: {t_ours / t_mcp:.2f}")
+
+
+if __name__ == "__main__":
+    main()

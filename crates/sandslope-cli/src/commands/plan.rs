@@ -1,0 +1,444 @@
+//! `sandslope plan`: heading-aware routes and risk maps over an elevation model.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Context, Result};
+use clap::{Args, ValueEnum};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use sandslope::plan::{
+    Cell, ClassTerrain, Descent, ElevationGrid, NoRoute, Objective, PlanSettings, Planner, Route,
+};
+use sandslope::{Regime, Uncertainty};
+
+use super::common::{RobotArgs, TerrainArgs};
+use crate::inputs::{check_flag, load_terrain};
+use crate::output::{num, print_json, table};
+use crate::plan::raster::{read_raster, write_two_band_geotiff, Raster};
+use crate::plan::{figure, writers};
+
+/// Maps at least this large get a progress bar (on a terminal).
+const PROGRESS_MIN_CELLS: usize = 1 << 20;
+
+/// `--objective` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, ValueEnum)]
+pub enum ObjectiveArg {
+    /// Fastest route through cells whose regime is success.
+    Time,
+    /// Maximum survival probability (plus --time-weight times the time).
+    Risk,
+    /// Shortest 3-D length, physics ignored (the naive baseline).
+    Distance,
+}
+
+impl From<ObjectiveArg> for Objective {
+    fn from(o: ObjectiveArg) -> Objective {
+        match o {
+            ObjectiveArg::Time => Objective::Time,
+            ObjectiveArg::Risk => Objective::Risk,
+            ObjectiveArg::Distance => Objective::Distance,
+        }
+    }
+}
+
+/// `--descent` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DescentArg {
+    /// Descending evaluated as climbing |pitch| (MODEL.md section 8 default).
+    Symmetric,
+    /// Descending evaluated as level ground (optimistic).
+    Level,
+}
+
+/// Arguments of `sandslope plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// Elevation model: GeoTIFF (.tif) or ESRI ASCII grid (.asc), heights and cell size in metres.
+    #[arg(long, value_name = "FILE")]
+    pub dem: PathBuf,
+    /// Start in map coordinates.
+    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, required_unless_present = "start_px")]
+    pub start: Option<String>,
+    /// Goal in map coordinates.
+    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, required_unless_present = "goal_px")]
+    pub goal: Option<String>,
+    /// Start as a cell of the DEM (column, row from the north-west corner).
+    #[arg(long, value_name = "COL,ROW", conflicts_with = "start")]
+    pub start_px: Option<String>,
+    /// Goal as a cell of the DEM (column, row from the north-west corner).
+    #[arg(long, value_name = "COL,ROW", conflicts_with = "goal")]
+    pub goal_px: Option<String>,
+    /// What to minimise (comma-separated for several); the distance route is always added.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "time")]
+    pub objective: Vec<ObjectiveArg>,
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    pub terrain: TerrainArgs,
+    /// Integer raster aligned with the DEM giving each cell's terrain class.
+    #[arg(long, value_name = "FILE", requires = "class_terrain")]
+    pub classes: Option<PathBuf>,
+    /// Terrain of each class, e.g. `1=dune.toml,2=crust.toml` (files or presets).
+    #[arg(long, value_name = "CLASS=TERRAIN,...", requires = "classes")]
+    pub class_terrain: Option<String>,
+    /// Let the time objective use metastable edges (0 < step < s_min).
+    #[arg(long)]
+    pub allow_metastable: bool,
+    /// Risk objective: weight of travel time, per second (1e-4: 100 s weigh like a 1 % risk).
+    #[arg(long, value_name = "PER_S", default_value_t = sandslope::plan::DEFAULT_TIME_WEIGHT)]
+    pub time_weight: f64,
+    /// Cross-slope (roll) limit, degrees: steeper cross slopes are impassable.
+    #[arg(long, value_name = "DEG", default_value_t = 20.0)]
+    pub max_roll: f64,
+    /// How descending edges are evaluated.
+    #[arg(long, value_enum, default_value = "symmetric")]
+    pub descent: DescentArg,
+    /// Coefficient of variation of k_n where the terrain gives no k_n_sd (risk, MODEL.md 9).
+    #[arg(long, value_name = "CV", default_value_t = 0.1)]
+    pub cv_n: f64,
+    /// Coefficient of variation of k_s where the terrain gives no k_s_sd (risk, MODEL.md 9).
+    #[arg(long, value_name = "CV", default_value_t = 0.2)]
+    pub cv_s: f64,
+    #[command(flatten)]
+    pub out: Box<OutputArgs>,
+}
+
+/// Output files of `sandslope plan`.
+#[derive(Debug, Args)]
+pub struct OutputArgs {
+    /// Write the routes as GeoJSON LineStrings in map coordinates.
+    #[arg(long, value_name = "FILE")]
+    pub geojson: Option<PathBuf>,
+    /// Write one row per route vertex (x, y, z, heading, pitch, roll, regime, speed, p_fail).
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Draw hillshade, risk layer and routes (PNG or SVG).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+    /// Write a 2-band GeoTIFF: best-heading p_fail, steepest safe climb azimuth (deg from north).
+    #[arg(long, value_name = "FILE")]
+    pub risk_map: Option<PathBuf>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One route as printed by `--json`.
+#[derive(Debug, Serialize)]
+pub struct RouteRecord {
+    pub found: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<NoRoute>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub message: Option<&'static str>,
+    pub length_m: Option<f64>,
+    pub time_s: Option<f64>,
+    pub survival: Option<f64>,
+    pub max_pitch_deg: Option<f64>,
+    pub max_roll_deg: Option<f64>,
+    pub edges_over_roll_limit: Option<usize>,
+    pub regimes: Option<BTreeMap<&'static str, usize>>,
+}
+
+impl RouteRecord {
+    fn from(r: &Result<Route, NoRoute>) -> RouteRecord {
+        match r {
+            Ok(r) => RouteRecord {
+                found: true,
+                reason: None,
+                message: None,
+                length_m: Some(r.length_m),
+                time_s: r.time_s,
+                survival: Some(r.survival),
+                max_pitch_deg: Some(r.max_pitch_deg),
+                max_roll_deg: Some(r.max_roll_deg),
+                edges_over_roll_limit: Some(r.over_roll_limit),
+                regimes: Some(Regime::ALL.iter().zip(r.regimes).map(|(g, n)| (g.name(), n)).collect()),
+            },
+            Err(e) => RouteRecord {
+                found: false,
+                reason: Some(*e),
+                message: Some(e.explain()),
+                length_m: None,
+                time_s: None,
+                survival: None,
+                max_pitch_deg: None,
+                max_roll_deg: None,
+                edges_over_roll_limit: None,
+                regimes: None,
+            },
+        }
+    }
+}
+
+/// Everything `plan` computed, for the writers.
+pub struct PlanResult<'a> {
+    /// DEM raster (georeferencing).
+    pub raster: &'a Raster,
+    /// The planner (grid, tables).
+    pub planner: &'a Planner,
+    /// Routes by objective.
+    pub routes: Vec<(Objective, Result<Route, NoRoute>)>,
+    /// Start and goal cells.
+    pub start: Cell,
+    /// Goal cell.
+    pub goal: Cell,
+}
+
+fn parse_pair(flag: &str, s: &str) -> Result<(f64, f64)> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    match parts.as_slice() {
+        [a, b] => match (a.parse::<f64>(), b.parse::<f64>()) {
+            (Ok(a), Ok(b)) if a.is_finite() && b.is_finite() => Ok((a, b)),
+            _ => bail!("{flag} = `{s}` must be two numbers separated by a comma"),
+        },
+        _ => bail!("{flag} = `{s}` must be two numbers separated by a comma"),
+    }
+}
+
+fn endpoint(raster: &Raster, which: &str, map: &Option<String>, px: &Option<String>) -> Result<Cell> {
+    let (cols, rows) = (raster.cols, raster.rows);
+    let (c, r, what) = if let Some(s) = px {
+        let (c, r) = parse_pair(&format!("--{which}-px"), s)?;
+        if c.fract() != 0.0 || r.fract() != 0.0 {
+            bail!("--{which}-px = `{s}` must be whole column and row numbers");
+        }
+        (c, r, format!("--{which}-px {s}"))
+    } else if let Some(s) = map {
+        let (x, y) = parse_pair(&format!("--{which}"), s)?;
+        let (c, r) = raster.geo.cell_of(x, y);
+        (c, r, format!("--{which} {s}"))
+    } else {
+        bail!("give --{which} X,Y or --{which}-px COL,ROW");
+    };
+    if c < 0.0 || r < 0.0 || c >= cols as f64 || r >= rows as f64 {
+        let g = &raster.geo;
+        bail!(
+            "{what} is outside the map: x {} to {}, y {} to {} (columns 0 to {}, rows 0 to {})",
+            g.west,
+            g.west + cols as f64 * g.cell_x,
+            g.north - rows as f64 * g.cell_y,
+            g.north,
+            cols - 1,
+            rows - 1
+        );
+    }
+    let cell = Cell { col: c as usize, row: r as usize };
+    if raster.is_nodata(cell.row * cols + cell.col) {
+        bail!("{what} lies on a nodata cell (column {}, row {}) of the DEM", cell.col, cell.row);
+    }
+    Ok(cell)
+}
+
+/// Loads the terrain classes: one terrain everywhere, or a class raster with its terrains.
+fn load_classes(
+    args: &PlanArgs,
+    dem: &Raster,
+    fallback: Uncertainty,
+) -> Result<(Option<Vec<u8>>, Vec<ClassTerrain>)> {
+    let (Some(path), Some(spec)) = (&args.classes, &args.class_terrain) else {
+        return Ok((None, vec![ClassTerrain { terrain: args.terrain.load()?, fallback }]));
+    };
+    let mut values = Vec::new();
+    let mut terrains = Vec::new();
+    for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let (k, t) = item
+            .split_once('=')
+            .ok_or_else(|| anyhow!("--class-terrain: `{item}` must be CLASS=TERRAIN, e.g. 1=dune.toml"))?;
+        let k: i64 =
+            k.trim().parse().map_err(|_| anyhow!("--class-terrain: class `{k}` must be an integer"))?;
+        if values.contains(&k) {
+            bail!("--class-terrain: class {k} is given twice");
+        }
+        let terrain = load_terrain(t.trim()).with_context(|| format!("--class-terrain: class {k}"))?;
+        values.push(k);
+        terrains.push(ClassTerrain { terrain, fallback });
+    }
+    if terrains.is_empty() || terrains.len() > 254 {
+        bail!("--class-terrain: give between 1 and 254 CLASS=TERRAIN pairs");
+    }
+    let classes = read_raster(path)?;
+    if classes.cols != dem.cols || classes.rows != dem.rows || !classes.geo.aligned(&dem.geo) {
+        bail!(
+            "{}: the class raster ({} x {}) must be aligned with the DEM ({} x {}): same size, origin and cell size",
+            path.display(),
+            classes.cols,
+            classes.rows,
+            dem.cols,
+            dem.rows
+        );
+    }
+    let mut missing = BTreeMap::new();
+    let idx: Vec<u8> = (0..classes.values.len())
+        .map(|i| {
+            if classes.is_nodata(i) {
+                return sandslope::plan::NO_CLASS;
+            }
+            let v = classes.values[i];
+            match values.iter().position(|&k| k as f64 == v) {
+                Some(p) => p as u8,
+                None => {
+                    *missing.entry(v.to_string()).or_insert(0usize) += 1;
+                    sandslope::plan::NO_CLASS
+                }
+            }
+        })
+        .collect();
+    if let Some((v, n)) = missing.iter().next() {
+        bail!(
+            "{}: class {v} ({n} cells) has no terrain; add it to --class-terrain (given: {})",
+            path.display(),
+            values.iter().map(|k| k.to_string()).collect::<Vec<_>>().join(", ")
+        );
+    }
+    Ok((Some(idx), terrains))
+}
+
+/// Runs `sandslope plan`.
+pub fn run(args: PlanArgs) -> Result<()> {
+    let robot = args.robot.load()?;
+    let max_roll = check_flag("--max-roll", args.max_roll, 0.0, 90.0)?;
+    if max_roll <= 0.0 || max_roll >= 90.0 {
+        bail!("--max-roll = {max_roll} must be strictly between 0 and 90 degrees");
+    }
+    let time_weight = check_flag("--time-weight", args.time_weight, 0.0, f64::MAX)?;
+    let fallback = Uncertainty::new(
+        check_flag("--cv-n", args.cv_n, 0.0, 10.0)?,
+        check_flag("--cv-s", args.cv_s, 0.0, 10.0)?,
+    )
+    .map_err(|e| anyhow!("{e}"))?;
+    let descent = match args.descent {
+        DescentArg::Symmetric => Descent::Symmetric,
+        DescentArg::Level => Descent::Level,
+    };
+    let settings = PlanSettings::new(max_roll, descent, args.allow_metastable, time_weight)
+        .map_err(|e| anyhow!("{e}"))?;
+    for p in [&args.out.plot].into_iter().flatten() {
+        crate::plot::format_of(p)?;
+    }
+
+    let dem = read_raster(&args.dem)?;
+    let start = endpoint(&dem, "start", &args.start, &args.start_px)?;
+    let goal = endpoint(&dem, "goal", &args.goal, &args.goal_px)?;
+    let (classes, terrains) = load_classes(&args, &dem, fallback)?;
+    let mask: Vec<bool> = (0..dem.values.len()).map(|i| dem.is_nodata(i)).collect();
+    let z: Vec<f32> = dem.values.iter().map(|&v| v as f32).collect();
+    let grid = ElevationGrid::new(dem.cols, dem.rows, dem.geo.cell_x, dem.geo.cell_y, z, Some(&mask))
+        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+    drop(mask);
+    let planner = Planner::new(grid, classes, &terrains, &robot, settings).map_err(|e| anyhow!("{e}"))?;
+    planner.check_endpoint(start, "start").map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+    planner.check_endpoint(goal, "goal").map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+
+    let mut objectives: Vec<Objective> = args.objective.iter().map(|&o| o.into()).collect();
+    objectives.push(Objective::Distance);
+    objectives.sort();
+    objectives.dedup();
+
+    let show_progress =
+        dem.values.len() >= PROGRESS_MIN_CELLS && std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let multi = MultiProgress::with_draw_target(if show_progress {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    });
+    let total = if show_progress { planner.passable_cells() as u64 } else { 0 };
+    let style = ProgressStyle::with_template("{prefix:>9} {bar:40} {pos}/{len} cells settled ({elapsed})")
+        .unwrap_or_else(|_| ProgressStyle::default_bar());
+    let routes: Vec<(Objective, Result<Route, NoRoute>)> = objectives
+        .par_iter()
+        .map(|&obj| {
+            let bar = multi.add(ProgressBar::new(total).with_style(style.clone()).with_prefix(obj.name()));
+            let r = planner.route(obj, start, goal, &|n| bar.set_position(n));
+            bar.finish();
+            r.map(|r| (obj, r))
+        })
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+
+    let result = PlanResult { raster: &dem, planner: &planner, routes, start, goal };
+    if let Some(p) = &args.out.geojson {
+        writers::write_geojson(p, &result)?;
+    }
+    if let Some(p) = &args.out.csv {
+        writers::write_csv(p, &result)?;
+    }
+    let risk = (args.out.risk_map.is_some() || args.out.plot.is_some()).then(|| planner.risk_map());
+    if let (Some(p), Some((p_fail, climb))) = (&args.out.risk_map, &risk) {
+        write_two_band_geotiff(p, dem.cols, dem.rows, &dem.geo, p_fail, climb)?;
+    }
+    if let (Some(p), Some((p_fail, _))) = (&args.out.plot, &risk) {
+        crate::plot::save(p, &figure::PlanFigure::new(&result, p_fail))?;
+    }
+    for t in planner.tables() {
+        if let (Some(last), Some(r)) =
+            (t.extrapolated_from_deg(), result.routes.iter().find_map(|(_, r)| r.as_ref().ok()))
+        {
+            if r.max_pitch_deg > last {
+                eprintln!(
+                    "warning: routes reach {:.1} deg, above the terrain's last measured point ({last} deg); k_n and \
+                     k_s are extrapolated linearly and floored at zero",
+                    r.max_pitch_deg
+                );
+                break;
+            }
+        }
+    }
+
+    if args.out.json {
+        let routes: BTreeMap<&str, RouteRecord> =
+            result.routes.iter().map(|(o, r)| (o.name(), RouteRecord::from(r))).collect();
+        return print_json(&serde_json::json!({ "routes": routes }));
+    }
+    let mut t = table(&[
+        "route",
+        "found",
+        "length m",
+        "time s",
+        "survival",
+        "max pitch deg",
+        "max roll deg",
+        "edges by regime",
+    ]);
+    for (o, r) in &result.routes {
+        match r {
+            Ok(r) => {
+                let regimes = Regime::ALL
+                    .iter()
+                    .zip(r.regimes)
+                    .filter(|(_, n)| *n > 0)
+                    .map(|(g, n)| format!("{g} {n}"))
+                    .chain((r.over_roll_limit > 0).then(|| format!("over roll limit {}", r.over_roll_limit)))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                t.add_row(vec![
+                    o.name().to_string(),
+                    "yes".into(),
+                    num(Some(r.length_m), 1),
+                    num(r.time_s, 1),
+                    format!("{:.4}", r.survival),
+                    num(Some(r.max_pitch_deg), 1),
+                    num(Some(r.max_roll_deg), 1),
+                    regimes,
+                ]);
+            }
+            Err(e) => {
+                t.add_row(vec![
+                    o.name().to_string(),
+                    "no".into(),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                    e.explain().into(),
+                ]);
+            }
+        }
+    }
+    println!("{t}");
+    Ok(())
+}

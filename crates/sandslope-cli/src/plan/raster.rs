@@ -1,0 +1,306 @@
+//! Raster files for `sandslope plan`: GeoTIFF (read with the `tiff` crate: float32/float64
+//! and integer samples, strips or tiles, any compression the crate decodes, the GeoTIFF
+//! ModelPixelScale/ModelTiepoint/ModelTransformation and GDAL_NODATA tags) and ESRI ASCII
+//! grids (`.asc`); and a two-band float32 GeoTIFF writer georeferenced like the input.
+
+use std::fs::File;
+use std::io::{BufReader, BufWriter};
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Context, Result};
+use tiff::decoder::{Decoder, DecodingResult, Limits};
+use tiff::encoder::{colortype::Gray32Float, compression::DeflateLevel, Compression, TiffEncoder};
+use tiff::tags::{ExtraSamples, Tag};
+
+/// GeoKey GTRasterTypeGeoKey and its value RasterPixelIsPoint.
+const GT_RASTER_TYPE: u16 = 1025;
+const PIXEL_IS_POINT: u16 = 2;
+
+/// Where a raster sits on the map: the north-west corner of its north-west cell and the cell
+/// size (x east, y north). Plus the raw GeoTIFF georeferencing tags, copied to outputs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeoRef {
+    /// Map x of the western edge of column 0.
+    pub west: f64,
+    /// Map y of the northern edge of row 0.
+    pub north: f64,
+    /// Cell width, map units.
+    pub cell_x: f64,
+    /// Cell height, map units.
+    pub cell_y: f64,
+    /// GeoKeyDirectory, GeoDoubleParams, GeoAsciiParams of the source, if any.
+    pub geokeys: Option<Vec<u16>>,
+    geodoubles: Option<Vec<f64>>,
+    geoascii: Option<String>,
+}
+
+impl GeoRef {
+    /// Map coordinates of the centre of (col, row).
+    pub fn centre(&self, col: usize, row: usize) -> (f64, f64) {
+        (self.west + (col as f64 + 0.5) * self.cell_x, self.north - (row as f64 + 0.5) * self.cell_y)
+    }
+    /// The (col, row) containing map point (x, y), as signed numbers (may be outside).
+    pub fn cell_of(&self, x: f64, y: f64) -> (f64, f64) {
+        (((x - self.west) / self.cell_x).floor(), ((self.north - y) / self.cell_y).floor())
+    }
+    /// Whether two rasters share cell size and origin (within a thousandth of a cell).
+    pub fn aligned(&self, other: &GeoRef) -> bool {
+        let tol = 1e-3 * self.cell_x.min(self.cell_y);
+        (self.west - other.west).abs() < tol
+            && (self.north - other.north).abs() < tol
+            && (self.cell_x - other.cell_x).abs() < tol
+            && (self.cell_y - other.cell_y).abs() < tol
+    }
+}
+
+/// A single-band raster: values row-major from the north-west corner.
+#[derive(Debug, Clone)]
+pub struct Raster {
+    /// Columns.
+    pub cols: usize,
+    /// Rows.
+    pub rows: usize,
+    /// Values (nodata cells hold the nodata value or NaN).
+    pub values: Vec<f64>,
+    /// The nodata value, if declared.
+    pub nodata: Option<f64>,
+    /// Georeferencing.
+    pub geo: GeoRef,
+}
+
+impl Raster {
+    /// Whether cell `i` is nodata (the declared value, or not finite).
+    pub fn is_nodata(&self, i: usize) -> bool {
+        let v = self.values[i];
+        !v.is_finite() || self.nodata.is_some_and(|nd| v == nd || (nd.is_nan() && v.is_nan()))
+    }
+}
+
+/// Reads a GeoTIFF (`.tif`, `.tiff`) or an ESRI ASCII grid (`.asc`), by extension.
+pub fn read_raster(path: &Path) -> Result<Raster> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("tif" | "tiff") => read_geotiff(path),
+        Some("asc") => read_asc(path),
+        _ => bail!(
+            "{}: unknown raster format; use a GeoTIFF (.tif, .tiff) or an ESRI ASCII grid (.asc)",
+            path.display()
+        ),
+    }
+}
+
+fn read_geotiff(path: &Path) -> Result<Raster> {
+    let name = path.display();
+    let file = File::open(path).with_context(|| format!("cannot read {name}"))?;
+    let mut dec = Decoder::new(BufReader::new(file))
+        .map_err(|e| anyhow!("{name}: not a readable TIFF: {e}"))?
+        .with_limits(Limits::unlimited());
+    let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
+    let samples: u16 = dec.find_tag_unsigned(Tag::SamplesPerPixel).ok().flatten().unwrap_or(1);
+    if samples != 1 {
+        bail!("{name}: has {samples} bands; an elevation or class raster must have exactly 1");
+    }
+    let tag_f64 = |dec: &mut Decoder<_>, tag: Tag| -> Result<Option<Vec<f64>>> {
+        match dec.find_tag(tag).map_err(|e| anyhow!("{name}: tag {tag:?}: {e}"))? {
+            Some(v) => Ok(Some(v.into_f64_vec().map_err(|e| anyhow!("{name}: tag {tag:?}: {e}"))?)),
+            None => Ok(None),
+        }
+    };
+    let scale = tag_f64(&mut dec, Tag::ModelPixelScaleTag)?;
+    let tie = tag_f64(&mut dec, Tag::ModelTiepointTag)?;
+    let transform = tag_f64(&mut dec, Tag::ModelTransformationTag)?;
+    let geodoubles = tag_f64(&mut dec, Tag::GeoDoubleParamsTag)?;
+    let geokeys = match dec.find_tag(Tag::GeoKeyDirectoryTag).ok().flatten() {
+        Some(v) => Some(v.into_u16_vec().map_err(|e| anyhow!("{name}: GeoKeyDirectory: {e}"))?),
+        None => None,
+    };
+    let geoascii = dec.find_tag(Tag::GeoAsciiParamsTag).ok().flatten().and_then(|v| v.into_string().ok());
+    let nodata = match dec.find_tag(Tag::GdalNodata).ok().flatten() {
+        Some(v) => {
+            let s = v.into_string().map_err(|e| anyhow!("{name}: GDAL_NODATA tag: {e}"))?;
+            let s = s.trim_matches(|c: char| c == '\0' || c.is_whitespace());
+            Some(s.parse::<f64>().map_err(|_| anyhow!("{name}: GDAL_NODATA tag `{s}` is not a number"))?)
+        }
+        None => None,
+    };
+    let (mut west, mut north, cell_x, cell_y) = match (scale, tie, transform) {
+        (Some(s), Some(t), _) if s.len() >= 2 && t.len() >= 6 => {
+            (t[3] - t[0] * s[0], t[4] + t[1] * s[1], s[0], s[1])
+        }
+        (_, _, Some(m)) if m.len() >= 16 => {
+            if m[1] != 0.0 || m[4] != 0.0 {
+                bail!("{name}: rotated or sheared rasters (ModelTransformation) are not supported");
+            }
+            (m[3], m[7], m[0], -m[5])
+        }
+        _ => bail!(
+            "{name}: no georeferencing (needs the GeoTIFF ModelPixelScale and ModelTiepoint tags, or \
+             ModelTransformation); the planner needs the cell size in metres"
+        ),
+    };
+    if !(cell_x.is_finite() && cell_x > 0.0 && cell_y.is_finite() && cell_y > 0.0) {
+        bail!("{name}: pixel scale ({cell_x}, {cell_y}) must be positive (north-up rasters only)");
+    }
+    if pixel_is_point(geokeys.as_deref()) {
+        west -= 0.5 * cell_x;
+        north += 0.5 * cell_y;
+    }
+    let image = dec.read_image().map_err(|e| anyhow!("{name}: cannot decode the image: {e}"))?;
+    let values: Vec<f64> = match image {
+        DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::F64(v) => v,
+        DecodingResult::I16(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::U16(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::I32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::U32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::I8(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::U8(v) => v.into_iter().map(f64::from).collect(),
+        _ => bail!("{name}: unsupported sample type (use float32, float64 or 8/16/32-bit integers)"),
+    };
+    let (cols, rows) = (w as usize, h as usize);
+    if values.len() != cols * rows {
+        bail!("{name}: decoded {} samples for a {cols} x {rows} image", values.len());
+    }
+    let geo = GeoRef { west, north, cell_x, cell_y, geokeys, geodoubles, geoascii };
+    Ok(Raster { cols, rows, values, nodata, geo })
+}
+
+fn pixel_is_point(keys: Option<&[u16]>) -> bool {
+    // Header (4 shorts) then entries (key, location, count, value); location 0 = inline value.
+    keys.is_some_and(|k| {
+        k.get(4..)
+            .unwrap_or(&[])
+            .chunks_exact(4)
+            .any(|e| e[0] == GT_RASTER_TYPE && e[1] == 0 && e[3] == PIXEL_IS_POINT)
+    })
+}
+
+fn read_asc(path: &Path) -> Result<Raster> {
+    let name = path.display();
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {name}"))?;
+    let mut header = std::collections::HashMap::new();
+    let mut lines = text.lines().enumerate().peekable();
+    // Header lines: a key starting with a letter, then a number.
+    while let Some((i, line)) = lines.peek().copied() {
+        let mut it = line.split_whitespace();
+        let Some(key) = it.next() else {
+            lines.next();
+            continue;
+        };
+        if !key.starts_with(|c: char| c.is_ascii_alphabetic()) {
+            break;
+        }
+        let value = it
+            .next()
+            .and_then(|v| v.parse::<f64>().ok())
+            .ok_or_else(|| anyhow!("{name}: line {}: header `{key}` needs a numeric value", i + 1))?;
+        header.insert(key.to_ascii_lowercase(), value);
+        lines.next();
+    }
+    let get = |k: &str| header.get(k).copied();
+    let need = |k: &str| get(k).ok_or_else(|| anyhow!("{name}: missing header `{k}`"));
+    let count = |k: &str| -> Result<usize> {
+        let v = need(k)?;
+        if v >= 1.0 && v.fract() == 0.0 && v < 1e9 {
+            Ok(v as usize)
+        } else {
+            bail!("{name}: header {k} = {v} must be a positive whole number")
+        }
+    };
+    let (cols, rows) = (count("ncols")?, count("nrows")?);
+    let (cell_x, cell_y) = match (get("cellsize"), get("dx"), get("dy")) {
+        (Some(c), _, _) => (c, c),
+        (None, Some(x), Some(y)) => (x, y),
+        _ => bail!("{name}: missing header `cellsize` (or `dx` and `dy`)"),
+    };
+    if !(cell_x.is_finite() && cell_x > 0.0 && cell_y.is_finite() && cell_y > 0.0) {
+        bail!("{name}: cellsize = {cell_x} must be a finite number greater than 0");
+    }
+    let west = match (get("xllcorner"), get("xllcenter")) {
+        (Some(x), _) => x,
+        (None, Some(x)) => x - 0.5 * cell_x,
+        _ => bail!("{name}: missing header `xllcorner` (or `xllcenter`)"),
+    };
+    let south = match (get("yllcorner"), get("yllcenter")) {
+        (Some(y), _) => y,
+        (None, Some(y)) => y - 0.5 * cell_y,
+        _ => bail!("{name}: missing header `yllcorner` (or `yllcenter`)"),
+    };
+    let nodata = get("nodata_value");
+    let mut values = Vec::with_capacity(cols * rows);
+    for (i, line) in lines {
+        for tok in line.split_whitespace() {
+            let v =
+                tok.parse::<f64>().map_err(|_| anyhow!("{name}: line {}: `{tok}` is not a number", i + 1))?;
+            values.push(v);
+        }
+    }
+    if values.len() != cols * rows {
+        bail!("{name}: {} values for ncols x nrows = {cols} x {rows} = {}", values.len(), cols * rows);
+    }
+    let geo = GeoRef {
+        west,
+        north: south + rows as f64 * cell_y,
+        cell_x,
+        cell_y,
+        geokeys: None,
+        geodoubles: None,
+        geoascii: None,
+    };
+    Ok(Raster { cols, rows, values, nodata, geo })
+}
+
+/// Writes a two-band float32 GeoTIFF (`band1`, `band2`, row-major, NaN for nodata, declared
+/// in GDAL_NODATA) georeferenced by `geo`: the source's GeoKeys are copied, so the CRS is kept.
+pub fn write_two_band_geotiff(
+    path: &Path,
+    cols: usize,
+    rows: usize,
+    geo: &GeoRef,
+    band1: &[f32],
+    band2: &[f32],
+) -> Result<()> {
+    let name = path.display().to_string();
+    crate::output::write_via_temp(path, |tmp| {
+        let file = File::create(tmp).with_context(|| format!("cannot write {name}"))?;
+        let err = |e: tiff::TiffError| anyhow!("{name}: {e}");
+        let mut enc = TiffEncoder::new(BufWriter::new(file))
+            .map_err(err)?
+            .with_compression(Compression::Deflate(DeflateLevel::default()));
+        let (w, h) = (u32::try_from(cols)?, u32::try_from(rows)?);
+        let mut img = enc.new_image::<Gray32Float>(w, h).map_err(err)?;
+        img.extra_samples(&[ExtraSamples::Unspecified]).map_err(err)?;
+        let d = img.encoder();
+        d.write_tag(Tag::ModelPixelScaleTag, &[geo.cell_x, geo.cell_y, 0.0][..]).map_err(err)?;
+        d.write_tag(Tag::ModelTiepointTag, &[0.0, 0.0, 0.0, geo.west, geo.north, 0.0][..]).map_err(err)?;
+        // Our tie point is the corner of the corner cell: declare PixelIsArea, keep the rest.
+        let keys = with_pixel_is_area(geo.geokeys.as_deref());
+        d.write_tag(Tag::GeoKeyDirectoryTag, &keys[..]).map_err(err)?;
+        if let Some(dbl) = &geo.geodoubles {
+            d.write_tag(Tag::GeoDoubleParamsTag, &dbl[..]).map_err(err)?;
+        }
+        if let Some(a) = &geo.geoascii {
+            d.write_tag(Tag::GeoAsciiParamsTag, a.as_str()).map_err(err)?;
+        }
+        d.write_tag(Tag::GdalNodata, "nan").map_err(err)?;
+        let data: Vec<f32> = band1.iter().zip(band2).flat_map(|(&a, &b)| [a, b]).collect();
+        img.write_data(&data).map_err(err)?;
+        Ok(())
+    })
+}
+
+/// A GeoKeyDirectory with GTRasterTypeGeoKey = PixelIsArea (added or replaced).
+fn with_pixel_is_area(keys: Option<&[u16]>) -> Vec<u16> {
+    let mut entries: Vec<[u16; 4]> = keys
+        .and_then(|k| k.get(4..))
+        .unwrap_or(&[])
+        .chunks_exact(4)
+        .filter(|e| e[0] != GT_RASTER_TYPE)
+        .map(|e| [e[0], e[1], e[2], e[3]])
+        .collect();
+    entries.push([GT_RASTER_TYPE, 0, 1, 1]);
+    entries.sort_by_key(|e| e[0]);
+    let (version, rev, minor) = keys.filter(|k| k.len() >= 4).map_or((1, 1, 0), |k| (k[0], k[1], k[2]));
+    let mut out = vec![version, rev, minor, entries.len() as u16];
+    out.extend(entries.into_iter().flatten());
+    out
+}

@@ -1,0 +1,83 @@
+//! Route writers for `sandslope plan`: GeoJSON LineStrings and a per-vertex CSV.
+
+use std::path::Path;
+
+use anyhow::Result;
+use geojson::{Feature, FeatureCollection, Geometry, GeometryValue};
+use serde::Serialize;
+
+use crate::commands::plan::PlanResult;
+use crate::output::{csv_string, write_atomic};
+
+/// Writes every found route as a GeoJSON Feature (LineString of cell centres in map
+/// coordinates, with objective, length_m, time_s and survival properties).
+pub fn write_geojson(path: &Path, result: &PlanResult) -> Result<()> {
+    let geo = &result.raster.geo;
+    let features = result.routes.iter().filter_map(|(obj, r)| {
+        let r = r.as_ref().ok()?;
+        let coords: Vec<[f64; 2]> = r
+            .cells
+            .iter()
+            .map(|c| {
+                let (x, y) = geo.centre(c.col, c.row);
+                [x, y]
+            })
+            .collect();
+        let mut f = Feature::from(Geometry::new(GeometryValue::new_line_string(coords)));
+        f.set_property("objective", obj.name());
+        f.set_property("length_m", r.length_m);
+        f.set_property("time_s", r.time_s);
+        f.set_property("survival", r.survival);
+        f.set_property("max_pitch_deg", r.max_pitch_deg);
+        f.set_property("max_roll_deg", r.max_roll_deg);
+        Some(f)
+    });
+    let fc = FeatureCollection::new(features);
+    write_atomic(path, serde_json::to_string_pretty(&fc)?.as_bytes())
+}
+
+/// One route vertex: where it is and the edge that leaves it (empty at the goal).
+#[derive(Debug, Serialize)]
+struct VertexRow {
+    objective: &'static str,
+    vertex: usize,
+    x: f64,
+    y: f64,
+    z: f64,
+    heading_deg: Option<f64>,
+    pitch_deg: Option<f64>,
+    roll_deg: Option<f64>,
+    regime: Option<&'static str>,
+    speed_m_s: Option<f64>,
+    p_fail: Option<f64>,
+    over_roll_limit: Option<bool>,
+}
+
+/// Writes one row per route vertex; the edge columns describe the edge leaving the vertex.
+pub fn write_csv(path: &Path, result: &PlanResult) -> Result<()> {
+    let geo = &result.raster.geo;
+    let grid = result.planner.grid();
+    let mut rows = Vec::new();
+    for (obj, r) in &result.routes {
+        let Ok(r) = r else { continue };
+        for (i, c) in r.cells.iter().enumerate() {
+            let (x, y) = geo.centre(c.col, c.row);
+            let s = r.steps.get(i);
+            rows.push(VertexRow {
+                objective: obj.name(),
+                vertex: i,
+                x,
+                y,
+                z: grid.height(*c).unwrap_or(f64::NAN),
+                heading_deg: s.map(|s| s.heading_deg),
+                pitch_deg: s.map(|s| s.pitch_deg),
+                roll_deg: s.map(|s| s.roll_deg),
+                regime: s.map(|s| s.regime.name()),
+                speed_m_s: s.and_then(|s| s.speed),
+                p_fail: s.map(|s| s.p_fail),
+                over_roll_limit: s.map(|s| s.over_roll_limit),
+            });
+        }
+    }
+    write_atomic(path, csv_string(&rows)?.as_bytes())
+}

@@ -1,0 +1,358 @@
+//! `sandslope plan` end to end, on synthetic DEMs whose geometry is known exactly.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use serde_json::Value;
+use tiff::encoder::{colortype, compression::DeflateLevel, Compression, TiffEncoder};
+use tiff::tags::Tag;
+
+use sandslope::{predict, Ground, Regime, Robot, RobotSpec, Slope};
+
+const ROBOT: &str = "mass_kg = 0.35\nleg_radius_m = 0.04\nleg_width_m = 0.01\nhip_height_m = 0.03\n\
+                     leg_speed_rad_s = 6.283185307179586\nstance_legs = 3\nresponse_time_s = 0.2\n";
+const TERRAIN: &str = "repose_deg = 25.0\n[[points]]\nslope_deg = 0.0\nk_n = 7.0e5\nk_s = 2.0e6\n";
+const WEAK: &str = "[[points]]\nslope_deg = 0.0\nk_n = 7.0e5\nk_s = 1.0e3\n";
+const CELL: f64 = 0.5;
+
+struct Setup {
+    dir: tempfile::TempDir,
+}
+
+impl Setup {
+    fn new() -> Setup {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("robot.toml"), ROBOT).unwrap();
+        std::fs::write(dir.path().join("terrain.toml"), TERRAIN).unwrap();
+        std::fs::write(dir.path().join("weak.toml"), WEAK).unwrap();
+        Setup { dir }
+    }
+    fn path(&self, name: &str) -> PathBuf {
+        self.dir.path().join(name)
+    }
+    fn cmd(&self, dem: &str) -> Command {
+        let mut c = Command::cargo_bin("sandslope").unwrap();
+        c.arg("plan")
+            .arg("--dem")
+            .arg(self.path(dem))
+            .arg("--robot")
+            .arg(self.path("robot.toml"))
+            .arg("--terrain")
+            .arg(self.path("terrain.toml"));
+        c
+    }
+}
+
+/// Writes an ESRI ASCII grid with lower-left corner (0, 0); `z(x, y)` at cell centres.
+fn write_asc(path: &Path, cols: usize, rows: usize, z: impl Fn(f64, f64) -> f64) {
+    let mut s = format!(
+        "ncols {cols}\nnrows {rows}\nxllcorner 0\nyllcorner 0\ncellsize {CELL}\nNODATA_value -9999\n"
+    );
+    for r in 0..rows {
+        let y = (rows - r) as f64 * CELL - 0.5 * CELL;
+        let line: Vec<String> = (0..cols).map(|c| format!("{:.6}", z((c as f64 + 0.5) * CELL, y))).collect();
+        s += &line.join(" ");
+        s.push('\n');
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+/// Writes a deflate-compressed single-band GeoTIFF with lower-left corner (0, 0).
+fn write_geotiff<C: colortype::ColorType>(
+    path: &Path,
+    cols: usize,
+    rows: usize,
+    data: &[C::Inner],
+    nodata: &str,
+) where
+    [C::Inner]: tiff::encoder::TiffValue,
+{
+    let mut enc = TiffEncoder::new(BufWriter::new(File::create(path).unwrap()))
+        .unwrap()
+        .with_compression(Compression::Deflate(DeflateLevel::default()));
+    let mut img = enc.new_image::<C>(cols as u32, rows as u32).unwrap();
+    img.encoder().write_tag(Tag::ModelPixelScaleTag, &[CELL, CELL, 0.0][..]).unwrap();
+    img.encoder()
+        .write_tag(Tag::ModelTiepointTag, &[0.0, 0.0, 0.0, 0.0, rows as f64 * CELL, 0.0][..])
+        .unwrap();
+    img.encoder().write_tag(Tag::GdalNodata, nodata).unwrap();
+    img.write_data(data).unwrap();
+}
+
+fn robot() -> Robot {
+    let spec: RobotSpec = toml::from_str(ROBOT).unwrap();
+    Robot::new(spec).unwrap()
+}
+
+/// The smallest pitch (to 0.01 degree) at which the test robot on the test terrain fails
+/// (sinkage or slippage), found by scanning the model.
+fn failure_pitch_deg() -> f64 {
+    let ground = Ground::new(7e5, 2e6).unwrap().with_repose(Some(Slope::from_degrees(25.0).unwrap()));
+    (0..9000)
+        .map(|i| i as f64 * 0.01)
+        .find(|&d| predict(&robot(), Slope::from_degrees(d).unwrap(), &ground).regime.is_failure())
+        .unwrap()
+}
+
+#[derive(Debug)]
+struct Vertex {
+    objective: String,
+    x: f64,
+    y: f64,
+    heading: Option<f64>,
+    roll: Option<f64>,
+    regime: String,
+}
+
+fn read_csv(path: &Path) -> Vec<Vertex> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let h = r.headers().unwrap().clone();
+    let col = |name: &str| h.iter().position(|c| c == name).unwrap();
+    let (o, x, y, hd, rl, rg) =
+        (col("objective"), col("x"), col("y"), col("heading_deg"), col("roll_deg"), col("regime"));
+    r.records()
+        .map(|rec| {
+            let rec = rec.unwrap();
+            let f = |i: usize| rec[i].parse::<f64>().ok();
+            Vertex {
+                objective: rec[o].to_string(),
+                x: f(x).unwrap(),
+                y: f(y).unwrap(),
+                heading: f(hd),
+                roll: f(rl),
+                regime: rec[rg].to_string(),
+            }
+        })
+        .collect()
+}
+
+fn route<'a>(v: &'a [Vertex], objective: &str) -> Vec<&'a Vertex> {
+    v.iter().filter(|p| p.objective == objective).collect()
+}
+
+fn json_of(out: &[u8]) -> Value {
+    serde_json::from_slice(out).unwrap()
+}
+
+#[test]
+fn steep_plane_distance_route_goes_straight_and_fails_while_time_route_zig_zags_below_failure_pitch() {
+    let s = Setup::new();
+    // A plane rising north at 25.5 degrees: head-on is at or beyond the 25-degree repose.
+    let tan = 25.5_f64.to_radians().tan();
+    let z = |_x: f64, y: f64| tan * y;
+    write_asc(&s.path("steep.asc"), 31, 61, z);
+    let out = s
+        .cmd("steep.asc")
+        .args(["--start-px", "15,58", "--goal-px", "15,2", "--json", "--csv"])
+        .arg(s.path("route.csv"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let j = json_of(&out.stdout);
+    let fail_deg = failure_pitch_deg();
+    assert!(fail_deg < 25.5 && fail_deg > 20.0, "{fail_deg}");
+
+    // Distance: straight up the fall line (one column), every edge failing.
+    let dist = &j["routes"]["distance"];
+    assert_eq!(dist["found"], true);
+    assert!(dist["survival"].as_f64().unwrap() < 1e-6);
+    assert!(dist["time_s"].is_null());
+    let v = read_csv(&s.path("route.csv"));
+    let d = route(&v, "distance");
+    assert_eq!(d.len(), 57, "56 unit steps north");
+    assert!(d.iter().all(|p| (p.x - d[0].x).abs() < 1e-9));
+    assert!(d.iter().filter_map(|p| p.heading).all(|h| h == 0.0));
+    assert!(d.iter().filter(|p| p.heading.is_some()).all(|p| p.regime == "slippage"));
+
+    // Time: found, zig-zags (goes both east and west), every edge's pitch from the DEM below
+    // the failure pitch and its roll within the 20-degree default limit.
+    let time = &j["routes"]["time"];
+    assert_eq!(time["found"], true);
+    assert_eq!(time["regimes"]["slippage"], 0);
+    assert_eq!(time["regimes"]["sinkage"], 0);
+    let t = route(&v, "time");
+    let (mut east, mut west) = (false, false);
+    for w in t.windows(2) {
+        let (dx, dy) = (w[1].x - w[0].x, w[1].y - w[0].y);
+        east |= dx > 0.0;
+        west |= dx < 0.0;
+        let pitch = ((z(w[1].x, w[1].y) - z(w[0].x, w[0].y)) / dx.hypot(dy)).atan().to_degrees();
+        assert!(pitch.abs() < fail_deg, "edge {w:?}: pitch {pitch} >= {fail_deg}");
+        assert!(w[0].roll.unwrap() <= 20.0 + 1e-6);
+        assert!(w[0].regime == "success");
+    }
+    assert!(east && west, "the time route should switch back");
+    let length = time["length_m"].as_f64().unwrap();
+    let straight = dist["length_m"].as_f64().unwrap();
+    assert!(length > straight * 1.1, "switchbacks are longer: {length} vs {straight}");
+}
+
+#[test]
+fn gentle_plane_time_route_is_as_long_as_the_straight_line() {
+    let s = Setup::new();
+    let tan = 5.0_f64.to_radians().tan();
+    let z = |x: f64, y: f64| tan * (0.6 * x + 0.8 * y);
+    write_asc(&s.path("gentle.asc"), 60, 50, z);
+    // Map coordinates: start and goal at cell centres.
+    let (a, b): ((f64, f64), (f64, f64)) = ((3.25, 2.75), (27.25, 22.25));
+    let out = s
+        .cmd("gentle.asc")
+        .args(["--start", &format!("{},{}", a.0, a.1), "--goal", &format!("{},{}", b.0, b.1), "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let j = json_of(&out.stdout);
+    let len = j["routes"]["time"]["length_m"].as_f64().unwrap();
+    let dz = z(b.0, b.1) - z(a.0, a.1);
+    let straight = (b.0 - a.0).hypot(b.1 - a.1).hypot(dz);
+    // A 16-connected grid path is never shorter, and within a few percent (the worst heading
+    // error between moves is half of 26.6 degrees: 1/cos(13.3 deg) - 1 = 2.8 %).
+    assert!(len >= straight * (1.0 - 1e-6), "{len} < {straight}");
+    assert!(len <= straight * 1.028, "{len} vs {straight}");
+    assert_eq!(j["routes"]["time"]["regimes"]["success"].as_u64().unwrap() as usize, {
+        // every edge succeeds on a 5-degree plane
+        j["routes"]["time"]["regimes"]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|v| v.as_u64().unwrap() as usize)
+            .sum::<usize>()
+    });
+}
+
+#[test]
+fn geotiff_nodata_hole_is_avoided_and_risk_map_is_georeferenced() {
+    let s = Setup::new();
+    let (cols, rows) = (40, 30);
+    // Level ground with a nodata block across the straight line from start to goal.
+    let hole = |c: usize, r: usize| (15..25).contains(&c) && (5..25).contains(&r);
+    let data: Vec<f32> =
+        (0..rows * cols).map(|i| if hole(i % cols, i / cols) { -9999.0 } else { 1.0 }).collect();
+    write_geotiff::<colortype::Gray32Float>(&s.path("hole.tif"), cols, rows, &data, "-9999");
+    let out = s
+        .cmd("hole.tif")
+        .args(["--start-px", "5,15", "--goal-px", "35,15", "--json", "--csv"])
+        .arg(s.path("r.csv"))
+        .arg("--risk-map")
+        .arg(s.path("risk.tif"))
+        .arg("--geojson")
+        .arg(s.path("r.geojson"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for v in read_csv(&s.path("r.csv")) {
+        let (c, r) = ((v.x / CELL).floor() as usize, rows - 1 - (v.y / CELL).floor() as usize);
+        // Neither in the hole nor next to it (no slope can be computed there).
+        assert!(!(14..26).contains(&c) || !(4..26).contains(&r), "{v:?} at ({c}, {r})");
+    }
+    let gj: Value = serde_json::from_str(&std::fs::read_to_string(s.path("r.geojson")).unwrap()).unwrap();
+    assert_eq!(gj["features"][0]["geometry"]["type"], "LineString");
+    assert!(gj["features"][0]["properties"]["length_m"].as_f64().unwrap() > 15.0);
+
+    // The risk map: 2 float bands, same pixel scale and tie point as the input.
+    let mut dec = tiff::decoder::Decoder::new(File::open(s.path("risk.tif")).unwrap()).unwrap();
+    assert_eq!(dec.dimensions().unwrap(), (cols as u32, rows as u32));
+    assert_eq!(dec.get_tag_unsigned::<u16>(Tag::SamplesPerPixel).unwrap(), 2);
+    assert_eq!(dec.get_tag(Tag::ModelPixelScaleTag).unwrap().into_f64_vec().unwrap()[..2], [CELL, CELL]);
+    assert_eq!(
+        dec.get_tag(Tag::ModelTiepointTag).unwrap().into_f64_vec().unwrap()[3..5],
+        [0.0, rows as f64 * CELL]
+    );
+    let tiff::decoder::DecodingResult::F32(px) = dec.read_image().unwrap() else { panic!("not float32") };
+    let (p_fail, climb): (Vec<f32>, Vec<f32>) = px.chunks(2).map(|c| (c[0], c[1])).unzip();
+    // Level ground: best-heading p_fail 0 wherever there is a slope; the hole is NaN.
+    assert_eq!(p_fail[10 * cols + 5], 0.0);
+    assert!(p_fail[15 * cols + 20].is_nan());
+    // No heading climbs on level ground.
+    assert!(climb[10 * cols + 5].is_nan());
+}
+
+#[test]
+fn classes_raster_keeps_the_time_route_off_weak_sand() {
+    let s = Setup::new();
+    let (cols, rows) = (40, 30);
+    write_asc(&s.path("flat.asc"), cols, rows, |_, _| 2.0);
+    // int16 classes: 1 everywhere, 2 (weak sand: no anchoring) in a band between start and goal.
+    let weak = |c: usize, r: usize| (18..22).contains(&c) && r < 26;
+    let classes: Vec<i16> = (0..rows * cols).map(|i| if weak(i % cols, i / cols) { 2 } else { 1 }).collect();
+    // A GeoTIFF aligned with the .asc grid (same corner and cell size).
+    write_geotiff::<colortype::GrayI16>(&s.path("classes.tif"), cols, rows, &classes, "-1");
+    let out = s
+        .cmd("flat.asc")
+        .args(["--start-px", "5,10", "--goal-px", "35,10", "--json", "--csv"])
+        .arg(s.path("c.csv"))
+        .arg("--classes")
+        .arg(s.path("classes.tif"))
+        .arg("--class-terrain")
+        .arg(format!("1={},2={}", s.path("terrain.toml").display(), s.path("weak.toml").display()))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let j = json_of(&out.stdout);
+    assert_eq!(j["routes"]["time"]["regimes"]["slippage"], 0);
+    assert!(j["routes"]["distance"]["regimes"]["slippage"].as_u64().unwrap() > 0);
+    for v in route(&read_csv(&s.path("c.csv")), "time") {
+        let (c, r) = ((v.x / CELL).floor() as usize, rows - 1 - (v.y / CELL).floor() as usize);
+        assert!(!weak(c, r), "{v:?}");
+    }
+    // A class without terrain is an error naming it.
+    let out = s
+        .cmd("flat.asc")
+        .args(["--start-px", "5,10", "--goal-px", "35,10", "--classes"])
+        .arg(s.path("classes.tif"))
+        .arg("--class-terrain")
+        .arg(format!("1={}", s.path("terrain.toml").display()))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("class 2"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn start_or_goal_in_nodata_or_outside_is_a_clear_error_without_output() {
+    let s = Setup::new();
+    let mut text =
+        String::from("ncols 10\nnrows 10\nxllcorner 100\nyllcorner 200\ncellsize 1\nNODATA_value -9999\n");
+    for r in 0..10 {
+        let row: Vec<&str> = (0..10).map(|c| if (r, c) == (4, 4) { "-9999" } else { "0" }).collect();
+        text += &row.join(" ");
+        text.push('\n');
+    }
+    std::fs::write(s.path("small.asc"), text).unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (&["--start", "104.5,205.5", "--goal", "107.5,202.5"], "nodata"),
+        (&["--start", "99,205", "--goal", "107.5,202.5"], "outside the map"),
+        (&["--start-px", "2,2", "--goal-px", "10,3"], "outside the map"),
+        (&["--start-px", "0,5", "--goal-px", "7,7"], "map border"),
+    ];
+    for (args, want) in cases {
+        let out = s.cmd("small.asc").args(args).arg("--geojson").arg(s.path("o.geojson")).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: {err}");
+        assert!(!s.path("o.geojson").exists());
+    }
+}
+
+#[test]
+fn unreachable_goal_is_reported_as_not_found() {
+    let s = Setup::new();
+    // A 40-degree plane: no heading has pitch below the success limit and roll within 20
+    // degrees, so nothing but the distance route exists.
+    let tan = 40.0_f64.to_radians().tan();
+    write_asc(&s.path("wall.asc"), 20, 20, |_, y| tan * y);
+    let out =
+        s.cmd("wall.asc").args(["--start-px", "10,17", "--goal-px", "10,3", "--json"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let j = json_of(&out.stdout);
+    assert_eq!(j["routes"]["time"]["found"], false);
+    assert_eq!(j["routes"]["time"]["reason"], "start_impassable");
+    assert_eq!(j["routes"]["distance"]["found"], true);
+    let _ = Regime::Success;
+}

@@ -1,0 +1,200 @@
+//! A digital elevation model on a regular grid and its surface gradient (Horn's method).
+//!
+//! Row 0 is the northern edge, columns run east; map `x` grows east and `y` grows north, so
+//! a step of one row is `-cell_y` in `y`. No file formats here: readers build the grid.
+
+use super::PlanError;
+
+/// Heights on a regular grid with a nodata mask. Build it with [`ElevationGrid::new`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ElevationGrid {
+    cols: usize,
+    rows: usize,
+    cell_x: f64,
+    cell_y: f64,
+    z: Vec<f32>,
+    valid: Vec<bool>,
+}
+
+/// A cell of a grid, by column (east) and row (south).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Cell {
+    /// Column, 0 at the western edge.
+    pub col: usize,
+    /// Row, 0 at the northern edge.
+    pub row: usize,
+}
+
+impl ElevationGrid {
+    /// A grid of `cols x rows` cells of `cell_x` by `cell_y` metres holding heights `z` (m,
+    /// row-major from the north-west corner). A cell is nodata where `nodata[i]` is true or its
+    /// height is not finite. Fails on a size mismatch, fewer than 3 x 3 cells, or a cell size
+    /// that is not finite and positive.
+    pub fn new(
+        cols: usize,
+        rows: usize,
+        cell_x: f64,
+        cell_y: f64,
+        z: Vec<f32>,
+        nodata: Option<&[bool]>,
+    ) -> Result<ElevationGrid, PlanError> {
+        for (key, v) in [("cell size x", cell_x), ("cell size y", cell_y)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(PlanError::Grid(format!("{key} = {v} must be a finite number greater than 0")));
+            }
+        }
+        if cols < 3 || rows < 3 {
+            return Err(PlanError::Grid(format!(
+                "the grid is {cols} x {rows} cells; at least 3 x 3 are needed"
+            )));
+        }
+        let n = cols.checked_mul(rows).filter(|&n| n < u32::MAX as usize).ok_or_else(|| {
+            PlanError::Grid(format!("{cols} x {rows} cells is more than the planner's 4 294 967 295"))
+        })?;
+        if z.len() != n || nodata.is_some_and(|m| m.len() != n) {
+            return Err(PlanError::Grid(format!(
+                "{} heights and {} nodata flags for a {cols} x {rows} grid ({n} cells)",
+                z.len(),
+                nodata.map_or(n, <[bool]>::len)
+            )));
+        }
+        let valid = match nodata {
+            Some(m) => z.iter().zip(m).map(|(h, &nd)| h.is_finite() && !nd).collect(),
+            None => z.iter().map(|h| h.is_finite()).collect(),
+        };
+        Ok(ElevationGrid { cols, rows, cell_x, cell_y, z, valid })
+    }
+
+    /// Number of columns (west to east).
+    pub fn cols(&self) -> usize {
+        self.cols
+    }
+    /// Number of rows (north to south).
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+    /// Cell width (east-west), m.
+    pub fn cell_x(&self) -> f64 {
+        self.cell_x
+    }
+    /// Cell height (north-south), m.
+    pub fn cell_y(&self) -> f64 {
+        self.cell_y
+    }
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.z.len()
+    }
+    /// Whether the grid has no cells (never true for a validated grid).
+    pub fn is_empty(&self) -> bool {
+        self.z.is_empty()
+    }
+    /// The flat index of `cell` (row-major), if it is inside the grid.
+    pub fn index(&self, cell: Cell) -> Option<usize> {
+        (cell.col < self.cols && cell.row < self.rows).then(|| cell.row * self.cols + cell.col)
+    }
+    /// The cell at flat index `i`.
+    pub fn cell(&self, i: usize) -> Cell {
+        Cell { col: i % self.cols, row: i / self.cols }
+    }
+    /// The height of `cell`, m, or `None` for nodata or outside the grid.
+    pub fn height(&self, cell: Cell) -> Option<f64> {
+        self.index(cell).filter(|&i| self.valid[i]).map(|i| f64::from(self.z[i]))
+    }
+    /// Whether the cell at flat index `i` holds a height.
+    pub fn is_valid(&self, i: usize) -> bool {
+        self.valid[i]
+    }
+    /// Heights, row-major (meaningless where [`ElevationGrid::is_valid`] is false).
+    pub fn heights(&self) -> &[f32] {
+        &self.z
+    }
+
+    /// The surface gradient `(dz/dx, dz/dy)` (x east, y north) of every cell by Horn's
+    /// third-order finite difference over the 3 x 3 window; `None` (stored as NaN) where the
+    /// cell is on the map border or any cell of its window is nodata.
+    ///
+    /// With the window `a b c / d e f / g h i` (north row first):
+    /// `dz/dx = ((c + 2f + i) - (a + 2d + g)) / (8 cell_x)` and
+    /// `dz/dy = ((a + 2b + c) - (g + 2h + i)) / (8 cell_y)`.
+    pub fn horn_gradient(&self) -> Vec<[f32; 2]> {
+        let (cols, rows) = (self.cols, self.rows);
+        let mut out = vec![[f32::NAN; 2]; cols * rows];
+        let (sx, sy) = (1.0 / (8.0 * self.cell_x), 1.0 / (8.0 * self.cell_y));
+        let z = &self.z;
+        let v = &self.valid;
+        let row_fn = |r: usize, out_row: &mut [[f32; 2]]| {
+            if r == 0 || r + 1 == rows {
+                return;
+            }
+            for (c, out) in out_row.iter_mut().enumerate().take(cols - 1).skip(1) {
+                let (n, m, s) = ((r - 1) * cols + c, r * cols + c, (r + 1) * cols + c);
+                let ok = [n - 1, n, n + 1, m - 1, m, m + 1, s - 1, s, s + 1].iter().all(|&i| v[i]);
+                if !ok {
+                    continue;
+                }
+                let h = |i: usize| f64::from(z[i]);
+                let dzdx =
+                    ((h(n + 1) + 2.0 * h(m + 1) + h(s + 1)) - (h(n - 1) + 2.0 * h(m - 1) + h(s - 1))) * sx;
+                let dzdy = ((h(n - 1) + 2.0 * h(n) + h(n + 1)) - (h(s - 1) + 2.0 * h(s) + h(s + 1))) * sy;
+                *out = [dzdx as f32, dzdy as f32];
+            }
+        };
+        use rayon::prelude::*;
+        out.par_chunks_mut(cols).enumerate().for_each(|(r, chunk)| row_fn(r, chunk));
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plane(cols: usize, rows: usize, dx: f64, dy: f64, a: f64, b: f64) -> ElevationGrid {
+        // z = a x + b y with x east of the west edge and y north of the south edge.
+        let mut z = Vec::new();
+        for r in 0..rows {
+            for c in 0..cols {
+                let (x, y) = (c as f64 * dx, (rows - 1 - r) as f64 * dy);
+                z.push((a * x + b * y) as f32);
+            }
+        }
+        ElevationGrid::new(cols, rows, dx, dy, z, None).unwrap()
+    }
+
+    #[test]
+    fn horn_recovers_a_plane_exactly_and_masks_the_border() {
+        let g = plane(6, 5, 2.0, 3.0, 0.25, -0.5);
+        let grad = g.horn_gradient();
+        for r in 0..5 {
+            for c in 0..6 {
+                let [gx, gy] = grad[r * 6 + c];
+                if r == 0 || r == 4 || c == 0 || c == 5 {
+                    assert!(gx.is_nan() && gy.is_nan());
+                } else {
+                    assert!((gx - 0.25).abs() < 1e-5 && (gy + 0.5).abs() < 1e-5, "{gx} {gy}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn nodata_poisons_its_window() {
+        let mut mask = vec![false; 36];
+        mask[2 * 6 + 2] = true;
+        let g = ElevationGrid::new(6, 6, 1.0, 1.0, vec![1.0; 36], Some(&mask)).unwrap();
+        let grad = g.horn_gradient();
+        // Every interior cell within one of (2, 2) has no gradient; (4, 4) has one.
+        for (c, r) in [(1, 1), (2, 2), (3, 3), (1, 3)] {
+            assert!(grad[r * 6 + c][0].is_nan(), "{c} {r}");
+        }
+        assert_eq!(grad[4 * 6 + 4], [0.0, 0.0]);
+    }
+
+    #[test]
+    fn rejects_bad_grids() {
+        assert!(ElevationGrid::new(2, 5, 1.0, 1.0, vec![0.0; 10], None).is_err());
+        assert!(ElevationGrid::new(3, 3, 0.0, 1.0, vec![0.0; 9], None).is_err());
+        assert!(ElevationGrid::new(3, 3, 1.0, 1.0, vec![0.0; 8], None).is_err());
+    }
+}

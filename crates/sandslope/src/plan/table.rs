@@ -1,0 +1,172 @@
+//! The model tabulated against pitch, once per terrain class.
+//!
+//! With one terrain per class, speed, regime and failure probability depend only on the
+//! pitch of an edge, so they are computed once on a fine table of `tan(pitch)` rather than
+//! per edge. Entry `i` holds the model at `tan(pitch) = i * TAN_STEP`; a lookup rounds the
+//! pitch *up* to the next entry (at most 0.06 degrees steeper: conservative where failure
+//! grows with slope). Failure probabilities come from [`crate::risk::regime_probabilities`]
+//! every [`P_FAIL_STEP_DEG`] degrees, interpolated linearly in degrees between samples.
+
+use rayon::prelude::*;
+
+use crate::model::predict;
+use crate::regime::Regime;
+use crate::risk::{regime_probabilities, Uncertainty};
+use crate::robot::Robot;
+use crate::slope::Slope;
+use crate::terrain::Terrain;
+
+/// Step of the pitch table in `tan(pitch)` (0.057 degrees on level ground, less when steeper).
+pub const TAN_STEP: f64 = 1e-3;
+/// Steepest pitch tabulated, degrees; steeper edges (cliffs in the DEM) are impassable.
+pub const MAX_PITCH_DEG: f64 = 89.0;
+/// Spacing of the failure-probability samples, degrees.
+pub const P_FAIL_STEP_DEG: f64 = 0.1;
+
+/// A terrain class: its table and where its uncertainty comes from.
+#[derive(Debug, Clone)]
+pub struct ClassTerrain {
+    /// The terrain table.
+    pub terrain: Terrain,
+    /// Coefficients of variation used where the terrain has no standard deviations
+    /// (MODEL.md section 9: "or a user-given value").
+    pub fallback: Uncertainty,
+}
+
+impl ClassTerrain {
+    /// The uncertainty at `slope`: the terrain's interpolated SDs when it has them, else the
+    /// fallback coefficients of variation.
+    pub fn uncertainty_at(&self, slope: Slope) -> Uncertainty {
+        let s = self.terrain.sample(slope);
+        match (s.k_n_sd, s.k_s_sd) {
+            (Some(n), Some(k)) => Uncertainty::from_sd(&s.ground, n, k).unwrap_or(self.fallback),
+            _ => self.fallback,
+        }
+    }
+}
+
+/// The model of one robot on one terrain class, against pitch.
+#[derive(Debug, Clone)]
+pub struct PitchTable {
+    /// Regime at each entry.
+    pub(crate) regime: Vec<Regime>,
+    /// Speed along the surface, m/s (NaN where undefined).
+    pub(crate) speed: Vec<f32>,
+    /// P(sinkage or slippage) at each entry.
+    pub(crate) p_fail: Vec<f32>,
+    /// Whether any tabulated slope lies beyond the terrain's last measured point.
+    pub(crate) extrapolated_from_deg: Option<f64>,
+}
+
+impl PitchTable {
+    /// Tabulates the model for `robot` on `class` for pitches up to `atan(max_tan)` (capped at
+    /// [`MAX_PITCH_DEG`]): one risk evaluation per [`P_FAIL_STEP_DEG`], in parallel. A map
+    /// needs no pitch steeper than its steepest gradient.
+    pub fn new(robot: &Robot, class: &ClassTerrain, max_tan: f64) -> PitchTable {
+        let n = table_len(max_tan);
+        let slope_of = |deg: f64| Slope::from_degrees(deg.clamp(0.0, MAX_PITCH_DEG)).unwrap_or(Slope::LEVEL);
+        let rows: Vec<(Regime, f32)> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let slope = slope_of((i as f64 * TAN_STEP).atan().to_degrees());
+                let p = predict(robot, slope, &class.terrain.sample(slope).ground);
+                (p.regime, p.speed.map_or(f32::NAN, |v| v as f32))
+            })
+            .collect();
+        let top_deg = ((n - 1) as f64 * TAN_STEP).atan().to_degrees();
+        let samples = ((top_deg / P_FAIL_STEP_DEG).ceil() as usize).max(1);
+        let p_deg: Vec<f64> = (0..=samples)
+            .into_par_iter()
+            .map(|k| {
+                let slope = slope_of(k as f64 * P_FAIL_STEP_DEG);
+                let ground = class.terrain.sample(slope).ground;
+                regime_probabilities(robot, slope, &ground, class.uncertainty_at(slope)).p_fail()
+            })
+            .collect();
+        let p_fail = (0..n)
+            .map(|i| {
+                let x = (i as f64 * TAN_STEP).atan().to_degrees() / P_FAIL_STEP_DEG;
+                let k = (x.floor() as usize).min(samples - 1);
+                let f = (x - k as f64).clamp(0.0, 1.0);
+                (p_deg[k] + f * (p_deg[k + 1] - p_deg[k])).clamp(0.0, 1.0) as f32
+            })
+            .collect();
+        let last = class.terrain.points().last().map_or(0.0, |p| p.slope_deg);
+        let extrapolated_from_deg =
+            (class.terrain.points().len() > 1 && last < MAX_PITCH_DEG).then_some(last);
+        let (regime, speed) = rows.into_iter().unzip();
+        PitchTable { regime, speed, p_fail, extrapolated_from_deg }
+    }
+
+    /// The table entry for `|tan(pitch)|`, rounding up; `None` beyond [`MAX_PITCH_DEG`].
+    pub fn index(&self, abs_tan: f64) -> Option<usize> {
+        let i = (abs_tan / TAN_STEP).ceil();
+        (i < self.regime.len() as f64).then_some(i as usize)
+    }
+
+    /// Regime at entry `i`.
+    pub fn regime(&self, i: usize) -> Regime {
+        self.regime[i]
+    }
+    /// Speed at entry `i`, m/s, if defined.
+    pub fn speed(&self, i: usize) -> Option<f64> {
+        let v = self.speed[i];
+        v.is_finite().then_some(f64::from(v))
+    }
+    /// P(failure) at entry `i`.
+    pub fn p_fail(&self, i: usize) -> f64 {
+        f64::from(self.p_fail[i])
+    }
+    /// `tan(pitch)` of entry `i`.
+    pub fn tan_of(i: usize) -> f64 {
+        i as f64 * TAN_STEP
+    }
+    /// If the terrain was extrapolated above its last point, that point's slope, degrees.
+    pub fn extrapolated_from_deg(&self) -> Option<f64> {
+        self.extrapolated_from_deg
+    }
+    /// Number of entries.
+    pub fn len(&self) -> usize {
+        self.regime.len()
+    }
+    /// Whether the table is empty (never for a built table).
+    pub fn is_empty(&self) -> bool {
+        self.regime.is_empty()
+    }
+}
+
+fn table_len(max_tan: f64) -> usize {
+    let cap = MAX_PITCH_DEG.to_radians().tan();
+    let top = if max_tan.is_finite() { max_tan.clamp(0.0, cap) } else { cap };
+    (top / TAN_STEP).ceil() as usize + 2
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::tests::paper_robot;
+    use crate::terrain::Ground;
+
+    #[test]
+    fn table_agrees_with_the_model_at_its_entries() {
+        let robot = paper_robot();
+        let terrain = Terrain::constant(7e5, 2e6).unwrap();
+        let class = ClassTerrain { terrain, fallback: Uncertainty::new(0.1, 0.2).unwrap() };
+        let t = PitchTable::new(&robot, &class, 0.5);
+        assert_eq!(t.len(), 502);
+        for deg in [0.0_f64, 10.0, 19.0, 21.5, 26.0] {
+            let i = t.index(deg.to_radians().tan()).unwrap();
+            let slope = Slope::from_radians(PitchTable::tan_of(i).atan()).unwrap();
+            // Rounded up by less than one step.
+            assert!(slope.degrees() >= deg - 1e-9 && slope.degrees() < deg + 0.06);
+            let p = predict(&robot, slope, &Ground::new(7e5, 2e6).unwrap());
+            assert_eq!(t.regime(i), p.regime);
+            assert!((t.speed(i).unwrap() - p.speed.unwrap()).abs() < 1e-6);
+            let q =
+                regime_probabilities(&robot, slope, &Ground::new(7e5, 2e6).unwrap(), class.fallback).p_fail();
+            // Linear interpolation over 0.1 degree.
+            assert!((t.p_fail(i) - q).abs() < 0.02, "{deg}: {} vs {q}", t.p_fail(i));
+        }
+        assert!(t.index(0.502).is_none());
+    }
+}

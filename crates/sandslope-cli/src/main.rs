@@ -27,12 +27,18 @@ enum Command {
     Predict(commands::predict::PredictArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
+    /// Phase diagrams: the regime (sinkage, slippage, metastable, success) over a (k_n, k_s) grid.
+    Phase(commands::phase::PhaseArgs),
+    /// Failure probability on uncertain terrain, the safe-slope limit and the heaviest safe mass.
+    Risk(commands::risk::RiskArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Predict(a) => commands::predict::run(a),
         Command::Presets(a) => commands::presets::run(a),
+        Command::Phase(a) => commands::phase::run(a),
+        Command::Risk(a) => commands::risk::run(a),
     }
 }
 

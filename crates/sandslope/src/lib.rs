@@ -33,6 +33,7 @@ pub mod calibrate;
 pub mod critical;
 pub mod error;
 pub mod model;
+pub mod phase;
 pub mod regime;
 pub mod risk;
 pub mod robot;
@@ -43,6 +44,7 @@ pub use calibrate::{calibrate, Calibration, CalibrationError, LawParams, ShearLa
 pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
 pub use error::ParamError;
 pub use model::{predict, Prediction, G};
+pub use phase::{Axis, AxisScale, PhaseMap, RegimeCounts};
 pub use regime::{Cause, Regime};
 pub use risk::{regime_probabilities, RegimeProbabilities, Uncertainty};
 pub use robot::{Robot, RobotSpec};

@@ -190,7 +190,7 @@ fn solve_mass_matches_predict_either_side() {
         "--terrain",
         &t,
         "--slope",
-        "20",
+        "15",
         "--cv-n",
         "0",
         "--cv-s",
@@ -203,7 +203,7 @@ fn solve_mass_matches_predict_either_side() {
     assert!(m > 0.35, "{v}");
     assert!((v["max_payload_kg"].as_f64().unwrap() - (m - 0.35)).abs() < 1e-12);
     let regime = |mass: f64| {
-        json(&["predict", "--terrain", &t, "--slope", "20", "--mass", &format!("{mass}"), "--json"])["regime"]
+        json(&["predict", "--terrain", &t, "--slope", "15", "--mass", &format!("{mass}"), "--json"])["regime"]
             .as_str()
             .unwrap()
             .to_string()

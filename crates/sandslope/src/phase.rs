@@ -4,11 +4,13 @@
 //! The model separates: the normal equilibrium depth `d_n`, the level step `s*` and sinkage
 //! depend on k_n only; the shear-equilibrium depth `d_s` and anchoring time `t1` depend on k_s
 //! only. So [`PhaseMap::compute`] evaluates the expensive parts (square roots, arcsines) once
-//! per grid column and row, and each cell costs one multiply and two subtractions,
-//! `s = s*_i scale_j - drag_j - slip_j`, in exactly the operation order of
-//! [`crate::model::net_step`], so every cell is bit-for-bit what [`crate::predict`] gives.
-//! Rows run in parallel (rayon). Only the regimes are stored (one byte per cell); the net step
-//! of any cell is recomputed on demand from the per-axis parts by [`PhaseMap::step`].
+//! per grid column and row, and the net step of a cell is `s = s*_i scale_j - drag_j - slip_j`,
+//! in exactly the operation order of [`crate::model::net_step`], so every cell is bit-for-bit
+//! what [`crate::predict`] gives. Within a row that step is monotone in `s*_i`, so the two
+//! regime thresholds (s > 0, s >= s_min) are found by binary search over the columns ranked by
+//! `s*`, and each cell costs two integer comparisons. Rows run in parallel (rayon). Only the
+//! regimes are stored (two bits per cell); the net step of any cell is recomputed on demand
+//! from the per-axis parts by [`PhaseMap::step`].
 //!
 //! The contour `s = s_min` (the boundary of the success region, drawn black in the paper) is
 //! extracted from the step field by marching squares in axis coordinates ([`contour_segments`]).
@@ -19,7 +21,7 @@ use crate::error::ParamError;
 use crate::model::{
     anchoring_time, backward_slip, level_step_length, normal_equilibrium_depth, shear_equilibrium_depth, G,
 };
-use crate::regime::{classify, Regime};
+use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::slope::Slope;
 
@@ -211,8 +213,12 @@ pub struct PhaseMap {
     sunk: Vec<bool>,
     /// Per k_s row: the step terms, `None` when the leg never anchors (`d_s > d_max`).
     terms: Vec<Option<StepTerms>>,
-    /// Row-major (one row per k_s value), `len = k_n.len() * k_s.len()`.
-    regimes: Vec<Regime>,
+    /// Regime codes, indices into [`Regime::ALL`] (0 sinkage, 1 slippage, 2 metastable,
+    /// 3 success), two bits each, four cells per byte (cell `i` of a row in bits `2 (i % 4)`
+    /// of byte `i / 4`), row-major with `row_bytes` bytes per k_s row.
+    codes: Vec<u8>,
+    row_bytes: usize,
+    counts: RegimeCounts,
 }
 
 impl PhaseMap {
@@ -250,23 +256,65 @@ impl PhaseMap {
         let beyond_repose = repose.is_some_and(|r| slope.radians() >= r.radians());
         let min_step = robot.min_step();
         let nx = k_n.len();
-        let mut regimes = vec![Regime::Slippage; nx * k_s.len()];
-        regimes.par_chunks_mut(nx).zip(terms.par_iter()).for_each(|(row, terms)| {
-            match terms {
-                // No anchoring: slippage unless the legs sink first.
-                None => {
-                    for (cell, &sunk) in row.iter_mut().zip(&sunk) {
-                        *cell = if sunk { Regime::Sinkage } else { Regime::Slippage };
-                    }
-                }
-                Some(t) => {
-                    for ((cell, &sunk), &s_star) in row.iter_mut().zip(&sunk).zip(&level_step) {
-                        *cell = classify(sunk, beyond_repose, Some(t.step(s_star)), min_step).regime();
-                    }
-                }
-            }
-            row_done();
-        });
+        // Per column: 0 where the legs sink, 1 elsewhere (a multiplier on the regime code).
+        let afloat: Vec<u8> = sunk.iter().map(|&s| u8::from(!s)).collect();
+        // In one row the step `s*_i scale - drag - slip` is a non-decreasing function of s*_i
+        // (scale >= 0; each rounded operation is monotone), so with the columns ranked by s*
+        // the cells with s > 0 (and s >= s_min) are exactly those ranked at or above a
+        // threshold, found by binary search with the exact expression. Ties in s* give equal
+        // steps, so they never straddle a threshold.
+        let mut order: Vec<u32> = (0..nx as u32).filter(|&i| !sunk[i as usize]).collect();
+        order.sort_by(|&a, &b| level_step[a as usize].total_cmp(&level_step[b as usize]));
+        let mut rank = vec![0u32; nx];
+        for (r, &i) in order.iter().enumerate() {
+            rank[i as usize] = r as u32;
+        }
+        let n_afloat = order.len();
+        // Four columns per byte; the per-column data padded to a multiple of four (as sunk).
+        let row_bytes = nx.div_ceil(4);
+        let (mut afloat_p, mut rank_p) = (afloat.clone(), rank.clone());
+        afloat_p.resize(4 * row_bytes, 0);
+        rank_p.resize(4 * row_bytes, 0);
+        // A row where nothing anchors: slippage (code 1) wherever the legs do not sink.
+        let mut slipping_row = vec![0u8; row_bytes];
+        pack_codes(&afloat_p, &mut slipping_row);
+        // Zero-initialised, so the allocator hands out fresh pages without a fill pass.
+        let mut codes = vec![0u8; row_bytes * k_s.len()];
+        let count = codes
+            .par_chunks_mut(row_bytes)
+            .zip(terms.par_iter())
+            .map_init(
+                || vec![0u8; 4 * row_bytes],
+                |scratch, (row, terms)| {
+                    let counts = match terms {
+                        Some(t) if !beyond_repose => {
+                            let first = |ok: &dyn Fn(f64) -> bool| {
+                                order.partition_point(|&i| !ok(t.step(level_step[i as usize]))) as u32
+                            };
+                            // The precedence of `regime::classify` as codes of `Regime::ALL`:
+                            // sinkage 0; else 1 + [s > 0] + [s >= s_min]; checked against
+                            // `predict` cell by cell in `every_cell_matches_predict`.
+                            let (r0, r1) = (first(&|s| s > 0.0), first(&|s| s >= min_step));
+                            for ((cell, &a), &r) in scratch.iter_mut().zip(&afloat_p).zip(&rank_p) {
+                                *cell = a * (1 + u8::from(r >= r0) + u8::from(r >= r1));
+                            }
+                            pack_codes(scratch, row);
+                            let (r0, r1) = (r0 as usize, r1 as usize);
+                            [nx - n_afloat, r0, r1 - r0, n_afloat - r1]
+                        }
+                        // No anchoring, or at/above repose: slippage unless the legs sink first.
+                        _ => {
+                            row.copy_from_slice(&slipping_row);
+                            [nx - n_afloat, n_afloat, 0, 0]
+                        }
+                    };
+                    row_done();
+                    counts
+                },
+            )
+            .reduce(|| [0; 4], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]);
+        let counts =
+            RegimeCounts { sinkage: count[0], slippage: count[1], metastable: count[2], success: count[3] };
         PhaseMap {
             slope,
             k_n_axis: *k_n_axis,
@@ -278,7 +326,9 @@ impl PhaseMap {
             level_step,
             sunk,
             terms,
-            regimes,
+            codes,
+            row_bytes,
+            counts,
         }
     }
 
@@ -307,9 +357,10 @@ impl PhaseMap {
         &self.k_s
     }
 
-    /// Every regime, row-major: index `j * k_n().len() + i`.
-    pub fn regimes(&self) -> &[Regime] {
-        &self.regimes
+    /// Every regime, row-major: the `(j * k_n().len() + i)`-th is cell `(i, j)`.
+    pub fn regimes(&self) -> impl ExactSizeIterator<Item = Regime> + '_ {
+        let nx = self.k_n.len();
+        (0..nx * self.k_s.len()).map(move |c| self.regime(c % nx, c / nx))
     }
 
     /// Whether the slope is at or beyond the terrain's angle of repose (every cell slips).
@@ -319,7 +370,8 @@ impl PhaseMap {
 
     /// The regime at column `i` (k_n) and row `j` (k_s).
     pub fn regime(&self, i: usize, j: usize) -> Regime {
-        self.regimes[j * self.k_n.len() + i]
+        let byte = self.codes[j * self.row_bytes + i / 4];
+        Regime::ALL[usize::from((byte >> (2 * (i % 4))) & 3)]
     }
 
     /// The net step `s` at cell `(i, j)`, m; `None` when the leg never anchors. Identical to
@@ -330,16 +382,7 @@ impl PhaseMap {
 
     /// The number of cells in each regime.
     pub fn counts(&self) -> RegimeCounts {
-        let mut c = RegimeCounts::default();
-        for r in &self.regimes {
-            match r {
-                Regime::Sinkage => c.sinkage += 1,
-                Regime::Slippage => c.slippage += 1,
-                Regime::Metastable => c.metastable += 1,
-                Regime::Success => c.success += 1,
-            }
-        }
-        c
+        self.counts
     }
 
     /// The contour `s = s_min` (the success boundary) as line segments, by marching squares
@@ -356,7 +399,7 @@ impl PhaseMap {
             return Vec::new();
         }
         let nx = self.k_n.len();
-        let field: Vec<f64> = (0..self.regimes.len())
+        let field: Vec<f64> = (0..nx * self.k_s.len())
             .into_par_iter()
             .map(|c| {
                 let (i, j) = (c % nx, c / nx);
@@ -367,6 +410,15 @@ impl PhaseMap {
             })
             .collect();
         contour_segments(&self.k_n_axis, &self.k_s_axis, &field, level)
+    }
+}
+
+/// Packs 2-bit codes, one per byte in `codes` (length `4 * packed.len()`), four to a byte:
+/// code `4b + k` goes to bits `2k` of byte `b`.
+fn pack_codes(codes: &[u8], packed: &mut [u8]) {
+    for (byte, quad) in packed.iter_mut().zip(codes.chunks_exact(4)) {
+        let v = u32::from_le_bytes([quad[0], quad[1], quad[2], quad[3]]) & 0x0303_0303;
+        *byte = ((v | v >> 6 | v >> 12 | v >> 18) & 0xff) as u8;
     }
 }
 
@@ -618,5 +670,8 @@ mod tests {
         let c = m.counts();
         assert_eq!(c.total(), 600);
         assert!(Regime::ALL.iter().all(|&g| c.get(g) > 0), "{c:?}");
+        for g in Regime::ALL {
+            assert_eq!(c.get(g), m.regimes().filter(|&r| r == g).count(), "{g}");
+        }
     }
 }

@@ -544,7 +544,10 @@ mod tests {
         }
     }
 
-    fn table(points: &[(f64, f64, f64, Option<f64>, Option<f64>)], repose: Option<f64>) -> Terrain {
+    /// (slope_deg, k_n, k_s, k_n_sd, k_s_sd).
+    type Point = (f64, f64, f64, Option<f64>, Option<f64>);
+
+    fn table(points: &[Point], repose: Option<f64>) -> Terrain {
         Terrain::new(crate::terrain::TerrainSpec {
             name: None,
             repose_deg: repose,

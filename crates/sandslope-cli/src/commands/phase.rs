@@ -102,6 +102,16 @@ pub fn default_axis(flag: &str, values: &[f64], down: f64, up: f64, n: usize) ->
     Axis::new(flag, lo, hi, n, AxisScale::Log).map_err(|e| anyhow!("{e}"))
 }
 
+/// The slopes (degrees, signed as given) strictly above the terrain's last measured point,
+/// where MODEL.md section 7 extrapolates. Compared in degrees as the user wrote them, so that
+/// a slope equal to the last point is not flagged by a degree-radian round trip.
+pub fn beyond_last_point(terrain: &Terrain, slopes_deg: &[f64]) -> Vec<f64> {
+    match terrain.points() {
+        [_, .., last] => slopes_deg.iter().copied().filter(|d| d.abs() > last.slope_deg).collect(),
+        _ => Vec::new(),
+    }
+}
+
 /// A progress bar of `len` steps on stderr, shown only when stdout and stderr are terminals
 /// and `quiet` is false (hidden in `--json` mode and when piped).
 pub fn progress_bar(len: u64, quiet: bool, what: &str) -> ProgressBar {
@@ -193,8 +203,7 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         .map(|&d| Slope::from_signed_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--slope"))))
         .collect::<Result<Vec<Slope>>>()?;
     let samples: Vec<_> = slopes.iter().map(|&s| terrain.sample(s)).collect();
-    let extrapolated: Vec<f64> =
-        args.slope.iter().zip(&samples).filter(|(_, s)| s.extrapolated).map(|(&d, _)| d).collect();
+    let extrapolated = beyond_last_point(&terrain, &args.slope);
     if !extrapolated.is_empty() {
         warn_extrapolated(&terrain, &extrapolated);
     }

@@ -179,7 +179,7 @@ fn describe_slope_limit(limit: &SafeLimit, max_risk: f64) -> String {
             format!("no slope is safe: p_fail = {p_fail:.4} >= {max_risk} already on level ground")
         }
         SafeLimit::Limit { value, p_fail } => format!(
-            "safe-slope limit: p_fail < {max_risk} from level up to {value:.2} deg (p_fail there {p_fail:.4})"
+            "safe-slope limit: p_fail < {max_risk} from level up to {value:.3} deg (p_fail there {p_fail:.4})"
         ),
         SafeLimit::BeyondRange { up_to, p_fail } => {
             format!(
@@ -212,11 +212,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
     if let Some(p) = &args.plot {
         crate::plot::format_of(p)?;
     }
-    let extrapolated: Vec<f64> = slopes
-        .iter()
-        .filter(|&&d| Slope::from_signed_degrees(d).is_ok_and(|s| terrain.terrain().sample(s).extrapolated))
-        .copied()
-        .collect();
+    let extrapolated = super::phase::beyond_last_point(terrain.terrain(), &slopes);
     if !extrapolated.is_empty() {
         warn_extrapolated(terrain.terrain(), &extrapolated);
     }
@@ -487,7 +483,7 @@ impl Figure for CurveFigure {
             .y_desc("probability")
             .label_style(font(16.0))
             .axis_desc_style(font(18.0))
-            .light_line_style(RGBColor(235, 235, 235))
+            .light_line_style(WHITE)
             .draw()
             .map_err(e)?;
         let red = RGBColor(214, 56, 48);
@@ -529,7 +525,7 @@ impl Figure for CurveFigure {
             chart
                 .draw_series(LineSeries::new(vec![(value, 0.0), (value, 1.02)], blue.stroke_width(2)))
                 .map_err(e)?
-                .label(format!("safe-slope limit {value:.2} deg"))
+                .label(format!("safe-slope limit {value:.3} deg"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(2)));
             chart
                 .draw_series(std::iter::once(Circle::new((value, self.max_risk), 7, blue.stroke_width(3))))
@@ -651,7 +647,11 @@ impl Figure for MapFigure {
             )
             .map_err(e)?
             .label(format!("p_fail = {} (--max-risk)", self.max_risk))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(3)));
+            .legend(|(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (24, 0)], BLACK.stroke_width(6))
+                    + PathElement::new(vec![(1, 0), (23, 0)], WHITE.stroke_width(3))
+            });
         let (k_n, k_s) = self.star;
         if k_n >= xe[0] && k_n <= xe[xe.len() - 1] && k_s >= ye[0] && k_s <= ye[ye.len() - 1] {
             chart

@@ -40,6 +40,10 @@ enum Command {
     Track(commands::track::TrackArgs),
     /// Heading-aware routes (fastest, safest, shortest) and risk maps over an elevation model.
     Plan(commands::plan::PlanArgs),
+    /// Phase diagrams: the regime (sinkage, slippage, metastable, success) over a (k_n, k_s) grid.
+    Phase(commands::phase::PhaseArgs),
+    /// Failure probability on uncertain terrain, the safe-slope limit and the heaviest safe mass.
+    Risk(commands::risk::RiskArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -51,6 +55,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fit(a) => commands::fit::run(a),
         Command::Track(a) => commands::track::run(a),
         Command::Plan(a) => commands::plan::run(a),
+        Command::Phase(a) => commands::phase::run(a),
+        Command::Risk(a) => commands::risk::run(a),
     }
 }
 

@@ -3,8 +3,10 @@
 pub mod calibrate;
 pub mod common;
 pub mod fit;
+pub mod phase;
 pub mod plan;
 pub mod predict;
 pub mod presets;
+pub mod risk;
 pub mod sweep;
 pub mod track;

@@ -1,0 +1,721 @@
+//! `sandslope risk`: the probability of failure when the terrain is uncertain (MODEL.md
+//! section 9): per slope, p_fail = P(sinkage or slippage) and P(not success); the safe-slope
+//! limit (steepest slope below `--max-risk`); the heaviest safe mass at a slope
+//! (`--solve mass`); figures of p_fail against slope and, with `--map`, over (k_n, k_s).
+
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Result};
+use clap::{Args, ValueEnum};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use sandslope::phase::contour_segments;
+use sandslope::risk::{
+    failure_risk, failure_risk_map, max_safe_mass, safe_slope_limit, SafeLimit, UncertainTerrain,
+};
+use sandslope::{Axis, RegimeProbabilities, Robot, Slope};
+
+use super::common::{warn_extrapolated, RobotArgs, TerrainArgs};
+use super::phase::{cell_edges, default_axis, parse_axis, progress_bar, sci_label, star_points, STAR_GREEN};
+use crate::inputs::check_flag;
+use crate::output::{csv_string, print_json, table, Format, FormatArgs};
+use crate::plot::{font, save, Figure};
+
+/// Default points per axis of the `--map` grid (each cell is a full quadrature).
+pub const MAP_POINTS: usize = 48;
+
+/// What `--solve` finds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Solve {
+    /// The safe-slope limit: the steepest slope with p_fail below --max-risk.
+    Slope,
+    /// The heaviest total mass with p_fail below --max-risk at --slope (one slope).
+    Mass,
+}
+
+/// Arguments of `sandslope risk`.
+#[derive(Debug, Args)]
+pub struct RiskArgs {
+    /// Slope(s), degrees: one value, a comma list (0,10,20) or a range MIN:MAX:N (0:24:13).
+    #[arg(long, value_name = "DEG|LIST|MIN:MAX:N", default_value = "0:24:7", allow_hyphen_values = true)]
+    pub slope: String,
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    pub terrain: TerrainArgs,
+    /// Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's
+    /// k_n_sd.
+    #[arg(long = "cv-n", value_name = "CV")]
+    pub cv_n: Option<f64>,
+    /// Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's
+    /// k_s_sd.
+    #[arg(long = "cv-s", value_name = "CV")]
+    pub cv_s: Option<f64>,
+    /// Largest acceptable failure probability, for the safe-slope limit and --solve.
+    #[arg(long = "max-risk", value_name = "P", default_value_t = 0.05)]
+    pub max_risk: f64,
+    /// Solve for the safe-slope limit (`slope`) or the heaviest safe mass at --slope (`mass`).
+    #[arg(long, value_enum)]
+    pub solve: Option<Solve>,
+    /// Draw p_fail against slope (or, with --map, over (k_n, k_s)) to this .png or .svg file.
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+    /// With --plot: a p_fail heat map over (k_n, k_s) at the first --slope.
+    #[arg(long, requires = "plot")]
+    pub map: bool,
+    /// --map grid of median k_n, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 100 to x 100, 48 points).
+    #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]", requires = "map")]
+    pub k_n: Option<String>,
+    /// --map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 1000 to x 100, 48 points).
+    #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", requires = "map")]
+    pub k_s: Option<String>,
+    #[command(flatten)]
+    pub format: FormatArgs,
+}
+
+/// Parses `--slope`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N` (N evenly spaced, ends included).
+pub fn parse_slopes(text: &str) -> Result<Vec<f64>> {
+    let number = |s: &str| -> Result<f64> {
+        let v: f64 =
+            s.trim().parse().map_err(|_| anyhow!("--slope: `{}` is not a number (in {text})", s.trim()))?;
+        Slope::from_signed_degrees(v).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+        Ok(v)
+    };
+    if text.contains(':') {
+        let parts: Vec<&str> = text.split(':').collect();
+        if parts.len() != 3 {
+            bail!("--slope = {text} must be DEG, a comma list, or MIN:MAX:N (e.g. 0:24:13)");
+        }
+        let (lo, hi) = (number(parts[0])?, number(parts[1])?);
+        let n: usize = parts[2].trim().parse().ok().filter(|&n| n >= 2).ok_or_else(|| {
+            anyhow!("--slope: N `{}` must be a whole number of at least 2 (in {text})", parts[2])
+        })?;
+        if hi <= lo {
+            bail!("--slope = {text}: MAX must be greater than MIN");
+        }
+        return Ok((0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect());
+    }
+    text.split(',').map(number).collect()
+}
+
+/// The regime probabilities as printed by `--json`.
+#[derive(Debug, Clone, Serialize)]
+struct RegimeRecord {
+    success: f64,
+    metastable: f64,
+    slippage: f64,
+    sinkage: f64,
+}
+
+/// One slope as printed by `--json`: exactly these keys.
+#[derive(Debug, Clone, Serialize)]
+struct RiskRecord {
+    slope_deg: f64,
+    p_fail: f64,
+    p_not_success: f64,
+    p_regime: RegimeRecord,
+}
+
+/// One slope as printed by `--csv`.
+#[derive(Debug, Clone, Serialize)]
+struct RiskRow {
+    slope_deg: f64,
+    cv_n: f64,
+    cv_s: f64,
+    p_fail: f64,
+    p_not_success: f64,
+    p_success: f64,
+    p_metastable: f64,
+    p_slippage: f64,
+    p_sinkage: f64,
+}
+
+/// `--solve slope` as printed by `--json`.
+#[derive(Debug, Clone, Serialize)]
+struct SlopeSolution {
+    max_risk: f64,
+    /// The steepest safe slope, or null when none was found (see `limit`).
+    safe_slope_deg: Option<f64>,
+    limit: SafeLimit,
+}
+
+/// `--solve mass` as printed by `--json`.
+#[derive(Debug, Clone, Serialize)]
+struct MassSolution {
+    slope_deg: f64,
+    max_risk: f64,
+    robot_mass_kg: f64,
+    /// The heaviest safe total mass, or null when none was found (see `limit`).
+    max_mass_kg: Option<f64>,
+    max_payload_kg: Option<f64>,
+    limit: SafeLimit,
+}
+
+fn record(slope_deg: f64, p: &RegimeProbabilities) -> RiskRecord {
+    RiskRecord {
+        slope_deg,
+        p_fail: p.p_fail(),
+        p_not_success: p.p_not_success(),
+        p_regime: RegimeRecord {
+            success: p.success,
+            metastable: p.metastable,
+            slippage: p.slippage,
+            sinkage: p.sinkage,
+        },
+    }
+}
+
+fn slope_of(deg: f64) -> Result<Slope> {
+    Slope::from_signed_degrees(deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))
+}
+
+fn describe_slope_limit(limit: &SafeLimit, max_risk: f64) -> String {
+    match limit {
+        SafeLimit::NoneSafe { p_fail } => {
+            format!("no slope is safe: p_fail = {p_fail:.4} >= {max_risk} already on level ground")
+        }
+        SafeLimit::Limit { value, p_fail } => format!(
+            "safe-slope limit: p_fail < {max_risk} from level up to {value:.3} deg (p_fail there {p_fail:.4})"
+        ),
+        SafeLimit::BeyondRange { up_to, p_fail } => {
+            format!(
+                "p_fail < {max_risk} at every slope up to {up_to} deg searched (p_fail there {p_fail:.4})"
+            )
+        }
+    }
+}
+
+/// Runs `sandslope risk`.
+pub fn run(args: RiskArgs) -> Result<()> {
+    let robot = args.robot.load()?;
+    let slopes = parse_slopes(&args.slope)?;
+    let max_risk = check_flag("--max-risk", args.max_risk, 0.0, 1.0)?;
+    if max_risk <= 0.0 || max_risk >= 1.0 {
+        bail!("--max-risk = {max_risk} must be strictly between 0 and 1");
+    }
+    let terrain = UncertainTerrain::new(args.terrain.load()?, args.cv_n, args.cv_s).map_err(|e| {
+        let hint = if e.key.starts_with("points") {
+            format!(
+                "terrain `{}`: {e}: the terrain file has no standard deviations; give --cv-n and --cv-s",
+                args.terrain.terrain
+            )
+        } else {
+            let flag = format!("--{}", e.key.replace('_', "-"));
+            format!("{}", e.renamed(flag))
+        };
+        anyhow!(hint)
+    })?;
+    if let Some(p) = &args.plot {
+        crate::plot::format_of(p)?;
+    }
+    let extrapolated = super::phase::beyond_last_point(terrain.terrain(), &slopes);
+    if !extrapolated.is_empty() {
+        warn_extrapolated(terrain.terrain(), &extrapolated);
+    }
+    let json = args.format.format() == Format::Json;
+
+    if args.map {
+        if let Some(path) = &args.plot {
+            draw_map(&args, &robot, &terrain, slopes[0], max_risk, path, json)?;
+        }
+    }
+
+    match args.solve {
+        Some(Solve::Mass) => {
+            if slopes.len() != 1 {
+                bail!("--solve mass needs exactly one --slope (got {})", args.slope);
+            }
+            let slope = slope_of(slopes[0])?;
+            let limit = max_safe_mass(&robot, slope, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
+            let own = robot.mass();
+            let sol = MassSolution {
+                slope_deg: slopes[0],
+                max_risk,
+                robot_mass_kg: own,
+                max_mass_kg: limit.value(),
+                max_payload_kg: limit.value().map(|m| m - own),
+                limit,
+            };
+            if args.plot.is_some() && !args.map {
+                let s_limit = safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
+                draw_curve(&args, &robot, &terrain, &slopes, max_risk, &s_limit, json)?;
+            }
+            return match args.format.format() {
+                Format::Json => print_json(&sol),
+                Format::Csv => {
+                    print!("{}", csv_string(&[sol_row(&sol)])?);
+                    Ok(())
+                }
+                Format::Table => {
+                    println!("{}", describe_mass_limit(&sol));
+                    Ok(())
+                }
+            };
+        }
+        Some(Solve::Slope) => {
+            let limit = safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
+            if args.plot.is_some() && !args.map {
+                draw_curve(&args, &robot, &terrain, &slopes, max_risk, &limit, json)?;
+            }
+            let sol = SlopeSolution { max_risk, safe_slope_deg: limit.value(), limit };
+            return match args.format.format() {
+                Format::Json => print_json(&sol),
+                Format::Csv => {
+                    #[derive(Serialize)]
+                    struct Row {
+                        max_risk: f64,
+                        safe_slope_deg: Option<f64>,
+                    }
+                    print!("{}", csv_string(&[Row { max_risk, safe_slope_deg: sol.safe_slope_deg }])?);
+                    Ok(())
+                }
+                Format::Table => {
+                    println!("{}", describe_slope_limit(&limit, max_risk));
+                    Ok(())
+                }
+            };
+        }
+        None => {}
+    }
+
+    // Probabilities at each requested slope.
+    let results: Vec<(f64, RegimeProbabilities, (f64, f64))> = slopes
+        .par_iter()
+        .map(|&d| {
+            let s = slope_of(d)?;
+            let (_, u) = terrain.at(s);
+            Ok((d, failure_risk(&robot, s, &terrain), (u.cv_n(), u.cv_s())))
+        })
+        .collect::<Result<_>>()?;
+    let need_limit = args.format.format() == Format::Table || (args.plot.is_some() && !args.map);
+    let limit = if need_limit {
+        Some(safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?)
+    } else {
+        None
+    };
+    if let (Some(limit), false) = (&limit, args.map) {
+        if args.plot.is_some() {
+            draw_curve(&args, &robot, &terrain, &slopes, max_risk, limit, json)?;
+        }
+    }
+    match args.format.format() {
+        Format::Json => {
+            let records: Vec<RiskRecord> = results.iter().map(|(d, p, _)| record(*d, p)).collect();
+            if records.len() == 1 {
+                print_json(&records[0])
+            } else {
+                print_json(&records)
+            }
+        }
+        Format::Csv => {
+            let rows: Vec<RiskRow> = results
+                .iter()
+                .map(|(d, p, (cv_n, cv_s))| RiskRow {
+                    slope_deg: *d,
+                    cv_n: *cv_n,
+                    cv_s: *cv_s,
+                    p_fail: p.p_fail(),
+                    p_not_success: p.p_not_success(),
+                    p_success: p.success,
+                    p_metastable: p.metastable,
+                    p_slippage: p.slippage,
+                    p_sinkage: p.sinkage,
+                })
+                .collect();
+            print!("{}", csv_string(&rows)?);
+            Ok(())
+        }
+        Format::Table => {
+            let mut t = table(&[
+                "slope (deg)",
+                "cv k_n",
+                "cv k_s",
+                "p_fail",
+                "p_not_success",
+                "P(sinkage)",
+                "P(slippage)",
+                "P(metastable)",
+                "P(success)",
+            ]);
+            let f = |x: f64| format!("{x:.4}");
+            for (d, p, (cv_n, cv_s)) in &results {
+                t.add_row([
+                    format!("{d}"),
+                    format!("{cv_n:.3}"),
+                    format!("{cv_s:.3}"),
+                    f(p.p_fail()),
+                    f(p.p_not_success()),
+                    f(p.sinkage),
+                    f(p.slippage),
+                    f(p.metastable),
+                    f(p.success),
+                ]);
+            }
+            println!("{t}");
+            if let Some(limit) = &limit {
+                println!("{}", describe_slope_limit(limit, max_risk));
+            }
+            println!("p_fail = P(sinkage or slippage); log-normal k_n, k_s (MODEL.md section 9), deterministic quadrature");
+            Ok(())
+        }
+    }
+}
+
+fn describe_mass_limit(sol: &MassSolution) -> String {
+    match sol.limit {
+        SafeLimit::NoneSafe { p_fail } => format!(
+            "no payload is safe at {} deg: p_fail = {p_fail:.4} >= {} already at the robot's own {} kg",
+            sol.slope_deg, sol.max_risk, sol.robot_mass_kg
+        ),
+        SafeLimit::Limit { value, p_fail } => format!(
+            "heaviest safe total mass at {} deg: {value:.4} kg (payload {:.4} kg over the robot's {} kg), p_fail {p_fail:.4} < {}",
+            sol.slope_deg,
+            value - sol.robot_mass_kg,
+            sol.robot_mass_kg,
+            sol.max_risk
+        ),
+        SafeLimit::BeyondRange { up_to, p_fail } => format!(
+            "p_fail < {} at {} deg for every total mass up to {up_to:.4} kg searched (p_fail there {p_fail:.4})",
+            sol.max_risk, sol.slope_deg
+        ),
+    }
+}
+
+#[derive(Serialize)]
+struct MassRow {
+    slope_deg: f64,
+    max_risk: f64,
+    robot_mass_kg: f64,
+    max_mass_kg: Option<f64>,
+    max_payload_kg: Option<f64>,
+}
+
+fn sol_row(s: &MassSolution) -> MassRow {
+    MassRow {
+        slope_deg: s.slope_deg,
+        max_risk: s.max_risk,
+        robot_mass_kg: s.robot_mass_kg,
+        max_mass_kg: s.max_mass_kg,
+        max_payload_kg: s.max_payload_kg,
+    }
+}
+
+/// p_fail and p_not_success against slope, sampled every 0.25 degrees.
+fn draw_curve(
+    args: &RiskArgs,
+    robot: &Robot,
+    terrain: &UncertainTerrain,
+    slopes: &[f64],
+    max_risk: f64,
+    limit: &SafeLimit,
+    quiet: bool,
+) -> Result<()> {
+    let Some(path) = &args.plot else { return Ok(()) };
+    let requested_max = slopes.iter().fold(0.0f64, |a, &d| a.max(d.abs()));
+    let mut hi = requested_max.max(30.0);
+    if let Some(v) = limit.value() {
+        hi = hi.max(v * 1.25);
+    }
+    if let Some(r) = terrain.terrain().repose() {
+        hi = hi.max(r.degrees() + 3.0);
+    }
+    let hi = hi.min(89.5);
+    let n = (hi / 0.25).round() as usize;
+    let bar = progress_bar(n as u64 + 1, quiet, "p_fail curve");
+    let curve: Vec<(f64, RegimeProbabilities)> = (0..=n)
+        .into_par_iter()
+        .filter_map(|i| {
+            let d = hi * i as f64 / n as f64;
+            let p = Slope::from_degrees(d).ok().map(|s| (d, failure_risk(robot, s, terrain)));
+            bar.inc(1);
+            p
+        })
+        .collect();
+    bar.finish_and_clear();
+    let points: Vec<(f64, f64)> = slopes
+        .iter()
+        .filter_map(|&d| slope_of(d).ok().map(|s| (d.abs(), failure_risk(robot, s, terrain).p_fail())))
+        .collect();
+    let figure = CurveFigure {
+        curve,
+        points,
+        hi,
+        max_risk,
+        limit: *limit,
+        title: format!(
+            "Failure risk: m = {} kg on {}",
+            robot.mass(),
+            terrain.terrain().name().unwrap_or("terrain")
+        ),
+    };
+    save(path, &figure)
+}
+
+struct CurveFigure {
+    curve: Vec<(f64, RegimeProbabilities)>,
+    points: Vec<(f64, f64)>,
+    hi: f64,
+    max_risk: f64,
+    limit: SafeLimit,
+    title: String,
+}
+
+impl Figure for CurveFigure {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = crate::error::plot_err;
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, font(24.0))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.0..self.hi, 0.0..1.02)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc("slope along the direction of travel (deg)")
+            .y_desc("probability")
+            .label_style(font(16.0))
+            .axis_desc_style(font(18.0))
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(e)?;
+        let red = RGBColor(214, 56, 48);
+        let orange = RGBColor(230, 150, 30);
+        chart
+            .draw_series(LineSeries::new(
+                self.curve.iter().map(|(d, p)| (*d, p.p_fail())),
+                red.stroke_width(3),
+            ))
+            .map_err(e)?
+            .label("p_fail = P(sinkage or slippage)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], red.stroke_width(3)));
+        chart
+            .draw_series(LineSeries::new(
+                self.curve.iter().map(|(d, p)| (*d, p.p_not_success())),
+                orange.stroke_width(2),
+            ))
+            .map_err(e)?
+            .label("p_not_success = P(regime != success)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], orange.stroke_width(2)));
+        let grey = RGBColor(90, 90, 90);
+        chart
+            .draw_series(DashedLineSeries::new(
+                vec![(0.0, self.max_risk), (self.hi, self.max_risk)],
+                8,
+                6,
+                grey.stroke_width(2),
+            ))
+            .map_err(e)?
+            .label(format!("threshold --max-risk = {}", self.max_risk))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], grey.stroke_width(2)));
+        chart
+            .draw_series(self.points.iter().map(|&(d, p)| Circle::new((d, p), 5, BLACK.filled())))
+            .map_err(e)?
+            .label("requested slopes")
+            .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
+        if let SafeLimit::Limit { value, .. } = self.limit {
+            let blue = RGBColor(40, 90, 200);
+            chart
+                .draw_series(LineSeries::new(vec![(value, 0.0), (value, 1.02)], blue.stroke_width(2)))
+                .map_err(e)?
+                .label(format!("safe-slope limit {value:.3} deg"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(2)));
+            chart
+                .draw_series(std::iter::once(Circle::new((value, self.max_risk), 7, blue.stroke_width(3))))
+                .map_err(e)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(font(16.0))
+            .draw()
+            .map_err(e)?;
+        Ok(())
+    }
+}
+
+/// The p_fail heat map over median (k_n, k_s) at one slope.
+fn draw_map(
+    args: &RiskArgs,
+    robot: &Robot,
+    terrain: &UncertainTerrain,
+    slope_deg: f64,
+    max_risk: f64,
+    path: &std::path::Path,
+    quiet: bool,
+) -> Result<()> {
+    let slope = slope_of(slope_deg)?;
+    let (ground, u) = terrain.at(slope);
+    let k_n_axis = match &args.k_n {
+        Some(t) => parse_axis("--k-n", t)?,
+        None => default_axis("--k-n", &[ground.k_n], 100.0, 100.0, MAP_POINTS)?,
+    };
+    let k_s_axis = match &args.k_s {
+        Some(t) => parse_axis("--k-s", t)?,
+        None => default_axis("--k-s", &[ground.k_s], 1000.0, 100.0, MAP_POINTS)?,
+    };
+    let cells = (k_n_axis.len() * k_s_axis.len()) as u64;
+    let bar = progress_bar(cells, quiet, "p_fail map");
+    let probs = failure_risk_map(robot, slope, ground.repose, &k_n_axis, &k_s_axis, u, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let p_fail: Vec<f64> = probs.iter().map(|p| p.p_fail()).collect();
+    let contour = contour_segments(&k_n_axis, &k_s_axis, &p_fail, max_risk);
+    let figure = MapFigure {
+        k_n_axis,
+        k_s_axis,
+        p_fail,
+        contour,
+        star: (ground.k_n, ground.k_s),
+        max_risk,
+        title: format!(
+            "p_fail at {slope_deg}\u{b0}, m = {} kg, cv k_n = {:.2}, cv k_s = {:.2}",
+            robot.mass(),
+            u.cv_n(),
+            u.cv_s()
+        ),
+    };
+    save(path, &figure)
+}
+
+struct MapFigure {
+    k_n_axis: Axis,
+    k_s_axis: Axis,
+    p_fail: Vec<f64>,
+    contour: Vec<sandslope::phase::Segment>,
+    star: (f64, f64),
+    max_risk: f64,
+    title: String,
+}
+
+impl Figure for MapFigure {
+    fn size(&self) -> (u32, u32) {
+        (900, 720)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = crate::error::plot_err;
+        let (main, bar_area) = root.split_horizontally(780);
+        let (xe, ye) = (cell_edges(&self.k_n_axis), cell_edges(&self.k_s_axis));
+        if self.k_n_axis.scale() != sandslope::AxisScale::Log
+            || self.k_s_axis.scale() != sandslope::AxisScale::Log
+        {
+            bail!("--map plots need log axes (:log)");
+        }
+        let mut chart = ChartBuilder::on(&main)
+            .caption(&self.title, font(20.0))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(75)
+            .build_cartesian_2d((xe[0]..xe[xe.len() - 1]).log_scale(), (ye[0]..ye[ye.len() - 1]).log_scale())
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("median normal resistance k_n (N/m\u{b3})")
+            .y_desc("median shear strength k_s (N/m\u{b3})")
+            .x_label_formatter(&sci_label)
+            .y_label_formatter(&sci_label)
+            .label_style(font(15.0))
+            .axis_desc_style(font(17.0))
+            .draw()
+            .map_err(e)?;
+        let nx = self.k_n_axis.len();
+        chart
+            .draw_series(self.p_fail.iter().enumerate().map(|(c, &p)| {
+                let (i, j) = (c % nx, c / nx);
+                Rectangle::new(
+                    [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])],
+                    ViridisRGB.get_color(p as f32).filled(),
+                )
+            }))
+            .map_err(e)?;
+        chart
+            .draw_series(
+                self.contour.iter().map(|&(a, b)| PathElement::new(vec![a, b], WHITE.stroke_width(3))),
+            )
+            .map_err(e)?
+            .label(format!("p_fail = {} (--max-risk)", self.max_risk))
+            .legend(|(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (24, 0)], BLACK.stroke_width(6))
+                    + PathElement::new(vec![(1, 0), (23, 0)], WHITE.stroke_width(3))
+            });
+        let (k_n, k_s) = self.star;
+        if k_n >= xe[0] && k_n <= xe[xe.len() - 1] && k_s >= ye[0] && k_s <= ye[ye.len() - 1] {
+            chart
+                .draw_series(std::iter::once(
+                    EmptyElement::at((k_n, k_s))
+                        + Polygon::new(star_points(13.0), STAR_GREEN.filled())
+                        + PathElement::new(
+                            star_points(13.0)
+                                .into_iter()
+                                .chain(std::iter::once(star_points(13.0)[0]))
+                                .collect::<Vec<_>>(),
+                            WHITE.stroke_width(1),
+                        ),
+                ))
+                .map_err(e)?
+                .label("terrain medians")
+                .legend(|(x, y)| {
+                    EmptyElement::at((x + 12, y)) + Polygon::new(star_points(9.0), STAR_GREEN.filled())
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(font(15.0))
+            .draw()
+            .map_err(e)?;
+        // Colour bar.
+        let mut cb = ChartBuilder::on(&bar_area)
+            .margin_top(45)
+            .margin_bottom(65)
+            .margin_right(10)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+            .map_err(e)?;
+        cb.configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc("p_fail")
+            .label_style(font(14.0))
+            .axis_desc_style(font(16.0))
+            .draw()
+            .map_err(e)?;
+        cb.draw_series((0..100).map(|k| {
+            let (a, b) = (k as f64 / 100.0, (k + 1) as f64 / 100.0);
+            Rectangle::new([(0.0, a), (1.0, b)], ViridisRGB.get_color((a + 0.005) as f32).filled())
+        }))
+        .map_err(e)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slope_lists_and_ranges() {
+        assert_eq!(parse_slopes("20").unwrap(), vec![20.0]);
+        assert_eq!(parse_slopes("0, 10,20").unwrap(), vec![0.0, 10.0, 20.0]);
+        assert_eq!(parse_slopes("0:24:4").unwrap(), vec![0.0, 8.0, 16.0, 24.0]);
+        for bad in ["x", "0:24", "0:24:1", "24:0:5", "95", "0:24:q"] {
+            assert!(parse_slopes(bad).unwrap_err().to_string().contains("--slope"), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,245 @@
+//! End-to-end tests of `sandslope phase` and `sandslope risk`.
+
+use std::path::Path;
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+use serde_json::Value;
+
+fn sandslope() -> Command {
+    Command::cargo_bin("sandslope").unwrap()
+}
+
+fn json(args: &[&str]) -> Value {
+    let out = sandslope().args(args).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// A terrain with standard deviations: 0 deg k_s 2e6 +- 4e5, 20 deg 1e6 +- 3e5; k_n 7e5 +- 1.4e5.
+const UNCERTAIN: &str = r#"
+name = "uncertain-sand"
+repose_deg = 25.0
+[[points]]
+slope_deg = 0.0
+k_n = 7.0e5
+k_s = 2.0e6
+k_n_sd = 1.4e5
+k_s_sd = 4.0e5
+[[points]]
+slope_deg = 20.0
+k_n = 7.0e5
+k_s = 1.0e6
+k_n_sd = 1.4e5
+k_s_sd = 3.0e5
+"#;
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+/// The CSV has one row per cell and panel with the documented columns, and the sinkage
+/// boundary sits at the hand-computed k_n* = m g cos(theta) / (n A_c (2R - h)):
+/// 0.35 kg level: 0.35*9.81/3/(4e-4*0.05) = 57225; 1 kg: 163500; times cos(24 deg) on 24 deg.
+#[test]
+fn phase_csv_has_every_cell_and_the_sinkage_boundary() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("cells.csv");
+    sandslope()
+        .args(["phase", "--k-n", "1e4:1e7:25", "--k-s", "1e3:1e8:20", "--slope", "0,24", "--mass", "0.35,1"])
+        .args(["--csv", csv.to_str().unwrap(), "--json"])
+        .assert()
+        .success()
+        .stderr("");
+    let mut reader = csv::Reader::from_path(&csv).unwrap();
+    assert_eq!(
+        reader.headers().unwrap().iter().collect::<Vec<_>>(),
+        ["k_n", "k_s", "slope_deg", "mass_kg", "regime", "step_m"]
+    );
+    let mut rows = 0;
+    for rec in reader.records() {
+        let rec = rec.unwrap();
+        rows += 1;
+        let num = |k: usize| rec[k].parse::<f64>().unwrap();
+        let (k_n, slope, mass) = (num(0), num(2), num(3));
+        let k_star = mass * 9.81 * slope.to_radians().cos() / 3.0 / (4e-4 * 0.05);
+        let sunk = &rec[4] == "sinkage";
+        assert_eq!(sunk, k_n <= k_star, "{rec:?} (k_n* = {k_star})");
+        assert!(["sinkage", "slippage", "metastable", "success"].contains(&&rec[4]));
+        // Steps are given wherever the leg anchors; success means s >= s_min = R = 0.04 m.
+        if &rec[4] == "success" {
+            assert!(num(5) >= 0.04);
+        }
+    }
+    assert_eq!(rows, 4 * 25 * 20);
+}
+
+#[test]
+fn phase_json_summarises_each_panel() {
+    let v = json(&["phase", "--k-n", "1e4:1e7:30", "--k-s", "1e3:1e8:30", "--slope", "0,30", "--json"]);
+    let panels = v.as_array().unwrap();
+    assert_eq!(panels.len(), 2);
+    let c = &panels[0]["counts"];
+    let total: u64 =
+        ["sinkage", "slippage", "metastable", "success"].iter().map(|k| c[k].as_u64().unwrap()).sum();
+    assert_eq!(total, 900);
+    // The preset terrain (k_n 7e5, k_s 2e6) on level sand: success (MODEL.md worked example,
+    // s = 75.7 mm >= 40 mm).
+    assert_eq!(panels[0]["terrain"]["regime"], "success");
+    // 30 deg is above the preset's angle of repose (25 deg): every non-sunk cell slips.
+    assert_eq!(panels[1]["beyond_repose"], true);
+    assert_eq!(panels[1]["counts"]["success"], 0);
+    assert_eq!(panels[1]["counts"]["metastable"], 0);
+    assert!((panels[0]["sinkage_threshold_k_n"].as_f64().unwrap() - 57_225.0).abs() < 1e-6);
+}
+
+#[test]
+fn phase_plot_is_written_and_bad_input_fails_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("phase.png");
+    sandslope()
+        .args(["phase", "--k-n", "1e4:1e7:40", "--k-s", "1e3:1e8:40", "--slope", "0,24", "--mass", "0.35,1"])
+        .args(["--plot", png.to_str().unwrap()])
+        .assert()
+        .success();
+    assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
+
+    let bad = dir.path().join("phase.jpg");
+    sandslope()
+        .args(["phase", "--k-n", "1e4:1e7:10", "--plot", bad.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(".png or .svg"));
+    assert!(!bad.exists());
+    sandslope()
+        .args(["phase", "--k-n", "1e7:1e4:10"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--k-n max = 10000 must be"));
+    sandslope()
+        .args(["phase", "--k-s", "0:1e4:10:log"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--k-s min"));
+    sandslope()
+        .args(["phase", "--mass", "0.35,-1"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--mass = -1"));
+    sandslope()
+        .args(["phase", "--slope", "95"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--slope = 95"));
+}
+
+/// With no uncertainty the probabilities are the certain regime (0 or 1), in the documented
+/// JSON shape.
+#[test]
+fn risk_without_uncertainty_is_certain() {
+    let v = json(&["risk", "--slope", "0", "--cv-n", "0", "--cv-s", "0", "--json"]);
+    let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
+    assert_eq!(keys, ["p_fail", "p_not_success", "p_regime", "slope_deg"]);
+    assert_eq!(v["p_fail"], 0.0);
+    assert_eq!(v["p_regime"]["success"], 1.0);
+    // At 26 deg, above the preset's repose of 25 deg: certain slippage.
+    let v = json(&["risk", "--slope", "10,26", "--cv-n", "0.1", "--cv-s", "0.1", "--json"]);
+    assert_eq!(v.as_array().unwrap().len(), 2);
+    assert!((v[1]["p_regime"]["slippage"].as_f64().unwrap() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn risk_uses_the_terrain_sds_interpolated_like_the_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let t = write(dir.path(), "sand.toml", UNCERTAIN);
+    let out = sandslope().args(["risk", "--terrain", &t, "--slope", "0,10,20", "--csv"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut reader = csv::Reader::from_reader(&out.stdout[..]);
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    // cv_s: 0 deg 4e5/2e6 = 0.2; 10 deg 3.5e5/1.5e6 = 0.2333; 20 deg 3e5/1e6 = 0.3; cv_n 0.2.
+    for (row, cv_s) in rows.iter().zip([0.2, 3.5e5 / 1.5e6, 0.3]) {
+        assert!((row[2].parse::<f64>().unwrap() - cv_s).abs() < 1e-12, "{row:?}");
+        assert!((row[1].parse::<f64>().unwrap() - 0.2).abs() < 1e-12, "{row:?}");
+        let p: Vec<f64> = (3..9).map(|k| row[k].parse().unwrap()).collect();
+        // p_fail = slippage + sinkage; the four regimes sum to 1.
+        assert!((p[0] - p[4] - p[5]).abs() < 1e-12 && (p[2] + p[3] + p[4] + p[5] - 1.0).abs() < 1e-9);
+    }
+    // Without sds and without --cv-n/--cv-s: a clear error, exit 2.
+    sandslope()
+        .args(["risk", "--slope", "10"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("k_n_sd").and(predicate::str::contains("--cv-n")));
+    sandslope()
+        .args(["risk", "--slope", "10", "--cv-n", "0.1", "--cv-s", "0.1", "--max-risk", "1.5"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--max-risk = 1.5"));
+}
+
+/// With no uncertainty the heaviest safe mass is where `predict` turns to failure: check it
+/// with `sandslope predict` just either side.
+#[test]
+fn solve_mass_matches_predict_either_side() {
+    let dir = tempfile::tempdir().unwrap();
+    let t = write(dir.path(), "weak.toml", "[[points]]\nslope_deg = 0.0\nk_n = 7.0e5\nk_s = 4.0e5\n");
+    let v = json(&[
+        "risk",
+        "--terrain",
+        &t,
+        "--slope",
+        "15",
+        "--cv-n",
+        "0",
+        "--cv-s",
+        "0",
+        "--solve",
+        "mass",
+        "--json",
+    ]);
+    let m = v["max_mass_kg"].as_f64().unwrap();
+    assert!(m > 0.35, "{v}");
+    assert!((v["max_payload_kg"].as_f64().unwrap() - (m - 0.35)).abs() < 1e-12);
+    let regime = |mass: f64| {
+        json(&["predict", "--terrain", &t, "--slope", "15", "--mass", &format!("{mass}"), "--json"])["regime"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    assert!(["metastable", "success"].contains(&regime(m * 0.999).as_str()), "{m}");
+    assert!(["slippage", "sinkage"].contains(&regime(m * 1.001).as_str()), "{m}");
+
+    let v = json(&["risk", "--terrain", &t, "--cv-n", "0", "--cv-s", "0", "--solve", "slope", "--json"]);
+    let s = v["safe_slope_deg"].as_f64().unwrap();
+    let at =
+        |d: f64| json(&["predict", "--terrain", &t, "--slope", &format!("{d}"), "--json"])["regime"].clone();
+    assert_ne!(at(s - 0.01), "slippage");
+    assert_eq!(at(s + 0.01), "slippage");
+    sandslope()
+        .args(["risk", "--slope", "0,10", "--cv-n", "0.1", "--cv-s", "0.1", "--solve", "mass"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("exactly one --slope"));
+}
+
+#[test]
+fn risk_plots_curve_and_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let t = write(dir.path(), "sand.toml", UNCERTAIN);
+    let curve = dir.path().join("risk.png");
+    sandslope()
+        .args(["risk", "--terrain", &t, "--slope", "0,10,20", "--plot", curve.to_str().unwrap()])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("safe-slope limit"));
+    assert!(std::fs::metadata(&curve).unwrap().len() > 10_000);
+    let map = dir.path().join("map.svg");
+    sandslope()
+        .args(["risk", "--terrain", &t, "--slope", "20", "--plot", map.to_str().unwrap(), "--map"])
+        .args(["--k-n", "1e4:1e7:6", "--k-s", "1e4:1e8:6", "--json"])
+        .assert()
+        .success();
+    assert!(std::fs::read_to_string(&map).unwrap().contains("<svg"));
+}

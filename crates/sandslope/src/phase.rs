@@ -1,0 +1,677 @@
+//! Phase diagrams: the regime of every terrain `(k_n, k_s)` on a grid, at a fixed robot and
+//! slope (MODEL.md section 6; the paper's Section IV and its four-panel figure).
+//!
+//! The model separates: the normal equilibrium depth `d_n`, the level step `s*` and sinkage
+//! depend on k_n only; the shear-equilibrium depth `d_s` and anchoring time `t1` depend on k_s
+//! only. So [`PhaseMap::compute`] evaluates the expensive parts (square roots, arcsines) once
+//! per grid column and row, and the net step of a cell is `s = s*_i scale_j - drag_j - slip_j`,
+//! in exactly the operation order of [`crate::model::net_step`], so every cell is bit-for-bit
+//! what [`crate::predict`] gives. Within a row that step is monotone in `s*_i`, so the two
+//! regime thresholds (s > 0, s >= s_min) are found by binary search over the columns ranked by
+//! `s*`, and each cell costs two integer comparisons. Rows run in parallel (rayon). Only the
+//! regimes are stored (two bits per cell); the net step of any cell is recomputed on demand
+//! from the per-axis parts by [`PhaseMap::step`].
+//!
+//! The contour `s = s_min` (the boundary of the success region, drawn black in the paper) is
+//! extracted from the step field by marching squares in axis coordinates ([`contour_segments`]).
+
+use rayon::prelude::*;
+
+use crate::error::ParamError;
+use crate::model::{
+    anchoring_time, backward_slip, level_step_length, normal_equilibrium_depth, shear_equilibrium_depth, G,
+};
+use crate::regime::Regime;
+use crate::robot::Robot;
+use crate::slope::Slope;
+
+/// Spacing of grid values along an axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AxisScale {
+    /// Evenly spaced values.
+    Linear,
+    /// Evenly spaced logarithms (the paper's phase diagrams are log-log).
+    Log,
+}
+
+/// The values of one grid axis: `n >= 2` points from `min` to `max` (both included).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Axis {
+    min: f64,
+    max: f64,
+    n: usize,
+    scale: AxisScale,
+}
+
+impl Axis {
+    /// An axis of `n` values from `min` to `max`, named `key` in errors. Requires finite
+    /// `0 <= min < max`, `min > 0` on a log axis, and `n >= 2`.
+    pub fn new(key: &str, min: f64, max: f64, n: usize, scale: AxisScale) -> Result<Axis, ParamError> {
+        let lowest = match scale {
+            AxisScale::Linear => 0.0,
+            AxisScale::Log => f64::MIN_POSITIVE,
+        };
+        if !(min.is_finite() && min >= lowest) {
+            let expected = match scale {
+                AxisScale::Linear => "a finite number of at least 0",
+                AxisScale::Log => "a finite number greater than 0 on a log axis",
+            };
+            return Err(ParamError::new(format!("{key} min"), min, expected));
+        }
+        if !(max.is_finite() && max > min) {
+            return Err(ParamError::new(
+                format!("{key} max"),
+                max,
+                format!("finite and greater than min = {min}"),
+            ));
+        }
+        if n < 2 {
+            return Err(ParamError::new(format!("{key} points"), n as f64, "at least 2"));
+        }
+        Ok(Axis { min, max, n, scale })
+    }
+
+    /// Number of values.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Always false: an axis has at least two values.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Smallest value.
+    pub fn min(&self) -> f64 {
+        self.min
+    }
+
+    /// Largest value.
+    pub fn max(&self) -> f64 {
+        self.max
+    }
+
+    /// Spacing.
+    pub fn scale(&self) -> AxisScale {
+        self.scale
+    }
+
+    /// The `i`-th value (`i < len`); the ends are exactly `min` and `max`.
+    pub fn value(&self, i: usize) -> f64 {
+        if i == 0 {
+            return self.min;
+        }
+        if i + 1 >= self.n {
+            return self.max;
+        }
+        let f = i as f64 / (self.n - 1) as f64;
+        match self.scale {
+            AxisScale::Linear => self.min + f * (self.max - self.min),
+            AxisScale::Log => (self.min.ln() + f * (self.max.ln() - self.min.ln())).exp(),
+        }
+    }
+
+    /// All values, ascending.
+    pub fn values(&self) -> Vec<f64> {
+        (0..self.n).map(|i| self.value(i)).collect()
+    }
+
+    /// The coordinate in which values are evenly spaced: the value itself, or its logarithm.
+    pub fn coordinate(&self, value: f64) -> f64 {
+        match self.scale {
+            AxisScale::Linear => value,
+            AxisScale::Log => value.ln(),
+        }
+    }
+
+    /// The inverse of [`Axis::coordinate`].
+    pub fn from_coordinate(&self, c: f64) -> f64 {
+        match self.scale {
+            AxisScale::Linear => c,
+            AxisScale::Log => c.exp(),
+        }
+    }
+}
+
+/// The k_s-only part of the net step at one grid row: `s = s* scale - drag - slip`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct StepTerms {
+    /// `((T/2 - t1)/(T/2))^2`.
+    scale: f64,
+    /// `g sin(theta) t1 (T/2 - t1)`, the slip inherited during propulsion.
+    drag: f64,
+    /// Backward slip before anchoring `s1 = 1/2 g sin(theta) t1^2`.
+    slip: f64,
+}
+
+impl StepTerms {
+    /// The terms for anchoring time `t1`, in the operation order of `model::propulsion` and
+    /// `model::backward_slip` (checked bit-for-bit against `predict` in the tests).
+    fn new(robot: &Robot, slope: Slope, t1: f64) -> StepTerms {
+        let half = robot.stance_duration();
+        let left = half - t1;
+        StepTerms {
+            scale: (left / half).powi(2),
+            drag: G * slope.sin() * t1 * left,
+            slip: backward_slip(slope, t1),
+        }
+    }
+
+    fn step(&self, level_step: f64) -> f64 {
+        level_step * self.scale - self.drag - self.slip
+    }
+}
+
+/// How many cells of a map fall in each regime.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub struct RegimeCounts {
+    /// Cells in sinkage.
+    pub sinkage: usize,
+    /// Cells in slippage.
+    pub slippage: usize,
+    /// Cells in the metastable regime.
+    pub metastable: usize,
+    /// Cells in success.
+    pub success: usize,
+}
+
+impl RegimeCounts {
+    /// The count for `regime`.
+    pub fn get(&self, regime: Regime) -> usize {
+        match regime {
+            Regime::Sinkage => self.sinkage,
+            Regime::Slippage => self.slippage,
+            Regime::Metastable => self.metastable,
+            Regime::Success => self.success,
+        }
+    }
+
+    /// All cells.
+    pub fn total(&self) -> usize {
+        self.sinkage + self.slippage + self.metastable + self.success
+    }
+}
+
+/// A straight piece of a contour line, from `.0` to `.1`, each point `(k_n, k_s)` in N/m^3.
+pub type Segment = ((f64, f64), (f64, f64));
+
+/// The regime of every cell of a `(k_n, k_s)` grid for one robot at one slope.
+///
+/// Cell `(i, j)` is `k_n = k_n axis value i`, `k_s = k_s axis value j`.
+#[derive(Debug, Clone)]
+pub struct PhaseMap {
+    slope: Slope,
+    k_n_axis: Axis,
+    k_s_axis: Axis,
+    k_n: Vec<f64>,
+    k_s: Vec<f64>,
+    min_step: f64,
+    beyond_repose: bool,
+    /// Per k_n column: level step `s*`.
+    level_step: Vec<f64>,
+    /// Per k_n column: `d_n >= d_max`.
+    sunk: Vec<bool>,
+    /// Per k_s row: the step terms, `None` when the leg never anchors (`d_s > d_max`).
+    terms: Vec<Option<StepTerms>>,
+    /// Regime codes, indices into [`Regime::ALL`] (0 sinkage, 1 slippage, 2 metastable,
+    /// 3 success), two bits each, four cells per byte (cell `i` of a row in bits `2 (i % 4)`
+    /// of byte `i / 4`), row-major with `row_bytes` bytes per k_s row.
+    codes: Vec<u8>,
+    row_bytes: usize,
+    counts: RegimeCounts,
+}
+
+impl PhaseMap {
+    /// Classifies every cell of the grid `k_n_axis x k_s_axis` for `robot` at `slope` on a
+    /// terrain whose angle of repose is `repose` (at or beyond it every cell slips).
+    ///
+    /// `row_done` is called once per finished k_s row, from any thread (for progress bars).
+    pub fn compute(
+        robot: &Robot,
+        slope: Slope,
+        repose: Option<Slope>,
+        k_n_axis: &Axis,
+        k_s_axis: &Axis,
+        row_done: &(dyn Fn() + Sync),
+    ) -> PhaseMap {
+        let k_n = k_n_axis.values();
+        let k_s = k_s_axis.values();
+        let d_max = robot.max_depth();
+        // k_n-only parts, once per column.
+        let (level_step, sunk): (Vec<f64>, Vec<bool>) = k_n
+            .iter()
+            .map(|&k| {
+                let d_n = normal_equilibrium_depth(robot, slope, k);
+                (level_step_length(robot, d_n), d_n >= d_max)
+            })
+            .unzip();
+        // k_s-only parts, once per row.
+        let terms: Vec<Option<StepTerms>> = k_s
+            .iter()
+            .map(|&k| {
+                anchoring_time(robot, shear_equilibrium_depth(robot, slope, k))
+                    .map(|t1| StepTerms::new(robot, slope, t1))
+            })
+            .collect();
+        let beyond_repose = repose.is_some_and(|r| slope.radians() >= r.radians());
+        let min_step = robot.min_step();
+        let nx = k_n.len();
+        // Per column: 0 where the legs sink, 1 elsewhere (a multiplier on the regime code).
+        let afloat: Vec<u8> = sunk.iter().map(|&s| u8::from(!s)).collect();
+        // In one row the step `s*_i scale - drag - slip` is a non-decreasing function of s*_i
+        // (scale >= 0; each rounded operation is monotone), so with the columns ranked by s*
+        // the cells with s > 0 (and s >= s_min) are exactly those ranked at or above a
+        // threshold, found by binary search with the exact expression. Ties in s* give equal
+        // steps, so they never straddle a threshold.
+        let mut order: Vec<u32> = (0..nx as u32).filter(|&i| !sunk[i as usize]).collect();
+        order.sort_by(|&a, &b| level_step[a as usize].total_cmp(&level_step[b as usize]));
+        let mut rank = vec![0u32; nx];
+        for (r, &i) in order.iter().enumerate() {
+            rank[i as usize] = r as u32;
+        }
+        let n_afloat = order.len();
+        // Four columns per byte; the per-column data padded to a multiple of four (as sunk).
+        let row_bytes = nx.div_ceil(4);
+        let (mut afloat_p, mut rank_p) = (afloat.clone(), rank.clone());
+        afloat_p.resize(4 * row_bytes, 0);
+        rank_p.resize(4 * row_bytes, 0);
+        // A row where nothing anchors: slippage (code 1) wherever the legs do not sink.
+        let mut slipping_row = vec![0u8; row_bytes];
+        pack_codes(&afloat_p, &mut slipping_row);
+        // Zero-initialised, so the allocator hands out fresh pages without a fill pass.
+        let mut codes = vec![0u8; row_bytes * k_s.len()];
+        let count = codes
+            .par_chunks_mut(row_bytes)
+            .zip(terms.par_iter())
+            .map_init(
+                || vec![0u8; 4 * row_bytes],
+                |scratch, (row, terms)| {
+                    let counts = match terms {
+                        Some(t) if !beyond_repose => {
+                            let first = |ok: &dyn Fn(f64) -> bool| {
+                                order.partition_point(|&i| !ok(t.step(level_step[i as usize]))) as u32
+                            };
+                            // The precedence of `regime::classify` as codes of `Regime::ALL`:
+                            // sinkage 0; else 1 + [s > 0] + [s >= s_min]; checked against
+                            // `predict` cell by cell in `every_cell_matches_predict`.
+                            let (r0, r1) = (first(&|s| s > 0.0), first(&|s| s >= min_step));
+                            for ((cell, &a), &r) in scratch.iter_mut().zip(&afloat_p).zip(&rank_p) {
+                                *cell = a * (1 + u8::from(r >= r0) + u8::from(r >= r1));
+                            }
+                            pack_codes(scratch, row);
+                            let (r0, r1) = (r0 as usize, r1 as usize);
+                            [nx - n_afloat, r0, r1 - r0, n_afloat - r1]
+                        }
+                        // No anchoring, or at/above repose: slippage unless the legs sink first.
+                        _ => {
+                            row.copy_from_slice(&slipping_row);
+                            [nx - n_afloat, n_afloat, 0, 0]
+                        }
+                    };
+                    row_done();
+                    counts
+                },
+            )
+            .reduce(|| [0; 4], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]);
+        let counts =
+            RegimeCounts { sinkage: count[0], slippage: count[1], metastable: count[2], success: count[3] };
+        PhaseMap {
+            slope,
+            k_n_axis: *k_n_axis,
+            k_s_axis: *k_s_axis,
+            k_n,
+            k_s,
+            min_step,
+            beyond_repose,
+            level_step,
+            sunk,
+            terms,
+            codes,
+            row_bytes,
+            counts,
+        }
+    }
+
+    /// The slope of this map.
+    pub fn slope(&self) -> Slope {
+        self.slope
+    }
+
+    /// The k_n axis.
+    pub fn k_n_axis(&self) -> &Axis {
+        &self.k_n_axis
+    }
+
+    /// The k_s axis.
+    pub fn k_s_axis(&self) -> &Axis {
+        &self.k_s_axis
+    }
+
+    /// The k_n values (columns), N/m^3.
+    pub fn k_n(&self) -> &[f64] {
+        &self.k_n
+    }
+
+    /// The k_s values (rows), N/m^3.
+    pub fn k_s(&self) -> &[f64] {
+        &self.k_s
+    }
+
+    /// Every regime, row-major: the `(j * k_n().len() + i)`-th is cell `(i, j)`.
+    pub fn regimes(&self) -> impl ExactSizeIterator<Item = Regime> + '_ {
+        let nx = self.k_n.len();
+        (0..nx * self.k_s.len()).map(move |c| self.regime(c % nx, c / nx))
+    }
+
+    /// Whether the slope is at or beyond the terrain's angle of repose (every cell slips).
+    pub fn beyond_repose(&self) -> bool {
+        self.beyond_repose
+    }
+
+    /// The regime at column `i` (k_n) and row `j` (k_s).
+    pub fn regime(&self, i: usize, j: usize) -> Regime {
+        let byte = self.codes[j * self.row_bytes + i / 4];
+        Regime::ALL[usize::from((byte >> (2 * (i % 4))) & 3)]
+    }
+
+    /// The net step `s` at cell `(i, j)`, m; `None` when the leg never anchors. Identical to
+    /// `predict(..).step` for that cell.
+    pub fn step(&self, i: usize, j: usize) -> Option<f64> {
+        self.terms[j].map(|t| t.step(self.level_step[i]))
+    }
+
+    /// The number of cells in each regime.
+    pub fn counts(&self) -> RegimeCounts {
+        self.counts
+    }
+
+    /// The contour `s = s_min` (the success boundary) as line segments, by marching squares
+    /// over the net step of the cells where the legs neither sink nor fail to anchor.
+    /// Empty at or beyond the angle of repose, where every cell slips.
+    pub fn robust_contour(&self) -> Vec<Segment> {
+        self.step_contour(self.min_step)
+    }
+
+    /// The contour `s = level` (m) of the net step, by marching squares (see
+    /// [`PhaseMap::robust_contour`]).
+    pub fn step_contour(&self, level: f64) -> Vec<Segment> {
+        if self.beyond_repose {
+            return Vec::new();
+        }
+        let nx = self.k_n.len();
+        let field: Vec<f64> = (0..nx * self.k_s.len())
+            .into_par_iter()
+            .map(|c| {
+                let (i, j) = (c % nx, c / nx);
+                match self.step(i, j) {
+                    Some(s) if !self.sunk[i] => s,
+                    _ => f64::NAN,
+                }
+            })
+            .collect();
+        contour_segments(&self.k_n_axis, &self.k_s_axis, &field, level)
+    }
+}
+
+/// Packs 2-bit codes, one per byte in `codes` (length `4 * packed.len()`), four to a byte:
+/// code `4b + k` goes to bits `2k` of byte `b`.
+fn pack_codes(codes: &[u8], packed: &mut [u8]) {
+    for (byte, quad) in packed.iter_mut().zip(codes.chunks_exact(4)) {
+        let v = u32::from_le_bytes([quad[0], quad[1], quad[2], quad[3]]) & 0x0303_0303;
+        *byte = ((v | v >> 6 | v >> 12 | v >> 18) & 0xff) as u8;
+    }
+}
+
+/// The contour `field = level` of a scalar field on the grid `x_axis x y_axis` (row-major,
+/// one row per y value), by marching squares with linear interpolation in axis coordinates
+/// (logarithms on log axes). Squares with a NaN corner are skipped; saddles are resolved by
+/// the mean of the four corners. Points are returned in axis values, not coordinates.
+pub fn contour_segments(x_axis: &Axis, y_axis: &Axis, field: &[f64], level: f64) -> Vec<Segment> {
+    let (nx, ny) = (x_axis.len(), y_axis.len());
+    assert_eq!(field.len(), nx * ny, "field must have one value per grid cell");
+    let xc: Vec<f64> = x_axis.values().iter().map(|&v| x_axis.coordinate(v)).collect();
+    let yc: Vec<f64> = y_axis.values().iter().map(|&v| y_axis.coordinate(v)).collect();
+    let at = |i: usize, j: usize| field[j * nx + i] - level;
+    let point = |x: f64, y: f64| (x_axis.from_coordinate(x), y_axis.from_coordinate(y));
+    (0..ny - 1)
+        .into_par_iter()
+        .flat_map_iter(|j| {
+            let mut out = Vec::new();
+            for i in 0..nx - 1 {
+                // Corners counter-clockwise from bottom-left: (i,j), (i+1,j), (i+1,j+1), (i,j+1).
+                let v = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+                if v.iter().any(|x| x.is_nan()) {
+                    continue;
+                }
+                let p = [(xc[i], yc[j]), (xc[i + 1], yc[j]), (xc[i + 1], yc[j + 1]), (xc[i], yc[j + 1])];
+                // Crossing on edge k, between corners k and k+1.
+                let cross = |k: usize| {
+                    let (a, b) = (k, (k + 1) % 4);
+                    let t = v[a] / (v[a] - v[b]);
+                    let (pa, pb) = (p[a], p[b]);
+                    point(pa.0 + t * (pb.0 - pa.0), pa.1 + t * (pb.1 - pa.1))
+                };
+                let above: Vec<bool> = v.iter().map(|&x| x >= 0.0).collect();
+                let edges: Vec<usize> = (0..4).filter(|&k| above[k] != above[(k + 1) % 4]).collect();
+                match edges.len() {
+                    2 => out.push((cross(edges[0]), cross(edges[1]))),
+                    4 => {
+                        // Saddle: if the centre is on the side of corner 0, corner 0's region
+                        // connects through the centre, so the lines cut off corners 1 and 3.
+                        let centre_above = v.iter().sum::<f64>() / 4.0 >= 0.0;
+                        if centre_above == above[0] {
+                            out.push((cross(0), cross(1)));
+                            out.push((cross(2), cross(3)));
+                        } else {
+                            out.push((cross(3), cross(0)));
+                            out.push((cross(1), cross(2)));
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            out
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::critical::{critical_shear_strength, StepTarget};
+    use crate::model::{anchoring_threshold_k_s, predict, sinkage_threshold_k_n, tests::paper_robot};
+    use crate::terrain::Ground;
+
+    fn deg(d: f64) -> Slope {
+        Slope::from_degrees(d).unwrap()
+    }
+
+    fn log_axis(min: f64, max: f64, n: usize) -> Axis {
+        Axis::new("k", min, max, n, AxisScale::Log).unwrap()
+    }
+
+    fn map(robot: &Robot, slope: Slope, kn: &Axis, ks: &Axis) -> PhaseMap {
+        PhaseMap::compute(robot, slope, None, kn, ks, &|| {})
+    }
+
+    #[test]
+    fn axes_hit_their_ends_and_space_evenly() {
+        let a = log_axis(1e3, 1e7, 5);
+        let v = a.values();
+        assert_eq!((v[0], v[4]), (1e3, 1e7));
+        for (x, e) in v.iter().zip([1e3, 1e4, 1e5, 1e6, 1e7]) {
+            assert!((x / e - 1.0).abs() < 1e-12, "{x} vs {e}");
+        }
+        let l = Axis::new("k", 0.0, 10.0, 11, AxisScale::Linear).unwrap();
+        assert!((l.value(3) - 3.0).abs() < 1e-12);
+        assert!(Axis::new("k", 0.0, 10.0, 11, AxisScale::Log).is_err());
+        assert!(Axis::new("k", 5.0, 5.0, 11, AxisScale::Linear).is_err());
+        assert_eq!(Axis::new("--k-n", 1.0, 5.0, 1, AxisScale::Linear).unwrap_err().key, "--k-n points");
+    }
+
+    /// Every cell agrees with `predict`, regime and step bit for bit, including on a slope,
+    /// with a measured level step and beyond the angle of repose.
+    #[test]
+    fn every_cell_matches_predict() {
+        let r = paper_robot();
+        let measured = Robot::new(crate::RobotSpec { level_step_m: Some(0.07), ..r.spec().clone() }).unwrap();
+        let kn = log_axis(1e4, 1e7, 37);
+        let ks = log_axis(1e3, 1e8, 41);
+        for (robot, d, repose) in
+            [(&r, 0.0, None), (&r, 20.0, None), (&measured, 24.0, None), (&r, 26.0, Some(25.0))]
+        {
+            let repose = repose.map(deg);
+            let m = PhaseMap::compute(robot, deg(d), repose, &kn, &ks, &|| {});
+            for (j, &k_s) in ks.values().iter().enumerate() {
+                for (i, &k_n) in kn.values().iter().enumerate() {
+                    let p = predict(robot, deg(d), &Ground::new(k_n, k_s).unwrap().with_repose(repose));
+                    assert_eq!(m.regime(i, j), p.regime, "{d} deg, k_n {k_n}, k_s {k_s}");
+                    assert_eq!(m.step(i, j).map(f64::to_bits), p.step.map(f64::to_bits));
+                }
+            }
+        }
+    }
+
+    /// Hand-worked cells on each side of each boundary, for the paper robot on level sand
+    /// (MODEL.md sections 3 to 6):
+    /// - sinkage: d_n = d_max = 0.05 m at k_n* = 0.35*9.81/3/(4e-4*0.05) = 57225 N/m^3;
+    /// - anchoring: d_s = d_max at k_s = F_a/(W d_max^2) = 0.146608/(0.01*0.0025) = 5864.3;
+    ///   on level sand there is no slip, so anchoring means s > 0 (slippage below, metastable
+    ///   just above);
+    /// - success needs s = s* (1 - 2 t1)^2 >= 0.04. With k_n = 286125 (d_n = 0.01, s* = 0.08)
+    ///   that is (1 - 2 t1)^2 >= 0.5, t1 <= (1 - 1/sqrt 2)/2 = 0.146447 s, leg phase
+    ///   2 pi t1 - 0.252680 = 0.667471 rad, d_s <= 0.04 sin(0.667471) + 0.01 = 0.034760 m,
+    ///   k_s >= 0.146608/(0.01 * 0.034760^2) = 12133.8.
+    #[test]
+    fn hand_worked_cells_on_each_side_of_each_boundary() {
+        let r = paper_robot();
+        let kn = Axis::new("k_n", 57_225.0 * 0.99, 286_125.0, 3, AxisScale::Linear).unwrap();
+        // Column 0 sinks; 1 and 2 do not (column 2 is k_n = 286125 exactly).
+        let ks_vals = [5_864.3 * 0.99, 5_864.3 * 1.01, 12_133.8 * 0.995, 12_133.8 * 1.005];
+        for (j, &k_s) in ks_vals.iter().enumerate() {
+            let ks = Axis::new("k_s", k_s, k_s * 2.0, 2, AxisScale::Linear).unwrap();
+            let m = map(&r, Slope::LEVEL, &kn, &ks);
+            assert_eq!(m.regime(0, 0), Regime::Sinkage, "k_s {k_s}");
+            let want = [Regime::Slippage, Regime::Metastable, Regime::Metastable, Regime::Success][j];
+            assert_eq!(m.regime(2, 0), want, "k_s {k_s}");
+        }
+        // Just above the sinkage threshold the legs do not sink.
+        let kn = Axis::new("k_n", 57_225.0 * 1.01, 1e6, 2, AxisScale::Linear).unwrap();
+        let ks = Axis::new("k_s", 1e8, 2e8, 2, AxisScale::Linear).unwrap();
+        assert_ne!(map(&r, Slope::LEVEL, &kn, &ks).regime(0, 0), Regime::Sinkage);
+    }
+
+    /// On a slope the slippage boundary is where s = 0, found independently by the root
+    /// finder; cells just either side of it fall on the right side.
+    #[test]
+    fn slope_boundaries_against_the_root_finder() {
+        let r = paper_robot();
+        let s = deg(24.0);
+        let k_n = 7e5;
+        for (target, below, above) in [
+            (StepTarget::Progress, Regime::Slippage, Regime::Metastable),
+            (StepTarget::Robust, Regime::Metastable, Regime::Success),
+        ] {
+            let k = critical_shear_strength(&r, s, k_n, false, target).unwrap();
+            let kn = Axis::new("k_n", k_n, 2.0 * k_n, 2, AxisScale::Linear).unwrap();
+            let ks = Axis::new("k_s", k * 0.999, k * 1.001, 2, AxisScale::Linear).unwrap();
+            let m = map(&r, s, &kn, &ks);
+            assert_eq!((m.regime(0, 0), m.regime(0, 1)), (below, above), "{target:?} at k_s {k}");
+        }
+        assert!(
+            critical_shear_strength(&r, s, k_n, false, StepTarget::Progress).unwrap()
+                > anchoring_threshold_k_s(&r, s)
+        );
+    }
+
+    /// The marching-squares contour crosses every k_n column at the k_s the root finder gives
+    /// for s = s_min, to within the interpolation error of the grid; and it crosses no column
+    /// where no k_s is enough.
+    #[test]
+    fn contour_matches_the_root_finder() {
+        let r = paper_robot();
+        for d in [0.0, 24.0] {
+            let s = deg(d);
+            let kn = log_axis(3e4, 3e7, 121);
+            let ks = log_axis(1e3, 1e9, 161);
+            let m = map(&r, s, &kn, &ks);
+            let segments = m.robust_contour();
+            assert!(!segments.is_empty());
+            let mut checked = 0;
+            for (i, &k_n) in kn.values().iter().enumerate() {
+                // Contour points on this column (vertical grid line), to relative 1e-9 in k_n.
+                let on_column: Vec<f64> = segments
+                    .iter()
+                    .flat_map(|&(a, b)| [a, b])
+                    .filter(|p| (p.0 / k_n - 1.0).abs() < 1e-9)
+                    .map(|p| p.1)
+                    .collect();
+                match critical_shear_strength(&r, s, k_n, false, StepTarget::Robust) {
+                    Ok(k) if k > ks.min() && k < ks.max() && i > 0 && i + 1 < kn.len() => {
+                        assert!(!on_column.is_empty(), "{d} deg: no contour at k_n {k_n}");
+                        for k_c in on_column {
+                            // Linear interpolation of s in ln k_s over a step of ln(1e6)/160.
+                            assert!((k_c.ln() - k.ln()).abs() < 5e-3, "{d} deg, k_n {k_n}: {k_c} vs {k}");
+                        }
+                        checked += 1;
+                    }
+                    Err(_) => {
+                        assert!(on_column.is_empty(), "{d} deg: contour at k_n {k_n} where none exists")
+                    }
+                    _ => {}
+                }
+            }
+            assert!(checked > 50, "{d} deg: only {checked} columns checked");
+        }
+    }
+
+    #[test]
+    fn contour_of_a_known_field_is_a_circle() {
+        // f = x^2 + y^2 on a linear grid; the contour f = 1 is the unit circle.
+        let a = Axis::new("x", -2.0 + 2.0, 2.0 + 2.0, 81, AxisScale::Linear).unwrap();
+        let field: Vec<f64> = (0..81 * 81)
+            .map(|c| {
+                let (x, y) = (a.value(c % 81) - 2.0, a.value(c / 81) - 2.0);
+                x * x + y * y
+            })
+            .collect();
+        let seg = contour_segments(&a, &a, &field, 1.0);
+        assert!(seg.len() > 40);
+        for (p, q) in seg {
+            for (x, y) in [p, q] {
+                let r = ((x - 2.0).powi(2) + (y - 2.0).powi(2)).sqrt();
+                assert!((r - 1.0).abs() < 2e-3, "radius {r}");
+            }
+        }
+    }
+
+    #[test]
+    fn sinkage_column_boundary_is_the_threshold_and_moves_with_mass() {
+        // The sinkage threshold scales with m cos(theta): 1 kg sinks where 0.35 kg does not.
+        let light = paper_robot();
+        let heavy = light.with_mass(1.0).unwrap();
+        let k_star = sinkage_threshold_k_n(&light, Slope::LEVEL);
+        let kn = Axis::new("k_n", k_star * 1.5, k_star * 2.0, 2, AxisScale::Linear).unwrap();
+        let ks = log_axis(1e7, 1e8, 2);
+        assert_ne!(map(&light, Slope::LEVEL, &kn, &ks).regime(0, 1), Regime::Sinkage);
+        assert_eq!(map(&heavy, Slope::LEVEL, &kn, &ks).regime(0, 1), Regime::Sinkage);
+    }
+
+    #[test]
+    fn counts_add_up_and_progress_is_reported_per_row() {
+        let r = paper_robot();
+        let kn = log_axis(1e4, 1e7, 30);
+        let ks = log_axis(1e3, 1e8, 20);
+        let rows = std::sync::atomic::AtomicUsize::new(0);
+        let m = PhaseMap::compute(&r, deg(10.0), None, &kn, &ks, &|| {
+            rows.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        });
+        assert_eq!(rows.into_inner(), 20);
+        let c = m.counts();
+        assert_eq!(c.total(), 600);
+        assert!(Regime::ALL.iter().all(|&g| c.get(g) > 0), "{c:?}");
+        for g in Regime::ALL {
+            assert_eq!(c.get(g), m.regimes().filter(|&r| r == g).count(), "{g}");
+        }
+    }
+}

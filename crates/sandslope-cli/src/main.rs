@@ -34,16 +34,16 @@ enum Command {
     Calibrate(commands::calibrate::CalibrateArgs),
     /// Fit k_n and k_s per slope from load-cell recordings into a terrain file (MODEL.md section 10).
     Fit(commands::fit::FitArgs),
-    /// List built-in robots and terrains, or print one as TOML.
-    Presets(commands::presets::PresetsArgs),
     /// Speed, anchoring time t1 and slip per step from motion-capture recordings at one slope.
     Track(commands::track::TrackArgs),
-    /// Heading-aware routes (fastest, safest, shortest) and risk maps over an elevation model.
-    Plan(commands::plan::PlanArgs),
     /// Phase diagrams: the regime (sinkage, slippage, metastable, success) over a (k_n, k_s) grid.
     Phase(commands::phase::PhaseArgs),
     /// Failure probability on uncertain terrain, the safe-slope limit and the heaviest safe mass.
     Risk(commands::risk::RiskArgs),
+    /// Heading-aware routes (fastest, safest, shortest) and risk maps over an elevation model.
+    Plan(commands::plan::PlanArgs),
+    /// List built-in robots and terrains, or print one as TOML.
+    Presets(commands::presets::PresetsArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -51,12 +51,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Predict(a) => commands::predict::run(a),
         Command::Sweep(a) => commands::sweep::run(a),
         Command::Calibrate(a) => commands::calibrate::run(a),
-        Command::Presets(a) => commands::presets::run(a),
         Command::Fit(a) => commands::fit::run(a),
         Command::Track(a) => commands::track::run(a),
-        Command::Plan(a) => commands::plan::run(a),
         Command::Phase(a) => commands::phase::run(a),
         Command::Risk(a) => commands::risk::run(a),
+        Command::Plan(a) => commands::plan::run(a),
+        Command::Presets(a) => commands::presets::run(a),
     }
 }
 

@@ -103,13 +103,12 @@ pub fn default_axis(flag: &str, values: &[f64], down: f64, up: f64, n: usize) ->
 }
 
 /// The slopes (degrees, signed as given) strictly above the terrain's last measured point,
-/// where MODEL.md section 7 extrapolates. Compared in degrees as the user wrote them, so that
-/// a slope equal to the last point is not flagged by a degree-radian round trip.
+/// where MODEL.md section 7 extrapolates.
 pub fn beyond_last_point(terrain: &Terrain, slopes_deg: &[f64]) -> Vec<f64> {
-    match terrain.points() {
-        [_, .., last] => slopes_deg.iter().copied().filter(|d| d.abs() > last.slope_deg).collect(),
-        _ => Vec::new(),
-    }
+    // One rule for "extrapolated": the library's (MODEL.md section 7).
+    let extrapolated =
+        |d: f64| sandslope::Slope::from_signed_degrees(d).is_ok_and(|s| terrain.sample(s).extrapolated);
+    slopes_deg.iter().copied().filter(|&d| extrapolated(d)).collect()
 }
 
 /// A progress bar of `len` steps on stderr, shown only when stdout and stderr are terminals

@@ -18,6 +18,7 @@
 //! overestimates.
 
 mod grid;
+mod queue;
 mod search;
 mod table;
 

@@ -89,8 +89,19 @@ pub fn temp_path_for(path: &Path) -> PathBuf {
         .with_extension(path.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default())
 }
 
+/// Fails with a clear message when the folder `path` should be written into does not exist.
+pub fn check_parent_exists(path: &Path) -> Result<()> {
+    match path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(dir) if !dir.is_dir() => {
+            anyhow::bail!("cannot write {}: the folder {} does not exist", path.display(), dir.display())
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Writes `bytes` to `path` atomically (temporary file, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    check_parent_exists(path)?;
     let tmp = temp_path_for(path);
     let result = std::fs::write(&tmp, bytes).and_then(|_| std::fs::rename(&tmp, path));
     if result.is_err() {
@@ -102,6 +113,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 /// Runs `write` on a temporary path beside `path`, then renames it into place; on failure
 /// the temporary file is removed and `path` is untouched.
 pub fn write_via_temp(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    check_parent_exists(path)?;
     let tmp = temp_path_for(path);
     match write(&tmp)
         .and_then(|_| std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display())))

@@ -271,6 +271,8 @@ fn bad_inputs_get_clear_errors() {
     // 9. A plot with an unknown extension, and no partial output.
     fails_with(&["sweep", "--plot", "fig.jpg"], d, "must end in .png or .svg");
     assert!(!d.join("fig.jpg").exists());
+    // 9b. A plot into a folder that does not exist.
+    fails_with(&["sweep", "--plot", "no/such/dir/fig.png"], d, "the folder no/such/dir does not exist");
     // 10. A zero step.
     fails_with(&["sweep", "--step", "0"], d, "--step = 0");
     // 11. Zero overrides.

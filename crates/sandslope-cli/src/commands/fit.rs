@@ -320,6 +320,10 @@ pub fn fit_manifest(manifest: &Manifest, args: &FitArgs) -> Result<Vec<FittedTri
 
 /// Runs `sandslope fit`.
 pub fn run(args: FitArgs) -> Result<()> {
+    // --plot DIR is created when missing; the terrain file's folder must exist.
+    if let Some(out) = &args.out {
+        crate::output::check_parent_exists(out)?;
+    }
     let manifest = load_manifest(&args.manifest)?;
     let trials = fit_manifest(&manifest, &args)?;
     let values = |kind: Kind| -> Vec<(f64, f64)> {

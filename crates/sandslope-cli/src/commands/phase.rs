@@ -189,6 +189,9 @@ struct PanelRecord {
 
 /// Runs `sandslope phase`.
 pub fn run(args: PhaseArgs) -> Result<()> {
+    for p in [&args.csv, &args.plot].into_iter().flatten() {
+        crate::output::check_parent_exists(p)?;
+    }
     let base = load_robot(&args.robot)?;
     let terrain = args.terrain.load()?;
     let masses = if args.mass.is_empty() { vec![base.mass()] } else { args.mass.clone() };

@@ -319,6 +319,11 @@ pub fn run(args: PlanArgs) -> Result<()> {
     for p in [&args.out.plot].into_iter().flatten() {
         crate::plot::format_of(p)?;
     }
+    // Every output folder is checked before any work, so a bad path cannot leave some of
+    // the outputs written and others not.
+    for p in [&args.out.geojson, &args.out.csv, &args.out.plot, &args.out.risk_map].into_iter().flatten() {
+        crate::output::check_parent_exists(p)?;
+    }
 
     let dem = read_raster(&args.dem)?;
     let start = endpoint(&dem, "start", &args.start, &args.start_px)?;

@@ -288,6 +288,9 @@ fn append_speed(path: &Path, row: SpeedRow) -> Result<Vec<SpeedRow>> {
 
 /// Runs `sandslope track`.
 pub fn run(args: TrackArgs) -> Result<()> {
+    for p in [&args.speeds_out, &args.plot].into_iter().flatten() {
+        crate::output::check_parent_exists(p)?;
+    }
     let robot = args.robot.load()?;
     let period = match args.leg_speed {
         Some(w) => std::f64::consts::TAU / check_positive("--leg-speed", w)?,

@@ -271,3 +271,23 @@ fn malformed_files_are_named_with_their_line() {
     let f = write(dir.path(), "m2.csv", &good);
     fails(&[f.to_str().unwrap(), "--body", "robot", "--cutoff", "100"], "--cutoff = 100 must be");
 }
+
+#[test]
+fn vicon_subject_or_segment_selects_the_body() {
+    // Vicon names columns `subject:segment`: `robot`, `CoM` and `robot:CoM` all select it.
+    let dir = tempfile::tempdir().unwrap();
+    let two =
+        "Trajectories\n120\n,,robot:CoM,,,box:Top,,\nFrame,Sub Frame,X,Y,Z,X,Y,Z\n,,mm,mm,mm,mm,mm,mm\n";
+    let mut text = String::from(two);
+    for i in 0..600 {
+        // The robot moves upslope at 0.1 m/s; the box stays put.
+        text.push_str(&format!("{},0,{:.3},0,0,5,5,5\n", i + 1, 100.0 * f64::from(i) / 120.0));
+    }
+    let f = write(dir.path(), "two.csv", &text);
+    let f = f.to_str().unwrap();
+    for body in ["robot", "CoM", "robot:CoM"] {
+        let v = track(&[f, "--body", body, "--upslope", "+x"]);
+        assert!((v["speed_m_s"].as_f64().unwrap() - 0.1).abs() < 1e-3, "{body}: {v}");
+    }
+    fails(&[f, "--body", "wheel"], "no body named `wheel`");
+}

@@ -94,8 +94,9 @@ pub(crate) fn parse(rows: &Rows, body: Option<&str>) -> Result<super::motive::Pa
             rows.err(first_line, "no position columns: no name over an `X,Y,Z` triple with units mm or m")
         );
     }
+    // Vicon names columns `subject:segment`; either part alone selects it when unique.
     let (name, cand) = pick_body(rows, first_line, candidates, body, |n, w| {
-        n == w || n.rsplit_once(':').is_some_and(|(_, short)| short == w)
+        n == w || n.split_once(':').is_some_and(|(subject, segment)| subject == w || segment == w)
     })?;
     let rate = cand.rate;
     let mut positions = Vec::new();

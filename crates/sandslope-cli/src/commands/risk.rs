@@ -199,9 +199,14 @@ pub fn run(args: RiskArgs) -> Result<()> {
     }
     let terrain = UncertainTerrain::new(args.terrain.load()?, args.cv_n, args.cv_s).map_err(|e| {
         let hint = if e.key.starts_with("points") {
+            // e.key is e.g. `points[0].k_n_sd`: name what is missing, not its NaN placeholder.
+            let what = e.key.rsplit('.').next().unwrap_or("k_n_sd / k_s_sd").to_string();
+            let flag = if what.starts_with("k_n") { "--cv-n" } else { "--cv-s" };
             format!(
-                "terrain `{}`: {e}: the terrain file has no standard deviations; give --cv-n and --cv-s",
-                args.terrain.terrain
+                "terrain `{}` has no {what} (standard deviation across trials) at {}: give {flag} \
+                 (a coefficient of variation, sd / value, e.g. {flag} 0.2), or add {what} to every point",
+                args.terrain.terrain,
+                e.key.split('.').next().unwrap_or("a point"),
             )
         } else {
             let flag = format!("--{}", e.key.replace('_', "-"));

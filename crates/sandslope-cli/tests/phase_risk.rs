@@ -243,3 +243,26 @@ fn risk_plots_curve_and_map() {
         .success();
     assert!(std::fs::read_to_string(&map).unwrap().contains("<svg"));
 }
+
+#[test]
+fn oversized_grids_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("cells.csv");
+    // 100000 x 100000 = 1e10 cells: far beyond the 2^28 limit.
+    Command::cargo_bin("sandslope")
+        .unwrap()
+        .args(["phase", "--k-n", "1e3:1e7:100000", "--k-s", "1e3:1e7:100000", "--csv"])
+        .arg(&csv)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("10000000000 cells").and(predicate::str::contains("at most")));
+    assert!(!csv.exists());
+    // 8000 x 8000 = 6.4e7 cells is a valid map but too many CSV rows (limit 2^25).
+    Command::cargo_bin("sandslope")
+        .unwrap()
+        .args(["phase", "--k-n", "1e3:1e7:8000", "--k-s", "1e3:1e7:8000", "--csv"])
+        .arg(&csv)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--csv would write 64000000 rows"));
+}

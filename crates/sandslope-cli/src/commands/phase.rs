@@ -67,6 +67,11 @@ pub struct PhaseArgs {
     pub json: bool,
 }
 
+/// Most grid cells a `phase` run computes, over all panels (2^28: 64 MiB of regimes).
+const MAX_CELLS: u128 = 1 << 28;
+/// Most rows `--csv` writes (2^25: about 2 GB of text).
+const MAX_CSV_CELLS: u128 = 1 << 25;
+
 /// Parses a grid axis `MIN:MAX:N[:log|:lin]` given to `flag` (log spacing by default).
 pub fn parse_axis(flag: &str, text: &str) -> Result<Axis> {
     let parts: Vec<&str> = text.split(':').map(str::trim).collect();
@@ -231,6 +236,19 @@ pub fn run(args: PhaseArgs) -> Result<()> {
     };
     if let Some(p) = &args.plot {
         crate::plot::format_of(p)?;
+    }
+    // Guards against a typo such as 100000 points per axis: the maps are kept in memory at two
+    // bits per cell, and every cell is a CSV row of about 60 bytes.
+    let cells = (robots.len() * slopes.len()) as u128 * k_n_axis.len() as u128 * k_s_axis.len() as u128;
+    if cells > MAX_CELLS {
+        bail!(
+            "--k-n and --k-s give {cells} cells over {} panel(s); at most {MAX_CELLS} are allowed (e.g. 4096 x 4096 per panel is {})",
+            robots.len() * slopes.len(),
+            4096u128 * 4096
+        );
+    }
+    if args.csv.is_some() && cells > MAX_CSV_CELLS {
+        bail!("--csv would write {cells} rows; at most {MAX_CSV_CELLS} are allowed: use fewer --k-n/--k-s points");
     }
 
     let rows = (robots.len() * slopes.len() * k_s_axis.len()) as u64;

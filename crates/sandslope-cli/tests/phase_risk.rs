@@ -265,4 +265,13 @@ fn oversized_grids_are_refused_before_any_work() {
         .assert()
         .code(2)
         .stderr(predicate::str::contains("--csv would write 64000000 rows"));
+    // risk runs one quadrature per slope or map cell: 1e6 of them is refused up front.
+    Command::cargo_bin("sandslope")
+        .unwrap()
+        .args(["risk", "--cv-n", "0.1", "--cv-s", "0.1", "--slope", "20", "--map", "--plot"])
+        .arg(dir.path().join("m.png"))
+        .args(["--k-n", "1e4:1e7:1000", "--k-s", "1e4:1e7:1000"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("1000000 map cells"));
 }

@@ -77,6 +77,10 @@ pub struct RiskArgs {
     pub format: FormatArgs,
 }
 
+/// Most probability evaluations one run makes (slopes, or map cells): 2^16, about a minute or
+/// two on two cores at the ~3 ms a quadrature takes.
+const MAX_QUADRATURES: u64 = 1 << 16;
+
 /// Parses `--slope`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N` (N evenly spaced, ends included).
 pub fn parse_slopes(text: &str) -> Result<Vec<f64>> {
     let number = |s: &str| -> Result<f64> {
@@ -193,6 +197,12 @@ fn describe_slope_limit(limit: &SafeLimit, max_risk: f64) -> String {
 pub fn run(args: RiskArgs) -> Result<()> {
     let robot = args.robot.load()?;
     let slopes = parse_slopes(&args.slope)?;
+    if slopes.len() as u64 > MAX_QUADRATURES {
+        bail!(
+            "--slope gives {} slopes, each a quadrature of a few ms; at most {MAX_QUADRATURES} are allowed",
+            slopes.len()
+        );
+    }
     let max_risk = check_flag("--max-risk", args.max_risk, 0.0, 1.0)?;
     if max_risk <= 0.0 || max_risk >= 1.0 {
         bail!("--max-risk = {max_risk} must be strictly between 0 and 1");
@@ -569,6 +579,11 @@ fn draw_map(
         None => default_axis("--k-s", &[ground.k_s], 1000.0, 100.0, MAP_POINTS)?,
     };
     let cells = (k_n_axis.len() * k_s_axis.len()) as u64;
+    if cells > MAX_QUADRATURES {
+        bail!(
+            "--k-n and --k-s give {cells} map cells, each a full quadrature of a few ms; at most {MAX_QUADRATURES} are allowed"
+        );
+    }
     let bar = progress_bar(cells, quiet, "p_fail map");
     let probs = failure_risk_map(robot, slope, ground.repose, &k_n_axis, &k_s_axis, u, &|| bar.inc(1));
     bar.finish_and_clear();

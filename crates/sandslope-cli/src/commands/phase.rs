@@ -13,7 +13,9 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
+use plotters::element::{Drawable, PointCollection};
 use plotters::prelude::*;
+use plotters_backend::{BackendCoord, DrawingErrorKind};
 use serde::Serialize;
 
 use sandslope::model::{anchoring_threshold_k_s, sinkage_threshold_k_n};
@@ -390,6 +392,44 @@ pub fn star_points(r: f64) -> Vec<(i32, i32)> {
         .collect()
 }
 
+/// The terrain's measured (k_n, k_s) drawn as the paper's dark green star, outlined in
+/// `outline` (black on the regime map, white on the dark risk map).
+pub struct TerrainStar {
+    /// Data coordinates (k_n, k_s).
+    pub at: (f64, f64),
+    /// Outline colour.
+    pub outline: RGBColor,
+}
+
+impl<'a> PointCollection<'a, (f64, f64)> for &'a TerrainStar {
+    type Point = &'a (f64, f64);
+    type IntoIter = std::iter::Once<&'a (f64, f64)>;
+    fn point_iter(self) -> Self::IntoIter {
+        std::iter::once(&self.at)
+    }
+}
+
+impl<DB: DrawingBackend> Drawable<DB> for TerrainStar {
+    fn draw<I: Iterator<Item = BackendCoord>>(
+        &self,
+        mut points: I,
+        backend: &mut DB,
+        _: (u32, u32),
+    ) -> Result<(), DrawingErrorKind<DB::ErrorType>> {
+        let Some((x, y)) = points.next() else { return Ok(()) };
+        let star: Vec<BackendCoord> = star_points(13.0).iter().map(|&(dx, dy)| (x + dx, y + dy)).collect();
+        backend.fill_polygon(star.iter().copied(), &STAR_GREEN)?;
+        backend.draw_path(star.iter().copied().chain(std::iter::once(star[0])), &self.outline)
+    }
+}
+
+/// Whether `(k_n, k_s)` lies within the cell edges `xe`, `ye` of a map (else no star is drawn).
+pub fn within(xe: &[f64], ye: &[f64], (k_n, k_s): (f64, f64)) -> bool {
+    let inside =
+        |v: f64, e: &[f64]| e.first().is_some_and(|&lo| v >= lo) && e.last().is_some_and(|&hi| v <= hi);
+    inside(k_n, xe) && inside(k_s, ye)
+}
+
 /// Cell edges along an axis: midpoints between values in axis coordinates, the ends
 /// extended by half a step.
 pub fn cell_edges(axis: &Axis) -> Vec<f64> {
@@ -436,11 +476,22 @@ impl<'a> PhaseFigure<'a> {
     fn rows(&self) -> usize {
         self.panels.len().div_ceil(self.columns)
     }
+    /// A single column is too narrow for the one-line legend (about 1100 px): wrap it.
+    fn legend_wraps(&self) -> bool {
+        self.columns == 1
+    }
+    fn legend_height(&self) -> u32 {
+        if self.legend_wraps() {
+            LEGEND_H + 60
+        } else {
+            LEGEND_H
+        }
+    }
 }
 
 impl Figure for PhaseFigure<'_> {
     fn size(&self) -> (u32, u32) {
-        (PANEL_W * self.columns as u32, PANEL_H * self.rows() as u32 + LEGEND_H)
+        (PANEL_W * self.columns as u32, PANEL_H * self.rows() as u32 + self.legend_height())
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
@@ -448,7 +499,7 @@ impl Figure for PhaseFigure<'_> {
         DB::ErrorType: 'static,
     {
         let (_, h) = self.size();
-        let (grid, legend) = root.split_vertically(h - LEGEND_H);
+        let (grid, legend) = root.split_vertically(h - self.legend_height());
         let areas = grid.split_evenly((self.rows(), self.columns));
         for (k, (panel, area)) in self.panels.iter().zip(areas.iter()).enumerate() {
             let letter = (b'a' + (k % 26) as u8) as char;
@@ -475,7 +526,7 @@ impl Figure for PhaseFigure<'_> {
                 (AxisScale::Linear, AxisScale::Linear) => draw_panel(area, xr, yr, panel, &title, &xe, &ye)?,
             }
         }
-        draw_legend(&legend, &self.terrain)?;
+        draw_legend(&legend, &self.terrain, self.legend_wraps())?;
         Ok(())
     }
 }
@@ -537,21 +588,8 @@ where
         .draw_series(contour.iter().map(|&(a, b)| PathElement::new(vec![a, b], BLACK.stroke_width(2))))
         .map_err(e)?;
     let (k_n, k_s, _) = panel.terrain;
-    let inside = k_n >= xe[0] && k_n <= xe[xe.len() - 1] && k_s >= ye[0] && k_s <= ye[ye.len() - 1];
-    if inside {
-        chart
-            .draw_series(std::iter::once(
-                EmptyElement::at((k_n, k_s))
-                    + Polygon::new(star_points(13.0), STAR_GREEN.filled())
-                    + PathElement::new(
-                        star_points(13.0)
-                            .into_iter()
-                            .chain(std::iter::once(star_points(13.0)[0]))
-                            .collect::<Vec<_>>(),
-                        BLACK.stroke_width(1),
-                    ),
-            ))
-            .map_err(e)?;
+    if within(xe, ye, (k_n, k_s)) {
+        chart.draw_series(std::iter::once(TerrainStar { at: (k_n, k_s), outline: BLACK })).map_err(e)?;
     }
     // Frame on top of the cells.
     let (xs, ys) = (chart.x_range(), chart.y_range());
@@ -564,24 +602,31 @@ where
     Ok(())
 }
 
-/// The legend strip shared by all panels.
-fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, terrain: &str) -> Result<()>
+/// The legend strip shared by all panels; `wrap` puts the contour and the star on lines of
+/// their own.
+fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, terrain: &str, wrap: bool) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
     let e = crate::error::plot_err;
     let style = font(16.0);
     let mut x = 20;
-    let y = 25;
+    let mut y = 25;
     for r in Regime::ALL {
         area.draw(&Rectangle::new([(x, y - 10), (x + 24, y + 10)], regime_colour(r).filled())).map_err(e)?;
         area.draw(&Rectangle::new([(x, y - 10), (x + 24, y + 10)], BLACK.stroke_width(1))).map_err(e)?;
         area.draw(&Text::new(r.name(), (x + 32, y - 9), style.clone())).map_err(e)?;
         x += 40 + 9 * r.name().len() as i32 + 20;
     }
+    if wrap {
+        (x, y) = (20, y + 35);
+    }
     area.draw(&PathElement::new(vec![(x, y), (x + 30, y)], BLACK.stroke_width(3))).map_err(e)?;
     area.draw(&Text::new("s = s_min (success boundary)", (x + 38, y - 9), style.clone())).map_err(e)?;
     x += 38 + 235;
+    if wrap {
+        (x, y) = (20, y + 35);
+    }
     area.draw(&(EmptyElement::at((x + 12, y)) + Polygon::new(star_points(12.0), STAR_GREEN.filled())))
         .map_err(e)?;
     area.draw(&Text::new(format!("{terrain} (k_n, k_s) at that slope"), (x + 30, y - 9), style))

@@ -20,7 +20,10 @@ use sandslope::risk::{
 use sandslope::{Axis, RegimeProbabilities, Robot, Slope};
 
 use super::common::{warn_extrapolated, RobotArgs, TerrainArgs};
-use super::phase::{cell_edges, default_axis, parse_axis, progress_bar, sci_label, star_points, STAR_GREEN};
+use super::phase::{
+    cell_edges, default_axis, parse_axis, progress_bar, sci_label, star_points, within, TerrainStar,
+    STAR_GREEN,
+};
 use crate::inputs::check_flag;
 use crate::output::{csv_string, print_json, table, Format, FormatArgs};
 use crate::plot::{font, save, Figure};
@@ -673,19 +676,9 @@ impl Figure for MapFigure {
                     + PathElement::new(vec![(1, 0), (23, 0)], WHITE.stroke_width(3))
             });
         let (k_n, k_s) = self.star;
-        if k_n >= xe[0] && k_n <= xe[xe.len() - 1] && k_s >= ye[0] && k_s <= ye[ye.len() - 1] {
+        if within(&xe, &ye, (k_n, k_s)) {
             chart
-                .draw_series(std::iter::once(
-                    EmptyElement::at((k_n, k_s))
-                        + Polygon::new(star_points(13.0), STAR_GREEN.filled())
-                        + PathElement::new(
-                            star_points(13.0)
-                                .into_iter()
-                                .chain(std::iter::once(star_points(13.0)[0]))
-                                .collect::<Vec<_>>(),
-                            WHITE.stroke_width(1),
-                        ),
-                ))
+                .draw_series(std::iter::once(TerrainStar { at: (k_n, k_s), outline: WHITE }))
                 .map_err(e)?
                 .label("terrain medians")
                 .legend(|(x, y)| {

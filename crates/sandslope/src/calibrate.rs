@@ -18,6 +18,7 @@ use std::fmt;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DVector, Dyn, OMatrix, Vector2, U2};
 
+use crate::measure::line_fit;
 use crate::model::{
     anchoring_threshold_k_s, anchoring_time, level_step_length, net_step, normal_equilibrium_depth,
     shear_equilibrium_depth, step_speed,
@@ -310,8 +311,8 @@ pub fn calibrate(
     let theta_max = obs.last().map_or(1.0, |o| o.slope.degrees()).max(1.0);
     let start = match law {
         ShearLaw::Linear => {
-            let (k0, b) =
-                if inverted.len() >= 2 { least_squares_line(&inverted) } else { (level_guess, 0.0) };
+            let (x, y): (Vec<f64>, Vec<f64>) = inverted.iter().copied().unzip();
+            let (k0, b) = line_fit(&x, &y).map_or((level_guess, 0.0), |f| (f.intercept, f.slope));
             Vector2::new(k0 / scale, b * theta_max / scale)
         }
         _ => Vector2::new(level_guess / scale, (theta_max + 10.0).min(89.0) / 90.0),
@@ -335,16 +336,6 @@ fn residual(robot: &Robot, o: &SpeedObservation, k_n: f64, k_s: f64) -> SpeedRes
         observed_sd: o.speed_sd,
         model: continued_speed(robot, o.slope, s_star, k_s),
     }
-}
-
-/// Ordinary least-squares line `y = a + b x`.
-fn least_squares_line(points: &[(f64, f64)]) -> (f64, f64) {
-    let n = points.len() as f64;
-    let (mx, my) = points.iter().fold((0.0, 0.0), |(sx, sy), &(x, y)| (sx + x / n, sy + y / n));
-    let sxx: f64 = points.iter().map(|&(x, _)| (x - mx).powi(2)).sum();
-    let sxy: f64 = points.iter().map(|&(x, y)| (x - mx) * (y - my)).sum();
-    let b = if sxx > 0.0 { sxy / sxx } else { 0.0 };
-    (my - b * mx, b)
 }
 
 /// The weighted least-squares problem in scaled parameters:

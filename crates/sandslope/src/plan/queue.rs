@@ -54,6 +54,12 @@ impl BucketQueue {
         }
     }
 
+    /// The entry [`BucketQueue::pop`] would return next if nothing were pushed before it.
+    #[inline(always)]
+    pub(crate) fn peek(&self) -> Option<Entry> {
+        self.buckets[self.current].last().copied()
+    }
+
     /// Removes an entry of the current bucket, moving on to the next non-empty bucket when it
     /// is empty; `None` when the queue is empty.
     #[inline(always)]

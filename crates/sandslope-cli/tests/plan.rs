@@ -356,3 +356,43 @@ fn unreachable_goal_is_reported_as_not_found() {
     assert_eq!(j["routes"]["distance"]["found"], true);
     let _ = Regime::Success;
 }
+
+#[test]
+fn gdal_written_dem_in_utm_coordinates_plans_and_keeps_its_crs() {
+    // A float32 GeoTIFF written by GDAL (deflate, floating-point predictor, 16 x 16 tiles;
+    // tests/fixtures/gdal/make.py): z = 100 + 0.25 col - 0.5 row on 2 m cells in UTM 33N,
+    // north-west corner (500000, 4100000), nodata at (3, 4) and (30, 20).
+    let s = Setup::new();
+    let dem = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal/f32-deflate-pred3-tiled.tif");
+    let out = Command::cargo_bin("sandslope")
+        .unwrap()
+        .arg("plan")
+        .arg("--dem")
+        .arg(&dem)
+        .args(["--robot"])
+        .arg(s.path("robot.toml"))
+        .arg("--terrain")
+        .arg(s.path("terrain.toml"))
+        .args(["--start", "500011,4099951", "--goal", "500071,4099991", "--json", "--csv"])
+        .arg(s.path("r.csv"))
+        .arg("--risk-map")
+        .arg(s.path("risk.tif"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(json_of(&out.stdout)["routes"]["time"]["found"], true);
+    // Start and goal are the centres of cells (5, 24) and (35, 4), in map coordinates.
+    let v = read_csv(&s.path("r.csv"));
+    let time = route(&v, "time");
+    let (first, last) = (time[0], time[time.len() - 1]);
+    assert_eq!((first.x, first.y), (500011.0, 4099951.0));
+    assert_eq!((last.x, last.y), (500071.0, 4099991.0));
+    // The risk map carries the DEM's projected CRS (ProjectedCSTypeGeoKey 3072 = EPSG:32633).
+    let mut dec = tiff::decoder::Decoder::new(File::open(s.path("risk.tif")).unwrap()).unwrap();
+    let keys = dec.get_tag(Tag::GeoKeyDirectoryTag).unwrap().into_u16_vec().unwrap();
+    assert!(keys[4..].chunks_exact(4).any(|e| e[0] == 3072 && e[3] == 32633), "{keys:?}");
+    assert_eq!(
+        dec.get_tag(Tag::ModelTiepointTag).unwrap().into_f64_vec().unwrap()[3..5],
+        [500000.0, 4100000.0]
+    );
+}

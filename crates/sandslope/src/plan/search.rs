@@ -461,9 +461,9 @@ impl Planner {
                 let w = w as usize;
                 for d in [0, cols, 2 * cols] {
                     prefetch(&node, w.wrapping_add(d).wrapping_sub(2));
-                    prefetch(&node, w.wrapping_add(d) + 2);
+                    prefetch(&node, w.wrapping_add(d).wrapping_add(2));
                     prefetch(&node, w.wrapping_sub(d).wrapping_sub(2));
-                    prefetch(&node, w.wrapping_sub(d) + 2);
+                    prefetch(&node, w.wrapping_sub(d).wrapping_add(2));
                 }
             }
             settled += 1;

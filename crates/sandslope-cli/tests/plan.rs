@@ -364,15 +364,9 @@ fn gdal_written_dem_in_utm_coordinates_plans_and_keeps_its_crs() {
     // north-west corner (500000, 4100000), nodata at (3, 4) and (30, 20).
     let s = Setup::new();
     let dem = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal/f32-deflate-pred3-tiled.tif");
-    let out = Command::cargo_bin("sandslope")
-        .unwrap()
-        .arg("plan")
-        .arg("--dem")
-        .arg(&dem)
-        .args(["--robot"])
-        .arg(s.path("robot.toml"))
-        .arg("--terrain")
-        .arg(s.path("terrain.toml"))
+    // An absolute path: `Setup::cmd` joins it onto the temporary folder, which keeps it.
+    let out = s
+        .cmd(dem.to_str().unwrap())
         .args(["--start", "500011,4099951", "--goal", "500071,4099991", "--json", "--csv"])
         .arg(s.path("r.csv"))
         .arg("--risk-map")

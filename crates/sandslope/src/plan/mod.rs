@@ -68,6 +68,12 @@ pub enum Descent {
     Level,
 }
 
+/// With a time weight of zero, the risk objective breaks ties between equally safe routes by
+/// their 3-D length, at this cost per metre (in units of `-ln(survival)`): a kilometre adds
+/// 1e-6, a survival change of 0.0001 %. Without it, edges where `p_fail` is 0 would cost
+/// nothing and any zero-risk detour, however long, would be optimal.
+pub const RISK_TIE_BREAK_PER_M: f64 = 1e-9;
+
 /// Planner settings, validated by [`PlanSettings::new`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanSettings {

@@ -19,17 +19,29 @@ pub(crate) type Entry = (u32, f32);
 /// Unordered min-bucket queue of cells keyed by non-negative `f64` keys.
 #[derive(Debug)]
 pub(crate) struct BucketQueue {
+    /// Bucket width; only ever grows (see [`BucketQueue::advance`]).
     width: f64,
     origin: f64,
     current: usize,
     buckets: Vec<Vec<Entry>>,
     far: Vec<(f64, Entry)>,
+    /// Times the buckets were restarted from the overflow list.
+    #[cfg(test)]
+    restarts: usize,
 }
 
 impl BucketQueue {
     /// An empty queue whose keys start at `origin`, with buckets `width` wide (positive).
     pub(crate) fn new(origin: f64, width: f64) -> BucketQueue {
-        BucketQueue { width, origin, current: 0, buckets: vec![Vec::new()], far: Vec::new() }
+        BucketQueue {
+            width,
+            origin,
+            current: 0,
+            buckets: vec![Vec::new()],
+            far: Vec::new(),
+            #[cfg(test)]
+            restarts: 0,
+        }
     }
 
     /// A lower bound on the key of every entry not yet popped from the current bucket and of
@@ -86,8 +98,19 @@ impl BucketQueue {
         if self.far.is_empty() {
             return None;
         }
-        // Restart the buckets at the smallest far key.
+        // Restart the buckets at the smallest far key. If the buckets are too narrow for the
+        // keys (a heuristic near zero gives a width far below the edge costs, and then nearly
+        // every push would land here), widen them so that the lower half of the far keys
+        // spans about 1024 buckets: at least half of the list then moves into buckets, so an
+        // entry passes through here O(log n) times at most.
         self.origin = self.far.iter().map(|e| e.0).fold(f64::INFINITY, f64::min);
+        let mid = self.far.len() / 2;
+        let (_, median, _) = self.far.select_nth_unstable_by(mid, |a, b| a.0.total_cmp(&b.0));
+        self.width = self.width.max((median.0 - self.origin) / 1024.0);
+        #[cfg(test)]
+        {
+            self.restarts += 1;
+        }
         self.current = 0;
         self.buckets.clear();
         self.buckets.push(Vec::new());
@@ -135,10 +158,40 @@ mod tests {
             last_floor = q.floor();
         }
         while let Some((c, _)) = q.pop() {
-            assert!(keys[&c] < q.floor() + 0.5, "{} vs floor {}", keys[&c], q.floor());
+            assert!(keys[&c] < q.floor() + q.width, "{} vs floor {}", keys[&c], q.floor());
             popped.push(c);
         }
         popped.sort_unstable();
         assert_eq!(popped, pushed);
+    }
+
+    #[test]
+    fn buckets_far_too_narrow_for_the_keys_widen_after_the_first_restart() {
+        // A Dijkstra-like workload (keys grow by about 1 per step) in buckets 1e-300 wide:
+        // every push lands in the overflow list until the first restart widens the buckets
+        // to the keys' scale; then the overflow list is rarely used again.
+        let mut q = BucketQueue::new(0.0, 1e-300);
+        let mut state = 99u64;
+        let mut rand = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut n, mut last) = (0u32, 0.0);
+        q.push(0.0, (0, 0.0));
+        while let Some((c, g)) = q.pop() {
+            // Keys come out in bucket order: never below the previous bucket's floor.
+            assert!(f64::from(g) >= last - q.width - 1e-3, "{g} after {last}");
+            last = f64::from(g);
+            if n < 100_000 {
+                for _ in 0..2 {
+                    n += 1;
+                    let key = f64::from(g) + 0.5 + rand();
+                    q.push(key, (n, key as f32));
+                }
+            }
+            let _ = c;
+        }
+        assert!(q.width > 1e-4 && q.width < 1.0, "{}", q.width);
+        assert!(q.restarts < 20, "{} restarts", q.restarts);
     }
 }

@@ -662,7 +662,9 @@ fn cost_table(t: &PitchTable, objective: Objective, settings: &PlanSettings, cel
                     let w = settings.time_weight();
                     match (risk, w > 0.0) {
                         (Some(r), true) => per_m_time.map(|tm| r + w * tm),
-                        (r, false) => r,
+                        // Zero-risk edges would cost nothing, and any zero-risk detour would
+                        // do: break such ties by length.
+                        (r, false) => r.map(|r| r + super::RISK_TIE_BREAK_PER_M * sec),
                         (None, true) => None,
                     }
                 }
@@ -836,6 +838,28 @@ mod tests {
         assert_eq!(p.neighbour(u, k), Some(4 * n + 5));
         p.grad[4 * n + 4] = [f32::NAN; 2];
         assert_eq!(p.neighbour(u, k), None);
+    }
+
+    #[test]
+    fn pure_risk_breaks_ties_between_zero_risk_routes_by_length() {
+        // Level ground without uncertainty: every edge has p_fail exactly 0, so with no weight on
+        // time every route is equally safe; the tie-break must pick the straight one.
+        let n = 30;
+        let g = ElevationGrid::new(n, n, 0.5, 0.5, vec![3.0; n * n], None).unwrap();
+        let certain = ClassTerrain {
+            terrain: Terrain::constant(7e5, 2e6).unwrap(),
+            fallback: Uncertainty::new(0.0, 0.0).unwrap(),
+        };
+        let settings = PlanSettings::new(20.0, Descent::Symmetric, false, 0.0).unwrap();
+        let p = Planner::new(g, None, &[certain], &paper_robot(), settings).unwrap();
+        assert_eq!(p.tables()[0].p_fail(0), 0.0);
+        let r = p
+            .route(Objective::Risk, Cell { col: 3, row: 3 }, Cell { col: 25, row: 14 }, &|_| {})
+            .unwrap()
+            .unwrap();
+        assert_eq!(r.survival, 1.0);
+        let straight = 0.5 * (22.0_f64).hypot(11.0);
+        assert!((r.length_m - straight).abs() < 1e-9, "{} vs {straight}", r.length_m);
     }
 
     #[test]

@@ -7,20 +7,9 @@ use sandslope::{
     regime_probabilities, Axis, AxisScale, Ground, PhaseMap, Robot, RobotSpec, Slope, Uncertainty,
 };
 
+/// The paper's hexapod (the library's `RobotSpec::paper_hexapod`).
 fn paper_robot() -> Robot {
-    Robot::new(RobotSpec {
-        mass_kg: 0.35,
-        leg_radius_m: 0.04,
-        leg_width_m: 0.01,
-        hip_height_m: 0.03,
-        leg_speed_rad_s: std::f64::consts::TAU,
-        stance_legs: 3,
-        response_time_s: 0.2,
-        leg_contact_area_m2: None,
-        level_step_m: None,
-        min_step_m: None,
-    })
-    .expect("valid robot")
+    Robot::new(RobotSpec::paper_hexapod()).expect("valid robot")
 }
 
 fn bench(c: &mut Criterion) {

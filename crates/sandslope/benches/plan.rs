@@ -12,20 +12,9 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use sandslope::plan::{Cell, ClassTerrain, ElevationGrid, Objective, PitchTable, PlanSettings, Planner};
 use sandslope::{Robot, RobotSpec, Terrain, Uncertainty};
 
+/// The paper's hexapod (the library's `RobotSpec::paper_hexapod`).
 fn paper_robot() -> Robot {
-    Robot::new(RobotSpec {
-        mass_kg: 0.35,
-        leg_radius_m: 0.04,
-        leg_width_m: 0.01,
-        hip_height_m: 0.03,
-        leg_speed_rad_s: std::f64::consts::TAU,
-        stance_legs: 3,
-        response_time_s: 0.2,
-        leg_contact_area_m2: None,
-        level_step_m: None,
-        min_step_m: None,
-    })
-    .expect("valid robot")
+    Robot::new(RobotSpec::paper_hexapod()).expect("valid robot")
 }
 
 fn dunes(n: usize, cell: f64) -> ElevationGrid {

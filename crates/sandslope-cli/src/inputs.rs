@@ -133,10 +133,13 @@ pub fn load_speeds(path: &Path) -> Result<Vec<SpeedObservation>> {
     Ok(out)
 }
 
-/// Checks a command-line number: finite and within `range` (inclusive), naming the flag.
+/// Checks a command-line number: finite and within `lo..=hi`, naming the flag (`hi` infinite:
+/// no upper bound).
 pub fn check_flag(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
     if value.is_finite() && value >= lo && value <= hi {
         Ok(value)
+    } else if hi == f64::INFINITY {
+        bail!("{flag} = {value} must be a finite number of at least {lo}")
     } else {
         bail!("{flag} = {value} must be between {lo} and {hi}")
     }

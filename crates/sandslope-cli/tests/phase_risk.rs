@@ -275,3 +275,12 @@ fn oversized_grids_are_refused_before_any_work() {
         .code(2)
         .stderr(predicate::str::contains("1000000 map cells"));
 }
+
+#[test]
+fn risk_negative_cv_gets_the_valid_range_not_a_parse_error() {
+    let out = sandslope().args(["risk", "--slope", "20", "--cv-n", "-1"]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("cv_n") || err.contains("--cv-n"), "{err}");
+    assert!(err.contains("at least 0"), "{err}");
+}

@@ -390,3 +390,23 @@ fn gdal_written_dem_in_utm_coordinates_plans_and_keeps_its_crs() {
         [500000.0, 4100000.0]
     );
 }
+
+#[test]
+fn negative_numbers_get_the_valid_range_not_a_parse_error() {
+    // A negative value used to be taken for an unknown flag ("unexpected argument '-1'").
+    let s = Setup::new();
+    write_asc(&s.path("flat.asc"), 10, 10, |_, _| 0.0);
+    let cases: [(&str, &str, &str); 4] = [
+        ("--time-weight", "-1", "--time-weight = -1 must be a finite number of at least 0"),
+        ("--max-roll", "-5", "--max-roll = -5 must be between 0 and 90"),
+        ("--cv-n", "-0.1", "--cv-n = -0.1 must be between 0 and 10"),
+        ("--cv-s", "-2", "--cv-s = -2 must be between 0 and 10"),
+    ];
+    for (flag, value, want) in cases {
+        let out =
+            s.cmd("flat.asc").args(["--start-px", "2,2", "--goal-px", "7,7", flag, value]).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag}: {err}");
+        assert!(err.contains(want), "{flag}: {err}");
+    }
+}

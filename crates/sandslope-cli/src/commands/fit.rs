@@ -35,13 +35,13 @@ pub struct FitArgs {
     #[arg(long, value_name = "MIN:MAX")]
     pub depth_window: Option<String>,
     /// Shear plateau starts at this displacement, metres, instead of being found (e.g. 0.02).
-    #[arg(long, value_name = "M")]
+    #[arg(long, allow_negative_numbers = true, value_name = "M")]
     pub plateau_from: Option<f64>,
     /// Subtract the in-air run's force curve against position instead of its mean.
     #[arg(long)]
     pub air_curve: bool,
     /// Load-cell counts per newton, for recordings with a force_counts column.
-    #[arg(long, value_name = "COUNTS")]
+    #[arg(long, allow_negative_numbers = true, value_name = "COUNTS")]
     pub counts_per_newton: Option<f64>,
     #[command(flatten)]
     pub format: FormatArgs,

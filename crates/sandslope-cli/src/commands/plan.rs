@@ -87,20 +87,21 @@ pub struct PlanArgs {
     /// Let the time objective use metastable edges (0 < step < s_min).
     #[arg(long)]
     pub allow_metastable: bool,
-    /// Risk objective: weight of travel time, per second (1e-4: 100 s weigh like a 1 % risk).
-    #[arg(long, value_name = "PER_S", default_value_t = sandslope::plan::DEFAULT_TIME_WEIGHT)]
+    /// Risk objective: weight of travel time, per second (1e-4: 100 s weigh like a 1 % risk;
+    /// 0: survival only, ties broken by length).
+    #[arg(long, allow_negative_numbers = true, value_name = "PER_S", default_value_t = sandslope::plan::DEFAULT_TIME_WEIGHT)]
     pub time_weight: f64,
     /// Cross-slope (roll) limit, degrees: steeper cross slopes are impassable.
-    #[arg(long, value_name = "DEG", default_value_t = 20.0)]
+    #[arg(long, allow_negative_numbers = true, value_name = "DEG", default_value_t = 20.0)]
     pub max_roll: f64,
     /// How descending edges are evaluated.
     #[arg(long, value_enum, default_value = "symmetric")]
     pub descent: DescentArg,
     /// Coefficient of variation of k_n where the terrain gives no k_n_sd (risk, MODEL.md 9).
-    #[arg(long, value_name = "CV", default_value_t = 0.1)]
+    #[arg(long, allow_negative_numbers = true, value_name = "CV", default_value_t = 0.1)]
     pub cv_n: f64,
     /// Coefficient of variation of k_s where the terrain gives no k_s_sd (risk, MODEL.md 9).
-    #[arg(long, value_name = "CV", default_value_t = 0.2)]
+    #[arg(long, allow_negative_numbers = true, value_name = "CV", default_value_t = 0.2)]
     pub cv_s: f64,
     #[command(flatten)]
     pub out: Box<OutputArgs>,
@@ -304,7 +305,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
     if max_roll <= 0.0 || max_roll >= 90.0 {
         bail!("--max-roll = {max_roll} must be strictly between 0 and 90 degrees");
     }
-    let time_weight = check_flag("--time-weight", args.time_weight, 0.0, f64::MAX)?;
+    let time_weight = check_flag("--time-weight", args.time_weight, 0.0, f64::INFINITY)?;
     let fallback = Uncertainty::new(
         check_flag("--cv-n", args.cv_n, 0.0, 10.0)?,
         check_flag("--cv-s", args.cv_s, 0.0, 10.0)?,

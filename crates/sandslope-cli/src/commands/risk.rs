@@ -52,14 +52,14 @@ pub struct RiskArgs {
     pub terrain: TerrainArgs,
     /// Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's
     /// k_n_sd.
-    #[arg(long = "cv-n", value_name = "CV")]
+    #[arg(long = "cv-n", allow_negative_numbers = true, value_name = "CV")]
     pub cv_n: Option<f64>,
     /// Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's
     /// k_s_sd.
-    #[arg(long = "cv-s", value_name = "CV")]
+    #[arg(long = "cv-s", allow_negative_numbers = true, value_name = "CV")]
     pub cv_s: Option<f64>,
     /// Largest acceptable failure probability, for the safe-slope limit and --solve.
-    #[arg(long = "max-risk", value_name = "P", default_value_t = 0.05)]
+    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = 0.05)]
     pub max_risk: f64,
     /// Solve for the safe-slope limit (`slope`) or the heaviest safe mass at --slope (`mass`).
     #[arg(long, value_enum)]

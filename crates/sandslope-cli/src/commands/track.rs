@@ -42,14 +42,14 @@ pub struct TrackArgs {
     #[arg(long, value_name = "FRAMES", default_value_t = DEFAULT_MAX_GAP)]
     pub max_gap: usize,
     /// Low-pass cutoff for the zero-phase speed estimate, Hz (see docs/tracking.md).
-    #[arg(long, value_name = "HZ", default_value_t = DEFAULT_CUTOFF_HZ)]
+    #[arg(long, allow_negative_numbers = true, value_name = "HZ", default_value_t = DEFAULT_CUTOFF_HZ)]
     pub cutoff: f64,
     #[command(flatten)]
     pub robot: RobotArgs,
     #[command(flatten)]
     pub terrain: TerrainArgs,
     /// Leg angular speed omega, rad/s, instead of the robot's (stride period T = 2 pi / omega).
-    #[arg(long, value_name = "RAD/S")]
+    #[arg(long, allow_negative_numbers = true, value_name = "RAD/S")]
     pub leg_speed: Option<f64>,
     /// Touchdown times, s, one per line in the recording's clock (e.g. from the gait
     /// controller's log); give it once per recording, in the same order. Estimated from the
@@ -57,7 +57,7 @@ pub struct TrackArgs {
     #[arg(long, value_name = "FILE")]
     pub touchdowns: Vec<PathBuf>,
     /// Slope of these recordings, degrees (labels the output and the `--speeds-out` row).
-    #[arg(long, value_name = "DEG")]
+    #[arg(long, allow_negative_numbers = true, value_name = "DEG")]
     pub slope: Option<f64>,
     /// Append `slope_deg,speed_m_s,speed_sd_m_s` to this file (created with a header), the
     /// format `sandslope calibrate` reads; needs --slope.

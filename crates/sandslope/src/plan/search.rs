@@ -17,7 +17,7 @@
 //!
 //! On the 4096 x 4096 benchmark (`bench/plan/run.py`) the time search settles 12.6 M cells;
 //! with a binary heap per bucket it took 10.4-10.8 s, unordered buckets brought it to
-//! 6.6-6.9 s, the packed node to 5.8-6.4 s and the prefetch to 4.9-5.2 s (single runs on the
+//! 6.6-6.9 s, the packed node to 5.8-6.4 s and the prefetch to 4.9-5.6 s (single runs on the
 //! 2-core VM).
 
 use rayon::prelude::*;

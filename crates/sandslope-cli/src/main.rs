@@ -3,15 +3,12 @@
 //! A thin binary over the `sandslope` library: it parses files and flags into validated
 //! library types, runs the model, and writes tables, JSON, CSV and figures.
 
+mod args;
 mod commands;
 mod error;
-mod inputs;
-mod measurements;
-mod mocap;
+mod figures;
 mod output;
-mod plan;
-mod plot;
-mod presets;
+mod progress;
 
 use clap::{Parser, Subcommand};
 
@@ -61,12 +58,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
 }
 
 fn main() {
+    error::exit_quietly_on_broken_pipe();
     let cli = Cli::parse();
     if let Err(e) = run(cli) {
+        let code = error::exit_code(&e);
+        if code == error::EXIT_OK {
+            // Stdout was closed by the reader (`sandslope sweep --json | head`): nothing to say.
+            std::process::exit(code);
+        }
         eprintln!("error: {e}");
         for cause in e.chain().skip(1) {
             eprintln!("  caused by: {cause}");
         }
-        std::process::exit(error::EXIT_USAGE);
+        std::process::exit(code);
     }
 }

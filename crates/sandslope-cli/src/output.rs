@@ -1,12 +1,9 @@
-//! Writing results: tables for people, JSON and CSV for machines, files written atomically.
-//!
-//! A file is first written next to its destination under a temporary name and renamed into
-//! place only when complete, so a failed run never leaves partial output.
+//! Printing results: tables for people, JSON and CSV for machines. Files are written
+//! atomically by `sandslope_io::files` (re-exported here for the commands).
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use comfy_table::{presets::UTF8_BORDERS_ONLY, Table};
 
@@ -73,55 +70,4 @@ pub fn print_json<T: serde::Serialize>(value: &T) -> Result<()> {
     Ok(())
 }
 
-/// CSV text of `rows` (with a header from the field names).
-pub fn csv_string<T: serde::Serialize>(rows: &[T]) -> Result<String> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    for r in rows {
-        w.serialize(r)?;
-    }
-    Ok(String::from_utf8(w.into_inner().context("CSV output")?)?)
-}
-
-/// A temporary path beside `path` that keeps its extension (backends choose formats by it).
-pub fn temp_path_for(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
-    path.with_file_name(format!(".{name}.partial-{}", std::process::id()))
-        .with_extension(path.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default())
-}
-
-/// Fails with a clear message when the folder `path` should be written into does not exist.
-pub fn check_parent_exists(path: &Path) -> Result<()> {
-    match path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        Some(dir) if !dir.is_dir() => {
-            anyhow::bail!("cannot write {}: the folder {} does not exist", path.display(), dir.display())
-        }
-        _ => Ok(()),
-    }
-}
-
-/// Writes `bytes` to `path` atomically (temporary file, then rename).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    check_parent_exists(path)?;
-    let tmp = temp_path_for(path);
-    let result = std::fs::write(&tmp, bytes).and_then(|_| std::fs::rename(&tmp, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.with_context(|| format!("cannot write {}", path.display()))
-}
-
-/// Runs `write` on a temporary path beside `path`, then renames it into place; on failure
-/// the temporary file is removed and `path` is untouched.
-pub fn write_via_temp(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    check_parent_exists(path)?;
-    let tmp = temp_path_for(path);
-    match write(&tmp)
-        .and_then(|_| std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display())))
-    {
-        Ok(()) => Ok(()),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
-    }
-}
+pub use sandslope_io::files::{check_parent_exists, csv_string, write_atomic, write_via_temp};

@@ -158,7 +158,8 @@ fn calibrate_reproduces_the_builtin_terrain() {
         .success()
         .stdout(predicate::str::contains("RMSE"));
     let fresh: toml::Value = toml::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
-    let preset: toml::Value = toml::from_str(include_str!("../presets/glass-beads-300um.toml")).unwrap();
+    let preset: toml::Value =
+        toml::from_str(include_str!("../../sandslope-io/presets/glass-beads-300um.toml")).unwrap();
     assert_eq!(fresh["name"], preset["name"]);
     assert_eq!(fresh["repose_deg"], preset["repose_deg"]);
     let (a, b) = (fresh["points"].as_array().unwrap(), preset["points"].as_array().unwrap());
@@ -240,8 +241,7 @@ fn fails_with(args: &[&str], dir: &Path, message: &str) {
 fn bad_inputs_get_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let robot =
-        std::fs::read_to_string(repo_file("crates/sandslope-cli/presets/paper-hexapod.toml")).unwrap();
+    let robot = std::fs::read_to_string(repo_file("crates/sandslope-io/presets/paper-hexapod.toml")).unwrap();
     std::fs::write(d.join("tall.toml"), robot.replace("hip_height_m = 0.03", "hip_height_m = 0.09")).unwrap();
     std::fs::write(d.join("extra.toml"), format!("{robot}\nwheels = 4\n")).unwrap();
     std::fs::write(d.join("terrain.toml"), "[[points]]\nslope_deg = 0\nk_n = 7e5\nk_s = -1\n").unwrap();

@@ -360,10 +360,11 @@ fn unreachable_goal_is_reported_as_not_found() {
 #[test]
 fn gdal_written_dem_in_utm_coordinates_plans_and_keeps_its_crs() {
     // A float32 GeoTIFF written by GDAL (deflate, floating-point predictor, 16 x 16 tiles;
-    // tests/fixtures/gdal/make.py): z = 100 + 0.25 col - 0.5 row on 2 m cells in UTM 33N,
+    // crates/sandslope-io/tests/fixtures/gdal/make.py): z = 100 + 0.25 col - 0.5 row on 2 m cells in UTM 33N,
     // north-west corner (500000, 4100000), nodata at (3, 4) and (30, 20).
     let s = Setup::new();
-    let dem = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal/f32-deflate-pred3-tiled.tif");
+    let dem = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../sandslope-io/tests/fixtures/gdal/f32-deflate-pred3-tiled.tif");
     // An absolute path: `Setup::cmd` joins it onto the temporary folder, which keeps it.
     let out = s
         .cmd(dem.to_str().unwrap())

@@ -10,9 +10,9 @@ use serde::Serialize;
 
 use sandslope::{calibrate, Calibration, LawParams, ShearLaw, Slope, Terrain, TerrainPoint, TerrainSpec};
 
-use super::common::{RobotArgs, TerrainArgs};
-use crate::inputs::{check_flag, check_positive, load_speeds};
+use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
 use crate::output::{print_json, table, write_atomic};
+use sandslope_io::load_speeds;
 
 /// The law to fit, as named on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -14,10 +14,10 @@ use sandslope::measure::{
 };
 use sandslope::{Terrain, TerrainSpec};
 
-use crate::inputs::check_positive;
-use crate::measurements::figures;
-use crate::measurements::reader::{load_manifest, read_recording, Manifest, Trial};
+use crate::args::check_positive;
+use crate::figures::measurements as figures;
 use crate::output::{csv_string, num, print_json, sci, table, write_atomic, Format, FormatArgs};
+use sandslope_io::measurements::{load_manifest, read_recording, Manifest, Trial};
 
 /// Arguments of `sandslope fit`.
 #[derive(Debug, Args)]

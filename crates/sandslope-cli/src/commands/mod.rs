@@ -1,7 +1,6 @@
 //! One module per subcommand; each parses its arguments, calls the library and writes.
 
 pub mod calibrate;
-pub mod common;
 pub mod fit;
 pub mod phase;
 pub mod plan;

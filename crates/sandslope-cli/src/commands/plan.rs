@@ -14,11 +14,12 @@ use sandslope::plan::{
 };
 use sandslope::{Regime, Uncertainty};
 
-use super::common::{RobotArgs, TerrainArgs};
-use crate::inputs::{check_flag, load_terrain};
+use crate::args::{check_flag, RobotArgs, TerrainArgs};
+use crate::figures::plan::{PlanFigure, PlanResult};
 use crate::output::{num, print_json, table};
-use crate::plan::raster::{read_raster, write_two_band_geotiff, Raster};
-use crate::plan::{figure, writers};
+use sandslope_io::load_terrain;
+use sandslope_io::raster::{read_raster, write_two_band_geotiff, Raster};
+use sandslope_io::routes as writers;
 
 /// Maps at least this large get a progress bar (on a terminal).
 const PROGRESS_MIN_CELLS: usize = 1 << 20;
@@ -175,20 +176,6 @@ impl RouteRecord {
     }
 }
 
-/// Everything `plan` computed, for the writers.
-pub struct PlanResult<'a> {
-    /// DEM raster (georeferencing).
-    pub raster: &'a Raster,
-    /// The planner (grid, tables).
-    pub planner: &'a Planner,
-    /// Routes by objective.
-    pub routes: Vec<(Objective, Result<Route, NoRoute>)>,
-    /// Start and goal cells.
-    pub start: Cell,
-    /// Goal cell.
-    pub goal: Cell,
-}
-
 fn parse_pair(flag: &str, s: &str) -> Result<(f64, f64)> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     match parts.as_slice() {
@@ -318,7 +305,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
     let settings = PlanSettings::new(max_roll, descent, args.allow_metastable, time_weight)
         .map_err(|e| anyhow!("{e}"))?;
     for p in [&args.out.plot].into_iter().flatten() {
-        crate::plot::format_of(p)?;
+        crate::figures::format_of(p)?;
     }
     // Every output folder is checked before any work, so a bad path cannot leave some of
     // the outputs written and others not.
@@ -367,17 +354,17 @@ pub fn run(args: PlanArgs) -> Result<()> {
 
     let result = PlanResult { raster: &dem, planner: &planner, routes, start, goal };
     if let Some(p) = &args.out.geojson {
-        writers::write_geojson(p, &result)?;
+        writers::write_geojson(p, &dem.geo, &result.routes)?;
     }
     if let Some(p) = &args.out.csv {
-        writers::write_csv(p, &result)?;
+        writers::write_csv(p, &dem.geo, planner.grid(), &result.routes)?;
     }
     let risk = (args.out.risk_map.is_some() || args.out.plot.is_some()).then(|| planner.risk_map());
     if let (Some(p), Some((p_fail, climb))) = (&args.out.risk_map, &risk) {
         write_two_band_geotiff(p, dem.cols, dem.rows, &dem.geo, p_fail, climb)?;
     }
     if let (Some(p), Some((p_fail, _))) = (&args.out.plot, &risk) {
-        crate::plot::save(p, &figure::PlanFigure::new(&result, p_fail))?;
+        crate::figures::save(p, &PlanFigure::new(&result, p_fail))?;
     }
     for t in planner.tables() {
         if let (Some(last), Some(r)) =

@@ -3,7 +3,7 @@
 use anyhow::Result;
 use clap::Args;
 
-use super::common::{warn_extrapolated, OverrideArgs, PredictionRecord, RobotArgs, Scenario, TerrainArgs};
+use crate::args::{warn_extrapolated, OverrideArgs, PredictionRecord, RobotArgs, Scenario, TerrainArgs};
 use crate::output::{csv_string, num, print_json, sci, table, Format, FormatArgs};
 
 /// Arguments of `sandslope predict`.

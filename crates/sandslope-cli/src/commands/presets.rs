@@ -4,7 +4,7 @@ use anyhow::{bail, Result};
 use clap::{Args, Subcommand};
 
 use crate::output::table;
-use crate::presets::{PresetKind, PRESETS};
+use sandslope_io::presets::{PresetKind, PRESETS};
 
 /// Arguments of `sandslope presets`.
 #[derive(Debug, Args)]

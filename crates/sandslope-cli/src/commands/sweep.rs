@@ -4,17 +4,13 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::Args;
-use plotters::coord::Shift;
-use plotters::prelude::*;
 
-use super::common::{
-    warn_extrapolated, Evaluation, OverrideArgs, PredictionRecord, RobotArgs, Scenario, TerrainArgs,
-};
-use crate::error::plot_err;
-use crate::inputs::{check_positive, load_speeds};
+use crate::args::check_positive;
+use crate::args::{warn_extrapolated, OverrideArgs, PredictionRecord, RobotArgs, Scenario, TerrainArgs};
+use crate::figures;
+use crate::figures::sweep::SweepFigure;
 use crate::output::{csv_string, num, print_json, table, Format, FormatArgs};
-use crate::plot::{self, font, Figure};
-use sandslope::SpeedObservation;
+use sandslope_io::load_speeds;
 
 /// Most slopes a sweep evaluates (a guard against `--step 1e-9`).
 const MAX_SLOPES: usize = 100_000;
@@ -78,7 +74,7 @@ pub fn run(args: SweepArgs) -> Result<()> {
             min_step_m: scenario.robot.min_step(),
             repose_deg: scenario.terrain.repose().map(|r| r.degrees()),
         };
-        plot::save(path, &figure)?;
+        figures::save(path, &figure)?;
     }
     let records: Vec<PredictionRecord> = evals.iter().map(PredictionRecord::from).collect();
     match args.format.format() {
@@ -114,189 +110,6 @@ pub fn run(args: SweepArgs) -> Result<()> {
     if let Some(path) = &args.plot {
         eprintln!("wrote {}", path.display());
     }
-    Ok(())
-}
-
-/// Speed, anchoring time and step length against slope, stacked in three panels.
-struct SweepFigure<'a> {
-    evals: &'a [Evaluation],
-    observed: &'a [SpeedObservation],
-    min_step_m: f64,
-    repose_deg: Option<f64>,
-}
-
-impl Figure for SweepFigure<'_> {
-    fn size(&self) -> (u32, u32) {
-        (900, 1100)
-    }
-
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
-    where
-        DB::ErrorType: 'static,
-    {
-        let panels = root.split_evenly((3, 1));
-        let x: Vec<f64> = self.evals.iter().map(|e| e.slope_deg).collect();
-        let x_range = plot::range(
-            x.iter().copied().chain(self.observed.iter().map(|o| o.slope.degrees())),
-            (0.0, 30.0),
-        );
-        let speed: Vec<Option<f64>> =
-            self.evals.iter().map(|e| e.prediction.speed.map(|v| v * 100.0)).collect();
-        let obs: Vec<(f64, f64, f64)> =
-            self.observed.iter().map(|o| (o.slope.degrees(), o.speed * 100.0, o.speed_sd * 100.0)).collect();
-        let speed_range = plot::range(
-            speed
-                .iter()
-                .flatten()
-                .copied()
-                .chain(obs.iter().flat_map(|&(_, v, sd)| [v - sd, v + sd]))
-                .chain([0.0]),
-            (0.0, 16.0),
-        );
-        let upper = SeriesLabelPosition::UpperRight;
-        let panel =
-            Panel { x_range, x: &x, observed: &[], reference: None, legend: upper, repose: self.repose_deg };
-        let speed_panel = Panel { observed: &obs, ..panel.clone() };
-        draw_panel(&panels[0], "Step-averaged speed", "speed v (cm/s)", speed_range, &speed, &speed_panel)?;
-        let t1: Vec<Option<f64>> =
-            self.evals.iter().map(|e| e.prediction.anchoring_time.map(|t| t * 1e3)).collect();
-        let t1_range = plot::range(t1.iter().flatten().copied().chain([0.0]), (0.0, 500.0));
-        let lower = SeriesLabelPosition::LowerRight;
-        draw_panel(
-            &panels[1],
-            "Anchoring time",
-            "anchoring time t1 (ms)",
-            t1_range,
-            &t1,
-            &Panel { legend: lower, ..panel.clone() },
-        )?;
-        let step: Vec<Option<f64>> = self.evals.iter().map(|e| e.prediction.step.map(|s| s * 1e3)).collect();
-        let s_min = self.min_step_m * 1e3;
-        let step_range = plot::range(step.iter().flatten().copied().chain([0.0, s_min]), (0.0, 80.0));
-        let reference = Some((s_min, "s_min: success above, metastable below"));
-        draw_panel(
-            &panels[2],
-            "Net step length",
-            "net step s (mm)",
-            step_range,
-            &step,
-            &Panel { reference, ..panel },
-        )?;
-        Ok(())
-    }
-}
-
-/// What the three panels share, and what each may add.
-#[derive(Clone)]
-struct Panel<'a> {
-    x_range: (f64, f64),
-    x: &'a [f64],
-    /// Observations `(slope, value, sd)` drawn with error bars.
-    observed: &'a [(f64, f64, f64)],
-    /// A dashed horizontal reference line and its label.
-    reference: Option<(f64, &'a str)>,
-    legend: SeriesLabelPosition,
-    /// The terrain's angle of repose: slopes at or above it are shaded (regime slippage).
-    repose: Option<f64>,
-}
-
-/// One panel: the model curve (gaps where undefined), an optional reference line and optional
-/// observations with error bars.
-fn draw_panel<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    title: &str,
-    y_label: &str,
-    y_range: (f64, f64),
-    y: &[Option<f64>],
-    panel: &Panel<'_>,
-) -> Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    let (x_range, x, observed) = (panel.x_range, panel.x, panel.observed);
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, font(22.0))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
-        .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .x_desc("slope (deg)")
-        .y_desc(y_label)
-        .label_style(font(15.0))
-        .axis_desc_style(font(17.0))
-        .light_line_style(RGBColor(235, 235, 235))
-        .draw()
-        .map_err(plot_err)?;
-    // Split the curve where the model is undefined (no anchoring).
-    let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for (&xi, yi) in x.iter().zip(y) {
-        match yi {
-            Some(v) => segments.last_mut().expect("non-empty").push((xi, *v)),
-            None if !segments.last().expect("non-empty").is_empty() => segments.push(Vec::new()),
-            None => {}
-        }
-    }
-    if let Some(repose) = panel.repose.filter(|r| *r < x_range.1) {
-        let shade = RGBColor(200, 200, 200).mix(0.45);
-        chart
-            .draw_series([Rectangle::new(
-                [(repose.max(x_range.0), y_range.0), (x_range.1, y_range.1)],
-                shade.filled(),
-            )])
-            .map_err(plot_err)?
-            .label("at or above the angle of repose: slippage")
-            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
-    }
-    if let Some((level, label)) = panel.reference {
-        let grey = RGBColor(90, 90, 90);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(x_range.0, level), (x_range.1, level)],
-                8,
-                5,
-                grey.stroke_width(2),
-            ))
-            .map_err(plot_err)?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(2)));
-    }
-    let mut first = true;
-    for seg in segments.into_iter().filter(|s| !s.is_empty()) {
-        let series = chart
-            .draw_series(LineSeries::new(seg, ShapeStyle::from(&RED).stroke_width(2)))
-            .map_err(plot_err)?;
-        if first {
-            series
-                .label("model")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
-            first = false;
-        }
-    }
-    if !observed.is_empty() {
-        chart
-            .draw_series(
-                observed.iter().map(|&(x, v, sd)| {
-                    ErrorBar::new_vertical(x, v - sd, v, v + sd, BLACK.stroke_width(2), 10)
-                }),
-            )
-            .map_err(plot_err)?;
-        chart
-            .draw_series(observed.iter().map(|&(x, v, _)| Circle::new((x, v), 5, BLACK.filled())))
-            .map_err(plot_err)?
-            .label("observed (mean ± SD)")
-            .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.filled()));
-    }
-    chart
-        .configure_series_labels()
-        .label_font(font(15.0))
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.85))
-        .position(panel.legend.clone())
-        .draw()
-        .map_err(plot_err)?;
     Ok(())
 }
 

@@ -14,12 +14,10 @@ use sandslope::gait::{
 };
 use sandslope::Slope;
 
-use super::common::{RobotArgs, TerrainArgs};
-use crate::inputs::{check_flag, check_positive, load_speeds, read_text, SpeedRow};
-use crate::mocap::{self, Capture, MocapFormat};
+use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
-
-mod figure;
+use sandslope_io::mocap::{self, Capture, MocapFormat};
+use sandslope_io::{load_speeds, read_text, SpeedRow};
 
 /// Arguments of `sandslope track`.
 #[derive(Debug, Args)]
@@ -27,8 +25,8 @@ pub struct TrackArgs {
     /// Recordings at one slope (files or glob patterns such as `runs/10deg-*.csv`), pooled.
     #[arg(required = true, value_name = "FILE|GLOB")]
     pub files: Vec<String>,
-    /// File format; detected from the first line when omitted.
-    #[arg(long, value_enum)]
+    /// File format: motive, vicon or plain; detected from the first line when omitted.
+    #[arg(long, value_name = "motive|vicon|plain", value_parser = parse_mocap_format)]
     pub format: Option<MocapFormat>,
     /// Rigid body, marker or model output to track (required when a file has several).
     #[arg(long, value_name = "NAME")]
@@ -72,6 +70,10 @@ pub struct TrackArgs {
 }
 
 /// Parses `--upslope`.
+fn parse_mocap_format(s: &str) -> Result<MocapFormat, String> {
+    s.parse()
+}
+
 fn parse_upslope(s: &str) -> Result<Upslope, String> {
     let axis = |i: usize, sign: f64| {
         let mut v = [0.0; 3];
@@ -301,7 +303,7 @@ pub fn run(args: TrackArgs) -> Result<()> {
         bail!("--speeds-out needs --slope (the slope of these recordings, degrees)");
     }
     if let Some(p) = &args.plot {
-        crate::plot::format_of(p)?;
+        crate::figures::format_of(p)?;
     }
     let mut options = GaitOptions::new(period)
         .and_then(|o| o.with_cutoff(args.cutoff))
@@ -378,8 +380,9 @@ pub fn run(args: TrackArgs) -> Result<()> {
             s.dedup();
             s.len() >= 2
         });
-        let fig = figure::TrackFigure::new(&analysis, period, slope, overlay, &robot, &terrain);
-        crate::plot::save(path, &fig)?;
+        let fig =
+            crate::figures::track::TrackFigure::new(&analysis, period, slope, overlay, &robot, &terrain);
+        crate::figures::save(path, &fig)?;
     }
 
     match args.format_args.format() {

@@ -8,9 +8,9 @@ use plotters::prelude::*;
 use sandslope::gait::GaitAnalysis;
 use sandslope::{predict, Robot, Slope, Terrain};
 
+use super::{font, range, Figure};
 use crate::error::plot_err;
-use crate::inputs::SpeedRow;
-use crate::plot::{font, range, Figure};
+use sandslope_io::SpeedRow;
 
 /// What the stride panel draws, in plotting units (s, cm/s).
 pub struct TrackFigure {

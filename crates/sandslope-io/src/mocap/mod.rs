@@ -1,4 +1,4 @@
-//! Motion-capture file readers for `sandslope track`: OptiTrack Motive CSV (format 1.23 and
+//! Motion-capture file readers (as `sandslope track` uses them): OptiTrack Motive CSV (format 1.23 and
 //! 1.25), Vicon Nexus CSV and a plain CSV, detected from the first line or forced with
 //! `--format`. Each reader returns one body's positions in metres (NaN where occluded), the
 //! frame rate and the time of the first frame; every error names the file and the line.
@@ -10,11 +10,10 @@ mod vicon;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
-use clap::ValueEnum;
 use csv::StringRecord;
 
 /// A file format `sandslope track` reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MocapFormat {
     /// OptiTrack Motive CSV export (format version 1.23 or 1.25).
     Motive,
@@ -24,7 +23,20 @@ pub enum MocapFormat {
     Plain,
 }
 
+impl std::str::FromStr for MocapFormat {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        MocapFormat::ALL
+            .into_iter()
+            .find(|f| f.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| format!("`{s}` is not a motion-capture format (motive, vicon or plain)"))
+    }
+}
+
 impl MocapFormat {
+    /// Every format, in the order they are documented.
+    pub const ALL: [MocapFormat; 3] = [MocapFormat::Motive, MocapFormat::Vicon, MocapFormat::Plain];
+
     /// Display name.
     pub fn name(self) -> &'static str {
         match self {

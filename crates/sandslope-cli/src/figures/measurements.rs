@@ -10,9 +10,9 @@ use plotters::prelude::*;
 
 use sandslope::measure::{Origin, SlopeEstimate, SlopeStat};
 
+use super::{font, range, save, Figure};
 use crate::commands::fit::{FittedTrial, TrialFit};
 use crate::error::plot_err;
-use crate::plot::{font, range, save, Figure};
 
 /// Which panel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,7 +1,9 @@
-//! Options shared by the model commands (`--robot`, `--mass`, `--terrain`, `--k-n`, `--k-s`)
-//! and the prediction record they print.
+//! Command-line arguments shared by several commands (`--robot`, `--mass`, `--terrain`,
+//! `--k-n`, `--k-s`, grid axes), the checks of flag values, and the prediction record that
+//! `predict` and `sweep` print. Commands share code through this module, never through
+//! each other.
 
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use serde::Serialize;
 
@@ -9,8 +11,9 @@ use sandslope::{
     critical_shear_strength, predict, Ground, NoShearSuffices, Prediction, Robot, Slope, StepTarget, Terrain,
 };
 
-use crate::inputs::{check_positive, load_robot, load_terrain};
-use crate::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
+use sandslope::{Axis, AxisScale};
+use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
+use sandslope_io::{load_robot, load_terrain};
 
 /// `--robot` and `--mass`.
 #[derive(Debug, Clone, Args)]
@@ -174,5 +177,87 @@ pub fn warn_extrapolated(terrain: &Terrain, slopes: &[f64]) {
              extrapolated linearly and floored at zero",
             last.slope_deg
         );
+    }
+}
+
+/// The slopes (degrees, signed as given) strictly above the terrain's last measured point,
+/// where MODEL.md section 7 extrapolates.
+pub fn beyond_last_point(terrain: &Terrain, slopes_deg: &[f64]) -> Vec<f64> {
+    // One rule for "extrapolated": the library's (MODEL.md section 7).
+    let extrapolated =
+        |d: f64| sandslope::Slope::from_signed_degrees(d).is_ok_and(|s| terrain.sample(s).extrapolated);
+    slopes_deg.iter().copied().filter(|&d| extrapolated(d)).collect()
+}
+
+/// Checks a command-line number: finite and within `lo..=hi`, naming the flag (`hi` infinite:
+/// no upper bound).
+pub fn check_flag(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
+    if value.is_finite() && value >= lo && value <= hi {
+        Ok(value)
+    } else if hi == f64::INFINITY {
+        bail!("{flag} = {value} must be a finite number of at least {lo}")
+    } else {
+        bail!("{flag} = {value} must be between {lo} and {hi}")
+    }
+}
+
+/// Checks a command-line number is finite and strictly positive, naming the flag.
+pub fn check_positive(flag: &str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        bail!("{flag} = {value} must be a finite number greater than 0")
+    }
+}
+
+/// Parses a grid axis `MIN:MAX:N[:log|:lin]` given to `flag` (log spacing by default).
+pub fn parse_axis(flag: &str, text: &str) -> Result<Axis> {
+    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
+    if !(3..=4).contains(&parts.len()) {
+        bail!("{flag} = {text} must be MIN:MAX:N or MIN:MAX:N:log or MIN:MAX:N:lin (e.g. 1e4:1e7:400)");
+    }
+    let number = |what: &str, s: &str| -> Result<f64> {
+        s.parse::<f64>().map_err(|_| anyhow!("{flag}: {what} `{s}` is not a number (in {text})"))
+    };
+    let (min, max) = (number("MIN", parts[0])?, number("MAX", parts[1])?);
+    let n: usize = parts[2]
+        .parse()
+        .map_err(|_| anyhow!("{flag}: N `{}` must be a whole number of at least 2 (in {text})", parts[2]))?;
+    let scale = match parts.get(3).map(|s| s.to_ascii_lowercase()).as_deref() {
+        None | Some("log") => AxisScale::Log,
+        Some("lin") | Some("linear") => AxisScale::Linear,
+        Some(other) => bail!("{flag}: spacing `{other}` must be `log` or `lin` (in {text})"),
+    };
+    Axis::new(flag, min, max, n, scale).map_err(|e| anyhow!("{e}"))
+}
+
+/// A log axis from `lo / down` to `hi * up` around positive terrain values, with `n` points.
+pub fn default_axis(flag: &str, values: &[f64], down: f64, up: f64, n: usize) -> Result<Axis> {
+    let positive: Vec<f64> = values.iter().copied().filter(|v| *v > 0.0 && v.is_finite()).collect();
+    let (lo, hi) = if positive.is_empty() {
+        (1e3, 1e9)
+    } else {
+        (
+            positive.iter().copied().fold(f64::INFINITY, f64::min) / down,
+            positive.iter().copied().fold(0.0, f64::max) * up,
+        )
+    };
+    Axis::new(flag, lo, hi, n, AxisScale::Log).map_err(|e| anyhow!("{e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_flags_parse_and_reject_bad_input() {
+        let a = parse_axis("--k-n", "1e4:1e7:31").unwrap();
+        assert_eq!((a.min(), a.max(), a.len(), a.scale()), (1e4, 1e7, 31, AxisScale::Log));
+        assert_eq!(parse_axis("--k-n", "0:10:11:lin").unwrap().scale(), AxisScale::Linear);
+        for bad in ["1e4:1e7", "a:1e7:3", "1e4:1e7:x", "1e4:1e7:3:cubic", "0:1e7:3", "1e7:1e4:3", "1e4:1e7:1"]
+        {
+            let msg = parse_axis("--k-n", bad).unwrap_err().to_string();
+            assert!(msg.contains("--k-n"), "{bad}: {msg}");
+        }
     }
 }

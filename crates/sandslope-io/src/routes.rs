@@ -1,4 +1,5 @@
-//! Route writers for `sandslope plan`: GeoJSON LineStrings and a per-vertex CSV.
+//! Route writers for `sandslope plan`: GeoJSON LineStrings and a per-vertex CSV, in the map
+//! coordinates of the elevation raster the routes were planned on.
 
 use std::path::Path;
 
@@ -6,14 +7,18 @@ use anyhow::Result;
 use geojson::{Feature, FeatureCollection, Geometry, GeometryValue};
 use serde::Serialize;
 
-use crate::commands::plan::PlanResult;
-use crate::output::{csv_string, write_atomic};
+use sandslope::plan::{ElevationGrid, NoRoute, Objective, Route};
+
+use crate::files::{csv_string, write_atomic};
+use crate::raster::GeoRef;
+
+/// Routes by objective, as `plan` found them (or why none exists).
+pub type Routes = [(Objective, Result<Route, NoRoute>)];
 
 /// Writes every found route as a GeoJSON Feature (LineString of cell centres in map
 /// coordinates, with objective, length_m, time_s and survival properties).
-pub fn write_geojson(path: &Path, result: &PlanResult) -> Result<()> {
-    let geo = &result.raster.geo;
-    let features = result.routes.iter().filter_map(|(obj, r)| {
+pub fn write_geojson(path: &Path, geo: &GeoRef, routes: &Routes) -> Result<()> {
+    let features = routes.iter().filter_map(|(obj, r)| {
         let r = r.as_ref().ok()?;
         let coords: Vec<[f64; 2]> = r
             .cells
@@ -54,11 +59,9 @@ struct VertexRow {
 }
 
 /// Writes one row per route vertex; the edge columns describe the edge leaving the vertex.
-pub fn write_csv(path: &Path, result: &PlanResult) -> Result<()> {
-    let geo = &result.raster.geo;
-    let grid = result.planner.grid();
+pub fn write_csv(path: &Path, geo: &GeoRef, grid: &ElevationGrid, routes: &Routes) -> Result<()> {
     let mut rows = Vec::new();
-    for (obj, r) in &result.routes {
+    for (obj, r) in routes {
         let Ok(r) = r else { continue };
         for (i, c) in r.cells.iter().enumerate() {
             let (x, y) = geo.centre(c.col, c.row);

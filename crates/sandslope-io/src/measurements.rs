@@ -15,7 +15,7 @@ use serde::Deserialize;
 use sandslope::measure::{disk_area, Kind, RawRecording, ShearPlate};
 use sandslope::Slope;
 
-use crate::inputs::{parse_toml, read_text, Source};
+use crate::files::{parse_toml, read_text, Source};
 
 /// `[penetration]`: the disk, by radius or area.
 #[derive(Debug, Clone, Deserialize)]

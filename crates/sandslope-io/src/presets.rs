@@ -1,6 +1,6 @@
 //! Built-in robots and terrains, embedded in the binary so they work from any directory.
 //!
-//! Each preset is a TOML file under `crates/sandslope-cli/presets/`, in exactly the format a
+//! Each preset is a TOML file under `crates/sandslope-io/presets/`, in exactly the format a
 //! user would write, and is parsed by the same code as a user's file.
 
 /// What a preset describes.
@@ -64,10 +64,10 @@ mod tests {
     #[test]
     fn every_preset_parses_and_validates() {
         for p in PRESETS {
-            let source = crate::inputs::Source::Preset(p.name);
+            let source = crate::files::Source::Preset(p.name);
             let ok = match p.kind {
-                PresetKind::Robot => crate::inputs::robot_from_toml(p.toml, &source).is_ok(),
-                PresetKind::Terrain => crate::inputs::terrain_from_toml(p.toml, &source).is_ok(),
+                PresetKind::Robot => crate::robot_terrain::robot_from_toml(p.toml, &source).is_ok(),
+                PresetKind::Terrain => crate::robot_terrain::terrain_from_toml(p.toml, &source).is_ok(),
             };
             assert!(ok, "preset {} does not load", p.name);
         }

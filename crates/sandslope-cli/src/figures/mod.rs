@@ -1,8 +1,18 @@
-//! Figures: PNG or SVG by file extension, with an embedded font so plots render on machines
-//! without system fonts.
+//! Every figure of the tool, in one place: PNG or SVG by file extension, with an embedded font
+//! so plots render on machines without system fonts, and one regime palette ([`palette`]).
 //!
-//! A figure implements [`Figure`] once, generically over the plotters backend; [`save`] picks
-//! the backend from the file name, draws into a temporary file and renames it into place.
+//! A figure implements [`Figure`] once, generically over the plotters backend, and draws from
+//! result values only (it computes nothing); [`save`] picks the backend from the file name,
+//! draws into a temporary file and renames it into place; [`to_svg`] renders it to a string
+//! (for pages that embed figures).
+
+pub mod measurements;
+pub mod palette;
+pub mod phase;
+pub mod plan;
+pub mod risk;
+pub mod sweep;
+pub mod track;
 
 use std::path::Path;
 use std::sync::Once;
@@ -11,7 +21,7 @@ use anyhow::{bail, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::output::write_via_temp;
+use sandslope_io::write_via_temp;
 
 /// Font family name under which the embedded DejaVu Sans is registered.
 pub const FONT: &str = "sans-serif";
@@ -79,6 +89,21 @@ pub fn save(path: &Path, figure: &impl Figure) -> Result<()> {
         }
         Ok(())
     })
+}
+
+/// Renders `figure` as an SVG document in memory (for pages that embed figures inline).
+#[allow(dead_code)] // used by the report (issue 12)
+pub fn to_svg(figure: &impl Figure) -> Result<String> {
+    register_fonts();
+    let size = figure.size();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE).map_err(crate::error::plot_err)?;
+        figure.draw(&root)?;
+        root.present().map_err(crate::error::plot_err)?;
+    }
+    Ok(svg)
 }
 
 /// A text style in the embedded font.

@@ -9,14 +9,31 @@ use plotters::prelude::*;
 use sandslope::plan::Objective;
 use sandslope::Regime;
 
-use crate::commands::plan::PlanResult;
+use sandslope::plan::{Cell, NoRoute, Planner, Route};
+use sandslope_io::raster::Raster;
+
+use super::palette;
+use super::{font, Figure};
 use crate::error::plot_err;
-use crate::plot::{font, Figure};
 
 /// Longest side of the map raster as drawn, in blocks (large DEMs are subsampled).
 const MAX_BLOCKS: usize = 600;
 
 /// Hillshade and risk, subsampled, with the routes.
+/// Everything `plan` computed that the route map draws (the plan command builds it).
+pub struct PlanResult<'a> {
+    /// DEM raster (georeferencing).
+    pub raster: &'a Raster,
+    /// The planner (grid, tables).
+    pub planner: &'a Planner,
+    /// Routes by objective.
+    pub routes: Vec<(Objective, Result<Route, NoRoute>)>,
+    /// Start and goal cells.
+    pub start: Cell,
+    /// Goal cell.
+    pub goal: Cell,
+}
+
 pub struct PlanFigure {
     /// Blocks across and down.
     nx: usize,
@@ -40,21 +57,21 @@ fn route_colour(o: Objective) -> RGBColor {
 }
 
 /// The colour keys of the layer: regimes of a head-on climb, then "no safe heading".
+/// The regime colours are the one palette of every figure ([`super::palette`]).
 const KEYS: [(&str, (f64, f64, f64)); 5] = [
-    ("head-on: success", (120.0, 200.0, 100.0)),
-    ("head-on: metastable", (245.0, 205.0, 70.0)),
-    ("head-on: slippage", (225.0, 80.0, 60.0)),
-    ("head-on: sinkage", (140.0, 70.0, 170.0)),
+    ("head-on: success", rgb(palette::SUCCESS)),
+    ("head-on: metastable", rgb(palette::METASTABLE)),
+    ("head-on: slippage", rgb(palette::SLIPPAGE)),
+    ("head-on: sinkage", rgb(palette::SINKAGE)),
     ("no heading with P(fail) < 0.5", (90.0, 20.0, 20.0)),
 ];
 
+const fn rgb(c: RGBColor) -> (f64, f64, f64) {
+    (c.0 as f64, c.1 as f64, c.2 as f64)
+}
+
 fn regime_colour(r: Regime) -> (f64, f64, f64) {
-    match r {
-        Regime::Success => KEYS[0].1,
-        Regime::Metastable => KEYS[1].1,
-        Regime::Slippage => KEYS[2].1,
-        Regime::Sinkage => KEYS[3].1,
-    }
+    rgb(palette::regime_colour(r))
 }
 
 impl PlanFigure {

@@ -1,0 +1,212 @@
+//! Risk figures: p_fail and p_not_success against slope with the safe-slope limit, and the
+//! p_fail heat map over median (k_n, k_s) with the max-risk contour and the terrain's star.
+
+use anyhow::{bail, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
+
+use sandslope::risk::SafeLimit;
+use sandslope::{Axis, RegimeProbabilities};
+
+use super::phase::{cell_edges, sci_label, star_points, within, TerrainStar, STAR_GREEN};
+use super::{font, Figure};
+
+/// p_fail and p_not_success against slope.
+pub struct CurveFigure {
+    pub curve: Vec<(f64, RegimeProbabilities)>,
+    pub points: Vec<(f64, f64)>,
+    pub hi: f64,
+    pub max_risk: f64,
+    pub limit: SafeLimit,
+    pub title: String,
+}
+
+impl Figure for CurveFigure {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = crate::error::plot_err;
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, font(24.0))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.0..self.hi, 0.0..1.02)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc("slope along the direction of travel (deg)")
+            .y_desc("probability")
+            .label_style(font(16.0))
+            .axis_desc_style(font(18.0))
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(e)?;
+        let red = RGBColor(214, 56, 48);
+        let orange = RGBColor(230, 150, 30);
+        chart
+            .draw_series(LineSeries::new(
+                self.curve.iter().map(|(d, p)| (*d, p.p_fail())),
+                red.stroke_width(3),
+            ))
+            .map_err(e)?
+            .label("p_fail = P(sinkage or slippage)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], red.stroke_width(3)));
+        chart
+            .draw_series(LineSeries::new(
+                self.curve.iter().map(|(d, p)| (*d, p.p_not_success())),
+                orange.stroke_width(2),
+            ))
+            .map_err(e)?
+            .label("p_not_success = P(regime != success)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], orange.stroke_width(2)));
+        let grey = RGBColor(90, 90, 90);
+        chart
+            .draw_series(DashedLineSeries::new(
+                vec![(0.0, self.max_risk), (self.hi, self.max_risk)],
+                8,
+                6,
+                grey.stroke_width(2),
+            ))
+            .map_err(e)?
+            .label(format!("threshold --max-risk = {}", self.max_risk))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], grey.stroke_width(2)));
+        chart
+            .draw_series(self.points.iter().map(|&(d, p)| Circle::new((d, p), 5, BLACK.filled())))
+            .map_err(e)?
+            .label("requested slopes")
+            .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
+        if let SafeLimit::Limit { value, .. } = self.limit {
+            let blue = RGBColor(40, 90, 200);
+            chart
+                .draw_series(LineSeries::new(vec![(value, 0.0), (value, 1.02)], blue.stroke_width(2)))
+                .map_err(e)?
+                .label(format!("safe-slope limit {value:.3} deg"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(2)));
+            chart
+                .draw_series(std::iter::once(Circle::new((value, self.max_risk), 7, blue.stroke_width(3))))
+                .map_err(e)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(font(16.0))
+            .draw()
+            .map_err(e)?;
+        Ok(())
+    }
+}
+
+/// The p_fail heat map over median (k_n, k_s) at one slope.
+pub struct MapFigure {
+    pub k_n_axis: Axis,
+    pub k_s_axis: Axis,
+    pub p_fail: Vec<f64>,
+    pub contour: Vec<sandslope::phase::Segment>,
+    pub star: (f64, f64),
+    pub max_risk: f64,
+    pub title: String,
+}
+
+impl Figure for MapFigure {
+    fn size(&self) -> (u32, u32) {
+        (900, 720)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = crate::error::plot_err;
+        let (main, bar_area) = root.split_horizontally(780);
+        let (xe, ye) = (cell_edges(&self.k_n_axis), cell_edges(&self.k_s_axis));
+        if self.k_n_axis.scale() != sandslope::AxisScale::Log
+            || self.k_s_axis.scale() != sandslope::AxisScale::Log
+        {
+            bail!("--map plots need log axes (:log)");
+        }
+        let mut chart = ChartBuilder::on(&main)
+            .caption(&self.title, font(20.0))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(75)
+            .build_cartesian_2d((xe[0]..xe[xe.len() - 1]).log_scale(), (ye[0]..ye[ye.len() - 1]).log_scale())
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("median normal resistance k_n (N/m\u{b3})")
+            .y_desc("median shear strength k_s (N/m\u{b3})")
+            .x_label_formatter(&sci_label)
+            .y_label_formatter(&sci_label)
+            .label_style(font(15.0))
+            .axis_desc_style(font(17.0))
+            .draw()
+            .map_err(e)?;
+        let nx = self.k_n_axis.len();
+        chart
+            .draw_series(self.p_fail.iter().enumerate().map(|(c, &p)| {
+                let (i, j) = (c % nx, c / nx);
+                Rectangle::new(
+                    [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])],
+                    ViridisRGB.get_color(p as f32).filled(),
+                )
+            }))
+            .map_err(e)?;
+        chart
+            .draw_series(
+                self.contour.iter().map(|&(a, b)| PathElement::new(vec![a, b], WHITE.stroke_width(3))),
+            )
+            .map_err(e)?
+            .label(format!("p_fail = {} (--max-risk)", self.max_risk))
+            .legend(|(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (24, 0)], BLACK.stroke_width(6))
+                    + PathElement::new(vec![(1, 0), (23, 0)], WHITE.stroke_width(3))
+            });
+        let (k_n, k_s) = self.star;
+        if within(&xe, &ye, (k_n, k_s)) {
+            chart
+                .draw_series(std::iter::once(TerrainStar { at: (k_n, k_s), outline: WHITE }))
+                .map_err(e)?
+                .label("terrain medians")
+                .legend(|(x, y)| {
+                    EmptyElement::at((x + 12, y)) + Polygon::new(star_points(9.0), STAR_GREEN.filled())
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(font(15.0))
+            .draw()
+            .map_err(e)?;
+        // Colour bar.
+        let mut cb = ChartBuilder::on(&bar_area)
+            .margin_top(45)
+            .margin_bottom(65)
+            .margin_right(10)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+            .map_err(e)?;
+        cb.configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc("p_fail")
+            .label_style(font(14.0))
+            .axis_desc_style(font(16.0))
+            .draw()
+            .map_err(e)?;
+        cb.draw_series((0..100).map(|k| {
+            let (a, b) = (k as f64 / 100.0, (k + 1) as f64 / 100.0);
+            Rectangle::new([(0.0, a), (1.0, b)], ViridisRGB.get_color((a + 0.005) as f32).filled())
+        }))
+        .map_err(e)?;
+        Ok(())
+    }
+}

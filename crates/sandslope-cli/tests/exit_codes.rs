@@ -1,0 +1,64 @@
+//! Exit codes (README, "Exit codes"): 2 for bad input, 3 when an output cannot be written, and
+//! a quiet 0 when the reader of stdout goes away.
+
+use std::io::Read;
+use std::process::{Command, Stdio};
+
+fn sandslope() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_sandslope"))
+}
+
+fn repo_file(rel: &str) -> String {
+    format!("{}/../../{rel}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn bad_input_exits_2() {
+    let out = sandslope().args(["predict", "--slope", "20", "--robot", "no-such-robot"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no-such-robot") && err.contains("paper-hexapod"), "{err}");
+}
+
+#[test]
+fn an_output_that_cannot_be_written_exits_3() {
+    // /proc exists but no regular file can be created in it, even by root.
+    let out = sandslope()
+        .args([
+            "calibrate",
+            "--observed",
+            &repo_file("data/paper-speeds.csv"),
+            "--out",
+            "/proc/sandslope-test.toml",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot write /proc/sandslope-test.toml"));
+}
+
+/// Runs `args` with stdout a pipe that the reader closes after the first bytes.
+fn run_with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
+    let mut child = sandslope().args(args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let mut first = [0u8; 16];
+    child.stdout.as_mut().unwrap().read_exact(&mut first).unwrap();
+    drop(child.stdout.take());
+    let status = child.wait().unwrap();
+    let mut err = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    (status.code(), err)
+}
+
+#[test]
+fn a_closed_stdout_ends_the_run_quietly() {
+    // Enough output that the pipe buffer (64 KiB) fills before the run ends.
+    for format in ["--json", "--csv", "--table"] {
+        let mut args = vec!["sweep", "--from", "0", "--to", "30", "--step", "0.01"];
+        if format != "--table" {
+            args.push(format);
+        }
+        let (code, err) = run_with_closed_stdout(&args);
+        assert_eq!(code, Some(0), "{format}: {err}");
+        assert!(!err.contains("error") && !err.contains("panicked"), "{format}: {err}");
+    }
+}

@@ -1,0 +1,27 @@
+//! # sandslope-io
+//!
+//! Readers and writers of every file format sandslope uses, shared by the `sandslope` binary,
+//! the Python package and the report: robot and terrain TOML files and the built-in presets
+//! ([`robot_terrain`], [`presets`]), speed tables ([`speeds`]), load-cell manifests and
+//! recordings ([`measurements`]), motion-capture exports ([`mocap`]), elevation rasters and the
+//! risk-map GeoTIFF ([`raster`]), route GeoJSON and CSV ([`routes`]), and atomic file writing
+//! ([`files`]).
+//!
+//! This is the edge where files become the library's validated types: every error names the
+//! file (or preset), the line, column or key, and the valid range. Nothing here computes
+//! physics; that is the `sandslope` library's job.
+
+#![warn(missing_docs)]
+
+pub mod files;
+pub mod measurements;
+pub mod mocap;
+pub mod presets;
+pub mod raster;
+pub mod robot_terrain;
+pub mod routes;
+pub mod speeds;
+
+pub use files::{csv_string, read_text, write_atomic, write_via_temp, Source, WriteError};
+pub use robot_terrain::{load_robot, load_terrain, robot_from_toml, terrain_from_toml};
+pub use speeds::{load_speeds, SpeedRow};

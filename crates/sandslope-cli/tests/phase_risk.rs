@@ -166,12 +166,29 @@ fn risk_uses_the_terrain_sds_interpolated_like_the_values() {
         // p_fail = slippage + sinkage; the four regimes sum to 1.
         assert!((p[0] - p[4] - p[5]).abs() < 1e-12 && (p[2] + p[3] + p[4] + p[5] - 1.0).abs() < 1e-9);
     }
-    // Without sds and without --cv-n/--cv-s: a clear error, exit 2.
+    // A given CV overrides the table's SD for its variable only (docs/model.md §9).
+    let out = sandslope()
+        .args(["risk", "--terrain", &t, "--slope", "10", "--cv-s", "0.05", "--csv"])
+        .output()
+        .unwrap();
+    let mut reader = csv::Reader::from_reader(&out.stdout[..]);
+    let row = reader.records().next().unwrap().unwrap();
+    assert_eq!((&row[1], &row[2]), ("0.2", "0.05"));
+    assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
+    // Without sds and without --cv-n/--cv-s (the built-in terrain): the defaults 0.1 and 0.2,
+    // and the output says so.
+    let out = sandslope().args(["risk", "--slope", "10", "--csv"]).output().unwrap();
+    assert!(out.status.success());
+    let mut reader = csv::Reader::from_reader(&out.stdout[..]);
+    let row = reader.records().next().unwrap().unwrap();
+    assert_eq!((&row[1], &row[2]), ("0.1", "0.2"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("default cv k_n = 0.1") && err.contains("default cv k_s = 0.2"), "{err}");
     sandslope()
         .args(["risk", "--slope", "10"])
         .assert()
-        .code(2)
-        .stderr(predicate::str::contains("k_n_sd").and(predicate::str::contains("--cv-n")));
+        .success()
+        .stdout(predicate::str::contains("default cv k_s = 0.2"));
     sandslope()
         .args(["risk", "--slope", "10", "--cv-n", "0.1", "--cv-s", "0.1", "--max-risk", "1.5"])
         .assert()
@@ -217,11 +234,34 @@ fn solve_mass_matches_predict_either_side() {
         |d: f64| json(&["predict", "--terrain", &t, "--slope", &format!("{d}"), "--json"])["regime"].clone();
     assert_ne!(at(s - 0.01), "slippage");
     assert_eq!(at(s + 0.01), "slippage");
-    sandslope()
-        .args(["risk", "--slope", "0,10", "--cv-n", "0.1", "--cv-s", "0.1", "--solve", "mass"])
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("exactly one --slope"));
+}
+
+/// `--solve mass` over several slopes is the payload envelope: each point is the one-slope
+/// answer, and the heaviest safe mass does not grow with slope on a terrain that weakens.
+#[test]
+fn payload_envelope_is_the_one_slope_answer_at_each_slope() {
+    let dir = tempfile::tempdir().unwrap();
+    let t = write(dir.path(), "sand.toml", UNCERTAIN);
+    let plot = dir.path().join("envelope.png");
+    let v = json(
+        &["risk", "--terrain", &t, "--slope", "0:20:3", "--solve", "mass", "--json", "--plot"]
+            .iter()
+            .copied()
+            .chain([plot.to_str().unwrap()])
+            .collect::<Vec<_>>(),
+    );
+    let points = v["points"].as_array().unwrap();
+    assert_eq!(points.len(), 3);
+    let mut last = f64::INFINITY;
+    for p in points {
+        let d = p["slope_deg"].as_f64().unwrap();
+        let one = json(&["risk", "--terrain", &t, "--slope", &format!("{d}"), "--solve", "mass", "--json"]);
+        assert_eq!(p["max_mass_kg"], one["max_mass_kg"], "{d}");
+        let m = p["max_mass_kg"].as_f64().unwrap();
+        assert!(m <= last, "{m} after {last}");
+        last = m;
+    }
+    assert!(std::fs::metadata(&plot).unwrap().len() > 10_000);
 }
 
 #[test]
@@ -236,12 +276,56 @@ fn risk_plots_curve_and_map() {
         .stdout(predicate::str::contains("safe-slope limit"));
     assert!(std::fs::metadata(&curve).unwrap().len() > 10_000);
     let map = dir.path().join("map.svg");
+    let v = json(&[
+        "risk",
+        "--terrain",
+        &t,
+        "--slope",
+        "20",
+        "--plot",
+        map.to_str().unwrap(),
+        "--map",
+        "--k-n",
+        "1e4:1e7:6",
+        "--k-s",
+        "1e4:1e8:6",
+        "--json",
+    ]);
+    assert_eq!(v["cells"], 36);
+    assert!(std::fs::read_to_string(&map).unwrap().contains("<svg"));
+}
+
+/// `risk --map` without --plot gives the numbers: one CSV row per cell, k_n-major, each
+/// p_fail the one-slope quadrature of `risk` at those medians.
+#[test]
+fn risk_map_csv_has_every_cell_k_n_major() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("map.csv");
     sandslope()
-        .args(["risk", "--terrain", &t, "--slope", "20", "--plot", map.to_str().unwrap(), "--map"])
-        .args(["--k-n", "1e4:1e7:6", "--k-s", "1e4:1e8:6", "--json"])
+        .args(["risk", "--slope", "20", "--map", "--k-n", "1e5:1e7:3", "--k-s", "1e5:1e7:4", "--csv"])
+        .arg(&csv)
         .assert()
         .success();
-    assert!(std::fs::read_to_string(&map).unwrap().contains("<svg"));
+    let mut reader = csv::Reader::from_path(&csv).unwrap();
+    assert_eq!(
+        reader.headers().unwrap().iter().collect::<Vec<_>>(),
+        ["k_n", "k_s", "p_fail", "p_not_success"]
+    );
+    let rows: Vec<Vec<f64>> =
+        reader.records().map(|r| r.unwrap().iter().map(|x| x.parse().unwrap()).collect()).collect();
+    assert_eq!(rows.len(), 12);
+    // k_n-major: the first four rows share k_n = 1e5, k_s ascending.
+    assert!(rows[..4].iter().all(|r| r[0] == 1e5) && (rows[4][0] / 1e6 - 1.0).abs() < 1e-12);
+    assert!(rows[..4].windows(2).all(|w| w[1][1] > w[0][1]));
+    // Row 5 is k_n = 1e6, k_s = 1e5 * 100^(1/3): check against a constant terrain there.
+    let t = write(
+        dir.path(),
+        "cell.toml",
+        &format!("[[points]]\nslope_deg = 0.0\nk_n = {}\nk_s = {}\n", rows[5][0], rows[5][1]),
+    );
+    let v = json(&["risk", "--terrain", &t, "--slope", "20", "--json"]);
+    assert!((v["p_fail"].as_f64().unwrap() - rows[5][2]).abs() < 1e-6, "{v} vs {:?}", rows[5]);
+    assert!(rows.iter().all(|r| r[2] <= r[3] + 1e-12 && (0.0..=1.0).contains(&r[2])));
 }
 
 #[test]

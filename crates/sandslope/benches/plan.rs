@@ -9,8 +9,8 @@
 //! two optima agree to that rounding (checked before timing).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use sandslope::plan::{Cell, ClassTerrain, ElevationGrid, Objective, PitchTable, PlanSettings, Planner};
-use sandslope::{Robot, RobotSpec, Terrain, Uncertainty};
+use sandslope::plan::{Cell, ElevationGrid, Objective, PitchTable, PlanSettings, Planner};
+use sandslope::{Robot, RobotSpec, Terrain, UncertainTerrain, Uncertainty};
 
 /// The paper's hexapod (the library's `RobotSpec::paper_hexapod`).
 fn paper_robot() -> Robot {
@@ -33,10 +33,10 @@ fn dunes(n: usize, cell: f64) -> ElevationGrid {
 
 fn bench(c: &mut Criterion) {
     let n = 1024;
-    let terrain = ClassTerrain {
-        terrain: Terrain::constant(7e5, 2e6).expect("terrain"),
-        fallback: Uncertainty::new(0.1, 0.2).expect("cv"),
-    };
+    let terrain = UncertainTerrain::with_uncertainty(
+        Terrain::constant(7e5, 2e6).expect("terrain"),
+        Uncertainty::new(0.1, 0.2).expect("cv"),
+    );
     let planner = Planner::new(dunes(n, 0.25), None, &[terrain], &paper_robot(), PlanSettings::default())
         .expect("planner");
     let (start, goal) = (Cell { col: 30, row: n - 31 }, Cell { col: n - 31, row: 30 });

@@ -49,10 +49,12 @@ pub use error::ParamError;
 pub use gait::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording, Upslope};
 pub use measure::{MeasureError, SlopeEstimate};
 pub use model::{predict, Prediction, G};
-pub use phase::{Axis, AxisScale, PhaseMap, RegimeCounts};
+pub use phase::{Axis, AxisScale, ContourSegment, PhaseMap, PhasePanel, RegimeCounts};
 pub use plan::{ElevationGrid, Objective, PlanSettings, Planner};
 pub use regime::{Cause, Regime};
-pub use risk::{regime_probabilities, RegimeProbabilities, Uncertainty};
+pub use risk::{
+    regime_probabilities, RegimeProbabilities, RiskCurve, RiskMap, SafeLimit, UncertainTerrain, Uncertainty,
+};
 pub use robot::{Robot, RobotSpec};
 pub use slope::Slope;
 pub use terrain::{Ground, Terrain, TerrainPoint, TerrainSample, TerrainSpec};

@@ -1,5 +1,5 @@
 //! Phase diagrams: the regime of every terrain `(k_n, k_s)` on a grid, at a fixed robot and
-//! slope (MODEL.md section 6; the paper's Section IV and its four-panel figure).
+//! slope (docs/model.md §6; the paper's Section IV and its four-panel figure).
 //!
 //! The model separates: the normal equilibrium depth `d_n`, the level step `s*` and sinkage
 //! depend on k_n only; the shear-equilibrium depth `d_s` and anchoring time `t1` depend on k_s
@@ -16,6 +16,8 @@
 //! extracted from the step field by marching squares in axis coordinates ([`contour_segments`]).
 
 use rayon::prelude::*;
+use serde::ser::{SerializeStruct, Serializer};
+use serde::Serialize;
 
 use crate::error::ParamError;
 use crate::model::{
@@ -24,9 +26,11 @@ use crate::model::{
 use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::slope::Slope;
+use crate::terrain::{Ground, Terrain};
 
 /// Spacing of grid values along an axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum AxisScale {
     /// Evenly spaced values.
     Linear,
@@ -35,10 +39,11 @@ pub enum AxisScale {
 }
 
 /// The values of one grid axis: `n >= 2` points from `min` to `max` (both included).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Axis {
     min: f64,
     max: f64,
+    #[serde(rename = "points")]
     n: usize,
     scale: AxisScale,
 }
@@ -163,7 +168,7 @@ impl StepTerms {
 }
 
 /// How many cells of a map fall in each regime.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 pub struct RegimeCounts {
     /// Cells in sinkage.
     pub sinkage: usize,
@@ -192,8 +197,9 @@ impl RegimeCounts {
     }
 }
 
-/// A straight piece of a contour line, from `.0` to `.1`, each point `(k_n, k_s)` in N/m^3.
-pub type Segment = ((f64, f64), (f64, f64));
+/// A straight piece of a contour line on a map, from `.0` to `.1`, each point `(k_n, k_s)` in
+/// N/m^3 (distinct from the planner's route segments).
+pub type ContourSegment = ((f64, f64), (f64, f64));
 
 /// The regime of every cell of a `(k_n, k_s)` grid for one robot at one slope.
 ///
@@ -388,13 +394,13 @@ impl PhaseMap {
     /// The contour `s = s_min` (the success boundary) as line segments, by marching squares
     /// over the net step of the cells where the legs neither sink nor fail to anchor.
     /// Empty at or beyond the angle of repose, where every cell slips.
-    pub fn robust_contour(&self) -> Vec<Segment> {
+    pub fn robust_contour(&self) -> Vec<ContourSegment> {
         self.step_contour(self.min_step)
     }
 
     /// The contour `s = level` (m) of the net step, by marching squares (see
     /// [`PhaseMap::robust_contour`]).
-    pub fn step_contour(&self, level: f64) -> Vec<Segment> {
+    pub fn step_contour(&self, level: f64) -> Vec<ContourSegment> {
         if self.beyond_repose {
             return Vec::new();
         }
@@ -413,6 +419,72 @@ impl PhaseMap {
     }
 }
 
+impl Serialize for PhaseMap {
+    /// The slope, axes, counts and every cell's regime code (0 sinkage, 1 slippage,
+    /// 2 metastable, 3 success; docs/model.md §6), row-major like [`PhaseMap::regimes`].
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let codes: Vec<u8> = self.regimes().map(|r| r as u8).collect();
+        let mut st = serializer.serialize_struct("PhaseMap", 6)?;
+        st.serialize_field("slope_deg", &self.slope.degrees())?;
+        st.serialize_field("k_n_axis", &self.k_n_axis)?;
+        st.serialize_field("k_s_axis", &self.k_s_axis)?;
+        st.serialize_field("beyond_repose", &self.beyond_repose)?;
+        st.serialize_field("counts", &self.counts)?;
+        st.serialize_field("regime_codes", &codes)?;
+        st.end()
+    }
+}
+
+/// One panel of a phase diagram: the map of one robot mass at one slope, with the terrain's
+/// own (k_n, k_s) at that slope and the thresholds drawn and reported with it.
+#[derive(Debug, Clone, Serialize)]
+pub struct PhasePanel {
+    /// Slope, degrees, as requested (a negative slope is evaluated as its magnitude).
+    pub slope_deg: f64,
+    /// Total robot mass, kg.
+    pub mass_kg: f64,
+    /// The regime of every grid cell.
+    pub map: PhaseMap,
+    /// The terrain's k_n at this slope, N/m^3.
+    pub terrain_k_n: f64,
+    /// The terrain's k_s at this slope, N/m^3.
+    pub terrain_k_s: f64,
+    /// The regime of the robot on the terrain's own (k_n, k_s).
+    pub terrain_regime: Regime,
+    /// Below this k_n the legs sink (docs/model.md §3), N/m^3.
+    pub sinkage_threshold_k_n: f64,
+    /// Below this k_s the legs never anchor (docs/model.md §4), N/m^3.
+    pub anchoring_threshold_k_s: f64,
+}
+
+impl PhasePanel {
+    /// The panel of `robot` at `slope_deg` (in (-90, 90); negative slopes are evaluated as
+    /// their magnitude) on `terrain`, over `k_n_axis x k_s_axis`. `row_done` as in
+    /// [`PhaseMap::compute`]. Errors name the key `slope_deg`.
+    pub fn compute(
+        robot: &Robot,
+        slope_deg: f64,
+        terrain: &Terrain,
+        k_n_axis: &Axis,
+        k_s_axis: &Axis,
+        row_done: &(dyn Fn() + Sync),
+    ) -> Result<PhasePanel, ParamError> {
+        let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+        let map = PhaseMap::compute(robot, slope, terrain.repose(), k_n_axis, k_s_axis, row_done);
+        let g: Ground = terrain.sample(slope).ground;
+        Ok(PhasePanel {
+            slope_deg,
+            mass_kg: robot.mass(),
+            map,
+            terrain_k_n: g.k_n,
+            terrain_k_s: g.k_s,
+            terrain_regime: crate::model::predict(robot, slope, &g).regime,
+            sinkage_threshold_k_n: crate::model::sinkage_threshold_k_n(robot, slope),
+            anchoring_threshold_k_s: crate::model::anchoring_threshold_k_s(robot, slope),
+        })
+    }
+}
+
 /// Packs 2-bit codes, one per byte in `codes` (length `4 * packed.len()`), four to a byte:
 /// code `4b + k` goes to bits `2k` of byte `b`.
 fn pack_codes(codes: &[u8], packed: &mut [u8]) {
@@ -426,7 +498,7 @@ fn pack_codes(codes: &[u8], packed: &mut [u8]) {
 /// one row per y value), by marching squares with linear interpolation in axis coordinates
 /// (logarithms on log axes). Squares with a NaN corner are skipped; saddles are resolved by
 /// the mean of the four corners. Points are returned in axis values, not coordinates.
-pub fn contour_segments(x_axis: &Axis, y_axis: &Axis, field: &[f64], level: f64) -> Vec<Segment> {
+pub fn contour_segments(x_axis: &Axis, y_axis: &Axis, field: &[f64], level: f64) -> Vec<ContourSegment> {
     let (nx, ny) = (x_axis.len(), y_axis.len());
     assert_eq!(field.len(), nx * ny, "field must have one value per grid cell");
     let xc: Vec<f64> = x_axis.values().iter().map(|&v| x_axis.coordinate(v)).collect();
@@ -533,7 +605,7 @@ mod tests {
     }
 
     /// Hand-worked cells on each side of each boundary, for the paper robot on level sand
-    /// (MODEL.md sections 3 to 6):
+    /// (docs/model.md §3 to §6):
     /// - sinkage: d_n = d_max = 0.05 m at k_n* = 0.35*9.81/3/(4e-4*0.05) = 57225 N/m^3;
     /// - anchoring: d_s = d_max at k_s = F_a/(W d_max^2) = 0.146608/(0.01*0.0025) = 5864.3;
     ///   on level sand there is no slip, so anchoring means s > 0 (slippage below, metastable

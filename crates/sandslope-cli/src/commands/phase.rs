@@ -11,11 +11,10 @@ use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
 
-use sandslope::model::{anchoring_threshold_k_s, sinkage_threshold_k_n};
-use sandslope::{predict, Axis, AxisScale, PhaseMap, Regime, RegimeCounts, Robot, Slope, Terrain};
+use sandslope::{Axis, AxisScale, PhasePanel, Regime, RegimeCounts, Robot, Slope, Terrain};
 
 use crate::args::{beyond_last_point, default_axis, parse_axis, warn_extrapolated, TerrainArgs};
-use crate::figures::phase::{PhaseFigure, PhasePanel};
+use crate::figures::phase::PhaseFigure;
 use crate::figures::save;
 use crate::output::{print_json, sci, table, write_via_temp};
 use crate::progress::progress_bar;
@@ -182,18 +181,11 @@ pub fn run(args: PhaseArgs) -> Result<()> {
     let rows = (robots.len() * slopes.len() * k_s_axis.len()) as u64;
     let bar = progress_bar(rows, args.json, "phase map");
     let mut panels = Vec::new();
-    for (robot, &mass_kg) in robots.iter().zip(&masses) {
-        for ((&slope, &slope_deg), sample) in slopes.iter().zip(&args.slope).zip(&samples) {
-            let map = PhaseMap::compute(robot, slope, terrain.repose(), &k_n_axis, &k_s_axis, &|| bar.inc(1));
-            let g = sample.ground;
-            panels.push(PhasePanel {
-                slope_deg,
-                mass_kg,
-                map,
-                terrain: (g.k_n, g.k_s, predict(robot, slope, &g).regime),
-                sinkage_k_n: sinkage_threshold_k_n(robot, slope),
-                anchoring_k_s: anchoring_threshold_k_s(robot, slope),
-            });
+    for robot in &robots {
+        for &slope_deg in &args.slope {
+            let panel = PhasePanel::compute(robot, slope_deg, &terrain, &k_n_axis, &k_s_axis, &|| bar.inc(1))
+                .map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+            panels.push(panel);
         }
     }
     bar.finish_and_clear();
@@ -227,10 +219,10 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         t.add_row([
             format!("{}", p.slope_deg),
             format!("{}", p.mass_kg),
-            sci(p.terrain.0),
-            sci(p.terrain.1),
-            p.terrain.2.name().to_string(),
-            sci(p.sinkage_k_n),
+            sci(p.terrain_k_n),
+            sci(p.terrain_k_s),
+            p.terrain_regime.name().to_string(),
+            sci(p.sinkage_threshold_k_n),
             pct(Regime::Sinkage),
             pct(Regime::Slippage),
             pct(Regime::Metastable),
@@ -261,9 +253,9 @@ fn record(p: &PhasePanel) -> PanelRecord {
         k_n_axis: p.map.k_n_axis().into(),
         k_s_axis: p.map.k_s_axis().into(),
         counts: p.map.counts(),
-        terrain: TerrainRecord { k_n: p.terrain.0, k_s: p.terrain.1, regime: p.terrain.2.name() },
-        sinkage_threshold_k_n: p.sinkage_k_n,
-        anchoring_threshold_k_s: p.anchoring_k_s,
+        terrain: TerrainRecord { k_n: p.terrain_k_n, k_s: p.terrain_k_s, regime: p.terrain_regime.name() },
+        sinkage_threshold_k_n: p.sinkage_threshold_k_n,
+        anchoring_threshold_k_s: p.anchoring_threshold_k_s,
         beyond_repose: p.map.beyond_repose(),
     }
 }

@@ -9,10 +9,9 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use sandslope::plan::{
-    Cell, ClassTerrain, Descent, ElevationGrid, NoRoute, Objective, PlanSettings, Planner, Route,
-};
-use sandslope::{Regime, Uncertainty};
+use sandslope::plan::{Cell, Descent, ElevationGrid, NoRoute, Objective, PlanSettings, Planner, Route};
+use sandslope::risk::{DefaultsUsed, UncertainTerrain};
+use sandslope::Regime;
 
 use crate::args::{check_flag, RobotArgs, TerrainArgs};
 use crate::figures::plan::{PlanFigure, PlanResult};
@@ -98,12 +97,14 @@ pub struct PlanArgs {
     /// How descending edges are evaluated.
     #[arg(long, value_enum, default_value = "symmetric")]
     pub descent: DescentArg,
-    /// Coefficient of variation of k_n where the terrain gives no k_n_sd (risk, MODEL.md 9).
-    #[arg(long, allow_negative_numbers = true, value_name = "CV", default_value_t = 0.1)]
-    pub cv_n: f64,
-    /// Coefficient of variation of k_s where the terrain gives no k_s_sd (risk, MODEL.md 9).
-    #[arg(long, allow_negative_numbers = true, value_name = "CV", default_value_t = 0.2)]
-    pub cv_s: f64,
+    /// Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's
+    /// k_n_sd; without either, 0.1 (docs/model.md §9).
+    #[arg(long, allow_negative_numbers = true, value_name = "CV")]
+    pub cv_n: Option<f64>,
+    /// Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's
+    /// k_s_sd; without either, 0.2 (docs/model.md §9).
+    #[arg(long, allow_negative_numbers = true, value_name = "CV")]
+    pub cv_s: Option<f64>,
     #[command(flatten)]
     pub out: Box<OutputArgs>,
 }
@@ -225,10 +226,16 @@ fn endpoint(raster: &Raster, which: &str, map: &Option<String>, px: &Option<Stri
 fn load_classes(
     args: &PlanArgs,
     dem: &Raster,
-    fallback: Uncertainty,
-) -> Result<(Option<Vec<u8>>, Vec<ClassTerrain>)> {
+    cv: (Option<f64>, Option<f64>),
+) -> Result<(Option<Vec<u8>>, Vec<UncertainTerrain>)> {
+    let uncertain = |t| {
+        UncertainTerrain::new(t, cv.0, cv.1).map_err(|e| {
+            let flag = format!("--{}", e.key.replace('_', "-"));
+            anyhow!("{}", e.renamed(flag))
+        })
+    };
     let (Some(path), Some(spec)) = (&args.classes, &args.class_terrain) else {
-        return Ok((None, vec![ClassTerrain { terrain: args.terrain.load()?, fallback }]));
+        return Ok((None, vec![uncertain(args.terrain.load()?)?]));
     };
     let mut values = Vec::new();
     let mut terrains = Vec::new();
@@ -243,7 +250,7 @@ fn load_classes(
         }
         let terrain = load_terrain(t.trim()).with_context(|| format!("--class-terrain: class {k}"))?;
         values.push(k);
-        terrains.push(ClassTerrain { terrain, fallback });
+        terrains.push(uncertain(terrain)?);
     }
     if terrains.is_empty() || terrains.len() > 254 {
         bail!("--class-terrain: give between 1 and 254 CLASS=TERRAIN pairs");
@@ -293,11 +300,10 @@ pub fn run(args: PlanArgs) -> Result<()> {
         bail!("--max-roll = {max_roll} must be strictly between 0 and 90 degrees");
     }
     let time_weight = check_flag("--time-weight", args.time_weight, 0.0, f64::INFINITY)?;
-    let fallback = Uncertainty::new(
-        check_flag("--cv-n", args.cv_n, 0.0, 10.0)?,
-        check_flag("--cv-s", args.cv_s, 0.0, 10.0)?,
-    )
-    .map_err(|e| anyhow!("{e}"))?;
+    let cv = (
+        args.cv_n.map(|v| check_flag("--cv-n", v, 0.0, 10.0)).transpose()?,
+        args.cv_s.map(|v| check_flag("--cv-s", v, 0.0, 10.0)).transpose()?,
+    );
     let descent = match args.descent {
         DescentArg::Symmetric => Descent::Symmetric,
         DescentArg::Level => Descent::Level,
@@ -316,7 +322,11 @@ pub fn run(args: PlanArgs) -> Result<()> {
     let dem = read_raster(&args.dem)?;
     let start = endpoint(&dem, "start", &args.start, &args.start_px)?;
     let goal = endpoint(&dem, "goal", &args.goal, &args.goal_px)?;
-    let (classes, terrains) = load_classes(&args, &dem, fallback)?;
+    let (classes, terrains) = load_classes(&args, &dem, cv)?;
+    let defaults = terrains.iter().fold(DefaultsUsed::default(), |a, t| a.or(t.defaults_used()));
+    if let Some(note) = defaults.note() {
+        eprintln!("note: {note}");
+    }
     let mask: Vec<bool> = (0..dem.values.len()).map(|i| dem.is_nodata(i)).collect();
     let z: Vec<f32> = dem.values.iter().map(|&v| v as f32).collect();
     let grid = ElevationGrid::new(dem.cols, dem.rows, dem.geo.cell_x, dem.geo.cell_y, z, Some(&mask))

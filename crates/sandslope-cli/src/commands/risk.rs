@@ -1,30 +1,32 @@
-//! `sandslope risk`: the probability of failure when the terrain is uncertain (MODEL.md
-//! section 9): per slope, p_fail = P(sinkage or slippage) and P(not success); the safe-slope
-//! limit (steepest slope below `--max-risk`); the heaviest safe mass at a slope
-//! (`--solve mass`); figures of p_fail against slope and, with `--map`, over (k_n, k_s).
+//! `sandslope risk`: the probability of failure when the terrain is uncertain (docs/model.md
+//! §9): per slope, p_fail = P(sinkage or slippage) and P(not success); the safe-slope limit
+//! (steepest slope below `--max-risk`); the heaviest safe mass at one slope, or at each slope
+//! (the payload envelope, `--solve mass`); with `--map`, p_fail over median (k_n, k_s).
+//! Parses, calls `sandslope::risk`, and hands the results to printers, writers and figures.
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Result};
+use std::io::Write;
+
+use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, ValueEnum};
-use rayon::prelude::*;
 use serde::Serialize;
 
-use sandslope::phase::contour_segments;
 use sandslope::risk::{
-    failure_risk, failure_risk_map, max_safe_mass, safe_slope_limit, SafeLimit, UncertainTerrain,
+    max_safe_mass, payload_envelope, risk_curve, safe_slope_limit, DefaultsUsed, PayloadEnvelope, RiskCurve,
+    RiskMap, SafeLimit, UncertainTerrain,
 };
 use sandslope::{RegimeProbabilities, Robot, Slope};
 
 use crate::args::{
     beyond_last_point, check_flag, default_axis, parse_axis, warn_extrapolated, RobotArgs, TerrainArgs,
 };
-use crate::figures::risk::{CurveFigure, MapFigure};
+use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
-use crate::output::{csv_string, print_json, table, Format, FormatArgs};
+use crate::output::{csv_string, num, print_json, sci, table, write_via_temp, Format};
 use crate::progress::progress_bar;
 
-/// Default points per axis of the `--map` grid (each cell is a full quadrature).
+/// Default points per axis of the `--map` grid.
 pub const MAP_POINTS: usize = 48;
 
 /// What `--solve` finds.
@@ -32,7 +34,8 @@ pub const MAP_POINTS: usize = 48;
 pub enum Solve {
     /// The safe-slope limit: the steepest slope with p_fail below --max-risk.
     Slope,
-    /// The heaviest total mass with p_fail below --max-risk at --slope (one slope).
+    /// The heaviest total mass with p_fail below --max-risk at each --slope (several slopes:
+    /// the payload envelope).
     Mass,
 }
 
@@ -47,24 +50,26 @@ pub struct RiskArgs {
     #[command(flatten)]
     pub terrain: TerrainArgs,
     /// Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's
-    /// k_n_sd.
+    /// k_n_sd; without either, 0.1 (docs/model.md §9).
     #[arg(long = "cv-n", allow_negative_numbers = true, value_name = "CV")]
     pub cv_n: Option<f64>,
     /// Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's
-    /// k_s_sd.
+    /// k_s_sd; without either, 0.2 (docs/model.md §9).
     #[arg(long = "cv-s", allow_negative_numbers = true, value_name = "CV")]
     pub cv_s: Option<f64>,
     /// Largest acceptable failure probability, for the safe-slope limit and --solve.
     #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = 0.05)]
     pub max_risk: f64,
-    /// Solve for the safe-slope limit (`slope`) or the heaviest safe mass at --slope (`mass`).
+    /// Solve for the safe-slope limit (`slope`) or the heaviest safe mass at each --slope
+    /// (`mass`; several slopes give the payload envelope).
     #[arg(long, value_enum)]
     pub solve: Option<Solve>,
-    /// Draw p_fail against slope (or, with --map, over (k_n, k_s)) to this .png or .svg file.
+    /// Draw p_fail against slope (with --map: over (k_n, k_s); with --solve mass over several
+    /// slopes: the payload envelope) to this .png or .svg file.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    /// With --plot: a p_fail heat map over (k_n, k_s) at the first --slope.
-    #[arg(long, requires = "plot")]
+    /// p_fail and p_not_success over a grid of median (k_n, k_s) at the first --slope.
+    #[arg(long, conflicts_with = "solve")]
     pub map: bool,
     /// --map grid of median k_n, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 100 to x 100, 48 points).
     #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]", requires = "map")]
@@ -72,12 +77,28 @@ pub struct RiskArgs {
     /// --map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 1000 to x 100, 48 points).
     #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", requires = "map")]
     pub k_s: Option<String>,
-    #[command(flatten)]
-    pub format: FormatArgs,
+    /// Print JSON instead of a table.
+    #[arg(long, conflicts_with = "csv")]
+    pub json: bool,
+    /// Print CSV instead of a table; with --map, write every cell to FILE
+    /// (k_n,k_s,p_fail,p_not_success, k_n-major) or, without FILE, to stdout.
+    #[arg(long, value_name = "FILE", num_args = 0..=1)]
+    pub csv: Option<Option<PathBuf>>,
 }
 
-/// Most probability evaluations one run makes (slopes, or map cells): 2^16, about a minute or
-/// two on two cores at the ~3 ms a quadrature takes.
+impl RiskArgs {
+    fn format(&self) -> Format {
+        if self.json {
+            Format::Json
+        } else if self.csv.is_some() {
+            Format::Csv
+        } else {
+            Format::Table
+        }
+    }
+}
+
+/// Most probability evaluations a one-slope-at-a-time run makes (slopes, or map cells).
 const MAX_QUADRATURES: u64 = 1 << 16;
 
 /// Parses `--slope`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N` (N evenly spaced, ends included).
@@ -192,6 +213,13 @@ fn describe_slope_limit(limit: &SafeLimit, max_risk: f64) -> String {
     }
 }
 
+fn uncertain_terrain(args: &RiskArgs) -> Result<UncertainTerrain> {
+    UncertainTerrain::new(args.terrain.load()?, args.cv_n, args.cv_s).map_err(|e| {
+        let flag = format!("--{}", e.key.replace('_', "-"));
+        anyhow!("{}", e.renamed(flag))
+    })
+}
+
 /// Runs `sandslope risk`.
 pub fn run(args: RiskArgs) -> Result<()> {
     let robot = args.robot.load()?;
@@ -206,44 +234,42 @@ pub fn run(args: RiskArgs) -> Result<()> {
     if max_risk <= 0.0 || max_risk >= 1.0 {
         bail!("--max-risk = {max_risk} must be strictly between 0 and 1");
     }
-    let terrain = UncertainTerrain::new(args.terrain.load()?, args.cv_n, args.cv_s).map_err(|e| {
-        let hint = if e.key.starts_with("points") {
-            // e.key is e.g. `points[0].k_n_sd`: name what is missing, not its NaN placeholder.
-            let what = e.key.rsplit('.').next().unwrap_or("k_n_sd / k_s_sd").to_string();
-            let flag = if what.starts_with("k_n") { "--cv-n" } else { "--cv-s" };
-            format!(
-                "terrain `{}` has no {what} (standard deviation across trials) at {}: give {flag} \
-                 (a coefficient of variation, sd / value, e.g. {flag} 0.2), or add {what} to every point",
-                args.terrain.terrain,
-                e.key.split('.').next().unwrap_or("a point"),
-            )
-        } else {
-            let flag = format!("--{}", e.key.replace('_', "-"));
-            format!("{}", e.renamed(flag))
-        };
-        anyhow!(hint)
-    })?;
+    let terrain = uncertain_terrain(&args)?;
     if let Some(p) = &args.plot {
         crate::figures::format_of(p)?;
+        crate::output::check_parent_exists(p)?;
+    }
+    if let Some(Some(p)) = &args.csv {
+        if !args.map {
+            bail!(
+                "--csv FILE writes the cells of --map; without --map, --csv prints to stdout (give no FILE)"
+            );
+        }
+        crate::output::check_parent_exists(p)?;
     }
     let extrapolated = beyond_last_point(terrain.terrain(), &slopes);
     if !extrapolated.is_empty() {
         warn_extrapolated(terrain.terrain(), &extrapolated);
     }
-    let json = args.format.format() == Format::Json;
+    let format = args.format();
+    let json = format == Format::Json;
 
     if args.map {
-        if let Some(path) = &args.plot {
-            draw_map(&args, &robot, &terrain, slopes[0], max_risk, path, json)?;
-        }
+        return run_map(&args, &robot, &terrain, slopes[0], max_risk, json);
     }
 
     match args.solve {
-        Some(Solve::Mass) => {
-            if slopes.len() != 1 {
-                bail!("--solve mass needs exactly one --slope (got {})", args.slope);
+        Some(Solve::Mass) if slopes.len() > 1 => {
+            let env = payload_envelope(&robot, &terrain, &slopes, max_risk).map_err(|e| anyhow!("{e}"))?;
+            note_defaults(env.defaults_used);
+            if let Some(path) = &args.plot {
+                save(path, &EnvelopeFigure::new(&env, &robot_title(&robot, &terrain)))?;
             }
+            return print_envelope(&env, format);
+        }
+        Some(Solve::Mass) => {
             let slope = slope_of(slopes[0])?;
+            note_defaults(terrain.defaults_used_at(slope));
             let limit = max_safe_mass(&robot, slope, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
             let own = robot.mass();
             let sol = MassSolution {
@@ -254,11 +280,11 @@ pub fn run(args: RiskArgs) -> Result<()> {
                 max_payload_kg: limit.value().map(|m| m - own),
                 limit,
             };
-            if args.plot.is_some() && !args.map {
+            if args.plot.is_some() {
                 let s_limit = safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
                 draw_curve(&args, &robot, &terrain, &slopes, max_risk, &s_limit, json)?;
             }
-            return match args.format.format() {
+            return match format {
                 Format::Json => print_json(&sol),
                 Format::Csv => {
                     print!("{}", csv_string(&[sol_row(&sol)])?);
@@ -271,12 +297,13 @@ pub fn run(args: RiskArgs) -> Result<()> {
             };
         }
         Some(Solve::Slope) => {
+            note_defaults(terrain.defaults_used());
             let limit = safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
-            if args.plot.is_some() && !args.map {
+            if args.plot.is_some() {
                 draw_curve(&args, &robot, &terrain, &slopes, max_risk, &limit, json)?;
             }
             let sol = SlopeSolution { max_risk, safe_slope_deg: limit.value(), limit };
-            return match args.format.format() {
+            return match format {
                 Format::Json => print_json(&sol),
                 Format::Csv => {
                     #[derive(Serialize)]
@@ -297,28 +324,36 @@ pub fn run(args: RiskArgs) -> Result<()> {
     }
 
     // Probabilities at each requested slope.
-    let results: Vec<(f64, RegimeProbabilities, (f64, f64))> = slopes
-        .par_iter()
-        .map(|&d| {
-            let s = slope_of(d)?;
-            let (_, u) = terrain.at(s);
-            Ok((d, failure_risk(&robot, s, &terrain), (u.cv_n(), u.cv_s())))
-        })
-        .collect::<Result<_>>()?;
-    let need_limit = args.format.format() == Format::Table || (args.plot.is_some() && !args.map);
+    let curve = risk_curve(&robot, &terrain, &slopes).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+    note_defaults(curve.defaults_used);
+    let need_limit = format == Format::Table || args.plot.is_some();
     let limit = if need_limit {
         Some(safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?)
     } else {
         None
     };
-    if let (Some(limit), false) = (&limit, args.map) {
-        if args.plot.is_some() {
-            draw_curve(&args, &robot, &terrain, &slopes, max_risk, limit, json)?;
-        }
+    if let (Some(limit), Some(_)) = (&limit, &args.plot) {
+        draw_curve(&args, &robot, &terrain, &slopes, max_risk, limit, json)?;
     }
-    match args.format.format() {
+    print_curve(&curve, limit.as_ref(), max_risk, format)
+}
+
+/// Tells the user on stderr when a default CV was used (docs/model.md §9).
+fn note_defaults(defaults: DefaultsUsed) {
+    if let Some(note) = defaults.note() {
+        eprintln!("note: {note}");
+    }
+}
+
+fn robot_title(robot: &Robot, terrain: &UncertainTerrain) -> String {
+    format!("m = {} kg on {}", robot.mass(), terrain.terrain().name().unwrap_or("terrain"))
+}
+
+fn print_curve(curve: &RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, format: Format) -> Result<()> {
+    match format {
         Format::Json => {
-            let records: Vec<RiskRecord> = results.iter().map(|(d, p, _)| record(*d, p)).collect();
+            let records: Vec<RiskRecord> =
+                curve.points.iter().map(|p| record(p.slope_deg, &p.probabilities)).collect();
             if records.len() == 1 {
                 print_json(&records[0])
             } else {
@@ -326,18 +361,19 @@ pub fn run(args: RiskArgs) -> Result<()> {
             }
         }
         Format::Csv => {
-            let rows: Vec<RiskRow> = results
+            let rows: Vec<RiskRow> = curve
+                .points
                 .iter()
-                .map(|(d, p, (cv_n, cv_s))| RiskRow {
-                    slope_deg: *d,
-                    cv_n: *cv_n,
-                    cv_s: *cv_s,
-                    p_fail: p.p_fail(),
-                    p_not_success: p.p_not_success(),
-                    p_success: p.success,
-                    p_metastable: p.metastable,
-                    p_slippage: p.slippage,
-                    p_sinkage: p.sinkage,
+                .map(|p| RiskRow {
+                    slope_deg: p.slope_deg,
+                    cv_n: p.cv_n,
+                    cv_s: p.cv_s,
+                    p_fail: p.p_fail,
+                    p_not_success: p.p_not_success,
+                    p_success: p.probabilities.success,
+                    p_metastable: p.probabilities.metastable,
+                    p_slippage: p.probabilities.slippage,
+                    p_sinkage: p.probabilities.sinkage,
                 })
                 .collect();
             print!("{}", csv_string(&rows)?);
@@ -356,24 +392,78 @@ pub fn run(args: RiskArgs) -> Result<()> {
                 "P(success)",
             ]);
             let f = |x: f64| format!("{x:.4}");
-            for (d, p, (cv_n, cv_s)) in &results {
+            for p in &curve.points {
+                let q = &p.probabilities;
                 t.add_row([
-                    format!("{d}"),
-                    format!("{cv_n:.3}"),
-                    format!("{cv_s:.3}"),
-                    f(p.p_fail()),
-                    f(p.p_not_success()),
-                    f(p.sinkage),
-                    f(p.slippage),
-                    f(p.metastable),
-                    f(p.success),
+                    format!("{}", p.slope_deg),
+                    format!("{:.3}", p.cv_n),
+                    format!("{:.3}", p.cv_s),
+                    f(p.p_fail),
+                    f(p.p_not_success),
+                    f(q.sinkage),
+                    f(q.slippage),
+                    f(q.metastable),
+                    f(q.success),
                 ]);
             }
             println!("{t}");
-            if let Some(limit) = &limit {
+            if let Some(limit) = limit {
                 println!("{}", describe_slope_limit(limit, max_risk));
             }
-            println!("p_fail = P(sinkage or slippage); log-normal k_n, k_s (MODEL.md section 9), deterministic quadrature");
+            if let Some(note) = curve.defaults_used.note() {
+                println!("note: {note}");
+            }
+            println!("p_fail = P(sinkage or slippage); log-normal k_n, k_s (docs/model.md §9), deterministic quadrature");
+            Ok(())
+        }
+    }
+}
+
+fn print_envelope(env: &PayloadEnvelope, format: Format) -> Result<()> {
+    match format {
+        Format::Json => print_json(env),
+        Format::Csv => {
+            let rows: Vec<MassRow> = env
+                .points
+                .iter()
+                .map(|p| MassRow {
+                    slope_deg: p.slope_deg,
+                    max_risk: env.max_risk,
+                    robot_mass_kg: env.robot_mass_kg,
+                    max_mass_kg: p.max_mass_kg,
+                    max_payload_kg: p.max_payload_kg,
+                })
+                .collect();
+            print!("{}", csv_string(&rows)?);
+            Ok(())
+        }
+        Format::Table => {
+            let mut t = table(&["slope (deg)", "heaviest safe mass (kg)", "payload (kg)", "note"]);
+            for p in &env.points {
+                let note = match p.limit {
+                    SafeLimit::NoneSafe { p_fail } => {
+                        format!("p_fail {p_fail:.4} already at the robot's own mass")
+                    }
+                    SafeLimit::Limit { p_fail, .. } => format!("p_fail {p_fail:.4} there"),
+                    SafeLimit::BeyondRange { up_to, .. } => {
+                        format!("safe up to {up_to:.3} kg, the end of the search")
+                    }
+                };
+                t.add_row([
+                    format!("{}", p.slope_deg),
+                    num(p.max_mass_kg, 4),
+                    num(p.max_payload_kg, 4),
+                    note,
+                ]);
+            }
+            println!("{t}");
+            println!(
+                "payload envelope: heaviest total mass with p_fail < {} (robot's own mass {} kg)",
+                env.max_risk, env.robot_mass_kg
+            );
+            if let Some(note) = env.defaults_used.note() {
+                println!("note: {note}");
+            }
             Ok(())
         }
     }
@@ -439,48 +529,52 @@ fn draw_curve(
     }
     let hi = hi.min(89.5);
     let n = (hi / 0.25).round() as usize;
-    let bar = progress_bar(n as u64 + 1, quiet, "p_fail curve");
-    let curve: Vec<(f64, RegimeProbabilities)> = (0..=n)
-        .into_par_iter()
-        .filter_map(|i| {
-            let d = hi * i as f64 / n as f64;
-            let p = Slope::from_degrees(d).ok().map(|s| (d, failure_risk(robot, s, terrain)));
-            bar.inc(1);
-            p
-        })
-        .collect();
+    let bar = progress_bar(1, quiet, "p_fail curve");
+    let fine: Vec<f64> = (0..=n).map(|i| hi * i as f64 / n as f64).collect();
+    let curve = risk_curve(robot, terrain, &fine).map_err(|e| anyhow!("{e}"))?;
+    let requested = risk_curve(robot, terrain, slopes).map_err(|e| anyhow!("{e}"))?;
     bar.finish_and_clear();
-    let points: Vec<(f64, f64)> = slopes
-        .iter()
-        .filter_map(|&d| slope_of(d).ok().map(|s| (d.abs(), failure_risk(robot, s, terrain).p_fail())))
-        .collect();
     let figure = CurveFigure {
-        curve,
-        points,
+        curve: curve.points.iter().map(|p| (p.slope_deg, p.probabilities)).collect(),
+        points: requested.points.iter().map(|p| (p.slope_deg.abs(), p.p_fail)).collect(),
         hi,
         max_risk,
         limit: *limit,
-        title: format!(
-            "Failure risk: m = {} kg on {}",
-            robot.mass(),
-            terrain.terrain().name().unwrap_or("terrain")
-        ),
+        title: format!("Failure risk: {}", robot_title(robot, terrain)),
     };
     save(path, &figure)
 }
 
-/// The p_fail heat map over median (k_n, k_s) at one slope.
-fn draw_map(
+/// One line of `risk --map --json`: the map's grid and a summary of its cells (the cells
+/// themselves go to --csv or --npy).
+#[derive(Serialize)]
+struct MapSummary {
+    slope_deg: f64,
+    cv_n: f64,
+    cv_s: f64,
+    max_risk: f64,
+    k_n_axis: sandslope::Axis,
+    k_s_axis: sandslope::Axis,
+    cells: usize,
+    cells_below_max_risk: usize,
+    terrain_k_n: f64,
+    terrain_k_s: f64,
+    terrain_p_fail: f64,
+    defaults_used: DefaultsUsed,
+}
+
+/// `--map`: p_fail and p_not_success over median (k_n, k_s) at one slope.
+fn run_map(
     args: &RiskArgs,
     robot: &Robot,
     terrain: &UncertainTerrain,
     slope_deg: f64,
     max_risk: f64,
-    path: &std::path::Path,
     quiet: bool,
 ) -> Result<()> {
     let slope = slope_of(slope_deg)?;
-    let (ground, u) = terrain.at(slope);
+    let sample = terrain.sample(slope);
+    let (ground, u) = (sample.ground, sample.uncertainty);
     let k_n_axis = match &args.k_n {
         Some(t) => parse_axis("--k-n", t)?,
         None => default_axis("--k-n", &[ground.k_n], 100.0, 100.0, MAP_POINTS)?,
@@ -495,26 +589,103 @@ fn draw_map(
             "--k-n and --k-s give {cells} map cells, each a full quadrature of a few ms; at most {MAX_QUADRATURES} are allowed"
         );
     }
-    let bar = progress_bar(cells, quiet, "p_fail map");
-    let probs = failure_risk_map(robot, slope, ground.repose, &k_n_axis, &k_s_axis, u, &|| bar.inc(1));
+    let defaults = terrain.defaults_used_at(slope);
+    note_defaults(defaults);
+    let bar = progress_bar(k_s_axis.len() as u64, quiet, "p_fail map");
+    let map = RiskMap::compute(robot, slope, ground.repose, &k_n_axis, &k_s_axis, u, &|| bar.inc(1));
     bar.finish_and_clear();
-    let p_fail: Vec<f64> = probs.iter().map(|p| p.p_fail()).collect();
-    let contour = contour_segments(&k_n_axis, &k_s_axis, &p_fail, max_risk);
-    let figure = MapFigure {
+    if let Some(Some(path)) = &args.csv {
+        write_map_csv(path, &map)?;
+    }
+    if let Some(path) = &args.plot {
+        let figure = MapFigure {
+            k_n_axis,
+            k_s_axis,
+            p_fail: map.p_fail.clone(),
+            contour: map.p_fail_contour(max_risk),
+            star: (ground.k_n, ground.k_s),
+            max_risk,
+            title: format!(
+                "p_fail at {slope_deg}\u{b0}, m = {} kg, cv k_n = {:.2}, cv k_s = {:.2}",
+                robot.mass(),
+                u.cv_n(),
+                u.cv_s()
+            ),
+        };
+        save(path, &figure)?;
+    }
+    let terrain_p_fail = sandslope::regime_probabilities(robot, slope, &ground, u).p_fail();
+    let summary = MapSummary {
+        slope_deg,
+        cv_n: u.cv_n(),
+        cv_s: u.cv_s(),
+        max_risk,
         k_n_axis,
         k_s_axis,
-        p_fail,
-        contour,
-        star: (ground.k_n, ground.k_s),
-        max_risk,
-        title: format!(
-            "p_fail at {slope_deg}\u{b0}, m = {} kg, cv k_n = {:.2}, cv k_s = {:.2}",
-            robot.mass(),
-            u.cv_n(),
-            u.cv_s()
-        ),
+        cells: map.p_fail.len(),
+        cells_below_max_risk: map.p_fail.iter().filter(|&&p| p < max_risk).count(),
+        terrain_k_n: ground.k_n,
+        terrain_k_s: ground.k_s,
+        terrain_p_fail,
+        defaults_used: defaults,
     };
-    save(path, &figure)
+    match args.format() {
+        Format::Json => print_json(&summary),
+        Format::Csv => match &args.csv {
+            Some(None) => {
+                let mut out = std::io::stdout().lock();
+                map_csv(&map, &mut out).context("cannot write to stdout")
+            }
+            _ => Ok(()),
+        },
+        Format::Table => {
+            println!(
+                "p_fail map at {slope_deg} deg: {} x {} cells (k_n {} to {}, k_s {} to {} N/m^3), cv k_n {:.3}, cv k_s {:.3}",
+                k_n_axis.len(),
+                k_s_axis.len(),
+                sci(k_n_axis.min()),
+                sci(k_n_axis.max()),
+                sci(k_s_axis.min()),
+                sci(k_s_axis.max()),
+                u.cv_n(),
+                u.cv_s()
+            );
+            println!(
+                "{} of {} cells have p_fail < {max_risk}; the terrain's own medians (k_n {}, k_s {}) have p_fail {:.4}",
+                summary.cells_below_max_risk,
+                summary.cells,
+                sci(ground.k_n),
+                sci(ground.k_s),
+                terrain_p_fail
+            );
+            if let Some(note) = defaults.note() {
+                println!("note: {note}");
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Every cell of `map`, one row each, k_n-major: `k_n,k_s,p_fail,p_not_success`.
+fn map_csv(map: &RiskMap, out: &mut dyn std::io::Write) -> Result<()> {
+    let (k_n, k_s) = (map.k_n_axis.values(), map.k_s_axis.values());
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, out);
+    writeln!(w, "k_n,k_s,p_fail,p_not_success")?;
+    for (i, &kn) in k_n.iter().enumerate() {
+        for (j, &ks) in k_s.iter().enumerate() {
+            writeln!(w, "{kn},{ks},{},{}", map.p_fail_at(i, j), map.p_not_success_at(i, j))?;
+        }
+    }
+    w.flush()?;
+    Ok(())
+}
+
+fn write_map_csv(path: &std::path::Path, map: &RiskMap) -> Result<()> {
+    write_via_temp(path, |tmp| {
+        let mut file =
+            std::fs::File::create(tmp).with_context(|| format!("cannot write {}", path.display()))?;
+        map_csv(map, &mut file).with_context(|| format!("cannot write {}", path.display()))
+    })
 }
 
 #[cfg(test)]

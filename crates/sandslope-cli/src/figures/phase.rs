@@ -9,21 +9,10 @@ use plotters::element::{Drawable, PointCollection};
 use plotters::prelude::*;
 use plotters_backend::{BackendCoord, DrawingErrorKind};
 
-use sandslope::{Axis, AxisScale, PhaseMap, Regime};
+use sandslope::{Axis, AxisScale, PhasePanel, Regime};
 
 use super::palette::regime_colour;
 use super::{font, Figure};
-
-/// One (mass, slope) panel: the map and what is drawn and reported with it.
-pub struct PhasePanel {
-    pub slope_deg: f64,
-    pub mass_kg: f64,
-    pub map: PhaseMap,
-    /// The terrain's (k_n, k_s) at this slope and its regime for this robot.
-    pub terrain: (f64, f64, Regime),
-    pub sinkage_k_n: f64,
-    pub anchoring_k_s: f64,
-}
 
 /// Dark green of the terrain star.
 pub const STAR_GREEN: RGBColor = RGBColor(0, 100, 0);
@@ -234,7 +223,7 @@ where
     chart
         .draw_series(contour.iter().map(|&(a, b)| PathElement::new(vec![a, b], BLACK.stroke_width(2))))
         .map_err(e)?;
-    let (k_n, k_s, _) = panel.terrain;
+    let (k_n, k_s) = (panel.terrain_k_n, panel.terrain_k_s);
     if within(xe, ye, (k_n, k_s)) {
         chart.draw_series(std::iter::once(TerrainStar { at: (k_n, k_s), outline: BLACK })).map_err(e)?;
     }

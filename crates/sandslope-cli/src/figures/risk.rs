@@ -1,12 +1,13 @@
-//! Risk figures: p_fail and p_not_success against slope with the safe-slope limit, and the
-//! p_fail heat map over median (k_n, k_s) with the max-risk contour and the terrain's star.
+//! Risk figures: p_fail and p_not_success against slope with the safe-slope limit; the
+//! p_fail heat map over median (k_n, k_s) with the max-risk contour and the terrain's star;
+//! and the payload envelope (heaviest safe mass against slope).
 
 use anyhow::{bail, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 
-use sandslope::risk::SafeLimit;
+use sandslope::risk::{PayloadEnvelope, SafeLimit};
 use sandslope::{Axis, RegimeProbabilities};
 
 use super::phase::{cell_edges, sci_label, star_points, within, TerrainStar, STAR_GREEN};
@@ -106,7 +107,7 @@ pub struct MapFigure {
     pub k_n_axis: Axis,
     pub k_s_axis: Axis,
     pub p_fail: Vec<f64>,
-    pub contour: Vec<sandslope::phase::Segment>,
+    pub contour: Vec<sandslope::ContourSegment>,
     pub star: (f64, f64),
     pub max_risk: f64,
     pub title: String,
@@ -207,6 +208,103 @@ impl Figure for MapFigure {
             Rectangle::new([(0.0, a), (1.0, b)], ViridisRGB.get_color((a + 0.005) as f32).filled())
         }))
         .map_err(e)?;
+        Ok(())
+    }
+}
+
+/// The payload envelope: the heaviest safe total mass against slope.
+pub struct EnvelopeFigure<'a> {
+    env: &'a PayloadEnvelope,
+    title: String,
+}
+
+impl<'a> EnvelopeFigure<'a> {
+    /// The figure of `env`, titled after the robot and terrain.
+    pub fn new(env: &'a PayloadEnvelope, what: &str) -> Self {
+        EnvelopeFigure { env, title: format!("Payload envelope (p_fail < {}): {what}", env.max_risk) }
+    }
+}
+
+impl Figure for EnvelopeFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = crate::error::plot_err;
+        let own = self.env.robot_mass_kg;
+        // Each point: (slope, mass drawn, kind) with kind 0 limit, 1 none safe, 2 beyond range.
+        let pts: Vec<(f64, f64, u8)> = self
+            .env
+            .points
+            .iter()
+            .map(|p| match p.limit {
+                SafeLimit::Limit { value, .. } => (p.slope_deg.abs(), value, 0),
+                SafeLimit::NoneSafe { .. } => (p.slope_deg.abs(), own, 1),
+                SafeLimit::BeyondRange { up_to, .. } => (p.slope_deg.abs(), up_to, 2),
+            })
+            .collect();
+        let x_hi = pts.iter().fold(1.0f64, |a, p| a.max(p.0));
+        let x_lo = pts.iter().fold(x_hi, |a, p| a.min(p.0));
+        let y_hi = pts.iter().fold(own, |a, p| a.max(p.1)) * 1.1;
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, font(22.0))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x_lo..x_hi + 0.02 * (x_hi - x_lo).max(1.0), 0.0..y_hi)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc("slope along the direction of travel (deg)")
+            .y_desc("heaviest safe total mass (kg)")
+            .label_style(font(16.0))
+            .axis_desc_style(font(18.0))
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(e)?;
+        let blue = RGBColor(40, 90, 200);
+        let grey = RGBColor(90, 90, 90);
+        let red = RGBColor(214, 56, 48);
+        let safe: Vec<(f64, f64)> = pts.iter().filter(|p| p.2 != 1).map(|p| (p.0, p.1)).collect();
+        chart.draw_series(AreaSeries::new(safe.iter().copied(), 0.0, blue.mix(0.15))).map_err(e)?;
+        chart
+            .draw_series(LineSeries::new(safe.iter().copied(), blue.stroke_width(3)))
+            .map_err(e)?
+            .label("heaviest safe total mass")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(3)));
+        chart.draw_series(safe.iter().map(|&(x, y)| Circle::new((x, y), 4, blue.filled()))).map_err(e)?;
+        chart
+            .draw_series(DashedLineSeries::new(vec![(x_lo, own), (x_hi, own)], 8, 6, grey.stroke_width(2)))
+            .map_err(e)?
+            .label(format!("robot's own mass {own} kg"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], grey.stroke_width(2)));
+        if pts.iter().any(|p| p.2 == 1) {
+            chart
+                .draw_series(
+                    pts.iter().filter(|p| p.2 == 1).map(|p| Cross::new((p.0, p.1), 7, red.stroke_width(3))),
+                )
+                .map_err(e)?
+                .label("no mass safe")
+                .legend(move |(x, y)| Cross::new((x + 12, y), 7, red.stroke_width(3)));
+        }
+        if pts.iter().any(|p| p.2 == 2) {
+            chart
+                .draw_series(
+                    pts.iter()
+                        .filter(|p| p.2 == 2)
+                        .map(|p| TriangleMarker::new((p.0, p.1), 7, blue.stroke_width(2))),
+                )
+                .map_err(e)?
+                .label("safe up to the end of the search");
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(font(16.0))
+            .draw()
+            .map_err(e)?;
         Ok(())
     }
 }

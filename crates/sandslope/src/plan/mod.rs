@@ -24,7 +24,7 @@ mod table;
 
 pub use grid::{Cell, ElevationGrid};
 pub use search::{heading_offsets, Planner, Route, RouteStep, HEADINGS, NO_CLASS};
-pub use table::{ClassTerrain, PitchTable, MAX_PITCH_DEG, P_FAIL_STEP_DEG, TAN_STEP};
+pub use table::{PitchTable, MAX_PITCH_DEG, P_FAIL_STEP_DEG, TAN_STEP};
 
 use serde::{Deserialize, Serialize};
 

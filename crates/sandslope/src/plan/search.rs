@@ -24,9 +24,10 @@ use rayon::prelude::*;
 
 use super::grid::{Cell, ElevationGrid};
 use super::queue::BucketQueue;
-use super::table::{ClassTerrain, PitchTable, TAN_STEP};
+use super::table::{PitchTable, TAN_STEP};
 use super::{Descent, NoRoute, Objective, PlanError, PlanSettings};
 use crate::regime::Regime;
+use crate::risk::UncertainTerrain;
 use crate::robot::Robot;
 
 /// Number of headings: 8 neighbours and 8 knight moves.
@@ -181,7 +182,7 @@ impl Planner {
     pub fn new(
         grid: ElevationGrid,
         classes: Option<Vec<u8>>,
-        terrains: &[ClassTerrain],
+        terrains: &[UncertainTerrain],
         robot: &Robot,
         settings: PlanSettings,
     ) -> Result<Planner, PlanError> {
@@ -698,9 +699,9 @@ mod tests {
     use crate::risk::Uncertainty;
     use crate::terrain::Terrain;
 
-    fn class() -> Vec<ClassTerrain> {
+    fn class() -> Vec<UncertainTerrain> {
         let terrain = Terrain::constant(7e5, 2e6).unwrap();
-        vec![ClassTerrain { terrain, fallback: Uncertainty::new(0.1, 0.2).unwrap() }]
+        vec![UncertainTerrain::with_uncertainty(terrain, Uncertainty::new(0.1, 0.2).unwrap())]
     }
 
     /// A bumpy surface from a few sines (deterministic), 1 m cells, slopes up to ~17 degrees.
@@ -776,7 +777,7 @@ mod tests {
         let soft = Terrain::constant(3e5, 1.2e6).unwrap();
         let classes = vec![
             class()[0].clone(),
-            ClassTerrain { terrain: soft, fallback: Uncertainty::new(0.1, 0.2).unwrap() },
+            UncertainTerrain::with_uncertainty(soft, Uncertainty::new(0.1, 0.2).unwrap()),
         ];
         let class_of: Vec<u8> = (0..n * n).map(|i| u8::from((i % n) * 3 / n == 1)).collect();
         let mut mask = vec![false; n * n];
@@ -878,10 +879,8 @@ mod tests {
         // time every route is equally safe; the tie-break must pick the straight one.
         let n = 30;
         let g = ElevationGrid::new(n, n, 0.5, 0.5, vec![3.0; n * n], None).unwrap();
-        let certain = ClassTerrain {
-            terrain: Terrain::constant(7e5, 2e6).unwrap(),
-            fallback: Uncertainty::new(0.0, 0.0).unwrap(),
-        };
+        let certain =
+            UncertainTerrain::with_uncertainty(Terrain::constant(7e5, 2e6).unwrap(), Uncertainty::NONE);
         let settings = PlanSettings::new(20.0, Descent::Symmetric, false, 0.0).unwrap();
         let p = Planner::new(g, None, &[certain], &paper_robot(), settings).unwrap();
         assert_eq!(p.tables()[0].p_fail(0), 0.0);

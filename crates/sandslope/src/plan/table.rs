@@ -4,17 +4,16 @@
 //! pitch of an edge, so they are computed once on a fine table of `tan(pitch)` rather than
 //! per edge. Entry `i` holds the model at `tan(pitch) = i * TAN_STEP`; a lookup rounds the
 //! pitch *up* to the next entry (at most 0.06 degrees steeper: conservative where failure
-//! grows with slope). Failure probabilities come from [`crate::risk::regime_probabilities`]
-//! every [`P_FAIL_STEP_DEG`] degrees, interpolated linearly in degrees between samples.
+//! grows with slope). Failure probabilities come from [`crate::risk::regime_probabilities`],
+//! with the uncertainty of [`crate::risk::UncertainTerrain`] (docs/model.md §9), every [`P_FAIL_STEP_DEG`] degrees, interpolated linearly in degrees between samples.
 
 use rayon::prelude::*;
 
 use crate::model::predict;
 use crate::regime::Regime;
-use crate::risk::{regime_probabilities, Uncertainty};
+use crate::risk::{regime_probabilities, UncertainTerrain};
 use crate::robot::Robot;
 use crate::slope::Slope;
-use crate::terrain::Terrain;
 
 /// Step of the pitch table in `tan(pitch)` (0.057 degrees on level ground, less when steeper).
 pub const TAN_STEP: f64 = 1e-3;
@@ -22,28 +21,6 @@ pub const TAN_STEP: f64 = 1e-3;
 pub const MAX_PITCH_DEG: f64 = 89.0;
 /// Spacing of the failure-probability samples, degrees.
 pub const P_FAIL_STEP_DEG: f64 = 0.1;
-
-/// A terrain class: its table and where its uncertainty comes from.
-#[derive(Debug, Clone)]
-pub struct ClassTerrain {
-    /// The terrain table.
-    pub terrain: Terrain,
-    /// Coefficients of variation used where the terrain has no standard deviations
-    /// (MODEL.md section 9: "or a user-given value").
-    pub fallback: Uncertainty,
-}
-
-impl ClassTerrain {
-    /// The uncertainty at `slope`: the terrain's interpolated SDs when it has them, else the
-    /// fallback coefficients of variation.
-    pub fn uncertainty_at(&self, slope: Slope) -> Uncertainty {
-        let s = self.terrain.sample(slope);
-        match (s.k_n_sd, s.k_s_sd) {
-            (Some(n), Some(k)) => Uncertainty::from_sd(&s.ground, n, k).unwrap_or(self.fallback),
-            _ => self.fallback,
-        }
-    }
-}
 
 /// The model of one robot on one terrain class, against pitch.
 #[derive(Debug, Clone)]
@@ -62,14 +39,14 @@ impl PitchTable {
     /// Tabulates the model for `robot` on `class` for pitches up to `atan(max_tan)` (capped at
     /// [`MAX_PITCH_DEG`]): one risk evaluation per [`P_FAIL_STEP_DEG`], in parallel. A map
     /// needs no pitch steeper than its steepest gradient.
-    pub fn new(robot: &Robot, class: &ClassTerrain, max_tan: f64) -> PitchTable {
+    pub fn new(robot: &Robot, class: &UncertainTerrain, max_tan: f64) -> PitchTable {
         let n = table_len(max_tan);
         let slope_of = |deg: f64| Slope::from_degrees(deg.clamp(0.0, MAX_PITCH_DEG)).unwrap_or(Slope::LEVEL);
         let rows: Vec<(Regime, f32)> = (0..n)
             .into_par_iter()
             .map(|i| {
                 let slope = slope_of((i as f64 * TAN_STEP).atan().to_degrees());
-                let p = predict(robot, slope, &class.terrain.sample(slope).ground);
+                let p = predict(robot, slope, &class.terrain().sample(slope).ground);
                 (p.regime, p.speed.map_or(f32::NAN, |v| v as f32))
             })
             .collect();
@@ -79,8 +56,8 @@ impl PitchTable {
             .into_par_iter()
             .map(|k| {
                 let slope = slope_of(k as f64 * P_FAIL_STEP_DEG);
-                let ground = class.terrain.sample(slope).ground;
-                regime_probabilities(robot, slope, &ground, class.uncertainty_at(slope)).p_fail()
+                let (ground, uncertainty) = class.at(slope);
+                regime_probabilities(robot, slope, &ground, uncertainty).p_fail()
             })
             .collect();
         let p_fail = (0..n)
@@ -91,9 +68,9 @@ impl PitchTable {
                 (p_deg[k] + f * (p_deg[k + 1] - p_deg[k])).clamp(0.0, 1.0) as f32
             })
             .collect();
-        let last = class.terrain.points().last().map_or(0.0, |p| p.slope_deg);
+        let last = class.terrain().points().last().map_or(0.0, |p| p.slope_deg);
         let extrapolated_from_deg =
-            (class.terrain.points().len() > 1 && last < MAX_PITCH_DEG).then_some(last);
+            (class.terrain().points().len() > 1 && last < MAX_PITCH_DEG).then_some(last);
         let (regime, speed) = rows.into_iter().unzip();
         PitchTable { regime, speed, p_fail, extrapolated_from_deg }
     }
@@ -145,13 +122,14 @@ fn table_len(max_tan: f64) -> usize {
 mod tests {
     use super::*;
     use crate::model::tests::paper_robot;
-    use crate::terrain::Ground;
+    use crate::risk::Uncertainty;
+    use crate::terrain::{Ground, Terrain};
 
     #[test]
     fn table_agrees_with_the_model_at_its_entries() {
         let robot = paper_robot();
         let terrain = Terrain::constant(7e5, 2e6).unwrap();
-        let class = ClassTerrain { terrain, fallback: Uncertainty::new(0.1, 0.2).unwrap() };
+        let class = UncertainTerrain::new(terrain, None, None).unwrap();
         let t = PitchTable::new(&robot, &class, 0.5);
         assert_eq!(t.len(), 502);
         for deg in [0.0_f64, 10.0, 19.0, 21.5, 26.0] {
@@ -163,10 +141,51 @@ mod tests {
             assert_eq!(t.regime(i), p.regime);
             assert!((t.speed(i).unwrap() - p.speed.unwrap()).abs() < 1e-6);
             let q =
-                regime_probabilities(&robot, slope, &Ground::new(7e5, 2e6).unwrap(), class.fallback).p_fail();
+                regime_probabilities(&robot, slope, &Ground::new(7e5, 2e6).unwrap(), Uncertainty::DEFAULT)
+                    .p_fail();
             // Linear interpolation over 0.1 degree.
             assert!((t.p_fail(i) - q).abs() < 0.02, "{deg}: {} vs {q}", t.p_fail(i));
         }
         assert!(t.index(0.502).is_none());
+    }
+
+    /// `risk` and `plan` read the same uncertainty from the same terrain and CVs (docs/model.md
+    /// §9): the table's failure probability is the risk quadrature on the same
+    /// [`UncertainTerrain`], within the interpolation between 0.1 degree samples. The terrain
+    /// has SDs (cv 0.2 / 0.3) and the user gives cv_s 0.05: the given CV must win in both
+    /// (before the rule was unified, plan used the table's 0.3 here, and p_fail moved by
+    /// more than 0.1).
+    #[test]
+    fn plan_and_risk_give_the_same_uncertainty() {
+        use crate::risk::failure_risk;
+        use crate::terrain::{TerrainPoint, TerrainSpec};
+        let robot = paper_robot();
+        let point = |slope_deg: f64, k_s: f64| TerrainPoint {
+            slope_deg,
+            k_n: 7e5,
+            k_s,
+            k_n_sd: Some(1.4e5),
+            k_s_sd: Some(0.3 * k_s),
+        };
+        let terrain = Terrain::new(TerrainSpec {
+            name: None,
+            repose_deg: None,
+            points: vec![point(0.0, 2e6), point(20.0, 1e6)],
+        })
+        .unwrap();
+        let given = UncertainTerrain::new(terrain.clone(), None, Some(0.05)).unwrap();
+        let table_only = UncertainTerrain::new(terrain, None, None).unwrap();
+        let t = PitchTable::new(&robot, &given, 0.6);
+        let mut separated = 0;
+        for deg in [5.0_f64, 12.0, 18.0, 21.0, 23.5, 26.0] {
+            let i = t.index(deg.to_radians().tan()).unwrap();
+            let slope = Slope::from_radians(PitchTable::tan_of(i).atan()).unwrap();
+            let risk = failure_risk(&robot, slope, &given).p_fail();
+            assert!((t.p_fail(i) - risk).abs() < 2e-3, "{deg}: plan {} vs risk {risk}", t.p_fail(i));
+            assert_eq!(given.uncertainty_at(slope).cv_s(), 0.05);
+            let other = failure_risk(&robot, slope, &table_only).p_fail();
+            separated += usize::from((other - risk).abs() > 0.1);
+        }
+        assert!(separated > 0, "the test cannot tell the two rules apart");
     }
 }

@@ -1,0 +1,300 @@
+//! Limits under uncertainty (docs/model.md §9): the safe-slope limit (the steepest slope
+//! below a failure-risk threshold), the heaviest safe mass at a slope, and the payload
+//! envelope (the heaviest safe mass at each of several slopes).
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::quadrature::regime_probabilities;
+use super::uncertainty::{DefaultsUsed, UncertainTerrain};
+use super::RegimeProbabilities;
+use crate::error::ParamError;
+use crate::robot::Robot;
+use crate::slope::Slope;
+
+/// The regime probabilities of `robot` at `slope` on an uncertain terrain (one quadrature).
+pub fn failure_risk(robot: &Robot, slope: Slope, terrain: &UncertainTerrain) -> RegimeProbabilities {
+    let (ground, u) = terrain.at(slope);
+    regime_probabilities(robot, slope, &ground, u)
+}
+
+/// The result of a search for the largest value of a quantity (slope or mass) at which the
+/// failure probability stays below a threshold, scanning up from the start of a range.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SafeLimit {
+    /// Already at the start of the range `p_fail >= max_risk`.
+    NoneSafe {
+        /// p_fail at the start of the range.
+        p_fail: f64,
+    },
+    /// `p_fail < max_risk` from the start up to `value`, and it reaches the threshold just
+    /// above `value` (within the search tolerance).
+    Limit {
+        /// The largest safe value found (degrees or kg).
+        value: f64,
+        /// p_fail at `value`.
+        p_fail: f64,
+    },
+    /// `p_fail < max_risk` over the whole range searched.
+    BeyondRange {
+        /// The end of the range searched (degrees or kg).
+        up_to: f64,
+        /// p_fail there.
+        p_fail: f64,
+    },
+}
+
+impl SafeLimit {
+    /// The largest safe value, if the search found a threshold crossing.
+    pub fn value(&self) -> Option<f64> {
+        match self {
+            SafeLimit::Limit { value, .. } => Some(*value),
+            _ => None,
+        }
+    }
+}
+
+pub(crate) fn check_risk(max_risk: f64) -> Result<f64, ParamError> {
+    if max_risk.is_finite() && max_risk > 0.0 && max_risk < 1.0 {
+        Ok(max_risk)
+    } else {
+        Err(ParamError::new("max_risk", max_risk, "a probability strictly between 0 and 1"))
+    }
+}
+
+/// Scans `p_fail` at the ascending points `scan` (a few in parallel at a time) for the first
+/// at or above `max_risk`, then bisects between it and the point before down to `tol`.
+/// Between scan points the crossing is assumed to be single.
+fn first_crossing(p_fail: &(dyn Fn(f64) -> f64 + Sync), scan: &[f64], max_risk: f64, tol: f64) -> SafeLimit {
+    let p0 = p_fail(scan[0]);
+    if p0 >= max_risk {
+        return SafeLimit::NoneSafe { p_fail: p0 };
+    }
+    let (mut lo, mut p_lo) = (scan[0], p0);
+    let batch = 2 * rayon::current_num_threads().max(1);
+    for chunk in scan[1..].chunks(batch) {
+        let ps: Vec<f64> = chunk.par_iter().map(|&x| p_fail(x)).collect();
+        for (&x, &p) in chunk.iter().zip(&ps) {
+            if p >= max_risk {
+                let mut hi = x;
+                while hi - lo > tol {
+                    let mid = 0.5 * (lo + hi);
+                    let p_mid = p_fail(mid);
+                    if p_mid >= max_risk {
+                        hi = mid;
+                    } else {
+                        (lo, p_lo) = (mid, p_mid);
+                    }
+                }
+                return SafeLimit::Limit { value: lo, p_fail: p_lo };
+            }
+            (lo, p_lo) = (x, p);
+        }
+    }
+    SafeLimit::BeyondRange { up_to: lo, p_fail: p_lo }
+}
+
+/// Slope scan step of [`safe_slope_limit`], degrees.
+pub const SLOPE_SCAN_STEP_DEG: f64 = 0.5;
+/// Final resolution of [`safe_slope_limit`], degrees.
+pub const SLOPE_TOLERANCE_DEG: f64 = 1e-3;
+/// Steepest slope [`safe_slope_limit`] considers, degrees.
+pub const MAX_SCAN_SLOPE_DEG: f64 = 89.5;
+
+/// The safe-slope limit: the steepest slope (degrees) such that `p_fail < max_risk` at every
+/// slope from level up to it, with the terrain interpolated per slope.
+///
+/// Scans in steps of [`SLOPE_SCAN_STEP_DEG`] from 0 to [`MAX_SCAN_SLOPE_DEG`], then bisects
+/// the first crossing to [`SLOPE_TOLERANCE_DEG`]. `max_risk` must be in (0, 1).
+pub fn safe_slope_limit(
+    robot: &Robot,
+    terrain: &UncertainTerrain,
+    max_risk: f64,
+) -> Result<SafeLimit, ParamError> {
+    let max_risk = check_risk(max_risk)?;
+    let n = (MAX_SCAN_SLOPE_DEG / SLOPE_SCAN_STEP_DEG).round() as usize;
+    let scan: Vec<f64> = (0..=n).map(|i| i as f64 * SLOPE_SCAN_STEP_DEG).collect();
+    let p = |deg: f64| match Slope::from_degrees(deg) {
+        Ok(s) => failure_risk(robot, s, terrain).p_fail(),
+        Err(_) => 1.0,
+    };
+    Ok(first_crossing(&p, &scan, max_risk, SLOPE_TOLERANCE_DEG))
+}
+
+/// Growth factor between scanned masses in [`max_safe_mass`].
+pub const MASS_SCAN_FACTOR: f64 = 1.05;
+/// Heaviest mass [`max_safe_mass`] considers, as a multiple of the robot's own.
+pub const MAX_MASS_FACTOR: f64 = 1000.0;
+
+/// The heaviest total mass (kg) of `robot` (the same robot carrying a payload) such that
+/// `p_fail < max_risk` at `slope` for every mass from the robot's own up to it.
+///
+/// Scans masses growing by [`MASS_SCAN_FACTOR`] up to [`MAX_MASS_FACTOR`] times the robot's
+/// mass, then bisects the first crossing to a relative 1e-5. `max_risk` must be in (0, 1).
+pub fn max_safe_mass(
+    robot: &Robot,
+    slope: Slope,
+    terrain: &UncertainTerrain,
+    max_risk: f64,
+) -> Result<SafeLimit, ParamError> {
+    let max_risk = check_risk(max_risk)?;
+    let m0 = robot.mass();
+    let n = (MAX_MASS_FACTOR.ln() / MASS_SCAN_FACTOR.ln()).ceil() as i32;
+    let scan: Vec<f64> = (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).collect();
+    let (ground, u) = terrain.at(slope);
+    let p = |m: f64| robot.with_mass(m).map_or(1.0, |r| regime_probabilities(&r, slope, &ground, u).p_fail());
+    Ok(first_crossing(&p, &scan, max_risk, 1e-5 * m0))
+}
+
+/// The heaviest safe mass at one slope of a [`PayloadEnvelope`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PayloadPoint {
+    /// Slope, degrees (as requested; a negative slope is evaluated as its magnitude).
+    pub slope_deg: f64,
+    /// The heaviest safe total mass, kg, when the search found a threshold crossing.
+    pub max_mass_kg: Option<f64>,
+    /// `max_mass_kg` minus the robot's own mass, kg.
+    pub max_payload_kg: Option<f64>,
+    /// What the search found (none safe, a limit, or safe over the whole range searched).
+    pub limit: SafeLimit,
+}
+
+/// The payload envelope: the heaviest total mass with `p_fail < max_risk` at each slope, the
+/// curve a team puts on a wall (docs/model.md §9).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PayloadEnvelope {
+    /// The failure-risk threshold.
+    pub max_risk: f64,
+    /// The robot's own mass, kg.
+    pub robot_mass_kg: f64,
+    /// One point per requested slope, in the order given.
+    pub points: Vec<PayloadPoint>,
+    /// Whether default CVs were used at any of the slopes.
+    pub defaults_used: DefaultsUsed,
+}
+
+/// The heaviest safe mass ([`max_safe_mass`]) at each of `slopes_deg` (degrees, in
+/// (-90, 90); negative slopes are evaluated as their magnitude, docs/model.md §8).
+pub fn payload_envelope(
+    robot: &Robot,
+    terrain: &UncertainTerrain,
+    slopes_deg: &[f64],
+    max_risk: f64,
+) -> Result<PayloadEnvelope, ParamError> {
+    check_risk(max_risk)?;
+    let slopes = slopes_deg
+        .iter()
+        .map(|&d| Slope::from_signed_degrees(d).map_err(|e| e.renamed("slope_deg")))
+        .collect::<Result<Vec<Slope>, ParamError>>()?;
+    let own = robot.mass();
+    let points = slopes
+        .par_iter()
+        .zip(slopes_deg.par_iter())
+        .map(|(&s, &slope_deg)| {
+            let limit = max_safe_mass(robot, s, terrain, max_risk)?;
+            Ok(PayloadPoint {
+                slope_deg,
+                max_mass_kg: limit.value(),
+                max_payload_kg: limit.value().map(|m| m - own),
+                limit,
+            })
+        })
+        .collect::<Result<Vec<_>, ParamError>>()?;
+    let defaults_used =
+        slopes.iter().fold(DefaultsUsed::default(), |a, &s| a.or(terrain.defaults_used_at(s)));
+    Ok(PayloadEnvelope { max_risk, robot_mass_kg: own, points, defaults_used })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::critical::{critical_shear_strength, StepTarget};
+    use crate::model::{predict, tests::paper_robot};
+    use crate::risk::uncertainty::tests::table;
+    use crate::terrain::Terrain;
+
+    fn slope(d: f64) -> Slope {
+        Slope::from_degrees(d).unwrap()
+    }
+    /// With no uncertainty p_fail is 0 or 1, so the safe-slope limit is where `predict` turns
+    /// to failure: just below it the robot progresses, just above it fails.
+    #[test]
+    fn certain_terrain_safe_slope_is_the_deterministic_failure_slope() {
+        let r = paper_robot();
+        let t = UncertainTerrain::new(
+            table(&[(0.0, 7e5, 2e6, None, None), (20.0, 7e5, 4e5, None, None)], None),
+            Some(0.0),
+            Some(0.0),
+        )
+        .unwrap();
+        let SafeLimit::Limit { value, p_fail } = safe_slope_limit(&r, &t, 0.05).unwrap() else {
+            panic!("no limit")
+        };
+        assert_eq!(p_fail, 0.0);
+        let regime = |d: f64| {
+            let s = slope(d);
+            predict(&r, s, &t.terrain().sample(s).ground).regime
+        };
+        assert!(!regime(value - 0.01).is_failure() && regime(value + 0.01).is_failure(), "limit {value}");
+    }
+
+    /// Symmetric case: at 20 deg the median k_s sits exactly on the progress boundary and k_n
+    /// is certain, so p_fail(20 deg) = 1/2; since the boundary rises with slope, the slope at
+    /// which p_fail reaches 0.5 is 20 deg (and the heaviest mass keeping it below 0.5 at
+    /// 20 deg is the robot's own).
+    #[test]
+    fn symmetric_case_puts_the_half_risk_limits_on_the_boundary() {
+        let r = paper_robot();
+        let k_crit = critical_shear_strength(&r, slope(20.0), 7e5, false, StepTarget::Progress).unwrap();
+        let t = UncertainTerrain::new(Terrain::constant(7e5, k_crit).unwrap(), Some(0.0), Some(0.3)).unwrap();
+        assert!((failure_risk(&r, slope(20.0), &t).p_fail() - 0.5).abs() < 1e-9);
+        let limit = safe_slope_limit(&r, &t, 0.5).unwrap().value().unwrap();
+        assert!((limit - 20.0).abs() < 2e-3, "{limit}");
+        // Same boundary for a 1 kg robot: the heaviest mass below 0.5 risk is 1 kg.
+        let heavy = r.with_mass(1.0).unwrap();
+        let k_crit = critical_shear_strength(&heavy, slope(20.0), 7e5, false, StepTarget::Progress).unwrap();
+        let t = UncertainTerrain::new(Terrain::constant(7e5, k_crit).unwrap(), Some(0.0), Some(0.3)).unwrap();
+        let m = max_safe_mass(&r, slope(20.0), &t, 0.5).unwrap().value().unwrap();
+        assert!((m - 1.0).abs() < 1e-4, "{m}");
+        // A threshold of 1 is not a probability strictly between 0 and 1.
+        assert!(matches!(safe_slope_limit(&r, &t, 1.0), Err(ParamError { .. })));
+    }
+
+    #[test]
+    fn repose_caps_the_safe_slope_and_mass_search_reports_none_safe() {
+        let r = paper_robot();
+        let t =
+            UncertainTerrain::new(table(&[(0.0, 7e5, 1e8, None, None)], Some(25.0)), Some(0.1), Some(0.1))
+                .unwrap();
+        let limit = safe_slope_limit(&r, &t, 0.05).unwrap().value().unwrap();
+        assert!(limit < 25.0 && limit > 25.0 - 2.0 * SLOPE_TOLERANCE_DEG, "{limit}");
+        assert!(matches!(max_safe_mass(&r, slope(26.0), &t, 0.05).unwrap(), SafeLimit::NoneSafe { .. }));
+    }
+
+    /// The envelope is the heaviest safe mass at each slope, and it does not grow with slope
+    /// on a terrain that weakens with slope.
+    #[test]
+    fn payload_envelope_is_max_safe_mass_per_slope() {
+        let r = paper_robot();
+        let t = UncertainTerrain::new(
+            table(&[(0.0, 7e5, 2e6, None, None), (24.0, 7e5, 8e5, None, None)], Some(25.0)),
+            Some(0.1),
+            None,
+        )
+        .unwrap();
+        let env = payload_envelope(&r, &t, &[0.0, 10.0, 20.0], 0.05).unwrap();
+        assert_eq!(env.points.len(), 3);
+        assert!(env.defaults_used.k_s && !env.defaults_used.k_n);
+        let mut last = f64::INFINITY;
+        for p in &env.points {
+            let m = max_safe_mass(&r, slope(p.slope_deg), &t, 0.05).unwrap();
+            assert_eq!(p.limit, m);
+            let v = p.max_mass_kg.unwrap();
+            assert!((p.max_payload_kg.unwrap() - (v - 0.35)).abs() < 1e-12);
+            assert!(v <= last + 1e-9, "{v} > {last}");
+            last = v;
+        }
+        assert_eq!(payload_envelope(&r, &t, &[95.0], 0.05).unwrap_err().key, "slope_deg");
+    }
+}

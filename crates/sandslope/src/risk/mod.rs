@@ -1,0 +1,34 @@
+//! Probability of each regime when the terrain is uncertain (docs/model.md §9).
+//!
+//! k_n and k_s at a slope are independent log-normal variables whose medians are the table
+//! values; their coefficients of variation follow the one rule of the whole tool
+//! ([`UncertainTerrain`]: a user-given CV, else the table's SD over its value, else the
+//! defaults 0.1 for k_n and 0.2 for k_s).
+//!
+//! - [`regime_probabilities`]: the four regime probabilities at one slope and one median
+//!   ground, by deterministic quadrature (the reference; [`quadrature`]).
+//! - [`failure_risk`], [`risk_curve`]: the same on an uncertain terrain, at one or several
+//!   slopes ([`RiskCurve`]).
+//! - [`safe_slope_limit`] (steepest slope below a failure-risk threshold), [`max_safe_mass`]
+//!   (heaviest safe robot at a slope) and [`payload_envelope`] (that mass at each slope).
+//! - [`RiskMap`]: p_fail and p_not_success over a grid of median (k_n, k_s).
+//!
+//! Every result is a plain serialisable value; none draws or writes anything.
+
+pub mod curve;
+pub mod limits;
+pub mod map;
+pub mod quadrature;
+pub mod uncertainty;
+
+pub use curve::{risk_curve, RiskCurve, RiskPoint};
+pub use limits::{
+    failure_risk, max_safe_mass, payload_envelope, safe_slope_limit, PayloadEnvelope, PayloadPoint,
+    SafeLimit, MASS_SCAN_FACTOR, MAX_MASS_FACTOR, MAX_SCAN_SLOPE_DEG, SLOPE_SCAN_STEP_DEG,
+    SLOPE_TOLERANCE_DEG,
+};
+pub use map::RiskMap;
+pub use quadrature::{regime_probabilities, RegimeProbabilities};
+pub use uncertainty::{
+    CvSource, DefaultsUsed, UncertainGround, UncertainTerrain, Uncertainty, DEFAULT_CV_N, DEFAULT_CV_S,
+};

@@ -57,6 +57,24 @@ pub fn num(x: Option<f64>, decimals: usize) -> String {
     }
 }
 
+/// The speed column of `predict` and `sweep`, cm/s: the speed the robot makes; where the
+/// regime rules the stance model's speed out (legs sinking, slope at or above repose) that
+/// speed in parentheses, explained by [`ruled_out_note`]; `-` where the model has none.
+pub fn speed_cell(e: &sandslope::SlopeEvaluation) -> String {
+    match (e.speed(), e.model_speed()) {
+        (Some(v), _) => format!("{:.2}", v * 100.0),
+        (None, Some(v)) => format!("({:.2})", v * 100.0),
+        (None, None) => "-".into(),
+    }
+}
+
+/// The note printed under a table that shows a speed in parentheses.
+pub fn ruled_out_note() -> &'static str {
+    "speed in parentheses: the stance model's v = s/(T/2), which the regime rules out (the surface yields at \
+     or above the angle of repose, or the legs sink; docs/model.md §6).\nJSON and CSV give it as \
+     model_speed_m_s, with speed_m_s null."
+}
+
 /// Formats a number in scientific notation with 3 significant digits.
 pub fn sci(x: f64) -> String {
     format!("{x:.3e}")

@@ -17,11 +17,12 @@ fn json(cmd: &mut Command) -> serde_json::Value {
     serde_json::from_slice(&out).unwrap()
 }
 
-const PREDICT_KEYS: [&str; 13] = [
+const PREDICT_KEYS: [&str; 18] = [
     "slope_deg",
     "k_n",
     "k_s",
     "regime",
+    "cause",
     "d_n_m",
     "level_step_m",
     "d_s_m",
@@ -30,7 +31,11 @@ const PREDICT_KEYS: [&str; 13] = [
     "propulsion_m",
     "step_m",
     "speed_m_s",
+    "model_speed_m_s",
     "k_s_margin",
+    "critical_k_s_progress",
+    "critical_k_s_robust",
+    "extrapolated",
 ];
 
 fn keys(v: &serde_json::Value) -> Vec<String> {

@@ -2,7 +2,7 @@
 //!
 //! Whether, how fast and why a C-legged robot climbs a sand slope: the shear-anchoring model of
 //! Liao and Qian, "Failure Mechanisms and Risk Estimation for Legged Robot Locomotion on
-//! Granular Slopes" (arXiv:2603.06928), implemented exactly as the project's `MODEL.md`
+//! Granular Slopes" (arXiv:2603.06928), implemented exactly as the repository's `docs/model.md`
 //! specifies, with the analysis around it.
 //!
 //! Slope weakens the sand's shear strength `k_s`, so each leg must dig deeper (to the
@@ -40,6 +40,7 @@ pub mod plan;
 pub mod regime;
 pub mod risk;
 pub mod robot;
+pub mod scenario;
 pub mod slope;
 pub mod terrain;
 
@@ -56,5 +57,6 @@ pub use risk::{
     regime_probabilities, RegimeProbabilities, RiskCurve, RiskMap, SafeLimit, UncertainTerrain, Uncertainty,
 };
 pub use robot::{Robot, RobotSpec};
+pub use scenario::{Scenario, SlopeEvaluation};
 pub use slope::Slope;
-pub use terrain::{Ground, Terrain, TerrainPoint, TerrainSample, TerrainSpec};
+pub use terrain::{Ground, Terrain, TerrainPoint, TerrainSpec};

@@ -471,7 +471,7 @@ impl PhasePanel {
     ) -> Result<PhasePanel, ParamError> {
         let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
         let map = PhaseMap::compute(robot, slope, terrain.repose(), k_n_axis, k_s_axis, row_done);
-        let g: Ground = terrain.sample(slope).ground;
+        let g: Ground = terrain.at(slope);
         Ok(PhasePanel {
             slope_deg,
             mass_kg: robot.mass(),

@@ -77,6 +77,26 @@ impl Cause {
         }
     }
 
+    /// The snake_case name used in files and JSON (`at_or_above_repose`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Cause::NormalSinkage => "normal_sinkage",
+            Cause::AtOrAboveRepose => "at_or_above_repose",
+            Cause::NoAnchoring => "no_anchoring",
+            Cause::NetBackwardStep => "net_backward_step",
+            Cause::ShortStep => "short_step",
+            Cause::RobustStep => "robust_step",
+        }
+    }
+
+    /// Whether the stance model's speed `v = s / (T/2)` means nothing in this case: the legs
+    /// sink (no normal support to walk on) or the slope is at or above the angle of repose
+    /// (the surface itself yields, whatever the legs do). Elsewhere the speed stands, even a
+    /// negative one (a net backward step: the robot loses ground).
+    pub fn rules_out_speed(self) -> bool {
+        matches!(self, Cause::NormalSinkage | Cause::AtOrAboveRepose)
+    }
+
     /// A one-line explanation for users.
     pub fn explain(self) -> &'static str {
         match self {

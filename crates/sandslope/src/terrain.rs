@@ -3,8 +3,10 @@
 //! A terrain is a table of measured points `(slope_deg, k_n, k_s)` with optional standard
 //! deviations, an optional angle of repose and an optional name. Between points values are
 //! interpolated linearly in degrees; below the first point the first point holds; above the
-//! last point the last segment is extended linearly and floored at zero, and the sample says
-//! it was extrapolated so the caller can warn (a MODEL.md choice).
+//! last point the last segment is extended linearly and floored at zero, and
+//! [`Terrain::extrapolates`] says so, so the caller can warn (a docs/model.md §7 choice).
+//! [`Terrain::at`] gives the one "ground at a slope" type, [`Ground`], which is all the model
+//! needs; [`Terrain::sd_at`] gives the table's uncertainty there.
 
 use serde::{Deserialize, Serialize};
 
@@ -71,19 +73,6 @@ impl Ground {
     pub fn beyond_repose(&self, slope: Slope) -> bool {
         self.repose.is_some_and(|r| slope.radians() >= r.radians())
     }
-}
-
-/// The terrain looked up at one slope.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TerrainSample {
-    /// Resistances (and repose) at this slope.
-    pub ground: Ground,
-    /// Interpolated standard deviation of k_n, if the table has them.
-    pub k_n_sd: Option<f64>,
-    /// Interpolated standard deviation of k_s, if the table has them.
-    pub k_s_sd: Option<f64>,
-    /// True when the slope is above the last measured point (values extrapolated).
-    pub extrapolated: bool,
 }
 
 /// A validated terrain table, points sorted by slope. Build it with [`Terrain::new`].
@@ -165,14 +154,13 @@ impl Terrain {
         self.spec.points.iter().all(|p| p.k_n_sd.is_some() && p.k_s_sd.is_some())
     }
 
-    /// The terrain at `slope`, by the interpolation rule of MODEL.md section 7.
-    pub fn sample(&self, slope: Slope) -> TerrainSample {
+    /// The segment of the table that covers `slope` (degrees), the fraction along it, and
+    /// whether the slope lies beyond the last point (extrapolated).
+    fn segment(&self, deg: f64) -> (&TerrainPoint, &TerrainPoint, f64, bool) {
         let pts = &self.spec.points;
-        let deg = slope.degrees();
         let first = &pts[0];
         let last = &pts[pts.len() - 1];
-        // Pick the segment (a, b) and whether we are extrapolating beyond the last point.
-        let (a, b, extrapolated) = if pts.len() == 1 || deg <= first.slope_deg {
+        let (a, b, beyond) = if pts.len() == 1 || deg <= first.slope_deg {
             (first, first, false)
         } else if deg > last.slope_deg {
             (&pts[pts.len() - 2], last, true)
@@ -182,17 +170,32 @@ impl Terrain {
         };
         let frac =
             if b.slope_deg > a.slope_deg { (deg - a.slope_deg) / (b.slope_deg - a.slope_deg) } else { 0.0 };
+        (a, b, frac, beyond && pts.len() > 1)
+    }
+
+    /// The ground at `slope`: k_n and k_s by the interpolation rule of docs/model.md §7, and
+    /// the terrain's angle of repose.
+    pub fn at(&self, slope: Slope) -> Ground {
+        let (a, b, frac, _) = self.segment(slope.degrees());
         let lerp = |x: f64, y: f64| (x + frac * (y - x)).max(0.0);
-        let lerp_opt = |x: Option<f64>, y: Option<f64>| match (x, y) {
-            (Some(x), Some(y)) => Some(lerp(x, y)),
+        Ground { k_n: lerp(a.k_n, b.k_n), k_s: lerp(a.k_s, b.k_s), repose: self.repose }
+    }
+
+    /// The standard deviations `(k_n_sd, k_s_sd)` at `slope`, interpolated like the values;
+    /// each `None` where the table does not give it at both ends of the segment.
+    pub fn sd_at(&self, slope: Slope) -> (Option<f64>, Option<f64>) {
+        let (a, b, frac, _) = self.segment(slope.degrees());
+        let lerp = |x: Option<f64>, y: Option<f64>| match (x, y) {
+            (Some(x), Some(y)) => Some((x + frac * (y - x)).max(0.0)),
             _ => None,
         };
-        TerrainSample {
-            ground: Ground { k_n: lerp(a.k_n, b.k_n), k_s: lerp(a.k_s, b.k_s), repose: self.repose },
-            k_n_sd: lerp_opt(a.k_n_sd, b.k_n_sd),
-            k_s_sd: lerp_opt(a.k_s_sd, b.k_s_sd),
-            extrapolated: extrapolated && pts.len() > 1,
-        }
+        (lerp(a.k_n_sd, b.k_n_sd), lerp(a.k_s_sd, b.k_s_sd))
+    }
+
+    /// Whether `slope` lies above the last measured point, where [`Terrain::at`] extrapolates
+    /// the last segment (docs/model.md §7); never for a one-point table.
+    pub fn extrapolates(&self, slope: Slope) -> bool {
+        self.segment(slope.degrees()).3
     }
 }
 
@@ -213,18 +216,19 @@ mod tests {
         .unwrap()
     }
 
-    fn at(t: &Terrain, deg: f64) -> TerrainSample {
-        t.sample(Slope::from_degrees(deg).unwrap())
+    fn at(t: &Terrain, deg: f64) -> (Ground, bool) {
+        let s = Slope::from_degrees(deg).unwrap();
+        (t.at(s), t.extrapolates(s))
     }
 
     #[test]
     fn interpolates_linearly_in_degrees() {
         let t = two_point();
         // Halfway: (2e6 + 1e6)/2 and (7e5 + 6e5)/2.
-        let s = at(&t, 10.0);
-        assert!((s.ground.k_s - 1.5e6).abs() < 1e-6);
-        assert!((s.ground.k_n - 6.5e5).abs() < 1e-6);
-        assert!(!s.extrapolated);
+        let (g, extrapolated) = at(&t, 10.0);
+        assert!((g.k_s - 1.5e6).abs() < 1e-6);
+        assert!((g.k_n - 6.5e5).abs() < 1e-6);
+        assert!(!extrapolated);
     }
 
     #[test]
@@ -235,21 +239,36 @@ mod tests {
             points: vec![pt(5.0, 7e5, 2e6), pt(15.0, 7e5, 1e6)],
         })
         .unwrap();
-        assert_eq!(at(&t, 0.0).ground.k_s, 2e6);
+        assert_eq!(at(&t, 0.0).0.k_s, 2e6);
         // Slope of -1e5 per degree beyond 15: at 20 deg 5e5, flagged.
-        let s = at(&t, 20.0);
-        assert!((s.ground.k_s - 5e5).abs() < 1e-6);
-        assert!(s.extrapolated);
+        let (g, extrapolated) = at(&t, 20.0);
+        assert!((g.k_s - 5e5).abs() < 1e-6);
+        assert!(extrapolated);
         // At 40 deg the line is negative: floored at zero.
-        assert_eq!(at(&t, 40.0).ground.k_s, 0.0);
+        assert_eq!(at(&t, 40.0).0.k_s, 0.0);
+    }
+
+    #[test]
+    fn standard_deviations_interpolate_like_values_and_need_both_ends() {
+        let sd = |slope_deg, k_n_sd, k_s_sd| TerrainPoint { k_n_sd, k_s_sd, ..pt(slope_deg, 7e5, 2e6) };
+        let t = Terrain::new(TerrainSpec {
+            name: None,
+            repose_deg: None,
+            points: vec![sd(0.0, Some(1e4), Some(2e5)), sd(10.0, Some(3e4), None)],
+        })
+        .unwrap();
+        // A quarter of the way: 1e4 + 0.25 * 2e4; k_s_sd missing at one end.
+        let (n, s) = t.sd_at(Slope::from_degrees(2.5).unwrap());
+        assert!((n.unwrap() - 1.5e4).abs() < 1e-9);
+        assert_eq!(s, None);
     }
 
     #[test]
     fn single_point_is_constant() {
         let t = Terrain::constant(7e5, 2e6).unwrap();
         for d in [0.0, 10.0, 60.0] {
-            let s = at(&t, d);
-            assert_eq!((s.ground.k_n, s.ground.k_s, s.extrapolated), (7e5, 2e6, false));
+            let (g, extrapolated) = at(&t, d);
+            assert_eq!((g.k_n, g.k_s, extrapolated), (7e5, 2e6, false));
         }
     }
 

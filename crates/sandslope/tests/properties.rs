@@ -111,17 +111,17 @@ proptest! {
         }).collect();
         let t = Terrain::new(TerrainSpec { name: None, repose_deg: None, points: points.clone() }).unwrap();
         for p in &points {
-            let g = t.sample(Slope::from_degrees(p.slope_deg).unwrap()).ground;
+            let g = t.at(Slope::from_degrees(p.slope_deg).unwrap());
             prop_assert!((g.k_n - p.k_n).abs() <= 1e-9 * p.k_n && (g.k_s - p.k_s).abs() <= 1e-9 * p.k_s);
         }
         let first = &t.points()[0];
         if first.slope_deg > 0.0 {
-            let g = t.sample(Slope::from_degrees(first.slope_deg / 2.0).unwrap()).ground;
+            let g = t.at(Slope::from_degrees(first.slope_deg / 2.0).unwrap());
             prop_assert_eq!((g.k_n, g.k_s), (first.k_n, first.k_s));
         }
         // Between two points the value lies between theirs.
         for w in t.points().windows(2) {
-            let mid = t.sample(Slope::from_degrees(0.5 * (w[0].slope_deg + w[1].slope_deg)).unwrap()).ground;
+            let mid = t.at(Slope::from_degrees(0.5 * (w[0].slope_deg + w[1].slope_deg)).unwrap());
             prop_assert!((mid.k_s - 0.5 * (w[0].k_s + w[1].k_s)).abs() <= 1e-9 * w[0].k_s.max(w[1].k_s));
         }
     }

@@ -136,7 +136,7 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         .iter()
         .map(|&d| Slope::from_signed_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--slope"))))
         .collect::<Result<Vec<Slope>>>()?;
-    let samples: Vec<_> = slopes.iter().map(|&s| terrain.sample(s)).collect();
+    let grounds: Vec<_> = slopes.iter().map(|&s| terrain.at(s)).collect();
     let extrapolated = beyond_last_point(&terrain, &args.slope);
     if !extrapolated.is_empty() {
         warn_extrapolated(&terrain, &extrapolated);
@@ -145,7 +145,7 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         Some(t) => parse_axis("--k-n", t)?,
         None => default_axis(
             "--k-n",
-            &samples.iter().map(|s| s.ground.k_n).collect::<Vec<_>>(),
+            &grounds.iter().map(|g| g.k_n).collect::<Vec<_>>(),
             100.0,
             100.0,
             DEFAULT_POINTS,
@@ -155,7 +155,7 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         Some(t) => parse_axis("--k-s", t)?,
         None => default_axis(
             "--k-s",
-            &samples.iter().map(|s| s.ground.k_s).collect::<Vec<_>>(),
+            &grounds.iter().map(|g| g.k_s).collect::<Vec<_>>(),
             1000.0,
             100.0,
             DEFAULT_POINTS,

@@ -1,15 +1,16 @@
 //! `sandslope predict`: every model quantity for one robot, terrain and slope.
 
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use clap::Args;
 
-use crate::args::{warn_extrapolated, OverrideArgs, PredictionRecord, RobotArgs, Scenario, TerrainArgs};
-use crate::output::{csv_string, num, print_json, sci, table, Format, FormatArgs};
+use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
+use crate::output::{csv_string, num, print_json, ruled_out_note, sci, speed_cell, table, Format, FormatArgs};
 
 /// Arguments of `sandslope predict`.
 #[derive(Debug, Args)]
 pub struct PredictArgs {
-    /// Slope along the direction of travel, degrees (negative: descending, evaluated as |slope|).
+    /// Slope along the direction of travel, degrees (negative: descending, evaluated as |slope|,
+    /// docs/model.md §8).
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     pub slope: f64,
     #[command(flatten)]
@@ -24,23 +25,22 @@ pub struct PredictArgs {
 
 /// Runs `sandslope predict`.
 pub fn run(args: PredictArgs) -> Result<()> {
-    let scenario = Scenario::load(&args.robot, &args.terrain, &args.over)?;
-    let e = scenario.evaluate(args.slope)?;
+    let scenario = args.over.scenario(&args.robot, &args.terrain)?;
+    let e = scenario.evaluate(args.slope).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
     if e.extrapolated {
-        warn_extrapolated(&scenario.terrain, &[args.slope]);
+        warn_extrapolated(scenario.terrain(), &[args.slope]);
     }
     if args.slope < 0.0 {
         eprintln!(
-            "note: descending {} deg is evaluated as climbing {} deg (MODEL.md section 8)",
+            "note: descending {} deg is evaluated as climbing {} deg (docs/model.md §8)",
             -args.slope,
             args.slope.abs()
         );
     }
-    let record = PredictionRecord::from(&e);
     match args.format.format() {
-        Format::Json => print_json(&record),
+        Format::Json => print_json(&e),
         Format::Csv => {
-            print!("{}", csv_string(&[record])?);
+            print!("{}", csv_string(&[&e])?);
             Ok(())
         }
         Format::Table => {
@@ -59,7 +59,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
                 ["backward slip s1".into(), mm(p.slip), "mm".into()],
                 ["propulsion s2".into(), mm(p.propulsion), "mm".into()],
                 ["net step s".into(), mm(p.step), "mm".into()],
-                ["speed v".into(), num(p.speed.map(|v| v * 100.0), 2), "cm/s".into()],
+                ["speed v".into(), speed_cell(&e), "cm/s".into()],
                 ["critical k_s for progress (s > 0)".into(), crit(&e.critical_progress), "N/m^3".into()],
                 [
                     "critical k_s for robust progress (s >= s_min)".into(),
@@ -68,12 +68,16 @@ pub fn run(args: PredictArgs) -> Result<()> {
                 ],
                 ["k_s margin (k_s / critical k_s for progress)".into(), num(e.k_s_margin, 2), "".into()],
                 ["regime".into(), p.regime.name().into(), "".into()],
+                ["cause".into(), p.cause.name().into(), "".into()],
             ];
             for r in rows {
                 t.add_row(r);
             }
             println!("{t}");
             println!("{}: {}", p.regime, p.cause.explain());
+            if e.speed_ruled_out() {
+                println!("{}", ruled_out_note());
+            }
             for (what, c) in [("progress", &e.critical_progress), ("robust progress", &e.critical_robust)] {
                 if let Err(why) = c {
                     println!("{what}: {why}");

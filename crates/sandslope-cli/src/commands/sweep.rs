@@ -2,14 +2,14 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::{anyhow, Result};
 use clap::Args;
 
-use crate::args::check_positive;
-use crate::args::{warn_extrapolated, OverrideArgs, PredictionRecord, RobotArgs, Scenario, TerrainArgs};
+use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::figures;
 use crate::figures::sweep::SweepFigure;
-use crate::output::{csv_string, num, print_json, table, Format, FormatArgs};
+use crate::output::{csv_string, num, print_json, ruled_out_note, speed_cell, table, Format, FormatArgs};
+use sandslope::scenario::slope_range;
 use sandslope_io::load_speeds;
 
 /// Most slopes a sweep evaluates (a guard against `--step 1e-9`).
@@ -43,43 +43,37 @@ pub struct SweepArgs {
     pub format: FormatArgs,
 }
 
-/// The slopes `from, from + step, ..., <= to` (with a tolerance so `to` is not lost to rounding).
-pub fn slope_range(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
-    check_positive("--step", step)?;
-    if !(from.is_finite() && to.is_finite()) || from > to {
-        bail!("--from = {from} must not exceed --to = {to}");
-    }
-    let n = ((to - from) / step + 1e-9).floor();
-    if n >= MAX_SLOPES as f64 {
-        bail!("--from {from} --to {to} --step {step} gives {n} slopes; at most {MAX_SLOPES} are allowed");
-    }
-    Ok((0..=n as usize).map(|i| from + i as f64 * step).collect())
+/// The slopes `from, from + step, ..., <= to`, with the library's keys renamed to the flags.
+fn slopes(args: &SweepArgs) -> Result<Vec<f64>> {
+    slope_range(args.from, args.to, args.step, MAX_SLOPES).map_err(|e| {
+        let flag = format!("--{}", e.key);
+        anyhow!("{}", e.renamed(flag))
+    })
 }
 
 /// Runs `sandslope sweep`.
 pub fn run(args: SweepArgs) -> Result<()> {
-    let slopes = slope_range(args.from, args.to, args.step)?;
-    let scenario = Scenario::load(&args.robot, &args.terrain, &args.over)?;
-    let evals = slopes.iter().map(|&s| scenario.evaluate(s)).collect::<Result<Vec<_>>>()?;
+    let slopes = slopes(&args)?;
+    let scenario = args.over.scenario(&args.robot, &args.terrain)?;
+    let evals = scenario.sweep(&slopes).map_err(|e| anyhow!("{}", e.renamed("--from/--to")))?;
     let observed = args.observed.as_deref().map(load_speeds).transpose()?;
     let extrapolated: Vec<f64> = evals.iter().filter(|e| e.extrapolated).map(|e| e.slope_deg).collect();
     if !extrapolated.is_empty() {
-        warn_extrapolated(&scenario.terrain, &extrapolated);
+        warn_extrapolated(scenario.terrain(), &extrapolated);
     }
     if let Some(path) = &args.plot {
         let observed = observed.as_deref().unwrap_or(&[]);
         let figure = SweepFigure {
             evals: &evals,
             observed,
-            min_step_m: scenario.robot.min_step(),
-            repose_deg: scenario.terrain.repose().map(|r| r.degrees()),
+            min_step_m: scenario.robot().min_step(),
+            repose_deg: scenario.terrain().repose().map(|r| r.degrees()),
         };
         figures::save(path, &figure)?;
     }
-    let records: Vec<PredictionRecord> = evals.iter().map(PredictionRecord::from).collect();
     match args.format.format() {
-        Format::Json => print_json(&records)?,
-        Format::Csv => print!("{}", csv_string(&records)?),
+        Format::Json => print_json(&evals)?,
+        Format::Csv => print!("{}", csv_string(&evals)?),
         Format::Table => {
             let mut t = table(&[
                 "slope deg",
@@ -90,6 +84,7 @@ pub fn run(args: SweepArgs) -> Result<()> {
                 "step mm",
                 "speed cm/s",
                 "regime",
+                "cause",
             ]);
             for e in &evals {
                 let p = &e.prediction;
@@ -100,11 +95,15 @@ pub fn run(args: SweepArgs) -> Result<()> {
                     num(p.anchoring_time.map(|t| t * 1e3), 1),
                     num(p.slip.map(|s| s * 1e3), 2),
                     num(p.step.map(|s| s * 1e3), 2),
-                    num(p.speed.map(|v| v * 100.0), 2),
+                    speed_cell(e),
                     p.regime.name().to_string(),
+                    p.cause.name().to_string(),
                 ]);
             }
             println!("{t}");
+            if evals.iter().any(|e| e.speed_ruled_out()) {
+                println!("{}", ruled_out_note());
+            }
         }
     }
     if let Some(path) = &args.plot {
@@ -115,14 +114,24 @@ pub fn run(args: SweepArgs) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::slope_range;
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        sweep: SweepArgs,
+    }
 
     #[test]
-    fn range_includes_end_despite_rounding() {
-        assert_eq!(slope_range(0.0, 1.0, 0.1).unwrap().len(), 11);
-        assert_eq!(slope_range(0.0, 30.0, 5.0).unwrap(), vec![0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0]);
-        assert!(slope_range(10.0, 0.0, 1.0).is_err());
-        assert!(slope_range(0.0, 10.0, 0.0).is_err());
-        assert!(slope_range(0.0, 10.0, 1e-9).is_err());
+    fn range_errors_name_the_flags() {
+        let parse = |a: &[&str]| Cli::parse_from([&["x"], a].concat()).sweep;
+        let msg = slopes(&parse(&["--from", "10", "--to", "0"])).unwrap_err().to_string();
+        assert!(msg.starts_with("--from = 10"), "{msg}");
+        let msg = slopes(&parse(&["--step", "-1"])).unwrap_err().to_string();
+        assert!(msg.starts_with("--step = -1"), "{msg}");
+        let msg = slopes(&parse(&["--step", "1e-9"])).unwrap_err().to_string();
+        assert!(msg.starts_with("--step = 0.000000001") && msg.contains("100000"), "{msg}");
+        assert_eq!(slopes(&parse(&["--from", "-5", "--to", "5", "--step", "5"])).unwrap(), vec![-5.0, 0.0, 5.0]);
     }
 }

@@ -8,12 +8,12 @@ use plotters::prelude::*;
 use sandslope::SpeedObservation;
 
 use super::{font, Figure};
-use crate::args::Evaluation;
+use sandslope::SlopeEvaluation;
 use crate::error::plot_err;
 
 /// Speed, anchoring time and step length against slope, stacked in three panels.
 pub struct SweepFigure<'a> {
-    pub evals: &'a [Evaluation],
+    pub evals: &'a [SlopeEvaluation],
     pub observed: &'a [SpeedObservation],
     pub min_step_m: f64,
     pub repose_deg: Option<f64>,

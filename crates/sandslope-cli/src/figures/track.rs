@@ -52,7 +52,7 @@ impl TrackFigure {
             for k in 0..=400 {
                 let deg = (top + 2.0).min(89.0) * k as f64 / 400.0;
                 let Ok(s) = Slope::from_degrees(deg) else { continue };
-                match predict(robot, s, &terrain.sample(s).ground).speed {
+                match predict(robot, s, &terrain.at(s)).speed {
                     Some(v) => piece.push((deg, v * 100.0)),
                     None if !piece.is_empty() => model.push(std::mem::take(&mut piece)),
                     None => {}

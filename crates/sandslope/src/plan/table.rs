@@ -46,7 +46,7 @@ impl PitchTable {
             .into_par_iter()
             .map(|i| {
                 let slope = slope_of((i as f64 * TAN_STEP).atan().to_degrees());
-                let p = predict(robot, slope, &class.terrain().sample(slope).ground);
+                let p = predict(robot, slope, &class.terrain().at(slope));
                 (p.regime, p.speed.map_or(f32::NAN, |v| v as f32))
             })
             .collect();

@@ -234,7 +234,7 @@ mod tests {
         assert_eq!(p_fail, 0.0);
         let regime = |d: f64| {
             let s = slope(d);
-            predict(&r, s, &t.terrain().sample(s).ground).regime
+            predict(&r, s, &t.terrain().at(s)).regime
         };
         assert!(!regime(value - 0.01).is_failure() && regime(value + 0.01).is_failure(), "limit {value}");
     }

@@ -177,8 +177,8 @@ impl UncertainTerrain {
 
     /// The medians, CVs and their sources at `slope`.
     pub fn sample(&self, slope: Slope) -> UncertainGround {
-        let sample = self.terrain.sample(slope);
-        let ground = sample.ground;
+        let ground = self.terrain.at(slope);
+        let (k_n_sd, k_s_sd) = self.terrain.sd_at(slope);
         let pick = |given: Option<f64>, sd: Option<f64>, k: f64, default: f64| match (given, sd) {
             (Some(cv), _) => (cv, CvSource::Given),
             (None, Some(sd)) if k > 0.0 && (sd / k).is_finite() => (sd / k, CvSource::Table),
@@ -186,8 +186,8 @@ impl UncertainTerrain {
             (None, Some(_)) => (0.0, CvSource::Table),
             (None, None) => (default, CvSource::Default),
         };
-        let (cv_n, cv_n_source) = pick(self.cv_n, sample.k_n_sd, ground.k_n, DEFAULT_CV_N);
-        let (cv_s, cv_s_source) = pick(self.cv_s, sample.k_s_sd, ground.k_s, DEFAULT_CV_S);
+        let (cv_n, cv_n_source) = pick(self.cv_n, k_n_sd, ground.k_n, DEFAULT_CV_N);
+        let (cv_s, cv_s_source) = pick(self.cv_s, k_s_sd, ground.k_s, DEFAULT_CV_S);
         UncertainGround { ground, uncertainty: Uncertainty { cv_n, cv_s }, cv_n_source, cv_s_source }
     }
 

@@ -158,8 +158,8 @@ fn both_motive_versions_vicon_and_plain_recover_the_profile() {
         assert!(
             (u[0].as_f64().unwrap() - up[0]).abs() < 5e-3 && (u[2].as_f64().unwrap() - up[2]).abs() < 5e-3
         );
-        let phase = v["recordings"][0]["touchdown_phase_s"].as_f64().unwrap();
-        assert!((phase - 0.2).abs() < 1.0 / 120.0, "phase {phase}");
+        let offset = v["recordings"][0]["touchdown_offset_s"].as_f64().unwrap();
+        assert!((offset - 0.2).abs() < 1.0 / 120.0, "offset {offset}");
         assert_eq!(v["per_step"].as_array().unwrap().len(), v["steps"].as_u64().unwrap() as usize);
     }
     // The Motive 1.25 file says its capture rate was 240: the export rate (120) is used.
@@ -182,7 +182,7 @@ fn touchdown_file_and_explicit_upslope() {
     let td = write(dir.path(), "td.txt", &format!("# controller log\n{times}"));
     let v = track(&[f.to_str().unwrap(), "--touchdowns", td.to_str().unwrap(), "--upslope", "-z"]);
     assert_eq!(v["upslope_estimated"], false);
-    assert_eq!(v["recordings"][0]["touchdowns"], "file");
+    assert_eq!(v["recordings"][0]["touchdowns"], "given");
     // With the true touchdowns only the noise and the filter's rounding of the minimum
     // remain: t1 within 6 ms, slip within 10%.
     assert!((v["t1_s"].as_f64().unwrap() - 0.12).abs() < 0.006);

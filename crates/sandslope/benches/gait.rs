@@ -1,6 +1,6 @@
 //! One hour of motion capture at 120 frames/s (432,000 frames) through the whole tracking
 //! pipeline (`sandslope::gait::analyse`: direction estimate, projection, gap handling,
-//! zero-phase low pass and differentiation, touchdown phase, 7,200 steps, stride curve).
+//! zero-phase low pass and differentiation, touchdown offset, 7,200 steps, stride curve).
 //! Target: well under a second in release mode. Run: `cargo bench -p sandslope --bench gait`.
 
 use criterion::{criterion_group, criterion_main, Criterion};

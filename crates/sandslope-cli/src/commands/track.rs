@@ -1,5 +1,5 @@
 //! `sandslope track`: speed, anchoring time and slip from motion-capture recordings
-//! (MODEL.md section 11), pooled over the files given for one slope; optionally appends the
+//! (docs/model.md §11), pooled over the files given for one slope; optionally appends the
 //! mean speed to a speeds file for `sandslope calibrate` and draws the paper's Fig. 3b (and
 //! Fig. 3a once the speeds file holds several slopes).
 
@@ -10,9 +10,10 @@ use clap::Args;
 use serde::Serialize;
 
 use sandslope::gait::{
-    analyse, GaitAnalysis, GaitOptions, Recording, Stats, Upslope, DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP,
+    track, GaitOptions, Recording, RecordingSummary, TouchdownSource, TrackResult, Upslope, DEFAULT_CUTOFF_HZ,
+    DEFAULT_MAX_GAP,
 };
-use sandslope::Slope;
+use sandslope::{Scenario, Slope};
 
 use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
@@ -139,10 +140,10 @@ fn load_touchdowns(path: &Path) -> Result<Vec<f64>> {
     Ok(times)
 }
 
-/// One step as printed (JSON `per_step`, `--csv`).
+/// One step as printed by `--csv`: the library's row with its file instead of its index.
 #[derive(Debug, Clone, Serialize)]
-struct StepRecord {
-    file: String,
+struct StepRecord<'a> {
+    file: &'a str,
     touchdown_s: f64,
     t1_s: Option<f64>,
     slip_m: Option<f64>,
@@ -150,116 +151,44 @@ struct StepRecord {
     speed_m_s: f64,
 }
 
-/// One recording as printed.
+/// One recording as printed: where it came from, then the library's summary.
 #[derive(Debug, Clone, Serialize)]
-struct RecordingRecord {
-    file: String,
+struct RecordingRecord<'a> {
+    file: &'a str,
     format: &'static str,
-    body: String,
-    frame_rate_hz: f64,
-    frames: usize,
-    segments: usize,
-    interpolated_frames: usize,
-    dropped_frames: usize,
-    steps: usize,
-    touchdowns: &'static str,
-    touchdown_phase_s: Option<f64>,
+    body: &'a str,
+    #[serde(flatten)]
+    summary: &'a RecordingSummary,
 }
 
-/// The whole result as printed by `--json`.
-#[derive(Debug, Clone, Serialize)]
-struct TrackRecord {
-    slope_deg: Option<f64>,
-    speed_m_s: f64,
-    speed_sd_m_s: Option<f64>,
-    t1_s: Option<f64>,
-    t1_sd_s: Option<f64>,
-    slip_m: Option<f64>,
-    slip_sd_m: Option<f64>,
-    step_m: f64,
-    step_sd_m: Option<f64>,
-    steps: usize,
-    unanchored_steps: usize,
-    period_s: f64,
-    upslope: [f64; 3],
-    upslope_estimated: bool,
-    cutoff_hz: f64,
-    max_gap_frames: usize,
-    segments: usize,
-    interpolated_frames: usize,
-    dropped_frames: usize,
-    recordings: Vec<RecordingRecord>,
-    per_step: Vec<StepRecord>,
-}
-
-fn mean_sd(s: Option<Stats>) -> (Option<f64>, Option<f64>) {
-    (s.map(|s| s.mean), s.and_then(|s| s.sd))
-}
-
-fn record(
-    captures: &[Capture],
-    a: &GaitAnalysis,
-    period: f64,
-    options: &GaitOptions,
-    slope: Option<f64>,
-) -> TrackRecord {
-    let s = &a.summary;
-    let (t1, t1_sd) = mean_sd(s.anchoring_time);
-    let (slip, slip_sd) = mean_sd(s.slip);
+/// The result as printed by `--json`: the library's value, with each recording's file,
+/// format and body, and each step's file.
+fn json_value(captures: &[Capture], files: &[String], r: &TrackResult) -> Result<serde_json::Value> {
+    let mut v = serde_json::to_value(r)?;
     let recordings: Vec<RecordingRecord> = captures
         .iter()
-        .zip(&a.recordings)
-        .map(|(c, r)| RecordingRecord {
-            file: c.path.display().to_string(),
-            format: c.format.name(),
-            body: c.body.clone(),
-            frame_rate_hz: c.frame_rate_hz,
-            frames: c.positions.len(),
-            segments: r.tracks.len(),
-            interpolated_frames: r.interpolated_frames,
-            dropped_frames: r.dropped_frames,
-            steps: r.steps.len(),
-            touchdowns: if r.phase.is_some() || r.steps.is_empty() { "estimated" } else { "file" },
-            touchdown_phase_s: r.phase.map(|p| p.phase_s),
-        })
+        .zip(files)
+        .zip(&r.recordings)
+        .map(|((c, f), summary)| RecordingRecord { file: f, format: c.format.name(), body: &c.body, summary })
         .collect();
-    let per_step = captures
+    v["recordings"] = serde_json::to_value(recordings)?;
+    v["per_step"] = serde_json::to_value(step_records(files, r))?;
+    Ok(v)
+}
+
+/// Every step with its file instead of its recording's index.
+fn step_records<'a>(files: &'a [String], r: &TrackResult) -> Vec<StepRecord<'a>> {
+    r.per_step
         .iter()
-        .zip(&a.recordings)
-        .flat_map(|(c, r)| {
-            r.steps.iter().map(move |st| StepRecord {
-                file: c.path.display().to_string(),
-                touchdown_s: st.touchdown_s,
-                t1_s: st.anchoring_time_s,
-                slip_m: st.slip_m,
-                step_m: st.step_m,
-                speed_m_s: st.speed_m_s,
-            })
+        .map(|st| StepRecord {
+            file: &files[st.recording],
+            touchdown_s: st.touchdown_s,
+            t1_s: st.t1_s,
+            slip_m: st.slip_m,
+            step_m: st.step_m,
+            speed_m_s: st.speed_m_s,
         })
-        .collect();
-    TrackRecord {
-        slope_deg: slope,
-        speed_m_s: s.speed.mean,
-        speed_sd_m_s: s.speed.sd,
-        t1_s: t1,
-        t1_sd_s: t1_sd,
-        slip_m: slip,
-        slip_sd_m: slip_sd,
-        step_m: s.step.mean,
-        step_sd_m: s.step.sd,
-        steps: s.speed.n,
-        unanchored_steps: s.unanchored_steps,
-        period_s: period,
-        upslope: a.upslope.vector(),
-        upslope_estimated: a.upslope_estimated,
-        cutoff_hz: options.cutoff(),
-        max_gap_frames: options.max_gap(),
-        segments: a.recordings.iter().map(|r| r.tracks.len()).sum(),
-        interpolated_frames: a.recordings.iter().map(|r| r.interpolated_frames).sum(),
-        dropped_frames: a.recordings.iter().map(|r| r.dropped_frames).sum(),
-        recordings,
-        per_step,
-    }
+        .collect()
 }
 
 /// Appends one row to a speeds file (creating it with its header), atomically, after checking
@@ -334,7 +263,8 @@ pub fn run(args: TrackArgs) -> Result<()> {
             touchdowns_s: touchdowns.get(i).map(|t| t.as_slice()),
         })
         .collect();
-    let analysis = analyse(&recordings, &options).map_err(|e| match e {
+    let slope_arg = slope.map(|d| Slope::from_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--slope")))).transpose()?;
+    let result = track(&recordings, &options, slope_arg).map_err(|e| match e {
         sandslope::GaitError::Param { index, source } => {
             let source = if source.key == "cutoff_hz" { source.renamed("--cutoff") } else { source };
             anyhow!(
@@ -345,60 +275,66 @@ pub fn run(args: TrackArgs) -> Result<()> {
         }
         other => anyhow!("{other}"),
     })?;
-    for (c, r) in captures.iter().zip(&analysis.recordings) {
-        if r.steps.is_empty() {
-            eprintln!(
-                "warning: {}: no complete step (T/2 = {} s without a gap longer than {} frames); not used",
-                c.path.display(),
-                options.step_duration(),
-                options.max_gap()
-            );
-        }
+    let names: Vec<String> = captures.iter().map(|c| c.path.display().to_string()).collect();
+    for i in result.recordings_without_steps() {
+        eprintln!(
+            "warning: {}: no complete step (T/2 = {} s without a gap longer than {} frames); not used",
+            names[i],
+            options.step_duration(),
+            options.max_gap()
+        );
     }
-    let rec = record(&captures, &analysis, period, &options, slope);
 
     let mut campaign = None;
     if let (Some(path), Some(slope_deg)) = (&args.speeds_out, slope) {
-        let sd = match rec.speed_sd_m_s {
+        let sd = match result.speed_sd_m_s {
             Some(sd) if sd > 0.0 => sd,
             _ => bail!(
                 "cannot append to {}: the speed SD needs at least two steps with different speeds (found {} steps)",
                 path.display(),
-                rec.steps
+                result.steps
             ),
         };
-        Slope::from_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
-        let rows = append_speed(path, SpeedRow { slope_deg, speed_m_s: rec.speed_m_s, speed_sd_m_s: sd })
+        let rows = append_speed(path, SpeedRow { slope_deg, speed_m_s: result.speed_m_s, speed_sd_m_s: sd })
             .with_context(|| format!("appending to {}", path.display()))?;
         campaign = Some(rows);
     }
     if let Some(path) = &args.plot {
-        let terrain = args.terrain.load()?;
         let overlay = campaign.filter(|rows| {
             let mut s: Vec<f64> = rows.iter().map(|r| r.slope_deg).collect();
             s.sort_by(f64::total_cmp);
             s.dedup();
             s.len() >= 2
         });
-        let fig =
-            crate::figures::track::TrackFigure::new(&analysis, period, slope, overlay, &robot, &terrain);
+        // The model's speed against slope beside a campaign (Fig. 3a), from the library.
+        let model = match &overlay {
+            Some(rows) => {
+                let top = rows.iter().map(|r| r.slope_deg).fold(0.0, f64::max);
+                let scenario = Scenario::new(robot.clone(), args.terrain.load()?, None, None)
+                    .map_err(|e| anyhow!("{e}"))?;
+                let slopes: Vec<f64> = (0..=400).map(|k| (top + 2.0).min(89.0) * k as f64 / 400.0).collect();
+                scenario.sweep(&slopes).map_err(|e| anyhow!("{e}"))?
+            }
+            None => Vec::new(),
+        };
+        let fig = crate::figures::track::TrackFigure::new(&result, overlay, &model);
         crate::figures::save(path, &fig)?;
     }
 
     match args.format_args.format() {
-        Format::Json => print_json(&rec),
+        Format::Json => print_json(&json_value(&captures, &names, &result)?),
         Format::Csv => {
-            print!("{}", csv_string(&rec.per_step)?);
+            print!("{}", csv_string(&step_records(&names, &result))?);
             Ok(())
         }
         Format::Table => {
-            print_table(&rec);
+            print_table(&result, &captures, &names);
             Ok(())
         }
     }
 }
 
-fn print_table(r: &TrackRecord) {
+fn print_table(r: &TrackResult, captures: &[Capture], names: &[String]) {
     let pm = |m: Option<f64>, sd: Option<f64>, scale: f64, d: usize| match (m, sd) {
         (Some(m), Some(sd)) => format!("{:.d$} ± {:.d$}", m * scale, sd * scale),
         (Some(m), None) => format!("{:.d$}", m * scale),
@@ -432,23 +368,44 @@ fn print_table(r: &TrackRecord) {
         "interp.",
         "dropped",
         "steps",
-        "touchdown phase",
+        "touchdown offset",
     ]);
-    for rec in &r.recordings {
+    for ((rec, c), name) in r.recordings.iter().zip(captures).zip(names) {
         f.add_row([
-            rec.file.clone(),
-            rec.body.clone(),
-            format!("{}", rec.frame_rate_hz),
+            name.clone(),
+            c.body.clone(),
+            fps(rec.frame_rate_hz),
             rec.frames.to_string(),
             rec.segments.to_string(),
             rec.interpolated_frames.to_string(),
             rec.dropped_frames.to_string(),
             rec.steps.to_string(),
-            match rec.touchdown_phase_s {
-                Some(p) => format!("{:.1} ms (estimated)", p * 1e3),
-                None => rec.touchdowns.into(),
+            match (rec.touchdown_offset_s, rec.touchdowns) {
+                (Some(p), _) => format!("{:.1} ms (estimated)", p * 1e3),
+                (None, TouchdownSource::Given) => "given (--touchdowns)".into(),
+                (None, TouchdownSource::Estimated) => "none found".into(),
             },
         ]);
     }
     println!("{f}");
+}
+
+/// A frame rate for people: whole numbers as such, otherwise three decimals (Motive writes
+/// 119.99999666435033 for a 120 Hz capture).
+fn fps(hz: f64) -> String {
+    let s = format!("{hz:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fps;
+
+    #[test]
+    fn frame_rates_are_rounded_for_people() {
+        assert_eq!(fps(119.999_996_664_350_33), "120");
+        assert_eq!(fps(100.0), "100");
+        assert_eq!(fps(59.94), "59.94");
+        assert_eq!(fps(29.970_03), "29.97");
+    }
 }

@@ -5,8 +5,8 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use sandslope::gait::GaitAnalysis;
-use sandslope::{predict, Robot, Slope, Terrain};
+use sandslope::gait::TrackResult;
+use sandslope::SlopeEvaluation;
 
 use super::{font, range, Figure};
 use crate::error::plot_err;
@@ -26,16 +26,10 @@ pub struct TrackFigure {
 }
 
 impl TrackFigure {
-    /// Prepares the figure; `campaign` (rows of the speeds file) adds the slope panel.
-    pub fn new(
-        a: &GaitAnalysis,
-        period: f64,
-        slope: Option<f64>,
-        campaign: Option<Vec<SpeedRow>>,
-        robot: &Robot,
-        terrain: &Terrain,
-    ) -> TrackFigure {
-        let (time, mean, sd, strides) = match &a.curve {
+    /// Prepares the figure from `track`'s result; `campaign` (rows of the speeds file) adds
+    /// the slope panel, with the model's speeds `model` (a sweep over slope) beside it.
+    pub fn new(r: &TrackResult, campaign: Option<Vec<SpeedRow>>, model: &[SlopeEvaluation]) -> TrackFigure {
+        let (time, mean, sd, strides) = match &r.analysis.curve {
             Some(c) => (
                 c.time_s.clone(),
                 c.mean.iter().map(|v| v * 100.0).collect(),
@@ -45,33 +39,29 @@ impl TrackFigure {
             None => (Vec::new(), Vec::new(), Vec::new(), 0),
         };
         let measured = campaign.unwrap_or_default();
-        let mut model = Vec::new();
-        if !measured.is_empty() {
-            let top = measured.iter().map(|r| r.slope_deg).fold(0.0, f64::max).min(89.0);
-            let mut piece = Vec::new();
-            for k in 0..=400 {
-                let deg = (top + 2.0).min(89.0) * k as f64 / 400.0;
-                let Ok(s) = Slope::from_degrees(deg) else { continue };
-                match predict(robot, s, &terrain.at(s)).speed {
-                    Some(v) => piece.push((deg, v * 100.0)),
-                    None if !piece.is_empty() => model.push(std::mem::take(&mut piece)),
-                    None => {}
-                }
+        // The model curve in pieces, split where the robot makes no speed.
+        let mut pieces = Vec::new();
+        let mut piece = Vec::new();
+        for e in model {
+            match e.speed() {
+                Some(v) => piece.push((e.slope_deg, v * 100.0)),
+                None if !piece.is_empty() => pieces.push(std::mem::take(&mut piece)),
+                None => {}
             }
-            if !piece.is_empty() {
-                model.push(piece);
-            }
+        }
+        if !piece.is_empty() {
+            pieces.push(piece);
         }
         TrackFigure {
             time,
             mean,
             sd,
             strides,
-            period,
-            t1: a.summary.anchoring_time.map(|s| s.mean),
-            slope,
+            period: r.period_s,
+            t1: r.t1_s,
+            slope: r.slope_deg,
             measured,
-            model,
+            model: pieces,
         }
     }
 

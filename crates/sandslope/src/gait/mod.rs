@@ -6,19 +6,22 @@
 //! low-pass and differentiate without phase shift ([`signal`]), place touchdowns every T/2
 //! (given, or estimated from the speed's periodic structure), and measure each step's
 //! anchoring time t1, backward slip, net step and speed ([`steps`]). [`analyse`] runs it all
-//! on several recordings at one slope and pools their steps.
+//! on several recordings at one slope and pools their steps; [`track()`] adds everything the
+//! `track` command reports ([`TrackResult`]).
 
 pub mod direction;
 pub mod signal;
 pub mod steps;
 pub mod synthetic;
+pub mod track;
 
 pub use direction::{principal_direction, project, Upslope};
 pub use signal::{split_at_gaps, LowPass, Segment, Segmentation};
 pub use steps::{
-    estimate_touchdown_phase, measure_step, stride_curve, summarize, touchdowns_in, GaitSummary, PhaseCurve,
-    SmoothTrack, Stats, StepMeasure, TouchdownPhase,
+    estimate_touchdown_offset, measure_step, stride_curve, summarize, touchdowns_in, GaitSummary, StrideCurve,
+    SmoothTrack, Stats, StepMeasure, TouchdownOffset,
 };
+pub use track::{track, RecordingSummary, StepRow, TouchdownSource, TrackResult};
 
 use crate::error::{positive, ParamError};
 
@@ -33,7 +36,7 @@ pub const DEFAULT_CUTOFF_HZ: f64 = 10.0;
 /// a step: linear interpolation over it cannot hide a whole slip phase).
 pub const DEFAULT_MAX_GAP: usize = 10;
 
-/// Points of the stride-phase-averaged curve when the caller has no preference.
+/// Points of the stride-averaged speed curve when the caller has no preference.
 pub const DEFAULT_CURVE_POINTS: usize = 121;
 
 /// How to analyse recordings.
@@ -74,7 +77,7 @@ impl GaitOptions {
         GaitOptions { upslope: Some(upslope), ..self }
     }
 
-    /// Points of the stride-phase-averaged curve (at least 2).
+    /// Points of the stride-averaged speed curve (at least 2).
     pub fn with_curve_points(self, points: usize) -> GaitOptions {
         GaitOptions { curve_points: points.max(2), ..self }
     }
@@ -121,9 +124,9 @@ pub struct RecordingAnalysis {
     pub tracks: Vec<SmoothTrack>,
     /// Touchdowns used in each track.
     pub touchdowns: Vec<Vec<f64>>,
-    /// The estimated touchdown phase (`None` when touchdowns were given or no segment was
+    /// The estimated touchdown offset (`None` when touchdowns were given or no segment was
     /// long enough).
-    pub phase: Option<TouchdownPhase>,
+    pub touchdown_offset: Option<TouchdownOffset>,
     /// Frames filled by interpolation.
     pub interpolated_frames: usize,
     /// Frames not analysed (long gaps, ends, too-short segments).
@@ -143,8 +146,8 @@ pub struct GaitAnalysis {
     pub recordings: Vec<RecordingAnalysis>,
     /// Summary over all steps of all recordings.
     pub summary: GaitSummary,
-    /// Stride-phase-averaged speed (`None` if no whole stride was recorded).
-    pub curve: Option<PhaseCurve>,
+    /// Speed averaged over strides against time since touchdown (`None` if no whole stride was recorded).
+    pub curve: Option<StrideCurve>,
 }
 
 impl GaitAnalysis {
@@ -213,7 +216,7 @@ pub fn analyse(recordings: &[Recording<'_>], options: &GaitOptions) -> Result<Ga
                 }
             })
             .collect();
-        let (phase, touchdowns): (Option<TouchdownPhase>, Vec<Vec<f64>>) = match rec.touchdowns_s {
+        let (touchdown_offset, touchdowns): (Option<TouchdownOffset>, Vec<Vec<f64>>) = match rec.touchdowns_s {
             Some(given) => {
                 let per_track = tracks
                     .iter()
@@ -222,12 +225,12 @@ pub fn analyse(recordings: &[Recording<'_>], options: &GaitOptions) -> Result<Ga
                 (None, per_track)
             }
             None => {
-                let phase = estimate_touchdown_phase(&tracks, step_s);
-                let per_track = match phase {
-                    Some(p) => tracks.iter().map(|t| touchdowns_in(t, p.phase_s, step_s)).collect(),
+                let offset = estimate_touchdown_offset(&tracks, step_s);
+                let per_track = match offset {
+                    Some(p) => tracks.iter().map(|t| touchdowns_in(t, p.offset_s, step_s)).collect(),
                     None => vec![Vec::new(); tracks.len()],
                 };
-                (phase, per_track)
+                (offset, per_track)
             }
         };
         let steps = tracks
@@ -238,7 +241,7 @@ pub fn analyse(recordings: &[Recording<'_>], options: &GaitOptions) -> Result<Ga
         results.push(RecordingAnalysis {
             tracks,
             touchdowns,
-            phase,
+            touchdown_offset,
             interpolated_frames: seg.interpolated_frames,
             dropped_frames: seg.dropped_frames,
             steps,
@@ -254,7 +257,7 @@ pub fn analyse(recordings: &[Recording<'_>], options: &GaitOptions) -> Result<Ga
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::synthetic::StepProfile;
     use super::*;
     use rand::{RngExt, SeedableRng};
@@ -313,7 +316,7 @@ mod tests {
         let s = a.summary;
         assert!((a.upslope.vector()[0] - 0.9).abs() < 5e-3);
         assert!(a.upslope_estimated);
-        assert!((r.phase.unwrap().phase_s - 0.2).abs() < 1.0 / 120.0);
+        assert!((r.touchdown_offset.unwrap().offset_s - 0.2).abs() < 1.0 / 120.0);
         assert_eq!(r.steps.len(), 39);
         assert!((s.speed.mean - profile.mean_speed()).abs() < 1e-3);
         assert!((s.step.mean - profile.step()).abs() < 5e-4);
@@ -335,7 +338,7 @@ mod tests {
         let truth: Vec<f64> = (0..40).map(|k| 0.2 + 0.5 * k as f64).collect();
         let given = Recording { touchdowns_s: Some(&truth), ..rec };
         let b = analyse(&[given], &GaitOptions::new(1.0).unwrap()).unwrap();
-        assert!(b.recordings[0].phase.is_none());
+        assert!(b.recordings[0].touchdown_offset.is_none());
         assert!((b.summary.anchoring_time.unwrap().mean - profile.anchoring_time()).abs() < 0.005);
         assert!((b.summary.slip.unwrap().mean - profile.slip()).abs() < 0.05 * profile.slip());
     }

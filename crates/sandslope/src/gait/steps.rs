@@ -1,6 +1,6 @@
-//! Steps within a smooth track: touchdown phase, anchoring time t1, backward slip, net step
+//! Steps within a smooth track: touchdown offset, anchoring time t1, backward slip, net step
 //! and step speed (MODEL.md section 11), their summary across steps, and the
-//! stride-phase-averaged speed curve (the paper's Fig. 3b).
+//! stride-averaged speed curve (the paper's Fig. 3b).
 
 /// Smoothed along-slope position and speed of one segment, sampled at a constant frame rate.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,16 +54,18 @@ impl SmoothTrack {
     }
 }
 
-/// Touchdown phase estimated from the speed signal's periodic structure.
+/// Where touchdowns fall in the recording's clock (touchdowns every T/2 from an offset),
+/// estimated from the speed signal's periodic structure.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TouchdownPhase {
-    /// Touchdowns happen at `phase_s + k T/2` in the recording's clock, s, in `[0, T/2)`.
-    pub phase_s: f64,
-    /// Minimum of the step-phase-averaged speed, m/s (negative: the robot slips back).
+pub struct TouchdownOffset {
+    /// Touchdowns happen at `offset_s + k T/2` in the recording's clock, s, in `[0, T/2)`.
+    pub offset_s: f64,
+    /// Minimum of the speed averaged over steps (folded at T/2), m/s (negative: the robot
+    /// slips back).
     pub min_mean_speed_m_s: f64,
 }
 
-/// Estimates the touchdown phase by folding the speed of all `tracks` (one recording, one
+/// Estimates the touchdown offset by folding the speed of all `tracks` (one recording, one
 /// clock) at the step period `step_s` (= T/2).
 ///
 /// The folded mean has one minimum per step, at the anchoring time t1. The model (MODEL.md
@@ -74,20 +76,20 @@ pub struct TouchdownPhase {
 /// its minimum; if the mean never turns negative (no slip, as on level sand, where the speed
 /// rises immediately after touchdown) the touchdown is the minimum itself; if it never turns
 /// positive (the robot only slides down), it is the maximum. `None` when the tracks do not
-/// fill every phase bin (less than one step of data).
-pub fn estimate_touchdown_phase(tracks: &[SmoothTrack], step_s: f64) -> Option<TouchdownPhase> {
+/// fill every bin of the folded step (less than one step of data).
+pub fn estimate_touchdown_offset(tracks: &[SmoothTrack], step_s: f64) -> Option<TouchdownOffset> {
     let rate = tracks.first()?.frame_rate_hz;
     let bins = ((step_s * rate).round() as usize).max(8);
     let width = step_s / bins as f64;
     let mut sum = vec![0.0; bins];
-    let mut phase_sum = vec![0.0; bins];
+    let mut offset_sum = vec![0.0; bins];
     let mut count = vec![0usize; bins];
     for track in tracks {
         for (i, &v) in track.speed.iter().enumerate() {
-            let phase = track.time(i).rem_euclid(step_s);
-            let b = ((phase / width) as usize).min(bins - 1);
+            let within = track.time(i).rem_euclid(step_s);
+            let b = ((within / width) as usize).min(bins - 1);
             sum[b] += v;
-            phase_sum[b] += phase;
+            offset_sum[b] += within;
             count[b] += 1;
         }
     }
@@ -95,9 +97,9 @@ pub fn estimate_touchdown_phase(tracks: &[SmoothTrack], step_s: f64) -> Option<T
         return None;
     }
     let mean: Vec<f64> = sum.iter().zip(&count).map(|(s, &c)| s / c as f64).collect();
-    // Mean phase of the samples in each bin (not the bin centre: at an integer number of
+    // Mean time-within-step of the samples in each bin (not the bin centre: at an integer number of
     // frames per step every sample sits at the same place in its bin).
-    let when: Vec<f64> = phase_sum.iter().zip(&count).map(|(s, &c)| s / c as f64).collect();
+    let when: Vec<f64> = offset_sum.iter().zip(&count).map(|(s, &c)| s / c as f64).collect();
     let wrap = |b: isize| b.rem_euclid(bins as isize) as usize;
     let at = |b: isize| mean[wrap(b)];
     let time_of = |b: isize| when[wrap(b)] + b.div_euclid(bins as isize) as f64 * step_s;
@@ -111,7 +113,7 @@ pub fn estimate_touchdown_phase(tracks: &[SmoothTrack], step_s: f64) -> Option<T
     let argmin = (0..bins).min_by(|&a, &b| mean[a].total_cmp(&mean[b]))?;
     let argmax = (0..bins).max_by(|&a, &b| mean[a].total_cmp(&mean[b]))?;
     let min = mean[argmin];
-    let phase = if min >= 0.0 {
+    let offset = if min >= 0.0 {
         vertex(argmin)
     } else if mean[argmax] <= 0.0 {
         vertex(argmax)
@@ -125,14 +127,14 @@ pub fn estimate_touchdown_phase(tracks: &[SmoothTrack], step_s: f64) -> Option<T
         let (ta, tb) = (time_of(j), time_of(j + 1));
         ta + (tb - ta) * a / (a - b)
     };
-    Some(TouchdownPhase { phase_s: phase.rem_euclid(step_s), min_mean_speed_m_s: min })
+    Some(TouchdownOffset { offset_s: offset.rem_euclid(step_s), min_mean_speed_m_s: min })
 }
 
-/// Touchdown times `phase_s + k step_s` whose whole step lies inside `track`.
-pub fn touchdowns_in(track: &SmoothTrack, phase_s: f64, step_s: f64) -> Vec<f64> {
-    let first = ((track.start_time_s - phase_s) / step_s).ceil() as i64;
+/// Touchdown times `offset_s + k step_s` whose whole step lies inside `track`.
+pub fn touchdowns_in(track: &SmoothTrack, offset_s: f64, step_s: f64) -> Vec<f64> {
+    let first = ((track.start_time_s - offset_s) / step_s).ceil() as i64;
     (first..)
-        .map(|k| phase_s + k as f64 * step_s)
+        .map(|k| offset_s + k as f64 * step_s)
         .take_while(|&t| t + step_s <= track.end_time() + 1e-9)
         .filter(|&t| track.covers(t, step_s))
         .collect()
@@ -290,7 +292,7 @@ pub fn summarize(steps: &[StepMeasure]) -> Option<GaitSummary> {
 
 /// Speed against time within a stride, averaged over strides (the paper's Fig. 3b).
 #[derive(Debug, Clone, PartialEq)]
-pub struct PhaseCurve {
+pub struct StrideCurve {
     /// Time since touchdown of the first tripod, s, from 0 to T.
     pub time_s: Vec<f64>,
     /// Mean speed, m/s.
@@ -304,7 +306,7 @@ pub struct PhaseCurve {
 /// Averages the speed over strides of period `stride_s` starting at every other touchdown
 /// of each track (`tracks[i].1` are its touchdowns in time order), sampled at `points`
 /// evenly spaced times from 0 to T inclusive. `None` when no whole stride exists.
-pub fn stride_curve(tracks: &[(&SmoothTrack, &[f64])], stride_s: f64, points: usize) -> Option<PhaseCurve> {
+pub fn stride_curve(tracks: &[(&SmoothTrack, &[f64])], stride_s: f64, points: usize) -> Option<StrideCurve> {
     let points = points.max(2);
     let time_s: Vec<f64> = (0..points).map(|j| stride_s * j as f64 / (points - 1) as f64).collect();
     let mut sum = vec![0.0; points];
@@ -330,5 +332,5 @@ pub fn stride_curve(tracks: &[(&SmoothTrack, &[f64])], stride_s: f64, points: us
         .zip(&mean)
         .map(|(sq, m)| if strides > 1 { ((sq - n * m * m) / (n - 1.0)).max(0.0).sqrt() } else { 0.0 })
         .collect();
-    Some(PhaseCurve { time_s, mean, sd, strides })
+    Some(StrideCurve { time_s, mean, sd, strides })
 }

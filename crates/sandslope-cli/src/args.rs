@@ -83,7 +83,8 @@ pub fn warn_extrapolated(terrain: &Terrain, slopes: &[f64]) {
 /// where docs/model.md §7 extrapolates.
 pub fn beyond_last_point(terrain: &Terrain, slopes_deg: &[f64]) -> Vec<f64> {
     // One rule for "extrapolated": the library's (docs/model.md §7).
-    let extrapolated = |d: f64| sandslope::Slope::from_signed_degrees(d).is_ok_and(|s| terrain.extrapolates(s));
+    let extrapolated =
+        |d: f64| sandslope::Slope::from_signed_degrees(d).is_ok_and(|s| terrain.extrapolates(s));
     slopes_deg.iter().copied().filter(|&d| extrapolated(d)).collect()
 }
 

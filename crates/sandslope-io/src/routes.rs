@@ -12,6 +12,25 @@ use sandslope::plan::{ElevationGrid, NoRoute, Objective, Route};
 use crate::files::{csv_string, write_atomic};
 use crate::raster::GeoRef;
 
+/// A map coordinate without float noise from cell arithmetic: rounded to 15 significant
+/// digits and at most 9 decimals (a nanometre in a metric CRS, 0.1 mm in degrees), so
+/// `51.449999999999996` becomes `51.45` while every real digit of a survey coordinate stays.
+pub fn round_coordinate(v: f64) -> f64 {
+    if !v.is_finite() || v == 0.0 {
+        return v;
+    }
+    let int_digits = (v.abs().log10().floor() as i32 + 1).max(1);
+    let decimals = (15 - int_digits).clamp(0, 9);
+    let scale = 10f64.powi(decimals);
+    (v * scale).round() / scale
+}
+
+/// A cell centre in map coordinates, rounded by [`round_coordinate`].
+fn centre(geo: &GeoRef, col: usize, row: usize) -> (f64, f64) {
+    let (x, y) = geo.centre(col, row);
+    (round_coordinate(x), round_coordinate(y))
+}
+
 /// Routes by objective, as `plan` found them (or why none exists).
 pub type Routes = [(Objective, Result<Route, NoRoute>)];
 
@@ -24,7 +43,7 @@ pub fn write_geojson(path: &Path, geo: &GeoRef, routes: &Routes) -> Result<()> {
             .cells
             .iter()
             .map(|c| {
-                let (x, y) = geo.centre(c.col, c.row);
+                let (x, y) = centre(geo, c.col, c.row);
                 [x, y]
             })
             .collect();
@@ -64,7 +83,7 @@ pub fn write_csv(path: &Path, geo: &GeoRef, grid: &ElevationGrid, routes: &Route
     for (obj, r) in routes {
         let Ok(r) = r else { continue };
         for (i, c) in r.cells.iter().enumerate() {
-            let (x, y) = geo.centre(c.col, c.row);
+            let (x, y) = centre(geo, c.col, c.row);
             let s = r.steps.get(i);
             rows.push(VertexRow {
                 objective: obj.name(),
@@ -83,4 +102,21 @@ pub fn write_csv(path: &Path, geo: &GeoRef, grid: &ElevationGrid, routes: &Route
         }
     }
     write_atomic(path, csv_string(&rows)?.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_coordinate;
+
+    #[test]
+    fn coordinates_lose_float_noise_but_keep_real_digits() {
+        assert_eq!(round_coordinate(51.449_999_999_999_996), 51.45);
+        assert_eq!(round_coordinate(0.1 + 0.2), 0.3);
+        assert_eq!(round_coordinate(-3.000_000_000_000_000_4), -3.0);
+        // A UTM northing keeps its millimetres, a longitude its 9 decimals.
+        assert_eq!(round_coordinate(5_712_345.678), 5_712_345.678);
+        assert_eq!(round_coordinate(13.123_456_789), 13.123_456_789);
+        assert_eq!(round_coordinate(0.0), 0.0);
+        assert!(round_coordinate(f64::NAN).is_nan());
+    }
 }

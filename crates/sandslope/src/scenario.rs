@@ -31,7 +31,12 @@ pub struct Scenario {
 impl Scenario {
     /// A scenario: `k_n` and `k_s`, if given, replace the terrain's values at every slope
     /// (finite, > 0; errors name the keys `k_n` and `k_s`).
-    pub fn new(robot: Robot, terrain: Terrain, k_n: Option<f64>, k_s: Option<f64>) -> Result<Scenario, ParamError> {
+    pub fn new(
+        robot: Robot,
+        terrain: Terrain,
+        k_n: Option<f64>,
+        k_s: Option<f64>,
+    ) -> Result<Scenario, ParamError> {
         let k_n = k_n.map(|v| positive("k_n", v)).transpose()?;
         let k_s = k_s.map(|v| positive("k_s", v)).transpose()?;
         Ok(Scenario { robot, terrain, k_n, k_s })
@@ -93,7 +98,11 @@ pub fn slope_range(from: f64, to: f64, step: f64, max: usize) -> Result<Vec<f64>
     }
     let n = ((to - from) / step + 1e-9).floor();
     if n >= max as f64 {
-        return Err(ParamError::new("step", step, format!("large enough to give at most {max} slopes ({n} asked)")));
+        return Err(ParamError::new(
+            "step",
+            step,
+            format!("large enough to give at most {max} slopes ({n} asked)"),
+        ));
     }
     Ok((0..=n as usize).map(|i| from + i as f64 * step).collect())
 }
@@ -209,7 +218,8 @@ mod tests {
 
     fn dune(repose_deg: Option<f64>) -> Terrain {
         let pt = |slope_deg, k_s| TerrainPoint { slope_deg, k_n: 7e5, k_s, k_n_sd: None, k_s_sd: None };
-        Terrain::new(TerrainSpec { name: None, repose_deg, points: vec![pt(0.0, 2e6), pt(20.0, 1e6)] }).unwrap()
+        Terrain::new(TerrainSpec { name: None, repose_deg, points: vec![pt(0.0, 2e6), pt(20.0, 1e6)] })
+            .unwrap()
     }
 
     #[test]

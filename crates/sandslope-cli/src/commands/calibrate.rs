@@ -148,8 +148,7 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
         check_flag("--repose", r, 0.0, 90.0)?;
     }
     let terrain = if fixed_k_n.is_none() { Some(args.terrain.load()?) } else { None };
-    let k_n_at =
-        |s: Slope| fixed_k_n.unwrap_or_else(|| terrain.as_ref().map_or(0.0, |t| t.at(s).k_n));
+    let k_n_at = |s: Slope| fixed_k_n.unwrap_or_else(|| terrain.as_ref().map_or(0.0, |t| t.at(s).k_n));
     let cal = calibrate(&robot, &k_n_at, &observations, args.law.law())
         .map_err(|e| anyhow!("{}: {e}", args.observed.display()))?;
     let name = args.name.clone().unwrap_or_else(|| format!("calibrated-{}", args.law.name()));

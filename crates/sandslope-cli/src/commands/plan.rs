@@ -6,15 +6,14 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
-use rayon::prelude::*;
 use serde::Serialize;
 
-use sandslope::plan::{Cell, Descent, ElevationGrid, NoRoute, Objective, PlanSettings, Planner, Route};
+use sandslope::plan::{plan, Cell, Descent, ElevationGrid, NoRoute, Objective, PlanRequest, PlanSettings, Route};
 use sandslope::risk::{DefaultsUsed, UncertainTerrain};
 use sandslope::Regime;
 
 use crate::args::{check_flag, RobotArgs, TerrainArgs};
-use crate::figures::plan::{PlanFigure, PlanResult};
+use crate::figures::plan::PlanFigure;
 use crate::output::{num, print_json, table};
 use sandslope_io::load_terrain;
 use sandslope_io::raster::{read_raster, write_two_band_geotiff, Raster};
@@ -190,36 +189,54 @@ fn parse_pair(flag: &str, s: &str) -> Result<(f64, f64)> {
 
 fn endpoint(raster: &Raster, which: &str, map: &Option<String>, px: &Option<String>) -> Result<Cell> {
     let (cols, rows) = (raster.cols, raster.rows);
-    let (c, r, what) = if let Some(s) = px {
+    let g = &raster.geo;
+    let (east, south) = (g.west + cols as f64 * g.cell_x, g.north - rows as f64 * g.cell_y);
+    let extent = format!(
+        "x {} to {}, y {} to {} (columns 0 to {}, rows 0 to {})",
+        round_coord(g.west),
+        round_coord(east),
+        round_coord(south),
+        round_coord(g.north),
+        cols - 1,
+        rows - 1
+    );
+    let (c, r, what, on_edge) = if let Some(s) = px {
         let (c, r) = parse_pair(&format!("--{which}-px"), s)?;
         if c.fract() != 0.0 || r.fract() != 0.0 {
             bail!("--{which}-px = `{s}` must be whole column and row numbers");
         }
-        (c, r, format!("--{which}-px {s}"))
+        (c, r, format!("--{which}-px {s}"), false)
     } else if let Some(s) = map {
         let (x, y) = parse_pair(&format!("--{which}"), s)?;
-        let (c, r) = raster.geo.cell_of(x, y);
-        (c, r, format!("--{which} {s}"))
+        let (c, r) = g.cell_of(x, y);
+        // On the map's outline (e.g. its corner 0,0): inside the closed extent, but not in any cell.
+        let on_edge = (g.west..=east).contains(&x) && (south..=g.north).contains(&y);
+        (c, r, format!("--{which} {s}"), on_edge)
     } else {
         bail!("give --{which} X,Y or --{which}-px COL,ROW");
     };
-    if c < 0.0 || r < 0.0 || c >= cols as f64 || r >= rows as f64 {
-        let g = &raster.geo;
+    let outside = c < 0.0 || r < 0.0 || c >= cols as f64 || r >= rows as f64;
+    if outside && on_edge {
         bail!(
-            "{what} is outside the map: x {} to {}, y {} to {} (columns 0 to {}, rows 0 to {})",
-            g.west,
-            g.west + cols as f64 * g.cell_x,
-            g.north - rows as f64 * g.cell_y,
-            g.north,
-            cols - 1,
-            rows - 1
+            "{what} lies on the edge of the map ({extent}); the border is impassable (no slope can be computed \
+             there): pick a point at least one cell ({} m) inside",
+            round_coord(g.cell_x.max(g.cell_y))
         );
+    }
+    if outside {
+        bail!("{what} is outside the map: {extent}");
     }
     let cell = Cell { col: c as usize, row: r as usize };
     if raster.is_nodata(cell.row * cols + cell.col) {
         bail!("{what} lies on a nodata cell (column {}, row {}) of the DEM", cell.col, cell.row);
     }
     Ok(cell)
+}
+
+/// A map coordinate for people: float noise from cell arithmetic removed (at most 9
+/// significant decimals), so `51.449999999999996` prints as `51.45`.
+fn round_coord(v: f64) -> f64 {
+    sandslope_io::routes::round_coordinate(v)
 }
 
 /// Loads the terrain classes: one terrain everywhere, or a class raster with its terrains.
@@ -327,19 +344,14 @@ pub fn run(args: PlanArgs) -> Result<()> {
     if let Some(note) = defaults.note() {
         eprintln!("note: {note}");
     }
-    let mask: Vec<bool> = (0..dem.values.len()).map(|i| dem.is_nodata(i)).collect();
-    let z: Vec<f32> = dem.values.iter().map(|&v| v as f32).collect();
-    let grid = ElevationGrid::new(dem.cols, dem.rows, dem.geo.cell_x, dem.geo.cell_y, z, Some(&mask))
+    let grid = ElevationGrid::from_heights(dem.cols, dem.rows, dem.geo.cell_x, dem.geo.cell_y, &dem.values, dem.nodata)
         .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
-    drop(mask);
-    let planner = Planner::new(grid, classes, &terrains, &robot, settings).map_err(|e| anyhow!("{e}"))?;
-    planner.check_endpoint(start, "start").map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
-    planner.check_endpoint(goal, "goal").map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
-
-    let mut objectives: Vec<Objective> = args.objective.iter().map(|&o| o.into()).collect();
-    objectives.push(Objective::Distance);
-    objectives.sort();
-    objectives.dedup();
+    let request = PlanRequest {
+        start,
+        goal,
+        objectives: args.objective.iter().map(|&o| o.into()).collect(),
+        risk_map: args.out.risk_map.is_some() || args.out.plot.is_some(),
+    };
 
     let show_progress =
         dem.values.len() >= PROGRESS_MIN_CELLS && std::io::IsTerminal::is_terminal(&std::io::stderr());
@@ -348,47 +360,43 @@ pub fn run(args: PlanArgs) -> Result<()> {
     } else {
         ProgressDrawTarget::hidden()
     });
-    let total = if show_progress { planner.passable_cells() as u64 } else { 0 };
     let style = ProgressStyle::with_template("{prefix:>9} {bar:40} {pos}/{len} cells settled ({elapsed})")
         .unwrap_or_else(|_| ProgressStyle::default_bar());
-    let routes: Vec<(Objective, Result<Route, NoRoute>)> = objectives
-        .par_iter()
-        .map(|&obj| {
-            let bar = multi.add(ProgressBar::new(total).with_style(style.clone()).with_prefix(obj.name()));
-            let r = planner.route(obj, start, goal, &|n| bar.set_position(n));
-            bar.finish();
-            r.map(|r| (obj, r))
-        })
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+    let bars: Vec<(Objective, ProgressBar)> =
+        Objective::ALL.iter().map(|&o| (o, ProgressBar::hidden())).collect();
+    let bars = std::sync::Mutex::new(bars);
+    let result = plan(grid, classes, &terrains, &robot, settings, &request, &|obj, n, total| {
+        let mut bars = bars.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, bar)) = bars.iter_mut().find(|(o, _)| *o == obj) {
+            if bar.is_hidden() && show_progress {
+                *bar = multi.add(ProgressBar::new(total).with_style(style.clone()).with_prefix(obj.name()));
+            }
+            bar.set_position(n);
+        }
+    })
+    .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+    for (_, bar) in bars.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        bar.finish();
+    }
 
-    let result = PlanResult { raster: &dem, planner: &planner, routes, start, goal };
     if let Some(p) = &args.out.geojson {
         writers::write_geojson(p, &dem.geo, &result.routes)?;
     }
     if let Some(p) = &args.out.csv {
-        writers::write_csv(p, &dem.geo, planner.grid(), &result.routes)?;
+        writers::write_csv(p, &dem.geo, result.planner.grid(), &result.routes)?;
     }
-    let risk = (args.out.risk_map.is_some() || args.out.plot.is_some()).then(|| planner.risk_map());
-    if let (Some(p), Some((p_fail, climb))) = (&args.out.risk_map, &risk) {
-        write_two_band_geotiff(p, dem.cols, dem.rows, &dem.geo, p_fail, climb)?;
+    if let (Some(p), Some(risk)) = (&args.out.risk_map, &result.risk) {
+        write_two_band_geotiff(p, dem.cols, dem.rows, &dem.geo, &risk.p_fail, &risk.climb_azimuth_deg)?;
     }
-    if let (Some(p), Some((p_fail, _))) = (&args.out.plot, &risk) {
-        crate::figures::save(p, &PlanFigure::new(&result, p_fail))?;
+    if let (Some(p), Some(risk)) = (&args.out.plot, &result.risk) {
+        crate::figures::save(p, &PlanFigure::new(&result, &dem.geo, &risk.p_fail))?;
     }
-    for t in planner.tables() {
-        if let (Some(last), Some(r)) =
-            (t.extrapolated_from_deg(), result.routes.iter().find_map(|(_, r)| r.as_ref().ok()))
-        {
-            if r.max_pitch_deg > last {
-                eprintln!(
-                    "warning: routes reach {:.1} deg, above the terrain's last measured point ({last} deg); k_n and \
-                     k_s are extrapolated linearly and floored at zero",
-                    r.max_pitch_deg
-                );
-                break;
-            }
-        }
+    if let Some(x) = result.extrapolation {
+        eprintln!(
+            "warning: routes reach {:.1} deg, above the terrain's last measured point ({} deg); k_n and k_s are \
+             extrapolated linearly and floored at zero (docs/model.md §7)",
+            x.max_pitch_deg, x.last_point_deg
+        );
     }
 
     if args.out.json {

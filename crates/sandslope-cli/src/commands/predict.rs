@@ -4,7 +4,9 @@ use anyhow::{anyhow, Result};
 use clap::Args;
 
 use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
-use crate::output::{csv_string, num, print_json, ruled_out_note, sci, speed_cell, table, Format, FormatArgs};
+use crate::output::{
+    csv_string, num, print_json, ruled_out_note, sci, speed_cell, table, Format, FormatArgs,
+};
 
 /// Arguments of `sandslope predict`.
 #[derive(Debug, Args)]

@@ -132,6 +132,9 @@ mod tests {
         assert!(msg.starts_with("--step = -1"), "{msg}");
         let msg = slopes(&parse(&["--step", "1e-9"])).unwrap_err().to_string();
         assert!(msg.starts_with("--step = 0.000000001") && msg.contains("100000"), "{msg}");
-        assert_eq!(slopes(&parse(&["--from", "-5", "--to", "5", "--step", "5"])).unwrap(), vec![-5.0, 0.0, 5.0]);
+        assert_eq!(
+            slopes(&parse(&["--from", "-5", "--to", "5", "--step", "5"])).unwrap(),
+            vec![-5.0, 0.0, 5.0]
+        );
     }
 }

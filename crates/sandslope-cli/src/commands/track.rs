@@ -10,8 +10,8 @@ use clap::Args;
 use serde::Serialize;
 
 use sandslope::gait::{
-    track, GaitOptions, Recording, RecordingSummary, TouchdownSource, TrackResult, Upslope, DEFAULT_CUTOFF_HZ,
-    DEFAULT_MAX_GAP,
+    track, GaitOptions, Recording, RecordingSummary, TouchdownSource, TrackResult, Upslope,
+    DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP,
 };
 use sandslope::{Scenario, Slope};
 
@@ -263,7 +263,8 @@ pub fn run(args: TrackArgs) -> Result<()> {
             touchdowns_s: touchdowns.get(i).map(|t| t.as_slice()),
         })
         .collect();
-    let slope_arg = slope.map(|d| Slope::from_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--slope")))).transpose()?;
+    let slope_arg =
+        slope.map(|d| Slope::from_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--slope")))).transpose()?;
     let result = track(&recordings, &options, slope_arg).map_err(|e| match e {
         sandslope::GaitError::Param { index, source } => {
             let source = if source.key == "cutoff_hz" { source.renamed("--cutoff") } else { source };

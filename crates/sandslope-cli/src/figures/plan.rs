@@ -9,8 +9,8 @@ use plotters::prelude::*;
 use sandslope::plan::Objective;
 use sandslope::Regime;
 
-use sandslope::plan::{Cell, NoRoute, Planner, Route};
-use sandslope_io::raster::Raster;
+use sandslope::plan::PlanResult;
+use sandslope_io::raster::GeoRef;
 
 use super::palette;
 use super::{font, Figure};
@@ -20,20 +20,6 @@ use crate::error::plot_err;
 const MAX_BLOCKS: usize = 600;
 
 /// Hillshade and risk, subsampled, with the routes.
-/// Everything `plan` computed that the route map draws (the plan command builds it).
-pub struct PlanResult<'a> {
-    /// DEM raster (georeferencing).
-    pub raster: &'a Raster,
-    /// The planner (grid, tables).
-    pub planner: &'a Planner,
-    /// Routes by objective.
-    pub routes: Vec<(Objective, Result<Route, NoRoute>)>,
-    /// Start and goal cells.
-    pub start: Cell,
-    /// Goal cell.
-    pub goal: Cell,
-}
-
 pub struct PlanFigure {
     /// Blocks across and down.
     nx: usize,
@@ -76,10 +62,9 @@ fn regime_colour(r: Regime) -> (f64, f64, f64) {
 
 impl PlanFigure {
     /// Builds the figure data from a plan result and the best-heading p_fail per cell.
-    pub fn new(result: &PlanResult, p_fail: &[f32]) -> PlanFigure {
-        let planner = result.planner;
+    pub fn new(result: &PlanResult, geo: &GeoRef, p_fail: &[f32]) -> PlanFigure {
+        let planner = &result.planner;
         let grid = planner.grid();
-        let geo = &result.raster.geo;
         let (cols, rows) = (grid.cols(), grid.rows());
         let step = cols.max(rows).div_ceil(MAX_BLOCKS).max(1);
         let (nx, ny) = (cols.div_ceil(step), rows.div_ceil(step));

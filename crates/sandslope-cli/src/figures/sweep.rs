@@ -8,8 +8,8 @@ use plotters::prelude::*;
 use sandslope::SpeedObservation;
 
 use super::{font, Figure};
-use sandslope::SlopeEvaluation;
 use crate::error::plot_err;
+use sandslope::SlopeEvaluation;
 
 /// Speed, anchoring time and step length against slope, stacked in three panels.
 pub struct SweepFigure<'a> {

@@ -18,8 +18,8 @@ pub mod track;
 pub use direction::{principal_direction, project, Upslope};
 pub use signal::{split_at_gaps, LowPass, Segment, Segmentation};
 pub use steps::{
-    estimate_touchdown_offset, measure_step, stride_curve, summarize, touchdowns_in, GaitSummary, StrideCurve,
-    SmoothTrack, Stats, StepMeasure, TouchdownOffset,
+    estimate_touchdown_offset, measure_step, stride_curve, summarize, touchdowns_in, GaitSummary,
+    SmoothTrack, Stats, StepMeasure, StrideCurve, TouchdownOffset,
 };
 pub use track::{track, RecordingSummary, StepRow, TouchdownSource, TrackResult};
 
@@ -216,7 +216,8 @@ pub fn analyse(recordings: &[Recording<'_>], options: &GaitOptions) -> Result<Ga
                 }
             })
             .collect();
-        let (touchdown_offset, touchdowns): (Option<TouchdownOffset>, Vec<Vec<f64>>) = match rec.touchdowns_s {
+        let (touchdown_offset, touchdowns): (Option<TouchdownOffset>, Vec<Vec<f64>>) = match rec.touchdowns_s
+        {
             Some(given) => {
                 let per_track = tracks
                     .iter()

@@ -135,7 +135,11 @@ pub fn track(
             interpolated_frames: r.interpolated_frames,
             dropped_frames: r.dropped_frames,
             steps: r.steps.len(),
-            touchdowns: if rec.touchdowns_s.is_some() { TouchdownSource::Given } else { TouchdownSource::Estimated },
+            touchdowns: if rec.touchdowns_s.is_some() {
+                TouchdownSource::Given
+            } else {
+                TouchdownSource::Estimated
+            },
             touchdown_offset_s: r.touchdown_offset.map(|o| o.offset_s),
         })
         .collect();
@@ -202,7 +206,8 @@ mod tests {
             Recording { positions: &a, frame_rate_hz: 120.0, start_time_s: 0.0, touchdowns_s: None },
             Recording { positions: &b, frame_rate_hz: 120.0, start_time_s: 0.0, touchdowns_s: Some(&truth) },
         ];
-        let r = track(&recs, &GaitOptions::new(1.0).unwrap(), Some(Slope::from_degrees(10.0).unwrap())).unwrap();
+        let r =
+            track(&recs, &GaitOptions::new(1.0).unwrap(), Some(Slope::from_degrees(10.0).unwrap())).unwrap();
         assert_eq!(r.slope_deg, Some(10.0));
         assert_eq!((r.recordings[0].segments, r.recordings[0].dropped_frames), (2, 40));
         assert_eq!(r.recordings[1].touchdowns, TouchdownSource::Given);

@@ -17,7 +17,7 @@ pub struct ElevationGrid {
 }
 
 /// A cell of a grid, by column (east) and row (south).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
 pub struct Cell {
     /// Column, 0 at the western edge.
     pub col: usize,
@@ -63,6 +63,30 @@ impl ElevationGrid {
             None => z.iter().map(|h| h.is_finite()).collect(),
         };
         Ok(ElevationGrid { cols, rows, cell_x, cell_y, z, valid })
+    }
+
+    /// A grid from heights as a raster holds them (`f64`, row-major from the north-west
+    /// corner): a cell is nodata where its value equals the raster's declared `nodata` value
+    /// (NaN matches NaN) or is not finite. Heights are stored as `f32` (a millimetre on a
+    /// 10 km mountain). Fails as [`ElevationGrid::new`].
+    pub fn from_heights(
+        cols: usize,
+        rows: usize,
+        cell_x: f64,
+        cell_y: f64,
+        heights: &[f64],
+        nodata: Option<f64>,
+    ) -> Result<ElevationGrid, PlanError> {
+        let is_nodata =
+            |v: f64| !v.is_finite() || nodata.is_some_and(|nd| v == nd || (nd.is_nan() && v.is_nan()));
+        let mask: Vec<bool> = heights.iter().map(|&v| is_nodata(v)).collect();
+        let z: Vec<f32> = heights.iter().map(|&v| v as f32).collect();
+        ElevationGrid::new(cols, rows, cell_x, cell_y, z, Some(&mask))
+    }
+
+    /// Whether `cell` lies on the outermost ring of cells, where no Horn gradient exists.
+    pub fn on_border(&self, cell: Cell) -> bool {
+        cell.col == 0 || cell.row == 0 || cell.col + 1 == self.cols || cell.row + 1 == self.rows
     }
 
     /// Number of columns (west to east).
@@ -189,6 +213,21 @@ mod tests {
             assert!(grad[r * 6 + c][0].is_nan(), "{c} {r}");
         }
         assert_eq!(grad[4 * 6 + 4], [0.0, 0.0]);
+    }
+
+    #[test]
+    fn from_heights_masks_the_declared_nodata_value_and_non_finite_heights() {
+        let mut h = vec![2.0; 16];
+        h[5] = -9999.0;
+        h[6] = f64::NAN;
+        let g = ElevationGrid::from_heights(4, 4, 1.0, 1.0, &h, Some(-9999.0)).unwrap();
+        let valid: Vec<bool> = (0..16).map(|i| g.is_valid(i)).collect();
+        assert_eq!(valid.iter().filter(|v| !**v).count(), 2);
+        assert!(!valid[5] && !valid[6] && valid[7]);
+        // Without a declared value, -9999 is a height.
+        assert!(ElevationGrid::from_heights(4, 4, 1.0, 1.0, &h, None).unwrap().is_valid(5));
+        assert!(g.on_border(Cell { col: 0, row: 2 }) && g.on_border(Cell { col: 2, row: 3 }));
+        assert!(!g.on_border(Cell { col: 1, row: 2 }));
     }
 
     #[test]

@@ -74,7 +74,7 @@ struct Move {
 }
 
 /// One edge of a route, with what the model says about it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct RouteStep {
     /// Cell left.
     pub from: Cell,
@@ -101,7 +101,7 @@ pub struct RouteStep {
 }
 
 /// A planned route and its statistics.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Route {
     /// The objective it minimises.
     pub objective: Objective,
@@ -292,8 +292,10 @@ impl Planner {
             "nodata"
         } else if self.class[i] == NO_CLASS {
             "without a terrain class"
+        } else if self.grad[i][0].is_nan() && g.on_border(cell) {
+            "on the map border, which is impassable (no slope can be computed there)"
         } else if self.grad[i][0].is_nan() {
-            "on the map border or next to nodata (no slope can be computed there)"
+            "next to nodata (no slope can be computed there)"
         } else {
             return Ok(i);
         };

@@ -1,0 +1,209 @@
+//! Everything `sandslope plan` computes, in one call: the planner built on the grid, the
+//! route of each objective (the distance route always among them, as the naive baseline),
+//! and, if asked, the risk raster (docs/model.md §8, §9).
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::grid::{Cell, ElevationGrid};
+use super::search::{Planner, Route};
+use super::{NoRoute, Objective, PlanError, PlanSettings};
+use crate::risk::UncertainTerrain;
+use crate::robot::Robot;
+
+/// What to plan on a grid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanRequest {
+    /// Start cell.
+    pub start: Cell,
+    /// Goal cell.
+    pub goal: Cell,
+    /// Objectives to route for; [`Objective::Distance`] is always added.
+    pub objectives: Vec<Objective>,
+    /// Whether to compute the risk raster ([`Planner::risk_map`]).
+    pub risk_map: bool,
+}
+
+/// The risk raster: per cell, row-major from the north-west corner, NaN where impassable.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RiskRaster {
+    /// The lowest P(failure) over the 16 headings.
+    pub p_fail: Vec<f32>,
+    /// Azimuth of the steepest climbing heading the time objective may use, degrees
+    /// clockwise from north.
+    pub climb_azimuth_deg: Vec<f32>,
+}
+
+/// Terrain values used beyond a table's last measured point (docs/model.md §7).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Extrapolation {
+    /// The steepest pitch a route reaches, degrees.
+    pub max_pitch_deg: f64,
+    /// The slope of the table's last measured point, degrees.
+    pub last_point_deg: f64,
+}
+
+/// What `plan` computed.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlanResult {
+    /// Start cell.
+    pub start: Cell,
+    /// Goal cell.
+    pub goal: Cell,
+    /// The route of each objective, or why none exists, in [`Objective`] order.
+    pub routes: Vec<(Objective, Result<Route, NoRoute>)>,
+    /// The risk raster, if asked for.
+    pub risk: Option<RiskRaster>,
+    /// Set when a route climbs above a terrain's last measured point.
+    pub extrapolation: Option<Extrapolation>,
+    /// The planner (grid, gradients, pitch tables), for figures and further routes.
+    #[serde(skip)]
+    pub planner: Planner,
+}
+
+impl PlanResult {
+    /// The route of `objective`, if it was planned.
+    pub fn route(&self, objective: Objective) -> Option<&Result<Route, NoRoute>> {
+        self.routes.iter().find(|(o, _)| *o == objective).map(|(_, r)| r)
+    }
+}
+
+/// Plans `request` on `grid` for `robot`: builds the [`Planner`] (classes and terrains as
+/// [`Planner::new`]), checks start and goal, searches every objective in parallel, and
+/// computes the risk raster if asked. `progress(objective, settled, passable)` is called as
+/// each search settles cells (every 65 536), with the number of passable cells as its scale.
+///
+/// Errors when the grid, classes, start or goal are unusable; an objective without a route is
+/// `Err(NoRoute)` in [`PlanResult::routes`], not an error.
+pub fn plan(
+    grid: ElevationGrid,
+    classes: Option<Vec<u8>>,
+    terrains: &[UncertainTerrain],
+    robot: &Robot,
+    settings: PlanSettings,
+    request: &PlanRequest,
+    progress: &(dyn Fn(Objective, u64, u64) + Sync),
+) -> Result<PlanResult, PlanError> {
+    let planner = Planner::new(grid, classes, terrains, robot, settings)?;
+    planner.check_endpoint(request.start, "start")?;
+    planner.check_endpoint(request.goal, "goal")?;
+    let mut objectives = request.objectives.clone();
+    objectives.push(Objective::Distance);
+    objectives.sort();
+    objectives.dedup();
+    let passable = planner.passable_cells() as u64;
+    let routes = objectives
+        .par_iter()
+        .map(|&obj| {
+            let r = planner.route(obj, request.start, request.goal, &|n| progress(obj, n, passable));
+            progress(obj, passable, passable);
+            r.map(|r| (obj, r))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let risk = request.risk_map.then(|| {
+        let (p_fail, climb_azimuth_deg) = planner.risk_map();
+        RiskRaster { p_fail, climb_azimuth_deg }
+    });
+    let max_pitch_deg = routes
+        .iter()
+        .filter_map(|(_, r)| r.as_ref().ok())
+        .map(|r| r.max_pitch_deg)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let extrapolation = planner
+        .tables()
+        .iter()
+        .filter_map(|t| t.extrapolated_from_deg())
+        .filter(|&last| max_pitch_deg > last)
+        .map(|last_point_deg| Extrapolation { max_pitch_deg, last_point_deg })
+        .next();
+    Ok(PlanResult { start: request.start, goal: request.goal, routes, risk, extrapolation, planner })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::tests::paper_robot;
+    use crate::risk::Uncertainty;
+    use crate::terrain::{Terrain, TerrainPoint, TerrainSpec};
+
+    fn tilted(n: usize, grade: f64) -> ElevationGrid {
+        // z = grade * x: every cell has the same slope atan(grade), rising to the east.
+        let h: Vec<f64> = (0..n * n).map(|i| grade * (i % n) as f64).collect();
+        ElevationGrid::from_heights(n, n, 1.0, 1.0, &h, None).unwrap()
+    }
+
+    fn class(terrain: Terrain) -> Vec<UncertainTerrain> {
+        vec![UncertainTerrain::with_uncertainty(terrain, Uncertainty::new(0.1, 0.2).unwrap())]
+    }
+
+    #[test]
+    fn plans_every_objective_with_distance_added_and_reports_progress() {
+        let seen = std::sync::Mutex::new(Vec::new());
+        let request = PlanRequest {
+            start: Cell { col: 2, row: 10 },
+            goal: Cell { col: 17, row: 10 },
+            objectives: vec![Objective::Time],
+            risk_map: true,
+        };
+        let r = plan(
+            tilted(20, 0.1),
+            None,
+            &class(Terrain::constant(7e5, 2e6).unwrap()),
+            &paper_robot(),
+            PlanSettings::default(),
+            &request,
+            &|o, n, total| seen.lock().unwrap().push((o, n, total)),
+        )
+        .unwrap();
+        let objectives: Vec<Objective> = r.routes.iter().map(|(o, _)| *o).collect();
+        assert_eq!(objectives, vec![Objective::Time, Objective::Distance]);
+        // A uniform 5.7 degree grade straight east: the straight line, 15 cells of
+        // sqrt(1 + 0.1^2) m each.
+        let d = r.route(Objective::Distance).unwrap().as_ref().unwrap();
+        assert!((d.length_m - 15.0 * 1.01_f64.sqrt()).abs() < 1e-4, "{}", d.length_m);
+        // Interior cells: 18 x 18 passable; each search reports its end at that scale.
+        let seen = seen.into_inner().unwrap();
+        assert!(
+            seen.contains(&(Objective::Time, 324, 324)) && seen.contains(&(Objective::Distance, 324, 324))
+        );
+        let risk = r.risk.unwrap();
+        assert_eq!(risk.p_fail.len(), 400);
+        assert!(risk.p_fail[0].is_nan() && risk.p_fail[21].is_finite());
+        assert_eq!(r.extrapolation, None);
+    }
+
+    #[test]
+    fn border_starts_are_refused_as_border_and_extrapolation_is_reported() {
+        let pt = |slope_deg, k_s| TerrainPoint { slope_deg, k_n: 7e5, k_s, k_n_sd: None, k_s_sd: None };
+        let terrain = Terrain::new(TerrainSpec {
+            name: None,
+            repose_deg: None,
+            points: vec![pt(0.0, 2e6), pt(5.0, 1.9e6)],
+        })
+        .unwrap();
+        let request = |start| PlanRequest {
+            start,
+            goal: Cell { col: 17, row: 10 },
+            objectives: vec![Objective::Time],
+            risk_map: false,
+        };
+        let run = |start| {
+            plan(
+                tilted(20, 0.2),
+                None,
+                &class(terrain.clone()),
+                &paper_robot(),
+                PlanSettings::default(),
+                &request(start),
+                &|_, _, _| {},
+            )
+        };
+        let e = run(Cell { col: 0, row: 10 }).unwrap_err().to_string();
+        assert!(e.contains("map border") && e.contains("impassable"), "{e}");
+        // An 11.3 degree grade climbs above the last point at 5 degrees.
+        let r = run(Cell { col: 2, row: 10 }).unwrap();
+        let x = r.extrapolation.unwrap();
+        assert_eq!(x.last_point_deg, 5.0);
+        assert!((x.max_pitch_deg - 0.2_f64.atan().to_degrees()).abs() < 0.01, "{x:?}");
+    }
+}

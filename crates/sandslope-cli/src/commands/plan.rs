@@ -8,7 +8,9 @@ use clap::{Args, ValueEnum};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use sandslope::plan::{plan, Cell, Descent, ElevationGrid, NoRoute, Objective, PlanRequest, PlanSettings, Route};
+use sandslope::plan::{
+    plan, Cell, Descent, ElevationGrid, NoRoute, Objective, PlanRequest, PlanSettings, Route,
+};
 use sandslope::risk::{DefaultsUsed, UncertainTerrain};
 use sandslope::Regime;
 
@@ -344,8 +346,15 @@ pub fn run(args: PlanArgs) -> Result<()> {
     if let Some(note) = defaults.note() {
         eprintln!("note: {note}");
     }
-    let grid = ElevationGrid::from_heights(dem.cols, dem.rows, dem.geo.cell_x, dem.geo.cell_y, &dem.values, dem.nodata)
-        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+    let grid = ElevationGrid::from_heights(
+        dem.cols,
+        dem.rows,
+        dem.geo.cell_x,
+        dem.geo.cell_y,
+        &dem.values,
+        dem.nodata,
+    )
+    .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
     let request = PlanRequest {
         start,
         goal,

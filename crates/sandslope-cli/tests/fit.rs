@@ -76,11 +76,12 @@ fn recovers_known_k_n_and_k_s_per_trial_and_reports_drops() {
             let k = f(&j["k_n"]);
             assert!((k / tr.k - 1.0).abs() < 0.015, "{}: k_n {k} vs {}", t.file, tr.k);
             assert!(f(&j["r_squared"]) > 0.995, "{}", t.file);
-            // The window must exclude the first 2 mm in air and most of the 3 mm soft layer
-            // (its last 0.75 mm has a local slope within the 25% tolerance, by design, and
-            // lies within 0.02 N of the line) and stop before the bed bottom at 37 mm.
+            // The window must exclude the first 2 mm in air and the first half of the 3 mm
+            // soft layer (from 3.5 mm the layer is within 0.08 N, 4 noise SDs on one sample, of
+            // the line: at the limit of what the tests can see) and stop before the bed bottom
+            // at 37 mm.
             let w = j["depth_window_m"].as_array().unwrap();
-            assert!(f(&w[0]) >= 0.004 && f(&w[1]) <= 0.037, "{}: window {w:?}", t.file);
+            assert!(f(&w[0]) >= 0.0035 && f(&w[1]) <= 0.037 + 1e-9, "{}: window {w:?}", t.file);
             assert!(f(&w[1]) - f(&w[0]) >= 0.02, "{}: window {w:?}", t.file);
         } else {
             // Granular fluctuations (2% of F_p, AR(1) with correlation 0.9) leave >= 3.8
@@ -92,7 +93,14 @@ fn recovers_known_k_n_and_k_s_per_trial_and_reports_drops() {
             // The rise reaches 90% at 2.3 x0 = 6.9 mm; noise and the running median may move
             // the crossing by two 80-Hz samples (1.25 mm), where the rise is still above 84%.
             assert!(f(&p[0]) >= 0.0056, "{}: plateau {p:?}", t.file);
-            assert_eq!(j["air_correction"], "mean");
+            // The shear in-air runs drift by 0.4 N/m over 100 mm with 0.03 N of noise at 80 Hz:
+            // the slope's SE is 0.03 / sqrt(161 * 0.1^2 / 12) = 0.082 N/m, t = 4.9, p < 1e-5:
+            // the default subtracts the fitted line, and says so.
+            assert_eq!(j["air_correction"], "trend", "{}", t.file);
+            let notes = j["notes"].as_array().unwrap();
+            assert!(notes.iter().any(|n| n.as_str().unwrap().contains("in-air run drifts by")), "{notes:?}");
+            let trend = &j["air_trend"];
+            assert!((f(&trend["slope_n_per_m"]) - 0.4).abs() < 4.0 * f(&trend["slope_se"]), "{trend}");
         }
     }
 }
@@ -117,7 +125,14 @@ fn per_slope_means_sds_and_interpolated_kind() {
             // |sd(a) - sd(b)| <= sd(a - b) <= max|a - b| sqrt(n / (n - 1)) (triangle inequality).
             let max_err = truth.iter().zip(&fitted).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
             let bound = max_err * (1.5f64).sqrt() + 1e-9;
-            assert!((f(&p[format!("{key}_sd")]) - sd(&truth)).abs() <= bound, "{slope} {key} sd");
+            let spread = f(&p[format!("{key}_spread_sd")]);
+            assert!((spread - sd(&truth)).abs() <= bound, "{slope} {key} sd");
+            // The terrain's SD combines the spread with the trials' SEs: sqrt(s^2 + mean se^2).
+            let ses: Vec<f64> =
+                trials.iter().map(|t| f(&trial_json(&json, &t.file)[format!("{key}_se")])).collect();
+            let se2 = ses.iter().map(|s| s * s).sum::<f64>() / ses.len() as f64;
+            let combined = (spread * spread + se2).sqrt();
+            assert!((f(&p[format!("{key}_sd")]) / combined - 1.0).abs() < 1e-12, "{slope} {key} combined sd");
             assert_eq!(p[format!("trials_{kind}")], trials.len());
         }
     }

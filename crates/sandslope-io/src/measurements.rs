@@ -204,8 +204,25 @@ pub struct Recording {
     pub rows: usize,
 }
 
-/// Reads one trial CSV. `counts_per_newton` converts a `force_counts` column.
+/// How trial CSVs are read.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ReadOptions {
+    /// Load-cell counts per newton, for a `force_counts` column.
+    pub counts_per_newton: Option<f64>,
+    /// Skip (and count) rows with a cell that is not a number, instead of failing.
+    pub skip_malformed: bool,
+}
+
+/// Reads one trial CSV. `counts_per_newton` converts a `force_counts` column. A cell that is
+/// not a number is an error naming the file, line and column.
 pub fn read_recording(path: &Path, kind: Kind, counts_per_newton: Option<f64>) -> Result<Recording> {
+    read_recording_with(path, kind, ReadOptions { counts_per_newton, skip_malformed: false })
+}
+
+/// Reads one trial CSV with `options`: with `skip_malformed`, a row with a cell that is not a
+/// number is skipped and counted in [`RawRecording::malformed`] instead of stopping the read.
+pub fn read_recording_with(path: &Path, kind: Kind, options: ReadOptions) -> Result<Recording> {
+    let counts_per_newton = options.counts_per_newton;
     let here = path.display();
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {here}"))?;
     let position_name = match kind {
@@ -274,8 +291,12 @@ pub fn read_recording(path: &Path, kind: Kind, counts_per_newton: Option<f64>) -
     };
     let time_col = names.iter().position(|n| n == "time_s");
 
-    let mut raw =
-        RawRecording { time: time_col.map(|_| Vec::new()), position: Vec::new(), force: Vec::new() };
+    let mut raw = RawRecording {
+        time: time_col.map(|_| Vec::new()),
+        position: Vec::new(),
+        force: Vec::new(),
+        malformed: 0,
+    };
     let mut rows = 0;
     for record in reader.records() {
         let record = record.map_err(|e| anyhow!("{here}: {e}"))?;
@@ -291,17 +312,30 @@ pub fn read_recording(path: &Path, kind: Kind, counts_per_newton: Option<f64>) -
                 Some(s) => s.parse::<f64>().map(|v| Some(v * scale)).map_err(|_| {
                     anyhow!(
                         "{here}: line {line}, column {} ({}): `{s}` is not a number (blank cells and NaN are \
-                         accepted and dropped)",
+                         accepted and dropped; rows like this can be skipped and counted instead)",
                         col + 1,
                         names[col]
                     )
                 }),
             }
         };
-        raw.position.push(cell(pos_col, pos_scale)?);
-        raw.force.push(cell(force_col, force_scale)?);
-        if let (Some(t), Some(c)) = (raw.time.as_mut(), time_col) {
-            t.push(cell(c, 1.0)?);
+        let cells = cell(pos_col, pos_scale).and_then(|p| {
+            let f = cell(force_col, force_scale)?;
+            let t = time_col.map(|c| cell(c, 1.0)).transpose()?;
+            Ok((p, f, t))
+        });
+        let (p, f, t) = match cells {
+            Ok(c) => c,
+            Err(_) if options.skip_malformed => {
+                raw.malformed += 1;
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
+        raw.position.push(p);
+        raw.force.push(f);
+        if let (Some(times), Some(t)) = (raw.time.as_mut(), t) {
+            times.push(t);
         }
     }
     if rows == 0 {
@@ -340,5 +374,8 @@ mod tests {
         let p = write(dir.path(), "a.csv", "depth_m,force_n\n0.001,1\n0.002,abc\n");
         let e = read_recording(&p, Kind::Penetration, None).unwrap_err().to_string();
         assert!(e.contains("line 3, column 2 (force_n)") && e.contains("`abc`"), "{e}");
+        let opts = ReadOptions { counts_per_newton: None, skip_malformed: true };
+        let r = read_recording_with(&p, Kind::Penetration, opts).unwrap();
+        assert_eq!((r.rows, r.raw.malformed, r.raw.position.len()), (2, 1, 1));
     }
 }

@@ -23,10 +23,10 @@ fn bench(c: &mut Criterion) {
     let pen = recording(10_000, false);
     let sh = recording(10_000, true);
     c.bench_function("clean + fit_penetration, 10k samples", |b| {
-        b.iter(|| fit_penetration(&clean(&pen).unwrap().0, area, None).unwrap())
+        b.iter(|| fit_penetration(&clean(&pen).unwrap().curve, area, None).unwrap())
     });
     c.bench_function("clean + fit_shear, 10k samples", |b| {
-        b.iter(|| fit_shear(&clean(&sh).unwrap().0, plate, None).unwrap())
+        b.iter(|| fit_shear(&clean(&sh).unwrap().curve, plate, None).unwrap())
     });
 }
 

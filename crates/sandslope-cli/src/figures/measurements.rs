@@ -1,6 +1,7 @@
 //! The force-measurement figure of the paper (its panels c, d, g, h): force against depth and
-//! against displacement coloured by slope, with the fitted lines and plateaus, and k_n and k_s
-//! against slope with error bars (SD across trials).
+//! against displacement coloured by slope, each trial's fitted line over its window (or plateau
+//! mean over its plateau) with the window's ends marked, and k_n and k_s against slope with
+//! error bars (the combined SD) and every single trial.
 
 use std::path::{Path, PathBuf};
 
@@ -8,10 +9,9 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use sandslope::measure::{Origin, SlopeEstimate, SlopeStat};
+use sandslope::measure::{Campaign, Origin, SlopeEstimate, SlopeStat, TrialFit, TrialResult};
 
 use super::{font, range, save, Figure};
-use crate::commands::fit::{FittedTrial, TrialFit};
 use crate::error::plot_err;
 
 /// Which panel.
@@ -31,9 +31,9 @@ impl Panel {
     fn title(self) -> &'static str {
         match self {
             Panel::PenetrationForce => "(c) Penetration force",
-            Panel::NormalResistance => "(d) Normal penetration resistance k_n",
+            Panel::NormalResistance => "(d) Normal penetration resistance kₙ",
             Panel::ShearForce => "(g) Shear force",
-            Panel::ShearStrength => "(h) Shear strength k_s",
+            Panel::ShearStrength => "(h) Shear strength kₛ",
         }
     }
 
@@ -47,24 +47,44 @@ impl Panel {
     }
 }
 
-/// Red (lowest slope) to blue (highest), as in the paper.
-fn slope_colour(deg: f64, lo: f64, hi: f64) -> RGBColor {
-    let t = if hi > lo { ((deg - lo) / (hi - lo)).clamp(0.0, 1.0) } else { 0.0 };
-    let (a, b) = ((215.0, 48.0, 39.0), (44.0, 90.0, 200.0));
-    let mix = |p: f64, q: f64| (p + t * (q - p)).round() as u8;
+/// Viridis (a perceptually uniform sequential map, readable in grey and by colour-blind
+/// readers) at `t` in [0, 1], from its published stops at every eighth.
+fn viridis(t: f64) -> RGBColor {
+    const STOPS: [(f64, f64, f64); 9] = [
+        (68.0, 1.0, 84.0),
+        (71.0, 44.0, 122.0),
+        (59.0, 81.0, 139.0),
+        (44.0, 113.0, 142.0),
+        (33.0, 144.0, 141.0),
+        (39.0, 173.0, 129.0),
+        (92.0, 200.0, 99.0),
+        (170.0, 220.0, 50.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let x = t.clamp(0.0, 1.0) * 8.0;
+    let i = (x.floor() as usize).min(7);
+    let w = x - i as f64;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    let mix = |p: f64, q: f64| (p + w * (q - p)).round() as u8;
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
 struct Data<'a> {
-    trials: &'a [FittedTrial],
-    points: &'a [SlopeEstimate],
+    campaign: &'a Campaign,
     slope_lo: f64,
     slope_hi: f64,
 }
 
 impl Data<'_> {
+    /// Slope colour: viridis from the lowest slope (dark purple) to just short of the highest
+    /// (yellow-green; pure yellow is too pale on white).
     fn colour(&self, deg: f64) -> RGBColor {
-        slope_colour(deg, self.slope_lo, self.slope_hi)
+        let t = if self.slope_hi > self.slope_lo {
+            (deg - self.slope_lo) / (self.slope_hi - self.slope_lo)
+        } else {
+            0.0
+        };
+        viridis(0.88 * t)
     }
 
     fn draw_panel<DB: DrawingBackend>(&self, panel: Panel, area: &DrawingArea<DB, Shift>) -> Result<()>
@@ -82,13 +102,14 @@ impl Data<'_> {
         DB::ErrorType: 'static,
     {
         let shear = panel == Panel::ShearForce;
-        let trials: Vec<&FittedTrial> = self
+        let trials: Vec<&TrialResult> = self
+            .campaign
             .trials
             .iter()
-            .filter(|t| !matches!(t.fit, TrialFit::Air) && matches!(t.fit, TrialFit::Shear(_)) == shear)
+            .filter(|t| !t.air && if shear { t.shear.is_some() } else { t.penetration.is_some() })
             .collect();
-        let xs = trials.iter().flat_map(|t| t.corrected.position().iter().map(|x| x * 1e3));
-        let ys = trials.iter().flat_map(|t| t.corrected.force().iter().copied());
+        let xs = trials.iter().flat_map(|t| t.curve.position().iter().map(|x| x * 1e3));
+        let ys = trials.iter().flat_map(|t| t.curve.force().iter().copied());
         let (x0, x1) = range(xs, (0.0, 1.0));
         let (y0, y1) = range(ys.chain([0.0]), (0.0, 1.0));
         let mut chart = ChartBuilder::on(area)
@@ -112,43 +133,58 @@ impl Data<'_> {
             .draw()
             .map_err(plot_err)?;
         let mut labelled = Vec::new();
+        // Data first, as small dots joined by a faint line, so every sample stays visible.
         for t in &trials {
-            let deg = t.clean.trial.slope_deg;
+            let deg = t.slope_deg;
             let colour = self.colour(deg);
             let pts: Vec<(f64, f64)> =
-                t.corrected.position().iter().zip(t.corrected.force()).map(|(x, f)| (x * 1e3, *f)).collect();
+                t.curve.position().iter().zip(t.curve.force()).map(|(x, f)| (x * 1e3, *f)).collect();
+            chart
+                .draw_series(LineSeries::new(pts.clone(), colour.mix(0.35).stroke_width(1)))
+                .map_err(plot_err)?;
             let series = chart
-                .draw_series(LineSeries::new(pts, colour.mix(0.55).stroke_width(1)))
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 2, colour.mix(0.8).filled())))
                 .map_err(plot_err)?;
             if !labelled.contains(&deg.to_bits()) {
                 labelled.push(deg.to_bits());
-                series.label(format!("{deg} deg")).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(3))
-                });
+                series
+                    .label(format!("{deg}°"))
+                    .legend(move |(x, y)| Circle::new((x + 9, y), 4, colour.filled()));
             }
-            // The fitted line over its window, or the plateau mean over the plateau.
-            let fitted: Vec<(f64, f64)> = match t.fit {
-                TrialFit::Penetration(f) => [f.window.0, f.window.1]
-                    .iter()
-                    .map(|&d| (d * 1e3, f.line.intercept + f.line.slope * d))
-                    .collect(),
-                TrialFit::Shear(f) => {
-                    vec![(f.plateau.0 * 1e3, f.plateau_force), (f.plateau.1 * 1e3, f.plateau_force)]
+        }
+        // Then each trial's fit: a thin black dashed line over the window (or the plateau mean
+        // over the plateau), with short vertical bars at the window's ends.
+        let tick = 0.025 * (y1 - y0);
+        for t in &trials {
+            let (a, b, fa, fb) = match t.fit() {
+                TrialFit::Penetration(f) => {
+                    let (a, b) = f.depth_window_m;
+                    (a, b, f.force_at(a), f.force_at(b))
                 }
+                TrialFit::Shear(f) => (f.plateau_m.0, f.plateau_m.1, f.plateau_force_n, f.plateau_force_n),
                 TrialFit::Air => continue,
             };
-            chart.draw_series(LineSeries::new(fitted.clone(), BLACK.stroke_width(1))).map_err(plot_err)?;
-            chart
-                .draw_series(fitted.iter().map(|&(x, y)| Circle::new((x, y), 2, BLACK.filled())))
-                .map_err(plot_err)?;
+            let line = vec![(a * 1e3, fa), (b * 1e3, fb)];
+            chart.draw_series(DashedLineSeries::new(line, 6, 4, BLACK.stroke_width(1))).map_err(plot_err)?;
+            for (x, y) in [(a * 1e3, fa), (b * 1e3, fb)] {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        vec![(x, y - tick), (x, y + tick)],
+                        BLACK.stroke_width(2),
+                    )))
+                    .map_err(plot_err)?;
+            }
         }
-        let fit_label =
-            if shear { "plateau mean (ends marked)" } else { "fitted line over window (ends marked)" };
+        let fit_label = if shear {
+            "plateau mean over the plateau (| ends)"
+        } else {
+            "fitted line over the window (| ends)"
+        };
         chart
             .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
             .map_err(plot_err)?
             .label(fit_label)
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(3)));
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(2)));
         chart
             .configure_series_labels()
             .position(if shear { SeriesLabelPosition::LowerRight } else { SeriesLabelPosition::UpperLeft })
@@ -167,21 +203,26 @@ impl Data<'_> {
         let normal = panel == Panel::NormalResistance;
         let stat = |p: &SlopeEstimate| if normal { p.k_n } else { p.k_s };
         let scale = 1e5;
-        let per_trial: Vec<(f64, f64)> = self
+        // Single trials are drawn just left of their slope so that the mean's marker does not
+        // cover them.
+        let offset = 0.6;
+        let per_trial: Vec<(f64, f64, bool)> = self
+            .campaign
             .trials
             .iter()
-            .filter_map(|t| match (normal, t.fit) {
-                (true, TrialFit::Penetration(f)) => Some((t.clean.trial.slope_deg, f.k_n / scale)),
-                (false, TrialFit::Shear(f)) => Some((t.clean.trial.slope_deg, f.k_s / scale)),
+            .filter_map(|t| match (normal, t.fit()) {
+                (true, TrialFit::Penetration(f)) => {
+                    Some((t.slope_deg - offset, f.k_n / scale, !t.warnings.is_empty()))
+                }
+                (false, TrialFit::Shear(f)) => {
+                    Some((t.slope_deg - offset, f.k_s / scale, !t.warnings.is_empty()))
+                }
                 _ => None,
             })
             .collect();
-        let bars = |s: &SlopeStat| {
-            let sd = s.sd.unwrap_or(0.0);
-            ((s.mean - sd) / scale, (s.mean + sd) / scale)
-        };
-        let ys = self
-            .points
+        let bars = |s: &SlopeStat| ((s.mean - s.sd) / scale, (s.mean + s.sd) / scale);
+        let points = &self.campaign.points;
+        let ys = points
             .iter()
             .flat_map(|p| {
                 let b = bars(&stat(p));
@@ -190,33 +231,49 @@ impl Data<'_> {
             .chain(per_trial.iter().map(|p| p.1))
             .chain([0.0]);
         let (y0, y1) = range(ys, (0.0, 1.0));
-        let (x0, x1) = range(self.points.iter().map(|p| p.slope_deg).chain([0.0]), (0.0, 25.0));
-        let x1 = x1 + 1.0;
+        let (x0, x1) = range(points.iter().map(|p| p.slope_deg).chain([0.0]), (0.0, 25.0));
         let mut chart = ChartBuilder::on(area)
             .caption(panel.title(), font(22.0))
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(60)
-            .build_cartesian_2d((x0 - 1.0)..x1, y0..(y1 * 1.08))
+            .build_cartesian_2d((x0 - 1.5)..(x1 + 1.0), y0..(y1 * 1.12))
             .map_err(plot_err)?;
         chart
             .configure_mesh()
-            .x_desc("slope (deg)")
-            .y_desc(if normal { "k_n (10^5 N/m^3)" } else { "k_s (10^5 N/m^3)" })
+            .x_desc("slope (°)")
+            .y_desc(if normal { "kₙ (10⁵ N/m³)" } else { "kₛ (10⁵ N/m³)" })
             .label_style(font(15.0))
             .axis_desc_style(font(17.0))
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(plot_err)?;
+        let grey = RGBColor(90, 90, 90);
         chart
             .draw_series(
-                per_trial.iter().map(|&(d, k)| Circle::new((d, k), 3, RGBColor(120, 120, 120).filled())),
+                per_trial
+                    .iter()
+                    .filter(|p| !p.2)
+                    .map(|&(d, k, _)| Circle::new((d, k), 4, grey.stroke_width(2))),
             )
             .map_err(plot_err)?
             .label("single trials (drawn left of their slope)")
-            .legend(|(x, y)| Circle::new((x + 9, y), 3, RGBColor(120, 120, 120).filled()));
+            .legend(move |(x, y)| Circle::new((x + 9, y), 4, grey.stroke_width(2)));
+        if per_trial.iter().any(|p| p.2) {
+            let red = RGBColor(200, 30, 30);
+            chart
+                .draw_series(
+                    per_trial
+                        .iter()
+                        .filter(|p| p.2)
+                        .map(|&(d, k, _)| Cross::new((d, k), 5, red.stroke_width(2))),
+                )
+                .map_err(plot_err)?
+                .label("single trial with a warning")
+                .legend(move |(x, y)| Cross::new((x + 9, y), 5, red.stroke_width(2)));
+        }
         let measured: Vec<&SlopeEstimate> =
-            self.points.iter().filter(|p| stat(p).origin == Origin::Measured).collect();
+            points.iter().filter(|p| stat(p).origin == Origin::Measured).collect();
         chart
             .draw_series(measured.iter().map(|p| {
                 let s = stat(p);
@@ -231,15 +288,16 @@ impl Data<'_> {
                 )
             }))
             .map_err(plot_err)?;
+        let legend_colour = self.colour(0.5 * (self.slope_lo + self.slope_hi));
         chart
             .draw_series(measured.iter().map(|p| {
                 Circle::new((p.slope_deg, stat(p).mean / scale), 6, self.colour(p.slope_deg).filled())
             }))
             .map_err(plot_err)?
-            .label("mean +- SD across trials")
-            .legend(|(x, y)| Circle::new((x + 9, y), 6, RGBColor(120, 60, 120).filled()));
+            .label("mean ± SD (trial spread and fit SE combined)")
+            .legend(move |(x, y)| Circle::new((x + 9, y), 6, legend_colour.filled()));
         let filled: Vec<&SlopeEstimate> =
-            self.points.iter().filter(|p| stat(p).origin != Origin::Measured).collect();
+            points.iter().filter(|p| stat(p).origin != Origin::Measured).collect();
         if !filled.is_empty() {
             chart
                 .draw_series(filled.iter().map(|p| {
@@ -308,11 +366,11 @@ impl Figure for Combined<'_> {
 
 /// Writes `force-measurements.png` (all four panels) and one PNG per panel into `dir`;
 /// returns the paths written.
-pub fn write_all(dir: &Path, trials: &[FittedTrial], points: &[SlopeEstimate]) -> Result<Vec<PathBuf>> {
-    let slopes = points.iter().map(|p| p.slope_deg);
+pub fn write_all(dir: &Path, campaign: &Campaign) -> Result<Vec<PathBuf>> {
+    let slopes = campaign.points.iter().map(|p| p.slope_deg);
     let slope_lo = slopes.clone().fold(f64::INFINITY, f64::min);
     let slope_hi = slopes.fold(f64::NEG_INFINITY, f64::max);
-    let data = Data { trials, points, slope_lo, slope_hi };
+    let data = Data { campaign, slope_lo, slope_hi };
     let mut written = Vec::new();
     let path = dir.join("force-measurements.png");
     save(&path, &Combined { data: &data })?;
@@ -323,4 +381,16 @@ pub fn write_all(dir: &Path, trials: &[FittedTrial], points: &[SlopeEstimate]) -
         written.push(path);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn viridis_ends_and_middle() {
+        assert_eq!(viridis(0.0), RGBColor(68, 1, 84));
+        assert_eq!(viridis(1.0), RGBColor(253, 231, 37));
+        assert_eq!(viridis(0.5), RGBColor(33, 144, 141));
+    }
 }

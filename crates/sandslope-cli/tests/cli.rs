@@ -89,6 +89,53 @@ fn predict_reports_null_where_the_model_is_undefined() {
 }
 
 #[test]
+fn above_repose_the_cause_is_shown_and_the_ruled_out_speed_is_not_presented_as_one() {
+    // The default terrain's repose is 25 deg; at 26 deg the stance model still gives its
+    // positive speed (2.29 cm/s), which the regime rules out: the surface itself yields.
+    let v = json(sandslope().args(["predict", "--slope", "26", "--json"]));
+    assert_eq!((v["regime"].as_str(), v["cause"].as_str()), (Some("slippage"), Some("at_or_above_repose")));
+    assert!(v["speed_m_s"].is_null());
+    let model = v["model_speed_m_s"].as_f64().unwrap();
+    // v = s / (T/2) with T/2 = 0.5 s for the paper robot.
+    assert!((model - v["step_m"].as_f64().unwrap() / 0.5).abs() < 1e-12 && model > 0.0);
+    // The table shows it in parentheses with the reason and the spec section.
+    let out = sandslope().args(["predict", "--slope", "26"]).assert().success().get_output().stdout.clone();
+    let text = String::from_utf8(out).unwrap();
+    let speed_row = text.lines().find(|l| l.contains("speed v")).unwrap();
+    assert!(speed_row.contains(&format!("({:.2})", model * 100.0)), "{speed_row}");
+    assert!(text.contains("at_or_above_repose") && text.contains("rules out") && text.contains("docs/model.md §6"));
+    // Below repose nothing is in parentheses and the speed is the model's.
+    let v = json(sandslope().args(["predict", "--slope", "20", "--json"]));
+    assert_eq!(v["speed_m_s"], v["model_speed_m_s"]);
+    assert_eq!(v["cause"], "short_step");
+    let text = sandslope().args(["predict", "--slope", "20"]).output().unwrap().stdout;
+    assert!(!String::from_utf8(text).unwrap().contains("parentheses"));
+}
+
+#[test]
+fn sweep_has_a_cause_column_in_table_csv_and_json() {
+    let args = ["sweep", "--from", "23", "--to", "26", "--step", "1"];
+    let v = json(sandslope().args(args).arg("--json"));
+    let causes: Vec<&str> = v.as_array().unwrap().iter().map(|r| r["cause"].as_str().unwrap()).collect();
+    assert_eq!(causes, ["short_step", "short_step", "at_or_above_repose", "at_or_above_repose"]);
+    let speeds: Vec<bool> = v.as_array().unwrap().iter().map(|r| r["speed_m_s"].is_null()).collect();
+    assert_eq!(speeds, [false, false, true, true]);
+    let csv = sandslope().args(args).arg("--csv").output().unwrap().stdout;
+    let csv = String::from_utf8(csv).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "cause").unwrap();
+    let speed = header.iter().position(|h| *h == "speed_m_s").unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.iter().map(|r| r[col]).collect::<Vec<_>>(), causes);
+    // CSV leaves a ruled-out speed empty.
+    assert_eq!(rows[2][speed], "");
+    let table = String::from_utf8(sandslope().args(args).output().unwrap().stdout).unwrap();
+    assert!(table.lines().next().is_some_and(|l| !l.is_empty()));
+    assert!(table.contains("cause") && table.contains("at_or_above_repose") && table.contains("(2.29)"), "{table}");
+    assert!(table.contains("speed in parentheses"));
+}
+
+#[test]
 fn predict_mass_override_changes_the_load() {
     let light = json(sandslope().args(["predict", "--slope", "10", "--json"]));
     let heavy = json(sandslope().args(["predict", "--slope", "10", "--mass", "1.0", "--json"]));

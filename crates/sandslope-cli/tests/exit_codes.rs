@@ -62,3 +62,27 @@ fn a_closed_stdout_ends_the_run_quietly() {
         assert!(!err.contains("error") && !err.contains("panicked"), "{format}: {err}");
     }
 }
+
+#[test]
+fn negative_values_in_ranges_reach_the_range_check() {
+    // A leading minus used to be taken for an unknown flag ("unexpected argument '-1'").
+    let cases: [(&[&str], &str); 7] = [
+        (&["phase", "--k-n", "-1:1e7:10"], "--k-n min = -1"),
+        (&["phase", "--k-s", "1e4:1e7:-3"], "--k-s"),
+        (&["phase", "--mass", "-1"], "--mass = -1"),
+        (&["risk", "--slope", "10", "--map", "--k-s", "-1:1e6:3"], "--k-s min = -1"),
+        (&["sweep", "--from", "5", "--to", "-5"], "--from = 5"),
+        (&["sweep", "--step", "-1"], "--step = -1"),
+        (&["predict", "--slope", "10", "--k-n", "-1"], "--k-n = -1"),
+    ];
+    for (args, want) in cases {
+        let out = sandslope().args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(want) && !err.contains("unexpected argument"), "{args:?}: {err}");
+    }
+    // And a negative slope range is a valid sweep (descending evaluated as climbing).
+    let out = sandslope().args(["sweep", "--from", "-5", "--to", "5", "--step", "5", "--csv"]).output().unwrap();
+    assert!(out.status.success());
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 4);
+}

@@ -325,11 +325,17 @@ fn start_or_goal_in_nodata_or_outside_is_a_clear_error_without_output() {
         text.push('\n');
     }
     std::fs::write(s.path("small.asc"), text).unwrap();
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 8] = [
         (&["--start", "104.5,205.5", "--goal", "107.5,202.5"], "nodata"),
         (&["--start", "99,205", "--goal", "107.5,202.5"], "outside the map"),
         (&["--start-px", "2,2", "--goal-px", "10,3"], "outside the map"),
-        (&["--start-px", "0,5", "--goal-px", "7,7"], "map border"),
+        (&["--start-px", "0,5", "--goal-px", "7,7"], "map border, which is impassable"),
+        (&["--start-px", "-1,5", "--goal-px", "7,7"], "outside the map"),
+        // The map's corner and a point on its southern edge lie on the impassable border.
+        (&["--start", "100,200", "--goal", "107.5,202.5"], "on the edge of the map"),
+        (&["--start", "104,200", "--goal", "107.5,202.5"], "the border is impassable"),
+        // Inside the outermost cells: the same reason, from the planner.
+        (&["--start", "100.5,205", "--goal", "107.5,202.5"], "map border, which is impassable"),
     ];
     for (args, want) in cases {
         let out = s.cmd("small.asc").args(args).arg("--geojson").arg(s.path("o.geojson")).output().unwrap();
@@ -409,5 +415,40 @@ fn negative_numbers_get_the_valid_range_not_a_parse_error() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{flag}: {err}");
         assert!(err.contains(want), "{flag}: {err}");
+    }
+}
+
+#[test]
+fn geojson_coordinates_carry_no_float_noise() {
+    // Cells of 0.1 m from x = 0.3: centres such as 0.3 + 12.5 * 0.1 are not exact in binary
+    // and used to print as 1.5499999999999998.
+    let s = Setup::new();
+    let mut text = String::from("ncols 30\nnrows 30\nxllcorner 0.3\nyllcorner 51.3\ncellsize 0.1\n");
+    for _ in 0..30 {
+        text += &vec!["0"; 30].join(" ");
+        text.push('\n');
+    }
+    std::fs::write(s.path("fine.asc"), text).unwrap();
+    let out = s
+        .cmd("fine.asc")
+        .args(["--start-px", "2,3", "--goal-px", "25,21", "--geojson"])
+        .arg(s.path("r.geojson"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(s.path("r.geojson")).unwrap();
+    let g: Value = serde_json::from_str(&text).unwrap();
+    let coords = g["features"][0]["geometry"]["coordinates"].as_array().unwrap();
+    // The start, the centre of column 2, row 3: x = 0.3 + 2.5 * 0.1, y = 54.3 - 3.5 * 0.1.
+    assert_eq!(coords[0][0].as_f64().unwrap(), 0.55);
+    assert_eq!(coords[0][1].as_f64().unwrap(), 53.95);
+    for c in coords {
+        for v in c.as_array().unwrap() {
+            // Every coordinate is a centre: a whole number of 0.05 m steps, printed with at most
+            // two decimals.
+            let printed = v.to_string();
+            let decimals = printed.split('.').nth(1).map_or(0, str::len);
+            assert!(decimals <= 2, "{printed} in {text}");
+        }
     }
 }

@@ -30,7 +30,7 @@ pub struct FitArgs {
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
     /// Fit k_n over this depth window, metres, instead of finding it (e.g. 0.005:0.03).
-    #[arg(long, value_name = "MIN:MAX")]
+    #[arg(long, value_name = "MIN:MAX", allow_hyphen_values = true)]
     pub depth_window: Option<String>,
     /// Shear plateau starts at this displacement, metres, instead of being found (e.g. 0.02).
     #[arg(long, allow_negative_numbers = true, value_name = "M")]

@@ -29,11 +29,11 @@ pub const DEFAULT_POINTS: usize = 400;
 pub struct PhaseArgs {
     /// Normal-resistance axis, N/m^3: MIN:MAX:N with optional :log (default) or :lin.
     /// Default: the terrain's k_n / 100 to x 100, 400 points, log.
-    #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]")]
+    #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]", allow_hyphen_values = true)]
     pub k_n: Option<String>,
     /// Shear-strength axis, N/m^3: MIN:MAX:N with optional :log (default) or :lin.
     /// Default: the terrain's k_s / 1000 to x 100, 400 points, log.
-    #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]")]
+    #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", allow_hyphen_values = true)]
     pub k_s: Option<String>,
     /// Slope(s) along the direction of travel, degrees, comma-separated (one panel each).
     #[arg(
@@ -45,7 +45,7 @@ pub struct PhaseArgs {
     )]
     pub slope: Vec<f64>,
     /// Total robot mass(es), kg, comma-separated (one panel row each). Default: the robot's.
-    #[arg(long, value_name = "KG[,KG...]", value_delimiter = ',')]
+    #[arg(long, value_name = "KG[,KG...]", value_delimiter = ',', allow_hyphen_values = true)]
     pub mass: Vec<f64>,
     /// Robot: a TOML file or a built-in preset (see `sandslope presets`).
     #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_ROBOT)]

@@ -67,10 +67,10 @@ pub struct PlanArgs {
     #[arg(long, value_name = "X,Y", allow_hyphen_values = true, required_unless_present = "goal_px")]
     pub goal: Option<String>,
     /// Start as a cell of the DEM (column, row from the north-west corner).
-    #[arg(long, value_name = "COL,ROW", conflicts_with = "start")]
+    #[arg(long, value_name = "COL,ROW", conflicts_with = "start", allow_hyphen_values = true)]
     pub start_px: Option<String>,
     /// Goal as a cell of the DEM (column, row from the north-west corner).
-    #[arg(long, value_name = "COL,ROW", conflicts_with = "goal")]
+    #[arg(long, value_name = "COL,ROW", conflicts_with = "goal", allow_hyphen_values = true)]
     pub goal_px: Option<String>,
     /// What to minimise (comma-separated for several); the distance route is always added.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "time")]

@@ -72,10 +72,10 @@ pub struct RiskArgs {
     #[arg(long, conflicts_with = "solve")]
     pub map: bool,
     /// --map grid of median k_n, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 100 to x 100, 48 points).
-    #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]", requires = "map")]
+    #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]", requires = "map", allow_hyphen_values = true)]
     pub k_n: Option<String>,
     /// --map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 1000 to x 100, 48 points).
-    #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", requires = "map")]
+    #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", requires = "map", allow_hyphen_values = true)]
     pub k_s: Option<String>,
     /// Print JSON instead of a table.
     #[arg(long, conflicts_with = "csv")]

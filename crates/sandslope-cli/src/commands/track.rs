@@ -38,7 +38,7 @@ pub struct TrackArgs {
     pub upslope: Option<Upslope>,
     /// Longest occlusion filled by linear interpolation, frames; longer gaps split the
     /// recording into segments analysed separately.
-    #[arg(long, value_name = "FRAMES", default_value_t = DEFAULT_MAX_GAP)]
+    #[arg(long, value_name = "FRAMES", default_value_t = DEFAULT_MAX_GAP, allow_negative_numbers = true)]
     pub max_gap: usize,
     /// Low-pass cutoff for the zero-phase speed estimate, Hz (see docs/tracking.md).
     #[arg(long, allow_negative_numbers = true, value_name = "HZ", default_value_t = DEFAULT_CUTOFF_HZ)]

@@ -291,3 +291,55 @@ fn vicon_subject_or_segment_selects_the_body() {
     }
     fails(&[f, "--body", "wheel"], "no body named `wheel`");
 }
+
+#[test]
+fn the_table_rounds_frame_rates_and_json_keeps_them() {
+    // Motive writes the export rate of a 120 Hz take as 119.99999666435033.
+    let dir = tempfile::tempdir().unwrap();
+    let p = slope20();
+    let rows = trajectory(&p, 6.0, 0.2, [1.0, 0.0, 0.0], 3e-4, &[]);
+    let text = motive(&rows, "1.23", "Meters", 1.0)
+        .replace("Export Frame Rate,120.000000", "Export Frame Rate,119.99999666435033");
+    let f = write(dir.path(), "m.csv", &text);
+    let v = track(&[f.to_str().unwrap(), "--body", "robot"]);
+    let hz = v["recordings"][0]["frame_rate_hz"].as_f64().unwrap();
+    assert!((hz - 119.999_996_664_350_33).abs() < 1e-9 && hz != 120.0, "{hz}");
+    let out = Command::cargo_bin("sandslope").unwrap().args(["track", f.to_str().unwrap(), "--body", "robot"]).output().unwrap();
+    let table = String::from_utf8(out.stdout).unwrap();
+    let row = table.lines().find(|l| l.contains("m.csv")).unwrap();
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    assert!(cells.contains(&"120"), "{row}");
+    assert!(!table.contains("119.99"), "{table}");
+    // The stride "phase" is called what it is: the touchdown offset.
+    assert!(table.contains("touchdown offset") && !table.contains("phase"), "{table}");
+}
+
+#[test]
+fn a_closed_stdout_ends_track_quietly() {
+    // Ten copies of a 40 s recording: about 800 steps, far more JSON and CSV than a pipe holds.
+    use std::io::Read;
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let rows = trajectory(&slope20(), 40.0, 0.2, [1.0, 0.0, 0.0], 3e-4, &[]);
+    let text = plain_mm(&rows);
+    let files: Vec<String> =
+        (0..10).map(|i| write(dir.path(), &format!("r{i}.csv"), &text).to_str().unwrap().to_string()).collect();
+    for format in ["--json", "--csv"] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sandslope"))
+            .arg("track")
+            .args(&files)
+            .arg(format)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = [0u8; 16];
+        child.stdout.as_mut().unwrap().read_exact(&mut first).unwrap();
+        drop(child.stdout.take());
+        let status = child.wait().unwrap();
+        let mut err = String::new();
+        child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+        assert_eq!(status.code(), Some(0), "{format}: {err}");
+        assert!(!err.contains("error") && !err.contains("panicked"), "{format}: {err}");
+    }
+}

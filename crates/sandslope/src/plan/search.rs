@@ -413,22 +413,31 @@ impl Planner {
         if s == t {
             return Ok(Ok(self.route_from_cells(objective, vec![s])));
         }
+        if let Some(blocked) = self.blocked_end(objective, s, t) {
+            return Ok(Err(blocked));
+        }
+        Ok(self.search(objective, s, t, progress).map(|cells| self.route_from_cells(objective, cells)))
+    }
+
+    /// Why no route can exist before searching: no passable edge leaves the start, or none
+    /// enters the goal, for this objective.
+    fn blocked_end(&self, objective: Objective, s: usize, t: usize) -> Option<NoRoute> {
         let any_out = (0..HEADINGS)
             .any(|k| self.neighbour(s, k).is_some_and(|v| self.edge_cost(objective, s, v, k).is_some()));
         if !any_out {
-            return Ok(Err(NoRoute::StartImpassable));
+            return Some(NoRoute::StartImpassable);
         }
         // Into the goal: from each neighbour w of t along the reverse move.
         let any_in = (0..HEADINGS).any(|k| {
             let back = (k + HEADINGS / 2) % HEADINGS;
             self.neighbour(t, k).is_some_and(|w| self.edge_cost(objective, w, t, back).is_some())
         });
-        if !any_in {
-            return Ok(Err(NoRoute::GoalImpassable));
-        }
-        Ok(self.search(objective, s, t, progress).map(|cells| self.route_from_cells(objective, cells)))
+        (!any_in).then_some(NoRoute::GoalImpassable)
     }
 
+    /// The cells of the cheapest path from `s` to `t`, by label-correcting A* ([`Search`]):
+    /// take the next cell to expand, start loading the one after it, relax its edges; then
+    /// walk the predecessors back from the goal.
     fn search(
         &self,
         objective: Objective,
@@ -436,105 +445,17 @@ impl Planner {
         t: usize,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Vec<usize>, NoRoute> {
-        let n = self.grid.len();
-        let cols = self.grid.cols();
-        let (cx, cy) = (self.grid.cell_x(), self.grid.cell_y());
-        let (tc, tr) = ((t % cols) as f64, (t / cols) as f64);
-        let h_scale = self.min_cost[objective as usize];
-        let h = |v: usize| {
-            let (ex, ey) = (((v % cols) as f64 - tc) * cx, ((v / cols) as f64 - tr) * cy);
-            h_scale * (ex * ex + ey * ey).sqrt()
-        };
-        // Each cell's distance beside its gradient: the two are read together for every
-        // neighbour, so one cache line serves both.
-        let mut node: Vec<Node> =
-            self.grad.par_iter().map(|&grad| Node { dist: f64::INFINITY, grad }).collect();
-        let mut pred = vec![u8::MAX; n];
-        // Buckets an eighth of the cheapest edge's cost wide (cell width times the smallest
-        // cost per metre): an edge whose reduced cost `c(u, v) - h(u) + h(v)` exceeds the width
-        // cannot make a cell of the same bucket re-expand.
-        let width = (0.125 * h_scale * self.cell_width).max(f64::MIN_POSITIVE);
-        let mut open = BucketQueue::new(h(s), width);
-        node[s].dist = 0.0;
-        open.push(h(s), (s as u32, 0.0));
-        let mut settled: u64 = 0;
-        let rows = self.grid.rows();
-        let offsets = self.moves.map(|m| m.dr * cols as isize + m.dc);
-        // Label-correcting A*: the lowest bucket is drained in any order and a cell is expanded
-        // again whenever its distance improves. Every open path's key is at least the floor and
-        // the heuristic never overestimates, so once the floor reaches `dist[t]` no path can
-        // improve on it: the result is the exact optimum.
-        while let Some((u, g)) = open.pop() {
-            let u = u as usize;
-            let Node { dist: du, grad: gu } = node[u];
-            // Stale: the cell was improved after this entry was pushed.
-            if (du as f32) < g || u == t {
-                continue;
+        let mut search = Search::new(self, objective, s, t);
+        while let Some((u, du, gu)) = search.next_cell() {
+            search.prefetch_next();
+            search.settled += 1;
+            if search.settled & 0xFFFF == 0 {
+                progress(search.settled);
             }
-            let best = node[t].dist;
-            if open.floor() >= best {
-                break;
-            }
-            // The next cell to expand is probably the entry below this one: start loading its
-            // neighbourhood now, while this cell is expanded.
-            if let Some((w, _)) = open.peek() {
-                let w = w as usize;
-                for d in [0, cols, 2 * cols] {
-                    prefetch(&node, w.wrapping_add(d).wrapping_sub(2));
-                    prefetch(&node, w.wrapping_add(d).wrapping_add(2));
-                    prefetch(&node, w.wrapping_sub(d).wrapping_sub(2));
-                    prefetch(&node, w.wrapping_sub(d).wrapping_add(2));
-                }
-            }
-            settled += 1;
-            if settled & 0xFFFF == 0 {
-                progress(settled);
-            }
-            // One division per settled cell; neighbours by flat offsets (a profile showed the
-            // per-neighbour `%` and `/` cost about a third of the search).
-            let (c, r) = (u % cols, u / cols);
-            for (k, m) in self.moves.iter().enumerate() {
-                let (nc, nr) = (c.wrapping_add_signed(m.dc), r.wrapping_add_signed(m.dr));
-                if nc >= cols || nr >= rows {
-                    continue;
-                }
-                let v = u.wrapping_add_signed(offsets[k]);
-                // Edges cost more than nothing: a cell already this close cannot improve.
-                let Node { dist: dv, grad: gv } = node[v];
-                if dv <= du || gv[0].is_nan() {
-                    continue;
-                }
-                if m.via[0] != 0 && m.via.iter().any(|&o| node[u.wrapping_add_signed(o)].grad[0].is_nan()) {
-                    continue;
-                }
-                let Some(cost) = self.cost_of(objective, self.geom_of(gu, gv, k), u, v, k) else { continue };
-                let nd = du + cost;
-                if nd < dv {
-                    let (ex, ey) = ((nc as f64 - tc) * cx, (nr as f64 - tr) * cy);
-                    let key = nd + h_scale * (ex * ex + ey * ey).sqrt();
-                    // A path through v at this distance cannot beat the goal's.
-                    if key >= node[t].dist {
-                        continue;
-                    }
-                    node[v].dist = nd;
-                    pred[v] = k as u8;
-                    open.push(key, (v as u32, nd as f32));
-                }
-            }
+            search.relax_edges(u, du, gu);
         }
-        progress(settled);
-        if !node[t].dist.is_finite() {
-            return Err(NoRoute::GoalUnreachable);
-        }
-        let mut cells = vec![t];
-        let mut v = t;
-        while v != s {
-            let m = &self.moves[usize::from(pred[v])];
-            v = v.wrapping_add_signed(-(m.dr * cols as isize + m.dc));
-            cells.push(v);
-        }
-        cells.reverse();
-        Ok(cells)
+        progress(search.settled);
+        search.path()
     }
 
     /// Evaluates the edge `u -> v` along move `k` (which must be a valid move).
@@ -659,6 +580,173 @@ impl Planner {
                 (best as f32, climb.map_or(f32::NAN, |(_, a)| a as f32))
             })
             .unzip()
+    }
+}
+
+/// The state of one A* search: per cell a [`Node`] (distance beside gradient) and the heading
+/// it was reached by, and the open set in buckets over the key `distance + heuristic`.
+///
+/// The heuristic is the straight-line horizontal distance to the goal times the smallest cost
+/// per horizontal metre of the objective, which never overestimates. The search is label
+/// correcting: the lowest bucket is drained in any order and a cell is expanded again whenever
+/// its distance improves; once the floor of the open set reaches the goal's distance no path
+/// can improve on it, so the result is the exact optimum.
+struct Search<'p> {
+    planner: &'p Planner,
+    objective: Objective,
+    /// The start's flat index.
+    s: usize,
+    /// The goal's flat index and its column and row.
+    t: usize,
+    tc: f64,
+    tr: f64,
+    /// Cost per horizontal metre of the heuristic.
+    h_scale: f64,
+    node: Vec<Node>,
+    /// Move index by which each cell was reached (`u8::MAX`: not reached).
+    pred: Vec<u8>,
+    open: BucketQueue,
+    /// Flat-index offset of each move.
+    offsets: [isize; HEADINGS],
+    /// Cells expanded so far.
+    settled: u64,
+}
+
+impl<'p> Search<'p> {
+    /// Every distance infinite but the start's (0), the start alone in the open set.
+    fn new(planner: &'p Planner, objective: Objective, s: usize, t: usize) -> Search<'p> {
+        let cols = planner.grid.cols();
+        let h_scale = planner.min_cost[objective as usize];
+        // Each cell's distance beside its gradient: the two are read together for every
+        // neighbour, so one cache line serves both.
+        let mut node: Vec<Node> =
+            planner.grad.par_iter().map(|&grad| Node { dist: f64::INFINITY, grad }).collect();
+        let pred = vec![u8::MAX; planner.grid.len()];
+        let mut search = Search {
+            planner,
+            objective,
+            s,
+            t,
+            tc: (t % cols) as f64,
+            tr: (t / cols) as f64,
+            h_scale,
+            node: Vec::new(),
+            pred,
+            // Replaced below, once the start's key is known.
+            open: BucketQueue::new(0.0, 1.0),
+            offsets: planner.moves.map(|m| m.dr * cols as isize + m.dc),
+            settled: 0,
+        };
+        let h_s = search.heuristic((s % cols) as f64, (s / cols) as f64);
+        // Buckets an eighth of the cheapest edge's cost wide (cell width times the smallest
+        // cost per metre): an edge whose reduced cost `c(u, v) - h(u) + h(v)` exceeds the width
+        // cannot make a cell of the same bucket re-expand.
+        let width = (0.125 * h_scale * planner.cell_width).max(f64::MIN_POSITIVE);
+        search.open = BucketQueue::new(h_s, width);
+        node[s].dist = 0.0;
+        search.node = node;
+        search.open.push(h_s, (s as u32, 0.0));
+        search
+    }
+
+    /// Lower bound of the cost from the cell at column `c`, row `r` to the goal.
+    #[inline(always)]
+    fn heuristic(&self, c: f64, r: f64) -> f64 {
+        let g = &self.planner.grid;
+        let (ex, ey) = ((c - self.tc) * g.cell_x(), (r - self.tr) * g.cell_y());
+        self.h_scale * (ex * ex + ey * ey).sqrt()
+    }
+
+    /// The next cell to expand with its distance and gradient, skipping stale entries (the
+    /// cell improved after the entry was pushed) and the goal; `None` once the open set is
+    /// empty or its floor reaches the goal's distance.
+    #[inline(always)]
+    fn next_cell(&mut self) -> Option<(usize, f64, [f32; 2])> {
+        while let Some((u, g)) = self.open.pop() {
+            let u = u as usize;
+            let Node { dist: du, grad: gu } = self.node[u];
+            if (du as f32) < g || u == self.t {
+                continue;
+            }
+            if self.open.floor() >= self.node[self.t].dist {
+                return None;
+            }
+            return Some((u, du, gu));
+        }
+        None
+    }
+
+    /// Starts loading the neighbourhood of the entry below the one being expanded, which is
+    /// probably the next to expand.
+    #[inline(always)]
+    fn prefetch_next(&self) {
+        if let Some((w, _)) = self.open.peek() {
+            let (w, cols) = (w as usize, self.planner.grid.cols());
+            for d in [0, cols, 2 * cols] {
+                prefetch(&self.node, w.wrapping_add(d).wrapping_sub(2));
+                prefetch(&self.node, w.wrapping_add(d).wrapping_add(2));
+                prefetch(&self.node, w.wrapping_sub(d).wrapping_sub(2));
+                prefetch(&self.node, w.wrapping_sub(d).wrapping_add(2));
+            }
+        }
+    }
+
+    /// Relaxes every edge out of `u` (distance `du`, gradient `gu`): a neighbour reached
+    /// more cheaply gets the new distance, `u` as predecessor and an entry in the open set,
+    /// unless its key cannot beat the goal's distance.
+    #[inline(always)]
+    fn relax_edges(&mut self, u: usize, du: f64, gu: [f32; 2]) {
+        let p = self.planner;
+        let (cols, rows) = (p.grid.cols(), p.grid.rows());
+        // One division per settled cell; neighbours by flat offsets (a profile showed the
+        // per-neighbour `%` and `/` cost about a third of the search).
+        let (c, r) = (u % cols, u / cols);
+        for (k, m) in p.moves.iter().enumerate() {
+            let (nc, nr) = (c.wrapping_add_signed(m.dc), r.wrapping_add_signed(m.dr));
+            if nc >= cols || nr >= rows {
+                continue;
+            }
+            let v = u.wrapping_add_signed(self.offsets[k]);
+            // Edges cost more than nothing: a cell already this close cannot improve.
+            let Node { dist: dv, grad: gv } = self.node[v];
+            if dv <= du || gv[0].is_nan() {
+                continue;
+            }
+            if m.via[0] != 0 && m.via.iter().any(|&o| self.node[u.wrapping_add_signed(o)].grad[0].is_nan()) {
+                continue;
+            }
+            let Some(cost) = p.cost_of(self.objective, p.geom_of(gu, gv, k), u, v, k) else { continue };
+            let nd = du + cost;
+            if nd < dv {
+                let key = nd + self.heuristic(nc as f64, nr as f64);
+                // A path through v at this distance cannot beat the goal's.
+                if key >= self.node[self.t].dist {
+                    continue;
+                }
+                self.node[v].dist = nd;
+                self.pred[v] = k as u8;
+                self.open.push(key, (v as u32, nd as f32));
+            }
+        }
+    }
+
+    /// The cells from start to goal, by walking the predecessors back from the goal;
+    /// [`NoRoute::GoalUnreachable`] if the search never reached it.
+    fn path(self) -> Result<Vec<usize>, NoRoute> {
+        let t = self.t;
+        if !self.node[t].dist.is_finite() {
+            return Err(NoRoute::GoalUnreachable);
+        }
+        let cols = self.planner.grid.cols() as isize;
+        let mut cells = vec![t];
+        let mut v = t;
+        while v != self.s {
+            let m = &self.planner.moves[usize::from(self.pred[v])];
+            v = v.wrapping_add_signed(-(m.dr * cols + m.dc));
+            cells.push(v);
+        }
+        cells.reverse();
+        Ok(cells)
     }
 }
 

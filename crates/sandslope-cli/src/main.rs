@@ -29,7 +29,7 @@ enum Command {
     Sweep(commands::sweep::SweepArgs),
     /// Fit k_s(theta) so the model's speeds match observed ones; write a terrain file.
     Calibrate(commands::calibrate::CalibrateArgs),
-    /// Fit k_n and k_s per slope from load-cell recordings into a terrain file (MODEL.md section 10).
+    /// Fit k_n and k_s per slope from load-cell recordings into a terrain file (docs/model.md §10).
     Fit(commands::fit::FitArgs),
     /// Speed, anchoring time t1 and slip per step from motion-capture recordings at one slope.
     Track(commands::track::TrackArgs),

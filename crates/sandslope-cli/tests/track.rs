@@ -306,6 +306,8 @@ fn the_table_rounds_frame_rates_and_json_keeps_them() {
     assert!((hz - 119.999_996_664_350_33).abs() < 1e-9 && hz != 120.0, "{hz}");
     let out = Command::cargo_bin("sandslope").unwrap().args(["track", f.to_str().unwrap(), "--body", "robot"]).output().unwrap();
     let table = String::from_utf8(out.stdout).unwrap();
+    // Piped: no progress bar or anything else on stderr.
+    assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
     let row = table.lines().find(|l| l.contains("m.csv")).unwrap();
     let cells: Vec<&str> = row.split_whitespace().collect();
     assert!(cells.contains(&"120"), "{row}");

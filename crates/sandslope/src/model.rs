@@ -1,4 +1,4 @@
-//! The shear-anchoring model of a C-legged robot on a sand slope (MODEL.md sections 3 to 6).
+//! The shear-anchoring model of a C-legged robot on a sand slope (docs/model.md §3-§6).
 //!
 //! Each equation is a function named after the paper's quantity, so phase maps and planners
 //! can reuse the parts that depend on only one of k_n, k_s; [`predict`] composes them into a
@@ -13,7 +13,7 @@ use crate::robot::Robot;
 use crate::slope::Slope;
 use crate::terrain::Ground;
 
-/// Gravitational acceleration, m/s^2 (MODEL.md section 1 fixes 9.81, not 9.80665).
+/// Gravitational acceleration, m/s^2 (docs/model.md §1 fixes 9.81, not 9.80665).
 pub const G: f64 = 9.81;
 
 /// Normal load per stance leg, `F_N = m g cos(theta) / n`, N.
@@ -35,7 +35,7 @@ pub fn sinkage_threshold_k_n(robot: &Robot, slope: Slope) -> f64 {
     normal_load_per_leg(robot, slope) / (robot.contact_area() * robot.max_depth())
 }
 
-/// Level-sand step length `s*`, m (rotary walking model, MODEL.md section 3).
+/// Level-sand step length `s*`, m (rotary walking model, docs/model.md §3).
 ///
 /// The robot's measured `level_step_m` if given; else `2 sqrt(R^2 - (d_n + h - R)^2)` when
 /// `d_n < d_max`, and 0 when `d_n >= d_max`.
@@ -116,7 +116,7 @@ pub fn step_speed(robot: &Robot, step: f64) -> f64 {
 
 /// Everything the model says about one stance of `robot` on `ground` at `slope`.
 ///
-/// Lengths in m, times in s, forces in N. `None` marks a quantity MODEL.md leaves undefined:
+/// Lengths in m, times in s, forces in N. `None` marks a quantity docs/model.md leaves undefined:
 /// without anchoring (`d_s > d_max`) there is no t1, slip, propulsion, step or speed; with
 /// `k_n = 0` (or `k_s = 0`) the depth `d_n` (or `d_s`) is infinite.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -147,13 +147,13 @@ pub struct Prediction {
     pub step: Option<f64>,
     /// Step-averaged speed along the surface `v`, m/s.
     pub speed: Option<f64>,
-    /// The regime (MODEL.md section 6).
+    /// The regime (docs/model.md §6).
     pub regime: Regime,
     /// The finer reason for the regime.
     pub cause: Cause,
 }
 
-/// Runs the whole model for one stance (MODEL.md sections 3 to 6).
+/// Runs the whole model for one stance (docs/model.md §3-§6).
 pub fn predict(robot: &Robot, slope: Slope, ground: &Ground) -> Prediction {
     let finite = |x: f64| x.is_finite().then_some(x);
     let d_n = normal_equilibrium_depth(robot, slope, ground.k_n);
@@ -205,7 +205,7 @@ pub(crate) mod tests {
     }
 
     /// Level sand, k_n = 7e5, k_s = 2e6, worked by hand (digits checked with an independent
-    /// transcription of MODEL.md in Python):
+    /// transcription of docs/model.md in Python):
     /// F_N = 0.35*9.81/3 = 1.14450 N; d_n = 1.14450/(7e5*4e-4) = 4.08750e-3 m;
     /// s* = 2 sqrt(0.04^2 - (0.0040875 + 0.03 - 0.04)^2) = 2 sqrt(0.0016 - 3.49577e-5) = 0.0791209 m;
     /// F_a = 0.35*(0.04*2pi/0.2)/3 = 0.146608 N; d_s = sqrt(0.146608/(2e6*0.01)) = 2.70747e-3 m;

@@ -1,7 +1,7 @@
-//! Locomotion regimes and the reason behind each (MODEL.md section 6).
+//! Locomotion regimes and the reason behind each (docs/model.md §6).
 //!
 //! The four regimes of the paper's phase diagrams are checked in a fixed order, the first
-//! that holds wins (a MODEL.md choice): sinkage, slippage, metastable, success. [`Cause`]
+//! that holds wins (a choice of docs/model.md): sinkage, slippage, metastable, success. [`Cause`]
 //! keeps the finer reason, because "slippage" has three distinct physical origins and a user
 //! deciding what to change needs to know which.
 
@@ -36,7 +36,7 @@ impl Regime {
         }
     }
 
-    /// Whether this regime counts as failure (sinkage or slippage; MODEL.md section 9).
+    /// Whether this regime counts as failure (sinkage or slippage; docs/model.md §9).
     pub fn is_failure(self) -> bool {
         matches!(self, Regime::Sinkage | Regime::Slippage)
     }
@@ -116,7 +116,7 @@ impl Cause {
     }
 }
 
-/// Classifies a stance by the precedence of MODEL.md section 6.
+/// Classifies a stance by the precedence of docs/model.md §6.
 ///
 /// `sunk`: `d_n >= d_max`; `beyond_repose`: slope at or above repose; `step`: the net step
 /// `s`, `None` when the leg does not anchor; `min_step`: s_min.

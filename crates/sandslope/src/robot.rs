@@ -1,7 +1,7 @@
-//! The legged robot: C-leg geometry, gait and mass (MODEL.md section 2).
+//! The legged robot: C-leg geometry, gait and mass (docs/model.md §2).
 //!
 //! A [`Robot`] can only hold values the model accepts; it is built from a [`RobotSpec`] (the
-//! plain, serialisable form with the exact file keys of MODEL.md) by [`Robot::new`], which
+//! plain, serialisable form with the exact file keys of docs/model.md) by [`Robot::new`], which
 //! checks every range once. The physics then trusts it.
 
 use serde::{Deserialize, Serialize};
@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 
 use crate::error::{positive, ParamError};
 
-/// The robot as written in a file: the keys of MODEL.md section 2, unknown keys rejected.
+/// The robot as written in a file: the keys of docs/model.md §2, unknown keys rejected.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RobotSpec {
@@ -27,7 +27,7 @@ pub struct RobotSpec {
     pub stance_legs: u32,
     /// Characteristic elastic response time dt, s.
     pub response_time_s: f64,
-    /// Effective leg area A_c for normal support, m^2; default `W * R` (a MODEL.md choice).
+    /// Effective leg area A_c for normal support, m^2; default `W * R` (a choice of docs/model.md).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub leg_contact_area_m2: Option<f64>,
     /// Measured level-sand step length s*, m; derived from the geometry when absent.
@@ -69,7 +69,7 @@ pub struct Robot {
 }
 
 impl Robot {
-    /// Validates `spec` (MODEL.md section 2): m, R, W, omega, dt, A_c > 0; n >= 1;
+    /// Validates `spec` (docs/model.md §2): m, R, W, omega, dt, A_c > 0; n >= 1;
     /// `0 <= h <= 2R`; `level_step_m` and `min_step_m`, when given, > 0.
     pub fn new(spec: RobotSpec) -> Result<Robot, ParamError> {
         positive("mass_kg", spec.mass_kg)?;

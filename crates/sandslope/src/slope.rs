@@ -1,9 +1,9 @@
-//! The inclination of the sand surface along the direction of travel (MODEL.md section 1).
+//! The inclination of the sand surface along the direction of travel (docs/model.md §1).
 //!
 //! Angles are degrees only at the edges of the program; a [`Slope`] is built
 //! from degrees and gives radians, sine and cosine to the physics.
 //! The model covers climbing, so a `Slope` is in `[0, 90)` degrees; descending travel is
-//! mapped onto it by the caller (MODEL.md section 8 evaluates descent with `|theta|`).
+//! mapped onto it by the caller (docs/model.md §8 evaluates descent with `|theta|`).
 
 use crate::error::ParamError;
 
@@ -38,7 +38,7 @@ impl Slope {
     }
 
     /// The slope felt when travelling with signed inclination `degrees`: descending
-    /// (`degrees < 0`) is evaluated as climbing `|degrees|` (MODEL.md section 8, a choice).
+    /// (`degrees < 0`) is evaluated as climbing `|degrees|` (docs/model.md §8, a choice).
     pub fn from_signed_degrees(degrees: f64) -> Result<Slope, ParamError> {
         Slope::from_degrees(degrees.abs()).map_err(|e| ParamError {
             value: degrees,

@@ -1,4 +1,4 @@
-//! Terrain resistance as a function of slope (MODEL.md section 7).
+//! Terrain resistance as a function of slope (docs/model.md §7).
 //!
 //! A terrain is a table of measured points `(slope_deg, k_n, k_s)` with optional standard
 //! deviations, an optional angle of repose and an optional name. Between points values are
@@ -31,7 +31,7 @@ pub struct TerrainPoint {
     pub k_s_sd: Option<f64>,
 }
 
-/// A terrain file: the keys of MODEL.md section 7, unknown keys rejected.
+/// A terrain file: the keys of docs/model.md §7, unknown keys rejected.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TerrainSpec {

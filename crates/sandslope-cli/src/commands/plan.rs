@@ -48,7 +48,7 @@ impl From<ObjectiveArg> for Objective {
 /// `--descent` values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum DescentArg {
-    /// Descending evaluated as climbing |pitch| (MODEL.md section 8 default).
+    /// Descending evaluated as climbing |pitch| (docs/model.md §8 default).
     Symmetric,
     /// Descending evaluated as level ground (optimistic).
     Level,

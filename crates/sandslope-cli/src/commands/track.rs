@@ -16,6 +16,7 @@ use sandslope::gait::{
 use sandslope::{Scenario, Slope};
 
 use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
+use crate::progress::progress_bar;
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
 use sandslope_io::mocap::{self, Capture, MocapFormat};
 use sandslope_io::{load_speeds, read_text, SpeedRow};
@@ -249,8 +250,17 @@ pub fn run(args: TrackArgs) -> Result<()> {
             files.len()
         );
     }
-    let captures: Vec<Capture> =
-        files.iter().map(|f| mocap::read(f, args.format, args.body.as_deref())).collect::<Result<_>>()?;
+    // Large exports take a while to parse: a bar on a terminal, nothing when piped.
+    let bar = progress_bar(files.len() as u64, files.len() < 2, "reading recordings");
+    let captures: Vec<Capture> = files
+        .iter()
+        .map(|f| {
+            let c = mocap::read(f, args.format, args.body.as_deref());
+            bar.inc(1);
+            c
+        })
+        .collect::<Result<_>>()?;
+    bar.finish_and_clear();
     let touchdowns: Vec<Vec<f64>> =
         args.touchdowns.iter().map(|p| load_touchdowns(p)).collect::<Result<_>>()?;
     let recordings: Vec<Recording> = captures

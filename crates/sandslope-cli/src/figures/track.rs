@@ -187,7 +187,7 @@ impl TrackFigure {
                 .draw_series(LineSeries::new(piece.iter().copied(), RED.stroke_width(2)))
                 .map_err(plot_err)?;
             if i == 0 {
-                s.label("model (MODEL.md §3-5), robot and terrain given")
+                s.label("model (docs/model.md §3-§5), robot and terrain given")
                     .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
             }
         }

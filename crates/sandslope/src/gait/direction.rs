@@ -1,5 +1,5 @@
 //! The along-slope coordinate: body positions projected on the upslope direction
-//! (MODEL.md section 11), and an estimate of that direction from the travel itself.
+//! (docs/model.md §11), and an estimate of that direction from the travel itself.
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 

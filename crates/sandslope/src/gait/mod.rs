@@ -1,4 +1,4 @@
-//! Gait tracking: speed, anchoring time and slip from motion capture (MODEL.md section 11).
+//! Gait tracking: speed, anchoring time and slip from motion capture (docs/model.md §11).
 //!
 //! Works on plain arrays of body positions (frames with a non-finite coordinate are
 //! occluded); file formats are the caller's business. The pipeline, per recording:
@@ -184,7 +184,7 @@ pub enum GaitError {
     },
 }
 
-/// Analyses recordings made at one slope and pools their steps (MODEL.md section 11).
+/// Analyses recordings made at one slope and pools their steps (docs/model.md §11).
 pub fn analyse(recordings: &[Recording<'_>], options: &GaitOptions) -> Result<GaitAnalysis, GaitError> {
     let (upslope, estimated) = match options.upslope {
         Some(u) => (u, false),

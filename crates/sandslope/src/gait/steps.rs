@@ -1,5 +1,5 @@
 //! Steps within a smooth track: touchdown offset, anchoring time t1, backward slip, net step
-//! and step speed (MODEL.md section 11), their summary across steps, and the
+//! and step speed (docs/model.md §11), their summary across steps, and the
 //! stride-averaged speed curve (the paper's Fig. 3b).
 
 /// Smoothed along-slope position and speed of one segment, sampled at a constant frame rate.
@@ -68,7 +68,7 @@ pub struct TouchdownOffset {
 /// Estimates the touchdown offset by folding the speed of all `tracks` (one recording, one
 /// clock) at the step period `step_s` (= T/2).
 ///
-/// The folded mean has one minimum per step, at the anchoring time t1. The model (MODEL.md
+/// The folded mean has one minimum per step, at the anchoring time t1. The model (docs/model.md
 /// section 5) starts each step at rest (the slip `s1 = g sin(theta) t1^2 / 2` assumes zero
 /// speed at touchdown), and the paper describes the speed falling "toward zero" after
 /// lift-off until the next tripod touches down, then turning negative while the robot slips.
@@ -264,7 +264,7 @@ impl Stats {
     }
 }
 
-/// Summary across steps (MODEL.md section 11).
+/// Summary across steps (docs/model.md §11).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GaitSummary {
     /// Step-averaged speed, m/s.

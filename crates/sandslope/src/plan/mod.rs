@@ -1,4 +1,4 @@
-//! Heading-aware route planning and risk maps over an elevation model (MODEL.md section 8).
+//! Heading-aware route planning and risk maps over an elevation model (docs/model.md §8).
 //!
 //! On a surface `z(x, y)`, a robot heading along the horizontal unit vector `u` feels the
 //! pitch `atan(grad z . u)` and the roll `atan(|grad z x u|)`. Crossing a slope feels gentler
@@ -8,12 +8,12 @@
 //! moves (headings every ~26.6 degrees). A directed edge's gradient is the mean of the Horn
 //! gradients of its two end cells; its pitch and roll follow from the heading. Descending is
 //! evaluated at `|pitch|` by default and any roll above a limit (default 20 degrees) is
-//! impassable, both configurable (**choices** of MODEL.md section 8). The model is evaluated
+//! impassable, both configurable (**choices** of docs/model.md §8). The model is evaluated
 //! once per class on a pitch table ([`PitchTable`]), never per edge.
 //!
 //! Objectives ([`Objective`]): fastest route through cells whose regime is success
 //! (`Time`), maximum survival probability (`Risk`: minimises `sum -ln(1 - p_fail)` plus a
-//! weight times the time, MODEL.md section 9), and shortest 3-D length with physics ignored
+//! weight times the time, docs/model.md §9), and shortest 3-D length with physics ignored
 //! (`Distance`). The search is A* on flat arrays with a straight-line heuristic that never
 //! overestimates.
 
@@ -63,7 +63,7 @@ impl Objective {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Descent {
-    /// As climbing `|pitch|` (MODEL.md section 8 default: symmetric, conservative).
+    /// As climbing `|pitch|` (docs/model.md §8 default: symmetric, conservative).
     #[default]
     Symmetric,
     /// As level ground (optimistic: gravity helps going down).

@@ -114,7 +114,7 @@ pub struct Route {
     /// Travel time, s; `None` when some step fails (sinkage or slippage: no progress), has no
     /// positive speed or exceeds the roll limit.
     pub time_s: Option<f64>,
-    /// Survival probability, `prod (1 - p_fail)^(cells crossed)` (MODEL.md section 9).
+    /// Survival probability, `prod (1 - p_fail)^(cells crossed)` (docs/model.md §9).
     pub survival: f64,
     /// Largest `|pitch|`, degrees.
     pub max_pitch_deg: f64,

@@ -103,7 +103,11 @@ fn above_repose_the_cause_is_shown_and_the_ruled_out_speed_is_not_presented_as_o
     let text = String::from_utf8(out).unwrap();
     let speed_row = text.lines().find(|l| l.contains("speed v")).unwrap();
     assert!(speed_row.contains(&format!("({:.2})", model * 100.0)), "{speed_row}");
-    assert!(text.contains("at_or_above_repose") && text.contains("rules out") && text.contains("docs/model.md §6"));
+    assert!(
+        text.contains("at_or_above_repose")
+            && text.contains("rules out")
+            && text.contains("docs/model.md §6")
+    );
     // Below repose nothing is in parentheses and the speed is the model's.
     let v = json(sandslope().args(["predict", "--slope", "20", "--json"]));
     assert_eq!(v["speed_m_s"], v["model_speed_m_s"]);
@@ -131,7 +135,10 @@ fn sweep_has_a_cause_column_in_table_csv_and_json() {
     assert_eq!(rows[2][speed], "");
     let table = String::from_utf8(sandslope().args(args).output().unwrap().stdout).unwrap();
     assert!(table.lines().next().is_some_and(|l| !l.is_empty()));
-    assert!(table.contains("cause") && table.contains("at_or_above_repose") && table.contains("(2.29)"), "{table}");
+    assert!(
+        table.contains("cause") && table.contains("at_or_above_repose") && table.contains("(2.29)"),
+        "{table}"
+    );
     assert!(table.contains("speed in parentheses"));
 }
 

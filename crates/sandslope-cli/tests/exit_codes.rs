@@ -82,7 +82,8 @@ fn negative_values_in_ranges_reach_the_range_check() {
         assert!(err.contains(want) && !err.contains("unexpected argument"), "{args:?}: {err}");
     }
     // And a negative slope range is a valid sweep (descending evaluated as climbing).
-    let out = sandslope().args(["sweep", "--from", "-5", "--to", "5", "--step", "5", "--csv"]).output().unwrap();
+    let out =
+        sandslope().args(["sweep", "--from", "-5", "--to", "5", "--step", "5", "--csv"]).output().unwrap();
     assert!(out.status.success());
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 4);
 }

@@ -304,7 +304,11 @@ fn the_table_rounds_frame_rates_and_json_keeps_them() {
     let v = track(&[f.to_str().unwrap(), "--body", "robot"]);
     let hz = v["recordings"][0]["frame_rate_hz"].as_f64().unwrap();
     assert!((hz - 119.999_996_664_350_33).abs() < 1e-9 && hz != 120.0, "{hz}");
-    let out = Command::cargo_bin("sandslope").unwrap().args(["track", f.to_str().unwrap(), "--body", "robot"]).output().unwrap();
+    let out = Command::cargo_bin("sandslope")
+        .unwrap()
+        .args(["track", f.to_str().unwrap(), "--body", "robot"])
+        .output()
+        .unwrap();
     let table = String::from_utf8(out.stdout).unwrap();
     // Piped: no progress bar or anything else on stderr.
     assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -324,8 +328,9 @@ fn a_closed_stdout_ends_track_quietly() {
     let dir = tempfile::tempdir().unwrap();
     let rows = trajectory(&slope20(), 40.0, 0.2, [1.0, 0.0, 0.0], 3e-4, &[]);
     let text = plain_mm(&rows);
-    let files: Vec<String> =
-        (0..10).map(|i| write(dir.path(), &format!("r{i}.csv"), &text).to_str().unwrap().to_string()).collect();
+    let files: Vec<String> = (0..10)
+        .map(|i| write(dir.path(), &format!("r{i}.csv"), &text).to_str().unwrap().to_string())
+        .collect();
     for format in ["--json", "--csv"] {
         let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sandslope"))
             .arg("track")

@@ -94,7 +94,11 @@ impl Scenario {
 pub fn slope_range(from: f64, to: f64, step: f64, max: usize) -> Result<Vec<f64>, ParamError> {
     positive("step", step)?;
     if !(from.is_finite() && to.is_finite()) || from > to {
-        return Err(ParamError::new("from", from, format!("a finite number not above the end of the range, {to}")));
+        return Err(ParamError::new(
+            "from",
+            from,
+            format!("a finite number not above the end of the range, {to}"),
+        ));
     }
     let n = ((to - from) / step + 1e-9).floor();
     if n >= max as f64 {

@@ -16,8 +16,8 @@ use sandslope::gait::{
 use sandslope::{Scenario, Slope};
 
 use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
-use crate::progress::progress_bar;
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
+use crate::progress::progress_bar;
 use sandslope_io::mocap::{self, Capture, MocapFormat};
 use sandslope_io::{load_speeds, read_text, SpeedRow};
 

@@ -111,6 +111,19 @@ pub fn font(size: f64) -> TextStyle<'static> {
     (FONT, size).into_font().into()
 }
 
+/// An axis tick label: whole numbers without a trailing `.0` (`16`, not `16.0`), others with
+/// up to three decimals and no trailing zeros (`0.25`, `2.5`).
+pub fn tick(v: &f64) -> String {
+    let r = (v * 1000.0).round() / 1000.0;
+    if r == r.trunc() {
+        // `-0` prints as `0`.
+        format!("{}", r.trunc() as i64)
+    } else {
+        let s = format!("{r:.3}");
+        s.trim_end_matches('0').to_string()
+    }
+}
+
 /// Padded `(min, max)` of finite values, or `fallback` if there are none.
 pub fn range(values: impl IntoIterator<Item = f64>, fallback: (f64, f64)) -> (f64, f64) {
     let (lo, hi) = values
@@ -122,4 +135,20 @@ pub fn range(values: impl IntoIterator<Item = f64>, fallback: (f64, f64)) -> (f6
     }
     let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.05 * lo.abs().max(1e-9) };
     (lo - pad, hi + pad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick;
+
+    #[test]
+    fn ticks_drop_a_trailing_point_zero() {
+        assert_eq!(tick(&16.0), "16");
+        assert_eq!(tick(&-0.0), "0");
+        assert_eq!(tick(&-2.0), "-2");
+        assert_eq!(tick(&2.5), "2.5");
+        assert_eq!(tick(&0.25), "0.25");
+        assert_eq!(tick(&(0.1 + 0.2)), "0.3");
+        assert_eq!(tick(&1e-4), "0");
+    }
 }

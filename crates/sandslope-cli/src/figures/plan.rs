@@ -49,7 +49,8 @@ const KEYS: [(&str, (f64, f64, f64)); 5] = [
     ("head-on: metastable", rgb(palette::METASTABLE)),
     ("head-on: slippage", rgb(palette::SLIPPAGE)),
     ("head-on: sinkage", rgb(palette::SINKAGE)),
-    ("no heading with P(fail) < 0.5", (90.0, 20.0, 20.0)),
+    // Charcoal, not a dark red: on the hillshade a dark red is lost beside slippage red.
+    ("no heading with P(fail) < 0.5", (55.0, 55.0, 62.0)),
 ];
 
 const fn rgb(c: RGBColor) -> (f64, f64, f64) {
@@ -155,6 +156,8 @@ impl Figure for PlanFigure {
             .disable_mesh()
             .x_desc("x (m)")
             .y_desc("y (m)")
+            .x_label_formatter(&super::tick)
+            .y_label_formatter(&super::tick)
             .label_style(font(14.0))
             .axis_desc_style(font(16.0))
             .draw()
@@ -168,14 +171,39 @@ impl Figure for PlanFigure {
                 Rectangle::new([(x0, y1 - bh), ((x0 + bw).min(east), (y1).max(south))], c.filled())
             }))
             .map_err(plot_err)?;
+        // Each route over a white halo (readable on dark and light cells) in its own colour and
+        // line style, so overlapping routes stay distinguishable: time solid, risk dashed,
+        // distance dotted.
+        for (_, pts) in &self.routes {
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), WHITE.mix(0.75).stroke_width(6)))
+                .map_err(plot_err)?;
+        }
         for (o, pts) in &self.routes {
             let c = route_colour(*o);
-            let width = if *o == Objective::Distance { 2 } else { 3 };
-            chart
-                .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(width)))
-                .map_err(plot_err)?
-                .label(format!("{} route", o.name()))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3)));
+            let style = c.stroke_width(3);
+            let (dash, gap) = match o {
+                Objective::Time => (0, 0),
+                Objective::Risk => (14, 7),
+                Objective::Distance => (4, 5),
+            };
+            let series = if dash == 0 {
+                chart.draw_series(LineSeries::new(pts.iter().copied(), style)).map_err(plot_err)?
+            } else {
+                chart
+                    .draw_series(DashedLineSeries::new(pts.iter().copied(), dash, gap, style))
+                    .map_err(plot_err)?
+            };
+            // The legend's 22 px sample in the same style, as three segments.
+            let segments: [(i32, i32); 3] = match o {
+                Objective::Time => [(0, 22), (0, 22), (0, 22)],
+                Objective::Risk => [(0, 8), (14, 22), (22, 22)],
+                Objective::Distance => [(0, 3), (9, 12), (18, 21)],
+            };
+            series.label(format!("{} route", o.name())).legend(move |(x, y)| {
+                let seg = |(a, b): (i32, i32)| PathElement::new(vec![(a, 0), (b, 0)], style);
+                EmptyElement::at((x, y)) + seg(segments[0]) + seg(segments[1]) + seg(segments[2])
+            });
         }
         chart
             .draw_series([

@@ -34,13 +34,20 @@ impl Figure for SweepFigure<'_> {
             x.iter().copied().chain(self.observed.iter().map(|o| o.slope.degrees())),
             (0.0, 30.0),
         );
-        let speed: Vec<Option<f64>> =
-            self.evals.iter().map(|e| e.prediction.speed.map(|v| v * 100.0)).collect();
+        let speed: Vec<Option<f64>> = self.evals.iter().map(|e| e.speed().map(|v| v * 100.0)).collect();
+        // Where the regime rules the stance model's speed out (at or above repose), that speed
+        // is drawn dashed and labelled, not as a speed the robot makes.
+        let ruled_out: Vec<Option<f64>> = self
+            .evals
+            .iter()
+            .map(|e| e.model_speed().filter(|_| e.speed_ruled_out()).map(|v| v * 100.0))
+            .collect();
         let obs: Vec<(f64, f64, f64)> =
             self.observed.iter().map(|o| (o.slope.degrees(), o.speed * 100.0, o.speed_sd * 100.0)).collect();
         let speed_range = super::range(
             speed
                 .iter()
+                .chain(&ruled_out)
                 .flatten()
                 .copied()
                 .chain(obs.iter().flat_map(|&(_, v, sd)| [v - sd, v + sd]))
@@ -48,9 +55,16 @@ impl Figure for SweepFigure<'_> {
             (0.0, 16.0),
         );
         let upper = SeriesLabelPosition::UpperRight;
-        let panel =
-            Panel { x_range, x: &x, observed: &[], reference: None, legend: upper, repose: self.repose_deg };
-        let speed_panel = Panel { observed: &obs, ..panel.clone() };
+        let panel = Panel {
+            x_range,
+            x: &x,
+            observed: &[],
+            reference: None,
+            legend: upper,
+            repose: self.repose_deg,
+            ruled_out: &[],
+        };
+        let speed_panel = Panel { observed: &obs, ruled_out: &ruled_out, ..panel.clone() };
         draw_panel(&panels[0], "Step-averaged speed", "speed v (cm/s)", speed_range, &speed, &speed_panel)?;
         let t1: Vec<Option<f64>> =
             self.evals.iter().map(|e| e.prediction.anchoring_time.map(|t| t * 1e3)).collect();
@@ -92,6 +106,22 @@ struct Panel<'a> {
     legend: SeriesLabelPosition,
     /// The terrain's angle of repose: slopes at or above it are shaded (regime slippage).
     repose: Option<f64>,
+    /// Model values the regime rules out, drawn dashed (empty: none).
+    ruled_out: &'a [Option<f64>],
+}
+
+/// Splits a curve into its defined stretches (gaps where the value is `None`).
+fn pieces(x: &[f64], y: &[Option<f64>]) -> Vec<Vec<(f64, f64)>> {
+    let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for (&xi, yi) in x.iter().zip(y) {
+        match yi {
+            Some(v) => segments.last_mut().expect("non-empty").push((xi, *v)),
+            None if !segments.last().expect("non-empty").is_empty() => segments.push(Vec::new()),
+            None => {}
+        }
+    }
+    segments.retain(|s| !s.is_empty());
+    segments
 }
 
 /// One panel: the model curve (gaps where undefined), an optional reference line and optional
@@ -119,20 +149,13 @@ where
         .configure_mesh()
         .x_desc("slope (deg)")
         .y_desc(y_label)
+        .x_label_formatter(&super::tick)
+        .y_label_formatter(&super::tick)
         .label_style(font(15.0))
         .axis_desc_style(font(17.0))
         .light_line_style(RGBColor(235, 235, 235))
         .draw()
         .map_err(plot_err)?;
-    // Split the curve where the model is undefined (no anchoring).
-    let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for (&xi, yi) in x.iter().zip(y) {
-        match yi {
-            Some(v) => segments.last_mut().expect("non-empty").push((xi, *v)),
-            None if !segments.last().expect("non-empty").is_empty() => segments.push(Vec::new()),
-            None => {}
-        }
-    }
     if let Some(repose) = panel.repose.filter(|r| *r < x_range.1) {
         let shade = RGBColor(200, 200, 200).mix(0.45);
         chart
@@ -157,16 +180,31 @@ where
             .label(label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(2)));
     }
-    let mut first = true;
-    for seg in segments.into_iter().filter(|s| !s.is_empty()) {
+    // Zero, where the curve goes below it (the robot loses ground).
+    if y_range.0 < 0.0 && y_range.1 > 0.0 {
+        chart
+            .draw_series([PathElement::new(vec![(x_range.0, 0.0), (x_range.1, 0.0)], BLACK.stroke_width(1))])
+            .map_err(plot_err)?;
+    }
+    for (i, seg) in pieces(x, y).into_iter().enumerate() {
         let series = chart
             .draw_series(LineSeries::new(seg, ShapeStyle::from(&RED).stroke_width(2)))
             .map_err(plot_err)?;
-        if first {
+        if i == 0 {
             series
                 .label("model")
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
-            first = false;
+        }
+    }
+    let faded = RED.mix(0.6).stroke_width(2);
+    for (i, seg) in pieces(x, panel.ruled_out).into_iter().enumerate() {
+        let series = chart.draw_series(DashedLineSeries::new(seg, 6, 5, faded)).map_err(plot_err)?;
+        if i == 0 {
+            series.label("stance model, ruled out: the surface yields").legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (6, 0)], faded)
+                    + PathElement::new(vec![(11, 0), (17, 0)], faded)
+            });
         }
     }
     if !observed.is_empty() {

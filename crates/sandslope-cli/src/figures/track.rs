@@ -22,7 +22,29 @@ pub struct TrackFigure {
     t1: Option<f64>,
     slope: Option<f64>,
     measured: Vec<SpeedRow>,
+    /// The model's speed against slope, in pieces where the robot makes a speed, cm/s.
     model: Vec<Vec<(f64, f64)>>,
+    /// The stance model's speed where the regime rules it out (at or above repose), cm/s.
+    ruled_out: Vec<Vec<(f64, f64)>>,
+    /// Slope axis: from, to, degrees.
+    x_range: (f64, f64),
+}
+
+/// The stretches of `(slope, speed)` where `speed` is defined, in cm/s.
+fn pieces(
+    model: &[SlopeEvaluation],
+    speed: impl Fn(&SlopeEvaluation) -> Option<f64>,
+) -> Vec<Vec<(f64, f64)>> {
+    let mut out = vec![Vec::new()];
+    for e in model {
+        match speed(e) {
+            Some(v) => out.last_mut().expect("non-empty").push((e.slope_deg, v * 100.0)),
+            None if !out.last().expect("non-empty").is_empty() => out.push(Vec::new()),
+            None => {}
+        }
+    }
+    out.retain(|p| !p.is_empty());
+    out
 }
 
 impl TrackFigure {
@@ -39,19 +61,13 @@ impl TrackFigure {
             None => (Vec::new(), Vec::new(), Vec::new(), 0),
         };
         let measured = campaign.unwrap_or_default();
-        // The model curve in pieces, split where the robot makes no speed.
-        let mut pieces = Vec::new();
-        let mut piece = Vec::new();
-        for e in model {
-            match e.speed() {
-                Some(v) => piece.push((e.slope_deg, v * 100.0)),
-                None if !piece.is_empty() => pieces.push(std::mem::take(&mut piece)),
-                None => {}
-            }
-        }
-        if !piece.is_empty() {
-            pieces.push(piece);
-        }
+        let model_pieces = pieces(model, SlopeEvaluation::speed);
+        let ruled_out = pieces(model, |e| e.model_speed().filter(|_| e.speed_ruled_out()));
+        // The slope axis holds the whole model curve and the data, with room on both sides,
+        // so that neither ends at the frame.
+        let hi =
+            model.iter().map(|e| e.slope_deg).chain(measured.iter().map(|r| r.slope_deg)).fold(0.0, f64::max);
+        let x_range = (-1.0, hi + 0.04 * hi.max(10.0));
         TrackFigure {
             time,
             mean,
@@ -61,7 +77,9 @@ impl TrackFigure {
             t1: r.t1_s,
             slope: r.slope_deg,
             measured,
-            model: pieces,
+            model: model_pieces,
+            ruled_out,
+            x_range,
         }
     }
 
@@ -86,6 +104,8 @@ impl TrackFigure {
             .configure_mesh()
             .x_desc("time since touchdown t0 (s)")
             .y_desc("upslope speed v (cm/s)")
+            .x_label_formatter(&super::tick)
+            .y_label_formatter(&super::tick)
             .label_style(font(15.0))
             .axis_desc_style(font(17.0))
             .light_line_style(WHITE.mix(0.0))
@@ -158,12 +178,11 @@ impl TrackFigure {
     where
         DB::ErrorType: 'static,
     {
-        let top = self.measured.iter().map(|r| r.slope_deg).fold(0.0, f64::max) + 2.0;
         let ys = self
             .measured
             .iter()
             .flat_map(|r| [100.0 * (r.speed_m_s - r.speed_sd_m_s), 100.0 * (r.speed_m_s + r.speed_sd_m_s)])
-            .chain(self.model.iter().flatten().map(|p| p.1))
+            .chain(self.model.iter().chain(&self.ruled_out).flatten().map(|p| p.1))
             .chain([0.0]);
         let (y0, y1) = range(ys, (0.0, 20.0));
         let mut chart = ChartBuilder::on(area)
@@ -171,12 +190,14 @@ impl TrackFigure {
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(60)
-            .build_cartesian_2d(-1.0..top, y0..y1)
+            .build_cartesian_2d(self.x_range.0..self.x_range.1, y0..y1)
             .map_err(plot_err)?;
         chart
             .configure_mesh()
             .x_desc("slope θ (deg)")
             .y_desc("step-averaged speed (cm/s)")
+            .x_label_formatter(&super::tick)
+            .y_label_formatter(&super::tick)
             .label_style(font(15.0))
             .axis_desc_style(font(17.0))
             .light_line_style(WHITE.mix(0.0))
@@ -187,10 +208,34 @@ impl TrackFigure {
                 .draw_series(LineSeries::new(piece.iter().copied(), RED.stroke_width(2)))
                 .map_err(plot_err)?;
             if i == 0 {
-                s.label("model (docs/model.md §3-§5), robot and terrain given")
+                s.label("model, for the robot and terrain given")
                     .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
             }
         }
+        let faded = RED.mix(0.6).stroke_width(2);
+        for (i, piece) in self.ruled_out.iter().enumerate() {
+            let s = chart
+                .draw_series(DashedLineSeries::new(piece.iter().copied(), 6, 5, faded))
+                .map_err(plot_err)?;
+            if i == 0 {
+                s.label("model at or above repose: ruled out, the surface yields").legend(move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (6, 0)], faded)
+                        + PathElement::new(vec![(11, 0), (17, 0)], faded)
+                });
+            }
+        }
+        // Markers first and small, SD bars over them with wide caps: an SD smaller than a
+        // marker still shows as its caps.
+        chart
+            .draw_series(
+                self.measured
+                    .iter()
+                    .map(|r| Circle::new((r.slope_deg, 100.0 * r.speed_m_s), 3, BLACK.filled())),
+            )
+            .map_err(plot_err)?
+            .label("tracked mean ± SD across steps (speeds file)")
+            .legend(|(x, y)| Circle::new((x + 10, y), 3, BLACK.filled()));
         chart
             .draw_series(self.measured.iter().map(|r| {
                 ErrorBar::new_vertical(
@@ -199,19 +244,10 @@ impl TrackFigure {
                     100.0 * r.speed_m_s,
                     100.0 * (r.speed_m_s + r.speed_sd_m_s),
                     BLACK.stroke_width(2),
-                    8,
+                    12,
                 )
             }))
             .map_err(plot_err)?;
-        chart
-            .draw_series(
-                self.measured
-                    .iter()
-                    .map(|r| Circle::new((r.slope_deg, 100.0 * r.speed_m_s), 5, BLACK.filled())),
-            )
-            .map_err(plot_err)?
-            .label("tracked mean ± SD (speeds file)")
-            .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.filled()));
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.85))

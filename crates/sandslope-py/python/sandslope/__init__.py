@@ -1,0 +1,469 @@
+"""sandslope: whether, how fast and why a legged robot climbs a sand slope.
+
+The shear-anchoring model of Liao and Qian, *Failure Mechanisms and Risk Estimation for Legged
+Robot Locomotion on Granular Slopes* (arXiv:2603.06928), from Python. This package wraps the
+Rust library (crate ``sandslope``) and its file readers (``sandslope-io``); it re-implements
+nothing, so every number is the one the ``sandslope`` command-line tool prints.
+
+On a slope ``theta`` each of the ``n`` stance legs carries the normal load
+``F_N = m g cos(theta) / n`` and sinks to the normal equilibrium depth
+``d_n = F_N / (k_n A_c)``; the downslope shear load ``F_a = m (g sin(theta) + R omega / dt) / n``
+is held once the leg reaches the shear-equilibrium depth ``d_s = sqrt(F_a / (k_s W))``, at the
+anchoring time ``t1``. Until then the robot slips back ``s1 = 1/2 g sin(theta) t1^2``; the net
+step is ``s = s* ((T/2 - t1)/(T/2))^2 - 1/2 g sin(theta) t1 (T - t1)`` and the speed
+``v = s / (T/2)``. Regimes (docs/model.md §6), in precedence order: sinkage
+(``d_n >= 2R - h``), slippage (at/above repose, no anchoring, or ``s <= 0``), metastable
+(``0 < s < s_min``), success.
+
+Units are SI throughout: kg, m, s, N/m^3 for ``k_n`` and ``k_s``; angles in degrees.
+Regimes are returned as ``int8`` codes, indices into :data:`REGIMES`.
+
+Errors in inputs raise :class:`ValueError` with the CLI's message: the key, the value and the
+valid range (and the file, for TOML files).
+
+Heavy calls release the GIL and run in parallel on all cores.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Dict, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _sandslope
+from ._sandslope import Robot, Terrain
+
+__all__ = [
+    "REGIMES",
+    "CAUSES",
+    "Robot",
+    "Terrain",
+    "presets",
+    "predict",
+    "phase",
+    "risk",
+    "risk_map",
+    "safe_slope",
+    "safe_mass",
+    "plan",
+    "risk_raster",
+    "read_raster",
+]
+
+__version__ = "0.1.0"
+
+#: Regime names; every ``regime`` array holds int8 indices into this tuple.
+REGIMES: Tuple[str, str, str, str] = tuple(_sandslope.REGIMES)  # type: ignore[assignment]
+
+#: Finer reasons for a regime; ``predict(...)["cause"]`` holds int8 indices into this tuple.
+CAUSES: Tuple[str, ...] = (
+    "normal_sinkage",
+    "at_or_above_repose",
+    "no_anchoring",
+    "net_backward_step",
+    "short_step",
+    "robust_step",
+)
+
+RobotLike = Union[Robot, str, "os.PathLike[str]"]
+TerrainLike = Union[Terrain, str, "os.PathLike[str]"]
+
+
+def presets() -> Dict[str, Dict[str, str]]:
+    """The built-in robots and terrains: ``{name: {"kind": "robot"|"terrain", "summary": ...}}``.
+
+    Load one with :meth:`Robot.preset` or :meth:`Terrain.preset`.
+    """
+    return {name: {"kind": kind, "summary": summary} for name, kind, summary in _sandslope.preset_names()}
+
+
+def _is_preset(name: str, kind: str) -> bool:
+    return any(n == name and k == kind for n, k, _ in _sandslope.preset_names())
+
+
+def _robot(robot: RobotLike) -> Robot:
+    """A Robot, a preset name or a TOML path (as the CLI's ``--robot FILE|PRESET``)."""
+    if isinstance(robot, Robot):
+        return robot
+    if isinstance(robot, (str, os.PathLike)):
+        text = os.fspath(robot)
+        if _is_preset(text, "robot") and not os.path.exists(text):
+            return Robot.preset(text)
+        return Robot.from_toml(text)
+    raise TypeError(f"robot must be a sandslope.Robot, a preset name or a TOML path, not {type(robot).__name__}")
+
+
+def _terrain(terrain: TerrainLike) -> Terrain:
+    """A Terrain, a preset name or a TOML path (as the CLI's ``--terrain FILE|PRESET``)."""
+    if isinstance(terrain, Terrain):
+        return terrain
+    if isinstance(terrain, (str, os.PathLike)):
+        text = os.fspath(terrain)
+        if _is_preset(text, "terrain") and not os.path.exists(text):
+            return Terrain.preset(text)
+        return Terrain.from_toml(text)
+    raise TypeError(
+        f"terrain must be a sandslope.Terrain, a preset name or a TOML path, not {type(terrain).__name__}"
+    )
+
+
+def _float_array(name: str, x: Any) -> np.ndarray:
+    try:
+        return np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name} must be a number or an array of numbers: {e}") from None
+
+
+_PREDICT_FLOAT_KEYS = (
+    "slope_deg",
+    "k_n",
+    "k_s",
+    "d_n_m",
+    "level_step_m",
+    "d_s_m",
+    "t1_s",
+    "slip_m",
+    "propulsion_m",
+    "step_m",
+    "speed_m_s",
+    "k_s_margin",
+)
+
+
+def predict(
+    robot: RobotLike,
+    slope_deg: Any,
+    k_n: Any = None,
+    k_s: Any = None,
+    *,
+    terrain: Optional[TerrainLike] = None,
+    mass_kg: Any = None,
+) -> Dict[str, Any]:
+    """Every model quantity (docs/model.md §3-§6) at each slope, as ``sandslope predict --json``.
+
+    ``slope_deg``, ``k_n``, ``k_s`` and ``mass_kg`` are scalars or arrays, broadcast together by
+    NumPy's rules. Give either ``k_n`` and ``k_s`` (N/m^3), or a ``terrain`` looked up at each
+    slope (docs/model.md §7: linear in degrees, held below the first point, extrapolated and
+    floored at 0 above the last); with a terrain, ``k_n`` or ``k_s`` override it. ``mass_kg``
+    replaces the robot's total mass. Negative slopes (descending) are evaluated as climbing
+    ``|slope|`` (docs/model.md §8).
+
+    Returns a dict of arrays of the broadcast shape, with the keys of ``predict --json``:
+
+    - ``slope_deg``, ``k_n``, ``k_s`` (N/m^3): the inputs used;
+    - ``regime`` (int8, index into :data:`REGIMES`) and ``cause`` (int8, into :data:`CAUSES`);
+    - ``d_n_m``: normal equilibrium depth ``d_n = m g cos(theta) / (n k_n A_c)``;
+    - ``level_step_m``: level-sand step ``s* = 2 sqrt(R^2 - (d_n + h - R)^2)``;
+    - ``d_s_m``: shear-equilibrium depth ``d_s = sqrt(F_a / (k_s W))``;
+    - ``t1_s``: anchoring time ``t1 = (asin((d_s + h)/R - 1) - phi0) / omega``;
+    - ``slip_m``: backward slip ``s1 = 1/2 g sin(theta) t1^2``;
+    - ``propulsion_m``: ``s2 = s* ((T/2 - t1)/(T/2))^2 - g sin(theta) t1 (T/2 - t1)``;
+    - ``step_m``: net step ``s = s2 - s1``; ``speed_m_s``: ``v = s / (T/2)``;
+    - ``k_s_margin``: k_s over the smallest k_s that still gives progress;
+    - ``extrapolated`` (bool): the terrain was extrapolated beyond its last point.
+
+    Floats are NaN where the JSON has ``null`` (no anchoring: no t1, slip, step or speed).
+    0-d inputs give 0-d arrays (use ``float(...)``).
+    """
+    robot = _robot(robot)
+    terrain = None if terrain is None else _terrain(terrain)
+    if terrain is None and (k_n is None or k_s is None):
+        raise ValueError("give both k_n and k_s, or a terrain (k_n and k_s then override it)")
+    inputs = {"slope_deg": _float_array("slope_deg", slope_deg)}
+    for name, value in (("k_n", k_n), ("k_s", k_s), ("mass_kg", mass_kg)):
+        if value is not None:
+            inputs[name] = _float_array(name, value)
+    try:
+        shape = np.broadcast_shapes(*(a.shape for a in inputs.values()))
+    except ValueError:
+        shapes = ", ".join(f"{k} {a.shape}" for k, a in inputs.items())
+        raise ValueError(f"the arguments cannot be broadcast together: {shapes}") from None
+    flat = {k: np.ascontiguousarray(np.broadcast_to(a, shape)).reshape(-1) for k, a in inputs.items()}
+    out = _sandslope.predict(
+        robot,
+        flat["slope_deg"],
+        k_n=flat.get("k_n"),
+        k_s=flat.get("k_s"),
+        terrain=terrain,
+        mass_kg=flat.get("mass_kg"),
+    )
+    return {k: v.reshape(shape) for k, v in out.items()}
+
+
+def _axis(name: str, x: Any) -> np.ndarray:
+    a = _float_array(name, x)
+    if a.ndim != 1:
+        raise ValueError(f"{name} must be one-dimensional (got shape {a.shape})")
+    return np.ascontiguousarray(a)
+
+
+def phase(
+    robot: RobotLike,
+    slope_deg: float,
+    k_n_axis: Any,
+    k_s_axis: Any,
+    *,
+    mass_kg: Optional[float] = None,
+    terrain: Optional[TerrainLike] = None,
+    repose_deg: Optional[float] = None,
+) -> Dict[str, Any]:
+    """The phase map (docs/model.md §6): the regime of every terrain ``(k_n, k_s)`` on a grid.
+
+    ``k_n_axis`` and ``k_s_axis`` (N/m^3) are ascending and evenly spaced
+    (``np.linspace``) or evenly spaced in logarithm (``np.geomspace``), as in
+    ``sandslope phase --k-n MIN:MAX:N[:log|:lin]``. ``mass_kg`` replaces the robot's mass;
+    at or above ``repose_deg`` (by default the ``terrain``'s angle of repose, if a terrain is
+    given, as ``sandslope phase --terrain`` does) every cell slips.
+
+    Returns a dict:
+
+    - ``regime``: int8, shape ``(len(k_n_axis), len(k_s_axis))``, index into :data:`REGIMES`;
+    - ``step_m``: float64, same shape, the net step ``s`` (NaN where the leg never anchors);
+    - ``k_n``, ``k_s``: the axis values used (the library's, equal to the given ones to 1e-9);
+    - ``counts``: cells per regime.
+
+    Cell for cell this is what :func:`predict` gives (the library evaluates the k_n-only and
+    k_s-only parts once per axis value, rows in parallel). Both arrays are transposed views of
+    row-major ``(k_s, k_n)`` buffers, so ``regime.T`` is C-contiguous with one row per k_s
+    (the layout of an image with k_s up).
+    """
+    robot = _robot(robot)
+    if mass_kg is not None:
+        robot = robot.with_mass(float(mass_kg))
+    if repose_deg is None and terrain is not None:
+        repose_deg = _terrain(terrain).repose_deg
+    kn, ks = _axis("k_n_axis", k_n_axis), _axis("k_s_axis", k_s_axis)
+    out = _sandslope.phase(robot, float(slope_deg), kn, ks, repose_deg=repose_deg)
+    shape = (len(out["k_s"]), len(out["k_n"]))
+    out["regime"] = out["regime"].reshape(shape).T
+    out["step_m"] = out["step_m"].reshape(shape).T
+    return out
+
+
+def risk(
+    robot: RobotLike,
+    slope_deg: Any,
+    *,
+    terrain: TerrainLike,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+) -> Dict[str, np.ndarray]:
+    """Regime probabilities on uncertain terrain (docs/model.md §9), as ``sandslope risk --csv``.
+
+    k_n and k_s at each slope are independent log-normals whose medians are the terrain's
+    values and whose coefficients of variation are ``cv_n``/``cv_s`` when given, else the
+    terrain's ``k_n_sd``/``k_s_sd`` over its value. Probabilities come from deterministic
+    quadrature (reproducible to 1e-9), not sampling.
+
+    Returns arrays of the shape of ``slope_deg``: ``p_fail`` = P(sinkage or slippage),
+    ``p_not_success``, ``p_success``, ``p_metastable``, ``p_slippage``, ``p_sinkage``, and the
+    ``cv_n``, ``cv_s`` used at each slope.
+    """
+    robot, terrain = _robot(robot), _terrain(terrain)
+    s = _float_array("slope_deg", slope_deg)
+    out = _sandslope.risk(robot, np.ascontiguousarray(s).reshape(-1), terrain, cv_n=cv_n, cv_s=cv_s)
+    return {k: v.reshape(s.shape) for k, v in out.items()}
+
+
+def risk_map(
+    robot: RobotLike,
+    slope_deg: float,
+    k_n_axis: Any = None,
+    k_s_axis: Any = None,
+    *,
+    terrain: TerrainLike,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+    mass_kg: Optional[float] = None,
+) -> Dict[str, Any]:
+    """P(failure) over a grid of median ``(k_n, k_s)`` at one slope (``sandslope risk --map``).
+
+    The uncertainty (coefficients of variation) and the angle of repose are the terrain's at
+    ``slope_deg`` (or ``cv_n``/``cv_s``). Axes as in :func:`phase`; by default the CLI's:
+    48 log-spaced values from the terrain's k_n / 100 to x 100 and k_s / 1000 to x 100.
+    Each cell is a full quadrature (about a millisecond).
+
+    Returns ``p_fail`` and the per-regime probabilities, each of shape
+    ``(len(k_n_axis), len(k_s_axis))``; ``k_n``, ``k_s`` (the axes); ``terrain_k_n``,
+    ``terrain_k_s`` (the terrain's medians at this slope) and the ``cv_n``, ``cv_s`` used.
+    """
+    robot, terrain = _robot(robot), _terrain(terrain)
+    if mass_kg is not None:
+        robot = robot.with_mass(float(mass_kg))
+    at = terrain.at(float(slope_deg))
+    kn = _axis("k_n_axis", np.geomspace(at["k_n"] / 100, at["k_n"] * 100, 48) if k_n_axis is None else k_n_axis)
+    ks = _axis("k_s_axis", np.geomspace(at["k_s"] / 1000, at["k_s"] * 100, 48) if k_s_axis is None else k_s_axis)
+    out = _sandslope.risk_map(robot, float(slope_deg), kn, ks, terrain, cv_n=cv_n, cv_s=cv_s)
+    shape = (len(out["k_s"]), len(out["k_n"]))
+    for k in ("p_fail", "p_not_success", "p_success", "p_metastable", "p_slippage", "p_sinkage"):
+        out[k] = out[k].reshape(shape).T
+    return out
+
+
+def safe_slope(
+    robot: RobotLike,
+    *,
+    terrain: TerrainLike,
+    max_risk: float = 0.05,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+) -> Dict[str, Any]:
+    """The safe-slope limit (``sandslope risk --solve slope --json``): the steepest slope with
+    ``p_fail < max_risk`` at every slope from level up to it (scan every 0.5 deg, then
+    bisection to 0.001 deg). ``limit["kind"]`` is ``"limit"``, ``"none_safe"`` or
+    ``"beyond_range"``; ``safe_slope_deg`` is None unless a limit was found."""
+    return _sandslope.safe_slope(
+        _robot(robot), _terrain(terrain), max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
+    )
+
+
+def safe_mass(
+    robot: RobotLike,
+    slope_deg: float,
+    *,
+    terrain: TerrainLike,
+    max_risk: float = 0.05,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+) -> Dict[str, Any]:
+    """The heaviest safe total mass at one slope (``sandslope risk --solve mass --json``):
+    ``max_mass_kg``, ``max_payload_kg`` (over the robot's own mass) and the ``limit``."""
+    return _sandslope.safe_mass(
+        _robot(robot), float(slope_deg), _terrain(terrain), max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
+    )
+
+
+def _cell_size(cell_size_m: Any) -> Tuple[float, float]:
+    if np.ndim(cell_size_m) == 0:
+        c = float(cell_size_m)
+        return c, c
+    pair = tuple(float(v) for v in cell_size_m)
+    if len(pair) != 2:
+        raise ValueError(f"cell_size_m must be one number or (cell_x, cell_y), not {cell_size_m!r}")
+    return pair  # type: ignore[return-value]
+
+
+def _dem(dem: Any, nodata: Optional[float]) -> np.ndarray:
+    z = np.asarray(dem)
+    if z.ndim != 2:
+        raise ValueError(f"dem must be a 2-D array (rows, cols), row 0 at the north (got shape {z.shape})")
+    z = np.ascontiguousarray(z, dtype=np.float32)
+    if nodata is not None:
+        z = np.where(z == np.float32(nodata), np.float32(np.nan), z)
+    return z
+
+
+def risk_raster(
+    dem: Any,
+    cell_size_m: Any,
+    *,
+    robot: RobotLike,
+    terrain: TerrainLike,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+    max_roll_deg: float = 20.0,
+    descent: str = "symmetric",
+    allow_metastable: bool = False,
+    nodata: Optional[float] = None,
+) -> np.ndarray:
+    """The two bands of ``sandslope plan --risk-map`` for an elevation array.
+
+    ``dem`` (m) is 2-D, row 0 at the north, columns to the east, NaN (or ``nodata``) for
+    missing heights; ``cell_size_m`` is one number or ``(cell_x, cell_y)``. Heights are used
+    as float32, as the CLI does. Each cell's gradient is Horn's 3 x 3 finite difference, so the
+    map border and cells next to nodata have none (NaN).
+
+    Returns float32 of shape ``(2, H, W)``: band 0 the lowest P(failure) over the 16 headings
+    of the planner's grid (roll above ``max_roll_deg`` counts as failure), band 1 the azimuth
+    (degrees clockwise from north) of the steepest climbing heading the time objective may use
+    (success, or metastable with ``allow_metastable``); NaN where impassable or none.
+
+    ``cv_n``/``cv_s``: coefficients of variation where the terrain has no standard deviations
+    (default 0.1 and 0.2, as ``sandslope plan``). For DEMs larger than memory use
+    :func:`sandslope.dask.risk_raster`, which gives the same values tile by tile.
+    """
+    z = _dem(dem, nodata)
+    cx, cy = _cell_size(cell_size_m)
+    bands = _sandslope.risk_raster(
+        z,
+        cx,
+        cy,
+        _robot(robot),
+        _terrain(terrain),
+        cv_n=0.1 if cv_n is None else float(cv_n),
+        cv_s=0.2 if cv_s is None else float(cv_s),
+        max_roll_deg=float(max_roll_deg),
+        descent=descent,
+        allow_metastable=bool(allow_metastable),
+    )
+    return bands.reshape((2,) + z.shape)
+
+
+def plan(
+    dem: Any,
+    cell_size_m: Any,
+    *,
+    robot: RobotLike,
+    terrain: TerrainLike,
+    start: Tuple[int, int],
+    goal: Tuple[int, int],
+    objective: Union[str, Sequence[str]] = "time",
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+    max_roll_deg: float = 20.0,
+    descent: str = "symmetric",
+    allow_metastable: bool = False,
+    time_weight: float = 1e-4,
+    origin: Optional[Tuple[float, float]] = None,
+    nodata: Optional[float] = None,
+) -> Dict[str, Dict[str, Any]]:
+    """Heading-aware routes over an elevation array (``sandslope plan --json``, docs/model.md §8).
+
+    ``start`` and ``goal`` are cells ``(row, col)`` of ``dem`` (NumPy index order: ``dem[row,
+    col]``). ``objective``: ``"time"`` (fastest route through success cells), ``"risk"``
+    (maximum survival, plus ``time_weight`` per second) and/or ``"distance"`` (shortest, physics
+    ignored); the distance route is always added for comparison, as the CLI does.
+
+    Returns ``{objective: route}``; each route has the figures of ``plan --json``
+    (``found``, ``length_m``, ``time_s``, ``survival``, ``max_pitch_deg``, ``max_roll_deg``,
+    ``edges_over_roll_limit``, ``regimes``; or ``found=False`` with ``reason`` and ``message``),
+    its cells (``rows``, ``cols``), their coordinates ``x_m``, ``y_m`` (cell centres; x east and
+    y north of ``origin``, the map's north-west corner, default ``(0, rows * cell_y)``) and
+    heights ``z_m``, and per edge ``steps`` (heading, pitch, roll, length, regime, speed,
+    p_fail, over the roll limit).
+    """
+    z = _dem(dem, nodata)
+    cx, cy = _cell_size(cell_size_m)
+    names = [objective] if isinstance(objective, str) else [str(o) for o in objective]
+    names = list(dict.fromkeys(names + ["distance"]))
+    if origin is None:
+        origin = (0.0, z.shape[0] * cy)
+    return _sandslope.plan(
+        z,
+        cx,
+        cy,
+        _robot(robot),
+        _terrain(terrain),
+        (int(start[0]), int(start[1])),
+        (int(goal[0]), int(goal[1])),
+        names,
+        (float(origin[0]), float(origin[1])),
+        cv_n=0.1 if cv_n is None else float(cv_n),
+        cv_s=0.2 if cv_s is None else float(cv_s),
+        max_roll_deg=float(max_roll_deg),
+        descent=descent,
+        allow_metastable=bool(allow_metastable),
+        time_weight=float(time_weight),
+    )
+
+
+def read_raster(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, Dict[str, float]]:
+    """Reads a GeoTIFF (``.tif``) or ESRI ASCII grid (``.asc``) as the CLI does.
+
+    Returns ``(values, geo)``: a float64 array ``(rows, cols)`` with nodata as NaN, and
+    ``geo = {"west", "north", "cell_x", "cell_y"}`` (map units). Pass ``values`` and
+    ``(geo["cell_x"], geo["cell_y"])`` to :func:`plan` or :func:`risk_raster`.
+    """
+    values, rows, cols, geo = _sandslope.read_raster(os.fspath(path))
+    return values.reshape(rows, cols), geo

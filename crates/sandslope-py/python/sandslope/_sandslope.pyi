@@ -1,0 +1,139 @@
+"""Type stubs of the compiled core (Rust, PyO3). Use the functions of ``sandslope``; the
+classes ``Robot`` and ``Terrain`` are re-exported there."""
+
+import os
+from typing import Any, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+_Path = Union[str, "os.PathLike[str]"]
+_F64 = npt.NDArray[np.float64]
+
+REGIMES: Tuple[str, str, str, str]
+
+class Robot:
+    """A legged robot (docs/model.md §2), validated when built.
+
+    Keys: ``mass_kg`` (m, kg), ``leg_radius_m`` (C-leg radius R), ``leg_width_m`` (W),
+    ``hip_height_m`` (h, 0 <= h <= 2R), ``leg_speed_rad_s`` (omega), ``stance_legs`` (n),
+    ``response_time_s`` (dt); optional ``leg_contact_area_m2`` (A_c, default W R),
+    ``level_step_m`` (measured s*), ``min_step_m`` (s_min, default R).
+    """
+
+    def __init__(self, **keys: Any) -> None: ...
+    @staticmethod
+    def from_toml(path: _Path) -> "Robot":
+        """The robot of a TOML file; ``ValueError`` names the file, key and valid range."""
+    @staticmethod
+    def preset(name: str) -> "Robot":
+        """A built-in robot, e.g. ``"paper-hexapod"``."""
+    def with_mass(self, mass_kg: float) -> "Robot":
+        """The same robot with another total mass, kg."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The keys of docs/model.md §2 (optional keys only when given)."""
+    @property
+    def mass_kg(self) -> float:
+        """Total mass m, kg."""
+    @property
+    def max_depth_m(self) -> float:
+        """Leg reach below the surface ``d_max = 2R - h``, m."""
+    @property
+    def min_step_m(self) -> float:
+        """Step for robust progress s_min, m."""
+    def __eq__(self, other: object) -> bool: ...
+    def __reduce__(self) -> Tuple[Any, ...]: ...
+
+class Terrain:
+    """A terrain table (docs/model.md §7): k_n and k_s (N/m^3, optional SDs) at measured
+    slopes, interpolated linearly in degrees, held below the first point, extrapolated and
+    floored at 0 above the last; optional angle of repose (at or above it: slippage)."""
+
+    def __init__(
+        self, points: List[Dict[str, float]], repose_deg: Optional[float] = None, name: Optional[str] = None
+    ) -> None: ...
+    @staticmethod
+    def from_toml(path: _Path) -> "Terrain":
+        """The terrain of a TOML file; ``ValueError`` names the file, key and valid range."""
+    @staticmethod
+    def preset(name: str) -> "Terrain":
+        """A built-in terrain, e.g. ``"glass-beads-300um"``."""
+    @staticmethod
+    def constant(k_n: float, k_s: float) -> "Terrain":
+        """The same k_n and k_s (N/m^3) at every slope."""
+    def to_dict(self) -> Dict[str, Any]:
+        """``{"name", "repose_deg", "points"}`` (points sorted by slope)."""
+    def at(self, slope_deg: float) -> Dict[str, Any]:
+        """k_n, k_s, k_n_sd, k_s_sd (None when absent) and ``extrapolated`` at one slope."""
+    @property
+    def name(self) -> Optional[str]: ...
+    @property
+    def repose_deg(self) -> Optional[float]: ...
+    def __eq__(self, other: object) -> bool: ...
+    def __reduce__(self) -> Tuple[Any, ...]: ...
+
+def preset_names() -> List[Tuple[str, str, str]]: ...
+def predict(
+    robot: Robot,
+    slope_deg: _F64,
+    k_n: Optional[_F64] = None,
+    k_s: Optional[_F64] = None,
+    terrain: Optional[Terrain] = None,
+    mass_kg: Optional[_F64] = None,
+) -> Dict[str, np.ndarray]: ...
+def phase(
+    robot: Robot, slope_deg: float, k_n_axis: _F64, k_s_axis: _F64, repose_deg: Optional[float] = None
+) -> Dict[str, Any]: ...
+def risk(
+    robot: Robot, slope_deg: _F64, terrain: Terrain, cv_n: Optional[float] = None, cv_s: Optional[float] = None
+) -> Dict[str, _F64]: ...
+def risk_map(
+    robot: Robot,
+    slope_deg: float,
+    k_n_axis: _F64,
+    k_s_axis: _F64,
+    terrain: Terrain,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+) -> Dict[str, Any]: ...
+def safe_slope(
+    robot: Robot, terrain: Terrain, max_risk: float = 0.05, cv_n: Optional[float] = None, cv_s: Optional[float] = None
+) -> Dict[str, Any]: ...
+def safe_mass(
+    robot: Robot,
+    slope_deg: float,
+    terrain: Terrain,
+    max_risk: float = 0.05,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+) -> Dict[str, Any]: ...
+def risk_raster(
+    dem: npt.NDArray[np.float32],
+    cell_x: float,
+    cell_y: float,
+    robot: Robot,
+    terrain: Terrain,
+    cv_n: float = 0.1,
+    cv_s: float = 0.2,
+    max_roll_deg: float = 20.0,
+    descent: str = "symmetric",
+    allow_metastable: bool = False,
+) -> npt.NDArray[np.float32]: ...
+def plan(
+    dem: npt.NDArray[np.float32],
+    cell_x: float,
+    cell_y: float,
+    robot: Robot,
+    terrain: Terrain,
+    start: Tuple[int, int],
+    goal: Tuple[int, int],
+    objectives: List[str],
+    origin: Tuple[float, float],
+    cv_n: float = 0.1,
+    cv_s: float = 0.2,
+    max_roll_deg: float = 20.0,
+    descent: str = "symmetric",
+    allow_metastable: bool = False,
+    time_weight: float = 1e-4,
+) -> Dict[str, Dict[str, Any]]: ...
+def read_raster(path: _Path) -> Tuple[_F64, int, int, Dict[str, float]]: ...

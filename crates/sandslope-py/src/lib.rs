@@ -1,0 +1,49 @@
+//! `sandslope._sandslope`: the compiled core of the `sandslope` Python package.
+//!
+//! A thin layer over the `sandslope` library and the `sandslope-io` readers: it converts
+//! Python values into the library's validated types, releases the GIL while the library
+//! computes (in parallel, with rayon), and hands the results back as NumPy arrays that own
+//! the Rust buffers (no copy). It computes nothing itself. The pure-Python package
+//! (`python/sandslope/`) adds NumPy broadcasting, reshaping, docstrings and the Dask layer.
+//!
+//! Errors are `ValueError`s carrying the message the CLI would print for the same input:
+//! the key (here the Python argument name), the value and the valid range (docs/model.md).
+
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+mod arrays;
+mod model;
+mod plan;
+mod risk;
+mod types;
+
+/// A `ValueError` from anything displayable, with its whole cause chain on one line
+/// (`file: key = value must be ...`).
+pub(crate) fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// A `ValueError` from an `anyhow` error, causes joined by `: ` as the CLI prints them.
+pub(crate) fn anyhow_error(e: anyhow::Error) -> PyErr {
+    PyValueError::new_err(format!("{e:#}"))
+}
+
+/// The compiled module.
+#[pymodule]
+fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<types::PyRobot>()?;
+    m.add_class::<types::PyTerrain>()?;
+    m.add_function(wrap_pyfunction!(types::preset_names, m)?)?;
+    m.add_function(wrap_pyfunction!(model::predict, m)?)?;
+    m.add_function(wrap_pyfunction!(model::phase, m)?)?;
+    m.add_function(wrap_pyfunction!(risk::risk, m)?)?;
+    m.add_function(wrap_pyfunction!(risk::risk_map, m)?)?;
+    m.add_function(wrap_pyfunction!(risk::safe_slope, m)?)?;
+    m.add_function(wrap_pyfunction!(risk::safe_mass, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::risk_raster, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::read_raster, m)?)?;
+    m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;
+    Ok(())
+}

@@ -1,0 +1,232 @@
+//! Elevation models (docs/model.md §8): the two-band risk raster of `sandslope plan
+//! --risk-map`, routes of `sandslope plan --json` with their cells, and the raster reader.
+
+use std::path::PathBuf;
+
+use numpy::PyReadonlyArray2;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use sandslope::plan::{Cell, ClassTerrain, Descent, ElevationGrid, Objective, PlanSettings, Planner, Route};
+use sandslope::{Regime, Uncertainty};
+use sandslope_io::raster::read_raster as read;
+
+use crate::arrays::put;
+use crate::types::{PyRobot, PyTerrain};
+use crate::{anyhow_error, value_error};
+
+/// The planner over a NumPy DEM (row 0 = north, NaN = nodata), as `sandslope plan` builds it.
+#[allow(clippy::too_many_arguments)]
+fn planner(
+    py: Python<'_>,
+    dem: &PyReadonlyArray2<'_, f32>,
+    cell_x: f64,
+    cell_y: f64,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+    cv_n: f64,
+    cv_s: f64,
+    max_roll_deg: f64,
+    descent: &str,
+    allow_metastable: bool,
+    time_weight: f64,
+) -> PyResult<Planner> {
+    let descent = match descent {
+        "symmetric" => Descent::Symmetric,
+        "level" => Descent::Level,
+        other => return Err(value_error(format!("descent = {other:?} must be \"symmetric\" or \"level\""))),
+    };
+    let settings =
+        PlanSettings::new(max_roll_deg, descent, allow_metastable, time_weight).map_err(value_error)?;
+    let fallback = Uncertainty::new(cv_n, cv_s).map_err(value_error)?;
+    let shape = dem.as_array().shape().to_vec();
+    let (rows, cols) = (shape[0], shape[1]);
+    let z: Vec<f32> = dem.as_array().iter().copied().collect();
+    let robot = robot.inner.clone();
+    let terrains = [ClassTerrain { terrain: terrain.inner.clone(), fallback }];
+    py.detach(move || {
+        let grid = ElevationGrid::new(cols, rows, cell_x, cell_y, z, None).map_err(|e| e.to_string())?;
+        Planner::new(grid, None, &terrains, &robot, settings).map_err(|e| e.to_string())
+    })
+    .map_err(value_error)
+}
+
+/// Per cell, the lowest p_fail over the 16 headings and the azimuth of the steepest usable
+/// climb (degrees from north): `2 * rows * cols` float32 values, band after band.
+#[pyfunction]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, cv_n=0.1, cv_s=0.2, max_roll_deg=20.0, descent="symmetric", allow_metastable=false))]
+#[allow(clippy::too_many_arguments)]
+pub fn risk_raster<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f32>,
+    cell_x: f64,
+    cell_y: f64,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+    cv_n: f64,
+    cv_s: f64,
+    max_roll_deg: f64,
+    descent: &str,
+    allow_metastable: bool,
+) -> PyResult<Bound<'py, numpy::PyArray1<f32>>> {
+    let planner = planner(
+        py,
+        &dem,
+        cell_x,
+        cell_y,
+        robot,
+        terrain,
+        cv_n,
+        cv_s,
+        max_roll_deg,
+        descent,
+        allow_metastable,
+        sandslope::plan::DEFAULT_TIME_WEIGHT,
+    )?;
+    let bands = py.detach(move || {
+        let (mut p_fail, climb) = planner.risk_map();
+        drop(planner);
+        p_fail.extend_from_slice(&climb);
+        p_fail
+    });
+    Ok(crate::arrays::array(py, bands))
+}
+
+fn objective(name: &str) -> PyResult<Objective> {
+    Objective::ALL.into_iter().find(|o| o.name() == name).ok_or_else(|| {
+        value_error(format!("objective = {name:?} must be \"time\", \"risk\" or \"distance\""))
+    })
+}
+
+fn cell(which: &str, rc: (i64, i64), rows: usize, cols: usize) -> PyResult<Cell> {
+    let (r, c) = rc;
+    if r < 0 || c < 0 || r as usize >= rows || c as usize >= cols {
+        return Err(value_error(format!(
+            "{which} = ({r}, {c}) is outside the map: rows 0 to {}, columns 0 to {}",
+            rows - 1,
+            cols - 1
+        )));
+    }
+    Ok(Cell { col: c as usize, row: r as usize })
+}
+
+fn route_dict<'py>(
+    py: Python<'py>,
+    r: &Result<Route, sandslope::plan::NoRoute>,
+    planner: &Planner,
+    origin: (f64, f64),
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    match r {
+        Err(e) => {
+            d.set_item("found", false)?;
+            d.set_item("reason", pythonize::pythonize(py, e).map_err(value_error)?)?;
+            d.set_item("message", e.explain())?;
+        }
+        Ok(r) => {
+            let g = planner.grid();
+            d.set_item("found", true)?;
+            d.set_item("length_m", r.length_m)?;
+            d.set_item("time_s", r.time_s)?;
+            d.set_item("survival", r.survival)?;
+            d.set_item("max_pitch_deg", r.max_pitch_deg)?;
+            d.set_item("max_roll_deg", r.max_roll_deg)?;
+            d.set_item("edges_over_roll_limit", r.over_roll_limit)?;
+            let counts = PyDict::new(py);
+            for (g, n) in Regime::ALL.iter().zip(r.regimes) {
+                counts.set_item(g.name(), n)?;
+            }
+            d.set_item("regimes", counts)?;
+            put(&d, "rows", r.cells.iter().map(|c| c.row as i64).collect())?;
+            put(&d, "cols", r.cells.iter().map(|c| c.col as i64).collect())?;
+            put(&d, "x_m", r.cells.iter().map(|c| origin.0 + (c.col as f64 + 0.5) * g.cell_x()).collect())?;
+            put(&d, "y_m", r.cells.iter().map(|c| origin.1 - (c.row as f64 + 0.5) * g.cell_y()).collect())?;
+            put(&d, "z_m", r.cells.iter().map(|&c| g.height(c).unwrap_or(f64::NAN)).collect())?;
+            let steps = PyDict::new(py);
+            put(&steps, "heading_deg", r.steps.iter().map(|s| s.heading_deg).collect())?;
+            put(&steps, "pitch_deg", r.steps.iter().map(|s| s.pitch_deg).collect())?;
+            put(&steps, "roll_deg", r.steps.iter().map(|s| s.roll_deg).collect())?;
+            put(&steps, "length_m", r.steps.iter().map(|s| s.length_m).collect())?;
+            put(&steps, "regime", r.steps.iter().map(|s| s.regime as i8).collect())?;
+            put(&steps, "speed_m_s", r.steps.iter().map(|s| s.speed.unwrap_or(f64::NAN)).collect())?;
+            put(&steps, "p_fail", r.steps.iter().map(|s| s.p_fail).collect())?;
+            put(&steps, "over_roll_limit", r.steps.iter().map(|s| s.over_roll_limit).collect())?;
+            d.set_item("steps", steps)?;
+        }
+    }
+    Ok(d)
+}
+
+/// Routes from `start` to `goal` (each `(row, col)`) for each objective: `{name: route}`.
+#[pyfunction]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, cv_n=0.1, cv_s=0.2, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT))]
+#[allow(clippy::too_many_arguments)]
+pub fn plan<'py>(
+    py: Python<'py>,
+    dem: PyReadonlyArray2<'py, f32>,
+    cell_x: f64,
+    cell_y: f64,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+    start: (i64, i64),
+    goal: (i64, i64),
+    objectives: Vec<String>,
+    origin: (f64, f64),
+    cv_n: f64,
+    cv_s: f64,
+    max_roll_deg: f64,
+    descent: &str,
+    allow_metastable: bool,
+    time_weight: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let objectives: Vec<Objective> = objectives.iter().map(|o| objective(o)).collect::<PyResult<_>>()?;
+    let shape = dem.as_array().shape().to_vec();
+    let (start, goal) = (cell("start", start, shape[0], shape[1])?, cell("goal", goal, shape[0], shape[1])?);
+    let planner = planner(
+        py,
+        &dem,
+        cell_x,
+        cell_y,
+        robot,
+        terrain,
+        cv_n,
+        cv_s,
+        max_roll_deg,
+        descent,
+        allow_metastable,
+        time_weight,
+    )?;
+    let routes = py
+        .detach(|| {
+            use rayon::prelude::*;
+            objectives
+                .par_iter()
+                .map(|&o| planner.route(o, start, goal, &|_| {}).map(|r| (o, r)))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(value_error)?;
+    let d = PyDict::new(py);
+    for (o, r) in &routes {
+        d.set_item(o.name(), route_dict(py, r, &planner, origin)?)?;
+    }
+    Ok(d)
+}
+
+/// `(values, rows, cols, geo)` as returned by [`read_raster`].
+type RasterTuple<'py> = (Bound<'py, numpy::PyArray1<f64>>, usize, usize, Bound<'py, PyDict>);
+
+/// A GeoTIFF or ESRI ASCII raster: `(values, rows, cols, geo)` with the values row-major
+/// (nodata as NaN) and `geo = {west, north, cell_x, cell_y}`.
+#[pyfunction]
+pub fn read_raster<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RasterTuple<'py>> {
+    let raster = py.detach(|| read(&path)).map_err(anyhow_error)?;
+    let values: Vec<f64> = (0..raster.values.len())
+        .map(|i| if raster.is_nodata(i) { f64::NAN } else { raster.values[i] })
+        .collect();
+    let geo = PyDict::new(py);
+    geo.set_item("west", raster.geo.west)?;
+    geo.set_item("north", raster.geo.north)?;
+    geo.set_item("cell_x", raster.geo.cell_x)?;
+    geo.set_item("cell_y", raster.geo.cell_y)?;
+    Ok((crate::arrays::array(py, values), raster.rows, raster.cols, geo))
+}

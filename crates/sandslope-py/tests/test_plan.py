@@ -1,0 +1,88 @@
+"""risk_raster and plan on an elevation array, against `sandslope plan` on the same DEM."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tifffile
+
+import sandslope
+
+DUNE = "examples/planning/dune.asc"
+
+
+@pytest.fixture(scope="module")
+def dune(root):
+    z, geo = sandslope.read_raster(root / DUNE)
+    return z, geo
+
+
+def test_read_raster(dune):
+    z, geo = dune
+    assert z.shape == (200, 200) and geo["cell_x"] == 0.3 and geo["cell_y"] == 0.3
+    assert geo["west"] == 0.0 and geo["north"] == pytest.approx(60.0)
+    # The file's NODATA_value cells come back as NaN.
+    text = (Path(__file__).resolve().parents[3] / DUNE).read_text().split("\n", 6)[6]
+    assert np.isnan(z).sum() == text.split().count("-9999") > 0
+
+
+def test_risk_raster_equals_the_cli(cli, robot, terrain, dune, tmp_path):
+    z, geo = dune
+    out = tmp_path / "risk.tif"
+    cli.run("plan", "--dem", DUNE, "--start-px", "100,150", "--goal-px", "100,50", "--risk-map", out)
+    want = tifffile.imread(out)  # (rows, cols, 2)
+    got = sandslope.risk_raster(z, 0.3, robot=robot, terrain=terrain)
+    assert got.shape == (2, 200, 200) and got.dtype == np.float32
+    for band in range(2):
+        np.testing.assert_array_equal(got[band], want[..., band])
+    # The map border has no gradient; the interior has one.
+    assert np.isnan(got[0, 0]).all() and np.isnan(got[0, :, -1]).all()
+    assert np.isfinite(got[0, 1:-1, 1:-1]).mean() > 0.9
+
+
+def test_nodata_and_flat_ground(robot, terrain):
+    z = np.zeros((6, 7))
+    z[3, 3] = -9999
+    got = sandslope.risk_raster(z, 1.0, robot=robot, terrain=terrain, nodata=-9999)
+    # Cells whose 3 x 3 window holds the nodata cell have no gradient.
+    assert np.isnan(got[0, 2:5, 2:5]).all()
+    # Level ground elsewhere: p_fail is the level-ground risk, and no heading climbs.
+    level = float(sandslope.risk(robot, 0, terrain=terrain, cv_n=0.1, cv_s=0.2)["p_fail"])
+    assert got[0, 1, 1] == pytest.approx(level, abs=1e-6)
+    assert np.isnan(got[1, 1, 1])
+
+
+def test_plan_matches_the_cli(cli, robot, terrain, dune):
+    z, _ = dune
+    want = cli.json("plan", "--dem", DUNE, "--start-px", "100,150", "--goal-px", "100,50", "--objective", "time,risk")
+    got = sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(150, 100), goal=(50, 100),
+                         objective=["time", "risk"])
+    assert set(got) == {"time", "risk", "distance"}
+    for name, w in want["routes"].items():
+        g = got[name]
+        assert g["found"] == w["found"]
+        if not w["found"]:
+            assert g["reason"] == w["reason"]
+            continue
+        for k in ["length_m", "time_s", "survival", "max_pitch_deg", "max_roll_deg", "edges_over_roll_limit",
+                  "regimes"]:
+            assert g[k] == pytest.approx(w[k], rel=1e-12), (name, k)
+        assert (g["rows"][0], g["cols"][0]) == (150, 100) and (g["rows"][-1], g["cols"][-1]) == (50, 100)
+        assert len(g["steps"]["pitch_deg"]) == len(g["rows"]) - 1
+        # Coordinates are cell centres; the route length is the sum of its edge lengths.
+        assert g["x_m"][0] == pytest.approx(100.5 * 0.3) and g["y_m"][0] == pytest.approx(60 - 150.5 * 0.3)
+        assert g["steps"]["length_m"].sum() == pytest.approx(g["length_m"], rel=1e-9)
+
+
+def test_plan_errors(robot, terrain, dune):
+    z, _ = dune
+    with pytest.raises(ValueError, match=r"start = \(500, 3\) is outside the map"):
+        sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(500, 3), goal=(50, 100))
+    with pytest.raises(ValueError, match="on the map border"):
+        sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(0, 3), goal=(50, 100))
+    with pytest.raises(ValueError, match="objective = \"fast\" must be"):
+        sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(150, 100), goal=(50, 100), objective="fast")
+    with pytest.raises(ValueError, match="max_roll_deg = 95 must be strictly between 0 and 90"):
+        sandslope.risk_raster(z, 0.3, robot=robot, terrain=terrain, max_roll_deg=95)
+    with pytest.raises(ValueError, match="dem must be a 2-D array"):
+        sandslope.risk_raster(z[0], 0.3, robot=robot, terrain=terrain)

@@ -1,0 +1,67 @@
+"""risk, risk_map, safe_slope, safe_mass against the CLI; the missing-SD message."""
+
+import numpy as np
+import pytest
+
+import sandslope
+
+
+def test_risk_matches_cli(cli, robot, terrain):
+    slopes = [0, 10, 20, 24]
+    want = cli.json("risk", "--slope", ",".join(map(str, slopes)), "--cv-n", 0.1, "--cv-s", 0.3)
+    got = sandslope.risk(robot, slopes, terrain=terrain, cv_n=0.1, cv_s=0.3)
+    for i, w in enumerate(want):
+        assert got["slope_deg"][i] == w["slope_deg"]
+        assert got["p_fail"][i] == pytest.approx(w["p_fail"], rel=1e-12, abs=1e-300)
+        assert got["p_not_success"][i] == pytest.approx(w["p_not_success"], rel=1e-12, abs=1e-300)
+        for k, v in w["p_regime"].items():
+            assert got[f"p_{k}"][i] == pytest.approx(v, rel=1e-12, abs=1e-300), k
+    total = got["p_success"] + got["p_metastable"] + got["p_slippage"] + got["p_sinkage"]
+    np.testing.assert_allclose(total, 1.0, atol=1e-8)
+    # Failure becomes likelier as the slope steepens on this terrain.
+    assert (np.diff(got["p_fail"]) > 0).all()
+    assert got["p_fail"].shape == (4,) and sandslope.risk(robot, 10, terrain=terrain, cv_n=0.1, cv_s=0.3)[
+        "p_fail"
+    ].shape == ()
+
+
+def test_no_uncertainty_is_the_certain_regime(robot, terrain):
+    # cv = 0: the probabilities are the indicator of predict's regime.
+    for slope in (0, 20, 24.5):
+        r = sandslope.risk(robot, slope, terrain=terrain, cv_n=0, cv_s=0)
+        regime = sandslope.REGIMES[int(sandslope.predict(robot, slope, terrain=terrain)["regime"])]
+        assert float(r[f"p_{regime}"]) == 1.0
+
+
+def test_missing_standard_deviations_name_the_argument(cli, robot, terrain):
+    with pytest.raises(ValueError) as e:
+        sandslope.risk(robot, 10, terrain=terrain)
+    cli_message = cli.error("risk", "--slope", 10)
+    assert str(e.value) == cli_message.replace("--cv-n 0.2", "cv_n=0.2").replace("--cv-n", "cv_n")
+    assert "has no k_n_sd" in str(e.value) and "cv_n=0.2" in str(e.value)
+    with pytest.raises(ValueError, match="cv_s = -1 must be"):
+        sandslope.risk(robot, 10, terrain=terrain, cv_n=0.1, cv_s=-1)
+
+
+def test_solvers_match_cli(cli, robot, root):
+    uncertain = root / "examples" / "phase" / "uncertain-sand.toml"
+    want = cli.json("risk", "--terrain", uncertain, "--solve", "slope", "--max-risk", 0.1)
+    got = sandslope.safe_slope(robot, terrain=uncertain, max_risk=0.1)
+    assert got["limit"] == want["limit"] and got["safe_slope_deg"] == want["safe_slope_deg"]
+    want = cli.json("risk", "--terrain", uncertain, "--slope", 10, "--solve", "mass")
+    got = sandslope.safe_mass(robot, 10, terrain=uncertain)
+    assert got == pytest.approx(want) if got["max_mass_kg"] is None else got["max_mass_kg"] == want["max_mass_kg"]
+    assert got["limit"] == want["limit"]
+
+
+def test_risk_map_matches_pointwise_risk(robot):
+    t = sandslope.Terrain.constant(7e5, 1.5e6)
+    k_n, k_s = np.geomspace(1e5, 1e7, 4), np.geomspace(1e5, 1e7, 5)
+    m = sandslope.risk_map(robot, 20, k_n, k_s, terrain=t, cv_n=0.1, cv_s=0.2)
+    assert m["p_fail"].shape == (4, 5)
+    for i, kn in enumerate(m["k_n"]):
+        for j, ks in enumerate(m["k_s"]):
+            one = sandslope.risk(robot, 20, terrain=sandslope.Terrain.constant(kn, ks), cv_n=0.1, cv_s=0.2)
+            assert m["p_fail"][i, j] == float(one["p_fail"])
+    # Default axes: the CLI's 48 x 48 around the terrain's medians.
+    assert sandslope.risk_map(robot, 20, terrain=t, cv_n=0.1, cv_s=0.2)["p_fail"].shape == (48, 48)

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# The project's one test command: every Rust test, then the Python package's tests.
+#
+# Needs the Rust toolchain and Python 3.9+ with pip (venv module). Creates .venv/ at the
+# repository root (reused on later runs), installs maturin, pytest, numpy, dask, distributed,
+# pandas and tifffile into it from PyPI, builds and installs crates/sandslope-py into it, and
+# runs `cargo test --workspace --locked` and pytest. Environment:
+#   PYTHON=python3.11   interpreter that creates the venv (default: python3)
+#   SANDSLOPE_VENV=DIR  where the venv lives (default: .venv)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+venv=${SANDSLOPE_VENV:-$root/.venv}
+python=${PYTHON:-python3}
+
+seconds() { date +%s; }
+t0=$(seconds)
+
+if [ ! -x "$venv/bin/python" ]; then
+  echo "== creating $venv"
+  "$python" -m venv "$venv"
+fi
+py="$venv/bin/python"
+# maturin's build backend runs the `maturin` program from PATH.
+export PATH="$venv/bin:$PATH"
+echo "== installing the Python test tools into $venv"
+"$py" -m pip install --quiet --disable-pip-version-check \
+  "maturin>=1.9,<2" "pytest>=7" "numpy>=1.21" "dask[array]>=2023.1" "distributed>=2023.1" \
+  "pandas>=1.5" "tifffile>=2023.1"
+t1=$(seconds)
+
+echo "== cargo test --workspace --locked"
+cargo test --workspace --locked
+t2=$(seconds)
+
+# Built in place (pip builds local directories in-tree), so Cargo uses the workspace's
+# target/ and its lock file; the profile is [profile.python-ext] of Cargo.toml.
+echo "== building and installing crates/sandslope-py"
+"$py" -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps \
+  --force-reinstall ./crates/sandslope-py
+t3=$(seconds)
+
+echo "== pytest crates/sandslope-py/tests"
+# The CLI built by `cargo test` above: the Python results are compared with it.
+SANDSLOPE_CLI="$root/target/debug/sandslope" "$py" -m pytest crates/sandslope-py/tests -q -p no:cacheprovider
+t4=$(seconds)
+
+echo "== times: python tools $((t1 - t0)) s, cargo test $((t2 - t1)) s, extension build $((t3 - t2)) s, pytest $((t4 - t3)) s, total $((t4 - t0)) s"

@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 
-use sandslope::{critical_shear_strength, predict as model, Ground, PhaseMap, Robot, Slope, StepTarget};
+use sandslope::{Cause, PhaseMap, Regime, Scenario, Slope, SlopeEvaluation, Terrain};
 
 use crate::arrays::{axis, put, scale_name, values};
 use crate::types::{PyRobot, PyTerrain};
@@ -35,23 +35,52 @@ struct Row {
     propulsion: f64,
     step: f64,
     speed: f64,
+    model_speed: f64,
     margin: f64,
+    critical_progress: f64,
+    critical_robust: f64,
     extrapolated: bool,
 }
 
 /// The reason codes, index of `cause` in the result (see `sandslope.CAUSES`).
-pub const CAUSES: [sandslope::Cause; 6] = [
-    sandslope::Cause::NormalSinkage,
-    sandslope::Cause::AtOrAboveRepose,
-    sandslope::Cause::NoAnchoring,
-    sandslope::Cause::NetBackwardStep,
-    sandslope::Cause::ShortStep,
-    sandslope::Cause::RobustStep,
+pub const CAUSES: [Cause; 6] = [
+    Cause::NormalSinkage,
+    Cause::AtOrAboveRepose,
+    Cause::NoAnchoring,
+    Cause::NetBackwardStep,
+    Cause::ShortStep,
+    Cause::RobustStep,
 ];
 
-/// Every model quantity at each element of the (already broadcast, equally long) inputs.
-/// Either `terrain` (looked up at each slope, `k_n`/`k_s` overriding it where given) or both
-/// `k_n` and `k_s`.
+impl Row {
+    fn from(e: &SlopeEvaluation) -> Row {
+        let nan = |x: Option<f64>| x.unwrap_or(f64::NAN);
+        let p = &e.prediction;
+        Row {
+            k_n: p.k_n,
+            k_s: p.k_s,
+            regime: Regime::ALL.iter().position(|&g| g == p.regime).unwrap_or(0) as i8,
+            cause: CAUSES.iter().position(|&c| c == p.cause).unwrap_or(0) as i8,
+            d_n: nan(p.normal_depth),
+            level_step: p.level_step,
+            d_s: nan(p.shear_depth),
+            t1: nan(p.anchoring_time),
+            slip: nan(p.slip),
+            propulsion: nan(p.propulsion),
+            step: nan(p.step),
+            speed: nan(e.speed()),
+            model_speed: nan(e.model_speed()),
+            margin: nan(e.k_s_margin),
+            critical_progress: e.critical_progress.as_ref().map_or(f64::NAN, |k| *k),
+            critical_robust: e.critical_robust.as_ref().map_or(f64::NAN, |k| *k),
+            extrapolated: e.extrapolated,
+        }
+    }
+}
+
+/// Every model quantity at each element of the (already broadcast, equally long) inputs, by
+/// the library's [`Scenario`] (what `sandslope predict` evaluates). Either `terrain` (looked up
+/// at each slope, `k_n`/`k_s` overriding it where given) or both `k_n` and `k_s`.
 #[pyfunction]
 #[pyo3(signature = (robot, slope_deg, k_n=None, k_s=None, terrain=None, mass_kg=None))]
 #[allow(clippy::too_many_arguments)]
@@ -64,65 +93,35 @@ pub fn predict<'py>(
     terrain: Option<&PyTerrain>,
     mass_kg: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if terrain.is_none() && (k_n.is_none() || k_s.is_none()) {
-        return Err(value_error("give both k_n and k_s, or a terrain (k_n and k_s then override it)"));
-    }
     let slope = slope_deg.as_slice()?;
     let n = slope.len();
     let k_n = k_n.as_ref().map(|a| a.as_slice()).transpose()?;
     let k_s = k_s.as_ref().map(|a| a.as_slice()).transpose()?;
     let mass = mass_kg.as_ref().map(|a| a.as_slice()).transpose()?;
     for (key, a) in [("k_n", k_n), ("k_s", k_s), ("mass_kg", mass)] {
-        if a.is_some_and(|a| a.len() != n) {
-            return Err(value_error(format!(
-                "{key} has {} values for {n} slopes",
-                a.map_or(0, <[f64]>::len)
-            )));
+        if let Some(a) = a.filter(|a| a.len() != n) {
+            return Err(value_error(format!("{key} has {} values for {n} slopes", a.len())));
         }
     }
+    // Without a terrain, both resistances are given everywhere: the table only lends its
+    // (absent) angle of repose, and any valid one-point table will do.
+    let terrain: Terrain = match (terrain, k_n, k_s) {
+        (Some(t), _, _) => t.inner.clone(),
+        (None, Some(_), Some(_)) => Terrain::constant(1.0, 1.0).map_err(value_error)?,
+        _ => return Err(value_error("give both k_n and k_s, or a terrain (k_n and k_s then override it)")),
+    };
     let robot = &robot.inner;
-    let terrain = terrain.map(|t| &t.inner);
     let eval = |i: usize| -> Result<Row, String> {
-        let s = Slope::from_signed_degrees(slope[i])
-            .map_err(|e| e.renamed(element("slope_deg", i, n)).to_string())?;
-        let own;
-        let robot: &Robot = match mass {
-            Some(m) => {
-                own = robot.with_mass(m[i]).map_err(|e| e.renamed(element("mass_kg", i, n)).to_string())?;
-                &own
-            }
-            None => robot,
+        let rename = |e: sandslope::ParamError| {
+            let key = e.key.clone();
+            e.renamed(element(&key, i, n)).to_string()
         };
-        let sample = terrain.map(|t| t.sample(s));
-        let kn = k_n.map(|a| a[i]).or(sample.map(|t| t.ground.k_n)).unwrap_or(f64::NAN);
-        let ks = k_s.map(|a| a[i]).or(sample.map(|t| t.ground.k_s)).unwrap_or(f64::NAN);
-        let ground = Ground::new(kn, ks)
-            .map_err(|e| {
-                let key = e.key.clone();
-                e.renamed(element(&key, i, n)).to_string()
-            })?
-            .with_repose(terrain.and_then(|t| t.repose()));
-        let p = model(robot, s, &ground);
-        let margin =
-            critical_shear_strength(robot, s, ground.k_n, ground.beyond_repose(s), StepTarget::Progress)
-                .map_or(f64::NAN, |k| ground.k_s / k);
-        let nan = |x: Option<f64>| x.unwrap_or(f64::NAN);
-        Ok(Row {
-            k_n: p.k_n,
-            k_s: p.k_s,
-            regime: p.regime as i8,
-            cause: CAUSES.iter().position(|&c| c == p.cause).unwrap_or(0) as i8,
-            d_n: nan(p.normal_depth),
-            level_step: p.level_step,
-            d_s: nan(p.shear_depth),
-            t1: nan(p.anchoring_time),
-            slip: nan(p.slip),
-            propulsion: nan(p.propulsion),
-            step: nan(p.step),
-            speed: nan(p.speed),
-            margin,
-            extrapolated: sample.is_some_and(|t| t.extrapolated) && (k_n.is_none() || k_s.is_none()),
-        })
+        let robot = match mass {
+            Some(m) => robot.with_mass(m[i]).map_err(|e| e.renamed(element("mass_kg", i, n)).to_string())?,
+            None => robot.clone(),
+        };
+        let scenario = Scenario::new(robot, terrain.clone(), k_n.map(|a| a[i]), k_s.map(|a| a[i])).map_err(rename)?;
+        scenario.evaluate(slope[i]).map(|e| Row::from(&e)).map_err(rename)
     };
     let rows: Vec<Row> =
         py.detach(|| (0..n).into_par_iter().map(eval).collect::<Result<_, _>>()).map_err(value_error)?;
@@ -136,6 +135,7 @@ pub fn predict<'py>(
     column!("k_n", k_n);
     column!("k_s", k_s);
     column!("regime", regime);
+    column!("cause", cause);
     column!("d_n_m", d_n);
     column!("level_step_m", level_step);
     column!("d_s_m", d_s);
@@ -144,8 +144,10 @@ pub fn predict<'py>(
     column!("propulsion_m", propulsion);
     column!("step_m", step);
     column!("speed_m_s", speed);
+    column!("model_speed_m_s", model_speed);
     column!("k_s_margin", margin);
-    column!("cause", cause);
+    column!("critical_k_s_progress", critical_progress);
+    column!("critical_k_s_robust", critical_robust);
     column!("extrapolated", extrapolated);
     Ok(d)
 }

@@ -7,30 +7,31 @@ use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use sandslope::plan::{Cell, ClassTerrain, Descent, ElevationGrid, Objective, PlanSettings, Planner, Route};
-use sandslope::{Regime, Uncertainty};
+use sandslope::plan::{Cell, Descent, ElevationGrid, Objective, PlanRequest, PlanSettings, Planner, Route};
+use sandslope::risk::UncertainTerrain;
+use sandslope::Regime;
 use sandslope_io::raster::read_raster as read;
 
 use crate::arrays::put;
 use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
 
-/// The planner over a NumPy DEM (row 0 = north, NaN = nodata), as `sandslope plan` builds it.
+/// The grid, terrain and settings of a NumPy DEM (row 0 = north; NaN or `nodata` = missing
+/// heights, used as float32 like the CLI), as `sandslope plan` builds them.
 #[allow(clippy::too_many_arguments)]
-fn planner(
-    py: Python<'_>,
-    dem: &PyReadonlyArray2<'_, f32>,
+fn inputs(
+    dem: &PyReadonlyArray2<'_, f64>,
     cell_x: f64,
     cell_y: f64,
-    robot: &PyRobot,
+    nodata: Option<f64>,
     terrain: &PyTerrain,
-    cv_n: f64,
-    cv_s: f64,
+    cv_n: Option<f64>,
+    cv_s: Option<f64>,
     max_roll_deg: f64,
     descent: &str,
     allow_metastable: bool,
     time_weight: f64,
-) -> PyResult<Planner> {
+) -> PyResult<(ElevationGrid, UncertainTerrain, PlanSettings)> {
     let descent = match descent {
         "symmetric" => Descent::Symmetric,
         "level" => Descent::Level,
@@ -38,43 +39,42 @@ fn planner(
     };
     let settings =
         PlanSettings::new(max_roll_deg, descent, allow_metastable, time_weight).map_err(value_error)?;
-    let fallback = Uncertainty::new(cv_n, cv_s).map_err(value_error)?;
-    let shape = dem.as_array().shape().to_vec();
-    let (rows, cols) = (shape[0], shape[1]);
-    let z: Vec<f32> = dem.as_array().iter().copied().collect();
-    let robot = robot.inner.clone();
-    let terrains = [ClassTerrain { terrain: terrain.inner.clone(), fallback }];
-    py.detach(move || {
-        let grid = ElevationGrid::new(cols, rows, cell_x, cell_y, z, None).map_err(|e| e.to_string())?;
-        Planner::new(grid, None, &terrains, &robot, settings).map_err(|e| e.to_string())
-    })
-    .map_err(value_error)
+    let terrain = crate::risk::uncertain(terrain, cv_n, cv_s)?;
+    let a = dem.as_array();
+    let (rows, cols) = (a.shape()[0], a.shape()[1]);
+    let grid = match a.as_slice() {
+        Some(z) => ElevationGrid::from_heights(cols, rows, cell_x, cell_y, z, nodata),
+        None => ElevationGrid::from_heights(cols, rows, cell_x, cell_y, &a.iter().copied().collect::<Vec<_>>(), nodata),
+    }
+    .map_err(value_error)?;
+    Ok((grid, terrain, settings))
 }
 
 /// Per cell, the lowest p_fail over the 16 headings and the azimuth of the steepest usable
-/// climb (degrees from north): `2 * rows * cols` float32 values, band after band.
+/// climb (degrees from north), as `sandslope plan --risk-map` writes them: `2 * rows * cols`
+/// float32 values, band after band.
 #[pyfunction]
-#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, cv_n=0.1, cv_s=0.2, max_roll_deg=20.0, descent="symmetric", allow_metastable=false))]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn risk_raster<'py>(
     py: Python<'py>,
-    dem: PyReadonlyArray2<'py, f32>,
+    dem: PyReadonlyArray2<'py, f64>,
     cell_x: f64,
     cell_y: f64,
     robot: &PyRobot,
     terrain: &PyTerrain,
-    cv_n: f64,
-    cv_s: f64,
+    nodata: Option<f64>,
+    cv_n: Option<f64>,
+    cv_s: Option<f64>,
     max_roll_deg: f64,
     descent: &str,
     allow_metastable: bool,
 ) -> PyResult<Bound<'py, numpy::PyArray1<f32>>> {
-    let planner = planner(
-        py,
+    let (grid, terrain, settings) = inputs(
         &dem,
         cell_x,
         cell_y,
-        robot,
+        nodata,
         terrain,
         cv_n,
         cv_s,
@@ -83,12 +83,16 @@ pub fn risk_raster<'py>(
         allow_metastable,
         sandslope::plan::DEFAULT_TIME_WEIGHT,
     )?;
-    let bands = py.detach(move || {
-        let (mut p_fail, climb) = planner.risk_map();
-        drop(planner);
-        p_fail.extend_from_slice(&climb);
-        p_fail
-    });
+    let robot = &robot.inner;
+    let bands = py
+        .detach(move || {
+            let planner = Planner::new(grid, None, &[terrain], robot, settings)?;
+            let (mut p_fail, climb) = planner.risk_map();
+            drop(planner);
+            p_fail.extend_from_slice(&climb);
+            Ok::<_, sandslope::plan::PlanError>(p_fail)
+        })
+        .map_err(value_error)?;
     Ok(crate::arrays::array(py, bands))
 }
 
@@ -157,13 +161,15 @@ fn route_dict<'py>(
     Ok(d)
 }
 
-/// Routes from `start` to `goal` (each `(row, col)`) for each objective: `{name: route}`.
+/// Routes from `start` to `goal` (each `(row, col)`) for each objective, by the library's
+/// `plan::plan` (what `sandslope plan` computes): `{"routes": {name: route}, "extrapolation":
+/// None or {max_pitch_deg, last_point_deg}}`.
 #[pyfunction]
-#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, cv_n=0.1, cv_s=0.2, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT))]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan<'py>(
     py: Python<'py>,
-    dem: PyReadonlyArray2<'py, f32>,
+    dem: PyReadonlyArray2<'py, f64>,
     cell_x: f64,
     cell_y: f64,
     robot: &PyRobot,
@@ -172,22 +178,20 @@ pub fn plan<'py>(
     goal: (i64, i64),
     objectives: Vec<String>,
     origin: (f64, f64),
-    cv_n: f64,
-    cv_s: f64,
+    nodata: Option<f64>,
+    cv_n: Option<f64>,
+    cv_s: Option<f64>,
     max_roll_deg: f64,
     descent: &str,
     allow_metastable: bool,
     time_weight: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let objectives: Vec<Objective> = objectives.iter().map(|o| objective(o)).collect::<PyResult<_>>()?;
-    let shape = dem.as_array().shape().to_vec();
-    let (start, goal) = (cell("start", start, shape[0], shape[1])?, cell("goal", goal, shape[0], shape[1])?);
-    let planner = planner(
-        py,
+    let (grid, terrain, settings) = inputs(
         &dem,
         cell_x,
         cell_y,
-        robot,
+        nodata,
         terrain,
         cv_n,
         cv_s,
@@ -196,19 +200,24 @@ pub fn plan<'py>(
         allow_metastable,
         time_weight,
     )?;
-    let routes = py
-        .detach(|| {
-            use rayon::prelude::*;
-            objectives
-                .par_iter()
-                .map(|&o| planner.route(o, start, goal, &|_| {}).map(|r| (o, r)))
-                .collect::<Result<Vec<_>, _>>()
-        })
+    let (rows, cols) = (grid.rows(), grid.cols());
+    let request = PlanRequest {
+        start: cell("start", start, rows, cols)?,
+        goal: cell("goal", goal, rows, cols)?,
+        objectives,
+        risk_map: false,
+    };
+    let robot = &robot.inner;
+    let result = py
+        .detach(|| sandslope::plan::plan(grid, None, &[terrain], robot, settings, &request, &|_, _, _| {}))
         .map_err(value_error)?;
-    let d = PyDict::new(py);
-    for (o, r) in &routes {
-        d.set_item(o.name(), route_dict(py, r, &planner, origin)?)?;
+    let routes = PyDict::new(py);
+    for (o, r) in &result.routes {
+        routes.set_item(o.name(), route_dict(py, r, &result.planner, origin)?)?;
     }
+    let d = PyDict::new(py);
+    d.set_item("routes", routes)?;
+    d.set_item("extrapolation", pythonize::pythonize(py, &result.extrapolation).map_err(value_error)?)?;
     Ok(d)
 }
 

@@ -6,44 +6,31 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
-use rayon::prelude::*;
 
-use sandslope::risk::{failure_risk, failure_risk_map, max_safe_mass, safe_slope_limit, UncertainTerrain};
-use sandslope::{RegimeProbabilities, Slope};
+use sandslope::risk::uncertainty::CvSource;
+use sandslope::risk::{max_safe_mass, risk_curve, safe_slope_limit, RiskMap, UncertainTerrain};
+use sandslope::Slope;
 
 use crate::arrays::{axis, put, values};
 use crate::types::{PyRobot, PyTerrain};
 use crate::value_error;
 
-/// The terrain read as uncertain, with the CLI's hint when standard deviations are missing
-/// (naming the Python arguments instead of the flags).
+/// The terrain read as uncertain by the library's one rule (docs/model.md §9): a given CV,
+/// else the table's SD over its value, else the default CV.
 pub fn uncertain(terrain: &PyTerrain, cv_n: Option<f64>, cv_s: Option<f64>) -> PyResult<UncertainTerrain> {
-    UncertainTerrain::new(terrain.inner.clone(), cv_n, cv_s).map_err(|e| {
-        if e.key.starts_with("points") {
-            let what = e.key.rsplit('.').next().unwrap_or("k_n_sd / k_s_sd").to_string();
-            let arg = if what.starts_with("k_n") { "cv_n" } else { "cv_s" };
-            value_error(format!(
-                "terrain `{}` has no {what} (standard deviation across trials) at {}: give {arg} \
-                 (a coefficient of variation, sd / value, e.g. {arg}=0.2), or add {what} to every point",
-                terrain.inner.name().unwrap_or("(unnamed)"),
-                e.key.split('.').next().unwrap_or("a point"),
-            ))
-        } else {
-            value_error(e)
-        }
-    })
+    UncertainTerrain::new(terrain.inner.clone(), cv_n, cv_s).map_err(value_error)
 }
 
-fn put_probabilities(d: &Bound<'_, PyDict>, p: &[RegimeProbabilities]) -> PyResult<()> {
-    put(d, "p_fail", p.iter().map(RegimeProbabilities::p_fail).collect())?;
-    put(d, "p_not_success", p.iter().map(RegimeProbabilities::p_not_success).collect())?;
-    put(d, "p_success", p.iter().map(|p| p.success).collect())?;
-    put(d, "p_metastable", p.iter().map(|p| p.metastable).collect())?;
-    put(d, "p_slippage", p.iter().map(|p| p.slippage).collect())?;
-    put(d, "p_sinkage", p.iter().map(|p| p.sinkage).collect())
+fn source(s: CvSource) -> &'static str {
+    match s {
+        CvSource::Given => "given",
+        CvSource::Table => "table",
+        CvSource::Default => "default",
+    }
 }
 
-/// Regime probabilities at each slope (the columns of `sandslope risk --csv`).
+/// Regime probabilities at each slope (the columns of `sandslope risk --csv`), with the
+/// coefficients of variation used and where they came from (`given`, `table`, `default`).
 #[pyfunction]
 #[pyo3(signature = (robot, slope_deg, terrain, cv_n=None, cv_s=None))]
 pub fn risk<'py>(
@@ -56,37 +43,31 @@ pub fn risk<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let terrain = uncertain(terrain, cv_n, cv_s)?;
     let degrees = values(&slope_deg);
-    let n = degrees.len();
-    let slopes: Vec<Slope> = degrees
-        .iter()
-        .enumerate()
-        .map(|(i, &d)| {
-            Slope::from_signed_degrees(d).map_err(|e| {
-                value_error(e.renamed(if n > 1 { format!("slope_deg[{i}]") } else { "slope_deg".into() }))
-            })
-        })
-        .collect::<PyResult<_>>()?;
     let robot = &robot.inner;
-    let out: Vec<(RegimeProbabilities, f64, f64)> = py.detach(|| {
-        slopes
-            .par_iter()
-            .map(|&s| {
-                let (_, u) = terrain.at(s);
-                (failure_risk(robot, s, &terrain), u.cv_n(), u.cv_s())
-            })
-            .collect()
-    });
+    let curve = py.detach(|| risk_curve(robot, &terrain, &degrees)).map_err(|e| {
+        // The library names the key; point at the element when there are several.
+        let at = degrees.iter().position(|&d| Slope::from_signed_degrees(d).is_err()).unwrap_or(0);
+        value_error(if degrees.len() > 1 { e.renamed(format!("slope_deg[{at}]")) } else { e })
+    })?;
+    let pts = &curve.points;
     let d = PyDict::new(py);
-    put(&d, "slope_deg", degrees)?;
-    put(&d, "cv_n", out.iter().map(|o| o.1).collect())?;
-    put(&d, "cv_s", out.iter().map(|o| o.2).collect())?;
-    let p: Vec<RegimeProbabilities> = out.into_iter().map(|o| o.0).collect();
-    put_probabilities(&d, &p)?;
+    put(&d, "slope_deg", degrees.clone())?;
+    put(&d, "cv_n", pts.iter().map(|p| p.cv_n).collect())?;
+    put(&d, "cv_s", pts.iter().map(|p| p.cv_s).collect())?;
+    d.set_item("cv_n_source", pts.iter().map(|p| source(p.cv_n_source)).collect::<Vec<_>>())?;
+    d.set_item("cv_s_source", pts.iter().map(|p| source(p.cv_s_source)).collect::<Vec<_>>())?;
+    put(&d, "p_fail", pts.iter().map(|p| p.p_fail).collect())?;
+    put(&d, "p_not_success", pts.iter().map(|p| p.p_not_success).collect())?;
+    put(&d, "p_success", pts.iter().map(|p| p.probabilities.success).collect())?;
+    put(&d, "p_metastable", pts.iter().map(|p| p.probabilities.metastable).collect())?;
+    put(&d, "p_slippage", pts.iter().map(|p| p.probabilities.slippage).collect())?;
+    put(&d, "p_sinkage", pts.iter().map(|p| p.probabilities.sinkage).collect())?;
     Ok(d)
 }
 
-/// Regime probabilities over a grid of median (k_n, k_s) at one slope, with the terrain's
-/// uncertainty and repose at that slope (`sandslope risk --map`); row-major, one row per k_s.
+/// P(failure) and P(not success) over a grid of median (k_n, k_s) at one slope, with the
+/// terrain's uncertainty and repose at that slope (`sandslope risk --map`); row-major, one
+/// row per k_s.
 #[pyfunction]
 #[pyo3(signature = (robot, slope_deg, k_n_axis, k_s_axis, terrain, cv_n=None, cv_s=None))]
 #[allow(clippy::too_many_arguments)]
@@ -101,20 +82,24 @@ pub fn risk_map<'py>(
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let terrain = uncertain(terrain, cv_n, cv_s)?;
-    let slope = Slope::from_signed_degrees(slope_deg).map_err(value_error)?;
+    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| value_error(e.renamed("slope_deg")))?;
     let kn = axis("k_n_axis", &values(&k_n_axis))?;
     let ks = axis("k_s_axis", &values(&k_s_axis))?;
-    let (ground, u) = terrain.at(slope);
+    let g = terrain.sample(slope);
     let robot = &robot.inner;
-    let p = py.detach(|| failure_risk_map(robot, slope, ground.repose, &kn, &ks, u, &|| {}));
+    let map = py.detach(|| RiskMap::compute(robot, slope, g.ground.repose, &kn, &ks, g.uncertainty, &|| {}));
     let d = PyDict::new(py);
-    put_probabilities(&d, &p)?;
+    put(&d, "p_fail", map.p_fail)?;
+    put(&d, "p_not_success", map.p_not_success)?;
     put(&d, "k_n", kn.values())?;
     put(&d, "k_s", ks.values())?;
-    d.set_item("terrain_k_n", ground.k_n)?;
-    d.set_item("terrain_k_s", ground.k_s)?;
-    d.set_item("cv_n", u.cv_n())?;
-    d.set_item("cv_s", u.cv_s())?;
+    d.set_item("terrain_k_n", g.ground.k_n)?;
+    d.set_item("terrain_k_s", g.ground.k_s)?;
+    d.set_item("cv_n", g.uncertainty.cv_n())?;
+    d.set_item("cv_s", g.uncertainty.cv_s())?;
+    d.set_item("cv_n_source", source(g.cv_n_source))?;
+    d.set_item("cv_s_source", source(g.cv_s_source))?;
+    d.set_item("beyond_repose", map.beyond_repose)?;
     Ok(d)
 }
 
@@ -152,7 +137,7 @@ pub fn safe_mass<'py>(
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let terrain = uncertain(terrain, cv_n, cv_s)?;
-    let slope = Slope::from_signed_degrees(slope_deg).map_err(value_error)?;
+    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| value_error(e.renamed("slope_deg")))?;
     let robot = &robot.inner;
     let limit = py.detach(|| max_safe_mass(robot, slope, &terrain, max_risk)).map_err(value_error)?;
     let own = robot.mass();

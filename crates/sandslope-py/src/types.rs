@@ -203,14 +203,15 @@ impl PyTerrain {
     /// The terrain at one slope (interpolation rule of docs/model.md §7): a dict with k_n,
     /// k_s, k_n_sd, k_s_sd (None where the table has none) and `extrapolated`.
     fn at<'py>(&self, py: Python<'py>, slope_deg: f64) -> PyResult<Bound<'py, PyDict>> {
-        let slope = Slope::from_signed_degrees(slope_deg).map_err(value_error)?;
-        let s = self.inner.sample(slope);
+        let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| value_error(e.renamed("slope_deg")))?;
+        let ground = self.inner.at(slope);
+        let (k_n_sd, k_s_sd) = self.inner.sd_at(slope);
         let d = PyDict::new(py);
-        d.set_item("k_n", s.ground.k_n)?;
-        d.set_item("k_s", s.ground.k_s)?;
-        d.set_item("k_n_sd", s.k_n_sd)?;
-        d.set_item("k_s_sd", s.k_s_sd)?;
-        d.set_item("extrapolated", s.extrapolated)?;
+        d.set_item("k_n", ground.k_n)?;
+        d.set_item("k_s", ground.k_s)?;
+        d.set_item("k_n_sd", k_n_sd)?;
+        d.set_item("k_s_sd", k_s_sd)?;
+        d.set_item("extrapolated", self.inner.extrapolates(slope))?;
         Ok(d)
     }
 

@@ -47,7 +47,7 @@ def test_nodata_and_flat_ground(robot, terrain):
     # Cells whose 3 x 3 window holds the nodata cell have no gradient.
     assert np.isnan(got[0, 2:5, 2:5]).all()
     # Level ground elsewhere: p_fail is the level-ground risk, and no heading climbs.
-    level = float(sandslope.risk(robot, 0, terrain=terrain, cv_n=0.1, cv_s=0.2)["p_fail"])
+    level = float(sandslope.risk(robot, 0, terrain=terrain)["p_fail"])
     assert got[0, 1, 1] == pytest.approx(level, abs=1e-6)
     assert np.isnan(got[1, 1, 1])
 
@@ -55,8 +55,9 @@ def test_nodata_and_flat_ground(robot, terrain):
 def test_plan_matches_the_cli(cli, robot, terrain, dune):
     z, _ = dune
     want = cli.json("plan", "--dem", DUNE, "--start-px", "100,150", "--goal-px", "100,50", "--objective", "time,risk")
-    got = sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(150, 100), goal=(50, 100),
-                         objective=["time", "risk"])
+    result = sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(150, 100), goal=(50, 100),
+                            objective=["time", "risk"])
+    got = result["routes"]
     assert set(got) == {"time", "risk", "distance"}
     for name, w in want["routes"].items():
         g = got[name]

@@ -8,7 +8,7 @@ import pytest
 import sandslope
 
 KEYS = ["slope_deg", "k_n", "k_s", "d_n_m", "level_step_m", "d_s_m", "t1_s", "slip_m", "propulsion_m",
-        "step_m", "speed_m_s", "k_s_margin"]
+        "step_m", "speed_m_s", "model_speed_m_s", "k_s_margin", "critical_k_s_progress", "critical_k_s_robust"]
 
 
 def same(a, b):
@@ -29,6 +29,8 @@ def test_terrain_lookup_matches_cli(cli, robot, terrain, slope):
     for k in KEYS:
         assert same(float(got[k]), want[k]), k
     assert sandslope.REGIMES[int(got["regime"])] == want["regime"]
+    assert sandslope.CAUSES[int(got["cause"])] == want["cause"]
+    assert bool(got["extrapolated"]) == want["extrapolated"]
 
 
 def test_overrides_and_mass_match_cli(cli, robot, terrain):
@@ -85,8 +87,11 @@ def test_errors_carry_the_cli_message(cli, robot, terrain):
     assert str(e.value) == cli.error("predict", "--slope", "95").replace("--slope", "slope_deg")
     with pytest.raises(ValueError, match=r"^slope_deg\[2\] = 95 must be strictly between -90 and 90 degrees$"):
         sandslope.predict(robot, [0, 10, 95], terrain=terrain)
-    with pytest.raises(ValueError, match=r"^k_s\[1\] = -1 must be a finite number of at least 0$"):
+    with pytest.raises(ValueError, match=r"^k_s\[1\] = -1 must be a finite number greater than 0$"):
         sandslope.predict(robot, 10, 7e5, [1e6, -1])
+    with pytest.raises(ValueError) as e:
+        sandslope.predict(robot, 10, k_n=0, terrain=terrain)
+    assert str(e.value) == cli.error("predict", "--slope", "10", "--k-n", "0").replace("--k-n", "k_n")
     with pytest.raises(ValueError, match="mass_kg = -2 must be"):
         sandslope.predict(robot, 10, 7e5, 1e6, mass_kg=-2)
     with pytest.raises(ValueError, match="give both k_n and k_s, or a terrain"):

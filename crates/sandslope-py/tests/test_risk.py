@@ -33,14 +33,21 @@ def test_no_uncertainty_is_the_certain_regime(robot, terrain):
         assert float(r[f"p_{regime}"]) == 1.0
 
 
-def test_missing_standard_deviations_name_the_argument(cli, robot, terrain):
-    with pytest.raises(ValueError) as e:
-        sandslope.risk(robot, 10, terrain=terrain)
-    cli_message = cli.error("risk", "--slope", 10)
-    assert str(e.value) == cli_message.replace("--cv-n 0.2", "cv_n=0.2").replace("--cv-n", "cv_n")
-    assert "has no k_n_sd" in str(e.value) and "cv_n=0.2" in str(e.value)
+def test_one_uncertainty_rule(cli, robot, terrain, root):
+    # docs/model.md §9: a given CV, else the table's SD over its value, else 0.1 / 0.2.
+    plain = sandslope.risk(robot, [0, 10], terrain=terrain)
+    assert list(plain["cv_n_source"]) == ["default", "default"] and (plain["cv_s"] == 0.2).all()
+    want = cli.json("risk", "--slope", "0,10")
+    assert [p["p_fail"] for p in want] == pytest.approx(list(plain["p_fail"]), rel=1e-12, abs=1e-300)
+    uncertain = root / "examples" / "phase" / "uncertain-sand.toml"
+    table = sandslope.risk(robot, 10, terrain=uncertain, cv_s=0.05)
+    assert table["cv_n_source"] == "table" and table["cv_s_source"] == "given" and table["cv_s"] == 0.05
+    at = sandslope.Terrain.from_toml(uncertain).at(10)
+    assert float(table["cv_n"]) == pytest.approx(at["k_n_sd"] / at["k_n"], rel=1e-12)
     with pytest.raises(ValueError, match="cv_s = -1 must be"):
         sandslope.risk(robot, 10, terrain=terrain, cv_n=0.1, cv_s=-1)
+    with pytest.raises(ValueError, match=r"slope_deg\[1\] = 95 must be"):
+        sandslope.risk(robot, [10, 95], terrain=terrain)
 
 
 def test_solvers_match_cli(cli, robot, root):
@@ -63,5 +70,3 @@ def test_risk_map_matches_pointwise_risk(robot):
         for j, ks in enumerate(m["k_s"]):
             one = sandslope.risk(robot, 20, terrain=sandslope.Terrain.constant(kn, ks), cv_n=0.1, cv_s=0.2)
             assert m["p_fail"][i, j] == float(one["p_fail"])
-    # Default axes: the CLI's 48 x 48 around the terrain's medians.
-    assert sandslope.risk_map(robot, 20, terrain=t, cv_n=0.1, cv_s=0.2)["p_fail"].shape == (48, 48)

@@ -145,7 +145,7 @@ def predict(
     ``slope_deg``, ``k_n``, ``k_s`` and ``mass_kg`` are scalars or arrays, broadcast together by
     NumPy's rules. Give either ``k_n`` and ``k_s`` (N/m^3), or a ``terrain`` looked up at each
     slope (docs/model.md §7: linear in degrees, held below the first point, extrapolated and
-    floored at 0 above the last); with a terrain, ``k_n`` or ``k_s`` override it. ``mass_kg``
+    floored at 0 above the last); with a terrain, ``k_n`` or ``k_s`` (> 0) override it. ``mass_kg``
     replaces the robot's total mass. Negative slopes (descending) are evaluated as climbing
     ``|slope|`` (docs/model.md §8).
 
@@ -159,9 +159,14 @@ def predict(
     - ``t1_s``: anchoring time ``t1 = (asin((d_s + h)/R - 1) - phi0) / omega``;
     - ``slip_m``: backward slip ``s1 = 1/2 g sin(theta) t1^2``;
     - ``propulsion_m``: ``s2 = s* ((T/2 - t1)/(T/2))^2 - g sin(theta) t1 (T/2 - t1)``;
-    - ``step_m``: net step ``s = s2 - s1``; ``speed_m_s``: ``v = s / (T/2)``;
-    - ``k_s_margin``: k_s over the smallest k_s that still gives progress;
-    - ``extrapolated`` (bool): the terrain was extrapolated beyond its last point.
+    - ``step_m``: net step ``s = s2 - s1``;
+    - ``speed_m_s``: the speed the robot makes, ``v = s / (T/2)``, except where the regime rules
+      it out (legs sinking, slope at or above repose: NaN); ``model_speed_m_s``: the stance
+      model's ``v`` whatever the regime;
+    - ``k_s_margin``: k_s over the smallest k_s that still gives progress (docs/model.md §13);
+      ``critical_k_s_progress``, ``critical_k_s_robust``: the smallest k_s giving ``s > 0`` and
+      ``s >= s_min``;
+    - ``extrapolated`` (bool): a terrain value was extrapolated beyond its last point.
 
     Floats are NaN where the JSON has ``null`` (no anchoring: no t1, slip, step or speed).
     0-d inputs give 0-d arrays (use ``float(...)``).
@@ -252,18 +257,20 @@ def risk(
     """Regime probabilities on uncertain terrain (docs/model.md §9), as ``sandslope risk --csv``.
 
     k_n and k_s at each slope are independent log-normals whose medians are the terrain's
-    values and whose coefficients of variation are ``cv_n``/``cv_s`` when given, else the
-    terrain's ``k_n_sd``/``k_s_sd`` over its value. Probabilities come from deterministic
-    quadrature (reproducible to 1e-9), not sampling.
+    values; their coefficients of variation follow the one rule of docs/model.md §9: ``cv_n``
+    /``cv_s`` when given, else the terrain's ``k_n_sd``/``k_s_sd`` over its value, else the
+    defaults 0.1 and 0.2. Probabilities come from deterministic quadrature (reproducible to
+    1e-9), not sampling.
 
     Returns arrays of the shape of ``slope_deg``: ``p_fail`` = P(sinkage or slippage),
-    ``p_not_success``, ``p_success``, ``p_metastable``, ``p_slippage``, ``p_sinkage``, and the
-    ``cv_n``, ``cv_s`` used at each slope.
+    ``p_not_success``, ``p_success``, ``p_metastable``, ``p_slippage``, ``p_sinkage``, the
+    ``cv_n``, ``cv_s`` used at each slope and where each came from (``cv_n_source``,
+    ``cv_s_source``: ``"given"``, ``"table"`` or ``"default"``).
     """
     robot, terrain = _robot(robot), _terrain(terrain)
     s = _float_array("slope_deg", slope_deg)
     out = _sandslope.risk(robot, np.ascontiguousarray(s).reshape(-1), terrain, cv_n=cv_n, cv_s=cv_s)
-    return {k: v.reshape(s.shape) for k, v in out.items()}
+    return {k: np.asarray(v).reshape(s.shape) for k, v in out.items()}
 
 
 def risk_map(
@@ -284,9 +291,10 @@ def risk_map(
     48 log-spaced values from the terrain's k_n / 100 to x 100 and k_s / 1000 to x 100.
     Each cell is a full quadrature (about a millisecond).
 
-    Returns ``p_fail`` and the per-regime probabilities, each of shape
-    ``(len(k_n_axis), len(k_s_axis))``; ``k_n``, ``k_s`` (the axes); ``terrain_k_n``,
-    ``terrain_k_s`` (the terrain's medians at this slope) and the ``cv_n``, ``cv_s`` used.
+    Returns ``p_fail`` and ``p_not_success``, each of shape ``(len(k_n_axis), len(k_s_axis))``;
+    ``k_n``, ``k_s`` (the axes); ``terrain_k_n``, ``terrain_k_s`` (the terrain's medians at this
+    slope), the ``cv_n``, ``cv_s`` used (rule of docs/model.md §9) and their sources, and
+    ``beyond_repose``.
     """
     robot, terrain = _robot(robot), _terrain(terrain)
     if mass_kg is not None:
@@ -296,7 +304,7 @@ def risk_map(
     ks = _axis("k_s_axis", np.geomspace(at["k_s"] / 1000, at["k_s"] * 100, 48) if k_s_axis is None else k_s_axis)
     out = _sandslope.risk_map(robot, float(slope_deg), kn, ks, terrain, cv_n=cv_n, cv_s=cv_s)
     shape = (len(out["k_s"]), len(out["k_n"]))
-    for k in ("p_fail", "p_not_success", "p_success", "p_metastable", "p_slippage", "p_sinkage"):
+    for k in ("p_fail", "p_not_success"):
         out[k] = out[k].reshape(shape).T
     return out
 
@@ -344,14 +352,11 @@ def _cell_size(cell_size_m: Any) -> Tuple[float, float]:
     return pair  # type: ignore[return-value]
 
 
-def _dem(dem: Any, nodata: Optional[float]) -> np.ndarray:
+def _dem(dem: Any) -> np.ndarray:
     z = np.asarray(dem)
     if z.ndim != 2:
         raise ValueError(f"dem must be a 2-D array (rows, cols), row 0 at the north (got shape {z.shape})")
-    z = np.ascontiguousarray(z, dtype=np.float32)
-    if nodata is not None:
-        z = np.where(z == np.float32(nodata), np.float32(np.nan), z)
-    return z
+    return np.ascontiguousarray(z, dtype=np.float64)
 
 
 def risk_raster(
@@ -379,11 +384,12 @@ def risk_raster(
     (degrees clockwise from north) of the steepest climbing heading the time objective may use
     (success, or metastable with ``allow_metastable``); NaN where impassable or none.
 
-    ``cv_n``/``cv_s``: coefficients of variation where the terrain has no standard deviations
-    (default 0.1 and 0.2, as ``sandslope plan``). For DEMs larger than memory use
+    ``cv_n``/``cv_s``: coefficients of variation, by the rule of docs/model.md §9 (given, else
+    the terrain's SDs, else 0.1 and 0.2), as ``sandslope plan --cv-n --cv-s``. For DEMs larger
+    than memory use
     :func:`sandslope.dask.risk_raster`, which gives the same values tile by tile.
     """
-    z = _dem(dem, nodata)
+    z = _dem(dem)
     cx, cy = _cell_size(cell_size_m)
     bands = _sandslope.risk_raster(
         z,
@@ -391,8 +397,9 @@ def risk_raster(
         cy,
         _robot(robot),
         _terrain(terrain),
-        cv_n=0.1 if cv_n is None else float(cv_n),
-        cv_s=0.2 if cv_s is None else float(cv_s),
+        nodata=None if nodata is None else float(nodata),
+        cv_n=cv_n,
+        cv_s=cv_s,
         max_roll_deg=float(max_roll_deg),
         descent=descent,
         allow_metastable=bool(allow_metastable),
@@ -417,7 +424,7 @@ def plan(
     time_weight: float = 1e-4,
     origin: Optional[Tuple[float, float]] = None,
     nodata: Optional[float] = None,
-) -> Dict[str, Dict[str, Any]]:
+) -> Dict[str, Any]:
     """Heading-aware routes over an elevation array (``sandslope plan --json``, docs/model.md §8).
 
     ``start`` and ``goal`` are cells ``(row, col)`` of ``dem`` (NumPy index order: ``dem[row,
@@ -425,7 +432,9 @@ def plan(
     (maximum survival, plus ``time_weight`` per second) and/or ``"distance"`` (shortest, physics
     ignored); the distance route is always added for comparison, as the CLI does.
 
-    Returns ``{objective: route}``; each route has the figures of ``plan --json``
+    Returns ``{"routes": {objective: route}, "extrapolation": None or {"max_pitch_deg",
+    "last_point_deg"}}`` (set when a route climbs above the terrain's last measured point);
+    each route has the figures of ``plan --json``
     (``found``, ``length_m``, ``time_s``, ``survival``, ``max_pitch_deg``, ``max_roll_deg``,
     ``edges_over_roll_limit``, ``regimes``; or ``found=False`` with ``reason`` and ``message``),
     its cells (``rows``, ``cols``), their coordinates ``x_m``, ``y_m`` (cell centres; x east and
@@ -433,7 +442,7 @@ def plan(
     heights ``z_m``, and per edge ``steps`` (heading, pitch, roll, length, regime, speed,
     p_fail, over the roll limit).
     """
-    z = _dem(dem, nodata)
+    z = _dem(dem)
     cx, cy = _cell_size(cell_size_m)
     names = [objective] if isinstance(objective, str) else [str(o) for o in objective]
     names = list(dict.fromkeys(names + ["distance"]))
@@ -449,8 +458,9 @@ def plan(
         (int(goal[0]), int(goal[1])),
         names,
         (float(origin[0]), float(origin[1])),
-        cv_n=0.1 if cv_n is None else float(cv_n),
-        cv_s=0.2 if cv_s is None else float(cv_s),
+        nodata=None if nodata is None else float(nodata),
+        cv_n=cv_n,
+        cv_s=cv_s,
         max_roll_deg=float(max_roll_deg),
         descent=descent,
         allow_metastable=bool(allow_metastable),

@@ -68,12 +68,12 @@ def risk_raster(
         max_roll_deg=max_roll_deg,
         descent=descent,
         allow_metastable=allow_metastable,
+        nodata=nodata,
     )
     # Fail now, not inside a worker: the same checks on a tiny map.
-    _eager_risk_raster(np.zeros((3, 3), np.float32), (cx, cy), **options)
-    z = z.astype(np.float32)
-    if nodata is not None:
-        z = da.where(z == np.float32(nodata), np.float32(np.nan), z)
+    _eager_risk_raster(np.zeros((3, 3)), (cx, cy), **options)
+    if not np.issubdtype(z.dtype, np.floating):
+        z = z.astype(np.float64)  # room for the NaN padding
     padded = da.overlap.overlap(z, depth={0: 1, 1: 1}, boundary={0: np.nan, 1: np.nan})
     return padded.map_blocks(
         _tile,

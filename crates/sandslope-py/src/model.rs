@@ -120,7 +120,8 @@ pub fn predict<'py>(
             Some(m) => robot.with_mass(m[i]).map_err(|e| e.renamed(element("mass_kg", i, n)).to_string())?,
             None => robot.clone(),
         };
-        let scenario = Scenario::new(robot, terrain.clone(), k_n.map(|a| a[i]), k_s.map(|a| a[i])).map_err(rename)?;
+        let scenario =
+            Scenario::new(robot, terrain.clone(), k_n.map(|a| a[i]), k_s.map(|a| a[i])).map_err(rename)?;
         scenario.evaluate(slope[i]).map(|e| Row::from(&e)).map_err(rename)
     };
     let rows: Vec<Row> =

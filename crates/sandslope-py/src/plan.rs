@@ -44,7 +44,14 @@ fn inputs(
     let (rows, cols) = (a.shape()[0], a.shape()[1]);
     let grid = match a.as_slice() {
         Some(z) => ElevationGrid::from_heights(cols, rows, cell_x, cell_y, z, nodata),
-        None => ElevationGrid::from_heights(cols, rows, cell_x, cell_y, &a.iter().copied().collect::<Vec<_>>(), nodata),
+        None => ElevationGrid::from_heights(
+            cols,
+            rows,
+            cell_x,
+            cell_y,
+            &a.iter().copied().collect::<Vec<_>>(),
+            nodata,
+        ),
     }
     .map_err(value_error)?;
     Ok((grid, terrain, settings))

@@ -1,0 +1,73 @@
+#!/usr/bin/env python3
+"""sandslope.dask.risk_raster on a large DEM: wall time and peak memory per worker.
+
+Usage (inside an environment with `sandslope[dask]`, e.g. after bash scripts/test.sh:
+`.venv/bin/python bench/python/bench_dask.py [--n 8192] [--chunk 1024] [--workers 2]`).
+
+The DEM (a synthetic dune field on 0.5 m cells, n x n) is itself lazy: each chunk is generated
+on the worker that needs it, so no process ever holds the whole map. The raster is reduced on
+the workers to a few numbers (mean best-heading p_fail, share of cells with a usable climb),
+so the client holds no band either. Runs on a `dask.distributed.LocalCluster` of worker
+processes with one thread each (the library parallelises inside a task with rayon; set
+RAYON_NUM_THREADS to change that). Peak memory per worker is the resident-set high-water mark
+(`ru_maxrss`) of each worker process, including the Python interpreter and libraries; the
+baseline of an idle worker is printed beside it.
+"""
+
+import argparse
+import os
+import resource
+import time
+
+import numpy as np
+
+
+def dunes(i, j):
+    """Heights (m) at rows i, columns j: dunes on an 8.5 degree ramp, 0.5 m cells."""
+    x, y = 0.5 * j, 0.5 * i
+    return 4.0 * np.sin(x / 25.0) * np.cos(y / 40.0) + 0.15 * x + 0.5 * np.sin(x / 3.1 + y / 4.3)
+
+
+def peak_rss_mib():
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--n", type=int, default=8192)
+    ap.add_argument("--chunk", type=int, default=1024)
+    ap.add_argument("--workers", type=int, default=2)
+    args = ap.parse_args()
+
+    import dask.array as da
+    from distributed import Client, LocalCluster
+
+    import sandslope
+    import sandslope.dask
+
+    robot = sandslope.Robot.preset("paper-hexapod")
+    terrain = sandslope.Terrain.preset("glass-beads-300um")
+    n, c = args.n, args.chunk
+    with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                      memory_limit=0) as cluster, Client(cluster) as client:
+        idle = client.run(peak_rss_mib)
+        dem = da.fromfunction(dunes, shape=(n, n), chunks=c, dtype=np.float64)
+        raster = sandslope.dask.risk_raster(dem, 0.5, robot=robot, terrain=terrain)
+        mean_p = da.nanmean(raster[0])
+        climbable = da.isfinite(raster[1]).mean()
+        t0 = time.perf_counter()
+        mean_p, climbable = client.compute([mean_p, climbable], sync=True)
+        wall = time.perf_counter() - t0
+        peaks = client.run(peak_rss_mib)
+    chunk_mib = c * c * 8 / 2**20
+    print(f"DEM {n} x {n} ({n * n * 8 / 2**30:.2f} GiB as float64), chunks {c} x {c} ({chunk_mib:.0f} MiB each), "
+          f"{raster.npartitions} tiles, {args.workers} worker processes x 1 thread, {os.cpu_count()} cores")
+    print(f"  wall time            {wall:8.1f} s  ({n * n / wall / 1e6:.2f} Mcells/s)")
+    for w, peak in sorted(peaks.items()):
+        print(f"  peak RSS {w.rsplit(':', 1)[-1]:>6}        {peak:8.0f} MiB  (idle {idle[w]:.0f} MiB; "
+              f"{(peak - idle[w]) / chunk_mib:.1f} float64 chunks above idle)")
+    print(f"  mean best-heading p_fail {mean_p:.3e}, cells with a usable climb {climbable:.1%}")
+
+
+if __name__ == "__main__":
+    main()

@@ -39,6 +39,8 @@ enum Command {
     Risk(commands::risk::RiskArgs),
     /// Heading-aware routes (fastest, safest, shortest) and risk maps over an elevation model.
     Plan(commands::plan::PlanArgs),
+    /// Robot design exploration: safe-slope limit and speed of every design, and the Pareto front.
+    Design(commands::design::DesignArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
 }
@@ -53,6 +55,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Phase(a) => commands::phase::run(a),
         Command::Risk(a) => commands::risk::run(a),
         Command::Plan(a) => commands::plan::run(a),
+        Command::Design(a) => commands::design::run(a),
         Command::Presets(a) => commands::presets::run(a),
     }
 }

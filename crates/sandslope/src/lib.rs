@@ -31,6 +31,7 @@
 
 pub mod calibrate;
 pub mod critical;
+pub mod design;
 pub mod error;
 pub mod gait;
 pub mod measure;

@@ -1,6 +1,7 @@
 //! One module per subcommand; each parses its arguments, calls the library and writes.
 
 pub mod calibrate;
+pub mod design;
 pub mod fit;
 pub mod phase;
 pub mod plan;

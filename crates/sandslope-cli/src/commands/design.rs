@@ -1,0 +1,350 @@
+//! `sandslope design`: which robot climbs the mission's slopes safely and fast. Varies robot
+//! keys over ranges (`--vary`), evaluates every design on the uncertain terrain with
+//! `sandslope::design::explore`, and prints the Pareto front over (safe-slope limit, speed at
+//! `--slope-target`), JSON of every design, a CSV file, and a figure.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+
+use sandslope::design::{explore, Design, DesignGoal, DesignKey, DesignRange, DesignSpace, DesignStudy};
+use sandslope::risk::SafeLimit;
+use sandslope::{AxisScale, Slope};
+
+use crate::args::{check_flag, RobotArgs, TerrainArgs, UncertaintyArgs};
+use crate::figures::design::{DesignFigure, SafeSlopeMap};
+use crate::figures::{format_of, save};
+use crate::output::{check_parent_exists, num, print_json, table, write_atomic};
+use crate::progress::progress_bar;
+
+/// Arguments of `sandslope design`.
+#[derive(Debug, Args)]
+pub struct DesignArgs {
+    /// Robot keys to vary: KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE, comma-separated or repeated
+    /// (e.g. leg_radius_m=0.03:0.06:7,mass_kg=0.3:1.5:9). Keys: the robot file's (docs/model.md §2).
+    #[arg(long, value_name = "KEY=MIN:MAX:N[:log],...", required = true)]
+    pub vary: Vec<String>,
+    /// The mission's target slope, degrees: speed, regime, p_fail and k_s margin are reported there.
+    #[arg(long = "slope-target", value_name = "DEG", allow_negative_numbers = true)]
+    pub slope_target: f64,
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    pub terrain: TerrainArgs,
+    #[command(flatten)]
+    pub uncertainty: UncertaintyArgs,
+    /// Largest acceptable failure probability, for the safe-slope limit.
+    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = 0.05)]
+    pub max_risk: f64,
+    /// Print every design as JSON instead of the front as a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write one row per design to this CSV file.
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Draw the front (and, for two varied keys, a map of the safe-slope limit) to this .png or .svg.
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+    /// Rows of the front shown in the table (the JSON and CSV hold every design).
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    pub show: usize,
+}
+
+/// Parses one `KEY=MIN:MAX:N[:log|:lin]` or `KEY=VALUE` item of `--vary`.
+pub fn parse_vary_item(item: &str) -> Result<DesignRange> {
+    let (key, range) = item
+        .split_once('=')
+        .ok_or_else(|| anyhow!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"))?;
+    let key = DesignKey::from_name(key.trim()).map_err(|e| anyhow!("--vary: {e}"))?;
+    let parts: Vec<&str> = range.split(':').map(str::trim).collect();
+    let number = |what: &str, s: &str| -> Result<f64> {
+        s.parse::<f64>().map_err(|_| anyhow!("--vary: {key} {what} `{s}` is not a number (in {item})"))
+    };
+    let (min, max, n, scale) = match parts.as_slice() {
+        [v] => {
+            let v = number("value", v)?;
+            (v, v, 1, AxisScale::Linear)
+        }
+        [lo, hi, n, rest @ ..] if rest.len() <= 1 => {
+            let n: usize = n.parse().ok().filter(|&n| n >= 2).ok_or_else(|| {
+                anyhow!("--vary: {key} N `{n}` must be a whole number of at least 2 (in {item})")
+            })?;
+            let scale = match rest.first().map(|s| s.to_ascii_lowercase()).as_deref() {
+                None | Some("lin") | Some("linear") => AxisScale::Linear,
+                Some("log") => AxisScale::Log,
+                Some(other) => bail!("--vary: {key} spacing `{other}` must be `log` or `lin` (in {item})"),
+            };
+            (number("MIN", lo)?, number("MAX", hi)?, n, scale)
+        }
+        _ => bail!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"),
+    };
+    DesignRange::new(key, min, max, n, scale).map_err(|e| anyhow!("--vary: {e}"))
+}
+
+/// One design as printed by `--json`.
+#[derive(Debug, Serialize)]
+struct DesignRecord {
+    params: BTreeMap<&'static str, f64>,
+    valid: bool,
+    /// Why the robot is not valid (docs/model.md §2), null when it is.
+    invalid_reason: Option<String>,
+    safe_slope_deg: Option<f64>,
+    /// `limit`, `none_safe` (not even level ground) or `beyond_range` (every slope searched).
+    safe_limit: Option<&'static str>,
+    speed_m_s: Option<f64>,
+    p_fail: Option<f64>,
+    regime: Option<&'static str>,
+    k_s_margin: Option<f64>,
+    pareto: bool,
+}
+
+#[derive(Debug, Serialize)]
+struct StudyRecord {
+    slope_target_deg: f64,
+    max_risk: f64,
+    designs_evaluated: usize,
+    invalid: usize,
+    notes: Vec<String>,
+    template: DesignRecord,
+    designs: Vec<DesignRecord>,
+}
+
+fn limit_kind(l: &SafeLimit) -> &'static str {
+    match l {
+        SafeLimit::Limit { .. } => "limit",
+        SafeLimit::NoneSafe { .. } => "none_safe",
+        SafeLimit::BeyondRange { .. } => "beyond_range",
+    }
+}
+
+fn record(keys: &[DesignKey], d: &Design) -> DesignRecord {
+    let params = keys.iter().zip(&d.params).map(|(k, v)| (k.name(), *v)).collect();
+    match &d.outcome {
+        Ok(p) => DesignRecord {
+            params,
+            valid: true,
+            invalid_reason: None,
+            safe_slope_deg: p.safe_slope_deg,
+            safe_limit: Some(limit_kind(&p.safe_limit)),
+            speed_m_s: p.speed_m_s,
+            p_fail: Some(p.p_fail),
+            regime: Some(p.regime.name()),
+            k_s_margin: p.k_s_margin,
+            pareto: d.pareto,
+        },
+        Err(reason) => DesignRecord {
+            params,
+            valid: false,
+            invalid_reason: Some(reason.clone()),
+            safe_slope_deg: None,
+            safe_limit: None,
+            speed_m_s: None,
+            p_fail: None,
+            regime: None,
+            k_s_margin: None,
+            pareto: false,
+        },
+    }
+}
+
+fn csv_text(study: &DesignStudy) -> Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<String> = study.keys.iter().map(|k| k.name().to_string()).collect();
+    header.extend(
+        [
+            "valid",
+            "invalid_reason",
+            "safe_slope_deg",
+            "safe_limit",
+            "speed_m_s",
+            "p_fail",
+            "regime",
+            "k_s_margin",
+            "pareto",
+        ]
+        .map(String::from),
+    );
+    w.write_record(&header)?;
+    let opt = |x: Option<f64>| x.map(|v| format!("{v}")).unwrap_or_default();
+    for d in &study.designs {
+        let r = record(&study.keys, d);
+        let mut row: Vec<String> = d.params.iter().map(|v| format!("{v}")).collect();
+        row.extend([
+            r.valid.to_string(),
+            r.invalid_reason.unwrap_or_default(),
+            opt(r.safe_slope_deg),
+            r.safe_limit.unwrap_or_default().to_string(),
+            opt(r.speed_m_s),
+            opt(r.p_fail),
+            r.regime.unwrap_or_default().to_string(),
+            opt(r.k_s_margin),
+            r.pareto.to_string(),
+        ]);
+        w.write_record(&row)?;
+    }
+    Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow!("{e}"))?)?)
+}
+
+/// Runs `sandslope design`.
+pub fn run(args: DesignArgs) -> Result<()> {
+    let robot = args.robot.load()?;
+    let mut ranges = Vec::new();
+    for text in &args.vary {
+        for item in text.split(',').filter(|s| !s.trim().is_empty()) {
+            ranges.push(parse_vary_item(item.trim())?);
+        }
+    }
+    let space = DesignSpace::new(robot.spec().clone(), ranges).map_err(|e| anyhow!("--vary: {e}"))?;
+    let max_risk = check_flag("--max-risk", args.max_risk, 0.0, 1.0)?;
+    let target = Slope::from_signed_degrees(args.slope_target)
+        .map_err(|e| anyhow!("{}", e.renamed("--slope-target")))?;
+    let goal = DesignGoal::new(max_risk, target).map_err(|e| anyhow!("--max-risk: {e}"))?;
+    let (terrain, notes) = args.uncertainty.apply(args.terrain.load()?)?;
+    // Check every output before the work.
+    if let Some(p) = &args.plot {
+        format_of(p)?;
+        check_parent_exists(p)?;
+    }
+    if let Some(p) = &args.csv {
+        check_parent_exists(p)?;
+    }
+
+    let bar = progress_bar(space.len() as u64, args.json, "designs");
+    let study = explore(&space, &terrain, &goal, &|| bar.inc(1));
+    bar.finish_and_clear();
+
+    if let Some(path) = &args.csv {
+        write_atomic(path, csv_text(&study)?.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.plot {
+        let name = terrain.terrain().name().map_or_else(|| args.terrain.terrain.clone(), str::to_string);
+        draw(&study, &space, &name, path)?;
+    }
+    if args.json {
+        let keys = &study.keys;
+        return print_json(&StudyRecord {
+            slope_target_deg: study.slope_target_deg,
+            max_risk,
+            designs_evaluated: study.designs.len(),
+            invalid: study.invalid_count(),
+            notes,
+            template: record(keys, &study.template),
+            designs: study.designs.iter().map(|d| record(keys, d)).collect(),
+        });
+    }
+    print_table(&study, args.show, &notes);
+    Ok(())
+}
+
+fn print_table(study: &DesignStudy, show: usize, notes: &[String]) {
+    let front = study.front();
+    println!(
+        "{} designs, {} invalid; Pareto front over (safe-slope limit at p_fail < {}, speed at {} deg): {} designs",
+        study.designs.len(),
+        study.invalid_count(),
+        study.max_risk,
+        study.slope_target_deg,
+        front.len()
+    );
+    let mut header: Vec<String> = study.keys.iter().map(|k| k.name().to_string()).collect();
+    header.extend(["safe slope (deg)", "speed (m/s)", "p_fail", "regime", "k_s margin"].map(String::from));
+    let refs: Vec<&str> = header.iter().map(String::as_str).collect();
+    let mut t = table(&refs);
+    let row = |d: &Design| -> Vec<String> {
+        let mut r: Vec<String> = d.params.iter().map(|v| format!("{v:.4}")).collect();
+        match &d.outcome {
+            Ok(p) => r.extend([
+                match p.safe_limit {
+                    SafeLimit::NoneSafe { .. } => "none".into(),
+                    SafeLimit::BeyondRange { up_to, .. } => format!(">= {up_to}"),
+                    SafeLimit::Limit { value, .. } => format!("{value:.3}"),
+                },
+                num(p.speed_m_s, 4),
+                format!("{:.4}", p.p_fail),
+                p.regime.name().to_string(),
+                num(p.k_s_margin, 3),
+            ]),
+            Err(reason) => r.extend([
+                format!("invalid: {reason}"),
+                String::new(),
+                String::new(),
+                String::new(),
+                String::new(),
+            ]),
+        }
+        r
+    };
+    for d in front.iter().take(show) {
+        t.add_row(row(d));
+    }
+    println!("{t}");
+    if front.len() > show {
+        println!("({} more on the front: --show N, --json or --csv FILE for all)", front.len() - show);
+    }
+    let template = row(&study.template);
+    println!(
+        "template robot: {}{}",
+        template[study.keys.len()..].join(", "),
+        if study.template.pareto { " (on the front)" } else { " (dominated by a design in the space)" }
+    );
+    let mut reasons: BTreeMap<&str, usize> = BTreeMap::new();
+    for d in &study.designs {
+        if let Err(r) = &d.outcome {
+            *reasons.entry(r.as_str()).or_default() += 1;
+        }
+    }
+    for (reason, count) in reasons.iter().take(5) {
+        println!("invalid ({count} designs): {reason}");
+    }
+    for n in notes {
+        println!("note: {n}");
+    }
+    println!(
+        "safe-slope limit: steepest slope with p_fail < {} from level up, as `sandslope risk --solve slope` (docs/model.md \u{a7}9)",
+        study.max_risk
+    );
+}
+
+fn draw(study: &DesignStudy, space: &DesignSpace, terrain: &str, path: &std::path::Path) -> Result<()> {
+    let point = |d: &Design| -> Option<(f64, f64)> {
+        let p = d.outcome.as_ref().ok()?;
+        Some((p.safe_slope_rank(), p.speed_m_s?))
+    };
+    let all: Vec<(f64, f64)> = study.designs.iter().filter(|d| !d.pareto).filter_map(point).collect();
+    let mut front: Vec<(f64, f64)> = study.designs.iter().filter(|d| d.pareto).filter_map(point).collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // A map when exactly two keys vary over at least two values each.
+    let varied: Vec<usize> =
+        (0..space.ranges().len()).filter(|&i| space.ranges()[i].values().len() > 1).collect();
+    let map = (varied.len() == 2).then(|| {
+        let (a, b) = (&space.ranges()[varied[0]], &space.ranges()[varied[1]]);
+        SafeSlopeMap {
+            x_key: a.key().name().to_string(),
+            y_key: b.key().name().to_string(),
+            x: a.values().to_vec(),
+            y: b.values().to_vec(),
+            // Designs are numbered first range slowest; with only these two varying, the
+            // design index is i_a * n_b + i_b.
+            safe: study
+                .designs
+                .iter()
+                .map(|d| d.outcome.as_ref().ok().map(|p| p.safe_slope_rank()))
+                .collect(),
+        }
+    });
+    let figure = DesignFigure {
+        others: all,
+        front,
+        template: point(&study.template),
+        map,
+        title: format!(
+            "Designs on {terrain}: safe-slope limit (p_fail < {}) vs speed at {} deg",
+            study.max_risk, study.slope_target_deg
+        ),
+    };
+    save(path, &figure)
+}

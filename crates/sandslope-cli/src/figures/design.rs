@@ -1,0 +1,203 @@
+//! Design figures: every design in the (safe-slope limit, speed at the target slope) plane with
+//! the Pareto front and the template robot, and, when two keys vary, a map of the safe-slope
+//! limit over them.
+
+use anyhow::Result;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
+
+use super::phase::{star_points, STAR_GREEN};
+use super::{font, range, Figure};
+
+/// The safe-slope limit over two varied keys (row-major: one row per `x` value).
+pub struct SafeSlopeMap {
+    pub x_key: String,
+    pub y_key: String,
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    /// Per design (`x` index slowest): the safe-slope rank, -1 when no slope is safe, `None`
+    /// when invalid.
+    pub safe: Vec<Option<f64>>,
+}
+
+/// The front figure, with the map beside it when there is one.
+pub struct DesignFigure {
+    pub others: Vec<(f64, f64)>,
+    pub front: Vec<(f64, f64)>,
+    pub template: Option<(f64, f64)>,
+    pub map: Option<SafeSlopeMap>,
+    pub title: String,
+}
+
+impl Figure for DesignFigure {
+    fn size(&self) -> (u32, u32) {
+        if self.map.is_some() {
+            (1700, 720)
+        } else {
+            (1000, 720)
+        }
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = crate::error::plot_err;
+        let root = root.titled(&self.title, font(22.0)).map_err(e)?;
+        let (left, right) = match &self.map {
+            Some(_) => {
+                let (l, r) = root.split_horizontally(950);
+                (l, Some(r))
+            }
+            None => (root, None),
+        };
+        let all = || self.others.iter().chain(&self.front).chain(self.template.iter());
+        let (x0, x1) = range(all().map(|p| p.0), (0.0, 30.0));
+        let (y0, y1) = range(all().map(|p| p.1), (0.0, 0.2));
+        let mut chart = ChartBuilder::on(&left)
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(75)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc("safe-slope limit (deg; -1: no slope is safe)")
+            .y_desc("speed at the target slope (m/s)")
+            .label_style(font(15.0))
+            .axis_desc_style(font(17.0))
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(e)?;
+        let grey = RGBColor(150, 150, 150);
+        chart
+            .draw_series(self.others.iter().map(|&p| Circle::new(p, 2, grey.mix(0.5).filled())))
+            .map_err(e)?
+            .label(format!("designs ({})", self.others.len() + self.front.len()))
+            .legend(move |(x, y)| Circle::new((x + 12, y), 4, grey.filled()));
+        let red = RGBColor(214, 56, 48);
+        chart.draw_series(LineSeries::new(self.front.iter().copied(), red.stroke_width(2))).map_err(e)?;
+        chart
+            .draw_series(self.front.iter().map(|&p| Circle::new(p, 5, red.filled())))
+            .map_err(e)?
+            .label(format!("Pareto front ({})", self.front.len()))
+            .legend(move |(x, y)| Circle::new((x + 12, y), 5, red.filled()));
+        if let Some(t) = self.template {
+            chart
+                .draw_series(std::iter::once(
+                    EmptyElement::at(t)
+                        + Polygon::new(star_points(12.0), STAR_GREEN.filled())
+                        + PathElement::new(close(star_points(12.0)), BLACK.stroke_width(1)),
+                ))
+                .map_err(e)?
+                .label("template robot (--robot)")
+                .legend(|(x, y)| {
+                    EmptyElement::at((x + 12, y)) + Polygon::new(star_points(9.0), STAR_GREEN.filled())
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(font(15.0))
+            .draw()
+            .map_err(e)?;
+        if let (Some(map), Some(area)) = (&self.map, right) {
+            draw_map(map, &area)?;
+        }
+        Ok(())
+    }
+}
+
+fn close(mut pts: Vec<(i32, i32)>) -> Vec<(i32, i32)> {
+    if let Some(&first) = pts.first() {
+        pts.push(first);
+    }
+    pts
+}
+
+/// Edges of cells centred on sorted values (half-way between neighbours).
+fn edges(v: &[f64]) -> Vec<f64> {
+    let n = v.len();
+    let mut e = Vec::with_capacity(n + 1);
+    e.push(v[0] - 0.5 * (v[1] - v[0]));
+    for w in v.windows(2) {
+        e.push(0.5 * (w[0] + w[1]));
+    }
+    e.push(v[n - 1] + 0.5 * (v[n - 1] - v[n - 2]));
+    e
+}
+
+fn draw_map<DB: DrawingBackend>(map: &SafeSlopeMap, area: &DrawingArea<DB, Shift>) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = crate::error::plot_err;
+    let (main, bar) = area.split_horizontally(640);
+    let (xe, ye) = (edges(&map.x), edges(&map.y));
+    let mut chart = ChartBuilder::on(&main)
+        .caption("safe-slope limit (deg)", font(18.0))
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(75)
+        .build_cartesian_2d(xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1])
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(map.x_key.as_str())
+        .y_desc(map.y_key.as_str())
+        .label_style(font(15.0))
+        .axis_desc_style(font(17.0))
+        .draw()
+        .map_err(e)?;
+    let finite = map.safe.iter().flatten().copied().filter(|v| *v >= 0.0);
+    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    let (lo, hi) = if lo.is_finite() { (lo, hi.max(lo + 1e-9)) } else { (0.0, 1.0) };
+    let ny = map.y.len();
+    let none_safe = RGBColor(60, 60, 60);
+    chart
+        .draw_series(map.safe.iter().enumerate().map(|(c, v)| {
+            let (i, j) = (c / ny, c % ny);
+            let colour = match v {
+                None => WHITE.filled(),
+                Some(s) if *s < 0.0 => none_safe.filled(),
+                Some(s) => ViridisRGB.get_color(((s - lo) / (hi - lo)) as f32).filled(),
+            };
+            Rectangle::new([(xe[i], ye[j]), (xe[i + 1], ye[j + 1])], colour)
+        }))
+        .map_err(e)?;
+    // Invalid designs: a cross on white.
+    chart
+        .draw_series(map.safe.iter().enumerate().filter(|(_, v)| v.is_none()).map(|(c, _)| {
+            let (i, j) = (c / ny, c % ny);
+            PathElement::new(
+                vec![(xe[i], ye[j]), (xe[i + 1], ye[j + 1])],
+                RGBColor(200, 200, 200).stroke_width(1),
+            )
+        }))
+        .map_err(e)?;
+    let mut cb = ChartBuilder::on(&bar)
+        .margin_top(45)
+        .margin_bottom(65)
+        .margin_right(10)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(e)?;
+    cb.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc("deg (dark grey: none safe; white: invalid)")
+        .label_style(font(13.0))
+        .axis_desc_style(font(14.0))
+        .draw()
+        .map_err(e)?;
+    cb.draw_series((0..100).map(|k| {
+        let (a, b) = (lo + (hi - lo) * k as f64 / 100.0, lo + (hi - lo) * (k + 1) as f64 / 100.0);
+        Rectangle::new([(0.0, a), (1.0, b)], ViridisRGB.get_color((k as f32 + 0.5) / 100.0).filled())
+    }))
+    .map_err(e)?;
+    Ok(())
+}

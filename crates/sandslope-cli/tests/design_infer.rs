@@ -1,0 +1,159 @@
+//! End-to-end tests of `sandslope design` and `sandslope infer`.
+
+use std::path::Path;
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+use serde_json::Value;
+
+fn sandslope() -> Command {
+    Command::cargo_bin("sandslope").unwrap()
+}
+
+fn json(args: &[&str]) -> Value {
+    let out = sandslope().args(args).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+/// Every design's safe-slope limit is the number `risk --solve slope` prints for that robot;
+/// invalid designs (hip height above 2R) are listed with the reason, not dropped.
+#[test]
+fn design_json_matches_risk_solve_slope_and_keeps_invalid_designs() {
+    let v = json(&[
+        "design",
+        "--vary",
+        "mass_kg=0.35:1.4:2",
+        "--vary",
+        "hip_height_m=0.03:0.09:2",
+        "--slope-target",
+        "15",
+        "--json",
+    ]);
+    let designs = v["designs"].as_array().unwrap();
+    assert_eq!(designs.len(), 4);
+    assert_eq!(v["invalid"], 2);
+    assert_eq!(v["notes"].as_array().unwrap().len(), 2, "default CVs are announced: {}", v["notes"]);
+    for d in designs {
+        let (m, h) =
+            (d["params"]["mass_kg"].as_f64().unwrap(), d["params"]["hip_height_m"].as_f64().unwrap());
+        if h > 0.08 {
+            assert_eq!(d["valid"], false);
+            assert!(d["invalid_reason"].as_str().unwrap().contains("hip_height_m"), "{d}");
+            assert_eq!(d["pareto"], false);
+            continue;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let robot = write(
+            dir.path(),
+            "r.toml",
+            &format!(
+                "mass_kg = {m}\nleg_radius_m = 0.04\nleg_width_m = 0.01\nhip_height_m = {h}\n\
+                 leg_speed_rad_s = 6.283185307179586\nstance_legs = 3\nresponse_time_s = 0.2\n"
+            ),
+        );
+        let risk = json(&[
+            "risk", "--robot", &robot, "--solve", "slope", "--cv-n", "0.1", "--cv-s", "0.2", "--json",
+        ]);
+        assert_eq!(d["safe_slope_deg"], risk["safe_slope_deg"], "mass {m}");
+        for key in ["speed_m_s", "p_fail", "regime", "k_s_margin", "pareto"] {
+            assert!(!d[key].is_null(), "{key} missing in {d}");
+        }
+    }
+    // The lighter robot climbs steeper safely and faster: the heavier one is dominated.
+    assert_eq!(designs[0]["pareto"], true);
+    assert_eq!(designs[2]["pareto"], false);
+}
+
+#[test]
+fn design_rejects_bad_vary_with_exit_2_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("d.csv");
+    let csv = csv.to_str().unwrap();
+    for (vary, says) in [
+        ("legs=1:3:3", "valid keys: mass_kg, leg_radius_m"),
+        ("mass_kg=1.5:0.3:4", "mass_kg max"),
+        ("mass_kg=0:1:3:log", "mass_kg min"),
+        ("mass_kg=0.3:1.5:1", "at least 2"),
+        ("stance_legs=2:4:4", "whole number"),
+        ("mass_kg", "KEY=MIN:MAX:N"),
+        ("mass_kg=0.3:1.5:3,mass_kg=0.5", "twice"),
+    ] {
+        sandslope()
+            .args(["design", "--vary", vary, "--slope-target", "15", "--csv", csv])
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains(says));
+        assert!(!Path::new(csv).exists(), "{vary}: partial output");
+    }
+    sandslope()
+        .args(["design", "--vary", "mass_kg=0.3:1:2", "--slope-target", "15", "--max-risk", "1"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("max-risk"));
+}
+
+/// The CSV has one row per design with the varied keys first; the table names the front.
+#[test]
+fn design_csv_and_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("d.csv");
+    sandslope()
+        .args(["design", "--vary", "leg_width_m=0.005:0.02:4:log", "--slope-target", "20", "--cv-n", "0.1"])
+        .args(["--cv-s", "0.3", "--csv", csv.to_str().unwrap()])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("Pareto front").and(predicate::str::contains("leg_width_m")));
+    let mut r = csv::Reader::from_path(&csv).unwrap();
+    assert_eq!(r.headers().unwrap().get(0), Some("leg_width_m"));
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 4);
+    // Log spacing: 0.005, 0.01 (x 2^(2/3) steps...), the last 0.02.
+    let w: Vec<f64> = rows.iter().map(|r| r[0].parse().unwrap()).collect();
+    assert!((w[3] - 0.02).abs() < 1e-12 && (w[1] / w[0] - w[2] / w[1]).abs() < 1e-9);
+    // A wider leg anchors shallower: the safe-slope limit never falls as W grows.
+    let safe: Vec<f64> = rows.iter().map(|r| r[3].parse().unwrap()).collect();
+    assert!(safe.windows(2).all(|p| p[1] >= p[0]), "{safe:?}");
+}
+
+/// The worked examples of docs/design.md and docs/inference.md run, and print exactly what
+/// the page shows (figures go to a temporary directory instead of docs/figures).
+#[test]
+fn worked_examples_in_the_docs_run_as_shown() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let dir = tempfile::tempdir().unwrap();
+    for page in ["docs/design.md", "docs/inference.md"] {
+        let Ok(text) = std::fs::read_to_string(root.join(page)) else {
+            assert_eq!(page, "docs/inference.md", "{page} missing");
+            continue;
+        };
+        let mut lines = text.lines().peekable();
+        let mut ran = 0;
+        while let Some(line) = lines.next() {
+            let Some(command) = line.strip_prefix("$ sandslope ") else { continue };
+            let mut expected = String::new();
+            while let Some(l) = lines.next_if(|l| !l.starts_with("```") && !l.starts_with("$ ")) {
+                expected.push_str(l);
+                expected.push('\n');
+            }
+            let mut args: Vec<String> = command.split_whitespace().map(String::from).collect();
+            for i in 1..args.len() {
+                if matches!(args[i - 1].as_str(), "--plot" | "--csv") {
+                    let name = Path::new(&args[i]).file_name().unwrap().to_owned();
+                    args[i] = dir.path().join(name).to_string_lossy().into_owned();
+                }
+            }
+            let out = sandslope().current_dir(&root).args(&args).output().unwrap();
+            assert!(out.status.success(), "{page}: {command}: {}", String::from_utf8_lossy(&out.stderr));
+            assert_eq!(String::from_utf8_lossy(&out.stdout), expected, "{page}: {command}");
+            ran += 1;
+        }
+        assert!(ran > 0, "{page} has no worked example");
+    }
+}

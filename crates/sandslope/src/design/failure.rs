@@ -1,0 +1,488 @@
+//! The failure probability and the safe-slope limit, evaluated fast enough for 10^5 designs.
+//!
+//! This is the same quantity as [`crate::risk::failure_risk`] (docs/model.md §9): with
+//! log-normal k_n and k_s, `p_fail = P(sinkage) + P(slippage)`, where
+//! `P(slippage) = ∫_{z*} φ(z) P(k_s < k_crit(k_n(z))) dz` and `k_crit` is the progress boundary
+//! of docs/model.md §13. Two things make it about a hundred times cheaper than the risk
+//! command's general routine, which also integrates `P(not success)` and finds each `k_crit`
+//! with Brent's method:
+//!
+//! - `k_crit` in closed form: the net step is a quadratic in the anchoring time `t1`
+//!   (docs/model.md §5), so the `t1` at which `s = 0` is its smaller root, and
+//!   `k_crit = F_a / (W d(t1)^2)` with the leg depth `d(t) ` of §4 (floored at the anchoring
+//!   threshold). The tests check it against [`crate::critical_shear_strength`] to 1e-9.
+//! - adaptive Gauss-Kronrod (7-15 points) quadrature of only `P(slippage)` to 1e-11, and a
+//!   closed-form upper bound that settles `p_fail < max_risk` without any quadrature on slopes
+//!   well below the limit.
+//!
+//! The safe-slope search is the risk command's ([`crate::risk::safe_slope_limit`]): the same
+//! scan every [`SLOPE_SCAN_STEP_DEG`] from level, the same bisection of the first crossing down
+//! to [`SLOPE_TOLERANCE_DEG`], so each decision `p_fail >= max_risk` is the same and the limit
+//! is the same number (the tests compare the two on several robots).
+
+use std::f64::consts::{FRAC_PI_2, PI, SQRT_2};
+
+use crate::model::{
+    anchoring_threshold_k_s, level_step_length, normal_equilibrium_depth, shear_load_per_leg,
+    sinkage_threshold_k_n, G,
+};
+use crate::risk::{
+    SafeLimit, UncertainTerrain, Uncertainty, MAX_SCAN_SLOPE_DEG, SLOPE_SCAN_STEP_DEG, SLOPE_TOLERANCE_DEG,
+};
+use crate::robot::Robot;
+use crate::slope::Slope;
+use crate::terrain::Ground;
+
+/// Standard normal CDF.
+pub(crate) fn phi(z: f64) -> f64 {
+    0.5 * statrs::function::erf::erfc(-z / SQRT_2)
+}
+
+/// Standard normal density.
+fn density(z: f64) -> f64 {
+    (-0.5 * z * z).exp() / (2.0 * PI).sqrt()
+}
+
+/// `P(ln k < ln threshold)` for `ln k ~ Normal(mu, sigma^2)`, as in [`crate::risk`].
+fn prob_below(threshold: f64, mu: f64, sigma: f64) -> f64 {
+    if threshold.is_infinite() {
+        return if threshold > 0.0 { 1.0 } else { 0.0 };
+    }
+    if threshold <= 0.0 {
+        return 0.0;
+    }
+    if sigma == 0.0 {
+        return if threshold.ln() > mu { 1.0 } else { 0.0 };
+    }
+    phi((threshold.ln() - mu) / sigma)
+}
+
+/// The progress boundary `k_crit(k_n)` of one robot at one slope, in closed form.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ProgressBoundary<'a> {
+    robot: &'a Robot,
+    slope: Slope,
+    /// `g sin(theta)`.
+    gs: f64,
+    /// Stride period T.
+    period: f64,
+    /// Time at which the leg reaches its deepest point `2R - h`.
+    t_deepest: f64,
+    /// Applied shear load per leg over the leg width, `F_a / W`.
+    load_per_width: f64,
+    /// Anchoring threshold `F_a / (W d_max^2)`.
+    k_anchor: f64,
+}
+
+impl<'a> ProgressBoundary<'a> {
+    pub(crate) fn new(robot: &'a Robot, slope: Slope) -> ProgressBoundary<'a> {
+        ProgressBoundary {
+            robot,
+            slope,
+            gs: G * slope.sin(),
+            period: robot.stride_period(),
+            t_deepest: (FRAC_PI_2 - robot.touchdown_angle()) / robot.leg_speed(),
+            load_per_width: shear_load_per_leg(robot, slope) / robot.leg_width(),
+            k_anchor: anchoring_threshold_k_s(robot, slope),
+        }
+    }
+
+    /// The smallest k_s giving a positive net step at level step `s_star`, or `None` when
+    /// no k_s does (`s_star <= 0`).
+    fn at_level_step(&self, s_star: f64) -> Option<f64> {
+        if s_star <= 0.0 || s_star.is_nan() {
+            return None;
+        }
+        // s(t1) = s* (1 - 2 t1/T)^2 - 1/2 g sin(theta) t1 (T - t1) = a t1^2 + b t1 + c.
+        let t = self.period;
+        let a = 4.0 * s_star / (t * t) + 0.5 * self.gs;
+        let b = -4.0 * s_star / t - 0.5 * self.gs * t;
+        let c = s_star;
+        let disc = (b * b - 4.0 * a * c).max(0.0);
+        // The smaller root, in the cancellation-free form 2c / (-b + sqrt(disc)).
+        let t_root = 2.0 * c / (-b + disc.sqrt());
+        if t_root >= self.t_deepest {
+            // Every anchoring (d_s <= d_max) happens before s reaches 0.
+            return Some(self.k_anchor);
+        }
+        let r = self.robot.leg_radius();
+        let depth = r * (self.robot.leg_speed() * t_root + self.robot.touchdown_angle()).sin() + r
+            - self.robot.hip_height();
+        Some((self.load_per_width / (depth * depth)).max(self.k_anchor))
+    }
+
+    /// The smallest k_s giving progress (`s > 0`) at normal resistance `k_n`; `None` when
+    /// no k_s does (the legs sink or the level step is zero).
+    pub(crate) fn k_crit(&self, k_n: f64) -> Option<f64> {
+        let d_n = normal_equilibrium_depth(self.robot, self.slope, k_n);
+        if d_n >= self.robot.max_depth() {
+            return None;
+        }
+        self.at_level_step(level_step_length(self.robot, d_n))
+    }
+
+    /// The largest `k_crit` over every `k_n >= k_lo` (above the sinkage threshold): the
+    /// level step is concave in `d_n`, so its least value on `d_n in (0, d_n(k_lo)]` is at an
+    /// end, and `k_crit` falls as the level step grows.
+    fn k_crit_max_above(&self, k_lo: f64) -> Option<f64> {
+        let d_lo = normal_equilibrium_depth(self.robot, self.slope, k_lo);
+        if d_lo >= self.robot.max_depth() {
+            return None;
+        }
+        let s_min = level_step_length(self.robot, d_lo).min(level_step_length(self.robot, 0.0));
+        self.at_level_step(s_min)
+    }
+}
+
+const Z_MAX: f64 = 8.5;
+/// Absolute tolerance of the slippage integral.
+const TOLERANCE: f64 = 1e-11;
+
+/// `p_fail = P(sinkage or slippage)` of `robot` at `slope` on ground whose medians are `median`
+/// (the same value as [`crate::risk::regime_probabilities`]`(..).p_fail()`, to 1e-9).
+pub fn p_fail(robot: &Robot, slope: Slope, median: &Ground, uncertainty: Uncertainty) -> f64 {
+    Evaluator::new(robot, slope, median, uncertainty).p_fail()
+}
+
+/// Everything about one (robot, slope, ground) needed for p_fail and its cheap upper bound.
+struct Evaluator<'a> {
+    boundary: ProgressBoundary<'a>,
+    beyond_repose: bool,
+    k_s_positive: bool,
+    mu_n: f64,
+    mu_s: f64,
+    sigma_n: f64,
+    sigma_s: f64,
+    k_n_star: f64,
+    p_sink: f64,
+}
+
+impl<'a> Evaluator<'a> {
+    fn new(robot: &'a Robot, slope: Slope, median: &Ground, u: Uncertainty) -> Evaluator<'a> {
+        let (sigma_n, sigma_s) = (u.sigma_n(), u.sigma_s());
+        let mu_n = median.k_n.ln();
+        let k_n_star = sinkage_threshold_k_n(robot, slope);
+        let p_sink = if median.k_n <= 0.0 {
+            1.0
+        } else if sigma_n == 0.0 {
+            if median.k_n <= k_n_star {
+                1.0
+            } else {
+                0.0
+            }
+        } else {
+            prob_below(k_n_star, mu_n, sigma_n)
+        };
+        Evaluator {
+            boundary: ProgressBoundary::new(robot, slope),
+            beyond_repose: median.beyond_repose(slope),
+            k_s_positive: median.k_s > 0.0,
+            mu_n,
+            mu_s: median.k_s.ln(),
+            sigma_n,
+            sigma_s,
+            k_n_star,
+            p_sink,
+        }
+    }
+
+    /// `P(slippage | k_n)`.
+    fn slip_given(&self, k_n: f64) -> f64 {
+        match self.boundary.k_crit(k_n) {
+            Some(k) if self.k_s_positive => prob_below(k, self.mu_s, self.sigma_s),
+            _ => 1.0,
+        }
+    }
+
+    fn trivially_failed(&self) -> bool {
+        self.beyond_repose || self.p_sink >= 1.0
+    }
+
+    fn p_fail(&self) -> f64 {
+        if self.trivially_failed() {
+            return 1.0;
+        }
+        let slip = if self.sigma_n == 0.0 {
+            self.slip_given(self.mu_n.exp())
+        } else {
+            let z_star = ((self.k_n_star.ln() - self.mu_n) / self.sigma_n).max(-Z_MAX);
+            if z_star >= Z_MAX {
+                0.0
+            } else {
+                let f = |z: f64| density(z) * self.slip_given((self.mu_n + self.sigma_n * z).exp());
+                integrate(&f, z_star, Z_MAX)
+            }
+        };
+        let not_sunk = 1.0 - self.p_sink;
+        self.p_sink + slip.clamp(0.0, not_sunk)
+    }
+
+    /// An upper bound of p_fail in closed form: `P(k_n < k_lo) + P(k_s < max k_crit above k_lo)`
+    /// with `k_lo` six standard deviations below the median (or just above the sinkage
+    /// threshold). Infinite when no useful bound exists.
+    fn upper_bound(&self) -> f64 {
+        if self.trivially_failed() || !self.k_s_positive {
+            return 1.0;
+        }
+        if self.sigma_n == 0.0 {
+            return f64::INFINITY; // exact value is cheap anyway
+        }
+        let z_star = (self.k_n_star.ln() - self.mu_n) / self.sigma_n;
+        let z_lo = (-6.0f64).max(z_star + 0.25);
+        match self.boundary.k_crit_max_above((self.mu_n + self.sigma_n * z_lo).exp()) {
+            Some(k) => phi(z_lo) + prob_below(k, self.mu_s, self.sigma_s),
+            None => f64::INFINITY,
+        }
+    }
+
+    /// Whether `p_fail >= max_risk`, settled by the upper bound when it can be.
+    fn fails(&self, max_risk: f64) -> (bool, Option<f64>) {
+        if self.upper_bound() < max_risk {
+            return (false, None);
+        }
+        let p = self.p_fail();
+        (p >= max_risk, Some(p))
+    }
+}
+
+/// The safe-slope limit of `robot` on `terrain`: the same search and the same answer as
+/// [`crate::risk::safe_slope_limit`] (scan every [`SLOPE_SCAN_STEP_DEG`] from level to
+/// [`MAX_SCAN_SLOPE_DEG`], bisect the first crossing to [`SLOPE_TOLERANCE_DEG`]), with p_fail
+/// from [`p_fail`]. `max_risk` must be in (0, 1) (checked by the caller).
+pub fn safe_slope_limit(robot: &Robot, terrain: &UncertainTerrain, max_risk: f64) -> SafeLimit {
+    let decide = |deg: f64| -> (bool, Option<f64>) {
+        match Slope::from_degrees(deg) {
+            Ok(s) => {
+                let (ground, u) = terrain.at(s);
+                Evaluator::new(robot, s, &ground, u).fails(max_risk)
+            }
+            Err(_) => (true, Some(1.0)),
+        }
+    };
+    let value_at = |deg: f64, known: Option<f64>| {
+        known.unwrap_or_else(|| {
+            let s = Slope::from_degrees(deg).expect("scanned slopes are valid");
+            let (ground, u) = terrain.at(s);
+            p_fail(robot, s, &ground, u)
+        })
+    };
+    let n = (MAX_SCAN_SLOPE_DEG / SLOPE_SCAN_STEP_DEG).round() as usize;
+    let (fails0, p0) = decide(0.0);
+    if fails0 {
+        return SafeLimit::NoneSafe { p_fail: value_at(0.0, p0) };
+    }
+    let (mut lo, mut p_lo) = (0.0, p0);
+    for i in 1..=n {
+        let x = i as f64 * SLOPE_SCAN_STEP_DEG;
+        let (fails, p) = decide(x);
+        if fails {
+            let mut hi = x;
+            while hi - lo > SLOPE_TOLERANCE_DEG {
+                let mid = 0.5 * (lo + hi);
+                let (fails_mid, p_mid) = decide(mid);
+                if fails_mid {
+                    hi = mid;
+                } else {
+                    (lo, p_lo) = (mid, p_mid);
+                }
+            }
+            return SafeLimit::Limit { value: lo, p_fail: value_at(lo, p_lo) };
+        }
+        (lo, p_lo) = (x, p);
+    }
+    SafeLimit::BeyondRange { up_to: lo, p_fail: value_at(lo, p_lo) }
+}
+
+/// Gauss-Kronrod 7-15 nodes (non-negative half) and weights.
+const XGK: [f64; 8] = [
+    0.991_455_371_120_812_6,
+    0.949_107_912_342_758_5,
+    0.864_864_423_359_769_1,
+    0.741_531_185_599_394_4,
+    0.586_087_235_467_691_1,
+    0.405_845_151_377_397_2,
+    0.207_784_955_007_898_5,
+    0.0,
+];
+const WGK: [f64; 8] = [
+    0.022_935_322_010_529_22,
+    0.063_092_092_629_978_55,
+    0.104_790_010_322_250_2,
+    0.140_653_259_715_525_9,
+    0.169_004_726_639_267_9,
+    0.190_350_578_064_785_4,
+    0.204_432_940_075_298_9,
+    0.209_482_141_084_727_8,
+];
+/// Gauss 7-point weights at the Kronrod nodes 1, 3, 5, 7.
+const WG: [f64; 4] =
+    [0.129_484_966_168_869_7, 0.279_705_391_489_276_7, 0.381_830_050_505_118_9, 0.417_959_183_673_469_4];
+
+/// One Gauss-Kronrod 7-15 panel: (Kronrod estimate, |Kronrod - Gauss|).
+fn gk15(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
+    let c = 0.5 * (a + b);
+    let h = 0.5 * (b - a);
+    let fc = f(c);
+    let mut kronrod = WGK[7] * fc;
+    let mut gauss = WG[3] * fc;
+    for j in 0..7 {
+        let dx = h * XGK[j];
+        let pair = f(c - dx) + f(c + dx);
+        kronrod += WGK[j] * pair;
+        if j % 2 == 1 {
+            gauss += WG[j / 2] * pair;
+        }
+    }
+    (kronrod * h, ((kronrod - gauss) * h).abs())
+}
+
+/// Adaptive Gauss-Kronrod on `[a, b]` from 4 panels, bisecting any panel whose error estimate
+/// exceeds its share of [`TOLERANCE`].
+fn integrate(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    fn panel(f: &dyn Fn(f64) -> f64, a: f64, b: f64, tol: f64, depth: u32) -> f64 {
+        let (value, err) = gk15(f, a, b);
+        if err <= tol || depth == 0 {
+            return value;
+        }
+        let m = 0.5 * (a + b);
+        panel(f, a, m, 0.5 * tol, depth - 1) + panel(f, m, b, 0.5 * tol, depth - 1)
+    }
+    const PANELS: usize = 4;
+    let h = (b - a) / PANELS as f64;
+    (0..PANELS)
+        .map(|i| {
+            let x1 = if i + 1 == PANELS { b } else { a + (i + 1) as f64 * h };
+            panel(f, a + i as f64 * h, x1, TOLERANCE / PANELS as f64, 40)
+        })
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::critical::{critical_shear_strength, StepTarget};
+    use crate::risk::{failure_risk, regime_probabilities};
+    use crate::robot::RobotSpec;
+    use crate::terrain::{Terrain, TerrainPoint, TerrainSpec};
+
+    fn slope(d: f64) -> Slope {
+        Slope::from_degrees(d).unwrap()
+    }
+
+    /// Robots unlike the paper's: heavy, hip above and below R, a measured level step, few legs.
+    fn robots() -> Vec<Robot> {
+        let p = RobotSpec::paper_hexapod();
+        [
+            p.clone(),
+            RobotSpec { mass_kg: 1.2, hip_height_m: 0.05, ..p.clone() },
+            RobotSpec { leg_radius_m: 0.06, hip_height_m: 0.015, leg_width_m: 0.02, ..p.clone() },
+            RobotSpec { stance_legs: 2, leg_speed_rad_s: 12.0, response_time_s: 0.1, ..p.clone() },
+            RobotSpec { level_step_m: Some(0.05), ..p },
+        ]
+        .into_iter()
+        .map(|s| Robot::new(s).unwrap())
+        .collect()
+    }
+
+    #[test]
+    fn closed_form_boundary_matches_brent() {
+        for r in robots() {
+            for deg in [0.0, 5.0, 12.0, 20.0, 30.0, 45.0] {
+                let b = ProgressBoundary::new(&r, slope(deg));
+                for k_n in [3e4, 1e5, 3e5, 7e5, 3e6, 1e8] {
+                    let brent =
+                        critical_shear_strength(&r, slope(deg), k_n, false, StepTarget::Progress).ok();
+                    let closed = b.k_crit(k_n);
+                    match (brent, closed) {
+                        (Some(x), Some(y)) => assert!((x - y).abs() <= 1e-9 * x, "{deg} {k_n}: {x} vs {y}"),
+                        (None, None) => {}
+                        other => panic!("{deg} {k_n}: {other:?}"),
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn p_fail_matches_the_risk_quadrature() {
+        let cases = [(0.1, 0.2), (0.3, 0.5), (0.0, 0.3), (0.2, 0.0), (0.6, 1.0)];
+        for r in robots() {
+            for deg in [0.0, 10.0, 20.0, 26.0] {
+                for (k_n, k_s) in [(7e5, 1.5e6), (1.2e5, 4e5), (5e4, 3e6), (7e5, 0.0)] {
+                    for (cv_n, cv_s) in cases {
+                        let u = Uncertainty::new(cv_n, cv_s).unwrap();
+                        let g = Ground { k_n, k_s, repose: Some(slope(25.0)) };
+                        let want = regime_probabilities(&r, slope(deg), &g, u).p_fail();
+                        let got = p_fail(&r, slope(deg), &g, u);
+                        assert!(
+                            (got - want).abs() < 2e-9,
+                            "{deg} {k_n} {k_s} {cv_n} {cv_s}: {got} vs {want}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn upper_bound_bounds() {
+        for r in robots() {
+            for deg in [0.0, 10.0, 20.0] {
+                for (k_n, k_s) in [(7e5, 1.5e6), (2e5, 5e5), (7e5, 3e7)] {
+                    let u = Uncertainty::new(0.1, 0.2).unwrap();
+                    let g = Ground::new(k_n, k_s).unwrap();
+                    let e = Evaluator::new(&r, slope(deg), &g, u);
+                    assert!(e.upper_bound() >= e.p_fail() - 1e-12, "{deg} {k_n} {k_s}");
+                }
+            }
+        }
+    }
+
+    fn terrain(cv: Option<(f64, f64)>) -> UncertainTerrain {
+        let pts = [(0.0, 7e5, 1.7e6), (10.0, 7e5, 1.56e6), (20.0, 6.5e5, 1.1e6), (24.0, 6e5, 9e5)];
+        let spec = TerrainSpec {
+            name: None,
+            repose_deg: Some(25.0),
+            points: pts
+                .iter()
+                .map(|&(slope_deg, k_n, k_s)| TerrainPoint {
+                    slope_deg,
+                    k_n,
+                    k_s,
+                    k_n_sd: Some(0.1 * k_n),
+                    k_s_sd: Some(0.25 * k_s),
+                })
+                .collect(),
+        };
+        let (n, s) = cv.unzip();
+        UncertainTerrain::new(Terrain::new(spec).unwrap(), n, s).unwrap()
+    }
+
+    /// The limit is the risk command's number, not merely close to it (a few robots; the risk
+    /// search costs ~50 quadratures each in a debug build).
+    #[test]
+    fn safe_slope_is_the_risk_commands() {
+        let rs = robots();
+        for (r, t, max_risk) in [
+            (&rs[0], terrain(None), 0.05),
+            (&rs[1], terrain(Some((0.2, 0.4))), 0.1),
+            (&rs[3], terrain(None), 0.01),
+        ] {
+            let want = crate::risk::safe_slope_limit(r, &t, max_risk).unwrap();
+            let got = safe_slope_limit(r, &t, max_risk);
+            match (want, got) {
+                (SafeLimit::Limit { value: a, p_fail: pa }, SafeLimit::Limit { value: b, p_fail: pb }) => {
+                    assert_eq!(a, b);
+                    assert!((pa - pb).abs() < 2e-9);
+                }
+                (SafeLimit::NoneSafe { .. }, SafeLimit::NoneSafe { .. }) => {}
+                other => panic!("{other:?}"),
+            }
+            // And p_fail is below the threshold just under it, above just over it.
+            if let SafeLimit::Limit { value, .. } = got {
+                assert!(failure_risk(r, slope(value), &t).p_fail() < max_risk);
+                assert!(failure_risk(r, slope(value + 2.0 * SLOPE_TOLERANCE_DEG), &t).p_fail() >= max_risk);
+            }
+        }
+    }
+}

@@ -48,12 +48,6 @@ impl TerrainArgs {
     }
 }
 
-/// Default coefficient of variation of k_n when neither `--cv-n` nor the terrain gives one
-/// (docs/model.md §9, the one uncertainty rule).
-pub const DEFAULT_CV_N: f64 = 0.1;
-/// Default coefficient of variation of k_s when neither `--cv-s` nor the terrain gives one.
-pub const DEFAULT_CV_S: f64 = 0.2;
-
 /// `--cv-n` and `--cv-s`: the terrain's uncertainty by the one rule of docs/model.md §9.
 #[derive(Debug, Clone, Copy, Args)]
 pub struct UncertaintyArgs {
@@ -68,34 +62,17 @@ pub struct UncertaintyArgs {
 }
 
 impl UncertaintyArgs {
-    /// The terrain read as uncertain: a flag's CV, else the table's SDs, else the default CV;
-    /// with one note per default used, for the output to say so.
-    pub fn apply(&self, terrain: Terrain) -> Result<(UncertainTerrain, Vec<String>)> {
-        let mut notes = Vec::new();
-        let all = |sd: fn(&sandslope::TerrainPoint) -> Option<f64>| {
-            terrain.points().iter().all(|p| sd(p).is_some())
-        };
-        let mut pick = |given: Option<f64>,
-                        flag: &str,
-                        has_sd: bool,
-                        what: &str,
-                        default: f64|
-         -> Result<Option<f64>> {
-            match given {
-                Some(cv) => Ok(Some(check_flag(flag, cv, 0.0, f64::INFINITY)?)),
-                None if has_sd => Ok(None),
-                None => {
-                    notes.push(format!(
-                        "the terrain gives no {what} at every point and {flag} is not set: default CV {default} (docs/model.md \u{a7}9)"
-                    ));
-                    Ok(Some(default))
-                }
+    /// The terrain read as uncertain (a flag's CV, else the table's SDs, else the default CV),
+    /// with the note to print when a default is used.
+    pub fn apply(&self, terrain: Terrain) -> Result<(UncertainTerrain, Option<String>)> {
+        for (flag, cv) in [("--cv-n", self.cv_n), ("--cv-s", self.cv_s)] {
+            if let Some(cv) = cv {
+                check_flag(flag, cv, 0.0, f64::INFINITY)?;
             }
-        };
-        let cv_n = pick(self.cv_n, "--cv-n", all(|p| p.k_n_sd), "k_n_sd", DEFAULT_CV_N)?;
-        let cv_s = pick(self.cv_s, "--cv-s", all(|p| p.k_s_sd), "k_s_sd", DEFAULT_CV_S)?;
-        let u = UncertainTerrain::new(terrain, cv_n, cv_s).map_err(|e| anyhow!("{e}"))?;
-        Ok((u, notes))
+        }
+        let u = UncertainTerrain::new(terrain, self.cv_n, self.cv_s).map_err(|e| anyhow!("{e}"))?;
+        let note = u.defaults_used().note();
+        Ok((u, note))
     }
 }
 

@@ -202,7 +202,8 @@ pub fn run(args: DesignArgs) -> Result<()> {
     let target = Slope::from_signed_degrees(args.slope_target)
         .map_err(|e| anyhow!("{}", e.renamed("--slope-target")))?;
     let goal = DesignGoal::new(max_risk, target).map_err(|e| anyhow!("--max-risk: {e}"))?;
-    let (terrain, notes) = args.uncertainty.apply(args.terrain.load()?)?;
+    let (terrain, note) = args.uncertainty.apply(args.terrain.load()?)?;
+    let notes: Vec<String> = note.into_iter().collect();
     // Check every output before the work.
     if let Some(p) = &args.plot {
         format_of(p)?;

@@ -15,6 +15,46 @@ pub fn array<'py, T: numpy::Element>(py: Python<'py>, v: Vec<T>) -> Bound<'py, P
     PyArray1::from_vec(py, v)
 }
 
+/// Fills a new vector of `n` values in parallel, `rows` of `width` values at a time
+/// (`fill(row, out)` writes every element of `out`), without zeroing it first.
+///
+/// Large outputs are where a phase map spends its time outside the model: a 2048 x 2048 map
+/// writes 36 MB into fresh memory, 9000 page faults with 4 KiB pages. The buffer is advised
+/// for transparent huge pages (2 MiB: a few dozen faults) before it is first touched.
+pub fn filled<T: Copy + Send + Sync>(
+    n: usize,
+    width: usize,
+    fill: impl Fn(usize, &mut [std::mem::MaybeUninit<T>]) + Sync,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    let mut v: Vec<T> = Vec::with_capacity(n);
+    advise_huge_pages(v.as_mut_ptr().cast(), n * std::mem::size_of::<T>());
+    v.spare_capacity_mut()[..n].par_chunks_mut(width.max(1)).enumerate().for_each(|(j, row)| fill(j, row));
+    // SAFETY: every element of the first `n` was written by `fill` (its contract), and
+    // `n <= capacity`.
+    unsafe { v.set_len(n) };
+    v
+}
+
+/// Asks the kernel to back `[ptr, ptr + bytes)` with transparent huge pages where it covers
+/// whole 2 MiB pages (a hint: ignored where unsupported).
+fn advise_huge_pages(ptr: *mut u8, bytes: usize) {
+    const HUGE: usize = 2 << 20;
+    if bytes < 2 * HUGE {
+        return;
+    }
+    #[cfg(target_os = "linux")]
+    {
+        let start = (ptr as usize).next_multiple_of(HUGE);
+        let end = (ptr as usize + bytes) / HUGE * HUGE;
+        if end > start {
+            // SAFETY: the range lies inside one live allocation of this process; MADV_HUGEPAGE
+            // only changes how its pages are backed, never their contents.
+            unsafe { libc::madvise(start as *mut libc::c_void, end - start, libc::MADV_HUGEPAGE) };
+        }
+    }
+}
+
 /// Puts `v` into `d` under `key` as a NumPy array.
 pub fn put<T: numpy::Element>(d: &Bound<'_, PyDict>, key: &str, v: Vec<T>) -> PyResult<()> {
     d.set_item(key, array(d.py(), v))

@@ -13,6 +13,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 mod arrays;
+mod measure;
 mod model;
 mod plan;
 mod risk;
@@ -44,6 +45,8 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plan::risk_raster, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan::read_raster, m)?)?;
+    m.add_function(wrap_pyfunction!(measure::fit, m)?)?;
+    m.add_function(wrap_pyfunction!(measure::track, m)?)?;
     m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;
     Ok(())
 }

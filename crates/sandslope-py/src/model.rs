@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use sandslope::{Cause, PhaseMap, Regime, Scenario, Slope, SlopeEvaluation, Terrain};
 
-use crate::arrays::{axis, put, scale_name, values};
+use crate::arrays::{axis, filled, put, scale_name, values};
 use crate::types::{PyRobot, PyTerrain};
 use crate::value_error;
 
@@ -183,14 +183,16 @@ pub fn phase<'py>(
         .ok_or_else(|| value_error(format!("a {nx} x {ny} map is too large")))?;
     let (regime, step, counts) = py.detach(|| {
         let map = PhaseMap::compute(robot, slope, repose, &kn, &ks, &|| {});
-        // Output buffers written row by row, in parallel, straight from the map's per-axis
-        // parts: one pass, no intermediate copies.
-        let mut regime = vec![0i8; cells];
-        let mut step = vec![0f64; cells];
-        regime.par_chunks_mut(nx).zip(step.par_chunks_mut(nx)).enumerate().for_each(|(j, (reg, st))| {
-            for i in 0..nx {
-                reg[i] = map.regime(i, j) as i8;
-                st[i] = map.step(i, j).unwrap_or(f64::NAN);
+        // Written row by row, in parallel, straight from the map into the buffers NumPy will
+        // own: one pass, no intermediate copies, no zeroing first.
+        let regime = filled::<i8>(cells, nx, |j, row| {
+            for (i, out) in row.iter_mut().enumerate() {
+                out.write(map.regime(i, j) as i8);
+            }
+        });
+        let step = filled::<f64>(cells, nx, |j, row| {
+            for (i, out) in row.iter_mut().enumerate() {
+                out.write(map.step(i, j).unwrap_or(f64::NAN));
             }
         });
         (regime, step, map.counts())

@@ -49,6 +49,8 @@ __all__ = [
     "plan",
     "risk_raster",
     "read_raster",
+    "fit",
+    "track",
 ]
 
 __version__ = "0.1.0"
@@ -477,3 +479,94 @@ def read_raster(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, Dict[
     """
     values, rows, cols, geo = _sandslope.read_raster(os.fspath(path))
     return values.reshape(rows, cols), geo
+
+
+def _frame(rows: Any) -> Any:
+    """A pandas DataFrame of a list of records when pandas is installed, else the list."""
+    try:
+        import pandas as pd
+    except ImportError:
+        return rows
+    return pd.json_normalize(rows) if rows and any(isinstance(v, dict) for v in rows[0].values()) else pd.DataFrame(rows)
+
+
+def fit(
+    manifest: Union[str, "os.PathLike[str]"],
+    *,
+    depth_window: Optional[Tuple[float, float]] = None,
+    plateau_from: Optional[float] = None,
+    air: str = "auto",
+    counts_per_newton: Optional[float] = None,
+    skip_malformed: bool = False,
+) -> Dict[str, Any]:
+    """k_n and k_s per slope from load-cell recordings (``sandslope fit``, docs/model.md §10).
+
+    ``manifest`` is the TOML manifest of the campaign (docs/measurements.md): disk area, shear
+    plate, and one ``[[trial]]`` per CSV (kind, slope, in-air or not). k_n is the slope of force
+    against depth over its linear part, divided by the disk area; k_s comes from the
+    quasi-static shear plateau; in-air runs are subtracted (``air``: ``"auto"``, ``"curve"``
+    or ``"mean"``). ``depth_window=(min, max)`` (m) and ``plateau_from`` (m) override the
+    automatic choices; ``counts_per_newton`` converts a ``force_counts`` column.
+
+    Returns ``{"points": per slope, "trials": per trial, "terrain": Terrain}``: ``points`` and
+    ``trials`` are pandas DataFrames when pandas is installed (lists of dicts otherwise), with
+    the fields of ``sandslope fit --json``; ``terrain`` is ready for :func:`predict`.
+    """
+    out = _sandslope.fit(
+        os.fspath(manifest),
+        depth_window=None if depth_window is None else (float(depth_window[0]), float(depth_window[1])),
+        plateau_from=plateau_from,
+        air=air,
+        counts_per_newton=counts_per_newton,
+        skip_malformed=skip_malformed,
+    )
+    out["points"] = _frame(out["points"])
+    out["trials"] = _frame(out["trials"])
+    return out
+
+
+def track(
+    paths: Union[str, "os.PathLike[str]", Sequence[Union[str, "os.PathLike[str]"]]],
+    slope_deg: Optional[float] = None,
+    *,
+    robot: RobotLike = "paper-hexapod",
+    format: Optional[str] = None,
+    body: Optional[str] = None,
+    upslope: Optional[Sequence[float]] = None,
+    max_gap: int = 10,
+    cutoff_hz: float = 10.0,
+    leg_speed_rad_s: Optional[float] = None,
+    touchdowns: Optional[Sequence[Sequence[float]]] = None,
+) -> Dict[str, Any]:
+    """Speed, anchoring time and slip from motion capture (``sandslope track``, docs/model.md §11).
+
+    ``paths``: one recording or several at the same ``slope_deg`` (OptiTrack Motive CSV, Vicon
+    Nexus CSV or plain ``time_s,x_m,y_m,z_m``, detected unless ``format`` is given; ``body``
+    picks the rigid body or marker). Gaps up to ``max_gap`` frames are filled, longer ones split
+    the recording; positions are differentiated with a zero-phase Butterworth low-pass at
+    ``cutoff_hz``; touchdowns every T/2 (T = 2 pi / leg speed, from the robot or
+    ``leg_speed_rad_s``) come from ``touchdowns`` (one list of times per recording, s) or are
+    estimated from the speed signal. ``upslope`` (x, y, z) fixes the upslope direction
+    (estimated from the travel otherwise).
+
+    Returns the fields of ``sandslope track --json``: pooled means and SDs (``speed_m_s``,
+    ``t1_s``, ``slip_m``, ``step_m``, ...), and ``recordings`` and ``per_step`` as pandas
+    DataFrames when pandas is installed (lists of dicts otherwise).
+    """
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [paths]
+    out = _sandslope.track(
+        [os.fspath(p) for p in paths],
+        slope_deg=None if slope_deg is None else float(slope_deg),
+        robot=_robot(robot),
+        format=format,
+        body=body,
+        upslope=None if upslope is None else [float(v) for v in upslope],
+        max_gap=int(max_gap),
+        cutoff_hz=float(cutoff_hz),
+        leg_speed_rad_s=None if leg_speed_rad_s is None else float(leg_speed_rad_s),
+        touchdowns=None if touchdowns is None else [[float(t) for t in ts] for ts in touchdowns],
+    )
+    out["recordings"] = _frame(out["recordings"])
+    out["per_step"] = _frame(out["per_step"])
+    return out

@@ -108,19 +108,20 @@ def safe_mass(
     cv_s: Optional[float] = None,
 ) -> Dict[str, Any]: ...
 def risk_raster(
-    dem: npt.NDArray[np.float32],
+    dem: _F64,
     cell_x: float,
     cell_y: float,
     robot: Robot,
     terrain: Terrain,
-    cv_n: float = 0.1,
-    cv_s: float = 0.2,
+    nodata: Optional[float] = None,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
     max_roll_deg: float = 20.0,
     descent: str = "symmetric",
     allow_metastable: bool = False,
 ) -> npt.NDArray[np.float32]: ...
 def plan(
-    dem: npt.NDArray[np.float32],
+    dem: _F64,
     cell_x: float,
     cell_y: float,
     robot: Robot,
@@ -129,11 +130,32 @@ def plan(
     goal: Tuple[int, int],
     objectives: List[str],
     origin: Tuple[float, float],
-    cv_n: float = 0.1,
-    cv_s: float = 0.2,
+    nodata: Optional[float] = None,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
     max_roll_deg: float = 20.0,
     descent: str = "symmetric",
     allow_metastable: bool = False,
     time_weight: float = 1e-4,
-) -> Dict[str, Dict[str, Any]]: ...
+) -> Dict[str, Any]: ...
 def read_raster(path: _Path) -> Tuple[_F64, int, int, Dict[str, float]]: ...
+def fit(
+    manifest: _Path,
+    depth_window: Optional[Tuple[float, float]] = None,
+    plateau_from: Optional[float] = None,
+    air: str = "auto",
+    counts_per_newton: Optional[float] = None,
+    skip_malformed: bool = False,
+) -> Dict[str, Any]: ...
+def track(
+    paths: List[_Path],
+    slope_deg: Optional[float] = None,
+    robot: Optional[Robot] = None,
+    format: Optional[str] = None,
+    body: Optional[str] = None,
+    upslope: Optional[List[float]] = None,
+    max_gap: int = 10,
+    cutoff_hz: float = 10.0,
+    leg_speed_rad_s: Optional[float] = None,
+    touchdowns: Optional[List[List[float]]] = None,
+) -> Dict[str, Any]: ...

@@ -1,0 +1,201 @@
+//! Measurements into model inputs, mirroring `sandslope fit` (load-cell campaigns, docs/model.md
+//! §10) and `sandslope track` (motion capture, docs/model.md §11): files read by
+//! `sandslope-io`, analysed by one library call each, returned as plain dicts (the Python layer
+//! turns their tables into DataFrames when pandas is installed).
+
+use std::path::PathBuf;
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use pythonize::pythonize;
+
+use sandslope::gait::{track as track_recordings, GaitOptions, Recording, Upslope};
+use sandslope::measure::{fit_campaign, AirMode, CampaignError, FitOptions, Setup, TrialInput};
+use sandslope::{Slope, Terrain, TerrainSpec};
+use sandslope_io::measurements::{load_manifest, read_recording_with, ReadOptions};
+use sandslope_io::mocap::{self, MocapFormat};
+
+use crate::types::{PyRobot, PyTerrain};
+use crate::{anyhow_error, value_error};
+
+/// A load-cell campaign (`sandslope fit MANIFEST --json`): `{"trials": [...], "points":
+/// [...], "terrain": Terrain}`.
+#[pyfunction]
+#[pyo3(signature = (manifest, depth_window=None, plateau_from=None, air="auto", counts_per_newton=None, skip_malformed=false))]
+pub fn fit<'py>(
+    py: Python<'py>,
+    manifest: PathBuf,
+    depth_window: Option<(f64, f64)>,
+    plateau_from: Option<f64>,
+    air: &str,
+    counts_per_newton: Option<f64>,
+    skip_malformed: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    if let Some((a, b)) = depth_window {
+        if !(a.is_finite() && b.is_finite() && a >= 0.0 && a < b) {
+            return Err(value_error(format!(
+                "depth_window = ({a}, {b}) must be (MIN, MAX) in metres with 0 <= MIN < MAX, e.g. (0.005, 0.03)"
+            )));
+        }
+    }
+    if let Some(x) = plateau_from.filter(|x| !(x.is_finite() && *x >= 0.0)) {
+        return Err(value_error(format!(
+            "plateau_from = {x} must be a displacement in metres of at least 0"
+        )));
+    }
+    let air = match air {
+        "auto" => AirMode::Auto,
+        "curve" => AirMode::Curve,
+        "mean" => AirMode::Mean,
+        other => return Err(value_error(format!("air = {other:?} must be \"auto\", \"curve\" or \"mean\""))),
+    };
+    if let Some(c) = counts_per_newton.filter(|c| !(c.is_finite() && *c > 0.0)) {
+        return Err(value_error(format!("counts_per_newton = {c} must be a finite number greater than 0")));
+    }
+    let options = FitOptions { depth_window, plateau_from, air };
+    let (campaign, terrain) = py
+        .detach(|| -> anyhow::Result<_> {
+            let manifest = load_manifest(&manifest)?;
+            let read = ReadOptions { counts_per_newton, skip_malformed };
+            let mut trials = Vec::with_capacity(manifest.trials.len());
+            for trial in &manifest.trials {
+                if !trial.path.is_file() {
+                    anyhow::bail!(
+                        "{}: [[trial]] #{} ({}): trial file {} does not exist",
+                        manifest.path.display(),
+                        trial.index,
+                        trial.file.display(),
+                        trial.path.display()
+                    );
+                }
+                let rec = read_recording_with(&trial.path, trial.kind, read)?;
+                trials.push(TrialInput {
+                    file: trial.file.display().to_string(),
+                    kind: trial.kind,
+                    slope_deg: trial.slope_deg,
+                    air: trial.air,
+                    rows: rec.rows,
+                    raw: rec.raw,
+                });
+            }
+            let setup = Setup { disk_area_m2: manifest.disk_area_m2, plate: manifest.plate };
+            let dir = manifest.path.parent().map(|d| d.join("")).unwrap_or_default();
+            let campaign = fit_campaign(&trials, &setup, &options).map_err(|e| match e {
+                CampaignError::Trial { .. } | CampaignError::TooFewRows { .. } => {
+                    anyhow::anyhow!("{}{e}", dir.display())
+                }
+                _ => anyhow::anyhow!("{}: {e}", manifest.path.display()),
+            })?;
+            let spec = TerrainSpec {
+                name: manifest.name.clone(),
+                repose_deg: manifest.repose_deg,
+                points: campaign.terrain_points(),
+            };
+            let terrain = Terrain::new(spec).map_err(|e| {
+                anyhow::anyhow!("{}: fitted terrain is invalid: {e}", manifest.path.display())
+            })?;
+            Ok((campaign, terrain))
+        })
+        .map_err(anyhow_error)?;
+    let d = PyDict::new(py);
+    d.set_item("trials", pythonize(py, &campaign.trials).map_err(value_error)?)?;
+    d.set_item("points", pythonize(py, &campaign.points).map_err(value_error)?)?;
+    d.set_item("terrain", Bound::new(py, PyTerrain { inner: terrain })?)?;
+    Ok(d)
+}
+
+/// Motion-capture recordings at one slope (`sandslope track FILES --json`).
+#[pyfunction]
+#[pyo3(signature = (paths, slope_deg=None, robot=None, format=None, body=None, upslope=None, max_gap=sandslope::gait::DEFAULT_MAX_GAP, cutoff_hz=sandslope::gait::DEFAULT_CUTOFF_HZ, leg_speed_rad_s=None, touchdowns=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn track<'py>(
+    py: Python<'py>,
+    paths: Vec<PathBuf>,
+    slope_deg: Option<f64>,
+    robot: Option<&PyRobot>,
+    format: Option<&str>,
+    body: Option<String>,
+    upslope: Option<[f64; 3]>,
+    max_gap: usize,
+    cutoff_hz: f64,
+    leg_speed_rad_s: Option<f64>,
+    touchdowns: Option<Vec<Vec<f64>>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    if paths.is_empty() {
+        return Err(value_error("paths is empty: give at least one recording"));
+    }
+    let format: Option<MocapFormat> = format.map(str::parse).transpose().map_err(value_error)?;
+    let period = match (leg_speed_rad_s, robot) {
+        (Some(w), _) if !(w.is_finite() && w > 0.0) => {
+            return Err(value_error(format!("leg_speed_rad_s = {w} must be a finite number greater than 0")))
+        }
+        (Some(w), _) => std::f64::consts::TAU / w,
+        (None, Some(r)) => r.inner.stride_period(),
+        (None, None) => {
+            return Err(value_error(
+                "give the robot (its leg speed sets the stride period) or leg_speed_rad_s",
+            ))
+        }
+    };
+    let mut options = GaitOptions::new(period)
+        .and_then(|o| o.with_cutoff(cutoff_hz))
+        .map_err(|e| value_error(e.renamed("cutoff_hz")))?
+        .with_max_gap(max_gap);
+    if let Some(u) = upslope {
+        options = options.with_upslope(Upslope::new(u).map_err(|e| value_error(e.renamed("upslope")))?);
+    }
+    let slope = slope_deg
+        .map(|d| Slope::from_degrees(d).map_err(|e| value_error(e.renamed("slope_deg"))))
+        .transpose()?;
+    if let Some(t) = &touchdowns {
+        if t.len() != paths.len() {
+            return Err(value_error(format!(
+                "touchdowns has {} lists for {} recordings: give one per recording, in order",
+                t.len(),
+                paths.len()
+            )));
+        }
+    }
+    let (captures, result) = py
+        .detach(|| -> anyhow::Result<_> {
+            let captures: Vec<mocap::Capture> = paths
+                .iter()
+                .map(|p| mocap::read(p, format, body.as_deref()))
+                .collect::<anyhow::Result<_>>()?;
+            let recordings: Vec<Recording> = captures
+                .iter()
+                .enumerate()
+                .map(|(i, c)| Recording {
+                    positions: &c.positions,
+                    frame_rate_hz: c.frame_rate_hz,
+                    start_time_s: c.start_time_s,
+                    touchdowns_s: touchdowns.as_ref().map(|t| t[i].as_slice()),
+                })
+                .collect();
+            let result = track_recordings(&recordings, &options, slope).map_err(|e| match e {
+                sandslope::GaitError::Param { index, source } => anyhow::anyhow!(
+                    "{}: {source} (at its frame rate {} Hz)",
+                    captures[index].path.display(),
+                    captures[index].frame_rate_hz
+                ),
+                other => anyhow::anyhow!("{other}"),
+            })?;
+            Ok((captures, result))
+        })
+        .map_err(anyhow_error)?;
+    let d = pythonize(py, &result).map_err(value_error)?.cast_into::<PyDict>()?;
+    let missing = || value_error("track result without recordings or per_step");
+    let recordings = d.get_item("recordings")?.ok_or_else(missing)?;
+    for (i, c) in captures.iter().enumerate() {
+        let r = recordings.get_item(i)?;
+        r.set_item("file", c.path.display().to_string())?;
+        r.set_item("format", c.format.name())?;
+        r.set_item("body", &c.body)?;
+    }
+    let files: Vec<String> = captures.iter().map(|c| c.path.display().to_string()).collect();
+    let steps = d.get_item("per_step")?.ok_or_else(missing)?;
+    for (i, st) in result.per_step.iter().enumerate() {
+        steps.get_item(i)?.set_item("file", &files[st.recording])?;
+    }
+    Ok(d)
+}

@@ -349,15 +349,32 @@ fn oversized_grids_are_refused_before_any_work() {
         .assert()
         .code(2)
         .stderr(predicate::str::contains("--csv would write 64000000 rows"));
-    // risk runs one quadrature per slope or map cell: 1e6 of them is refused up front.
+    // A risk map of 1e8 cells would not fit in memory: refused up front, nothing written.
+    let csv = dir.path().join("m.csv");
     Command::cargo_bin("sandslope")
         .unwrap()
-        .args(["risk", "--cv-n", "0.1", "--cv-s", "0.1", "--slope", "20", "--map", "--plot"])
-        .arg(dir.path().join("m.png"))
-        .args(["--k-n", "1e4:1e7:1000", "--k-s", "1e4:1e7:1000"])
+        .args(["risk", "--slope", "20", "--map", "--csv"])
+        .arg(&csv)
+        .args(["--k-n", "1e4:1e7:10000", "--k-s", "1e4:1e7:10000"])
         .assert()
         .code(2)
-        .stderr(predicate::str::contains("1000000 map cells"));
+        .stderr(predicate::str::contains("100000000 map cells"));
+    assert!(!csv.exists());
+    // Bad grids: N = 0, MIN >= MAX, a log axis through 0.
+    for (flag, bad, says) in [
+        ("--k-n", "1e4:1e7:0", "--k-n points = 0"),
+        ("--k-s", "1e7:1e4:10", "--k-s max"),
+        ("--k-n", "0:1e7:10", "greater than 0 on a log axis"),
+    ] {
+        for cmd in ["phase", "risk"] {
+            let mut c = Command::cargo_bin("sandslope").unwrap();
+            c.args([cmd, flag, bad]);
+            if cmd == "risk" {
+                c.args(["--slope", "20", "--map"]);
+            }
+            c.assert().code(2).stderr(predicate::str::contains(says));
+        }
+    }
 }
 
 #[test]

@@ -27,7 +27,9 @@ use crate::output::{csv_string, num, print_json, sci, table, write_via_temp, For
 use crate::progress::progress_bar;
 
 /// Default points per axis of the `--map` grid.
-pub const MAP_POINTS: usize = 48;
+pub const MAP_POINTS: usize = 200;
+/// Most `--map` cells (2^24: two 128 MiB arrays of probabilities).
+const MAX_MAP_CELLS: u128 = 1 << 24;
 
 /// What `--solve` finds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -71,10 +73,10 @@ pub struct RiskArgs {
     /// p_fail and p_not_success over a grid of median (k_n, k_s) at the first --slope.
     #[arg(long, conflicts_with = "solve")]
     pub map: bool,
-    /// --map grid of median k_n, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 100 to x 100, 48 points).
+    /// --map grid of median k_n, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 100 to x 100, 200 points).
     #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]", requires = "map", allow_hyphen_values = true)]
     pub k_n: Option<String>,
-    /// --map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 1000 to x 100, 48 points).
+    /// --map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 1000 to x 100, 200 points).
     #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", requires = "map", allow_hyphen_values = true)]
     pub k_s: Option<String>,
     /// Print JSON instead of a table.
@@ -98,7 +100,7 @@ impl RiskArgs {
     }
 }
 
-/// Most probability evaluations a one-slope-at-a-time run makes (slopes, or map cells).
+/// Most slopes one run evaluates (each a quadrature of a few ms).
 const MAX_QUADRATURES: u64 = 1 << 16;
 
 /// Parses `--slope`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N` (N evenly spaced, ends included).
@@ -583,10 +585,10 @@ fn run_map(
         Some(t) => parse_axis("--k-s", t)?,
         None => default_axis("--k-s", &[ground.k_s], 1000.0, 100.0, MAP_POINTS)?,
     };
-    let cells = (k_n_axis.len() * k_s_axis.len()) as u64;
-    if cells > MAX_QUADRATURES {
+    let cells = k_n_axis.len() as u128 * k_s_axis.len() as u128;
+    if cells > MAX_MAP_CELLS {
         bail!(
-            "--k-n and --k-s give {cells} map cells, each a full quadrature of a few ms; at most {MAX_QUADRATURES} are allowed"
+            "--k-n and --k-s give {cells} map cells; at most {MAX_MAP_CELLS} are allowed (e.g. 4096 x 4096), to keep the map in memory"
         );
     }
     let defaults = terrain.defaults_used_at(slope);

@@ -1,11 +1,48 @@
 //! The risk map: p_fail and p_not_success at every cell of a grid of median (k_n, k_s), at
-//! one robot, slope and uncertainty (docs/model.md §9; algorithm in docs/phase-and-risk.md).
+//! one robot, slope and uncertainty (docs/model.md §9; algorithm and error bound in
+//! docs/phase-and-risk.md).
+//!
+//! Per cell, with `x = ln k_n ~ Normal(mu_n, sigma_n^2)` and `ln k_s ~ Normal(mu_s, sigma_s^2)`,
+//!
+//! `p_fail = Phi((x* - mu_n)/sigma_n) + integral over x > x* of
+//!           phi_n(x - mu_n) Phi((g(x) - mu_s)/sigma_s) dx`
+//!
+//! where `x* = ln k_n*` (sinkage) and `g(x) = ln k_s_crit(e^x)` is the critical shear strength
+//! for progress (docs/model.md §13); `p_not_success` is the same with the critical strength
+//! for robust progress. `g` does not depend on the medians, so the map shares all the work
+//! that does not depend on the cell:
+//!
+//! 1. **Nodes, once per map.** The integration range (the union over columns of
+//!    `[mu_n - 8.5 sigma_n, mu_n + 8.5 sigma_n]`, cut at `x*`) is split into panels of width
+//!    at most `sigma_n`, narrower wherever `g` moves by more than `sigma_s` inside a panel
+//!    while within reach of some row's `mu_s`, and split exactly where `g` has a kink
+//!    (where the anchoring threshold starts to bind) or becomes infinite (no strength
+//!    suffices). Each panel carries 5 Gauss-Legendre nodes; `g` is evaluated at each node in
+//!    closed form ([`crate::critical::critical_shear_strength_closed_form`]).
+//! 2. **Weights, once per column:** `w_q phi((x_q - mu_n)/sigma_n)/sigma_n` over the nodes
+//!    within 8.5 sigma_n of the column's median.
+//! 3. **Conditional probabilities, once per row:** `Phi((g(x_q) - mu_s)/sigma_s)` at every node
+//!    (0 or 1 without an erfc call where the argument is beyond +-9).
+//! 4. **Each cell** is then two dot products of a column's weights with a row's
+//!    probabilities.
+//!
+//! Both factors of the integrand change by a bounded amount within a panel, so the 10th-order
+//! Gauss-Legendre rule converges far below the 1e-6 target; the tests check every cell of
+//! random maps (random robots, slopes, spreads down to `cv_s = 0.01`, `cv_n = 0`, medians on
+//! the sinkage boundary) against the per-cell adaptive quadrature of
+//! [`super::regime_probabilities`] ([`RiskMap::compute_by_quadrature`]) to 1e-6 absolute.
+//! Without spread in k_n (`cv_n = 0`) each cell is a normal CDF at the column's critical
+//! strength; without spread in k_s (`cv_s = 0`) the conditional probability is a step, so
+//! each row's crossings `g(x) = mu_s` are found by bisection and each cell is a sum of normal
+//! CDF differences.
 
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::quadrature::regime_probabilities;
+use super::quadrature::{density, phi, regime_probabilities, Z_MAX};
 use super::uncertainty::Uncertainty;
+use crate::critical::ln_critical_closed_form;
+use crate::model::{level_step_length, normal_equilibrium_depth, sinkage_threshold_k_n};
 use crate::phase::{contour_segments, Axis, ContourSegment};
 use crate::robot::Robot;
 use crate::slope::Slope;
@@ -32,11 +69,354 @@ pub struct RiskMap {
     pub p_not_success: Vec<f64>,
 }
 
+/// 5-point Gauss-Legendre nodes and weights on `[-1, 1]`.
+const GL_X: [f64; 5] =
+    [-0.906_179_845_938_664, -0.538_469_310_105_683_1, 0.0, 0.538_469_310_105_683_1, 0.906_179_845_938_664];
+const GL_W: [f64; 5] = [
+    0.236_926_885_056_189_1,
+    0.478_628_670_499_366_5,
+    0.568_888_888_888_888_9,
+    0.478_628_670_499_366_5,
+    0.236_926_885_056_189_1,
+];
+/// Beyond this many standard deviations a normal CDF is 0 or 1 to within 1e-19.
+const Z_FLAT: f64 = 9.0;
+/// Narrowest panel, in ln k_n.
+const MIN_PANEL: f64 = 1e-10;
+
+/// The two critical strengths `(ln k_s for s > 0, ln k_s for s >= s_min)` at `x = ln k_n`
+/// (infinite where no strength suffices or the legs sink), and which branch each is on
+/// (capped at the anchoring threshold, finite), to find kinks.
+fn curves(robot: &Robot, slope: Slope, x: f64) -> ([f64; 2], [(bool, bool); 2]) {
+    let d_n = normal_equilibrium_depth(robot, slope, x.exp());
+    if d_n >= robot.max_depth() {
+        return ([f64::INFINITY; 2], [(false, false); 2]);
+    }
+    let s_star = level_step_length(robot, d_n);
+    let (g0, c0) = ln_critical_closed_form(robot, slope, s_star, 0.0);
+    let (g1, c1) = ln_critical_closed_form(robot, slope, s_star, robot.min_step());
+    ([g0, g1], [(c0, g0.is_finite()), (c1, g1.is_finite())])
+}
+
+/// The integration nodes of one map: positions, Gauss-Legendre weights and the two curves.
+struct Nodes {
+    x: Vec<f64>,
+    w: Vec<f64>,
+    g: [Vec<f64>; 2],
+    /// Per segment, the panel ends with the curves there (for the crossings when
+    /// `sigma_s = 0`).
+    ends: Vec<Vec<(f64, [f64; 2])>>,
+}
+
+/// Builds the nodes on `[lo, hi]` (see the module documentation). `band` is the range of g
+/// within which some row's conditional probability is not flat (empty when `sigma_s = 0`).
+fn build_nodes(
+    robot: &Robot,
+    slope: Slope,
+    segments: &[(f64, f64)],
+    sigma_n: f64,
+    sigma_s: f64,
+    band: (f64, f64),
+) -> Nodes {
+    let mut nodes = Nodes { x: Vec::new(), w: Vec::new(), g: [Vec::new(), Vec::new()], ends: Vec::new() };
+    let base = sigma_n;
+    let resolves = |ga: [f64; 2], gb: [f64; 2]| {
+        sigma_s == 0.0
+            || (0..2).all(|t| {
+                let (a, b) = (ga[t].min(gb[t]), ga[t].max(gb[t]));
+                !a.is_finite() || !b.is_finite() || b < band.0 || a > band.1 || b - a <= sigma_s
+            })
+    };
+    for &(lo, hi) in segments {
+        let mut a = lo;
+        let (mut ga, mut sa) = curves(robot, slope, a);
+        let mut ends = vec![(a, ga)];
+        while a < hi {
+            let mut b = (a + base).min(hi);
+            let (mut gb, mut sb) = curves(robot, slope, b);
+            // Split at a kink or where a curve becomes infinite: bisect for the switch.
+            if sb != sa {
+                let (mut l, mut h) = (a, b);
+                for _ in 0..200 {
+                    let m = 0.5 * (l + h);
+                    if m <= l || m >= h {
+                        break;
+                    }
+                    if curves(robot, slope, m).1 == sa {
+                        l = m;
+                    } else {
+                        h = m;
+                    }
+                }
+                b = if l > a { l } else { h };
+                (gb, sb) = curves(robot, slope, b);
+            }
+            // Narrower where a curve moves fast within reach of the rows' medians.
+            while b - a > MIN_PANEL && !resolves(ga, gb) {
+                b = a + 0.5 * (b - a);
+                (gb, sb) = curves(robot, slope, b);
+            }
+            let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+            for (&u, &wu) in GL_X.iter().zip(&GL_W) {
+                let x = mid + half * u;
+                let (g, _) = curves(robot, slope, x);
+                nodes.x.push(x);
+                nodes.w.push(half * wu);
+                nodes.g[0].push(g[0]);
+                nodes.g[1].push(g[1]);
+            }
+            ends.push((b, gb));
+            (a, ga, sa) = (b, gb, sb);
+        }
+        nodes.ends.push(ends);
+    }
+    nodes
+}
+
+/// `[w . f0, w . f1]`, with four partial sums each so the additions pipeline.
+fn dot2(w: &[f64], f0: &[f64], f1: &[f64]) -> [f64; 2] {
+    let (mut a, mut b) = ([0.0; 4], [0.0; 4]);
+    let (wc, f0c, f1c) = (w.chunks_exact(4), f0.chunks_exact(4), f1.chunks_exact(4));
+    let (wr, f0r, f1r) = (wc.remainder(), f0c.remainder(), f1c.remainder());
+    for ((w, x), y) in wc.zip(f0c).zip(f1c) {
+        for k in 0..4 {
+            a[k] += w[k] * x[k];
+            b[k] += w[k] * y[k];
+        }
+    }
+    let mut s = [(a[0] + a[1]) + (a[2] + a[3]), (b[0] + b[1]) + (b[2] + b[3])];
+    for ((w, x), y) in wr.iter().zip(f0r).zip(f1r) {
+        s[0] += w * x;
+        s[1] += w * y;
+    }
+    s
+}
+
+/// `Phi((g - mu) / sigma)` with the flat tails short-cut.
+fn cdf(g: f64, mu: f64, sigma: f64) -> f64 {
+    let z = (g - mu) / sigma;
+    if z > Z_FLAT {
+        1.0
+    } else if z < -Z_FLAT {
+        0.0
+    } else {
+        phi(z)
+    }
+}
+
+/// The intervals of `x` where `g_t(x) > mu`, from the curves at the panel ends of each
+/// segment (crossings refined by bisection on the closed form), for `sigma_s = 0`.
+fn above(
+    robot: &Robot,
+    slope: Slope,
+    segments: &[Vec<(f64, [f64; 2])>],
+    t: usize,
+    mu: f64,
+) -> Vec<(f64, f64)> {
+    let crossing = |l: f64, h: f64, l_above: bool| {
+        let (mut l, mut h) = (l, h);
+        for _ in 0..200 {
+            let m = 0.5 * (l + h);
+            if m <= l || m >= h {
+                break;
+            }
+            if (curves(robot, slope, m).0[t] > mu) == l_above {
+                l = m;
+            } else {
+                h = m;
+            }
+        }
+        0.5 * (l + h)
+    };
+    let mut out = Vec::new();
+    for ends in segments {
+        let mut start = None;
+        for (k, &(x, g)) in ends.iter().enumerate() {
+            let now = g[t] > mu;
+            match (start, now) {
+                (None, true) => start = Some(if k == 0 { x } else { crossing(ends[k - 1].0, x, false) }),
+                (Some(s), false) => {
+                    out.push((s, crossing(ends[k - 1].0, x, true)));
+                    start = None;
+                }
+                _ => {}
+            }
+        }
+        if let (Some(s), Some(&(x, _))) = (start, ends.last()) {
+            out.push((s, x));
+        }
+    }
+    out
+}
+
 impl RiskMap {
     /// The map for `robot` at `slope` on terrain with angle of repose `repose`, over
-    /// `k_n_axis x k_s_axis` with `uncertainty` in every cell. `row_done` is called once per
-    /// finished k_s row, from any thread (for progress bars).
+    /// `k_n_axis x k_s_axis` with `uncertainty` in every cell, by the shared-work algorithm
+    /// of the module documentation (within 1e-6 of [`RiskMap::compute_by_quadrature`]).
+    /// `row_done` is called once per finished k_s row, from any thread (for progress bars).
     pub fn compute(
+        robot: &Robot,
+        slope: Slope,
+        repose: Option<Slope>,
+        k_n_axis: &Axis,
+        k_s_axis: &Axis,
+        uncertainty: Uncertainty,
+        row_done: &(dyn Fn() + Sync),
+    ) -> RiskMap {
+        let (nx, ny) = (k_n_axis.len(), k_s_axis.len());
+        let beyond_repose = repose.is_some_and(|r| slope.radians() >= r.radians());
+        let ln = |v: f64| if v > 0.0 { v.ln() } else { f64::NEG_INFINITY };
+        let mu_n: Vec<f64> = k_n_axis.values().into_iter().map(ln).collect();
+        let mu_s: Vec<f64> = k_s_axis.values().into_iter().map(ln).collect();
+        let (sigma_n, sigma_s) = (uncertainty.sigma_n(), uncertainty.sigma_s());
+        let x_star = sinkage_threshold_k_n(robot, slope).ln();
+        // P(sinkage) per column.
+        let p_sink: Vec<f64> = mu_n
+            .iter()
+            .map(|&m| {
+                if m == f64::NEG_INFINITY || x_star == f64::INFINITY {
+                    1.0
+                } else if sigma_n == 0.0 {
+                    f64::from(u8::from(m <= x_star))
+                } else {
+                    phi((x_star - m) / sigma_n)
+                }
+            })
+            .collect();
+
+        // Per column: the integration window as a node range and its weights, or (sigma_n = 0)
+        // the two curves at the column's median.
+        enum Columns {
+            Certain(Vec<[f64; 2]>),
+            Spread { nodes: Nodes, ranges: Vec<(usize, usize)>, weights: Vec<Vec<f64>> },
+        }
+        let columns = if beyond_repose {
+            Columns::Certain(Vec::new())
+        } else if sigma_n == 0.0 {
+            Columns::Certain(
+                mu_n.iter()
+                    .map(|&m| if m > x_star { curves(robot, slope, m).0 } else { [f64::INFINITY; 2] })
+                    .collect(),
+            )
+        } else {
+            // The union of the columns' windows, cut at x*.
+            let mut windows: Vec<(f64, f64)> = mu_n
+                .iter()
+                .filter(|m| m.is_finite())
+                .map(|&m| ((m - Z_MAX * sigma_n).max(x_star), m + Z_MAX * sigma_n))
+                .filter(|(a, b)| a < b)
+                .collect();
+            windows.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut segments: Vec<(f64, f64)> = Vec::new();
+            for (a, b) in windows {
+                match segments.last_mut() {
+                    Some(last) if a <= last.1 => last.1 = last.1.max(b),
+                    _ => segments.push((a, b)),
+                }
+            }
+            let finite_s: Vec<f64> = mu_s.iter().copied().filter(|m| m.is_finite()).collect();
+            let band = if sigma_s > 0.0 && !finite_s.is_empty() {
+                let lo = finite_s.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = finite_s.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                (lo - Z_FLAT * sigma_s, hi + Z_FLAT * sigma_s)
+            } else {
+                (f64::INFINITY, f64::NEG_INFINITY)
+            };
+            let nodes = build_nodes(robot, slope, &segments, sigma_n, sigma_s, band);
+            let (ranges, weights): (Vec<(usize, usize)>, Vec<Vec<f64>>) = mu_n
+                .par_iter()
+                .map(|&m| {
+                    if !m.is_finite() {
+                        return ((0, 0), Vec::new());
+                    }
+                    let a = nodes.x.partition_point(|&x| x < m - Z_MAX * sigma_n);
+                    let b = nodes.x.partition_point(|&x| x <= m + Z_MAX * sigma_n);
+                    let w =
+                        (a..b).map(|q| nodes.w[q] * density((nodes.x[q] - m) / sigma_n) / sigma_n).collect();
+                    ((a, b), w)
+                })
+                .unzip();
+            Columns::Spread { nodes, ranges, weights }
+        };
+
+        let mut p_fail = vec![0.0; nx * ny];
+        let mut p_not_success = vec![0.0; nx * ny];
+        p_fail.par_chunks_mut(nx).zip(p_not_success.par_chunks_mut(nx)).zip(mu_s.par_iter()).for_each(
+            |((fail_row, ns_row), &ms)| {
+                // Conditional integrals [P(slip, not sunk), P(not success, not sunk)] per column.
+                let integrals: Vec<[f64; 2]> = if beyond_repose || ms == f64::NEG_INFINITY {
+                    // Every leg that does not sink slips (at/above repose, or k_s = 0).
+                    p_sink.iter().map(|&p| [1.0 - p; 2]).collect()
+                } else {
+                    match &columns {
+                        Columns::Certain(g) => g
+                            .iter()
+                            .zip(&p_sink)
+                            .map(|(g, &p)| {
+                                if p >= 1.0 {
+                                    return [0.0; 2];
+                                }
+                                let f = |g: f64| {
+                                    if sigma_s == 0.0 {
+                                        f64::from(u8::from(g > ms))
+                                    } else {
+                                        cdf(g, ms, sigma_s)
+                                    }
+                                };
+                                [f(g[0]), f(g[1])]
+                            })
+                            .collect(),
+                        Columns::Spread { nodes, ranges, weights } if sigma_s > 0.0 => {
+                            let f: [Vec<f64>; 2] =
+                                [0, 1].map(|t| nodes.g[t].iter().map(|&g| cdf(g, ms, sigma_s)).collect());
+                            ranges
+                                .iter()
+                                .zip(weights)
+                                .map(|(&(a, b), w)| dot2(w, &f[0][a..b], &f[1][a..b]))
+                                .collect()
+                        }
+                        Columns::Spread { nodes, .. } => {
+                            let intervals = [0, 1].map(|t| above(robot, slope, &nodes.ends, t, ms));
+                            mu_n.iter()
+                                .map(|&m| {
+                                    if !m.is_finite() {
+                                        return [0.0; 2];
+                                    }
+                                    intervals.clone().map(|iv| {
+                                        iv.iter()
+                                            .map(|&(a, b)| phi((b - m) / sigma_n) - phi((a - m) / sigma_n))
+                                            .sum::<f64>()
+                                    })
+                                })
+                                .collect()
+                        }
+                    }
+                };
+                for (i, [slip, not_success]) in integrals.into_iter().enumerate() {
+                    let sink = p_sink[i];
+                    let not_sunk = 1.0 - sink;
+                    let slip = slip.clamp(0.0, not_sunk);
+                    let not_success = not_success.clamp(slip, not_sunk);
+                    fail_row[i] = sink + slip;
+                    ns_row[i] = sink + not_success;
+                }
+                row_done();
+            },
+        );
+        RiskMap {
+            slope_deg: slope.degrees(),
+            beyond_repose,
+            k_n_axis: *k_n_axis,
+            k_s_axis: *k_s_axis,
+            uncertainty,
+            p_fail,
+            p_not_success,
+        }
+    }
+
+    /// The same map by one adaptive quadrature per cell ([`super::regime_probabilities`]):
+    /// the reference [`RiskMap::compute`] is tested against, a few milliseconds per cell.
+    pub fn compute_by_quadrature(
         robot: &Robot,
         slope: Slope,
         repose: Option<Slope>,
@@ -47,28 +427,31 @@ impl RiskMap {
     ) -> RiskMap {
         let k_n = k_n_axis.values();
         let k_s = k_s_axis.values();
-        let nx = k_n.len();
         let rows: Vec<(Vec<f64>, Vec<f64>)> = k_s
             .par_iter()
             .map(|&ks| {
-                let (a, b) = k_n
+                let row = k_n
                     .iter()
                     .map(|&kn| {
-                        let ground = Ground { k_n: kn, k_s: ks, repose };
-                        let p = regime_probabilities(robot, slope, &ground, uncertainty);
+                        let p = regime_probabilities(
+                            robot,
+                            slope,
+                            &Ground { k_n: kn, k_s: ks, repose },
+                            uncertainty,
+                        );
                         (p.p_fail(), p.p_not_success())
                     })
                     .unzip();
                 row_done();
-                (a, b)
+                row
             })
             .collect();
-        let mut p_fail = Vec::with_capacity(nx * k_s.len());
-        let mut p_not_success = Vec::with_capacity(nx * k_s.len());
-        for (a, b) in rows {
-            p_fail.extend(a);
-            p_not_success.extend(b);
-        }
+        let (p_fail, p_not_success) =
+            rows.into_iter().fold((Vec::new(), Vec::new()), |(mut a, mut b), (x, y)| {
+                a.extend(x);
+                b.extend(y);
+                (a, b)
+            });
         RiskMap {
             slope_deg: slope.degrees(),
             beyond_repose: repose.is_some_and(|r| slope.radians() >= r.radians()),
@@ -100,16 +483,100 @@ impl RiskMap {
 mod tests {
     use super::*;
     use crate::model::tests::paper_robot;
-    use crate::AxisScale;
+    use crate::{AxisScale, RobotSpec};
 
+    fn log_axis(min: f64, max: f64, n: usize) -> Axis {
+        Axis::new("k", min, max, n, AxisScale::Log).unwrap()
+    }
+
+    /// Largest absolute difference between the fast map and the per-cell quadrature.
+    fn worst(robot: &Robot, deg: f64, repose: Option<f64>, kn: &Axis, ks: &Axis, cv: (f64, f64)) -> f64 {
+        let s = Slope::from_degrees(deg).unwrap();
+        let repose = repose.map(|r| Slope::from_degrees(r).unwrap());
+        let u = Uncertainty::new(cv.0, cv.1).unwrap();
+        let fast = RiskMap::compute(robot, s, repose, kn, ks, u, &|| {});
+        let slow = RiskMap::compute_by_quadrature(robot, s, repose, kn, ks, u, &|| {});
+        fast.p_fail
+            .iter()
+            .zip(&slow.p_fail)
+            .chain(fast.p_not_success.iter().zip(&slow.p_not_success))
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Random robots, slopes, spreads and grids (a small deterministic generator), every
+    /// cell within 1e-6 of the quadrature; grids straddle the sinkage threshold and both
+    /// critical strengths so every regime boundary is crossed.
     #[test]
-    fn risk_map_cells_are_the_regime_probabilities() {
+    fn fast_map_agrees_with_the_quadrature_on_random_cases() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rand = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let base = RobotSpec::paper_hexapod();
+        let mut overall: f64 = 0.0;
+        for case in 0..10 {
+            let spec = RobotSpec {
+                mass_kg: 0.2 + 1.2 * rand(),
+                hip_height_m: 0.005 + 0.05 * rand(),
+                level_step_m: (case % 5 == 4).then_some(0.05 + 0.04 * rand()),
+                ..base.clone()
+            };
+            let robot = Robot::new(spec).unwrap();
+            let deg = 30.0 * rand();
+            let s = Slope::from_degrees(deg).unwrap();
+            let k_star = sinkage_threshold_k_n(&robot, s);
+            let cv = [(0.1, 0.2), (0.3, 0.5), (0.2, 0.01), (0.05, 0.05), (0.6, 1.0)][case % 5];
+            // Columns from below the sinkage threshold to far above; rows across both curves.
+            let kn = log_axis(k_star * (0.3 + 0.6 * rand()), k_star * (30.0 + 300.0 * rand()), 9);
+            let ks = log_axis(2e3 * (1.0 + rand()), 1e7 * (1.0 + rand()), 7);
+            let e = worst(&robot, deg, None, &kn, &ks, cv);
+            eprintln!("case {case}: {deg:.1} deg, cv {cv:?}: worst error {e:.2e}");
+            assert!(e < 1e-6, "case {case}: {deg} deg, cv {cv:?}, mass {}: error {e}", robot.mass());
+            overall = overall.max(e);
+        }
+        assert!(overall > 0.0);
+    }
+
+    /// Sharp and degenerate cases: cv_s = 0.01 (a near-step in k_s), cv_n = 0 (no
+    /// integral), cv_s = 0 (crossings), medians exactly on the sinkage boundary, beyond the
+    /// angle of repose, and a linear k_s axis starting at 0.
+    #[test]
+    fn fast_map_agrees_in_sharp_and_degenerate_cases() {
         let r = paper_robot();
         let s = Slope::from_degrees(20.0).unwrap();
-        let kn = Axis::new("k_n", 3e4, 3e6, 4, AxisScale::Log).unwrap();
-        let ks = Axis::new("k_s", 1e5, 1e7, 3, AxisScale::Log).unwrap();
+        let k_star = sinkage_threshold_k_n(&r, s);
+        let kn = log_axis(k_star, k_star * 100.0, 7);
+        let ks = log_axis(1e4, 1e7, 7);
+        for cv in [(0.1, 0.01), (0.0, 0.2), (0.0, 0.0), (0.3, 0.0), (0.01, 0.3)] {
+            let e = worst(&r, 20.0, None, &kn, &ks, cv);
+            eprintln!("cv {cv:?}: worst error {e:.2e}");
+            assert!(e < 1e-6, "cv {cv:?}: error {e}");
+        }
+        assert!(worst(&r, 26.0, Some(25.0), &kn, &ks, (0.1, 0.2)) < 1e-12);
+        let lin = Axis::new("k_s", 0.0, 4e6, 5, AxisScale::Linear).unwrap();
+        assert!(worst(&r, 10.0, None, &kn, &lin, (0.2, 0.3)) < 1e-6);
+        // The first column sits exactly on the sinkage threshold: P(sinkage) = 1/2 there, and
+        // just above it the level step is short, so slipping is likely too.
+        let m = RiskMap::compute(&r, s, None, &kn, &ks, Uncertainty::new(0.2, 0.2).unwrap(), &|| {});
+        assert!(m.p_fail_at(0, 6) > 0.5 && m.p_fail_at(0, 6) <= 1.0);
+    }
+
+    #[test]
+    fn rows_are_reported_and_cells_are_the_regime_probabilities() {
+        let r = paper_robot();
+        let s = Slope::from_degrees(20.0).unwrap();
+        let kn = log_axis(3e4, 3e6, 4);
+        let ks = log_axis(1e5, 1e7, 3);
         let u = Uncertainty::new(0.2, 0.4).unwrap();
-        let map = RiskMap::compute(&r, s, None, &kn, &ks, u, &|| {});
+        let rows = std::sync::atomic::AtomicUsize::new(0);
+        let map = RiskMap::compute(&r, s, None, &kn, &ks, u, &|| {
+            rows.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        });
+        assert_eq!(rows.into_inner(), 3);
         assert_eq!(map.p_fail.len(), 12);
         let g = Ground::new(kn.value(2), ks.value(1)).unwrap();
         let p = regime_probabilities(&r, s, &g, u);

@@ -211,11 +211,13 @@ fn calibrate_reproduces_the_builtin_terrain() {
     sandslope()
         .args(["calibrate", "--observed"])
         .arg(repo_file("data/paper-speeds.csv"))
-        .args(["--law", "linear", "--k-n", "7e5", "--name", "glass-beads-300um", "--repose", "25", "--out"])
+        .arg("--forces")
+        .arg(repo_file("data/example-force-tests.toml"))
+        .args(["--free", "plate_scale,error_floor", "--name", "glass-beads-300um", "--out"])
         .arg(&out)
         .assert()
         .success()
-        .stdout(predicate::str::contains("RMSE"));
+        .stdout(predicate::str::contains("k_s(20)/k_s(0)"));
     let fresh: toml::Value = toml::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     let preset: toml::Value =
         toml::from_str(include_str!("../../sandslope-io/presets/glass-beads-300um.toml")).unwrap();
@@ -224,7 +226,7 @@ fn calibrate_reproduces_the_builtin_terrain() {
     let (a, b) = (fresh["points"].as_array().unwrap(), preset["points"].as_array().unwrap());
     assert_eq!(a.len(), b.len());
     for (p, q) in a.iter().zip(b) {
-        for key in ["slope_deg", "k_n", "k_s"] {
+        for key in ["slope_deg", "k_n", "k_s", "k_n_sd", "k_s_sd"] {
             let (x, y) = (p[key].as_float().unwrap(), q[key].as_float().unwrap());
             assert!((x - y).abs() <= 1e-6 * y.abs(), "{key}: {x} vs {y}");
         }

@@ -2,7 +2,7 @@
 //!
 //! Readers and writers of every file format sandslope uses, shared by the `sandslope` binary,
 //! the Python package and the report: robot and terrain TOML files and the built-in presets
-//! ([`robot_terrain`], [`presets`]), speed tables ([`speeds`]), load-cell manifests and
+//! ([`robot_terrain`], [`presets`]), speed tables ([`speeds`]), anchoring-time tables ([`anchoring`]), load-cell manifests and
 //! recordings ([`measurements`]), motion-capture exports ([`mocap`]), elevation rasters and the
 //! risk-map GeoTIFF ([`raster`]), route GeoJSON and CSV ([`routes`]), and atomic file writing
 //! ([`files`]).
@@ -13,6 +13,7 @@
 
 #![warn(missing_docs)]
 
+pub mod anchoring;
 pub mod files;
 pub mod measurements;
 pub mod mocap;
@@ -22,6 +23,7 @@ pub mod robot_terrain;
 pub mod routes;
 pub mod speeds;
 
+pub use anchoring::{load_anchoring_times, AnchoringRow};
 pub use files::{csv_string, read_text, write_atomic, write_via_temp, Source, WriteError};
 pub use robot_terrain::{load_robot, load_terrain, robot_from_toml, terrain_from_toml};
 pub use speeds::{load_speeds, SpeedRow};

@@ -42,7 +42,7 @@ pub const PRESETS: &[Preset] = &[
         name: "glass-beads-300um",
         kind: PresetKind::Terrain,
         summary:
-            "300 um glass beads: k_n = 7e5 N/m^3 assumed, k_s calibrated on the paper's speeds (linear law)",
+            "300 um glass beads: joint calibration on the paper's speeds and force-test ratio (k_n = 7e5 N/m^3 assumed)",
         toml: include_str!("../presets/glass-beads-300um.toml"),
     },
 ];

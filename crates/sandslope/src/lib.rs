@@ -36,6 +36,7 @@ pub mod error;
 pub mod gait;
 pub mod measure;
 pub mod model;
+pub mod paper;
 pub mod phase;
 pub mod plan;
 pub mod regime;
@@ -45,6 +46,10 @@ pub mod scenario;
 pub mod slope;
 pub mod terrain;
 
+pub use calibrate::joint::{
+    calibrate_jointly, AnchoringObservation, CalibrationWarning, FreeParameter, JointCalibration, JointError,
+    JointSetup, Parameter, RobotKey, ShearShape,
+};
 pub use calibrate::{calibrate, Calibration, CalibrationError, LawParams, ShearLaw, SpeedObservation};
 pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
 pub use error::ParamError;

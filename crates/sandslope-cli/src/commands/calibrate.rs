@@ -1,27 +1,33 @@
-//! `sandslope calibrate`: fit k_s(theta) so that the model's speeds match observed speeds, and
-//! write the result as a terrain file every other command accepts.
+//! `sandslope calibrate`: fit the unmeasured quantities (k_s(theta), and any robot key, a
+//! plate-to-leg scale or a model-error floor) so that the model agrees with observed speeds,
+//! anchoring times and force tests together (docs/calibration.md), and write the result as a
+//! terrain file (and robot file) every other command accepts.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 
-use sandslope::{calibrate, Calibration, LawParams, ShearLaw, Slope, Terrain, TerrainPoint, TerrainSpec};
+use sandslope::{
+    calibrate, calibrate_jointly, predict, Calibration, FreeParameter, JointCalibration, JointSetup,
+    LawParams, Parameter, ShearLaw, ShearShape, Slope, Terrain, TerrainPoint, TerrainSpec,
+};
 
 use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
-use crate::output::{print_json, table, write_atomic};
-use sandslope_io::load_speeds;
+use crate::figures::calibrate::{CalibrationFigure, SpeedPoint};
+use crate::output::{check_parent_exists, print_json, table, write_atomic};
+use sandslope_io::{load_anchoring_times, load_speeds, load_terrain};
 
 /// The law to fit, as named on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum LawArg {
-    /// k_s(theta) = k_s0 + b * theta_deg.
+    /// k_s(theta) = k_s0 * (1 + (rho - 1) * theta_deg / 20), rho = k_s(20)/k_s(0).
     Linear,
     /// k_s(theta) = k_s0 * (cos theta - sin theta / tan phi), Mohr-Coulomb on an infinite slope.
     Coulomb,
-    /// One k_s per observed slope, by root finding.
+    /// One k_s per observed slope, by root finding (speeds only).
     PerSlope,
 }
 
@@ -47,20 +53,42 @@ impl LawArg {
 pub struct CalibrateArgs {
     /// Observed speeds: CSV with columns slope_deg,speed_m_s,speed_sd_m_s.
     #[arg(long, value_name = "CSV")]
-    pub observed: PathBuf,
-    /// Form of k_s(theta) to fit.
+    pub observed: Option<PathBuf>,
+    /// Force tests: a terrain file (as `sandslope fit` writes) whose k_s(theta) and k_s_sd give
+    /// the shape of k_s; its k_n is used too. Without it, k_s follows --law.
+    #[arg(long, value_name = "FILE|PRESET")]
+    pub forces: Option<String>,
+    /// Observed anchoring times: CSV with columns slope_deg,t1_s,t1_sd_s.
+    #[arg(long, value_name = "CSV")]
+    pub t1: Option<PathBuf>,
+    /// Quantities to fit besides k_s, comma-separated: any robot key (hip_height_m,
+    /// level_step_m, response_time_s, leg_contact_area_m2, ...), plate_scale (k_s_leg = c *
+    /// k_s_plate, needs --forces) and error_floor; each optionally with bounds, KEY=MIN:MAX.
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub free: Vec<String>,
+    /// A fixed model-error floor added in quadrature to every observed speed SD, m/s.
+    #[arg(long, value_name = "M/S", allow_negative_numbers = true)]
+    pub error_floor: Option<f64>,
+    /// Form of k_s(theta) to fit when there are no --forces.
     #[arg(long, value_enum, default_value_t = LawArg::Linear)]
     pub law: LawArg,
-    /// Write the calibrated terrain (MODEL.md section 7 format) to this TOML file.
+    /// Write the calibrated terrain (docs/model.md §7 format) to this TOML file.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
-    /// Normal resistance k_n, N/m^3, at every slope (default: the --terrain's k_n).
+    /// Write the robot with its fitted keys to this TOML file (needs a robot key in --free).
+    #[arg(long, value_name = "FILE")]
+    pub robot_out: Option<PathBuf>,
+    /// Draw observed against fitted speeds, with the pulls, to this PNG or SVG file.
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+    /// Normal resistance k_n, N/m^3, at every slope (default: the --forces' or --terrain's k_n).
     #[arg(long = "k-n", value_name = "N/M^3", allow_negative_numbers = true)]
     pub k_n: Option<f64>,
-    /// Name written into the terrain file (default: calibrated-<law>).
+    /// Name written into the terrain file (default: calibrated-<law> or calibrated-forces).
     #[arg(long)]
     pub name: Option<String>,
-    /// Angle of repose written into the terrain file, degrees.
+    /// Angle of repose written into the terrain file, degrees (default: carried over from the
+    /// --forces or --terrain file).
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     pub repose: Option<f64>,
     /// Print the fit as JSON instead of tables.
@@ -68,9 +96,47 @@ pub struct CalibrateArgs {
     pub json: bool,
     #[command(flatten)]
     pub robot: RobotArgs,
-    /// Source of k_n when --k-n is not given.
+    /// Source of k_n (when neither --forces nor --k-n is given) and of the angle of repose.
     #[command(flatten)]
     pub terrain: TerrainArgs,
+}
+
+/// Parses `--free` items: `KEY` or `KEY=MIN:MAX`.
+fn parse_free(items: &[String]) -> Result<Vec<FreeParameter>> {
+    let mut out = Vec::new();
+    for item in items.iter().map(|s| s.trim()).filter(|s| !s.is_empty()) {
+        let (key, bounds) = match item.split_once('=') {
+            Some((k, b)) => {
+                let (lo, hi) = b.split_once(':').ok_or_else(|| {
+                    anyhow!("--free {item}: bounds must be written MIN:MAX (e.g. hip_height_m=0.01:0.07)")
+                })?;
+                let num = |s: &str| {
+                    s.trim().parse::<f64>().map_err(|_| anyhow!("--free {item}: `{s}` is not a number"))
+                };
+                (k.trim(), Some((num(lo)?, num(hi)?)))
+            }
+            None => (item, None),
+        };
+        let parameter = Parameter::parse(key)
+            .ok_or_else(|| anyhow!("--free: unknown quantity `{key}` (valid: {})", Parameter::names()))?;
+        out.push(FreeParameter { parameter, bounds });
+    }
+    Ok(out)
+}
+
+/// Where the angle of repose written into the terrain came from.
+#[derive(Debug, Clone, Serialize)]
+struct ReposeRecord {
+    deg: Option<f64>,
+    source: String,
+}
+
+#[derive(Serialize)]
+struct JointRecord<'a> {
+    mode: &'static str,
+    #[serde(flatten)]
+    calibration: &'a JointCalibration,
+    repose: &'a ReposeRecord,
 }
 
 #[derive(Serialize)]
@@ -85,141 +151,312 @@ struct ResidualRecord {
 }
 
 #[derive(Serialize)]
-struct CalibrationRecord<'a> {
+struct PerSlopeRecord<'a> {
+    mode: &'static str,
     law: &'static str,
-    params: serde_json::Value,
-    param_se: Option<serde_json::Value>,
     residuals: Vec<ResidualRecord>,
     rmse_m_s: f64,
     chi_squared: f64,
     terrain: &'a TerrainSpec,
-}
-
-/// Parameters as named JSON values (and their standard errors).
-fn params_json(params: &LawParams, se: Option<[f64; 2]>) -> (serde_json::Value, Option<serde_json::Value>) {
-    match *params {
-        LawParams::Linear { k_s0, per_degree } => (
-            serde_json::json!({"k_s0": k_s0, "k_s_per_deg": per_degree}),
-            se.map(|s| serde_json::json!({"k_s0": s[0], "k_s_per_deg": s[1]})),
-        ),
-        LawParams::Coulomb { k_s0, friction_angle_deg } => (
-            serde_json::json!({"k_s0": k_s0, "friction_angle_deg": friction_angle_deg}),
-            se.map(|s| serde_json::json!({"k_s0": s[0], "friction_angle_deg": s[1]})),
-        ),
-        LawParams::PerSlope => (serde_json::json!({}), None),
-    }
-}
-
-/// The terrain table for a calibration: the law at each observed slope (the linear law is then
-/// reproduced exactly by the table's linear interpolation); the Coulomb law is also sampled every
-/// degree between the observed slopes, since it is curved.
-fn terrain_spec(
-    cal: &Calibration,
-    name: String,
-    repose_deg: Option<f64>,
-    k_n_at: &dyn Fn(Slope) -> f64,
-) -> Result<TerrainSpec> {
-    let mut slopes: Vec<f64> = cal.residuals.iter().map(|r| r.slope_deg).collect();
-    if let (LawParams::Coulomb { .. }, Some(&first), Some(&last)) =
-        (&cal.params, slopes.first(), slopes.last())
-    {
-        let whole = (first.ceil() as i64..=last.floor() as i64).map(|d| d as f64);
-        slopes.extend(whole.filter(|d| !slopes.contains(d)).collect::<Vec<_>>());
-        slopes.sort_by(f64::total_cmp);
-    }
-    let mut points = Vec::with_capacity(slopes.len());
-    for d in slopes {
-        let slope = Slope::from_degrees(d).map_err(|e| anyhow!("{e}"))?;
-        let k_s = match cal.params.k_s(slope) {
-            Some(k) => k,
-            None => cal.residuals.iter().find(|r| r.slope_deg == d).map(|r| r.k_s).unwrap_or(0.0),
-        };
-        points.push(TerrainPoint { slope_deg: d, k_n: k_n_at(slope), k_s, k_n_sd: None, k_s_sd: None });
-    }
-    Ok(TerrainSpec { name: Some(name), repose_deg, points })
+    repose: &'a ReposeRecord,
 }
 
 /// Runs `sandslope calibrate`.
 pub fn run(args: CalibrateArgs) -> Result<()> {
     let robot = args.robot.load()?;
-    let observations = load_speeds(&args.observed)?;
+    let free = parse_free(&args.free)?;
     let fixed_k_n = args.k_n.map(|v| check_positive("--k-n", v)).transpose()?;
     if let Some(r) = args.repose {
         check_flag("--repose", r, 0.0, 90.0)?;
     }
-    let terrain = if fixed_k_n.is_none() { Some(args.terrain.load()?) } else { None };
-    let k_n_at = |s: Slope| fixed_k_n.unwrap_or_else(|| terrain.as_ref().map_or(0.0, |t| t.at(s).k_n));
-    let cal = calibrate(&robot, &k_n_at, &observations, args.law.law())
-        .map_err(|e| anyhow!("{}: {e}", args.observed.display()))?;
-    let name = args.name.clone().unwrap_or_else(|| format!("calibrated-{}", args.law.name()));
-    let spec = terrain_spec(&cal, name, args.repose, &k_n_at)?;
-    // Validate through the same constructor every reader uses, so the file we write loads.
-    Terrain::new(spec.clone()).map_err(|e| {
-        anyhow!("the calibrated terrain is not valid ({e}); a fitted k_s reached zero within the observed slopes: try --law per-slope or coulomb")
-    })?;
-    let mut text = String::new();
-    let command: Vec<String> = std::env::args().skip(1).collect();
-    writeln!(text, "# Written by: sandslope {}", command.join(" "))?;
-    match cal.params {
-        LawParams::Linear { k_s0, per_degree } => {
-            writeln!(text, "# k_s(theta) = {k_s0:.6e} + ({per_degree:.6e}) * theta_deg N/m^3")?
-        }
-        LawParams::Coulomb { k_s0, friction_angle_deg } => writeln!(
-            text,
-            "# k_s(theta) = {k_s0:.6e} * (cos theta - sin theta / tan({friction_angle_deg:.4} deg)) N/m^3"
-        )?,
-        LawParams::PerSlope => writeln!(text, "# k_s per observed slope, inverted from each speed")?,
+    let error_floor = args.error_floor.map(|v| check_flag("--error-floor", v, 0.0, 1.0)).transpose()?;
+    if error_floor.is_some() && free.iter().any(|f| f.parameter == Parameter::ErrorFloor) {
+        bail!("--error-floor fixes the floor and --free error_floor fits it: give one of them");
     }
-    writeln!(text, "# RMSE of speed {:.3e} m/s over {} slopes.", cal.rmse(), cal.residuals.len())?;
-    text.push_str(&toml::to_string(&spec)?);
-    write_atomic(&args.out, text.as_bytes())?;
+    let robot_free = free.iter().any(|f| matches!(f.parameter, Parameter::Robot(_)));
+    if args.robot_out.is_some() && !robot_free {
+        bail!("--robot-out: no robot key is in --free, so the robot would be written unchanged");
+    }
+    for out in [Some(&args.out), args.robot_out.as_ref(), args.plot.as_ref()].into_iter().flatten() {
+        check_parent_exists(out)?;
+    }
+    if let Some(p) = &args.plot {
+        crate::figures::format_of(p)?;
+    }
+    let speeds = args.observed.as_deref().map(load_speeds).transpose()?.unwrap_or_default();
+    let anchoring = args.t1.as_deref().map(load_anchoring_times).transpose()?.unwrap_or_default();
+    let source = args.terrain.load()?;
+    let forces = args.forces.as_deref().map(load_terrain).transpose()?;
 
-    if args.json {
-        let (params, param_se) = params_json(&cal.params, cal.param_se);
-        let residuals = cal
-            .residuals
-            .iter()
-            .map(|r| ResidualRecord {
-                slope_deg: r.slope_deg,
-                k_n: r.k_n,
-                k_s: r.k_s,
-                observed_m_s: r.observed,
-                observed_sd_m_s: r.observed_sd,
-                model_m_s: r.model,
-                residual_m_s: r.residual(),
+    // The angle of repose: given, or carried over from the force tests or the source terrain.
+    let repose = match (args.repose, &forces) {
+        (Some(r), _) => ReposeRecord { deg: Some(r), source: "--repose".into() },
+        (None, Some(f)) if f.spec().repose_deg.is_some() => ReposeRecord {
+            deg: f.spec().repose_deg,
+            source: format!("carried over from --forces {}", args.forces.as_deref().unwrap_or("")),
+        },
+        _ => ReposeRecord {
+            deg: source.spec().repose_deg,
+            source: match source.spec().repose_deg {
+                Some(_) => format!("carried over from --terrain {}", args.terrain.terrain),
+                None => format!("none: --terrain {} has no repose_deg", args.terrain.terrain),
+            },
+        },
+    };
+    // k_n: --k-n, else the force tests', else the source terrain's.
+    let normal = match (fixed_k_n, &forces) {
+        (Some(k), _) => Terrain::constant(k, 1.0).map_err(|e| anyhow!("{}", e.renamed("--k-n")))?,
+        (None, Some(f)) => f.clone(),
+        (None, None) => source.clone(),
+    };
+
+    if args.law == LawArg::PerSlope && forces.is_none() {
+        if !free.is_empty() || !anchoring.is_empty() || error_floor.is_some() {
+            bail!("--law per-slope inverts each speed alone: it takes no --free, --t1 or --error-floor");
+        }
+        let Some(observed) = &args.observed else { bail!("--law per-slope needs --observed speeds") };
+        return run_per_slope(&args, &robot, &speeds, observed, &normal, &repose);
+    }
+
+    let shear = match &forces {
+        Some(f) => ShearShape::ForceTests(f.clone()),
+        None => ShearShape::Law(args.law.law()),
+    };
+    let setup = JointSetup {
+        robot: robot.clone(),
+        normal,
+        shear,
+        speeds: speeds.clone(),
+        anchoring,
+        free,
+        error_floor: error_floor.unwrap_or(0.0),
+    };
+    let mut cal = calibrate_jointly(&setup).map_err(|e| anyhow!("calibrate: {e}"))?;
+    let default_name = if forces.is_some() {
+        "calibrated-forces".to_string()
+    } else {
+        format!("calibrated-{}", args.law.name())
+    };
+    cal.terrain.name = Some(args.name.clone().unwrap_or(default_name));
+    cal.terrain.repose_deg = repose.deg;
+    let terrain = Terrain::new(cal.terrain.clone()).map_err(|e| {
+        anyhow!("the calibrated terrain is not valid ({e}); a fitted k_s reached zero within the observed slopes: try --law coulomb or force tests")
+    })?;
+    let fitted_robot = sandslope::Robot::new(cal.robot.clone())
+        .map_err(|e| anyhow!("the fitted robot is not valid: {e}"))?;
+
+    // Outputs: the figure first (it is the likeliest to fail), then the files.
+    if let Some(path) = &args.plot {
+        let lo = speeds.iter().map(|o| o.slope.degrees()).fold(0.0, f64::min);
+        let hi = speeds.iter().map(|o| o.slope.degrees()).fold(lo + 1.0, f64::max);
+        let curve: Vec<(f64, Option<f64>)> = (0..=200)
+            .map(|i| lo + (hi - lo) * i as f64 / 200.0)
+            .filter_map(|d| Slope::from_degrees(d).ok().map(|s| (d, s)))
+            .map(|(d, s)| {
+                let mut ground = terrain.at(s);
+                ground.repose = None; // the fit ignores repose: an observed speed shows the robot moved
+                (d, predict(&fitted_robot, s, &ground).speed)
             })
             .collect();
-        let record = CalibrationRecord {
-            law: args.law.name(),
-            params,
-            param_se,
+        let points: Vec<SpeedPoint> = cal
+            .pulls
+            .iter()
+            .filter(|p| p.kind == sandslope::calibrate::joint::ObservationKind::Speed)
+            .map(|p| SpeedPoint {
+                slope_deg: p.slope_deg,
+                observed: p.observed,
+                sd: p.sd,
+                sd_total: p.sd_total,
+                model: p.model,
+                pull: p.pull,
+            })
+            .collect();
+        let title = format!(
+            "chi^2/dof = {}, k_s(20)/k_s(0) = {:.2}",
+            cal.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),
+            cal.shear_ratio_20.value
+        );
+        crate::figures::save(path, &CalibrationFigure { points: &points, curve: &curve, subtitle: &title })?;
+    }
+    let command: Vec<String> = std::env::args().skip(1).collect();
+    let mut text = String::new();
+    writeln!(text, "# Written by: sandslope {}", command.join(" "))?;
+    writeln!(
+        text,
+        "# Joint calibration (docs/calibration.md): chi^2 = {:.3} over {} dof; error floor {:.4} m/s; k_s(20)/k_s(0) = {:.3} [{:.3}, {:.3}].",
+        cal.chi_squared, cal.dof, cal.error_floor_m_s, cal.shear_ratio_20.value, cal.shear_ratio_20.lower, cal.shear_ratio_20.upper
+    )?;
+    writeln!(text, "# repose_deg: {}", repose.source)?;
+    text.push_str(&toml::to_string(&cal.terrain)?);
+    write_atomic(&args.out, text.as_bytes())?;
+    if let Some(path) = &args.robot_out {
+        let mut text = String::new();
+        writeln!(text, "# Written by: sandslope {}", command.join(" "))?;
+        for p in cal
+            .parameters
+            .iter()
+            .filter(|p| Parameter::parse(&p.name).is_some_and(|q| matches!(q, Parameter::Robot(_))))
+        {
+            writeln!(
+                text,
+                "# {} fitted: {:.6e} (68% interval {:.6e} to {:.6e})",
+                p.name, p.estimate.value, p.estimate.lower, p.estimate.upper
+            )?;
+        }
+        text.push_str(&toml::to_string(&cal.robot)?);
+        write_atomic(path, text.as_bytes())?;
+    }
+
+    if args.json {
+        return print_json(&JointRecord { mode: "joint", calibration: &cal, repose: &repose });
+    }
+    print_joint(&cal, &repose);
+    for p in [Some(&args.out), args.robot_out.as_ref(), args.plot.as_ref()].into_iter().flatten() {
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn interval_text(iv: &sandslope::calibrate::joint::Interval, sci: bool) -> String {
+    let f = |x: f64| if sci { format!("{x:.4e}") } else { format!("{x:.4}") };
+    format!(
+        "{}{} to {}{}",
+        if iv.lower_open { "≤ " } else { "" },
+        f(iv.lower),
+        f(iv.upper),
+        if iv.upper_open { " (bound)" } else { "" }
+    )
+}
+
+fn print_joint(cal: &JointCalibration, repose: &ReposeRecord) {
+    let mut t = table(&["quantity", "best", "68% interval", "unit"]);
+    for p in &cal.parameters {
+        let sci = p.estimate.value.abs() >= 1e4 || (p.estimate.value != 0.0 && p.estimate.value.abs() < 1e-2);
+        t.add_row([
+            p.name.clone(),
+            if sci { format!("{:.4e}", p.estimate.value) } else { format!("{:.4}", p.estimate.value) },
+            interval_text(&p.estimate, sci),
+            p.unit.clone(),
+        ]);
+    }
+    println!("{t}");
+    let mut t = table(&["observation", "slope deg", "observed ± SD", "model", "pull"]);
+    for p in &cal.pulls {
+        use sandslope::calibrate::joint::ObservationKind as K;
+        let (name, scale, unit) = match p.kind {
+            K::Speed => ("speed", 100.0, "cm/s"),
+            K::AnchoringTime => ("t1", 1000.0, "ms"),
+            K::PlateShearStrength => ("plate k_s", 1.0, "N/m^3"),
+        };
+        let fmt = |x: f64| {
+            if p.kind == K::PlateShearStrength {
+                format!("{x:.3e}")
+            } else {
+                format!("{:.2}", x * scale)
+            }
+        };
+        let sd = if p.sd_total > p.sd * (1.0 + 1e-9) {
+            format!("{} (fit {})", fmt(p.sd), fmt(p.sd_total))
+        } else {
+            fmt(p.sd)
+        };
+        t.add_row([
+            name.to_string(),
+            format!("{}", p.slope_deg),
+            format!("{} ± {} {unit}", fmt(p.observed), sd),
+            format!("{} {unit}", fmt(p.model)),
+            format!("{:+.2}", p.pull),
+        ]);
+    }
+    println!("{t}");
+    let level = cal.shear.first().map(|s| s.k_s).filter(|k| *k > 0.0);
+    let mut t =
+        table(&["slope deg", "k_n N/m^3", "k_s N/m^3", "k_s / first", "force on the paper's plate N"]);
+    for s in &cal.shear {
+        t.add_row([
+            format!("{}", s.slope_deg),
+            format!("{:.3e}", s.k_n),
+            format!("{:.4e}", s.k_s),
+            level.map_or("-".into(), |l| format!("{:.3}", s.k_s / l)),
+            format!("{:.1}", s.plate_force_n),
+        ]);
+    }
+    println!("{t}");
+    println!(
+        "chi^2 = {:.2} over {} dof (chi^2/dof {}); error floor {:.2} cm/s",
+        cal.chi_squared,
+        cal.dof,
+        cal.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),
+        cal.error_floor_m_s * 100.0
+    );
+    println!(
+        "k_s(20)/k_s(0) = {:.3} (68%: {}); the paper's force tests: about 0.40",
+        cal.shear_ratio_20.value,
+        interval_text(&cal.shear_ratio_20, false)
+    );
+    println!("repose_deg = {} ({})", repose.deg.map_or("none".into(), |r| format!("{r}")), repose.source);
+    for w in &cal.warnings {
+        println!("warning: {w}");
+    }
+}
+
+fn run_per_slope(
+    args: &CalibrateArgs,
+    robot: &sandslope::Robot,
+    observations: &[sandslope::SpeedObservation],
+    observed: &std::path::Path,
+    normal: &Terrain,
+    repose: &ReposeRecord,
+) -> Result<()> {
+    let k_n_at = |s: Slope| normal.at(s).k_n;
+    let cal: Calibration = calibrate(robot, &k_n_at, observations, ShearLaw::PerSlope)
+        .map_err(|e| anyhow!("{}: {e}", observed.display()))?;
+    let points = cal
+        .residuals
+        .iter()
+        .map(|r| TerrainPoint { slope_deg: r.slope_deg, k_n: r.k_n, k_s: r.k_s, k_n_sd: None, k_s_sd: None })
+        .collect();
+    let spec = TerrainSpec {
+        name: Some(args.name.clone().unwrap_or_else(|| "calibrated-per-slope".into())),
+        repose_deg: repose.deg,
+        points,
+    };
+    Terrain::new(spec.clone()).map_err(|e| anyhow!("the calibrated terrain is not valid ({e})"))?;
+    let command: Vec<String> = std::env::args().skip(1).collect();
+    let mut text = String::new();
+    writeln!(text, "# Written by: sandslope {}", command.join(" "))?;
+    writeln!(text, "# k_s per observed slope, inverted from each speed")?;
+    writeln!(text, "# repose_deg: {}", repose.source)?;
+    text.push_str(&toml::to_string(&spec)?);
+    write_atomic(&args.out, text.as_bytes())?;
+    debug_assert!(matches!(cal.params, LawParams::PerSlope));
+    let residuals: Vec<ResidualRecord> = cal
+        .residuals
+        .iter()
+        .map(|r| ResidualRecord {
+            slope_deg: r.slope_deg,
+            k_n: r.k_n,
+            k_s: r.k_s,
+            observed_m_s: r.observed,
+            observed_sd_m_s: r.observed_sd,
+            model_m_s: r.model,
+            residual_m_s: r.residual(),
+        })
+        .collect();
+    if args.json {
+        return print_json(&PerSlopeRecord {
+            mode: "per-slope",
+            law: "per-slope",
             residuals,
             rmse_m_s: cal.rmse(),
             chi_squared: cal.chi_squared(),
             terrain: &spec,
-        };
-        return print_json(&record);
+            repose,
+        });
     }
-    let se = |i: usize| cal.param_se.map(|s| format!(" ± {:.3e}", s[i])).unwrap_or_default();
-    match cal.params {
-        LawParams::Linear { k_s0, per_degree } => {
-            println!("law: linear, k_s(theta) = k_s0 + b theta_deg");
-            println!("  k_s0 = {k_s0:.4e}{} N/m^3", se(0));
-            println!("  b    = {per_degree:.4e}{} N/m^3 per deg", se(1));
-        }
-        LawParams::Coulomb { k_s0, friction_angle_deg } => {
-            println!("law: coulomb, k_s(theta) = k_s0 (cos theta - sin theta / tan phi)");
-            println!("  k_s0 = {k_s0:.4e}{} N/m^3", se(0));
-            println!(
-                "  phi  = {friction_angle_deg:.3}{} deg",
-                cal.param_se.map(|s| format!(" ± {:.3}", s[1])).unwrap_or_default()
-            );
-        }
-        LawParams::PerSlope => println!("law: per-slope (each speed inverted by root finding)"),
-    }
+    println!("law: per-slope (each speed inverted by root finding)");
     let level = cal.residuals.first().map(|r| r.k_s).filter(|k| *k > 0.0);
-    let mut t =
-        table(&["slope deg", "k_s N/m^3", "k_s / first", "observed cm/s", "model cm/s", "residual cm/s"]);
+    let mut t = table(&["slope deg", "k_s N/m^3", "k_s / first", "observed cm/s", "model cm/s"]);
     for r in &cal.residuals {
         t.add_row([
             format!("{}", r.slope_deg),
@@ -227,16 +464,10 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
             level.map_or("-".into(), |l| format!("{:.3}", r.k_s / l)),
             format!("{:.2} ± {:.2}", r.observed * 100.0, r.observed_sd * 100.0),
             format!("{:.2}", r.model * 100.0),
-            format!("{:+.2}", r.residual() * 100.0),
         ]);
     }
     println!("{t}");
-    println!(
-        "RMSE {:.3} cm/s, chi^2 {:.2} over {} slopes",
-        cal.rmse() * 100.0,
-        cal.chi_squared(),
-        cal.residuals.len()
-    );
+    println!("repose_deg = {} ({})", repose.deg.map_or("none".into(), |r| format!("{r}")), repose.source);
     eprintln!("wrote {}", args.out.display());
     Ok(())
 }

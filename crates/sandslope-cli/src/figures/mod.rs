@@ -6,6 +6,7 @@
 //! draws into a temporary file and renames it into place; [`to_svg`] renders it to a string
 //! (for pages that embed figures).
 
+pub mod calibrate;
 pub mod design;
 pub mod measurements;
 pub mod palette;

@@ -1,4 +1,6 @@
-//! Calibration: the shear strength k_s(theta) that makes the model's speeds match observed ones.
+//! Calibration: the shear strength k_s(theta) that makes the model's speeds match observed ones
+//! (this module), and the joint calibration against speeds, anchoring times and force tests with
+//! freed robot quantities ([`joint`]).
 //!
 //! Three laws (the normal resistance k_n is given, because the speed hardly depends on it):
 //! - [`ShearLaw::Linear`]: `k_s(theta) = k_s0 + b theta_deg`, linear in degrees, the same form
@@ -12,6 +14,8 @@
 //! from the per-slope inversion (or, where it fails, from a level-sand guess). Where a law
 //! would make the leg fail to anchor, the speed is continued at the anchoring limit
 //! (`d_s = d_max`) so the objective stays continuous.
+
+pub mod joint;
 
 use std::fmt;
 
@@ -208,7 +212,7 @@ fn level_step_at(robot: &Robot, slope: Slope, k_n: f64) -> Result<f64, Calibrati
 }
 
 /// Model speed at k_s, continued at the anchoring limit when the leg would not anchor.
-fn continued_speed(robot: &Robot, slope: Slope, s_star: f64, k_s: f64) -> f64 {
+pub(crate) fn continued_speed(robot: &Robot, slope: Slope, s_star: f64, k_s: f64) -> f64 {
     let d_s = if k_s > 0.0 { shear_equilibrium_depth(robot, slope, k_s) } else { f64::INFINITY };
     let t1 = anchoring_time(robot, d_s.min(robot.max_depth())).expect("clamped depth anchors");
     step_speed(robot, net_step(robot, slope, s_star, t1))

@@ -1,0 +1,175 @@
+//! The calibration figure (`calibrate --plot`): observed speeds (mean ± SD, and the SD with the
+//! error floor) against the fitted model curve, and each observation's pull below.
+
+use anyhow::Result;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{font, Figure};
+use crate::error::plot_err;
+
+/// One observed speed against the fitted model.
+#[derive(Debug, Clone, Copy)]
+pub struct SpeedPoint {
+    /// Slope, degrees.
+    pub slope_deg: f64,
+    /// Observed mean, m/s.
+    pub observed: f64,
+    /// Observed SD, m/s.
+    pub sd: f64,
+    /// SD used in the fit (with the error floor), m/s.
+    pub sd_total: f64,
+    /// Fitted model, m/s.
+    pub model: f64,
+    /// `(observed - model) / sd_total`.
+    pub pull: f64,
+}
+
+/// Observed against fitted speeds (top) and pulls (bottom).
+pub struct CalibrationFigure<'a> {
+    /// The observations.
+    pub points: &'a [SpeedPoint],
+    /// The fitted model's speed over a fine slope grid (None where undefined), m/s.
+    pub curve: &'a [(f64, Option<f64>)],
+    /// A line under the title (fit statistics).
+    pub subtitle: &'a str,
+}
+
+impl Figure for CalibrationFigure<'_> {
+    fn size(&self) -> (u32, u32) {
+        (900, 900)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let (top, bottom) = root.split_vertically(560);
+        let xs = self.points.iter().map(|p| p.slope_deg).chain(self.curve.iter().map(|c| c.0));
+        let x_range = super::range(xs, (0.0, 25.0));
+        let ys = self
+            .points
+            .iter()
+            .flat_map(|p| {
+                [100.0 * (p.observed - p.sd_total), 100.0 * (p.observed + p.sd_total), 100.0 * p.model]
+            })
+            .chain(self.curve.iter().filter_map(|c| c.1.map(|v| v * 100.0)))
+            .chain([0.0]);
+        let y_range = super::range(ys, (0.0, 16.0));
+        let mut chart = ChartBuilder::on(&top)
+            .caption(format!("Observed and fitted speeds ({})", self.subtitle), font(20.0))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("slope (deg)")
+            .y_desc("speed v (cm/s)")
+            .label_style(font(15.0))
+            .axis_desc_style(font(17.0))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(plot_err)?;
+        if y_range.0 < 0.0 {
+            chart
+                .draw_series(LineSeries::new([(x_range.0, 0.0), (x_range.1, 0.0)], BLACK.stroke_width(1)))
+                .map_err(plot_err)?;
+        }
+        let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+        for &(x, y) in self.curve {
+            match y {
+                Some(v) => segments.last_mut().expect("non-empty").push((x, v * 100.0)),
+                None if !segments.last().expect("non-empty").is_empty() => segments.push(Vec::new()),
+                None => {}
+            }
+        }
+        let mut first = true;
+        for seg in segments.into_iter().filter(|s| !s.is_empty()) {
+            let s = chart.draw_series(LineSeries::new(seg, RED.stroke_width(2))).map_err(plot_err)?;
+            if first {
+                s.label("fitted model")
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+                first = false;
+            }
+        }
+        let floor = self.points.iter().any(|p| p.sd_total > p.sd * (1.0 + 1e-9));
+        if floor {
+            let grey = RGBColor(150, 150, 150);
+            chart
+                .draw_series(self.points.iter().map(|p| {
+                    let (v, s) = (p.observed * 100.0, p.sd_total * 100.0);
+                    ErrorBar::new_vertical(p.slope_deg, v - s, v, v + s, grey.stroke_width(5), 6)
+                }))
+                .map_err(plot_err)?
+                .label("SD with the fitted error floor")
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x + 10, y - 6), (x + 10, y + 6)], grey.stroke_width(5))
+                });
+        }
+        chart
+            .draw_series(self.points.iter().map(|p| {
+                let (v, s) = (p.observed * 100.0, p.sd * 100.0);
+                ErrorBar::new_vertical(p.slope_deg, v - s, v, v + s, BLACK.stroke_width(2), 12)
+            }))
+            .map_err(plot_err)?;
+        chart
+            .draw_series(
+                self.points.iter().map(|p| Circle::new((p.slope_deg, p.observed * 100.0), 5, BLACK.filled())),
+            )
+            .map_err(plot_err)?
+            .label("observed (mean ± SD)")
+            .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.filled()));
+        chart
+            .draw_series(
+                self.points
+                    .iter()
+                    .map(|p| TriangleMarker::new((p.slope_deg, p.model * 100.0), 7, RED.filled())),
+            )
+            .map_err(plot_err)?
+            .label("model at the observed slope")
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 7, RED.filled()));
+        chart
+            .configure_series_labels()
+            .label_font(font(15.0))
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.85))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(plot_err)?;
+
+        let max_pull = self.points.iter().map(|p| p.pull.abs()).fold(2.5_f64, f64::max) * 1.15;
+        let mut chart = ChartBuilder::on(&bottom)
+            .caption("Pulls: (observed - model) / SD used in the fit", font(18.0))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x_range.0..x_range.1, -max_pull..max_pull)
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("slope (deg)")
+            .y_desc("pull")
+            .label_style(font(15.0))
+            .axis_desc_style(font(17.0))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(plot_err)?;
+        let band = RGBColor(120, 170, 220).mix(0.25);
+        chart
+            .draw_series([Rectangle::new([(x_range.0, -1.0), (x_range.1, 1.0)], band.filled())])
+            .map_err(plot_err)?;
+        chart
+            .draw_series(LineSeries::new([(x_range.0, 0.0), (x_range.1, 0.0)], BLACK.stroke_width(1)))
+            .map_err(plot_err)?;
+        let w = 0.012 * (x_range.1 - x_range.0);
+        chart
+            .draw_series(self.points.iter().map(|p| {
+                let colour = if p.pull.abs() > 2.0 { RGBColor(214, 56, 48) } else { RGBColor(60, 60, 60) };
+                Rectangle::new([(p.slope_deg - w, 0.0), (p.slope_deg + w, p.pull)], colour.filled())
+            }))
+            .map_err(plot_err)?;
+        Ok(())
+    }
+}

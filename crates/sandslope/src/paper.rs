@@ -1,0 +1,225 @@
+//! The numbers Liao and Qian report (docs/model.md §12), and the model set beside them.
+//!
+//! Every constant here is a fact from the paper's text (arXiv:2603.06928), with the place it
+//! comes from. [`compare_with_paper`] evaluates a robot and terrain on each of them and says,
+//! by a stated rule, whether the model agrees.
+
+use serde::Serialize;
+
+use crate::model::predict;
+use crate::regime::Regime;
+use crate::robot::Robot;
+use crate::slope::Slope;
+use crate::terrain::Terrain;
+
+/// Observed step-averaged upslope speeds of the 0.35 kg robot on 300 um glass beads,
+/// `(slope_deg, mean_m_s, sd_m_s)` (Sec. III-A, Fig. 3a; `data/paper-speeds.csv`).
+pub const SPEEDS: [(f64, f64, f64); 5] = [
+    (0.0, 0.157, 0.0097),
+    (10.0, 0.110, 0.0014),
+    (15.0, 0.105, 0.0023),
+    (20.0, 0.0498, 0.0032),
+    (24.0, 0.056, 0.016),
+];
+
+/// Shear resistance at 20 degrees relative to level sand, "approximately 40%" (Sec. III-C, Fig. 4h).
+pub const SHEAR_RATIO_20: f64 = 0.40;
+
+/// Normal resistance "nearly unchanged" with slope (Sec. III-B, Fig. 4d): the ratio
+/// k_n(20)/k_n(0) the text implies.
+pub const NORMAL_RATIO_20: f64 = 1.0;
+
+/// Slopes of the force tests, degrees (Sec. II-C).
+pub const FORCE_TEST_SLOPES: [f64; 6] = [0.0, 5.0, 10.0, 15.0, 20.0, 24.0];
+
+/// Radius of the penetration disk, m (Sec. II-C).
+pub const DISK_RADIUS_M: f64 = 0.01;
+
+/// Width of the shear plate, m (Sec. II-C: "height = 2 cm, width = 3 cm").
+pub const SHEAR_PLATE_WIDTH_M: f64 = 0.03;
+
+/// Depth of the shear plate, m (Sec. II-C: "maintained at 2 cm").
+pub const SHEAR_PLATE_DEPTH_M: f64 = 0.02;
+
+/// Intruder speed in both force tests, m/s (Sec. II-C).
+pub const INTRUDER_SPEED_M_S: f64 = 0.05;
+
+/// Angle of repose, "near 25 degrees", degrees (Sec. II-C footnote).
+pub const REPOSE_DEG: f64 = 25.0;
+
+/// Touchdown times of the two tripods, s (Sec. III-A).
+pub const TOUCHDOWNS_S: [f64; 2] = [0.0, 0.5];
+
+/// Fig. 6d's claim: a robot of this mass (kg) on the measured terrain at this slope (degrees)
+/// is metastable.
+pub const HEAVY_ROBOT_CLAIM: (f64, f64, Regime) = (1.0, 24.0, Regime::Metastable);
+
+/// The plate force a shear strength k_s gives on the paper's shear plate,
+/// `F = k_s W_p d_p^2`, N (docs/model.md §10).
+pub fn plate_force(k_s: f64) -> f64 {
+    k_s * SHEAR_PLATE_WIDTH_M * SHEAR_PLATE_DEPTH_M * SHEAR_PLATE_DEPTH_M
+}
+
+/// One reported number beside the model's.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PaperComparison {
+    /// Stable identifier (`speed_20`, `shear_ratio_20`, ...).
+    pub id: String,
+    /// What is compared, in words.
+    pub quantity: String,
+    /// Where in the paper.
+    pub source: String,
+    /// The paper's value as reported.
+    pub paper: String,
+    /// The model's value, formatted like the paper's.
+    pub model: String,
+    /// The paper's number, when it is one.
+    pub paper_value: Option<f64>,
+    /// The model's number, when it is one.
+    pub model_value: Option<f64>,
+    /// Whether the model agrees, by `rule`.
+    pub agrees: bool,
+    /// The rule used to decide.
+    pub rule: String,
+}
+
+/// Evaluates `robot` on `terrain` at every number of docs/model.md §12.
+///
+/// Rules: a speed agrees when within 2 SD of the observed mean; the shear ratio within 0.10 of
+/// 0.40 (the paper gives no uncertainty); the normal ratio within 0.15 of 1; the anchoring time
+/// must rise with slope at the observed slopes; the step period `T/2` must match the touchdown
+/// spacing within 1%; the 1 kg regime must match exactly.
+pub fn compare_with_paper(robot: &Robot, terrain: &Terrain) -> Vec<PaperComparison> {
+    let at = |deg: f64| Slope::from_degrees(deg).expect("paper slopes are valid");
+    let mut rows = Vec::new();
+    for &(deg, mean, sd) in &SPEEDS {
+        let p = predict(robot, at(deg), &terrain.at(at(deg)));
+        let agrees = p.speed.is_some_and(|v| (v - mean).abs() <= 2.0 * sd) && !p.regime.is_failure();
+        rows.push(PaperComparison {
+            id: format!("speed_{deg}"),
+            quantity: format!("speed at {deg} deg (0.35 kg)"),
+            source: "Sec. III-A, Fig. 3a".into(),
+            paper: format!("{:.2} ± {:.2} cm/s", mean * 100.0, sd * 100.0),
+            model: match p.speed {
+                Some(v) if !p.regime.is_failure() => format!("{:.2} cm/s ({})", v * 100.0, p.regime),
+                _ => format!("- ({}: {})", p.regime, p.cause.explain()),
+            },
+            paper_value: Some(mean),
+            model_value: p.speed,
+            agrees,
+            rule: "within 2 SD".into(),
+        });
+    }
+    let ratio = |f: &dyn Fn(Slope) -> f64| {
+        let level = f(Slope::LEVEL);
+        (level > 0.0).then(|| f(at(20.0)) / level)
+    };
+    let k_s_ratio = ratio(&|s| terrain.at(s).k_s);
+    rows.push(PaperComparison {
+        id: "shear_ratio_20".into(),
+        quantity: "k_s(20 deg) / k_s(0)".into(),
+        source: "Sec. III-C, Fig. 4h".into(),
+        paper: "about 0.40".into(),
+        model: k_s_ratio.map_or("-".into(), |r| format!("{r:.2}")),
+        paper_value: Some(SHEAR_RATIO_20),
+        model_value: k_s_ratio,
+        agrees: k_s_ratio.is_some_and(|r| (r - SHEAR_RATIO_20).abs() <= 0.10),
+        rule: "within 0.10".into(),
+    });
+    let k_n_ratio = ratio(&|s| terrain.at(s).k_n);
+    rows.push(PaperComparison {
+        id: "normal_ratio_20".into(),
+        quantity: "k_n(20 deg) / k_n(0)".into(),
+        source: "Sec. III-B, Fig. 4d".into(),
+        paper: "nearly unchanged (1)".into(),
+        model: k_n_ratio.map_or("-".into(), |r| format!("{r:.2}")),
+        paper_value: Some(NORMAL_RATIO_20),
+        model_value: k_n_ratio,
+        agrees: k_n_ratio.is_some_and(|r| (r - NORMAL_RATIO_20).abs() <= 0.15),
+        rule: "within 0.15".into(),
+    });
+    let t1: Vec<Option<f64>> =
+        SPEEDS.iter().map(|s| predict(robot, at(s.0), &terrain.at(at(s.0))).anchoring_time).collect();
+    let rising = t1.windows(2).all(|w| matches!((w[0], w[1]), (Some(a), Some(b)) if b > a));
+    rows.push(PaperComparison {
+        id: "t1_rises".into(),
+        quantity: "anchoring time t1 rises with slope (0 to 24 deg)".into(),
+        source: "Sec. III-A, Fig. 5b".into(),
+        paper: "monotone increase".into(),
+        model: t1
+            .iter()
+            .map(|t| t.map_or("-".into(), |t| format!("{:.0}", t * 1000.0)))
+            .collect::<Vec<_>>()
+            .join(", ")
+            + " ms",
+        paper_value: None,
+        model_value: None,
+        agrees: rising,
+        rule: "strictly increasing".into(),
+    });
+    let half = robot.stance_duration();
+    rows.push(PaperComparison {
+        id: "step_period".into(),
+        quantity: "time between tripod touchdowns, T/2".into(),
+        source: "Sec. III-A".into(),
+        paper: "0.5 s".into(),
+        model: format!("{half:.3} s"),
+        paper_value: Some(TOUCHDOWNS_S[1]),
+        model_value: Some(half),
+        agrees: (half / TOUCHDOWNS_S[1] - 1.0).abs() <= 0.01,
+        rule: "within 1%".into(),
+    });
+    let (mass, deg, claim) = HEAVY_ROBOT_CLAIM;
+    let heavy = robot.with_mass(mass).ok().map(|r| predict(&r, at(deg), &terrain.at(at(deg))));
+    rows.push(PaperComparison {
+        id: "heavy_robot_24".into(),
+        quantity: format!("regime of a {mass} kg robot at {deg} deg"),
+        source: "Sec. IV, Fig. 6d".into(),
+        paper: claim.to_string(),
+        model: heavy.map_or("-".into(), |p| match p.step {
+            Some(s) => format!("{} (step {:.1} mm)", p.regime, s * 1000.0),
+            None => format!("{} ({})", p.regime, p.cause.explain()),
+        }),
+        paper_value: None,
+        model_value: heavy.and_then(|p| p.step),
+        agrees: heavy.is_some_and(|p| p.regime == claim),
+        rule: "same regime".into(),
+    });
+    rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::tests::paper_robot;
+
+    #[test]
+    fn plate_force_by_hand() {
+        // 1e6 N/m^3 * 0.03 m * (0.02 m)^2 = 12 N.
+        assert!((plate_force(1e6) - 12.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn comparison_on_a_terrain_that_matches_the_ratio() {
+        // k_s falls to 40% at 20 deg; k_n constant: both ratio rows agree, T/2 = 0.5 s agrees.
+        let t = Terrain::new(crate::TerrainSpec {
+            name: None,
+            repose_deg: Some(25.0),
+            points: vec![
+                crate::TerrainPoint { slope_deg: 0.0, k_n: 7e5, k_s: 2e6, k_n_sd: None, k_s_sd: None },
+                crate::TerrainPoint { slope_deg: 20.0, k_n: 7e5, k_s: 8e5, k_n_sd: None, k_s_sd: None },
+            ],
+        })
+        .unwrap();
+        let rows = compare_with_paper(&paper_robot(), &t);
+        let row = |id: &str| rows.iter().find(|r| r.id == id).unwrap();
+        assert!((row("shear_ratio_20").model_value.unwrap() - 0.4).abs() < 1e-12);
+        assert!(row("shear_ratio_20").agrees && row("normal_ratio_20").agrees && row("step_period").agrees);
+        // 5 speeds + 5 other rows.
+        assert_eq!(rows.len(), 10);
+        // A 1e6 k_s at 20 deg gave 4.35 cm/s in the model tests; here k_s(20) = 8e5 gives less,
+        // and the observed 4.98 ± 0.32 agrees only if within 0.64 cm/s: checked, not assumed.
+        let v20 = row("speed_20").model_value.unwrap();
+        assert_eq!(row("speed_20").agrees, (v20 - 0.0498).abs() <= 0.0064);
+    }
+}

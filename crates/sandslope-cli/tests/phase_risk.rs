@@ -303,7 +303,9 @@ fn risk_map_csv_has_every_cell_k_n_major() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("map.csv");
     sandslope()
-        .args(["risk", "--slope", "20", "--map", "--k-n", "1e5:1e7:3", "--k-s", "1e5:1e7:4", "--csv"])
+        // Explicit CVs: the map and the one-cell check below must use the same uncertainty.
+        .args(["risk", "--slope", "20", "--cv-n", "0.1", "--cv-s", "0.2", "--map", "--k-n", "1e5:1e7:3"])
+        .args(["--k-s", "1e5:1e7:4", "--csv"])
         .arg(&csv)
         .assert()
         .success();
@@ -324,7 +326,7 @@ fn risk_map_csv_has_every_cell_k_n_major() {
         "cell.toml",
         &format!("[[points]]\nslope_deg = 0.0\nk_n = {}\nk_s = {}\n", rows[5][0], rows[5][1]),
     );
-    let v = json(&["risk", "--terrain", &t, "--slope", "20", "--json"]);
+    let v = json(&["risk", "--terrain", &t, "--slope", "20", "--cv-n", "0.1", "--cv-s", "0.2", "--json"]);
     assert!((v["p_fail"].as_f64().unwrap() - rows[5][2]).abs() < 1e-6, "{v} vs {:?}", rows[5]);
     assert!(rows.iter().all(|r| r[2] <= r[3] + 1e-12 && (0.0..=1.0).contains(&r[2])));
 }

@@ -136,7 +136,9 @@ fn sweep_has_a_cause_column_in_table_csv_and_json() {
     let table = String::from_utf8(sandslope().args(args).output().unwrap().stdout).unwrap();
     assert!(table.lines().next().is_some_and(|l| !l.is_empty()));
     assert!(
-        table.contains("cause") && table.contains("at_or_above_repose") && table.contains("(2.29)"),
+        // 25 deg on the built-in terrain, worked independently from docs/model.md §3-§5 with k_s
+        // extrapolated from the 20 and 24 deg points: 1.4848 cm/s, shown in parentheses.
+        table.contains("cause") && table.contains("at_or_above_repose") && table.contains("(1.48)"),
         "{table}"
     );
     assert!(table.contains("speed in parentheses"));

@@ -12,8 +12,10 @@ use statrs::distribution::{ContinuousCDF, StudentsT};
 use super::clean::Curve;
 use super::line::line_fit;
 
-/// Significance level of the in-air trend test.
-pub const TREND_ALPHA: f64 = 0.01;
+/// Significance level of the in-air trend test. 5% rather than 1%: a drift the test misses is
+/// a bias in every trial at that slope, whereas subtracting a line that was not needed only adds
+/// the line's (small) uncertainty.
+pub const TREND_ALPHA: f64 = 0.05;
 
 /// How the in-air offset is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
@@ -172,15 +174,6 @@ impl AirCorrection {
         }
     }
 
-    /// Standard error of the slope subtracted from force against position, N/m (a trend's;
-    /// 0 for a constant; for a raw curve its noise is already in the trial's residuals).
-    pub fn slope_se(&self) -> f64 {
-        match self {
-            AirCorrection::Trend { sigma_n, sxx, .. } if *sxx > 0.0 => sigma_n / sxx.sqrt(),
-            _ => 0.0,
-        }
-    }
-
     /// Standard error of the mean offset subtracted over samples centred on position `x`, N.
     pub fn offset_se_at(&self, x: f64) -> f64 {
         match self {
@@ -241,13 +234,13 @@ mod tests {
             Curve::new(xs, fs).unwrap()
         };
         let drifting = make(20.0, 3);
+        // (The line's residual SD is the noise, 0.1 N, within 25%.)
         let (c, t) = AirCorrection::choose(&[&drifting], AirMode::Auto);
         let t = t.unwrap();
         assert!(t.significant && t.p_value < 1e-10 && (t.slope_n_per_m - 20.0).abs() < 4.0 * t.slope_se);
         assert_eq!(c.name(), "trend");
-        assert!((c.slope_se() - t.slope_se).abs() < 1e-12);
-        // Without drift the test picks the trend in about 1% of runs (its level): at most 8 of
-        // 200 (expected 2; P(> 8) < 1e-3).
+        // Without drift the test picks the trend in about 5% of runs (its level): at most 20 of
+        // 200 (expected 10; P(> 20) < 3e-3).
         let wrong = (0..200u64)
             .filter(|&seed| {
                 let (c, t) = AirCorrection::choose(&[&make(0.0, seed)], AirMode::Auto);
@@ -255,6 +248,6 @@ mod tests {
                 t.unwrap().significant
             })
             .count();
-        assert!(wrong <= 8, "{wrong}");
+        assert!(wrong <= 20, "{wrong}");
     }
 }

@@ -392,7 +392,7 @@ pub fn fit_campaign(
                 }
             }
             (AirCorrection::Trend { slope_n_per_m, .. }, Some(tr)) => r.notes.push(format!(
-                "the in-air run drifts by {slope_n_per_m:.3} N/m (t-test p = {:.1e} < 0.01): its fitted line is \
+                "the in-air run drifts by {slope_n_per_m:.3} N/m (t-test p = {:.1e} < 0.05): its fitted line is \
                  subtracted",
                 tr.p_value
             )),
@@ -409,7 +409,9 @@ pub fn fit_campaign(
         let window = match t.kind {
             Kind::Penetration => {
                 let mut p = fit_penetration(&corrected, area, options.depth_window).map_err(fail)?;
-                p.k_n_se = p.k_n_se.hypot(air.slope_se() / area);
+                // The in-air run bounds a drift (a slope in force against depth, which k_n would
+                // absorb) only to its slope's SE, whether or not the trend was subtracted.
+                p.k_n_se = p.k_n_se.hypot(trend.map_or(0.0, |t| t.slope_se) / area);
                 if p.r_squared < LOW_R_SQUARED {
                     r.warnings.push(TrialWarning::LowRSquared { r_squared: p.r_squared });
                 }

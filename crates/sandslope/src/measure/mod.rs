@@ -97,9 +97,18 @@ pub enum MeasureError {
     /// The columns of a recording have different lengths (a caller bug, not user input).
     #[error("columns have different lengths ({0} and {1})")]
     LengthMismatch(usize, usize),
-    /// Force does not increase with depth anywhere: no linear window.
-    #[error("force does not increase with depth (best line slope {0:.3} N/m): no linear window")]
-    NoLinearWindow(f64),
+    /// No stretch of at least `MIN_WINDOW_SAMPLES` samples is straight within the curve's noise
+    /// with a slope clearly above zero.
+    #[error(
+        "no linear window: no stretch of the curve is straight within its noise (SD {noise_sd_n:.3} N) with force \
+         rising clearly with depth (steepest stretch {steepest_n_per_m:.1} N/m); set the depth window by hand"
+    )]
+    NoLinearWindow {
+        /// Noise SD estimated from the curve, N.
+        noise_sd_n: f64,
+        /// Slope of the steepest candidate stretch, N/m.
+        steepest_n_per_m: f64,
+    },
     /// The shear force never rises above zero after the offset is removed.
     #[error("shear force has no positive plateau (median force over the second half {0:.4} N)")]
     NoPlateau(f64),

@@ -10,19 +10,23 @@
 //! from the end of the transient to the onset of the bottom or of saturation. The line is then
 //! fitted robustly (a Huber line, [`huber_line`]) over the window.
 
-use statrs::distribution::{ContinuousCDF, Normal};
-
 use crate::error::{positive, ParamError};
 
 use super::clean::Curve;
 use super::line::{huber_line, noise_sd, LineFit};
 use super::{MeasureError, WindowChoice};
 
-/// Family-wise significance level of the tests that reject a candidate window.
-pub const WINDOW_ALPHA: f64 = 0.5;
+/// A candidate window is rejected when any of its tests has |z| above this. Deliberately low
+/// (each test at a two-sided 4.6%, not corrected for the number of tests): rejecting a straight
+/// window by chance costs only a slightly shorter window, whereas an end that bends away by
+/// less than the threshold still moves the slope by up to about `z sqrt(3 m / n)` standard
+/// errors (`m` samples of `n` at the end), and that bias does not average out over trials.
+/// On generated campaigns at 3% full-scale noise, 2.0 halves the bias of a Bonferroni-corrected
+/// 1% level (-0.85% against -1.3% of k_n) for 10% more scatter.
+pub const WINDOW_Z: f64 = 2.0;
 /// A window's slope must be at least this many standard errors above zero (a flat stretch
 /// before contact or after saturation is straight too, but it is not the linear part).
-pub const MIN_SLOPE_T: f64 = 10.0;
+pub const MIN_SLOPE_T: f64 = 5.0;
 /// Fewest samples in an automatic window.
 pub const MIN_WINDOW_SAMPLES: usize = 8;
 /// Candidate window ends are taken on a grid of at most this many points along the curve
@@ -218,17 +222,6 @@ impl Sums {
     }
 }
 
-/// Number of tests [`Sums::worst`] makes on a window of `n` samples.
-fn tests_for(n: usize) -> usize {
-    let mut k = 1;
-    let mut m = 3;
-    while m <= n / 3 {
-        k += 4;
-        m *= 2;
-    }
-    k
-}
-
 /// Index range `[lo, hi)` of the automatic linear window (see the module documentation).
 fn linear_window(x: &[f64], f: &[f64], sigma: f64) -> Result<(usize, usize), MeasureError> {
     let n = x.len();
@@ -248,9 +241,7 @@ fn linear_window(x: &[f64], f: &[f64], sigma: f64) -> Result<(usize, usize), Mea
         g.dedup();
         g
     };
-    // Bonferroni over the tests of one window; the critical |z| for each count of tests.
-    let normal = Normal::new(0.0, 1.0).map_err(|_| MeasureError::NoLinearWindow(f64::NAN))?;
-    let crit = |k: usize| normal.inverse_cdf(1.0 - WINDOW_ALPHA / (2.0 * k as f64));
+
     let mut best: Option<(usize, usize, f64)> = None;
     let mut best_slope = f64::NEG_INFINITY;
     for (ia, &a) in grid.iter().enumerate() {
@@ -268,7 +259,7 @@ fn linear_window(x: &[f64], f: &[f64], sigma: f64) -> Result<(usize, usize), Mea
             if w.beta * w.suu.sqrt() < MIN_SLOPE_T * sigma {
                 continue;
             }
-            if sums.worst(a, b, &w, sigma) <= crit(tests_for(b - a)) {
+            if sums.worst(a, b, &w, sigma) <= WINDOW_Z {
                 best = Some((a, b, length));
                 break;
             }
@@ -276,7 +267,7 @@ fn linear_window(x: &[f64], f: &[f64], sigma: f64) -> Result<(usize, usize), Mea
     }
     match best {
         Some((a, b, _)) => Ok((a, b)),
-        None => Err(MeasureError::NoLinearWindow(best_slope / span)),
+        None => Err(MeasureError::NoLinearWindow { noise_sd_n: sigma, steepest_n_per_m: best_slope / span }),
     }
 }
 
@@ -381,6 +372,6 @@ mod tests {
         let x: Vec<f64> = (0..40).map(|i| i as f64 * 1e-3).collect();
         let f = x.iter().map(|_| 1.0 + 0.01 * noise.normal()).collect();
         let c = Curve::new(x, f).unwrap();
-        assert!(matches!(fit_penetration(&c, AREA, None), Err(MeasureError::NoLinearWindow(_))));
+        assert!(matches!(fit_penetration(&c, AREA, None), Err(MeasureError::NoLinearWindow { .. })));
     }
 }

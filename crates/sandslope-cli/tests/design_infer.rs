@@ -26,8 +26,19 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
 /// invalid designs (hip height above 2R) are listed with the reason, not dropped.
 #[test]
 fn design_json_matches_risk_solve_slope_and_keeps_invalid_designs() {
+    // A terrain without SDs, so that the default CVs (and their note) are used: the built-in
+    // terrain carries SDs since its joint calibration.
+    let tdir = tempfile::tempdir().unwrap();
+    let terrain = write(
+        tdir.path(),
+        "bare.toml",
+        "repose_deg = 25.0\n[[points]]\nslope_deg = 0.0\nk_n = 7.0e5\nk_s = 2.0e6\n\
+         [[points]]\nslope_deg = 20.0\nk_n = 7.0e5\nk_s = 1.0e6\n",
+    );
     let v = json(&[
         "design",
+        "--terrain",
+        &terrain,
         "--vary",
         "mass_kg=0.35:1.4:2",
         "--vary",
@@ -60,7 +71,18 @@ fn design_json_matches_risk_solve_slope_and_keeps_invalid_designs() {
             ),
         );
         let risk = json(&[
-            "risk", "--robot", &robot, "--solve", "slope", "--cv-n", "0.1", "--cv-s", "0.2", "--json",
+            "risk",
+            "--robot",
+            &robot,
+            "--terrain",
+            &terrain,
+            "--solve",
+            "slope",
+            "--cv-n",
+            "0.1",
+            "--cv-s",
+            "0.2",
+            "--json",
         ]);
         assert_eq!(d["safe_slope_deg"], risk["safe_slope_deg"], "mass {m}");
         for key in ["speed_m_s", "p_fail", "regime", "k_s_margin", "pareto"] {

@@ -33,11 +33,14 @@ def test_no_uncertainty_is_the_certain_regime(robot, terrain):
         assert float(r[f"p_{regime}"]) == 1.0
 
 
-def test_one_uncertainty_rule(cli, robot, terrain, root):
+def test_one_uncertainty_rule(cli, robot, terrain, root, tmp_path):
     # docs/model.md §9: a given CV, else the table's SD over its value, else 0.1 / 0.2.
-    plain = sandslope.risk(robot, [0, 10], terrain=terrain)
+    # A table without SDs (the built-in terrain carries SDs since its joint calibration).
+    bare = tmp_path / "bare.toml"
+    bare.write_text("[[points]]\nslope_deg = 0.0\nk_n = 7.0e5\nk_s = 2.0e6\n")
+    plain = sandslope.risk(robot, [0, 10], terrain=sandslope.Terrain.from_toml(bare))
     assert list(plain["cv_n_source"]) == ["default", "default"] and (plain["cv_s"] == 0.2).all()
-    want = cli.json("risk", "--slope", "0,10")
+    want = cli.json("risk", "--slope", "0,10", "--terrain", str(bare))
     assert [p["p_fail"] for p in want] == pytest.approx(list(plain["p_fail"]), rel=1e-12, abs=1e-300)
     uncertain = root / "examples" / "phase" / "uncertain-sand.toml"
     table = sandslope.risk(robot, 10, terrain=uncertain, cv_s=0.05)

@@ -388,3 +388,102 @@ fn risk_negative_cv_gets_the_valid_range_not_a_parse_error() {
     assert!(err.contains("cv_n") || err.contains("--cv-n"), "{err}");
     assert!(err.contains("at least 0"), "{err}");
 }
+
+/// Reads a `.npy` file written by sandslope: (descr, shape, raw data).
+fn read_npy(path: &Path) -> (String, Vec<usize>, Vec<u8>) {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00", "{}", path.display());
+    let len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let dict = std::str::from_utf8(&bytes[10..10 + len]).unwrap();
+    let descr = dict.split("'descr': '").nth(1).unwrap().split('\'').next().unwrap().to_string();
+    let shape = dict.split("'shape': (").nth(1).unwrap().split(')').next().unwrap();
+    let shape =
+        shape.split(',').map(str::trim).filter(|s| !s.is_empty()).map(|s| s.parse().unwrap()).collect();
+    (descr, shape, bytes[10 + len..].to_vec())
+}
+
+fn f64s(raw: &[u8]) -> Vec<f64> {
+    raw.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect()
+}
+
+/// `--npy` writes the same cells as `--csv`: regime codes (0 sinkage .. 3 success), steps
+/// with NaN where the CSV is empty, and the axes; for risk, p_fail as in the map CSV.
+#[test]
+fn npy_arrays_hold_the_same_cells_as_the_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("cells.csv");
+    sandslope()
+        .args([
+            "phase",
+            "--k-n",
+            "1e4:1e7:7",
+            "--k-s",
+            "1e3:1e8:5",
+            "--slope",
+            "0,24",
+            "--mass",
+            "0.35,1",
+            "--json",
+        ])
+        .arg("--csv")
+        .arg(&csv)
+        .arg("--npy")
+        .arg(dir.path())
+        .assert()
+        .success();
+    let (descr, shape, regime) = read_npy(&dir.path().join("regime.npy"));
+    assert_eq!((descr.as_str(), shape), ("|i1", vec![2, 2, 5, 7]));
+    let (descr, _, step) = read_npy(&dir.path().join("step_m.npy"));
+    assert_eq!(descr, "<f8");
+    let step = f64s(&step);
+    assert_eq!(f64s(&read_npy(&dir.path().join("slope_deg.npy")).2), [0.0, 24.0]);
+    assert_eq!(read_npy(&dir.path().join("k_n.npy")).1, [7]);
+    let names = ["sinkage", "slippage", "metastable", "success"];
+    let mut reader = csv::Reader::from_path(&csv).unwrap();
+    let mut n = 0;
+    for (c, row) in reader.records().enumerate() {
+        let row = row.unwrap();
+        assert_eq!(names[regime[c] as usize], &row[4], "cell {c}");
+        match row[5].parse::<f64>() {
+            Ok(s) => assert_eq!(s, step[c]),
+            Err(_) => assert!(step[c].is_nan()),
+        }
+        n += 1;
+    }
+    assert_eq!(n, 140);
+    // Risk: a missing folder is refused before any work; then the arrays match the CSV.
+    sandslope()
+        .args(["risk", "--slope", "20", "--map", "--k-n", "1e5:1e7:3", "--k-s", "1e5:1e7:4", "--npy"])
+        .arg(dir.path().join("missing"))
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("no such folder"));
+    let risk_dir = dir.path().join("risk");
+    std::fs::create_dir(&risk_dir).unwrap();
+    let out = sandslope()
+        .args([
+            "risk",
+            "--slope",
+            "20",
+            "--map",
+            "--k-n",
+            "1e5:1e7:3",
+            "--k-s",
+            "1e5:1e7:4",
+            "--csv",
+            "--npy",
+        ])
+        .arg(&risk_dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let (_, shape, p) = read_npy(&risk_dir.join("p_fail.npy"));
+    assert_eq!(shape, [4, 3]);
+    let p = f64s(&p);
+    let mut reader = csv::Reader::from_reader(&out.stdout[..]);
+    for (c, row) in reader.records().enumerate() {
+        // CSV is k_n-major (c = i * 4 + j); the array is [k_s][k_n].
+        let (i, j) = (c / 4, c % 4);
+        assert_eq!(row.unwrap()[2].parse::<f64>().unwrap(), p[j * 3 + i]);
+    }
+}

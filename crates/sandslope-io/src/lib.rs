@@ -4,8 +4,9 @@
 //! the Python package and the report: robot and terrain TOML files and the built-in presets
 //! ([`robot_terrain`], [`presets`]), speed tables ([`speeds`]), anchoring-time tables ([`anchoring`]), load-cell manifests and
 //! recordings ([`measurements`]), motion-capture exports ([`mocap`]), elevation rasters and the
-//! risk-map GeoTIFF ([`raster`]), route GeoJSON and CSV ([`routes`]), and atomic file writing
-//! ([`files`]).
+//! risk-map GeoTIFF ([`raster`]), route GeoJSON and CSV ([`routes`]), NumPy `.npy` arrays of
+//! phase and risk maps ([`npy`]), fast CSV of large grids ([`grid_csv`]), and atomic file
+//! writing ([`files`]).
 //!
 //! This is the edge where files become the library's validated types: every error names the
 //! file (or preset), the line, column or key, and the valid range. Nothing here computes
@@ -15,8 +16,10 @@
 
 pub mod anchoring;
 pub mod files;
+pub mod grid_csv;
 pub mod measurements;
 pub mod mocap;
+pub mod npy;
 pub mod presets;
 pub mod raster;
 pub mod robot_terrain;

@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use serde::Serialize;
 
@@ -16,7 +16,7 @@ use sandslope::{Axis, AxisScale, PhasePanel, Regime, RegimeCounts, Robot, Slope,
 use crate::args::{beyond_last_point, default_axis, parse_axis, warn_extrapolated, TerrainArgs};
 use crate::figures::phase::PhaseFigure;
 use crate::figures::save;
-use crate::output::{print_json, sci, table, write_via_temp};
+use crate::output::{print_json, sci, table};
 use crate::progress::progress_bar;
 use sandslope_io::load_robot;
 use sandslope_io::presets::DEFAULT_ROBOT;
@@ -55,6 +55,11 @@ pub struct PhaseArgs {
     /// Write every cell to this CSV file: k_n,k_s,slope_deg,mass_kg,regime,step_m.
     #[arg(long, value_name = "FILE")]
     pub csv: Option<PathBuf>,
+    /// Write NumPy arrays into this existing folder: regime.npy (int8 codes 0 sinkage,
+    /// 1 slippage, 2 metastable, 3 success; shape mass x slope x k_s x k_n), step_m.npy
+    /// (float64, NaN where the leg never anchors), k_n.npy, k_s.npy, slope_deg.npy, mass_kg.npy.
+    #[arg(long, value_name = "DIR")]
+    pub npy: Option<PathBuf>,
     /// Draw the phase diagram(s) to this file (.png or .svg).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
@@ -67,17 +72,6 @@ pub struct PhaseArgs {
 const MAX_CELLS: u128 = 1 << 28;
 /// Most rows `--csv` writes (2^25: about 2 GB of text).
 const MAX_CSV_CELLS: u128 = 1 << 25;
-
-/// One cell as written by `--csv`.
-#[derive(Serialize)]
-struct CellRow {
-    k_n: f64,
-    k_s: f64,
-    slope_deg: f64,
-    mass_kg: f64,
-    regime: &'static str,
-    step_m: Option<f64>,
-}
 
 #[derive(Serialize)]
 struct AxisRecord {
@@ -123,6 +117,9 @@ struct PanelRecord {
 pub fn run(args: PhaseArgs) -> Result<()> {
     for p in [&args.csv, &args.plot].into_iter().flatten() {
         crate::output::check_parent_exists(p)?;
+    }
+    if let Some(dir) = &args.npy {
+        sandslope_io::npy::check_npy_dir(dir)?;
     }
     let base = load_robot(&args.robot)?;
     let terrain = args.terrain.load()?;
@@ -193,6 +190,9 @@ pub fn run(args: PhaseArgs) -> Result<()> {
     if let Some(path) = &args.csv {
         write_cells(path, &panels)?;
     }
+    if let Some(dir) = &args.npy {
+        write_npy(dir, &panels, &masses, &args.slope)?;
+    }
     if let Some(path) = &args.plot {
         let figure = PhaseFigure::new(&panels, slopes.len(), terrain_label(&terrain));
         save(path, &figure)?;
@@ -260,28 +260,80 @@ fn record(p: &PhasePanel) -> PanelRecord {
     }
 }
 
-/// Writes every cell of every panel, atomically.
+/// Writes every cell of every panel, atomically, formatted in parallel
+/// (`sandslope_io::grid_csv`), one row per cell: `k_n,k_s,slope_deg,mass_kg,regime,step_m` (step empty
+/// where the leg never anchors).
 fn write_cells(path: &std::path::Path, panels: &[PhasePanel]) -> Result<()> {
-    write_via_temp(path, |tmp| {
-        let file = std::fs::File::create(tmp).with_context(|| format!("cannot write {}", path.display()))?;
-        let mut w = csv::Writer::from_writer(std::io::BufWriter::with_capacity(1 << 20, file));
-        for p in panels {
-            let (k_n, k_s) = (p.map.k_n(), p.map.k_s());
-            for (j, &ks) in k_s.iter().enumerate() {
-                for (i, &kn) in k_n.iter().enumerate() {
-                    w.serialize(CellRow {
-                        k_n: kn,
-                        k_s: ks,
-                        slope_deg: p.slope_deg,
-                        mass_kg: p.mass_kg,
-                        regime: p.map.regime(i, j).name(),
-                        step_m: p.map.step(i, j),
-                    })
-                    .with_context(|| format!("cannot write {}", path.display()))?;
-                }
-            }
+    use sandslope_io::grid_csv::{push_f64, write_rows_file};
+    let per_panel: Vec<usize> = panels.iter().map(|p| p.map.k_n().len() * p.map.k_s().len()).collect();
+    let starts: Vec<usize> = per_panel
+        .iter()
+        .scan(0, |a, &n| {
+            let s = *a;
+            *a += n;
+            Some(s)
+        })
+        .collect();
+    let total = per_panel.iter().sum();
+    // Per panel, the constant text ",slope,mass,".
+    let mids: Vec<Vec<u8>> = panels
+        .iter()
+        .map(|p| {
+            let mut b = vec![b','];
+            push_f64(&mut b, p.slope_deg);
+            b.push(b',');
+            push_f64(&mut b, p.mass_kg);
+            b.push(b',');
+            b
+        })
+        .collect();
+    let header = "k_n,k_s,slope_deg,mass_kg,regime,step_m";
+    write_rows_file(path, header, total, &|c, buf| {
+        let k = starts.partition_point(|&s| s <= c) - 1;
+        let (p, cell) = (&panels[k], c - starts[k]);
+        let nx = p.map.k_n().len();
+        let (i, j) = (cell % nx, cell / nx);
+        push_f64(buf, p.map.k_n()[i]);
+        buf.push(b',');
+        push_f64(buf, p.map.k_s()[j]);
+        buf.extend_from_slice(&mids[k]);
+        buf.extend_from_slice(p.map.regime(i, j).name().as_bytes());
+        buf.push(b',');
+        if let Some(step) = p.map.step(i, j) {
+            push_f64(buf, step);
         }
-        w.flush().with_context(|| format!("cannot write {}", path.display()))?;
-        Ok(())
     })
+}
+
+/// Writes the maps as NumPy arrays into `dir` (checked before any work).
+fn write_npy(dir: &std::path::Path, panels: &[PhasePanel], masses: &[f64], slopes: &[f64]) -> Result<()> {
+    use rayon::prelude::*;
+    use sandslope_io::npy::{write_npy_dir, NpyData};
+    let first = &panels[0].map;
+    let (k_n, k_s) = (first.k_n(), first.k_s());
+    let cells = k_n.len() * k_s.len();
+    let mut regime = vec![0i8; cells * panels.len()];
+    let mut step = vec![0.0f64; cells * panels.len()];
+    regime.par_chunks_mut(cells).zip(step.par_chunks_mut(cells)).zip(panels.par_iter()).for_each(
+        |((r, s), p)| {
+            let nx = k_n.len();
+            for c in 0..cells {
+                let (i, j) = (c % nx, c / nx);
+                r[c] = p.map.regime(i, j) as i8;
+                s[c] = p.map.step(i, j).unwrap_or(f64::NAN);
+            }
+        },
+    );
+    let shape = vec![masses.len(), slopes.len(), k_s.len(), k_n.len()];
+    write_npy_dir(
+        dir,
+        &[
+            ("regime.npy", shape.clone(), NpyData::I8(&regime)),
+            ("step_m.npy", shape, NpyData::F64(&step)),
+            ("k_n.npy", vec![k_n.len()], NpyData::F64(k_n)),
+            ("k_s.npy", vec![k_s.len()], NpyData::F64(k_s)),
+            ("slope_deg.npy", vec![slopes.len()], NpyData::F64(slopes)),
+            ("mass_kg.npy", vec![masses.len()], NpyData::F64(masses)),
+        ],
+    )
 }

@@ -79,6 +79,10 @@ pub struct RiskArgs {
     /// --map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 1000 to x 100, 200 points).
     #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", requires = "map", allow_hyphen_values = true)]
     pub k_s: Option<String>,
+    /// With --map: write NumPy arrays into this existing folder: p_fail.npy and
+    /// p_not_success.npy (float64, shape k_s x k_n), k_n.npy, k_s.npy.
+    #[arg(long, value_name = "DIR", requires = "map")]
+    pub npy: Option<PathBuf>,
     /// Print JSON instead of a table.
     #[arg(long, conflicts_with = "csv")]
     pub json: bool,
@@ -248,6 +252,9 @@ pub fn run(args: RiskArgs) -> Result<()> {
             );
         }
         crate::output::check_parent_exists(p)?;
+    }
+    if let Some(dir) = &args.npy {
+        sandslope_io::npy::check_npy_dir(dir)?;
     }
     let extrapolated = beyond_last_point(terrain.terrain(), &slopes);
     if !extrapolated.is_empty() {
@@ -599,6 +606,20 @@ fn run_map(
     if let Some(Some(path)) = &args.csv {
         write_map_csv(path, &map)?;
     }
+    if let Some(dir) = &args.npy {
+        use sandslope_io::npy::{write_npy_dir, NpyData};
+        let (k_n, k_s) = (map.k_n_axis.values(), map.k_s_axis.values());
+        let shape = vec![k_s.len(), k_n.len()];
+        write_npy_dir(
+            dir,
+            &[
+                ("p_fail.npy", shape.clone(), NpyData::F64(&map.p_fail)),
+                ("p_not_success.npy", shape, NpyData::F64(&map.p_not_success)),
+                ("k_n.npy", vec![k_n.len()], NpyData::F64(&k_n)),
+                ("k_s.npy", vec![k_s.len()], NpyData::F64(&k_s)),
+            ],
+        )?;
+    }
     if let Some(path) = &args.plot {
         let figure = MapFigure {
             k_n_axis,
@@ -635,8 +656,8 @@ fn run_map(
         Format::Json => print_json(&summary),
         Format::Csv => match &args.csv {
             Some(None) => {
-                let mut out = std::io::stdout().lock();
-                map_csv(&map, &mut out).context("cannot write to stdout")
+                let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+                map_csv(&map, &mut out).and_then(|_| out.flush()).context("cannot write to stdout")
             }
             _ => Ok(()),
         },
@@ -669,24 +690,32 @@ fn run_map(
 }
 
 /// Every cell of `map`, one row each, k_n-major: `k_n,k_s,p_fail,p_not_success`.
-fn map_csv(map: &RiskMap, out: &mut dyn std::io::Write) -> Result<()> {
+fn map_csv(map: &RiskMap, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+    use sandslope_io::grid_csv::{push_f64, write_rows};
     let (k_n, k_s) = (map.k_n_axis.values(), map.k_s_axis.values());
-    let mut w = std::io::BufWriter::with_capacity(1 << 20, out);
-    writeln!(w, "k_n,k_s,p_fail,p_not_success")?;
-    for (i, &kn) in k_n.iter().enumerate() {
-        for (j, &ks) in k_s.iter().enumerate() {
-            writeln!(w, "{kn},{ks},{},{}", map.p_fail_at(i, j), map.p_not_success_at(i, j))?;
+    let ny = k_s.len();
+    write_rows(out, MAP_CSV_HEADER, k_n.len() * ny, &|c, buf| {
+        let (i, j) = (c / ny, c % ny);
+        for (k, v) in
+            [k_n[i], k_s[j], map.p_fail_at(i, j), map.p_not_success_at(i, j)].into_iter().enumerate()
+        {
+            if k > 0 {
+                buf.push(b',');
+            }
+            push_f64(buf, v);
         }
-    }
-    w.flush()?;
-    Ok(())
+    })
 }
+
+const MAP_CSV_HEADER: &str = "k_n,k_s,p_fail,p_not_success";
 
 fn write_map_csv(path: &std::path::Path, map: &RiskMap) -> Result<()> {
     write_via_temp(path, |tmp| {
-        let mut file =
-            std::fs::File::create(tmp).with_context(|| format!("cannot write {}", path.display()))?;
-        map_csv(map, &mut file).with_context(|| format!("cannot write {}", path.display()))
+        let file = std::fs::File::create(tmp).with_context(|| format!("cannot write {}", path.display()))?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 22, file);
+        map_csv(map, &mut w)
+            .and_then(|_| w.flush())
+            .map_err(|source| sandslope_io::WriteError { path: path.to_path_buf(), source }.into())
     })
 }
 

@@ -47,6 +47,9 @@ impl Panel {
     }
 }
 
+/// Trials with a warning (short window, poor line, outlier).
+const WARNING_RED: RGBColor = RGBColor(200, 30, 30);
+
 /// Viridis (a perceptually uniform sequential map, readable in grey and by colour-blind
 /// readers) at `t` in [0, 1], from its published stops at every eighth.
 fn viridis(t: f64) -> RGBColor {
@@ -112,6 +115,8 @@ impl Data<'_> {
         let ys = trials.iter().flat_map(|t| t.curve.force().iter().copied());
         let (x0, x1) = range(xs, (0.0, 1.0));
         let (y0, y1) = range(ys.chain([0.0]), (0.0, 1.0));
+        // Shear curves fill the panel's width at their plateau: room above them for the legend.
+        let y1 = if shear { y1 + 0.4 * (y1 - y0) } else { y1 };
         let mut chart = ChartBuilder::on(area)
             .caption(panel.title(), font(22.0))
             .margin(12)
@@ -155,7 +160,10 @@ impl Data<'_> {
         // Then each trial's fit: a thin black dashed line over the window (or the plateau mean
         // over the plateau), with short vertical bars at the window's ends.
         let tick = 0.025 * (y1 - y0);
-        for t in &trials {
+        // Trials with a warning last, on top.
+        let mut in_order = trials.clone();
+        in_order.sort_by_key(|t| !t.warnings.is_empty());
+        for t in &in_order {
             let (a, b, fa, fb) = match t.fit() {
                 TrialFit::Penetration(f) => {
                     let (a, b) = f.depth_window_m;
@@ -164,13 +172,18 @@ impl Data<'_> {
                 TrialFit::Shear(f) => (f.plateau_m.0, f.plateau_m.1, f.plateau_force_n, f.plateau_force_n),
                 TrialFit::Air => continue,
             };
+            // A trial with a warning is drawn in red, so that a bad window stands out.
+            let ink = if t.warnings.is_empty() { BLACK } else { WARNING_RED };
             let line = vec![(a * 1e3, fa), (b * 1e3, fb)];
-            chart.draw_series(DashedLineSeries::new(line, 6, 4, BLACK.stroke_width(1))).map_err(plot_err)?;
+            let width = if t.warnings.is_empty() { 1 } else { 2 };
+            chart
+                .draw_series(DashedLineSeries::new(line, 6, 4, ink.stroke_width(width)))
+                .map_err(plot_err)?;
             for (x, y) in [(a * 1e3, fa), (b * 1e3, fb)] {
                 chart
                     .draw_series(std::iter::once(PathElement::new(
                         vec![(x, y - tick), (x, y + tick)],
-                        BLACK.stroke_width(2),
+                        ink.stroke_width(2),
                     )))
                     .map_err(plot_err)?;
             }
@@ -185,9 +198,16 @@ impl Data<'_> {
             .map_err(plot_err)?
             .label(fit_label)
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(2)));
+        if trials.iter().any(|t| !t.warnings.is_empty()) {
+            chart
+                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                .map_err(plot_err)?
+                .label("trial with a warning")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], WARNING_RED.stroke_width(2)));
+        }
         chart
             .configure_series_labels()
-            .position(if shear { SeriesLabelPosition::LowerRight } else { SeriesLabelPosition::UpperLeft })
+            .position(if shear { SeriesLabelPosition::UpperRight } else { SeriesLabelPosition::UpperLeft })
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK.mix(0.4))
             .label_font(font(14.0))

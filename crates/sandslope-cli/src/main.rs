@@ -9,6 +9,7 @@ mod error;
 mod figures;
 mod output;
 mod progress;
+mod report;
 
 use clap::{Parser, Subcommand};
 
@@ -41,6 +42,8 @@ enum Command {
     Plan(commands::plan::PlanArgs),
     /// Robot design exploration: safe-slope limit and speed of every design, and the Pareto front.
     Design(commands::design::DesignArgs),
+    /// The paper reproduced and confronted: one self-contained HTML page and report.json.
+    Report(commands::report::ReportArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
 }
@@ -56,6 +59,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Risk(a) => commands::risk::run(a),
         Command::Plan(a) => commands::plan::run(a),
         Command::Design(a) => commands::design::run(a),
+        Command::Report(a) => commands::report::run(a),
         Command::Presets(a) => commands::presets::run(a),
     }
 }

@@ -7,6 +7,7 @@ pub mod phase;
 pub mod plan;
 pub mod predict;
 pub mod presets;
+pub mod report;
 pub mod risk;
 pub mod sweep;
 pub mod track;

@@ -13,6 +13,7 @@ pub mod palette;
 pub mod phase;
 pub mod plan;
 pub mod risk;
+pub mod slope_curves;
 pub mod sweep;
 pub mod track;
 
@@ -94,7 +95,6 @@ pub fn save(path: &Path, figure: &impl Figure) -> Result<()> {
 }
 
 /// Renders `figure` as an SVG document in memory (for pages that embed figures inline).
-#[allow(dead_code)] // used by the report (issue 12)
 pub fn to_svg(figure: &impl Figure) -> Result<String> {
     register_fonts();
     let size = figure.size();

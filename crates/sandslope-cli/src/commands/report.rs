@@ -1,0 +1,405 @@
+//! `sandslope report --out DIR`: the paper reproduced and confronted in one self-contained
+//! HTML page (`DIR/index.html`, figures inline as SVG) and `DIR/report.json`. On the defaults it
+//! reproduces the paper from the shipped data; `--robot`, `--terrain`, `--observed`, `--forces`
+//! and `--t1` make it a report on the user's own campaign.
+
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Result};
+use clap::Args;
+
+use sandslope::calibrate::joint::ObservationKind;
+use sandslope::paper::{self, compare_with_paper};
+use sandslope::risk::{risk_curve, safe_slope_limit};
+use sandslope::{
+    calibrate_jointly, predict, Axis, AxisScale, FreeParameter, JointCalibration, JointSetup, Parameter,
+    PhasePanel, Robot, ShearShape, Slope, SpeedObservation, Terrain, UncertainTerrain,
+};
+use sandslope_io::presets::DEFAULT_TERRAIN;
+use sandslope_io::{load_anchoring_times, load_speeds, load_terrain, terrain_from_toml, Source};
+
+/// The paper's force tests as its text reports them (docs/calibration.md).
+const PAPER_FORCE_TESTS: &str = include_str!("../../../../data/example-force-tests.toml");
+
+use crate::args::{RobotArgs, TerrainArgs};
+use crate::figures::calibrate::{CalibrationFigure, SpeedPoint};
+use crate::figures::phase::PhaseFigure;
+use crate::figures::risk::CurveFigure;
+use crate::figures::slope_curves::SlopeCurveFigure;
+use crate::figures::to_svg;
+use crate::output::write_atomic;
+use crate::report::{page, FigureRecord, PageFigure, ReportJson, SpeedRecord};
+
+/// Arguments of `sandslope report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Folder to write index.html and report.json into (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Observed speeds (slope_deg,speed_m_s,speed_sd_m_s); default: the paper's five.
+    #[arg(long, value_name = "CSV")]
+    pub observed: Option<PathBuf>,
+    /// Force tests (a terrain file with k_s_sd, as `sandslope fit` writes): drawn in fig4d/h
+    /// and used as the k_s shape in the calibration; default: the terrain itself.
+    #[arg(long, value_name = "FILE|PRESET")]
+    pub forces: Option<String>,
+    /// Observed anchoring times (slope_deg,t1_s,t1_sd_s), drawn in fig5b and calibrated on.
+    #[arg(long, value_name = "CSV")]
+    pub t1: Option<PathBuf>,
+    /// Risk threshold for the safe-slope limit.
+    #[arg(long, default_value_t = 0.05)]
+    pub max_risk: f64,
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    pub terrain: TerrainArgs,
+}
+
+/// Slopes of the model curves: 0 to 30 deg every 0.25 deg.
+fn slope_grid() -> Vec<f64> {
+    (0..=120).map(|i| i as f64 * 0.25).collect()
+}
+
+fn at(d: f64) -> Slope {
+    Slope::from_degrees(d).expect("grid slopes are valid")
+}
+
+/// Runs `sandslope report`.
+pub fn run(args: ReportArgs) -> Result<()> {
+    if !(args.max_risk > 0.0 && args.max_risk < 1.0) {
+        bail!("--max-risk = {} must be a probability strictly between 0 and 1", args.max_risk);
+    }
+    if args.out.exists() && !args.out.is_dir() {
+        bail!("--out {}: exists and is not a folder", args.out.display());
+    }
+    let robot = args.robot.load()?;
+    let terrain = args.terrain.load()?;
+    // The force tests: given, or on the built-in terrain the paper's as its text reports them
+    // (data/example-force-tests.toml, from which the built-in terrain was calibrated).
+    let paper_forces = args.forces.is_none() && args.terrain.terrain == DEFAULT_TERRAIN;
+    let forces = match &args.forces {
+        Some(f) => Some(load_terrain(f)?),
+        None if paper_forces => {
+            Some(terrain_from_toml(PAPER_FORCE_TESTS, &Source::Preset("example-force-tests"))?)
+        }
+        None => None,
+    };
+    let speeds: Vec<SpeedObservation> = match &args.observed {
+        Some(p) => load_speeds(p)?,
+        None => paper::SPEEDS
+            .iter()
+            .map(|&(d, v, sd)| SpeedObservation { slope: at(d), speed: v, speed_sd: sd })
+            .collect(),
+    };
+    let anchoring = args.t1.as_deref().map(load_anchoring_times).transpose()?.unwrap_or_default();
+    let mut inputs = vec![
+        ("robot".to_string(), args.robot.robot.clone()),
+        ("terrain".to_string(), args.terrain.terrain.clone()),
+        (
+            "observed speeds".to_string(),
+            args.observed
+                .as_ref()
+                .map_or("the paper's (docs/model.md §12)".into(), |p| p.display().to_string()),
+        ),
+        (
+            "force tests".to_string(),
+            match (&args.forces, paper_forces) {
+                (Some(f), _) => f.clone(),
+                (None, true) => {
+                    "the paper's, as its text reports them (data/example-force-tests.toml)".into()
+                }
+                (None, false) => "the terrain's own table".into(),
+            },
+        ),
+    ];
+    if let Some(p) = &args.t1 {
+        inputs.push(("anchoring times".into(), p.display().to_string()));
+    }
+
+    // The joint calibration of the terrain's (or the force tests') k_s shape on the evidence.
+    let shape = forces.clone().unwrap_or_else(|| terrain.clone());
+    let setup = JointSetup {
+        robot: robot.clone(),
+        normal: shape.clone(),
+        shear: ShearShape::ForceTests(shape.clone()),
+        speeds: speeds.clone(),
+        anchoring: anchoring.clone(),
+        free: [Parameter::PlateScale, Parameter::ErrorFloor]
+            .into_iter()
+            .map(|parameter| FreeParameter { parameter, bounds: None })
+            .collect(),
+        error_floor: 0.0,
+    };
+    let calibration = calibrate_jointly(&setup).ok();
+
+    let grid = slope_grid();
+    let predictions: Vec<_> = grid.iter().map(|&d| predict(&robot, at(d), &terrain.at(at(d)))).collect();
+    let repose = terrain.spec().repose_deg;
+    let mut figures = Vec::new();
+    let mut add = |id: &str, title: &str, caption: String, svg: String| {
+        figures.push(PageFigure { id: id.into(), title: title.into(), caption, svg });
+    };
+
+    // fig3a: speed against slope.
+    let fig = SlopeCurveFigure {
+        title: "Step-averaged upslope speed".into(),
+        y_label: "speed v (cm/s)".into(),
+        model: grid.iter().zip(&predictions).map(|(&d, p)| (d, p.speed.map(|v| v * 100.0))).collect(),
+        model_label: "model on the terrain".into(),
+        observed: speeds.iter().map(|o| (o.slope.degrees(), o.speed * 100.0, o.speed_sd * 100.0)).collect(),
+        observed_label: "observed (mean ± SD)".into(),
+        reference: None,
+        repose,
+        from_zero: true,
+    };
+    add("fig3a", "Speed against slope", "The model's step-averaged speed v = s/(T/2) on the terrain (dashed) and the observed speeds. Where the line stops, the regime rules a speed out (slippage or sinkage, docs/model.md §6).".into(), to_svg(&fig)?);
+
+    // fig4d, fig4h: k_n and k_s against slope with error bars.
+    let table = forces.as_ref().unwrap_or(&terrain);
+    let label =
+        if forces.is_some() { "force tests (mean ± SD)" } else { "terrain table (± SD where given)" };
+    for (id, title, unit_scale, pick) in [
+        ("fig4d", "Normal penetration resistance k_n", 1e-5, 0usize),
+        ("fig4h", "Shear strength k_s", 1e-5, 1usize),
+    ] {
+        let value =
+            |p: &sandslope::TerrainPoint| if pick == 0 { (p.k_n, p.k_n_sd) } else { (p.k_s, p.k_s_sd) };
+        let fig = SlopeCurveFigure {
+            title: title.into(),
+            y_label: format!("{} (10⁵ N/m³)", if pick == 0 { "k_n" } else { "k_s" }),
+            model: grid
+                .iter()
+                .map(|&d| {
+                    let g = terrain.at(at(d));
+                    (d, Some(if pick == 0 { g.k_n } else { g.k_s } * unit_scale))
+                })
+                .collect(),
+            model_label: "terrain used by the model (interpolated)".into(),
+            observed: table
+                .points()
+                .iter()
+                .map(|p| {
+                    let (v, sd) = value(p);
+                    (p.slope_deg, v * unit_scale, sd.unwrap_or(0.0) * unit_scale)
+                })
+                .collect(),
+            observed_label: label.into(),
+            reference: None,
+            repose,
+            from_zero: true,
+        };
+        let caption = if pick == 0 {
+            "The paper: k_n \"remains nearly constant\" with slope (Fig. 4d).".to_string()
+        } else {
+            "The paper: k_s at 20° is about 40% of level (Fig. 4h). With force tests given, the model's leg k_s is plate_scale times the plate's (docs/calibration.md).".to_string()
+        };
+        add(id, title, caption, to_svg(&fig)?);
+    }
+
+    // fig5b: anchoring time; fig5c: net step.
+    let fig = SlopeCurveFigure {
+        title: "Anchoring time t1".into(),
+        y_label: "t1 (ms)".into(),
+        model: grid.iter().zip(&predictions).map(|(&d, p)| (d, p.anchoring_time.map(|t| t * 1e3))).collect(),
+        model_label: "model".into(),
+        observed: anchoring.iter().map(|o| (o.slope.degrees(), o.t1 * 1e3, o.t1_sd * 1e3)).collect(),
+        observed_label: "observed (mean ± SD)".into(),
+        reference: None,
+        repose,
+        from_zero: true,
+    };
+    add("fig5b", "Anchoring time against slope", "The time after touchdown at which the leg reaches the shear-equilibrium depth d_s (docs/model.md §4). The paper plots measured t1 but prints no values; give --t1 to overlay yours.".into(), to_svg(&fig)?);
+    let fig = SlopeCurveFigure {
+        title: "Net step length".into(),
+        y_label: "net step s (mm)".into(),
+        model: grid.iter().zip(&predictions).map(|(&d, p)| (d, p.step.map(|s| s * 1e3))).collect(),
+        model_label: "model".into(),
+        observed: speeds
+            .iter()
+            .map(|o| {
+                let half = robot.stance_duration() * 1e3;
+                (o.slope.degrees(), o.speed * half, o.speed_sd * half)
+            })
+            .collect(),
+        observed_label: "observed speed × T/2".into(),
+        reference: Some((robot.min_step() * 1e3, "s_min = R: success above, metastable below".into())),
+        repose,
+        from_zero: true,
+    };
+    add(
+        "fig5c",
+        "Net step against slope",
+        "s = s2 - s1 (docs/model.md §5); the observed points are the observed speeds times T/2.".into(),
+        to_svg(&fig)?,
+    );
+
+    // fig6a-d: the four phase diagrams.
+    let k_n_axis = Axis::new("k_n", 1e4, 1e8, 120, AxisScale::Log).map_err(|e| anyhow!("{e}"))?;
+    let k_s_axis = Axis::new("k_s", 1e4, 1e9, 120, AxisScale::Log).map_err(|e| anyhow!("{e}"))?;
+    for (id, mass, slope_deg) in
+        [("fig6a", 0.35, 0.0), ("fig6b", 0.35, 24.0), ("fig6c", 1.0, 0.0), ("fig6d", 1.0, 24.0)]
+    {
+        let r = robot.with_mass(mass).map_err(|e| anyhow!("{e}"))?;
+        let panel = PhasePanel::compute(&r, slope_deg, &terrain, &k_n_axis, &k_s_axis, &|| {})
+            .map_err(|e| anyhow!("{e}"))?;
+        let title = format!("Phase diagram, {mass} kg at {slope_deg}°");
+        let caption = format!(
+            "Regime over (k_n, k_s): blue sinkage, red slippage, yellow metastable, green success; the black line is s = R; the star is the terrain at {slope_deg}° ({}).",
+            panel.terrain_regime
+        );
+        let panels = [panel];
+        let fig = PhaseFigure::new(&panels, 1, terrain.name().unwrap_or("terrain").to_string());
+        add(id, &title, caption, to_svg(&fig)?);
+    }
+
+    // p_fail against slope with the safe-slope limit.
+    let uncertain = UncertainTerrain::new(terrain.clone(), None, None).map_err(|e| anyhow!("{e}"))?;
+    let risk_slopes: Vec<f64> = (0..=60).map(|i| i as f64 * 0.5).collect();
+    let curve = risk_curve(&robot, &uncertain, &risk_slopes).map_err(|e| anyhow!("{e}"))?;
+    let limit = safe_slope_limit(&robot, &uncertain, args.max_risk).map_err(|e| anyhow!("{e}"))?;
+    let fig = CurveFigure {
+        curve: curve.points.iter().map(|p| (p.slope_deg, p.probabilities)).collect(),
+        points: vec![],
+        hi: 30.0,
+        max_risk: args.max_risk,
+        limit,
+        title: format!("Failure risk of the {} kg robot", robot.mass()),
+    };
+    let note = curve.defaults_used.note().map(|n| format!(" {n}.")).unwrap_or_default();
+    add(
+        "risk",
+        "Failure probability against slope",
+        format!(
+            "p_fail = P(sinkage or slippage) with log-normal k_n, k_s (docs/model.md §9), and the safe-slope limit at p_fail < {}.{note}",
+            args.max_risk
+        ),
+        to_svg(&fig)?,
+    );
+
+    // The calibration pulls.
+    if let Some(c) = &calibration {
+        let points: Vec<SpeedPoint> = c
+            .pulls
+            .iter()
+            .filter(|p| p.kind == ObservationKind::Speed)
+            .map(|p| SpeedPoint {
+                slope_deg: p.slope_deg,
+                observed: p.observed,
+                sd: p.sd,
+                sd_total: p.sd_total,
+                model: p.model,
+                pull: p.pull,
+            })
+            .collect();
+        let fitted = Robot::new(c.robot.clone()).map_err(|e| anyhow!("{e}"))?;
+        let fitted_terrain = Terrain::new(c.terrain.clone()).map_err(|e| anyhow!("{e}"))?;
+        let curve: Vec<(f64, Option<f64>)> = grid
+            .iter()
+            .filter(|&&d| d <= 24.5)
+            .map(|&d| {
+                let g = fitted_terrain.at(at(d));
+                (d, predict(&fitted, at(d), &g).speed)
+            })
+            .collect();
+        let subtitle = format!(
+            "χ²/dof = {}, floor {:.2} cm/s",
+            c.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),
+            c.error_floor_m_s * 100.0
+        );
+        add("calibration", "Joint calibration: observed against fitted speeds, and pulls", "The terrain's k_s shape scaled by a fitted plate_scale, with a fitted model-error floor (docs/calibration.md). Pulls beyond ±2 are red.".into(), to_svg(&CalibrationFigure { points: &points, curve: &curve, subtitle: &subtitle })?);
+    }
+
+    let paper_rows = compare_with_paper(&robot, &terrain);
+    let disagreements = disagreements(&paper_rows, calibration.as_ref(), &speeds);
+    let speed_records: Vec<SpeedRecord> = speeds
+        .iter()
+        .map(|o| SpeedRecord {
+            slope_deg: o.slope.degrees(),
+            observed_m_s: o.speed,
+            observed_sd_m_s: o.speed_sd,
+            model_m_s: predict(&robot, o.slope, &terrain.at(o.slope)).speed,
+        })
+        .collect();
+    let html = page(&inputs, &figures, &paper_rows, calibration.as_ref(), &disagreements);
+    let json = ReportJson {
+        figures: figures.iter().map(|f| FigureRecord { id: &f.id, title: &f.title }).collect(),
+        speeds: &speed_records,
+        calibration: calibration.as_ref(),
+        paper_vs_model: &paper_rows,
+        disagreements: &disagreements,
+        inputs: &inputs,
+    };
+    let json = serde_json::to_string_pretty(&json)?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|source| sandslope_io::WriteError { path: args.out.clone(), source })?;
+    write_atomic(&args.out.join("report.json"), json.as_bytes())?;
+    write_atomic(&args.out.join("index.html"), html.as_bytes())?;
+    let failing = paper_rows.iter().filter(|r| !r.agrees).count();
+    println!(
+        "{} figures; the model agrees with {} of the paper's {} numbers; {} disagreement(s) listed",
+        figures.len(),
+        paper_rows.len() - failing,
+        paper_rows.len(),
+        disagreements.len()
+    );
+    eprintln!(
+        "wrote {} and {}",
+        args.out.join("index.html").display(),
+        args.out.join("report.json").display()
+    );
+    Ok(())
+}
+
+/// The "where the model and the paper disagree" items, generated from the comparison and the
+/// calibration.
+fn disagreements(
+    rows: &[sandslope::paper::PaperComparison],
+    calibration: Option<&JointCalibration>,
+    speeds: &[SpeedObservation],
+) -> Vec<String> {
+    let mut out: Vec<String> = rows
+        .iter()
+        .filter(|r| !r.agrees)
+        .map(|r| {
+            format!(
+                "{}: the paper reports {}, the model gives {} (rule: {}; {}).",
+                r.quantity, r.paper, r.model, r.rule, r.source
+            )
+        })
+        .collect();
+    let mut sorted: Vec<&SpeedObservation> = speeds.iter().collect();
+    sorted.sort_by(|a, b| a.slope.radians().total_cmp(&b.slope.radians()));
+    for w in sorted.windows(2) {
+        if w[1].speed > w[0].speed {
+            out.push(format!(
+                "The observed speed rises from {} to {} deg ({:.2} to {:.2} cm/s); a k_s that falls with slope makes the model's speed fall, so no calibration of this model can follow it.",
+                w[0].slope.degrees(),
+                w[1].slope.degrees(),
+                w[0].speed * 100.0,
+                w[1].speed * 100.0
+            ));
+        }
+    }
+    if let Some(c) = calibration {
+        if c.error_floor_m_s > 0.0 {
+            out.push(format!(
+                "Fitting the speeds takes a model-error floor of {:.2} cm/s added to the quoted SDs (68%: {:.2} to {:.2}); the quoted SDs alone (as small as {:.2} cm/s) are not reachable by the model.",
+                c.error_floor_m_s * 100.0,
+                c.parameters.iter().find(|p| p.name == "error_floor").map_or(0.0, |p| p.estimate.lower * 100.0),
+                c.parameters.iter().find(|p| p.name == "error_floor").map_or(0.0, |p| p.estimate.upper * 100.0),
+                speeds.iter().map(|o| o.speed_sd).fold(f64::INFINITY, f64::min) * 100.0
+            ));
+        }
+        let scale = c.parameters.iter().find(|p| p.name == "plate_scale").map_or(1.0, |p| p.estimate.value);
+        if let (Some(level), true) = (c.shear.first(), scale > 3.0) {
+            out.push(format!(
+                "The leg k_s the model needs at {} deg ({:.2e} N/m³) would give {:.0} N on the paper's 3 cm × 2 cm shear plate (F = k_s W d²), {scale:.0} times what the force tests give: the model's k_s is an effective leg parameter, not the plate's.",
+                level.slope_deg, level.k_s, level.plate_force_n
+            ));
+        }
+        for w in &c.warnings {
+            out.push(format!("Calibration: {w}."));
+        }
+    }
+    out
+}

@@ -1,0 +1,141 @@
+//! One quantity against slope, in the paper's style: the model as a line (gaps where it is
+//! undefined), measurements as points with SD bars, an optional reference line and the slopes
+//! at or above the angle of repose shaded. The report's fig3a, fig4d, fig4h, fig5b and fig5c.
+
+use anyhow::Result;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{font, Figure};
+use crate::error::plot_err;
+
+/// A quantity against slope.
+pub struct SlopeCurveFigure {
+    /// Caption.
+    pub title: String,
+    /// Y-axis label (with unit).
+    pub y_label: String,
+    /// The model curve `(slope_deg, value)`, `None` where undefined.
+    pub model: Vec<(f64, Option<f64>)>,
+    /// Legend of the model curve.
+    pub model_label: String,
+    /// Measurements `(slope_deg, mean, sd)`.
+    pub observed: Vec<(f64, f64, f64)>,
+    /// Legend of the measurements.
+    pub observed_label: String,
+    /// A dashed horizontal line and its legend.
+    pub reference: Option<(f64, String)>,
+    /// Angle of repose, degrees: shaded from there on.
+    pub repose: Option<f64>,
+    /// Start the y axis at zero.
+    pub from_zero: bool,
+}
+
+impl Figure for SlopeCurveFigure {
+    fn size(&self) -> (u32, u32) {
+        (760, 480)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let xs = self.model.iter().map(|m| m.0).chain(self.observed.iter().map(|o| o.0));
+        let x_range = super::range(xs, (0.0, 30.0));
+        let ys = self
+            .model
+            .iter()
+            .filter_map(|m| m.1)
+            .chain(self.observed.iter().flat_map(|o| [o.1 - o.2, o.1 + o.2]))
+            .chain(self.reference.as_ref().map(|r| r.0))
+            .chain(self.from_zero.then_some(0.0));
+        let y_range = super::range(ys, (0.0, 1.0));
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, font(20.0))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("slope (deg)")
+            .y_desc(&self.y_label)
+            .label_style(font(14.0))
+            .axis_desc_style(font(16.0))
+            .light_line_style(WHITE)
+            .bold_line_style(RGBColor(225, 225, 225))
+            .draw()
+            .map_err(plot_err)?;
+        if y_range.0 < 0.0 && y_range.1 > 0.0 {
+            chart
+                .draw_series(LineSeries::new([(x_range.0, 0.0), (x_range.1, 0.0)], BLACK.stroke_width(1)))
+                .map_err(plot_err)?;
+        }
+        if let Some(repose) = self.repose.filter(|r| *r < x_range.1) {
+            let shade = RGBColor(200, 200, 200).mix(0.45);
+            chart
+                .draw_series([Rectangle::new(
+                    [(repose.max(x_range.0), y_range.0), (x_range.1, y_range.1)],
+                    shade.filled(),
+                )])
+                .map_err(plot_err)?
+                .label("at or above the angle of repose")
+                .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+        }
+        if let Some((level, label)) = &self.reference {
+            let grey = RGBColor(90, 90, 90);
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(x_range.0, *level), (x_range.1, *level)],
+                    8,
+                    5,
+                    grey.stroke_width(2),
+                ))
+                .map_err(plot_err)?
+                .label(label.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(2)));
+        }
+        let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+        for &(x, y) in &self.model {
+            match y {
+                Some(v) => segments.last_mut().expect("non-empty").push((x, v)),
+                None if !segments.last().expect("non-empty").is_empty() => segments.push(Vec::new()),
+                None => {}
+            }
+        }
+        let red = RGBColor(200, 40, 40);
+        let mut first = true;
+        for seg in segments.into_iter().filter(|s| !s.is_empty()) {
+            let s = chart
+                .draw_series(DashedLineSeries::new(seg, 10, 4, red.stroke_width(3)))
+                .map_err(plot_err)?;
+            if first && !self.model_label.is_empty() {
+                s.label(self.model_label.as_str())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red.stroke_width(3)));
+                first = false;
+            }
+        }
+        if !self.observed.is_empty() {
+            chart
+                .draw_series(self.observed.iter().map(|&(x, v, sd)| {
+                    ErrorBar::new_vertical(x, v - sd, v, v + sd, BLACK.stroke_width(2), 10)
+                }))
+                .map_err(plot_err)?;
+            chart
+                .draw_series(self.observed.iter().map(|&(x, v, _)| Circle::new((x, v), 5, BLACK.filled())))
+                .map_err(plot_err)?
+                .label(self.observed_label.as_str())
+                .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .label_font(font(14.0))
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.85))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(plot_err)?;
+        Ok(())
+    }
+}

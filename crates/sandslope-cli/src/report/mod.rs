@@ -1,0 +1,180 @@
+//! The report page: one self-contained HTML file (figures inline as SVG, styles inline, no
+//! scripts, no network) and the `report.json` beside it. This module assembles what
+//! `commands/report.rs` computed; it computes no physics.
+
+use serde::Serialize;
+
+use sandslope::paper::PaperComparison;
+use sandslope::JointCalibration;
+
+/// One figure of the page, by the paper's figure number.
+pub struct PageFigure {
+    /// The paper's id (`fig3a`, ...), or a name for figures the paper does not have.
+    pub id: String,
+    /// Title.
+    pub title: String,
+    /// What it shows and how to read it.
+    pub caption: String,
+    /// The figure as an SVG document.
+    pub svg: String,
+}
+
+/// `report.json`'s figure entry.
+#[derive(Serialize)]
+pub struct FigureRecord<'a> {
+    /// Id.
+    pub id: &'a str,
+    /// Title.
+    pub title: &'a str,
+}
+
+/// One observed speed beside the model.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct SpeedRecord {
+    /// Slope, degrees.
+    pub slope_deg: f64,
+    /// Observed mean, m/s.
+    pub observed_m_s: f64,
+    /// Observed SD, m/s.
+    pub observed_sd_m_s: f64,
+    /// The model's speed on the terrain (`null` where the regime rules it out), m/s.
+    pub model_m_s: Option<f64>,
+}
+
+/// Everything on the page, as `report.json`.
+#[derive(Serialize)]
+pub struct ReportJson<'a> {
+    /// The figures, in page order.
+    pub figures: Vec<FigureRecord<'a>>,
+    /// Observed against model speeds.
+    pub speeds: &'a [SpeedRecord],
+    /// The joint calibration of the terrain's k_s shape on the evidence (`null` if it failed).
+    pub calibration: Option<&'a JointCalibration>,
+    /// Every number the paper reports beside the model's.
+    pub paper_vs_model: &'a [PaperComparison],
+    /// The generated "where the model and the paper disagree" items.
+    pub disagreements: &'a [String],
+    /// What the report was made from.
+    pub inputs: &'a [(String, String)],
+}
+
+/// Escapes text for HTML.
+pub fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// Drops the XML prolog of an SVG document so it can sit inside HTML.
+fn inline_svg(svg: &str) -> &str {
+    match svg.find("<svg") {
+        Some(i) => &svg[i..],
+        None => svg,
+    }
+}
+
+const STYLE: &str = "body{font-family:'DejaVu Sans',Verdana,sans-serif;max-width:1100px;margin:2em auto;\
+padding:0 1em;color:#222;line-height:1.45}h1{font-size:1.7em}h2{margin-top:2em;border-bottom:1px solid #ccc}\
+table{border-collapse:collapse;margin:1em 0;font-size:0.92em}td,th{border:1px solid #ccc;padding:4px 8px;\
+text-align:left}th{background:#f3f3f3}tr.no td{background:#fdecea}tr.yes td.v{color:#1b6e2a}\
+figure{margin:1.5em 0;display:inline-block;vertical-align:top;max-width:100%}\
+figure svg{max-width:100%;height:auto;border:1px solid #eee}figcaption{font-size:0.9em;color:#444;max-width:760px}\
+.warn{background:#fff8e1;border-left:4px solid #e0a800;padding:0.5em 1em}code{background:#f4f4f4;padding:0 3px}";
+
+/// The whole page.
+pub fn page(
+    inputs: &[(String, String)],
+    figures: &[PageFigure],
+    paper: &[PaperComparison],
+    calibration: Option<&JointCalibration>,
+    disagreements: &[String],
+) -> String {
+    let mut h = String::with_capacity(1 << 20);
+    h.push_str("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">");
+    h.push_str("<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">");
+    h.push_str("<title>sandslope report: the paper reproduced and confronted</title>");
+    h.push_str(&format!("<style>{STYLE}</style></head><body>\n"));
+    h.push_str("<h1>Legged robots on granular slopes: the model, the paper, and where they part</h1>\n");
+    h.push_str(
+        "<p>Liao and Qian, <i>Failure Mechanisms and Risk Estimation for Legged Robot Locomotion on Granular \
+         Slopes</i> (arXiv:2603.06928), recomputed by <code>sandslope report</code> from the inputs below. \
+         Figure ids are the paper's figure numbers. The model is specified in the repository's \
+         <code>docs/model.md</code>; the calibration in <code>docs/calibration.md</code>.</p>\n",
+    );
+    h.push_str("<table><tr><th>input</th><th>value</th></tr>");
+    for (k, v) in inputs {
+        h.push_str(&format!("<tr><td>{}</td><td>{}</td></tr>", escape(k), escape(v)));
+    }
+    h.push_str("</table>\n");
+
+    h.push_str("<h2 id=\"disagree\">Where the model and the paper disagree</h2>\n");
+    if disagreements.is_empty() {
+        h.push_str("<p>Nowhere, by the rules in the table below.</p>");
+    } else {
+        h.push_str("<ul>");
+        for d in disagreements {
+            h.push_str(&format!("<li>{}</li>", escape(d)));
+        }
+        h.push_str("</ul>\n");
+    }
+
+    h.push_str("<h2 id=\"numbers\">Every number the paper reports, beside the model's</h2>\n");
+    h.push_str("<table><tr><th>quantity</th><th>paper</th><th>model</th><th>agrees?</th><th>rule</th><th>source</th></tr>");
+    for r in paper {
+        h.push_str(&format!(
+            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td class=\"v\">{}</td><td>{}</td><td>{}</td></tr>",
+            if r.agrees { "yes" } else { "no" },
+            escape(&r.quantity),
+            escape(&r.paper),
+            escape(&r.model),
+            if r.agrees { "yes" } else { "no" },
+            escape(&r.rule),
+            escape(&r.source)
+        ));
+    }
+    h.push_str("</table>\n");
+
+    if let Some(c) = calibration {
+        h.push_str("<h2 id=\"calibration\">Joint calibration</h2>\n");
+        h.push_str(&format!(
+            "<p>chi² = {:.2} over {} degrees of freedom{}; model-error floor {:.2} cm/s; \
+             k<sub>s</sub>(20°)/k<sub>s</sub>(0) = {:.3} (68%: {:.3} to {:.3}; the paper's force tests: about 0.40).</p>",
+            c.chi_squared,
+            c.dof,
+            c.chi_squared_per_dof.map_or(String::new(), |r| format!(" (χ²/dof {r:.2})")),
+            c.error_floor_m_s * 100.0,
+            c.shear_ratio_20.value,
+            c.shear_ratio_20.lower,
+            c.shear_ratio_20.upper
+        ));
+        h.push_str("<table><tr><th>fitted quantity</th><th>best</th><th>68% interval</th><th>unit</th></tr>");
+        for p in &c.parameters {
+            h.push_str(&format!(
+                "<tr><td>{}</td><td>{:.4e}</td><td>{:.4e} to {:.4e}{}</td><td>{}</td></tr>",
+                escape(&p.name),
+                p.estimate.value,
+                p.estimate.lower,
+                p.estimate.upper,
+                if p.at_bound { " (at a bound)" } else { "" },
+                escape(&p.unit)
+            ));
+        }
+        h.push_str("</table>\n");
+        for w in &c.warnings {
+            h.push_str(&format!("<p class=\"warn\">{}</p>", escape(&w.to_string())));
+        }
+    }
+
+    h.push_str("<h2 id=\"figures\">Figures</h2>\n");
+    for f in figures {
+        h.push_str(&format!(
+            "<figure id=\"{}\">{}<figcaption><b>{} · {}</b>. {}</figcaption></figure>\n",
+            escape(&f.id),
+            inline_svg(&f.svg),
+            escape(&f.id),
+            escape(&f.title),
+            escape(&f.caption)
+        ));
+    }
+    h.push_str("<p><small>Made by <code>sandslope report</code>. Self-contained: no scripts, no network.</small></p>");
+    h.push_str("</body></html>\n");
+    h
+}

@@ -44,6 +44,8 @@ enum Command {
     Design(commands::design::DesignArgs),
     /// The paper reproduced and confronted: one self-contained HTML page and report.json.
     Report(commands::report::ReportArgs),
+    /// Terrain inference from the gait: posterior of k_s per observed slope, and risk at slopes not walked.
+    Infer(commands::infer::InferArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
 }
@@ -60,6 +62,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Plan(a) => commands::plan::run(a),
         Command::Design(a) => commands::design::run(a),
         Command::Report(a) => commands::report::run(a),
+        Command::Infer(a) => commands::infer::run(a),
         Command::Presets(a) => commands::presets::run(a),
     }
 }

@@ -180,3 +180,105 @@ fn worked_examples_in_the_docs_run_as_shown() {
         assert!(ran > 0, "{page} has no worked example");
     }
 }
+
+/// The paper's speeds: level sand is at the ceiling (only a lower bound); the other slopes are
+/// bounded, and their medians reproduce the observed speed through `predict` (checked at 20 deg:
+/// the model's speed at the median k_s is within one standard error of 4.98 cm/s).
+#[test]
+fn infer_paper_speeds_json() {
+    let v = json(&["infer", "--observed", "../../data/paper-speeds.csv", "--json"]);
+    let pts = v["points"].as_array().unwrap();
+    assert_eq!(pts.len(), 5);
+    assert_eq!((pts[0]["bounded"].as_bool(), pts[0]["bound"].as_str()), (Some(false), Some("lower_only")));
+    for p in &pts[1..] {
+        assert_eq!(p["bounded"], true, "{p}");
+        let (q05, med, q95) = (
+            p["k_s_q05"].as_f64().unwrap(),
+            p["k_s_median"].as_f64().unwrap(),
+            p["k_s_q95"].as_f64().unwrap(),
+        );
+        assert!(q05 < med && med < q95);
+    }
+    let k = pts[3]["k_s_median"].as_f64().unwrap().to_string();
+    let pred = json(&["predict", "--slope", "20", "--k-s", &k, "--json"]);
+    let speed = pred["speed_m_s"].as_f64().unwrap();
+    assert!((speed - 0.0498).abs() < 0.0032, "{speed}");
+    assert!(v["law"].is_null() && v["prediction"].as_array().unwrap().is_empty());
+}
+
+/// --law predicts at unobserved slopes with p_fail bands ordered q05 <= median <= q95, and the
+/// risk rises with slope for the heavy robot; p_fail at the band's ends is risk's p_fail at those
+/// k_s medians.
+#[test]
+fn infer_law_predicts_risk_with_a_band() {
+    let v = json(&[
+        "infer",
+        "--observed",
+        "../../examples/inference/walk-1kg.csv",
+        "--mass",
+        "1",
+        "--law",
+        "linear",
+        "--predict",
+        "18,22",
+        "--cv-n",
+        "0.1",
+        "--cv-s",
+        "0.2",
+        "--json",
+    ]);
+    let pred = v["prediction"].as_array().unwrap();
+    assert_eq!(pred.len(), 2);
+    for p in pred {
+        let f = &p["p_fail"];
+        let (a, m, b) =
+            (f["q05"].as_f64().unwrap(), f["median"].as_f64().unwrap(), f["q95"].as_f64().unwrap());
+        assert!(a <= m && m <= b, "{p}");
+        assert_eq!(p["observed"], false);
+    }
+    assert!(pred[1]["p_fail"]["median"].as_f64() > pred[0]["p_fail"]["median"].as_f64());
+    let k = pred[1]["k_s"]["median"].as_f64().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let terrain =
+        write(dir.path(), "t.toml", &format!("[[points]]\nslope_deg = 0.0\nk_n = 7e5\nk_s = {k}\n"));
+    let risk = json(&[
+        "risk",
+        "--mass",
+        "1",
+        "--slope",
+        "22",
+        "--terrain",
+        &terrain,
+        "--cv-n",
+        "0.1",
+        "--cv-s",
+        "0.2",
+        "--json",
+    ]);
+    let want = risk["p_fail"].as_f64().unwrap();
+    let got = pred[1]["p_fail"]["median"].as_f64().unwrap();
+    assert!((got - want).abs() < 1e-9, "{got} vs {want}");
+}
+
+#[test]
+fn infer_rejects_impossible_input_with_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let plot = dir.path().join("p.png");
+    for (csv, extra, says) in [
+        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.25,0.005\n", "", "above the model's ceiling"),
+        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0\n", "", "speed_sd_m_s = 0 must be greater than 0"),
+        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,-0.01\n", "", "must be greater than 0"),
+        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n", "--k-s-prior=1e6:1e5", "0 < MIN < MAX"),
+        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n", "--law=linear", "two or more slopes"),
+        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n10,0.11,0.01\n", "", "two observations at 10"),
+    ] {
+        let f = write(dir.path(), "obs.csv", csv);
+        let mut cmd = sandslope();
+        cmd.args(["infer", "--observed", &f, "--plot", plot.to_str().unwrap()]);
+        if !extra.is_empty() {
+            cmd.arg(extra);
+        }
+        cmd.assert().code(2).stderr(predicate::str::contains(says));
+        assert!(!plot.exists(), "{csv}: partial output");
+    }
+}

@@ -20,6 +20,7 @@ pub mod grid_csv;
 pub mod measurements;
 pub mod mocap;
 pub mod npy;
+pub mod observations;
 pub mod presets;
 pub mod raster;
 pub mod robot_terrain;

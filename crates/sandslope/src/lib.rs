@@ -34,6 +34,7 @@ pub mod critical;
 pub mod design;
 pub mod error;
 pub mod gait;
+pub mod infer;
 pub mod measure;
 pub mod model;
 pub mod paper;

@@ -3,6 +3,7 @@
 pub mod calibrate;
 pub mod design;
 pub mod fit;
+pub mod infer;
 pub mod phase;
 pub mod plan;
 pub mod predict;

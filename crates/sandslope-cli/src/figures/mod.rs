@@ -8,6 +8,7 @@
 
 pub mod calibrate;
 pub mod design;
+pub mod infer;
 pub mod measurements;
 pub mod palette;
 pub mod phase;

@@ -1,0 +1,240 @@
+//! `sandslope infer`: what the robot's own gait says about the sand. From observed speeds (and
+//! anchoring times), the exact posterior of k_s at each observed slope (`sandslope::infer`);
+//! with `--law`, the joint posterior of a shear law and the predicted failure risk, with a
+//! credible band, at slopes not walked.
+
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Result};
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+
+use sandslope::infer::{
+    law_posterior, posteriors, Bound, GaitObservation, InferLaw, LawPosterior, LogUniformPrior,
+    SlopePosterior,
+};
+use sandslope::Slope;
+use sandslope_io::observations::{load_speed_observations, load_step_observation};
+
+use crate::args::{RobotArgs, TerrainArgs, UncertaintyArgs};
+use crate::figures::infer::InferFigure;
+use crate::figures::{format_of, save};
+use crate::output::{check_parent_exists, print_json, sci, table};
+
+/// `--law`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LawArg {
+    /// k_s(theta) = k_s0 + b theta_deg.
+    Linear,
+    /// k_s(theta) = k_s0 (cos theta - sin theta / tan phi).
+    Coulomb,
+}
+
+/// Arguments of `sandslope infer`.
+#[derive(Debug, Args)]
+pub struct InferArgs {
+    /// Observed speeds: CSV slope_deg,speed_m_s,speed_sd_m_s[,n] (as `track --speeds-out` writes;
+    /// with n, the mean's standard error is sd/sqrt(n)).
+    #[arg(long, value_name = "FILE", required_unless_present = "steps")]
+    pub observed: Option<PathBuf>,
+    /// Per-step output of `track --csv` at one slope, DEG=FILE (repeat for several slopes): speed
+    /// and anchoring time t1 of every step.
+    #[arg(long, value_name = "DEG=FILE", conflicts_with = "observed")]
+    pub steps: Vec<String>,
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// Terrain giving k_n (and the angle of repose) at each slope; its k_s is not used except
+    /// as the comparison in the figure.
+    #[command(flatten)]
+    pub terrain: TerrainArgs,
+    #[command(flatten)]
+    pub uncertainty: UncertaintyArgs,
+    /// Log-uniform prior range of k_s, N/m^3.
+    #[arg(long = "k-s-prior", value_name = "MIN:MAX", default_value = "1e4:1e9")]
+    pub k_s_prior: String,
+    /// Tie the slopes together with a shear law and predict at --predict slopes.
+    #[arg(long, value_enum)]
+    pub law: Option<LawArg>,
+    /// Slopes to predict k_s and p_fail at with --law: DEG, a comma list or MIN:MAX:N.
+    #[arg(long, value_name = "DEG|LIST|MIN:MAX:N", default_value = "0:30:31", requires = "law")]
+    pub predict: String,
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+    /// Draw the posterior bands (and with --law the predicted risk) to this .png or .svg file.
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+}
+
+fn parse_prior(text: &str) -> Result<LogUniformPrior> {
+    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
+    let [lo, hi] = parts.as_slice() else {
+        bail!("--k-s-prior = {text} must be MIN:MAX in N/m^3 (e.g. 1e4:1e9)");
+    };
+    let num =
+        |s: &str| s.parse::<f64>().map_err(|_| anyhow!("--k-s-prior: `{s}` is not a number (in {text})"));
+    LogUniformPrior::new(num(lo)?, num(hi)?).map_err(|e| anyhow!("--k-s-prior: {e}"))
+}
+
+/// Parses `--predict`: DEG, DEG,DEG,... or MIN:MAX:N.
+fn parse_slopes(text: &str) -> Result<Vec<Slope>> {
+    let number = |s: &str| -> Result<Slope> {
+        let v: f64 =
+            s.trim().parse().map_err(|_| anyhow!("--predict: `{}` is not a number (in {text})", s.trim()))?;
+        Slope::from_degrees(v).map_err(|e| anyhow!("{}", e.renamed("--predict")))
+    };
+    if text.contains(':') {
+        let parts: Vec<&str> = text.split(':').collect();
+        let [lo, hi, n] = parts.as_slice() else {
+            bail!("--predict = {text} must be DEG, a comma list, or MIN:MAX:N (e.g. 0:30:31)");
+        };
+        let (lo, hi) = (number(lo)?.degrees(), number(hi)?.degrees());
+        let n: usize = n.trim().parse().ok().filter(|&n| (2..=10_000).contains(&n)).ok_or_else(|| {
+            anyhow!("--predict: N `{n}` must be a whole number from 2 to 10000 (in {text})")
+        })?;
+        if hi <= lo {
+            bail!("--predict = {text}: MAX must be greater than MIN");
+        }
+        return (0..n).map(|i| number(&format!("{}", lo + (hi - lo) * i as f64 / (n - 1) as f64))).collect();
+    }
+    text.split(',').map(number).collect()
+}
+
+fn observations(args: &InferArgs) -> Result<Vec<GaitObservation>> {
+    if let Some(path) = &args.observed {
+        return load_speed_observations(path);
+    }
+    args.steps
+        .iter()
+        .map(|item| {
+            let (deg, file) = item.split_once('=').ok_or_else(|| {
+                anyhow!("--steps `{item}` must be DEG=FILE (the slope of that track output)")
+            })?;
+            let deg: f64 = deg
+                .trim()
+                .parse()
+                .map_err(|_| anyhow!("--steps: slope `{deg}` is not a number (in {item})"))?;
+            let slope = Slope::from_degrees(deg).map_err(|e| anyhow!("{}", e.renamed("--steps slope")))?;
+            load_step_observation(std::path::Path::new(file.trim()), slope)
+        })
+        .collect()
+}
+
+/// The whole result as printed by `--json`.
+#[derive(Debug, Serialize)]
+struct InferRecord<'a> {
+    prior: LogUniformPrior,
+    points: &'a [SlopePosterior],
+    law: Option<&'a LawPosterior>,
+    prediction: &'a [sandslope::infer::RiskPrediction],
+    notes: Vec<String>,
+}
+
+fn bound_note(b: Bound) -> &'static str {
+    match b {
+        Bound::TwoSided => "",
+        Bound::LowerOnly => "only a lower bound: speed at the model's ceiling",
+        Bound::UpperOnly => "only an upper bound: speed at the model's floor",
+        Bound::Neither => "not bounded: speed insensitive to k_s",
+    }
+}
+
+/// Runs `sandslope infer`.
+pub fn run(args: InferArgs) -> Result<()> {
+    let robot = args.robot.load()?;
+    let prior = parse_prior(&args.k_s_prior)?;
+    let predict = if args.law.is_some() { parse_slopes(&args.predict)? } else { Vec::new() };
+    let obs = observations(&args)?;
+    let (terrain, note) = args.uncertainty.apply(args.terrain.load()?)?;
+    if let Some(p) = &args.plot {
+        format_of(p)?;
+        check_parent_exists(p)?;
+    }
+    let points = posteriors(&robot, terrain.terrain(), &obs, &prior).map_err(|e| anyhow!("{e}"))?;
+    let law = match args.law {
+        None => None,
+        Some(l) => {
+            let law = match l {
+                LawArg::Linear => InferLaw::Linear,
+                LawArg::Coulomb => InferLaw::Coulomb,
+            };
+            Some(
+                law_posterior(&robot, &terrain, &obs, &prior, law, &predict)
+                    .map_err(|e| anyhow!("--law: {e}"))?,
+            )
+        }
+    };
+    let mut notes: Vec<String> = Vec::new();
+    if law.is_some() {
+        notes.extend(note);
+    }
+    if let Some(path) = &args.plot {
+        let figure = InferFigure {
+            points: points.clone(),
+            law: law.clone(),
+            table: terrain.terrain().points().iter().map(|p| (p.slope_deg, p.k_s)).collect(),
+            prior,
+            title: format!(
+                "k_s from the gait of {} kg on {}",
+                robot.mass(),
+                terrain.terrain().name().unwrap_or("the terrain")
+            ),
+        };
+        save(path, &figure)?;
+    }
+    let prediction = law.as_ref().map_or(&[][..], |l| l.prediction.as_slice());
+    if args.json {
+        return print_json(&InferRecord { prior, points: &points, law: law.as_ref(), prediction, notes });
+    }
+    let mut t = table(&["slope (deg)", "speed (m/s)", "k_n", "k_s median", "k_s 90% interval", "note"]);
+    for p in &points {
+        t.add_row([
+            format!("{}", p.slope_deg),
+            format!("{:.4} ± {:.4}", p.speed_m_s, p.speed_se_m_s),
+            sci(p.k_n),
+            sci(p.k_s_median),
+            format!("{} – {}", sci(p.k_s_q05), sci(p.k_s_q95)),
+            bound_note(p.bound).to_string(),
+        ]);
+    }
+    println!("{t}");
+    println!(
+        "posterior of k_s per slope on a ln k_s grid, log-uniform prior {}:{} N/m^3 (docs/inference.md)",
+        sci(prior.min()),
+        sci(prior.max())
+    );
+    if let Some(l) = &law {
+        let (name, unit) = match l.law {
+            InferLaw::Linear => ("per degree", "N/m^3/deg"),
+            InferLaw::Coulomb => ("friction angle", "deg"),
+        };
+        println!(
+            "{:?} law: k_s0 {} [{} – {}] N/m^3, {name} {:.4e} [{:.4e} – {:.4e}] {unit} (median [90% interval])",
+            l.law,
+            sci(l.k_s0.median),
+            sci(l.k_s0.q05),
+            sci(l.k_s0.q95),
+            l.second.median,
+            l.second.q05,
+            l.second.q95
+        );
+        let mut t =
+            table(&["slope (deg)", "k_s median", "k_s 90% band", "p_fail median", "p_fail 90% band", ""]);
+        for p in &l.prediction {
+            t.add_row([
+                format!("{}", p.slope_deg),
+                sci(p.k_s.median),
+                format!("{} – {}", sci(p.k_s.q05), sci(p.k_s.q95)),
+                format!("{:.4}", p.p_fail.median),
+                format!("{:.4} – {:.4}", p.p_fail.q05, p.p_fail.q95),
+                if p.observed { "observed".into() } else { String::new() },
+            ]);
+        }
+        println!("{t}");
+        println!("p_fail = P(sinkage or slippage) with the law's k_s as the median and the terrain's spread (docs/model.md \u{a7}9)");
+    }
+    for n in &notes {
+        println!("note: {n}");
+    }
+    Ok(())
+}

@@ -54,8 +54,11 @@ impl<DB: DrawingBackend> Drawable<DB> for TerrainStar {
     ) -> Result<(), DrawingErrorKind<DB::ErrorType>> {
         let Some((x, y)) = points.next() else { return Ok(()) };
         let star: Vec<BackendCoord> = star_points(13.0).iter().map(|&(dx, dy)| (x + dx, y + dy)).collect();
+        let closed = || star.iter().copied().chain(std::iter::once(star[0]));
+        // A white halo first, so the star stands out on the light green of success cells.
+        backend.draw_path(closed(), &WHITE.stroke_width(5))?;
         backend.fill_polygon(star.iter().copied(), &STAR_GREEN)?;
-        backend.draw_path(star.iter().copied().chain(std::iter::once(star[0])), &self.outline)
+        backend.draw_path(closed(), &self.outline.stroke_width(2))
     }
 }
 
@@ -78,6 +81,19 @@ pub fn cell_edges(axis: &Axis) -> Vec<f64> {
     }
     edges.push(c[n - 1] + 0.5 * (c[n - 1] - c[n - 2]));
     edges.into_iter().map(|e| axis.from_coordinate(e)).collect()
+}
+
+/// Most cells drawn along one axis of a panel (about its width in pixels).
+pub const MAX_DRAWN_CELLS: usize = 512;
+
+/// Reduces an axis of `n` cells to at most `max` drawn blocks: the cell-edge index where each
+/// block starts (and the final edge `n`), and the cell whose value each block shows (its
+/// middle cell). With `n <= max`, every cell is its own block.
+pub fn reduce(n: usize, max: usize) -> (Vec<usize>, Vec<usize>) {
+    let m = n.min(max).max(1);
+    let edges: Vec<usize> = (0..=m).map(|k| k * n / m).collect();
+    let centres = edges.windows(2).map(|w| (w[0] + w[1]) / 2).collect();
+    (edges, centres)
 }
 
 /// Tick labels for N/m^3 values: 1e5, 3e5, ...
@@ -206,15 +222,21 @@ where
         .draw()
         .map_err(e)?;
     let map = &panel.map;
-    let nx = map.k_n().len();
+    // At most one drawn block per pixel: the grid is reduced to the panel's pixels first, so
+    // drawing costs the same for 400 x 400 and 4096 x 4096 cells.
+    let (xs, xc) = reduce(map.k_n().len(), MAX_DRAWN_CELLS);
+    let (ys, yc) = reduce(map.k_s().len(), MAX_DRAWN_CELLS);
     let mut rects = Vec::new();
-    for j in 0..map.k_s().len() {
+    for (jj, &j) in yc.iter().enumerate() {
         let mut start = 0;
-        for i in 1..=nx {
-            if i == nx || map.regime(i, j) != map.regime(start, j) {
-                let colour = regime_colour(map.regime(start, j));
-                rects.push(Rectangle::new([(xe[start], ye[j]), (xe[i], ye[j + 1])], colour.filled()));
-                start = i;
+        for ii in 1..=xc.len() {
+            if ii == xc.len() || map.regime(xc[ii], j) != map.regime(xc[start], j) {
+                let colour = regime_colour(map.regime(xc[start], j));
+                rects.push(Rectangle::new(
+                    [(xe[xs[start]], ye[ys[jj]]), (xe[xs[ii]], ye[ys[jj + 1]])],
+                    colour.filled(),
+                ));
+                start = ii;
             }
         }
     }
@@ -285,5 +307,13 @@ mod tests {
             assert!((x / want - 1.0).abs() < 1e-12, "{x} vs {want}");
         }
         assert_eq!(sci_label(&3e5), "3e5");
+    }
+
+    #[test]
+    fn reduction_keeps_small_axes_and_covers_large_ones() {
+        assert_eq!(reduce(3, 512), (vec![0, 1, 2, 3], vec![0, 1, 2]));
+        let (e, c) = reduce(4096, 512);
+        assert_eq!((e.len(), c.len(), e[0], e[512]), (513, 512, 0, 4096));
+        assert!(e.windows(2).all(|w| w[1] - w[0] == 8) && c[0] == 4);
     }
 }

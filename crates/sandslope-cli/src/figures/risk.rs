@@ -10,7 +10,9 @@ use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 use sandslope::risk::{PayloadEnvelope, SafeLimit};
 use sandslope::{Axis, RegimeProbabilities};
 
-use super::phase::{cell_edges, sci_label, star_points, within, TerrainStar, STAR_GREEN};
+use super::phase::{
+    cell_edges, reduce, sci_label, star_points, within, TerrainStar, MAX_DRAWN_CELLS, STAR_GREEN,
+};
 use super::{font, Figure};
 
 /// p_fail and p_not_success against slope.
@@ -34,7 +36,7 @@ impl Figure for CurveFigure {
             .margin(20)
             .x_label_area_size(50)
             .y_label_area_size(70)
-            .build_cartesian_2d(0.0..self.hi, 0.0..1.02)
+            .build_cartesian_2d(0.0..self.hi, -0.015..1.02)
             .map_err(e)?;
         chart
             .configure_mesh()
@@ -49,7 +51,7 @@ impl Figure for CurveFigure {
         let orange = RGBColor(230, 150, 30);
         chart
             .draw_series(LineSeries::new(
-                self.curve.iter().map(|(d, p)| (*d, p.p_fail())),
+                self.curve.iter().map(|(d, p)| (*d, p.p_fail().clamp(0.0, 1.0))),
                 red.stroke_width(3),
             ))
             .map_err(e)?
@@ -57,7 +59,7 @@ impl Figure for CurveFigure {
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], red.stroke_width(3)));
         chart
             .draw_series(LineSeries::new(
-                self.curve.iter().map(|(d, p)| (*d, p.p_not_success())),
+                self.curve.iter().map(|(d, p)| (*d, p.p_not_success().clamp(0.0, 1.0))),
                 orange.stroke_width(2),
             ))
             .map_err(e)?
@@ -82,7 +84,7 @@ impl Figure for CurveFigure {
         if let SafeLimit::Limit { value, .. } = self.limit {
             let blue = RGBColor(40, 90, 200);
             chart
-                .draw_series(LineSeries::new(vec![(value, 0.0), (value, 1.02)], blue.stroke_width(2)))
+                .draw_series(LineSeries::new(vec![(value, -0.015), (value, 1.02)], blue.stroke_width(2)))
                 .map_err(e)?
                 .label(format!("safe-slope limit {value:.3} deg"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(2)));
@@ -149,14 +151,24 @@ impl Figure for MapFigure {
             .draw()
             .map_err(e)?;
         let nx = self.k_n_axis.len();
+        // At most one block per pixel, whatever the grid.
+        let (xs, xc) = reduce(nx, MAX_DRAWN_CELLS);
+        let (ys, yc) = reduce(self.k_s_axis.len(), MAX_DRAWN_CELLS);
         chart
-            .draw_series(self.p_fail.iter().enumerate().map(|(c, &p)| {
-                let (i, j) = (c % nx, c / nx);
-                Rectangle::new(
-                    [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])],
-                    ViridisRGB.get_color(p as f32).filled(),
-                )
+            .draw_series(yc.iter().enumerate().flat_map(|(jj, &j)| {
+                let (xs, ys, xe, ye) = (&xs, &ys, &xe, &ye);
+                xc.iter().enumerate().map(move |(ii, &i)| {
+                    Rectangle::new(
+                        [(xe[xs[ii]], ye[ys[jj]]), (xe[xs[ii + 1]], ye[ys[jj + 1]])],
+                        ViridisRGB.get_color(self.p_fail[j * nx + i] as f32).filled(),
+                    )
+                })
             }))
+            .map_err(e)?;
+        chart
+            .draw_series(
+                self.contour.iter().map(|&(a, b)| PathElement::new(vec![a, b], BLACK.stroke_width(5))),
+            )
             .map_err(e)?;
         chart
             .draw_series(
@@ -172,7 +184,7 @@ impl Figure for MapFigure {
         let (k_n, k_s) = self.star;
         if within(&xe, &ye, (k_n, k_s)) {
             chart
-                .draw_series(std::iter::once(TerrainStar { at: (k_n, k_s), outline: WHITE }))
+                .draw_series(std::iter::once(TerrainStar { at: (k_n, k_s), outline: BLACK }))
                 .map_err(e)?
                 .label("terrain medians")
                 .legend(|(x, y)| {
@@ -192,7 +204,7 @@ impl Figure for MapFigure {
             .margin_top(45)
             .margin_bottom(65)
             .margin_right(10)
-            .y_label_area_size(60)
+            .y_label_area_size(44)
             .build_cartesian_2d(0.0..1.0, 0.0..1.0)
             .map_err(e)?;
         cb.configure_mesh()

@@ -5,9 +5,10 @@ Usage (inside an environment with `sandslope[dask]`, e.g. after bash scripts/tes
 `.venv/bin/python bench/python/bench_dask.py [--n 8192] [--chunk 1024] [--workers 2]`).
 
 The DEM (a synthetic dune field on 0.5 m cells, n x n) is itself lazy: each chunk is generated
-on the worker that needs it, so no process ever holds the whole map. The raster is reduced on
-the workers to a few numbers (mean best-heading p_fail, share of cells with a usable climb),
-so the client holds no band either. Runs on a `dask.distributed.LocalCluster` of worker
+on the worker that needs it, so no process ever holds the whole map. Each tile of the raster is
+reduced where it is made to a few numbers (mean best-heading p_fail, share of cells with a
+usable climb), as a pipeline that stores tiles would consume them, so the client holds no band
+either. Runs on a `dask.distributed.LocalCluster` of worker
 processes with one thread each (the library parallelises inside a task with rayon; set
 RAYON_NUM_THREADS to change that). Peak memory per worker is the resident-set high-water mark
 (`ru_maxrss`) of each worker process, including the Python interpreter and libraries; the
@@ -26,6 +27,14 @@ def dunes(i, j):
     """Heights (m) at rows i, columns j: dunes on an 8.5 degree ramp, 0.5 m cells."""
     x, y = 0.5 * j, 0.5 * i
     return 4.0 * np.sin(x / 25.0) * np.cos(y / 40.0) + 0.15 * x + 0.5 * np.sin(x / 3.1 + y / 4.3)
+
+
+def tile_stats(bands):
+    """Per tile: sum and count of the finite best-heading p_fail, cells with a usable climb."""
+    p = bands[0]
+    finite = np.isfinite(p)
+    out = np.array([p[finite].sum(), finite.sum(), np.isfinite(bands[1]).sum()], dtype=np.float64)
+    return out.reshape(3, 1, 1)
 
 
 def peak_rss_mib():
@@ -53,11 +62,14 @@ def main():
         idle = client.run(peak_rss_mib)
         dem = da.fromfunction(dunes, shape=(n, n), chunks=c, dtype=np.float64)
         raster = sandslope.dask.risk_raster(dem, 0.5, robot=robot, terrain=terrain)
-        mean_p = da.nanmean(raster[0])
-        climbable = da.isfinite(raster[1]).mean()
+        # Each tile is reduced where it is made (the two steps fuse into one task), as a
+        # pipeline that stores tiles (to_zarr, store) would consume them.
+        stats = raster.map_blocks(tile_stats, dtype=np.float64, chunks=((3,),) + tuple((1,) * len(c) for c in
+                                                                                   raster.chunks[1:]))
         t0 = time.perf_counter()
-        mean_p, climbable = client.compute([mean_p, climbable], sync=True)
+        totals = client.compute(stats.sum(axis=(1, 2)), sync=True)
         wall = time.perf_counter() - t0
+        mean_p, climbable = totals[0] / totals[1], totals[2] / (n * n)
         peaks = client.run(peak_rss_mib)
     chunk_mib = c * c * 8 / 2**20
     print(f"DEM {n} x {n} ({n * n * 8 / 2**30:.2f} GiB as float64), chunks {c} x {c} ({chunk_mib:.0f} MiB each), "

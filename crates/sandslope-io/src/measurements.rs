@@ -312,7 +312,7 @@ pub fn read_recording_with(path: &Path, kind: Kind, options: ReadOptions) -> Res
                 Some(s) => s.parse::<f64>().map(|v| Some(v * scale)).map_err(|_| {
                     anyhow!(
                         "{here}: line {line}, column {} ({}): `{s}` is not a number (blank cells and NaN are \
-                         accepted and dropped; rows like this can be skipped and counted instead)",
+                         accepted and dropped)",
                         col + 1,
                         names[col]
                     )

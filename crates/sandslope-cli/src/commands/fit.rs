@@ -98,10 +98,10 @@ fn read_trials(manifest: &Manifest, args: &FitArgs) -> Result<Vec<TrialInput>> {
             );
         }
         let rec = read_recording_with(&trial.path, trial.kind, read).map_err(|e| {
-            if args.skip_malformed {
-                e
+            if !args.skip_malformed && e.to_string().contains("is not a number") {
+                anyhow!("{e:#}; --skip-malformed skips such rows and counts them")
             } else {
-                e.context("(--skip-malformed skips rows with a cell that is not a number and counts them)")
+                e
             }
         })?;
         out.push(TrialInput {

@@ -194,7 +194,7 @@ fn endpoint(raster: &Raster, which: &str, map: &Option<String>, px: &Option<Stri
     let g = &raster.geo;
     let (east, south) = (g.west + cols as f64 * g.cell_x, g.north - rows as f64 * g.cell_y);
     let extent = format!(
-        "x {} to {}, y {} to {} (columns 0 to {}, rows 0 to {})",
+        "x {} to {} and y {} to {}, columns 0 to {} and rows 0 to {}",
         round_coord(g.west),
         round_coord(east),
         round_coord(south),
@@ -220,8 +220,8 @@ fn endpoint(raster: &Raster, which: &str, map: &Option<String>, px: &Option<Stri
     let outside = c < 0.0 || r < 0.0 || c >= cols as f64 || r >= rows as f64;
     if outside && on_edge {
         bail!(
-            "{what} lies on the edge of the map ({extent}); the border is impassable (no slope can be computed \
-             there): pick a point at least one cell ({} m) inside",
+            "{what} lies on the edge of the map ({extent}); the border is impassable, no slope can be computed \
+             there: pick a point at least one cell ({} m) inside",
             round_coord(g.cell_x.max(g.cell_y))
         );
     }

@@ -6,9 +6,9 @@
 /// What a preset describes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PresetKind {
-    /// A robot file (MODEL.md section 2).
+    /// A robot file (docs/model.md §2).
     Robot,
-    /// A terrain file (MODEL.md section 7).
+    /// A terrain file (docs/model.md §7).
     Terrain,
 }
 

@@ -1,4 +1,4 @@
-//! Property tests over random valid robots and terrains (MODEL.md sections 3 to 7).
+//! Property tests over random valid robots and terrains (docs/model.md §3-§7).
 
 use proptest::prelude::*;
 use sandslope::model::{level_step_length, normal_equilibrium_depth};

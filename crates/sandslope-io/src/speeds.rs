@@ -38,16 +38,23 @@ pub fn load_speeds(path: &Path) -> Result<Vec<SpeedObservation>> {
     }
     let mut out = Vec::new();
     for record in reader.records() {
-        let record = record.map_err(|e| anyhow!("{}: {e} (expected columns {})", path.display(), COLUMNS.join(",")))?;
+        let record = record
+            .map_err(|e| anyhow!("{}: {e} (expected columns {})", path.display(), COLUMNS.join(",")))?;
         let line = record.position().map_or(0, |p| p.line());
         if record.len() != COLUMNS.len() {
-            bail!("{}: line {line}: {} cells; expected 3 ({})", path.display(), record.len(), COLUMNS.join(","));
+            bail!(
+                "{}: line {line}: {} cells; expected 3 ({})",
+                path.display(),
+                record.len(),
+                COLUMNS.join(",")
+            );
         }
         // Cells by column name, so an error names the column, not a field index.
         let cell = |i: usize| -> Result<f64> {
             let text = &record[i];
-            text.parse::<f64>()
-                .map_err(|_| anyhow!("{}: line {line}: column {}: `{text}` is not a number", path.display(), COLUMNS[i]))
+            text.parse::<f64>().map_err(|_| {
+                anyhow!("{}: line {line}: column {}: `{text}` is not a number", path.display(), COLUMNS[i])
+            })
         };
         let row = SpeedRow { slope_deg: cell(0)?, speed_m_s: cell(1)?, speed_sd_m_s: cell(2)? };
         let slope = Slope::from_degrees(row.slope_deg)
@@ -86,11 +93,15 @@ mod tests {
 
     #[test]
     fn errors_name_the_column_and_the_line_despite_comments() {
-        let e = load("slope_deg,speed_m_s,speed_sd_m_s\n# measured 2025\n0,0.15,0.01\n10,abc,0.01\n").unwrap_err();
+        let e = load("slope_deg,speed_m_s,speed_sd_m_s\n# measured 2025\n0,0.15,0.01\n10,abc,0.01\n")
+            .unwrap_err();
         let msg = e.to_string();
         assert!(msg.ends_with("line 4: column speed_m_s: `abc` is not a number"), "{msg}");
         let e = load("slope,speed,sd\n0,0.1,0.01\n").unwrap_err().to_string();
-        assert!(e.contains("line 1") && e.contains("expected columns slope_deg,speed_m_s,speed_sd_m_s"), "{e}");
+        assert!(
+            e.contains("line 1") && e.contains("expected columns slope_deg,speed_m_s,speed_sd_m_s"),
+            "{e}"
+        );
         let ok = load("slope_deg,speed_m_s,speed_sd_m_s\n0, 0.15 ,0.01\n").unwrap();
         assert_eq!((ok[0].speed, ok[0].speed_sd), (0.15, 0.01));
     }

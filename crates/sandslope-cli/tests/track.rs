@@ -228,7 +228,10 @@ fn speeds_out_appends_calibrate_rows_and_plots() {
     assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
     fails(&[fs, "--speeds-out", ss], "--speeds-out needs --slope");
     let bad = write(dir.path(), "bad-speeds.csv", "slope,speed\n1,2\n");
-    fails(&[fs, "--slope", "5", "--speeds-out", bad.to_str().unwrap()], "bad-speeds.csv: line 2");
+    fails(
+        &[fs, "--slope", "5", "--speeds-out", bad.to_str().unwrap()],
+        "bad-speeds.csv: line 1: the header is `slope,speed`",
+    );
     assert_eq!(std::fs::read_to_string(&bad).unwrap(), "slope,speed\n1,2\n");
 }
 

@@ -72,4 +72,6 @@ def test_risk_map_matches_pointwise_risk(robot):
     for i, kn in enumerate(m["k_n"]):
         for j, ks in enumerate(m["k_s"]):
             one = sandslope.risk(robot, 20, terrain=sandslope.Terrain.constant(kn, ks), cv_n=0.1, cv_s=0.2)
-            assert m["p_fail"][i, j] == float(one["p_fail"])
+            # The map shares the critical-strength curve between cells (docs/phase-and-risk.md);
+            # the library keeps it within 1e-6 of the per-cell quadrature.
+            assert m["p_fail"][i, j] == pytest.approx(float(one["p_fail"]), abs=1e-6)

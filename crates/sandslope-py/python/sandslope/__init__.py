@@ -290,8 +290,7 @@ def risk_map(
 
     The uncertainty (coefficients of variation) and the angle of repose are the terrain's at
     ``slope_deg`` (or ``cv_n``/``cv_s``). Axes as in :func:`phase`; by default the CLI's:
-    48 log-spaced values from the terrain's k_n / 100 to x 100 and k_s / 1000 to x 100.
-    Each cell is a full quadrature (about a millisecond).
+    200 log-spaced values from the terrain's k_n / 100 to x 100 and k_s / 1000 to x 100.
 
     Returns ``p_fail`` and ``p_not_success``, each of shape ``(len(k_n_axis), len(k_s_axis))``;
     ``k_n``, ``k_s`` (the axes); ``terrain_k_n``, ``terrain_k_s`` (the terrain's medians at this
@@ -302,8 +301,8 @@ def risk_map(
     if mass_kg is not None:
         robot = robot.with_mass(float(mass_kg))
     at = terrain.at(float(slope_deg))
-    kn = _axis("k_n_axis", np.geomspace(at["k_n"] / 100, at["k_n"] * 100, 48) if k_n_axis is None else k_n_axis)
-    ks = _axis("k_s_axis", np.geomspace(at["k_s"] / 1000, at["k_s"] * 100, 48) if k_s_axis is None else k_s_axis)
+    kn = _axis("k_n_axis", np.geomspace(at["k_n"] / 100, at["k_n"] * 100, 200) if k_n_axis is None else k_n_axis)
+    ks = _axis("k_s_axis", np.geomspace(at["k_s"] / 1000, at["k_s"] * 100, 200) if k_s_axis is None else k_s_axis)
     out = _sandslope.risk_map(robot, float(slope_deg), kn, ks, terrain, cv_n=cv_n, cv_s=cv_s)
     shape = (len(out["k_s"]), len(out["k_n"]))
     for k in ("p_fail", "p_not_success"):

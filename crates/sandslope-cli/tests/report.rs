@@ -9,6 +9,9 @@ fn sandslope() -> Command {
     Command::cargo_bin("sandslope").unwrap()
 }
 
+/// The page's figure elements; fig6 holds the panels fig6a-d (anchored inside it).
+const PAGE_IDS: [&str; 8] = ["fig3a", "fig4d", "fig4h", "fig5b", "fig5c", "fig6", "risk", "calibration"];
+/// The ids of report.json, the paper's figure numbers.
 const IDS: [&str; 11] =
     ["fig3a", "fig4d", "fig4h", "fig5b", "fig5c", "fig6a", "fig6b", "fig6c", "fig6d", "risk", "calibration"];
 
@@ -25,9 +28,14 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
     let out = dir.path().join("report");
     let (html, v) = make_report(&out);
     // Every figure inline, by the paper's ids; nothing fetched at view time.
-    for id in IDS {
-        assert!(html.contains(&format!("<figure id=\"{id}\"><svg")), "figure {id} missing or not inline");
+    for id in PAGE_IDS {
+        assert!(html.contains(&format!("<figure id=\"{id}\">")), "figure {id} missing");
     }
+    for id in ["fig6a", "fig6b", "fig6c", "fig6d"] {
+        assert!(html.contains(&format!("<span id=\"{id}\"></span>")), "anchor {id} missing");
+    }
+    // Inline SVG, one per figure element.
+    assert_eq!(html.matches("<svg").count(), PAGE_IDS.len());
     for remote in ["src=\"http", "href=\"http", "<script", "@import", "url(http"] {
         assert!(!html.contains(remote), "page references {remote}");
     }

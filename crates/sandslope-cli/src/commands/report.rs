@@ -21,6 +21,8 @@ use sandslope_io::{load_anchoring_times, load_speeds, load_terrain, terrain_from
 /// The paper's force tests as its text reports them (docs/calibration.md).
 const PAPER_FORCE_TESTS: &str = include_str!("../../../../data/example-force-tests.toml");
 
+use plotters::chart::SeriesLabelPosition;
+
 use crate::args::{RobotArgs, TerrainArgs};
 use crate::figures::calibrate::{CalibrationFigure, SpeedPoint};
 use crate::figures::phase::PhaseFigure;
@@ -62,6 +64,10 @@ fn slope_grid() -> Vec<f64> {
 
 fn at(d: f64) -> Slope {
     Slope::from_degrees(d).expect("grid slopes are valid")
+}
+
+fn add(figures: &mut Vec<PageFigure>, id: &str, title: &str, caption: String, svg: String) {
+    figures.push(PageFigure { id: id.into(), title: title.into(), caption, svg, parts: vec![] });
 }
 
 /// Runs `sandslope report`.
@@ -136,26 +142,36 @@ pub fn run(args: ReportArgs) -> Result<()> {
     let predictions: Vec<_> = grid.iter().map(|&d| predict(&robot, at(d), &terrain.at(at(d)))).collect();
     let repose = terrain.spec().repose_deg;
     let mut figures = Vec::new();
-    let mut add = |id: &str, title: &str, caption: String, svg: String| {
-        figures.push(PageFigure { id: id.into(), title: title.into(), caption, svg });
-    };
 
     // fig3a: speed against slope.
     let fig = SlopeCurveFigure {
         title: "Step-averaged upslope speed".into(),
         y_label: "speed v (cm/s)".into(),
-        model: grid.iter().zip(&predictions).map(|(&d, p)| (d, p.speed.map(|v| v * 100.0))).collect(),
+        // No speed where the regime rules one out (docs/model.md §6).
+        model: grid
+            .iter()
+            .zip(&predictions)
+            .map(|(&d, p)| (d, p.speed.filter(|_| !p.regime.is_failure()).map(|v| v * 100.0)))
+            .collect(),
         model_label: "model on the terrain".into(),
         observed: speeds.iter().map(|o| (o.slope.degrees(), o.speed * 100.0, o.speed_sd * 100.0)).collect(),
         observed_label: "observed (mean ± SD)".into(),
         reference: None,
         repose,
         from_zero: true,
+        legend: SeriesLabelPosition::LowerLeft,
     };
-    add("fig3a", "Speed against slope", "The model's step-averaged speed v = s/(T/2) on the terrain (dashed) and the observed speeds. Where the line stops, the regime rules a speed out (slippage or sinkage, docs/model.md §6).".into(), to_svg(&fig)?);
+    add(&mut figures, "fig3a", "Speed against slope", "The model's step-averaged speed v = s/(T/2) on the terrain (dashed) and the observed speeds. Where the line stops, the regime rules a speed out (slippage or sinkage, docs/model.md §6).".into(), to_svg(&fig)?);
 
     // fig4d, fig4h: k_n and k_s against slope with error bars.
     let table = forces.as_ref().unwrap_or(&terrain);
+    // Plate values are drawn on the leg's scale: times the fitted plate_scale.
+    let plate_scale = match (&forces, &calibration) {
+        (Some(_), Some(c)) => {
+            c.parameters.iter().find(|p| p.name == "plate_scale").map_or(1.0, |p| p.estimate.value)
+        }
+        _ => 1.0,
+    };
     let label =
         if forces.is_some() { "force tests (mean ± SD)" } else { "terrain table (± SD where given)" };
     for (id, title, unit_scale, pick) in [
@@ -180,20 +196,26 @@ pub fn run(args: ReportArgs) -> Result<()> {
                 .iter()
                 .map(|p| {
                     let (v, sd) = value(p);
-                    (p.slope_deg, v * unit_scale, sd.unwrap_or(0.0) * unit_scale)
+                    let c = if pick == 1 { plate_scale } else { 1.0 };
+                    (p.slope_deg, c * v * unit_scale, c * sd.unwrap_or(0.0) * unit_scale)
                 })
                 .collect(),
-            observed_label: label.into(),
+            observed_label: if pick == 1 && plate_scale != 1.0 {
+                format!("{label} × plate_scale {plate_scale:.1}")
+            } else {
+                label.into()
+            },
             reference: None,
             repose,
             from_zero: true,
+            legend: if pick == 0 { SeriesLabelPosition::LowerRight } else { SeriesLabelPosition::LowerLeft },
         };
         let caption = if pick == 0 {
             "The paper: k_n \"remains nearly constant\" with slope (Fig. 4d).".to_string()
         } else {
             "The paper: k_s at 20° is about 40% of level (Fig. 4h). With force tests given, the model's leg k_s is plate_scale times the plate's (docs/calibration.md).".to_string()
         };
-        add(id, title, caption, to_svg(&fig)?);
+        add(&mut figures, id, title, caption, to_svg(&fig)?);
     }
 
     // fig5b: anchoring time; fig5c: net step.
@@ -207,8 +229,9 @@ pub fn run(args: ReportArgs) -> Result<()> {
         reference: None,
         repose,
         from_zero: true,
+        legend: SeriesLabelPosition::UpperLeft,
     };
-    add("fig5b", "Anchoring time against slope", "The time after touchdown at which the leg reaches the shear-equilibrium depth d_s (docs/model.md §4). The paper plots measured t1 but prints no values; give --t1 to overlay yours.".into(), to_svg(&fig)?);
+    add(&mut figures, "fig5b", "Anchoring time against slope", "The time after touchdown at which the leg reaches the shear-equilibrium depth d_s (docs/model.md §4). The paper plots measured t1 but prints no values; give --t1 to overlay yours.".into(), to_svg(&fig)?);
     let fig = SlopeCurveFigure {
         title: "Net step length".into(),
         y_label: "net step s (mm)".into(),
@@ -225,32 +248,44 @@ pub fn run(args: ReportArgs) -> Result<()> {
         reference: Some((robot.min_step() * 1e3, "s_min = R: success above, metastable below".into())),
         repose,
         from_zero: true,
+        legend: SeriesLabelPosition::LowerLeft,
     };
     add(
+        &mut figures,
         "fig5c",
         "Net step against slope",
         "s = s2 - s1 (docs/model.md §5); the observed points are the observed speeds times T/2.".into(),
         to_svg(&fig)?,
     );
 
-    // fig6a-d: the four phase diagrams.
+    // fig6a-d: the four phase diagrams, in the paper's order (a, b: 0.35 kg on level sand and
+    // at 24 deg; c, d: 1 kg), drawn as one 2 x 2 figure so the panel letters match the paper's.
     let k_n_axis = Axis::new("k_n", 1e4, 1e8, 120, AxisScale::Log).map_err(|e| anyhow!("{e}"))?;
     let k_s_axis = Axis::new("k_s", 1e4, 1e9, 120, AxisScale::Log).map_err(|e| anyhow!("{e}"))?;
+    let mut panels = Vec::new();
+    let mut parts = Vec::new();
+    let mut regimes = Vec::new();
     for (id, mass, slope_deg) in
         [("fig6a", 0.35, 0.0), ("fig6b", 0.35, 24.0), ("fig6c", 1.0, 0.0), ("fig6d", 1.0, 24.0)]
     {
         let r = robot.with_mass(mass).map_err(|e| anyhow!("{e}"))?;
         let panel = PhasePanel::compute(&r, slope_deg, &terrain, &k_n_axis, &k_s_axis, &|| {})
             .map_err(|e| anyhow!("{e}"))?;
-        let title = format!("Phase diagram, {mass} kg at {slope_deg}°");
-        let caption = format!(
-            "Regime over (k_n, k_s): blue sinkage, red slippage, yellow metastable, green success; the black line is s = R; the star is the terrain at {slope_deg}° ({}).",
-            panel.terrain_regime
-        );
-        let panels = [panel];
-        let fig = PhaseFigure::new(&panels, 1, terrain.name().unwrap_or("terrain").to_string());
-        add(id, &title, caption, to_svg(&fig)?);
+        regimes.push(format!("({}) {}", &id[4..], panel.terrain_regime));
+        parts.push((id.to_string(), format!("Phase diagram, {mass} kg at {slope_deg} deg")));
+        panels.push(panel);
     }
+    let fig = PhaseFigure::new(&panels, 2, terrain.name().unwrap_or("terrain").to_string());
+    figures.push(PageFigure {
+        id: "fig6".into(),
+        title: "Phase diagrams: 0.35 kg and 1 kg, on level sand and at 24°".into(),
+        caption: format!(
+            "Regime over (k_n, k_s): blue sinkage, red slippage, yellow metastable, green success; the black line is s = R; the star is the terrain at that slope: {}. The paper (Fig. 6d) calls the 1 kg robot at 24° metastable.",
+            regimes.join(", ")
+        ),
+        svg: to_svg(&fig)?,
+        parts,
+    });
 
     // p_fail against slope with the safe-slope limit.
     let uncertain = UncertainTerrain::new(terrain.clone(), None, None).map_err(|e| anyhow!("{e}"))?;
@@ -266,7 +301,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
         title: format!("Failure risk of the {} kg robot", robot.mass()),
     };
     let note = curve.defaults_used.note().map(|n| format!(" {n}.")).unwrap_or_default();
-    add(
+    add(&mut figures,
         "risk",
         "Failure probability against slope",
         format!(
@@ -306,7 +341,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
             c.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),
             c.error_floor_m_s * 100.0
         );
-        add("calibration", "Joint calibration: observed against fitted speeds, and pulls", "The terrain's k_s shape scaled by a fitted plate_scale, with a fitted model-error floor (docs/calibration.md). Pulls beyond ±2 are red.".into(), to_svg(&CalibrationFigure { points: &points, curve: &curve, subtitle: &subtitle })?);
+        add(&mut figures, "calibration", "Joint calibration: observed against fitted speeds, and pulls", "The terrain's k_s shape scaled by a fitted plate_scale, with a fitted model-error floor (docs/calibration.md). Pulls beyond ±2 are red.".into(), to_svg(&CalibrationFigure { points: &points, curve: &curve, subtitle: &subtitle })?);
     }
 
     let paper_rows = compare_with_paper(&robot, &terrain);
@@ -322,7 +357,16 @@ pub fn run(args: ReportArgs) -> Result<()> {
         .collect();
     let html = page(&inputs, &figures, &paper_rows, calibration.as_ref(), &disagreements);
     let json = ReportJson {
-        figures: figures.iter().map(|f| FigureRecord { id: &f.id, title: &f.title }).collect(),
+        figures: figures
+            .iter()
+            .flat_map(|f| {
+                if f.parts.is_empty() {
+                    vec![FigureRecord { id: &f.id, title: &f.title }]
+                } else {
+                    f.parts.iter().map(|(id, title)| FigureRecord { id, title }).collect()
+                }
+            })
+            .collect(),
         speeds: &speed_records,
         calibration: calibration.as_ref(),
         paper_vs_model: &paper_rows,

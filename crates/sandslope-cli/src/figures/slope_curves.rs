@@ -29,6 +29,8 @@ pub struct SlopeCurveFigure {
     pub repose: Option<f64>,
     /// Start the y axis at zero.
     pub from_zero: bool,
+    /// Where the legend goes (where the curves are not).
+    pub legend: SeriesLabelPosition,
 }
 
 impl Figure for SlopeCurveFigure {
@@ -133,7 +135,7 @@ impl Figure for SlopeCurveFigure {
             .label_font(font(14.0))
             .border_style(BLACK)
             .background_style(WHITE.mix(0.85))
-            .position(SeriesLabelPosition::UpperRight)
+            .position(self.legend.clone())
             .draw()
             .map_err(plot_err)?;
         Ok(())

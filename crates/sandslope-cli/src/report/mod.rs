@@ -17,6 +17,8 @@ pub struct PageFigure {
     pub caption: String,
     /// The figure as an SVG document.
     pub svg: String,
+    /// Panels with their own paper ids and titles (`fig6a`...), when one figure holds several.
+    pub parts: Vec<(String, String)>,
 }
 
 /// `report.json`'s figure entry.
@@ -165,8 +167,10 @@ pub fn page(
 
     h.push_str("<h2 id=\"figures\">Figures</h2>\n");
     for f in figures {
+        let anchors: String =
+            f.parts.iter().map(|(id, _)| format!("<span id=\"{}\"></span>", escape(id))).collect();
         h.push_str(&format!(
-            "<figure id=\"{}\">{}<figcaption><b>{} · {}</b>. {}</figcaption></figure>\n",
+            "<figure id=\"{}\">{anchors}{}<figcaption><b>{} · {}</b>. {}</figcaption></figure>\n",
             escape(&f.id),
             inline_svg(&f.svg),
             escape(&f.id),

@@ -398,6 +398,19 @@ impl PhaseMap {
         self.step_contour(self.min_step)
     }
 
+    /// [`PhaseMap::robust_contour`] traced over the sub-grid of cells `xi x yj` (ascending
+    /// indices along k_n and k_s), as a figure that draws those cells needs it.
+    pub fn robust_contour_on(&self, xi: &[usize], yj: &[usize]) -> Vec<ContourSegment> {
+        if self.beyond_repose {
+            return Vec::new();
+        }
+        let field = |i: usize, j: usize| match self.step(i, j) {
+            Some(s) if !self.sunk[i] => s,
+            _ => f64::NAN,
+        };
+        contour_on_cells(&self.k_n_axis, &self.k_s_axis, xi, yj, field, self.min_step)
+    }
+
     /// The contour `s = level` (m) of the net step, by marching squares (see
     /// [`PhaseMap::robust_contour`]).
     pub fn step_contour(&self, level: f64) -> Vec<ContourSegment> {
@@ -501,15 +514,34 @@ fn pack_codes(codes: &[u8], packed: &mut [u8]) {
 pub fn contour_segments(x_axis: &Axis, y_axis: &Axis, field: &[f64], level: f64) -> Vec<ContourSegment> {
     let (nx, ny) = (x_axis.len(), y_axis.len());
     assert_eq!(field.len(), nx * ny, "field must have one value per grid cell");
-    let xc: Vec<f64> = x_axis.values().iter().map(|&v| x_axis.coordinate(v)).collect();
-    let yc: Vec<f64> = y_axis.values().iter().map(|&v| y_axis.coordinate(v)).collect();
-    let at = |i: usize, j: usize| field[j * nx + i] - level;
+    let xi: Vec<usize> = (0..nx).collect();
+    let yj: Vec<usize> = (0..ny).collect();
+    contour_on_cells(x_axis, y_axis, &xi, &yj, |i, j| field[j * nx + i], level)
+}
+
+/// [`contour_segments`] over the sub-grid of the cells `xi x yj` (ascending indices into the
+/// axes), reading the field through `field(i, j)`: a figure traces its contour over the cells
+/// it draws, so tracing costs the same for 400 x 400 and 4096 x 4096 maps.
+pub fn contour_on_cells(
+    x_axis: &Axis,
+    y_axis: &Axis,
+    xi: &[usize],
+    yj: &[usize],
+    field: impl Fn(usize, usize) -> f64 + Sync,
+    level: f64,
+) -> Vec<ContourSegment> {
+    if xi.len() < 2 || yj.len() < 2 {
+        return Vec::new();
+    }
+    let xc: Vec<f64> = xi.iter().map(|&i| x_axis.coordinate(x_axis.value(i))).collect();
+    let yc: Vec<f64> = yj.iter().map(|&j| y_axis.coordinate(y_axis.value(j))).collect();
+    let at = |a: usize, b: usize| field(xi[a], yj[b]) - level;
     let point = |x: f64, y: f64| (x_axis.from_coordinate(x), y_axis.from_coordinate(y));
-    (0..ny - 1)
+    (0..yj.len() - 1)
         .into_par_iter()
         .flat_map_iter(|j| {
             let mut out = Vec::new();
-            for i in 0..nx - 1 {
+            for i in 0..xi.len() - 1 {
                 // Corners counter-clockwise from bottom-left: (i,j), (i+1,j), (i+1,j+1), (i,j+1).
                 let v = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
                 if v.iter().any(|x| x.is_nan()) {
@@ -695,6 +727,39 @@ mod tests {
             }
             assert!(checked > 50, "{d} deg: only {checked} columns checked");
         }
+    }
+
+    /// Traced over every cell, the figure's sub-grid contour is the full contour; traced over
+    /// every 4th cell, each of its points still lies on the critical strength (a coarser grid
+    /// only interpolates over longer steps).
+    #[test]
+    fn contour_on_a_subgrid_follows_the_full_contour() {
+        let r = paper_robot();
+        let s = deg(10.0);
+        let kn = log_axis(3e4, 3e7, 121);
+        let ks = log_axis(1e3, 1e9, 161);
+        let m = map(&r, s, &kn, &ks);
+        let all_x: Vec<usize> = (0..kn.len()).collect();
+        let all_y: Vec<usize> = (0..ks.len()).collect();
+        assert_eq!(m.robust_contour_on(&all_x, &all_y), m.robust_contour());
+        let sub_x: Vec<usize> = (0..kn.len()).step_by(4).collect();
+        let sub_y: Vec<usize> = (0..ks.len()).step_by(4).collect();
+        let coarse = m.robust_contour_on(&sub_x, &sub_y);
+        assert!(!coarse.is_empty());
+        let columns: Vec<f64> = sub_x.iter().map(|&i| kn.value(i)).collect();
+        let mut checked = 0;
+        for (k_n, k_s) in coarse.iter().flat_map(|&(a, b)| [a, b]) {
+            // Points on a drawn column are interpolated in k_s only.
+            if !columns.iter().any(|c| (k_n / c - 1.0).abs() < 1e-9) {
+                continue;
+            }
+            let k = critical_shear_strength(&r, s, k_n, false, StepTarget::Robust).unwrap();
+            // Linear interpolation errs as the square of the step: 4x the step of
+            // `contour_matches_the_root_finder` (bound 5e-3) gives 16 x 5e-3 = 0.08.
+            assert!((k_s.ln() - k.ln()).abs() < 0.08, "k_n {k_n}: {k_s} vs {k}");
+            checked += 1;
+        }
+        assert!(checked > 10, "only {checked} points checked");
     }
 
     #[test]

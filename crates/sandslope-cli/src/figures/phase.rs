@@ -241,7 +241,7 @@ where
         }
     }
     chart.draw_series(rects).map_err(e)?;
-    let contour = map.robust_contour();
+    let contour = map.robust_contour_on(&xc, &yc);
     chart
         .draw_series(contour.iter().map(|&(a, b)| PathElement::new(vec![a, b], BLACK.stroke_width(2))))
         .map_err(e)?;

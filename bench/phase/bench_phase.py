@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Times `sandslope phase` against a straightforward NumPy implementation of the same
-equations (MODEL.md sections 3 to 6) on a 4096 x 4096 (k_n, k_s) grid, in one run, and
+equations (docs/model.md §3-§6) on a 4096 x 4096 (k_n, k_s) grid, in one run, and
 prints the ratio. The issue requires sandslope to be at least 50x faster.
 
 Usage (from anywhere):  python3 bench/phase/bench_phase.py [--n 4096] [--slope 20] [--repeat 3]

@@ -170,7 +170,7 @@ fn terrain_file_loads_in_predict() {
     assert_eq!(points.len(), 6);
     assert!(points[0].get("k_n_sd").is_some() && points[0].get("k_s_sd").is_some());
     assert_eq!(table["repose_deg"].as_float(), Some(25.0));
-    // predict reads it and interpolates it by MODEL.md section 7: at 12 deg, 40% of the way
+    // predict reads it and interpolates it by docs/model.md §7: at 12 deg, 40% of the way
     // from the 10 to the 15 deg point.
     let pred =
         sandslope().args(["predict", "--slope", "12", "--json", "--terrain"]).arg(&terrain).output().unwrap();

@@ -85,7 +85,7 @@ fn phase_json_summarises_each_panel() {
     let total: u64 =
         ["sinkage", "slippage", "metastable", "success"].iter().map(|k| c[k].as_u64().unwrap()).sum();
     assert_eq!(total, 900);
-    // The preset terrain (k_n 7e5, k_s 2e6) on level sand: success (MODEL.md worked example,
+    // The preset terrain (k_n 7e5, k_s 2e6) on level sand: success (docs/model.md §3-§6 by hand,
     // s = 75.7 mm >= 40 mm).
     assert_eq!(panels[0]["terrain"]["regime"], "success");
     // 30 deg is above the preset's angle of repose (25 deg): every non-sunk cell slips.

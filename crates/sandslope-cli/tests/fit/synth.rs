@@ -2,7 +2,7 @@
 //! the shipped example dataset `examples/measurements/` (regenerate it with
 //! `cargo test -p sandslope-cli --test fit -- --ignored regenerate_example_dataset`).
 //!
-//! The physics is MODEL.md section 10 with the paper's protocol (disk radius 1 cm, plate 3 cm
+//! The physics is docs/model.md §10 with the paper's protocol (disk radius 1 cm, plate 3 cm
 //! wide inserted 2 cm, 5 cm/s), plus what real recordings have:
 //! - penetration: the disk starts 2 mm above the surface (force = in-air offset), a 3 mm soft
 //!   surface layer where the stiffness ramps up, the linear part `k_n A`, the bed bottom at

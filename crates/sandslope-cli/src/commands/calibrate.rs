@@ -258,19 +258,7 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
                 (d, predict(&fitted_robot, s, &ground).speed)
             })
             .collect();
-        let points: Vec<SpeedPoint> = cal
-            .pulls
-            .iter()
-            .filter(|p| p.kind == sandslope::calibrate::joint::ObservationKind::Speed)
-            .map(|p| SpeedPoint {
-                slope_deg: p.slope_deg,
-                observed: p.observed,
-                sd: p.sd,
-                sd_total: p.sd_total,
-                model: p.model,
-                pull: p.pull,
-            })
-            .collect();
+        let points: Vec<SpeedPoint> = SpeedPoint::from_pulls(&cal.pulls);
         let title = format!(
             "chi^2/dof = {}, k_s(20)/k_s(0) = {:.2}",
             cal.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),

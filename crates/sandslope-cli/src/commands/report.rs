@@ -8,7 +8,6 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
 
-use sandslope::calibrate::joint::ObservationKind;
 use sandslope::paper::{self, compare_with_paper};
 use sandslope::risk::{risk_curve, safe_slope_limit};
 use sandslope::{
@@ -313,19 +312,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
 
     // The calibration pulls.
     if let Some(c) = &calibration {
-        let points: Vec<SpeedPoint> = c
-            .pulls
-            .iter()
-            .filter(|p| p.kind == ObservationKind::Speed)
-            .map(|p| SpeedPoint {
-                slope_deg: p.slope_deg,
-                observed: p.observed,
-                sd: p.sd,
-                sd_total: p.sd_total,
-                model: p.model,
-                pull: p.pull,
-            })
-            .collect();
+        let points: Vec<SpeedPoint> = SpeedPoint::from_pulls(&c.pulls);
         let fitted = Robot::new(c.robot.clone()).map_err(|e| anyhow!("{e}"))?;
         let fitted_terrain = Terrain::new(c.terrain.clone()).map_err(|e| anyhow!("{e}"))?;
         let curve: Vec<(f64, Option<f64>)> = grid

@@ -5,6 +5,8 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use sandslope::calibrate::joint::{ObservationKind, Pull};
+
 use super::{font, Figure};
 use crate::error::plot_err;
 
@@ -23,6 +25,25 @@ pub struct SpeedPoint {
     pub model: f64,
     /// `(observed - model) / sd_total`.
     pub pull: f64,
+}
+
+impl SpeedPoint {
+    /// The speed observations among a joint calibration's pulls (anchoring times and force
+    /// tests are not drawn in this figure).
+    pub fn from_pulls(pulls: &[Pull]) -> Vec<SpeedPoint> {
+        pulls
+            .iter()
+            .filter(|p| p.kind == ObservationKind::Speed)
+            .map(|p| SpeedPoint {
+                slope_deg: p.slope_deg,
+                observed: p.observed,
+                sd: p.sd,
+                sd_total: p.sd_total,
+                model: p.model,
+                pull: p.pull,
+            })
+            .collect()
+    }
 }
 
 /// Observed against fitted speeds (top) and pulls (bottom).

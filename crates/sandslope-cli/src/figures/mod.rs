@@ -140,9 +140,79 @@ pub fn range(values: impl IntoIterator<Item = f64>, fallback: (f64, f64)) -> (f6
     (lo - pad, hi + pad)
 }
 
+/// Joins marching-squares segments that share an end into polylines, so a contour is stroked
+/// as continuous paths: stroked one by one, segments shorter than a pixel leave gaps in a wide
+/// line. Ends are matched at 8 significant digits (two squares compute their shared edge's
+/// crossing in opposite directions, so the floats can differ in the last bits).
+pub fn polylines(segments: &[sandslope::ContourSegment]) -> Vec<Vec<(f64, f64)>> {
+    use std::collections::HashMap;
+    type Key = (String, String);
+    let key = |p: (f64, f64)| -> Key { (format!("{:.7e}", p.0), format!("{:.7e}", p.1)) };
+    // Every segment end, by key: (segment, which end).
+    let mut ends: HashMap<Key, Vec<(usize, bool)>> = HashMap::new();
+    for (k, &(a, b)) in segments.iter().enumerate() {
+        ends.entry(key(a)).or_default().push((k, false));
+        ends.entry(key(b)).or_default().push((k, true));
+    }
+    let mut used = vec![false; segments.len()];
+    // The unused segment touching `p` and its other end, marking it used.
+    let mut next = |p: (f64, f64), used: &mut Vec<bool>| -> Option<(f64, f64)> {
+        let list = ends.get_mut(&key(p))?;
+        let pos = list.iter().position(|&(k, _)| !used[k])?;
+        let (k, at_b) = list.swap_remove(pos);
+        used[k] = true;
+        let (a, b) = segments[k];
+        Some(if at_b { a } else { b })
+    };
+    let mut lines = Vec::new();
+    for k in 0..segments.len() {
+        if used[k] {
+            continue;
+        }
+        used[k] = true;
+        let (a, b) = segments[k];
+        let mut forward = vec![a, b];
+        while let Some(p) = next(*forward.last().expect("non-empty"), &mut used) {
+            forward.push(p);
+        }
+        let mut backward = Vec::new();
+        let mut at = a;
+        while let Some(p) = next(at, &mut used) {
+            backward.push(p);
+            at = p;
+        }
+        backward.reverse();
+        backward.extend(forward);
+        lines.push(backward);
+    }
+    lines
+}
+
 #[cfg(test)]
 mod tests {
-    use super::tick;
+    use super::{polylines, tick};
+
+    #[test]
+    fn segments_sharing_ends_become_one_polyline() {
+        // A square's four sides, out of order and in mixed directions, with the last bits of
+        // one shared corner perturbed: one closed polyline of 5 points.
+        let eps = 1e-15;
+        let segs = vec![
+            ((1.0, 1.0), (0.0, 1.0)),
+            ((0.0, 0.0), (1.0, 0.0)),
+            ((0.0, 1.0 + eps), (0.0, 0.0)),
+            ((1.0, 1.0), (1.0, 0.0)),
+        ];
+        let lines = polylines(&segs);
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        assert_eq!(lines[0].len(), 5);
+        assert_eq!(lines[0].first(), lines[0].last());
+        // Two separate segments stay two lines; no segment is lost or repeated.
+        let apart = polylines(&[((0.0, 0.0), (1.0, 0.0)), ((5.0, 5.0), (6.0, 5.0))]);
+        assert_eq!(apart.len(), 2);
+        assert!(apart.iter().all(|l| l.len() == 2));
+        assert!(polylines(&[]).is_empty());
+    }
 
     #[test]
     fn ticks_drop_a_trailing_point_zero() {

@@ -243,7 +243,9 @@ where
     chart.draw_series(rects).map_err(e)?;
     let contour = map.robust_contour_on(&xc, &yc);
     chart
-        .draw_series(contour.iter().map(|&(a, b)| PathElement::new(vec![a, b], BLACK.stroke_width(2))))
+        .draw_series(
+            super::polylines(&contour).into_iter().map(|line| PathElement::new(line, BLACK.stroke_width(2))),
+        )
         .map_err(e)?;
     let (k_n, k_s) = (panel.terrain_k_n, panel.terrain_k_s);
     if within(xe, ye, (k_n, k_s)) {

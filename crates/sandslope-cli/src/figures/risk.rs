@@ -165,15 +165,12 @@ impl Figure for MapFigure {
                 })
             }))
             .map_err(e)?;
+        let contour = super::polylines(&self.contour);
         chart
-            .draw_series(
-                self.contour.iter().map(|&(a, b)| PathElement::new(vec![a, b], BLACK.stroke_width(5))),
-            )
+            .draw_series(contour.iter().map(|line| PathElement::new(line.clone(), BLACK.stroke_width(5))))
             .map_err(e)?;
         chart
-            .draw_series(
-                self.contour.iter().map(|&(a, b)| PathElement::new(vec![a, b], WHITE.stroke_width(3))),
-            )
+            .draw_series(contour.iter().map(|line| PathElement::new(line.clone(), WHITE.stroke_width(3))))
             .map_err(e)?
             .label(format!("p_fail = {} (--max-risk)", self.max_risk))
             .legend(|(x, y)| {

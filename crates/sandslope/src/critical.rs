@@ -90,23 +90,7 @@ pub fn critical_shear_strength(
     beyond_repose: bool,
     target: StepTarget,
 ) -> Result<f64, NoShearSuffices> {
-    let d_n = normal_equilibrium_depth(robot, slope, k_n);
-    let d_max = robot.max_depth();
-    if d_n >= d_max {
-        return Err(NoShearSuffices::Sinkage { d_n, d_max });
-    }
-    if beyond_repose {
-        return Err(NoShearSuffices::AtOrAboveRepose);
-    }
-    let s_star = level_step_length(robot, d_n);
-    let s_target = match target {
-        StepTarget::Progress => 0.0,
-        StepTarget::Robust => robot.min_step(),
-    };
-    // As k_s -> infinity, d_s -> 0, t1 -> 0 and s -> s*: the supremum of the step.
-    if s_star <= s_target {
-        return Err(NoShearSuffices::LevelStepTooShort { level_step: s_star, target: s_target });
-    }
+    let (s_star, s_target) = reachable_step(robot, slope, k_n, beyond_repose, target)?;
     let k_anchor = anchoring_threshold_k_s(robot, slope);
     let f = |ln_k: f64| step_at(robot, slope, s_star, ln_k.exp()) - s_target;
     let lo = k_anchor.ln();
@@ -159,16 +143,17 @@ pub(crate) fn ln_critical_closed_form(
     (k.ln(), capped)
 }
 
-/// The same as [`critical_shear_strength`], in closed form instead of by root finding
-/// (docs/model.md §13): about a hundred times faster, and equal to it within the root
-/// finder's tolerance (relative 1e-9 in the tests). Risk maps evaluate it on fine grids.
-pub fn critical_shear_strength_closed_form(
+/// The level step `s*` at `k_n` and the step `target` asks for, or why no k_s reaches it:
+/// the legs sink, the slope is at or beyond repose, or `s*` (the step's supremum as
+/// k_s -> infinity, where d_s -> 0 and t1 -> 0) is not above the target. Shared by the root
+/// finder and the closed form, so both refuse the same cases.
+fn reachable_step(
     robot: &Robot,
     slope: Slope,
     k_n: f64,
     beyond_repose: bool,
     target: StepTarget,
-) -> Result<f64, NoShearSuffices> {
+) -> Result<(f64, f64), NoShearSuffices> {
     let d_n = normal_equilibrium_depth(robot, slope, k_n);
     let d_max = robot.max_depth();
     if d_n >= d_max {
@@ -185,6 +170,20 @@ pub fn critical_shear_strength_closed_form(
     if s_star <= s_target {
         return Err(NoShearSuffices::LevelStepTooShort { level_step: s_star, target: s_target });
     }
+    Ok((s_star, s_target))
+}
+
+/// The same as [`critical_shear_strength`], in closed form instead of by root finding
+/// (docs/model.md §13): about a hundred times faster, and equal to it within the root
+/// finder's tolerance (relative 1e-9 in the tests). Risk maps evaluate it on fine grids.
+pub fn critical_shear_strength_closed_form(
+    robot: &Robot,
+    slope: Slope,
+    k_n: f64,
+    beyond_repose: bool,
+    target: StepTarget,
+) -> Result<f64, NoShearSuffices> {
+    let (s_star, s_target) = reachable_step(robot, slope, k_n, beyond_repose, target)?;
     let (ln_k, _) = ln_critical_closed_form(robot, slope, s_star, s_target);
     Ok(ln_k.exp().max(anchoring_threshold_k_s(robot, slope)))
 }

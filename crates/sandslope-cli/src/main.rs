@@ -7,6 +7,7 @@ mod args;
 mod commands;
 mod error;
 mod figures;
+mod mocap_input;
 mod output;
 mod progress;
 mod report;

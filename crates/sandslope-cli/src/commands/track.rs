@@ -10,16 +10,15 @@ use clap::Args;
 use serde::Serialize;
 
 use sandslope::gait::{
-    track, GaitOptions, Recording, RecordingSummary, TouchdownSource, TrackResult, Upslope,
-    DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP,
+    GaitOptions, RecordingSummary, TouchdownSource, TrackResult, Upslope, DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP,
 };
 use sandslope::{Scenario, Slope};
 
 use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
+use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions, Tracked};
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
-use crate::progress::progress_bar;
-use sandslope_io::mocap::{self, Capture, MocapFormat};
-use sandslope_io::{load_speeds, read_text, SpeedRow};
+use sandslope_io::mocap::{Capture, MocapFormat};
+use sandslope_io::{load_speeds, SpeedRow};
 
 /// Arguments of `sandslope track`.
 #[derive(Debug, Args)]
@@ -35,7 +34,12 @@ pub struct TrackArgs {
     pub body: Option<String>,
     /// Upslope direction in the capture frame: +x, -x, +y, -y, +z, -z or a vector such as
     /// `0.91,0,0.41`; estimated as the principal direction of travel when omitted.
-    #[arg(long, value_name = "AXIS|X,Y,Z", value_parser = parse_upslope, allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "AXIS|X,Y,Z",
+        value_parser = |s: &str| parse_upslope(s, "--upslope"),
+        allow_hyphen_values = true
+    )]
     pub upslope: Option<Upslope>,
     /// Longest occlusion filled by linear interpolation, frames; longer gaps split the
     /// recording into segments analysed separately.
@@ -69,76 +73,6 @@ pub struct TrackArgs {
     pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub format_args: FormatArgs,
-}
-
-/// Parses `--upslope`.
-fn parse_mocap_format(s: &str) -> Result<MocapFormat, String> {
-    s.parse()
-}
-
-fn parse_upslope(s: &str) -> Result<Upslope, String> {
-    let axis = |i: usize, sign: f64| {
-        let mut v = [0.0; 3];
-        v[i] = sign;
-        v
-    };
-    let v = match s.trim().to_ascii_lowercase().as_str() {
-        "+x" | "x" => axis(0, 1.0),
-        "-x" => axis(0, -1.0),
-        "+y" | "y" => axis(1, 1.0),
-        "-y" => axis(1, -1.0),
-        "+z" | "z" => axis(2, 1.0),
-        "-z" => axis(2, -1.0),
-        other => {
-            let parts: Vec<&str> = other.split(',').map(str::trim).collect();
-            let nums: Option<Vec<f64>> = parts.iter().map(|p| p.parse::<f64>().ok()).collect();
-            match nums.as_deref() {
-                Some([x, y, z]) => [*x, *y, *z],
-                _ => return Err(format!("`{s}` must be +x, -x, +y, -y, +z, -z or three numbers `x,y,z`")),
-            }
-        }
-    };
-    Upslope::new(v).map_err(|e| e.renamed("--upslope").to_string())
-}
-
-/// Expands the file arguments: existing paths as they are, anything else as a glob.
-fn expand(patterns: &[String]) -> Result<Vec<PathBuf>> {
-    let mut out = Vec::new();
-    for p in patterns {
-        if Path::new(p).exists() {
-            out.push(PathBuf::from(p));
-            continue;
-        }
-        let matches = glob::glob(p).map_err(|e| anyhow!("`{p}` is not a valid glob pattern: {e}"))?;
-        let mut found: Vec<PathBuf> = matches.filter_map(|m| m.ok()).filter(|m| m.is_file()).collect();
-        if found.is_empty() {
-            bail!("{p}: no such file (and no file matches it as a glob pattern)");
-        }
-        found.sort();
-        out.append(&mut found);
-    }
-    Ok(out)
-}
-
-/// Reads a touchdowns file: one time in seconds per line; blank lines and `#` comments skipped.
-fn load_touchdowns(path: &Path) -> Result<Vec<f64>> {
-    let text = read_text(path)?;
-    let mut times = Vec::new();
-    for (i, raw) in text.lines().enumerate() {
-        let line = raw.split('#').next().unwrap_or("").trim();
-        if line.is_empty() {
-            continue;
-        }
-        let t = line.parse::<f64>().ok().filter(|t| t.is_finite()).ok_or_else(|| {
-            anyhow!("{}: line {}: `{line}` is not a time in seconds", path.display(), i + 1)
-        })?;
-        times.push(t);
-    }
-    if times.is_empty() {
-        bail!("{}: no touchdown times (expected one time in seconds per line)", path.display());
-    }
-    times.sort_by(f64::total_cmp);
-    Ok(times)
 }
 
 /// One step as printed by `--csv`: the library's row with its file instead of its index.
@@ -250,51 +184,12 @@ pub fn run(args: TrackArgs) -> Result<()> {
             files.len()
         );
     }
-    // Large exports take a while to parse: a bar on a terminal, nothing when piped.
-    let bar = progress_bar(files.len() as u64, files.len() < 2, "reading recordings");
-    let captures: Vec<Capture> = files
-        .iter()
-        .map(|f| {
-            let c = mocap::read(f, args.format, args.body.as_deref());
-            bar.inc(1);
-            c
-        })
-        .collect::<Result<_>>()?;
-    bar.finish_and_clear();
-    let touchdowns: Vec<Vec<f64>> =
-        args.touchdowns.iter().map(|p| load_touchdowns(p)).collect::<Result<_>>()?;
-    let recordings: Vec<Recording> = captures
-        .iter()
-        .enumerate()
-        .map(|(i, c)| Recording {
-            positions: &c.positions,
-            frame_rate_hz: c.frame_rate_hz,
-            start_time_s: c.start_time_s,
-            touchdowns_s: touchdowns.get(i).map(|t| t.as_slice()),
-        })
-        .collect();
     let slope_arg =
         slope.map(|d| Slope::from_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--slope")))).transpose()?;
-    let result = track(&recordings, &options, slope_arg).map_err(|e| match e {
-        sandslope::GaitError::Param { index, source } => {
-            let source = if source.key == "cutoff_hz" { source.renamed("--cutoff") } else { source };
-            anyhow!(
-                "{}: {source} (at its frame rate {} Hz)",
-                captures[index].path.display(),
-                captures[index].frame_rate_hz
-            )
-        }
-        other => anyhow!("{other}"),
-    })?;
-    let names: Vec<String> = captures.iter().map(|c| c.path.display().to_string()).collect();
-    for i in result.recordings_without_steps() {
-        eprintln!(
-            "warning: {}: no complete step (T/2 = {} s without a gap longer than {} frames); not used",
-            names[i],
-            options.step_duration(),
-            options.max_gap()
-        );
-    }
+    let read =
+        CaptureOptions { format: args.format, body: args.body.as_deref(), cutoff_flag: Some("--cutoff") };
+    let Tracked { captures, names, result } =
+        track_files(&files, read, &args.touchdowns, &options, slope_arg)?;
 
     let mut campaign = None;
     if let (Some(path), Some(slope_deg)) = (&args.speeds_out, slope) {

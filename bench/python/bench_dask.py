@@ -2,22 +2,29 @@
 """sandslope.dask.risk_raster on a large DEM: wall time and peak memory per worker.
 
 Usage (inside an environment with `sandslope[dask]`, e.g. after bash scripts/test.sh:
-`.venv/bin/python bench/python/bench_dask.py [--n 8192] [--chunk 1024] [--workers 2]`).
+`.venv/bin/python bench/python/bench_dask.py [--source npy|tiff|zarr|dask] [--n 8192] [--chunk 1024]
+[--workers 2] [--dir DIR]`).
 
-The DEM (a synthetic dune field on 0.5 m cells, n x n) is itself lazy: each chunk is generated
-on the worker that needs it, so no process ever holds the whole map. Each tile of the raster is
+The DEM is a synthetic dune field on 0.5 m cells, n x n, and comes from one of:
+- `npy`, `tiff`, `zarr` (a store): written first to a file in --dir (default: a temporary
+  folder; 0.5 GiB at n = 8192) one strip of rows at a time; each task then reads its own tile
+  and one-cell halo from the file (tiled, zlib-compressed GeoTIFF; zarr in chunk-sized chunks).
+- `dask` (a computed dask array): `da.fromfunction`, each chunk generated on the worker that needs
+  it, so no process ever holds the whole map; the halos are cut from neighbouring chunks.
+Each tile of the raster is
 reduced where it is made to a few numbers (mean best-heading p_fail, share of cells with a
 usable climb), as a pipeline that stores tiles would consume them, so the client holds no band
 either. Runs on a `dask.distributed.LocalCluster` of worker
 processes with one thread each (the library parallelises inside a task with rayon; set
 RAYON_NUM_THREADS to change that). Peak memory per worker is the resident-set high-water mark
-(`ru_maxrss`) of each worker process, including the Python interpreter and libraries; the
+(VmHWM) of each worker process, including the Python interpreter and libraries; the
 baseline of an idle worker is printed beside it.
 """
 
 import argparse
 import os
 import resource
+import tempfile
 import time
 
 import numpy as np
@@ -37,7 +44,43 @@ def tile_stats(bands):
     return out.reshape(3, 1, 1)
 
 
+def write_store(kind, n, chunk, folder):
+    """Writes the dune field to a .npy, GeoTIFF or .zarr file, a strip of rows at a time."""
+    strip = max(chunk, 1)
+    rows = lambda r0: np.mgrid[r0:min(r0 + strip, n), 0:n]  # noqa: E731
+    if kind == "npy":
+        path = os.path.join(folder, "dem.npy")
+        out = np.lib.format.open_memmap(path, mode="w+", dtype=np.float64, shape=(n, n))
+        for r0 in range(0, n, strip):
+            out[r0:r0 + strip] = dunes(*rows(r0))
+        out.flush()
+        del out
+    elif kind == "tiff":
+        import tifffile
+
+        path = os.path.join(folder, "dem.tif")
+        source = np.load(write_store("npy", n, chunk, folder), mmap_mode="r")
+        tifffile.imwrite(path, source, tile=(256, 256), compression="zlib", bigtiff=True)
+    else:
+        import zarr
+
+        path = os.path.join(folder, "dem.zarr")
+        out = zarr.open_array(path, mode="w", shape=(n, n), chunks=(chunk, chunk), dtype="f8")
+        for r0 in range(0, n, strip):
+            out[r0:r0 + strip] = dunes(*rows(r0))
+    return path
+
+
 def peak_rss_mib():
+    """This process's resident-set high-water mark, MiB: VmHWM on Linux (its own, whereas
+    ru_maxrss also keeps the peak of the process that started it), else ru_maxrss."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
@@ -46,6 +89,8 @@ def main():
     ap.add_argument("--n", type=int, default=8192)
     ap.add_argument("--chunk", type=int, default=1024)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--source", choices=["npy", "tiff", "zarr", "dask"], default="npy")
+    ap.add_argument("--dir", default=None, help="folder for the DEM file (default: a temporary one)")
     args = ap.parse_args()
 
     import dask.array as da
@@ -57,11 +102,17 @@ def main():
     robot = sandslope.Robot.preset("paper-hexapod")
     terrain = sandslope.Terrain.preset("glass-beads-300um")
     n, c = args.n, args.chunk
+    folder = args.dir or tempfile.mkdtemp(prefix="sandslope-bench-")
+    if args.source == "dask":
+        dem = da.fromfunction(dunes, shape=(n, n), chunks=c, dtype=np.float64)
+    else:
+        t0 = time.perf_counter()
+        dem = write_store(args.source, n, c, folder)
+        print(f"wrote {dem} in {time.perf_counter() - t0:.1f} s")
     with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=None,
                       memory_limit=0) as cluster, Client(cluster) as client:
         idle = client.run(peak_rss_mib)
-        dem = da.fromfunction(dunes, shape=(n, n), chunks=c, dtype=np.float64)
-        raster = sandslope.dask.risk_raster(dem, 0.5, robot=robot, terrain=terrain)
+        raster = sandslope.dask.risk_raster(dem, 0.5, robot=robot, terrain=terrain, chunks=c)
         # Each tile is reduced where it is made (the two steps fuse into one task), as a
         # pipeline that stores tiles (to_zarr, store) would consume them.
         stats = raster.map_blocks(tile_stats, dtype=np.float64, chunks=((3,),) + tuple((1,) * len(c) for c in
@@ -72,7 +123,7 @@ def main():
         mean_p, climbable = totals[0] / totals[1], totals[2] / (n * n)
         peaks = client.run(peak_rss_mib)
     chunk_mib = c * c * 8 / 2**20
-    print(f"DEM {n} x {n} ({n * n * 8 / 2**30:.2f} GiB as float64), chunks {c} x {c} ({chunk_mib:.0f} MiB each), "
+    print(f"DEM {n} x {n} from {args.source} ({n * n * 8 / 2**30:.2f} GiB as float64), chunks {c} x {c} ({chunk_mib:.0f} MiB each), "
           f"{raster.npartitions} tiles, {args.workers} worker processes x 1 thread, {os.cpu_count()} cores")
     print(f"  wall time            {wall:8.1f} s  ({n * n / wall / 1e6:.2f} Mcells/s)")
     for w, peak in sorted(peaks.items()):

@@ -94,3 +94,13 @@ if da is not None:
     tiled = lazy.compute()  # threads here; a dask.distributed Client runs it on a cluster
     assert np.array_equal(tiled, eager, equal_nan=True), "tiles differ from the eager raster"
     print("Dask raster equals the eager one, seams and border included")
+    # A DEM larger than memory lives in a file: give its path (.npy, GeoTIFF, .zarr) and each
+    # task reads only its tile and one-cell halo, so a worker holds a few tiles at most.
+    import os
+    import tempfile
+
+    path = os.path.join(tempfile.mkdtemp(), "dem.npy")
+    np.save(path, dem)
+    from_file = sandslope.dask.risk_raster(path, cell, robot=robot, terrain=terrain, chunks=(256, 192))
+    assert np.array_equal(from_file.compute(), eager, equal_nan=True), "tiles read from file differ"
+    print(f"the same raster read tile by tile from {os.path.basename(path)}")

@@ -49,3 +49,77 @@ def test_options_and_errors_pass_through(robot, terrain):
     # Bad options fail at once, not inside a worker.
     with pytest.raises(ValueError, match="max_roll_deg = 0 must be"):
         sdask.risk_raster(da.from_array(z, chunks=7), 0.5, robot=robot, terrain=terrain, max_roll_deg=0)
+
+
+def test_stores_are_read_tile_by_tile_with_the_same_values(client, robot, terrain, tmp_path):
+    """A .npy, a tiled and compressed GeoTIFF with a GDAL_NODATA tag, and a .zarr array, each
+    read window by window on worker processes, give the eager raster exactly."""
+    tifffile = pytest.importorskip("tifffile")
+    zarr = pytest.importorskip("zarr")
+    z = dunes(61, 47)
+    eager = sandslope.risk_raster(z, 0.5, robot=robot, terrain=terrain)
+    np.save(tmp_path / "dem.npy", z)
+    # GeoTIFFs mark holes with a nodata number, not NaN; the tag says which.
+    tifffile.imwrite(tmp_path / "dem.tif", np.where(np.isnan(z), -9999.0, z), tile=(16, 16),
+                     compression="zlib", extratags=[(42113, "s", 0, "-9999", True)])
+    stored = zarr.open_array(str(tmp_path / "dem.zarr"), mode="w", shape=z.shape, chunks=(20, 20), dtype="f8")
+    stored[:] = z
+    for source in [tmp_path / "dem.npy", str(tmp_path / "dem.tif"), str(tmp_path / "dem.zarr")]:
+        for chunks in [(23, 19), (30, 46), None]:
+            lazy = sdask.risk_raster(source, 0.5, robot=robot, terrain=terrain, chunks=chunks)
+            assert lazy.shape == (2, 61, 47) and lazy.dtype == np.float32
+            got = client.compute(lazy).result()
+            np.testing.assert_array_equal(got, eager, err_msg=f"{source}, chunks {chunks}")
+    # Without chunks a store is tiled as it is stored.
+    assert sdask.risk_raster(str(tmp_path / "dem.zarr"), 0.5, robot=robot, terrain=terrain).chunks[1:] == \
+        ((20, 20, 20, 1), (20, 20, 7))
+
+
+class CountingStore:
+    """An array-like that records the size of every read."""
+
+    def __init__(self, z):
+        self.z, self.shape, self.dtype, self.reads = z, z.shape, z.dtype, []
+
+    def __getitem__(self, index):
+        out = self.z[index]
+        self.reads.append(out.shape)
+        return out
+
+
+def test_each_tile_reads_only_its_window(robot, terrain):
+    """Tiles depend on no other task: each reads its own tile and one-cell halo, once."""
+    z = dunes(50, 41)
+    store = CountingStore(z)
+    lazy = sdask.risk_raster(store, 0.5, robot=robot, terrain=terrain, chunks=(16, 12))
+    # One task per tile, and nothing else in the graph.
+    assert len(dict(lazy.__dask_graph__())) == lazy.npartitions == 4 * 4
+    np.testing.assert_array_equal(lazy.compute(scheduler="sync"),
+                                  sandslope.risk_raster(z, 0.5, robot=robot, terrain=terrain))
+    assert len(store.reads) == 16
+    assert max(r * c for r, c in store.reads) <= (16 + 2) * (12 + 2)
+    # Corner tiles have no halo beyond the map: 17 x 13 cells.
+    assert (17, 13) in store.reads
+
+
+def test_store_errors_name_the_source(robot, terrain, tmp_path):
+    with pytest.raises(ValueError, match="nope.npy'?: no such file"):
+        sdask.risk_raster(tmp_path / "nope.npy", 0.5, robot=robot, terrain=terrain)
+    np.save(tmp_path / "cube.npy", np.zeros((2, 3, 4)))
+    with pytest.raises(ValueError, match=r"2-D array .*got shape \(2, 3, 4\)"):
+        sdask.risk_raster(tmp_path / "cube.npy", 0.5, robot=robot, terrain=terrain)
+
+
+def test_npy_windows_in_any_layout(tmp_path):
+    """The .npy reader gives exactly NumPy's slice: C and Fortran order, other dtypes, edges."""
+    z = dunes(37, 29)
+    for name, a in [("c", z), ("f", np.asfortranarray(z)), ("i", (np.nan_to_num(z) * 100).astype(np.int32)),
+                    ("be", z.astype(">f4"))]:
+        np.save(tmp_path / f"{name}.npy", a)
+        for top, bottom, left, right in [(0, 37, 0, 29), (5, 6, 0, 1), (10, 30, 3, 29), (36, 37, 28, 29)]:
+            got = sdask._read_window(tmp_path / f"{name}.npy", top, bottom, left, right)
+            np.testing.assert_array_equal(got, a[top:bottom, left:right], err_msg=name)
+    (tmp_path / "text.npy").write_text("not an array")
+    with pytest.raises(ValueError, match="text.npy'?: not a .npy file"):
+        sdask.risk_raster(tmp_path / "text.npy", 0.5, robot=sandslope.Robot.preset("paper-hexapod"),
+                          terrain=sandslope.Terrain.preset("glass-beads-300um"))

@@ -4,20 +4,32 @@ Needs the ``dask`` extra: ``pip install "crates/sandslope-py[dask]"``.
 
 :func:`risk_raster` gives exactly the values of the eager :func:`sandslope.risk_raster` for
 any chunking: each cell's gradient is Horn's 3 x 3 finite difference, so every tile is
-computed with a halo of one cell from its neighbours (``dask.array.overlap``), and the map's
-outer border is padded with NaN (nodata), which leaves border cells without a gradient
-exactly as in the eager raster. Only the interior of each padded tile is kept.
+computed with a halo of one cell from its neighbours, and the map's outer border is padded with
+NaN (nodata), which leaves border cells without a gradient exactly as in the eager raster. Only
+the interior of each padded tile is kept.
 
-Each task holds one padded tile and its two output bands (about 30 bytes per cell of the tile
-at its peak), so memory per worker is bounded by a few chunks, not by the DEM. The pitch
-table (the model at every pitch and its failure probability every 0.1 degree) is rebuilt per
-tile; it depends only on the robot and terrain, so tiles agree with each other and with the
-eager raster.
+Where the heights come from decides the memory a worker needs:
+
+* **A store** (a path to a ``.npy`` file, a GeoTIFF or a ``.zarr`` array, or an array-like such as a ``zarr.Array`` that
+  slices lazily and pickles as a reference): each task reads its own tile and its one-cell
+  halo straight from the store, computes, and lets go. Tiles depend on nothing else, so memory
+  per worker is a few tiles, whatever the size of the DEM. This is the way to run a DEM larger
+  than memory.
+* **A dask array** (computed by some other graph): the halos are cut from the neighbouring
+  chunks (``dask.array.overlap``). Dask computes each chunk once and must keep it until its
+  neighbours have taken their halos, so a worker holds about one row of chunks across the map:
+  memory grows with the map's width in chunks (measured in docs/python.md). Store such a DEM
+  first (``da.to_zarr``) when that is too much.
+
+The planner's pitch table (the model at every pitch and its failure probability every 0.1
+degree) is rebuilt per tile; it depends only on the robot and terrain, so tiles agree with each
+other and with the eager raster.
 """
 
 from __future__ import annotations
 
-from typing import Any, Optional
+import os
+from typing import Any, Callable, Optional, Tuple, TypeVar
 
 import dask.array as da
 import numpy as np
@@ -27,11 +39,147 @@ from . import risk_raster as _eager_risk_raster
 
 __all__ = ["risk_raster"]
 
+T = TypeVar("T")
+
+#: Tile side for stores that do not say how they are chunked, cells (8 MiB of float64).
+DEFAULT_TILE = 1024
+
 
 def _tile(block: np.ndarray, cell_x: float, cell_y: float, options: dict) -> np.ndarray:
     """The two bands of one tile padded by one cell on every side, without the padding."""
     bands = _eager_risk_raster(block, (cell_x, cell_y), **options)
     return bands[:, 1:-1, 1:-1]
+
+
+def _npy_header(f: Any) -> Tuple[Tuple[int, ...], bool, np.dtype]:
+    """Shape, Fortran order and dtype of an open ``.npy`` file, left at the first element."""
+    version = np.lib.format.read_magic(f)
+    if version == (1, 0):
+        return np.lib.format.read_array_header_1_0(f)
+    return np.lib.format.read_array_header_2_0(f)
+
+
+def _read_npy_window(path: str, top: int, bottom: int, left: int, right: int) -> np.ndarray:
+    """Rows ``top:bottom``, columns ``left:right`` of a 2-D ``.npy`` file, read row by row.
+
+    Plain reads rather than a memory map: faulting in a mapped window maps whole neighbouring
+    pages (fault-around), which on an 8192-wide float64 DEM made a 1024 x 1024 window cost
+    74 MiB of resident memory instead of 8.
+    """
+    with open(path, "rb") as f:
+        shape, fortran, dtype = _npy_header(f)
+        if fortran or dtype.hasobject:
+            return np.load(path, mmap_mode="r")[top:bottom, left:right]
+        start, row_bytes, item = f.tell(), shape[1] * dtype.itemsize, dtype.itemsize
+        out = np.empty((bottom - top, right - left), dtype=dtype)
+        for i, r in enumerate(range(top, bottom)):
+            f.seek(start + r * row_bytes + left * item)
+            f.readinto(memoryview(out[i]).cast("B"))
+        return out
+
+
+def _zarr() -> Any:
+    try:
+        import zarr
+    except ImportError as e:
+        raise ValueError("reading .zarr and GeoTIFF DEMs tile by tile needs zarr: pip install zarr") from e
+    return zarr
+
+
+def _with_array(source: Any, use: Callable[[Any], T]) -> T:
+    """Calls ``use`` on the array behind a source other than ``.npy``: a GeoTIFF path through
+    ``tifffile``'s zarr view (which reads only the strips or tiles a window touches), a
+    ``.zarr`` path, any other object as it is."""
+    if not isinstance(source, (str, os.PathLike)):
+        return use(source)
+    path = os.fspath(source)
+    zarr = _zarr()
+    if path.lower().endswith((".tif", ".tiff")):
+        import tifffile
+
+        with tifffile.imread(path, aszarr=True) as store:
+            return use(zarr.open(store, mode="r"))
+    return use(zarr.open_array(path, mode="r"))
+
+
+def _is_npy(source: Any) -> bool:
+    return isinstance(source, (str, os.PathLike)) and os.fspath(source).lower().endswith(".npy")
+
+
+def _read_window(source: Any, top: int, bottom: int, left: int, right: int) -> np.ndarray:
+    """Rows ``top:bottom``, columns ``left:right`` of a store."""
+    if _is_npy(source):
+        return _read_npy_window(os.fspath(source), top, bottom, left, right)
+    return _with_array(source, lambda a: np.asarray(a[top:bottom, left:right]))
+
+
+def _window_tile(
+    source: Any,
+    shape: Tuple[int, int],
+    cell_x: float,
+    cell_y: float,
+    options: dict,
+    block_info: Optional[dict] = None,
+) -> np.ndarray:
+    """Reads one tile and its one-cell halo from the store (NaN beyond the map) and returns
+    its two bands."""
+    (_, _), (r0, r1), (c0, c1) = block_info[None]["array-location"]
+    rows, cols = shape
+    top, bottom = max(r0 - 1, 0), min(r1 + 1, rows)
+    left, right = max(c0 - 1, 0), min(c1 + 1, cols)
+    padded = np.full((r1 - r0 + 2, c1 - c0 + 2), np.nan)
+    window = _read_window(source, top, bottom, left, right)
+    padded[top - (r0 - 1) : bottom - (r0 - 1), left - (c0 - 1) : right - (c0 - 1)] = window
+    del window
+    return _tile(padded, cell_x, cell_y, options)
+
+
+def _is_store(dem: Any) -> bool:
+    """A path, or an array-like that is neither NumPy nor dask and slices lazily."""
+    if isinstance(dem, (str, os.PathLike)):
+        return True
+    if isinstance(dem, (da.Array, np.ndarray)):
+        return False
+    return hasattr(dem, "shape") and hasattr(dem, "__getitem__")
+
+
+def _tiff_nodata(source: Any) -> Optional[float]:
+    """The GDAL_NODATA tag of a GeoTIFF path, as the eager reader (``read_raster``) honours it."""
+    if not (isinstance(source, (str, os.PathLike)) and os.fspath(source).lower().endswith((".tif", ".tiff"))):
+        return None
+    import tifffile
+
+    with tifffile.TiffFile(os.fspath(source)) as tif:
+        tag = tif.pages[0].tags.get(42113)  # GDAL_NODATA, an ASCII number
+        if tag is None:
+            return None
+        try:
+            return float(str(tag.value).strip("\x00 "))
+        except ValueError:
+            return None
+
+
+def _store_shape(source: Any) -> Tuple[Tuple[int, int], Optional[Tuple[int, int]]]:
+    """Shape and native chunks of a store, checked here, on the client."""
+    if isinstance(source, (str, os.PathLike)) and not os.path.exists(source):
+        raise ValueError(f"dem = {os.fspath(source)!r}: no such file or folder")
+    try:
+        if _is_npy(source):
+            with open(source, "rb") as f:
+                shape, native = _npy_header(f)[0], None
+        else:
+            shape, native = _with_array(source, lambda a: (tuple(getattr(a, "shape", ())), getattr(a, "chunks", None)))
+    except ValueError as e:
+        if _is_npy(source):
+            raise ValueError(f"dem = {os.fspath(source)!r}: not a .npy file: {e}") from e
+        raise
+    except Exception as e:  # a file that is not an array: the reader says why
+        raise ValueError(f"dem = {source!r}: cannot be read as an array: {e}") from e
+    if len(shape) != 2:
+        raise ValueError(f"dem must be a 2-D array (rows, cols), row 0 at the north (got shape {shape})")
+    if not (isinstance(native, tuple) and len(native) == 2 and all(isinstance(c, int) for c in native)):
+        native = None
+    return (int(shape[0]), int(shape[1])), native
 
 
 def risk_raster(
@@ -46,19 +194,31 @@ def risk_raster(
     descent: str = "symmetric",
     allow_metastable: bool = False,
     nodata: Optional[float] = None,
+    chunks: Any = None,
 ) -> da.Array:
     """Lazy ``(2, H, W)`` float32 dask array: the two bands of :func:`sandslope.risk_raster`
-    (best-heading P(failure), steepest usable climb azimuth) for a 2-D dask (or NumPy) DEM,
-    chunked like the DEM in its two dimensions.
+    (best-heading P(failure), steepest usable climb azimuth) for a 2-D DEM, row 0 at the north.
 
-    Same arguments and the same values as the eager function, whatever the chunking,
-    including at chunk seams and on the map border. Robot and terrain are checked here, at
-    once; they are pickled to the workers, so this runs on a ``dask.distributed`` cluster of
-    worker processes. Call ``.compute()`` (or ``da.to_zarr``, ``.store``) to evaluate.
+    ``dem`` is one of:
+
+    * a path to a ``.npy`` file, a GeoTIFF (``.tif``, read through ``tifffile``) or a
+      ``.zarr`` array (both need ``zarr``), or an array-like that slices lazily and
+      pickles cheaply (``zarr.Array``): each task reads its tile and one-cell halo from it, so
+      memory per worker is bounded by a few tiles whatever the DEM's size;
+    * a dask array: halos are cut from neighbouring chunks, and a worker holds about a row of
+      chunks (see the module's notes);
+    * a NumPy array (in memory; chunked like a dask array).
+
+    ``chunks``: tile shape (an int or ``(rows, cols)``, any form ``dask.array`` accepts);
+    default: the dask array's chunks, a store's own chunks, or 1024 x 1024.
+
+    Same other arguments and the same values as the eager function, whatever the chunking,
+    including at chunk seams and on the map border. Robot and terrain are checked here, at once;
+    they are pickled to the workers, so this runs on a ``dask.distributed`` cluster of worker
+    processes (a store must then be readable from every worker: a path on a shared file
+    system, or a zarr store the workers can reach). Call ``.compute()``, ``da.to_zarr`` or
+    ``.store`` to evaluate.
     """
-    z = da.asarray(dem)
-    if z.ndim != 2:
-        raise ValueError(f"dem must be a 2-D array (rows, cols), row 0 at the north (got shape {z.shape})")
     cx, cy = _cell_size(cell_size_m)
     options = dict(
         robot=_robot(robot),
@@ -72,17 +232,47 @@ def risk_raster(
     )
     # Fail now, not inside a worker: the same checks on a tiny map.
     _eager_risk_raster(np.zeros((3, 3)), (cx, cy), **options)
-    if not np.issubdtype(z.dtype, np.floating):
-        z = z.astype(np.float64)  # room for the NaN padding
-    padded = da.overlap.overlap(z, depth={0: 1, 1: 1}, boundary={0: np.nan, 1: np.nan})
-    return padded.map_blocks(
-        _tile,
+    meta = np.empty((0, 0, 0), dtype=np.float32)
+
+    if not _is_store(dem):
+        z = da.asarray(dem)
+        if z.ndim != 2:
+            raise ValueError(f"dem must be a 2-D array (rows, cols), row 0 at the north (got shape {z.shape})")
+        if chunks is not None:
+            z = z.rechunk(chunks)
+        elif isinstance(dem, np.ndarray):
+            z = z.rechunk(DEFAULT_TILE)
+        if not np.issubdtype(z.dtype, np.floating):
+            z = z.astype(np.float64)  # room for the NaN padding
+        padded = da.overlap.overlap(z, depth={0: 1, 1: 1}, boundary={0: np.nan, 1: np.nan})
+        return padded.map_blocks(
+            _tile,
+            cx,
+            cy,
+            options,
+            dtype=np.float32,
+            chunks=((2,),) + z.chunks,
+            new_axis=0,
+            meta=meta,
+            token="sandslope-risk-raster",
+        )
+
+    # A store: one independent task per tile, each reading its own window.
+    shape, native = _store_shape(dem)
+    if nodata is None:
+        options["nodata"] = _tiff_nodata(dem)
+    tiles = da.core.normalize_chunks(
+        chunks if chunks is not None else (native or DEFAULT_TILE), shape, dtype=np.float64
+    )
+    return da.map_blocks(
+        _window_tile,
+        dem,
+        shape,
         cx,
         cy,
         options,
         dtype=np.float32,
-        chunks=((2,),) + z.chunks,
-        new_axis=0,
-        meta=np.empty((0, 0, 0), dtype=np.float32),
-        token="sandslope-risk-raster",
+        chunks=((2,),) + tuple(tiles),
+        meta=meta,
+        token="sandslope-risk-raster-window",
     )

@@ -13,94 +13,14 @@
 //! - slip: integrates a speed of at most V_s over t1, so a timing error dt moves it by about
 //!   V_s dt (0.15 m/s x 15 ms = 2.3 mm at most here), checked as 20% of the true slip.
 
-use std::path::{Path, PathBuf};
-
 use assert_cmd::Command;
 use predicates::str::contains;
-use rand::{RngExt, SeedableRng};
 use sandslope::gait::synthetic::StepProfile;
 use serde_json::Value;
 
-const FPS: f64 = 120.0;
+mod common;
 
-/// (time, position or None when occluded), metres.
-type Rows = Vec<(f64, Option<[f64; 3]>)>;
-
-fn trajectory(
-    p: &StepProfile,
-    seconds: f64,
-    offset: f64,
-    dir: [f64; 3],
-    noise: f64,
-    gaps: &[(usize, usize)],
-) -> Rows {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
-    let mut gauss = move || {
-        let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    };
-    let n = (seconds * FPS) as usize;
-    (0..n)
-        .map(|i| {
-            let t = i as f64 / FPS;
-            let s = p.position(t - offset + 2.0 * p.step_duration());
-            let pos = [
-                dir[0] * s + noise * gauss(),
-                dir[1] * s + 0.3 + noise * gauss(),
-                dir[2] * s + noise * gauss(),
-            ];
-            (t, (!gaps.iter().any(|&(a, b)| (a..b).contains(&i))).then_some(pos))
-        })
-        .collect()
-}
-
-fn cells(p: Option<[f64; 3]>, scale: f64) -> String {
-    match p {
-        Some(p) => format!("{},{},{}", p[0] * scale, p[1] * scale, p[2] * scale),
-        None => ",,".into(),
-    }
-}
-
-fn motive(rows: &Rows, version: &str, units: &str, scale: f64) -> String {
-    let mut s = format!(
-        "Format Version,{version},Take Name,t,Capture Frame Rate,240.000000,Export Frame Rate,120.000000,\
-         Total Exported Frames,99999,Rotation Type,Quaternion,Length Units,{units},Coordinate Space,Global\n\n"
-    );
-    s += ",Type,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Marker,Marker,Marker\n";
-    s += ",Name,robot,robot,robot,robot,robot,robot,robot,m1,m1,m1\n,ID,1,1,1,1,1,1,1,2,2,2\n";
-    if version == "1.25" {
-        s += ",Parent,,,,,,,,,,\n";
-    }
-    s += ",,Rotation,Rotation,Rotation,Rotation,Position,Position,Position,Position,Position,Position\n";
-    s += "Frame,Time (Seconds),X,Y,Z,W,X,Y,Z,X,Y,Z\n";
-    for (i, (t, p)) in rows.iter().enumerate() {
-        let rot = if p.is_some() { "0,0,0,1" } else { ",,," };
-        s += &format!("{i},{t:.6},{rot},{},1,2,3\n", cells(*p, scale));
-    }
-    s
-}
-
-fn vicon(rows: &Rows) -> String {
-    let mut s = "Trajectories\n120\n,,robot:CoM,,\nFrame,Sub Frame,X,Y,Z\n,,mm,mm,mm\n".to_string();
-    for (i, (_, p)) in rows.iter().enumerate() {
-        s += &format!("{},0,{}\n", i + 1, cells(*p, 1000.0));
-    }
-    s
-}
-
-fn plain_mm(rows: &Rows) -> String {
-    let mut s = "time_s,x_mm,y_mm,z_mm,quality\n".to_string();
-    for (t, p) in rows {
-        s += &format!("{t:.6},{},1\n", cells(*p, 1000.0));
-    }
-    s
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
+use common::{motive, plain_mm, trajectory, vicon, write};
 
 fn track(args: &[&str]) -> Value {
     let out =

@@ -1,0 +1,112 @@
+//! Test helpers shared by the motion-capture tests (`track.rs`, `report.rs`): trajectories
+//! sampled from a known step profile (`sandslope::gait::synthetic::StepProfile`) with noise
+//! and occlusions, written as Motive, Vicon or plain CSV files.
+#![allow(dead_code)] // each test binary uses a different subset
+
+use std::path::{Path, PathBuf};
+
+use rand::{RngExt, SeedableRng};
+use sandslope::gait::synthetic::StepProfile;
+
+/// Frame rate of the generated recordings, frames/s.
+pub const FPS: f64 = 120.0;
+
+/// (time, position or None when occluded), metres.
+pub type Rows = Vec<(f64, Option<[f64; 3]>)>;
+
+/// `seconds` of a robot stepping with profile `p` along `dir` (unit vector), first touchdown
+/// at `offset` s, with Gaussian noise of SD `noise` m per axis and frames `gaps` (half-open
+/// index ranges) occluded; the noise is seeded, so the recording is reproducible.
+pub fn trajectory(
+    p: &StepProfile,
+    seconds: f64,
+    offset: f64,
+    dir: [f64; 3],
+    noise: f64,
+    gaps: &[(usize, usize)],
+) -> Rows {
+    trajectory_seeded(p, seconds, offset, dir, noise, gaps, 11)
+}
+
+/// [`trajectory`] with its own noise: recordings pooled together need independent noise.
+pub fn trajectory_seeded(
+    p: &StepProfile,
+    seconds: f64,
+    offset: f64,
+    dir: [f64; 3],
+    noise: f64,
+    gaps: &[(usize, usize)],
+    seed: u64,
+) -> Rows {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let mut gauss = move || {
+        let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    };
+    let n = (seconds * FPS) as usize;
+    (0..n)
+        .map(|i| {
+            let t = i as f64 / FPS;
+            let s = p.position(t - offset + 2.0 * p.step_duration());
+            let pos = [
+                dir[0] * s + noise * gauss(),
+                dir[1] * s + 0.3 + noise * gauss(),
+                dir[2] * s + noise * gauss(),
+            ];
+            (t, (!gaps.iter().any(|&(a, b)| (a..b).contains(&i))).then_some(pos))
+        })
+        .collect()
+}
+
+/// One position as three CSV cells scaled by `scale` (1000 for mm); empty when occluded.
+pub fn cells(p: Option<[f64; 3]>, scale: f64) -> String {
+    match p {
+        Some(p) => format!("{},{},{}", p[0] * scale, p[1] * scale, p[2] * scale),
+        None => ",,".into(),
+    }
+}
+
+/// A Motive CSV export (`version` 1.23 or 1.25) with rigid body `robot` and marker `m1`.
+pub fn motive(rows: &Rows, version: &str, units: &str, scale: f64) -> String {
+    let mut s = format!(
+        "Format Version,{version},Take Name,t,Capture Frame Rate,240.000000,Export Frame Rate,120.000000,\
+         Total Exported Frames,99999,Rotation Type,Quaternion,Length Units,{units},Coordinate Space,Global\n\n"
+    );
+    s += ",Type,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Marker,Marker,Marker\n";
+    s += ",Name,robot,robot,robot,robot,robot,robot,robot,m1,m1,m1\n,ID,1,1,1,1,1,1,1,2,2,2\n";
+    if version == "1.25" {
+        s += ",Parent,,,,,,,,,,\n";
+    }
+    s += ",,Rotation,Rotation,Rotation,Rotation,Position,Position,Position,Position,Position,Position\n";
+    s += "Frame,Time (Seconds),X,Y,Z,W,X,Y,Z,X,Y,Z\n";
+    for (i, (t, p)) in rows.iter().enumerate() {
+        let rot = if p.is_some() { "0,0,0,1" } else { ",,," };
+        s += &format!("{i},{t:.6},{rot},{},1,2,3\n", cells(*p, scale));
+    }
+    s
+}
+
+/// A Vicon Nexus trajectories export, subject `robot`, segment `CoM`, in mm.
+pub fn vicon(rows: &Rows) -> String {
+    let mut s = "Trajectories\n120\n,,robot:CoM,,\nFrame,Sub Frame,X,Y,Z\n,,mm,mm,mm\n".to_string();
+    for (i, (_, p)) in rows.iter().enumerate() {
+        s += &format!("{},0,{}\n", i + 1, cells(*p, 1000.0));
+    }
+    s
+}
+
+/// A plain CSV (`time_s,x_mm,y_mm,z_mm,quality`).
+pub fn plain_mm(rows: &Rows) -> String {
+    let mut s = "time_s,x_mm,y_mm,z_mm,quality\n".to_string();
+    for (t, p) in rows {
+        s += &format!("{t:.6},{},1\n", cells(*p, 1000.0));
+    }
+    s
+}
+
+/// Writes `text` to `dir/name`, returning the path.
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}

@@ -1,9 +1,18 @@
 //! `sandslope report`: the page is self-contained, carries every figure id of the paper and the
 //! documented report.json; a real browser (headless Chromium, when installed) renders it to a
-//! screenshot that is not blank.
+//! screenshot that is not blank. With `--tracks`, motion-capture recordings generated from
+//! known step profiles (`sandslope::gait::synthetic::StepProfile`, see tests/track.rs for the
+//! tolerances: speed 1 mm/s, t1 15 ms, slip 20%) feed the speeds, fig5b, fig3b and the
+//! calibration.
+
+mod common;
 
 use assert_cmd::Command;
+use predicates::str::contains;
+use sandslope::gait::synthetic::StepProfile;
 use std::path::Path;
+
+use common::{motive, plain_mm, trajectory_seeded, write};
 
 fn sandslope() -> Command {
     Command::cargo_bin("sandslope").unwrap()
@@ -133,4 +142,250 @@ fn report_renders_in_a_real_browser() {
     let fraction = non_white as f64 / pixels.len() as f64;
     assert!(fraction > 0.03, "screenshot nearly blank: {fraction:.4} of pixels non-white");
     assert!(colours.len() > 20, "screenshot has only {} colours", colours.len());
+}
+
+/// The upslope unit vector of a slope of `deg` degrees in the capture frame (x along the
+/// slope's fall line, z up).
+fn upslope(deg: f64) -> [f64; 3] {
+    [deg.to_radians().cos(), 0.0, deg.to_radians().sin()]
+}
+
+/// A report made with `args` into a fresh folder: its page and report.json.
+fn report_with(dir: &Path, args: &[&str]) -> (String, serde_json::Value) {
+    let out = dir.join("report");
+    let run = sandslope().args(["report", "--out"]).arg(&out).args(args).output().unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let json = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    (html, json)
+}
+
+fn f(v: &serde_json::Value, key: &str) -> f64 {
+    v[key].as_f64().unwrap_or_else(|| panic!("{key} missing in {v}"))
+}
+
+#[test]
+fn tracks_at_three_slopes_become_the_observed_speeds_and_anchoring_times() {
+    // Three slopes with different known t1 (70, 110, 160 ms: further apart than twice the
+    // 15 ms tolerance, so a mix-up between slopes would show), 0.3 mm noise, a 5-frame
+    // occlusion (interpolated) and a 40-frame one (splits the recording).
+    let profiles = [
+        (10.0, StepProfile::new(0.5, 0.07, 0.38, 0.10, 0.30).unwrap()),
+        (15.0, StepProfile::new(0.5, 0.11, 0.40, 0.14, 0.29).unwrap()),
+        (20.0, StepProfile::new(0.5, 0.16, 0.42, 0.18, 0.28).unwrap()),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let gaps = [(100, 105), (600, 640)];
+    let rows = |k: usize, seed: u64, offset: f64| {
+        let (deg, p) = &profiles[k];
+        trajectory_seeded(p, 10.0, offset, upslope(*deg), 3e-4, &gaps, seed)
+    };
+    // 10 deg: two Motive files by one glob; 15 deg: two --tracks values (Motive 1.25 in mm,
+    // plain); 20 deg: one plain file.
+    write(d, "ten-a.csv", &motive(&rows(0, 1, 0.2), "1.23", "Meters", 1.0));
+    write(d, "ten-b.csv", &motive(&rows(0, 2, 0.05), "1.23", "Meters", 1.0));
+    let fifteen_a = write(d, "fifteen-a.csv", &motive(&rows(1, 3, 0.3), "1.25", "Millimeters", 1000.0));
+    let fifteen_b = write(d, "fifteen-b.csv", &plain_mm(&rows(1, 4, 0.1)));
+    let twenty = write(d, "twenty.csv", &plain_mm(&rows(2, 5, 0.25)));
+    let arg = |deg: &str, p: &Path| format!("{deg}={}", p.display());
+    let (html, v) = report_with(
+        d,
+        &[
+            "--tracks",
+            &arg("10", &d.join("ten-*.csv")),
+            "--tracks",
+            &arg("15", &fifteen_a),
+            "--tracks",
+            &arg("15.0", &fifteen_b),
+            "--tracks",
+            &arg("20", &twenty),
+        ],
+    );
+    let tracks = v["tracks"].as_array().unwrap();
+    assert_eq!(tracks.len(), 3, "{tracks:?}");
+    for (t, (deg, p)) in tracks.iter().zip(&profiles) {
+        assert_eq!(f(t, "slope_deg"), *deg);
+        let files = t["files"].as_array().unwrap().len();
+        assert_eq!(files, if *deg == 20.0 { 1 } else { 2 }, "{t}");
+        // About 19 complete steps per 10 s file, less the split at the long occlusion.
+        assert!(t["steps"].as_u64().unwrap() >= 14 * files as u64, "{t}");
+        assert!(
+            (f(t, "t1_s") - p.anchoring_time()).abs() < 0.015,
+            "{deg}: t1 {} vs {}",
+            t["t1_s"],
+            p.anchoring_time()
+        );
+        assert!(f(t, "t1_sd_s") > 0.0);
+        assert!(
+            (f(t, "speed_m_s") - p.mean_speed()).abs() < 1e-3,
+            "{deg}: v {} vs {}",
+            t["speed_m_s"],
+            p.mean_speed()
+        );
+        assert!(f(t, "speed_sd_m_s") > 0.0);
+        assert!(
+            (f(t, "slip_m") - p.slip()).abs() < 0.2 * p.slip(),
+            "{deg}: slip {} vs {}",
+            t["slip_m"],
+            p.slip()
+        );
+    }
+    // Without --observed the tracks' speeds are the observed speeds (not the paper's five).
+    let speeds = v["speeds"].as_array().unwrap();
+    assert_eq!(speeds.len(), 3);
+    for (s, (deg, p)) in speeds.iter().zip(&profiles) {
+        assert_eq!(f(s, "slope_deg"), *deg);
+        assert!((f(s, "observed_m_s") - p.mean_speed()).abs() < 1e-3, "{s}");
+    }
+    // fig3b is drawn, after fig3a; the page has the motion-capture table naming the files.
+    let ids: Vec<&str> = v["figures"].as_array().unwrap().iter().map(|f| f["id"].as_str().unwrap()).collect();
+    assert_eq!(&ids[..2], ["fig3a", "fig3b"]);
+    assert!(html.contains("<figure id=\"fig3b\">"));
+    assert!(html.contains("<h2 id=\"tracks\">Motion capture</h2>"));
+    for name in ["ten-a.csv", "ten-b.csv", "fifteen-a.csv", "fifteen-b.csv", "twenty.csv"] {
+        assert!(html.contains(name), "{name} not on the page");
+    }
+    let inputs = v["inputs"].to_string();
+    assert!(inputs.contains("motion capture at 15°") && inputs.contains("fifteen-b.csv"), "{inputs}");
+    // The calibration fits the tracks' t1 and speeds: one anchoring-time pull and one speed
+    // pull per slope, the observed values the profiles' (independently of the table above).
+    let pulls = v["calibration"]["pulls"].as_array().expect("calibration with pulls");
+    for (kind, truth) in [
+        ("anchoring_time", profiles.map(|(d, p)| (d, p.anchoring_time(), 0.015))),
+        ("speed", profiles.map(|(d, p)| (d, p.mean_speed(), 1e-3))),
+    ] {
+        let of_kind: Vec<&serde_json::Value> = pulls.iter().filter(|p| p["kind"] == kind).collect();
+        assert_eq!(of_kind.len(), 3, "{kind}: {pulls:?}");
+        for (deg, value, tol) in truth {
+            let pull = of_kind.iter().find(|p| f(p, "slope_deg") == deg).unwrap();
+            assert!((f(pull, "observed") - value).abs() < tol, "{kind} at {deg}: {pull}");
+            assert!(f(pull, "pull").is_finite());
+        }
+    }
+}
+
+#[test]
+fn observed_speeds_win_over_track_speeds_and_t1_rows_are_added() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = StepProfile::new(0.5, 0.12, 0.40, 0.15, 0.2816).unwrap();
+    let rec =
+        write(d, "r.csv", &plain_mm(&trajectory_seeded(&p, 10.0, 0.2, upslope(20.0), 3e-4, &[(50, 54)], 7)));
+    let observed = write(d, "speeds.csv", "slope_deg,speed_m_s,speed_sd_m_s\n0,0.15,0.01\n20,0.05,0.01\n");
+    let t1 = write(d, "t1.csv", "slope_deg,t1_s,t1_sd_s\n10,0.09,0.02\n");
+    let (html, v) = report_with(
+        d,
+        &[
+            "--tracks",
+            &format!("20={}", rec.display()),
+            "--observed",
+            observed.to_str().unwrap(),
+            "--t1",
+            t1.to_str().unwrap(),
+            "--tracks-upslope",
+            "0.9397,0,0.3420",
+        ],
+    );
+    let slopes: Vec<f64> = v["speeds"].as_array().unwrap().iter().map(|s| f(s, "slope_deg")).collect();
+    assert_eq!(slopes, [0.0, 20.0]);
+    assert_eq!(v["speeds"][1]["observed_m_s"], 0.05);
+    assert!((f(&v["tracks"][0], "speed_m_s") - p.mean_speed()).abs() < 1e-3);
+    assert!(html.contains("shown in this table only"), "the page must say the track speeds are not used");
+    // Anchoring times: the --t1 row at 10 deg and the track's at 20 deg.
+    let t1s: Vec<(f64, f64)> = v["calibration"]["pulls"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["kind"] == "anchoring_time")
+        .map(|p| (f(p, "slope_deg"), f(p, "observed")))
+        .collect();
+    assert_eq!(t1s.len(), 2, "{t1s:?}");
+    assert!(t1s.contains(&(10.0, 0.09)));
+    let (_, t20) = t1s.iter().find(|(s, _)| *s == 20.0).unwrap();
+    assert!((t20 - p.anchoring_time()).abs() < 0.015, "{t20}");
+}
+
+#[test]
+fn tracks_without_anchoring_are_skipped_with_a_warning() {
+    // A body moving upslope at a steady 0.1 m/s with no steps in it: no anchored step, so no
+    // t1 (warned and noted on the page); the report is still written.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let stepping = StepProfile::new(0.5, 0.12, 0.40, 0.15, 0.2816).unwrap();
+    let good =
+        write(d, "good.csv", &plain_mm(&trajectory_seeded(&stepping, 8.0, 0.2, upslope(10.0), 3e-4, &[], 3)));
+    let mut text = String::from("time_s,x_mm,y_mm,z_mm\n");
+    for i in 0..1200 {
+        let t = i as f64 / 120.0;
+        text.push_str(&format!("{t:.6},{:.3},0,0\n", 100.0 * t));
+    }
+    let flat = write(d, "steady.csv", &text);
+    let out = d.join("report");
+    let run = sandslope()
+        .args(["report", "--out"])
+        .arg(&out)
+        .args(["--tracks", &format!("10={}", good.display()), "--tracks", &format!("5={}", flat.display())])
+        .args(["--tracks-upslope", "+x"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(stderr.contains("warning: --tracks at 5°") && stderr.contains("steady.csv"), "{stderr}");
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("The tracks at 5° (") && html.contains("give no anchoring time"), "note missing");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert!(v["tracks"][0]["t1_s"].is_null(), "{}", v["tracks"][0]);
+    // Its speed is still an observed speed: the steady 0.1 m/s, beside the stepping one.
+    let speeds = v["speeds"].as_array().unwrap();
+    let slopes: Vec<f64> = speeds.iter().map(|s| f(s, "slope_deg")).collect();
+    assert_eq!(slopes, [5.0, 10.0]);
+    assert!((f(&speeds[0], "observed_m_s") - 0.1).abs() < 1e-3, "{}", speeds[0]);
+    assert!((f(&speeds[1], "observed_m_s") - stepping.mean_speed()).abs() < 1e-3, "{}", speeds[1]);
+    // Only the stepping track's t1 reaches the calibration.
+    let t1_pulls: Vec<f64> = v["calibration"]["pulls"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["kind"] == "anchoring_time")
+        .map(|p| f(p, "slope_deg"))
+        .collect();
+    assert_eq!(t1_pulls, [10.0]);
+}
+
+#[test]
+fn bad_tracks_values_exit_2_naming_the_flag_and_the_form() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("report");
+    let p = StepProfile::new(0.5, 0.12, 0.40, 0.15, 0.2816).unwrap();
+    let good = motive(&trajectory_seeded(&p, 3.0, 0.0, upslope(10.0), 3e-4, &[], 1), "1.25", "Meters", 1.0);
+    let head: String = good.lines().take(5).map(|l| format!("{l}\n")).collect();
+    let trunc = write(d, "trunc.csv", &head);
+    let missing = format!("10={}", d.join("nothing-*.csv").display());
+    let trunc_arg = format!("10={}", trunc.display());
+    for (value, needles) in [
+        ("runs/a.csv", vec!["--tracks", "runs/a.csv", "DEG=FILE|GLOB"]),
+        ("ten=runs/a.csv", vec!["--tracks", "`ten` is not a slope", "DEG=FILE|GLOB"]),
+        ("95=runs/a.csv", vec!["--tracks", "95=runs/a.csv", "outside 0 to 90", "DEG=FILE|GLOB"]),
+        ("10=", vec!["--tracks", "no file after `=`", "DEG=FILE|GLOB"]),
+        (missing.as_str(), vec!["--tracks", missing.as_str(), "DEG=FILE|GLOB", "no such file"]),
+        (trunc_arg.as_str(), vec!["trunc.csv: line 5: truncated header"]),
+    ] {
+        let mut a =
+            sandslope().args(["report", "--out"]).arg(&out).args(["--tracks", value]).assert().code(2);
+        for n in needles {
+            a = a.stderr(contains(n));
+        }
+        assert!(!out.exists(), "{value}: output written");
+    }
+    sandslope()
+        .args(["report", "--out"])
+        .arg(&out)
+        .args(["--tracks-body", "robot"])
+        .assert()
+        .code(2)
+        .stderr(contains("--tracks"));
+    assert!(!out.exists());
 }

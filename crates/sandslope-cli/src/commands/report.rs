@@ -1,12 +1,17 @@
 //! `sandslope report --out DIR`: the paper reproduced and confronted in one self-contained
 //! HTML page (`DIR/index.html`, figures inline as SVG) and `DIR/report.json`. On the defaults it
-//! reproduces the paper from the shipped data; `--robot`, `--terrain`, `--observed`, `--forces`
-//! and `--t1` make it a report on the user's own campaign.
+//! reproduces the paper from the shipped data; `--robot`, `--terrain`, `--observed`, `--forces`,
+//! `--t1` and `--tracks` (motion-capture recordings per slope, analysed as `sandslope track`
+//! does) make it a report on the user's own campaign.
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
+
+use sandslope::gait::{GaitOptions, Upslope};
+use sandslope::AnchoringObservation;
+use sandslope_io::mocap::MocapFormat;
 
 use sandslope::paper::{self, compare_with_paper};
 use sandslope::risk::{risk_curve, safe_slope_limit};
@@ -28,8 +33,10 @@ use crate::figures::phase::PhaseFigure;
 use crate::figures::risk::CurveFigure;
 use crate::figures::slope_curves::SlopeCurveFigure;
 use crate::figures::to_svg;
+use crate::figures::track::{StridePanels, TrackFigure};
+use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions, Tracked};
 use crate::output::write_atomic;
-use crate::report::{page, FigureRecord, PageFigure, ReportJson, SpeedRecord};
+use crate::report::{page, FigureRecord, PageFigure, ReportJson, SpeedRecord, TrackRecord, TracksSection};
 
 /// Arguments of `sandslope report`.
 #[derive(Debug, Args)]
@@ -47,6 +54,32 @@ pub struct ReportArgs {
     /// Observed anchoring times (slope_deg,t1_s,t1_sd_s), drawn in fig5b and calibrated on.
     #[arg(long, value_name = "CSV")]
     pub t1: Option<PathBuf>,
+    /// Motion-capture recordings at one slope, `DEG=FILE|GLOB` (e.g. `10=runs/10deg-*.csv`);
+    /// repeat for more files or slopes. Each slope's files are pooled and analysed as
+    /// `sandslope track` does: their anchoring time t1 joins the observed ones (fig5b and the
+    /// calibration) and, without --observed, their mean speeds are the observed speeds. Adds
+    /// fig3b (speed within a stride) and a motion-capture table.
+    #[arg(long, value_name = "DEG=FILE|GLOB", value_parser = parse_tracks)]
+    pub tracks: Vec<TracksArg>,
+    /// Format of the --tracks files: motive, vicon or plain; detected from each file's first
+    /// line when omitted.
+    #[arg(long, value_name = "motive|vicon|plain", value_parser = parse_mocap_format, requires = "tracks")]
+    pub tracks_format: Option<MocapFormat>,
+    /// Rigid body, marker or model output to track in the --tracks files (required when a
+    /// file has several).
+    #[arg(long, value_name = "NAME", requires = "tracks")]
+    pub tracks_body: Option<String>,
+    /// Upslope direction in the --tracks files' capture frame: +x, -x, +y, -y, +z, -z or a
+    /// vector such as `0.91,0,0.41`; estimated per slope from the direction of travel when
+    /// omitted.
+    #[arg(
+        long,
+        value_name = "AXIS|X,Y,Z",
+        value_parser = |s: &str| parse_upslope(s, "--tracks-upslope"),
+        allow_hyphen_values = true,
+        requires = "tracks"
+    )]
+    pub tracks_upslope: Option<Upslope>,
     /// Risk threshold for the safe-slope limit.
     #[arg(long, default_value_t = 0.05)]
     pub max_risk: f64,
@@ -54,6 +87,74 @@ pub struct ReportArgs {
     pub robot: RobotArgs,
     #[command(flatten)]
     pub terrain: TerrainArgs,
+}
+
+/// One `--tracks DEG=FILE|GLOB` value.
+#[derive(Debug, Clone)]
+pub struct TracksArg {
+    /// The value as given.
+    pub text: String,
+    /// Slope of the recordings, degrees.
+    pub slope_deg: f64,
+    /// A recording or a glob pattern.
+    pub pattern: String,
+}
+
+/// The valid form of a `--tracks` value, for error messages.
+const TRACKS_FORM: &str = "expected DEG=FILE|GLOB: a slope in degrees (0 to 90, 90 excluded), `=`, \
+     then a recording or a glob pattern, e.g. `10=runs/10deg-*.csv`";
+
+/// Parses `--tracks`; whether its files exist is checked when they are read.
+fn parse_tracks(s: &str) -> Result<TracksArg, String> {
+    let Some((deg, pattern)) = s.split_once('=') else {
+        return Err(format!("no `=` in `{s}`; {TRACKS_FORM}"));
+    };
+    let slope_deg: f64 =
+        deg.trim().parse().map_err(|_| format!("`{deg}` is not a slope in degrees; {TRACKS_FORM}"))?;
+    if Slope::from_degrees(slope_deg).is_err() {
+        return Err(format!("slope {slope_deg} is outside 0 to 90 degrees; {TRACKS_FORM}"));
+    }
+    if pattern.trim().is_empty() {
+        return Err(format!("no file after `=` in `{s}`; {TRACKS_FORM}"));
+    }
+    Ok(TracksArg { text: s.to_string(), slope_deg, pattern: pattern.to_string() })
+}
+
+/// One slope's recordings, read and analysed pooled.
+struct SlopeTracks {
+    slope_deg: f64,
+    tracked: Tracked,
+}
+
+/// Reads and analyses the `--tracks` recordings, one pooled analysis per slope, lowest slope
+/// first; `period` is the robot's stride period.
+fn load_tracks(args: &ReportArgs, period: f64) -> Result<Vec<SlopeTracks>> {
+    let mut slopes: Vec<f64> = args.tracks.iter().map(|t| t.slope_deg).collect();
+    slopes.sort_by(f64::total_cmp);
+    slopes.dedup();
+    let mut options = GaitOptions::new(period).map_err(|e| anyhow!("the robot's stride period: {e}"))?;
+    if let Some(u) = args.tracks_upslope {
+        options = options.with_upslope(u);
+    }
+    let read =
+        CaptureOptions { format: args.tracks_format, body: args.tracks_body.as_deref(), cutoff_flag: None };
+    let mut out = Vec::new();
+    for slope_deg in slopes {
+        let mut files: Vec<PathBuf> = Vec::new();
+        for t in args.tracks.iter().filter(|t| t.slope_deg == slope_deg) {
+            let found = expand(std::slice::from_ref(&t.pattern))
+                .with_context(|| format!("--tracks `{}`: no recording to read ({TRACKS_FORM})", t.text))?;
+            // A file named twice (a path and a glob that matches it) is read once.
+            for f in found {
+                if !files.contains(&f) {
+                    files.push(f);
+                }
+            }
+        }
+        let tracked = track_files(&files, read, &[], &options, Some(at(slope_deg)))?;
+        out.push(SlopeTracks { slope_deg, tracked });
+    }
+    Ok(out)
 }
 
 /// Slopes of the model curves: 0 to 30 deg every 0.25 deg.
@@ -89,22 +190,28 @@ pub fn run(args: ReportArgs) -> Result<()> {
         }
         None => None,
     };
+    let mut anchoring = args.t1.as_deref().map(load_anchoring_times).transpose()?.unwrap_or_default();
+    let tracks = load_tracks(&args, robot.stride_period())?;
+    let track_use = TrackUse::new(&tracks, args.observed.is_some());
+    anchoring.extend(track_use.anchoring.iter().copied());
     let speeds: Vec<SpeedObservation> = match &args.observed {
         Some(p) => load_speeds(p)?,
+        None if !tracks.is_empty() => track_use.speeds.clone(),
         None => paper::SPEEDS
             .iter()
             .map(|&(d, v, sd)| SpeedObservation { slope: at(d), speed: v, speed_sd: sd })
             .collect(),
     };
-    let anchoring = args.t1.as_deref().map(load_anchoring_times).transpose()?.unwrap_or_default();
     let mut inputs = vec![
         ("robot".to_string(), args.robot.robot.clone()),
         ("terrain".to_string(), args.terrain.terrain.clone()),
         (
             "observed speeds".to_string(),
-            args.observed
-                .as_ref()
-                .map_or("the paper's (docs/model.md §12)".into(), |p| p.display().to_string()),
+            match (&args.observed, tracks.is_empty()) {
+                (Some(p), _) => p.display().to_string(),
+                (None, false) => "the motion-capture tracks' (mean ± SD per slope, --tracks)".into(),
+                (None, true) => "the paper's (docs/model.md §12)".into(),
+            },
         ),
         (
             "force tests".to_string(),
@@ -117,8 +224,32 @@ pub fn run(args: ReportArgs) -> Result<()> {
             },
         ),
     ];
-    if let Some(p) = &args.t1 {
-        inputs.push(("anchoring times".into(), p.display().to_string()));
+    let t1_sources: Vec<String> = args
+        .t1
+        .iter()
+        .map(|p| p.display().to_string())
+        .chain((!track_use.anchoring.is_empty()).then(|| "the motion-capture tracks (--tracks)".to_string()))
+        .collect();
+    if !t1_sources.is_empty() {
+        inputs.push(("anchoring times".into(), t1_sources.join(" and ")));
+    }
+    for t in &tracks {
+        inputs.push((format!("motion capture at {}°", t.slope_deg), t.tracked.names.join(", ")));
+    }
+    if !tracks.is_empty() {
+        inputs.push((
+            "motion-capture reading".into(),
+            format!(
+                "format {}; body {}; upslope {}; stride period T = {} s (the robot's)",
+                args.tracks_format.map_or("detected per file", |f| f.name()),
+                args.tracks_body.as_deref().unwrap_or("chosen per file (no --tracks-body)"),
+                args.tracks_upslope.map_or("estimated per slope from the travel".to_string(), |u| {
+                    let v = u.vector();
+                    format!("[{:.3}, {:.3}, {:.3}]", v[0], v[1], v[2])
+                }),
+                robot.stride_period()
+            ),
+        ));
     }
 
     // The joint calibration of the terrain's (or the force tests') k_s shape on the evidence.
@@ -161,6 +292,24 @@ pub fn run(args: ReportArgs) -> Result<()> {
         legend: SeriesLabelPosition::LowerLeft,
     };
     add(&mut figures, "fig3a", "Speed against slope", "The model's step-averaged speed v = s/(T/2) on the terrain (dashed) and the observed speeds. Where the line stops, the regime rules a speed out (slippage or sinkage, docs/model.md §6).".into(), to_svg(&fig)?);
+
+    // fig3b: speed within a stride, one panel per tracked slope with a complete step.
+    let strided: Vec<&SlopeTracks> = tracks.iter().filter(|t| t.tracked.result.steps > 0).collect();
+    if !strided.is_empty() {
+        let slopes: Vec<String> = strided.iter().map(|t| format!("{}°", t.slope_deg)).collect();
+        let fig =
+            StridePanels(strided.iter().map(|t| TrackFigure::new(&t.tracked.result, None, &[])).collect());
+        add(
+            &mut figures,
+            "fig3b",
+            "Speed within a stride",
+            format!(
+                "The motion-capture tracks' upslope speed against time since touchdown, averaged over strides (mean ± SD band), with the mean anchoring time t1 (docs/model.md §11); one panel per tracked slope, lowest first: {}.",
+                slopes.join(", ")
+            ),
+            to_svg(&fig)?,
+        );
+    }
 
     // fig4d, fig4h: k_n and k_s against slope with error bars.
     let table = forces.as_ref().unwrap_or(&terrain);
@@ -342,7 +491,15 @@ pub fn run(args: ReportArgs) -> Result<()> {
             model_m_s: predict(&robot, o.slope, &terrain.at(o.slope)).speed,
         })
         .collect();
-    let html = page(&inputs, &figures, &paper_rows, calibration.as_ref(), &disagreements);
+    let track_records: Vec<TrackRecord> = tracks.iter().map(track_record).collect();
+    let html = page(
+        &inputs,
+        &figures,
+        &paper_rows,
+        calibration.as_ref(),
+        &disagreements,
+        &TracksSection { records: &track_records, notes: &track_use.notes },
+    );
     let json = ReportJson {
         figures: figures
             .iter()
@@ -355,6 +512,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
             })
             .collect(),
         speeds: &speed_records,
+        tracks: &track_records,
         calibration: calibration.as_ref(),
         paper_vs_model: &paper_rows,
         disagreements: &disagreements,
@@ -379,6 +537,95 @@ pub fn run(args: ReportArgs) -> Result<()> {
         args.out.join("report.json").display()
     );
     Ok(())
+}
+
+/// How the tracks enter the report: their anchoring times, their speeds (used as the
+/// observed speeds unless --observed is given) and the page's notes on what was left out.
+struct TrackUse {
+    anchoring: Vec<AnchoringObservation>,
+    speeds: Vec<SpeedObservation>,
+    notes: Vec<String>,
+}
+
+impl TrackUse {
+    /// Splits the tracks into observations, warning on stderr (and noting for the page) about
+    /// every slope whose t1 or speed cannot be used: without an SD > 0 an observation has no
+    /// weight in the calibration.
+    fn new(tracks: &[SlopeTracks], observed_given: bool) -> TrackUse {
+        let mut out = TrackUse { anchoring: Vec::new(), speeds: Vec::new(), notes: Vec::new() };
+        for t in tracks {
+            let r = &t.tracked.result;
+            let files = t.tracked.names.join(", ");
+            let slope = at(t.slope_deg);
+            match (r.t1_s, r.t1_sd_s) {
+                (Some(t1), Some(sd)) if sd > 0.0 => {
+                    out.anchoring.push(AnchoringObservation { slope, t1, t1_sd: sd })
+                }
+                _ => {
+                    let why = if r.t1_s.is_none() {
+                        format!("no anchored step among {} steps", r.steps)
+                    } else {
+                        "its SD needs at least two anchored steps with different t1".to_string()
+                    };
+                    let note = format!(
+                        "The tracks at {}° ({files}) give no anchoring time ({why}): not drawn in fig5b nor used in the calibration.",
+                        t.slope_deg
+                    );
+                    eprintln!(
+                        "warning: --tracks at {}° ({files}): no anchoring time ({why}); not used",
+                        t.slope_deg
+                    );
+                    out.notes.push(note);
+                }
+            }
+            if observed_given {
+                continue;
+            }
+            match r.speed_sd_m_s {
+                Some(sd) if sd > 0.0 => {
+                    out.speeds.push(SpeedObservation { slope, speed: r.speed_m_s, speed_sd: sd })
+                }
+                _ => {
+                    let why = format!(
+                        "its SD needs at least two steps with different speeds; found {} steps",
+                        r.steps
+                    );
+                    eprintln!(
+                        "warning: --tracks at {}° ({files}): no observed speed ({why}); not used",
+                        t.slope_deg
+                    );
+                    out.notes.push(format!(
+                        "The tracks at {}° ({files}) give no observed speed ({why}): not drawn in fig3a nor used in the calibration.",
+                        t.slope_deg
+                    ));
+                }
+            }
+        }
+        if observed_given && !tracks.is_empty() {
+            out.notes.push(
+                "The observed speeds are --observed's: the tracks' speeds are shown in this table only."
+                    .into(),
+            );
+        }
+        out
+    }
+}
+
+/// One slope's row of the motion-capture table and of report.json's `tracks`.
+fn track_record(t: &SlopeTracks) -> TrackRecord {
+    let r = &t.tracked.result;
+    TrackRecord {
+        slope_deg: t.slope_deg,
+        files: t.tracked.names.clone(),
+        steps: r.steps,
+        unanchored_steps: r.unanchored_steps,
+        speed_m_s: r.speed_m_s,
+        speed_sd_m_s: r.speed_sd_m_s,
+        t1_s: r.t1_s,
+        t1_sd_s: r.t1_sd_s,
+        slip_m: r.slip_m,
+        slip_sd_m: r.slip_sd_m,
+    }
 }
 
 /// The "where the model and the paper disagree" items, generated from the comparison and the

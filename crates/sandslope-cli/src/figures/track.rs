@@ -281,3 +281,23 @@ impl Figure for TrackFigure {
         self.draw_slopes(&right)
     }
 }
+
+/// Several stride panels (Fig. 3b at several slopes) stacked in one figure, first on top;
+/// each panel is a [`TrackFigure`] without a campaign, drawn at its own size.
+pub struct StridePanels(pub Vec<TrackFigure>);
+
+impl Figure for StridePanels {
+    fn size(&self) -> (u32, u32) {
+        (1000, 650 * self.0.len().max(1) as u32)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        for (panel, area) in self.0.iter().zip(root.split_evenly((self.0.len().max(1), 1))) {
+            panel.draw(&area)?;
+        }
+        Ok(())
+    }
+}

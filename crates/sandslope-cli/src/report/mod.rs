@@ -43,6 +43,39 @@ pub struct SpeedRecord {
     pub model_m_s: Option<f64>,
 }
 
+/// One slope's motion-capture tracks (`--tracks`), pooled over their files.
+#[derive(Debug, Clone, Serialize)]
+pub struct TrackRecord {
+    /// Slope, degrees.
+    pub slope_deg: f64,
+    /// The recordings pooled at this slope, as given or matched.
+    pub files: Vec<String>,
+    /// Steps measured.
+    pub steps: usize,
+    /// Steps without anchoring (the speed never turned upward).
+    pub unanchored_steps: usize,
+    /// Mean step-averaged speed, m/s.
+    pub speed_m_s: f64,
+    /// Its SD across steps, m/s (`null` with fewer than two steps).
+    pub speed_sd_m_s: Option<f64>,
+    /// Mean anchoring time over anchored steps, s (`null` without anchored steps).
+    pub t1_s: Option<f64>,
+    /// Its SD, s.
+    pub t1_sd_s: Option<f64>,
+    /// Mean backward slip over anchored steps, m.
+    pub slip_m: Option<f64>,
+    /// Its SD, m.
+    pub slip_sd_m: Option<f64>,
+}
+
+/// The page's "Motion capture" section: one row per tracked slope, and what was (not) used.
+pub struct TracksSection<'a> {
+    /// One row per slope, lowest first; no section when empty.
+    pub records: &'a [TrackRecord],
+    /// Sentences on how the tracks entered the report (skipped t1s, speeds not used, ...).
+    pub notes: &'a [String],
+}
+
 /// Everything on the page, as `report.json`.
 #[derive(Serialize)]
 pub struct ReportJson<'a> {
@@ -50,6 +83,8 @@ pub struct ReportJson<'a> {
     pub figures: Vec<FigureRecord<'a>>,
     /// Observed against model speeds.
     pub speeds: &'a [SpeedRecord],
+    /// The motion-capture tracks per slope (`--tracks`; empty without).
+    pub tracks: &'a [TrackRecord],
     /// The joint calibration of the terrain's k_s shape on the evidence (`null` if it failed).
     pub calibration: Option<&'a JointCalibration>,
     /// Every number the paper reports beside the model's.
@@ -88,6 +123,7 @@ pub fn page(
     paper: &[PaperComparison],
     calibration: Option<&JointCalibration>,
     disagreements: &[String],
+    tracks: &TracksSection<'_>,
 ) -> String {
     let mut h = String::with_capacity(1 << 20);
     h.push_str("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">");
@@ -165,6 +201,10 @@ pub fn page(
         }
     }
 
+    if !tracks.records.is_empty() {
+        h.push_str(&tracks_section(tracks));
+    }
+
     h.push_str("<h2 id=\"figures\">Figures</h2>\n");
     for f in figures {
         let anchors: String =
@@ -180,5 +220,44 @@ pub fn page(
     }
     h.push_str("<p><small>Made by <code>sandslope report</code>. Self-contained: no scripts, no network.</small></p>");
     h.push_str("</body></html>\n");
+    h
+}
+
+/// `mean ± SD` scaled for display, `mean` alone without an SD, `-` without a mean.
+fn plus_minus(mean: Option<f64>, sd: Option<f64>, scale: f64, decimals: usize) -> String {
+    match (mean, sd) {
+        (Some(m), Some(sd)) => format!("{:.decimals$} ± {:.decimals$}", m * scale, sd * scale),
+        (Some(m), None) => format!("{:.decimals$}", m * scale),
+        _ => "-".into(),
+    }
+}
+
+/// The "Motion capture" section: the tracks' table and notes.
+fn tracks_section(tracks: &TracksSection<'_>) -> String {
+    let mut h = String::from("<h2 id=\"tracks\">Motion capture</h2>\n");
+    h.push_str(
+        "<p>Each slope's recordings (<code>--tracks</code>) pooled and analysed as <code>sandslope track</code> \
+         does (docs/model.md §11): means and SDs across steps; t1 and slip over anchored steps.</p>\n",
+    );
+    h.push_str(
+        "<table><tr><th>slope (°)</th><th>files</th><th>steps</th><th>unanchored</th>\
+         <th>speed ± SD (cm/s)</th><th>t1 ± SD (ms)</th><th>slip ± SD (mm)</th></tr>",
+    );
+    for r in tracks.records {
+        h.push_str(&format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            r.slope_deg,
+            r.files.iter().map(|f| escape(f)).collect::<Vec<_>>().join("<br>"),
+            r.steps,
+            r.unanchored_steps,
+            plus_minus(Some(r.speed_m_s), r.speed_sd_m_s, 100.0, 2),
+            plus_minus(r.t1_s, r.t1_sd_s, 1e3, 1),
+            plus_minus(r.slip_m, r.slip_sd_m, 1e3, 2),
+        ));
+    }
+    h.push_str("</table>\n");
+    for n in tracks.notes {
+        h.push_str(&format!("<p class=\"warn\">{}</p>", escape(n)));
+    }
     h
 }

@@ -28,6 +28,7 @@ other and with the eager raster.
 
 from __future__ import annotations
 
+import contextlib
 import os
 from typing import Any, Callable, Optional, Tuple, TypeVar
 
@@ -94,12 +95,22 @@ def _with_array(source: Any, use: Callable[[Any], T]) -> T:
         return use(source)
     path = os.fspath(source)
     zarr = _zarr()
-    if path.lower().endswith((".tif", ".tiff")):
-        import tifffile
+    with _one_chunk_at_a_time(zarr):
+        if path.lower().endswith((".tif", ".tiff")):
+            import tifffile
 
-        with tifffile.imread(path, aszarr=True) as store:
-            return use(zarr.open(store, mode="r"))
-    return use(zarr.open_array(path, mode="r"))
+            with tifffile.imread(path, aszarr=True) as store:
+                return use(zarr.open(store, mode="r"))
+        return use(zarr.open_array(path, mode="r"))
+
+
+def _one_chunk_at_a_time(zarr: Any) -> Any:
+    """zarr 3 decodes up to 10 chunks of a read at once; a window with its halo touches up to 9,
+    so that held 146 MiB for a 1024 x 1024 float64 window, against 39 MiB one at a time."""
+    config = getattr(zarr, "config", None)
+    if config is not None and config.get("async.concurrency", None) is not None:
+        return config.set({"async.concurrency": 1})
+    return contextlib.nullcontext()
 
 
 def _is_npy(source: Any) -> bool:

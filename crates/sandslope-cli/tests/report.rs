@@ -43,6 +43,12 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
     for id in ["fig6a", "fig6b", "fig6c", "fig6d"] {
         assert!(html.contains(&format!("<span id=\"{id}\"></span>")), "anchor {id} missing");
     }
+    // Element ids are unique, so every #fragment link lands on one place.
+    let mut ids: Vec<&str> = html.split(" id=\"").skip(1).filter_map(|s| s.split('"').next()).collect();
+    let all = ids.len();
+    ids.sort_unstable();
+    ids.dedup();
+    assert_eq!(ids.len(), all, "duplicate element ids in the page");
     // Inline SVG, one per figure element.
     assert_eq!(html.matches("<svg").count(), PAGE_IDS.len());
     for remote in ["src=\"http", "href=\"http", "<script", "@import", "url(http"] {

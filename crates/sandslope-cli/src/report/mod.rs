@@ -171,7 +171,7 @@ pub fn page(
     h.push_str("</table>\n");
 
     if let Some(c) = calibration {
-        h.push_str("<h2 id=\"calibration\">Joint calibration</h2>\n");
+        h.push_str("<h2 id=\"joint-calibration\">Joint calibration</h2>\n");
         h.push_str(&format!(
             "<p>chi² = {:.2} over {} degrees of freedom{}; model-error floor {:.2} cm/s; \
              k<sub>s</sub>(20°)/k<sub>s</sub>(0) = {:.3} (68%: {:.3} to {:.3}; the paper's force tests: about 0.40).</p>",

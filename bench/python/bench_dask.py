@@ -90,6 +90,8 @@ def main():
     ap.add_argument("--chunk", type=int, default=1024)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--source", choices=["npy", "tiff", "zarr", "dask"], default="npy")
+    ap.add_argument("--eager", action="store_true",
+                    help="also time the eager sandslope.risk_raster on the whole DEM in memory (the peer)")
     ap.add_argument("--dir", default=None, help="folder for the DEM file (default: a temporary one)")
     args = ap.parse_args()
 
@@ -130,6 +132,15 @@ def main():
         print(f"  peak RSS {w.rsplit(':', 1)[-1]:>6}        {peak:8.0f} MiB  (idle {idle[w]:.0f} MiB; "
               f"{(peak - idle[w]) / chunk_mib:.1f} float64 chunks above idle)")
     print(f"  mean best-heading p_fail {mean_p:.3e}, cells with a usable climb {climbable:.1%}")
+    if args.eager:
+        # The peer: the whole map at once in this process (rayon on every core), same values.
+        z = np.load(dem) if isinstance(dem, str) and dem.endswith(".npy") else np.asarray(dem)
+        t0 = time.perf_counter()
+        bands = sandslope.risk_raster(z, 0.5, robot=robot, terrain=terrain)
+        eager = time.perf_counter() - t0
+        p = bands[0][np.isfinite(bands[0])]
+        print(f"  eager risk_raster    {eager:8.1f} s  in one process, peak RSS {peak_rss_mib():.0f} MiB; "
+              f"Dask / eager wall = {wall / eager:.2f}; same mean p_fail: {abs(p.mean() - mean_p) <= 1e-6 * max(mean_p, 1e-30)}")
 
 
 if __name__ == "__main__":

@@ -2,12 +2,15 @@
 //! --risk-map`, routes of `sandslope plan --json` with their cells, and the raster reader.
 
 use std::path::PathBuf;
+use std::sync::LazyLock;
 
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use sandslope::plan::{Cell, Descent, ElevationGrid, Objective, PlanRequest, PlanSettings, Planner, Route};
+use sandslope::plan::{
+    Cell, Descent, ElevationGrid, Objective, PitchTableCache, PlanRequest, PlanSettings, Planner, Route,
+};
 use sandslope::risk::UncertainTerrain;
 use sandslope::Regime;
 use sandslope_io::raster::read_raster as read;
@@ -57,6 +60,11 @@ fn inputs(
     Ok((grid, terrain, settings))
 }
 
+/// The pitch tables of this process, shared by every `risk_raster` call: the tiles of a Dask
+/// raster on one worker tabulate the model once, not once per tile (the table was 60% of a
+/// 1024 x 1024 tile's time); results are bit for bit those of a fresh table.
+static PITCH_TABLES: LazyLock<PitchTableCache> = LazyLock::new(PitchTableCache::new);
+
 /// Per cell, the lowest p_fail over the 16 headings and the azimuth of the steepest usable
 /// climb (degrees from north), as `sandslope plan --risk-map` writes them: `2 * rows * cols`
 /// float32 values, band after band.
@@ -93,7 +101,7 @@ pub fn risk_raster<'py>(
     let robot = &robot.inner;
     let bands = py
         .detach(move || {
-            let planner = Planner::new(grid, None, &[terrain], robot, settings)?;
+            let planner = Planner::with_cache(grid, None, &[terrain], robot, settings, &PITCH_TABLES)?;
             let (mut p_fail, climb) = planner.risk_map();
             drop(planner);
             p_fail.extend_from_slice(&climb);

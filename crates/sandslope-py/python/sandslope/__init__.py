@@ -387,8 +387,9 @@ def risk_raster(
 
     ``cv_n``/``cv_s``: coefficients of variation, by the rule of docs/model.md §9 (given, else
     the terrain's SDs, else 0.1 and 0.2), as ``sandslope plan --cv-n --cv-s``. For DEMs larger
-    than memory use
-    :func:`sandslope.dask.risk_raster`, which gives the same values tile by tile.
+    than memory use :func:`sandslope.dask.risk_raster` on the DEM's file, which gives the same
+    values tile by tile. Repeated calls with the same robot and terrain reuse the model's
+    pitch table (kept per process), so later calls are faster with the same results.
     """
     z = _dem(dem)
     cx, cy = _cell_size(cell_size_m)

@@ -26,7 +26,7 @@ mod table;
 pub use grid::{Cell, ElevationGrid};
 pub use result::{plan, Extrapolation, PlanRequest, PlanResult, RiskRaster};
 pub use search::{heading_offsets, Planner, Route, RouteStep, HEADINGS, NO_CLASS};
-pub use table::{PitchTable, MAX_PITCH_DEG, P_FAIL_STEP_DEG, TAN_STEP};
+pub use table::{PitchTable, PitchTableCache, MAX_PITCH_DEG, P_FAIL_STEP_DEG, TAN_STEP};
 
 use serde::{Deserialize, Serialize};
 

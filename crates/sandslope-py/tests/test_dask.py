@@ -79,7 +79,7 @@ class CountingStore:
     """An array-like that records the size of every read."""
 
     def __init__(self, z):
-        self.z, self.shape, self.dtype, self.reads = z, z.shape, z.dtype, []
+        self.z, self.shape, self.dtype, self.ndim, self.reads = z, z.shape, z.dtype, z.ndim, []
 
     def __getitem__(self, index):
         out = self.z[index]
@@ -123,3 +123,35 @@ def test_npy_windows_in_any_layout(tmp_path):
     with pytest.raises(ValueError, match="text.npy'?: not a .npy file"):
         sdask.risk_raster(tmp_path / "text.npy", 0.5, robot=sandslope.Robot.preset("paper-hexapod"),
                           terrain=sandslope.Terrain.preset("glass-beads-300um"))
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")  # zarr and xarray on deliberately odd chunks
+def test_dask_arrays_that_only_read_a_store_are_read_as_the_store(robot, terrain, tmp_path):
+    """da.from_array on a lazy array-like, da.from_zarr and xarray's dask arrays read windows
+    from their source in their own chunks (one task per tile); a computed array does not."""
+    z = dunes(50, 41)
+    eager = sandslope.risk_raster(z, 0.5, robot=robot, terrain=terrain)
+    store = CountingStore(z)
+    lazy = sdask.risk_raster(da.from_array(store, chunks=(16, 12)), 0.5, robot=robot, terrain=terrain)
+    assert lazy.chunks[1:] == ((16, 16, 16, 2), (12, 12, 12, 5))
+    assert len(dict(lazy.__dask_graph__())) == lazy.npartitions
+    np.testing.assert_array_equal(lazy.compute(scheduler="sync"), eager)
+    assert max(r * c for r, c in store.reads) <= (16 + 2) * (12 + 2)
+
+    zarr = pytest.importorskip("zarr")
+    stored = zarr.open_array(str(tmp_path / "dem.zarr"), mode="w", shape=z.shape, chunks=(20, 20), dtype="f8")
+    stored[:] = z
+    lazy = sdask.risk_raster(da.from_zarr(str(tmp_path / "dem.zarr")), 0.5, robot=robot, terrain=terrain)
+    assert len(dict(lazy.__dask_graph__())) == lazy.npartitions == 9
+    np.testing.assert_array_equal(lazy.compute(scheduler="sync"), eager)
+    # Anything computed goes through the halo exchange: more tasks than tiles.
+    computed = sdask.risk_raster(da.from_zarr(str(tmp_path / "dem.zarr")) * 1.0, 0.5, robot=robot, terrain=terrain)
+    assert len(dict(computed.__dask_graph__())) > computed.npartitions
+    np.testing.assert_array_equal(computed.compute(scheduler="sync"), eager)
+
+    xr = pytest.importorskip("xarray")
+    xr.Dataset({"z": (("y", "x"), z)}).to_zarr(str(tmp_path / "xr.zarr"), mode="w")
+    opened = xr.open_zarr(str(tmp_path / "xr.zarr"), chunks={"y": 30, "x": 17})["z"].data
+    lazy = sdask.risk_raster(opened, 0.5, robot=robot, terrain=terrain)
+    assert len(dict(lazy.__dask_graph__())) == lazy.npartitions == 2 * 3
+    np.testing.assert_array_equal(lazy.compute(scheduler="sync"), eager)

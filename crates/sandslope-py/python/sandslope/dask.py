@@ -10,20 +10,23 @@ the interior of each padded tile is kept.
 
 Where the heights come from decides the memory a worker needs:
 
-* **A store** (a path to a ``.npy`` file, a GeoTIFF or a ``.zarr`` array, or an array-like such as a ``zarr.Array`` that
-  slices lazily and pickles as a reference): each task reads its own tile and its one-cell
-  halo straight from the store, computes, and lets go. Tiles depend on nothing else, so memory
-  per worker is a few tiles, whatever the size of the DEM. This is the way to run a DEM larger
-  than memory.
-* **A dask array** (computed by some other graph): the halos are cut from the neighbouring
+* **A store** (a path to a ``.npy`` file, a GeoTIFF or a ``.zarr`` array, or an array-like
+  such as a ``zarr.Array`` that slices lazily and pickles as a reference): each task reads its
+  own tile and its one-cell halo straight from the store, computes, and lets go. Tiles depend
+  on nothing else, so memory per worker is a few tiles, whatever the size of the DEM. This is
+  the way to run a DEM larger than memory. A dask array that does nothing but read such a
+  store (``da.from_zarr``, ``da.from_array`` on a zarr array) is read the same way, in its own
+  chunks.
+* **A dask array** computed by some other graph: the halos are cut from the neighbouring
   chunks (``dask.array.overlap``). Dask computes each chunk once and must keep it until its
   neighbours have taken their halos, so a worker holds about one row of chunks across the map:
   memory grows with the map's width in chunks (measured in docs/python.md). Store such a DEM
   first (``da.to_zarr``) when that is too much.
 
 The planner's pitch table (the model at every pitch and its failure probability every 0.1
-degree) is rebuilt per tile; it depends only on the robot and terrain, so tiles agree with each
-other and with the eager raster.
+degree) depends only on the robot and terrain; each worker process builds it once and keeps it
+for its next tiles (the first entries of a longer table are a shorter one's, bit for bit), so
+tiles agree with each other and with the eager raster.
 """
 
 from __future__ import annotations
@@ -170,6 +173,24 @@ def _tiff_nodata(source: Any) -> Optional[float]:
             return None
 
 
+def _store_behind(z: da.Array) -> Any:
+    """The lazy array a dask array reads its chunks from, when it is nothing more than that
+    (``da.from_zarr``, ``da.from_array`` on a zarr array, xarray or rioxarray opened with
+    ``chunks=``): Dask keeps the source as the only key of an ``original-`` layer beside the
+    layer of getters. ``None`` for anything computed, or held in memory."""
+    layers = z.__dask_graph__().layers
+    if len(layers) != 2:
+        return None
+    originals = [layer for name, layer in layers.items() if str(name).startswith("original-")]
+    if len(originals) != 1 or len(originals[0]) != 1:
+        return None
+    (source,) = originals[0].values()
+    source = getattr(source, "value", source)  # a task-spec DataNode in some Dask versions
+    if isinstance(source, np.ndarray) or tuple(getattr(source, "shape", ())) != z.shape:
+        return None
+    return source if hasattr(source, "__getitem__") else None
+
+
 def _store_shape(source: Any) -> Tuple[Tuple[int, int], Optional[Tuple[int, int]]]:
     """Shape and native chunks of a store, checked here, on the client."""
     if isinstance(source, (str, os.PathLike)) and not os.path.exists(source):
@@ -216,8 +237,10 @@ def risk_raster(
       ``.zarr`` array (both need ``zarr``), or an array-like that slices lazily and
       pickles cheaply (``zarr.Array``): each task reads its tile and one-cell halo from it, so
       memory per worker is bounded by a few tiles whatever the DEM's size;
-    * a dask array: halos are cut from neighbouring chunks, and a worker holds about a row of
-      chunks (see the module's notes);
+    * a dask array that only reads a store (``da.from_zarr(path)``, ``da.from_array`` on a
+      zarr array): read as that store, in the dask array's chunks;
+    * any other dask array: halos are cut from neighbouring chunks, and a worker holds about a
+      row of chunks (see the module's notes);
     * a NumPy array (in memory; chunked like a dask array).
 
     ``chunks``: tile shape (an int or ``(rows, cols)``, any form ``dask.array`` accepts);
@@ -245,6 +268,11 @@ def risk_raster(
     _eager_risk_raster(np.zeros((3, 3)), (cx, cy), **options)
     meta = np.empty((0, 0, 0), dtype=np.float32)
 
+    if isinstance(dem, da.Array) and _store_behind(dem) is not None:
+        # Read the source window by window, in the dask array's own tiles.
+        if chunks is None:
+            chunks = dem.chunks
+        dem = _store_behind(dem)
     if not _is_store(dem):
         z = da.asarray(dem)
         if z.ndim != 2:

@@ -9,6 +9,7 @@ The DEM is a synthetic dune field on 0.5 m cells, n x n, and comes from one of:
 - `npy`, `tiff`, `zarr` (a store): written first to a file in --dir (default: a temporary
   folder; 0.5 GiB at n = 8192) one strip of rows at a time; each task then reads its own tile
   and one-cell halo from the file (tiled, zlib-compressed GeoTIFF; zarr in chunk-sized chunks).
+- `from-zarr`: the zarr file opened as a dask array, `da.from_zarr(path)` (read as its store).
 - `dask` (a computed dask array): `da.fromfunction`, each chunk generated on the worker that needs
   it, so no process ever holds the whole map; the halos are cut from neighbouring chunks.
 Each tile of the raster is
@@ -89,7 +90,7 @@ def main():
     ap.add_argument("--n", type=int, default=8192)
     ap.add_argument("--chunk", type=int, default=1024)
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--source", choices=["npy", "tiff", "zarr", "dask"], default="npy")
+    ap.add_argument("--source", choices=["npy", "tiff", "zarr", "from-zarr", "dask"], default="npy")
     ap.add_argument("--eager", action="store_true",
                     help="also time the eager sandslope.risk_raster on the whole DEM in memory (the peer)")
     ap.add_argument("--dir", default=None, help="folder for the DEM file (default: a temporary one)")
@@ -109,7 +110,9 @@ def main():
         dem = da.fromfunction(dunes, shape=(n, n), chunks=c, dtype=np.float64)
     else:
         t0 = time.perf_counter()
-        dem = write_store(args.source, n, c, folder)
+        dem = write_store(args.source.replace("from-", ""), n, c, folder)
+        if args.source == "from-zarr":
+            dem = da.from_zarr(dem)
         print(f"wrote {dem} in {time.perf_counter() - t0:.1f} s")
     with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=None,
                       memory_limit=0) as cluster, Client(cluster) as client:

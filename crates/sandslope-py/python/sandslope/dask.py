@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 from typing import Any, Callable, Optional, Tuple, TypeVar
 
 import dask.array as da
@@ -95,7 +96,10 @@ def _with_array(source: Any, use: Callable[[Any], T]) -> T:
     ``tifffile``'s zarr view (which reads only the strips or tiles a window touches), a
     ``.zarr`` path, any other object as it is."""
     if not isinstance(source, (str, os.PathLike)):
-        return use(source)
+        # A zarr array (or xarray over one) has imported zarr when it was unpickled here.
+        zarr = sys.modules.get("zarr")
+        with _one_chunk_at_a_time(zarr) if zarr is not None else contextlib.nullcontext():
+            return use(source)
     path = os.fspath(source)
     zarr = _zarr()
     with _one_chunk_at_a_time(zarr):

@@ -379,7 +379,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
         from_zero: true,
         legend: SeriesLabelPosition::UpperLeft,
     };
-    add(&mut figures, "fig5b", "Anchoring time against slope", "The time after touchdown at which the leg reaches the shear-equilibrium depth d_s (docs/model.md §4). The paper plots measured t1 but prints no values; give --t1 to overlay yours.".into(), to_svg(&fig)?);
+    add(&mut figures, "fig5b", "Anchoring time against slope", "The time after touchdown at which the leg reaches the shear-equilibrium depth d_s (docs/model.md §4). The paper plots measured t1 but prints no values; give --t1 (a CSV of means and SDs) or --tracks (motion-capture recordings) to overlay yours.".into(), to_svg(&fig)?);
     let fig = SlopeCurveFigure {
         title: "Net step length".into(),
         y_label: "net step s (mm)".into(),

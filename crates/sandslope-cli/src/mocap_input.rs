@@ -137,16 +137,8 @@ pub fn track_files(
         .collect::<Result<_>>()?;
     bar.finish_and_clear();
     let touchdowns: Vec<Vec<f64>> = touchdowns.iter().map(|p| load_touchdowns(p)).collect::<Result<_>>()?;
-    let recordings: Vec<Recording> = captures
-        .iter()
-        .enumerate()
-        .map(|(i, c)| Recording {
-            positions: &c.positions,
-            frame_rate_hz: c.frame_rate_hz,
-            start_time_s: c.start_time_s,
-            touchdowns_s: touchdowns.get(i).map(|t| t.as_slice()),
-        })
-        .collect();
+    let recordings: Vec<Recording> =
+        captures.iter().enumerate().map(|(i, c)| c.recording(touchdowns.get(i).map(Vec::as_slice))).collect();
     let result = track(&recordings, options, slope).map_err(|e| match e {
         sandslope::GaitError::Param { index, source } => {
             let source = match read.cutoff_flag {

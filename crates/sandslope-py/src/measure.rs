@@ -165,12 +165,7 @@ pub fn track<'py>(
             let recordings: Vec<Recording> = captures
                 .iter()
                 .enumerate()
-                .map(|(i, c)| Recording {
-                    positions: &c.positions,
-                    frame_rate_hz: c.frame_rate_hz,
-                    start_time_s: c.start_time_s,
-                    touchdowns_s: touchdowns.as_ref().map(|t| t[i].as_slice()),
-                })
+                .map(|(i, c)| c.recording(touchdowns.as_ref().map(|t| t[i].as_slice())))
                 .collect();
             let result = track_recordings(&recordings, &options, slope).map_err(|e| match e {
                 sandslope::GaitError::Param { index, source } => anyhow::anyhow!(

@@ -64,6 +64,19 @@ pub struct Capture {
     pub positions: Vec<[f64; 3]>,
 }
 
+impl Capture {
+    /// The library's view of this capture for [`sandslope::gait::track`], with the touchdown
+    /// times given for it (from a gait controller's log), if any.
+    pub fn recording<'a>(&'a self, touchdowns_s: Option<&'a [f64]>) -> sandslope::gait::Recording<'a> {
+        sandslope::gait::Recording {
+            positions: &self.positions,
+            frame_rate_hz: self.frame_rate_hz,
+            start_time_s: self.start_time_s,
+            touchdowns_s,
+        }
+    }
+}
+
 /// The records of a CSV file with their line numbers.
 pub(crate) struct Rows {
     pub path: PathBuf,

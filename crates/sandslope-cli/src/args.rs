@@ -48,22 +48,25 @@ impl TerrainArgs {
     }
 }
 
-/// `--cv-n` and `--cv-s`: the terrain's uncertainty by the one rule of docs/model.md §9.
+/// `--cv-n` and `--cv-s`: the terrain's uncertainty by the one rule of docs/model.md §9 (a
+/// given CV, else the table's SD over its value, else 0.1 / 0.2), shared by `risk`, `design`
+/// and `infer` so that the flags read, check and report the same everywhere.
 #[derive(Debug, Clone, Copy, Args)]
 pub struct UncertaintyArgs {
-    /// Coefficient of variation of k_n (sd / value) at every slope; default: the terrain's
-    /// k_n_sd, else 0.1.
+    /// Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's
+    /// k_n_sd; without either, 0.1 (docs/model.md §9).
     #[arg(long = "cv-n", allow_negative_numbers = true, value_name = "CV")]
     pub cv_n: Option<f64>,
-    /// Coefficient of variation of k_s (sd / value) at every slope; default: the terrain's
-    /// k_s_sd, else 0.2.
+    /// Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's
+    /// k_s_sd; without either, 0.2 (docs/model.md §9).
     #[arg(long = "cv-s", allow_negative_numbers = true, value_name = "CV")]
     pub cv_s: Option<f64>,
 }
 
 impl UncertaintyArgs {
     /// The terrain read as uncertain (a flag's CV, else the table's SDs, else the default CV),
-    /// with the note to print when a default is used.
+    /// with the note to print when a default is used anywhere on the table. Errors name the
+    /// flag: `--cv-n = -1 must be a finite number of at least 0`.
     pub fn apply(&self, terrain: Terrain) -> Result<(UncertainTerrain, Option<String>)> {
         for (flag, cv) in [("--cv-n", self.cv_n), ("--cv-s", self.cv_s)] {
             if let Some(cv) = cv {

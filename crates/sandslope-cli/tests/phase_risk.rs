@@ -389,6 +389,39 @@ fn risk_negative_cv_gets_the_valid_range_not_a_parse_error() {
     assert!(err.contains("at least 0"), "{err}");
 }
 
+/// `risk` reads `--cv-n`/`--cv-s` through the same arguments as `design` and `infer`: the same
+/// help and the same message for the same bad value, naming the flag.
+#[test]
+fn risk_cv_flags_are_the_shared_uncertainty_flags() {
+    for (flag, bad) in [("--cv-n", "-0.5"), ("--cv-s", "NaN"), ("--cv-s", "inf")] {
+        let want = format!("error: {flag} = {bad} must be a finite number of at least 0\n");
+        let risk = sandslope().args(["risk", "--slope", "20", flag, bad]).output().unwrap();
+        let design = sandslope()
+            .args(["design", "--vary", "leg_width_m=0.005:0.02:4:log", "--slope-target", "20", flag, bad])
+            .output()
+            .unwrap();
+        for out in [risk, design] {
+            assert_eq!(out.status.code(), Some(2));
+            assert_eq!(String::from_utf8_lossy(&out.stderr), want);
+            assert!(out.stdout.is_empty());
+        }
+    }
+    // The same help for the flags everywhere (words compared, whatever clap's line wrapping).
+    let help = |cmd: &str| {
+        let out = sandslope().args([cmd, "--help"]).output().unwrap();
+        String::from_utf8(out.stdout).unwrap().split_whitespace().collect::<Vec<_>>().join(" ")
+    };
+    for cmd in ["risk", "design", "infer"] {
+        let text = help(cmd);
+        for says in [
+            "--cv-n <CV> Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's k_n_sd; without either, 0.1 (docs/model.md §9)",
+            "--cv-s <CV> Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's k_s_sd; without either, 0.2 (docs/model.md §9)",
+        ] {
+            assert!(text.contains(says), "{cmd}: {text}");
+        }
+    }
+}
+
 /// Reads a `.npy` file written by sandslope: (descr, shape, raw data).
 fn read_npy(path: &Path) -> (String, Vec<usize>, Vec<u8>) {
     let bytes = std::fs::read(path).unwrap();

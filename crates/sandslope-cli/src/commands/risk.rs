@@ -20,6 +20,7 @@ use sandslope::{RegimeProbabilities, Robot, Slope};
 
 use crate::args::{
     beyond_last_point, check_flag, default_axis, parse_axis, warn_extrapolated, RobotArgs, TerrainArgs,
+    UncertaintyArgs,
 };
 use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
@@ -51,14 +52,8 @@ pub struct RiskArgs {
     pub robot: RobotArgs,
     #[command(flatten)]
     pub terrain: TerrainArgs,
-    /// Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's
-    /// k_n_sd; without either, 0.1 (docs/model.md §9).
-    #[arg(long = "cv-n", allow_negative_numbers = true, value_name = "CV")]
-    pub cv_n: Option<f64>,
-    /// Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's
-    /// k_s_sd; without either, 0.2 (docs/model.md §9).
-    #[arg(long = "cv-s", allow_negative_numbers = true, value_name = "CV")]
-    pub cv_s: Option<f64>,
+    #[command(flatten)]
+    pub uncertainty: UncertaintyArgs,
     /// Largest acceptable failure probability, for the safe-slope limit and --solve.
     #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = 0.05)]
     pub max_risk: f64,
@@ -219,13 +214,6 @@ fn describe_slope_limit(limit: &SafeLimit, max_risk: f64) -> String {
     }
 }
 
-fn uncertain_terrain(args: &RiskArgs) -> Result<UncertainTerrain> {
-    UncertainTerrain::new(args.terrain.load()?, args.cv_n, args.cv_s).map_err(|e| {
-        let flag = format!("--{}", e.key.replace('_', "-"));
-        anyhow!("{}", e.renamed(flag))
-    })
-}
-
 /// Runs `sandslope risk`.
 pub fn run(args: RiskArgs) -> Result<()> {
     let robot = args.robot.load()?;
@@ -240,7 +228,9 @@ pub fn run(args: RiskArgs) -> Result<()> {
     if max_risk <= 0.0 || max_risk >= 1.0 {
         bail!("--max-risk = {max_risk} must be strictly between 0 and 1");
     }
-    let terrain = uncertain_terrain(&args)?;
+    // The note `apply` returns covers the whole table; each mode below notes the defaults at
+    // the slopes it evaluates instead.
+    let (terrain, _) = args.uncertainty.apply(args.terrain.load()?)?;
     if let Some(p) = &args.plot {
         crate::figures::format_of(p)?;
         crate::output::check_parent_exists(p)?;

@@ -141,7 +141,14 @@ fn phase_plot_is_written_and_bad_input_fails_cleanly() {
 fn risk_without_uncertainty_is_certain() {
     let v = json(&["risk", "--slope", "0", "--cv-n", "0", "--cv-s", "0", "--json"]);
     let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
-    assert_eq!(keys, ["p_fail", "p_not_success", "p_regime", "slope_deg"]);
+    assert_eq!(
+        keys,
+        ["cv_n", "cv_n_source", "cv_s", "cv_s_source", "p_fail", "p_not_success", "p_regime", "slope_deg"]
+    );
+    assert_eq!(
+        (&v["cv_n"], &v["cv_n_source"], &v["cv_s_source"]),
+        (&0.0.into(), &"given".into(), &"given".into())
+    );
     assert_eq!(v["p_fail"], 0.0);
     assert_eq!(v["p_regime"]["success"], 1.0);
     // At 26 deg, above the preset's repose of 25 deg: certain slippage.
@@ -195,6 +202,77 @@ fn risk_uses_the_terrain_sds_interpolated_like_the_values() {
         .assert()
         .code(2)
         .stderr(predicate::str::contains("--max-risk = 1.5"));
+}
+
+/// Every `risk --json` result carries the CVs it used and where each came from (docs/model.md
+/// §9: given, else the table's SD over its value, else the default), as the CSV and the table
+/// do; the stderr note about defaults stays.
+#[test]
+fn risk_json_reports_the_uncertainty_used_and_its_source() {
+    let dir = tempfile::tempdir().unwrap();
+    let t = write(dir.path(), "sand.toml", UNCERTAIN);
+    let bare = write(dir.path(), "bare.toml", "[[points]]\nslope_deg = 0.0\nk_n = 7.0e5\nk_s = 2.0e6\n");
+    let close = |v: &Value, want: f64| (v.as_f64().unwrap() - want).abs() < 1e-12;
+    // Per slope, from the table: cv_n 1.4e5/7e5 = 0.2; cv_s at 10 deg 3.5e5/1.5e6, at 20 deg 0.3.
+    let v = json(&["risk", "--terrain", &t, "--slope", "10,20", "--json"]);
+    for (p, cv_s) in v.as_array().unwrap().iter().zip([3.5e5 / 1.5e6, 0.3]) {
+        assert!(close(&p["cv_n"], 0.2) && close(&p["cv_s"], cv_s), "{p}");
+        assert_eq!((p["cv_n_source"].as_str(), p["cv_s_source"].as_str()), (Some("table"), Some("table")));
+    }
+    // A given CV for k_s only; no SDs at all: the defaults, named as such, and the note on stderr.
+    let v = json(&["risk", "--terrain", &t, "--slope", "10", "--cv-s", "0.05", "--json"]);
+    assert_eq!(
+        (v["cv_s"].as_f64(), v["cv_s_source"].as_str(), v["cv_n_source"].as_str()),
+        (Some(0.05), Some("given"), Some("table"))
+    );
+    let out = sandslope().args(["risk", "--terrain", &bare, "--slope", "10", "--json"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!((v["cv_n"].as_f64(), v["cv_s"].as_f64()), (Some(0.1), Some(0.2)));
+    assert_eq!((v["cv_n_source"].as_str(), v["cv_s_source"].as_str()), (Some("default"), Some("default")));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("default cv k_n = 0.1"));
+    // --solve slope: the CVs where the limit's p_fail was evaluated, and the defaults over the table.
+    let v = json(&["risk", "--terrain", &bare, "--cv-n", "0.3", "--solve", "slope", "--json"]);
+    assert_eq!((v["cv_n"].as_f64(), v["cv_n_source"].as_str()), (Some(0.3), Some("given")));
+    assert_eq!((v["cv_s"].as_f64(), v["cv_s_source"].as_str()), (Some(0.2), Some("default")));
+    assert_eq!(v["defaults_used"], serde_json::json!({"k_n": false, "k_s": true}));
+    let v = json(&["risk", "--terrain", &t, "--solve", "slope", "--json"]);
+    let at = v["safe_slope_deg"].as_f64().unwrap();
+    assert!(at > 0.0 && at < 25.0, "{v}");
+    // From 0 deg (4e5 / 2e6) to 20 deg (3e5 / 1e6) and beyond (docs/model.md §7) both are linear.
+    let (sd, k) = (4e5 - 1e5 * at / 20.0, 2e6 - 1e6 * at / 20.0);
+    assert!(close(&v["cv_s"], sd / k) && v["cv_s_source"] == "table", "{v}");
+    assert_eq!(v["defaults_used"], serde_json::json!({"k_n": false, "k_s": false}));
+    // --solve mass at one slope and over several (the envelope), and --map.
+    let v = json(&["risk", "--terrain", &t, "--slope", "20", "--solve", "mass", "--json"]);
+    assert!(close(&v["cv_s"], 0.3) && v["cv_s_source"] == "table" && v["max_mass_kg"].is_number(), "{v}");
+    let v =
+        json(&["risk", "--terrain", &t, "--slope", "0,20", "--cv-n", "0.15", "--solve", "mass", "--json"]);
+    for (p, cv_s) in v["points"].as_array().unwrap().iter().zip([0.2, 0.3]) {
+        assert!(close(&p["cv_s"], cv_s) && p["cv_s_source"] == "table", "{p}");
+        assert!(close(&p["cv_n"], 0.15) && p["cv_n_source"] == "given", "{p}");
+        assert!(p["max_mass_kg"].is_number() && p["limit"]["kind"] == "limit", "{p}");
+    }
+    let v = json(&[
+        "risk",
+        "--terrain",
+        &bare,
+        "--slope",
+        "20",
+        "--cv-s",
+        "0.4",
+        "--map",
+        "--k-n",
+        "1e5:1e7:3",
+        "--k-s",
+        "1e5:1e7:3",
+        "--json",
+    ]);
+    assert_eq!(
+        (v["cv_n_source"].as_str(), v["cv_s_source"].as_str(), v["cv_s"].as_f64()),
+        (Some("default"), Some("given"), Some(0.4))
+    );
+    assert_eq!(v["defaults_used"], serde_json::json!({"k_n": true, "k_s": false}));
 }
 
 /// With no uncertainty the heaviest safe mass is where `predict` turns to failure: check it

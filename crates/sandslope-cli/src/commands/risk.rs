@@ -13,10 +13,10 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 
 use sandslope::risk::{
-    max_safe_mass, payload_envelope, risk_curve, safe_slope_limit, DefaultsUsed, PayloadEnvelope, RiskCurve,
-    RiskMap, SafeLimit, UncertainTerrain,
+    max_safe_mass, payload_envelope, risk_curve, safe_slope_limit, CvSource, DefaultsUsed, PayloadEnvelope,
+    PayloadPoint, RiskCurve, RiskMap, RiskPoint, SafeLimit, UncertainGround, UncertainTerrain,
 };
-use sandslope::{RegimeProbabilities, Robot, Slope};
+use sandslope::{Robot, Slope};
 
 use crate::args::{
     beyond_last_point, check_flag, default_axis, parse_axis, warn_extrapolated, RobotArgs, TerrainArgs,
@@ -136,10 +136,38 @@ struct RegimeRecord {
     sinkage: f64,
 }
 
+/// The uncertainty used at one slope, as every `--json` result prints it beside the numbers
+/// it produced: the coefficients of variation and where each came from (`given`, `table` or
+/// `default`, docs/model.md §9). The same keys as the Python `sandslope.risk` result.
+#[derive(Debug, Clone, Copy, Serialize)]
+struct UsedUncertainty {
+    cv_n: f64,
+    cv_s: f64,
+    cv_n_source: CvSource,
+    cv_s_source: CvSource,
+}
+
+impl UsedUncertainty {
+    fn of(g: &UncertainGround) -> UsedUncertainty {
+        UsedUncertainty {
+            cv_n: g.uncertainty.cv_n(),
+            cv_s: g.uncertainty.cv_s(),
+            cv_n_source: g.cv_n_source,
+            cv_s_source: g.cv_s_source,
+        }
+    }
+
+    fn at(terrain: &UncertainTerrain, slope: Slope) -> UsedUncertainty {
+        UsedUncertainty::of(&terrain.sample(slope))
+    }
+}
+
 /// One slope as printed by `--json`: exactly these keys.
 #[derive(Debug, Clone, Serialize)]
 struct RiskRecord {
     slope_deg: f64,
+    #[serde(flatten)]
+    uncertainty: UsedUncertainty,
     p_fail: f64,
     p_not_success: f64,
     p_regime: RegimeRecord,
@@ -166,6 +194,12 @@ struct SlopeSolution {
     /// The steepest safe slope, or null when none was found (see `limit`).
     safe_slope_deg: Option<f64>,
     limit: SafeLimit,
+    /// The uncertainty at the slope where `limit.p_fail` was evaluated (the safe slope, level
+    /// ground when none is safe, the end of the search when all are).
+    #[serde(flatten)]
+    uncertainty: UsedUncertainty,
+    /// Whether a default CV was used at some slope of the table (the search covers them all).
+    defaults_used: DefaultsUsed,
 }
 
 /// `--solve mass` as printed by `--json`.
@@ -178,11 +212,41 @@ struct MassSolution {
     max_mass_kg: Option<f64>,
     max_payload_kg: Option<f64>,
     limit: SafeLimit,
+    /// The uncertainty at `slope_deg`.
+    #[serde(flatten)]
+    uncertainty: UsedUncertainty,
 }
 
-fn record(slope_deg: f64, p: &RegimeProbabilities) -> RiskRecord {
+/// One point of the payload envelope as printed by `--json`: the library's point and the
+/// uncertainty at its slope.
+#[derive(Debug, Clone, Serialize)]
+struct EnvelopeRecord<'a> {
+    #[serde(flatten)]
+    point: &'a PayloadPoint,
+    #[serde(flatten)]
+    uncertainty: UsedUncertainty,
+}
+
+/// `--solve mass` over several slopes as printed by `--json`: [`PayloadEnvelope`]'s keys, each
+/// point with its uncertainty.
+#[derive(Debug, Clone, Serialize)]
+struct EnvelopeOutput<'a> {
+    max_risk: f64,
+    robot_mass_kg: f64,
+    points: Vec<EnvelopeRecord<'a>>,
+    defaults_used: DefaultsUsed,
+}
+
+fn record(point: &RiskPoint) -> RiskRecord {
+    let (slope_deg, p) = (point.slope_deg, &point.probabilities);
     RiskRecord {
         slope_deg,
+        uncertainty: UsedUncertainty {
+            cv_n: point.cv_n,
+            cv_s: point.cv_s,
+            cv_n_source: point.cv_n_source,
+            cv_s_source: point.cv_s_source,
+        },
         p_fail: p.p_fail(),
         p_not_success: p.p_not_success(),
         p_regime: RegimeRecord {
@@ -264,7 +328,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
             if let Some(path) = &args.plot {
                 save(path, &EnvelopeFigure::new(&env, &robot_title(&robot, &terrain)))?;
             }
-            return print_envelope(&env, format);
+            return print_envelope(&env, &terrain, format);
         }
         Some(Solve::Mass) => {
             let slope = slope_of(slopes[0])?;
@@ -278,6 +342,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
                 max_mass_kg: limit.value(),
                 max_payload_kg: limit.value().map(|m| m - own),
                 limit,
+                uncertainty: UsedUncertainty::at(&terrain, slope),
             };
             if args.plot.is_some() {
                 let s_limit = safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
@@ -301,7 +366,19 @@ pub fn run(args: RiskArgs) -> Result<()> {
             if args.plot.is_some() {
                 draw_curve(&args, &robot, &terrain, &slopes, max_risk, &limit, json)?;
             }
-            let sol = SlopeSolution { max_risk, safe_slope_deg: limit.value(), limit };
+            // Where the search evaluated `limit.p_fail`: it scans up from level ground.
+            let at = match limit {
+                SafeLimit::NoneSafe { .. } => 0.0,
+                SafeLimit::Limit { value, .. } => value,
+                SafeLimit::BeyondRange { up_to, .. } => up_to,
+            };
+            let sol = SlopeSolution {
+                max_risk,
+                safe_slope_deg: limit.value(),
+                limit,
+                uncertainty: UsedUncertainty::at(&terrain, slope_of(at)?),
+                defaults_used: terrain.defaults_used(),
+            };
             return match format {
                 Format::Json => print_json(&sol),
                 Format::Csv => {
@@ -351,8 +428,7 @@ fn robot_title(robot: &Robot, terrain: &UncertainTerrain) -> String {
 fn print_curve(curve: &RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, format: Format) -> Result<()> {
     match format {
         Format::Json => {
-            let records: Vec<RiskRecord> =
-                curve.points.iter().map(|p| record(p.slope_deg, &p.probabilities)).collect();
+            let records: Vec<RiskRecord> = curve.points.iter().map(record).collect();
             if records.len() == 1 {
                 print_json(&records[0])
             } else {
@@ -418,9 +494,24 @@ fn print_curve(curve: &RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, form
     }
 }
 
-fn print_envelope(env: &PayloadEnvelope, format: Format) -> Result<()> {
+fn print_envelope(env: &PayloadEnvelope, terrain: &UncertainTerrain, format: Format) -> Result<()> {
     match format {
-        Format::Json => print_json(env),
+        Format::Json => {
+            let points = env
+                .points
+                .iter()
+                .map(|point| {
+                    let uncertainty = UsedUncertainty::at(terrain, slope_of(point.slope_deg)?);
+                    Ok(EnvelopeRecord { point, uncertainty })
+                })
+                .collect::<Result<Vec<_>>>()?;
+            print_json(&EnvelopeOutput {
+                max_risk: env.max_risk,
+                robot_mass_kg: env.robot_mass_kg,
+                points,
+                defaults_used: env.defaults_used,
+            })
+        }
         Format::Csv => {
             let rows: Vec<MassRow> = env
                 .points
@@ -549,8 +640,9 @@ fn draw_curve(
 #[derive(Serialize)]
 struct MapSummary {
     slope_deg: f64,
-    cv_n: f64,
-    cv_s: f64,
+    /// The uncertainty at `slope_deg`, applied around every cell's medians.
+    #[serde(flatten)]
+    uncertainty: UsedUncertainty,
     max_risk: f64,
     k_n_axis: sandslope::Axis,
     k_s_axis: sandslope::Axis,
@@ -630,8 +722,7 @@ fn run_map(
     let terrain_p_fail = sandslope::regime_probabilities(robot, slope, &ground, u).p_fail();
     let summary = MapSummary {
         slope_deg,
-        cv_n: u.cv_n(),
-        cv_s: u.cv_s(),
+        uncertainty: UsedUncertainty::of(&sample),
         max_risk,
         k_n_axis,
         k_s_axis,

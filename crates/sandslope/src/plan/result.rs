@@ -3,7 +3,8 @@
 //! and, if asked, the risk raster (docs/model.md §8, §9).
 
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::ser::{SerializeMap, SerializeSeq};
+use serde::{Serialize, Serializer};
 
 use super::grid::{Cell, ElevationGrid};
 use super::search::{Planner, Route};
@@ -50,7 +51,11 @@ pub struct PlanResult {
     pub start: Cell,
     /// Goal cell.
     pub goal: Cell,
-    /// The route of each objective, or why none exists, in [`Objective`] order.
+    /// The route of each objective, or why none exists, in [`Objective`] order. Serialised as
+    /// a list of objects, `{"objective": "time", "route": {...}}` or `{"objective": "time",
+    /// "no_route": {"reason": "goal_unreachable", "message": "..."}}`, not as tuples and
+    /// `Ok`/`Err` variants.
+    #[serde(serialize_with = "routes_as_objects")]
     pub routes: Vec<(Objective, Result<Route, NoRoute>)>,
     /// The risk raster, if asked for.
     pub risk: Option<RiskRaster>,
@@ -59,6 +64,38 @@ pub struct PlanResult {
     /// The planner (grid, gradients, pitch tables), for figures and further routes.
     #[serde(skip)]
     pub planner: Planner,
+}
+
+/// Serialises [`PlanResult::routes`] as a list of `{"objective", "route" | "no_route"}`
+/// objects.
+fn routes_as_objects<S: Serializer>(
+    routes: &[(Objective, Result<Route, NoRoute>)],
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    /// Why an objective has no route: the reason and its explanation for users.
+    #[derive(Serialize)]
+    struct Missing {
+        reason: NoRoute,
+        message: &'static str,
+    }
+    /// One objective's outcome.
+    struct Outcome<'a>(Objective, &'a Result<Route, NoRoute>);
+    impl Serialize for Outcome<'_> {
+        fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+            let mut m = serializer.serialize_map(Some(2))?;
+            m.serialize_entry("objective", &self.0)?;
+            match self.1 {
+                Ok(route) => m.serialize_entry("route", route)?,
+                Err(e) => m.serialize_entry("no_route", &Missing { reason: *e, message: e.explain() })?,
+            }
+            m.end()
+        }
+    }
+    let mut seq = serializer.serialize_seq(Some(routes.len()))?;
+    for (objective, outcome) in routes {
+        seq.serialize_element(&Outcome(*objective, outcome))?;
+    }
+    seq.end()
 }
 
 impl PlanResult {
@@ -170,6 +207,46 @@ mod tests {
         assert_eq!(risk.p_fail.len(), 400);
         assert!(risk.p_fail[0].is_nan() && risk.p_fail[21].is_finite());
         assert_eq!(r.extrapolation, None);
+    }
+
+    /// The routes serialise as objects named by objective, a found route under `route` and a
+    /// missing one under `no_route` with its reason, never as tuples or `Ok`/`Err`.
+    #[test]
+    fn routes_serialise_as_objects_by_objective() {
+        // A 45 degree grade to the east: the distance route goes straight up it, the time
+        // objective (success edges only) finds none.
+        let request = PlanRequest {
+            start: Cell { col: 2, row: 10 },
+            goal: Cell { col: 17, row: 10 },
+            objectives: vec![Objective::Time],
+            risk_map: false,
+        };
+        let r = plan(
+            tilted(20, 1.0),
+            None,
+            &class(Terrain::constant(7e5, 2e6).unwrap()),
+            &paper_robot(),
+            PlanSettings::default(),
+            &request,
+            &|_, _, _| {},
+        )
+        .unwrap();
+        let no_route = *r.route(Objective::Time).unwrap().as_ref().unwrap_err();
+        let v = serde_json::to_value(&r).unwrap();
+        let routes = v["routes"].as_array().unwrap();
+        assert_eq!(routes.len(), 2);
+        let time = routes[0].as_object().unwrap();
+        assert_eq!(time.keys().collect::<Vec<_>>(), ["no_route", "objective"]);
+        assert_eq!(time["objective"], "time");
+        assert_eq!(time["no_route"]["reason"], serde_json::to_value(no_route).unwrap());
+        assert_eq!(time["no_route"]["message"], no_route.explain());
+        let distance = routes[1].as_object().unwrap();
+        assert_eq!(distance.keys().collect::<Vec<_>>(), ["objective", "route"]);
+        assert_eq!(distance["objective"], "distance");
+        // 15 cells of sqrt(1 + 1^2) m.
+        let length = distance["route"]["length_m"].as_f64().unwrap();
+        assert!((length - 15.0 * 2f64.sqrt()).abs() < 1e-4, "{length}");
+        assert_eq!(distance["route"]["cells"].as_array().unwrap().len(), 16);
     }
 
     #[test]

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Benchmark of `sandslope design` on 10^5 designs, against the general risk routine.
+"""Benchmark of `sandslope design` on 10^5 designs, against `risk --solve slope` per design.
 
 What it does (run from anywhere; builds the release binary the first time):
 1. builds the release binary (`cargo build --release -p sandslope-cli`);
@@ -8,10 +8,11 @@ What it does (run from anywhere; builds the release binary the first time):
    design to a CSV file, `--repeat` times (default 3), and reports each run, the median, how
    many runs met the 60 s target, the CPU time (user + system, all threads), the machine's core count and the 1-minute load average
    (2 cores are shared by several sessions on the development machine);
-3. times `sandslope risk --solve slope` (the general routine: adaptive Simpson quadrature of
-   P(slippage) and P(not success) with Brent's method for each critical k_s) for a sample of
-   the same designs, one process each, and prints the time 10^5 of them would take and the
-   ratio to the median design run;
+3. times `sandslope risk --solve slope` for a sample of the same designs, one process each, and
+   prints the time 10^5 of them would take and the ratio to the median design run (until the
+   risk command shared design's fast search, this was the general routine: adaptive Simpson
+   quadrature of P(slippage) and P(not success) with Brent's method for each critical k_s; it
+   now runs the same search, plus one reference quadrature and a process start per design);
 4. checks that the sampled designs' safe-slope limits in the design CSV are the numbers
    `risk --solve slope` printed.
 

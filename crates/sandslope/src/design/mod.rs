@@ -5,8 +5,9 @@
 //! (docs/model.md §2) varied over ranges; [`explore`] evaluates every combination on an
 //! uncertain terrain (docs/model.md §9) and returns, per design:
 //!
-//! - the *safe-slope limit*, the steepest slope with `p_fail < max_risk`, exactly as
-//!   `sandslope risk --solve slope` computes it ([`failure::safe_slope_limit`]);
+//! - the *safe-slope limit*, the steepest slope with `p_fail < max_risk`: the search of
+//!   `sandslope risk --solve slope` ([`crate::risk::safe_slope_limit`]), reporting the fast
+//!   p_fail it decided with ([`crate::risk::p_fail`]) rather than one more reference quadrature;
 //! - at the target slope: the speed, regime and `k_s_margin` on the median terrain
 //!   (docs/model.md §5, §6, §13) and `p_fail`;
 //! - whether it is on the *Pareto front* over (safe-slope limit, speed at the target slope),
@@ -14,8 +15,6 @@
 //!
 //! Designs the model cannot hold (a hip height above 2R, for instance) are kept, with the
 //! reason, so a user sees which corner of the space is impossible rather than a shorter list.
-
-pub mod failure;
 
 use std::fmt;
 
@@ -27,7 +26,8 @@ use crate::error::ParamError;
 use crate::model::predict;
 use crate::phase::AxisScale;
 use crate::regime::Regime;
-use crate::risk::{SafeLimit, UncertainTerrain};
+use crate::risk::limits::{safe_slope_search, ReportedPFail};
+use crate::risk::{p_fail, SafeLimit, UncertainTerrain};
 use crate::robot::{Robot, RobotSpec};
 use crate::slope::Slope;
 
@@ -427,13 +427,13 @@ pub fn evaluate(robot: &Robot, terrain: &UncertainTerrain, goal: &DesignGoal) ->
     )
     .ok()
     .map(|k| ground.k_s / k);
-    let safe_limit = failure::safe_slope_limit(robot, terrain, goal.max_risk);
+    let safe_limit = safe_slope_search(robot, terrain, goal.max_risk, ReportedPFail::Fast);
     Performance {
         safe_slope_deg: safe_limit.value(),
         safe_limit,
         speed_m_s: prediction.speed,
         regime: prediction.regime,
-        p_fail: failure::p_fail(robot, target, &ground, u),
+        p_fail: p_fail(robot, target, &ground, u),
         k_s_margin,
     }
 }

@@ -1,10 +1,16 @@
 //! Limits under uncertainty (docs/model.md §9): the safe-slope limit (the steepest slope
 //! below a failure-risk threshold), the heaviest safe mass at a slope, and the payload
 //! envelope (the heaviest safe mass at each of several slopes).
+//!
+//! Every limit is one search, [`first_crossing`]: a scan up a range and a bisection of the
+//! first point where `p_fail >= max_risk`. The safe-slope limit decides each point with the
+//! fast p_fail of [`super::failure_probability`] (used by `risk --solve slope`, the report, the Python
+//! `safe_slope` and every design of `design`); the mass searches with the reference quadrature.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::failure_probability::FailureProbability;
 use super::quadrature::regime_probabilities;
 use super::uncertainty::{DefaultsUsed, UncertainTerrain};
 use super::RegimeProbabilities;
@@ -63,36 +69,66 @@ pub(crate) fn check_risk(max_risk: f64) -> Result<f64, ParamError> {
     }
 }
 
-/// Scans `p_fail` at the ascending points `scan` (a few in parallel at a time) for the first
-/// at or above `max_risk`, then bisects between it and the point before down to `tol`.
-/// Between scan points the crossing is assumed to be single.
-fn first_crossing(p_fail: &(dyn Fn(f64) -> f64 + Sync), scan: &[f64], max_risk: f64, tol: f64) -> SafeLimit {
-    let p0 = p_fail(scan[0]);
-    if p0 >= max_risk {
-        return SafeLimit::NoneSafe { p_fail: p0 };
+/// What a search learns at one point: whether `p_fail >= max_risk` there, and p_fail itself
+/// if deciding computed it (a bound may decide without it).
+type Verdict = (bool, Option<f64>);
+
+/// Scans the ascending points `scan` (`batch` at a time, in parallel when `batch > 1`) for the
+/// first where `decide` says `p_fail >= max_risk`, then bisects between it and the point before
+/// down to `tol`. Between scan points the crossing is assumed to be single. The result carries
+/// p_fail at the point it returns: the one `decide` computed there, else `p_fail(point)`.
+fn first_crossing(
+    decide: &(dyn Fn(f64) -> Verdict + Sync),
+    p_fail: &dyn Fn(f64) -> f64,
+    scan: &[f64],
+    tol: f64,
+    batch: usize,
+) -> SafeLimit {
+    let value = |x: f64, known: Option<f64>| known.unwrap_or_else(|| p_fail(x));
+    let (fails0, p0) = decide(scan[0]);
+    if fails0 {
+        return SafeLimit::NoneSafe { p_fail: value(scan[0], p0) };
     }
     let (mut lo, mut p_lo) = (scan[0], p0);
-    let batch = 2 * rayon::current_num_threads().max(1);
-    for chunk in scan[1..].chunks(batch) {
-        let ps: Vec<f64> = chunk.par_iter().map(|&x| p_fail(x)).collect();
-        for (&x, &p) in chunk.iter().zip(&ps) {
-            if p >= max_risk {
+    for chunk in scan[1..].chunks(batch.max(1)) {
+        let verdicts: Vec<Verdict> = if chunk.len() > 1 {
+            chunk.par_iter().map(|&x| decide(x)).collect()
+        } else {
+            chunk.iter().map(|&x| decide(x)).collect()
+        };
+        for (&x, &(fails, p)) in chunk.iter().zip(&verdicts) {
+            if fails {
                 let mut hi = x;
                 while hi - lo > tol {
                     let mid = 0.5 * (lo + hi);
-                    let p_mid = p_fail(mid);
-                    if p_mid >= max_risk {
+                    let (fails_mid, p_mid) = decide(mid);
+                    if fails_mid {
                         hi = mid;
                     } else {
                         (lo, p_lo) = (mid, p_mid);
                     }
                 }
-                return SafeLimit::Limit { value: lo, p_fail: p_lo };
+                return SafeLimit::Limit { value: lo, p_fail: value(lo, p_lo) };
             }
             (lo, p_lo) = (x, p);
         }
     }
-    SafeLimit::BeyondRange { up_to: lo, p_fail: p_lo }
+    SafeLimit::BeyondRange { up_to: lo, p_fail: value(lo, p_lo) }
+}
+
+/// A search deciding by the reference p_fail itself: each point is one quadrature, so a few are
+/// evaluated in parallel at a time.
+fn reference_crossing(
+    p_fail: &(dyn Fn(f64) -> f64 + Sync),
+    scan: &[f64],
+    max_risk: f64,
+    tol: f64,
+) -> SafeLimit {
+    let decide = |x: f64| {
+        let p = p_fail(x);
+        (p >= max_risk, Some(p))
+    };
+    first_crossing(&decide, p_fail, scan, tol, 2 * rayon::current_num_threads().max(1))
 }
 
 /// Slope scan step of [`safe_slope_limit`], degrees.
@@ -107,19 +143,64 @@ pub const MAX_SCAN_SLOPE_DEG: f64 = 89.5;
 ///
 /// Scans in steps of [`SLOPE_SCAN_STEP_DEG`] from 0 to [`MAX_SCAN_SLOPE_DEG`], then bisects
 /// the first crossing to [`SLOPE_TOLERANCE_DEG`]. `max_risk` must be in (0, 1).
+///
+/// Each decision `p_fail >= max_risk` is the fast p_fail's ([`super::failure_probability`]: a closed-form
+/// bound below the limit, Gauss-Kronrod near it), about a hundred times cheaper than the
+/// reference quadrature and within 2e-9 of it, so the decisions and the limit are the
+/// reference's (the tests run the reference search beside it). The p_fail reported at the
+/// slope returned is the reference's, [`failure_risk`]: the number [`super::risk_curve`] gives
+/// at that slope, so a limit printed beside a risk curve agrees with it.
 pub fn safe_slope_limit(
     robot: &Robot,
     terrain: &UncertainTerrain,
     max_risk: f64,
 ) -> Result<SafeLimit, ParamError> {
     let max_risk = check_risk(max_risk)?;
+    Ok(safe_slope_search(robot, terrain, max_risk, ReportedPFail::Reference))
+}
+
+/// Which p_fail a safe-slope search reports at the slope it returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ReportedPFail {
+    /// The reference quadrature's ([`failure_risk`]), one more quadrature per search.
+    Reference,
+    /// The fast p_fail the search decided with, free when the search computed it there
+    /// (`design`: 10^5 searches, each reporting p_fail within 2e-9 of the reference).
+    Fast,
+}
+
+/// The search of [`safe_slope_limit`], `max_risk` checked by the caller, reporting p_fail as
+/// `reported` says. Sequential: the fast decisions cost microseconds, below what a parallel
+/// batch costs in scheduling and in points evaluated past the crossing, and `design` runs its
+/// searches in parallel already.
+pub(crate) fn safe_slope_search(
+    robot: &Robot,
+    terrain: &UncertainTerrain,
+    max_risk: f64,
+    reported: ReportedPFail,
+) -> SafeLimit {
     let n = (MAX_SCAN_SLOPE_DEG / SLOPE_SCAN_STEP_DEG).round() as usize;
     let scan: Vec<f64> = (0..=n).map(|i| i as f64 * SLOPE_SCAN_STEP_DEG).collect();
-    let p = |deg: f64| match Slope::from_degrees(deg) {
-        Ok(s) => failure_risk(robot, s, terrain).p_fail(),
-        Err(_) => 1.0,
+    let decide = |deg: f64| -> Verdict {
+        let Ok(s) = Slope::from_degrees(deg) else { return (true, Some(1.0)) };
+        let (ground, u) = terrain.at(s);
+        let (fails, p) = FailureProbability::new(robot, s, &ground, u).fails(max_risk);
+        match reported {
+            ReportedPFail::Fast => (fails, p),
+            ReportedPFail::Reference => (fails, None),
+        }
     };
-    Ok(first_crossing(&p, &scan, max_risk, SLOPE_TOLERANCE_DEG))
+    let p_fail = |deg: f64| {
+        let Ok(s) = Slope::from_degrees(deg) else { return 1.0 };
+        match reported {
+            ReportedPFail::Fast => {
+                let (ground, u) = terrain.at(s);
+                FailureProbability::new(robot, s, &ground, u).p_fail()
+            }
+            ReportedPFail::Reference => failure_risk(robot, s, terrain).p_fail(),
+        }
+    };
+    first_crossing(&decide, &p_fail, &scan, SLOPE_TOLERANCE_DEG, 1)
 }
 
 /// Growth factor between scanned masses in [`max_safe_mass`].
@@ -144,7 +225,7 @@ pub fn max_safe_mass(
     let scan: Vec<f64> = (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).collect();
     let (ground, u) = terrain.at(slope);
     let p = |m: f64| robot.with_mass(m).map_or(1.0, |r| regime_probabilities(&r, slope, &ground, u).p_fail());
-    Ok(first_crossing(&p, &scan, max_risk, 1e-5 * m0))
+    Ok(reference_crossing(&p, &scan, max_risk, 1e-5 * m0))
 }
 
 /// The heaviest safe mass at one slope of a [`PayloadEnvelope`].
@@ -259,6 +340,102 @@ mod tests {
         assert!((m - 1.0).abs() < 1e-4, "{m}");
         // A threshold of 1 is not a probability strictly between 0 and 1.
         assert!(matches!(safe_slope_limit(&r, &t, 1.0), Err(ParamError { .. })));
+    }
+
+    /// The reference search, written out: the scan and bisection of the safe-slope limit with
+    /// every decision and the reported p_fail by the reference quadrature ([`failure_risk`]).
+    fn reference_safe_slope(r: &Robot, t: &UncertainTerrain, max_risk: f64) -> SafeLimit {
+        let p = |deg: f64| failure_risk(r, slope(deg), t).p_fail();
+        if p(0.0) >= max_risk {
+            return SafeLimit::NoneSafe { p_fail: p(0.0) };
+        }
+        let n = (MAX_SCAN_SLOPE_DEG / SLOPE_SCAN_STEP_DEG).round() as usize;
+        let mut lo = 0.0;
+        for i in 1..=n {
+            let mut hi = i as f64 * SLOPE_SCAN_STEP_DEG;
+            if p(hi) >= max_risk {
+                while hi - lo > SLOPE_TOLERANCE_DEG {
+                    let mid = 0.5 * (lo + hi);
+                    if p(mid) >= max_risk {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                return SafeLimit::Limit { value: lo, p_fail: p(lo) };
+            }
+            lo = hi;
+        }
+        SafeLimit::BeyondRange { up_to: lo, p_fail: p(lo) }
+    }
+
+    /// (slope_deg, k_n, k_s) points with SDs of 10% (k_n) and 25% (k_s), repose 25 deg.
+    fn weakening_sand(cv: Option<(f64, f64)>) -> UncertainTerrain {
+        let pts = [(0.0, 7e5, 1.7e6), (10.0, 7e5, 1.56e6), (20.0, 6.5e5, 1.1e6), (24.0, 6e5, 9e5)];
+        let t = table(&pts.map(|(d, k_n, k_s)| (d, k_n, k_s, Some(0.1 * k_n), Some(0.25 * k_s))), Some(25.0));
+        let (n, s) = cv.unzip();
+        UncertainTerrain::new(t, n, s).unwrap()
+    }
+
+    /// The safe-slope limit, decided by the fast p_fail, is the reference search's: the same
+    /// slope bit for bit and the same reported p_fail, on robots and terrains unlike the
+    /// paper's, ending in each of the three ways; `design`'s variant reports the fast p_fail
+    /// within 2e-9 of it. (Each reference search is ~50 quadratures: a few seconds in a debug
+    /// build, so the cases run in parallel.)
+    #[test]
+    fn safe_slope_limit_is_the_reference_search() {
+        let rs = crate::risk::failure_probability::tests::robots();
+        let loose =
+            || table(&[(0.0, 3e5, 9e5, Some(4e4), Some(2e5)), (25.0, 2.8e5, 3e5, None, None)], Some(32.0));
+        let strong = table(&[(0.0, 7e7, 1e12, None, None)], None);
+        let cases = [
+            (&rs[0], weakening_sand(None), 0.05),
+            (&rs[1], weakening_sand(Some((0.2, 0.4))), 0.1),
+            (&rs[2], weakening_sand(Some((0.3, 0.0))), 0.05),
+            (&rs[3], weakening_sand(None), 0.01),
+            (&rs[4], UncertainTerrain::new(loose(), None, None).unwrap(), 0.05),
+            (&rs[0], UncertainTerrain::new(loose(), Some(0.3), Some(0.5)).unwrap(), 0.2),
+            (&rs[1], UncertainTerrain::new(loose(), None, None).unwrap(), 0.05),
+            (&rs[0], UncertainTerrain::new(strong, Some(0.05), Some(0.1)).unwrap(), 0.05),
+        ];
+        let kinds: Vec<&str> = cases
+            .par_iter()
+            .map(|(r, t, max_risk)| {
+                let want = reference_safe_slope(r, t, *max_risk);
+                assert_eq!(safe_slope_limit(r, t, *max_risk).unwrap(), want);
+                let fast = safe_slope_search(r, t, *max_risk, ReportedPFail::Fast);
+                match (want, fast) {
+                    (
+                        SafeLimit::Limit { value: a, p_fail: pa },
+                        SafeLimit::Limit { value: b, p_fail: pb },
+                    ) => {
+                        assert_eq!(a, b);
+                        assert!((pa - pb).abs() < 2e-9, "{pa} vs {pb}");
+                        // Below the threshold at the limit, at or above it just over.
+                        assert!(pa < *max_risk);
+                        let over = failure_risk(r, slope(a + 2.0 * SLOPE_TOLERANCE_DEG), t).p_fail();
+                        assert!(over >= *max_risk, "{a}: {over}");
+                        "limit"
+                    }
+                    (SafeLimit::NoneSafe { p_fail: pa }, SafeLimit::NoneSafe { p_fail: pb }) => {
+                        assert!((pa - pb).abs() < 2e-9 && pa >= *max_risk, "{pa} vs {pb}");
+                        "none_safe"
+                    }
+                    (
+                        SafeLimit::BeyondRange { up_to: a, p_fail: pa },
+                        SafeLimit::BeyondRange { up_to: b, p_fail: pb },
+                    ) => {
+                        assert_eq!(a, b);
+                        assert!((pa - pb).abs() < 2e-9 && pa < *max_risk, "{pa} vs {pb}");
+                        "beyond_range"
+                    }
+                    other => panic!("{other:?}"),
+                }
+            })
+            .collect();
+        for kind in ["limit", "none_safe", "beyond_range"] {
+            assert!(kinds.contains(&kind), "no case ends in {kind}: {kinds:?}");
+        }
     }
 
     #[test]

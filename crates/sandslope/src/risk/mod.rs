@@ -9,19 +9,25 @@
 //!   ground, by deterministic quadrature (the reference; [`quadrature`]).
 //! - [`failure_risk`], [`risk_curve`]: the same on an uncertain terrain, at one or several
 //!   slopes ([`RiskCurve`]).
+//! - [`p_fail`]: the failure probability alone, about a hundred times faster than the
+//!   reference and within 2e-9 of it ([`failure_probability`]); what the safe-slope limit and
+//!   `design` decide with.
 //! - [`safe_slope_limit`] (steepest slope below a failure-risk threshold), [`max_safe_mass`]
-//!   (heaviest safe robot at a slope) and [`payload_envelope`] (that mass at each slope).
+//!   (heaviest safe robot at a slope) and [`payload_envelope`] (that mass at each slope): one
+//!   scan-and-bisect search ([`limits`]).
 //! - [`RiskMap`]: p_fail and p_not_success over a grid of median (k_n, k_s).
 //!
 //! Every result is a plain serialisable value; none draws or writes anything.
 
 pub mod curve;
+pub mod failure_probability;
 pub mod limits;
 pub mod map;
 pub mod quadrature;
 pub mod uncertainty;
 
 pub use curve::{risk_curve, RiskCurve, RiskPoint};
+pub use failure_probability::p_fail;
 pub use limits::{
     failure_risk, max_safe_mass, payload_envelope, safe_slope_limit, PayloadEnvelope, PayloadPoint,
     SafeLimit, MASS_SCAN_FACTOR, MAX_MASS_FACTOR, MAX_SCAN_SLOPE_DEG, SLOPE_SCAN_STEP_DEG,

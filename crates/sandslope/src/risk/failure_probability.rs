@@ -1,61 +1,38 @@
-//! The failure probability and the safe-slope limit, evaluated fast enough for 10^5 designs.
+//! The failure probability `p_fail` fast enough for a safe-slope search per robot, 10^5 robots
+//! at a time (docs/model.md §9): what [`super::safe_slope_limit`] and `design` decide with.
 //!
-//! This is the same quantity as [`crate::risk::failure_risk`] (docs/model.md §9): with
+//! The quantity is the reference's, [`super::regime_probabilities`]`(..).p_fail()`: with
 //! log-normal k_n and k_s, `p_fail = P(sinkage) + P(slippage)`, where
 //! `P(slippage) = ∫_{z*} φ(z) P(k_s < k_crit(k_n(z))) dz` and `k_crit` is the progress boundary
-//! of docs/model.md §13. Two things make it about a hundred times cheaper than the risk
-//! command's general routine, which also integrates `P(not success)` and finds each `k_crit`
-//! with Brent's method:
+//! of docs/model.md §13. The reference integrates `P(slippage)` and `P(not success)` together
+//! and finds each `k_crit` with Brent's method; three things make this about a hundred times
+//! cheaper:
 //!
 //! - `k_crit` in closed form: the net step is a quadratic in the anchoring time `t1`
 //!   (docs/model.md §5), so the `t1` at which `s = 0` is its smaller root, and
-//!   `k_crit = F_a / (W d(t1)^2)` with the leg depth `d(t) ` of §4 (floored at the anchoring
+//!   `k_crit = F_a / (W d(t1)^2)` with the leg depth `d(t)` of §4 (floored at the anchoring
 //!   threshold). The tests check it against [`crate::critical_shear_strength`] to 1e-9.
-//! - adaptive Gauss-Kronrod (7-15 points) quadrature of only `P(slippage)` to 1e-11, and a
-//!   closed-form upper bound that settles `p_fail < max_risk` without any quadrature on slopes
-//!   well below the limit.
+//! - adaptive Gauss-Kronrod (7-15 points) quadrature of only `P(slippage)` to 1e-11: p_fail
+//!   needs no metastable/success boundary.
+//! - a closed-form upper bound ([`FailureProbability::fails`]) that settles `p_fail < max_risk`
+//!   without any quadrature on slopes well below the limit.
 //!
-//! The safe-slope search is the risk command's ([`crate::risk::safe_slope_limit`]): the same
-//! scan every [`SLOPE_SCAN_STEP_DEG`] from level, the same bisection of the first crossing down
-//! to [`SLOPE_TOLERANCE_DEG`], so each decision `p_fail >= max_risk` is the same and the limit
-//! is the same number (the tests compare the two on several robots).
+//! It covers every input the reference does (any robot, repose, `k_s = 0`, a median k_n at or
+//! below the sinkage threshold, zero CVs); the tests check it against the reference to 2e-9 on
+//! robots, slopes, grounds and CVs unlike the paper's. What it does not give is the other
+//! regime probabilities: [`super::failure_risk`] and [`super::risk_curve`] keep the reference.
 
-use std::f64::consts::{FRAC_PI_2, PI, SQRT_2};
+use std::f64::consts::FRAC_PI_2;
 
+use super::quadrature::{density, phi, prob_below, Z_MAX};
+use super::uncertainty::Uncertainty;
 use crate::model::{
     anchoring_threshold_k_s, level_step_length, normal_equilibrium_depth, shear_load_per_leg,
     sinkage_threshold_k_n, G,
 };
-use crate::risk::{
-    SafeLimit, UncertainTerrain, Uncertainty, MAX_SCAN_SLOPE_DEG, SLOPE_SCAN_STEP_DEG, SLOPE_TOLERANCE_DEG,
-};
 use crate::robot::Robot;
 use crate::slope::Slope;
 use crate::terrain::Ground;
-
-/// Standard normal CDF.
-pub(crate) fn phi(z: f64) -> f64 {
-    0.5 * statrs::function::erf::erfc(-z / SQRT_2)
-}
-
-/// Standard normal density.
-fn density(z: f64) -> f64 {
-    (-0.5 * z * z).exp() / (2.0 * PI).sqrt()
-}
-
-/// `P(ln k < ln threshold)` for `ln k ~ Normal(mu, sigma^2)`, as in [`crate::risk`].
-fn prob_below(threshold: f64, mu: f64, sigma: f64) -> f64 {
-    if threshold.is_infinite() {
-        return if threshold > 0.0 { 1.0 } else { 0.0 };
-    }
-    if threshold <= 0.0 {
-        return 0.0;
-    }
-    if sigma == 0.0 {
-        return if threshold.ln() > mu { 1.0 } else { 0.0 };
-    }
-    phi((threshold.ln() - mu) / sigma)
-}
 
 /// The progress boundary `k_crit(k_n)` of one robot at one slope, in closed form.
 #[derive(Debug, Clone, Copy)]
@@ -134,18 +111,17 @@ impl<'a> ProgressBoundary<'a> {
     }
 }
 
-const Z_MAX: f64 = 8.5;
 /// Absolute tolerance of the slippage integral.
 const TOLERANCE: f64 = 1e-11;
 
 /// `p_fail = P(sinkage or slippage)` of `robot` at `slope` on ground whose medians are `median`
-/// (the same value as [`crate::risk::regime_probabilities`]`(..).p_fail()`, to 1e-9).
+/// (the same value as [`super::regime_probabilities`]`(..).p_fail()`, to 2e-9).
 pub fn p_fail(robot: &Robot, slope: Slope, median: &Ground, uncertainty: Uncertainty) -> f64 {
-    Evaluator::new(robot, slope, median, uncertainty).p_fail()
+    FailureProbability::new(robot, slope, median, uncertainty).p_fail()
 }
 
 /// Everything about one (robot, slope, ground) needed for p_fail and its cheap upper bound.
-struct Evaluator<'a> {
+pub(crate) struct FailureProbability<'a> {
     boundary: ProgressBoundary<'a>,
     beyond_repose: bool,
     k_s_positive: bool,
@@ -157,8 +133,13 @@ struct Evaluator<'a> {
     p_sink: f64,
 }
 
-impl<'a> Evaluator<'a> {
-    fn new(robot: &'a Robot, slope: Slope, median: &Ground, u: Uncertainty) -> Evaluator<'a> {
+impl<'a> FailureProbability<'a> {
+    pub(crate) fn new(
+        robot: &'a Robot,
+        slope: Slope,
+        median: &Ground,
+        u: Uncertainty,
+    ) -> FailureProbability<'a> {
         let (sigma_n, sigma_s) = (u.sigma_n(), u.sigma_s());
         let mu_n = median.k_n.ln();
         let k_n_star = sinkage_threshold_k_n(robot, slope);
@@ -173,7 +154,7 @@ impl<'a> Evaluator<'a> {
         } else {
             prob_below(k_n_star, mu_n, sigma_n)
         };
-        Evaluator {
+        FailureProbability {
             boundary: ProgressBoundary::new(robot, slope),
             beyond_repose: median.beyond_repose(slope),
             k_s_positive: median.k_s > 0.0,
@@ -198,7 +179,7 @@ impl<'a> Evaluator<'a> {
         self.beyond_repose || self.p_sink >= 1.0
     }
 
-    fn p_fail(&self) -> f64 {
+    pub(crate) fn p_fail(&self) -> f64 {
         if self.trivially_failed() {
             return 1.0;
         }
@@ -235,62 +216,15 @@ impl<'a> Evaluator<'a> {
         }
     }
 
-    /// Whether `p_fail >= max_risk`, settled by the upper bound when it can be.
-    fn fails(&self, max_risk: f64) -> (bool, Option<f64>) {
+    /// Whether `p_fail >= max_risk`, settled by the upper bound when it can be; p_fail itself
+    /// when it had to be computed.
+    pub(crate) fn fails(&self, max_risk: f64) -> (bool, Option<f64>) {
         if self.upper_bound() < max_risk {
             return (false, None);
         }
         let p = self.p_fail();
         (p >= max_risk, Some(p))
     }
-}
-
-/// The safe-slope limit of `robot` on `terrain`: the same search and the same answer as
-/// [`crate::risk::safe_slope_limit`] (scan every [`SLOPE_SCAN_STEP_DEG`] from level to
-/// [`MAX_SCAN_SLOPE_DEG`], bisect the first crossing to [`SLOPE_TOLERANCE_DEG`]), with p_fail
-/// from [`p_fail`]. `max_risk` must be in (0, 1) (checked by the caller).
-pub fn safe_slope_limit(robot: &Robot, terrain: &UncertainTerrain, max_risk: f64) -> SafeLimit {
-    let decide = |deg: f64| -> (bool, Option<f64>) {
-        match Slope::from_degrees(deg) {
-            Ok(s) => {
-                let (ground, u) = terrain.at(s);
-                Evaluator::new(robot, s, &ground, u).fails(max_risk)
-            }
-            Err(_) => (true, Some(1.0)),
-        }
-    };
-    let value_at = |deg: f64, known: Option<f64>| {
-        known.unwrap_or_else(|| {
-            let s = Slope::from_degrees(deg).expect("scanned slopes are valid");
-            let (ground, u) = terrain.at(s);
-            p_fail(robot, s, &ground, u)
-        })
-    };
-    let n = (MAX_SCAN_SLOPE_DEG / SLOPE_SCAN_STEP_DEG).round() as usize;
-    let (fails0, p0) = decide(0.0);
-    if fails0 {
-        return SafeLimit::NoneSafe { p_fail: value_at(0.0, p0) };
-    }
-    let (mut lo, mut p_lo) = (0.0, p0);
-    for i in 1..=n {
-        let x = i as f64 * SLOPE_SCAN_STEP_DEG;
-        let (fails, p) = decide(x);
-        if fails {
-            let mut hi = x;
-            while hi - lo > SLOPE_TOLERANCE_DEG {
-                let mid = 0.5 * (lo + hi);
-                let (fails_mid, p_mid) = decide(mid);
-                if fails_mid {
-                    hi = mid;
-                } else {
-                    (lo, p_lo) = (mid, p_mid);
-                }
-            }
-            return SafeLimit::Limit { value: lo, p_fail: value_at(lo, p_lo) };
-        }
-        (lo, p_lo) = (x, p);
-    }
-    SafeLimit::BeyondRange { up_to: lo, p_fail: value_at(lo, p_lo) }
 }
 
 /// Gauss-Kronrod 7-15 nodes (non-negative half) and weights.
@@ -358,19 +292,18 @@ fn integrate(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::critical::{critical_shear_strength, StepTarget};
-    use crate::risk::{failure_risk, regime_probabilities};
+    use crate::risk::regime_probabilities;
     use crate::robot::RobotSpec;
-    use crate::terrain::{Terrain, TerrainPoint, TerrainSpec};
 
     fn slope(d: f64) -> Slope {
         Slope::from_degrees(d).unwrap()
     }
 
     /// Robots unlike the paper's: heavy, hip above and below R, a measured level step, few legs.
-    fn robots() -> Vec<Robot> {
+    pub(crate) fn robots() -> Vec<Robot> {
         let p = RobotSpec::paper_hexapod();
         [
             p.clone(),
@@ -403,6 +336,8 @@ mod tests {
         }
     }
 
+    /// The reference is the general quadrature (Simpson to 1e-9 over both boundaries found by
+    /// Brent's method), computed independently of everything in this module.
     #[test]
     fn p_fail_matches_the_risk_quadrature() {
         let cases = [(0.1, 0.2), (0.3, 0.5), (0.0, 0.3), (0.2, 0.0), (0.6, 1.0)];
@@ -431,57 +366,9 @@ mod tests {
                 for (k_n, k_s) in [(7e5, 1.5e6), (2e5, 5e5), (7e5, 3e7)] {
                     let u = Uncertainty::new(0.1, 0.2).unwrap();
                     let g = Ground::new(k_n, k_s).unwrap();
-                    let e = Evaluator::new(&r, slope(deg), &g, u);
+                    let e = FailureProbability::new(&r, slope(deg), &g, u);
                     assert!(e.upper_bound() >= e.p_fail() - 1e-12, "{deg} {k_n} {k_s}");
                 }
-            }
-        }
-    }
-
-    fn terrain(cv: Option<(f64, f64)>) -> UncertainTerrain {
-        let pts = [(0.0, 7e5, 1.7e6), (10.0, 7e5, 1.56e6), (20.0, 6.5e5, 1.1e6), (24.0, 6e5, 9e5)];
-        let spec = TerrainSpec {
-            name: None,
-            repose_deg: Some(25.0),
-            points: pts
-                .iter()
-                .map(|&(slope_deg, k_n, k_s)| TerrainPoint {
-                    slope_deg,
-                    k_n,
-                    k_s,
-                    k_n_sd: Some(0.1 * k_n),
-                    k_s_sd: Some(0.25 * k_s),
-                })
-                .collect(),
-        };
-        let (n, s) = cv.unzip();
-        UncertainTerrain::new(Terrain::new(spec).unwrap(), n, s).unwrap()
-    }
-
-    /// The limit is the risk command's number, not merely close to it (a few robots; the risk
-    /// search costs ~50 quadratures each in a debug build).
-    #[test]
-    fn safe_slope_is_the_risk_commands() {
-        let rs = robots();
-        for (r, t, max_risk) in [
-            (&rs[0], terrain(None), 0.05),
-            (&rs[1], terrain(Some((0.2, 0.4))), 0.1),
-            (&rs[3], terrain(None), 0.01),
-        ] {
-            let want = crate::risk::safe_slope_limit(r, &t, max_risk).unwrap();
-            let got = safe_slope_limit(r, &t, max_risk);
-            match (want, got) {
-                (SafeLimit::Limit { value: a, p_fail: pa }, SafeLimit::Limit { value: b, p_fail: pb }) => {
-                    assert_eq!(a, b);
-                    assert!((pa - pb).abs() < 2e-9);
-                }
-                (SafeLimit::NoneSafe { .. }, SafeLimit::NoneSafe { .. }) => {}
-                other => panic!("{other:?}"),
-            }
-            // And p_fail is below the threshold just under it, above just over it.
-            if let SafeLimit::Limit { value, .. } = got {
-                assert!(failure_risk(r, slope(value), &t).p_fail() < max_risk);
-                assert!(failure_risk(r, slope(value + 2.0 * SLOPE_TOLERANCE_DEG), &t).p_fail() >= max_risk);
             }
         }
     }

@@ -14,7 +14,7 @@
 //!   threshold). The tests check it against [`crate::critical_shear_strength`] to 1e-9.
 //! - adaptive Gauss-Kronrod (7-15 points) quadrature of only `P(slippage)` to 1e-11: p_fail
 //!   needs no metastable/success boundary.
-//! - a closed-form upper bound ([`FailureProbability::fails`]) that settles `p_fail < max_risk`
+//! - a closed-form upper bound (`FailureProbability::fails`) that settles `p_fail < max_risk`
 //!   without any quadrature on slopes well below the limit.
 //!
 //! It covers every input the reference does (any robot, repose, `k_s = 0`, a median k_n at or

@@ -2,7 +2,7 @@
 //! below a failure-risk threshold), the heaviest safe mass at a slope, and the payload
 //! envelope (the heaviest safe mass at each of several slopes).
 //!
-//! Every limit is one search, [`first_crossing`]: a scan up a range and a bisection of the
+//! Every limit is one search, `first_crossing`: a scan up a range and a bisection of the
 //! first point where `p_fail >= max_risk`. The safe-slope limit decides each point with the
 //! fast p_fail of [`super::failure_probability`] (used by `risk --solve slope`, the report, the Python
 //! `safe_slope` and every design of `design`); the mass searches with the reference quadrature.
@@ -18,7 +18,9 @@ use crate::error::ParamError;
 use crate::robot::Robot;
 use crate::slope::Slope;
 
-/// The regime probabilities of `robot` at `slope` on an uncertain terrain (one quadrature).
+/// The regime probabilities of `robot` at `slope` on an uncertain terrain (one reference
+/// quadrature: all four regimes; for p_fail alone [`super::p_fail()`] is about a hundred times
+/// cheaper).
 pub fn failure_risk(robot: &Robot, slope: Slope, terrain: &UncertainTerrain) -> RegimeProbabilities {
     let (ground, u) = terrain.at(slope);
     regime_probabilities(robot, slope, &ground, u)
@@ -224,6 +226,9 @@ pub fn max_safe_mass(
     let n = (MAX_MASS_FACTOR.ln() / MASS_SCAN_FACTOR.ln()).ceil() as i32;
     let scan: Vec<f64> = (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).collect();
     let (ground, u) = terrain.at(slope);
+    // Decided by the reference quadrature, a few masses in parallel. The fast p_fail would
+    // apply here too (it takes any robot), but `--solve mass` runs one search per request, not
+    // 10^5, and switching it would need its own bit-for-bit check against this search.
     let p = |m: f64| robot.with_mass(m).map_or(1.0, |r| regime_probabilities(&r, slope, &ground, u).p_fail());
     Ok(reference_crossing(&p, &scan, max_risk, 1e-5 * m0))
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
 
-use sandslope::infer::{AnchoringObservation, GaitObservation};
+use sandslope::infer::{GaitObservation, MeanAnchoringTime};
 use sandslope::Slope;
 
 use crate::files::read_text;
@@ -151,7 +151,7 @@ pub fn load_step_observation(path: &Path, slope: Slope) -> Result<GaitObservatio
     }
     let anchoring = if t1s.len() >= 2 {
         let (t1, t1_sd, m) = mean_sd(&t1s);
-        (t1_sd > 0.0).then(|| AnchoringObservation { t1_s: t1, t1_se_s: t1_sd / (m as f64).sqrt() })
+        (t1_sd > 0.0).then(|| MeanAnchoringTime { t1_s: t1, t1_se_s: t1_sd / (m as f64).sqrt() })
     } else {
         None
     };

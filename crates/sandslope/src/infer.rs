@@ -135,9 +135,12 @@ impl fmt::Display for InferError {
 
 impl std::error::Error for InferError {}
 
-/// An observed mean anchoring time with its standard error.
+/// The anchoring part of a [`GaitObservation`]: the mean anchoring time over a walk's
+/// anchored steps with the standard error of that mean (no slope: the observation it belongs
+/// to has it). Not [`crate::AnchoringObservation`], the joint calibration's anchoring time at
+/// a slope with its spread (`calibrate --t1`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct AnchoringObservation {
+pub struct MeanAnchoringTime {
     /// Mean anchoring time t1 over steps, s.
     pub t1_s: f64,
     /// Standard error of that mean, s (> 0).
@@ -151,7 +154,7 @@ pub struct GaitObservation {
     slope: Slope,
     speed: f64,
     speed_se: f64,
-    anchoring: Option<AnchoringObservation>,
+    anchoring: Option<MeanAnchoringTime>,
 }
 
 impl GaitObservation {
@@ -161,7 +164,7 @@ impl GaitObservation {
         slope: Slope,
         speed_m_s: f64,
         speed_se_m_s: f64,
-        anchoring: Option<AnchoringObservation>,
+        anchoring: Option<MeanAnchoringTime>,
     ) -> Result<GaitObservation, InferError> {
         let bad = |reason: String| InferError::BadObservation { slope_deg: slope.degrees(), reason };
         if !speed_m_s.is_finite() {
@@ -214,7 +217,7 @@ impl GaitObservation {
         self.speed_se
     }
     /// The anchoring-time observation, if any.
-    pub fn anchoring(&self) -> Option<AnchoringObservation> {
+    pub fn anchoring(&self) -> Option<MeanAnchoringTime> {
         self.anchoring
     }
 }
@@ -372,7 +375,7 @@ pub struct SlopePosterior {
     /// Its standard error, m/s.
     pub speed_se_m_s: f64,
     /// Observed mean anchoring time, if used.
-    pub anchoring: Option<AnchoringObservation>,
+    pub anchoring: Option<MeanAnchoringTime>,
     /// Posterior median of k_s, N/m^3.
     pub k_s_median: f64,
     /// 5% quantile, N/m^3.
@@ -797,7 +800,7 @@ mod tests {
             slope(20.0),
             p.speed.unwrap(),
             0.01,
-            Some(AnchoringObservation { t1_s: t1, t1_se_s: 0.001 }),
+            Some(MeanAnchoringTime { t1_s: t1, t1_se_s: 0.001 }),
         )
         .unwrap();
         let a = posteriors(&r, &t, &[speed_only], &LogUniformPrior::DEFAULT).unwrap().remove(0);
@@ -829,7 +832,7 @@ mod tests {
             for (k, &d) in slopes.iter().enumerate() {
                 let p = predict(&r, slope(d), &Ground::new(7e5, truth(d)).unwrap());
                 let v = p.speed.unwrap() + 0.004 * unit.sample(&mut rng);
-                let anchoring = (trial % 2 == 1).then(|| AnchoringObservation {
+                let anchoring = (trial % 2 == 1).then(|| MeanAnchoringTime {
                     t1_s: p.anchoring_time.unwrap() + 0.002 * unit.sample(&mut rng),
                     t1_se_s: 0.002,
                 });

@@ -37,7 +37,9 @@ use crate::robot::{Robot, RobotSpec};
 use crate::slope::Slope;
 use crate::terrain::{Terrain, TerrainPoint, TerrainSpec};
 
-/// One observed anchoring time with its standard deviation (as `sandslope track` measures it).
+/// One observed anchoring time with its standard deviation (as `sandslope track` measures it)
+/// at a slope, for the joint calibration. `infer`'s per-walk mean with its standard error is
+/// [`crate::infer::MeanAnchoringTime`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AnchoringObservation {
     /// Slope of the trials.

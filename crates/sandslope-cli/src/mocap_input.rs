@@ -1,7 +1,7 @@
 //! Motion-capture input shared by `sandslope track` and `sandslope report --tracks`: the
 //! parsers of the format and upslope flags, the expansion of file arguments (paths or glob
 //! patterns), touchdown files, and the one path from capture files to the library's
-//! [`track`] (read every file, build the [`Recording`]s, run the analysis of docs/model.md
+//! [`track()`] (read every file, build the [`Recording`]s, run the analysis of docs/model.md
 //! §11, name the file in any error). Commands share this code through this module, never
 //! through each other.
 

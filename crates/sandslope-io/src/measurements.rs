@@ -198,7 +198,7 @@ fn unit_scale(unit: &str) -> Option<f64> {
 /// A trial's columns in SI units, with how many data rows the file had.
 #[derive(Debug, Clone)]
 pub struct Recording {
-    /// The columns, for [`sandslope::measure::clean`].
+    /// The columns, for [`sandslope::measure::clean()`].
     pub raw: RawRecording,
     /// Data rows read.
     pub rows: usize,

@@ -84,7 +84,7 @@ pub struct CalibrateArgs {
     /// Normal resistance k_n, N/m^3, at every slope (default: the --forces' or --terrain's k_n).
     #[arg(long = "k-n", value_name = "N/M^3", allow_negative_numbers = true)]
     pub k_n: Option<f64>,
-    /// Name written into the terrain file (default: calibrated-<law> or calibrated-forces).
+    /// Name written into the terrain file (default: `calibrated-<law>` or calibrated-forces).
     #[arg(long)]
     pub name: Option<String>,
     /// Angle of repose written into the terrain file, degrees (default: carried over from the

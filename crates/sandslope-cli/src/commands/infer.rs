@@ -33,7 +33,7 @@ pub enum LawArg {
 /// Arguments of `sandslope infer`.
 #[derive(Debug, Args)]
 pub struct InferArgs {
-    /// Observed speeds: CSV slope_deg,speed_m_s,speed_sd_m_s[,n] (as `track --speeds-out` writes;
+    /// Observed speeds: CSV `slope_deg,speed_m_s,speed_sd_m_s[,n]` (as `track --speeds-out` writes;
     /// with n, the mean's standard error is sd/sqrt(n)).
     #[arg(long, value_name = "FILE", required_unless_present = "steps")]
     pub observed: Option<PathBuf>,

@@ -65,7 +65,7 @@ pub struct Capture {
 }
 
 impl Capture {
-    /// The library's view of this capture for [`sandslope::gait::track`], with the touchdown
+    /// The library's view of this capture for [`sandslope::gait::track()`], with the touchdown
     /// times given for it (from a gait controller's log), if any.
     pub fn recording<'a>(&'a self, touchdowns_s: Option<&'a [f64]>) -> sandslope::gait::Recording<'a> {
         sandslope::gait::Recording {

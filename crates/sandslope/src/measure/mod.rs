@@ -3,13 +3,13 @@
 //!
 //! Everything here works on plain arrays (no file formats), one concept per module:
 //!
-//! - [`clean`]: a [`RawRecording`] holds one trial's columns as read (a blank cell is `None`);
+//! - [`clean`](mod@clean): a [`RawRecording`] holds one trial's columns as read (a blank cell is `None`);
 //!   [`clean()`] drops what cannot be used (blank, non-finite, repeated and saturated samples,
 //!   the return stroke of a recording that goes down and back up) and says what it dropped
 //!   ([`Dropped`]), giving a [`Curve`] sorted by position;
 //! - [`air`]: the in-air offset subtracted from a recording ([`AirCorrection`]), chosen by a
 //!   significance test of the in-air run's trend unless the user forces it ([`AirMode`]);
-//! - [`line`]: line fits (ordinary least squares, Huber), medians and the noise level of a
+//! - [`line`](mod@line): line fits (ordinary least squares, Huber), medians and the noise level of a
 //!   curve estimated from its own samples;
 //! - [`penetration`]: the linear window of force against depth and `k_n = b / A`;
 //! - [`shear`]: the quasi-static plateau of a shear curve and `k_s = F_plateau / (W_p d_p^2)`;

@@ -12,6 +12,7 @@ use sandslope::infer::{GaitObservation, MeanAnchoringTime};
 use sandslope::Slope;
 
 use crate::files::read_text;
+use crate::speeds::{read_speed_table, SpeedColumns};
 
 fn reader(text: &str) -> csv::Reader<&[u8]> {
     csv::ReaderBuilder::new()
@@ -22,76 +23,18 @@ fn reader(text: &str) -> csv::Reader<&[u8]> {
 }
 
 /// Reads a speeds table: `slope_deg,speed_m_s,speed_sd_m_s` and optionally `n` (steps or trials
-/// averaged). With `n` the standard error of the mean is `speed_sd_m_s / sqrt(n)`; without it
-/// `speed_sd_m_s` is taken as that standard error.
+/// averaged), the format `calibrate` reads, through the same reader
+/// ([`crate::speeds::read_speed_table`]). With `n` the standard error of the mean is
+/// `speed_sd_m_s / sqrt(n)`; without it `speed_sd_m_s` is taken as that standard error.
 pub fn load_speed_observations(path: &Path) -> Result<Vec<GaitObservation>> {
-    let text = read_text(path)?;
-    let mut r = reader(&text);
-    let headers = r.headers().map_err(|e| anyhow!("{}: {e}", path.display()))?.clone();
-    let col = |name: &str| headers.iter().position(|h| h == name);
-    let (Some(c_slope), Some(c_speed), Some(c_sd)) =
-        (col("slope_deg"), col("speed_m_s"), col("speed_sd_m_s"))
-    else {
-        bail!(
-            "{}: line 1: columns must be slope_deg,speed_m_s,speed_sd_m_s and optionally n (found {})",
-            path.display(),
-            headers.iter().collect::<Vec<_>>().join(",")
-        );
-    };
-    let c_n = col("n");
-    if let Some(extra) = headers.iter().find(|h| !["slope_deg", "speed_m_s", "speed_sd_m_s", "n"].contains(h))
-    {
-        bail!(
-            "{}: line 1: unknown column `{extra}` (expected slope_deg,speed_m_s,speed_sd_m_s[,n])",
-            path.display()
-        );
-    }
-    let mut out = Vec::new();
-    for (i, row) in r.records().enumerate() {
-        let line = i + 2;
-        let row = row.map_err(|e| anyhow!("{}: line {line}: {e}", path.display()))?;
-        let number = |c: usize, name: &str| -> Result<f64> {
-            row.get(c).and_then(|s| s.parse::<f64>().ok()).ok_or_else(|| {
-                anyhow!(
-                    "{}: line {line}: {name} `{}` is not a number",
-                    path.display(),
-                    row.get(c).unwrap_or("")
-                )
-            })
-        };
-        let slope_deg = number(c_slope, "slope_deg")?;
-        let slope =
-            Slope::from_degrees(slope_deg).map_err(|e| anyhow!("{}: line {line}: {e}", path.display()))?;
-        let speed = number(c_speed, "speed_m_s")?;
-        let sd = number(c_sd, "speed_sd_m_s")?;
-        if !(sd.is_finite() && sd > 0.0) {
-            bail!("{}: line {line}: speed_sd_m_s = {sd} must be greater than 0", path.display());
-        }
-        let se = match c_n {
-            None => sd,
-            Some(c) => {
-                let n: usize =
-                    row.get(c).and_then(|s| s.parse().ok()).filter(|&n| n >= 1).ok_or_else(|| {
-                        anyhow!(
-                            "{}: line {line}: n `{}` must be a whole number of at least 1",
-                            path.display(),
-                            row.get(c).unwrap_or("")
-                        )
-                    })?;
-                sd / (n as f64).sqrt()
-            }
-        };
-        let obs = GaitObservation::new(slope, speed, se, None)
-            .map_err(|e| anyhow!("{}: line {line}: {e}", path.display()))?;
-        out.push(obs);
-    }
-    if out.is_empty() {
-        bail!(
-            "{}: no data rows (expected a header slope_deg,speed_m_s,speed_sd_m_s[,n] and one row per slope)",
-            path.display()
-        );
-    }
-    Ok(out)
+    read_speed_table(path, SpeedColumns::WithCount)?
+        .into_iter()
+        .map(|r| {
+            let se = r.n.map_or(r.speed_sd_m_s, |n| r.speed_sd_m_s / (n as f64).sqrt());
+            GaitObservation::new(r.slope, r.speed_m_s, se, None)
+                .map_err(|e| anyhow!("{}: line {}: {e}", path.display(), r.line))
+        })
+        .collect()
 }
 
 /// Mean, standard deviation and count of `values`.
@@ -183,7 +126,10 @@ mod tests {
             ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.11,0\n", "line 2: speed_sd_m_s = 0"),
             ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.11,-0.01\n", "must be greater than 0"),
             ("slope_deg,speed_m_s,speed_sd_m_s,n\n10,0.11,0.01,0\n", "n `0`"),
-            ("slope_deg,speed,speed_sd_m_s\n10,0.11,0.01\n", "columns must be"),
+            (
+                "slope_deg,speed,speed_sd_m_s\n10,0.11,0.01\n",
+                "line 1: the header is `slope_deg,speed,speed_sd_m_s`",
+            ),
             ("slope_deg,speed_m_s,speed_sd_m_s,k\n10,0.11,0.01,1\n", "unknown column `k`"),
             ("slope_deg,speed_m_s,speed_sd_m_s\n95,0.11,0.01\n", "line 2: slope_deg"),
             ("slope_deg,speed_m_s,speed_sd_m_s\n", "no data rows"),

@@ -21,42 +21,79 @@ pub struct SpeedRow {
     pub speed_sd_m_s: f64,
 }
 
-/// Reads a speeds CSV into observations, validating every row.
-pub fn load_speeds(path: &Path) -> Result<Vec<SpeedObservation>> {
+/// The three columns every speeds table has, in the order `track --speeds-out` writes them.
+const COLUMNS: [&str; 3] = ["slope_deg", "speed_m_s", "speed_sd_m_s"];
+
+/// Which columns a reader of a speeds table accepts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpeedColumns {
+    /// `slope_deg,speed_m_s,speed_sd_m_s` only (`calibrate`, `sweep`, `report`, `track`).
+    Plain,
+    /// Those and optionally `n`, the steps or trials averaged (`infer --observed`).
+    WithCount,
+}
+
+impl SpeedColumns {
+    fn expected(self) -> &'static str {
+        match self {
+            SpeedColumns::Plain => "slope_deg,speed_m_s,speed_sd_m_s",
+            SpeedColumns::WithCount => "slope_deg,speed_m_s,speed_sd_m_s[,n]",
+        }
+    }
+}
+
+/// One validated row of a speeds table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeedTableRow {
+    /// Line of the file (1 is the header), for messages about the row.
+    pub line: u64,
+    /// `slope_deg`, checked.
+    pub slope: Slope,
+    /// `speed_m_s`, finite.
+    pub speed_m_s: f64,
+    /// `speed_sd_m_s`, finite and greater than 0.
+    pub speed_sd_m_s: f64,
+    /// `n` (at least 1), when the table has that column.
+    pub n: Option<usize>,
+}
+
+/// Reads a speeds table, `slope_deg,speed_m_s,speed_sd_m_s` (columns by name, in any order)
+/// and, with [`SpeedColumns::WithCount`], optionally `n`: the one reader of that format
+/// ([`load_speeds`] and `observations::load_speed_observations` build on it). Blank lines
+/// and `#` comments are skipped; errors name the file, its line and the column.
+pub fn read_speed_table(path: &Path, columns: SpeedColumns) -> Result<Vec<SpeedTableRow>> {
     let text = read_text(path)?;
     let mut reader =
         csv::ReaderBuilder::new().trim(csv::Trim::All).comment(Some(b'#')).from_reader(text.as_bytes());
-    const COLUMNS: [&str; 3] = ["slope_deg", "speed_m_s", "speed_sd_m_s"];
+    let expected = columns.expected();
     let headers = reader.headers().map_err(|e| anyhow!("{}: line 1: {e}", path.display()))?.clone();
     let names: Vec<&str> = headers.iter().collect();
-    if names != COLUMNS {
-        bail!(
-            "{}: line 1: the header is `{}`; expected columns slope_deg,speed_m_s,speed_sd_m_s",
-            path.display(),
-            names.join(",")
-        );
+    let col = |name: &str| names.iter().position(|h| *h == name);
+    let (Some(c_slope), Some(c_speed), Some(c_sd)) = (col(COLUMNS[0]), col(COLUMNS[1]), col(COLUMNS[2]))
+    else {
+        bail!("{}: line 1: the header is `{}`; expected columns {expected}", path.display(), names.join(","));
+    };
+    let allowed: &[&str] = match columns {
+        SpeedColumns::Plain => &COLUMNS,
+        SpeedColumns::WithCount => &["slope_deg", "speed_m_s", "speed_sd_m_s", "n"],
+    };
+    if let Some(extra) = names.iter().find(|h| !allowed.contains(h)) {
+        bail!("{}: line 1: unknown column `{extra}` (expected columns {expected})", path.display());
     }
+    let c_n = col("n");
     let mut out = Vec::new();
     for record in reader.records() {
-        let record = record
-            .map_err(|e| anyhow!("{}: {e} (expected columns {})", path.display(), COLUMNS.join(",")))?;
-        let line = record.position().map_or(0, |p| p.line());
-        if record.len() != COLUMNS.len() {
-            bail!(
-                "{}: line {line}: {} cells; expected 3 ({})",
-                path.display(),
-                record.len(),
-                COLUMNS.join(",")
-            );
-        }
+        let record = record.map_err(|e| anyhow!("{}: {e} (expected columns {expected})", path.display()))?;
+        let line = record.position().map_or(0, |p| record_line(&text, p));
         // Cells by column name, so an error names the column, not a field index.
-        let cell = |i: usize| -> Result<f64> {
-            let text = &record[i];
+        let cell = |c: usize| -> Result<f64> {
+            let text = &record[c];
             text.parse::<f64>().map_err(|_| {
-                anyhow!("{}: line {line}: column {}: `{text}` is not a number", path.display(), COLUMNS[i])
+                anyhow!("{}: line {line}: column {}: `{text}` is not a number", path.display(), names[c])
             })
         };
-        let row = SpeedRow { slope_deg: cell(0)?, speed_m_s: cell(1)?, speed_sd_m_s: cell(2)? };
+        let row =
+            SpeedRow { slope_deg: cell(c_slope)?, speed_m_s: cell(c_speed)?, speed_sd_m_s: cell(c_sd)? };
         let slope = Slope::from_degrees(row.slope_deg)
             .map_err(|e| anyhow!("{}: line {line}: {e}", path.display()))?;
         if !row.speed_m_s.is_finite() {
@@ -69,15 +106,46 @@ pub fn load_speeds(path: &Path) -> Result<Vec<SpeedObservation>> {
                 row.speed_sd_m_s
             );
         }
-        out.push(SpeedObservation { slope, speed: row.speed_m_s, speed_sd: row.speed_sd_m_s });
+        let n = match c_n {
+            None => None,
+            Some(c) => Some(record[c].parse::<usize>().ok().filter(|&n| n >= 1).ok_or_else(|| {
+                anyhow!(
+                    "{}: line {line}: n `{}` must be a whole number of at least 1",
+                    path.display(),
+                    &record[c]
+                )
+            })?),
+        };
+        out.push(SpeedTableRow { line, slope, speed_m_s: row.speed_m_s, speed_sd_m_s: row.speed_sd_m_s, n });
     }
     if out.is_empty() {
-        bail!(
-            "{}: no data rows (expected a header slope_deg,speed_m_s,speed_sd_m_s and one row per slope)",
-            path.display()
-        );
+        bail!("{}: no data rows (expected a header {expected} and one row per slope)", path.display());
     }
     Ok(out)
+}
+
+/// The line a record is on: the csv reader's position is where it began reading, before the
+/// blank lines and `#` comments it skipped, so those are stepped over here.
+fn record_line(text: &str, at: &csv::Position) -> u64 {
+    let mut line = at.line();
+    let mut rest = text.get(at.byte() as usize..).unwrap_or("");
+    while let Some((first, after)) = rest.split_once('\n') {
+        if !(first.starts_with('#') || first.is_empty() || first == "\r") {
+            break;
+        }
+        line += 1;
+        rest = after;
+    }
+    line
+}
+
+/// Reads a speeds CSV (`slope_deg,speed_m_s,speed_sd_m_s`) into observations, validating
+/// every row.
+pub fn load_speeds(path: &Path) -> Result<Vec<SpeedObservation>> {
+    Ok(read_speed_table(path, SpeedColumns::Plain)?
+        .into_iter()
+        .map(|r| SpeedObservation { slope: r.slope, speed: r.speed_m_s, speed_sd: r.speed_sd_m_s })
+        .collect())
 }
 
 #[cfg(test)]
@@ -104,5 +172,34 @@ mod tests {
         );
         let ok = load("slope_deg,speed_m_s,speed_sd_m_s\n0, 0.15 ,0.01\n").unwrap();
         assert_eq!((ok[0].speed, ok[0].speed_sd), (0.15, 0.01));
+    }
+
+    /// Columns are found by name; `n` is `infer`'s only, and every error names its line,
+    /// whatever comments come before it.
+    #[test]
+    fn columns_by_name_and_n_only_where_asked() {
+        let ok = load("speed_sd_m_s,slope_deg,speed_m_s\n0.01,10,0.12\n").unwrap();
+        assert_eq!((ok[0].slope.degrees(), ok[0].speed, ok[0].speed_sd), (10.0, 0.12, 0.01));
+        let e = load("slope_deg,speed_m_s,speed_sd_m_s,n\n10,0.12,0.01,4\n").unwrap_err().to_string();
+        assert!(
+            e.contains("line 1: unknown column `n` (expected columns slope_deg,speed_m_s,speed_sd_m_s)"),
+            "{e}"
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("s.csv");
+        std::fs::write(&p, "slope_deg,speed_m_s,speed_sd_m_s,n\n# a\n\n# b\n10,0.12,0.01,4\n15,0.1,0.01\n")
+            .unwrap();
+        let e = read_speed_table(&p, SpeedColumns::WithCount).unwrap_err().to_string();
+        assert!(
+            e.contains("line: 6") && e.contains("expected columns slope_deg,speed_m_s,speed_sd_m_s[,n]"),
+            "{e}"
+        );
+        std::fs::write(&p, "slope_deg,speed_m_s,speed_sd_m_s,n\n# a\n10,0.12,0.01,4\n# b\n15,0.1,0.01,x\n")
+            .unwrap();
+        let e = read_speed_table(&p, SpeedColumns::WithCount).unwrap_err().to_string();
+        assert!(e.ends_with("line 5: n `x` must be a whole number of at least 1"), "{e}");
+        std::fs::write(&p, "slope_deg,speed_m_s,speed_sd_m_s,n\n# a\n10,0.12,0.01,4\n").unwrap();
+        let rows = read_speed_table(&p, SpeedColumns::WithCount).unwrap();
+        assert_eq!((rows[0].line, rows[0].n), (3, Some(4)));
     }
 }

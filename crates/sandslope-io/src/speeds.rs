@@ -27,9 +27,11 @@ const COLUMNS: [&str; 3] = ["slope_deg", "speed_m_s", "speed_sd_m_s"];
 /// Which columns a reader of a speeds table accepts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SpeedColumns {
-    /// `slope_deg,speed_m_s,speed_sd_m_s` only (`calibrate`, `sweep`, `report`, `track`).
+    /// Exactly `slope_deg,speed_m_s,speed_sd_m_s`, in that order (`calibrate`, `sweep`,
+    /// `report`, and `track --speeds-out`, which appends rows in that order to the file).
     Plain,
-    /// Those and optionally `n`, the steps or trials averaged (`infer --observed`).
+    /// Those by name in any order and optionally `n`, the steps or trials averaged (`infer
+    /// --observed`).
     WithCount,
 }
 
@@ -57,8 +59,8 @@ pub struct SpeedTableRow {
     pub n: Option<usize>,
 }
 
-/// Reads a speeds table, `slope_deg,speed_m_s,speed_sd_m_s` (columns by name, in any order)
-/// and, with [`SpeedColumns::WithCount`], optionally `n`: the one reader of that format
+/// Reads a speeds table, `slope_deg,speed_m_s,speed_sd_m_s` (with [`SpeedColumns::WithCount`]
+/// by name in any order, and optionally `n`): the one reader of that format
 /// ([`load_speeds`] and `observations::load_speed_observations` build on it). Blank lines
 /// and `#` comments are skipped; errors name the file, its line and the column.
 pub fn read_speed_table(path: &Path, columns: SpeedColumns) -> Result<Vec<SpeedTableRow>> {
@@ -79,6 +81,10 @@ pub fn read_speed_table(path: &Path, columns: SpeedColumns) -> Result<Vec<SpeedT
     };
     if let Some(extra) = names.iter().find(|h| !allowed.contains(h)) {
         bail!("{}: line 1: unknown column `{extra}` (expected columns {expected})", path.display());
+    }
+    if columns == SpeedColumns::Plain && names != COLUMNS {
+        // `track --speeds-out` appends rows in this order: another order would be corrupted.
+        bail!("{}: line 1: the header is `{}`; expected columns {expected}", path.display(), names.join(","));
     }
     let c_n = col("n");
     let mut out = Vec::new();
@@ -174,12 +180,17 @@ mod tests {
         assert_eq!((ok[0].speed, ok[0].speed_sd), (0.15, 0.01));
     }
 
-    /// Columns are found by name; `n` is `infer`'s only, and every error names its line,
-    /// whatever comments come before it.
+    /// `infer` finds columns by name and reads `n`; the others keep the fixed order `track`
+    /// appends in; every error names its line, whatever comments come before it.
     #[test]
     fn columns_by_name_and_n_only_where_asked() {
-        let ok = load("speed_sd_m_s,slope_deg,speed_m_s\n0.01,10,0.12\n").unwrap();
-        assert_eq!((ok[0].slope.degrees(), ok[0].speed, ok[0].speed_sd), (10.0, 0.12, 0.01));
+        let e = load("speed_sd_m_s,slope_deg,speed_m_s\n0.01,10,0.12\n").unwrap_err().to_string();
+        assert!(e.contains("line 1: the header is `speed_sd_m_s,slope_deg,speed_m_s`; expected"), "{e}");
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("any-order.csv");
+        std::fs::write(&p, "speed_sd_m_s,n,slope_deg,speed_m_s\n0.01,4,10,0.12\n").unwrap();
+        let r = read_speed_table(&p, SpeedColumns::WithCount).unwrap()[0];
+        assert_eq!((r.slope.degrees(), r.speed_m_s, r.speed_sd_m_s, r.n), (10.0, 0.12, 0.01, Some(4)));
         let e = load("slope_deg,speed_m_s,speed_sd_m_s,n\n10,0.12,0.01,4\n").unwrap_err().to_string();
         assert!(
             e.contains("line 1: unknown column `n` (expected columns slope_deg,speed_m_s,speed_sd_m_s)"),

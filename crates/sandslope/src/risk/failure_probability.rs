@@ -24,7 +24,7 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use super::quadrature::{density, phi, prob_below, Z_MAX};
+use super::quadrature::{density, phi, prob_below, sinkage_probability, Z_MAX};
 use super::uncertainty::Uncertainty;
 use crate::model::{
     anchoring_threshold_k_s, level_step_length, normal_equilibrium_depth, shear_load_per_leg,
@@ -143,17 +143,7 @@ impl<'a> FailureProbability<'a> {
         let (sigma_n, sigma_s) = (u.sigma_n(), u.sigma_s());
         let mu_n = median.k_n.ln();
         let k_n_star = sinkage_threshold_k_n(robot, slope);
-        let p_sink = if median.k_n <= 0.0 {
-            1.0
-        } else if sigma_n == 0.0 {
-            if median.k_n <= k_n_star {
-                1.0
-            } else {
-                0.0
-            }
-        } else {
-            prob_below(k_n_star, mu_n, sigma_n)
-        };
+        let p_sink = sinkage_probability(median.k_n, k_n_star, sigma_n);
         FailureProbability {
             boundary: ProgressBoundary::new(robot, slope),
             beyond_repose: median.beyond_repose(slope),

@@ -80,6 +80,23 @@ pub(crate) fn prob_below(threshold: f64, mu: f64, sigma: f64) -> f64 {
 pub(crate) const Z_MAX: f64 = 8.5;
 const TOLERANCE: f64 = 1e-9;
 
+/// P(sinkage) = P(k_n <= k_n*) for a log-normal k_n of median `median_k_n` and log-SD
+/// `sigma_n` (docs/model.md §9); `k_n_star` may be infinite (h = 2R: every leg sinks). A
+/// median of zero or less always sinks; with `sigma_n = 0` the median decides.
+pub(crate) fn sinkage_probability(median_k_n: f64, k_n_star: f64, sigma_n: f64) -> f64 {
+    if median_k_n <= 0.0 {
+        1.0
+    } else if sigma_n == 0.0 {
+        if median_k_n <= k_n_star {
+            1.0
+        } else {
+            0.0
+        }
+    } else {
+        prob_below(k_n_star, median_k_n.ln(), sigma_n)
+    }
+}
+
 /// The regime probabilities of `robot` at `slope` on ground whose medians are `median`.
 pub fn regime_probabilities(
     robot: &Robot,
@@ -92,18 +109,7 @@ pub fn regime_probabilities(
     let mu_n = median.k_n.ln();
     let mu_s = median.k_s.ln();
     let k_n_star = sinkage_threshold_k_n(robot, slope);
-    let p_sink = if median.k_n <= 0.0 {
-        1.0
-    } else if sigma_n == 0.0 {
-        if median.k_n <= k_n_star {
-            1.0
-        } else {
-            0.0
-        }
-    } else {
-        // P(k_n <= k_n*), k_n* may be infinite (h = 2R: every leg sinks).
-        prob_below(k_n_star, mu_n, sigma_n)
-    };
+    let p_sink = sinkage_probability(median.k_n, k_n_star, sigma_n);
     if median.beyond_repose(slope) {
         return RegimeProbabilities { sinkage: p_sink, slippage: 1.0 - p_sink, ..Default::default() };
     }

@@ -102,6 +102,21 @@ pub fn write_via_temp(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> R
     }
 }
 
+/// The line a record is on: the csv reader's position is where it began reading, before the
+/// blank lines and `#` comments it skipped, so those are stepped over here.
+pub(crate) fn record_line(text: &str, at: &csv::Position) -> u64 {
+    let mut line = at.line();
+    let mut rest = text.get(at.byte() as usize..).unwrap_or("");
+    while let Some((first, after)) = rest.split_once('\n') {
+        if !(first.starts_with('#') || first.is_empty() || first == "\r") {
+            break;
+        }
+        line += 1;
+        rest = after;
+    }
+    line
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -300,7 +300,7 @@ pub fn read_recording_with(path: &Path, kind: Kind, options: ReadOptions) -> Res
     let mut rows = 0;
     for record in reader.records() {
         let record = record.map_err(|e| anyhow!("{here}: {e}"))?;
-        let line = record.position().map(|p| p.line()).unwrap_or(0);
+        let line = record.position().map_or(0, |p| crate::files::record_line(&text, p));
         // A line of only separators (or whitespace) is skipped, not counted.
         if record.iter().all(str::is_empty) {
             continue;
@@ -377,5 +377,18 @@ mod tests {
         let opts = ReadOptions { counts_per_newton: None, skip_malformed: true };
         let r = read_recording_with(&p, Kind::Penetration, opts).unwrap();
         assert_eq!((r.rows, r.raw.malformed, r.raw.position.len()), (2, 1, 1));
+    }
+
+    /// A lab's notes between rows (`#` lines) and blank lines do not shift the line an error
+    /// names: the bad cell below is on line 6 of the file, right after a note and a blank line
+    /// (the csv reader places the record where it began reading, line 4).
+    #[test]
+    fn bad_cell_line_counts_comments_and_blank_lines() {
+        let dir = tempfile::tempdir().unwrap();
+        let text =
+            "# rig 2, operator notes\ndepth_m,force_n\n0.001,1\n# re-zeroed here\n\n0.002,abc\n0.003,3\n";
+        let p = write(dir.path(), "a.csv", text);
+        let e = read_recording(&p, Kind::Penetration, None).unwrap_err().to_string();
+        assert!(e.contains("line 6, column 2 (force_n)"), "{e}");
     }
 }

@@ -7,7 +7,7 @@ use anyhow::{anyhow, bail, Result};
 
 use sandslope::{Slope, SpeedObservation};
 
-use crate::files::read_text;
+use crate::files::{read_text, record_line};
 
 /// One row of a speeds file (`slope_deg,speed_m_s,speed_sd_m_s`, as `data/paper-speeds.csv`).
 #[derive(Debug, Clone, Copy, serde::Deserialize, serde::Serialize)]
@@ -128,21 +128,6 @@ pub fn read_speed_table(path: &Path, columns: SpeedColumns) -> Result<Vec<SpeedT
         bail!("{}: no data rows (expected a header {expected} and one row per slope)", path.display());
     }
     Ok(out)
-}
-
-/// The line a record is on: the csv reader's position is where it began reading, before the
-/// blank lines and `#` comments it skipped, so those are stepped over here.
-fn record_line(text: &str, at: &csv::Position) -> u64 {
-    let mut line = at.line();
-    let mut rest = text.get(at.byte() as usize..).unwrap_or("");
-    while let Some((first, after)) = rest.split_once('\n') {
-        if !(first.starts_with('#') || first.is_empty() || first == "\r") {
-            break;
-        }
-        line += 1;
-        rest = after;
-    }
-    line
 }
 
 /// Reads a speeds CSV (`slope_deg,speed_m_s,speed_sd_m_s`) into observations, validating

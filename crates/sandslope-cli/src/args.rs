@@ -64,15 +64,21 @@ pub struct UncertaintyArgs {
 }
 
 impl UncertaintyArgs {
-    /// The terrain read as uncertain (a flag's CV, else the table's SDs, else the default CV),
-    /// with the note to print when a default is used anywhere on the table. Errors name the
-    /// flag: `--cv-n = -1 must be a finite number of at least 0`.
-    pub fn apply(&self, terrain: Terrain) -> Result<(UncertainTerrain, Option<String>)> {
+    /// Checks the flags alone, before any file is read: each CV a finite number of at least 0.
+    pub fn check(&self) -> Result<()> {
         for (flag, cv) in [("--cv-n", self.cv_n), ("--cv-s", self.cv_s)] {
             if let Some(cv) = cv {
                 check_flag(flag, cv, 0.0, f64::INFINITY)?;
             }
         }
+        Ok(())
+    }
+
+    /// The terrain read as uncertain (a flag's CV, else the table's SDs, else the default CV),
+    /// with the note to print when a default is used anywhere on the table. Errors name the
+    /// flag: `--cv-n = -1 must be a finite number of at least 0`.
+    pub fn apply(&self, terrain: Terrain) -> Result<(UncertainTerrain, Option<String>)> {
+        self.check()?;
         let u = UncertainTerrain::new(terrain, self.cv_n, self.cv_s).map_err(|e| anyhow!("{e}"))?;
         let note = u.defaults_used().note();
         Ok((u, note))

@@ -14,7 +14,7 @@ use sandslope::plan::{
 use sandslope::risk::{DefaultsUsed, UncertainTerrain};
 use sandslope::Regime;
 
-use crate::args::{check_flag, RobotArgs, TerrainArgs};
+use crate::args::{check_flag, RobotArgs, TerrainArgs, UncertaintyArgs};
 use crate::figures::plan::PlanFigure;
 use crate::output::{num, print_json, table};
 use sandslope_io::load_terrain;
@@ -98,14 +98,8 @@ pub struct PlanArgs {
     /// How descending edges are evaluated.
     #[arg(long, value_enum, default_value = "symmetric")]
     pub descent: DescentArg,
-    /// Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's
-    /// k_n_sd; without either, 0.1 (docs/model.md §9).
-    #[arg(long, allow_negative_numbers = true, value_name = "CV")]
-    pub cv_n: Option<f64>,
-    /// Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's
-    /// k_s_sd; without either, 0.2 (docs/model.md §9).
-    #[arg(long, allow_negative_numbers = true, value_name = "CV")]
-    pub cv_s: Option<f64>,
+    #[command(flatten)]
+    pub uncertainty: UncertaintyArgs,
     #[command(flatten)]
     pub out: Box<OutputArgs>,
 }
@@ -242,17 +236,9 @@ fn round_coord(v: f64) -> f64 {
 }
 
 /// Loads the terrain classes: one terrain everywhere, or a class raster with its terrains.
-fn load_classes(
-    args: &PlanArgs,
-    dem: &Raster,
-    cv: (Option<f64>, Option<f64>),
-) -> Result<(Option<Vec<u8>>, Vec<UncertainTerrain>)> {
-    let uncertain = |t| {
-        UncertainTerrain::new(t, cv.0, cv.1).map_err(|e| {
-            let flag = format!("--{}", e.key.replace('_', "-"));
-            anyhow!("{}", e.renamed(flag))
-        })
-    };
+fn load_classes(args: &PlanArgs, dem: &Raster) -> Result<(Option<Vec<u8>>, Vec<UncertainTerrain>)> {
+    // The one uncertainty rule of docs/model.md §9, per class; the note is printed once below.
+    let uncertain = |t| args.uncertainty.apply(t).map(|(u, _note)| u);
     let (Some(path), Some(spec)) = (&args.classes, &args.class_terrain) else {
         return Ok((None, vec![uncertain(args.terrain.load()?)?]));
     };
@@ -319,10 +305,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
         bail!("--max-roll = {max_roll} must be strictly between 0 and 90 degrees");
     }
     let time_weight = check_flag("--time-weight", args.time_weight, 0.0, f64::INFINITY)?;
-    let cv = (
-        args.cv_n.map(|v| check_flag("--cv-n", v, 0.0, 10.0)).transpose()?,
-        args.cv_s.map(|v| check_flag("--cv-s", v, 0.0, 10.0)).transpose()?,
-    );
+    args.uncertainty.check()?;
     let descent = match args.descent {
         DescentArg::Symmetric => Descent::Symmetric,
         DescentArg::Level => Descent::Level,
@@ -341,7 +324,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
     let dem = read_raster(&args.dem)?;
     let start = endpoint(&dem, "start", &args.start, &args.start_px)?;
     let goal = endpoint(&dem, "goal", &args.goal, &args.goal_px)?;
-    let (classes, terrains) = load_classes(&args, &dem, cv)?;
+    let (classes, terrains) = load_classes(&args, &dem)?;
     let defaults = terrains.iter().fold(DefaultsUsed::default(), |a, t| a.or(t.defaults_used()));
     if let Some(note) = defaults.note() {
         eprintln!("note: {note}");

@@ -120,13 +120,9 @@ pub fn critical_shear_strength(
 /// `a = s*/tau^2 + g sin(theta)/2`, `b = -2 s*/tau - g sin(theta) tau`, `c = s* - target` is
 /// where `s = target`. A leg reaches the depth `d(t1)` at `t1` only up to its deepest point
 /// (`t_max`, `d = d_max`), so `t1` is capped there; the strength is `F_a / (W d(t1)^2)`.
-/// Returns `(ln k_s, capped)`, `ln k_s = +inf` when `s* <= target` (no strength suffices).
-pub(crate) fn ln_critical_closed_form(
-    robot: &Robot,
-    slope: Slope,
-    level_step: f64,
-    target: f64,
-) -> (f64, bool) {
+/// Returns `(k_s, capped)`, `k_s = +inf` when `s* <= target` (no strength suffices). The
+/// anchoring floor is the caller's (a capped strength is the anchoring threshold itself).
+pub(crate) fn critical_closed_form(robot: &Robot, slope: Slope, level_step: f64, target: f64) -> (f64, bool) {
     if level_step <= target {
         return (f64::INFINITY, false);
     }
@@ -139,7 +135,17 @@ pub(crate) fn ln_critical_closed_form(
     let t_max = (std::f64::consts::FRAC_PI_2 - robot.touchdown_angle()) / robot.leg_speed();
     let capped = t1 >= t_max;
     let d_s = if capped { robot.max_depth() } else { crate::model::leg_depth(robot, t1) };
-    let k = shear_load_per_leg(robot, slope) / (robot.leg_width() * d_s * d_s);
+    (shear_load_per_leg(robot, slope) / (robot.leg_width() * d_s * d_s), capped)
+}
+
+/// [`critical_closed_form`] as `(ln k_s, capped)`, the form the risk map integrates over.
+pub(crate) fn ln_critical_closed_form(
+    robot: &Robot,
+    slope: Slope,
+    level_step: f64,
+    target: f64,
+) -> (f64, bool) {
+    let (k, capped) = critical_closed_form(robot, slope, level_step, target);
     (k.ln(), capped)
 }
 

@@ -8,10 +8,11 @@
 //! and finds each `k_crit` with Brent's method; three things make this about a hundred times
 //! cheaper:
 //!
-//! - `k_crit` in closed form: the net step is a quadratic in the anchoring time `t1`
-//!   (docs/model.md §5), so the `t1` at which `s = 0` is its smaller root, and
-//!   `k_crit = F_a / (W d(t1)^2)` with the leg depth `d(t)` of §4 (floored at the anchoring
-//!   threshold). The tests check it against [`crate::critical_shear_strength`] to 1e-9.
+//! - `k_crit` in closed form (the critical module's, which the risk map also uses): the net
+//!   step is a quadratic in the anchoring time `t1` (docs/model.md §5), so the `t1` at which
+//!   `s = 0` is its smaller root, and `k_crit = F_a / (W d(t1)^2)` with the leg depth `d(t)`
+//!   of §4 (floored at the anchoring threshold). The tests check it against
+//!   [`crate::critical_shear_strength`] (Brent's method) to 1e-9.
 //! - adaptive Gauss-Kronrod (7-15 points) quadrature of only `P(slippage)` to 1e-11: p_fail
 //!   needs no metastable/success boundary.
 //! - a closed-form upper bound (`FailureProbability::fails`) that settles `p_fail < max_risk`
@@ -22,46 +23,29 @@
 //! robots, slopes, grounds and CVs unlike the paper's. What it does not give is the other
 //! regime probabilities: [`super::failure_risk`] and [`super::risk_curve`] keep the reference.
 
-use std::f64::consts::FRAC_PI_2;
-
 use super::quadrature::{density, phi, prob_below, sinkage_probability, Z_MAX};
 use super::uncertainty::Uncertainty;
+use crate::critical::critical_closed_form;
 use crate::model::{
-    anchoring_threshold_k_s, level_step_length, normal_equilibrium_depth, shear_load_per_leg,
-    sinkage_threshold_k_n, G,
+    anchoring_threshold_k_s, level_step_length, normal_equilibrium_depth, sinkage_threshold_k_n,
 };
 use crate::robot::Robot;
 use crate::slope::Slope;
 use crate::terrain::Ground;
 
-/// The progress boundary `k_crit(k_n)` of one robot at one slope, in closed form.
+/// The progress boundary `k_crit(k_n)` of one robot at one slope, in closed form
+/// ([`crate::critical`]'s, with the target step 0), floored at the anchoring threshold.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ProgressBoundary<'a> {
     robot: &'a Robot,
     slope: Slope,
-    /// `g sin(theta)`.
-    gs: f64,
-    /// Stride period T.
-    period: f64,
-    /// Time at which the leg reaches its deepest point `2R - h`.
-    t_deepest: f64,
-    /// Applied shear load per leg over the leg width, `F_a / W`.
-    load_per_width: f64,
     /// Anchoring threshold `F_a / (W d_max^2)`.
     k_anchor: f64,
 }
 
 impl<'a> ProgressBoundary<'a> {
     pub(crate) fn new(robot: &'a Robot, slope: Slope) -> ProgressBoundary<'a> {
-        ProgressBoundary {
-            robot,
-            slope,
-            gs: G * slope.sin(),
-            period: robot.stride_period(),
-            t_deepest: (FRAC_PI_2 - robot.touchdown_angle()) / robot.leg_speed(),
-            load_per_width: shear_load_per_leg(robot, slope) / robot.leg_width(),
-            k_anchor: anchoring_threshold_k_s(robot, slope),
-        }
+        ProgressBoundary { robot, slope, k_anchor: anchoring_threshold_k_s(robot, slope) }
     }
 
     /// The smallest k_s giving a positive net step at level step `s_star`, or `None` when
@@ -70,22 +54,8 @@ impl<'a> ProgressBoundary<'a> {
         if s_star <= 0.0 || s_star.is_nan() {
             return None;
         }
-        // s(t1) = s* (1 - 2 t1/T)^2 - 1/2 g sin(theta) t1 (T - t1) = a t1^2 + b t1 + c.
-        let t = self.period;
-        let a = 4.0 * s_star / (t * t) + 0.5 * self.gs;
-        let b = -4.0 * s_star / t - 0.5 * self.gs * t;
-        let c = s_star;
-        let disc = (b * b - 4.0 * a * c).max(0.0);
-        // The smaller root, in the cancellation-free form 2c / (-b + sqrt(disc)).
-        let t_root = 2.0 * c / (-b + disc.sqrt());
-        if t_root >= self.t_deepest {
-            // Every anchoring (d_s <= d_max) happens before s reaches 0.
-            return Some(self.k_anchor);
-        }
-        let r = self.robot.leg_radius();
-        let depth = r * (self.robot.leg_speed() * t_root + self.robot.touchdown_angle()).sin() + r
-            - self.robot.hip_height();
-        Some((self.load_per_width / (depth * depth)).max(self.k_anchor))
+        let (k, _capped) = critical_closed_form(self.robot, self.slope, s_star, 0.0);
+        Some(k.max(self.k_anchor))
     }
 
     /// The smallest k_s giving progress (`s > 0`) at normal resistance `k_n`; `None` when

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::Deserialize;
 
-use sandslope::measure::{disk_area, Kind, RawRecording, ShearPlate};
+use sandslope::measure::{disk_area, Kind, RawRecording, ShearPlate, TrialInput};
 use sandslope::Slope;
 
 use crate::files::{parse_toml, read_text, Source};
@@ -211,6 +211,33 @@ pub struct ReadOptions {
     pub counts_per_newton: Option<f64>,
     /// Skip (and count) rows with a cell that is not a number, instead of failing.
     pub skip_malformed: bool,
+}
+
+/// Reads every trial of a manifest, in its order, as the library's [`TrialInput`]s; a trial
+/// file that does not exist is an error naming the manifest, the trial and the file.
+pub fn read_trials(manifest: &Manifest, options: ReadOptions) -> Result<Vec<TrialInput>> {
+    let mut out = Vec::with_capacity(manifest.trials.len());
+    for trial in &manifest.trials {
+        if !trial.path.is_file() {
+            bail!(
+                "{}: [[trial]] #{} ({}): trial file {} does not exist",
+                manifest.path.display(),
+                trial.index,
+                trial.file.display(),
+                trial.path.display()
+            );
+        }
+        let rec = read_recording_with(&trial.path, trial.kind, options)?;
+        out.push(TrialInput {
+            file: trial.file.display().to_string(),
+            kind: trial.kind,
+            slope_deg: trial.slope_deg,
+            air: trial.air,
+            rows: rec.rows,
+            raw: rec.raw,
+        });
+    }
+    Ok(out)
 }
 
 /// Reads one trial CSV. `counts_per_newton` converts a `force_counts` column. A cell that is

@@ -10,9 +10,9 @@ use pyo3::types::PyDict;
 use pythonize::pythonize;
 
 use sandslope::gait::{track as track_recordings, GaitOptions, Recording, Upslope};
-use sandslope::measure::{fit_campaign, AirMode, CampaignError, FitOptions, Setup, TrialInput};
+use sandslope::measure::{fit_campaign, AirMode, CampaignError, FitOptions, Setup};
 use sandslope::{Slope, Terrain, TerrainSpec};
-use sandslope_io::measurements::{load_manifest, read_recording_with, ReadOptions};
+use sandslope_io::measurements::{load_manifest, read_trials, ReadOptions};
 use sandslope_io::mocap::{self, MocapFormat};
 
 use crate::types::{PyRobot, PyTerrain};
@@ -57,27 +57,7 @@ pub fn fit<'py>(
         .detach(|| -> anyhow::Result<_> {
             let manifest = load_manifest(&manifest)?;
             let read = ReadOptions { counts_per_newton, skip_malformed };
-            let mut trials = Vec::with_capacity(manifest.trials.len());
-            for trial in &manifest.trials {
-                if !trial.path.is_file() {
-                    anyhow::bail!(
-                        "{}: [[trial]] #{} ({}): trial file {} does not exist",
-                        manifest.path.display(),
-                        trial.index,
-                        trial.file.display(),
-                        trial.path.display()
-                    );
-                }
-                let rec = read_recording_with(&trial.path, trial.kind, read)?;
-                trials.push(TrialInput {
-                    file: trial.file.display().to_string(),
-                    kind: trial.kind,
-                    slope_deg: trial.slope_deg,
-                    air: trial.air,
-                    rows: rec.rows,
-                    raw: rec.raw,
-                });
-            }
+            let trials = read_trials(&manifest, read)?;
             let setup = Setup { disk_area_m2: manifest.disk_area_m2, plate: manifest.plate };
             let dir = manifest.path.parent().map(|d| d.join("")).unwrap_or_default();
             let campaign = fit_campaign(&trials, &setup, &options).map_err(|e| match e {

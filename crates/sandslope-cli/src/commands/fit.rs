@@ -15,7 +15,7 @@ use sandslope::{Terrain, TerrainSpec};
 use crate::args::check_positive;
 use crate::figures::measurements as figures;
 use crate::output::{csv_string, num, print_json, sci, table, write_atomic, Format, FormatArgs};
-use sandslope_io::measurements::{load_manifest, read_recording_with, Manifest, ReadOptions};
+use sandslope_io::measurements::{load_manifest, Manifest, ReadOptions};
 
 /// Arguments of `sandslope fit`.
 #[derive(Debug, Args)]
@@ -86,34 +86,13 @@ fn read_trials(manifest: &Manifest, args: &FitArgs) -> Result<Vec<TrialInput>> {
     let counts_per_newton =
         args.counts_per_newton.map(|c| check_positive("--counts-per-newton", c)).transpose()?;
     let read = ReadOptions { counts_per_newton, skip_malformed: args.skip_malformed };
-    let mut out = Vec::with_capacity(manifest.trials.len());
-    for trial in &manifest.trials {
-        if !trial.path.is_file() {
-            bail!(
-                "{}: [[trial]] #{} ({}): trial file {} does not exist",
-                manifest.path.display(),
-                trial.index,
-                trial.file.display(),
-                trial.path.display()
-            );
+    sandslope_io::measurements::read_trials(manifest, read).map_err(|e| {
+        if !args.skip_malformed && e.to_string().contains("is not a number") {
+            anyhow!("{e:#}; --skip-malformed skips such rows and counts them")
+        } else {
+            e
         }
-        let rec = read_recording_with(&trial.path, trial.kind, read).map_err(|e| {
-            if !args.skip_malformed && e.to_string().contains("is not a number") {
-                anyhow!("{e:#}; --skip-malformed skips such rows and counts them")
-            } else {
-                e
-            }
-        })?;
-        out.push(TrialInput {
-            file: trial.file.display().to_string(),
-            kind: trial.kind,
-            slope_deg: trial.slope_deg,
-            air: trial.air,
-            rows: rec.rows,
-            raw: rec.raw,
-        });
-    }
-    Ok(out)
+    })
 }
 
 /// Reads and fits a manifest: the campaign result.

@@ -140,6 +140,59 @@ pub fn range(values: impl IntoIterator<Item = f64>, fallback: (f64, f64)) -> (f6
     (lo - pad, hi + pad)
 }
 
+/// A chart over slope (degrees, x) and some quantity (y), as the slope-curve figures draw.
+pub type SlopeChart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    plotters::coord::cartesian::Cartesian2d<
+        plotters::coord::types::RangedCoordf64,
+        plotters::coord::types::RangedCoordf64,
+    >,
+>;
+
+/// Shades the slopes at or above the angle of repose `repose` (when inside `x`) over the
+/// whole height `y`, with a legend entry `label`: the one look of "the surface yields here".
+pub fn shade_repose<DB: DrawingBackend>(
+    chart: &mut SlopeChart<'_, DB>,
+    repose: Option<f64>,
+    x: (f64, f64),
+    y: (f64, f64),
+    label: &str,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    if let Some(repose) = repose.filter(|r| *r < x.1) {
+        let shade = RGBColor(200, 200, 200).mix(0.45);
+        chart
+            .draw_series([Rectangle::new([(repose.max(x.0), y.0), (x.1, y.1)], shade.filled())])
+            .map_err(crate::error::plot_err)?
+            .label(label)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+    }
+    Ok(())
+}
+
+/// A dashed grey horizontal line at `level` across `x`, with a legend entry `label` (a
+/// threshold such as s_min = R).
+pub fn reference_line<DB: DrawingBackend>(
+    chart: &mut SlopeChart<'_, DB>,
+    level: f64,
+    label: &str,
+    x: (f64, f64),
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let grey = RGBColor(90, 90, 90);
+    chart
+        .draw_series(DashedLineSeries::new([(x.0, level), (x.1, level)], 8, 5, grey.stroke_width(2)))
+        .map_err(crate::error::plot_err)?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(2)));
+    Ok(())
+}
+
 /// Joins marching-squares segments that share an end into polylines, so a contour is stroked
 /// as continuous paths: stroked one by one, segments shorter than a pixel leave gaps in a wide
 /// line. Ends are matched at 8 significant digits (two squares compute their shared edge's

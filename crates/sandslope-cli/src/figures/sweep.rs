@@ -156,29 +156,15 @@ where
         .light_line_style(RGBColor(235, 235, 235))
         .draw()
         .map_err(plot_err)?;
-    if let Some(repose) = panel.repose.filter(|r| *r < x_range.1) {
-        let shade = RGBColor(200, 200, 200).mix(0.45);
-        chart
-            .draw_series([Rectangle::new(
-                [(repose.max(x_range.0), y_range.0), (x_range.1, y_range.1)],
-                shade.filled(),
-            )])
-            .map_err(plot_err)?
-            .label("at or above the angle of repose: slippage")
-            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
-    }
+    super::shade_repose(
+        &mut chart,
+        panel.repose,
+        x_range,
+        y_range,
+        "at or above the angle of repose: slippage",
+    )?;
     if let Some((level, label)) = panel.reference {
-        let grey = RGBColor(90, 90, 90);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(x_range.0, level), (x_range.1, level)],
-                8,
-                5,
-                grey.stroke_width(2),
-            ))
-            .map_err(plot_err)?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(2)));
+        super::reference_line(&mut chart, level, label, x_range)?;
     }
     // Zero, where the curve goes below it (the robot loses ground).
     if y_range.0 < 0.0 && y_range.1 > 0.0 {

@@ -1,22 +1,10 @@
 //! End-to-end tests of `sandslope calibrate`: the joint fit's outputs (terrain, robot, figure,
 //! JSON), the angle of repose carried over from the source terrain, and the refusals.
 
-use assert_cmd::Command;
+mod common;
+use common::{json_of as json, repo_file, sandslope};
+
 use predicates::prelude::*;
-use std::path::{Path, PathBuf};
-
-fn sandslope() -> Command {
-    Command::cargo_bin("sandslope").unwrap()
-}
-
-fn repo_file(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
-}
-
-fn json(cmd: &mut Command) -> serde_json::Value {
-    let out = cmd.assert().success().get_output().stdout.clone();
-    serde_json::from_slice(&out).unwrap()
-}
 
 #[test]
 fn calibrate_without_repose_carries_the_source_terrains_and_says_so() {

@@ -1,26 +1,11 @@
 //! End-to-end tests of `sandslope design` and `sandslope infer`.
 
+mod common;
+use common::{json, sandslope, write_arg as write};
+
 use std::path::Path;
 
-use assert_cmd::Command;
 use predicates::prelude::*;
-use serde_json::Value;
-
-fn sandslope() -> Command {
-    Command::cargo_bin("sandslope").unwrap()
-}
-
-fn json(args: &[&str]) -> Value {
-    let out = sandslope().args(args).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    serde_json::from_slice(&out.stdout).unwrap()
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> String {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p.to_string_lossy().into_owned()
-}
 
 /// Every design's safe-slope limit is the number `risk --solve slope` prints for that robot;
 /// invalid designs (hip height above 2R) are listed with the reason, not dropped.

@@ -2,19 +2,17 @@
 //! offsets, transients, saturation and file defects) are fitted back; malformed inputs get
 //! clear errors and no output file; the terrain written loads in `sandslope predict`.
 
+mod common;
+use common::sandslope;
+
 #[path = "fit/synth.rs"]
 mod synth;
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
 use serde_json::Value;
 
 use synth::{example_dataset, Dataset, GeneratedTrial};
-
-fn sandslope() -> Command {
-    Command::cargo_bin("sandslope").unwrap()
-}
 
 fn example_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/measurements")

@@ -4,12 +4,14 @@
 //! m, cm or mm at 80 to 100 Hz. k_n and k_s must come back within 3% at every slope (the mean
 //! of 3 trials), every window forced short must be flagged, and no other.
 
+mod common;
+use common::sandslope;
+
 #[path = "fit/synth.rs"]
 mod synth;
 
 use std::path::Path;
 
-use assert_cmd::Command;
 use serde_json::Value;
 
 use sandslope::measure::{fit_campaign, Campaign, FitOptions, Kind, Setup, TrialInput};
@@ -233,10 +235,6 @@ fn regenerate_noisy_example() {
 }
 
 // ---------------------------------------------------------------- the CLI on a noisy campaign
-
-fn sandslope() -> Command {
-    Command::cargo_bin("sandslope").unwrap()
-}
 
 #[test]
 fn skip_malformed_counts_rows_and_the_strict_default_names_the_column() {

@@ -1,20 +1,13 @@
 //! End-to-end tests of `sandslope phase` and `sandslope risk`.
 
+mod common;
+use common::{json, sandslope, write_arg as write};
+
 use std::path::Path;
 
 use assert_cmd::Command;
 use predicates::prelude::*;
 use serde_json::Value;
-
-fn sandslope() -> Command {
-    Command::cargo_bin("sandslope").unwrap()
-}
-
-fn json(args: &[&str]) -> Value {
-    let out = sandslope().args(args).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    serde_json::from_slice(&out.stdout).unwrap()
-}
 
 /// A terrain with standard deviations: 0 deg k_s 2e6 +- 4e5, 20 deg 1e6 +- 3e5; k_n 7e5 +- 1.4e5.
 const UNCERTAIN: &str = r#"
@@ -33,12 +26,6 @@ k_s = 1.0e6
 k_n_sd = 1.4e5
 k_s_sd = 3.0e5
 "#;
-
-fn write(dir: &Path, name: &str, text: &str) -> String {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p.to_string_lossy().into_owned()
-}
 
 /// The CSV has one row per cell and panel with the documented columns, and the sinkage
 /// boundary sits at the hand-computed k_n* = m g cos(theta) / (n A_c (2R - h)):

@@ -7,16 +7,11 @@
 
 mod common;
 
-use assert_cmd::Command;
 use predicates::str::contains;
 use sandslope::gait::synthetic::StepProfile;
 use std::path::Path;
 
-use common::{motive, plain_mm, trajectory_seeded, write};
-
-fn sandslope() -> Command {
-    Command::cargo_bin("sandslope").unwrap()
-}
+use common::{motive, plain_mm, sandslope, trajectory_seeded, write};
 
 /// The page's figure elements; fig6 holds the panels fig6a-d (anchored inside it).
 const PAGE_IDS: [&str; 8] = ["fig3a", "fig4d", "fig4h", "fig5b", "fig5c", "fig6", "risk", "calibration"];

@@ -1,12 +1,42 @@
-//! Test helpers shared by the motion-capture tests (`track.rs`, `report.rs`): trajectories
-//! sampled from a known step profile (`sandslope::gait::synthetic::StepProfile`) with noise
-//! and occlusions, written as Motive, Vicon or plain CSV files.
+//! Test helpers shared by the end-to-end tests: running the `sandslope` binary and reading its
+//! JSON, repository and temporary files, and (for the motion-capture tests, `track.rs` and
+//! `report.rs`) trajectories sampled from a known step profile
+//! (`sandslope::gait::synthetic::StepProfile`) with noise and occlusions, written as Motive,
+//! Vicon or plain CSV files.
 #![allow(dead_code)] // each test binary uses a different subset
 
 use std::path::{Path, PathBuf};
 
 use rand::{RngExt, SeedableRng};
 use sandslope::gait::synthetic::StepProfile;
+
+/// The `sandslope` binary under test.
+pub fn sandslope() -> assert_cmd::Command {
+    assert_cmd::Command::cargo_bin("sandslope").unwrap()
+}
+
+/// A file of the repository, by its path from the repository root.
+pub fn repo_file(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
+}
+
+/// Runs `cmd`, which must succeed, and parses its stdout as JSON.
+pub fn json_of(cmd: &mut assert_cmd::Command) -> serde_json::Value {
+    let out = cmd.assert().success().get_output().stdout.clone();
+    serde_json::from_slice(&out).unwrap()
+}
+
+/// `sandslope ARGS`, which must succeed (its stderr is shown if not), stdout parsed as JSON.
+pub fn json(args: &[&str]) -> serde_json::Value {
+    let out = sandslope().args(args).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Writes `text` to `dir/name` and returns the path as a string, for an argument list.
+pub fn write_arg(dir: &Path, name: &str, text: &str) -> String {
+    write(dir, name, text).to_string_lossy().into_owned()
+}
 
 /// Frame rate of the generated recordings, frames/s.
 pub const FPS: f64 = 120.0;

@@ -16,7 +16,7 @@ use sandslope::{
 };
 
 use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
-use crate::figures::calibrate::{CalibrationFigure, SpeedPoint};
+use crate::figures::calibrate::{speed_pulls, CalibrationFigure};
 use crate::output::{check_parent_exists, print_json, table, write_atomic};
 use sandslope_io::{load_anchoring_times, load_speeds, load_terrain};
 
@@ -258,7 +258,7 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
                 (d, predict(&fitted_robot, s, &ground).speed)
             })
             .collect();
-        let points: Vec<SpeedPoint> = SpeedPoint::from_pulls(&cal.pulls);
+        let points = speed_pulls(&cal.pulls);
         let title = format!(
             "chi^2/dof = {}, k_s(20)/k_s(0) = {:.2}",
             cal.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),

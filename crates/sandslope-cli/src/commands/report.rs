@@ -28,7 +28,7 @@ const PAPER_FORCE_TESTS: &str = include_str!("../../../../data/example-force-tes
 use plotters::chart::SeriesLabelPosition;
 
 use crate::args::{RobotArgs, TerrainArgs};
-use crate::figures::calibrate::{CalibrationFigure, SpeedPoint};
+use crate::figures::calibrate::{speed_pulls, CalibrationFigure};
 use crate::figures::phase::PhaseFigure;
 use crate::figures::risk::CurveFigure;
 use crate::figures::slope_curves::SlopeCurveFigure;
@@ -461,7 +461,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
 
     // The calibration pulls.
     if let Some(c) = &calibration {
-        let points: Vec<SpeedPoint> = SpeedPoint::from_pulls(&c.pulls);
+        let points = speed_pulls(&c.pulls);
         let fitted = Robot::new(c.robot.clone()).map_err(|e| anyhow!("{e}"))?;
         let fitted_terrain = Terrain::new(c.terrain.clone()).map_err(|e| anyhow!("{e}"))?;
         let curve: Vec<(f64, Option<f64>)> = grid

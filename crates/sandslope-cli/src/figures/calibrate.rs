@@ -10,46 +10,16 @@ use sandslope::calibrate::joint::{ObservationKind, Pull};
 use super::{font, Figure};
 use crate::error::plot_err;
 
-/// One observed speed against the fitted model.
-#[derive(Debug, Clone, Copy)]
-pub struct SpeedPoint {
-    /// Slope, degrees.
-    pub slope_deg: f64,
-    /// Observed mean, m/s.
-    pub observed: f64,
-    /// Observed SD, m/s.
-    pub sd: f64,
-    /// SD used in the fit (with the error floor), m/s.
-    pub sd_total: f64,
-    /// Fitted model, m/s.
-    pub model: f64,
-    /// `(observed - model) / sd_total`.
-    pub pull: f64,
-}
-
-impl SpeedPoint {
-    /// The speed observations among a joint calibration's pulls (anchoring times and force
-    /// tests are not drawn in this figure).
-    pub fn from_pulls(pulls: &[Pull]) -> Vec<SpeedPoint> {
-        pulls
-            .iter()
-            .filter(|p| p.kind == ObservationKind::Speed)
-            .map(|p| SpeedPoint {
-                slope_deg: p.slope_deg,
-                observed: p.observed,
-                sd: p.sd,
-                sd_total: p.sd_total,
-                model: p.model,
-                pull: p.pull,
-            })
-            .collect()
-    }
+/// The speed observations among a joint calibration's pulls: the points this figure draws
+/// (anchoring times and force tests are not drawn in it).
+pub fn speed_pulls(pulls: &[Pull]) -> Vec<Pull> {
+    pulls.iter().filter(|p| p.kind == ObservationKind::Speed).copied().collect()
 }
 
 /// Observed against fitted speeds (top) and pulls (bottom).
 pub struct CalibrationFigure<'a> {
     /// The observations.
-    pub points: &'a [SpeedPoint],
+    pub points: &'a [Pull],
     /// The fitted model's speed over a fine slope grid (None where undefined), m/s.
     pub curve: &'a [(f64, Option<f64>)],
     /// A line under the title (fit statistics).

@@ -102,6 +102,14 @@ def test_each_tile_reads_only_its_window(robot, terrain):
     assert (17, 13) in store.reads
 
 
+def test_bad_chunks_name_the_argument_and_the_valid_form(robot, terrain, tmp_path):
+    np.save(tmp_path / "dem.npy", dunes(30, 20))
+    for source in [tmp_path / "dem.npy", dunes(30, 20)]:
+        for chunks in [0, -5, (10, 0), 2.5, (10,)]:
+            with pytest.raises(ValueError, match=r"chunks = .* must be a tile size in cells of at least 1"):
+                sdask.risk_raster(source, 0.5, robot=robot, terrain=terrain, chunks=chunks)
+
+
 def test_store_errors_name_the_source(robot, terrain, tmp_path):
     with pytest.raises(ValueError, match="nope.npy'?: no such file"):
         sdask.risk_raster(tmp_path / "nope.npy", 0.5, robot=robot, terrain=terrain)

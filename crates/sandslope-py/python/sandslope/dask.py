@@ -152,6 +152,17 @@ def _window_tile(
     return _tile(padded, cell_x, cell_y, options)
 
 
+def _tiles(chunks: Any, shape: Tuple[int, ...]) -> Tuple[Tuple[int, ...], ...]:
+    """``chunks`` as dask's explicit block sizes for ``shape``, or a ValueError naming it."""
+    message = f"chunks = {chunks!r} must be a tile size in cells of at least 1: an int, (rows, cols), or dask block sizes"
+    if any(isinstance(c, (int, np.integer)) and not isinstance(c, bool) and c < 1 for c in np.ravel(np.array(chunks, dtype=object))):
+        raise ValueError(message)
+    try:
+        return da.core.normalize_chunks(chunks, shape, dtype=np.float64)
+    except (ValueError, TypeError, ZeroDivisionError) as e:
+        raise ValueError(f"{message} ({e})") from e
+
+
 def _is_store(dem: Any) -> bool:
     """A path, or an array-like that is neither NumPy nor dask and slices lazily."""
     if isinstance(dem, (str, os.PathLike)):
@@ -282,7 +293,7 @@ def risk_raster(
         if z.ndim != 2:
             raise ValueError(f"dem must be a 2-D array (rows, cols), row 0 at the north (got shape {z.shape})")
         if chunks is not None:
-            z = z.rechunk(chunks)
+            z = z.rechunk(_tiles(chunks, z.shape))
         elif isinstance(dem, np.ndarray):
             z = z.rechunk(DEFAULT_TILE)
         if not np.issubdtype(z.dtype, np.floating):
@@ -304,9 +315,7 @@ def risk_raster(
     shape, native = _store_shape(dem)
     if nodata is None:
         options["nodata"] = _tiff_nodata(dem)
-    tiles = da.core.normalize_chunks(
-        chunks if chunks is not None else (native or DEFAULT_TILE), shape, dtype=np.float64
-    )
+    tiles = _tiles(chunks if chunks is not None else (native or DEFAULT_TILE), shape)
     return da.map_blocks(
         _window_tile,
         dem,

@@ -47,6 +47,23 @@ pub const PRESETS: &[Preset] = &[
     },
 ];
 
+/// The paper's force tests as its text reports them: k_s(20)/k_s(0) = 0.40 and k_n unchanged,
+/// with assumed levels and SDs (the file's comments say which). `sandslope report` uses them
+/// on the built-in terrain, which was calibrated from them (docs/calibration.md). The same
+/// text is `data/example-force-tests.toml` (a test keeps the two equal).
+pub const PAPER_FORCE_TESTS: Preset = Preset {
+    name: "example-force-tests",
+    kind: PresetKind::Terrain,
+    summary: "the paper's force tests as its text reports them (levels and SDs assumed)",
+    toml: include_str!("../presets/example-force-tests.toml"),
+};
+
+/// [`PAPER_FORCE_TESTS`] read as a terrain table.
+pub fn paper_force_tests() -> anyhow::Result<sandslope::Terrain> {
+    let p = PAPER_FORCE_TESTS;
+    crate::robot_terrain::terrain_from_toml(p.toml, &crate::files::Source::Preset(p.name))
+}
+
 /// The preset called `name` of kind `kind`.
 pub fn find(name: &str, kind: PresetKind) -> Option<&'static Preset> {
     PRESETS.iter().find(|p| p.name == name && p.kind == kind)
@@ -71,6 +88,17 @@ mod tests {
             };
             assert!(ok, "preset {} does not load", p.name);
         }
+    }
+
+    #[test]
+    fn the_built_in_force_tests_are_the_data_file() {
+        let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/example-force-tests.toml");
+        assert_eq!(std::fs::read_to_string(data).unwrap(), PAPER_FORCE_TESTS.toml);
+        let t = paper_force_tests().unwrap();
+        // The paper's one number: k_s(20)/k_s(0) = 0.40 (Sec. III-C).
+        let (p0, p20) = (&t.points()[0], &t.points()[1]);
+        assert_eq!((p0.slope_deg, p20.slope_deg), (0.0, 20.0));
+        assert!((p20.k_s / p0.k_s - 0.40).abs() < 1e-12);
     }
 
     #[test]

@@ -41,6 +41,7 @@ pub mod paper;
 pub mod phase;
 pub mod plan;
 pub mod regime;
+pub mod report;
 pub mod risk;
 pub mod robot;
 pub mod scenario;

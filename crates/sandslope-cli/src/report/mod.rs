@@ -1,11 +1,12 @@
 //! The report page: one self-contained HTML file (figures inline as SVG, styles inline, no
-//! scripts, no network) and the `report.json` beside it. This module assembles what
-//! `commands/report.rs` computed; it computes no physics.
+//! scripts, no network) rendered from the library's [`Report`]; `report.json` beside it is the
+//! same value serialised. This module renders; it computes no physics.
 
-use serde::Serialize;
+mod figures;
 
-use sandslope::paper::PaperComparison;
-use sandslope::JointCalibration;
+pub use figures::page_figures;
+
+use sandslope::report::{Report, TrackRecord};
 
 /// One figure of the page, by the paper's figure number.
 pub struct PageFigure {
@@ -21,78 +22,12 @@ pub struct PageFigure {
     pub parts: Vec<(String, String)>,
 }
 
-/// `report.json`'s figure entry.
-#[derive(Serialize)]
-pub struct FigureRecord<'a> {
-    /// Id.
-    pub id: &'a str,
-    /// Title.
-    pub title: &'a str,
-}
-
-/// One observed speed beside the model.
-#[derive(Debug, Clone, Copy, Serialize)]
-pub struct SpeedRecord {
-    /// Slope, degrees.
-    pub slope_deg: f64,
-    /// Observed mean, m/s.
-    pub observed_m_s: f64,
-    /// Observed SD, m/s.
-    pub observed_sd_m_s: f64,
-    /// The model's speed on the terrain (`null` where the regime rules it out), m/s.
-    pub model_m_s: Option<f64>,
-}
-
-/// One slope's motion-capture tracks (`--tracks`), pooled over their files.
-#[derive(Debug, Clone, Serialize)]
-pub struct TrackRecord {
-    /// Slope, degrees.
-    pub slope_deg: f64,
-    /// The recordings pooled at this slope, as given or matched.
-    pub files: Vec<String>,
-    /// Steps measured.
-    pub steps: usize,
-    /// Steps without anchoring (the speed never turned upward).
-    pub unanchored_steps: usize,
-    /// Mean step-averaged speed, m/s.
-    pub speed_m_s: f64,
-    /// Its SD across steps, m/s (`null` with fewer than two steps).
-    pub speed_sd_m_s: Option<f64>,
-    /// Mean anchoring time over anchored steps, s (`null` without anchored steps).
-    pub t1_s: Option<f64>,
-    /// Its SD, s.
-    pub t1_sd_s: Option<f64>,
-    /// Mean backward slip over anchored steps, m.
-    pub slip_m: Option<f64>,
-    /// Its SD, m.
-    pub slip_sd_m: Option<f64>,
-}
-
 /// The page's "Motion capture" section: one row per tracked slope, and what was (not) used.
-pub struct TracksSection<'a> {
+struct TracksSection<'a> {
     /// One row per slope, lowest first; no section when empty.
-    pub records: &'a [TrackRecord],
+    records: &'a [TrackRecord],
     /// Sentences on how the tracks entered the report (skipped t1s, speeds not used, ...).
-    pub notes: &'a [String],
-}
-
-/// Everything on the page, as `report.json`.
-#[derive(Serialize)]
-pub struct ReportJson<'a> {
-    /// The figures, in page order.
-    pub figures: Vec<FigureRecord<'a>>,
-    /// Observed against model speeds.
-    pub speeds: &'a [SpeedRecord],
-    /// The motion-capture tracks per slope (`--tracks`; empty without).
-    pub tracks: &'a [TrackRecord],
-    /// The joint calibration of the terrain's k_s shape on the evidence (`null` if it failed).
-    pub calibration: Option<&'a JointCalibration>,
-    /// Every number the paper reports beside the model's.
-    pub paper_vs_model: &'a [PaperComparison],
-    /// The generated "where the model and the paper disagree" items.
-    pub disagreements: &'a [String],
-    /// What the report was made from.
-    pub inputs: &'a [(String, String)],
+    notes: &'a [String],
 }
 
 /// Escapes text for HTML.
@@ -117,14 +52,12 @@ figure svg{max-width:100%;height:auto;border:1px solid #eee}figcaption{font-size
 .warn{background:#fff8e1;border-left:4px solid #e0a800;padding:0.5em 1em}code{background:#f4f4f4;padding:0 3px}";
 
 /// The whole page.
-pub fn page(
-    inputs: &[(String, String)],
-    figures: &[PageFigure],
-    paper: &[PaperComparison],
-    calibration: Option<&JointCalibration>,
-    disagreements: &[String],
-    tracks: &TracksSection<'_>,
-) -> String {
+pub fn page(report: &Report, figures: &[PageFigure]) -> String {
+    let inputs = &report.inputs;
+    let paper = &report.paper_vs_model;
+    let calibration = report.calibration.as_ref();
+    let disagreements = &report.disagreements;
+    let tracks = TracksSection { records: &report.tracks, notes: &report.track_notes };
     let mut h = String::with_capacity(1 << 20);
     h.push_str("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">");
     h.push_str("<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">");
@@ -202,7 +135,7 @@ pub fn page(
     }
 
     if !tracks.records.is_empty() {
-        h.push_str(&tracks_section(tracks));
+        h.push_str(&tracks_section(&tracks));
     }
 
     h.push_str("<h2 id=\"figures\">Figures</h2>\n");

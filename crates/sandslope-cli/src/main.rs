@@ -11,6 +11,7 @@ mod mocap_input;
 mod output;
 mod progress;
 mod report;
+mod serve;
 
 use clap::{Parser, Subcommand};
 
@@ -49,6 +50,8 @@ enum Command {
     Infer(commands::infer::InferArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
+    /// A local web explorer (model, risk, routes on a DEM) and a JSON API equal to `--json`.
+    Serve(serve::ServeArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -65,6 +68,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Report(a) => commands::report::run(a),
         Command::Infer(a) => commands::infer::run(a),
         Command::Presets(a) => commands::presets::run(a),
+        Command::Serve(a) => serve::run(a),
     }
 }
 

@@ -2,6 +2,7 @@
 
 use anyhow::{anyhow, Result};
 use clap::Args;
+use sandslope::{Scenario, SlopeEvaluation};
 
 use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::output::{
@@ -25,10 +26,20 @@ pub struct PredictArgs {
     pub format: FormatArgs,
 }
 
+/// The value `predict --json` prints (and `serve`'s `/api/predict` returns): the library's
+/// evaluation of the scenario at `--slope`.
+pub fn answer(args: &PredictArgs) -> Result<SlopeEvaluation> {
+    evaluate(&args.over.scenario(&args.robot, &args.terrain)?, args.slope)
+}
+
+fn evaluate(scenario: &Scenario, slope: f64) -> Result<SlopeEvaluation> {
+    scenario.evaluate(slope).map_err(|e| anyhow!("{}", e.renamed("--slope")))
+}
+
 /// Runs `sandslope predict`.
 pub fn run(args: PredictArgs) -> Result<()> {
     let scenario = args.over.scenario(&args.robot, &args.terrain)?;
-    let e = scenario.evaluate(args.slope).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+    let e = evaluate(&scenario, args.slope)?;
     if e.extrapolated {
         warn_extrapolated(scenario.terrain(), &[args.slope]);
     }

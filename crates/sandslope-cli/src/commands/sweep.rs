@@ -10,6 +10,7 @@ use crate::figures;
 use crate::figures::sweep::SweepFigure;
 use crate::output::{csv_string, num, print_json, ruled_out_note, speed_cell, table, Format, FormatArgs};
 use sandslope::scenario::slope_range;
+use sandslope::{Scenario, SlopeEvaluation};
 use sandslope_io::load_speeds;
 
 /// Most slopes a sweep evaluates (a guard against `--step 1e-9`).
@@ -51,11 +52,26 @@ fn slopes(args: &SweepArgs) -> Result<Vec<f64>> {
     })
 }
 
+/// The value `sweep --json` prints (and `serve`'s `/api/sweep` returns): the library's
+/// evaluation of the scenario at every slope of the range.
+pub fn answer(args: &SweepArgs) -> Result<Vec<SlopeEvaluation>> {
+    evaluate(&args.over.scenario(&args.robot, &args.terrain)?, &slopes(args)?)
+}
+
+fn evaluate(scenario: &Scenario, slopes: &[f64]) -> Result<Vec<SlopeEvaluation>> {
+    scenario.sweep(slopes).map_err(|e| anyhow!("{}", e.renamed("--from/--to")))
+}
+
+/// How many slopes the range of `args` holds, or the error naming the flag.
+pub fn slope_count(args: &SweepArgs) -> Result<usize> {
+    Ok(slopes(args)?.len())
+}
+
 /// Runs `sandslope sweep`.
 pub fn run(args: SweepArgs) -> Result<()> {
     let slopes = slopes(&args)?;
     let scenario = args.over.scenario(&args.robot, &args.terrain)?;
-    let evals = scenario.sweep(&slopes).map_err(|e| anyhow!("{}", e.renamed("--from/--to")))?;
+    let evals = evaluate(&scenario, &slopes)?;
     let observed = args.observed.as_deref().map(load_speeds).transpose()?;
     let extrapolated: Vec<f64> = evals.iter().filter(|e| e.extrapolated).map(|e| e.slope_deg).collect();
     if !extrapolated.is_empty() {

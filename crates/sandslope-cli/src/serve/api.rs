@@ -1,0 +1,268 @@
+//! The JSON API: `GET /api/<command>?<flag>=<value>&...` answered with exactly what
+//! `sandslope <command> <flags> --json` prints.
+//!
+//! A request's parameters become the command's argument list (`slope=20` -> `--slope=20`),
+//! which the command's own clap `Args` parses, so flags, defaults, checks and messages are the
+//! command line's. The answer is the value the command's `answer` function returns (the one its
+//! `run` prints with `--json`), serialised as `print_json` does: pretty JSON and a newline.
+//!
+//! What a request may not do: name a file (robots and terrains are built-in presets or the
+//! ones the server was started with; `plan` plans on the served DEM), ask for an output file
+//! (`--plot`, `--csv`, ...), or ask for more work than the limits below.
+
+use std::path::PathBuf;
+
+use clap::error::{ContextKind, ContextValue};
+use clap::{ArgAction, FromArgMatches};
+use serde::Serialize;
+
+use crate::commands::{predict, sweep};
+use sandslope_io::presets::{self, PresetKind};
+
+/// Most slopes one `/api/sweep` request evaluates.
+pub const MAX_SWEEP_SLOPES: usize = 10_000;
+
+/// The files the server was started with; requests that name none use these.
+#[derive(Debug, Clone)]
+pub struct Served {
+    /// `--robot` of `serve`: a file or a preset.
+    pub robot: String,
+    /// `--terrain` of `serve`: a file or a preset.
+    pub terrain: String,
+    /// `--dem` of `serve`, the only elevation model `/api/plan` uses.
+    pub dem: Option<PathBuf>,
+}
+
+/// The commands the API answers, in the order docs/serve.md lists them.
+pub const COMMANDS: [&str; 2] = ["predict", "sweep"];
+
+/// Flags that write files or choose an output format: the API always answers JSON and
+/// writes nothing.
+const OUTPUT_FLAGS: [&str; 10] =
+    ["json", "csv", "plot", "npy", "observed", "geojson", "risk-map", "out", "classes", "class-terrain"];
+
+/// A refused request: the HTTP status, the parameter at fault (when one is) and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ApiError {
+    /// HTTP status code (400 bad input, 404 no such endpoint, 413/414 too big, ...).
+    #[serde(skip)]
+    pub status: u16,
+    /// The request parameter the error is about, without `--` (`slope`), when there is one.
+    pub field: Option<String>,
+    /// What is wrong and what is accepted, as the command line says it.
+    pub error: String,
+}
+
+impl ApiError {
+    /// A 400 about `field`.
+    pub fn bad(field: impl Into<Option<String>>, error: impl Into<String>) -> ApiError {
+        ApiError { status: 400, field: field.into(), error: error.into() }
+    }
+
+    /// A command's error (a checked flag value): 400, the field read from the `--flag` the
+    /// message names first.
+    fn from_command(e: &anyhow::Error) -> ApiError {
+        let error = format!("{e:#}");
+        ApiError::bad(flag_named_in(&error), error)
+    }
+
+    /// A clap parse error: 400, the field from clap's context.
+    fn from_clap(e: &clap::Error) -> ApiError {
+        let field = match e.get(ContextKind::InvalidArg) {
+            Some(ContextValue::String(s)) => flag_named_in(s),
+            Some(ContextValue::Strings(v)) => v.first().and_then(|s| flag_named_in(s)),
+            _ => None,
+        };
+        let text = e.to_string();
+        let first = text.lines().next().unwrap_or_default();
+        let error = first.strip_prefix("error: ").unwrap_or(first).to_string();
+        ApiError::bad(field, error)
+    }
+}
+
+/// The first `--flag` named in `text`, without the dashes.
+fn flag_named_in(text: &str) -> Option<String> {
+    let start = text.find("--")? + 2;
+    let name: String =
+        text[start..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_').collect();
+    (!name.is_empty()).then_some(name)
+}
+
+/// Answers `/api/<command>` with these parameters (in request order): the JSON body.
+pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Result<Vec<u8>, ApiError> {
+    match command {
+        "predict" => {
+            let args: predict::PredictArgs = parse("predict", params, served)?;
+            json(&predict::answer(&args).map_err(|e| ApiError::from_command(&e))?)
+        }
+        "sweep" => {
+            let args: sweep::SweepArgs = parse("sweep", params, served)?;
+            let n = sweep::slope_count(&args).map_err(|e| ApiError::from_command(&e))?;
+            if n > MAX_SWEEP_SLOPES {
+                return Err(ApiError::bad(
+                    Some("step".to_string()),
+                    format!("--from/--to/--step give {n} slopes; the server evaluates at most {MAX_SWEEP_SLOPES}"),
+                ));
+            }
+            json(&sweep::answer(&args).map_err(|e| ApiError::from_command(&e))?)
+        }
+        _ => Err(ApiError {
+            status: 404,
+            field: None,
+            error: format!("no endpoint /api/{command}; the API answers {}", COMMANDS.join(", ")),
+        }),
+    }
+}
+
+/// `value` as `print_json` prints it: pretty JSON and a newline.
+pub fn json<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
+    let mut body = serde_json::to_vec_pretty(value)
+        .map_err(|e| ApiError { status: 500, field: None, error: format!("serialising the answer: {e}") })?;
+    body.push(b'\n');
+    Ok(body)
+}
+
+/// Parses `params` as `sandslope <name> --<key>=<value>...` with the command's own `Args`,
+/// adding the served robot and terrain when the request names none.
+pub fn parse<T: clap::Args + FromArgMatches>(
+    name: &'static str,
+    params: &[(String, String)],
+    served: &Served,
+) -> Result<T, ApiError> {
+    let cmd = T::augment_args(clap::Command::new(name).no_binary_name(true).disable_help_flag(true));
+    let args: Vec<&clap::Arg> = cmd.get_arguments().filter(|a| a.get_long().is_some()).collect();
+    let takes = |key: &str| args.iter().find(|a| a.get_long() == Some(key)).copied();
+    let accepted = || {
+        args.iter()
+            .filter_map(|a| a.get_long())
+            .filter(|l| !OUTPUT_FLAGS.contains(l) && *l != "dem")
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut argv: Vec<String> = Vec::new();
+    for (key, value) in params {
+        let key = key.as_str();
+        if key == "dem" && takes(key).is_some() {
+            return Err(ApiError::bad(
+                Some("dem".into()),
+                "dem: a request cannot name a file; the server plans on the DEM it was started with (serve --dem)",
+            ));
+        }
+        if OUTPUT_FLAGS.contains(&key) && takes(key).is_some() {
+            return Err(ApiError::bad(
+                Some(key.into()),
+                format!("{key}: the API answers JSON and writes no file; this flag is for the command line only"),
+            ));
+        }
+        let Some(arg) = takes(key) else {
+            return Err(ApiError::bad(
+                Some(key.into()),
+                format!("unknown parameter `{key}`: {name} takes {}", accepted()),
+            ));
+        };
+        if let Some(kind) = preset_kind(key) {
+            if presets::find(value, kind).is_none() {
+                return Err(ApiError::bad(
+                    Some(key.into()),
+                    format!(
+                        "{key} = `{value}` is not a built-in preset ({}); a request cannot name a file",
+                        presets::names(kind)
+                    ),
+                ));
+            }
+        }
+        if matches!(arg.get_action(), ArgAction::SetTrue) {
+            match value.as_str() {
+                "" | "true" | "1" => argv.push(format!("--{key}")),
+                "false" | "0" => {}
+                _ => {
+                    return Err(ApiError::bad(
+                        Some(key.into()),
+                        format!("{key} = `{value}` must be true or false (or empty: true)"),
+                    ))
+                }
+            }
+        } else {
+            argv.push(format!("--{key}={value}"));
+        }
+    }
+    for (key, served_value) in [("robot", &served.robot), ("terrain", &served.terrain)] {
+        if takes(key).is_some() && !params.iter().any(|(k, _)| k == key) {
+            argv.push(format!("--{key}={served_value}"));
+        }
+    }
+    if takes("dem").is_some() {
+        match &served.dem {
+            Some(dem) => argv.push(format!("--dem={}", dem.display())),
+            None => {
+                return Err(ApiError {
+                    status: 404,
+                    field: None,
+                    error: format!("/api/{name} needs an elevation model: start the server with --dem FILE"),
+                })
+            }
+        }
+    }
+    let matches = cmd.try_get_matches_from(argv).map_err(|e| ApiError::from_clap(&e))?;
+    T::from_arg_matches(&matches).map_err(|e| ApiError::from_clap(&e))
+}
+
+/// Parameters whose value must be a built-in preset of this kind.
+fn preset_kind(key: &str) -> Option<PresetKind> {
+    match key {
+        "robot" => Some(PresetKind::Robot),
+        "terrain" => Some(PresetKind::Terrain),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn served() -> Served {
+        Served { robot: "paper-hexapod".into(), terrain: "glass-beads-300um".into(), dem: None }
+    }
+
+    fn ask(command: &str, params: &[(&str, &str)]) -> Result<serde_json::Value, ApiError> {
+        let params: Vec<(String, String)> = params.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+        answer(command, &params, &served()).map(|b| serde_json::from_slice(&b).unwrap())
+    }
+
+    #[test]
+    fn bad_requests_are_400s_naming_the_field() {
+        let field = |r: Result<serde_json::Value, ApiError>| {
+            let e = r.unwrap_err();
+            assert_eq!(e.status, 400, "{e:?}");
+            e.field.unwrap_or_default()
+        };
+        assert_eq!(field(ask("predict", &[("slope", "abc")])), "slope");
+        assert_eq!(field(ask("predict", &[("slope", "NaN")])), "slope");
+        assert_eq!(field(ask("predict", &[("slope", "1e308")])), "slope");
+        assert_eq!(field(ask("predict", &[])), "slope");
+        assert_eq!(field(ask("predict", &[("slope", "10"), ("mass", "-1")])), "mass");
+        assert_eq!(field(ask("predict", &[("slope", "10"), ("mass", "1e400")])), "mass");
+        assert_eq!(field(ask("predict", &[("slope", "10"), ("bogus", "1")])), "bogus");
+        assert_eq!(field(ask("predict", &[("slope", "10"), ("robot", "/etc/passwd")])), "robot");
+        assert_eq!(field(ask("predict", &[("slope", "10"), ("terrain", "../x.toml")])), "terrain");
+        assert_eq!(field(ask("predict", &[("slope", "10"), ("json", "")])), "json");
+        assert_eq!(field(ask("predict", &[("slope", "10"), ("slope", "11")])), "slope");
+        assert_eq!(field(ask("sweep", &[("step", "1e-6")])), "step");
+        assert_eq!(field(ask("sweep", &[("plot", "/tmp/x.png")])), "plot");
+        assert_eq!(ask("nothing", &[]).unwrap_err().status, 404);
+    }
+
+    #[test]
+    fn a_good_request_is_the_library_value() {
+        // On level ground the paper's robot on the built-in terrain succeeds at about the
+        // paper's measured 0.157 m/s (the terrain is calibrated on it; within 5 %), and with
+        // omega = 2 pi rad/s the stance lasts T/2 = 0.5 s, so v = step / 0.5 s (docs/model.md §5).
+        let v = ask("predict", &[("slope", "0")]).unwrap();
+        assert_eq!(v["regime"], "success");
+        let speed = v["speed_m_s"].as_f64().unwrap();
+        assert!((speed - 0.157).abs() < 0.157 * 0.05, "{v}");
+        assert!((speed - v["step_m"].as_f64().unwrap() / 0.5).abs() < 1e-12, "{v}");
+        let v = ask("sweep", &[("from", "0"), ("to", "10"), ("step", "5")]).unwrap();
+        assert_eq!(v.as_array().unwrap().len(), 3);
+    }
+}

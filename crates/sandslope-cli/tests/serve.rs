@@ -1,0 +1,223 @@
+//! `sandslope serve`: the JSON API returns exactly what `--json` prints for the same flags;
+//! bad, huge or hostile requests get a 4xx naming the field or the limit, never a 500; the
+//! server answers many concurrent requests without losing one.
+
+mod common;
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+use rand::{RngExt, SeedableRng};
+
+use common::{repo_file, sandslope};
+
+/// A running `sandslope serve`, stopped when dropped.
+struct Server {
+    child: Child,
+    /// `127.0.0.1:PORT`
+    addr: String,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Server {
+    /// Starts `sandslope serve --port 0 ARGS` and reads the URL it prints.
+    fn start(args: &[&str]) -> Server {
+        let mut child = Command::new(assert_cmd::cargo::cargo_bin("sandslope"))
+            .args(["serve", "--port", "0"])
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .unwrap();
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
+        let addr = line
+            .trim()
+            .strip_prefix("sandslope serve: http://")
+            .and_then(|s| s.strip_suffix('/'))
+            .unwrap_or_else(|| panic!("unexpected first line {line:?}"))
+            .to_string();
+        Server { child, addr }
+    }
+
+    /// `METHOD path` with `body`: (status, body).
+    fn request(&self, method: &str, path: &str, body: &[u8]) -> (u16, Vec<u8>) {
+        let mut s = TcpStream::connect(&self.addr).unwrap();
+        s.set_read_timeout(Some(Duration::from_secs(120))).unwrap();
+        write!(
+            s,
+            "{method} {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\nContent-Length: {}\r\n\r\n",
+            self.addr,
+            body.len()
+        )
+        .unwrap();
+        s.write_all(body).unwrap();
+        let mut raw = Vec::new();
+        s.read_to_end(&mut raw).unwrap();
+        let split = raw.windows(4).position(|w| w == b"\r\n\r\n").expect("no header end");
+        let head = String::from_utf8_lossy(&raw[..split]).to_string();
+        let status = head.split(' ').nth(1).and_then(|s| s.parse().ok()).expect("no status");
+        (status, raw[split + 4..].to_vec())
+    }
+
+    fn get(&self, path: &str) -> (u16, Vec<u8>) {
+        self.request("GET", path, b"")
+    }
+}
+
+/// The stdout of `sandslope ARGS`, which must succeed.
+fn cli_stdout(args: &[String]) -> Vec<u8> {
+    let out = sandslope().args(args).output().unwrap();
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    out.stdout
+}
+
+/// The API path for `command` with these flags, and the CLI's argument list for the same.
+fn both(command: &str, flags: &[(&str, String)]) -> (String, Vec<String>) {
+    let query: Vec<String> = flags.iter().map(|(k, v)| format!("{k}={}", encode(v))).collect();
+    let mut argv = vec![command.to_string()];
+    for (k, v) in flags {
+        argv.push(format!("--{k}={v}"));
+    }
+    argv.push("--json".into());
+    (format!("/api/{command}?{}", query.join("&")), argv)
+}
+
+/// Percent-encodes what a query value cannot hold as is.
+fn encode(v: &str) -> String {
+    v.bytes()
+        .map(|b| match b {
+            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'.' | b'_' | b'~' => (b as char).to_string(),
+            _ => format!("%{b:02X}"),
+        })
+        .collect()
+}
+
+fn assert_same(server: &Server, command: &str, flags: &[(&str, String)]) {
+    let (path, argv) = both(command, flags);
+    let (status, body) = server.get(&path);
+    assert_eq!(status, 200, "{path}: {}", String::from_utf8_lossy(&body));
+    let cli = cli_stdout(&argv);
+    assert!(
+        body == cli,
+        "{path} differs from {argv:?}:\n{}\nvs\n{}",
+        String::from_utf8_lossy(&body),
+        String::from_utf8_lossy(&cli)
+    );
+}
+
+#[test]
+fn predict_endpoint_equals_predict_json_for_50_random_inputs() {
+    let server = Server::start(&[]);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(25);
+    for _ in 0..50 {
+        // Slopes across descending, level, steep and beyond the terrain's table; masses and
+        // resistances from a tenth to ten times the paper's, sometimes left to the defaults.
+        let mut flags = vec![("slope", format!("{}", (rng.random_range(-30.0..40.0f64) * 4.0).round() / 4.0))];
+        if rng.random_bool(0.7) {
+            flags.push(("mass", format!("{}", 0.35 * 10f64.powf(rng.random_range(-1.0..1.0)))));
+        }
+        if rng.random_bool(0.4) {
+            flags.push(("k-s", format!("{:e}", 2e6 * 10f64.powf(rng.random_range(-3.0..1.0)))));
+        }
+        if rng.random_bool(0.3) {
+            flags.push(("k-n", format!("{:e}", 7e5 * 10f64.powf(rng.random_range(-1.0..1.0)))));
+        }
+        assert_same(&server, "predict", &flags);
+    }
+}
+
+#[test]
+fn sweep_endpoint_equals_sweep_json() {
+    let server = Server::start(&[]);
+    assert_same(&server, "sweep", &[("from", "-5".into()), ("to", "30".into()), ("step", "2.5".into())]);
+    assert_same(&server, "sweep", &[("mass", "1.2".into())]);
+}
+
+#[test]
+fn a_served_robot_file_is_the_default_of_every_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = dir.path().join("heavy.toml");
+    let preset = std::fs::read_to_string(repo_file("crates/sandslope-io/presets/paper-hexapod.toml")).unwrap();
+    std::fs::write(&robot, preset.replace("mass_kg = 0.35", "mass_kg = 1.5")).unwrap();
+    let robot = robot.to_string_lossy().into_owned();
+    let server = Server::start(&["--robot", &robot]);
+    let (status, body) = server.get("/api/predict?slope=15");
+    assert_eq!(status, 200);
+    let cli = cli_stdout(&["predict".into(), "--slope=15".into(), format!("--robot={robot}"), "--json".into()]);
+    assert_eq!(body, cli);
+    // A request cannot name that file (or any other) itself.
+    let (status, body) = server.get(&format!("/api/predict?slope=15&robot={}", encode(&robot)));
+    assert_eq!(status, 400, "{}", String::from_utf8_lossy(&body));
+}
+
+/// The JSON error of a refused request: (status, field, message).
+fn refused(server: &Server, method: &str, path: &str, body: &[u8]) -> (u16, Option<String>, String) {
+    let (status, body) = server.request(method, path, body);
+    let v: serde_json::Value = serde_json::from_slice(&body)
+        .unwrap_or_else(|e| panic!("{path}: not JSON ({e}): {}", String::from_utf8_lossy(&body)));
+    (status, v["field"].as_str().map(str::to_string), v["error"].as_str().unwrap_or_default().to_string())
+}
+
+#[test]
+fn hostile_requests_get_a_4xx_naming_the_field_or_limit() {
+    let server = Server::start(&[]);
+    for (path, field) in [
+        ("/api/predict?slope=NaN", "slope"),
+        ("/api/predict?slope=inf", "slope"),
+        ("/api/predict?slope=1e999", "slope"),
+        ("/api/predict?slope=99999999999999999999", "slope"),
+        ("/api/predict?slope=", "slope"),
+        ("/api/predict?slope=%FF%FE", "slope"),
+        ("/api/predict?slope=10&mass=-0", "mass"),
+        ("/api/predict?slope=10&mass=1e309", "mass"),
+        ("/api/predict?slope=10&k-s=0", "k-s"),
+        ("/api/predict?slope=10&colour=red", "colour"),
+        ("/api/predict?slope=10&robot=..%2F..%2Fetc%2Fpasswd", "robot"),
+        ("/api/predict?slope=10&terrain=%2Ftmp%2Fx.toml", "terrain"),
+        ("/api/sweep?step=0.0000001", "step"),
+        ("/api/sweep?plot=%2Ftmp%2Fx.svg", "plot"),
+    ] {
+        let (status, got, error) = refused(&server, "GET", path, b"");
+        assert_eq!((status, got.as_deref()), (400, Some(field)), "{path}: {error}");
+        assert!(!error.is_empty());
+    }
+    // POST bodies: malformed JSON, a non-object, a huge number, an unknown key, a nested list.
+    for (body, field) in [
+        (&b"{\"slope\": "[..], "body"),
+        (&b"[1, 2]"[..], "body"),
+        (&b"{\"slope\": 1e999}"[..], "body"),
+        (&b"{\"slope\": 10, \"wings\": 2}"[..], "wings"),
+        (&b"{\"slope\": [[1]]}"[..], "slope"),
+        (&b"{\"slope\": null}"[..], "slope"),
+        (&b"{\"slope\": 10, \"mass\": \"NaN\"}"[..], "mass"),
+    ] {
+        let (status, got, error) = refused(&server, "POST", "/api/predict", body);
+        assert_eq!((status, got.as_deref()), (400, Some(field)), "{}: {error}", String::from_utf8_lossy(body));
+    }
+    let (status, body) = server.request("POST", "/api/predict", b"{\"slope\": 12.5, \"mass\": 0.5}");
+    assert_eq!(status, 200);
+    assert_eq!(body, cli_stdout(&["predict".into(), "--slope=12.5".into(), "--mass=0.5".into(), "--json".into()]));
+    // Too big: a body over 64 KiB, a URL over 8 KiB.
+    let big = format!("{{\"slope\": 10, \"robot\": \"{}\"}}", "x".repeat(70_000));
+    let (status, _, error) = refused(&server, "POST", "/api/predict", big.as_bytes());
+    assert_eq!(status, 413, "{error}");
+    assert!(error.contains("65536"), "{error}");
+    let (status, _, error) = refused(&server, "GET", &format!("/api/predict?slope={}", "1".repeat(9000)), b"");
+    assert_eq!(status, 414, "{error}");
+    assert!(error.contains("8192"), "{error}");
+    let (status, _, _) = refused(&server, "GET", "/api/rm?rf=1", b"");
+    assert_eq!(status, 404);
+    let (status, _, error) = refused(&server, "GET", "/api/plan?start-px=5,5&goal-px=6,6", b"");
+    assert!((400..500).contains(&status), "{status}: {error}");
+    // The server is still up and right after all that.
+    assert_same(&server, "predict", &[("slope", "20".into())]);
+}

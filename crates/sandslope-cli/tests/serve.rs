@@ -121,7 +121,8 @@ fn predict_endpoint_equals_predict_json_for_50_random_inputs() {
     for _ in 0..50 {
         // Slopes across descending, level, steep and beyond the terrain's table; masses and
         // resistances from a tenth to ten times the paper's, sometimes left to the defaults.
-        let mut flags = vec![("slope", format!("{}", (rng.random_range(-30.0..40.0f64) * 4.0).round() / 4.0))];
+        let mut flags =
+            vec![("slope", format!("{}", (rng.random_range(-30.0..40.0f64) * 4.0).round() / 4.0))];
         if rng.random_bool(0.7) {
             flags.push(("mass", format!("{}", 0.35 * 10f64.powf(rng.random_range(-1.0..1.0)))));
         }
@@ -146,13 +147,15 @@ fn sweep_endpoint_equals_sweep_json() {
 fn a_served_robot_file_is_the_default_of_every_request() {
     let dir = tempfile::tempdir().unwrap();
     let robot = dir.path().join("heavy.toml");
-    let preset = std::fs::read_to_string(repo_file("crates/sandslope-io/presets/paper-hexapod.toml")).unwrap();
+    let preset =
+        std::fs::read_to_string(repo_file("crates/sandslope-io/presets/paper-hexapod.toml")).unwrap();
     std::fs::write(&robot, preset.replace("mass_kg = 0.35", "mass_kg = 1.5")).unwrap();
     let robot = robot.to_string_lossy().into_owned();
     let server = Server::start(&["--robot", &robot]);
     let (status, body) = server.get("/api/predict?slope=15");
     assert_eq!(status, 200);
-    let cli = cli_stdout(&["predict".into(), "--slope=15".into(), format!("--robot={robot}"), "--json".into()]);
+    let cli =
+        cli_stdout(&["predict".into(), "--slope=15".into(), format!("--robot={robot}"), "--json".into()]);
     assert_eq!(body, cli);
     // A request cannot name that file (or any other) itself.
     let (status, body) = server.get(&format!("/api/predict?slope=15&robot={}", encode(&robot)));
@@ -201,17 +204,26 @@ fn hostile_requests_get_a_4xx_naming_the_field_or_limit() {
         (&b"{\"slope\": 10, \"mass\": \"NaN\"}"[..], "mass"),
     ] {
         let (status, got, error) = refused(&server, "POST", "/api/predict", body);
-        assert_eq!((status, got.as_deref()), (400, Some(field)), "{}: {error}", String::from_utf8_lossy(body));
+        assert_eq!(
+            (status, got.as_deref()),
+            (400, Some(field)),
+            "{}: {error}",
+            String::from_utf8_lossy(body)
+        );
     }
     let (status, body) = server.request("POST", "/api/predict", b"{\"slope\": 12.5, \"mass\": 0.5}");
     assert_eq!(status, 200);
-    assert_eq!(body, cli_stdout(&["predict".into(), "--slope=12.5".into(), "--mass=0.5".into(), "--json".into()]));
+    assert_eq!(
+        body,
+        cli_stdout(&["predict".into(), "--slope=12.5".into(), "--mass=0.5".into(), "--json".into()])
+    );
     // Too big: a body over 64 KiB, a URL over 8 KiB.
     let big = format!("{{\"slope\": 10, \"robot\": \"{}\"}}", "x".repeat(70_000));
     let (status, _, error) = refused(&server, "POST", "/api/predict", big.as_bytes());
     assert_eq!(status, 413, "{error}");
     assert!(error.contains("65536"), "{error}");
-    let (status, _, error) = refused(&server, "GET", &format!("/api/predict?slope={}", "1".repeat(9000)), b"");
+    let (status, _, error) =
+        refused(&server, "GET", &format!("/api/predict?slope={}", "1".repeat(9000)), b"");
     assert_eq!(status, 414, "{error}");
     assert!(error.contains("8192"), "{error}");
     let (status, _, _) = refused(&server, "GET", "/api/rm?rf=1", b"");

@@ -101,7 +101,9 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
             if n > MAX_SWEEP_SLOPES {
                 return Err(ApiError::bad(
                     Some("step".to_string()),
-                    format!("--from/--to/--step give {n} slopes; the server evaluates at most {MAX_SWEEP_SLOPES}"),
+                    format!(
+                        "--from/--to/--step give {n} slopes; the server evaluates at most {MAX_SWEEP_SLOPES}"
+                    ),
                 ));
             }
             json(&sweep::answer(&args).map_err(|e| ApiError::from_command(&e))?)
@@ -116,8 +118,11 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
 
 /// `value` as `print_json` prints it: pretty JSON and a newline.
 pub fn json<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
-    let mut body = serde_json::to_vec_pretty(value)
-        .map_err(|e| ApiError { status: 500, field: None, error: format!("serialising the answer: {e}") })?;
+    let mut body = serde_json::to_vec_pretty(value).map_err(|e| ApiError {
+        status: 500,
+        field: None,
+        error: format!("serialising the answer: {e}"),
+    })?;
     body.push(b'\n');
     Ok(body)
 }
@@ -151,7 +156,9 @@ pub fn parse<T: clap::Args + FromArgMatches>(
         if OUTPUT_FLAGS.contains(&key) && takes(key).is_some() {
             return Err(ApiError::bad(
                 Some(key.into()),
-                format!("{key}: the API answers JSON and writes no file; this flag is for the command line only"),
+                format!(
+                    "{key}: the API answers JSON and writes no file; this flag is for the command line only"
+                ),
             ));
         }
         let Some(arg) = takes(key) else {
@@ -225,7 +232,8 @@ mod tests {
     }
 
     fn ask(command: &str, params: &[(&str, &str)]) -> Result<serde_json::Value, ApiError> {
-        let params: Vec<(String, String)> = params.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+        let params: Vec<(String, String)> =
+            params.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
         answer(command, &params, &served()).map(|b| serde_json::from_slice(&b).unwrap())
     }
 

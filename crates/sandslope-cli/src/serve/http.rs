@@ -112,7 +112,8 @@ fn respond_api(request: Request, result: Result<Vec<u8>, ApiError>) {
         Ok(body) => (200, body),
         Err(e) => (e.status, api::json(&e).unwrap_or_else(|_| b"{}\n".to_vec())),
     };
-    let _ = request.respond(with_type(Response::from_data(body).with_status_code(status), "application/json"));
+    let _ =
+        request.respond(with_type(Response::from_data(body).with_status_code(status), "application/json"));
 }
 
 fn with_type<R: Read>(r: Response<R>, content_type: &str) -> Response<R> {
@@ -161,7 +162,14 @@ fn route(mut request: Request, tx: &SyncSender<Job>, served: &Served) {
                 Ok(mut more) => params.append(&mut more),
                 Err(e) => return respond_api(request, Err(e)),
             },
-            _ => return refuse(request, 405, None, format!("{method} is not accepted; use GET (or POST with JSON)")),
+            _ => {
+                return refuse(
+                    request,
+                    405,
+                    None,
+                    format!("{method} is not accepted; use GET (or POST with JSON)"),
+                )
+            }
         }
         let job = Job { request, command: command.to_string(), params };
         if let Err(e) = tx.try_send(job) {

@@ -64,7 +64,8 @@ pub fn run(args: ServeArgs) -> Result<()> {
         Some(n) => n,
         None => std::thread::available_parallelism().map_or(2, |n| n.get()),
     };
-    let served = api::Served { robot: args.robot.clone(), terrain: args.terrain.clone(), dem: args.dem.clone() };
+    let served =
+        api::Served { robot: args.robot.clone(), terrain: args.terrain.clone(), dem: args.dem.clone() };
     let server = http::Server::bind(args.host, args.port, served, threads)?;
     let url = format!("http://{}/", server.address());
     if !args.host.is_loopback() {

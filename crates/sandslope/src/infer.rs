@@ -29,8 +29,7 @@ use std::fmt;
 use serde::Serialize;
 
 use crate::model::{
-    anchoring_time, level_step_length, net_step, normal_equilibrium_depth, shear_equilibrium_depth,
-    step_speed,
+    continued_anchoring_time, level_step_length, net_step, normal_equilibrium_depth, step_speed,
 };
 use crate::risk::{regime_probabilities, UncertainTerrain};
 use crate::robot::Robot;
@@ -354,12 +353,7 @@ impl SpeedTable {
 /// The model's speed and t1 at `k_s`, continued at the anchoring limit `d_s = d_max` where the
 /// leg would not anchor (`k_s = 0`: the limit itself).
 fn continued(robot: &Robot, slope: Slope, s_star: f64, k_s: f64) -> (f64, f64) {
-    let d_s = if k_s > 0.0 {
-        shear_equilibrium_depth(robot, slope, k_s).min(robot.max_depth())
-    } else {
-        robot.max_depth()
-    };
-    let t1 = anchoring_time(robot, d_s).expect("d_s clamped to d_max anchors");
+    let t1 = continued_anchoring_time(robot, slope, k_s);
     (step_speed(robot, net_step(robot, slope, s_star, t1)), t1)
 }
 

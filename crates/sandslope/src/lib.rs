@@ -48,11 +48,11 @@ pub mod scenario;
 pub mod slope;
 pub mod terrain;
 
-pub use calibrate::joint::{
-    calibrate_jointly, AnchoringObservation, CalibrationWarning, FreeParameter, JointCalibration, JointError,
-    JointSetup, Parameter, RobotKey, ShearShape,
+pub use calibrate::{
+    calibrate_jointly, invert_each_speed, AnchoringObservation, CalibrationError, CalibrationWarning,
+    FreeParameter, JointCalibration, JointSetup, Parameter, Quantity, RobotKey, ShearLaw, ShearShape,
+    SpeedObservation,
 };
-pub use calibrate::{calibrate, Calibration, CalibrationError, LawParams, ShearLaw, SpeedObservation};
 pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
 pub use error::ParamError;
 pub use gait::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording, Upslope};

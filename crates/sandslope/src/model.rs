@@ -92,6 +92,23 @@ pub fn anchoring_time(robot: &Robot, d_s: f64) -> Option<f64> {
     Some((arg.asin() - robot.touchdown_angle()) / robot.leg_speed())
 }
 
+/// Anchoring time at `k_s`, continued at the anchoring limit: where the leg would not anchor
+/// (`d_s > d_max`, or `k_s <= 0`) it is taken to anchor at its deepest point, `d_s = d_max`, s.
+///
+/// Not the model's prediction there (which has no t1, docs/model.md §4) but the continuous
+/// extension that calibration and inference fit through, so their objectives have no jump at
+/// the anchoring threshold (docs/model.md §14).
+pub fn continued_anchoring_time(robot: &Robot, slope: Slope, k_s: f64) -> f64 {
+    let d_s = if k_s > 0.0 { shear_equilibrium_depth(robot, slope, k_s) } else { f64::INFINITY };
+    anchoring_time(robot, d_s.min(robot.max_depth())).unwrap_or(robot.stance_duration())
+}
+
+/// Step-averaged speed at `k_s` with level step `level_step`, continued at the anchoring limit
+/// as [`continued_anchoring_time`] is, m/s.
+pub fn continued_speed(robot: &Robot, slope: Slope, level_step: f64, k_s: f64) -> f64 {
+    step_speed(robot, net_step(robot, slope, level_step, continued_anchoring_time(robot, slope, k_s)))
+}
+
 /// Backward slip before anchoring, `s1 = 1/2 g sin(theta) t1^2`, m.
 pub fn backward_slip(slope: Slope, t1: f64) -> f64 {
     0.5 * G * slope.sin() * t1 * t1

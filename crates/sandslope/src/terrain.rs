@@ -158,26 +158,15 @@ impl Terrain {
     /// whether the slope lies beyond the last point (extrapolated).
     fn segment(&self, deg: f64) -> (&TerrainPoint, &TerrainPoint, f64, bool) {
         let pts = &self.spec.points;
-        let first = &pts[0];
-        let last = &pts[pts.len() - 1];
-        let (a, b, beyond) = if pts.len() == 1 || deg <= first.slope_deg {
-            (first, first, false)
-        } else if deg > last.slope_deg {
-            (&pts[pts.len() - 2], last, true)
-        } else {
-            let i = pts.partition_point(|p| p.slope_deg < deg).max(1);
-            (&pts[i - 1], &pts[i], false)
-        };
-        let frac =
-            if b.slope_deg > a.slope_deg { (deg - a.slope_deg) / (b.slope_deg - a.slope_deg) } else { 0.0 };
-        (a, b, frac, beyond && pts.len() > 1)
+        let (a, b, frac, beyond) = segment(pts, |p| p.slope_deg, deg);
+        (&pts[a], &pts[b], frac, beyond)
     }
 
     /// The ground at `slope`: k_n and k_s by the interpolation rule of docs/model.md §7, and
     /// the terrain's angle of repose.
     pub fn at(&self, slope: Slope) -> Ground {
         let (a, b, frac, _) = self.segment(slope.degrees());
-        let lerp = |x: f64, y: f64| (x + frac * (y - x)).max(0.0);
+        let lerp = |x: f64, y: f64| lerp(x, y, frac);
         Ground { k_n: lerp(a.k_n, b.k_n), k_s: lerp(a.k_s, b.k_s), repose: self.repose }
     }
 
@@ -186,7 +175,7 @@ impl Terrain {
     pub fn sd_at(&self, slope: Slope) -> (Option<f64>, Option<f64>) {
         let (a, b, frac, _) = self.segment(slope.degrees());
         let lerp = |x: Option<f64>, y: Option<f64>| match (x, y) {
-            (Some(x), Some(y)) => Some((x + frac * (y - x)).max(0.0)),
+            (Some(x), Some(y)) => Some(lerp(x, y, frac)),
             _ => None,
         };
         (lerp(a.k_n_sd, b.k_n_sd), lerp(a.k_s_sd, b.k_s_sd))
@@ -197,6 +186,37 @@ impl Terrain {
     pub fn extrapolates(&self, slope: Slope) -> bool {
         self.segment(slope.degrees()).3
     }
+}
+
+/// The interpolation rule of docs/model.md §7 over points sorted by slope: the indices of the
+/// two points whose segment covers `deg`, the fraction along it, and whether `deg` lies beyond
+/// the last point (the last segment extended). Below the first point the first point holds.
+fn segment<T>(points: &[T], slope_deg: impl Fn(&T) -> f64, deg: f64) -> (usize, usize, f64, bool) {
+    let n = points.len();
+    let (a, b, beyond) = if n == 1 || deg <= slope_deg(&points[0]) {
+        (0, 0, false)
+    } else if deg > slope_deg(&points[n - 1]) {
+        (n - 2, n - 1, true)
+    } else {
+        let i = points.partition_point(|p| slope_deg(p) < deg).max(1);
+        (i - 1, i, false)
+    };
+    let (da, db) = (slope_deg(&points[a]), slope_deg(&points[b]));
+    let frac = if db > da { (deg - da) / (db - da) } else { 0.0 };
+    (a, b, frac, beyond && n > 1)
+}
+
+/// `x + frac (y - x)`, floored at zero (docs/model.md §7).
+fn lerp(x: f64, y: f64, frac: f64) -> f64 {
+    (x + frac * (y - x)).max(0.0)
+}
+
+/// A `(slope_deg, value)` table (sorted by slope, not empty) at `deg`, by the terrain table's
+/// interpolation rule (docs/model.md §7): what a table of fitted values between force-test
+/// slopes follows.
+pub(crate) fn interpolate(points: &[(f64, f64)], deg: f64) -> f64 {
+    let (a, b, frac, _) = segment(points, |p| p.0, deg);
+    lerp(points[a].1, points[b].1, frac)
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 use rand::{rngs::StdRng, SeedableRng};
 use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
-use sandslope::calibrate::joint::Interval;
+use sandslope::calibrate::Interval;
 use sandslope::*;
 
 fn slope(d: f64) -> Slope {
@@ -50,9 +50,13 @@ fn t1(robot: &Robot, terrain: &Terrain, d: f64) -> f64 {
 
 const SLOPES: [f64; 6] = [0.0, 5.0, 10.0, 15.0, 20.0, 24.0];
 
-fn param<'a>(c: &'a JointCalibration, name: &str) -> &'a Interval {
-    &c.parameters.iter().find(|p| p.name == name).unwrap_or_else(|| panic!("no {name}")).estimate
+fn param(c: &JointCalibration, quantity: Quantity) -> &Interval {
+    &c.fitted(quantity).unwrap_or_else(|| panic!("no {quantity:?}")).estimate
 }
+
+const HIP_HEIGHT: Quantity = Quantity::Free(Parameter::Robot(RobotKey::HipHeightM));
+const PLATE_SCALE: Quantity = Quantity::Free(Parameter::PlateScale);
+const ERROR_FLOOR: Quantity = Quantity::Free(Parameter::ErrorFloor);
 
 fn contains(iv: &Interval, truth: f64) -> bool {
     iv.lower <= truth && truth <= iv.upper
@@ -106,10 +110,11 @@ fn joint_fit_recovers_hip_height_plate_scale_and_ratio_from_exact_data() {
         error_floor: 0.0,
     };
     let c = calibrate_jointly(&setup).unwrap();
-    let h = param(&c, "hip_height_m");
-    let scale = param(&c, "plate_scale");
+    let h = param(&c, HIP_HEIGHT);
+    let scale = param(&c, PLATE_SCALE);
     assert!((h.value - 0.025).abs() < 1e-5, "h = {h:?}");
     assert!((scale.value - 20.0).abs() < 0.02, "c = {scale:?}");
+    assert_eq!(c.plate_scale(), scale.value);
     assert!(contains(h, 0.025) && contains(scale, 20.0));
     assert!((c.shear_ratio_20.value - 0.5).abs() < 1e-3 && contains(&c.shear_ratio_20, 0.5));
     // Exact data: chi^2 ~ 0, every pull ~ 0, no warnings about the fit.
@@ -157,7 +162,10 @@ fn profile_intervals_have_68_percent_coverage() {
                 error_floor: 0.0,
             };
             let c = calibrate_jointly(&setup).unwrap();
-            [contains(param(&c, "k_s0"), 2e6), contains(param(&c, "k_s(20 deg)/k_s(0)"), 0.5)]
+            [
+                contains(param(&c, Quantity::LevelShearStrength), 2e6),
+                contains(param(&c, Quantity::ShearRatio20), 0.5),
+            ]
         })
         .collect();
     for (i, name) in ["k_s0", "ratio"].iter().enumerate() {
@@ -193,7 +201,7 @@ fn a_free_error_floor_is_the_maximum_likelihood_one_when_the_stated_sds_are_too_
         error_floor: 0.0,
     };
     let c = calibrate_jointly(&setup).unwrap();
-    let f = param(&c, "error_floor");
+    let f = param(&c, ERROR_FLOOR);
     let n = c.pulls.len() as f64;
     let rss: f64 = c.pulls.iter().map(|p| (p.observed - p.model).powi(2)).sum();
     let expected = (rss / n - 0.001f64.powi(2)).sqrt();
@@ -252,7 +260,7 @@ fn warnings_fire_for_the_ceiling_and_for_a_bound() {
         .warnings
         .iter()
         .any(|w| matches!(w, CalibrationWarning::ParameterAtBound { name, .. } if name == "hip_height_m"));
-    let p = c.parameters.iter().find(|p| p.name == "hip_height_m").unwrap();
+    let p = c.parameter(Parameter::Robot(RobotKey::HipHeightM)).unwrap();
     assert_eq!(at, p.at_bound);
     assert!(p.at_bound, "{p:?}");
 }
@@ -270,17 +278,71 @@ fn bad_setups_are_refused_with_the_reason() {
         error_floor: 0.0,
     };
     // Two law parameters from one speed.
-    assert!(matches!(calibrate_jointly(&base), Err(JointError::TooFewObservations { .. })));
+    assert!(matches!(calibrate_jointly(&base), Err(CalibrationError::TooFewObservations { .. })));
     let plate = JointSetup { free: free(&["plate_scale"]), ..base.clone() };
-    assert_eq!(calibrate_jointly(&plate).unwrap_err(), JointError::PlateScaleWithoutForces);
+    assert_eq!(calibrate_jointly(&plate).unwrap_err(), CalibrationError::PlateScaleWithoutForces);
     let bounds = JointSetup {
         free: vec![FreeParameter { parameter: Parameter::PlateScale, bounds: Some((2.0, 1.0)) }],
         shear: ShearShape::ForceTests(linear_terrain(1e5, 0.5, 0.1)),
         ..base.clone()
     };
-    assert!(matches!(calibrate_jointly(&bounds), Err(JointError::BadBounds { .. })));
+    assert!(matches!(calibrate_jointly(&bounds), Err(CalibrationError::BadBounds { .. })));
+    let bad_sd = vec![SpeedObservation { slope: slope(0.0), speed: 0.15, speed_sd: 0.0 }];
+    let e = calibrate_jointly(&JointSetup { speeds: bad_sd, ..base.clone() }).unwrap_err();
+    assert!(matches!(e, CalibrationError::BadObservation { what: "speed", .. }), "{e:?}");
+    let twice = vec![base.speeds[0], base.speeds[0]];
+    let e = calibrate_jointly(&JointSetup { speeds: twice, ..base.clone() }).unwrap_err();
+    assert!(matches!(e, CalibrationError::DuplicateSlope { what: "speed", .. }), "{e:?}");
     let none = JointSetup { speeds: vec![], ..base };
-    assert_eq!(calibrate_jointly(&none).unwrap_err(), JointError::NoObservations);
+    assert_eq!(calibrate_jointly(&none).unwrap_err(), CalibrationError::NoObservations);
     assert_eq!(Parameter::parse("level_step_m"), Some(Parameter::Robot(RobotKey::LevelStepM)));
     assert_eq!(Parameter::parse("stance_legs"), None);
+}
+
+/// The two smooth laws recover the parameters that made exact speeds: linear with k_s0 = 2e6
+/// and -5e4 per degree (rho = 1 + 20 (-5e4) / 2e6 = 0.5), Coulomb with k_s0 = 2e6 and phi = 35
+/// deg (rho = cos 20 - sin 20 / tan 35 = 0.939693 - 0.342020 / 0.700208 = 0.451241).
+#[test]
+fn smooth_laws_recover_the_parameters_that_made_exact_speeds() {
+    let robot = paper_robot();
+    let normal = Terrain::constant(7e5, 1.0).unwrap();
+    let cases = [
+        (ShearLaw::Linear, [2.0e6, 0.5], Quantity::ShearRatio20, 0.5, 0.5),
+        (ShearLaw::Coulomb, [2.0e6, 35.0], Quantity::FrictionAngle, 35.0, 0.451_241),
+    ];
+    for (law, truth, second, second_truth, ratio) in cases {
+        let k_s = |d: f64| match law {
+            ShearLaw::Linear => 2.0e6 - 5.0e4 * d,
+            ShearLaw::Coulomb => {
+                let t = d.to_radians();
+                2.0e6 * (t.cos() - t.sin() / 35f64.to_radians().tan())
+            }
+        };
+        let speeds: Vec<SpeedObservation> = SLOPES
+            .iter()
+            .map(|&d| {
+                let v = predict(&robot, slope(d), &Ground::new(7e5, k_s(d)).unwrap()).speed.unwrap();
+                SpeedObservation { slope: slope(d), speed: v, speed_sd: 0.005 }
+            })
+            .collect();
+        let setup = JointSetup {
+            robot: robot.clone(),
+            normal: normal.clone(),
+            shear: ShearShape::Law(law),
+            speeds,
+            anchoring: vec![],
+            free: vec![],
+            error_floor: 0.0,
+        };
+        let c = calibrate_jointly(&setup).unwrap();
+        assert!(c.chi_squared < 1e-6, "{law:?}: chi2 {}", c.chi_squared);
+        let level = param(&c, Quantity::LevelShearStrength).value;
+        assert!((level / truth[0] - 1.0).abs() < 1e-4, "{law:?}: k_s0 {level}");
+        let got = param(&c, second).value;
+        assert!((got / second_truth - 1.0).abs() < 1e-4, "{law:?}: {got} vs {second_truth}");
+        assert!((c.shear_ratio_20.value - ratio).abs() < 1e-4, "{law:?}: ratio {:?}", c.shear_ratio_20);
+        for s in &c.shear {
+            assert!((s.k_s / k_s(s.slope_deg) - 1.0).abs() < 1e-4, "{law:?} at {}: {}", s.slope_deg, s.k_s);
+        }
+    }
 }

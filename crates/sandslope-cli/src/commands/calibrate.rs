@@ -10,9 +10,10 @@ use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 
+use sandslope::calibrate::{Interval, ObservationKind};
 use sandslope::{
-    calibrate, calibrate_jointly, predict, Calibration, FreeParameter, JointCalibration, JointSetup,
-    LawParams, Parameter, ShearLaw, ShearShape, Slope, Terrain, TerrainPoint, TerrainSpec,
+    calibrate_jointly, invert_each_speed, predict, FreeParameter, JointCalibration, JointSetup, Parameter,
+    Quantity, ShearLaw, ShearShape, Slope, Terrain, TerrainPoint, TerrainSpec,
 };
 
 use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
@@ -32,13 +33,6 @@ pub enum LawArg {
 }
 
 impl LawArg {
-    fn law(self) -> ShearLaw {
-        match self {
-            LawArg::Linear => ShearLaw::Linear,
-            LawArg::Coulomb => ShearLaw::Coulomb,
-            LawArg::PerSlope => ShearLaw::PerSlope,
-        }
-    }
     fn name(self) -> &'static str {
         match self {
             LawArg::Linear => "linear",
@@ -210,17 +204,17 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
         (None, None) => source.clone(),
     };
 
-    if args.law == LawArg::PerSlope && forces.is_none() {
-        if !free.is_empty() || !anchoring.is_empty() || error_floor.is_some() {
-            bail!("--law per-slope inverts each speed alone: it takes no --free, --t1 or --error-floor");
+    let shear = match (&forces, args.law) {
+        (Some(f), _) => ShearShape::ForceTests(f.clone()),
+        (None, LawArg::Linear) => ShearShape::Law(ShearLaw::Linear),
+        (None, LawArg::Coulomb) => ShearShape::Law(ShearLaw::Coulomb),
+        (None, LawArg::PerSlope) => {
+            if !free.is_empty() || !anchoring.is_empty() || error_floor.is_some() {
+                bail!("--law per-slope inverts each speed alone: it takes no --free, --t1 or --error-floor");
+            }
+            let Some(observed) = &args.observed else { bail!("--law per-slope needs --observed speeds") };
+            return run_per_slope(&args, &robot, &speeds, observed, &normal, &repose);
         }
-        let Some(observed) = &args.observed else { bail!("--law per-slope needs --observed speeds") };
-        return run_per_slope(&args, &robot, &speeds, observed, &normal, &repose);
-    }
-
-    let shear = match &forces {
-        Some(f) => ShearShape::ForceTests(f.clone()),
-        None => ShearShape::Law(args.law.law()),
     };
     let setup = JointSetup {
         robot: robot.clone(),
@@ -280,11 +274,7 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
     if let Some(path) = &args.robot_out {
         let mut text = String::new();
         writeln!(text, "# Written by: sandslope {}", command.join(" "))?;
-        for p in cal
-            .parameters
-            .iter()
-            .filter(|p| Parameter::parse(&p.name).is_some_and(|q| matches!(q, Parameter::Robot(_))))
-        {
+        for p in cal.parameters.iter().filter(|p| matches!(p.quantity, Quantity::Free(Parameter::Robot(_)))) {
             writeln!(
                 text,
                 "# {} fitted: {:.6e} (68% interval {:.6e} to {:.6e})",
@@ -305,7 +295,7 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
     Ok(())
 }
 
-fn interval_text(iv: &sandslope::calibrate::joint::Interval, sci: bool) -> String {
+fn interval_text(iv: &Interval, sci: bool) -> String {
     let f = |x: f64| if sci { format!("{x:.4e}") } else { format!("{x:.4}") };
     format!(
         "{}{} to {}{}",
@@ -330,7 +320,7 @@ fn print_joint(cal: &JointCalibration, repose: &ReposeRecord) {
     println!("{t}");
     let mut t = table(&["observation", "slope deg", "observed ± SD", "model", "pull"]);
     for p in &cal.pulls {
-        use sandslope::calibrate::joint::ObservationKind as K;
+        use ObservationKind as K;
         let (name, scale, unit) = match p.kind {
             K::Speed => ("speed", 100.0, "cm/s"),
             K::AnchoringTime => ("t1", 1000.0, "ms"),
@@ -396,11 +386,10 @@ fn run_per_slope(
     normal: &Terrain,
     repose: &ReposeRecord,
 ) -> Result<()> {
-    let k_n_at = |s: Slope| normal.at(s).k_n;
-    let cal: Calibration = calibrate(robot, &k_n_at, observations, ShearLaw::PerSlope)
-        .map_err(|e| anyhow!("{}: {e}", observed.display()))?;
+    let cal =
+        invert_each_speed(robot, normal, observations).map_err(|e| anyhow!("{}: {e}", observed.display()))?;
     let points = cal
-        .residuals
+        .points
         .iter()
         .map(|r| TerrainPoint { slope_deg: r.slope_deg, k_n: r.k_n, k_s: r.k_s, k_n_sd: None, k_s_sd: None })
         .collect();
@@ -417,9 +406,8 @@ fn run_per_slope(
     writeln!(text, "# repose_deg: {}", repose.source)?;
     text.push_str(&toml::to_string(&spec)?);
     write_atomic(&args.out, text.as_bytes())?;
-    debug_assert!(matches!(cal.params, LawParams::PerSlope));
     let residuals: Vec<ResidualRecord> = cal
-        .residuals
+        .points
         .iter()
         .map(|r| ResidualRecord {
             slope_deg: r.slope_deg,
@@ -443,9 +431,9 @@ fn run_per_slope(
         });
     }
     println!("law: per-slope (each speed inverted by root finding)");
-    let level = cal.residuals.first().map(|r| r.k_s).filter(|k| *k > 0.0);
+    let level = cal.points.first().map(|r| r.k_s).filter(|k| *k > 0.0);
     let mut t = table(&["slope deg", "k_s N/m^3", "k_s / first", "observed cm/s", "model cm/s"]);
-    for r in &cal.residuals {
+    for r in &cal.points {
         t.add_row([
             format!("{}", r.slope_deg),
             format!("{:.4e}", r.k_s),

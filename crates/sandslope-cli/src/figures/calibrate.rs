@@ -5,7 +5,7 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use sandslope::calibrate::joint::{ObservationKind, Pull};
+use sandslope::calibrate::{ObservationKind, Pull};
 
 use super::{font, Figure};
 use crate::error::plot_err;

@@ -1,0 +1,348 @@
+//! The calibration in numbers: the unknowns with their bounds and search coordinates, a
+//! candidate point resolved into a robot and a k_s(theta), the pulls and `-2 ln L` there.
+
+use super::evidence::{check_anchoring, check_speeds};
+use super::inversion::shear_strength_for_speed;
+use super::{CalibrationError, JointSetup, ObservationKind, Parameter, Pull, Quantity, ShearLaw, ShearShape};
+use crate::model::{continued_anchoring_time, continued_speed, level_step_length, normal_equilibrium_depth};
+use crate::robot::Robot;
+use crate::slope::Slope;
+use crate::terrain::interpolate;
+
+/// One quantity the fit varies, with its search bounds and starting value.
+///
+/// The optimiser works on an unbounded coordinate `u`: a logistic map sends it into the bounds
+/// of the *search coordinate*, which is `ln` of the value for a scale quantity (`log`) and the
+/// value itself otherwise.
+#[derive(Debug, Clone)]
+pub(crate) struct Unknown {
+    pub quantity: Quantity,
+    pub lo: f64,
+    pub hi: f64,
+    pub log: bool,
+    pub start: f64,
+}
+
+impl Unknown {
+    /// The search coordinate of a value.
+    pub fn to_search(&self, value: f64) -> f64 {
+        if self.log {
+            value.ln()
+        } else {
+            value
+        }
+    }
+
+    /// The value at a search coordinate.
+    pub fn from_search(&self, q: f64) -> f64 {
+        if self.log {
+            q.exp()
+        } else {
+            q
+        }
+    }
+
+    /// The value at an unbounded coordinate.
+    pub fn from_unbounded(&self, u: f64) -> f64 {
+        let t = 1.0 / (1.0 + (-u).exp());
+        let (a, b) = (self.to_search(self.lo), self.to_search(self.hi));
+        self.from_search(a + t * (b - a)).clamp(self.lo, self.hi)
+    }
+
+    /// The unbounded coordinate of a value (clamped just inside the bounds).
+    pub fn to_unbounded(&self, value: f64) -> f64 {
+        let (a, b) = (self.to_search(self.lo), self.to_search(self.hi));
+        let t = ((self.to_search(value) - a) / (b - a)).clamp(1e-9, 1.0 - 1e-9);
+        (t / (1.0 - t)).ln()
+    }
+
+    /// The value sits within 0.1% of the search range of a bound.
+    pub fn at_bound(&self, value: f64) -> bool {
+        let tol = 1e-3 * (self.to_search(self.hi) - self.to_search(self.lo));
+        (self.to_search(value) - self.to_search(self.lo)).abs() < tol
+            || (self.to_search(self.hi) - self.to_search(value)).abs() < tol
+    }
+}
+
+/// One force test: slope, measured plate k_s and its SD (if any).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ForceTest {
+    pub slope_deg: f64,
+    pub k_s: f64,
+    pub sd: Option<f64>,
+}
+
+/// The calibration problem: the setup, its unknowns, and the shape of k_s(theta).
+pub(crate) struct Problem<'a> {
+    pub setup: &'a JointSetup,
+    pub unknowns: Vec<Unknown>,
+    /// The force tests (empty for a law).
+    pub force_tests: Vec<ForceTest>,
+    /// For each force test, the index of its unknown (`None`: fixed at the measurement).
+    pub force_test_unknown: Vec<Option<usize>>,
+    /// The smooth law (`None`: force tests).
+    pub law: Option<ShearLaw>,
+    /// Observations: speeds, anchoring times and force tests with SDs.
+    pub n_obs: usize,
+}
+
+/// A candidate point (one value per unknown) resolved into what the model needs.
+pub(crate) struct Candidate {
+    /// The robot; `None` when the values make an invalid one (say h > 2R with both free).
+    pub robot: Option<Robot>,
+    pub error_floor: f64,
+    /// The plate k_s at each force-test slope, `(slope_deg, k_s)`.
+    pub plate: Vec<(f64, f64)>,
+    pub plate_scale: f64,
+    /// The law's two parameters.
+    pub law: [f64; 2],
+}
+
+impl Problem<'_> {
+    pub fn candidate(&self, x: &[f64]) -> Candidate {
+        let mut spec = self.setup.robot.spec().clone();
+        let mut c = Candidate {
+            robot: None,
+            error_floor: self.setup.error_floor,
+            plate: self.force_tests.iter().map(|k| (k.slope_deg, k.k_s)).collect(),
+            plate_scale: 1.0,
+            law: [0.0, 1.0],
+        };
+        for (unknown, &v) in self.unknowns.iter().zip(x) {
+            match unknown.quantity {
+                Quantity::Free(Parameter::Robot(k)) => k.set(&mut spec, v),
+                Quantity::Free(Parameter::PlateScale) => c.plate_scale = v,
+                Quantity::Free(Parameter::ErrorFloor) => c.error_floor = v,
+                Quantity::PlateShearStrength { point, .. } => c.plate[point].1 = v,
+                Quantity::LevelShearStrength => c.law[0] = v,
+                Quantity::ShearRatio20 | Quantity::FrictionAngle => c.law[1] = v,
+            }
+        }
+        c.robot = Robot::new(spec).ok();
+        c
+    }
+
+    /// The leg's k_s at `deg` degrees.
+    pub fn k_s(&self, c: &Candidate, deg: f64) -> f64 {
+        match self.law {
+            Some(law) => law.k_s(c.law, deg),
+            None => c.plate_scale * interpolate(&c.plate, deg),
+        }
+    }
+
+    pub fn k_n(&self, slope: Slope) -> f64 {
+        self.setup.normal.at(slope).k_n
+    }
+
+    pub fn level_step(&self, robot: &Robot, slope: Slope) -> f64 {
+        level_step_length(robot, normal_equilibrium_depth(robot, slope, self.k_n(slope)))
+    }
+
+    /// Pulls of every observation (speeds, anchoring times, force tests) at `x`, and the
+    /// floor's term `sum_speeds ln(1 + f^2 / sd_i^2)` of `-2 ln L`.
+    pub fn pulls(&self, x: &[f64]) -> Option<(Vec<Pull>, f64)> {
+        let c = self.candidate(x);
+        let robot = c.robot.as_ref()?;
+        let mut out = Vec::with_capacity(self.n_obs);
+        let pull = |kind, slope: Slope, observed: f64, sd: f64, sd_total: f64, model: f64| Pull {
+            kind,
+            slope_deg: slope.degrees(),
+            observed,
+            sd,
+            sd_total,
+            model,
+            pull: (observed - model) / sd_total,
+        };
+        for o in &self.setup.speeds {
+            let model = continued_speed(
+                robot,
+                o.slope,
+                self.level_step(robot, o.slope),
+                self.k_s(&c, o.slope.degrees()),
+            );
+            out.push(pull(
+                ObservationKind::Speed,
+                o.slope,
+                o.speed,
+                o.speed_sd,
+                o.speed_sd.hypot(c.error_floor),
+                model,
+            ));
+        }
+        for o in &self.setup.anchoring {
+            let model = continued_anchoring_time(robot, o.slope, self.k_s(&c, o.slope.degrees()));
+            out.push(pull(ObservationKind::AnchoringTime, o.slope, o.t1, o.t1_sd, o.t1_sd, model));
+        }
+        for (k, fitted) in self.force_tests.iter().zip(&c.plate) {
+            if let Some(sd) = k.sd.filter(|&s| s > 0.0) {
+                out.push(Pull {
+                    kind: ObservationKind::PlateShearStrength,
+                    slope_deg: k.slope_deg,
+                    observed: k.k_s,
+                    sd,
+                    sd_total: sd,
+                    model: fitted.1,
+                    pull: (k.k_s - fitted.1) / sd,
+                });
+            }
+        }
+        let log_det: f64 =
+            self.setup.speeds.iter().map(|o| (1.0 + (c.error_floor / o.speed_sd).powi(2)).ln()).sum();
+        Some((out, log_det))
+    }
+
+    /// Residual vector whose sum of squares is `-2 ln L` (+ const).
+    pub fn residuals(&self, x: &[f64]) -> Vec<f64> {
+        match self.pulls(x) {
+            Some((pulls, log_det)) => {
+                let mut r: Vec<f64> = pulls.iter().map(|p| p.pull).collect();
+                r.push(log_det.max(0.0).sqrt());
+                r
+            }
+            // An invalid robot (say h > 2R with both free): a large, flat penalty.
+            None => vec![1e3; self.n_obs + 1],
+        }
+    }
+
+    /// `-2 ln L` (+ const) at `x`.
+    pub fn objective(&self, x: &[f64]) -> f64 {
+        self.residuals(x).iter().map(|r| r * r).sum()
+    }
+
+    /// k_s(20)/k_s(0) at `x`.
+    pub fn ratio(&self, x: &[f64]) -> f64 {
+        let c = self.candidate(x);
+        let level = self.k_s(&c, 0.0);
+        if level > 0.0 {
+            self.k_s(&c, 20.0) / level
+        } else {
+            f64::NAN
+        }
+    }
+}
+
+/// The k_s each observed speed alone implies (where the model can reach it).
+fn inverted_k_s(setup: &JointSetup) -> Vec<(f64, f64)> {
+    setup
+        .speeds
+        .iter()
+        .filter_map(|o| {
+            let k_n = setup.normal.at(o.slope).k_n;
+            shear_strength_for_speed(&setup.robot, o.slope, k_n, o.speed).ok().map(|k| (o.slope.degrees(), k))
+        })
+        .collect()
+}
+
+/// The unknown of one freed parameter, with its bounds checked.
+fn free_unknown(
+    setup: &JointSetup,
+    parameter: Parameter,
+    bounds: Option<(f64, f64)>,
+) -> Result<Unknown, CalibrationError> {
+    let (default, log, start) = match parameter {
+        Parameter::Robot(k) => {
+            let k_n_level = setup.normal.at(Slope::LEVEL).k_n;
+            (k.default_bounds(setup.robot.spec()), k.is_scale(), k.get(&setup.robot, k_n_level))
+        }
+        Parameter::PlateScale => {
+            if !matches!(setup.shear, ShearShape::ForceTests(_)) {
+                return Err(CalibrationError::PlateScaleWithoutForces);
+            }
+            ((1e-3, 1e4), true, 1.0)
+        }
+        Parameter::ErrorFloor => {
+            // Start inside: at the median observed SD (a logistic map has no slope at its bound).
+            let mut sds: Vec<f64> = setup.speeds.iter().map(|o| o.speed_sd).collect();
+            sds.sort_by(f64::total_cmp);
+            let median = sds.get(sds.len() / 2).copied().unwrap_or(0.0);
+            ((0.0, 0.1), false, setup.error_floor.max(median))
+        }
+    };
+    let (lo, hi) = bounds.unwrap_or(default);
+    let bad = |reason: String| CalibrationError::BadBounds { name: parameter.name().into(), reason };
+    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+        return Err(bad(format!("{lo}:{hi} must be finite with min < max")));
+    }
+    if log && lo <= 0.0 {
+        return Err(bad(format!("min = {lo} must be greater than 0 for a scale parameter")));
+    }
+    Ok(Unknown { quantity: Quantity::Free(parameter), lo, hi, log, start: start.clamp(lo, hi) })
+}
+
+/// The problem for `setup`, with every check of the evidence, the freed parameters and their
+/// bounds, and the starting values (from the speeds inverted alone where they exist).
+pub(crate) fn build(setup: &JointSetup) -> Result<Problem<'_>, CalibrationError> {
+    check_speeds(&setup.speeds)?;
+    check_anchoring(&setup.anchoring)?;
+    if setup.speeds.is_empty() && setup.anchoring.is_empty() {
+        return Err(CalibrationError::NoObservations);
+    }
+    if !(setup.error_floor.is_finite() && setup.error_floor >= 0.0) {
+        return Err(CalibrationError::BadErrorFloor(setup.error_floor));
+    }
+    let mut unknowns: Vec<Unknown> = Vec::new();
+    for f in &setup.free {
+        if unknowns.iter().any(|u| u.quantity == Quantity::Free(f.parameter)) {
+            return Err(CalibrationError::DuplicateParameter { name: f.parameter.name().into() });
+        }
+        unknowns.push(free_unknown(setup, f.parameter, f.bounds)?);
+    }
+    let inverted = inverted_k_s(setup);
+    let (mut force_tests, mut force_test_unknown, mut law) = (Vec::new(), Vec::new(), None);
+    match &setup.shear {
+        ShearShape::ForceTests(terrain) => {
+            for p in terrain.points() {
+                force_tests.push(ForceTest {
+                    slope_deg: p.slope_deg,
+                    k_s: p.k_s,
+                    sd: p.k_s_sd.filter(|&s| s > 0.0),
+                });
+            }
+            for (point, k) in force_tests.iter().enumerate() {
+                let Some(sd) = k.sd else {
+                    force_test_unknown.push(None);
+                    continue;
+                };
+                force_test_unknown.push(Some(unknowns.len()));
+                unknowns.push(Unknown {
+                    quantity: Quantity::PlateShearStrength { point, slope_deg: k.slope_deg },
+                    lo: (k.k_s - 10.0 * sd).max(k.k_s * 1e-3),
+                    hi: k.k_s + 10.0 * sd,
+                    log: true,
+                    start: k.k_s,
+                });
+            }
+            // Start the plate scale where the speeds' own k_s lie (geometric mean of the ratios).
+            let plate: Vec<(f64, f64)> = force_tests.iter().map(|k| (k.slope_deg, k.k_s)).collect();
+            let ln: Vec<f64> = inverted.iter().map(|&(d, k)| (k / interpolate(&plate, d)).ln()).collect();
+            let scale = unknowns.iter_mut().find(|u| u.quantity == Quantity::Free(Parameter::PlateScale));
+            if let (Some(u), false) = (scale, ln.is_empty()) {
+                let c = (ln.iter().sum::<f64>() / ln.len() as f64).exp();
+                u.start = c.clamp(u.lo, u.hi);
+            }
+        }
+        ShearShape::Law(l) => {
+            law = Some(*l);
+            let level = inverted.first().map_or(1e6, |&(_, k)| k).clamp(1e3, 1e11);
+            let theta_max = setup.speeds.iter().map(|o| o.slope.degrees()).fold(0.0, f64::max);
+            let [first, second] = Quantity::of_law(*l);
+            unknowns.push(Unknown { quantity: first, lo: 1.0, hi: 1e12, log: true, start: level });
+            unknowns.push(match l {
+                ShearLaw::Coulomb => Unknown {
+                    quantity: second,
+                    lo: theta_max + 1e-3,
+                    hi: 89.999,
+                    log: false,
+                    start: (theta_max + 20.0).min(89.0),
+                },
+                ShearLaw::Linear => Unknown { quantity: second, lo: 0.0, hi: 5.0, log: false, start: 0.8 },
+            });
+        }
+    }
+    let n_force = force_tests.iter().filter(|k| k.sd.is_some()).count();
+    let n_obs = setup.speeds.len() + setup.anchoring.len() + n_force;
+    if unknowns.len() > n_obs {
+        return Err(CalibrationError::TooFewObservations { observations: n_obs, parameters: unknowns.len() });
+    }
+    Ok(Problem { setup, unknowns, force_tests, force_test_unknown, law, n_obs })
+}

@@ -1,0 +1,139 @@
+//! 68% profile-likelihood intervals: `{value : min over the others of -2 ln L <= minimum + 1}`,
+//! found by walking out from the best value and bracketing the crossing with Brent's method.
+
+use super::optimiser::{minimise, RatioPenalty};
+use super::problem::Problem;
+use super::{FittedParameter, Interval, Quantity, ShearLaw};
+
+/// What is profiled: one unknown (in its search coordinate), or `ln k_s(20)/k_s(0)` held by a
+/// stiff penalty.
+#[derive(Clone, Copy)]
+pub(crate) enum Profiled {
+    Unknown(usize),
+    LnShearRatio,
+}
+
+/// The profile of `-2 ln L` with the profiled quantity held at `q`, warm-started at `from`.
+fn profile_at(problem: &Problem, target: Profiled, q: f64, from: &[f64]) -> (Vec<f64>, f64) {
+    match target {
+        Profiled::Unknown(j) => {
+            let mut x = from.to_vec();
+            let u = &problem.unknowns[j];
+            x[j] = u.from_search(q).clamp(u.lo, u.hi);
+            minimise(problem, &x, &[j], None)
+        }
+        Profiled::LnShearRatio => {
+            minimise(problem, from, &[], Some(RatioPenalty { target: q, tolerance: 1e-5 }))
+        }
+    }
+}
+
+/// Where a walk starts, where it must stop, its first step and its direction (+1 or -1).
+#[derive(Clone, Copy)]
+struct Walk {
+    q_best: f64,
+    limit: f64,
+    step0: f64,
+    dir: f64,
+}
+
+/// One end of the 68% interval: walk from the best value in the walk's direction until the
+/// profile rises by 1, then bracket the crossing with Brent's method. Returns `(end, open)`.
+fn interval_end(problem: &Problem, target: Profiled, best: &[f64], s_min: f64, walk: Walk) -> (f64, bool) {
+    let Walk { q_best, limit, step0, dir } = walk;
+    let mut q_in = q_best;
+    let mut x_in = best.to_vec();
+    let mut step = step0;
+    for _ in 0..40 {
+        let mut q = q_in + dir * step;
+        let at_limit = (q - limit) * dir >= 0.0;
+        if at_limit {
+            q = limit;
+        }
+        let (x, s) = profile_at(problem, target, q, &x_in);
+        if s - s_min >= 1.0 {
+            let f = |q: f64| profile_at(problem, target, q, &x_in).1 - s_min - 1.0;
+            let mut conv = roots::SimpleConvergency { eps: 1e-4 * (q - q_in).abs().max(1e-12), max_iter: 40 };
+            return match roots::find_root_brent(q_in, q, f, &mut conv) {
+                Ok(r) => (r, false),
+                Err(_) => (0.5 * (q_in + q), false),
+            };
+        }
+        if at_limit {
+            return (limit, true);
+        }
+        q_in = q;
+        x_in = x;
+        step *= 2.0;
+    }
+    (q_in, true)
+}
+
+/// Initial step for the walk along unknown `j`: the conditional standard error from the
+/// curvature of `-2 ln L` in it alone (never larger than the profile's), bounded to a sane
+/// fraction of the search range.
+fn initial_step(problem: &Problem, j: usize, best: &[f64], s_min: f64, q_best: f64, span: f64) -> f64 {
+    let h = 1e-3 * span.max(1e-12);
+    let s_at = |q: f64| {
+        let mut x = best.to_vec();
+        let u = &problem.unknowns[j];
+        x[j] = u.from_search(q).clamp(u.lo, u.hi);
+        problem.objective(&x)
+    };
+    let curv = (s_at(q_best + h) - 2.0 * s_min + s_at(q_best - h)) / (h * h);
+    let se = if curv > 0.0 { (2.0 / curv).sqrt() } else { 0.1 * span };
+    se.clamp(1e-6 * span.max(1e-9), 0.25 * span.max(1e-9))
+}
+
+/// The 68% interval of `target` around the best point `best` (objective `s_min`).
+pub(crate) fn interval_for(problem: &Problem, target: Profiled, best: &[f64], s_min: f64) -> Interval {
+    let (q_best, lo, hi, step) = match target {
+        Profiled::Unknown(j) => {
+            let u = &problem.unknowns[j];
+            let (q_best, lo, hi) = (u.to_search(best[j]), u.to_search(u.lo), u.to_search(u.hi));
+            (q_best, lo, hi, initial_step(problem, j, best, s_min, q_best, hi - lo))
+        }
+        Profiled::LnShearRatio => {
+            let r = problem.ratio(best).ln();
+            (r, r - 5.0, r + 3.0, 0.05)
+        }
+    };
+    let (q_lo, lower_open) =
+        interval_end(problem, target, best, s_min, Walk { q_best, limit: lo, step0: step, dir: -1.0 });
+    let (q_hi, upper_open) =
+        interval_end(problem, target, best, s_min, Walk { q_best, limit: hi, step0: step, dir: 1.0 });
+    let back = |q: f64| match target {
+        Profiled::Unknown(j) => problem.unknowns[j].from_search(q),
+        Profiled::LnShearRatio => q.exp(),
+    };
+    Interval { value: back(q_best), lower: back(q_lo), upper: back(q_hi), lower_open, upper_open }
+}
+
+/// The interval of `k_s(20)/k_s(0)`: a parameter of the linear law, a monotone function of the
+/// friction angle for Coulomb, a penalty-held profile for force tests (exact when the force
+/// values are not free).
+pub(crate) fn ratio_interval(
+    problem: &Problem,
+    best: &[f64],
+    s_min: f64,
+    params: &[FittedParameter],
+) -> Interval {
+    let value = problem.ratio(best);
+    let find = |q: Quantity| params.iter().find(|p| p.quantity == q);
+    match problem.law {
+        Some(ShearLaw::Linear) => find(Quantity::ShearRatio20).map(|p| p.estimate),
+        Some(ShearLaw::Coulomb) => find(Quantity::FrictionAngle).map(|p| {
+            let r = |phi: f64| ShearLaw::Coulomb.k_s([1.0, phi], 20.0);
+            Interval { value, lower: r(p.estimate.lower), upper: r(p.estimate.upper), ..p.estimate }
+        }),
+        None => {
+            let free_force_tests = problem.force_test_unknown.iter().any(Option::is_some);
+            Some(if free_force_tests {
+                interval_for(problem, Profiled::LnShearRatio, best, s_min)
+            } else {
+                Interval { value, lower: value, upper: value, lower_open: false, upper_open: false }
+            })
+        }
+    }
+    .unwrap_or(Interval { value, lower: value, upper: value, lower_open: false, upper_open: false })
+}

@@ -28,7 +28,7 @@ impl LeastSquares<'_, '_> {
     fn values_at(&self, u: &DVector<f64>) -> Vec<f64> {
         let mut x = self.base.clone();
         for (k, &i) in self.free.iter().enumerate() {
-            x[i] = self.problem.unknowns[i].from_unbounded(u[k]);
+            x[i] = self.problem.unknowns[i].value_at_unbounded(u[k]);
         }
         x
     }
@@ -88,8 +88,10 @@ pub(crate) fn minimise(
     if free.is_empty() {
         return (start.to_vec(), problem.objective(start));
     }
-    let u =
-        DVector::from_iterator(free.len(), free.iter().map(|&i| problem.unknowns[i].to_unbounded(start[i])));
+    let u = DVector::from_iterator(
+        free.len(),
+        free.iter().map(|&i| problem.unknowns[i].unbounded_coordinate(start[i])),
+    );
     let fit = LeastSquares { problem, base: start.to_vec(), free, u, penalty };
     let (fit, _) = LevenbergMarquardt::new().with_patience(100).with_xtol(1e-12).minimize(fit);
     let x = fit.values_at(&fit.u);

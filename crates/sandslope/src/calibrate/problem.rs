@@ -25,7 +25,7 @@ pub(crate) struct Unknown {
 
 impl Unknown {
     /// The search coordinate of a value.
-    pub fn to_search(&self, value: f64) -> f64 {
+    pub fn search_coordinate(&self, value: f64) -> f64 {
         if self.log {
             value.ln()
         } else {
@@ -34,7 +34,7 @@ impl Unknown {
     }
 
     /// The value at a search coordinate.
-    pub fn from_search(&self, q: f64) -> f64 {
+    pub fn value_at_search(&self, q: f64) -> f64 {
         if self.log {
             q.exp()
         } else {
@@ -43,24 +43,24 @@ impl Unknown {
     }
 
     /// The value at an unbounded coordinate.
-    pub fn from_unbounded(&self, u: f64) -> f64 {
+    pub fn value_at_unbounded(&self, u: f64) -> f64 {
         let t = 1.0 / (1.0 + (-u).exp());
-        let (a, b) = (self.to_search(self.lo), self.to_search(self.hi));
-        self.from_search(a + t * (b - a)).clamp(self.lo, self.hi)
+        let (a, b) = (self.search_coordinate(self.lo), self.search_coordinate(self.hi));
+        self.value_at_search(a + t * (b - a)).clamp(self.lo, self.hi)
     }
 
     /// The unbounded coordinate of a value (clamped just inside the bounds).
-    pub fn to_unbounded(&self, value: f64) -> f64 {
-        let (a, b) = (self.to_search(self.lo), self.to_search(self.hi));
-        let t = ((self.to_search(value) - a) / (b - a)).clamp(1e-9, 1.0 - 1e-9);
+    pub fn unbounded_coordinate(&self, value: f64) -> f64 {
+        let (a, b) = (self.search_coordinate(self.lo), self.search_coordinate(self.hi));
+        let t = ((self.search_coordinate(value) - a) / (b - a)).clamp(1e-9, 1.0 - 1e-9);
         (t / (1.0 - t)).ln()
     }
 
     /// The value sits within 0.1% of the search range of a bound.
     pub fn at_bound(&self, value: f64) -> bool {
-        let tol = 1e-3 * (self.to_search(self.hi) - self.to_search(self.lo));
-        (self.to_search(value) - self.to_search(self.lo)).abs() < tol
-            || (self.to_search(self.hi) - self.to_search(value)).abs() < tol
+        let tol = 1e-3 * (self.search_coordinate(self.hi) - self.search_coordinate(self.lo));
+        (self.search_coordinate(value) - self.search_coordinate(self.lo)).abs() < tol
+            || (self.search_coordinate(self.hi) - self.search_coordinate(value)).abs() < tol
     }
 }
 

@@ -19,7 +19,7 @@ fn profile_at(problem: &Problem, target: Profiled, q: f64, from: &[f64]) -> (Vec
         Profiled::Unknown(j) => {
             let mut x = from.to_vec();
             let u = &problem.unknowns[j];
-            x[j] = u.from_search(q).clamp(u.lo, u.hi);
+            x[j] = u.value_at_search(q).clamp(u.lo, u.hi);
             minimise(problem, &x, &[j], None)
         }
         Profiled::LnShearRatio => {
@@ -77,7 +77,7 @@ fn initial_step(problem: &Problem, j: usize, best: &[f64], s_min: f64, q_best: f
     let s_at = |q: f64| {
         let mut x = best.to_vec();
         let u = &problem.unknowns[j];
-        x[j] = u.from_search(q).clamp(u.lo, u.hi);
+        x[j] = u.value_at_search(q).clamp(u.lo, u.hi);
         problem.objective(&x)
     };
     let curv = (s_at(q_best + h) - 2.0 * s_min + s_at(q_best - h)) / (h * h);
@@ -90,7 +90,8 @@ pub(crate) fn interval_for(problem: &Problem, target: Profiled, best: &[f64], s_
     let (q_best, lo, hi, step) = match target {
         Profiled::Unknown(j) => {
             let u = &problem.unknowns[j];
-            let (q_best, lo, hi) = (u.to_search(best[j]), u.to_search(u.lo), u.to_search(u.hi));
+            let (q_best, lo, hi) =
+                (u.search_coordinate(best[j]), u.search_coordinate(u.lo), u.search_coordinate(u.hi));
             (q_best, lo, hi, initial_step(problem, j, best, s_min, q_best, hi - lo))
         }
         Profiled::LnShearRatio => {
@@ -103,7 +104,7 @@ pub(crate) fn interval_for(problem: &Problem, target: Profiled, best: &[f64], s_
     let (q_hi, upper_open) =
         interval_end(problem, target, best, s_min, Walk { q_best, limit: hi, step0: step, dir: 1.0 });
     let back = |q: f64| match target {
-        Profiled::Unknown(j) => problem.unknowns[j].from_search(q),
+        Profiled::Unknown(j) => problem.unknowns[j].value_at_search(q),
         Profiled::LnShearRatio => q.exp(),
     };
     Interval { value: back(q_best), lower: back(q_lo), upper: back(q_hi), lower_open, upper_open }

@@ -2,11 +2,9 @@
 //! decided it: the comparison rows that fail their rule, observed speeds that rise with slope,
 //! the calibration's model-error floor and plate scale, and its warnings.
 
-use crate::calibrate::joint::{JointCalibration, Parameter};
 use crate::calibrate::SpeedObservation;
+use crate::calibrate::{JointCalibration, Parameter};
 use crate::paper::PaperComparison;
-
-use super::fitted;
 
 /// The disagreements, generated from the comparison rows, the calibration and the observed
 /// speeds.
@@ -55,7 +53,7 @@ fn rising_speeds(speeds: &[SpeedObservation]) -> Vec<String> {
 fn calibration_items(c: &JointCalibration, speeds: &[SpeedObservation]) -> Vec<String> {
     let mut out = Vec::new();
     if c.error_floor_m_s > 0.0 {
-        let floor = fitted(c, Parameter::ErrorFloor);
+        let floor = c.parameter(Parameter::ErrorFloor);
         out.push(format!(
             "Fitting the speeds takes a model-error floor of {:.2} cm/s added to the quoted SDs (68%: {:.2} to {:.2}); the quoted SDs alone (as small as {:.2} cm/s) are not reachable by the model.",
             c.error_floor_m_s * 100.0,
@@ -64,7 +62,7 @@ fn calibration_items(c: &JointCalibration, speeds: &[SpeedObservation]) -> Vec<S
             speeds.iter().map(|o| o.speed_sd).fold(f64::INFINITY, f64::min) * 100.0
         ));
     }
-    let scale = fitted(c, Parameter::PlateScale).map_or(1.0, |p| p.estimate.value);
+    let scale = c.plate_scale();
     if let (Some(level), true) = (c.shear.first(), scale > 3.0) {
         out.push(format!(
             "The leg k_s the model needs at {} deg ({:.2e} N/m³) would give {:.0} N on the paper's 3 cm × 2 cm shear plate (F = k_s W d²), {scale:.0} times what the force tests give: the model's k_s is an effective leg parameter, not the plate's.",

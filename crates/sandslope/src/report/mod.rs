@@ -12,11 +12,11 @@ mod tracks;
 
 use serde::Serialize;
 
-use crate::calibrate::joint::{
-    calibrate_jointly, AnchoringObservation, FittedParameter, FreeParameter, JointCalibration, JointSetup,
-    Parameter, ShearShape,
-};
 use crate::calibrate::SpeedObservation;
+use crate::calibrate::{
+    calibrate_jointly, AnchoringObservation, FreeParameter, JointCalibration, JointSetup, Parameter,
+    ShearShape,
+};
 use crate::error::ParamError;
 use crate::gait::track::TrackResult;
 use crate::model::{predict, Prediction};
@@ -188,11 +188,6 @@ pub struct Report {
     pub plots: Plots,
 }
 
-/// A calibration's fitted value of `parameter`, if it was freed.
-pub fn fitted(c: &JointCalibration, parameter: Parameter) -> Option<&FittedParameter> {
-    c.parameters.iter().find(|p| p.name == parameter.name())
-}
-
 /// Slopes of the model curves: 0 to 30 deg every 0.25 deg.
 fn slope_grid() -> Vec<Slope> {
     (0..=120).map(|i| at(i as f64 * 0.25)).collect()
@@ -282,7 +277,7 @@ fn plots(
     let forces = evidence.forces.table();
     // Plate values are drawn on the leg's scale: times the fitted plate_scale.
     let plate_scale = match (forces, calibration) {
-        (Some(_), Some(c)) => fitted(c, Parameter::PlateScale).map_or(1.0, |p| p.estimate.value),
+        (Some(_), Some(c)) => c.plate_scale(),
         _ => 1.0,
     };
     let k_n_axis = Axis::new("k_n", 1e4, 1e8, 120, AxisScale::Log)?;

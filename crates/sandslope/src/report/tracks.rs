@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use crate::calibrate::joint::AnchoringObservation;
+use crate::calibrate::AnchoringObservation;
 use crate::calibrate::SpeedObservation;
 use crate::gait::track::TrackResult;
 use crate::slope::Slope;

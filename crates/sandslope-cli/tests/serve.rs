@@ -144,6 +144,21 @@ fn sweep_endpoint_equals_sweep_json() {
 }
 
 #[test]
+fn phase_endpoint_equals_phase_json() {
+    let server = Server::start(&[]);
+    assert_same(
+        &server,
+        "phase",
+        &[("slope", "0,20".into()), ("k-n", "1e4:1e7:60".into()), ("k-s", "1e3:1e7:50:lin".into())],
+    );
+    assert_same(&server, "phase", &[("slope", "15".into()), ("mass", "0.35,2".into())]);
+    // Over the server's limit of 2^20 cells: refused before any work, naming the limit.
+    let (status, field, error) = refused(&server, "GET", "/api/phase?k-n=1e4:1e7:2000&k-s=1e3:1e7:1000", b"");
+    assert_eq!((status, field.as_deref()), (400, Some("k-n")), "{error}");
+    assert!(error.contains("1048576"), "{error}");
+}
+
+#[test]
 fn a_served_robot_file_is_the_default_of_every_request() {
     let dir = tempfile::tempdir().unwrap();
     let robot = dir.path().join("heavy.toml");

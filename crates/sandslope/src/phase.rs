@@ -498,6 +498,63 @@ impl PhasePanel {
     }
 }
 
+/// The terrain's ground on a phase panel: its `(k_n, k_s)` at the panel's slope and the
+/// robot's regime there.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PanelGround {
+    /// The terrain's k_n at the panel's slope, N/m^3.
+    pub k_n: f64,
+    /// The terrain's k_s at the panel's slope, N/m^3.
+    pub k_s: f64,
+    /// The robot's regime on that ground.
+    pub regime: Regime,
+}
+
+/// A phase panel without its cells: what `sandslope phase --json` prints per panel (and the
+/// explorer's `/api/phase` returns).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PanelSummary {
+    /// Slope, degrees, as requested.
+    pub slope_deg: f64,
+    /// Total robot mass, kg.
+    pub mass_kg: f64,
+    /// The grid's k_n axis.
+    pub k_n_axis: Axis,
+    /// The grid's k_s axis.
+    pub k_s_axis: Axis,
+    /// Cells per regime.
+    pub counts: RegimeCounts,
+    /// The terrain's own point and its regime.
+    pub terrain: PanelGround,
+    /// Below this k_n the legs sink (docs/model.md §3), N/m^3.
+    pub sinkage_threshold_k_n: f64,
+    /// Below this k_s the legs never anchor (docs/model.md §4), N/m^3.
+    pub anchoring_threshold_k_s: f64,
+    /// Whether the slope is at or beyond the terrain's angle of repose (every cell slips).
+    pub beyond_repose: bool,
+}
+
+impl PhasePanel {
+    /// The panel without its cells ([`PanelSummary`]).
+    pub fn summary(&self) -> PanelSummary {
+        PanelSummary {
+            slope_deg: self.slope_deg,
+            mass_kg: self.mass_kg,
+            k_n_axis: *self.map.k_n_axis(),
+            k_s_axis: *self.map.k_s_axis(),
+            counts: self.map.counts(),
+            terrain: PanelGround {
+                k_n: self.terrain_k_n,
+                k_s: self.terrain_k_s,
+                regime: self.terrain_regime,
+            },
+            sinkage_threshold_k_n: self.sinkage_threshold_k_n,
+            anchoring_threshold_k_s: self.anchoring_threshold_k_s,
+            beyond_repose: self.map.beyond_repose(),
+        }
+    }
+}
+
 /// Packs 2-bit codes, one per byte in `codes` (length `4 * packed.len()`), four to a byte:
 /// code `4b + k` goes to bits `2k` of byte `b`.
 fn pack_codes(codes: &[u8], packed: &mut [u8]) {

@@ -9,9 +9,8 @@ use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
-use serde::Serialize;
 
-use sandslope::{Axis, AxisScale, PhasePanel, Regime, RegimeCounts, Robot, Slope, Terrain};
+use sandslope::{Axis, PanelSummary, PhasePanel, Regime, Robot, Slope, Terrain};
 
 use crate::args::{beyond_last_point, default_axis, parse_axis, warn_extrapolated, TerrainArgs};
 use crate::figures::phase::PhaseFigure;
@@ -73,54 +72,32 @@ const MAX_CELLS: u128 = 1 << 28;
 /// Most rows `--csv` writes (2^25: about 2 GB of text).
 const MAX_CSV_CELLS: u128 = 1 << 25;
 
-#[derive(Serialize)]
-struct AxisRecord {
-    min: f64,
-    max: f64,
-    points: usize,
-    scale: &'static str,
+/// The panels of a `phase` run and what its figure needs.
+pub struct Panels {
+    /// One panel per (mass, slope), masses outermost.
+    pub panels: Vec<PhasePanel>,
+    /// The masses, kg.
+    pub masses: Vec<f64>,
+    /// How many slopes each mass has.
+    pub slopes: usize,
+    /// The terrain read from `--terrain`.
+    pub terrain: Terrain,
+    /// The grid's k_n axis.
+    pub k_n_axis: Axis,
+    /// The grid's k_s axis.
+    pub k_s_axis: Axis,
 }
 
-impl From<&Axis> for AxisRecord {
-    fn from(a: &Axis) -> Self {
-        AxisRecord {
-            min: a.min(),
-            max: a.max(),
-            points: a.len(),
-            scale: if a.scale() == AxisScale::Log { "log" } else { "lin" },
-        }
-    }
+/// The value `phase --json` prints (and `serve`'s `/api/phase` returns): each panel's summary.
+/// At most `max_cells` grid cells are computed.
+pub fn answer(args: &PhaseArgs, max_cells: u128) -> Result<Vec<PanelSummary>> {
+    Ok(compute(args, max_cells, true, false)?.panels.iter().map(PhasePanel::summary).collect())
 }
 
-#[derive(Serialize)]
-struct TerrainRecord {
-    k_n: f64,
-    k_s: f64,
-    regime: &'static str,
-}
-
-/// One panel as printed by `--json`.
-#[derive(Serialize)]
-struct PanelRecord {
-    slope_deg: f64,
-    mass_kg: f64,
-    k_n_axis: AxisRecord,
-    k_s_axis: AxisRecord,
-    counts: RegimeCounts,
-    terrain: TerrainRecord,
-    sinkage_threshold_k_n: f64,
-    anchoring_threshold_k_s: f64,
-    beyond_repose: bool,
-}
-
-/// Runs `sandslope phase`.
-pub fn run(args: PhaseArgs) -> Result<()> {
-    for p in [&args.csv, &args.plot].into_iter().flatten() {
-        crate::output::check_parent_exists(p)?;
-    }
-    if let Some(dir) = &args.npy {
-        sandslope_io::npy::check_npy_dir(dir)?;
-    }
+/// Reads the robot and terrain, checks the flags and computes every panel (at most
+/// `max_cells` cells; a progress bar on a terminal unless `quiet`; the extrapolation warning
+/// on stderr when `warn`).
+pub fn compute(args: &PhaseArgs, max_cells: u128, quiet: bool, warn: bool) -> Result<Panels> {
     let base = load_robot(&args.robot)?;
     let terrain = args.terrain.load()?;
     let masses = if args.mass.is_empty() { vec![base.mass()] } else { args.mass.clone() };
@@ -135,7 +112,7 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         .collect::<Result<Vec<Slope>>>()?;
     let grounds: Vec<_> = slopes.iter().map(|&s| terrain.at(s)).collect();
     let extrapolated = beyond_last_point(&terrain, &args.slope);
-    if !extrapolated.is_empty() {
+    if !extrapolated.is_empty() && warn {
         warn_extrapolated(&terrain, &extrapolated);
     }
     let k_n_axis = match &args.k_n {
@@ -164,11 +141,12 @@ pub fn run(args: PhaseArgs) -> Result<()> {
     // Guards against a typo such as 100000 points per axis: the maps are kept in memory at two
     // bits per cell, and every cell is a CSV row of about 60 bytes.
     let cells = (robots.len() * slopes.len()) as u128 * k_n_axis.len() as u128 * k_s_axis.len() as u128;
-    if cells > MAX_CELLS {
+    if cells > max_cells {
+        let side = if max_cells >= 4096 * 4096 { 4096 } else { 1u128 << (max_cells.max(1).ilog2() / 2) };
         bail!(
-            "--k-n and --k-s give {cells} cells over {} panel(s); at most {MAX_CELLS} are allowed (e.g. 4096 x 4096 per panel is {})",
+            "--k-n and --k-s give {cells} cells over {} panel(s); at most {max_cells} are allowed (e.g. {side} x {side} per panel is {})",
             robots.len() * slopes.len(),
-            4096u128 * 4096
+            side * side
         );
     }
     if args.csv.is_some() && cells > MAX_CSV_CELLS {
@@ -176,7 +154,7 @@ pub fn run(args: PhaseArgs) -> Result<()> {
     }
 
     let rows = (robots.len() * slopes.len() * k_s_axis.len()) as u64;
-    let bar = progress_bar(rows, args.json, "phase map");
+    let bar = progress_bar(rows, quiet, "phase map");
     let mut panels = Vec::new();
     for robot in &robots {
         for &slope_deg in &args.slope {
@@ -186,6 +164,19 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         }
     }
     bar.finish_and_clear();
+    Ok(Panels { panels, masses, slopes: slopes.len(), terrain, k_n_axis, k_s_axis })
+}
+
+/// Runs `sandslope phase`.
+pub fn run(args: PhaseArgs) -> Result<()> {
+    for p in [&args.csv, &args.plot].into_iter().flatten() {
+        crate::output::check_parent_exists(p)?;
+    }
+    if let Some(dir) = &args.npy {
+        sandslope_io::npy::check_npy_dir(dir)?;
+    }
+    let Panels { panels, masses, slopes, terrain, k_n_axis, k_s_axis } =
+        compute(&args, MAX_CELLS, args.json, true)?;
 
     if let Some(path) = &args.csv {
         write_cells(path, &panels)?;
@@ -194,12 +185,12 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         write_npy(dir, &panels, &masses, &args.slope)?;
     }
     if let Some(path) = &args.plot {
-        let figure = PhaseFigure::new(&panels, slopes.len(), terrain_label(&terrain));
+        let figure = PhaseFigure::new(&panels, slopes, terrain_label(&terrain));
         save(path, &figure)?;
     }
     if args.json {
-        let records: Vec<PanelRecord> = panels.iter().map(record).collect();
-        return print_json(&records);
+        let summaries: Vec<PanelSummary> = panels.iter().map(PhasePanel::summary).collect();
+        return print_json(&summaries);
     }
     let mut t = table(&[
         "slope (deg)",
@@ -244,20 +235,6 @@ pub fn run(args: PhaseArgs) -> Result<()> {
 
 fn terrain_label(terrain: &Terrain) -> String {
     terrain.name().map(str::to_string).unwrap_or_else(|| "terrain".into())
-}
-
-fn record(p: &PhasePanel) -> PanelRecord {
-    PanelRecord {
-        slope_deg: p.slope_deg,
-        mass_kg: p.mass_kg,
-        k_n_axis: p.map.k_n_axis().into(),
-        k_s_axis: p.map.k_s_axis().into(),
-        counts: p.map.counts(),
-        terrain: TerrainRecord { k_n: p.terrain_k_n, k_s: p.terrain_k_s, regime: p.terrain_regime.name() },
-        sinkage_threshold_k_n: p.sinkage_threshold_k_n,
-        anchoring_threshold_k_s: p.anchoring_threshold_k_s,
-        beyond_repose: p.map.beyond_repose(),
-    }
 }
 
 /// Writes every cell of every panel, atomically, formatted in parallel

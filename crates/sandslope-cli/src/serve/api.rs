@@ -16,11 +16,14 @@ use clap::error::{ContextKind, ContextValue};
 use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
-use crate::commands::{predict, sweep};
+use crate::commands::{phase, predict, sweep};
 use sandslope_io::presets::{self, PresetKind};
 
 /// Most slopes one `/api/sweep` request evaluates.
 pub const MAX_SWEEP_SLOPES: usize = 10_000;
+/// Most grid cells one `/api/phase` request computes, over all its panels (the command line
+/// allows 2^28; 2^20 is 6 panels of the default 400 x 400 and takes about a second).
+pub const MAX_PHASE_CELLS: u128 = 1 << 20;
 
 /// The files the server was started with; requests that name none use these.
 #[derive(Debug, Clone)]
@@ -34,7 +37,7 @@ pub struct Served {
 }
 
 /// The commands the API answers, in the order docs/serve.md lists them.
-pub const COMMANDS: [&str; 2] = ["predict", "sweep"];
+pub const COMMANDS: [&str; 3] = ["predict", "sweep", "phase"];
 
 /// Flags that write files or choose an output format: the API always answers JSON and
 /// writes nothing.
@@ -107,6 +110,10 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
                 ));
             }
             json(&sweep::answer(&args).map_err(|e| ApiError::from_command(&e))?)
+        }
+        "phase" => {
+            let args: phase::PhaseArgs = parse("phase", params, served)?;
+            json(&phase::answer(&args, MAX_PHASE_CELLS).map_err(|e| ApiError::from_command(&e))?)
         }
         _ => Err(ApiError {
             status: 404,

@@ -85,7 +85,65 @@ impl UncertaintyArgs {
     }
 }
 
-/// `--k-n` and `--k-s`: fixed resistances overriding the terrain's at every slope.
+/// `--leg-radius`, `--leg-width`, `--hip-height`, `--leg-speed`, `--stance-legs` and
+/// `--response-time`: robot quantities overriding the robot file's (docs/model.md §2), so a
+/// design question ("and with 5 cm legs?") needs no new file. Checked by the library's one
+/// robot validation, errors naming the flag.
+#[derive(Debug, Clone, Copy, Default, Args)]
+pub struct RobotQuantityArgs {
+    /// Override the C-leg radius R, m.
+    #[arg(long = "leg-radius", value_name = "M", allow_negative_numbers = true)]
+    pub leg_radius: Option<f64>,
+    /// Override the leg width W, m.
+    #[arg(long = "leg-width", value_name = "M", allow_negative_numbers = true)]
+    pub leg_width: Option<f64>,
+    /// Override the hip height h, m (between 0 and 2R).
+    #[arg(long = "hip-height", value_name = "M", allow_negative_numbers = true)]
+    pub hip_height: Option<f64>,
+    /// Override the leg angular speed omega, rad/s.
+    #[arg(long = "leg-speed", value_name = "RAD/S", allow_negative_numbers = true)]
+    pub leg_speed: Option<f64>,
+    /// Override the number of legs in stance at once.
+    #[arg(long = "stance-legs", value_name = "N")]
+    pub stance_legs: Option<u32>,
+    /// Override the elastic response time dt, s.
+    #[arg(long = "response-time", value_name = "S", allow_negative_numbers = true)]
+    pub response_time: Option<f64>,
+}
+
+impl RobotQuantityArgs {
+    /// `robot` with the given quantities replaced, validated again as a whole.
+    pub fn apply(&self, robot: Robot) -> Result<Robot> {
+        let mut spec = robot.spec().clone();
+        let flags = [
+            ("leg_radius_m", "--leg-radius", self.leg_radius, &mut spec.leg_radius_m),
+            ("leg_width_m", "--leg-width", self.leg_width, &mut spec.leg_width_m),
+            ("hip_height_m", "--hip-height", self.hip_height, &mut spec.hip_height_m),
+            ("leg_speed_rad_s", "--leg-speed", self.leg_speed, &mut spec.leg_speed_rad_s),
+            ("response_time_s", "--response-time", self.response_time, &mut spec.response_time_s),
+        ];
+        let mut names = vec![("stance_legs", "--stance-legs")];
+        for (key, flag, value, slot) in flags {
+            if let Some(v) = value {
+                *slot = v;
+            }
+            names.push((key, flag));
+        }
+        if let Some(n) = self.stance_legs {
+            spec.stance_legs = n;
+        }
+        Robot::new(spec).map_err(|e| {
+            let flag = names.iter().find(|(key, _)| *key == e.key).map(|(_, flag)| *flag);
+            match flag {
+                Some(flag) => anyhow!("{}", e.renamed(flag)),
+                None => anyhow!("{e}"),
+            }
+        })
+    }
+}
+
+/// `--k-n` and `--k-s`: fixed resistances overriding the terrain's at every slope; with the
+/// robot quantities of [`RobotQuantityArgs`].
 #[derive(Debug, Clone, Copy, Args)]
 pub struct OverrideArgs {
     /// Normal penetration resistance k_n, N/m^3, instead of the terrain's.
@@ -94,6 +152,8 @@ pub struct OverrideArgs {
     /// Shear strength k_s, N/m^3, instead of the terrain's.
     #[arg(long = "k-s", value_name = "N/M^3", allow_negative_numbers = true)]
     pub k_s: Option<f64>,
+    #[command(flatten)]
+    pub robot: RobotQuantityArgs,
 }
 
 impl OverrideArgs {
@@ -101,7 +161,8 @@ impl OverrideArgs {
     pub fn scenario(&self, robot: &RobotArgs, terrain: &TerrainArgs) -> Result<Scenario> {
         let k_n = self.k_n.map(|v| check_positive("--k-n", v)).transpose()?;
         let k_s = self.k_s.map(|v| check_positive("--k-s", v)).transpose()?;
-        Scenario::new(robot.load()?, terrain.load()?, k_n, k_s).map_err(|e| anyhow!("{e}"))
+        let robot = self.robot.apply(robot.load()?)?;
+        Scenario::new(robot, terrain.load()?, k_n, k_s).map_err(|e| anyhow!("{e}"))
     }
 }
 

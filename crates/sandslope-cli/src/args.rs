@@ -20,12 +20,14 @@ pub struct RobotArgs {
     /// Override the robot's total mass, kg.
     #[arg(long, value_name = "KG", allow_negative_numbers = true)]
     pub mass: Option<f64>,
+    #[command(flatten)]
+    pub quantities: RobotQuantityArgs,
 }
 
 impl RobotArgs {
-    /// Loads the robot and applies `--mass`.
+    /// Loads the robot and applies `--mass` and the other robot quantities given.
     pub fn load(&self) -> Result<Robot> {
-        let robot = load_robot(&self.robot)?;
+        let robot = self.quantities.apply(load_robot(&self.robot)?)?;
         match self.mass {
             Some(m) => robot.with_mass(m).map_err(|e| anyhow!("{}", e.renamed("--mass"))),
             None => Ok(robot),
@@ -142,8 +144,7 @@ impl RobotQuantityArgs {
     }
 }
 
-/// `--k-n` and `--k-s`: fixed resistances overriding the terrain's at every slope; with the
-/// robot quantities of [`RobotQuantityArgs`].
+/// `--k-n` and `--k-s`: fixed resistances overriding the terrain's at every slope.
 #[derive(Debug, Clone, Copy, Args)]
 pub struct OverrideArgs {
     /// Normal penetration resistance k_n, N/m^3, instead of the terrain's.
@@ -152,8 +153,6 @@ pub struct OverrideArgs {
     /// Shear strength k_s, N/m^3, instead of the terrain's.
     #[arg(long = "k-s", value_name = "N/M^3", allow_negative_numbers = true)]
     pub k_s: Option<f64>,
-    #[command(flatten)]
-    pub robot: RobotQuantityArgs,
 }
 
 impl OverrideArgs {
@@ -161,8 +160,7 @@ impl OverrideArgs {
     pub fn scenario(&self, robot: &RobotArgs, terrain: &TerrainArgs) -> Result<Scenario> {
         let k_n = self.k_n.map(|v| check_positive("--k-n", v)).transpose()?;
         let k_s = self.k_s.map(|v| check_positive("--k-s", v)).transpose()?;
-        let robot = self.robot.apply(robot.load()?)?;
-        Scenario::new(robot, terrain.load()?, k_n, k_s).map_err(|e| anyhow!("{e}"))
+        Scenario::new(robot.load()?, terrain.load()?, k_n, k_s).map_err(|e| anyhow!("{e}"))
     }
 }
 

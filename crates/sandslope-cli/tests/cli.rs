@@ -335,7 +335,8 @@ fn bad_inputs_get_clear_errors() {
 fn robot_quantity_flags_equal_a_robot_file_with_those_values() {
     // The same robot written as a file and given as flags must predict the same, byte for byte.
     let dir = tempfile::tempdir().unwrap();
-    let preset = std::fs::read_to_string(repo_file("crates/sandslope-io/presets/paper-hexapod.toml")).unwrap();
+    let preset =
+        std::fs::read_to_string(repo_file("crates/sandslope-io/presets/paper-hexapod.toml")).unwrap();
     let edited = preset
         .replace("leg_radius_m = 0.04", "leg_radius_m = 0.05")
         .replace("leg_speed_rad_s = 6.283185307179586", "leg_speed_rad_s = 4")
@@ -343,18 +344,28 @@ fn robot_quantity_flags_equal_a_robot_file_with_those_values() {
     assert_ne!(edited, preset);
     let file = common::write_arg(dir.path(), "robot.toml", &edited);
     for slope in ["0", "12.5", "22"] {
-        let by_file = sandslope().args(["sweep", "--json", "--robot", &file, "--to", slope]).output().unwrap();
+        let by_file =
+            sandslope().args(["sweep", "--json", "--robot", &file, "--to", slope]).output().unwrap();
         let by_flags = sandslope()
-            .args(["sweep", "--json", "--leg-radius", "0.05", "--leg-speed", "4", "--stance-legs", "2", "--to", slope])
+            .args([
+                "sweep",
+                "--json",
+                "--leg-radius",
+                "0.05",
+                "--leg-speed",
+                "4",
+                "--stance-legs",
+                "2",
+                "--to",
+                slope,
+            ])
             .output()
             .unwrap();
         assert!(by_file.status.success() && by_flags.status.success());
         assert_eq!(by_file.stdout, by_flags.stdout);
     }
     // A hip height above 2R is refused naming the flag (docs/model.md §2: 0 <= h <= 2R).
-    sandslope()
-        .args(["predict", "--slope", "10", "--leg-radius", "0.01"])
-        .assert()
-        .code(2)
-        .stderr(predicates::str::contains("--hip-height = 0.03 must be between 0 and 2 * leg_radius_m = 0.02"));
+    sandslope().args(["predict", "--slope", "10", "--leg-radius", "0.01"]).assert().code(2).stderr(
+        predicates::str::contains("--hip-height = 0.03 must be between 0 and 2 * leg_radius_m = 0.02"),
+    );
 }

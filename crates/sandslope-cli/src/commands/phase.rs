@@ -12,7 +12,9 @@ use clap::Args;
 
 use sandslope::{Axis, PanelSummary, PhasePanel, Regime, Robot, Slope, Terrain};
 
-use crate::args::{beyond_last_point, default_axis, parse_axis, warn_extrapolated, TerrainArgs};
+use crate::args::{
+    beyond_last_point, default_axis, parse_axis, warn_extrapolated, RobotQuantityArgs, TerrainArgs,
+};
 use crate::figures::phase::PhaseFigure;
 use crate::figures::save;
 use crate::output::{print_json, sci, table};
@@ -49,6 +51,8 @@ pub struct PhaseArgs {
     /// Robot: a TOML file or a built-in preset (see `sandslope presets`).
     #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_ROBOT)]
     pub robot: String,
+    #[command(flatten)]
+    pub quantities: RobotQuantityArgs,
     #[command(flatten)]
     pub terrain: TerrainArgs,
     /// Write every cell to this CSV file: k_n,k_s,slope_deg,mass_kg,regime,step_m.
@@ -98,7 +102,7 @@ pub fn answer(args: &PhaseArgs, max_cells: u128) -> Result<Vec<PanelSummary>> {
 /// `max_cells` cells; a progress bar on a terminal unless `quiet`; the extrapolation warning
 /// on stderr when `warn`).
 pub fn compute(args: &PhaseArgs, max_cells: u128, quiet: bool, warn: bool) -> Result<Panels> {
-    let base = load_robot(&args.robot)?;
+    let base = args.quantities.apply(load_robot(&args.robot)?)?;
     let terrain = args.terrain.load()?;
     let masses = if args.mass.is_empty() { vec![base.mass()] } else { args.mass.clone() };
     let robots = masses

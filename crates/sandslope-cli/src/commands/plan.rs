@@ -9,10 +9,11 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use sandslope::plan::{
-    plan, Cell, Descent, ElevationGrid, NoRoute, Objective, PlanRequest, PlanSettings, Route,
+    plan, Cell, Descent, ElevationGrid, NoRoute, Objective, PlanRequest, PlanResult, PlanSettings, Planner,
+    Route,
 };
 use sandslope::risk::{DefaultsUsed, UncertainTerrain};
-use sandslope::Regime;
+use sandslope::{Regime, Robot};
 
 use crate::args::{check_flag, RobotArgs, TerrainArgs, UncertaintyArgs};
 use crate::figures::plan::PlanFigure;
@@ -124,21 +125,22 @@ pub struct OutputArgs {
     pub json: bool,
 }
 
-/// One route as printed by `--json`.
+/// One route as printed by `--json`. The keys are in alphabetical order, the order `plan --json`
+/// has always printed (it went through a `serde_json::Value`).
 #[derive(Debug, Serialize)]
 pub struct RouteRecord {
+    pub edges_over_roll_limit: Option<usize>,
     pub found: bool,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub reason: Option<NoRoute>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub message: Option<&'static str>,
     pub length_m: Option<f64>,
-    pub time_s: Option<f64>,
-    pub survival: Option<f64>,
     pub max_pitch_deg: Option<f64>,
     pub max_roll_deg: Option<f64>,
-    pub edges_over_roll_limit: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub message: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<NoRoute>,
     pub regimes: Option<BTreeMap<&'static str, usize>>,
+    pub survival: Option<f64>,
+    pub time_s: Option<f64>,
 }
 
 impl RouteRecord {
@@ -297,9 +299,69 @@ fn load_classes(args: &PlanArgs, dem: &Raster) -> Result<(Option<Vec<u8>>, Vec<U
     Ok((Some(idx), terrains))
 }
 
-/// Runs `sandslope plan`.
-pub fn run(args: PlanArgs) -> Result<()> {
-    let robot = args.robot.load()?;
+/// What `plan` reads and checks before any search: the DEM, the robot, the terrain classes and
+/// the settings (the planner's inputs), shared by the routes and by risk maps without routes.
+pub struct Inputs {
+    /// The elevation model as read.
+    pub dem: Raster,
+    /// The robot.
+    pub robot: Robot,
+    /// Per-cell terrain class indices, when `--classes` is given.
+    pub classes: Option<Vec<u8>>,
+    /// The terrain of each class, with its uncertainty (docs/model.md §9).
+    pub terrains: Vec<UncertainTerrain>,
+    /// Roll limit, descent rule, metastable edges and time weight.
+    pub settings: PlanSettings,
+}
+
+impl Inputs {
+    /// Reads and checks everything `args` names except the endpoints (output folders are the
+    /// caller's), printing the note on default CVs unless `quiet`.
+    pub fn read(args: &PlanArgs, quiet: bool) -> Result<Inputs> {
+        let robot = args.robot.load()?;
+        let settings = settings(args)?;
+        let dem = read_raster(&args.dem)?;
+        let (classes, terrains) = classes_of(args, &dem, quiet)?;
+        Ok(Inputs { dem, robot, classes, terrains, settings })
+    }
+
+    /// The elevation grid of the DEM (named after the file in errors).
+    pub fn grid(&self, args: &PlanArgs) -> Result<ElevationGrid> {
+        let dem = &self.dem;
+        ElevationGrid::from_heights(
+            dem.cols,
+            dem.rows,
+            dem.geo.cell_x,
+            dem.geo.cell_y,
+            &dem.values,
+            dem.nodata,
+        )
+        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))
+    }
+
+    /// The planner over the whole DEM (for per-cell maps without routes).
+    pub fn planner(&self, args: &PlanArgs) -> Result<Planner> {
+        Planner::new(self.grid(args)?, self.classes.clone(), &self.terrains, &self.robot, self.settings)
+            .map_err(|e| anyhow!("{}: {e}", args.dem.display()))
+    }
+}
+
+/// [`load_classes`], with the note on default CVs printed unless `quiet`.
+fn classes_of(
+    args: &PlanArgs,
+    dem: &Raster,
+    quiet: bool,
+) -> Result<(Option<Vec<u8>>, Vec<UncertainTerrain>)> {
+    let (classes, terrains) = load_classes(args, dem)?;
+    let defaults = terrains.iter().fold(DefaultsUsed::default(), |a, t| a.or(t.defaults_used()));
+    if let (Some(note), false) = (defaults.note(), quiet) {
+        eprintln!("note: {note}");
+    }
+    Ok((classes, terrains))
+}
+
+/// The settings the flags give, checked.
+fn settings(args: &PlanArgs) -> Result<PlanSettings> {
     let max_roll = check_flag("--max-roll", args.max_roll, 0.0, 90.0)?;
     if max_roll <= 0.0 || max_roll >= 90.0 {
         bail!("--max-roll = {max_roll} must be strictly between 0 and 90 degrees");
@@ -310,25 +372,39 @@ pub fn run(args: PlanArgs) -> Result<()> {
         DescentArg::Symmetric => Descent::Symmetric,
         DescentArg::Level => Descent::Level,
     };
-    let settings = PlanSettings::new(max_roll, descent, args.allow_metastable, time_weight)
-        .map_err(|e| anyhow!("{e}"))?;
-    for p in [&args.out.plot].into_iter().flatten() {
-        crate::figures::format_of(p)?;
-    }
-    // Every output folder is checked before any work, so a bad path cannot leave some of
-    // the outputs written and others not.
-    for p in [&args.out.geojson, &args.out.csv, &args.out.plot, &args.out.risk_map].into_iter().flatten() {
-        crate::output::check_parent_exists(p)?;
-    }
+    PlanSettings::new(max_roll, descent, args.allow_metastable, time_weight).map_err(|e| anyhow!("{e}"))
+}
 
+/// The routes `plan` found and the DEM they were planned on.
+pub struct Planned {
+    /// The elevation model as read (its georeference places the routes).
+    pub dem: Raster,
+    /// The library's result.
+    pub result: PlanResult,
+}
+
+/// What `plan --json` prints: per objective, the route's statistics or why none exists.
+#[derive(Debug, Serialize)]
+pub struct PlanJson {
+    /// By objective name.
+    pub routes: BTreeMap<&'static str, RouteRecord>,
+}
+
+/// The value `plan --json` prints (and `serve`'s `/api/plan` returns).
+pub fn answer(planned: &Planned) -> PlanJson {
+    PlanJson { routes: planned.result.routes.iter().map(|(o, r)| (o.name(), RouteRecord::from(r))).collect() }
+}
+
+/// Reads the inputs of `args`, places start and goal and plans every objective, with the risk
+/// raster when `risk_map` (progress bars on a terminal for large maps, notes on stderr, unless
+/// `quiet`).
+pub fn compute(args: &PlanArgs, risk_map: bool, quiet: bool) -> Result<Planned> {
+    let robot = args.robot.load()?;
+    let settings = settings(args)?;
     let dem = read_raster(&args.dem)?;
     let start = endpoint(&dem, "start", &args.start, &args.start_px)?;
     let goal = endpoint(&dem, "goal", &args.goal, &args.goal_px)?;
-    let (classes, terrains) = load_classes(&args, &dem)?;
-    let defaults = terrains.iter().fold(DefaultsUsed::default(), |a, t| a.or(t.defaults_used()));
-    if let Some(note) = defaults.note() {
-        eprintln!("note: {note}");
-    }
+    let (classes, terrains) = classes_of(args, &dem, quiet)?;
     let grid = ElevationGrid::from_heights(
         dem.cols,
         dem.rows,
@@ -338,15 +414,12 @@ pub fn run(args: PlanArgs) -> Result<()> {
         dem.nodata,
     )
     .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
-    let request = PlanRequest {
-        start,
-        goal,
-        objectives: args.objective.iter().map(|&o| o.into()).collect(),
-        risk_map: args.out.risk_map.is_some() || args.out.plot.is_some(),
-    };
+    let request =
+        PlanRequest { start, goal, objectives: args.objective.iter().map(|&o| o.into()).collect(), risk_map };
 
-    let show_progress =
-        dem.values.len() >= PROGRESS_MIN_CELLS && std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let show_progress = !quiet
+        && dem.values.len() >= PROGRESS_MIN_CELLS
+        && std::io::IsTerminal::is_terminal(&std::io::stderr());
     let multi = MultiProgress::with_draw_target(if show_progress {
         ProgressDrawTarget::stderr()
     } else {
@@ -370,6 +443,24 @@ pub fn run(args: PlanArgs) -> Result<()> {
     for (_, bar) in bars.into_inner().unwrap_or_else(|e| e.into_inner()) {
         bar.finish();
     }
+    Ok(Planned { dem, result })
+}
+
+/// Runs `sandslope plan`.
+pub fn run(args: PlanArgs) -> Result<()> {
+    // The flags are checked, in this order, before the output folders and any other file.
+    args.robot.load()?;
+    settings(&args)?;
+    for p in [&args.out.plot].into_iter().flatten() {
+        crate::figures::format_of(p)?;
+    }
+    // Every output folder is checked before any work, so a bad path cannot leave some of
+    // the outputs written and others not.
+    for p in [&args.out.geojson, &args.out.csv, &args.out.plot, &args.out.risk_map].into_iter().flatten() {
+        crate::output::check_parent_exists(p)?;
+    }
+    let planned = compute(&args, args.out.risk_map.is_some() || args.out.plot.is_some(), false)?;
+    let Planned { dem, result } = &planned;
 
     if let Some(p) = &args.out.geojson {
         writers::write_geojson(p, &dem.geo, &result.routes)?;
@@ -392,9 +483,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
     }
 
     if args.out.json {
-        let routes: BTreeMap<&str, RouteRecord> =
-            result.routes.iter().map(|(o, r)| (o.name(), RouteRecord::from(r))).collect();
-        return print_json(&serde_json::json!({ "routes": routes }));
+        return print_json(&answer(&planned));
     }
     let mut t = table(&[
         "route",

@@ -14,7 +14,7 @@ use sandslope::gait::{
 };
 use sandslope::{Scenario, Slope};
 
-use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
+use crate::args::{check_flag, RobotArgs, TerrainArgs};
 use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions, Tracked};
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
 use sandslope_io::mocap::{Capture, MocapFormat};
@@ -52,9 +52,6 @@ pub struct TrackArgs {
     pub robot: RobotArgs,
     #[command(flatten)]
     pub terrain: TerrainArgs,
-    /// Leg angular speed omega, rad/s, instead of the robot's (stride period T = 2 pi / omega).
-    #[arg(long, allow_negative_numbers = true, value_name = "RAD/S")]
-    pub leg_speed: Option<f64>,
     /// Touchdown times, s, one per line in the recording's clock (e.g. from the gait
     /// controller's log); give it once per recording, in the same order. Estimated from the
     /// speed signal when omitted.
@@ -157,11 +154,10 @@ pub fn run(args: TrackArgs) -> Result<()> {
     for p in [&args.speeds_out, &args.plot].into_iter().flatten() {
         crate::output::check_parent_exists(p)?;
     }
+    // --leg-speed (the robot's, shared by every command) sets the stride period T = 2 pi / omega,
+    // and the model curve of --plot is that robot's too.
     let robot = args.robot.load()?;
-    let period = match args.leg_speed {
-        Some(w) => std::f64::consts::TAU / check_positive("--leg-speed", w)?,
-        None => robot.stride_period(),
-    };
+    let period = robot.stride_period();
     let slope = args.slope.map(|d| check_flag("--slope", d, 0.0, 89.999)).transpose()?;
     if args.speeds_out.is_some() && slope.is_none() {
         bail!("--speeds-out needs --slope (the slope of these recordings, degrees)");

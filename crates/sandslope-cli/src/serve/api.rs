@@ -16,7 +16,7 @@ use clap::error::{ContextKind, ContextValue};
 use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
-use crate::commands::{phase, predict, sweep};
+use crate::commands::{phase, plan, predict, sweep};
 use sandslope_io::presets::{self, PresetKind};
 
 /// Most slopes one `/api/sweep` request evaluates.
@@ -37,7 +37,7 @@ pub struct Served {
 }
 
 /// The commands the API answers, in the order docs/serve.md lists them.
-pub const COMMANDS: [&str; 3] = ["predict", "sweep", "phase"];
+pub const COMMANDS: [&str; 4] = ["predict", "sweep", "phase", "plan"];
 
 /// Flags that write files or choose an output format: the API always answers JSON and
 /// writes nothing.
@@ -64,7 +64,7 @@ impl ApiError {
 
     /// A command's error (a checked flag value): 400, the field read from the `--flag` the
     /// message names first.
-    fn from_command(e: &anyhow::Error) -> ApiError {
+    pub fn from_command(e: &anyhow::Error) -> ApiError {
         let error = format!("{e:#}");
         ApiError::bad(flag_named_in(&error), error)
     }
@@ -114,6 +114,11 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
         "phase" => {
             let args: phase::PhaseArgs = parse("phase", params, served)?;
             json(&phase::answer(&args, MAX_PHASE_CELLS).map_err(|e| ApiError::from_command(&e))?)
+        }
+        "plan" => {
+            let args: plan::PlanArgs = parse("plan", params, served)?;
+            let planned = plan::compute(&args, false, true).map_err(|e| ApiError::from_command(&e))?;
+            json(&plan::answer(&planned))
         }
         _ => Err(ApiError {
             status: 404,

@@ -17,6 +17,7 @@ use anyhow::{anyhow, Result};
 use tiny_http::{Header, Method, Request, Response};
 
 use super::api::{self, ApiError, Served};
+use super::data::{self, Reply};
 use super::page;
 
 /// Longest request URL accepted, bytes.
@@ -31,8 +32,26 @@ const READERS: usize = 2;
 /// One API request handed to a compute thread.
 struct Job {
     request: Request,
-    command: String,
+    path: String,
     params: Vec<(String, String)>,
+}
+
+/// Answers a queued request by its path: `/api/<command>`, `/data/<name>`, `/download/<file>`.
+fn dispatch(path: &str, params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
+    if let Some(command) = path.strip_prefix("/api/") {
+        api::answer(command, params, served).map(Reply::json)
+    } else if let Some(name) = path.strip_prefix("/data/") {
+        data::answer(name, params, served)
+    } else if let Some(file) = path.strip_prefix("/download/") {
+        data::download(file, params, served)
+    } else {
+        Err(ApiError { status: 404, field: None, error: format!("no page {path}") })
+    }
+}
+
+/// Whether `path` is answered by the compute threads.
+fn computed(path: &str) -> bool {
+    ["/api/", "/data/", "/download/"].iter().any(|p| path.starts_with(p))
 }
 
 /// A bound server, ready to [`Server::serve`].
@@ -94,7 +113,7 @@ fn compute_loop(rx: &Mutex<Receiver<Job>>, served: &Served) {
                 Err(_) => return,
             }
         };
-        let result = catch_unwind(AssertUnwindSafe(|| api::answer(&job.command, &job.params, served)))
+        let result = catch_unwind(AssertUnwindSafe(|| dispatch(&job.path, &job.params, served)))
             .unwrap_or_else(|_| {
                 Err(ApiError {
                     status: 500,
@@ -106,14 +125,21 @@ fn compute_loop(rx: &Mutex<Receiver<Job>>, served: &Served) {
     }
 }
 
-/// Sends an API result: the body on success, `{"field": ..., "error": ...}` otherwise.
-fn respond_api(request: Request, result: Result<Vec<u8>, ApiError>) {
-    let (status, body) = match result {
-        Ok(body) => (200, body),
-        Err(e) => (e.status, api::json(&e).unwrap_or_else(|_| b"{}\n".to_vec())),
+/// Sends a result: the body on success, `{"field": ..., "error": ...}` otherwise.
+fn respond_api(request: Request, result: Result<Reply, ApiError>) {
+    let (status, reply) = match result {
+        Ok(reply) => (200, reply),
+        Err(e) => (e.status, Reply::json(api::json(&e).unwrap_or_else(|_| b"{}\n".to_vec()))),
     };
-    let _ =
-        request.respond(with_type(Response::from_data(body).with_status_code(status), "application/json"));
+    let mut response =
+        with_type(Response::from_data(reply.body).with_status_code(status), reply.content_type);
+    if let Some(name) = reply.filename {
+        let value = format!("attachment; filename=\"{name}\"");
+        if let Ok(h) = Header::from_bytes(&b"Content-Disposition"[..], value.as_bytes()) {
+            response.add_header(h);
+        }
+    }
+    let _ = request.respond(response);
 }
 
 fn with_type<R: Read>(r: Response<R>, content_type: &str) -> Response<R> {
@@ -153,7 +179,7 @@ fn route(mut request: Request, tx: &SyncSender<Job>, served: &Served) {
     }
     let (path, query) = url.split_once('?').unwrap_or((&url, ""));
     let method = request.method().clone();
-    if let Some(command) = path.strip_prefix("/api/") {
+    if computed(path) {
         let mut params: Vec<(String, String)> =
             form_urlencoded::parse(query.as_bytes()).map(|(k, v)| (k.into_owned(), v.into_owned())).collect();
         match method {
@@ -171,7 +197,7 @@ fn route(mut request: Request, tx: &SyncSender<Job>, served: &Served) {
                 )
             }
         }
-        let job = Job { request, command: command.to_string(), params };
+        let job = Job { request, path: path.to_string(), params };
         if let Err(e) = tx.try_send(job) {
             let job = match e {
                 TrySendError::Full(job) | TrySendError::Disconnected(job) => job,

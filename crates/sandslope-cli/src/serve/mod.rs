@@ -10,6 +10,7 @@
 //! are embedded in the binary: nothing is fetched from the network.
 
 pub mod api;
+pub mod data;
 pub mod http;
 pub mod page;
 

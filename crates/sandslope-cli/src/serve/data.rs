@@ -1,0 +1,270 @@
+//! What the page needs beyond the commands' JSON: the served robot and DEM, the cells of a phase
+//! map, a risk raster without routes (`/data/...`), and the files `plan` writes
+//! (`/download/...`), each computed by the same command code (docs/serve.md).
+
+use serde::Serialize;
+
+use super::api::{self, ApiError, Served};
+use crate::commands::{phase, plan};
+use sandslope::Cause;
+use sandslope_io::presets::{PresetKind, PRESETS};
+use sandslope_io::raster::{read_raster, write_two_band_geotiff};
+
+/// Most cells of a `/data/phase-map` (the page asks for about 160 x 160).
+pub const MAX_MAP_CELLS: u128 = 1 << 18;
+/// Most cells sent for the DEM and its risk raster; a larger DEM is sent every `stride`-th
+/// cell in each direction.
+pub const MAX_DISPLAY_CELLS: usize = 1 << 20;
+
+/// An answer: its bytes, type, and the file name a download is saved under.
+pub struct Reply {
+    /// The body.
+    pub body: Vec<u8>,
+    /// Its content type.
+    pub content_type: &'static str,
+    /// For downloads: the suggested file name.
+    pub filename: Option<&'static str>,
+}
+
+impl Reply {
+    /// A JSON body as `print_json` writes it.
+    pub fn json(body: Vec<u8>) -> Reply {
+        Reply { body, content_type: "application/json", filename: None }
+    }
+}
+
+/// `value` as compact JSON (the page's data need not read like `--json`, only be small).
+fn compact<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
+    serde_json::to_vec(value).map_err(|e| ApiError {
+        status: 500,
+        field: None,
+        error: format!("serialising the answer: {e}"),
+    })
+}
+
+fn not_found(what: &str, names: &str) -> ApiError {
+    ApiError { status: 404, field: None, error: format!("no {what}; there are {names}") }
+}
+
+fn failed(e: &anyhow::Error) -> ApiError {
+    ApiError::bad(None, format!("{e:#}"))
+}
+
+/// Answers `/data/<name>`.
+pub fn answer(name: &str, params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
+    match name {
+        "served" => served_info(served),
+        "dem" => dem(served),
+        "phase-map" => phase_map(params, served),
+        "risk-map" => risk_map(params, served),
+        _ => Err(not_found(
+            &format!("/data/{name}"),
+            "/data/served, /data/dem, /data/phase-map, /data/risk-map",
+        )),
+    }
+    .map(Reply::json)
+}
+
+/// Answers `/download/<name>`: the bytes `plan` writes to `--geojson` or `--risk-map` for the
+/// same flags.
+pub fn download(name: &str, params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
+    let (file, content_type): (&'static str, &'static str) = match name {
+        "plan.geojson" => ("plan.geojson", "application/geo+json"),
+        "risk-map.tif" => ("risk-map.tif", "image/tiff"),
+        _ => {
+            return Err(not_found(
+                &format!("/download/{name}"),
+                "/download/plan.geojson, /download/risk-map.tif",
+            ))
+        }
+    };
+    let args: plan::PlanArgs = api::parse("plan", params, served)?;
+    let planned = plan::compute(&args, file == "risk-map.tif", true).map_err(|e| failed(&e))?;
+    let dir = tempfile::tempdir().map_err(|e| ApiError { status: 500, field: None, error: e.to_string() })?;
+    let path = dir.path().join(file);
+    let geo = &planned.dem.geo;
+    let written = match (file, &planned.result.risk) {
+        ("plan.geojson", _) => sandslope_io::routes::write_geojson(&path, geo, &planned.result.routes),
+        (_, Some(risk)) => write_two_band_geotiff(
+            &path,
+            planned.dem.cols,
+            planned.dem.rows,
+            geo,
+            &risk.p_fail,
+            &risk.climb_azimuth_deg,
+        ),
+        (_, None) => Err(anyhow::anyhow!("no risk raster was computed")),
+    };
+    written.map_err(|e| ApiError { status: 500, field: None, error: format!("{e:#}") })?;
+    let body =
+        std::fs::read(&path).map_err(|e| ApiError { status: 500, field: None, error: e.to_string() })?;
+    Ok(Reply { body, content_type, filename: Some(file) })
+}
+
+/// The served robot (its file keys), terrain name, the presets and the DEM's size.
+fn served_info(served: &Served) -> Result<Vec<u8>, ApiError> {
+    #[derive(Serialize)]
+    struct Dem {
+        cols: usize,
+        rows: usize,
+        cell_x: f64,
+        cell_y: f64,
+        west: f64,
+        north: f64,
+        stride: usize,
+    }
+    #[derive(Serialize)]
+    struct Info {
+        robot: sandslope::RobotSpec,
+        robot_name: String,
+        terrain_name: String,
+        robots: Vec<&'static str>,
+        terrains: Vec<&'static str>,
+        /// Each regime cause's name and its one-line explanation.
+        causes: Vec<(&'static str, &'static str)>,
+        dem: Option<Dem>,
+    }
+    let robot = sandslope_io::load_robot(&served.robot).map_err(|e| failed(&e))?;
+    let terrain = sandslope_io::load_terrain(&served.terrain).map_err(|e| failed(&e))?;
+    let names = |kind| PRESETS.iter().filter(|p| p.kind == kind).map(|p| p.name).collect();
+    let dem = match &served.dem {
+        Some(path) => {
+            let r = read_raster(path).map_err(|e| failed(&e))?;
+            Some(Dem {
+                cols: r.cols,
+                rows: r.rows,
+                cell_x: r.geo.cell_x,
+                cell_y: r.geo.cell_y,
+                west: r.geo.west,
+                north: r.geo.north,
+                stride: stride(r.cols, r.rows),
+            })
+        }
+        None => None,
+    };
+    compact(&Info {
+        robot: robot.spec().clone(),
+        robot_name: served.robot.clone(),
+        terrain_name: terrain.name().unwrap_or(&served.terrain).to_string(),
+        robots: names(PresetKind::Robot),
+        terrains: names(PresetKind::Terrain),
+        causes: [
+            Cause::NormalSinkage,
+            Cause::AtOrAboveRepose,
+            Cause::NoAnchoring,
+            Cause::NetBackwardStep,
+            Cause::ShortStep,
+            Cause::RobustStep,
+        ]
+        .iter()
+        .map(|c| (c.name(), c.explain()))
+        .collect(),
+        dem,
+    })
+}
+
+/// Every how many cells the page is sent for a DEM of this size.
+fn stride(cols: usize, rows: usize) -> usize {
+    let cells = cols * rows;
+    let mut s = 1;
+    while cells.div_ceil(s * s) > MAX_DISPLAY_CELLS {
+        s += 1;
+    }
+    s
+}
+
+/// Values at every `stride`-th cell, NaN as null.
+fn sampled(values: &[f32], cols: usize, rows: usize, stride: usize) -> Vec<Option<f32>> {
+    (0..rows)
+        .step_by(stride)
+        .flat_map(|r| (0..cols).step_by(stride).map(move |c| r * cols + c))
+        .map(|i| Some(values[i]).filter(|v| v.is_finite()))
+        .collect()
+}
+
+#[derive(Serialize)]
+struct Grid {
+    cols: usize,
+    rows: usize,
+    stride: usize,
+    values: Vec<Option<f32>>,
+}
+
+/// The served DEM's heights (nodata as null), every `stride`-th cell.
+fn dem(served: &Served) -> Result<Vec<u8>, ApiError> {
+    let Some(path) = &served.dem else {
+        return Err(not_found("DEM: the server was started without --dem", "none"));
+    };
+    let r = read_raster(path).map_err(|e| failed(&e))?;
+    let heights: Vec<f32> =
+        (0..r.values.len()).map(|i| if r.is_nodata(i) { f32::NAN } else { r.values[i] as f32 }).collect();
+    let stride = stride(r.cols, r.rows);
+    compact(&Grid { cols: r.cols, rows: r.rows, stride, values: sampled(&heights, r.cols, r.rows, stride) })
+}
+
+/// The regime of every cell of the first panel of `phase` with these flags: `regimes` holds
+/// one digit per cell (0 sinkage, 1 slippage, 2 metastable, 3 success), k_s rows from the
+/// lowest, k_n columns from the lowest.
+fn phase_map(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, ApiError> {
+    #[derive(Serialize)]
+    struct Map {
+        k_n: Vec<f64>,
+        k_s: Vec<f64>,
+        regimes: String,
+        summary: sandslope::PanelSummary,
+    }
+    let args: phase::PhaseArgs = api::parse("phase", params, served)?;
+    let panels = phase::compute(&args, MAX_MAP_CELLS, true, false).map_err(|e| {
+        let error = format!("{e:#}");
+        ApiError::bad(Some("k-n".to_string()), error)
+    })?;
+    let Some(p) = panels.panels.first() else {
+        return Err(ApiError::bad(Some("slope".to_string()), "no panel: give a slope"));
+    };
+    let (nx, ny) = (p.map.k_n().len(), p.map.k_s().len());
+    let regimes = (0..ny)
+        .flat_map(|j| (0..nx).map(move |i| (i, j)))
+        .map(|(i, j)| char::from(b'0' + p.map.regime(i, j) as u8))
+        .collect();
+    compact(&Map { k_n: p.map.k_n().to_vec(), k_s: p.map.k_s().to_vec(), regimes, summary: p.summary() })
+}
+
+/// P(failure) of every cell of the served DEM under `plan`'s flags, by a heading rule:
+/// `rule=best` (the lowest over the 16 headings, band 1 of `plan --risk-map`) or
+/// `rule=fall-line` (climbing straight up the cell's fall line). Start and goal are not
+/// needed (any given are ignored).
+fn risk_map(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, ApiError> {
+    let mut rule = "best".to_string();
+    let mut rest: Vec<(String, String)> = Vec::new();
+    for (k, v) in params {
+        match k.as_str() {
+            "rule" => rule = v.clone(),
+            "start" | "goal" | "start-px" | "goal-px" | "objective" => {}
+            _ => rest.push((k.clone(), v.clone())),
+        }
+    }
+    // The planner's inputs need no endpoints; plan's flags require some, so any cell will do.
+    rest.push(("start-px".into(), "0,0".into()));
+    rest.push(("goal-px".into(), "0,0".into()));
+    let args: plan::PlanArgs = api::parse("plan", &rest, served)?;
+    let inputs = plan::Inputs::read(&args, true).map_err(|e| ApiError::from_command(&e))?;
+    let planner = inputs.planner(&args).map_err(|e| failed(&e))?;
+    let (cols, rows) = (inputs.dem.cols, inputs.dem.rows);
+    let p_fail: Vec<f32> = match rule.as_str() {
+        "best" => planner.risk_map().0,
+        "fall-line" => {
+            let grid = planner.grid();
+            (0..grid.len())
+                .map(|i| planner.fall_line(grid.cell(i)).map_or(f32::NAN, |(_, p)| p as f32))
+                .collect()
+        }
+        _ => {
+            return Err(ApiError::bad(
+                Some("rule".to_string()),
+                format!("rule = `{rule}` must be best (lowest over 16 headings) or fall-line (straight up)"),
+            ))
+        }
+    };
+    let stride = stride(cols, rows);
+    compact(&Grid { cols, rows, stride, values: sampled(&p_fail, cols, rows, stride) })
+}

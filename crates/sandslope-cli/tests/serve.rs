@@ -13,6 +13,9 @@ use rand::{RngExt, SeedableRng};
 
 use common::{repo_file, sandslope};
 
+// Browser tests: `browse` below. The page is also checked by eye: SANDSLOPE_SERVE_SCREENSHOTS=DIR
+// keeps the screenshots.
+
 /// A running `sandslope serve`, stopped when dropped.
 struct Server {
     child: Child,
@@ -54,7 +57,8 @@ impl Server {
         s.set_read_timeout(Some(Duration::from_secs(120))).unwrap();
         write!(
             s,
-            "{method} {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\nContent-Length: {}\r\n\r\n",
+            // HTTP/1.0: the answer is the body as is, never chunked.
+            "{method} {path} HTTP/1.0\r\nHost: {}\r\nContent-Length: {}\r\n\r\n",
             self.addr,
             body.len()
         )
@@ -159,6 +163,56 @@ fn phase_endpoint_equals_phase_json() {
 }
 
 #[test]
+fn plan_endpoint_and_downloads_equal_plans_json_and_files() {
+    let dem = repo_file("examples/planning/dune.asc").to_string_lossy().into_owned();
+    let server = Server::start(&["--dem", &dem]);
+    let flags = [("start-px", "40,100".to_string()), ("goal-px", "160,100".into()), ("objective", "time,risk".into())];
+    let (path, mut argv) = both("plan", &flags);
+    let (status, body) = server.get(&path);
+    assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
+    argv.push(format!("--dem={dem}"));
+    assert_eq!(body, cli_stdout(&argv));
+    // No route (the goal on the lee face's nodata patch is refused as plan refuses it).
+    let (status, body) = server.get("/api/plan?start-px=40,100&goal-px=140,50");
+    let cli = sandslope().args(["plan", "--dem", &dem, "--start-px", "40,100", "--goal-px", "140,50", "--json"]).output().unwrap();
+    assert_eq!(status == 200, cli.status.success(), "{}", String::from_utf8_lossy(&body));
+    // The files plan writes, byte for byte.
+    let dir = tempfile::tempdir().unwrap();
+    let (geojson, tif) = (dir.path().join("r.geojson"), dir.path().join("r.tif"));
+    let mut argv = argv.clone();
+    argv.retain(|a| a != "--json");
+    argv.push(format!("--geojson={}", geojson.display()));
+    argv.push(format!("--risk-map={}", tif.display()));
+    cli_stdout(&argv);
+    let query = path.split_once('?').unwrap().1;
+    assert_eq!(server.get(&format!("/download/plan.geojson?{query}")).1, std::fs::read(&geojson).unwrap());
+    assert_eq!(server.get(&format!("/download/risk-map.tif?{query}")).1, std::fs::read(&tif).unwrap());
+    // The page's risk overlay (best heading) is band 1 of that GeoTIFF, cell for cell.
+    let (status, body) = server.get("/data/risk-map?rule=best");
+    assert_eq!(status, 200);
+    let v: serde_json::Value = serde_json::from_slice(&body).unwrap();
+    assert_eq!((v["cols"].as_u64(), v["rows"].as_u64(), v["stride"].as_u64()), (Some(200), Some(200), Some(1)));
+    let mut decoder = tiff::decoder::Decoder::new(std::fs::File::open(&tif).unwrap()).unwrap();
+    let tiff::decoder::DecodingResult::F32(bands) = decoder.read_image().unwrap() else { panic!("not float32") };
+    let overlay = v["values"].as_array().unwrap();
+    assert_eq!(bands.len(), 2 * overlay.len());
+    let mut passable = 0;
+    for (cell, value) in overlay.iter().enumerate() {
+        match value.as_f64() {
+            Some(p) => {
+                assert_eq!(p as f32, bands[2 * cell], "cell {cell}");
+                passable += 1;
+            }
+            None => assert!(bands[2 * cell].is_nan(), "cell {cell}"),
+        }
+    }
+    assert!(passable > 30_000, "{passable} passable cells");
+    // A request naming another DEM is refused.
+    let (status, _) = server.get("/api/plan?dem=%2Fetc%2Fpasswd&start-px=40,100&goal-px=160,100");
+    assert_eq!(status, 400);
+}
+
+#[test]
 fn a_served_robot_file_is_the_default_of_every_request() {
     let dir = tempfile::tempdir().unwrap();
     let robot = dir.path().join("heavy.toml");
@@ -247,4 +301,137 @@ fn hostile_requests_get_a_4xx_naming_the_field_or_limit() {
     assert!((400..500).contains(&status), "{status}: {error}");
     // The server is still up and right after all that.
     assert_same(&server, "predict", &[("slope", "20".into())]);
+}
+
+// ---- the page in a real browser (headless Chromium) ----
+
+/// Loads `path` from `server` in headless Chromium and returns the DOM once the page's scripts
+/// are done, and every console line the page produced (`--enable-logging` prints them as
+/// `INFO:CONSOLE`). With `screenshot`, takes a screenshot of the same page instead of the DOM
+/// (the DOM is then empty).
+fn browse(browser: &str, server: &Server, path: &str, screenshot: Option<&std::path::Path>) -> (String, Vec<String>) {
+    let profile = tempfile::tempdir().unwrap();
+    let mut cmd = Command::new(browser);
+    cmd.args(common::CHROMIUM_FLAGS)
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .args(["--enable-logging=stderr", "--v=0", "--window-size=1400,1000"])
+        // Virtual time: the budget runs while the page is idle, waits while requests are open.
+        .arg("--virtual-time-budget=30000");
+    match screenshot {
+        Some(p) => cmd.arg(format!("--screenshot={}", p.display())),
+        None => cmd.arg("--dump-dom"),
+    };
+    let out = cmd.arg(format!("http://{}{path}", server.addr)).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let console = stderr.lines().filter(|l| l.contains(":CONSOLE")).map(str::to_string).collect();
+    (String::from_utf8_lossy(&out.stdout).into_owned(), console)
+}
+
+/// The value of attribute `name` on the element whose opening tag contains `anchor`.
+fn attribute(dom: &str, anchor: &str, name: &str) -> Option<String> {
+    let at = dom.find(anchor)?;
+    let start = dom[..at].rfind('<')?;
+    let end = at + dom[at..].find('>')?;
+    let tag = &dom[start..end];
+    let from = tag.find(&format!(" {name}=\""))? + name.len() + 3;
+    Some(tag[from..from + tag[from..].find('"')?].to_string())
+}
+
+/// The text of the element with this id (no nested elements).
+fn text_of(dom: &str, id: &str) -> String {
+    let anchor = format!("id=\"{id}\"");
+    let at = dom.find(&anchor).unwrap_or_else(|| panic!("no #{id} in the page"));
+    let open = at + dom[at..].find('>').unwrap() + 1;
+    dom[open..open + dom[open..].find('<').unwrap()].to_string()
+}
+
+/// The number after `"key": ` in `json` text, from position `from` on, exactly as written
+/// (serde_json's default parser may round the last digit, so numbers are compared as text and
+/// then by Rust's exact parser).
+fn raw_number(json: &str, key: &str, from: usize) -> String {
+    let marker = format!("\"{key}\": ");
+    let at = from + json[from..].find(&marker).unwrap_or_else(|| panic!("no {key}")) + marker.len();
+    json[at..].chars().take_while(|c| !matches!(c, ',' | '\n' | '}')).collect()
+}
+
+/// The page loaded nothing from outside this server and reported no error.
+fn assert_clean(server: &Server, dom: &str, console: &[String]) {
+    assert!(console.is_empty(), "the page wrote to the console:\n{}", console.join("\n"));
+    assert_eq!(text_of(dom, "log-errors"), "", "page errors");
+    let resources = text_of(dom, "log-resources");
+    assert!(resources.lines().count() >= 4, "too few requests logged: {resources}");
+    let own = format!("http://{}/", server.addr);
+    for url in resources.lines() {
+        assert!(url.starts_with(&own), "request outside the server: {url}");
+    }
+    assert!(own.starts_with("http://127.0.0.1:"), "{own}");
+    assert_eq!(attribute(dom, "<body", "data-busy").as_deref(), Some("0"), "requests still open");
+}
+
+#[test]
+fn the_page_shows_predicts_speed_after_the_slope_slider_moves() {
+    let Some(browser) = common::chromium_or_skip("the_page_shows_predicts_speed_after_the_slope_slider_moves")
+    else {
+        return;
+    };
+    let server = Server::start(&[]);
+    for slope in ["20", "-12.5", "27"] {
+        // ?slope= moves the slider (an input event, as a drag does) after the page has shown
+        // its first answer at 10 deg.
+        let (dom, console) = browse(&browser, &server, &format!("/?slope={slope}"), None);
+        assert_clean(&server, &dom, &console);
+        let raw = String::from_utf8(cli_stdout(&["predict".into(), format!("--slope={slope}"), "--json".into()])).unwrap();
+        let cli: serde_json::Value = serde_json::from_str(&raw).unwrap();
+        let shown_slope = attribute(&dom, "id=\"speed\"", "data-slope-deg").expect("no slope on #speed");
+        assert_eq!(shown_slope.parse::<f64>().unwrap(), slope.parse::<f64>().unwrap());
+        let shown = attribute(&dom, "id=\"speed\"", "data-speed-m-s").expect("no speed on #speed");
+        assert_eq!(shown, raw_number(&raw, "speed_m_s", 0), "slope {slope}");
+        let text = text_of(&dom, "speed");
+        match cli["speed_m_s"].as_f64() {
+            Some(_) => {
+                let v: f64 = shown.parse().unwrap();
+                assert_eq!(text, format!("{:.2}", v * 100.0), "slope {slope}");
+            }
+            // Beyond repose the speed is ruled out: null in JSON, the model's in parentheses.
+            None => {
+                let model: f64 = raw_number(&raw, "model_speed_m_s", 0).parse().unwrap();
+                assert_eq!(text, format!("({:.2})", model * 100.0), "slope {slope}");
+            }
+        }
+        assert_eq!(text_of(&dom, "regime"), cli["regime"].as_str().unwrap());
+    }
+}
+
+#[test]
+fn clicking_start_and_goal_on_the_example_dem_draws_plans_routes() {
+    let Some(browser) =
+        common::chromium_or_skip("clicking_start_and_goal_on_the_example_dem_draws_plans_routes")
+    else {
+        return;
+    };
+    let dem = repo_file("examples/planning/dune.asc").to_string_lossy().into_owned();
+    let server = Server::start(&["--dem", &dem]);
+    // The page clicks the map at these cells itself (a click event at their pixels), once drawn.
+    let page = "/?tab=routes&start-px=40,100&goal-px=160,100";
+    let (dom, console) = browse(&browser, &server, page, None);
+    assert_clean(&server, &dom, &console);
+    let argv: Vec<String> =
+        ["plan", "--dem", &dem, "--start-px", "40,100", "--goal-px", "160,100", "--objective", "time,risk", "--json"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+    let raw = String::from_utf8(cli_stdout(&argv)).unwrap();
+    for objective in ["time", "risk", "distance"] {
+        let anchor = format!("data-objective=\"{objective}\"");
+        let length = attribute(&dom, &anchor, "data-length-m").unwrap_or_else(|| panic!("no {objective} row"));
+        let section = raw.find(&format!("\"{objective}\": {{")).unwrap();
+        assert_eq!(length, raw_number(&raw, "length_m", section), "{objective}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("routes.png");
+    browse(&browser, &server, page, Some(&shot));
+    common::assert_shows_content(&shot);
+    if let Ok(keep) = std::env::var("SANDSLOPE_SERVE_SCREENSHOTS") {
+        std::fs::copy(&shot, std::path::Path::new(&keep).join("routes.png")).unwrap();
+    }
 }

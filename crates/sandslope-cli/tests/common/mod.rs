@@ -33,6 +33,56 @@ pub fn json(args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
+/// Debian's `chromium` (or another Chromium on PATH) for the browser tests, or `None` after
+/// saying the test is skipped. With `CI=true` a missing browser fails the test instead: CI
+/// installs it (.ci/run), so a browser test must never pass there by skipping.
+pub fn chromium_or_skip(test: &str) -> Option<String> {
+    let found = ["chromium", "chromium-browser", "google-chrome"].iter().find_map(|name| {
+        let ok = std::process::Command::new(name).arg("--version").output().is_ok_and(|o| o.status.success());
+        ok.then(|| name.to_string())
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "{test}: no chromium installed and CI=true: browser tests must run in CI (apt-get install chromium)"
+        );
+        eprintln!("{test}: skipped: no chromium installed (apt-get install chromium)");
+    }
+    found
+}
+
+/// The flags every browser test starts headless Chromium with: no first-run, sync, component
+/// updates or background traffic, so the only requests are the page's.
+pub const CHROMIUM_FLAGS: [&str; 9] = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--hide-scrollbars",
+];
+
+/// Checks a browser screenshot (PNG) shows content: more than 3 % non-white pixels and more
+/// than 20 colours (a blank or broken page has neither).
+pub fn assert_shows_content(shot: &Path) {
+    let decoder = png::Decoder::new(std::fs::File::open(shot).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let channels = info.color_type.samples();
+    let pixels: Vec<&[u8]> = buf[..info.buffer_size()].chunks(channels).collect();
+    let non_white = pixels.iter().filter(|p| p[..3].iter().any(|&c| c < 235)).count();
+    let mut colours: Vec<[u8; 3]> = pixels.iter().map(|p| [p[0] & 0xf0, p[1] & 0xf0, p[2] & 0xf0]).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    let fraction = non_white as f64 / pixels.len() as f64;
+    assert!(fraction > 0.03, "{}: nearly blank: {fraction:.4} of pixels non-white", shot.display());
+    assert!(colours.len() > 20, "{}: only {} colours", shot.display(), colours.len());
+}
+
 /// Writes `text` to `dir/name` and returns the path as a string, for an argument list.
 pub fn write_arg(dir: &Path, name: &str, text: &str) -> String {
     write(dir, name, text).to_string_lossy().into_owned()

@@ -1,15 +1,709 @@
 "use strict";
+// The explorer page of `sandslope serve` (docs/serve.md). Every number comes from the server:
+// /api/<command> answers exactly what `sandslope <command> --json` prints for the same flags,
+// /data/... gives what the charts need beyond that. The charts are drawn here, on SVG and
+// canvas, in the regime palette of the command line's figures (src/figures/palette.rs).
+// Nothing is loaded from anywhere but this server.
+
+const COLOURS = { sinkage: "#426ec9", slippage: "#d63830", metastable: "#f7d643", success: "#a8e296" };
+const CODES = ["sinkage", "slippage", "metastable", "success"];
+const ROUTE_COLOURS = { time: "#0b6e2f", risk: "#7b2cbf", distance: "#111111" };
+const ROUTE_ORDER = ["time", "risk", "distance"];
+const ROBOT_FLAGS = ["mass", "leg-radius", "leg-width", "hip-height", "leg-speed", "stance-legs", "response-time"];
+const SPEC_KEYS = {
+  mass: "mass_kg", "leg-radius": "leg_radius_m", "leg-width": "leg_width_m", "hip-height": "hip_height_m",
+  "leg-speed": "leg_speed_rad_s", "stance-legs": "stance_legs", "response-time": "response_time_s",
+};
+const SVGNS = "http://www.w3.org/2000/svg";
 const $ = (id) => document.getElementById(id);
-async function api(command, params) {
-  const q = new URLSearchParams(params).toString();
-  const r = await fetch(`/api/${command}?${q}`);
-  return r.json();
+const pageUrl = new URLSearchParams(location.search);
+
+// ---- the page log: errors, and every URL the page loaded (read by the browser tests) ----
+const errors = [];
+function logError(message) {
+  errors.push(String(message));
+  $("log-errors").textContent = errors.join("\n");
 }
-async function update() {
-  const slope = $("slope").value;
-  $("slope-out").textContent = slope;
-  const e = await api("predict", { slope });
-  $("speed").textContent = e.speed_m_s == null ? "-" : (e.speed_m_s * 100).toFixed(2);
+window.addEventListener("error", (e) => logError(`error: ${e.message}`));
+window.addEventListener("unhandledrejection", (e) => logError(`unhandled: ${e.reason && (e.reason.stack || e.reason)}`));
+document.addEventListener("securitypolicyviolation", (e) => logError(`blocked: ${e.blockedURI}`));
+function logResources() {
+  $("log-resources").textContent = performance.getEntriesByType("resource").map((r) => r.name).join("\n");
 }
-$("slope").addEventListener("input", update);
-update();
+
+// ---- requests ----
+class RequestError extends Error {
+  constructor(message, field) {
+    super(message);
+    this.field = field;
+  }
+}
+let inFlight = 0;
+function busy(delta) {
+  inFlight += delta;
+  document.body.dataset.busy = String(inFlight);
+}
+function query(params) {
+  return new URLSearchParams(params).toString();
+}
+async function get(path, params) {
+  const q = params ? query(params) : "";
+  busy(1);
+  try {
+    const response = await fetch(q ? `${path}?${q}` : path);
+    const body = await response.json();
+    if (!response.ok) throw new RequestError(body.error || response.statusText, body.field);
+    return body;
+  } finally {
+    busy(-1);
+  }
+}
+// Draws the answer to the latest request of `key` only; a bad input is shown in the status
+// line (it is the user's to fix), anything else is a page error.
+const tickets = {};
+const statuses = {};
+function setStatus(key, text) {
+  statuses[key] = text;
+  $("status").textContent = Object.values(statuses).filter(Boolean).join(" · ");
+}
+async function fresh(key, fetcher, draw) {
+  const ticket = (tickets[key] = (tickets[key] || 0) + 1);
+  try {
+    const data = await fetcher();
+    if (ticket !== tickets[key]) return;
+    setStatus(key, "");
+    draw(data);
+  } catch (e) {
+    if (ticket !== tickets[key]) return;
+    if (e instanceof RequestError) setStatus(key, `${key}: ${e.message}`);
+    else logError(`${key}: ${e.stack || e}`);
+  } finally {
+    logResources();
+  }
+}
+const timers = {};
+function soon(key, fn, ms = 80) {
+  clearTimeout(timers[key]);
+  timers[key] = setTimeout(fn, ms);
+}
+
+// ---- state ----
+const state = {
+  served: null,
+  causes: {},
+  defaults: {},
+  level: null, // the served terrain at 0 deg: fixes the phase diagram's axes
+  sweep: null,
+  phase: null,
+  point: null,
+  visited: { explore: true, risk: false, routes: false },
+  dem: null,
+  overlay: null,
+  start: null,
+  goal: null,
+  routes: null,
+};
+
+// ---- flags from the controls ----
+function robotFlags() {
+  const q = {};
+  if ($("robot").value) q.robot = $("robot").value;
+  if ($("terrain").value) q.terrain = $("terrain").value;
+  for (const flag of ROBOT_FLAGS) {
+    const v = $(flag).value.trim();
+    if (v !== "" && v !== state.defaults[flag]) q[flag] = v;
+  }
+  return q;
+}
+function ksValue() {
+  return Number(10 ** Number($("k-s-slider").value)).toPrecision(4);
+}
+function exploreFlags() {
+  const q = robotFlags();
+  if ($("k-s-on").checked) q["k-s"] = ksValue();
+  return q;
+}
+function uncertaintyFlags() {
+  if ($("cv-auto").checked) return {};
+  return { "cv-n": $("cv-n").value, "cv-s": $("cv-s").value };
+}
+function slope() {
+  return $("slope").value;
+}
+
+// ---- SVG helpers ----
+function el(name, attrs, parent) {
+  const e = document.createElementNS(SVGNS, name);
+  for (const [k, v] of Object.entries(attrs || {})) e.setAttribute(k, v);
+  if (parent) parent.appendChild(e);
+  return e;
+}
+function text(parent, x, y, s, attrs) {
+  const t = el("text", { x, y, ...(attrs || {}) }, parent);
+  t.textContent = s;
+  return t;
+}
+function linear(d0, d1, r0, r1) {
+  const f = (v) => r0 + ((v - d0) / (d1 - d0 || 1)) * (r1 - r0);
+  f.domain = [d0, d1];
+  return f;
+}
+function niceTicks(lo, hi, n) {
+  const span = hi - lo || 1;
+  const step0 = span / n;
+  const mag = 10 ** Math.floor(Math.log10(step0));
+  const step = [1, 2, 5, 10].map((m) => m * mag).find((s) => span / s <= n) || 10 * mag;
+  const ticks = [];
+  for (let v = Math.ceil(lo / step) * step; v <= hi + 1e-9 * span; v += step) ticks.push(Number(v.toPrecision(12)));
+  return ticks;
+}
+// A frame with axes: returns the plot area and scales.
+function frame(svg, xDomain, yDomain, xLabel, yLabel, margin) {
+  svg.replaceChildren();
+  const m = margin || { l: 58, r: 14, t: 10, b: 42 };
+  const w = Number(svg.getAttribute("width"));
+  const h = Number(svg.getAttribute("height"));
+  const x = linear(xDomain[0], xDomain[1], m.l, w - m.r);
+  const y = linear(yDomain[0], yDomain[1], h - m.b, m.t);
+  el("rect", { x: m.l, y: m.t, width: w - m.l - m.r, height: h - m.t - m.b, fill: "#fff", stroke: "#aab" }, svg);
+  for (const t of niceTicks(xDomain[0], xDomain[1], 8)) {
+    el("line", { x1: x(t), x2: x(t), y1: h - m.b, y2: h - m.b + 4, stroke: "#333" }, svg);
+    el("line", { x1: x(t), x2: x(t), y1: m.t, y2: h - m.b, stroke: "#eef" }, svg);
+    text(svg, x(t), h - m.b + 16, String(t), { "text-anchor": "middle" });
+  }
+  for (const t of niceTicks(yDomain[0], yDomain[1], 6)) {
+    el("line", { x1: m.l - 4, x2: m.l, y1: y(t), y2: y(t), stroke: "#333" }, svg);
+    el("line", { x1: m.l, x2: w - m.r, y1: y(t), y2: y(t), stroke: "#eef" }, svg);
+    text(svg, m.l - 7, y(t) + 4, String(t), { "text-anchor": "end" });
+  }
+  text(svg, (m.l + w - m.r) / 2, h - 8, xLabel, { "text-anchor": "middle" });
+  text(svg, 14, (m.t + h - m.b) / 2, yLabel, { "text-anchor": "middle", transform: `rotate(-90 14 ${(m.t + h - m.b) / 2})` });
+  return { x, y, m, w, h };
+}
+function fmt(v, digits) {
+  return v === null || v === undefined ? "-" : Number(v).toFixed(digits);
+}
+
+// ---- Explore ----
+function showPrediction(e) {
+  const badge = $("regime");
+  badge.textContent = e.regime;
+  badge.style.background = COLOURS[e.regime];
+  const speed = $("speed");
+  if (e.speed_m_s !== null) speed.textContent = fmt(e.speed_m_s * 100, 2);
+  else if (e.model_speed_m_s !== null) speed.textContent = `(${fmt(e.model_speed_m_s * 100, 2)})`;
+  else speed.textContent = "-";
+  speed.dataset.speedMS = String(e.speed_m_s);
+  speed.dataset.slopeDeg = String(e.slope_deg);
+  $("t1").textContent = e.t1_s === null ? "-" : fmt(e.t1_s * 1e3, 1);
+  $("slip").textContent = e.slip_m === null ? "-" : fmt(e.slip_m * 1e3, 2);
+  $("step").textContent = e.step_m === null ? "-" : fmt(e.step_m * 1e3, 2);
+  $("margin").textContent = fmt(e.k_s_margin, 2);
+  let cause = `${e.cause.replaceAll("_", " ")}: ${state.causes[e.cause] || ""}`;
+  if (e.speed_m_s === null && e.model_speed_m_s !== null) {
+    cause += ". The speed in parentheses is the stance model's, which this regime rules out.";
+  }
+  if (e.extrapolated) cause += " (k_n and k_s extrapolated beyond the terrain's last measured slope)";
+  $("cause").textContent = cause;
+  state.point = e;
+  drawSweep();
+  drawPhaseMarker();
+}
+function updatePredict() {
+  const q = { ...exploreFlags(), slope: slope() };
+  return fresh("predict", () => get("/api/predict", q), showPrediction);
+}
+function updateSweep() {
+  const q = { ...exploreFlags(), from: "-30", to: "40", step: "0.5" };
+  return fresh("sweep", () => get("/api/sweep", q), (rows) => {
+    state.sweep = rows;
+    drawSweep();
+  });
+}
+function drawSweep() {
+  const rows = state.sweep;
+  if (!rows) return;
+  const svg = $("sweep-chart");
+  const speeds = rows.map((r) => (r.speed_m_s === null ? null : r.speed_m_s * 100));
+  const finite = speeds.filter((v) => v !== null);
+  const top = Math.max(1, ...finite);
+  const bottom = Math.min(0, ...finite);
+  const f = frame(svg, [-30, 40], [bottom, top * 1.08], "slope (deg)", "speed (cm/s)");
+  el("line", { x1: f.x(-30), x2: f.x(40), y1: f.y(0), y2: f.y(0), stroke: "#999" }, svg);
+  for (let i = 1; i < rows.length; i++) {
+    if (speeds[i - 1] === null || speeds[i] === null) continue;
+    el("line", {
+      x1: f.x(rows[i - 1].slope_deg), y1: f.y(speeds[i - 1]), x2: f.x(rows[i].slope_deg), y2: f.y(speeds[i]),
+      stroke: COLOURS[rows[i].regime], "stroke-width": 3,
+    }, svg);
+  }
+  const p = state.point;
+  if (p) {
+    el("line", { x1: f.x(p.slope_deg), x2: f.x(p.slope_deg), y1: f.m.t, y2: f.h - f.m.b, stroke: "#333", "stroke-dasharray": "4 3" }, svg);
+    if (p.speed_m_s !== null) {
+      el("circle", { cx: f.x(p.slope_deg), cy: f.y(p.speed_m_s * 100), r: 6, fill: COLOURS[p.regime], stroke: "#000", "stroke-width": 2, id: "sweep-marker" }, svg);
+    }
+  }
+}
+function phaseAxes() {
+  const { k_n, k_s } = state.level;
+  return { kn: [k_n / 100, k_n * 100], ks: [k_s / 1000, k_s * 100], n: 160 };
+}
+function updatePhase() {
+  if (!state.level) return undefined;
+  const a = phaseAxes();
+  const q = { ...robotFlags(), slope: slope(), "k-n": `${a.kn[0]}:${a.kn[1]}:${a.n}`, "k-s": `${a.ks[0]}:${a.ks[1]}:${a.n}` };
+  return fresh("phase", () => get("/data/phase-map", q), (map) => {
+    state.phase = map;
+    drawPhase();
+  });
+}
+function drawPhase() {
+  const map = state.phase;
+  if (!map) return;
+  const canvas = $("phase-canvas");
+  const nx = map.k_n.length;
+  const ny = map.k_s.length;
+  canvas.width = nx;
+  canvas.height = ny;
+  const ctx = canvas.getContext("2d");
+  const img = ctx.createImageData(nx, ny);
+  const rgb = CODES.map((c) => [1, 3, 5].map((i) => parseInt(COLOURS[c].slice(i, i + 2), 16)));
+  for (let j = 0; j < ny; j++) {
+    for (let i = 0; i < nx; i++) {
+      const c = rgb[map.regimes.charCodeAt(j * nx + i) - 48];
+      const o = ((ny - 1 - j) * nx + i) * 4;
+      img.data.set([c[0], c[1], c[2], 255], o);
+    }
+  }
+  ctx.putImageData(img, 0, 0);
+  drawPhaseMarker();
+}
+function drawPhaseMarker() {
+  const map = state.phase;
+  if (!map) return;
+  const svg = $("phase-axes");
+  const lx = [Math.log10(map.k_n[0]), Math.log10(map.k_n[map.k_n.length - 1])];
+  const ly = [Math.log10(map.k_s[0]), Math.log10(map.k_s[map.k_s.length - 1])];
+  svg.replaceChildren();
+  const x = linear(lx[0], lx[1], 60, 400);
+  const y = linear(ly[0], ly[1], 270, 10);
+  el("rect", { x: 60, y: 10, width: 340, height: 260, fill: "none", stroke: "#333" }, svg);
+  for (let d = Math.ceil(lx[0]); d <= lx[1]; d++) {
+    el("line", { x1: x(d), x2: x(d), y1: 270, y2: 275, stroke: "#333" }, svg);
+    text(svg, x(d), 288, `1e${d}`, { "text-anchor": "middle" });
+  }
+  for (let d = Math.ceil(ly[0]); d <= ly[1]; d++) {
+    el("line", { x1: 55, x2: 60, y1: y(d), y2: y(d), stroke: "#333" }, svg);
+    text(svg, 52, y(d) + 4, `1e${d}`, { "text-anchor": "end" });
+  }
+  text(svg, 230, 312, "normal resistance k_n (N/m³)", { "text-anchor": "middle" });
+  text(svg, 12, 140, "shear strength k_s (N/m³)", { "text-anchor": "middle", transform: "rotate(-90 12 140)" });
+  const p = state.point;
+  if (p && p.k_n > 0 && p.k_s > 0) {
+    const cx = x(Math.log10(p.k_n));
+    const cy = y(Math.log10(p.k_s));
+    el("circle", { cx, cy, r: 7, fill: "none", stroke: "#000", "stroke-width": 2.5, id: "phase-marker" }, svg);
+    el("circle", { cx, cy, r: 2, fill: "#000" }, svg);
+  }
+}
+function updateExplore() {
+  updatePredict();
+  updatePhase();
+}
+
+// ---- Risk ----
+function riskFlags() {
+  return { ...robotFlags(), ...uncertaintyFlags(), "max-risk": $("max-risk").value };
+}
+function updateRisk() {
+  const q = riskFlags();
+  fresh("risk", async () => {
+    const [curve, limit] = await Promise.all([
+      get("/api/risk", { ...q, slope: "0:30:31" }),
+      get("/api/risk", { ...q, solve: "slope" }),
+    ]);
+    return { curve, limit };
+  }, drawRisk);
+  fresh("envelope", () => get("/api/risk", { ...q, solve: "mass", slope: "0:30:7" }), drawEnvelope);
+}
+function drawRisk({ curve, limit }) {
+  const svg = $("risk-chart");
+  const f = frame(svg, [0, 30], [0, 1], "slope (deg)", "p_fail");
+  const pts = curve.map((r) => `${f.x(r.slope_deg)},${f.y(r.p_fail)}`).join(" ");
+  el("polyline", { points: pts, fill: "none", stroke: COLOURS.slippage, "stroke-width": 2.5 }, svg);
+  for (const r of curve) el("circle", { cx: f.x(r.slope_deg), cy: f.y(r.p_fail), r: 2.5, fill: COLOURS.slippage }, svg);
+  const maxRisk = limit.max_risk;
+  el("line", { x1: f.x(0), x2: f.x(30), y1: f.y(maxRisk), y2: f.y(maxRisk), stroke: "#555", "stroke-dasharray": "2 3" }, svg);
+  text(svg, f.x(0.5), f.y(maxRisk) - 4, `max risk ${maxRisk}`);
+  const safe = limit.safe_slope_deg;
+  let summary;
+  if (safe !== null && safe <= 30) {
+    el("line", { x1: f.x(safe), x2: f.x(safe), y1: f.m.t, y2: f.h - f.m.b, stroke: "#000", "stroke-width": 2, "stroke-dasharray": "6 4", id: "safe-slope" }, svg);
+    text(svg, f.x(safe) + 4, f.m.t + 14, `safe up to ${safe.toFixed(2)} deg`);
+  }
+  if (limit.limit.kind === "limit") summary = `safe-slope limit: p_fail < ${maxRisk} up to ${safe.toFixed(3)} deg`;
+  else if (limit.limit.kind === "none_safe") summary = `no slope is safe: p_fail = ${limit.limit.p_fail.toFixed(4)} already on level ground`;
+  else summary = `p_fail < ${maxRisk} at every slope searched (up to ${limit.limit.up_to} deg)`;
+  const first = curve[0];
+  summary += `; CVs used: k_n ${first.cv_n.toFixed(3)} (${first.cv_n_source}), k_s ${first.cv_s.toFixed(3)} (${first.cv_s_source}) at level`;
+  $("risk-summary").textContent = summary;
+  $("risk-summary").dataset.safeSlopeDeg = String(safe);
+  if ($("cv-auto").checked) {
+    $("cv-n-out").textContent = first.cv_n.toFixed(3);
+    $("cv-s-out").textContent = first.cv_s.toFixed(3);
+  }
+}
+function drawEnvelope(env) {
+  const svg = $("envelope-chart");
+  const payloads = env.points.map((p) => p.max_payload_kg).filter((v) => v !== null);
+  const top = Math.max(0.1, ...payloads);
+  const f = frame(svg, [0, 30], [Math.min(0, ...payloads), top * 1.1], "slope (deg)", "heaviest safe payload (kg)");
+  let path = "";
+  for (const p of env.points) {
+    if (p.max_payload_kg === null) continue;
+    path += `${f.x(p.slope_deg)},${f.y(p.max_payload_kg)} `;
+    el("circle", { cx: f.x(p.slope_deg), cy: f.y(p.max_payload_kg), r: 3.5, fill: COLOURS.sinkage }, svg);
+  }
+  el("polyline", { points: path.trim(), fill: "none", stroke: COLOURS.sinkage, "stroke-width": 2.5 }, svg);
+  text(svg, f.w - 20, f.m.t + 14, `robot ${env.robot_mass_kg} kg, max risk ${env.max_risk}`, { "text-anchor": "end" });
+}
+
+// ---- Routes ----
+function planFlags() {
+  const objectives = ["time", "risk"].filter((o) => $(`obj-${o}`).checked);
+  return {
+    ...robotFlags(), ...uncertaintyFlags(), "max-roll": $("max-roll").value,
+    objective: objectives.length ? objectives.join(",") : "distance",
+  };
+}
+async function loadMap() {
+  if (!state.served.dem) {
+    $("routes-hint").textContent = "No elevation model: start the server with --dem FILE to plan routes.";
+    return;
+  }
+  await fresh("dem", () => get("/data/dem"), (dem) => {
+    state.dem = dem;
+    const canvas = $("map");
+    const w = Math.ceil(dem.cols / dem.stride);
+    const h = Math.ceil(dem.rows / dem.stride);
+    const scale = Math.max(1, Math.floor(600 / Math.max(w, h)));
+    Object.assign(state.dem, { w, h, scale });
+    canvas.width = w * scale;
+    canvas.height = h * scale;
+    state.hillshade = hillshade(dem, w, h);
+    drawMap();
+  });
+  updateOverlay();
+}
+function hillshade(dem, w, h) {
+  const info = state.served.dem;
+  const dx = info.cell_x * dem.stride;
+  const dy = info.cell_y * dem.stride;
+  const z = (c, r) => {
+    const cc = Math.min(w - 1, Math.max(0, c));
+    const rr = Math.min(h - 1, Math.max(0, r));
+    return dem.values[rr * w + cc];
+  };
+  const shade = new Float32Array(w * h);
+  const az = (315 * Math.PI) / 180;
+  const alt = (45 * Math.PI) / 180;
+  for (let r = 0; r < h; r++) {
+    for (let c = 0; c < w; c++) {
+      const here = z(c, r);
+      if (here === null) {
+        shade[r * w + c] = NaN;
+        continue;
+      }
+      const e = z(c + 1, r) ?? here;
+      const wv = z(c - 1, r) ?? here;
+      const n = z(c, r - 1) ?? here;
+      const s = z(c, r + 1) ?? here;
+      // relief exaggerated 3 x, so low dunes show
+      const gx = (3 * (e - wv)) / (2 * dx);
+      const gy = (3 * (n - s)) / (2 * dy);
+      const slopeAngle = Math.atan(Math.hypot(gx, gy));
+      const aspect = Math.atan2(gx, gy);
+      shade[r * w + c] = Math.max(0, Math.sin(alt) * Math.cos(slopeAngle) + Math.cos(alt) * Math.sin(slopeAngle) * Math.cos(az - aspect + Math.PI));
+    }
+  }
+  return shade;
+}
+// The overlay's colour and weight for a p_fail: invisible below 1e-6, then yellow to red on a
+// log scale up to 1 (most of a dune is safe; what matters is where it is not).
+function rampRisk(p) {
+  const t = Math.min(1, Math.max(0, (Math.log10(Math.max(p, 1e-12)) + 6) / 6));
+  return { rgb: [255, 220 - 200 * t, 40], alpha: t === 0 ? 0 : 0.25 + 0.6 * t };
+}
+function drawMap() {
+  const dem = state.dem;
+  if (!dem) return;
+  const canvas = $("map");
+  const ctx = canvas.getContext("2d");
+  const { w, h, scale } = dem;
+  const img = ctx.createImageData(w, h);
+  const overlay = $("rule").value === "none" ? null : state.overlay;
+  for (let i = 0; i < w * h; i++) {
+    const s = state.hillshade[i];
+    let rgb = Number.isNaN(s) ? [255, 255, 255] : [40 + 200 * s, 40 + 200 * s, 40 + 200 * s];
+    if (overlay && overlay.values[i] !== null && !Number.isNaN(s)) {
+      const { rgb: c, alpha } = rampRisk(overlay.values[i]);
+      rgb = rgb.map((v, k) => (1 - alpha) * v + alpha * c[k]);
+    }
+    img.data.set([rgb[0], rgb[1], rgb[2], 255], i * 4);
+  }
+  const off = document.createElement("canvas");
+  off.width = w;
+  off.height = h;
+  off.getContext("2d").putImageData(img, 0, 0);
+  ctx.imageSmoothingEnabled = false;
+  ctx.drawImage(off, 0, 0, w * scale, h * scale);
+  drawRoutes(ctx);
+}
+function cellToPixel(col, row) {
+  const { stride, scale } = state.dem;
+  return [(col / stride) * scale + scale / 2, (row / stride) * scale + scale / 2];
+}
+function drawRoutes(ctx) {
+  const info = state.served.dem;
+  if (state.routes) {
+    const order = (f) => ROUTE_ORDER.indexOf(f.properties.objective);
+    for (const feature of [...state.routes.features].sort((a, b) => order(a) - order(b))) {
+      const name = feature.properties.objective;
+      ctx.strokeStyle = ROUTE_COLOURS[name] || "#000";
+      // time under risk under distance, so coinciding routes all show
+      ctx.lineWidth = { time: 7, risk: 3, distance: 2 }[name] || 3;
+      ctx.setLineDash(name === "distance" ? [6, 4] : []);
+      ctx.beginPath();
+      feature.geometry.coordinates.forEach(([x, y], i) => {
+        const [px, py] = cellToPixel((x - info.west) / info.cell_x - 0.5, (info.north - y) / info.cell_y - 0.5);
+        if (i === 0) ctx.moveTo(px, py);
+        else ctx.lineTo(px, py);
+      });
+      ctx.stroke();
+    }
+    ctx.setLineDash([]);
+  }
+  for (const [cell, colour, label] of [[state.start, "#fff", "S"], [state.goal, "#000", "G"]]) {
+    if (!cell) continue;
+    const [px, py] = cellToPixel(cell[0], cell[1]);
+    ctx.fillStyle = colour;
+    ctx.strokeStyle = colour === "#fff" ? "#000" : "#fff";
+    ctx.lineWidth = 2;
+    ctx.beginPath();
+    ctx.arc(px, py, 7, 0, 2 * Math.PI);
+    ctx.fill();
+    ctx.stroke();
+    ctx.fillStyle = colour === "#fff" ? "#000" : "#fff";
+    ctx.font = "bold 10px sans-serif";
+    ctx.textAlign = "center";
+    ctx.fillText(label, px, py + 3.5);
+  }
+}
+function updateOverlay() {
+  if (!state.dem || $("rule").value === "none") {
+    drawMap();
+    return;
+  }
+  const q = { ...planFlags(), rule: $("rule").value };
+  delete q.objective;
+  fresh("overlay", () => get("/data/risk-map", q), (grid) => {
+    state.overlay = grid;
+    drawMap();
+  });
+}
+function onMapClick(event) {
+  if (!state.dem) return;
+  const rect = $("map").getBoundingClientRect();
+  const { stride, scale, cols, rows } = state.dem;
+  const col = Math.min(cols - 1, Math.floor((event.clientX - rect.left) / scale) * stride);
+  const row = Math.min(rows - 1, Math.floor((event.clientY - rect.top) / scale) * stride);
+  if (!state.start || state.goal) {
+    state.start = [col, row];
+    state.goal = null;
+    state.routes = null;
+    $("routes-table").tBodies[0].replaceChildren();
+    $("downloads").replaceChildren();
+    $("routes-hint").textContent = `start: column ${col}, row ${row}. Click the goal.`;
+  } else {
+    state.goal = [col, row];
+    $("routes-hint").textContent = `start: column ${state.start[0]}, row ${state.start[1]}; goal: column ${col}, row ${row}.`;
+    updatePlan();
+  }
+  drawMap();
+}
+function updatePlan() {
+  if (!state.start || !state.goal) return;
+  const q = { ...planFlags(), "start-px": state.start.join(","), "goal-px": state.goal.join(",") };
+  fresh("plan", async () => {
+    const [json, geojson] = await Promise.all([get("/api/plan", q), get("/download/plan.geojson", q)]);
+    return { json, geojson };
+  }, ({ json, geojson }) => {
+    state.routes = geojson;
+    drawTable(json);
+    drawMap();
+    const links = $("downloads");
+    links.replaceChildren();
+    for (const [file, label] of [["plan.geojson", "routes (GeoJSON)"], ["risk-map.tif", "risk map (GeoTIFF: p_fail, climb azimuth)"]]) {
+      const a = document.createElement("a");
+      a.href = `/download/${file}?${query(q)}`;
+      a.download = file;
+      a.textContent = `download ${label}`;
+      links.append(a, " ");
+    }
+  });
+}
+// The routes table as `plan` prints it.
+function drawTable(json) {
+  const body = $("routes-table").tBodies[0];
+  body.replaceChildren();
+  for (const name of ROUTE_ORDER) {
+    const r = json.routes[name];
+    if (!r) continue;
+    const tr = document.createElement("tr");
+    tr.dataset.objective = name;
+    let cells;
+    if (r.found) {
+      tr.dataset.lengthM = String(r.length_m);
+      const regimes = CODES.filter((c) => r.regimes[c] > 0).map((c) => `${c} ${r.regimes[c]}`);
+      if (r.edges_over_roll_limit > 0) regimes.push(`over roll limit ${r.edges_over_roll_limit}`);
+      cells = [name, "yes", fmt(r.length_m, 1), fmt(r.time_s, 1), fmt(r.survival, 4), fmt(r.max_pitch_deg, 1), fmt(r.max_roll_deg, 1), regimes.join(", ")];
+    } else {
+      cells = [name, "no", "-", "-", "-", "-", "-", r.message];
+    }
+    cells.forEach((c, i) => {
+      const td = document.createElement("td");
+      td.textContent = c;
+      if (i === 0) {
+        const swatch = document.createElement("span");
+        swatch.style.cssText = `display:inline-block;width:1.2em;height:0.25em;margin-right:0.4em;vertical-align:middle;background:${ROUTE_COLOURS[name]}`;
+        td.prepend(swatch);
+      }
+      tr.appendChild(td);
+    });
+    body.appendChild(tr);
+  }
+}
+
+// ---- wiring ----
+function showTab(name) {
+  for (const b of document.querySelectorAll("#tabs button")) b.classList.toggle("active", b.dataset.tab === name);
+  for (const s of document.querySelectorAll(".tab")) s.classList.toggle("active", s.id === name);
+  if (!state.visited[name]) {
+    state.visited[name] = true;
+    if (name === "risk") updateRisk();
+    if (name === "routes") state.mapReady = loadMap();
+  }
+}
+function onRobotChange() {
+  soon("robot", () => {
+    updateSweep();
+    updateExplore();
+    if (state.visited.risk) updateRisk();
+    if (state.visited.routes) {
+      updateOverlay();
+      updatePlan();
+    }
+  });
+}
+function syncMassSlider() {
+  const m = Number($("mass").value);
+  if (m > 0) $("mass-slider").value = String(Math.log10(m));
+}
+function setSlope(value) {
+  $("slope").value = value;
+  $("slope-num").value = value;
+  $("slope").dispatchEvent(new Event("input"));
+}
+
+async function start() {
+  const served = await get("/data/served");
+  state.served = served;
+  state.causes = Object.fromEntries(served.causes);
+  for (const [id, list, current] of [["robot", served.robots, served.robot_name], ["terrain", served.terrains, served.terrain_name]]) {
+    const select = $(id);
+    select.append(new Option(`${current} (served)`, ""));
+    for (const name of list) if (name !== current) select.append(new Option(name, name));
+  }
+  for (const flag of ROBOT_FLAGS) {
+    state.defaults[flag] = String(served.robot[SPEC_KEYS[flag]]);
+    $(flag).value = state.defaults[flag];
+  }
+  syncMassSlider();
+  for (const c of CODES) {
+    const swatch = document.createElement("span");
+    swatch.style.background = COLOURS[c];
+    $("legend").append(swatch, c);
+  }
+  // The phase diagram's axes: the served terrain's level (k_n, k_s) / 100 (/ 1000) to x 100, as `phase`'s defaults.
+  state.level = await get("/api/predict", { slope: "0" });
+  $("k-s-slider").value = String(Math.log10(state.level.k_s));
+  $("k-s-out").textContent = ksValue();
+
+  for (const b of document.querySelectorAll("#tabs button")) b.addEventListener("click", () => showTab(b.dataset.tab));
+  $("slope").addEventListener("input", () => {
+    $("slope-num").value = $("slope").value;
+    soon("explore", updateExplore, 30);
+  });
+  $("slope-num").addEventListener("change", () => setSlope($("slope-num").value));
+  $("mass-slider").addEventListener("input", () => {
+    $("mass").value = Number(10 ** Number($("mass-slider").value)).toPrecision(3);
+    onRobotChange();
+  });
+  $("mass").addEventListener("change", () => {
+    syncMassSlider();
+    onRobotChange();
+  });
+  for (const id of [...ROBOT_FLAGS.filter((f) => f !== "mass"), "robot", "terrain"]) $(id).addEventListener("change", onRobotChange);
+  $("k-s-on").addEventListener("change", () => {
+    $("k-s-slider").disabled = !$("k-s-on").checked;
+    onRobotChange();
+  });
+  $("k-s-slider").addEventListener("input", () => {
+    $("k-s-out").textContent = ksValue();
+    soon("ks", () => {
+      updateSweep();
+      updatePredict();
+    });
+  });
+  $("cv-auto").addEventListener("change", () => {
+    $("cv-n").disabled = $("cv-s").disabled = $("cv-auto").checked;
+    onRobotChange();
+  });
+  $("cv-n").disabled = $("cv-s").disabled = true;
+  for (const id of ["cv-n", "cv-s"]) {
+    $(id).addEventListener("input", () => {
+      $(`${id}-out`).textContent = $(id).value;
+      soon("cv", onRobotChange);
+    });
+  }
+  $("max-risk").addEventListener("change", onRobotChange);
+  $("rule").addEventListener("change", updateOverlay);
+  for (const id of ["obj-time", "obj-risk"]) $(id).addEventListener("change", updatePlan);
+  $("max-roll").addEventListener("change", () => {
+    updateOverlay();
+    updatePlan();
+  });
+  $("map").addEventListener("click", onMapClick);
+
+  // The page's URL can set what a user would: ?slope=20, ?tab=risk, ?mass=1.2,
+  // ?tab=routes&start-px=COL,ROW&goal-px=COL,ROW (clicked on the map once it is drawn).
+  for (const flag of ROBOT_FLAGS) if (pageUrl.has(flag)) $(flag).value = pageUrl.get(flag);
+  syncMassSlider();
+  updateSweep();
+  await updateExplore();
+  // ?slope= moves the slider as a user would (an input event), after the first answer is shown.
+  if (pageUrl.has("slope")) setSlope(pageUrl.get("slope"));
+  const tab = pageUrl.get("tab");
+  if (tab === "risk" || tab === "routes") showTab(tab);
+  if (tab === "routes" && pageUrl.has("start-px") && pageUrl.has("goal-px")) {
+    await state.mapReady;
+    for (const key of ["start-px", "goal-px"]) {
+      const [col, row] = pageUrl.get(key).split(",").map(Number);
+      const rect = $("map").getBoundingClientRect();
+      const [px, py] = cellToPixel(col, row);
+      $("map").dispatchEvent(new MouseEvent("click", { clientX: rect.left + px, clientY: rect.top + py, bubbles: true }));
+    }
+  }
+}
+start().catch((e) => logError(`start: ${e.stack || e}`));

@@ -11,7 +11,10 @@ use predicates::str::contains;
 use sandslope::gait::synthetic::StepProfile;
 use std::path::Path;
 
-use common::{assert_shows_content, chromium_or_skip, motive, plain_mm, sandslope, trajectory_seeded, write, CHROMIUM_FLAGS};
+use common::{
+    assert_shows_content, chromium_or_skip, motive, plain_mm, sandslope, trajectory_seeded, write,
+    CHROMIUM_FLAGS,
+};
 
 /// The page's figure elements; fig6 holds the panels fig6a-d (anchored inside it).
 const PAGE_IDS: [&str; 8] = ["fig3a", "fig4d", "fig4h", "fig5b", "fig5c", "fig6", "risk", "calibration"];

@@ -166,7 +166,11 @@ fn phase_endpoint_equals_phase_json() {
 fn plan_endpoint_and_downloads_equal_plans_json_and_files() {
     let dem = repo_file("examples/planning/dune.asc").to_string_lossy().into_owned();
     let server = Server::start(&["--dem", &dem]);
-    let flags = [("start-px", "40,100".to_string()), ("goal-px", "160,100".into()), ("objective", "time,risk".into())];
+    let flags = [
+        ("start-px", "40,100".to_string()),
+        ("goal-px", "160,100".into()),
+        ("objective", "time,risk".into()),
+    ];
     let (path, mut argv) = both("plan", &flags);
     let (status, body) = server.get(&path);
     assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
@@ -174,7 +178,10 @@ fn plan_endpoint_and_downloads_equal_plans_json_and_files() {
     assert_eq!(body, cli_stdout(&argv));
     // No route (the goal on the lee face's nodata patch is refused as plan refuses it).
     let (status, body) = server.get("/api/plan?start-px=40,100&goal-px=140,50");
-    let cli = sandslope().args(["plan", "--dem", &dem, "--start-px", "40,100", "--goal-px", "140,50", "--json"]).output().unwrap();
+    let cli = sandslope()
+        .args(["plan", "--dem", &dem, "--start-px", "40,100", "--goal-px", "140,50", "--json"])
+        .output()
+        .unwrap();
     assert_eq!(status == 200, cli.status.success(), "{}", String::from_utf8_lossy(&body));
     // The files plan writes, byte for byte.
     let dir = tempfile::tempdir().unwrap();
@@ -191,9 +198,14 @@ fn plan_endpoint_and_downloads_equal_plans_json_and_files() {
     let (status, body) = server.get("/data/risk-map?rule=best");
     assert_eq!(status, 200);
     let v: serde_json::Value = serde_json::from_slice(&body).unwrap();
-    assert_eq!((v["cols"].as_u64(), v["rows"].as_u64(), v["stride"].as_u64()), (Some(200), Some(200), Some(1)));
+    assert_eq!(
+        (v["cols"].as_u64(), v["rows"].as_u64(), v["stride"].as_u64()),
+        (Some(200), Some(200), Some(1))
+    );
     let mut decoder = tiff::decoder::Decoder::new(std::fs::File::open(&tif).unwrap()).unwrap();
-    let tiff::decoder::DecodingResult::F32(bands) = decoder.read_image().unwrap() else { panic!("not float32") };
+    let tiff::decoder::DecodingResult::F32(bands) = decoder.read_image().unwrap() else {
+        panic!("not float32")
+    };
     let overlay = v["values"].as_array().unwrap();
     assert_eq!(bands.len(), 2 * overlay.len());
     let mut passable = 0;
@@ -309,7 +321,12 @@ fn hostile_requests_get_a_4xx_naming_the_field_or_limit() {
 /// are done, and every console line the page produced (`--enable-logging` prints them as
 /// `INFO:CONSOLE`). With `screenshot`, takes a screenshot of the same page instead of the DOM
 /// (the DOM is then empty).
-fn browse(browser: &str, server: &Server, path: &str, screenshot: Option<&std::path::Path>) -> (String, Vec<String>) {
+fn browse(
+    browser: &str,
+    server: &Server,
+    path: &str,
+    screenshot: Option<&std::path::Path>,
+) -> (String, Vec<String>) {
     let profile = tempfile::tempdir().unwrap();
     let mut cmd = Command::new(browser);
     cmd.args(common::CHROMIUM_FLAGS)
@@ -370,7 +387,8 @@ fn assert_clean(server: &Server, dom: &str, console: &[String]) {
 
 #[test]
 fn the_page_shows_predicts_speed_after_the_slope_slider_moves() {
-    let Some(browser) = common::chromium_or_skip("the_page_shows_predicts_speed_after_the_slope_slider_moves")
+    let Some(browser) =
+        common::chromium_or_skip("the_page_shows_predicts_speed_after_the_slope_slider_moves")
     else {
         return;
     };
@@ -380,7 +398,9 @@ fn the_page_shows_predicts_speed_after_the_slope_slider_moves() {
         // its first answer at 10 deg.
         let (dom, console) = browse(&browser, &server, &format!("/?slope={slope}"), None);
         assert_clean(&server, &dom, &console);
-        let raw = String::from_utf8(cli_stdout(&["predict".into(), format!("--slope={slope}"), "--json".into()])).unwrap();
+        let raw =
+            String::from_utf8(cli_stdout(&["predict".into(), format!("--slope={slope}"), "--json".into()]))
+                .unwrap();
         let cli: serde_json::Value = serde_json::from_str(&raw).unwrap();
         let shown_slope = attribute(&dom, "id=\"speed\"", "data-slope-deg").expect("no slope on #speed");
         assert_eq!(shown_slope.parse::<f64>().unwrap(), slope.parse::<f64>().unwrap());
@@ -415,15 +435,26 @@ fn clicking_start_and_goal_on_the_example_dem_draws_plans_routes() {
     let page = "/?tab=routes&start-px=40,100&goal-px=160,100";
     let (dom, console) = browse(&browser, &server, page, None);
     assert_clean(&server, &dom, &console);
-    let argv: Vec<String> =
-        ["plan", "--dem", &dem, "--start-px", "40,100", "--goal-px", "160,100", "--objective", "time,risk", "--json"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+    let argv: Vec<String> = [
+        "plan",
+        "--dem",
+        &dem,
+        "--start-px",
+        "40,100",
+        "--goal-px",
+        "160,100",
+        "--objective",
+        "time,risk",
+        "--json",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     let raw = String::from_utf8(cli_stdout(&argv)).unwrap();
     for objective in ["time", "risk", "distance"] {
         let anchor = format!("data-objective=\"{objective}\"");
-        let length = attribute(&dom, &anchor, "data-length-m").unwrap_or_else(|| panic!("no {objective} row"));
+        let length =
+            attribute(&dom, &anchor, "data-length-m").unwrap_or_else(|| panic!("no {objective} row"));
         let section = raw.find(&format!("\"{objective}\": {{")).unwrap();
         assert_eq!(length, raw_number(&raw, "length_m", section), "{objective}");
     }

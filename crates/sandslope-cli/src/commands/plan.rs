@@ -472,7 +472,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
         write_two_band_geotiff(p, dem.cols, dem.rows, &dem.geo, &risk.p_fail, &risk.climb_azimuth_deg)?;
     }
     if let (Some(p), Some(risk)) = (&args.out.plot, &result.risk) {
-        crate::figures::save(p, &PlanFigure::new(&result, &dem.geo, &risk.p_fail))?;
+        crate::figures::save(p, &PlanFigure::new(result, &dem.geo, &risk.p_fail))?;
     }
     if let Some(x) = result.extrapolation {
         eprintln!(

@@ -12,6 +12,36 @@ use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::encoder::{colortype::Gray32Float, compression::DeflateLevel, Compression, TiffEncoder};
 use tiff::tags::{ExtraSamples, Tag};
 
+/// The most cells a raster may have: 2^29 (about 23,000 x 23,000; 4 GiB as f64). The size a
+/// file claims is checked against it before anything is allocated, so a small file that claims
+/// a huge image is refused at once instead of exhausting memory.
+pub const MAX_RASTER_CELLS: usize = 1 << 29;
+
+/// The largest GeoTIFF tag value (GeoKeys, strip offsets, ...) read, in bytes. A tag whose
+/// count claims more is refused before its value is allocated.
+pub const MAX_TIFF_TAG_BYTES: usize = 16 << 20;
+
+/// Refuses a `cols` x `rows` raster with more than [`MAX_RASTER_CELLS`] cells, naming the file.
+fn check_raster_size(name: &dyn std::fmt::Display, cols: u64, rows: u64) -> Result<()> {
+    let cells = cols.saturating_mul(rows);
+    if cells > MAX_RASTER_CELLS as u64 {
+        bail!(
+            "{name}: {cols} x {rows} = {cells} cells is more than the {MAX_RASTER_CELLS}-cell limit \
+             (2^29); crop or resample the raster (for example with gdal_translate -srcwin or -tr)"
+        );
+    }
+    Ok(())
+}
+
+/// The decoder's limits: the image at most [`MAX_RASTER_CELLS`] 8-byte samples, any tag
+/// value at most [`MAX_TIFF_TAG_BYTES`].
+fn tiff_limits() -> Limits {
+    let mut limits = Limits::default();
+    limits.decoding_buffer_size = MAX_RASTER_CELLS * 8;
+    limits.ifd_value_size = MAX_TIFF_TAG_BYTES;
+    limits
+}
+
 /// GeoKey GTRasterTypeGeoKey and its value RasterPixelIsPoint.
 const GT_RASTER_TYPE: u16 = 1025;
 const PIXEL_IS_POINT: u16 = 2;
@@ -93,8 +123,9 @@ fn read_geotiff(path: &Path) -> Result<Raster> {
     let file = File::open(path).with_context(|| format!("cannot read {name}"))?;
     let mut dec = Decoder::new(BufReader::new(file))
         .map_err(|e| anyhow!("{name}: not a readable TIFF: {e}"))?
-        .with_limits(Limits::unlimited());
+        .with_limits(tiff_limits());
     let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
+    check_raster_size(&name, u64::from(w), u64::from(h))?;
     let samples: u16 = dec.find_tag_unsigned(Tag::SamplesPerPixel).ok().flatten().unwrap_or(1);
     if samples != 1 {
         bail!("{name}: has {samples} bands; an elevation or class raster must have exactly 1");
@@ -176,6 +207,11 @@ fn pixel_is_point(keys: Option<&[u16]>) -> bool {
 
 fn read_asc(path: &Path) -> Result<Raster> {
     let name = path.display();
+    let bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
+    // 24 bytes a value is more than any ASCII grid writer uses (`-1234.567890123456789 `).
+    if bytes > MAX_RASTER_CELLS as u64 * 24 {
+        bail!("{name}: {bytes} bytes is larger than an ESRI ASCII grid within the {MAX_RASTER_CELLS}-cell limit");
+    }
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {name}"))?;
     let mut header = std::collections::HashMap::new();
     let mut lines = text.lines().enumerate().peekable();
@@ -207,6 +243,17 @@ fn read_asc(path: &Path) -> Result<Raster> {
         }
     };
     let (cols, rows) = (count("ncols")?, count("nrows")?);
+    check_raster_size(&name, cols as u64, rows as u64)?;
+    // Every value takes at least two bytes (a digit and a separator): a header that claims more
+    // cells than the file can hold is refused before the grid is allocated.
+    if cols.saturating_mul(rows) > text.len() / 2 + 1 {
+        bail!(
+            "{name}: the header claims ncols x nrows = {cols} x {rows} = {} values, but the file has only \
+             {} bytes",
+            cols * rows,
+            text.len()
+        );
+    }
     let (cell_x, cell_y) = match (get("cellsize"), get("dx"), get("dy")) {
         (Some(c), _, _) => (c, c),
         (None, Some(x), Some(y)) => (x, y),
@@ -368,5 +415,94 @@ mod tests {
         let r = fixture("aaigrid.asc");
         check_grid(&r);
         check_values(&r, &[(3, 4), (30, 20)], |c, w| 100.0 + 0.25 * c - 0.5 * w);
+    }
+}
+
+#[cfg(test)]
+mod hostile {
+    //! Files that lie about their size: each is refused by the size it claims, before the
+    //! claimed amount is allocated (without the limits each of these aborts the process).
+    use super::*;
+
+    /// A little-endian classic TIFF of one IFD whose entries are (tag, type, count, value).
+    fn tiff_with(entries: &[(u16, u16, u32, u32)]) -> Vec<u8> {
+        let mut b = b"II*\0".to_vec();
+        b.extend_from_slice(&8u32.to_le_bytes());
+        b.extend_from_slice(&(entries.len() as u16).to_le_bytes());
+        for &(tag, ty, count, value) in entries {
+            b.extend_from_slice(&tag.to_le_bytes());
+            b.extend_from_slice(&ty.to_le_bytes());
+            b.extend_from_slice(&count.to_le_bytes());
+            b.extend_from_slice(&value.to_le_bytes());
+        }
+        b.extend_from_slice(&0u32.to_le_bytes());
+        b.resize(1024, 0);
+        b
+    }
+
+    fn read_bytes(name: &str, bytes: &[u8]) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let started = std::time::Instant::now();
+        let err = read_raster(&path).expect_err("a lying file must be refused");
+        // Refused from the header: no time is spent (or memory allocated) on the claimed size.
+        assert!(started.elapsed().as_secs() < 5);
+        format!("{err:#}")
+    }
+
+    const SHORT: u16 = 3;
+    const LONG: u16 = 4;
+    const DOUBLE: u16 = 12;
+
+    #[test]
+    fn a_1kb_tiff_claiming_3_6e9_cells_is_refused_by_its_dimensions() {
+        let bytes = tiff_with(&[
+            (256, LONG, 1, 60_000), // ImageWidth
+            (257, LONG, 1, 60_000), // ImageLength
+            (258, SHORT, 1, 32),    // BitsPerSample
+            (259, SHORT, 1, 1),     // Compression: none
+            (262, SHORT, 1, 1),     // Photometric
+            (273, LONG, 1, 200),    // StripOffsets
+            (278, LONG, 1, 60_000), // RowsPerStrip
+            (279, LONG, 1, 800),    // StripByteCounts
+            (339, SHORT, 1, 3),     // SampleFormat: float
+        ]);
+        let err = read_bytes("claims.tif", &bytes);
+        assert!(
+            err.contains("claims.tif") && err.contains("3600000000 cells") && err.contains("limit"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_tag_whose_count_claims_gigabytes_is_refused() {
+        let bytes = tiff_with(&[
+            (256, LONG, 1, 10),
+            (257, LONG, 1, 10),
+            (258, SHORT, 1, 32),
+            (259, SHORT, 1, 1),
+            (262, SHORT, 1, 1),
+            (273, LONG, 1, 200),
+            (278, LONG, 1, 10),
+            (279, LONG, 1, 400),
+            (339, SHORT, 1, 3),
+            (33550, DOUBLE, 0x1000_0000, 300), // ModelPixelScale: 2^28 doubles = 2 GiB
+        ]);
+        let err = read_bytes("tag.tif", &bytes);
+        assert!(err.contains("tag.tif") && err.contains("ModelPixelScale") && err.contains("limit"), "{err}");
+    }
+
+    #[test]
+    fn an_ascii_grid_claiming_more_cells_than_its_bytes_is_refused() {
+        let text = "ncols 60000\nnrows 60000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n";
+        let err = read_bytes("big.asc", text.as_bytes());
+        assert!(err.contains("big.asc") && err.contains("limit"), "{err}");
+        let text = "ncols 20000\nnrows 20000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n";
+        let err = read_bytes("lies.asc", text.as_bytes());
+        assert!(
+            err.contains("lies.asc") && err.contains("400000000 values") && err.contains("bytes"),
+            "{err}"
+        );
     }
 }

@@ -3,7 +3,8 @@
 //! Commands return `anyhow::Result`; context added on the way up names the file, key and
 //! valid range. `main` prints the chain on one line per cause and exits with
 //! [`exit_code`]: 2 for bad input (flags, files, values out of range; clap uses 2 for usage
-//! errors too), 3 when an output could not be written (disk full, no permission), and 0,
+//! errors too), 3 when an output could not be written (disk full, no permission), 4 when
+//! `report --strict` wrote a report that carries warnings, and 0,
 //! silently, when the reader of stdout went away (`sandslope sweep --json | head`).
 
 use std::io::ErrorKind;
@@ -14,6 +15,15 @@ pub const EXIT_OK: i32 = 0;
 pub const EXIT_USAGE: i32 = 2;
 /// Exit code when an output file could not be written (the environment, not the input).
 pub const EXIT_OUTPUT: i32 = 3;
+/// Exit code of `report --strict` when the report was written but carries warnings.
+pub const EXIT_WARNINGS: i32 = 4;
+
+/// `report --strict`: the outputs were written, but the report carries this many warnings.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "--strict: the report carries {0} warning(s) (above); its numbers are not to be trusted as they stand"
+)]
+pub struct Strict(pub usize);
 
 /// The exit code for a failed run (see the module documentation).
 pub fn exit_code(e: &anyhow::Error) -> i32 {
@@ -30,6 +40,8 @@ pub fn exit_code(e: &anyhow::Error) -> i32 {
         EXIT_OK
     } else if e.chain().any(|c| c.is::<sandslope_io::WriteError>()) {
         EXIT_OUTPUT
+    } else if e.chain().any(|c| c.is::<Strict>()) {
+        EXIT_WARNINGS
     } else {
         EXIT_USAGE
     }

@@ -17,13 +17,29 @@ use common::{
 };
 
 /// The page's figure elements; fig6 holds the panels fig6a-d (anchored inside it).
-const PAGE_IDS: [&str; 8] = ["fig3a", "fig4d", "fig4h", "fig5b", "fig5c", "fig6", "risk", "calibration"];
-/// The ids of report.json, the paper's figure numbers.
-const IDS: [&str; 11] =
-    ["fig3a", "fig4d", "fig4h", "fig5b", "fig5c", "fig6a", "fig6b", "fig6c", "fig6d", "risk", "calibration"];
+const PAGE_IDS: [&str; 9] =
+    ["fig3a", "fig4d", "fig4h", "fig5b", "fig5c", "fig6", "risk", "step_budget", "calibration"];
+/// The ids of report.json, the paper's figure numbers (and names for figures the paper lacks).
+const IDS: [&str; 12] = [
+    "fig3a",
+    "fig4d",
+    "fig4h",
+    "fig5b",
+    "fig5c",
+    "fig6a",
+    "fig6b",
+    "fig6c",
+    "fig6d",
+    "risk",
+    "step_budget",
+    "calibration",
+];
 
 fn make_report(dir: &Path) -> (String, serde_json::Value) {
-    sandslope().args(["report", "--out"]).arg(dir).assert().success();
+    let out = sandslope().args(["report", "--out"]).arg(dir).assert().success();
+    // The summary counts report.json's figures, the panels of fig6 one by one.
+    let stdout = String::from_utf8(out.get_output().stdout.clone()).unwrap();
+    assert!(stdout.starts_with(&format!("{} figures; ", IDS.len())), "{stdout}");
     let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
     let json = serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
     (html, json)
@@ -80,6 +96,131 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
         let text = d.as_str().unwrap().replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
         assert!(html.contains(&text.replace('"', "&quot;")), "{text}");
     }
+}
+
+/// Issue 27's audit, recomputed independently where it can be: the provenance of every input
+/// and comparison, the summary counting independent agreements only, the fit without the
+/// floor, the per-slope inversion, the extrapolation at 24 deg and the step budget.
+#[test]
+fn the_default_report_says_where_every_number_comes_from() {
+    let dir = tempfile::tempdir().unwrap();
+    let (html, v) = make_report(&dir.path().join("report"));
+    let kinds = ["measured", "assumed", "tuned", "derived"];
+    for i in v["inputs"].as_array().unwrap() {
+        let kind = i["provenance"]["kind"].as_str().unwrap_or_default();
+        assert!(kinds.contains(&kind), "{i}");
+        assert!(!i["provenance"]["detail"].as_str().unwrap().is_empty(), "{i}");
+    }
+    // The paper's speeds are measured; the force tests' levels are assumed, their ratio measured.
+    let input =
+        |name: &str| v["inputs"].as_array().unwrap().iter().find(|i| i["name"] == name).unwrap().clone();
+    assert_eq!(input("observed speeds")["provenance"]["kind"], "measured");
+    assert_eq!(input("force tests: levels and SDs")["provenance"]["kind"], "assumed");
+    assert_eq!(input("robot: hip height h")["provenance"]["kind"], "tuned");
+    let rows = v["paper_vs_model"].as_array().unwrap();
+    for r in rows {
+        assert!(
+            ["independent", "input", "tuned", "consequence"].contains(&r["basis"].as_str().unwrap()),
+            "{r}"
+        );
+    }
+    // On the built-in terrain the speeds were fitted, the ratios are inputs, T/2 follows from
+    // omega and the t1 trend from the model's form: only the 1 kg claim is independent, and
+    // the model disagrees with it.
+    let independent: Vec<&str> =
+        rows.iter().filter(|r| r["basis"] == "independent").map(|r| r["id"].as_str().unwrap()).collect();
+    assert_eq!(independent, ["heavy_robot_24"]);
+    assert_eq!(v["summary"]["independent"], 1);
+    assert_eq!(v["summary"]["independent_agree"], 0);
+    assert!(
+        html.contains("agrees with 0 of the paper&#x27;s 1 independent")
+            || html.contains("agrees with 0 of the paper's 1 independent")
+    );
+    // The fit without the floor is the test: chi^2 76.1 on 4 dof (docs/calibration.md's table),
+    // p = P(chi^2_4 >= 76.1) = e^(-x/2) (1 + x/2) = 1.18e-15 by the closed form for 4 dof.
+    let nf = &v["calibration"]["no_floor"];
+    let x = nf["chi_squared"].as_f64().unwrap();
+    assert!((x - 76.1).abs() < 0.05, "{nf}");
+    assert_eq!(nf["dof"], 4);
+    let p = nf["p_value"].as_f64().unwrap();
+    let closed = (-x / 2.0).exp() * (1.0 + x / 2.0);
+    assert!(p < 1e-10 && (p / closed - 1.0).abs() < 1e-6, "{p} vs {closed}");
+    // The per-slope inversion: 10 and 15 deg need 1.28e6 and 2.51e6 (calibrate --law per-slope).
+    let inv = v["speed_inversion"].as_array().unwrap();
+    let needed = |deg: f64| {
+        inv.iter().find(|i| i["slope_deg"].as_f64() == Some(deg)).unwrap()["k_s_needed"].as_f64().unwrap()
+    };
+    assert!((needed(10.0) / 1.28e6 - 1.0).abs() < 0.01 && (needed(15.0) / 2.51e6 - 1.0).abs() < 0.01);
+    let rises = v["disagreements"].as_array().unwrap().iter().any(|d| {
+        let d = d.as_str().unwrap();
+        d.contains("rise from 10° to 15°")
+            && d.contains("1.28 × 10⁶ at 10°")
+            && d.contains("2.51 × 10⁶ at 15°")
+    });
+    assert!(rises, "{}", v["disagreements"]);
+    // The 1 kg claim at 24 deg rests on an extrapolated k_s (force tests at 0 and 20 only).
+    let x = &v["extrapolations"][0];
+    assert_eq!((x["slope_deg"].as_f64(), x["last_measured_deg"].as_f64()), (Some(24.0), Some(20.0)));
+    assert!((x["k_s_from"].as_f64().unwrap() / 2.21e6 - 1.0).abs() < 0.01, "{x}");
+    // Step budget: one entry per observed slope; the losses add up to s* - s (docs/model.md §5).
+    let budget = v["step_budget"].as_array().unwrap();
+    assert_eq!(budget.len(), 5);
+    for b in budget {
+        let g = |k: &str| b[k].as_f64().unwrap();
+        let sum = g("shorter_propulsion_m") + g("inherited_speed_m") + g("slip_m") + g("step_m");
+        assert!((sum - g("level_step_m")).abs() < 1e-12, "{b}");
+    }
+    let at24 = &budget[4];
+    assert!(at24["inherited_speed_m"].as_f64().unwrap() > 10.0 * at24["slip_m"].as_f64().unwrap());
+}
+
+/// Issue 28's --tracks example: one calibration drives the page, its warnings are printed, and
+/// `--strict` fails after writing the page.
+#[test]
+fn a_report_on_the_example_tracks_is_consistent_and_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rep");
+    let args = |strict: bool| {
+        let mut c = sandslope();
+        c.current_dir(common::repo_file("examples/tracking")).args(["report", "--out"]).arg(&out).args([
+            "--tracks",
+            "0=level-plain.csv",
+            "--tracks",
+            "10=slope10-motive123.csv",
+            "--tracks",
+            "20=slope20-*.csv",
+            "--tracks-body",
+            "robot",
+        ]);
+        if strict {
+            c.arg("--strict");
+        }
+        c
+    };
+    let run = args(false).assert().success();
+    let stderr = String::from_utf8(run.get_output().stderr.clone()).unwrap();
+    assert!(
+        stderr.contains("warning: the calibration's error_floor stopped at its search bound"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("χ²/dof"), "{stderr}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(v["own_observations"], true);
+    assert!(!v["warnings"].as_array().unwrap().is_empty());
+    // The table's k_s ratio is the calibration's.
+    let row =
+        v["paper_vs_model"].as_array().unwrap().iter().find(|r| r["id"] == "shear_ratio_20").unwrap().clone();
+    let ratio = v["calibration"]["shear_ratio_20"]["value"].as_f64().unwrap();
+    assert!((row["model_value"].as_f64().unwrap() - ratio).abs() < 1e-9, "{row} vs {ratio}");
+    // The tracked t1 (67 and 114 ms) are compared with the model.
+    let ds = v["disagreements"].to_string();
+    assert!(ds.contains("Your anchoring time at 10°") && ds.contains("Your anchoring time at 20°"), "{ds}");
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("your observations, the model"), "heading still about the paper");
+    assert!(html.contains("<b>Warning:</b>"));
+    args(true).assert().code(4);
+    assert!(out.join("index.html").exists());
 }
 
 #[test]

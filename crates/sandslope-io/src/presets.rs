@@ -3,6 +3,8 @@
 //! Each preset is a TOML file under `crates/sandslope-io/presets/`, in exactly the format a
 //! user would write, and is parsed by the same code as a user's file.
 
+use sandslope::report::ForceTests;
+
 /// What a preset describes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PresetKind {
@@ -62,6 +64,24 @@ pub const PAPER_FORCE_TESTS: Preset = Preset {
 pub fn paper_force_tests() -> anyhow::Result<sandslope::Terrain> {
     let p = PAPER_FORCE_TESTS;
     crate::robot_terrain::terrain_from_toml(p.toml, &crate::files::Source::Preset(p.name))
+}
+
+/// The force tests of a report: `forces` (a file or preset name) when given; else, on the
+/// built-in terrain `terrain_arg == DEFAULT_TERRAIN`, the paper's (the terrain was calibrated
+/// from them); else none (the terrain's own table is used).
+pub fn report_force_tests(forces: Option<&str>, terrain_arg: &str) -> anyhow::Result<ForceTests> {
+    Ok(match forces {
+        Some(f) => ForceTests::Given { table: crate::load_terrain(f)?, source: f.to_string() },
+        None if is_default(terrain_arg, PresetKind::Terrain) => ForceTests::Paper(paper_force_tests()?),
+        None => ForceTests::None,
+    })
+}
+
+/// Whether `--robot`/`--terrain` value `arg` names the default preset of `kind` (and no file
+/// of that name, which would win).
+pub fn is_default(arg: &str, kind: PresetKind) -> bool {
+    let default = if kind == PresetKind::Robot { DEFAULT_ROBOT } else { DEFAULT_TERRAIN };
+    arg == default && !std::path::Path::new(arg).exists()
 }
 
 /// The preset called `name` of kind `kind`.

@@ -16,6 +16,7 @@ mod arrays;
 mod measure;
 mod model;
 mod plan;
+mod report;
 mod risk;
 mod types;
 
@@ -47,6 +48,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plan::read_raster, m)?)?;
     m.add_function(wrap_pyfunction!(measure::fit, m)?)?;
     m.add_function(wrap_pyfunction!(measure::track, m)?)?;
+    m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;
     Ok(())
 }

@@ -137,26 +137,7 @@ pub fn track<'py>(
         }
     }
     let (captures, result) = py
-        .detach(|| -> anyhow::Result<_> {
-            let captures: Vec<mocap::Capture> = paths
-                .iter()
-                .map(|p| mocap::read(p, format, body.as_deref()))
-                .collect::<anyhow::Result<_>>()?;
-            let recordings: Vec<Recording> = captures
-                .iter()
-                .enumerate()
-                .map(|(i, c)| c.recording(touchdowns.as_ref().map(|t| t[i].as_slice())))
-                .collect();
-            let result = track_recordings(&recordings, &options, slope).map_err(|e| match e {
-                sandslope::GaitError::Param { index, source } => anyhow::anyhow!(
-                    "{}: {source} (at its frame rate {} Hz)",
-                    captures[index].path.display(),
-                    captures[index].frame_rate_hz
-                ),
-                other => anyhow::anyhow!("{other}"),
-            })?;
-            Ok((captures, result))
-        })
+        .detach(|| read_and_track(&paths, format, body.as_deref(), touchdowns.as_deref(), &options, slope))
         .map_err(anyhow_error)?;
     let d = pythonize(py, &result).map_err(value_error)?.cast_into::<PyDict>()?;
     let missing = || value_error("track result without recordings or per_step");
@@ -173,4 +154,29 @@ pub fn track<'py>(
         steps.get_item(i)?.set_item("file", &files[st.recording])?;
     }
     Ok(d)
+}
+
+/// Reads `paths` (touchdowns, when given, one list per path) and analyses them pooled at
+/// `slope`, as `sandslope track` does; errors name the file.
+pub(crate) fn read_and_track(
+    paths: &[PathBuf],
+    format: Option<MocapFormat>,
+    body: Option<&str>,
+    touchdowns: Option<&[Vec<f64>]>,
+    options: &GaitOptions,
+    slope: Option<Slope>,
+) -> anyhow::Result<(Vec<mocap::Capture>, sandslope::gait::TrackResult)> {
+    let captures: Vec<mocap::Capture> =
+        paths.iter().map(|p| mocap::read(p, format, body)).collect::<anyhow::Result<_>>()?;
+    let recordings: Vec<Recording> =
+        captures.iter().enumerate().map(|(i, c)| c.recording(touchdowns.map(|t| t[i].as_slice()))).collect();
+    let result = track_recordings(&recordings, options, slope).map_err(|e| match e {
+        sandslope::GaitError::Param { index, source } => anyhow::anyhow!(
+            "{}: {source} (at its frame rate {} Hz)",
+            captures[index].path.display(),
+            captures[index].frame_rate_hz
+        ),
+        other => anyhow::anyhow!("{other}"),
+    })?;
+    Ok((captures, result))
 }

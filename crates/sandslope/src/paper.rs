@@ -60,6 +60,35 @@ pub fn plate_force(k_s: f64) -> f64 {
     k_s * SHEAR_PLATE_WIDTH_M * SHEAR_PLATE_DEPTH_M * SHEAR_PLATE_DEPTH_M
 }
 
+/// Why a comparison can or cannot test the model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Basis {
+    /// Nothing of the paper's number went into the model: a test.
+    Independent,
+    /// The paper's number (or what it follows from) is a model input: agreement by construction.
+    Input,
+    /// The model was tuned to this number (a calibration or a chosen parameter).
+    Tuned,
+    /// Follows from the model's structure for any inputs of the usual shape (e.g. t1 rises
+    /// whenever k_s falls with slope).
+    Consequence,
+}
+
+/// What the model being compared was built from, which decides each comparison's [`Basis`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ComparisonContext {
+    /// The model's k_s was fitted to the paper's five speeds (the built-in terrain, or a
+    /// calibration on them).
+    pub fitted_to_paper_speeds: bool,
+    /// The robot's hip height was tuned to the paper's level speed (the built-in robot).
+    pub tuned_to_level_speed: bool,
+    /// The paper's force-test ratio k_s(20)/k_s(0) = 0.40 went into the model's k_s.
+    pub shear_ratio_input: bool,
+    /// k_n was assumed constant with slope (as the paper's text says) rather than measured.
+    pub normal_ratio_input: bool,
+}
+
 /// One reported number beside the model's.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PaperComparison {
@@ -81,6 +110,10 @@ pub struct PaperComparison {
     pub agrees: bool,
     /// The rule used to decide.
     pub rule: String,
+    /// Whether agreement here tests the model, or holds by construction.
+    pub basis: Basis,
+    /// Why that basis.
+    pub basis_note: String,
 }
 
 /// Evaluates `robot` on `terrain` at every number of docs/model.md §12.
@@ -89,12 +122,17 @@ pub struct PaperComparison {
 /// 0.40 (the paper gives no uncertainty); the normal ratio within 0.15 of 1; the anchoring time
 /// must rise with slope at the observed slopes; the step period `T/2` must match the touchdown
 /// spacing within 1%; the 1 kg regime must match exactly.
-pub fn compare_with_paper(robot: &Robot, terrain: &Terrain) -> Vec<PaperComparison> {
+pub fn compare_with_paper(
+    robot: &Robot,
+    terrain: &Terrain,
+    context: ComparisonContext,
+) -> Vec<PaperComparison> {
     let at = |deg: f64| Slope::from_degrees(deg).expect("paper slopes are valid");
     let mut rows = Vec::new();
     for &(deg, mean, sd) in &SPEEDS {
         let p = predict(robot, at(deg), &terrain.at(at(deg)));
         let agrees = p.speed.is_some_and(|v| (v - mean).abs() <= 2.0 * sd) && !p.regime.is_failure();
+        let (basis, basis_note) = speed_basis(deg, context);
         rows.push(PaperComparison {
             id: format!("speed_{deg}"),
             quantity: format!("speed at {deg} deg (0.35 kg)"),
@@ -108,6 +146,8 @@ pub fn compare_with_paper(robot: &Robot, terrain: &Terrain) -> Vec<PaperComparis
             model_value: p.speed,
             agrees,
             rule: "within 2 SD".into(),
+            basis,
+            basis_note,
         });
     }
     let ratio = |f: &dyn Fn(Slope) -> f64| {
@@ -125,6 +165,12 @@ pub fn compare_with_paper(robot: &Robot, terrain: &Terrain) -> Vec<PaperComparis
         model_value: k_s_ratio,
         agrees: k_s_ratio.is_some_and(|r| (r - SHEAR_RATIO_20).abs() <= 0.10),
         rule: "within 0.10".into(),
+        basis: if context.shear_ratio_input { Basis::Input } else { Basis::Independent },
+        basis_note: if context.shear_ratio_input {
+            "the force tests' 0.40 is an input of the calibration (held by its SD)".into()
+        } else {
+            "the model's k_s did not take the paper's ratio as input".into()
+        },
     });
     let k_n_ratio = ratio(&|s| terrain.at(s).k_n);
     rows.push(PaperComparison {
@@ -137,6 +183,12 @@ pub fn compare_with_paper(robot: &Robot, terrain: &Terrain) -> Vec<PaperComparis
         model_value: k_n_ratio,
         agrees: k_n_ratio.is_some_and(|r| (r - NORMAL_RATIO_20).abs() <= 0.15),
         rule: "within 0.15".into(),
+        basis: if context.normal_ratio_input { Basis::Input } else { Basis::Independent },
+        basis_note: if context.normal_ratio_input {
+            "k_n was assumed constant with slope, as the paper's text says".into()
+        } else {
+            "the model's k_n did not take the paper's statement as input".into()
+        },
     });
     let t1: Vec<Option<f64>> =
         SPEEDS.iter().map(|s| predict(robot, at(s.0), &terrain.at(at(s.0))).anchoring_time).collect();
@@ -156,6 +208,8 @@ pub fn compare_with_paper(robot: &Robot, terrain: &Terrain) -> Vec<PaperComparis
         model_value: None,
         agrees: rising,
         rule: "strictly increasing".into(),
+        basis: Basis::Consequence,
+        basis_note: "any k_s that falls with slope makes d_s and so t1 rise (docs/model.md §4); the paper prints no t1 values to test".into(),
     });
     let half = robot.stance_duration();
     rows.push(PaperComparison {
@@ -168,6 +222,8 @@ pub fn compare_with_paper(robot: &Robot, terrain: &Terrain) -> Vec<PaperComparis
         model_value: Some(half),
         agrees: (half / TOUCHDOWNS_S[1] - 1.0).abs() <= 0.01,
         rule: "within 1%".into(),
+        basis: Basis::Input,
+        basis_note: "T/2 = π/ω follows from the paper's leg speed".into(),
     });
     let (mass, deg, claim) = HEAVY_ROBOT_CLAIM;
     let heavy = robot.with_mass(mass).ok().map(|r| predict(&r, at(deg), &terrain.at(at(deg))));
@@ -184,8 +240,21 @@ pub fn compare_with_paper(robot: &Robot, terrain: &Terrain) -> Vec<PaperComparis
         model_value: heavy.and_then(|p| p.step),
         agrees: heavy.is_some_and(|p| p.regime == claim),
         rule: "same regime".into(),
+        basis: Basis::Independent,
+        basis_note: "no input was chosen to match it".into(),
     });
     rows
+}
+
+/// The basis of the comparison of the speed at `deg`, and why.
+fn speed_basis(deg: f64, context: ComparisonContext) -> (Basis, String) {
+    if deg == 0.0 && context.tuned_to_level_speed {
+        (Basis::Tuned, "the hip height h was chosen to put the level-sand ceiling at this speed".into())
+    } else if context.fitted_to_paper_speeds {
+        (Basis::Tuned, "the model's k_s was fitted to the paper's five speeds".into())
+    } else {
+        (Basis::Independent, "no input was fitted to the paper's speeds".into())
+    }
 }
 
 #[cfg(test)]
@@ -211,12 +280,22 @@ mod tests {
             ],
         })
         .unwrap();
-        let rows = compare_with_paper(&paper_robot(), &t);
+        let rows = compare_with_paper(&paper_robot(), &t, ComparisonContext::default());
         let row = |id: &str| rows.iter().find(|r| r.id == id).unwrap();
         assert!((row("shear_ratio_20").model_value.unwrap() - 0.4).abs() < 1e-12);
         assert!(row("shear_ratio_20").agrees && row("normal_ratio_20").agrees && row("step_period").agrees);
-        // 5 speeds + 5 other rows.
+        // 5 speeds + 5 other rows; with nothing fitted, only T/2 (an input) and the t1 trend
+        // (a consequence) do not test the model.
         assert_eq!(rows.len(), 10);
+        let independent = rows.iter().filter(|r| r.basis == Basis::Independent).count();
+        assert_eq!(independent, 8);
+        let tuned = ComparisonContext {
+            fitted_to_paper_speeds: true,
+            tuned_to_level_speed: true,
+            ..Default::default()
+        };
+        let rows = compare_with_paper(&paper_robot(), &t, tuned);
+        assert!(rows.iter().filter(|r| r.id.starts_with("speed_")).all(|r| r.basis == Basis::Tuned));
         // A 1e6 k_s at 20 deg gave 4.35 cm/s in the model tests; here k_s(20) = 8e5 gives less,
         // and the observed 4.98 ± 0.32 agrees only if within 0.64 cm/s: checked, not assumed.
         let v20 = row("speed_20").model_value.unwrap();

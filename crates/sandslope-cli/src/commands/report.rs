@@ -10,11 +10,11 @@ use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 
 use sandslope::gait::{GaitOptions, Upslope};
-use sandslope::report::{report, Evidence, ForceTests, TrackReading, TrackedSlope};
+use sandslope::report::{report, Evidence, TrackReading, TrackedSlope};
 use sandslope::Slope;
 use sandslope_io::mocap::MocapFormat;
-use sandslope_io::presets::{paper_force_tests, DEFAULT_TERRAIN};
-use sandslope_io::{load_anchoring_times, load_speeds, load_terrain};
+use sandslope_io::presets::{is_default, report_force_tests, PresetKind};
+use sandslope_io::{load_anchoring_times, load_speeds};
 
 use crate::args::{RobotArgs, TerrainArgs};
 use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions};
@@ -66,6 +66,11 @@ pub struct ReportArgs {
     /// Risk threshold for the safe-slope limit.
     #[arg(long, default_value_t = 0.05)]
     pub max_risk: f64,
+    /// Fail (exit code 3, after writing the page) when the report carries a warning: a
+    /// calibration quantity at its search bound, chi^2/dof > 3, or tracks that could not be
+    /// used. Without it such a report exits 0 and prints the warnings on stderr.
+    #[arg(long)]
+    pub strict: bool,
     #[command(flatten)]
     pub robot: RobotArgs,
     #[command(flatten)]
@@ -155,13 +160,10 @@ pub fn run(args: ReportArgs) -> Result<()> {
         .map_err(|source| sandslope_io::WriteError { path: args.out.clone(), source })?;
     write_atomic(&args.out.join("report.json"), json.as_bytes())?;
     write_atomic(&args.out.join("index.html"), html.as_bytes())?;
-    let rows = &report.paper_vs_model;
-    let failing = rows.iter().filter(|r| !r.agrees).count();
     println!(
-        "{} figures; the model agrees with {} of the paper's {} numbers; {} disagreement(s) listed",
-        figures.len(),
-        rows.len() - failing,
-        rows.len(),
+        "{} figures; {}; {} disagreement(s) listed",
+        report.figures.len(),
+        report.summary.text,
         report.disagreements.len()
     );
     eprintln!(
@@ -169,6 +171,9 @@ pub fn run(args: ReportArgs) -> Result<()> {
         args.out.join("index.html").display(),
         args.out.join("report.json").display()
     );
+    if args.strict && !report.warnings.is_empty() {
+        return Err(crate::error::Strict(report.warnings.len()).into());
+    }
     Ok(())
 }
 
@@ -178,11 +183,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
 fn evidence(args: &ReportArgs) -> Result<Evidence> {
     let robot = args.robot.load()?;
     let terrain = args.terrain.load()?;
-    let forces = match &args.forces {
-        Some(f) => ForceTests::Given { table: load_terrain(f)?, source: f.clone() },
-        None if args.terrain.terrain == DEFAULT_TERRAIN => ForceTests::Paper(paper_force_tests()?),
-        None => ForceTests::None,
-    };
+    let forces = report_force_tests(args.forces.as_deref(), &args.terrain.terrain)?;
     let observed = match &args.observed {
         Some(p) => Some((p.display().to_string(), load_speeds(p)?)),
         None => None,
@@ -205,6 +206,8 @@ fn evidence(args: &ReportArgs) -> Result<Evidence> {
             upslope: args.tracks_upslope.map(|u| u.vector()),
         },
         max_risk: args.max_risk,
+        builtin_robot: is_default(&args.robot.robot, PresetKind::Robot),
+        builtin_terrain: is_default(&args.terrain.terrain, PresetKind::Terrain),
         robot,
         terrain,
     })

@@ -15,6 +15,7 @@ pub mod phase;
 pub mod plan;
 pub mod risk;
 pub mod slope_curves;
+pub mod step_budget;
 pub mod sweep;
 pub mod track;
 
@@ -175,8 +176,8 @@ where
 
 /// A dashed grey horizontal line at `level` across `x`, with a legend entry `label` (a
 /// threshold such as s_min = R).
-pub fn reference_line<DB: DrawingBackend>(
-    chart: &mut SlopeChart<'_, DB>,
+pub fn reference_line<'a, DB: DrawingBackend + 'a>(
+    chart: &mut SlopeChart<'a, DB>,
     level: f64,
     label: &str,
     x: (f64, f64),
@@ -189,7 +190,13 @@ where
         .draw_series(DashedLineSeries::new([(x.0, level), (x.1, level)], 8, 5, grey.stroke_width(2)))
         .map_err(crate::error::plot_err)?
         .label(label)
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(2)));
+        .legend(move |(x, y)| {
+            // Dashed like the line it names.
+            let (a, b) = slope_curves::swatch_gap(true);
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (a, 0)], grey.stroke_width(2))
+                + PathElement::new(vec![(b, 0), (20, 0)], grey.stroke_width(2))
+        });
     Ok(())
 }
 

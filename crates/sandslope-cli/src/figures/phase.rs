@@ -232,10 +232,12 @@ where
         for ii in 1..=xc.len() {
             if ii == xc.len() || map.regime(xc[ii], j) != map.regime(xc[start], j) {
                 let colour = regime_colour(map.regime(xc[start], j));
-                rects.push(Rectangle::new(
-                    [(xe[xs[start]], ye[ys[jj]]), (xe[xs[ii]], ye[ys[jj + 1]])],
-                    colour.filled(),
-                ));
+                // Each block reaches one cell into the next row and run, which are drawn
+                // after it and cover the overlap: no hairline seams of background where
+                // rounded pixel edges of neighbours do not meet.
+                let right = xe[xs[(ii + 1).min(xc.len())]];
+                let top = ye[ys[(jj + 2).min(yc.len())]];
+                rects.push(Rectangle::new([(xe[xs[start]], ye[ys[jj]]), (right, top)], colour.filled()));
                 start = ii;
             }
         }

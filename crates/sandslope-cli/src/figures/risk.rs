@@ -13,6 +13,7 @@ use sandslope::{Axis, RegimeProbabilities};
 use super::phase::{
     cell_edges, reduce, sci_label, star_points, within, TerrainStar, MAX_DRAWN_CELLS, STAR_GREEN,
 };
+use super::slope_curves::swatch_gap;
 use super::{font, Figure};
 
 /// p_fail and p_not_success against slope.
@@ -74,19 +75,27 @@ impl Figure for CurveFigure {
                 grey.stroke_width(2),
             ))
             .map_err(e)?
-            .label(format!("threshold --max-risk = {}", self.max_risk))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], grey.stroke_width(2)));
-        chart
-            .draw_series(self.points.iter().map(|&(d, p)| Circle::new((d, p), 5, BLACK.filled())))
-            .map_err(e)?
-            .label("requested slopes")
-            .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
+            .label(format!("risk threshold {}", self.max_risk))
+            .legend(move |(x, y)| {
+                let (a, b) = swatch_gap(true);
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (a, 0)], grey.stroke_width(2))
+                    + PathElement::new(vec![(b, 0), (20, 0)], grey.stroke_width(2))
+            });
+        if !self.points.is_empty() {
+            chart
+                .draw_series(self.points.iter().map(|&(d, p)| Circle::new((d, p), 5, BLACK.filled())))
+                .map_err(e)?
+                .label("requested slopes")
+                .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
+        }
         if let SafeLimit::Limit { value, .. } = self.limit {
             let blue = RGBColor(40, 90, 200);
             chart
                 .draw_series(LineSeries::new(vec![(value, -0.015), (value, 1.02)], blue.stroke_width(2)))
                 .map_err(e)?
-                .label(format!("safe-slope limit {value:.3} deg"))
+                // One decimal: the search's tolerance shows as 24.999 below a 25 deg repose.
+                .label(format!("safe-slope limit {value:.1}°"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(2)));
             chart
                 .draw_series(std::iter::once(Circle::new((value, self.max_risk), 7, blue.stroke_width(3))))

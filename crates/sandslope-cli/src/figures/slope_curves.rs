@@ -9,14 +9,28 @@ use plotters::prelude::*;
 use super::{font, Figure};
 use crate::error::plot_err;
 
+/// A legend swatch is two segments 20 px long in all: `(0, a)` and `(b, 20)`. Touching for a
+/// solid line; with a gap for a dashed one, so the legend looks like the line it names:
+/// `EmptyElement::at(p) + PathElement::new(vec![(0, 0), (a, 0)], s) + PathElement::new(vec![(b, 0), (20, 0)], s)`.
+pub fn swatch_gap(dashed: bool) -> (i32, i32) {
+    if dashed {
+        (8, 12)
+    } else {
+        (10, 10)
+    }
+}
+
 /// A quantity against slope.
 pub struct SlopeCurveFigure {
     /// Caption.
     pub title: String,
     /// Y-axis label (with unit).
     pub y_label: String,
-    /// The model curve `(slope_deg, value)`, `None` where undefined.
+    /// The model curve `(slope_deg, value)`, `None` where undefined or ruled out; solid.
     pub model: Vec<(f64, Option<f64>)>,
+    /// The model's values where its regime rules them out (slippage or sinkage), `None`
+    /// elsewhere; dashed and faded, as `sweep --plot` draws them.
+    pub ruled_out: Vec<(f64, Option<f64>)>,
     /// Legend of the model curve.
     pub model_label: String,
     /// Measurements `(slope_deg, mean, sd)`.
@@ -43,11 +57,13 @@ impl Figure for SlopeCurveFigure {
         DB::ErrorType: 'static,
     {
         let xs = self.model.iter().map(|m| m.0).chain(self.observed.iter().map(|o| o.0));
+        let ruled_out = self.ruled_out.iter().filter_map(|m| m.1);
         let x_range = super::range(xs, (0.0, 30.0));
         let ys = self
             .model
             .iter()
             .filter_map(|m| m.1)
+            .chain(ruled_out)
             .chain(self.observed.iter().flat_map(|o| [o.1 - o.2, o.1 + o.2]))
             .chain(self.reference.as_ref().map(|r| r.0))
             .chain(self.from_zero.then_some(0.0));
@@ -78,26 +94,16 @@ impl Figure for SlopeCurveFigure {
         if let Some((level, label)) = &self.reference {
             super::reference_line(&mut chart, *level, label, x_range)?;
         }
-        let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-        for &(x, y) in &self.model {
-            match y {
-                Some(v) => segments.last_mut().expect("non-empty").push((x, v)),
-                None if !segments.last().expect("non-empty").is_empty() => segments.push(Vec::new()),
-                None => {}
-            }
-        }
         let red = RGBColor(200, 40, 40);
-        let mut first = true;
-        for seg in segments.into_iter().filter(|s| !s.is_empty()) {
-            let s = chart
-                .draw_series(DashedLineSeries::new(seg, 10, 4, red.stroke_width(3)))
-                .map_err(plot_err)?;
-            if first && !self.model_label.is_empty() {
-                s.label(self.model_label.as_str())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red.stroke_width(3)));
-                first = false;
-            }
-        }
+        let label = (!self.model_label.is_empty()).then_some(self.model_label.as_str());
+        draw_pieces(&mut chart, &self.model, red.stroke_width(3), false, label)?;
+        draw_pieces(
+            &mut chart,
+            &self.ruled_out,
+            red.mix(0.6).stroke_width(2),
+            true,
+            Some("model where the regime rules it out"),
+        )?;
         if !self.observed.is_empty() {
             chart
                 .draw_series(self.observed.iter().map(|&(x, v, sd)| {
@@ -120,4 +126,47 @@ impl Figure for SlopeCurveFigure {
             .map_err(plot_err)?;
         Ok(())
     }
+}
+
+/// The continuous pieces of `curve` (split at `None`).
+fn pieces(curve: &[(f64, Option<f64>)]) -> Vec<Vec<(f64, f64)>> {
+    let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for &(x, y) in curve {
+        match y {
+            Some(v) => segments.last_mut().expect("non-empty").push((x, v)),
+            None if !segments.last().expect("non-empty").is_empty() => segments.push(Vec::new()),
+            None => {}
+        }
+    }
+    segments.retain(|s| !s.is_empty());
+    segments
+}
+
+/// Draws `curve` solid or dashed, with one legend entry (a swatch like the line) if labelled.
+fn draw_pieces<'a, DB: DrawingBackend + 'a>(
+    chart: &mut super::SlopeChart<'a, DB>,
+    curve: &[(f64, Option<f64>)],
+    style: ShapeStyle,
+    dashed: bool,
+    label: Option<&str>,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    for (i, seg) in pieces(curve).into_iter().enumerate() {
+        let s = if dashed {
+            chart.draw_series(DashedLineSeries::new(seg, 8, 5, style)).map_err(plot_err)?
+        } else {
+            chart.draw_series(LineSeries::new(seg, style)).map_err(plot_err)?
+        };
+        if let (0, Some(label)) = (i, label) {
+            let (a, b) = swatch_gap(dashed);
+            s.label(label).legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (a, 0)], style)
+                    + PathElement::new(vec![(b, 0), (20, 0)], style)
+            });
+        }
+    }
+    Ok(())
 }

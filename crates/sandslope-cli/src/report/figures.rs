@@ -6,13 +6,14 @@ use anyhow::Result;
 use plotters::chart::SeriesLabelPosition;
 
 use sandslope::report::{Plots, Report, PHASE_PANELS};
-use sandslope::TerrainPoint;
+use sandslope::{Prediction, TerrainPoint};
 
 use super::PageFigure;
 use crate::figures::calibrate::{speed_pulls, CalibrationFigure};
 use crate::figures::phase::PhaseFigure;
 use crate::figures::risk::CurveFigure;
 use crate::figures::slope_curves::SlopeCurveFigure;
+use crate::figures::step_budget::StepBudgetFigure;
 use crate::figures::to_svg;
 use crate::figures::track::{StridePanels, TrackFigure};
 
@@ -74,13 +75,23 @@ pub fn page_figures(report: &Report) -> Result<Vec<PageFigure>> {
         to_svg(&fig)?,
     );
 
+    // The step budget.
+    let fig = StepBudgetFigure { budget: &p.step_budget, repose: p.repose_deg };
+    add(
+        &mut figures,
+        report,
+        "step_budget",
+        "The model's level step s* and what each term of docs/model.md §5 takes from it, up to the angle of repose: the net step is s* minus the three losses. Which term carries the lost step says what the model's speed rests on.".into(),
+        to_svg(&fig)?,
+    );
+
     // The calibration pulls.
     if let Some(c) = &report.calibration {
-        let points = speed_pulls(&c.pulls);
+        let points = speed_pulls(&c.fit.pulls);
         let subtitle = format!(
             "χ²/dof = {}, floor {:.2} cm/s",
-            c.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),
-            c.error_floor_m_s * 100.0
+            c.fit.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),
+            c.fit.error_floor_m_s * 100.0
         );
         add(&mut figures, report, "calibration", "The terrain's k_s shape scaled by a fitted plate_scale, with a fitted model-error floor (docs/calibration.md). Pulls beyond ±2 are red.".into(), to_svg(&CalibrationFigure { points: &points, curve: &p.calibrated_speed, subtitle: &subtitle })?);
     }
@@ -99,7 +110,12 @@ fn speed_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
             .iter()
             .map(|q| (q.slope.degrees(), q.speed.filter(|_| !q.regime.is_failure()).map(|v| v * 100.0)))
             .collect(),
-        model_label: "model on the terrain".into(),
+        ruled_out: p
+            .model
+            .iter()
+            .map(|q| (q.slope.degrees(), q.speed.filter(|_| q.regime.is_failure()).map(|v| v * 100.0)))
+            .collect(),
+        model_label: model_label(report).into(),
         observed: p.speeds.iter().map(|o| (o.slope.degrees(), o.speed * 100.0, o.speed_sd * 100.0)).collect(),
         observed_label: "observed (mean ± SD)".into(),
         reference: None,
@@ -107,7 +123,7 @@ fn speed_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
         from_zero: true,
         legend: SeriesLabelPosition::LowerLeft,
     };
-    add(figures, report, "fig3a", "The model's step-averaged speed v = s/(T/2) on the terrain (dashed) and the observed speeds. Where the line stops, the regime rules a speed out (slippage or sinkage, docs/model.md §6).".into(), to_svg(&fig)?);
+    add(figures, report, "fig3a", "The model's step-averaged speed v = s/(T/2) (solid) and the observed speeds (mean ± SD as measured). Where the regime rules a speed out (slippage or sinkage, docs/model.md §6) the line is dashed and faded: the stance model's number, not a speed the robot makes.".into(), to_svg(&fig)?);
 
     if !p.strides.is_empty() {
         let slopes: Vec<String> = p.strides.iter().map(|(d, _)| format!("{d}°")).collect();
@@ -145,6 +161,7 @@ fn resistance_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<
                 .iter()
                 .map(|q| (q.slope.degrees(), Some(if pick == 0 { q.k_n } else { q.k_s } * unit_scale)))
                 .collect(),
+            ruled_out: vec![],
             model_label: "terrain used by the model (interpolated)".into(),
             observed: p
                 .table
@@ -163,7 +180,8 @@ fn resistance_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<
             reference: None,
             repose: p.repose_deg,
             from_zero: true,
-            legend: if pick == 0 { SeriesLabelPosition::LowerRight } else { SeriesLabelPosition::LowerLeft },
+            // Where the curves are not: k_n is flat, k_s falls with slope.
+            legend: if pick == 0 { SeriesLabelPosition::LowerRight } else { SeriesLabelPosition::UpperRight },
         };
         let caption = if pick == 0 {
             "The paper: k_n \"remains nearly constant\" with slope (Fig. 4d).".to_string()
@@ -181,7 +199,8 @@ fn step_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
     let fig = SlopeCurveFigure {
         title: "Anchoring time t1".into(),
         y_label: "t1 (ms)".into(),
-        model: p.model.iter().map(|q| (q.slope.degrees(), q.anchoring_time.map(|t| t * 1e3))).collect(),
+        model: split(p, |q| q.anchoring_time.map(|t| t * 1e3), false),
+        ruled_out: split(p, |q| q.anchoring_time.map(|t| t * 1e3), true),
         model_label: "model".into(),
         observed: p.anchoring.iter().map(|o| (o.slope.degrees(), o.t1 * 1e3, o.t1_sd * 1e3)).collect(),
         observed_label: "observed (mean ± SD)".into(),
@@ -195,7 +214,8 @@ fn step_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
     let fig = SlopeCurveFigure {
         title: "Net step length".into(),
         y_label: "net step s (mm)".into(),
-        model: p.model.iter().map(|q| (q.slope.degrees(), q.step.map(|s| s * 1e3))).collect(),
+        model: split(p, |q| q.step.map(|s| s * 1e3), false),
+        ruled_out: split(p, |q| q.step.map(|s| s * 1e3), true),
         model_label: "model".into(),
         observed: p.speeds.iter().map(|o| (o.slope.degrees(), o.speed * half, o.speed_sd * half)).collect(),
         observed_label: "observed speed × T/2".into(),
@@ -212,4 +232,21 @@ fn step_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
         to_svg(&fig)?,
     );
     Ok(())
+}
+
+/// The model's `value` where its regime allows it (`ruled_out = false`) or rules it out.
+fn split(p: &Plots, value: impl Fn(&Prediction) -> Option<f64>, ruled_out: bool) -> Vec<(f64, Option<f64>)> {
+    p.model
+        .iter()
+        .map(|q| (q.slope.degrees(), value(q).filter(|_| q.regime.is_failure() == ruled_out)))
+        .collect()
+}
+
+/// The legend of the model: on the paper's evidence the terrain as given, else the calibration.
+fn model_label(report: &Report) -> &'static str {
+    if report.own_observations {
+        "model calibrated on your observations"
+    } else {
+        "model on the terrain"
+    }
 }

@@ -3,6 +3,7 @@
 //! same value serialised. This module renders; it computes no physics.
 
 mod figures;
+mod sections;
 
 pub use figures::page_figures;
 
@@ -53,87 +54,26 @@ figure svg{max-width:100%;height:auto;border:1px solid #eee}figcaption{font-size
 
 /// The whole page.
 pub fn page(report: &Report, figures: &[PageFigure]) -> String {
-    let inputs = &report.inputs;
-    let paper = &report.paper_vs_model;
-    let calibration = report.calibration.as_ref();
-    let disagreements = &report.disagreements;
-    let tracks = TracksSection { records: &report.tracks, notes: &report.track_notes };
+    let own = report.own_observations;
     let mut h = String::with_capacity(1 << 20);
     h.push_str("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">");
     h.push_str("<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">");
-    h.push_str("<title>sandslope report: the paper reproduced and confronted</title>");
-    h.push_str(&format!("<style>{STYLE}</style></head><body>\n"));
-    h.push_str("<h1>Legged robots on granular slopes: the model, the paper, and where they part</h1>\n");
-    h.push_str(
-        "<p>Liao and Qian, <i>Failure Mechanisms and Risk Estimation for Legged Robot Locomotion on Granular \
-         Slopes</i> (arXiv:2603.06928), recomputed by <code>sandslope report</code> from the inputs below. \
-         Figure ids are the paper's figure numbers. The model is specified in the repository's \
-         <code>docs/model.md</code>; the calibration in <code>docs/calibration.md</code>.</p>\n",
-    );
-    h.push_str("<table><tr><th>input</th><th>value</th></tr>");
-    for (k, v) in inputs {
-        h.push_str(&format!("<tr><td>{}</td><td>{}</td></tr>", escape(k), escape(v)));
-    }
-    h.push_str("</table>\n");
-
-    h.push_str("<h2 id=\"disagree\">Where the model and the paper disagree</h2>\n");
-    if disagreements.is_empty() {
-        h.push_str("<p>Nowhere, by the rules in the table below.</p>");
+    h.push_str(if own {
+        "<title>sandslope report: your observations beside the model</title>"
     } else {
-        h.push_str("<ul>");
-        for d in disagreements {
-            h.push_str(&format!("<li>{}</li>", escape(d)));
-        }
-        h.push_str("</ul>\n");
+        "<title>sandslope report: the paper reproduced and confronted</title>"
+    });
+    h.push_str(&format!("<style>{STYLE}</style></head><body>\n"));
+    h.push_str(&sections::header(report));
+    h.push_str(&sections::warnings(report));
+    h.push_str(&sections::inputs(report));
+    h.push_str(&sections::disagreements(report));
+    h.push_str(&sections::comparison(report));
+    if let Some(c) = &report.calibration {
+        h.push_str(&sections::calibration(c, report.model_is_calibration));
     }
-
-    h.push_str("<h2 id=\"numbers\">Every number the paper reports, beside the model's</h2>\n");
-    h.push_str("<table><tr><th>quantity</th><th>paper</th><th>model</th><th>agrees?</th><th>rule</th><th>source</th></tr>");
-    for r in paper {
-        h.push_str(&format!(
-            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td class=\"v\">{}</td><td>{}</td><td>{}</td></tr>",
-            if r.agrees { "yes" } else { "no" },
-            escape(&r.quantity),
-            escape(&r.paper),
-            escape(&r.model),
-            if r.agrees { "yes" } else { "no" },
-            escape(&r.rule),
-            escape(&r.source)
-        ));
-    }
-    h.push_str("</table>\n");
-
-    if let Some(c) = calibration {
-        h.push_str("<h2 id=\"joint-calibration\">Joint calibration</h2>\n");
-        h.push_str(&format!(
-            "<p>chi² = {:.2} over {} degrees of freedom{}; model-error floor {:.2} cm/s; \
-             k<sub>s</sub>(20°)/k<sub>s</sub>(0) = {:.3} (68%: {:.3} to {:.3}; the paper's force tests: about 0.40).</p>",
-            c.chi_squared,
-            c.dof,
-            c.chi_squared_per_dof.map_or(String::new(), |r| format!(" (χ²/dof {r:.2})")),
-            c.error_floor_m_s * 100.0,
-            c.shear_ratio_20.value,
-            c.shear_ratio_20.lower,
-            c.shear_ratio_20.upper
-        ));
-        h.push_str("<table><tr><th>fitted quantity</th><th>best</th><th>68% interval</th><th>unit</th></tr>");
-        for p in &c.parameters {
-            h.push_str(&format!(
-                "<tr><td>{}</td><td>{:.4e}</td><td>{:.4e} to {:.4e}{}</td><td>{}</td></tr>",
-                escape(&p.name),
-                p.estimate.value,
-                p.estimate.lower,
-                p.estimate.upper,
-                if p.at_bound { " (at a bound)" } else { "" },
-                escape(&p.unit)
-            ));
-        }
-        h.push_str("</table>\n");
-        for w in &c.warnings {
-            h.push_str(&format!("<p class=\"warn\">{}</p>", escape(&w.to_string())));
-        }
-    }
-
+    h.push_str(&sections::step_budget(report));
+    let tracks = TracksSection { records: &report.tracks, notes: &report.track_notes };
     if !tracks.records.is_empty() {
         h.push_str(&tracks_section(&tracks));
     }
@@ -157,7 +97,7 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
 }
 
 /// `mean ± SD` scaled for display, `mean` alone without an SD, `-` without a mean.
-fn plus_minus(mean: Option<f64>, sd: Option<f64>, scale: f64, decimals: usize) -> String {
+pub(crate) fn plus_minus(mean: Option<f64>, sd: Option<f64>, scale: f64, decimals: usize) -> String {
     match (mean, sd) {
         (Some(m), Some(sd)) => format!("{:.decimals$} ± {:.decimals$}", m * scale, sd * scale),
         (Some(m), None) => format!("{:.decimals$}", m * scale),

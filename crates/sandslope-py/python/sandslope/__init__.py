@@ -51,6 +51,7 @@ __all__ = [
     "read_raster",
     "fit",
     "track",
+    "report",
 ]
 
 __version__ = "0.1.0"
@@ -570,3 +571,63 @@ def track(
     out["recordings"] = _frame(out["recordings"])
     out["per_step"] = _frame(out["per_step"])
     return out
+
+
+_PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _source(x: Any, default: str) -> str:
+    """How the report's inputs table names a robot or terrain: its preset name or path as given."""
+    if isinstance(x, (str, os.PathLike)):
+        return os.fspath(x)
+    return default
+
+
+def report(
+    robot: RobotLike = "paper-hexapod",
+    terrain: TerrainLike = "glass-beads-300um",
+    *,
+    observed: Optional[_PathLike] = None,
+    forces: Optional[_PathLike] = None,
+    t1: Optional[_PathLike] = None,
+    tracks: Optional[Dict[float, Union[_PathLike, Sequence[_PathLike]]]] = None,
+    tracks_format: Optional[str] = None,
+    tracks_body: Optional[str] = None,
+    tracks_upslope: Optional[Sequence[float]] = None,
+    max_risk: float = 0.05,
+) -> Dict[str, Any]:
+    """The paper reproduced and confronted (``sandslope report``), as ``report.json``'s dict.
+
+    On the defaults it is the paper's own evidence: its five speeds, the built-in terrain and
+    the paper's force tests as its text reports them. ``observed`` (speeds CSV), ``forces`` (a
+    terrain file with ``k_s_sd``), ``t1`` (anchoring-time CSV) and ``tracks``
+    (``{slope_deg: path or [paths]}`` of motion-capture recordings, read as :func:`track` reads
+    them) make it a report on your own campaign, as the CLI's flags of the same names.
+
+    Returns exactly the keys and values of ``report.json`` (README.md, ``sandslope report``): ``figures``,
+    ``speeds``, ``tracks``, ``calibration``, ``paper_vs_model``, ``disagreements``, ``inputs``.
+    """
+    track_list = None
+    if tracks is not None:
+        track_list = []
+        for slope, paths in tracks.items():
+            if isinstance(paths, (str, os.PathLike)):
+                paths = [paths]
+            track_list.append((float(slope), [os.fspath(p) for p in paths]))
+    import json
+
+    text = _sandslope.report(
+        _robot(robot),
+        _terrain(terrain),
+        _source(robot, "a sandslope.Robot"),
+        _source(terrain, "a sandslope.Terrain"),
+        observed=None if observed is None else os.fspath(observed),
+        forces=None if forces is None else os.fspath(forces),
+        t1=None if t1 is None else os.fspath(t1),
+        tracks=track_list,
+        tracks_format=tracks_format,
+        tracks_body=tracks_body,
+        tracks_upslope=None if tracks_upslope is None else [float(v) for v in tracks_upslope],
+        max_risk=float(max_risk),
+    )
+    return json.loads(text)

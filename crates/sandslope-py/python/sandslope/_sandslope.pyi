@@ -159,3 +159,17 @@ def track(
     leg_speed_rad_s: Optional[float] = None,
     touchdowns: Optional[List[List[float]]] = None,
 ) -> Dict[str, Any]: ...
+def report(
+    robot: Robot,
+    terrain: Terrain,
+    robot_source: str,
+    terrain_source: str,
+    observed: Optional[_Path] = None,
+    forces: Optional[str] = None,
+    t1: Optional[_Path] = None,
+    tracks: Optional[List[Tuple[float, List[_Path]]]] = None,
+    tracks_format: Optional[str] = None,
+    tracks_body: Optional[str] = None,
+    tracks_upslope: Optional[List[float]] = None,
+    max_risk: float = 0.05,
+) -> str: ...

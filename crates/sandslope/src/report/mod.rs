@@ -7,7 +7,9 @@
 //! the disagreements with the rules that found them, and the data of every figure. It reads
 //! no file and draws nothing.
 
+mod audit;
 mod disagreements;
+mod provenance;
 mod tracks;
 
 use serde::Serialize;
@@ -20,13 +22,15 @@ use crate::calibrate::{
 use crate::error::ParamError;
 use crate::gait::track::TrackResult;
 use crate::model::{predict, Prediction};
-use crate::paper::{self, compare_with_paper, PaperComparison};
+use crate::paper::{self, compare_with_paper, Basis, ComparisonContext, PaperComparison};
 use crate::phase::{Axis, AxisScale, PhasePanel};
 use crate::risk::{risk_curve, safe_slope_limit, RiskCurve, SafeLimit, UncertainTerrain};
 use crate::robot::Robot;
 use crate::slope::Slope;
 use crate::terrain::{Terrain, TerrainPoint};
 
+pub use audit::{Extrapolation, NoFloorFit, SpeedInversion, StepBudget, PAPER_FRAME_RATE_HZ};
+pub use provenance::{Input, Provenance, ProvenanceKind};
 use tracks::TrackUse;
 pub use tracks::{TrackRecord, TrackedSlope};
 
@@ -90,6 +94,19 @@ pub struct Evidence {
     pub track_reading: TrackReading,
     /// Risk threshold of the safe-slope limit, in (0, 1).
     pub max_risk: f64,
+    /// The robot is the built-in paper-hexapod (the paper's robot, h tuned to its level speed).
+    pub builtin_robot: bool,
+    /// The terrain is the built-in glass-beads-300um (the joint calibration on the paper's
+    /// speeds and force-test ratio).
+    pub builtin_terrain: bool,
+}
+
+impl Evidence {
+    /// Whether the observations are the user's (speeds, anchoring times or tracks) rather
+    /// than the paper's.
+    pub fn has_own_observations(&self) -> bool {
+        self.observed.is_some() || self.anchoring.is_some() || !self.tracks.is_empty()
+    }
 }
 
 /// `report.json`'s figure entry: the paper's figure number (or a name for figures the paper
@@ -156,36 +173,93 @@ pub struct Plots {
     pub max_risk: f64,
     /// The calibrated model's speed, 0 to 24.5 degrees (empty without a calibration).
     pub calibrated_speed: Vec<(f64, Option<f64>)>,
+    /// The step budget over the slope grid, up to the angle of repose.
+    pub step_budget: Vec<StepBudget>,
 }
 
 /// The whole report. Serialises to `report.json`; [`Report::plots`], the page's notes and
 /// the terminal warnings are not part of it.
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
+    /// Whether the observations are the user's (then the model is the joint calibration on
+    /// them) rather than the paper's.
+    pub own_observations: bool,
+    /// Whether the model of every table and figure is the calibration's robot and terrain (the
+    /// user's observations, or the built-in terrain, which is that calibration); otherwise the
+    /// terrain as given, and the calibration is shown beside it.
+    pub model_is_calibration: bool,
     /// The figures, in page order (panels of one figure each listed).
     pub figures: Vec<FigureRecord>,
     /// Observed against model speeds.
     pub speeds: Vec<SpeedRecord>,
     /// The motion-capture tracks per slope (empty without).
     pub tracks: Vec<TrackRecord>,
-    /// The joint calibration of the terrain's (or force tests') k_s shape on the evidence
-    /// (`null` if it failed).
-    pub calibration: Option<JointCalibration>,
-    /// Every number the paper reports beside the model's.
+    /// The joint calibration of the terrain's (or force tests') k_s shape on the evidence,
+    /// with its fit without the floor (`null` if it failed).
+    pub calibration: Option<ReportCalibration>,
+    /// Every number the paper reports beside the model's, each with its basis.
     pub paper_vs_model: Vec<PaperComparison>,
-    /// The generated "where the model and the paper disagree" items.
+    /// How many of the paper's numbers the model agrees with, independent ones apart.
+    pub summary: Summary,
+    /// The generated "where the model and the evidence disagree" items.
     pub disagreements: Vec<String>,
-    /// What the report was made from: `[what, value]`.
-    pub inputs: Vec<(String, String)>,
+    /// The k_s each observed speed needs on its own, lowest slope first.
+    pub speed_inversion: Vec<SpeedInversion>,
+    /// Regime claims at slopes beyond the measured k_s, and the k_s at which they would hold.
+    pub extrapolations: Vec<Extrapolation>,
+    /// Where the step is lost, one entry per observed slope (docs/model.md §5).
+    pub step_budget: Vec<StepBudget>,
+    /// What the report was made from, each with its provenance.
+    pub inputs: Vec<Input>,
     /// Sentences on how the tracks entered the report (skipped t1s, speeds not used, ...).
     #[serde(skip)]
     pub track_notes: Vec<String>,
-    /// Warnings for the user's terminal.
-    #[serde(skip)]
+    /// What a reader must know before trusting the page: a fitted quantity at its search
+    /// bound, a fit far worse than the quoted SDs allow (chi^2/dof > 3), tracks that could not be
+    /// used. Printed at the top of the page and on stderr (`report --strict` fails on any).
     pub warnings: Vec<String>,
     /// The figures' data.
     #[serde(skip)]
     pub plots: Plots,
+}
+
+/// The report's joint calibration: the fit itself (flattened: the keys of `calibrate --json`)
+/// and the same fit with the error floor fixed at 0.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReportCalibration {
+    /// The fit with the floor free.
+    #[serde(flatten)]
+    pub fit: JointCalibration,
+    /// The fit without the floor: its chi^2 is the goodness-of-fit test.
+    pub no_floor: Option<NoFloorFit>,
+    /// Which chi^2 tests the model, in words.
+    pub goodness_of_fit: String,
+}
+
+/// The comparison table summed up.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// Comparisons whose basis is independent.
+    pub independent: usize,
+    /// Of those, how many agree.
+    pub independent_agree: usize,
+    /// Comparisons that agree by construction (input, tuned, consequence).
+    pub by_construction_agree: usize,
+    /// All comparisons.
+    pub total: usize,
+    /// The summary sentence.
+    pub text: String,
+}
+
+fn summary(rows: &[PaperComparison]) -> Summary {
+    let independent = rows.iter().filter(|r| r.basis == Basis::Independent).count();
+    let independent_agree = rows.iter().filter(|r| r.basis == Basis::Independent && r.agrees).count();
+    let by_construction_agree = rows.iter().filter(|r| r.basis != Basis::Independent && r.agrees).count();
+    let text = format!(
+        "the model agrees with {independent_agree} of the paper's {independent} independent numbers; {by_construction_agree} more agree by construction (inputs, tuned values, consequences of the model's form), out of {} compared",
+        rows.len()
+    );
+    Summary { independent, independent_agree, by_construction_agree, total: rows.len(), text }
 }
 
 /// Slopes of the model curves: 0 to 30 deg every 0.25 deg.
@@ -199,9 +273,11 @@ fn at(d: f64) -> Slope {
 
 /// Builds the report from the evidence. Errors: `max_risk` outside (0, 1), a track slope
 /// outside [0, 90), or a robot the phase panels' masses make invalid.
+///
+/// One model drives every table and figure: with the user's own observations, the robot and
+/// terrain of the joint calibration on them; on the paper's evidence, the robot and terrain as
+/// given (the built-in terrain is that calibration).
 pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
-    let robot = &evidence.robot;
-    let terrain = &evidence.terrain;
     let track_use = TrackUse::new(&evidence.tracks, evidence.observed.is_some())?;
     let mut anchoring: Vec<AnchoringObservation> =
         evidence.anchoring.as_ref().map(|(_, a)| a.clone()).unwrap_or_default();
@@ -215,30 +291,82 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
             .collect(),
     };
     let calibration = calibrate(evidence, &speeds, &anchoring);
-    let plots = plots(evidence, speeds.clone(), anchoring, calibration.as_ref())?;
-    let paper_vs_model = compare_with_paper(robot, terrain);
-    let disagreements = disagreements::disagreements(&paper_vs_model, calibration.as_ref(), &speeds);
-    let speeds = speeds
+    let (robot, terrain) = model(evidence, calibration.as_ref())?;
+    let plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
+    let own = evidence.has_own_observations();
+    let context = ComparisonContext {
+        fitted_to_paper_speeds: !own && evidence.builtin_terrain,
+        tuned_to_level_speed: evidence.builtin_robot,
+        shear_ratio_input: matches!(evidence.forces, ForceTests::Paper(_)),
+        normal_ratio_input: evidence.builtin_terrain || matches!(evidence.forces, ForceTests::Paper(_)),
+    };
+    let paper_vs_model = compare_with_paper(&robot, &terrain, context);
+    let speed_inversion = audit::invert_speeds(&robot, &terrain, &speeds);
+    let measured: Vec<f64> = plots.table.iter().map(|p| p.slope_deg).collect();
+    let extrapolations: Vec<Extrapolation> =
+        audit::extrapolation(&robot, &terrain, &measured, paper::HEAVY_ROBOT_CLAIM).into_iter().collect();
+    let disagreements = disagreements::disagreements(&disagreements::Findings {
+        rows: &paper_vs_model,
+        calibration: calibration.as_ref(),
+        speeds: &speeds,
+        inversion: &speed_inversion,
+        extrapolations: &extrapolations,
+        forces: &evidence.forces,
+    });
+    let mut slopes: Vec<Slope> = speeds.iter().map(|o| o.slope).collect();
+    slopes.sort_by(|a, b| a.degrees().total_cmp(&b.degrees()));
+    slopes.dedup();
+    let step_budget = audit::step_budget(&robot, &terrain, &slopes);
+    let speed_records = speeds
         .iter()
         .map(|o| SpeedRecord {
             slope_deg: o.slope.degrees(),
             observed_m_s: o.speed,
             observed_sd_m_s: o.speed_sd,
-            model_m_s: predict(robot, o.slope, &terrain.at(o.slope)).speed,
+            model_m_s: predict(&robot, o.slope, &terrain.at(o.slope)).speed,
         })
         .collect();
+    let mut warnings = track_use.warnings;
+    if let Some(c) = &calibration {
+        warnings.extend(disagreements::calibration_warnings(c));
+    }
+    let observations = if own {
+        disagreements::observation_items(&robot, &terrain, &speeds, &plots.anchoring)
+    } else {
+        Vec::new()
+    };
+    let disagreements: Vec<String> = observations.into_iter().chain(disagreements).collect();
     Ok(Report {
+        own_observations: own,
+        model_is_calibration: own || evidence.builtin_terrain,
         figures: figure_records(&plots, calibration.is_some()),
-        speeds,
+        speeds: speed_records,
         tracks: evidence.tracks.iter().map(TrackRecord::from).collect(),
+        summary: summary(&paper_vs_model),
         calibration,
         paper_vs_model,
         disagreements,
-        inputs: inputs(evidence, !track_use.anchoring.is_empty()),
+        speed_inversion,
+        extrapolations,
+        step_budget,
+        inputs: provenance::inputs(evidence, !track_use.anchoring.is_empty()),
         track_notes: track_use.notes,
-        warnings: track_use.warnings,
+        warnings,
         plots,
     })
+}
+
+/// The robot and terrain every table and figure uses (see [`report`]).
+fn model(
+    evidence: &Evidence,
+    calibration: Option<&ReportCalibration>,
+) -> Result<(Robot, Terrain), ParamError> {
+    match calibration {
+        Some(c) if evidence.has_own_observations() => {
+            Ok((Robot::new(c.fit.robot.clone())?, Terrain::new(c.fit.terrain.clone())?))
+        }
+        _ => Ok((evidence.robot.clone(), evidence.terrain.clone())),
+    }
 }
 
 /// The joint calibration of the force tests' (or the terrain's) k_s shape on the evidence,
@@ -247,8 +375,9 @@ fn calibrate(
     evidence: &Evidence,
     speeds: &[SpeedObservation],
     anchoring: &[AnchoringObservation],
-) -> Option<JointCalibration> {
+) -> Option<ReportCalibration> {
     let shape = evidence.forces.table().unwrap_or(&evidence.terrain).clone();
+    let no_floor = audit::no_floor_fit(&evidence.robot, &shape, speeds, anchoring);
     let setup = JointSetup {
         robot: evidence.robot.clone(),
         normal: shape.clone(),
@@ -261,23 +390,68 @@ fn calibrate(
             .collect(),
         error_floor: 0.0,
     };
-    calibrate_jointly(&setup).ok()
+    let fit = calibrate_jointly(&setup).ok()?;
+    let goodness_of_fit = match no_floor.and_then(|n| n.p_value.map(|p| (n, p))) {
+        Some((n, p)) => format!(
+            "The goodness-of-fit test is the fit without the floor: χ² = {:.1} on {} dof, p = {}. With the floor free, χ²/dof near 1 to 2 is built in (the floor grows until it is), so that χ² tests nothing.",
+            n.chi_squared,
+            n.dof,
+            format_p(p)
+        ),
+        None => "The fit without the floor has no degrees of freedom left: no goodness-of-fit test is possible on this evidence.".into(),
+    };
+    Some(ReportCalibration { fit, no_floor, goodness_of_fit })
+}
+
+/// A probability as text: 2 significant digits, `< 10⁻³⁰⁰` below what a float holds.
+pub fn format_p(p: f64) -> String {
+    if p <= 0.0 {
+        "< 10⁻³⁰⁰".into()
+    } else if p >= 0.01 {
+        format!("{p:.2}")
+    } else {
+        sci(p, 1)
+    }
+}
+
+/// `x` as `m.mm × 10ⁿ` with `decimals` digits after the point (superscript exponent), or
+/// plainly when `0.01 <= |x| < 10⁴`; the one number format of the report's text.
+pub fn sci(x: f64, decimals: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (0.01..1e4).contains(&a) {
+        let digits = (decimals as i32 + 1 - a.log10().floor() as i32 - 1).max(0) as usize;
+        return format!("{x:.digits$}");
+    }
+    let text = format!("{x:.decimals$e}");
+    let (m, e) = text.split_once('e').unwrap_or((&text, "0"));
+    const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let exp: String = e
+        .chars()
+        .map(|c| match c {
+            '-' => '⁻',
+            d => d.to_digit(10).map_or(d, |d| SUP[d as usize]),
+        })
+        .collect();
+    format!("{m} × 10{exp}")
 }
 
 /// The figures' data.
 fn plots(
     evidence: &Evidence,
+    robot: &Robot,
+    terrain: &Terrain,
     speeds: Vec<SpeedObservation>,
     anchoring: Vec<AnchoringObservation>,
-    calibration: Option<&JointCalibration>,
+    calibration: Option<&ReportCalibration>,
 ) -> Result<Plots, ParamError> {
-    let robot = &evidence.robot;
-    let terrain = &evidence.terrain;
     let grid = slope_grid();
     let forces = evidence.forces.table();
     // Plate values are drawn on the leg's scale: times the fitted plate_scale.
     let plate_scale = match (forces, calibration) {
-        (Some(_), Some(c)) => c.plate_scale(),
+        (Some(_), Some(c)) => c.fit.plate_scale(),
         _ => 1.0,
     };
     let k_n_axis = Axis::new("k_n", 1e4, 1e8, 120, AxisScale::Log)?;
@@ -291,8 +465,8 @@ fn plots(
     let risk_slopes: Vec<f64> = (0..=60).map(|i| i as f64 * 0.5).collect();
     let calibrated_speed = match calibration {
         Some(c) => {
-            let fitted_robot = Robot::new(c.robot.clone())?;
-            let fitted_terrain = Terrain::new(c.terrain.clone())?;
+            let fitted_robot = Robot::new(c.fit.robot.clone())?;
+            let fitted_terrain = Terrain::new(c.fit.terrain.clone())?;
             grid.iter()
                 .filter(|s| s.degrees() <= 24.5)
                 .map(|&s| (s.degrees(), predict(&fitted_robot, s, &fitted_terrain.at(s)).speed))
@@ -323,6 +497,11 @@ fn plots(
         safe_limit: safe_slope_limit(robot, &uncertain, evidence.max_risk)?,
         max_risk: evidence.max_risk,
         calibrated_speed,
+        step_budget: audit::step_budget(
+            robot,
+            terrain,
+            &grid.iter().copied().filter(|s| !terrain.at(*s).beyond_repose(*s)).collect::<Vec<_>>(),
+        ),
     })
 }
 
@@ -342,65 +521,11 @@ fn figure_records(plots: &Plots, calibrated: bool) -> Vec<FigureRecord> {
         out.push((id, format!("Phase diagram, {mass} kg at {slope} deg")));
     }
     out.push(("risk", "Failure probability against slope".into()));
+    out.push(("step_budget", "Where the step goes against slope".into()));
     if calibrated {
         out.push(("calibration", "Joint calibration: observed against fitted speeds, and pulls".into()));
     }
     out.into_iter().map(|(id, title)| FigureRecord { id: id.into(), title }).collect()
-}
-
-/// The inputs table: what the report was made from.
-fn inputs(evidence: &Evidence, tracks_give_t1: bool) -> Vec<(String, String)> {
-    let tracks = &evidence.tracks;
-    let mut inputs = vec![
-        ("robot".to_string(), evidence.robot_source.clone()),
-        ("terrain".to_string(), evidence.terrain_source.clone()),
-        (
-            "observed speeds".to_string(),
-            match (&evidence.observed, tracks.is_empty()) {
-                (Some((p, _)), _) => p.clone(),
-                (None, false) => "the motion-capture tracks' (mean ± SD per slope, --tracks)".into(),
-                (None, true) => "the paper's (docs/model.md §12)".into(),
-            },
-        ),
-        (
-            "force tests".to_string(),
-            match &evidence.forces {
-                ForceTests::Given { source, .. } => source.clone(),
-                ForceTests::Paper(_) => {
-                    "the paper's, as its text reports them (data/example-force-tests.toml)".into()
-                }
-                ForceTests::None => "the terrain's own table".into(),
-            },
-        ),
-    ];
-    let t1_sources: Vec<String> = evidence
-        .anchoring
-        .iter()
-        .map(|(p, _)| p.clone())
-        .chain(tracks_give_t1.then(|| "the motion-capture tracks (--tracks)".to_string()))
-        .collect();
-    if !t1_sources.is_empty() {
-        inputs.push(("anchoring times".into(), t1_sources.join(" and ")));
-    }
-    for t in tracks {
-        inputs.push((format!("motion capture at {}°", t.slope_deg), t.files.join(", ")));
-    }
-    if !tracks.is_empty() {
-        let r = &evidence.track_reading;
-        inputs.push((
-            "motion-capture reading".into(),
-            format!(
-                "format {}; body {}; upslope {}; stride period T = {} s (the robot's)",
-                r.format.as_deref().unwrap_or("detected per file"),
-                r.body.as_deref().unwrap_or("chosen per file (no --tracks-body)"),
-                r.upslope.map_or("estimated per slope from the travel".to_string(), |v| {
-                    format!("[{:.3}, {:.3}, {:.3}]", v[0], v[1], v[2])
-                }),
-                evidence.robot.stride_period()
-            ),
-        ));
-    }
-    inputs
 }
 
 #[cfg(test)]
@@ -432,6 +557,8 @@ mod tests {
             tracks: vec![],
             track_reading: TrackReading::default(),
             max_risk: 0.05,
+            builtin_robot: false,
+            builtin_terrain: false,
         }
     }
 
@@ -468,16 +595,17 @@ mod tests {
         assert_eq!(ids.iter().filter(|id| id.starts_with("fig6")).count(), 4);
         assert_eq!(r.plots.phase.len(), 4);
         assert_eq!(r.calibration.is_some(), ids.contains(&"calibration"));
-        // The observed speed rises from 20 to 24 deg (4.98 to 5.6 cm/s): named.
+        // The observed speed rises from 20 to 24 deg (4.98 to 5.6 cm/s): the k_s it needs rises.
         assert!(
-            r.disagreements.iter().any(|d| d.contains("rises from 20 to 24 deg")),
+            r.disagreements.iter().any(|d| d.contains("rise from") && d.contains("20° to 24°")),
             "{:?}",
             r.disagreements
         );
-        assert_eq!(
-            r.inputs[2],
-            ("observed speeds".to_string(), "the paper's (docs/model.md §12)".to_string())
-        );
+        let speeds = r.inputs.iter().find(|i| i.name == "observed speeds").unwrap();
+        assert_eq!(speeds.provenance.kind, ProvenanceKind::Measured);
+        // A terrain file of the user's: its speed comparisons are independent tests.
+        let mut speed_rows = r.paper_vs_model.iter().filter(|c| c.id.starts_with("speed_"));
+        assert!(speed_rows.clone().count() == 5 && speed_rows.all(|c| c.basis == Basis::Independent));
     }
 
     #[test]
@@ -489,7 +617,8 @@ mod tests {
         assert_eq!(r.speeds.len(), 1);
         assert_eq!(r.speeds[0].slope_deg, 10.0);
         assert_eq!(r.plots.anchoring.len(), 1);
-        assert_eq!(r.warnings.len(), 2, "{:?}", r.warnings);
+        let tracks: Vec<&String> = r.warnings.iter().filter(|w| w.starts_with("--tracks at 20°")).collect();
+        assert_eq!(tracks.len(), 2, "{:?}", r.warnings);
         assert!(r.track_notes.iter().all(|n| n.contains("20°")));
         assert_eq!(r.figures[1].id, "fig3b");
         assert_eq!(r.plots.strides.len(), 2);

@@ -1,0 +1,94 @@
+//! Where the model's step goes, against slope (docs/model.md §5): the level step s*, the three
+//! losses (shorter propulsion time, inherited speed, backward slip) and the net step. The
+//! report's step-budget figure.
+
+use anyhow::Result;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use sandslope::report::StepBudget;
+
+use super::slope_curves::swatch_gap;
+use super::{font, Figure};
+use crate::error::plot_err;
+
+/// The step budget over a slope grid (entries without anchoring are gaps).
+pub struct StepBudgetFigure<'a> {
+    /// One entry per slope, ascending.
+    pub budget: &'a [StepBudget],
+    /// Angle of repose, degrees: shaded from there on.
+    pub repose: Option<f64>,
+}
+
+impl Figure for StepBudgetFigure<'_> {
+    fn size(&self) -> (u32, u32) {
+        (760, 480)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        type Pick = fn(&StepBudget) -> Option<f64>;
+        let series: [(&str, RGBColor, bool, Pick); 5] = [
+            ("level step s*", RGBColor(90, 90, 90), true, |b| Some(b.level_step_m)),
+            ("net step s", RGBColor(20, 20, 20), false, |b| b.step_m),
+            ("inherited speed g sin θ t1 (T/2 - t1)", RGBColor(200, 40, 40), false, |b| b.inherited_speed_m),
+            ("shorter propulsion time", RGBColor(40, 90, 200), false, |b| b.shorter_propulsion_m),
+            ("backward slip ½ g sin θ t1²", RGBColor(230, 150, 20), false, |b| b.slip_m),
+        ];
+        let x_hi = self.budget.last().map_or(30.0, |b| b.slope_deg);
+        let ys =
+            self.budget.iter().flat_map(|b| series.iter().filter_map(move |s| (s.3)(b).map(|v| v * 1e3)));
+        let y_range = super::range(ys.chain([0.0]), (0.0, 1.0));
+        let mut chart = ChartBuilder::on(root)
+            .caption("Where the step goes", font(20.0))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0.0..x_hi, y_range.0..y_range.1)
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("slope (deg)")
+            .y_desc("length per step (mm)")
+            .label_style(font(14.0))
+            .axis_desc_style(font(16.0))
+            .light_line_style(WHITE)
+            .bold_line_style(RGBColor(225, 225, 225))
+            .draw()
+            .map_err(plot_err)?;
+        super::shade_repose(
+            &mut chart,
+            self.repose,
+            (0.0, x_hi),
+            y_range,
+            "at or above the angle of repose",
+        )?;
+        for (label, colour, dashed, pick) in series {
+            let points: Vec<(f64, f64)> =
+                self.budget.iter().filter_map(|b| pick(b).map(|v| (b.slope_deg, v * 1e3))).collect();
+            let style = colour.stroke_width(3);
+            let drawn = if dashed {
+                chart.draw_series(DashedLineSeries::new(points, 10, 4, style)).map_err(plot_err)?
+            } else {
+                chart.draw_series(LineSeries::new(points, style)).map_err(plot_err)?
+            };
+            let (a, b) = swatch_gap(dashed);
+            drawn.label(label).legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (a, 0)], style)
+                    + PathElement::new(vec![(b, 0), (20, 0)], style)
+            });
+        }
+        chart
+            .configure_series_labels()
+            .label_font(font(14.0))
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.85))
+            .position(SeriesLabelPosition::MiddleLeft)
+            .draw()
+            .map_err(plot_err)?;
+        Ok(())
+    }
+}

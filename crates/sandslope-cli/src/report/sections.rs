@@ -1,0 +1,220 @@
+//! The page's sections, each rendered from the library's [`Report`]: heading, warnings,
+//! inputs with their provenance, disagreements, the comparison table with its basis, the two
+//! calibration fits, and the step budget with the per-slope inversion.
+
+use sandslope::paper::Basis;
+use sandslope::report::{format_p, sci, ProvenanceKind, Report, ReportCalibration};
+
+use super::{escape, plus_minus};
+
+/// The heading and the paragraph under it: the paper's evidence, or the user's.
+pub fn header(report: &Report) -> String {
+    let mut h = String::new();
+    if report.own_observations {
+        h.push_str(
+            "<h1>Legged robots on granular slopes: your observations, the model, and where they part</h1>\n",
+        );
+        h.push_str(
+            "<p>The shear-anchoring model of Liao and Qian, <i>Failure Mechanisms and Risk Estimation for Legged \
+             Robot Locomotion on Granular Slopes</i> (arXiv:2603.06928), calibrated by <code>sandslope report</code> \
+             on your observations (inputs below). One calibration drives every table and figure: the model on this \
+             page is the joint calibration's robot and terrain. Figure ids are the paper's figure numbers. The model \
+             is specified in the repository's <code>docs/model.md</code>; the calibration in \
+             <code>docs/calibration.md</code>.</p>\n",
+        );
+    } else {
+        h.push_str("<h1>Legged robots on granular slopes: the model, the paper, and where they part</h1>\n");
+        h.push_str(
+            "<p>Liao and Qian, <i>Failure Mechanisms and Risk Estimation for Legged Robot Locomotion on Granular \
+             Slopes</i> (arXiv:2603.06928), recomputed by <code>sandslope report</code> from the inputs below. \
+             Figure ids are the paper's figure numbers. The model is specified in the repository's \
+             <code>docs/model.md</code>; the calibration in <code>docs/calibration.md</code>.</p>\n",
+        );
+    }
+    h
+}
+
+/// The top-level warnings, before anything else is read.
+pub fn warnings(report: &Report) -> String {
+    report
+        .warnings
+        .iter()
+        .map(|w| format!("<p class=\"warn\"><b>Warning:</b> {}.</p>\n", escape(w)))
+        .collect()
+}
+
+fn kind(k: ProvenanceKind) -> &'static str {
+    match k {
+        ProvenanceKind::Measured => "measured",
+        ProvenanceKind::Assumed => "assumed",
+        ProvenanceKind::Tuned => "tuned",
+        ProvenanceKind::Derived => "derived",
+    }
+}
+
+/// The inputs table with the provenance of each.
+pub fn inputs(report: &Report) -> String {
+    let mut h = String::from("<table><tr><th>input</th><th>value</th><th>where it comes from</th></tr>");
+    for i in &report.inputs {
+        h.push_str(&format!(
+            "<tr><td>{}</td><td>{}</td><td><b>{}</b>: {}</td></tr>",
+            escape(&i.name),
+            escape(&i.value),
+            kind(i.provenance.kind),
+            escape(&i.provenance.detail)
+        ));
+    }
+    h.push_str("</table>\n<p><small><b>measured</b>: printed in the paper (section given) or your own measurement; \
+         <b>assumed</b>: in neither, chosen for the reason given; <b>tuned</b>: chosen to match an observation; \
+         <b>derived</b>: follows from other inputs.</small></p>\n");
+    h
+}
+
+/// The disagreements list.
+pub fn disagreements(report: &Report) -> String {
+    let mut h = if report.own_observations {
+        String::from(
+            "<h2 id=\"disagree\">Where the model and your observations (and the paper) disagree</h2>\n",
+        )
+    } else {
+        String::from("<h2 id=\"disagree\">Where the model and the paper disagree</h2>\n")
+    };
+    if report.disagreements.is_empty() {
+        h.push_str("<p>Nowhere, by the rules in the table below.</p>");
+    } else {
+        h.push_str("<ul>");
+        for d in &report.disagreements {
+            h.push_str(&format!("<li>{}</li>", escape(d)));
+        }
+        h.push_str("</ul>\n");
+    }
+    h
+}
+
+fn basis(b: Basis) -> &'static str {
+    match b {
+        Basis::Independent => "independent",
+        Basis::Input => "input",
+        Basis::Tuned => "tuned",
+        Basis::Consequence => "consequence",
+    }
+}
+
+/// The paper's numbers beside the model's, each with its basis, and the summary.
+pub fn comparison(report: &Report) -> String {
+    let mut h = String::from("<h2 id=\"numbers\">Every number the paper reports, beside the model's</h2>\n");
+    h.push_str(&format!("<p><b>Summary:</b> {}.</p>\n", escape(&report.summary.text)));
+    h.push_str(
+        "<table><tr><th>quantity</th><th>paper</th><th>model</th><th>agrees?</th><th>rule</th><th>source</th>\
+         <th>basis</th></tr>",
+    );
+    for r in &report.paper_vs_model {
+        h.push_str(&format!(
+            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td class=\"v\">{}</td><td>{}</td><td>{}</td><td><b>{}</b>: {}</td></tr>",
+            if r.agrees { "yes" } else { "no" },
+            escape(&r.quantity),
+            escape(&r.paper),
+            escape(&r.model),
+            if r.agrees { "yes" } else { "no" },
+            escape(&r.rule),
+            escape(&r.source),
+            basis(r.basis),
+            escape(&r.basis_note)
+        ));
+    }
+    h.push_str("</table>\n<p><small><b>independent</b>: nothing of the paper's number went into the model, so \
+         agreement tests it; <b>input</b>: the number is (or follows from) a model input; <b>tuned</b>: the model \
+         was fitted to it; <b>consequence</b>: the model's form gives it for any inputs of the usual shape.</small></p>\n");
+    h
+}
+
+/// The two fits: with the floor (the fitted quantities) and without it (the test).
+pub fn calibration(c: &ReportCalibration, model_is_calibration: bool) -> String {
+    let fit = &c.fit;
+    let mut h = String::from("<h2 id=\"joint-calibration\">Joint calibration</h2>\n");
+    h.push_str(&format!(
+        "<p>With the model-error floor free: χ² = {:.2} over {} degrees of freedom{}; floor {:.2} cm/s; \
+         k<sub>s</sub>(20°)/k<sub>s</sub>(0) = {:.3} (68%: {:.3} to {:.3}; the paper's force tests: about 0.40). {}</p>",
+        fit.chi_squared,
+        fit.dof,
+        fit.chi_squared_per_dof.map_or(String::new(), |r| format!(" (χ²/dof {r:.2})")),
+        fit.error_floor_m_s * 100.0,
+        fit.shear_ratio_20.value,
+        fit.shear_ratio_20.lower,
+        fit.shear_ratio_20.upper,
+        if model_is_calibration {
+            "Every number and figure on this page uses this fit."
+        } else {
+            "The tables and figures above and below use the terrain as given, not this fit: this is what the evidence makes of its k_s shape."
+        }
+    ));
+    if let Some(n) = &c.no_floor {
+        h.push_str(&format!(
+            "<p>Without the floor (the quoted SDs only): χ² = {:.2} over {} degrees of freedom{}, p = {}{}.</p>",
+            n.chi_squared,
+            n.dof,
+            n.chi_squared_per_dof.map_or(String::new(), |r| format!(" (χ²/dof {r:.2})")),
+            n.p_value.map_or("-".into(), format_p),
+            n.plate_scale.map_or(String::new(), |s| format!("; plate_scale {s:.1}"))
+        ));
+    }
+    h.push_str(&format!("<p><b>Which is the test:</b> {}</p>\n", escape(&c.goodness_of_fit)));
+    h.push_str("<table><tr><th>fitted quantity</th><th>best</th><th>68% interval</th><th>unit</th></tr>");
+    for p in &fit.parameters {
+        let (scale, unit) = match p.unit.as_str() {
+            "m/s" => (100.0, "cm/s".to_string()),
+            "N/m^3" => (1.0, "N/m³".to_string()),
+            u => (1.0, u.to_string()),
+        };
+        h.push_str(&format!(
+            "<tr><td>{}</td><td>{}</td><td>{} to {}{}</td><td>{}</td></tr>",
+            escape(&p.name),
+            sci(p.estimate.value * scale, 3),
+            sci(p.estimate.lower * scale, 3),
+            sci(p.estimate.upper * scale, 3),
+            if p.at_bound { " (at a bound)" } else { "" },
+            escape(&unit)
+        ));
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// The step budget (docs/model.md §5) and the per-slope inversion, one row per observed slope.
+pub fn step_budget(report: &Report) -> String {
+    if report.step_budget.is_empty() {
+        return String::new();
+    }
+    let mut h = String::from("<h2 id=\"step-budget\">Where the step is lost</h2>\n");
+    h.push_str(
+        "<p>The model's net step is the level step s* minus three losses (docs/model.md §5): the shorter \
+         propulsion time s* (1 - ((T/2 - t1)/(T/2))²), the inherited-speed term g sin θ t1 (T/2 - t1) of the \
+         propulsion, and the backward slip ½ g sin θ t1². t1 is also given in frames of the paper's 120 fps \
+         motion capture. The last two columns invert each observed speed alone: the k<sub>s</sub> it needs, \
+         beside the model's.</p>\n",
+    );
+    h.push_str(
+        "<table><tr><th>slope (°)</th><th>s* (mm)</th><th>t1 (ms)</th><th>t1 (frames)</th><th>shorter propulsion (mm)</th>\
+         <th>inherited speed (mm)</th><th>slip (mm)</th><th>net step (mm)</th><th>k<sub>s</sub> needed (N/m³)</th>\
+         <th>model k<sub>s</sub> (N/m³)</th></tr>",
+    );
+    let mm = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{:.1}", v * 1e3));
+    for b in &report.step_budget {
+        let inv = report.speed_inversion.iter().find(|i| i.slope_deg == b.slope_deg);
+        h.push_str(&format!(
+            "<tr><td>{}</td><td>{:.1}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            b.slope_deg,
+            b.level_step_m * 1e3,
+            b.t1_s.map_or("-".into(), |t| format!("{:.1}", t * 1e3)),
+            b.t1_frames.map_or("-".into(), |f| format!("{f:.1}")),
+            mm(b.shorter_propulsion_m),
+            mm(b.inherited_speed_m),
+            plus_minus(b.slip_m.map(|s| s * 1e3), None, 1.0, 1),
+            mm(b.step_m),
+            inv.and_then(|i| i.k_s_needed).map_or("none (above the ceiling)".into(), |k| sci(k, 2)),
+            inv.map_or("-".into(), |i| sci(i.k_s_model, 2)),
+        ));
+    }
+    h.push_str("</table>\n");
+    h
+}

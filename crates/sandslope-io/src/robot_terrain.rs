@@ -54,3 +54,40 @@ pub fn terrain_from_toml(text: &str, source: &Source) -> Result<Terrain> {
     let spec: TerrainSpec = parse_toml(text, source)?;
     Terrain::new(spec).map_err(|e| anyhow!("{source}: {e}"))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PAPER: &str = "mass_kg = 0.35\nleg_radius_m = 0.04\nleg_width_m = 0.01\nhip_height_m = 0.03\n\
+                         leg_speed_rad_s = 6.283185307179586\nstance_legs = 3\nresponse_time_s = 0.2\n";
+
+    fn read(extra: &str) -> Result<Robot> {
+        robot_from_toml(&format!("{PAPER}{extra}"), &Source::File("r.toml".into()))
+    }
+
+    /// The simulator's optional keys (docs/model.md §15): a file without them keeps loading,
+    /// with the documented defaults; given ones are range-checked with file and key named.
+    #[test]
+    fn simulator_keys_are_optional_and_checked() {
+        let r = read("").unwrap();
+        assert_eq!((r.leg_elements(), r.servo_torque_limit()), (16, None));
+        let r = read("body_length_m = 0.3\nservo_torque_limit_n_m = 0.52\nleg_elements = 32\n").unwrap();
+        assert_eq!((r.body_length(), r.servo_torque_limit(), r.leg_elements()), (0.3, Some(0.52), 32));
+        // I = m L^2 / 12 with the given length: 0.35 * 0.09 / 12.
+        assert!((r.pitch_inertia() - 2.625e-3).abs() < 1e-12);
+        for (extra, key) in [
+            ("leg_elements = 1000\n", "leg_elements = 1000 must be a whole number from 4 to 256"),
+            ("servo_torque_limit_n_m = -1.0\n", "servo_torque_limit_n_m = -1"),
+            ("pitch_inertia_kg_m2 = 0.0\n", "pitch_inertia_kg_m2 = 0"),
+            ("body_width_m = 0.0\n", "body_width_m = 0"),
+        ] {
+            let msg = format!("{:#}", read(extra).unwrap_err());
+            assert!(msg.contains("r.toml") && msg.contains(key), "{extra}: {msg}");
+        }
+        let msg = format!("{:#}", read("leg_elements = 2.5\n").unwrap_err());
+        assert!(msg.contains("leg_elements"), "{msg}");
+        let msg = format!("{:#}", read("leg_element = 8\n").unwrap_err());
+        assert!(msg.contains("leg_element"), "{msg}");
+    }
+}

@@ -36,6 +36,24 @@ pub struct RobotSpec {
     /// Step length s_min that counts as robust progress, m; default `R`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_step_m: Option<f64>,
+    /// Body length L along the direction of travel, m (simulator only, docs/model.md §15);
+    /// default `5.5 R` (the paper's 22 cm robot with R = 4 cm). At least `2R`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_length_m: Option<f64>,
+    /// Body width B, m (simulator only: the belly's contact area is `L B`); default `L / 2.2`
+    /// (the paper's 22 cm x 10 cm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_width_m: Option<f64>,
+    /// Pitch moment of inertia about the centre of mass, kg m^2 (simulator only); default
+    /// `m L^2 / 12` (a uniform slender body of length L).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch_inertia_kg_m2: Option<f64>,
+    /// Servo torque limit per leg, N m (simulator only); default none (ideal position servo).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub servo_torque_limit_n_m: Option<f64>,
+    /// Resistive-force-theory elements per C-leg (simulator only); default 16, 4 to 256.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leg_elements: Option<u32>,
 }
 
 impl RobotSpec {
@@ -56,6 +74,11 @@ impl RobotSpec {
             leg_contact_area_m2: None,
             level_step_m: None,
             min_step_m: None,
+            body_length_m: None,
+            body_width_m: None,
+            pitch_inertia_kg_m2: None,
+            servo_torque_limit_n_m: None,
+            leg_elements: None,
         }
     }
 }
@@ -66,7 +89,15 @@ pub struct Robot {
     spec: RobotSpec,
     contact_area: f64,
     min_step: f64,
+    body_length: f64,
+    body_width: f64,
+    pitch_inertia: f64,
 }
+
+/// Default resistive-force-theory elements per leg (docs/model.md §15).
+pub const DEFAULT_LEG_ELEMENTS: u32 = 16;
+/// Fewest and most elements per leg a robot file may ask for.
+pub const LEG_ELEMENTS_RANGE: (u32, u32) = (4, 256);
 
 impl Robot {
     /// Validates `spec` (docs/model.md §2): m, R, W, omega, dt, A_c > 0; n >= 1;
@@ -103,7 +134,39 @@ impl Robot {
             Some(s) => positive("min_step_m", s)?,
             None => r,
         };
-        Ok(Robot { spec, contact_area, min_step })
+        let body_length = match spec.body_length_m {
+            Some(l) if !(l.is_finite() && l >= 2.0 * r) => {
+                return Err(ParamError::new(
+                    "body_length_m",
+                    l,
+                    format!("a finite number of at least 2 * leg_radius_m = {}", 2.0 * r),
+                ))
+            }
+            Some(l) => l,
+            None => 5.5 * r,
+        };
+        let body_width = match spec.body_width_m {
+            Some(b) => positive("body_width_m", b)?,
+            None => body_length / 2.2,
+        };
+        let pitch_inertia = match spec.pitch_inertia_kg_m2 {
+            Some(i) => positive("pitch_inertia_kg_m2", i)?,
+            None => spec.mass_kg * body_length * body_length / 12.0,
+        };
+        if let Some(t) = spec.servo_torque_limit_n_m {
+            positive("servo_torque_limit_n_m", t)?;
+        }
+        if let Some(n) = spec.leg_elements {
+            let (lo, hi) = LEG_ELEMENTS_RANGE;
+            if !(lo..=hi).contains(&n) {
+                return Err(ParamError::new(
+                    "leg_elements",
+                    f64::from(n),
+                    format!("a whole number from {lo} to {hi}"),
+                ));
+            }
+        }
+        Ok(Robot { spec, contact_area, min_step, body_length, body_width, pitch_inertia })
     }
 
     /// The same robot with another total mass (e.g. carrying a payload).
@@ -157,6 +220,27 @@ impl Robot {
         self.min_step
     }
 
+    /// Body length L, m (`5.5 R` unless given; simulator, docs/model.md §15).
+    pub fn body_length(&self) -> f64 {
+        self.body_length
+    }
+    /// Body width B, m (`L / 2.2` unless given; simulator).
+    pub fn body_width(&self) -> f64 {
+        self.body_width
+    }
+    /// Pitch moment of inertia about the centre of mass, kg m^2 (`m L^2 / 12` unless given).
+    pub fn pitch_inertia(&self) -> f64 {
+        self.pitch_inertia
+    }
+    /// Servo torque limit per leg, N m, if the robot file gives one (simulator).
+    pub fn servo_torque_limit(&self) -> Option<f64> {
+        self.spec.servo_torque_limit_n_m
+    }
+    /// Resistive-force-theory elements per leg ([`DEFAULT_LEG_ELEMENTS`] unless given).
+    pub fn leg_elements(&self) -> u32 {
+        self.spec.leg_elements.unwrap_or(DEFAULT_LEG_ELEMENTS)
+    }
+
     /// Stride period `T = 2 pi / omega`, s.
     pub fn stride_period(&self) -> f64 {
         2.0 * PI / self.spec.leg_speed_rad_s
@@ -198,6 +282,24 @@ mod tests {
         assert!((r.touchdown_angle() + 0.252_680_255_142_078_6).abs() < 1e-12);
     }
 
+    /// Simulator keys: defaults from the paper's 22 cm x 10 cm, 0.35 kg body worked by hand:
+    /// L = 5.5 * 0.04 = 0.22 m, B = 0.22 / 2.2 = 0.1 m, I = 0.35 * 0.22^2 / 12 = 1.41167e-3.
+    #[test]
+    fn simulator_keys_default_from_the_body() {
+        let r = Robot::new(paper_spec()).unwrap();
+        assert!((r.body_length() - 0.22).abs() < 1e-12);
+        assert!((r.body_width() - 0.1).abs() < 1e-12);
+        assert!((r.pitch_inertia() - 1.411_666_7e-3).abs() < 1e-9);
+        assert_eq!((r.servo_torque_limit(), r.leg_elements()), (None, 16));
+        let e = Robot::new(RobotSpec { leg_elements: Some(3), ..paper_spec() }).unwrap_err();
+        assert_eq!(e.to_string(), "leg_elements = 3 must be a whole number from 4 to 256");
+        let e = Robot::new(RobotSpec { body_length_m: Some(0.05), ..paper_spec() }).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "body_length_m = 0.05 must be a finite number of at least 2 * leg_radius_m = 0.08"
+        );
+    }
+
     #[test]
     fn hip_height_message_names_range() {
         let e = Robot::new(RobotSpec { hip_height_m: 0.09, ..paper_spec() }).unwrap_err();
@@ -216,6 +318,12 @@ mod tests {
             RobotSpec { leg_contact_area_m2: Some(0.0), ..paper_spec() },
             RobotSpec { level_step_m: Some(-1.0), ..paper_spec() },
             RobotSpec { min_step_m: Some(0.0), ..paper_spec() },
+            RobotSpec { body_length_m: Some(0.07), ..paper_spec() },
+            RobotSpec { body_width_m: Some(-0.1), ..paper_spec() },
+            RobotSpec { pitch_inertia_kg_m2: Some(0.0), ..paper_spec() },
+            RobotSpec { servo_torque_limit_n_m: Some(f64::NAN), ..paper_spec() },
+            RobotSpec { leg_elements: Some(3), ..paper_spec() },
+            RobotSpec { leg_elements: Some(257), ..paper_spec() },
         ];
         for spec in bad {
             assert!(Robot::new(spec.clone()).is_err(), "{spec:?} accepted");

@@ -28,6 +28,7 @@ prop_compose! {
             leg_contact_area_m2: None,
             level_step_m: measured,
             min_step_m: None,
+            ..RobotSpec::paper_hexapod()
         }).expect("generated within the valid ranges")
     }
 }

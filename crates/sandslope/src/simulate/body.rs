@@ -1,0 +1,178 @@
+//! The planar robot (docs/model.md §15): body, legs and their resistive-force elements, and the
+//! sand forces on them (docs/model.md §16).
+//!
+//! Slope frame: x along the slope (upslope positive), z normal to the undisturbed surface
+//! (z = 0, sand below), pitch phi positive nose-up. The body's centre of mass lies on the
+//! axle line, halfway along; the belly is a flat plate `h` below the axle line.
+
+use super::rft::Rft;
+use crate::robot::Robot;
+
+/// The shape of every leg (docs/model.md §15): the robot's C-leg, or the plates the oracle
+/// tests use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LegShape {
+    /// A semicircular arc of radius R from the axle to a tip 2R away (the paper's C-leg).
+    CLeg,
+    /// A straight plate from the axle to 2R along the C's diameter (a spoke).
+    Spoke,
+    /// A flat foot of area A_c (length A_c / W), R below the axle and centred under it at
+    /// angle 0 (the closed form's contact, docs/model.md §3).
+    Foot,
+}
+
+/// Node positions of one leg in its own frame (angle 0: the C's circle centre at (R, 0)).
+pub(crate) fn leg_nodes(robot: &Robot, shape: LegShape, elements: usize) -> Vec<[f64; 2]> {
+    let r = robot.leg_radius();
+    (0..=elements)
+        .map(|k| {
+            let f = k as f64 / elements as f64;
+            match shape {
+                LegShape::CLeg => {
+                    let u = std::f64::consts::PI * f;
+                    [r * (1.0 - u.cos()), -r * u.sin()]
+                }
+                LegShape::Spoke => [2.0 * r * f, 0.0],
+                LegShape::Foot => {
+                    let l = robot.contact_area() / robot.leg_width();
+                    [-0.5 * l + l * f, -r]
+                }
+            }
+        })
+        .collect()
+}
+
+/// Resistive-force memory of one element (docs/model.md §16: the elastic slip vector).
+pub(crate) type Memory = [f64; 2];
+
+/// The generalized force, damping and stiffness a contact adds to the body's equations.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Assembly {
+    /// Generalized force (F_x, F_z, torque about the centre of mass).
+    pub q: [f64; 3],
+    /// `d(-Q)/d(qdot)` times dt-weighted factors (implicit damping), 3x3.
+    pub c: [[f64; 3]; 3],
+    /// `d(-Q)/dq` (stiffness), 3x3.
+    pub k: [[f64; 3]; 3],
+}
+
+/// One element's contribution, kept for the memory update after the step.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Touch {
+    /// Where its memory lives (leg index or the belly, element index).
+    pub slot: usize,
+    /// Point of application relative to the centre of mass, m.
+    pub rel: [f64; 2],
+    /// Its velocity before the step, m/s.
+    pub vel: [f64; 2],
+}
+
+/// A straight element between world points `a` and `b` with velocities `va`, `vb`, width `w`.
+pub(crate) struct Element {
+    pub a: [f64; 2],
+    pub b: [f64; 2],
+    pub va: [f64; 2],
+    pub vb: [f64; 2],
+    pub w: f64,
+}
+
+/// What one element feels: force, its point, the velocity there and the implicit Jacobians.
+pub(crate) struct ElementForce {
+    pub force: [f64; 2],
+    pub point: [f64; 2],
+    pub vel: [f64; 2],
+    /// Isotropic damping coefficient for the implicit step, N s/m.
+    pub damping: f64,
+    /// `dF/d(depth)` (vector), N/m: force gained per metre the element moves down.
+    pub depth_gain: [f64; 2],
+    /// Deepest point, m.
+    pub depth: f64,
+}
+
+/// Sand force on an element (docs/model.md §16), updating nothing: `memory` is the element's
+/// elastic slip, `yield_m` the slip at which the stress reaches its resistive-force value,
+/// `dt` the step. `None` when the element is out of the sand.
+#[inline]
+pub(crate) fn element_force(
+    rft: &Rft,
+    el: &Element,
+    memory: Memory,
+    yield_m: f64,
+    dt: f64,
+) -> Option<ElementForce> {
+    let (za, zb) = (el.a[1], el.b[1]);
+    if za >= 0.0 && zb >= 0.0 {
+        return None;
+    }
+    // Submerged part, as parameters [ta, tb] along a -> b.
+    let (ta, tb) = if za < 0.0 && zb < 0.0 {
+        (0.0, 1.0)
+    } else {
+        let t0 = za / (za - zb);
+        if za < 0.0 {
+            (0.0, t0)
+        } else {
+            (t0, 1.0)
+        }
+    };
+    let d = [el.b[0] - el.a[0], el.b[1] - el.a[1]];
+    let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    if len <= 0.0 {
+        return None;
+    }
+    let da = -(za + ta * d[1]).min(0.0);
+    let db = -(za + tb * d[1]).min(0.0);
+    let sub = (tb - ta) * len;
+    let depth_integral = 0.5 * sub * (da + db);
+    if depth_integral <= 0.0 {
+        return None;
+    }
+    // Depth-weighted centroid of the submerged part.
+    let tc = ta + (tb - ta) * (da + 2.0 * db) / (3.0 * (da + db));
+    let point = [el.a[0] + tc * d[0], el.a[1] + tc * d[1]];
+    let vel = [el.va[0] + tc * (el.vb[0] - el.va[0]), el.va[1] + tc * (el.vb[1] - el.va[1])];
+    let trial = [memory[0] + dt * vel[0], memory[1] + dt * vel[1]];
+    let m = (trial[0] * trial[0] + trial[1] * trial[1]).sqrt();
+    if m <= 0.0 {
+        return None;
+    }
+    let (ex, ez) = (trial[0] / m, trial[1] / m);
+    let (sx, sz) = rft.stress(d[0] / len, d[1] / len, ex, ez);
+    let full = el.w * depth_integral;
+    let sat = (m / yield_m).min(1.0);
+    let force = [sx * full * sat, sz * full * sat];
+    let magnitude = (sx * sx + sz * sz).sqrt() * full;
+    let gain = sub / depth_integral;
+    Some(ElementForce {
+        force,
+        point,
+        vel,
+        damping: dt * magnitude / yield_m.max(m),
+        depth_gain: [force[0] * gain, force[1] * gain],
+        depth: da.max(db),
+    })
+}
+
+/// Adds an element force acting at `rel` (from the centre of mass) to the body's assembly.
+#[inline]
+pub(crate) fn assemble(asm: &mut Assembly, f: &ElementForce, rel: [f64; 2]) {
+    // Velocity Jacobian rows: v = (vx - w rel_z, vz + w rel_x).
+    let jx = [1.0, 0.0, -rel[1]];
+    let jz = [0.0, 1.0, rel[0]];
+    asm.q[0] += f.force[0];
+    asm.q[1] += f.force[1];
+    asm.q[2] += rel[0] * f.force[1] - rel[1] * f.force[0];
+    // Generalized depth gain: J^T dF/d(depth); depth grows as z falls: dz/dq = jz.
+    let gq = [
+        jx[0] * f.depth_gain[0] + jz[0] * f.depth_gain[1],
+        jx[1] * f.depth_gain[0] + jz[1] * f.depth_gain[1],
+        jx[2] * f.depth_gain[0] + jz[2] * f.depth_gain[1],
+    ];
+    for i in 0..3 {
+        for j in 0..3 {
+            asm.c[i][j] += f.damping * (jx[i] * jx[j] + jz[i] * jz[j]);
+            asm.k[i][j] += gq[i] * jz[j];
+        }
+    }
+}

@@ -1,0 +1,495 @@
+//! A dynamic stride simulator on granular slopes (docs/model.md §15-§18): the closed form's
+//! test bench.
+//!
+//! A planar rigid body (x along the slope, z normal to it, pitch) walks on C-legs in the
+//! alternating tripod, driven by position servos with an optional torque limit; the sand
+//! pushes on every leg element by resistive force theory scaled to the same terrain file as
+//! the closed form ([`rft`]), so the two differ only by the closed form's assumptions. The
+//! integrator is a fixed-step, linearly implicit Euler step ([`dynamics`]). [`simulate`] runs
+//! one walk and measures it exactly as `track` measures a recording (docs/model.md §11):
+//! speed, per-step anchoring time, slip and step, and the regime read from the motion, beside
+//! the closed form's answer for the same inputs. [`simulate_slopes`] runs several slopes in
+//! parallel.
+
+pub mod body;
+pub mod dynamics;
+pub mod rft;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+pub use body::LegShape;
+use dynamics::Walker;
+
+use crate::error::ParamError;
+use crate::gait::{measure_step, SmoothTrack};
+use crate::regime::{classify, Cause, Regime};
+use crate::scenario::{Scenario, SlopeEvaluation};
+use crate::slope::Slope;
+
+/// Default elastic slip at which the sand's stress reaches its resistive-force value, m
+/// (docs/model.md §16; a few bead diameters of the paper's 300 um beads).
+pub const DEFAULT_YIELD_M: f64 = 1e-3;
+/// Default output sample rate, Hz (the paper's motion capture).
+pub const DEFAULT_SAMPLE_RATE_HZ: f64 = 120.0;
+/// Default settling time before the gait starts, s (gravity ramps in over it).
+pub const DEFAULT_SETTLE_S: f64 = 0.5;
+/// Longest walk, s.
+pub const MAX_DURATION_S: f64 = 3600.0;
+/// Most integration steps one walk may take.
+pub const MAX_STEPS: f64 = 2e7;
+/// Steps (one tripod stance each) left out of the means while the gait settles in.
+pub const WARMUP_STEPS: usize = 2;
+
+/// How to run a walk. Build with [`SimSettings::new`] and the `with_` methods.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SimSettings {
+    /// Simulated time after settling, s.
+    pub duration_s: f64,
+    /// Integration step, s; `None`: chosen from the stiffness and the gait (docs/model.md §17).
+    pub dt_s: Option<f64>,
+    /// Trajectory sample rate, Hz.
+    pub sample_rate_hz: f64,
+    /// Elastic slip at which the stress reaches its resistive-force value, m.
+    pub yield_m: f64,
+    /// Settling time before the gait starts (gravity ramps in), s.
+    pub settle_s: f64,
+    /// Leg shape.
+    pub shape: LegShape,
+    /// Hold every leg at this angle (rad, tripod B half a turn on) instead of walking.
+    pub locked_leg_angle: Option<f64>,
+}
+
+impl SimSettings {
+    /// A walk of `duration_s` seconds with the defaults; fails (key `duration_s`) unless
+    /// `0 < duration_s <= 3600`.
+    pub fn new(duration_s: f64) -> Result<SimSettings, ParamError> {
+        if !(duration_s.is_finite() && duration_s > 0.0 && duration_s <= MAX_DURATION_S) {
+            return Err(ParamError::new(
+                "duration_s",
+                duration_s,
+                format!("a number of seconds greater than 0 and at most {MAX_DURATION_S}"),
+            ));
+        }
+        Ok(SimSettings {
+            duration_s,
+            dt_s: None,
+            sample_rate_hz: DEFAULT_SAMPLE_RATE_HZ,
+            yield_m: DEFAULT_YIELD_M,
+            settle_s: DEFAULT_SETTLE_S,
+            shape: LegShape::CLeg,
+            locked_leg_angle: None,
+        })
+    }
+
+    /// A fixed integration step, s (checked against the stiffness by [`simulate`]).
+    pub fn with_dt(self, dt_s: f64) -> Result<SimSettings, ParamError> {
+        Ok(SimSettings { dt_s: Some(crate::error::positive("dt_s", dt_s)?), ..self })
+    }
+
+    /// The trajectory sample rate, Hz (1 to 100000).
+    pub fn with_sample_rate(self, hz: f64) -> Result<SimSettings, ParamError> {
+        if !(hz.is_finite() && (1.0..=1e5).contains(&hz)) {
+            return Err(ParamError::new("sample_rate_hz", hz, "between 1 and 100000 Hz"));
+        }
+        Ok(SimSettings { sample_rate_hz: hz, ..self })
+    }
+
+    /// The yield slip, m (1e-6 to 0.01).
+    pub fn with_yield(self, yield_m: f64) -> Result<SimSettings, ParamError> {
+        if !(yield_m.is_finite() && (1e-6..=1e-2).contains(&yield_m)) {
+            return Err(ParamError::new("yield_m", yield_m, "between 1e-6 and 0.01 m"));
+        }
+        Ok(SimSettings { yield_m, ..self })
+    }
+
+    /// The settling time, s (0 to 60).
+    pub fn with_settle(self, settle_s: f64) -> Result<SimSettings, ParamError> {
+        if !(settle_s.is_finite() && (0.0..=60.0).contains(&settle_s)) {
+            return Err(ParamError::new("settle_s", settle_s, "between 0 and 60 s"));
+        }
+        Ok(SimSettings { settle_s, ..self })
+    }
+
+    /// Another leg shape.
+    pub fn with_shape(self, shape: LegShape) -> SimSettings {
+        SimSettings { shape, ..self }
+    }
+
+    /// Legs held at `angle` rad (tripod B at `angle + pi`) instead of walking.
+    pub fn with_locked_legs(self, angle: f64) -> SimSettings {
+        SimSettings { locked_leg_angle: Some(angle), ..self }
+    }
+}
+
+/// Why a walk ended in its regime: the closed form's causes (docs/model.md §6) read from the
+/// motion, plus a stalled servo.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MotionCause {
+    /// A leg went deeper than `2R - h`: the body sank onto its belly.
+    NormalSinkage,
+    /// The slope is at or above the terrain's angle of repose.
+    AtOrAboveRepose,
+    /// No step anchored (the speed never turned from falling to rising) and no progress.
+    NoAnchoring,
+    /// Net backward motion over the measured steps.
+    NetBackwardStep,
+    /// Progress, but the mean step is shorter than s_min.
+    ShortStep,
+    /// Mean step at least s_min.
+    RobustStep,
+    /// A servo stalled (its torque limit bound) and the walk did not succeed.
+    ServoStall,
+}
+
+impl MotionCause {
+    fn from_cause(c: Cause) -> MotionCause {
+        match c {
+            Cause::NormalSinkage => MotionCause::NormalSinkage,
+            Cause::AtOrAboveRepose => MotionCause::AtOrAboveRepose,
+            Cause::NoAnchoring => MotionCause::NoAnchoring,
+            Cause::NetBackwardStep => MotionCause::NetBackwardStep,
+            Cause::ShortStep => MotionCause::ShortStep,
+            Cause::RobustStep => MotionCause::RobustStep,
+        }
+    }
+
+    /// The snake_case name used in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionCause::NormalSinkage => "normal_sinkage",
+            MotionCause::AtOrAboveRepose => "at_or_above_repose",
+            MotionCause::NoAnchoring => "no_anchoring",
+            MotionCause::NetBackwardStep => "net_backward_step",
+            MotionCause::ShortStep => "short_step",
+            MotionCause::RobustStep => "robust_step",
+            MotionCause::ServoStall => "servo_stall",
+        }
+    }
+}
+
+/// One step: one tripod's stance of T/2 from its touchdown, measured as docs/model.md §11.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SimStep {
+    /// Step number from 0.
+    pub index: usize,
+    /// Tripod in stance (0 or 1).
+    pub tripod: usize,
+    /// Touchdown time t0, s.
+    pub touchdown_s: f64,
+    /// Whether the step is left out of the means (the first stride).
+    pub warmup: bool,
+    /// Anchoring time t1 - t0, s (`None`: the speed never turned from falling to rising).
+    pub t1_s: Option<f64>,
+    /// Backward slip between t0 and t1, m.
+    pub slip_m: Option<f64>,
+    /// Net displacement upslope over the step, m.
+    pub step_m: f64,
+    /// `step / (T/2)`, m/s.
+    pub speed_m_s: f64,
+    /// Deepest any leg went below the surface, m.
+    pub max_depth_m: f64,
+    /// Largest sand force on one leg, N.
+    pub peak_leg_force_n: f64,
+    /// Largest servo torque on one leg, N m.
+    pub peak_servo_torque_n_m: f64,
+    /// Time servos spent stalled, summed over legs, s.
+    pub stall_s: f64,
+}
+
+/// The body and legs over time, sampled at the settings' rate (one column per quantity).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trajectory {
+    /// Time since the gait started, s.
+    pub time_s: Vec<f64>,
+    /// Centre of mass along the slope (upslope positive), m.
+    pub x_m: Vec<f64>,
+    /// Axle line height above the undisturbed surface, normal to it, m.
+    pub z_m: Vec<f64>,
+    /// Pitch, rad (nose up positive).
+    pub pitch_rad: Vec<f64>,
+    /// Velocity along the slope, m/s.
+    pub vx_m_s: Vec<f64>,
+    /// Velocity normal to the slope, m/s.
+    pub vz_m_s: Vec<f64>,
+    /// Each leg's angle, rad (0: the C's circle centre straight ahead of the axle).
+    pub leg_angle_rad: Vec<Vec<f64>>,
+    /// Each leg's depth below the surface (deepest point, 0 when out), m.
+    pub leg_depth_m: Vec<Vec<f64>>,
+    /// Each leg's sand force, along the slope, N.
+    pub leg_force_x_n: Vec<Vec<f64>>,
+    /// Each leg's sand force, normal to the slope, N.
+    pub leg_force_z_n: Vec<Vec<f64>>,
+    /// Each leg's servo torque, N m.
+    pub leg_torque_n_m: Vec<Vec<f64>>,
+}
+
+/// The hip positions and tripods of the legs, for drawing.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Geometry {
+    /// Hip x in the body frame, m, one per leg.
+    pub hip_x_m: Vec<f64>,
+    /// Tripod of each leg (0 or 1).
+    pub tripod: Vec<usize>,
+    /// Leg outline in its own frame (angle 0), m: the element nodes.
+    pub leg_nodes_m: Vec<[f64; 2]>,
+    /// Body length, m.
+    pub body_length_m: f64,
+    /// Hip height h (axle to belly), m.
+    pub hip_height_m: f64,
+}
+
+/// What a walk did, as `simulate --json` prints it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SimSummary {
+    /// Slope, degrees (negative: descending).
+    pub slope_deg: f64,
+    /// Normal penetration resistance used, N/m^3.
+    pub k_n: f64,
+    /// Shear strength used, N/m^3.
+    pub k_s: f64,
+    /// Simulated time after settling, s.
+    pub duration_s: f64,
+    /// Integration step used, s.
+    pub dt_s: f64,
+    /// Elements per leg.
+    pub leg_elements: u32,
+    /// Leg shape.
+    pub shape: LegShape,
+    /// Elastic slip to full stress, m.
+    pub yield_m: f64,
+    /// Mean step speed over the measured steps, m/s.
+    pub speed_m_s: f64,
+    /// Mean anchoring time over the measured steps that anchored, s.
+    pub t1_s: Option<f64>,
+    /// Mean backward slip over the measured steps that anchored, m.
+    pub slip_m: Option<f64>,
+    /// Mean net step over the measured steps, m.
+    pub step_m: f64,
+    /// Standard deviation of the step speed across measured steps, m/s.
+    pub speed_sd_m_s: f64,
+    /// Measured steps (after the first stride).
+    pub steps_measured: usize,
+    /// Measured steps without anchoring.
+    pub unanchored_steps: usize,
+    /// Deepest any leg went in a measured step, m.
+    pub max_depth_m: f64,
+    /// The leg reach `2R - h`, m: deeper means the body sank.
+    pub d_max_m: f64,
+    /// Regime read from the motion (docs/model.md §18).
+    pub regime: Regime,
+    /// Why.
+    pub cause: MotionCause,
+    /// Legs whose servo stalled in a measured step (indices).
+    pub stalled_legs: Vec<usize>,
+    /// Every step, warm-up included.
+    pub steps: Vec<SimStep>,
+    /// What `predict --json` gives for the same robot, terrain and slope.
+    pub closed_form: SlopeEvaluation,
+}
+
+/// A walk: its summary and its trajectory.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Simulation {
+    /// The measured walk.
+    pub summary: SimSummary,
+    /// Body and legs over time.
+    pub trajectory: Trajectory,
+    /// The robot's legs, for drawing.
+    pub geometry: Geometry,
+}
+
+/// Why a walk could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimulateError {
+    /// A parameter is out of range.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+}
+
+/// The integration step for `scenario` at `slope`: the given one, checked, or the default
+/// `min(1 ms, 0.25 / omega_n, T / 200)` (docs/model.md §17).
+pub fn integration_step(scenario: &Scenario, slope: Slope, given: Option<f64>) -> Result<f64, ParamError> {
+    let robot = scenario.robot();
+    let (ground, _) = scenario.ground_at(slope);
+    let omega_n = (f64::from(robot.stance_legs()) * ground.k_n * robot.contact_area() / robot.mass()).sqrt();
+    let period = robot.stride_period();
+    let limit = (0.5 / omega_n).min(period / 100.0);
+    match given {
+        None => Ok(1e-3f64.min(0.25 / omega_n).min(period / 200.0)),
+        Some(dt) if dt.is_finite() && dt > 0.0 && dt <= limit => Ok(dt),
+        Some(dt) => Err(ParamError::new(
+            "dt_s",
+            dt,
+            format!(
+                "greater than 0 and at most {limit:.3e} s for this robot and ground (0.5 / omega_n with omega_n = \
+                 sqrt(n k_n A_c / m) = {omega_n:.1} rad/s, and T / 100 = {:.3e} s)",
+                period / 100.0
+            ),
+        )),
+    }
+}
+
+/// Simulates `scenario`'s robot walking on its terrain at `slope_deg` (signed: negative walks
+/// downhill; the terrain is read at |slope| as docs/model.md §8) for `settings.duration_s`
+/// seconds, and measures the walk (docs/model.md §15-§18).
+pub fn simulate(
+    scenario: &Scenario,
+    slope_deg: f64,
+    settings: &SimSettings,
+) -> Result<Simulation, SimulateError> {
+    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+    let closed_form = scenario.evaluate(slope_deg)?;
+    let robot = scenario.robot();
+    let (ground, _) = scenario.ground_at(slope);
+    let dt = integration_step(scenario, slope, settings.dt_s)?;
+    let half = robot.stance_duration();
+    if settings.locked_leg_angle.is_none() && settings.duration_s < 3.0 * half {
+        return Err(ParamError::new(
+            "duration_s",
+            settings.duration_s,
+            format!(
+                "at least 1.5 T = {} s (one stride to settle into the gait, then one step to measure)",
+                3.0 * half
+            ),
+        )
+        .into());
+    }
+    let n_steps = (settings.duration_s / dt).round();
+    if n_steps + settings.settle_s / dt > MAX_STEPS {
+        return Err(ParamError::new(
+            "duration_s",
+            settings.duration_s,
+            format!("at most {MAX_STEPS:e} integration steps of {dt:.3e} s (settling included)"),
+        )
+        .into());
+    }
+    let n_steps = n_steps as usize;
+    let theta = slope_deg.to_radians();
+    let mut walker = Walker::new(robot, &ground, theta, settings, dt);
+    walker.settle(settings.settle_s);
+    let run = walker.run(n_steps, half, settings.sample_rate_hz);
+
+    // Measure each step exactly as `track` does (docs/model.md §11) on the full-rate track.
+    let track = SmoothTrack {
+        start_time_s: 0.0,
+        frame_rate_hz: 1.0 / dt,
+        position: run.x,
+        speed: run.vx,
+        speed_noise_m_s: SPEED_RISE_M_S / 3.0,
+    };
+    let duration = n_steps as f64 * dt;
+    let n_meas = ((duration + 1e-9) / half).floor() as usize;
+    let mut steps = Vec::with_capacity(n_meas);
+    for k in 0..n_meas {
+        let t0 = k as f64 * half;
+        if !track.covers(t0, half) {
+            break;
+        }
+        let m = measure_step(&track, t0, half);
+        let acc = run.per_step.get(k).copied().unwrap_or_default();
+        steps.push(SimStep {
+            index: k,
+            tripod: k % 2,
+            touchdown_s: t0,
+            warmup: k < WARMUP_STEPS,
+            t1_s: m.anchoring_time_s,
+            slip_m: m.slip_m,
+            step_m: m.step_m,
+            speed_m_s: m.speed_m_s,
+            max_depth_m: acc.max_depth,
+            peak_leg_force_n: acc.peak_force,
+            peak_servo_torque_n_m: acc.peak_torque,
+            stall_s: acc.stall_s,
+        });
+    }
+    let summary = summarise(scenario, slope, &ground, settings, dt, steps, closed_form, &run.stalled_by_step);
+    Ok(Simulation { summary, trajectory: run.trajectory, geometry: run.geometry })
+}
+
+/// A speed minimum counts as the anchoring time only if the speed then rises by more than
+/// this, m/s (docs/model.md §18; the simulated speed has no noise, but resistive-force
+/// elements entering the sand leave sub-millimetre-per-second ripples).
+pub const SPEED_RISE_M_S: f64 = 3e-4;
+
+#[allow(clippy::too_many_arguments)]
+fn summarise(
+    scenario: &Scenario,
+    slope: Slope,
+    ground: &crate::terrain::Ground,
+    settings: &SimSettings,
+    dt: f64,
+    steps: Vec<SimStep>,
+    closed_form: SlopeEvaluation,
+    stalled_by_step: &[Vec<usize>],
+) -> SimSummary {
+    let robot = scenario.robot();
+    let measured: Vec<&SimStep> = steps.iter().filter(|s| !s.warmup).collect();
+    let n = measured.len().max(1) as f64;
+    let speed = measured.iter().map(|s| s.speed_m_s).sum::<f64>() / n;
+    let speed_sd = if measured.len() > 1 {
+        (measured.iter().map(|s| (s.speed_m_s - speed).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+    } else {
+        0.0
+    };
+    let step = measured.iter().map(|s| s.step_m).sum::<f64>() / n;
+    let anchored: Vec<&&SimStep> = measured.iter().filter(|s| s.t1_s.is_some()).collect();
+    let mean_of = |f: &dyn Fn(&SimStep) -> f64| {
+        (!anchored.is_empty()).then(|| anchored.iter().map(|s| f(s)).sum::<f64>() / anchored.len() as f64)
+    };
+    let t1 = mean_of(&|s| s.t1_s.unwrap_or(0.0));
+    let slip = mean_of(&|s| s.slip_m.unwrap_or(0.0));
+    let max_depth = measured.iter().map(|s| s.max_depth_m).fold(0.0, f64::max);
+    let d_max = robot.max_depth();
+    // Sinkage: in most measured steps a leg went deeper than its reach from the rest height.
+    let sunk_steps = measured.iter().filter(|s| s.max_depth_m > d_max * (1.0 + 1e-3)).count();
+    let sunk = 2 * sunk_steps > measured.len();
+    let step_for_regime = if anchored.is_empty() && step <= 0.0 { None } else { Some(step) };
+    let cause = classify(sunk, ground.beyond_repose(slope), step_for_regime, robot.min_step());
+    let mut stalled_legs: Vec<usize> =
+        measured.iter().filter_map(|s| stalled_by_step.get(s.index)).flatten().copied().collect();
+    stalled_legs.sort_unstable();
+    stalled_legs.dedup();
+    let motion_cause = if !stalled_legs.is_empty() && cause.regime() != Regime::Success {
+        MotionCause::ServoStall
+    } else {
+        MotionCause::from_cause(cause)
+    };
+    SimSummary {
+        slope_deg: closed_form.slope_deg,
+        k_n: ground.k_n,
+        k_s: ground.k_s,
+        duration_s: settings.duration_s,
+        dt_s: dt,
+        leg_elements: robot.leg_elements(),
+        shape: settings.shape,
+        yield_m: settings.yield_m,
+        speed_m_s: speed,
+        t1_s: t1,
+        slip_m: slip,
+        step_m: step,
+        speed_sd_m_s: speed_sd,
+        steps_measured: measured.len(),
+        unanchored_steps: measured.len() - anchored.len(),
+        max_depth_m: max_depth,
+        d_max_m: d_max,
+        regime: cause.regime(),
+        cause: motion_cause,
+        stalled_legs,
+        steps,
+        closed_form,
+    }
+}
+
+/// Simulates every slope of `slopes_deg` in parallel (rayon), in order.
+pub fn simulate_slopes(
+    scenario: &Scenario,
+    slopes_deg: &[f64],
+    settings: &SimSettings,
+) -> Result<Vec<Simulation>, SimulateError> {
+    slopes_deg.par_iter().map(|&d| simulate(scenario, d, settings)).collect()
+}
+
+#[cfg(test)]
+mod tests;

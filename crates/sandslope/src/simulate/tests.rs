@@ -1,0 +1,206 @@
+//! Oracle tests of the simulator (docs/model.md §15-§18).
+
+use super::body::{element_force, leg_nodes, Element};
+use super::dynamics::Walker;
+use super::rft::Rft;
+use super::*;
+use crate::model::tests::paper_robot;
+use crate::model::{normal_equilibrium_depth, G};
+use crate::robot::{Robot, RobotSpec};
+use crate::terrain::{Ground, Terrain};
+
+fn scenario(k_n: f64, k_s: f64) -> Scenario {
+    Scenario::new(paper_robot(), Terrain::constant(k_n, k_s).unwrap(), None, None).unwrap()
+}
+
+/// Static oracle: legs locked with flat feet of area A_c (docs/model.md §3's contact), level
+/// sand, loaded quasi-statically (gravity ramped in over 8 s): each foot settles at the closed
+/// form's `d_n = m g / (n k_n A_c)` within 1%, at every k_n of a sweep over two decades (d_n from 7.2 mm to 0.07 mm; below 4e5 the belly, 1 cm above the feet, touches).
+#[test]
+fn locked_feet_settle_at_the_closed_form_depth() {
+    let robot = paper_robot();
+    // A yield slip of 1 um: the closed form has none (with the default 1 mm, a foot that
+    // settles only ~1 mm deep has not mobilised its full stress, docs/model.md §16).
+    let settings = SimSettings::new(1.0)
+        .unwrap()
+        .with_shape(LegShape::Foot)
+        .with_locked_legs(0.0)
+        .with_yield(1e-6)
+        .unwrap();
+    for k_n in [4e5, 1e6, 3e6, 1e7, 4e7] {
+        let ground = Ground::new(k_n, 2e6).unwrap();
+        let mut w = Walker::new(&robot, &ground, 0.0, &settings, 1e-3);
+        w.settle(10.0);
+        w.hold(500);
+        // By hand: d_n = 0.35 * 9.81 / (3 * k_n * 4e-4).
+        let d_n = 0.35 * G / (3.0 * k_n * 4e-4);
+        assert!((d_n - normal_equilibrium_depth(&robot, Slope::LEVEL, k_n)).abs() < 1e-15);
+        let depth = w.leg_depth();
+        assert!((depth / d_n - 1.0).abs() < 0.01, "k_n = {k_n}: depth {depth} vs d_n {d_n}");
+        let (q, v) = w.state();
+        assert!(q[2].abs() < 1e-6 && v.iter().all(|x| x.abs() < 1e-4), "{q:?} {v:?}");
+    }
+}
+
+/// A leg pushed sideways at fixed depth: a spoke held vertical, reaching d below the surface,
+/// dragged along +x with its slip saturated, feels `k_s W d^2` against the motion (the
+/// resistive-force scaling of docs/model.md §16), whatever the element count.
+#[test]
+fn spoke_dragged_sideways_feels_k_s_w_d_squared() {
+    let robot = paper_robot();
+    let rft = Rft::new(7e5, 2e6);
+    for (d, elements) in [(0.02, 16), (0.013, 7), (0.05, 64)] {
+        let nodes = leg_nodes(&robot, LegShape::Spoke, elements);
+        // Angle pi/2 turns the spoke straight down: node (x, 0) goes to (0, -x).
+        let hip_z = 2.0 * robot.leg_radius() - d;
+        let world: Vec<[f64; 2]> = nodes.iter().map(|p| [0.0, hip_z - p[0]]).collect();
+        let mut fx = 0.0;
+        for k in 0..elements {
+            let el = Element {
+                a: world[k],
+                b: world[k + 1],
+                va: [0.05, 0.0],
+                vb: [0.05, 0.0],
+                w: robot.leg_width(),
+            };
+            if let Some(f) = element_force(&rft, &el, [1e-3, 0.0], 1e-3, 1e-3) {
+                fx += f.force[0];
+            }
+        }
+        let expected = 2e6 * 0.01 * d * d;
+        assert!((fx + expected).abs() < 1e-9 * expected, "d = {d}: {fx} vs {expected}");
+    }
+}
+
+/// The walk converges as the step halves (first order): on level sand and on a 10 degree
+/// slope with the plate force tests' shear strength (data/example-force-tests.toml), the
+/// change in speed from 0.5 to 0.25 ms is smaller than from 1 to 0.5 ms, and the speed and
+/// deepest leg depth at 0.5 ms are within 3% of those at 0.25 ms.
+#[test]
+fn converges_when_the_step_halves() {
+    for (slope, k_s) in [(0.0, 1e5), (10.0, 7e4)] {
+        let s = scenario(7e5, k_s);
+        let run = |dt: f64| {
+            simulate(&s, slope, &SimSettings::new(4.0).unwrap().with_dt(dt).unwrap()).unwrap().summary
+        };
+        let (coarse, mid, fine) = (run(1e-3), run(5e-4), run(2.5e-4));
+        let (d1, d2) = ((coarse.speed_m_s - mid.speed_m_s).abs(), (mid.speed_m_s - fine.speed_m_s).abs());
+        assert!(d2 < d1, "{slope} deg: {} {} {}", coarse.speed_m_s, mid.speed_m_s, fine.speed_m_s);
+        assert!((mid.speed_m_s / fine.speed_m_s - 1.0).abs() < 0.03);
+        assert!((mid.max_depth_m / fine.max_depth_m - 1.0).abs() < 0.03);
+    }
+}
+
+/// Bad input names the value and its range; nothing runs.
+#[test]
+fn bad_input_names_the_value_and_range() {
+    let e = SimSettings::new(-1.0).unwrap_err();
+    assert_eq!(e.key, "duration_s");
+    assert!(e.to_string().contains("greater than 0"), "{e}");
+    let s = scenario(7e5, 2e6);
+    let short = simulate(&s, 0.0, &SimSettings::new(1.0).unwrap()).unwrap_err().to_string();
+    assert!(short.contains("duration_s = 1") && short.contains("1.5 T = 1.5"), "{short}");
+    let coarse = SimSettings::new(5.0).unwrap().with_dt(0.05).unwrap();
+    let msg = simulate(&s, 0.0, &coarse).unwrap_err().to_string();
+    // omega_n = sqrt(3 * 7e5 * 4e-4 / 0.35) = 48.99 rad/s; 0.5 / omega_n = 0.0102 > T/100.
+    assert!(
+        msg.starts_with("dt_s = 0.05") && msg.contains("49.0 rad/s") && msg.contains("1.000e-2"),
+        "{msg}"
+    );
+    let msg = simulate(&s, 90.0, &SimSettings::new(5.0).unwrap()).unwrap_err().to_string();
+    assert!(msg.starts_with("slope_deg = 90"), "{msg}");
+    let stiff = scenario(7e9, 2e6);
+    let msg = simulate(&stiff, 0.0, &SimSettings::new(5.0).unwrap().with_dt(1e-3).unwrap()).unwrap_err();
+    assert!(msg.to_string().contains("omega_n"), "{msg}");
+}
+
+/// The summary's closed form is exactly what `predict` computes for the same inputs.
+#[test]
+fn closed_form_is_predicts_answer() {
+    let s = scenario(7e5, 2e6);
+    let sim = simulate(&s, 12.0, &SimSettings::new(2.0).unwrap()).unwrap();
+    assert_eq!(sim.summary.closed_form, s.evaluate(12.0).unwrap());
+    assert_eq!(sim.summary.steps.len(), 4);
+    assert_eq!(sim.summary.steps_measured, 2);
+    // 2 s at 120 Hz: 241 samples from t = 0.
+    assert_eq!(sim.trajectory.time_s.len(), 241);
+    assert!((sim.trajectory.time_s[240] - 2.0).abs() < 1e-12);
+}
+
+/// A torque limit far below what the legs need stalls the servos, and the summary says so.
+#[test]
+fn a_weak_servo_stalls_and_is_named() {
+    let weak =
+        Robot::new(RobotSpec { servo_torque_limit_n_m: Some(0.01), ..RobotSpec::paper_hexapod() }).unwrap();
+    let s = Scenario::new(weak, Terrain::constant(7e5, 2e6).unwrap(), None, None).unwrap();
+    let m = simulate(&s, 10.0, &SimSettings::new(3.0).unwrap()).unwrap().summary;
+    assert!(!m.stalled_legs.is_empty());
+    assert!(m.steps.iter().any(|st| st.stall_s > 0.0));
+    let strong = simulate(&scenario(7e5, 2e6), 10.0, &SimSettings::new(3.0).unwrap()).unwrap().summary;
+    assert!(strong.stalled_legs.is_empty());
+    assert!(m.speed_m_s < strong.speed_m_s);
+}
+
+/// Numbers for docs/simulate.md (run with `cargo test -p sandslope --release --lib
+/// simulate::tests::table -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn dt_series() {
+    for (slope, k_s) in [(0.0, 1e5), (10.0, 7e4), (10.0, 2e6)] {
+        let s = scenario(7e5, k_s);
+        for dt in [2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4] {
+            let m =
+                simulate(&s, slope, &SimSettings::new(4.0).unwrap().with_dt(dt).unwrap()).unwrap().summary;
+            let sp: Vec<String> = m.steps.iter().map(|s| format!("{:.3}", s.speed_m_s)).collect();
+            println!(
+                "{slope} {k_s} {dt}: v={:.4} t1={:?} d={:.4} {}",
+                m.speed_m_s,
+                m.t1_s,
+                m.max_depth_m,
+                sp.join(" ")
+            );
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn table() {
+    let s = Scenario::new(paper_robot(), builtin_terrain(), None, None).unwrap();
+    for slope in [0.0, 4.0, 8.0, 10.0, 12.0, 15.0, 16.0, 20.0, 24.0] {
+        let m = simulate(&s, slope, &SimSettings::new(10.0).unwrap()).unwrap().summary;
+        let p = &m.closed_form.prediction;
+        println!(
+            "| {slope} | {:.1} / {:.1} | {:.2} / {:.2} | {:.1} / {:.1} | {:.2} / {:.2} | {} / {} | {:.1} |",
+            m.t1_s.unwrap_or(f64::NAN) * 1e3,
+            p.anchoring_time.unwrap_or(f64::NAN) * 1e3,
+            m.slip_m.unwrap_or(f64::NAN) * 1e3,
+            p.slip.unwrap_or(f64::NAN) * 1e3,
+            m.step_m * 1e3,
+            p.step.unwrap_or(f64::NAN) * 1e3,
+            m.speed_m_s * 1e2,
+            p.speed.unwrap_or(f64::NAN) * 1e2,
+            m.regime,
+            p.regime,
+            m.max_depth_m * 1e3,
+        );
+    }
+}
+
+/// The built-in glass-beads terrain (crates/sandslope-io/presets/glass-beads-300um.toml).
+fn builtin_terrain() -> Terrain {
+    use crate::terrain::{TerrainPoint, TerrainSpec};
+    let pt = |slope_deg, k_s| TerrainPoint { slope_deg, k_n: 7e5, k_s, k_n_sd: None, k_s_sd: None };
+    Terrain::new(TerrainSpec {
+        name: None,
+        repose_deg: Some(25.0),
+        points: vec![
+            pt(0.0, 3_260_672.8),
+            pt(10.0, 2_385_555.1),
+            pt(15.0, 1_947_996.3),
+            pt(20.0, 1_510_437.4),
+            pt(24.0, 1_160_390.4),
+        ],
+    })
+    .unwrap()
+}

@@ -28,6 +28,8 @@ struct Cli {
 enum Command {
     /// Every model quantity (d_n, s*, d_s, t1, slip, step, speed, regime) at one slope.
     Predict(commands::predict::PredictArgs),
+    /// Dynamic stride simulation on a granular slope (docs/model.md §15-§18), beside the closed form.
+    Simulate(commands::simulate::SimulateArgs),
     /// The model over a range of slopes (table, JSON, CSV, or a three-panel figure).
     Sweep(commands::sweep::SweepArgs),
     /// Fit k_s(theta) so the model's speeds match observed ones; write a terrain file.
@@ -57,6 +59,7 @@ enum Command {
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Predict(a) => commands::predict::run(a),
+        Command::Simulate(a) => commands::simulate::run(a),
         Command::Sweep(a) => commands::sweep::run(a),
         Command::Calibrate(a) => commands::calibrate::run(a),
         Command::Fit(a) => commands::fit::run(a),

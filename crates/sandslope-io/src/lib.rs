@@ -5,7 +5,8 @@
 //! ([`robot_terrain`], [`presets`]), speed tables ([`speeds`]), anchoring-time tables ([`anchoring`]), load-cell manifests and
 //! recordings ([`measurements`]), motion-capture exports ([`mocap`]), elevation rasters and the
 //! risk-map GeoTIFF ([`raster`]), route GeoJSON and CSV ([`routes`]), NumPy `.npy` arrays of
-//! phase and risk maps ([`npy`]), fast CSV of large grids ([`grid_csv`]), and atomic file
+//! phase and risk maps ([`npy`]), fast CSV of large grids ([`grid_csv`]), simulated walks as
+//! motion capture ([`trajectory`]), and atomic file
 //! writing ([`files`]).
 //!
 //! This is the edge where files become the library's validated types: every error names the
@@ -26,6 +27,7 @@ pub mod raster;
 pub mod robot_terrain;
 pub mod routes;
 pub mod speeds;
+pub mod trajectory;
 
 pub use anchoring::{load_anchoring_times, AnchoringRow};
 pub use files::{csv_string, read_text, write_atomic, write_via_temp, Source, WriteError};

@@ -10,5 +10,6 @@ pub mod predict;
 pub mod presets;
 pub mod report;
 pub mod risk;
+pub mod simulate;
 pub mod sweep;
 pub mod track;

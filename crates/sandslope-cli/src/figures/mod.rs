@@ -14,6 +14,7 @@ pub mod palette;
 pub mod phase;
 pub mod plan;
 pub mod risk;
+pub mod simulate;
 pub mod slope_curves;
 pub mod step_budget;
 pub mod sweep;

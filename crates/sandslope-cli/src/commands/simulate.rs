@@ -1,0 +1,335 @@
+//! `sandslope simulate`: the dynamic stride simulator (docs/model.md §15-§18) at one slope or
+//! over a range of slopes in parallel, beside the closed form's answer for the same inputs;
+//! optionally the trajectory as motion capture (`--out`, what `track` reads), a figure and a
+//! GIF animation.
+
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Result};
+use clap::Args;
+use serde::Serialize;
+
+use crate::args::{check_flag, warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
+use crate::figures;
+use crate::figures::simulate::{Animation, SimulateFigure, SlopesFigure};
+use crate::output::{
+    check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
+};
+use sandslope::scenario::slope_range;
+use sandslope::simulate::{simulate, simulate_slopes, SimSettings, SimSummary, SimulateError, Simulation};
+use sandslope::{ParamError, Scenario};
+use sandslope_io::load_speeds;
+use sandslope_io::trajectory::plain_mocap_csv;
+
+/// Most slopes one `--slopes` run simulates.
+const MAX_SLOPES: usize = 1000;
+
+/// Arguments of `sandslope simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Slope, degrees (negative: walking downhill).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true, required_unless_present = "slopes")]
+    pub slope: Option<f64>,
+    /// Slopes MIN:MAX:STEP, degrees, simulated in parallel (instead of --slope).
+    #[arg(long, value_name = "MIN:MAX:STEP", conflicts_with_all = ["slope", "out", "animate"])]
+    pub slopes: Option<String>,
+    /// Simulated time after settling, s (at least 1.5 T: one stride to settle into the gait,
+    /// then steps to measure).
+    #[arg(long, value_name = "S", default_value_t = 10.0, allow_negative_numbers = true)]
+    pub duration: f64,
+    /// Integration step, s (default: min(1 ms, 0.25 / omega_n, T / 200), docs/model.md §17).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub dt: Option<f64>,
+    /// Elastic slip at which the sand's stress is fully mobilised, m (docs/model.md §16).
+    #[arg(long = "yield", value_name = "M", allow_negative_numbers = true)]
+    pub yield_m: Option<f64>,
+    /// Trajectory sample rate for --out, --plot and --animate, Hz.
+    #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
+    pub rate: f64,
+    /// Write the body's centre as plain motion capture (time_s,x_m,y_m,z_m) for `track`.
+    #[arg(long, value_name = "CSV")]
+    pub out: Option<PathBuf>,
+    /// Draw position, leg depths and leg forces against time (one slope), or simulated,
+    /// closed-form and observed speeds against slope (--slopes), to FILE (.png or .svg).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+    /// Observed speeds (CSV: slope_deg,speed_m_s,speed_sd_m_s) for the --slopes figure.
+    #[arg(long, value_name = "CSV", requires_all = ["slopes", "plot"])]
+    pub observed: Option<PathBuf>,
+    /// Side-view animation (slope, sand, body, legs, force arrows) to FILE.gif.
+    #[arg(long, value_name = "FILE.gif")]
+    pub animate: Option<PathBuf>,
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    pub terrain: TerrainArgs,
+    #[command(flatten)]
+    pub over: OverrideArgs,
+    #[command(flatten)]
+    pub format: FormatArgs,
+}
+
+/// A library error with its keys renamed to this command's flags.
+fn flagged(e: ParamError) -> anyhow::Error {
+    let flag = match e.key.as_str() {
+        "duration_s" => "--duration",
+        "dt_s" => "--dt",
+        "slope_deg" => "--slope",
+        "yield_m" => "--yield",
+        "sample_rate_hz" => "--rate",
+        "step" | "from" => "--slopes",
+        other => return anyhow!("{}", e.clone().renamed(other)),
+    };
+    anyhow!("{}", e.renamed(flag))
+}
+
+fn sim_err(e: SimulateError) -> anyhow::Error {
+    match e {
+        SimulateError::Param(p) => flagged(p),
+    }
+}
+
+/// The settings the flags ask for, checked.
+fn settings(args: &SimulateArgs) -> Result<SimSettings> {
+    let mut s = SimSettings::new(args.duration).map_err(flagged)?;
+    if let Some(dt) = args.dt {
+        s = s.with_dt(dt).map_err(flagged)?;
+    }
+    if let Some(y) = args.yield_m {
+        s = s.with_yield(y).map_err(flagged)?;
+    }
+    s.with_sample_rate(args.rate).map_err(flagged)
+}
+
+/// Parses `--slopes MIN:MAX:STEP`.
+fn parse_slopes(text: &str) -> Result<Vec<f64>> {
+    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
+    let [a, b, c] = parts[..] else {
+        bail!("--slopes = {text} must be MIN:MAX:STEP in degrees (e.g. 0:24:2)");
+    };
+    let number = |what: &str, s: &str| -> Result<f64> {
+        s.parse::<f64>().map_err(|_| anyhow!("--slopes: {what} `{s}` is not a number (in {text})"))
+    };
+    let (lo, hi, step) = (number("MIN", a)?, number("MAX", b)?, number("STEP", c)?);
+    for (what, v) in [("MIN", lo), ("MAX", hi)] {
+        if !(v.is_finite() && v.abs() < 90.0) {
+            bail!("--slopes: {what} = {v} must be strictly between -90 and 90 degrees (in {text})");
+        }
+    }
+    slope_range(lo, hi, step, MAX_SLOPES).map_err(flagged)
+}
+
+/// What `simulate --json` prints: one walk's summary, or one per slope.
+#[derive(Debug, Serialize)]
+#[serde(untagged)]
+pub enum Answer {
+    /// `--slope`.
+    One(Box<SimSummary>),
+    /// `--slopes`.
+    Many(Vec<SimSummary>),
+}
+
+/// Runs `sandslope simulate`.
+pub fn run(args: SimulateArgs) -> Result<()> {
+    let settings = settings(&args)?;
+    let slopes = args.slopes.as_deref().map(parse_slopes).transpose()?;
+    for path in [&args.out, &args.plot, &args.animate].into_iter().flatten() {
+        check_parent_exists(path)?;
+    }
+    if let Some(path) = &args.plot {
+        figures::format_of(path)?;
+    }
+    if let Some(path) = &args.animate {
+        if !path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("gif")) {
+            bail!("--animate {} must end in .gif", path.display());
+        }
+    }
+    let observed = args.observed.as_deref().map(load_speeds).transpose()?;
+    let scenario = args.over.scenario(&args.robot, &args.terrain)?;
+    match slopes {
+        Some(slopes) => run_slopes(&args, &scenario, &slopes, &settings, observed.as_deref().unwrap_or(&[])),
+        None => run_one(&args, &scenario, args.slope.expect("clap requires --slope or --slopes"), &settings),
+    }
+}
+
+fn run_one(args: &SimulateArgs, scenario: &Scenario, slope: f64, settings: &SimSettings) -> Result<()> {
+    check_flag("--slope", slope, -89.999_999, 89.999_999)
+        .map_err(|_| anyhow!("--slope = {slope} must be strictly between -90 and 90 degrees"))?;
+    let sim = simulate(scenario, slope, settings).map_err(sim_err)?;
+    if sim.summary.closed_form.extrapolated {
+        warn_extrapolated(scenario.terrain(), &[slope]);
+    }
+    // Every output is rendered before any is written, so a failure leaves nothing behind.
+    let csv = args.out.as_ref().map(|_| plain_mocap_csv(&sim.trajectory, slope));
+    if let Some(path) = &args.plot {
+        figures::save(path, &SimulateFigure { sim: &sim, robot: scenario.robot() })?;
+    }
+    if let Some(path) = &args.animate {
+        figures::simulate::save_gif(path, &Animation { sim: &sim, slope_deg: slope })?;
+    }
+    if let (Some(path), Some(csv)) = (&args.out, &csv) {
+        write_atomic(path, csv.as_bytes())?;
+    }
+    let m = &sim.summary;
+    match args.format.format() {
+        Format::Json => print_json(&Answer::One(Box::new(m.clone())))?,
+        Format::Csv => print!("{}", csv_string(&m.steps)?),
+        Format::Table => print_one(&sim),
+    }
+    for path in [&args.out, &args.plot, &args.animate].into_iter().flatten() {
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn print_one(sim: &Simulation) {
+    let m = &sim.summary;
+    let p = &m.closed_form.prediction;
+    println!(
+        "slope {} deg, k_n {:.3e}, k_s {:.3e} N/m^3: {} s simulated at dt = {:.2e} s, {} steps measured (after one \
+         stride of warm-up)",
+        m.slope_deg, m.k_n, m.k_s, m.duration_s, m.dt_s, m.steps_measured
+    );
+    let mut t = table(&["", "simulated", "closed form"]);
+    t.add_row([
+        "speed cm/s".into(),
+        format!("{:.2} ± {:.2}", m.speed_m_s * 100.0, m.speed_sd_m_s * 100.0),
+        num(p.speed.map(|v| v * 100.0), 2),
+    ]);
+    t.add_row(["t1 ms".into(), num(m.t1_s.map(|v| v * 1e3), 1), num(p.anchoring_time.map(|v| v * 1e3), 1)]);
+    t.add_row(["slip mm".into(), num(m.slip_m.map(|v| v * 1e3), 2), num(p.slip.map(|v| v * 1e3), 2)]);
+    t.add_row(["step mm".into(), format!("{:.2}", m.step_m * 1e3), num(p.step.map(|v| v * 1e3), 2)]);
+    t.add_row([
+        "deepest leg mm".into(),
+        format!("{:.2} (reach 2R - h = {:.1})", m.max_depth_m * 1e3, m.d_max_m * 1e3),
+        format!("d_n = {}", num(p.normal_depth.map(|v| v * 1e3), 2)),
+    ]);
+    t.add_row(["regime", m.regime.name(), p.regime.name()]);
+    t.add_row(["cause", m.cause.name(), p.cause.name()]);
+    println!("{t}");
+    if !m.stalled_legs.is_empty() {
+        let legs: Vec<String> = m.stalled_legs.iter().map(|l| l.to_string()).collect();
+        println!("servo stalled (torque limit bound) on legs {}", legs.join(", "));
+    }
+    if m.unanchored_steps > 0 {
+        println!(
+            "{} measured step(s) never anchored (the speed did not turn from falling to rising)",
+            m.unanchored_steps
+        );
+    }
+}
+
+/// One row of `simulate --slopes --csv`.
+#[derive(Serialize)]
+struct SlopeRow {
+    slope_deg: f64,
+    speed_m_s: f64,
+    t1_s: Option<f64>,
+    slip_m: Option<f64>,
+    step_m: f64,
+    max_depth_m: f64,
+    regime: &'static str,
+    cause: &'static str,
+    closed_form_speed_m_s: Option<f64>,
+    closed_form_t1_s: Option<f64>,
+    closed_form_slip_m: Option<f64>,
+    closed_form_step_m: Option<f64>,
+    closed_form_regime: &'static str,
+}
+
+fn run_slopes(
+    args: &SimulateArgs,
+    scenario: &Scenario,
+    slopes: &[f64],
+    settings: &SimSettings,
+    observed: &[sandslope::SpeedObservation],
+) -> Result<()> {
+    let sims = simulate_slopes(scenario, slopes, settings).map_err(sim_err)?;
+    let beyond: Vec<f64> =
+        sims.iter().filter(|s| s.summary.closed_form.extrapolated).map(|s| s.summary.slope_deg).collect();
+    if !beyond.is_empty() {
+        warn_extrapolated(scenario.terrain(), &beyond);
+    }
+    let summaries: Vec<SimSummary> = sims.into_iter().map(|s| s.summary).collect();
+    if let Some(path) = &args.plot {
+        let repose_deg = scenario.terrain().repose().map(|r| r.degrees());
+        figures::save(path, &SlopesFigure { sims: &summaries, observed, repose_deg })?;
+    }
+    match args.format.format() {
+        Format::Json => print_json(&Answer::Many(summaries))?,
+        Format::Csv => {
+            let rows: Vec<SlopeRow> = summaries
+                .iter()
+                .map(|m| {
+                    let p = &m.closed_form.prediction;
+                    SlopeRow {
+                        slope_deg: m.slope_deg,
+                        speed_m_s: m.speed_m_s,
+                        t1_s: m.t1_s,
+                        slip_m: m.slip_m,
+                        step_m: m.step_m,
+                        max_depth_m: m.max_depth_m,
+                        regime: m.regime.name(),
+                        cause: m.cause.name(),
+                        closed_form_speed_m_s: m.closed_form.speed(),
+                        closed_form_t1_s: p.anchoring_time,
+                        closed_form_slip_m: p.slip,
+                        closed_form_step_m: p.step,
+                        closed_form_regime: p.regime.name(),
+                    }
+                })
+                .collect();
+            print!("{}", csv_string(&rows)?);
+        }
+        Format::Table => {
+            let mut t = table(&[
+                "slope deg",
+                "speed cm/s sim | cf",
+                "t1 ms sim | cf",
+                "slip mm sim | cf",
+                "step mm sim | cf",
+                "regime sim | cf",
+                "cause (sim)",
+            ]);
+            for m in &summaries {
+                let p = &m.closed_form.prediction;
+                t.add_row([
+                    format!("{}", m.slope_deg),
+                    format!(
+                        "{:.2} | {}",
+                        m.speed_m_s * 100.0,
+                        num(m.closed_form.speed().map(|v| v * 100.0), 2)
+                    ),
+                    format!(
+                        "{} | {}",
+                        num(m.t1_s.map(|v| v * 1e3), 1),
+                        num(p.anchoring_time.map(|v| v * 1e3), 1)
+                    ),
+                    format!("{} | {}", num(m.slip_m.map(|v| v * 1e3), 2), num(p.slip.map(|v| v * 1e3), 2)),
+                    format!("{:.1} | {}", m.step_m * 1e3, num(p.step.map(|v| v * 1e3), 1)),
+                    format!("{} | {}", m.regime.name(), p.regime.name()),
+                    m.cause.name().to_string(),
+                ]);
+            }
+            println!("{t}");
+        }
+    }
+    if let Some(path) = &args.plot {
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slope_ranges_name_the_flag() {
+        assert_eq!(parse_slopes("0:24:12").unwrap(), vec![0.0, 12.0, 24.0]);
+        for bad in ["0:24", "a:1:1", "0:95:5", "10:0:1", "0:10:0"] {
+            let msg = parse_slopes(bad).unwrap_err().to_string();
+            assert!(msg.starts_with("--slopes"), "{bad}: {msg}");
+        }
+    }
+}

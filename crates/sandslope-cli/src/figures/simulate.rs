@@ -1,0 +1,475 @@
+//! Figures of `sandslope simulate`: one walk against time (position along the slope, each
+//! leg's depth, each leg's force), simulated and closed-form speeds against slope, and the
+//! side-view GIF animation (slope, sand surface, body, legs, force arrows).
+
+use std::path::Path;
+
+use anyhow::Result;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use sandslope::simulate::{SimSummary, Simulation};
+use sandslope::{Robot, SpeedObservation};
+
+use super::{font, Figure};
+use crate::error::plot_err;
+use crate::output::write_via_temp;
+
+/// Tripod colours: tripod 0 blue, tripod 1 orange (legs of one tripod share the colour,
+/// front to rear from dark to light).
+fn leg_colour(tripod: usize, rank: usize, n: usize) -> RGBColor {
+    let base = if tripod == 0 { (31.0, 90.0, 180.0) } else { (230.0, 120.0, 20.0) };
+    let f = if n > 1 { 0.45 * rank as f64 / (n - 1) as f64 } else { 0.0 };
+    let mix = |c: f64| (c + (255.0 - c) * f) as u8;
+    RGBColor(mix(base.0), mix(base.1), mix(base.2))
+}
+
+/// Position along the slope, leg depths and leg forces against time, stacked.
+pub struct SimulateFigure<'a> {
+    /// The walk.
+    pub sim: &'a Simulation,
+    /// The robot (for the leg reach).
+    pub robot: &'a Robot,
+}
+
+type Chart<'a, DB> = super::SlopeChart<'a, DB>;
+
+fn time_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    y_label: &str,
+    t: (f64, f64),
+    y: (f64, f64),
+) -> Result<Chart<'a, DB>>
+where
+    DB::ErrorType: 'static,
+{
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, font(20.0))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(t.0..t.1, y.0..y.1)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time since the gait started (s)")
+        .y_desc(y_label)
+        .x_label_formatter(&super::tick)
+        .y_label_formatter(&super::tick)
+        .label_style(font(14.0))
+        .axis_desc_style(font(16.0))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(plot_err)?;
+    Ok(chart)
+}
+
+impl Figure for SimulateFigure<'_> {
+    fn size(&self) -> (u32, u32) {
+        (1000, 1100)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let tr = &self.sim.trajectory;
+        let m = &self.sim.summary;
+        let g = &self.sim.geometry;
+        let panels = root.split_evenly((3, 1));
+        let t = (0.0, tr.time_s.last().copied().unwrap_or(1.0).max(1e-3));
+        let legs = g.hip_x_m.len();
+        let n = legs / 2;
+
+        // Position along the slope, with touchdowns and anchoring times.
+        let x_cm: Vec<f64> = tr.x_m.iter().map(|x| x * 100.0).collect();
+        let xr = super::range(x_cm.iter().copied(), (0.0, 1.0));
+        let title = format!(
+            "{} deg: simulated {:.2} cm/s, closed form {} ({}, {})",
+            m.slope_deg,
+            m.speed_m_s * 100.0,
+            m.closed_form.speed().map_or("-".to_string(), |v| format!("{:.2} cm/s", v * 100.0)),
+            m.regime,
+            m.cause.name()
+        );
+        let mut c = time_chart(&panels[0], &title, "position along the slope (cm)", t, xr)?;
+        let grey = RGBColor(170, 170, 170);
+        for s in &m.steps {
+            c.draw_series([PathElement::new(
+                vec![(s.touchdown_s, xr.0), (s.touchdown_s, xr.1)],
+                grey.stroke_width(1),
+            )])
+            .map_err(plot_err)?;
+        }
+        c.draw_series(LineSeries::new(
+            tr.time_s.iter().copied().zip(x_cm.iter().copied()),
+            BLACK.stroke_width(2),
+        ))
+        .map_err(plot_err)?
+        .label("body (centre of mass)")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+        let marks: Vec<(f64, f64)> = m
+            .steps
+            .iter()
+            .filter_map(|s| s.t1_s.map(|t1| s.touchdown_s + t1))
+            .filter_map(|ta| {
+                let i = tr.time_s.partition_point(|&ts| ts < ta).min(tr.time_s.len().saturating_sub(1));
+                x_cm.get(i).map(|&x| (ta, x))
+            })
+            .collect();
+        c.draw_series(marks.iter().map(|&p| Circle::new(p, 4, RED.filled())))
+            .map_err(plot_err)?
+            .label("anchoring t1 (speed minimum)")
+            .legend(|(x, y)| Circle::new((x + 10, y), 4, RED.filled()));
+        c.configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font(font(14.0))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(plot_err)?;
+
+        // Leg depths.
+        let depth_mm: Vec<Vec<f64>> =
+            tr.leg_depth_m.iter().map(|d| d.iter().map(|v| v * 1e3).collect()).collect();
+        let reach = self.robot.max_depth() * 1e3;
+        let dr = super::range(depth_mm.iter().flatten().copied().chain([0.0, reach]), (0.0, reach));
+        let mut c = time_chart(&panels[1], "Leg depth below the surface", "depth (mm)", t, dr)?;
+        super::reference_line(&mut c, reach, "leg reach 2R - h: deeper means the body sank", t)?;
+        for (j, depth) in depth_mm.iter().enumerate() {
+            let col = leg_colour(g.tripod[j], j % n.max(1), n);
+            let s = c
+                .draw_series(LineSeries::new(
+                    tr.time_s.iter().copied().zip(depth.iter().copied()),
+                    col.stroke_width(2),
+                ))
+                .map_err(plot_err)?;
+            if j % n.max(1) == 0 {
+                let label = format!("tripod {} (front to rear: dark to light)", g.tripod[j]);
+                s.label(label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+            }
+        }
+        c.configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(font(14.0))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(plot_err)?;
+
+        // Leg forces: normal solid, along the slope dashed.
+        let fr = super::range(
+            tr.leg_force_z_n.iter().chain(&tr.leg_force_x_n).flatten().copied().chain([0.0]),
+            (0.0, 1.0),
+        );
+        let mut c = time_chart(
+            &panels[2],
+            "Sand force on each leg",
+            "force (N): normal solid, along slope dashed",
+            t,
+            fr,
+        )?;
+        for j in 0..legs {
+            let col = leg_colour(g.tripod[j], j % n.max(1), n);
+            c.draw_series(LineSeries::new(
+                tr.time_s.iter().copied().zip(tr.leg_force_z_n[j].iter().copied()),
+                col.stroke_width(2),
+            ))
+            .map_err(plot_err)?;
+            c.draw_series(DashedLineSeries::new(
+                tr.time_s.iter().copied().zip(tr.leg_force_x_n[j].iter().copied()),
+                5,
+                4,
+                col.stroke_width(1),
+            ))
+            .map_err(plot_err)?;
+        }
+        Ok(())
+    }
+}
+
+/// Simulated speed, the closed form's and the observed speeds against slope.
+pub struct SlopesFigure<'a> {
+    /// One walk per slope, in slope order.
+    pub sims: &'a [SimSummary],
+    /// Observed speeds with SDs.
+    pub observed: &'a [SpeedObservation],
+    /// The terrain's angle of repose.
+    pub repose_deg: Option<f64>,
+}
+
+impl Figure for SlopesFigure<'_> {
+    fn size(&self) -> (u32, u32) {
+        (1000, 650)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let sim: Vec<(f64, f64)> = self.sims.iter().map(|m| (m.slope_deg, m.speed_m_s * 100.0)).collect();
+        let cf: Vec<(f64, f64)> = self
+            .sims
+            .iter()
+            .filter_map(|m| m.closed_form.speed().map(|v| (m.slope_deg, v * 100.0)))
+            .collect();
+        let obs: Vec<(f64, f64, f64)> =
+            self.observed.iter().map(|o| (o.slope.degrees(), o.speed * 100.0, o.speed_sd * 100.0)).collect();
+        let xr = super::range(sim.iter().map(|p| p.0).chain(obs.iter().map(|o| o.0)), (0.0, 30.0));
+        let yr = super::range(
+            sim.iter()
+                .chain(&cf)
+                .map(|p| p.1)
+                .chain(obs.iter().flat_map(|o| [o.1 - o.2, o.1 + o.2]))
+                .chain([0.0]),
+            (0.0, 16.0),
+        );
+        let mut c = ChartBuilder::on(root)
+            .caption("Step-averaged speed: simulator, closed form and observations", font(22.0))
+            .margin(14)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
+            .map_err(plot_err)?;
+        c.configure_mesh()
+            .x_desc("slope (deg)")
+            .y_desc("speed (cm/s)")
+            .x_label_formatter(&super::tick)
+            .y_label_formatter(&super::tick)
+            .label_style(font(15.0))
+            .axis_desc_style(font(17.0))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(plot_err)?;
+        super::shade_repose(&mut c, self.repose_deg, xr, yr, "at or above the angle of repose: slippage")?;
+        if yr.0 < 0.0 {
+            c.draw_series([PathElement::new(vec![(xr.0, 0.0), (xr.1, 0.0)], BLACK.stroke_width(1))])
+                .map_err(plot_err)?;
+        }
+        let blue = RGBColor(31, 90, 180);
+        c.draw_series(LineSeries::new(sim.iter().copied(), blue.stroke_width(3)))
+            .map_err(plot_err)?
+            .label("simulated (docs/model.md §15-§18)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(3)));
+        c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, blue.filled()))).map_err(plot_err)?;
+        c.draw_series(LineSeries::new(cf.iter().copied(), RED.stroke_width(2)))
+            .map_err(plot_err)?
+            .label("closed form (docs/model.md §3-§6)")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+        if !obs.is_empty() {
+            c.draw_series(
+                obs.iter().map(|&(x, v, sd)| {
+                    ErrorBar::new_vertical(x, v - sd, v, v + sd, BLACK.stroke_width(2), 10)
+                }),
+            )
+            .map_err(plot_err)?
+            .label("observed (mean ± SD)")
+            .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));
+        }
+        c.configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(font(15.0))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(plot_err)?;
+        Ok(())
+    }
+}
+
+/// The side-view animation of a walk.
+pub struct Animation<'a> {
+    /// The walk.
+    pub sim: &'a Simulation,
+    /// Slope, degrees (the view is rotated so the slope rises to the right).
+    pub slope_deg: f64,
+}
+
+/// Frames per second of the animation (every sample at 120 Hz would make huge files).
+const GIF_FPS: f64 = 20.0;
+/// Longest animation, s of simulated time.
+const GIF_MAX_S: f64 = 6.0;
+
+/// Writes `anim` as an animated GIF to `path`, atomically.
+pub fn save_gif(path: &Path, anim: &Animation<'_>) -> Result<()> {
+    super::register_fonts();
+    let tr = &anim.sim.trajectory;
+    let rate = if tr.time_s.len() > 1 { 1.0 / (tr.time_s[1] - tr.time_s[0]) } else { GIF_FPS };
+    let every = ((rate / GIF_FPS).round() as usize).max(1);
+    let frames: Vec<usize> =
+        (0..tr.time_s.len()).step_by(every).take_while(|&i| tr.time_s[i] <= GIF_MAX_S + 1e-9).collect();
+    let delay = (1000.0 / GIF_FPS) as u32;
+    write_via_temp(path, |tmp| {
+        let root = BitMapBackend::gif(tmp, (800, 450), delay).map_err(plot_err)?.into_drawing_area();
+        for &i in &frames {
+            root.fill(&WHITE).map_err(plot_err)?;
+            draw_frame(&root, anim, i)?;
+            root.present().map_err(plot_err)?;
+        }
+        Ok(())
+    })
+}
+
+/// One frame: world view (slope rising to the right), sand, body, legs and force arrows.
+fn draw_frame<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, anim: &Animation<'_>, i: usize) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let tr = &anim.sim.trajectory;
+    let g = &anim.sim.geometry;
+    let (s, c) = anim.slope_deg.to_radians().sin_cos();
+    let world = |p: [f64; 2]| (p[0] * c - p[1] * s, p[0] * s + p[1] * c);
+    let (x, z, phi) = (tr.x_m[i], tr.z_m[i], tr.pitch_rad[i]);
+    let centre = world([x, z]);
+    let half_w = 0.25;
+    let half_h = half_w * 450.0 / 800.0;
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            format!(
+                "t = {:.2} s, {} deg, speed {:.2} cm/s (simulated)",
+                tr.time_s[i],
+                anim.slope_deg,
+                anim.sim.summary.speed_m_s * 100.0
+            ),
+            font(18.0),
+        )
+        .margin(8)
+        .build_cartesian_2d(centre.0 - half_w..centre.0 + half_w, centre.1 - half_h..centre.1 + half_h)
+        .map_err(plot_err)?;
+    // Sand: the view box clipped to the half-plane below the surface line (points must stay
+    // inside the view: plotters clamps points outside it, which would tilt the line).
+    let view = [
+        (centre.0 - half_w, centre.1 - half_h),
+        (centre.0 + half_w, centre.1 - half_h),
+        (centre.0 + half_w, centre.1 + half_h),
+        (centre.0 - half_w, centre.1 + half_h),
+    ];
+    let (sand_poly, surface) = below_line(&view, (-s, c));
+    let sand = RGBColor(230, 205, 150);
+    if sand_poly.len() >= 3 {
+        chart.draw_series([Polygon::new(sand_poly, sand.filled())]).map_err(plot_err)?;
+    }
+    if surface.len() == 2 {
+        chart
+            .draw_series([PathElement::new(surface, RGBColor(150, 120, 60).stroke_width(2))])
+            .map_err(plot_err)?;
+    }
+    // Body: a box from the belly (h below the axle) to h above it, pitched.
+    let (sp, cp) = phi.sin_cos();
+    let body = |p: [f64; 2]| world([x + cp * p[0] - sp * p[1], z + sp * p[0] + cp * p[1]]);
+    let (l, h) = (g.body_length_m, g.hip_height_m);
+    let corners = [[-l / 2.0, -h], [l / 2.0, -h], [l / 2.0, 0.3 * h], [-l / 2.0, 0.3 * h]];
+    chart
+        .draw_series([Polygon::new(
+            corners.iter().map(|&p| body(p)).collect::<Vec<_>>(),
+            RGBColor(90, 90, 90).mix(0.8).filled(),
+        )])
+        .map_err(plot_err)?;
+    let legs = g.hip_x_m.len();
+    let n = (legs / 2).max(1);
+    let scale = 0.02; // m of arrow per N
+    for j in 0..legs {
+        let psi = tr.leg_angle_rad[j][i];
+        let (sa, ca) = (phi - psi).sin_cos();
+        let hip = [g.hip_x_m[j], 0.0];
+        let pts: Vec<(f64, f64)> = g
+            .leg_nodes_m
+            .iter()
+            .map(|p| {
+                let r = [ca * p[0] - sa * p[1], sa * p[0] + ca * p[1]];
+                let hp = [cp * hip[0] - sp * hip[1], sp * hip[0] + cp * hip[1]];
+                world([x + hp[0] + r[0], z + hp[1] + r[1]])
+            })
+            .collect();
+        let col = leg_colour(g.tripod[j], j % n, n);
+        let width = if g.tripod[j] == 0 { 4 } else { 3 };
+        chart.draw_series([PathElement::new(pts.clone(), col.stroke_width(width))]).map_err(plot_err)?;
+        let (fx, fz) = (tr.leg_force_x_n[j][i], tr.leg_force_z_n[j][i]);
+        if fx.hypot(fz) > 0.05 {
+            // Arrow from the leg's lowest point, in the slope frame turned into the world.
+            let lowest = pts
+                .iter()
+                .copied()
+                .min_by(|p, q| (-p.0 * s + p.1 * c).total_cmp(&(-q.0 * s + q.1 * c)))
+                .unwrap_or(centre);
+            let tip = (lowest.0 + scale * (fx * c - fz * s), lowest.1 + scale * (fx * s + fz * c));
+            chart
+                .draw_series([PathElement::new(vec![lowest, tip], RED.stroke_width(2))])
+                .map_err(plot_err)?;
+            chart.draw_series([Circle::new(tip, 3, RED.filled())]).map_err(plot_err)?;
+        }
+    }
+    chart.draw_series([Circle::new(world([x, z]), 4, BLACK.filled())]).map_err(plot_err)?;
+    Ok(())
+}
+
+/// A point of the animation's world view, m.
+type Point = (f64, f64);
+
+/// The part of polygon `poly` where `n . p <= 0` (Sutherland-Hodgman against one half-plane
+/// through the origin), and the points where its boundary crosses the line `n . p = 0`.
+fn below_line(poly: &[Point], n: Point) -> (Vec<Point>, Vec<Point>) {
+    let side = |p: (f64, f64)| n.0 * p.0 + n.1 * p.1;
+    let mut out = Vec::new();
+    let mut crossings = Vec::new();
+    for (k, &a) in poly.iter().enumerate() {
+        let b = poly[(k + 1) % poly.len()];
+        let (sa, sb) = (side(a), side(b));
+        if sa <= 0.0 {
+            out.push(a);
+        }
+        if (sa < 0.0) != (sb < 0.0) && sa != sb {
+            let t = sa / (sa - sb);
+            let p = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+            out.push(p);
+            crossings.push(p);
+        }
+    }
+    (out, crossings)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sandslope::simulate::{simulate, SimSettings};
+    use sandslope::{Robot, RobotSpec, Scenario, Terrain};
+
+    /// Frames of the animation draw (written as PNG to the temp folder, for looking at), and
+    /// the GIF holds every 6th sample of 120 Hz (20 frames/s) up to 6 s.
+    #[test]
+    fn the_sand_is_the_view_below_the_surface_line() {
+        // A unit box centred on the origin cut by a 45 degree line: the lower-right triangle.
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let (poly, line) = below_line(&[(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)], (-h, h));
+        assert_eq!(line.len(), 2);
+        assert!(poly.iter().all(|p| p.1 <= p.0 + 1e-12), "{poly:?}");
+        assert!(poly.contains(&(1.0, -1.0)) && !poly.contains(&(-1.0, 1.0)));
+    }
+
+    #[test]
+    fn animation_frames_draw_and_the_gif_is_written() {
+        let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
+        let s = Scenario::new(robot, Terrain::constant(7e5, 2e6).unwrap(), None, None).unwrap();
+        let sim = simulate(&s, 15.0, &SimSettings::new(2.0).unwrap()).unwrap();
+        let anim = Animation { sim: &sim, slope_deg: 15.0 };
+        let dir = std::env::temp_dir();
+        for i in [30usize, 54] {
+            let path = dir.join(format!("sandslope-sim-frame{i}.png"));
+            {
+                let root = BitMapBackend::new(&path, (800, 450)).into_drawing_area();
+                root.fill(&WHITE).unwrap();
+                super::super::register_fonts();
+                draw_frame(&root, &anim, i).unwrap();
+                root.present().unwrap();
+            }
+            assert!(std::fs::metadata(&path).unwrap().len() > 1000);
+        }
+        let gif = dir.join("sandslope-sim-test.gif");
+        save_gif(&gif, &anim).unwrap();
+        let bytes = std::fs::read(&gif).unwrap();
+        assert_eq!(&bytes[..6], b"GIF89a");
+        let _ = std::fs::remove_file(gif);
+    }
+}

@@ -1,0 +1,136 @@
+//! `sandslope simulate` end to end: `track` measures the simulated walk as a lab recording
+//! (docs/model.md §18) and recovers the simulator's own speed and t1; bad input exits 2 with
+//! the value and its range and leaves no file behind; --slopes runs several slopes.
+//!
+//! Tolerances: the speed is a difference of positions over each T/2, both sides read the same
+//! 120 Hz samples: 1%. t1: the simulator finds the speed minimum on its 1 kHz noise-free speed,
+//! `track` on the 120 Hz samples through its zero-phase low pass; the walk has no noise, so the
+//! cutoff may rise to 30 Hz (at the default 10 Hz, meant for noisy recordings, the filter
+//! moves a shallow minimum by ~15 ms), and the touchdowns are the simulator's: one frame
+//! (1/120 s).
+
+mod common;
+
+use common::{json, sandslope, write_arg};
+use predicates::str::contains;
+use serde_json::Value;
+
+fn mean(v: impl Iterator<Item = f64>) -> f64 {
+    let v: Vec<f64> = v.collect();
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+fn track_recovers(extra: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("walk.csv");
+    let mut args =
+        vec!["simulate", "--slope", "10", "--duration", "10", "--json", "--out", csv.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let sim = json(&args);
+    let steps = sim["steps"].as_array().unwrap();
+    let touchdowns: Vec<String> = steps.iter().map(|s| s["touchdown_s"].to_string()).collect();
+    let td = write_arg(dir.path(), "touchdowns.txt", &(touchdowns.join("\n") + "\n"));
+    let tracked = json(&["track", csv.to_str().unwrap(), "--json", "--touchdowns", &td, "--cutoff", "30"]);
+    let per_step = tracked["per_step"].as_array().unwrap();
+    assert_eq!(per_step.len(), steps.len());
+    let sim_speed = mean(steps.iter().map(|s| s["speed_m_s"].as_f64().unwrap()));
+    let track_speed = tracked["speed_m_s"].as_f64().unwrap();
+    assert!((track_speed / sim_speed - 1.0).abs() < 0.01, "{track_speed} vs {sim_speed}");
+    let sim_t1 = mean(steps.iter().filter_map(|s| s["t1_s"].as_f64()));
+    let track_t1 = tracked["t1_s"].as_f64().unwrap();
+    assert!((track_t1 - sim_t1).abs() < 1.0 / 120.0, "{track_t1} vs {sim_t1}");
+}
+
+#[test]
+fn track_recovers_the_simulated_speed_and_t1() {
+    // The built-in terrain at 10 degrees (t1 about 17 ms), and weaker sand (the plate force
+    // tests' k_s at 10 degrees, t1 about 57 ms).
+    track_recovers(&[]);
+    track_recovers(&["--k-s", "7e4"]);
+}
+
+#[test]
+fn json_has_the_summary_keys_and_the_closed_form_is_predicts() {
+    let sim = json(&["simulate", "--slope", "12", "--duration", "3", "--json"]);
+    for key in ["speed_m_s", "regime", "cause", "t1_s", "slip_m", "step_m", "steps", "closed_form"] {
+        assert!(sim.get(key).is_some(), "{key} missing");
+    }
+    let predict = json(&["predict", "--slope", "12", "--json"]);
+    let predict = if predict.is_array() { predict[0].clone() } else { predict };
+    assert_eq!(sim["closed_form"], predict);
+}
+
+#[test]
+fn bad_input_exits_2_naming_the_value_and_range_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.csv");
+    let plot = dir.path().join("p.png");
+    let o = out.to_str().unwrap();
+    let p = plot.to_str().unwrap();
+    let robot = write_arg(
+        dir.path(),
+        "r.toml",
+        &format!("{}leg_elemnts = 8\n", include_str!("../../sandslope-io/presets/paper-hexapod.toml")),
+    );
+    let bad_elements = write_arg(
+        dir.path(),
+        "e.toml",
+        &format!("{}leg_elements = 2\n", include_str!("../../sandslope-io/presets/paper-hexapod.toml")),
+    );
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["--slope", "10", "--duration", "-1"],
+            "--duration = -1 must be a number of seconds greater than 0",
+        ),
+        (vec!["--slope", "10", "--dt", "0.05"], "--dt = 0.05 must be greater than 0 and at most"),
+        (vec!["--slope", "90"], "--slope = 90"),
+        (vec!["--slope", "10", "--robot", &robot], "leg_elemnts"),
+        (
+            vec!["--slope", "10", "--robot", &bad_elements],
+            "leg_elements = 2 must be a whole number from 4 to 256",
+        ),
+        (vec!["--slope", "10", "--duration", "1"], "at least 1.5 T"),
+        (vec!["--slopes", "0:95:5"], "--slopes"),
+    ];
+    for (args, needle) in cases {
+        sandslope()
+            .arg("simulate")
+            .args(&args)
+            .args(["--out", o, "--plot", p])
+            .assert()
+            .code(2)
+            .stderr(contains(needle));
+        assert!(!out.exists() && !plot.exists(), "{args:?} left a file");
+    }
+    let gif = dir.path().join("a.png");
+    sandslope()
+        .args(["simulate", "--slope", "5", "--duration", "2", "--animate", gif.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(contains("must end in .gif"));
+    assert!(!gif.exists());
+}
+
+#[test]
+fn slopes_run_in_parallel_and_draw_against_observations() {
+    let dir = tempfile::tempdir().unwrap();
+    let plot = dir.path().join("speeds.svg");
+    let observed = common::repo_file("data/paper-speeds.csv");
+    let v: Value = json(&[
+        "simulate",
+        "--slopes",
+        "0:20:10",
+        "--duration",
+        "3",
+        "--json",
+        "--plot",
+        plot.to_str().unwrap(),
+        "--observed",
+        observed.to_str().unwrap(),
+    ]);
+    let rows = v.as_array().unwrap();
+    assert_eq!(rows.len(), 3);
+    assert_eq!(rows[2]["slope_deg"], 20.0);
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(svg.contains("observed") && svg.contains("closed form"));
+}

@@ -1,11 +1,19 @@
 //! The CLI's error handling: every failure is a user-facing message and an exit code.
 //!
 //! Commands return `anyhow::Result`; context added on the way up names the file, key and
-//! valid range. `main` prints the chain on one line per cause and exits with
-//! [`exit_code`]: 2 for bad input (flags, files, values out of range; clap uses 2 for usage
-//! errors too), 3 when an output could not be written (disk full, no permission), 4 when
-//! `report --strict` wrote a report that carries warnings, and 0,
-//! silently, when the reader of stdout went away (`sandslope sweep --json | head`).
+//! valid range. `main` prints the chain on one line per cause and exits with [`exit_code`]:
+//!
+//! | code | meaning |
+//! |---|---|
+//! | 0 | success, or stdout was closed by its reader (`sandslope sweep --json \| head`) |
+//! | 2 | bad input: a flag, value, key or file the tool cannot accept (a file that does not exist, a malformed or implausible one); clap's usage errors |
+//! | 3 | the system failed: an output (file, folder, stdout or stderr) could not be written (disk full, no permission), or an input that exists could not be read (no permission, I/O error) |
+//! | 4 | `report --strict`: the report was written, but it carries warnings |
+//! | 130, 143 | interrupted by SIGINT (Ctrl-C) or SIGTERM; temporary files removed, no output left |
+//!
+//! Whatever the code, a run that does not succeed leaves no output behind
+//! (`sandslope_io::files::discard_outputs`); the one exception is code 4, whose outputs are
+//! written and whose failure is the verdict on them.
 
 use std::io::ErrorKind;
 
@@ -13,10 +21,13 @@ use std::io::ErrorKind;
 pub const EXIT_OK: i32 = 0;
 /// Exit code for bad input: flags, files, keys or values the tool cannot accept.
 pub const EXIT_USAGE: i32 = 2;
-/// Exit code when an output file could not be written (the environment, not the input).
+/// Exit code when the system failed: an output could not be written, or an existing input
+/// could not be read.
 pub const EXIT_OUTPUT: i32 = 3;
 /// Exit code of `report --strict` when the report was written but carries warnings.
 pub const EXIT_WARNINGS: i32 = 4;
+/// Exit code after SIGINT (128 + 2), as shells report it.
+pub const EXIT_SIGINT: i32 = 130;
 
 /// `report --strict`: the outputs were written, but the report carries this many warnings.
 #[derive(Debug, thiserror::Error)]
@@ -25,31 +36,56 @@ pub const EXIT_WARNINGS: i32 = 4;
 )]
 pub struct Strict(pub usize);
 
+/// Whether `e` is a verdict on outputs that are nonetheless kept ([`Strict`]).
+pub fn keeps_outputs(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| c.is::<Strict>())
+}
+/// The I/O error kinds that mean the input is wrong rather than the system failing.
+fn is_input_kind(kind: ErrorKind) -> bool {
+    matches!(
+        kind,
+        ErrorKind::NotFound
+            | ErrorKind::IsADirectory
+            | ErrorKind::NotADirectory
+            | ErrorKind::InvalidInput
+            | ErrorKind::InvalidData
+            | ErrorKind::UnexpectedEof
+            | ErrorKind::InvalidFilename
+    )
+}
+
+/// The I/O error kind somewhere in `e`'s chain of causes (the outermost one), if any.
+fn io_kind(e: &anyhow::Error) -> Option<ErrorKind> {
+    e.chain().find_map(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .map(std::io::Error::kind)
+            .or_else(|| c.downcast_ref::<serde_json::Error>().and_then(serde_json::Error::io_error_kind))
+            .or_else(|| {
+                c.downcast_ref::<csv::Error>().and_then(|e| match e.kind() {
+                    csv::ErrorKind::Io(io) => Some(io.kind()),
+                    _ => None,
+                })
+            })
+    })
+}
+
 /// The exit code for a failed run (see the module documentation).
 pub fn exit_code(e: &anyhow::Error) -> i32 {
-    let broken_pipe = e.chain().any(|c| {
-        c.downcast_ref::<std::io::Error>().map(std::io::Error::kind) == Some(ErrorKind::BrokenPipe)
-            || c.downcast_ref::<serde_json::Error>().and_then(serde_json::Error::io_error_kind)
-                == Some(ErrorKind::BrokenPipe)
-            || c.downcast_ref::<csv::Error>().is_some_and(|e| match e.kind() {
-                csv::ErrorKind::Io(io) => io.kind() == ErrorKind::BrokenPipe,
-                _ => false,
-            })
-    });
-    if broken_pipe {
-        EXIT_OK
-    } else if e.chain().any(|c| c.is::<sandslope_io::WriteError>()) {
-        EXIT_OUTPUT
-    } else if e.chain().any(|c| c.is::<Strict>()) {
-        EXIT_WARNINGS
-    } else {
-        EXIT_USAGE
+    match io_kind(e) {
+        Some(ErrorKind::BrokenPipe) => EXIT_OK,
+        _ if e.chain().any(|c| c.is::<sandslope_io::WriteError>()) => EXIT_OUTPUT,
+        _ if keeps_outputs(e) => EXIT_WARNINGS,
+        Some(kind) if !is_input_kind(kind) => EXIT_OUTPUT,
+        _ => EXIT_USAGE,
     }
 }
 
-/// `println!` panics when stdout is a closed pipe; end such a run quietly instead, as
-/// coreutils and ripgrep do, leaving every other panic message as it is.
-pub fn exit_quietly_on_broken_pipe() {
+/// `println!` and `eprintln!` panic when their stream fails. End such a run as a careful Unix
+/// tool does instead of with a panic (exit 101): quietly with 0 when stdout is a pipe whose
+/// reader went away (`sandslope sweep --json | head`), and otherwise (a full disk, a closed
+/// terminal) with one line on stderr, if it can still be written, and exit code 3. Temporary
+/// outputs are removed first. Every other panic keeps its message.
+pub fn exit_cleanly_on_stream_errors() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         let message = info
@@ -58,11 +94,37 @@ pub fn exit_quietly_on_broken_pipe() {
             .map(String::as_str)
             .or_else(|| info.payload().downcast_ref::<&str>().copied())
             .unwrap_or("");
-        if message.contains("failed printing to stdout") && message.contains("Broken pipe") {
+        let stream = if message.contains("failed printing to stdout") {
+            Some("standard output")
+        } else if message.contains("failed printing to stderr") {
+            None
+        } else {
+            default(info);
+            return;
+        };
+        sandslope_io::files::discard_outputs();
+        if message.contains("Broken pipe") {
             std::process::exit(EXIT_OK);
         }
-        default(info);
+        if let Some(stream) = stream {
+            let reason = message.rsplit_once(": ").map_or(message, |(_, r)| r);
+            let _ = std::io::Write::write_all(
+                &mut std::io::stderr(),
+                format!("error: cannot write to {stream}: {reason}\n").as_bytes(),
+            );
+        }
+        std::process::exit(EXIT_OUTPUT);
     }));
+}
+
+/// On SIGINT, SIGTERM or SIGHUP: remove this run's temporary files and exit (130 for SIGINT
+/// and the others alike, as the handler cannot tell them apart), so a killed run leaves nothing.
+pub fn clean_up_on_signals() {
+    // Failing to install the handler (another one is set) only loses the clean-up.
+    let _ = ctrlc::set_handler(|| {
+        sandslope_io::files::discard_outputs();
+        std::process::exit(EXIT_SIGINT);
+    });
 }
 
 /// Turns a plotting backend error (not `Send + Sync` in general) into an `anyhow::Error`.

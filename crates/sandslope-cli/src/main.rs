@@ -13,6 +13,9 @@ mod progress;
 mod report;
 mod serve;
 
+use std::io::Write;
+
+use anyhow::Context;
 use clap::{Parser, Subcommand};
 
 /// Whether, how fast and why a legged robot climbs a sand slope (the shear-anchoring model of
@@ -76,18 +79,42 @@ fn run(cli: Cli) -> anyhow::Result<()> {
 }
 
 fn main() {
-    error::exit_quietly_on_broken_pipe();
+    error::exit_cleanly_on_stream_errors();
+    error::clean_up_on_signals();
     let cli = Cli::parse();
-    if let Err(e) = run(cli) {
+    // Every output of a run is put in place together at the end, so a failure leaves none;
+    // the server writes nothing of its own and serves for as long as it runs.
+    let serving = matches!(cli.command, Command::Serve(_));
+    if !serving {
+        sandslope_io::files::stage_outputs();
+    }
+    let result = match run(cli) {
+        // `report --strict` with warnings: the report is kept, the exit code gives the verdict.
+        Err(verdict) if error::keeps_outputs(&verdict) => finish().and(Err(verdict)),
+        done => done.and_then(|()| finish()),
+    };
+    if let Err(e) = result {
+        sandslope_io::files::discard_outputs();
         let code = error::exit_code(&e);
         if code == error::EXIT_OK {
             // Stdout was closed by the reader (`sandslope sweep --json | head`): nothing to say.
             std::process::exit(code);
         }
-        eprintln!("error: {e}");
+        let mut err = std::io::stderr().lock();
+        let _ = writeln!(err, "error: {e}");
         for cause in e.chain().skip(1) {
-            eprintln!("  caused by: {cause}");
+            let _ = writeln!(err, "  caused by: {cause}");
         }
         std::process::exit(code);
     }
+}
+
+/// After a successful run: flush stdout (an error here, such as a full disk, is a failed run:
+/// the process's own exit would swallow it), then put every output in place and say so.
+fn finish() -> anyhow::Result<()> {
+    std::io::stdout().flush().context("cannot write to standard output")?;
+    for path in sandslope_io::files::commit_outputs()? {
+        let _ = writeln!(std::io::stderr(), "wrote {}", path.display());
+    }
+    Ok(())
 }

@@ -3,7 +3,7 @@
 
 use std::io::Write;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
 use comfy_table::{presets::UTF8_BORDERS_ONLY, Table};
 
@@ -83,9 +83,13 @@ pub fn sci(x: f64) -> String {
 /// Prints `value` as pretty JSON on stdout.
 pub fn print_json<T: serde::Serialize>(value: &T) -> Result<()> {
     let mut out = std::io::stdout().lock();
-    serde_json::to_writer_pretty(&mut out, value)?;
-    writeln!(out)?;
-    Ok(())
+    serde_json::to_writer_pretty(&mut out, value)
+        .map_err(std::io::Error::from)
+        .and_then(|()| writeln!(out))
+        .context(STDOUT)
 }
+
+/// The context of a failure to write to stdout (exit code 3, or 0 for a closed pipe).
+pub const STDOUT: &str = "cannot write to standard output";
 
 pub use sandslope_io::files::{check_parent_exists, csv_string, write_atomic, write_via_temp};

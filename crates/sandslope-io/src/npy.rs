@@ -85,22 +85,20 @@ pub fn write_npy_file(path: &Path, shape: &[usize], data: NpyData<'_>) -> Result
     })
 }
 
-/// Writes several arrays `(file name, shape, data)` into the folder `dir` (which must exist),
-/// each atomically; checks the folder before writing anything.
+/// Writes several arrays `(file name, shape, data)` into the folder `dir` (created if missing),
+/// each atomically.
 pub fn write_npy_dir(dir: &Path, arrays: &[(&str, Vec<usize>, NpyData<'_>)]) -> Result<()> {
-    check_npy_dir(dir)?;
+    prepare_npy_dir(dir)?;
     for (name, shape, data) in arrays {
         write_npy_file(&dir.join(name), shape, *data)?;
     }
     Ok(())
 }
 
-/// Fails with a clear message unless `dir` is an existing folder.
-pub fn check_npy_dir(dir: &Path) -> Result<()> {
-    if !dir.is_dir() {
-        anyhow::bail!("--npy {}: no such folder (create it first)", dir.display());
-    }
-    Ok(())
+/// Makes the `--npy` folder `dir` if it is missing, as `mkdir -p` would (a run that fails
+/// removes what it made); fails with a clear message if `dir` is a file.
+pub fn prepare_npy_dir(dir: &Path) -> Result<()> {
+    crate::files::create_output_dir(dir).map_err(|e| e.context(format!("--npy {}", dir.display())))
 }
 
 #[cfg(test)]

@@ -289,9 +289,6 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
         return print_json(&JointRecord { mode: "joint", calibration: &cal, repose: &repose });
     }
     print_joint(&cal, &repose);
-    for p in [Some(&args.out), args.robot_out.as_ref(), args.plot.as_ref()].into_iter().flatten() {
-        eprintln!("wrote {}", p.display());
-    }
     Ok(())
 }
 
@@ -444,6 +441,5 @@ fn run_per_slope(
     }
     println!("{t}");
     println!("repose_deg = {} ({})", repose.deg.map_or("none".into(), |r| format!("{r}")), repose.source);
-    eprintln!("wrote {}", args.out.display());
     Ok(())
 }

@@ -138,9 +138,8 @@ pub fn run(args: FitArgs) -> Result<()> {
     // Outputs: the plot folder first (creating it is the step most likely to fail), then the
     // figures are drawn in memory and every file is written atomically.
     if let Some(dir) = &args.plot {
-        std::fs::create_dir_all(dir)
-            .map_err(|source| sandslope_io::WriteError { path: dir.clone(), source })
-            .map_err(|e| anyhow!(e).context(format!("cannot create plot folder {}", dir.display())))?;
+        sandslope_io::files::create_output_dir(dir)
+            .map_err(|e| e.context(format!("cannot create plot folder {}", dir.display())))?;
     }
     if let Some(out) = &args.out {
         let header = format!(
@@ -152,9 +151,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         write_atomic(out, format!("{header}{body}").as_bytes())?;
     }
     if let Some(dir) = &args.plot {
-        for path in figures::write_all(dir, &campaign)? {
-            eprintln!("wrote {}", path.display());
-        }
+        figures::write_all(dir, &campaign)?;
     }
 
     match args.format.format() {

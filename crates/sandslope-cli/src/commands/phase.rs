@@ -177,7 +177,7 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         crate::output::check_parent_exists(p)?;
     }
     if let Some(dir) = &args.npy {
-        sandslope_io::npy::check_npy_dir(dir)?;
+        sandslope_io::npy::prepare_npy_dir(dir)?;
     }
     let Panels { panels, masses, slopes, terrain, k_n_axis, k_s_axis } =
         compute(&args, MAX_CELLS, args.json, true)?;

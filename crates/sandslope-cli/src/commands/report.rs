@@ -156,8 +156,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
     let figures = page_figures(&report)?;
     let html = page(&report, &figures);
     let json = serde_json::to_string_pretty(&report)?;
-    std::fs::create_dir_all(&args.out)
-        .map_err(|source| sandslope_io::WriteError { path: args.out.clone(), source })?;
+    sandslope_io::files::create_output_dir(&args.out)?;
     write_atomic(&args.out.join("report.json"), json.as_bytes())?;
     write_atomic(&args.out.join("index.html"), html.as_bytes())?;
     println!(
@@ -165,11 +164,6 @@ pub fn run(args: ReportArgs) -> Result<()> {
         report.figures.len(),
         report.summary.text,
         report.disagreements.len()
-    );
-    eprintln!(
-        "wrote {} and {}",
-        args.out.join("index.html").display(),
-        args.out.join("report.json").display()
     );
     if args.strict && !report.warnings.is_empty() {
         return Err(crate::error::Strict(report.warnings.len()).into());

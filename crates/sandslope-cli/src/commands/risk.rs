@@ -308,7 +308,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
         crate::output::check_parent_exists(p)?;
     }
     if let Some(dir) = &args.npy {
-        sandslope_io::npy::check_npy_dir(dir)?;
+        sandslope_io::npy::prepare_npy_dir(dir)?;
     }
     let extrapolated = beyond_last_point(terrain.terrain(), &slopes);
     if !extrapolated.is_empty() {

@@ -122,9 +122,6 @@ pub fn run(args: SweepArgs) -> Result<()> {
             }
         }
     }
-    if let Some(path) = &args.plot {
-        eprintln!("wrote {}", path.display());
-    }
     Ok(())
 }
 

@@ -129,11 +129,17 @@ mod tests {
         assert_eq!(&out[10 + len..], &[0, 3, 255]);
     }
 
+    /// A missing folder is made (as `--plot figures/` is); a file in its place is refused.
     #[test]
-    fn a_missing_folder_is_refused_before_writing() {
+    fn a_missing_folder_is_made_and_a_file_in_the_way_refused() {
         let dir = tempfile::tempdir().unwrap();
-        let missing = dir.path().join("nope");
-        let err = write_npy_dir(&missing, &[("a.npy", vec![1], NpyData::I8(&[1]))]).unwrap_err();
-        assert!(err.to_string().contains("no such folder"), "{err}");
+        let missing = dir.path().join("new/maps");
+        write_npy_dir(&missing, &[("a.npy", vec![1], NpyData::I8(&[1]))]).unwrap();
+        assert_eq!(std::fs::read(missing.join("a.npy")).unwrap().last(), Some(&1));
+        let file = dir.path().join("plain");
+        std::fs::write(&file, "x").unwrap();
+        let err = write_npy_dir(&file, &[("a.npy", vec![1], NpyData::I8(&[1]))]).unwrap_err();
+        assert!(format!("{err:#}").contains("--npy"), "{err:#}");
+        assert_eq!(std::fs::read(&file).unwrap(), b"x");
     }
 }

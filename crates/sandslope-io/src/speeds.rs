@@ -59,12 +59,26 @@ pub struct SpeedTableRow {
     pub n: Option<usize>,
 }
 
+/// Largest speed magnitude a speeds table may hold, m/s: 10 m/s (36 km/h) is far beyond any
+/// legged robot on sand, so a larger value is a typo or a unit error, and refusing it keeps
+/// values such as -1e308 from every fit and figure downstream (issue 21).
+pub const MAX_SPEED_M_S: f64 = 10.0;
+
+/// Smallest speed SD a speeds table may hold, m/s (1 um/s): a smaller SD would weigh one row
+/// more than 10^12 times a 1 mm/s one and overflow chi^2 (an SD of 1e-320 made it inf).
+pub const MIN_SPEED_SD_M_S: f64 = 1e-6;
+
 /// Reads a speeds table, `slope_deg,speed_m_s,speed_sd_m_s` (with [`SpeedColumns::WithCount`]
 /// by name in any order, and optionally `n`): the one reader of that format
 /// ([`load_speeds`] and `observations::load_speed_observations` build on it). Blank lines
-/// and `#` comments are skipped; errors name the file, its line and the column.
+/// and `#` comments are skipped; errors name the file, its line and the column, and the valid
+/// range (|speed| <= [`MAX_SPEED_M_S`], SD in [[`MIN_SPEED_SD_M_S`], [`MAX_SPEED_M_S`]]).
 pub fn read_speed_table(path: &Path, columns: SpeedColumns) -> Result<Vec<SpeedTableRow>> {
-    let text = read_text(path)?;
+    parse_speed_table(&read_text(path)?, path, columns)
+}
+
+/// [`read_speed_table`] on text already in memory; `path` names it in messages.
+pub fn parse_speed_table(text: &str, path: &Path, columns: SpeedColumns) -> Result<Vec<SpeedTableRow>> {
     let mut reader =
         csv::ReaderBuilder::new().trim(csv::Trim::All).comment(Some(b'#')).from_reader(text.as_bytes());
     let expected = columns.expected();
@@ -90,7 +104,7 @@ pub fn read_speed_table(path: &Path, columns: SpeedColumns) -> Result<Vec<SpeedT
     let mut out = Vec::new();
     for record in reader.records() {
         let record = record.map_err(|e| anyhow!("{}: {e} (expected columns {expected})", path.display()))?;
-        let line = record.position().map_or(0, |p| record_line(&text, p));
+        let line = record.position().map_or(0, |p| record_line(text, p));
         // Cells by column name, so an error names the column, not a field index.
         let cell = |c: usize| -> Result<f64> {
             let text = &record[c];
@@ -102,14 +116,22 @@ pub fn read_speed_table(path: &Path, columns: SpeedColumns) -> Result<Vec<SpeedT
             SpeedRow { slope_deg: cell(c_slope)?, speed_m_s: cell(c_speed)?, speed_sd_m_s: cell(c_sd)? };
         let slope = Slope::from_degrees(row.slope_deg)
             .map_err(|e| anyhow!("{}: line {line}: {e}", path.display()))?;
-        if !row.speed_m_s.is_finite() {
-            bail!("{}: line {line}: speed_m_s = {} must be a finite number", path.display(), row.speed_m_s);
-        }
-        if !(row.speed_sd_m_s.is_finite() && row.speed_sd_m_s > 0.0) {
+        if !(row.speed_m_s.is_finite() && row.speed_m_s.abs() <= MAX_SPEED_M_S) {
             bail!(
-                "{}: line {line}: speed_sd_m_s = {} must be greater than 0",
+                "{}: line {line}: column speed_m_s: {} is not a robot's speed on sand: expected a number \
+                 from -{MAX_SPEED_M_S} to {MAX_SPEED_M_S} m/s",
                 path.display(),
-                row.speed_sd_m_s
+                &record[c_speed]
+            );
+        }
+        if !(row.speed_sd_m_s.is_finite()
+            && (MIN_SPEED_SD_M_S..=MAX_SPEED_M_S).contains(&row.speed_sd_m_s))
+        {
+            bail!(
+                "{}: line {line}: column speed_sd_m_s: {} is outside the valid range {MIN_SPEED_SD_M_S:e} \
+                 to {MAX_SPEED_M_S} m/s (a standard deviation, greater than 0)",
+                path.display(),
+                &record[c_sd]
             );
         }
         let n = match c_n {
@@ -133,10 +155,16 @@ pub fn read_speed_table(path: &Path, columns: SpeedColumns) -> Result<Vec<SpeedT
 /// Reads a speeds CSV (`slope_deg,speed_m_s,speed_sd_m_s`) into observations, validating
 /// every row.
 pub fn load_speeds(path: &Path) -> Result<Vec<SpeedObservation>> {
-    Ok(read_speed_table(path, SpeedColumns::Plain)?
-        .into_iter()
-        .map(|r| SpeedObservation { slope: r.slope, speed: r.speed_m_s, speed_sd: r.speed_sd_m_s })
-        .collect())
+    Ok(observations(read_speed_table(path, SpeedColumns::Plain)?))
+}
+
+/// [`load_speeds`] on text already in memory (a file about to be written); `path` names it.
+pub fn parse_speeds(text: &str, path: &Path) -> Result<Vec<SpeedObservation>> {
+    Ok(observations(parse_speed_table(text, path, SpeedColumns::Plain)?))
+}
+
+fn observations(rows: Vec<SpeedTableRow>) -> Vec<SpeedObservation> {
+    rows.into_iter().map(|r| SpeedObservation { slope: r.slope, speed: r.speed_m_s, speed_sd: r.speed_sd_m_s }).collect()
 }
 
 #[cfg(test)]
@@ -197,5 +225,30 @@ mod tests {
         std::fs::write(&p, "slope_deg,speed_m_s,speed_sd_m_s,n\n# a\n10,0.12,0.01,4\n").unwrap();
         let rows = read_speed_table(&p, SpeedColumns::WithCount).unwrap();
         assert_eq!((rows[0].line, rows[0].n), (3, Some(4)));
+    }
+
+    /// Values no robot on sand has (the fuzz's -1e308 speed, SDs of 1e-320 and 1e308) are
+    /// refused at the edge with the file, line, column and valid range; the bounds themselves pass.
+    #[test]
+    fn implausible_speeds_and_sds_are_refused_with_the_range() {
+        let row = |v: &str, sd: &str| load(&format!("slope_deg,speed_m_s,speed_sd_m_s\n0,{v},{sd}\n"));
+        let e = row("-1e308", "0.01").unwrap_err().to_string();
+        assert!(e.contains("line 2: column speed_m_s: -1e308") && e.contains("from -10 to 10 m/s"), "{e}");
+        for sd in ["1e-320", "1e308", "0", "-0.01", "inf"] {
+            let e = row("0.1", sd).unwrap_err().to_string();
+            assert!(e.contains("line 2: column speed_sd_m_s") && e.contains("valid range 1e-6 to 10 m/s"), "{sd}: {e}");
+        }
+        assert_eq!(row("-10", "1e-6").unwrap()[0].speed, -10.0);
+        assert_eq!(row("10", "10").unwrap()[0].speed_sd, 10.0);
+    }
+
+    /// The text form reads what the file form reads, naming the path it was given.
+    #[test]
+    fn parse_speeds_names_the_path() {
+        let p = Path::new("out/speeds.csv");
+        let ok = parse_speeds("slope_deg,speed_m_s,speed_sd_m_s\n20,0.05,0.004\n", p).unwrap();
+        assert_eq!((ok[0].slope.degrees(), ok[0].speed), (20.0, 0.05));
+        let e = parse_speeds("slope_deg,speed_m_s,speed_sd_m_s\n20,x,0.004\n", p).unwrap_err().to_string();
+        assert!(e.starts_with("out/speeds.csv: line 2"), "{e}");
     }
 }

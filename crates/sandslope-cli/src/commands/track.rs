@@ -18,7 +18,7 @@ use crate::args::{check_flag, RobotArgs, TerrainArgs};
 use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions, Tracked};
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
 use sandslope_io::mocap::{Capture, MocapFormat};
-use sandslope_io::{load_speeds, SpeedRow};
+use sandslope_io::{parse_speeds, SpeedRow};
 
 /// Arguments of `sandslope track`.
 #[derive(Debug, Args)]
@@ -136,14 +136,17 @@ fn append_speed(path: &Path, row: SpeedRow) -> Result<Vec<SpeedRow>> {
     if existing.trim().is_empty() {
         text = format!("{HEADER}\n");
     } else {
-        load_speeds(path)?;
+        parse_speeds(&existing, path)?;
         if !text.ends_with('\n') {
             text.push('\n');
         }
     }
     text.push_str(&format!("{},{},{}\n", row.slope_deg, row.speed_m_s, row.speed_sd_m_s));
+    // The rows as the file will hold them, read from the text (the file itself is put in
+    // place only when the whole run has succeeded).
+    let rows = parse_speeds(&text, path)?;
     write_atomic(path, text.as_bytes())?;
-    Ok(load_speeds(path)?
+    Ok(rows
         .into_iter()
         .map(|o| SpeedRow { slope_deg: o.slope.degrees(), speed_m_s: o.speed, speed_sd_m_s: o.speed_sd })
         .collect())

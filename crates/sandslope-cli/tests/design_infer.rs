@@ -251,8 +251,12 @@ fn infer_rejects_impossible_input_with_exit_2() {
     let plot = dir.path().join("p.png");
     for (csv, extra, says) in [
         ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.25,0.005\n", "", "above the model's ceiling"),
-        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0\n", "", "speed_sd_m_s = 0 must be greater than 0"),
-        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,-0.01\n", "", "must be greater than 0"),
+        (
+            "slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0\n",
+            "",
+            "column speed_sd_m_s: 0 is outside the valid range",
+        ),
+        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,-0.01\n", "", "a standard deviation, greater than 0"),
         ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n", "--k-s-prior=1e6:1e5", "0 < MIN < MAX"),
         ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n", "--law=linear", "two or more slopes"),
         ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n10,0.11,0.01\n", "", "two observations at 10"),

@@ -123,7 +123,10 @@ mod tests {
         let f = file("slope_deg,speed_m_s,speed_sd_m_s\n10,0.11,0.02\n");
         assert!((load_speed_observations(f.path()).unwrap()[0].speed_se() - 0.02).abs() < 1e-15);
         for (bad, says) in [
-            ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.11,0\n", "line 2: column speed_sd_m_s: 0 is outside the valid range"),
+            (
+                "slope_deg,speed_m_s,speed_sd_m_s\n10,0.11,0\n",
+                "line 2: column speed_sd_m_s: 0 is outside the valid range",
+            ),
             ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.11,-0.01\n", "greater than 0"),
             ("slope_deg,speed_m_s,speed_sd_m_s,n\n10,0.11,0.01,0\n", "n `0`"),
             (

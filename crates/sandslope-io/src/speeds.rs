@@ -124,9 +124,7 @@ pub fn parse_speed_table(text: &str, path: &Path, columns: SpeedColumns) -> Resu
                 &record[c_speed]
             );
         }
-        if !(row.speed_sd_m_s.is_finite()
-            && (MIN_SPEED_SD_M_S..=MAX_SPEED_M_S).contains(&row.speed_sd_m_s))
-        {
+        if !(row.speed_sd_m_s.is_finite() && (MIN_SPEED_SD_M_S..=MAX_SPEED_M_S).contains(&row.speed_sd_m_s)) {
             bail!(
                 "{}: line {line}: column speed_sd_m_s: {} is outside the valid range {MIN_SPEED_SD_M_S:e} \
                  to {MAX_SPEED_M_S} m/s (a standard deviation, greater than 0)",
@@ -164,7 +162,9 @@ pub fn parse_speeds(text: &str, path: &Path) -> Result<Vec<SpeedObservation>> {
 }
 
 fn observations(rows: Vec<SpeedTableRow>) -> Vec<SpeedObservation> {
-    rows.into_iter().map(|r| SpeedObservation { slope: r.slope, speed: r.speed_m_s, speed_sd: r.speed_sd_m_s }).collect()
+    rows.into_iter()
+        .map(|r| SpeedObservation { slope: r.slope, speed: r.speed_m_s, speed_sd: r.speed_sd_m_s })
+        .collect()
 }
 
 #[cfg(test)]
@@ -236,7 +236,10 @@ mod tests {
         assert!(e.contains("line 2: column speed_m_s: -1e308") && e.contains("from -10 to 10 m/s"), "{e}");
         for sd in ["1e-320", "1e308", "0", "-0.01", "inf"] {
             let e = row("0.1", sd).unwrap_err().to_string();
-            assert!(e.contains("line 2: column speed_sd_m_s") && e.contains("valid range 1e-6 to 10 m/s"), "{sd}: {e}");
+            assert!(
+                e.contains("line 2: column speed_sd_m_s") && e.contains("valid range 1e-6 to 10 m/s"),
+                "{sd}: {e}"
+            );
         }
         assert_eq!(row("-10", "1e-6").unwrap()[0].speed, -10.0);
         assert_eq!(row("10", "10").unwrap()[0].speed_sd, 10.0);

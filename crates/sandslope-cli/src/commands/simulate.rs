@@ -176,9 +176,6 @@ fn run_one(args: &SimulateArgs, scenario: &Scenario, slope: f64, settings: &SimS
         Format::Csv => print!("{}", csv_string(&m.steps)?),
         Format::Table => print_one(&sim),
     }
-    for path in [&args.out, &args.plot, &args.animate].into_iter().flatten() {
-        eprintln!("wrote {}", path.display());
-    }
     Ok(())
 }
 
@@ -313,9 +310,6 @@ fn run_slopes(
             }
             println!("{t}");
         }
-    }
-    if let Some(path) = &args.plot {
-        eprintln!("wrote {}", path.display());
     }
     Ok(())
 }

@@ -4,7 +4,7 @@
 
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
-use sandslope::{Robot, Scenario, Terrain};
+use sandslope::{Robot, Scenario, Slope, Terrain};
 
 use sandslope::risk::UncertainTerrain;
 use sandslope::{Axis, AxisScale};
@@ -167,12 +167,21 @@ impl OverrideArgs {
 /// Prints a warning to stderr when terrain values were extrapolated (docs/model.md §7).
 pub fn warn_extrapolated(terrain: &Terrain, slopes: &[f64]) {
     if let (Some(last), false) = (terrain.points().last(), slopes.is_empty()) {
-        let list = slopes.iter().map(|s| format!("{s}")).collect::<Vec<_>>().join(", ");
+        let list = slope_list_text(slopes);
         eprintln!(
             "warning: slope(s) {list} deg are above the terrain's last measured point ({} deg); k_n and k_s are \
              extrapolated linearly and floored at zero",
             last.slope_deg
         );
+    }
+}
+
+/// Slopes for a message: all of them up to six, else the first and last and how many (a
+/// `sweep --step 0.001` warning listed 10,000 slopes on one 59 KB line).
+fn slope_list_text(slopes: &[f64]) -> String {
+    match slopes {
+        [first, .., last] if slopes.len() > 6 => format!("{first} to {last} ({} slopes)", slopes.len()),
+        _ => slopes.iter().map(|s| format!("{s}")).collect::<Vec<_>>().join(", "),
     }
 }
 
@@ -195,6 +204,64 @@ pub fn check_flag(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
     } else {
         bail!("{flag} = {value} must be between {lo} and {hi}")
     }
+}
+
+/// Parses `--max-risk` (clap's value parser, so every command that takes it says the same):
+/// a failure probability strictly between 0 and 1.
+pub fn parse_max_risk(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(p) if p > 0.0 && p < 1.0 => Ok(p),
+        Ok(p) => Err(format!("{p} is not a failure probability strictly between 0 and 1 (e.g. 0.05)")),
+        Err(_) => Err(format!(
+            "`{text}` is not a number: expected a failure probability strictly between 0 and 1 (e.g. 0.05)"
+        )),
+    }
+}
+
+/// Which slopes a slope list accepts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SlopeSign {
+    /// Climbing only: 0 <= deg < 90.
+    Uphill,
+    /// Signed inclinations, -90 < deg < 90 (a descent is felt as the climb of its size,
+    /// docs/model.md §8).
+    Signed,
+}
+
+/// Parses a slope list given to `flag`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N` (N evenly spaced
+/// slopes, both ends included), in degrees, with at most `max` slopes. N and the list's length
+/// are checked against `max` before anything is expanded (`0:24:99999999999` is refused at
+/// once, not after allocating 800 GB). The one slope-list grammar of every command.
+pub fn parse_slope_list(flag: &str, text: &str, sign: SlopeSign, max: usize) -> Result<Vec<f64>> {
+    let number = |s: &str| -> Result<f64> {
+        let v: f64 =
+            s.trim().parse().map_err(|_| anyhow!("{flag}: `{}` is not a number (in {text})", s.trim()))?;
+        match sign {
+            SlopeSign::Uphill => Slope::from_degrees(v).map(|_| ()),
+            SlopeSign::Signed => Slope::from_signed_degrees(v).map(|_| ()),
+        }
+        .map_err(|e| anyhow!("{}", e.renamed(flag)))?;
+        Ok(v)
+    };
+    if text.contains(':') {
+        let parts: Vec<&str> = text.split(':').collect();
+        let [lo, hi, n] = parts.as_slice() else {
+            bail!("{flag} = {text} must be DEG, a comma list DEG,DEG,... or MIN:MAX:N (e.g. 0:24:13)");
+        };
+        let n: usize = n.trim().parse().ok().filter(|n| (2..=max).contains(n)).ok_or_else(|| {
+            anyhow!("{flag}: N `{}` must be a whole number from 2 to {max} (in {text})", n.trim())
+        })?;
+        let (lo, hi) = (number(lo)?, number(hi)?);
+        if hi <= lo {
+            bail!("{flag} = {text}: MAX must be greater than MIN");
+        }
+        return Ok((0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect());
+    }
+    let count = text.split(',').count();
+    if count > max {
+        bail!("{flag} lists {count} slopes; at most {max} are allowed");
+    }
+    text.split(',').map(number).collect()
 }
 
 /// Checks a command-line number is finite and strictly positive, naming the flag.
@@ -255,5 +322,44 @@ mod tests {
             let msg = parse_axis("--k-n", bad).unwrap_err().to_string();
             assert!(msg.contains("--k-n"), "{bad}: {msg}");
         }
+    }
+
+    /// One grammar for every slope list: N is refused before any expansion (an N of 1e11
+    /// would have asked for 800 GB), each slope by the library's rule, named by its flag.
+    #[test]
+    fn slope_lists_share_one_grammar_and_cap_n_before_expanding() {
+        assert_eq!(
+            parse_slope_list("--slope", "0:24:4", SlopeSign::Uphill, 10).unwrap(),
+            vec![0.0, 8.0, 16.0, 24.0]
+        );
+        assert_eq!(parse_slope_list("--slope", " 5, -10", SlopeSign::Signed, 10).unwrap(), vec![5.0, -10.0]);
+        let err = |text: &str, sign| parse_slope_list("--x", text, sign, 10).unwrap_err().to_string();
+        let start = std::time::Instant::now();
+        assert!(err("0:24:99999999999", SlopeSign::Uphill)
+            .contains("N `99999999999` must be a whole number from 2 to 10"));
+        assert!(start.elapsed().as_millis() < 100);
+        assert!(err("0:24:11", SlopeSign::Uphill).contains("from 2 to 10"));
+        assert!(err("1,2,3,4,5,6,7,8,9,10,11", SlopeSign::Uphill).contains("lists 11 slopes; at most 10"));
+        assert!(err("-5", SlopeSign::Uphill).starts_with("--x"));
+        assert!(err("-95", SlopeSign::Signed).starts_with("--x"));
+        assert!(err("10:5:3", SlopeSign::Uphill).contains("MAX must be greater than MIN"));
+        assert!(err("0:24", SlopeSign::Uphill).contains("MIN:MAX:N"));
+        assert!(err("a", SlopeSign::Uphill).contains("`a` is not a number"));
+    }
+
+    #[test]
+    fn max_risk_is_a_probability_strictly_inside_0_1() {
+        assert_eq!(parse_max_risk("0.05"), Ok(0.05));
+        for bad in ["0", "1", "-0.1", "2", "nan", "inf"] {
+            assert!(parse_max_risk(bad).unwrap_err().contains("strictly between 0 and 1"), "{bad}");
+        }
+        assert!(parse_max_risk("x").unwrap_err().contains("`x` is not a number"));
+    }
+
+    #[test]
+    fn long_slope_lists_are_summarised_in_messages() {
+        assert_eq!(slope_list_text(&[25.0, 26.0]), "25, 26");
+        let many: Vec<f64> = (0..1000).map(|i| 25.0 + f64::from(i) * 0.001).collect();
+        assert_eq!(slope_list_text(&many), format!("25 to {} (1000 slopes)", many[999]));
     }
 }

@@ -119,7 +119,7 @@ fn slopes_run_in_parallel_and_draw_against_observations() {
     let v: Value = json(&[
         "simulate",
         "--slopes",
-        "0:20:10",
+        "0:20:3",
         "--duration",
         "3",
         "--json",

@@ -14,7 +14,7 @@ use sandslope::design::{explore, Design, DesignGoal, DesignKey, DesignRange, Des
 use sandslope::risk::SafeLimit;
 use sandslope::{AxisScale, Slope};
 
-use crate::args::{check_flag, RobotArgs, TerrainArgs, UncertaintyArgs};
+use crate::args::{parse_max_risk, RobotArgs, TerrainArgs, UncertaintyArgs};
 use crate::figures::design::{DesignFigure, SafeSlopeMap};
 use crate::figures::{format_of, save};
 use crate::output::{check_parent_exists, num, print_json, table, write_atomic};
@@ -37,7 +37,7 @@ pub struct DesignArgs {
     #[command(flatten)]
     pub uncertainty: UncertaintyArgs,
     /// Largest acceptable failure probability, for the safe-slope limit.
-    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = 0.05)]
+    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value = "0.05", value_parser = parse_max_risk)]
     pub max_risk: f64,
     /// Print every design as JSON instead of the front as a table.
     #[arg(long)]
@@ -198,7 +198,7 @@ pub fn run(args: DesignArgs) -> Result<()> {
         }
     }
     let space = DesignSpace::new(robot.spec().clone(), ranges).map_err(|e| anyhow!("--vary: {e}"))?;
-    let max_risk = check_flag("--max-risk", args.max_risk, 0.0, 1.0)?;
+    let max_risk = args.max_risk;
     let target = Slope::from_signed_degrees(args.slope_target)
         .map_err(|e| anyhow!("{}", e.renamed("--slope-target")))?;
     let goal = DesignGoal::new(max_risk, target).map_err(|e| anyhow!("--max-risk: {e}"))?;

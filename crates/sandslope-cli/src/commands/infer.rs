@@ -16,7 +16,7 @@ use sandslope::infer::{
 use sandslope::Slope;
 use sandslope_io::observations::{load_speed_observations, load_step_observation};
 
-use crate::args::{RobotArgs, TerrainArgs, UncertaintyArgs};
+use crate::args::{parse_slope_list, RobotArgs, SlopeSign, TerrainArgs, UncertaintyArgs};
 use crate::figures::infer::InferFigure;
 use crate::figures::{format_of, save};
 use crate::output::{check_parent_exists, print_json, sci, table};
@@ -76,28 +76,15 @@ fn parse_prior(text: &str) -> Result<LogUniformPrior> {
     LogUniformPrior::new(num(lo)?, num(hi)?).map_err(|e| anyhow!("--k-s-prior: {e}"))
 }
 
-/// Parses `--predict`: DEG, DEG,DEG,... or MIN:MAX:N.
+/// Most slopes `--predict` evaluates.
+const MAX_PREDICT: usize = 10_000;
+
+/// Parses `--predict` (the slope-list grammar of `args::parse_slope_list`, climbing slopes).
 fn parse_slopes(text: &str) -> Result<Vec<Slope>> {
-    let number = |s: &str| -> Result<Slope> {
-        let v: f64 =
-            s.trim().parse().map_err(|_| anyhow!("--predict: `{}` is not a number (in {text})", s.trim()))?;
-        Slope::from_degrees(v).map_err(|e| anyhow!("{}", e.renamed("--predict")))
-    };
-    if text.contains(':') {
-        let parts: Vec<&str> = text.split(':').collect();
-        let [lo, hi, n] = parts.as_slice() else {
-            bail!("--predict = {text} must be DEG, a comma list, or MIN:MAX:N (e.g. 0:30:31)");
-        };
-        let (lo, hi) = (number(lo)?.degrees(), number(hi)?.degrees());
-        let n: usize = n.trim().parse().ok().filter(|&n| (2..=10_000).contains(&n)).ok_or_else(|| {
-            anyhow!("--predict: N `{n}` must be a whole number from 2 to 10000 (in {text})")
-        })?;
-        if hi <= lo {
-            bail!("--predict = {text}: MAX must be greater than MIN");
-        }
-        return (0..n).map(|i| number(&format!("{}", lo + (hi - lo) * i as f64 / (n - 1) as f64))).collect();
-    }
-    text.split(',').map(number).collect()
+    parse_slope_list("--predict", text, SlopeSign::Uphill, MAX_PREDICT)?
+        .into_iter()
+        .map(|d| Slope::from_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--predict"))))
+        .collect()
 }
 
 fn observations(args: &InferArgs) -> Result<Vec<GaitObservation>> {

@@ -16,7 +16,7 @@ use sandslope_io::mocap::MocapFormat;
 use sandslope_io::presets::{is_default, report_force_tests, PresetKind};
 use sandslope_io::{load_anchoring_times, load_speeds};
 
-use crate::args::{RobotArgs, TerrainArgs};
+use crate::args::{parse_max_risk, RobotArgs, TerrainArgs};
 use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions};
 use crate::output::write_atomic;
 use crate::report::{page, page_figures};
@@ -64,9 +64,9 @@ pub struct ReportArgs {
     )]
     pub tracks_upslope: Option<Upslope>,
     /// Risk threshold for the safe-slope limit.
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, allow_negative_numbers = true, value_name = "P", default_value = "0.05", value_parser = parse_max_risk)]
     pub max_risk: f64,
-    /// Fail (exit code 3, after writing the page) when the report carries a warning: a
+    /// Fail (exit code 4, after writing the page) when the report carries a warning: a
     /// calibration quantity at its search bound, chi^2/dof > 3, or tracks that could not be
     /// used. Without it such a report exits 0 and prints the warnings on stderr.
     #[arg(long)]
@@ -142,9 +142,6 @@ fn load_tracks(args: &ReportArgs, period: f64) -> Result<Vec<TrackedSlope>> {
 
 /// Runs `sandslope report`.
 pub fn run(args: ReportArgs) -> Result<()> {
-    if !(args.max_risk > 0.0 && args.max_risk < 1.0) {
-        bail!("--max-risk = {} must be a probability strictly between 0 and 1", args.max_risk);
-    }
     if args.out.exists() && !args.out.is_dir() {
         bail!("--out {}: exists and is not a folder", args.out.display());
     }

@@ -19,8 +19,8 @@ use sandslope::risk::{
 use sandslope::{Robot, Slope};
 
 use crate::args::{
-    beyond_last_point, check_flag, default_axis, parse_axis, warn_extrapolated, RobotArgs, TerrainArgs,
-    UncertaintyArgs,
+    beyond_last_point, default_axis, parse_axis, parse_max_risk, parse_slope_list, warn_extrapolated,
+    RobotArgs, SlopeSign, TerrainArgs, UncertaintyArgs,
 };
 use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
@@ -55,7 +55,7 @@ pub struct RiskArgs {
     #[command(flatten)]
     pub uncertainty: UncertaintyArgs,
     /// Largest acceptable failure probability, for the safe-slope limit and --solve.
-    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = 0.05)]
+    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value = "0.05", value_parser = parse_max_risk)]
     pub max_risk: f64,
     /// Solve for the safe-slope limit (`slope`) or the heaviest safe mass at each --slope
     /// (`mass`; several slopes give the payload envelope).
@@ -100,31 +100,12 @@ impl RiskArgs {
 }
 
 /// Most slopes one run evaluates (each a quadrature of a few ms).
-const MAX_QUADRATURES: u64 = 1 << 16;
+const MAX_QUADRATURES: usize = 1 << 16;
 
-/// Parses `--slope`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N` (N evenly spaced, ends included).
+/// Parses `--slope` (the slope-list grammar of `args::parse_slope_list`, signed: a descent is
+/// felt as the climb of its size).
 pub fn parse_slopes(text: &str) -> Result<Vec<f64>> {
-    let number = |s: &str| -> Result<f64> {
-        let v: f64 =
-            s.trim().parse().map_err(|_| anyhow!("--slope: `{}` is not a number (in {text})", s.trim()))?;
-        Slope::from_signed_degrees(v).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
-        Ok(v)
-    };
-    if text.contains(':') {
-        let parts: Vec<&str> = text.split(':').collect();
-        if parts.len() != 3 {
-            bail!("--slope = {text} must be DEG, a comma list, or MIN:MAX:N (e.g. 0:24:13)");
-        }
-        let (lo, hi) = (number(parts[0])?, number(parts[1])?);
-        let n: usize = parts[2].trim().parse().ok().filter(|&n| n >= 2).ok_or_else(|| {
-            anyhow!("--slope: N `{}` must be a whole number of at least 2 (in {text})", parts[2])
-        })?;
-        if hi <= lo {
-            bail!("--slope = {text}: MAX must be greater than MIN");
-        }
-        return Ok((0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect());
-    }
-    text.split(',').map(number).collect()
+    parse_slope_list("--slope", text, SlopeSign::Signed, MAX_QUADRATURES)
 }
 
 /// The regime probabilities as printed by `--json`.
@@ -282,16 +263,7 @@ fn describe_slope_limit(limit: &SafeLimit, max_risk: f64) -> String {
 pub fn run(args: RiskArgs) -> Result<()> {
     let robot = args.robot.load()?;
     let slopes = parse_slopes(&args.slope)?;
-    if slopes.len() as u64 > MAX_QUADRATURES {
-        bail!(
-            "--slope gives {} slopes, each a quadrature of a few ms; at most {MAX_QUADRATURES} are allowed",
-            slopes.len()
-        );
-    }
-    let max_risk = check_flag("--max-risk", args.max_risk, 0.0, 1.0)?;
-    if max_risk <= 0.0 || max_risk >= 1.0 {
-        bail!("--max-risk = {max_risk} must be strictly between 0 and 1");
-    }
+    let max_risk = args.max_risk;
     // The note `apply` returns covers the whole table; each mode below notes the defaults at
     // the slopes it evaluates instead.
     let (terrain, _) = args.uncertainty.apply(args.terrain.load()?)?;

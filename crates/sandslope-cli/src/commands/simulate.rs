@@ -9,13 +9,14 @@ use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use serde::Serialize;
 
-use crate::args::{check_flag, warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
+use crate::args::{
+    check_flag, parse_slope_list, warn_extrapolated, OverrideArgs, RobotArgs, SlopeSign, TerrainArgs,
+};
 use crate::figures;
 use crate::figures::simulate::{Animation, SimulateFigure, SlopesFigure};
 use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
-use sandslope::scenario::slope_range;
 use sandslope::simulate::{simulate, simulate_slopes, SimSettings, SimSummary, SimulateError, Simulation};
 use sandslope::{ParamError, Scenario};
 use sandslope_io::load_speeds;
@@ -30,8 +31,9 @@ pub struct SimulateArgs {
     /// Slope, degrees (negative: walking downhill).
     #[arg(long, value_name = "DEG", allow_negative_numbers = true, required_unless_present = "slopes")]
     pub slope: Option<f64>,
-    /// Slopes MIN:MAX:STEP, degrees, simulated in parallel (instead of --slope).
-    #[arg(long, value_name = "MIN:MAX:STEP", conflicts_with_all = ["slope", "out", "animate"])]
+    /// Slopes, degrees, simulated in parallel (instead of --slope): DEG,DEG,... or MIN:MAX:N
+    /// (N evenly spaced, ends included), as risk --slope takes them.
+    #[arg(long, value_name = "MIN:MAX:N", conflicts_with_all = ["slope", "out", "animate"])]
     pub slopes: Option<String>,
     /// Simulated time after settling, s (at least 1.5 T: one stride to settle into the gait,
     /// then steps to measure).
@@ -101,22 +103,10 @@ fn settings(args: &SimulateArgs) -> Result<SimSettings> {
     s.with_sample_rate(args.rate).map_err(flagged)
 }
 
-/// Parses `--slopes MIN:MAX:STEP`.
+/// Parses `--slopes` (the slope-list grammar of `args::parse_slope_list`: DEG, a comma list
+/// or MIN:MAX:N, signed: negative is downhill).
 fn parse_slopes(text: &str) -> Result<Vec<f64>> {
-    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
-    let [a, b, c] = parts[..] else {
-        bail!("--slopes = {text} must be MIN:MAX:STEP in degrees (e.g. 0:24:2)");
-    };
-    let number = |what: &str, s: &str| -> Result<f64> {
-        s.parse::<f64>().map_err(|_| anyhow!("--slopes: {what} `{s}` is not a number (in {text})"))
-    };
-    let (lo, hi, step) = (number("MIN", a)?, number("MAX", b)?, number("STEP", c)?);
-    for (what, v) in [("MIN", lo), ("MAX", hi)] {
-        if !(v.is_finite() && v.abs() < 90.0) {
-            bail!("--slopes: {what} = {v} must be strictly between -90 and 90 degrees (in {text})");
-        }
-    }
-    slope_range(lo, hi, step, MAX_SLOPES).map_err(flagged)
+    parse_slope_list("--slopes", text, SlopeSign::Signed, MAX_SLOPES)
 }
 
 /// What `simulate --json` prints: one walk's summary, or one per slope.
@@ -320,8 +310,9 @@ mod tests {
 
     #[test]
     fn slope_ranges_name_the_flag() {
-        assert_eq!(parse_slopes("0:24:12").unwrap(), vec![0.0, 12.0, 24.0]);
-        for bad in ["0:24", "a:1:1", "0:95:5", "10:0:1", "0:10:0"] {
+        assert_eq!(parse_slopes("0:24:3").unwrap(), vec![0.0, 12.0, 24.0]);
+        assert_eq!(parse_slopes("-10,5").unwrap(), vec![-10.0, 5.0]);
+        for bad in ["0:24", "a:1:1", "0:95:5", "10:0:2", "0:10:0", "0:10:1001"] {
             let msg = parse_slopes(bad).unwrap_err().to_string();
             assert!(msg.starts_with("--slopes"), "{bad}: {msg}");
         }

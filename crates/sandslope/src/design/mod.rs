@@ -209,6 +209,14 @@ impl DesignRange {
         if n == 0 || (n == 1 && max != min) {
             return Err(bad("points", n as f64, "at least 2 for a range (MIN:MAX:N), or one value".into()));
         }
+        // Decided before the values are made: one range cannot exceed the study's cap.
+        if n > MAX_DESIGNS {
+            return Err(bad(
+                "points",
+                n as f64,
+                format!("at most {MAX_DESIGNS} (the most designs one study evaluates)"),
+            ));
+        }
         // Rounded to 12 significant digits, so that 0.0:0.06:13 gives 0.06, not
         // 0.060000000000000005 (which a hip-height check against 2R = 0.06 would reject).
         let snap = |v: f64| format!("{v:.11e}").parse::<f64>().unwrap_or(v);

@@ -1,0 +1,87 @@
+//! Hostile input (issue 21): sizes that come from input are decided before anything is
+//! allocated, and values no robot on sand has are refused at the edge. Each case failed before
+//! its fix: a range of 1e11 slopes or designs aborted the process after minutes and gigabytes,
+//! and a speeds table holding -1e308 hung `calibrate --plot` in the plotting library's tick loop.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use common::{repo_file, sandslope};
+use predicates::prelude::*;
+use predicates::str::contains;
+
+/// Runs `args`, which must exit 2 within `limit` with `needle` on stderr.
+fn refused_fast(args: &[&str], needle: &str, limit: Duration) {
+    let start = Instant::now();
+    sandslope().args(args).timeout(limit * 10).assert().code(2).stderr(contains(needle));
+    assert!(start.elapsed() < limit, "{args:?} took {:?}", start.elapsed());
+}
+
+#[test]
+fn huge_ranges_are_refused_before_they_are_expanded() {
+    let fast = Duration::from_secs(3);
+    refused_fast(
+        &["risk", "--slope", "0:24:99999999999"],
+        "--slope: N `99999999999` must be a whole number from 2 to 65536",
+        fast,
+    );
+    refused_fast(
+        &["design", "--vary", "mass_kg=0.3:1:99999999999", "--slope-target", "15"],
+        "mass_kg points",
+        fast,
+    );
+    refused_fast(&["simulate", "--slopes", "0:24:99999999999"], "--slopes: N", fast);
+    refused_fast(
+        &[
+            "infer",
+            "--observed",
+            repo_file("data/paper-speeds.csv").to_str().unwrap(),
+            "--law",
+            "linear",
+            "--predict",
+            "0:30:99999999999",
+        ],
+        "--predict: N",
+        fast,
+    );
+    refused_fast(&["sweep", "--from", "0", "--to", "24", "--step", "1e-9"], "at most 100000 slopes", fast);
+    refused_fast(&["phase", "--k-n", "1e4:1e7:99999999", "--k-s", "1e4:1e7:99999999"], "cells", fast);
+}
+
+#[test]
+fn max_risk_says_the_same_everywhere() {
+    for cmd in ["risk", "design", "report"] {
+        sandslope().args([cmd, "--max-risk", "1.5"]).assert().code(2).stderr(
+            contains("--max-risk").and(contains("1.5 is not a failure probability strictly between 0 and 1")),
+        );
+    }
+}
+
+#[test]
+fn an_impossible_speed_is_refused_at_once_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    for (row, column) in
+        [("0,-1e308,0.01", "speed_m_s"), ("0,0.1,1e-320", "speed_sd_m_s"), ("0,0.1,1e308", "speed_sd_m_s")]
+    {
+        let speeds = dir.path().join("speeds.csv");
+        std::fs::write(&speeds, format!("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n{row}\n")).unwrap();
+        let plot = dir.path().join("fit.svg");
+        let out = dir.path().join("terrain.toml");
+        let needle = format!("speeds.csv: line 3: column {column}");
+        refused_fast(
+            &[
+                "calibrate",
+                "--observed",
+                speeds.to_str().unwrap(),
+                "--plot",
+                plot.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &needle,
+            Duration::from_secs(5),
+        );
+        assert!(!plot.exists() && !out.exists(), "{row} left a file");
+    }
+}

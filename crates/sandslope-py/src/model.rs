@@ -177,10 +177,14 @@ pub fn phase<'py>(
     let ks = axis("k_s_axis", &values(&k_s_axis))?;
     let robot = &robot.inner;
     let (nx, ny) = (kn.len(), ks.len());
-    let cells = nx
-        .checked_mul(ny)
-        .filter(|&c| c <= isize::MAX as usize / 16)
-        .ok_or_else(|| value_error(format!("a {nx} x {ny} map is too large")))?;
+    let cells = sandslope::limits::grid_cells(
+        "len(k_n_axis) * len(k_s_axis)",
+        nx,
+        ny,
+        1,
+        sandslope::limits::MAX_PHASE_CELLS,
+    )
+    .map_err(value_error)?;
     let (regime, step, counts) = py.detach(|| {
         let map = PhaseMap::compute(robot, slope, repose, &kn, &ks, &|| {});
         // Written row by row, in parallel, straight from the map into the buffers NumPy will

@@ -43,6 +43,8 @@ pub fn risk<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let terrain = uncertain(terrain, cv_n, cv_s)?;
     let degrees = values(&slope_deg);
+    sandslope::limits::count("len(slope_deg)", degrees.len(), sandslope::limits::MAX_RISK_SLOPES)
+        .map_err(value_error)?;
     let robot = &robot.inner;
     let curve = py.detach(|| risk_curve(robot, &terrain, &degrees)).map_err(|e| {
         // The library names the key; point at the element when there are several.
@@ -85,6 +87,14 @@ pub fn risk_map<'py>(
     let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| value_error(e.renamed("slope_deg")))?;
     let kn = axis("k_n_axis", &values(&k_n_axis))?;
     let ks = axis("k_s_axis", &values(&k_s_axis))?;
+    sandslope::limits::grid_cells(
+        "len(k_n_axis) * len(k_s_axis)",
+        kn.len(),
+        ks.len(),
+        1,
+        sandslope::limits::MAX_RISK_MAP_CELLS,
+    )
+    .map_err(value_error)?;
     let g = terrain.sample(slope);
     let robot = &robot.inner;
     let map = py.detach(|| RiskMap::compute(robot, slope, g.ground.repose, &kn, &ks, g.uncertainty, &|| {}));

@@ -36,6 +36,7 @@ pub mod design;
 pub mod error;
 pub mod gait;
 pub mod infer;
+pub mod limits;
 pub mod measure;
 pub mod model;
 pub mod paper;

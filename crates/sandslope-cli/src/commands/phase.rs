@@ -71,8 +71,8 @@ pub struct PhaseArgs {
     pub json: bool,
 }
 
-/// Most grid cells a `phase` run computes, over all panels (2^28: 64 MiB of regimes).
-const MAX_CELLS: u128 = 1 << 28;
+/// Most grid cells a `phase` run computes, over all panels (the library's cap, as Python's).
+const MAX_CELLS: u128 = sandslope::limits::MAX_PHASE_CELLS as u128;
 /// Most rows `--csv` writes (2^25: about 2 GB of text).
 const MAX_CSV_CELLS: u128 = 1 << 25;
 

@@ -29,8 +29,8 @@ use crate::progress::progress_bar;
 
 /// Default points per axis of the `--map` grid.
 pub const MAP_POINTS: usize = 200;
-/// Most `--map` cells (2^24: two 128 MiB arrays of probabilities).
-const MAX_MAP_CELLS: u128 = 1 << 24;
+/// Most `--map` cells (the library's cap, as Python's).
+const MAX_MAP_CELLS: u128 = sandslope::limits::MAX_RISK_MAP_CELLS as u128;
 
 /// What `--solve` finds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -100,7 +100,7 @@ impl RiskArgs {
 }
 
 /// Most slopes one run evaluates (each a quadrature of a few ms).
-const MAX_QUADRATURES: usize = 1 << 16;
+const MAX_QUADRATURES: usize = sandslope::limits::MAX_RISK_SLOPES;
 
 /// Parses `--slope` (the slope-list grammar of `args::parse_slope_list`, signed: a descent is
 /// felt as the climb of its size).

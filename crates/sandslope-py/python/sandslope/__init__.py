@@ -112,10 +112,17 @@ def _terrain(terrain: TerrainLike) -> Terrain:
 
 
 def _float_array(name: str, x: Any) -> np.ndarray:
+    _refuse_complex(name, x)
     try:
         return np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as e:
         raise ValueError(f"{name} must be a number or an array of numbers: {e}") from None
+
+
+def _refuse_complex(name: str, x: Any) -> None:
+    """A complex value would be cast to its real part with only NumPy's ComplexWarning."""
+    if np.iscomplexobj(x):
+        raise ValueError(f"{name} must be real numbers, not complex ({np.asarray(x).dtype})")
 
 
 _PREDICT_FLOAT_KEYS = (
@@ -355,6 +362,7 @@ def _cell_size(cell_size_m: Any) -> Tuple[float, float]:
 
 
 def _dem(dem: Any) -> np.ndarray:
+    _refuse_complex("dem", dem)
     z = np.asarray(dem)
     if z.ndim != 2:
         raise ValueError(f"dem must be a 2-D array (rows, cols), row 0 at the north (got shape {z.shape})")

@@ -45,4 +45,9 @@ echo "== pytest crates/sandslope-py/tests"
 SANDSLOPE_CLI="$root/target/debug/sandslope" "$py" -m pytest crates/sandslope-py/tests -q -p no:cacheprovider
 t4=$(seconds)
 
-echo "== times: python tools $((t1 - t0)) s, cargo test $((t2 - t1)) s, extension build $((t3 - t2)) s, pytest $((t4 - t3)) s, total $((t4 - t0)) s"
+echo "== fuzz, short pass: 200 mutated inputs per reader and command (scripts/fuzz.sh; docs/robustness.md)"
+# Debug builds, already made by cargo test above; any panic, abort, hang or peak over 1 GiB fails.
+FUZZ_PROFILE=debug SANDSLOPE_VENV="$venv" bash scripts/fuzz.sh 200
+t5=$(seconds)
+
+echo "== times: python tools $((t1 - t0)) s, cargo test $((t2 - t1)) s, extension build $((t3 - t2)) s, pytest $((t4 - t3)) s, fuzz $((t5 - t4)) s, total $((t5 - t0)) s"

@@ -33,6 +33,33 @@ fn check_raster_size(name: &dyn std::fmt::Display, cols: u64, rows: u64) -> Resu
     Ok(())
 }
 
+/// Largest expansion of a compressed GeoTIFF's bytes into samples that is believed: LZW's
+/// 12-bit codes expand to at most 4096 bytes each (about 2730:1), Deflate to about 1032:1.
+const MAX_EXPANSION: u64 = 4096;
+
+/// Decoded images up to this size are allocated whatever the file's size.
+const ALWAYS_BELIEVED_BYTES: u64 = 64 << 20;
+
+/// Refuses an image whose decoded samples (`cols` x `rows` x `bits` / 8 bytes) could not come
+/// from a file of `file_bytes` bytes under any TIFF compression, before the decoder allocates
+/// them: a 700-byte file claiming a 4 GiB image made the allocation abort the process.
+fn check_claimed_bytes(
+    name: &dyn std::fmt::Display,
+    cols: u64,
+    rows: u64,
+    bits: u64,
+    file_bytes: u64,
+) -> Result<()> {
+    let claimed = cols.saturating_mul(rows).saturating_mul(bits.max(8) / 8);
+    if claimed > ALWAYS_BELIEVED_BYTES && claimed / MAX_EXPANSION > file_bytes {
+        bail!(
+            "{name}: claims {cols} x {rows} samples of {bits} bits ({claimed} bytes), more than a \
+             {file_bytes}-byte file can hold under any TIFF compression; the file is truncated or corrupt"
+        );
+    }
+    Ok(())
+}
+
 /// The decoder's limits: the image at most [`MAX_RASTER_CELLS`] 8-byte samples, any tag
 /// value at most [`MAX_TIFF_TAG_BYTES`].
 fn tiff_limits() -> Limits {
@@ -126,6 +153,9 @@ fn read_geotiff(path: &Path) -> Result<Raster> {
         .with_limits(tiff_limits());
     let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
     check_raster_size(&name, u64::from(w), u64::from(h))?;
+    let bits: u64 = dec.find_tag_unsigned(Tag::BitsPerSample).ok().flatten().unwrap_or(64);
+    let file_bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
+    check_claimed_bytes(&name, u64::from(w), u64::from(h), bits, file_bytes)?;
     let samples: u16 = dec.find_tag_unsigned(Tag::SamplesPerPixel).ok().flatten().unwrap_or(1);
     if samples != 1 {
         bail!("{name}: has {samples} bands; an elevation or class raster must have exactly 1");
@@ -471,6 +501,29 @@ mod hostile {
         let err = read_bytes("claims.tif", &bytes);
         assert!(
             err.contains("claims.tif") && err.contains("3600000000 cells") && err.contains("limit"),
+            "{err}"
+        );
+    }
+
+    /// Within the cell limit (2^28 cells) but 1 GiB of samples from a 1 KB file: no
+    /// compression expands that far, so it is refused before the decoder allocates (found by
+    /// scripts/fuzz.sh: a 700-byte file made the decoder ask for 4 GiB and abort).
+    #[test]
+    fn a_1kb_tiff_claiming_a_gigabyte_of_samples_is_refused_by_the_file_size() {
+        let bytes = tiff_with(&[
+            (256, LONG, 1, 16_384),
+            (257, LONG, 1, 16_384),
+            (258, SHORT, 1, 32),
+            (259, SHORT, 1, 5), // LZW
+            (262, SHORT, 1, 1),
+            (273, LONG, 1, 200),
+            (278, LONG, 1, 16_384),
+            (279, LONG, 1, 800),
+            (339, SHORT, 1, 3),
+        ]);
+        let err = read_bytes("small.tif", &bytes);
+        assert!(
+            err.contains("small.tif") && err.contains("1073741824 bytes") && err.contains("1024-byte file"),
             "{err}"
         );
     }

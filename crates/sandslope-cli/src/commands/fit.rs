@@ -187,9 +187,6 @@ pub fn run(args: FitArgs) -> Result<()> {
         }
         Format::Table => {
             print_tables(&campaign);
-            if let Some(out) = &args.out {
-                println!("terrain written to {}", out.display());
-            }
             Ok(())
         }
     }

@@ -375,7 +375,9 @@ impl Planner {
         // a 4096 x 4096 plan in perf). NaN and negative values give 0, as `ceil` did.
         let x = e.tan_pitch.abs() * (1.0 / TAN_STEP as f32);
         let floor = x as usize;
-        let geometric = if (floor as f32) < x { floor + 1 } else { floor };
+        // Saturating: an infinite pitch (elevations of 1e38 in a corrupt DEM) casts to
+        // usize::MAX, and is then beyond the table like any pitch too steep (found by fuzzing).
+        let geometric = if (floor as f32) < x { floor.saturating_add(1) } else { floor };
         if geometric >= self.tables[0].len() {
             return None;
         }
@@ -1030,6 +1032,24 @@ mod tests {
         assert_eq!(r.regimes, [0, 0, 0, 11]);
         // Level-sand speed, by the model test's hand calculation: 0.151334 m/s.
         assert!((r.time_s.unwrap() - straight / 0.151_334).abs() < 1e-3 * r.time_s.unwrap());
+    }
+
+    /// A wall of 3e38 m (a corrupt DEM's float noise, not declared nodata) gives its
+    /// neighbours an infinite pitch: impassable like any pitch beyond the table, never an
+    /// overflow (found by fuzzing `plan`).
+    #[test]
+    fn an_infinitely_steep_wall_is_impassable_not_an_overflow() {
+        let n = 12;
+        let z: Vec<f32> = (0..n * n).map(|i| if i % n == 6 && i / n < 11 { 3e38 } else { 0.0 }).collect();
+        let g = ElevationGrid::new(n, n, 1.0, 1.0, z, None).unwrap();
+        let p = Planner::new(g, None, &class(), &paper_robot(), PlanSettings::default()).unwrap();
+        let r = p
+            .route(Objective::Time, Cell { col: 2, row: 2 }, Cell { col: 10, row: 2 }, &|_| {})
+            .unwrap()
+            .unwrap();
+        // The cells beside the wall (columns 5 and 7) have a gradient of 1.5e38: impassable
+        // (an overflow panicked here, and in a release build wrapped round to level ground).
+        assert!(r.cells.iter().all(|c| !((c.col == 5 || c.col == 7) && c.row < 11)), "{:?}", r.cells);
     }
 
     /// A planner built from cached tables draws the same risk map, bit for bit, as one built

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Mutation fuzz of every reader and every command that reads a file, and of the Python
+# package's readers (issue 21; docs/robustness.md).
+#
+#   scripts/fuzz.sh N [TARGET...]     N mutated inputs per target (default 1000)
+#
+# Reports, per target, panics, aborts, hangs (over 10 s) and peak memory, and exits 1 if any
+# target had a panic, abort, hang or a peak above 1 GiB. Failing inputs are kept in fuzz-out/.
+# Environment:
+#   FUZZ_PROFILE=debug   use debug builds (what scripts/test.sh's short pass does; default release)
+#   FUZZ_SEED=S          another sequence of inputs (default 1)
+#   SANDSLOPE_VENV=DIR   the venv with the Python package (default .venv); the Python targets
+#                        are skipped, with a note, when it has no sandslope
+set -euo pipefail
+cd "$(dirname "$0")/.."
+runs=${1:-1000}
+shift || true
+profile=${FUZZ_PROFILE:-release}
+seed=${FUZZ_SEED:-1}
+venv=${SANDSLOPE_VENV:-$PWD/.venv}
+flag=--release
+dir=release
+if [ "$profile" = debug ]; then flag=; dir=debug; fi
+
+cargo build $flag --locked -p sandslope-cli -p sandslope-fuzz
+bin=target/$dir
+rust_targets=()
+py_targets=()
+for t in "$@"; do
+  case $t in py-*) py_targets+=("$t") ;; *) rust_targets+=("$t") ;; esac
+done
+
+status=0
+if [ $# -eq 0 ] || [ ${#rust_targets[@]} -gt 0 ]; then
+  "$bin/sandslope-fuzz" --runs "$runs" --seed "$seed" --bin "$bin/sandslope" ${rust_targets[@]+"${rust_targets[@]}"} || status=1
+fi
+if [ $# -eq 0 ] || [ ${#py_targets[@]} -gt 0 ]; then
+  if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import sandslope" 2>/dev/null; then
+    "$venv/bin/python" scripts/fuzz_python.py --runs "$runs" --seed "$seed" --fuzz-bin "$bin/sandslope-fuzz" \
+      ${py_targets[@]+"${py_targets[@]}"} || status=1
+  else
+    echo "note: no sandslope Python package in $venv: the Python readers were not fuzzed (run scripts/test.sh first)"
+  fi
+fi
+exit $status

@@ -466,3 +466,52 @@ fn clicking_start_and_goal_on_the_example_dem_draws_plans_routes() {
         std::fs::copy(&shot, std::path::Path::new(&keep).join("routes.png")).unwrap();
     }
 }
+
+/// 200 requests at once on loopback (one thread each, released together): every one answered
+/// with the right body, none lost. Prints the latencies; docs/serve.md has the release build's.
+#[test]
+fn two_hundred_concurrent_requests_are_all_answered() {
+    let server = std::sync::Arc::new(Server::start(&[]));
+    let paths: Vec<String> = (0..200)
+        .map(|i| match i % 4 {
+            0 | 1 => format!("/api/predict?slope={}&mass={}", i % 35, 0.2 + (i % 7) as f64 * 0.1),
+            2 => format!("/api/sweep?from=0&to=30&step=0.5&mass={}", 0.3 + (i % 5) as f64 * 0.1),
+            _ => format!("/api/phase?slope={}&k-n=1e4:1e7:100&k-s=1e3:1e8:100", i % 25),
+        })
+        .collect();
+    let gate = std::sync::Arc::new(std::sync::Barrier::new(paths.len()));
+    let handles: Vec<_> = paths
+        .iter()
+        .cloned()
+        .map(|path| {
+            let (server, gate) = (std::sync::Arc::clone(&server), std::sync::Arc::clone(&gate));
+            std::thread::spawn(move || {
+                gate.wait();
+                let t = std::time::Instant::now();
+                let (status, body) = server.get(&path);
+                (path, status, body, t.elapsed())
+            })
+        })
+        .collect();
+    let mut latencies = Vec::new();
+    for h in handles {
+        let (path, status, body, took) = h.join().unwrap();
+        assert_eq!(status, 200, "{path}: {}", String::from_utf8_lossy(&body));
+        // The body is the command's: spot-check one in four against the command line.
+        if latencies.len() % 4 == 0 {
+            let (command, query) = path.trim_start_matches("/api/").split_once('?').unwrap();
+            let mut argv = vec![command.to_string(), "--json".to_string()];
+            argv.extend(query.split('&').map(|kv| format!("--{kv}")));
+            assert_eq!(body, cli_stdout(&argv), "{path}");
+        }
+        latencies.push(took.as_secs_f64());
+    }
+    latencies.sort_by(f64::total_cmp);
+    let at = |q: f64| latencies[((latencies.len() - 1) as f64 * q).round() as usize] * 1e3;
+    eprintln!(
+        "200 concurrent requests: all answered; p50 {:.0} ms, p99 {:.0} ms, max {:.0} ms",
+        at(0.5),
+        at(0.99),
+        at(1.0)
+    );
+}

@@ -76,9 +76,11 @@ impl ApiError {
             Some(ContextValue::Strings(v)) => v.first().and_then(|s| flag_named_in(s)),
             _ => None,
         };
+        // clap's message up to its usage lines, on one line.
         let text = e.to_string();
-        let first = text.lines().next().unwrap_or_default();
-        let error = first.strip_prefix("error: ").unwrap_or(first).to_string();
+        let lines: Vec<&str> = text.lines().take_while(|l| !l.trim().is_empty()).map(str::trim).collect();
+        let joined = lines.join(" ");
+        let error = joined.strip_prefix("error: ").unwrap_or(&joined).to_string();
         ApiError::bad(field, error)
     }
 }

@@ -246,6 +246,12 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, Api
     // The planner's inputs need no endpoints; plan's flags require some, so any cell will do.
     rest.push(("start-px".into(), "0,0".into()));
     rest.push(("goal-px".into(), "0,0".into()));
+    if !["best", "fall-line"].contains(&rule.as_str()) {
+        return Err(ApiError::bad(
+            Some("rule".to_string()),
+            format!("rule = `{rule}` must be best (lowest over 16 headings) or fall-line (straight up)"),
+        ));
+    }
     let args: plan::PlanArgs = api::parse("plan", &rest, served)?;
     let inputs = plan::Inputs::read(&args, true).map_err(|e| ApiError::from_command(&e))?;
     let planner = inputs.planner(&args).map_err(|e| failed(&e))?;

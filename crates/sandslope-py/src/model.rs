@@ -43,14 +43,7 @@ struct Row {
 }
 
 /// The reason codes, index of `cause` in the result (see `sandslope.CAUSES`).
-pub const CAUSES: [Cause; 6] = [
-    Cause::NormalSinkage,
-    Cause::AtOrAboveRepose,
-    Cause::NoAnchoring,
-    Cause::NetBackwardStep,
-    Cause::ShortStep,
-    Cause::RobustStep,
-];
+pub const CAUSES: [Cause; 6] = Cause::ALL;
 
 impl Row {
     fn from(e: &SlopeEvaluation) -> Row {

@@ -67,6 +67,16 @@ pub enum Cause {
 }
 
 impl Cause {
+    /// Every cause, in the order of the regimes they belong to (docs/model.md §6).
+    pub const ALL: [Cause; 6] = [
+        Cause::NormalSinkage,
+        Cause::AtOrAboveRepose,
+        Cause::NoAnchoring,
+        Cause::NetBackwardStep,
+        Cause::ShortStep,
+        Cause::RobustStep,
+    ];
+
     /// The regime this cause belongs to.
     pub fn regime(self) -> Regime {
         match self {

@@ -327,16 +327,7 @@ impl Inputs {
 
     /// The elevation grid of the DEM (named after the file in errors).
     pub fn grid(&self, args: &PlanArgs) -> Result<ElevationGrid> {
-        let dem = &self.dem;
-        ElevationGrid::from_heights(
-            dem.cols,
-            dem.rows,
-            dem.geo.cell_x,
-            dem.geo.cell_y,
-            &dem.values,
-            dem.nodata,
-        )
-        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))
+        grid_of(&self.dem, args)
     }
 
     /// The planner over the whole DEM (for per-cell maps without routes).
@@ -344,6 +335,12 @@ impl Inputs {
         Planner::new(self.grid(args)?, self.classes.clone(), &self.terrains, &self.robot, self.settings)
             .map_err(|e| anyhow!("{}: {e}", args.dem.display()))
     }
+}
+
+/// The elevation grid of `dem`, read from `--dem` (named in errors).
+fn grid_of(dem: &Raster, args: &PlanArgs) -> Result<ElevationGrid> {
+    ElevationGrid::from_heights(dem.cols, dem.rows, dem.geo.cell_x, dem.geo.cell_y, &dem.values, dem.nodata)
+        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))
 }
 
 /// [`load_classes`], with the note on default CVs printed unless `quiet`.
@@ -405,15 +402,7 @@ pub fn compute(args: &PlanArgs, risk_map: bool, quiet: bool) -> Result<Planned> 
     let start = endpoint(&dem, "start", &args.start, &args.start_px)?;
     let goal = endpoint(&dem, "goal", &args.goal, &args.goal_px)?;
     let (classes, terrains) = classes_of(args, &dem, quiet)?;
-    let grid = ElevationGrid::from_heights(
-        dem.cols,
-        dem.rows,
-        dem.geo.cell_x,
-        dem.geo.cell_y,
-        &dem.values,
-        dem.nodata,
-    )
-    .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+    let grid = grid_of(&dem, args)?;
     let request =
         PlanRequest { start, goal, objectives: args.objective.iter().map(|&o| o.into()).collect(), risk_map };
 

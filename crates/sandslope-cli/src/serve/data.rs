@@ -148,17 +148,7 @@ fn served_info(served: &Served) -> Result<Vec<u8>, ApiError> {
         terrain_name: terrain.name().unwrap_or(&served.terrain).to_string(),
         robots: names(PresetKind::Robot),
         terrains: names(PresetKind::Terrain),
-        causes: [
-            Cause::NormalSinkage,
-            Cause::AtOrAboveRepose,
-            Cause::NoAnchoring,
-            Cause::NetBackwardStep,
-            Cause::ShortStep,
-            Cause::RobustStep,
-        ]
-        .iter()
-        .map(|c| (c.name(), c.explain()))
-        .collect(),
+        causes: Cause::ALL.iter().map(|c| (c.name(), c.explain())).collect(),
         dem,
     })
 }

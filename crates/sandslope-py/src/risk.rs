@@ -8,7 +8,8 @@ use pyo3::types::PyDict;
 use pythonize::pythonize;
 
 use sandslope::risk::uncertainty::CvSource;
-use sandslope::risk::{max_safe_mass, risk_curve, safe_slope_limit, RiskMap, UncertainTerrain};
+use sandslope::risk::RegimeProbabilities;
+use sandslope::risk::{risk_curve, RiskMap, UncertainTerrain};
 use sandslope::Slope;
 
 use crate::arrays::{axis, put, values};
@@ -29,7 +30,8 @@ fn source(s: CvSource) -> &'static str {
     }
 }
 
-/// Regime probabilities at each slope (the columns of `sandslope risk --csv`), with the
+/// Regime probabilities at each slope: the keys of `sandslope risk --json` as columns
+/// (`p_regime` a dict of columns) and the columns of `risk --csv` (`p_<regime>`), with the
 /// coefficients of variation used and where they came from (`given`, `table`, `default`).
 #[pyfunction]
 #[pyo3(signature = (robot, slope_deg, terrain, cv_n=None, cv_s=None))]
@@ -54,16 +56,20 @@ pub fn risk<'py>(
     let pts = &curve.points;
     let d = PyDict::new(py);
     put(&d, "slope_deg", degrees.clone())?;
-    put(&d, "cv_n", pts.iter().map(|p| p.cv_n).collect())?;
-    put(&d, "cv_s", pts.iter().map(|p| p.cv_s).collect())?;
-    d.set_item("cv_n_source", pts.iter().map(|p| source(p.cv_n_source)).collect::<Vec<_>>())?;
-    d.set_item("cv_s_source", pts.iter().map(|p| source(p.cv_s_source)).collect::<Vec<_>>())?;
+    put(&d, "cv_n", pts.iter().map(|p| p.uncertainty.cv_n).collect())?;
+    put(&d, "cv_s", pts.iter().map(|p| p.uncertainty.cv_s).collect())?;
+    d.set_item("cv_n_source", pts.iter().map(|p| source(p.uncertainty.cv_n_source)).collect::<Vec<_>>())?;
+    d.set_item("cv_s_source", pts.iter().map(|p| source(p.uncertainty.cv_s_source)).collect::<Vec<_>>())?;
     put(&d, "p_fail", pts.iter().map(|p| p.p_fail).collect())?;
     put(&d, "p_not_success", pts.iter().map(|p| p.p_not_success).collect())?;
-    put(&d, "p_success", pts.iter().map(|p| p.probabilities.success).collect())?;
-    put(&d, "p_metastable", pts.iter().map(|p| p.probabilities.metastable).collect())?;
-    put(&d, "p_slippage", pts.iter().map(|p| p.probabilities.slippage).collect())?;
-    put(&d, "p_sinkage", pts.iter().map(|p| p.probabilities.sinkage).collect())?;
+    let p_regime = PyDict::new(py);
+    let of = |q: &RegimeProbabilities| [q.success, q.metastable, q.slippage, q.sinkage];
+    for (i, name) in ["success", "metastable", "slippage", "sinkage"].into_iter().enumerate() {
+        let column: Vec<f64> = pts.iter().map(|p| of(&p.probabilities)[i]).collect();
+        put(&p_regime, name, column.clone())?;
+        put(&d, &format!("p_{name}"), column)?;
+    }
+    d.set_item("p_regime", p_regime)?;
     Ok(d)
 }
 
@@ -113,7 +119,8 @@ pub fn risk_map<'py>(
     Ok(d)
 }
 
-/// The safe-slope limit (`sandslope risk --solve slope --json`).
+/// The safe-slope limit with the uncertainty it used: the value `sandslope risk --solve slope
+/// --json` prints.
 #[pyfunction]
 #[pyo3(signature = (robot, terrain, max_risk=0.05, cv_n=None, cv_s=None))]
 pub fn safe_slope<'py>(
@@ -126,15 +133,12 @@ pub fn safe_slope<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let terrain = uncertain(terrain, cv_n, cv_s)?;
     let robot = &robot.inner;
-    let limit = py.detach(|| safe_slope_limit(robot, &terrain, max_risk)).map_err(value_error)?;
-    let d = PyDict::new(py);
-    d.set_item("max_risk", max_risk)?;
-    d.set_item("safe_slope_deg", limit.value())?;
-    d.set_item("limit", pythonize(py, &limit).map_err(value_error)?)?;
-    Ok(d)
+    let answer = py.detach(|| sandslope::risk::safe_slope(robot, &terrain, max_risk)).map_err(value_error)?;
+    Ok(pythonize(py, &answer).map_err(value_error)?.cast_into::<PyDict>()?)
 }
 
-/// The heaviest safe total mass at one slope (`sandslope risk --solve mass --json`).
+/// The heaviest safe total mass at one slope, the payload it leaves and the uncertainty it used:
+/// the value `sandslope risk --solve mass --json` prints.
 #[pyfunction]
 #[pyo3(signature = (robot, slope_deg, terrain, max_risk=0.05, cv_n=None, cv_s=None))]
 pub fn safe_mass<'py>(
@@ -147,16 +151,9 @@ pub fn safe_mass<'py>(
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let terrain = uncertain(terrain, cv_n, cv_s)?;
-    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| value_error(e.renamed("slope_deg")))?;
     let robot = &robot.inner;
-    let limit = py.detach(|| max_safe_mass(robot, slope, &terrain, max_risk)).map_err(value_error)?;
-    let own = robot.mass();
-    let d = PyDict::new(py);
-    d.set_item("slope_deg", slope_deg)?;
-    d.set_item("max_risk", max_risk)?;
-    d.set_item("robot_mass_kg", own)?;
-    d.set_item("max_mass_kg", limit.value())?;
-    d.set_item("max_payload_kg", limit.value().map(|m| m - own))?;
-    d.set_item("limit", pythonize(py, &limit).map_err(value_error)?)?;
-    Ok(d)
+    let answer = py
+        .detach(|| sandslope::risk::safe_mass(robot, slope_deg, &terrain, max_risk))
+        .map_err(value_error)?;
+    Ok(pythonize(py, &answer).map_err(value_error)?.cast_into::<PyDict>()?)
 }

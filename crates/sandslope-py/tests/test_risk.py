@@ -16,6 +16,12 @@ def test_risk_matches_cli(cli, robot, terrain):
         assert got["p_not_success"][i] == pytest.approx(w["p_not_success"], rel=1e-12, abs=1e-300)
         for k, v in w["p_regime"].items():
             assert got[f"p_{k}"][i] == pytest.approx(v, rel=1e-12, abs=1e-300), k
+        assert got["cv_n_source"][i] == w["cv_n_source"] and got["cv_s"][i] == w["cv_s"]
+        for k, v in w["p_regime"].items():
+            assert got["p_regime"][k][i] == got[f"p_{k}"][i]
+    # The keys of risk --json, and the regime columns of risk --csv.
+    csv_header = cli.run("risk", "--slope", "0,10", "--csv").stdout.splitlines()[0].split(",")
+    assert set(got) == set(want[0]) | set(csv_header)
     total = got["p_success"] + got["p_metastable"] + got["p_slippage"] + got["p_sinkage"]
     np.testing.assert_allclose(total, 1.0, atol=1e-8)
     # Failure becomes likelier as the slope steepens on this terrain.
@@ -57,11 +63,13 @@ def test_solvers_match_cli(cli, robot, root):
     uncertain = root / "examples" / "phase" / "uncertain-sand.toml"
     want = cli.json("risk", "--terrain", uncertain, "--solve", "slope", "--max-risk", 0.1)
     got = sandslope.safe_slope(robot, terrain=uncertain, max_risk=0.1)
-    assert got["limit"] == want["limit"] and got["safe_slope_deg"] == want["safe_slope_deg"]
+    # One library value: the same keys and the same numbers, bit for bit.
+    assert got == want
     want = cli.json("risk", "--terrain", uncertain, "--slope", 10, "--solve", "mass")
     got = sandslope.safe_mass(robot, 10, terrain=uncertain)
-    assert got == pytest.approx(want) if got["max_mass_kg"] is None else got["max_mass_kg"] == want["max_mass_kg"]
-    assert got["limit"] == want["limit"]
+    assert got == want
+    # The payload is the heaviest safe mass less the robot's own.
+    assert got["max_payload_kg"] == pytest.approx(got["max_mass_kg"] - robot.mass_kg, abs=1e-12)
 
 
 def test_risk_map_matches_pointwise_risk(robot):

@@ -13,8 +13,8 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 
 use sandslope::risk::{
-    max_safe_mass, payload_envelope, risk_curve, safe_slope_limit, CvSource, DefaultsUsed, PayloadEnvelope,
-    PayloadPoint, RiskCurve, RiskMap, RiskPoint, SafeLimit, UncertainGround, UncertainTerrain,
+    payload_envelope, risk_curve, safe_mass, safe_slope, safe_slope_limit, DefaultsUsed, PayloadEnvelope,
+    RiskCurve, RiskMap, RiskMapSummary, RiskPoint, SafeLimit, SafeMass, UncertainTerrain,
 };
 use sandslope::{Robot, Slope};
 
@@ -108,53 +108,7 @@ pub fn parse_slopes(text: &str) -> Result<Vec<f64>> {
     parse_slope_list("--slope", text, SlopeSign::Signed, MAX_QUADRATURES)
 }
 
-/// The regime probabilities as printed by `--json`.
-#[derive(Debug, Clone, Serialize)]
-struct RegimeRecord {
-    success: f64,
-    metastable: f64,
-    slippage: f64,
-    sinkage: f64,
-}
-
-/// The uncertainty used at one slope, as every `--json` result prints it beside the numbers
-/// it produced: the coefficients of variation and where each came from (`given`, `table` or
-/// `default`, docs/model.md §9). The same keys as the Python `sandslope.risk` result.
-#[derive(Debug, Clone, Copy, Serialize)]
-struct UsedUncertainty {
-    cv_n: f64,
-    cv_s: f64,
-    cv_n_source: CvSource,
-    cv_s_source: CvSource,
-}
-
-impl UsedUncertainty {
-    fn of(g: &UncertainGround) -> UsedUncertainty {
-        UsedUncertainty {
-            cv_n: g.uncertainty.cv_n(),
-            cv_s: g.uncertainty.cv_s(),
-            cv_n_source: g.cv_n_source,
-            cv_s_source: g.cv_s_source,
-        }
-    }
-
-    fn at(terrain: &UncertainTerrain, slope: Slope) -> UsedUncertainty {
-        UsedUncertainty::of(&terrain.sample(slope))
-    }
-}
-
-/// One slope as printed by `--json`: exactly these keys.
-#[derive(Debug, Clone, Serialize)]
-struct RiskRecord {
-    slope_deg: f64,
-    #[serde(flatten)]
-    uncertainty: UsedUncertainty,
-    p_fail: f64,
-    p_not_success: f64,
-    p_regime: RegimeRecord,
-}
-
-/// One slope as printed by `--csv`.
+/// One slope as printed by `--csv`: [`RiskPoint`] flattened.
 #[derive(Debug, Clone, Serialize)]
 struct RiskRow {
     slope_deg: f64,
@@ -168,75 +122,30 @@ struct RiskRow {
     p_sinkage: f64,
 }
 
-/// `--solve slope` as printed by `--json`.
-#[derive(Debug, Clone, Serialize)]
-struct SlopeSolution {
-    max_risk: f64,
-    /// The steepest safe slope, or null when none was found (see `limit`).
-    safe_slope_deg: Option<f64>,
-    limit: SafeLimit,
-    /// The uncertainty at the slope where `limit.p_fail` was evaluated (the safe slope, level
-    /// ground when none is safe, the end of the search when all are).
-    #[serde(flatten)]
-    uncertainty: UsedUncertainty,
-    /// Whether a default CV was used at some slope of the table (the search covers them all).
-    defaults_used: DefaultsUsed,
+impl RiskRow {
+    fn of(p: &RiskPoint) -> RiskRow {
+        RiskRow {
+            slope_deg: p.slope_deg,
+            cv_n: p.uncertainty.cv_n,
+            cv_s: p.uncertainty.cv_s,
+            p_fail: p.p_fail,
+            p_not_success: p.p_not_success,
+            p_success: p.probabilities.success,
+            p_metastable: p.probabilities.metastable,
+            p_slippage: p.probabilities.slippage,
+            p_sinkage: p.probabilities.sinkage,
+        }
+    }
 }
 
-/// `--solve mass` as printed by `--json`.
-#[derive(Debug, Clone, Serialize)]
-struct MassSolution {
+/// One slope of `--solve mass` as printed by `--csv`.
+#[derive(Serialize)]
+struct MassRow {
     slope_deg: f64,
     max_risk: f64,
     robot_mass_kg: f64,
-    /// The heaviest safe total mass, or null when none was found (see `limit`).
     max_mass_kg: Option<f64>,
     max_payload_kg: Option<f64>,
-    limit: SafeLimit,
-    /// The uncertainty at `slope_deg`.
-    #[serde(flatten)]
-    uncertainty: UsedUncertainty,
-}
-
-/// One point of the payload envelope as printed by `--json`: the library's point and the
-/// uncertainty at its slope.
-#[derive(Debug, Clone, Serialize)]
-struct EnvelopeRecord<'a> {
-    #[serde(flatten)]
-    point: &'a PayloadPoint,
-    #[serde(flatten)]
-    uncertainty: UsedUncertainty,
-}
-
-/// `--solve mass` over several slopes as printed by `--json`: [`PayloadEnvelope`]'s keys, each
-/// point with its uncertainty.
-#[derive(Debug, Clone, Serialize)]
-struct EnvelopeOutput<'a> {
-    max_risk: f64,
-    robot_mass_kg: f64,
-    points: Vec<EnvelopeRecord<'a>>,
-    defaults_used: DefaultsUsed,
-}
-
-fn record(point: &RiskPoint) -> RiskRecord {
-    let (slope_deg, p) = (point.slope_deg, &point.probabilities);
-    RiskRecord {
-        slope_deg,
-        uncertainty: UsedUncertainty {
-            cv_n: point.cv_n,
-            cv_s: point.cv_s,
-            cv_n_source: point.cv_n_source,
-            cv_s_source: point.cv_s_source,
-        },
-        p_fail: p.p_fail(),
-        p_not_success: p.p_not_success(),
-        p_regime: RegimeRecord {
-            success: p.success,
-            metastable: p.metastable,
-            slippage: p.slippage,
-            sinkage: p.sinkage,
-        },
-    }
 }
 
 fn slope_of(deg: f64) -> Result<Slope> {
@@ -300,22 +209,11 @@ pub fn run(args: RiskArgs) -> Result<()> {
             if let Some(path) = &args.plot {
                 save(path, &EnvelopeFigure::new(&env, &robot_title(&robot, &terrain)))?;
             }
-            return print_envelope(&env, &terrain, format);
+            return print_envelope(&env, format);
         }
         Some(Solve::Mass) => {
-            let slope = slope_of(slopes[0])?;
-            note_defaults(terrain.defaults_used_at(slope));
-            let limit = max_safe_mass(&robot, slope, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
-            let own = robot.mass();
-            let sol = MassSolution {
-                slope_deg: slopes[0],
-                max_risk,
-                robot_mass_kg: own,
-                max_mass_kg: limit.value(),
-                max_payload_kg: limit.value().map(|m| m - own),
-                limit,
-                uncertainty: UsedUncertainty::at(&terrain, slope),
-            };
+            note_defaults(terrain.defaults_used_at(slope_of(slopes[0])?));
+            let sol = safe_mass(&robot, slopes[0], &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
             if args.plot.is_some() {
                 let s_limit = safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
                 draw_curve(&args, &robot, &terrain, &slopes, max_risk, &s_limit, json)?;
@@ -323,7 +221,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
             return match format {
                 Format::Json => print_json(&sol),
                 Format::Csv => {
-                    print!("{}", csv_string(&[sol_row(&sol)])?);
+                    print!("{}", csv_string(&[mass_row(&sol)])?);
                     Ok(())
                 }
                 Format::Table => {
@@ -334,23 +232,10 @@ pub fn run(args: RiskArgs) -> Result<()> {
         }
         Some(Solve::Slope) => {
             note_defaults(terrain.defaults_used());
-            let limit = safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
+            let sol = safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
             if args.plot.is_some() {
-                draw_curve(&args, &robot, &terrain, &slopes, max_risk, &limit, json)?;
+                draw_curve(&args, &robot, &terrain, &slopes, max_risk, &sol.limit, json)?;
             }
-            // Where the search evaluated `limit.p_fail`: it scans up from level ground.
-            let at = match limit {
-                SafeLimit::NoneSafe { .. } => 0.0,
-                SafeLimit::Limit { value, .. } => value,
-                SafeLimit::BeyondRange { up_to, .. } => up_to,
-            };
-            let sol = SlopeSolution {
-                max_risk,
-                safe_slope_deg: limit.value(),
-                limit,
-                uncertainty: UsedUncertainty::at(&terrain, slope_of(at)?),
-                defaults_used: terrain.defaults_used(),
-            };
             return match format {
                 Format::Json => print_json(&sol),
                 Format::Csv => {
@@ -363,7 +248,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
                     Ok(())
                 }
                 Format::Table => {
-                    println!("{}", describe_slope_limit(&limit, max_risk));
+                    println!("{}", describe_slope_limit(&sol.limit, max_risk));
                     Ok(())
                 }
             };
@@ -399,30 +284,12 @@ fn robot_title(robot: &Robot, terrain: &UncertainTerrain) -> String {
 
 fn print_curve(curve: &RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, format: Format) -> Result<()> {
     match format {
-        Format::Json => {
-            let records: Vec<RiskRecord> = curve.points.iter().map(record).collect();
-            if records.len() == 1 {
-                print_json(&records[0])
-            } else {
-                print_json(&records)
-            }
-        }
+        Format::Json => match curve.points.as_slice() {
+            [one] => print_json(one),
+            points => print_json(&points),
+        },
         Format::Csv => {
-            let rows: Vec<RiskRow> = curve
-                .points
-                .iter()
-                .map(|p| RiskRow {
-                    slope_deg: p.slope_deg,
-                    cv_n: p.cv_n,
-                    cv_s: p.cv_s,
-                    p_fail: p.p_fail,
-                    p_not_success: p.p_not_success,
-                    p_success: p.probabilities.success,
-                    p_metastable: p.probabilities.metastable,
-                    p_slippage: p.probabilities.slippage,
-                    p_sinkage: p.probabilities.sinkage,
-                })
-                .collect();
+            let rows: Vec<RiskRow> = curve.points.iter().map(RiskRow::of).collect();
             print!("{}", csv_string(&rows)?);
             Ok(())
         }
@@ -443,8 +310,8 @@ fn print_curve(curve: &RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, form
                 let q = &p.probabilities;
                 t.add_row([
                     format!("{}", p.slope_deg),
-                    format!("{:.3}", p.cv_n),
-                    format!("{:.3}", p.cv_s),
+                    format!("{:.3}", p.uncertainty.cv_n),
+                    format!("{:.3}", p.uncertainty.cv_s),
                     f(p.p_fail),
                     f(p.p_not_success),
                     f(q.sinkage),
@@ -466,24 +333,9 @@ fn print_curve(curve: &RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, form
     }
 }
 
-fn print_envelope(env: &PayloadEnvelope, terrain: &UncertainTerrain, format: Format) -> Result<()> {
+fn print_envelope(env: &PayloadEnvelope, format: Format) -> Result<()> {
     match format {
-        Format::Json => {
-            let points = env
-                .points
-                .iter()
-                .map(|point| {
-                    let uncertainty = UsedUncertainty::at(terrain, slope_of(point.slope_deg)?);
-                    Ok(EnvelopeRecord { point, uncertainty })
-                })
-                .collect::<Result<Vec<_>>>()?;
-            print_json(&EnvelopeOutput {
-                max_risk: env.max_risk,
-                robot_mass_kg: env.robot_mass_kg,
-                points,
-                defaults_used: env.defaults_used,
-            })
-        }
+        Format::Json => print_json(env),
         Format::Csv => {
             let rows: Vec<MassRow> = env
                 .points
@@ -531,7 +383,7 @@ fn print_envelope(env: &PayloadEnvelope, terrain: &UncertainTerrain, format: For
     }
 }
 
-fn describe_mass_limit(sol: &MassSolution) -> String {
+fn describe_mass_limit(sol: &SafeMass) -> String {
     match sol.limit {
         SafeLimit::NoneSafe { p_fail } => format!(
             "no payload is safe at {} deg: p_fail = {p_fail:.4} >= {} already at the robot's own {} kg",
@@ -551,16 +403,7 @@ fn describe_mass_limit(sol: &MassSolution) -> String {
     }
 }
 
-#[derive(Serialize)]
-struct MassRow {
-    slope_deg: f64,
-    max_risk: f64,
-    robot_mass_kg: f64,
-    max_mass_kg: Option<f64>,
-    max_payload_kg: Option<f64>,
-}
-
-fn sol_row(s: &MassSolution) -> MassRow {
+fn mass_row(s: &SafeMass) -> MassRow {
     MassRow {
         slope_deg: s.slope_deg,
         max_risk: s.max_risk,
@@ -605,25 +448,6 @@ fn draw_curve(
         title: format!("Failure risk: {}", robot_title(robot, terrain)),
     };
     save(path, &figure)
-}
-
-/// One line of `risk --map --json`: the map's grid and a summary of its cells (the cells
-/// themselves go to --csv or --npy).
-#[derive(Serialize)]
-struct MapSummary {
-    slope_deg: f64,
-    /// The uncertainty at `slope_deg`, applied around every cell's medians.
-    #[serde(flatten)]
-    uncertainty: UsedUncertainty,
-    max_risk: f64,
-    k_n_axis: sandslope::Axis,
-    k_s_axis: sandslope::Axis,
-    cells: usize,
-    cells_below_max_risk: usize,
-    terrain_k_n: f64,
-    terrain_k_s: f64,
-    terrain_p_fail: f64,
-    defaults_used: DefaultsUsed,
 }
 
 /// `--map`: p_fail and p_not_success over median (k_n, k_s) at one slope.
@@ -691,20 +515,8 @@ fn run_map(
         };
         save(path, &figure)?;
     }
-    let terrain_p_fail = sandslope::regime_probabilities(robot, slope, &ground, u).p_fail();
-    let summary = MapSummary {
-        slope_deg,
-        uncertainty: UsedUncertainty::of(&sample),
-        max_risk,
-        k_n_axis,
-        k_s_axis,
-        cells: map.p_fail.len(),
-        cells_below_max_risk: map.p_fail.iter().filter(|&&p| p < max_risk).count(),
-        terrain_k_n: ground.k_n,
-        terrain_k_s: ground.k_s,
-        terrain_p_fail,
-        defaults_used: defaults,
-    };
+    let summary =
+        RiskMapSummary::of(&map, robot, slope_deg, terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
     match args.format() {
         Format::Json => print_json(&summary),
         Format::Csv => match &args.csv {
@@ -732,7 +544,7 @@ fn run_map(
                 summary.cells,
                 sci(ground.k_n),
                 sci(ground.k_s),
-                terrain_p_fail
+                summary.terrain_p_fail
             );
             if let Some(note) = defaults.note() {
                 println!("note: {note}");

@@ -272,15 +272,21 @@ def risk(
     defaults 0.1 and 0.2. Probabilities come from deterministic quadrature (reproducible to
     1e-9), not sampling.
 
-    Returns arrays of the shape of ``slope_deg``: ``p_fail`` = P(sinkage or slippage),
-    ``p_not_success``, ``p_success``, ``p_metastable``, ``p_slippage``, ``p_sinkage``, the
-    ``cv_n``, ``cv_s`` used at each slope and where each came from (``cv_n_source``,
-    ``cv_s_source``: ``"given"``, ``"table"`` or ``"default"``).
+    Returns arrays of the shape of ``slope_deg`` under the keys of ``sandslope risk --json``:
+    ``slope_deg``, the ``cv_n``, ``cv_s`` used at each slope and where each came from
+    (``cv_n_source``, ``cv_s_source``: ``"given"``, ``"table"`` or ``"default"``), ``p_fail`` =
+    P(sinkage or slippage), ``p_not_success`` and ``p_regime`` (a dict of ``success``,
+    ``metastable``, ``slippage``, ``sinkage``); and the same four as the ``risk --csv`` columns
+    ``p_success``, ``p_metastable``, ``p_slippage``, ``p_sinkage``.
     """
     robot, terrain = _robot(robot), _terrain(terrain)
     s = _float_array("slope_deg", slope_deg)
     out = _sandslope.risk(robot, np.ascontiguousarray(s).reshape(-1), terrain, cv_n=cv_n, cv_s=cv_s)
-    return {k: np.asarray(v).reshape(s.shape) for k, v in out.items()}
+
+    def shaped(v: Any) -> Any:
+        return {k: shaped(x) for k, x in v.items()} if isinstance(v, dict) else np.asarray(v).reshape(s.shape)
+
+    return {k: shaped(v) for k, v in out.items()}
 
 
 def risk_map(
@@ -329,7 +335,9 @@ def safe_slope(
     """The safe-slope limit (``sandslope risk --solve slope --json``): the steepest slope with
     ``p_fail < max_risk`` at every slope from level up to it (scan every 0.5 deg, then
     bisection to 0.001 deg). ``limit["kind"]`` is ``"limit"``, ``"none_safe"`` or
-    ``"beyond_range"``; ``safe_slope_deg`` is None unless a limit was found."""
+    ``"beyond_range"``; ``safe_slope_deg`` is None unless a limit was found; ``cv_n``, ``cv_s``
+    and their sources are those where ``limit["p_fail"]`` was evaluated, ``defaults_used`` says
+    whether a default CV was used anywhere in the table. The same keys as the CLI's JSON."""
     return _sandslope.safe_slope(
         _robot(robot), _terrain(terrain), max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
     )
@@ -344,8 +352,9 @@ def safe_mass(
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
 ) -> Dict[str, Any]:
-    """The heaviest safe total mass at one slope (``sandslope risk --solve mass --json``):
-    ``max_mass_kg``, ``max_payload_kg`` (over the robot's own mass) and the ``limit``."""
+    """The heaviest safe total mass at one slope (``sandslope risk --solve mass --json``, the same
+    keys): ``max_mass_kg``, ``max_payload_kg`` (over the robot's own mass), the ``limit``, and
+    the ``cv_n``, ``cv_s`` used there with their sources."""
     return _sandslope.safe_mass(
         _robot(robot), float(slope_deg), _terrain(terrain), max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
     )

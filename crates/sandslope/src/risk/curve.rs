@@ -5,7 +5,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::quadrature::regime_probabilities;
-use super::uncertainty::{CvSource, DefaultsUsed, UncertainTerrain};
+use super::uncertainty::{DefaultsUsed, UncertainTerrain, UsedUncertainty};
 use super::RegimeProbabilities;
 use crate::error::ParamError;
 use crate::robot::Robot;
@@ -16,19 +16,15 @@ use crate::slope::Slope;
 pub struct RiskPoint {
     /// Slope, degrees, as requested (a negative slope is evaluated as its magnitude).
     pub slope_deg: f64,
-    /// Coefficient of variation of k_n used.
-    pub cv_n: f64,
-    /// Coefficient of variation of k_s used.
-    pub cv_s: f64,
-    /// Where cv_n came from.
-    pub cv_n_source: CvSource,
-    /// Where cv_s came from.
-    pub cv_s_source: CvSource,
+    /// The CVs used and where they came from.
+    #[serde(flatten)]
+    pub uncertainty: UsedUncertainty,
     /// `P(sinkage or slippage)`.
     pub p_fail: f64,
     /// `P(regime != success)`.
     pub p_not_success: f64,
-    /// The probability of each regime.
+    /// The probability of each regime (`p_regime` in JSON).
+    #[serde(rename = "p_regime")]
     pub probabilities: RegimeProbabilities,
 }
 
@@ -61,22 +57,15 @@ pub fn risk_curve(
             let p = regime_probabilities(robot, s, &g.ground, g.uncertainty);
             RiskPoint {
                 slope_deg,
-                cv_n: g.uncertainty.cv_n(),
-                cv_s: g.uncertainty.cv_s(),
-                cv_n_source: g.cv_n_source,
-                cv_s_source: g.cv_s_source,
+                uncertainty: g.used(),
                 p_fail: p.p_fail(),
                 p_not_success: p.p_not_success(),
                 probabilities: p,
             }
         })
         .collect();
-    let defaults_used = points.iter().fold(DefaultsUsed::default(), |a, p| {
-        a.or(DefaultsUsed {
-            k_n: p.cv_n_source == CvSource::Default,
-            k_s: p.cv_s_source == CvSource::Default,
-        })
-    });
+    let defaults_used =
+        points.iter().fold(DefaultsUsed::default(), |a, p| a.or(p.uncertainty.defaults_used()));
     Ok(RiskCurve { points, defaults_used })
 }
 
@@ -96,7 +85,7 @@ mod tests {
         let c = risk_curve(&r, &t, &[0.0, -10.0, 20.0]).unwrap();
         assert_eq!(c.defaults_used, DefaultsUsed { k_n: true, k_s: true });
         for p in &c.points {
-            assert_eq!((p.cv_n, p.cv_s), (0.1, 0.2));
+            assert_eq!((p.uncertainty.cv_n, p.uncertainty.cv_s), (0.1, 0.2));
             let s = Slope::from_signed_degrees(p.slope_deg).unwrap();
             assert_eq!(p.probabilities, failure_risk(&r, s, &t));
             assert_eq!(p.p_fail, p.probabilities.p_fail());

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use super::failure_probability::FailureProbability;
 use super::quadrature::regime_probabilities;
-use super::uncertainty::{DefaultsUsed, UncertainTerrain};
+use super::uncertainty::{DefaultsUsed, UncertainTerrain, UsedUncertainty};
 use super::RegimeProbabilities;
 use crate::error::ParamError;
 use crate::robot::Robot;
@@ -60,6 +60,12 @@ impl SafeLimit {
             SafeLimit::Limit { value, .. } => Some(*value),
             _ => None,
         }
+    }
+
+    /// For a mass search: the payload the heaviest safe total mass leaves over the robot's own
+    /// mass, kg, if the search found a threshold crossing.
+    pub fn payload_over(&self, robot_mass_kg: f64) -> Option<f64> {
+        self.value().map(|m| m - robot_mass_kg)
     }
 }
 
@@ -244,6 +250,9 @@ pub struct PayloadPoint {
     pub max_payload_kg: Option<f64>,
     /// What the search found (none safe, a limit, or safe over the whole range searched).
     pub limit: SafeLimit,
+    /// The CVs used at this slope and where they came from.
+    #[serde(flatten)]
+    pub uncertainty: UsedUncertainty,
 }
 
 /// The payload envelope: the heaviest total mass with `p_fail < max_risk` at each slope, the
@@ -282,8 +291,9 @@ pub fn payload_envelope(
             Ok(PayloadPoint {
                 slope_deg,
                 max_mass_kg: limit.value(),
-                max_payload_kg: limit.value().map(|m| m - own),
+                max_payload_kg: limit.payload_over(own),
                 limit,
+                uncertainty: terrain.sample(s).used(),
             })
         })
         .collect::<Result<Vec<_>, ParamError>>()?;

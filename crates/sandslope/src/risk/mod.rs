@@ -16,6 +16,8 @@
 //!   (heaviest safe robot at a slope) and [`payload_envelope`] (that mass at each slope): one
 //!   scan-and-bisect search ([`limits`]).
 //! - [`RiskMap`]: p_fail and p_not_success over a grid of median (k_n, k_s).
+//! - [`safe_slope`], [`safe_mass`], [`RiskMapSummary`]: the solving modes' answers with the
+//!   uncertainty they used ([`results`]), what `risk --json` prints and Python returns.
 //!
 //! Every result is a plain serialisable value; none draws or writes anything.
 
@@ -24,6 +26,7 @@ pub mod failure_probability;
 pub mod limits;
 pub mod map;
 pub mod quadrature;
+pub mod results;
 pub mod uncertainty;
 
 pub use curve::{risk_curve, RiskCurve, RiskPoint};
@@ -35,6 +38,8 @@ pub use limits::{
 };
 pub use map::RiskMap;
 pub use quadrature::{regime_probabilities, RegimeProbabilities};
+pub use results::{safe_mass, safe_slope, RiskMapSummary, SafeMass, SafeSlope};
 pub use uncertainty::{
-    CvSource, DefaultsUsed, UncertainGround, UncertainTerrain, Uncertainty, DEFAULT_CV_N, DEFAULT_CV_S,
+    CvSource, DefaultsUsed, UncertainGround, UncertainTerrain, Uncertainty, UsedUncertainty, DEFAULT_CV_N,
+    DEFAULT_CV_S,
 };

@@ -119,6 +119,31 @@ impl DefaultsUsed {
     }
 }
 
+/// The uncertainty used at one slope, as every risk result reports it beside the numbers it
+/// produced: the coefficients of variation and where each came from (`given`, `table` or
+/// `default`, docs/model.md §9).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct UsedUncertainty {
+    /// Coefficient of variation of k_n used.
+    pub cv_n: f64,
+    /// Coefficient of variation of k_s used.
+    pub cv_s: f64,
+    /// Where cv_n came from.
+    pub cv_n_source: CvSource,
+    /// Where cv_s came from.
+    pub cv_s_source: CvSource,
+}
+
+impl UsedUncertainty {
+    /// Whether a default CV was used for k_n and for k_s.
+    pub fn defaults_used(&self) -> DefaultsUsed {
+        DefaultsUsed {
+            k_n: self.cv_n_source == CvSource::Default,
+            k_s: self.cv_s_source == CvSource::Default,
+        }
+    }
+}
+
 /// The uncertainty at one slope: medians, coefficients of variation and their sources.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UncertainGround {
@@ -130,6 +155,18 @@ pub struct UncertainGround {
     pub cv_n_source: CvSource,
     /// Where cv_s came from.
     pub cv_s_source: CvSource,
+}
+
+impl UncertainGround {
+    /// The CVs used here and where they came from.
+    pub fn used(&self) -> UsedUncertainty {
+        UsedUncertainty {
+            cv_n: self.uncertainty.cv_n(),
+            cv_s: self.uncertainty.cv_s(),
+            cv_n_source: self.cv_n_source,
+            cv_s_source: self.cv_s_source,
+        }
+    }
 }
 
 /// A terrain table read as uncertain, by the one rule of docs/model.md §9: at each slope,

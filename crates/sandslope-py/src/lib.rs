@@ -18,6 +18,7 @@ mod model;
 mod plan;
 mod report;
 mod risk;
+mod simulate;
 mod types;
 
 /// A `ValueError` from anything displayable, with its whole cause chain on one line
@@ -48,6 +49,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plan::read_raster, m)?)?;
     m.add_function(wrap_pyfunction!(measure::fit, m)?)?;
     m.add_function(wrap_pyfunction!(measure::track, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;
     Ok(())

@@ -648,3 +648,49 @@ def report(
         max_risk=float(max_risk),
     )
     return json.loads(text)
+
+
+def simulate(
+    robot: RobotLike,
+    terrain: TerrainLike,
+    slope_deg: float,
+    duration_s: float = 10.0,
+    *,
+    k_n: Optional[float] = None,
+    k_s: Optional[float] = None,
+    dt_s: Optional[float] = None,
+    yield_m: Optional[float] = None,
+    sample_rate_hz: float = 120.0,
+) -> Tuple[Any, Dict[str, Any]]:
+    """Simulates the robot walking for ``duration_s`` seconds on ``terrain`` at ``slope_deg``
+    (``sandslope simulate``, docs/model.md §15-§18).
+
+    A planar body on C-legs in the alternating tripod, the sand pushing on every leg element by
+    resistive force theory scaled to the terrain's k_n and k_s (``k_n``/``k_s`` override them at
+    every slope, as ``--k-n``/``--k-s``); ``dt_s`` fixes the integration step, ``yield_m`` the
+    elastic slip at which the sand's stress is fully mobilised, ``sample_rate_hz`` the
+    trajectory's sampling. Negative slopes walk downhill.
+
+    Returns ``(trajectory, summary)``: ``trajectory`` a pandas DataFrame (a dict of NumPy
+    columns without pandas) with ``time_s``, ``x_m``, ``z_m``, ``pitch_rad``, ``vx_m_s``,
+    ``vz_m_s`` and per leg j ``leg{j}_angle_rad``, ``leg{j}_depth_m``, ``leg{j}_force_x_n``,
+    ``leg{j}_force_z_n``, ``leg{j}_torque_n_m``; ``summary`` the dict ``sandslope simulate
+    --json`` prints (``speed_m_s``, ``t1_s``, ``slip_m``, ``step_m``, ``regime``, ``cause``,
+    ``steps``, ``closed_form``, ...).
+    """
+    columns, summary = _sandslope.simulate(
+        _robot(robot),
+        _terrain(terrain),
+        float(slope_deg),
+        float(duration_s),
+        k_n=None if k_n is None else float(k_n),
+        k_s=None if k_s is None else float(k_s),
+        dt_s=None if dt_s is None else float(dt_s),
+        yield_m=None if yield_m is None else float(yield_m),
+        sample_rate_hz=float(sample_rate_hz),
+    )
+    try:
+        import pandas as pd
+    except ImportError:
+        return columns, summary
+    return pd.DataFrame(columns), summary

@@ -173,3 +173,14 @@ def report(
     tracks_upslope: Optional[List[float]] = None,
     max_risk: float = 0.05,
 ) -> str: ...
+def simulate(
+    robot: Robot,
+    terrain: Terrain,
+    slope_deg: float,
+    duration_s: float,
+    k_n: Optional[float] = None,
+    k_s: Optional[float] = None,
+    dt_s: Optional[float] = None,
+    yield_m: Optional[float] = None,
+    sample_rate_hz: float = 120.0,
+) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...

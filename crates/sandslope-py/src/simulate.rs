@@ -1,0 +1,73 @@
+//! `simulate`: the dynamic stride simulator (`sandslope simulate --json`, docs/model.md
+//! §15-§18): the trajectory as NumPy columns (the Python layer makes a DataFrame of them) and
+//! the summary as a dict with the same keys as `--json`.
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use pythonize::pythonize;
+
+use sandslope::simulate::{simulate as run, SimSettings, SimulateError};
+use sandslope::Scenario;
+
+use crate::arrays::put;
+use crate::types::{PyRobot, PyTerrain};
+use crate::value_error;
+
+/// Runs one walk; returns `(columns, summary)`: `columns` maps each trajectory column
+/// (`time_s`, `x_m`, `z_m`, `pitch_rad`, `vx_m_s`, `vz_m_s`, then per leg j `leg{j}_angle_rad`,
+/// `leg{j}_depth_m`, `leg{j}_force_x_n`, `leg{j}_force_z_n`, `leg{j}_torque_n_m`) to a 1-D
+/// array; `summary` is `sandslope simulate --json`.
+#[pyfunction]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, yield_m=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+    slope_deg: f64,
+    duration_s: f64,
+    k_n: Option<f64>,
+    k_s: Option<f64>,
+    dt_s: Option<f64>,
+    yield_m: Option<f64>,
+    sample_rate_hz: f64,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
+    let scenario =
+        Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
+    let mut settings = SimSettings::new(duration_s).map_err(value_error)?;
+    if let Some(dt) = dt_s {
+        settings = settings.with_dt(dt).map_err(value_error)?;
+    }
+    if let Some(y) = yield_m {
+        settings = settings.with_yield(y).map_err(value_error)?;
+    }
+    settings = settings.with_sample_rate(sample_rate_hz).map_err(value_error)?;
+    let sim = py.detach(|| run(&scenario, slope_deg, &settings)).map_err(|e| match e {
+        SimulateError::Param(p) => value_error(p),
+    })?;
+    let tr = sim.trajectory;
+    let d = PyDict::new(py);
+    put(&d, "time_s", tr.time_s)?;
+    put(&d, "x_m", tr.x_m)?;
+    put(&d, "z_m", tr.z_m)?;
+    put(&d, "pitch_rad", tr.pitch_rad)?;
+    put(&d, "vx_m_s", tr.vx_m_s)?;
+    put(&d, "vz_m_s", tr.vz_m_s)?;
+    let legs = tr.leg_depth_m.len();
+    let columns = tr
+        .leg_angle_rad
+        .into_iter()
+        .zip(tr.leg_depth_m)
+        .zip(tr.leg_force_x_n)
+        .zip(tr.leg_force_z_n)
+        .zip(tr.leg_torque_n_m);
+    for (j, ((((angle, depth), fx), fz), torque)) in columns.enumerate().take(legs) {
+        put(&d, &format!("leg{j}_angle_rad"), angle)?;
+        put(&d, &format!("leg{j}_depth_m"), depth)?;
+        put(&d, &format!("leg{j}_force_x_n"), fx)?;
+        put(&d, &format!("leg{j}_force_z_n"), fz)?;
+        put(&d, &format!("leg{j}_torque_n_m"), torque)?;
+    }
+    let summary = pythonize(py, &sim.summary).map_err(value_error)?;
+    Ok((d, summary))
+}

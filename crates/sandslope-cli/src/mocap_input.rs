@@ -151,7 +151,16 @@ pub fn track_files(
                 captures[index].frame_rate_hz
             )
         }
-        other => anyhow!("{other}"),
+        // Errors of the pooled analysis name the recordings they are about.
+        other => match captures.as_slice() {
+            [one] => anyhow!("{}: {other}", one.path.display()),
+            many => anyhow!(
+                "{} recordings ({}{}): {other}",
+                many.len(),
+                many.iter().take(3).map(|c| c.path.display().to_string()).collect::<Vec<_>>().join(", "),
+                if many.len() > 3 { ", ..." } else { "" }
+            ),
+        },
     })?;
     let names: Vec<String> = captures.iter().map(|c| c.path.display().to_string()).collect();
     for i in result.recordings_without_steps() {

@@ -85,3 +85,29 @@ fn an_impossible_speed_is_refused_at_once_and_nothing_is_written() {
         assert!(!plot.exists() && !out.exists(), "{row} left a file");
     }
 }
+
+/// Errors found after reading still name the file they are about.
+#[test]
+fn errors_after_reading_name_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let still = dir.path().join("still.csv");
+    std::fs::write(&still, "time_s,x_m,y_m,z_m\n0,0,0,0\n0.01,0,0,0\n0.02,0,0,0\n").unwrap();
+    sandslope()
+        .arg("track")
+        .arg(&still)
+        .assert()
+        .code(2)
+        .stderr(contains("still.csv: cannot estimate the upslope direction: the body did not move"));
+    let dup = dir.path().join("dup.csv");
+    std::fs::write(&dup, "slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n10,0.1,0.01\n").unwrap();
+    for cmd in [&["infer", "--observed"][..], &["calibrate", "--out", "t.toml", "--observed"][..]] {
+        sandslope()
+            .current_dir(dir.path())
+            .args(cmd)
+            .arg(&dup)
+            .assert()
+            .code(2)
+            .stderr(contains("dup.csv: lines 2 and 3 both give slope_deg = 10"));
+    }
+    assert!(!dir.path().join("t.toml").exists());
+}

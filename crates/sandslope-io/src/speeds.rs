@@ -142,6 +142,15 @@ pub fn parse_speed_table(text: &str, path: &Path, columns: SpeedColumns) -> Resu
                 )
             })?),
         };
+        if let Some(first) = out.iter().find(|r: &&SpeedTableRow| r.slope == slope) {
+            bail!(
+                "{}: lines {} and {line} both give slope_deg = {}: pool them into one mean and SD \
+                 (one row per slope)",
+                path.display(),
+                first.line,
+                row.slope_deg
+            );
+        }
         out.push(SpeedTableRow { line, slope, speed_m_s: row.speed_m_s, speed_sd_m_s: row.speed_sd_m_s, n });
     }
     if out.is_empty() {
@@ -243,6 +252,16 @@ mod tests {
         }
         assert_eq!(row("-10", "1e-6").unwrap()[0].speed, -10.0);
         assert_eq!(row("10", "10").unwrap()[0].speed_sd, 10.0);
+    }
+
+    /// Two rows at one slope are refused by the reader, naming both lines (calibrate and infer
+    /// refused them later without naming the file).
+    #[test]
+    fn two_rows_at_one_slope_name_both_lines() {
+        let e = load("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n# again\n10,0.12,0.01\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("s.csv: lines 2 and 4 both give slope_deg = 10: pool them into one mean and SD (one row per slope)"), "{e}");
     }
 
     /// The text form reads what the file form reads, naming the path it was given.

@@ -111,3 +111,22 @@ fn errors_after_reading_name_the_file() {
     }
     assert!(!dir.path().join("t.toml").exists());
 }
+
+/// One wrong time in a plain capture (0.2 s, then 655360.2 s) asked for 78 million NaN frames
+/// (1.9 GB) before any check; now the row is named at once (found by scripts/fuzz.sh).
+#[test]
+fn a_capture_whose_time_jumps_by_days_is_refused_before_filling_the_gap() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("time_s,x_m,y_m,z_m\n");
+    for i in 0..25 {
+        text.push_str(&format!("{},{},0.2,0.05\n", f64::from(i) / 120.0, 0.2 + f64::from(i) * 0.001));
+    }
+    text.push_str("655360.2,0.25,0.2,0.05\n");
+    let file = dir.path().join("jump.csv");
+    std::fs::write(&file, text).unwrap();
+    refused_fast(
+        &["track", file.to_str().unwrap()],
+        "jump.csv: line 27: time_s = 655360.2 is frame 78643224",
+        Duration::from_secs(3),
+    );
+}

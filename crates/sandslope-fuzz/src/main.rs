@@ -230,6 +230,8 @@ struct Tally {
     panics: Vec<String>,
     aborts: Vec<String>,
     hangs: Vec<String>,
+    /// Runs whose peak resident memory exceeded `--max-peak-mib`.
+    memory: Vec<String>,
     peak_kib: u64,
     seconds: f64,
 }
@@ -252,8 +254,8 @@ fn parent(o: &Options) -> Result<i32> {
         o.mem_limit_mib
     );
     println!(
-        "{:<17} {:>8} {:>7} {:>7} {:>6} {:>6} {:>9} {:>8}  exit codes",
-        "target", "runs", "panics", "aborts", "hangs", "ok", "peak MiB", "seconds"
+        "{:<17} {:>8} {:>7} {:>7} {:>6} {:>7} {:>6} {:>9} {:>8}  exit codes",
+        "target", "runs", "panics", "aborts", "hangs", "memory", "ok", "peak MiB", "seconds"
     );
     let mut any_failed = false;
     for target in &o.targets {
@@ -267,18 +269,20 @@ fn parent(o: &Options) -> Result<i32> {
         any_failed |= failed;
         let codes: Vec<String> = tally.exits.iter().map(|(c, n)| format!("{c}:{n}")).collect();
         println!(
-            "{:<17} {:>8} {:>7} {:>7} {:>6} {:>6} {:>9.1} {:>8.1}  {}",
+            "{:<17} {:>8} {:>7} {:>7} {:>6} {:>7} {:>6} {:>9.1} {:>8.1}  {}",
             target.name,
             tally.runs,
             tally.panics.len(),
             tally.aborts.len(),
             tally.hangs.len(),
+            tally.memory.len(),
             if failed { "NO" } else { "yes" },
             tally.peak_kib as f64 / 1024.0,
             tally.seconds,
             codes.join(" ")
         );
-        for line in tally.panics.iter().chain(&tally.aborts).chain(&tally.hangs).take(10) {
+        for line in tally.panics.iter().chain(&tally.aborts).chain(&tally.hangs).chain(&tally.memory).take(10)
+        {
             println!("    {line}");
         }
         std::io::stdout().flush()?;
@@ -336,6 +340,9 @@ fn fuzz_command(o: &Options, target: &Target, args: &[&str]) -> Result<Tally> {
         let first_line = stderr.lines().find(|l| !l.trim().is_empty()).unwrap_or("").to_string();
         tally.runs += 1;
         tally.peak_kib = tally.peak_kib.max(peak);
+        if peak > o.max_peak_mib * 1024 {
+            tally.memory.push(keep(o, target, i, &data, "memory", &format!("peak {} MiB", peak / 1024)));
+        }
         match ending {
             // 101: a Rust panic; any other code outside the documented table is a defect too.
             Ending::Exit(101) => tally.panics.push(keep(o, target, i, &data, "panic", &first_line)),
@@ -432,6 +439,24 @@ fn fuzz_reader(o: &Options, target: &Target) -> Result<Tally> {
         let (lines, ending, peak) = reader_chunk(o, target, from, to, &scratch)?;
         tally.peak_kib = tally.peak_kib.max(peak);
         match ending {
+            Ending::Exit(0) if peak > o.max_peak_mib * 1024 => {
+                // Over the memory budget: find the inputs that were, one process each.
+                record(&mut tally, &lines);
+                for i in from..to {
+                    let (_, _, peak) = reader_chunk(o, target, i, i + 1, &scratch)?;
+                    if peak > o.max_peak_mib * 1024 {
+                        let data = input(&seeds, o.seed, i);
+                        tally.memory.push(keep(
+                            o,
+                            target,
+                            i,
+                            &data,
+                            "memory",
+                            &format!("peak {} MiB", peak / 1024),
+                        ));
+                    }
+                }
+            }
             Ending::Exit(0) => {
                 record(&mut tally, &lines);
             }

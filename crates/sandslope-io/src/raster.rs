@@ -60,6 +60,84 @@ fn check_claimed_bytes(
     Ok(())
 }
 
+/// Checks every entry of a TIFF's first image directory (classic or BigTIFF) before the decoder
+/// reads one: a value larger than [`MAX_TIFF_TAG_BYTES`], or one that would lie past the end of
+/// the file, is refused naming the tag. The decoder's own limit does not cover ASCII tags, so a
+/// 450-byte file whose GeoAsciiParams or GDAL_NODATA tag claimed 4 GiB made it allocate that
+/// and abort (found by scripts/fuzz.sh).
+fn check_tiff_directory(name: &dyn std::fmt::Display, file: &mut File) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let file_len = file.metadata().with_context(|| format!("cannot read {name}"))?.len();
+    let mut head = [0u8; 16];
+    let got = file.read(&mut head).with_context(|| format!("cannot read {name}"))?;
+    if got < 8 {
+        bail!("{name}: not a TIFF ({got} bytes)");
+    }
+    let little = match &head[..2] {
+        b"II" => true,
+        b"MM" => false,
+        _ => return Ok(()), // not a TIFF: the decoder says so
+    };
+    let u16_at =
+        |b: &[u8]| if little { u16::from_le_bytes([b[0], b[1]]) } else { u16::from_be_bytes([b[0], b[1]]) };
+    let u32_at = |b: &[u8]| {
+        let a = [b[0], b[1], b[2], b[3]];
+        u64::from(if little { u32::from_le_bytes(a) } else { u32::from_be_bytes(a) })
+    };
+    let u64_at = |b: &[u8]| {
+        let a: [u8; 8] = b[..8].try_into().expect("8 bytes");
+        if little {
+            u64::from_le_bytes(a)
+        } else {
+            u64::from_be_bytes(a)
+        }
+    };
+    let big = match u16_at(&head[2..4]) {
+        42 => false,
+        43 if got >= 16 => true,
+        _ => return Ok(()),
+    };
+    let ifd = if big { u64_at(&head[8..16]) } else { u32_at(&head[4..8]) };
+    let (count_len, entry_len, inline) = if big { (8u64, 20u64, 8u64) } else { (2, 12, 4) };
+    if ifd.saturating_add(count_len) > file_len {
+        bail!(
+            "{name}: the first image directory (at byte {ifd}) lies past the end of the {file_len}-byte file"
+        );
+    }
+    file.seek(SeekFrom::Start(ifd))?;
+    let mut n = [0u8; 8];
+    file.read_exact(&mut n[..count_len as usize])?;
+    let entries = if big { u64_at(&n) } else { u64::from(u16_at(&n)) };
+    let table = entries.saturating_mul(entry_len);
+    if table > 1 << 20 || ifd + count_len + table > file_len {
+        bail!("{name}: the first image directory claims {entries} entries, more than the {file_len}-byte file holds");
+    }
+    let mut buf = vec![0u8; table as usize];
+    file.read_exact(&mut buf)?;
+    for e in buf.chunks_exact(entry_len as usize) {
+        let tag = u16_at(&e[0..2]);
+        let size_of = match u16_at(&e[2..4]) {
+            1 | 2 | 6 | 7 => 1u64,
+            3 | 8 => 2,
+            4 | 9 | 11 | 13 => 4,
+            5 | 10 | 12 | 16 | 17 | 18 => 8,
+            _ => continue, // an unknown type: the decoder skips or refuses it
+        };
+        let count = if big { u64_at(&e[4..12]) } else { u32_at(&e[4..8]) };
+        let bytes = count.saturating_mul(size_of);
+        let offset = if big { u64_at(&e[12..20]) } else { u32_at(&e[8..12]) };
+        let label = Tag::from_u16(tag).map_or_else(|| format!("{tag}"), |t| format!("{t:?} ({tag})"));
+        if bytes > MAX_TIFF_TAG_BYTES as u64 {
+            bail!("{name}: tag {label} claims {bytes} bytes, more than the {MAX_TIFF_TAG_BYTES}-byte limit of a tag value");
+        }
+        if bytes > inline && offset.saturating_add(bytes) > file_len {
+            bail!("{name}: tag {label} claims {bytes} bytes at byte {offset}, past the end of the {file_len}-byte file");
+        }
+    }
+    file.seek(SeekFrom::Start(0))?;
+    Ok(())
+}
+
 /// The decoder's limits: the image at most [`MAX_RASTER_CELLS`] 8-byte samples, any tag
 /// value at most [`MAX_TIFF_TAG_BYTES`].
 fn tiff_limits() -> Limits {
@@ -147,7 +225,8 @@ pub fn read_raster(path: &Path) -> Result<Raster> {
 
 fn read_geotiff(path: &Path) -> Result<Raster> {
     let name = path.display();
-    let file = File::open(path).with_context(|| format!("cannot read {name}"))?;
+    let mut file = File::open(path).with_context(|| format!("cannot read {name}"))?;
+    check_tiff_directory(&name, &mut file)?;
     let mut dec = Decoder::new(BufReader::new(file))
         .map_err(|e| anyhow!("{name}: not a readable TIFF: {e}"))?
         .with_limits(tiff_limits());
@@ -503,6 +582,29 @@ mod hostile {
             err.contains("claims.tif") && err.contains("3600000000 cells") && err.contains("limit"),
             "{err}"
         );
+    }
+
+    /// An ASCII tag (GDAL_NODATA) claiming 4 GiB in a 1 KB file: the decoder's limit does not
+    /// cover ASCII values, so the directory is checked first (found by scripts/fuzz.sh).
+    #[test]
+    fn an_ascii_tag_claiming_gigabytes_is_refused_before_the_decoder_reads_it() {
+        let bytes = tiff_with(&[
+            (256, LONG, 1, 10),
+            (257, LONG, 1, 10),
+            (258, SHORT, 1, 32),
+            (259, SHORT, 1, 1),
+            (262, SHORT, 1, 1),
+            (273, LONG, 1, 200),
+            (278, LONG, 1, 10),
+            (279, LONG, 1, 400),
+            (339, SHORT, 1, 3),
+            (42113, 2, 0xFFFF_0000, 300), // GDAL_NODATA, ASCII
+        ]);
+        let err = read_bytes("nodata.tif", &bytes);
+        assert!(err.contains("nodata.tif: tag GdalNodata (42113) claims 4294901760 bytes"), "{err}");
+        let bytes = tiff_with(&[(256, LONG, 1, 10), (34737, 2, 5000, 300)]);
+        let err = read_bytes("past.tif", &bytes);
+        assert!(err.contains("past.tif: tag GeoAsciiParamsTag (34737) claims 5000 bytes at byte 300, past the end of the 1024-byte file"), "{err}");
     }
 
     /// Within the cell limit (2^28 cells) but 1 GiB of samples from a 1 KB file: no

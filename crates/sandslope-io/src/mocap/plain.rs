@@ -51,6 +51,10 @@ pub(crate) fn parse(rows: &Rows) -> Result<super::motive::Parsed> {
     let median = steps[steps.len() / 2];
     let span = samples[samples.len() - 1].1 - t0;
     let dt = span / (span / median).round().max(1.0);
+    // Missing frames are filled with NaN: decided before filling, so that one wrong time
+    // (0.2 s, then 655360.2 s) cannot ask for 78 million frames (found by scripts/fuzz.sh).
+    let rows_read = samples.len() as f64;
+    let max_frames = (MISSING_PER_ROW * rows_read).max(MIN_MISSING_ALLOWED) + rows_read;
     let mut positions = Vec::with_capacity(samples.len());
     for (line, t, p) in samples {
         let x = (t - t0) / dt;
@@ -61,8 +65,25 @@ pub(crate) fn parse(rows: &Rows) -> Result<super::motive::Parsed> {
                 format!("time_s = {t} is off the regular grid of {dt} s steps from {t0}; resample the file"),
             ));
         }
+        if index >= max_frames {
+            return Err(rows.err(
+                line,
+                format!(
+                    "time_s = {t} is frame {index} of {dt} s steps from {t0}, but the file has only {} rows: \
+                     at most {} frames may be missing (a wrong time, or a recording to split)",
+                    rows_read,
+                    max_frames - rows_read
+                ),
+            ));
+        }
         positions.resize(index as usize, [f64::NAN; 3]);
         positions.push(p);
     }
     Ok(("body".into(), 1.0 / dt, t0, positions))
 }
+
+/// Frames that may be missing per row read (beyond [`MIN_MISSING_ALLOWED`]): a recording that is
+/// mostly gaps is a wrong time column, not an occluded marker.
+const MISSING_PER_ROW: f64 = 10.0;
+/// Missing frames always allowed (about 14 minutes at 120 Hz).
+const MIN_MISSING_ALLOWED: f64 = 100_000.0;

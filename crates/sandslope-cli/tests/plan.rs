@@ -452,3 +452,67 @@ fn geojson_coordinates_carry_no_float_noise() {
         }
     }
 }
+
+/// One synthetic hill written by GDAL in EPSG:4326 (1 arc-second cells) and in a projected CRS
+/// whose cells are the geographic cells' ground size (crates/sandslope-io/tests/fixtures/gdal/
+/// make_crs.py): plan finds the same route on both, its GeoJSON is in lon/lat for the
+/// geographic DEM, and its length agrees with the haversine length of that polyline (a sphere
+/// of the mean Earth radius, 6 371 008.8 m) within 0.5% (before issue 24 the degrees were read as
+/// metres and every cell was far too steep).
+#[test]
+fn a_geographic_dem_plans_in_metres_like_its_projected_twin() {
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal");
+    let dir = tempfile::tempdir().unwrap();
+    let run = |dem: &str| -> (Value, Value, String) {
+        let geojson = dir.path().join(format!("{dem}.geojson"));
+        let out = Command::cargo_bin("sandslope")
+            .unwrap()
+            .args([
+                "plan",
+                "--start-px",
+                "5,10",
+                "--goal-px",
+                "55,40",
+                "--objective",
+                "distance,time",
+                "--json",
+            ])
+            .arg("--dem")
+            .arg(fixtures.join(dem))
+            .arg("--geojson")
+            .arg(&geojson)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let g: Value = serde_json::from_str(&std::fs::read_to_string(&geojson).unwrap()).unwrap();
+        (json_of(&out.stdout), g, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (geo, geo_json, notes) = run("geo-wgs84.tif");
+    let (utm, utm_json, _) = run("proj-same-cells.tif");
+    assert!(notes.contains("geographic coordinates (degrees) on WGS84"), "{notes}");
+    for objective in ["distance", "time"] {
+        let (a, b) = (&geo["routes"][objective], &utm["routes"][objective]);
+        assert_eq!(a["found"], true);
+        let (la, lb) = (a["length_m"].as_f64().unwrap(), b["length_m"].as_f64().unwrap());
+        assert!((la - lb).abs() < 1e-6 * lb, "{objective}: {la} vs {lb}");
+    }
+    let coords = |g: &Value| -> Vec<(f64, f64)> {
+        g["features"][0]["geometry"]["coordinates"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+            .collect()
+    };
+    let (lonlat, metres) = (coords(&geo_json), coords(&utm_json));
+    assert_eq!(lonlat.len(), metres.len(), "the same cells");
+    assert!(lonlat.iter().all(|&(lon, lat)| (10.0..10.02).contains(&lon) && (40.0..40.03).contains(&lat)));
+    let haversine = |a: (f64, f64), b: (f64, f64)| {
+        let (l1, p1, l2, p2) = (a.0.to_radians(), a.1.to_radians(), b.0.to_radians(), b.1.to_radians());
+        let h = ((p2 - p1) / 2.0).sin().powi(2) + p1.cos() * p2.cos() * ((l2 - l1) / 2.0).sin().powi(2);
+        2.0 * 6_371_008.8 * h.sqrt().asin()
+    };
+    let along: f64 = lonlat.windows(2).map(|w| haversine(w[0], w[1])).sum();
+    let length = geo["routes"]["distance"]["length_m"].as_f64().unwrap();
+    assert!((length - along).abs() < 0.005 * along, "{length} m vs haversine {along} m");
+}

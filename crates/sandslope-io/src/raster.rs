@@ -9,6 +9,8 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
 use tiff::decoder::{Decoder, DecodingResult, Limits};
+
+use crate::crs::Crs;
 use tiff::encoder::{colortype::Gray32Float, compression::DeflateLevel, Compression, TiffEncoder};
 use tiff::tags::{ExtraSamples, Tag};
 
@@ -199,8 +201,15 @@ pub struct Raster {
     pub values: Vec<f64>,
     /// The nodata value, if declared.
     pub nodata: Option<f64>,
-    /// Georeferencing.
+    /// Georeferencing, in the file's own map units (degrees for a geographic CRS).
     pub geo: GeoRef,
+    /// What the map coordinates are (crs.rs).
+    pub crs: Crs,
+    /// Ground size of a cell, metres (east, north): the cell size the planner uses.
+    pub cell_m: (f64, f64),
+    /// What was assumed or converted in reading (units, ellipsoid, the mid-latitude), for the
+    /// front end to print as notes.
+    pub notes: Vec<String>,
 }
 
 impl Raster {
@@ -213,17 +222,54 @@ impl Raster {
 
 /// Reads a GeoTIFF (`.tif`, `.tiff`) or an ESRI ASCII grid (`.asc`), by extension.
 pub fn read_raster(path: &Path) -> Result<Raster> {
-    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
-        Some("tif" | "tiff") => read_geotiff(path),
-        Some("asc") => read_asc(path),
-        _ => bail!(
-            "{}: unknown raster format; use a GeoTIFF (.tif, .tiff) or an ESRI ASCII grid (.asc)",
-            path.display()
-        ),
+    let (mut raster, vertical) =
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("tif" | "tiff") => read_geotiff(path)?,
+            Some("asc") => read_asc(path)?,
+            _ => bail!(
+                "{}: unknown raster format; use a GeoTIFF (.tif, .tiff) or an ESRI ASCII grid (.asc)",
+                path.display()
+            ),
+        };
+    if vertical != 1.0 {
+        for v in raster.values.iter_mut().filter(|v| v.is_finite()) {
+            *v *= vertical;
+        }
+        raster.nodata = raster.nodata.map(|nd| nd * vertical);
     }
+    let g = &raster.geo;
+    let south = g.north - raster.rows as f64 * g.cell_y;
+    raster.cell_m = crate::crs::ground_cell_size(
+        &path.display(),
+        &raster.crs,
+        g.cell_x,
+        g.cell_y,
+        g.north,
+        south,
+        &mut raster.notes,
+    )?;
+    if !raster.crs.is_geographic()
+        && g.cell_x < 0.01
+        && g.west.abs() <= 180.0
+        && g.north.abs() <= 90.0
+        && south >= -90.0
+    {
+        raster.notes.push(format!(
+            "{}: cells of {} map units inside the longitude/latitude range look like degrees, but the file \
+             declares no geographic CRS; they are read as {}s",
+            path.display(),
+            g.cell_x,
+            match &raster.crs {
+                Crs::Projected { unit, .. } => unit,
+                Crs::Geographic { .. } => "degree",
+            }
+        ));
+    }
+    Ok(raster)
 }
 
-fn read_geotiff(path: &Path) -> Result<Raster> {
+/// A GeoTIFF, and the factor converting its heights to metres.
+fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
     let name = path.display();
     let mut file = File::open(path).with_context(|| format!("cannot read {name}"))?;
     check_tiff_directory(&name, &mut file)?;
@@ -300,8 +346,16 @@ fn read_geotiff(path: &Path) -> Result<Raster> {
     if values.len() != cols * rows {
         bail!("{name}: decoded {} samples for a {cols} x {rows} image", values.len());
     }
+    let mut notes = Vec::new();
+    let (crs, vertical) = crate::crs::from_geokeys(
+        &name,
+        geokeys.as_deref(),
+        geodoubles.as_deref(),
+        geoascii.as_deref(),
+        &mut notes,
+    )?;
     let geo = GeoRef { west, north, cell_x, cell_y, geokeys, geodoubles, geoascii };
-    Ok(Raster { cols, rows, values, nodata, geo })
+    Ok((Raster { cols, rows, values, nodata, geo, crs, cell_m: (cell_x, cell_y), notes }, vertical))
 }
 
 fn pixel_is_point(keys: Option<&[u16]>) -> bool {
@@ -314,7 +368,9 @@ fn pixel_is_point(keys: Option<&[u16]>) -> bool {
     })
 }
 
-fn read_asc(path: &Path) -> Result<Raster> {
+/// An ESRI ASCII grid (its CRS from a `.prj` beside it, if any), and the factor converting its
+/// heights to metres.
+fn read_asc(path: &Path) -> Result<(Raster, f64)> {
     let name = path.display();
     let bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
     // 24 bytes a value is more than any ASCII grid writer uses (`-1234.567890123456789 `).
@@ -402,7 +458,9 @@ fn read_asc(path: &Path) -> Result<Raster> {
         geodoubles: None,
         geoascii: None,
     };
-    Ok(Raster { cols, rows, values, nodata, geo })
+    let mut notes = Vec::new();
+    let crs = crate::crs::from_prj(&path.with_extension("prj"), &mut notes)?;
+    Ok((Raster { cols, rows, values, nodata, geo, crs, cell_m: (cell_x, cell_y), notes }, 1.0))
 }
 
 /// Writes a two-band float32 GeoTIFF (`band1`, `band2`, row-major, NaN for nodata, declared
@@ -470,6 +528,35 @@ mod tests {
     fn fixture(name: &str) -> Raster {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal").join(name);
         read_raster(&path).unwrap_or_else(|e| panic!("{name}: {e:#}"))
+    }
+
+    /// Coordinates as GDAL writes them (make_crs.py): EPSG:4326 in degrees, a user-defined Mars
+    /// sphere, a projected CRS in metres. Ground cell sizes by hand: on the Mars sphere one
+    /// thousandth of a degree is 3 396 190 * pi / 180 / 1000 = 59.2747 m north and that times
+    /// cos(4.524 deg) = 0.996885 east (the mid-latitude of rows -4.5 to -4.548).
+    #[test]
+    fn geographic_and_planetary_rasters_get_ground_cell_sizes_in_metres() {
+        let mars = fixture("mars-sphere.tif");
+        assert!(
+            matches!(&mars.crs, Crs::Geographic { ellipsoid } if ellipsoid.name == "Mars" && ellipsoid.semi_major_m == 3_396_190.0),
+            "{:?}",
+            mars.crs
+        );
+        assert!((mars.cell_m.1 - 59.2747).abs() < 1e-3, "{:?}", mars.cell_m);
+        assert!((mars.cell_m.0 - 59.2747 * 0.996_885).abs() < 2e-3, "{:?}", mars.cell_m);
+        assert!(mars.notes.iter().any(|n| n.contains("on Mars (a = 3396190 m)")), "{:?}", mars.notes);
+        let earth = fixture("geo-wgs84.tif");
+        assert!(matches!(&earth.crs, Crs::Geographic { ellipsoid } if ellipsoid.name == "WGS84"));
+        // One arc-second: about 30.8 m north and 23.7 m east at 40 N (cos 40 = 0.766).
+        assert!(
+            (earth.cell_m.1 - 30.84).abs() < 0.01 && (earth.cell_m.0 - 23.72).abs() < 0.01,
+            "{:?}",
+            earth.cell_m
+        );
+        let utm = fixture("proj-same-cells.tif");
+        assert_eq!(utm.crs, Crs::Projected { metres_per_unit: 1.0, unit: "metre" });
+        assert_eq!(utm.cell_m, (utm.geo.cell_x, utm.geo.cell_y));
+        assert!(utm.notes.is_empty(), "{:?}", utm.notes);
     }
 
     /// The grid every fixture shares: 40 x 30 cells of 2 m, north-west corner (500000, 4100000).

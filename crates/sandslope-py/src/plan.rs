@@ -252,5 +252,11 @@ pub fn read_raster<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RasterTuple<
     geo.set_item("north", raster.geo.north)?;
     geo.set_item("cell_x", raster.geo.cell_x)?;
     geo.set_item("cell_y", raster.geo.cell_y)?;
+    // The ground size of a cell in metres (what plan and risk_raster take as cell_size_m), and
+    // what the coordinates are: cell_x/cell_y are in map units (degrees when geographic).
+    geo.set_item("cell_x_m", raster.cell_m.0)?;
+    geo.set_item("cell_y_m", raster.cell_m.1)?;
+    geo.set_item("crs", pythonize::pythonize(py, &raster.crs).map_err(crate::value_error)?)?;
+    geo.set_item("notes", raster.notes.clone())?;
     Ok((crate::arrays::array(py, values), raster.rows, raster.cols, geo))
 }

@@ -189,8 +189,9 @@ fn endpoint(raster: &Raster, which: &str, map: &Option<String>, px: &Option<Stri
     let (cols, rows) = (raster.cols, raster.rows);
     let g = &raster.geo;
     let (east, south) = (g.west + cols as f64 * g.cell_x, g.north - rows as f64 * g.cell_y);
+    let (x, y) = if raster.crs.is_geographic() { ("longitude", "latitude") } else { ("x", "y") };
     let extent = format!(
-        "x {} to {} and y {} to {}, columns 0 to {} and rows 0 to {}",
+        "{x} {} to {} and {y} {} to {}, columns 0 to {} and rows 0 to {}",
         round_coord(g.west),
         round_coord(east),
         round_coord(south),
@@ -339,7 +340,10 @@ impl Inputs {
 
 /// The elevation grid of `dem`, read from `--dem` (named in errors).
 fn grid_of(dem: &Raster, args: &PlanArgs) -> Result<ElevationGrid> {
-    ElevationGrid::from_heights(dem.cols, dem.rows, dem.geo.cell_x, dem.geo.cell_y, &dem.values, dem.nodata)
+    // The planner works in metres: the cell's ground size, not its size in map units (degrees
+    // for a geographic DEM, feet for some projected ones).
+    let (cell_x, cell_y) = dem.cell_m;
+    ElevationGrid::from_heights(dem.cols, dem.rows, cell_x, cell_y, &dem.values, dem.nodata)
         .map_err(|e| anyhow!("{}: {e}", args.dem.display()))
 }
 
@@ -399,6 +403,11 @@ pub fn compute(args: &PlanArgs, risk_map: bool, quiet: bool) -> Result<Planned> 
     let robot = args.robot.load()?;
     let settings = settings(args)?;
     let dem = read_raster(&args.dem)?;
+    if !quiet {
+        for note in &dem.notes {
+            eprintln!("note: {note}");
+        }
+    }
     let start = endpoint(&dem, "start", &args.start, &args.start_px)?;
     let goal = endpoint(&dem, "goal", &args.goal, &args.goal_px)?;
     let (classes, terrains) = classes_of(args, &dem, quiet)?;

@@ -107,8 +107,12 @@ fn served_info(served: &Served) -> Result<Vec<u8>, ApiError> {
     struct Dem {
         cols: usize,
         rows: usize,
+        /// Cell size in map units (degrees for a geographic DEM).
         cell_x: f64,
         cell_y: f64,
+        /// Ground size of a cell, metres (for the hillshade).
+        cell_x_m: f64,
+        cell_y_m: f64,
         west: f64,
         north: f64,
         stride: usize,
@@ -135,6 +139,8 @@ fn served_info(served: &Served) -> Result<Vec<u8>, ApiError> {
                 rows: r.rows,
                 cell_x: r.geo.cell_x,
                 cell_y: r.geo.cell_y,
+                cell_x_m: r.cell_m.0,
+                cell_y_m: r.cell_m.1,
                 west: r.geo.west,
                 north: r.geo.north,
                 stride: stride(r.cols, r.rows),

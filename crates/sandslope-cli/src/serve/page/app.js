@@ -398,8 +398,8 @@ async function loadMap() {
 }
 function hillshade(dem, w, h) {
   const info = state.served.dem;
-  const dx = info.cell_x * dem.stride;
-  const dy = info.cell_y * dem.stride;
+  const dx = info.cell_x_m * dem.stride;
+  const dy = info.cell_y_m * dem.stride;
   const z = (c, r) => {
     const cc = Math.min(w - 1, Math.max(0, c));
     const rr = Math.min(h - 1, Math.max(0, r));

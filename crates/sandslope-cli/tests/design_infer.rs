@@ -259,7 +259,11 @@ fn infer_rejects_impossible_input_with_exit_2() {
         ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,-0.01\n", "", "a standard deviation, greater than 0"),
         ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n", "--k-s-prior=1e6:1e5", "0 < MIN < MAX"),
         ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n", "--law=linear", "two or more slopes"),
-        ("slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n10,0.11,0.01\n", "", "obs.csv: lines 2 and 3 both give slope_deg = 10"),
+        (
+            "slope_deg,speed_m_s,speed_sd_m_s\n10,0.1,0.01\n10,0.11,0.01\n",
+            "",
+            "obs.csv: lines 2 and 3 both give slope_deg = 10",
+        ),
     ] {
         let f = write(dir.path(), "obs.csv", csv);
         let mut cmd = sandslope();

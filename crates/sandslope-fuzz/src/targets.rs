@@ -60,6 +60,9 @@ const RASTERS: &[&str] = &[
     "crates/sandslope-io/tests/fixtures/gdal/f32-deflate-pred3-tiled.tif",
     "crates/sandslope-io/tests/fixtures/gdal/f64-point.tif",
     "crates/sandslope-io/tests/fixtures/gdal/aaigrid.asc",
+    "crates/sandslope-io/tests/fixtures/gdal/geo-wgs84-lzw-pred3.tif",
+    "crates/sandslope-io/tests/fixtures/gdal/geo-wgs84-lzw-pred2-i16-be.tif",
+    "crates/sandslope-io/tests/fixtures/gdal/mars-sphere.tif",
 ];
 
 fn unit<T>(r: Result<T>) -> Result<()> {

@@ -19,6 +19,7 @@ pub mod anchoring;
 pub mod crs;
 pub mod files;
 pub mod grid_csv;
+mod lzw_tiles;
 pub mod measurements;
 pub mod mocap;
 pub mod npy;

@@ -121,9 +121,9 @@ fn undo_predictor(raw: &mut [u8], l: &TileLayout, bytes_per: usize) {
                         v
                     };
                     let sum = read(p).wrapping_add(read(c));
-                    for k in 0..bytes_per {
+                    for (k, byte) in c.iter_mut().enumerate() {
                         let shift = 8 * if l.little_endian { k } else { bytes_per - 1 - k };
-                        c[k] = (sum >> shift) as u8;
+                        *byte = (sum >> shift) as u8;
                     }
                 }
             }

@@ -352,27 +352,39 @@ fn print_envelope(env: &PayloadEnvelope, format: Format) -> Result<()> {
             Ok(())
         }
         Format::Table => {
-            let mut t = table(&["slope (deg)", "heaviest safe mass (kg)", "payload (kg)", "note"]);
-            for p in &env.points {
-                let note = match p.limit {
+            // A row's note only where its search did not end at a threshold crossing (at a
+            // crossing p_fail is the threshold itself: saying so on every row said nothing).
+            let notes: Vec<Option<String>> = env
+                .points
+                .iter()
+                .map(|p| match p.limit {
                     SafeLimit::NoneSafe { p_fail } => {
-                        format!("p_fail {p_fail:.4} already at the robot's own mass")
+                        Some(format!("none safe: p_fail {p_fail:.4} already at the robot's own mass"))
                     }
-                    SafeLimit::Limit { p_fail, .. } => format!("p_fail {p_fail:.4} there"),
+                    SafeLimit::Limit { .. } => None,
                     SafeLimit::BeyondRange { up_to, .. } => {
-                        format!("safe up to {up_to:.3} kg, the end of the search")
+                        Some(format!("safe up to {up_to:.3} kg, the end of the search"))
                     }
-                };
-                t.add_row([
-                    format!("{}", p.slope_deg),
-                    num(p.max_mass_kg, 4),
-                    num(p.max_payload_kg, 4),
-                    note,
-                ]);
+                })
+                .collect();
+            let with_notes = notes.iter().any(Option::is_some);
+            let mut header = vec!["slope (deg)", "heaviest safe mass (kg)", "payload (kg)"];
+            if with_notes {
+                header.push("note");
+            }
+            let mut t = table(&header);
+            for (p, note) in env.points.iter().zip(notes) {
+                let mut row =
+                    vec![format!("{}", p.slope_deg), num(p.max_mass_kg, 4), num(p.max_payload_kg, 4)];
+                if with_notes {
+                    row.push(note.unwrap_or_default());
+                }
+                t.add_row(row);
             }
             println!("{t}");
             println!(
-                "payload envelope: heaviest total mass with p_fail < {} (robot's own mass {} kg)",
+                "payload envelope: heaviest total mass with p_fail < {} (robot's own mass {} kg; at each \
+                 limit p_fail reaches the threshold)",
                 env.max_risk, env.robot_mass_kg
             );
             if let Some(note) = env.defaults_used.note() {

@@ -5,7 +5,8 @@
 //! Every limit is one search, `first_crossing`: a scan up a range and a bisection of the
 //! first point where `p_fail >= max_risk`. The safe-slope limit decides each point with the
 //! fast p_fail of [`super::failure_probability`] (used by `risk --solve slope`, the report, the Python
-//! `safe_slope` and every design of `design`); the mass searches with the reference quadrature.
+//! `safe_slope` and every design of `design`), and so do the mass searches; each reports the
+//! reference quadrature's p_fail at the limit it returns.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -125,7 +126,8 @@ fn first_crossing(
 }
 
 /// A search deciding by the reference p_fail itself: each point is one quadrature, so a few are
-/// evaluated in parallel at a time.
+/// evaluated in parallel at a time (the tests' reference for the fast searches).
+#[cfg(test)]
 fn reference_crossing(
     p_fail: &(dyn Fn(f64) -> f64 + Sync),
     scan: &[f64],
@@ -232,11 +234,17 @@ pub fn max_safe_mass(
     let n = (MAX_MASS_FACTOR.ln() / MASS_SCAN_FACTOR.ln()).ceil() as i32;
     let scan: Vec<f64> = (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).collect();
     let (ground, u) = terrain.at(slope);
-    // Decided by the reference quadrature, a few masses in parallel. The fast p_fail would
-    // apply here too (it takes any robot), but `--solve mass` runs one search per request, not
-    // 10^5, and switching it would need its own bit-for-bit check against this search.
+    // Each decision by the fast p_fail (a closed form over the anchoring boundary, about a
+    // hundred times cheaper than the reference quadrature, issue 26), as the safe-slope search
+    // decides; the p_fail reported at the mass found is the reference quadrature's.
+    let decide = |m: f64| -> Verdict {
+        match robot.with_mass(m) {
+            Ok(r) => (FailureProbability::new(&r, slope, &ground, u).fails(max_risk).0, None),
+            Err(_) => (true, Some(1.0)),
+        }
+    };
     let p = |m: f64| robot.with_mass(m).map_or(1.0, |r| regime_probabilities(&r, slope, &ground, u).p_fail());
-    Ok(reference_crossing(&p, &scan, max_risk, 1e-5 * m0))
+    Ok(first_crossing(&decide, &p, &scan, 1e-5 * m0, 1))
 }
 
 /// The heaviest safe mass at one slope of a [`PayloadEnvelope`].
@@ -488,5 +496,43 @@ mod tests {
             last = v;
         }
         assert_eq!(payload_envelope(&r, &t, &[95.0], 0.05).unwrap_err().key, "slope_deg");
+    }
+
+    /// The mass search decides with the fast p_fail (issue 26); the reference search, deciding
+    /// every mass by quadrature, finds the same heaviest safe mass (to the search's 1e-5
+    /// relative tolerance) on a terrain whose k_s falls with slope, at slopes from success to
+    /// none safe, and both report the reference p_fail there.
+    #[test]
+    fn fast_mass_search_finds_the_reference_search_s_mass() {
+        let r = paper_robot();
+        let t = UncertainTerrain::new(
+            table(&[(0.0, 7e5, 2e6, None, None), (24.0, 6e5, 9e5, None, None)], None),
+            Some(0.1),
+            Some(0.2),
+        )
+        .unwrap();
+        let mut kinds = std::collections::BTreeSet::new();
+        for deg in [0.0, 6.0, 12.0, 18.0, 24.0] {
+            let s = slope(deg);
+            let fast = max_safe_mass(&r, s, &t, 0.05).unwrap();
+            let (ground, u) = t.at(s);
+            let m0 = r.mass();
+            let n = (MAX_MASS_FACTOR.ln() / MASS_SCAN_FACTOR.ln()).ceil() as i32;
+            let scan: Vec<f64> = (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).collect();
+            let p = |m: f64| r.with_mass(m).map_or(1.0, |r| regime_probabilities(&r, s, &ground, u).p_fail());
+            let reference = reference_crossing(&p, &scan, 0.05, 1e-5 * m0);
+            match (fast, reference) {
+                (SafeLimit::Limit { value: a, p_fail: pa }, SafeLimit::Limit { value: b, p_fail: pb }) => {
+                    assert!((a - b).abs() <= 2e-5 * m0, "{deg} deg: {a} vs {b}");
+                    assert!((pa - p(a)).abs() < 1e-15 && pb < 0.05 && pa < 0.05, "{deg} deg: {pa} {pb}");
+                    kinds.insert("limit");
+                }
+                (f, r) => {
+                    assert_eq!(std::mem::discriminant(&f), std::mem::discriminant(&r), "{deg} deg");
+                    kinds.insert("other");
+                }
+            }
+        }
+        assert!(kinds.contains("limit"), "{kinds:?}");
     }
 }

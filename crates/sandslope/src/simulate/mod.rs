@@ -331,6 +331,9 @@ pub fn integration_step(scenario: &Scenario, slope: Slope, given: Option<f64>) -
     }
 }
 
+/// Most legs per tripod the simulator takes (a 128-legged robot).
+pub const MAX_STANCE_LEGS: u32 = 64;
+
 /// Simulates `scenario`'s robot walking on its terrain at `slope_deg` (signed: negative walks
 /// downhill; the terrain is read at |slope| as docs/model.md §8) for `settings.duration_s`
 /// seconds, and measures the walk (docs/model.md §15-§18).
@@ -342,6 +345,16 @@ pub fn simulate(
     let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
     let closed_form = scenario.evaluate(slope_deg)?;
     let robot = scenario.robot();
+    // Decided before the legs are made: 2 n legs of `leg_elements` elements each (a robot file
+    // with stance_legs = 1e9 asked for 8 GB and aborted; found by scripts/fuzz.sh).
+    if robot.stance_legs() > MAX_STANCE_LEGS {
+        return Err(ParamError::new(
+            "stance_legs",
+            f64::from(robot.stance_legs()),
+            format!("at most {MAX_STANCE_LEGS} for the simulator (it simulates 2 n legs)"),
+        )
+        .into());
+    }
     let (ground, _) = scenario.ground_at(slope);
     let dt = integration_step(scenario, slope, settings.dt_s)?;
     let half = robot.stance_duration();

@@ -127,6 +127,17 @@ fn closed_form_is_predicts_answer() {
     assert!((sim.trajectory.time_s[240] - 2.0).abs() < 1e-12);
 }
 
+/// A robot file with 10^9 stance legs is refused before 2 x 10^9 legs are made (it asked for
+/// 8 GB and aborted; found by scripts/fuzz.sh); 64 per tripod is the cap.
+#[test]
+fn a_robot_with_a_billion_legs_is_refused_before_allocating() {
+    let spec = RobotSpec { stance_legs: 1_000_000_000, ..paper_robot().spec().clone() };
+    let s =
+        Scenario::new(Robot::new(spec).unwrap(), Terrain::constant(7e5, 2e6).unwrap(), None, None).unwrap();
+    let e = simulate(&s, 10.0, &SimSettings::new(2.0).unwrap()).unwrap_err().to_string();
+    assert!(e.contains("stance_legs = 1000000000 must be at most 64"), "{e}");
+}
+
 /// Issue 23's acceptance check: on stiff level sand (k_n = k_s = 1e8 N/m^3) a leg barely sinks
 /// (d_n = 0.03 mm), so the step tends to the geometric s* = 2 sqrt(R^2 - (h - R)^2) =
 /// 2 sqrt(0.04^2 - 0.01^2) = 77.5 mm (docs/model.md §3), within 2%. It fails today (145 mm):

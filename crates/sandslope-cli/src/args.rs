@@ -4,7 +4,7 @@
 
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
-use sandslope::{Robot, Scenario, Slope, Terrain};
+use sandslope::{LevelStep, Robot, Scenario, Slope, Terrain};
 
 use sandslope::risk::UncertainTerrain;
 use sandslope::{Axis, AxisScale};
@@ -32,6 +32,25 @@ impl RobotArgs {
             Some(m) => robot.with_mass(m).map_err(|e| anyhow!("{}", e.renamed("--mass"))),
             None => Ok(robot),
         }
+    }
+}
+
+/// `--level-step`: which normal depth the derived level step s* uses (docs/model.md §3).
+#[derive(Debug, Clone, Copy, Args)]
+pub struct LevelStepArgs {
+    /// Normal depth of the derived level step s* (docs/model.md §3, a choice the paper leaves
+    /// open): `slope` takes d_n at the slope, with its cos(theta) (the default); `level` takes
+    /// d_n on level sand, the paper's definition of s*. Up to 0.7% in speed on the built-in
+    /// robot and terrain. No effect on a robot with `level_step_m`.
+    #[arg(long, value_name = "slope|level", default_value = "slope", value_parser = parse_level_step)]
+    pub level_step: LevelStep,
+}
+
+fn parse_level_step(s: &str) -> Result<LevelStep, String> {
+    match s {
+        "slope" => Ok(LevelStep::Slope),
+        "level" => Ok(LevelStep::Level),
+        other => Err(format!("`{other}` is not a level-step rule: expected `slope` (d_n at the slope) or `level` (d_n on level sand)")),
     }
 }
 
@@ -144,7 +163,8 @@ impl RobotQuantityArgs {
     }
 }
 
-/// `--k-n` and `--k-s`: fixed resistances overriding the terrain's at every slope.
+/// `--k-n` and `--k-s`: fixed resistances overriding the terrain's at every slope; and
+/// `--level-step`, the model choice of docs/model.md §3.
 #[derive(Debug, Clone, Copy, Args)]
 pub struct OverrideArgs {
     /// Normal penetration resistance k_n, N/m^3, instead of the terrain's.
@@ -153,6 +173,8 @@ pub struct OverrideArgs {
     /// Shear strength k_s, N/m^3, instead of the terrain's.
     #[arg(long = "k-s", value_name = "N/M^3", allow_negative_numbers = true)]
     pub k_s: Option<f64>,
+    #[command(flatten)]
+    pub level: LevelStepArgs,
 }
 
 impl OverrideArgs {
@@ -160,7 +182,8 @@ impl OverrideArgs {
     pub fn scenario(&self, robot: &RobotArgs, terrain: &TerrainArgs) -> Result<Scenario> {
         let k_n = self.k_n.map(|v| check_positive("--k-n", v)).transpose()?;
         let k_s = self.k_s.map(|v| check_positive("--k-s", v)).transpose()?;
-        Scenario::new(robot.load()?, terrain.load()?, k_n, k_s).map_err(|e| anyhow!("{e}"))
+        let robot = robot.load()?.with_level_step(self.level.level_step);
+        Scenario::new(robot, terrain.load()?, k_n, k_s).map_err(|e| anyhow!("{e}"))
     }
 }
 

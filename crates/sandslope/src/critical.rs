@@ -168,7 +168,7 @@ fn reachable_step(
     if beyond_repose {
         return Err(NoShearSuffices::AtOrAboveRepose);
     }
-    let s_star = level_step_length(robot, d_n);
+    let s_star = level_step_length(robot, slope, d_n);
     let s_target = match target {
         StepTarget::Progress => 0.0,
         StepTarget::Robust => robot.min_step(),
@@ -220,7 +220,7 @@ mod tests {
         let r = paper_robot();
         for deg in [10.0, 15.0, 20.0, 24.0, 35.0] {
             let slope = Slope::from_degrees(deg).unwrap();
-            let s_star = level_step_length(&r, normal_equilibrium_depth(&r, slope, 7e5));
+            let s_star = level_step_length(&r, slope, normal_equilibrium_depth(&r, slope, 7e5));
             for (target, s_t) in [(StepTarget::Progress, 0.0), (StepTarget::Robust, r.min_step())] {
                 let k = critical_shear_strength(&r, slope, 7e5, false, target).unwrap();
                 let expect = closed_form(&r, slope, s_star, s_t).max(anchoring_threshold_k_s(&r, slope));

@@ -298,7 +298,7 @@ impl SpeedTable {
         if d_n >= robot.max_depth() {
             return Err(InferError::Sinkage { slope_deg: slope.degrees() });
         }
-        let s_star = level_step_length(robot, d_n);
+        let s_star = level_step_length(robot, slope, d_n);
         let (lo, hi) = (prior.min.ln(), prior.max.ln());
         let n = GRID_POINTS;
         let ln_k: Vec<f64> = (0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect();

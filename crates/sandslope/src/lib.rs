@@ -69,7 +69,7 @@ pub use regime::{Cause, Regime};
 pub use risk::{
     regime_probabilities, RegimeProbabilities, RiskCurve, RiskMap, SafeLimit, UncertainTerrain, Uncertainty,
 };
-pub use robot::{Robot, RobotSpec};
+pub use robot::{LevelStep, Robot, RobotSpec};
 pub use scenario::{Scenario, SlopeEvaluation};
 pub use simulate::{simulate, simulate_slopes, SimSettings, SimSummary, Simulation};
 pub use slope::Slope;

@@ -9,7 +9,7 @@
 //! propulsion `s2`, net step `s = s2 - s1`, step-averaged speed `v = s / (T/2)`, and the regime.
 
 use crate::regime::{classify, Cause, Regime};
-use crate::robot::Robot;
+use crate::robot::{LevelStep, Robot};
 use crate::slope::Slope;
 use crate::terrain::Ground;
 
@@ -35,17 +35,24 @@ pub fn sinkage_threshold_k_n(robot: &Robot, slope: Slope) -> f64 {
     normal_load_per_leg(robot, slope) / (robot.contact_area() * robot.max_depth())
 }
 
-/// Level-sand step length `s*`, m (rotary walking model, docs/model.md §3).
+/// Level-sand step length `s*`, m (rotary walking model, docs/model.md §3), for the normal
+/// depth `d_n` at `slope`.
 ///
-/// The robot's measured `level_step_m` if given; else `2 sqrt(R^2 - (d_n + h - R)^2)` when
-/// `d_n < d_max`, and 0 when `d_n >= d_max`.
-pub fn level_step_length(robot: &Robot, d_n: f64) -> f64 {
+/// The robot's measured `level_step_m` if given; else `2 sqrt(R^2 - (d + h - R)^2)` when
+/// `d_n < d_max`, and 0 when `d_n >= d_max`, where `d = d_n` (the default,
+/// [`LevelStep::Slope`]) or `d = d_n / cos(theta)`, the depth on level sand
+/// ([`LevelStep::Level`], the paper's definition of s*; docs/model.md §3 marks the choice).
+pub fn level_step_length(robot: &Robot, slope: Slope, d_n: f64) -> f64 {
     if let Some(s) = robot.measured_level_step() {
         return s;
     }
     if d_n >= robot.max_depth() {
         return 0.0;
     }
+    let d_n = match robot.level_step_rule() {
+        LevelStep::Slope => d_n,
+        LevelStep::Level => d_n / slope.cos(),
+    };
     let r = robot.leg_radius();
     let x = d_n + robot.hip_height() - r;
     2.0 * (r * r - x * x).max(0.0).sqrt()
@@ -174,7 +181,7 @@ pub struct Prediction {
 pub fn predict(robot: &Robot, slope: Slope, ground: &Ground) -> Prediction {
     let finite = |x: f64| x.is_finite().then_some(x);
     let d_n = normal_equilibrium_depth(robot, slope, ground.k_n);
-    let s_star = level_step_length(robot, d_n);
+    let s_star = level_step_length(robot, slope, d_n);
     let d_s = shear_equilibrium_depth(robot, slope, ground.k_s);
     let t1 = anchoring_time(robot, d_s);
     let slip = t1.map(|t1| backward_slip(slope, t1));
@@ -321,5 +328,28 @@ pub(crate) mod tests {
         close(p.level_step, 0.08, 1e-9);
         close(p.speed.unwrap(), 0.16, 1e-5);
         assert!(p.speed.unwrap() <= 0.16);
+    }
+
+    /// The s* choice of docs/model.md §3 at 24 degrees, k_n = 7e5, by hand: level-ground depth
+    /// d = 0.35*9.81/(3*7e5*4e-4) = 4.08750e-3 m; at the slope d_n = d cos 24 = 3.73412e-3 m.
+    /// s* = 2 sqrt(R^2 - (d + h - R)^2) with R = 0.04, h = 0.03: 2 sqrt(1.6e-3 - (-5.91250e-3)^2)
+    /// = 7.91212e-2 m (level) and 2 sqrt(1.6e-3 - (-6.26588e-3)^2) = 7.90124e-2 m (slope).
+    #[test]
+    fn level_step_rules_by_hand() {
+        let slope = deg(24.0);
+        let d_n = normal_equilibrium_depth(&paper_robot(), slope, 7e5);
+        close(d_n, 4.08750e-3 * 24f64.to_radians().cos(), 1e-5);
+        let by_hand = |d: f64| 2.0 * (0.04f64.powi(2) - (d + 0.03 - 0.04).powi(2)).sqrt();
+        let slope_rule = level_step_length(&paper_robot(), slope, d_n);
+        let level_rule = level_step_length(&paper_robot().with_level_step(LevelStep::Level), slope, d_n);
+        close(slope_rule, by_hand(3.73412e-3), 1e-5);
+        close(level_rule, by_hand(4.08750e-3), 1e-5);
+        close(level_rule, 7.91212e-2, 1e-5);
+        close(slope_rule, 7.90124e-2, 1e-5);
+        // Level ground: the two rules are one.
+        assert_eq!(
+            level_step_length(&paper_robot(), Slope::LEVEL, 4.0875e-3),
+            level_step_length(&paper_robot().with_level_step(LevelStep::Level), Slope::LEVEL, 4.0875e-3)
+        );
     }
 }

@@ -248,7 +248,7 @@ impl PhaseMap {
             .iter()
             .map(|&k| {
                 let d_n = normal_equilibrium_depth(robot, slope, k);
-                (level_step_length(robot, d_n), d_n >= d_max)
+                (level_step_length(robot, slope, d_n), d_n >= d_max)
             })
             .unzip();
         // k_s-only parts, once per row.

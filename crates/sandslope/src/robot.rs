@@ -92,6 +92,28 @@ pub struct Robot {
     body_length: f64,
     body_width: f64,
     pitch_inertia: f64,
+    level_step_rule: LevelStep,
+}
+
+/// Which normal depth the derived level-sand step `s*` uses (docs/model.md §3, a choice).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LevelStep {
+    /// `d_n(theta)`, with the `cos(theta)` of the normal load at the slope (the default).
+    #[default]
+    Slope,
+    /// `d_n(0)`: `s*` as the paper defines it, the step on level sand, at every slope.
+    Level,
+}
+
+impl LevelStep {
+    /// The name as written on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            LevelStep::Slope => "slope",
+            LevelStep::Level => "level",
+        }
+    }
 }
 
 /// Default resistive-force-theory elements per leg (docs/model.md §15).
@@ -166,12 +188,31 @@ impl Robot {
                 ));
             }
         }
-        Ok(Robot { spec, contact_area, min_step, body_length, body_width, pitch_inertia })
+        Ok(Robot {
+            spec,
+            contact_area,
+            min_step,
+            body_length,
+            body_width,
+            pitch_inertia,
+            level_step_rule: LevelStep::Slope,
+        })
     }
 
     /// The same robot with another total mass (e.g. carrying a payload).
     pub fn with_mass(&self, mass_kg: f64) -> Result<Robot, ParamError> {
-        Robot::new(RobotSpec { mass_kg, ..self.spec.clone() })
+        Ok(Robot::new(RobotSpec { mass_kg, ..self.spec.clone() })?.with_level_step(self.level_step_rule))
+    }
+
+    /// The same robot with the derived level step `s*` taken at `rule`'s normal depth.
+    pub fn with_level_step(mut self, rule: LevelStep) -> Robot {
+        self.level_step_rule = rule;
+        self
+    }
+
+    /// Which normal depth the derived `s*` uses.
+    pub fn level_step_rule(&self) -> LevelStep {
+        self.level_step_rule
     }
 
     /// The plain, serialisable form of this robot (as it was given, defaults not filled in).

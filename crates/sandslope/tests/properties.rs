@@ -97,7 +97,7 @@ proptest! {
         prop_assert_eq!(p.cause.regime(), p.regime);
         if p.regime == Regime::Sinkage {
             prop_assert_eq!(p.cause, Cause::NormalSinkage);
-            prop_assert!(r.measured_level_step().is_some() || level_step_length(&r, d_n) == 0.0);
+            prop_assert!(r.measured_level_step().is_some() || level_step_length(&r, s, d_n) == 0.0);
         }
     }
 

@@ -16,7 +16,7 @@ use sandslope_io::mocap::MocapFormat;
 use sandslope_io::presets::{is_default, report_force_tests, PresetKind};
 use sandslope_io::{load_anchoring_times, load_speeds};
 
-use crate::args::{parse_max_risk, RobotArgs, TerrainArgs};
+use crate::args::{parse_max_risk, LevelStepArgs, RobotArgs, TerrainArgs};
 use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions};
 use crate::output::write_atomic;
 use crate::report::{page, page_figures};
@@ -71,6 +71,8 @@ pub struct ReportArgs {
     /// used. Without it such a report exits 0 and prints the warnings on stderr.
     #[arg(long)]
     pub strict: bool,
+    #[command(flatten)]
+    pub level: LevelStepArgs,
     #[command(flatten)]
     pub robot: RobotArgs,
     #[command(flatten)]
@@ -172,7 +174,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
 /// tests are the paper's as its text reports them (the built-in terrain was calibrated from
 /// them).
 fn evidence(args: &ReportArgs) -> Result<Evidence> {
-    let robot = args.robot.load()?;
+    let robot = args.robot.load()?.with_level_step(args.level.level_step);
     let terrain = args.terrain.load()?;
     let forces = report_force_tests(args.forces.as_deref(), &args.terrain.terrain)?;
     let observed = match &args.observed {

@@ -18,7 +18,7 @@ fn level_step_at(robot: &Robot, slope: Slope, k_n: f64) -> Result<f64, Calibrati
     if d_n >= robot.max_depth() {
         return Err(CalibrationError::Sinkage { slope_deg: slope.degrees() });
     }
-    Ok(level_step_length(robot, d_n))
+    Ok(level_step_length(robot, slope, d_n))
 }
 
 /// The k_s (N/m^3) at which the model's speed equals `speed`, by Brent's method on `ln k_s`.

@@ -98,9 +98,11 @@ impl RobotKey {
             RobotKey::LegSpeedRadS => robot.leg_speed(),
             RobotKey::ResponseTimeS => robot.response_time(),
             RobotKey::LegContactAreaM2 => robot.contact_area(),
-            RobotKey::LevelStepM => {
-                level_step_length(robot, normal_equilibrium_depth(robot, Slope::LEVEL, k_n_level))
-            }
+            RobotKey::LevelStepM => level_step_length(
+                robot,
+                Slope::LEVEL,
+                normal_equilibrium_depth(robot, Slope::LEVEL, k_n_level),
+            ),
         }
     }
 

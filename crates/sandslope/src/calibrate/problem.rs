@@ -118,7 +118,8 @@ impl Problem<'_> {
                 Quantity::ShearRatio20 | Quantity::FrictionAngle => c.law[1] = v,
             }
         }
-        c.robot = Robot::new(spec).ok();
+        // The fitted keys on the setup's robot, keeping its level-step rule (docs/model.md §3).
+        c.robot = Robot::new(spec).ok().map(|r| r.with_level_step(self.setup.robot.level_step_rule()));
         c
     }
 
@@ -135,7 +136,7 @@ impl Problem<'_> {
     }
 
     pub fn level_step(&self, robot: &Robot, slope: Slope) -> f64 {
-        level_step_length(robot, normal_equilibrium_depth(robot, slope, self.k_n(slope)))
+        level_step_length(robot, slope, normal_equilibrium_depth(robot, slope, self.k_n(slope)))
     }
 
     /// Pulls of every observation (speeds, anchoring times, force tests) at `x`, and the

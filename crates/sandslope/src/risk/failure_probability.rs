@@ -65,7 +65,7 @@ impl<'a> ProgressBoundary<'a> {
         if d_n >= self.robot.max_depth() {
             return None;
         }
-        self.at_level_step(level_step_length(self.robot, d_n))
+        self.at_level_step(level_step_length(self.robot, self.slope, d_n))
     }
 
     /// The largest `k_crit` over every `k_n >= k_lo` (above the sinkage threshold): the
@@ -76,7 +76,8 @@ impl<'a> ProgressBoundary<'a> {
         if d_lo >= self.robot.max_depth() {
             return None;
         }
-        let s_min = level_step_length(self.robot, d_lo).min(level_step_length(self.robot, 0.0));
+        let s_min = level_step_length(self.robot, self.slope, d_lo)
+            .min(level_step_length(self.robot, self.slope, 0.0));
         self.at_level_step(s_min)
     }
 }

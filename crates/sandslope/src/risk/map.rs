@@ -92,7 +92,7 @@ fn curves(robot: &Robot, slope: Slope, x: f64) -> ([f64; 2], [(bool, bool); 2]) 
     if d_n >= robot.max_depth() {
         return ([f64::INFINITY; 2], [(false, false); 2]);
     }
-    let s_star = level_step_length(robot, d_n);
+    let s_star = level_step_length(robot, slope, d_n);
     let (g0, c0) = ln_critical_closed_form(robot, slope, s_star, 0.0);
     let (g1, c1) = ln_critical_closed_form(robot, slope, s_star, robot.min_step());
     ([g0, g1], [(c0, g0.is_finite()), (c1, g1.is_finite())])

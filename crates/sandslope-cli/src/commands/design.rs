@@ -252,7 +252,8 @@ fn print_table(study: &DesignStudy, show: usize, notes: &[String]) {
         front.len()
     );
     let mut header: Vec<String> = study.keys.iter().map(|k| k.name().to_string()).collect();
-    header.extend(["safe slope (deg)", "speed (m/s)", "p_fail", "regime", "k_s margin"].map(String::from));
+    const OUTCOME: [&str; 5] = ["safe slope (deg)", "speed (cm/s)", "p_fail", "regime", "k_s margin"];
+    header.extend(OUTCOME.map(String::from));
     let refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut t = table(&refs);
     let row = |d: &Design| -> Vec<String> {
@@ -264,7 +265,7 @@ fn print_table(study: &DesignStudy, show: usize, notes: &[String]) {
                     SafeLimit::BeyondRange { up_to, .. } => format!(">= {up_to}"),
                     SafeLimit::Limit { value, .. } => format!("{value:.3}"),
                 },
-                num(p.speed_m_s, 4),
+                num(p.speed_m_s.map(|v| 100.0 * v), 2),
                 format!("{:.4}", p.p_fail),
                 p.regime.name().to_string(),
                 num(p.k_s_margin, 3),
@@ -287,9 +288,12 @@ fn print_table(study: &DesignStudy, show: usize, notes: &[String]) {
         println!("({} more on the front: --show N, --json or --csv FILE for all)", front.len() - show);
     }
     let template = row(&study.template);
+    // Each of the template's outcomes named, as the table's columns are.
+    let labelled: Vec<String> =
+        OUTCOME.iter().zip(&template[study.keys.len()..]).map(|(name, v)| format!("{name} {v}")).collect();
     println!(
-        "template robot: {}{}",
-        template[study.keys.len()..].join(", "),
+        "template robot (the --robot file): {}{}",
+        labelled.join(", "),
         if study.template.pareto { " (on the front)" } else { " (dominated by a design in the space)" }
     );
     let mut reasons: BTreeMap<&str, usize> = BTreeMap::new();

@@ -530,5 +530,36 @@ pub fn run(args: PlanArgs) -> Result<()> {
         }
     }
     println!("{t}");
+    if let Some(note) = time_route_note(&result.routes, args.allow_metastable) {
+        println!("note: {note}");
+    }
     Ok(())
+}
+
+/// Why the time route can be slower than another route: it uses success edges only unless
+/// `--allow-metastable`, while the risk route may cross metastable edges (issue 28).
+fn time_route_note(
+    routes: &[(sandslope::plan::Objective, Result<sandslope::plan::Route, sandslope::plan::NoRoute>)],
+    allow_metastable: bool,
+) -> Option<String> {
+    use sandslope::plan::Objective;
+    if allow_metastable {
+        return None;
+    }
+    let time_of = |o: Objective| {
+        routes.iter().find(|(k, _)| *k == o).and_then(|(_, r)| r.as_ref().ok()).and_then(|r| r.time_s)
+    };
+    let fastest = time_of(Objective::Time)?;
+    let (other, t) = routes
+        .iter()
+        .filter(|(k, _)| *k != Objective::Time)
+        .filter_map(|(k, r)| Some((*k, r.as_ref().ok()?.time_s?)))
+        .filter(|(_, t)| *t < fastest)
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    Some(format!(
+        "the {} route ({t:.1} s) is faster than the time route ({fastest:.1} s): the time route uses only \
+         edges where the robot succeeds (unless --allow-metastable), and the other crosses metastable ones \
+         (docs/planning.md)",
+        other.name()
+    ))
 }

@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 
 use super::phase::{star_points, STAR_GREEN};
-use super::{font, range, Figure};
+use super::{font, range, tick, Figure};
 
 /// The safe-slope limit over two varied keys (row-major: one row per `x` value).
 pub struct SafeSlopeMap {
@@ -52,9 +52,14 @@ impl Figure for DesignFigure {
             }
             None => (root, None),
         };
-        let all = || self.others.iter().chain(&self.front).chain(self.template.iter());
+        // Speeds in cm/s, as every table prints them.
+        let cm = |p: &(f64, f64)| (p.0, 100.0 * p.1);
+        let others: Vec<(f64, f64)> = self.others.iter().map(cm).collect();
+        let front: Vec<(f64, f64)> = self.front.iter().map(cm).collect();
+        let template = self.template.as_ref().map(cm);
+        let all = || others.iter().chain(&front).chain(template.iter());
         let (x0, x1) = range(all().map(|p| p.0), (0.0, 30.0));
-        let (y0, y1) = range(all().map(|p| p.1), (0.0, 0.2));
+        let (y0, y1) = range(all().map(|p| p.1), (0.0, 20.0));
         let mut chart = ChartBuilder::on(&left)
             .margin(15)
             .x_label_area_size(50)
@@ -64,7 +69,9 @@ impl Figure for DesignFigure {
         chart
             .configure_mesh()
             .x_desc("safe-slope limit (deg; -1: no slope is safe)")
-            .y_desc("speed at the target slope (m/s)")
+            .y_desc("speed at the target slope (cm/s)")
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
             .label_style(font(15.0))
             .axis_desc_style(font(17.0))
             .light_line_style(WHITE)
@@ -72,18 +79,18 @@ impl Figure for DesignFigure {
             .map_err(e)?;
         let grey = RGBColor(150, 150, 150);
         chart
-            .draw_series(self.others.iter().map(|&p| Circle::new(p, 2, grey.mix(0.5).filled())))
+            .draw_series(others.iter().map(|&p| Circle::new(p, 2, grey.mix(0.5).filled())))
             .map_err(e)?
-            .label(format!("designs ({})", self.others.len() + self.front.len()))
+            .label(format!("designs ({})", others.len() + front.len()))
             .legend(move |(x, y)| Circle::new((x + 12, y), 4, grey.filled()));
         let red = RGBColor(214, 56, 48);
-        chart.draw_series(LineSeries::new(self.front.iter().copied(), red.stroke_width(2))).map_err(e)?;
+        chart.draw_series(LineSeries::new(front.iter().copied(), red.stroke_width(2))).map_err(e)?;
         chart
-            .draw_series(self.front.iter().map(|&p| Circle::new(p, 5, red.filled())))
+            .draw_series(front.iter().map(|&p| Circle::new(p, 5, red.filled())))
             .map_err(e)?
-            .label(format!("Pareto front ({})", self.front.len()))
+            .label(format!("Pareto front ({})", front.len()))
             .legend(move |(x, y)| Circle::new((x + 12, y), 5, red.filled()));
-        if let Some(t) = self.template {
+        if let Some(t) = template {
             chart
                 .draw_series(std::iter::once(
                     EmptyElement::at(t)
@@ -135,7 +142,7 @@ where
     DB::ErrorType: 'static,
 {
     let e = crate::error::plot_err;
-    let (main, bar) = area.split_horizontally(640);
+    let (main, bar) = area.split_horizontally(600);
     let (xe, ye) = (edges(&map.x), edges(&map.y));
     let mut chart = ChartBuilder::on(&main)
         .caption("safe-slope limit (deg)", font(18.0))
@@ -149,6 +156,8 @@ where
         .disable_mesh()
         .x_desc(map.x_key.as_str())
         .y_desc(map.y_key.as_str())
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
         .label_style(font(15.0))
         .axis_desc_style(font(17.0))
         .draw()
@@ -190,6 +199,7 @@ where
         .disable_mesh()
         .disable_x_axis()
         .y_desc("deg (dark grey: none safe; white: invalid)")
+        .y_label_formatter(&tick)
         .label_style(font(13.0))
         .axis_desc_style(font(14.0))
         .draw()

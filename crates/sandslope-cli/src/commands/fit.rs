@@ -204,9 +204,11 @@ fn print_tables(campaign: &Campaign) {
         "window (mm)",
         "air",
         "used",
-        "dropped",
         "warnings",
     ]);
+    // What each trial set aside, listed below the table (as a column it made the table about
+    // 194 characters wide).
+    let mut set_aside = Vec::new();
     for tr in &campaign.trials {
         let (k, se, r2) = match (&tr.penetration, &tr.shear) {
             (Some(p), _) => (sci(p.k_n), sci(p.k_n_se), num(Some(p.r_squared), 3)),
@@ -230,11 +232,17 @@ fn print_tables(campaign: &Campaign) {
             window,
             if tr.air { "-".into() } else { tr.air_correction.to_string() },
             format!("{}/{}", tr.used, tr.rows),
-            dropped_text(&tr.dropped),
             if warnings.is_empty() { "-".into() } else { warnings.join(", ") },
         ]);
+        let dropped = dropped_text(&tr.dropped);
+        if dropped != "none" {
+            set_aside.push(format!("  {}: {dropped}", tr.file));
+        }
     }
     println!("{t}");
+    if !set_aside.is_empty() {
+        println!("rows not used (docs/measurements.md):\n{}", set_aside.join("\n"));
+    }
     let mut t = table(&["slope deg", "k_n (N/m^3)", "k_n SD", "n", "k_s (N/m^3)", "k_s SD", "n", "note"]);
     for p in &campaign.points {
         t.add_row([

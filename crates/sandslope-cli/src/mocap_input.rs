@@ -12,7 +12,6 @@ use anyhow::{anyhow, bail, Result};
 use sandslope::gait::{track, GaitOptions, Recording, TrackResult, Upslope};
 use sandslope::Slope;
 use sandslope_io::mocap::{self, Capture, MocapFormat};
-use sandslope_io::read_text;
 
 use crate::progress::progress_bar;
 
@@ -68,27 +67,6 @@ pub fn expand(patterns: &[String]) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
-/// Reads a touchdowns file: one time in seconds per line; blank lines and `#` comments skipped.
-fn load_touchdowns(path: &Path) -> Result<Vec<f64>> {
-    let text = read_text(path)?;
-    let mut times = Vec::new();
-    for (i, raw) in text.lines().enumerate() {
-        let line = raw.split('#').next().unwrap_or("").trim();
-        if line.is_empty() {
-            continue;
-        }
-        let t = line.parse::<f64>().ok().filter(|t| t.is_finite()).ok_or_else(|| {
-            anyhow!("{}: line {}: `{line}` is not a time in seconds", path.display(), i + 1)
-        })?;
-        times.push(t);
-    }
-    if times.is_empty() {
-        bail!("{}: no touchdown times (expected one time in seconds per line)", path.display());
-    }
-    times.sort_by(f64::total_cmp);
-    Ok(times)
-}
-
 /// How to read a set of capture files (the `--format` and `--body` flags).
 #[derive(Debug, Clone, Copy)]
 pub struct CaptureOptions<'a> {
@@ -136,7 +114,8 @@ pub fn track_files(
         })
         .collect::<Result<_>>()?;
     bar.finish_and_clear();
-    let touchdowns: Vec<Vec<f64>> = touchdowns.iter().map(|p| load_touchdowns(p)).collect::<Result<_>>()?;
+    let touchdowns: Vec<Vec<f64>> =
+        touchdowns.iter().map(|p| sandslope_io::mocap::load_touchdowns(p)).collect::<Result<_>>()?;
     let recordings: Vec<Recording> =
         captures.iter().enumerate().map(|(i, c)| c.recording(touchdowns.get(i).map(Vec::as_slice))).collect();
     let result = track(&recordings, options, slope).map_err(|e| match e {

@@ -351,7 +351,7 @@ fn counts_without_factor() {
     let out = sandslope().arg("fit").arg(dir.path().join("manifest.toml")).output().unwrap();
     assert_eq!(out.status.code(), Some(2));
     let e = String::from_utf8_lossy(&out.stderr);
-    assert!(e.contains("force_counts needs --counts-per-newton"), "{e}");
+    assert!(e.contains("force_counts needs the load cell's counts per newton, from your calibration (--counts-per-newton; counts_per_newton= in Python)"), "{e}");
 }
 
 #[test]

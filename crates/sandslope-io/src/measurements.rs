@@ -258,7 +258,7 @@ pub fn read_recording_with(path: &Path, kind: Kind, options: ReadOptions) -> Res
     };
     let expected = format!(
         "{position_name}_m, {position_name}_mm or {position_name}_cm, and force_n (or force_counts with \
-         --counts-per-newton), optionally time_s"
+         a counts-per-newton factor), optionally time_s"
     );
     if text.trim().is_empty() {
         bail!("{here}: empty file (expected a header line with {expected}, then one row per sample)");
@@ -302,8 +302,8 @@ pub fn read_recording_with(path: &Path, kind: Kind, options: ReadOptions) -> Res
         (None, Some(i)) => match counts_per_newton {
             Some(c) => (i, 1.0 / c),
             None => bail!(
-                "{here}: line {header_line}, column {}: force_counts needs --counts-per-newton (load-cell counts per \
-                 newton, from your calibration)",
+                "{here}: line {header_line}, column {}: force_counts needs the load cell's counts per newton, from \
+                 your calibration (--counts-per-newton; counts_per_newton= in Python)",
                 i + 1
             ),
         },

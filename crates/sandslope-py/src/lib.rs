@@ -47,10 +47,12 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plan::risk_raster, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan::read_raster, m)?)?;
+    m.add_function(wrap_pyfunction!(measure::read_touchdowns, m)?)?;
     m.add_function(wrap_pyfunction!(measure::fit, m)?)?;
     m.add_function(wrap_pyfunction!(measure::track, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;
+    m.add("CAUSES", sandslope::Cause::ALL.map(sandslope::Cause::name))?;
     Ok(())
 }

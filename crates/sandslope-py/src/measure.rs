@@ -85,6 +85,13 @@ pub fn fit<'py>(
 }
 
 /// Motion-capture recordings at one slope (`sandslope track FILES --json`).
+/// A touchdowns file (one time in seconds per line, `#` comments), as `track --touchdowns`
+/// reads it.
+#[pyfunction]
+pub fn read_touchdowns(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Vec<f64>> {
+    py.detach(|| sandslope_io::mocap::load_touchdowns(&path)).map_err(crate::anyhow_error)
+}
+
 #[pyfunction]
 #[pyo3(signature = (paths, slope_deg=None, robot=None, format=None, body=None, upslope=None, max_gap=sandslope::gait::DEFAULT_MAX_GAP, cutoff_hz=sandslope::gait::DEFAULT_CUTOFF_HZ, leg_speed_rad_s=None, touchdowns=None))]
 #[allow(clippy::too_many_arguments)]

@@ -33,3 +33,36 @@ def test_complex_numbers_are_refused_not_truncated():
         sandslope.predict("paper-hexapod", np.array([10 + 1j]), terrain="glass-beads-300um")
     with pytest.raises(ValueError, match=r"dem must be real numbers"):
         sandslope.risk_raster(np.ones((4, 4), dtype=complex), 1.0, robot="paper-hexapod", terrain="glass-beads-300um")
+
+
+def test_python_speaks_python(cli, tmp_path):
+    """Issue 28 item 9: touchdowns from a file as the CLI reads them; CAUSES from the library;
+    the CLI's extrapolation warning; a clean dir(); errors naming Python arguments."""
+    import os
+    import warnings
+
+    root = os.path.join(os.path.dirname(__file__), "..", "..", "..")
+    capture = os.path.join(root, "examples", "tracking", "slope20-vicon.csv")
+    log = os.path.join(root, "examples", "tracking", "slope20-touchdowns.txt")
+    from_file = sandslope.track([capture], touchdowns=[log])
+    want = cli.json("track", capture, "--touchdowns", log)
+    assert from_file["t1_s"] == pytest.approx(want["t1_s"], rel=1e-12)
+    with pytest.raises(ValueError, match="touchdowns must hold, per recording, a list of times"):
+        sandslope.track([capture], touchdowns=[[0.2, "x"]])
+    assert sandslope.CAUSES[-1] == "robust_step" and len(sandslope.CAUSES) == 6
+    assert not {"np", "os", "Any", "Dict"} & set(dir(sandslope))
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        sandslope.predict("paper-hexapod", [10, 30], terrain="glass-beads-300um")
+    assert any("30 deg are above the terrain's last measured point (24 deg)" in str(x.message) for x in w)
+    manifest = tmp_path / "m.toml"
+    trial = tmp_path / "t.csv"
+    trial.write_text("depth_mm,force_counts\n0,0\n1,10\n2,20\n")
+    (tmp_path / "s.csv").write_text("displacement_mm,force_n\n0,0\n1,1\n2,2\n")
+    manifest.write_text(
+        '[penetration]\ndisk_radius_m = 0.01\n[shear]\nplate_width_m = 0.03\nplate_depth_m = 0.02\n'
+        '[[trial]]\nkind = "penetration"\nslope_deg = 0\nfile = "t.csv"\n'
+        '[[trial]]\nkind = "shear"\nslope_deg = 0\nfile = "s.csv"\n'
+    )
+    with pytest.raises(ValueError, match="counts_per_newton= in Python"):
+        sandslope.fit(str(manifest))

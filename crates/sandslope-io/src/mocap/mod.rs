@@ -204,3 +204,23 @@ pub fn read(path: &Path, format: Option<MocapFormat>, body: Option<&str>) -> Res
     };
     Ok(Capture { path: path.to_path_buf(), format, body, frame_rate_hz, start_time_s, positions })
 }
+/// Reads a touchdowns file: one time in seconds per line; blank lines and `#` comments skipped.
+pub fn load_touchdowns(path: &Path) -> Result<Vec<f64>> {
+    let text = crate::files::read_text(path)?;
+    let mut times = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let t = line.parse::<f64>().ok().filter(|t| t.is_finite()).ok_or_else(|| {
+            anyhow!("{}: line {}: `{line}` is not a time in seconds", path.display(), i + 1)
+        })?;
+        times.push(t);
+    }
+    if times.is_empty() {
+        bail!("{}: no touchdown times (expected one time in seconds per line)", path.display());
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(times)
+}

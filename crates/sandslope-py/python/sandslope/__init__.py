@@ -27,6 +27,7 @@ Heavy calls release the GIL and run in parallel on all cores.
 from __future__ import annotations
 
 import os
+import warnings as _warnings
 from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -51,23 +52,23 @@ __all__ = [
     "read_raster",
     "fit",
     "track",
+    "simulate",
     "report",
 ]
+
+
+def __dir__() -> Sequence[str]:
+    """The public names only (PEP 562): not the modules and typing names this file imports."""
+    return sorted(__all__ + ["__version__"])
 
 __version__ = "0.1.0"
 
 #: Regime names; every ``regime`` array holds int8 indices into this tuple.
 REGIMES: Tuple[str, str, str, str] = tuple(_sandslope.REGIMES)  # type: ignore[assignment]
 
-#: Finer reasons for a regime; ``predict(...)["cause"]`` holds int8 indices into this tuple.
-CAUSES: Tuple[str, ...] = (
-    "normal_sinkage",
-    "at_or_above_repose",
-    "no_anchoring",
-    "net_backward_step",
-    "short_step",
-    "robust_step",
-)
+#: Finer reasons for a regime; ``predict(...)["cause"]`` holds int8 indices into this tuple
+#: (the library's ``Cause::ALL``, so the two cannot drift).
+CAUSES: Tuple[str, ...] = tuple(_sandslope.CAUSES)
 
 RobotLike = Union[Robot, str, "os.PathLike[str]"]
 TerrainLike = Union[Terrain, str, "os.PathLike[str]"]
@@ -203,7 +204,27 @@ def predict(
         terrain=terrain,
         mass_kg=flat.get("mass_kg"),
     )
+    if terrain is not None and (k_n is None or k_s is None):
+        _warn_extrapolated(terrain, flat["slope_deg"])
     return {k: v.reshape(shape) for k, v in out.items()}
+
+
+def _warn_extrapolated(terrain: Terrain, slopes: np.ndarray) -> None:
+    """The CLI's warning when slopes lie above the terrain's last measured point (docs/model.md §7)."""
+    points = terrain.to_dict()["points"]
+    if not points:
+        return
+    last = max(p["slope_deg"] for p in points)
+    beyond = np.unique(np.abs(slopes[np.isfinite(slopes)]))
+    beyond = beyond[beyond > last]
+    if beyond.size:
+        shown = ", ".join(f"{v:g}" for v in beyond[:6]) + (f" ... ({beyond.size} slopes)" if beyond.size > 6 else "")
+        _warnings.warn(
+            f"slope(s) {shown} deg are above the terrain's last measured point ({last:g} deg); k_n and k_s are "
+            "extrapolated linearly and floored at zero (docs/model.md §7)",
+            UserWarning,
+            stacklevel=3,
+        )
 
 
 def _axis(name: str, x: Any) -> np.ndarray:
@@ -554,7 +575,7 @@ def track(
     max_gap: int = 10,
     cutoff_hz: float = 10.0,
     leg_speed_rad_s: Optional[float] = None,
-    touchdowns: Optional[Sequence[Sequence[float]]] = None,
+    touchdowns: Optional[Sequence[Any]] = None,
 ) -> Dict[str, Any]:
     """Speed, anchoring time and slip from motion capture (``sandslope track``, docs/model.md §11).
 
@@ -563,7 +584,8 @@ def track(
     picks the rigid body or marker). Gaps up to ``max_gap`` frames are filled, longer ones split
     the recording; positions are differentiated with a zero-phase Butterworth low-pass at
     ``cutoff_hz``; touchdowns every T/2 (T = 2 pi / leg speed, from the robot or
-    ``leg_speed_rad_s``) come from ``touchdowns`` (one list of times per recording, s) or are
+    ``leg_speed_rad_s``) come from ``touchdowns`` (per recording, a list of times in s or the
+    path of a touchdowns file, as ``track --touchdowns`` reads) or are
     estimated from the speed signal. ``upslope`` (x, y, z) fixes the upslope direction
     (estimated from the travel otherwise).
 
@@ -583,11 +605,24 @@ def track(
         max_gap=int(max_gap),
         cutoff_hz=float(cutoff_hz),
         leg_speed_rad_s=None if leg_speed_rad_s is None else float(leg_speed_rad_s),
-        touchdowns=None if touchdowns is None else [[float(t) for t in ts] for ts in touchdowns],
+        touchdowns=None if touchdowns is None else [_touchdown_times(ts) for ts in touchdowns],
     )
     out["recordings"] = _frame(out["recordings"])
     out["per_step"] = _frame(out["per_step"])
     return out
+
+
+def _touchdown_times(ts: Any) -> list:
+    """One recording's touchdowns: a file (as the CLI's --touchdowns) or a sequence of times."""
+    if isinstance(ts, (str, os.PathLike)):
+        return _sandslope.read_touchdowns(os.fspath(ts))
+    try:
+        return [float(t) for t in ts]
+    except (TypeError, ValueError):
+        raise ValueError(
+            "touchdowns must hold, per recording, a list of times in seconds or a touchdowns file path, "
+            f"not {ts!r}"
+        ) from None
 
 
 _PathLike = Union[str, "os.PathLike[str]"]

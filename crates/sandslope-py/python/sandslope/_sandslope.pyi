@@ -11,6 +11,7 @@ _Path = Union[str, "os.PathLike[str]"]
 _F64 = npt.NDArray[np.float64]
 
 REGIMES: Tuple[str, str, str, str]
+CAUSES: Tuple[str, ...]
 
 class Robot:
     """A legged robot (docs/model.md §2), validated when built.
@@ -184,3 +185,5 @@ def simulate(
     yield_m: Optional[float] = None,
     sample_rate_hz: float = 120.0,
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
+
+def read_touchdowns(path: _Path) -> List[float]: ...

@@ -700,11 +700,9 @@ mod hostile {
         );
     }
 
-    /// An ASCII tag (GDAL_NODATA) claiming 4 GiB in a 1 KB file: the decoder's limit does not
-    /// cover ASCII values, so the directory is checked first (found by scripts/fuzz.sh).
-    #[test]
-    fn an_ascii_tag_claiming_gigabytes_is_refused_before_the_decoder_reads_it() {
-        let bytes = tiff_with(&[
+    /// The entries of an uncompressed 10 x 10 float32 image, and `extra`.
+    fn small_float_image_with(extra: (u16, u16, u32, u32)) -> Vec<(u16, u16, u32, u32)> {
+        vec![
             (256, LONG, 1, 10),
             (257, LONG, 1, 10),
             (258, SHORT, 1, 32),
@@ -714,8 +712,15 @@ mod hostile {
             (278, LONG, 1, 10),
             (279, LONG, 1, 400),
             (339, SHORT, 1, 3),
-            (42113, 2, 0xFFFF_0000, 300), // GDAL_NODATA, ASCII
-        ]);
+            extra,
+        ]
+    }
+
+    /// An ASCII tag (GDAL_NODATA) claiming 4 GiB in a 1 KB file: the decoder's limit does not
+    /// cover ASCII values, so the directory is checked first (found by scripts/fuzz.sh).
+    #[test]
+    fn an_ascii_tag_claiming_gigabytes_is_refused_before_the_decoder_reads_it() {
+        let bytes = tiff_with(&small_float_image_with((42113, 2, 0xFFFF_0000, 300))); // GDAL_NODATA, ASCII
         let err = read_bytes("nodata.tif", &bytes);
         assert!(err.contains("nodata.tif: tag GdalNodata (42113) claims 4294901760 bytes"), "{err}");
         let bytes = tiff_with(&[(256, LONG, 1, 10), (34737, 2, 5000, 300)]);
@@ -748,18 +753,8 @@ mod hostile {
 
     #[test]
     fn a_tag_whose_count_claims_gigabytes_is_refused() {
-        let bytes = tiff_with(&[
-            (256, LONG, 1, 10),
-            (257, LONG, 1, 10),
-            (258, SHORT, 1, 32),
-            (259, SHORT, 1, 1),
-            (262, SHORT, 1, 1),
-            (273, LONG, 1, 200),
-            (278, LONG, 1, 10),
-            (279, LONG, 1, 400),
-            (339, SHORT, 1, 3),
-            (33550, DOUBLE, 0x1000_0000, 300), // ModelPixelScale: 2^28 doubles = 2 GiB
-        ]);
+        // ModelPixelScale: 2^28 doubles = 2 GiB.
+        let bytes = tiff_with(&small_float_image_with((33550, DOUBLE, 0x1000_0000, 300)));
         let err = read_bytes("tag.tif", &bytes);
         assert!(err.contains("tag.tif") && err.contains("ModelPixelScale") && err.contains("limit"), "{err}");
     }

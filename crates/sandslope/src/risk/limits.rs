@@ -231,8 +231,7 @@ pub fn max_safe_mass(
 ) -> Result<SafeLimit, ParamError> {
     let max_risk = check_risk(max_risk)?;
     let m0 = robot.mass();
-    let n = (MAX_MASS_FACTOR.ln() / MASS_SCAN_FACTOR.ln()).ceil() as i32;
-    let scan: Vec<f64> = (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).collect();
+    let scan = mass_scan(m0);
     let (ground, u) = terrain.at(slope);
     // Each decision by the fast p_fail (a closed form over the anchoring boundary, about a
     // hundred times cheaper than the reference quadrature, issue 26), as the safe-slope search
@@ -245,6 +244,13 @@ pub fn max_safe_mass(
     };
     let p = |m: f64| robot.with_mass(m).map_or(1.0, |r| regime_probabilities(&r, slope, &ground, u).p_fail());
     Ok(first_crossing(&decide, &p, &scan, 1e-5 * m0, 1))
+}
+
+/// The masses [`max_safe_mass`] scans from the robot's own `m0`: growing by
+/// [`MASS_SCAN_FACTOR`] up to [`MAX_MASS_FACTOR`] times `m0`.
+fn mass_scan(m0: f64) -> Vec<f64> {
+    let n = (MAX_MASS_FACTOR.ln() / MASS_SCAN_FACTOR.ln()).ceil() as i32;
+    (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).collect()
 }
 
 /// The heaviest safe mass at one slope of a [`PayloadEnvelope`].
@@ -517,8 +523,7 @@ mod tests {
             let fast = max_safe_mass(&r, s, &t, 0.05).unwrap();
             let (ground, u) = t.at(s);
             let m0 = r.mass();
-            let n = (MAX_MASS_FACTOR.ln() / MASS_SCAN_FACTOR.ln()).ceil() as i32;
-            let scan: Vec<f64> = (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).collect();
+            let scan = mass_scan(m0);
             let p = |m: f64| r.with_mass(m).map_or(1.0, |r| regime_probabilities(&r, s, &ground, u).p_fail());
             let reference = reference_crossing(&p, &scan, 0.05, 1e-5 * m0);
             match (fast, reference) {

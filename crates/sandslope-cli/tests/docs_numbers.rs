@@ -1,4 +1,4 @@
-//! Every number docs/calibration.md and docs/phase-and-risk.md quote about the built-in terrain
+//! Every number docs/calibration.md, docs/phase-and-risk.md and docs/model.md §3 quote about the built-in terrain
 //! and the report is regenerated here from the commands that produce it, formatted as the docs
 //! print it, and looked up in the docs: a number that drifts (a changed fit, a changed model)
 //! fails this test instead of silently going stale. When it fails, rerun the command the
@@ -180,4 +180,32 @@ fn phase_and_risk_md_extrapolation_numbers_are_what_report_gives() {
     assert_in("phase-and-risk.md", &text, &format!("{:.1} cm/s or more", v24 * 100.0), how);
     let within = (v24 - 0.056) / 0.016;
     assert_in("phase-and-risk.md", &text, &format!("within {within:.2} SD"), how);
+}
+
+/// docs/model.md §3: the effect of `--level-step level` on the built-in robot and terrain's
+/// speed at 0, 10, 15, 20 and 24 degrees, as the doc prints it.
+#[test]
+fn model_md_level_step_effect_is_what_predict_gives() {
+    let text = doc("model.md");
+    let speed = |slope: &str, rule: &str| {
+        let run = sandslope()
+            .args(["predict", "--slope", slope, "--level-step", rule, "--json"])
+            .assert()
+            .success();
+        let v: serde_json::Value = serde_json::from_slice(&run.get_output().stdout).unwrap();
+        f(&v["speed_m_s"])
+    };
+    let rise: Vec<String> = ["0", "10", "15", "20", "24"]
+        .iter()
+        .map(|s| {
+            let p = 100.0 * (speed(s, "level") / speed(s, "slope") - 1.0);
+            if p.abs() < 0.005 {
+                "0".to_string()
+            } else {
+                format!("{p:.2}")
+            }
+        })
+        .collect();
+    let expected = format!("{}, {}, {}, {} and {}%", rise[0], rise[1], rise[2], rise[3], rise[4]);
+    assert_in("model.md", &text, &expected, "sandslope predict --slope S --level-step level|slope --json");
 }

@@ -1,0 +1,206 @@
+//! Every `sandslope` command the README, docs/*.md and examples/*/README.md show, run as written
+//! (issue 28): each fenced block's commands go to `sh` unchanged, with this build's `sandslope`
+//! first on PATH. Each document runs in a fresh scratch folder holding copies of `data/`,
+//! `examples/` and the GDAL fixtures, its blocks in order (a later block may use what an earlier
+//! one wrote), plus the files a reader of the README has made by then and other docs use:
+//! `my-robot.toml` and `my-sand.toml`, made by the README's own commands.
+//!
+//! A doc command that fails, or that names a file no step makes, fails this test with the
+//! command (`sh -x`) and its stderr. What is not run is listed in `SKIPPED` with the reason, and
+//! each entry must still match a command in the docs (no stale exceptions).
+//!
+//! The README's placeholders for a reader's own recordings (`runs/10deg-*.csv`,
+//! `runs/15deg-a.csv`, ...) are made from the example recordings and from `sandslope simulate
+//! --out`, the only inputs this test provides that the docs do not.
+
+mod common;
+
+use std::path::Path;
+use std::time::Duration;
+
+use common::repo_file;
+
+/// Commands that are not run, by their first words, and why.
+const SKIPPED: &[(&str, &str)] = &[
+    ("sandslope serve", "runs until stopped (and --open starts a browser); tests/serve.rs covers it"),
+    ("cargo run", "the same `report --out report/` the README shows as `sandslope report` below it"),
+    ("bash scripts/test.sh", "the whole test suite, this test included"),
+    ("pip install", "installs the Python package; scripts/test.sh does"),
+    ("python -c", "Python: crates/sandslope-py/tests/test_docs_examples.py runs it"),
+    ("python3 bench/", "a benchmark against NumPy, minutes long; run by hand"),
+    ("curl ", "needs a running `sandslope serve`; tests/serve.rs calls every endpoint"),
+];
+
+/// One fenced code block: where it is, its language tag and its text.
+struct Block {
+    file: String,
+    line: usize,
+    lang: String,
+    body: String,
+}
+
+fn blocks(rel: &str) -> Vec<Block> {
+    let text = std::fs::read_to_string(repo_file(rel)).unwrap();
+    let mut out = Vec::new();
+    let mut open: Option<Block> = None;
+    for (i, line) in text.lines().enumerate() {
+        if let Some(rest) = line.strip_prefix("```") {
+            match open.take() {
+                Some(b) => out.push(b),
+                None => {
+                    open = Some(Block {
+                        file: rel.into(),
+                        line: i + 1,
+                        lang: rest.trim().into(),
+                        body: String::new(),
+                    })
+                }
+            }
+        } else if let Some(b) = open.as_mut() {
+            b.body.push_str(line);
+            b.body.push('\n');
+        }
+    }
+    assert!(open.is_none(), "{rel}: a code block is not closed");
+    out
+}
+
+/// The logical command lines of a block (continuation lines joined), without comments, in the
+/// order shown. `sh` blocks are scripts; in `console` blocks only lines starting with `$ ` are
+/// commands (the rest is their output); other blocks (`text`, `toml`, ...) have none. An
+/// untagged block is refused: it would be ambiguous.
+fn commands(b: &Block) -> Vec<String> {
+    assert!(!b.lang.is_empty(), "{}:{}: tag the code block (sh, console, text, ...)", b.file, b.line);
+    let script = matches!(b.lang.as_str(), "sh" | "bash");
+    if !script && b.lang != "console" {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    let mut lines = b.body.lines();
+    while let Some(line) = lines.next() {
+        let line = line.trim_end();
+        let cmd = if script {
+            line.trim_start()
+        } else if let Some(c) = line.strip_prefix("$ ") {
+            c
+        } else {
+            continue;
+        };
+        if cmd.is_empty() || cmd.starts_with('#') {
+            continue;
+        }
+        let mut full = cmd.to_string();
+        while full.ends_with('\\') {
+            full.pop();
+            match lines.next() {
+                Some(next) => full.push_str(next.trim_end()),
+                None => break,
+            }
+        }
+        out.push(full);
+    }
+    out
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let dest = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_dir(&entry.path(), &dest);
+        } else {
+            std::fs::copy(entry.path(), dest).unwrap();
+        }
+    }
+}
+
+/// Runs `script` with `sh -ex` in `dir`, this build's `sandslope` first on PATH; panics with
+/// `what`, the trace and stderr if it fails or takes more than two minutes.
+fn run(dir: &Path, script: &str, what: &str) {
+    let bin = Path::new(env!("CARGO_BIN_EXE_sandslope"));
+    let path = format!("{}:{}", bin.parent().unwrap().display(), std::env::var("PATH").unwrap_or_default());
+    let out = assert_cmd::Command::new("sh")
+        .args(["-exc", script])
+        .current_dir(dir)
+        .env("PATH", path)
+        .timeout(Duration::from_secs(120))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{what} failed ({}):\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn every_command_in_the_readme_and_docs_runs_as_written() {
+    let mut files = vec!["README.md".to_string()];
+    for folder in ["docs", "examples"] {
+        let mut more: Vec<String> = std::fs::read_dir(repo_file(folder))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .flat_map(|p| if p.is_dir() { vec![p.join("README.md")] } else { vec![p] })
+            .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "md"))
+            .map(|p| format!("{folder}/{}", p.strip_prefix(repo_file(folder)).unwrap().display()))
+            .collect();
+        more.sort();
+        files.extend(more);
+    }
+
+    let template = tempfile::tempdir().unwrap();
+    let seed = template.path();
+    copy_dir(&repo_file("data"), &seed.join("data"));
+    copy_dir(&repo_file("examples"), &seed.join("examples"));
+    copy_dir(
+        &repo_file("crates/sandslope-io/tests/fixtures/gdal"),
+        &seed.join("crates/sandslope-io/tests/fixtures/gdal"),
+    );
+    std::fs::create_dir_all(seed.join("docs/figures")).unwrap();
+    run(
+        seed,
+        // The README's commands that make the reader's robot and terrain files.
+        "sandslope presets show paper-hexapod > my-robot.toml
+         sandslope fit examples/measurements/manifest.toml --counts-per-newton 2000 --out my-sand.toml
+         # the README's stand-ins for a reader's own recordings
+         mkdir -p runs
+         cp examples/tracking/slope10-motive123.csv runs/10deg-a.csv
+         cp examples/tracking/slope20-motive125.csv runs/20deg-a.csv
+         cp examples/tracking/slope20-vicon.csv runs/20deg-b.csv
+         sandslope simulate --slope 15 --out runs/15deg-a.csv
+         sandslope simulate --slope 15 --duration 8 --out runs/15deg-b.csv",
+        "making the reader's files",
+    );
+
+    let mut ran = 0;
+    let mut skips_used = vec![false; SKIPPED.len()];
+    for file in &files {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path();
+        copy_dir(seed, root);
+        for b in blocks(file) {
+            let mut script = Vec::new();
+            for cmd in commands(&b) {
+                if let Some(i) = SKIPPED.iter().position(|(start, _)| cmd.starts_with(start)) {
+                    skips_used[i] = true;
+                    continue;
+                }
+                if cmd.starts_with("sandslope ") {
+                    ran += 1;
+                }
+                script.push(cmd);
+            }
+            if script.iter().any(|c| c.starts_with("sandslope ")) {
+                run(root, &script.join("\n"), &format!("the block at {}:{}", b.file, b.line));
+            }
+        }
+    }
+    eprintln!("{ran} sandslope commands from {} documents ran as written", files.len());
+    // Guards against a parser that finds nothing: the docs show more than 50 commands.
+    assert!(ran >= 50, "only {ran} sandslope commands found in {files:?}");
+    for ((start, why), used) in SKIPPED.iter().zip(skips_used) {
+        assert!(used, "SKIPPED lists `{start}` ({why}) but no doc shows such a command any more");
+    }
+}

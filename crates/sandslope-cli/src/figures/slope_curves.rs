@@ -20,6 +20,28 @@ pub fn swatch_gap(dashed: bool) -> (i32, i32) {
     }
 }
 
+/// The ruled-out values within `range` widened by half its span on each side: a value beyond
+/// is cut to that edge where the line leaves (so the line runs off the chart) and dropped
+/// after that, until the line comes back.
+fn ruled_out_within(values: &[(f64, Option<f64>)], range: (f64, f64)) -> Vec<(f64, Option<f64>)> {
+    let half = (range.1 - range.0) / 2.0;
+    let (lo, hi) = (range.0 - half, range.1 + half);
+    let mut inside_before = false;
+    values
+        .iter()
+        .map(|&(x, v)| {
+            let Some(v) = v else {
+                inside_before = false;
+                return (x, None);
+            };
+            let inside = (lo..=hi).contains(&v);
+            let kept = (inside || inside_before).then(|| v.clamp(lo, hi));
+            inside_before = inside;
+            (x, kept)
+        })
+        .collect()
+}
+
 /// A quantity against slope.
 pub struct SlopeCurveFigure {
     /// Caption.
@@ -57,17 +79,21 @@ impl Figure for SlopeCurveFigure {
         DB::ErrorType: 'static,
     {
         let xs = self.model.iter().map(|m| m.0).chain(self.observed.iter().map(|o| o.0));
-        let ruled_out = self.ruled_out.iter().filter_map(|m| m.1);
         let x_range = super::range(xs, (0.0, 30.0));
         let ys = self
             .model
             .iter()
             .filter_map(|m| m.1)
-            .chain(ruled_out)
             .chain(self.observed.iter().flat_map(|o| [o.1 - o.2, o.1 + o.2]))
             .chain(self.reference.as_ref().map(|r| r.0))
             .chain(self.from_zero.then_some(0.0));
         let y_range = super::range(ys, (0.0, 1.0));
+        // The ruled-out part widens the axis by at most half the span of the rest: a badly
+        // calibrated model's -70 cm/s "speed" near repose would otherwise squash the data into
+        // a strip. Beyond that the dashed line runs off the edge.
+        let ruled_out = ruled_out_within(&self.ruled_out, y_range);
+        let y_range =
+            ruled_out.iter().filter_map(|m| m.1).fold(y_range, |(lo, hi), v| (lo.min(v), hi.max(v)));
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, font(20.0))
             .margin(12)
@@ -99,7 +125,7 @@ impl Figure for SlopeCurveFigure {
         draw_pieces(&mut chart, &self.model, red.stroke_width(3), false, label)?;
         draw_pieces(
             &mut chart,
-            &self.ruled_out,
+            &ruled_out,
             red.mix(0.6).stroke_width(2),
             true,
             Some("model where the regime rules it out"),
@@ -169,4 +195,22 @@ where
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ruled_out_within;
+
+    #[test]
+    fn ruled_out_line_is_cut_at_half_a_span_beyond_the_data() {
+        // Data span 0..10: the dashed line may reach -5..15; -70 is cut to -5 where the line
+        // leaves, the next point beyond is dropped, and the line resumes when it is back.
+        let values =
+            [(20.0, Some(2.0)), (21.0, Some(-70.0)), (22.0, Some(-90.0)), (23.0, None), (24.0, Some(-4.0))];
+        let cut = ruled_out_within(&values, (0.0, 10.0));
+        assert_eq!(
+            cut,
+            vec![(20.0, Some(2.0)), (21.0, Some(-5.0)), (22.0, None), (23.0, None), (24.0, Some(-4.0))]
+        );
+    }
 }

@@ -216,6 +216,11 @@ fn a_report_on_the_example_tracks_is_consistent_and_warns() {
     // The tracked t1 (67 and 114 ms) are compared with the model.
     let ds = v["disagreements"].to_string();
     assert!(ds.contains("Your anchoring time at 10°") && ds.contains("Your anchoring time at 20°"), "{ds}");
+    // The inputs table says the k_s was calibrated on these tracks, not on the paper's speeds.
+    let k_s =
+        v["inputs"].as_array().unwrap().iter().find(|i| i["name"] == "terrain: leg k_s(θ)").unwrap().clone();
+    let detail = k_s["provenance"]["detail"].as_str().unwrap();
+    assert!(detail.contains("your observations") && !detail.contains("paper's five speeds"), "{k_s}");
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(html.contains("your observations, the model"), "heading still about the paper");
     assert!(html.contains("<b>Warning:</b>"));

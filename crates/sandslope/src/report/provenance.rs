@@ -109,13 +109,30 @@ fn terrain_rows(e: &Evidence) -> Vec<Input> {
             "your terrain file: sandslope cannot tell which of its values were measured",
         )];
     }
-    vec![
+    // With the user's observations the page's model is calibrated on them, not on the paper's
+    // speeds (one calibration drives the page, issue 28).
+    let k_s = if e.has_own_observations() {
+        let forces = match e.forces {
+            ForceTests::Given { .. } => "your force tests",
+            ForceTests::Paper(_) => "the paper's force-test ratio",
+            ForceTests::None => "the terrain's own k_s shape",
+        };
+        row(
+            "terrain: leg k_s(θ)",
+            format!("{}, recalibrated", e.terrain_source),
+            Tuned,
+            format!("the joint calibration on your observations (below) and {forces} (docs/calibration.md): plate_scale and a model-error floor fitted"),
+        )
+    } else {
         row(
             "terrain: leg k_s(θ)",
             e.terrain_source.clone(),
             Tuned,
             "the joint calibration on the paper's five speeds and its force-test ratio (docs/calibration.md): plate_scale and a model-error floor fitted",
-        ),
+        )
+    };
+    vec![
+        k_s,
         row(
             "terrain: k_n",
             "7 × 10⁵ N/m³ at every slope",

@@ -35,8 +35,9 @@ t2=$(seconds)
 
 # Built in place (pip builds local directories in-tree), so Cargo uses the workspace's
 # target/ and its lock file; the profile is [profile.python-ext] of Cargo.toml.
-echo "== building and installing crates/sandslope-py"
-"$py" -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps \
+echo "== building and installing crates/sandslope-py: Cargo compiles the extension (profile python-ext);"
+echo "   minutes on a cold build, seconds when target/python-ext is warm; pip says when the wheel is built"
+"$py" -m pip install --disable-pip-version-check --no-build-isolation --no-deps \
   --force-reinstall ./crates/sandslope-py
 t3=$(seconds)
 

@@ -154,10 +154,12 @@ fn every_command_in_the_readme_and_docs_runs_as_written() {
     let seed = template.path();
     copy_dir(&repo_file("data"), &seed.join("data"));
     copy_dir(&repo_file("examples"), &seed.join("examples"));
-    copy_dir(
-        &repo_file("crates/sandslope-io/tests/fixtures/gdal"),
-        &seed.join("crates/sandslope-io/tests/fixtures/gdal"),
-    );
+    for fixtures in ["gdal", "pds3"] {
+        copy_dir(
+            &repo_file(&format!("crates/sandslope-io/tests/fixtures/{fixtures}")),
+            &seed.join(format!("crates/sandslope-io/tests/fixtures/{fixtures}")),
+        );
+    }
     std::fs::create_dir_all(seed.join("docs/figures")).unwrap();
     run(
         seed,

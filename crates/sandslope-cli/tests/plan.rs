@@ -516,3 +516,38 @@ fn a_geographic_dem_plans_in_metres_like_its_projected_twin() {
     let length = geo["routes"]["distance"]["length_m"].as_f64().unwrap();
     assert!((length - along).abs() < 0.005 * along, "{length} m vs haversine {along} m");
 }
+
+/// A HiRISE-layout PDS3 DTM (`sandslope-io/tests/fixtures/pds3/make_pds3.py`: equirectangular
+/// on Mars, MAP_SCALE 20 m true at latitude 15, rows at latitude 20) plans like its GeoTIFF
+/// twin written by GDAL with the ground cells worked out in the script (20 cos 20 / cos 15 =
+/// 19.4568 m east, 20 m north): the same route, the same length; and cell (5, 10) of the .IMG
+/// is at x = -88 000 + 5.5 x 20, y = 1 186 000 - 10.5 x 20 in the map's own metres.
+#[test]
+fn a_pds3_dtm_plans_in_ground_metres_like_its_geotiff_twin() {
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/pds3");
+    let run = |dem: &str, start: &[&str]| -> (Value, String) {
+        let out = Command::cargo_bin("sandslope")
+            .unwrap()
+            .args(["plan", "--objective", "distance,time", "--json"])
+            .args(start)
+            .args(["--goal-px", "55,40", "--dem"])
+            .arg(fixtures.join(dem))
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        (json_of(&out.stdout), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (pds, notes) = run("dtm-attached.img", &["--start", "-87890,1185790"]);
+    let (twin, _) = run("pds3-twin.tif", &["--start-px", "5,10"]);
+    assert!(notes.contains("PDS3 equirectangular map on Mars"), "{notes}");
+    for objective in ["distance", "time"] {
+        let (a, b) = (&pds["routes"][objective], &twin["routes"][objective]);
+        assert_eq!(a["found"], true, "{objective}");
+        let (la, lb) = (a["length_m"].as_f64().unwrap(), b["length_m"].as_f64().unwrap());
+        assert!((la - lb).abs() < 1e-6 * lb, "{objective}: {la} vs {lb}");
+    }
+    // At least 50 cells east and 30 north: more than 50 x 19.4568 m, and not 50 x 20 m's worth
+    // of straight diagonal moves mistaken for square 20 m cells.
+    let length = pds["routes"]["distance"]["length_m"].as_f64().unwrap();
+    assert!(length > 50.0 * 19.4568, "{length}");
+}

@@ -4,7 +4,7 @@
 //! the Python package and the report: robot and terrain TOML files and the built-in presets
 //! ([`robot_terrain`], [`presets`]), speed tables ([`speeds`]), anchoring-time tables ([`anchoring`]), load-cell manifests and
 //! recordings ([`measurements`]), motion-capture exports ([`mocap`]), elevation rasters and the
-//! risk-map GeoTIFF ([`raster`]), route GeoJSON and CSV ([`routes`]), NumPy `.npy` arrays of
+//! risk-map GeoTIFF ([`raster`]; PDS3 DTMs in [`pds3`]), route GeoJSON and CSV ([`routes`]), NumPy `.npy` arrays of
 //! phase and risk maps ([`npy`]), fast CSV of large grids ([`grid_csv`]), simulated walks as
 //! motion capture ([`trajectory`]), and atomic file
 //! writing ([`files`]).
@@ -24,6 +24,7 @@ pub mod measurements;
 pub mod mocap;
 pub mod npy;
 pub mod observations;
+pub mod pds3;
 pub mod presets;
 pub mod raster;
 pub mod robot_terrain;

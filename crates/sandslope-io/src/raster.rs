@@ -24,7 +24,7 @@ pub const MAX_RASTER_CELLS: usize = 1 << 29;
 pub const MAX_TIFF_TAG_BYTES: usize = 16 << 20;
 
 /// Refuses a `cols` x `rows` raster with more than [`MAX_RASTER_CELLS`] cells, naming the file.
-fn check_raster_size(name: &dyn std::fmt::Display, cols: u64, rows: u64) -> Result<()> {
+pub(crate) fn check_raster_size(name: &dyn std::fmt::Display, cols: u64, rows: u64) -> Result<()> {
     let cells = cols.saturating_mul(rows);
     if cells > MAX_RASTER_CELLS as u64 {
         bail!(
@@ -172,6 +172,10 @@ pub struct GeoRef {
 }
 
 impl GeoRef {
+    /// A north-up raster's georeferencing with no GeoTIFF keys (a PDS3 map, for instance).
+    pub(crate) fn north_up(west: f64, north: f64, cell_x: f64, cell_y: f64) -> GeoRef {
+        GeoRef { west, north, cell_x, cell_y, geokeys: None, geodoubles: None, geoascii: None }
+    }
     /// Map coordinates of the centre of (col, row).
     pub fn centre(&self, col: usize, row: usize) -> (f64, f64) {
         (self.west + (col as f64 + 0.5) * self.cell_x, self.north - (row as f64 + 0.5) * self.cell_y)
@@ -220,17 +224,23 @@ impl Raster {
     }
 }
 
-/// Reads a GeoTIFF (`.tif`, `.tiff`) or an ESRI ASCII grid (`.asc`), by extension.
+/// Reads a GeoTIFF (`.tif`, `.tiff`), an ESRI ASCII grid (`.asc`) or a PDS3 DTM (`.img` with
+/// its label attached or a `.lbl` beside it, or the `.lbl`; any file beginning with a PDS3
+/// label), by extension or, for other names, by its first bytes.
 pub fn read_raster(path: &Path) -> Result<Raster> {
-    let (mut raster, vertical) =
-        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
-            Some("tif" | "tiff") => read_geotiff(path)?,
-            Some("asc") => read_asc(path)?,
-            _ => bail!(
-                "{}: unknown raster format; use a GeoTIFF (.tif, .tiff) or an ESRI ASCII grid (.asc)",
-                path.display()
-            ),
-        };
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let (mut raster, vertical) = match ext.as_deref() {
+        Some("tif" | "tiff") => read_geotiff(path)?,
+        Some("asc") => read_asc(path)?,
+        // PDS3 rasters carry their own cell size in metres (pds3.rs).
+        Some("img" | "lbl") => return crate::pds3::read_pds3(path),
+        _ if crate::pds3::starts_with_label(path) => return crate::pds3::read_pds3(path),
+        _ => bail!(
+            "{}: unknown raster format; use a GeoTIFF (.tif, .tiff), an ESRI ASCII grid (.asc) or a PDS3 DTM \
+             (.img, .lbl)",
+            path.display()
+        ),
+    };
     if vertical != 1.0 {
         for v in raster.values.iter_mut().filter(|v| v.is_finite()) {
             *v *= vertical;

@@ -239,7 +239,7 @@ pub fn plan<'py>(
 /// `(values, rows, cols, geo)` as returned by [`read_raster`].
 type RasterTuple<'py> = (Bound<'py, numpy::PyArray1<f64>>, usize, usize, Bound<'py, PyDict>);
 
-/// A GeoTIFF or ESRI ASCII raster: `(values, rows, cols, geo)` with the values row-major
+/// A GeoTIFF, ESRI ASCII or PDS3 raster: `(values, rows, cols, geo)` with the values row-major
 /// (nodata as NaN) and `geo = {west, north, cell_x, cell_y}`.
 #[pyfunction]
 pub fn read_raster<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RasterTuple<'py>> {

@@ -510,7 +510,7 @@ def plan(
 
 
 def read_raster(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, Dict[str, float]]:
-    """Reads a GeoTIFF (``.tif``) or ESRI ASCII grid (``.asc``) as the CLI does.
+    """Reads a GeoTIFF (``.tif``), ESRI ASCII grid (``.asc``) or PDS3 DTM (``.img``, ``.lbl``) as the CLI does.
 
     Returns ``(values, geo)``: a float64 array ``(rows, cols)`` with nodata as NaN, and
     ``geo = {"west", "north", "cell_x", "cell_y"}`` (map units). Pass ``values`` and

@@ -912,3 +912,49 @@ mod tests {
         assert!(parse_label("t.lbl", b"A = (((((((((((((((((((((1)))))))))))))))))))))\nEND").is_err());
     }
 }
+
+#[cfg(test)]
+mod mutated {
+    //! Mutated labels and truncated files are refused or read, never a panic or an abort.
+    use super::*;
+
+    #[test]
+    fn mutated_and_truncated_pds3_files_never_panic() {
+        let dir = tempfile::tempdir().unwrap();
+        let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pds3");
+        std::fs::copy(fixtures.join("dtm-detached.img"), dir.path().join("dtm-detached.img")).unwrap();
+        let mut seed = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let tokens: [&[u8]; 8] = [b"=", b"(", b"\"", b"<", b"#", b"-", b"9999999999", b"END"];
+        for (file, label_len) in [("dtm-attached.img", 1680usize), ("dtm-detached.lbl", 682), ("moon-bytes.img", 2048)] {
+            let original = std::fs::read(fixtures.join(file)).unwrap();
+            let path = dir.path().join(file);
+            for _ in 0..300 {
+                let mut bytes = original.clone();
+                match next() % 3 {
+                    0 => bytes.truncate((next() % original.len() as u64) as usize),
+                    1 => {
+                        for _ in 0..1 + next() % 4 {
+                            let at = (next() % label_len as u64) as usize;
+                            bytes[at] = next() as u8;
+                        }
+                    }
+                    _ => {
+                        let at = (next() % label_len as u64) as usize;
+                        let t = tokens[(next() % tokens.len() as u64) as usize];
+                        bytes.splice(at..at, t.iter().copied());
+                    }
+                }
+                std::fs::write(&path, &bytes).unwrap();
+                if let Ok(r) = crate::raster::read_raster(&path) {
+                    assert_eq!(r.values.len(), r.cols * r.rows);
+                }
+            }
+        }
+    }
+}

@@ -551,3 +551,47 @@ fn a_pds3_dtm_plans_in_ground_metres_like_its_geotiff_twin() {
     let length = pds["routes"]["distance"]["length_m"].as_f64().unwrap();
     assert!(length > 50.0 * 19.4568, "{length}");
 }
+
+/// The same hill written by GDAL as ZSTD, BigTIFF (Deflate; LZW with partial edge tiles), a COG
+/// with overviews and a GTiff with COPY_SRC_OVERVIEWS (`make_layouts.py`) plans exactly like
+/// the Deflate GeoTIFF: the same route length for each objective.
+#[test]
+fn every_gdal_layout_of_one_dem_plans_the_same_routes() {
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal");
+    let run = |dem: &str| -> Value {
+        let out = Command::cargo_bin("sandslope")
+            .unwrap()
+            .args([
+                "plan",
+                "--start-px",
+                "5,10",
+                "--goal-px",
+                "55,40",
+                "--objective",
+                "distance,time",
+                "--json",
+            ])
+            .arg("--dem")
+            .arg(fixtures.join(dem))
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{dem}: {}", String::from_utf8_lossy(&out.stderr));
+        json_of(&out.stdout)
+    };
+    let reference = run("geo-wgs84.tif");
+    for dem in [
+        "zstd-pred3-tiled.tif",
+        "bigtiff-deflate-tiled.tif",
+        "bigtiff-lzw-pred3-tiled.tif",
+        "cog-overviews.tif",
+        "gtiff-copy-src-overviews.tif",
+    ] {
+        let got = run(dem);
+        for objective in ["distance", "time"] {
+            let (a, b) = (&got["routes"][objective], &reference["routes"][objective]);
+            assert_eq!(a["found"], true, "{dem} {objective}");
+            assert_eq!(a["length_m"], b["length_m"], "{dem} {objective}");
+            assert_eq!(a["time_s"], b["time_s"], "{dem} {objective}");
+        }
+    }
+}

@@ -931,7 +931,9 @@ mod mutated {
             seed
         };
         let tokens: [&[u8]; 8] = [b"=", b"(", b"\"", b"<", b"#", b"-", b"9999999999", b"END"];
-        for (file, label_len) in [("dtm-attached.img", 1680usize), ("dtm-detached.lbl", 682), ("moon-bytes.img", 2048)] {
+        for (file, label_len) in
+            [("dtm-attached.img", 1680usize), ("dtm-detached.lbl", 682), ("moon-bytes.img", 2048)]
+        {
             let original = std::fs::read(fixtures.join(file)).unwrap();
             let path = dir.path().join(file);
             for _ in 0..300 {

@@ -99,23 +99,77 @@ fn check_tiff_directory(name: &dyn std::fmt::Display, file: &mut File) -> Result
         43 if got >= 16 => true,
         _ => return Ok(()),
     };
-    let ifd = if big { u64_at(&head[8..16]) } else { u32_at(&head[4..8]) };
+    let mut ifd = if big { u64_at(&head[8..16]) } else { u32_at(&head[4..8]) };
     let (count_len, entry_len, inline) = if big { (8u64, 20u64, 8u64) } else { (2, 12, 4) };
-    if ifd.saturating_add(count_len) > file_len {
-        bail!(
-            "{name}: the first image directory (at byte {ifd}) lies past the end of the {file_len}-byte file"
-        );
+    // Every directory (a COG's overviews and masks follow the full image), at most 64.
+    for index in 0..MAX_IFDS {
+        if index > 0 && ifd == 0 {
+            break;
+        }
+        let which = if index == 0 {
+            "the first image directory".to_string()
+        } else {
+            format!("image directory {index}")
+        };
+        if ifd.saturating_add(count_len) > file_len {
+            bail!("{name}: {which} (at byte {ifd}) lies past the end of the {file_len}-byte file");
+        }
+        file.seek(SeekFrom::Start(ifd))?;
+        let mut n = [0u8; 8];
+        file.read_exact(&mut n[..count_len as usize])?;
+        let entries = if big { u64_at(&n) } else { u64::from(u16_at(&n)) };
+        let table = entries.saturating_mul(entry_len);
+        if table > 1 << 20 || ifd + count_len + table > file_len {
+            bail!("{name}: {which} claims {entries} entries, more than the {file_len}-byte file holds");
+        }
+        let mut buf = vec![0u8; table as usize];
+        file.read_exact(&mut buf)?;
+        check_entries(name, &buf, entry_len, inline, file_len, big, little)?;
+        // The next directory's offset follows the entries (absent when the file ends there).
+        let mut next = [0u8; 8];
+        let want = if big { 8 } else { 4 };
+        ifd = match file.read_exact(&mut next[..want]) {
+            Ok(()) => {
+                if big {
+                    u64_at(&next)
+                } else {
+                    u32_at(&next[..4])
+                }
+            }
+            Err(_) => 0,
+        };
     }
-    file.seek(SeekFrom::Start(ifd))?;
-    let mut n = [0u8; 8];
-    file.read_exact(&mut n[..count_len as usize])?;
-    let entries = if big { u64_at(&n) } else { u64::from(u16_at(&n)) };
-    let table = entries.saturating_mul(entry_len);
-    if table > 1 << 20 || ifd + count_len + table > file_len {
-        bail!("{name}: the first image directory claims {entries} entries, more than the {file_len}-byte file holds");
-    }
-    let mut buf = vec![0u8; table as usize];
-    file.read_exact(&mut buf)?;
+    file.seek(SeekFrom::Start(0))?;
+    Ok(())
+}
+
+/// Image directories checked by [`check_tiff_directory`] (a COG has one per overview and mask).
+const MAX_IFDS: usize = 64;
+
+/// Checks one directory's entries (see [`check_tiff_directory`]).
+fn check_entries(
+    name: &dyn std::fmt::Display,
+    buf: &[u8],
+    entry_len: u64,
+    inline: u64,
+    file_len: u64,
+    big: bool,
+    little: bool,
+) -> Result<()> {
+    let u16_at =
+        |b: &[u8]| if little { u16::from_le_bytes([b[0], b[1]]) } else { u16::from_be_bytes([b[0], b[1]]) };
+    let u32_at = |b: &[u8]| {
+        let a = [b[0], b[1], b[2], b[3]];
+        u64::from(if little { u32::from_le_bytes(a) } else { u32::from_be_bytes(a) })
+    };
+    let u64_at = |b: &[u8]| {
+        let a: [u8; 8] = b[..8].try_into().expect("8 bytes");
+        if little {
+            u64::from_le_bytes(a)
+        } else {
+            u64::from_be_bytes(a)
+        }
+    };
     for e in buf.chunks_exact(entry_len as usize) {
         let tag = u16_at(&e[0..2]);
         let size_of = match u16_at(&e[2..4]) {
@@ -136,7 +190,6 @@ fn check_tiff_directory(name: &dyn std::fmt::Display, file: &mut File) -> Result
             bail!("{name}: tag {label} claims {bytes} bytes at byte {offset}, past the end of the {file_len}-byte file");
         }
     }
-    file.seek(SeekFrom::Start(0))?;
     Ok(())
 }
 
@@ -286,6 +339,19 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
     let mut dec = Decoder::new(BufReader::new(file))
         .map_err(|e| anyhow!("{name}: not a readable TIFF: {e}"))?
         .with_limits(tiff_limits());
+    // The full-resolution image: should a file begin with an overview or a mask (NewSubfileType
+    // bit 0, reduced resolution, or bit 2, transparency mask), skip to the first that is neither.
+    // (GDAL's COG and COPY_SRC_OVERVIEWS put the full image first and overviews after it.)
+    loop {
+        let kind: u32 = dec.find_tag_unsigned(Tag::NewSubfileType).ok().flatten().unwrap_or(0);
+        if kind & 0b101 == 0 {
+            break;
+        }
+        if !dec.more_images() {
+            bail!("{name}: every image directory is an overview or a mask (NewSubfileType = {kind}): no full-resolution image");
+        }
+        dec.next_image().map_err(|e| anyhow!("{name}: the image directory after an overview: {e}"))?;
+    }
     let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
     check_raster_size(&name, u64::from(w), u64::from(h))?;
     let bits: u64 = dec.find_tag_unsigned(Tag::BitsPerSample).ok().flatten().unwrap_or(64);
@@ -319,12 +385,22 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
         None => None,
     };
     let (mut west, mut north, cell_x, cell_y) = match (scale, tie, transform) {
+        (_, Some(t), None) if t.len() > 6 => bail!(
+            "{name}: ModelTiepointTag (33922) holds {} tie points: a raster georeferenced by ground control \
+             points is not a regular grid; warp it to one first (gdalwarp -t_srs ...)",
+            t.len() / 6
+        ),
         (Some(s), Some(t), _) if s.len() >= 2 && t.len() >= 6 => {
             (t[3] - t[0] * s[0], t[4] + t[1] * s[1], s[0], s[1])
         }
         (_, _, Some(m)) if m.len() >= 16 => {
             if m[1] != 0.0 || m[4] != 0.0 {
-                bail!("{name}: rotated or sheared rasters (ModelTransformation) are not supported");
+                bail!(
+                    "{name}: ModelTransformationTag (34264) has rotation or shear terms {} (row 1, column 2) and {} \
+                     (row 2, column 1): only north-up rasters are supported; make it north-up first (gdalwarp)",
+                    m[1],
+                    m[4]
+                );
             }
             (m[3], m[7], m[0], -m[5])
         }
@@ -598,6 +674,88 @@ mod tests {
         assert!(utm.notes.is_empty(), "{:?}", utm.notes);
     }
 
+    /// make_crs.py's hill, as make_layouts.py wrote it in every layout: 60 x 48 float32 cells of
+    /// 1 arc-second from (10.0 E, 40.02 N), nodata -32768 at (0, 0); `z(col, row)` in f32.
+    fn hill(col: usize, row: usize) -> f64 {
+        let (c, r) = (col as f64, row as f64);
+        f64::from((12.0 * (-(((c - 30.0) / 14.0).powi(2) + ((r - 24.0) / 11.0).powi(2))).exp()) as f32)
+    }
+
+    fn check_hill(name: &str, decimetres: bool) {
+        let r = fixture(name);
+        assert_eq!((r.cols, r.rows), (60, 48), "{name}");
+        assert_eq!((r.geo.west, r.geo.north), (10.0, 40.02), "{name}");
+        assert!((r.geo.cell_x - 1.0 / 3600.0).abs() < 1e-15 && r.geo.cell_x == r.geo.cell_y, "{name}");
+        assert!(r.is_nodata(0), "{name}: (0, 0) is nodata");
+        for i in 1..r.values.len() {
+            let z = hill(i % 60, i / 60);
+            let want = if decimetres { (10.0 * z).round() } else { z };
+            assert!(
+                (r.values[i] - want).abs() <= 1e-6 * want.abs().max(1.0),
+                "{name} cell {i}: {} vs {want}",
+                r.values[i]
+            );
+        }
+    }
+
+    /// ZSTD (both predictors, tiles with partial edge tiles and strips with a partial last strip)
+    /// and BigTIFF (Deflate, and LZW with partial edge tiles), written by GDAL 3.10.3
+    /// (make_layouts.py, which checks GDAL reads back what it wrote).
+    #[test]
+    fn zstd_and_bigtiff_written_by_gdal_read_to_the_written_heights() {
+        check_hill("zstd-pred3-tiled.tif", false);
+        check_hill("zstd-pred2-i16-strips.tif", true);
+        check_hill("bigtiff-deflate-tiled.tif", false);
+        check_hill("bigtiff-lzw-pred3-tiled.tif", false);
+    }
+
+    /// A cloud-optimised GeoTIFF (GDAL's COG driver) and a GTiff with COPY_SRC_OVERVIEWS carry
+    /// overviews of 30 x 24 and 15 x 12 cells in the same file: the full-resolution image is read.
+    #[test]
+    fn a_cog_reads_its_full_resolution_image_not_an_overview() {
+        check_hill("cog-overviews.tif", false);
+        check_hill("gtiff-copy-src-overviews.tif", false);
+    }
+
+    /// A geotransform with rotation terms (GDAL writes ModelTransformationTag) and a raster
+    /// georeferenced by ground control points only (four tie points) are refused, naming the tag.
+    #[test]
+    fn rotated_and_gcp_georeferenced_rasters_are_refused_naming_the_tag() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal");
+        let err = format!("{:#}", read_raster(&path.join("rotated.tif")).unwrap_err());
+        assert!(err.contains("rotated.tif") && err.contains("ModelTransformationTag (34264)"), "{err}");
+        // The rotation terms GDAL wrote: 0.2 and 0.1 arc-seconds.
+        assert!(err.contains("0.0000555") && err.contains("0.0000277"), "{err}");
+        let err = format!("{:#}", read_raster(&path.join("gcps.tif")).unwrap_err());
+        assert!(
+            err.contains("gcps.tif") && err.contains("ModelTiepointTag (33922) holds 4 tie points"),
+            "{err}"
+        );
+    }
+
+    /// A file whose first directory is a 2 x 2 overview (NewSubfileType 1) and whose second is
+    /// the 4 x 3 image: the image is read, with its own georeferencing.
+    #[test]
+    fn an_overview_written_before_the_full_image_is_skipped() {
+        use tiff::encoder::colortype::Gray32Float;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("overview-first.tif");
+        {
+            let mut enc = TiffEncoder::new(BufWriter::new(File::create(&path).unwrap())).unwrap();
+            let mut small = enc.new_image::<Gray32Float>(2, 2).unwrap();
+            small.encoder().write_tag(Tag::NewSubfileType, 1u32).unwrap();
+            small.write_data(&[9.0f32; 4]).unwrap();
+            let mut full = enc.new_image::<Gray32Float>(4, 3).unwrap();
+            full.encoder().write_tag(Tag::ModelPixelScaleTag, &[2.0, 2.0, 0.0][..]).unwrap();
+            full.encoder().write_tag(Tag::ModelTiepointTag, &[0.0, 0.0, 0.0, 100.0, 200.0, 0.0][..]).unwrap();
+            let data: Vec<f32> = (0..12).map(|i| i as f32).collect();
+            full.write_data(&data).unwrap();
+        }
+        let r = read_raster(&path).unwrap();
+        assert_eq!((r.cols, r.rows, r.geo.west, r.geo.north, r.geo.cell_x), (4, 3, 100.0, 200.0, 2.0));
+        assert_eq!(r.values, (0..12).map(f64::from).collect::<Vec<_>>());
+    }
+
     /// The grid every fixture shares: 40 x 30 cells of 2 m, north-west corner (500000, 4100000).
     fn check_grid(r: &Raster) {
         assert_eq!((r.cols, r.rows), (40, 30));
@@ -736,6 +894,25 @@ mod hostile {
         let bytes = tiff_with(&[(256, LONG, 1, 10), (34737, 2, 5000, 300)]);
         let err = read_bytes("past.tif", &bytes);
         assert!(err.contains("past.tif: tag GeoAsciiParamsTag (34737) claims 5000 bytes at byte 300, past the end of the 1024-byte file"), "{err}");
+    }
+
+    /// The same lie in a second directory (where a COG keeps its overviews) is refused too.
+    #[test]
+    fn a_lying_tag_in_a_later_image_directory_is_refused() {
+        let entries = small_float_image_with((254, LONG, 1, 0)); // NewSubfileType 0
+        let mut bytes = tiff_with(&entries);
+        let next = 8 + 2 + 12 * entries.len();
+        bytes[next..next + 4].copy_from_slice(&600u32.to_le_bytes());
+        let mut ifd1 = 1u16.to_le_bytes().to_vec();
+        for v in [42113u16.to_le_bytes().to_vec(), 2u16.to_le_bytes().to_vec()] {
+            ifd1.extend(v);
+        }
+        ifd1.extend(0xFFFF_0000u32.to_le_bytes());
+        ifd1.extend(300u32.to_le_bytes());
+        ifd1.extend(0u32.to_le_bytes());
+        bytes[600..600 + ifd1.len()].copy_from_slice(&ifd1);
+        let err = read_bytes("second.tif", &bytes);
+        assert!(err.contains("second.tif: tag GdalNodata (42113) claims 4294901760 bytes"), "{err}");
     }
 
     /// Within the cell limit (2^28 cells) but 1 GiB of samples from a 1 KB file: no

@@ -550,6 +550,35 @@ fn a_pds3_dtm_plans_in_ground_metres_like_its_geotiff_twin() {
     // of straight diagonal moves mistaken for square 20 m cells.
     let length = pds["routes"]["distance"]["length_m"].as_f64().unwrap();
     assert!(length > 50.0 * 19.4568, "{length}");
+
+    // The risk map carries the DTM's map: its corner and cell, and the projection as GeoKeys
+    // (GDAL 3.10.3 reads this file as +proj=eqc +lat_ts=15 +lat_0=0 +lon_0=137 +R=3396190, the
+    // CRS its PDS driver gives the .IMG).
+    let dir = tempfile::tempdir().unwrap();
+    let risk = dir.path().join("risk.tif");
+    let out = Command::cargo_bin("sandslope")
+        .unwrap()
+        .args(["plan", "--start-px", "5,10", "--goal-px", "55,40", "--dem"])
+        .arg(fixtures.join("dtm-attached.img"))
+        .arg("--risk-map")
+        .arg(&risk)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut dec = tiff::decoder::Decoder::new(File::open(&risk).unwrap()).unwrap();
+    let tie = dec.get_tag(Tag::ModelTiepointTag).unwrap().into_f64_vec().unwrap();
+    let scale = dec.get_tag(Tag::ModelPixelScaleTag).unwrap().into_f64_vec().unwrap();
+    assert_eq!((tie[3], tie[4], scale[0], scale[1]), (-88_000.0, 1_186_000.0, 20.0, 20.0));
+    let keys = dec.get_tag(Tag::GeoKeyDirectoryTag).unwrap().into_u16_vec().unwrap();
+    let doubles = dec.get_tag(Tag::GeoDoubleParamsTag).unwrap().into_f64_vec().unwrap();
+    let key = |k: u16| keys[4..].chunks_exact(4).find(|e| e[0] == k).map(|e| (e[1], e[3])).unwrap();
+    assert_eq!(key(3075), (0, 17), "CT_Equirectangular");
+    assert_eq!(key(3076), (0, 9001), "metres");
+    let double = |k: u16| doubles[usize::from(key(k).1)];
+    assert_eq!(
+        (double(2057), double(2058), double(3078), double(3088)),
+        (3_396_190.0, 3_396_190.0, 15.0, 137.0)
+    );
 }
 
 /// The same hill written by GDAL as ZSTD, BigTIFF (Deflate; LZW with partial edge tiles), a COG

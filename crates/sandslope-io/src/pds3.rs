@@ -675,7 +675,9 @@ pub fn read_pds3(path: &Path) -> Result<Raster> {
         ));
         (g, g)
     };
-    let geo = GeoRef::north_up(west, north, cell, cell);
+    let clon = label.number(&map("CENTER_LONGITUDE"))?.map_or(0.0, |v| v.0);
+    let (keys, doubles, ascii) = geokeys(&projection, radius_m, clat, clon, &body);
+    let geo = GeoRef::north_up((west, north, cell, cell), keys, doubles, ascii);
     Ok(Raster {
         cols: cols_n,
         rows: rows_n,
@@ -686,6 +688,63 @@ pub fn read_pds3(path: &Path) -> Result<Raster> {
         cell_m,
         notes,
     })
+}
+
+/// GeoTIFF keys (OGC 19-008r4) of the map's projected CRS, user-defined on the body's sphere,
+/// so that a GeoTIFF written over a PDS3 DTM (`plan --risk-map`) carries its projection: the
+/// GeoKeyDirectory, GeoDoubleParams and GeoAsciiParams. Equirectangular is CT_Equirectangular
+/// (17) with the standard parallel CENTER_LATITUDE and latitude of origin 0 (y = R lat); polar
+/// stereographic is CT_PolarStereographic (15) with origin at the pole and scale 1 there.
+fn geokeys(
+    projection: &str,
+    radius_m: f64,
+    clat: f64,
+    clon: f64,
+    body: &str,
+) -> (Vec<u16>, Vec<f64>, String) {
+    const USER: u16 = 32767;
+    const DOUBLES: u16 = 34736;
+    const ASCII: u16 = 34737;
+    let equi = projection == "EQUIRECTANGULAR";
+    let citation = format!("{} {body}|", if equi { "Equirectangular" } else { "Polar Stereographic" });
+    let geog = format!("GCS {body} sphere|");
+    let ascii = format!("{citation}{geog}");
+    let mut doubles = vec![radius_m, radius_m];
+    let mut entries: Vec<[u16; 4]> = vec![
+        [1024, 0, 1, 1], // GTModelTypeGeoKey: projected
+        [1025, 0, 1, 1], // GTRasterTypeGeoKey: PixelIsArea
+        [1026, ASCII, citation.len() as u16, 0],
+        [2048, 0, 1, USER], // GeographicTypeGeoKey
+        [2049, ASCII, geog.len() as u16, citation.len() as u16],
+        [2050, 0, 1, USER],                       // GeogGeodeticDatumGeoKey
+        [2054, 0, 1, 9102],                       // GeogAngularUnitsGeoKey: degree
+        [2056, 0, 1, USER],                       // GeogEllipsoidGeoKey
+        [2057, DOUBLES, 1, 0],                    // GeogSemiMajorAxisGeoKey
+        [2058, DOUBLES, 1, 1],                    // GeogSemiMinorAxisGeoKey
+        [3072, 0, 1, USER],                       // ProjectedCSTypeGeoKey
+        [3074, 0, 1, USER],                       // ProjectionGeoKey
+        [3075, 0, 1, if equi { 17 } else { 15 }], // ProjCoordTransGeoKey
+        [3076, 0, 1, 9001],                       // ProjLinearUnitsGeoKey: metre
+    ];
+    let mut param = |key: u16, v: f64| {
+        entries.push([key, DOUBLES, 1, doubles.len() as u16]);
+        doubles.push(v);
+    };
+    param(3082, 0.0); // ProjFalseEastingGeoKey
+    param(3083, 0.0); // ProjFalseNorthingGeoKey
+    if equi {
+        param(3078, clat); // ProjStdParallel1GeoKey
+        param(3088, clon); // ProjCenterLongGeoKey
+        param(3089, 0.0); // ProjCenterLatGeoKey
+    } else {
+        param(3081, clat); // ProjNatOriginLatGeoKey: the pole
+        param(3092, 1.0); // ProjScaleAtNatOriginGeoKey
+        param(3095, clon); // ProjStraightVertPoleLongGeoKey
+    }
+    entries.sort_by_key(|e| e[0]);
+    let mut dir = vec![1, 1, 0, entries.len() as u16];
+    dir.extend(entries.into_iter().flatten());
+    (dir, doubles, ascii)
 }
 
 /// A sample's bits (as stored, for comparing reals with MISSING_CONSTANT) and value.

@@ -225,9 +225,23 @@ pub struct GeoRef {
 }
 
 impl GeoRef {
-    /// A north-up raster's georeferencing with no GeoTIFF keys (a PDS3 map, for instance).
-    pub(crate) fn north_up(west: f64, north: f64, cell_x: f64, cell_y: f64) -> GeoRef {
-        GeoRef { west, north, cell_x, cell_y, geokeys: None, geodoubles: None, geoascii: None }
+    /// A north-up raster's georeferencing with the GeoTIFF keys that describe its CRS (a PDS3
+    /// map's, for instance), copied to the GeoTIFFs written over it.
+    pub(crate) fn north_up(
+        (west, north, cell_x, cell_y): (f64, f64, f64, f64),
+        geokeys: Vec<u16>,
+        geodoubles: Vec<f64>,
+        geoascii: String,
+    ) -> GeoRef {
+        GeoRef {
+            west,
+            north,
+            cell_x,
+            cell_y,
+            geokeys: Some(geokeys),
+            geodoubles: Some(geodoubles),
+            geoascii: Some(geoascii),
+        }
     }
     /// Map coordinates of the centre of (col, row).
     pub fn centre(&self, col: usize, row: usize) -> (f64, f64) {

@@ -247,7 +247,7 @@ fn parse_value(name: &str, c: &mut Cursor, depth: usize) -> Result<Value> {
         Some(open @ (b'(' | b'{')) => {
             c.bump();
             let close = if open == b'(' { b')' } else { b'}' };
-            let mut items = Vec::new();
+            let mut items: Vec<Item> = Vec::new();
             loop {
                 c.skip_space();
                 match c.peek() {
@@ -256,6 +256,12 @@ fn parse_value(name: &str, c: &mut Cursor, depth: usize) -> Result<Value> {
                     }
                     Some(x) if x == close => {
                         c.bump();
+                        // A unit after the list (`(450, 550) <NM>`) applies to every item.
+                        if let Some(u) = unit(c) {
+                            for i in items.iter_mut().filter(|i| i.unit.is_none()) {
+                                i.unit = Some(u.clone());
+                            }
+                        }
                         return Ok(Value::List(items));
                     }
                     None => bail!("{name}: line {line}: a list opened here is never closed"),
@@ -959,7 +965,7 @@ mod tests {
     fn odl_values_parse_as_the_standard_writes_them() {
         let text =
             b"PDS_VERSION_ID = PDS3\r\n/* a comment */ A = 16#FF7FFFFB#\nB = (\"x.img\",\n 3 <BYTES>)\n\
-            OBJECT = IMAGE\n C = \"two\n lines\" D = -1.5E+02 <M>\nEND_OBJECT\nEND\n";
+            W = (450, 550) <NM>\nOBJECT = IMAGE\n C = \"two\n lines\" D = -1.5E+02 <M>\nEND_OBJECT\nEND\n";
         let l = parse_label("t.lbl", text).unwrap();
         assert_eq!(parse_based("16#FF7FFFFB#"), Some(0xFF7F_FFFB));
         assert_eq!(parse_based("2#101#"), Some(5));
@@ -967,6 +973,7 @@ mod tests {
             matches!(l.get("B"), Some((Value::List(v), 3)) if v.len() == 2 && v[1].unit.as_deref() == Some("BYTES"))
         );
         assert_eq!(l.word("IMAGE.C").unwrap().0, "TWO LINES");
+        assert!(matches!(l.get("W"), Some((Value::List(v), 5)) if v[1].unit.as_deref() == Some("NM")));
         assert_eq!(l.number("IMAGE.D").unwrap(), Some((-150.0, Some("M".into()))));
         assert!(parse_label("t.lbl", b"A = (((((((((((((((((((((1)))))))))))))))))))))\nEND").is_err());
     }

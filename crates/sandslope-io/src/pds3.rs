@@ -427,6 +427,12 @@ fn find_label(path: &Path) -> Result<(PathBuf, Vec<u8>, bool)> {
     } else if !path.is_file() {
         bail!("cannot read {name}: no such file");
     } else {
+        let mut head = [0u8; 15];
+        if File::open(path).and_then(|mut f| f.read_exact(&mut head)).is_ok() && &head == b"EHFA_HEADER_TAG" {
+            bail!(
+                "{name}: an ERDAS IMAGINE .img, not a PDS3 DTM; convert it to a GeoTIFF first (gdal_translate -of GTiff)"
+            );
+        }
         let found = ["lbl", "LBL"].iter().map(|e| path.with_extension(e)).find(|p| p.is_file() && p != path);
         found.ok_or_else(|| {
             anyhow!(
@@ -959,6 +965,12 @@ mod tests {
         assert!(err.contains("line 49: keyword `XND` is not followed by `=`"), "{err}");
         let err = edited("^IMAGE = 8", "^IMAGE = 0");
         assert!(err.contains("^IMAGE = 0"), "{err}");
+        // Another format's .img: ERDAS IMAGINE begins with its own header tag.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("erdas.img");
+        std::fs::write(&path, b"EHFA_HEADER_TAG\0\0\0\0").unwrap();
+        let err = format!("{:#}", crate::raster::read_raster(&path).unwrap_err());
+        assert!(err.contains("erdas.img: an ERDAS IMAGINE .img, not a PDS3 DTM"), "{err}");
     }
 
     #[test]

@@ -191,9 +191,16 @@ fn print_one(sim: &Simulation) {
         format!("{:.2} (reach 2R - h = {:.1})", m.max_depth_m * 1e3, m.d_max_m * 1e3),
         format!("d_n = {}", num(p.normal_depth.map(|v| v * 1e3), 2)),
     ]);
+    t.add_row(["largest pitch deg".into(), format!("{:.1}", m.max_pitch_deg), "0 (no pitch)".to_string()]);
     t.add_row(["regime", m.regime.name(), p.regime.name()]);
     t.add_row(["cause", m.cause.name(), p.cause.name()]);
     println!("{t}");
+    if let Some(at) = m.pitch_over_s {
+        println!(
+            "the body pitched past 90 deg at t = {at:.2} s: the robot tumbled, and the step means above describe \
+             a tumbling body, not a walk (docs/simulate.md)"
+        );
+    }
     if !m.stalled_legs.is_empty() {
         let legs: Vec<String> = m.stalled_legs.iter().map(|l| l.to_string()).collect();
         println!("servo stalled (torque limit bound) on legs {}", legs.join(", "));
@@ -215,6 +222,8 @@ struct SlopeRow {
     slip_m: Option<f64>,
     step_m: f64,
     max_depth_m: f64,
+    max_pitch_deg: f64,
+    pitch_over_s: Option<f64>,
     regime: &'static str,
     cause: &'static str,
     closed_form_speed_m_s: Option<f64>,
@@ -256,6 +265,8 @@ fn run_slopes(
                         slip_m: m.slip_m,
                         step_m: m.step_m,
                         max_depth_m: m.max_depth_m,
+                        max_pitch_deg: m.max_pitch_deg,
+                        pitch_over_s: m.pitch_over_s,
                         regime: m.regime.name(),
                         cause: m.cause.name(),
                         closed_form_speed_m_s: m.closed_form.speed(),

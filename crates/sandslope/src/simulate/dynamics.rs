@@ -38,6 +38,10 @@ pub(crate) struct Run {
     pub geometry: Geometry,
     pub per_step: Vec<StepPeaks>,
     pub stalled_by_step: Vec<Vec<usize>>,
+    /// Largest |pitch| over the walk, rad (full rate).
+    pub max_abs_pitch: f64,
+    /// First time |pitch| exceeded [`super::PITCH_OVER_RAD`], s.
+    pub pitch_over_s: Option<f64>,
 }
 
 /// Per-leg outputs of one force evaluation.
@@ -354,6 +358,8 @@ impl Walker {
         };
         let mut next_sample = 0usize;
         let mut prev = (self.q, self.v, 0.0);
+        let mut max_abs_pitch = self.q[2].abs();
+        let mut pitch_over_s = None;
         x.push(self.q[0]);
         vx.push(self.v[0]);
         // Sample t = 0 from the settled state (legs as the first step will see them).
@@ -362,6 +368,10 @@ impl Walker {
             x.push(self.q[0]);
             vx.push(self.v[0]);
             let t = (i + 1) as f64 * self.dt;
+            max_abs_pitch = max_abs_pitch.max(self.q[2].abs());
+            if pitch_over_s.is_none() && self.q[2].abs() > super::PITCH_OVER_RAD {
+                pitch_over_s = Some(t);
+            }
             let k = ((t - 0.5 * self.dt) / half).floor().max(0.0) as usize;
             if let Some(p) = per_step.get_mut(k) {
                 for j in 0..legs {
@@ -410,7 +420,7 @@ impl Walker {
             body_length_m: self.body_length,
             hip_height_m: self.hip_height,
         };
-        Run { x, vx, trajectory: tr, geometry, per_step, stalled_by_step }
+        Run { x, vx, trajectory: tr, geometry, per_step, stalled_by_step, max_abs_pitch, pitch_over_s }
     }
 
     /// Current state `(x, z, pitch)` and rates (tests).

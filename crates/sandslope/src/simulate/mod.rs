@@ -32,6 +32,9 @@ use crate::slope::Slope;
 pub const DEFAULT_YIELD_M: f64 = 1e-3;
 /// Default output sample rate, Hz (the paper's motion capture).
 pub const DEFAULT_SAMPLE_RATE_HZ: f64 = 120.0;
+/// Pitch beyond which the body has pitched over (tumbled), rad: 90 degrees, the body standing
+/// on its end (docs/model.md §18).
+pub const PITCH_OVER_RAD: f64 = std::f64::consts::FRAC_PI_2;
 /// Default settling time before the gait starts, s (gravity ramps in over it).
 pub const DEFAULT_SETTLE_S: f64 = 0.5;
 /// Longest walk, s.
@@ -141,6 +144,9 @@ pub enum MotionCause {
     RobustStep,
     /// A servo stalled (its torque limit bound) and the walk did not succeed.
     ServoStall,
+    /// The body pitched past 90 degrees: the robot tumbled (docs/model.md §18). The closed
+    /// form has no pitch, so it has no such failure.
+    PitchOver,
 }
 
 impl MotionCause {
@@ -165,6 +171,7 @@ impl MotionCause {
             MotionCause::ShortStep => "short_step",
             MotionCause::RobustStep => "robust_step",
             MotionCause::ServoStall => "servo_stall",
+            MotionCause::PitchOver => "pitch_over",
         }
     }
 }
@@ -277,6 +284,12 @@ pub struct SimSummary {
     pub max_depth_m: f64,
     /// The leg reach `2R - h`, m: deeper means the body sank.
     pub d_max_m: f64,
+    /// Largest |pitch| over the walk, degrees.
+    pub max_pitch_deg: f64,
+    /// When the body first pitched past 90 degrees (it tumbled), s after the gait started;
+    /// `None` if it never did. Steps from then on still count in the means, which then
+    /// describe a tumbling body, not a walk.
+    pub pitch_over_s: Option<f64>,
     /// Regime read from the motion (docs/model.md §18).
     pub regime: Regime,
     /// Why.
@@ -417,7 +430,9 @@ pub fn simulate(
             stall_s: acc.stall_s,
         });
     }
-    let summary = summarise(scenario, slope, &ground, settings, dt, steps, closed_form, &run.stalled_by_step);
+    let pitch = Pitch { max_abs_rad: run.max_abs_pitch, over_s: run.pitch_over_s };
+    let summary =
+        summarise(scenario, slope, &ground, settings, dt, steps, closed_form, &run.stalled_by_step, pitch);
     Ok(Simulation { summary, trajectory: run.trajectory, geometry: run.geometry })
 }
 
@@ -425,6 +440,27 @@ pub fn simulate(
 /// this, m/s (docs/model.md §18; the simulated speed has no noise, but resistive-force
 /// elements entering the sand leave sub-millimetre-per-second ripples).
 pub const SPEED_RISE_M_S: f64 = 3e-4;
+
+/// How far the body pitched over a walk.
+#[derive(Debug, Clone, Copy)]
+struct Pitch {
+    max_abs_rad: f64,
+    over_s: Option<f64>,
+}
+
+/// The cause read from the motion, by docs/model.md §18's precedence: at or above repose, then
+/// a pitch-over, then a stalled servo when the walk did not succeed, then §6's causes.
+fn motion_cause(cause: Cause, pitched_over: bool, stalled: bool) -> MotionCause {
+    if cause == Cause::AtOrAboveRepose {
+        MotionCause::AtOrAboveRepose
+    } else if pitched_over {
+        MotionCause::PitchOver
+    } else if stalled && cause.regime() != Regime::Success {
+        MotionCause::ServoStall
+    } else {
+        MotionCause::from_cause(cause)
+    }
+}
 
 #[allow(clippy::too_many_arguments)]
 fn summarise(
@@ -436,6 +472,7 @@ fn summarise(
     steps: Vec<SimStep>,
     closed_form: SlopeEvaluation,
     stalled_by_step: &[Vec<usize>],
+    pitch: Pitch,
 ) -> SimSummary {
     let robot = scenario.robot();
     let measured: Vec<&SimStep> = steps.iter().filter(|s| !s.warmup).collect();
@@ -464,11 +501,10 @@ fn summarise(
         measured.iter().filter_map(|s| stalled_by_step.get(s.index)).flatten().copied().collect();
     stalled_legs.sort_unstable();
     stalled_legs.dedup();
-    let motion_cause = if !stalled_legs.is_empty() && cause.regime() != Regime::Success {
-        MotionCause::ServoStall
-    } else {
-        MotionCause::from_cause(cause)
-    };
+    let motion_cause = motion_cause(cause, pitch.over_s.is_some(), !stalled_legs.is_empty());
+    // A body that pitched over failed whatever its steps measure: the closed form's regimes
+    // have no tumble, so it is counted with the failures that lose ground (slippage).
+    let regime = if motion_cause == MotionCause::PitchOver { Regime::Slippage } else { cause.regime() };
     SimSummary {
         slope_deg: closed_form.slope_deg,
         k_n: ground.k_n,
@@ -487,7 +523,9 @@ fn summarise(
         unanchored_steps: measured.len() - anchored.len(),
         max_depth_m: max_depth,
         d_max_m: d_max,
-        regime: cause.regime(),
+        max_pitch_deg: pitch.max_abs_rad.to_degrees(),
+        pitch_over_s: pitch.over_s,
+        regime,
         cause: motion_cause,
         stalled_legs,
         steps,

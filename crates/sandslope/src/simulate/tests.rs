@@ -230,3 +230,32 @@ fn builtin_terrain() -> Terrain {
     })
     .unwrap()
 }
+
+/// docs/model.md §18's precedence, by hand: repose first, then a pitch-over (whatever the
+/// steps measured), then a stalled servo only when the walk failed.
+#[test]
+fn pitch_over_outranks_every_cause_but_repose() {
+    assert_eq!(motion_cause(Cause::AtOrAboveRepose, true, true), MotionCause::AtOrAboveRepose);
+    assert_eq!(motion_cause(Cause::RobustStep, true, false), MotionCause::PitchOver);
+    assert_eq!(motion_cause(Cause::NormalSinkage, true, true), MotionCause::PitchOver);
+    assert_eq!(motion_cause(Cause::NetBackwardStep, false, true), MotionCause::ServoStall);
+    assert_eq!(motion_cause(Cause::RobustStep, false, true), MotionCause::RobustStep);
+    assert_eq!(motion_cause(Cause::ShortStep, false, false), MotionCause::ShortStep);
+}
+
+/// The tumble docs/simulate.md reports: on the built-in robot at 20 degrees with k_s(20) of the
+/// built-in terrain (1.51e6 N/m^3), the body rears up about its rear stance leg and passes 90
+/// degrees within the first two seconds, where on level sand it stays within 15 degrees. The
+/// walk is then a failure with cause pitch_over, not the slippage at -50 cm/s its steps alone
+/// would say.
+#[test]
+fn a_body_that_pitches_past_ninety_degrees_is_reported_as_pitched_over() {
+    let settings = SimSettings::new(3.0).unwrap();
+    let level = simulate(&scenario(7e5, 3.26e6), 0.0, &settings).unwrap().summary;
+    assert!(level.pitch_over_s.is_none() && level.max_pitch_deg < 15.0, "{}", level.max_pitch_deg);
+    assert_ne!(level.cause, MotionCause::PitchOver);
+    let steep = simulate(&scenario(7e5, 1.51e6), 20.0, &settings).unwrap().summary;
+    let t = steep.pitch_over_s.expect("pitched over");
+    assert!(t < 2.0 && steep.max_pitch_deg > 90.0, "{t} {}", steep.max_pitch_deg);
+    assert_eq!((steep.cause, steep.regime), (MotionCause::PitchOver, Regime::Slippage));
+}

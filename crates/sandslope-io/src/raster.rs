@@ -372,8 +372,9 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
     let file_bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
     check_claimed_bytes(&name, u64::from(w), u64::from(h), bits, file_bytes)?;
     let samples: u16 = dec.find_tag_unsigned(Tag::SamplesPerPixel).ok().flatten().unwrap_or(1);
+    let sample_format: u16 = dec.find_tag_unsigned(Tag::SampleFormat).ok().flatten().unwrap_or(1);
     if samples != 1 {
-        bail!("{name}: has {samples} bands; an elevation or class raster must have exactly 1");
+        bail!("{name}: has {samples} bands (SamplesPerPixel = {samples}); an elevation or class raster must have exactly 1");
     }
     let tag_f64 = |dec: &mut Decoder<_>, tag: Tag| -> Result<Option<Vec<f64>>> {
         match dec.find_tag(tag).map_err(|e| anyhow!("{name}: tag {tag:?}: {e}"))? {
@@ -398,6 +399,8 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
         }
         None => None,
     };
+    let from_transform =
+        !(scale.as_ref().is_some_and(|s| s.len() >= 2) && tie.as_ref().is_some_and(|t| t.len() >= 6));
     let (mut west, mut north, cell_x, cell_y) = match (scale, tie, transform) {
         (_, Some(t), None) if t.len() > 6 => bail!(
             "{name}: ModelTiepointTag (33922) holds {} tie points: a raster georeferenced by ground control \
@@ -424,7 +427,12 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
         ),
     };
     if !(cell_x.is_finite() && cell_x > 0.0 && cell_y.is_finite() && cell_y > 0.0) {
-        bail!("{name}: pixel scale ({cell_x}, {cell_y}) must be positive (north-up rasters only)");
+        let tag = if from_transform {
+            "ModelTransformationTag (34264): m[0], -m[5]"
+        } else {
+            "ModelPixelScaleTag (33550)"
+        };
+        bail!("{name}: pixel scale ({cell_x}, {cell_y}) from {tag} must be positive (north-up rasters only)");
     }
     if pixel_is_point(geokeys.as_deref()) {
         west -= 0.5 * cell_x;
@@ -451,7 +459,16 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
         DecodingResult::U32(v) => v.into_iter().map(f64::from).collect(),
         DecodingResult::I8(v) => v.into_iter().map(f64::from).collect(),
         DecodingResult::U8(v) => v.into_iter().map(f64::from).collect(),
-        _ => bail!("{name}: unsupported sample type (use float32, float64 or 8/16/32-bit integers)"),
+        other => bail!(
+            "{name}: unsupported sample type (BitsPerSample = {bits}, SampleFormat = {}: {}); use float32, float64 or \
+             8/16/32-bit integers",
+            sample_format,
+            match other {
+                DecodingResult::U64(_) | DecodingResult::I64(_) => "64-bit integers",
+                DecodingResult::F16(_) => "16-bit floats",
+                _ => "another type",
+            }
+        ),
     };
     let (cols, rows) = (w as usize, h as usize);
     if values.len() != cols * rows {
@@ -768,6 +785,44 @@ mod tests {
         let r = read_raster(&path).unwrap();
         assert_eq!((r.cols, r.rows, r.geo.west, r.geo.north, r.geo.cell_x), (4, 3, 100.0, 200.0, 2.0));
         assert_eq!(r.values, (0..12).map(f64::from).collect::<Vec<_>>());
+    }
+
+    /// 64-bit integers and three bands are refused naming the tags and their values.
+    #[test]
+    fn unsupported_samples_and_bands_are_refused_naming_the_tag() {
+        use tiff::encoder::colortype::{Gray64, RGB8};
+        let dir = tempfile::tempdir().unwrap();
+        let georef = |d: &mut tiff::encoder::DirectoryEncoder<
+            '_,
+            BufWriter<File>,
+            tiff::encoder::TiffKindStandard,
+        >| {
+            d.write_tag(Tag::ModelPixelScaleTag, &[2.0, 2.0, 0.0][..]).unwrap();
+            d.write_tag(Tag::ModelTiepointTag, &[0.0, 0.0, 0.0, 100.0, 200.0, 0.0][..]).unwrap();
+        };
+        let u64_path = dir.path().join("u64.tif");
+        {
+            let mut enc = TiffEncoder::new(BufWriter::new(File::create(&u64_path).unwrap())).unwrap();
+            let mut img = enc.new_image::<Gray64>(2, 2).unwrap();
+            georef(img.encoder());
+            img.write_data(&[1u64, 2, 3, 4]).unwrap();
+        }
+        let err = format!("{:#}", read_raster(&u64_path).unwrap_err());
+        assert!(
+            err.contains(
+                "u64.tif: unsupported sample type (BitsPerSample = 64, SampleFormat = 1: 64-bit integers)"
+            ),
+            "{err}"
+        );
+        let rgb_path = dir.path().join("rgb.tif");
+        {
+            let mut enc = TiffEncoder::new(BufWriter::new(File::create(&rgb_path).unwrap())).unwrap();
+            let mut img = enc.new_image::<RGB8>(2, 2).unwrap();
+            georef(img.encoder());
+            img.write_data(&[0u8; 12]).unwrap();
+        }
+        let err = format!("{:#}", read_raster(&rgb_path).unwrap_err());
+        assert!(err.contains("rgb.tif: has 3 bands (SamplesPerPixel = 3)"), "{err}");
     }
 
     /// The grid every fixture shares: 40 x 30 cells of 2 m, north-west corner (500000, 4100000).

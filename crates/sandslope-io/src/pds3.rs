@@ -340,19 +340,6 @@ fn sample_kind(t: &str) -> Option<Sample> {
     })
 }
 
-/// The ISIS special pixels of 32-bit reals (NULL, LRS, LIS, HIS, HRS: 0xFF7FFFFB to
-/// 0xFF7FFFFF, the five most negative finite floats), of 64-bit reals (0xFFEFFFFFFFFFFFFB to
-/// ...FF) and of signed 16-bit integers (-32768 to -32764): HiRISE DTMs mark cells without a
-/// height with them.
-fn is_special(kind: Sample, bytes: usize, bits: u64, raw: f64) -> bool {
-    match (kind, bytes) {
-        (Sample::Real { .. }, 4) => (0xFF7F_FFFB..=0xFF7F_FFFF).contains(&bits),
-        (Sample::Real { .. }, 8) => (0xFFEF_FFFF_FFFF_FFFB..=0xFFEF_FFFF_FFFF_FFFF).contains(&bits),
-        (Sample::Int { signed: true, .. }, 2) => raw <= -32764.0,
-        _ => false,
-    }
-}
-
 /// Where the image's bytes are: the file and the byte offset of its first line.
 fn image_location(label: &Label, label_path: &Path, attached: bool) -> Result<(PathBuf, u64)> {
     let name = &label.name;
@@ -546,25 +533,85 @@ pub fn read_pds3(path: &Path) -> Result<Raster> {
     let (cols_n, rows_n) = (cols as usize, rows as usize);
     let mut values = Vec::with_capacity(cols_n * rows_n);
     let mut buf = vec![0u8; line_bytes as usize];
+    // MISSING_CONSTANT as the stored sample's bits, so every type compares the same way.
+    let missing_bits: Option<u64> = missing.and_then(|(bits, value)| match kind {
+        Sample::Real { .. } => Some(bits),
+        _ if value.fract() != 0.0 => None,
+        Sample::Int { signed: true, .. } => {
+            Some((value as i64 as u64) & (u64::MAX >> (64 - 8 * bytes as u32)))
+        }
+        Sample::Int { signed: false, .. } => (value >= 0.0).then_some(value as u64),
+    });
+    let big = match kind {
+        Sample::Int { big, .. } | Sample::Real { big } => big,
+    };
     let (mut special, mut missing_n) = (0usize, 0usize);
     for _ in 0..rows_n {
         file.read_exact(&mut buf).with_context(|| format!("cannot read {data_name}"))?;
-        for s in buf[prefix as usize..prefix as usize + cols_n * bytes].chunks_exact(bytes) {
-            let (stored, raw) = decode(kind, s);
-            let is_missing = missing.is_some_and(|(mb, mv)| match kind {
-                Sample::Real { .. } => stored == mb,
-                Sample::Int { .. } => raw == mv,
-            });
-            if is_missing {
-                missing_n += 1;
-                values.push(f64::NAN);
-            } else if is_special(kind, bytes, stored, raw) {
-                special += 1;
-                values.push(f64::NAN);
-            } else {
-                values.push(add + scale * raw);
+        let line = &buf[prefix as usize..prefix as usize + cols_n * bytes];
+        let out = &mut values;
+        // The ISIS special pixels (NULL, LRS, LIS, HIS, HRS) mark cells without a height in
+        // HiRISE DTMs: the five most negative finite 32-bit reals (0xFF7FFFFB to 0xFF7FFFFF),
+        // their 64-bit twins (0xFFEFFFFFFFFFFFFB to ...FF), and -32768 to -32764 of 16-bit
+        // signed integers.
+        let (m, sp) = match (kind, bytes) {
+            (Sample::Real { .. }, 4) => decode_line::<4>(
+                line,
+                big,
+                |u| f64::from(f32::from_bits(u as u32)),
+                |u| (0xFF7F_FFFB..=0xFF7F_FFFF).contains(&u),
+                missing_bits,
+                (add, scale),
+                out,
+            ),
+            (Sample::Real { .. }, _) => decode_line::<8>(
+                line,
+                big,
+                f64::from_bits,
+                |u| (0xFFEF_FFFF_FFFF_FFFB..=0xFFEF_FFFF_FFFF_FFFF).contains(&u),
+                missing_bits,
+                (add, scale),
+                out,
+            ),
+            (Sample::Int { signed: true, .. }, 1) => decode_line::<1>(
+                line,
+                big,
+                |u| f64::from(u as u8 as i8),
+                |_| false,
+                missing_bits,
+                (add, scale),
+                out,
+            ),
+            (Sample::Int { signed: true, .. }, 2) => decode_line::<2>(
+                line,
+                big,
+                |u| f64::from(u as u16 as i16),
+                |u| (u as u16 as i16) <= -32764,
+                missing_bits,
+                (add, scale),
+                out,
+            ),
+            (Sample::Int { signed: true, .. }, _) => decode_line::<4>(
+                line,
+                big,
+                |u| f64::from(u as u32 as i32),
+                |_| false,
+                missing_bits,
+                (add, scale),
+                out,
+            ),
+            (Sample::Int { signed: false, .. }, 1) => {
+                decode_line::<1>(line, big, |u| u as f64, |_| false, missing_bits, (add, scale), out)
             }
-        }
+            (Sample::Int { signed: false, .. }, 2) => {
+                decode_line::<2>(line, big, |u| u as f64, |_| false, missing_bits, (add, scale), out)
+            }
+            (Sample::Int { signed: false, .. }, _) => {
+                decode_line::<4>(line, big, |u| u as f64, |_| false, missing_bits, (add, scale), out)
+            }
+        };
+        missing_n += m;
+        special += sp;
     }
     if missing_n + special > 0 {
         notes.push(format!(
@@ -759,30 +806,41 @@ fn geokeys(
     (dir, doubles, ascii)
 }
 
-/// A sample's bits (as stored, for comparing reals with MISSING_CONSTANT) and value.
-fn decode(kind: Sample, s: &[u8]) -> (u64, f64) {
-    let big = match kind {
-        Sample::Int { big, .. } | Sample::Real { big } => big,
-    };
-    let mut b = [0u8; 8];
-    let n = s.len();
-    if big {
-        b[8 - n..].copy_from_slice(s);
-    } else {
-        for (i, &x) in s.iter().enumerate() {
-            b[7 - i] = x;
+/// Decodes one line of `N`-byte samples onto `out`: `add + scale value(bits)`, or NaN where the
+/// stored bits are MISSING_CONSTANT's or an ISIS special pixel's (`special`). Returns how many
+/// were missing and how many special. (Generic over the sample size so each type's loop is
+/// compiled on its own: one match per sample made `plan` on a 4096^2 PC_REAL DTM 0.35 s slower
+/// than on the same heights as an uncompressed GeoTIFF; now it is as fast.)
+fn decode_line<const N: usize>(
+    line: &[u8],
+    big: bool,
+    value: impl Fn(u64) -> f64,
+    special: impl Fn(u64) -> bool,
+    missing: Option<u64>,
+    (add, scale): (f64, f64),
+    out: &mut Vec<f64>,
+) -> (usize, usize) {
+    let (mut m, mut sp) = (0, 0);
+    for s in line.chunks_exact(N) {
+        let mut b = [0u8; 8];
+        let u = if big {
+            b[8 - N..].copy_from_slice(s);
+            u64::from_be_bytes(b)
+        } else {
+            b[..N].copy_from_slice(s);
+            u64::from_le_bytes(b)
+        };
+        if missing == Some(u) {
+            m += 1;
+            out.push(f64::NAN);
+        } else if special(u) {
+            sp += 1;
+            out.push(f64::NAN);
+        } else {
+            out.push(add + scale * value(u));
         }
     }
-    let u = u64::from_be_bytes(b);
-    let value = match (kind, n) {
-        (Sample::Real { .. }, 4) => f64::from(f32::from_bits(u as u32)),
-        (Sample::Real { .. }, _) => f64::from_bits(u),
-        (Sample::Int { signed: true, .. }, 1) => f64::from(u as u8 as i8),
-        (Sample::Int { signed: true, .. }, 2) => f64::from(u as u16 as i16),
-        (Sample::Int { signed: true, .. }, _) => f64::from(u as u32 as i32),
-        (Sample::Int { signed: false, .. }, _) => u as f64,
-    };
-    (u, value)
+    (m, sp)
 }
 
 /// The body: TARGET_NAME as written ("MARS" -> "Mars"), else by its radius.

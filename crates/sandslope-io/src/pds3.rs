@@ -973,6 +973,48 @@ mod tests {
         );
     }
 
+    /// Line prefix and suffix bytes are skipped; LSB_INTEGER 16-bit with MISSING_CONSTANT 7 and
+    /// the ISIS LRS -32767, and 8-bit unsigned samples, decode to the values written.
+    #[test]
+    fn line_prefixes_and_suffixes_are_skipped_and_integers_decode() {
+        let label = |t: &str, bits: u32| {
+            format!(
+                "PDS_VERSION_ID = PDS3\r\nRECORD_TYPE = UNDEFINED\r\n^IMAGE = 513 <BYTES>\r\nOBJECT = IMAGE\r\n\
+                 LINES = 2\r\nLINE_SAMPLES = 3\r\nSAMPLE_TYPE = {t}\r\nSAMPLE_BITS = {bits}\r\n\
+                 LINE_PREFIX_BYTES = 4\r\nLINE_SUFFIX_BYTES = 2\r\nMISSING_CONSTANT = 7\r\nEND_OBJECT = IMAGE\r\n\
+                 OBJECT = IMAGE_MAP_PROJECTION\r\nMAP_PROJECTION_TYPE = EQUIRECTANGULAR\r\nA_AXIS_RADIUS = 3396.19\r\n\
+                 CENTER_LATITUDE = 0\r\nMAP_SCALE = 2 <METERS/PIXEL>\r\nLINE_PROJECTION_OFFSET = 0.5\r\n\
+                 SAMPLE_PROJECTION_OFFSET = -0.5\r\nEND_OBJECT = IMAGE_MAP_PROJECTION\r\nEND\r\n"
+            )
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let write = |name: &str, label: String, lines: [&[u8]; 2]| {
+            let mut bytes = label.into_bytes();
+            bytes.resize(512, b' ');
+            for l in lines {
+                bytes.extend_from_slice(&[0xEE; 4]);
+                bytes.extend_from_slice(l);
+                bytes.extend_from_slice(&[0xDD; 2]);
+            }
+            let path = dir.path().join(name);
+            std::fs::write(&path, bytes).unwrap();
+            crate::raster::read_raster(&path).unwrap()
+        };
+        // -2, 300, 7 (missing) / -32767 (LRS), 0, 1000 as little-endian 16-bit.
+        let r = write(
+            "i16.img",
+            label("LSB_INTEGER", 16),
+            [&[0xFE, 0xFF, 0x2C, 0x01, 0x07, 0x00], &[0x01, 0x80, 0x00, 0x00, 0xE8, 0x03]],
+        );
+        let v: Vec<String> = r.values.iter().map(|v| format!("{v}")).collect();
+        assert_eq!(v, ["-2", "300", "NaN", "NaN", "0", "1000"]);
+        // Corner x = -(-0.5 + 0.5) 2 = 0, y = (0.5 + 0.5) 2 = 2.
+        assert_eq!((r.geo.west, r.geo.north), (0.0, 2.0));
+        let r = write("u8.img", label("MSB_UNSIGNED_INTEGER", 8), [&[0, 255, 7], &[1, 2, 3]]);
+        let v: Vec<String> = r.values.iter().map(|v| format!("{v}")).collect();
+        assert_eq!(v, ["0", "255", "NaN", "1", "2", "3"]);
+    }
+
     /// A copy of the attached fixture with `from` replaced by `to` in its label, read.
     fn edited(from: &str, to: &str) -> String {
         let mut bytes = std::fs::read(fixture_path("dtm-attached.img")).unwrap();

@@ -27,12 +27,13 @@ pub const MAX_LABEL_BYTES: u64 = 1 << 20;
 /// Lists nested deeper than this are refused (a label is not a program).
 const MAX_NESTING: usize = 16;
 
-/// Whether the file at `path` begins with a PDS3 label (`PDS_VERSION_ID`).
+/// Whether the file at `path` begins with a PDS3 label (`PDS_VERSION_ID`, or the SFDU line
+/// `CCSD3ZF0000100000001NJPL3IF0PDS200000001 = SFDU_LABEL` older products put before it).
 pub fn starts_with_label(path: &Path) -> bool {
     let mut head = [0u8; 32];
     File::open(path).and_then(|mut f| f.read(&mut head)).is_ok_and(|n| {
-        let text = String::from_utf8_lossy(&head[..n]);
-        text.trim_start().to_ascii_uppercase().starts_with("PDS_VERSION_ID")
+        let text = String::from_utf8_lossy(&head[..n]).trim_start().to_ascii_uppercase();
+        text.starts_with("PDS_VERSION_ID") || text.starts_with("CCSD3ZF")
     })
 }
 
@@ -979,7 +980,7 @@ mod tests {
     fn line_prefixes_and_suffixes_are_skipped_and_integers_decode() {
         let label = |t: &str, bits: u32| {
             format!(
-                "PDS_VERSION_ID = PDS3\r\nRECORD_TYPE = UNDEFINED\r\n^IMAGE = 513 <BYTES>\r\nOBJECT = IMAGE\r\n\
+                "PDS_VERSION_ID = PDS3\r\nRECORD_TYPE = UNDEFINED\r\n^IMAGE = 1025 <BYTES>\r\nOBJECT = IMAGE\r\n\
                  LINES = 2\r\nLINE_SAMPLES = 3\r\nSAMPLE_TYPE = {t}\r\nSAMPLE_BITS = {bits}\r\n\
                  LINE_PREFIX_BYTES = 4\r\nLINE_SUFFIX_BYTES = 2\r\nMISSING_CONSTANT = 7\r\nEND_OBJECT = IMAGE\r\n\
                  OBJECT = IMAGE_MAP_PROJECTION\r\nMAP_PROJECTION_TYPE = EQUIRECTANGULAR\r\nA_AXIS_RADIUS = 3396.19\r\n\
@@ -990,7 +991,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let write = |name: &str, label: String, lines: [&[u8]; 2]| {
             let mut bytes = label.into_bytes();
-            bytes.resize(512, b' ');
+            assert!(bytes.len() <= 1024, "the label fits before byte 1025");
+            bytes.resize(1024, b' ');
             for l in lines {
                 bytes.extend_from_slice(&[0xEE; 4]);
                 bytes.extend_from_slice(l);
@@ -1010,7 +1012,12 @@ mod tests {
         assert_eq!(v, ["-2", "300", "NaN", "NaN", "0", "1000"]);
         // Corner x = -(-0.5 + 0.5) 2 = 0, y = (0.5 + 0.5) 2 = 2.
         assert_eq!((r.geo.west, r.geo.north), (0.0, 2.0));
-        let r = write("u8.img", label("MSB_UNSIGNED_INTEGER", 8), [&[0, 255, 7], &[1, 2, 3]]);
+        // Behind an SFDU line, under a name that is not .img: found by its first bytes.
+        let sfdu = format!(
+            "CCSD3ZF0000100000001NJPL3IF0PDS200000001 = SFDU_LABEL\r\n{}",
+            label("MSB_UNSIGNED_INTEGER", 8)
+        );
+        let r = write("u8.dat", sfdu, [&[0, 255, 7], &[1, 2, 3]]);
         let v: Vec<String> = r.values.iter().map(|v| format!("{v}")).collect();
         assert_eq!(v, ["0", "255", "NaN", "1", "2", "3"]);
     }

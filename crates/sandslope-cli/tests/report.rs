@@ -17,10 +17,10 @@ use common::{
 };
 
 /// The page's figure elements; fig6 holds the panels fig6a-d (anchored inside it).
-const PAGE_IDS: [&str; 9] =
-    ["fig3a", "fig4d", "fig4h", "fig5b", "fig5c", "fig6", "risk", "step_budget", "calibration"];
+const PAGE_IDS: [&str; 10] =
+    ["fig3a", "fig4d", "fig4h", "fig5b", "fig5c", "fig6", "risk", "step_budget", "simulator", "calibration"];
 /// The ids of report.json, the paper's figure numbers (and names for figures the paper lacks).
-const IDS: [&str; 12] = [
+const IDS: [&str; 13] = [
     "fig3a",
     "fig4d",
     "fig4h",
@@ -32,6 +32,7 @@ const IDS: [&str; 12] = [
     "fig6d",
     "risk",
     "step_budget",
+    "simulator",
     "calibration",
 ];
 
@@ -91,6 +92,37 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
     let rows = v["paper_vs_model"].as_array().unwrap();
     assert!(rows.iter().any(|r| r["id"] == "shear_ratio_20" && r["paper_value"] == 0.4));
     assert!(rows.iter().any(|r| r["id"] == "heavy_robot_24"));
+    // The simulator section (issue 23): 0 to 24 deg every 2 plus the observed 15, below the
+    // repose of 25; at the observed slopes the paper's speeds and the same closed form as the
+    // speeds table; a walk that pitched over never counts as agreement; every reason is on
+    // the page; and the 0 deg walk is the one `simulate --slope 0 --json` walks.
+    let sim = v["simulator"].as_array().unwrap();
+    let slopes: Vec<f64> = sim.iter().map(|r| r["slope_deg"].as_f64().unwrap()).collect();
+    let mut expected: Vec<f64> = (0..=12).map(|i| 2.0 * f64::from(i)).collect();
+    expected.insert(8, 15.0);
+    assert_eq!(slopes, expected);
+    for r in sim {
+        let at = speeds.iter().find(|s| s["slope_deg"] == r["slope_deg"]);
+        match at {
+            Some(s) => {
+                assert_eq!(r["observed_m_s"], s["observed_m_s"]);
+                assert_eq!(r["closed_form_m_s"], s["model_m_s"]);
+            }
+            None => assert!(r["observed_m_s"].is_null()),
+        }
+        if !r["pitch_over_s"].is_null() {
+            assert_eq!(r["agree"], false);
+            assert_eq!(r["simulated_cause"], "pitch_over");
+        }
+        let why = r["why"].as_str().unwrap().replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+        assert!(html.contains(&why.replace('"', "&quot;")), "{why}");
+    }
+    let walk: serde_json::Value = serde_json::from_slice(
+        &sandslope().args(["simulate", "--slope", "0", "--json"]).assert().success().get_output().stdout,
+    )
+    .unwrap();
+    assert_eq!(sim[0]["simulated_m_s"], walk["speed_m_s"]);
+    assert!(html.contains("The stride simulator against the closed form"));
     // Every disagreement in the JSON is on the page.
     for d in v["disagreements"].as_array().unwrap() {
         let text = d.as_str().unwrap().replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");

@@ -209,7 +209,16 @@ impl Figure for SlopesFigure<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let sim: Vec<(f64, f64)> = self.sims.iter().map(|m| (m.slope_deg, m.speed_m_s * 100.0)).collect();
+        // A walk that pitched over has no speed: its step means describe a tumbling body
+        // (docs/model.md §18). It is marked on the zero line, not drawn in the curve.
+        let sim: Vec<(f64, f64)> = self
+            .sims
+            .iter()
+            .filter(|m| m.pitch_over_s.is_none())
+            .map(|m| (m.slope_deg, m.speed_m_s * 100.0))
+            .collect();
+        let tumbled: Vec<f64> =
+            self.sims.iter().filter(|m| m.pitch_over_s.is_some()).map(|m| m.slope_deg).collect();
         let cf: Vec<(f64, f64)> = self
             .sims
             .iter()
@@ -217,7 +226,10 @@ impl Figure for SlopesFigure<'_> {
             .collect();
         let obs: Vec<(f64, f64, f64)> =
             self.observed.iter().map(|o| (o.slope.degrees(), o.speed * 100.0, o.speed_sd * 100.0)).collect();
-        let xr = super::range(sim.iter().map(|p| p.0).chain(obs.iter().map(|o| o.0)), (0.0, 30.0));
+        let xr = super::range(
+            sim.iter().map(|p| p.0).chain(tumbled.iter().copied()).chain(obs.iter().map(|o| o.0)),
+            (0.0, 30.0),
+        );
         let yr = super::range(
             sim.iter()
                 .chain(&cf)
@@ -254,6 +266,13 @@ impl Figure for SlopesFigure<'_> {
             .label("simulated (docs/model.md §15-§18)")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(3)));
         c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, blue.filled()))).map_err(plot_err)?;
+        if !tumbled.is_empty() {
+            let orange = RGBColor(230, 120, 0);
+            c.draw_series(tumbled.iter().map(|&x| Cross::new((x, 0.0), 7, orange.stroke_width(3))))
+                .map_err(plot_err)?
+                .label("simulated body pitched over (tumbled): no speed")
+                .legend(move |(x, y)| Cross::new((x + 10, y), 6, orange.stroke_width(3)));
+        }
         c.draw_series(LineSeries::new(cf.iter().copied(), RED.stroke_width(2)))
             .map_err(plot_err)?
             .label("closed form (docs/model.md §3-§6)")

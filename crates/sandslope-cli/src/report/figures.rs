@@ -13,6 +13,7 @@ use crate::figures::calibrate::{speed_pulls, CalibrationFigure};
 use crate::figures::phase::PhaseFigure;
 use crate::figures::risk::CurveFigure;
 use crate::figures::slope_curves::SlopeCurveFigure;
+use crate::figures::simulate::SlopesFigure;
 use crate::figures::step_budget::StepBudgetFigure;
 use crate::figures::to_svg;
 use crate::figures::track::{StridePanels, TrackFigure};
@@ -84,6 +85,21 @@ pub fn page_figures(report: &Report) -> Result<Vec<PageFigure>> {
         "The model's level step s* and what each term of docs/model.md §5 takes from it, up to the angle of repose: the net step is s* minus the three losses. Which term carries the lost step says what the model's speed rests on.".into(),
         to_svg(&fig)?,
     );
+
+    // The stride simulator beside the closed form and the observations.
+    if !p.simulated.is_empty() {
+        let fig = SlopesFigure { sims: &p.simulated, observed: &p.speeds, repose_deg: p.repose_deg };
+        add(
+            &mut figures,
+            report,
+            "simulator",
+            format!(
+                "The dynamic stride simulator (docs/model.md §15-§18, {} s walks on the same robot and terrain) against the closed form and the observed speeds. Slopes where the simulated body pitched over (tumbled) are marked on the zero line and left out of its curve. The table \"The stride simulator against the closed form\" says where the two part and why.",
+                sandslope::report::REPORT_WALK_S
+            ),
+            to_svg(&fig)?,
+        );
+    }
 
     // The calibration pulls.
     if let Some(c) = &report.calibration {

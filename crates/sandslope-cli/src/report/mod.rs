@@ -73,6 +73,7 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
         h.push_str(&sections::calibration(c, report.model_is_calibration));
     }
     h.push_str(&sections::step_budget(report));
+    h.push_str(&sections::simulator(report));
     let tracks = TracksSection { records: &report.tracks, notes: &report.track_notes };
     if !tracks.records.is_empty() {
         h.push_str(&tracks_section(&tracks));

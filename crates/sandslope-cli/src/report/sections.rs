@@ -218,3 +218,46 @@ pub fn step_budget(report: &Report) -> String {
     h.push_str("</table>\n");
     h
 }
+
+/// The stride simulator beside the closed form and the observations, with where they part.
+pub fn simulator(report: &Report) -> String {
+    if report.simulator.is_empty() {
+        return String::new();
+    }
+    let agree = report.simulator.iter().filter(|r| r.agree).count();
+    let tumbles = report.simulator.iter().filter(|r| r.pitch_over_s.is_some()).count();
+    let mut h = String::from("<h2 id=\"simulator-table\">The stride simulator against the closed form</h2>\n");
+    h.push_str(&format!(
+        "<p>The same robot and terrain walked by the dynamic stride simulator (<code>sandslope simulate</code>: \
+         a planar body with pitch on C-legs in resistive-force sand, docs/model.md §15-§18; {} s walks). It tests \
+         the closed form's assumptions (quasi-static stance, no body pitch, the leg's circle fixed in solidified \
+         sand). They agree (same regime, speeds within {:.0}%) at {agree} of {} slopes; the simulated body pitched \
+         over at {tumbles}. <b>The simulator does not yet reproduce the closed form or the paper, and its slope \
+         answers depend on its contact regularisation</b> (docs/simulate.md): read this table as a test of the \
+         simulator as much as of the model.</p>\n",
+        sandslope::report::REPORT_WALK_S,
+        sandslope::report::AGREE_WITHIN * 100.0,
+        report.simulator.len()
+    ));
+    h.push_str(
+        "<table><tr><th>slope (°)</th><th>observed (cm/s)</th><th>closed form (cm/s)</th><th>simulated (cm/s)</th>\
+         <th>regime: closed form</th><th>regime: simulated (cause)</th><th>largest pitch (°)</th><th>where they part, and why</th></tr>",
+    );
+    for r in &report.simulator {
+        h.push_str(&format!(
+            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} ({})</td><td>{:.0}</td><td>{}</td></tr>",
+            if r.agree { "yes" } else { "no" },
+            r.slope_deg,
+            plus_minus(r.observed_m_s.map(|v| v * 100.0), r.observed_sd_m_s.map(|v| v * 100.0), 1.0, 1),
+            r.closed_form_m_s.map_or("- (ruled out)".into(), |v| format!("{:.1}", v * 100.0)),
+            if r.pitch_over_s.is_some() { "- (tumbled)".to_string() } else { format!("{:.1}", r.simulated_m_s * 100.0) },
+            r.closed_form_regime.name(),
+            r.simulated_regime.name(),
+            r.simulated_cause.name(),
+            r.max_pitch_deg,
+            escape(&r.why),
+        ));
+    }
+    h.push_str("</table>\n");
+    h
+}

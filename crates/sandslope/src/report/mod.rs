@@ -10,6 +10,7 @@
 mod audit;
 mod disagreements;
 mod provenance;
+mod simulator;
 mod tracks;
 
 use serde::Serialize;
@@ -31,6 +32,7 @@ use crate::terrain::{Terrain, TerrainPoint};
 
 pub use audit::{Extrapolation, NoFloorFit, SpeedInversion, StepBudget, PAPER_FRAME_RATE_HZ};
 pub use provenance::{Input, Provenance, ProvenanceKind};
+pub use simulator::{SimulatorRecord, AGREE_WITHIN, REPORT_WALK_S};
 use tracks::TrackUse;
 pub use tracks::{TrackRecord, TrackedSlope};
 
@@ -175,6 +177,8 @@ pub struct Plots {
     pub calibrated_speed: Vec<(f64, Option<f64>)>,
     /// The step budget over the slope grid, up to the angle of repose.
     pub step_budget: Vec<StepBudget>,
+    /// The simulator's walks of the simulator section, in slope order.
+    pub simulated: Vec<crate::simulate::SimSummary>,
 }
 
 /// The whole report. Serialises to `report.json`; [`Report::plots`], the page's notes and
@@ -209,6 +213,9 @@ pub struct Report {
     pub extrapolations: Vec<Extrapolation>,
     /// Where the step is lost, one entry per observed slope (docs/model.md §5).
     pub step_budget: Vec<StepBudget>,
+    /// The stride simulator beside the closed form and the observations, slope by slope, with
+    /// where and why the two part (docs/simulate.md).
+    pub simulator: Vec<SimulatorRecord>,
     /// What the report was made from, each with its provenance.
     pub inputs: Vec<Input>,
     /// Sentences on how the tracks entered the report (skipped t1s, speeds not used, ...).
@@ -292,7 +299,9 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     };
     let calibration = calibrate(evidence, &speeds, &anchoring);
     let (robot, terrain) = model(evidence, calibration.as_ref())?;
-    let plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
+    let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
+    let (simulator, simulated) = simulator::simulator_section(&robot, &terrain, &speeds)?;
+    plots.simulated = simulated;
     let own = evidence.has_own_observations();
     let context = ComparisonContext {
         fitted_to_paper_speeds: !own && evidence.builtin_terrain,
@@ -349,6 +358,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         speed_inversion,
         extrapolations,
         step_budget,
+        simulator,
         inputs: provenance::inputs(evidence, !track_use.anchoring.is_empty()),
         track_notes: track_use.notes,
         warnings,
@@ -502,6 +512,7 @@ fn plots(
             terrain,
             &grid.iter().copied().filter(|s| !terrain.at(*s).beyond_repose(*s)).collect::<Vec<_>>(),
         ),
+        simulated: Vec::new(),
     })
 }
 
@@ -522,6 +533,7 @@ fn figure_records(plots: &Plots, calibrated: bool) -> Vec<FigureRecord> {
     }
     out.push(("risk", "Failure probability against slope".into()));
     out.push(("step_budget", "Where the step goes against slope".into()));
+    out.push(("simulator", "Stride simulator against the closed form".into()));
     if calibrated {
         out.push(("calibration", "Joint calibration: observed against fitted speeds, and pulls".into()));
     }

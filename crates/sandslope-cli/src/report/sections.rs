@@ -226,7 +226,8 @@ pub fn simulator(report: &Report) -> String {
     }
     let agree = report.simulator.iter().filter(|r| r.agree).count();
     let tumbles = report.simulator.iter().filter(|r| r.pitch_over_s.is_some()).count();
-    let mut h = String::from("<h2 id=\"simulator-table\">The stride simulator against the closed form</h2>\n");
+    let mut h =
+        String::from("<h2 id=\"simulator-table\">The stride simulator against the closed form</h2>\n");
     h.push_str(&format!(
         "<p>The same robot and terrain walked by the dynamic stride simulator (<code>sandslope simulate</code>: \
          a planar body with pitch on C-legs in resistive-force sand, docs/model.md §15-§18; {} s walks). It tests \

@@ -165,7 +165,8 @@ mod tests {
     /// repose of 20 cuts everything from 20 up.
     #[test]
     fn slopes_are_the_grid_plus_observed_below_repose() {
-        let obs = |d: f64| SpeedObservation { slope: Slope::from_degrees(d).unwrap(), speed: 0.1, speed_sd: 0.01 };
+        let obs =
+            |d: f64| SpeedObservation { slope: Slope::from_degrees(d).unwrap(), speed: 0.1, speed_sd: 0.01 };
         let s = section_slopes(&[obs(10.0), obs(15.0)], &terrain(25.0));
         assert_eq!(s.len(), 14);
         assert!(s.contains(&15.0) && s.contains(&24.0));

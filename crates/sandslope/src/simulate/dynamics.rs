@@ -182,8 +182,17 @@ impl Walker {
 
     /// Sand forces on leg `j` at angle `psi` turning at `rate`, assembled into `asm`; records
     /// touching elements when `record`.
-    fn leg_forces(&mut self, j: usize, psi: f64, rate: f64, asm: &mut Assembly, record: bool) -> LegOut {
-        let (sp, cp) = self.q[2].sin_cos();
+    /// `pitch_sc`: the body pitch's `(sin, cos)`, computed once per step by the caller.
+    fn leg_forces(
+        &mut self,
+        j: usize,
+        psi: f64,
+        rate: f64,
+        pitch_sc: (f64, f64),
+        asm: &mut Assembly,
+        record: bool,
+    ) -> LegOut {
+        let (sp, cp) = pitch_sc;
         let hip_rel = self.rot(cp, sp, [self.hips[j], 0.0]);
         let hip = [self.q[0] + hip_rel[0], self.q[1] + hip_rel[1]];
         let (sa, ca) = (self.q[2] - psi).sin_cos();
@@ -198,6 +207,17 @@ impl Walker {
         let _ = q;
         let elements = self.nodes.len() - 1;
         let mut out = LegOut::default();
+        // A leg wholly above the surface feels nothing: decided from the nodes' heights alone,
+        // computed exactly as `point` computes them, so the answer is bit-for-bit the same as
+        // the full loop's (every element would return `None`). Half the legs are in swing at
+        // any time; this took the 100 s level walk from 0.19 to 0.16 s of CPU (perf: the node
+        // transforms and `element_force` were 68% of the time).
+        if self.nodes.iter().all(|p| hip[1] + (sa * p[0] + ca * p[1]) >= 0.0) {
+            if record {
+                self.touching[j * elements..(j + 1) * elements].fill(false);
+            }
+            return out;
+        }
         let (mut pa, _, mut va) = point(self.nodes[0]);
         for k in 0..elements {
             let (pb, _, vb) = point(self.nodes[k + 1]);
@@ -256,6 +276,7 @@ impl Walker {
         self.touches.clear();
         let mut asm = Assembly::default();
         let legs = self.psi.len();
+        let pitch_sc = self.q[2].sin_cos();
         for j in 0..legs {
             let (psi, rate) = if gait {
                 let cmd = self.command(j, self.time);
@@ -272,7 +293,7 @@ impl Walker {
             };
             let mut trial = asm;
             let start = self.touches.len();
-            let mut out = self.leg_forces(j, psi, rate, &mut trial, true);
+            let mut out = self.leg_forces(j, psi, rate, pitch_sc, &mut trial, true);
             self.stalled[j] = false;
             if let Some(limit) = self.torque_limit {
                 // The sand's torque about the hip resists the rotation when positive (the leg
@@ -280,7 +301,7 @@ impl Walker {
                 if rate > 0.0 && out.torque > limit {
                     self.touches.truncate(start);
                     trial = asm;
-                    out = self.leg_forces(j, psi, 0.0, &mut trial, true);
+                    out = self.leg_forces(j, psi, 0.0, pitch_sc, &mut trial, true);
                     self.stalled[j] = true;
                 }
             }

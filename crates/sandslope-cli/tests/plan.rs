@@ -515,6 +515,11 @@ fn a_geographic_dem_plans_in_metres_like_its_projected_twin() {
     let along: f64 = lonlat.windows(2).map(|w| haversine(w[0], w[1])).sum();
     let length = geo["routes"]["distance"]["length_m"].as_f64().unwrap();
     assert!((length - along).abs() < 0.005 * along, "{length} m vs haversine {along} m");
+    // The projected twin's routes name their CRS, EPSG:32632 as make_crs.py wrote it, in the
+    // `crs` member GDAL and QGIS read; RFC 7946 longitude, latitude needs none.
+    assert_eq!(utm_json["crs"]["type"], "name");
+    assert_eq!(utm_json["crs"]["properties"]["name"], "urn:ogc:def:crs:EPSG::32632");
+    assert!(geo_json.get("crs").is_none(), "{}", geo_json["crs"]);
 }
 
 /// A HiRISE-layout PDS3 DTM (`sandslope-io/tests/fixtures/pds3/make_pds3.py`: equirectangular

@@ -26,6 +26,8 @@ const GEOG_SEMI_MINOR: u16 = 2058;
 const GEOG_INV_FLATTENING: u16 = 2059;
 /// ProjLinearUnitsGeoKey.
 const PROJ_LINEAR_UNITS: u16 = 3076;
+/// ProjectedCSTypeGeoKey: the EPSG code of a projected CRS.
+const PROJECTED_CS_TYPE: u16 = 3072;
 /// VerticalUnitsGeoKey.
 const VERTICAL_UNITS: u16 = 4099;
 
@@ -175,6 +177,17 @@ impl Keys<'_> {
             self.ascii.get(start..start + len)
         })
     }
+}
+
+/// The EPSG code of a projected CRS named by its GeoKeys (`ProjectedCSTypeGeoKey`, 3072), if
+/// the keys name one (not user-defined, 32767). Geographic rasters have none here: their
+/// GeoJSON is RFC 7946's longitude, latitude.
+pub fn projected_epsg(dir: &[u16]) -> Option<u16> {
+    let keys = Keys { dir, doubles: &[], ascii: "" };
+    if keys.short(GT_MODEL_TYPE) == Some(2) {
+        return None;
+    }
+    keys.short(PROJECTED_CS_TYPE).filter(|&c| (1024..32767).contains(&c))
 }
 
 /// Reads the CRS from GeoKeys (`dir`, `doubles`, `ascii` as in the file); `notes` gains what was

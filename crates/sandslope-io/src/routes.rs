@@ -56,7 +56,19 @@ pub fn write_geojson(path: &Path, geo: &GeoRef, routes: &Routes) -> Result<()> {
         f.set_property("max_roll_deg", r.max_roll_deg);
         Some(f)
     });
-    let fc = FeatureCollection::new(features);
+    let mut fc = FeatureCollection::new(features);
+    // RFC 7946 GeoJSON is longitude, latitude on WGS84; routes on a projected map are in its
+    // own coordinates, so the CRS is named beside them the way GDAL and QGIS read it (the
+    // 2008 GeoJSON `crs` member), when the GeoKeys give its EPSG code.
+    if let Some(code) = geo.geokeys.as_deref().and_then(crate::crs::projected_epsg) {
+        let mut crs = serde_json::Map::new();
+        crs.insert("type".into(), "name".into());
+        crs.insert(
+            "properties".into(),
+            serde_json::json!({ "name": format!("urn:ogc:def:crs:EPSG::{code}") }),
+        );
+        fc.foreign_members = Some(serde_json::Map::from_iter([("crs".to_string(), crs.into())]));
+    }
     write_atomic(path, serde_json::to_string_pretty(&fc)?.as_bytes())
 }
 

@@ -89,7 +89,8 @@ fn both(command: &str, flags: &[(&str, String)]) -> (String, Vec<String>) {
     let query: Vec<String> = flags.iter().map(|(k, v)| format!("{k}={}", encode(v))).collect();
     let mut argv = vec![command.to_string()];
     for (k, v) in flags {
-        argv.push(format!("--{k}={v}"));
+        // An empty value is a switch (`map=` is `--map`).
+        argv.push(if v.is_empty() { format!("--{k}") } else { format!("--{k}={v}") });
     }
     argv.push("--json".into());
     (format!("/api/{command}?{}", query.join("&")), argv)
@@ -160,6 +161,61 @@ fn phase_endpoint_equals_phase_json() {
     let (status, field, error) = refused(&server, "GET", "/api/phase?k-n=1e4:1e7:2000&k-s=1e3:1e7:1000", b"");
     assert_eq!((status, field.as_deref()), (400, Some("k-n")), "{error}");
     assert!(error.contains("1048576"), "{error}");
+}
+
+#[test]
+fn risk_endpoint_equals_risk_json_in_every_mode() {
+    let server = Server::start(&[]);
+    // The curve (several slopes, one slope), the safe-slope limit, the heaviest safe mass at
+    // one slope and the payload envelope, the --map summary, and given CVs.
+    assert_same(&server, "risk", &[("slope", "0:24:25".into())]);
+    assert_same(&server, "risk", &[("slope", "12".into()), ("mass", "0.8".into())]);
+    assert_same(&server, "risk", &[("solve", "slope".into()), ("max-risk", "0.01".into())]);
+    assert_same(&server, "risk", &[("solve", "mass".into()), ("slope", "10".into())]);
+    assert_same(&server, "risk", &[("solve", "mass".into()), ("slope", "0:30:7".into())]);
+    assert_same(
+        &server,
+        "risk",
+        &[
+            ("map", String::new()),
+            ("slope", "10".into()),
+            ("k-n", "1e4:1e7:40".into()),
+            ("k-s", "1e3:1e8:30".into()),
+        ],
+    );
+    assert_same(
+        &server,
+        "risk",
+        &[
+            ("cv-n", "0.3".into()),
+            ("cv-s", "0.5".into()),
+            ("slope", "-10,0,10,20".into()),
+            ("leg-radius", "0.05".into()),
+        ],
+    );
+    // More work than the server does for one request: refused, naming the flag and the limit.
+    for (path, field, limit) in [
+        ("/api/risk?slope=0:30:1001", "slope", "1000"),
+        ("/api/risk?solve=mass&slope=0:30:101", "slope", "100"),
+        ("/api/risk?map&slope=10&k-n=1e4:1e7:2000&k-s=1e3:1e8:1000", "k-n", "1048576"),
+    ] {
+        let (status, got, error) = refused(&server, "GET", path, b"");
+        assert_eq!((status, got.as_deref()), (400, Some(field)), "{path}: {error}");
+        assert!(error.contains(limit), "{path}: {error}");
+    }
+    // Its file flags are refused, bad values named.
+    for (path, field) in [
+        ("/api/risk?plot=%2Ftmp%2Fr.png", "plot"),
+        ("/api/risk?map&npy=%2Ftmp", "npy"),
+        ("/api/risk?map&csv=%2Ftmp%2Fr.csv", "csv"),
+        ("/api/risk?max-risk=1.5", "max-risk"),
+        ("/api/risk?cv-s=NaN", "cv-s"),
+        ("/api/risk?slope=0:24:q", "slope"),
+        ("/api/risk?solve=speed", "solve"),
+    ] {
+        let (status, got, error) = refused(&server, "GET", path, b"");
+        assert_eq!((status, got.as_deref()), (400, Some(field)), "{path}: {error}");
+    }
 }
 
 #[test]
@@ -375,6 +431,8 @@ fn raw_number(json: &str, key: &str, from: usize) -> String {
 fn assert_clean(server: &Server, dom: &str, console: &[String]) {
     assert!(console.is_empty(), "the page wrote to the console:\n{}", console.join("\n"));
     assert_eq!(text_of(dom, "log-errors"), "", "page errors");
+    // A refused request shows in the status line: none of the tests' requests may be refused.
+    assert_eq!(text_of(dom, "status"), "", "a request was refused");
     let resources = text_of(dom, "log-resources");
     assert!(resources.lines().count() >= 4, "too few requests logged: {resources}");
     let own = format!("http://{}/", server.addr);
@@ -420,6 +478,60 @@ fn the_page_shows_predicts_speed_after_the_slope_slider_moves() {
         }
         assert_eq!(text_of(&dom, "regime"), cli["regime"].as_str().unwrap());
     }
+}
+
+#[test]
+fn the_risk_tab_draws_risks_safe_slope_limit_and_payload_envelope() {
+    let Some(browser) =
+        common::chromium_or_skip("the_risk_tab_draws_risks_safe_slope_limit_and_payload_envelope")
+    else {
+        return;
+    };
+    let server = Server::start(&[]);
+    let (dom, console) = browse(&browser, &server, "/?tab=risk&mass=0.5", None);
+    assert_clean(&server, &dom, &console);
+    let raw = String::from_utf8(cli_stdout(&[
+        "risk".into(),
+        "--solve=slope".into(),
+        "--mass=0.5".into(),
+        "--max-risk=0.05".into(),
+        "--json".into(),
+    ]))
+    .unwrap();
+    let shown = attribute(&dom, "id=\"risk-summary\"", "data-safe-slope-deg").expect("no safe-slope limit");
+    let cli: f64 = raw_number(&raw, "safe_slope_deg", 0).parse().unwrap();
+    assert_eq!(shown.parse::<f64>().unwrap(), cli);
+    // The dashed limit line is drawn where the limit is (within the 0-30 deg chart).
+    assert!(dom.contains("id=\"safe-slope\""), "no safe-slope line");
+    // The payload envelope's points are risk --solve mass's over 0:30:7.
+    let raw = String::from_utf8(cli_stdout(&[
+        "risk".into(),
+        "--solve=mass".into(),
+        "--slope=0:30:7".into(),
+        "--mass=0.5".into(),
+        "--json".into(),
+    ]))
+    .unwrap();
+    let env: serde_json::Value = serde_json::from_str(&raw).unwrap();
+    let mut from = 0;
+    let mut drawn = 0;
+    for point in env["points"].as_array().unwrap() {
+        let slope = point["slope_deg"].as_f64().unwrap();
+        let at = raw[from..].find("\"max_payload_kg\": ").unwrap() + from;
+        let payload = raw_number(&raw, "max_payload_kg", at);
+        from = at + 1;
+        let anchor = format!("data-slope-deg=\"{slope}\" data-max-payload-kg=");
+        match payload.as_str() {
+            "null" => assert!(!dom.contains(&anchor), "a point drawn at {slope} deg, where none is safe"),
+            p => {
+                let got = attribute(&dom, &anchor, "data-max-payload-kg")
+                    .unwrap_or_else(|| panic!("no envelope point at {slope} deg"));
+                assert_eq!(got.parse::<f64>().unwrap(), p.parse::<f64>().unwrap(), "{slope} deg");
+                drawn += 1;
+            }
+        }
+    }
+    assert!(drawn >= 3, "only {drawn} envelope points");
 }
 
 #[test]

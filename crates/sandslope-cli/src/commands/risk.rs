@@ -271,6 +271,115 @@ pub fn run(args: RiskArgs) -> Result<()> {
     print_curve(&curve, limit.as_ref(), max_risk, format)
 }
 
+/// What `risk --json` prints, one shape per mode: one slope's [`RiskPoint`], several slopes'
+/// points, the safe-slope limit (`--solve slope`), the heaviest safe mass at one slope or the
+/// payload envelope over several (`--solve mass`), or the `--map` summary.
+#[derive(Debug, Serialize)]
+#[serde(untagged)]
+pub enum Answer {
+    /// One `--slope`.
+    Point(Box<RiskPoint>),
+    /// Several `--slope`s.
+    Curve(Vec<RiskPoint>),
+    /// `--solve slope`.
+    Slope(Box<sandslope::risk::SafeSlope>),
+    /// `--solve mass` at one slope.
+    Mass(Box<SafeMass>),
+    /// `--solve mass` at several slopes.
+    Envelope(Box<PayloadEnvelope>),
+    /// `--map`.
+    Map(Box<RiskMapSummary>),
+}
+
+/// Limits of one [`answer`] call (the server's; the command line's are the library's).
+#[derive(Debug, Clone, Copy)]
+pub struct AnswerLimits {
+    /// Most slopes of a p_fail curve (each a quadrature).
+    pub curve_slopes: usize,
+    /// Most slopes of a payload envelope (each a search over masses).
+    pub envelope_slopes: usize,
+    /// Most `--map` cells.
+    pub map_cells: u128,
+}
+
+/// The value `risk --json` prints for these flags (what `serve`'s `/api/risk` returns), by
+/// the same library calls as [`run`], without its notes, figures and files; more work than
+/// `limits` allows is an error naming the limit.
+pub fn answer(args: &RiskArgs, limits: AnswerLimits) -> Result<Answer> {
+    let robot = args.robot.load()?;
+    let slopes = parse_slopes(&args.slope)?;
+    let max_risk = args.max_risk;
+    let (terrain, _) = args.uncertainty.apply(args.terrain.load()?)?;
+    let too_many = |n: usize, most: usize, what: &str| {
+        anyhow!("--slope gives {n} slopes; at most {most} are allowed for {what} here")
+    };
+    if args.map {
+        let (slope, k_n_axis, k_s_axis) = map_axes(args, &terrain, slopes[0], limits.map_cells)?;
+        let u = terrain.sample(slope).uncertainty;
+        let repose = terrain.sample(slope).ground.repose;
+        let map = RiskMap::compute(&robot, slope, repose, &k_n_axis, &k_s_axis, u, &|| {});
+        let summary =
+            RiskMapSummary::of(&map, &robot, slopes[0], &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
+        return Ok(Answer::Map(Box::new(summary)));
+    }
+    Ok(match args.solve {
+        Some(Solve::Mass) if slopes.len() > 1 => {
+            if slopes.len() > limits.envelope_slopes {
+                return Err(too_many(slopes.len(), limits.envelope_slopes, "--solve mass"));
+            }
+            let env = payload_envelope(&robot, &terrain, &slopes, max_risk).map_err(|e| anyhow!("{e}"))?;
+            Answer::Envelope(Box::new(env))
+        }
+        Some(Solve::Mass) => {
+            slope_of(slopes[0])?;
+            let sol = safe_mass(&robot, slopes[0], &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
+            Answer::Mass(Box::new(sol))
+        }
+        Some(Solve::Slope) => {
+            Answer::Slope(Box::new(safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?))
+        }
+        None => {
+            if slopes.len() > limits.curve_slopes {
+                return Err(too_many(slopes.len(), limits.curve_slopes, "a p_fail curve"));
+            }
+            let curve =
+                risk_curve(&robot, &terrain, &slopes).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+            match <[RiskPoint; 1]>::try_from(curve.points) {
+                Ok([one]) => Answer::Point(Box::new(one)),
+                Err(points) => Answer::Curve(points),
+            }
+        }
+    })
+}
+
+/// The `--map` slope and axes (the flags', else the defaults around the terrain's medians),
+/// at most `max_cells` cells.
+fn map_axes(
+    args: &RiskArgs,
+    terrain: &UncertainTerrain,
+    slope_deg: f64,
+    max_cells: u128,
+) -> Result<(Slope, sandslope::Axis, sandslope::Axis)> {
+    let slope = slope_of(slope_deg)?;
+    let ground = terrain.sample(slope).ground;
+    let k_n_axis = match &args.k_n {
+        Some(t) => parse_axis("--k-n", t)?,
+        None => default_axis("--k-n", &[ground.k_n], 100.0, 100.0, MAP_POINTS)?,
+    };
+    let k_s_axis = match &args.k_s {
+        Some(t) => parse_axis("--k-s", t)?,
+        None => default_axis("--k-s", &[ground.k_s], 1000.0, 100.0, MAP_POINTS)?,
+    };
+    let cells = k_n_axis.len() as u128 * k_s_axis.len() as u128;
+    if cells > max_cells {
+        let side = (max_cells as f64).sqrt().floor();
+        bail!(
+            "--k-n and --k-s give {cells} map cells; at most {max_cells} are allowed (e.g. {side} x {side}), to keep the map in memory"
+        );
+    }
+    Ok((slope, k_n_axis, k_s_axis))
+}
+
 /// Tells the user on stderr when a default CV was used (docs/model.md §9).
 fn note_defaults(defaults: DefaultsUsed) {
     if let Some(note) = defaults.note() {
@@ -471,23 +580,9 @@ fn run_map(
     max_risk: f64,
     quiet: bool,
 ) -> Result<()> {
-    let slope = slope_of(slope_deg)?;
+    let (slope, k_n_axis, k_s_axis) = map_axes(args, terrain, slope_deg, MAX_MAP_CELLS)?;
     let sample = terrain.sample(slope);
     let (ground, u) = (sample.ground, sample.uncertainty);
-    let k_n_axis = match &args.k_n {
-        Some(t) => parse_axis("--k-n", t)?,
-        None => default_axis("--k-n", &[ground.k_n], 100.0, 100.0, MAP_POINTS)?,
-    };
-    let k_s_axis = match &args.k_s {
-        Some(t) => parse_axis("--k-s", t)?,
-        None => default_axis("--k-s", &[ground.k_s], 1000.0, 100.0, MAP_POINTS)?,
-    };
-    let cells = k_n_axis.len() as u128 * k_s_axis.len() as u128;
-    if cells > MAX_MAP_CELLS {
-        bail!(
-            "--k-n and --k-s give {cells} map cells; at most {MAX_MAP_CELLS} are allowed (e.g. 4096 x 4096), to keep the map in memory"
-        );
-    }
     let defaults = terrain.defaults_used_at(slope);
     note_defaults(defaults);
     let bar = progress_bar(k_s_axis.len() as u64, quiet, "p_fail map");

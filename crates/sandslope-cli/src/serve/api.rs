@@ -16,7 +16,7 @@ use clap::error::{ContextKind, ContextValue};
 use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
-use crate::commands::{phase, plan, predict, sweep};
+use crate::commands::{phase, plan, predict, risk, sweep};
 use sandslope_io::presets::{self, PresetKind};
 
 /// Most slopes one `/api/sweep` request evaluates.
@@ -24,6 +24,11 @@ pub const MAX_SWEEP_SLOPES: usize = 10_000;
 /// Most grid cells one `/api/phase` request computes, over all its panels (the command line
 /// allows 2^28; 2^20 is 6 panels of the default 400 x 400 and takes about a second).
 pub const MAX_PHASE_CELLS: u128 = 1 << 20;
+/// What one `/api/risk` request may ask for: at most 1000 slopes of a p_fail curve (a
+/// quadrature each, a few ms), 100 slopes of a payload envelope (a search over masses each)
+/// and 2^20 `--map` cells (the command line allows 65536 slopes and 2^24 cells).
+pub const RISK_LIMITS: risk::AnswerLimits =
+    risk::AnswerLimits { curve_slopes: 1000, envelope_slopes: 100, map_cells: 1 << 20 };
 
 /// The files the server was started with; requests that name none use these.
 #[derive(Debug, Clone)]
@@ -37,7 +42,7 @@ pub struct Served {
 }
 
 /// The commands the API answers, in the order docs/serve.md lists them.
-pub const COMMANDS: [&str; 4] = ["predict", "sweep", "phase", "plan"];
+pub const COMMANDS: [&str; 5] = ["predict", "sweep", "phase", "risk", "plan"];
 
 /// Flags that write files or choose an output format: the API always answers JSON and
 /// writes nothing.
@@ -116,6 +121,10 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
         "phase" => {
             let args: phase::PhaseArgs = parse("phase", params, served)?;
             json(&phase::answer(&args, MAX_PHASE_CELLS).map_err(|e| ApiError::from_command(&e))?)
+        }
+        "risk" => {
+            let args: risk::RiskArgs = parse("risk", params, served)?;
+            json(&risk::answer(&args, RISK_LIMITS).map_err(|e| ApiError::from_command(&e))?)
         }
         "plan" => {
             let args: plan::PlanArgs = parse("plan", params, served)?;

@@ -363,7 +363,10 @@ function drawEnvelope(env) {
   for (const p of env.points) {
     if (p.max_payload_kg === null) continue;
     path += `${f.x(p.slope_deg)},${f.y(p.max_payload_kg)} `;
-    el("circle", { cx: f.x(p.slope_deg), cy: f.y(p.max_payload_kg), r: 3.5, fill: COLOURS.sinkage }, svg);
+    el("circle", {
+      cx: f.x(p.slope_deg), cy: f.y(p.max_payload_kg), r: 3.5, fill: COLOURS.sinkage,
+      "data-slope-deg": String(p.slope_deg), "data-max-payload-kg": String(p.max_payload_kg),
+    }, svg);
   }
   el("polyline", { points: path.trim(), fill: "none", stroke: COLOURS.sinkage, "stroke-width": 2.5 }, svg);
   text(svg, f.w - 20, f.m.t + 14, `robot ${env.robot_mass_kg} kg, max risk ${env.max_risk}`, { "text-anchor": "end" });

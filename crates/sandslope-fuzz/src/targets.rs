@@ -63,6 +63,10 @@ const RASTERS: &[&str] = &[
     "crates/sandslope-io/tests/fixtures/gdal/geo-wgs84-lzw-pred3.tif",
     "crates/sandslope-io/tests/fixtures/gdal/geo-wgs84-lzw-pred2-i16-be.tif",
     "crates/sandslope-io/tests/fixtures/gdal/mars-sphere.tif",
+    "crates/sandslope-io/tests/fixtures/gdal/zstd-pred3-tiled.tif",
+    "crates/sandslope-io/tests/fixtures/gdal/bigtiff-lzw-pred3-tiled.tif",
+    "crates/sandslope-io/tests/fixtures/pds3/dtm-attached.img",
+    "crates/sandslope-io/tests/fixtures/pds3/moon-bytes.img",
 ];
 
 fn unit<T>(r: Result<T>) -> Result<()> {
@@ -152,10 +156,13 @@ pub const TARGETS: &[Target] = &[
         file_name: "dem.tif",
         companions: &[],
         run: Run::Reader(|p| {
-            // The same bytes as a GeoTIFF and as an ASCII grid: each reader meets both.
-            let asc = p.with_extension("asc");
-            std::fs::copy(p, &asc)?;
-            let _ = read_raster(&asc);
+            // The same bytes as a GeoTIFF, an ASCII grid and a PDS3 image (attached label):
+            // each reader meets every format.
+            for ext in ["asc", "img"] {
+                let other = p.with_extension(ext);
+                std::fs::copy(p, &other)?;
+                let _ = read_raster(&other);
+            }
             unit(read_raster(p))
         }),
     },

@@ -80,20 +80,8 @@ fn check_tiff_directory(name: &dyn std::fmt::Display, file: &mut File) -> Result
         b"MM" => false,
         _ => return Ok(()), // not a TIFF: the decoder says so
     };
-    let u16_at =
-        |b: &[u8]| if little { u16::from_le_bytes([b[0], b[1]]) } else { u16::from_be_bytes([b[0], b[1]]) };
-    let u32_at = |b: &[u8]| {
-        let a = [b[0], b[1], b[2], b[3]];
-        u64::from(if little { u32::from_le_bytes(a) } else { u32::from_be_bytes(a) })
-    };
-    let u64_at = |b: &[u8]| {
-        let a: [u8; 8] = b[..8].try_into().expect("8 bytes");
-        if little {
-            u64::from_le_bytes(a)
-        } else {
-            u64::from_be_bytes(a)
-        }
-    };
+    let (u16_at, u32_at, u64_at) =
+        (|b: &[u8]| u16_at(b, little), |b: &[u8]| u32_at(b, little), |b: &[u8]| u64_at(b, little));
     let big = match u16_at(&head[2..4]) {
         42 => false,
         43 if got >= 16 => true,
@@ -146,6 +134,32 @@ fn check_tiff_directory(name: &dyn std::fmt::Display, file: &mut File) -> Result
 /// Image directories checked by [`check_tiff_directory`] (a COG has one per overview and mask).
 const MAX_IFDS: usize = 64;
 
+/// A TIFF's 16-bit field at the start of `b`, in the file's byte order.
+fn u16_at(b: &[u8], little: bool) -> u16 {
+    let a = [b[0], b[1]];
+    if little {
+        u16::from_le_bytes(a)
+    } else {
+        u16::from_be_bytes(a)
+    }
+}
+
+/// A TIFF's 32-bit field at the start of `b`, in the file's byte order, widened.
+fn u32_at(b: &[u8], little: bool) -> u64 {
+    let a = [b[0], b[1], b[2], b[3]];
+    u64::from(if little { u32::from_le_bytes(a) } else { u32::from_be_bytes(a) })
+}
+
+/// A BigTIFF's 64-bit field at the start of `b`, in the file's byte order.
+fn u64_at(b: &[u8], little: bool) -> u64 {
+    let a = [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]];
+    if little {
+        u64::from_le_bytes(a)
+    } else {
+        u64::from_be_bytes(a)
+    }
+}
+
 /// Checks one directory's entries (see [`check_tiff_directory`]).
 fn check_entries(
     name: &dyn std::fmt::Display,
@@ -156,20 +170,8 @@ fn check_entries(
     big: bool,
     little: bool,
 ) -> Result<()> {
-    let u16_at =
-        |b: &[u8]| if little { u16::from_le_bytes([b[0], b[1]]) } else { u16::from_be_bytes([b[0], b[1]]) };
-    let u32_at = |b: &[u8]| {
-        let a = [b[0], b[1], b[2], b[3]];
-        u64::from(if little { u32::from_le_bytes(a) } else { u32::from_be_bytes(a) })
-    };
-    let u64_at = |b: &[u8]| {
-        let a: [u8; 8] = b[..8].try_into().expect("8 bytes");
-        if little {
-            u64::from_le_bytes(a)
-        } else {
-            u64::from_be_bytes(a)
-        }
-    };
+    let (u16_at, u32_at, u64_at) =
+        (|b: &[u8]| u16_at(b, little), |b: &[u8]| u32_at(b, little), |b: &[u8]| u64_at(b, little));
     for e in buf.chunks_exact(entry_len as usize) {
         let tag = u16_at(&e[0..2]);
         let size_of = match u16_at(&e[2..4]) {

@@ -219,6 +219,73 @@ fn risk_endpoint_equals_risk_json_in_every_mode() {
 }
 
 #[test]
+fn simulate_endpoint_equals_simulate_json_and_feeds_the_animation() {
+    let server = Server::start(&[]);
+    assert_same(&server, "simulate", &[("slope", "10".into())]);
+    assert_same(
+        &server,
+        "simulate",
+        &[("slope", "-5".into()), ("duration", "4".into()), ("mass", "0.5".into())],
+    );
+    assert_same(
+        &server,
+        "simulate",
+        &[("slope", "15".into()), ("duration", "3".into()), ("k-s", "5e5".into())],
+    );
+    // --slopes: a list, even of one slope.
+    assert_same(&server, "simulate", &[("slopes", "0:20:3".into()), ("duration", "3".into())]);
+    assert_same(&server, "simulate", &[("slopes", "10".into()), ("duration", "2".into())]);
+    // The server's limits and the command's own checks, each naming its flag.
+    for (path, field, says) in [
+        ("/api/simulate?slope=10&duration=61", "duration", "60"),
+        ("/api/simulate?slopes=0:20:101&duration=2", "slopes", "100"),
+        ("/api/simulate?slope=10&rate=5000", "rate", "1000"),
+        ("/api/simulate?slope=10&dt=1e-5&duration=30", "dt", "2e6"),
+        ("/api/simulate?slopes=0:20:100&duration=30", "duration", "2e6"),
+        ("/api/simulate?slope=10&duration=0.1", "duration", "1.5"),
+        ("/api/simulate?slope=95", "slope", "90"),
+        ("/api/simulate?duration=5", "slope", "--slope"),
+        ("/api/simulate?slope=10&animate=%2Ftmp%2Fa.gif", "animate", "no file"),
+        ("/api/simulate?slope=10&out=walk.csv", "out", "no file"),
+        ("/api/simulate?slope=10&yield=NaN", "yield", "yield"),
+        ("/data/simulation?slopes=0:10:2", "slopes", "one walk"),
+        ("/data/simulation?slope=10&duration=60&rate=1000", "rate", "7200"),
+    ] {
+        let (status, got, error) = refused(&server, "GET", path, b"");
+        assert_eq!((status, got.as_deref()), (400, Some(field)), "{path}: {error}");
+        assert!(error.contains(says), "{path}: {error}");
+    }
+    // The page's walk: the same summary, the trajectory at the asked rate, the robot's legs.
+    let (status, body) = server.get("/data/simulation?slope=10&duration=4&rate=30");
+    assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
+    let walk: serde_json::Value = serde_json::from_slice(&body).unwrap();
+    let (_, api) = server.get("/api/simulate?slope=10&duration=4&rate=30");
+    assert_eq!(walk["summary"], serde_json::from_slice::<serde_json::Value>(&api).unwrap());
+    let tr = &walk["trajectory"];
+    let times: Vec<f64> = tr["time_s"].as_array().unwrap().iter().map(|t| t.as_f64().unwrap()).collect();
+    // 0 to 4 s every 1/30 s, ends included: 121 samples.
+    assert_eq!(times.len(), 121);
+    for (k, t) in times.iter().enumerate() {
+        assert!((t - k as f64 / 30.0).abs() < 1e-9, "sample {k} at {t} s");
+    }
+    // The paper's hexapod: 3 stance legs per tripod, so 6 legs in two tripods.
+    let g = &walk["geometry"];
+    assert_eq!(g["hip_x_m"].as_array().unwrap().len(), 6);
+    assert_eq!(g["tripod"], serde_json::json!([0, 0, 0, 1, 1, 1]));
+    for key in ["leg_angle_rad", "leg_force_x_n", "leg_force_z_n"] {
+        let legs = tr[key].as_array().unwrap();
+        assert_eq!(legs.len(), 6, "{key}");
+        assert!(legs.iter().all(|l| l.as_array().unwrap().len() == 121), "{key}");
+    }
+    // The body moves as fast as the summary says: x(4 s) - x(0) is the measured speed times
+    // 4 s within a quarter (the first stride, left out of the speed, settles the gait).
+    let x = tr["x_m"].as_array().unwrap();
+    let moved = x[120].as_f64().unwrap() - x[0].as_f64().unwrap();
+    let speed = walk["summary"]["speed_m_s"].as_f64().unwrap();
+    assert!((moved - speed * 4.0).abs() < 0.25 * (speed * 4.0).abs() + 0.02, "{moved} m at {speed} m/s");
+}
+
+#[test]
 fn plan_endpoint_and_downloads_equal_plans_json_and_files() {
     let dem = repo_file("examples/planning/dune.asc").to_string_lossy().into_owned();
     let server = Server::start(&["--dem", &dem]);
@@ -605,6 +672,42 @@ fn clicking_start_and_goal_on_the_example_dem_draws_plans_routes() {
     common::assert_shows_content(&shot);
     if let Ok(keep) = std::env::var("SANDSLOPE_SERVE_SCREENSHOTS") {
         std::fs::copy(&shot, std::path::Path::new(&keep).join("routes.png")).unwrap();
+    }
+}
+
+#[test]
+fn the_simulate_tab_animates_simulates_walk() {
+    let Some(browser) = common::chromium_or_skip("the_simulate_tab_animates_simulates_walk") else {
+        return;
+    };
+    let server = Server::start(&[]);
+    let page = "/?tab=simulate&sim-slope=12.5&sim-duration=4";
+    let (dom, console) = browse(&browser, &server, page, None);
+    assert_clean(&server, &dom, &console);
+    let raw = String::from_utf8(cli_stdout(&[
+        "simulate".into(),
+        "--slope=12.5".into(),
+        "--duration=4".into(),
+        "--rate=30".into(),
+        "--json".into(),
+    ]))
+    .unwrap();
+    let shown = attribute(&dom, "id=\"sim-speed\"", "data-speed-m-s").expect("no simulated speed");
+    assert_eq!(shown.parse::<f64>().unwrap(), raw_number(&raw, "speed_m_s", 0).parse::<f64>().unwrap());
+    assert_eq!(attribute(&dom, "id=\"sim-speed\"", "data-slope-deg").as_deref(), Some("12.5"));
+    let cf = raw.find("\"closed_form\"").unwrap();
+    let shown = attribute(&dom, "id=\"sim-cf-speed\"", "data-speed-m-s").expect("no closed-form speed");
+    assert_eq!(shown, raw_number(&raw, "speed_m_s", cf));
+    // 0 to 4 s at 30 frames/s; the animation has moved on from the first frame.
+    assert_eq!(attribute(&dom, "id=\"sim-canvas\"", "data-frames").as_deref(), Some("121"));
+    let frame: usize = attribute(&dom, "id=\"sim-canvas\"", "data-frame").unwrap().parse().unwrap();
+    assert!(frame > 0, "the animation did not advance");
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("simulate.png");
+    browse(&browser, &server, page, Some(&shot));
+    common::assert_shows_content(&shot);
+    if let Ok(keep) = std::env::var("SANDSLOPE_SERVE_SCREENSHOTS") {
+        std::fs::copy(&shot, std::path::Path::new(&keep).join("simulate.png")).unwrap();
     }
 }
 

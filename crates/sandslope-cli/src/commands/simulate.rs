@@ -119,6 +119,73 @@ pub enum Answer {
     Many(Vec<SimSummary>),
 }
 
+/// The walks `simulate` runs for its flags, checked as [`run`] checks them: what `serve`'s
+/// `/api/simulate` weighs against its limits before running them.
+#[derive(Debug)]
+pub struct Walks {
+    /// The robot on its terrain.
+    pub scenario: Scenario,
+    /// The slopes, degrees: `--slopes`, or the one `--slope`.
+    pub slopes: Vec<f64>,
+    /// Whether they came from `--slopes` (the answer is then a list, even of one).
+    pub many: bool,
+    /// The checked settings.
+    pub settings: SimSettings,
+}
+
+impl Walks {
+    /// Reads the robot and terrain and checks every flag but the output files.
+    pub fn prepare(args: &SimulateArgs) -> Result<Walks> {
+        let settings = settings(args)?;
+        let slopes = args.slopes.as_deref().map(parse_slopes).transpose()?;
+        let scenario = args.over.scenario(&args.robot, &args.terrain)?;
+        let (slopes, many) = match slopes {
+            Some(slopes) => (slopes, true),
+            None => {
+                let slope = args.slope.ok_or_else(|| anyhow!("--slope or --slopes is required"))?;
+                check_flag("--slope", slope, -89.999_999, 89.999_999)
+                    .map_err(|_| anyhow!("--slope = {slope} must be strictly between -90 and 90 degrees"))?;
+                (vec![slope], false)
+            }
+        };
+        Ok(Walks { scenario, slopes, many, settings })
+    }
+
+    /// Integration steps of all the walks, settling included (what they cost to run).
+    pub fn integration_steps(&self) -> Result<f64> {
+        let mut steps = 0.0;
+        for &deg in &self.slopes {
+            let slope = sandslope::Slope::from_signed_degrees(deg)
+                .map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+            let dt = sandslope::simulate::integration_step(&self.scenario, slope, self.settings.dt_s)
+                .map_err(flagged)?;
+            steps += (self.settings.duration_s + self.settings.settle_s) / dt;
+        }
+        Ok(steps)
+    }
+
+    /// Runs the walks (several in parallel), as `run` does.
+    pub fn simulate(&self) -> Result<Vec<Simulation>> {
+        if self.many {
+            simulate_slopes(&self.scenario, &self.slopes, &self.settings).map_err(sim_err)
+        } else {
+            Ok(vec![simulate(&self.scenario, self.slopes[0], &self.settings).map_err(sim_err)?])
+        }
+    }
+
+    /// The value `simulate --json` prints for these walks' results.
+    pub fn answer(&self, sims: Vec<Simulation>) -> Answer {
+        let mut summaries: Vec<SimSummary> = sims.into_iter().map(|s| s.summary).collect();
+        match (self.many, summaries.pop()) {
+            (false, Some(one)) if summaries.is_empty() => Answer::One(Box::new(one)),
+            (_, last) => {
+                summaries.extend(last);
+                Answer::Many(summaries)
+            }
+        }
+    }
+}
+
 /// Runs `sandslope simulate`.
 pub fn run(args: SimulateArgs) -> Result<()> {
     let settings = settings(&args)?;

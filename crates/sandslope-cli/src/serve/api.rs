@@ -16,7 +16,7 @@ use clap::error::{ContextKind, ContextValue};
 use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
-use crate::commands::{phase, plan, predict, risk, sweep};
+use crate::commands::{phase, plan, predict, risk, simulate, sweep};
 use sandslope_io::presets::{self, PresetKind};
 
 /// Most slopes one `/api/sweep` request evaluates.
@@ -30,6 +30,17 @@ pub const MAX_PHASE_CELLS: u128 = 1 << 20;
 pub const RISK_LIMITS: risk::AnswerLimits =
     risk::AnswerLimits { curve_slopes: 1000, envelope_slopes: 100, map_cells: 1 << 20 };
 
+/// Longest walk one `/api/simulate` request simulates, s (the command line has no limit but
+/// the library's 2e7 integration steps).
+pub const MAX_SIM_DURATION_S: f64 = 60.0;
+/// Most slopes of one `/api/simulate?slopes=...` request (the command line allows 1000).
+pub const MAX_SIM_SLOPES: usize = 100;
+/// Highest trajectory sample rate one request may ask for, Hz (the command line allows 1e5).
+pub const MAX_SIM_RATE_HZ: f64 = 1000.0;
+/// Most integration steps of one request, over all its slopes, settling included (2e6 at the
+/// default 1 ms step is 100 slopes of 10 s or 33 of 60 s: about 2 s of one core, release build).
+pub const MAX_SIM_STEPS: f64 = 2e6;
+
 /// The files the server was started with; requests that name none use these.
 #[derive(Debug, Clone)]
 pub struct Served {
@@ -42,12 +53,23 @@ pub struct Served {
 }
 
 /// The commands the API answers, in the order docs/serve.md lists them.
-pub const COMMANDS: [&str; 5] = ["predict", "sweep", "phase", "risk", "plan"];
+pub const COMMANDS: [&str; 6] = ["predict", "sweep", "phase", "risk", "simulate", "plan"];
 
 /// Flags that write files or choose an output format: the API always answers JSON and
 /// writes nothing.
-const OUTPUT_FLAGS: [&str; 10] =
-    ["json", "csv", "plot", "npy", "observed", "geojson", "risk-map", "out", "classes", "class-terrain"];
+const OUTPUT_FLAGS: [&str; 11] = [
+    "json",
+    "csv",
+    "plot",
+    "npy",
+    "observed",
+    "geojson",
+    "risk-map",
+    "out",
+    "classes",
+    "class-terrain",
+    "animate",
+];
 
 /// A refused request: the HTTP status, the parameter at fault (when one is) and why.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -126,6 +148,11 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
             let args: risk::RiskArgs = parse("risk", params, served)?;
             json(&risk::answer(&args, RISK_LIMITS).map_err(|e| ApiError::from_command(&e))?)
         }
+        "simulate" => {
+            let walks = simulate_walks(params, served)?;
+            let sims = walks.simulate().map_err(|e| ApiError::from_command(&e))?;
+            json(&walks.answer(sims))
+        }
         "plan" => {
             let args: plan::PlanArgs = parse("plan", params, served)?;
             let planned = plan::compute(&args, false, true).map_err(|e| ApiError::from_command(&e))?;
@@ -137,6 +164,50 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
             error: format!("no endpoint /api/{command}; the API answers {}", COMMANDS.join(", ")),
         }),
     }
+}
+
+/// The walks a `simulate` request asks for, checked by the command's own flags and then
+/// against the server's limits ([`MAX_SIM_DURATION_S`], [`MAX_SIM_SLOPES`],
+/// [`MAX_SIM_RATE_HZ`], [`MAX_SIM_STEPS`]), each refusal naming its flag and limit.
+pub fn simulate_walks(params: &[(String, String)], served: &Served) -> Result<simulate::Walks, ApiError> {
+    let args: simulate::SimulateArgs = parse("simulate", params, served)?;
+    let walks = simulate::Walks::prepare(&args).map_err(|e| ApiError::from_command(&e))?;
+    let duration = walks.settings.duration_s;
+    if duration > MAX_SIM_DURATION_S {
+        return Err(ApiError::bad(
+            Some("duration".to_string()),
+            format!(
+                "--duration = {duration} s: the server simulates at most {MAX_SIM_DURATION_S} s per walk"
+            ),
+        ));
+    }
+    if walks.slopes.len() > MAX_SIM_SLOPES {
+        return Err(ApiError::bad(
+            Some("slopes".to_string()),
+            format!(
+                "--slopes gives {} slopes: the server simulates at most {MAX_SIM_SLOPES} per request",
+                walks.slopes.len()
+            ),
+        ));
+    }
+    if args.rate > MAX_SIM_RATE_HZ {
+        return Err(ApiError::bad(
+            Some("rate".to_string()),
+            format!("--rate = {} Hz: the server samples at most {MAX_SIM_RATE_HZ} Hz", args.rate),
+        ));
+    }
+    let steps = walks.integration_steps().map_err(|e| ApiError::from_command(&e))?;
+    if steps > MAX_SIM_STEPS {
+        let flag = if args.dt.is_some() { "dt" } else { "duration" };
+        return Err(ApiError::bad(
+            Some(flag.to_string()),
+            format!(
+                "--duration, --dt and the slopes ask for {steps:.3e} integration steps: the server takes at \
+                 most {MAX_SIM_STEPS:e} per request"
+            ),
+        ));
+    }
+    Ok(walks)
 }
 
 /// `value` as `print_json` prints it: pretty JSON and a newline.

@@ -12,6 +12,9 @@ use sandslope_io::raster::{read_raster, write_two_band_geotiff};
 
 /// Most cells of a `/data/phase-map` (the page asks for about 160 x 160).
 pub const MAX_MAP_CELLS: u128 = 1 << 18;
+/// Most trajectory samples of a `/data/simulation` (duration x rate: 60 s at 120 Hz; the page
+/// asks for 30 Hz).
+pub const MAX_SIM_SAMPLES: f64 = 7200.0;
 /// Most cells sent for the DEM and its risk raster; a larger DEM is sent every `stride`-th
 /// cell in each direction.
 pub const MAX_DISPLAY_CELLS: usize = 1 << 20;
@@ -57,9 +60,10 @@ pub fn answer(name: &str, params: &[(String, String)], served: &Served) -> Resul
         "dem" => dem(served),
         "phase-map" => phase_map(params, served),
         "risk-map" => risk_map(params, served),
+        "simulation" => simulation(params, served),
         _ => Err(not_found(
             &format!("/data/{name}"),
-            "/data/served, /data/dem, /data/phase-map, /data/risk-map",
+            "/data/served, /data/dem, /data/phase-map, /data/risk-map, /data/simulation",
         )),
     }
     .map(Reply::json)
@@ -269,4 +273,31 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, Api
     };
     let stride = stride(cols, rows);
     compact(&Grid { cols, rows, stride, values: sampled(&p_fail, cols, rows, stride) })
+}
+
+/// One walk of `simulate` with these flags (one `slope`, not `slopes`), whole: the summary
+/// `simulate --json` prints, the trajectory sampled at `rate` and the legs' geometry, for the
+/// page's animation (the library's [`sandslope::simulate::Simulation`], as compact JSON).
+fn simulation(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, ApiError> {
+    if params.iter().any(|(k, _)| k == "slopes") {
+        return Err(ApiError::bad(
+            Some("slopes".to_string()),
+            "/data/simulation animates one walk: give slope, not slopes (/api/simulate takes slopes)",
+        ));
+    }
+    let walks = api::simulate_walks(params, served)?;
+    let samples = walks.settings.duration_s * walks.settings.sample_rate_hz;
+    if samples > MAX_SIM_SAMPLES {
+        return Err(ApiError::bad(
+            Some("rate".to_string()),
+            format!(
+                "--duration x --rate = {samples} trajectory samples: the page's animation takes at most {MAX_SIM_SAMPLES}"
+            ),
+        ));
+    }
+    let sim = walks.simulate().map_err(|e| ApiError::from_command(&e))?.pop();
+    let Some(sim) = sim else {
+        return Err(ApiError::bad(Some("slope".to_string()), "no walk: give a slope"));
+    };
+    compact(&sim)
 }

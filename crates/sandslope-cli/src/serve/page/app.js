@@ -96,7 +96,7 @@ const state = {
   sweep: null,
   phase: null,
   point: null,
-  visited: { explore: true, risk: false, routes: false },
+  visited: { explore: true, risk: false, routes: false, simulate: false },
   dem: null,
   overlay: null,
   start: null,
@@ -588,6 +588,170 @@ function drawTable(json) {
   }
 }
 
+// ---- Simulate ----
+// The walk comes whole from /data/simulation (the library's Simulation: the summary
+// `simulate --json` prints, the trajectory sampled at SIM_RATE_HZ, the legs' outline and hips);
+// the page only places the body and legs where the trajectory says, as the GIF of
+// `simulate --animate` does (src/figures/simulate.rs draw_frame).
+const SIM_RATE_HZ = 30;
+const sim = { walk: null, pos: 0, playing: true, timer: null };
+function simFlags() {
+  return { ...exploreFlags(), slope: $("sim-slope").value, duration: $("sim-duration").value, rate: String(SIM_RATE_HZ) };
+}
+function updateSimulation() {
+  fresh("simulate", () => get("/data/simulation", simFlags()), showSimulation);
+}
+function both(a, b, scale, digits) {
+  const f = (v) => (v === null || v === undefined ? "-" : fmt(v * scale, digits));
+  return `${f(a)} | ${f(b)}`;
+}
+function showSimulation(walk) {
+  sim.walk = walk;
+  sim.pos = 0;
+  const m = walk.summary;
+  const cf = m.closed_form;
+  $("sim-regime").textContent = `${m.regime} | ${cf.regime}`;
+  const speed = $("sim-speed");
+  speed.textContent = `${fmt(m.speed_m_s * 100, 2)} ± ${fmt(m.speed_sd_m_s * 100, 2)}`;
+  speed.dataset.speedMS = String(m.speed_m_s);
+  speed.dataset.slopeDeg = String(m.slope_deg);
+  const cfSpeed = $("sim-cf-speed");
+  if (cf.speed_m_s !== null) cfSpeed.textContent = fmt(cf.speed_m_s * 100, 2);
+  else if (cf.model_speed_m_s !== null) cfSpeed.textContent = `(${fmt(cf.model_speed_m_s * 100, 2)})`;
+  else cfSpeed.textContent = "-";
+  cfSpeed.dataset.speedMS = String(cf.speed_m_s);
+  $("sim-t1").textContent = both(m.t1_s, cf.t1_s, 1e3, 1);
+  $("sim-slip").textContent = both(m.slip_m, cf.slip_m, 1e3, 2);
+  $("sim-step").textContent = both(m.step_m, cf.step_m, 1e3, 1);
+  $("sim-depth").textContent = `${fmt(m.max_depth_m * 1e3, 1)} (${fmt(m.d_max_m * 1e3, 1)})`;
+  let cause = `simulated: ${m.cause.replaceAll("_", " ")}, over ${m.steps_measured} measured steps of ${m.duration_s} s at dt = ${m.dt_s.toExponential(2)} s`;
+  if (m.unanchored_steps > 0) cause += ` (${m.unanchored_steps} never anchored)`;
+  if (m.stalled_legs.length) cause += `; servo stalled on legs ${m.stalled_legs.join(", ")}`;
+  cause += `. Closed form: ${cf.cause.replaceAll("_", " ")}: ${state.causes[cf.cause] || ""}`;
+  $("sim-cause").textContent = cause;
+  const n = walk.trajectory.time_s.length;
+  const slider = $("sim-time");
+  slider.max = String(Math.max(0, n - 1));
+  $("sim-canvas").dataset.frames = String(n);
+  drawSimFrame();
+}
+function legColour(tripod, rank, n) {
+  const base = tripod === 0 ? [31, 90, 180] : [230, 120, 20];
+  const f = n > 1 ? (0.45 * rank) / (n - 1) : 0;
+  return `rgb(${base.map((c) => Math.floor(c + (255 - c) * f)).join(",")})`;
+}
+function drawSimFrame() {
+  const walk = sim.walk;
+  if (!walk) return;
+  const tr = walk.trajectory;
+  const g = walk.geometry;
+  const n = tr.time_s.length;
+  if (n === 0) return;
+  const i = Math.min(n - 1, Math.floor(sim.pos) % n);
+  const canvas = $("sim-canvas");
+  canvas.dataset.frame = String(i);
+  $("sim-time").value = String(i);
+  $("sim-time-out").textContent = `t = ${tr.time_s[i].toFixed(2)} s`;
+  const ctx = canvas.getContext("2d");
+  const W = canvas.width;
+  const H = canvas.height;
+  const theta = (walk.summary.slope_deg * Math.PI) / 180;
+  const s = Math.sin(theta);
+  const c = Math.cos(theta);
+  const world = (p) => [p[0] * c - p[1] * s, p[0] * s + p[1] * c];
+  const x = tr.x_m[i];
+  const z = tr.z_m[i];
+  const phi = tr.pitch_rad[i];
+  const centre = world([x, z]);
+  const halfW = 0.25;
+  const halfH = (halfW * H) / W;
+  const px = (p) => [((p[0] - centre[0] + halfW) / (2 * halfW)) * W, H - ((p[1] - centre[1] + halfH) / (2 * halfH)) * H];
+  const path = (points, close) => {
+    ctx.beginPath();
+    points.forEach((p, k) => {
+      const [u, v] = px(p);
+      if (k === 0) ctx.moveTo(u, v);
+      else ctx.lineTo(u, v);
+    });
+    if (close) ctx.closePath();
+  };
+  ctx.fillStyle = "#fff";
+  ctx.fillRect(0, 0, W, H);
+  // Sand: the slope frame below its surface, turned into the world.
+  const far = 2;
+  path([world([x - far, 0]), world([x + far, 0]), world([x + far, -far]), world([x - far, -far])], true);
+  ctx.fillStyle = "rgb(230,205,150)";
+  ctx.fill();
+  path([world([x - far, 0]), world([x + far, 0])], false);
+  ctx.strokeStyle = "rgb(150,120,60)";
+  ctx.lineWidth = 2;
+  ctx.stroke();
+  // Marks on the sand every 5 cm along the slope, so the walk shows against the ground.
+  ctx.lineWidth = 1;
+  for (let k = Math.floor((x - 0.4) / 0.05); k <= Math.ceil((x + 0.4) / 0.05); k++) {
+    path([world([k * 0.05, 0]), world([k * 0.05, -0.012])], false);
+    ctx.stroke();
+  }
+  // Body: a box from the belly (h below the axle) to 0.3 h above it, pitched.
+  const sp = Math.sin(phi);
+  const cp = Math.cos(phi);
+  const body = (p) => world([x + cp * p[0] - sp * p[1], z + sp * p[0] + cp * p[1]]);
+  const l = g.body_length_m;
+  const h = g.hip_height_m;
+  path([[-l / 2, -h], [l / 2, -h], [l / 2, 0.3 * h], [-l / 2, 0.3 * h]].map(body), true);
+  ctx.fillStyle = "rgba(90,90,90,0.8)";
+  ctx.fill();
+  const legs = g.hip_x_m.length;
+  const half = Math.max(1, Math.floor(legs / 2));
+  const scale = 0.02; // m of arrow per N
+  for (let j = 0; j < legs; j++) {
+    const a = phi - tr.leg_angle_rad[j][i];
+    const sa = Math.sin(a);
+    const ca = Math.cos(a);
+    const hp = [cp * g.hip_x_m[j], sp * g.hip_x_m[j]];
+    const pts = g.leg_nodes_m.map((p) => world([x + hp[0] + ca * p[0] - sa * p[1], z + hp[1] + sa * p[0] + ca * p[1]]));
+    path(pts, false);
+    ctx.strokeStyle = legColour(g.tripod[j], j % half, half);
+    ctx.lineWidth = g.tripod[j] === 0 ? 4 : 3;
+    ctx.stroke();
+    const fx = tr.leg_force_x_n[j][i];
+    const fz = tr.leg_force_z_n[j][i];
+    if (Math.hypot(fx, fz) > 0.05) {
+      let lowest = pts[0];
+      for (const p of pts) if (-p[0] * s + p[1] * c < -lowest[0] * s + lowest[1] * c) lowest = p;
+      const tip = [lowest[0] + scale * (fx * c - fz * s), lowest[1] + scale * (fx * s + fz * c)];
+      path([lowest, tip], false);
+      ctx.strokeStyle = "#d00";
+      ctx.lineWidth = 2;
+      ctx.stroke();
+      const [u, v] = px(tip);
+      ctx.fillStyle = "#d00";
+      ctx.beginPath();
+      ctx.arc(u, v, 3, 0, 2 * Math.PI);
+      ctx.fill();
+    }
+  }
+  const [u, v] = px(centre);
+  ctx.fillStyle = "#000";
+  ctx.beginPath();
+  ctx.arc(u, v, 4, 0, 2 * Math.PI);
+  ctx.fill();
+  ctx.font = "14px system-ui, sans-serif";
+  ctx.fillText(`t = ${tr.time_s[i].toFixed(2)} s, ${walk.summary.slope_deg} deg, x = ${(x * 100).toFixed(1)} cm, speed ${fmt(walk.summary.speed_m_s * 100, 2)} cm/s (simulated)`, 10, 20);
+}
+// Plays the walk at its sample rate (times the chosen speed) while the tab is shown.
+function simTick() {
+  sim.timer = setTimeout(simTick, 1000 / SIM_RATE_HZ);
+  if (!sim.walk || !sim.playing || !$("simulate").classList.contains("active")) return;
+  sim.pos = (sim.pos + Number($("sim-rate").value)) % sim.walk.trajectory.time_s.length;
+  drawSimFrame();
+}
+function setSimSlope(value) {
+  $("sim-slope").value = value;
+  $("sim-slope-num").value = value;
+  soon("sim", updateSimulation, 150);
+}
+
 // ---- wiring ----
 function showTab(name) {
   for (const b of document.querySelectorAll("#tabs button")) b.classList.toggle("active", b.dataset.tab === name);
@@ -596,6 +760,10 @@ function showTab(name) {
     state.visited[name] = true;
     if (name === "risk") updateRisk();
     if (name === "routes") state.mapReady = loadMap();
+    if (name === "simulate") {
+      updateSimulation();
+      simTick();
+    }
   }
 }
 function onRobotChange() {
@@ -607,6 +775,7 @@ function onRobotChange() {
       updateOverlay();
       updatePlan();
     }
+    if (state.visited.simulate) updateSimulation();
   });
 }
 function syncMassSlider() {
@@ -688,8 +857,19 @@ async function start() {
     updatePlan();
   });
   $("map").addEventListener("click", onMapClick);
+  $("sim-slope").addEventListener("input", () => setSimSlope($("sim-slope").value));
+  $("sim-slope-num").addEventListener("change", () => setSimSlope($("sim-slope-num").value));
+  $("sim-duration").addEventListener("change", updateSimulation);
+  $("sim-play").addEventListener("click", () => {
+    sim.playing = !sim.playing;
+    $("sim-play").textContent = sim.playing ? "pause" : "play";
+  });
+  $("sim-time").addEventListener("input", () => {
+    sim.pos = Number($("sim-time").value);
+    drawSimFrame();
+  });
 
-  // The page's URL can set what a user would: ?slope=20, ?tab=risk, ?mass=1.2,
+  // The page's URL can set what a user would: ?slope=20, ?tab=risk, ?mass=1.2, ?tab=simulate,
   // ?tab=routes&start-px=COL,ROW&goal-px=COL,ROW (clicked on the map once it is drawn).
   for (const flag of ROBOT_FLAGS) if (pageUrl.has(flag)) $(flag).value = pageUrl.get(flag);
   syncMassSlider();
@@ -697,8 +877,11 @@ async function start() {
   await updateExplore();
   // ?slope= moves the slider as a user would (an input event), after the first answer is shown.
   if (pageUrl.has("slope")) setSlope(pageUrl.get("slope"));
+  // ?tab=simulate&sim-slope=DEG&sim-duration=S: the Simulate tab's walk.
+  for (const key of ["sim-slope", "sim-duration"]) if (pageUrl.has(key)) $(key).value = pageUrl.get(key);
+  $("sim-slope-num").value = $("sim-slope").value;
   const tab = pageUrl.get("tab");
-  if (tab === "risk" || tab === "routes") showTab(tab);
+  if (["risk", "routes", "simulate"].includes(tab)) showTab(tab);
   if (tab === "routes" && pageUrl.has("start-px") && pageUrl.has("goal-px")) {
     await state.mapReady;
     for (const key of ["start-px", "goal-px"]) {

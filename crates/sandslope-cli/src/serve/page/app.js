@@ -46,15 +46,38 @@ function busy(delta) {
 function query(params) {
   return new URLSearchParams(params).toString();
 }
+// At most MAX_FETCHES requests at once, so the browser keeps at most that many connections
+// open besides the page's own. The HTTP layer (tiny_http 0.12) reads each open connection on
+// a thread of a pool of 4 that grows on demand, and a burst of new connections can leave one
+// queued behind idle kept-alive ones, never read: with six requests at once the Risk tab's
+// load hung in 4 of 5 headless Chromium runs, a request's 562 bytes unread in the server's
+// socket; two at once, 0 of 20. The server computes on 2 threads by default anyway.
+const MAX_FETCHES = 2;
+let fetching = 0;
+const queued = [];
+async function fetchSlot() {
+  if (fetching < MAX_FETCHES) {
+    fetching += 1;
+    return;
+  }
+  await new Promise((resolve) => queued.push(resolve));
+}
+function releaseSlot() {
+  const next = queued.shift();
+  if (next) next();
+  else fetching -= 1;
+}
 async function get(path, params) {
   const q = params ? query(params) : "";
   busy(1);
+  await fetchSlot();
   try {
     const response = await fetch(q ? `${path}?${q}` : path);
     const body = await response.json();
     if (!response.ok) throw new RequestError(body.error || response.statusText, body.field);
     return body;
   } finally {
+    releaseSlot();
     busy(-1);
   }
 }

@@ -19,6 +19,7 @@ use sandslope::{
 use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
 use crate::figures::calibrate::{speed_pulls, CalibrationFigure};
 use crate::output::{check_parent_exists, print_json, table, write_atomic};
+use sandslope_io::robot_terrain::{robot_toml, terrain_toml};
 use sandslope_io::{load_anchoring_times, load_speeds, load_terrain};
 
 /// The law to fit, as named on the command line.
@@ -261,28 +262,26 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
         crate::figures::save(path, &CalibrationFigure { points: &points, curve: &curve, subtitle: &title })?;
     }
     let command: Vec<String> = std::env::args().skip(1).collect();
-    let mut text = String::new();
-    writeln!(text, "# Written by: sandslope {}", command.join(" "))?;
+    let mut header = String::new();
+    writeln!(header, "Written by: sandslope {}", command.join(" "))?;
     writeln!(
-        text,
-        "# Joint calibration (docs/calibration.md): chi^2 = {:.3} over {} dof; error floor {:.4} m/s; k_s(20)/k_s(0) = {:.3} [{:.3}, {:.3}].",
+        header,
+        "Joint calibration (docs/calibration.md): chi^2 = {:.3} over {} dof; error floor {:.4} m/s; k_s(20)/k_s(0) = {:.3} [{:.3}, {:.3}].",
         cal.chi_squared, cal.dof, cal.error_floor_m_s, cal.shear_ratio_20.value, cal.shear_ratio_20.lower, cal.shear_ratio_20.upper
     )?;
-    writeln!(text, "# repose_deg: {}", repose.source)?;
-    text.push_str(&toml::to_string(&cal.terrain)?);
-    write_atomic(&args.out, text.as_bytes())?;
+    write!(header, "repose_deg: {}", repose.source)?;
+    write_atomic(&args.out, terrain_toml(&cal.terrain, &header)?.as_bytes())?;
     if let Some(path) = &args.robot_out {
-        let mut text = String::new();
-        writeln!(text, "# Written by: sandslope {}", command.join(" "))?;
+        let mut header = String::new();
+        write!(header, "Written by: sandslope {}", command.join(" "))?;
         for p in cal.parameters.iter().filter(|p| matches!(p.quantity, Quantity::Free(Parameter::Robot(_)))) {
-            writeln!(
-                text,
-                "# {} fitted: {:.6e} (68% interval {:.6e} to {:.6e})",
+            write!(
+                header,
+                "\n{} fitted: {:.6e} (68% interval {:.6e} to {:.6e})",
                 p.name, p.estimate.value, p.estimate.lower, p.estimate.upper
             )?;
         }
-        text.push_str(&toml::to_string(&cal.robot)?);
-        write_atomic(path, text.as_bytes())?;
+        write_atomic(path, robot_toml(&cal.robot, &header)?.as_bytes())?;
     }
 
     if args.json {
@@ -397,12 +396,12 @@ fn run_per_slope(
     };
     Terrain::new(spec.clone()).map_err(|e| anyhow!("the calibrated terrain is not valid ({e})"))?;
     let command: Vec<String> = std::env::args().skip(1).collect();
-    let mut text = String::new();
-    writeln!(text, "# Written by: sandslope {}", command.join(" "))?;
-    writeln!(text, "# k_s per observed slope, inverted from each speed")?;
-    writeln!(text, "# repose_deg: {}", repose.source)?;
-    text.push_str(&toml::to_string(&spec)?);
-    write_atomic(&args.out, text.as_bytes())?;
+    let header = format!(
+        "Written by: sandslope {}\nk_s per observed slope, inverted from each speed\nrepose_deg: {}",
+        command.join(" "),
+        repose.source
+    );
+    write_atomic(&args.out, terrain_toml(&spec, &header)?.as_bytes())?;
     let residuals: Vec<ResidualRecord> = cal
         .points
         .iter()

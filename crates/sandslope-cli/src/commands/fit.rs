@@ -143,12 +143,11 @@ pub fn run(args: FitArgs) -> Result<()> {
     }
     if let Some(out) = &args.out {
         let header = format!(
-            "# Terrain fitted by `sandslope fit` from {} (docs/model.md §7).\n# k_n_sd/k_s_sd: sqrt(s^2 + mean \
-             se^2), the sample SD across trials combined with each trial's standard error (docs/measurements.md).\n",
+            "Terrain fitted by `sandslope fit` from {} (docs/model.md §7).\nk_n_sd/k_s_sd: sqrt(s^2 + mean \
+             se^2), the sample SD across trials combined with each trial's standard error (docs/measurements.md).",
             manifest.path.display()
         );
-        let body = toml::to_string(terrain.spec()).map_err(|e| anyhow!("cannot write terrain TOML: {e}"))?;
-        write_atomic(out, format!("{header}{body}").as_bytes())?;
+        write_atomic(out, sandslope_io::robot_terrain::terrain_toml(terrain.spec(), &header)?.as_bytes())?;
     }
     if let Some(dir) = &args.plot {
         figures::write_all(dir, &campaign)?;

@@ -5,7 +5,7 @@ together), every one checked answered with 200, latencies reported (p50, p99, ma
 Bounded: one round of N requests (default 200) to 127.0.0.1 only, then the server is stopped.
 
     cargo build --release -p sandslope-cli
-    python3 bench/serve/load.py [--requests 200] [--rounds 3] [--bin target/release/sandslope]
+    python3 bench/serve/load.py [--requests 200] [--rounds 3] [--mix basic|all] [--bin target/release/sandslope]
 """
 import argparse
 import http.client
@@ -14,9 +14,17 @@ import threading
 import time
 
 
-def paths(n):
+def paths(n, mix="basic"):
+    """The requests of one round: `basic` predict, sweep and phase; `all` also risk curves and
+    4 s simulator walks (one in six each)."""
     out = []
     for i in range(n):
+        if mix == "all" and i % 6 == 4:
+            out.append(f"/api/risk?slope=0:24:25&mass={0.3 + (i % 5) * 0.1:.1f}")
+            continue
+        if mix == "all" and i % 6 == 5:
+            out.append(f"/api/simulate?slope={i % 20}&duration=4")
+            continue
         k = i % 4
         if k in (0, 1):
             out.append(f"/api/predict?slope={i % 35}&mass={0.2 + (i % 7) * 0.1:.1f}")
@@ -27,7 +35,7 @@ def paths(n):
     return out
 
 
-def one_round(port, n):
+def one_round(port, n, mix):
     gate = threading.Barrier(n)
     results = [None] * n
 
@@ -41,7 +49,7 @@ def one_round(port, n):
         results[i] = (r.status, len(body), time.perf_counter() - t)
         c.close()
 
-    threads = [threading.Thread(target=worker, args=(i, p)) for i, p in enumerate(paths(n))]
+    threads = [threading.Thread(target=worker, args=(i, p)) for i, p in enumerate(paths(n, mix))]
     for t in threads:
         t.start()
     for t in threads:
@@ -54,13 +62,14 @@ def main():
     ap.add_argument("--bin", default="target/release/sandslope")
     ap.add_argument("--requests", type=int, default=200)
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--mix", choices=["basic", "all"], default="basic")
     a = ap.parse_args()
     server = subprocess.Popen([a.bin, "serve", "--port", "0"], stdout=subprocess.PIPE, text=True)
     try:
         line = server.stdout.readline().strip()
         port = int(line.rsplit(":", 1)[1].rstrip("/"))
         for k in range(a.rounds):
-            res = one_round(port, a.requests)
+            res = one_round(port, a.requests, a.mix)
             lost = [r for r in res if r is None or r[0] != 200]
             lat = sorted(r[2] * 1e3 for r in res if r)
             q = lambda p: lat[round((len(lat) - 1) * p)]

@@ -30,6 +30,10 @@ fn source(s: CvSource) -> &'static str {
     }
 }
 
+/// Slopes per chunk of [`risk`], between which Ctrl-C is checked (about 0.1 s of work each on
+/// this 2-core machine).
+const RISK_SLOPES_PER_CHUNK: usize = 128;
+
 /// Regime probabilities at each slope: the keys of `sandslope risk --json` as columns
 /// (`p_regime` a dict of columns) and the columns of `risk --csv` (`p_<regime>`), with the
 /// coefficients of variation used and where they came from (`given`, `table`, `default`).
@@ -48,12 +52,23 @@ pub fn risk<'py>(
     sandslope::limits::count("len(slope_deg)", degrees.len(), sandslope::limits::MAX_RISK_SLOPES)
         .map_err(value_error)?;
     let robot = &robot.inner;
-    let curve = py.detach(|| risk_curve(robot, &terrain, &degrees)).map_err(|e| {
-        // The library names the key; point at the element when there are several.
-        let at = degrees.iter().position(|&d| Slope::from_signed_degrees(d).is_err()).unwrap_or(0);
-        value_error(if degrees.len() > 1 { e.renamed(format!("slope_deg[{at}]")) } else { e })
-    })?;
-    let pts = &curve.points;
+    // In chunks, the GIL released for each and Ctrl-C checked between them: 65,536 slopes (the
+    // cap) took 74 s in one call that only a kill could stop (issue 21); a chunk is a fraction
+    // of a second.
+    let chunks: Vec<&[f64]> =
+        if degrees.is_empty() { vec![&degrees[..]] } else { degrees.chunks(RISK_SLOPES_PER_CHUNK).collect() };
+    let mut pts = Vec::with_capacity(degrees.len());
+    for (c, chunk) in chunks.into_iter().enumerate() {
+        let curve = py.detach(|| risk_curve(robot, &terrain, chunk)).map_err(|e| {
+            // The library names the key; point at the element when there are several.
+            let at = c * RISK_SLOPES_PER_CHUNK
+                + chunk.iter().position(|&d| Slope::from_signed_degrees(d).is_err()).unwrap_or(0);
+            value_error(if degrees.len() > 1 { e.renamed(format!("slope_deg[{at}]")) } else { e })
+        })?;
+        pts.extend(curve.points);
+        py.check_signals()?;
+    }
+    let pts = &pts;
     let d = PyDict::new(py);
     put(&d, "slope_deg", degrees.clone())?;
     put(&d, "cv_n", pts.iter().map(|p| p.uncertainty.cv_n).collect())?;

@@ -66,3 +66,23 @@ def test_python_speaks_python(cli, tmp_path):
     )
     with pytest.raises(ValueError, match="counts_per_newton= in Python"):
         sandslope.fit(str(manifest))
+
+
+def test_ctrl_c_stops_a_long_risk_call():
+    """Issue 21: `risk` over the cap of 65,536 slopes ran for over a minute with the GIL
+    released and ignored Ctrl-C until it finished. It now works in chunks and checks for a
+    pending signal between them: a SIGINT 0.5 s in raises KeyboardInterrupt within seconds."""
+    import _thread
+    import threading
+
+    slopes = np.linspace(0.0, 24.0, 65_536)
+    timer = threading.Timer(0.5, _thread.interrupt_main)  # simulates SIGINT (Ctrl-C)
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            sandslope.risk("paper-hexapod", slopes, terrain="glass-beads-300um")
+    finally:
+        timer.cancel()
+    # The whole call takes 30 s or more on two cores; a chunk is a fraction of a second.
+    assert time.monotonic() - start < 8.0

@@ -261,10 +261,21 @@ impl Figure for SlopesFigure<'_> {
                 .map_err(plot_err)?;
         }
         let blue = RGBColor(31, 90, 180);
-        c.draw_series(LineSeries::new(sim.iter().copied(), blue.stroke_width(3)))
-            .map_err(plot_err)?
-            .label("simulated (docs/model.md §15-§18)")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(3)));
+        // The curve breaks at a walk that pitched over: no line bridges a tumble.
+        let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+        for m in self.sims {
+            if m.pitch_over_s.is_some() {
+                runs.push(Vec::new());
+            } else if let Some(run) = runs.last_mut() {
+                run.push((m.slope_deg, m.speed_m_s * 100.0));
+            }
+        }
+        c.draw_series(
+            runs.iter().filter(|r| !r.is_empty()).map(|r| PathElement::new(r.clone(), blue.stroke_width(3))),
+        )
+        .map_err(plot_err)?
+        .label("simulated (docs/model.md §15-§18)")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(3)));
         c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, blue.filled()))).map_err(plot_err)?;
         if !tumbled.is_empty() {
             let orange = RGBColor(230, 120, 0);

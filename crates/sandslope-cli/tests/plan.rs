@@ -453,6 +453,22 @@ fn geojson_coordinates_carry_no_float_noise() {
     }
 }
 
+/// `plan --json` by distance and time from cell (5, 10) to (55, 40) of the GDAL fixture `dem`
+/// (`sandslope-io/tests/fixtures/gdal`), with `extra` flags; asserts that it succeeded.
+fn plan_gdal_fixture(dem: &str, extra: &[std::ffi::OsString]) -> std::process::Output {
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal");
+    let out = Command::cargo_bin("sandslope")
+        .unwrap()
+        .args(["plan", "--start-px", "5,10", "--goal-px", "55,40", "--objective", "distance,time", "--json"])
+        .arg("--dem")
+        .arg(fixtures.join(dem))
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{dem}: {}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
 /// One synthetic hill written by GDAL in EPSG:4326 (1 arc-second cells) and in a projected CRS
 /// whose cells are the geographic cells' ground size (crates/sandslope-io/tests/fixtures/gdal/
 /// make_crs.py): plan finds the same route on both, its GeoJSON is in lon/lat for the
@@ -461,29 +477,10 @@ fn geojson_coordinates_carry_no_float_noise() {
 /// metres and every cell was far too steep).
 #[test]
 fn a_geographic_dem_plans_in_metres_like_its_projected_twin() {
-    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal");
     let dir = tempfile::tempdir().unwrap();
     let run = |dem: &str| -> (Value, Value, String) {
         let geojson = dir.path().join(format!("{dem}.geojson"));
-        let out = Command::cargo_bin("sandslope")
-            .unwrap()
-            .args([
-                "plan",
-                "--start-px",
-                "5,10",
-                "--goal-px",
-                "55,40",
-                "--objective",
-                "distance,time",
-                "--json",
-            ])
-            .arg("--dem")
-            .arg(fixtures.join(dem))
-            .arg("--geojson")
-            .arg(&geojson)
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let out = plan_gdal_fixture(dem, &["--geojson".into(), geojson.clone().into()]);
         let g: Value = serde_json::from_str(&std::fs::read_to_string(&geojson).unwrap()).unwrap();
         (json_of(&out.stdout), g, String::from_utf8_lossy(&out.stderr).into_owned())
     };
@@ -591,27 +588,7 @@ fn a_pds3_dtm_plans_in_ground_metres_like_its_geotiff_twin() {
 /// the Deflate GeoTIFF: the same route length for each objective.
 #[test]
 fn every_gdal_layout_of_one_dem_plans_the_same_routes() {
-    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal");
-    let run = |dem: &str| -> Value {
-        let out = Command::cargo_bin("sandslope")
-            .unwrap()
-            .args([
-                "plan",
-                "--start-px",
-                "5,10",
-                "--goal-px",
-                "55,40",
-                "--objective",
-                "distance,time",
-                "--json",
-            ])
-            .arg("--dem")
-            .arg(fixtures.join(dem))
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "{dem}: {}", String::from_utf8_lossy(&out.stderr));
-        json_of(&out.stdout)
-    };
+    let run = |dem: &str| -> Value { json_of(&plan_gdal_fixture(dem, &[]).stdout) };
     let reference = run("geo-wgs84.tif");
     for dem in [
         "zstd-pred3-tiled.tif",

@@ -542,3 +542,29 @@ fn bad_tracks_values_exit_2_naming_the_flag_and_the_form() {
         .stderr(contains("--tracks"));
     assert!(!out.exists());
 }
+
+/// A robot the closed form takes but the simulator refuses (65 stance legs; the simulator takes
+/// at most 64) still gets its report: the simulator section is left out with a warning naming
+/// the key, and neither report.json nor the page has the simulator figure.
+#[test]
+fn a_robot_the_simulator_refuses_still_gets_its_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = dir.path().join("many-legs.toml");
+    let preset = sandslope().args(["presets", "show", "paper-hexapod"]).assert().success();
+    let text = String::from_utf8(preset.get_output().stdout.clone()).unwrap();
+    assert!(text.contains("stance_legs = 3"));
+    std::fs::write(&robot, text.replace("stance_legs = 3", "stance_legs = 65")).unwrap();
+    let out = dir.path().join("rep");
+    let run = sandslope().args(["report", "--robot"]).arg(&robot).arg("--out").arg(&out).assert().success();
+    let stderr = String::from_utf8_lossy(&run.get_output().stderr).into_owned();
+    assert!(
+        stderr.contains("stride simulator section is left out") && stderr.contains("stance_legs"),
+        "{stderr}"
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(v["simulator"].as_array().unwrap().len(), 0);
+    assert!(v["figures"].as_array().unwrap().iter().all(|f| f["id"] != "simulator"));
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(!html.contains("<figure id=\"simulator\">"));
+}

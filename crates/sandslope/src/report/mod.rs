@@ -300,8 +300,15 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     let calibration = calibrate(evidence, &speeds, &anchoring);
     let (robot, terrain) = model(evidence, calibration.as_ref())?;
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
-    let (simulator, simulated) = simulator::simulator_section(&robot, &terrain, &speeds)?;
-    plots.simulated = simulated;
+    // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...): a
+    // robot it refuses loses this section, with a warning, not the report.
+    let (simulator, simulator_refusal) = match simulator::simulator_section(&robot, &terrain, &speeds) {
+        Ok((records, walks)) => {
+            plots.simulated = walks;
+            (records, None)
+        }
+        Err(e) => (Vec::new(), Some(format!("the stride simulator section is left out: {e}"))),
+    };
     let own = evidence.has_own_observations();
     let context = ComparisonContext {
         fitted_to_paper_speeds: !own && evidence.builtin_terrain,
@@ -336,6 +343,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         })
         .collect();
     let mut warnings = track_use.warnings;
+    warnings.extend(simulator_refusal);
     if let Some(c) = &calibration {
         warnings.extend(disagreements::calibration_warnings(c));
     }
@@ -533,7 +541,9 @@ fn figure_records(plots: &Plots, calibrated: bool) -> Vec<FigureRecord> {
     }
     out.push(("risk", "Failure probability against slope".into()));
     out.push(("step_budget", "Where the step goes against slope".into()));
-    out.push(("simulator", "Stride simulator against the closed form".into()));
+    if !plots.simulated.is_empty() {
+        out.push(("simulator", "Stride simulator against the closed form".into()));
+    }
     if calibrated {
         out.push(("calibration", "Joint calibration: observed against fitted speeds, and pulls".into()));
     }

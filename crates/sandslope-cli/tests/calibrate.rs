@@ -165,3 +165,62 @@ fn anchoring_times_alone_calibrate_k_s() {
         .unwrap();
     assert!((k0 / 2e6 - 1.0).abs() < 1e-3, "{k0}");
 }
+
+/// `--model simulate` (issue 23): one observed speed, force tests used exactly, only the error
+/// floor free. The simulator's model speed is what `simulate` gives for the same robot, ground
+/// and the fit's walk setting (4 s at dt = 2 ms); with one speed the best floor solves
+/// `sd^2 + f^2 = (observed - model)^2` (docs/calibration.md), so f is worked out from that
+/// speed alone; the closed form's fit is printed beside it. Refusals exit 2 naming the flag.
+#[test]
+fn model_simulate_fits_the_walks_and_shows_the_closed_form_beside() {
+    let dir = tempfile::tempdir().unwrap();
+    let forces = common::write_arg(
+        dir.path(),
+        "forces.toml",
+        "repose_deg = 25.0\n[[points]]\nslope_deg = 0.0\nk_n = 7.0e5\nk_s = 1.0e5\n",
+    );
+    let observed =
+        common::write_arg(dir.path(), "v.csv", "slope_deg,speed_m_s,speed_sd_m_s\n0,0.157,0.0097\n");
+    let out = dir.path().join("t.toml");
+    let args = |extra: &[&str]| {
+        let mut c = sandslope();
+        c.args(["calibrate", "--model", "simulate", "--forces", &forces, "--observed", &observed, "--out"])
+            .arg(&out)
+            .args(extra);
+        c
+    };
+    let v = json(&mut args(&["--free", "error_floor=0:0.5", "--json"]));
+    assert_eq!(v["model"]["kind"], "simulator");
+    assert_eq!(v["model"]["settings"]["duration_s"], 4.0);
+    assert_eq!(v["walks"], 1);
+    let walk = json(
+        sandslope()
+            .args(["simulate", "--slope", "0", "--duration", "4", "--dt", "0.002", "--json", "--terrain"])
+            .arg(&forces),
+    );
+    let model = v["pulls"][0]["model"].as_f64().unwrap();
+    assert_eq!(model, walk["speed_m_s"].as_f64().unwrap());
+    let r: f64 = 0.157 - model;
+    let f = (r * r - 0.0097f64 * 0.0097).max(0.0).sqrt();
+    // Within 0.2%: with the simulator the optimiser stops at a relative change of 1e-6 in -2 ln L,
+    // which leaves about sqrt(1e-6) = 1e-3 in a parameter at a smooth minimum.
+    let fitted = v["error_floor_m_s"].as_f64().unwrap();
+    assert!((fitted - f).abs() < 2e-3 * f, "{fitted} vs {f}");
+    let cf = &v["closed_form_fit"];
+    assert_eq!(cf["model"]["kind"], "closed_form");
+    assert!(cf["pulls"][0]["model"].as_f64().unwrap() != model);
+    // The tables print both fits side by side.
+    args(&["--free", "error_floor"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("closed form").and(predicate::str::contains("simulator")));
+    // (The floor is bounded to 0.5 m/s: the default bound 0.1 m/s is below what this walk needs.)
+    // Refusals: exit 2, naming the flag, nothing written.
+    std::fs::remove_file(&out).unwrap();
+    args(&["--free", "response_time_s"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("response_time_s").and(predicate::str::contains("simulator")));
+    args(&["--law", "per-slope"]).assert().code(2).stderr(predicate::str::contains("--law per-slope"));
+    assert!(!out.exists());
+}

@@ -52,9 +52,9 @@ pub mod slope;
 pub mod terrain;
 
 pub use calibrate::{
-    calibrate_jointly, invert_each_speed, AnchoringObservation, CalibrationError, CalibrationWarning,
-    FreeParameter, JointCalibration, JointSetup, Parameter, Quantity, RobotKey, ShearLaw, ShearShape,
-    SpeedObservation,
+    calibrate_jointly, calibrate_jointly_with, invert_each_speed, AnchoringObservation, CalibrationError,
+    CalibrationWarning, FittedParameter, FreeParameter, JointCalibration, JointSetup, Parameter, Quantity,
+    RobotKey, ShearLaw, ShearShape, SpeedModel, SpeedObservation,
 };
 pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
 pub use error::ParamError;

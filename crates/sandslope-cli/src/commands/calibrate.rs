@@ -10,10 +10,10 @@ use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 
-use sandslope::calibrate::{Interval, ObservationKind};
+use sandslope::calibrate::{Interval, ObservationKind, SpeedModel};
 use sandslope::{
-    calibrate_jointly, invert_each_speed, predict, FreeParameter, JointCalibration, JointSetup, Parameter,
-    Quantity, ShearLaw, ShearShape, Slope, Terrain, TerrainPoint, TerrainSpec,
+    calibrate_jointly, calibrate_jointly_with, invert_each_speed, predict, FreeParameter, JointCalibration,
+    JointSetup, Parameter, Quantity, ShearLaw, ShearShape, Slope, Terrain, TerrainPoint, TerrainSpec,
 };
 
 use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
@@ -43,6 +43,17 @@ impl LawArg {
     }
 }
 
+/// The model whose speeds are fitted, as named on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ModelArg {
+    /// The closed form (docs/model.md §3-§5).
+    ClosedForm,
+    /// The stride simulator (docs/model.md §15-§18), with the fit's coarse setting: 4 s walks at
+    /// dt = 2 ms, one per observed slope and trial point, in parallel. Slower (a minute or more);
+    /// the closed form's fit is printed beside it.
+    Simulate,
+}
+
 /// Arguments of `sandslope calibrate`.
 #[derive(Debug, Args)]
 pub struct CalibrateArgs {
@@ -67,6 +78,9 @@ pub struct CalibrateArgs {
     /// Form of k_s(theta) to fit when there are no --forces.
     #[arg(long, value_enum, default_value_t = LawArg::Linear)]
     pub law: LawArg,
+    /// The model whose speeds and anchoring times are fitted (docs/calibration.md).
+    #[arg(long, value_enum, default_value_t = ModelArg::ClosedForm)]
+    pub model: ModelArg,
     /// Write the calibrated terrain (docs/model.md §7 format) to this TOML file.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
@@ -132,6 +146,9 @@ struct JointRecord<'a> {
     #[serde(flatten)]
     calibration: &'a JointCalibration,
     repose: &'a ReposeRecord,
+    /// With `--model simulate`: the closed form's fit of the same evidence, for comparison.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    closed_form_fit: Option<&'a JointCalibration>,
 }
 
 #[derive(Serialize)]
@@ -158,6 +175,9 @@ struct PerSlopeRecord<'a> {
 
 /// Runs `sandslope calibrate`.
 pub fn run(args: CalibrateArgs) -> Result<()> {
+    if args.model == ModelArg::Simulate && args.law == LawArg::PerSlope {
+        bail!("--law per-slope inverts the closed form only: with --model simulate use --law linear, --law coulomb or --forces");
+    }
     let robot = args.robot.load()?;
     let free = parse_free(&args.free)?;
     let fixed_k_n = args.k_n.map(|v| check_positive("--k-n", v)).transpose()?;
@@ -226,7 +246,15 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
         free,
         error_floor: error_floor.unwrap_or(0.0),
     };
-    let mut cal = calibrate_jointly(&setup).map_err(|e| anyhow!("calibrate: {e}"))?;
+    let closed_form_fit = calibrate_jointly(&setup).map_err(|e| anyhow!("calibrate: {e}"))?;
+    let (mut cal, closed_form) = match args.model {
+        ModelArg::ClosedForm => (closed_form_fit, None),
+        ModelArg::Simulate => {
+            let sim = calibrate_jointly_with(&setup, SpeedModel::simulator_for_fit())
+                .map_err(|e| anyhow!("calibrate --model simulate: {e}"))?;
+            (sim, Some(closed_form_fit))
+        }
+    };
     let default_name = if forces.is_some() {
         "calibrated-forces".to_string()
     } else {
@@ -285,9 +313,17 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
     }
 
     if args.json {
-        return print_json(&JointRecord { mode: "joint", calibration: &cal, repose: &repose });
+        return print_json(&JointRecord {
+            mode: "joint",
+            calibration: &cal,
+            repose: &repose,
+            closed_form_fit: closed_form.as_ref(),
+        });
     }
     print_joint(&cal, &repose);
+    if let Some(cf) = &closed_form {
+        print_side_by_side(cf, &cal);
+    }
     Ok(())
 }
 
@@ -372,6 +408,77 @@ fn print_joint(cal: &JointCalibration, repose: &ReposeRecord) {
     for w in &cal.warnings {
         println!("warning: {w}");
     }
+}
+
+/// The closed form's and the simulator's fits of the same evidence, side by side.
+fn print_side_by_side(closed: &JointCalibration, sim: &JointCalibration) {
+    let settings = match sim.model {
+        SpeedModel::Simulator { settings } => settings,
+        SpeedModel::ClosedForm => return,
+    };
+    println!();
+    println!(
+        "The same evidence fitted by the closed form and by the simulator ({} s walks at dt = {} ms, \
+         yield slip {} mm; {} walks):",
+        settings.duration_s,
+        settings.dt_s.map_or("default".into(), |d| format!("{}", d * 1e3)),
+        settings.yield_m * 1e3,
+        sim.walks
+    );
+    let mut t =
+        table(&["observation", "slope deg", "observed ± SD", "closed form", "pull", "simulator", "pull"]);
+    for (c, s) in closed.pulls.iter().zip(&sim.pulls) {
+        use ObservationKind as K;
+        let (name, scale, unit, sci) = match c.kind {
+            K::Speed => ("speed", 100.0, "cm/s", false),
+            K::AnchoringTime => ("t1", 1000.0, "ms", false),
+            K::PlateShearStrength => ("plate k_s", 1.0, "N/m^3", true),
+        };
+        let f = |x: f64| if sci { format!("{x:.3e}") } else { format!("{:.2}", x * scale) };
+        t.add_row([
+            name.to_string(),
+            format!("{}", c.slope_deg),
+            format!("{} ± {} {unit}", f(c.observed), f(c.sd)),
+            format!("{} {unit}", f(c.model)),
+            format!("{:+.2}", c.pull),
+            format!("{} {unit}", f(s.model)),
+            format!("{:+.2}", s.pull),
+        ]);
+    }
+    println!("{t}");
+    let mut t = table(&["quantity", "closed form (68%)", "simulator (68%)"]);
+    let cell = |p: Option<&sandslope::FittedParameter>| {
+        p.map_or("-".into(), |p| {
+            let sci =
+                p.estimate.value.abs() >= 1e4 || (p.estimate.value != 0.0 && p.estimate.value.abs() < 1e-2);
+            let v =
+                if sci { format!("{:.3e}", p.estimate.value) } else { format!("{:.4}", p.estimate.value) };
+            format!("{v} ({})", interval_text(&p.estimate, sci))
+        })
+    };
+    for p in &closed.parameters {
+        t.add_row([p.name.clone(), cell(Some(p)), cell(sim.fitted(p.quantity))]);
+    }
+    let dof = |c: &JointCalibration| {
+        format!(
+            "{:.2} / {} ({})",
+            c.chi_squared,
+            c.dof,
+            c.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}"))
+        )
+    };
+    t.add_row(["chi^2 / dof".to_string(), dof(closed), dof(sim)]);
+    t.add_row([
+        "error floor cm/s".to_string(),
+        format!("{:.2}", closed.error_floor_m_s * 100.0),
+        format!("{:.2}", sim.error_floor_m_s * 100.0),
+    ]);
+    t.add_row([
+        "k_s(20)/k_s(0)".to_string(),
+        format!("{:.3}", closed.shear_ratio_20.value),
+        format!("{:.3}", sim.shear_ratio_20.value),
+    ]);
+    println!("{t}");
 }
 
 fn run_per_slope(

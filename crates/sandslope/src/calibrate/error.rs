@@ -77,4 +77,20 @@ pub enum CalibrationError {
         /// Slope, degrees.
         slope_deg: f64,
     },
+    /// A freed quantity the simulator does not read (`calibrate --model simulate`).
+    #[error(
+        "--free {name}: the simulator does not use {name} (it computes the contact and the body's \
+         acceleration itself, docs/model.md §15), so the fit could not constrain it; free it with \
+         --model closed-form only"
+    )]
+    NotASimulatorInput {
+        /// The robot key.
+        name: String,
+    },
+    /// The simulator refused a walk at the starting point (`calibrate --model simulate`).
+    #[error("the simulator cannot walk this robot and ground: {reason}")]
+    Simulator {
+        /// The simulator's message.
+        reason: String,
+    },
 }

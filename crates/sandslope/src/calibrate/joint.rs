@@ -4,6 +4,7 @@
 
 use rayon::prelude::*;
 
+use super::model::SpeedModel;
 use super::optimiser::minimise;
 use super::problem::{build, Candidate, Problem};
 use super::profile::{interval_for, ratio_interval, Profiled};
@@ -36,9 +37,20 @@ pub struct JointSetup {
     pub error_floor: f64,
 }
 
-/// Fits the free quantities of `setup` to all its evidence at once; see the module docs.
+/// Fits the free quantities of `setup` to all its evidence at once with the closed form; see
+/// the module docs.
 pub fn calibrate_jointly(setup: &JointSetup) -> Result<JointCalibration, CalibrationError> {
-    let problem = build(setup)?;
+    calibrate_jointly_with(setup, SpeedModel::ClosedForm)
+}
+
+/// Fits the free quantities of `setup` to all its evidence at once with `model` giving the
+/// speeds and anchoring times (the closed form, or the stride simulator: `calibrate --model
+/// simulate`, docs/calibration.md); the same statistics, intervals and warnings either way.
+pub fn calibrate_jointly_with(
+    setup: &JointSetup,
+    model: SpeedModel,
+) -> Result<JointCalibration, CalibrationError> {
+    let problem = build(setup, model)?;
     let n = problem.unknowns.len();
     let start: Vec<f64> = problem.unknowns.iter().map(|u| u.start).collect();
     // Several starts: the given one, and the scale-like quantities a decade either way.
@@ -113,6 +125,8 @@ pub fn calibrate_jointly(setup: &JointSetup) -> Result<JointCalibration, Calibra
         robot: robot.spec().clone(),
         terrain,
         warnings,
+        model,
+        walks: problem.simulator.as_ref().map_or(0, |s| s.walks_run()),
     })
 }
 
@@ -127,7 +141,9 @@ fn warnings(
     chi_squared_per_dof: Option<f64>,
 ) -> Vec<CalibrationWarning> {
     let mut warnings = Vec::new();
-    for p in pulls.iter().filter(|p| p.kind == ObservationKind::Speed) {
+    // The closed form's ceiling s*/(T/2) is not the simulator's: it has no such warning.
+    let closed_form = problem.simulator.is_none();
+    for p in pulls.iter().filter(|p| closed_form && p.kind == ObservationKind::Speed) {
         let ceiling = shear.iter().find(|s| s.slope_deg == p.slope_deg).map(|s| s.speed_ceiling_m_s);
         let ceiling = ceiling.unwrap_or_else(|| {
             let slope = Slope::from_degrees(p.slope_deg).unwrap_or(Slope::LEVEL);

@@ -31,6 +31,7 @@ pub mod error;
 pub mod evidence;
 pub mod inversion;
 pub mod joint;
+pub mod model;
 mod optimiser;
 pub mod parameter;
 mod problem;
@@ -41,7 +42,8 @@ pub mod shear;
 pub use error::CalibrationError;
 pub use evidence::{AnchoringObservation, SpeedObservation};
 pub use inversion::{invert_each_speed, shear_strength_for_speed, InvertedSpeed, PerSlopeCalibration};
-pub use joint::{calibrate_jointly, JointSetup};
+pub use joint::{calibrate_jointly, calibrate_jointly_with, JointSetup};
+pub use model::SpeedModel;
 pub use parameter::{FreeParameter, Parameter, Quantity, RobotKey};
 pub use result::{
     CalibrationWarning, FittedParameter, Interval, JointCalibration, ObservationKind, Pull, ShearAtSlope,

@@ -3,6 +3,7 @@
 
 use super::evidence::{check_anchoring, check_speeds};
 use super::inversion::shear_strength_for_speed;
+use super::model::{check_free_for_simulator, SimulatedModel, SpeedModel, Walked};
 use super::{CalibrationError, JointSetup, ObservationKind, Parameter, Pull, Quantity, ShearLaw, ShearShape};
 use crate::model::{continued_anchoring_time, continued_speed, level_step_length, normal_equilibrium_depth};
 use crate::robot::Robot;
@@ -84,6 +85,10 @@ pub(crate) struct Problem<'a> {
     pub law: Option<ShearLaw>,
     /// Observations: speeds, anchoring times and force tests with SDs.
     pub n_obs: usize,
+    /// The simulator when it is the model (`None`: the closed form).
+    pub simulator: Option<SimulatedModel>,
+    /// The distinct slopes of speeds and anchoring times, degrees (one walk each).
+    pub walk_slopes: Vec<f64>,
 }
 
 /// A candidate point (one value per unknown) resolved into what the model needs.
@@ -139,11 +144,50 @@ impl Problem<'_> {
         level_step_length(robot, slope, normal_equilibrium_depth(robot, slope, self.k_n(slope)))
     }
 
+    /// The relative step of the optimiser's finite-difference Jacobian in the unbounded
+    /// coordinates: 1e-6 for the smooth closed form; 1e-3 for the simulator, whose walks are
+    /// integrated with a fixed step and so are smooth in the parameters only at scales well
+    /// above round-off.
+    pub fn jacobian_step(&self) -> f64 {
+        if self.simulator.is_some() {
+            1e-3
+        } else {
+            1e-6
+        }
+    }
+
+    /// The simulator's walk at every observed slope for candidate `c` (`None` when the model is
+    /// the closed form; `Some(Err)` when the simulator refuses a walk).
+    fn walked(&self, robot: &Robot, c: &Candidate) -> Option<Result<Vec<Walked>, String>> {
+        let sim = self.simulator.as_ref()?;
+        let grounds: Vec<(f64, f64, f64)> = self
+            .walk_slopes
+            .iter()
+            .map(|&deg| {
+                let k_n = self.k_n(Slope::from_degrees(deg).unwrap_or(Slope::LEVEL));
+                // A law or an extrapolated table can reach k_s <= 0 (no strength); the simulator
+                // needs a positive value, and 1 N/m^3 is no strength at all for a 0.35 kg robot.
+                (deg, k_n, self.k_s(c, deg).max(MIN_SIMULATED_K_S))
+            })
+            .collect();
+        Some(sim.walks(robot, &grounds))
+    }
+
+    /// The walk at `deg` among `walks` (in the order of `walk_slopes`).
+    fn walk_at(&self, walks: &[Walked], deg: f64) -> Option<Walked> {
+        self.walk_slopes.iter().position(|&d| d == deg).and_then(|i| walks.get(i).copied())
+    }
+
     /// Pulls of every observation (speeds, anchoring times, force tests) at `x`, and the
     /// floor's term `sum_speeds ln(1 + f^2 / sd_i^2)` of `-2 ln L`.
     pub fn pulls(&self, x: &[f64]) -> Option<(Vec<Pull>, f64)> {
         let c = self.candidate(x);
         let robot = c.robot.as_ref()?;
+        let walks = match self.walked(robot, &c) {
+            None => None,
+            Some(Ok(w)) => Some(w),
+            Some(Err(_)) => return None,
+        };
         let mut out = Vec::with_capacity(self.n_obs);
         let pull = |kind, slope: Slope, observed: f64, sd: f64, sd_total: f64, model: f64| Pull {
             kind,
@@ -155,12 +199,15 @@ impl Problem<'_> {
             pull: (observed - model) / sd_total,
         };
         for o in &self.setup.speeds {
-            let model = continued_speed(
-                robot,
-                o.slope,
-                self.level_step(robot, o.slope),
-                self.k_s(&c, o.slope.degrees()),
-            );
+            let model = match &walks {
+                Some(w) => self.walk_at(w, o.slope.degrees())?.speed,
+                None => continued_speed(
+                    robot,
+                    o.slope,
+                    self.level_step(robot, o.slope),
+                    self.k_s(&c, o.slope.degrees()),
+                ),
+            };
             out.push(pull(
                 ObservationKind::Speed,
                 o.slope,
@@ -171,7 +218,10 @@ impl Problem<'_> {
             ));
         }
         for o in &self.setup.anchoring {
-            let model = continued_anchoring_time(robot, o.slope, self.k_s(&c, o.slope.degrees()));
+            let model = match &walks {
+                Some(w) => self.walk_at(w, o.slope.degrees())?.t1,
+                None => continued_anchoring_time(robot, o.slope, self.k_s(&c, o.slope.degrees())),
+            };
             out.push(pull(ObservationKind::AnchoringTime, o.slope, o.t1, o.t1_sd, o.t1_sd, model));
         }
         for (k, fitted) in self.force_tests.iter().zip(&c.plate) {
@@ -221,6 +271,9 @@ impl Problem<'_> {
         }
     }
 }
+
+/// The smallest leg k_s handed to the simulator, N/m^3 (docs/calibration.md).
+pub(crate) const MIN_SIMULATED_K_S: f64 = 1.0;
 
 /// The k_s each observed speed alone implies (where the model can reach it).
 fn inverted_k_s(setup: &JointSetup) -> Vec<(f64, f64)> {
@@ -272,7 +325,7 @@ fn free_unknown(
 
 /// The problem for `setup`, with every check of the evidence, the freed parameters and their
 /// bounds, and the starting values (from the speeds inverted alone where they exist).
-pub(crate) fn build(setup: &JointSetup) -> Result<Problem<'_>, CalibrationError> {
+pub(crate) fn build(setup: &JointSetup, model: SpeedModel) -> Result<Problem<'_>, CalibrationError> {
     check_speeds(&setup.speeds)?;
     check_anchoring(&setup.anchoring)?;
     if setup.speeds.is_empty() && setup.anchoring.is_empty() {
@@ -283,6 +336,9 @@ pub(crate) fn build(setup: &JointSetup) -> Result<Problem<'_>, CalibrationError>
     }
     let mut unknowns: Vec<Unknown> = Vec::new();
     for f in &setup.free {
+        if matches!(model, SpeedModel::Simulator { .. }) {
+            check_free_for_simulator(f.parameter)?;
+        }
         if unknowns.iter().any(|u| u.quantity == Quantity::Free(f.parameter)) {
             return Err(CalibrationError::DuplicateParameter { name: f.parameter.name().into() });
         }
@@ -345,5 +401,24 @@ pub(crate) fn build(setup: &JointSetup) -> Result<Problem<'_>, CalibrationError>
     if unknowns.len() > n_obs {
         return Err(CalibrationError::TooFewObservations { observations: n_obs, parameters: unknowns.len() });
     }
-    Ok(Problem { setup, unknowns, force_tests, force_test_unknown, law, n_obs })
+    let mut walk_slopes: Vec<f64> = setup.speeds.iter().map(|o| o.slope.degrees()).collect();
+    walk_slopes.extend(setup.anchoring.iter().map(|o| o.slope.degrees()));
+    walk_slopes.sort_by(f64::total_cmp);
+    walk_slopes.dedup();
+    let simulator = match model {
+        SpeedModel::ClosedForm => None,
+        SpeedModel::Simulator { settings } => Some(SimulatedModel::new(settings)),
+    };
+    let problem =
+        Problem { setup, unknowns, force_tests, force_test_unknown, law, n_obs, simulator, walk_slopes };
+    // The simulator refuses some robots and grounds (more than 64 stance legs, a step too
+    // coarse for the stiffness): say so now rather than fit a flat penalty.
+    let start: Vec<f64> = problem.unknowns.iter().map(|u| u.start).collect();
+    let c = problem.candidate(&start);
+    if let (Some(robot), true) = (c.robot.as_ref(), problem.simulator.is_some()) {
+        if let Some(Err(reason)) = problem.walked(robot, &c) {
+            return Err(CalibrationError::Simulator { reason });
+        }
+    }
+    Ok(problem)
 }

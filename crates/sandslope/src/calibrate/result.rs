@@ -4,7 +4,7 @@ use std::fmt;
 
 use serde::Serialize;
 
-use super::{Parameter, Quantity};
+use super::{Parameter, Quantity, SpeedModel};
 use crate::robot::RobotSpec;
 use crate::terrain::TerrainSpec;
 
@@ -182,6 +182,10 @@ pub struct JointCalibration {
     pub terrain: TerrainSpec,
     /// What to be careful about.
     pub warnings: Vec<CalibrationWarning>,
+    /// The model the speeds and anchoring times came from.
+    pub model: SpeedModel,
+    /// Simulated walks the fit ran (0 for the closed form).
+    pub walks: usize,
 }
 
 impl JointCalibration {

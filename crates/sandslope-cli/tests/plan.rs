@@ -606,3 +606,36 @@ fn every_gdal_layout_of_one_dem_plans_the_same_routes() {
         }
     }
 }
+
+/// A DEM whose planning would need more memory than `--max-memory` is refused before the
+/// planner allocates, with exit code 2 and a message naming the cells, the bytes a cell and the
+/// limit. The example dune is 200 x 200 cells; by hand, the planner holds 4 + 1 + 1 + 8 = 14
+/// bytes a cell (f32 height, nodata flag, class, two f32 gradients) and each route search 16 + 1
+/// (node, predecessor): with the time and distance searches at once (two threads or more) 48
+/// bytes a cell, 1.92 MB, or 31 (1.24 MB) on one thread; both above 0.001 GiB (1.07 MB), both
+/// below 0.01 GiB.
+#[test]
+fn a_dem_too_big_for_the_memory_limit_is_refused_naming_the_limit() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let run = |limit: &str| {
+        Command::cargo_bin("sandslope")
+            .unwrap()
+            .current_dir(&root)
+            .args(["plan", "--dem", "examples/planning/dune.asc", "--start", "52,30", "--goal", "30,30"])
+            .args(["--max-memory", limit, "--json"])
+            .output()
+            .unwrap()
+    };
+    let out = run("0.001");
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("dune.asc") && err.contains("200 x 200 cells"), "{err}");
+    assert!(err.contains("48 bytes a cell") || err.contains("31 bytes a cell"), "{err}");
+    assert!(err.contains("--max-memory limit of 0.001 GiB"), "{err}");
+    assert!(out.stdout.is_empty());
+    let out = run("0.01");
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run("0");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--max-memory = 0 must be"));
+}

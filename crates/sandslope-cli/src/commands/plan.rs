@@ -101,6 +101,10 @@ pub struct PlanArgs {
     pub descent: DescentArg,
     #[command(flatten)]
     pub uncertainty: UncertaintyArgs,
+    /// Refuse a DEM whose planning would need more than this many GiB (default: the memory
+    /// available when plan starts, MemAvailable in /proc/meminfo).
+    #[arg(long, allow_negative_numbers = true, value_name = "GIB")]
+    pub max_memory: Option<f64>,
     #[command(flatten)]
     pub out: Box<OutputArgs>,
 }
@@ -361,6 +365,58 @@ fn classes_of(
     Ok((classes, terrains))
 }
 
+/// Refuses, before the planner allocates anything, a DEM whose planning would need more memory
+/// than `--max-memory` (default: what the machine has available), naming the limit and the
+/// bytes per cell.
+fn check_memory(args: &PlanArgs, dem: &Raster, request: &PlanRequest) -> Result<()> {
+    const GIB: f64 = (1u64 << 30) as f64;
+    let (limit, what) = match args.max_memory {
+        Some(gib) => {
+            let gib = check_flag("--max-memory", gib, 0.0, f64::INFINITY)?;
+            if gib <= 0.0 {
+                bail!("--max-memory = {gib} must be a number of GiB greater than 0");
+            }
+            (gib * GIB, "the --max-memory limit")
+        }
+        None => match available_memory() {
+            Some(bytes) => (bytes as f64, "the memory available (MemAvailable in /proc/meminfo; --max-memory sets another limit)"),
+            None => return Ok(()),
+        },
+    };
+    let mut objectives = request.objectives.clone();
+    objectives.push(Objective::Distance);
+    objectives.sort();
+    objectives.dedup();
+    let searches = objectives.len().min(rayon::current_num_threads().max(1)) as u64;
+    let per_cell = sandslope::plan::bytes_per_cell(searches);
+    let cells = dem.cols as u64 * dem.rows as u64;
+    let need = (cells * per_cell) as f64;
+    if need > limit {
+        bail!(
+            "{}: planning on {} x {} cells needs about {:.3} GiB ({per_cell} bytes a cell: {} for the grid and \
+             gradients, {} for each of {searches} route searches at once), more than {what} of {:.3} GiB; crop or \
+             resample the DEM (for example with gdal_translate -srcwin or -tr)",
+            args.dem.display(),
+            dem.cols,
+            dem.rows,
+            need / GIB,
+            sandslope::plan::PLANNER_BYTES_PER_CELL,
+            sandslope::plan::SEARCH_BYTES_PER_CELL,
+            limit / GIB
+        );
+    }
+    Ok(())
+}
+
+/// The memory the kernel says is available for new allocations (MemAvailable), in bytes;
+/// `None` where /proc/meminfo cannot be read (not Linux).
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
 /// The settings the flags give, checked.
 fn settings(args: &PlanArgs) -> Result<PlanSettings> {
     let max_roll = check_flag("--max-roll", args.max_roll, 0.0, 90.0)?;
@@ -378,7 +434,8 @@ fn settings(args: &PlanArgs) -> Result<PlanSettings> {
 
 /// The routes `plan` found and the DEM they were planned on.
 pub struct Planned {
-    /// The elevation model as read (its georeference places the routes).
+    /// The elevation model as read (its georeference places the routes), its `values` released
+    /// once the planner's grid holds the heights (`result.planner.grid()`).
     pub dem: Raster,
     /// The library's result.
     pub result: PlanResult,
@@ -411,12 +468,17 @@ pub fn compute(args: &PlanArgs, risk_map: bool, quiet: bool) -> Result<Planned> 
     let start = endpoint(&dem, "start", &args.start, &args.start_px)?;
     let goal = endpoint(&dem, "goal", &args.goal, &args.goal_px)?;
     let (classes, terrains) = classes_of(args, &dem, quiet)?;
-    let grid = grid_of(&dem, args)?;
     let request =
         PlanRequest { start, goal, objectives: args.objective.iter().map(|&o| o.into()).collect(), risk_map };
+    check_memory(args, &dem, &request)?;
+    let grid = grid_of(&dem, args)?;
+    // The grid holds the heights as f32 now: the f64 values (8 bytes a cell) are not needed
+    // again (the outputs use the georeference, the figures the planner's grid).
+    let mut dem = dem;
+    dem.values = Vec::new();
 
     let show_progress = !quiet
-        && dem.values.len() >= PROGRESS_MIN_CELLS
+        && grid.len() >= PROGRESS_MIN_CELLS
         && std::io::IsTerminal::is_terminal(&std::io::stderr());
     let multi = MultiProgress::with_draw_target(if show_progress {
         ProgressDrawTarget::stderr()

@@ -33,6 +33,21 @@ use serde::{Deserialize, Serialize};
 use crate::error::ParamError;
 use crate::slope::Slope;
 
+/// Bytes per cell the planner holds besides its route searches: the grid's height (`f32`),
+/// nodata mask (`bool`) and terrain class (`u8`), and the Horn gradient (two `f32`).
+pub const PLANNER_BYTES_PER_CELL: u64 = 4 + 1 + 1 + 8;
+
+/// Bytes per cell of one route search: the 16-byte node (the `f64` distance beside a copy of
+/// the gradient) and the predecessor heading (`u8`).
+pub const SEARCH_BYTES_PER_CELL: u64 = 16 + 1;
+
+/// The memory [`plan`] allocates per cell with `searches` route searches running at once (one
+/// per objective, as many at once as there are threads): what to check a map against before
+/// planning on it.
+pub fn bytes_per_cell(searches: u64) -> u64 {
+    PLANNER_BYTES_PER_CELL + searches * SEARCH_BYTES_PER_CELL
+}
+
 /// What a route minimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]

@@ -379,7 +379,10 @@ fn check_memory(args: &PlanArgs, dem: &Raster, request: &PlanRequest) -> Result<
             (gib * GIB, "the --max-memory limit")
         }
         None => match available_memory() {
-            Some(bytes) => (bytes as f64, "the memory available (MemAvailable in /proc/meminfo; --max-memory sets another limit)"),
+            Some(bytes) => (
+                bytes as f64,
+                "the memory available (MemAvailable in /proc/meminfo; --max-memory sets another limit)",
+            ),
             None => return Ok(()),
         },
     };
@@ -477,9 +480,8 @@ pub fn compute(args: &PlanArgs, risk_map: bool, quiet: bool) -> Result<Planned> 
     let mut dem = dem;
     dem.values = Vec::new();
 
-    let show_progress = !quiet
-        && grid.len() >= PROGRESS_MIN_CELLS
-        && std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let show_progress =
+        !quiet && grid.len() >= PROGRESS_MIN_CELLS && std::io::IsTerminal::is_terminal(&std::io::stderr());
     let multi = MultiProgress::with_draw_target(if show_progress {
         ProgressDrawTarget::stderr()
     } else {

@@ -15,7 +15,13 @@ What it does (run from anywhere; takes a few minutes the first time):
    (1 / level speed * sec(slope) per metre: one cost per cell, no heading) between the same
    cells, and prints the ratio of the median to it.
 
-Usage: python3 bench/plan/run.py [--size 4096] [--repeat 5]
+Usage: python3 bench/plan/run.py [--size 4096] [--repeat 5] [--max-memory GIB] [--no-mcp]
+
+`--size 16384` is issue 24's scale (2.7e8 cells): the DEM (about 1 GiB of float32 before
+deflate) is written 256 rows at a time, so generating it holds a few tens of MiB, and
+MCP_Geometric is skipped there (its float64 cost grid alone is 2 GiB). `--max-memory` is passed
+to `sandslope plan` (for instance 4, the issue's limit: plan then says what it would need and
+refuses, exit code 2, which the script reports instead of timing).
 """
 import argparse
 import os
@@ -43,6 +49,8 @@ def main():
     ap.add_argument("--size", type=int, default=4096)
     ap.add_argument("--cell", type=float, default=0.25)
     ap.add_argument("--repeat", type=int, default=5, help="runs of sandslope plan (the median is compared)")
+    ap.add_argument("--max-memory", type=float, help="GiB, passed to sandslope plan --max-memory")
+    ap.add_argument("--no-mcp", action="store_true", help="skip MCP_Geometric (always skipped above 8192 x 8192)")
     args = ap.parse_args()
     ensure([("numpy", "numpy"), ("tifffile", "tifffile"), ("skimage", "scikit-image")])
     import numpy as np
@@ -56,41 +64,67 @@ def main():
     work = os.path.join(ROOT, "target", "bench-plan")
     os.makedirs(work, exist_ok=True)
     dem_path = os.path.join(work, f"dunes-v2-{n}.tif")
-    x = (np.arange(n) + 0.5) * cell
-    y = (n - np.arange(n) - 0.5) * cell
-    X, Y = np.meshgrid(x, y)
-    # Dune crests every ~40 m with amplitude up to 3 m (steepest ~ 3 * 2 pi / 40 = 0.47,
-    # 25 deg), modulated along the crests, plus smaller superimposed dunes (0.25 m, 11 m):
-    # slopes up to ~30 deg, so direct climbs often fail and routes must switch back.
-    z = (3.0 * np.sin(2 * np.pi * X / 40.0 + 0.8 * np.sin(2 * np.pi * Y / 90.0)) * (0.6 + 0.4 * np.cos(2 * np.pi * Y / 130.0))
-         + 0.25 * np.sin(2 * np.pi * (X + Y) / 11.0)).astype(np.float32)
+    def heights(r0, r1):
+        """Rows r0..r1 of the dune field (float32)."""
+        x = (np.arange(n) + 0.5) * cell
+        y = (n - np.arange(r0, r1) - 0.5) * cell
+        X, Y = np.meshgrid(x, y)
+        # Dune crests every ~40 m with amplitude up to 3 m (steepest ~ 3 * 2 pi / 40 = 0.47,
+        # 25 deg), modulated along the crests, plus smaller superimposed dunes (0.25 m, 11 m):
+        # slopes up to ~30 deg, so direct climbs often fail and routes must switch back.
+        return (3.0 * np.sin(2 * np.pi * X / 40.0 + 0.8 * np.sin(2 * np.pi * Y / 90.0))
+                * (0.6 + 0.4 * np.cos(2 * np.pi * Y / 130.0))
+                + 0.25 * np.sin(2 * np.pi * (X + Y) / 11.0)).astype(np.float32)
+
+    def tiles():
+        for r0 in range(0, n, 256):
+            band = heights(r0, min(n, r0 + 256))
+            if band.shape[0] < 256:
+                band = np.pad(band, ((0, 256 - band.shape[0]), (0, 0)))
+            for c0 in range(0, n, 256):
+                yield np.ascontiguousarray(band[:, c0:c0 + 256])
+
     if not os.path.exists(dem_path):
+        assert n % 256 == 0, "--size must be a multiple of 256"
+        t0 = time.perf_counter()
         tifffile.imwrite(
-            dem_path, z, tile=(256, 256), compression="zlib",
+            dem_path + ".part", tiles(), shape=(n, n), dtype=np.float32, tile=(256, 256), compression="zlib",
             extratags=[(33550, "d", 3, (cell, cell, 0.0)), (33922, "d", 6, (0, 0, 0, 0.0, n * cell, 0.0)),
                        (42113, "s", 0, "-9999", False)])
+        os.replace(dem_path + ".part", dem_path)
+        print(f"wrote {dem_path} ({os.path.getsize(dem_path) / 2**20:.0f} MiB) in {time.perf_counter() - t0:.0f} s")
     start = (int(0.03 * n), int(0.97 * n))  # col, row: near the south-west corner
     goal = (int(0.97 * n), int(0.03 * n))  # near the north-east corner
     cmd = ["/usr/bin/time", "-v", exe, "plan", "--dem", dem_path, "--start-px", f"{start[0]},{start[1]}",
            "--goal-px", f"{goal[0]},{goal[1]}", "--objective", "time", "--json"]
+    if args.max_memory is not None:
+        cmd += ["--max-memory", str(args.max_memory)]
     runs = []
     for _ in range(args.repeat):
         t0 = time.perf_counter()
         p = subprocess.run(cmd, capture_output=True, text=True)
         wall = time.perf_counter() - t0
+        rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1))
+        if p.returncode == 2 and "--max-memory" in p.stderr:
+            print(p.stderr.split("\tCommand being timed")[0].strip())
+            print(f"refused after {wall:.2f} s wall, peak RSS {rss_kb / 1024:.0f} MiB (reading the DEM)")
+            return
         if p.returncode != 0:
             print(p.stderr)
             sys.exit(1)
-        rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1))
         runs.append((wall, rss_kb))
     print(p.stdout)
     walls = sorted(w for w, _ in runs)
     t_ours = walls[len(walls) // 2]
     print(f"sandslope plan ({n} x {n}, time + distance routes), {args.repeat} runs: "
           + ", ".join(f"{w:.2f} s" for w, _ in runs)
-          + f" wall (median {t_ours:.2f} s, max {walls[-1]:.2f} s); peak RSS {max(r for _, r in runs) / 1024:.0f} MiB")
+          + f" wall (median {t_ours:.2f} s, max {walls[-1]:.2f} s); peak RSS {max(r for _, r in runs) / 1024:.0f} MiB"
+          + f" ({max(r for _, r in runs) * 1024 / (n * n):.1f} bytes a cell)")
     print(f"target < 10 s: met in {sum(w < 10.0 for w in walls)} of {len(walls)} runs")
 
+    if args.no_mcp or n > 8192:
+        return
+    z = heights(0, n)
     # Isotropic per-cell cost: seconds per metre at the cell's own slope, level-sand speed
     # 0.15 m/s (the model's level speed for the default robot and terrain), sec(slope)
     # for the surface length.

@@ -106,7 +106,8 @@ def main():
         wall = time.perf_counter() - t0
         rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1))
         if p.returncode == 2 and "--max-memory" in p.stderr:
-            print(p.stderr.split("\tCommand being timed")[0].strip())
+            print("\n".join(l for l in p.stderr.split("\tCommand being timed")[0].splitlines()
+                            if not l.startswith("Command exited")))
             print(f"refused after {wall:.2f} s wall, peak RSS {rss_kb / 1024:.0f} MiB (reading the DEM)")
             return
         if p.returncode != 0:

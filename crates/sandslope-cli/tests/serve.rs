@@ -610,7 +610,7 @@ fn the_risk_tab_draws_risks_safe_slope_limit_and_payload_envelope() {
     .unwrap();
     let env: serde_json::Value = serde_json::from_str(&raw).unwrap();
     let mut from = 0;
-    let mut drawn = 0;
+    let (mut drawn, mut none_safe) = (0, 0);
     for point in env["points"].as_array().unwrap() {
         let slope = point["slope_deg"].as_f64().unwrap();
         let at = raw[from..].find("\"max_payload_kg\": ").unwrap() + from;
@@ -618,7 +618,13 @@ fn the_risk_tab_draws_risks_safe_slope_limit_and_payload_envelope() {
         from = at + 1;
         let anchor = format!("data-slope-deg=\"{slope}\" data-max-payload-kg=");
         match payload.as_str() {
-            "null" => assert!(!dom.contains(&anchor), "a point drawn at {slope} deg, where none is safe"),
+            "null" => {
+                assert!(!dom.contains(&anchor), "a point drawn at {slope} deg, where none is safe");
+                // ... but a cross says so, and the legend names the slope.
+                let cross = format!("data-slope-deg=\"{slope}\" data-none-safe=\"true\"");
+                assert!(dom.contains(&cross), "no 'none safe' cross at {slope} deg");
+                none_safe += 1;
+            }
             p => {
                 let got = attribute(&dom, &anchor, "data-max-payload-kg")
                     .unwrap_or_else(|| panic!("no envelope point at {slope} deg"));
@@ -628,6 +634,11 @@ fn the_risk_tab_draws_risks_safe_slope_limit_and_payload_envelope() {
         }
     }
     assert!(drawn >= 3, "only {drawn} envelope points");
+    assert!(none_safe >= 1, "0:30:7 reaches past the repose angle, where no load is safe");
+    assert!(
+        dom.contains("no safe load at 25, 30 deg"),
+        "the legend does not name the slopes with no safe load"
+    );
 }
 
 #[test]
@@ -758,4 +769,82 @@ fn two_hundred_concurrent_requests_are_all_answered() {
         at(0.99),
         at(1.0)
     );
+}
+
+/// Clients that keep connections open (browsers keep six per host, HTTP/1.1 keep-alive) must not
+/// stall anyone: with 3 idle kept-alive connections, each after one answered request, and a
+/// burst of 12 more that connect and send nothing yet, a new request is answered within 10 s,
+/// and so is a request on each idle connection. (tiny_http 0.12 hands each connection to a
+/// thread pool that counts an idle thread still waking as free, so a burst of connections
+/// left one unread behind the kept-alive ones; the page then had to send at most two requests
+/// at once.)
+#[test]
+fn idle_kept_alive_connections_do_not_stall_new_requests() {
+    let server = Server::start(&[]);
+    let ask = |s: &mut TcpStream, slope: u32| -> (u16, Vec<u8>) {
+        write!(s, "GET /api/predict?slope={slope} HTTP/1.1\r\nHost: {}\r\n\r\n", server.addr).unwrap();
+        read_http11(s)
+    };
+    let mut idle: Vec<TcpStream> = (0..3)
+        .map(|i| {
+            let mut s = TcpStream::connect(&server.addr).unwrap();
+            s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+            let (status, _) = ask(&mut s, i);
+            assert_eq!(status, 200);
+            s
+        })
+        .collect();
+    let silent: Vec<TcpStream> = (0..12).map(|_| TcpStream::connect(&server.addr).unwrap()).collect();
+    let mut fresh = TcpStream::connect(&server.addr).unwrap();
+    fresh.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    let (status, body) = ask(&mut fresh, 20);
+    assert_eq!(status, 200);
+    assert_eq!(body, cli_stdout(&["predict".into(), "--slope".into(), "20".into(), "--json".into()]));
+    for (i, s) in idle.iter_mut().enumerate() {
+        let (status, _) = ask(s, 30 + i as u32);
+        assert_eq!(status, 200, "idle connection {i}");
+    }
+    drop(silent);
+}
+
+/// Reads one HTTP/1.1 response (Content-Length or chunked) from a kept-alive connection:
+/// (status, body). Fails the test on a read timeout.
+fn read_http11(s: &mut TcpStream) -> (u16, Vec<u8>) {
+    let mut reader = BufReader::new(s.try_clone().unwrap());
+    let mut status_line = String::new();
+    reader.read_line(&mut status_line).expect("no answer within the timeout");
+    let status: u16 = status_line.split(' ').nth(1).and_then(|v| v.parse().ok()).expect("no status");
+    let (mut length, mut chunked) = (None, false);
+    loop {
+        let mut line = String::new();
+        reader.read_line(&mut line).unwrap();
+        let line = line.trim_end();
+        if line.is_empty() {
+            break;
+        }
+        let (k, v) = line.split_once(':').unwrap();
+        match k.trim().to_ascii_lowercase().as_str() {
+            "content-length" => length = Some(v.trim().parse::<usize>().unwrap()),
+            "transfer-encoding" => chunked = v.trim().eq_ignore_ascii_case("chunked"),
+            _ => {}
+        }
+    }
+    let mut body = Vec::new();
+    if chunked {
+        loop {
+            let mut size = String::new();
+            reader.read_line(&mut size).unwrap();
+            let n = usize::from_str_radix(size.trim(), 16).unwrap();
+            let mut chunk = vec![0; n + 2];
+            reader.read_exact(&mut chunk).unwrap();
+            if n == 0 {
+                break;
+            }
+            body.extend_from_slice(&chunk[..n]);
+        }
+    } else {
+        body.resize(length.expect("neither Content-Length nor chunked"), 0);
+        reader.read_exact(&mut body).unwrap();
+    }
+    (status, body)
 }

@@ -1,20 +1,28 @@
-//! The HTTP layer: a small synchronous server (`tiny_http`) with two threads that read
-//! requests and answer the embedded page, and a bounded pool of compute threads that answer
-//! the API, so a slow phase map or route never holds up the page or other requests.
+//! The HTTP layer: `axum` on a small `tokio` runtime (2 threads) that reads requests and
+//! answers the embedded page, and at most `--threads` computations at once on tokio's blocking
+//! pool, so a slow phase map or route never holds up the page, other connections or other
+//! requests. Every connection is read as soon as it has bytes, whatever other clients keep open
+//! (the server before this one, `tiny_http` 0.12, could leave a new connection unread behind
+//! idle kept-alive ones; `idle_kept_alive_connections_do_not_stall_new_requests` in
+//! tests/serve.rs reproduced it in 2 of 3 runs).
 //!
 //! Limits, each refused with a 4xx whose JSON names it: a URL of at most [`MAX_URL`] bytes
 //! (414), a POST body of at most [`MAX_BODY`] bytes (413), at most [`MAX_QUEUE`] API requests
 //! waiting for a compute thread (503). A panic inside a computation is caught and answered
 //! with a 500 (none is known: bad input is a 400).
 
-use std::io::Read;
 use std::net::{IpAddr, SocketAddr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::mpsc::{sync_channel, Receiver, SyncSender, TrySendError};
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 
-use anyhow::{anyhow, Result};
-use tiny_http::{Header, Method, Request, Response};
+use anyhow::{Context, Result};
+use axum::body::{to_bytes, Body};
+use axum::extract::{Request, State};
+use axum::http::{header, HeaderValue, Method, StatusCode};
+use axum::response::Response;
+use axum::Router;
+use tokio::sync::Semaphore;
 
 use super::api::{self, ApiError, Served};
 use super::data::{self, Reply};
@@ -26,17 +34,11 @@ pub const MAX_URL: usize = 8192;
 pub const MAX_BODY: usize = 65_536;
 /// Most API requests waiting for a compute thread; more get 503.
 pub const MAX_QUEUE: usize = 1024;
-/// Threads that read requests and answer the page's files.
+/// Threads of the runtime that read requests and answer the page's files (the computations
+/// run elsewhere, so two keep every connection read).
 const READERS: usize = 2;
 
-/// One API request handed to a compute thread.
-struct Job {
-    request: Request,
-    path: String,
-    params: Vec<(String, String)>,
-}
-
-/// Answers a queued request by its path: `/api/<command>`, `/data/<name>`, `/download/<file>`.
+/// Answers a computed request by its path: `/api/<command>`, `/data/<name>`, `/download/<file>`.
 fn dispatch(path: &str, params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
     if let Some(command) = path.strip_prefix("/api/") {
         api::answer(command, params, served).map(Reply::json)
@@ -49,202 +51,203 @@ fn dispatch(path: &str, params: &[(String, String)], served: &Served) -> Result<
     }
 }
 
-/// Whether `path` is answered by the compute threads.
+/// Whether `path` is answered by a computation.
 fn computed(path: &str) -> bool {
     ["/api/", "/data/", "/download/"].iter().any(|p| path.starts_with(p))
 }
 
+/// What every request handler shares.
+struct App {
+    served: Served,
+    /// One permit per compute thread.
+    compute: Semaphore,
+    /// API requests admitted and not yet answered (computing or waiting for a permit).
+    admitted: AtomicUsize,
+    threads: usize,
+}
+
 /// A bound server, ready to [`Server::serve`].
 pub struct Server {
-    http: Arc<tiny_http::Server>,
-    served: Arc<Served>,
+    listener: std::net::TcpListener,
+    served: Served,
     threads: usize,
 }
 
 impl Server {
     /// Listens on `host:port` (port 0: any free port).
     pub fn bind(host: IpAddr, port: u16, served: Served, threads: usize) -> Result<Server> {
-        let http = tiny_http::Server::http(SocketAddr::new(host, port))
-            .map_err(|e| anyhow!("cannot listen on {host}:{port}: {e}"))?;
-        Ok(Server { http: Arc::new(http), served: Arc::new(served), threads: threads.max(1) })
+        let listener = std::net::TcpListener::bind(SocketAddr::new(host, port))
+            .with_context(|| format!("cannot listen on {host}:{port}"))?;
+        listener.set_nonblocking(true).context("cannot make the listening socket non-blocking")?;
+        Ok(Server { listener, served, threads: threads.max(1) })
     }
 
     /// The address the server listens on (with the port chosen when 0 was asked).
     pub fn address(&self) -> String {
-        match self.http.server_addr().to_ip() {
-            Some(a) => a.to_string(),
-            None => "?".into(),
-        }
+        self.listener.local_addr().map_or_else(|_| "?".into(), |a| a.to_string())
     }
 
     /// Answers requests until the process ends.
-    pub fn serve(self) {
-        let (tx, rx) = sync_channel::<Job>(MAX_QUEUE);
-        let rx = Arc::new(Mutex::new(rx));
-        let mut handles = Vec::new();
-        for _ in 0..self.threads {
-            let (rx, served) = (Arc::clone(&rx), Arc::clone(&self.served));
-            handles.push(std::thread::spawn(move || compute_loop(&rx, &served)));
-        }
-        for _ in 0..READERS {
-            let (http, tx, served) = (Arc::clone(&self.http), tx.clone(), Arc::clone(&self.served));
-            handles.push(std::thread::spawn(move || read_loop(&http, &tx, &served)));
-        }
-        drop(tx);
-        for h in handles {
-            let _ = h.join();
-        }
+    pub fn serve(self) -> Result<()> {
+        let runtime = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(READERS)
+            .enable_io()
+            .build()
+            .context("cannot start the server's threads")?;
+        let app = Arc::new(App {
+            served: self.served,
+            compute: Semaphore::new(self.threads),
+            admitted: AtomicUsize::new(0),
+            threads: self.threads,
+        });
+        runtime.block_on(async move {
+            let listener =
+                tokio::net::TcpListener::from_std(self.listener).context("cannot listen on the socket")?;
+            let router = Router::new().fallback(route).with_state(app);
+            axum::serve(listener, router).await.context("the server stopped")
+        })
     }
 }
 
-fn read_loop(http: &tiny_http::Server, tx: &SyncSender<Job>, served: &Served) {
-    loop {
-        let Ok(request) = http.recv() else { continue };
-        route(request, tx, served);
-    }
-}
-
-fn compute_loop(rx: &Mutex<Receiver<Job>>, served: &Served) {
-    loop {
-        let job = {
-            let Ok(rx) = rx.lock() else { return };
-            match rx.recv() {
-                Ok(job) => job,
-                Err(_) => return,
-            }
-        };
-        let result = catch_unwind(AssertUnwindSafe(|| dispatch(&job.path, &job.params, served)))
-            .unwrap_or_else(|_| {
-                Err(ApiError {
-                    status: 500,
-                    field: None,
-                    error: "internal error: the computation panicked (please report it)".into(),
-                })
-            });
-        respond_api(job.request, result);
-    }
-}
-
-/// Sends a result: the body on success, `{"field": ..., "error": ...}` otherwise.
-fn respond_api(request: Request, result: Result<Reply, ApiError>) {
+/// The answer to a request: the reply's body on success, `{"field": ..., "error": ...}`
+/// otherwise, with the page's headers.
+fn respond(result: Result<Reply, ApiError>) -> Response {
     let (status, reply) = match result {
         Ok(reply) => (200, reply),
         Err(e) => (e.status, Reply::json(api::json(&e).unwrap_or_else(|_| b"{}\n".to_vec()))),
     };
-    let mut response =
-        with_type(Response::from_data(reply.body).with_status_code(status), reply.content_type);
-    if let Some(name) = reply.filename {
-        let value = format!("attachment; filename=\"{name}\"");
-        if let Ok(h) = Header::from_bytes(&b"Content-Disposition"[..], value.as_bytes()) {
-            response.add_header(h);
-        }
-    }
-    let _ = request.respond(response);
-}
-
-fn with_type<R: Read>(r: Response<R>, content_type: &str) -> Response<R> {
-    let mut r = r;
+    let mut response = Response::new(Body::from(reply.body));
+    *response.status_mut() = StatusCode::from_u16(status).unwrap_or(StatusCode::INTERNAL_SERVER_ERROR);
+    let headers = response.headers_mut();
     for (k, v) in [
-        ("Content-Type", content_type),
-        ("Cache-Control", "no-store"),
-        ("X-Content-Type-Options", "nosniff"),
+        (header::CONTENT_TYPE, reply.content_type),
+        (header::CACHE_CONTROL, "no-store"),
+        (header::X_CONTENT_TYPE_OPTIONS, "nosniff"),
         // The page loads nothing from anywhere but this server.
         (
-            "Content-Security-Policy",
+            header::CONTENT_SECURITY_POLICY,
             "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; \
              connect-src 'self'; frame-ancestors 'none'",
         ),
     ] {
-        if let Ok(h) = Header::from_bytes(k.as_bytes(), v.as_bytes()) {
-            r.add_header(h);
+        headers.insert(k, HeaderValue::from_static(v));
+    }
+    if let Some(name) = reply.filename {
+        if let Ok(v) = HeaderValue::from_str(&format!("attachment; filename=\"{name}\"")) {
+            headers.insert(header::CONTENT_DISPOSITION, v);
         }
     }
-    r
+    response
 }
 
-fn refuse(request: Request, status: u16, field: Option<&str>, error: String) {
-    respond_api(request, Err(ApiError { status, field: field.map(str::to_string), error }));
+fn refuse(status: u16, error: String) -> Response {
+    respond(Err(ApiError { status, field: None, error }))
 }
 
-/// Answers the page's files on this thread and queues API requests for the compute threads.
-fn route(mut request: Request, tx: &SyncSender<Job>, served: &Served) {
-    let url = request.url().to_string();
+/// Answers the page's files on the runtime and hands API requests to a compute thread.
+async fn route(State(app): State<Arc<App>>, request: Request) -> Response {
+    let url = request.uri().path_and_query().map_or("/", |pq| pq.as_str()).to_string();
     if url.len() > MAX_URL {
-        return refuse(
-            request,
-            414,
-            None,
-            format!("the URL is {} bytes; at most {MAX_URL} are accepted", url.len()),
-        );
+        return refuse(414, format!("the URL is {} bytes; at most {MAX_URL} are accepted", url.len()));
     }
     let (path, query) = url.split_once('?').unwrap_or((&url, ""));
     let method = request.method().clone();
-    if computed(path) {
-        let mut params: Vec<(String, String)> =
-            form_urlencoded::parse(query.as_bytes()).map(|(k, v)| (k.into_owned(), v.into_owned())).collect();
-        match method {
-            Method::Get => {}
-            Method::Post => match body_params(&mut request) {
-                Ok(mut more) => params.append(&mut more),
-                Err(e) => return respond_api(request, Err(e)),
-            },
-            _ => {
-                return refuse(
-                    request,
-                    405,
-                    None,
-                    format!("{method} is not accepted; use GET (or POST with JSON)"),
-                )
-            }
+    if !computed(path) {
+        if method != Method::GET && method != Method::HEAD {
+            return refuse(405, format!("{method} is not accepted here; use GET"));
         }
-        let job = Job { request, path: path.to_string(), params };
-        if let Err(e) = tx.try_send(job) {
-            let job = match e {
-                TrySendError::Full(job) | TrySendError::Disconnected(job) => job,
-            };
-            refuse(
-                job.request,
-                503,
-                None,
-                format!("the server is busy: at most {MAX_QUEUE} API requests may wait; try again"),
-            );
-        }
-        return;
+        return match page::asset(path, &app.served) {
+            Some((body, content_type)) => respond(Ok(Reply { body, content_type, filename: None })),
+            None => refuse(404, format!("no page {path}: the explorer is at /, the API at /api/")),
+        };
     }
-    if method != Method::Get && method != Method::Head {
-        return refuse(request, 405, None, format!("{method} is not accepted here; use GET"));
+    let mut params: Vec<(String, String)> =
+        form_urlencoded::parse(query.as_bytes()).map(|(k, v)| (k.into_owned(), v.into_owned())).collect();
+    match method {
+        Method::GET => {}
+        Method::POST => match body_params(request).await {
+            Ok(mut more) => params.append(&mut more),
+            Err(e) => return respond(Err(e)),
+        },
+        _ => return refuse(405, format!("{method} is not accepted; use GET (or POST with JSON)")),
     }
-    match page::asset(path, served) {
-        Some((body, content_type)) => {
-            let _ = request.respond(with_type(Response::from_data(body), content_type));
-        }
-        None => refuse(request, 404, None, format!("no page {path}: the explorer is at /, the API at /api/")),
+    // Admitted: computing or waiting for one of the compute threads.
+    let _admitted = Admitted::new(&app.admitted);
+    if _admitted.count > MAX_QUEUE + app.threads {
+        return refuse(
+            503,
+            format!("the server is busy: at most {MAX_QUEUE} API requests may wait; try again"),
+        );
+    }
+    let Ok(_permit) = app.compute.acquire().await else {
+        return refuse(503, "the server is stopping".into());
+    };
+    let path = path.to_string();
+    let job = Arc::clone(&app);
+    let result = tokio::task::spawn_blocking(move || {
+        catch_unwind(AssertUnwindSafe(|| dispatch(&path, &params, &job.served)))
+            .unwrap_or_else(|_| Err(panicked()))
+    })
+    .await
+    .unwrap_or_else(|_| Err(panicked()));
+    respond(result)
+}
+
+fn panicked() -> ApiError {
+    ApiError {
+        status: 500,
+        field: None,
+        error: "internal error: the computation panicked (please report it)".into(),
+    }
+}
+
+/// Counts an admitted API request for as long as it lives.
+struct Admitted<'a> {
+    counter: &'a AtomicUsize,
+    /// Requests admitted, this one included, when it came.
+    count: usize,
+}
+
+impl<'a> Admitted<'a> {
+    fn new(counter: &'a AtomicUsize) -> Admitted<'a> {
+        Admitted { counter, count: counter.fetch_add(1, Ordering::AcqRel) + 1 }
+    }
+}
+
+impl Drop for Admitted<'_> {
+    fn drop(&mut self) {
+        self.counter.fetch_sub(1, Ordering::AcqRel);
     }
 }
 
 /// A POST body: a JSON object of parameters (`{"slope": 20, "mass": 1.0}`), at most
 /// [`MAX_BODY`] bytes. Numbers are passed on as JSON writes them, strings as they are, arrays
 /// comma-joined, booleans as true/false.
-fn body_params(request: &mut Request) -> Result<Vec<(String, String)>, ApiError> {
+async fn body_params(request: Request) -> Result<Vec<(String, String)>, ApiError> {
     let too_big = |n: String| ApiError {
         status: 413,
         field: None,
         error: format!("the request body is {n} bytes; at most {MAX_BODY} are accepted"),
     };
-    if let Some(n) = request.body_length() {
-        if n > MAX_BODY {
+    let declared = request
+        .headers()
+        .get(header::CONTENT_LENGTH)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.trim().parse::<u64>().ok());
+    if let Some(n) = declared {
+        if n > MAX_BODY as u64 {
             return Err(too_big(n.to_string()));
         }
     }
-    let mut body = Vec::new();
-    request
-        .as_reader()
-        .take(MAX_BODY as u64 + 1)
-        .read_to_end(&mut body)
-        .map_err(|e| ApiError::bad(None, format!("reading the request body: {e}")))?;
-    if body.len() > MAX_BODY {
-        return Err(too_big(format!("more than {MAX_BODY}")));
-    }
+    // A body without Content-Length (chunked) is read up to the limit and refused past it.
+    let body = to_bytes(request.into_body(), MAX_BODY).await.map_err(|e| {
+        let e = e.into_inner();
+        if e.downcast_ref::<http_body_util::LengthLimitError>().is_some() {
+            too_big(format!("more than {MAX_BODY}"))
+        } else {
+            ApiError::bad(None, format!("reading the request body: {e}"))
+        }
+    })?;
     if body.iter().all(u8::is_ascii_whitespace) {
         return Ok(Vec::new());
     }

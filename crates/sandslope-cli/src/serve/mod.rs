@@ -82,8 +82,7 @@ pub fn run(args: ServeArgs) -> Result<()> {
     if args.open {
         open_browser(&url);
     }
-    server.serve();
-    Ok(())
+    server.serve()
 }
 
 /// Asks the desktop to open `url`; a failure is a note, not an error (the URL is printed).

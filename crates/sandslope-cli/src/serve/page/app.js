@@ -46,38 +46,15 @@ function busy(delta) {
 function query(params) {
   return new URLSearchParams(params).toString();
 }
-// At most MAX_FETCHES requests at once, so the browser keeps at most that many connections
-// open besides the page's own. The HTTP layer (tiny_http 0.12) reads each open connection on
-// a thread of a pool of 4 that grows on demand, and a burst of new connections can leave one
-// queued behind idle kept-alive ones, never read: with six requests at once the Risk tab's
-// load hung in 4 of 5 headless Chromium runs, a request's 562 bytes unread in the server's
-// socket; two at once, 0 of 20. The server computes on 2 threads by default anyway.
-const MAX_FETCHES = 2;
-let fetching = 0;
-const queued = [];
-async function fetchSlot() {
-  if (fetching < MAX_FETCHES) {
-    fetching += 1;
-    return;
-  }
-  await new Promise((resolve) => queued.push(resolve));
-}
-function releaseSlot() {
-  const next = queued.shift();
-  if (next) next();
-  else fetching -= 1;
-}
 async function get(path, params) {
   const q = params ? query(params) : "";
   busy(1);
-  await fetchSlot();
   try {
     const response = await fetch(q ? `${path}?${q}` : path);
     const body = await response.json();
     if (!response.ok) throw new RequestError(body.error || response.statusText, body.field);
     return body;
   } finally {
-    releaseSlot();
     busy(-1);
   }
 }
@@ -382,16 +359,32 @@ function drawEnvelope(env) {
   const payloads = env.points.map((p) => p.max_payload_kg).filter((v) => v !== null);
   const top = Math.max(0.1, ...payloads);
   const f = frame(svg, [0, 30], [Math.min(0, ...payloads), top * 1.1], "slope (deg)", "heaviest safe payload (kg)");
-  let path = "";
+  // The curve is broken where no mass is safe (`limit.kind` "none_safe": even the robot
+  // empty fails more often than the risk allows); those slopes get a cross on the zero line.
+  const segments = [[]];
   for (const p of env.points) {
-    if (p.max_payload_kg === null) continue;
-    path += `${f.x(p.slope_deg)},${f.y(p.max_payload_kg)} `;
+    if (p.max_payload_kg === null) {
+      if (segments[segments.length - 1].length) segments.push([]);
+      const [cx, cy] = [f.x(p.slope_deg), f.y(0)];
+      el("path", {
+        d: `M${cx - 5},${cy - 5}L${cx + 5},${cy + 5}M${cx - 5},${cy + 5}L${cx + 5},${cy - 5}`,
+        stroke: COLOURS.slippage, "stroke-width": 2.5, "data-slope-deg": String(p.slope_deg), "data-none-safe": "true",
+      }, svg);
+      continue;
+    }
+    segments[segments.length - 1].push(`${f.x(p.slope_deg)},${f.y(p.max_payload_kg)}`);
     el("circle", {
       cx: f.x(p.slope_deg), cy: f.y(p.max_payload_kg), r: 3.5, fill: COLOURS.sinkage,
       "data-slope-deg": String(p.slope_deg), "data-max-payload-kg": String(p.max_payload_kg),
     }, svg);
   }
-  el("polyline", { points: path.trim(), fill: "none", stroke: COLOURS.sinkage, "stroke-width": 2.5 }, svg);
+  for (const seg of segments.filter((s) => s.length > 1)) {
+    el("polyline", { points: seg.join(" "), fill: "none", stroke: COLOURS.sinkage, "stroke-width": 2.5 }, svg);
+  }
+  const none = env.points.filter((p) => p.max_payload_kg === null).map((p) => p.slope_deg);
+  if (none.length) {
+    text(svg, f.w - 20, f.m.t + 30, `× no safe load at ${none.join(", ")} deg`, { "text-anchor": "end", fill: COLOURS.slippage });
+  }
   text(svg, f.w - 20, f.m.t + 14, `robot ${env.robot_mass_kg} kg, max risk ${env.max_risk}`, { "text-anchor": "end" });
 }
 

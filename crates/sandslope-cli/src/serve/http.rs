@@ -66,9 +66,14 @@ struct App {
     threads: usize,
 }
 
+/// Connections that may wait to be accepted: a browser opens six at once, the load test 200
+/// (with the usual 128, a burst of 200 connects lost SYNs and waited the 1 s retransmission).
+const BACKLOG: u32 = 1024;
+
 /// A bound server, ready to [`Server::serve`].
 pub struct Server {
-    listener: std::net::TcpListener,
+    runtime: tokio::runtime::Runtime,
+    listener: tokio::net::TcpListener,
     served: Served,
     threads: usize,
 }
@@ -76,10 +81,29 @@ pub struct Server {
 impl Server {
     /// Listens on `host:port` (port 0: any free port).
     pub fn bind(host: IpAddr, port: u16, served: Served, threads: usize) -> Result<Server> {
-        let listener = std::net::TcpListener::bind(SocketAddr::new(host, port))
-            .with_context(|| format!("cannot listen on {host}:{port}"))?;
-        listener.set_nonblocking(true).context("cannot make the listening socket non-blocking")?;
-        Ok(Server { listener, served, threads: threads.max(1) })
+        let runtime = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(READERS)
+            .enable_io()
+            .build()
+            .context("cannot start the server's threads")?;
+        let address = SocketAddr::new(host, port);
+        let listener = {
+            let _in_runtime = runtime.enter();
+            let socket = match host {
+                IpAddr::V4(_) => tokio::net::TcpSocket::new_v4(),
+                IpAddr::V6(_) => tokio::net::TcpSocket::new_v6(),
+            }
+            .and_then(|s| {
+                // As std's TcpListener::bind does: a restarted server can take its port back.
+                #[cfg(unix)]
+                s.set_reuseaddr(true)?;
+                s.bind(address)?;
+                s.listen(BACKLOG)
+            })
+            .with_context(|| format!("cannot listen on {address}"))?;
+            socket
+        };
+        Ok(Server { runtime, listener, served, threads: threads.max(1) })
     }
 
     /// The address the server listens on (with the port chosen when 0 was asked).
@@ -89,20 +113,14 @@ impl Server {
 
     /// Answers requests until the process ends.
     pub fn serve(self) -> Result<()> {
-        let runtime = tokio::runtime::Builder::new_multi_thread()
-            .worker_threads(READERS)
-            .enable_io()
-            .build()
-            .context("cannot start the server's threads")?;
         let app = Arc::new(App {
             served: self.served,
             compute: Semaphore::new(self.threads),
             admitted: AtomicUsize::new(0),
             threads: self.threads,
         });
+        let (runtime, listener) = (self.runtime, self.listener);
         runtime.block_on(async move {
-            let listener =
-                tokio::net::TcpListener::from_std(self.listener).context("cannot listen on the socket")?;
             let router = Router::new().fallback(route).with_state(app);
             axum::serve(listener, router).await.context("the server stopped")
         })

@@ -21,6 +21,10 @@ mod common;
 use std::path::Path;
 use std::time::Duration;
 
+/// Wall time one documented block may take before it counts as hung: the debug build's
+/// `simulate --animate` took over 120 s on this 2-core machine under a load average of 10.
+const BLOCK_TIMEOUT_S: u64 = 600;
+
 use common::repo_file;
 
 /// Commands that are not run, by their first words, and why.
@@ -127,7 +131,7 @@ fn run(dir: &Path, script: &str, what: &str) {
         .args(["-exc", script])
         .current_dir(dir)
         .env("PATH", path)
-        .timeout(Duration::from_secs(120))
+        .timeout(Duration::from_secs(BLOCK_TIMEOUT_S))
         .output()
         .unwrap();
     assert!(
@@ -274,7 +278,7 @@ fn console_transcripts_in_the_docs_are_what_the_commands_print() {
                     .args(["-c", &cmd])
                     .current_dir(dir.path())
                     .env("PATH", &path)
-                    .timeout(Duration::from_secs(120))
+                    .timeout(Duration::from_secs(BLOCK_TIMEOUT_S))
                     .output()
                     .unwrap();
                 assert!(out.status.success(), "{}:{}: `{cmd}` failed", b.file, b.line);

@@ -1,0 +1,241 @@
+//! The IMAGE_MAP_PROJECTION of a PDS3 DTM: equirectangular or polar stereographic on the
+//! body's sphere, as projected-metre georeferencing, ground cell sizes, and GeoKeys.
+
+use anyhow::{anyhow, bail, Result};
+
+use super::label::Label;
+use crate::raster::GeoRef;
+
+/// Where the DTM lies on its projection (projected metres) and on which sphere.
+#[derive(Debug, Clone, Copy)]
+struct Extent<'a> {
+    name: &'a str,
+    body: &'a str,
+    radius_m: f64,
+    /// MAP_SCALE, metres per pixel.
+    cell: f64,
+    /// CENTER_LATITUDE, degrees.
+    clat: f64,
+    /// LINE_PROJECTION_OFFSET.
+    lpo: f64,
+    west: f64,
+    east: f64,
+    north: f64,
+    south: f64,
+}
+
+/// The map's georeferencing (projected metres, north up) and the ground cell size (x, y) in
+/// metres of a DTM of `rows` x `cols`; notes what was assumed.
+pub(super) fn georef(
+    label: &Label,
+    rows: u64,
+    cols: u64,
+    notes: &mut Vec<String>,
+) -> Result<(GeoRef, (f64, f64))> {
+    let name = &label.name;
+    let map = |key: &str| format!("IMAGE_MAP_PROJECTION.{key}");
+    if !label
+        .entries
+        .iter()
+        .any(|(p, _, _)| p.starts_with("IMAGE_MAP_PROJECTION.") || p.contains(".IMAGE_MAP_PROJECTION."))
+    {
+        bail!(
+            "{name}: the label has no IMAGE_MAP_PROJECTION object (MAP_SCALE, the projection): the planner needs \
+             the cell size in metres"
+        );
+    }
+    let (ptype, pline) = label
+        .word(&map("MAP_PROJECTION_TYPE"))
+        .ok_or_else(|| anyhow!("{name}: the label has no IMAGE_MAP_PROJECTION.MAP_PROJECTION_TYPE"))?;
+    let projection = ptype.replace([' ', '_'], "");
+    if !matches!(projection.as_str(), "EQUIRECTANGULAR" | "POLARSTEREOGRAPHIC") {
+        bail!(
+            "{name}: line {pline}: MAP_PROJECTION_TYPE = {ptype} is not supported (EQUIRECTANGULAR or \
+             POLARSTEREOGRAPHIC, the projections of HiRISE DTMs); reproject it (gdalwarp) to one of those or to a GeoTIFF"
+        );
+    }
+    if let Some((rot, _)) = label.number(&map("MAP_PROJECTION_ROTATION"))? {
+        if rot != 0.0 {
+            bail!("{name}: MAP_PROJECTION_ROTATION = {rot}: rotated maps are not supported (north-up only)");
+        }
+    }
+    let (radius, runit) = label.need_number(&map("A_AXIS_RADIUS"), "the body's radius")?;
+    let radius_m = match runit.as_deref() {
+        None | Some("KM" | "KILOMETERS" | "KILOMETER") => radius * 1000.0,
+        Some("M" | "METERS" | "METER" | "METRES" | "METRE") => radius,
+        Some(u) => bail!("{name}: A_AXIS_RADIUS = {radius} <{u}>: the unit must be KM or M"),
+    };
+    if !(1e3..=1e8).contains(&radius_m) {
+        bail!("{name}: A_AXIS_RADIUS = {radius} ({radius_m} m) must be from 1 to 100000 km");
+    }
+    let (map_scale, sunit) = label.need_number(&map("MAP_SCALE"), "the cell size")?;
+    let cell = match sunit.as_deref().map(|u| u.replace(' ', "")).as_deref() {
+        Some("METERS/PIXEL" | "METERS/PIX" | "M/PIXEL" | "M/PIX" | "METERS" | "M" | "METRES/PIXEL") => {
+            map_scale
+        }
+        Some("KM/PIXEL" | "KM/PIX" | "KM" | "KILOMETERS/PIXEL") => map_scale * 1000.0,
+        None => {
+            notes.push(format!(
+                "{name}: MAP_SCALE = {map_scale} has no unit: taken as the PDS3 standard's KM/PIXEL ({} m cells)",
+                map_scale * 1000.0
+            ));
+            map_scale * 1000.0
+        }
+        Some(u) => bail!("{name}: MAP_SCALE = {map_scale} <{u}>: the unit must be METERS/PIXEL or KM/PIXEL"),
+    };
+    if !(cell.is_finite() && cell > 0.0) {
+        bail!("{name}: MAP_SCALE = {map_scale} must be a number greater than 0");
+    }
+    let (lpo, _) = label.need_number(&map("LINE_PROJECTION_OFFSET"), "where the map's origin is")?;
+    let (spo, _) = label.need_number(&map("SAMPLE_PROJECTION_OFFSET"), "where the map's origin is")?;
+    let (clat, _) = label.need_number(&map("CENTER_LATITUDE"), "the projection's latitude")?;
+    let west = -(spo + 0.5) * cell;
+    let north = (lpo + 0.5) * cell;
+    let south = north - rows as f64 * cell;
+    let body = body_name(label, radius_m);
+    let east = west + cols as f64 * cell;
+    let extent = Extent { name, body: &body, radius_m, cell, clat, lpo, west, east, north, south };
+    let cell_m = if projection == "EQUIRECTANGULAR" {
+        equirectangular_cells(&extent, notes)?
+    } else {
+        polar_cells(&extent, notes)?
+    };
+    let clon = label.number(&map("CENTER_LONGITUDE"))?.map_or(0.0, |v| v.0);
+    let (keys, doubles, ascii) = geokeys(&projection, radius_m, clat, clon, &body);
+    Ok((GeoRef::north_up((west, north, cell, cell), keys, doubles, ascii), cell_m))
+}
+
+/// Ground cell size of an equirectangular map (y = R lat): MAP_SCALE north-south; east-west
+/// MAP_SCALE is true at CENTER_LATITUDE, so the cells are taken at the DTM's mid-latitude.
+fn equirectangular_cells(e: &Extent, notes: &mut Vec<String>) -> Result<(f64, f64)> {
+    let Extent { name, body, radius_m, cell, clat, lpo, north, south, .. } = *e;
+    if clat.abs() >= 89.0 {
+        bail!("{name}: CENTER_LATITUDE = {clat}: an equirectangular DTM's must lie within 89 degrees of the equator");
+    }
+    // y = R lat: the rows' latitudes; east-west, MAP_SCALE is true at CENTER_LATITUDE.
+    let lat = |y: f64| (y / radius_m).to_degrees();
+    let (lat_n, lat_s) = (lat(north), lat(south));
+    if lat_n.abs() >= 89.0 || lat_s.abs() >= 89.0 {
+        bail!(
+            "{name}: LINE_PROJECTION_OFFSET = {lpo} puts the rows at latitudes {lat_s:.3} to {lat_n:.3} degrees: \
+             an equirectangular DTM must lie within 89 degrees of the equator"
+        );
+    }
+    let mid = 0.5 * (lat_n + lat_s);
+    let east = |phi: f64| cell * phi.to_radians().cos() / clat.to_radians().cos();
+    let gx = east(mid);
+    let vary = (1.0 - east(lat_n) / gx).abs().max((1.0 - east(lat_s) / gx).abs());
+    notes.push(format!(
+        "{name}: PDS3 equirectangular map on {body} (sphere of radius {radius_m} m): MAP_SCALE {cell} m is true \
+         east-west at CENTER_LATITUDE {clat} degrees; cells taken as {gx:.4} x {cell} m at the mid-latitude \
+         {mid:.4} degrees (the east-west size varies by up to {:.3}% across the rows{})",
+        100.0 * vary,
+        if vary > 0.005 { ": more than 0.5%, crop the DTM for exact lengths" } else { "" }
+    ));
+    Ok((gx, cell))
+}
+
+/// Ground cell size of a polar stereographic map centred on a pole, at the DTM's centre.
+fn polar_cells(e: &Extent, notes: &mut Vec<String>) -> Result<(f64, f64)> {
+    let Extent { name, body, radius_m, cell, clat, west, east: east_edge, north, south, .. } = *e;
+    if (clat.abs() - 90.0).abs() > 1e-9 {
+        bail!(
+            "{name}: CENTER_LATITUDE = {clat}: only polar stereographic maps centred on a pole (CENTER_LATITUDE \
+             = 90 or -90) are supported"
+        );
+    }
+    // Scale factor of the polar stereographic on a sphere, true at the pole: k = 2 / (1 +
+    // sin|lat|), |lat| = 90 - 2 atan(rho / 2R) degrees.
+    let k_at = |x: f64, y: f64| {
+        let colat = 2.0 * (x.hypot(y) / (2.0 * radius_m)).atan();
+        2.0 / (1.0 + colat.cos())
+    };
+    let k = k_at(0.5 * (west + east_edge), 0.5 * (north + south));
+    let corners = [(west, north), (east_edge, north), (west, south), (east_edge, south)];
+    let vary = corners.iter().map(|&(x, y)| (1.0 - k / k_at(x, y)).abs()).fold(0.0, f64::max);
+    let g = cell / k;
+    notes.push(format!(
+        "{name}: PDS3 polar stereographic map about the {} pole of {body} (sphere of radius {radius_m} m): \
+         MAP_SCALE {cell} m is true at the pole; cells taken as {g:.4} x {g:.4} m at the DTM's centre (scale \
+         factor {k:.6}; the cell size varies by up to {:.3}% across the DTM{})",
+        if clat > 0.0 { "north" } else { "south" },
+        100.0 * vary,
+        if vary > 0.005 { ": more than 0.5%, crop the DTM for exact lengths" } else { "" }
+    ));
+    Ok((g, g))
+}
+
+/// GeoTIFF keys (OGC 19-008r4) of the map's projected CRS, user-defined on the body's sphere,
+/// so that a GeoTIFF written over a PDS3 DTM (`plan --risk-map`) carries its projection: the
+/// GeoKeyDirectory, GeoDoubleParams and GeoAsciiParams. Equirectangular is CT_Equirectangular
+/// (17) with the standard parallel CENTER_LATITUDE and latitude of origin 0 (y = R lat); polar
+/// stereographic is CT_PolarStereographic (15) with origin at the pole and scale 1 there.
+fn geokeys(
+    projection: &str,
+    radius_m: f64,
+    clat: f64,
+    clon: f64,
+    body: &str,
+) -> (Vec<u16>, Vec<f64>, String) {
+    const USER: u16 = 32767;
+    const DOUBLES: u16 = 34736;
+    const ASCII: u16 = 34737;
+    let equi = projection == "EQUIRECTANGULAR";
+    let citation = format!("{} {body}|", if equi { "Equirectangular" } else { "Polar Stereographic" });
+    let geog = format!("GCS {body} sphere|");
+    let ascii = format!("{citation}{geog}");
+    let mut doubles = vec![radius_m, radius_m];
+    let mut entries: Vec<[u16; 4]> = vec![
+        [1024, 0, 1, 1], // GTModelTypeGeoKey: projected
+        [1025, 0, 1, 1], // GTRasterTypeGeoKey: PixelIsArea
+        [1026, ASCII, citation.len() as u16, 0],
+        [2048, 0, 1, USER], // GeographicTypeGeoKey
+        [2049, ASCII, geog.len() as u16, citation.len() as u16],
+        [2050, 0, 1, USER],                       // GeogGeodeticDatumGeoKey
+        [2054, 0, 1, 9102],                       // GeogAngularUnitsGeoKey: degree
+        [2056, 0, 1, USER],                       // GeogEllipsoidGeoKey
+        [2057, DOUBLES, 1, 0],                    // GeogSemiMajorAxisGeoKey
+        [2058, DOUBLES, 1, 1],                    // GeogSemiMinorAxisGeoKey
+        [3072, 0, 1, USER],                       // ProjectedCSTypeGeoKey
+        [3074, 0, 1, USER],                       // ProjectionGeoKey
+        [3075, 0, 1, if equi { 17 } else { 15 }], // ProjCoordTransGeoKey
+        [3076, 0, 1, 9001],                       // ProjLinearUnitsGeoKey: metre
+    ];
+    let mut param = |key: u16, v: f64| {
+        entries.push([key, DOUBLES, 1, doubles.len() as u16]);
+        doubles.push(v);
+    };
+    param(3082, 0.0); // ProjFalseEastingGeoKey
+    param(3083, 0.0); // ProjFalseNorthingGeoKey
+    if equi {
+        param(3078, clat); // ProjStdParallel1GeoKey
+        param(3088, clon); // ProjCenterLongGeoKey
+        param(3089, 0.0); // ProjCenterLatGeoKey
+    } else {
+        param(3081, clat); // ProjNatOriginLatGeoKey: the pole
+        param(3092, 1.0); // ProjScaleAtNatOriginGeoKey
+        param(3095, clon); // ProjStraightVertPoleLongGeoKey
+    }
+    entries.sort_by_key(|e| e[0]);
+    let mut dir = vec![1, 1, 0, entries.len() as u16];
+    dir.extend(entries.into_iter().flatten());
+    (dir, doubles, ascii)
+}
+
+/// The body: TARGET_NAME as written ("MARS" -> "Mars"), else by its radius.
+fn body_name(label: &Label, radius_m: f64) -> String {
+    if let Some((t, _)) = label.word("TARGET_NAME") {
+        let mut chars = t.chars();
+        if let Some(first) = chars.next() {
+            return first.to_string() + &chars.as_str().to_ascii_lowercase();
+        }
+    }
+    let near = |r: f64| (radius_m - r).abs() < 1000.0;
+    if near(3_396_190.0) {
+        "Mars".into()
+    } else if near(1_737_400.0) {
+        "the Moon".into()
+    } else {
+        "the body".into()
+    }
+}

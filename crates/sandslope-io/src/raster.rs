@@ -355,6 +355,41 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
     let mut dec = Decoder::new(BufReader::new(file))
         .map_err(|e| anyhow!("{name}: not a readable TIFF: {e}"))?
         .with_limits(tiff_limits());
+    skip_to_full_resolution(&name, &mut dec)?;
+    let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
+    check_raster_size(&name, u64::from(w), u64::from(h))?;
+    let bits: u64 = dec.find_tag_unsigned(Tag::BitsPerSample).ok().flatten().unwrap_or(64);
+    let file_bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
+    check_claimed_bytes(&name, u64::from(w), u64::from(h), bits, file_bytes)?;
+    let samples: u16 = dec.find_tag_unsigned(Tag::SamplesPerPixel).ok().flatten().unwrap_or(1);
+    if samples != 1 {
+        bail!("{name}: has {samples} bands (SamplesPerPixel = {samples}); an elevation or class raster must have exactly 1");
+    }
+    let tags = GeoTags::read(&name, &mut dec)?;
+    let (west, north, cell_x, cell_y) = tags.origin_and_cell(&name)?;
+    let values = decode_samples(&name, path, &mut dec, bits)?;
+    let (cols, rows) = (w as usize, h as usize);
+    if values.len() != cols * rows {
+        bail!("{name}: decoded {} samples for a {cols} x {rows} image", values.len());
+    }
+    let mut notes = Vec::new();
+    let GeoTags { geokeys, geodoubles, geoascii, nodata, .. } = tags;
+    let (crs, vertical) = crate::crs::from_geokeys(
+        &name,
+        geokeys.as_deref(),
+        geodoubles.as_deref(),
+        geoascii.as_deref(),
+        &mut notes,
+    )?;
+    let geo = GeoRef { west, north, cell_x, cell_y, geokeys, geodoubles, geoascii };
+    Ok((Raster { cols, rows, values, nodata, geo, crs, cell_m: (cell_x, cell_y), notes }, vertical))
+}
+
+/// Moves `dec` to the full-resolution image.
+fn skip_to_full_resolution<R: std::io::Read + std::io::Seek>(
+    name: &dyn std::fmt::Display,
+    dec: &mut Decoder<R>,
+) -> Result<()> {
     // The full-resolution image: should a file begin with an overview or a mask (NewSubfileType
     // bit 0, reduced resolution, or bit 2, transparency mask), skip to the first that is neither.
     // (GDAL's COG and COPY_SRC_OVERVIEWS put the full image first and overviews after it.)
@@ -368,78 +403,107 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
         }
         dec.next_image().map_err(|e| anyhow!("{name}: the image directory after an overview: {e}"))?;
     }
-    let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
-    check_raster_size(&name, u64::from(w), u64::from(h))?;
-    let bits: u64 = dec.find_tag_unsigned(Tag::BitsPerSample).ok().flatten().unwrap_or(64);
-    let file_bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
-    check_claimed_bytes(&name, u64::from(w), u64::from(h), bits, file_bytes)?;
-    let samples: u16 = dec.find_tag_unsigned(Tag::SamplesPerPixel).ok().flatten().unwrap_or(1);
-    let sample_format: u16 = dec.find_tag_unsigned(Tag::SampleFormat).ok().flatten().unwrap_or(1);
-    if samples != 1 {
-        bail!("{name}: has {samples} bands (SamplesPerPixel = {samples}); an elevation or class raster must have exactly 1");
-    }
-    let tag_f64 = |dec: &mut Decoder<_>, tag: Tag| -> Result<Option<Vec<f64>>> {
-        match dec.find_tag(tag).map_err(|e| anyhow!("{name}: tag {tag:?}: {e}"))? {
-            Some(v) => Ok(Some(v.into_f64_vec().map_err(|e| anyhow!("{name}: tag {tag:?}: {e}"))?)),
-            None => Ok(None),
-        }
-    };
-    let scale = tag_f64(&mut dec, Tag::ModelPixelScaleTag)?;
-    let tie = tag_f64(&mut dec, Tag::ModelTiepointTag)?;
-    let transform = tag_f64(&mut dec, Tag::ModelTransformationTag)?;
-    let geodoubles = tag_f64(&mut dec, Tag::GeoDoubleParamsTag)?;
-    let geokeys = match dec.find_tag(Tag::GeoKeyDirectoryTag).ok().flatten() {
-        Some(v) => Some(v.into_u16_vec().map_err(|e| anyhow!("{name}: GeoKeyDirectory: {e}"))?),
-        None => None,
-    };
-    let geoascii = dec.find_tag(Tag::GeoAsciiParamsTag).ok().flatten().and_then(|v| v.into_string().ok());
-    let nodata = match dec.find_tag(Tag::GdalNodata).ok().flatten() {
-        Some(v) => {
-            let s = v.into_string().map_err(|e| anyhow!("{name}: GDAL_NODATA tag: {e}"))?;
-            let s = s.trim_matches(|c: char| c == '\0' || c.is_whitespace());
-            Some(s.parse::<f64>().map_err(|_| anyhow!("{name}: GDAL_NODATA tag `{s}` is not a number"))?)
-        }
-        None => None,
-    };
-    let from_transform =
-        !(scale.as_ref().is_some_and(|s| s.len() >= 2) && tie.as_ref().is_some_and(|t| t.len() >= 6));
-    let (mut west, mut north, cell_x, cell_y) = match (scale, tie, transform) {
-        (_, Some(t), None) if t.len() > 6 => bail!(
-            "{name}: ModelTiepointTag (33922) holds {} tie points: a raster georeferenced by ground control \
-             points is not a regular grid; warp it to one first (gdalwarp -t_srs ...)",
-            t.len() / 6
-        ),
-        (Some(s), Some(t), _) if s.len() >= 2 && t.len() >= 6 => {
-            (t[3] - t[0] * s[0], t[4] + t[1] * s[1], s[0], s[1])
-        }
-        (_, _, Some(m)) if m.len() >= 16 => {
-            if m[1] != 0.0 || m[4] != 0.0 {
-                bail!(
-                    "{name}: ModelTransformationTag (34264) has rotation or shear terms {} (row 1, column 2) and {} \
-                     (row 2, column 1): only north-up rasters are supported; make it north-up first (gdalwarp)",
-                    m[1],
-                    m[4]
-                );
+    Ok(())
+}
+
+/// A GeoTIFF's georeferencing tags and GDAL_NODATA, as stored.
+struct GeoTags {
+    scale: Option<Vec<f64>>,
+    tie: Option<Vec<f64>>,
+    transform: Option<Vec<f64>>,
+    geodoubles: Option<Vec<f64>>,
+    geokeys: Option<Vec<u16>>,
+    geoascii: Option<String>,
+    nodata: Option<f64>,
+}
+
+impl GeoTags {
+    fn read<R: std::io::Read + std::io::Seek>(
+        name: &dyn std::fmt::Display,
+        dec: &mut Decoder<R>,
+    ) -> Result<GeoTags> {
+        let tag_f64 = |dec: &mut Decoder<_>, tag: Tag| -> Result<Option<Vec<f64>>> {
+            match dec.find_tag(tag).map_err(|e| anyhow!("{name}: tag {tag:?}: {e}"))? {
+                Some(v) => Ok(Some(v.into_f64_vec().map_err(|e| anyhow!("{name}: tag {tag:?}: {e}"))?)),
+                None => Ok(None),
             }
-            (m[3], m[7], m[0], -m[5])
-        }
-        _ => bail!(
-            "{name}: no georeferencing (needs the GeoTIFF ModelPixelScale and ModelTiepoint tags, or \
-             ModelTransformation); the planner needs the cell size in metres"
-        ),
-    };
-    if !(cell_x.is_finite() && cell_x > 0.0 && cell_y.is_finite() && cell_y > 0.0) {
-        let tag = if from_transform {
-            "ModelTransformationTag (34264): m[0], -m[5]"
-        } else {
-            "ModelPixelScaleTag (33550)"
         };
-        bail!("{name}: pixel scale ({cell_x}, {cell_y}) from {tag} must be positive (north-up rasters only)");
+        let scale = tag_f64(dec, Tag::ModelPixelScaleTag)?;
+        let tie = tag_f64(dec, Tag::ModelTiepointTag)?;
+        let transform = tag_f64(dec, Tag::ModelTransformationTag)?;
+        let geodoubles = tag_f64(dec, Tag::GeoDoubleParamsTag)?;
+        let geokeys = match dec.find_tag(Tag::GeoKeyDirectoryTag).ok().flatten() {
+            Some(v) => Some(v.into_u16_vec().map_err(|e| anyhow!("{name}: GeoKeyDirectory: {e}"))?),
+            None => None,
+        };
+        let geoascii = dec.find_tag(Tag::GeoAsciiParamsTag).ok().flatten().and_then(|v| v.into_string().ok());
+        let nodata = match dec.find_tag(Tag::GdalNodata).ok().flatten() {
+            Some(v) => {
+                let s = v.into_string().map_err(|e| anyhow!("{name}: GDAL_NODATA tag: {e}"))?;
+                let s = s.trim_matches(|c: char| c == '\0' || c.is_whitespace());
+                Some(s.parse::<f64>().map_err(|_| anyhow!("{name}: GDAL_NODATA tag `{s}` is not a number"))?)
+            }
+            None => None,
+        };
+        Ok(GeoTags { scale, tie, transform, geodoubles, geokeys, geoascii, nodata })
     }
-    if pixel_is_point(geokeys.as_deref()) {
-        west -= 0.5 * cell_x;
-        north += 0.5 * cell_y;
+
+    /// The raster's west and north edges and cell size (x, y), in the CRS's units, from the
+    /// pixel scale and tie point or the transformation matrix (north up only), corrected for
+    /// PixelIsPoint.
+    fn origin_and_cell(&self, name: &dyn std::fmt::Display) -> Result<(f64, f64, f64, f64)> {
+        let (scale, tie, transform) = (self.scale.as_deref(), self.tie.as_deref(), self.transform.as_deref());
+        let from_transform =
+            !(scale.as_ref().is_some_and(|s| s.len() >= 2) && tie.as_ref().is_some_and(|t| t.len() >= 6));
+        let (mut west, mut north, cell_x, cell_y) = match (scale, tie, transform) {
+            (_, Some(t), None) if t.len() > 6 => bail!(
+                "{name}: ModelTiepointTag (33922) holds {} tie points: a raster georeferenced by ground control \
+                 points is not a regular grid; warp it to one first (gdalwarp -t_srs ...)",
+                t.len() / 6
+            ),
+            (Some(s), Some(t), _) if s.len() >= 2 && t.len() >= 6 => {
+                (t[3] - t[0] * s[0], t[4] + t[1] * s[1], s[0], s[1])
+            }
+            (_, _, Some(m)) if m.len() >= 16 => {
+                if m[1] != 0.0 || m[4] != 0.0 {
+                    bail!(
+                        "{name}: ModelTransformationTag (34264) has rotation or shear terms {} (row 1, column 2) and {} \
+                         (row 2, column 1): only north-up rasters are supported; make it north-up first (gdalwarp)",
+                        m[1],
+                        m[4]
+                    );
+                }
+                (m[3], m[7], m[0], -m[5])
+            }
+            _ => bail!(
+                "{name}: no georeferencing (needs the GeoTIFF ModelPixelScale and ModelTiepoint tags, or \
+                 ModelTransformation); the planner needs the cell size in metres"
+            ),
+        };
+        if !(cell_x.is_finite() && cell_x > 0.0 && cell_y.is_finite() && cell_y > 0.0) {
+            let tag = if from_transform {
+                "ModelTransformationTag (34264): m[0], -m[5]"
+            } else {
+                "ModelPixelScaleTag (33550)"
+            };
+            bail!("{name}: pixel scale ({cell_x}, {cell_y}) from {tag} must be positive (north-up rasters only)");
+        }
+        if pixel_is_point(self.geokeys.as_deref()) {
+            west -= 0.5 * cell_x;
+            north += 0.5 * cell_y;
+        }
+        Ok((west, north, cell_x, cell_y))
     }
+}
+
+/// The image's samples as f64, whatever their integer or float type.
+fn decode_samples<R: std::io::Read + std::io::Seek>(
+    name: &dyn std::fmt::Display,
+    path: &Path,
+    dec: &mut Decoder<R>,
+    bits: u64,
+) -> Result<Vec<f64>> {
+    let sample_format: u16 = dec.find_tag_unsigned(Tag::SampleFormat).ok().flatten().unwrap_or(1);
     let image = match dec.read_image() {
         Ok(image) => image,
         // Tiled LZW with partial edge tiles, which the `tiff` crate cannot decode (lzw_tiles.rs).
@@ -447,8 +511,8 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
             let mut file = File::open(path).with_context(|| format!("cannot read {name}"))?;
             let mut order = [0u8; 2];
             std::io::Read::read_exact(&mut file, &mut order)?;
-            let layout = crate::lzw_tiles::layout(&name, &mut dec, &order == b"II")?;
-            DecodingResult::F64(crate::lzw_tiles::decode(&name, &mut file, &layout)?)
+            let layout = crate::lzw_tiles::layout(name, dec, &order == b"II")?;
+            DecodingResult::F64(crate::lzw_tiles::decode(name, &mut file, &layout)?)
         }
         Err(e) => bail!("{name}: cannot decode the image: {e}"),
     };
@@ -472,20 +536,7 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
             }
         ),
     };
-    let (cols, rows) = (w as usize, h as usize);
-    if values.len() != cols * rows {
-        bail!("{name}: decoded {} samples for a {cols} x {rows} image", values.len());
-    }
-    let mut notes = Vec::new();
-    let (crs, vertical) = crate::crs::from_geokeys(
-        &name,
-        geokeys.as_deref(),
-        geodoubles.as_deref(),
-        geoascii.as_deref(),
-        &mut notes,
-    )?;
-    let geo = GeoRef { west, north, cell_x, cell_y, geokeys, geodoubles, geoascii };
-    Ok((Raster { cols, rows, values, nodata, geo, crs, cell_m: (cell_x, cell_y), notes }, vertical))
+    Ok(values)
 }
 
 fn pixel_is_point(keys: Option<&[u16]>) -> bool {

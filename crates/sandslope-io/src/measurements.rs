@@ -272,51 +272,8 @@ pub fn read_recording_with(path: &Path, kind: Kind, options: ReadOptions) -> Res
     let header_line = header.position().map(|p| p.line()).unwrap_or(1).max(1);
     let names: Vec<String> = header.iter().map(|h| h.to_ascii_lowercase()).collect();
 
-    // Position column: exactly one `<name>_<unit>` with a known unit.
-    let prefix = format!("{position_name}_");
-    let mut position: Option<(usize, f64)> = None;
-    for (i, n) in names.iter().enumerate() {
-        if let Some(unit) = n.strip_prefix(&prefix) {
-            let scale = unit_scale(unit).ok_or_else(|| {
-                anyhow!(
-                    "{here}: line {header_line}, column {}: unknown unit `{unit}` in `{n}` (valid: {position_name}_m, \
-                     {position_name}_mm, {position_name}_cm)",
-                    i + 1
-                )
-            })?;
-            if position.is_some() {
-                bail!("{here}: line {header_line}, column {}: a second {position_name} column `{n}`", i + 1);
-            }
-            position = Some((i, scale));
-        }
-    }
-    let found = names.join(", ");
-    let (pos_col, pos_scale) = position.ok_or_else(|| {
-        anyhow!("{here}: line {header_line}: no {position_name} column for a {kind} trial (expected {expected}; found: {found})")
-    })?;
-    let force_n = names.iter().position(|n| n == "force_n");
-    let force_counts = names.iter().position(|n| n == "force_counts");
-    let (force_col, force_scale) = match (force_n, force_counts) {
-        (Some(_), Some(_)) => bail!("{here}: line {header_line}: both force_n and force_counts; keep one"),
-        (Some(i), None) => (i, 1.0),
-        (None, Some(i)) => match counts_per_newton {
-            Some(c) => (i, 1.0 / c),
-            None => bail!(
-                "{here}: line {header_line}, column {}: force_counts needs the load cell's counts per newton, from \
-                 your calibration (--counts-per-newton; counts_per_newton= in Python)",
-                i + 1
-            ),
-        },
-        (None, None) => {
-            let unit_hint = names
-                .iter()
-                .find(|n| n.starts_with("force_"))
-                .map(|n| format!(" (`{n}` is not a known force column)"))
-                .unwrap_or_default();
-            bail!("{here}: line {header_line}: no force column{unit_hint} (expected {expected}; found: {found})")
-        }
-    };
-    let time_col = names.iter().position(|n| n == "time_s");
+    let Columns { position: (pos_col, pos_scale), force: (force_col, force_scale), time: time_col } =
+        columns(&here, header_line, &names, kind, counts_per_newton, &expected)?;
 
     let mut raw = RawRecording {
         time: time_col.map(|_| Vec::new()),
@@ -369,6 +326,75 @@ pub fn read_recording_with(path: &Path, kind: Kind, options: ReadOptions) -> Res
         bail!("{here}: a header but no data rows (expected {expected})");
     }
     Ok(Recording { raw, rows })
+}
+
+/// A trial's columns: position and force (index, factor to metres or newtons), and time.
+struct Columns {
+    position: (usize, f64),
+    force: (usize, f64),
+    time: Option<usize>,
+}
+
+/// Finds the columns in the header's lower-cased `names`: exactly one `<name>_<unit>` position
+/// column with a known unit, `force_n` or `force_counts` (with `counts_per_newton`), `time_s`.
+fn columns(
+    here: &dyn std::fmt::Display,
+    header_line: u64,
+    names: &[String],
+    kind: Kind,
+    counts_per_newton: Option<f64>,
+    expected: &str,
+) -> Result<Columns> {
+    let position_name = match kind {
+        Kind::Penetration => "depth",
+        Kind::Shear => "displacement",
+    };
+    // Position column: exactly one `<name>_<unit>` with a known unit.
+    let prefix = format!("{position_name}_");
+    let mut position: Option<(usize, f64)> = None;
+    for (i, n) in names.iter().enumerate() {
+        if let Some(unit) = n.strip_prefix(&prefix) {
+            let scale = unit_scale(unit).ok_or_else(|| {
+                anyhow!(
+                    "{here}: line {header_line}, column {}: unknown unit `{unit}` in `{n}` (valid: {position_name}_m, \
+                     {position_name}_mm, {position_name}_cm)",
+                    i + 1
+                )
+            })?;
+            if position.is_some() {
+                bail!("{here}: line {header_line}, column {}: a second {position_name} column `{n}`", i + 1);
+            }
+            position = Some((i, scale));
+        }
+    }
+    let found = names.join(", ");
+    let (pos_col, pos_scale) = position.ok_or_else(|| {
+        anyhow!("{here}: line {header_line}: no {position_name} column for a {kind} trial (expected {expected}; found: {found})")
+    })?;
+    let force_n = names.iter().position(|n| n == "force_n");
+    let force_counts = names.iter().position(|n| n == "force_counts");
+    let (force_col, force_scale) = match (force_n, force_counts) {
+        (Some(_), Some(_)) => bail!("{here}: line {header_line}: both force_n and force_counts; keep one"),
+        (Some(i), None) => (i, 1.0),
+        (None, Some(i)) => match counts_per_newton {
+            Some(c) => (i, 1.0 / c),
+            None => bail!(
+                "{here}: line {header_line}, column {}: force_counts needs the load cell's counts per newton, from \
+                 your calibration (--counts-per-newton; counts_per_newton= in Python)",
+                i + 1
+            ),
+        },
+        (None, None) => {
+            let unit_hint = names
+                .iter()
+                .find(|n| n.starts_with("force_"))
+                .map(|n| format!(" (`{n}` is not a known force column)"))
+                .unwrap_or_default();
+            bail!("{here}: line {header_line}: no force column{unit_hint} (expected {expected}; found: {found})")
+        }
+    };
+    let time_col = names.iter().position(|n| n == "time_s");
+    Ok(Columns { position: (pos_col, pos_scale), force: (force_col, force_scale), time: time_col })
 }
 
 #[cfg(test)]

@@ -25,6 +25,36 @@ use super::{pick_body, unit_scale, Rows};
 pub(crate) type Parsed = (String, f64, f64, Vec<[f64; 3]>);
 
 pub(crate) fn parse(rows: &Rows, body: Option<&str>) -> Result<Parsed> {
+    let (frame_rate, scale) = metadata(rows)?;
+    let (header, names_at) = header_rows(rows)?;
+    let names_line = rows.rows[names_at].0;
+    let candidates = position_columns(rows, &header, names_at)?;
+    let (name, cols) = pick_body(rows, names_line, candidates, body, |n, w| n == w)?;
+
+    let mut positions = Vec::with_capacity(rows.rows.len() - names_at);
+    let mut start_time = None;
+    for (line, r) in &rows.rows[names_at + 1..] {
+        if start_time.is_none() {
+            let t = r.get(1).unwrap_or("");
+            start_time = Some(t.parse::<f64>().ok().filter(|t| t.is_finite()).ok_or_else(|| {
+                rows.err(*line, format!("column 2 (Time (Seconds)): `{t}` is not a number"))
+            })?);
+        }
+        let mut p = [0.0; 3];
+        for (k, &c) in cols.iter().enumerate() {
+            let what = format!("`{name}` {}", ["X", "Y", "Z"][k]);
+            p[k] = rows.position_cell(*line, r, c, &what)? * scale;
+        }
+        positions.push(p);
+    }
+    if positions.is_empty() {
+        return Err(rows.err(names_line, "no data rows after the column names"));
+    }
+    Ok((name, frame_rate, start_time.unwrap_or(0.0), positions))
+}
+
+/// The metadata row's frame rate (export, else capture) and length unit in metres.
+fn metadata(rows: &Rows) -> Result<(f64, f64)> {
     let Some((meta_line, meta)) = rows.rows.first() else {
         return Err(anyhow::anyhow!("{}: the file is empty", rows.path.display()));
     };
@@ -59,7 +89,13 @@ pub(crate) fn parse(rows: &Rows, body: Option<&str>) -> Result<Parsed> {
             rows.err(meta_line, format!("`Length Units` = `{u}` must be Meters, Centimeters or Millimeters"))
         })?,
     };
+    Ok((frame_rate, scale))
+}
 
+/// The header rows (`type`, `name`, `id`, `parent`, `kind` -> row index) up to the column-name
+/// row `Frame,Time (Seconds),...`, and that row's index.
+fn header_rows(rows: &Rows) -> Result<(BTreeMap<&'static str, usize>, usize)> {
+    let meta_line = rows.rows.first().map_or(0, |(l, _)| *l);
     // Header rows up to the column-name row `Frame,Time (Seconds),...`.
     let mut header: BTreeMap<&'static str, usize> = BTreeMap::new();
     let mut names_at = None;
@@ -96,6 +132,16 @@ pub(crate) fn parse(rows: &Rows, body: Option<&str>) -> Result<Parsed> {
             );
         }
     }
+    Ok((header, names_at))
+}
+
+/// The position X/Y/Z columns of each rigid body (of each marker if there is no rigid body).
+fn position_columns(
+    rows: &Rows,
+    header: &BTreeMap<&'static str, usize>,
+    names_at: usize,
+) -> Result<Vec<(String, [usize; 3])>> {
+    let names_line = rows.rows[names_at].0;
     let row = |k: &str| &rows.rows[header[k]].1;
     let (types, names, kinds, axes) = (row("type"), row("name"), row("kind"), &rows.rows[names_at].1);
 
@@ -138,26 +184,5 @@ pub(crate) fn parse(rows: &Rows, body: Option<&str>) -> Result<Parsed> {
             "no position columns: no rigid body or marker has X, Y and Z columns under `Position`",
         ));
     }
-    let (name, cols) = pick_body(rows, names_line, candidates, body, |n, w| n == w)?;
-
-    let mut positions = Vec::with_capacity(rows.rows.len() - names_at);
-    let mut start_time = None;
-    for (line, r) in &rows.rows[names_at + 1..] {
-        if start_time.is_none() {
-            let t = r.get(1).unwrap_or("");
-            start_time = Some(t.parse::<f64>().ok().filter(|t| t.is_finite()).ok_or_else(|| {
-                rows.err(*line, format!("column 2 (Time (Seconds)): `{t}` is not a number"))
-            })?);
-        }
-        let mut p = [0.0; 3];
-        for (k, &c) in cols.iter().enumerate() {
-            let what = format!("`{name}` {}", ["X", "Y", "Z"][k]);
-            p[k] = rows.position_cell(*line, r, c, &what)? * scale;
-        }
-        positions.push(p);
-    }
-    if positions.is_empty() {
-        return Err(rows.err(names_line, "no data rows after the column names"));
-    }
-    Ok((name, frame_rate, start_time.unwrap_or(0.0), positions))
+    Ok(candidates)
 }

@@ -137,7 +137,7 @@ pub(super) fn read_samples(
     check_raster_size(&name, cols, rows)?;
     let line_bytes = prefix + cols * bytes as u64 + suffix;
     let data_name = data_path.display();
-    let file_len = std::fs::metadata(&data_path).with_context(|| format!("cannot read {data_name}"))?.len();
+    let file_len = std::fs::metadata(data_path).with_context(|| format!("cannot read {data_name}"))?.len();
     let need = offset.saturating_add(rows.saturating_mul(line_bytes));
     if need > file_len {
         bail!(
@@ -149,8 +149,7 @@ pub(super) fn read_samples(
     }
 
     // The samples.
-    let mut file =
-        BufReader::new(File::open(&data_path).with_context(|| format!("cannot read {data_name}"))?);
+    let mut file = BufReader::new(File::open(data_path).with_context(|| format!("cannot read {data_name}"))?);
     file.seek(SeekFrom::Start(offset)).with_context(|| format!("cannot read {data_name}"))?;
     let (cols_n, rows_n) = (cols as usize, rows as usize);
     let mut values = Vec::with_capacity(cols_n * rows_n);

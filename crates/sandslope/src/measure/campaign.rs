@@ -11,7 +11,7 @@ use crate::error::{positive, ParamError};
 use crate::terrain::TerrainPoint;
 
 use super::air::{AirCorrection, AirMode, AirTrend};
-use super::clean::{clean, Curve, Dropped, RawRecording};
+use super::clean::{clean, Cleaned, Curve, Dropped, RawRecording};
 use super::penetration::{fit_penetration, PenetrationFit};
 use super::shear::{fit_shear, ShearFit, ShearPlate};
 use super::slopes::{modified_z_scores, per_slope, SlopeEstimate, TrialValue, OUTLIER_Z};
@@ -308,6 +308,32 @@ pub fn fit_campaign(
     options: &FitOptions,
 ) -> Result<Campaign, CampaignError> {
     let area = positive("disk_area_m2", setup.disk_area_m2)?;
+    let cleaned = clean_all(trials)?;
+    // In-air runs by (kind, slope).
+    let key = |t: &TrialInput| (t.kind, t.slope_deg.to_bits());
+    let mut runs: BTreeMap<(Kind, u64), Vec<&Curve>> = BTreeMap::new();
+    for (t, c) in trials.iter().zip(&cleaned) {
+        if t.air {
+            runs.entry(key(t)).or_default().push(&c.curve);
+        }
+    }
+    let corrections: BTreeMap<(Kind, u64), (AirCorrection, Option<AirTrend>)> =
+        runs.iter().map(|(k, r)| (*k, AirCorrection::choose(r, options.air))).collect();
+    let none = (AirCorrection::None, None);
+    let mut results = Vec::with_capacity(trials.len());
+    for (t, c) in trials.iter().zip(cleaned) {
+        let (air, trend) = corrections.get(&key(t)).unwrap_or(&none);
+        results.push(fit_trial(t, c, air, trend.as_ref(), setup, area, options)?);
+    }
+    let values = flag_outliers(&mut results);
+    let k_n: Vec<TrialValue> = values[0].iter().map(|v| v.1).collect();
+    let k_s: Vec<TrialValue> = values[1].iter().map(|v| v.1).collect();
+    let points = per_slope(&k_n, &k_s).map_err(CampaignError::Table)?;
+    Ok(Campaign { points, trials: results })
+}
+
+/// Each trial's curve cleaned (docs/model.md's cleaning), refused when too few rows are left.
+fn clean_all(trials: &[TrialInput]) -> Result<Vec<Cleaned>, CampaignError> {
     let mut cleaned = Vec::with_capacity(trials.len());
     for t in trials {
         let c = clean(&t.raw).map_err(|error| CampaignError::Trial {
@@ -328,111 +354,110 @@ pub fn fit_campaign(
         }
         cleaned.push(c);
     }
-    // In-air runs by (kind, slope).
-    let key = |t: &TrialInput| (t.kind, t.slope_deg.to_bits());
-    let mut runs: BTreeMap<(Kind, u64), Vec<&Curve>> = BTreeMap::new();
-    for (t, c) in trials.iter().zip(&cleaned) {
-        if t.air {
-            runs.entry(key(t)).or_default().push(&c.curve);
-        }
+    Ok(cleaned)
+}
+
+/// One trial's result: an in-air run's mean force, or a trial's fit after subtracting its
+/// in-air correction, with its notes and warnings.
+fn fit_trial(
+    t: &TrialInput,
+    c: Cleaned,
+    air: &AirCorrection,
+    trend: Option<&AirTrend>,
+    setup: &Setup,
+    area: f64,
+    options: &FitOptions,
+) -> Result<TrialResult, CampaignError> {
+    let mut r = TrialResult {
+        file: t.file.clone(),
+        kind: t.kind,
+        slope_deg: t.slope_deg,
+        air: t.air,
+        rows: t.rows,
+        used: c.curve.len(),
+        dropped: c.dropped,
+        stroke_m: c.stroke,
+        air_correction: "none",
+        air_offset_n: None,
+        air_trend: trend.copied(),
+        penetration: None,
+        shear: None,
+        warnings: Vec::new(),
+        notes: Vec::new(),
+        curve: Curve::default(),
+    };
+    if c.dropped.retraction > 0 {
+        let what = if t.kind == Kind::Penetration { "deepest point" } else { "farthest displacement" };
+        r.notes.push(format!(
+            "goes back after its {what}: {} rows of the return stroke dropped, the {} only is used",
+            c.dropped.retraction,
+            if t.kind == Kind::Penetration { "downstroke" } else { "forward drag" }
+        ));
     }
-    let corrections: BTreeMap<(Kind, u64), (AirCorrection, Option<AirTrend>)> =
-        runs.iter().map(|(k, r)| (*k, AirCorrection::choose(r, options.air))).collect();
-    let none = (AirCorrection::None, None);
-    let mut results = Vec::with_capacity(trials.len());
-    for (t, c) in trials.iter().zip(cleaned) {
-        let (air, trend) = corrections.get(&key(t)).unwrap_or(&none);
-        let mut r = TrialResult {
-            file: t.file.clone(),
-            kind: t.kind,
-            slope_deg: t.slope_deg,
-            air: t.air,
-            rows: t.rows,
-            used: c.curve.len(),
-            dropped: c.dropped,
-            stroke_m: c.stroke,
-            air_correction: "none",
-            air_offset_n: None,
-            air_trend: *trend,
-            penetration: None,
-            shear: None,
-            warnings: Vec::new(),
-            notes: Vec::new(),
-            curve: Curve::default(),
-        };
-        if c.dropped.retraction > 0 {
-            let what = if t.kind == Kind::Penetration { "deepest point" } else { "farthest displacement" };
-            r.notes.push(format!(
-                "goes back after its {what}: {} rows of the return stroke dropped, the {} only is used",
-                c.dropped.retraction,
-                if t.kind == Kind::Penetration { "downstroke" } else { "forward drag" }
-            ));
-        }
-        if c.dropped.malformed > 0 {
-            r.notes.push(format!("{} rows with a malformed cell skipped", c.dropped.malformed));
-        }
-        if t.air {
-            r.air_offset_n = Some(c.curve.mean_force());
-            r.curve = c.curve;
-            results.push(r);
-            continue;
-        }
-        r.air_correction = air.name();
-        r.air_offset_n = air.mean_offset();
-        match (air, trend) {
-            (AirCorrection::None, _) => {
-                if t.kind == Kind::Shear {
-                    r.warnings.push(TrialWarning::NoAirRun);
-                } else {
-                    r.notes.push(
-                        "no in-air run at this kind and slope: force not offset-corrected (the fitted intercept \
-                         absorbs a constant offset; k_n is unaffected)"
-                            .into(),
-                    );
-                }
-            }
-            (AirCorrection::Trend { slope_n_per_m, .. }, Some(tr)) => r.notes.push(format!(
-                "the in-air run drifts by {slope_n_per_m:.3} N/m (t-test p = {:.1e} < 0.05): its fitted line is \
-                 subtracted",
-                tr.p_value
-            )),
-            _ => {}
-        }
-        let corrected = c.curve.minus(|x| air.at(x));
-        let fail = |error| CampaignError::Trial {
-            file: t.file.clone(),
-            kind: t.kind,
-            slope_deg: t.slope_deg,
-            error,
-        };
-        let stroke = c.stroke.1 - c.stroke.0;
-        let window = match t.kind {
-            Kind::Penetration => {
-                let mut p = fit_penetration(&corrected, area, options.depth_window).map_err(fail)?;
-                // The in-air run bounds a drift (a slope in force against depth, which k_n would
-                // absorb) only to its slope's SE, whether or not the trend was subtracted.
-                p.k_n_se = p.k_n_se.hypot(trend.map_or(0.0, |t| t.slope_se) / area);
-                if p.r_squared < LOW_R_SQUARED {
-                    r.warnings.push(TrialWarning::LowRSquared { r_squared: p.r_squared });
-                }
-                r.penetration = Some(p);
-                p.depth_window_m
-            }
-            Kind::Shear => {
-                let mut s = fit_shear(&corrected, setup.plate, options.plateau_from).map_err(fail)?;
-                let mid = 0.5 * (s.plateau_m.0 + s.plateau_m.1);
-                s.k_s_se = s.k_s_se.hypot(air.offset_se_at(mid) / setup.plate.factor());
-                r.shear = Some(s);
-                s.plateau_m
-            }
-        };
-        let length = window.1 - window.0;
-        if stroke > 0.0 && length < SHORT_WINDOW_FRACTION * stroke {
-            r.warnings.push(TrialWarning::ShortWindow { window_m: length, stroke_m: stroke });
-        }
-        r.curve = corrected;
-        results.push(r);
+    if c.dropped.malformed > 0 {
+        r.notes.push(format!("{} rows with a malformed cell skipped", c.dropped.malformed));
     }
+    if t.air {
+        r.air_offset_n = Some(c.curve.mean_force());
+        r.curve = c.curve;
+        return Ok(r);
+    }
+    r.air_correction = air.name();
+    r.air_offset_n = air.mean_offset();
+    match (air, trend) {
+        (AirCorrection::None, _) => {
+            if t.kind == Kind::Shear {
+                r.warnings.push(TrialWarning::NoAirRun);
+            } else {
+                r.notes.push(
+                    "no in-air run at this kind and slope: force not offset-corrected (the fitted intercept \
+                     absorbs a constant offset; k_n is unaffected)"
+                        .into(),
+                );
+            }
+        }
+        (AirCorrection::Trend { slope_n_per_m, .. }, Some(tr)) => r.notes.push(format!(
+            "the in-air run drifts by {slope_n_per_m:.3} N/m (t-test p = {:.1e} < 0.05): its fitted line is \
+             subtracted",
+            tr.p_value
+        )),
+        _ => {}
+    }
+    let corrected = c.curve.minus(|x| air.at(x));
+    let fail =
+        |error| CampaignError::Trial { file: t.file.clone(), kind: t.kind, slope_deg: t.slope_deg, error };
+    let stroke = c.stroke.1 - c.stroke.0;
+    let window = match t.kind {
+        Kind::Penetration => {
+            let mut p = fit_penetration(&corrected, area, options.depth_window).map_err(fail)?;
+            // The in-air run bounds a drift (a slope in force against depth, which k_n would
+            // absorb) only to its slope's SE, whether or not the trend was subtracted.
+            p.k_n_se = p.k_n_se.hypot(trend.map_or(0.0, |t| t.slope_se) / area);
+            if p.r_squared < LOW_R_SQUARED {
+                r.warnings.push(TrialWarning::LowRSquared { r_squared: p.r_squared });
+            }
+            r.penetration = Some(p);
+            p.depth_window_m
+        }
+        Kind::Shear => {
+            let mut s = fit_shear(&corrected, setup.plate, options.plateau_from).map_err(fail)?;
+            let mid = 0.5 * (s.plateau_m.0 + s.plateau_m.1);
+            s.k_s_se = s.k_s_se.hypot(air.offset_se_at(mid) / setup.plate.factor());
+            r.shear = Some(s);
+            s.plateau_m
+        }
+    };
+    let length = window.1 - window.0;
+    if stroke > 0.0 && length < SHORT_WINDOW_FRACTION * stroke {
+        r.warnings.push(TrialWarning::ShortWindow { window_m: length, stroke_m: stroke });
+    }
+    r.curve = corrected;
+    Ok(r)
+}
+
+/// Flags each trial whose k is an outlier against the other trials at the same slope
+/// (modified z-score over OUTLIER_Z); returns the trials' (index, k) for k_n and k_s.
+fn flag_outliers(results: &mut [TrialResult]) -> [Vec<(usize, TrialValue)>; 2] {
     // Per slope, and outliers against the other trials at the same slope.
     let mut values: [Vec<(usize, TrialValue)>; 2] = [Vec::new(), Vec::new()];
     for (i, r) in results.iter().enumerate() {
@@ -464,8 +489,5 @@ pub fn fit_campaign(
             }
         }
     }
-    let k_n: Vec<TrialValue> = values[0].iter().map(|v| v.1).collect();
-    let k_s: Vec<TrialValue> = values[1].iter().map(|v| v.1).collect();
-    let points = per_slope(&k_n, &k_s).map_err(CampaignError::Table)?;
-    Ok(Campaign { points, trials: results })
+    values
 }

@@ -127,7 +127,21 @@ pub fn compare_with_paper(
     terrain: &Terrain,
     context: ComparisonContext,
 ) -> Vec<PaperComparison> {
-    let at = |deg: f64| Slope::from_degrees(deg).expect("paper slopes are valid");
+    let mut rows = speed_rows(robot, terrain, context);
+    rows.extend(ratio_rows(terrain, context));
+    rows.push(t1_row(robot, terrain));
+    rows.push(step_period_row(robot));
+    rows.push(heavy_robot_row(robot, terrain));
+    rows
+}
+
+/// A slope of the paper's, in degrees.
+fn at(deg: f64) -> Slope {
+    Slope::from_degrees(deg).expect("paper slopes are valid")
+}
+
+/// The speed at each of the paper's slopes (Fig. 3a), within 2 SD.
+fn speed_rows(robot: &Robot, terrain: &Terrain, context: ComparisonContext) -> Vec<PaperComparison> {
     let mut rows = Vec::new();
     for &(deg, mean, sd) in &SPEEDS {
         let p = predict(robot, at(deg), &terrain.at(at(deg)));
@@ -150,12 +164,17 @@ pub fn compare_with_paper(
             basis_note,
         });
     }
+    rows
+}
+
+/// k_s(20)/k_s(0) (Fig. 4h) and k_n(20)/k_n(0) (Fig. 4d).
+fn ratio_rows(terrain: &Terrain, context: ComparisonContext) -> [PaperComparison; 2] {
     let ratio = |f: &dyn Fn(Slope) -> f64| {
         let level = f(Slope::LEVEL);
         (level > 0.0).then(|| f(at(20.0)) / level)
     };
     let k_s_ratio = ratio(&|s| terrain.at(s).k_s);
-    rows.push(PaperComparison {
+    let shear = PaperComparison {
         id: "shear_ratio_20".into(),
         quantity: "k_s(20 deg) / k_s(0)".into(),
         source: "Sec. III-C, Fig. 4h".into(),
@@ -171,9 +190,9 @@ pub fn compare_with_paper(
         } else {
             "the model's k_s did not take the paper's ratio as input".into()
         },
-    });
+    };
     let k_n_ratio = ratio(&|s| terrain.at(s).k_n);
-    rows.push(PaperComparison {
+    let normal = PaperComparison {
         id: "normal_ratio_20".into(),
         quantity: "k_n(20 deg) / k_n(0)".into(),
         source: "Sec. III-B, Fig. 4d".into(),
@@ -189,11 +208,16 @@ pub fn compare_with_paper(
         } else {
             "the model's k_n did not take the paper's statement as input".into()
         },
-    });
+    };
+    [shear, normal]
+}
+
+/// Whether t1 rises with slope (Fig. 5b; the paper prints no values).
+fn t1_row(robot: &Robot, terrain: &Terrain) -> PaperComparison {
     let t1: Vec<Option<f64>> =
         SPEEDS.iter().map(|s| predict(robot, at(s.0), &terrain.at(at(s.0))).anchoring_time).collect();
     let rising = t1.windows(2).all(|w| matches!((w[0], w[1]), (Some(a), Some(b)) if b > a));
-    rows.push(PaperComparison {
+    PaperComparison {
         id: "t1_rises".into(),
         quantity: "anchoring time t1 rises with slope (0 to 24 deg)".into(),
         source: "Sec. III-A, Fig. 5b".into(),
@@ -210,9 +234,13 @@ pub fn compare_with_paper(
         rule: "strictly increasing".into(),
         basis: Basis::Consequence,
         basis_note: "any k_s that falls with slope makes d_s and so t1 rise (docs/model.md §4); the paper prints no t1 values to test".into(),
-    });
+    }
+}
+
+/// The time between tripod touchdowns, T/2 (Sec. III-A).
+fn step_period_row(robot: &Robot) -> PaperComparison {
     let half = robot.stance_duration();
-    rows.push(PaperComparison {
+    PaperComparison {
         id: "step_period".into(),
         quantity: "time between tripod touchdowns, T/2".into(),
         source: "Sec. III-A".into(),
@@ -224,10 +252,14 @@ pub fn compare_with_paper(
         rule: "within 1%".into(),
         basis: Basis::Input,
         basis_note: "T/2 = π/ω follows from the paper's leg speed".into(),
-    });
+    }
+}
+
+/// The regime of the heavy robot at 24 deg (Fig. 6d).
+fn heavy_robot_row(robot: &Robot, terrain: &Terrain) -> PaperComparison {
     let (mass, deg, claim) = HEAVY_ROBOT_CLAIM;
     let heavy = robot.with_mass(mass).ok().map(|r| predict(&r, at(deg), &terrain.at(at(deg))));
-    rows.push(PaperComparison {
+    PaperComparison {
         id: "heavy_robot_24".into(),
         quantity: format!("regime of a {mass} kg robot at {deg} deg"),
         source: "Sec. IV, Fig. 6d".into(),
@@ -242,8 +274,7 @@ pub fn compare_with_paper(
         rule: "same regime".into(),
         basis: Basis::Independent,
         basis_note: "no input was chosen to match it".into(),
-    });
-    rows
+    }
 }
 
 /// The basis of the comparison of the speed at `deg`, and why.

@@ -52,6 +52,21 @@ impl Figure for InferFigure {
             slopes.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &s| (a.min(s), b.max(s)));
         let pad = ((s1 - s0) * 0.05).max(1.0);
         let (x0, x1) = ((s0 - pad).max(0.0), s1 + pad);
+        self.draw_k_s(&left, (x0, x1))?;
+        if let (Some(l), Some(area)) = (&self.law, right) {
+            draw_p_fail(l, &area, (x0, x1))?;
+        }
+        Ok(())
+    }
+}
+
+impl InferFigure {
+    /// Left panel: k_s against slope, the observed intervals, the law's band and the table.
+    fn draw_k_s<DB: DrawingBackend>(&self, left: &DrawingArea<DB, Shift>, (x0, x1): (f64, f64)) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = crate::error::plot_err;
         // k_s range: the intervals (open ends clipped to a decade beyond the bounded values).
         // Open ends (a quantile that is the prior's) do not set the range: they get an arrow.
         let mut ks: Vec<f64> = self
@@ -71,7 +86,7 @@ impl Figure for InferFigure {
         let (lo, hi) =
             ks.iter().filter(|k| **k > 0.0).fold((f64::INFINITY, 0.0f64), |(a, b), &k| (a.min(k), b.max(k)));
         let (y0, y1) = ((lo / 1.5).max(self.prior.min()), (hi * 1.5).min(self.prior.max()));
-        let mut chart = ChartBuilder::on(&left)
+        let mut chart = ChartBuilder::on(left)
             .margin(15)
             .x_label_area_size(50)
             .y_label_area_size(80)
@@ -154,57 +169,67 @@ impl Figure for InferFigure {
             .label_font(font(14.0))
             .draw()
             .map_err(e)?;
-
-        if let (Some(l), Some(area)) = (&self.law, right) {
-            let mut c = ChartBuilder::on(&area)
-                .margin(15)
-                .x_label_area_size(50)
-                .y_label_area_size(60)
-                .build_cartesian_2d(x0..x1, 0.0..1.02)
-                .map_err(e)?;
-            c.configure_mesh()
-                .x_desc("slope (deg)")
-                .y_desc("p_fail")
-                .label_style(font(15.0))
-                .axis_desc_style(font(17.0))
-                .light_line_style(WHITE)
-                .draw()
-                .map_err(e)?;
-            let red = RGBColor(214, 56, 48);
-            let band: Vec<(f64, f64)> = l
-                .prediction
-                .iter()
-                .map(|p| (p.slope_deg, p.p_fail.q95))
-                .chain(l.prediction.iter().rev().map(|p| (p.slope_deg, p.p_fail.q05)))
-                .collect();
-            c.draw_series(std::iter::once(Polygon::new(band, red.mix(0.2).filled())))
-                .map_err(e)?
-                .label("90% credible band")
-                .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 24, y + 6)], red.mix(0.2).filled()));
-            c.draw_series(LineSeries::new(
-                l.prediction.iter().map(|p| (p.slope_deg, p.p_fail.median)),
-                red.stroke_width(2),
-            ))
-            .map_err(e)?
-            .label("predicted p_fail (posterior median)")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], red.stroke_width(2)));
-            c.draw_series(
-                l.prediction
-                    .iter()
-                    .filter(|p| p.observed)
-                    .map(|p| Circle::new((p.slope_deg, p.p_fail.median), 5, BLACK.filled())),
-            )
-            .map_err(e)?
-            .label("observed slopes")
-            .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
-            c.configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .background_style(WHITE.mix(0.9))
-                .border_style(BLACK)
-                .label_font(font(14.0))
-                .draw()
-                .map_err(e)?;
-        }
         Ok(())
     }
+}
+
+/// Right panel: the law's predicted p_fail against slope with its credible band.
+fn draw_p_fail<DB: DrawingBackend>(
+    l: &LawPosterior,
+    area: &DrawingArea<DB, Shift>,
+    (x0, x1): (f64, f64),
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = crate::error::plot_err;
+    let mut c = ChartBuilder::on(area)
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, 0.0..1.02)
+        .map_err(e)?;
+    c.configure_mesh()
+        .x_desc("slope (deg)")
+        .y_desc("p_fail")
+        .label_style(font(15.0))
+        .axis_desc_style(font(17.0))
+        .light_line_style(WHITE)
+        .draw()
+        .map_err(e)?;
+    let red = RGBColor(214, 56, 48);
+    let band: Vec<(f64, f64)> = l
+        .prediction
+        .iter()
+        .map(|p| (p.slope_deg, p.p_fail.q95))
+        .chain(l.prediction.iter().rev().map(|p| (p.slope_deg, p.p_fail.q05)))
+        .collect();
+    c.draw_series(std::iter::once(Polygon::new(band, red.mix(0.2).filled())))
+        .map_err(e)?
+        .label("90% credible band")
+        .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 24, y + 6)], red.mix(0.2).filled()));
+    c.draw_series(LineSeries::new(
+        l.prediction.iter().map(|p| (p.slope_deg, p.p_fail.median)),
+        red.stroke_width(2),
+    ))
+    .map_err(e)?
+    .label("predicted p_fail (posterior median)")
+    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], red.stroke_width(2)));
+    c.draw_series(
+        l.prediction
+            .iter()
+            .filter(|p| p.observed)
+            .map(|p| Circle::new((p.slope_deg, p.p_fail.median), 5, BLACK.filled())),
+    )
+    .map_err(e)?
+    .label("observed slopes")
+    .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
+    c.configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(font(14.0))
+        .draw()
+        .map_err(e)?;
+    Ok(())
 }

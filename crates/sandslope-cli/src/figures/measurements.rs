@@ -226,20 +226,7 @@ impl Data<'_> {
         // Single trials are drawn just left of their slope so that the mean's marker does not
         // cover them.
         let offset = 0.6;
-        let per_trial: Vec<(f64, f64, bool)> = self
-            .campaign
-            .trials
-            .iter()
-            .filter_map(|t| match (normal, t.fit()) {
-                (true, TrialFit::Penetration(f)) => {
-                    Some((t.slope_deg - offset, f.k_n / scale, !t.warnings.is_empty()))
-                }
-                (false, TrialFit::Shear(f)) => {
-                    Some((t.slope_deg - offset, f.k_s / scale, !t.warnings.is_empty()))
-                }
-                _ => None,
-            })
-            .collect();
+        let per_trial = self.trial_points(normal, offset, scale);
         let bars = |s: &SlopeStat| ((s.mean - s.sd) / scale, (s.mean + s.sd) / scale);
         let points = &self.campaign.points;
         let ys = points
@@ -268,30 +255,7 @@ impl Data<'_> {
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(plot_err)?;
-        let grey = RGBColor(90, 90, 90);
-        chart
-            .draw_series(
-                per_trial
-                    .iter()
-                    .filter(|p| !p.2)
-                    .map(|&(d, k, _)| Circle::new((d, k), 4, grey.stroke_width(2))),
-            )
-            .map_err(plot_err)?
-            .label("single trials (drawn left of their slope)")
-            .legend(move |(x, y)| Circle::new((x + 9, y), 4, grey.stroke_width(2)));
-        if per_trial.iter().any(|p| p.2) {
-            let red = RGBColor(200, 30, 30);
-            chart
-                .draw_series(
-                    per_trial
-                        .iter()
-                        .filter(|p| p.2)
-                        .map(|&(d, k, _)| Cross::new((d, k), 5, red.stroke_width(2))),
-                )
-                .map_err(plot_err)?
-                .label("single trial with a warning")
-                .legend(move |(x, y)| Cross::new((x + 9, y), 5, red.stroke_width(2)));
-        }
+        draw_trials(&mut chart, &per_trial)?;
         let measured: Vec<&SlopeEstimate> =
             points.iter().filter(|p| stat(p).origin == Origin::Measured).collect();
         chart
@@ -341,6 +305,59 @@ impl Data<'_> {
             .map_err(plot_err)?;
         Ok(())
     }
+}
+
+impl Data<'_> {
+    /// Each trial's k (in units of `scale`) at its slope less `offset`, and whether it has a
+    /// warning.
+    fn trial_points(&self, normal: bool, offset: f64, scale: f64) -> Vec<(f64, f64, bool)> {
+        self.campaign
+            .trials
+            .iter()
+            .filter_map(|t| match (normal, t.fit()) {
+                (true, TrialFit::Penetration(f)) => {
+                    Some((t.slope_deg - offset, f.k_n / scale, !t.warnings.is_empty()))
+                }
+                (false, TrialFit::Shear(f)) => {
+                    Some((t.slope_deg - offset, f.k_s / scale, !t.warnings.is_empty()))
+                }
+                _ => None,
+            })
+            .collect()
+    }
+}
+
+/// The single trials: circles, and crosses for those with a warning.
+fn draw_trials<DB: DrawingBackend>(
+    chart: &mut ChartContext<
+        '_,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    per_trial: &[(f64, f64, bool)],
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let grey = RGBColor(90, 90, 90);
+    chart
+        .draw_series(
+            per_trial.iter().filter(|p| !p.2).map(|&(d, k, _)| Circle::new((d, k), 4, grey.stroke_width(2))),
+        )
+        .map_err(plot_err)?
+        .label("single trials (drawn left of their slope)")
+        .legend(move |(x, y)| Circle::new((x + 9, y), 4, grey.stroke_width(2)));
+    if per_trial.iter().any(|p| p.2) {
+        let red = RGBColor(200, 30, 30);
+        chart
+            .draw_series(
+                per_trial.iter().filter(|p| p.2).map(|&(d, k, _)| Cross::new((d, k), 5, red.stroke_width(2))),
+            )
+            .map_err(plot_err)?
+            .label("single trial with a warning")
+            .legend(move |(x, y)| Cross::new((x + 9, y), 5, red.stroke_width(2)));
+    }
+    Ok(())
 }
 
 /// One panel on its own.

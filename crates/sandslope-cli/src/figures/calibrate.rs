@@ -7,6 +7,7 @@ use plotters::prelude::*;
 
 use sandslope::calibrate::{ObservationKind, Pull};
 
+use super::palette;
 use super::{font, Figure};
 use crate::error::plot_err;
 
@@ -60,7 +61,7 @@ impl Figure for CalibrationFigure<'_> {
             .y_desc("speed v (cm/s)")
             .label_style(font(15.0))
             .axis_desc_style(font(17.0))
-            .light_line_style(RGBColor(235, 235, 235))
+            .light_line_style(palette::GRID)
             .draw()
             .map_err(plot_err)?;
         if y_range.0 < 0.0 {
@@ -87,7 +88,7 @@ impl Figure for CalibrationFigure<'_> {
         }
         let floor = self.points.iter().any(|p| p.sd_total > p.sd * (1.0 + 1e-9));
         if floor {
-            let grey = RGBColor(150, 150, 150);
+            let grey = palette::MUTED_GREY;
             chart
                 .draw_series(self.points.iter().map(|p| {
                     let (v, s) = (p.observed * 100.0, p.sd_total * 100.0);
@@ -144,7 +145,7 @@ impl Figure for CalibrationFigure<'_> {
             .y_desc("pull")
             .label_style(font(15.0))
             .axis_desc_style(font(17.0))
-            .light_line_style(RGBColor(235, 235, 235))
+            .light_line_style(palette::GRID)
             .draw()
             .map_err(plot_err)?;
         let band = RGBColor(120, 170, 220).mix(0.25);
@@ -157,7 +158,7 @@ impl Figure for CalibrationFigure<'_> {
         let w = 0.012 * (x_range.1 - x_range.0);
         chart
             .draw_series(self.points.iter().map(|p| {
-                let colour = if p.pull.abs() > 2.0 { RGBColor(214, 56, 48) } else { RGBColor(60, 60, 60) };
+                let colour = if p.pull.abs() > 2.0 { palette::SLIPPAGE } else { palette::DARK_GREY };
                 Rectangle::new([(p.slope_deg - w, 0.0), (p.slope_deg + w, p.pull)], colour.filled())
             }))
             .map_err(plot_err)?;

@@ -7,6 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 
+use super::palette;
 use super::phase::{star_points, STAR_GREEN};
 use super::{font, range, tick, Figure};
 
@@ -77,13 +78,13 @@ impl Figure for DesignFigure {
             .light_line_style(WHITE)
             .draw()
             .map_err(e)?;
-        let grey = RGBColor(150, 150, 150);
+        let grey = palette::MUTED_GREY;
         chart
             .draw_series(others.iter().map(|&p| Circle::new(p, 2, grey.mix(0.5).filled())))
             .map_err(e)?
             .label(format!("designs ({})", others.len() + front.len()))
             .legend(move |(x, y)| Circle::new((x + 12, y), 4, grey.filled()));
-        let red = RGBColor(214, 56, 48);
+        let red = palette::SLIPPAGE;
         chart.draw_series(LineSeries::new(front.iter().copied(), red.stroke_width(2))).map_err(e)?;
         chart
             .draw_series(front.iter().map(|&p| Circle::new(p, 5, red.filled())))
@@ -166,7 +167,7 @@ where
     let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
     let (lo, hi) = if lo.is_finite() { (lo, hi.max(lo + 1e-9)) } else { (0.0, 1.0) };
     let ny = map.y.len();
-    let none_safe = RGBColor(60, 60, 60);
+    let none_safe = palette::DARK_GREY;
     chart
         .draw_series(map.safe.iter().enumerate().map(|(c, v)| {
             let (i, j) = (c / ny, c % ny);
@@ -184,7 +185,7 @@ where
             let (i, j) = (c / ny, c % ny);
             PathElement::new(
                 vec![(xe[i], ye[j]), (xe[i + 1], ye[j + 1])],
-                RGBColor(200, 200, 200).stroke_width(1),
+                palette::SHADE_GREY.stroke_width(1),
             )
         }))
         .map_err(e)?;

@@ -8,6 +8,7 @@ use plotters::prelude::*;
 
 use sandslope::infer::{Bound, LawPosterior, LogUniformPrior, SlopePosterior};
 
+use super::palette;
 use super::phase::sci_label;
 use super::{font, Figure};
 
@@ -102,7 +103,7 @@ impl InferFigure {
             .light_line_style(WHITE)
             .draw()
             .map_err(e)?;
-        let blue = RGBColor(40, 90, 200);
+        let blue = palette::MODEL_BLUE;
         if let Some(l) = &self.law {
             let band: Vec<(f64, f64)> = l
                 .prediction
@@ -197,7 +198,7 @@ where
         .light_line_style(WHITE)
         .draw()
         .map_err(e)?;
-    let red = RGBColor(214, 56, 48);
+    let red = palette::SLIPPAGE;
     let band: Vec<(f64, f64)> = l
         .prediction
         .iter()

@@ -11,6 +11,7 @@ use plotters::prelude::*;
 
 use sandslope::measure::{Campaign, Origin, SlopeEstimate, SlopeStat, TrialFit, TrialResult};
 
+use super::palette;
 use super::{font, range, save, Figure};
 use crate::error::plot_err;
 
@@ -46,9 +47,6 @@ impl Panel {
         }
     }
 }
-
-/// Trials with a warning (short window, poor line, outlier).
-const WARNING_RED: RGBColor = RGBColor(200, 30, 30);
 
 /// Viridis (a perceptually uniform sequential map, readable in grey and by colour-blind
 /// readers) at `t` in [0, 1], from its published stops at every eighth.
@@ -173,7 +171,7 @@ impl Data<'_> {
                 TrialFit::Air => continue,
             };
             // A trial with a warning is drawn in red, so that a bad window stands out.
-            let ink = if t.warnings.is_empty() { BLACK } else { WARNING_RED };
+            let ink = if t.warnings.is_empty() { BLACK } else { palette::WARNING_RED };
             let line = vec![(a * 1e3, fa), (b * 1e3, fb)];
             let width = if t.warnings.is_empty() { 1 } else { 2 };
             chart
@@ -203,7 +201,9 @@ impl Data<'_> {
                 .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
                 .map_err(plot_err)?
                 .label("trial with a warning")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], WARNING_RED.stroke_width(2)));
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], palette::WARNING_RED.stroke_width(2))
+                });
         }
         chart
             .configure_series_labels()
@@ -339,7 +339,7 @@ fn draw_trials<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let grey = RGBColor(90, 90, 90);
+    let grey = palette::DATA_GREY;
     chart
         .draw_series(
             per_trial.iter().filter(|p| !p.2).map(|&(d, k, _)| Circle::new((d, k), 4, grey.stroke_width(2))),
@@ -348,7 +348,7 @@ where
         .label("single trials (drawn left of their slope)")
         .legend(move |(x, y)| Circle::new((x + 9, y), 4, grey.stroke_width(2)));
     if per_trial.iter().any(|p| p.2) {
-        let red = RGBColor(200, 30, 30);
+        let red = palette::WARNING_RED;
         chart
             .draw_series(
                 per_trial.iter().filter(|p| p.2).map(|&(d, k, _)| Cross::new((d, k), 5, red.stroke_width(2))),

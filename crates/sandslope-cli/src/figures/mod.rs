@@ -165,7 +165,7 @@ where
     DB::ErrorType: 'static,
 {
     if let Some(repose) = repose.filter(|r| *r < x.1) {
-        let shade = RGBColor(200, 200, 200).mix(0.45);
+        let shade = palette::SHADE_GREY.mix(0.45);
         chart
             .draw_series([Rectangle::new([(repose.max(x.0), y.0), (x.1, y.1)], shade.filled())])
             .map_err(crate::error::plot_err)?
@@ -186,7 +186,7 @@ pub fn reference_line<'a, DB: DrawingBackend + 'a>(
 where
     DB::ErrorType: 'static,
 {
-    let grey = RGBColor(90, 90, 90);
+    let grey = palette::DATA_GREY;
     chart
         .draw_series(DashedLineSeries::new([(x.0, level), (x.1, level)], 8, 5, grey.stroke_width(2)))
         .map_err(crate::error::plot_err)?

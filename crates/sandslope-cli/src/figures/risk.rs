@@ -10,6 +10,7 @@ use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 use sandslope::risk::{PayloadEnvelope, SafeLimit};
 use sandslope::{Axis, RegimeProbabilities};
 
+use super::palette;
 use super::phase::{
     cell_edges, reduce, sci_label, star_points, within, TerrainStar, MAX_DRAWN_CELLS, STAR_GREEN,
 };
@@ -48,7 +49,7 @@ impl Figure for CurveFigure {
             .light_line_style(WHITE)
             .draw()
             .map_err(e)?;
-        let red = RGBColor(214, 56, 48);
+        let red = palette::SLIPPAGE;
         let orange = RGBColor(230, 150, 30);
         chart
             .draw_series(LineSeries::new(
@@ -66,7 +67,7 @@ impl Figure for CurveFigure {
             .map_err(e)?
             .label("p_not_success = P(regime != success)")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], orange.stroke_width(2)));
-        let grey = RGBColor(90, 90, 90);
+        let grey = palette::DATA_GREY;
         chart
             .draw_series(DashedLineSeries::new(
                 vec![(0.0, self.max_risk), (self.hi, self.max_risk)],
@@ -90,7 +91,7 @@ impl Figure for CurveFigure {
                 .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
         }
         if let SafeLimit::Limit { value, .. } = self.limit {
-            let blue = RGBColor(40, 90, 200);
+            let blue = palette::MODEL_BLUE;
             chart
                 .draw_series(LineSeries::new(vec![(value, -0.015), (value, 1.02)], blue.stroke_width(2)))
                 .map_err(e)?
@@ -280,9 +281,9 @@ impl Figure for EnvelopeFigure<'_> {
             .light_line_style(WHITE)
             .draw()
             .map_err(e)?;
-        let blue = RGBColor(40, 90, 200);
-        let grey = RGBColor(90, 90, 90);
-        let red = RGBColor(214, 56, 48);
+        let blue = palette::MODEL_BLUE;
+        let grey = palette::DATA_GREY;
+        let red = palette::SLIPPAGE;
         let safe: Vec<(f64, f64)> = pts.iter().filter(|p| p.2 != 1).map(|p| (p.0, p.1)).collect();
         chart.draw_series(AreaSeries::new(safe.iter().copied(), 0.0, blue.mix(0.15))).map_err(e)?;
         chart

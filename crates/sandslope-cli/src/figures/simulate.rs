@@ -11,6 +11,7 @@ use plotters::prelude::*;
 use sandslope::simulate::{SimSummary, Simulation};
 use sandslope::{Robot, SpeedObservation};
 
+use super::palette;
 use super::{font, Figure};
 use crate::error::plot_err;
 use crate::output::write_via_temp;
@@ -59,7 +60,7 @@ where
         .y_label_formatter(&super::tick)
         .label_style(font(14.0))
         .axis_desc_style(font(16.0))
-        .light_line_style(RGBColor(235, 235, 235))
+        .light_line_style(palette::GRID)
         .draw()
         .map_err(plot_err)?;
     Ok(chart)
@@ -252,7 +253,7 @@ impl Figure for SlopesFigure<'_> {
             .y_label_formatter(&super::tick)
             .label_style(font(15.0))
             .axis_desc_style(font(17.0))
-            .light_line_style(RGBColor(235, 235, 235))
+            .light_line_style(palette::GRID)
             .draw()
             .map_err(plot_err)?;
         super::shade_repose(&mut c, self.repose_deg, xr, yr, "at or above the angle of repose: slippage")?;
@@ -394,7 +395,7 @@ where
     chart
         .draw_series([Polygon::new(
             corners.iter().map(|&p| body(p)).collect::<Vec<_>>(),
-            RGBColor(90, 90, 90).mix(0.8).filled(),
+            palette::DATA_GREY.mix(0.8).filled(),
         )])
         .map_err(plot_err)?;
     let legs = g.hip_x_m.len();

@@ -6,6 +6,7 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::palette;
 use super::{font, Figure};
 use crate::error::plot_err;
 
@@ -108,7 +109,7 @@ impl Figure for SlopeCurveFigure {
             .label_style(font(14.0))
             .axis_desc_style(font(16.0))
             .light_line_style(WHITE)
-            .bold_line_style(RGBColor(225, 225, 225))
+            .bold_line_style(palette::GRID_BOLD)
             .draw()
             .map_err(plot_err)?;
         if y_range.0 < 0.0 && y_range.1 > 0.0 {
@@ -120,7 +121,7 @@ impl Figure for SlopeCurveFigure {
         if let Some((level, label)) = &self.reference {
             super::reference_line(&mut chart, *level, label, x_range)?;
         }
-        let red = RGBColor(200, 40, 40);
+        let red = palette::LOSS_RED;
         let label = (!self.model_label.is_empty()).then_some(self.model_label.as_str());
         draw_pieces(&mut chart, &self.model, red.stroke_width(3), false, label)?;
         draw_pieces(

@@ -8,6 +8,7 @@ use plotters::prelude::*;
 
 use sandslope::report::StepBudget;
 
+use super::palette;
 use super::slope_curves::swatch_gap;
 use super::{font, Figure};
 use crate::error::plot_err;
@@ -31,10 +32,10 @@ impl Figure for StepBudgetFigure<'_> {
     {
         type Pick = fn(&StepBudget) -> Option<f64>;
         let series: [(&str, RGBColor, bool, Pick); 5] = [
-            ("level step s*", RGBColor(90, 90, 90), true, |b| Some(b.level_step_m)),
+            ("level step s*", palette::DATA_GREY, true, |b| Some(b.level_step_m)),
             ("net step s", RGBColor(20, 20, 20), false, |b| b.step_m),
-            ("inherited speed g sin θ t1 (T/2 - t1)", RGBColor(200, 40, 40), false, |b| b.inherited_speed_m),
-            ("shorter propulsion time", RGBColor(40, 90, 200), false, |b| b.shorter_propulsion_m),
+            ("inherited speed g sin θ t1 (T/2 - t1)", palette::LOSS_RED, false, |b| b.inherited_speed_m),
+            ("shorter propulsion time", palette::MODEL_BLUE, false, |b| b.shorter_propulsion_m),
             ("backward slip ½ g sin θ t1²", RGBColor(230, 150, 20), false, |b| b.slip_m),
         ];
         let x_hi = self.budget.last().map_or(30.0, |b| b.slope_deg);
@@ -55,7 +56,7 @@ impl Figure for StepBudgetFigure<'_> {
             .label_style(font(14.0))
             .axis_desc_style(font(16.0))
             .light_line_style(WHITE)
-            .bold_line_style(RGBColor(225, 225, 225))
+            .bold_line_style(palette::GRID_BOLD)
             .draw()
             .map_err(plot_err)?;
         super::shade_repose(

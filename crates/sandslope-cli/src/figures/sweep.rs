@@ -7,6 +7,7 @@ use plotters::prelude::*;
 
 use sandslope::SpeedObservation;
 
+use super::palette;
 use super::{font, Figure};
 use crate::error::plot_err;
 use sandslope::SlopeEvaluation;
@@ -153,7 +154,7 @@ where
         .y_label_formatter(&super::tick)
         .label_style(font(15.0))
         .axis_desc_style(font(17.0))
-        .light_line_style(RGBColor(235, 235, 235))
+        .light_line_style(palette::GRID)
         .draw()
         .map_err(plot_err)?;
     super::shade_repose(

@@ -385,6 +385,20 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
     Ok((Raster { cols, rows, values, nodata, geo, crs, cell_m: (cell_x, cell_y), notes }, vertical))
 }
 
+/// The GDAL_NODATA value of a GeoTIFF, from its tags alone (the samples are not decoded), as
+/// [`read_raster`] honours it: for readers that take a GeoTIFF's samples window by window (the
+/// Python package's Dask raster) and must mark the same cells as nodata.
+pub fn geotiff_nodata(path: &Path) -> Result<Option<f64>> {
+    let name = path.display();
+    let mut file = File::open(path).with_context(|| format!("cannot read {name}"))?;
+    check_tiff_directory(&name, &mut file)?;
+    let mut dec = Decoder::new(BufReader::new(file))
+        .map_err(|e| anyhow!("{name}: not a readable TIFF: {e}"))?
+        .with_limits(tiff_limits());
+    skip_to_full_resolution(&name, &mut dec)?;
+    Ok(GeoTags::read(&name, &mut dec)?.nodata)
+}
+
 /// Moves `dec` to the full-resolution image.
 fn skip_to_full_resolution<R: std::io::Read + std::io::Seek>(
     name: &dyn std::fmt::Display,

@@ -236,6 +236,13 @@ pub fn plan<'py>(
     Ok(d)
 }
 
+/// The GDAL_NODATA value of a GeoTIFF (None when it has none), read from its tags only, as
+/// `read_raster` honours it (the Dask raster reads windows itself and marks the same cells).
+#[pyfunction]
+pub fn geotiff_nodata(path: PathBuf) -> PyResult<Option<f64>> {
+    sandslope_io::raster::geotiff_nodata(&path).map_err(crate::anyhow_error)
+}
+
 /// `(values, rows, cols, geo)` as returned by [`read_raster`].
 type RasterTuple<'py> = (Bound<'py, numpy::PyArray1<f64>>, usize, usize, Bound<'py, PyDict>);
 

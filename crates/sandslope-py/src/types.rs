@@ -71,6 +71,15 @@ impl PyRobot {
         robot_from_toml(&text, &Source::File(path)).map(|inner| PyRobot { inner }).map_err(anyhow_error)
     }
 
+    /// A TOML file or a built-in robot's name, as the command line's `--robot FILE|PRESET`
+    /// takes it (an existing path, or anything ending in `.toml`, is a file).
+    #[staticmethod]
+    fn load(file_or_preset: PathBuf) -> PyResult<Self> {
+        sandslope_io::load_robot(&file_or_preset.to_string_lossy())
+            .map(|inner| PyRobot { inner })
+            .map_err(anyhow_error)
+    }
+
     /// A built-in robot by name (see `sandslope.presets()`), e.g. `"paper-hexapod"`.
     #[staticmethod]
     fn preset(name: &str) -> PyResult<Self> {
@@ -168,6 +177,15 @@ impl PyTerrain {
     fn from_toml(path: PathBuf) -> PyResult<Self> {
         let text = read_text(&path).map_err(anyhow_error)?;
         terrain_from_toml(&text, &Source::File(path)).map(|inner| PyTerrain { inner }).map_err(anyhow_error)
+    }
+
+    /// A TOML file or a built-in terrain's name, as the command line's `--terrain
+    /// FILE|PRESET` takes it (an existing path, or anything ending in `.toml`, is a file).
+    #[staticmethod]
+    fn load(file_or_preset: PathBuf) -> PyResult<Self> {
+        sandslope_io::load_terrain(&file_or_preset.to_string_lossy())
+            .map(|inner| PyTerrain { inner })
+            .map_err(anyhow_error)
     }
 
     /// A built-in terrain by name (see `sandslope.presets()`), e.g. `"glass-beads-300um"`.

@@ -76,6 +76,22 @@ def test_files_and_presets(tmp_path, robot):
     assert sandslope.REGIMES[int(p["regime"])] == "success"
 
 
+def test_file_or_preset_follows_the_cli_rule(tmp_path, monkeypatch, cli):
+    """A name is a file when it exists or ends in .toml, else a preset (sandslope-io's rule,
+    the one the command line applies), and an unknown name gets the CLI's message."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "paper-hexapod").write_text("\n".join(f"{k} = {v}" for k, v in {**PAPER, "mass_kg": 0.9}.items()))
+    assert Robot.load("paper-hexapod").mass_kg == 0.9  # the file, which shadows the preset
+    assert Robot.load(tmp_path / "paper-hexapod") == Robot.load("paper-hexapod")
+    (tmp_path / "paper-hexapod").unlink()
+    assert Robot.load("paper-hexapod") == Robot.preset("paper-hexapod")
+    with pytest.raises(ValueError) as e:
+        sandslope.predict("no-such-robot", 10)
+    assert str(e.value) == cli.error("predict", "--slope", "10", "--robot", "no-such-robot")
+    with pytest.raises(ValueError, match="cannot read missing.toml"):
+        Terrain.load("missing.toml")  # ends in .toml: a file, and it is not there
+
+
 def test_errors_carry_the_cli_message(tmp_path, cli):
     bad = tmp_path / "bad.toml"
     bad.write_text("\n".join(f"{k} = {v}" for k, v in {**PAPER, "hip_height_m": 0.09}.items()))

@@ -82,19 +82,13 @@ def presets() -> Dict[str, Dict[str, str]]:
     return {name: {"kind": kind, "summary": summary} for name, kind, summary in _sandslope.preset_names()}
 
 
-def _is_preset(name: str, kind: str) -> bool:
-    return any(n == name and k == kind for n, k, _ in _sandslope.preset_names())
-
-
 def _robot(robot: RobotLike) -> Robot:
     """A Robot, a preset name or a TOML path (as the CLI's ``--robot FILE|PRESET``)."""
     if isinstance(robot, Robot):
         return robot
     if isinstance(robot, (str, os.PathLike)):
-        text = os.fspath(robot)
-        if _is_preset(text, "robot") and not os.path.exists(text):
-            return Robot.preset(text)
-        return Robot.from_toml(text)
+        # The command line's rule (sandslope-io): a file if it exists or ends in .toml, else a preset.
+        return Robot.load(os.fspath(robot))
     raise TypeError(f"robot must be a sandslope.Robot, a preset name or a TOML path, not {type(robot).__name__}")
 
 
@@ -103,10 +97,7 @@ def _terrain(terrain: TerrainLike) -> Terrain:
     if isinstance(terrain, Terrain):
         return terrain
     if isinstance(terrain, (str, os.PathLike)):
-        text = os.fspath(terrain)
-        if _is_preset(text, "terrain") and not os.path.exists(text):
-            return Terrain.preset(text)
-        return Terrain.from_toml(text)
+        return Terrain.load(os.fspath(terrain))
     raise TypeError(
         f"terrain must be a sandslope.Terrain, a preset name or a TOML path, not {type(terrain).__name__}"
     )

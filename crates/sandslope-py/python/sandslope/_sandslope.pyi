@@ -27,6 +27,9 @@ class Robot:
     def from_toml(path: _Path) -> "Robot":
         """The robot of a TOML file; ``ValueError`` names the file, key and valid range."""
     @staticmethod
+    def load(file_or_preset: _Path) -> "Robot":
+        """A TOML file or a built-in robot's name, as the CLI's ``--robot FILE|PRESET``."""
+    @staticmethod
     def preset(name: str) -> "Robot":
         """A built-in robot, e.g. ``"paper-hexapod"``."""
     def with_mass(self, mass_kg: float) -> "Robot":
@@ -56,6 +59,9 @@ class Terrain:
     @staticmethod
     def from_toml(path: _Path) -> "Terrain":
         """The terrain of a TOML file; ``ValueError`` names the file, key and valid range."""
+    @staticmethod
+    def load(file_or_preset: _Path) -> "Terrain":
+        """A TOML file or a built-in terrain's name, as the CLI's ``--terrain FILE|PRESET``."""
     @staticmethod
     def preset(name: str) -> "Terrain":
         """A built-in terrain, e.g. ``"glass-beads-300um"``."""
@@ -140,6 +146,8 @@ def plan(
     time_weight: float = 1e-4,
 ) -> Dict[str, Any]: ...
 def read_raster(path: _Path) -> Tuple[_F64, int, int, Dict[str, float]]: ...
+def geotiff_nodata(path: _Path) -> Optional[float]:
+    """The GDAL_NODATA value of a GeoTIFF (None when it has none), read from its tags only."""
 def fit(
     manifest: _Path,
     depth_window: Optional[Tuple[float, float]] = None,

@@ -39,7 +39,7 @@ from typing import Any, Callable, Optional, Tuple, TypeVar
 import dask.array as da
 import numpy as np
 
-from . import _cell_size, _robot, _terrain
+from . import _cell_size, _robot, _sandslope, _terrain
 from . import risk_raster as _eager_risk_raster
 
 __all__ = ["risk_raster"]
@@ -173,19 +173,10 @@ def _is_store(dem: Any) -> bool:
 
 
 def _tiff_nodata(source: Any) -> Optional[float]:
-    """The GDAL_NODATA tag of a GeoTIFF path, as the eager reader (``read_raster``) honours it."""
+    """The GDAL_NODATA tag of a GeoTIFF path, read by the same code as ``read_raster``."""
     if not (isinstance(source, (str, os.PathLike)) and os.fspath(source).lower().endswith((".tif", ".tiff"))):
         return None
-    import tifffile
-
-    with tifffile.TiffFile(os.fspath(source)) as tif:
-        tag = tif.pages[0].tags.get(42113)  # GDAL_NODATA, an ASCII number
-        if tag is None:
-            return None
-        try:
-            return float(str(tag.value).strip("\x00 "))
-        except ValueError:
-            return None
+    return _sandslope.geotiff_nodata(os.fspath(source))
 
 
 def _store_behind(z: da.Array) -> Any:

@@ -178,6 +178,20 @@ fn observations(rows: Vec<SpeedTableRow>) -> Vec<SpeedObservation> {
 
 #[cfg(test)]
 mod tests {
+    /// The paper's speeds are written twice, as the file users pass (`data/paper-speeds.csv`)
+    /// and as the library's constant the report compares with (`sandslope::paper::SPEEDS`):
+    /// they must be the same numbers, bit for bit.
+    #[test]
+    fn the_paper_speeds_file_is_the_librarys_constant() {
+        let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/paper-speeds.csv");
+        let got: Vec<(f64, f64, f64)> = load_speeds(&file)
+            .unwrap()
+            .into_iter()
+            .map(|o| (o.slope.degrees(), o.speed, o.speed_sd))
+            .collect();
+        assert_eq!(got, sandslope::paper::SPEEDS.to_vec());
+    }
+
     use super::*;
 
     fn load(text: &str) -> Result<Vec<SpeedObservation>> {

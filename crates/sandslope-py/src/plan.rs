@@ -180,7 +180,7 @@ fn route_dict<'py>(
 /// `plan::plan` (what `sandslope plan` computes): `{"routes": {name: route}, "extrapolation":
 /// None or {max_pitch_deg, last_point_deg}}`.
 #[pyfunction]
-#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT))]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT, classes=None, class_terrains=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan<'py>(
     py: Python<'py>,
@@ -200,6 +200,8 @@ pub fn plan<'py>(
     descent: &str,
     allow_metastable: bool,
     time_weight: f64,
+    classes: Option<PyReadonlyArray2<'py, f64>>,
+    class_terrains: Option<Vec<(i64, PyRef<'py, PyTerrain>)>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let objectives: Vec<Objective> = objectives.iter().map(|o| objective(o)).collect::<PyResult<_>>()?;
     let (grid, terrain, settings) = inputs(
@@ -222,9 +224,17 @@ pub fn plan<'py>(
         objectives,
         risk_map: false,
     };
+    let (classes, terrains) = match (classes, class_terrains) {
+        (None, None) => (None, vec![terrain]),
+        (Some(c), Some(t)) => {
+            let (indices, terrains) = class_inputs(&c, &t, rows, cols, cv_n, cv_s)?;
+            (Some(indices), terrains)
+        }
+        _ => return Err(value_error("classes and class_terrains go together: give both or neither")),
+    };
     let robot = &robot.inner;
     let result = py
-        .detach(|| sandslope::plan::plan(grid, None, &[terrain], robot, settings, &request, &|_, _, _| {}))
+        .detach(|| sandslope::plan::plan(grid, classes, &terrains, robot, settings, &request, &|_, _, _| {}))
         .map_err(value_error)?;
     let routes = PyDict::new(py);
     for (o, r) in &result.routes {
@@ -234,6 +244,39 @@ pub fn plan<'py>(
     d.set_item("routes", routes)?;
     d.set_item("extrapolation", pythonize::pythonize(py, &result.extrapolation).map_err(value_error)?)?;
     Ok(d)
+}
+
+/// A class array (aligned with the DEM; NaN: no class) and `(class, terrain)` pairs as the
+/// planner takes them: each cell's index into the terrains, and the terrains with their
+/// uncertainty, by the rule of `sandslope plan --classes --class-terrain`.
+fn class_inputs(
+    classes: &PyReadonlyArray2<'_, f64>,
+    class_terrains: &[(i64, PyRef<'_, PyTerrain>)],
+    rows: usize,
+    cols: usize,
+    cv_n: Option<f64>,
+    cv_s: Option<f64>,
+) -> PyResult<(Vec<u8>, Vec<UncertainTerrain>)> {
+    let a = classes.as_array();
+    if a.shape() != [rows, cols] {
+        let shape = a.shape();
+        return Err(value_error(format!(
+            "classes has shape ({}, {}); it must be the DEM's ({rows}, {cols})",
+            shape[0], shape[1]
+        )));
+    }
+    if class_terrains.is_empty() || class_terrains.len() >= usize::from(sandslope::plan::NO_CLASS) {
+        return Err(value_error("class_terrains: give between 1 and 254 {class: terrain} pairs"));
+    }
+    let keys: Vec<i64> = class_terrains.iter().map(|(k, _)| *k).collect();
+    let terrains = class_terrains
+        .iter()
+        .map(|(_, t)| crate::risk::uncertain(t, cv_n, cv_s))
+        .collect::<PyResult<Vec<_>>>()?;
+    let values: Vec<f64> = a.iter().copied().collect();
+    let indices = sandslope::plan::class_indices(&values, |i| !values[i].is_finite(), &keys)
+        .map_err(|e| value_error(format!("classes: {e}; add it to class_terrains")))?;
+    Ok((indices, terrains))
 }
 
 /// The GDAL_NODATA value of a GeoTIFF (None when it has none), read from its tags only, as

@@ -87,3 +87,38 @@ def test_plan_errors(robot, terrain, dune):
         sandslope.risk_raster(z, 0.3, robot=robot, terrain=terrain, max_roll_deg=95)
     with pytest.raises(ValueError, match="dem must be a 2-D array"):
         sandslope.risk_raster(z[0], 0.3, robot=robot, terrain=terrain)
+
+
+def test_plan_with_terrain_classes_matches_the_cli(cli, robot, terrain, dune, tmp_path):
+    """Classes as `plan --classes --class-terrain` takes them: a band of weak sand (k_s far too
+    low to anchor) across the dune; the time route keeps off it, the distance route does not,
+    and every figure equals the command line's on the same class raster."""
+    z, geo = dune
+    classes = np.ones(z.shape)
+    classes[:150, 95:105] = 2.0  # a gap in the south lets the time route round it
+    classes[np.isnan(z)] = np.nan
+    weak = tmp_path / "weak.toml"
+    weak.write_text("[[points]]\nslope_deg = 0.0\nk_n = 7.0e5\nk_s = 1.0e3\n")
+    tif = tmp_path / "classes.tif"
+    # Aligned with dune.asc: 0.3 m cells, north-west corner (0, 60); -1 marks no class.
+    tifffile.imwrite(tif, np.where(np.isnan(classes), -1, classes).astype(np.int16), extratags=[
+        (33550, "d", 3, (0.3, 0.3, 0.0), True), (33922, "d", 6, (0, 0, 0, geo["west"], geo["north"], 0), True),
+        (42113, "s", 0, "-1", True)])
+    want = cli.json("plan", "--dem", DUNE, "--start-px", "60,100", "--goal-px", "140,100", "--classes", tif,
+                    "--class-terrain", f"1=glass-beads-300um,2={weak}")
+    got = sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(100, 60), goal=(100, 140),
+                         classes=classes, class_terrains={1: "glass-beads-300um", 2: weak})["routes"]
+    assert want["routes"]["time"]["found"]
+    assert want["routes"]["time"]["regimes"]["slippage"] == 0
+    assert want["routes"]["distance"]["regimes"]["slippage"] > 0
+    for name, w in want["routes"].items():
+        for k in ["found", "length_m", "time_s", "survival", "regimes"]:
+            assert got[name][k] == (w[k] if w[k] is None else pytest.approx(w[k], rel=1e-12)), (name, k)
+    with pytest.raises(ValueError, match=r"classes: class 2 \(\d+ cells\) has no terrain \(given: 1\)"):
+        sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(100, 60), goal=(100, 140),
+                       classes=classes, class_terrains={1: terrain})
+    with pytest.raises(ValueError, match="give both or neither"):
+        sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(100, 60), goal=(100, 140), classes=classes)
+    with pytest.raises(ValueError, match=r"classes has shape \(3, 3\)"):
+        sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(100, 60), goal=(100, 140),
+                       classes=np.ones((3, 3)), class_terrains={1: terrain})

@@ -278,29 +278,16 @@ fn load_classes(args: &PlanArgs, dem: &Raster) -> Result<(Option<Vec<u8>>, Vec<U
             dem.rows
         );
     }
-    let mut missing = BTreeMap::new();
-    let idx: Vec<u8> = (0..classes.values.len())
-        .map(|i| {
-            if classes.is_nodata(i) {
-                return sandslope::plan::NO_CLASS;
-            }
-            let v = classes.values[i];
-            match values.iter().position(|&k| k as f64 == v) {
-                Some(p) => p as u8,
-                None => {
-                    *missing.entry(v.to_string()).or_insert(0usize) += 1;
-                    sandslope::plan::NO_CLASS
-                }
-            }
-        })
-        .collect();
-    if let Some((v, n)) = missing.iter().next() {
-        bail!(
-            "{}: class {v} ({n} cells) has no terrain; add it to --class-terrain (given: {})",
-            path.display(),
-            values.iter().map(|k| k.to_string()).collect::<Vec<_>>().join(", ")
-        );
-    }
+    let idx =
+        sandslope::plan::class_indices(&classes.values, |i| classes.is_nodata(i), &values).map_err(|e| {
+            anyhow!(
+                "{}: class {} ({} cells) has no terrain; add it to --class-terrain (given: {})",
+                path.display(),
+                e.value,
+                e.cells,
+                e.given
+            )
+        })?;
     Ok((Some(idx), terrains))
 }
 

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import os
 import warnings as _warnings
-from typing import Any, Dict, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -456,6 +456,8 @@ def plan(
     time_weight: float = 1e-4,
     origin: Optional[Tuple[float, float]] = None,
     nodata: Optional[float] = None,
+    classes: Any = None,
+    class_terrains: Optional[Mapping[int, TerrainLike]] = None,
 ) -> Dict[str, Any]:
     """Heading-aware routes over an elevation array (``sandslope plan --json``, docs/model.md §8).
 
@@ -473,9 +475,19 @@ def plan(
     y north of ``origin``, the map's north-west corner, default ``(0, rows * cell_y)``) and
     heights ``z_m``, and per edge ``steps`` (heading, pitch, roll, length, regime, speed,
     p_fail, over the roll limit).
+
+    Terrain classes (``plan --classes --class-terrain``): ``classes`` an array of the DEM's shape
+    holding each cell's class number (NaN: none, impassable) and ``class_terrains`` a mapping
+    ``{class: terrain}`` (Terrain, preset name or TOML path); ``terrain`` is then unused.
     """
     z = _dem(dem)
     cx, cy = _cell_size(cell_size_m)
+    if (classes is None) != (class_terrains is None):
+        raise ValueError("classes and class_terrains go together: give both or neither")
+    class_args: Dict[str, Any] = {}
+    if classes is not None:
+        class_args["classes"] = _float_array("classes", classes)
+        class_args["class_terrains"] = [(int(k), _terrain(t)) for k, t in dict(class_terrains).items()]
     names = [objective] if isinstance(objective, str) else [str(o) for o in objective]
     names = list(dict.fromkeys(names + ["distance"]))
     if origin is None:
@@ -497,6 +509,7 @@ def plan(
         descent=descent,
         allow_metastable=bool(allow_metastable),
         time_weight=float(time_weight),
+        **class_args,
     )
 
 

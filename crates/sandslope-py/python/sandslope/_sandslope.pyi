@@ -144,6 +144,8 @@ def plan(
     descent: str = "symmetric",
     allow_metastable: bool = False,
     time_weight: float = 1e-4,
+    classes: Optional[_F64] = None,
+    class_terrains: Optional[List[Tuple[int, Terrain]]] = None,
 ) -> Dict[str, Any]: ...
 def read_raster(path: _Path) -> Tuple[_F64, int, int, Dict[str, float]]: ...
 def geotiff_nodata(path: _Path) -> Optional[float]:

@@ -17,12 +17,14 @@
 //! (`Distance`). The search is A* on flat arrays with a straight-line heuristic that never
 //! overestimates.
 
+mod classes;
 mod grid;
 mod queue;
 mod result;
 mod search;
 mod table;
 
+pub use classes::{class_indices, UnmappedClass};
 pub use grid::{Cell, ElevationGrid};
 pub use result::{plan, Extrapolation, PlanRequest, PlanResult, RiskRaster};
 pub use search::{heading_offsets, Planner, Route, RouteStep, HEADINGS, NO_CLASS};

@@ -504,6 +504,54 @@ fn f64s(raw: &[u8]) -> Vec<f64> {
     raw.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect()
 }
 
+/// `--regime-only` writes the same CSV without the step column, byte for byte the full CSV's
+/// text up to the regime (each row's first five fields), and no `step_m.npy`; the regime
+/// codes in `regime.npy` are the full run's.
+#[test]
+fn regime_only_leaves_out_the_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let (full, short) = (dir.path().join("full.csv"), dir.path().join("short.csv"));
+    let (full_npy, short_npy) = (dir.path().join("full"), dir.path().join("short"));
+    std::fs::create_dir(&full_npy).unwrap();
+    std::fs::create_dir(&short_npy).unwrap();
+    let grid = [
+        "phase",
+        "--k-n",
+        "1e4:1e7:9",
+        "--k-s",
+        "1e3:1e8:6",
+        "--slope",
+        "0,24",
+        "--mass",
+        "0.35,1",
+        "--json",
+    ];
+    sandslope().args(grid).arg("--csv").arg(&full).arg("--npy").arg(&full_npy).assert().success();
+    sandslope()
+        .args(grid)
+        .arg("--regime-only")
+        .arg("--csv")
+        .arg(&short)
+        .arg("--npy")
+        .arg(&short_npy)
+        .assert()
+        .success();
+    let (full, short) = (std::fs::read_to_string(full).unwrap(), std::fs::read_to_string(short).unwrap());
+    let (mut f, mut s) = (full.lines(), short.lines());
+    assert_eq!(f.next(), Some("k_n,k_s,slope_deg,mass_kg,regime,step_m"));
+    assert_eq!(s.next(), Some("k_n,k_s,slope_deg,mass_kg,regime"));
+    let mut rows = 0;
+    for (a, b) in f.zip(s) {
+        let five: Vec<&str> = a.split(',').take(5).collect();
+        assert_eq!(five.join(","), b);
+        rows += 1;
+    }
+    assert_eq!((rows, short.lines().count()), (4 * 9 * 6, 4 * 9 * 6 + 1));
+    assert_eq!(read_npy(&full_npy.join("regime.npy")), read_npy(&short_npy.join("regime.npy")));
+    assert!(full_npy.join("step_m.npy").exists());
+    assert!(!short_npy.join("step_m.npy").exists());
+}
+
 /// `--npy` writes the same cells as `--csv`: regime codes (0 sinkage .. 3 success), steps
 /// with NaN where the CSV is empty, and the axes; for risk, p_fail as in the map CSV.
 #[test]

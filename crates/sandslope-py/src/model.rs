@@ -5,9 +5,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 
-use sandslope::{Cause, PhaseMap, Regime, Scenario, Slope, SlopeEvaluation, Terrain};
+use sandslope::{write_phase, Cause, Regime, Scenario, Slope, SlopeEvaluation, Terrain};
 
-use crate::arrays::{axis, filled, put, scale_name, values};
+use crate::arrays::{axis, put, scale_name, uninit, values};
 use crate::types::{PyRobot, PyTerrain};
 use crate::value_error;
 
@@ -147,9 +147,11 @@ pub fn predict<'py>(
 }
 
 /// The phase map at one slope: regime codes (int8) and net step (m, NaN where the leg never
-/// anchors) of every cell, row-major with one row per k_s value (`(len(k_s), len(k_n))`).
+/// anchors) of every cell, row-major with one row per k_s value (`(len(k_s), len(k_n))`);
+/// with `regime_only` the codes alone (no `step_m`).
 #[pyfunction]
-#[pyo3(signature = (robot, slope_deg, k_n_axis, k_s_axis, repose_deg=None))]
+#[pyo3(signature = (robot, slope_deg, k_n_axis, k_s_axis, repose_deg=None, regime_only=false))]
+#[allow(clippy::too_many_arguments)]
 pub fn phase<'py>(
     py: Python<'py>,
     robot: &PyRobot,
@@ -157,6 +159,7 @@ pub fn phase<'py>(
     k_n_axis: PyReadonlyArray1<'py, f64>,
     k_s_axis: PyReadonlyArray1<'py, f64>,
     repose_deg: Option<f64>,
+    regime_only: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let slope = Slope::from_signed_degrees(slope_deg).map_err(value_error)?;
     let repose = repose_deg
@@ -179,24 +182,35 @@ pub fn phase<'py>(
     )
     .map_err(value_error)?;
     let (regime, step, counts) = py.detach(|| {
-        let map = PhaseMap::compute(robot, slope, repose, &kn, &ks, &|| {});
-        // Written row by row, in parallel, straight from the map into the buffers NumPy will
-        // own: one pass, no intermediate copies, no zeroing first.
-        let regime = filled::<i8>(cells, nx, |j, row| {
-            for (i, out) in row.iter_mut().enumerate() {
-                out.write(map.regime(i, j) as i8);
+        // Written row by row, in parallel, straight into the buffers NumPy will own, in one
+        // pass (`sandslope::phase::write_phase`: no packed map to unpack afterwards, the row's
+        // step terms once for both arrays), no intermediate copies, no zeroing first.
+        let mut regime = uninit::<i8>(cells);
+        let mut step = (!regime_only).then(|| uninit::<f64>(cells));
+        let counts = write_phase(
+            robot,
+            slope,
+            repose,
+            &kn,
+            &ks,
+            &mut regime.spare_capacity_mut()[..cells],
+            step.as_mut().map(|s| &mut s.spare_capacity_mut()[..cells]),
+        );
+        // SAFETY: `write_phase` writes every one of the `cells` elements of each buffer it is
+        // given, and `cells` is within their capacities.
+        unsafe {
+            regime.set_len(cells);
+            if let Some(s) = step.as_mut() {
+                s.set_len(cells);
             }
-        });
-        let step = filled::<f64>(cells, nx, |j, row| {
-            for (i, out) in row.iter_mut().enumerate() {
-                out.write(map.step(i, j).unwrap_or(f64::NAN));
-            }
-        });
-        (regime, step, map.counts())
+        }
+        (regime, step, counts)
     });
     let d = PyDict::new(py);
     put(&d, "regime", regime)?;
-    put(&d, "step_m", step)?;
+    if let Some(step) = step {
+        put(&d, "step_m", step)?;
+    }
     put(&d, "k_n", kn.values())?;
     put(&d, "k_s", ks.values())?;
     d.set_item("k_n_scale", scale_name(&kn))?;

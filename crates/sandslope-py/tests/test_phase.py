@@ -28,6 +28,22 @@ def test_every_cell_matches_predict(robot):
             assert set(np.unique(m["regime"])) == {0, 1, 2, 3}
 
 
+def test_regime_only_gives_the_regime_of_predict_and_no_step(robot, terrain):
+    # 23 x 31 (not multiples of four: the last codes of a row come from a partial byte).
+    k_n = np.geomspace(1e4, 1e7, 23)
+    k_s = np.geomspace(1e3, 1e8, 31)
+    r = sandslope.phase(robot, 20.0, k_n, k_s, regime_only=True)
+    assert "step_m" not in r
+    assert r["regime"].shape == (23, 31) and r["regime"].dtype == np.int8
+    p = sandslope.predict(robot, 20.0, r["k_n"][:, None], r["k_s"][None, :])
+    np.testing.assert_array_equal(r["regime"], p["regime"])
+    # Beyond the terrain's angle of repose: the full map's regimes and counts.
+    r = sandslope.phase(robot, 26.0, k_n, k_s, terrain=terrain, regime_only=True)
+    full = sandslope.phase(robot, 26.0, k_n, k_s, terrain=terrain)
+    np.testing.assert_array_equal(r["regime"], full["regime"])
+    assert r["counts"] == full["counts"]
+
+
 def test_matches_the_cli_csv(cli, robot, terrain, tmp_path):
     out = tmp_path / "cells.csv"
     cli.run("phase", "--slope", 24, "--k-n", "1e4:1e7:17", "--k-s", "1e3:1e8:13:log", "--csv", out)

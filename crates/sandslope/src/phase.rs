@@ -227,21 +227,27 @@ pub struct PhaseMap {
     counts: RegimeCounts,
 }
 
-impl PhaseMap {
-    /// Classifies every cell of the grid `k_n_axis x k_s_axis` for `robot` at `slope` on a
-    /// terrain whose angle of repose is `repose` (at or beyond it every cell slips).
-    ///
-    /// `row_done` is called once per finished k_s row, from any thread (for progress bars).
-    pub fn compute(
-        robot: &Robot,
-        slope: Slope,
-        repose: Option<Slope>,
-        k_n_axis: &Axis,
-        k_s_axis: &Axis,
-        row_done: &(dyn Fn() + Sync),
-    ) -> PhaseMap {
-        let k_n = k_n_axis.values();
-        let k_s = k_s_axis.values();
+/// What a phase map shares across its cells: the k_n-only parts per column, the k_s-only
+/// parts per row, and the columns ranked by level step (see [`PhaseMap::compute`]).
+struct Parts {
+    /// Per k_n column: level step `s*`.
+    level_step: Vec<f64>,
+    /// Per k_n column: `d_n >= d_max`.
+    sunk: Vec<bool>,
+    /// Per k_s row: the step terms, `None` when the leg never anchors (`d_s > d_max`).
+    terms: Vec<Option<StepTerms>>,
+    beyond_repose: bool,
+    min_step: f64,
+    /// The columns that do not sink, by ascending level step.
+    order: Vec<u32>,
+    /// Per column: its place in `order` (0 where it sinks).
+    rank: Vec<u32>,
+    /// Per column: 0 where the legs sink, 1 elsewhere (a multiplier on the regime code).
+    afloat: Vec<u8>,
+}
+
+impl Parts {
+    fn new(robot: &Robot, slope: Slope, repose: Option<Slope>, k_n: &[f64], k_s: &[f64]) -> Parts {
         let d_max = robot.max_depth();
         // k_n-only parts, once per column.
         let (level_step, sunk): (Vec<f64>, Vec<bool>) = k_n
@@ -260,25 +266,146 @@ impl PhaseMap {
             })
             .collect();
         let beyond_repose = repose.is_some_and(|r| slope.radians() >= r.radians());
-        let min_step = robot.min_step();
-        let nx = k_n.len();
-        // Per column: 0 where the legs sink, 1 elsewhere (a multiplier on the regime code).
         let afloat: Vec<u8> = sunk.iter().map(|&s| u8::from(!s)).collect();
         // In one row the step `s*_i scale - drag - slip` is a non-decreasing function of s*_i
         // (scale >= 0; each rounded operation is monotone), so with the columns ranked by s*
         // the cells with s > 0 (and s >= s_min) are exactly those ranked at or above a
         // threshold, found by binary search with the exact expression. Ties in s* give equal
         // steps, so they never straddle a threshold.
-        let mut order: Vec<u32> = (0..nx as u32).filter(|&i| !sunk[i as usize]).collect();
+        let mut order: Vec<u32> = (0..k_n.len() as u32).filter(|&i| !sunk[i as usize]).collect();
         order.sort_by(|&a, &b| level_step[a as usize].total_cmp(&level_step[b as usize]));
-        let mut rank = vec![0u32; nx];
+        let mut rank = vec![0u32; k_n.len()];
         for (r, &i) in order.iter().enumerate() {
             rank[i as usize] = r as u32;
         }
-        let n_afloat = order.len();
+        Parts { level_step, sunk, terms, beyond_repose, min_step: robot.min_step(), order, rank, afloat }
+    }
+
+    /// Row `j`'s two thresholds on the rank (the first ranks with `s > 0` and with
+    /// `s >= s_min`), or `None` when every afloat cell of the row slips (no anchoring, or
+    /// at/above repose).
+    fn thresholds(&self, j: usize) -> Option<(u32, u32)> {
+        match self.terms[j] {
+            Some(t) if !self.beyond_repose => {
+                let first = |ok: &dyn Fn(f64) -> bool| {
+                    self.order.partition_point(|&i| !ok(t.step(self.level_step[i as usize]))) as u32
+                };
+                Some((first(&|s| s > 0.0), first(&|s| s >= self.min_step)))
+            }
+            _ => None,
+        }
+    }
+
+    /// Cells per regime in a row with these thresholds.
+    fn counts(&self, thresholds: Option<(u32, u32)>) -> [usize; 4] {
+        let (nx, n_afloat) = (self.rank.len(), self.order.len());
+        match thresholds {
+            Some((r0, r1)) => {
+                let (r0, r1) = (r0 as usize, r1 as usize);
+                [nx - n_afloat, r0, r1 - r0, n_afloat - r1]
+            }
+            None => [nx - n_afloat, n_afloat, 0, 0],
+        }
+    }
+}
+
+/// The precedence of `regime::classify` as codes of `Regime::ALL`: sinkage 0; else
+/// 1 + [s > 0] + [s >= s_min], from the column's rank against the row's thresholds (checked
+/// against `predict` cell by cell in `every_cell_matches_predict`).
+#[inline]
+fn code(afloat: u8, rank: u32, r0: u32, r1: u32) -> u8 {
+    afloat * (1 + u8::from(rank >= r0) + u8::from(rank >= r1))
+}
+
+/// The phase map written straight into caller-owned buffers in one pass, without building a
+/// [`PhaseMap`]: the regime code of every cell (the index into [`Regime::ALL`]: 0 sinkage,
+/// 1 slippage, 2 metastable, 3 success) into `codes` and, when given, the net step (NaN where
+/// the leg never anchors) into `steps`, both row-major with one row per k_s value
+/// (`k_n_axis.len() * k_s_axis.len()` elements, every one written). The per-column and per-row
+/// parts and each row's two thresholds are [`PhaseMap::compute`]'s, so the values are its
+/// `regime` and `step` bit for bit; rows run in parallel. Returns the cells per regime.
+///
+/// This is what Python's `sandslope.phase` runs: building the two-bit map and then unpacking
+/// it cell by cell into the NumPy arrays took about twice as long as this one pass.
+///
+/// # Panics
+/// If `codes` (or `steps`) is shorter than the grid.
+pub fn write_phase(
+    robot: &Robot,
+    slope: Slope,
+    repose: Option<Slope>,
+    k_n_axis: &Axis,
+    k_s_axis: &Axis,
+    codes: &mut [std::mem::MaybeUninit<i8>],
+    steps: Option<&mut [std::mem::MaybeUninit<f64>]>,
+) -> RegimeCounts {
+    let (k_n, k_s) = (k_n_axis.values(), k_s_axis.values());
+    let parts = Parts::new(robot, slope, repose, &k_n, &k_s);
+    let (nx, cells) = (k_n.len(), k_n.len() * k_s.len());
+    let write_codes = |j: usize, row: &mut [std::mem::MaybeUninit<i8>]| {
+        let thresholds = parts.thresholds(j);
+        match thresholds {
+            Some((r0, r1)) => {
+                for ((c, &a), &r) in row.iter_mut().zip(&parts.afloat).zip(&parts.rank) {
+                    c.write(code(a, r, r0, r1) as i8);
+                }
+            }
+            None => {
+                for (c, &a) in row.iter_mut().zip(&parts.afloat) {
+                    c.write(a as i8);
+                }
+            }
+        }
+        parts.counts(thresholds)
+    };
+    let write_steps = |j: usize, row: &mut [std::mem::MaybeUninit<f64>]| match parts.terms[j] {
+        Some(t) => {
+            for (out, &s) in row.iter_mut().zip(&parts.level_step) {
+                out.write(t.step(s));
+            }
+        }
+        None => {
+            for out in row {
+                out.write(f64::NAN);
+            }
+        }
+    };
+    let add = |a: [usize; 4], b: [usize; 4]| [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]];
+    let codes = codes[..cells].par_chunks_mut(nx);
+    let count = match steps {
+        Some(steps) => codes
+            .zip(steps[..cells].par_chunks_mut(nx))
+            .enumerate()
+            .map(|(j, (c, s))| {
+                write_steps(j, s);
+                write_codes(j, c)
+            })
+            .reduce(|| [0; 4], add),
+        None => codes.enumerate().map(|(j, c)| write_codes(j, c)).reduce(|| [0; 4], add),
+    };
+    RegimeCounts { sinkage: count[0], slippage: count[1], metastable: count[2], success: count[3] }
+}
+
+impl PhaseMap {
+    /// Classifies every cell of the grid `k_n_axis x k_s_axis` for `robot` at `slope` on a
+    /// terrain whose angle of repose is `repose` (at or beyond it every cell slips).
+    ///
+    /// `row_done` is called once per finished k_s row, from any thread (for progress bars).
+    pub fn compute(
+        robot: &Robot,
+        slope: Slope,
+        repose: Option<Slope>,
+        k_n_axis: &Axis,
+        k_s_axis: &Axis,
+        row_done: &(dyn Fn() + Sync),
+    ) -> PhaseMap {
+        let k_n = k_n_axis.values();
+        let k_s = k_s_axis.values();
+        let parts = Parts::new(robot, slope, repose, &k_n, &k_s);
+        let nx = k_n.len();
         // Four columns per byte; the per-column data padded to a multiple of four (as sunk).
         let row_bytes = nx.div_ceil(4);
-        let (mut afloat_p, mut rank_p) = (afloat.clone(), rank.clone());
+        let (mut afloat_p, mut rank_p) = (parts.afloat.clone(), parts.rank.clone());
         afloat_p.resize(4 * row_bytes, 0);
         rank_p.resize(4 * row_bytes, 0);
         // A row where nothing anchors: slippage (code 1) wherever the legs do not sink.
@@ -288,30 +415,21 @@ impl PhaseMap {
         let mut codes = vec![0u8; row_bytes * k_s.len()];
         let count = codes
             .par_chunks_mut(row_bytes)
-            .zip(terms.par_iter())
+            .enumerate()
             .map_init(
                 || vec![0u8; 4 * row_bytes],
-                |scratch, (row, terms)| {
-                    let counts = match terms {
-                        Some(t) if !beyond_repose => {
-                            let first = |ok: &dyn Fn(f64) -> bool| {
-                                order.partition_point(|&i| !ok(t.step(level_step[i as usize]))) as u32
-                            };
-                            // The precedence of `regime::classify` as codes of `Regime::ALL`:
-                            // sinkage 0; else 1 + [s > 0] + [s >= s_min]; checked against
-                            // `predict` cell by cell in `every_cell_matches_predict`.
-                            let (r0, r1) = (first(&|s| s > 0.0), first(&|s| s >= min_step));
+                |scratch, (j, row)| {
+                    let counts = match parts.thresholds(j) {
+                        Some((r0, r1)) => {
                             for ((cell, &a), &r) in scratch.iter_mut().zip(&afloat_p).zip(&rank_p) {
-                                *cell = a * (1 + u8::from(r >= r0) + u8::from(r >= r1));
+                                *cell = code(a, r, r0, r1);
                             }
                             pack_codes(scratch, row);
-                            let (r0, r1) = (r0 as usize, r1 as usize);
-                            [nx - n_afloat, r0, r1 - r0, n_afloat - r1]
+                            parts.counts(Some((r0, r1)))
                         }
-                        // No anchoring, or at/above repose: slippage unless the legs sink first.
-                        _ => {
+                        None => {
                             row.copy_from_slice(&slipping_row);
-                            [nx - n_afloat, n_afloat, 0, 0]
+                            parts.counts(None)
                         }
                     };
                     row_done();
@@ -319,6 +437,7 @@ impl PhaseMap {
                 },
             )
             .reduce(|| [0; 4], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]);
+        let Parts { level_step, sunk, terms, beyond_repose, min_step, .. } = parts;
         let counts =
             RegimeCounts { sinkage: count[0], slippage: count[1], metastable: count[2], success: count[3] };
         PhaseMap {
@@ -384,6 +503,43 @@ impl PhaseMap {
     /// `predict(..).step` for that cell.
     pub fn step(&self, i: usize, j: usize) -> Option<f64> {
         self.terms[j].map(|t| t.step(self.level_step[i]))
+    }
+
+    /// Row `j` (the `j`-th k_s value) in one pass: the regime code of every column (the index
+    /// into [`Regime::ALL`]: 0 sinkage, 1 slippage, 2 metastable, 3 success) into `codes`
+    /// and, when `steps` is given, the net step (NaN where the leg never anchors) into
+    /// `steps`; each must be `k_n.len()` long (extra elements are left alone). The values are
+    /// those of [`PhaseMap::regime`] and [`PhaseMap::step`], but the row's step terms are
+    /// looked up once and its codes unpacked four at a time, instead of per cell. Every
+    /// element of `codes[..nx]` (and `steps[..nx]`) is written.
+    pub fn write_row(
+        &self,
+        j: usize,
+        codes: &mut [std::mem::MaybeUninit<i8>],
+        steps: Option<&mut [std::mem::MaybeUninit<f64>]>,
+    ) {
+        let nx = self.k_n.len();
+        let packed = &self.codes[j * self.row_bytes..(j + 1) * self.row_bytes];
+        for (out, &byte) in codes[..nx].chunks_mut(4).zip(packed) {
+            for (k, c) in out.iter_mut().enumerate() {
+                c.write(((byte >> (2 * k)) & 3) as i8);
+            }
+        }
+        if let Some(steps) = steps {
+            let steps = &mut steps[..nx];
+            match self.terms[j] {
+                Some(t) => {
+                    for (out, &s) in steps.iter_mut().zip(&self.level_step) {
+                        out.write(t.step(s));
+                    }
+                }
+                None => {
+                    for out in steps {
+                        out.write(f64::NAN);
+                    }
+                }
+            }
+        }
     }
 
     /// The number of cells in each regime.
@@ -683,11 +839,44 @@ mod tests {
         {
             let repose = repose.map(deg);
             let m = PhaseMap::compute(robot, deg(d), repose, &kn, &ks, &|| {});
+            // The one-pass writer into caller buffers, with and without the steps.
+            let cells = kn.len() * ks.len();
+            let mut all_codes = vec![std::mem::MaybeUninit::new(-1i8); cells];
+            let mut all_steps = vec![std::mem::MaybeUninit::new(-1.0f64); cells];
+            let mut only_codes = vec![std::mem::MaybeUninit::new(-1i8); cells];
+            let counts = write_phase(robot, deg(d), repose, &kn, &ks, &mut all_codes, Some(&mut all_steps));
+            assert_eq!(counts, m.counts());
+            assert_eq!(write_phase(robot, deg(d), repose, &kn, &ks, &mut only_codes, None), m.counts());
+            for c in 0..cells {
+                let (i, j) = (c % kn.len(), c / kn.len());
+                // SAFETY: initialised above (and overwritten by write_phase).
+                let (a, s, b) = unsafe {
+                    (all_codes[c].assume_init(), all_steps[c].assume_init(), only_codes[c].assume_init())
+                };
+                assert_eq!(
+                    (Regime::ALL[a as usize], a),
+                    (m.regime(i, j), b),
+                    "write_phase: {d} deg, cell {c}"
+                );
+                assert_eq!(s.to_bits(), m.step(i, j).unwrap_or(f64::NAN).to_bits());
+            }
             for (j, &k_s) in ks.values().iter().enumerate() {
+                // The one-pass row writer too (37 columns: a partial last byte of codes).
+                let mut codes = vec![std::mem::MaybeUninit::new(-1i8); kn.len()];
+                let mut steps = vec![std::mem::MaybeUninit::new(-1.0f64); kn.len()];
+                m.write_row(j, &mut codes, Some(&mut steps));
                 for (i, &k_n) in kn.values().iter().enumerate() {
                     let p = predict(robot, deg(d), &Ground::new(k_n, k_s).unwrap().with_repose(repose));
                     assert_eq!(m.regime(i, j), p.regime, "{d} deg, k_n {k_n}, k_s {k_s}");
                     assert_eq!(m.step(i, j).map(f64::to_bits), p.step.map(f64::to_bits));
+                    // SAFETY: initialised above (and overwritten by write_row).
+                    let (code, step) = unsafe { (codes[i].assume_init(), steps[i].assume_init()) };
+                    assert_eq!(
+                        Regime::ALL[code as usize],
+                        p.regime,
+                        "write_row: {d} deg, k_n {k_n}, k_s {k_s}"
+                    );
+                    assert_eq!(step.to_bits(), p.step.unwrap_or(f64::NAN).to_bits());
                 }
             }
         }

@@ -234,6 +234,7 @@ def phase(
     mass_kg: Optional[float] = None,
     terrain: Optional[TerrainLike] = None,
     repose_deg: Optional[float] = None,
+    regime_only: bool = False,
 ) -> Dict[str, Any]:
     """The phase map (docs/model.md §6): the regime of every terrain ``(k_n, k_s)`` on a grid.
 
@@ -247,6 +248,8 @@ def phase(
 
     - ``regime``: int8, shape ``(len(k_n_axis), len(k_s_axis))``, index into :data:`REGIMES`;
     - ``step_m``: float64, same shape, the net step ``s`` (NaN where the leg never anchors);
+      left out with ``regime_only=True``, which skips computing and writing it
+      (docs/python.md);
     - ``k_n``, ``k_s``: the axis values used (the library's, equal to the given ones to 1e-9);
     - ``counts``: cells per regime.
 
@@ -261,10 +264,11 @@ def phase(
     if repose_deg is None and terrain is not None:
         repose_deg = _terrain(terrain).repose_deg
     kn, ks = _axis("k_n_axis", k_n_axis), _axis("k_s_axis", k_s_axis)
-    out = _sandslope.phase(robot, float(slope_deg), kn, ks, repose_deg=repose_deg)
+    out = _sandslope.phase(robot, float(slope_deg), kn, ks, repose_deg=repose_deg, regime_only=bool(regime_only))
     shape = (len(out["k_s"]), len(out["k_n"]))
     out["regime"] = out["regime"].reshape(shape).T
-    out["step_m"] = out["step_m"].reshape(shape).T
+    if "step_m" in out:
+        out["step_m"] = out["step_m"].reshape(shape).T
     return out
 
 

@@ -89,7 +89,12 @@ def predict(
     mass_kg: Optional[_F64] = None,
 ) -> Dict[str, np.ndarray]: ...
 def phase(
-    robot: Robot, slope_deg: float, k_n_axis: _F64, k_s_axis: _F64, repose_deg: Optional[float] = None
+    robot: Robot,
+    slope_deg: float,
+    k_n_axis: _F64,
+    k_s_axis: _F64,
+    repose_deg: Optional[float] = None,
+    regime_only: bool = False,
 ) -> Dict[str, Any]: ...
 def risk(
     robot: Robot, slope_deg: _F64, terrain: Terrain, cv_n: Optional[float] = None, cv_s: Optional[float] = None

@@ -93,7 +93,7 @@ pub(crate) struct ElementForce {
 /// Sand force on an element (docs/model.md §16), updating nothing: `memory` is the element's
 /// elastic slip, `yield_m` the slip at which the stress reaches its resistive-force value,
 /// `dt` the step. `None` when the element is out of the sand.
-#[inline]
+#[inline(always)]
 pub(crate) fn element_force(
     rft: &Rft,
     el: &Element,
@@ -155,24 +155,33 @@ pub(crate) fn element_force(
 }
 
 /// Adds an element force acting at `rel` (from the centre of mass) to the body's assembly.
+///
+/// With the velocity Jacobian rows `jx = (1, 0, -rel_z)`, `jz = (0, 1, rel_x)` the damping adds
+/// `c (jx jx^T + jz jz^T)` and the depth gain `(J^T dF/d(depth)) jz^T`; the entries are written
+/// out with the Jacobians' zeros and ones already applied (the products with exact 0 and 1 the
+/// general 3 x 3 loop formed change nothing, so the sums are the same numbers; perf: the loop
+/// was a fifth of the step).
 #[inline]
 pub(crate) fn assemble(asm: &mut Assembly, f: &ElementForce, rel: [f64; 2]) {
-    // Velocity Jacobian rows: v = (vx - w rel_z, vz + w rel_x).
-    let jx = [1.0, 0.0, -rel[1]];
-    let jz = [0.0, 1.0, rel[0]];
+    let (rx, rz) = (rel[0], rel[1]);
     asm.q[0] += f.force[0];
     asm.q[1] += f.force[1];
-    asm.q[2] += rel[0] * f.force[1] - rel[1] * f.force[0];
-    // Generalized depth gain: J^T dF/d(depth); depth grows as z falls: dz/dq = jz.
-    let gq = [
-        jx[0] * f.depth_gain[0] + jz[0] * f.depth_gain[1],
-        jx[1] * f.depth_gain[0] + jz[1] * f.depth_gain[1],
-        jx[2] * f.depth_gain[0] + jz[2] * f.depth_gain[1],
-    ];
-    for i in 0..3 {
-        for j in 0..3 {
-            asm.c[i][j] += f.damping * (jx[i] * jx[j] + jz[i] * jz[j]);
-            asm.k[i][j] += gq[i] * jz[j];
-        }
+    asm.q[2] += rx * f.force[1] - rz * f.force[0];
+    let c = f.damping;
+    // c (jx jx^T + jz jz^T): [[1, 0, -rz], [0, 1, rx], [-rz, rx, rz^2 + rx^2]] times c.
+    let (c02, c12, c22) = (c * -rz, c * rx, c * (rz * rz + rx * rx));
+    asm.c[0][0] += c;
+    asm.c[0][2] += c02;
+    asm.c[1][1] += c;
+    asm.c[1][2] += c12;
+    asm.c[2][0] += c02;
+    asm.c[2][1] += c12;
+    asm.c[2][2] += c22;
+    // Generalized depth gain g = J^T dF/d(depth) = (g_x, g_z, -rz g_x + rx g_z); K += g jz^T,
+    // whose first column is zero.
+    let g = [f.depth_gain[0], f.depth_gain[1], -rz * f.depth_gain[0] + rx * f.depth_gain[1]];
+    for (row, gi) in asm.k.iter_mut().zip(g) {
+        row[1] += gi;
+        row[2] += gi * rx;
     }
 }

@@ -131,8 +131,22 @@ impl Figure for CalibrationFigure<'_> {
             .draw()
             .map_err(plot_err)?;
 
+        self.draw_pulls(&bottom, x_range)
+    }
+}
+
+impl CalibrationFigure<'_> {
+    /// Bottom panel: each slope's pull, (observed - model) / SD, with the +-1 band.
+    fn draw_pulls<DB: DrawingBackend>(
+        &self,
+        bottom: &DrawingArea<DB, Shift>,
+        x_range: (f64, f64),
+    ) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
         let max_pull = self.points.iter().map(|p| p.pull.abs()).fold(2.5_f64, f64::max) * 1.15;
-        let mut chart = ChartBuilder::on(&bottom)
+        let mut chart = ChartBuilder::on(bottom)
             .caption("Pulls: (observed - model) / SD used in the fit", font(18.0))
             .margin(12)
             .x_label_area_size(45)

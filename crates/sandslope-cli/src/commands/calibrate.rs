@@ -4,13 +4,13 @@
 //! terrain file (and robot file) every other command accepts.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 
-use sandslope::calibrate::{Interval, ObservationKind, SpeedModel};
+use sandslope::calibrate::{Interval, ObservationKind, SpeedModel, SpeedObservation};
 use sandslope::{
     calibrate_jointly, calibrate_jointly_with, invert_each_speed, predict, FreeParameter, JointCalibration,
     JointSetup, Parameter, Quantity, ShearLaw, ShearShape, Slope, Terrain, TerrainPoint, TerrainSpec,
@@ -203,21 +203,7 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
     let source = args.terrain.load()?;
     let forces = args.forces.as_deref().map(load_terrain).transpose()?;
 
-    // The angle of repose: given, or carried over from the force tests or the source terrain.
-    let repose = match (args.repose, &forces) {
-        (Some(r), _) => ReposeRecord { deg: Some(r), source: "--repose".into() },
-        (None, Some(f)) if f.spec().repose_deg.is_some() => ReposeRecord {
-            deg: f.spec().repose_deg,
-            source: format!("carried over from --forces {}", args.forces.as_deref().unwrap_or("")),
-        },
-        _ => ReposeRecord {
-            deg: source.spec().repose_deg,
-            source: match source.spec().repose_deg {
-                Some(_) => format!("carried over from --terrain {}", args.terrain.terrain),
-                None => format!("none: --terrain {} has no repose_deg", args.terrain.terrain),
-            },
-        },
-    };
+    let repose = repose_record(&args, &source, forces.as_ref());
     // k_n: --k-n, else the force tests', else the source terrain's.
     let normal = match (fixed_k_n, &forces) {
         (Some(k), _) => Terrain::constant(k, 1.0).map_err(|e| anyhow!("{}", e.renamed("--k-n")))?,
@@ -270,25 +256,75 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
 
     // Outputs: the figure first (it is the likeliest to fail), then the files.
     if let Some(path) = &args.plot {
-        let lo = speeds.iter().map(|o| o.slope.degrees()).fold(0.0, f64::min);
-        let hi = speeds.iter().map(|o| o.slope.degrees()).fold(lo + 1.0, f64::max);
-        let curve: Vec<(f64, Option<f64>)> = (0..=200)
-            .map(|i| lo + (hi - lo) * i as f64 / 200.0)
-            .filter_map(|d| Slope::from_degrees(d).ok().map(|s| (d, s)))
-            .map(|(d, s)| {
-                let mut ground = terrain.at(s);
-                ground.repose = None; // the fit ignores repose: an observed speed shows the robot moved
-                (d, predict(&fitted_robot, s, &ground).speed)
-            })
-            .collect();
-        let points = speed_pulls(&cal.pulls);
-        let title = format!(
-            "chi^2/dof = {}, k_s(20)/k_s(0) = {:.2}",
-            cal.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),
-            cal.shear_ratio_20.value
-        );
-        crate::figures::save(path, &CalibrationFigure { points: &points, curve: &curve, subtitle: &title })?;
+        draw_fit(path, &speeds, &terrain, &fitted_robot, &cal)?;
     }
+    write_files(&args, &cal, &repose)?;
+
+    if args.json {
+        return print_json(&JointRecord {
+            mode: "joint",
+            calibration: &cal,
+            repose: &repose,
+            closed_form_fit: closed_form.as_ref(),
+        });
+    }
+    print_joint(&cal, &repose);
+    if let Some(cf) = &closed_form {
+        print_side_by_side(cf, &cal);
+    }
+    Ok(())
+}
+
+/// The angle of repose: `--repose`, else carried over from the force tests or the source
+/// terrain, with where it came from.
+fn repose_record(args: &CalibrateArgs, source: &Terrain, forces: Option<&Terrain>) -> ReposeRecord {
+    match (args.repose, forces) {
+        (Some(r), _) => ReposeRecord { deg: Some(r), source: "--repose".into() },
+        (None, Some(f)) if f.spec().repose_deg.is_some() => ReposeRecord {
+            deg: f.spec().repose_deg,
+            source: format!("carried over from --forces {}", args.forces.as_deref().unwrap_or("")),
+        },
+        _ => ReposeRecord {
+            deg: source.spec().repose_deg,
+            source: match source.spec().repose_deg {
+                Some(_) => format!("carried over from --terrain {}", args.terrain.terrain),
+                None => format!("none: --terrain {} has no repose_deg", args.terrain.terrain),
+            },
+        },
+    }
+}
+
+/// The `--plot` figure: observed speeds, the fitted model's curve, and the pulls.
+fn draw_fit(
+    path: &Path,
+    speeds: &[SpeedObservation],
+    terrain: &Terrain,
+    fitted_robot: &sandslope::Robot,
+    cal: &JointCalibration,
+) -> Result<()> {
+    let lo = speeds.iter().map(|o| o.slope.degrees()).fold(0.0, f64::min);
+    let hi = speeds.iter().map(|o| o.slope.degrees()).fold(lo + 1.0, f64::max);
+    let curve: Vec<(f64, Option<f64>)> = (0..=200)
+        .map(|i| lo + (hi - lo) * i as f64 / 200.0)
+        .filter_map(|d| Slope::from_degrees(d).ok().map(|s| (d, s)))
+        .map(|(d, s)| {
+            let mut ground = terrain.at(s);
+            ground.repose = None; // the fit ignores repose: an observed speed shows the robot moved
+            (d, predict(fitted_robot, s, &ground).speed)
+        })
+        .collect();
+    let points = speed_pulls(&cal.pulls);
+    let title = format!(
+        "chi^2/dof = {}, k_s(20)/k_s(0) = {:.2}",
+        cal.chi_squared_per_dof.map_or("-".into(), |r| format!("{r:.2}")),
+        cal.shear_ratio_20.value
+    );
+    crate::figures::save(path, &CalibrationFigure { points: &points, curve: &curve, subtitle: &title })?;
+    Ok(())
+}
+
+/// Writes `--out` (the calibrated terrain) and `--robot-out`, each with a header saying how.
+fn write_files(args: &CalibrateArgs, cal: &JointCalibration, repose: &ReposeRecord) -> Result<()> {
     let command: Vec<String> = std::env::args().skip(1).collect();
     let mut header = String::new();
     writeln!(header, "Written by: sandslope {}", command.join(" "))?;
@@ -310,19 +346,6 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
             )?;
         }
         write_atomic(path, robot_toml(&cal.robot, &header)?.as_bytes())?;
-    }
-
-    if args.json {
-        return print_json(&JointRecord {
-            mode: "joint",
-            calibration: &cal,
-            repose: &repose,
-            closed_form_fit: closed_form.as_ref(),
-        });
-    }
-    print_joint(&cal, &repose);
-    if let Some(cf) = &closed_form {
-        print_side_by_side(cf, &cal);
     }
     Ok(())
 }

@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 
-use sandslope::{write_phase, Cause, Regime, Scenario, Slope, SlopeEvaluation, Terrain};
+use sandslope::{write_phase_rows, Cause, Regime, Scenario, Slope, SlopeEvaluation, Terrain};
 
 use crate::arrays::{axis, put, scale_name, uninit, values};
 use crate::types::{PyRobot, PyTerrain};
@@ -146,6 +146,9 @@ pub fn predict<'py>(
     Ok(d)
 }
 
+/// Cells `phase` computes between two checks for Ctrl-C (about 10 ms of one core).
+const PHASE_CELLS_PER_BLOCK: usize = 1 << 20;
+
 /// The phase map at one slope: regime codes (int8) and net step (m, NaN where the leg never
 /// anchors) of every cell, row-major with one row per k_s value (`(len(k_s), len(k_n))`);
 /// with `regime_only` the codes alone (no `step_m`).
@@ -181,31 +184,36 @@ pub fn phase<'py>(
         sandslope::limits::MAX_PHASE_CELLS,
     )
     .map_err(value_error)?;
-    let (regime, step, counts) = py.detach(|| {
-        // Written row by row, in parallel, straight into the buffers NumPy will own, in one
-        // pass (`sandslope::phase::write_phase`: no packed map to unpack afterwards, the row's
-        // step terms once for both arrays), no intermediate copies, no zeroing first.
-        let mut regime = uninit::<i8>(cells);
-        let mut step = (!regime_only).then(|| uninit::<f64>(cells));
-        let counts = write_phase(
-            robot,
-            slope,
-            repose,
-            &kn,
-            &ks,
-            &mut regime.spare_capacity_mut()[..cells],
-            step.as_mut().map(|s| &mut s.spare_capacity_mut()[..cells]),
-        );
-        // SAFETY: `write_phase` writes every one of the `cells` elements of each buffer it is
-        // given, and `cells` is within their capacities.
-        unsafe {
-            regime.set_len(cells);
-            if let Some(s) = step.as_mut() {
-                s.set_len(cells);
-            }
+    // Written row by row, in parallel, straight into the buffers NumPy will own, in one pass
+    // (`sandslope::phase::write_phase_rows`: no packed map to unpack afterwards, the row's
+    // step terms once for both arrays), no intermediate copies, no zeroing first; in blocks of
+    // about 2^20 cells with the GIL released for each and Ctrl-C checked between them (issue
+    // 21: the cap, 2^28 cells, took minutes that only a kill could stop).
+    let mut regime = uninit::<i8>(cells);
+    let mut step = (!regime_only).then(|| uninit::<f64>(cells));
+    let block = (PHASE_CELLS_PER_BLOCK / nx).max(1);
+    let mut counts = [0usize; 4];
+    let mut j0 = 0;
+    while j0 < ny {
+        let rows = j0..(j0 + block).min(ny);
+        let span = rows.start * nx..rows.end * nx;
+        let codes = &mut regime.spare_capacity_mut()[span.clone()];
+        let steps = step.as_mut().map(|s| &mut s.spare_capacity_mut()[span]);
+        let c = py.detach(|| write_phase_rows(robot, slope, repose, &kn, &ks, rows.clone(), codes, steps));
+        for (n, g) in counts.iter_mut().zip(sandslope::Regime::ALL) {
+            *n += c.get(g);
         }
-        (regime, step, counts)
-    });
+        j0 = rows.end;
+        py.check_signals()?;
+    }
+    // SAFETY: the blocks cover rows 0..ny, and `write_phase_rows` writes every one of its
+    // rows' elements of each buffer it is given; `cells` is within their capacities.
+    unsafe {
+        regime.set_len(cells);
+        if let Some(s) = step.as_mut() {
+            s.set_len(cells);
+        }
+    }
     let d = PyDict::new(py);
     put(&d, "regime", regime)?;
     if let Some(step) = step {
@@ -216,8 +224,8 @@ pub fn phase<'py>(
     d.set_item("k_n_scale", scale_name(&kn))?;
     d.set_item("k_s_scale", scale_name(&ks))?;
     let c = PyDict::new(py);
-    for g in sandslope::Regime::ALL {
-        c.set_item(g.name(), counts.get(g))?;
+    for (g, n) in sandslope::Regime::ALL.into_iter().zip(counts) {
+        c.set_item(g.name(), n)?;
     }
     d.set_item("counts", c)?;
     Ok(d)

@@ -62,8 +62,8 @@ pub use gait::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording, Upslope
 pub use measure::{MeasureError, SlopeEstimate};
 pub use model::{predict, Prediction, G};
 pub use phase::{
-    write_phase, Axis, AxisScale, ContourSegment, PanelGround, PanelSummary, PhaseMap, PhasePanel,
-    RegimeCounts,
+    write_phase, write_phase_rows, Axis, AxisScale, ContourSegment, PanelGround, PanelSummary, PhaseMap,
+    PhasePanel, RegimeCounts,
 };
 pub use plan::{ElevationGrid, Objective, PlanSettings, Planner};
 pub use regime::{Cause, Regime};

@@ -339,9 +339,31 @@ pub fn write_phase(
     codes: &mut [std::mem::MaybeUninit<i8>],
     steps: Option<&mut [std::mem::MaybeUninit<f64>]>,
 ) -> RegimeCounts {
+    write_phase_rows(robot, slope, repose, k_n_axis, k_s_axis, 0..k_s_axis.len(), codes, steps)
+}
+
+/// [`write_phase`] for the k_s rows `rows` only: `codes` (and `steps`) hold those rows,
+/// `rows.len() * k_n_axis.len()` elements, row-major; the values are [`write_phase`]'s rows
+/// bit for bit. A caller that must stay responsive (Python's `phase`, which checks for Ctrl-C
+/// between blocks of rows) writes the grid a block at a time.
+///
+/// # Panics
+/// If `rows` is not within the k_s axis, or a buffer is shorter than the rows.
+#[allow(clippy::too_many_arguments)]
+pub fn write_phase_rows(
+    robot: &Robot,
+    slope: Slope,
+    repose: Option<Slope>,
+    k_n_axis: &Axis,
+    k_s_axis: &Axis,
+    rows: std::ops::Range<usize>,
+    codes: &mut [std::mem::MaybeUninit<i8>],
+    steps: Option<&mut [std::mem::MaybeUninit<f64>]>,
+) -> RegimeCounts {
     let (k_n, k_s) = (k_n_axis.values(), k_s_axis.values());
-    let parts = Parts::new(robot, slope, repose, &k_n, &k_s);
-    let (nx, cells) = (k_n.len(), k_n.len() * k_s.len());
+    // The row parts depend on the row's k_s alone: those of `rows` only.
+    let parts = Parts::new(robot, slope, repose, &k_n, &k_s[rows.clone()]);
+    let (nx, cells) = (k_n.len(), k_n.len() * rows.len());
     let write_codes = |j: usize, row: &mut [std::mem::MaybeUninit<i8>]| {
         let thresholds = parts.thresholds(j);
         match thresholds {
@@ -847,6 +869,40 @@ mod tests {
             let counts = write_phase(robot, deg(d), repose, &kn, &ks, &mut all_codes, Some(&mut all_steps));
             assert_eq!(counts, m.counts());
             assert_eq!(write_phase(robot, deg(d), repose, &kn, &ks, &mut only_codes, None), m.counts());
+            // Block by block (Python's phase, checking for Ctrl-C between blocks): the same
+            // cells, bit for bit, and the blocks' counts add up.
+            let mut block_codes = vec![std::mem::MaybeUninit::new(-1i8); cells];
+            let mut block_steps = vec![std::mem::MaybeUninit::new(-1.0f64); cells];
+            let mut total = [0usize; 4];
+            for rows in [0..1, 1..8, 8..21, 21..ks.len()] {
+                let span = rows.start * kn.len()..rows.end * kn.len();
+                let c = write_phase_rows(
+                    robot,
+                    deg(d),
+                    repose,
+                    &kn,
+                    &ks,
+                    rows,
+                    &mut block_codes[span.clone()],
+                    Some(&mut block_steps[span]),
+                );
+                for (t, g) in total.iter_mut().zip(Regime::ALL) {
+                    *t += c.get(g);
+                }
+            }
+            assert_eq!(total, Regime::ALL.map(|g| m.counts().get(g)));
+            for c in 0..cells {
+                // SAFETY: initialised above (and overwritten by write_phase/write_phase_rows).
+                let (a, b, s, t) = unsafe {
+                    (
+                        all_codes[c].assume_init(),
+                        block_codes[c].assume_init(),
+                        all_steps[c].assume_init(),
+                        block_steps[c].assume_init(),
+                    )
+                };
+                assert_eq!((a, s.to_bits()), (b, t.to_bits()), "write_phase_rows: {d} deg, cell {c}");
+            }
             for c in 0..cells {
                 let (i, j) = (c % kn.len(), c / kn.len());
                 // SAFETY: initialised above (and overwritten by write_phase).

@@ -108,7 +108,7 @@ def main():
         if p.returncode == 2 and "--max-memory" in p.stderr:
             print("\n".join(l for l in p.stderr.split("\tCommand being timed")[0].splitlines()
                             if not l.startswith("Command exited")))
-            print(f"refused after {wall:.2f} s wall, peak RSS {rss_kb / 1024:.0f} MiB (reading the DEM)")
+            print(f"refused after {wall:.2f} s wall, peak RSS {rss_kb / 1024:.0f} MiB")
             return
         if p.returncode != 0:
             print(p.stderr)

@@ -639,3 +639,32 @@ fn a_dem_too_big_for_the_memory_limit_is_refused_naming_the_limit() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--max-memory = 0 must be"));
 }
+
+/// The memory check reads the size from the DEM's header, before its samples: an ESRI ASCII
+/// grid whose header says 5000 x 5000 cells but which holds a single row is refused for memory
+/// (5000^2 x 31 or 48 bytes, 0.72 or 1.12 GiB, against 0.5 GiB) and not for its missing rows,
+/// which reading it would have found first; with room for it, the missing rows are the error.
+#[test]
+fn the_memory_check_comes_from_the_header_before_the_samples_are_read() {
+    let s = Setup::new();
+    let row: Vec<&str> = vec!["1.0"; 5000];
+    std::fs::write(
+        s.path("huge.asc"),
+        format!("ncols 5000\nnrows 5000\nxllcorner 0\nyllcorner 0\ncellsize 1\n{}\n", row.join(" ")),
+    )
+    .unwrap();
+    let run = |limit: &str| {
+        let out = s
+            .cmd("huge.asc")
+            .args(["--start-px", "10,10", "--goal-px", "20,20", "--max-memory", limit])
+            .output()
+            .unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (code, err) = run("0.5");
+    assert_eq!(code, Some(2));
+    assert!(err.contains("5000 x 5000 cells") && err.contains("--max-memory limit of 0.500 GiB"), "{err}");
+    let (code, err) = run("100");
+    assert_eq!(code, Some(2));
+    assert!(!err.contains("--max-memory") && err.contains("huge.asc"), "{err}");
+}

@@ -297,13 +297,24 @@ impl Raster {
 /// its label attached or a `.lbl` beside it, or the `.lbl`; any file beginning with a PDS3
 /// label), by extension or, for other names, by its first bytes.
 pub fn read_raster(path: &Path) -> Result<Raster> {
+    read_raster_within(path, &|_, _| Ok(()))
+}
+
+/// What a caller checks a raster's size against before its samples are read: `fits(cols,
+/// rows)` fails to refuse the raster (for instance because what the caller would build on it
+/// cannot fit in memory).
+pub type SizeCheck<'a> = &'a dyn Fn(usize, usize) -> Result<()>;
+
+/// [`read_raster`], with `fits(cols, rows)` called once the header gives the size and before
+/// anything of that size is allocated or decoded: its error refuses the raster.
+pub fn read_raster_within(path: &Path, fits: SizeCheck) -> Result<Raster> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let (mut raster, vertical) = match ext.as_deref() {
-        Some("tif" | "tiff") => read_geotiff(path)?,
-        Some("asc") => read_asc(path)?,
+        Some("tif" | "tiff") => read_geotiff(path, fits)?,
+        Some("asc") => read_asc(path, fits)?,
         // PDS3 rasters carry their own cell size in metres (pds3.rs).
-        Some("img" | "lbl") => return crate::pds3::read_pds3(path),
-        _ if crate::pds3::starts_with_label(path) => return crate::pds3::read_pds3(path),
+        Some("img" | "lbl") => return crate::pds3::read_pds3_within(path, fits),
+        _ if crate::pds3::starts_with_label(path) => return crate::pds3::read_pds3_within(path, fits),
         _ => bail!(
             "{}: unknown raster format; use a GeoTIFF (.tif, .tiff), an ESRI ASCII grid (.asc) or a PDS3 DTM \
              (.img, .lbl)",
@@ -348,7 +359,7 @@ pub fn read_raster(path: &Path) -> Result<Raster> {
 }
 
 /// A GeoTIFF, and the factor converting its heights to metres.
-fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
+fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
     let name = path.display();
     let mut file = File::open(path).with_context(|| format!("cannot read {name}"))?;
     check_tiff_directory(&name, &mut file)?;
@@ -358,6 +369,7 @@ fn read_geotiff(path: &Path) -> Result<(Raster, f64)> {
     skip_to_full_resolution(&name, &mut dec)?;
     let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
     check_raster_size(&name, u64::from(w), u64::from(h))?;
+    fits(w as usize, h as usize)?;
     let bits: u64 = dec.find_tag_unsigned(Tag::BitsPerSample).ok().flatten().unwrap_or(64);
     let file_bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
     check_claimed_bytes(&name, u64::from(w), u64::from(h), bits, file_bytes)?;
@@ -565,7 +577,7 @@ fn pixel_is_point(keys: Option<&[u16]>) -> bool {
 
 /// An ESRI ASCII grid (its CRS from a `.prj` beside it, if any), and the factor converting its
 /// heights to metres.
-fn read_asc(path: &Path) -> Result<(Raster, f64)> {
+fn read_asc(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
     let name = path.display();
     let bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
     // 24 bytes a value is more than any ASCII grid writer uses (`-1234.567890123456789 `).
@@ -604,6 +616,7 @@ fn read_asc(path: &Path) -> Result<(Raster, f64)> {
     };
     let (cols, rows) = (count("ncols")?, count("nrows")?);
     check_raster_size(&name, cols as u64, rows as u64)?;
+    fits(cols, rows)?;
     // Every value takes at least two bytes (a digit and a separator): a header that claims more
     // cells than the file can hold is refused before the grid is allocated.
     if cols.saturating_mul(rows) > text.len() / 2 + 1 {

@@ -19,7 +19,7 @@ use crate::args::{check_flag, RobotArgs, TerrainArgs, UncertaintyArgs};
 use crate::figures::plan::PlanFigure;
 use crate::output::{num, print_json, table};
 use sandslope_io::load_terrain;
-use sandslope_io::raster::{read_raster, write_two_band_geotiff, Raster};
+use sandslope_io::raster::{read_raster, read_raster_within, write_two_band_geotiff, Raster};
 use sandslope_io::routes as writers;
 
 /// Maps at least this large get a progress bar (on a terminal).
@@ -352,10 +352,10 @@ fn classes_of(
     Ok((classes, terrains))
 }
 
-/// Refuses, before the planner allocates anything, a DEM whose planning would need more memory
-/// than `--max-memory` (default: what the machine has available), naming the limit and the
-/// bytes per cell.
-fn check_memory(args: &PlanArgs, dem: &Raster, request: &PlanRequest) -> Result<()> {
+/// Refuses a `cols` x `rows` DEM whose planning for `objectives` (and distance) would need more
+/// memory than `--max-memory` (default: what the machine has available), naming the limit and
+/// the bytes per cell; called from the DEM's header, before its samples are read.
+fn check_memory(args: &PlanArgs, cols: usize, rows: usize, objectives: &[Objective]) -> Result<()> {
     const GIB: f64 = (1u64 << 30) as f64;
     let (limit, what) = match args.max_memory {
         Some(gib) => {
@@ -373,13 +373,13 @@ fn check_memory(args: &PlanArgs, dem: &Raster, request: &PlanRequest) -> Result<
             None => return Ok(()),
         },
     };
-    let mut objectives = request.objectives.clone();
+    let mut objectives = objectives.to_vec();
     objectives.push(Objective::Distance);
     objectives.sort();
     objectives.dedup();
     let searches = objectives.len().min(rayon::current_num_threads().max(1)) as u64;
     let per_cell = sandslope::plan::bytes_per_cell(searches);
-    let cells = dem.cols as u64 * dem.rows as u64;
+    let cells = cols as u64 * rows as u64;
     let need = (cells * per_cell) as f64;
     if need > limit {
         bail!(
@@ -387,8 +387,8 @@ fn check_memory(args: &PlanArgs, dem: &Raster, request: &PlanRequest) -> Result<
              gradients, {} for each of {searches} route searches at once), more than {what} of {:.3} GiB; crop or \
              resample the DEM (for example with gdal_translate -srcwin or -tr)",
             args.dem.display(),
-            dem.cols,
-            dem.rows,
+            cols,
+            rows,
             need / GIB,
             sandslope::plan::PLANNER_BYTES_PER_CELL,
             sandslope::plan::SEARCH_BYTES_PER_CELL,
@@ -449,7 +449,10 @@ pub fn answer(planned: &Planned) -> PlanJson {
 pub fn compute(args: &PlanArgs, risk_map: bool, quiet: bool) -> Result<Planned> {
     let robot = args.robot.load()?;
     let settings = settings(args)?;
-    let dem = read_raster(&args.dem)?;
+    let objectives: Vec<Objective> = args.objective.iter().map(|&o| o.into()).collect();
+    // The size is checked against the memory limit from the file's header, before its samples
+    // are read (a 16384 x 16384 DEM is refused in a moment instead of after reading 3 GiB).
+    let dem = read_raster_within(&args.dem, &|cols, rows| check_memory(args, cols, rows, &objectives))?;
     if !quiet {
         for note in &dem.notes {
             eprintln!("note: {note}");
@@ -458,9 +461,7 @@ pub fn compute(args: &PlanArgs, risk_map: bool, quiet: bool) -> Result<Planned> 
     let start = endpoint(&dem, "start", &args.start, &args.start_px)?;
     let goal = endpoint(&dem, "goal", &args.goal, &args.goal_px)?;
     let (classes, terrains) = classes_of(args, &dem, quiet)?;
-    let request =
-        PlanRequest { start, goal, objectives: args.objective.iter().map(|&o| o.into()).collect(), risk_map };
-    check_memory(args, &dem, &request)?;
+    let request = PlanRequest { start, goal, objectives, risk_map };
     let grid = grid_of(&dem, args)?;
     // The grid holds the heights as f32 now: the f64 values (8 bytes a cell) are not needed
     // again (the outputs use the georeference, the figures the planner's grid).

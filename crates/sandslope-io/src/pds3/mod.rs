@@ -46,11 +46,18 @@ pub fn starts_with_label(path: &Path) -> bool {
 /// `.LBL`): heights in metres (NaN where missing or special), the map georeferencing in
 /// projected metres, and the ground cell size in metres.
 pub fn read_pds3(path: &Path) -> Result<Raster> {
+    read_pds3_within(path, &|_, _| Ok(()))
+}
+
+/// [`read_pds3`], with `fits(cols, rows)` called once the label gives the size and before the
+/// samples are read ([`crate::raster::read_raster_within`]).
+pub fn read_pds3_within(path: &Path, fits: crate::raster::SizeCheck) -> Result<Raster> {
     let (label_path, text, attached) = find_label(path)?;
     let label = parse_label(&label_path.display().to_string(), &text)?;
     let (data_path, offset) = image_location(&label, &label_path, attached)?;
     let mut notes = Vec::new();
     let layout = image::layout(&label, &mut notes)?;
+    fits(layout.cols as usize, layout.rows as usize)?;
     let values = image::read_samples(&layout, &label.name, &data_path, offset, &mut notes)?;
     let (geo, cell_m) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
     Ok(Raster {

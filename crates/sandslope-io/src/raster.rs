@@ -361,12 +361,7 @@ pub fn read_raster_within(path: &Path, fits: SizeCheck) -> Result<Raster> {
 /// A GeoTIFF, and the factor converting its heights to metres.
 fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
     let name = path.display();
-    let mut file = File::open(path).with_context(|| format!("cannot read {name}"))?;
-    check_tiff_directory(&name, &mut file)?;
-    let mut dec = Decoder::new(BufReader::new(file))
-        .map_err(|e| anyhow!("{name}: not a readable TIFF: {e}"))?
-        .with_limits(tiff_limits());
-    skip_to_full_resolution(&name, &mut dec)?;
+    let mut dec = open_full_resolution(path)?;
     let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
     check_raster_size(&name, u64::from(w), u64::from(h))?;
     fits(w as usize, h as usize)?;
@@ -402,13 +397,20 @@ fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
 /// Python package's Dask raster) and must mark the same cells as nodata.
 pub fn geotiff_nodata(path: &Path) -> Result<Option<f64>> {
     let name = path.display();
+    let mut dec = open_full_resolution(path)?;
+    Ok(GeoTags::read(&name, &mut dec)?.nodata)
+}
+
+/// A GeoTIFF's decoder at its full-resolution image, every directory's tags checked first.
+fn open_full_resolution(path: &Path) -> Result<Decoder<BufReader<File>>> {
+    let name = path.display();
     let mut file = File::open(path).with_context(|| format!("cannot read {name}"))?;
     check_tiff_directory(&name, &mut file)?;
     let mut dec = Decoder::new(BufReader::new(file))
         .map_err(|e| anyhow!("{name}: not a readable TIFF: {e}"))?
         .with_limits(tiff_limits());
     skip_to_full_resolution(&name, &mut dec)?;
-    Ok(GeoTags::read(&name, &mut dec)?.nodata)
+    Ok(dec)
 }
 
 /// Moves `dec` to the full-resolution image.

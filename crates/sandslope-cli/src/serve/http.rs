@@ -190,8 +190,8 @@ async fn route(State(app): State<Arc<App>>, request: Request) -> Response {
         _ => return refuse(405, format!("{method} is not accepted; use GET (or POST with JSON)")),
     }
     // Admitted: computing or waiting for one of the compute threads.
-    let _admitted = Admitted::new(&app.admitted);
-    if _admitted.count > MAX_QUEUE + app.threads {
+    let admitted = Admitted::new(&app.admitted);
+    if admitted.count > MAX_QUEUE + app.threads {
         return refuse(
             503,
             format!("the server is busy: at most {MAX_QUEUE} API requests may wait; try again"),

@@ -715,6 +715,16 @@ impl RiskMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The largest difference between two maps over every cell of p_fail and p_not_success.
+    fn largest_difference(a: &RiskMap, b: &RiskMap) -> f64 {
+        a.p_fail
+            .iter()
+            .zip(&b.p_fail)
+            .chain(a.p_not_success.iter().zip(&b.p_not_success))
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    }
     use crate::model::tests::paper_robot;
     use crate::{AxisScale, RobotSpec};
 
@@ -729,12 +739,7 @@ mod tests {
         let u = Uncertainty::new(cv.0, cv.1).unwrap();
         let fast = RiskMap::compute(robot, s, repose, kn, ks, u, &|| {});
         let slow = RiskMap::compute_by_quadrature(robot, s, repose, kn, ks, u, &|| {});
-        fast.p_fail
-            .iter()
-            .zip(&slow.p_fail)
-            .chain(fast.p_not_success.iter().zip(&slow.p_not_success))
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max)
+        largest_difference(&fast, &slow)
     }
 
     /// Random robots, slopes, spreads and grids (a small deterministic generator), every
@@ -806,12 +811,7 @@ mod tests {
         let u = Uncertainty::new(cv.0, cv.1).unwrap();
         let fast = RiskMap::compute_blocked(&r, s, None, kn, ks, u, &|| {}, blocks);
         let slow = RiskMap::compute_by_quadrature(&r, s, None, kn, ks, u, &|| {});
-        fast.p_fail
-            .iter()
-            .zip(&slow.p_fail)
-            .chain(fast.p_not_success.iter().zip(&slow.p_not_success))
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max)
+        largest_difference(&fast, &slow)
     }
 
     /// The banded matrix product across block edges (blocks of 1, 3 and 4 columns and rows,

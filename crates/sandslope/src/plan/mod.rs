@@ -21,13 +21,16 @@ mod classes;
 mod grid;
 mod queue;
 mod result;
+mod risk_map;
+mod route;
 mod search;
 mod table;
 
 pub use classes::{class_indices, UnmappedClass};
 pub use grid::{Cell, ElevationGrid};
 pub use result::{plan, Extrapolation, PlanRequest, PlanResult, RiskRaster};
-pub use search::{heading_offsets, Planner, Route, RouteStep, HEADINGS, NO_CLASS};
+pub use route::{Route, RouteStep};
+pub use search::{heading_offsets, Planner, HEADINGS, NO_CLASS};
 pub use table::{PitchTable, PitchTableCache, MAX_PITCH_DEG, P_FAIL_STEP_DEG, TAN_STEP};
 
 use serde::{Deserialize, Serialize};

@@ -1,4 +1,5 @@
-//! The 16-connected grid graph, A* on flat arrays, routes and their statistics, risk maps.
+//! The 16-connected grid graph and A* on flat arrays (routes: [`super::route`]; risk maps:
+//! [`super::risk_map`]).
 //!
 //! Nothing per edge is stored: a cell keeps its Horn gradient (2 x f32, NaN when impassable)
 //! and its class (u8); an edge's cost is computed when it is relaxed, from the two cells'
@@ -24,6 +25,7 @@ use rayon::prelude::*;
 
 use super::grid::{Cell, ElevationGrid};
 use super::queue::BucketQueue;
+use super::route::Route;
 use super::table::{PitchTable, PitchTableCache, TAN_STEP};
 use super::{Descent, NoRoute, Objective, PlanError, PlanSettings};
 use crate::regime::Regime;
@@ -59,88 +61,35 @@ pub fn heading_offsets() -> [(isize, isize); HEADINGS] {
 pub const NO_CLASS: u8 = u8::MAX;
 
 #[derive(Debug, Clone, Copy)]
-struct Move {
-    dc: isize,
-    dr: isize,
+pub(super) struct Move {
+    pub(super) dc: isize,
+    pub(super) dr: isize,
     /// Unit heading (east, north), f32 for the hot loop.
-    ux: f32,
-    uy: f32,
+    pub(super) ux: f32,
+    pub(super) uy: f32,
     /// Horizontal length, m.
-    len: f64,
+    pub(super) len: f64,
     /// Azimuth clockwise from north, degrees.
-    azimuth_deg: f64,
+    pub(super) azimuth_deg: f64,
     /// Flat offsets of the two cells a knight move passes through (0 if not a knight move).
     via: [isize; 2],
-}
-
-/// One edge of a route, with what the model says about it.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct RouteStep {
-    /// Cell left.
-    pub from: Cell,
-    /// Cell reached.
-    pub to: Cell,
-    /// Heading, degrees clockwise from north.
-    pub heading_deg: f64,
-    /// Signed pitch along the heading, degrees (positive: climbing).
-    pub pitch_deg: f64,
-    /// Cross slope, degrees.
-    pub roll_deg: f64,
-    /// Length along the surface, `horizontal / cos(pitch)`, m.
-    pub length_m: f64,
-    /// Horizontal length in cell widths: the number of independent cells the edge crosses.
-    pub cells_crossed: f64,
-    /// Whether the roll exceeds the cross-slope limit (impassable: counts as failure).
-    pub over_roll_limit: bool,
-    /// The model's regime at this pitch (the worse of the two cells' classes).
-    pub regime: Regime,
-    /// Speed along the surface, m/s, where defined.
-    pub speed: Option<f64>,
-    /// P(sinkage or slippage) per cell crossed at this pitch (1 over the roll limit).
-    pub p_fail: f64,
-}
-
-/// A planned route and its statistics.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Route {
-    /// The objective it minimises.
-    pub objective: Objective,
-    /// Cells from start to goal.
-    pub cells: Vec<Cell>,
-    /// One step per edge (`cells.len() - 1`).
-    pub steps: Vec<RouteStep>,
-    /// Length along the surface, m.
-    pub length_m: f64,
-    /// Travel time, s; `None` when some step fails (sinkage or slippage: no progress), has no
-    /// positive speed or exceeds the roll limit.
-    pub time_s: Option<f64>,
-    /// Survival probability, `prod (1 - p_fail)^(cells crossed)` (docs/model.md §9).
-    pub survival: f64,
-    /// Largest `|pitch|`, degrees.
-    pub max_pitch_deg: f64,
-    /// Largest roll, degrees.
-    pub max_roll_deg: f64,
-    /// Number of steps in each regime, in [`Regime::ALL`] order (sinkage first).
-    pub regimes: [usize; 4],
-    /// Number of steps over the roll limit.
-    pub over_roll_limit: usize,
 }
 
 /// The grid graph with the model tabulated on it; build once, plan many routes.
 #[derive(Debug, Clone)]
 pub struct Planner {
-    grid: ElevationGrid,
-    grad: Vec<[f32; 2]>,
-    class: Vec<u8>,
-    tables: Vec<PitchTable>,
+    pub(super) grid: ElevationGrid,
+    pub(super) grad: Vec<[f32; 2]>,
+    pub(super) class: Vec<u8>,
+    pub(super) tables: Vec<PitchTable>,
     /// Cost per horizontal metre, `[objective][class][entry]` (infinite: impassable).
     costs: [Vec<Vec<f32>>; 3],
     /// Smallest entry of `costs[objective]`, scaled down a hair for f32 rounding.
     min_cost: [f64; 3],
-    moves: [Move; HEADINGS],
-    settings: PlanSettings,
-    tan_max_roll: f32,
-    cell_width: f64,
+    pub(super) moves: [Move; HEADINGS],
+    pub(super) settings: PlanSettings,
+    pub(super) tan_max_roll: f32,
+    pub(super) cell_width: f64,
 }
 
 /// Hints the processor to load `v[i]` into cache (nothing if `i` is out of bounds or the
@@ -167,10 +116,11 @@ struct Node {
     grad: [f32; 2],
 }
 
+/// Pitch and roll of an edge, as tangents.
 #[derive(Debug, Clone, Copy)]
-struct EdgeGeom {
-    tan_pitch: f32,
-    tan_roll: f32,
+pub(super) struct EdgeGeom {
+    pub(super) tan_pitch: f32,
+    pub(super) tan_roll: f32,
 }
 
 impl Planner {
@@ -334,7 +284,7 @@ impl Planner {
     }
 
     #[inline(always)]
-    fn geom(&self, u: usize, v: usize, k: usize) -> EdgeGeom {
+    pub(super) fn geom(&self, u: usize, v: usize, k: usize) -> EdgeGeom {
         self.geom_of(self.grad[u], self.grad[v], k)
     }
 
@@ -370,7 +320,7 @@ impl Planner {
     /// Table entry used by the model for this edge (descent rule applied), and the entry of
     /// `|tan(pitch)|` used for the 3-D length; `None` beyond the steepest tabulated pitch.
     #[inline(always)]
-    fn entries(&self, e: EdgeGeom) -> Option<(usize, usize)> {
+    pub(super) fn entries(&self, e: EdgeGeom) -> Option<(usize, usize)> {
         // Rounded up by integer arithmetic: `f32::ceil` is a libm call without SSE4.1 (2 % of
         // a 4096 x 4096 plan in perf). NaN and negative values give 0, as `ceil` did.
         let x = e.tan_pitch.abs() * (1.0 / TAN_STEP as f32);
@@ -489,130 +439,6 @@ impl Planner {
         }
         progress(search.settled);
         search.path()
-    }
-
-    /// Evaluates the edge `u -> v` along move `k` (which must be a valid move).
-    fn step(&self, u: usize, v: usize, k: usize) -> RouteStep {
-        let e = self.geom(u, v, k);
-        let m = &self.moves[k];
-        let over = e.tan_roll > self.tan_max_roll;
-        let tan_p = f64::from(e.tan_pitch);
-        let (cu, cv) = (usize::from(self.class[u]), usize::from(self.class[v]));
-        let (regime, speed, p_fail) = match self.entries(e) {
-            None => (Regime::Slippage, None, 1.0),
-            Some((i, _)) => {
-                let (a, b) = (&self.tables[cu], &self.tables[cv]);
-                let regime = a.regime(i).min(b.regime(i));
-                let speed = match (a.speed(i), b.speed(i)) {
-                    (Some(x), Some(y)) if x > 0.0 && y > 0.0 => Some(2.0 / (1.0 / x + 1.0 / y)),
-                    (Some(x), Some(y)) => Some(x.min(y)),
-                    _ => None,
-                };
-                let p = 1.0 - ((1.0 - a.p_fail(i)) * (1.0 - b.p_fail(i))).sqrt();
-                (regime, speed, if over { 1.0 } else { p })
-            }
-        };
-        RouteStep {
-            from: self.grid.cell(u),
-            to: self.grid.cell(v),
-            heading_deg: m.azimuth_deg,
-            pitch_deg: tan_p.atan().to_degrees(),
-            roll_deg: f64::from(e.tan_roll).atan().to_degrees(),
-            length_m: m.len * (1.0 + tan_p * tan_p).sqrt(),
-            cells_crossed: m.len / self.cell_width,
-            over_roll_limit: over,
-            regime,
-            speed,
-            p_fail,
-        }
-    }
-
-    /// The move index from `u` to `v`, if they are one move apart.
-    fn move_between(&self, u: usize, v: usize) -> Option<usize> {
-        let cols = self.grid.cols();
-        let (dc, dr) = ((v % cols) as isize - (u % cols) as isize, (v / cols) as isize - (u / cols) as isize);
-        self.moves.iter().position(|m| m.dc == dc && m.dr == dr)
-    }
-
-    /// Statistics of a chain of cells (consecutive cells must be one move apart).
-    fn route_from_cells(&self, objective: Objective, cells: Vec<usize>) -> Route {
-        let steps: Vec<RouteStep> = cells
-            .windows(2)
-            .filter_map(|w| self.move_between(w[0], w[1]).map(|k| self.step(w[0], w[1], k)))
-            .collect();
-        let mut regimes = [0; 4];
-        for s in &steps {
-            regimes[Regime::ALL.iter().position(|&r| r == s.regime).unwrap_or(0)] += 1;
-        }
-        let time_s = steps.iter().try_fold(0.0, |acc, s| match s.speed {
-            Some(v) if v > 0.0 && !s.over_roll_limit && !s.regime.is_failure() => Some(acc + s.length_m / v),
-            _ => None,
-        });
-        let log_survival: f64 = steps.iter().map(|s| s.cells_crossed * (-s.p_fail).ln_1p()).sum();
-        Route {
-            objective,
-            cells: cells.iter().map(|&i| self.grid.cell(i)).collect(),
-            length_m: steps.iter().map(|s| s.length_m).sum(),
-            time_s,
-            survival: log_survival.exp(),
-            max_pitch_deg: steps.iter().map(|s| s.pitch_deg.abs()).fold(0.0, f64::max),
-            max_roll_deg: steps.iter().map(|s| s.roll_deg).fold(0.0, f64::max),
-            regimes,
-            over_roll_limit: steps.iter().filter(|s| s.over_roll_limit).count(),
-            steps,
-        }
-    }
-
-    /// The regime and P(failure) of climbing `cell` head-on, straight up its fall line
-    /// (pitch `atan |grad z|`, no roll); `None` where the cell is impassable.
-    pub fn fall_line(&self, cell: Cell) -> Option<(Regime, f64)> {
-        let i = self.grid.index(cell)?;
-        let g = self.grad[i];
-        if g[0].is_nan() {
-            return None;
-        }
-        let (_, k) = self.entries(EdgeGeom { tan_pitch: g[0].hypot(g[1]), tan_roll: 0.0 })?;
-        let t = &self.tables[usize::from(self.class[i])];
-        Some((t.regime(k), t.p_fail(k)))
-    }
-
-    /// Per cell, the lowest P(failure) over the 16 headings (roll over the limit counts as
-    /// failure), and the azimuth (degrees clockwise from north) of the steepest climbing
-    /// heading the time objective may use; NaN where the cell is impassable or no heading
-    /// qualifies. Uses the cell's own gradient.
-    pub fn risk_map(&self) -> (Vec<f32>, Vec<f32>) {
-        let allowed =
-            |r: Regime| r == Regime::Success || (self.settings.allow_metastable() && r == Regime::Metastable);
-        self.grad
-            .par_iter()
-            .zip(self.class.par_iter())
-            .map(|(g, &c)| {
-                if g[0].is_nan() {
-                    return (f32::NAN, f32::NAN);
-                }
-                let table = &self.tables[usize::from(c)];
-                let mut best = 1.0_f64;
-                let mut climb: Option<(f32, f64)> = None;
-                for m in &self.moves {
-                    let e = EdgeGeom {
-                        tan_pitch: g[0] * m.ux + g[1] * m.uy,
-                        tan_roll: (g[0] * m.uy - g[1] * m.ux).abs(),
-                    };
-                    if e.tan_roll > self.tan_max_roll {
-                        continue;
-                    }
-                    let Some((i, _)) = self.entries(e) else { continue };
-                    best = best.min(table.p_fail(i));
-                    if e.tan_pitch > 0.0
-                        && allowed(table.regime(i))
-                        && climb.is_none_or(|(t, _)| e.tan_pitch > t)
-                    {
-                        climb = Some((e.tan_pitch, m.azimuth_deg));
-                    }
-                }
-                (best as f32, climb.map_or(f32::NAN, |(_, a)| a as f32))
-            })
-            .unzip()
     }
 }
 

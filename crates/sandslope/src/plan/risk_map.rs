@@ -1,0 +1,62 @@
+//! Per-cell risk over all headings (the `--risk-map` raster) and the head-on climb of a cell
+//! (the plan figure's tint), from the planner's gradients and pitch tables.
+
+use rayon::prelude::*;
+
+use super::grid::Cell;
+use super::search::{EdgeGeom, Planner};
+use crate::regime::Regime;
+
+impl Planner {
+    /// The regime and P(failure) of climbing `cell` head-on, straight up its fall line
+    /// (pitch `atan |grad z|`, no roll); `None` where the cell is impassable.
+    pub fn fall_line(&self, cell: Cell) -> Option<(Regime, f64)> {
+        let i = self.grid.index(cell)?;
+        let g = self.grad[i];
+        if g[0].is_nan() {
+            return None;
+        }
+        let (_, k) = self.entries(EdgeGeom { tan_pitch: g[0].hypot(g[1]), tan_roll: 0.0 })?;
+        let t = &self.tables[usize::from(self.class[i])];
+        Some((t.regime(k), t.p_fail(k)))
+    }
+
+    /// Per cell, the lowest P(failure) over the 16 headings (roll over the limit counts as
+    /// failure), and the azimuth (degrees clockwise from north) of the steepest climbing
+    /// heading the time objective may use; NaN where the cell is impassable or no heading
+    /// qualifies. Uses the cell's own gradient.
+    pub fn risk_map(&self) -> (Vec<f32>, Vec<f32>) {
+        let allowed =
+            |r: Regime| r == Regime::Success || (self.settings.allow_metastable() && r == Regime::Metastable);
+        self.grad
+            .par_iter()
+            .zip(self.class.par_iter())
+            .map(|(g, &c)| {
+                if g[0].is_nan() {
+                    return (f32::NAN, f32::NAN);
+                }
+                let table = &self.tables[usize::from(c)];
+                let mut best = 1.0_f64;
+                let mut climb: Option<(f32, f64)> = None;
+                for m in &self.moves {
+                    let e = EdgeGeom {
+                        tan_pitch: g[0] * m.ux + g[1] * m.uy,
+                        tan_roll: (g[0] * m.uy - g[1] * m.ux).abs(),
+                    };
+                    if e.tan_roll > self.tan_max_roll {
+                        continue;
+                    }
+                    let Some((i, _)) = self.entries(e) else { continue };
+                    best = best.min(table.p_fail(i));
+                    if e.tan_pitch > 0.0
+                        && allowed(table.regime(i))
+                        && climb.is_none_or(|(t, _)| e.tan_pitch > t)
+                    {
+                        climb = Some((e.tan_pitch, m.azimuth_deg));
+                    }
+                }
+                (best as f32, climb.map_or(f32::NAN, |(_, a)| a as f32))
+            })
+            .unzip()
+    }
+}

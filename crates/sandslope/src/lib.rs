@@ -30,7 +30,9 @@
 
 #![warn(missing_docs)]
 
+pub mod axis;
 pub mod calibrate;
+pub mod contour;
 pub mod critical;
 pub mod design;
 pub mod error;
@@ -51,19 +53,20 @@ pub mod simulate;
 pub mod slope;
 pub mod terrain;
 
+pub use axis::{Axis, AxisScale};
 pub use calibrate::{
     calibrate_jointly, calibrate_jointly_with, invert_each_speed, AnchoringObservation, CalibrationError,
     CalibrationWarning, FittedParameter, FreeParameter, JointCalibration, JointSetup, Parameter, Quantity,
     RobotKey, ShearLaw, ShearShape, SpeedModel, SpeedObservation,
 };
+pub use contour::ContourSegment;
 pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
 pub use error::ParamError;
 pub use gait::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording, Upslope};
 pub use measure::{MeasureError, SlopeEstimate};
 pub use model::{predict, Prediction, G};
 pub use phase::{
-    write_phase, write_phase_rows, Axis, AxisScale, ContourSegment, PanelGround, PanelSummary, PhaseMap,
-    PhasePanel, RegimeCounts,
+    write_phase, write_phase_rows, PanelGround, PanelSummary, PhaseMap, PhasePanel, RegimeCounts,
 };
 pub use plan::{ElevationGrid, Objective, PlanSettings, Planner};
 pub use regime::{Cause, Regime};

@@ -13,12 +13,14 @@
 //! from the per-axis parts by [`PhaseMap::step`].
 //!
 //! The contour `s = s_min` (the boundary of the success region, drawn black in the paper) is
-//! extracted from the step field by marching squares in axis coordinates ([`contour_segments`]).
+//! extracted from the step field by marching squares in axis coordinates ([`crate::contour`]).
 
 use rayon::prelude::*;
 use serde::ser::{SerializeStruct, Serializer};
 use serde::Serialize;
 
+use crate::axis::Axis;
+use crate::contour::{contour_on_cells, contour_segments, ContourSegment};
 use crate::error::ParamError;
 use crate::model::{
     anchoring_time, backward_slip, level_step_length, normal_equilibrium_depth, shear_equilibrium_depth, G,
@@ -27,116 +29,6 @@ use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::slope::Slope;
 use crate::terrain::{Ground, Terrain};
-
-/// Spacing of grid values along an axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum AxisScale {
-    /// Evenly spaced values.
-    Linear,
-    /// Evenly spaced logarithms (the paper's phase diagrams are log-log).
-    Log,
-}
-
-/// The values of one grid axis: `n >= 2` points from `min` to `max` (both included).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Axis {
-    min: f64,
-    max: f64,
-    #[serde(rename = "points")]
-    n: usize,
-    scale: AxisScale,
-}
-
-impl Axis {
-    /// An axis of `n` values from `min` to `max`, named `key` in errors. Requires finite
-    /// `0 <= min < max`, `min > 0` on a log axis, and `n >= 2`.
-    pub fn new(key: &str, min: f64, max: f64, n: usize, scale: AxisScale) -> Result<Axis, ParamError> {
-        let lowest = match scale {
-            AxisScale::Linear => 0.0,
-            AxisScale::Log => f64::MIN_POSITIVE,
-        };
-        if !(min.is_finite() && min >= lowest) {
-            let expected = match scale {
-                AxisScale::Linear => "a finite number of at least 0",
-                AxisScale::Log => "a finite number greater than 0 on a log axis",
-            };
-            return Err(ParamError::new(format!("{key} min"), min, expected));
-        }
-        if !(max.is_finite() && max > min) {
-            return Err(ParamError::new(
-                format!("{key} max"),
-                max,
-                format!("finite and greater than min = {min}"),
-            ));
-        }
-        if n < 2 {
-            return Err(ParamError::new(format!("{key} points"), n as f64, "at least 2"));
-        }
-        Ok(Axis { min, max, n, scale })
-    }
-
-    /// Number of values.
-    pub fn len(&self) -> usize {
-        self.n
-    }
-
-    /// Always false: an axis has at least two values.
-    pub fn is_empty(&self) -> bool {
-        false
-    }
-
-    /// Smallest value.
-    pub fn min(&self) -> f64 {
-        self.min
-    }
-
-    /// Largest value.
-    pub fn max(&self) -> f64 {
-        self.max
-    }
-
-    /// Spacing.
-    pub fn scale(&self) -> AxisScale {
-        self.scale
-    }
-
-    /// The `i`-th value (`i < len`); the ends are exactly `min` and `max`.
-    pub fn value(&self, i: usize) -> f64 {
-        if i == 0 {
-            return self.min;
-        }
-        if i + 1 >= self.n {
-            return self.max;
-        }
-        let f = i as f64 / (self.n - 1) as f64;
-        match self.scale {
-            AxisScale::Linear => self.min + f * (self.max - self.min),
-            AxisScale::Log => (self.min.ln() + f * (self.max.ln() - self.min.ln())).exp(),
-        }
-    }
-
-    /// All values, ascending.
-    pub fn values(&self) -> Vec<f64> {
-        (0..self.n).map(|i| self.value(i)).collect()
-    }
-
-    /// The coordinate in which values are evenly spaced: the value itself, or its logarithm.
-    pub fn coordinate(&self, value: f64) -> f64 {
-        match self.scale {
-            AxisScale::Linear => value,
-            AxisScale::Log => value.ln(),
-        }
-    }
-
-    /// The inverse of [`Axis::coordinate`].
-    pub fn from_coordinate(&self, c: f64) -> f64 {
-        match self.scale {
-            AxisScale::Linear => c,
-            AxisScale::Log => c.exp(),
-        }
-    }
-}
 
 /// The k_s-only part of the net step at one grid row: `s = s* scale - drag - slip`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -196,10 +88,6 @@ impl RegimeCounts {
         self.sinkage + self.slippage + self.metastable + self.success
     }
 }
-
-/// A straight piece of a contour line on a map, from `.0` to `.1`, each point `(k_n, k_s)` in
-/// N/m^3 (distinct from the planner's route segments).
-pub type ContourSegment = ((f64, f64), (f64, f64));
 
 /// The regime of every cell of a `(k_n, k_s)` grid for one robot at one slope.
 ///
@@ -742,81 +630,10 @@ fn pack_codes(codes: &[u8], packed: &mut [u8]) {
     }
 }
 
-/// The contour `field = level` of a scalar field on the grid `x_axis x y_axis` (row-major,
-/// one row per y value), by marching squares with linear interpolation in axis coordinates
-/// (logarithms on log axes). Squares with a NaN corner are skipped; saddles are resolved by
-/// the mean of the four corners. Points are returned in axis values, not coordinates.
-pub fn contour_segments(x_axis: &Axis, y_axis: &Axis, field: &[f64], level: f64) -> Vec<ContourSegment> {
-    let (nx, ny) = (x_axis.len(), y_axis.len());
-    assert_eq!(field.len(), nx * ny, "field must have one value per grid cell");
-    let xi: Vec<usize> = (0..nx).collect();
-    let yj: Vec<usize> = (0..ny).collect();
-    contour_on_cells(x_axis, y_axis, &xi, &yj, |i, j| field[j * nx + i], level)
-}
-
-/// [`contour_segments`] over the sub-grid of the cells `xi x yj` (ascending indices into the
-/// axes), reading the field through `field(i, j)`: a figure traces its contour over the cells
-/// it draws, so tracing costs the same for 400 x 400 and 4096 x 4096 maps.
-pub fn contour_on_cells(
-    x_axis: &Axis,
-    y_axis: &Axis,
-    xi: &[usize],
-    yj: &[usize],
-    field: impl Fn(usize, usize) -> f64 + Sync,
-    level: f64,
-) -> Vec<ContourSegment> {
-    if xi.len() < 2 || yj.len() < 2 {
-        return Vec::new();
-    }
-    let xc: Vec<f64> = xi.iter().map(|&i| x_axis.coordinate(x_axis.value(i))).collect();
-    let yc: Vec<f64> = yj.iter().map(|&j| y_axis.coordinate(y_axis.value(j))).collect();
-    let at = |a: usize, b: usize| field(xi[a], yj[b]) - level;
-    let point = |x: f64, y: f64| (x_axis.from_coordinate(x), y_axis.from_coordinate(y));
-    (0..yj.len() - 1)
-        .into_par_iter()
-        .flat_map_iter(|j| {
-            let mut out = Vec::new();
-            for i in 0..xi.len() - 1 {
-                // Corners counter-clockwise from bottom-left: (i,j), (i+1,j), (i+1,j+1), (i,j+1).
-                let v = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
-                if v.iter().any(|x| x.is_nan()) {
-                    continue;
-                }
-                let p = [(xc[i], yc[j]), (xc[i + 1], yc[j]), (xc[i + 1], yc[j + 1]), (xc[i], yc[j + 1])];
-                // Crossing on edge k, between corners k and k+1.
-                let cross = |k: usize| {
-                    let (a, b) = (k, (k + 1) % 4);
-                    let t = v[a] / (v[a] - v[b]);
-                    let (pa, pb) = (p[a], p[b]);
-                    point(pa.0 + t * (pb.0 - pa.0), pa.1 + t * (pb.1 - pa.1))
-                };
-                let above: Vec<bool> = v.iter().map(|&x| x >= 0.0).collect();
-                let edges: Vec<usize> = (0..4).filter(|&k| above[k] != above[(k + 1) % 4]).collect();
-                match edges.len() {
-                    2 => out.push((cross(edges[0]), cross(edges[1]))),
-                    4 => {
-                        // Saddle: if the centre is on the side of corner 0, corner 0's region
-                        // connects through the centre, so the lines cut off corners 1 and 3.
-                        let centre_above = v.iter().sum::<f64>() / 4.0 >= 0.0;
-                        if centre_above == above[0] {
-                            out.push((cross(0), cross(1)));
-                            out.push((cross(2), cross(3)));
-                        } else {
-                            out.push((cross(3), cross(0)));
-                            out.push((cross(1), cross(2)));
-                        }
-                    }
-                    _ => {}
-                }
-            }
-            out
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::axis::AxisScale;
     use crate::critical::{critical_shear_strength, StepTarget};
     use crate::model::{anchoring_threshold_k_s, predict, sinkage_threshold_k_n, tests::paper_robot};
     use crate::terrain::Ground;
@@ -831,21 +648,6 @@ mod tests {
 
     fn map(robot: &Robot, slope: Slope, kn: &Axis, ks: &Axis) -> PhaseMap {
         PhaseMap::compute(robot, slope, None, kn, ks, &|| {})
-    }
-
-    #[test]
-    fn axes_hit_their_ends_and_space_evenly() {
-        let a = log_axis(1e3, 1e7, 5);
-        let v = a.values();
-        assert_eq!((v[0], v[4]), (1e3, 1e7));
-        for (x, e) in v.iter().zip([1e3, 1e4, 1e5, 1e6, 1e7]) {
-            assert!((x / e - 1.0).abs() < 1e-12, "{x} vs {e}");
-        }
-        let l = Axis::new("k", 0.0, 10.0, 11, AxisScale::Linear).unwrap();
-        assert!((l.value(3) - 3.0).abs() < 1e-12);
-        assert!(Axis::new("k", 0.0, 10.0, 11, AxisScale::Log).is_err());
-        assert!(Axis::new("k", 5.0, 5.0, 11, AxisScale::Linear).is_err());
-        assert_eq!(Axis::new("--k-n", 1.0, 5.0, 1, AxisScale::Linear).unwrap_err().key, "--k-n points");
     }
 
     /// Every cell agrees with `predict`, regime and step bit for bit, including on a slope,
@@ -1062,26 +864,6 @@ mod tests {
             checked += 1;
         }
         assert!(checked > 10, "only {checked} points checked");
-    }
-
-    #[test]
-    fn contour_of_a_known_field_is_a_circle() {
-        // f = x^2 + y^2 on a linear grid; the contour f = 1 is the unit circle.
-        let a = Axis::new("x", -2.0 + 2.0, 2.0 + 2.0, 81, AxisScale::Linear).unwrap();
-        let field: Vec<f64> = (0..81 * 81)
-            .map(|c| {
-                let (x, y) = (a.value(c % 81) - 2.0, a.value(c / 81) - 2.0);
-                x * x + y * y
-            })
-            .collect();
-        let seg = contour_segments(&a, &a, &field, 1.0);
-        assert!(seg.len() > 40);
-        for (p, q) in seg {
-            for (x, y) in [p, q] {
-                let r = ((x - 2.0).powi(2) + (y - 2.0).powi(2)).sqrt();
-                assert!((r - 1.0).abs() < 2e-3, "radius {r}");
-            }
-        }
     }
 
     #[test]

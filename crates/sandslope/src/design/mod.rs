@@ -21,10 +21,10 @@ use std::fmt;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::axis::AxisScale;
 use crate::critical::{critical_shear_strength, StepTarget};
 use crate::error::ParamError;
 use crate::model::predict;
-use crate::phase::AxisScale;
 use crate::regime::Regime;
 use crate::risk::limits::{safe_slope_search, ReportedPFail};
 use crate::risk::{p_fail, SafeLimit, UncertainTerrain};

@@ -15,6 +15,7 @@ mod tracks;
 
 use serde::Serialize;
 
+use crate::axis::{Axis, AxisScale};
 use crate::calibrate::SpeedObservation;
 use crate::calibrate::{
     calibrate_jointly, AnchoringObservation, FreeParameter, JointCalibration, JointSetup, Parameter,
@@ -24,7 +25,7 @@ use crate::error::ParamError;
 use crate::gait::track::TrackResult;
 use crate::model::{predict, Prediction};
 use crate::paper::{self, compare_with_paper, Basis, ComparisonContext, PaperComparison};
-use crate::phase::{Axis, AxisScale, PhasePanel};
+use crate::phase::PhasePanel;
 use crate::risk::{risk_curve, safe_slope_limit, RiskCurve, SafeLimit, UncertainTerrain};
 use crate::robot::Robot;
 use crate::slope::Slope;

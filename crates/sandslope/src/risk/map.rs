@@ -45,9 +45,10 @@ use serde::Serialize;
 
 use super::quadrature::{density, phi, regime_probabilities, Z_MAX};
 use super::uncertainty::Uncertainty;
+use crate::axis::Axis;
+use crate::contour::{contour_segments, ContourSegment};
 use crate::critical::ln_critical_closed_form;
 use crate::model::{level_step_length, normal_equilibrium_depth, sinkage_threshold_k_n};
-use crate::phase::{contour_segments, Axis, ContourSegment};
 use crate::robot::Robot;
 use crate::slope::Slope;
 use crate::terrain::Ground;

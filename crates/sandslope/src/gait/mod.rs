@@ -12,6 +12,7 @@
 pub mod direction;
 pub mod signal;
 pub mod steps;
+#[cfg(any(test, feature = "test-support"))]
 pub mod synthetic;
 pub mod track;
 

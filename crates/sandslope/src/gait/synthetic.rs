@@ -1,5 +1,7 @@
-//! A known speed profile for one step, repeated every `T/2`: for tests, benchmarks and
-//! examples that need a trajectory whose t1, slip, step and speed are known exactly.
+//! A known speed profile for one step, repeated every `T/2`: for tests and benchmarks that need
+//! a trajectory whose t1, slip, step and speed are known exactly. Test support, not the
+//! library's API: compiled for this crate's tests and with the `test-support` feature (which
+//! this crate's benches and the CLI's tests enable as a dev-dependency).
 //!
 //! The phases follow the paper's description of a stride (Results, Fig. 3b): touchdown at
 //! rest (`v = 0`), backward slip to a speed minimum `-V_s` at the anchoring time `t1`,

@@ -40,7 +40,12 @@ fn bench(c: &mut Criterion) {
     let planner = Planner::new(dunes(n, 0.25), None, &[terrain], &paper_robot(), PlanSettings::default())
         .expect("planner");
     let (start, goal) = (Cell { col: 30, row: n - 31 }, Cell { col: n - 31, row: 30 });
-    let ours = || planner.route(Objective::Time, start, goal, &|_| {}).expect("endpoints").expect("route");
+    let ours = || {
+        planner
+            .route(Objective::Time, start, goal, &|_| std::ops::ControlFlow::Continue(()))
+            .expect("endpoints")
+            .expect("route")
+    };
     // The same cost-to-go bound as the library's: straight-line distance times the smallest
     // time per horizontal metre in the pitch table, sec(pitch) / speed.
     let table = &planner.tables()[0];

@@ -488,6 +488,7 @@ pub fn compute(args: &PlanArgs, risk_map: bool, quiet: bool) -> Result<Planned> 
             }
             bar.set_position(n);
         }
+        std::ops::ControlFlow::Continue(())
     })
     .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
     for (_, bar) in bars.into_inner().unwrap_or_else(|e| e.into_inner()) {

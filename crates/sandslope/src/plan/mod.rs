@@ -192,6 +192,9 @@ pub enum PlanError {
         /// What is wrong with it.
         reason: &'static str,
     },
+    /// The caller's progress callback asked the search to stop (Ctrl-C in a front end).
+    #[error("stopped before the search finished")]
+    Stopped,
 }
 
 /// Why an objective found no route (reported as `found: false`, not as an error).

@@ -2,6 +2,8 @@
 //! route of each objective (the distance route always among them, as the naive baseline),
 //! and, if asked, the risk raster (docs/model.md §8, §9).
 
+use std::ops::ControlFlow;
+
 use rayon::prelude::*;
 use serde::ser::{SerializeMap, SerializeSeq};
 use serde::{Serialize, Serializer};
@@ -109,7 +111,8 @@ impl PlanResult {
 /// Plans `request` on `grid` for `robot`: builds the [`Planner`] (classes and terrains as
 /// [`Planner::new`]), checks start and goal, searches every objective in parallel, and
 /// computes the risk raster if asked. `progress(objective, settled, passable)` is called as
-/// each search settles cells (every 65 536), with the number of passable cells as its scale.
+/// each search settles cells (every 65 536), with the number of passable cells as its scale;
+/// returning `ControlFlow::Break(())` stops every search with [`PlanError::Stopped`].
 ///
 /// Errors when the grid, classes, start or goal are unusable; an objective without a route is
 /// `Err(NoRoute)` in [`PlanResult::routes`], not an error.
@@ -120,7 +123,7 @@ pub fn plan(
     robot: &Robot,
     settings: PlanSettings,
     request: &PlanRequest,
-    progress: &(dyn Fn(Objective, u64, u64) + Sync),
+    progress: &(dyn Fn(Objective, u64, u64) -> ControlFlow<()> + Sync),
 ) -> Result<PlanResult, PlanError> {
     let planner = Planner::new(grid, classes, terrains, robot, settings)?;
     planner.check_endpoint(request.start, "start")?;
@@ -133,9 +136,10 @@ pub fn plan(
     let routes = objectives
         .par_iter()
         .map(|&obj| {
-            let r = planner.route(obj, request.start, request.goal, &|n| progress(obj, n, passable));
-            progress(obj, passable, passable);
-            r.map(|r| (obj, r))
+            let r = planner.route(obj, request.start, request.goal, &|n| progress(obj, n, passable))?;
+            // Only the final position of the bar; a stop asked now changes nothing.
+            let _ = progress(obj, passable, passable);
+            Ok((obj, r))
         })
         .collect::<Result<Vec<_>, _>>()?;
     let risk = request.risk_map.then(|| {
@@ -190,7 +194,10 @@ mod tests {
             &paper_robot(),
             PlanSettings::default(),
             &request,
-            &|o, n, total| seen.lock().unwrap().push((o, n, total)),
+            &|o, n, total| {
+                seen.lock().unwrap().push((o, n, total));
+                ControlFlow::Continue(())
+            },
         )
         .unwrap();
         let objectives: Vec<Objective> = r.routes.iter().map(|(o, _)| *o).collect();
@@ -208,6 +215,39 @@ mod tests {
         assert_eq!(risk.p_fail.len(), 400);
         assert!(risk.p_fail[0].is_nan() && risk.p_fail[21].is_finite());
         assert_eq!(r.extrapolation, None);
+    }
+
+    /// A progress callback that asks to stop ends every search at its first report. A 400 x 400
+    /// level map cut by a column of missing heights (col 300) leaves the goal unreachable, so
+    /// the search would settle the whole west side (about 398 x 298 cells) before giving up;
+    /// told to stop at its first report (65 536 settled cells), it reports nothing more.
+    #[test]
+    fn a_progress_callback_can_stop_the_searches() {
+        const NODATA: f64 = -9999.0;
+        let n = 400;
+        let h: Vec<f64> = (0..n * n).map(|i| if i % n == 300 { NODATA } else { 0.0 }).collect();
+        let grid = ElevationGrid::from_heights(n, n, 1.0, 1.0, &h, Some(NODATA)).unwrap();
+        let seen = std::sync::Mutex::new(Vec::new());
+        let request = PlanRequest {
+            start: Cell { col: 1, row: 1 },
+            goal: Cell { col: 350, row: 200 },
+            objectives: vec![Objective::Distance],
+            risk_map: false,
+        };
+        let r = plan(
+            grid,
+            None,
+            &class(Terrain::constant(7e5, 2e6).unwrap()),
+            &paper_robot(),
+            PlanSettings::default(),
+            &request,
+            &|_, settled, _| {
+                seen.lock().unwrap().push(settled);
+                ControlFlow::Break(())
+            },
+        );
+        assert!(matches!(r, Err(PlanError::Stopped)), "{:?}", r.err());
+        assert_eq!(seen.into_inner().unwrap(), vec![65_536]);
     }
 
     /// The routes serialise as objects named by objective, a found route under `route` and a
@@ -229,7 +269,7 @@ mod tests {
             &paper_robot(),
             PlanSettings::default(),
             &request,
-            &|_, _, _| {},
+            &|_, _, _| ControlFlow::Continue(()),
         )
         .unwrap();
         let no_route = *r.route(Objective::Time).unwrap().as_ref().unwrap_err();
@@ -273,7 +313,7 @@ mod tests {
                 &paper_robot(),
                 PlanSettings::default(),
                 &request(start),
-                &|_, _, _| {},
+                &|_, _, _| ControlFlow::Continue(()),
             )
         };
         let e = run(Cell { col: 0, row: 10 }).unwrap_err().to_string();

@@ -21,6 +21,8 @@
 //! 6.6-6.9 s, the packed node to 5.8-6.4 s and the prefetch to 4.9-5.6 s (single runs on the
 //! 2-core VM).
 
+use std::ops::ControlFlow;
+
 use rayon::prelude::*;
 
 use super::grid::{Cell, ElevationGrid};
@@ -380,7 +382,9 @@ impl Planner {
     }
 
     /// The route minimising `objective` from `start` to `goal`, by A*. `progress` is called
-    /// with the number of cells settled so far, every 65 536 cells.
+    /// with the number of cells settled so far, every 65 536 cells; returning
+    /// `ControlFlow::Break(())` stops the search with [`PlanError::Stopped`] (how a front end
+    /// honours Ctrl-C).
     ///
     /// Errors when start or goal is outside the map or unusable (see
     /// [`Planner::check_endpoint`]); `Ok(Err(NoRoute))` when they are valid but not joined.
@@ -389,7 +393,7 @@ impl Planner {
         objective: Objective,
         start: Cell,
         goal: Cell,
-        progress: &(dyn Fn(u64) + Sync),
+        progress: &(dyn Fn(u64) -> ControlFlow<()> + Sync),
     ) -> Result<Result<Route, NoRoute>, PlanError> {
         let s = self.check_endpoint(start, "start")?;
         let t = self.check_endpoint(goal, "goal")?;
@@ -399,7 +403,8 @@ impl Planner {
         if let Some(blocked) = self.blocked_end(objective, s, t) {
             return Ok(Err(blocked));
         }
-        Ok(self.search(objective, s, t, progress).map(|cells| self.route_from_cells(objective, cells)))
+        let cells = self.search(objective, s, t, progress).ok_or(PlanError::Stopped)?;
+        Ok(cells.map(|cells| self.route_from_cells(objective, cells)))
     }
 
     /// Why no route can exist before searching: no passable edge leaves the start, or none
@@ -420,25 +425,27 @@ impl Planner {
 
     /// The cells of the cheapest path from `s` to `t`, by label-correcting A* ([`Search`]):
     /// take the next cell to expand, start loading the one after it, relax its edges; then
-    /// walk the predecessors back from the goal.
+    /// walk the predecessors back from the goal. `None` when `progress` asked to stop.
     fn search(
         &self,
         objective: Objective,
         s: usize,
         t: usize,
-        progress: &(dyn Fn(u64) + Sync),
-    ) -> Result<Vec<usize>, NoRoute> {
+        progress: &(dyn Fn(u64) -> ControlFlow<()> + Sync),
+    ) -> Option<Result<Vec<usize>, NoRoute>> {
         let mut search = Search::new(self, objective, s, t);
         while let Some((u, du, gu)) = search.next_cell() {
             search.prefetch_next();
             search.settled += 1;
-            if search.settled & 0xFFFF == 0 {
-                progress(search.settled);
+            if search.settled & 0xFFFF == 0 && progress(search.settled).is_break() {
+                return None;
             }
             search.relax_edges(u, du, gu);
         }
-        progress(search.settled);
-        search.path()
+        if progress(search.settled).is_break() {
+            return None;
+        }
+        Some(search.path())
     }
 }
 
@@ -707,7 +714,7 @@ mod tests {
         let p = Planner::new(bumpy(40), None, &class(), &paper_robot(), PlanSettings::default()).unwrap();
         let (s, t) = (Cell { col: 2, row: 37 }, Cell { col: 36, row: 3 });
         for obj in Objective::ALL {
-            let r = p.route(obj, s, t, &|_| {}).unwrap().unwrap();
+            let r = p.route(obj, s, t, &|_| ControlFlow::Continue(())).unwrap().unwrap();
             let want = reference_cost(&p, obj, p.grid.index(s).unwrap(), p.grid.index(t).unwrap()).unwrap();
             let got = route_cost(&p, &r);
             assert!((got - want).abs() <= 1e-9 * want, "{obj:?}: {got} vs {want}");
@@ -756,7 +763,7 @@ mod tests {
                 };
                 for obj in Objective::ALL {
                     let want = if si == ti { Some(0.0) } else { reference_cost(&p, obj, si, ti) };
-                    match (p.route(obj, s, t, &|_| {}).unwrap(), want) {
+                    match (p.route(obj, s, t, &|_| ControlFlow::Continue(())).unwrap(), want) {
                         (Ok(r), Some(w)) => {
                             let got = route_cost(&p, &r);
                             assert!((got - w).abs() <= 1e-9 * w, "{obj:?} {s:?}->{t:?}: {got} vs {w}");
@@ -777,7 +784,9 @@ mod tests {
     #[test]
     fn edges_are_the_graph_the_route_is_costed_on() {
         let p = Planner::new(bumpy(40), None, &class(), &paper_robot(), PlanSettings::default()).unwrap();
-        let r = p.route(Objective::Time, Cell { col: 2, row: 37 }, Cell { col: 36, row: 3 }, &|_| {});
+        let r = p.route(Objective::Time, Cell { col: 2, row: 37 }, Cell { col: 36, row: 3 }, &|_| {
+            ControlFlow::Continue(())
+        });
         let r = r.unwrap().unwrap();
         // Summing the route's edges as `edges` reports them gives the route's time.
         let total: f64 =
@@ -801,7 +810,9 @@ mod tests {
         }
         let g = ElevationGrid::new(n, n, 1.0, 1.0, vec![0.0; n * n], Some(&mask)).unwrap();
         let mut p = Planner::new(g, None, &class(), &paper_robot(), PlanSettings::default()).unwrap();
-        let r = p.route(Objective::Distance, Cell { col: 3, row: 10 }, Cell { col: 17, row: 10 }, &|_| {});
+        let r = p.route(Objective::Distance, Cell { col: 3, row: 10 }, Cell { col: 17, row: 10 }, &|_| {
+            ControlFlow::Continue(())
+        });
         let r = r.unwrap().unwrap();
         for c in &r.cells {
             // Neither nodata nor within one cell of it (no Horn gradient there).
@@ -834,7 +845,9 @@ mod tests {
         let p = Planner::new(g, None, &[certain], &paper_robot(), settings).unwrap();
         assert_eq!(p.tables()[0].p_fail(0), 0.0);
         let r = p
-            .route(Objective::Risk, Cell { col: 3, row: 3 }, Cell { col: 25, row: 14 }, &|_| {})
+            .route(Objective::Risk, Cell { col: 3, row: 3 }, Cell { col: 25, row: 14 }, &|_| {
+                ControlFlow::Continue(())
+            })
             .unwrap()
             .unwrap();
         assert_eq!(r.survival, 1.0);
@@ -849,7 +862,9 @@ mod tests {
         let p = Planner::new(g, None, &class(), &paper_robot(), PlanSettings::default()).unwrap();
         // (3, 3) to (25, 14): 22 columns, 11 rows = 11 knight moves (2, 1), exactly straight.
         let r = p
-            .route(Objective::Time, Cell { col: 3, row: 3 }, Cell { col: 25, row: 14 }, &|_| {})
+            .route(Objective::Time, Cell { col: 3, row: 3 }, Cell { col: 25, row: 14 }, &|_| {
+                ControlFlow::Continue(())
+            })
             .unwrap()
             .unwrap();
         let straight = 0.5 * (22.0_f64).hypot(11.0);
@@ -870,7 +885,9 @@ mod tests {
         let g = ElevationGrid::new(n, n, 1.0, 1.0, z, None).unwrap();
         let p = Planner::new(g, None, &class(), &paper_robot(), PlanSettings::default()).unwrap();
         let r = p
-            .route(Objective::Time, Cell { col: 2, row: 2 }, Cell { col: 10, row: 2 }, &|_| {})
+            .route(Objective::Time, Cell { col: 2, row: 2 }, Cell { col: 10, row: 2 }, &|_| {
+                ControlFlow::Continue(())
+            })
             .unwrap()
             .unwrap();
         // The cells beside the wall (columns 5 and 7) have a gradient of 1.5e38: impassable

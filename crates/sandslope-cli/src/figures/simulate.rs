@@ -485,7 +485,10 @@ mod tests {
         let s = Scenario::new(robot, Terrain::constant(7e5, 2e6).unwrap(), None, None).unwrap();
         let sim = simulate(&s, 15.0, &SimSettings::new(2.0).unwrap()).unwrap();
         let anim = Animation { sim: &sim, slope_deg: 15.0 };
-        let dir = std::env::temp_dir();
+        // A directory of its own: concurrent test runs (two checkouts) shared fixed names in
+        // /tmp and removed each other's files.
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
         for i in [30usize, 54] {
             let path = dir.join(format!("sandslope-sim-frame{i}.png"));
             {
@@ -501,6 +504,5 @@ mod tests {
         save_gif(&gif, &anim).unwrap();
         let bytes = std::fs::read(&gif).unwrap();
         assert_eq!(&bytes[..6], b"GIF89a");
-        let _ = std::fs::remove_file(gif);
     }
 }

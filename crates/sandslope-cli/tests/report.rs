@@ -110,6 +110,11 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
             }
             None => assert!(r["observed_m_s"].is_null()),
         }
+        // The closed form's slip is 1/2 g sin(theta) t1^2 (docs/model.md §5), by hand here.
+        if let (Some(t1), Some(slip)) = (r["closed_form_t1_s"].as_f64(), r["closed_form_slip_m"].as_f64()) {
+            let by_hand = 0.5 * 9.81 * r["slope_deg"].as_f64().unwrap().to_radians().sin() * t1 * t1;
+            assert!((slip - by_hand).abs() <= 1e-9 + 1e-6 * by_hand, "{r}");
+        }
         if !r["pitch_over_s"].is_null() {
             assert_eq!(r["agree"], false);
             assert_eq!(r["simulated_cause"], "pitch_over");
@@ -122,7 +127,17 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
     )
     .unwrap();
     assert_eq!(sim[0]["simulated_m_s"], walk["speed_m_s"]);
+    for (col, key) in
+        [("simulated_t1_s", "t1_s"), ("simulated_slip_m", "slip_m"), ("simulated_step_m", "step_m")]
+    {
+        assert_eq!(sim[0][col], walk[key], "{col}");
+    }
+    assert_eq!(sim[0]["closed_form_step_m"], walk["closed_form"]["step_m"]);
     assert!(html.contains("The stride simulator against the closed form"));
+    // The simulator's joint fit costs about 90 s of CPU: left out unless asked for, and the page
+    // names the flag that adds it.
+    assert!(v["simulator_fit"].is_null());
+    assert!(html.contains("<code>sandslope report --simulator-fit</code> adds it"));
     // Every disagreement in the JSON is on the page.
     for d in v["disagreements"].as_array().unwrap() {
         let text = d.as_str().unwrap().replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");

@@ -21,9 +21,9 @@ use crate::{anyhow_error, value_error};
 /// so the dict equals the file's, lists and nulls alike). `robot_source` and
 /// `terrain_source` name the robot and terrain as the inputs table shows them; without
 /// `forces`, the built-in terrain is reported with the paper's force tests. `tracks`: one
-/// `(slope_deg, paths)` per slope.
+/// `(slope_deg, paths)` per slope; `simulator_fit`: also the simulator's joint fit (about 90 s).
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, robot_source, terrain_source, observed=None, forces=None, t1=None, tracks=None, tracks_format=None, tracks_body=None, tracks_upslope=None, max_risk=0.05))]
+#[pyo3(signature = (robot, terrain, robot_source, terrain_source, observed=None, forces=None, t1=None, tracks=None, tracks_format=None, tracks_body=None, tracks_upslope=None, max_risk=0.05, simulator_fit=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn report(
     py: Python<'_>,
@@ -39,6 +39,7 @@ pub fn report(
     tracks_body: Option<String>,
     tracks_upslope: Option<[f64; 3]>,
     max_risk: f64,
+    simulator_fit: bool,
 ) -> PyResult<String> {
     if !(max_risk > 0.0 && max_risk < 1.0) {
         return Err(value_error(format!(
@@ -83,6 +84,7 @@ pub fn report(
                     upslope: tracks_upslope.map(|u| Upslope::new(u).map_or(u, |u| u.vector())),
                 },
                 max_risk,
+                simulator_fit,
                 builtin_robot: is_default(&robot_source, PresetKind::Robot),
                 builtin_terrain: is_default(&terrain_source, PresetKind::Terrain),
                 robot,

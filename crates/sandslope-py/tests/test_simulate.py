@@ -38,3 +38,44 @@ def test_bad_input_is_a_value_error_naming_the_value_and_range(cli):
     robot = sandslope.Robot(**{**sandslope.Robot.preset("paper-hexapod").to_dict(), "leg_elements": 8})
     _, m = sandslope.simulate(robot, "glass-beads-300um", 0, 2)
     assert m["leg_elements"] == 8 and math.isfinite(m["speed_m_s"])
+
+
+def test_stiff_level_sand_steps_the_rigid_rolling_step():
+    # A physical limit worked out by hand (docs/simulate.md, "On level sand the legs roll"): on
+    # sand so stiff that the legs barely sink (k_n = k_s = 1e8 N/m^3, d_n = 0.03 mm) a C-leg of
+    # radius R = 0.04 m with the belly h = 0.03 m below the hips rolls on its arc from
+    # touchdown (phi0 = asin((h - R)/R)) until its tip points down, then pivots on its tip until
+    # the belly lands: R (pi/2 - phi0) + R cos(phi0) + 2R sqrt(1 - (h/2R)^2) = 185.8 mm per
+    # step, more than twice the closed form's s* = 2 sqrt(R^2 - (h - R)^2) = 77.5 mm.
+    r, h = 0.04, 0.03
+    phi0 = math.asin((h - r) / r)
+    rolling = r * (math.pi / 2 - phi0) + r * math.cos(phi0) + 2 * r * math.sqrt(1 - (h / (2 * r)) ** 2)
+    traj, m = sandslope.simulate("paper-hexapod", "glass-beads-300um", 0, 2.5, k_n=1e8, k_s=1e8, yield_m=1e-4)
+    assert m["step_m"] == pytest.approx(rolling, rel=0.03)
+    assert m["closed_form"]["level_step_m"] == pytest.approx(2 * math.sqrt(r * r - (h - r) ** 2), rel=1e-3)
+    # The body vaults: at the tip's pivot the axle line is up to 2R above the sand.
+    assert traj["z_m"].max() == pytest.approx(2 * r, rel=0.03)
+
+
+def test_simulate_releases_the_gil():
+    import threading
+    import time
+
+    done = threading.Event()
+    elapsed = []
+
+    def heavy():
+        t = time.perf_counter()
+        sandslope.simulate("paper-hexapod", "glass-beads-300um", 10, 150, sample_rate_hz=10)
+        elapsed.append(time.perf_counter() - t)
+        done.set()
+
+    ticks = 0
+    th = threading.Thread(target=heavy)
+    th.start()
+    while not done.is_set():
+        time.sleep(0.002)
+        ticks += 1
+    th.join()
+    # Holding the GIL for the whole walk would leave this thread a handful of wake-ups at most.
+    assert ticks >= 0.05 * elapsed[0] / 0.002 and ticks > 10, (ticks, elapsed)

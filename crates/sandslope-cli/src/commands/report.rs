@@ -71,6 +71,12 @@ pub struct ReportArgs {
     /// used. Without it such a report exits 0 and prints the warnings on stderr.
     #[arg(long)]
     pub strict: bool,
+    /// Also fit the evidence with the stride simulator in place of the closed form
+    /// (`calibrate --model simulate`) and show the two fits side by side. Left out by default:
+    /// its tens of thousands of walks take about 90 s of CPU on the paper's evidence, where the
+    /// rest of the report takes under a second (docs/simulate.md).
+    #[arg(long)]
+    pub simulator_fit: bool,
     #[command(flatten)]
     pub level: LevelStepArgs,
     #[command(flatten)]
@@ -199,6 +205,7 @@ fn evidence(args: &ReportArgs) -> Result<Evidence> {
             upslope: args.tracks_upslope.map(|u| u.vector()),
         },
         max_risk: args.max_risk,
+        simulator_fit: args.simulator_fit,
         builtin_robot: is_default(&args.robot.robot, PresetKind::Robot),
         builtin_terrain: is_default(&args.terrain.terrain, PresetKind::Terrain),
         robot,

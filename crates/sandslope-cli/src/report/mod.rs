@@ -74,6 +74,7 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
     }
     h.push_str(&sections::step_budget(report));
     h.push_str(&sections::simulator(report));
+    h.push_str(&sections::simulator_fit(report));
     let tracks = TracksSection { records: &report.tracks, notes: &report.track_notes };
     if !tracks.records.is_empty() {
         h.push_str(&tracks_section(&tracks));

@@ -655,6 +655,7 @@ def report(
     tracks_body: Optional[str] = None,
     tracks_upslope: Optional[Sequence[float]] = None,
     max_risk: float = 0.05,
+    simulator_fit: bool = False,
 ) -> Dict[str, Any]:
     """The paper reproduced and confronted (``sandslope report``), as ``report.json``'s dict.
 
@@ -663,6 +664,8 @@ def report(
     terrain file with ``k_s_sd``), ``t1`` (anchoring-time CSV) and ``tracks``
     (``{slope_deg: path or [paths]}`` of motion-capture recordings, read as :func:`track` reads
     them) make it a report on your own campaign, as the CLI's flags of the same names.
+    ``simulator_fit=True`` (``report --simulator-fit``) adds the stride simulator's joint fit of
+    the same evidence (``simulator_fit``; about 90 s of CPU on the paper's evidence).
 
     Returns exactly the keys and values of ``report.json`` (README.md, ``sandslope report``): ``figures``,
     ``speeds``, ``tracks``, ``calibration``, ``paper_vs_model``, ``disagreements``, ``inputs``.
@@ -689,6 +692,7 @@ def report(
         tracks_body=tracks_body,
         tracks_upslope=None if tracks_upslope is None else [float(v) for v in tracks_upslope],
         max_risk=float(max_risk),
+        simulator_fit=bool(simulator_fit),
     )
     return json.loads(text)
 

@@ -188,6 +188,7 @@ def report(
     tracks_body: Optional[str] = None,
     tracks_upslope: Optional[List[float]] = None,
     max_risk: float = 0.05,
+    simulator_fit: bool = False,
 ) -> str: ...
 def simulate(
     robot: Robot,

@@ -18,8 +18,8 @@ use serde::Serialize;
 use crate::axis::{Axis, AxisScale};
 use crate::calibrate::SpeedObservation;
 use crate::calibrate::{
-    calibrate_jointly, AnchoringObservation, FreeParameter, JointCalibration, JointSetup, Parameter,
-    ShearShape,
+    calibrate_jointly, calibrate_jointly_with, AnchoringObservation, FreeParameter, JointCalibration,
+    JointSetup, Parameter, ShearShape, SpeedModel,
 };
 use crate::error::ParamError;
 use crate::gait::track::TrackResult;
@@ -102,6 +102,10 @@ pub struct Evidence {
     /// The terrain is the built-in glass-beads-300um (the joint calibration on the paper's
     /// speeds and force-test ratio).
     pub builtin_terrain: bool,
+    /// Also fit the evidence with the stride simulator in place of the closed form
+    /// (`report --simulator-fit`, [`Report::simulator_fit`]): about 90 s of CPU on the paper's
+    /// evidence, where the rest of the report takes under a second, so it is asked for.
+    pub simulator_fit: bool,
 }
 
 impl Evidence {
@@ -217,6 +221,11 @@ pub struct Report {
     /// The stride simulator beside the closed form and the observations, slope by slope, with
     /// where and why the two part (docs/simulate.md).
     pub simulator: Vec<SimulatorRecord>,
+    /// The same joint calibration with the stride simulator in place of the closed form
+    /// (`calibrate --model simulate`), beside [`Report::calibration`]; `null` unless asked for
+    /// ([`Evidence::simulator_fit`]: its tens of thousands of walks take about 90 s of CPU) or
+    /// when it failed (then a warning says why).
+    pub simulator_fit: Option<JointCalibration>,
     /// What the report was made from, each with its provenance.
     pub inputs: Vec<Input>,
     /// Sentences on how the tracks entered the report (skipped t1s, speeds not used, ...).
@@ -299,6 +308,17 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
             .collect(),
     };
     let calibration = calibrate(evidence, &speeds, &anchoring);
+    let (simulator_fit, simulator_fit_failure) = if evidence.simulator_fit {
+        match calibrate_jointly_with(
+            &joint_setup(evidence, &speeds, &anchoring),
+            SpeedModel::simulator_for_fit(),
+        ) {
+            Ok(fit) => (Some(fit), None),
+            Err(e) => (None, Some(format!("the simulator's joint fit failed: {e}"))),
+        }
+    } else {
+        (None, None)
+    };
     let (robot, terrain) = model(evidence, calibration.as_ref())?;
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
     // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...): a
@@ -345,6 +365,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         .collect();
     let mut warnings = track_use.warnings;
     warnings.extend(simulator_refusal);
+    warnings.extend(simulator_fit_failure);
     if let Some(c) = &calibration {
         warnings.extend(disagreements::calibration_warnings(c));
     }
@@ -368,6 +389,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         extrapolations,
         step_budget,
         simulator,
+        simulator_fit,
         inputs: provenance::inputs(evidence, !track_use.anchoring.is_empty()),
         track_notes: track_use.notes,
         warnings,
@@ -388,16 +410,15 @@ fn model(
     }
 }
 
-/// The joint calibration of the force tests' (or the terrain's) k_s shape on the evidence,
-/// `plate_scale` and the model-error floor free (docs/calibration.md); `None` if it fails.
-fn calibrate(
+/// The report's joint calibration problem: the force tests' (or the terrain's) k_s shape on
+/// the evidence, `plate_scale` and the model-error floor free (docs/calibration.md).
+fn joint_setup(
     evidence: &Evidence,
     speeds: &[SpeedObservation],
     anchoring: &[AnchoringObservation],
-) -> Option<ReportCalibration> {
+) -> JointSetup {
     let shape = evidence.forces.table().unwrap_or(&evidence.terrain).clone();
-    let no_floor = audit::no_floor_fit(&evidence.robot, &shape, speeds, anchoring);
-    let setup = JointSetup {
+    JointSetup {
         robot: evidence.robot.clone(),
         normal: shape.clone(),
         shear: ShearShape::ForceTests(shape),
@@ -408,7 +429,17 @@ fn calibrate(
             .map(|parameter| FreeParameter { parameter, bounds: None })
             .collect(),
         error_floor: 0.0,
-    };
+    }
+}
+
+/// The joint calibration of [`joint_setup`] by the closed form; `None` if it fails.
+fn calibrate(
+    evidence: &Evidence,
+    speeds: &[SpeedObservation],
+    anchoring: &[AnchoringObservation],
+) -> Option<ReportCalibration> {
+    let setup = joint_setup(evidence, speeds, anchoring);
+    let no_floor = audit::no_floor_fit(&evidence.robot, &setup.normal, speeds, anchoring);
     let fit = calibrate_jointly(&setup).ok()?;
     let goodness_of_fit = match no_floor.and_then(|n| n.p_value.map(|p| (n, p))) {
         Some((n, p)) => format!(
@@ -582,6 +613,7 @@ mod tests {
             max_risk: 0.05,
             builtin_robot: false,
             builtin_terrain: false,
+            simulator_fit: false,
         }
     }
 

@@ -38,6 +38,19 @@ pub struct SimulatorRecord {
     pub simulated_cause: MotionCause,
     /// The closed form's regime.
     pub closed_form_regime: Regime,
+    /// The simulator's mean anchoring time over the measured steps that anchored, s (`null`:
+    /// no step anchored).
+    pub simulated_t1_s: Option<f64>,
+    /// The closed form's anchoring time t1, s (`null`: it does not anchor).
+    pub closed_form_t1_s: Option<f64>,
+    /// The simulator's mean backward slip before anchoring, m.
+    pub simulated_slip_m: Option<f64>,
+    /// The closed form's slip `1/2 g sin(theta) t1^2`, m.
+    pub closed_form_slip_m: Option<f64>,
+    /// The simulator's mean net step, m.
+    pub simulated_step_m: f64,
+    /// The closed form's net step s, m.
+    pub closed_form_step_m: Option<f64>,
     /// Largest |pitch| of the simulated body, degrees.
     pub max_pitch_deg: f64,
     /// When the simulated body pitched past 90 degrees, s (`null`: it did not).
@@ -74,20 +87,21 @@ pub fn simulator_section(
         crate::simulate::SimulateError::Param(p) => p,
     })?;
     let summaries: Vec<SimSummary> = sims.into_iter().map(|s| s.summary).collect();
+    let rolling = crate::simulate::rigid_rolling_step(robot);
     let records = summaries
         .iter()
         .map(|m| {
             let observed = speeds.iter().find(|o| (o.slope.degrees() - m.slope_deg).abs() < 1e-9);
-            record(m, observed)
+            record(m, observed, rolling)
         })
         .collect();
     Ok((records, summaries))
 }
 
-fn record(m: &SimSummary, observed: Option<&SpeedObservation>) -> SimulatorRecord {
+fn record(m: &SimSummary, observed: Option<&SpeedObservation>, rolling: f64) -> SimulatorRecord {
     let cf = m.closed_form.speed();
     let cf_regime = m.closed_form.prediction.regime;
-    let (agree, why) = reason(m, cf, cf_regime);
+    let (agree, why) = reason(m, cf, cf_regime, rolling);
     SimulatorRecord {
         slope_deg: m.slope_deg,
         observed_m_s: observed.map(|o| o.speed),
@@ -97,6 +111,12 @@ fn record(m: &SimSummary, observed: Option<&SpeedObservation>) -> SimulatorRecor
         simulated_regime: m.regime,
         simulated_cause: m.cause,
         closed_form_regime: cf_regime,
+        simulated_t1_s: m.t1_s,
+        closed_form_t1_s: m.closed_form.prediction.anchoring_time,
+        simulated_slip_m: m.slip_m,
+        closed_form_slip_m: m.closed_form.prediction.slip,
+        simulated_step_m: m.step_m,
+        closed_form_step_m: m.closed_form.prediction.step,
         max_pitch_deg: m.max_pitch_deg,
         pitch_over_s: m.pitch_over_s,
         agree,
@@ -104,15 +124,13 @@ fn record(m: &SimSummary, observed: Option<&SpeedObservation>) -> SimulatorRecor
     }
 }
 
-/// Whether simulator and closed form agree at one slope, and the reason they part
-/// (docs/simulate.md names the mechanisms).
-fn reason(m: &SimSummary, cf: Option<f64>, cf_regime: Regime) -> (bool, String) {
+/// Whether simulator and closed form agree at one slope, and the reason they part, short: the
+/// page's paragraph above the table and docs/simulate.md explain each mechanism once.
+fn reason(m: &SimSummary, cf: Option<f64>, cf_regime: Regime, rolling: f64) -> (bool, String) {
     if let Some(t) = m.pitch_over_s {
         return (
             false,
-            format!(
-                "the simulated body pitched over (past 90° at t = {t:.2} s): a failure the closed form, which has no body pitch, cannot show"
-            ),
+            format!("tumbled: the body pitched past 90° at t = {t:.2} s (the closed form has no pitch)"),
         );
     }
     let sim = m.speed_m_s;
@@ -120,7 +138,7 @@ fn reason(m: &SimSummary, cf: Option<f64>, cf_regime: Regime) -> (bool, String) 
         None => (
             m.regime == cf_regime,
             format!(
-                "the closed form rules a speed out ({}); the simulator's walk is {} ({})",
+                "the closed form rules a speed out ({}); the simulated walk is {} ({})",
                 cf_regime.name(),
                 m.regime.name(),
                 m.cause.name()
@@ -129,21 +147,39 @@ fn reason(m: &SimSummary, cf: Option<f64>, cf_regime: Regime) -> (bool, String) 
         Some(c) => {
             let rel = (sim - c) / c.abs().max(1e-12);
             let same = m.regime == cf_regime;
+            let s_star = m.closed_form.prediction.level_step;
             if rel.abs() <= AGREE_WITHIN {
                 (same, format!("within {:.0}% ({:+.0}%)", AGREE_WITHIN * 100.0, rel * 100.0))
             } else if rel > 0.0 {
                 (
                     false,
                     format!(
-                        "simulated {:+.0}%: the simulated legs grip and the body vaults over them, a longer step than the closed form's s*, whose leg slides along its own circle",
-                        rel * 100.0
+                        "legs roll, body vaults ({:+.0}%): step {:.2} × the rigid rolling {}, {:.1} × s* = {}",
+                        rel * 100.0,
+                        m.step_m / rolling,
+                        mm(Some(rolling)),
+                        m.step_m / s_star,
+                        mm(Some(s_star))
                     ),
                 )
             } else {
-                (false, format!("simulated {:+.0}%: not yet explained (docs/simulate.md)", rel * 100.0))
+                (
+                    false,
+                    format!(
+                        "slower by {:.0}%: slip before anchoring {} against {}; not yet explained",
+                        -rel * 100.0,
+                        mm(m.slip_m),
+                        mm(m.closed_form.prediction.slip)
+                    ),
+                )
             }
         }
     }
+}
+
+/// A length in millimetres for the reasons, `none` where undefined.
+fn mm(v: Option<f64>) -> String {
+    v.map_or("none".into(), |v| format!("{:.1} mm", v * 1e3))
 }
 
 #[cfg(test)]

@@ -344,6 +344,21 @@ pub fn integration_step(scenario: &Scenario, slope: Slope, given: Option<f64>) -
     }
 }
 
+/// The step of a C-leg that rolls on rigid ground, m (docs/simulate.md, "On level sand the
+/// legs roll"): per stance of half a turn the leg rolls on its arc from touchdown until its tip
+/// points straight down (the C's circle centre moves `R (pi/2 - phi0)`, the hip `R cos(phi0)`
+/// more, from behind the centre to above it), then pivots on its tip until the belly lands
+/// (the hip moves `2R sqrt(1 - (h / 2R)^2)`), with `phi0 = asin((h - R)/R)`. The limit the
+/// simulated step tends to on stiff level sand; the closed form's s* is the step of a leg that
+/// slides along its own fixed circle instead.
+pub fn rigid_rolling_step(robot: &crate::robot::Robot) -> f64 {
+    let (r, h) = (robot.leg_radius(), robot.hip_height());
+    let phi0 = robot.touchdown_angle();
+    let rolling = r * (std::f64::consts::FRAC_PI_2 - phi0) + r * phi0.cos();
+    let pivot = 2.0 * r * (1.0 - (h / (2.0 * r)).powi(2)).max(0.0).sqrt();
+    rolling + pivot
+}
+
 /// Most legs per tripod the simulator takes (a 128-legged robot).
 pub const MAX_STANCE_LEGS: u32 = 64;
 

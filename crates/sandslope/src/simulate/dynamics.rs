@@ -323,6 +323,16 @@ impl Walker {
             let rel = [cp * p[0] - sp * p[1], sp * p[0] + cp * p[1]];
             ([q[0] + rel[0], q[1] + rel[1]], [v[0] - v[2] * rel[1], v[1] + v[2] * rel[0]])
         };
+        // The belly is a straight plate: its lowest point is one of its ends. With both ends
+        // more than 1e-12 m above the surface (far above the nodes' round-off) every node is
+        // above it, and every element would feel nothing: skipped, the same forces bit for bit
+        // (perf: the belly is out of the sand most of a walk, and its eight elements were
+        // placed every step).
+        let end_height = |p: [f64; 2]| q[1] + (sp * p[0] + cp * p[1]);
+        if end_height(self.belly[0]).min(end_height(self.belly[BELLY_ELEMENTS])) > 1e-12 {
+            self.touching[base..].fill(false);
+            return;
+        }
         for k in 0..BELLY_ELEMENTS {
             let (a, va) = point(self.belly[k]);
             let (b, vb) = point(self.belly[k + 1]);

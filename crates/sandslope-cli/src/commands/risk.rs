@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use sandslope::risk::{
     payload_envelope, risk_curve, safe_mass, safe_slope, safe_slope_limit, DefaultsUsed, PayloadEnvelope,
-    RiskCurve, RiskMap, RiskMapSummary, RiskPoint, SafeLimit, SafeMass, UncertainTerrain,
+    RiskAnswer, RiskCurve, RiskMap, RiskMapSummary, RiskPoint, SafeLimit, SafeMass, UncertainTerrain,
 };
 use sandslope::{Robot, Slope};
 
@@ -209,7 +209,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
             if let Some(path) = &args.plot {
                 save(path, &EnvelopeFigure::new(&env, &robot_title(&robot, &terrain)))?;
             }
-            return print_envelope(&env, format);
+            return print_envelope(env, format);
         }
         Some(Solve::Mass) => {
             note_defaults(terrain.defaults_used_at(slope_of(slopes[0])?));
@@ -219,7 +219,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
                 draw_curve(&args, &robot, &terrain, &slopes, max_risk, &s_limit, json)?;
             }
             return match format {
-                Format::Json => print_json(&sol),
+                Format::Json => print_json(&RiskAnswer::Mass(Box::new(sol))),
                 Format::Csv => {
                     print!("{}", csv_string(&[mass_row(&sol)])?);
                     Ok(())
@@ -237,7 +237,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
                 draw_curve(&args, &robot, &terrain, &slopes, max_risk, &sol.limit, json)?;
             }
             return match format {
-                Format::Json => print_json(&sol),
+                Format::Json => print_json(&RiskAnswer::Slope(Box::new(sol))),
                 Format::Csv => {
                     #[derive(Serialize)]
                     struct Row {
@@ -268,27 +268,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
     if let (Some(limit), Some(_)) = (&limit, &args.plot) {
         draw_curve(&args, &robot, &terrain, &slopes, max_risk, limit, json)?;
     }
-    print_curve(&curve, limit.as_ref(), max_risk, format)
-}
-
-/// What `risk --json` prints, one shape per mode: one slope's [`RiskPoint`], several slopes'
-/// points, the safe-slope limit (`--solve slope`), the heaviest safe mass at one slope or the
-/// payload envelope over several (`--solve mass`), or the `--map` summary.
-#[derive(Debug, Serialize)]
-#[serde(untagged)]
-pub enum Answer {
-    /// One `--slope`.
-    Point(Box<RiskPoint>),
-    /// Several `--slope`s.
-    Curve(Vec<RiskPoint>),
-    /// `--solve slope`.
-    Slope(Box<sandslope::risk::SafeSlope>),
-    /// `--solve mass` at one slope.
-    Mass(Box<SafeMass>),
-    /// `--solve mass` at several slopes.
-    Envelope(Box<PayloadEnvelope>),
-    /// `--map`.
-    Map(Box<RiskMapSummary>),
+    print_curve(curve, limit.as_ref(), max_risk, format)
 }
 
 /// Limits of one [`answer`] call (the server's; the command line's are the library's).
@@ -305,7 +285,7 @@ pub struct AnswerLimits {
 /// The value `risk --json` prints for these flags (what `serve`'s `/api/risk` returns), by
 /// the same library calls as [`run`], without its notes, figures and files; more work than
 /// `limits` allows is an error naming the limit.
-pub fn answer(args: &RiskArgs, limits: AnswerLimits) -> Result<Answer> {
+pub fn answer(args: &RiskArgs, limits: AnswerLimits) -> Result<RiskAnswer> {
     let robot = args.robot.load()?;
     let slopes = parse_slopes(&args.slope)?;
     let max_risk = args.max_risk;
@@ -320,7 +300,7 @@ pub fn answer(args: &RiskArgs, limits: AnswerLimits) -> Result<Answer> {
         let map = RiskMap::compute(&robot, slope, repose, &k_n_axis, &k_s_axis, u, &|| {});
         let summary =
             RiskMapSummary::of(&map, &robot, slopes[0], &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
-        return Ok(Answer::Map(Box::new(summary)));
+        return Ok(RiskAnswer::Map(Box::new(summary)));
     }
     Ok(match args.solve {
         Some(Solve::Mass) if slopes.len() > 1 => {
@@ -328,15 +308,15 @@ pub fn answer(args: &RiskArgs, limits: AnswerLimits) -> Result<Answer> {
                 return Err(too_many(slopes.len(), limits.envelope_slopes, "--solve mass"));
             }
             let env = payload_envelope(&robot, &terrain, &slopes, max_risk).map_err(|e| anyhow!("{e}"))?;
-            Answer::Envelope(Box::new(env))
+            RiskAnswer::Envelope(Box::new(env))
         }
         Some(Solve::Mass) => {
             slope_of(slopes[0])?;
             let sol = safe_mass(&robot, slopes[0], &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
-            Answer::Mass(Box::new(sol))
+            RiskAnswer::Mass(Box::new(sol))
         }
         Some(Solve::Slope) => {
-            Answer::Slope(Box::new(safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?))
+            RiskAnswer::Slope(Box::new(safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?))
         }
         None => {
             if slopes.len() > limits.curve_slopes {
@@ -344,10 +324,7 @@ pub fn answer(args: &RiskArgs, limits: AnswerLimits) -> Result<Answer> {
             }
             let curve =
                 risk_curve(&robot, &terrain, &slopes).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
-            match <[RiskPoint; 1]>::try_from(curve.points) {
-                Ok([one]) => Answer::Point(Box::new(one)),
-                Err(points) => Answer::Curve(points),
-            }
+            RiskAnswer::of_points(curve.points)
         }
     })
 }
@@ -391,12 +368,9 @@ fn robot_title(robot: &Robot, terrain: &UncertainTerrain) -> String {
     format!("m = {} kg on {}", robot.mass(), terrain.terrain().name().unwrap_or("terrain"))
 }
 
-fn print_curve(curve: &RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, format: Format) -> Result<()> {
+fn print_curve(curve: RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, format: Format) -> Result<()> {
     match format {
-        Format::Json => match curve.points.as_slice() {
-            [one] => print_json(one),
-            points => print_json(&points),
-        },
+        Format::Json => print_json(&RiskAnswer::of_points(curve.points)),
         Format::Csv => {
             let rows: Vec<RiskRow> = curve.points.iter().map(RiskRow::of).collect();
             print!("{}", csv_string(&rows)?);
@@ -442,9 +416,9 @@ fn print_curve(curve: &RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, form
     }
 }
 
-fn print_envelope(env: &PayloadEnvelope, format: Format) -> Result<()> {
+fn print_envelope(env: PayloadEnvelope, format: Format) -> Result<()> {
     match format {
-        Format::Json => print_json(env),
+        Format::Json => print_json(&RiskAnswer::Envelope(Box::new(env))),
         Format::Csv => {
             let rows: Vec<MassRow> = env
                 .points
@@ -625,7 +599,7 @@ fn run_map(
     let summary =
         RiskMapSummary::of(&map, robot, slope_deg, terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
     match args.format() {
-        Format::Json => print_json(&summary),
+        Format::Json => print_json(&RiskAnswer::Map(Box::new(summary))),
         Format::Csv => match &args.csv {
             Some(None) => {
                 let mut out = std::io::BufWriter::new(std::io::stdout().lock());

@@ -17,7 +17,8 @@
 //!   scan-and-bisect search ([`limits`]).
 //! - [`RiskMap`]: p_fail and p_not_success over a grid of median (k_n, k_s).
 //! - [`safe_slope`], [`safe_mass`], [`RiskMapSummary`]: the solving modes' answers with the
-//!   uncertainty they used ([`results`]), what `risk --json` prints and Python returns.
+//!   uncertainty they used ([`results`]), what `risk --json` prints and Python returns;
+//!   [`RiskAnswer`]: the one value every `risk --json` mode prints.
 //!
 //! Every result is a plain serialisable value; none draws or writes anything.
 
@@ -38,7 +39,7 @@ pub use limits::{
 };
 pub use map::RiskMap;
 pub use quadrature::{regime_probabilities, RegimeProbabilities};
-pub use results::{safe_mass, safe_slope, RiskMapSummary, SafeMass, SafeSlope};
+pub use results::{safe_mass, safe_slope, RiskAnswer, RiskMapSummary, SafeMass, SafeSlope};
 pub use uncertainty::{
     CvSource, DefaultsUsed, UncertainGround, UncertainTerrain, Uncertainty, UsedUncertainty, DEFAULT_CV_N,
     DEFAULT_CV_S,

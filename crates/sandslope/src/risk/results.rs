@@ -1,10 +1,12 @@
-//! The answers of `sandslope risk`'s solving modes as plain serialisable values: what
+//! The answers of `sandslope risk` as plain serialisable values: the solving modes' (what
 //! `risk --solve slope|mass --json` and `risk --map --json` print and what Python's
-//! `safe_slope` and `safe_mass` return, each with the uncertainty it used (docs/model.md §9).
+//! `safe_slope` and `safe_mass` return, each with the uncertainty it used, docs/model.md §9),
+//! and [`RiskAnswer`], the one value every `risk --json` mode prints.
 
 use serde::{Deserialize, Serialize};
 
-use super::limits::{max_safe_mass, safe_slope_limit, SafeLimit};
+use super::curve::RiskPoint;
+use super::limits::{max_safe_mass, safe_slope_limit, PayloadEnvelope, SafeLimit};
 use super::map::RiskMap;
 use super::quadrature::regime_probabilities;
 use super::uncertainty::{DefaultsUsed, UncertainTerrain, UsedUncertainty};
@@ -12,6 +14,37 @@ use crate::error::ParamError;
 use crate::robot::Robot;
 use crate::slope::Slope;
 use crate::Axis;
+
+/// What `sandslope risk --json` prints (and `serve`'s `/api/risk` returns), one variant per
+/// mode, serialised as its value alone: one slope's [`RiskPoint`], several slopes' points,
+/// the safe-slope limit (`--solve slope`), the heaviest safe mass at one slope or the payload
+/// envelope over several (`--solve mass`), or the `--map` summary.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum RiskAnswer {
+    /// One slope.
+    Point(Box<RiskPoint>),
+    /// Several slopes.
+    Curve(Vec<RiskPoint>),
+    /// The safe-slope limit.
+    Slope(Box<SafeSlope>),
+    /// The heaviest safe mass at one slope.
+    Mass(Box<SafeMass>),
+    /// The heaviest safe mass at several slopes.
+    Envelope(Box<PayloadEnvelope>),
+    /// A map's summary.
+    Map(Box<RiskMapSummary>),
+}
+
+impl RiskAnswer {
+    /// The answer for a risk curve's points: one point alone, several (or none) as a list.
+    pub fn of_points(points: Vec<RiskPoint>) -> RiskAnswer {
+        match <[RiskPoint; 1]>::try_from(points) {
+            Ok([one]) => RiskAnswer::Point(Box::new(one)),
+            Err(points) => RiskAnswer::Curve(points),
+        }
+    }
+}
 
 /// The safe-slope limit with what it assumed (`risk --solve slope`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -39,7 +39,7 @@ fn bench(c: &mut Criterion) {
     let rec =
         Recording { positions: &positions, frame_rate_hz: 120.0, start_time_s: 0.0, touchdowns_s: None };
     let check = analyse(&[rec], &options).unwrap();
-    assert!(check.summary.speed.n > 7000);
+    assert!(check.summary.steps > 7000);
     let mut group = c.benchmark_group("gait");
     group.sample_size(20);
     group.bench_function("analyse one hour at 120 fps (432k frames)", |b| {

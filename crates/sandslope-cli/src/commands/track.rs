@@ -114,11 +114,11 @@ fn step_records<'a>(files: &'a [String], r: &TrackResult) -> Vec<StepRecord<'a>>
         .iter()
         .map(|st| StepRecord {
             file: &files[st.recording],
-            touchdown_s: st.touchdown_s,
-            t1_s: st.t1_s,
-            slip_m: st.slip_m,
-            step_m: st.step_m,
-            speed_m_s: st.speed_m_s,
+            touchdown_s: st.step.touchdown_s,
+            t1_s: st.step.anchoring_time_s,
+            slip_m: st.step.slip_m,
+            step_m: st.step.step_m,
+            speed_m_s: st.step.speed_m_s,
         })
         .collect()
 }
@@ -192,16 +192,17 @@ pub fn run(args: TrackArgs) -> Result<()> {
 
     let mut campaign = None;
     if let (Some(path), Some(slope_deg)) = (&args.speeds_out, slope) {
-        let sd = match result.speed_sd_m_s {
+        let sd = match result.summary.speed_sd_m_s {
             Some(sd) if sd > 0.0 => sd,
             _ => bail!(
                 "cannot append to {}: the speed SD needs at least two steps with different speeds (found {} steps)",
                 path.display(),
-                result.steps
+                result.summary.steps
             ),
         };
-        let rows = append_speed(path, SpeedRow { slope_deg, speed_m_s: result.speed_m_s, speed_sd_m_s: sd })
-            .with_context(|| format!("appending to {}", path.display()))?;
+        let rows =
+            append_speed(path, SpeedRow { slope_deg, speed_m_s: result.summary.speed_m_s, speed_sd_m_s: sd })
+                .with_context(|| format!("appending to {}", path.display()))?;
         campaign = Some(rows);
     }
     if let Some(path) = &args.plot {
@@ -245,14 +246,15 @@ fn print_table(r: &TrackResult, captures: &[Capture], names: &[String]) {
         (Some(m), None) => format!("{:.d$}", m * scale),
         _ => "-".into(),
     };
+    let s = &r.summary;
     let mut t = table(&["quantity", "mean ± SD across steps", "unit"]);
     let rows: Vec<[String; 3]> = vec![
         ["slope".into(), num(r.slope_deg, 1), "deg".into()],
-        ["step-averaged speed v".into(), pm(Some(r.speed_m_s), r.speed_sd_m_s, 100.0, 2), "cm/s".into()],
-        ["anchoring time t1".into(), pm(r.t1_s, r.t1_sd_s, 1e3, 1), "ms".into()],
-        ["backward slip s1".into(), pm(r.slip_m, r.slip_sd_m, 1e3, 2), "mm".into()],
-        ["net step s".into(), pm(Some(r.step_m), r.step_sd_m, 1e3, 2), "mm".into()],
-        ["steps (unanchored)".into(), format!("{} ({})", r.steps, r.unanchored_steps), "".into()],
+        ["step-averaged speed v".into(), pm(Some(s.speed_m_s), s.speed_sd_m_s, 100.0, 2), "cm/s".into()],
+        ["anchoring time t1".into(), pm(s.t1_s, s.t1_sd_s, 1e3, 1), "ms".into()],
+        ["backward slip s1".into(), pm(s.slip_m, s.slip_sd_m, 1e3, 2), "mm".into()],
+        ["net step s".into(), pm(Some(s.step_m), s.step_sd_m, 1e3, 2), "mm".into()],
+        ["steps (unanchored)".into(), format!("{} ({})", s.steps, s.unanchored_steps), "".into()],
         ["stride period T".into(), format!("{:.3}", r.period_s), "s".into()],
         [
             format!("upslope direction{}", if r.upslope_estimated { " (estimated)" } else { "" }),

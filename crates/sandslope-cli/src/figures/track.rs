@@ -74,7 +74,7 @@ impl TrackFigure {
             sd,
             strides,
             period: r.period_s,
-            t1: r.t1_s,
+            t1: r.summary.t1_s,
             slope: r.slope_deg,
             measured,
             model: model_pieces,

@@ -320,10 +320,10 @@ pub(crate) mod tests {
         assert!(a.upslope_estimated);
         assert!((r.touchdown_offset.unwrap().offset_s - 0.2).abs() < 1.0 / 120.0);
         assert_eq!(r.steps.len(), 39);
-        assert!((s.speed.mean - profile.mean_speed()).abs() < 1e-3);
-        assert!((s.step.mean - profile.step()).abs() < 5e-4);
-        assert!((s.anchoring_time.unwrap().mean - profile.anchoring_time()).abs() < 0.012);
-        assert!((s.slip.unwrap().mean - profile.slip()).abs() < 0.1 * profile.slip());
+        assert!((s.speed_m_s - profile.mean_speed()).abs() < 1e-3);
+        assert!((s.step_m - profile.step()).abs() < 5e-4);
+        assert!((s.t1_s.unwrap() - profile.anchoring_time()).abs() < 0.012);
+        assert!((s.slip_m.unwrap() - profile.slip()).abs() < 0.1 * profile.slip());
         assert_eq!(s.unanchored_steps, 0);
         let curve = a.curve.unwrap();
         assert_eq!(curve.strides, 19);
@@ -341,8 +341,8 @@ pub(crate) mod tests {
         let given = Recording { touchdowns_s: Some(&truth), ..rec };
         let b = analyse(&[given], &GaitOptions::new(1.0).unwrap()).unwrap();
         assert!(b.recordings[0].touchdown_offset.is_none());
-        assert!((b.summary.anchoring_time.unwrap().mean - profile.anchoring_time()).abs() < 0.005);
-        assert!((b.summary.slip.unwrap().mean - profile.slip()).abs() < 0.05 * profile.slip());
+        assert!((b.summary.t1_s.unwrap() - profile.anchoring_time()).abs() < 0.005);
+        assert!((b.summary.slip_m.unwrap() - profile.slip()).abs() < 0.05 * profile.slip());
     }
 
     /// Level sand: no slip, the speed rises right after touchdown, so t1 = 0 and slip = 0.
@@ -353,10 +353,10 @@ pub(crate) mod tests {
         let rec = Recording { positions: &pos, frame_rate_hz: 120.0, start_time_s: 0.0, touchdowns_s: None };
         let a = analyse(&[rec], &GaitOptions::new(1.0).unwrap()).unwrap();
         let s = a.summary;
-        assert!((s.speed.mean - profile.mean_speed()).abs() < 1e-3);
+        assert!((s.speed_m_s - profile.mean_speed()).abs() < 1e-3);
         // The noise can make the minimum wander by a frame or two around touchdown.
-        assert!(s.anchoring_time.unwrap().mean < 0.02);
-        assert!(s.slip.unwrap().mean < 2e-4);
+        assert!(s.t1_s.unwrap() < 0.02);
+        assert!(s.slip_m.unwrap() < 2e-4);
     }
 
     #[test]
@@ -376,7 +376,7 @@ pub(crate) mod tests {
         assert_eq!(r.dropped_frames, 30);
         assert_eq!(r.interpolated_frames, 5);
         assert!((r.tracks[1].start_time_s - (3.0 + 530.0 / 120.0)).abs() < 1e-12);
-        assert!((a.summary.speed.mean - profile.mean_speed()).abs() < 1e-3);
+        assert!((a.summary.speed_m_s - profile.mean_speed()).abs() < 1e-3);
         let still = vec![[1.0, 2.0, 3.0]; 300];
         let rec = Recording { positions: &still, ..rec };
         assert_eq!(analyse(&[rec], &GaitOptions::new(1.0).unwrap()).unwrap_err(), GaitError::NoDirection);

@@ -2,6 +2,8 @@
 //! and step speed (docs/model.md §11), their summary across steps, and the
 //! stride-averaged speed curve (the paper's Fig. 3b).
 
+use serde::Serialize;
+
 /// Smoothed along-slope position and speed of one segment, sampled at a constant frame rate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SmoothTrack {
@@ -140,13 +142,16 @@ pub fn touchdowns_in(track: &SmoothTrack, offset_s: f64, step_s: f64) -> Vec<f64
         .collect()
 }
 
-/// What one step (one tripod's stance, `T/2` from touchdown) did.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// What one step (one tripod's stance, `T/2` from touchdown) did: the one step type of
+/// `track`'s result ([`super::StepRow`] adds its recording's index), serialised with the
+/// anchoring time as `t1_s`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct StepMeasure {
     /// Touchdown time t0, s (recording clock).
     pub touchdown_s: f64,
     /// Anchoring time after touchdown, t1 - t0, s; `None` if the speed never turned from
     /// falling to rising within the step (no anchoring).
+    #[serde(rename = "t1_s")]
     pub anchoring_time_s: Option<f64>,
     /// Backward slip: distance travelled downslope between t0 and t1, m (0 if none);
     /// `None` without anchoring.
@@ -264,28 +269,49 @@ impl Stats {
     }
 }
 
-/// Summary across steps (docs/model.md §11).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Means and sample SDs across steps (docs/model.md §11; an SD is `None` with fewer than two
+/// values): the one summary of recordings at one slope, what `track` reports (flattened into
+/// [`super::TrackResult`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct GaitSummary {
-    /// Step-averaged speed, m/s.
-    pub speed: Stats,
-    /// Net step length, m.
-    pub step: Stats,
-    /// Anchoring time t1, s, over anchored steps; `None` if no step anchored.
-    pub anchoring_time: Option<Stats>,
-    /// Backward slip, m, over anchored steps.
-    pub slip: Option<Stats>,
+    /// Mean step-averaged speed, m/s.
+    pub speed_m_s: f64,
+    /// Its SD across steps, m/s.
+    pub speed_sd_m_s: Option<f64>,
+    /// Mean anchoring time t1 over anchored steps, s; `None` if no step anchored.
+    pub t1_s: Option<f64>,
+    /// Its SD, s.
+    pub t1_sd_s: Option<f64>,
+    /// Mean backward slip over anchored steps, m.
+    pub slip_m: Option<f64>,
+    /// Its SD, m.
+    pub slip_sd_m: Option<f64>,
+    /// Mean net step, m.
+    pub step_m: f64,
+    /// Its SD, m.
+    pub step_sd_m: Option<f64>,
+    /// Steps measured.
+    pub steps: usize,
     /// Steps in which the speed never turned upward (no anchoring).
     pub unanchored_steps: usize,
 }
 
 /// Summarises `steps`; `None` when there are none.
 pub fn summarize(steps: &[StepMeasure]) -> Option<GaitSummary> {
+    let speed = Stats::of(steps.iter().map(|s| s.speed_m_s))?;
+    let step = Stats::of(steps.iter().map(|s| s.step_m))?;
+    let t1 = Stats::of(steps.iter().filter_map(|s| s.anchoring_time_s));
+    let slip = Stats::of(steps.iter().filter_map(|s| s.slip_m));
     Some(GaitSummary {
-        speed: Stats::of(steps.iter().map(|s| s.speed_m_s))?,
-        step: Stats::of(steps.iter().map(|s| s.step_m))?,
-        anchoring_time: Stats::of(steps.iter().filter_map(|s| s.anchoring_time_s)),
-        slip: Stats::of(steps.iter().filter_map(|s| s.slip_m)),
+        speed_m_s: speed.mean,
+        speed_sd_m_s: speed.sd,
+        t1_s: t1.map(|t| t.mean),
+        t1_sd_s: t1.and_then(|t| t.sd),
+        slip_m: slip.map(|s| s.mean),
+        slip_sd_m: slip.and_then(|s| s.sd),
+        step_m: step.mean,
+        step_sd_m: step.sd,
+        steps: speed.n,
         unanchored_steps: steps.iter().filter(|s| s.anchoring_time_s.is_none()).count(),
     })
 }

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording};
+use super::{analyse, GaitAnalysis, GaitError, GaitOptions, GaitSummary, Recording, StepMeasure};
 use crate::slope::Slope;
 
 /// Where a recording's touchdowns came from.
@@ -44,16 +44,9 @@ pub struct RecordingSummary {
 pub struct StepRow {
     /// Index of the recording it came from.
     pub recording: usize,
-    /// Touchdown time, s (recording clock).
-    pub touchdown_s: f64,
-    /// Anchoring time t1 after touchdown, s; `None` without anchoring.
-    pub t1_s: Option<f64>,
-    /// Backward slip, m; `None` without anchoring.
-    pub slip_m: Option<f64>,
-    /// Net step upslope, m.
-    pub step_m: f64,
-    /// Step-averaged speed, m/s.
-    pub speed_m_s: f64,
+    /// The step.
+    #[serde(flatten)]
+    pub step: StepMeasure,
 }
 
 /// What `track` reports: means and sample SDs across all steps of all recordings (SDs `None`
@@ -64,26 +57,9 @@ pub struct StepRow {
 pub struct TrackResult {
     /// The recordings' slope, degrees, if known.
     pub slope_deg: Option<f64>,
-    /// Mean step-averaged speed, m/s.
-    pub speed_m_s: f64,
-    /// Its SD across steps, m/s.
-    pub speed_sd_m_s: Option<f64>,
-    /// Mean anchoring time t1 over anchored steps, s.
-    pub t1_s: Option<f64>,
-    /// Its SD, s.
-    pub t1_sd_s: Option<f64>,
-    /// Mean backward slip over anchored steps, m.
-    pub slip_m: Option<f64>,
-    /// Its SD, m.
-    pub slip_sd_m: Option<f64>,
-    /// Mean net step, m.
-    pub step_m: f64,
-    /// Its SD, m.
-    pub step_sd_m: Option<f64>,
-    /// Steps measured.
-    pub steps: usize,
-    /// Steps without anchoring (the speed never turned upward).
-    pub unanchored_steps: usize,
+    /// Means and SDs across all steps of all recordings.
+    #[serde(flatten)]
+    pub summary: GaitSummary,
     /// Stride period T used, s.
     pub period_s: f64,
     /// Upslope unit vector in the capture frame.
@@ -124,7 +100,6 @@ pub fn track(
     slope: Option<Slope>,
 ) -> Result<TrackResult, GaitError> {
     let a = analyse(recordings, options)?;
-    let s = a.summary;
     let summaries = recordings
         .iter()
         .zip(&a.recordings)
@@ -147,29 +122,11 @@ pub fn track(
         .recordings
         .iter()
         .enumerate()
-        .flat_map(|(recording, r)| {
-            r.steps.iter().map(move |st| StepRow {
-                recording,
-                touchdown_s: st.touchdown_s,
-                t1_s: st.anchoring_time_s,
-                slip_m: st.slip_m,
-                step_m: st.step_m,
-                speed_m_s: st.speed_m_s,
-            })
-        })
+        .flat_map(|(recording, r)| r.steps.iter().map(move |&step| StepRow { recording, step }))
         .collect();
     Ok(TrackResult {
         slope_deg: slope.map(Slope::degrees),
-        speed_m_s: s.speed.mean,
-        speed_sd_m_s: s.speed.sd,
-        t1_s: s.anchoring_time.map(|t| t.mean),
-        t1_sd_s: s.anchoring_time.and_then(|t| t.sd),
-        slip_m: s.slip.map(|t| t.mean),
-        slip_sd_m: s.slip.and_then(|t| t.sd),
-        step_m: s.step.mean,
-        step_sd_m: s.step.sd,
-        steps: s.speed.n,
-        unanchored_steps: s.unanchored_steps,
+        summary: a.summary,
         period_s: options.stride_period(),
         upslope: a.upslope.vector(),
         upslope_estimated: a.upslope_estimated,
@@ -214,13 +171,13 @@ mod tests {
         assert_eq!(r.recordings[1].touchdown_offset_s, None);
         let offset = r.recordings[0].touchdown_offset_s.unwrap();
         assert!((offset - 0.2).abs() < 1.0 / 120.0, "{offset}");
-        assert_eq!(r.steps, r.per_step.len());
-        assert_eq!(r.steps, r.recordings.iter().map(|x| x.steps).sum::<usize>());
+        assert_eq!(r.summary.steps, r.per_step.len());
+        assert_eq!(r.summary.steps, r.recordings.iter().map(|x| x.steps).sum::<usize>());
         assert_eq!(r.segments, 3);
         assert!(r.per_step.iter().any(|s| s.recording == 1));
         // The profile's mean speed (a difference of positions over 0.5 s: 1 mm/s for noise).
-        assert!((r.speed_m_s - profile.mean_speed()).abs() < 1e-3);
-        assert!(r.speed_sd_m_s.unwrap() < 0.01);
+        assert!((r.summary.speed_m_s - profile.mean_speed()).abs() < 1e-3);
+        assert!(r.summary.speed_sd_m_s.unwrap() < 0.01);
         assert_eq!(r.recordings_without_steps().count(), 0);
     }
 }

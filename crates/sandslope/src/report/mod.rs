@@ -531,7 +531,7 @@ fn plots(
         strides: evidence
             .tracks
             .iter()
-            .filter(|t| t.result.steps > 0)
+            .filter(|t| t.result.summary.steps > 0)
             .map(|t| (t.slope_deg, t.result.clone()))
             .collect(),
         table: forces.unwrap_or(terrain).points().to_vec(),
@@ -628,8 +628,8 @@ mod tests {
             Recording { positions: &positions, frame_rate_hz: 120.0, start_time_s: 0.0, touchdowns_s: None };
         let slope = Slope::from_degrees(slope_deg).unwrap();
         let mut result = track(&[rec], &GaitOptions::new(1.0).unwrap(), Some(slope)).unwrap();
-        result.speed_sd_m_s = speed_sd;
-        result.t1_sd_s = t1_sd;
+        result.summary.speed_sd_m_s = speed_sd;
+        result.summary.t1_sd_s = t1_sd;
         TrackedSlope { slope_deg, files: vec![format!("{slope_deg}.csv")], result }
     }
 

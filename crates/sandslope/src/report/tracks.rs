@@ -47,7 +47,7 @@ pub struct TrackRecord {
 
 impl From<&TrackedSlope> for TrackRecord {
     fn from(t: &TrackedSlope) -> TrackRecord {
-        let r = &t.result;
+        let r = &t.result.summary;
         TrackRecord {
             slope_deg: t.slope_deg,
             files: t.files.clone(),
@@ -80,7 +80,7 @@ impl TrackUse {
     pub fn new(tracks: &[TrackedSlope], observed_given: bool) -> Result<TrackUse, crate::ParamError> {
         let mut out = TrackUse::default();
         for t in tracks {
-            let r = &t.result;
+            let r = &t.result.summary;
             let files = t.files.join(", ");
             let slope = Slope::from_degrees(t.slope_deg).map_err(|e| e.renamed("tracks slope_deg"))?;
             match (r.t1_s, r.t1_sd_s) {

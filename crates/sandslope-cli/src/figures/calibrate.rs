@@ -162,7 +162,7 @@ impl CalibrationFigure<'_> {
             .light_line_style(palette::GRID)
             .draw()
             .map_err(plot_err)?;
-        let band = RGBColor(120, 170, 220).mix(0.25);
+        let band = palette::PULL_BAND.mix(0.25);
         chart
             .draw_series([Rectangle::new([(x_range.0, -1.0), (x_range.1, 1.0)], band.filled())])
             .map_err(plot_err)?;

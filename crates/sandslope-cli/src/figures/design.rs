@@ -8,7 +8,8 @@ use plotters::prelude::*;
 use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 
 use super::palette;
-use super::phase::{star_points, STAR_GREEN};
+use super::palette::STAR_GREEN;
+use super::phase::star_points;
 use super::{font, range, tick, Figure};
 
 /// The safe-slope limit over two varied keys (row-major: one row per `x` value).

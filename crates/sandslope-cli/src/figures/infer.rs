@@ -125,7 +125,7 @@ impl InferFigure {
                 .label("law: posterior median")
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(2)));
         }
-        let grey = RGBColor(110, 110, 110);
+        let grey = palette::TABLE_GREY;
         if !self.table.is_empty() {
             chart
                 .draw_series(DashedLineSeries::new(self.table.iter().copied(), 6, 4, grey.stroke_width(2)))

@@ -11,11 +11,8 @@ use plotters_backend::{BackendCoord, DrawingErrorKind};
 
 use sandslope::{Axis, AxisScale, PhasePanel, Regime};
 
-use super::palette::regime_colour;
+use super::palette::{regime_colour, STAR_GREEN};
 use super::{font, Figure};
-
-/// Dark green of the terrain star.
-pub const STAR_GREEN: RGBColor = RGBColor(0, 100, 0);
 
 /// A five-pointed star of outer radius `r` pixels, centred on (0, 0).
 pub fn star_points(r: f64) -> Vec<(i32, i32)> {

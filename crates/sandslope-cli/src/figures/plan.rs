@@ -36,9 +36,9 @@ pub struct PlanFigure {
 
 fn route_colour(o: Objective) -> RGBColor {
     match o {
-        Objective::Time => RGBColor(0, 90, 220),
-        Objective::Risk => RGBColor(170, 0, 200),
-        Objective::Distance => RGBColor(0, 0, 0),
+        Objective::Time => palette::ROUTE_TIME,
+        Objective::Risk => palette::ROUTE_RISK,
+        Objective::Distance => palette::ROUTE_DISTANCE,
     }
 }
 
@@ -49,8 +49,7 @@ const KEYS: [(&str, (f64, f64, f64)); 5] = [
     ("head-on: metastable", rgb(palette::METASTABLE)),
     ("head-on: slippage", rgb(palette::SLIPPAGE)),
     ("head-on: sinkage", rgb(palette::SINKAGE)),
-    // Charcoal, not a dark red: on the hillshade a dark red is lost beside slippage red.
-    ("no heading with P(fail) < 0.5", (55.0, 55.0, 62.0)),
+    ("no heading with P(fail) < 0.5", rgb(palette::NO_SAFE_HEADING)),
 ];
 
 const fn rgb(c: RGBColor) -> (f64, f64, f64) {
@@ -81,8 +80,8 @@ impl PlanFigure {
                 };
                 let i = cell.row * cols + cell.col;
                 let colour = match (grid.height(cell), planner.gradient(cell)) {
-                    (None, _) => RGBColor(255, 255, 255),
-                    (Some(_), None) => RGBColor(190, 190, 190),
+                    (None, _) => palette::NODATA,
+                    (Some(_), None) => palette::NO_SLOPE,
                     (Some(_), Some([gx, gy])) => {
                         let n = (gx * gx + gy * gy + 1.0).sqrt();
                         let shade = ((-gx * light[0] - gy * light[1] + light[2]) / n).max(0.0);
@@ -91,7 +90,7 @@ impl PlanFigure {
                         let (r, g, b) = match planner.fall_line(cell) {
                             _ if best >= 0.5 => KEYS[4].1,
                             Some((regime, _)) => regime_colour(regime),
-                            None => (190.0, 190.0, 190.0),
+                            None => rgb(palette::NO_SLOPE),
                         };
                         let c = |v: f64| (v * k).clamp(0.0, 255.0) as u8;
                         RGBColor(c(r), c(g), c(b))
@@ -266,7 +265,7 @@ where
     let keys = KEYS
         .iter()
         .map(|(label, c)| (*label, *c))
-        .chain([("no slope (border)", (190.0, 190.0, 190.0)), ("nodata", (255.0, 255.0, 255.0))]);
+        .chain([("no slope (border)", rgb(palette::NO_SLOPE)), ("nodata", rgb(palette::NODATA))]);
     for (i, (label, (r, g, b))) in keys.enumerate() {
         let y = 70 + 30 * i as i32;
         area.draw(&Rectangle::new([(0, y), (18, y + 18)], RGBColor(r as u8, g as u8, b as u8).filled()))

@@ -11,8 +11,9 @@ use sandslope::risk::{PayloadEnvelope, SafeLimit};
 use sandslope::{Axis, RegimeProbabilities};
 
 use super::palette;
+use super::palette::STAR_GREEN;
 use super::phase::{
-    cell_edges, reduce, sci_label, star_points, within, TerrainStar, MAX_DRAWN_CELLS, STAR_GREEN,
+    cell_edges, reduce, sci_label, star_points, within, TerrainStar, MAX_DRAWN_CELLS,
 };
 use super::slope_curves::swatch_gap;
 use super::{font, Figure};
@@ -50,7 +51,7 @@ impl Figure for CurveFigure {
             .draw()
             .map_err(e)?;
         let red = palette::SLIPPAGE;
-        let orange = RGBColor(230, 150, 30);
+        let orange = palette::NOT_SUCCESS_ORANGE;
         chart
             .draw_series(LineSeries::new(
                 self.curve.iter().map(|(d, p)| (*d, p.p_fail().clamp(0.0, 1.0))),

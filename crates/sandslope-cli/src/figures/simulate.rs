@@ -95,7 +95,7 @@ impl Figure for SimulateFigure<'_> {
             m.cause.name()
         );
         let mut c = time_chart(&panels[0], &title, "position along the slope (cm)", t, xr)?;
-        let grey = RGBColor(170, 170, 170);
+        let grey = palette::STEP_MARK_GREY;
         for s in &m.steps {
             c.draw_series([PathElement::new(
                 vec![(s.touchdown_s, xr.0), (s.touchdown_s, xr.1)],
@@ -261,7 +261,7 @@ impl Figure for SlopesFigure<'_> {
             c.draw_series([PathElement::new(vec![(xr.0, 0.0), (xr.1, 0.0)], BLACK.stroke_width(1))])
                 .map_err(plot_err)?;
         }
-        let blue = RGBColor(31, 90, 180);
+        let blue = palette::SIMULATED_BLUE;
         // The curve breaks at a walk that pitched over: no line bridges a tumble.
         let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
         for m in self.sims {
@@ -279,7 +279,7 @@ impl Figure for SlopesFigure<'_> {
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(3)));
         c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, blue.filled()))).map_err(plot_err)?;
         if !tumbled.is_empty() {
-            let orange = RGBColor(230, 120, 0);
+            let orange = palette::TUMBLE_ORANGE;
             c.draw_series(tumbled.iter().map(|&x| Cross::new((x, 0.0), 7, orange.stroke_width(3))))
                 .map_err(plot_err)?
                 .label("simulated body pitched over (tumbled): no speed")
@@ -378,13 +378,13 @@ where
         (centre.0 - half_w, centre.1 + half_h),
     ];
     let (sand_poly, surface) = below_line(&view, (-s, c));
-    let sand = RGBColor(230, 205, 150);
+    let sand = palette::SAND;
     if sand_poly.len() >= 3 {
         chart.draw_series([Polygon::new(sand_poly, sand.filled())]).map_err(plot_err)?;
     }
     if surface.len() == 2 {
         chart
-            .draw_series([PathElement::new(surface, RGBColor(150, 120, 60).stroke_width(2))])
+            .draw_series([PathElement::new(surface, palette::SAND_SURFACE.stroke_width(2))])
             .map_err(plot_err)?;
     }
     // Body: a box from the belly (h below the axle) to h above it, pitched.

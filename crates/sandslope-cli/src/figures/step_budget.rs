@@ -33,10 +33,10 @@ impl Figure for StepBudgetFigure<'_> {
         type Pick = fn(&StepBudget) -> Option<f64>;
         let series: [(&str, RGBColor, bool, Pick); 5] = [
             ("level step s*", palette::DATA_GREY, true, |b| Some(b.level_step_m)),
-            ("net step s", RGBColor(20, 20, 20), false, |b| b.step_m),
+            ("net step s", palette::NET_STEP, false, |b| b.step_m),
             ("inherited speed g sin θ t1 (T/2 - t1)", palette::LOSS_RED, false, |b| b.inherited_speed_m),
             ("shorter propulsion time", palette::MODEL_BLUE, false, |b| b.shorter_propulsion_m),
-            ("backward slip ½ g sin θ t1²", RGBColor(230, 150, 20), false, |b| b.slip_m),
+            ("backward slip ½ g sin θ t1²", palette::SLIP_ORANGE, false, |b| b.slip_m),
         ];
         let x_hi = self.budget.last().map_or(30.0, |b| b.slope_deg);
         let ys =

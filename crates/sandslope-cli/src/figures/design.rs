@@ -10,7 +10,7 @@ use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 use super::palette;
 use super::palette::STAR_GREEN;
 use super::phase::star_points;
-use super::{font, range, tick, Figure};
+use super::{font, range, tick, ChartSetup, Figure};
 
 /// The safe-slope limit over two varied keys (row-major: one row per `x` value).
 pub struct SafeSlopeMap {
@@ -62,23 +62,14 @@ impl Figure for DesignFigure {
         let all = || others.iter().chain(&front).chain(template.iter());
         let (x0, x1) = range(all().map(|p| p.0), (0.0, 30.0));
         let (y0, y1) = range(all().map(|p| p.1), (0.0, 20.0));
-        let mut chart = ChartBuilder::on(&left)
-            .margin(15)
-            .x_label_area_size(50)
-            .y_label_area_size(75)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc("safe-slope limit (deg; -1: no slope is safe)")
-            .y_desc("speed at the target slope (cm/s)")
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .light_line_style(WHITE)
-            .draw()
-            .map_err(e)?;
+        let setup = ChartSetup { x_ticks: Some(&tick), y_ticks: Some(&tick), ..ChartSetup::PANEL };
+        let mut chart = setup.build(
+            &left,
+            x0..x1,
+            y0..y1,
+            "safe-slope limit (deg; -1: no slope is safe)",
+            "speed at the target slope (cm/s)",
+        )?;
         let grey = palette::MUTED_GREY;
         chart
             .draw_series(others.iter().map(|&p| Circle::new(p, 2, grey.mix(0.5).filled())))
@@ -105,14 +96,7 @@ impl Figure for DesignFigure {
                     EmptyElement::at((x + 12, y)) + Polygon::new(star_points(9.0), STAR_GREEN.filled())
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(font(15.0))
-            .draw()
-            .map_err(e)?;
+        super::legend(&mut chart, SeriesLabelPosition::LowerLeft, 15.0)?;
         if let (Some(map), Some(area)) = (&self.map, right) {
             draw_map(map, &area)?;
         }

@@ -10,7 +10,7 @@ use sandslope::infer::{Bound, LawPosterior, LogUniformPrior, SlopePosterior};
 
 use super::palette;
 use super::phase::sci_label;
-use super::{font, Figure};
+use super::{font, ChartSetup, Figure};
 
 /// The posterior bands and, with a law, the predicted risk.
 pub struct InferFigure {
@@ -87,22 +87,14 @@ impl InferFigure {
         let (lo, hi) =
             ks.iter().filter(|k| **k > 0.0).fold((f64::INFINITY, 0.0f64), |(a, b), &k| (a.min(k), b.max(k)));
         let (y0, y1) = ((lo / 1.5).max(self.prior.min()), (hi * 1.5).min(self.prior.max()));
-        let mut chart = ChartBuilder::on(left)
-            .margin(15)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
-            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-            .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc("slope (deg)")
-            .y_desc("shear strength k_s (N/m\u{b3})")
-            .y_label_formatter(&sci_label)
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .light_line_style(WHITE)
-            .draw()
-            .map_err(e)?;
+        let setup = ChartSetup { y_label_area: 80, y_ticks: Some(&sci_label), ..ChartSetup::PANEL };
+        let mut chart = setup.build(
+            left,
+            x0..x1,
+            (y0..y1).log_scale(),
+            "slope (deg)",
+            "shear strength k_s (N/m\u{b3})",
+        )?;
         let blue = palette::MODEL_BLUE;
         if let Some(l) = &self.law {
             let band: Vec<(f64, f64)> = l
@@ -162,14 +154,7 @@ impl InferFigure {
             .map_err(e)?
             .label("observed slopes: median and 90% interval (arrow: only a lower bound)")
             .legend(|(x, y)| Circle::new((x + 12, y), 6, BLACK.filled()));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(font(14.0))
-            .draw()
-            .map_err(e)?;
+        super::legend(&mut chart, SeriesLabelPosition::UpperRight, 14.0)?;
         Ok(())
     }
 }
@@ -184,20 +169,8 @@ where
     DB::ErrorType: 'static,
 {
     let e = crate::error::plot_err;
-    let mut c = ChartBuilder::on(area)
-        .margin(15)
-        .x_label_area_size(50)
-        .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, 0.0..1.02)
-        .map_err(e)?;
-    c.configure_mesh()
-        .x_desc("slope (deg)")
-        .y_desc("p_fail")
-        .label_style(font(15.0))
-        .axis_desc_style(font(17.0))
-        .light_line_style(WHITE)
-        .draw()
-        .map_err(e)?;
+    let setup = ChartSetup { y_label_area: 60, ..ChartSetup::PANEL };
+    let mut c = setup.build(area, x0..x1, 0.0..1.02, "slope (deg)", "p_fail")?;
     let red = palette::SLIPPAGE;
     let band: Vec<(f64, f64)> = l
         .prediction
@@ -225,12 +198,6 @@ where
     .map_err(e)?
     .label("observed slopes")
     .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
-    c.configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .label_font(font(14.0))
-        .draw()
-        .map_err(e)?;
+    super::legend(&mut c, SeriesLabelPosition::UpperLeft, 14.0)?;
     Ok(())
 }

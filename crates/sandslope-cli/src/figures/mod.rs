@@ -24,6 +24,8 @@ use std::path::Path;
 use std::sync::Once;
 
 use anyhow::{bail, Result};
+use plotters::coord::cartesian::Cartesian2d;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -140,6 +142,136 @@ pub fn range(values: impl IntoIterator<Item = f64>, fallback: (f64, f64)) -> (f6
     }
     let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.05 * lo.abs().max(1e-9) };
     (lo - pad, hi + pad)
+}
+
+/// A chart over two axes (plain or log coordinates `X`, `Y`), as [`ChartSetup::build`] makes.
+pub type XyChart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
+
+/// How an x-y chart is set up: caption, margin, label areas, type sizes, grid lines and tick
+/// labels, the one place these are chosen ([`ChartSetup::PANEL`] for design and inference
+/// panels, [`ChartSetup::SLOPE`] for charts against slope).
+#[derive(Clone, Copy)]
+pub struct ChartSetup<'s> {
+    /// Caption and its size, pt.
+    pub caption: Option<(&'s str, f64)>,
+    /// Margin around the chart, px.
+    pub margin: u32,
+    /// Height of the x axis' label area, px.
+    pub x_label_area: u32,
+    /// Width of the y axis' label area, px.
+    pub y_label_area: u32,
+    /// Tick labels, pt.
+    pub label_pt: f64,
+    /// Axis descriptions, pt.
+    pub desc_pt: f64,
+    /// Light grid lines (white: none).
+    pub light_lines: RGBColor,
+    /// Bold grid lines, if not plotters' default.
+    pub bold_lines: Option<RGBColor>,
+    /// Tick labels of the x axis, if not plotters' default.
+    pub x_ticks: Option<&'s dyn Fn(&f64) -> String>,
+    /// Tick labels of the y axis, if not plotters' default.
+    pub y_ticks: Option<&'s dyn Fn(&f64) -> String>,
+}
+
+impl<'s> ChartSetup<'s> {
+    /// Design and inference panels: margin 15, 15-pt ticks, 17-pt descriptions, no light grid.
+    pub const PANEL: ChartSetup<'static> = ChartSetup {
+        caption: None,
+        margin: 15,
+        x_label_area: 50,
+        y_label_area: 75,
+        label_pt: 15.0,
+        desc_pt: 17.0,
+        light_lines: WHITE,
+        bold_lines: None,
+        x_ticks: None,
+        y_ticks: None,
+    };
+    /// Charts against slope (sweep, slope curves): margin 12, 15-pt ticks, 17-pt descriptions.
+    pub const SLOPE: ChartSetup<'static> = ChartSetup {
+        caption: None,
+        margin: 12,
+        x_label_area: 45,
+        y_label_area: 70,
+        label_pt: 15.0,
+        desc_pt: 17.0,
+        light_lines: palette::GRID,
+        bold_lines: None,
+        x_ticks: None,
+        y_ticks: None,
+    };
+
+    /// The chart over `x` and `y` (plain or log ranges) on `area`, its mesh drawn with the
+    /// axis descriptions `x_desc` and `y_desc`.
+    pub fn build<'a, DB, X, Y>(
+        &self,
+        area: &'a DrawingArea<DB, Shift>,
+        x: X,
+        y: Y,
+        x_desc: &str,
+        y_desc: &str,
+    ) -> Result<XyChart<'a, DB, X::CoordDescType, Y::CoordDescType>>
+    where
+        DB: DrawingBackend + 'a,
+        DB::ErrorType: 'static,
+        X: AsRangedCoord,
+        Y: AsRangedCoord,
+        X::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        let e = crate::error::plot_err;
+        let mut builder = ChartBuilder::on(area);
+        if let Some((text, pt)) = self.caption {
+            builder.caption(text, font(pt));
+        }
+        let mut chart = builder
+            .margin(self.margin)
+            .x_label_area_size(self.x_label_area)
+            .y_label_area_size(self.y_label_area)
+            .build_cartesian_2d(x, y)
+            .map_err(e)?;
+        let mut mesh = chart.configure_mesh();
+        mesh.x_desc(x_desc)
+            .y_desc(y_desc)
+            .label_style(font(self.label_pt))
+            .axis_desc_style(font(self.desc_pt))
+            .light_line_style(self.light_lines);
+        if let Some(c) = self.bold_lines {
+            mesh.bold_line_style(c);
+        }
+        if let Some(f) = self.x_ticks {
+            mesh.x_label_formatter(f);
+        }
+        if let Some(f) = self.y_ticks {
+            mesh.y_label_formatter(f);
+        }
+        mesh.draw().map_err(e)?;
+        Ok(chart)
+    }
+}
+
+/// The legend box of most figures: at `position`, on 90%-opaque white with a black border, in
+/// `pt`-point type.
+pub fn legend<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    pt: f64,
+) -> Result<()>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    CT: plotters::coord::CoordTranslate,
+{
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(font(pt))
+        .draw()
+        .map_err(crate::error::plot_err)?;
+    Ok(())
 }
 
 /// A chart over slope (degrees, x) and some quantity (y), as the slope-curve figures draw.

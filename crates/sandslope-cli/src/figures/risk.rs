@@ -12,9 +12,7 @@ use sandslope::{Axis, RegimeProbabilities};
 
 use super::palette;
 use super::palette::STAR_GREEN;
-use super::phase::{
-    cell_edges, reduce, sci_label, star_points, within, TerrainStar, MAX_DRAWN_CELLS,
-};
+use super::phase::{cell_edges, reduce, sci_label, star_points, within, TerrainStar, MAX_DRAWN_CELLS};
 use super::slope_curves::swatch_gap;
 use super::{font, Figure};
 
@@ -103,14 +101,7 @@ impl Figure for CurveFigure {
                 .draw_series(std::iter::once(Circle::new((value, self.max_risk), 7, blue.stroke_width(3))))
                 .map_err(e)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(font(16.0))
-            .draw()
-            .map_err(e)?;
+        super::legend(&mut chart, SeriesLabelPosition::UpperLeft, 16.0)?;
         Ok(())
     }
 }
@@ -199,14 +190,7 @@ impl Figure for MapFigure {
                     EmptyElement::at((x + 12, y)) + Polygon::new(star_points(9.0), STAR_GREEN.filled())
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(font(15.0))
-            .draw()
-            .map_err(e)?;
+        super::legend(&mut chart, SeriesLabelPosition::LowerRight, 15.0)?;
         // Colour bar.
         let mut cb = ChartBuilder::on(&bar_area)
             .margin_top(45)
@@ -317,14 +301,7 @@ impl Figure for EnvelopeFigure<'_> {
                 .map_err(e)?
                 .label("safe up to the end of the search");
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(font(16.0))
-            .draw()
-            .map_err(e)?;
+        super::legend(&mut chart, SeriesLabelPosition::UpperRight, 16.0)?;
         Ok(())
     }
 }

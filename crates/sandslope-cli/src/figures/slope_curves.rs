@@ -7,7 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::palette;
-use super::{font, Figure};
+use super::{font, ChartSetup, Figure};
 use crate::error::plot_err;
 
 /// A legend swatch is two segments 20 px long in all: `(0, a)` and `(b, 20)`. Touching for a
@@ -95,23 +95,17 @@ impl Figure for SlopeCurveFigure {
         let ruled_out = ruled_out_within(&self.ruled_out, y_range);
         let y_range =
             ruled_out.iter().filter_map(|m| m.1).fold(y_range, |(lo, hi), v| (lo.min(v), hi.max(v)));
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, font(20.0))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(80)
-            .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("slope (deg)")
-            .y_desc(&self.y_label)
-            .label_style(font(14.0))
-            .axis_desc_style(font(16.0))
-            .light_line_style(WHITE)
-            .bold_line_style(palette::GRID_BOLD)
-            .draw()
-            .map_err(plot_err)?;
+        let setup = ChartSetup {
+            caption: Some((&self.title, 20.0)),
+            y_label_area: 80,
+            label_pt: 14.0,
+            desc_pt: 16.0,
+            light_lines: WHITE,
+            bold_lines: Some(palette::GRID_BOLD),
+            ..ChartSetup::SLOPE
+        };
+        let mut chart =
+            setup.build(root, x_range.0..x_range.1, y_range.0..y_range.1, "slope (deg)", &self.y_label)?;
         if y_range.0 < 0.0 && y_range.1 > 0.0 {
             chart
                 .draw_series(LineSeries::new([(x_range.0, 0.0), (x_range.1, 0.0)], BLACK.stroke_width(1)))

@@ -7,8 +7,7 @@ use plotters::prelude::*;
 
 use sandslope::SpeedObservation;
 
-use super::palette;
-use super::{font, Figure};
+use super::{font, ChartSetup, Figure};
 use crate::error::plot_err;
 use sandslope::SlopeEvaluation;
 
@@ -139,24 +138,13 @@ where
     DB::ErrorType: 'static,
 {
     let (x_range, x, observed) = (panel.x_range, panel.x, panel.observed);
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, font(22.0))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
-        .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .x_desc("slope (deg)")
-        .y_desc(y_label)
-        .x_label_formatter(&super::tick)
-        .y_label_formatter(&super::tick)
-        .label_style(font(15.0))
-        .axis_desc_style(font(17.0))
-        .light_line_style(palette::GRID)
-        .draw()
-        .map_err(plot_err)?;
+    let setup = ChartSetup {
+        caption: Some((title, 22.0)),
+        x_ticks: Some(&super::tick),
+        y_ticks: Some(&super::tick),
+        ..ChartSetup::SLOPE
+    };
+    let mut chart = setup.build(area, x_range.0..x_range.1, y_range.0..y_range.1, "slope (deg)", y_label)?;
     super::shade_repose(
         &mut chart,
         panel.repose,

@@ -123,11 +123,11 @@ fn tracks_section(tracks: &TracksSection<'_>) -> String {
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             r.slope_deg,
             r.files.iter().map(|f| escape(f)).collect::<Vec<_>>().join("<br>"),
-            r.steps,
-            r.unanchored_steps,
-            plus_minus(Some(r.speed_m_s), r.speed_sd_m_s, 100.0, 2),
-            plus_minus(r.t1_s, r.t1_sd_s, 1e3, 1),
-            plus_minus(r.slip_m, r.slip_sd_m, 1e3, 2),
+            r.summary.steps,
+            r.summary.unanchored_steps,
+            plus_minus(Some(r.summary.speed_m_s), r.summary.speed_sd_m_s, 100.0, 2),
+            plus_minus(r.summary.t1_s, r.summary.t1_sd_s, 1e3, 1),
+            plus_minus(r.summary.slip_m, r.summary.slip_sd_m, 1e3, 2),
         ));
     }
     h.push_str("</table>\n");

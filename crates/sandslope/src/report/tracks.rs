@@ -7,6 +7,7 @@ use serde::Serialize;
 use crate::calibrate::AnchoringObservation;
 use crate::calibrate::SpeedObservation;
 use crate::gait::track::TrackResult;
+use crate::gait::GaitSummary;
 use crate::slope::Slope;
 
 /// One slope's recordings, analysed pooled (what `sandslope track` reports for them).
@@ -20,46 +21,22 @@ pub struct TrackedSlope {
     pub result: TrackResult,
 }
 
-/// One slope's row of the motion-capture table and of report.json's `tracks`.
+/// One slope's row of the motion-capture table and of report.json's `tracks`: its files and
+/// the summary `track` reports for them.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TrackRecord {
     /// Slope, degrees.
     pub slope_deg: f64,
     /// The recordings pooled at this slope, as given or matched.
     pub files: Vec<String>,
-    /// Steps measured.
-    pub steps: usize,
-    /// Steps without anchoring (the speed never turned upward).
-    pub unanchored_steps: usize,
-    /// Mean step-averaged speed, m/s.
-    pub speed_m_s: f64,
-    /// Its SD across steps, m/s (`null` with fewer than two steps).
-    pub speed_sd_m_s: Option<f64>,
-    /// Mean anchoring time over anchored steps, s (`null` without anchored steps).
-    pub t1_s: Option<f64>,
-    /// Its SD, s.
-    pub t1_sd_s: Option<f64>,
-    /// Mean backward slip over anchored steps, m.
-    pub slip_m: Option<f64>,
-    /// Its SD, m.
-    pub slip_sd_m: Option<f64>,
+    /// Means and SDs across their steps.
+    #[serde(flatten)]
+    pub summary: GaitSummary,
 }
 
 impl From<&TrackedSlope> for TrackRecord {
     fn from(t: &TrackedSlope) -> TrackRecord {
-        let r = &t.result.summary;
-        TrackRecord {
-            slope_deg: t.slope_deg,
-            files: t.files.clone(),
-            steps: r.steps,
-            unanchored_steps: r.unanchored_steps,
-            speed_m_s: r.speed_m_s,
-            speed_sd_m_s: r.speed_sd_m_s,
-            t1_s: r.t1_s,
-            t1_sd_s: r.t1_sd_s,
-            slip_m: r.slip_m,
-            slip_sd_m: r.slip_sd_m,
-        }
+        TrackRecord { slope_deg: t.slope_deg, files: t.files.clone(), summary: t.result.summary }
     }
 }
 

@@ -16,6 +16,15 @@ What it does (run from anywhere; takes a few minutes the first time):
    cells, and prints the ratio of the median to it.
 
 Usage: python3 bench/plan/run.py [--size 4096] [--repeat 5] [--max-memory GIB] [--no-mcp]
+                                  [--search auto|full|corridor] [--coarse-factor N] [--corridor-width CELLS]
+                                  [--gap]
+
+`--search`, `--coarse-factor` and `--corridor-width` are passed to `sandslope plan` (by default
+none, so plan's `auto` decides: full resolution up to 4096 x 4096, corridor above). `--gap` times
+the full-resolution search (`--search full`) and the corridor search (`--search corridor` with the
+given factor and width) once each, interleaved, `--repeat` times, and prints the corridor
+routes' excess cost over the full optimum (time for the time route, length for the distance
+route): the corridor's optimality gap on this map.
 
 `--size 16384` is issue 24's scale (2.7e8 cells): the DEM (about 1 GiB of float32 before
 deflate) is written 256 rows at a time, so generating it holds a few tens of MiB, and
@@ -51,6 +60,10 @@ def main():
     ap.add_argument("--repeat", type=int, default=5, help="runs of sandslope plan (the median is compared)")
     ap.add_argument("--max-memory", type=float, help="GiB, passed to sandslope plan --max-memory")
     ap.add_argument("--no-mcp", action="store_true", help="skip MCP_Geometric (always skipped above 8192 x 8192)")
+    ap.add_argument("--search", choices=["auto", "full", "corridor"], help="passed to sandslope plan")
+    ap.add_argument("--coarse-factor", type=int, help="passed to sandslope plan")
+    ap.add_argument("--corridor-width", type=int, help="passed to sandslope plan")
+    ap.add_argument("--gap", action="store_true", help="compare --search full and --search corridor")
     args = ap.parse_args()
     ensure([("numpy", "numpy"), ("tifffile", "tifffile"), ("skimage", "scikit-image")])
     import numpy as np
@@ -99,6 +112,17 @@ def main():
            "--goal-px", f"{goal[0]},{goal[1]}", "--objective", "time", "--json"]
     if args.max_memory is not None:
         cmd += ["--max-memory", str(args.max_memory)]
+    corridor = []
+    if args.coarse_factor is not None:
+        corridor += ["--coarse-factor", str(args.coarse_factor)]
+    if args.corridor_width is not None:
+        corridor += ["--corridor-width", str(args.corridor_width)]
+    if args.gap:
+        gap(cmd, corridor, args.repeat)
+        return
+    if args.search is not None:
+        cmd += ["--search", args.search]
+    cmd += corridor
     runs = []
     for _ in range(args.repeat):
         t0 = time.perf_counter()
@@ -138,6 +162,40 @@ def main():
     t_mcp = time.perf_counter() - t0
     print(f"skimage MCP_Geometric (isotropic, 8-connected): {t_mcp:.2f} s, {len(path)} cells on its path")
     print(f"time ratio sandslope (median) / MCP_Geometric: {t_ours / t_mcp:.2f}")
+
+
+def timed(cmd):
+    """Runs cmd (under /usr/bin/time -v): wall s, user + sys s, peak RSS KiB and the JSON."""
+    import json
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if p.returncode != 0:
+        print(p.stderr)
+        sys.exit(1)
+    field = lambda name: re.search(name + r": ([\d.:]+)", p.stderr).group(1)
+    cpu = float(field("User time \\(seconds\\)")) + float(field("System time \\(seconds\\)"))
+    rss = int(field("Maximum resident set size \\(kbytes\\)"))
+    return wall, cpu, rss, json.loads(p.stdout)
+
+
+def gap(cmd, corridor, repeat):
+    """Times the full and the corridor search, interleaved, and prints the corridor's gap."""
+    runs = {"full": [], "corridor": []}
+    for _ in range(repeat):
+        for mode in runs:
+            extra = ["--search", mode] + (corridor if mode == "corridor" else [])
+            runs[mode].append(timed(cmd + extra))
+    for mode, rs in runs.items():
+        print(f"--search {mode}: " + ", ".join(f"{w:.2f} s wall / {c:.2f} s CPU / {r / 1024:.0f} MiB" for w, c, r, _ in rs))
+    full, corr = runs["full"][0][3], runs["corridor"][0][3]
+    print("corridor:", corr.get("search"))
+    for objective, key in [("time", "time_s"), ("distance", "length_m")]:
+        a, b = full["routes"][objective], corr["routes"][objective]
+        if a["found"] and b["found"] and a[key] and b[key]:
+            print(f"{objective}: full {a[key]:.3f}, corridor {b[key]:.3f}, gap {100 * (b[key] / a[key] - 1):+.3f} %")
+        else:
+            print(f"{objective}: full found {a['found']}, corridor found {b['found']}")
 
 
 if __name__ == "__main__":

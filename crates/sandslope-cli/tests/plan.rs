@@ -653,18 +653,77 @@ fn the_memory_check_comes_from_the_header_before_the_samples_are_read() {
         format!("ncols 5000\nnrows 5000\nxllcorner 0\nyllcorner 0\ncellsize 1\n{}\n", row.join(" ")),
     )
     .unwrap();
-    let run = |limit: &str| {
+    let run = |limit: &str, search: &str| {
         let out = s
             .cmd("huge.asc")
-            .args(["--start-px", "10,10", "--goal-px", "20,20", "--max-memory", limit])
+            .args(["--start-px", "10,10", "--goal-px", "20,20", "--max-memory", limit, "--search", search])
             .output()
             .unwrap();
         (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
     };
-    let (code, err) = run("0.5");
+    let (code, err) = run("0.5", "full");
     assert_eq!(code, Some(2));
     assert!(err.contains("5000 x 5000 cells") && err.contains("--max-memory limit of 0.500 GiB"), "{err}");
-    let (code, err) = run("100");
+    let (code, err) = run("100", "full");
     assert_eq!(code, Some(2));
     assert!(!err.contains("--max-memory") && err.contains("huge.asc"), "{err}");
+    // In a corridor (auto's choice above 4096 x 4096 cells) the map holds 5 bytes a cell and
+    // the coarse planner 48 for each of 625 x 625 coarse cells: 0.116 + 0.017 GiB, above 0.1
+    // GiB and below 0.5.
+    for search in ["corridor", "auto"] {
+        let (code, err) = run("0.1", search);
+        assert_eq!(code, Some(2));
+        assert!(err.contains("in a corridor") && err.contains("--max-memory limit of 0.100 GiB"), "{err}");
+        let (code, err) = run("0.5", search);
+        assert_eq!(code, Some(2));
+        assert!(!err.contains("--max-memory") && err.contains("huge.asc"), "{err}");
+    }
+}
+
+/// `--search corridor` on the example dune (200 x 200 cells, 8 x 8 blocks): the routes are
+/// routes of the same graph, so never faster or shorter than the full search's optima, and the
+/// JSON says how they were found; the full search's JSON has no such key. Outputs that need the
+/// full planner are refused.
+#[test]
+fn corridor_search_is_never_better_than_the_full_optimum_and_says_so() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let run = |extra: &[&str]| {
+        Command::cargo_bin("sandslope")
+            .unwrap()
+            .current_dir(&root)
+            .args([
+                "plan",
+                "--dem",
+                "examples/planning/dune.asc",
+                "--start",
+                "52,30",
+                "--goal",
+                "30,30",
+                "--json",
+            ])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let full = json_of(&run(&[]).stdout);
+    assert!(full.get("search").is_none(), "{full}");
+    for width in ["1", "4"] {
+        let out = run(&["--search", "corridor", "--corridor-width", width]);
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        let corridor = json_of(&out.stdout);
+        assert_eq!(corridor["search"]["mode"], "corridor");
+        assert_eq!(corridor["search"]["coarse_size"], serde_json::json!([25, 25]));
+        let (a, b) = (&corridor["routes"], &full["routes"]);
+        let t = |v: &Value| v["time"]["time_s"].as_f64().unwrap();
+        let d = |v: &Value| v["distance"]["length_m"].as_f64().unwrap();
+        assert!(t(a) >= t(b) * (1.0 - 1e-12) && d(a) >= d(b) * (1.0 - 1e-12), "{a} vs {b}");
+        let cells = corridor["search"]["corridors"]["time"]["corridor_cells"].as_u64().unwrap();
+        assert!(cells > 0 && cells <= 40_000, "{cells}");
+    }
+    let out = run(&["--search", "corridor", "--plot", "x.png"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--plot needs the full-resolution search"));
+    let out = run(&["--search", "corridor", "--coarse-factor", "1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--coarse-factor = 1 must be between 2 and 64"));
 }

@@ -288,7 +288,11 @@ pub struct Raster {
 impl Raster {
     /// Whether cell `i` is nodata (the declared value, or not finite).
     pub fn is_nodata(&self, i: usize) -> bool {
-        let v = self.values[i];
+        self.is_nodata_value(self.values[i])
+    }
+
+    /// Whether `v` is a nodata value here (the declared value, or not finite).
+    pub fn is_nodata_value(&self, v: f64) -> bool {
         !v.is_finite() || self.nodata.is_some_and(|nd| v == nd || (nd.is_nan() && v.is_nan()))
     }
 }
@@ -308,23 +312,79 @@ pub type SizeCheck<'a> = &'a dyn Fn(usize, usize) -> Result<()>;
 /// [`read_raster`], with `fits(cols, rows)` called once the header gives the size and before
 /// anything of that size is allocated or decoded: its error refuses the raster.
 pub fn read_raster_within(path: &Path, fits: SizeCheck) -> Result<Raster> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let (mut raster, vertical) = match ext.as_deref() {
-        Some("tif" | "tiff") => read_geotiff(path, fits)?,
-        Some("asc") => read_asc(path, fits)?,
+    let (mut raster, vertical) = match Format::of(path)? {
+        Format::GeoTiff => {
+            let (mut raster, vertical, image) = read_geotiff(path, fits)?;
+            let n = raster.cols * raster.rows;
+            raster.values =
+                samples_as(&path.display(), image, n, |v| v, |v| v.into_iter().map(f64::from).collect())?;
+            (raster, vertical)
+        }
+        Format::Asc => read_asc(path, fits)?,
         // PDS3 rasters carry their own cell size in metres (pds3.rs).
-        Some("img" | "lbl") => return crate::pds3::read_pds3_within(path, fits),
-        _ if crate::pds3::starts_with_label(path) => return crate::pds3::read_pds3_within(path, fits),
-        _ => bail!(
-            "{}: unknown raster format; use a GeoTIFF (.tif, .tiff), an ESRI ASCII grid (.asc) or a PDS3 DTM \
-             (.img, .lbl)",
-            path.display()
-        ),
+        Format::Pds3 => return crate::pds3::read_pds3_within(path, fits),
     };
     if vertical != 1.0 {
         for v in raster.values.iter_mut().filter(|v| v.is_finite()) {
             *v *= vertical;
         }
+    }
+    finish(path, raster, vertical)
+}
+
+/// A raster's heights in metres as `f32` (the planner's precision), nodata cells as NaN, with
+/// the raster's georeference (its `values` left empty): [`read_raster_within`] without the
+/// `f64` copy of the samples, so a float32 GeoTIFF is held once, 4 bytes a cell (its decoded
+/// buffer is converted in place). Each height is the `f64` value [`read_raster_within`] gives
+/// rounded to `f32`, and NaN exactly where [`Raster::is_nodata`] holds; an ASCII grid or a PDS3
+/// DTM is read as `f64` first and converted.
+pub fn read_heights_within(path: &Path, fits: SizeCheck) -> Result<(Raster, Vec<f32>)> {
+    let to_f32 = |raster: &Raster, v: f64| if raster.is_nodata_value(v) { f32::NAN } else { v as f32 };
+    if Format::of(path)? != Format::GeoTiff {
+        let mut raster = read_raster_within(path, fits)?;
+        let values = std::mem::take(&mut raster.values);
+        let heights = values.iter().map(|&v| to_f32(&raster, v)).collect();
+        return Ok((raster, heights));
+    }
+    let (raster, vertical, image) = read_geotiff(path, fits)?;
+    let raster = finish(path, raster, vertical)?;
+    let height = |v: f64| to_f32(&raster, if v.is_finite() { v * vertical } else { v });
+    let n = raster.cols * raster.rows;
+    let heights = samples_as(&path.display(), image, n, height, |v| {
+        v.into_iter().map(|x| height(f64::from(x))).collect()
+    })?;
+    Ok((raster, heights))
+}
+
+/// The raster formats read, by extension or, for other names, by the first bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Format {
+    GeoTiff,
+    Asc,
+    Pds3,
+}
+
+impl Format {
+    fn of(path: &Path) -> Result<Format> {
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        Ok(match ext.as_deref() {
+            Some("tif" | "tiff") => Format::GeoTiff,
+            Some("asc") => Format::Asc,
+            Some("img" | "lbl") => Format::Pds3,
+            _ if crate::pds3::starts_with_label(path) => Format::Pds3,
+            _ => bail!(
+                "{}: unknown raster format; use a GeoTIFF (.tif, .tiff), an ESRI ASCII grid (.asc) or a PDS3 DTM \
+                 (.img, .lbl)",
+                path.display()
+            ),
+        })
+    }
+}
+
+/// A GeoTIFF or ASCII grid read so far, its heights (if any) already in metres: the nodata
+/// value converted by `vertical` too, the ground cell size and the notes on the CRS.
+fn finish(path: &Path, mut raster: Raster, vertical: f64) -> Result<Raster> {
+    if vertical != 1.0 {
         raster.nodata = raster.nodata.map(|nd| nd * vertical);
     }
     let g = &raster.geo;
@@ -358,8 +418,9 @@ pub fn read_raster_within(path: &Path, fits: SizeCheck) -> Result<Raster> {
     Ok(raster)
 }
 
-/// A GeoTIFF, and the factor converting its heights to metres.
-fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
+/// A GeoTIFF (its `values` left empty), the factor converting its heights to metres, and its
+/// decoded samples.
+fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64, DecodingResult)> {
     let name = path.display();
     let mut dec = open_full_resolution(path)?;
     let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
@@ -374,11 +435,8 @@ fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
     }
     let tags = GeoTags::read(&name, &mut dec)?;
     let (west, north, cell_x, cell_y) = tags.origin_and_cell(&name)?;
-    let values = decode_samples(&name, path, &mut dec, bits)?;
+    let image = decode_samples(&name, path, &mut dec, bits)?;
     let (cols, rows) = (w as usize, h as usize);
-    if values.len() != cols * rows {
-        bail!("{name}: decoded {} samples for a {cols} x {rows} image", values.len());
-    }
     let mut notes = Vec::new();
     let GeoTags { geokeys, geodoubles, geoascii, nodata, .. } = tags;
     let (crs, vertical) = crate::crs::from_geokeys(
@@ -389,7 +447,8 @@ fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
         &mut notes,
     )?;
     let geo = GeoRef { west, north, cell_x, cell_y, geokeys, geodoubles, geoascii };
-    Ok((Raster { cols, rows, values, nodata, geo, crs, cell_m: (cell_x, cell_y), notes }, vertical))
+    let raster = Raster { cols, rows, values: Vec::new(), nodata, geo, crs, cell_m: (cell_x, cell_y), notes };
+    Ok((raster, vertical, image))
 }
 
 /// The GDAL_NODATA value of a GeoTIFF, from its tags alone (the samples are not decoded), as
@@ -524,13 +583,14 @@ impl GeoTags {
     }
 }
 
-/// The image's samples as f64, whatever their integer or float type.
+/// The image's samples, of a type [`samples_as`] converts (float32, float64 or 8/16/32-bit
+/// integers; others are refused naming BitsPerSample and SampleFormat).
 fn decode_samples<R: std::io::Read + std::io::Seek>(
     name: &dyn std::fmt::Display,
     path: &Path,
     dec: &mut Decoder<R>,
     bits: u64,
-) -> Result<Vec<f64>> {
+) -> Result<DecodingResult> {
     let sample_format: u16 = dec.find_tag_unsigned(Tag::SampleFormat).ok().flatten().unwrap_or(1);
     let image = match dec.read_image() {
         Ok(image) => image,
@@ -544,15 +604,15 @@ fn decode_samples<R: std::io::Read + std::io::Seek>(
         }
         Err(e) => bail!("{name}: cannot decode the image: {e}"),
     };
-    let values: Vec<f64> = match image {
-        DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
-        DecodingResult::F64(v) => v,
-        DecodingResult::I16(v) => v.into_iter().map(f64::from).collect(),
-        DecodingResult::U16(v) => v.into_iter().map(f64::from).collect(),
-        DecodingResult::I32(v) => v.into_iter().map(f64::from).collect(),
-        DecodingResult::U32(v) => v.into_iter().map(f64::from).collect(),
-        DecodingResult::I8(v) => v.into_iter().map(f64::from).collect(),
-        DecodingResult::U8(v) => v.into_iter().map(f64::from).collect(),
+    match image {
+        DecodingResult::F32(_)
+        | DecodingResult::F64(_)
+        | DecodingResult::I16(_)
+        | DecodingResult::U16(_)
+        | DecodingResult::I32(_)
+        | DecodingResult::U32(_)
+        | DecodingResult::I8(_)
+        | DecodingResult::U8(_) => Ok(image),
         other => bail!(
             "{name}: unsupported sample type (BitsPerSample = {bits}, SampleFormat = {}: {}); use float32, float64 or \
              8/16/32-bit integers",
@@ -563,7 +623,32 @@ fn decode_samples<R: std::io::Read + std::io::Seek>(
                 _ => "another type",
             }
         ),
+    }
+}
+
+/// The `n` samples of `image` ([`decode_samples`]) converted by `f` from their value as `f64`,
+/// float32 samples by `from_f32` (which may convert them in place).
+fn samples_as<T>(
+    name: &dyn std::fmt::Display,
+    image: DecodingResult,
+    n: usize,
+    f: impl Fn(f64) -> T,
+    from_f32: impl FnOnce(Vec<f32>) -> Vec<T>,
+) -> Result<Vec<T>> {
+    let values: Vec<T> = match image {
+        DecodingResult::F32(v) => from_f32(v),
+        DecodingResult::F64(v) => v.into_iter().map(f).collect(),
+        DecodingResult::I16(v) => v.into_iter().map(|x| f(f64::from(x))).collect(),
+        DecodingResult::U16(v) => v.into_iter().map(|x| f(f64::from(x))).collect(),
+        DecodingResult::I32(v) => v.into_iter().map(|x| f(f64::from(x))).collect(),
+        DecodingResult::U32(v) => v.into_iter().map(|x| f(f64::from(x))).collect(),
+        DecodingResult::I8(v) => v.into_iter().map(|x| f(f64::from(x))).collect(),
+        DecodingResult::U8(v) => v.into_iter().map(|x| f(f64::from(x))).collect(),
+        _ => bail!("{name}: unsupported sample type"),
     };
+    if values.len() != n {
+        bail!("{name}: decoded {} samples for an image of {n} cells", values.len());
+    }
     Ok(values)
 }
 
@@ -738,6 +823,44 @@ mod tests {
     fn fixture(name: &str) -> Raster {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal").join(name);
         read_raster(&path).unwrap_or_else(|e| panic!("{name}: {e:#}"))
+    }
+
+    /// The planner's `f32` heights are the `f64` values rounded, NaN exactly where the raster
+    /// says nodata (the declared value, or not finite), with the same size, georeference and
+    /// cell size: for float32 (converted in place), int16, float64, LZW tiles read by
+    /// lzw_tiles.rs, an ASCII grid and a PDS3 DTM with special pixels.
+    #[test]
+    fn f32_heights_are_the_f64_values_rounded_with_nodata_as_nan() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+        let mut nodata_seen = 0;
+        for name in [
+            "gdal/f32-deflate-pred3-tiled.tif",
+            "gdal/i16-lzw-pred2-strips.tif",
+            "gdal/f64-point.tif",
+            "gdal/geo-wgs84-lzw-pred2-i16-be.tif",
+            "gdal/aaigrid.asc",
+            "pds3/dtm-attached.img",
+        ] {
+            let path = dir.join(name);
+            let raster = read_raster(&path).unwrap();
+            let (meta, heights) = read_heights_within(&path, &|_, _| Ok(())).unwrap();
+            assert!(meta.values.is_empty(), "{name}");
+            assert_eq!(
+                (meta.cols, meta.rows, meta.cell_m, meta.nodata),
+                (raster.cols, raster.rows, raster.cell_m, raster.nodata)
+            );
+            assert_eq!((meta.geo.west, meta.geo.north), (raster.geo.west, raster.geo.north), "{name}");
+            assert_eq!(heights.len(), raster.values.len(), "{name}");
+            for (i, (&h, &v)) in heights.iter().zip(&raster.values).enumerate() {
+                if raster.is_nodata(i) {
+                    assert!(h.is_nan(), "{name} cell {i}: {h} for nodata {v}");
+                    nodata_seen += 1;
+                } else {
+                    assert_eq!(h.to_bits(), (v as f32).to_bits(), "{name} cell {i}");
+                }
+            }
+        }
+        assert!(nodata_seen > 0);
     }
 
     /// Tiled LZW with partial edge tiles, which the `tiff` crate fails on: read tile by tile,

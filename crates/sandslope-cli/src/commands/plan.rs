@@ -9,8 +9,8 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use sandslope::plan::{
-    plan, Cell, Descent, ElevationGrid, NoRoute, Objective, PlanRequest, PlanResult, PlanSettings, Planner,
-    Route,
+    plan, plan_corridor, Cell, CorridorPlan, CorridorSettings, Descent, ElevationGrid, NoRoute, Objective,
+    PlanRequest, PlanResult, PlanSettings, Planner, Route,
 };
 use sandslope::risk::{DefaultsUsed, UncertainTerrain};
 use sandslope::{Regime, Robot};
@@ -19,7 +19,7 @@ use crate::args::{check_flag, RobotArgs, TerrainArgs, UncertaintyArgs};
 use crate::figures::plan::PlanFigure;
 use crate::output::{num, print_json, table};
 use sandslope_io::load_terrain;
-use sandslope_io::raster::{read_raster, read_raster_within, write_two_band_geotiff, Raster};
+use sandslope_io::raster::{read_heights_within, read_raster, write_two_band_geotiff, Raster};
 use sandslope_io::routes as writers;
 
 /// Maps at least this large get a progress bar (on a terminal).
@@ -44,6 +44,30 @@ impl From<ObjectiveArg> for Objective {
             ObjectiveArg::Distance => Objective::Distance,
         }
     }
+}
+
+/// `--search` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SearchArg {
+    /// Full resolution for maps of up to 4096 x 4096 cells, corridor above.
+    Auto,
+    /// The exact optimum over every cell of the map.
+    Full,
+    /// Coarse-to-fine: the exact optimum inside a corridor around a route planned on a
+    /// coarsened map (not the full optimum: docs/planning.md measures the gap).
+    Corridor,
+}
+
+/// `--search auto` searches maps of up to this many cells at full resolution (4096 x 4096) and
+/// larger ones in a corridor.
+pub const AUTO_FULL_MAX_CELLS: u64 = 1 << 24;
+
+/// How the routes are searched for, as decided from the DEM's size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Search {
+    Full,
+    /// With the bytes each corridor may take.
+    Corridor(Option<u64>),
 }
 
 /// `--descent` values.
@@ -105,6 +129,20 @@ pub struct PlanArgs {
     /// available when plan starts, MemAvailable in /proc/meminfo).
     #[arg(long, allow_negative_numbers = true, value_name = "GIB")]
     pub max_memory: Option<f64>,
+    /// How to search: `full`, the exact optimum over the whole map (48 bytes a cell); `corridor`,
+    /// coarse-to-fine for maps too large or slow for that: the routes planned on the map
+    /// averaged over --coarse-factor cells, then the exact optimum at full resolution inside a
+    /// corridor of --corridor-width coarse cells on each side of the coarse route (an upper
+    /// bound on the full optimum; docs/planning.md measures the gap; one terrain, no --plot or
+    /// --risk-map); `auto`, full for maps of up to 4096 x 4096 cells, corridor above.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub search: SearchArg,
+    /// Corridor search: fine cells per coarse cell along each axis (2 to 64).
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    pub coarse_factor: usize,
+    /// Corridor search: the corridor's half-width around the coarse route, in coarse cells (1 to 256).
+    #[arg(long, value_name = "CELLS", default_value_t = 8)]
+    pub corridor_width: usize,
     #[command(flatten)]
     pub out: Box<OutputArgs>,
 }
@@ -189,7 +227,13 @@ fn parse_pair(flag: &str, s: &str) -> Result<(f64, f64)> {
     }
 }
 
-fn endpoint(raster: &Raster, which: &str, map: &Option<String>, px: &Option<String>) -> Result<Cell> {
+fn endpoint(
+    raster: &Raster,
+    grid: &ElevationGrid,
+    which: &str,
+    map: &Option<String>,
+    px: &Option<String>,
+) -> Result<Cell> {
     let (cols, rows) = (raster.cols, raster.rows);
     let g = &raster.geo;
     let (east, south) = (g.west + cols as f64 * g.cell_x, g.north - rows as f64 * g.cell_y);
@@ -230,7 +274,7 @@ fn endpoint(raster: &Raster, which: &str, map: &Option<String>, px: &Option<Stri
         bail!("{what} is outside the map: {extent}");
     }
     let cell = Cell { col: c as usize, row: r as usize };
-    if raster.is_nodata(cell.row * cols + cell.col) {
+    if !grid.is_valid(cell.row * cols + cell.col) {
         bail!("{what} lies on a nodata cell (column {}, row {}) of the DEM", cell.col, cell.row);
     }
     Ok(cell)
@@ -352,50 +396,92 @@ fn classes_of(
     Ok((classes, terrains))
 }
 
-/// Refuses a `cols` x `rows` DEM whose planning for `objectives` (and distance) would need more
-/// memory than `--max-memory` (default: what the machine has available), naming the limit and
-/// the bytes per cell; called from the DEM's header, before its samples are read.
-fn check_memory(args: &PlanArgs, cols: usize, rows: usize, objectives: &[Objective]) -> Result<()> {
-    const GIB: f64 = (1u64 << 30) as f64;
-    let (limit, what) = match args.max_memory {
+/// The memory limit: `--max-memory` (checked), else what the machine has available; `None`
+/// where that cannot be read.
+fn memory_limit(args: &PlanArgs) -> Result<Option<(f64, &'static str)>> {
+    Ok(match args.max_memory {
         Some(gib) => {
             let gib = check_flag("--max-memory", gib, 0.0, f64::INFINITY)?;
             if gib <= 0.0 {
                 bail!("--max-memory = {gib} must be a number of GiB greater than 0");
             }
-            (gib * GIB, "the --max-memory limit")
+            Some((gib * GIB, "the --max-memory limit"))
         }
-        None => match available_memory() {
-            Some(bytes) => (
+        None => available_memory().map(|bytes| {
+            (
                 bytes as f64,
                 "the memory available (MemAvailable in /proc/meminfo; --max-memory sets another limit)",
-            ),
-            None => return Ok(()),
-        },
-    };
+            )
+        }),
+    })
+}
+
+const GIB: f64 = (1u64 << 30) as f64;
+
+/// Decides how a `cols` x `rows` DEM is searched (`--search`; `full_only` when an output needs
+/// the full-resolution planner) and refuses it when that would need more memory than
+/// `--max-memory` (default: what the machine has available), naming the limit and the bytes a
+/// cell; called from the DEM's header, before its samples are read.
+fn choose_search(
+    args: &PlanArgs,
+    cols: usize,
+    rows: usize,
+    objectives: &[Objective],
+    full_only: bool,
+) -> Result<Search> {
     let mut objectives = objectives.to_vec();
     objectives.push(Objective::Distance);
     objectives.sort();
     objectives.dedup();
     let searches = objectives.len().min(rayon::current_num_threads().max(1)) as u64;
-    let per_cell = sandslope::plan::bytes_per_cell(searches);
     let cells = cols as u64 * rows as u64;
-    let need = (cells * per_cell) as f64;
-    if need > limit {
+    let corridor = match args.search {
+        SearchArg::Full => false,
+        SearchArg::Corridor => true,
+        SearchArg::Auto => !full_only && cells > AUTO_FULL_MAX_CELLS,
+    };
+    let limit = memory_limit(args)?;
+    if !corridor {
+        let per_cell = sandslope::plan::bytes_per_cell(searches);
+        let need = (cells * per_cell) as f64;
+        if let Some((limit, what)) = limit.filter(|(limit, _)| need > *limit) {
+            bail!(
+                "{}: planning on {} x {} cells needs about {:.3} GiB ({per_cell} bytes a cell: {} for the grid and \
+                 gradients, {} for each of {searches} route searches at once), more than {what} of {:.3} GiB; crop or \
+                 resample the DEM (for example with gdal_translate -srcwin or -tr), or plan in a corridor \
+                 (--search corridor)",
+                args.dem.display(),
+                cols,
+                rows,
+                need / GIB,
+                sandslope::plan::PLANNER_BYTES_PER_CELL,
+                sandslope::plan::SEARCH_BYTES_PER_CELL,
+                limit / GIB
+            );
+        }
+        return Ok(Search::Full);
+    }
+    // The grid at full resolution and the coarse planner with its searches; what is left is
+    // shared by the corridors searched at once.
+    let f = args.coarse_factor.max(1) as u64;
+    let coarse = cols.div_ceil(f as usize) as u64 * rows.div_ceil(f as usize) as u64;
+    let need = cells * sandslope::plan::CORRIDOR_MAP_BYTES_PER_CELL
+        + coarse * sandslope::plan::bytes_per_cell(searches);
+    let Some((limit, what)) = limit else { return Ok(Search::Corridor(None)) };
+    if need as f64 > limit {
         bail!(
-            "{}: planning on {} x {} cells needs about {:.3} GiB ({per_cell} bytes a cell: {} for the grid and \
-             gradients, {} for each of {searches} route searches at once), more than {what} of {:.3} GiB; crop or \
-             resample the DEM (for example with gdal_translate -srcwin or -tr)",
+            "{}: planning on {} x {} cells in a corridor needs about {:.3} GiB before the corridors ({} bytes a \
+             cell for the heights, and the coarse planner), more than {what} of {:.3} GiB; crop or resample the \
+             DEM (for example with gdal_translate -srcwin or -tr)",
             args.dem.display(),
             cols,
             rows,
-            need / GIB,
-            sandslope::plan::PLANNER_BYTES_PER_CELL,
-            sandslope::plan::SEARCH_BYTES_PER_CELL,
+            need as f64 / GIB,
+            sandslope::plan::CORRIDOR_MAP_BYTES_PER_CELL,
             limit / GIB
         );
     }
-    Ok(())
+    Ok(Search::Corridor(Some(((limit - need as f64) / searches as f64) as u64)))
 }
 
 /// The memory the kernel says is available for new allocations (MemAvailable), in bytes;
@@ -431,70 +517,171 @@ pub struct Planned {
     pub result: PlanResult,
 }
 
-/// What `plan --json` prints: per objective, the route's statistics or why none exists.
+/// What `plan --json` prints: per objective, the route's statistics or why none exists, and,
+/// when the routes were planned in corridors, how.
 #[derive(Debug, Serialize)]
 pub struct PlanJson {
     /// By objective name.
     pub routes: BTreeMap<&'static str, RouteRecord>,
+    /// The corridor search's settings and corridors (absent for the full search).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub search: Option<CorridorJson>,
+}
+
+/// How the routes were planned by `--search corridor`, in `plan --json`.
+#[derive(Debug, Serialize)]
+pub struct CorridorJson {
+    /// `corridor`.
+    pub mode: &'static str,
+    /// Fine cells per coarse cell along each axis.
+    pub coarse_factor: usize,
+    /// The corridor's half-width, coarse cells.
+    pub corridor_width: usize,
+    /// The coarse grid's columns and rows.
+    pub coarse_size: (usize, usize),
+    /// Per objective, the coarse route's cost (seconds for time, metres for distance) and the
+    /// corridor's cells.
+    pub corridors: BTreeMap<&'static str, sandslope::plan::CorridorStats>,
 }
 
 /// The value `plan --json` prints (and `serve`'s `/api/plan` returns).
 pub fn answer(planned: &Planned) -> PlanJson {
-    PlanJson { routes: planned.result.routes.iter().map(|(o, r)| (o.name(), RouteRecord::from(r))).collect() }
+    PlanJson { routes: records(&planned.result.routes), search: None }
 }
 
-/// Reads the inputs of `args`, places start and goal and plans every objective, with the risk
-/// raster when `risk_map` (progress bars on a terminal for large maps, notes on stderr, unless
-/// `quiet`).
+/// The `--json` record of each route, by objective name.
+fn records(routes: &[(Objective, Result<Route, NoRoute>)]) -> BTreeMap<&'static str, RouteRecord> {
+    routes.iter().map(|(o, r)| (o.name(), RouteRecord::from(r))).collect()
+}
+
+/// The routes `plan` found in corridors (`--search corridor`) and what they were planned on.
+pub struct CorridorPlanned {
+    /// The elevation model's georeference (its heights are in `grid`).
+    pub dem: Raster,
+    /// The full-resolution grid.
+    pub grid: ElevationGrid,
+    /// The library's result.
+    pub plan: CorridorPlan,
+    /// How the corridors were made.
+    pub settings: CorridorSettings,
+}
+
+/// What `plan` computed, by the search `--search` chose.
+pub enum Computed {
+    /// The full-resolution search.
+    Full(Box<Planned>),
+    /// The corridor search.
+    Corridor(Box<CorridorPlanned>),
+}
+
+/// Reads the inputs of `args`, places start and goal and plans every objective at full
+/// resolution, with the risk raster when `risk_map` (progress bars on a terminal for large
+/// maps, notes on stderr, unless `quiet`); `--search corridor` is refused.
 pub fn compute(args: &PlanArgs, risk_map: bool, quiet: bool) -> Result<Planned> {
+    match compute_any(args, risk_map, true, quiet)? {
+        Computed::Full(planned) => Ok(*planned),
+        Computed::Corridor(_) => {
+            bail!("search = corridor: only the full-resolution search is available here")
+        }
+    }
+}
+
+/// [`compute`] by the search `--search` chooses for the DEM's size (`full_only`: always the
+/// full one, which the risk raster, the figure and terrain classes need).
+pub fn compute_any(args: &PlanArgs, risk_map: bool, full_only: bool, quiet: bool) -> Result<Computed> {
     let robot = args.robot.load()?;
     let settings = settings(args)?;
     let objectives: Vec<Objective> = args.objective.iter().map(|&o| o.into()).collect();
     // The size is checked against the memory limit from the file's header, before its samples
     // are read (a 16384 x 16384 DEM is refused in a moment instead of after reading 3 GiB).
-    let dem = read_raster_within(&args.dem, &|cols, rows| check_memory(args, cols, rows, &objectives))?;
+    let chosen = std::cell::Cell::new(Search::Full);
+    let full_only = full_only || risk_map || args.classes.is_some();
+    let (dem, heights) = read_heights_within(&args.dem, &|cols, rows| {
+        chosen.set(choose_search(args, cols, rows, &objectives, full_only)?);
+        Ok(())
+    })?;
     if !quiet {
         for note in &dem.notes {
             eprintln!("note: {note}");
         }
     }
-    let start = endpoint(&dem, "start", &args.start, &args.start_px)?;
-    let goal = endpoint(&dem, "goal", &args.goal, &args.goal_px)?;
+    // The planner works in metres: the cell's ground size, not its size in map units (degrees
+    // for a geographic DEM, feet for some projected ones). Heights are f32, nodata NaN.
+    let grid = ElevationGrid::new(dem.cols, dem.rows, dem.cell_m.0, dem.cell_m.1, heights, None)
+        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+    let start = endpoint(&dem, &grid, "start", &args.start, &args.start_px)?;
+    let goal = endpoint(&dem, &grid, "goal", &args.goal, &args.goal_px)?;
     let (classes, terrains) = classes_of(args, &dem, quiet)?;
     let request = PlanRequest { start, goal, objectives, risk_map };
-    let grid = grid_of(&dem, args)?;
-    // The grid holds the heights as f32 now: the f64 values (8 bytes a cell) are not needed
-    // again (the outputs use the georeference, the figures the planner's grid).
-    let mut dem = dem;
-    dem.values = Vec::new();
+    let bars = Bars::new(!quiet && grid.len() >= PROGRESS_MIN_CELLS);
+    let progress = |obj: Objective, n: u64, total: u64| {
+        bars.set(obj, n, total);
+        std::ops::ControlFlow::Continue(())
+    };
+    let computed = match chosen.get() {
+        Search::Full => {
+            let result = plan(grid, classes, &terrains, &robot, settings, &request, &progress)
+                .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+            Computed::Full(Box::new(Planned { dem, result }))
+        }
+        Search::Corridor(max_bytes) => {
+            let (None, [terrain]) = (&classes, terrains.as_slice()) else {
+                bail!("--classes needs the full-resolution search (--search full)");
+            };
+            let corridor = CorridorSettings::new(args.coarse_factor, args.corridor_width, max_bytes)
+                .map_err(|e| anyhow!("{e}"))?;
+            let plan = plan_corridor(&grid, terrain, &robot, settings, &request, &corridor, &progress)
+                .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+            Computed::Corridor(Box::new(CorridorPlanned { dem, grid, plan, settings: corridor }))
+        }
+    };
+    bars.finish();
+    Ok(computed)
+}
 
-    let show_progress =
-        !quiet && grid.len() >= PROGRESS_MIN_CELLS && std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let multi = MultiProgress::with_draw_target(if show_progress {
-        ProgressDrawTarget::stderr()
-    } else {
-        ProgressDrawTarget::hidden()
-    });
-    let style = ProgressStyle::with_template("{prefix:>9} {bar:40} {pos}/{len} cells settled ({elapsed})")
-        .unwrap_or_else(|_| ProgressStyle::default_bar());
-    let bars: Vec<(Objective, ProgressBar)> =
-        Objective::ALL.iter().map(|&o| (o, ProgressBar::hidden())).collect();
-    let bars = std::sync::Mutex::new(bars);
-    let result = plan(grid, classes, &terrains, &robot, settings, &request, &|obj, n, total| {
-        let mut bars = bars.lock().unwrap_or_else(|e| e.into_inner());
+/// A progress bar per objective on a terminal (hidden ones otherwise).
+struct Bars {
+    show: bool,
+    multi: MultiProgress,
+    style: ProgressStyle,
+    bars: std::sync::Mutex<Vec<(Objective, ProgressBar)>>,
+}
+
+impl Bars {
+    /// Bars drawn on stderr when `show` and stderr is a terminal.
+    fn new(show: bool) -> Bars {
+        let show = show && std::io::IsTerminal::is_terminal(&std::io::stderr());
+        let multi = MultiProgress::with_draw_target(if show {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        });
+        let style =
+            ProgressStyle::with_template("{prefix:>9} {bar:40} {pos}/{len} cells settled ({elapsed})")
+                .unwrap_or_else(|_| ProgressStyle::default_bar());
+        let bars = Objective::ALL.iter().map(|&o| (o, ProgressBar::hidden())).collect();
+        Bars { show, multi, style, bars: std::sync::Mutex::new(bars) }
+    }
+
+    /// `n` of `total` cells settled by the search of `obj`.
+    fn set(&self, obj: Objective, n: u64, total: u64) {
+        let mut bars = self.bars.lock().unwrap_or_else(|e| e.into_inner());
         if let Some((_, bar)) = bars.iter_mut().find(|(o, _)| *o == obj) {
-            if bar.is_hidden() && show_progress {
-                *bar = multi.add(ProgressBar::new(total).with_style(style.clone()).with_prefix(obj.name()));
+            if bar.is_hidden() && self.show {
+                *bar = self
+                    .multi
+                    .add(ProgressBar::new(total).with_style(self.style.clone()).with_prefix(obj.name()));
             }
+            bar.set_length(total);
             bar.set_position(n);
         }
-        std::ops::ControlFlow::Continue(())
-    })
-    .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
-    for (_, bar) in bars.into_inner().unwrap_or_else(|e| e.into_inner()) {
-        bar.finish();
     }
-    Ok(Planned { dem, result })
+
+    fn finish(self) {
+        for (_, bar) in self.bars.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            bar.finish();
+        }
+    }
 }
 
 /// Runs `sandslope plan`.
@@ -510,9 +697,33 @@ pub fn run(args: PlanArgs) -> Result<()> {
     for p in [&args.out.geojson, &args.out.csv, &args.out.plot, &args.out.risk_map].into_iter().flatten() {
         crate::output::check_parent_exists(p)?;
     }
-    let planned = compute(&args, args.out.risk_map.is_some() || args.out.plot.is_some(), false)?;
-    let Planned { dem, result } = &planned;
+    if args.search == SearchArg::Corridor {
+        for (flag, given) in [
+            ("--plot", args.out.plot.is_some()),
+            ("--risk-map", args.out.risk_map.is_some()),
+            ("--classes", args.classes.is_some()),
+        ] {
+            if given {
+                bail!("{flag} needs the full-resolution search: drop --search corridor (or crop the DEM)");
+            }
+        }
+    }
+    if !(2..=64).contains(&args.coarse_factor) {
+        bail!("--coarse-factor = {} must be between 2 and 64", args.coarse_factor);
+    }
+    if !(1..=256).contains(&args.corridor_width) {
+        bail!("--corridor-width = {} must be between 1 and 256 coarse cells", args.corridor_width);
+    }
+    let full_only = args.out.plot.is_some();
+    match compute_any(&args, args.out.risk_map.is_some() || args.out.plot.is_some(), full_only, false)? {
+        Computed::Full(planned) => run_full(&args, &planned),
+        Computed::Corridor(planned) => run_corridor(&args, &planned),
+    }
+}
 
+/// Writes and prints what the full-resolution search found.
+fn run_full(args: &PlanArgs, planned: &Planned) -> Result<()> {
+    let Planned { dem, result } = planned;
     if let Some(p) = &args.out.geojson {
         writers::write_geojson(p, &dem.geo, &result.routes)?;
     }
@@ -525,17 +736,75 @@ pub fn run(args: PlanArgs) -> Result<()> {
     if let (Some(p), Some(risk)) = (&args.out.plot, &result.risk) {
         crate::figures::save(p, &PlanFigure::new(result, &dem.geo, &risk.p_fail))?;
     }
-    if let Some(x) = result.extrapolation {
+    warn_extrapolation(result.extrapolation);
+    if args.out.json {
+        return print_json(&answer(planned));
+    }
+    print_routes(&result.routes, args.allow_metastable);
+    Ok(())
+}
+
+/// Writes and prints what the corridor search found, saying how it was found.
+fn run_corridor(args: &PlanArgs, planned: &CorridorPlanned) -> Result<()> {
+    let CorridorPlanned { dem, grid, plan, settings } = planned;
+    if let Some(p) = &args.out.geojson {
+        writers::write_geojson(p, &dem.geo, &plan.routes)?;
+    }
+    if let Some(p) = &args.out.csv {
+        writers::write_csv(p, &dem.geo, grid, &plan.routes)?;
+    }
+    warn_extrapolation(plan.extrapolation);
+    let search = CorridorJson {
+        mode: "corridor",
+        coarse_factor: settings.factor(),
+        corridor_width: settings.half_width(),
+        coarse_size: plan.coarse_size,
+        corridors: plan.corridors.iter().map(|c| (c.objective.name(), *c)).collect(),
+    };
+    if args.out.json {
+        return print_json(&PlanJson { routes: records(&plan.routes), search: Some(search) });
+    }
+    print_routes(&plan.routes, args.allow_metastable);
+    let cells: Vec<String> = plan
+        .corridors
+        .iter()
+        .map(|c| {
+            let extent =
+                if c.whole { "the whole map".to_string() } else { format!("{} coarse cells", c.half_width) };
+            format!("{} within {extent}, {} cells", c.objective.name(), c.corridor_cells)
+        })
+        .collect();
+    println!(
+        "note: planned coarse-to-fine (--search corridor): routes on the map averaged over {f} x {f} cells \
+         ({} x {}), then the exact optimum at full resolution in a corridor around each ({}); the \
+         full-resolution optimum may be cheaper (docs/planning.md measures by how much; --search full finds it)",
+        plan.coarse_size.0,
+        plan.coarse_size.1,
+        cells.join("; "),
+        f = settings.factor()
+    );
+    if plan.routes.iter().zip(&plan.corridors).any(|((_, r), c)| r.is_err() && !c.whole) {
+        println!(
+            "note: a route not found in its corridor may still exist on the whole map (the corridor could not be \
+             widened to it within the memory limit): --search full decides"
+        );
+    }
+    Ok(())
+}
+
+/// The warning for routes above a terrain's last measured point.
+fn warn_extrapolation(extrapolation: Option<sandslope::plan::Extrapolation>) {
+    if let Some(x) = extrapolation {
         eprintln!(
             "warning: routes reach {:.1} deg, above the terrain's last measured point ({} deg); k_n and k_s are \
              extrapolated linearly and floored at zero (docs/model.md §7)",
             x.max_pitch_deg, x.last_point_deg
         );
     }
+}
 
-    if args.out.json {
-        return print_json(&answer(&planned));
-    }
+/// Prints the routes' table and the note on the time route.
+fn print_routes(routes: &[(Objective, Result<Route, NoRoute>)], allow_metastable: bool) {
     let mut t = table(&[
         "route",
         "found",
@@ -546,7 +815,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
         "max roll deg",
         "edges by regime",
     ]);
-    for (o, r) in &result.routes {
+    for (o, r) in routes {
         match r {
             Ok(r) => {
                 let regimes = Regime::ALL
@@ -583,10 +852,9 @@ pub fn run(args: PlanArgs) -> Result<()> {
         }
     }
     println!("{t}");
-    if let Some(note) = time_route_note(&result.routes, args.allow_metastable) {
+    if let Some(note) = time_route_note(routes, allow_metastable) {
         println!("note: {note}");
     }
-    Ok(())
 }
 
 /// Why the time route can be slower than another route: it uses success edges only unless

@@ -144,29 +144,68 @@ impl ElevationGrid {
     pub fn horn_gradient(&self) -> Vec<[f32; 2]> {
         let (cols, rows) = (self.cols, self.rows);
         let mut out = vec![[f32::NAN; 2]; cols * rows];
-        let (sx, sy) = (1.0 / (8.0 * self.cell_x), 1.0 / (8.0 * self.cell_y));
-        let z = &self.z;
-        let v = &self.valid;
         let row_fn = |r: usize, out_row: &mut [[f32; 2]]| {
             if r == 0 || r + 1 == rows {
                 return;
             }
             for (c, out) in out_row.iter_mut().enumerate().take(cols - 1).skip(1) {
-                let (n, m, s) = ((r - 1) * cols + c, r * cols + c, (r + 1) * cols + c);
-                let ok = [n - 1, n, n + 1, m - 1, m, m + 1, s - 1, s, s + 1].iter().all(|&i| v[i]);
-                if !ok {
-                    continue;
-                }
-                let h = |i: usize| f64::from(z[i]);
-                let dzdx =
-                    ((h(n + 1) + 2.0 * h(m + 1) + h(s + 1)) - (h(n - 1) + 2.0 * h(m - 1) + h(s - 1))) * sx;
-                let dzdy = ((h(n - 1) + 2.0 * h(n) + h(n + 1)) - (h(s - 1) + 2.0 * h(s) + h(s + 1))) * sy;
-                *out = [dzdx as f32, dzdy as f32];
+                *out = self.horn_at(c, r);
             }
         };
         use rayon::prelude::*;
         out.par_chunks_mut(cols).enumerate().for_each(|(r, chunk)| row_fn(r, chunk));
         out
+    }
+
+    /// The Horn gradient of the cell at column `c`, row `r` ([`ElevationGrid::horn_gradient`]),
+    /// NaN on the border or next to nodata.
+    #[inline(always)]
+    pub fn horn_at(&self, c: usize, r: usize) -> [f32; 2] {
+        let cols = self.cols;
+        if c == 0 || r == 0 || c + 1 >= cols || r + 1 >= self.rows {
+            return [f32::NAN; 2];
+        }
+        let (z, v) = (&self.z, &self.valid);
+        let (sx, sy) = (1.0 / (8.0 * self.cell_x), 1.0 / (8.0 * self.cell_y));
+        let (n, m, s) = ((r - 1) * cols + c, r * cols + c, (r + 1) * cols + c);
+        let ok = [n - 1, n, n + 1, m - 1, m, m + 1, s - 1, s, s + 1].iter().all(|&i| v[i]);
+        if !ok {
+            return [f32::NAN; 2];
+        }
+        let h = |i: usize| f64::from(z[i]);
+        let dzdx = ((h(n + 1) + 2.0 * h(m + 1) + h(s + 1)) - (h(n - 1) + 2.0 * h(m - 1) + h(s - 1))) * sx;
+        let dzdy = ((h(n - 1) + 2.0 * h(n) + h(n + 1)) - (h(s - 1) + 2.0 * h(s) + h(s + 1))) * sy;
+        [dzdx as f32, dzdy as f32]
+    }
+
+    /// The grid averaged into blocks of `factor` x `factor` cells (the last row and column of
+    /// blocks may be smaller): a block's height is the mean of its cells with heights, nodata
+    /// when fewer than half of its cells have one; cells `factor` times as large. Fails as
+    /// [`ElevationGrid::new`] when that leaves fewer than 3 x 3 blocks.
+    pub fn coarsened(&self, factor: usize) -> Result<ElevationGrid, PlanError> {
+        use rayon::prelude::*;
+        let f = factor.max(1);
+        let (cc, cr) = (self.cols.div_ceil(f), self.rows.div_ceil(f));
+        let mut z = vec![f32::NAN; cc * cr];
+        z.par_chunks_mut(cc).enumerate().for_each(|(br, out)| {
+            let rows = br * f..((br + 1) * f).min(self.rows);
+            for (bc, out) in out.iter_mut().enumerate() {
+                let cols = bc * f..((bc + 1) * f).min(self.cols);
+                let (mut sum, mut n) = (0.0_f64, 0usize);
+                for r in rows.clone() {
+                    for i in r * self.cols + cols.start..r * self.cols + cols.end {
+                        if self.valid[i] {
+                            sum += f64::from(self.z[i]);
+                            n += 1;
+                        }
+                    }
+                }
+                if 2 * n >= rows.len() * cols.len() && n > 0 {
+                    *out = (sum / n as f64) as f32;
+                }
+            }
+        });
+        ElevationGrid::new(cc, cr, self.cell_x * f as f64, self.cell_y * f as f64, z, None)
     }
 }
 

@@ -18,6 +18,7 @@
 //! overestimates.
 
 mod classes;
+mod corridor;
 mod grid;
 mod queue;
 mod result;
@@ -27,6 +28,10 @@ mod search;
 mod table;
 
 pub use classes::{class_indices, UnmappedClass};
+pub use corridor::{
+    plan_corridor, CorridorPlan, CorridorSettings, CorridorStats, CORRIDOR_BYTES_PER_CELL,
+    CORRIDOR_MAP_BYTES_PER_CELL,
+};
 pub use grid::{Cell, ElevationGrid};
 pub use result::{plan, Extrapolation, PlanRequest, PlanResult, RiskRaster};
 pub use route::{Route, RouteStep};

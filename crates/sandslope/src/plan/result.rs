@@ -146,19 +146,26 @@ pub fn plan(
         let (p_fail, climb_azimuth_deg) = planner.risk_map();
         RiskRaster { p_fail, climb_azimuth_deg }
     });
+    let extrapolation = extrapolation_of(&routes, planner.tables());
+    Ok(PlanResult { start: request.start, goal: request.goal, routes, risk, extrapolation, planner })
+}
+
+/// Whether a route climbs above the last measured point of a terrain's table, and how far.
+pub(super) fn extrapolation_of(
+    routes: &[(Objective, Result<Route, NoRoute>)],
+    tables: &[super::PitchTable],
+) -> Option<Extrapolation> {
     let max_pitch_deg = routes
         .iter()
         .filter_map(|(_, r)| r.as_ref().ok())
         .map(|r| r.max_pitch_deg)
         .fold(f64::NEG_INFINITY, f64::max);
-    let extrapolation = planner
-        .tables()
+    tables
         .iter()
         .filter_map(|t| t.extrapolated_from_deg())
         .filter(|&last| max_pitch_deg > last)
         .map(|last_point_deg| Extrapolation { max_pitch_deg, last_point_deg })
-        .next();
-    Ok(PlanResult { start: request.start, goal: request.goal, routes, risk, extrapolation, planner })
+        .next()
 }
 
 #[cfg(test)]

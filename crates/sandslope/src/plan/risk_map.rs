@@ -11,7 +11,7 @@ impl Planner {
     /// The regime and P(failure) of climbing `cell` head-on, straight up its fall line
     /// (pitch `atan |grad z|`, no roll); `None` where the cell is impassable.
     pub fn fall_line(&self, cell: Cell) -> Option<(Regime, f64)> {
-        let i = self.grid.index(cell)?;
+        let i = self.index_of(cell)?;
         let g = self.grad[i];
         if g[0].is_nan() {
             return None;

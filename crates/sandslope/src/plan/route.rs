@@ -83,8 +83,8 @@ impl Planner {
             }
         };
         RouteStep {
-            from: self.grid.cell(u),
-            to: self.grid.cell(v),
+            from: self.cell_at(u),
+            to: self.cell_at(v),
             heading_deg: m.azimuth_deg,
             pitch_deg: tan_p.atan().to_degrees(),
             roll_deg: f64::from(e.tan_roll).atan().to_degrees(),
@@ -99,8 +99,8 @@ impl Planner {
 
     /// The move index from `u` to `v`, if they are one move apart.
     pub(super) fn move_between(&self, u: usize, v: usize) -> Option<usize> {
-        let cols = self.grid.cols();
-        let (dc, dr) = ((v % cols) as isize - (u % cols) as isize, (v / cols) as isize - (u / cols) as isize);
+        let (a, b) = (self.cell_at(u), self.cell_at(v));
+        let (dc, dr) = (b.col as isize - a.col as isize, b.row as isize - a.row as isize);
         self.moves.iter().position(|m| m.dc == dc && m.dr == dr)
     }
 
@@ -121,7 +121,7 @@ impl Planner {
         let log_survival: f64 = steps.iter().map(|s| s.cells_crossed * (-s.p_fail).ln_1p()).sum();
         Route {
             objective,
-            cells: cells.iter().map(|&i| self.grid.cell(i)).collect(),
+            cells: cells.iter().map(|&i| self.cell_at(i)).collect(),
             length_m: steps.iter().map(|s| s.length_m).sum(),
             time_s,
             survival: log_survival.exp(),

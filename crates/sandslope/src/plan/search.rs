@@ -75,6 +75,9 @@ pub(super) struct Move {
     pub(super) azimuth_deg: f64,
     /// Flat offsets of the two cells a knight move passes through (0 if not a knight move).
     via: [isize; 2],
+    /// The same two cells as `(d_col, d_row)` (for a corridor, whose rows start at different
+    /// map columns).
+    via_at: [(isize, isize); 2],
 }
 
 /// The grid graph with the model tabulated on it; build once, plan many routes.
@@ -92,6 +95,39 @@ pub struct Planner {
     pub(super) settings: PlanSettings,
     pub(super) tan_max_roll: f32,
     pub(super) cell_width: f64,
+    /// Where the cells lie on the map.
+    pub(super) layout: Layout,
+}
+
+/// Where a planner's cells lie on the map: the whole map (`col0` empty: cell indices are the
+/// map's), or a corridor of it ([`super::corridor`]) whose local row `r` is the map's row
+/// `row0 + r` from the map's column `col0[r]`, `width` cells wide (the grid's columns).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(super) struct Layout {
+    pub(super) row0: usize,
+    pub(super) col0: Vec<isize>,
+    pub(super) width: usize,
+    pub(super) map_cols: usize,
+    pub(super) map_rows: usize,
+}
+
+impl Layout {
+    /// The whole of a `cols` x `rows` map.
+    pub(super) fn whole(cols: usize, rows: usize) -> Layout {
+        Layout { row0: 0, col0: Vec::new(), width: cols, map_cols: cols, map_rows: rows }
+    }
+    /// Whether the planner holds the whole map.
+    pub(super) fn is_whole(&self) -> bool {
+        self.col0.is_empty()
+    }
+    /// Number of cells held.
+    pub(super) fn cells(&self) -> usize {
+        if self.is_whole() {
+            self.map_cols * self.map_rows
+        } else {
+            self.col0.len() * self.width
+        }
+    }
 }
 
 /// Hints the processor to load `v[i]` into cache (nothing if `i` is out of bounds or the
@@ -138,7 +174,7 @@ impl Planner {
         robot: &Robot,
         settings: PlanSettings,
     ) -> Result<Planner, PlanError> {
-        Planner::build(grid, classes, terrains, robot, settings, None)
+        Planner::build(grid, None, classes, terrains, robot, settings, None)
     }
 
     /// [`Planner::new`] with its pitch tables taken from (and kept in) `cache`: the same
@@ -152,11 +188,14 @@ impl Planner {
         settings: PlanSettings,
         cache: &PitchTableCache,
     ) -> Result<Planner, PlanError> {
-        Planner::build(grid, classes, terrains, robot, settings, Some(cache))
+        Planner::build(grid, None, classes, terrains, robot, settings, Some(cache))
     }
 
-    fn build(
+    /// The planner on `grid` (a corridor when `placed` gives its layout and gradients, else the
+    /// whole map with its own Horn gradients).
+    pub(super) fn build(
         grid: ElevationGrid,
+        placed: Option<(Layout, Vec<[f32; 2]>)>,
         classes: Option<Vec<u8>>,
         terrains: &[UncertainTerrain],
         robot: &Robot,
@@ -185,7 +224,8 @@ impl Planner {
                 c
             }
         };
-        let mut grad = grid.horn_gradient();
+        let (layout, mut grad) =
+            placed.unwrap_or_else(|| (Layout::whole(grid.cols(), grid.rows()), grid.horn_gradient()));
         grad.par_iter_mut().zip(class.par_iter()).for_each(|(g, &k)| {
             if k == NO_CLASS {
                 *g = [f32::NAN; 2];
@@ -221,15 +261,16 @@ impl Planner {
             let len = ex.hypot(ny);
             // A knight move's segment crosses two cells between its ends (a corner-to-corner
             // diagonal crosses none): both must be passable too.
-            let via = if dc.abs() + dr.abs() == 3 {
+            let via_at = if dc.abs() + dr.abs() == 3 {
                 if dc.abs() == 2 {
-                    [dc.signum(), dc.signum() + dr * cols]
+                    [(dc.signum(), 0), (dc.signum(), dr)]
                 } else {
-                    [dr.signum() * cols, dr.signum() * cols + dc]
+                    [(0, dr.signum()), (dc, dr.signum())]
                 }
             } else {
-                [0, 0]
+                [(0, 0); 2]
             };
+            let via = via_at.map(|(c, r)| r * cols + c);
             Move {
                 dc,
                 dr,
@@ -238,10 +279,23 @@ impl Planner {
                 len,
                 azimuth_deg: ex.atan2(ny).to_degrees().rem_euclid(360.0),
                 via,
+                via_at,
             }
         });
         let tan_max_roll = settings.max_roll().radians().tan() as f32;
-        Ok(Planner { grid, grad, class, tables, costs, min_cost, moves, settings, tan_max_roll, cell_width })
+        Ok(Planner {
+            grid,
+            grad,
+            class,
+            tables,
+            costs,
+            min_cost,
+            moves,
+            settings,
+            tan_max_roll,
+            cell_width,
+            layout,
+        })
     }
 
     /// The elevation grid.
@@ -258,7 +312,7 @@ impl Planner {
     }
     /// The Horn gradient `(dz/dx, dz/dy)` of a cell, if it is passable.
     pub fn gradient(&self, cell: Cell) -> Option<[f64; 2]> {
-        let g = self.grad[self.grid.index(cell)?];
+        let g = self.grad[self.index_of(cell)?];
         (!g[0].is_nan()).then(|| [f64::from(g[0]), f64::from(g[1])])
     }
     /// Number of passable cells (those with a gradient and a class).
@@ -269,13 +323,14 @@ impl Planner {
     /// Checks that `cell` can start or end a route: inside the grid, with a height, a Horn
     /// gradient and a terrain class. `which` names it in the error (`start` or `goal`).
     pub fn check_endpoint(&self, cell: Cell, which: &'static str) -> Result<usize, PlanError> {
-        let g = &self.grid;
-        let i = g.index(cell).ok_or(PlanError::Outside { which, cell, cols: g.cols(), rows: g.rows() })?;
-        let reason = if !g.is_valid(i) {
+        let (cols, rows) = (self.layout.map_cols, self.layout.map_rows);
+        let i = self.index_of(cell).ok_or(PlanError::Outside { which, cell, cols, rows })?;
+        let on_border = cell.col == 0 || cell.row == 0 || cell.col + 1 == cols || cell.row + 1 == rows;
+        let reason = if !self.grid.is_valid(i) {
             "nodata"
         } else if self.class[i] == NO_CLASS {
             "without a terrain class"
-        } else if self.grad[i][0].is_nan() && g.on_border(cell) {
+        } else if self.grad[i][0].is_nan() && on_border {
             "on the map border, which is impassable (no slope can be computed there)"
         } else if self.grad[i][0].is_nan() {
             "next to nodata (no slope can be computed there)"
@@ -283,6 +338,32 @@ impl Planner {
             return Ok(i);
         };
         Err(PlanError::NoData { which, cell, reason })
+    }
+
+    /// The map cell of the planner's cell `i`.
+    pub(super) fn cell_at(&self, i: usize) -> Cell {
+        let c = self.grid.cell(i);
+        match self.layout.col0.get(c.row) {
+            None => c,
+            Some(&c0) => Cell { col: (c0 + c.col as isize) as usize, row: self.layout.row0 + c.row },
+        }
+    }
+
+    /// The planner's index of map cell `cell`, if it holds it.
+    pub(super) fn index_of(&self, cell: Cell) -> Option<usize> {
+        if self.layout.is_whole() {
+            return self.grid.index(cell);
+        }
+        let r = cell.row.checked_sub(self.layout.row0)?;
+        let c = usize::try_from(cell.col as isize - *self.layout.col0.get(r)?).ok()?;
+        self.grid.index(Cell { col: c, row: r })
+    }
+
+    /// The planner's index of the map cell `(d_col, d_row)` away from its cell `u`, if it
+    /// holds it.
+    fn offset_of(&self, u: usize, (dc, dr): (isize, isize)) -> Option<usize> {
+        let c = self.cell_at(u);
+        self.index_of(Cell { col: c.col.checked_add_signed(dc)?, row: c.row.checked_add_signed(dr)? })
     }
 
     #[inline(always)]
@@ -300,23 +381,11 @@ impl Planner {
 
     /// The neighbour of `u` along move `k` if it exists and is passable (and, for a knight
     /// move, so are the two cells it passes through).
-    #[inline(always)]
     fn neighbour(&self, u: usize, k: usize) -> Option<usize> {
-        let cols = self.grid.cols();
         let m = &self.moves[k];
-        let c = (u % cols).wrapping_add_signed(m.dc);
-        let r = (u / cols).wrapping_add_signed(m.dr);
-        if c >= cols || r >= self.grid.rows() {
-            return None;
-        }
-        let v = r * cols + c;
-        if self.grad[v][0].is_nan() {
-            return None;
-        }
-        if m.via[0] != 0 && m.via.iter().any(|&o| self.grad[u.wrapping_add_signed(o)][0].is_nan()) {
-            return None;
-        }
-        Some(v)
+        let v = self.offset_of(u, (m.dc, m.dr)).filter(|&v| !self.grad[v][0].is_nan())?;
+        let open = |d| self.offset_of(u, d).is_some_and(|w| !self.grad[w][0].is_nan());
+        (m.via[0] == 0 || m.via_at.iter().all(|&d| open(d))).then_some(v)
     }
 
     /// Table entry used by the model for this edge (descent rule applied), and the entry of
@@ -340,7 +409,7 @@ impl Planner {
 
     /// Cost of edge `u -> v` along move `k` for `objective`; `None` if impassable.
     #[inline(always)]
-    fn edge_cost(&self, objective: Objective, u: usize, v: usize, k: usize) -> Option<f64> {
+    pub(super) fn edge_cost(&self, objective: Objective, u: usize, v: usize, k: usize) -> Option<f64> {
         self.cost_of(objective, self.geom(u, v, k), u, v, k)
     }
 
@@ -373,11 +442,11 @@ impl Planner {
     /// `Distance`). This is the graph [`Planner::route`] searches, for use with other graph
     /// algorithms; empty where `cell` is outside the map or impassable.
     pub fn edges(&self, objective: Objective, cell: Cell) -> impl Iterator<Item = (Cell, f64)> + '_ {
-        let u = self.grid.index(cell).filter(|&u| !self.grad[u][0].is_nan());
+        let u = self.index_of(cell).filter(|&u| !self.grad[u][0].is_nan());
         (0..HEADINGS).filter_map(move |k| {
             let u = u?;
             let v = self.neighbour(u, k)?;
-            Some((self.grid.cell(v), self.edge_cost(objective, u, v, k)?))
+            Some((self.cell_at(v), self.edge_cost(objective, u, v, k)?))
         })
     }
 
@@ -410,17 +479,25 @@ impl Planner {
     /// Why no route can exist before searching: no passable edge leaves the start, or none
     /// enters the goal, for this objective.
     fn blocked_end(&self, objective: Objective, s: usize, t: usize) -> Option<NoRoute> {
-        let any_out = (0..HEADINGS)
-            .any(|k| self.neighbour(s, k).is_some_and(|v| self.edge_cost(objective, s, v, k).is_some()));
-        if !any_out {
+        if !self.has_edge_out(objective, s) {
             return Some(NoRoute::StartImpassable);
         }
-        // Into the goal: from each neighbour w of t along the reverse move.
-        let any_in = (0..HEADINGS).any(|k| {
+        (!self.has_edge_in(objective, t)).then_some(NoRoute::GoalImpassable)
+    }
+
+    /// Whether a passable edge leaves the cell `s` for this objective.
+    pub(super) fn has_edge_out(&self, objective: Objective, s: usize) -> bool {
+        (0..HEADINGS)
+            .any(|k| self.neighbour(s, k).is_some_and(|v| self.edge_cost(objective, s, v, k).is_some()))
+    }
+
+    /// Whether a passable edge enters the cell `t` for this objective: from a neighbour `w`
+    /// along the reverse move.
+    pub(super) fn has_edge_in(&self, objective: Objective, t: usize) -> bool {
+        (0..HEADINGS).any(|k| {
             let back = (k + HEADINGS / 2) % HEADINGS;
             self.neighbour(t, k).is_some_and(|w| self.edge_cost(objective, w, t, back).is_some())
-        });
-        (!any_in).then_some(NoRoute::GoalImpassable)
+        })
     }
 
     /// The cells of the cheapest path from `s` to `t`, by label-correcting A* ([`Search`]):
@@ -434,15 +511,9 @@ impl Planner {
         progress: &(dyn Fn(u64) -> ControlFlow<()> + Sync),
     ) -> Option<Result<Vec<usize>, NoRoute>> {
         let mut search = Search::new(self, objective, s, t);
-        while let Some((u, du, gu)) = search.next_cell() {
-            search.prefetch_next();
-            search.settled += 1;
-            if search.settled & 0xFFFF == 0 && progress(search.settled).is_break() {
-                return None;
-            }
-            search.relax_edges(u, du, gu);
-        }
-        if progress(search.settled).is_break() {
+        let stopped =
+            if self.layout.is_whole() { search.run::<false>(progress) } else { search.run::<true>(progress) };
+        if stopped {
             return None;
         }
         Some(search.path())
@@ -493,8 +564,8 @@ impl<'p> Search<'p> {
             objective,
             s,
             t,
-            tc: (t % cols) as f64,
-            tr: (t / cols) as f64,
+            tc: planner.cell_at(t).col as f64,
+            tr: planner.cell_at(t).row as f64,
             h_scale,
             node: Vec::new(),
             pred,
@@ -503,7 +574,7 @@ impl<'p> Search<'p> {
             offsets: planner.moves.map(|m| m.dr * cols as isize + m.dc),
             settled: 0,
         };
-        let h_s = search.heuristic((s % cols) as f64, (s / cols) as f64);
+        let h_s = search.heuristic(planner.cell_at(s).col as f64, planner.cell_at(s).row as f64);
         // Buckets an eighth of the cheapest edge's cost wide (cell width times the smallest
         // cost per metre): an edge whose reduced cost `c(u, v) - h(u) + h(v)` exceeds the width
         // cannot make a cell of the same bucket re-expand.
@@ -521,6 +592,21 @@ impl<'p> Search<'p> {
         let g = &self.planner.grid;
         let (ex, ey) = ((c - self.tc) * g.cell_x(), (r - self.tr) * g.cell_y());
         self.h_scale * (ex * ex + ey * ey).sqrt()
+    }
+
+    /// Expands cells until the goal's distance is final (or the open set is empty), calling
+    /// `progress` every 65 536 cells and at the end; `CORRIDOR` when the planner holds a
+    /// corridor. Whether `progress` asked to stop.
+    fn run<const CORRIDOR: bool>(&mut self, progress: &(dyn Fn(u64) -> ControlFlow<()> + Sync)) -> bool {
+        while let Some((u, du, gu)) = self.next_cell() {
+            self.prefetch_next();
+            self.settled += 1;
+            if self.settled & 0xFFFF == 0 && progress(self.settled).is_break() {
+                return true;
+            }
+            self.relax_edges::<CORRIDOR>(u, du, gu);
+        }
+        progress(self.settled).is_break()
     }
 
     /// The next cell to expand with its distance and gradient, skipping stale entries (the
@@ -561,30 +647,56 @@ impl<'p> Search<'p> {
     /// more cheaply gets the new distance, `u` as predecessor and an entry in the open set,
     /// unless its key cannot beat the goal's distance.
     #[inline(always)]
-    fn relax_edges(&mut self, u: usize, du: f64, gu: [f32; 2]) {
+    fn relax_edges<const CORRIDOR: bool>(&mut self, u: usize, du: f64, gu: [f32; 2]) {
         let p = self.planner;
         let (cols, rows) = (p.grid.cols(), p.grid.rows());
         // One division per settled cell; neighbours by flat offsets (a profile showed the
         // per-neighbour `%` and `/` cost about a third of the search).
         let (c, r) = (u % cols, u / cols);
+        // In a corridor, rows start at different map columns: the shift of the local column
+        // into each of the rows r - 2 ..= r + 2, and u's map cell for the heuristic.
+        let col0 = &p.layout.col0;
+        let shift: [isize; 5] = if CORRIDOR {
+            std::array::from_fn(|i| col0.get((r + i).wrapping_sub(2)).map_or(0, |&s| col0[r] - s))
+        } else {
+            [0; 5]
+        };
+        let (mc, mr) = if CORRIDOR { (c as isize + col0[r], (p.layout.row0 + r) as isize) } else { (0, 0) };
         for (k, m) in p.moves.iter().enumerate() {
-            let (nc, nr) = (c.wrapping_add_signed(m.dc), r.wrapping_add_signed(m.dr));
+            let s = shift[(m.dr + 2) as usize];
+            let (nc, nr) = (c.wrapping_add_signed(m.dc + s), r.wrapping_add_signed(m.dr));
             if nc >= cols || nr >= rows {
                 continue;
             }
-            let v = u.wrapping_add_signed(self.offsets[k]);
+            let v = u.wrapping_add_signed(self.offsets[k] + s);
             // Edges cost more than nothing: a cell already this close cannot improve.
             let Node { dist: dv, grad: gv } = self.node[v];
             if dv <= du || gv[0].is_nan() {
                 continue;
             }
-            if m.via[0] != 0 && m.via.iter().any(|&o| self.node[u.wrapping_add_signed(o)].grad[0].is_nan()) {
-                continue;
+            if m.via[0] != 0 {
+                let blocked = if CORRIDOR {
+                    m.via_at.iter().any(|&(dc, dr)| {
+                        let s = shift[(dr + 2) as usize];
+                        c.wrapping_add_signed(dc + s) >= cols
+                            || self.node[u.wrapping_add_signed(dr * cols as isize + dc + s)].grad[0].is_nan()
+                    })
+                } else {
+                    m.via.iter().any(|&o| self.node[u.wrapping_add_signed(o)].grad[0].is_nan())
+                };
+                if blocked {
+                    continue;
+                }
             }
             let Some(cost) = p.cost_of(self.objective, p.geom_of(gu, gv, k), u, v, k) else { continue };
             let nd = du + cost;
             if nd < dv {
-                let key = nd + self.heuristic(nc as f64, nr as f64);
+                let key = nd
+                    + if CORRIDOR {
+                        self.heuristic((mc + m.dc) as f64, (mr + m.dr) as f64)
+                    } else {
+                        self.heuristic(nc as f64, nr as f64)
+                    };
                 // A path through v at this distance cannot beat the goal's.
                 if key >= self.node[self.t].dist {
                     continue;
@@ -603,12 +715,11 @@ impl<'p> Search<'p> {
         if !self.node[t].dist.is_finite() {
             return Err(NoRoute::GoalUnreachable);
         }
-        let cols = self.planner.grid.cols() as isize;
         let mut cells = vec![t];
         let mut v = t;
         while v != self.s {
             let m = &self.planner.moves[usize::from(self.pred[v])];
-            v = v.wrapping_add_signed(-(m.dr * cols + m.dc));
+            v = self.planner.offset_of(v, (-m.dc, -m.dr)).ok_or(NoRoute::GoalUnreachable)?;
             cells.push(v);
         }
         cells.reverse();

@@ -1,0 +1,500 @@
+//! Coarse-to-fine planning for maps too large for the full-resolution search (issue 24).
+//!
+//! The map is averaged into coarse cells of `factor x factor` fine cells
+//! ([`ElevationGrid::coarsened`]) and each objective is planned on the coarse grid; the fine
+//! search then runs at full resolution, exactly, but only inside a corridor: the fine cells
+//! within `half_width` coarse cells (Chebyshev distance) of the coarse route and of the start's
+//! and goal's coarse cells. A corridor is held as rows of one common width, row `r` starting at
+//! its own map column (the planner's `Layout`), so a diagonal corridor costs its own cells, not
+//! its bounding box.
+//!
+//! What this gives up: the fine route is the optimum among routes inside the corridor, not over
+//! the whole map. Every corridor route is a route of the full graph, with the same edges, costs
+//! and statistics (the gradients are the full map's, edges leaving the corridor are dropped),
+//! so its cost is an upper bound on the full optimum; the gap is measured against the full
+//! search where that fits (docs/planning.md). A passage narrower than a coarse cell can be
+//! missed by the coarse route (it then goes around it, or finds no route).
+
+use std::ops::ControlFlow;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::grid::{Cell, ElevationGrid};
+use super::result::{extrapolation_of, Extrapolation, PlanRequest};
+use super::route::Route;
+use super::search::{Layout, Planner};
+use super::table::PitchTableCache;
+use super::{NoRoute, Objective, PlanError, PlanSettings, PLANNER_BYTES_PER_CELL, SEARCH_BYTES_PER_CELL};
+use crate::risk::UncertainTerrain;
+use crate::robot::Robot;
+
+/// How the corridor search is set up; validated by [`CorridorSettings::new`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct CorridorSettings {
+    factor: usize,
+    half_width: usize,
+    #[serde(skip)]
+    max_bytes: Option<u64>,
+}
+
+impl CorridorSettings {
+    /// `factor` fine cells per coarse cell along each axis (2 to 64), a corridor of
+    /// `half_width` coarse cells (1 to 256) on each side of the coarse route, and, if given, the
+    /// most bytes one corridor's planner and search may take (checked before they are built).
+    pub fn new(
+        factor: usize,
+        half_width: usize,
+        max_bytes: Option<u64>,
+    ) -> Result<CorridorSettings, PlanError> {
+        if !(2..=64).contains(&factor) {
+            return Err(PlanError::Grid(format!("coarse factor = {factor} must be between 2 and 64")));
+        }
+        if !(1..=256).contains(&half_width) {
+            return Err(PlanError::Grid(format!(
+                "corridor half-width = {half_width} coarse cells must be between 1 and 256"
+            )));
+        }
+        Ok(CorridorSettings { factor, half_width, max_bytes })
+    }
+    /// Fine cells per coarse cell along each axis.
+    pub fn factor(&self) -> usize {
+        self.factor
+    }
+    /// Corridor half-width, coarse cells.
+    pub fn half_width(&self) -> usize {
+        self.half_width
+    }
+}
+
+/// Bytes per fine cell of the map that the corridor search holds besides its corridors: the
+/// grid (an `f32` height and a validity flag).
+pub const CORRIDOR_MAP_BYTES_PER_CELL: u64 = 4 + 1;
+
+/// Bytes per corridor cell: a planner's cell and one search's.
+pub const CORRIDOR_BYTES_PER_CELL: u64 = PLANNER_BYTES_PER_CELL + SEARCH_BYTES_PER_CELL;
+
+/// What the corridor search did for one objective.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CorridorStats {
+    /// The objective.
+    pub objective: Objective,
+    /// Cost of the coarse route (the objective's units), if there was one.
+    pub coarse_cost: Option<f64>,
+    /// The corridor's half-width in the end, coarse cells: the one asked for, or wider when
+    /// that corridor held no route.
+    pub half_width: usize,
+    /// Fine cells in the corridor.
+    pub corridor_cells: usize,
+    /// Whether the corridor was the whole map (the route is then the full optimum, and no
+    /// route means none exists).
+    pub whole: bool,
+}
+
+/// What [`plan_corridor`] computed.
+#[derive(Debug, Clone, Serialize)]
+pub struct CorridorPlan {
+    /// The route of each objective, or why none exists, in [`Objective`] order.
+    pub routes: Vec<(Objective, Result<Route, NoRoute>)>,
+    /// Per objective, the coarse route's cost and the corridor's size.
+    pub corridors: Vec<CorridorStats>,
+    /// The coarse grid's size (columns, rows).
+    pub coarse_size: (usize, usize),
+    /// Set when a route climbs above a terrain's last measured point.
+    pub extrapolation: Option<Extrapolation>,
+}
+
+/// Plans `request` on `grid` coarse-to-fine ([module docs](self)): one terrain everywhere, no
+/// risk raster. `progress(objective, settled, corridor passable cells)` as in
+/// [`super::plan`], for the fine searches.
+///
+/// Errors as [`super::plan`], and when a corridor would need more than the settings' byte
+/// limit. Where the corridor holds no route (or the coarse grid has none: the corridor is then
+/// the start's and goal's surroundings), it is widened, twice as wide each time, until it holds
+/// one or is the whole map, as far as the byte limit allows; [`CorridorStats`] says how wide it
+/// ended and whether it was the whole map (only then is a missing route known not to exist).
+pub fn plan_corridor(
+    grid: &ElevationGrid,
+    terrain: &UncertainTerrain,
+    robot: &Robot,
+    settings: PlanSettings,
+    request: &PlanRequest,
+    corridor: &CorridorSettings,
+    progress: &(dyn Fn(Objective, u64, u64) -> ControlFlow<()> + Sync),
+) -> Result<CorridorPlan, PlanError> {
+    for (which, cell) in [("start", request.start), ("goal", request.goal)] {
+        if grid.index(cell).is_none() {
+            return Err(PlanError::Outside { which, cell, cols: grid.cols(), rows: grid.rows() });
+        }
+    }
+    let terrains = std::slice::from_ref(terrain);
+    let cache = PitchTableCache::new();
+    let coarse =
+        Planner::with_cache(grid.coarsened(corridor.factor)?, None, terrains, robot, settings, &cache)?;
+    let mut objectives = request.objectives.clone();
+    objectives.push(Objective::Distance);
+    objectives.sort();
+    objectives.dedup();
+    let coarse_cells = coarse.passable_cells() as u64;
+    let planned = objectives
+        .par_iter()
+        .map(|&obj| {
+            let route = coarse_route(&coarse, obj, request, corridor, &|n| progress(obj, n, coarse_cells))?;
+            let coarse_cost = route.as_ref().map(|r| coarse.cost_of_route(obj, &r.cells));
+            let cells = route.map_or_else(Vec::new, |r| r.cells);
+            // Widened (twice as wide each time) while the corridor holds no route and not yet
+            // the whole map, as far as the byte limit allows.
+            let mut wider = *corridor;
+            let mut found = None;
+            loop {
+                let (layout, spans) = match corridor_layout(grid, &cells, request, &wider) {
+                    Ok(corridor) => corridor,
+                    Err(e) => match found {
+                        Some(found) => break Ok(found),
+                        None => break Err(e),
+                    },
+                };
+                let corridor_cells = spans.iter().map(|s| s.1 - s.0).sum();
+                let whole = corridor_cells == grid.len();
+                let p = Planner::corridor(grid, layout, &spans, terrains, robot, settings, &cache)?;
+                let passable = p.passable_cells() as u64;
+                let r = p.route(obj, request.start, request.goal, &|n| progress(obj, n, passable))?;
+                // Only the final position of the bar; a stop asked now changes nothing.
+                let _ = progress(obj, passable, passable);
+                let stats = CorridorStats {
+                    objective: obj,
+                    coarse_cost,
+                    half_width: wider.half_width,
+                    corridor_cells,
+                    whole,
+                };
+                let done = r.is_ok() || whole;
+                if done {
+                    break Ok(((obj, r), stats));
+                }
+                found = Some(((obj, r), stats));
+                wider.half_width *= 2;
+            }
+        })
+        .collect::<Result<Vec<_>, PlanError>>()?;
+    let (routes, corridors): (Vec<_>, Vec<_>) = planned.into_iter().unzip();
+    let extrapolation = extrapolation_of(&routes, coarse.tables());
+    Ok(CorridorPlan {
+        routes,
+        corridors,
+        coarse_size: (coarse.grid().cols(), coarse.grid().rows()),
+        extrapolation,
+    })
+}
+
+/// The coarse route of `objective` between the coarse cells of the request's start and goal;
+/// where such a cell cannot start or end a route (the coarse border, nodata, every edge
+/// impassable) the nearest one within the corridor's half-width that can is taken.
+fn coarse_route(
+    coarse: &Planner,
+    objective: Objective,
+    request: &PlanRequest,
+    corridor: &CorridorSettings,
+    progress: &(dyn Fn(u64) -> ControlFlow<()> + Sync),
+) -> Result<Option<Route>, PlanError> {
+    let candidates = |fine: Cell| {
+        let g = coarse.grid();
+        let f = corridor.factor;
+        let (c, r) = ((fine.col / f).clamp(1, g.cols() - 2), (fine.row / f).clamp(1, g.rows() - 2));
+        let w = corridor.half_width as isize;
+        let mut ring: Vec<Cell> = (-w..=w)
+            .flat_map(|dr| (-w..=w).map(move |dc| (dc, dr)))
+            .filter_map(|(dc, dr)| {
+                Some(Cell { col: c.checked_add_signed(dc)?, row: r.checked_add_signed(dr)? })
+            })
+            .filter(|cell| coarse.check_endpoint(*cell, "start").is_ok())
+            .collect();
+        ring.sort_by_key(|cell| {
+            let (dc, dr) = (cell.col.abs_diff(c), cell.row.abs_diff(r));
+            (dc.max(dr), dc + dr)
+        });
+        ring
+    };
+    let (starts, goals) = (candidates(request.start), candidates(request.goal));
+    let index = |cell: &Cell| coarse.index_of(*cell);
+    let s = starts.iter().find(|c| index(c).is_some_and(|i| coarse.has_edge_out(objective, i)));
+    let t = goals.iter().find(|c| index(c).is_some_and(|i| coarse.has_edge_in(objective, i)));
+    let (Some(s), Some(t)) = (s, t) else { return Ok(None) };
+    Ok(coarse.route(objective, *s, *t, progress)?.ok())
+}
+
+impl Planner {
+    /// The planner on the corridor `spans` (map columns `[start, end)` of each of the layout's
+    /// rows) of the map `map`: its heights, and the map's own Horn gradients, so that every edge
+    /// inside the corridor is the full planner's edge; the layout's cells outside the spans
+    /// are nodata.
+    fn corridor(
+        map: &ElevationGrid,
+        layout: Layout,
+        spans: &[(usize, usize)],
+        terrains: &[UncertainTerrain],
+        robot: &Robot,
+        settings: PlanSettings,
+        cache: &PitchTableCache,
+    ) -> Result<Planner, PlanError> {
+        let (width, rows) = (layout.width, layout.col0.len());
+        let mut z = vec![f32::NAN; width * rows];
+        let mut grad = vec![[f32::NAN; 2]; width * rows];
+        z.par_chunks_mut(width).zip(grad.par_chunks_mut(width)).enumerate().for_each(|(r, (z, grad))| {
+            let row = layout.row0 + r;
+            let c0 = layout.col0[r] as usize;
+            let (start, end) = spans[r];
+            for (j, (z, grad)) in
+                z.iter_mut().zip(grad.iter_mut()).enumerate().skip(start - c0).take(end - start)
+            {
+                let i = row * map.cols() + c0 + j;
+                if map.is_valid(i) {
+                    *z = map.heights()[i];
+                }
+                *grad = map.horn_at(c0 + j, row);
+            }
+        });
+        let grid = ElevationGrid::new(width, rows, map.cell_x(), map.cell_y(), z, None)?;
+        Planner::build(grid, Some((layout, grad)), None, terrains, robot, settings, Some(cache))
+    }
+
+    /// The cost of the chain of cells `cells` for `objective` (infinite if an edge is missing).
+    fn cost_of_route(&self, objective: Objective, cells: &[Cell]) -> f64 {
+        cells
+            .windows(2)
+            .map(|w| {
+                let (Some(u), Some(v)) = (self.index_of(w[0]), self.index_of(w[1])) else {
+                    return f64::INFINITY;
+                };
+                self.move_between(u, v)
+                    .and_then(|k| self.edge_cost(objective, u, v, k))
+                    .unwrap_or(f64::INFINITY)
+            })
+            .sum()
+    }
+}
+
+/// The corridor around a coarse route: the fine cells within `half_width` coarse cells of a
+/// route cell or of the start's or goal's coarse cell, as each row's span of map columns
+/// (`[start, end)`), and the layout that holds them: rows as wide as the widest span, each
+/// starting at its span (or further west, to stay inside the map).
+fn corridor_layout(
+    grid: &ElevationGrid,
+    route: &[Cell],
+    request: &PlanRequest,
+    corridor: &CorridorSettings,
+) -> Result<(Layout, Vec<(usize, usize)>), PlanError> {
+    let (f, w) = (corridor.factor, corridor.half_width);
+    let (cc, cr) = (grid.cols().div_ceil(f), grid.rows().div_ceil(f));
+    // Per coarse row, the smallest and largest coarse column within the corridor.
+    let mut span = vec![(usize::MAX, 0usize); cr];
+    let ends = [request.start, request.goal].map(|c| Cell { col: c.col / f, row: c.row / f });
+    for c in route.iter().chain(&ends) {
+        let (c0, c1) = (c.col.saturating_sub(w), (c.col + w).min(cc - 1));
+        for s in &mut span[c.row.saturating_sub(w)..=(c.row + w).min(cr - 1)] {
+            *s = (s.0.min(c0), s.1.max(c1));
+        }
+    }
+    // The fine columns of each coarse row's span (none where the corridor misses the row).
+    let fine: Vec<(usize, usize)> = span
+        .iter()
+        .map(|&(c0, c1)| if c0 == usize::MAX { (0, 0) } else { (c0 * f, ((c1 + 1) * f).min(grid.cols())) })
+        .collect();
+    let first = fine.iter().position(|s| s.1 > s.0).unwrap_or(0);
+    let last = fine.iter().rposition(|s| s.1 > s.0).unwrap_or(0);
+    let (row0, row1) = (first * f, ((last + 1) * f).min(grid.rows()));
+    let width = fine[first..=last].iter().map(|s| s.1 - s.0).max().unwrap_or(0);
+    let spans: Vec<(usize, usize)> = (row0..row1).map(|r| fine[r / f]).collect();
+    let col0 = spans.iter().map(|s| s.0.min(grid.cols() - width) as isize).collect();
+    let layout = Layout { row0, col0, width, map_cols: grid.cols(), map_rows: grid.rows() };
+    let bytes = layout.cells() as u64 * CORRIDOR_BYTES_PER_CELL;
+    if let Some(limit) = corridor.max_bytes.filter(|&l| bytes > l) {
+        return Err(PlanError::Grid(format!(
+            "the corridor around the coarse route is {} rows of {} cells, which need {:.3} GiB \
+             ({CORRIDOR_BYTES_PER_CELL} bytes a cell), more than the {:.3} GiB left for it; narrow the corridor \
+             or coarsen less",
+            row1 - row0,
+            width,
+            bytes as f64 / (1u64 << 30) as f64,
+            limit as f64 / (1u64 << 30) as f64
+        )));
+    }
+    Ok((layout, spans))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::tests::paper_robot;
+    use crate::risk::Uncertainty;
+    use crate::terrain::Terrain;
+
+    fn terrain() -> UncertainTerrain {
+        UncertainTerrain::with_uncertainty(
+            Terrain::constant(7e5, 2e6).unwrap(),
+            Uncertainty::new(0.1, 0.2).unwrap(),
+        )
+    }
+
+    /// Dunes from a few sines, 0.5 m cells, slopes up to about 25 degrees: routes must wind.
+    fn dunes(n: usize) -> ElevationGrid {
+        let z = (0..n * n)
+            .map(|i| {
+                let (x, y) = (0.5 * (i % n) as f64, 0.5 * (i / n) as f64);
+                (1.2 * (x / 3.0 + 0.5 * (y / 7.0).sin()).sin() + 0.3 * ((x + y) / 2.0).sin()) as f32
+            })
+            .collect();
+        ElevationGrid::new(n, n, 0.5, 0.5, z, None).unwrap()
+    }
+
+    fn request(start: Cell, goal: Cell) -> PlanRequest {
+        PlanRequest { start, goal, objectives: vec![Objective::Time], risk_map: false }
+    }
+
+    #[test]
+    fn coarsening_averages_blocks_and_drops_mostly_empty_ones() {
+        // 5 x 6 cells in blocks of 2: 3 x 3 blocks, the last column of blocks one cell wide.
+        let z: Vec<f32> = (0..30).map(|i| i as f32).collect();
+        let mut nodata = vec![false; 30];
+        // Block (0, 0) holds cells 0, 1, 5, 6: with 0 and 1 missing, half remain: (5 + 6) / 2.
+        nodata[0] = true;
+        nodata[1] = true;
+        // Block (1, 1) holds 12, 13, 17, 18: three missing, nodata.
+        for i in [12, 13, 17] {
+            nodata[i] = true;
+        }
+        let g = ElevationGrid::new(5, 6, 1.0, 2.0, z, Some(&nodata)).unwrap().coarsened(2).unwrap();
+        assert_eq!((g.cols(), g.rows(), g.cell_x(), g.cell_y()), (3, 3, 2.0, 4.0));
+        let h = |c, r| g.height(Cell { col: c, row: r });
+        assert_eq!(h(0, 0), Some(5.5));
+        assert_eq!(h(1, 0), Some((2.0 + 3.0 + 7.0 + 8.0) / 4.0));
+        assert_eq!(h(2, 0), Some((4.0 + 9.0) / 2.0));
+        assert_eq!(h(1, 1), None);
+        assert_eq!(h(0, 1), Some((10.0 + 11.0 + 15.0 + 16.0) / 4.0));
+        assert_eq!(h(2, 2), Some((24.0 + 29.0) / 2.0));
+    }
+
+    /// With a corridor wider than the map the corridor search is the full search: the same
+    /// optimum. With a narrow one its route is a route of the full graph, costed exactly as
+    /// the full planner costs it, and never cheaper than the full optimum.
+    #[test]
+    fn a_corridor_route_is_a_full_route_no_cheaper_than_the_optimum() {
+        let grid = dunes(72);
+        let full =
+            Planner::new(grid.clone(), None, &[terrain()], &paper_robot(), PlanSettings::default()).unwrap();
+        let (s, t) = (Cell { col: 3, row: 66 }, Cell { col: 68, row: 5 });
+        for (half_width, exact) in [(40, true), (1, false)] {
+            let settings = CorridorSettings::new(4, half_width, None).unwrap();
+            let plan = plan_corridor(
+                &grid,
+                &terrain(),
+                &paper_robot(),
+                PlanSettings::default(),
+                &request(s, t),
+                &settings,
+                &|_, _, _| ControlFlow::Continue(()),
+            )
+            .unwrap();
+            for (obj, r) in &plan.routes {
+                let want = full.route(*obj, s, t, &|_| ControlFlow::Continue(())).unwrap().unwrap();
+                let r = r.as_ref().unwrap();
+                let (got, best) = (full.cost_of_route(*obj, &r.cells), full.cost_of_route(*obj, &want.cells));
+                // Every step is a full-graph edge, with the full planner's statistics.
+                let cells: Vec<usize> = r.cells.iter().map(|c| full.index_of(*c).unwrap()).collect();
+                assert_eq!(*r, full.route_from_cells(*obj, cells));
+                assert!(got.is_finite());
+                if exact {
+                    assert!((got - best).abs() <= 1e-9 * best, "{obj:?}: {got} vs {best}");
+                } else {
+                    assert!(got >= best * (1.0 - 1e-12), "{obj:?}: {got} below the optimum {best}");
+                }
+            }
+            let stats = &plan.corridors[0];
+            assert!(stats.corridor_cells > 0 && stats.corridor_cells <= 72 * 72, "{stats:?}");
+            assert!(stats.coarse_cost.is_some());
+        }
+    }
+
+    /// What the corridor gives up: a passage narrower than a coarse cell. Level ground, 1 m
+    /// cells, a wall of nodata across rows 32 to 63 with a 3-cell gap at columns 30 to 32 (its
+    /// middle column passable) and a wide gap at columns 64 to 94. Averaged over 8 x 8 cells the
+    /// narrow gap's blocks are mostly wall, so the coarse route takes the wide gap, and a
+    /// corridor one coarse cell wide misses the narrow one: from (10, 10) to (10, 85) the full
+    /// route is about 21 sqrt 2 + 33 + 21 sqrt 2 = 92 m long through the narrow gap, the
+    /// corridor's about 2 x hypot(55, 21) + 33 = 151 m through the wide one (column 65 is the
+    /// first with a slope beside the wall).
+    #[test]
+    fn a_passage_narrower_than_a_coarse_cell_can_be_missed() {
+        let n = 96;
+        let nodata: Vec<bool> = (0..n * n)
+            .map(|i| {
+                let (c, r) = (i % n, i / n);
+                (32..64).contains(&r) && !(30..33).contains(&c) && !(64..95).contains(&c)
+            })
+            .collect();
+        let grid = ElevationGrid::new(n, n, 1.0, 1.0, vec![0.0; n * n], Some(&nodata)).unwrap();
+        let (s, t) = (Cell { col: 10, row: 10 }, Cell { col: 10, row: 85 });
+        let settings = CorridorSettings::new(8, 1, None).unwrap();
+        let plan = plan_corridor(
+            &grid,
+            &terrain(),
+            &paper_robot(),
+            PlanSettings::default(),
+            &request(s, t),
+            &settings,
+            &|_, _, _| ControlFlow::Continue(()),
+        )
+        .unwrap();
+        let full = Planner::new(grid, None, &[terrain()], &paper_robot(), PlanSettings::default()).unwrap();
+        for (obj, r) in &plan.routes {
+            let got = r.as_ref().unwrap().length_m;
+            let best = full.route(*obj, s, t, &|_| ControlFlow::Continue(())).unwrap().unwrap().length_m;
+            assert!((best - 92.0).abs() < 3.0 && (got - 151.0).abs() < 8.0, "{obj:?}: {best} and {got}");
+        }
+    }
+
+    #[test]
+    fn a_corridor_planner_holds_only_its_cells_and_places_them_on_the_map() {
+        let grid = dunes(40);
+        let route: Vec<Cell> = (1..9).map(|i| Cell { col: i, row: i }).collect();
+        let settings = CorridorSettings::new(4, 1, None).unwrap();
+        let req = request(Cell { col: 5, row: 5 }, Cell { col: 34, row: 34 });
+        let (layout, spans) = corridor_layout(&grid, &route, &req, &settings).unwrap();
+        // Coarse cells within 1 of a diagonal route cell: in coarse row R those of rows R - 1 to
+        // R + 1 reach columns R - 2 to R + 2, 5 coarse columns = 20 fine ones a row, all rows.
+        assert_eq!((layout.row0, layout.col0.len(), layout.width), (0, 40, 20));
+        let p = Planner::corridor(
+            &grid,
+            layout,
+            &spans,
+            &[terrain()],
+            &paper_robot(),
+            PlanSettings::default(),
+            &PitchTableCache::new(),
+        )
+        .unwrap();
+        for r in 0..40 {
+            for c in 0..40 {
+                let cell = Cell { col: c, row: r };
+                let inside = (spans[r].0..spans[r].1).contains(&c);
+                // The corridor: within two coarse cells of the diagonal.
+                assert_eq!(inside, (c / 4).abs_diff(r / 4) <= 2, "{cell:?}");
+                match p.index_of(cell) {
+                    Some(i) if inside => {
+                        assert_eq!(p.cell_at(i), cell);
+                        assert_eq!(p.grid().heights()[i], grid.heights()[r * 40 + c]);
+                        let g = grid.horn_at(c, r);
+                        assert_eq!(p.grad[i].map(f32::to_bits), g.map(f32::to_bits));
+                    }
+                    // Held to make the rows equally wide, but impassable.
+                    Some(i) => assert!(!p.grid().is_valid(i) && p.grad[i][0].is_nan(), "{cell:?}"),
+                    None => assert!(!inside, "{cell:?}"),
+                }
+            }
+        }
+        // Too small a byte limit is refused before anything is built.
+        let tight = CorridorSettings::new(4, 1, Some(1000)).unwrap();
+        let e = corridor_layout(&grid, &route, &req, &tight).unwrap_err().to_string();
+        assert!(e.contains("40 rows of 20 cells"), "{e}");
+    }
+}

@@ -473,10 +473,10 @@ mod tests {
             &PitchTableCache::new(),
         )
         .unwrap();
-        for r in 0..40 {
+        for (r, span) in spans.iter().enumerate() {
             for c in 0..40 {
                 let cell = Cell { col: c, row: r };
-                let inside = (spans[r].0..spans[r].1).contains(&c);
+                let inside = (span.0..span.1).contains(&c);
                 // The corridor: within two coarse cells of the diagonal.
                 assert_eq!(inside, (c / 4).abs_diff(r / 4) <= 2, "{cell:?}");
                 match p.index_of(cell) {

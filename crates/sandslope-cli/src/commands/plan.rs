@@ -82,7 +82,7 @@ pub enum DescentArg {
 /// Arguments of `sandslope plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// Elevation model: GeoTIFF (.tif) or ESRI ASCII grid (.asc), heights and cell size in metres.
+    /// Elevation model: GeoTIFF (.tif), ESRI ASCII grid (.asc) or PDS3 DTM (.img, .lbl).
     #[arg(long, value_name = "FILE")]
     pub dem: PathBuf,
     /// Start in map coordinates.

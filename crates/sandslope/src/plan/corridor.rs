@@ -351,6 +351,28 @@ mod tests {
         PlanRequest { start, goal, objectives: vec![Objective::Time], risk_map: false }
     }
 
+    /// The time and distance routes from `s` to `t` in corridors of `half_width` blocks of
+    /// `factor` cells.
+    fn corridor_plan(
+        grid: &ElevationGrid,
+        s: Cell,
+        t: Cell,
+        factor: usize,
+        half_width: usize,
+    ) -> CorridorPlan {
+        let settings = CorridorSettings::new(factor, half_width, None).unwrap();
+        plan_corridor(
+            grid,
+            &terrain(),
+            &paper_robot(),
+            PlanSettings::default(),
+            &request(s, t),
+            &settings,
+            &|_, _, _| ControlFlow::Continue(()),
+        )
+        .unwrap()
+    }
+
     #[test]
     fn coarsening_averages_blocks_and_drops_mostly_empty_ones() {
         // 5 x 6 cells in blocks of 2: 3 x 3 blocks, the last column of blocks one cell wide.
@@ -384,17 +406,7 @@ mod tests {
             Planner::new(grid.clone(), None, &[terrain()], &paper_robot(), PlanSettings::default()).unwrap();
         let (s, t) = (Cell { col: 3, row: 66 }, Cell { col: 68, row: 5 });
         for (half_width, exact) in [(40, true), (1, false)] {
-            let settings = CorridorSettings::new(4, half_width, None).unwrap();
-            let plan = plan_corridor(
-                &grid,
-                &terrain(),
-                &paper_robot(),
-                PlanSettings::default(),
-                &request(s, t),
-                &settings,
-                &|_, _, _| ControlFlow::Continue(()),
-            )
-            .unwrap();
+            let plan = corridor_plan(&grid, s, t, 4, half_width);
             for (obj, r) in &plan.routes {
                 let want = full.route(*obj, s, t, &|_| ControlFlow::Continue(())).unwrap().unwrap();
                 let r = r.as_ref().unwrap();
@@ -434,17 +446,7 @@ mod tests {
             .collect();
         let grid = ElevationGrid::new(n, n, 1.0, 1.0, vec![0.0; n * n], Some(&nodata)).unwrap();
         let (s, t) = (Cell { col: 10, row: 10 }, Cell { col: 10, row: 85 });
-        let settings = CorridorSettings::new(8, 1, None).unwrap();
-        let plan = plan_corridor(
-            &grid,
-            &terrain(),
-            &paper_robot(),
-            PlanSettings::default(),
-            &request(s, t),
-            &settings,
-            &|_, _, _| ControlFlow::Continue(()),
-        )
-        .unwrap();
+        let plan = corridor_plan(&grid, s, t, 8, 1);
         let full = Planner::new(grid, None, &[terrain()], &paper_robot(), PlanSettings::default()).unwrap();
         for (obj, r) in &plan.routes {
             let got = r.as_ref().unwrap().length_m;

@@ -17,10 +17,16 @@ use sandslope::{Regime, Robot};
 
 use crate::args::{check_flag, RobotArgs, TerrainArgs, UncertaintyArgs};
 use crate::figures::plan::PlanFigure;
-use crate::output::{num, print_json, table};
+use crate::output::print_json;
 use sandslope_io::load_terrain;
 use sandslope_io::raster::{read_heights_within, read_raster, write_two_band_geotiff, Raster};
 use sandslope_io::routes as writers;
+
+mod memory;
+mod table;
+
+use memory::choose_search;
+use table::print_routes;
 
 /// Maps at least this large get a progress bar (on a terminal).
 const PROGRESS_MIN_CELLS: usize = 1 << 20;
@@ -396,103 +402,6 @@ fn classes_of(
     Ok((classes, terrains))
 }
 
-/// The memory limit: `--max-memory` (checked), else what the machine has available; `None`
-/// where that cannot be read.
-fn memory_limit(args: &PlanArgs) -> Result<Option<(f64, &'static str)>> {
-    Ok(match args.max_memory {
-        Some(gib) => {
-            let gib = check_flag("--max-memory", gib, 0.0, f64::INFINITY)?;
-            if gib <= 0.0 {
-                bail!("--max-memory = {gib} must be a number of GiB greater than 0");
-            }
-            Some((gib * GIB, "the --max-memory limit"))
-        }
-        None => available_memory().map(|bytes| {
-            (
-                bytes as f64,
-                "the memory available (MemAvailable in /proc/meminfo; --max-memory sets another limit)",
-            )
-        }),
-    })
-}
-
-const GIB: f64 = (1u64 << 30) as f64;
-
-/// Decides how a `cols` x `rows` DEM is searched (`--search`; `full_only` when an output needs
-/// the full-resolution planner) and refuses it when that would need more memory than
-/// `--max-memory` (default: what the machine has available), naming the limit and the bytes a
-/// cell; called from the DEM's header, before its samples are read.
-fn choose_search(
-    args: &PlanArgs,
-    cols: usize,
-    rows: usize,
-    objectives: &[Objective],
-    full_only: bool,
-) -> Result<Search> {
-    let mut objectives = objectives.to_vec();
-    objectives.push(Objective::Distance);
-    objectives.sort();
-    objectives.dedup();
-    let searches = objectives.len().min(rayon::current_num_threads().max(1)) as u64;
-    let cells = cols as u64 * rows as u64;
-    let corridor = match args.search {
-        SearchArg::Full => false,
-        SearchArg::Corridor => true,
-        SearchArg::Auto => !full_only && cells > AUTO_FULL_MAX_CELLS,
-    };
-    let limit = memory_limit(args)?;
-    if !corridor {
-        let per_cell = sandslope::plan::bytes_per_cell(searches);
-        let need = (cells * per_cell) as f64;
-        if let Some((limit, what)) = limit.filter(|(limit, _)| need > *limit) {
-            bail!(
-                "{}: planning on {} x {} cells needs about {:.3} GiB ({per_cell} bytes a cell: {} for the grid and \
-                 gradients, {} for each of {searches} route searches at once), more than {what} of {:.3} GiB; crop or \
-                 resample the DEM (for example with gdal_translate -srcwin or -tr), or plan in a corridor \
-                 (--search corridor)",
-                args.dem.display(),
-                cols,
-                rows,
-                need / GIB,
-                sandslope::plan::PLANNER_BYTES_PER_CELL,
-                sandslope::plan::SEARCH_BYTES_PER_CELL,
-                limit / GIB
-            );
-        }
-        return Ok(Search::Full);
-    }
-    // The grid at full resolution and the coarse planner with its searches; what is left is
-    // shared by the corridors searched at once.
-    let f = args.coarse_factor.max(1) as u64;
-    let coarse = cols.div_ceil(f as usize) as u64 * rows.div_ceil(f as usize) as u64;
-    let need = cells * sandslope::plan::CORRIDOR_MAP_BYTES_PER_CELL
-        + coarse * sandslope::plan::bytes_per_cell(searches);
-    let Some((limit, what)) = limit else { return Ok(Search::Corridor(None)) };
-    if need as f64 > limit {
-        bail!(
-            "{}: planning on {} x {} cells in a corridor needs about {:.3} GiB before the corridors ({} bytes a \
-             cell for the heights, and the coarse planner), more than {what} of {:.3} GiB; crop or resample the \
-             DEM (for example with gdal_translate -srcwin or -tr)",
-            args.dem.display(),
-            cols,
-            rows,
-            need as f64 / GIB,
-            sandslope::plan::CORRIDOR_MAP_BYTES_PER_CELL,
-            limit / GIB
-        );
-    }
-    Ok(Search::Corridor(Some(((limit - need as f64) / searches as f64) as u64)))
-}
-
-/// The memory the kernel says is available for new allocations (MemAvailable), in bytes;
-/// `None` where /proc/meminfo cannot be read (not Linux).
-fn available_memory() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
-
 /// The settings the flags give, checked.
 fn settings(args: &PlanArgs) -> Result<PlanSettings> {
     let max_roll = check_flag("--max-roll", args.max_roll, 0.0, 90.0)?;
@@ -801,86 +710,4 @@ fn warn_extrapolation(extrapolation: Option<sandslope::plan::Extrapolation>) {
             x.max_pitch_deg, x.last_point_deg
         );
     }
-}
-
-/// Prints the routes' table and the note on the time route.
-fn print_routes(routes: &[(Objective, Result<Route, NoRoute>)], allow_metastable: bool) {
-    let mut t = table(&[
-        "route",
-        "found",
-        "length m",
-        "time s",
-        "survival",
-        "max pitch deg",
-        "max roll deg",
-        "edges by regime",
-    ]);
-    for (o, r) in routes {
-        match r {
-            Ok(r) => {
-                let regimes = Regime::ALL
-                    .iter()
-                    .zip(r.regimes)
-                    .filter(|(_, n)| *n > 0)
-                    .map(|(g, n)| format!("{g} {n}"))
-                    .chain((r.over_roll_limit > 0).then(|| format!("over roll limit {}", r.over_roll_limit)))
-                    .collect::<Vec<_>>()
-                    .join(", ");
-                t.add_row(vec![
-                    o.name().to_string(),
-                    "yes".into(),
-                    num(Some(r.length_m), 1),
-                    num(r.time_s, 1),
-                    format!("{:.4}", r.survival),
-                    num(Some(r.max_pitch_deg), 1),
-                    num(Some(r.max_roll_deg), 1),
-                    regimes,
-                ]);
-            }
-            Err(e) => {
-                t.add_row(vec![
-                    o.name().to_string(),
-                    "no".into(),
-                    "-".into(),
-                    "-".into(),
-                    "-".into(),
-                    "-".into(),
-                    "-".into(),
-                    e.explain().into(),
-                ]);
-            }
-        }
-    }
-    println!("{t}");
-    if let Some(note) = time_route_note(routes, allow_metastable) {
-        println!("note: {note}");
-    }
-}
-
-/// Why the time route can be slower than another route: it uses success edges only unless
-/// `--allow-metastable`, while the risk route may cross metastable edges (issue 28).
-fn time_route_note(
-    routes: &[(sandslope::plan::Objective, Result<sandslope::plan::Route, sandslope::plan::NoRoute>)],
-    allow_metastable: bool,
-) -> Option<String> {
-    use sandslope::plan::Objective;
-    if allow_metastable {
-        return None;
-    }
-    let time_of = |o: Objective| {
-        routes.iter().find(|(k, _)| *k == o).and_then(|(_, r)| r.as_ref().ok()).and_then(|r| r.time_s)
-    };
-    let fastest = time_of(Objective::Time)?;
-    let (other, t) = routes
-        .iter()
-        .filter(|(k, _)| *k != Objective::Time)
-        .filter_map(|(k, r)| Some((*k, r.as_ref().ok()?.time_s?)))
-        .filter(|(_, t)| *t < fastest)
-        .min_by(|a, b| a.1.total_cmp(&b.1))?;
-    Some(format!(
-        "the {} route ({t:.1} s) is faster than the time route ({fastest:.1} s): the time route uses only \
-         edges where the robot succeeds (unless --allow-metastable), and the other crosses metastable ones \
-         (docs/planning.md)",
-        other.name()
-    ))
 }

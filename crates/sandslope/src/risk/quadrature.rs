@@ -63,6 +63,68 @@ pub(crate) fn density(z: f64) -> f64 {
     (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt()
 }
 
+/// Half-width of [`NormalCdfTable`], in standard deviations; beyond it the CDF is 0 or 1 to
+/// within 1.2e-19.
+pub(crate) const CDF_TABLE_SPAN: f64 = 9.0;
+/// Nodes of [`NormalCdfTable`] per standard deviation.
+const CDF_TABLE_PER_SD: f64 = 64.0;
+
+/// The standard normal CDF on `[-9, 9]` by cubic Hermite interpolation between values of
+/// [`phi`] and of its derivative, the [`density`], tabulated every 1/64 standard deviation
+/// (1,153 nodes, 18 KiB: it stays in the L1 cache).
+///
+/// Why not [`phi`]: the risk map evaluates a few hundred thousand CDFs per 1024 x 1024 map, and
+/// statrs' erfc took 15% of `risk --map`'s CPU time there (`perf record`, 8 single-threaded
+/// runs; 17-23 ns per call in a loop against 2-3 ns for this table). Accuracy: cubic Hermite
+/// interpolation with exact derivatives errs by at most `h^4/384 max|Phi''''|`, and
+/// `Phi'''' = -(z^3 - 3z) phi(z)` peaks at 0.5506, so with `h = 1/64` by at most 8.6e-11,
+/// far below the map's 1e-6 (a test checks the bound against [`phi`]).
+pub(crate) struct NormalCdfTable {
+    /// `[Phi(z_k), h phi(z_k)]` at `z_k = -9 + k h`.
+    nodes: Vec<[f64; 2]>,
+}
+
+impl NormalCdfTable {
+    /// Tabulates the CDF (about 1,153 erfc and exp calls).
+    pub(crate) fn new() -> Self {
+        let h = 1.0 / CDF_TABLE_PER_SD;
+        let n = (2.0 * CDF_TABLE_SPAN * CDF_TABLE_PER_SD).round() as usize;
+        let nodes = (0..=n)
+            .map(|k| {
+                let z = -CDF_TABLE_SPAN + k as f64 * h;
+                [phi(z), h * density(z)]
+            })
+            .collect();
+        NormalCdfTable { nodes }
+    }
+
+    /// `Phi(z)`: interpolated inside `[-9, 9]`, 0 below and 1 above.
+    #[inline]
+    pub(crate) fn cdf(&self, z: f64) -> f64 {
+        let t = (z + CDF_TABLE_SPAN) * CDF_TABLE_PER_SD;
+        let last = self.nodes.len() - 1;
+        if t.is_nan() {
+            return f64::NAN;
+        }
+        if t < 0.0 {
+            return 0.0;
+        }
+        if t >= last as f64 {
+            return 1.0;
+        }
+        let k = t as usize;
+        let u = t - k as f64;
+        let ([p0, m0], [p1, m1]) = (self.nodes[k], self.nodes[k + 1]);
+        // Hermite basis on [0, 1].
+        let (u2, u3) = (u * u, u * u * u);
+        let h00 = 2.0 * u3 - 3.0 * u2 + 1.0;
+        let h10 = u3 - 2.0 * u2 + u;
+        let h01 = 3.0 * u2 - 2.0 * u3;
+        let h11 = u3 - u2;
+        h00 * p0 + h10 * m0 + h01 * p1 + h11 * m1
+    }
+}
+
 /// `P(ln k < ln threshold)` for `ln k ~ Normal(mu, sigma^2)`; a step function when sigma = 0.
 pub(crate) fn prob_below(threshold: f64, mu: f64, sigma: f64) -> f64 {
     if threshold.is_infinite() {
@@ -211,6 +273,29 @@ mod tests {
 
     fn slope(d: f64) -> Slope {
         Slope::from_degrees(d).unwrap()
+    }
+
+    /// The tabulated CDF is within the cubic Hermite bound h^4/384 max|(z^3 - 3z) phi(z)| =
+    /// 8.6e-11 (h = 1/64, the maximum 0.5506 found by hand at z = 0.742) of statrs' erfc
+    /// everywhere, at the nodes and between them; exactly 0 and 1 beyond +-9 sd, where the
+    /// true CDF is within 1.2e-19 of them; NaN stays NaN.
+    #[test]
+    fn the_tabulated_cdf_is_within_its_interpolation_bound() {
+        let table = NormalCdfTable::new();
+        let mut worst: f64 = 0.0;
+        // 1/997 sd apart: prime against the 1/64 spacing, so every phase within an interval.
+        for k in -9_500..=9_500 {
+            let z = k as f64 / 997.0;
+            worst = worst.max((table.cdf(z) - phi(z)).abs());
+        }
+        assert!(worst < 8.6e-11, "worst error {worst:e}");
+        assert!(worst > 0.0, "an exact match everywhere would mean the table is not interpolating");
+        assert_eq!(table.cdf(-9.5), 0.0);
+        assert_eq!(table.cdf(9.0), 1.0);
+        assert_eq!(table.cdf(f64::INFINITY), 1.0);
+        assert_eq!(table.cdf(f64::NEG_INFINITY), 0.0);
+        assert!(table.cdf(f64::NAN).is_nan());
+        assert!((table.cdf(0.0) - 0.5).abs() < 1e-15);
     }
 
     #[test]

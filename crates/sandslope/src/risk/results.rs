@@ -8,7 +8,6 @@ use serde::{Deserialize, Serialize};
 use super::curve::RiskPoint;
 use super::limits::{max_safe_mass, safe_slope_limit, PayloadEnvelope, SafeLimit};
 use super::map::RiskMap;
-use super::quadrature::regime_probabilities;
 use super::uncertainty::{DefaultsUsed, UncertainTerrain, UsedUncertainty};
 use crate::error::ParamError;
 use crate::robot::Robot;
@@ -179,7 +178,7 @@ impl RiskMapSummary {
             cells_below_max_risk: map.p_fail.iter().filter(|&&p| p < max_risk).count(),
             terrain_k_n: ground.k_n,
             terrain_k_s: ground.k_s,
-            terrain_p_fail: regime_probabilities(robot, slope, &ground, sample.uncertainty).p_fail(),
+            terrain_p_fail: super::failure_probability::p_fail(robot, slope, &ground, sample.uncertainty),
             defaults_used: terrain.defaults_used_at(slope),
         })
     }

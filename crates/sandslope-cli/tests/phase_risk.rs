@@ -394,6 +394,31 @@ fn risk_map_csv_has_every_cell_k_n_major() {
     let v = json(&["risk", "--terrain", &t, "--slope", "20", "--cv-n", "0.1", "--cv-s", "0.2", "--json"]);
     assert!((v["p_fail"].as_f64().unwrap() - rows[5][2]).abs() < 1e-6, "{v} vs {:?}", rows[5]);
     assert!(rows.iter().all(|r| r[2] <= r[3] + 1e-12 && (0.0..=1.0).contains(&r[2])));
+    // `--json` lists the same cells indexed [k_n][k_s] (Python's risk_map shape), after the
+    // axis values.
+    let v = json(&[
+        "risk",
+        "--slope",
+        "20",
+        "--cv-n",
+        "0.1",
+        "--cv-s",
+        "0.2",
+        "--map",
+        "--k-n",
+        "1e5:1e7:3",
+        "--k-s",
+        "1e5:1e7:4",
+        "--json",
+    ]);
+    assert_eq!((v["k_n"].as_array().unwrap().len(), v["k_s"].as_array().unwrap().len()), (3, 4));
+    for (c, r) in rows.iter().enumerate() {
+        let (i, j) = (c / 4, c % 4);
+        let near =
+            |x: &serde_json::Value, y: f64| (x.as_f64().unwrap() - y).abs() <= 1e-15 * y.abs().max(1e-300);
+        assert!(near(&v["k_n"][i], r[0]) && near(&v["k_s"][j], r[1]), "{c}");
+        assert!(near(&v["p_fail"][i][j], r[2]) && near(&v["p_not_success"][i][j], r[3]), "{c}");
+    }
 }
 
 #[test]

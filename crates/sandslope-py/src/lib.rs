@@ -44,6 +44,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(risk::risk_map, m)?)?;
     m.add_function(wrap_pyfunction!(risk::safe_slope, m)?)?;
     m.add_function(wrap_pyfunction!(risk::safe_mass, m)?)?;
+    m.add_function(wrap_pyfunction!(risk::payload_envelope, m)?)?;
     m.add_function(wrap_pyfunction!(plan::risk_raster, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan::read_raster, m)?)?;

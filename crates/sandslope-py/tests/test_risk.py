@@ -1,4 +1,5 @@
-"""risk, risk_map, safe_slope, safe_mass against the CLI; the missing-SD message."""
+"""risk, risk_map, safe_slope, safe_mass, payload_envelope against the CLI; the missing-SD
+message."""
 
 import numpy as np
 import pytest
@@ -70,6 +71,43 @@ def test_solvers_match_cli(cli, robot, root):
     assert got == want
     # The payload is the heaviest safe mass less the robot's own.
     assert got["max_payload_kg"] == pytest.approx(got["max_mass_kg"] - robot.mass_kg, abs=1e-12)
+
+
+def test_payload_envelope_is_the_cli_envelope(cli, robot, root):
+    uncertain = root / "examples" / "phase" / "uncertain-sand.toml"
+    want = cli.json("risk", "--terrain", uncertain, "--slope", "0,8,-12", "--solve", "mass", "--max-risk", 0.1)
+    got = sandslope.payload_envelope(robot, [0, 8, -12], terrain=uncertain, max_risk=0.1)
+    # One library value: the same keys and numbers, bit for bit.
+    assert got == want
+    # Each point is the one-slope search, whose payload is its mass less the robot's own.
+    for p in got["points"]:
+        one = sandslope.safe_mass(robot, p["slope_deg"], terrain=uncertain, max_risk=0.1)
+        assert (p["max_mass_kg"], p["limit"]) == (one["max_mass_kg"], one["limit"])
+        assert p["max_payload_kg"] == pytest.approx(p["max_mass_kg"] - robot.mass_kg, abs=1e-12)
+    # A descent is felt as the climb of its size (docs/model.md §8).
+    assert got["points"][2]["max_mass_kg"] == sandslope.safe_mass(robot, 12, terrain=uncertain, max_risk=0.1)["max_mass_kg"]
+    with pytest.raises(ValueError, match=r"slope_deg\[1\] = 95 must be"):
+        sandslope.payload_envelope(robot, [10, 95], terrain=uncertain)
+    with pytest.raises(ValueError, match="max_risk = 1 must be"):
+        sandslope.payload_envelope(robot, [10], terrain=uncertain, max_risk=1)
+
+
+def test_risk_map_is_the_cli_map(cli, robot, terrain):
+    # `risk --map --json` and risk_map serialise one library value: the same keys; the
+    # summary equal, the axes and cells (arrays here, nested lists [k_n][k_s] there) equal.
+    want = cli.json(
+        "risk", "--slope", 20, "--map", "--k-n", "1e5:1e7:4", "--k-s", "1e5:1e7:5", "--cv-n", 0.1, "--max-risk", 0.2
+    )
+    got = sandslope.risk_map(
+        robot, 20, np.geomspace(1e5, 1e7, 4), np.geomspace(1e5, 1e7, 5), terrain=terrain, cv_n=0.1, max_risk=0.2
+    )
+    assert set(got) == set(want)
+    arrays = {"k_n", "k_s", "p_fail", "p_not_success"}
+    assert {k: v for k, v in got.items() if k not in arrays} == {k: v for k, v in want.items() if k not in arrays}
+    for k in arrays:
+        np.testing.assert_array_equal(got[k], np.array(want[k]), err_msg=k)
+    assert got["p_fail"].shape == (4, 5) and got["cells"] == 20
+    assert got["cells_below_max_risk"] == int((got["p_fail"] < 0.2).sum())
 
 
 def test_risk_map_matches_pointwise_risk(robot):

@@ -13,8 +13,8 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 
 use sandslope::risk::{
-    payload_envelope, risk_curve, safe_mass, safe_slope, safe_slope_limit, DefaultsUsed, PayloadEnvelope,
-    RiskAnswer, RiskCurve, RiskMap, RiskMapSummary, RiskPoint, SafeLimit, SafeMass, UncertainTerrain,
+    payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, safe_slope_limit, DefaultsUsed,
+    PayloadEnvelope, RiskAnswer, RiskCurve, RiskMap, RiskPoint, SafeLimit, SafeMass, UncertainTerrain,
 };
 use sandslope::{Robot, Slope};
 
@@ -294,13 +294,10 @@ pub fn answer(args: &RiskArgs, limits: AnswerLimits) -> Result<RiskAnswer> {
         anyhow!("--slope gives {n} slopes; at most {most} are allowed for {what} here")
     };
     if args.map {
-        let (slope, k_n_axis, k_s_axis) = map_axes(args, &terrain, slopes[0], limits.map_cells)?;
-        let u = terrain.sample(slope).uncertainty;
-        let repose = terrain.sample(slope).ground.repose;
-        let map = RiskMap::compute(&robot, slope, repose, &k_n_axis, &k_s_axis, u, &|| {});
-        let summary =
-            RiskMapSummary::of(&map, &robot, slopes[0], &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
-        return Ok(RiskAnswer::Map(Box::new(summary)));
+        let (k_n_axis, k_s_axis) = map_axes(args, &terrain, slopes[0], limits.map_cells)?;
+        let map = risk_map(&robot, slopes[0], &terrain, (&k_n_axis, &k_s_axis), max_risk, &|| {})
+            .map_err(|e| anyhow!("{e}"))?;
+        return Ok(RiskAnswer::Map(Box::new(map)));
     }
     Ok(match args.solve {
         Some(Solve::Mass) if slopes.len() > 1 => {
@@ -329,14 +326,14 @@ pub fn answer(args: &RiskArgs, limits: AnswerLimits) -> Result<RiskAnswer> {
     })
 }
 
-/// The `--map` slope and axes (the flags', else the defaults around the terrain's medians),
-/// at most `max_cells` cells.
+/// The `--map` axes (the flags', else the defaults around the terrain's medians at
+/// `slope_deg`, an error naming `--slope` if it is out of range), at most `max_cells` cells.
 fn map_axes(
     args: &RiskArgs,
     terrain: &UncertainTerrain,
     slope_deg: f64,
     max_cells: u128,
-) -> Result<(Slope, sandslope::Axis, sandslope::Axis)> {
+) -> Result<(sandslope::Axis, sandslope::Axis)> {
     let slope = slope_of(slope_deg)?;
     let ground = terrain.sample(slope).ground;
     let k_n_axis = match &args.k_n {
@@ -354,7 +351,7 @@ fn map_axes(
             "--k-n and --k-s give {cells} map cells; at most {max_cells} are allowed (e.g. {side} x {side}), to keep the map in memory"
         );
     }
-    Ok((slope, k_n_axis, k_s_axis))
+    Ok((k_n_axis, k_s_axis))
 }
 
 /// Tells the user on stderr when a default CV was used (docs/model.md §9).
@@ -554,16 +551,19 @@ fn run_map(
     max_risk: f64,
     quiet: bool,
 ) -> Result<()> {
-    let (slope, k_n_axis, k_s_axis) = map_axes(args, terrain, slope_deg, MAX_MAP_CELLS)?;
+    let (k_n_axis, k_s_axis) = map_axes(args, terrain, slope_deg, MAX_MAP_CELLS)?;
+    let slope = slope_of(slope_deg)?;
     let sample = terrain.sample(slope);
     let (ground, u) = (sample.ground, sample.uncertainty);
     let defaults = terrain.defaults_used_at(slope);
     note_defaults(defaults);
     let bar = progress_bar(k_s_axis.len() as u64, quiet, "p_fail map");
-    let map = RiskMap::compute(robot, slope, ground.repose, &k_n_axis, &k_s_axis, u, &|| bar.inc(1));
+    let answer = risk_map(robot, slope_deg, terrain, (&k_n_axis, &k_s_axis), max_risk, &|| bar.inc(1))
+        .map_err(|e| anyhow!("{e}"))?;
     bar.finish_and_clear();
+    let map = &answer.map;
     if let Some(Some(path)) = &args.csv {
-        write_map_csv(path, &map)?;
+        write_map_csv(path, map)?;
     }
     if let Some(dir) = &args.npy {
         use sandslope_io::npy::{write_npy_dir, NpyData};
@@ -596,14 +596,12 @@ fn run_map(
         };
         save(path, &figure)?;
     }
-    let summary =
-        RiskMapSummary::of(&map, robot, slope_deg, terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
     match args.format() {
-        Format::Json => print_json(&RiskAnswer::Map(Box::new(summary))),
+        Format::Json => print_json(&RiskAnswer::Map(Box::new(answer))),
         Format::Csv => match &args.csv {
             Some(None) => {
                 let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-                map_csv(&map, &mut out).and_then(|_| out.flush()).context("cannot write to stdout")
+                map_csv(map, &mut out).and_then(|_| out.flush()).context("cannot write to stdout")
             }
             _ => Ok(()),
         },
@@ -621,11 +619,11 @@ fn run_map(
             );
             println!(
                 "{} of {} cells have p_fail < {max_risk}; the terrain's own medians (k_n {}, k_s {}) have p_fail {:.4}",
-                summary.cells_below_max_risk,
-                summary.cells,
+                answer.summary.cells_below_max_risk,
+                answer.summary.cells,
                 sci(ground.k_n),
                 sci(ground.k_s),
-                summary.terrain_p_fail
+                answer.summary.terrain_p_fail
             );
             if let Some(note) = defaults.note() {
                 println!("note: {note}");

@@ -47,6 +47,7 @@ __all__ = [
     "risk_map",
     "safe_slope",
     "safe_mass",
+    "payload_envelope",
     "plan",
     "risk_raster",
     "read_raster",
@@ -315,6 +316,7 @@ def risk_map(
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
     mass_kg: Optional[float] = None,
+    max_risk: float = 0.05,
 ) -> Dict[str, Any]:
     """P(failure) over a grid of median ``(k_n, k_s)`` at one slope (``sandslope risk --map``).
 
@@ -322,10 +324,13 @@ def risk_map(
     ``slope_deg`` (or ``cv_n``/``cv_s``). Axes as in :func:`phase`; by default the CLI's:
     200 log-spaced values from the terrain's k_n / 100 to x 100 and k_s / 1000 to x 100.
 
-    Returns ``p_fail`` and ``p_not_success``, each of shape ``(len(k_n_axis), len(k_s_axis))``;
-    ``k_n``, ``k_s`` (the axes); ``terrain_k_n``, ``terrain_k_s`` (the terrain's medians at this
-    slope), the ``cv_n``, ``cv_s`` used (rule of docs/model.md §9) and their sources, and
-    ``beyond_repose``.
+    Returns the keys of ``sandslope risk --map --json`` (one library value): ``p_fail`` and
+    ``p_not_success``, each of shape ``(len(k_n_axis), len(k_s_axis))``; ``k_n``, ``k_s`` (the
+    axis values) and ``k_n_axis``, ``k_s_axis`` (``min``, ``max``, ``points``, ``scale``);
+    ``cells`` and ``cells_below_max_risk`` (``p_fail < max_risk``); ``terrain_k_n``,
+    ``terrain_k_s`` (the terrain's medians at this slope) and ``terrain_p_fail`` there; the
+    ``cv_n``, ``cv_s`` used (rule of docs/model.md §9), their sources and ``defaults_used``;
+    ``slope_deg``, ``max_risk`` and ``beyond_repose``.
     """
     robot, terrain = _robot(robot), _terrain(terrain)
     if mass_kg is not None:
@@ -333,7 +338,9 @@ def risk_map(
     at = terrain.at(float(slope_deg))
     kn = _axis("k_n_axis", np.geomspace(at["k_n"] / 100, at["k_n"] * 100, 200) if k_n_axis is None else k_n_axis)
     ks = _axis("k_s_axis", np.geomspace(at["k_s"] / 1000, at["k_s"] * 100, 200) if k_s_axis is None else k_s_axis)
-    out = _sandslope.risk_map(robot, float(slope_deg), kn, ks, terrain, cv_n=cv_n, cv_s=cv_s)
+    out = _sandslope.risk_map(
+        robot, float(slope_deg), kn, ks, terrain, max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
+    )
     shape = (len(out["k_s"]), len(out["k_n"]))
     for k in ("p_fail", "p_not_success"):
         out[k] = out[k].reshape(shape).T
@@ -373,6 +380,27 @@ def safe_mass(
     the ``cv_n``, ``cv_s`` used there with their sources."""
     return _sandslope.safe_mass(
         _robot(robot), float(slope_deg), _terrain(terrain), max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
+    )
+
+
+def payload_envelope(
+    robot: RobotLike,
+    slope_deg: Any,
+    *,
+    terrain: TerrainLike,
+    max_risk: float = 0.05,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+) -> Dict[str, Any]:
+    """The payload envelope: the heaviest safe total mass at each slope of ``slope_deg`` (one
+    value or a sequence), as ``sandslope risk --slope A,B,... --solve mass --json`` prints it
+    (the same keys and numbers): ``max_risk``, ``robot_mass_kg``, ``points`` (per slope, in the
+    order given: ``slope_deg``, ``max_mass_kg``, ``max_payload_kg`` over the robot's own mass,
+    the ``limit`` and the ``cv_n``, ``cv_s`` used there with their sources) and
+    ``defaults_used``. Stops on Ctrl-C between chunks of slopes."""
+    s = np.ascontiguousarray(_float_array("slope_deg", slope_deg)).reshape(-1)
+    return _sandslope.payload_envelope(
+        _robot(robot), s, _terrain(terrain), max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
     )
 
 

@@ -105,6 +105,7 @@ def risk_map(
     k_n_axis: _F64,
     k_s_axis: _F64,
     terrain: Terrain,
+    max_risk: float = 0.05,
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
 ) -> Dict[str, Any]: ...
@@ -114,6 +115,14 @@ def safe_slope(
 def safe_mass(
     robot: Robot,
     slope_deg: float,
+    terrain: Terrain,
+    max_risk: float = 0.05,
+    cv_n: Optional[float] = None,
+    cv_s: Optional[float] = None,
+) -> Dict[str, Any]: ...
+def payload_envelope(
+    robot: Robot,
+    slope_deg: _F64,
     terrain: Terrain,
     max_risk: float = 0.05,
     cv_n: Optional[float] = None,

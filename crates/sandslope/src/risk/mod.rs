@@ -16,8 +16,9 @@
 //!   (heaviest safe robot at a slope) and [`payload_envelope`] (that mass at each slope): one
 //!   scan-and-bisect search ([`limits`]).
 //! - [`RiskMap`]: p_fail and p_not_success over a grid of median (k_n, k_s).
-//! - [`safe_slope`], [`safe_mass`], [`RiskMapSummary`]: the solving modes' answers with the
-//!   uncertainty they used ([`results`]), what `risk --json` prints and Python returns;
+//! - [`safe_slope`], [`safe_mass`], [`risk_map`] ([`RiskMapAnswer`]: the cells and their
+//!   summary): the solving modes' answers with the uncertainty they used ([`results`]), what
+//!   `risk --json` prints and Python returns;
 //!   [`RiskAnswer`]: the one value every `risk --json` mode prints.
 //!
 //! Every result is a plain serialisable value; none draws or writes anything.
@@ -39,7 +40,10 @@ pub use limits::{
 };
 pub use map::RiskMap;
 pub use quadrature::{regime_probabilities, RegimeProbabilities};
-pub use results::{safe_mass, safe_slope, RiskAnswer, RiskMapSummary, SafeMass, SafeSlope};
+pub use results::{
+    risk_map, safe_mass, safe_slope, RiskAnswer, RiskMapAnswer, RiskMapSummary, SafeMass, SafeSlope,
+    RISK_MAP_CELL_KEYS,
+};
 pub use uncertainty::{
     CvSource, DefaultsUsed, UncertainGround, UncertainTerrain, Uncertainty, UsedUncertainty, DEFAULT_CV_N,
     DEFAULT_CV_S,

@@ -1,9 +1,10 @@
 //! The answers of `sandslope risk` as plain serialisable values: the solving modes' (what
 //! `risk --solve slope|mass --json` and `risk --map --json` print and what Python's
-//! `safe_slope` and `safe_mass` return, each with the uncertainty it used, docs/model.md §9),
-//! and [`RiskAnswer`], the one value every `risk --json` mode prints.
+//! `safe_slope`, `safe_mass` and `risk_map` return, each with the uncertainty it used,
+//! docs/model.md §9), and [`RiskAnswer`], the one value every `risk --json` mode prints.
 
-use serde::{Deserialize, Serialize};
+use serde::ser::{SerializeSeq, SerializeStruct};
+use serde::{Deserialize, Serialize, Serializer};
 
 use super::curve::RiskPoint;
 use super::limits::{max_safe_mass, safe_slope_limit, PayloadEnvelope, SafeLimit};
@@ -17,7 +18,7 @@ use crate::Axis;
 /// What `sandslope risk --json` prints (and `serve`'s `/api/risk` returns), one variant per
 /// mode, serialised as its value alone: one slope's [`RiskPoint`], several slopes' points,
 /// the safe-slope limit (`--solve slope`), the heaviest safe mass at one slope or the payload
-/// envelope over several (`--solve mass`), or the `--map` summary.
+/// envelope over several (`--solve mass`), or the `--map` cells with their summary.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum RiskAnswer {
@@ -31,8 +32,8 @@ pub enum RiskAnswer {
     Mass(Box<SafeMass>),
     /// The heaviest safe mass at several slopes.
     Envelope(Box<PayloadEnvelope>),
-    /// A map's summary.
-    Map(Box<RiskMapSummary>),
+    /// A map with its summary.
+    Map(Box<RiskMapAnswer>),
 }
 
 impl RiskAnswer {
@@ -127,8 +128,7 @@ pub fn safe_mass(
     })
 }
 
-/// A [`RiskMap`]'s grid and a summary of its cells (`risk --map --json`; the cells themselves
-/// are the map's arrays).
+/// A [`RiskMap`]'s grid and a summary of its cells (the first keys of [`RiskMapAnswer`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RiskMapSummary {
     /// Slope, degrees, as requested.
@@ -181,5 +181,125 @@ impl RiskMapSummary {
             terrain_p_fail: super::failure_probability::p_fail(robot, slope, &ground, sample.uncertainty),
             defaults_used: terrain.defaults_used_at(slope),
         })
+    }
+}
+
+/// A risk map and its summary: what `risk --map --json` prints and Python's `risk_map`
+/// returns (there the cells and axis values as NumPy arrays, under the same keys).
+///
+/// Serialised as the [`RiskMapSummary`]'s keys followed by `beyond_repose`, the axis values
+/// `k_n` and `k_s`, and the cells `p_fail` and `p_not_success` as nested lists indexed
+/// `[k_n][k_s]` (Python's shape `(len(k_n), len(k_s))`; [`RiskMap`] holds them row-major,
+/// one row per k_s).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RiskMapAnswer {
+    /// The grid and the summary of its cells.
+    #[serde(flatten)]
+    pub summary: RiskMapSummary,
+    /// The cells.
+    #[serde(flatten, serialize_with = "serialize_cells")]
+    pub map: RiskMap,
+}
+
+/// The keys [`RiskMapAnswer`] adds to its summary, in order: the ones Python gives as arrays
+/// (all but `beyond_repose`).
+pub const RISK_MAP_CELL_KEYS: [&str; 5] = ["beyond_repose", "k_n", "k_s", "p_fail", "p_not_success"];
+
+/// A row-major `rows x columns` block serialised by columns: `[i][j]` is `values[j * columns + i]`.
+struct ByColumns<'a> {
+    values: &'a [f64],
+    columns: usize,
+}
+
+impl Serialize for ByColumns<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let rows = self.values.len().checked_div(self.columns).unwrap_or(0);
+        let mut seq = s.serialize_seq(Some(self.columns))?;
+        for i in 0..self.columns {
+            let column: Vec<f64> = (0..rows).map(|j| self.values[j * self.columns + i]).collect();
+            seq.serialize_element(&column)?;
+        }
+        seq.end()
+    }
+}
+
+fn serialize_cells<S: Serializer>(map: &RiskMap, s: S) -> Result<S::Ok, S::Error> {
+    let columns = map.k_n_axis.len();
+    let [repose, k_n, k_s, p_fail, p_not_success] = RISK_MAP_CELL_KEYS;
+    let mut st = s.serialize_struct("RiskMapCells", RISK_MAP_CELL_KEYS.len())?;
+    st.serialize_field(repose, &map.beyond_repose)?;
+    st.serialize_field(k_n, &map.k_n_axis.values())?;
+    st.serialize_field(k_s, &map.k_s_axis.values())?;
+    st.serialize_field(p_fail, &ByColumns { values: &map.p_fail, columns })?;
+    st.serialize_field(p_not_success, &ByColumns { values: &map.p_not_success, columns })?;
+    st.end()
+}
+
+/// The risk map of `robot` at `slope_deg` (degrees, in (-90, 90)) on `terrain` over
+/// `k_n_axis x k_s_axis`, each cell with the terrain's uncertainty and angle of repose at that
+/// slope ([`RiskMap::compute`]; `row_done` is called once per finished k_s row), and its
+/// summary against `max_risk`.
+pub fn risk_map(
+    robot: &Robot,
+    slope_deg: f64,
+    terrain: &UncertainTerrain,
+    (k_n_axis, k_s_axis): (&Axis, &Axis),
+    max_risk: f64,
+    row_done: &(dyn Fn() + Sync),
+) -> Result<RiskMapAnswer, ParamError> {
+    super::limits::check_risk(max_risk)?;
+    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+    let sample = terrain.sample(slope);
+    let map = RiskMap::compute(
+        robot,
+        slope,
+        sample.ground.repose,
+        k_n_axis,
+        k_s_axis,
+        sample.uncertainty,
+        row_done,
+    );
+    let summary = RiskMapSummary::of(&map, robot, slope_deg, terrain, max_risk)?;
+    Ok(RiskMapAnswer { summary, map })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::tests::paper_robot;
+    use crate::terrain::Terrain;
+    use crate::AxisScale;
+
+    /// The cells come out indexed `[k_n][k_s]` after the summary's keys: a 3 x 2 map read back
+    /// from its JSON cell by cell against the map's own row-major store.
+    #[test]
+    fn map_answer_lists_cells_by_k_n_after_the_summary() {
+        let t = UncertainTerrain::new(Terrain::constant(7e5, 1.5e6).unwrap(), None, None).unwrap();
+        let kn = Axis::new("k_n", 1e5, 1e7, 3, AxisScale::Log).unwrap();
+        let ks = Axis::new("k_s", 1e5, 1e7, 2, AxisScale::Log).unwrap();
+        let a = risk_map(&paper_robot(), 20.0, &t, (&kn, &ks), 0.05, &|| {}).unwrap();
+        // The summary's text, then the cells' keys in order.
+        let text = serde_json::to_string(&a).unwrap();
+        let summary = serde_json::to_string(&a.summary).unwrap();
+        let rest = text.strip_prefix(summary.strip_suffix('}').unwrap()).unwrap();
+        let at: Vec<usize> =
+            RISK_MAP_CELL_KEYS.iter().map(|k| rest.find(&format!(",\"{k}\":")).unwrap()).collect();
+        assert!(at[0] == 0 && at.windows(2).all(|w| w[0] < w[1]), "{rest}");
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        // (serde_json reads numbers back to within an ulp without its float_roundtrip feature.)
+        let close = |x: &serde_json::Value, y: f64| (x.as_f64().unwrap() - y).abs() <= 1e-15 * y.abs();
+        for i in 0..3 {
+            for j in 0..2 {
+                assert!(close(&v["p_fail"][i][j], a.map.p_fail_at(i, j)), "{i} {j}");
+                assert!(close(&v["p_not_success"][i][j], a.map.p_not_success_at(i, j)), "{i} {j}");
+            }
+        }
+        // Distinct cells: the layout is tested, not a constant.
+        assert!(
+            a.map.p_fail_at(0, 1) != a.map.p_fail_at(1, 1) && a.map.p_fail_at(0, 0) != a.map.p_fail_at(0, 1)
+        );
+        assert_eq!(v["p_fail"].as_array().unwrap().len(), 3);
+        assert_eq!(v["k_s"], serde_json::json!([1e5, 1e7]));
+        assert_eq!(risk_map(&paper_robot(), 20.0, &t, (&kn, &ks), 1.0, &|| {}).unwrap_err().key, "max_risk");
     }
 }

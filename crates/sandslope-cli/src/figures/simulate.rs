@@ -98,7 +98,7 @@ impl Figure for SimulateFigure<'_> {
         let grey = palette::STEP_MARK_GREY;
         for s in &m.steps {
             c.draw_series([PathElement::new(
-                vec![(s.touchdown_s, xr.0), (s.touchdown_s, xr.1)],
+                vec![(s.step.touchdown_s, xr.0), (s.step.touchdown_s, xr.1)],
                 grey.stroke_width(1),
             )])
             .map_err(plot_err)?;
@@ -113,7 +113,7 @@ impl Figure for SimulateFigure<'_> {
         let marks: Vec<(f64, f64)> = m
             .steps
             .iter()
-            .filter_map(|s| s.t1_s.map(|t1| s.touchdown_s + t1))
+            .filter_map(|s| s.step.anchoring_time_s.map(|t1| s.step.touchdown_s + t1))
             .filter_map(|ta| {
                 let i = tr.time_s.partition_point(|&ts| ts < ta).min(tr.time_s.len().saturating_sub(1));
                 x_cm.get(i).map(|&x| (ta, x))

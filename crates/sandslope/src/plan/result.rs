@@ -181,26 +181,43 @@ mod tests {
         ElevationGrid::from_heights(n, n, 1.0, 1.0, &h, None).unwrap()
     }
 
-    fn class(terrain: Terrain) -> Vec<UncertainTerrain> {
-        vec![UncertainTerrain::with_uncertainty(terrain, Uncertainty::new(0.1, 0.2).unwrap())]
+    /// A progress callback that never stops the searches.
+    fn go_on(_: Objective, _: u64, _: u64) -> ControlFlow<()> {
+        ControlFlow::Continue(())
+    }
+
+    /// What to plan from `start` to `goal` (columns and rows) for one objective.
+    fn request(
+        start: (usize, usize),
+        goal: (usize, usize),
+        objective: Objective,
+        risk_map: bool,
+    ) -> PlanRequest {
+        let cell = |(col, row)| Cell { col, row };
+        PlanRequest { start: cell(start), goal: cell(goal), objectives: vec![objective], risk_map }
+    }
+
+    /// [`plan`] for the paper's robot on `grid`, one class of `terrain` with CVs 0.1 and 0.2,
+    /// default settings.
+    fn plan_on(
+        grid: ElevationGrid,
+        terrain: &Terrain,
+        request: &PlanRequest,
+        progress: &(dyn Fn(Objective, u64, u64) -> ControlFlow<()> + Sync),
+    ) -> Result<PlanResult, PlanError> {
+        let class =
+            vec![UncertainTerrain::with_uncertainty(terrain.clone(), Uncertainty::new(0.1, 0.2).unwrap())];
+        plan(grid, None, &class, &paper_robot(), PlanSettings::default(), request, progress)
     }
 
     #[test]
     fn plans_every_objective_with_distance_added_and_reports_progress() {
         let seen = std::sync::Mutex::new(Vec::new());
-        let request = PlanRequest {
-            start: Cell { col: 2, row: 10 },
-            goal: Cell { col: 17, row: 10 },
-            objectives: vec![Objective::Time],
-            risk_map: true,
-        };
-        let r = plan(
+        let sand = Terrain::constant(7e5, 2e6).unwrap();
+        let r = plan_on(
             tilted(20, 0.1),
-            None,
-            &class(Terrain::constant(7e5, 2e6).unwrap()),
-            &paper_robot(),
-            PlanSettings::default(),
-            &request,
+            &sand,
+            &request((2, 10), (17, 10), Objective::Time, true),
             &|o, n, total| {
                 seen.lock().unwrap().push((o, n, total));
                 ControlFlow::Continue(())
@@ -235,19 +252,11 @@ mod tests {
         let h: Vec<f64> = (0..n * n).map(|i| if i % n == 300 { NODATA } else { 0.0 }).collect();
         let grid = ElevationGrid::from_heights(n, n, 1.0, 1.0, &h, Some(NODATA)).unwrap();
         let seen = std::sync::Mutex::new(Vec::new());
-        let request = PlanRequest {
-            start: Cell { col: 1, row: 1 },
-            goal: Cell { col: 350, row: 200 },
-            objectives: vec![Objective::Distance],
-            risk_map: false,
-        };
-        let r = plan(
+        let sand = Terrain::constant(7e5, 2e6).unwrap();
+        let r = plan_on(
             grid,
-            None,
-            &class(Terrain::constant(7e5, 2e6).unwrap()),
-            &paper_robot(),
-            PlanSettings::default(),
-            &request,
+            &sand,
+            &request((1, 1), (350, 200), Objective::Distance, false),
             &|_, settled, _| {
                 seen.lock().unwrap().push(settled);
                 ControlFlow::Break(())
@@ -263,22 +272,9 @@ mod tests {
     fn routes_serialise_as_objects_by_objective() {
         // A 45 degree grade to the east: the distance route goes straight up it, the time
         // objective (success edges only) finds none.
-        let request = PlanRequest {
-            start: Cell { col: 2, row: 10 },
-            goal: Cell { col: 17, row: 10 },
-            objectives: vec![Objective::Time],
-            risk_map: false,
-        };
-        let r = plan(
-            tilted(20, 1.0),
-            None,
-            &class(Terrain::constant(7e5, 2e6).unwrap()),
-            &paper_robot(),
-            PlanSettings::default(),
-            &request,
-            &|_, _, _| ControlFlow::Continue(()),
-        )
-        .unwrap();
+        let sand = Terrain::constant(7e5, 2e6).unwrap();
+        let r = plan_on(tilted(20, 1.0), &sand, &request((2, 10), (17, 10), Objective::Time, false), &go_on)
+            .unwrap();
         let no_route = *r.route(Objective::Time).unwrap().as_ref().unwrap_err();
         let v = serde_json::to_value(&r).unwrap();
         let routes = v["routes"].as_array().unwrap();
@@ -306,27 +302,13 @@ mod tests {
             points: vec![pt(0.0, 2e6), pt(5.0, 1.9e6)],
         })
         .unwrap();
-        let request = |start| PlanRequest {
-            start,
-            goal: Cell { col: 17, row: 10 },
-            objectives: vec![Objective::Time],
-            risk_map: false,
-        };
         let run = |start| {
-            plan(
-                tilted(20, 0.2),
-                None,
-                &class(terrain.clone()),
-                &paper_robot(),
-                PlanSettings::default(),
-                &request(start),
-                &|_, _, _| ControlFlow::Continue(()),
-            )
+            plan_on(tilted(20, 0.2), &terrain, &request(start, (17, 10), Objective::Time, false), &go_on)
         };
-        let e = run(Cell { col: 0, row: 10 }).unwrap_err().to_string();
+        let e = run((0, 10)).unwrap_err().to_string();
         assert!(e.contains("map border") && e.contains("impassable"), "{e}");
         // An 11.3 degree grade climbs above the last point at 5 degrees.
-        let r = run(Cell { col: 2, row: 10 }).unwrap();
+        let r = run((2, 10)).unwrap();
         let x = r.extrapolation.unwrap();
         assert_eq!(x.last_point_deg, 5.0);
         assert!((x.max_pitch_deg - 0.2_f64.atan().to_degrees()).abs() < 0.01, "{x:?}");

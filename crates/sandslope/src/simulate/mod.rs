@@ -22,7 +22,7 @@ pub use body::LegShape;
 use dynamics::Walker;
 
 use crate::error::ParamError;
-use crate::gait::{measure_step, SmoothTrack};
+use crate::gait::{measure_step, SmoothTrack, StepMeasure};
 use crate::regime::{classify, Cause, Regime};
 use crate::scenario::{Scenario, SlopeEvaluation};
 use crate::slope::Slope;
@@ -176,25 +176,25 @@ impl MotionCause {
     }
 }
 
-/// One step: one tripod's stance of T/2 from its touchdown, measured as docs/model.md §11.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// One step: one tripod's stance of T/2 from its touchdown, measured as docs/model.md §11
+/// (the gait's one step type, [`StepMeasure`], as `track` measures a recording) with what the
+/// simulation knows besides.
+///
+/// Serialised flat, its fields in the order `simulate --json` and `--csv` have always listed
+/// them: `index`, `tripod`, `touchdown_s`, `warmup`, then the rest of the step's (`t1_s`,
+/// `slip_m`, `step_m`, `speed_m_s`) and this type's own (`serde(flatten)` would move
+/// `touchdown_s`, and the CSV writer cannot write a flattened struct).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimStep {
     /// Step number from 0.
     pub index: usize,
     /// Tripod in stance (0 or 1).
     pub tripod: usize,
-    /// Touchdown time t0, s.
-    pub touchdown_s: f64,
     /// Whether the step is left out of the means (the first stride).
     pub warmup: bool,
-    /// Anchoring time t1 - t0, s (`None`: the speed never turned from falling to rising).
-    pub t1_s: Option<f64>,
-    /// Backward slip between t0 and t1, m.
-    pub slip_m: Option<f64>,
-    /// Net displacement upslope over the step, m.
-    pub step_m: f64,
-    /// `step / (T/2)`, m/s.
-    pub speed_m_s: f64,
+    /// The step as `track` measures it: touchdown (s after the gait started), anchoring time,
+    /// backward slip, net step and step speed.
+    pub step: StepMeasure,
     /// Deepest any leg went below the surface, m.
     pub max_depth_m: f64,
     /// Largest sand force on one leg, N.
@@ -203,6 +203,28 @@ pub struct SimStep {
     pub peak_servo_torque_n_m: f64,
     /// Time servos spent stalled, summed over legs, s.
     pub stall_s: f64,
+}
+
+impl Serialize for SimStep {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let m = &self.step;
+        let mut st = s.serialize_struct("SimStep", 12)?;
+        st.serialize_field("index", &self.index)?;
+        st.serialize_field("tripod", &self.tripod)?;
+        st.serialize_field("touchdown_s", &m.touchdown_s)?;
+        st.serialize_field("warmup", &self.warmup)?;
+        // StepMeasure's own names (a test checks they match its serialisation).
+        st.serialize_field("t1_s", &m.anchoring_time_s)?;
+        st.serialize_field("slip_m", &m.slip_m)?;
+        st.serialize_field("step_m", &m.step_m)?;
+        st.serialize_field("speed_m_s", &m.speed_m_s)?;
+        st.serialize_field("max_depth_m", &self.max_depth_m)?;
+        st.serialize_field("peak_leg_force_n", &self.peak_leg_force_n)?;
+        st.serialize_field("peak_servo_torque_n_m", &self.peak_servo_torque_n_m)?;
+        st.serialize_field("stall_s", &self.stall_s)?;
+        st.end()
+    }
 }
 
 /// The body and legs over time, sampled at the settings' rate (one column per quantity).
@@ -428,17 +450,12 @@ pub fn simulate(
         if !track.covers(t0, half) {
             break;
         }
-        let m = measure_step(&track, t0, half);
         let acc = run.per_step.get(k).copied().unwrap_or_default();
         steps.push(SimStep {
             index: k,
             tripod: k % 2,
-            touchdown_s: t0,
             warmup: k < WARMUP_STEPS,
-            t1_s: m.anchoring_time_s,
-            slip_m: m.slip_m,
-            step_m: m.step_m,
-            speed_m_s: m.speed_m_s,
+            step: measure_step(&track, t0, half),
             max_depth_m: acc.max_depth,
             peak_leg_force_n: acc.peak_force,
             peak_servo_torque_n_m: acc.peak_torque,
@@ -492,18 +509,19 @@ fn summarise(
     let robot = scenario.robot();
     let measured: Vec<&SimStep> = steps.iter().filter(|s| !s.warmup).collect();
     let n = measured.len().max(1) as f64;
-    let speed = measured.iter().map(|s| s.speed_m_s).sum::<f64>() / n;
+    let speed = measured.iter().map(|s| s.step.speed_m_s).sum::<f64>() / n;
     let speed_sd = if measured.len() > 1 {
-        (measured.iter().map(|s| (s.speed_m_s - speed).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+        (measured.iter().map(|s| (s.step.speed_m_s - speed).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
     } else {
         0.0
     };
-    let step = measured.iter().map(|s| s.step_m).sum::<f64>() / n;
-    let anchored: Vec<&&SimStep> = measured.iter().filter(|s| s.t1_s.is_some()).collect();
-    let mean_of = |f: &dyn Fn(&SimStep) -> f64| {
+    let step = measured.iter().map(|s| s.step.step_m).sum::<f64>() / n;
+    let anchored: Vec<&StepMeasure> =
+        measured.iter().map(|s| &s.step).filter(|s| s.anchoring_time_s.is_some()).collect();
+    let mean_of = |f: &dyn Fn(&StepMeasure) -> f64| {
         (!anchored.is_empty()).then(|| anchored.iter().map(|s| f(s)).sum::<f64>() / anchored.len() as f64)
     };
-    let t1 = mean_of(&|s| s.t1_s.unwrap_or(0.0));
+    let t1 = mean_of(&|s| s.anchoring_time_s.unwrap_or(0.0));
     let slip = mean_of(&|s| s.slip_m.unwrap_or(0.0));
     let max_depth = measured.iter().map(|s| s.max_depth_m).fold(0.0, f64::max);
     let d_max = robot.max_depth();

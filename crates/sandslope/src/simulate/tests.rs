@@ -127,6 +127,31 @@ fn closed_form_is_predicts_answer() {
     assert!((sim.trajectory.time_s[240] - 2.0).abs() < 1e-12);
 }
 
+/// A simulated step serialises the gait's step under its own names and values (SimStep lists
+/// them by hand to keep `simulate --json`'s order), then the simulation's quantities.
+#[test]
+fn a_step_serialises_the_gait_step_in_place() {
+    let sim = simulate(&scenario(7e5, 2e6), 12.0, &SimSettings::new(2.0).unwrap()).unwrap();
+    let step = sim.summary.steps[3];
+    let v = serde_json::to_value(step).unwrap();
+    let gait = serde_json::to_value(step.step).unwrap();
+    for (k, value) in gait.as_object().unwrap() {
+        assert_eq!(&v[k], value, "{k}");
+    }
+    let text = serde_json::to_string(&step).unwrap();
+    let order =
+        ["index", "tripod", "touchdown_s", "warmup", "t1_s", "slip_m", "step_m", "speed_m_s", "max_depth_m"];
+    let at: Vec<usize> = order.iter().map(|k| text.find(&format!("\"{k}\":")).unwrap()).collect();
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "{text}");
+    assert_eq!(v.as_object().unwrap().len(), 12);
+    // The fourth step touches down at 3 T/2 = 1.5 s (T = 1 s for this robot) on tripod 1.
+    assert_eq!(
+        (v["index"].as_u64(), v["tripod"].as_u64(), v["warmup"].as_bool()),
+        (Some(3), Some(1), Some(false))
+    );
+    assert_eq!(v["touchdown_s"], 1.5);
+}
+
 /// A robot file with 10^9 stance legs is refused before 2 x 10^9 legs are made (it asked for
 /// 8 GB and aborted; found by scripts/fuzz.sh); 64 per tripod is the cap.
 #[test]
@@ -193,7 +218,7 @@ fn dt_series() {
         for dt in [2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4] {
             let m =
                 simulate(&s, slope, &SimSettings::new(4.0).unwrap().with_dt(dt).unwrap()).unwrap().summary;
-            let sp: Vec<String> = m.steps.iter().map(|s| format!("{:.3}", s.speed_m_s)).collect();
+            let sp: Vec<String> = m.steps.iter().map(|s| format!("{:.3}", s.step.speed_m_s)).collect();
             println!(
                 "{slope} {k_s} {dt}: v={:.4} t1={:?} d={:.4} {}",
                 m.speed_m_s,

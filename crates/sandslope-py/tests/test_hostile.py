@@ -26,6 +26,12 @@ def test_huge_maps_are_refused_before_allocating():
         r"at most 16777216 cells \(here 100000 x 100000\)",
     )
     refused_fast(lambda: sandslope.risk("paper-hexapod", np.zeros(70_000), terrain="glass-beads-300um"), r"len\(slope_deg\) = 70000 must be at most 65536")
+    refused_fast(
+        lambda: sandslope.payload_envelope("paper-hexapod", np.zeros(70_000), terrain="glass-beads-300um"),
+        r"len\(slope_deg\) = 70000 must be at most 65536",
+    )
+    with pytest.raises(ValueError, match=r"slope_deg must be real numbers, not complex"):
+        sandslope.payload_envelope("paper-hexapod", np.array([10 + 1j]), terrain="glass-beads-300um")
 
 
 def test_complex_numbers_are_refused_not_truncated():

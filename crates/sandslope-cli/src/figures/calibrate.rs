@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use sandslope::calibrate::{ObservationKind, Pull};
 
 use super::palette;
-use super::{font, Figure};
+use super::{ChartSetup, Figure};
 use crate::error::plot_err;
 
 /// The speed observations among a joint calibration's pulls: the points this figure draws
@@ -48,22 +48,10 @@ impl Figure for CalibrationFigure<'_> {
             .chain(self.curve.iter().filter_map(|c| c.1.map(|v| v * 100.0)))
             .chain([0.0]);
         let y_range = super::range(ys, (0.0, 16.0));
-        let mut chart = ChartBuilder::on(&top)
-            .caption(format!("Observed and fitted speeds ({})", self.subtitle), font(20.0))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("slope (deg)")
-            .y_desc("speed v (cm/s)")
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .light_line_style(palette::GRID)
-            .draw()
-            .map_err(plot_err)?;
+        let title = format!("Observed and fitted speeds ({})", self.subtitle);
+        let setup = ChartSetup { caption: Some((&title, 20.0)), ..ChartSetup::SLOPE };
+        let mut chart =
+            setup.build(&top, x_range.0..x_range.1, y_range.0..y_range.1, "slope (deg)", "speed v (cm/s)")?;
         if y_range.0 < 0.0 {
             chart
                 .draw_series(LineSeries::new([(x_range.0, 0.0), (x_range.1, 0.0)], BLACK.stroke_width(1)))
@@ -79,10 +67,13 @@ impl Figure for CalibrationFigure<'_> {
         }
         let mut first = true;
         for seg in segments.into_iter().filter(|s| !s.is_empty()) {
-            let s = chart.draw_series(LineSeries::new(seg, RED.stroke_width(2))).map_err(plot_err)?;
+            let s = chart
+                .draw_series(LineSeries::new(seg, palette::CLOSED_FORM_RED.stroke_width(2)))
+                .map_err(plot_err)?;
             if first {
-                s.label("fitted model")
-                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+                s.label("fitted model").legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], palette::CLOSED_FORM_RED.stroke_width(2))
+                });
                 first = false;
             }
         }
@@ -114,22 +105,13 @@ impl Figure for CalibrationFigure<'_> {
             .label("observed (mean ± SD)")
             .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.filled()));
         chart
-            .draw_series(
-                self.points
-                    .iter()
-                    .map(|p| TriangleMarker::new((p.slope_deg, p.model * 100.0), 7, RED.filled())),
-            )
+            .draw_series(self.points.iter().map(|p| {
+                TriangleMarker::new((p.slope_deg, p.model * 100.0), 7, palette::CLOSED_FORM_RED.filled())
+            }))
             .map_err(plot_err)?
             .label("model at the observed slope")
-            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 7, RED.filled()));
-        chart
-            .configure_series_labels()
-            .label_font(font(15.0))
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.85))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(plot_err)?;
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 7, palette::CLOSED_FORM_RED.filled()));
+        super::legend_box(&mut chart, SeriesLabelPosition::UpperRight, 15.0, super::LegendBox::LIGHT)?;
 
         self.draw_pulls(&bottom, x_range)
     }
@@ -146,22 +128,12 @@ impl CalibrationFigure<'_> {
         DB::ErrorType: 'static,
     {
         let max_pull = self.points.iter().map(|p| p.pull.abs()).fold(2.5_f64, f64::max) * 1.15;
-        let mut chart = ChartBuilder::on(bottom)
-            .caption("Pulls: (observed - model) / SD used in the fit", font(18.0))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x_range.0..x_range.1, -max_pull..max_pull)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("slope (deg)")
-            .y_desc("pull")
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .light_line_style(palette::GRID)
-            .draw()
-            .map_err(plot_err)?;
+        let setup = ChartSetup {
+            caption: Some(("Pulls: (observed - model) / SD used in the fit", 18.0)),
+            ..ChartSetup::SLOPE
+        };
+        let mut chart =
+            setup.build(bottom, x_range.0..x_range.1, -max_pull..max_pull, "slope (deg)", "pull")?;
         let band = palette::PULL_BAND.mix(0.25);
         chart
             .draw_series([Rectangle::new([(x_range.0, -1.0), (x_range.1, 1.0)], band.filled())])

@@ -130,24 +130,19 @@ where
     let e = crate::error::plot_err;
     let (main, bar) = area.split_horizontally(600);
     let (xe, ye) = (edges(&map.x), edges(&map.y));
-    let mut chart = ChartBuilder::on(&main)
-        .caption("safe-slope limit (deg)", font(18.0))
-        .margin(15)
-        .x_label_area_size(50)
-        .y_label_area_size(75)
-        .build_cartesian_2d(xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1])
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(map.x_key.as_str())
-        .y_desc(map.y_key.as_str())
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .label_style(font(15.0))
-        .axis_desc_style(font(17.0))
-        .draw()
-        .map_err(e)?;
+    let setup = ChartSetup {
+        caption: Some(("safe-slope limit (deg)", 18.0)),
+        x_ticks: Some(&tick),
+        y_ticks: Some(&tick),
+        ..ChartSetup::MAP
+    };
+    let mut chart = setup.build(
+        &main,
+        xe[0]..xe[xe.len() - 1],
+        ye[0]..ye[ye.len() - 1],
+        map.x_key.as_str(),
+        map.y_key.as_str(),
+    )?;
     let finite = map.safe.iter().flatten().copied().filter(|v| *v >= 0.0);
     let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
     let (lo, hi) = if lo.is_finite() { (lo, hi.max(lo + 1e-9)) } else { (0.0, 1.0) };
@@ -174,26 +169,14 @@ where
             )
         }))
         .map_err(e)?;
-    let mut cb = ChartBuilder::on(&bar)
-        .margin_top(45)
-        .margin_bottom(65)
-        .margin_right(10)
-        .y_label_area_size(55)
-        .build_cartesian_2d(0.0..1.0, lo..hi)
-        .map_err(e)?;
-    cb.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_desc("deg (dark grey: none safe; white: invalid)")
-        .y_label_formatter(&tick)
-        .label_style(font(13.0))
-        .axis_desc_style(font(14.0))
-        .draw()
-        .map_err(e)?;
-    cb.draw_series((0..100).map(|k| {
-        let (a, b) = (lo + (hi - lo) * k as f64 / 100.0, lo + (hi - lo) * (k + 1) as f64 / 100.0);
-        Rectangle::new([(0.0, a), (1.0, b)], ViridisRGB.get_color((k as f32 + 0.5) / 100.0).filled())
-    }))
-    .map_err(e)?;
+    super::colour_bar(
+        &bar,
+        (lo, hi),
+        55,
+        "deg (dark grey: none safe; white: invalid)",
+        Some(&tick),
+        (13.0, 14.0),
+        &|k| ViridisRGB.get_color((k as f32 + 0.5) / 100.0),
+    )?;
     Ok(())
 }

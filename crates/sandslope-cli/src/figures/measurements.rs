@@ -12,7 +12,7 @@ use plotters::prelude::*;
 use sandslope::measure::{Campaign, Origin, SlopeEstimate, SlopeStat, TrialFit, TrialResult};
 
 use super::palette;
-use super::{font, range, save, Figure};
+use super::{range, save, ChartSetup, Figure};
 use crate::error::plot_err;
 
 /// Which panel.
@@ -115,26 +115,18 @@ impl Data<'_> {
         let (y0, y1) = range(ys.chain([0.0]), (0.0, 1.0));
         // Shear curves fill the panel's width at their plateau: room above them for the legend.
         let y1 = if shear { y1 + 0.4 * (y1 - y0) } else { y1 };
-        let mut chart = ChartBuilder::on(area)
-            .caption(panel.title(), font(22.0))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(60)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc(if shear { "shear displacement (mm)" } else { "penetration depth (mm)" })
-            .y_desc(if shear {
+        let setup = ChartSetup { caption: Some((panel.title(), 22.0)), ..ChartSetup::DATA };
+        let mut chart = setup.build(
+            area,
+            x0..x1,
+            y0..y1,
+            if shear { "shear displacement (mm)" } else { "penetration depth (mm)" },
+            if shear {
                 "shear force, in-air offset removed (N)"
             } else {
                 "normal force, in-air offset removed (N)"
-            })
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(plot_err)?;
+            },
+        )?;
         let mut labelled = Vec::new();
         // Data first, as small dots joined by a faint line, so every sample stays visible.
         for t in &trials {
@@ -205,14 +197,12 @@ impl Data<'_> {
                     PathElement::new(vec![(x, y), (x + 18, y)], palette::WARNING_RED.stroke_width(2))
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(if shear { SeriesLabelPosition::UpperRight } else { SeriesLabelPosition::UpperLeft })
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .label_font(font(14.0))
-            .draw()
-            .map_err(plot_err)?;
+        super::legend_box(
+            &mut chart,
+            if shear { SeriesLabelPosition::UpperRight } else { SeriesLabelPosition::UpperLeft },
+            14.0,
+            super::LegendBox::FAINT,
+        )?;
         Ok(())
     }
 
@@ -239,22 +229,14 @@ impl Data<'_> {
             .chain([0.0]);
         let (y0, y1) = range(ys, (0.0, 1.0));
         let (x0, x1) = range(points.iter().map(|p| p.slope_deg).chain([0.0]), (0.0, 25.0));
-        let mut chart = ChartBuilder::on(area)
-            .caption(panel.title(), font(22.0))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(60)
-            .build_cartesian_2d((x0 - 1.5)..(x1 + 1.0), y0..(y1 * 1.12))
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("slope (°)")
-            .y_desc(if normal { "kₙ (10⁵ N/m³)" } else { "kₛ (10⁵ N/m³)" })
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(plot_err)?;
+        let setup = ChartSetup { caption: Some((panel.title(), 22.0)), ..ChartSetup::DATA };
+        let mut chart = setup.build(
+            area,
+            (x0 - 1.5)..(x1 + 1.0),
+            y0..(y1 * 1.12),
+            "slope (°)",
+            if normal { "kₙ (10⁵ N/m³)" } else { "kₛ (10⁵ N/m³)" },
+        )?;
         draw_trials(&mut chart, &per_trial)?;
         let measured: Vec<&SlopeEstimate> =
             points.iter().filter(|p| stat(p).origin == Origin::Measured).collect();
@@ -295,14 +277,7 @@ impl Data<'_> {
                 .label("not measured: interpolated")
                 .legend(|(x, y)| Circle::new((x + 9, y), 6, BLACK.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .label_font(font(14.0))
-            .draw()
-            .map_err(plot_err)?;
+        super::legend_box(&mut chart, SeriesLabelPosition::LowerLeft, 14.0, super::LegendBox::FAINT)?;
         Ok(())
     }
 }

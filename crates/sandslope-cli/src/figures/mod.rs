@@ -149,7 +149,7 @@ pub type XyChart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
 
 /// How an x-y chart is set up: caption, margin, label areas, type sizes, grid lines and tick
 /// labels, the one place these are chosen ([`ChartSetup::PANEL`] for design and inference
-/// panels, [`ChartSetup::SLOPE`] for charts against slope).
+/// panels, [`ChartSetup::SLOPE`] for charts against slope, [`ChartSetup::MAP`] for heat maps).
 #[derive(Clone, Copy)]
 pub struct ChartSetup<'s> {
     /// Caption and its size, pt.
@@ -164,8 +164,10 @@ pub struct ChartSetup<'s> {
     pub label_pt: f64,
     /// Axis descriptions, pt.
     pub desc_pt: f64,
-    /// Light grid lines (white: none).
-    pub light_lines: RGBColor,
+    /// Whether grid lines are drawn at all (heat maps have none).
+    pub grid: bool,
+    /// Light grid lines (white or [`palette::NO_GRID`]: none to see).
+    pub light_lines: RGBAColor,
     /// Bold grid lines, if not plotters' default.
     pub bold_lines: Option<RGBColor>,
     /// Tick labels of the x axis, if not plotters' default.
@@ -183,7 +185,8 @@ impl<'s> ChartSetup<'s> {
         y_label_area: 75,
         label_pt: 15.0,
         desc_pt: 17.0,
-        light_lines: WHITE,
+        grid: true,
+        light_lines: palette::opaque(WHITE),
         bold_lines: None,
         x_ticks: None,
         y_ticks: None,
@@ -196,7 +199,53 @@ impl<'s> ChartSetup<'s> {
         y_label_area: 70,
         label_pt: 15.0,
         desc_pt: 17.0,
-        light_lines: palette::GRID,
+        grid: true,
+        light_lines: palette::opaque(palette::GRID),
+        bold_lines: None,
+        x_ticks: None,
+        y_ticks: None,
+    };
+    /// The model's curves against slope (slope curves, the step budget): margin 12, 14-pt
+    /// ticks, 16-pt descriptions, bold grid lines only.
+    pub const CURVES: ChartSetup<'static> = ChartSetup {
+        caption: None,
+        margin: 12,
+        x_label_area: 45,
+        y_label_area: 80,
+        label_pt: 14.0,
+        desc_pt: 16.0,
+        grid: true,
+        light_lines: palette::opaque(WHITE),
+        bold_lines: Some(palette::GRID_BOLD),
+        x_ticks: None,
+        y_ticks: None,
+    };
+    /// Measurements and gait (load-cell curves, per-slope tables, tracked speeds): margin 12,
+    /// 15-pt ticks, 17-pt descriptions, light grid lines transparent.
+    pub const DATA: ChartSetup<'static> = ChartSetup {
+        caption: None,
+        margin: 12,
+        x_label_area: 45,
+        y_label_area: 60,
+        label_pt: 15.0,
+        desc_pt: 17.0,
+        grid: true,
+        light_lines: palette::NO_GRID,
+        bold_lines: None,
+        x_ticks: None,
+        y_ticks: None,
+    };
+    /// Heat maps (risk and design maps; phase diagrams and the planned routes' map with
+    /// smaller type): margin 15, 15-pt ticks, 17-pt descriptions, no grid lines.
+    pub const MAP: ChartSetup<'static> = ChartSetup {
+        caption: None,
+        margin: 15,
+        x_label_area: 50,
+        y_label_area: 75,
+        label_pt: 15.0,
+        desc_pt: 17.0,
+        grid: false,
+        light_lines: palette::opaque(WHITE),
         bold_lines: None,
         x_ticks: None,
         y_ticks: None,
@@ -232,6 +281,9 @@ impl<'s> ChartSetup<'s> {
             .build_cartesian_2d(x, y)
             .map_err(e)?;
         let mut mesh = chart.configure_mesh();
+        if !self.grid {
+            mesh.disable_mesh();
+        }
         mesh.x_desc(x_desc)
             .y_desc(y_desc)
             .label_style(font(self.label_pt))
@@ -251,8 +303,68 @@ impl<'s> ChartSetup<'s> {
     }
 }
 
-/// The legend box of most figures: at `position`, on 90%-opaque white with a black border, in
-/// `pt`-point type.
+/// The colour bar beside a heat map: 100 bands from `lo` to `hi` on `area`, band `k` in
+/// `colour(k)`, its axis described by `desc` with `ticks` (plotters' default if `None`) in
+/// `label_pt`-point type, its description in `desc_pt`.
+#[allow(clippy::too_many_arguments)]
+pub fn colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (lo, hi): (f64, f64),
+    y_label_area: u32,
+    desc: &str,
+    ticks: Option<&dyn Fn(&f64) -> String>,
+    (label_pt, desc_pt): (f64, f64),
+    colour: &dyn Fn(usize) -> RGBColor,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = crate::error::plot_err;
+    let mut cb = ChartBuilder::on(area)
+        .margin_top(45)
+        .margin_bottom(65)
+        .margin_right(10)
+        .y_label_area_size(y_label_area)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(e)?;
+    let mut mesh = cb.configure_mesh();
+    mesh.disable_mesh()
+        .disable_x_axis()
+        .y_desc(desc)
+        .label_style(font(label_pt))
+        .axis_desc_style(font(desc_pt));
+    if let Some(f) = ticks {
+        mesh.y_label_formatter(f);
+    }
+    mesh.draw().map_err(e)?;
+    cb.draw_series((0..100).map(|k| {
+        let (a, b) = (lo + (hi - lo) * k as f64 / 100.0, lo + (hi - lo) * (k + 1) as f64 / 100.0);
+        Rectangle::new([(0.0, a), (1.0, b)], colour(k).filled())
+    }))
+    .map_err(e)?;
+    Ok(())
+}
+
+/// How opaque a legend box is: its white background and its black border.
+#[derive(Debug, Clone, Copy)]
+pub struct LegendBox {
+    /// Opacity of the white background.
+    pub white: f64,
+    /// Opacity of the black border.
+    pub border: f64,
+}
+
+impl LegendBox {
+    /// Design, inference and risk figures: 90%-opaque white, black border.
+    pub const PANEL: LegendBox = LegendBox { white: 0.9, border: 1.0 };
+    /// Charts against slope, gait, simulation and routes: 85%-opaque white, black border.
+    pub const LIGHT: LegendBox = LegendBox { white: 0.85, border: 1.0 };
+    /// Load-cell measurements: 85%-opaque white, a 40% black border.
+    pub const FAINT: LegendBox = LegendBox { white: 0.85, border: 0.4 };
+}
+
+/// The legend box of the design, inference and risk figures: at `position`, on 90%-opaque
+/// white with a black border, in `pt`-point type.
 pub fn legend<'a, DB, CT>(
     chart: &mut ChartContext<'a, DB, CT>,
     position: SeriesLabelPosition,
@@ -263,11 +375,27 @@ where
     DB::ErrorType: 'static,
     CT: plotters::coord::CoordTranslate,
 {
+    legend_box(chart, position, pt, LegendBox::PANEL)
+}
+
+/// The legend box of every figure: at `position`, `style`'s white and border, in `pt`-point
+/// type.
+pub fn legend_box<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    pt: f64,
+    style: LegendBox,
+) -> Result<()>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    CT: plotters::coord::CoordTranslate,
+{
     chart
         .configure_series_labels()
         .position(position)
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
+        .background_style(WHITE.mix(style.white))
+        .border_style(BLACK.mix(style.border))
         .label_font(font(pt))
         .draw()
         .map_err(crate::error::plot_err)?;

@@ -1,7 +1,7 @@
 //! The one regime palette of every figure, after the paper's Fig. 6: blue sinkage, red
 //! slippage, yellow metastable, light green success.
 
-use plotters::style::RGBColor;
+use plotters::style::{RGBAColor, RGBColor};
 
 use sandslope::Regime;
 
@@ -29,6 +29,13 @@ pub fn regime_colour(r: Regime) -> RGBColor {
 pub const GRID: RGBColor = RGBColor(235, 235, 235);
 /// Bold grid lines.
 pub const GRID_BOLD: RGBColor = RGBColor(225, 225, 225);
+/// Light grid lines drawn fully transparent (the figures of measurements and gait).
+pub const NO_GRID: RGBAColor = RGBAColor(255, 255, 255, 0.0);
+
+/// `c` as an opaque [`RGBAColor`] (what plotters makes of an [`RGBColor`] style).
+pub const fn opaque(c: RGBColor) -> RGBAColor {
+    RGBAColor(c.0, c.1, c.2, 1.0)
+}
 /// Observations, reference lines and their labels.
 pub const DATA_GREY: RGBColor = RGBColor(90, 90, 90);
 /// Secondary marks: points off the front, bounds.
@@ -80,3 +87,8 @@ pub const SAND_SURFACE: RGBColor = RGBColor(150, 120, 60);
 pub const NET_STEP: RGBColor = RGBColor(20, 20, 20);
 /// Step budget: the backward slip.
 pub const SLIP_ORANGE: RGBColor = RGBColor(230, 150, 20);
+/// The closed-form model's curves and points beside measured or simulated ones, the anchoring
+/// time t1 and the legs' sand forces (plotters' pure red).
+pub const CLOSED_FORM_RED: RGBColor = RGBColor(255, 0, 0);
+/// The tracked stride-averaged speed and its band (plotters' pure blue).
+pub const TRACKED_BLUE: RGBColor = RGBColor(0, 0, 255);

@@ -12,7 +12,7 @@ use plotters_backend::{BackendCoord, DrawingErrorKind};
 use sandslope::{Axis, AxisScale, PhasePanel, Regime};
 
 use super::palette::{regime_colour, STAR_GREEN};
-use super::{font, Figure};
+use super::{font, ChartSetup, Figure};
 
 /// A five-pointed star of outer radius `r` pixels, centred on (0, 0).
 pub fn star_points(r: f64) -> Vec<(i32, i32)> {
@@ -200,24 +200,19 @@ where
     Y::CoordDescType: ValueFormatter<f64>,
 {
     let e = crate::error::plot_err;
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, font(20.0))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(72)
-        .build_cartesian_2d(xr, yr)
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("normal resistance k_n (N/m\u{b3})")
-        .y_desc("shear strength k_s (N/m\u{b3})")
-        .x_label_formatter(&sci_label)
-        .y_label_formatter(&sci_label)
-        .label_style(font(14.0))
-        .axis_desc_style(font(16.0))
-        .draw()
-        .map_err(e)?;
+    let setup = ChartSetup {
+        caption: Some((title, 20.0)),
+        margin: 12,
+        x_label_area: 48,
+        y_label_area: 72,
+        label_pt: 14.0,
+        desc_pt: 16.0,
+        x_ticks: Some(&sci_label),
+        y_ticks: Some(&sci_label),
+        ..ChartSetup::MAP
+    };
+    let mut chart =
+        setup.build(area, xr, yr, "normal resistance k_n (N/m\u{b3})", "shear strength k_s (N/m\u{b3})")?;
     let map = &panel.map;
     // At most one drawn block per pixel: the grid is reduced to the panel's pixels first, so
     // drawing costs the same for 400 x 400 and 4096 x 4096 cells.

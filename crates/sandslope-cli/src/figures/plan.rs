@@ -13,7 +13,7 @@ use sandslope::plan::PlanResult;
 use sandslope_io::raster::GeoRef;
 
 use super::palette;
-use super::{font, Figure};
+use super::{font, ChartSetup, Figure};
 use crate::error::plot_err;
 
 /// Longest side of the map raster as drawn, in blocks (large DEMs are subsampled).
@@ -143,24 +143,17 @@ impl Figure for PlanFigure {
         let (w, _) = self.size();
         let (map_area, side) = root.split_horizontally(w - 170);
         let [west, east, south, north] = self.extent;
-        let mut chart = ChartBuilder::on(&map_area)
-            .caption("Planned routes: hillshade tinted by the regime of a head-on climb", font(22.0))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(75)
-            .build_cartesian_2d(west..east, south..north)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("x (m)")
-            .y_desc("y (m)")
-            .x_label_formatter(&super::tick)
-            .y_label_formatter(&super::tick)
-            .label_style(font(14.0))
-            .axis_desc_style(font(16.0))
-            .draw()
-            .map_err(plot_err)?;
+        let setup = ChartSetup {
+            caption: Some(("Planned routes: hillshade tinted by the regime of a head-on climb", 22.0)),
+            margin: 12,
+            x_label_area: 45,
+            label_pt: 14.0,
+            desc_pt: 16.0,
+            x_ticks: Some(&super::tick),
+            y_ticks: Some(&super::tick),
+            ..ChartSetup::MAP
+        };
+        let mut chart = setup.build(&map_area, west..east, south..north, "x (m)", "y (m)")?;
         let (bw, bh) = ((east - west) / self.nx as f64, (north - south) / self.ny as f64);
         chart
             .draw_series(self.colours.iter().enumerate().map(|(i, c)| {
@@ -220,14 +213,7 @@ impl Figure for PlanFigure {
             .map_err(plot_err)?
             .label("goal")
             .legend(|(x, y)| TriangleMarker::new((x + 12, y), 7, BLACK.filled()));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(font(15.0))
-            .draw()
-            .map_err(plot_err)?;
+        super::legend_box(&mut chart, SeriesLabelPosition::UpperRight, 15.0, super::LegendBox::LIGHT)?;
         // Scale bar, bottom left, about a fifth of the map width.
         let len = nice_length((east - west) / 5.0);
         let (x0, y0) = (west + 0.05 * (east - west), south + 0.05 * (north - south));

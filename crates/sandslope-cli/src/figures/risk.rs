@@ -14,7 +14,18 @@ use super::palette;
 use super::palette::STAR_GREEN;
 use super::phase::{cell_edges, reduce, sci_label, star_points, within, TerrainStar, MAX_DRAWN_CELLS};
 use super::slope_curves::swatch_gap;
-use super::{font, Figure};
+use super::{ChartSetup, Figure};
+
+/// The charts against slope (p_fail curve, payload envelope): margin 20, 16-pt ticks, 18-pt
+/// descriptions, no light grid.
+const RISK_CURVES: ChartSetup<'static> = ChartSetup {
+    margin: 20,
+    x_label_area: 50,
+    y_label_area: 70,
+    label_pt: 16.0,
+    desc_pt: 18.0,
+    ..ChartSetup::PANEL
+};
 
 /// p_fail and p_not_success against slope.
 pub struct CurveFigure {
@@ -32,22 +43,14 @@ impl Figure for CurveFigure {
         DB::ErrorType: 'static,
     {
         let e = crate::error::plot_err;
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, font(24.0))
-            .margin(20)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..self.hi, -0.015..1.02)
-            .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc("slope along the direction of travel (deg)")
-            .y_desc("probability")
-            .label_style(font(16.0))
-            .axis_desc_style(font(18.0))
-            .light_line_style(WHITE)
-            .draw()
-            .map_err(e)?;
+        let setup = ChartSetup { caption: Some((&self.title, 24.0)), ..RISK_CURVES };
+        let mut chart = setup.build(
+            root,
+            0.0..self.hi,
+            -0.015..1.02,
+            "slope along the direction of travel (deg)",
+            "probability",
+        )?;
         let red = palette::SLIPPAGE;
         let orange = palette::NOT_SUCCESS_ORANGE;
         chart
@@ -134,24 +137,19 @@ impl Figure for MapFigure {
         {
             bail!("--map plots need log axes (:log)");
         }
-        let mut chart = ChartBuilder::on(&main)
-            .caption(&self.title, font(20.0))
-            .margin(15)
-            .x_label_area_size(50)
-            .y_label_area_size(75)
-            .build_cartesian_2d((xe[0]..xe[xe.len() - 1]).log_scale(), (ye[0]..ye[ye.len() - 1]).log_scale())
-            .map_err(e)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("median normal resistance k_n (N/m\u{b3})")
-            .y_desc("median shear strength k_s (N/m\u{b3})")
-            .x_label_formatter(&sci_label)
-            .y_label_formatter(&sci_label)
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .draw()
-            .map_err(e)?;
+        let setup = ChartSetup {
+            caption: Some((&self.title, 20.0)),
+            x_ticks: Some(&sci_label),
+            y_ticks: Some(&sci_label),
+            ..ChartSetup::MAP
+        };
+        let mut chart = setup.build(
+            &main,
+            (xe[0]..xe[xe.len() - 1]).log_scale(),
+            (ye[0]..ye[ye.len() - 1]).log_scale(),
+            "median normal resistance k_n (N/m\u{b3})",
+            "median shear strength k_s (N/m\u{b3})",
+        )?;
         let nx = self.k_n_axis.len();
         // At most one block per pixel, whatever the grid.
         let (xs, xc) = reduce(nx, MAX_DRAWN_CELLS);
@@ -191,27 +189,9 @@ impl Figure for MapFigure {
                 });
         }
         super::legend(&mut chart, SeriesLabelPosition::LowerRight, 15.0)?;
-        // Colour bar.
-        let mut cb = ChartBuilder::on(&bar_area)
-            .margin_top(45)
-            .margin_bottom(65)
-            .margin_right(10)
-            .y_label_area_size(44)
-            .build_cartesian_2d(0.0..1.0, 0.0..1.0)
-            .map_err(e)?;
-        cb.configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .y_desc("p_fail")
-            .label_style(font(14.0))
-            .axis_desc_style(font(16.0))
-            .draw()
-            .map_err(e)?;
-        cb.draw_series((0..100).map(|k| {
-            let (a, b) = (k as f64 / 100.0, (k + 1) as f64 / 100.0);
-            Rectangle::new([(0.0, a), (1.0, b)], ViridisRGB.get_color((a + 0.005) as f32).filled())
-        }))
-        .map_err(e)?;
+        super::colour_bar(&bar_area, (0.0, 1.0), 44, "p_fail", None, (14.0, 16.0), &|k| {
+            ViridisRGB.get_color((k as f64 / 100.0 + 0.005) as f32)
+        })?;
         Ok(())
     }
 }
@@ -250,22 +230,14 @@ impl Figure for EnvelopeFigure<'_> {
         let x_hi = pts.iter().fold(1.0f64, |a, p| a.max(p.0));
         let x_lo = pts.iter().fold(x_hi, |a, p| a.min(p.0));
         let y_hi = pts.iter().fold(own, |a, p| a.max(p.1)) * 1.1;
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, font(22.0))
-            .margin(20)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x_lo..x_hi + 0.02 * (x_hi - x_lo).max(1.0), 0.0..y_hi)
-            .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc("slope along the direction of travel (deg)")
-            .y_desc("heaviest safe total mass (kg)")
-            .label_style(font(16.0))
-            .axis_desc_style(font(18.0))
-            .light_line_style(WHITE)
-            .draw()
-            .map_err(e)?;
+        let setup = ChartSetup { caption: Some((&self.title, 22.0)), ..RISK_CURVES };
+        let mut chart = setup.build(
+            root,
+            x_lo..x_hi + 0.02 * (x_hi - x_lo).max(1.0),
+            0.0..y_hi,
+            "slope along the direction of travel (deg)",
+            "heaviest safe total mass (kg)",
+        )?;
         let blue = palette::MODEL_BLUE;
         let grey = palette::DATA_GREY;
         let red = palette::SLIPPAGE;

@@ -12,7 +12,7 @@ use sandslope::simulate::{SimSummary, Simulation};
 use sandslope::{Robot, SpeedObservation};
 
 use super::palette;
-use super::{font, Figure};
+use super::{font, ChartSetup, Figure};
 use crate::error::plot_err;
 use crate::output::write_via_temp;
 
@@ -45,24 +45,17 @@ fn time_chart<'a, DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, font(20.0))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(t.0..t.1, y.0..y.1)
-        .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .x_desc("time since the gait started (s)")
-        .y_desc(y_label)
-        .x_label_formatter(&super::tick)
-        .y_label_formatter(&super::tick)
-        .label_style(font(14.0))
-        .axis_desc_style(font(16.0))
-        .light_line_style(palette::GRID)
-        .draw()
-        .map_err(plot_err)?;
+    let setup = ChartSetup {
+        caption: Some((title, 20.0)),
+        margin: 10,
+        x_label_area: 40,
+        label_pt: 14.0,
+        desc_pt: 16.0,
+        x_ticks: Some(&super::tick),
+        y_ticks: Some(&super::tick),
+        ..ChartSetup::SLOPE
+    };
+    let chart = setup.build(area, t.0..t.1, y.0..y.1, "time since the gait started (s)", y_label)?;
     Ok(chart)
 }
 
@@ -119,17 +112,11 @@ impl Figure for SimulateFigure<'_> {
                 x_cm.get(i).map(|&x| (ta, x))
             })
             .collect();
-        c.draw_series(marks.iter().map(|&p| Circle::new(p, 4, RED.filled())))
+        c.draw_series(marks.iter().map(|&p| Circle::new(p, 4, palette::CLOSED_FORM_RED.filled())))
             .map_err(plot_err)?
             .label("anchoring t1 (speed minimum)")
-            .legend(|(x, y)| Circle::new((x + 10, y), 4, RED.filled()));
-        c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font(font(14.0))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(plot_err)?;
+            .legend(|(x, y)| Circle::new((x + 10, y), 4, palette::CLOSED_FORM_RED.filled()));
+        super::legend_box(&mut c, SeriesLabelPosition::UpperLeft, 14.0, super::LegendBox::LIGHT)?;
 
         // Leg depths.
         let depth_mm: Vec<Vec<f64>> =
@@ -152,13 +139,7 @@ impl Figure for SimulateFigure<'_> {
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
             }
         }
-        c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(font(14.0))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(plot_err)?;
+        super::legend_box(&mut c, SeriesLabelPosition::UpperRight, 14.0, super::LegendBox::LIGHT)?;
 
         // Leg forces: normal solid, along the slope dashed.
         let fr = super::range(
@@ -239,23 +220,14 @@ impl Figure for SlopesFigure<'_> {
                 .chain([0.0]),
             (0.0, 16.0),
         );
-        let mut c = ChartBuilder::on(root)
-            .caption("Step-averaged speed: simulator, closed form and observations", font(22.0))
-            .margin(14)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
-            .map_err(plot_err)?;
-        c.configure_mesh()
-            .x_desc("slope (deg)")
-            .y_desc("speed (cm/s)")
-            .x_label_formatter(&super::tick)
-            .y_label_formatter(&super::tick)
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .light_line_style(palette::GRID)
-            .draw()
-            .map_err(plot_err)?;
+        let setup = ChartSetup {
+            caption: Some(("Step-averaged speed: simulator, closed form and observations", 22.0)),
+            margin: 14,
+            x_ticks: Some(&super::tick),
+            y_ticks: Some(&super::tick),
+            ..ChartSetup::SLOPE
+        };
+        let mut c = setup.build(root, xr.0..xr.1, yr.0..yr.1, "slope (deg)", "speed (cm/s)")?;
         super::shade_repose(&mut c, self.repose_deg, xr, yr, "at or above the angle of repose: slippage")?;
         if yr.0 < 0.0 {
             c.draw_series([PathElement::new(vec![(xr.0, 0.0), (xr.1, 0.0)], BLACK.stroke_width(1))])
@@ -285,10 +257,12 @@ impl Figure for SlopesFigure<'_> {
                 .label("simulated body pitched over (tumbled): no speed")
                 .legend(move |(x, y)| Cross::new((x + 10, y), 6, orange.stroke_width(3)));
         }
-        c.draw_series(LineSeries::new(cf.iter().copied(), RED.stroke_width(2)))
+        c.draw_series(LineSeries::new(cf.iter().copied(), palette::CLOSED_FORM_RED.stroke_width(2)))
             .map_err(plot_err)?
             .label("closed form (docs/model.md §3-§6)")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], palette::CLOSED_FORM_RED.stroke_width(2))
+            });
         if !obs.is_empty() {
             c.draw_series(
                 obs.iter().map(|&(x, v, sd)| {
@@ -299,13 +273,7 @@ impl Figure for SlopesFigure<'_> {
             .label("observed (mean ± SD)")
             .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));
         }
-        c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(font(15.0))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(plot_err)?;
+        super::legend_box(&mut c, SeriesLabelPosition::UpperRight, 15.0, super::LegendBox::LIGHT)?;
         Ok(())
     }
 }
@@ -427,9 +395,9 @@ where
                 .unwrap_or(centre);
             let tip = (lowest.0 + scale * (fx * c - fz * s), lowest.1 + scale * (fx * s + fz * c));
             chart
-                .draw_series([PathElement::new(vec![lowest, tip], RED.stroke_width(2))])
+                .draw_series([PathElement::new(vec![lowest, tip], palette::CLOSED_FORM_RED.stroke_width(2))])
                 .map_err(plot_err)?;
-            chart.draw_series([Circle::new(tip, 3, RED.filled())]).map_err(plot_err)?;
+            chart.draw_series([Circle::new(tip, 3, palette::CLOSED_FORM_RED.filled())]).map_err(plot_err)?;
         }
     }
     chart.draw_series([Circle::new(world([x, z]), 4, BLACK.filled())]).map_err(plot_err)?;

@@ -7,7 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::palette;
-use super::{font, ChartSetup, Figure};
+use super::{ChartSetup, Figure};
 use crate::error::plot_err;
 
 /// A legend swatch is two segments 20 px long in all: `(0, a)` and `(b, 20)`. Touching for a
@@ -95,15 +95,7 @@ impl Figure for SlopeCurveFigure {
         let ruled_out = ruled_out_within(&self.ruled_out, y_range);
         let y_range =
             ruled_out.iter().filter_map(|m| m.1).fold(y_range, |(lo, hi), v| (lo.min(v), hi.max(v)));
-        let setup = ChartSetup {
-            caption: Some((&self.title, 20.0)),
-            y_label_area: 80,
-            label_pt: 14.0,
-            desc_pt: 16.0,
-            light_lines: WHITE,
-            bold_lines: Some(palette::GRID_BOLD),
-            ..ChartSetup::SLOPE
-        };
+        let setup = ChartSetup { caption: Some((&self.title, 20.0)), ..ChartSetup::CURVES };
         let mut chart =
             setup.build(root, x_range.0..x_range.1, y_range.0..y_range.1, "slope (deg)", &self.y_label)?;
         if y_range.0 < 0.0 && y_range.1 > 0.0 {
@@ -137,14 +129,7 @@ impl Figure for SlopeCurveFigure {
                 .label(self.observed_label.as_str())
                 .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.filled()));
         }
-        chart
-            .configure_series_labels()
-            .label_font(font(14.0))
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.85))
-            .position(self.legend.clone())
-            .draw()
-            .map_err(plot_err)?;
+        super::legend_box(&mut chart, self.legend.clone(), 14.0, super::LegendBox::LIGHT)?;
         Ok(())
     }
 }

@@ -10,7 +10,7 @@ use sandslope::report::StepBudget;
 
 use super::palette;
 use super::slope_curves::swatch_gap;
-use super::{font, Figure};
+use super::{ChartSetup, Figure};
 use crate::error::plot_err;
 
 /// The step budget over a slope grid (entries without anchoring are gaps).
@@ -42,23 +42,9 @@ impl Figure for StepBudgetFigure<'_> {
         let ys =
             self.budget.iter().flat_map(|b| series.iter().filter_map(move |s| (s.3)(b).map(|v| v * 1e3)));
         let y_range = super::range(ys.chain([0.0]), (0.0, 1.0));
-        let mut chart = ChartBuilder::on(root)
-            .caption("Where the step goes", font(20.0))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(80)
-            .build_cartesian_2d(0.0..x_hi, y_range.0..y_range.1)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("slope (deg)")
-            .y_desc("length per step (mm)")
-            .label_style(font(14.0))
-            .axis_desc_style(font(16.0))
-            .light_line_style(WHITE)
-            .bold_line_style(palette::GRID_BOLD)
-            .draw()
-            .map_err(plot_err)?;
+        let setup = ChartSetup { caption: Some(("Where the step goes", 20.0)), ..ChartSetup::CURVES };
+        let mut chart =
+            setup.build(root, 0.0..x_hi, y_range.0..y_range.1, "slope (deg)", "length per step (mm)")?;
         super::shade_repose(
             &mut chart,
             self.repose,
@@ -82,14 +68,7 @@ impl Figure for StepBudgetFigure<'_> {
                     + PathElement::new(vec![(b, 0), (20, 0)], style)
             });
         }
-        chart
-            .configure_series_labels()
-            .label_font(font(14.0))
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.85))
-            .position(SeriesLabelPosition::MiddleLeft)
-            .draw()
-            .map_err(plot_err)?;
+        super::legend_box(&mut chart, SeriesLabelPosition::MiddleLeft, 14.0, super::LegendBox::LIGHT)?;
         Ok(())
     }
 }

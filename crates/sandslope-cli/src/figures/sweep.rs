@@ -7,7 +7,8 @@ use plotters::prelude::*;
 
 use sandslope::SpeedObservation;
 
-use super::{font, ChartSetup, Figure};
+use super::palette;
+use super::{ChartSetup, Figure};
 use crate::error::plot_err;
 use sandslope::SlopeEvaluation;
 
@@ -163,15 +164,15 @@ where
     }
     for (i, seg) in pieces(x, y).into_iter().enumerate() {
         let series = chart
-            .draw_series(LineSeries::new(seg, ShapeStyle::from(&RED).stroke_width(2)))
+            .draw_series(LineSeries::new(seg, ShapeStyle::from(&palette::CLOSED_FORM_RED).stroke_width(2)))
             .map_err(plot_err)?;
         if i == 0 {
-            series
-                .label("model")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+            series.label("model").legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], palette::CLOSED_FORM_RED.stroke_width(2))
+            });
         }
     }
-    let faded = RED.mix(0.6).stroke_width(2);
+    let faded = palette::CLOSED_FORM_RED.mix(0.6).stroke_width(2);
     for (i, seg) in pieces(x, panel.ruled_out).into_iter().enumerate() {
         let series = chart.draw_series(DashedLineSeries::new(seg, 6, 5, faded)).map_err(plot_err)?;
         if i == 0 {
@@ -196,13 +197,6 @@ where
             .label("observed (mean ± SD)")
             .legend(|(x, y)| Circle::new((x + 10, y), 5, BLACK.filled()));
     }
-    chart
-        .configure_series_labels()
-        .label_font(font(15.0))
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.85))
-        .position(panel.legend.clone())
-        .draw()
-        .map_err(plot_err)?;
+    super::legend_box(&mut chart, panel.legend.clone(), 15.0, super::LegendBox::LIGHT)?;
     Ok(())
 }

@@ -8,7 +8,8 @@ use plotters::prelude::*;
 use sandslope::gait::TrackResult;
 use sandslope::SlopeEvaluation;
 
-use super::{font, range, Figure};
+use super::palette;
+use super::{range, ChartSetup, Figure};
 use crate::error::plot_err;
 use sandslope_io::SpeedRow;
 
@@ -93,24 +94,19 @@ impl TrackFigure {
             Some(s) => format!("Speed within a stride, {s} deg ({} strides)", self.strides),
             None => format!("Speed within a stride ({} strides)", self.strides),
         };
-        let mut chart = ChartBuilder::on(area)
-            .caption(title, font(22.0))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..self.period, y0..y1)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("time since touchdown t0 (s)")
-            .y_desc("upslope speed v (cm/s)")
-            .x_label_formatter(&super::tick)
-            .y_label_formatter(&super::tick)
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(plot_err)?;
+        let setup = ChartSetup {
+            caption: Some((&title, 22.0)),
+            x_ticks: Some(&super::tick),
+            y_ticks: Some(&super::tick),
+            ..ChartSetup::DATA
+        };
+        let mut chart = setup.build(
+            area,
+            0.0..self.period,
+            y0..y1,
+            "time since touchdown t0 (s)",
+            "upslope speed v (cm/s)",
+        )?;
         let band: Vec<(f64, f64)> = self
             .time
             .iter()
@@ -119,18 +115,22 @@ impl TrackFigure {
             .chain(self.time.iter().zip(self.mean.iter().zip(&self.sd)).rev().map(|(t, (m, s))| (*t, m - s)))
             .collect();
         chart
-            .draw_series(std::iter::once(Polygon::new(band, BLUE.mix(0.2).filled())))
+            .draw_series(std::iter::once(Polygon::new(band, palette::TRACKED_BLUE.mix(0.2).filled())))
             .map_err(plot_err)?
             .label("± 1 SD across strides")
-            .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], BLUE.mix(0.2).filled()));
+            .legend(|(x, y)| {
+                Rectangle::new([(x, y - 6), (x + 20, y + 6)], palette::TRACKED_BLUE.mix(0.2).filled())
+            });
         chart
             .draw_series(LineSeries::new(
                 self.time.iter().copied().zip(self.mean.iter().copied()),
-                BLUE.stroke_width(3),
+                palette::TRACKED_BLUE.stroke_width(3),
             ))
             .map_err(plot_err)?
             .label("mean speed")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(3)));
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], palette::TRACKED_BLUE.stroke_width(3))
+            });
         chart
             .draw_series(std::iter::once(PathElement::new(
                 vec![(0.0, 0.0), (self.period, 0.0)],
@@ -154,23 +154,17 @@ impl TrackFigure {
                 let dashes = (0..40).filter(|k| k % 2 == 0).map(move |k| {
                     let a = y0 + (y1 - y0) * k as f64 / 40.0;
                     let b = y0 + (y1 - y0) * (k + 1) as f64 / 40.0;
-                    PathElement::new(vec![(x, a), (x, b)], RED.stroke_width(2))
+                    PathElement::new(vec![(x, a), (x, b)], palette::CLOSED_FORM_RED.stroke_width(2))
                 });
                 let s = chart.draw_series(dashes).map_err(plot_err)?;
                 if i == 0 {
-                    s.label(format!("mean anchoring time t1 = {:.0} ms", t1 * 1e3))
-                        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+                    s.label(format!("mean anchoring time t1 = {:.0} ms", t1 * 1e3)).legend(|(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], palette::CLOSED_FORM_RED.stroke_width(2))
+                    });
                 }
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(font(14.0))
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(plot_err)?;
+        super::legend_box(&mut chart, SeriesLabelPosition::UpperLeft, 14.0, super::LegendBox::LIGHT)?;
         Ok(())
     }
 
@@ -185,34 +179,30 @@ impl TrackFigure {
             .chain(self.model.iter().chain(&self.ruled_out).flatten().map(|p| p.1))
             .chain([0.0]);
         let (y0, y1) = range(ys, (0.0, 20.0));
-        let mut chart = ChartBuilder::on(area)
-            .caption("Speed against slope", font(22.0))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(60)
-            .build_cartesian_2d(self.x_range.0..self.x_range.1, y0..y1)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("slope θ (deg)")
-            .y_desc("step-averaged speed (cm/s)")
-            .x_label_formatter(&super::tick)
-            .y_label_formatter(&super::tick)
-            .label_style(font(15.0))
-            .axis_desc_style(font(17.0))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(plot_err)?;
+        let setup = ChartSetup {
+            caption: Some(("Speed against slope", 22.0)),
+            x_ticks: Some(&super::tick),
+            y_ticks: Some(&super::tick),
+            ..ChartSetup::DATA
+        };
+        let mut chart = setup.build(
+            area,
+            self.x_range.0..self.x_range.1,
+            y0..y1,
+            "slope θ (deg)",
+            "step-averaged speed (cm/s)",
+        )?;
         for (i, piece) in self.model.iter().enumerate() {
             let s = chart
-                .draw_series(LineSeries::new(piece.iter().copied(), RED.stroke_width(2)))
+                .draw_series(LineSeries::new(piece.iter().copied(), palette::CLOSED_FORM_RED.stroke_width(2)))
                 .map_err(plot_err)?;
             if i == 0 {
-                s.label("model, for the robot and terrain given")
-                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+                s.label("model, for the robot and terrain given").legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], palette::CLOSED_FORM_RED.stroke_width(2))
+                });
             }
         }
-        let faded = RED.mix(0.6).stroke_width(2);
+        let faded = palette::CLOSED_FORM_RED.mix(0.6).stroke_width(2);
         for (i, piece) in self.ruled_out.iter().enumerate() {
             let s = chart
                 .draw_series(DashedLineSeries::new(piece.iter().copied(), 6, 5, faded))
@@ -248,14 +238,7 @@ impl TrackFigure {
                 )
             }))
             .map_err(plot_err)?;
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(font(14.0))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(plot_err)?;
+        super::legend_box(&mut chart, SeriesLabelPosition::UpperRight, 14.0, super::LegendBox::LIGHT)?;
         Ok(())
     }
 }

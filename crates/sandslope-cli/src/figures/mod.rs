@@ -208,48 +208,20 @@ impl<'s> ChartSetup<'s> {
     /// The model's curves against slope (slope curves, the step budget): margin 12, 14-pt
     /// ticks, 16-pt descriptions, bold grid lines only.
     pub const CURVES: ChartSetup<'static> = ChartSetup {
-        caption: None,
-        margin: 12,
-        x_label_area: 45,
         y_label_area: 80,
         label_pt: 14.0,
         desc_pt: 16.0,
-        grid: true,
         light_lines: palette::opaque(WHITE),
         bold_lines: Some(palette::GRID_BOLD),
-        x_ticks: None,
-        y_ticks: None,
+        ..ChartSetup::SLOPE
     };
     /// Measurements and gait (load-cell curves, per-slope tables, tracked speeds): margin 12,
     /// 15-pt ticks, 17-pt descriptions, light grid lines transparent.
-    pub const DATA: ChartSetup<'static> = ChartSetup {
-        caption: None,
-        margin: 12,
-        x_label_area: 45,
-        y_label_area: 60,
-        label_pt: 15.0,
-        desc_pt: 17.0,
-        grid: true,
-        light_lines: palette::NO_GRID,
-        bold_lines: None,
-        x_ticks: None,
-        y_ticks: None,
-    };
+    pub const DATA: ChartSetup<'static> =
+        ChartSetup { y_label_area: 60, light_lines: palette::NO_GRID, ..ChartSetup::SLOPE };
     /// Heat maps (risk and design maps; phase diagrams and the planned routes' map with
     /// smaller type): margin 15, 15-pt ticks, 17-pt descriptions, no grid lines.
-    pub const MAP: ChartSetup<'static> = ChartSetup {
-        caption: None,
-        margin: 15,
-        x_label_area: 50,
-        y_label_area: 75,
-        label_pt: 15.0,
-        desc_pt: 17.0,
-        grid: false,
-        light_lines: palette::opaque(WHITE),
-        bold_lines: None,
-        x_ticks: None,
-        y_ticks: None,
-    };
+    pub const MAP: ChartSetup<'static> = ChartSetup { grid: false, ..ChartSetup::PANEL };
 
     /// The chart over `x` and `y` (plain or log ranges) on `area`, its mesh drawn with the
     /// axis descriptions `x_desc` and `y_desc`.

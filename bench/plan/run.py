@@ -9,15 +9,24 @@ What it does (run from anywhere; takes a few minutes the first time):
    as GDAL writes large rasters);
 4. times `sandslope plan --objective time` (the time route plus the distance route, run
    concurrently) from near the south-west corner to near the north-east corner, `--repeat`
-   times (default 5), under /usr/bin/time -v for the peak memory (maximum resident set size),
-   and reports each run, the median and how many runs met the 10 s target;
+   times (default 5), under /usr/bin/time -v for the CPU time (user + system) and the peak
+   memory (maximum resident set size), and reports each run, the median and how many runs met
+   the 10 s target;
 5. times `skimage.graph.MCP_Geometric` on the same grid with an isotropic per-cell cost
    (1 / level speed * sec(slope) per metre: one cost per cell, no heading) between the same
-   cells, and prints the ratio of the median to it.
+   cells, once after each sandslope run (the two take turns, so each pair sees the same load
+   from whatever else runs on the machine), with its wall and CPU time, and prints the ratios
+   of the medians, wall and CPU, and of each pair. The load average (1 minute) is printed
+   with every run. `--baseline EXE` times another sandslope binary in the same turns (for
+   instance the main branch's, before and after a change) and says whether its `--json`
+   output is byte for byte the same.
+
+The binary is `target/release/sandslope`, or `$CARGO_TARGET_DIR/release/sandslope` when that
+is set (the script builds it there). bench/plan/README.md has the last measurements.
 
 Usage: python3 bench/plan/run.py [--size 4096] [--repeat 5] [--max-memory GIB] [--no-mcp]
                                   [--search auto|full|corridor] [--coarse-factor N] [--corridor-width CELLS]
-                                  [--gap]
+                                  [--gap] [--baseline EXE]
 
 `--search`, `--coarse-factor` and `--corridor-width` are passed to `sandslope plan` (by default
 none, so plan's `auto` decides: full resolution up to 4096 x 4096, corridor above). `--gap` times
@@ -64,14 +73,14 @@ def main():
     ap.add_argument("--coarse-factor", type=int, help="passed to sandslope plan")
     ap.add_argument("--corridor-width", type=int, help="passed to sandslope plan")
     ap.add_argument("--gap", action="store_true", help="compare --search full and --search corridor")
+    ap.add_argument("--baseline", help="another sandslope binary, timed in turn with this one (and its --json compared)")
     args = ap.parse_args()
     ensure([("numpy", "numpy"), ("tifffile", "tifffile"), ("skimage", "scikit-image")])
     import numpy as np
     import tifffile
-    from skimage.graph import MCP_Geometric
 
     subprocess.check_call(["cargo", "build", "--release", "-q", "-p", "sandslope-cli"], cwd=ROOT)
-    exe = os.path.join(ROOT, "target", "release", "sandslope")
+    exe = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")), "release", "sandslope")
 
     n, cell = args.size, args.cell
     work = os.path.join(ROOT, "target", "bench-plan")
@@ -123,45 +132,83 @@ def main():
     if args.search is not None:
         cmd += ["--search", args.search]
     cmd += corridor
-    runs = []
-    for _ in range(args.repeat):
-        t0 = time.perf_counter()
-        p = subprocess.run(cmd, capture_output=True, text=True)
-        wall = time.perf_counter() - t0
-        rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1))
-        if p.returncode == 2 and "--max-memory" in p.stderr:
-            print("\n".join(l for l in p.stderr.split("\tCommand being timed")[0].splitlines()
-                            if not l.startswith("Command exited")))
-            print(f"refused after {wall:.2f} s wall, peak RSS {rss_kb / 1024:.0f} MiB")
-            return
-        if p.returncode != 0:
-            print(p.stderr)
-            sys.exit(1)
-        runs.append((wall, rss_kb))
-    print(p.stdout)
-    walls = sorted(w for w, _ in runs)
-    t_ours = walls[len(walls) // 2]
-    print(f"sandslope plan ({n} x {n}, time + distance routes), {args.repeat} runs: "
-          + ", ".join(f"{w:.2f} s" for w, _ in runs)
-          + f" wall (median {t_ours:.2f} s, max {walls[-1]:.2f} s); peak RSS {max(r for _, r in runs) / 1024:.0f} MiB"
-          + f" ({max(r for _, r in runs) * 1024 / (n * n):.1f} bytes a cell)")
-    print(f"target < 10 s: met in {sum(w < 10.0 for w in walls)} of {len(walls)} runs")
-
-    if args.no_mcp or n > 8192:
+    mcp = None if args.no_mcp or n > 8192 else mcp_runner(heights(0, n), cell, start, goal)
+    # sandslope, its baseline (--baseline) and MCP_Geometric take turns, so that each pair of
+    # timings sees the same load from whatever else runs on the machine.
+    exes = [("sandslope", exe)] + ([("baseline", args.baseline)] if args.baseline else [])
+    runs = {name: [] for name, _ in exes}
+    t_mcp, cpu_mcp = [], []
+    outputs = {}
+    for i in range(args.repeat):
+        for name, path in exes:
+            load = os.getloadavg()[0]
+            t0 = time.perf_counter()
+            p = subprocess.run([cmd[0], cmd[1], path] + cmd[3:], capture_output=True, text=True)
+            wall = time.perf_counter() - t0
+            rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1))
+            cpu = sum(float(re.search(f"{f} time \\(seconds\\): ([\\d.]+)", p.stderr).group(1)) for f in ["User", "System"])
+            if p.returncode == 2 and "--max-memory" in p.stderr:
+                print("\n".join(l for l in p.stderr.split("\tCommand being timed")[0].splitlines()
+                                if not l.startswith("Command exited")))
+                print(f"refused after {wall:.2f} s wall, peak RSS {rss_kb / 1024:.0f} MiB")
+                return
+            if p.returncode != 0:
+                print(p.stderr)
+                sys.exit(1)
+            runs[name].append((wall, rss_kb, load, cpu))
+            outputs.setdefault(name, p.stdout)
+            print(f"run {i + 1}: {name} {wall:.2f} s wall, {cpu:.2f} s CPU, peak RSS {rss_kb / 1024:.0f} MiB"
+                  f" (load average {load:.2f})", flush=True)
+        if mcp is not None:
+            load = os.getloadavg()[0]
+            wall, cpu = mcp()
+            t_mcp.append(wall)
+            cpu_mcp.append(cpu)
+            print(f"run {i + 1}: MCP_Geometric {wall:.2f} s wall, {cpu:.2f} s CPU (load average {load:.2f})", flush=True)
+    print(outputs["sandslope"])
+    if args.baseline:
+        print("--json identical to the baseline's:", outputs["sandslope"] == outputs["baseline"])
+    median = lambda xs: sorted(xs)[len(xs) // 2]
+    for name, rs in runs.items():
+        walls = sorted(w for w, _, _, _ in rs)
+        rss = max(r for _, r, _, _ in rs)
+        print(f"{name} plan ({n} x {n}, time + distance routes), {args.repeat} runs: "
+              + ", ".join(f"{w:.2f} s" for w, _, _, _ in rs)
+              + f" wall (median {median(walls):.2f} s, max {walls[-1]:.2f} s); peak RSS {rss / 1024:.0f} MiB"
+              + f" ({rss * 1024 / (n * n):.1f} bytes a cell); load average "
+              + ", ".join(f"{l:.1f}" for _, _, l, _ in rs))
+        print(f"target < 10 s: met in {sum(w < 10.0 for w in walls)} of {len(walls)} runs")
+    if not t_mcp:
         return
-    z = heights(0, n)
+    print("skimage MCP_Geometric (isotropic, 8-connected): " + ", ".join(f"{t:.2f} s" for t in t_mcp)
+          + f" wall (median {median(t_mcp):.2f} s); CPU " + ", ".join(f"{c:.2f} s" for c in cpu_mcp)
+          + f" (median {median(cpu_mcp):.2f} s)")
+    for name, rs in runs.items():
+        wall, cpu = median([w for w, _, _, _ in rs]), median([c for _, _, _, c in rs])
+        print(f"time ratio {name} / MCP_Geometric: {wall / median(t_mcp):.3f} wall (medians; per run "
+              + ", ".join(f"{w / t:.3f}" for (w, _, _, _), t in zip(rs, t_mcp))
+              + f"), {cpu / median(cpu_mcp):.3f} CPU (medians); MCP_Geometric / {name} {median(t_mcp) / wall:.2f}x wall")
+
+
+def mcp_runner(z, cell, start, goal):
+    """A function timing one MCP_Geometric search on heights `z` between the same cells."""
+    import numpy as np
+    from skimage.graph import MCP_Geometric
     # Isotropic per-cell cost: seconds per metre at the cell's own slope, level-sand speed
     # 0.15 m/s (the model's level speed for the default robot and terrain), sec(slope)
     # for the surface length.
     gy, gx = np.gradient(z.astype(np.float64), cell)
     cost = np.sqrt(1.0 + gx * gx + gy * gy) / 0.15
-    t0 = time.perf_counter()
-    m = MCP_Geometric(cost, fully_connected=True, sampling=(cell, cell))
-    m.find_costs([(start[1], start[0])], [(goal[1], goal[0])], find_all_ends=True)
-    path = m.traceback((goal[1], goal[0]))
-    t_mcp = time.perf_counter() - t0
-    print(f"skimage MCP_Geometric (isotropic, 8-connected): {t_mcp:.2f} s, {len(path)} cells on its path")
-    print(f"time ratio sandslope (median) / MCP_Geometric: {t_ours / t_mcp:.2f}")
+    del gx, gy
+
+    def run():
+        t0, c0 = time.perf_counter(), time.process_time()
+        m = MCP_Geometric(cost, fully_connected=True, sampling=(cell, cell))
+        m.find_costs([(start[1], start[0])], [(goal[1], goal[0])], find_all_ends=True)
+        m.traceback((goal[1], goal[0]))
+        return time.perf_counter() - t0, time.process_time() - c0
+
+    return run
 
 
 def timed(cmd):

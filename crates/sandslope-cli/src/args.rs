@@ -319,16 +319,7 @@ pub fn parse_axis(flag: &str, text: &str) -> Result<Axis> {
 
 /// A log axis from `lo / down` to `hi * up` around positive terrain values, with `n` points.
 pub fn default_axis(flag: &str, values: &[f64], down: f64, up: f64, n: usize) -> Result<Axis> {
-    let positive: Vec<f64> = values.iter().copied().filter(|v| *v > 0.0 && v.is_finite()).collect();
-    let (lo, hi) = if positive.is_empty() {
-        (1e3, 1e9)
-    } else {
-        (
-            positive.iter().copied().fold(f64::INFINITY, f64::min) / down,
-            positive.iter().copied().fold(0.0, f64::max) * up,
-        )
-    };
-    Axis::new(flag, lo, hi, n, AxisScale::Log).map_err(|e| anyhow!("{e}"))
+    Axis::log_around(flag, values, down, up, n).map_err(|e| anyhow!("{e}"))
 }
 
 #[cfg(test)]

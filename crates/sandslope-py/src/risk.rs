@@ -111,7 +111,7 @@ pub fn risk<'py>(
 /// P(failure) and P(not success) over a grid of median (k_n, k_s) at one slope, with the
 /// terrain's uncertainty and repose at that slope: the value `sandslope risk --map --json`
 /// prints (the library's `RiskMapAnswer`, key for key), its axis values and cells as NumPy
-/// arrays (cells row-major, one row per k_s).
+/// arrays (cells row-major, one row per k_s); an axis not given is the library's default.
 #[pyfunction]
 #[pyo3(signature = (robot, slope_deg, k_n_axis, k_s_axis, terrain, max_risk=0.05, cv_n=None, cv_s=None))]
 #[allow(clippy::too_many_arguments)]
@@ -119,16 +119,25 @@ pub fn risk_map<'py>(
     py: Python<'py>,
     robot: &PyRobot,
     slope_deg: f64,
-    k_n_axis: PyReadonlyArray1<'py, f64>,
-    k_s_axis: PyReadonlyArray1<'py, f64>,
+    k_n_axis: Option<PyReadonlyArray1<'py, f64>>,
+    k_s_axis: Option<PyReadonlyArray1<'py, f64>>,
     terrain: &PyTerrain,
     max_risk: f64,
     cv_n: Option<f64>,
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let terrain = uncertain(terrain, cv_n, cv_s)?;
-    let kn = axis("k_n_axis", &values(&k_n_axis))?;
-    let ks = axis("k_s_axis", &values(&k_s_axis))?;
+    let given = |key: &str, a: &Option<PyReadonlyArray1<'py, f64>>| {
+        a.as_ref().map(|a| axis(key, &values(a))).transpose()
+    };
+    // The library's default grid where an axis is not given, as `risk --map` without --k-n/--k-s.
+    let (kn, ks) = sandslope::risk::map_axes(
+        &terrain,
+        slope_deg,
+        given("k_n_axis", &k_n_axis)?,
+        given("k_s_axis", &k_s_axis)?,
+    )
+    .map_err(value_error)?;
     sandslope::limits::grid_cells(
         "len(k_n_axis) * len(k_s_axis)",
         kn.len(),

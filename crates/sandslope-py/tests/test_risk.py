@@ -108,6 +108,15 @@ def test_risk_map_is_the_cli_map(cli, robot, terrain):
         np.testing.assert_array_equal(got[k], np.array(want[k]), err_msg=k)
     assert got["p_fail"].shape == (4, 5) and got["cells"] == 20
     assert got["cells_below_max_risk"] == int((got["p_fail"] < 0.2).sum())
+    # Without axes: the library's one default grid, the CLI's without --k-n/--k-s (200 x 200
+    # log-spaced around the terrain's medians at the slope), the same numbers.
+    want = cli.json("risk", "--slope", 20, "--map")
+    got = sandslope.risk_map(robot, 20, terrain=terrain)
+    assert got["k_n_axis"] == want["k_n_axis"] and got["k_s_axis"] == want["k_s_axis"]
+    assert got["k_n_axis"]["min"] == pytest.approx(got["terrain_k_n"] / 100, rel=1e-15)
+    assert got["k_s_axis"]["max"] == pytest.approx(got["terrain_k_s"] * 100, rel=1e-15)
+    assert got["p_fail"].shape == (200, 200) and got["cells_below_max_risk"] == want["cells_below_max_risk"]
+    np.testing.assert_array_equal(got["p_fail"], np.array(want["p_fail"]))
 
 
 def test_risk_map_matches_pointwise_risk(robot):

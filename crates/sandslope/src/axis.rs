@@ -53,6 +53,18 @@ impl Axis {
         Ok(Axis { min, max, n, scale })
     }
 
+    /// `n` log-spaced values from the smallest positive finite value of `values` / `down` to
+    /// the largest x `up` (1e3 to 1e9 when none is positive): the default grid around a
+    /// terrain's values (the maps' default axes), named `key` in errors.
+    pub fn log_around(key: &str, values: &[f64], down: f64, up: f64, n: usize) -> Result<Axis, ParamError> {
+        let positive = || values.iter().copied().filter(|v| *v > 0.0 && v.is_finite());
+        let (lo, hi) = match positive().next() {
+            None => (1e3, 1e9),
+            Some(_) => (positive().fold(f64::INFINITY, f64::min) / down, positive().fold(0.0, f64::max) * up),
+        };
+        Axis::new(key, lo, hi, n, AxisScale::Log)
+    }
+
     /// Number of values.
     pub fn len(&self) -> usize {
         self.n
@@ -118,6 +130,17 @@ impl Axis {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The default grid spans the positive values' range widened by the factors; with no
+    /// positive value (a table floored at zero), 1e3 to 1e9.
+    #[test]
+    fn log_around_widens_the_positive_values() {
+        let a = Axis::log_around("k_s", &[0.0, 2e6, f64::NAN, 5e5], 100.0, 10.0, 7).unwrap();
+        assert_eq!((a.min(), a.max(), a.len(), a.scale()), (5e3, 2e7, 7, AxisScale::Log));
+        let b = Axis::log_around("k_n", &[0.0], 100.0, 100.0, 3).unwrap();
+        assert_eq!((b.min(), b.max()), (1e3, 1e9));
+        assert_eq!(Axis::log_around("k_n", &[7e5], 100.0, 100.0, 1).unwrap_err().key, "k_n points");
+    }
 
     #[test]
     fn axes_hit_their_ends_and_space_evenly() {

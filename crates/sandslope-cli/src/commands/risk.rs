@@ -19,16 +19,14 @@ use sandslope::risk::{
 use sandslope::{Robot, Slope};
 
 use crate::args::{
-    beyond_last_point, default_axis, parse_axis, parse_max_risk, parse_slope_list, warn_extrapolated,
-    RobotArgs, SlopeSign, TerrainArgs, UncertaintyArgs,
+    beyond_last_point, parse_axis, parse_max_risk, parse_slope_list, warn_extrapolated, RobotArgs, SlopeSign,
+    TerrainArgs, UncertaintyArgs,
 };
 use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
 use crate::output::{csv_string, num, print_json, sci, table, write_via_temp, Format};
 use crate::progress::progress_bar;
 
-/// Default points per axis of the `--map` grid.
-pub const MAP_POINTS: usize = 200;
 /// Most `--map` cells (the library's cap, as Python's).
 const MAX_MAP_CELLS: u128 = sandslope::limits::MAX_RISK_MAP_CELLS as u128;
 
@@ -334,16 +332,11 @@ fn map_axes(
     slope_deg: f64,
     max_cells: u128,
 ) -> Result<(sandslope::Axis, sandslope::Axis)> {
-    let slope = slope_of(slope_deg)?;
-    let ground = terrain.sample(slope).ground;
-    let k_n_axis = match &args.k_n {
-        Some(t) => parse_axis("--k-n", t)?,
-        None => default_axis("--k-n", &[ground.k_n], 100.0, 100.0, MAP_POINTS)?,
-    };
-    let k_s_axis = match &args.k_s {
-        Some(t) => parse_axis("--k-s", t)?,
-        None => default_axis("--k-s", &[ground.k_s], 1000.0, 100.0, MAP_POINTS)?,
-    };
+    slope_of(slope_deg)?;
+    let given = |flag: &str, text: &Option<String>| text.as_ref().map(|t| parse_axis(flag, t)).transpose();
+    let (k_n_axis, k_s_axis) =
+        sandslope::risk::map_axes(terrain, slope_deg, given("--k-n", &args.k_n)?, given("--k-s", &args.k_s)?)
+            .map_err(|e| anyhow!("{e}"))?;
     let cells = k_n_axis.len() as u128 * k_s_axis.len() as u128;
     if cells > max_cells {
         let side = (max_cells as f64).sqrt().floor();

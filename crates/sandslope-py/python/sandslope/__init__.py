@@ -321,8 +321,9 @@ def risk_map(
     """P(failure) over a grid of median ``(k_n, k_s)`` at one slope (``sandslope risk --map``).
 
     The uncertainty (coefficients of variation) and the angle of repose are the terrain's at
-    ``slope_deg`` (or ``cv_n``/``cv_s``). Axes as in :func:`phase`; by default the CLI's:
-    200 log-spaced values from the terrain's k_n / 100 to x 100 and k_s / 1000 to x 100.
+    ``slope_deg`` (or ``cv_n``/``cv_s``). Axes as in :func:`phase`; by default the CLI's (the
+    library's one default grid): 200 log-spaced values from the terrain's k_n / 100 to x 100
+    and k_s / 1000 to x 100 at that slope.
 
     Returns the keys of ``sandslope risk --map --json`` (one library value): ``p_fail`` and
     ``p_not_success``, each of shape ``(len(k_n_axis), len(k_s_axis))``; ``k_n``, ``k_s`` (the
@@ -335,9 +336,8 @@ def risk_map(
     robot, terrain = _robot(robot), _terrain(terrain)
     if mass_kg is not None:
         robot = robot.with_mass(float(mass_kg))
-    at = terrain.at(float(slope_deg))
-    kn = _axis("k_n_axis", np.geomspace(at["k_n"] / 100, at["k_n"] * 100, 200) if k_n_axis is None else k_n_axis)
-    ks = _axis("k_s_axis", np.geomspace(at["k_s"] / 1000, at["k_s"] * 100, 200) if k_s_axis is None else k_s_axis)
+    kn = None if k_n_axis is None else _axis("k_n_axis", k_n_axis)
+    ks = None if k_s_axis is None else _axis("k_s_axis", k_s_axis)
     out = _sandslope.risk_map(
         robot, float(slope_deg), kn, ks, terrain, max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
     )

@@ -102,8 +102,8 @@ def risk(
 def risk_map(
     robot: Robot,
     slope_deg: float,
-    k_n_axis: _F64,
-    k_s_axis: _F64,
+    k_n_axis: Optional[_F64],
+    k_s_axis: Optional[_F64],
     terrain: Terrain,
     max_risk: float = 0.05,
     cv_n: Optional[float] = None,

@@ -41,8 +41,8 @@ pub use limits::{
 pub use map::RiskMap;
 pub use quadrature::{regime_probabilities, RegimeProbabilities};
 pub use results::{
-    risk_map, safe_mass, safe_slope, RiskAnswer, RiskMapAnswer, RiskMapSummary, SafeMass, SafeSlope,
-    RISK_MAP_CELL_KEYS,
+    map_axes, risk_map, safe_mass, safe_slope, RiskAnswer, RiskMapAnswer, RiskMapSummary, SafeMass,
+    SafeSlope, MAP_POINTS, RISK_MAP_CELL_KEYS,
 };
 pub use uncertainty::{
     CvSource, DefaultsUsed, UncertainGround, UncertainTerrain, Uncertainty, UsedUncertainty, DEFAULT_CV_N,

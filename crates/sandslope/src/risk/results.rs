@@ -235,6 +235,32 @@ fn serialize_cells<S: Serializer>(map: &RiskMap, s: S) -> Result<S::Ok, S::Error
     st.end()
 }
 
+/// Points per axis of a risk map's default grid.
+pub const MAP_POINTS: usize = 200;
+
+/// The axes of a risk map at `slope_deg` (degrees, in (-90, 90)) on `terrain`: `k_n_axis` and
+/// `k_s_axis` where given, else the default grid around the terrain's medians at that slope,
+/// [`MAP_POINTS`] log-spaced values of k_n from its median / 100 to x 100 and of k_s from
+/// / 1000 to x 100 (what `risk --map` and Python's `risk_map` use without axes).
+pub fn map_axes(
+    terrain: &UncertainTerrain,
+    slope_deg: f64,
+    k_n_axis: Option<Axis>,
+    k_s_axis: Option<Axis>,
+) -> Result<(Axis, Axis), ParamError> {
+    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+    let ground = terrain.sample(slope).ground;
+    let k_n_axis = match k_n_axis {
+        Some(a) => a,
+        None => Axis::log_around("k_n_axis", &[ground.k_n], 100.0, 100.0, MAP_POINTS)?,
+    };
+    let k_s_axis = match k_s_axis {
+        Some(a) => a,
+        None => Axis::log_around("k_s_axis", &[ground.k_s], 1000.0, 100.0, MAP_POINTS)?,
+    };
+    Ok((k_n_axis, k_s_axis))
+}
+
 /// The risk map of `robot` at `slope_deg` (degrees, in (-90, 90)) on `terrain` over
 /// `k_n_axis x k_s_axis`, each cell with the terrain's uncertainty and angle of repose at that
 /// slope ([`RiskMap::compute`]; `row_done` is called once per finished k_s row), and its
@@ -301,5 +327,19 @@ mod tests {
         assert_eq!(v["p_fail"].as_array().unwrap().len(), 3);
         assert_eq!(v["k_s"], serde_json::json!([1e5, 1e7]));
         assert_eq!(risk_map(&paper_robot(), 20.0, &t, (&kn, &ks), 1.0, &|| {}).unwrap_err().key, "max_risk");
+    }
+
+    /// A given axis is kept; a missing one is 200 log-spaced values around the terrain's median
+    /// at the slope (k_n / 100 to x 100, k_s / 1000 to x 100); a bad slope names `slope_deg`.
+    #[test]
+    fn map_axes_default_around_the_medians() {
+        let t = UncertainTerrain::new(Terrain::constant(7e5, 1.5e6).unwrap(), None, None).unwrap();
+        let kn = Axis::new("k_n", 1e5, 1e7, 3, AxisScale::Log).unwrap();
+        let (a, b) = map_axes(&t, 20.0, Some(kn), None).unwrap();
+        assert_eq!(a, kn);
+        assert_eq!((b.min(), b.max(), b.len(), b.scale()), (1.5e3, 1.5e8, 200, AxisScale::Log));
+        let (a, _) = map_axes(&t, -20.0, None, None).unwrap();
+        assert_eq!((a.min(), a.max()), (7e3, 7e7));
+        assert_eq!(map_axes(&t, 95.0, None, None).unwrap_err().key, "slope_deg");
     }
 }

@@ -49,6 +49,8 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan::read_raster, m)?)?;
     m.add_function(wrap_pyfunction!(plan::geotiff_nodata, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::pds3_info, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::pds3_window, m)?)?;
     m.add_function(wrap_pyfunction!(measure::read_touchdowns, m)?)?;
     m.add_function(wrap_pyfunction!(measure::fit, m)?)?;
     m.add_function(wrap_pyfunction!(measure::track, m)?)?;

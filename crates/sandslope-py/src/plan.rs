@@ -8,7 +8,7 @@ use std::sync::LazyLock;
 use std::thread::Thread;
 use std::time::Duration;
 
-use numpy::PyReadonlyArray2;
+use numpy::{PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -17,6 +17,7 @@ use sandslope::plan::{
 };
 use sandslope::risk::UncertainTerrain;
 use sandslope::Regime;
+use sandslope_io::pds3::Pds3Dtm;
 use sandslope_io::raster::read_raster as read;
 
 use crate::arrays::put;
@@ -297,6 +298,38 @@ fn class_inputs(
 #[pyfunction]
 pub fn geotiff_nodata(path: PathBuf) -> PyResult<Option<f64>> {
     sandslope_io::raster::geotiff_nodata(&path).map_err(crate::anyhow_error)
+}
+
+/// The size, ground cell size and notes of a PDS3 DTM from its label alone, checked against
+/// its data file: `{rows, cols, cell_x_m, cell_y_m, notes}`. The Dask raster then reads it
+/// window by window with [`pds3_window`] (a HiRISE DTM can be larger than memory).
+#[pyfunction]
+pub fn pds3_info<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    let dtm = py.detach(|| Pds3Dtm::open(&path)).map_err(anyhow_error)?;
+    let d = PyDict::new(py);
+    d.set_item("rows", dtm.rows)?;
+    d.set_item("cols", dtm.cols)?;
+    d.set_item("cell_x_m", dtm.cell_m.0)?;
+    d.set_item("cell_y_m", dtm.cell_m.1)?;
+    d.set_item("notes", dtm.notes)?;
+    Ok(d)
+}
+
+/// Rows `top:bottom` and columns `left:right` of a PDS3 DTM as a 2-D float64 array of heights
+/// in metres (NaN where missing or special), the same values `read_raster` gives there; only
+/// those samples are read from the file.
+#[pyfunction]
+pub fn pds3_window<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    top: usize,
+    bottom: usize,
+    left: usize,
+    right: usize,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let values =
+        py.detach(|| Pds3Dtm::open(&path)?.read_window(top..bottom, left..right)).map_err(anyhow_error)?;
+    crate::arrays::array(py, values).reshape([bottom - top, right - left])
 }
 
 /// `(values, rows, cols, geo)` as returned by [`read_raster`].

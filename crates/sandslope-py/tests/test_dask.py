@@ -1,5 +1,7 @@
 """The Dask risk raster equals the eager one whatever the chunking, on worker processes."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -163,3 +165,32 @@ def test_dask_arrays_that_only_read_a_store_are_read_as_the_store(robot, terrain
     lazy = sdask.risk_raster(opened, 0.5, robot=robot, terrain=terrain)
     assert len(dict(lazy.__dask_graph__())) == lazy.npartitions == 2 * 3
     np.testing.assert_array_equal(lazy.compute(scheduler="sync"), eager)
+
+
+PDS3 = Path(__file__).resolve().parents[2] / "sandslope-io" / "tests" / "fixtures" / "pds3"
+
+
+def test_pds3_dtms_are_read_window_by_window(client, robot, terrain, tmp_path):
+    """Issue 24: PDS3 DTMs as HiRISE publishes them (attached label, PC_REAL, ISIS special
+    pixels; a detached .lbl) through the Dask raster give exactly the eager raster of
+    read_raster's heights, on worker processes, whatever the tiles, with the label's ground
+    cell size when cell_size_m is None; each window holds read_raster's heights there."""
+    for name in ["dtm-attached.img", "dtm-detached.lbl"]:
+        path = PDS3 / name
+        heights, geo = sandslope.read_raster(path)
+        rows, cols = heights.shape
+        assert np.isnan(heights).any() or name != "dtm-attached.img"  # its special pixels
+        window = sandslope._sandslope.pds3_window(str(path), 2, rows - 1, 3, cols)
+        np.testing.assert_array_equal(window, heights[2 : rows - 1, 3:cols])
+        eager = sandslope.risk_raster(heights, (geo["cell_x_m"], geo["cell_y_m"]), robot=robot, terrain=terrain)
+        assert np.isfinite(eager[0]).sum() > rows * cols // 2
+        for chunks in [(7, 9), (rows, cols)]:
+            lazy = sdask.risk_raster(path, None, robot=robot, terrain=terrain, chunks=chunks)
+            np.testing.assert_array_equal(client.compute(lazy).result(), eager, err_msg=f"{name} {chunks}")
+    # Errors name the file and what is wrong, at once on the client.
+    with pytest.raises(ValueError, match="cell_size_m = None takes the cell size from a PDS3"):
+        sdask.risk_raster(tmp_path / "dem.npy", None, robot=robot, terrain=terrain)
+    cut = tmp_path / "cut.img"
+    cut.write_bytes((PDS3 / "dtm-attached.img").read_bytes()[:-100])
+    with pytest.raises(ValueError, match=r"cut.img: LINES = \d+ lines .* the label claims more than the file holds"):
+        sdask.risk_raster(cut, 20.0, robot=robot, terrain=terrain)

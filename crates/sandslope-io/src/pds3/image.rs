@@ -122,6 +122,13 @@ pub(super) fn layout(label: &Label, notes: &mut Vec<String>) -> Result<Layout> {
     Ok(Layout { rows, cols, kind, bits, bytes, prefix, suffix, add, scale, missing })
 }
 
+/// Rows `rows` and columns `cols` of an image (half-open ranges of 0-based lines and samples).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) struct Window {
+    pub(super) rows: std::ops::Range<u64>,
+    pub(super) cols: std::ops::Range<u64>,
+}
+
 /// The samples of `data_path` from byte `offset`: heights in metres, NaN where missing or
 /// special. The file is checked to hold them before anything is allocated; a note says how
 /// many cells have no height.
@@ -132,6 +139,28 @@ pub(super) fn read_samples(
     offset: u64,
     notes: &mut Vec<String>,
 ) -> Result<Vec<f64>> {
+    let whole = Window { rows: 0..layout.rows, cols: 0..layout.cols };
+    let (values, missing_n, special) = read_window(layout, name, data_path, offset, &whole)?;
+    if missing_n + special > 0 {
+        notes.push(format!(
+            "{name}: {} cells without a height (MISSING_CONSTANT: {missing_n}, other ISIS special pixels: {special}) are nodata",
+            missing_n + special
+        ));
+    }
+    Ok(values)
+}
+
+/// The samples of `window` (row-major, `window.cols` wide), with how many were
+/// MISSING_CONSTANT and how many other special pixels. The file is checked to hold the whole
+/// image, and the window to lie inside it, before anything is allocated; only the window's
+/// bytes are read (the Dask raster reads a DTM larger than memory tile by tile this way).
+pub(super) fn read_window(
+    layout: &Layout,
+    name: &str,
+    data_path: &Path,
+    offset: u64,
+    window: &Window,
+) -> Result<(Vec<f64>, usize, usize)> {
     let Layout { rows, cols, kind, bits, bytes, prefix, suffix, add, scale, missing } = *layout;
     // Sizes, checked before anything is allocated.
     check_raster_size(&name, cols, rows)?;
@@ -147,13 +176,22 @@ pub(super) fn read_samples(
             if prefix + suffix > 0 { format!(", {prefix} prefix and {suffix} suffix bytes") } else { String::new() }
         );
     }
+    let Window { rows: ref wr, cols: ref wc } = *window;
+    if wr.start > wr.end || wr.end > rows || wc.start > wc.end || wc.end > cols {
+        bail!(
+            "{name}: rows {}..{} and columns {}..{} are not a window of the {rows} x {cols} image (LINES x LINE_SAMPLES)",
+            wr.start,
+            wr.end,
+            wc.start,
+            wc.end
+        );
+    }
 
     // The samples.
     let mut file = BufReader::new(File::open(data_path).with_context(|| format!("cannot read {data_name}"))?);
-    file.seek(SeekFrom::Start(offset)).with_context(|| format!("cannot read {data_name}"))?;
-    let (cols_n, rows_n) = (cols as usize, rows as usize);
-    let mut values = Vec::with_capacity(cols_n * rows_n);
-    let mut buf = vec![0u8; line_bytes as usize];
+    let width = (wc.end - wc.start) as usize;
+    let mut values = Vec::with_capacity(width * (wr.end - wr.start) as usize);
+    let mut buf = vec![0u8; width * bytes];
     // MISSING_CONSTANT as the stored sample's bits, so every type compares the same way.
     let missing_bits: Option<u64> = missing.and_then(|(bits, value)| match kind {
         Sample::Real { .. } => Some(bits),
@@ -163,84 +201,97 @@ pub(super) fn read_samples(
         }
         Sample::Int { signed: false, .. } => (value >= 0.0).then_some(value as u64),
     });
-    let big = match kind {
-        Sample::Int { big, .. } | Sample::Real { big } => big,
-    };
     let (mut special, mut missing_n) = (0usize, 0usize);
-    for _ in 0..rows_n {
+    let mut at = None;
+    for r in wr.clone() {
+        let start = offset + r * line_bytes + prefix + wc.start * bytes as u64;
+        // Consecutive whole lines without prefix or suffix need no seek (BufReader keeps its
+        // buffer); otherwise seek to the window's part of the line.
+        if at != Some(start) {
+            file.seek(SeekFrom::Start(start)).with_context(|| format!("cannot read {data_name}"))?;
+        }
         file.read_exact(&mut buf).with_context(|| format!("cannot read {data_name}"))?;
-        let line = &buf[prefix as usize..prefix as usize + cols_n * bytes];
-        let out = &mut values;
-        // The ISIS special pixels (NULL, LRS, LIS, HIS, HRS) mark cells without a height in
-        // HiRISE DTMs: the five most negative finite 32-bit reals (0xFF7FFFFB to 0xFF7FFFFF),
-        // their 64-bit twins (0xFFEFFFFFFFFFFFFB to ...FF), and -32768 to -32764 of 16-bit
-        // signed integers.
-        let (m, sp) = match (kind, bytes) {
-            (Sample::Real { .. }, 4) => decode_line::<4>(
-                line,
-                big,
-                |u| f64::from(f32::from_bits(u as u32)),
-                |u| (0xFF7F_FFFB..=0xFF7F_FFFF).contains(&u),
-                missing_bits,
-                (add, scale),
-                out,
-            ),
-            (Sample::Real { .. }, _) => decode_line::<8>(
-                line,
-                big,
-                f64::from_bits,
-                |u| (0xFFEF_FFFF_FFFF_FFFB..=0xFFEF_FFFF_FFFF_FFFF).contains(&u),
-                missing_bits,
-                (add, scale),
-                out,
-            ),
-            (Sample::Int { signed: true, .. }, 1) => decode_line::<1>(
-                line,
-                big,
-                |u| f64::from(u as u8 as i8),
-                |_| false,
-                missing_bits,
-                (add, scale),
-                out,
-            ),
-            (Sample::Int { signed: true, .. }, 2) => decode_line::<2>(
-                line,
-                big,
-                |u| f64::from(u as u16 as i16),
-                |u| (u as u16 as i16) <= -32764,
-                missing_bits,
-                (add, scale),
-                out,
-            ),
-            (Sample::Int { signed: true, .. }, _) => decode_line::<4>(
-                line,
-                big,
-                |u| f64::from(u as u32 as i32),
-                |_| false,
-                missing_bits,
-                (add, scale),
-                out,
-            ),
-            (Sample::Int { signed: false, .. }, 1) => {
-                decode_line::<1>(line, big, |u| u as f64, |_| false, missing_bits, (add, scale), out)
-            }
-            (Sample::Int { signed: false, .. }, 2) => {
-                decode_line::<2>(line, big, |u| u as f64, |_| false, missing_bits, (add, scale), out)
-            }
-            (Sample::Int { signed: false, .. }, _) => {
-                decode_line::<4>(line, big, |u| u as f64, |_| false, missing_bits, (add, scale), out)
-            }
-        };
+        at = Some(start + buf.len() as u64);
+        let (m, sp) = decode(kind, bytes, &buf, missing_bits, (add, scale), &mut values);
         missing_n += m;
         special += sp;
     }
-    if missing_n + special > 0 {
-        notes.push(format!(
-            "{name}: {} cells without a height (MISSING_CONSTANT: {missing_n}, other ISIS special pixels: {special}) are nodata",
-            missing_n + special
-        ));
+    Ok((values, missing_n, special))
+}
+
+/// Decodes one line of samples of `kind` (`bytes` each) onto `out`; returns how many were
+/// MISSING_CONSTANT and how many other special pixels.
+fn decode(
+    kind: Sample,
+    bytes: usize,
+    line: &[u8],
+    missing_bits: Option<u64>,
+    (add, scale): (f64, f64),
+    out: &mut Vec<f64>,
+) -> (usize, usize) {
+    let big = match kind {
+        Sample::Int { big, .. } | Sample::Real { big } => big,
+    };
+    // The ISIS special pixels (NULL, LRS, LIS, HIS, HRS) mark cells without a height in
+    // HiRISE DTMs: the five most negative finite 32-bit reals (0xFF7FFFFB to 0xFF7FFFFF),
+    // their 64-bit twins (0xFFEFFFFFFFFFFFFB to ...FF), and -32768 to -32764 of 16-bit
+    // signed integers.
+    match (kind, bytes) {
+        (Sample::Real { .. }, 4) => decode_line::<4>(
+            line,
+            big,
+            |u| f64::from(f32::from_bits(u as u32)),
+            |u| (0xFF7F_FFFB..=0xFF7F_FFFF).contains(&u),
+            missing_bits,
+            (add, scale),
+            out,
+        ),
+        (Sample::Real { .. }, _) => decode_line::<8>(
+            line,
+            big,
+            f64::from_bits,
+            |u| (0xFFEF_FFFF_FFFF_FFFB..=0xFFEF_FFFF_FFFF_FFFF).contains(&u),
+            missing_bits,
+            (add, scale),
+            out,
+        ),
+        (Sample::Int { signed: true, .. }, 1) => decode_line::<1>(
+            line,
+            big,
+            |u| f64::from(u as u8 as i8),
+            |_| false,
+            missing_bits,
+            (add, scale),
+            out,
+        ),
+        (Sample::Int { signed: true, .. }, 2) => decode_line::<2>(
+            line,
+            big,
+            |u| f64::from(u as u16 as i16),
+            |u| (u as u16 as i16) <= -32764,
+            missing_bits,
+            (add, scale),
+            out,
+        ),
+        (Sample::Int { signed: true, .. }, _) => decode_line::<4>(
+            line,
+            big,
+            |u| f64::from(u as u32 as i32),
+            |_| false,
+            missing_bits,
+            (add, scale),
+            out,
+        ),
+        (Sample::Int { signed: false, .. }, 1) => {
+            decode_line::<1>(line, big, |u| u as f64, |_| false, missing_bits, (add, scale), out)
+        }
+        (Sample::Int { signed: false, .. }, 2) => {
+            decode_line::<2>(line, big, |u| u as f64, |_| false, missing_bits, (add, scale), out)
+        }
+        (Sample::Int { signed: false, .. }, _) => {
+            decode_line::<4>(line, big, |u| u as f64, |_| false, missing_bits, (add, scale), out)
+        }
     }
-    Ok(values)
 }
 
 /// Decodes one line of `N`-byte samples onto `out`: `add + scale value(bits)`, or NaN where the

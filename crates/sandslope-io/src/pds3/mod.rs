@@ -72,6 +72,74 @@ pub fn read_pds3_within(path: &Path, fits: crate::raster::SizeCheck) -> Result<R
     })
 }
 
+/// A PDS3 DTM opened for reading windows of it: the size and ground cell size from its label,
+/// the samples only when a window is read. The Dask raster reads a DTM larger than memory tile
+/// by tile this way (`sandslope.dask.risk_raster` on a `.img` path); every window holds
+/// exactly the heights [`read_pds3`] gives there.
+#[derive(Debug, Clone)]
+pub struct Pds3Dtm {
+    name: String,
+    data_path: PathBuf,
+    offset: u64,
+    layout: image::Layout,
+    /// LINES.
+    pub rows: usize,
+    /// LINE_SAMPLES.
+    pub cols: usize,
+    /// Ground size of a cell, metres (east, north), as [`read_pds3`] gives it.
+    pub cell_m: (f64, f64),
+    /// What was assumed (the projection, a unit converted), as [`read_pds3`] notes it.
+    pub notes: Vec<String>,
+}
+
+impl Pds3Dtm {
+    /// Reads the label of the DTM at `path` (the `.IMG` with its label attached or a `.LBL`
+    /// beside it, or the `.LBL`) and checks that the data file holds the image it describes.
+    pub fn open(path: &Path) -> Result<Pds3Dtm> {
+        let (label_path, text, attached) = find_label(path)?;
+        let label = parse_label(&label_path.display().to_string(), &text)?;
+        let (data_path, offset) = image_location(&label, &label_path, attached)?;
+        let mut notes = Vec::new();
+        let layout = image::layout(&label, &mut notes)?;
+        // The size checks of a read, on an empty window: nothing is allocated.
+        image::read_window(
+            &layout,
+            &label.name,
+            &data_path,
+            offset,
+            &image::Window { rows: 0..0, cols: 0..0 },
+        )?;
+        let (_, cell_m) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
+        Ok(Pds3Dtm {
+            name: label.name.clone(),
+            data_path,
+            offset,
+            rows: layout.rows as usize,
+            cols: layout.cols as usize,
+            layout,
+            cell_m,
+            notes,
+        })
+    }
+
+    /// Heights in metres of rows `rows` and columns `cols` (row-major, NaN where missing or
+    /// special); only those samples' bytes are read. An error names the DTM when the window
+    /// is not inside the image.
+    pub fn read_window(
+        &self,
+        rows: std::ops::Range<usize>,
+        cols: std::ops::Range<usize>,
+    ) -> Result<Vec<f64>> {
+        let window = image::Window {
+            rows: rows.start as u64..rows.end as u64,
+            cols: cols.start as u64..cols.end as u64,
+        };
+        let (values, _, _) =
+            image::read_window(&self.layout, &self.name, &self.data_path, self.offset, &window)?;
+        Ok(values)
+    }
+}
+
 /// Where the image's bytes are: the file and the byte offset of its first line.
 fn image_location(label: &Label, label_path: &Path, attached: bool) -> Result<(PathBuf, u64)> {
     let name = &label.name;
@@ -404,6 +472,42 @@ mod tests {
         assert!(matches!(l.get("W"), Some((Value::List(v), 5)) if v[1].unit.as_deref() == Some("NM")));
         assert_eq!(l.number("IMAGE.D").unwrap(), Some((-150.0, Some("M".into()))));
         assert!(parse_label("t.lbl", b"A = (((((((((((((((((((((1)))))))))))))))))))))\nEND").is_err());
+    }
+
+    /// Every window of each fixture (edges, one cell, whole lines, the empty window) holds the
+    /// same heights as the whole read there, NaN where it has NaN; a window outside the image
+    /// is an error naming LINES x LINE_SAMPLES, and opening reads no sample.
+    #[test]
+    fn windows_are_the_whole_reads_heights() {
+        for name in ["dtm-attached.img", "dtm-detached.lbl", "dtm-detached.img", "moon-bytes.img"] {
+            let whole = fixture(name);
+            let dtm = Pds3Dtm::open(&fixture_path(name)).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+            assert_eq!((dtm.rows, dtm.cols), (whole.rows, whole.cols), "{name}");
+            assert_eq!(dtm.cell_m, whole.cell_m, "{name}");
+            assert_eq!(dtm.notes.iter().filter(|n| !n.contains("without a height")).count(), dtm.notes.len());
+            let (r, c) = (whole.rows, whole.cols);
+            for (rows, cols) in [
+                (0..r, 0..c),
+                (0..1, 0..1),
+                (r - 1..r, c - 1..c),
+                (1..r / 2, c / 3..c),
+                (r / 2..r, 0..c / 2 + 1),
+                (3..3, 0..c),
+            ] {
+                let got = dtm.read_window(rows.clone(), cols.clone()).unwrap();
+                assert_eq!(got.len(), rows.len() * cols.len(), "{name} {rows:?} {cols:?}");
+                for (k, g) in got.iter().enumerate() {
+                    let (i, j) = (rows.start + k / cols.len(), cols.start + k % cols.len());
+                    let want = whole.values[i * c + j];
+                    assert!(
+                        g.to_bits() == want.to_bits() || (g.is_nan() && want.is_nan()),
+                        "{name} ({i}, {j}): {g} vs {want}"
+                    );
+                }
+            }
+            let err = format!("{:#}", dtm.read_window(0..r + 1, 0..c).unwrap_err());
+            assert!(err.contains(&format!("the {r} x {c} image (LINES x LINE_SAMPLES)")), "{err}");
+        }
     }
 }
 

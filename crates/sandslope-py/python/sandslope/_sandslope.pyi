@@ -164,6 +164,10 @@ def plan(
 def read_raster(path: _Path) -> Tuple[_F64, int, int, Dict[str, float]]: ...
 def geotiff_nodata(path: _Path) -> Optional[float]:
     """The GDAL_NODATA value of a GeoTIFF (None when it has none), read from its tags only."""
+def pds3_info(path: _Path) -> Dict[str, Any]:
+    """A PDS3 DTM's ``{rows, cols, cell_x_m, cell_y_m, notes}`` from its label alone."""
+def pds3_window(path: _Path, top: int, bottom: int, left: int, right: int) -> np.ndarray:
+    """Rows ``top:bottom``, columns ``left:right`` of a PDS3 DTM (metres, NaN where missing)."""
 def fit(
     manifest: _Path,
     depth_window: Optional[Tuple[float, float]] = None,

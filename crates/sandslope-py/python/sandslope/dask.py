@@ -10,7 +10,7 @@ the interior of each padded tile is kept.
 
 Where the heights come from decides the memory a worker needs:
 
-* **A store** (a path to a ``.npy`` file, a GeoTIFF or a ``.zarr`` array, or an array-like
+* **A store** (a path to a ``.npy`` file, a GeoTIFF, a PDS3 DTM or a ``.zarr`` array, or an array-like
   such as a ``zarr.Array`` that slices lazily and pickles as a reference): each task reads its
   own tile and its one-cell halo straight from the store, computes, and lets go. Tiles depend
   on nothing else, so memory per worker is a few tiles, whatever the size of the DEM. This is
@@ -124,8 +124,17 @@ def _is_npy(source: Any) -> bool:
     return isinstance(source, (str, os.PathLike)) and os.fspath(source).lower().endswith(".npy")
 
 
+def _is_pds3(source: Any) -> bool:
+    """A path to a PDS3 DTM: an ``.img`` with its label attached or beside it, or its ``.lbl``."""
+    return isinstance(source, (str, os.PathLike)) and os.fspath(source).lower().endswith((".img", ".lbl"))
+
+
 def _read_window(source: Any, top: int, bottom: int, left: int, right: int) -> np.ndarray:
     """Rows ``top:bottom``, columns ``left:right`` of a store."""
+    if _is_pds3(source):
+        # Read by sandslope's own PDS3 reader (sample types, scaling, special pixels as NaN),
+        # only the window's samples.
+        return _sandslope.pds3_window(os.fspath(source), top, bottom, left, right)
     if _is_npy(source):
         return _read_npy_window(os.fspath(source), top, bottom, left, right)
     return _with_array(source, lambda a: np.asarray(a[top:bottom, left:right]))
@@ -202,13 +211,16 @@ def _store_shape(source: Any) -> Tuple[Tuple[int, int], Optional[Tuple[int, int]
     if isinstance(source, (str, os.PathLike)) and not os.path.exists(source):
         raise ValueError(f"dem = {os.fspath(source)!r}: no such file or folder")
     try:
-        if _is_npy(source):
+        if _is_pds3(source):
+            info = _sandslope.pds3_info(os.fspath(source))
+            shape, native = (info["rows"], info["cols"]), None
+        elif _is_npy(source):
             with open(source, "rb") as f:
                 shape, native = _npy_header(f)[0], None
         else:
             shape, native = _with_array(source, lambda a: (tuple(getattr(a, "shape", ())), getattr(a, "chunks", None)))
     except ValueError as e:
-        if _is_npy(source):
+        if _is_npy(source) and not _is_pds3(source):
             raise ValueError(f"dem = {os.fspath(source)!r}: not a .npy file: {e}") from e
         raise
     except Exception as e:  # a file that is not an array: the reader says why
@@ -239,8 +251,10 @@ def risk_raster(
 
     ``dem`` is one of:
 
-    * a path to a ``.npy`` file, a GeoTIFF (``.tif``, read through ``tifffile``) or a
-      ``.zarr`` array (both need ``zarr``), or an array-like that slices lazily and
+    * a path to a ``.npy`` file, a PDS3 DTM as HiRISE publishes them (``.img`` with its label
+      attached or a ``.lbl`` beside it, or the ``.lbl``: read by sandslope's PDS3 reader, the
+      same heights as :func:`sandslope.read_raster`), a GeoTIFF (``.tif``, read through
+      ``tifffile``) or a ``.zarr`` array (both need ``zarr``), or an array-like that slices lazily and
       pickles cheaply (``zarr.Array``): each task reads its tile and one-cell halo from it, so
       memory per worker is bounded by a few tiles whatever the DEM's size;
     * a dask array that only reads a store (``da.from_zarr(path)``, ``da.from_array`` on a
@@ -248,6 +262,11 @@ def risk_raster(
     * any other dask array: halos are cut from neighbouring chunks, and a worker holds about a
       row of chunks (see the module's notes);
     * a NumPy array (in memory; chunked like a dask array).
+
+    ``cell_size_m``: ground cell size in metres, one number or ``(cell_x, cell_y)``; ``None``
+    for a PDS3 DTM takes the label's (as :func:`sandslope.read_raster` gives it in
+    ``geo["cell_x_m"]``, ``geo["cell_y_m"]``: ``MAP_SCALE`` on the body's sphere, at the DTM's
+    middle).
 
     ``chunks``: tile shape (an int or ``(rows, cols)``, any form ``dask.array`` accepts);
     default: the dask array's chunks, a store's own chunks, or 1024 x 1024.
@@ -259,6 +278,13 @@ def risk_raster(
     system, or a zarr store the workers can reach). Call ``.compute()``, ``da.to_zarr`` or
     ``.store`` to evaluate.
     """
+    if cell_size_m is None:
+        if not _is_pds3(dem):
+            raise ValueError("cell_size_m = None takes the cell size from a PDS3 DTM's label; give it in metres for any other dem")
+        if not os.path.exists(dem):
+            raise ValueError(f"dem = {os.fspath(dem)!r}: no such file or folder")
+        info = _sandslope.pds3_info(os.fspath(dem))
+        cell_size_m = (info["cell_x_m"], info["cell_y_m"])
     cx, cy = _cell_size(cell_size_m)
     options = dict(
         robot=_robot(robot),

@@ -68,8 +68,8 @@ fn in_chunks<T: Send>(
 }
 
 /// Regime probabilities at each slope: the keys of `sandslope risk --json` as columns
-/// (`p_regime` a dict of columns) and the columns of `risk --csv` (`p_<regime>`), with the
-/// coefficients of variation used and where they came from (`given`, `table`, `default`).
+/// (`p_regime` a dict of columns), with the coefficients of variation used and where they came
+/// from (`given`, `table`, `default`); no other keys.
 #[pyfunction]
 #[pyo3(signature = (robot, slope_deg, terrain, cv_n=None, cv_s=None))]
 pub fn risk<'py>(
@@ -100,9 +100,7 @@ pub fn risk<'py>(
     let p_regime = PyDict::new(py);
     let of = |q: &RegimeProbabilities| [q.success, q.metastable, q.slippage, q.sinkage];
     for (i, name) in ["success", "metastable", "slippage", "sinkage"].into_iter().enumerate() {
-        let column: Vec<f64> = pts.iter().map(|p| of(&p.probabilities)[i]).collect();
-        put(&p_regime, name, column.clone())?;
-        put(&d, &format!("p_{name}"), column)?;
+        put(&p_regime, name, pts.iter().map(|p| of(&p.probabilities)[i]).collect())?;
     }
     d.set_item("p_regime", p_regime)?;
     Ok(d)

@@ -293,8 +293,8 @@ def risk(
     ``slope_deg``, the ``cv_n``, ``cv_s`` used at each slope and where each came from
     (``cv_n_source``, ``cv_s_source``: ``"given"``, ``"table"`` or ``"default"``), ``p_fail`` =
     P(sinkage or slippage), ``p_not_success`` and ``p_regime`` (a dict of ``success``,
-    ``metastable``, ``slippage``, ``sinkage``); and the same four as the ``risk --csv`` columns
-    ``p_success``, ``p_metastable``, ``p_slippage``, ``p_sinkage``.
+    ``metastable``, ``slippage``, ``sinkage``), and no other keys (issue 22: the same keys as
+    ``--json``; ``pandas.DataFrame(r["p_regime"])`` gives the ``risk --csv`` regime columns).
     """
     robot, terrain = _robot(robot), _terrain(terrain)
     s = _float_array("slope_deg", slope_deg)

@@ -459,6 +459,157 @@ fn banded_product(
         });
 }
 
+/// `P(sinkage)` of each column (k_n median `e^mu_n`): `Phi((x* - mu_n)/sigma_n)`, a step when
+/// `sigma_n = 0`, 1 where the median is 0 or no depth supports the robot.
+fn sinkage_probabilities(mu_n: &[f64], x_star: f64, sigma_n: f64) -> Vec<f64> {
+    mu_n.iter()
+        .map(|&m| {
+            if m == f64::NEG_INFINITY || x_star == f64::INFINITY {
+                1.0
+            } else if sigma_n == 0.0 {
+                f64::from(u8::from(m <= x_star))
+            } else {
+                phi((x_star - m) / sigma_n)
+            }
+        })
+        .collect()
+}
+
+/// Per column: the integration window as a node range and its weights, or (`sigma_n = 0`) the
+/// two curves at the column's median.
+enum Columns {
+    Certain(Vec<[f64; 2]>),
+    /// The nodes, and (`sigma_s > 0`) the column blocks of the weight matrix.
+    Spread {
+        nodes: Nodes,
+        blocks: Vec<ColumnBlock>,
+    },
+}
+
+impl Columns {
+    /// The columns of a map below the angle of repose (module documentation, steps 1 and 2).
+    fn new(
+        robot: &Robot,
+        slope: Slope,
+        mu_n: &[f64],
+        mu_s: &[f64],
+        x_star: f64,
+        uncertainty: Uncertainty,
+        block_columns: usize,
+    ) -> Columns {
+        let (sigma_n, sigma_s) = (uncertainty.sigma_n(), uncertainty.sigma_s());
+        if sigma_n == 0.0 {
+            return Columns::Certain(
+                mu_n.iter()
+                    .map(|&m| if m > x_star { curves(robot, slope, m).0 } else { [f64::INFINITY; 2] })
+                    .collect(),
+            );
+        }
+        // The union of the columns' windows, cut at x*.
+        let mut windows: Vec<(f64, f64)> = mu_n
+            .iter()
+            .filter(|m| m.is_finite())
+            .map(|&m| ((m - Z_MAX * sigma_n).max(x_star), m + Z_MAX * sigma_n))
+            .filter(|(a, b)| a < b)
+            .collect();
+        windows.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut segments: Vec<(f64, f64)> = Vec::new();
+        for (a, b) in windows {
+            match segments.last_mut() {
+                Some(last) if a <= last.1 => last.1 = last.1.max(b),
+                _ => segments.push((a, b)),
+            }
+        }
+        let finite_s: Vec<f64> = mu_s.iter().copied().filter(|m| m.is_finite()).collect();
+        let band = if sigma_s > 0.0 && !finite_s.is_empty() {
+            let lo = finite_s.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = finite_s.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            (lo - Z_FLAT * sigma_s, hi + Z_FLAT * sigma_s)
+        } else {
+            (f64::INFINITY, f64::NEG_INFINITY)
+        };
+        let nodes = build_nodes(robot, slope, &segments, sigma_n, sigma_s, band);
+        let column_blocks =
+            if sigma_s > 0.0 { column_blocks(&nodes, mu_n, sigma_n, block_columns) } else { Vec::new() };
+        Columns::Spread { nodes, blocks: column_blocks }
+    }
+}
+
+/// What every cell of a map shares: the medians' logarithms per column and row, `P(sinkage)`
+/// per column, the spreads, and whether the slope is at or beyond repose.
+struct Cells<'a> {
+    mu_n: &'a [f64],
+    mu_s: &'a [f64],
+    p_sink: &'a [f64],
+    sigma_n: f64,
+    sigma_s: f64,
+    beyond_repose: bool,
+}
+
+/// The cells of a map that needs no matrix product (at or beyond repose, `k_s = 0`, `cv_n =
+/// 0` or `cv_s = 0`; module documentation), row by row in parallel: `out` is `[p_fail,
+/// p_not_success]`, row-major.
+fn cells_without_product(
+    robot: &Robot,
+    slope: Slope,
+    columns: &Columns,
+    cells: &Cells<'_>,
+    out: [&mut [f64]; 2],
+    row_done: &(dyn Fn() + Sync),
+) {
+    let Cells { mu_n, mu_s, p_sink, sigma_n, sigma_s, beyond_repose } = *cells;
+    let nx = mu_n.len().max(1);
+    let [p_fail, p_not_success] = out;
+    p_fail.par_chunks_mut(nx).zip(p_not_success.par_chunks_mut(nx)).zip(mu_s.par_iter()).for_each(
+        |((fail_row, ns_row), &ms)| {
+            // Conditional integrals [P(slip, not sunk), P(not success, not sunk)] per column.
+            let integrals: Vec<[f64; 2]> = if beyond_repose || ms == f64::NEG_INFINITY {
+                // Every leg that does not sink slips (at/above repose, or k_s = 0).
+                p_sink.iter().map(|&p| [1.0 - p; 2]).collect()
+            } else {
+                match columns {
+                    Columns::Certain(g) => g
+                        .iter()
+                        .zip(p_sink)
+                        .map(|(g, &p)| {
+                            if p >= 1.0 {
+                                return [0.0; 2];
+                            }
+                            let f = |g: f64| {
+                                if sigma_s == 0.0 {
+                                    f64::from(u8::from(g > ms))
+                                } else {
+                                    cdf(g, ms, sigma_s)
+                                }
+                            };
+                            [f(g[0]), f(g[1])]
+                        })
+                        .collect(),
+                    Columns::Spread { nodes, .. } => {
+                        let intervals = [0, 1].map(|t| above(robot, slope, &nodes.ends, t, ms));
+                        mu_n.iter()
+                            .map(|&m| {
+                                if !m.is_finite() {
+                                    return [0.0; 2];
+                                }
+                                intervals.clone().map(|iv| {
+                                    iv.iter()
+                                        .map(|&(a, b)| phi((b - m) / sigma_n) - phi((a - m) / sigma_n))
+                                        .sum::<f64>()
+                                })
+                            })
+                            .collect()
+                    }
+                }
+            };
+            for (i, [slip, not_success]) in integrals.into_iter().enumerate() {
+                (fail_row[i], ns_row[i]) = finish(p_sink[i], slip, not_success);
+            }
+            row_done();
+        },
+    );
+}
+
 impl RiskMap {
     /// The map for `robot` at `slope` on terrain with angle of repose `repose`, over
     /// `k_n_axis x k_s_axis` with `uncertainty` in every cell, by the shared-work algorithm
@@ -505,69 +656,12 @@ impl RiskMap {
         let mu_s: Vec<f64> = k_s_axis.values().into_iter().map(ln).collect();
         let (sigma_n, sigma_s) = (uncertainty.sigma_n(), uncertainty.sigma_s());
         let x_star = sinkage_threshold_k_n(robot, slope).ln();
-        // P(sinkage) per column.
-        let p_sink: Vec<f64> = mu_n
-            .iter()
-            .map(|&m| {
-                if m == f64::NEG_INFINITY || x_star == f64::INFINITY {
-                    1.0
-                } else if sigma_n == 0.0 {
-                    f64::from(u8::from(m <= x_star))
-                } else {
-                    phi((x_star - m) / sigma_n)
-                }
-            })
-            .collect();
+        let p_sink = sinkage_probabilities(&mu_n, x_star, sigma_n);
 
-        // Per column: the integration window as a node range and its weights, or (sigma_n = 0)
-        // the two curves at the column's median.
-        enum Columns {
-            Certain(Vec<[f64; 2]>),
-            /// The nodes, and (`sigma_s > 0`) the column blocks of the weight matrix.
-            Spread {
-                nodes: Nodes,
-                blocks: Vec<ColumnBlock>,
-            },
-        }
         let columns = if beyond_repose {
             Columns::Certain(Vec::new())
-        } else if sigma_n == 0.0 {
-            Columns::Certain(
-                mu_n.iter()
-                    .map(|&m| if m > x_star { curves(robot, slope, m).0 } else { [f64::INFINITY; 2] })
-                    .collect(),
-            )
         } else {
-            // The union of the columns' windows, cut at x*.
-            let mut windows: Vec<(f64, f64)> = mu_n
-                .iter()
-                .filter(|m| m.is_finite())
-                .map(|&m| ((m - Z_MAX * sigma_n).max(x_star), m + Z_MAX * sigma_n))
-                .filter(|(a, b)| a < b)
-                .collect();
-            windows.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let mut segments: Vec<(f64, f64)> = Vec::new();
-            for (a, b) in windows {
-                match segments.last_mut() {
-                    Some(last) if a <= last.1 => last.1 = last.1.max(b),
-                    _ => segments.push((a, b)),
-                }
-            }
-            let finite_s: Vec<f64> = mu_s.iter().copied().filter(|m| m.is_finite()).collect();
-            let band = if sigma_s > 0.0 && !finite_s.is_empty() {
-                let lo = finite_s.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = finite_s.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                (lo - Z_FLAT * sigma_s, hi + Z_FLAT * sigma_s)
-            } else {
-                (f64::INFINITY, f64::NEG_INFINITY)
-            };
-            let nodes = build_nodes(robot, slope, &segments, sigma_n, sigma_s, band);
-            let column_blocks = if sigma_s > 0.0 {
-                column_blocks(&nodes, &mu_n, sigma_n, blocks.columns)
-            } else {
-                Vec::new()
-            };
-            Columns::Spread { nodes, blocks: column_blocks }
+            Columns::new(robot, slope, &mu_n, &mu_s, x_star, uncertainty, blocks.columns)
         };
 
         let mut p_fail = zeroed(nx * ny);
@@ -595,54 +689,8 @@ impl RiskMap {
                 };
             }
         }
-        p_fail.par_chunks_mut(nx).zip(p_not_success.par_chunks_mut(nx)).zip(mu_s.par_iter()).for_each(
-            |((fail_row, ns_row), &ms)| {
-                // Conditional integrals [P(slip, not sunk), P(not success, not sunk)] per column.
-                let integrals: Vec<[f64; 2]> = if beyond_repose || ms == f64::NEG_INFINITY {
-                    // Every leg that does not sink slips (at/above repose, or k_s = 0).
-                    p_sink.iter().map(|&p| [1.0 - p; 2]).collect()
-                } else {
-                    match &columns {
-                        Columns::Certain(g) => g
-                            .iter()
-                            .zip(&p_sink)
-                            .map(|(g, &p)| {
-                                if p >= 1.0 {
-                                    return [0.0; 2];
-                                }
-                                let f = |g: f64| {
-                                    if sigma_s == 0.0 {
-                                        f64::from(u8::from(g > ms))
-                                    } else {
-                                        cdf(g, ms, sigma_s)
-                                    }
-                                };
-                                [f(g[0]), f(g[1])]
-                            })
-                            .collect(),
-                        Columns::Spread { nodes, .. } => {
-                            let intervals = [0, 1].map(|t| above(robot, slope, &nodes.ends, t, ms));
-                            mu_n.iter()
-                                .map(|&m| {
-                                    if !m.is_finite() {
-                                        return [0.0; 2];
-                                    }
-                                    intervals.clone().map(|iv| {
-                                        iv.iter()
-                                            .map(|&(a, b)| phi((b - m) / sigma_n) - phi((a - m) / sigma_n))
-                                            .sum::<f64>()
-                                    })
-                                })
-                                .collect()
-                        }
-                    }
-                };
-                for (i, [slip, not_success]) in integrals.into_iter().enumerate() {
-                    (fail_row[i], ns_row[i]) = finish(p_sink[i], slip, not_success);
-                }
-                row_done();
-            },
-        );
+        let cells = Cells { mu_n: &mu_n, mu_s: &mu_s, p_sink: &p_sink, sigma_n, sigma_s, beyond_repose };
+        cells_without_product(robot, slope, &columns, &cells, [&mut p_fail, &mut p_not_success], row_done);
         RiskMap {
             slope_deg: slope.degrees(),
             beyond_repose,

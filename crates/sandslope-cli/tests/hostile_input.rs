@@ -130,3 +130,24 @@ fn a_capture_whose_time_jumps_by_days_is_refused_before_filling_the_gap() {
         Duration::from_secs(3),
     );
 }
+
+/// The fuzz at 100,000 inputs per command found `predict --json` hanging on a robot file whose
+/// `response_time_s` had become `1e-320` (positive and finite, so accepted): the shear load
+/// m (g + R omega / dt) overflowed to infinity and the critical-strength search never ended.
+/// Now exit 2 at once, naming the file, the key and the valid range.
+#[test]
+fn a_response_time_that_overflows_the_loads_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = dir.path().join("robot.toml");
+    let preset = sandslope().args(["presets", "show", "paper-hexapod"]).output().unwrap();
+    let text = String::from_utf8(preset.stdout)
+        .unwrap()
+        .replace("response_time_s = 0.2", "response_time_s = 1e-320");
+    assert!(text.contains("response_time_s = 1e-320"));
+    std::fs::write(&robot, text).unwrap();
+    refused_fast(
+        &["predict", "--robot", robot.to_str().unwrap(), "--slope", "15", "--json"],
+        "robot.toml: response_time_s = 1e-320 must be large enough that the shear load",
+        Duration::from_secs(3),
+    );
+}

@@ -101,7 +101,9 @@ pub fn critical_shear_strength(
     let mut hi = lo + 1.0;
     while f(hi) <= 0.0 {
         hi += 2.0;
-        if hi > lo + 200.0 {
+        // Written so that a NaN or infinite end also stops the search (an infinite anchoring
+        // threshold once made `hi > lo + 200` never true: a hang).
+        if (hi - lo).is_nan() || hi - lo > 200.0 {
             // s is within rounding of s* at k_s ~ e^200 k_anchor: treat as unreachable.
             return Err(NoShearSuffices::LevelStepTooShort { level_step: s_star, target: s_target });
         }

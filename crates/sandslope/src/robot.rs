@@ -129,7 +129,21 @@ impl Robot {
         let r = positive("leg_radius_m", spec.leg_radius_m)?;
         positive("leg_width_m", spec.leg_width_m)?;
         positive("leg_speed_rad_s", spec.leg_speed_rad_s)?;
-        positive("response_time_s", spec.response_time_s)?;
+        let dt = positive("response_time_s", spec.response_time_s)?;
+        // The loads of docs/model.md §4 must be finite numbers: a response time of 1e-320 s
+        // made the shear load m (g + R omega / dt) infinite, and the critical-strength search
+        // of `predict --json` then never ended (scripts/fuzz.sh, input 15811 of 100,000).
+        let shear_load = spec.mass_kg * (crate::model::G + r * spec.leg_speed_rad_s / dt);
+        if !shear_load.is_finite() {
+            return Err(ParamError::new(
+                "response_time_s",
+                dt,
+                format!(
+                    "large enough that the shear load mass_kg * (9.81 + leg_radius_m * leg_speed_rad_s / response_time_s) \
+                     is a finite number (here {shear_load}); the paper's robot has 0.2 s"
+                ),
+            ));
+        }
         if spec.stance_legs < 1 {
             return Err(ParamError::new(
                 "stance_legs",
@@ -355,6 +369,9 @@ mod tests {
             RobotSpec { leg_width_m: f64::NAN, ..paper_spec() },
             RobotSpec { leg_speed_rad_s: 0.0, ..paper_spec() },
             RobotSpec { response_time_s: f64::INFINITY, ..paper_spec() },
+            // Finite and positive, but R omega / dt overflows: 0.04 * 2 pi / 1e-320 > 1.8e308.
+            RobotSpec { response_time_s: 1e-320, ..paper_spec() },
+            RobotSpec { mass_kg: 1e308, leg_speed_rad_s: 1e3, ..paper_spec() },
             RobotSpec { stance_legs: 0, ..paper_spec() },
             RobotSpec { leg_contact_area_m2: Some(0.0), ..paper_spec() },
             RobotSpec { level_step_m: Some(-1.0), ..paper_spec() },
@@ -369,5 +386,24 @@ mod tests {
         for spec in bad {
             assert!(Robot::new(spec.clone()).is_err(), "{spec:?} accepted");
         }
+    }
+
+    /// A response time of 1e-320 s is positive and finite, but the shear load
+    /// m (g + R omega / dt) = 0.35 (9.81 + 0.04 x 2 pi / 1e-320) overflows to infinity; it hung
+    /// `predict --json` in the critical-strength search (scripts/fuzz.sh at 100,000 inputs).
+    /// Refused at the edge, the value in scientific notation, the paper's 0.2 s beside it.
+    #[test]
+    fn a_response_time_that_makes_the_loads_infinite_is_refused() {
+        let e = Robot::new(RobotSpec { response_time_s: 1e-320, ..paper_spec() }).unwrap_err();
+        assert_eq!(e.key, "response_time_s");
+        let text = e.to_string();
+        assert!(
+            text.starts_with("response_time_s = 1e-320 must be large enough that the shear load"),
+            "{text}"
+        );
+        assert!(text.contains("(here inf)") && text.contains("0.2 s"), "{text}");
+        // The smallest response time that keeps the load finite is accepted: 0.35 * 0.2513 / dt
+        // < 1.8e308 for dt = 1e-300.
+        assert!(Robot::new(RobotSpec { response_time_s: 1e-300, ..paper_spec() }).is_ok());
     }
 }

@@ -45,7 +45,8 @@ pub fn shear_strength_for_speed(
     let mut hi = lo + 1.0;
     while f(hi) < 0.0 {
         hi += 2.0;
-        if hi > lo + 200.0 {
+        // A NaN or infinite end also stops the search (`hi > lo + 200` never holds for them).
+        if (hi - lo).is_nan() || hi - lo > 200.0 {
             return Err(unreachable);
         }
     }

@@ -35,9 +35,9 @@ impl ParamError {
 impl fmt::Display for ParamError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let v = self.value;
-        // Very small and very large values in scientific notation: `{}` writes 1e-320 as a
-        // zero and 324 more digits.
-        if v != 0.0 && v.is_finite() && !(1e-6..1e16).contains(&v.abs()) {
+        // Extreme values in scientific notation: `{}` writes 1e-320 as a zero and 324 more
+        // digits. Values from 1e-15 to 1e21 keep the plain form the messages have always had.
+        if v != 0.0 && v.is_finite() && !(1e-15..1e21).contains(&v.abs()) {
             write!(f, "{} = {v:e} must be {}", self.key, self.expected)
         } else {
             write!(f, "{} = {v} must be {}", self.key, self.expected)

@@ -9,6 +9,7 @@
 # Environment:
 #   FUZZ_PROFILE=debug   use debug builds (what scripts/test.sh's short pass does; default release)
 #   FUZZ_SEED=S          another sequence of inputs (default 1)
+#   FUZZ_TIMEOUT=SECONDS one input running longer is a hang (default 10, for release builds)
 #   SANDSLOPE_VENV=DIR   the venv with the Python package (default .venv); the Python targets
 #                        are skipped, with a note, when it has no sandslope
 set -euo pipefail
@@ -17,6 +18,7 @@ runs=${1:-1000}
 shift || true
 profile=${FUZZ_PROFILE:-release}
 seed=${FUZZ_SEED:-1}
+timeout=${FUZZ_TIMEOUT:-10}
 venv=${SANDSLOPE_VENV:-$PWD/.venv}
 flag=--release
 dir=release
@@ -32,11 +34,11 @@ done
 
 status=0
 if [ $# -eq 0 ] || [ ${#rust_targets[@]} -gt 0 ]; then
-  "$bin/sandslope-fuzz" --runs "$runs" --seed "$seed" --bin "$bin/sandslope" ${rust_targets[@]+"${rust_targets[@]}"} || status=1
+  "$bin/sandslope-fuzz" --runs "$runs" --seed "$seed" --timeout "$timeout" --bin "$bin/sandslope" ${rust_targets[@]+"${rust_targets[@]}"} || status=1
 fi
 if [ $# -eq 0 ] || [ ${#py_targets[@]} -gt 0 ]; then
   if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import sandslope" 2>/dev/null; then
-    "$venv/bin/python" scripts/fuzz_python.py --runs "$runs" --seed "$seed" --fuzz-bin "$bin/sandslope-fuzz" \
+    "$venv/bin/python" scripts/fuzz_python.py --runs "$runs" --seed "$seed" --timeout "$timeout" --fuzz-bin "$bin/sandslope-fuzz" \
       ${py_targets[@]+"${py_targets[@]}"} || status=1
   else
     echo "note: no sandslope Python package in $venv: the Python readers were not fuzzed (run scripts/test.sh first)"

@@ -52,11 +52,7 @@ pub fn read_pds3(path: &Path) -> Result<Raster> {
 /// [`read_pds3`], with `fits(cols, rows)` called once the label gives the size and before the
 /// samples are read ([`crate::raster::read_raster_within`]).
 pub fn read_pds3_within(path: &Path, fits: crate::raster::SizeCheck) -> Result<Raster> {
-    let (label_path, text, attached) = find_label(path)?;
-    let label = parse_label(&label_path.display().to_string(), &text)?;
-    let (data_path, offset) = image_location(&label, &label_path, attached)?;
-    let mut notes = Vec::new();
-    let layout = image::layout(&label, &mut notes)?;
+    let Described { label, data_path, offset, layout, mut notes } = describe(path)?;
     fits(layout.cols as usize, layout.rows as usize)?;
     let values = image::read_samples(&layout, &label.name, &data_path, offset, &mut notes)?;
     let (geo, cell_m) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
@@ -70,6 +66,26 @@ pub fn read_pds3_within(path: &Path, fits: crate::raster::SizeCheck) -> Result<R
         cell_m,
         notes,
     })
+}
+
+/// What a DTM's label says before any sample is read: the label, where the image's bytes are
+/// (file and offset), its layout, and the notes so far.
+struct Described {
+    label: Label,
+    data_path: PathBuf,
+    offset: u64,
+    layout: image::Layout,
+    notes: Vec<String>,
+}
+
+/// Finds and parses the label of the DTM at `path`, and where and how its image is stored.
+fn describe(path: &Path) -> Result<Described> {
+    let (label_path, text, attached) = find_label(path)?;
+    let label = parse_label(&label_path.display().to_string(), &text)?;
+    let (data_path, offset) = image_location(&label, &label_path, attached)?;
+    let mut notes = Vec::new();
+    let layout = image::layout(&label, &mut notes)?;
+    Ok(Described { label, data_path, offset, layout, notes })
 }
 
 /// A PDS3 DTM opened for reading windows of it: the size and ground cell size from its label,
@@ -96,11 +112,7 @@ impl Pds3Dtm {
     /// Reads the label of the DTM at `path` (the `.IMG` with its label attached or a `.LBL`
     /// beside it, or the `.LBL`) and checks that the data file holds the image it describes.
     pub fn open(path: &Path) -> Result<Pds3Dtm> {
-        let (label_path, text, attached) = find_label(path)?;
-        let label = parse_label(&label_path.display().to_string(), &text)?;
-        let (data_path, offset) = image_location(&label, &label_path, attached)?;
-        let mut notes = Vec::new();
-        let layout = image::layout(&label, &mut notes)?;
+        let Described { label, data_path, offset, layout, mut notes } = describe(path)?;
         // The size checks of a read, on an empty window: nothing is allocated.
         image::read_window(
             &layout,

@@ -60,6 +60,20 @@ fn json_has_the_summary_keys_and_the_closed_form_is_predicts() {
     assert_eq!(sim["closed_form"], predict);
 }
 
+/// `--body-pitch locked` (the closed form's no-pitch assumption): the walk that tumbles at 20
+/// degrees keeps its pitch at zero, and --json says which setting ran.
+#[test]
+fn body_pitch_locked_holds_the_body_parallel_to_the_slope() {
+    let free = json(&["simulate", "--slope", "20", "--duration", "3", "--json"]);
+    assert_eq!(free["body_pitch"], "free");
+    assert!(free["max_pitch_deg"].as_f64().unwrap() > 90.0);
+    let locked = json(&["simulate", "--slope", "20", "--duration", "3", "--json", "--body-pitch", "locked"]);
+    assert_eq!(locked["body_pitch"], "locked");
+    assert_eq!(locked["max_pitch_deg"], 0.0);
+    assert!(locked["pitch_over_s"].is_null());
+    assert_eq!(locked["closed_form"], free["closed_form"]);
+}
+
 #[test]
 fn bad_input_exits_2_naming_the_value_and_range_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -91,6 +105,7 @@ fn bad_input_exits_2_naming_the_value_and_range_and_writes_nothing() {
         ),
         (vec!["--slope", "10", "--duration", "1"], "at least 1.5 T"),
         (vec!["--slopes", "0:95:5"], "--slopes"),
+        (vec!["--slope", "10", "--body-pitch", "fixed"], "possible values: free, locked"),
     ];
     for (args, needle) in cases {
         sandslope()

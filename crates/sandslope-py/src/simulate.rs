@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
 
-use sandslope::simulate::{simulate as run, SimSettings, SimulateError};
+use sandslope::simulate::{simulate as run, BodyPitch, SimSettings, SimulateError};
 use sandslope::Scenario;
 
 use crate::arrays::put;
@@ -18,7 +18,7 @@ use crate::value_error;
 /// `leg{j}_depth_m`, `leg{j}_force_x_n`, `leg{j}_force_z_n`, `leg{j}_torque_n_m`) to a 1-D
 /// array; `summary` is `sandslope simulate --json`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, yield_m=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ))]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, yield_m=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="free"))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -31,6 +31,7 @@ pub fn simulate<'py>(
     dt_s: Option<f64>,
     yield_m: Option<f64>,
     sample_rate_hz: f64,
+    body_pitch: &str,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     let scenario =
         Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
@@ -42,6 +43,15 @@ pub fn simulate<'py>(
         settings = settings.with_yield(y).map_err(value_error)?;
     }
     settings = settings.with_sample_rate(sample_rate_hz).map_err(value_error)?;
+    settings = settings.with_body_pitch(match body_pitch {
+        "free" => BodyPitch::Free,
+        "locked" => BodyPitch::Locked,
+        other => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "body_pitch = {other:?}: expected \"free\" or \"locked\""
+            )))
+        }
+    });
     let sim = py.detach(|| run(&scenario, slope_deg, &settings)).map_err(|e| match e {
         SimulateError::Param(p) => value_error(p),
     })?;

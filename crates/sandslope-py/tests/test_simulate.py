@@ -55,3 +55,15 @@ def test_stiff_level_sand_steps_the_rigid_rolling_step():
     assert m["closed_form"]["level_step_m"] == pytest.approx(2 * math.sqrt(r * r - (h - r) ** 2), rel=1e-3)
     # The body vaults: at the tip's pivot the axle line is up to 2R above the sand.
     assert traj["z_m"].max() == pytest.approx(2 * r, rel=0.03)
+
+
+def test_body_pitch_locked_is_the_cli_flag(cli):
+    # The body held parallel to the slope (docs/model.md §15): no pitch in the trajectory, and
+    # the same walk as `simulate --body-pitch locked --json`.
+    want = cli.json("simulate", "--slope", 20, "--duration", 3, "--body-pitch", "locked")
+    traj, got = sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, body_pitch="locked")
+    assert got["body_pitch"] == want["body_pitch"] == "locked"
+    assert got["speed_m_s"] == pytest.approx(want["speed_m_s"], rel=1e-12)
+    assert (traj["pitch_rad"] == 0.0).all() and got["max_pitch_deg"] == 0.0
+    with pytest.raises(ValueError, match=r'body_pitch = "sideways": expected "free" or "locked"'):
+        sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, body_pitch="sideways")

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use serde::Serialize;
 
 use crate::args::{
@@ -17,7 +17,9 @@ use crate::figures::simulate::{Animation, SimulateFigure, SlopesFigure};
 use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
-use sandslope::simulate::{simulate, simulate_slopes, SimSettings, SimSummary, SimulateError, Simulation};
+use sandslope::simulate::{
+    simulate, simulate_slopes, BodyPitch, SimSettings, SimSummary, SimulateError, Simulation,
+};
 use sandslope::{ParamError, Scenario};
 use sandslope_io::load_speeds;
 use sandslope_io::trajectory::plain_mocap_csv;
@@ -45,6 +47,10 @@ pub struct SimulateArgs {
     /// Elastic slip at which the sand's stress is fully mobilised, m (docs/model.md §16).
     #[arg(long = "yield", value_name = "M", allow_negative_numbers = true)]
     pub yield_m: Option<f64>,
+    /// Whether the body may pitch: `locked` holds it parallel to the slope, the closed form's
+    /// assumption, to see what the pitch does to a walk (docs/simulate.md).
+    #[arg(long, value_name = "MODE", value_enum, default_value_t = PitchArg::Free)]
+    pub body_pitch: PitchArg,
     /// Trajectory sample rate for --out, --plot and --animate, Hz.
     #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
     pub rate: f64,
@@ -69,6 +75,24 @@ pub struct SimulateArgs {
     pub over: OverrideArgs,
     #[command(flatten)]
     pub format: FormatArgs,
+}
+
+/// `--body-pitch`: the library's [`BodyPitch`] as a flag value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PitchArg {
+    /// The body pitches under the sand's and gravity's moments (default).
+    Free,
+    /// The body is held parallel to the slope, as the closed form assumes.
+    Locked,
+}
+
+impl From<PitchArg> for BodyPitch {
+    fn from(p: PitchArg) -> BodyPitch {
+        match p {
+            PitchArg::Free => BodyPitch::Free,
+            PitchArg::Locked => BodyPitch::Locked,
+        }
+    }
 }
 
 /// A library error with its keys renamed to this command's flags.
@@ -100,6 +124,7 @@ fn settings(args: &SimulateArgs) -> Result<SimSettings> {
     if let Some(y) = args.yield_m {
         s = s.with_yield(y).map_err(flagged)?;
     }
+    s = s.with_body_pitch(args.body_pitch.into());
     s.with_sample_rate(args.rate).map_err(flagged)
 }
 
@@ -258,7 +283,11 @@ fn print_one(sim: &Simulation) {
         format!("{:.2} (reach 2R - h = {:.1})", m.max_depth_m * 1e3, m.d_max_m * 1e3),
         format!("d_n = {}", num(p.normal_depth.map(|v| v * 1e3), 2)),
     ]);
-    t.add_row(["largest pitch deg".into(), format!("{:.1}", m.max_pitch_deg), "0 (no pitch)".to_string()]);
+    let largest = match m.body_pitch {
+        BodyPitch::Free => format!("{:.1}", m.max_pitch_deg),
+        BodyPitch::Locked => "0 (locked)".to_string(),
+    };
+    t.add_row(["largest pitch deg".into(), largest, "0 (no pitch)".to_string()]);
     t.add_row(["regime", m.regime.name(), p.regime.name()]);
     t.add_row(["cause", m.cause.name(), p.cause.name()]);
     println!("{t}");
@@ -316,7 +345,7 @@ fn run_slopes(
     let summaries: Vec<SimSummary> = sims.into_iter().map(|s| s.summary).collect();
     if let Some(path) = &args.plot {
         let repose_deg = scenario.terrain().repose().map(|r| r.degrees());
-        figures::save(path, &SlopesFigure { sims: &summaries, observed, repose_deg })?;
+        figures::save(path, &SlopesFigure { sims: &summaries, pitch_locked: &[], observed, repose_deg })?;
     }
     match args.format.format() {
         Format::Json => print_json(&Answer::Many(summaries))?,
@@ -377,6 +406,9 @@ fn run_slopes(
                 ]);
             }
             println!("{t}");
+            if settings.body_pitch == BodyPitch::Locked {
+                println!("body pitch locked at 0 (--body-pitch locked), as the closed form assumes");
+            }
         }
     }
     Ok(())

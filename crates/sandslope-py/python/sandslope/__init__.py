@@ -736,6 +736,7 @@ def simulate(
     dt_s: Optional[float] = None,
     yield_m: Optional[float] = None,
     sample_rate_hz: float = 120.0,
+    body_pitch: str = "free",
 ) -> Tuple[Any, Dict[str, Any]]:
     """Simulates the robot walking for ``duration_s`` seconds on ``terrain`` at ``slope_deg``
     (``sandslope simulate``, docs/model.md §15-§18).
@@ -744,7 +745,8 @@ def simulate(
     resistive force theory scaled to the terrain's k_n and k_s (``k_n``/``k_s`` override them at
     every slope, as ``--k-n``/``--k-s``); ``dt_s`` fixes the integration step, ``yield_m`` the
     elastic slip at which the sand's stress is fully mobilised, ``sample_rate_hz`` the
-    trajectory's sampling. Negative slopes walk downhill.
+    trajectory's sampling; ``body_pitch="locked"`` holds the body parallel to the slope, as the
+    closed form assumes (``--body-pitch locked``). Negative slopes walk downhill.
 
     Returns ``(trajectory, summary)``: ``trajectory`` a pandas DataFrame (a dict of NumPy
     columns without pandas) with ``time_s``, ``x_m``, ``z_m``, ``pitch_rad``, ``vx_m_s``,
@@ -763,6 +765,7 @@ def simulate(
         dt_s=None if dt_s is None else float(dt_s),
         yield_m=None if yield_m is None else float(yield_m),
         sample_rate_hz=float(sample_rate_hz),
+        body_pitch=str(body_pitch),
     )
     try:
         import pandas as pd

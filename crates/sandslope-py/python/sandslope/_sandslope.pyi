@@ -213,6 +213,7 @@ def simulate(
     dt_s: Optional[float] = None,
     yield_m: Optional[float] = None,
     sample_rate_hz: float = 120.0,
+    body_pitch: str = "free",
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 
 def read_touchdowns(path: _Path) -> List[float]: ...

@@ -22,6 +22,31 @@ pub enum LegShape {
     Foot,
 }
 
+/// Whether the body may pitch (docs/model.md §15). The closed form has no body pitch; locking
+/// it in the simulator removes that one difference, so a comparison of the two settings tells
+/// what the pitch does to a walk (docs/simulate.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BodyPitch {
+    /// The body pitches under the moments of the sand and gravity (the default).
+    #[default]
+    Free,
+    /// The body keeps its pitch at zero (parallel to the slope), as the closed form assumes:
+    /// the moments are carried by a constraint and the body moves along and normal to the slope
+    /// only.
+    Locked,
+}
+
+impl BodyPitch {
+    /// The setting's name, as `--body-pitch` and `--json` spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            BodyPitch::Free => "free",
+            BodyPitch::Locked => "locked",
+        }
+    }
+}
+
 /// Node positions of one leg in its own frame (angle 0: the C's circle centre at (R, 0)).
 pub(crate) fn leg_nodes(robot: &Robot, shape: LegShape, elements: usize) -> Vec<[f64; 2]> {
     let r = robot.leg_radius();

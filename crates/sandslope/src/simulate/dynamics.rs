@@ -8,7 +8,7 @@
 //! velocity and `K` the position Jacobian of the sand forces (depth gain), so the stiff contact
 //! neither rings nor blows up at bead-bed stiffness.
 
-use super::body::{assemble, element_force, leg_nodes, Assembly, Element, Memory, Touch};
+use super::body::{assemble, element_force, leg_nodes, Assembly, BodyPitch, Element, Memory, Touch};
 use super::rft::Rft;
 use super::{Geometry, SimSettings, Trajectory};
 use crate::model::G;
@@ -67,6 +67,8 @@ pub(crate) struct Walker {
     yield_m: f64,
     dt: f64,
     locked: Option<f64>,
+    /// The body's pitch is held at zero (§15, `BodyPitch::Locked`).
+    pitch_locked: bool,
     nodes: Vec<[f64; 2]>,
     belly: Vec<[f64; 2]>,
     hips: Vec<f64>,
@@ -132,6 +134,7 @@ impl Walker {
             yield_m: settings.yield_m,
             dt,
             locked: settings.locked_leg_angle,
+            pitch_locked: settings.body_pitch == BodyPitch::Locked,
             nodes,
             belly,
             hips,
@@ -412,6 +415,12 @@ impl Walker {
             }
             a[i][i] += m[i];
             rhs[i] = dt * (asm.q[i] - dt * kv);
+        }
+        if self.pitch_locked {
+            // The constraint phi = 0 carries the pitch moment: the third equation becomes
+            // dv_phi = 0 (the pitch rate stays at its initial zero).
+            a[2] = [0.0, 0.0, 1.0];
+            rhs[2] = 0.0;
         }
         let dv = solve3(a, rhs);
         for ((v, q), d) in self.v.iter_mut().zip(self.q.iter_mut()).zip(dv) {

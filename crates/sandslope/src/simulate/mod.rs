@@ -18,7 +18,7 @@ pub mod rft;
 use rayon::prelude::*;
 use serde::Serialize;
 
-pub use body::LegShape;
+pub use body::{BodyPitch, LegShape};
 use dynamics::Walker;
 
 use crate::error::ParamError;
@@ -61,6 +61,8 @@ pub struct SimSettings {
     pub shape: LegShape,
     /// Hold every leg at this angle (rad, tripod B half a turn on) instead of walking.
     pub locked_leg_angle: Option<f64>,
+    /// Whether the body may pitch (default: free).
+    pub body_pitch: BodyPitch,
 }
 
 impl SimSettings {
@@ -82,6 +84,7 @@ impl SimSettings {
             settle_s: DEFAULT_SETTLE_S,
             shape: LegShape::CLeg,
             locked_leg_angle: None,
+            body_pitch: BodyPitch::Free,
         })
     }
 
@@ -112,6 +115,11 @@ impl SimSettings {
             return Err(ParamError::new("settle_s", settle_s, "between 0 and 60 s"));
         }
         Ok(SimSettings { settle_s, ..self })
+    }
+
+    /// Lets the body pitch, or holds its pitch at zero as the closed form assumes.
+    pub fn with_body_pitch(self, body_pitch: BodyPitch) -> SimSettings {
+        SimSettings { body_pitch, ..self }
     }
 
     /// Another leg shape.
@@ -288,6 +296,8 @@ pub struct SimSummary {
     pub shape: LegShape,
     /// Elastic slip to full stress, m.
     pub yield_m: f64,
+    /// Whether the body could pitch (`locked`: held parallel to the slope).
+    pub body_pitch: BodyPitch,
     /// Mean step speed over the measured steps, m/s.
     pub speed_m_s: f64,
     /// Mean anchoring time over the measured steps that anchored, s.
@@ -547,6 +557,7 @@ fn summarise(
         leg_elements: robot.leg_elements(),
         shape: settings.shape,
         yield_m: settings.yield_m,
+        body_pitch: settings.body_pitch,
         speed_m_s: speed,
         t1_s: t1,
         slip_m: slip,

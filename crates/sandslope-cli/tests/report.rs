@@ -133,6 +133,19 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
         assert_eq!(sim[0][col], walk[key], "{col}");
     }
     assert_eq!(sim[0]["closed_form_step_m"], walk["closed_form"]["step_m"]);
+    // The pitch-locked column is `simulate --body-pitch locked` at the same slope.
+    let locked: serde_json::Value = serde_json::from_slice(
+        &sandslope()
+            .args(["simulate", "--slope", "20", "--body-pitch", "locked", "--json"])
+            .assert()
+            .success()
+            .get_output()
+            .stdout,
+    )
+    .unwrap();
+    let at20 = sim.iter().find(|r| r["slope_deg"] == 20.0).unwrap();
+    assert_eq!(at20["pitch_locked_m_s"], locked["speed_m_s"]);
+    assert_eq!(at20["pitch_locked_regime"], locked["regime"]);
     assert!(html.contains("The stride simulator against the closed form"));
     // The simulator's joint fit costs about 90 s of CPU: left out unless asked for, and the page
     // names the flag that adds it.

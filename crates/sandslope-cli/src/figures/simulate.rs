@@ -8,7 +8,7 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use sandslope::simulate::{SimSummary, Simulation};
+use sandslope::simulate::{BodyPitch, SimSummary, Simulation};
 use sandslope::{Robot, SpeedObservation};
 
 use super::palette;
@@ -176,6 +176,8 @@ impl Figure for SimulateFigure<'_> {
 pub struct SlopesFigure<'a> {
     /// One walk per slope, in slope order.
     pub sims: &'a [SimSummary],
+    /// The same walks with the body's pitch locked (drawn dashed; empty: not drawn).
+    pub pitch_locked: &'a [SimSummary],
     /// Observed speeds with SDs.
     pub observed: &'a [SpeedObservation],
     /// The terrain's angle of repose.
@@ -208,6 +210,8 @@ impl Figure for SlopesFigure<'_> {
             .collect();
         let obs: Vec<(f64, f64, f64)> =
             self.observed.iter().map(|o| (o.slope.degrees(), o.speed * 100.0, o.speed_sd * 100.0)).collect();
+        let locked: Vec<(f64, f64)> =
+            self.pitch_locked.iter().map(|m| (m.slope_deg, m.speed_m_s * 100.0)).collect();
         let xr = super::range(
             sim.iter().map(|p| p.0).chain(tumbled.iter().copied()).chain(obs.iter().map(|o| o.0)),
             (0.0, 30.0),
@@ -215,6 +219,7 @@ impl Figure for SlopesFigure<'_> {
         let yr = super::range(
             sim.iter()
                 .chain(&cf)
+                .chain(&locked)
                 .map(|p| p.1)
                 .chain(obs.iter().flat_map(|o| [o.1 - o.2, o.1 + o.2]))
                 .chain([0.0]),
@@ -247,9 +252,26 @@ impl Figure for SlopesFigure<'_> {
             runs.iter().filter(|r| !r.is_empty()).map(|r| PathElement::new(r.clone(), blue.stroke_width(3))),
         )
         .map_err(plot_err)?
-        .label("simulated (docs/model.md §15-§18)")
+        .label(if self.sims.first().is_some_and(|m| m.body_pitch == BodyPitch::Locked) {
+            "simulated, pitch locked (docs/model.md §15-§18)"
+        } else {
+            "simulated (docs/model.md §15-§18)"
+        })
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(3)));
         c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, blue.filled()))).map_err(plot_err)?;
+        if !locked.is_empty() {
+            c.draw_series(DashedLineSeries::new(locked.iter().copied(), 8, 5, blue.stroke_width(2)))
+                .map_err(plot_err)?
+                .label("simulated, body pitch locked (the closed form's assumption)")
+                .legend(move |(x, y)| {
+                    // Two dashes, as the curve draws them.
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (8, 0)], blue.stroke_width(2))
+                        + PathElement::new(vec![(13, 0), (20, 0)], blue.stroke_width(2))
+                });
+            c.draw_series(locked.iter().map(|&p| Circle::new(p, 3, blue.stroke_width(1))))
+                .map_err(plot_err)?;
+        }
         if !tumbled.is_empty() {
             let orange = palette::TUMBLE_ORANGE;
             c.draw_series(tumbled.iter().map(|&x| Cross::new((x, 0.0), 7, orange.stroke_width(3))))
@@ -271,9 +293,14 @@ impl Figure for SlopesFigure<'_> {
             )
             .map_err(plot_err)?
             .label("observed (mean ± SD)")
-            .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));
+            .legend(|(x, y)| {
+                // The error bar's own mark: an open circle on a vertical bar.
+                EmptyElement::at((x + 10, y))
+                    + PathElement::new(vec![(0, -7), (0, 7)], BLACK.stroke_width(2))
+                    + Circle::new((0, 0), 4, BLACK.stroke_width(2))
+            });
         }
-        super::legend_box(&mut c, SeriesLabelPosition::UpperRight, 15.0, super::LegendBox::LIGHT)?;
+        super::legend_box(&mut c, SeriesLabelPosition::LowerLeft, 15.0, super::LegendBox::LIGHT)?;
         Ok(())
     }
 }

@@ -88,13 +88,18 @@ pub fn page_figures(report: &Report) -> Result<Vec<PageFigure>> {
 
     // The stride simulator beside the closed form and the observations.
     if !p.simulated.is_empty() {
-        let fig = SlopesFigure { sims: &p.simulated, observed: &p.speeds, repose_deg: p.repose_deg };
+        let fig = SlopesFigure {
+            sims: &p.simulated,
+            pitch_locked: &p.simulated_pitch_locked,
+            observed: &p.speeds,
+            repose_deg: p.repose_deg,
+        };
         add(
             &mut figures,
             report,
             "simulator",
             format!(
-                "The dynamic stride simulator (docs/model.md §15-§18, {} s walks on the same robot and terrain) against the closed form and the observed speeds. Slopes where the simulated body pitched over (tumbled) are marked on the zero line and left out of its curve. The table \"The stride simulator against the closed form\" says where the two part and why.",
+                "The dynamic stride simulator (docs/model.md §15-§18, {} s walks on the same robot and terrain) against the closed form and the observed speeds. Slopes where the simulated body pitched over (tumbled) are marked on the zero line and left out of its curve; the dashed curve is the same walks with the body's pitch locked, as the closed form assumes. The table \"The stride simulator against the closed form\" says where the two part and why.",
                 sandslope::report::REPORT_WALK_S
             ),
             to_svg(&fig)?,

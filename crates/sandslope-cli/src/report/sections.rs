@@ -248,24 +248,28 @@ pub fn simulator(report: &Report) -> String {
          held fixed by solidified sand, and steps s*. Resistive force theory has no term that holds the \
          circle: this is the two models' different kinematics, not a parameter. <i>Tumbled</i>: the body, lifted \
          on one tripod, pitched over backwards, a failure the closed form cannot show; whether it does depends on \
-         the contact's yield slip (docs/simulate.md).</p>\n",
+         the contact's yield slip (docs/simulate.md). <i>Pitch locked</i>: the same walks with the body held \
+         parallel to the slope, as the closed form assumes (<code>--body-pitch locked</code>): no walk tumbles, so \
+         this column shows what the simulator says once the pitch is taken out.</p>\n",
         sandslope::report::REPORT_WALK_S,
         sandslope::report::AGREE_WITHIN * 100.0,
         report.simulator.len()
     ));
     h.push_str(
-        "<table><tr><th>slope (°)</th><th>observed (cm/s)</th><th>closed form (cm/s)</th><th>simulated (cm/s)</th>\
+        "<table><tr><th>slope (°)</th><th>observed (cm/s)</th><th>closed form (cm/s)</th><th>simulated (cm/s)</th><th>simulated, pitch locked (cm/s)</th>\
          <th>t1 (ms): simulated / closed form</th><th>slip (mm): simulated / closed form</th><th>step (mm): simulated / closed form</th>\
          <th>regime: closed form</th><th>regime: simulated (cause)</th><th>largest pitch (°)</th><th>where they part, and why</th></tr>",
     );
     for r in &report.simulator {
         h.push_str(&format!(
-            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} ({})</td><td>{:.0}</td><td>{}</td></tr>",
+            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1} ({})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} ({})</td><td>{:.0}</td><td>{}</td></tr>",
             if r.agree { "yes" } else { "no" },
             r.slope_deg,
             plus_minus(r.observed_m_s.map(|v| v * 100.0), r.observed_sd_m_s.map(|v| v * 100.0), 1.0, 1),
             r.closed_form_m_s.map_or("- (ruled out)".into(), |v| format!("{:.1}", v * 100.0)),
             if r.pitch_over_s.is_some() { "- (tumbled)".to_string() } else { format!("{:.1}", r.simulated_m_s * 100.0) },
+            r.pitch_locked_m_s * 100.0,
+            r.pitch_locked_regime.name(),
             pair(r.simulated_t1_s, r.closed_form_t1_s, 1e3, 1),
             pair(r.simulated_slip_m, r.closed_form_slip_m, 1e3, 1),
             pair(Some(r.simulated_step_m), r.closed_form_step_m, 1e3, 0),

@@ -33,7 +33,7 @@ use crate::terrain::{Terrain, TerrainPoint};
 
 pub use audit::{Extrapolation, NoFloorFit, SpeedInversion, StepBudget, PAPER_FRAME_RATE_HZ};
 pub use provenance::{Input, Provenance, ProvenanceKind};
-pub use simulator::{SimulatorRecord, AGREE_WITHIN, REPORT_WALK_S};
+pub use simulator::{SimulatorRecord, SimulatorWalks, AGREE_WITHIN, REPORT_WALK_S};
 use tracks::TrackUse;
 pub use tracks::{TrackRecord, TrackedSlope};
 
@@ -184,6 +184,8 @@ pub struct Plots {
     pub step_budget: Vec<StepBudget>,
     /// The simulator's walks of the simulator section, in slope order.
     pub simulated: Vec<crate::simulate::SimSummary>,
+    /// The same walks with the body's pitch locked (docs/model.md §15).
+    pub simulated_pitch_locked: Vec<crate::simulate::SimSummary>,
 }
 
 /// The whole report. Serialises to `report.json`; [`Report::plots`], the page's notes and
@@ -324,9 +326,10 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...): a
     // robot it refuses loses this section, with a warning, not the report.
     let (simulator, simulator_refusal) = match simulator::simulator_section(&robot, &terrain, &speeds) {
-        Ok((records, walks)) => {
-            plots.simulated = walks;
-            (records, None)
+        Ok(walks) => {
+            plots.simulated = walks.free;
+            plots.simulated_pitch_locked = walks.pitch_locked;
+            (walks.records, None)
         }
         Err(e) => (Vec::new(), Some(format!("the stride simulator section is left out: {e}"))),
     };
@@ -553,6 +556,7 @@ fn plots(
             &grid.iter().copied().filter(|s| !terrain.at(*s).beyond_repose(*s)).collect::<Vec<_>>(),
         ),
         simulated: Vec::new(),
+        simulated_pitch_locked: Vec::new(),
     })
 }
 

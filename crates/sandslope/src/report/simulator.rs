@@ -9,7 +9,7 @@ use crate::error::ParamError;
 use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::scenario::Scenario;
-use crate::simulate::{simulate_slopes, MotionCause, SimSettings, SimSummary};
+use crate::simulate::{simulate_slopes, BodyPitch, MotionCause, SimSettings, SimSummary};
 use crate::terrain::Terrain;
 
 /// Simulated seconds per slope in the report (after the simulator's settling).
@@ -55,6 +55,13 @@ pub struct SimulatorRecord {
     pub max_pitch_deg: f64,
     /// When the simulated body pitched past 90 degrees, s (`null`: it did not).
     pub pitch_over_s: Option<f64>,
+    /// The simulator's mean step speed with the body's pitch locked (the closed form's
+    /// no-pitch assumption, docs/model.md §15), m/s.
+    pub pitch_locked_m_s: f64,
+    /// The regime of that walk.
+    pub pitch_locked_regime: Regime,
+    /// Its cause.
+    pub pitch_locked_cause: MotionCause,
     /// Whether the two agree: same regime and, where both have a speed, within 15%.
     pub agree: bool,
     /// Where they part and why, in words.
@@ -73,35 +80,66 @@ pub fn section_slopes(speeds: &[SpeedObservation], terrain: &Terrain) -> Vec<f64
     slopes
 }
 
+/// The section's walks: every slope of [`section_slopes`] with the body free to pitch and
+/// with its pitch locked, and the table's records.
+#[derive(Debug, Clone)]
+pub struct SimulatorWalks {
+    /// One record per slope.
+    pub records: Vec<SimulatorRecord>,
+    /// The walks with the body free to pitch, in slope order.
+    pub free: Vec<SimSummary>,
+    /// The same walks with the pitch locked.
+    pub pitch_locked: Vec<SimSummary>,
+}
+
 /// Simulates `robot` on `terrain` at every slope of [`section_slopes`] (10 s walks, the
-/// simulator's defaults) and sets each beside the closed form and the observed speed.
+/// simulator's defaults), once with the body free to pitch and once with its pitch locked,
+/// and sets each beside the closed form and the observed speed.
 pub fn simulator_section(
     robot: &Robot,
     terrain: &Terrain,
     speeds: &[SpeedObservation],
-) -> Result<(Vec<SimulatorRecord>, Vec<SimSummary>), ParamError> {
+) -> Result<SimulatorWalks, ParamError> {
     let slopes = section_slopes(speeds, terrain);
     let scenario = Scenario::new(robot.clone(), terrain.clone(), None, None)?;
     let settings = SimSettings::new(REPORT_WALK_S)?;
-    let sims = simulate_slopes(&scenario, &slopes, &settings).map_err(|e| match e {
-        crate::simulate::SimulateError::Param(p) => p,
-    })?;
-    let summaries: Vec<SimSummary> = sims.into_iter().map(|s| s.summary).collect();
+    let walk = |settings: &SimSettings| -> Result<Vec<SimSummary>, ParamError> {
+        let sims = simulate_slopes(&scenario, &slopes, settings).map_err(|e| match e {
+            crate::simulate::SimulateError::Param(p) => p,
+        })?;
+        Ok(sims.into_iter().map(|s| s.summary).collect())
+    };
+    let free = walk(&settings)?;
+    let pitch_locked = walk(&settings.with_body_pitch(BodyPitch::Locked))?;
     let rolling = crate::simulate::rigid_rolling_step(robot);
-    let records = summaries
+    let records = free
         .iter()
-        .map(|m| {
+        .zip(&pitch_locked)
+        .map(|(m, locked)| {
             let observed = speeds.iter().find(|o| (o.slope.degrees() - m.slope_deg).abs() < 1e-9);
-            record(m, observed, rolling)
+            record(m, locked, observed, rolling)
         })
         .collect();
-    Ok((records, summaries))
+    Ok(SimulatorWalks { records, free, pitch_locked })
 }
 
-fn record(m: &SimSummary, observed: Option<&SpeedObservation>, rolling: f64) -> SimulatorRecord {
+fn record(
+    m: &SimSummary,
+    locked: &SimSummary,
+    observed: Option<&SpeedObservation>,
+    rolling: f64,
+) -> SimulatorRecord {
     let cf = m.closed_form.speed();
     let cf_regime = m.closed_form.prediction.regime;
-    let (agree, why) = reason(m, cf, cf_regime, rolling);
+    let (agree, mut why) = reason(m, cf, cf_regime, rolling);
+    if m.pitch_over_s.is_some() {
+        why.push_str(&format!(
+            "; with the pitch locked: {:.1} cm/s, {} ({})",
+            locked.speed_m_s * 100.0,
+            locked.regime.name(),
+            locked.cause.name()
+        ));
+    }
     SimulatorRecord {
         slope_deg: m.slope_deg,
         observed_m_s: observed.map(|o| o.speed),
@@ -119,6 +157,9 @@ fn record(m: &SimSummary, observed: Option<&SpeedObservation>, rolling: f64) -> 
         closed_form_step_m: m.closed_form.prediction.step,
         max_pitch_deg: m.max_pitch_deg,
         pitch_over_s: m.pitch_over_s,
+        pitch_locked_m_s: locked.speed_m_s,
+        pitch_locked_regime: locked.regime,
+        pitch_locked_cause: locked.cause,
         agree,
         why,
     }

@@ -254,7 +254,10 @@ impl Planner {
                 *grad = map.horn_at(c0 + j, row);
             }
         });
-        let grid = ElevationGrid::new(width, rows, map.cell_x(), map.cell_y(), z, None)?;
+        let mut grid = ElevationGrid::new(width, rows, map.cell_x(), map.cell_y(), z, None)?;
+        if let Some(w) = map.row_widths() {
+            grid = grid.with_row_widths(w[layout.row0..layout.row0 + rows].to_vec())?;
+        }
         Planner::build(grid, Some((layout, grad)), None, terrains, robot, settings, Some(cache))
     }
 
@@ -385,7 +388,12 @@ mod tests {
         for i in [12, 13, 17] {
             nodata[i] = true;
         }
-        let g = ElevationGrid::new(5, 6, 1.0, 2.0, z, Some(&nodata)).unwrap().coarsened(2).unwrap();
+        let g = ElevationGrid::new(5, 6, 1.0, 2.0, z, Some(&nodata)).unwrap();
+        // Rows of different widths: a block row is twice its two rows' mean width.
+        let rows =
+            g.clone().with_row_widths(vec![1.0, 3.0, 2.0, 2.0, 0.5, 1.5]).unwrap().coarsened(2).unwrap();
+        assert_eq!(rows.row_widths(), Some(&[4.0, 4.0, 2.0][..]));
+        let g = g.coarsened(2).unwrap();
         assert_eq!((g.cols(), g.rows(), g.cell_x(), g.cell_y()), (3, 3, 2.0, 4.0));
         let h = |c, r| g.height(Cell { col: c, row: r });
         assert_eq!(h(0, 0), Some(5.5));
@@ -401,7 +409,16 @@ mod tests {
     /// the full planner costs it, and never cheaper than the full optimum.
     #[test]
     fn a_corridor_route_is_a_full_route_no_cheaper_than_the_optimum() {
-        let grid = dunes(72);
+        // Also on rows of different widths (0.6 m in the north to 0.4 m in the south, as a
+        // geographic DEM's): the corridor's rows keep the map's widths.
+        let widths = (0..72).map(|r| 0.6 - 0.2 * r as f64 / 71.0).collect();
+        for grid in [dunes(72), dunes(72).with_row_widths(widths).unwrap()] {
+            corridor_routes_are_full_routes(&grid);
+        }
+    }
+
+    fn corridor_routes_are_full_routes(grid: &ElevationGrid) {
+        let grid = grid.clone();
         let full =
             Planner::new(grid.clone(), None, &[terrain()], &paper_robot(), PlanSettings::default()).unwrap();
         let (s, t) = (Cell { col: 3, row: 66 }, Cell { col: 68, row: 5 });

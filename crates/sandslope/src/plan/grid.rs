@@ -2,6 +2,11 @@
 //!
 //! Row 0 is the northern edge, columns run east; map `x` grows east and `y` grows north, so
 //! a step of one row is `-cell_y` in `y`. No file formats here: readers build the grid.
+//!
+//! A grid in geographic coordinates (degrees) has cells of one north-south size but an
+//! east-west size that shrinks with latitude, `N(phi) cos(phi) dlambda`: such a grid carries
+//! one width per row ([`ElevationGrid::with_row_widths`]), and everything that measures east-west
+//! (Horn gradients, move lengths and headings, the heuristic) uses the row's.
 
 use super::PlanError;
 
@@ -14,6 +19,8 @@ pub struct ElevationGrid {
     cell_y: f64,
     z: Vec<f32>,
     valid: Vec<bool>,
+    /// East-west size of each row's cells, m; empty when every row is `cell_x` wide.
+    row_cell_x: Vec<f64>,
 }
 
 /// A cell of a grid, by column (east) and row (south).
@@ -62,7 +69,35 @@ impl ElevationGrid {
             Some(m) => z.iter().zip(m).map(|(h, &nd)| h.is_finite() && !nd).collect(),
             None => z.iter().map(|h| h.is_finite()).collect(),
         };
-        Ok(ElevationGrid { cols, rows, cell_x, cell_y, z, valid })
+        Ok(ElevationGrid { cols, rows, cell_x, cell_y, z, valid, row_cell_x: Vec::new() })
+    }
+
+    /// The grid with the east-west cell size of each row given (`widths[r]`, m, row 0 at the
+    /// north), as in a geographic DEM whose cells narrow towards the pole; `cell_x` stays the
+    /// grid's reference width (the mid-latitude's, from the readers), which sets only the
+    /// cell length of the risk objective (docs/model.md §9). Fails unless there is one finite,
+    /// positive width per row. Equal widths leave the grid uniform, as cheap as one built by
+    /// [`ElevationGrid::new`] with that width.
+    pub fn with_row_widths(mut self, widths: Vec<f64>) -> Result<ElevationGrid, PlanError> {
+        if widths.len() != self.rows {
+            return Err(PlanError::Grid(format!(
+                "{} row widths for a grid of {} rows",
+                widths.len(),
+                self.rows
+            )));
+        }
+        if let Some((r, w)) = widths.iter().enumerate().find(|(_, w)| !(w.is_finite() && **w > 0.0)) {
+            return Err(PlanError::Grid(format!(
+                "cell size x of row {r} = {w} must be a finite number greater than 0"
+            )));
+        }
+        if widths.iter().all(|&w| w == widths[0]) {
+            self.cell_x = widths[0];
+            self.row_cell_x = Vec::new();
+        } else {
+            self.row_cell_x = widths;
+        }
+        Ok(self)
     }
 
     /// A grid from heights as a raster holds them (`f64`, row-major from the north-west
@@ -97,9 +132,31 @@ impl ElevationGrid {
     pub fn rows(&self) -> usize {
         self.rows
     }
-    /// Cell width (east-west), m.
+    /// Cell width (east-west), m: every row's on a uniform grid; on a grid with per-row widths
+    /// ([`ElevationGrid::with_row_widths`]) the reference width it was built with.
     pub fn cell_x(&self) -> f64 {
         self.cell_x
+    }
+    /// The east-west size of row `row`'s cells, m (the last row's beyond the grid).
+    #[inline(always)]
+    pub fn cell_x_at(&self, row: usize) -> f64 {
+        if self.row_cell_x.is_empty() {
+            self.cell_x
+        } else {
+            self.row_cell_x[row.min(self.rows - 1)]
+        }
+    }
+    /// The east-west size of each row's cells, if the rows differ (`None`: every row is
+    /// [`ElevationGrid::cell_x`] wide).
+    pub fn row_widths(&self) -> Option<&[f64]> {
+        (!self.row_cell_x.is_empty()).then_some(&self.row_cell_x[..])
+    }
+    /// The smallest east-west cell size of any row, m.
+    pub fn min_cell_x(&self) -> f64 {
+        self.row_cell_x
+            .iter()
+            .copied()
+            .fold(if self.row_cell_x.is_empty() { self.cell_x } else { f64::INFINITY }, f64::min)
     }
     /// Cell height (north-south), m.
     pub fn cell_y(&self) -> f64 {
@@ -140,7 +197,8 @@ impl ElevationGrid {
     ///
     /// With the window `a b c / d e f / g h i` (north row first):
     /// `dz/dx = ((c + 2f + i) - (a + 2d + g)) / (8 cell_x)` and
-    /// `dz/dy = ((a + 2b + c) - (g + 2h + i)) / (8 cell_y)`.
+    /// `dz/dy = ((a + 2b + c) - (g + 2h + i)) / (8 cell_y)`, where `cell_x` is the centre
+    /// row's width on a grid with per-row widths (docs/model.md §8).
     pub fn horn_gradient(&self) -> Vec<[f32; 2]> {
         let (cols, rows) = (self.cols, self.rows);
         let mut out = vec![[f32::NAN; 2]; cols * rows];
@@ -166,7 +224,7 @@ impl ElevationGrid {
             return [f32::NAN; 2];
         }
         let (z, v) = (&self.z, &self.valid);
-        let (sx, sy) = (1.0 / (8.0 * self.cell_x), 1.0 / (8.0 * self.cell_y));
+        let (sx, sy) = (1.0 / (8.0 * self.cell_x_at(r)), 1.0 / (8.0 * self.cell_y));
         let (n, m, s) = ((r - 1) * cols + c, r * cols + c, (r + 1) * cols + c);
         let ok = [n - 1, n, n + 1, m - 1, m, m + 1, s - 1, s, s + 1].iter().all(|&i| v[i]);
         if !ok {
@@ -180,7 +238,8 @@ impl ElevationGrid {
 
     /// The grid averaged into blocks of `factor` x `factor` cells (the last row and column of
     /// blocks may be smaller): a block's height is the mean of its cells with heights, nodata
-    /// when fewer than half of its cells have one; cells `factor` times as large. Fails as
+    /// when fewer than half of its cells have one; cells `factor` times as large (a block row
+    /// `factor` times its rows' mean width when the rows differ). Fails as
     /// [`ElevationGrid::new`] when that leaves fewer than 3 x 3 blocks.
     pub fn coarsened(&self, factor: usize) -> Result<ElevationGrid, PlanError> {
         use rayon::prelude::*;
@@ -205,7 +264,16 @@ impl ElevationGrid {
                 }
             }
         });
-        ElevationGrid::new(cc, cr, self.cell_x * f as f64, self.cell_y * f as f64, z, None)
+        let grid = ElevationGrid::new(cc, cr, self.cell_x * f as f64, self.cell_y * f as f64, z, None)?;
+        if self.row_cell_x.is_empty() {
+            return Ok(grid);
+        }
+        let widths = self
+            .row_cell_x
+            .chunks(f)
+            .map(|rows| f as f64 * rows.iter().sum::<f64>() / rows.len() as f64)
+            .collect();
+        grid.with_row_widths(widths)
     }
 }
 
@@ -267,6 +335,53 @@ mod tests {
         assert!(ElevationGrid::from_heights(4, 4, 1.0, 1.0, &h, None).unwrap().is_valid(5));
         assert!(g.on_border(Cell { col: 0, row: 2 }) && g.on_border(Cell { col: 2, row: 3 }));
         assert!(!g.on_border(Cell { col: 1, row: 2 }));
+    }
+
+    /// A plane tilted 0.1 east and -0.05 north on a geographic grid, 0.25-degree cells from
+    /// 60 to 30 degrees north on a sphere of 6371 km: each row's Horn gradient recovers the
+    /// tilt when the row's own width is used, where one mid-latitude width misreads it by the
+    /// ratio of the widths (cos 59.875 / cos 45 = 0.71 at the northern row).
+    #[test]
+    fn horn_recovers_an_east_tilt_on_every_row_of_a_geographic_grid() {
+        let (cols, rows, r_m) = (5, 120, 6_371_000.0_f64);
+        let d = 0.25_f64.to_radians();
+        let lat = |r: usize| (60.0 - (r as f64 + 0.5) * 0.25_f64).to_radians();
+        let widths: Vec<f64> = (0..rows).map(|r| r_m * lat(r).cos() * d).collect();
+        let cell_y = r_m * d;
+        // Heights from ground metres: x east along the row from the middle column (the
+        // meridian of the cells tested), y north of the southern row.
+        let z: Vec<f32> = (0..rows * cols)
+            .map(|i| {
+                let (c, r) = (i % cols, i / cols);
+                (0.1 * (c as f64 - 2.0) * widths[r] - 0.05 * (rows - 1 - r) as f64 * cell_y) as f32
+            })
+            .collect();
+        let mid = r_m * 45.0_f64.to_radians().cos() * d;
+        let uniform = ElevationGrid::new(cols, rows, mid, cell_y, z, None).unwrap();
+        let g = uniform.clone().with_row_widths(widths.clone()).unwrap();
+        for r in 1..rows - 1 {
+            let [gx, gy] = g.horn_at(2, r);
+            // The window's outer rows are a little wider or narrower than its centre: the
+            // east tilt is read within their second difference, (d lat)^2 / 4 = 5e-6.
+            assert!((f64::from(gx) / 0.1 - 1.0).abs() < 2e-5, "row {r}: {gx}");
+            assert!((f64::from(gy) / -0.05 - 1.0).abs() < 1e-4, "row {r}: {gy}");
+        }
+        let [gx0, _] = uniform.horn_at(2, 1);
+        let want = 0.1 * widths[1] / mid;
+        assert!((f64::from(gx0) / want - 1.0).abs() < 1e-4 && want < 0.072, "{gx0} vs {want}");
+    }
+
+    #[test]
+    fn row_widths_are_checked_and_equal_ones_leave_the_grid_uniform() {
+        let g = ElevationGrid::new(3, 4, 2.0, 1.0, vec![0.0; 12], None).unwrap();
+        assert!(g.clone().with_row_widths(vec![1.0; 3]).is_err());
+        assert!(g.clone().with_row_widths(vec![1.0, 0.0, 1.0, 1.0]).is_err());
+        assert!(g.clone().with_row_widths(vec![1.0, f64::NAN, 1.0, 1.0]).is_err());
+        let same = g.clone().with_row_widths(vec![1.5; 4]).unwrap();
+        assert_eq!(same, ElevationGrid::new(3, 4, 1.5, 1.0, vec![0.0; 12], None).unwrap());
+        assert_eq!(same.row_widths(), None);
+        let rows = g.with_row_widths(vec![4.0, 3.0, 2.0, 1.0]).unwrap();
+        assert_eq!((rows.cell_x(), rows.cell_x_at(1), rows.min_cell_x()), (2.0, 3.0, 1.0));
     }
 
     #[test]

@@ -28,17 +28,19 @@ impl Planner {
     pub fn risk_map(&self) -> (Vec<f32>, Vec<f32>) {
         let allowed =
             |r: Regime| r == Regime::Success || (self.settings.allow_metastable() && r == Regime::Metastable);
+        let cols = self.grid.cols();
         self.grad
             .par_iter()
             .zip(self.class.par_iter())
-            .map(|(g, &c)| {
+            .enumerate()
+            .map(|(i, (g, &c))| {
                 if g[0].is_nan() {
                     return (f32::NAN, f32::NAN);
                 }
                 let table = &self.tables[usize::from(c)];
                 let mut best = 1.0_f64;
-                let mut climb: Option<(f32, f64)> = None;
-                for m in &self.moves {
+                let mut climb: Option<(f32, usize)> = None;
+                for (k, m) in self.geoms_at(i / cols).iter().enumerate() {
                     let e = EdgeGeom {
                         tan_pitch: g[0] * m.ux + g[1] * m.uy,
                         tan_roll: (g[0] * m.uy - g[1] * m.ux).abs(),
@@ -52,10 +54,10 @@ impl Planner {
                         && allowed(table.regime(i))
                         && climb.is_none_or(|(t, _)| e.tan_pitch > t)
                     {
-                        climb = Some((e.tan_pitch, m.azimuth_deg));
+                        climb = Some((e.tan_pitch, k));
                     }
                 }
-                (best as f32, climb.map_or(f32::NAN, |(_, a)| a as f32))
+                (best as f32, climb.map_or(f32::NAN, |(_, k)| self.azimuth_deg(i, k) as f32))
             })
             .unzip()
     }

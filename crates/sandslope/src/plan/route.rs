@@ -64,7 +64,7 @@ impl Planner {
     /// Evaluates the edge `u -> v` along move `k` (which must be a valid move).
     pub(super) fn step(&self, u: usize, v: usize, k: usize) -> RouteStep {
         let e = self.geom(u, v, k);
-        let m = &self.moves[k];
+        let m = self.move_geom(u, k);
         let over = e.tan_roll > self.tan_max_roll;
         let tan_p = f64::from(e.tan_pitch);
         let (cu, cv) = (usize::from(self.class[u]), usize::from(self.class[v]));
@@ -85,7 +85,7 @@ impl Planner {
         RouteStep {
             from: self.cell_at(u),
             to: self.cell_at(v),
-            heading_deg: m.azimuth_deg,
+            heading_deg: self.azimuth_deg(u, k),
             pitch_deg: tan_p.atan().to_degrees(),
             roll_deg: f64::from(e.tan_roll).atan().to_degrees(),
             length_m: m.len * (1.0 + tan_p * tan_p).sqrt(),

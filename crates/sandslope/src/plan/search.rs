@@ -66,18 +66,20 @@ pub const NO_CLASS: u8 = u8::MAX;
 pub(super) struct Move {
     pub(super) dc: isize,
     pub(super) dr: isize,
-    /// Unit heading (east, north), f32 for the hot loop.
-    pub(super) ux: f32,
-    pub(super) uy: f32,
-    /// Horizontal length, m.
-    pub(super) len: f64,
-    /// Azimuth clockwise from north, degrees.
-    pub(super) azimuth_deg: f64,
     /// Flat offsets of the two cells a knight move passes through (0 if not a knight move).
     via: [isize; 2],
     /// The same two cells as `(d_col, d_row)` (for a corridor, whose rows start at different
     /// map columns).
     via_at: [(isize, isize); 2],
+}
+
+/// A move's horizontal geometry from a cell of a given row: unit heading (east, north), f32
+/// for the hot loop, and horizontal length, m.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct MoveGeom {
+    pub(super) ux: f32,
+    pub(super) uy: f32,
+    pub(super) len: f64,
 }
 
 /// The grid graph with the model tabulated on it; build once, plan many routes.
@@ -92,6 +94,10 @@ pub struct Planner {
     /// Smallest entry of `costs[objective]`, scaled down a hair for f32 rounding.
     min_cost: [f64; 3],
     pub(super) moves: [Move; HEADINGS],
+    /// Each move's geometry from a cell of row `r`: `geoms[r]`, or `geoms[0]` for every row
+    /// when the grid's rows are equally wide (one entry: the hot loop reads
+    /// `geoms[r.min(last)]`, no branch).
+    geoms: Vec<[MoveGeom; HEADINGS]>,
     pub(super) settings: PlanSettings,
     pub(super) tan_max_roll: f32,
     pub(super) cell_width: f64,
@@ -256,9 +262,17 @@ impl Planner {
             }
         });
         let cols = grid.cols() as isize;
+        let geom_rows = if grid.row_widths().is_some() { grid.rows() } else { 1 };
+        let geoms = (0..geom_rows)
+            .map(|r| {
+                heading_offsets().map(|(dc, dr)| {
+                    let (ex, ny) = move_vector(&grid, r, dc, dr);
+                    let len = ex.hypot(ny);
+                    MoveGeom { ux: (ex / len) as f32, uy: (ny / len) as f32, len }
+                })
+            })
+            .collect();
         let moves = heading_offsets().map(|(dc, dr)| {
-            let (ex, ny) = (dc as f64 * grid.cell_x(), -(dr as f64) * grid.cell_y());
-            let len = ex.hypot(ny);
             // A knight move's segment crosses two cells between its ends (a corner-to-corner
             // diagonal crosses none): both must be passable too.
             let via_at = if dc.abs() + dr.abs() == 3 {
@@ -271,16 +285,7 @@ impl Planner {
                 [(0, 0); 2]
             };
             let via = via_at.map(|(c, r)| r * cols + c);
-            Move {
-                dc,
-                dr,
-                ux: (ex / len) as f32,
-                uy: (ny / len) as f32,
-                len,
-                azimuth_deg: ex.atan2(ny).to_degrees().rem_euclid(360.0),
-                via,
-                via_at,
-            }
+            Move { dc, dr, via, via_at }
         });
         let tan_max_roll = settings.max_roll().radians().tan() as f32;
         Ok(Planner {
@@ -291,6 +296,7 @@ impl Planner {
             costs,
             min_cost,
             moves,
+            geoms,
             settings,
             tan_max_roll,
             cell_width,
@@ -366,15 +372,33 @@ impl Planner {
         self.index_of(Cell { col: c.col.checked_add_signed(dc)?, row: c.row.checked_add_signed(dr)? })
     }
 
+    /// The geometry of every move from a cell of the planner's row `r`.
     #[inline(always)]
-    pub(super) fn geom(&self, u: usize, v: usize, k: usize) -> EdgeGeom {
-        self.geom_of(self.grad[u], self.grad[v], k)
+    pub(super) fn geoms_at(&self, r: usize) -> &[MoveGeom; HEADINGS] {
+        &self.geoms[r.min(self.geoms.len() - 1)]
     }
 
-    /// Pitch and roll of move `k` between cells of gradients `a` and `b`.
+    /// The geometry of move `k` from the planner's cell `u`.
     #[inline(always)]
-    fn geom_of(&self, a: [f32; 2], b: [f32; 2], k: usize) -> EdgeGeom {
+    pub(super) fn move_geom(&self, u: usize, k: usize) -> &MoveGeom {
+        &self.geoms_at(u / self.grid.cols())[k]
+    }
+
+    /// The azimuth of move `k` from the planner's cell `u`, degrees clockwise from north.
+    pub(super) fn azimuth_deg(&self, u: usize, k: usize) -> f64 {
         let m = &self.moves[k];
+        let (ex, ny) = move_vector(&self.grid, u / self.grid.cols(), m.dc, m.dr);
+        ex.atan2(ny).to_degrees().rem_euclid(360.0)
+    }
+
+    #[inline(always)]
+    pub(super) fn geom(&self, u: usize, v: usize, k: usize) -> EdgeGeom {
+        Self::geom_of(self.grad[u], self.grad[v], self.move_geom(u, k))
+    }
+
+    /// Pitch and roll of the move of geometry `m` between cells of gradients `a` and `b`.
+    #[inline(always)]
+    fn geom_of(a: [f32; 2], b: [f32; 2], m: &MoveGeom) -> EdgeGeom {
         let (gx, gy) = (0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]));
         EdgeGeom { tan_pitch: gx * m.ux + gy * m.uy, tan_roll: (gx * m.uy - gy * m.ux).abs() }
     }
@@ -410,12 +434,12 @@ impl Planner {
     /// Cost of edge `u -> v` along move `k` for `objective`; `None` if impassable.
     #[inline(always)]
     pub(super) fn edge_cost(&self, objective: Objective, u: usize, v: usize, k: usize) -> Option<f64> {
-        self.cost_of(objective, self.geom(u, v, k), u, v, k)
+        self.cost_of(objective, self.geom(u, v, k), u, v, self.move_geom(u, k).len)
     }
 
-    /// Cost of edge `u -> v` along move `k` whose pitch and roll are `e`.
+    /// Cost of edge `u -> v` of horizontal length `len` whose pitch and roll are `e`.
     #[inline(always)]
-    fn cost_of(&self, objective: Objective, e: EdgeGeom, u: usize, v: usize, k: usize) -> Option<f64> {
+    fn cost_of(&self, objective: Objective, e: EdgeGeom, u: usize, v: usize, len: f64) -> Option<f64> {
         let physics = objective != Objective::Distance;
         if physics && e.tan_roll > self.tan_max_roll {
             return None;
@@ -434,7 +458,7 @@ impl Planner {
                 0.5 * (t[cu][i] + t[cv][i])
             }
         };
-        per_m.is_finite().then(|| self.moves[k].len * f64::from(per_m))
+        per_m.is_finite().then(|| len * f64::from(per_m))
     }
 
     /// The edges out of `cell` for `objective`: each passable neighbour with the edge's cost
@@ -539,6 +563,9 @@ struct Search<'p> {
     tr: f64,
     /// Cost per horizontal metre of the heuristic.
     h_scale: f64,
+    /// East-west metres per column of the heuristic: the narrowest row's cell width, so that
+    /// no move is shorter than the heuristic takes it to be.
+    h_cell_x: f64,
     node: Vec<Node>,
     /// Move index by which each cell was reached (`u8::MAX`: not reached).
     pred: Vec<u8>,
@@ -567,6 +594,7 @@ impl<'p> Search<'p> {
             tc: planner.cell_at(t).col as f64,
             tr: planner.cell_at(t).row as f64,
             h_scale,
+            h_cell_x: planner.grid.min_cell_x(),
             node: Vec::new(),
             pred,
             // Replaced below, once the start's key is known.
@@ -589,8 +617,7 @@ impl<'p> Search<'p> {
     /// Lower bound of the cost from the cell at column `c`, row `r` to the goal.
     #[inline(always)]
     fn heuristic(&self, c: f64, r: f64) -> f64 {
-        let g = &self.planner.grid;
-        let (ex, ey) = ((c - self.tc) * g.cell_x(), (r - self.tr) * g.cell_y());
+        let (ex, ey) = ((c - self.tc) * self.h_cell_x, (r - self.tr) * self.planner.grid.cell_y());
         self.h_scale * (ex * ex + ey * ey).sqrt()
     }
 
@@ -662,6 +689,7 @@ impl<'p> Search<'p> {
             [0; 5]
         };
         let (mc, mr) = if CORRIDOR { (c as isize + col0[r], (p.layout.row0 + r) as isize) } else { (0, 0) };
+        let geoms = p.geoms_at(r);
         for (k, m) in p.moves.iter().enumerate() {
             let s = shift[(m.dr + 2) as usize];
             let (nc, nr) = (c.wrapping_add_signed(m.dc + s), r.wrapping_add_signed(m.dr));
@@ -688,7 +716,10 @@ impl<'p> Search<'p> {
                     continue;
                 }
             }
-            let Some(cost) = p.cost_of(self.objective, p.geom_of(gu, gv, k), u, v, k) else { continue };
+            let g = &geoms[k];
+            let Some(cost) = p.cost_of(self.objective, Planner::geom_of(gu, gv, g), u, v, g.len) else {
+                continue;
+            };
             let nd = du + cost;
             if nd < dv {
                 let key = nd
@@ -725,6 +756,21 @@ impl<'p> Search<'p> {
         cells.reverse();
         Ok(cells)
     }
+}
+
+/// The horizontal vector (metres east, metres north) of the move `(dc, dr)` from a cell of row
+/// `r`: `dr` rows of `cell_y` south, `dc` columns of the mean of the two end rows' widths east
+/// (a row's width on a uniform grid; within 1e-6 of the haversine on the rows of a geographic
+/// DEM, docs/model.md §8).
+fn move_vector(grid: &ElevationGrid, r: usize, dc: isize, dr: isize) -> (f64, f64) {
+    let width = match grid.row_widths() {
+        None => grid.cell_x(),
+        Some(_) => {
+            let end = r.saturating_add_signed(dr);
+            0.5 * (grid.cell_x_at(r) + grid.cell_x_at(end))
+        }
+    };
+    (dc as f64 * width, -(dr as f64) * grid.cell_y())
 }
 
 /// Cost per horizontal metre at each table entry for `objective` (infinite: impassable).
@@ -890,6 +936,108 @@ mod tests {
         }
         // Both outcomes occur, so the comparison is not vacuous.
         assert!(checked[0] > 150 && checked[1] > 10, "{checked:?}");
+    }
+
+    /// The cost from every cell to `t`, by plain Dijkstra over the reversed edges.
+    fn costs_to(p: &Planner, obj: Objective, t: usize) -> Vec<f64> {
+        let mut dist = vec![f64::INFINITY; p.grid.len()];
+        let mut open = std::collections::BTreeSet::new();
+        dist[t] = 0.0;
+        open.insert((0u64, t));
+        while let Some((_, v)) = open.pop_first() {
+            for k in 0..HEADINGS {
+                let back = (k + HEADINGS / 2) % HEADINGS;
+                let Some(w) = p.neighbour(v, k) else { continue };
+                if let Some(c) = p.edge_cost(obj, w, v, back) {
+                    if dist[v] + c < dist[w] {
+                        open.remove(&(dist[w].to_bits(), w));
+                        dist[w] = dist[v] + c;
+                        open.insert((dist[w].to_bits(), w));
+                    }
+                }
+            }
+        }
+        dist
+    }
+
+    /// Rows of very different widths (1.3 m in the north to 0.5 m in the south, far more than
+    /// any geographic DEM's): the heuristic never exceeds the true cost to the goal from any
+    /// cell, for every objective, and A* finds plain Dijkstra's optimum.
+    #[test]
+    fn on_rows_of_different_widths_the_heuristic_is_admissible_and_a_star_exact() {
+        let n = 32;
+        let widths = (0..n).map(|r| 1.3 - 0.8 * r as f64 / (n - 1) as f64).collect();
+        let grid = bumpy(n).with_row_widths(widths).unwrap();
+        let p = Planner::new(grid, None, &class(), &paper_robot(), PlanSettings::default()).unwrap();
+        for (s, t) in [
+            (Cell { col: 2, row: 29 }, Cell { col: 29, row: 2 }),
+            (Cell { col: 28, row: 3 }, Cell { col: 4, row: 27 }),
+        ] {
+            let (si, ti) = (p.grid.index(s).unwrap(), p.grid.index(t).unwrap());
+            for obj in Objective::ALL {
+                let to_goal = costs_to(&p, obj, ti);
+                let search = Search::new(&p, obj, ti, ti);
+                let mut reached = 0;
+                for (u, &d) in to_goal.iter().enumerate().filter(|(_, d)| d.is_finite()) {
+                    let c = p.grid.cell(u);
+                    let h = search.heuristic(c.col as f64, c.row as f64);
+                    assert!(h <= d, "{obj:?} {c:?}: heuristic {h} > cost {d}");
+                    reached += 1;
+                }
+                assert!(reached > n * n / 2, "{obj:?}: {reached}");
+                let r = p.route(obj, s, t, &|_| ControlFlow::Continue(())).unwrap().unwrap();
+                let got = route_cost(&p, &r);
+                assert!((got - to_goal[si]).abs() <= 1e-9 * got, "{obj:?}: {got} vs {}", to_goal[si]);
+            }
+        }
+    }
+
+    /// The haversine distance, m, between two points (degrees) on a sphere of radius `r_m`.
+    fn haversine(r_m: f64, (lon1, lat1): (f64, f64), (lon2, lat2): (f64, f64)) -> f64 {
+        let (p1, p2) = (lat1.to_radians(), lat2.to_radians());
+        let a = ((p2 - p1) / 2.0).sin().powi(2)
+            + p1.cos() * p2.cos() * ((lon2 - lon1).to_radians() / 2.0).sin().powi(2);
+        2.0 * r_m * a.sqrt().asin()
+    }
+
+    /// Level ground in 0.25-degree cells from 60 to 30 degrees north on a sphere of 6371 km:
+    /// with each row's width (R cos(lat) dlambda) the distance routes east-west along a row,
+    /// north-south and corner to corner are as long as the haversine lengths of their
+    /// longitude,latitude polylines (within 1e-5); with one mid-latitude width (45 degrees)
+    /// the east-west route at 54.875 degrees is 23% too long and the diagonal one wrong too.
+    #[test]
+    fn routes_on_geographic_rows_are_as_long_as_the_haversine() {
+        let (cols, rows, r_m, deg) = (41, 120, 6_371_000.0_f64, 0.25_f64);
+        let lat = |r: usize| 60.0 - (r as f64 + 0.5) * deg;
+        let widths: Vec<f64> =
+            (0..rows).map(|r| r_m * lat(r).to_radians().cos() * deg.to_radians()).collect();
+        let (mid, cell_y) = (r_m * 45.0_f64.to_radians().cos() * deg.to_radians(), r_m * deg.to_radians());
+        let uniform = ElevationGrid::new(cols, rows, mid, cell_y, vec![0.0; cols * rows], None).unwrap();
+        let per_row = uniform.clone().with_row_widths(widths).unwrap();
+        let error = |grid: &ElevationGrid, s: Cell, t: Cell| {
+            let p =
+                Planner::new(grid.clone(), None, &class(), &paper_robot(), PlanSettings::default()).unwrap();
+            let r = p.route(Objective::Distance, s, t, &|_| ControlFlow::Continue(())).unwrap().unwrap();
+            let at = |c: &Cell| ((c.col as f64 + 0.5) * deg, lat(c.row));
+            let want: f64 = r.cells.windows(2).map(|w| haversine(r_m, at(&w[0]), at(&w[1]))).sum();
+            r.length_m / want - 1.0
+        };
+        // Each route, and how far off the mid-latitude width leaves it at least (east-west at
+        // 54.875 degrees: cos 54.875 / cos 45 - 1 = -19% of the true length, so the route is
+        // 23% too long; at 32.375 degrees 16% too short).
+        let routes = [
+            (Cell { col: 2, row: 20 }, Cell { col: 38, row: 20 }, 0.22),
+            (Cell { col: 38, row: 110 }, Cell { col: 2, row: 110 }, 0.15),
+            (Cell { col: 20, row: 2 }, Cell { col: 20, row: 117 }, 0.0),
+            (Cell { col: 2, row: 2 }, Cell { col: 38, row: 117 }, 0.005),
+            (Cell { col: 38, row: 110 }, Cell { col: 1, row: 3 }, 0.0),
+        ];
+        for (s, t, off) in routes {
+            let (e, e_mid) = (error(&per_row, s, t), error(&uniform, s, t));
+            eprintln!("{s:?} -> {t:?}: per-row {e:+.2e}, mid-latitude {e_mid:+.4}");
+            assert!(e.abs() < 1e-5, "{s:?} -> {t:?}: {e}");
+            assert!(e_mid.abs() >= off, "{s:?} -> {t:?}: {e_mid}");
+        }
     }
 
     #[test]

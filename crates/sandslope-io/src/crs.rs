@@ -263,10 +263,31 @@ pub fn from_geokeys(
     Ok((Crs::Geographic { ellipsoid }, vertical))
 }
 
-/// Ground size (metres east, metres north) of a cell of `cell_x` by `cell_y` map units whose
-/// rows span latitudes `south..north` (geographic) or any (projected), taken at the middle
-/// latitude; a note says what was assumed and how much the east-west size varies across the
-/// rows. A geographic raster reaching a pole, or with latitudes outside -90..90, is refused.
+/// The ground size of a raster's cells, metres.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroundCells {
+    /// (east, north): everywhere on a projected map; on a geographic or equirectangular one
+    /// the east-west size at the raster's mid-latitude (the planner's reference cell).
+    pub cell_m: (f64, f64),
+    /// East-west size of each row's cells (row 0 at the north) where the rows differ: a
+    /// geographic raster's `N(lat) cos(lat) dlambda`, an equirectangular map's. The planner
+    /// uses these (`ElevationGrid::with_row_widths`).
+    pub row_widths_m: Option<Vec<f64>>,
+}
+
+impl GroundCells {
+    /// Cells of one size everywhere.
+    pub fn uniform(cell_m: (f64, f64)) -> GroundCells {
+        GroundCells { cell_m, row_widths_m: None }
+    }
+}
+
+/// Ground size of the cells of `cell_x` by `cell_y` map units of a raster whose `rows` rows
+/// span latitudes `south..north` (geographic) or anything (projected): on a geographic CRS
+/// each row's east-west size `N cos(lat) dlambda` at the row's central latitude, and `M dphi`
+/// north-south at the mid-latitude; a note says what was assumed. A geographic raster
+/// reaching a pole, or with latitudes outside -90..90, is refused.
+#[allow(clippy::too_many_arguments)]
 pub fn ground_cell_size(
     name: &dyn std::fmt::Display,
     crs: &Crs,
@@ -274,10 +295,13 @@ pub fn ground_cell_size(
     cell_y: f64,
     north: f64,
     south: f64,
+    rows: usize,
     notes: &mut Vec<String>,
-) -> Result<(f64, f64)> {
+) -> Result<GroundCells> {
     match crs {
-        Crs::Projected { metres_per_unit, .. } => Ok((cell_x * metres_per_unit, cell_y * metres_per_unit)),
+        Crs::Projected { metres_per_unit, .. } => {
+            Ok(GroundCells::uniform((cell_x * metres_per_unit, cell_y * metres_per_unit)))
+        }
         Crs::Geographic { ellipsoid } => {
             if !(north <= 90.0 && south >= -90.0) {
                 bail!("{name}: latitudes {south}..{north} are outside -90..90 degrees: not a geographic raster in degrees");
@@ -288,18 +312,23 @@ pub fn ground_cell_size(
             let mid = 0.5 * (north + south);
             let (m, p) = ellipsoid.metres_per_radian(mid);
             let (gx, gy) = (p * cell_x.to_radians(), m * cell_y.to_radians());
-            let edge = if north.abs() > south.abs() { north } else { south };
-            let vary = 1.0 - ellipsoid.metres_per_radian(edge).1 / p;
+            // Each row at its central latitude.
+            let lat = |r: usize| north - (r as f64 + 0.5) * cell_y;
+            let widths: Vec<f64> =
+                (0..rows).map(|r| ellipsoid.metres_per_radian(lat(r)).1 * cell_x.to_radians()).collect();
+            let last = rows.saturating_sub(1);
             notes.push(format!(
                 "{name}: geographic coordinates (degrees) on {} (a = {} m): cells of {cell_x} x {cell_y} degrees \
-                 taken as {gx:.2} x {gy:.2} m at the mid-latitude {mid:.4} degrees; across the raster's \
-                 latitudes the east-west size differs from that by up to {:.2}%{}",
+                 are {gy:.2} m north-south (at the mid-latitude {mid:.4} degrees) and, east-west, each row's own \
+                 width, from {:.2} m (row 0, latitude {:.4}) to {:.2} m (row {last}, latitude {:.4})",
                 ellipsoid.name,
                 ellipsoid.semi_major_m,
-                100.0 * vary.abs(),
-                if vary.abs() > 0.005 { " (more than 0.5%: crop the DEM or reproject it to a projected CRS with gdalwarp for exact lengths)" } else { "" }
+                widths.first().copied().unwrap_or(gx),
+                lat(0),
+                widths.last().copied().unwrap_or(gx),
+                lat(last),
             ));
-            Ok((gx, gy))
+            Ok(GroundCells { cell_m: (gx, gy), row_widths_m: Some(widths) })
         }
     }
 }
@@ -372,22 +401,57 @@ mod tests {
         let crs = Crs::Geographic { ellipsoid: WGS84 };
         let arcsec = 1.0 / 3600.0;
         let mut notes = Vec::new();
-        let (gx, gy) = ground_cell_size(&"dem", &crs, arcsec, arcsec, 0.01, -0.01, &mut notes).unwrap();
+        let (gx, gy) =
+            ground_cell_size(&"dem", &crs, arcsec, arcsec, 0.01, -0.01, 72, &mut notes).unwrap().cell_m;
         let e2 = 0.006_694_379_990_14;
         assert!((gy - 6_378_137.0 * (1.0 - e2) * arcsec.to_radians()).abs() < 1e-6, "{gy}");
         assert!((gx - 6_378_137.0 * arcsec.to_radians()).abs() < 1e-3, "{gx}");
-        let (gx60, _) = ground_cell_size(&"dem", &crs, arcsec, arcsec, 60.0001, 59.9999, &mut notes).unwrap();
+        let (gx60, _) =
+            ground_cell_size(&"dem", &crs, arcsec, arcsec, 60.0001, 59.9999, 1, &mut notes).unwrap().cell_m;
         let n60 = 6_378_137.0 / (1.0 - e2 * 0.75_f64).sqrt();
         assert!((gx60 - n60 * 0.5 * arcsec.to_radians()).abs() < 1e-3, "{gx60}");
         // Mars as a sphere: 1 degree is 3 396 190 * pi / 180 = 59 274.7 m both ways at 0 degrees.
         let mars = Crs::Geographic { ellipsoid: by_axes(3_396_190.0, 0.0) };
-        let (mx, my) = ground_cell_size(&"dtm", &mars, 1.0, 1.0, 0.5, -0.5, &mut notes).unwrap();
+        let (mx, my) = ground_cell_size(&"dtm", &mars, 1.0, 1.0, 0.5, -0.5, 1, &mut notes).unwrap().cell_m;
         assert!((my - 59_274.7).abs() < 0.1 && (mx - my).abs() < 1.0, "{mx} {my}");
         assert!(notes.iter().any(|n| n.contains("on Mars (a = 3396190 m)")), "{notes:?}");
-        assert!(ground_cell_size(&"p", &crs, 0.1, 0.1, 89.5, 80.0, &mut notes)
+        assert!(ground_cell_size(&"p", &crs, 0.1, 0.1, 89.5, 80.0, 95, &mut notes)
             .unwrap_err()
             .to_string()
             .contains("pole"));
+    }
+
+    /// Half-degree cells on WGS84 from 60.25 to 29.75 degrees north: 61 rows centred on 60,
+    /// 59.5, ..., 30 degrees, each its own width N cos(lat) dlambda. By hand at 45 degrees:
+    /// N = a / sqrt(1 - e^2 sin^2 45) = 6 388 838.29 m, times cos 45 = 0.707107 and 0.5 degree
+    /// (8.72665e-3 rad): 39 423.42 m; at 60 degrees N = a / sqrt(1 - 0.75 e^2), half of it.
+    #[test]
+    fn a_geographic_rasters_rows_each_get_their_width_on_the_ellipsoid() {
+        let crs = Crs::Geographic { ellipsoid: WGS84 };
+        let mut notes = Vec::new();
+        let cells = ground_cell_size(&"dem", &crs, 0.5, 0.5, 60.25, 29.75, 61, &mut notes).unwrap();
+        let w = cells.row_widths_m.unwrap();
+        assert_eq!(w.len(), 61);
+        assert!((w[30] - 39_423.42).abs() < 0.01, "{}", w[30]);
+        let e2 = 0.006_694_379_990_14;
+        let n60 = 6_378_137.0 / (1.0 - e2 * 0.75_f64).sqrt();
+        assert!((w[0] - n60 * 0.5 * 0.5_f64.to_radians()).abs() < 1e-6, "{}", w[0]);
+        let n30 = 6_378_137.0 / (1.0 - e2 * 0.25_f64).sqrt();
+        assert!((w[60] - n30 * 0.75_f64.sqrt() * 0.5_f64.to_radians()).abs() < 1e-6, "{}", w[60]);
+        // The mid-latitude's width stays the reference cell.
+        assert_eq!(cells.cell_m.0, w[30]);
+        assert!(
+            notes[0].contains(
+                "from 27900.00 m (row 0, latitude 60.0000) to 48243.14 m (row 60, latitude 30.0000)"
+            ),
+            "{notes:?}"
+        );
+        // A projected raster's rows are all alike.
+        let utm = Crs::Projected { metres_per_unit: 1.0, unit: "metre" };
+        assert_eq!(
+            ground_cell_size(&"p", &utm, 2.0, 2.0, 10.0, 0.0, 5, &mut notes).unwrap(),
+            GroundCells::uniform((2.0, 2.0))
+        );
     }
 
     /// GeoKeys as GDAL writes them: EPSG:4326 by code; a user-defined Mars sphere by its axis;

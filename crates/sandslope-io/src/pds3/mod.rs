@@ -55,7 +55,7 @@ pub fn read_pds3_within(path: &Path, fits: crate::raster::SizeCheck) -> Result<R
     let Described { label, data_path, offset, layout, mut notes } = describe(path)?;
     fits(layout.cols as usize, layout.rows as usize)?;
     let values = image::read_samples(&layout, &label.name, &data_path, offset, &mut notes)?;
-    let (geo, cell_m) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
+    let (geo, cells) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
     Ok(Raster {
         cols: layout.cols as usize,
         rows: layout.rows as usize,
@@ -63,7 +63,8 @@ pub fn read_pds3_within(path: &Path, fits: crate::raster::SizeCheck) -> Result<R
         nodata: None,
         geo,
         crs: Crs::Projected { metres_per_unit: 1.0, unit: "metre" },
-        cell_m,
+        cell_m: cells.cell_m,
+        row_widths_m: cells.row_widths_m,
         notes,
     })
 }
@@ -104,6 +105,8 @@ pub struct Pds3Dtm {
     pub cols: usize,
     /// Ground size of a cell, metres (east, north), as [`read_pds3`] gives it.
     pub cell_m: (f64, f64),
+    /// East-west ground size of each row's cells (equirectangular), as [`read_pds3`] gives it.
+    pub row_widths_m: Option<Vec<f64>>,
     /// What was assumed (the projection, a unit converted), as [`read_pds3`] notes it.
     pub notes: Vec<String>,
 }
@@ -121,7 +124,7 @@ impl Pds3Dtm {
             offset,
             &image::Window { rows: 0..0, cols: 0..0 },
         )?;
-        let (_, cell_m) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
+        let (_, cells) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
         Ok(Pds3Dtm {
             name: label.name.clone(),
             data_path,
@@ -129,7 +132,8 @@ impl Pds3Dtm {
             rows: layout.rows as usize,
             cols: layout.cols as usize,
             layout,
-            cell_m,
+            cell_m: cells.cell_m,
+            row_widths_m: cells.row_widths_m,
             notes,
         })
     }
@@ -301,6 +305,11 @@ mod tests {
             }
         }
         assert!((r.cell_m.0 - 19.4568).abs() < 1e-3 && r.cell_m.1 == 20.0, "{:?}", r.cell_m);
+        // Each row its own width: row 0's centre at y = 59 299.5 x 20 = 1 185 990 m, latitude
+        // 1 185 990 / 3 396 190 rad = 20.00837 deg, 20 cos(20.00837) / cos(15) = 19.45579 m;
+        // row 47's at 1 185 050 m, 19.99251 deg, 19.45775 m.
+        let w = r.row_widths_m.as_ref().unwrap();
+        assert!(w.len() == 48 && (w[0] - 19.45579).abs() < 1e-5 && (w[47] - 19.45775).abs() < 1e-5, "{w:?}");
         assert_eq!(r.crs, Crs::Projected { metres_per_unit: 1.0, unit: "metre" });
         let notes = r.notes.join("\n");
         assert!(notes.contains("equirectangular map on Mars (sphere of radius 3396190 m)"), "{notes}");
@@ -495,7 +504,7 @@ mod tests {
             let whole = fixture(name);
             let dtm = Pds3Dtm::open(&fixture_path(name)).unwrap_or_else(|e| panic!("{name}: {e:#}"));
             assert_eq!((dtm.rows, dtm.cols), (whole.rows, whole.cols), "{name}");
-            assert_eq!(dtm.cell_m, whole.cell_m, "{name}");
+            assert_eq!((&dtm.cell_m, &dtm.row_widths_m), (&whole.cell_m, &whole.row_widths_m), "{name}");
             assert_eq!(dtm.notes.iter().filter(|n| !n.contains("without a height")).count(), dtm.notes.len());
             let (r, c) = (whole.rows, whole.cols);
             for (rows, cols) in [

@@ -4,6 +4,7 @@
 use anyhow::{anyhow, bail, Result};
 
 use super::label::Label;
+use crate::crs::GroundCells;
 use crate::raster::GeoRef;
 
 /// Where the DTM lies on its projection (projected metres) and on which sphere.
@@ -24,14 +25,14 @@ struct Extent<'a> {
     south: f64,
 }
 
-/// The map's georeferencing (projected metres, north up) and the ground cell size (x, y) in
-/// metres of a DTM of `rows` x `cols`; notes what was assumed.
+/// The map's georeferencing (projected metres, north up) and the ground cell sizes in metres
+/// of a DTM of `rows` x `cols`; notes what was assumed.
 pub(super) fn georef(
     label: &Label,
     rows: u64,
     cols: u64,
     notes: &mut Vec<String>,
-) -> Result<(GeoRef, (f64, f64))> {
+) -> Result<(GeoRef, GroundCells)> {
     let name = &label.name;
     let map = |key: &str| format!("IMAGE_MAP_PROJECTION.{key}");
     if !label
@@ -95,19 +96,21 @@ pub(super) fn georef(
     let body = body_name(label, radius_m);
     let east = west + cols as f64 * cell;
     let extent = Extent { name, body: &body, radius_m, cell, clat, lpo, west, east, north, south };
-    let cell_m = if projection == "EQUIRECTANGULAR" {
-        equirectangular_cells(&extent, notes)?
+    let cells = if projection == "EQUIRECTANGULAR" {
+        equirectangular_cells(&extent, rows, notes)?
     } else {
-        polar_cells(&extent, notes)?
+        GroundCells::uniform(polar_cells(&extent, notes)?)
     };
     let clon = label.number(&map("CENTER_LONGITUDE"))?.map_or(0.0, |v| v.0);
     let (keys, doubles, ascii) = geokeys(&projection, radius_m, clat, clon, &body);
-    Ok((GeoRef::north_up((west, north, cell, cell), keys, doubles, ascii), cell_m))
+    Ok((GeoRef::north_up((west, north, cell, cell), keys, doubles, ascii), cells))
 }
 
-/// Ground cell size of an equirectangular map (y = R lat): MAP_SCALE north-south; east-west
-/// MAP_SCALE is true at CENTER_LATITUDE, so the cells are taken at the DTM's mid-latitude.
-fn equirectangular_cells(e: &Extent, notes: &mut Vec<String>) -> Result<(f64, f64)> {
+/// Ground cell sizes of an equirectangular map (y = R lat): MAP_SCALE north-south; east-west
+/// MAP_SCALE is true at CENTER_LATITUDE, so each row's cells are `MAP_SCALE cos(lat) /
+/// cos(CENTER_LATITUDE)` wide at the row's central latitude (the reference cell at the DTM's
+/// mid-latitude).
+fn equirectangular_cells(e: &Extent, rows: u64, notes: &mut Vec<String>) -> Result<GroundCells> {
     let Extent { name, body, radius_m, cell, clat, lpo, north, south, .. } = *e;
     if clat.abs() >= 89.0 {
         bail!("{name}: CENTER_LATITUDE = {clat}: an equirectangular DTM's must lie within 89 degrees of the equator");
@@ -124,15 +127,20 @@ fn equirectangular_cells(e: &Extent, notes: &mut Vec<String>) -> Result<(f64, f6
     let mid = 0.5 * (lat_n + lat_s);
     let east = |phi: f64| cell * phi.to_radians().cos() / clat.to_radians().cos();
     let gx = east(mid);
-    let vary = (1.0 - east(lat_n) / gx).abs().max((1.0 - east(lat_s) / gx).abs());
+    let row_lat = |r: u64| lat(north - (r as f64 + 0.5) * cell);
+    let widths: Vec<f64> = (0..rows).map(|r| east(row_lat(r))).collect();
+    let last = rows.saturating_sub(1);
     notes.push(format!(
         "{name}: PDS3 equirectangular map on {body} (sphere of radius {radius_m} m): MAP_SCALE {cell} m is true \
-         east-west at CENTER_LATITUDE {clat} degrees; cells taken as {gx:.4} x {cell} m at the mid-latitude \
-         {mid:.4} degrees (the east-west size varies by up to {:.3}% across the rows{})",
-        100.0 * vary,
-        if vary > 0.005 { ": more than 0.5%, crop the DTM for exact lengths" } else { "" }
+         east-west at CENTER_LATITUDE {clat} degrees; cells are {cell} m north-south and, east-west, each row's \
+         own width MAP_SCALE cos(latitude) / cos(CENTER_LATITUDE), from {:.4} m (row 0, latitude {:.4}) to \
+         {:.4} m (row {last}, latitude {:.4})",
+        widths.first().copied().unwrap_or(gx),
+        row_lat(0),
+        widths.last().copied().unwrap_or(gx),
+        row_lat(last),
     ));
-    Ok((gx, cell))
+    Ok(GroundCells { cell_m: (gx, cell), row_widths_m: Some(widths) })
 }
 
 /// Ground cell size of a polar stereographic map centred on a pole, at the DTM's centre.

@@ -99,5 +99,6 @@ pub(super) fn read_asc(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
     };
     let mut notes = Vec::new();
     let crs = crate::crs::from_prj(&path.with_extension("prj"), &mut notes)?;
-    Ok((Raster { cols, rows, values, nodata, geo, crs, cell_m: (cell_x, cell_y), notes }, 1.0))
+    let cell_m = (cell_x, cell_y);
+    Ok((Raster { cols, rows, values, nodata, geo, crs, cell_m, row_widths_m: None, notes }, 1.0))
 }

@@ -282,8 +282,12 @@ pub struct Raster {
     pub geo: GeoRef,
     /// What the map coordinates are (crs.rs).
     pub crs: Crs,
-    /// Ground size of a cell, metres (east, north): the cell size the planner uses.
+    /// Ground size of a cell, metres (east, north): the cell size the planner uses (on a
+    /// geographic raster the east-west size at the mid-latitude, the reference cell).
     pub cell_m: (f64, f64),
+    /// East-west ground size of each row's cells, metres (row 0 at the north), where the rows
+    /// differ (a geographic CRS): what the planner uses east-west instead of `cell_m.0`.
+    pub row_widths_m: Option<Vec<f64>>,
     /// What was assumed or converted in reading (units, ellipsoid, the mid-latitude), for the
     /// front end to print as notes.
     pub notes: Vec<String>,
@@ -393,15 +397,17 @@ fn finish(path: &Path, mut raster: Raster, vertical: f64) -> Result<Raster> {
     }
     let g = &raster.geo;
     let south = g.north - raster.rows as f64 * g.cell_y;
-    raster.cell_m = crate::crs::ground_cell_size(
+    let cells = crate::crs::ground_cell_size(
         &path.display(),
         &raster.crs,
         g.cell_x,
         g.cell_y,
         g.north,
         south,
+        raster.rows,
         &mut raster.notes,
     )?;
+    (raster.cell_m, raster.row_widths_m) = (cells.cell_m, cells.row_widths_m);
     if !raster.crs.is_geographic()
         && g.cell_x < 0.01
         && g.west.abs() <= 180.0
@@ -451,7 +457,17 @@ fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64, DecodingRe
         &mut notes,
     )?;
     let geo = GeoRef { west, north, cell_x, cell_y, geokeys, geodoubles, geoascii };
-    let raster = Raster { cols, rows, values: Vec::new(), nodata, geo, crs, cell_m: (cell_x, cell_y), notes };
+    let raster = Raster {
+        cols,
+        rows,
+        values: Vec::new(),
+        nodata,
+        geo,
+        crs,
+        cell_m: (cell_x, cell_y),
+        row_widths_m: None,
+        notes,
+    };
     Ok((raster, vertical, image))
 }
 

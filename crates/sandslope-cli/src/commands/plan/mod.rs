@@ -384,8 +384,22 @@ fn grid_of(dem: &Raster, args: &PlanArgs) -> Result<ElevationGrid> {
     // The planner works in metres: the cell's ground size, not its size in map units (degrees
     // for a geographic DEM, feet for some projected ones).
     let (cell_x, cell_y) = dem.cell_m;
-    ElevationGrid::from_heights(dem.cols, dem.rows, cell_x, cell_y, &dem.values, dem.nodata)
-        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))
+    let grid = ElevationGrid::from_heights(dem.cols, dem.rows, cell_x, cell_y, &dem.values, dem.nodata);
+    with_rows_of(dem, grid, args)
+}
+
+/// `grid` with the east-west ground size of each of `dem`'s rows where they differ (a
+/// geographic or equirectangular DEM: the cells narrow towards the pole).
+fn with_rows_of(
+    dem: &Raster,
+    grid: Result<ElevationGrid, sandslope::plan::PlanError>,
+    args: &PlanArgs,
+) -> Result<ElevationGrid> {
+    let grid = match &dem.row_widths_m {
+        Some(w) => grid.and_then(|g| g.with_row_widths(w.clone())),
+        None => grid,
+    };
+    grid.map_err(|e| anyhow!("{}: {e}", args.dem.display()))
 }
 
 /// [`load_classes`], with the note on default CVs printed unless `quiet`.
@@ -516,8 +530,8 @@ pub fn compute_any(args: &PlanArgs, risk_map: bool, full_only: bool, quiet: bool
     }
     // The planner works in metres: the cell's ground size, not its size in map units (degrees
     // for a geographic DEM, feet for some projected ones). Heights are f32, nodata NaN.
-    let grid = ElevationGrid::new(dem.cols, dem.rows, dem.cell_m.0, dem.cell_m.1, heights, None)
-        .map_err(|e| anyhow!("{}: {e}", args.dem.display()))?;
+    let grid = ElevationGrid::new(dem.cols, dem.rows, dem.cell_m.0, dem.cell_m.1, heights, None);
+    let grid = with_rows_of(&dem, grid, args)?;
     let start = endpoint(&dem, &grid, "start", &args.start, &args.start_px)?;
     let goal = endpoint(&dem, &grid, "goal", &args.goal, &args.goal_px)?;
     let (classes, terrains) = classes_of(args, &dem, quiet)?;

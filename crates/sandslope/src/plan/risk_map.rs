@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 
 use super::grid::Cell;
-use super::search::{EdgeGeom, Planner};
+use super::search::{EdgeGeom, MoveGeom, Planner, HEADINGS};
 use crate::regime::Regime;
 
 impl Planner {
@@ -24,11 +24,16 @@ impl Planner {
     /// Per cell, the lowest P(failure) over the 16 headings (roll over the limit counts as
     /// failure), and the azimuth (degrees clockwise from north) of the steepest climbing
     /// heading the time objective may use; NaN where the cell is impassable or no heading
-    /// qualifies. Uses the cell's own gradient.
+    /// qualifies. Uses the cell's own gradient, and the headings in its own row's metric (on
+    /// a grid with per-row widths, the 16 moves' directions with the cell's row width east-west:
+    /// a cell's values depend on its 3 x 3 window alone, so a raster computed tile by tile with a
+    /// one-cell halo is this one, bit for bit).
     pub fn risk_map(&self) -> (Vec<f32>, Vec<f32>) {
         let allowed =
             |r: Regime| r == Regime::Success || (self.settings.allow_metastable() && r == Regime::Metastable);
         let cols = self.grid.cols();
+        let rows = if self.grid.row_widths().is_some() { self.grid.rows() } else { 1 };
+        let headings: Vec<[(MoveGeom, f64); HEADINGS]> = (0..rows).map(|r| self.headings_in_row(r)).collect();
         self.grad
             .par_iter()
             .zip(self.class.par_iter())
@@ -39,8 +44,8 @@ impl Planner {
                 }
                 let table = &self.tables[usize::from(c)];
                 let mut best = 1.0_f64;
-                let mut climb: Option<(f32, usize)> = None;
-                for (k, m) in self.geoms_at(i / cols).iter().enumerate() {
+                let mut climb: Option<(f32, f64)> = None;
+                for (m, azimuth) in &headings[(i / cols).min(rows - 1)] {
                     let e = EdgeGeom {
                         tan_pitch: g[0] * m.ux + g[1] * m.uy,
                         tan_roll: (g[0] * m.uy - g[1] * m.ux).abs(),
@@ -54,10 +59,10 @@ impl Planner {
                         && allowed(table.regime(i))
                         && climb.is_none_or(|(t, _)| e.tan_pitch > t)
                     {
-                        climb = Some((e.tan_pitch, k));
+                        climb = Some((e.tan_pitch, *azimuth));
                     }
                 }
-                (best as f32, climb.map_or(f32::NAN, |(_, k)| self.azimuth_deg(i, k) as f32))
+                (best as f32, climb.map_or(f32::NAN, |(_, a)| a as f32))
             })
             .unzip()
     }

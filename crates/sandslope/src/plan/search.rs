@@ -384,6 +384,19 @@ impl Planner {
         &self.geoms_at(u / self.grid.cols())[k]
     }
 
+    /// The 16 headings at a cell of row `r` in that row's own metric (`dc` columns of the
+    /// row's width east, `dr` rows of `cell_y` south), with their azimuths, degrees clockwise
+    /// from north: what the risk map scans (on a uniform grid, the moves' own geometry).
+    pub(super) fn headings_in_row(&self, r: usize) -> [(MoveGeom, f64); HEADINGS] {
+        let w = self.grid.cell_x_at(r);
+        self.moves.map(|m| {
+            let (ex, ny) = (m.dc as f64 * w, -(m.dr as f64) * self.grid.cell_y());
+            let len = ex.hypot(ny);
+            let g = MoveGeom { ux: (ex / len) as f32, uy: (ny / len) as f32, len };
+            (g, ex.atan2(ny).to_degrees().rem_euclid(360.0))
+        })
+    }
+
     /// The azimuth of move `k` from the planner's cell `u`, degrees clockwise from north.
     pub(super) fn azimuth_deg(&self, u: usize, k: usize) -> f64 {
         let m = &self.moves[k];
@@ -1152,6 +1165,28 @@ mod tests {
         // The cells beside the wall (columns 5 and 7) have a gradient of 1.5e38: impassable
         // (an overflow panicked here, and in a release build wrapped round to level ground).
         assert!(r.cells.iter().all(|c| !((c.col == 5 || c.col == 7) && c.row < 11)), "{:?}", r.cells);
+    }
+
+    /// On rows of different widths a cell's risk depends on its 3 x 3 window alone: a band of
+    /// rows planned as a grid of its own (with its rows' widths) gives the whole map's values
+    /// on its interior rows, bit for bit (what the Dask raster's tiles rely on).
+    #[test]
+    fn a_risk_map_on_rows_of_different_widths_is_the_same_tile_by_tile() {
+        let n = 30;
+        let widths: Vec<f64> = (0..n).map(|r| 1.3 - 0.8 * r as f64 / (n - 1) as f64).collect();
+        let whole = bumpy(n).with_row_widths(widths.clone()).unwrap();
+        let band = ElevationGrid::new(n, 12, 1.0, 1.0, whole.heights()[9 * n..21 * n].to_vec(), None)
+            .unwrap()
+            .with_row_widths(widths[9..21].to_vec())
+            .unwrap();
+        let map = |g: ElevationGrid| {
+            Planner::new(g, None, &class(), &paper_robot(), PlanSettings::default()).unwrap().risk_map()
+        };
+        let ((p, c), (bp, bc)) = (map(whole), map(band));
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&p[10 * n..20 * n]), bits(&bp[n..11 * n]));
+        assert_eq!(bits(&c[10 * n..20 * n]), bits(&bc[n..11 * n]));
+        assert!(p[10 * n..20 * n].iter().filter(|v| !v.is_nan()).count() > 250);
     }
 
     /// A planner built from cached tables draws the same risk map, bit for bit, as one built

@@ -578,11 +578,11 @@ fn a_geographic_dem_from_60_to_30_degrees_north_measures_each_row_on_the_sphere(
             .unwrap();
         let notes = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{notes}");
-        // Row 0 at 59.875 degrees: 6 371 000 x cos(59.875 deg) x 0.25 deg = 13 951.85 m; row 119
-        // at 30.125 degrees: 24 044.03 m.
+        // Row 0 at 59.875 degrees: 6 371 000 x cos(59.875 deg) x 0.25 deg = 13 951.8549 m; row
+        // 119 at 30.125 degrees: 24 044.0268 m.
         assert!(
             notes.contains(
-                "from 13951.85 m (row 0, latitude 59.8750) to 24044.03 m (row 119, latitude 30.1250)"
+                "from 13951.8549 m (row 0, latitude 59.8750) to 24044.0268 m (row 119, latitude 30.1250)"
             ),
             "{notes}"
         );

@@ -320,7 +320,7 @@ pub fn ground_cell_size(
             notes.push(format!(
                 "{name}: geographic coordinates (degrees) on {} (a = {} m): cells of {cell_x} x {cell_y} degrees \
                  are {gy:.2} m north-south (at the mid-latitude {mid:.4} degrees) and, east-west, each row's own \
-                 width, from {:.2} m (row 0, latitude {:.4}) to {:.2} m (row {last}, latitude {:.4})",
+                 width, from {:.4} m (row 0, latitude {:.4}) to {:.4} m (row {last}, latitude {:.4})",
                 ellipsoid.name,
                 ellipsoid.semi_major_m,
                 widths.first().copied().unwrap_or(gx),
@@ -442,7 +442,7 @@ mod tests {
         assert_eq!(cells.cell_m.0, w[30]);
         assert!(
             notes[0].contains(
-                "from 27900.00 m (row 0, latitude 60.0000) to 48243.14 m (row 60, latitude 30.0000)"
+                "from 27900.0008 m (row 0, latitude 60.0000) to 48243.1401 m (row 60, latitude 30.0000)"
             ),
             "{notes:?}"
         );

@@ -861,28 +861,35 @@ mod tests {
     /// Plain Dijkstra over the same edges, with a sorted set instead of a heap and no
     /// heuristic: the reference for A*.
     fn reference_cost(p: &Planner, obj: Objective, s: usize, t: usize) -> Option<f64> {
-        let n = p.grid.len();
-        let mut dist = vec![f64::INFINITY; n];
+        let d = dijkstra(p, obj, s, false, Some(t))[t];
+        d.is_finite().then_some(d)
+    }
+
+    /// Plain Dijkstra from `from` over the graph's edges (`reverse`: over the reversed edges,
+    /// so each cell gets its cost *to* `from`), stopping once `stop` is settled.
+    fn dijkstra(p: &Planner, obj: Objective, from: usize, reverse: bool, stop: Option<usize>) -> Vec<f64> {
+        let mut dist = vec![f64::INFINITY; p.grid.len()];
         let mut open = std::collections::BTreeSet::new();
-        dist[s] = 0.0;
-        open.insert((0u64, s));
+        dist[from] = 0.0;
+        open.insert((0u64, from));
         while let Some((_, u)) = open.pop_first() {
-            if u == t {
-                return Some(dist[t]);
+            if Some(u) == stop {
+                break;
             }
             for k in 0..HEADINGS {
-                if let Some(v) = p.neighbour(u, k) {
-                    if let Some(c) = p.edge_cost(obj, u, v, k) {
-                        if dist[u] + c < dist[v] {
-                            open.remove(&(dist[v].to_bits(), v));
-                            dist[v] = dist[u] + c;
-                            open.insert((dist[v].to_bits(), v));
-                        }
+                let Some(v) = p.neighbour(u, k) else { continue };
+                let back = (k + HEADINGS / 2) % HEADINGS;
+                let cost = if reverse { p.edge_cost(obj, v, u, back) } else { p.edge_cost(obj, u, v, k) };
+                if let Some(c) = cost {
+                    if dist[u] + c < dist[v] {
+                        open.remove(&(dist[v].to_bits(), v));
+                        dist[v] = dist[u] + c;
+                        open.insert((dist[v].to_bits(), v));
                     }
                 }
             }
         }
-        None
+        dist
     }
 
     fn route_cost(p: &Planner, r: &Route) -> f64 {
@@ -968,28 +975,6 @@ mod tests {
         assert!(checked[0] > 150 && checked[1] > 10, "{checked:?}");
     }
 
-    /// The cost from every cell to `t`, by plain Dijkstra over the reversed edges.
-    fn costs_to(p: &Planner, obj: Objective, t: usize) -> Vec<f64> {
-        let mut dist = vec![f64::INFINITY; p.grid.len()];
-        let mut open = std::collections::BTreeSet::new();
-        dist[t] = 0.0;
-        open.insert((0u64, t));
-        while let Some((_, v)) = open.pop_first() {
-            for k in 0..HEADINGS {
-                let back = (k + HEADINGS / 2) % HEADINGS;
-                let Some(w) = p.neighbour(v, k) else { continue };
-                if let Some(c) = p.edge_cost(obj, w, v, back) {
-                    if dist[v] + c < dist[w] {
-                        open.remove(&(dist[w].to_bits(), w));
-                        dist[w] = dist[v] + c;
-                        open.insert((dist[w].to_bits(), w));
-                    }
-                }
-            }
-        }
-        dist
-    }
-
     /// Rows of very different widths (1.3 m in the north to 0.5 m in the south, far more than
     /// any geographic DEM's): the heuristic never exceeds the true cost to the goal from any
     /// cell, for every objective, and A* finds plain Dijkstra's optimum.
@@ -1005,7 +990,7 @@ mod tests {
         ] {
             let (si, ti) = (p.grid.index(s).unwrap(), p.grid.index(t).unwrap());
             for obj in Objective::ALL {
-                let to_goal = costs_to(&p, obj, ti);
+                let to_goal = dijkstra(&p, obj, ti, true, None);
                 let search = Search::new(&p, obj, ti, ti);
                 let mut reached = 0;
                 for (u, &d) in to_goal.iter().enumerate().filter(|(_, d)| d.is_finite()) {

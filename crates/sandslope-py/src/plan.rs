@@ -25,12 +25,14 @@ use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
 
 /// The grid, terrain and settings of a NumPy DEM (row 0 = north; NaN or `nodata` = missing
-/// heights, used as float32 like the CLI), as `sandslope plan` builds them.
+/// heights, used as float32 like the CLI), as `sandslope plan` builds them; `row_widths`, the
+/// east-west ground size of each row's cells where they differ (a geographic DEM's).
 #[allow(clippy::too_many_arguments)]
 fn inputs(
     dem: &PyReadonlyArray2<'_, f64>,
     cell_x: f64,
     cell_y: f64,
+    row_widths: Option<Vec<f64>>,
     nodata: Option<f64>,
     terrain: &PyTerrain,
     cv_n: Option<f64>,
@@ -61,7 +63,11 @@ fn inputs(
             nodata,
         ),
     }
-    .map_err(value_error)?;
+    .and_then(|g| match row_widths {
+        Some(w) => g.with_row_widths(w),
+        None => Ok(g),
+    })
+    .map_err(|e| value_error(format!("{e} (row_widths_m: one width per row of the dem, in metres)")))?;
     Ok((grid, terrain, settings))
 }
 
@@ -74,7 +80,7 @@ static PITCH_TABLES: LazyLock<PitchTableCache> = LazyLock::new(PitchTableCache::
 /// climb (degrees from north), as `sandslope plan --risk-map` writes them: `2 * rows * cols`
 /// float32 values, band after band.
 #[pyfunction]
-#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false))]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, row_widths_m=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn risk_raster<'py>(
     py: Python<'py>,
@@ -89,11 +95,13 @@ pub fn risk_raster<'py>(
     max_roll_deg: f64,
     descent: &str,
     allow_metastable: bool,
+    row_widths_m: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, numpy::PyArray1<f32>>> {
     let (grid, terrain, settings) = inputs(
         &dem,
         cell_x,
         cell_y,
+        row_widths_m,
         nodata,
         terrain,
         cv_n,
@@ -185,7 +193,7 @@ fn route_dict<'py>(
 /// `plan::plan` (what `sandslope plan` computes): `{"routes": {name: route}, "extrapolation":
 /// None or {max_pitch_deg, last_point_deg}}`.
 #[pyfunction]
-#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT, classes=None, class_terrains=None))]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT, classes=None, class_terrains=None, row_widths_m=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan<'py>(
     py: Python<'py>,
@@ -207,12 +215,14 @@ pub fn plan<'py>(
     time_weight: f64,
     classes: Option<PyReadonlyArray2<'py, f64>>,
     class_terrains: Option<Vec<(i64, PyRef<'py, PyTerrain>)>>,
+    row_widths_m: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let objectives: Vec<Objective> = objectives.iter().map(|o| objective(o)).collect::<PyResult<_>>()?;
     let (grid, terrain, settings) = inputs(
         &dem,
         cell_x,
         cell_y,
+        row_widths_m,
         nodata,
         terrain,
         cv_n,
@@ -301,7 +311,8 @@ pub fn geotiff_nodata(path: PathBuf) -> PyResult<Option<f64>> {
 }
 
 /// The size, ground cell size and notes of a PDS3 DTM from its label alone, checked against
-/// its data file: `{rows, cols, cell_x_m, cell_y_m, notes}`. The Dask raster then reads it
+/// its data file: `{rows, cols, cell_x_m, cell_y_m, row_widths_m, notes}` (`row_widths_m`: an
+/// equirectangular DTM's east-west size of each row's cells, else None). The Dask raster then reads it
 /// window by window with [`pds3_window`] (a HiRISE DTM can be larger than memory).
 #[pyfunction]
 pub fn pds3_info<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
@@ -311,6 +322,7 @@ pub fn pds3_info<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyD
     d.set_item("cols", dtm.cols)?;
     d.set_item("cell_x_m", dtm.cell_m.0)?;
     d.set_item("cell_y_m", dtm.cell_m.1)?;
+    d.set_item("row_widths_m", dtm.row_widths_m.map(|w| crate::arrays::array(py, w)))?;
     d.set_item("notes", dtm.notes)?;
     Ok(d)
 }
@@ -352,6 +364,9 @@ pub fn read_raster<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RasterTuple<
     // what the coordinates are: cell_x/cell_y are in map units (degrees when geographic).
     geo.set_item("cell_x_m", raster.cell_m.0)?;
     geo.set_item("cell_y_m", raster.cell_m.1)?;
+    // Where the rows' east-west sizes differ (geographic, equirectangular), each row's, m: what
+    // plan and risk_raster take as row_widths_m.
+    geo.set_item("row_widths_m", raster.row_widths_m.clone().map(|w| crate::arrays::array(py, w)))?;
     geo.set_item("crs", pythonize::pythonize(py, &raster.crs).map_err(crate::value_error)?)?;
     geo.set_item("notes", raster.notes.clone())?;
     Ok((crate::arrays::array(py, values), raster.rows, raster.cols, geo))

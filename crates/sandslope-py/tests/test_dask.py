@@ -53,6 +53,26 @@ def test_options_and_errors_pass_through(robot, terrain):
         sdask.risk_raster(da.from_array(z, chunks=7), 0.5, robot=robot, terrain=terrain, max_roll_deg=0)
 
 
+def test_rows_of_different_widths_give_the_eager_values_tile_by_tile(robot, terrain, tmp_path):
+    """Issue 24: on a geographic DEM every row has its own east-west cell size; each tile takes
+    its rows' (and its halo's), so chunks cut across rows or not, and a .npy store read
+    window by window, give the eager raster exactly."""
+    z = dunes(61, 47)
+    widths = np.linspace(0.6, 0.4, 61)
+    eager = sandslope.risk_raster(z, 0.5, robot=robot, terrain=terrain, row_widths_m=widths)
+    assert not np.array_equal(eager, sandslope.risk_raster(z, 0.5, robot=robot, terrain=terrain), equal_nan=True)
+    for chunks in [(23, 19), (1, 47), (61, 10)]:
+        lazy = sdask.risk_raster(da.from_array(z, chunks=chunks), 0.5, robot=robot, terrain=terrain,
+                                 row_widths_m=widths)
+        np.testing.assert_array_equal(lazy.compute(scheduler="threads"), eager, err_msg=f"chunks {chunks}")
+    np.save(tmp_path / "dem.npy", z)
+    lazy = sdask.risk_raster(tmp_path / "dem.npy", 0.5, robot=robot, terrain=terrain, row_widths_m=widths,
+                             chunks=(16, 20))
+    np.testing.assert_array_equal(lazy.compute(scheduler="sync"), eager)
+    with pytest.raises(ValueError, match="row_widths_m must hold one finite width greater than 0 .* 60 values for 61 rows"):
+        sdask.risk_raster(da.from_array(z, chunks=20), 0.5, robot=robot, terrain=terrain, row_widths_m=widths[1:])
+
+
 def test_stores_are_read_tile_by_tile_with_the_same_values(client, robot, terrain, tmp_path):
     """A .npy, a tiled and compressed GeoTIFF with a GDAL_NODATA tag, and a .zarr array, each
     read window by window on worker processes, give the eager raster exactly."""
@@ -182,7 +202,10 @@ def test_pds3_dtms_are_read_window_by_window(client, robot, terrain, tmp_path):
         assert np.isnan(heights).any() or name != "dtm-attached.img"  # its special pixels
         window = sandslope._sandslope.pds3_window(str(path), 2, rows - 1, 3, cols)
         np.testing.assert_array_equal(window, heights[2 : rows - 1, 3:cols])
-        eager = sandslope.risk_raster(heights, (geo["cell_x_m"], geo["cell_y_m"]), robot=robot, terrain=terrain)
+        # An equirectangular DTM's rows each have their width (the polar one's are alike).
+        assert (geo["row_widths_m"] is None) == (name == "dtm-detached.lbl")
+        eager = sandslope.risk_raster(heights, (geo["cell_x_m"], geo["cell_y_m"]), robot=robot, terrain=terrain,
+                                      row_widths_m=geo["row_widths_m"])
         assert np.isfinite(eager[0]).sum() > rows * cols // 2
         for chunks in [(7, 9), (rows, cols)]:
             lazy = sdask.risk_raster(path, None, robot=robot, terrain=terrain, chunks=chunks)

@@ -75,6 +75,37 @@ def test_plan_matches_the_cli(cli, robot, terrain, dune):
         assert g["steps"]["length_m"].sum() == pytest.approx(g["length_m"], rel=1e-9)
 
 
+GEO = "crates/sandslope-io/tests/fixtures/gdal/geo-wgs84.tif"
+
+
+def test_a_geographic_dem_with_its_row_widths_plans_and_maps_as_the_cli(cli, robot, terrain, root, tmp_path):
+    """Issue 24: a GeoTIFF in degrees (EPSG:4326, 1 arc-second cells) has one east-west cell
+    size per row; read_raster gives them and plan and risk_raster with row_widths_m give the
+    CLI's routes and risk map (without them, the mid-latitude width for every row, they differ)."""
+    z, geo = sandslope.read_raster(root / GEO)
+    widths = geo["row_widths_m"]
+    assert widths.shape == (z.shape[0],) and widths[0] < geo["cell_x_m"] < widths[-1]  # north to south
+    cell = (geo["cell_x_m"], geo["cell_y_m"])
+    want = cli.json("plan", "--dem", GEO, "--start-px", "5,10", "--goal-px", "55,40", "--objective", "time,risk")
+    got = sandslope.plan(z, cell, robot=robot, terrain=terrain, start=(10, 5), goal=(40, 55),
+                         objective=["time", "risk"], row_widths_m=widths)["routes"]
+    for name, w in want["routes"].items():
+        assert w["found"] and got[name]["found"], name
+        for k in ["length_m", "time_s", "survival", "max_pitch_deg", "max_roll_deg"]:
+            assert got[name][k] == pytest.approx(w[k], rel=1e-12), (name, k)
+    out = tmp_path / "risk.tif"
+    cli.run("plan", "--dem", GEO, "--start-px", "5,10", "--goal-px", "55,40", "--risk-map", out)
+    want = tifffile.imread(out)
+    rows = sandslope.risk_raster(z, cell, robot=robot, terrain=terrain, row_widths_m=widths)
+    for band in range(2):
+        np.testing.assert_array_equal(rows[band], want[..., band])
+    mid = sandslope.risk_raster(z, cell, robot=robot, terrain=terrain)
+    # The climb azimuths (band 1) follow each row's width: atan(dc w / (dr dy)).
+    assert not np.array_equal(mid[1], want[..., 1], equal_nan=True)
+    with pytest.raises(ValueError, match="row_widths_m"):
+        sandslope.risk_raster(z, cell, robot=robot, terrain=terrain, row_widths_m=widths[:-1])
+
+
 def test_plan_errors(robot, terrain, dune):
     z, _ = dune
     with pytest.raises(ValueError, match=r"start = \(500, 3\) is outside the map"):

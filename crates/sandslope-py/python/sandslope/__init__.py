@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import os
 import warnings as _warnings
-from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -414,6 +414,16 @@ def _cell_size(cell_size_m: Any) -> Tuple[float, float]:
     return pair  # type: ignore[return-value]
 
 
+def _row_widths(row_widths_m: Any) -> Optional[List[float]]:
+    """Each row's east-west cell size (m) as the extension takes it, or None."""
+    if row_widths_m is None:
+        return None
+    w = _float_array("row_widths_m", row_widths_m)
+    if w.ndim != 1:
+        raise ValueError(f"row_widths_m must be a 1-D array, one width per row of the dem (got shape {w.shape})")
+    return w.tolist()
+
+
 def _dem(dem: Any) -> np.ndarray:
     _refuse_complex("dem", dem)
     z = np.asarray(dem)
@@ -434,12 +444,16 @@ def risk_raster(
     descent: str = "symmetric",
     allow_metastable: bool = False,
     nodata: Optional[float] = None,
+    row_widths_m: Any = None,
 ) -> np.ndarray:
     """The two bands of ``sandslope plan --risk-map`` for an elevation array.
 
     ``dem`` (m) is 2-D, row 0 at the north, columns to the east, NaN (or ``nodata``) for
-    missing heights; ``cell_size_m`` is one number or ``(cell_x, cell_y)``. Heights are used
-    as float32, as the CLI does. Each cell's gradient is Horn's 3 x 3 finite difference, so the
+    missing heights; ``cell_size_m`` is one number or ``(cell_x, cell_y)``. ``row_widths_m``:
+    on a geographic DEM (degrees; an equirectangular map), whose cells narrow towards the pole,
+    the east-west size of each row's cells in metres, one per row (what
+    :func:`read_raster` gives as ``geo["row_widths_m"]``), used row by row as ``sandslope plan``
+    does (docs/model.md §8). Heights are used as float32, as the CLI does. Each cell's gradient is Horn's 3 x 3 finite difference, so the
     map border and cells next to nodata have none (NaN).
 
     Returns float32 of shape ``(2, H, W)``: band 0 the lowest P(failure) over the 16 headings
@@ -455,6 +469,7 @@ def risk_raster(
     """
     z = _dem(dem)
     cx, cy = _cell_size(cell_size_m)
+    widths = _row_widths(row_widths_m)
     bands = _sandslope.risk_raster(
         z,
         cx,
@@ -467,6 +482,7 @@ def risk_raster(
         max_roll_deg=float(max_roll_deg),
         descent=descent,
         allow_metastable=bool(allow_metastable),
+        row_widths_m=widths,
     )
     return bands.reshape((2,) + z.shape)
 
@@ -490,6 +506,7 @@ def plan(
     nodata: Optional[float] = None,
     classes: Any = None,
     class_terrains: Optional[Mapping[int, TerrainLike]] = None,
+    row_widths_m: Any = None,
 ) -> Dict[str, Any]:
     """Heading-aware routes over an elevation array (``sandslope plan --json``, docs/model.md §8).
 
@@ -511,6 +528,10 @@ def plan(
     Terrain classes (``plan --classes --class-terrain``): ``classes`` an array of the DEM's shape
     holding each cell's class number (NaN: none, impassable) and ``class_terrains`` a mapping
     ``{class: terrain}`` (Terrain, preset name or TOML path); ``terrain`` is then unused.
+
+    ``row_widths_m``: each row's east-west cell size in metres on a geographic DEM, as in
+    :func:`risk_raster` (``cell_size_m``'s ``cell_x`` stays the reference cell of the risk
+    objective, ``geo["cell_x_m"]``).
     """
     z = _dem(dem)
     cx, cy = _cell_size(cell_size_m)
@@ -541,6 +562,7 @@ def plan(
         descent=descent,
         allow_metastable=bool(allow_metastable),
         time_weight=float(time_weight),
+        row_widths_m=_row_widths(row_widths_m),
         **class_args,
     )
 
@@ -549,8 +571,11 @@ def read_raster(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, Dict[
     """Reads a GeoTIFF (``.tif``), ESRI ASCII grid (``.asc``) or PDS3 DTM (``.img``, ``.lbl``) as the CLI does.
 
     Returns ``(values, geo)``: a float64 array ``(rows, cols)`` with nodata as NaN, and
-    ``geo = {"west", "north", "cell_x", "cell_y"}`` (map units). Pass ``values`` and
-    ``(geo["cell_x"], geo["cell_y"])`` to :func:`plan` or :func:`risk_raster`.
+    ``geo = {"west", "north", "cell_x", "cell_y"}`` (map units) with the ground cell size in
+    metres, ``"cell_x_m"``, ``"cell_y_m"``, and ``"row_widths_m"``: each row's east-west size
+    where the rows differ (a geographic DEM, an equirectangular DTM), else None. Pass ``values``,
+    ``(geo["cell_x_m"], geo["cell_y_m"])`` and ``row_widths_m=geo["row_widths_m"]`` to
+    :func:`plan` or :func:`risk_raster`.
     """
     values, rows, cols, geo = _sandslope.read_raster(os.fspath(path))
     return values.reshape(rows, cols), geo

@@ -140,6 +140,7 @@ def risk_raster(
     max_roll_deg: float = 20.0,
     descent: str = "symmetric",
     allow_metastable: bool = False,
+    row_widths_m: Optional[List[float]] = None,
 ) -> npt.NDArray[np.float32]: ...
 def plan(
     dem: _F64,
@@ -160,12 +161,13 @@ def plan(
     time_weight: float = 1e-4,
     classes: Optional[_F64] = None,
     class_terrains: Optional[List[Tuple[int, Terrain]]] = None,
+    row_widths_m: Optional[List[float]] = None,
 ) -> Dict[str, Any]: ...
 def read_raster(path: _Path) -> Tuple[_F64, int, int, Dict[str, float]]: ...
 def geotiff_nodata(path: _Path) -> Optional[float]:
     """The GDAL_NODATA value of a GeoTIFF (None when it has none), read from its tags only."""
 def pds3_info(path: _Path) -> Dict[str, Any]:
-    """A PDS3 DTM's ``{rows, cols, cell_x_m, cell_y_m, notes}`` from its label alone."""
+    """A PDS3 DTM's ``{rows, cols, cell_x_m, cell_y_m, row_widths_m, notes}`` from its label alone."""
 def pds3_window(path: _Path, top: int, bottom: int, left: int, right: int) -> np.ndarray:
     """Rows ``top:bottom``, columns ``left:right`` of a PDS3 DTM (metres, NaN where missing)."""
 def fit(

@@ -39,7 +39,7 @@ from typing import Any, Callable, Optional, Tuple, TypeVar
 import dask.array as da
 import numpy as np
 
-from . import _cell_size, _robot, _sandslope, _terrain
+from . import _cell_size, _robot, _row_widths, _sandslope, _terrain
 from . import risk_raster as _eager_risk_raster
 
 __all__ = ["risk_raster"]
@@ -50,10 +50,43 @@ T = TypeVar("T")
 DEFAULT_TILE = 1024
 
 
-def _tile(block: np.ndarray, cell_x: float, cell_y: float, options: dict) -> np.ndarray:
-    """The two bands of one tile padded by one cell on every side, without the padding."""
+def _tile(
+    block: np.ndarray,
+    cell_x: float,
+    cell_y: float,
+    options: dict,
+    rows: Optional[Tuple[int, int]] = None,
+    widths: Optional[np.ndarray] = None,
+) -> np.ndarray:
+    """The two bands of one tile padded by one cell on every side, without the padding.
+
+    ``widths``: the map's east-west cell size of each row (m), of which the tile of map rows
+    ``rows`` (``(top, bottom)``, without its halo) takes its own rows' and its halo rows'
+    (beyond the map, the edge row's: those rows are NaN and their values dropped). A cell's
+    values depend on its 3 x 3 window and its own row's width only, so every tile gives the
+    eager raster's values."""
+    if widths is not None and rows is not None:
+        r0, r1 = rows
+        halo = np.clip(np.arange(r0 - 1, r1 + 1), 0, len(widths) - 1)
+        options = dict(options, row_widths_m=widths[halo])
     bands = _eager_risk_raster(block, (cell_x, cell_y), **options)
     return bands[:, 1:-1, 1:-1]
+
+
+def _overlap_tile(
+    block: np.ndarray,
+    cell_x: float,
+    cell_y: float,
+    options: dict,
+    widths: Optional[np.ndarray] = None,
+    block_info: Optional[dict] = None,
+) -> np.ndarray:
+    """:func:`_tile` of a chunk cut with its halo by ``dask.array.overlap``."""
+    rows = None
+    if widths is not None:
+        (_, _), (r0, r1), _ = block_info[None]["array-location"]
+        rows = (r0, r1)
+    return _tile(block, cell_x, cell_y, options, rows, widths)
 
 
 def _npy_header(f: Any) -> Tuple[Tuple[int, ...], bool, np.dtype]:
@@ -146,6 +179,7 @@ def _window_tile(
     cell_x: float,
     cell_y: float,
     options: dict,
+    widths: Optional[np.ndarray] = None,
     block_info: Optional[dict] = None,
 ) -> np.ndarray:
     """Reads one tile and its one-cell halo from the store (NaN beyond the map) and returns
@@ -158,7 +192,7 @@ def _window_tile(
     window = _read_window(source, top, bottom, left, right)
     padded[top - (r0 - 1) : bottom - (r0 - 1), left - (c0 - 1) : right - (c0 - 1)] = window
     del window
-    return _tile(padded, cell_x, cell_y, options)
+    return _tile(padded, cell_x, cell_y, options, (r0, r1), widths)
 
 
 def _tiles(chunks: Any, shape: Tuple[int, ...]) -> Tuple[Tuple[int, ...], ...]:
@@ -245,6 +279,7 @@ def risk_raster(
     allow_metastable: bool = False,
     nodata: Optional[float] = None,
     chunks: Any = None,
+    row_widths_m: Any = None,
 ) -> da.Array:
     """Lazy ``(2, H, W)`` float32 dask array: the two bands of :func:`sandslope.risk_raster`
     (best-heading P(failure), steepest usable climb azimuth) for a 2-D DEM, row 0 at the north.
@@ -266,7 +301,12 @@ def risk_raster(
     ``cell_size_m``: ground cell size in metres, one number or ``(cell_x, cell_y)``; ``None``
     for a PDS3 DTM takes the label's (as :func:`sandslope.read_raster` gives it in
     ``geo["cell_x_m"]``, ``geo["cell_y_m"]``: ``MAP_SCALE`` on the body's sphere, at the DTM's
-    middle).
+    middle), and ``row_widths_m`` too when the DTM is equirectangular (its rows narrow
+    towards the pole).
+
+    ``row_widths_m``: on a geographic DEM, the east-west cell size of each row in metres, one
+    per row of the whole DEM (:func:`sandslope.read_raster`'s ``geo["row_widths_m"]``), as the
+    eager function takes it; each tile uses its own rows'.
 
     ``chunks``: tile shape (an int or ``(rows, cols)``, any form ``dask.array`` accepts);
     default: the dask array's chunks, a store's own chunks, or 1024 x 1024.
@@ -285,7 +325,18 @@ def risk_raster(
             raise ValueError(f"dem = {os.fspath(dem)!r}: no such file or folder")
         info = _sandslope.pds3_info(os.fspath(dem))
         cell_size_m = (info["cell_x_m"], info["cell_y_m"])
+        if row_widths_m is None:
+            row_widths_m = info["row_widths_m"]
     cx, cy = _cell_size(cell_size_m)
+    widths = None if row_widths_m is None else np.asarray(_row_widths(row_widths_m), dtype=np.float64)
+
+    def check_widths(rows: int) -> None:
+        if widths is not None and not (len(widths) == rows and np.all(np.isfinite(widths)) and np.all(widths > 0)):
+            raise ValueError(
+                f"row_widths_m must hold one finite width greater than 0 (m) per row of the dem: "
+                f"{len(widths)} values for {rows} rows"
+            )
+
     options = dict(
         robot=_robot(robot),
         terrain=_terrain(terrain),
@@ -315,12 +366,14 @@ def risk_raster(
             z = z.rechunk(DEFAULT_TILE)
         if not np.issubdtype(z.dtype, np.floating):
             z = z.astype(np.float64)  # room for the NaN padding
+        check_widths(z.shape[0])
         padded = da.overlap.overlap(z, depth={0: 1, 1: 1}, boundary={0: np.nan, 1: np.nan})
         return padded.map_blocks(
-            _tile,
+            _overlap_tile,
             cx,
             cy,
             options,
+            widths=widths,
             dtype=np.float32,
             chunks=((2,),) + z.chunks,
             new_axis=0,
@@ -330,6 +383,7 @@ def risk_raster(
 
     # A store: one independent task per tile, each reading its own window.
     shape, native = _store_shape(dem)
+    check_widths(shape[0])
     if nodata is None:
         options["nodata"] = _tiff_nodata(dem)
     tiles = _tiles(chunks if chunks is not None else (native or DEFAULT_TILE), shape)
@@ -340,6 +394,7 @@ def risk_raster(
         cx,
         cy,
         options,
+        widths=widths,
         dtype=np.float32,
         chunks=((2,),) + tuple(tiles),
         meta=meta,

@@ -72,6 +72,11 @@ fn body_pitch_locked_holds_the_body_parallel_to_the_slope() {
     assert_eq!(locked["max_pitch_deg"], 0.0);
     assert!(locked["pitch_over_s"].is_null());
     assert_eq!(locked["closed_form"], free["closed_form"]);
+    assert_eq!(free["rft_scaling"], "motion");
+    let components =
+        json(&["simulate", "--slope", "20", "--duration", "3", "--json", "--rft-scaling", "components"]);
+    assert_eq!(components["rft_scaling"], "components");
+    assert_ne!(components["speed_m_s"], free["speed_m_s"]);
 }
 
 #[test]
@@ -106,6 +111,7 @@ fn bad_input_exits_2_naming_the_value_and_range_and_writes_nothing() {
         (vec!["--slope", "10", "--duration", "1"], "at least 1.5 T"),
         (vec!["--slopes", "0:95:5"], "--slopes"),
         (vec!["--slope", "10", "--body-pitch", "fixed"], "possible values: free, locked"),
+        (vec!["--slope", "10", "--rft-scaling", "stress"], "possible values: motion, components"),
     ];
     for (args, needle) in cases {
         sandslope()

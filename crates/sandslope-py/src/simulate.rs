@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
 
-use sandslope::simulate::{simulate as run, BodyPitch, SimSettings, SimulateError};
+use sandslope::simulate::{simulate as run, BodyPitch, RftScaling, SimSettings, SimulateError};
 use sandslope::Scenario;
 
 use crate::arrays::put;
@@ -18,7 +18,7 @@ use crate::value_error;
 /// `leg{j}_depth_m`, `leg{j}_force_x_n`, `leg{j}_force_z_n`, `leg{j}_torque_n_m`) to a 1-D
 /// array; `summary` is `sandslope simulate --json`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, yield_m=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="free"))]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, yield_m=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="free", rft_scaling="motion"))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -32,6 +32,7 @@ pub fn simulate<'py>(
     yield_m: Option<f64>,
     sample_rate_hz: f64,
     body_pitch: &str,
+    rft_scaling: &str,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     let scenario =
         Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
@@ -49,6 +50,15 @@ pub fn simulate<'py>(
         other => {
             return Err(pyo3::exceptions::PyValueError::new_err(format!(
                 "body_pitch = {other:?}: expected \"free\" or \"locked\""
+            )))
+        }
+    });
+    settings = settings.with_rft_scaling(match rft_scaling {
+        "motion" => RftScaling::Motion,
+        "components" => RftScaling::Components,
+        other => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "rft_scaling = {other:?}: expected \"motion\" or \"components\""
             )))
         }
     });

@@ -67,3 +67,12 @@ def test_body_pitch_locked_is_the_cli_flag(cli):
     assert (traj["pitch_rad"] == 0.0).all() and got["max_pitch_deg"] == 0.0
     with pytest.raises(ValueError, match=r'body_pitch = "sideways": expected "free" or "locked"'):
         sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, body_pitch="sideways")
+
+
+def test_rft_scaling_is_the_cli_flag(cli):
+    want = cli.json("simulate", "--slope", 20, "--duration", 3, "--rft-scaling", "components")
+    _, got = sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, rft_scaling="components")
+    assert got["rft_scaling"] == want["rft_scaling"] == "components"
+    assert got["speed_m_s"] == pytest.approx(want["speed_m_s"], rel=1e-12)
+    with pytest.raises(ValueError, match=r'rft_scaling = "shear": expected "motion" or "components"'):
+        sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, rft_scaling="shear")

@@ -18,7 +18,7 @@ use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
 use sandslope::simulate::{
-    simulate, simulate_slopes, BodyPitch, SimSettings, SimSummary, SimulateError, Simulation,
+    simulate, simulate_slopes, BodyPitch, RftScaling, SimSettings, SimSummary, SimulateError, Simulation,
 };
 use sandslope::{ParamError, Scenario};
 use sandslope_io::load_speeds;
@@ -51,6 +51,11 @@ pub struct SimulateArgs {
     /// assumption, to see what the pitch does to a walk (docs/simulate.md).
     #[arg(long, value_name = "MODE", value_enum, default_value_t = PitchArg::Free)]
     pub body_pitch: PitchArg,
+    /// How resistive force theory is scaled to the terrain's k_n and k_s: `motion` (one scale
+    /// that follows the direction of motion) or `components` (normal stress by k_n, shear
+    /// stress by k_s), docs/model.md §16.
+    #[arg(long, value_name = "MODE", value_enum, default_value_t = ScalingArg::Motion)]
+    pub rft_scaling: ScalingArg,
     /// Trajectory sample rate for --out, --plot and --animate, Hz.
     #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
     pub rate: f64,
@@ -95,6 +100,24 @@ impl From<PitchArg> for BodyPitch {
     }
 }
 
+/// `--rft-scaling`: the library's [`RftScaling`] as a flag value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ScalingArg {
+    /// One scale that follows the direction of motion (default).
+    Motion,
+    /// Normal stress by k_n, along-surface stress by k_s.
+    Components,
+}
+
+impl From<ScalingArg> for RftScaling {
+    fn from(p: ScalingArg) -> RftScaling {
+        match p {
+            ScalingArg::Motion => RftScaling::Motion,
+            ScalingArg::Components => RftScaling::Components,
+        }
+    }
+}
+
 /// A library error with its keys renamed to this command's flags.
 fn flagged(e: ParamError) -> anyhow::Error {
     let flag = match e.key.as_str() {
@@ -124,7 +147,7 @@ fn settings(args: &SimulateArgs) -> Result<SimSettings> {
     if let Some(y) = args.yield_m {
         s = s.with_yield(y).map_err(flagged)?;
     }
-    s = s.with_body_pitch(args.body_pitch.into());
+    s = s.with_body_pitch(args.body_pitch.into()).with_rft_scaling(args.rft_scaling.into());
     s.with_sample_rate(args.rate).map_err(flagged)
 }
 
@@ -408,6 +431,9 @@ fn run_slopes(
             println!("{t}");
             if settings.body_pitch == BodyPitch::Locked {
                 println!("body pitch locked at 0 (--body-pitch locked), as the closed form assumes");
+            }
+            if settings.rft_scaling == RftScaling::Components {
+                println!("resistive force theory scaled by components (--rft-scaling components, docs/model.md §16)");
             }
         }
     }

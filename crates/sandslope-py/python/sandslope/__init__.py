@@ -762,6 +762,7 @@ def simulate(
     yield_m: Optional[float] = None,
     sample_rate_hz: float = 120.0,
     body_pitch: str = "free",
+    rft_scaling: str = "motion",
 ) -> Tuple[Any, Dict[str, Any]]:
     """Simulates the robot walking for ``duration_s`` seconds on ``terrain`` at ``slope_deg``
     (``sandslope simulate``, docs/model.md §15-§18).
@@ -771,7 +772,9 @@ def simulate(
     every slope, as ``--k-n``/``--k-s``); ``dt_s`` fixes the integration step, ``yield_m`` the
     elastic slip at which the sand's stress is fully mobilised, ``sample_rate_hz`` the
     trajectory's sampling; ``body_pitch="locked"`` holds the body parallel to the slope, as the
-    closed form assumes (``--body-pitch locked``). Negative slopes walk downhill.
+    closed form assumes (``--body-pitch locked``); ``rft_scaling="components"`` scales the sand's
+    normal stress by k_n and its shear stress by k_s instead of one scale following the motion
+    (``--rft-scaling``, docs/model.md §16). Negative slopes walk downhill.
 
     Returns ``(trajectory, summary)``: ``trajectory`` a pandas DataFrame (a dict of NumPy
     columns without pandas) with ``time_s``, ``x_m``, ``z_m``, ``pitch_rad``, ``vx_m_s``,
@@ -791,6 +794,7 @@ def simulate(
         yield_m=None if yield_m is None else float(yield_m),
         sample_rate_hz=float(sample_rate_hz),
         body_pitch=str(body_pitch),
+        rft_scaling=str(rft_scaling),
     )
     try:
         import pandas as pd

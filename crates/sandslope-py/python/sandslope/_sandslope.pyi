@@ -216,6 +216,7 @@ def simulate(
     yield_m: Optional[float] = None,
     sample_rate_hz: float = 120.0,
     body_pitch: str = "free",
+    rft_scaling: str = "motion",
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 
 def read_touchdowns(path: _Path) -> List[float]: ...

@@ -121,7 +121,7 @@ impl Walker {
         let legs = 2 * n;
         let slots = legs * elements + BELLY_ELEMENTS;
         let mut w = Walker {
-            rft: Rft::new(ground.k_n, ground.k_s),
+            rft: Rft::with_scaling(ground.k_n, ground.k_s, settings.rft_scaling),
             mass: robot.mass(),
             inertia: robot.pitch_inertia(),
             gx: -G * theta.sin(),

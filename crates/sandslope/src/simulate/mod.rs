@@ -20,6 +20,7 @@ use serde::Serialize;
 
 pub use body::{BodyPitch, LegShape};
 use dynamics::Walker;
+pub use rft::RftScaling;
 
 use crate::error::ParamError;
 use crate::gait::{measure_step, SmoothTrack, StepMeasure};
@@ -63,6 +64,8 @@ pub struct SimSettings {
     pub locked_leg_angle: Option<f64>,
     /// Whether the body may pitch (default: free).
     pub body_pitch: BodyPitch,
+    /// How resistive force theory is scaled to the terrain (default: by the direction of motion).
+    pub rft_scaling: RftScaling,
 }
 
 impl SimSettings {
@@ -85,6 +88,7 @@ impl SimSettings {
             shape: LegShape::CLeg,
             locked_leg_angle: None,
             body_pitch: BodyPitch::Free,
+            rft_scaling: RftScaling::Motion,
         })
     }
 
@@ -120,6 +124,11 @@ impl SimSettings {
     /// Lets the body pitch, or holds its pitch at zero as the closed form assumes.
     pub fn with_body_pitch(self, body_pitch: BodyPitch) -> SimSettings {
         SimSettings { body_pitch, ..self }
+    }
+
+    /// Another scaling of resistive force theory to the terrain (docs/model.md §16).
+    pub fn with_rft_scaling(self, rft_scaling: RftScaling) -> SimSettings {
+        SimSettings { rft_scaling, ..self }
     }
 
     /// Another leg shape.
@@ -298,6 +307,8 @@ pub struct SimSummary {
     pub yield_m: f64,
     /// Whether the body could pitch (`locked`: held parallel to the slope).
     pub body_pitch: BodyPitch,
+    /// How resistive force theory was scaled to the terrain.
+    pub rft_scaling: RftScaling,
     /// Mean step speed over the measured steps, m/s.
     pub speed_m_s: f64,
     /// Mean anchoring time over the measured steps that anchored, s.
@@ -558,6 +569,7 @@ fn summarise(
         shape: settings.shape,
         yield_m: settings.yield_m,
         body_pitch: settings.body_pitch,
+        rft_scaling: settings.rft_scaling,
         speed_m_s: speed,
         t1_s: t1,
         slip_m: slip,

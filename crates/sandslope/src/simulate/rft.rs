@@ -36,21 +36,54 @@ pub fn generic(cos2b: f64, sin2b: f64, cosg: f64, sing: f64) -> (f64, f64) {
     (az, ax)
 }
 
+/// How the generic form is scaled to the terrain's k_n and k_s (docs/model.md §16). Both
+/// choices make a horizontal plate pushed straight down feel `k_n d` and a vertical plate
+/// pushed sideways feel `2 k_s d`; they differ for every other motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RftScaling {
+    /// One scale for both stresses that follows the direction of motion,
+    /// `zeta_n e_z^2 + zeta_s e_x^2` (the default): motion normal to the surface is governed by
+    /// the penetration tests, motion along it by the shear tests.
+    #[default]
+    Motion,
+    /// The normal stress scaled by `zeta_n` and the along-surface stress by `zeta_s`, whatever
+    /// the motion: normal stresses by the penetration tests, shear stresses by the shear tests.
+    Components,
+}
+
+impl RftScaling {
+    /// The setting's name, as `--rft-scaling` and `--json` spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            RftScaling::Motion => "motion",
+            RftScaling::Components => "components",
+        }
+    }
+}
+
 /// Resistive force theory scaled to one ground (k_n, k_s at one slope).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rft {
     zeta_z: f64,
     zeta_x: f64,
+    scaling: RftScaling,
 }
 
 impl Rft {
-    /// Scales the generic form to `k_n` (N/m^3) and `k_s` (N/m^3), docs/model.md §16.
+    /// Scales the generic form to `k_n` (N/m^3) and `k_s` (N/m^3) by the default
+    /// [`RftScaling::Motion`], docs/model.md §16.
     pub fn new(k_n: f64, k_s: f64) -> Rft {
+        Rft::with_scaling(k_n, k_s, RftScaling::Motion)
+    }
+
+    /// Scales the generic form to `k_n` and `k_s` by `scaling`, docs/model.md §16.
+    pub fn with_scaling(k_n: f64, k_s: f64, scaling: RftScaling) -> Rft {
         // Horizontal plate (beta = 0) pushed straight down (gamma = pi/2).
         let (az_down, _) = generic(1.0, 0.0, 0.0, 1.0);
         // Vertical plate (beta = pi/2, so 2 beta = pi) pushed sideways (gamma = 0).
         let (_, ax_side) = generic(-1.0, 0.0, 1.0, 0.0);
-        Rft { zeta_z: k_n / az_down, zeta_x: 2.0 * k_s / ax_side }
+        Rft { zeta_z: k_n / az_down, zeta_x: 2.0 * k_s / ax_side, scaling }
     }
 
     /// Stress per unit depth `(sigma_x, sigma_z)`, N/m^3 (force per unit area per unit depth),
@@ -62,9 +95,15 @@ impl Rft {
         let cos2b = tx * tx - tz * tz;
         let sin2b = s * 2.0 * tx * tz;
         let (az, ax) = generic(cos2b, sin2b, ex.abs(), -ez);
-        // The scale follows the direction of motion: normal motion k_n, along-slope motion k_s.
-        let zeta = self.zeta_z * ez * ez + self.zeta_x * ex * ex;
-        (-s * zeta * ax, zeta * az)
+        match self.scaling {
+            // The scale follows the direction of motion: normal motion k_n, along-slope motion k_s.
+            RftScaling::Motion => {
+                let zeta = self.zeta_z * ez * ez + self.zeta_x * ex * ex;
+                (-s * zeta * ax, zeta * az)
+            }
+            // Normal stress k_n, along-surface stress k_s.
+            RftScaling::Components => (-s * self.zeta_x * ax, self.zeta_z * az),
+        }
     }
 }
 
@@ -105,5 +144,29 @@ mod tests {
         // The same plate as `\`: pushed towards +x.
         let (sx, _) = rft.stress(h, -h, 0.0, -1.0);
         assert!(sx > 0.0);
+    }
+
+    /// Both scalings hold the two reference motions (k_n d down, 2 k_s d sideways); they part on
+    /// a horizontal plate dragged along the surface, whose stress ratio by hand is the generic
+    /// 0.136 / 0.375 = tan 19.9 deg under `Motion` whatever k_s, and
+    /// (2 k_s / 0.370) 0.136 / (k_n 0.375) = 1.960 k_s / k_n under `Components`.
+    #[test]
+    fn the_two_scalings_share_the_reference_motions_and_part_on_a_dragged_plate() {
+        let (k_n, k_s) = (7e5, 1.5e6);
+        for scaling in [RftScaling::Motion, RftScaling::Components] {
+            let rft = Rft::with_scaling(k_n, k_s, scaling);
+            let (sx, sz) = rft.stress(1.0, 0.0, 0.0, -1.0);
+            assert!(sx.abs() < 1e-6 && (sz - k_n).abs() < 1e-6, "{scaling:?}");
+            let (sx, _) = rft.stress(0.0, 1.0, 1.0, 0.0);
+            assert!((sx + 2.0 * k_s).abs() < 1e-6, "{scaling:?}");
+        }
+        let ratio = |scaling| {
+            let (sx, sz) = Rft::with_scaling(k_n, k_s, scaling).stress(1.0, 0.0, 1.0, 0.0);
+            -sx / sz
+        };
+        assert!((ratio(RftScaling::Motion) - 0.136 / 0.375).abs() < 1e-12);
+        assert!((ratio(RftScaling::Motion).atan().to_degrees() - 19.93).abs() < 0.01);
+        let by_hand = (2.0 * k_s / 0.370) * 0.136 / (k_n * 0.375);
+        assert!((ratio(RftScaling::Components) / by_hand - 1.0).abs() < 1e-12);
     }
 }

@@ -44,24 +44,17 @@ pub fn simulate<'py>(
         settings = settings.with_yield(y).map_err(value_error)?;
     }
     settings = settings.with_sample_rate(sample_rate_hz).map_err(value_error)?;
-    settings = settings.with_body_pitch(match body_pitch {
-        "free" => BodyPitch::Free,
-        "locked" => BodyPitch::Locked,
-        other => {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                "body_pitch = {other:?}: expected \"free\" or \"locked\""
-            )))
-        }
-    });
-    settings = settings.with_rft_scaling(match rft_scaling {
-        "motion" => RftScaling::Motion,
-        "components" => RftScaling::Components,
-        other => {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                "rft_scaling = {other:?}: expected \"motion\" or \"components\""
-            )))
-        }
-    });
+    settings = settings
+        .with_body_pitch(choose(
+            "body_pitch",
+            body_pitch,
+            &[("free", BodyPitch::Free), ("locked", BodyPitch::Locked)],
+        )?)
+        .with_rft_scaling(choose(
+            "rft_scaling",
+            rft_scaling,
+            &[("motion", RftScaling::Motion), ("components", RftScaling::Components)],
+        )?);
     let sim = py.detach(|| run(&scenario, slope_deg, &settings)).map_err(|e| match e {
         SimulateError::Param(p) => value_error(p),
     })?;
@@ -90,4 +83,13 @@ pub fn simulate<'py>(
     }
     let summary = pythonize(py, &sim.summary).map_err(value_error)?;
     Ok((d, summary))
+}
+
+/// The option named `value` of a keyword argument `key` that takes one of `options`' names, or a
+/// ValueError naming the key, the value and the names it takes.
+fn choose<T: Copy>(key: &str, value: &str, options: &[(&str, T)]) -> PyResult<T> {
+    options.iter().find(|(name, _)| *name == value).map(|&(_, v)| v).ok_or_else(|| {
+        let names: Vec<String> = options.iter().map(|(name, _)| format!("{name:?}")).collect();
+        pyo3::exceptions::PyValueError::new_err(format!("{key} = {value:?}: expected {}", names.join(" or ")))
+    })
 }

@@ -202,17 +202,37 @@ impl ElevationGrid {
     pub fn horn_gradient(&self) -> Vec<[f32; 2]> {
         let (cols, rows) = (self.cols, self.rows);
         let mut out = vec![[f32::NAN; 2]; cols * rows];
-        let row_fn = |r: usize, out_row: &mut [[f32; 2]]| {
-            if r == 0 || r + 1 == rows {
-                return;
-            }
-            for (c, out) in out_row.iter_mut().enumerate().take(cols - 1).skip(1) {
-                *out = self.horn_at(c, r);
-            }
-        };
         use rayon::prelude::*;
-        out.par_chunks_mut(cols).enumerate().for_each(|(r, chunk)| row_fn(r, chunk));
+        out.par_chunks_mut(cols).enumerate().for_each(|(r, chunk)| {
+            if r != 0 && r + 1 != rows {
+                self.horn_row(r, chunk);
+            }
+        });
         out
+    }
+
+    /// [`ElevationGrid::horn_at`] for every interior cell of the interior row `r`, into `out`
+    /// (the row's gradients; its first and last stay as they are): the same arithmetic in the
+    /// same order, with the row's scale and the three rows' slices taken once (the per-cell
+    /// form took 0.28 s of CPU of a 4096 x 4096 plan, the third of everything before its
+    /// searches).
+    fn horn_row(&self, r: usize, out: &mut [[f32; 2]]) {
+        let cols = self.cols;
+        let (sx, sy) = (1.0 / (8.0 * self.cell_x_at(r)), 1.0 / (8.0 * self.cell_y));
+        let row = |k: usize| (&self.z[k * cols..(k + 1) * cols], &self.valid[k * cols..(k + 1) * cols]);
+        let ((zn, vn), (zm, vm), (zs, vs)) = (row(r - 1), row(r), row(r + 1));
+        let windows = zn.windows(3).zip(zm.windows(3)).zip(zs.windows(3));
+        let valid = vn.windows(3).zip(vm.windows(3)).zip(vs.windows(3));
+        for ((((n, m), s), ((a, b), c)), out) in windows.zip(valid).zip(&mut out[1..cols - 1]) {
+            if !(a.iter().chain(b).chain(c).all(|&v| v)) {
+                *out = [f32::NAN; 2];
+                continue;
+            }
+            let h = |z: &[f32], i: usize| f64::from(z[i]);
+            let dzdx = ((h(n, 2) + 2.0 * h(m, 2) + h(s, 2)) - (h(n, 0) + 2.0 * h(m, 0) + h(s, 0))) * sx;
+            let dzdy = ((h(n, 0) + 2.0 * h(n, 1) + h(n, 2)) - (h(s, 0) + 2.0 * h(s, 1) + h(s, 2))) * sy;
+            *out = [dzdx as f32, dzdy as f32];
+        }
     }
 
     /// The Horn gradient of the cell at column `c`, row `r` ([`ElevationGrid::horn_gradient`]),

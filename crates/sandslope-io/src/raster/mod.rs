@@ -13,6 +13,7 @@ use tiff::decoder::{Decoder, DecodingResult, Limits};
 use crate::crs::Crs;
 
 mod ascii;
+mod chunks;
 
 use ascii::read_asc;
 use tiff::encoder::{colortype::Gray32Float, compression::DeflateLevel, Compression, TiffEncoder};
@@ -612,7 +613,11 @@ fn decode_samples<R: std::io::Read + std::io::Seek>(
     bits: u64,
 ) -> Result<DecodingResult> {
     let sample_format: u16 = dec.find_tag_unsigned(Tag::SampleFormat).ok().flatten().unwrap_or(1);
-    let image = match dec.read_image() {
+    let limit = tiff_limits().decoding_buffer_size;
+    let parallel = chunks::read_image_in_parallel(dec, bits, limit, chunks::MIN_PARALLEL_CELLS, || {
+        open_full_resolution(path).ok()
+    });
+    let image = match parallel.map_or_else(|| dec.read_image(), Ok) {
         Ok(image) => image,
         // Tiled LZW with partial edge tiles, which the `tiff` crate cannot decode (lzw_tiles.rs).
         Err(e) if crate::lzw_tiles::is_partial_tile_lzw_error(&e.to_string()) => {

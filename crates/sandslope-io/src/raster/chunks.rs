@@ -69,26 +69,27 @@ where
         return None;
     }
     let band_bytes = ch * w * sample;
-    let decoded = bytes.par_chunks_mut(band_bytes).enumerate().try_for_each_init(open, |dec, (band, rows)| {
-        let dec = dec.as_mut().ok_or(())?;
-        let dh = rows.len() / (w * sample);
-        for a in 0..across {
-            let index = u32::try_from(band * across + a).map_err(|_| ())?;
-            let dw = if tiled { cw.min(w - a * cw) } else { w };
-            let mut chunk = dec.read_chunk(index).map_err(|_| ())?;
-            let chunk = chunk.as_buffer(0);
-            let data = chunk.as_bytes();
-            if data.len() != dw * dh * sample {
-                return Err(());
+    let decoded =
+        bytes.par_chunks_mut(band_bytes).enumerate().try_for_each_init(open, |dec, (band, rows)| {
+            let dec = dec.as_mut().ok_or(())?;
+            let dh = rows.len() / (w * sample);
+            for a in 0..across {
+                let index = u32::try_from(band * across + a).map_err(|_| ())?;
+                let dw = if tiled { cw.min(w - a * cw) } else { w };
+                let mut chunk = dec.read_chunk(index).map_err(|_| ())?;
+                let chunk = chunk.as_buffer(0);
+                let data = chunk.as_bytes();
+                if data.len() != dw * dh * sample {
+                    return Err(());
+                }
+                let (row_bytes, x0) = (dw * sample, a * cw * sample);
+                for (r, src) in data.chunks_exact(row_bytes).enumerate() {
+                    let start = r * w * sample + x0;
+                    rows[start..start + row_bytes].copy_from_slice(src);
+                }
             }
-            let (row_bytes, x0) = (dw * sample, a * cw * sample);
-            for (r, src) in data.chunks_exact(row_bytes).enumerate() {
-                let start = r * w * sample + x0;
-                rows[start..start + row_bytes].copy_from_slice(src);
-            }
-        }
-        Ok(())
-    });
+            Ok(())
+        });
     drop(out);
     decoded.ok().map(|()| image)
 }
@@ -126,16 +127,14 @@ mod tests {
         names.sort();
         for path in names.iter().filter(|p| p.extension().is_some_and(|e| e == "tif")) {
             let Ok(mut dec) = super::super::open_full_resolution(path) else { continue };
-            let bits: u64 = dec.find_tag_unsigned(tiff::tags::Tag::BitsPerSample).ok().flatten().unwrap_or(64);
+            let bits: u64 =
+                dec.find_tag_unsigned(tiff::tags::Tag::BitsPerSample).ok().flatten().unwrap_or(64);
             let open = || super::super::open_full_resolution(path).ok();
-            let Some(mut image) = read_image_in_parallel(&mut dec, bits, usize::MAX, 0, open) else { continue };
+            let Some(mut image) = read_image_in_parallel(&mut dec, bits, usize::MAX, 0, open) else {
+                continue;
+            };
             let mut serial = super::super::open_full_resolution(path).unwrap().read_image().unwrap();
-            assert_eq!(
-                image.as_buffer(0).as_bytes(),
-                serial.as_buffer(0).as_bytes(),
-                "{}",
-                path.display()
-            );
+            assert_eq!(image.as_buffer(0).as_bytes(), serial.as_buffer(0).as_bytes(), "{}", path.display());
             parallel.push(path.file_name().unwrap().to_string_lossy().into_owned());
         }
         for name in [

@@ -343,7 +343,10 @@ mod tests {
             .collect();
         let mask: Vec<bool> = (0..cols * rows).map(|i| i % 29 == 7 || i == 5 * cols + 11).collect();
         let widths = (0..rows).map(|r| 0.7 + 0.01 * r as f64).collect();
-        let g = ElevationGrid::new(cols, rows, 0.8, 0.9, z, Some(&mask)).unwrap().with_row_widths(widths).unwrap();
+        let g = ElevationGrid::new(cols, rows, 0.8, 0.9, z, Some(&mask))
+            .unwrap()
+            .with_row_widths(widths)
+            .unwrap();
         let grad = g.horn_gradient();
         let (mut nan, mut finite) = (0, 0);
         for r in 0..rows {

@@ -63,35 +63,55 @@ where
     let across = if tiled { w.div_ceil(cw) } else { 1 };
     // The first chunk says which kind of samples the image holds.
     let mut image = empty_like(&dec.read_chunk(0).ok()?, w * h)?;
-    let mut out = image.as_buffer(0);
-    let bytes = out.as_bytes_mut();
-    if bytes.len() != w * h * sample {
-        return None;
-    }
-    let band_bytes = ch * w * sample;
-    let decoded =
-        bytes.par_chunks_mut(band_bytes).enumerate().try_for_each_init(open, |dec, (band, rows)| {
-            let dec = dec.as_mut().ok_or(())?;
-            let dh = rows.len() / (w * sample);
-            for a in 0..across {
-                let index = u32::try_from(band * across + a).map_err(|_| ())?;
-                let dw = if tiled { cw.min(w - a * cw) } else { w };
-                let mut chunk = dec.read_chunk(index).map_err(|_| ())?;
-                let chunk = chunk.as_buffer(0);
-                let data = chunk.as_bytes();
-                if data.len() != dw * dh * sample {
-                    return Err(());
-                }
-                let (row_bytes, x0) = (dw * sample, a * cw * sample);
-                for (r, src) in data.chunks_exact(row_bytes).enumerate() {
-                    let start = r * w * sample + x0;
-                    rows[start..start + row_bytes].copy_from_slice(src);
-                }
+    let bytes_ok = {
+        let mut out = image.as_buffer(0);
+        let bytes = out.as_bytes_mut();
+        bytes.len() == w * h * sample
+            && decode_bands(bytes, Geometry { w, cw, ch, across, tiled, sample }, open).is_ok()
+    };
+    bytes_ok.then_some(image)
+}
+
+/// The image's and its chunks' sizes: width `w`, chunk `cw` x `ch`, `across` chunks a band,
+/// whether they are tiles, and bytes a sample.
+#[derive(Clone, Copy)]
+struct Geometry {
+    w: usize,
+    cw: usize,
+    ch: usize,
+    across: usize,
+    tiled: bool,
+    sample: usize,
+}
+
+/// Decodes every band of chunk rows into its rows of `bytes` (the image, row-major), the bands
+/// in parallel, each worker with a decoder from `open`; `Err` on the first failure.
+fn decode_bands<S: Read + Seek>(
+    bytes: &mut [u8],
+    g: Geometry,
+    open: impl Fn() -> Option<Decoder<S>> + Sync + Send,
+) -> Result<(), ()> {
+    let Geometry { w, cw, ch, across, tiled, sample } = g;
+    bytes.par_chunks_mut(ch * w * sample).enumerate().try_for_each_init(open, |dec, (band, rows)| {
+        let dec = dec.as_mut().ok_or(())?;
+        let dh = rows.len() / (w * sample);
+        for a in 0..across {
+            let index = u32::try_from(band * across + a).map_err(|_| ())?;
+            let dw = if tiled { cw.min(w - a * cw) } else { w };
+            let mut chunk = dec.read_chunk(index).map_err(|_| ())?;
+            let chunk = chunk.as_buffer(0);
+            let data = chunk.as_bytes();
+            if data.len() != dw * dh * sample {
+                return Err(());
             }
-            Ok(())
-        });
-    drop(out);
-    decoded.ok().map(|()| image)
+            let (row_bytes, x0) = (dw * sample, a * cw * sample);
+            for (r, src) in data.chunks_exact(row_bytes).enumerate() {
+                let start = r * w * sample + x0;
+                rows[start..start + row_bytes].copy_from_slice(src);
+            }
+        }
+        Ok(())
+    })
 }
 
 /// A zeroed image of `n` samples of the same kind as `chunk`'s (`None` for 16-bit floats and

@@ -360,5 +360,42 @@ pub fn simulator_fit(report: &Report) -> String {
     }
     let dof = |c: &sandslope::JointCalibration| format!("{:.2} / {}", c.chi_squared, c.dof);
     h.push_str(&format!("<tr><td>χ² / dof</td><td>{}</td><td>{}</td></tr></table>\n", dof(closed), dof(sim)));
+    h.push_str(&simulator_misses(&report.simulator_fit_misses));
+    h
+}
+
+/// `s` with its first letter capitalised.
+fn sentence(s: &str) -> String {
+    let mut c = s.chars();
+    c.next().map_or(String::new(), |f| f.to_uppercase().chain(c).collect())
+}
+
+/// The observed speeds the simulator's fit misses (by more than `MISS_SD` of their own SD),
+/// each with why and what a scan of the leg's k_s reaches at that slope.
+fn simulator_misses(misses: &[sandslope::report::SimulatorMiss]) -> String {
+    if misses.is_empty() {
+        return format!(
+            "<p>The simulator's fit comes within {} SD (each observation's own) of every observed speed.</p>\n",
+            sandslope::report::MISS_SD
+        );
+    }
+    let mut h = format!(
+        "<p>The observations the simulator's fit misses by more than {} SD of their own, the reason the error \
+         floor must grow, and why (each walked again on the fitted ground, and at each leg k_s of a scan at \
+         that slope):</p>\n<ul>\n",
+        sandslope::report::MISS_SD
+    );
+    for m in misses {
+        h.push_str(&format!(
+            "<li><b>{}°: observed {:.1} ± {:.2} cm/s, the simulator's fit {:.1} cm/s ({:+.1} SD).</b> {}.</li>\n",
+            m.slope_deg,
+            m.observed_m_s * 100.0,
+            m.observed_sd_m_s * 100.0,
+            m.fitted_m_s * 100.0,
+            m.miss_sd,
+            escape(&sentence(&m.why))
+        ));
+    }
+    h.push_str("</ul>\n");
     h
 }

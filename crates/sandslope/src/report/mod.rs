@@ -33,7 +33,10 @@ use crate::terrain::{Terrain, TerrainPoint};
 
 pub use audit::{Extrapolation, NoFloorFit, SpeedInversion, StepBudget, PAPER_FRAME_RATE_HZ};
 pub use provenance::{Input, Provenance, ProvenanceKind};
-pub use simulator::{SimulatorRecord, SimulatorWalks, AGREE_WITHIN, REPORT_WALK_S};
+pub use simulator::{
+    simulator_fit_misses, SimulatorMiss, SimulatorRecord, SimulatorWalks, AGREE_WITHIN, MISS_SD, REACH_K_S,
+    REPORT_WALK_S,
+};
 use tracks::TrackUse;
 pub use tracks::{TrackRecord, TrackedSlope};
 
@@ -228,6 +231,10 @@ pub struct Report {
     /// ([`Evidence::simulator_fit`]: its tens of thousands of walks take about 90 s of CPU) or
     /// when it failed (then a warning says why).
     pub simulator_fit: Option<JointCalibration>,
+    /// The observed speeds that fit misses by more than [`MISS_SD`] of their own SD, each with
+    /// the walk on the fitted ground, what a scan of the leg's k_s reaches there, and why
+    /// (empty without the fit).
+    pub simulator_fit_misses: Vec<SimulatorMiss>,
     /// What the report was made from, each with its provenance.
     pub inputs: Vec<Input>,
     /// Sentences on how the tracks entered the report (skipped t1s, speeds not used, ...).
@@ -321,6 +328,13 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     } else {
         (None, None)
     };
+    let (simulator_fit_misses, misses_failure) = match &simulator_fit {
+        None => (Vec::new(), None),
+        Some(fit) => match simulator_fit_misses(fit, &speeds) {
+            Ok(m) => (m, None),
+            Err(e) => (Vec::new(), Some(format!("the simulator fit's misses could not be walked: {e}"))),
+        },
+    };
     let (robot, terrain) = model(evidence, calibration.as_ref())?;
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
     // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...): a
@@ -369,6 +383,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     let mut warnings = track_use.warnings;
     warnings.extend(simulator_refusal);
     warnings.extend(simulator_fit_failure);
+    warnings.extend(misses_failure);
     if let Some(c) = &calibration {
         warnings.extend(disagreements::calibration_warnings(c));
     }
@@ -393,6 +408,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         step_budget,
         simulator,
         simulator_fit,
+        simulator_fit_misses,
         inputs: provenance::inputs(evidence, !track_use.anchoring.is_empty()),
         track_notes: track_use.notes,
         warnings,

@@ -300,7 +300,7 @@ fn fit_misses(
         // As the fit walks: a k_s at or below zero (an extrapolated law) is no strength at all.
         let m = walk(robot, deg, k_n, k_s.max(1.0), settings)?;
         let miss_sd = (m.speed_m_s - o.speed) / o.speed_sd;
-        if !(miss_sd.abs() > MISS_SD) {
+        if miss_sd.is_nan() || miss_sd.abs() <= MISS_SD {
             continue;
         }
         let reach_m_s = REACH_K_S

@@ -93,6 +93,17 @@ def test_a_geographic_dem_with_its_row_widths_plans_and_maps_as_the_cli(cli, rob
         assert w["found"] and got[name]["found"], name
         for k in ["length_m", "time_s", "survival", "max_pitch_deg", "max_roll_deg"]:
             assert got[name][k] == pytest.approx(w[k], rel=1e-12), (name, k)
+    # x_m is metres east of the west edge along the cell's own parallel: the longitude offset
+    # times the parallel's radius on WGS84, N(lat) cos(lat), worked out here from the degrees.
+    a, f = 6378137.0, 1 / 298.257223563
+    e2 = f * (2 - f)
+    route = got["time"]
+    lat = np.radians(geo["north"] - (route["rows"] + 0.5) * geo["cell_y"])
+    parallel = a / np.sqrt(1 - e2 * np.sin(lat) ** 2) * np.cos(lat)
+    east = np.radians((route["cols"] + 0.5) * geo["cell_x"]) * parallel
+    np.testing.assert_allclose(route["x_m"], east, rtol=1e-6)
+    # Rows far apart differ: one mid-latitude width for all would be off by more than that.
+    assert np.ptp(widths) / np.mean(widths) > 1e-4
     out = tmp_path / "risk.tif"
     cli.run("plan", "--dem", GEO, "--start-px", "5,10", "--goal-px", "55,40", "--risk-map", out)
     want = tifffile.imread(out)

@@ -521,7 +521,8 @@ def plan(
     (``found``, ``length_m``, ``time_s``, ``survival``, ``max_pitch_deg``, ``max_roll_deg``,
     ``edges_over_roll_limit``, ``regimes``; or ``found=False`` with ``reason`` and ``message``),
     its cells (``rows``, ``cols``), their coordinates ``x_m``, ``y_m`` (cell centres; x east and
-    y north of ``origin``, the map's north-west corner, default ``(0, rows * cell_y)``) and
+    y north of ``origin``, the map's north-west corner, default ``(0, rows * cell_y)``; with
+    ``row_widths_m``, x is measured along the cell's own row, in that row's cell widths) and
     heights ``z_m``, and per edge ``steps`` (heading, pitch, roll, length, regime, speed,
     p_fail, over the roll limit).
 

@@ -3,7 +3,8 @@
 #
 # Needs the Rust toolchain and Python 3.9+ with pip (venv module). Creates .venv/ at the
 # repository root (reused on later runs), installs maturin, pytest, numpy, dask, distributed,
-# pandas, tifffile, zarr and xarray into it from PyPI, builds and installs crates/sandslope-py into it, and
+# pandas, tifffile, zarr, xarray and rasterio (whose wheels carry GDAL: the tests write every
+# GeoTIFF layout with it) into it from PyPI, builds and installs crates/sandslope-py into it, and
 # runs `cargo test --workspace --locked` and pytest. Environment:
 #   PYTHON=python3.11   interpreter that creates the venv (default: python3)
 #   SANDSLOPE_VENV=DIR  where the venv lives (default: .venv)
@@ -26,7 +27,7 @@ export PATH="$venv/bin:$PATH"
 echo "== installing the Python test tools into $venv"
 "$py" -m pip install --quiet --disable-pip-version-check \
   "maturin>=1.9,<2" "pytest>=7" "numpy>=1.21" "dask[array]>=2023.1" "distributed>=2023.1" \
-  "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1"
+  "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1" "rasterio>=1.3"
 t1=$(seconds)
 
 echo "== cargo test --workspace --locked"

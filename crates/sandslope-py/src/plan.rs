@@ -173,7 +173,11 @@ fn route_dict<'py>(
             put(&d, "cols", r.cells.iter().map(|c| c.col as i64).collect())?;
             // East of the west edge along the cell's own row: on a geographic DEM each row's
             // cells have their own width (`row_widths_m`), on a uniform grid this is cell_x.
-            put(&d, "x_m", r.cells.iter().map(|c| origin.0 + (c.col as f64 + 0.5) * g.cell_x_at(c.row)).collect())?;
+            put(
+                &d,
+                "x_m",
+                r.cells.iter().map(|c| origin.0 + (c.col as f64 + 0.5) * g.cell_x_at(c.row)).collect(),
+            )?;
             put(&d, "y_m", r.cells.iter().map(|c| origin.1 - (c.row as f64 + 0.5) * g.cell_y()).collect())?;
             put(&d, "z_m", r.cells.iter().map(|&c| g.height(c).unwrap_or(f64::NAN)).collect())?;
             let steps = PyDict::new(py);

@@ -652,3 +652,21 @@ fn npy_arrays_hold_the_same_cells_as_the_csv() {
         assert_eq!(row.unwrap()[2].parse::<f64>().unwrap(), p[j * 3 + i]);
     }
 }
+
+/// On the built-in glass beads p_fail stays below 0.05 up to the angle of repose, 25 degrees
+/// (the terrain file's `repose_deg`), where the sand flows and p_fail jumps to 1: the limit is
+/// named as the repose, not as a risk threshold at "24.999"; a stricter risk crosses below it
+/// and is given as a slope.
+#[test]
+fn a_safe_slope_limit_at_the_angle_of_repose_is_named_as_such() {
+    let out = |max_risk: &str| {
+        let o = sandslope().args(["risk", "--solve", "slope", "--max-risk", max_risk]).assert().success();
+        String::from_utf8(o.get_output().stdout.clone()).unwrap()
+    };
+    let at_repose = out("0.05");
+    assert!(at_repose.contains("up to the angle of repose, 25 deg"), "{at_repose}");
+    let below = out("0.001");
+    assert!(below.contains("safe-slope limit") && !below.contains("repose"), "{below}");
+    let v = json(&["risk", "--solve", "slope", "--max-risk", "0.001", "--json"]);
+    assert!(v["safe_slope_deg"].as_f64().unwrap() < 24.0, "{v}");
+}

@@ -77,6 +77,16 @@ fn body_pitch_locked_holds_the_body_parallel_to_the_slope() {
         json(&["simulate", "--slope", "20", "--duration", "3", "--json", "--rft-scaling", "components"]);
     assert_eq!(components["rft_scaling"], "components");
     assert_ne!(components["speed_m_s"], free["speed_m_s"]);
+    // The table says which scaling ran, as the --slopes table does.
+    let text = sandslope()
+        .args(["simulate", "--slope", "20", "--duration", "1.5", "--rft-scaling", "components"])
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let text = String::from_utf8(text).unwrap();
+    assert!(text.contains("scaled by components (--rft-scaling components"), "{text}");
 }
 
 #[test]

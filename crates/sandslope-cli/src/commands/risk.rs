@@ -150,10 +150,28 @@ fn slope_of(deg: f64) -> Result<Slope> {
     Slope::from_signed_degrees(deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))
 }
 
-fn describe_slope_limit(limit: &SafeLimit, max_risk: f64) -> String {
+/// The terrain's angle of repose, degrees, if it has one.
+fn repose_of(terrain: &UncertainTerrain) -> Option<f64> {
+    terrain.terrain().spec().repose_deg
+}
+
+/// The safe-slope limit in words; `repose_deg` is the terrain's angle of repose, at which
+/// p_fail jumps to 1 (the sand flows): a limit the search finds there is the repose, not the
+/// risk threshold, and is said so.
+fn describe_slope_limit(limit: &SafeLimit, max_risk: f64, repose_deg: Option<f64>) -> String {
     match limit {
         SafeLimit::NoneSafe { p_fail } => {
             format!("no slope is safe: p_fail = {p_fail:.4} >= {max_risk} already on level ground")
+        }
+        // The search bisects to SLOPE_TOLERANCE_DEG below the jump.
+        SafeLimit::Limit { value, p_fail }
+            if repose_deg.is_some_and(|r| r - value <= 2.0 * sandslope::risk::SLOPE_TOLERANCE_DEG) =>
+        {
+            format!(
+                "safe-slope limit: p_fail < {max_risk} from level up to the angle of repose, {} deg (p_fail {p_fail:.4} \
+                 at {value:.3} deg; at and beyond repose the sand flows and p_fail = 1)",
+                repose_deg.unwrap_or(*value)
+            )
         }
         SafeLimit::Limit { value, p_fail } => format!(
             "safe-slope limit: p_fail < {max_risk} from level up to {value:.3} deg (p_fail there {p_fail:.4})"
@@ -246,7 +264,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
                     Ok(())
                 }
                 Format::Table => {
-                    println!("{}", describe_slope_limit(&sol.limit, max_risk));
+                    println!("{}", describe_slope_limit(&sol.limit, max_risk, repose_of(&terrain)));
                     Ok(())
                 }
             };
@@ -266,7 +284,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
     if let (Some(limit), Some(_)) = (&limit, &args.plot) {
         draw_curve(&args, &robot, &terrain, &slopes, max_risk, limit, json)?;
     }
-    print_curve(curve, limit.as_ref(), max_risk, format)
+    print_curve(curve, limit.as_ref().map(|l| (l, repose_of(&terrain))), max_risk, format)
 }
 
 /// Limits of one [`answer`] call (the server's; the command line's are the library's).
@@ -358,7 +376,14 @@ fn robot_title(robot: &Robot, terrain: &UncertainTerrain) -> String {
     format!("m = {} kg on {}", robot.mass(), terrain.terrain().name().unwrap_or("terrain"))
 }
 
-fn print_curve(curve: RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, format: Format) -> Result<()> {
+/// Prints the risk curve, and in a table the safe-slope limit (with the terrain's repose) if
+/// it was searched.
+fn print_curve(
+    curve: RiskCurve,
+    limit: Option<(&SafeLimit, Option<f64>)>,
+    max_risk: f64,
+    format: Format,
+) -> Result<()> {
     match format {
         Format::Json => print_json(&RiskAnswer::of_points(curve.points)),
         Format::Csv => {
@@ -394,8 +419,8 @@ fn print_curve(curve: RiskCurve, limit: Option<&SafeLimit>, max_risk: f64, forma
                 ]);
             }
             println!("{t}");
-            if let Some(limit) = limit {
-                println!("{}", describe_slope_limit(limit, max_risk));
+            if let Some((limit, repose_deg)) = limit {
+                println!("{}", describe_slope_limit(limit, max_risk, repose_deg));
             }
             if let Some(note) = curve.defaults_used.note() {
                 println!("note: {note}");

@@ -314,6 +314,9 @@ fn print_one(sim: &Simulation) {
     t.add_row(["regime", m.regime.name(), p.regime.name()]);
     t.add_row(["cause", m.cause.name(), p.cause.name()]);
     println!("{t}");
+    if m.rft_scaling == RftScaling::Components {
+        println!("resistive force theory scaled by components (--rft-scaling components, docs/model.md §16)");
+    }
     if let Some(at) = m.pitch_over_s {
         println!(
             "the body pitched past 90 deg at t = {at:.2} s: the robot tumbled, and the step means above describe \

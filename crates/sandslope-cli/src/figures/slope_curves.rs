@@ -54,6 +54,9 @@ pub struct SlopeCurveFigure {
     /// The model's values where its regime rules them out (slippage or sinkage), `None`
     /// elsewhere; dashed and faded, as `sweep --plot` draws them.
     pub ruled_out: Vec<(f64, Option<f64>)>,
+    /// Legend of the dashed curve (by default what the regime rules out; fig4d/h: the
+    /// terrain extrapolated beyond its last point).
+    pub ruled_out_label: String,
     /// Legend of the model curve.
     pub model_label: String,
     /// Measurements `(slope_deg, mean, sd)`.
@@ -115,7 +118,7 @@ impl Figure for SlopeCurveFigure {
             &ruled_out,
             red.mix(0.6).stroke_width(2),
             true,
-            Some("model where the regime rules it out"),
+            Some(self.ruled_out_label.as_str()),
         )?;
         if !self.observed.is_empty() {
             chart

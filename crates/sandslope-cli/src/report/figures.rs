@@ -137,6 +137,7 @@ fn speed_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
             .map(|q| (q.slope.degrees(), q.speed.filter(|_| q.regime.is_failure()).map(|v| v * 100.0)))
             .collect(),
         model_label: model_label(report).into(),
+        ruled_out_label: RULED_OUT.into(),
         observed: p.speeds.iter().map(|o| (o.slope.degrees(), o.speed * 100.0, o.speed_sd * 100.0)).collect(),
         observed_label: "observed (mean ± SD)".into(),
         reference: None,
@@ -163,6 +164,9 @@ fn speed_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
     Ok(())
 }
 
+/// The legend of a model curve where its regime rules it out (dashed, faded).
+const RULED_OUT: &str = "model where the regime rules it out";
+
 /// fig4d, fig4h: k_n and k_s against slope with error bars.
 fn resistance_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
     let p = &report.plots;
@@ -174,15 +178,28 @@ fn resistance_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<
         [("fig4d", "Normal penetration resistance k_n", 0usize), ("fig4h", "Shear strength k_s", 1usize)]
     {
         let value = |p: &TerrainPoint| if pick == 0 { (p.k_n, p.k_n_sd) } else { (p.k_s, p.k_s_sd) };
+        // Solid up to the terrain's last point, dashed beyond it, where Terrain::at extends
+        // the last segment (both include the last point, so the line is unbroken).
+        let last = p
+            .last_point_deg
+            .filter(|&l| p.model.iter().any(|q| q.slope.degrees() > l))
+            .unwrap_or(f64::INFINITY);
+        let curve = |measured: bool| {
+            p.model
+                .iter()
+                .map(|q| {
+                    let d = q.slope.degrees();
+                    let keep = if measured { d <= last } else { d >= last };
+                    (d, keep.then_some(if pick == 0 { q.k_n } else { q.k_s } * unit_scale))
+                })
+                .collect()
+        };
         let fig = SlopeCurveFigure {
             title: title.into(),
             y_label: format!("{} (10⁵ N/m³)", if pick == 0 { "k_n" } else { "k_s" }),
-            model: p
-                .model
-                .iter()
-                .map(|q| (q.slope.degrees(), Some(if pick == 0 { q.k_n } else { q.k_s } * unit_scale)))
-                .collect(),
-            ruled_out: vec![],
+            model: curve(true),
+            ruled_out: curve(false),
+            ruled_out_label: format!("extrapolated beyond the terrain's last point ({last}°)"),
             model_label: "terrain used by the model (interpolated)".into(),
             observed: p
                 .table
@@ -223,6 +240,7 @@ fn step_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
         model: split(p, |q| q.anchoring_time.map(|t| t * 1e3), false),
         ruled_out: split(p, |q| q.anchoring_time.map(|t| t * 1e3), true),
         model_label: "model".into(),
+        ruled_out_label: RULED_OUT.into(),
         observed: p.anchoring.iter().map(|o| (o.slope.degrees(), o.t1 * 1e3, o.t1_sd * 1e3)).collect(),
         observed_label: "observed (mean ± SD)".into(),
         reference: None,
@@ -238,6 +256,7 @@ fn step_figures(report: &Report, figures: &mut Vec<PageFigure>) -> Result<()> {
         model: split(p, |q| q.step.map(|s| s * 1e3), false),
         ruled_out: split(p, |q| q.step.map(|s| s * 1e3), true),
         model_label: "model".into(),
+        ruled_out_label: RULED_OUT.into(),
         observed: p.speeds.iter().map(|o| (o.slope.degrees(), o.speed * half, o.speed_sd * half)).collect(),
         observed_label: "observed speed × T/2".into(),
         reference: Some((p.min_step_m * 1e3, "s_min = R: success above, metastable below".into())),

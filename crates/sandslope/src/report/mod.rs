@@ -165,6 +165,9 @@ pub struct Plots {
     pub plate_scale: f64,
     /// The terrain's angle of repose, degrees.
     pub repose_deg: Option<f64>,
+    /// The slope of the terrain's last point when it has several, degrees: beyond it the
+    /// model's k_n and k_s are extrapolated (docs/model.md §1).
+    pub last_point_deg: Option<f64>,
     /// The terrain's name.
     pub terrain_name: String,
     /// The robot's stance duration T/2, s.
@@ -557,6 +560,8 @@ fn plots(
         table_is_forces: forces.is_some(),
         plate_scale,
         repose_deg: terrain.spec().repose_deg,
+        last_point_deg: (terrain.points().len() > 1)
+            .then(|| terrain.points().last().map_or(0.0, |p| p.slope_deg)),
         terrain_name: terrain.name().unwrap_or("terrain").to_string(),
         stance_duration_s: robot.stance_duration(),
         min_step_m: robot.min_step(),
@@ -669,6 +674,8 @@ mod tests {
         assert!(!ids.contains(&"fig3b"));
         assert_eq!(ids.iter().filter(|id| id.starts_with("fig6")).count(), 4);
         assert_eq!(r.plots.phase.len(), 4);
+        // The test terrain's points are at 0 and 20 deg: fig4d/h draw beyond 20 dashed.
+        assert_eq!(r.plots.last_point_deg, Some(20.0));
         assert_eq!(r.calibration.is_some(), ids.contains(&"calibration"));
         // The observed speed rises from 20 to 24 deg (4.98 to 5.6 cm/s): the k_s it needs rises.
         assert!(

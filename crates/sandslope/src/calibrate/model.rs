@@ -18,9 +18,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::{CalibrationError, Parameter, RobotKey};
+use crate::error::ParamError;
 use crate::robot::Robot;
 use crate::scenario::Scenario;
-use crate::simulate::{simulate, SimSettings};
+use crate::simulate::{simulate, SimSettings, SimSummary};
 use crate::terrain::Terrain;
 
 /// The fit's walk length, s: one stride of warm-up and three strides measured (six steps).
@@ -71,6 +72,25 @@ pub(crate) struct Walked {
     pub t1: f64,
 }
 
+/// The smallest leg k_s handed to the simulator, N/m^3 (docs/calibration.md).
+pub(crate) const MIN_SIMULATED_K_S: f64 = 1.0;
+
+/// One walk of `robot` at `slope_deg` on the constant ground `(k_n, k_s)` (no angle of repose)
+/// with `settings`: the walk a trial point of the fit takes its model values from, and the
+/// report walks again on the fitted ground (`report::simulator_fit_misses`).
+pub(crate) fn walk_on_ground(
+    robot: &Robot,
+    slope_deg: f64,
+    k_n: f64,
+    k_s: f64,
+    settings: &SimSettings,
+) -> Result<SimSummary, ParamError> {
+    let scenario = Scenario::new(robot.clone(), Terrain::constant(k_n, k_s)?, None, None)?;
+    simulate(&scenario, slope_deg, settings).map(|s| s.summary).map_err(|e| match e {
+        crate::simulate::SimulateError::Param(p) => p,
+    })
+}
+
 /// The simulator as the fit's model: its settings and the walks already run.
 pub(crate) struct SimulatedModel {
     settings: SimSettings,
@@ -90,13 +110,11 @@ impl SimulatedModel {
         if let Some(w) = self.walks.lock().ok().and_then(|m| m.get(&key).cloned()) {
             return w;
         }
-        let walked = Terrain::constant(k_n, k_s)
-            .and_then(|t| Scenario::new(robot.clone(), t, None, None))
+        let walked = walk_on_ground(robot, slope_deg, k_n, k_s, &self.settings)
             .map_err(|e| e.to_string())
-            .and_then(|scenario| simulate(&scenario, slope_deg, &self.settings).map_err(|e| e.to_string()))
-            .map(|sim| Walked {
-                speed: sim.summary.speed_m_s,
-                t1: sim.summary.t1_s.unwrap_or(robot.stance_duration()),
+            .map(|summary| Walked {
+                speed: summary.speed_m_s,
+                t1: summary.t1_s.unwrap_or(robot.stance_duration()),
             });
         if let Ok(mut m) = self.walks.lock() {
             m.insert(key, walked.clone());

@@ -3,7 +3,7 @@
 
 use super::evidence::{check_anchoring, check_speeds};
 use super::inversion::shear_strength_for_speed;
-use super::model::{check_free_for_simulator, SimulatedModel, SpeedModel, Walked};
+use super::model::{check_free_for_simulator, SimulatedModel, SpeedModel, Walked, MIN_SIMULATED_K_S};
 use super::{CalibrationError, JointSetup, ObservationKind, Parameter, Pull, Quantity, ShearLaw, ShearShape};
 use crate::model::{continued_anchoring_time, continued_speed, level_step_length, normal_equilibrium_depth};
 use crate::robot::Robot;
@@ -271,9 +271,6 @@ impl Problem<'_> {
         }
     }
 }
-
-/// The smallest leg k_s handed to the simulator, N/m^3 (docs/calibration.md).
-pub(crate) const MIN_SIMULATED_K_S: f64 = 1.0;
 
 /// The k_s each observed speed alone implies (where the model can reach it).
 fn inverted_k_s(setup: &JointSetup) -> Vec<(f64, f64)> {

@@ -6,12 +6,13 @@ use serde::Serialize;
 
 use rayon::prelude::*;
 
+use crate::calibrate::model::{walk_on_ground, MIN_SIMULATED_K_S};
 use crate::calibrate::{JointCalibration, SpeedModel, SpeedObservation};
 use crate::error::ParamError;
 use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::scenario::Scenario;
-use crate::simulate::{simulate, simulate_slopes, BodyPitch, MotionCause, SimSettings, SimSummary};
+use crate::simulate::{simulate_slopes, BodyPitch, MotionCause, SimSettings, SimSummary};
 use crate::slope::Slope;
 use crate::terrain::Terrain;
 
@@ -298,14 +299,14 @@ fn fit_misses(
         let deg = o.slope.degrees();
         let (k_n, k_s) = ground(o.slope);
         // As the fit walks: a k_s at or below zero (an extrapolated law) is no strength at all.
-        let m = walk(robot, deg, k_n, k_s.max(1.0), settings)?;
+        let m = walk_on_ground(robot, deg, k_n, k_s.max(MIN_SIMULATED_K_S), settings)?;
         let miss_sd = (m.speed_m_s - o.speed) / o.speed_sd;
         if miss_sd.is_nan() || miss_sd.abs() <= MISS_SD {
             continue;
         }
         let reach_m_s = REACH_K_S
             .par_iter()
-            .map(|&k| walk(robot, deg, k_n, k, settings).map(|w| w.speed_m_s))
+            .map(|&k| walk_on_ground(robot, deg, k_n, k, settings).map(|w| w.speed_m_s))
             .collect::<Result<Vec<f64>, ParamError>>()?;
         let reached_between = bracket(&REACH_K_S, &reach_m_s, o.speed);
         let why = miss_reason(&m, o, rolling, &reach_m_s, reached_between);
@@ -328,20 +329,6 @@ fn fit_misses(
         });
     }
     Ok(misses)
-}
-
-/// One walk of `robot` at `deg` on the constant ground `(k_n, k_s)`.
-fn walk(
-    robot: &Robot,
-    deg: f64,
-    k_n: f64,
-    k_s: f64,
-    settings: &SimSettings,
-) -> Result<SimSummary, ParamError> {
-    let scenario = Scenario::new(robot.clone(), Terrain::constant(k_n, k_s)?, None, None)?;
-    simulate(&scenario, deg, settings).map(|s| s.summary).map_err(|e| match e {
-        crate::simulate::SimulateError::Param(p) => p,
-    })
 }
 
 /// The first pair of neighbouring `xs` whose `ys` lie on either side of `target` (or on it).

@@ -2,7 +2,7 @@
 //!
 //! Readers and writers of every file format sandslope uses, shared by the `sandslope` binary,
 //! the Python package and the report: robot and terrain TOML files and the built-in presets
-//! ([`robot_terrain`], [`presets`]), speed tables ([`speeds`]), anchoring-time tables ([`anchoring`]), load-cell manifests and
+//! ([`robot_terrain`], [`presets`]), a report's force tests ([`force_tests`]), speed tables ([`speeds`]), anchoring-time tables ([`anchoring`]), load-cell manifests and
 //! recordings ([`measurements`]), motion-capture exports ([`mocap`]), elevation rasters and the
 //! risk-map GeoTIFF ([`raster`]; PDS3 DTMs in [`pds3`]), route GeoJSON and CSV ([`routes`]), NumPy `.npy` arrays of
 //! phase and risk maps ([`npy`]), fast CSV of large grids ([`grid_csv`]), simulated walks as
@@ -18,6 +18,7 @@
 pub mod anchoring;
 pub mod crs;
 pub mod files;
+pub mod force_tests;
 pub mod grid_csv;
 mod lzw_tiles;
 pub mod measurements;

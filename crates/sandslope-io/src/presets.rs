@@ -3,8 +3,6 @@
 //! Each preset is a TOML file under `crates/sandslope-io/presets/`, in exactly the format a
 //! user would write, and is parsed by the same code as a user's file.
 
-use sandslope::report::ForceTests;
-
 /// What a preset describes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PresetKind {
@@ -60,23 +58,6 @@ pub const PAPER_FORCE_TESTS: Preset = Preset {
     toml: include_str!("../presets/example-force-tests.toml"),
 };
 
-/// [`PAPER_FORCE_TESTS`] read as a terrain table.
-pub fn paper_force_tests() -> anyhow::Result<sandslope::Terrain> {
-    let p = PAPER_FORCE_TESTS;
-    crate::robot_terrain::terrain_from_toml(p.toml, &crate::files::Source::Preset(p.name))
-}
-
-/// The force tests of a report: `forces` (a file or preset name) when given; else, on the
-/// built-in terrain `terrain_arg == DEFAULT_TERRAIN`, the paper's (the terrain was calibrated
-/// from them); else none (the terrain's own table is used).
-pub fn report_force_tests(forces: Option<&str>, terrain_arg: &str) -> anyhow::Result<ForceTests> {
-    Ok(match forces {
-        Some(f) => ForceTests::Given { table: crate::load_terrain(f)?, source: f.to_string() },
-        None if is_default(terrain_arg, PresetKind::Terrain) => ForceTests::Paper(paper_force_tests()?),
-        None => ForceTests::None,
-    })
-}
-
 /// Whether `--robot`/`--terrain` value `arg` names the default preset of `kind` (and no file
 /// of that name, which would win).
 pub fn is_default(arg: &str, kind: PresetKind) -> bool {
@@ -108,17 +89,6 @@ mod tests {
             };
             assert!(ok, "preset {} does not load", p.name);
         }
-    }
-
-    #[test]
-    fn the_built_in_force_tests_are_the_data_file() {
-        let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/example-force-tests.toml");
-        assert_eq!(std::fs::read_to_string(data).unwrap(), PAPER_FORCE_TESTS.toml);
-        let t = paper_force_tests().unwrap();
-        // The paper's one number: k_s(20)/k_s(0) = 0.40 (Sec. III-C).
-        let (p0, p20) = (&t.points()[0], &t.points()[1]);
-        assert_eq!((p0.slope_deg, p20.slope_deg), (0.0, 20.0));
-        assert!((p20.k_s / p0.k_s - 0.40).abs() < 1e-12);
     }
 
     #[test]

@@ -9,8 +9,9 @@ use pyo3::prelude::*;
 use sandslope::gait::{GaitOptions, Upslope};
 use sandslope::report::{report as build_report, Evidence, TrackReading, TrackedSlope};
 use sandslope::Slope;
+use sandslope_io::force_tests::report_force_tests;
 use sandslope_io::mocap::MocapFormat;
-use sandslope_io::presets::{is_default, report_force_tests, PresetKind};
+use sandslope_io::presets::{is_default, PresetKind};
 use sandslope_io::{load_anchoring_times, load_speeds};
 
 use crate::measure::read_and_track;

@@ -129,7 +129,7 @@ pub(crate) fn critical_closed_form(robot: &Robot, slope: Slope, level_step: f64,
         return (f64::INFINITY, false);
     }
     let tau = robot.stance_duration();
-    let gs = crate::model::G * slope.sin();
+    let gs = crate::constants::G * slope.sin();
     let a = level_step / (tau * tau) + 0.5 * gs;
     let b = -2.0 * level_step / tau - gs * tau;
     let c = level_step - target;
@@ -199,7 +199,8 @@ pub fn critical_shear_strength_closed_form(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{leg_depth, predict, tests::paper_robot, G};
+    use crate::constants::G;
+    use crate::model::{leg_depth, predict, tests::paper_robot};
     use crate::regime::Regime;
     use crate::terrain::Ground;
 

@@ -32,6 +32,7 @@
 
 pub mod axis;
 pub mod calibrate;
+pub mod constants;
 pub mod contour;
 pub mod critical;
 pub mod design;
@@ -59,12 +60,13 @@ pub use calibrate::{
     CalibrationWarning, FittedParameter, FreeParameter, JointCalibration, JointSetup, Parameter, Quantity,
     RobotKey, ShearLaw, ShearShape, SpeedModel, SpeedObservation,
 };
+pub use constants::G;
 pub use contour::ContourSegment;
 pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
 pub use error::ParamError;
 pub use gait::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording, Upslope};
 pub use measure::{MeasureError, SlopeEstimate};
-pub use model::{predict, Prediction, G};
+pub use model::{predict, Prediction};
 pub use phase::{
     write_phase, write_phase_rows, PanelGround, PanelSummary, PhaseMap, PhasePanel, RegimeCounts,
 };

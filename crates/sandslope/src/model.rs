@@ -13,8 +13,7 @@ use crate::robot::{LevelStep, Robot};
 use crate::slope::Slope;
 use crate::terrain::Ground;
 
-/// Gravitational acceleration, m/s^2 (docs/model.md §1 fixes 9.81, not 9.80665).
-pub const G: f64 = 9.81;
+pub use crate::constants::G;
 
 /// Normal load per stance leg, `F_N = m g cos(theta) / n`, N.
 pub fn normal_load_per_leg(robot: &Robot, slope: Slope) -> f64 {

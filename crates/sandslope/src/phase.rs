@@ -20,10 +20,11 @@ use serde::ser::{SerializeStruct, Serializer};
 use serde::Serialize;
 
 use crate::axis::Axis;
+use crate::constants::G;
 use crate::contour::{contour_on_cells, contour_segments, ContourSegment};
 use crate::error::ParamError;
 use crate::model::{
-    anchoring_time, backward_slip, level_step_length, normal_equilibrium_depth, shear_equilibrium_depth, G,
+    anchoring_time, backward_slip, level_step_length, normal_equilibrium_depth, shear_equilibrium_depth,
 };
 use crate::regime::Regime;
 use crate::robot::Robot;

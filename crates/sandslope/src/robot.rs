@@ -133,7 +133,7 @@ impl Robot {
         // The loads of docs/model.md §4 must be finite numbers: a response time of 1e-320 s
         // made the shear load m (g + R omega / dt) infinite, and the critical-strength search
         // of `predict --json` then never ended (scripts/fuzz.sh, input 15811 of 100,000).
-        let shear_load = spec.mass_kg * (crate::model::G + r * spec.leg_speed_rad_s / dt);
+        let shear_load = spec.mass_kg * (crate::constants::G + r * spec.leg_speed_rad_s / dt);
         if !shear_load.is_finite() {
             return Err(ParamError::new(
                 "response_time_s",

@@ -12,8 +12,9 @@ use clap::Args;
 use sandslope::gait::{GaitOptions, Upslope};
 use sandslope::report::{report, Evidence, TrackReading, TrackedSlope};
 use sandslope::Slope;
+use sandslope_io::force_tests::report_force_tests;
 use sandslope_io::mocap::MocapFormat;
-use sandslope_io::presets::{is_default, report_force_tests, PresetKind};
+use sandslope_io::presets::{is_default, PresetKind};
 use sandslope_io::{load_anchoring_times, load_speeds};
 
 use crate::args::{parse_max_risk, LevelStepArgs, RobotArgs, TerrainArgs};

@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Context, Result};
 
 use crate::crs::Crs;
-use crate::raster::Raster;
+use crate::raster::grid::{Raster, SizeCheck};
 use label::{parse_label, Item, Label, Value};
 
 /// The largest PDS3 label read, in bytes (a HiRISE DTM's is about 10 KB).
@@ -51,7 +51,7 @@ pub fn read_pds3(path: &Path) -> Result<Raster> {
 
 /// [`read_pds3`], with `fits(cols, rows)` called once the label gives the size and before the
 /// samples are read ([`crate::raster::read_raster_within`]).
-pub fn read_pds3_within(path: &Path, fits: crate::raster::SizeCheck) -> Result<Raster> {
+pub fn read_pds3_within(path: &Path, fits: SizeCheck) -> Result<Raster> {
     let Described { label, data_path, offset, layout, mut notes } = describe(path)?;
     fits(layout.cols as usize, layout.rows as usize)?;
     let values = image::read_samples(&layout, &label.name, &data_path, offset, &mut notes)?;

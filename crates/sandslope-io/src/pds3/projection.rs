@@ -5,7 +5,7 @@ use anyhow::{anyhow, bail, Result};
 
 use super::label::Label;
 use crate::crs::GroundCells;
-use crate::raster::GeoRef;
+use crate::raster::grid::GeoRef;
 
 /// Where the DTM lies on its projection (projected metres) and on which sphere.
 #[derive(Debug, Clone, Copy)]

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
 
-use super::{check_raster_size, GeoRef, Raster, SizeCheck, MAX_RASTER_CELLS};
+use super::grid::{check_raster_size, GeoRef, Raster, SizeCheck, MAX_RASTER_CELLS};
 
 /// An ESRI ASCII grid (its CRS from a `.prj` beside it, if any), and the factor converting its
 /// heights to metres.

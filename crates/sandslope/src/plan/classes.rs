@@ -5,7 +5,7 @@
 //!
 //! [`Planner::new`]: super::Planner::new
 
-use super::search::NO_CLASS;
+use super::planner::NO_CLASS;
 
 /// A class value that covers cells but was given no terrain.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

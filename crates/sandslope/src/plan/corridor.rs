@@ -21,9 +21,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::grid::{Cell, ElevationGrid};
+use super::planner::{Layout, Planner};
 use super::result::{extrapolation_of, Extrapolation, PlanRequest};
 use super::route::Route;
-use super::search::{Layout, Planner};
 use super::table::PitchTableCache;
 use super::{NoRoute, Objective, PlanError, PlanSettings, PLANNER_BYTES_PER_CELL, SEARCH_BYTES_PER_CELL};
 use crate::risk::UncertainTerrain;

@@ -20,6 +20,7 @@
 mod classes;
 mod corridor;
 mod grid;
+mod planner;
 mod queue;
 mod result;
 mod risk_map;
@@ -33,9 +34,9 @@ pub use corridor::{
     CORRIDOR_MAP_BYTES_PER_CELL,
 };
 pub use grid::{Cell, ElevationGrid};
+pub use planner::{heading_offsets, Planner, HEADINGS, NO_CLASS};
 pub use result::{plan, Extrapolation, PlanRequest, PlanResult, RiskRaster};
 pub use route::{Route, RouteStep};
-pub use search::{heading_offsets, Planner, HEADINGS, NO_CLASS};
 pub use table::{PitchTable, PitchTableCache, MAX_PITCH_DEG, P_FAIL_STEP_DEG, TAN_STEP};
 
 use serde::{Deserialize, Serialize};

@@ -9,8 +9,8 @@ use serde::ser::{SerializeMap, SerializeSeq};
 use serde::{Serialize, Serializer};
 
 use super::grid::{Cell, ElevationGrid};
+use super::planner::Planner;
 use super::route::Route;
-use super::search::Planner;
 use super::{NoRoute, Objective, PlanError, PlanSettings};
 use crate::risk::UncertainTerrain;
 use crate::robot::Robot;

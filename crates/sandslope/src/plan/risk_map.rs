@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 
 use super::grid::Cell;
-use super::search::{EdgeGeom, MoveGeom, Planner, HEADINGS};
+use super::planner::{EdgeGeom, MoveGeom, Planner, HEADINGS};
 use crate::regime::Regime;
 
 impl Planner {

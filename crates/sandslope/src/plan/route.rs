@@ -3,7 +3,7 @@
 //! survival, docs/model.md §8-§9).
 
 use super::grid::Cell;
-use super::search::Planner;
+use super::planner::Planner;
 use super::Objective;
 use crate::regime::Regime;
 

@@ -11,8 +11,9 @@ use crate::calibrate::SpeedObservation;
 use crate::calibrate::{
     calibrate_jointly, AnchoringObservation, FreeParameter, JointSetup, Parameter, ShearShape,
 };
+use crate::constants::G;
 use crate::critical::{critical_shear_strength, StepTarget};
-use crate::model::{predict, G};
+use crate::model::predict;
 use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::slope::Slope;

@@ -1,6 +1,7 @@
 //! `sandslope serve`: the JSON API returns exactly what `--json` prints for the same flags;
 //! bad, huge or hostile requests get a 4xx naming the field or the limit, never a 500; the
-//! server answers many concurrent requests without losing one.
+//! server answers many concurrent requests without losing one, and survives clients that
+//! hold connections, do not read, flood it or come from another web site (issue 39).
 
 mod common;
 
@@ -33,13 +34,27 @@ impl Drop for Server {
 impl Server {
     /// Starts `sandslope serve --port 0 ARGS` and reads the URL it prints.
     fn start(args: &[&str]) -> Server {
-        let mut child = Command::new(assert_cmd::cargo::cargo_bin("sandslope"))
-            .args(["serve", "--port", "0"])
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap();
+        Server::start_limited(args, None)
+    }
+
+    /// As [`Server::start`], with at most `open_files` open files (`ulimit -n`, soft and hard).
+    fn start_limited(args: &[&str], open_files: Option<u64>) -> Server {
+        let mut command = Command::new(assert_cmd::cargo::cargo_bin("sandslope"));
+        command.args(["serve", "--port", "0"]).args(args).stdout(Stdio::piped()).stderr(Stdio::inherit());
+        if let Some(n) = open_files {
+            use std::os::unix::process::CommandExt;
+            // SAFETY: setrlimit is async-signal-safe; nothing else runs between fork and exec.
+            unsafe {
+                command.pre_exec(move || {
+                    let lim = libc::rlimit { rlim_cur: n as libc::rlim_t, rlim_max: n as libc::rlim_t };
+                    if libc::setrlimit(libc::RLIMIT_NOFILE, &lim) != 0 {
+                        return Err(std::io::Error::last_os_error());
+                    }
+                    Ok(())
+                });
+            }
+        }
+        let mut child = command.spawn().unwrap();
         let mut line = String::new();
         BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
         let addr = line
@@ -847,4 +862,336 @@ fn read_http11(s: &mut TcpStream) -> (u16, Vec<u8>) {
         reader.read_exact(&mut body).unwrap();
     }
     (status, body)
+}
+
+// ---- clients that hold, flood, do not read, or come from elsewhere (issue 39) ----
+
+/// Lets this test process open `n` files (the clients' connections), up to its hard limit.
+fn allow_open_files(n: u64) {
+    let mut lim = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+    // SAFETY: plain FFI with a valid pointer to a local.
+    unsafe {
+        assert_eq!(libc::getrlimit(libc::RLIMIT_NOFILE, &mut lim), 0);
+        if lim.rlim_cur < n as libc::rlim_t {
+            lim.rlim_cur = (n as libc::rlim_t).min(lim.rlim_max);
+            assert_eq!(libc::setrlimit(libc::RLIMIT_NOFILE, &lim), 0);
+        }
+    }
+}
+
+/// The server's peak resident memory so far (VmHWM), MiB.
+fn peak_rss_mib(server: &Server) -> f64 {
+    let status = std::fs::read_to_string(format!("/proc/{}/status", server.child.id())).unwrap();
+    let line = status.lines().find(|l| l.starts_with("VmHWM:")).unwrap();
+    line.split_whitespace().nth(1).unwrap().parse::<f64>().unwrap() / 1024.0
+}
+
+/// Whether the server has closed `s` (EOF or reset), without reading data it sent.
+fn closed_by_server(s: &TcpStream) -> bool {
+    s.set_nonblocking(true).unwrap();
+    let mut byte = [0u8; 1];
+    let closed = match s.peek(&mut byte) {
+        Ok(0) => true,
+        Ok(_) => false,
+        Err(e) => e.kind() != std::io::ErrorKind::WouldBlock,
+    };
+    s.set_nonblocking(false).unwrap();
+    closed
+}
+
+/// `GET path` on a fresh connection, timed: (status, body, seconds).
+fn timed_get(server: &Server, path: &str) -> (u16, Vec<u8>, f64) {
+    let t = std::time::Instant::now();
+    let (status, body) = server.get(path);
+    (status, body, t.elapsed().as_secs_f64())
+}
+
+/// At `ulimit -n 1024` (where the server before this one panicked and exited 101 at about
+/// 1,020 idle connections: the accept back-off slept on a runtime without timers), 1,100
+/// idle connections: the server keeps at most its 512 (`--max-connections`, below 1024 - 64),
+/// closing the idle longest to make room, and a new request is answered at once. Then, with
+/// its limit lowered to 48 files while it runs, 100 more: accepting fails with EMFILE, and the
+/// server backs off, closes idle connections and still answers.
+#[test]
+fn the_server_answers_after_1100_idle_connections_at_1024_open_files() {
+    allow_open_files(4096);
+    let server = Server::start_limited(&[], Some(1024));
+    let expected = cli_stdout(&["predict".into(), "--slope=20".into(), "--json".into()]);
+    let idle: Vec<TcpStream> = (0..1100).map(|_| TcpStream::connect(&server.addr).unwrap()).collect();
+    let (status, body, took) = timed_get(&server, "/api/predict?slope=20");
+    assert_eq!((status, &body), (200, &expected), "{}", String::from_utf8_lossy(&body));
+    assert!(took < 5.0, "answered after {took:.1} s");
+    // 1,100 idle and one more: all but the newest 512 were closed, the oldest first.
+    std::thread::sleep(Duration::from_millis(500));
+    let closed: Vec<bool> = idle.iter().map(closed_by_server).collect();
+    let n_closed = closed.iter().filter(|&&c| c).count();
+    assert!(n_closed >= 1101 - 512, "{n_closed} of 1100 idle connections closed");
+    assert!(closed[..500].iter().all(|&c| c), "the oldest idle connections were not the ones closed");
+    drop(idle);
+
+    // Out of file descriptors while running: EMFILE on accept.
+    let pid = server.child.id() as libc::pid_t;
+    let lim = libc::rlimit { rlim_cur: 48, rlim_max: 48 };
+    // SAFETY: plain FFI; prlimit on a child of this process.
+    assert_eq!(unsafe { libc::prlimit(pid, libc::RLIMIT_NOFILE, &lim, std::ptr::null_mut()) }, 0);
+    let idle: Vec<TcpStream> = (0..100).map(|_| TcpStream::connect(&server.addr).unwrap()).collect();
+    let (status, body, took) = timed_get(&server, "/api/predict?slope=20");
+    assert_eq!((status, &body), (200, &expected), "{}", String::from_utf8_lossy(&body));
+    assert!(took < 5.0, "answered after {took:.1} s with the files used up");
+    drop(idle);
+    let mut server = server;
+    assert!(server.child.try_wait().unwrap().is_none(), "the server exited");
+}
+
+/// Connections that send nothing, or trickle a request's head a byte every 0.5 s (slowloris),
+/// or stay idle after an answer (kept alive), are all closed within 15 s: the header-read
+/// timeout is 10 s by default. Before, 0 of 50 silent and 0 of 300 trickling connections were
+/// closed after 35-45 s.
+#[test]
+fn silent_trickling_and_idle_connections_are_closed_within_15_s() {
+    let server = Server::start(&[]);
+    let start = std::time::Instant::now();
+    let silent: Vec<TcpStream> = (0..20).map(|_| TcpStream::connect(&server.addr).unwrap()).collect();
+    let mut kept: Vec<TcpStream> = (0..3)
+        .map(|i| {
+            let mut s = TcpStream::connect(&server.addr).unwrap();
+            s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+            write!(s, "GET /api/predict?slope={i} HTTP/1.1\r\nHost: {}\r\n\r\n", server.addr).unwrap();
+            assert_eq!(read_http11(&mut s).0, 200);
+            s
+        })
+        .collect();
+    let head = format!(
+        "GET /api/predict?slope=10 HTTP/1.1\r\nHost: {}\r\nX-Padding: {}\r\n\r\n",
+        server.addr,
+        "a".repeat(200)
+    );
+    let mut trickling: Vec<TcpStream> = (0..5).map(|_| TcpStream::connect(&server.addr).unwrap()).collect();
+    let mut closed_at: Vec<Option<f64>> = vec![None; silent.len() + kept.len() + trickling.len()];
+    let mut sent = 0;
+    while start.elapsed() < Duration::from_secs(20) && closed_at.iter().any(Option::is_none) {
+        for s in &mut trickling {
+            let _ = s.write_all(&head.as_bytes()[sent..sent + 1]);
+        }
+        sent += 1;
+        std::thread::sleep(Duration::from_millis(500));
+        let all = silent.iter().chain(&kept).chain(&trickling);
+        for (at, s) in closed_at.iter_mut().zip(all) {
+            if at.is_none() && closed_by_server(s) {
+                *at = Some(start.elapsed().as_secs_f64());
+            }
+        }
+    }
+    for (i, at) in closed_at.iter().enumerate() {
+        let at = at.unwrap_or_else(|| panic!("connection {i} still open after 20 s"));
+        assert!((9.0..15.0).contains(&at), "connection {i} closed after {at:.1} s");
+    }
+    // The trickled heads were never complete (the server never answered them).
+    assert!(sent < head.len());
+    kept.clear();
+    // Still up.
+    assert_eq!(server.get("/api/predict?slope=5").0, 200);
+}
+
+/// 20 clients ask for a 2^20-cell risk map (44 MB of JSON) and do not read it. The answers are
+/// written as they are read, and at most 2 per heavy thread are computing or being sent, so
+/// the server stays under 200 MB (before: from 6 MB to 887 MB, every answer buffered whole).
+#[test]
+fn twenty_unread_44_mb_answers_hold_the_server_under_200_mb() {
+    let server = Server::start(&["--threads", "2"]);
+    let path = "/api/risk?map&slope=10&k-n=1e4:1e7:1024&k-s=1e3:1e8:1024";
+    let clients: Vec<TcpStream> = (0..20)
+        .map(|_| {
+            let mut s = TcpStream::connect(&server.addr).unwrap();
+            write!(s, "GET {path} HTTP/1.1\r\nHost: {}\r\n\r\n", server.addr).unwrap();
+            s
+        })
+        .collect();
+    // Wait until 4 answers (2 threads x 2) have begun, watching the memory, then 3 s more.
+    let start = std::time::Instant::now();
+    let mut peak: f64 = 0.0;
+    let mut begun_at = None;
+    while begun_at.is_none_or(|t: std::time::Instant| t.elapsed() < Duration::from_secs(3)) {
+        assert!(start.elapsed() < Duration::from_secs(120), "4 answers did not begin in 120 s");
+        std::thread::sleep(Duration::from_millis(250));
+        peak = peak.max(peak_rss_mib(&server));
+        let begun = clients
+            .iter()
+            .filter(|s| {
+                s.set_nonblocking(true).unwrap();
+                let got = s.peek(&mut [0u8; 1]).is_ok_and(|n| n > 0);
+                s.set_nonblocking(false).unwrap();
+                got
+            })
+            .count();
+        if begun >= 4 && begun_at.is_none() {
+            begun_at = Some(std::time::Instant::now());
+        }
+    }
+    peak = peak.max(peak_rss_mib(&server));
+    eprintln!("20 unread 2^20-cell risk maps: peak {peak:.0} MiB");
+    assert!(peak < 200.0, "the server peaked at {peak:.0} MiB");
+    // Light requests are answered meanwhile, and the answers are the 44 MB ones.
+    let (status, _, took) = timed_get(&server, "/api/predict?slope=10");
+    assert!(status == 200 && took < 2.0, "{status} after {took:.1} s");
+    let mut first = clients.into_iter().next().unwrap();
+    let (status, body) = read_http11(&mut first);
+    assert_eq!(status, 200);
+    assert!(body.len() > 40_000_000, "{} bytes", body.len());
+    let v: serde_json::Value = serde_json::from_slice(&body).unwrap();
+    assert_eq!(v["cells"], 1024 * 1024);
+}
+
+/// A client that reads nothing of its answer is dropped after `--send-timeout`, which frees
+/// its place: with one heavy thread (2 answers in flight) and 2 unread risk maps, a cheap
+/// heavy request is answered once the timeout (2 s here) drops them, and the unread answers
+/// end short.
+#[test]
+fn a_client_that_reads_nothing_is_dropped_after_the_send_timeout() {
+    let server = Server::start(&["--threads", "1", "--send-timeout", "2"]);
+    let path = "/api/risk?map&slope=10&k-n=1e4:1e7:1024&k-s=1e3:1e8:1024";
+    let unread: Vec<TcpStream> = (0..2)
+        .map(|_| {
+            let mut s = TcpStream::connect(&server.addr).unwrap();
+            write!(s, "GET {path} HTTP/1.1\r\nHost: {}\r\n\r\n", server.addr).unwrap();
+            s
+        })
+        .collect();
+    let (status, body, took) = timed_get(&server, "/api/phase?slope=10&k-n=1e4:1e7:20&k-s=1e3:1e8:20");
+    assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
+    assert!(took < 90.0, "{took}");
+    for mut s in unread {
+        // Once its answer has begun, a client that reads nothing for over 2 s is dropped.
+        s.set_read_timeout(Some(Duration::from_secs(90))).unwrap();
+        assert!(s.peek(&mut [0u8; 1]).unwrap() > 0);
+        std::thread::sleep(Duration::from_secs(4));
+        let mut got = Vec::new();
+        let _ = s.read_to_end(&mut got);
+        assert!(got.len() < 40_000_000, "{} bytes arrived: the answer was not cut", got.len());
+    }
+}
+
+/// Behind 10 open `/api/simulate?slopes=0:24:25&duration=60` (each minutes of a debug build's
+/// computing), `predict`, `sweep` and the page are answered within 0.5 s: they have their own
+/// threads. Before, a predict waited 13.6 s behind 6 and 33 s behind 10.
+#[test]
+fn predict_sweep_and_the_page_are_fast_behind_ten_heavy_simulations() {
+    let server = Server::start(&[]);
+    let expected = cli_stdout(&["predict".into(), "--slope=17".into(), "--json".into()]);
+    let heavy: Vec<TcpStream> = (0..10)
+        .map(|_| {
+            let mut s = TcpStream::connect(&server.addr).unwrap();
+            write!(
+                s,
+                "GET /api/simulate?slopes=0:24:25&duration=60 HTTP/1.1\r\nHost: {}\r\n\r\n",
+                server.addr
+            )
+            .unwrap();
+            s
+        })
+        .collect();
+    std::thread::sleep(Duration::from_secs(1));
+    for _ in 0..3 {
+        let (status, body, took) = timed_get(&server, "/api/predict?slope=17");
+        assert_eq!((status, &body), (200, &expected));
+        assert!(took < 0.5, "predict took {took:.2} s behind 10 simulations");
+        let (status, _, took) = timed_get(&server, "/api/sweep?from=0&to=30&step=1");
+        assert!(status == 200 && took < 0.5, "sweep: {status} after {took:.2} s");
+        let (status, _, took) = timed_get(&server, "/");
+        assert!(status == 200 && took < 0.5, "the page: {status} after {took:.2} s");
+    }
+    // The simulations were accepted, not refused: each is still running or answering 200.
+    for s in &heavy {
+        s.set_nonblocking(true).unwrap();
+        let mut start = [0u8; 12];
+        match s.peek(&mut start) {
+            Err(e) => assert_eq!(e.kind(), std::io::ErrorKind::WouldBlock),
+            Ok(n) => assert!(
+                start[..n].starts_with(b"HTTP/1.1 200") || n < 12,
+                "{:?}",
+                String::from_utf8_lossy(&start)
+            ),
+        }
+    }
+}
+
+/// A raw request with these header lines: (status, headers, body).
+fn raw(server: &Server, request: &str) -> (u16, String, Vec<u8>) {
+    let mut s = TcpStream::connect(&server.addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+    s.write_all(request.as_bytes()).unwrap();
+    let mut got = Vec::new();
+    s.read_to_end(&mut got).unwrap();
+    let split = got.windows(4).position(|w| w == b"\r\n\r\n").expect("no header end");
+    let head = String::from_utf8_lossy(&got[..split]).to_string();
+    let status = head.split(' ').nth(1).and_then(|s| s.parse().ok()).expect("no status");
+    (status, head, got[split + 4..].to_vec())
+}
+
+/// DNS rebinding and cross-site requests: a foreign Host gets 403 (on the API and on the page);
+/// localhost, the address listened on and `--allow-host` names are accepted; an Origin other
+/// than the server's own gets 403, so a cross-site `text/plain` POST is not answered. HEAD is
+/// answered on every GET route with GET's status and length and no body (before: 405 on the API).
+#[test]
+fn foreign_hosts_and_origins_are_refused_and_head_is_answered() {
+    let server = Server::start(&["--allow-host", "robot-lab.example"]);
+    let port = server.addr.rsplit(':').next().unwrap().to_string();
+    let get = |path: &str, host: &str, extra: &str| {
+        raw(&server, &format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n{extra}Connection: close\r\n\r\n"))
+    };
+    for host in
+        ["evil.example", &format!("evil.example:{port}"), "127.0.0.1.evil.example", "localhost.evil.example"]
+    {
+        for path in ["/api/predict?slope=10", "/"] {
+            let (status, _, body) = get(path, host, "");
+            assert_eq!(status, 403, "Host {host} {path}");
+            assert!(String::from_utf8_lossy(&body).contains("--allow-host"));
+        }
+    }
+    for host in [
+        format!("127.0.0.1:{port}"),
+        format!("localhost:{port}"),
+        "LOCALHOST".to_string(),
+        format!("127.0.0.2:{port}"),
+        format!("robot-lab.example:{port}"),
+    ] {
+        assert_eq!(get("/api/predict?slope=10", &host, "").0, 200, "Host {host}");
+    }
+    // Origin: the server's own is answered, any other refused before any work.
+    let post = |origin: &str| {
+        raw(
+            &server,
+            &format!(
+                "POST /api/predict HTTP/1.1\r\nHost: {}\r\nOrigin: {origin}\r\nContent-Type: text/plain\r\n\
+                 Content-Length: 13\r\nConnection: close\r\n\r\n{{\"slope\": 10}}",
+                server.addr
+            ),
+        )
+    };
+    for origin in
+        ["http://evil.example", "null", &format!("http://localhost:{port}.evil.example"), "http://127.0.0.1"]
+    {
+        let (status, _, body) = post(origin);
+        assert_eq!(status, 403, "Origin {origin}: {}", String::from_utf8_lossy(&body));
+        assert!(!String::from_utf8_lossy(&body).contains("speed_m_s"));
+    }
+    assert_eq!(post(&format!("http://{}", server.addr)).0, 200);
+    let (status, _, _) = get("/api/predict?slope=10", &server.addr, "Origin: http://evil.example\r\n");
+    assert_eq!(status, 403);
+    // HEAD: GET's status and Content-Length, no body.
+    for (path, want) in
+        [("/api/predict?slope=10", 200), ("/", 200), ("/api/predict?slope=NaN", 400), ("/nothing", 404)]
+    {
+        let (get_status, _, get_body) = get(path, &server.addr, "");
+        let (status, head, body) = raw(
+            &server,
+            &format!("HEAD {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n\r\n", server.addr),
+        );
+        assert_eq!((status, get_status), (want, want), "{path}");
+        assert!(body.is_empty(), "HEAD {path} sent a body");
+        assert!(
+            head.to_ascii_lowercase().contains(&format!("content-length: {}", get_body.len())),
+            "HEAD {path}: {head}"
+        );
+    }
 }

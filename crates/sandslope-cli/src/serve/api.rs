@@ -16,6 +16,7 @@ use clap::error::{ContextKind, ContextValue};
 use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
+use super::data::{DemInfo, Reply};
 use crate::commands::{phase, plan, predict, risk, simulate, sweep};
 use sandslope_io::presets::{self, PresetKind};
 
@@ -50,6 +51,22 @@ pub struct Served {
     pub terrain: String,
     /// `--dem` of `serve`, the only elevation model `/api/plan` uses.
     pub dem: Option<PathBuf>,
+    /// The DEM's size and georeference, read at start.
+    pub dem_info: Option<DemInfo>,
+}
+
+impl Served {
+    /// Reads everything the server will use now, so a bad file fails at start, not per request.
+    pub fn load(robot: String, terrain: String, dem: Option<PathBuf>) -> anyhow::Result<Served> {
+        use anyhow::Context;
+        sandslope_io::load_robot(&robot).context("--robot")?;
+        sandslope_io::load_terrain(&terrain).context("--terrain")?;
+        let dem_info = match &dem {
+            Some(path) => Some(DemInfo::of(&sandslope_io::raster::read_raster(path)?)),
+            None => None,
+        };
+        Ok(Served { robot, terrain, dem, dem_info })
+    }
 }
 
 /// The commands the API answers, in the order docs/serve.md lists them.
@@ -120,12 +137,13 @@ fn flag_named_in(text: &str) -> Option<String> {
     (!name.is_empty()).then_some(name)
 }
 
-/// Answers `/api/<command>` with these parameters (in request order): the JSON body.
-pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Result<Vec<u8>, ApiError> {
+/// Answers `/api/<command>` with these parameters (in request order): the JSON body, written
+/// as it is sent.
+pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
     match command {
         "predict" => {
             let args: predict::PredictArgs = parse("predict", params, served)?;
-            json(&predict::answer(&args).map_err(|e| ApiError::from_command(&e))?)
+            Ok(Reply::pretty(predict::answer(&args).map_err(|e| ApiError::from_command(&e))?))
         }
         "sweep" => {
             let args: sweep::SweepArgs = parse("sweep", params, served)?;
@@ -138,25 +156,25 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
                     ),
                 ));
             }
-            json(&sweep::answer(&args).map_err(|e| ApiError::from_command(&e))?)
+            Ok(Reply::pretty(sweep::answer(&args).map_err(|e| ApiError::from_command(&e))?))
         }
         "phase" => {
             let args: phase::PhaseArgs = parse("phase", params, served)?;
-            json(&phase::answer(&args, MAX_PHASE_CELLS).map_err(|e| ApiError::from_command(&e))?)
+            Ok(Reply::pretty(phase::answer(&args, MAX_PHASE_CELLS).map_err(|e| ApiError::from_command(&e))?))
         }
         "risk" => {
             let args: risk::RiskArgs = parse("risk", params, served)?;
-            json(&risk::answer(&args, RISK_LIMITS).map_err(|e| ApiError::from_command(&e))?)
+            Ok(Reply::pretty(risk::answer(&args, RISK_LIMITS).map_err(|e| ApiError::from_command(&e))?))
         }
         "simulate" => {
             let walks = simulate_walks(params, served)?;
             let sims = walks.simulate().map_err(|e| ApiError::from_command(&e))?;
-            json(&walks.answer(sims))
+            Ok(Reply::pretty(walks.answer(sims)))
         }
         "plan" => {
             let args: plan::PlanArgs = parse("plan", params, served)?;
             let planned = plan::compute(&args, false, true).map_err(|e| ApiError::from_command(&e))?;
-            json(&plan::answer(&planned))
+            Ok(Reply::pretty(plan::answer(&planned)))
         }
         _ => Err(ApiError {
             status: 404,
@@ -322,13 +340,18 @@ mod tests {
     use super::*;
 
     fn served() -> Served {
-        Served { robot: "paper-hexapod".into(), terrain: "glass-beads-300um".into(), dem: None }
+        Served {
+            robot: "paper-hexapod".into(),
+            terrain: "glass-beads-300um".into(),
+            dem: None,
+            dem_info: None,
+        }
     }
 
     fn ask(command: &str, params: &[(&str, &str)]) -> Result<serde_json::Value, ApiError> {
         let params: Vec<(String, String)> =
             params.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-        answer(command, &params, &served()).map(|b| serde_json::from_slice(&b).unwrap())
+        answer(command, &params, &served()).map(|r| serde_json::from_slice(&r.into_bytes().unwrap()).unwrap())
     }
 
     #[test]

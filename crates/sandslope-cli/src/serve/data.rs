@@ -2,6 +2,8 @@
 //! map, a risk raster without routes (`/data/...`), and the files `plan` writes
 //! (`/download/...`), each computed by the same command code (docs/serve.md).
 
+use std::io::Write;
+
 use serde::Serialize;
 
 use super::api::{self, ApiError, Served};
@@ -19,10 +21,16 @@ pub const MAX_SIM_SAMPLES: f64 = 7200.0;
 /// cell in each direction.
 pub const MAX_DISPLAY_CELLS: usize = 1 << 20;
 
-/// An answer: its bytes, type, and the file name a download is saved under.
+/// How a reply's body is made: written into the response as the client reads it (http.rs
+/// sends it in 64 KiB chunks), so a large answer (the 44 MB of a 2^20-cell `risk --map`) is
+/// never whole in memory: a client that does not read holds the computed value and a few
+/// chunks.
+pub type Writer = Box<dyn FnOnce(&mut dyn Write) -> std::io::Result<()> + Send>;
+
+/// An answer: its body, type, and the file name a download is saved under.
 pub struct Reply {
     /// The body.
-    pub body: Vec<u8>,
+    pub body: Writer,
     /// Its content type.
     pub content_type: &'static str,
     /// For downloads: the suggested file name.
@@ -30,19 +38,29 @@ pub struct Reply {
 }
 
 impl Reply {
-    /// A JSON body as `print_json` writes it.
-    pub fn json(body: Vec<u8>) -> Reply {
-        Reply { body, content_type: "application/json", filename: None }
+    /// `value` as `print_json` prints it (pretty JSON and a newline), written as it is sent.
+    pub fn pretty<T: Serialize + Send + 'static>(value: T) -> Reply {
+        let write = move |w: &mut dyn Write| {
+            serde_json::to_writer_pretty(&mut *w, &value)?;
+            w.write_all(b"\n")
+        };
+        Reply { body: Box::new(write), content_type: "application/json", filename: None }
     }
-}
 
-/// `value` as compact JSON (the page's data need not read like `--json`, only be small).
-fn compact<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
-    serde_json::to_vec(value).map_err(|e| ApiError {
-        status: 500,
-        field: None,
-        error: format!("serialising the answer: {e}"),
-    })
+    /// `value` as compact JSON (the page's data need not read like `--json`, only be small),
+    /// written as it is sent.
+    pub fn compact<T: Serialize + Send + 'static>(value: T) -> Reply {
+        let write = move |w: &mut dyn Write| Ok(serde_json::to_writer(&mut *w, &value)?);
+        Reply { body: Box::new(write), content_type: "application/json", filename: None }
+    }
+
+    /// The whole body in memory.
+    #[cfg(test)]
+    pub fn into_bytes(self) -> std::io::Result<Vec<u8>> {
+        let mut out = Vec::new();
+        (self.body)(&mut out)?;
+        Ok(out)
+    }
 }
 
 fn not_found(what: &str, names: &str) -> ApiError {
@@ -66,7 +84,6 @@ pub fn answer(name: &str, params: &[(String, String)], served: &Served) -> Resul
             "/data/served, /data/dem, /data/phase-map, /data/risk-map, /data/simulation",
         )),
     }
-    .map(Reply::json)
 }
 
 /// Answers `/download/<name>`: the bytes `plan` writes to `--geojson` or `--risk-map` for the
@@ -100,27 +117,56 @@ pub fn download(name: &str, params: &[(String, String)], served: &Served) -> Res
         (_, None) => Err(anyhow::anyhow!("no risk raster was computed")),
     };
     written.map_err(|e| ApiError { status: 500, field: None, error: format!("{e:#}") })?;
-    let body =
-        std::fs::read(&path).map_err(|e| ApiError { status: 500, field: None, error: e.to_string() })?;
-    Ok(Reply { body, content_type, filename: Some(file) })
+    let mut opened = std::fs::File::open(&path).map_err(|e| ApiError {
+        status: 500,
+        field: None,
+        error: e.to_string(),
+    })?;
+    // The folder (and the file in it) lives until the file is sent.
+    let write = move |w: &mut dyn Write| {
+        std::io::copy(&mut opened, w)?;
+        drop(dir);
+        Ok(())
+    };
+    Ok(Reply { body: Box::new(write), content_type, filename: Some(file) })
+}
+
+/// The served DEM's size and georeference, read once when the server starts.
+#[derive(Debug, Clone, Serialize)]
+pub struct DemInfo {
+    cols: usize,
+    rows: usize,
+    /// Cell size in map units (degrees for a geographic DEM).
+    cell_x: f64,
+    cell_y: f64,
+    /// Ground size of a cell, metres (for the hillshade).
+    cell_x_m: f64,
+    cell_y_m: f64,
+    west: f64,
+    north: f64,
+    /// Every how many cells the page is sent.
+    stride: usize,
+}
+
+impl DemInfo {
+    /// What the page is told about this DEM.
+    pub fn of(r: &sandslope_io::raster::Raster) -> DemInfo {
+        DemInfo {
+            cols: r.cols,
+            rows: r.rows,
+            cell_x: r.geo.cell_x,
+            cell_y: r.geo.cell_y,
+            cell_x_m: r.cell_m.0,
+            cell_y_m: r.cell_m.1,
+            west: r.geo.west,
+            north: r.geo.north,
+            stride: stride(r.cols, r.rows),
+        }
+    }
 }
 
 /// The served robot (its file keys), terrain name, the presets and the DEM's size.
-fn served_info(served: &Served) -> Result<Vec<u8>, ApiError> {
-    #[derive(Serialize)]
-    struct Dem {
-        cols: usize,
-        rows: usize,
-        /// Cell size in map units (degrees for a geographic DEM).
-        cell_x: f64,
-        cell_y: f64,
-        /// Ground size of a cell, metres (for the hillshade).
-        cell_x_m: f64,
-        cell_y_m: f64,
-        west: f64,
-        north: f64,
-        stride: usize,
-    }
+fn served_info(served: &Served) -> Result<Reply, ApiError> {
     #[derive(Serialize)]
     struct Info {
         robot: sandslope::RobotSpec,
@@ -130,37 +176,20 @@ fn served_info(served: &Served) -> Result<Vec<u8>, ApiError> {
         terrains: Vec<&'static str>,
         /// Each regime cause's name and its one-line explanation.
         causes: Vec<(&'static str, &'static str)>,
-        dem: Option<Dem>,
+        dem: Option<DemInfo>,
     }
     let robot = sandslope_io::load_robot(&served.robot).map_err(|e| failed(&e))?;
     let terrain = sandslope_io::load_terrain(&served.terrain).map_err(|e| failed(&e))?;
     let names = |kind| PRESETS.iter().filter(|p| p.kind == kind).map(|p| p.name).collect();
-    let dem = match &served.dem {
-        Some(path) => {
-            let r = read_raster(path).map_err(|e| failed(&e))?;
-            Some(Dem {
-                cols: r.cols,
-                rows: r.rows,
-                cell_x: r.geo.cell_x,
-                cell_y: r.geo.cell_y,
-                cell_x_m: r.cell_m.0,
-                cell_y_m: r.cell_m.1,
-                west: r.geo.west,
-                north: r.geo.north,
-                stride: stride(r.cols, r.rows),
-            })
-        }
-        None => None,
-    };
-    compact(&Info {
+    Ok(Reply::compact(Info {
         robot: robot.spec().clone(),
         robot_name: served.robot.clone(),
         terrain_name: terrain.name().unwrap_or(&served.terrain).to_string(),
         robots: names(PresetKind::Robot),
         terrains: names(PresetKind::Terrain),
         causes: Cause::ALL.iter().map(|c| (c.name(), c.explain())).collect(),
-        dem,
-    })
+        dem: served.dem_info.clone(),
+    }))
 }
 
 /// Every how many cells the page is sent for a DEM of this size.
@@ -191,7 +220,7 @@ struct Grid {
 }
 
 /// The served DEM's heights (nodata as null), every `stride`-th cell.
-fn dem(served: &Served) -> Result<Vec<u8>, ApiError> {
+fn dem(served: &Served) -> Result<Reply, ApiError> {
     let Some(path) = &served.dem else {
         return Err(not_found("DEM: the server was started without --dem", "none"));
     };
@@ -199,13 +228,18 @@ fn dem(served: &Served) -> Result<Vec<u8>, ApiError> {
     let heights: Vec<f32> =
         (0..r.values.len()).map(|i| if r.is_nodata(i) { f32::NAN } else { r.values[i] as f32 }).collect();
     let stride = stride(r.cols, r.rows);
-    compact(&Grid { cols: r.cols, rows: r.rows, stride, values: sampled(&heights, r.cols, r.rows, stride) })
+    Ok(Reply::compact(Grid {
+        cols: r.cols,
+        rows: r.rows,
+        stride,
+        values: sampled(&heights, r.cols, r.rows, stride),
+    }))
 }
 
 /// The regime of every cell of the first panel of `phase` with these flags: `regimes` holds
 /// one digit per cell (0 sinkage, 1 slippage, 2 metastable, 3 success), k_s rows from the
 /// lowest, k_n columns from the lowest.
-fn phase_map(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, ApiError> {
+fn phase_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
     #[derive(Serialize)]
     struct Map {
         k_n: Vec<f64>,
@@ -226,14 +260,19 @@ fn phase_map(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, Ap
         .flat_map(|j| (0..nx).map(move |i| (i, j)))
         .map(|(i, j)| char::from(b'0' + p.map.regime(i, j) as u8))
         .collect();
-    compact(&Map { k_n: p.map.k_n().to_vec(), k_s: p.map.k_s().to_vec(), regimes, summary: p.summary() })
+    Ok(Reply::compact(Map {
+        k_n: p.map.k_n().to_vec(),
+        k_s: p.map.k_s().to_vec(),
+        regimes,
+        summary: p.summary(),
+    }))
 }
 
 /// P(failure) of every cell of the served DEM under `plan`'s flags, by a heading rule:
 /// `rule=best` (the lowest over the 16 headings, band 1 of `plan --risk-map`) or
 /// `rule=fall-line` (climbing straight up the cell's fall line). Start and goal are not
 /// needed (any given are ignored).
-fn risk_map(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, ApiError> {
+fn risk_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
     let mut rule = "best".to_string();
     let mut rest: Vec<(String, String)> = Vec::new();
     for (k, v) in params {
@@ -272,13 +311,13 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, Api
         }
     };
     let stride = stride(cols, rows);
-    compact(&Grid { cols, rows, stride, values: sampled(&p_fail, cols, rows, stride) })
+    Ok(Reply::compact(Grid { cols, rows, stride, values: sampled(&p_fail, cols, rows, stride) }))
 }
 
 /// One walk of `simulate` with these flags (one `slope`, not `slopes`), whole: the summary
 /// `simulate --json` prints, the trajectory sampled at `rate` and the legs' geometry, for the
 /// page's animation (the library's [`sandslope::simulate::Simulation`], as compact JSON).
-fn simulation(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, ApiError> {
+fn simulation(params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
     if params.iter().any(|(k, _)| k == "slopes") {
         return Err(ApiError::bad(
             Some("slopes".to_string()),
@@ -299,5 +338,5 @@ fn simulation(params: &[(String, String)], served: &Served) -> Result<Vec<u8>, A
     let Some(sim) = sim else {
         return Err(ApiError::bad(Some("slope".to_string()), "no walk: give a slope"));
     };
-    compact(&sim)
+    Ok(Reply::compact(sim))
 }

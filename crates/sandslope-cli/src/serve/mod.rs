@@ -5,19 +5,22 @@
 //! (same flags, defaults, checks and messages), and answered with the same library value the
 //! command's `--json` prints, serialised the same way, so the two bodies are equal byte for
 //! byte. Commands know nothing of the server ([`api`]); the HTTP layer ([`http`]) parses
-//! requests, refuses what is too big, and runs every API call on a bounded pool of compute
-//! threads, off the threads that accept and read requests. The page ([`page`]) and its scripts
+//! requests, refuses what is too big or not addressed to this server, and runs every API call
+//! on one of two bounded pools of compute threads (light and heavy), off the threads that
+//! accept and read requests; [`conn`] caps the connections and times them out. The page ([`page`]) and its scripts
 //! are embedded in the binary: nothing is fetched from the network.
 
 pub mod api;
+pub mod conn;
 pub mod data;
 pub mod http;
 pub mod page;
 
 use std::net::IpAddr;
 use std::path::PathBuf;
+use std::time::Duration;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
@@ -47,27 +50,71 @@ pub struct ServeArgs {
     /// Open the page in the default web browser once the server listens.
     #[arg(long)]
     pub open: bool,
-    /// Threads that compute API answers (default: the machine's cores).
+    /// Threads that compute the heavy answers: phase maps, risk, simulations, plans, the DEM and
+    /// downloads (default: the machine's cores). `predict`, `sweep` and the page have their own.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Seconds a connection has to send a request's head, from opening or from the previous
+    /// answer's end (so also how long an idle kept-alive connection stays open).
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+    pub header_timeout: f64,
+    /// Seconds a client may read nothing of an answer before its connection is closed.
+    #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
+    pub send_timeout: f64,
+    /// Most connections open at once (at most the open-file limit, `ulimit -n`, less 64); past
+    /// it the connection idle longest is closed to make room.
+    #[arg(long, value_name = "N", default_value_t = 512)]
+    pub max_connections: usize,
+    /// Another name the server may be reached by (the Host header), besides localhost and the
+    /// address it listens on: a machine name or a reverse proxy's. Repeat for several.
+    #[arg(long, value_name = "NAME")]
+    pub allow_host: Vec<String>,
+}
+
+/// Checks a timeout flag: a finite number of seconds in 0.1..=86400.
+fn seconds(flag: &str, value: f64) -> Result<Duration> {
+    if !(0.1..=86_400.0).contains(&value) {
+        bail!("--{flag} = {value} must be a number of seconds from 0.1 to 86400");
+    }
+    Ok(Duration::from_secs_f64(value))
 }
 
 /// Runs `sandslope serve` until the process is stopped.
 pub fn run(args: ServeArgs) -> Result<()> {
-    // Read everything the server will use now, so a bad file fails at start, not per request.
-    sandslope_io::load_robot(&args.robot).context("--robot")?;
-    sandslope_io::load_terrain(&args.terrain).context("--terrain")?;
-    if let Some(dem) = &args.dem {
-        sandslope_io::raster::read_raster(dem)?;
-    }
+    let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
     let threads = match args.threads {
         Some(0) => bail!("--threads = 0 must be at least 1"),
         Some(n) => n,
-        None => std::thread::available_parallelism().map_or(2, |n| n.get()),
+        None => cores,
     };
-    let served =
-        api::Served { robot: args.robot.clone(), terrain: args.terrain.clone(), dem: args.dem.clone() };
-    let server = http::Server::bind(args.host, args.port, served, threads)?;
+    if args.max_connections == 0 {
+        bail!("--max-connections = 0 must be at least 1");
+    }
+    let mut max_connections = args.max_connections;
+    if let Some(files) = conn::open_file_limit() {
+        let room = files.saturating_sub(conn::RESERVED_FDS).max(1);
+        if room < max_connections {
+            eprintln!(
+                "note: at most {room} connections (--max-connections {max_connections}): this process may open \
+                 {files} files (ulimit -n), {} of them kept for other uses",
+                conn::RESERVED_FDS
+            );
+            max_connections = room;
+        }
+    }
+    let limits = http::Limits {
+        conn: conn::ConnLimits {
+            header_timeout: seconds("header-timeout", args.header_timeout)?,
+            send_timeout: seconds("send-timeout", args.send_timeout)?,
+            max_connections,
+        },
+        threads,
+        light_threads: cores,
+        allowed_hosts: args.allow_host.clone(),
+    };
+    // Read everything the server will use now, so a bad file fails at start, not per request.
+    let served = api::Served::load(args.robot.clone(), args.terrain.clone(), args.dem.clone())?;
+    let server = http::Server::bind(args.host, args.port, served, limits)?;
     let url = format!("http://{}/", server.address());
     if !args.host.is_loopback() {
         eprintln!(

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Mutation fuzz of every reader and every command that reads a file, and of the Python
-# package's readers (issue 21; docs/robustness.md).
+# Mutation fuzz of every reader and every command that reads a file, of the Python
+# package's readers (issue 21), and of `sandslope serve` (issue 39: `serve-requests`, mutated
+# HTTP requests, and `serve-connections`, connection patterns, each under a load mix, with the
+# latencies printed); docs/robustness.md.
 #
 #   scripts/fuzz.sh N [TARGET...]     N mutated inputs per target (default 1000)
 #

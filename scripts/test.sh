@@ -47,7 +47,7 @@ echo "== pytest crates/sandslope-py/tests"
 SANDSLOPE_CLI="$root/target/debug/sandslope" "$py" -m pytest crates/sandslope-py/tests -q -p no:cacheprovider
 t4=$(seconds)
 
-echo "== fuzz, short pass: 200 mutated inputs per reader and command (scripts/fuzz.sh; docs/robustness.md)"
+echo "== fuzz, short pass: 200 mutated inputs per reader, command and server target (scripts/fuzz.sh; docs/robustness.md)"
 # Debug builds, already made by cargo test above; any panic, abort, hang or peak over 1 GiB fails.
 # Debug builds: the 10 s hang limit is for release builds, and a debug `report` takes about 8
 # times as long (2.3 s against 0.3 s on a mutated speeds table); on a machine shared with other

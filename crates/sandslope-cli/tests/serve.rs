@@ -1132,6 +1132,7 @@ fn raw(server: &Server, request: &str) -> (u16, String, Vec<u8>) {
 /// localhost, the address listened on and `--allow-host` names are accepted; an Origin other
 /// than the server's own gets 403, so a cross-site `text/plain` POST is not answered. HEAD is
 /// answered on every GET route with GET's status and length and no body (before: 405 on the API).
+/// A request head over 64 KiB is refused with 431.
 #[test]
 fn foreign_hosts_and_origins_are_refused_and_head_is_answered() {
     let server = Server::start(&["--allow-host", "robot-lab.example"]);
@@ -1178,6 +1179,18 @@ fn foreign_hosts_and_origins_are_refused_and_head_is_answered() {
     assert_eq!(post(&format!("http://{}", server.addr)).0, 200);
     let (status, _, _) = get("/api/predict?slope=10", &server.addr, "Origin: http://evil.example\r\n");
     assert_eq!(status, 403);
+    // A request head over 64 KiB: 431, however fast it arrives.
+    let big = format!(
+        "GET /api/predict?slope=10 HTTP/1.1\r\nHost: {}\r\nX-Pad: {}\r\n\r\n",
+        server.addr,
+        "a".repeat(100_000)
+    );
+    let mut s = TcpStream::connect(&server.addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
+    let _ = s.write_all(big.as_bytes());
+    let mut answer = String::new();
+    let _ = BufReader::new(&s).read_line(&mut answer);
+    assert!(answer.starts_with("HTTP/1.1 431"), "{answer:?}");
     // HEAD: GET's status and Content-Length, no body.
     for (path, want) in
         [("/api/predict?slope=10", 200), ("/", 200), ("/api/predict?slope=NaN", 400), ("/nothing", 404)]

@@ -13,6 +13,7 @@
 //! target had a panic, abort, hang or a peak above `--max-peak-mib`.
 
 mod mutate;
+mod serve;
 mod targets;
 
 use std::collections::BTreeMap;
@@ -122,7 +123,7 @@ fn parse(args: &[String]) -> Result<Options> {
     if o.targets.is_empty() {
         o.targets = TARGETS.iter().collect();
     }
-    if o.targets.iter().any(|t| matches!(t.run, Run::Command(_))) && !o.bin.is_file() {
+    if o.targets.iter().any(|t| matches!(t.run, Run::Command(_) | Run::Serve(_))) && !o.bin.is_file() {
         bail!("{}: no sandslope binary (build it, or give --bin)", o.bin.display());
     }
     Ok(o)
@@ -260,9 +261,15 @@ fn parent(o: &Options) -> Result<i32> {
     let mut any_failed = false;
     for target in &o.targets {
         let start = Instant::now();
+        let mut notes = Vec::new();
         let mut tally = match target.run {
             Run::Reader(_) => fuzz_reader(o, target)?,
             Run::Command(args) => fuzz_command(o, target, args)?,
+            Run::Serve(kind) => {
+                let (tally, lines) = serve::fuzz(o, target, kind)?;
+                notes = lines;
+                tally
+            }
         };
         tally.seconds = start.elapsed().as_secs_f64();
         let failed = tally.failed(o.max_peak_mib);
@@ -281,6 +288,9 @@ fn parent(o: &Options) -> Result<i32> {
             tally.seconds,
             codes.join(" ")
         );
+        for line in &notes {
+            println!("    {line}");
+        }
         for line in tally.panics.iter().chain(&tally.aborts).chain(&tally.hangs).chain(&tally.memory).take(10)
         {
             println!("    {line}");
@@ -567,7 +577,11 @@ fn emit(args: &[String]) -> Result<()> {
     let seeds = read_seeds(&repo, target)?;
     std::fs::create_dir_all(&dir)?;
     for i in from..to {
-        std::fs::write(dir.join(format!("{i}-{}", target.file_name)), input(&seeds, seed, i))?;
+        let data = match target.run {
+            Run::Serve(kind) => serve::emitted(kind, &seeds, seed, i),
+            _ => input(&seeds, seed, i),
+        };
+        std::fs::write(dir.join(format!("{i}-{}", target.file_name)), data)?;
     }
     Ok(())
 }

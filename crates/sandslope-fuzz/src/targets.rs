@@ -22,6 +22,8 @@ pub enum Run {
     /// The `sandslope` binary with these arguments; `{in}` is the input file, `{dir}` a fresh
     /// folder for outputs, `{repo}` the repository root.
     Command(&'static [&'static str]),
+    /// A running `sandslope serve`, fed requests or connection patterns (serve.rs).
+    Serve(crate::serve::Kind),
 }
 
 /// One fuzz target.
@@ -292,6 +294,20 @@ pub const TARGETS: &[Target] = &[
         file_name: "speeds.csv",
         companions: &[],
         run: Run::Command(&["report", "--observed", "{in}", "--out", "{dir}/report"]),
+    },
+    Target {
+        name: "serve-requests",
+        seeds: crate::serve::SEEDS,
+        file_name: "request.http",
+        companions: &[],
+        run: Run::Serve(crate::serve::Kind::Requests),
+    },
+    Target {
+        name: "serve-connections",
+        seeds: crate::serve::SEEDS,
+        file_name: "connection.bin",
+        companions: &[],
+        run: Run::Serve(crate::serve::Kind::Connections),
     },
 ];
 

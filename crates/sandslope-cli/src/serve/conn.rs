@@ -160,6 +160,8 @@ pub async fn accept_loop(listener: TcpListener, app: Arc<App>, limits: ConnLimit
         .timer(TokioTimer::new())
         .header_read_timeout(limits.header_timeout)
         .max_buf_size(MAX_HEAD)
+        // The exact limit: a head that arrives in one read can overshoot max_buf_size.
+        .max_header_size(MAX_HEAD)
         .keep_alive(true);
     let builder = Arc::new(builder);
     let mut backoff: Option<Duration> = None;

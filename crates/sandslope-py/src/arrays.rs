@@ -15,37 +15,7 @@ pub fn array<'py, T: numpy::Element>(py: Python<'py>, v: Vec<T>) -> Bound<'py, P
     PyArray1::from_vec(py, v)
 }
 
-/// An empty vector with room for `n` values, advised for transparent huge pages before
-/// anything touches it; the caller writes every value through `spare_capacity_mut` (in
-/// parallel, without zeroing first) and then sets the length.
-///
-/// Large outputs are where a phase map spends its time outside the model: a 2048 x 2048 map
-/// writes 36 MB into fresh memory, 9000 page faults with 4 KiB pages. Advised for transparent
-/// huge pages (2 MiB), the same buffer takes a few dozen faults.
-pub fn uninit<T>(n: usize) -> Vec<T> {
-    let mut v: Vec<T> = Vec::with_capacity(n);
-    advise_huge_pages(v.as_mut_ptr().cast(), n * std::mem::size_of::<T>());
-    v
-}
-
-/// Asks the kernel to back `[ptr, ptr + bytes)` with transparent huge pages where it covers
-/// whole 2 MiB pages (a hint: ignored where unsupported).
-fn advise_huge_pages(ptr: *mut u8, bytes: usize) {
-    const HUGE: usize = 2 << 20;
-    if bytes < 2 * HUGE {
-        return;
-    }
-    #[cfg(target_os = "linux")]
-    {
-        let start = (ptr as usize).next_multiple_of(HUGE);
-        let end = (ptr as usize + bytes) / HUGE * HUGE;
-        if end > start {
-            // SAFETY: the range lies inside one live allocation of this process; MADV_HUGEPAGE
-            // only changes how its pages are backed, never their contents.
-            unsafe { libc::madvise(start as *mut libc::c_void, end - start, libc::MADV_HUGEPAGE) };
-        }
-    }
-}
+pub use sandslope::memory::uninit;
 
 /// Puts `v` into `d` under `key` as a NumPy array.
 pub fn put<T: numpy::Element>(d: &Bound<'_, PyDict>, key: &str, v: Vec<T>) -> PyResult<()> {

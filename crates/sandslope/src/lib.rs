@@ -11,7 +11,8 @@
 //! back (`Regime::Slippage`); too weak in normal support `k_n` and its legs sink
 //! (`Regime::Sinkage`).
 //!
-//! This crate is pure physics and analysis: no file formats, no plotting, no CLI. Types are
+//! This crate is physics and analysis: no file formats, no plotting, no CLI; its one word to
+//! the operating system is a huge-page hint for large output buffers ([`memory`]). Types are
 //! validated once when built ([`Robot::new`], [`Terrain::new`], [`Slope::from_degrees`]) and
 //! trusted after.
 //!
@@ -41,6 +42,7 @@ pub mod gait;
 pub mod infer;
 pub mod limits;
 pub mod measure;
+pub mod memory;
 pub mod model;
 pub mod paper;
 pub mod phase;

@@ -183,29 +183,6 @@ fn build_nodes(
     nodes
 }
 
-/// `n` zeros, the buffer advised for transparent huge pages before it is first touched.
-///
-/// A large zeroed vector is fresh memory from the kernel, faulted in page by page when first
-/// written: `risk --map` 4096 x 4096 (two maps of 128 MiB) spent 0.17 s of its 0.5 s CPU time
-/// in the kernel with 4 KiB pages (`/usr/bin/time -v`, shared 2-core machine); advised for
-/// 2 MiB pages, 0.03 to 0.10 s, and the whole 1024 x 1024 run fell from 44 to 36 ms of CPU
-/// time (`perf stat`, 5 runs each). A hint: ignored where unsupported.
-fn zeroed(n: usize) -> Vec<f64> {
-    let mut v = vec![0.0; n];
-    #[cfg(target_os = "linux")]
-    {
-        const HUGE: usize = 2 << 20;
-        let (ptr, bytes) = (v.as_mut_ptr() as usize, n * std::mem::size_of::<f64>());
-        let (start, end) = (ptr.next_multiple_of(HUGE), (ptr + bytes) / HUGE * HUGE);
-        if end > start {
-            // SAFETY: [start, end) lies inside the live allocation of `v`; MADV_HUGEPAGE only
-            // changes how its pages are backed, never their contents.
-            unsafe { libc::madvise(start as *mut libc::c_void, end - start, libc::MADV_HUGEPAGE) };
-        }
-    }
-    v
-}
-
 /// `(p_fail, p_not_success)` of a cell: `P(sinkage)` plus the conditional integrals
 /// `[P(slip, not sunk), P(not success, not sunk)]`, clamped to what is consistent.
 fn finish(sink: f64, slip: f64, not_success: f64) -> (f64, f64) {
@@ -664,8 +641,8 @@ impl RiskMap {
             Columns::new(robot, slope, &mu_n, &mu_s, x_star, uncertainty, blocks.columns)
         };
 
-        let mut p_fail = zeroed(nx * ny);
-        let mut p_not_success = zeroed(nx * ny);
+        let mut p_fail = crate::memory::zeroed(nx * ny);
+        let mut p_not_success = crate::memory::zeroed(nx * ny);
         if let (false, Columns::Spread { nodes, blocks: column_blocks }) = (beyond_repose, &columns) {
             if sigma_s > 0.0 {
                 banded_product(

@@ -27,6 +27,7 @@ pub mod curve;
 pub mod failure_probability;
 pub mod limits;
 pub mod map;
+mod panels;
 pub mod quadrature;
 pub mod results;
 pub mod uncertainty;

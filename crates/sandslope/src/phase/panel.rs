@@ -1,0 +1,120 @@
+//! One panel of a phase diagram: the map of one robot at one slope with the terrain's own
+//! `(k_n, k_s)` there and the sinkage and anchoring thresholds drawn with it, and the panel
+//! without its cells, as `sandslope phase --json` prints it.
+
+use serde::Serialize;
+
+use super::{PhaseMap, RegimeCounts};
+use crate::axis::Axis;
+use crate::error::ParamError;
+use crate::regime::Regime;
+use crate::robot::Robot;
+use crate::slope::Slope;
+use crate::terrain::{Ground, Terrain};
+
+/// One panel of a phase diagram: the map of one robot mass at one slope, with the terrain's
+/// own (k_n, k_s) at that slope and the thresholds drawn and reported with it.
+#[derive(Debug, Clone, Serialize)]
+pub struct PhasePanel {
+    /// Slope, degrees, as requested (a negative slope is evaluated as its magnitude).
+    pub slope_deg: f64,
+    /// Total robot mass, kg.
+    pub mass_kg: f64,
+    /// The regime of every grid cell.
+    pub map: PhaseMap,
+    /// The terrain's k_n at this slope, N/m^3.
+    pub terrain_k_n: f64,
+    /// The terrain's k_s at this slope, N/m^3.
+    pub terrain_k_s: f64,
+    /// The regime of the robot on the terrain's own (k_n, k_s).
+    pub terrain_regime: Regime,
+    /// Below this k_n the legs sink (docs/model.md §3), N/m^3.
+    pub sinkage_threshold_k_n: f64,
+    /// Below this k_s the legs never anchor (docs/model.md §4), N/m^3.
+    pub anchoring_threshold_k_s: f64,
+}
+
+impl PhasePanel {
+    /// The panel of `robot` at `slope_deg` (in (-90, 90); negative slopes are evaluated as
+    /// their magnitude) on `terrain`, over `k_n_axis x k_s_axis`. `row_done` as in
+    /// [`PhaseMap::compute`]. Errors name the key `slope_deg`.
+    pub fn compute(
+        robot: &Robot,
+        slope_deg: f64,
+        terrain: &Terrain,
+        k_n_axis: &Axis,
+        k_s_axis: &Axis,
+        row_done: &(dyn Fn() + Sync),
+    ) -> Result<PhasePanel, ParamError> {
+        let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+        let map = PhaseMap::compute(robot, slope, terrain.repose(), k_n_axis, k_s_axis, row_done);
+        let g: Ground = terrain.at(slope);
+        Ok(PhasePanel {
+            slope_deg,
+            mass_kg: robot.mass(),
+            map,
+            terrain_k_n: g.k_n,
+            terrain_k_s: g.k_s,
+            terrain_regime: crate::model::predict(robot, slope, &g).regime,
+            sinkage_threshold_k_n: crate::model::sinkage_threshold_k_n(robot, slope),
+            anchoring_threshold_k_s: crate::model::anchoring_threshold_k_s(robot, slope),
+        })
+    }
+}
+
+/// The terrain's ground on a phase panel: its `(k_n, k_s)` at the panel's slope and the
+/// robot's regime there.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PanelGround {
+    /// The terrain's k_n at the panel's slope, N/m^3.
+    pub k_n: f64,
+    /// The terrain's k_s at the panel's slope, N/m^3.
+    pub k_s: f64,
+    /// The robot's regime on that ground.
+    pub regime: Regime,
+}
+
+/// A phase panel without its cells: what `sandslope phase --json` prints per panel (and the
+/// explorer's `/api/phase` returns).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PanelSummary {
+    /// Slope, degrees, as requested.
+    pub slope_deg: f64,
+    /// Total robot mass, kg.
+    pub mass_kg: f64,
+    /// The grid's k_n axis.
+    pub k_n_axis: Axis,
+    /// The grid's k_s axis.
+    pub k_s_axis: Axis,
+    /// Cells per regime.
+    pub counts: RegimeCounts,
+    /// The terrain's own point and its regime.
+    pub terrain: PanelGround,
+    /// Below this k_n the legs sink (docs/model.md §3), N/m^3.
+    pub sinkage_threshold_k_n: f64,
+    /// Below this k_s the legs never anchor (docs/model.md §4), N/m^3.
+    pub anchoring_threshold_k_s: f64,
+    /// Whether the slope is at or beyond the terrain's angle of repose (every cell slips).
+    pub beyond_repose: bool,
+}
+
+impl PhasePanel {
+    /// The panel without its cells ([`PanelSummary`]).
+    pub fn summary(&self) -> PanelSummary {
+        PanelSummary {
+            slope_deg: self.slope_deg,
+            mass_kg: self.mass_kg,
+            k_n_axis: *self.map.k_n_axis(),
+            k_s_axis: *self.map.k_s_axis(),
+            counts: self.map.counts(),
+            terrain: PanelGround {
+                k_n: self.terrain_k_n,
+                k_s: self.terrain_k_s,
+                regime: self.terrain_regime,
+            },
+            sinkage_threshold_k_n: self.sinkage_threshold_k_n,
+            anchoring_threshold_k_s: self.anchoring_threshold_k_s,
+            beyond_repose: self.map.beyond_repose(),
+        }
+    }
+}

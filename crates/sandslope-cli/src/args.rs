@@ -296,25 +296,57 @@ pub fn check_positive(flag: &str, value: f64) -> Result<f64> {
     }
 }
 
-/// Parses a grid axis `MIN:MAX:N[:log|:lin]` given to `flag` (log spacing by default).
+/// Parses a grid axis `MIN:MAX:N[:log|:lin]` given to `flag` (log spacing by default: the
+/// strengths k_n and k_s span decades).
 pub fn parse_axis(flag: &str, text: &str) -> Result<Axis> {
+    let range = parse_axis_range(text, AxisScale::Log, &format!("{flag}:"), text)?.ok_or_else(|| {
+        anyhow!("{flag} = {text} must be MIN:MAX:N or MIN:MAX:N:log or MIN:MAX:N:lin (e.g. 1e4:1e7:400)")
+    })?;
+    Axis::new(flag, range.min, range.max, range.n, range.scale).map_err(|e| anyhow!("{e}"))
+}
+
+/// The numbers of an axis `MIN:MAX:N[:log|:lin]`, before the library checks their ranges.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AxisRange {
+    /// First value.
+    pub min: f64,
+    /// Last value.
+    pub max: f64,
+    /// Number of values (at least 2).
+    pub n: usize,
+    /// Spacing.
+    pub scale: AxisScale,
+}
+
+/// The one grammar of a grid axis on the command line, `MIN:MAX:N[:log|:lin]`, for every flag
+/// that takes one (`--k-n`, `--k-s`, `design --vary KEY=...`); `default` is the spacing when
+/// none is written, stated by each use (log for strengths, linear for robot quantities).
+/// `None` when `text` is not of that shape (each use names its own forms); errors begin with
+/// `prefix` and quote `context`.
+pub fn parse_axis_range(
+    text: &str,
+    default: AxisScale,
+    prefix: &str,
+    context: &str,
+) -> Result<Option<AxisRange>> {
     let parts: Vec<&str> = text.split(':').map(str::trim).collect();
     if !(3..=4).contains(&parts.len()) {
-        bail!("{flag} = {text} must be MIN:MAX:N or MIN:MAX:N:log or MIN:MAX:N:lin (e.g. 1e4:1e7:400)");
+        return Ok(None);
     }
     let number = |what: &str, s: &str| -> Result<f64> {
-        s.parse::<f64>().map_err(|_| anyhow!("{flag}: {what} `{s}` is not a number (in {text})"))
+        s.parse::<f64>().map_err(|_| anyhow!("{prefix} {what} `{s}` is not a number (in {context})"))
     };
     let (min, max) = (number("MIN", parts[0])?, number("MAX", parts[1])?);
-    let n: usize = parts[2]
-        .parse()
-        .map_err(|_| anyhow!("{flag}: N `{}` must be a whole number of at least 2 (in {text})", parts[2]))?;
+    let n: usize = parts[2].parse().ok().filter(|&n| n >= 2).ok_or_else(|| {
+        anyhow!("{prefix} N `{}` must be a whole number of at least 2 (in {context})", parts[2])
+    })?;
     let scale = match parts.get(3).map(|s| s.to_ascii_lowercase()).as_deref() {
-        None | Some("log") => AxisScale::Log,
+        None => default,
+        Some("log") => AxisScale::Log,
         Some("lin") | Some("linear") => AxisScale::Linear,
-        Some(other) => bail!("{flag}: spacing `{other}` must be `log` or `lin` (in {text})"),
+        Some(other) => bail!("{prefix} spacing `{other}` must be `log` or `lin` (in {context})"),
     };
-    Axis::new(flag, min, max, n, scale).map_err(|e| anyhow!("{e}"))
+    Ok(Some(AxisRange { min, max, n, scale }))
 }
 
 /// A log axis from `lo / down` to `hi * up` around positive terrain values, with `n` points.

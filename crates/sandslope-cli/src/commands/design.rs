@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use serde::Serialize;
 
@@ -14,7 +14,7 @@ use sandslope::design::{explore, Design, DesignGoal, DesignKey, DesignRange, Des
 use sandslope::risk::SafeLimit;
 use sandslope::{AxisScale, Slope};
 
-use crate::args::{parse_max_risk, RobotArgs, TerrainArgs, UncertaintyArgs};
+use crate::args::{parse_axis_range, parse_max_risk, RobotArgs, TerrainArgs, UncertaintyArgs};
 use crate::figures::design::{DesignFigure, SafeSlopeMap};
 use crate::figures::{format_of, save};
 use crate::output::{check_parent_exists, num, print_json, table, write_atomic};
@@ -59,27 +59,16 @@ pub fn parse_vary_item(item: &str) -> Result<DesignRange> {
         .split_once('=')
         .ok_or_else(|| anyhow!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"))?;
     let key = DesignKey::from_name(key.trim()).map_err(|e| anyhow!("--vary: {e}"))?;
-    let parts: Vec<&str> = range.split(':').map(str::trim).collect();
-    let number = |what: &str, s: &str| -> Result<f64> {
-        s.parse::<f64>().map_err(|_| anyhow!("--vary: {key} {what} `{s}` is not a number (in {item})"))
-    };
-    let (min, max, n, scale) = match parts.as_slice() {
-        [v] => {
-            let v = number("value", v)?;
-            (v, v, 1, AxisScale::Linear)
-        }
-        [lo, hi, n, rest @ ..] if rest.len() <= 1 => {
-            let n: usize = n.parse().ok().filter(|&n| n >= 2).ok_or_else(|| {
-                anyhow!("--vary: {key} N `{n}` must be a whole number of at least 2 (in {item})")
-            })?;
-            let scale = match rest.first().map(|s| s.to_ascii_lowercase()).as_deref() {
-                None | Some("lin") | Some("linear") => AxisScale::Linear,
-                Some("log") => AxisScale::Log,
-                Some(other) => bail!("--vary: {key} spacing `{other}` must be `log` or `lin` (in {item})"),
-            };
-            (number("MIN", lo)?, number("MAX", hi)?, n, scale)
-        }
-        _ => bail!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"),
+    // Robot quantities vary over less than a decade: linear spacing unless `:log` is written.
+    let (min, max, n, scale) = if range.contains(':') {
+        let r = parse_axis_range(range, AxisScale::Linear, &format!("--vary: {key}"), item)?
+            .ok_or_else(|| anyhow!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"))?;
+        (r.min, r.max, r.n, r.scale)
+    } else {
+        let v = range.trim();
+        let v =
+            v.parse::<f64>().map_err(|_| anyhow!("--vary: {key} value `{v}` is not a number (in {item})"))?;
+        (v, v, 1, AxisScale::Linear)
     };
     DesignRange::new(key, min, max, n, scale).map_err(|e| anyhow!("--vary: {e}"))
 }

@@ -7,6 +7,7 @@ use clap::Args;
 use sandslope::{LevelStep, Robot, Scenario, Slope, Terrain};
 
 use sandslope::risk::UncertainTerrain;
+use sandslope::robot_key::RobotKey;
 use sandslope::{Axis, AxisScale};
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 use sandslope_io::{load_robot, load_terrain};
@@ -133,28 +134,25 @@ pub struct RobotQuantityArgs {
 }
 
 impl RobotQuantityArgs {
-    /// `robot` with the given quantities replaced, validated again as a whole.
+    /// `robot` with the given quantities replaced, validated again as a whole; an error on
+    /// one of these keys names its flag (from the library's table, [`RobotKey::flag`]).
     pub fn apply(&self, robot: Robot) -> Result<Robot> {
         let mut spec = robot.spec().clone();
-        let flags = [
-            ("leg_radius_m", "--leg-radius", self.leg_radius, &mut spec.leg_radius_m),
-            ("leg_width_m", "--leg-width", self.leg_width, &mut spec.leg_width_m),
-            ("hip_height_m", "--hip-height", self.hip_height, &mut spec.hip_height_m),
-            ("leg_speed_rad_s", "--leg-speed", self.leg_speed, &mut spec.leg_speed_rad_s),
-            ("response_time_s", "--response-time", self.response_time, &mut spec.response_time_s),
+        let given = [
+            (RobotKey::LegRadiusM, self.leg_radius),
+            (RobotKey::LegWidthM, self.leg_width),
+            (RobotKey::HipHeightM, self.hip_height),
+            (RobotKey::LegSpeedRadS, self.leg_speed),
+            (RobotKey::StanceLegs, self.stance_legs.map(f64::from)),
+            (RobotKey::ResponseTimeS, self.response_time),
         ];
-        let mut names = vec![("stance_legs", "--stance-legs")];
-        for (key, flag, value, slot) in flags {
+        for (key, value) in given {
             if let Some(v) = value {
-                *slot = v;
+                key.set(&mut spec, v);
             }
-            names.push((key, flag));
-        }
-        if let Some(n) = self.stance_legs {
-            spec.stance_legs = n;
         }
         Robot::new(spec).map_err(|e| {
-            let flag = names.iter().find(|(key, _)| *key == e.key).map(|(_, flag)| *flag);
+            let flag = given.iter().find(|(key, _)| key.name() == e.key).and_then(|(key, _)| key.flag());
             match flag {
                 Some(flag) => anyhow!("{}", e.renamed(flag)),
                 None => anyhow!("{e}"),

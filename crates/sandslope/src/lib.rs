@@ -51,6 +51,7 @@ pub mod regime;
 pub mod report;
 pub mod risk;
 pub mod robot;
+pub mod robot_key;
 pub mod scenario;
 pub mod simulate;
 pub mod slope;

@@ -10,8 +10,9 @@ use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use serde::Serialize;
 
-use sandslope::design::{explore, Design, DesignGoal, DesignKey, DesignRange, DesignSpace, DesignStudy};
+use sandslope::design::{design_key, explore, Design, DesignGoal, DesignRange, DesignSpace, DesignStudy};
 use sandslope::risk::SafeLimit;
+use sandslope::robot_key::RobotKey;
 use sandslope::{AxisScale, Slope};
 
 use crate::args::{parse_axis_range, parse_max_risk, RobotArgs, TerrainArgs, UncertaintyArgs};
@@ -58,7 +59,7 @@ pub fn parse_vary_item(item: &str) -> Result<DesignRange> {
     let (key, range) = item
         .split_once('=')
         .ok_or_else(|| anyhow!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"))?;
-    let key = DesignKey::from_name(key.trim()).map_err(|e| anyhow!("--vary: {e}"))?;
+    let key = design_key(key.trim()).map_err(|e| anyhow!("--vary: {e}"))?;
     // Robot quantities vary over less than a decade: linear spacing unless `:log` is written.
     let (min, max, n, scale) = if range.contains(':') {
         let r = parse_axis_range(range, AxisScale::Linear, &format!("--vary: {key}"), item)?
@@ -109,7 +110,7 @@ fn limit_kind(l: &SafeLimit) -> &'static str {
     }
 }
 
-fn record(keys: &[DesignKey], d: &Design) -> DesignRecord {
+fn record(keys: &[RobotKey], d: &Design) -> DesignRecord {
     let params = keys.iter().zip(&d.params).map(|(k, v)| (k.name(), *v)).collect();
     match &d.outcome {
         Ok(p) => DesignRecord {

@@ -40,6 +40,14 @@ pub enum CalibrationError {
         /// What is wrong.
         reason: String,
     },
+    /// A robot key no calibration can free (a whole number, or one no observation depends on).
+    #[error("{name} cannot be freed; the parameters that can: {fittable}")]
+    NotFittable {
+        /// The key.
+        name: String,
+        /// The parameters that can be freed, comma-separated.
+        fittable: String,
+    },
     /// A parameter freed twice.
     #[error("{name} is freed twice")]
     DuplicateParameter {

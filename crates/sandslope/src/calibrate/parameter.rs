@@ -1,73 +1,16 @@
 //! What a calibration may fit: the robot keys and other quantities a user frees
 //! ([`Parameter`]), and every quantity a fit reports ([`Quantity`]), each with its name and unit.
 
-use serde::{Deserialize, Serialize};
-
 use super::ShearLaw;
 use crate::model::{level_step_length, normal_equilibrium_depth};
 use crate::robot::{Robot, RobotSpec};
 use crate::slope::Slope;
 
-/// A continuous robot key that a calibration may free (docs/model.md §2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RobotKey {
-    /// `mass_kg`.
-    MassKg,
-    /// `leg_radius_m`.
-    LegRadiusM,
-    /// `leg_width_m`.
-    LegWidthM,
-    /// `hip_height_m`.
-    HipHeightM,
-    /// `leg_speed_rad_s`.
-    LegSpeedRadS,
-    /// `response_time_s`.
-    ResponseTimeS,
-    /// `leg_contact_area_m2`.
-    LegContactAreaM2,
-    /// `level_step_m`.
-    LevelStepM,
-}
+pub use crate::robot_key::RobotKey;
 
+/// What calibration adds to the table of robot keys ([`crate::robot_key`]): the search of a
+/// freed key ([`RobotKey::FITTABLE`]).
 impl RobotKey {
-    /// Every key, in file order.
-    pub const ALL: [RobotKey; 8] = [
-        RobotKey::MassKg,
-        RobotKey::LegRadiusM,
-        RobotKey::LegWidthM,
-        RobotKey::HipHeightM,
-        RobotKey::LegSpeedRadS,
-        RobotKey::ResponseTimeS,
-        RobotKey::LegContactAreaM2,
-        RobotKey::LevelStepM,
-    ];
-
-    /// The file key.
-    pub fn name(self) -> &'static str {
-        match self {
-            RobotKey::MassKg => "mass_kg",
-            RobotKey::LegRadiusM => "leg_radius_m",
-            RobotKey::LegWidthM => "leg_width_m",
-            RobotKey::HipHeightM => "hip_height_m",
-            RobotKey::LegSpeedRadS => "leg_speed_rad_s",
-            RobotKey::ResponseTimeS => "response_time_s",
-            RobotKey::LegContactAreaM2 => "leg_contact_area_m2",
-            RobotKey::LevelStepM => "level_step_m",
-        }
-    }
-
-    /// The unit of the key's value.
-    pub fn unit(self) -> &'static str {
-        match self {
-            RobotKey::MassKg => "kg",
-            RobotKey::LegSpeedRadS => "rad/s",
-            RobotKey::ResponseTimeS => "s",
-            RobotKey::LegContactAreaM2 => "m^2",
-            _ => "m",
-        }
-    }
-
     /// Default search bounds around a robot.
     pub(crate) fn default_bounds(self, spec: &RobotSpec) -> (f64, f64) {
         let r = spec.leg_radius_m;
@@ -79,7 +22,9 @@ impl RobotKey {
             RobotKey::LegSpeedRadS => (0.1, 100.0),
             RobotKey::ResponseTimeS => (0.01, 2.0),
             RobotKey::LegContactAreaM2 => (1e-6, 1e-2),
-            RobotKey::LevelStepM => (1e-3, 2.0 * r),
+            RobotKey::LevelStepM | RobotKey::MinStepM => (1e-3, 2.0 * r),
+            // Never searched: `free_unknown` refuses keys outside `RobotKey::FITTABLE`.
+            RobotKey::StanceLegs => (1.0, 6.0),
         }
     }
 
@@ -89,33 +34,22 @@ impl RobotKey {
     }
 
     /// The key's value for `robot` (the level step at `k_n_level` unless measured).
-    pub(crate) fn get(self, robot: &Robot, k_n_level: f64) -> f64 {
+    pub(crate) fn value_for(self, robot: &Robot, k_n_level: f64) -> f64 {
         match self {
             RobotKey::MassKg => robot.mass(),
             RobotKey::LegRadiusM => robot.leg_radius(),
             RobotKey::LegWidthM => robot.leg_width(),
             RobotKey::HipHeightM => robot.hip_height(),
             RobotKey::LegSpeedRadS => robot.leg_speed(),
+            RobotKey::StanceLegs => f64::from(robot.stance_legs()),
             RobotKey::ResponseTimeS => robot.response_time(),
             RobotKey::LegContactAreaM2 => robot.contact_area(),
+            RobotKey::MinStepM => robot.min_step(),
             RobotKey::LevelStepM => level_step_length(
                 robot,
                 Slope::LEVEL,
                 normal_equilibrium_depth(robot, Slope::LEVEL, k_n_level),
             ),
-        }
-    }
-
-    pub(crate) fn set(self, spec: &mut RobotSpec, v: f64) {
-        match self {
-            RobotKey::MassKg => spec.mass_kg = v,
-            RobotKey::LegRadiusM => spec.leg_radius_m = v,
-            RobotKey::LegWidthM => spec.leg_width_m = v,
-            RobotKey::HipHeightM => spec.hip_height_m = v,
-            RobotKey::LegSpeedRadS => spec.leg_speed_rad_s = v,
-            RobotKey::ResponseTimeS => spec.response_time_s = v,
-            RobotKey::LegContactAreaM2 => spec.leg_contact_area_m2 = Some(v),
-            RobotKey::LevelStepM => spec.level_step_m = Some(v),
         }
     }
 }
@@ -138,13 +72,13 @@ impl Parameter {
         match name {
             "plate_scale" => Some(Parameter::PlateScale),
             "error_floor" => Some(Parameter::ErrorFloor),
-            _ => RobotKey::ALL.into_iter().find(|k| k.name() == name).map(Parameter::Robot),
+            _ => RobotKey::FITTABLE.into_iter().find(|k| k.name() == name).map(Parameter::Robot),
         }
     }
 
     /// Every name [`Parameter::parse`] accepts, comma-separated (for error messages).
     pub fn names() -> String {
-        let mut v: Vec<&str> = RobotKey::ALL.iter().map(|k| k.name()).collect();
+        let mut v: Vec<&str> = RobotKey::FITTABLE.iter().map(|k| k.name()).collect();
         v.extend(["plate_scale", "error_floor"]);
         v.join(", ")
     }

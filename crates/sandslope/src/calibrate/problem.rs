@@ -4,7 +4,9 @@
 use super::evidence::{check_anchoring, check_speeds};
 use super::inversion::shear_strength_for_speed;
 use super::model::{check_free_for_simulator, SimulatedModel, SpeedModel, Walked, MIN_SIMULATED_K_S};
-use super::{CalibrationError, JointSetup, ObservationKind, Parameter, Pull, Quantity, ShearLaw, ShearShape};
+use super::{
+    CalibrationError, JointSetup, ObservationKind, Parameter, Pull, Quantity, RobotKey, ShearLaw, ShearShape,
+};
 use crate::model::{continued_anchoring_time, continued_speed, level_step_length, normal_equilibrium_depth};
 use crate::robot::Robot;
 use crate::slope::Slope;
@@ -291,9 +293,15 @@ fn free_unknown(
     bounds: Option<(f64, f64)>,
 ) -> Result<Unknown, CalibrationError> {
     let (default, log, start) = match parameter {
+        Parameter::Robot(k) if !RobotKey::FITTABLE.contains(&k) => {
+            return Err(CalibrationError::NotFittable {
+                name: k.name().to_string(),
+                fittable: Parameter::names(),
+            });
+        }
         Parameter::Robot(k) => {
             let k_n_level = setup.normal.at(Slope::LEVEL).k_n;
-            (k.default_bounds(setup.robot.spec()), k.is_scale(), k.get(&setup.robot, k_n_level))
+            (k.default_bounds(setup.robot.spec()), k.is_scale(), k.value_for(&setup.robot, k_n_level))
         }
         Parameter::PlateScale => {
             if !matches!(setup.shear, ShearShape::ForceTests(_)) {

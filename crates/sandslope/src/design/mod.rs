@@ -29,110 +29,16 @@ use crate::regime::Regime;
 use crate::risk::limits::{safe_slope_search, ReportedPFail};
 use crate::risk::{p_fail, SafeLimit, UncertainTerrain};
 use crate::robot::{Robot, RobotSpec};
+use crate::robot_key::RobotKey;
 use crate::slope::Slope;
 
-/// A robot key that a design study can vary (the robot file keys of docs/model.md §2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum DesignKey {
-    /// `mass_kg`.
-    MassKg,
-    /// `leg_radius_m`.
-    LegRadiusM,
-    /// `leg_width_m`.
-    LegWidthM,
-    /// `hip_height_m`.
-    HipHeightM,
-    /// `leg_speed_rad_s`.
-    LegSpeedRadS,
-    /// `stance_legs` (whole numbers only).
-    StanceLegs,
-    /// `response_time_s`.
-    ResponseTimeS,
-    /// `leg_contact_area_m2`.
-    LegContactAreaM2,
-    /// `level_step_m`.
-    LevelStepM,
-    /// `min_step_m`.
-    MinStepM,
-}
-
-impl DesignKey {
-    /// Every key, in the order of docs/model.md §2.
-    pub const ALL: [DesignKey; 10] = [
-        DesignKey::MassKg,
-        DesignKey::LegRadiusM,
-        DesignKey::LegWidthM,
-        DesignKey::HipHeightM,
-        DesignKey::LegSpeedRadS,
-        DesignKey::StanceLegs,
-        DesignKey::ResponseTimeS,
-        DesignKey::LegContactAreaM2,
-        DesignKey::LevelStepM,
-        DesignKey::MinStepM,
-    ];
-
-    /// The robot file key.
-    pub fn name(self) -> &'static str {
-        match self {
-            DesignKey::MassKg => "mass_kg",
-            DesignKey::LegRadiusM => "leg_radius_m",
-            DesignKey::LegWidthM => "leg_width_m",
-            DesignKey::HipHeightM => "hip_height_m",
-            DesignKey::LegSpeedRadS => "leg_speed_rad_s",
-            DesignKey::StanceLegs => "stance_legs",
-            DesignKey::ResponseTimeS => "response_time_s",
-            DesignKey::LegContactAreaM2 => "leg_contact_area_m2",
-            DesignKey::LevelStepM => "level_step_m",
-            DesignKey::MinStepM => "min_step_m",
-        }
-    }
-
-    /// The key named `name`, or an error listing the valid keys.
-    pub fn from_name(name: &str) -> Result<DesignKey, DesignError> {
-        DesignKey::ALL.into_iter().find(|k| k.name() == name).ok_or_else(|| DesignError::UnknownKey {
-            key: name.to_string(),
-            valid: DesignKey::ALL.iter().map(|k| k.name()).collect::<Vec<_>>().join(", "),
-        })
-    }
-
-    /// The template's value of this key (`None` for an optional key it leaves to its default).
-    pub fn get(self, spec: &RobotSpec) -> Option<f64> {
-        match self {
-            DesignKey::MassKg => Some(spec.mass_kg),
-            DesignKey::LegRadiusM => Some(spec.leg_radius_m),
-            DesignKey::LegWidthM => Some(spec.leg_width_m),
-            DesignKey::HipHeightM => Some(spec.hip_height_m),
-            DesignKey::LegSpeedRadS => Some(spec.leg_speed_rad_s),
-            DesignKey::StanceLegs => Some(f64::from(spec.stance_legs)),
-            DesignKey::ResponseTimeS => Some(spec.response_time_s),
-            DesignKey::LegContactAreaM2 => spec.leg_contact_area_m2,
-            DesignKey::LevelStepM => spec.level_step_m,
-            DesignKey::MinStepM => spec.min_step_m,
-        }
-    }
-
-    fn set(self, spec: &mut RobotSpec, value: f64) {
-        match self {
-            DesignKey::MassKg => spec.mass_kg = value,
-            DesignKey::LegRadiusM => spec.leg_radius_m = value,
-            DesignKey::LegWidthM => spec.leg_width_m = value,
-            DesignKey::HipHeightM => spec.hip_height_m = value,
-            DesignKey::LegSpeedRadS => spec.leg_speed_rad_s = value,
-            // Range values are checked to be whole numbers >= 1 in DesignRange::new.
-            DesignKey::StanceLegs => spec.stance_legs = value as u32,
-            DesignKey::ResponseTimeS => spec.response_time_s = value,
-            DesignKey::LegContactAreaM2 => spec.leg_contact_area_m2 = Some(value),
-            DesignKey::LevelStepM => spec.level_step_m = Some(value),
-            DesignKey::MinStepM => spec.min_step_m = Some(value),
-        }
-    }
-}
-
-impl fmt::Display for DesignKey {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
+/// The robot key named `name` (any key of docs/model.md §2 can be varied), or an error
+/// listing the valid keys.
+pub fn design_key(name: &str) -> Result<RobotKey, DesignError> {
+    RobotKey::from_name(name).ok_or_else(|| DesignError::UnknownKey {
+        key: name.to_string(),
+        valid: RobotKey::ALL.iter().map(|k| k.name()).collect::<Vec<_>>().join(", "),
+    })
 }
 
 /// Why a design study cannot be set up.
@@ -146,7 +52,7 @@ pub enum DesignError {
         valid: String,
     },
     /// A key varied twice.
-    DuplicateKey(DesignKey),
+    DuplicateKey(RobotKey),
     /// A range that is empty, reversed, not finite, or not positive on a log scale.
     BadRange(ParamError),
     /// More designs than [`MAX_DESIGNS`].
@@ -182,7 +88,7 @@ pub const MAX_DESIGNS: usize = 1 << 21;
 /// The values one key takes: `n` points from `min` to `max`, evenly spaced or log-spaced.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DesignRange {
-    key: DesignKey,
+    key: RobotKey,
     values: Vec<f64>,
 }
 
@@ -191,7 +97,7 @@ impl DesignRange {
     /// it). Finite, `min <= max`, `min > 0` on a log scale; `stance_legs` values must be whole
     /// numbers of at least 1.
     pub fn new(
-        key: DesignKey,
+        key: RobotKey,
         min: f64,
         max: f64,
         n: usize,
@@ -232,7 +138,7 @@ impl DesignRange {
                 })
             })
             .collect();
-        if key == DesignKey::StanceLegs {
+        if key == RobotKey::StanceLegs {
             if let Some(&v) =
                 values.iter().find(|v| v.fract() != 0.0 || **v < 1.0 || **v > f64::from(u32::MAX))
             {
@@ -247,7 +153,7 @@ impl DesignRange {
     }
 
     /// The key varied.
-    pub fn key(&self) -> DesignKey {
+    pub fn key(&self) -> RobotKey {
         self.key
     }
 
@@ -395,7 +301,7 @@ pub struct Design {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DesignStudy {
     /// The keys varied, in the order of every design's `params`.
-    pub keys: Vec<DesignKey>,
+    pub keys: Vec<RobotKey>,
     /// Largest acceptable failure probability.
     pub max_risk: f64,
     /// Target slope, degrees.
@@ -571,17 +477,17 @@ mod tests {
 
     #[test]
     fn keys_ranges_and_space() {
-        let e = DesignKey::from_name("legs").unwrap_err().to_string();
+        let e = design_key("legs").unwrap_err().to_string();
         assert!(e.contains("legs") && e.contains("mass_kg") && e.contains("min_step_m"), "{e}");
-        let r = DesignRange::new(DesignKey::MassKg, 0.1, 10.0, 3, AxisScale::Log).unwrap();
+        let r = DesignRange::new(RobotKey::MassKg, 0.1, 10.0, 3, AxisScale::Log).unwrap();
         assert_eq!(r.values(), [0.1, 1.0, 10.0]);
-        let h = DesignRange::new(DesignKey::HipHeightM, 0.0, 0.06, 13, AxisScale::Linear).unwrap();
+        let h = DesignRange::new(RobotKey::HipHeightM, 0.0, 0.06, 13, AxisScale::Linear).unwrap();
         assert_eq!((h.values()[12], h.values()[7]), (0.06, 0.035));
-        assert!(DesignRange::new(DesignKey::MassKg, 1.0, 0.5, 3, AxisScale::Linear).is_err());
-        assert!(DesignRange::new(DesignKey::MassKg, 0.0, 1.0, 3, AxisScale::Log).is_err());
-        assert!(DesignRange::new(DesignKey::StanceLegs, 2.0, 4.0, 4, AxisScale::Linear).is_err());
-        let legs = DesignRange::new(DesignKey::StanceLegs, 2.0, 4.0, 3, AxisScale::Linear).unwrap();
-        let mass = DesignRange::new(DesignKey::MassKg, 0.3, 0.5, 2, AxisScale::Linear).unwrap();
+        assert!(DesignRange::new(RobotKey::MassKg, 1.0, 0.5, 3, AxisScale::Linear).is_err());
+        assert!(DesignRange::new(RobotKey::MassKg, 0.0, 1.0, 3, AxisScale::Log).is_err());
+        assert!(DesignRange::new(RobotKey::StanceLegs, 2.0, 4.0, 4, AxisScale::Linear).is_err());
+        let legs = DesignRange::new(RobotKey::StanceLegs, 2.0, 4.0, 3, AxisScale::Linear).unwrap();
+        let mass = DesignRange::new(RobotKey::MassKg, 0.3, 0.5, 2, AxisScale::Linear).unwrap();
         let space = DesignSpace::new(RobotSpec::paper_hexapod(), vec![legs.clone(), mass.clone()]).unwrap();
         assert_eq!(space.len(), 6);
         // First range slowest: design 3 is (legs 3, mass 0.5).
@@ -622,8 +528,8 @@ mod tests {
         let space = DesignSpace::new(
             RobotSpec::paper_hexapod(),
             vec![
-                DesignRange::new(DesignKey::HipHeightM, 0.02, 0.09, 3, AxisScale::Linear).unwrap(),
-                DesignRange::new(DesignKey::MassKg, 0.3, 1.5, 3, AxisScale::Linear).unwrap(),
+                DesignRange::new(RobotKey::HipHeightM, 0.02, 0.09, 3, AxisScale::Linear).unwrap(),
+                DesignRange::new(RobotKey::MassKg, 0.3, 1.5, 3, AxisScale::Linear).unwrap(),
             ],
         )
         .unwrap();

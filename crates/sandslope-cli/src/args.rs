@@ -310,7 +310,7 @@ pub struct AxisRange {
     pub min: f64,
     /// Last value.
     pub max: f64,
-    /// Number of values (at least 2).
+    /// Number of values, as written (each use checks it is at least 2).
     pub n: usize,
     /// Spacing.
     pub scale: AxisScale,
@@ -335,7 +335,8 @@ pub fn parse_axis_range(
         s.parse::<f64>().map_err(|_| anyhow!("{prefix} {what} `{s}` is not a number (in {context})"))
     };
     let (min, max) = (number("MIN", parts[0])?, number("MAX", parts[1])?);
-    let n: usize = parts[2].parse().ok().filter(|&n| n >= 2).ok_or_else(|| {
+    // N < 2 is left to the use: the library's axis names its own key (`--k-n points = 0`).
+    let n: usize = parts[2].parse().map_err(|_| {
         anyhow!("{prefix} N `{}` must be a whole number of at least 2 (in {context})", parts[2])
     })?;
     let scale = match parts.get(3).map(|s| s.to_ascii_lowercase()).as_deref() {

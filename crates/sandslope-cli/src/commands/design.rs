@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
 
@@ -64,6 +64,9 @@ pub fn parse_vary_item(item: &str) -> Result<DesignRange> {
     let (min, max, n, scale) = if range.contains(':') {
         let r = parse_axis_range(range, AxisScale::Linear, &format!("--vary: {key}"), item)?
             .ok_or_else(|| anyhow!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"))?;
+        if r.n < 2 {
+            bail!("--vary: {key} N `{}` must be a whole number of at least 2 (in {item})", r.n);
+        }
         (r.min, r.max, r.n, r.scale)
     } else {
         let v = range.trim();

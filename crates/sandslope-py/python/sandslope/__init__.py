@@ -28,11 +28,21 @@ from __future__ import annotations
 
 import os
 import warnings as _warnings
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _sandslope
+from ._inputs import (
+    RobotLike,
+    TerrainLike,
+    _cell_size,
+    _dem,
+    _float_array,
+    _robot,
+    _row_widths,
+    _terrain,
+)
 from ._sandslope import Robot, Terrain
 
 __all__ = [
@@ -71,8 +81,6 @@ REGIMES: Tuple[str, str, str, str] = tuple(_sandslope.REGIMES)  # type: ignore[a
 #: (the library's ``Cause::ALL``, so the two cannot drift).
 CAUSES: Tuple[str, ...] = tuple(_sandslope.CAUSES)
 
-RobotLike = Union[Robot, str, "os.PathLike[str]"]
-TerrainLike = Union[Terrain, str, "os.PathLike[str]"]
 
 
 def presets() -> Dict[str, Dict[str, str]]:
@@ -81,41 +89,6 @@ def presets() -> Dict[str, Dict[str, str]]:
     Load one with :meth:`Robot.preset` or :meth:`Terrain.preset`.
     """
     return {name: {"kind": kind, "summary": summary} for name, kind, summary in _sandslope.preset_names()}
-
-
-def _robot(robot: RobotLike) -> Robot:
-    """A Robot, a preset name or a TOML path (as the CLI's ``--robot FILE|PRESET``)."""
-    if isinstance(robot, Robot):
-        return robot
-    if isinstance(robot, (str, os.PathLike)):
-        # The command line's rule (sandslope-io): a file if it exists or ends in .toml, else a preset.
-        return Robot.load(os.fspath(robot))
-    raise TypeError(f"robot must be a sandslope.Robot, a preset name or a TOML path, not {type(robot).__name__}")
-
-
-def _terrain(terrain: TerrainLike) -> Terrain:
-    """A Terrain, a preset name or a TOML path (as the CLI's ``--terrain FILE|PRESET``)."""
-    if isinstance(terrain, Terrain):
-        return terrain
-    if isinstance(terrain, (str, os.PathLike)):
-        return Terrain.load(os.fspath(terrain))
-    raise TypeError(
-        f"terrain must be a sandslope.Terrain, a preset name or a TOML path, not {type(terrain).__name__}"
-    )
-
-
-def _float_array(name: str, x: Any) -> np.ndarray:
-    _refuse_complex(name, x)
-    try:
-        return np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as e:
-        raise ValueError(f"{name} must be a number or an array of numbers: {e}") from None
-
-
-def _refuse_complex(name: str, x: Any) -> None:
-    """A complex value would be cast to its real part with only NumPy's ComplexWarning."""
-    if np.iscomplexobj(x):
-        raise ValueError(f"{name} must be real numbers, not complex ({np.asarray(x).dtype})")
 
 
 _PREDICT_FLOAT_KEYS = (
@@ -402,34 +375,6 @@ def payload_envelope(
     return _sandslope.payload_envelope(
         _robot(robot), s, _terrain(terrain), max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
     )
-
-
-def _cell_size(cell_size_m: Any) -> Tuple[float, float]:
-    if np.ndim(cell_size_m) == 0:
-        c = float(cell_size_m)
-        return c, c
-    pair = tuple(float(v) for v in cell_size_m)
-    if len(pair) != 2:
-        raise ValueError(f"cell_size_m must be one number or (cell_x, cell_y), not {cell_size_m!r}")
-    return pair  # type: ignore[return-value]
-
-
-def _row_widths(row_widths_m: Any) -> Optional[List[float]]:
-    """Each row's east-west cell size (m) as the extension takes it, or None."""
-    if row_widths_m is None:
-        return None
-    w = _float_array("row_widths_m", row_widths_m)
-    if w.ndim != 1:
-        raise ValueError(f"row_widths_m must be a 1-D array, one width per row of the dem (got shape {w.shape})")
-    return w.tolist()
-
-
-def _dem(dem: Any) -> np.ndarray:
-    _refuse_complex("dem", dem)
-    z = np.asarray(dem)
-    if z.ndim != 2:
-        raise ValueError(f"dem must be a 2-D array (rows, cols), row 0 at the north (got shape {z.shape})")
-    return np.ascontiguousarray(z, dtype=np.float64)
 
 
 def risk_raster(

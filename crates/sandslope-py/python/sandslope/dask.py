@@ -39,7 +39,8 @@ from typing import Any, Callable, Optional, Tuple, TypeVar
 import dask.array as da
 import numpy as np
 
-from . import _cell_size, _robot, _row_widths, _sandslope, _terrain
+from . import _sandslope
+from ._inputs import _cell_size, _robot, _row_widths, _terrain
 from . import risk_raster as _eager_risk_raster
 
 __all__ = ["risk_raster"]

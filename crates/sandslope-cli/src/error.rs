@@ -9,7 +9,7 @@
 //! | 2 | bad input: a flag, value, key or file the tool cannot accept (a file that does not exist, a malformed or implausible one); clap's usage errors |
 //! | 3 | the system failed: an output (file, folder, stdout or stderr) could not be written (disk full, no permission), or an input that exists could not be read (no permission, I/O error) |
 //! | 4 | `report --strict`: the report was written, but it carries warnings |
-//! | 130, 143 | interrupted by SIGINT (Ctrl-C) or SIGTERM; temporary files removed, no output left |
+//! | 130, 143, 129 | interrupted by SIGINT (Ctrl-C), SIGTERM or SIGHUP (128 + the signal); temporary files removed, no output left |
 //!
 //! Whatever the code, a run that does not succeed leaves no output behind
 //! (`sandslope_io::files::discard_outputs`); the one exception is code 4, whose outputs are
@@ -26,8 +26,6 @@ pub const EXIT_USAGE: i32 = 2;
 pub const EXIT_OUTPUT: i32 = 3;
 /// Exit code of `report --strict` when the report was written but carries warnings.
 pub const EXIT_WARNINGS: i32 = 4;
-/// Exit code after SIGINT (128 + 2), as shells report it.
-pub const EXIT_SIGINT: i32 = 130;
 
 /// `report --strict`: the outputs were written, but the report carries this many warnings.
 #[derive(Debug, thiserror::Error)]
@@ -117,13 +115,21 @@ pub fn exit_cleanly_on_stream_errors() {
     }));
 }
 
-/// On SIGINT, SIGTERM or SIGHUP: remove this run's temporary files and exit (130 for SIGINT
-/// and the others alike, as the handler cannot tell them apart), so a killed run leaves nothing.
+/// On SIGINT, SIGTERM or SIGHUP: remove this run's temporary files and exit with 128 plus the
+/// signal's number (130, 143, 129), as shells report a process the signal ended, so a killed
+/// run leaves nothing. The outputs of a run whose final renames have begun are all put in
+/// place first ([`sandslope_io::files::discard_outputs`] waits for them): never a mixed set.
 pub fn clean_up_on_signals() {
-    // Failing to install the handler (another one is set) only loses the clean-up.
-    let _ = ctrlc::set_handler(|| {
-        sandslope_io::files::discard_outputs();
-        std::process::exit(EXIT_SIGINT);
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    // Failing to install the handler only loses the clean-up.
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return;
+    };
+    let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            sandslope_io::files::discard_outputs();
+            std::process::exit(128 + signal);
+        }
     });
 }
 

@@ -5,7 +5,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use rayon::prelude::*;
 
 /// Rows per formatting chunk.
@@ -56,8 +56,7 @@ pub fn write_rows_file(
     rows: usize,
     row: &(dyn Fn(usize, &mut Vec<u8>) + Sync),
 ) -> Result<()> {
-    crate::files::write_via_temp(path, |tmp| {
-        let file = std::fs::File::create(tmp).with_context(|| format!("cannot write {}", path.display()))?;
+    crate::files::write_output(path, |file| {
         let mut w = std::io::BufWriter::with_capacity(1 << 22, file);
         write_rows(&mut w, header, rows, row)
             .and_then(|_| w.flush())

@@ -34,6 +34,6 @@ pub mod speeds;
 pub mod trajectory;
 
 pub use anchoring::{load_anchoring_times, AnchoringRow};
-pub use files::{csv_string, read_text, write_atomic, write_via_temp, Source, WriteError};
+pub use files::{csv_string, read_text, write_atomic, write_output, OutputFile, Source, WriteError};
 pub use robot_terrain::{load_robot, load_terrain, robot_from_toml, terrain_from_toml};
 pub use speeds::{load_speeds, parse_speeds, SpeedRow};

@@ -8,7 +8,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 /// The data of one array.
 #[derive(Debug, Clone, Copy)]
@@ -76,8 +76,7 @@ pub fn write_npy(w: &mut dyn Write, shape: &[usize], data: NpyData<'_>) -> std::
 
 /// Writes one `.npy` file atomically.
 pub fn write_npy_file(path: &Path, shape: &[usize], data: NpyData<'_>) -> Result<()> {
-    crate::files::write_via_temp(path, |tmp| {
-        let file = std::fs::File::create(tmp).with_context(|| format!("cannot write {}", path.display()))?;
+    crate::files::write_output(path, |file| {
         let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
         write_npy(&mut w, shape, data)
             .and_then(|_| w.flush())

@@ -118,6 +118,149 @@ impl LevelStep {
 
 /// Default resistive-force-theory elements per leg (docs/model.md §15).
 pub const DEFAULT_LEG_ELEMENTS: u32 = 16;
+
+/// The range of plausibility of one robot quantity (docs/model.md §2): a value outside it is
+/// refused, because it is a unit mistake far more often than a robot (a mass of 350 "kg" that
+/// was 350 g; a leg radius of 4 "m" that was 4 cm), and because the simulator's step count and
+/// memory grow with it (a leg speed of 310,445 rad/s made a 1.5 s walk take 10 s and 263 MB).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plausible {
+    /// The robot file key.
+    pub key: &'static str,
+    /// Smallest plausible value, in the key's unit.
+    pub min: f64,
+    /// Largest plausible value, in the key's unit.
+    pub max: f64,
+    /// The key's unit, for messages.
+    pub unit: &'static str,
+    /// Units the value may mistakenly have been given in, with the factor into the key's unit.
+    pub mistakes: &'static [(&'static str, f64)],
+}
+
+const LENGTH_MISTAKES: &[(&str, f64)] = &[("cm", 0.01), ("mm", 0.001), ("inches", 0.0254)];
+
+/// The ranges of plausibility of the robot file's quantities (docs/model.md §2): wide enough
+/// for every legged robot from a few grams to the largest field robots, narrow enough to catch
+/// a unit mistake. The integer `stance_legs` is checked against [`STANCE_LEGS_RANGE`].
+pub const PLAUSIBLE: &[Plausible] = &[
+    Plausible {
+        key: "mass_kg",
+        min: 1e-3,
+        max: 250.0,
+        unit: "kg",
+        mistakes: &[("g", 1e-3), ("lb", 0.453_592_37)],
+    },
+    Plausible { key: "leg_radius_m", min: 1e-3, max: 1.0, unit: "m", mistakes: LENGTH_MISTAKES },
+    Plausible { key: "leg_width_m", min: 1e-4, max: 1.0, unit: "m", mistakes: LENGTH_MISTAKES },
+    Plausible {
+        key: "leg_speed_rad_s",
+        min: 1e-2,
+        max: 100.0,
+        unit: "rad/s",
+        mistakes: &[("degrees per second", PI / 180.0), ("rpm", PI / 30.0)],
+    },
+    Plausible { key: "response_time_s", min: 1e-4, max: 100.0, unit: "s", mistakes: &[("ms", 1e-3)] },
+    Plausible {
+        key: "leg_contact_area_m2",
+        min: 1e-8,
+        max: 1.0,
+        unit: "m^2",
+        mistakes: &[("cm^2", 1e-4), ("mm^2", 1e-6)],
+    },
+    Plausible { key: "level_step_m", min: 1e-4, max: 5.0, unit: "m", mistakes: LENGTH_MISTAKES },
+    Plausible { key: "min_step_m", min: 1e-4, max: 5.0, unit: "m", mistakes: LENGTH_MISTAKES },
+    Plausible { key: "body_length_m", min: 2e-3, max: 10.0, unit: "m", mistakes: LENGTH_MISTAKES },
+    Plausible { key: "body_width_m", min: 1e-3, max: 10.0, unit: "m", mistakes: LENGTH_MISTAKES },
+    Plausible {
+        key: "pitch_inertia_kg_m2",
+        min: 1e-9,
+        max: 1e3,
+        unit: "kg m^2",
+        mistakes: &[("g cm^2", 1e-7)],
+    },
+    Plausible {
+        key: "servo_torque_limit_n_m",
+        min: 1e-4,
+        max: 1e3,
+        unit: "N m",
+        mistakes: &[("N cm", 0.01), ("N mm", 0.001), ("kgf cm", 0.098_066_5)],
+    },
+];
+
+/// Fewest and most legs in stance at once a robot file may give.
+pub const STANCE_LEGS_RANGE: (u32, u32) = (1, 16);
+
+impl Plausible {
+    /// The range for `key`, if the robot file has such a real-valued key.
+    pub fn of(key: &str) -> Option<&'static Plausible> {
+        PLAUSIBLE.iter().find(|p| p.key == key)
+    }
+
+    /// Checks `value`; the error names the range and, where one fits, the likely unit mistake.
+    pub fn check(&self, value: f64) -> Result<f64, ParamError> {
+        if (self.min..=self.max).contains(&value) {
+            return Ok(value);
+        }
+        let mut expected = format!(
+            "between {} and {} {} to be a plausible legged robot (docs/model.md §2)",
+            self.min, self.max, self.unit
+        );
+        let fits: Vec<String> = self
+            .mistakes
+            .iter()
+            .filter(|(_, f)| (self.min..=self.max).contains(&(value * f)))
+            .map(|(unit, f)| {
+                format!("if it was given in {unit}, that is {} {}", round_sig(value * f), self.unit)
+            })
+            .collect();
+        if !fits.is_empty() {
+            expected.push_str("; ");
+            expected.push_str(&fits.join("; "));
+        }
+        Err(ParamError::new(self.key, value, expected))
+    }
+}
+
+/// `x` to 6 significant digits, without trailing noise (0.35 rather than 0.35000000000000003).
+fn round_sig(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let p = 10f64.powi(5 - x.abs().log10().floor() as i32);
+    (x * p).round() / p
+}
+
+/// Every quantity of `spec` against its range of plausibility ([`PLAUSIBLE`]).
+fn check_plausible(spec: &RobotSpec) -> Result<(), ParamError> {
+    let values = [
+        ("mass_kg", Some(spec.mass_kg)),
+        ("leg_radius_m", Some(spec.leg_radius_m)),
+        ("leg_width_m", Some(spec.leg_width_m)),
+        ("leg_speed_rad_s", Some(spec.leg_speed_rad_s)),
+        ("response_time_s", Some(spec.response_time_s)),
+        ("leg_contact_area_m2", spec.leg_contact_area_m2),
+        ("level_step_m", spec.level_step_m),
+        ("min_step_m", spec.min_step_m),
+        ("body_length_m", spec.body_length_m),
+        ("body_width_m", spec.body_width_m),
+        ("pitch_inertia_kg_m2", spec.pitch_inertia_kg_m2),
+        ("servo_torque_limit_n_m", spec.servo_torque_limit_n_m),
+    ];
+    for (key, value) in values {
+        if let (Some(range), Some(v)) = (Plausible::of(key), value) {
+            range.check(v)?;
+        }
+    }
+    let (lo, hi) = STANCE_LEGS_RANGE;
+    if !(lo..=hi).contains(&spec.stance_legs) {
+        return Err(ParamError::new(
+            "stance_legs",
+            f64::from(spec.stance_legs),
+            format!("a whole number from {lo} to {hi}"),
+        ));
+    }
+    Ok(())
+}
 /// Fewest and most elements per leg a robot file may ask for.
 pub const LEG_ELEMENTS_RANGE: (u32, u32) = (4, 256);
 
@@ -202,6 +345,7 @@ impl Robot {
                 ));
             }
         }
+        check_plausible(&spec)?;
         Ok(Robot {
             spec,
             contact_area,
@@ -326,6 +470,53 @@ mod tests {
         RobotSpec::paper_hexapod()
     }
 
+    /// Issue 39's unit mistakes: each refused, naming the key, the range and the value in the
+    /// unit it was likely meant in (worked by hand: 350 g = 0.35 kg; 4 cm = 0.04 m; 300 ms =
+    /// 0.3 s; 360 degrees per second = 2 pi = 6.28319 rad/s).
+    #[test]
+    fn unit_mistakes_are_refused_naming_the_likely_unit() {
+        type Edit = fn(&mut RobotSpec);
+        let cases: [(Edit, &str, &str); 5] = [
+            (
+                |s| s.mass_kg = 350.0,
+                "mass_kg = 350 must be between 0.001 and 250 kg",
+                "given in g, that is 0.35 kg",
+            ),
+            (
+                |s| s.leg_radius_m = 4.0,
+                "leg_radius_m = 4 must be between 0.001 and 1 m",
+                "given in cm, that is 0.04 m",
+            ),
+            (|s| s.response_time_s = 300.0, "response_time_s = 300", "given in ms, that is 0.3 s"),
+            (
+                |s| s.leg_speed_rad_s = 360.0,
+                "leg_speed_rad_s = 360",
+                "degrees per second, that is 6.28319 rad/s",
+            ),
+            (
+                |s| s.mass_kg = 1e23,
+                "mass_kg = 1e23 must be between 0.001 and 250 kg",
+                "plausible legged robot",
+            ),
+        ];
+        for (edit, head, hint) in cases {
+            let mut spec = paper_spec();
+            edit(&mut spec);
+            let e = Robot::new(spec).unwrap_err().to_string();
+            assert!(e.contains(head) && e.contains(hint), "{e}");
+        }
+        let mut spec = paper_spec();
+        spec.leg_speed_rad_s = 310_445.0;
+        assert!(Robot::new(spec).unwrap_err().to_string().contains("between 0.01 and 100 rad/s"));
+        let mut spec = paper_spec();
+        spec.stance_legs = 40;
+        assert!(Robot::new(spec).unwrap_err().to_string().contains("from 1 to 16"));
+        // The edges themselves are plausible.
+        let mut spec = paper_spec();
+        spec.mass_kg = 250.0;
+        assert!(Robot::new(spec).is_ok());
+    }
+
     #[test]
     fn derived_quantities() {
         let r = Robot::new(paper_spec()).unwrap();
@@ -402,8 +593,9 @@ mod tests {
             "{text}"
         );
         assert!(text.contains("(here inf)") && text.contains("0.2 s"), "{text}");
-        // The smallest response time that keeps the load finite is accepted: 0.35 * 0.2513 / dt
-        // < 1.8e308 for dt = 1e-300.
-        assert!(Robot::new(RobotSpec { response_time_s: 1e-300, ..paper_spec() }).is_ok());
+        // A response time that keeps the load finite but is no robot's (1e-300 s) is refused by
+        // the range of plausibility instead (issue 39).
+        let e = Robot::new(RobotSpec { response_time_s: 1e-300, ..paper_spec() }).unwrap_err().to_string();
+        assert!(e.contains("between 0.0001 and 100 s"), "{e}");
     }
 }

@@ -24,7 +24,7 @@ use crate::args::{
 };
 use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
-use crate::output::{csv_string, num, print_json, sci, table, write_via_temp, Format};
+use crate::output::{csv_string, num, print_json, sci, table, write_output, Format};
 use crate::progress::progress_bar;
 
 /// Most `--map` cells (the library's cap, as Python's).
@@ -672,8 +672,7 @@ fn map_csv(map: &RiskMap, out: &mut dyn std::io::Write) -> std::io::Result<()> {
 const MAP_CSV_HEADER: &str = "k_n,k_s,p_fail,p_not_success";
 
 fn write_map_csv(path: &std::path::Path, map: &RiskMap) -> Result<()> {
-    write_via_temp(path, |tmp| {
-        let file = std::fs::File::create(tmp).with_context(|| format!("cannot write {}", path.display()))?;
+    write_output(path, |file| {
         let mut w = std::io::BufWriter::with_capacity(1 << 22, file);
         map_csv(map, &mut w)
             .and_then(|_| w.flush())

@@ -29,7 +29,7 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use sandslope_io::write_via_temp;
+use sandslope_io::write_atomic;
 
 /// Font family name under which the embedded DejaVu Sans is registered.
 pub const FONT: &str = "sans-serif";
@@ -75,28 +75,41 @@ pub fn format_of(path: &Path) -> Result<ImageFormat> {
     }
 }
 
-/// Draws `figure` into `path` (PNG or SVG by extension), atomically.
+/// Draws `figure` into `path` (PNG or SVG by extension) through the one output writer.
+///
+/// The image is drawn and encoded in memory first, so that writing it is writing bytes: a
+/// full disk is a write error naming the file (exit code 3), and a FIFO or `/dev/stdout`
+/// receives the image directly.
 pub fn save(path: &Path, figure: &impl Figure) -> Result<()> {
+    let bytes = match format_of(path)? {
+        ImageFormat::Png => to_png(figure)?,
+        ImageFormat::Svg => to_svg(figure)?.into_bytes(),
+    };
+    write_atomic(path, &bytes)
+}
+
+/// Renders `figure` as a PNG file's bytes (RGB, the encoder plotters itself uses).
+pub fn to_png(figure: &impl Figure) -> Result<Vec<u8>> {
     register_fonts();
-    let format = format_of(path)?;
-    let size = figure.size();
-    write_via_temp(path, |tmp| {
-        match format {
-            ImageFormat::Png => {
-                let root = BitMapBackend::new(tmp, size).into_drawing_area();
-                root.fill(&WHITE).map_err(crate::error::plot_err)?;
-                figure.draw(&root)?;
-                root.present().map_err(crate::error::plot_err)?;
-            }
-            ImageFormat::Svg => {
-                let root = SVGBackend::new(tmp, size).into_drawing_area();
-                root.fill(&WHITE).map_err(crate::error::plot_err)?;
-                figure.draw(&root)?;
-                root.present().map_err(crate::error::plot_err)?;
-            }
-        }
-        Ok(())
-    })
+    let (w, h) = figure.size();
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(crate::error::plot_err)?;
+        figure.draw(&root)?;
+        root.present().map_err(crate::error::plot_err)?;
+    }
+    png_bytes(&rgb, w, h)
+}
+
+/// Encodes an RGB buffer of `w` x `h` pixels as PNG.
+pub fn png_bytes(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>> {
+    use image::ImageEncoder;
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(rgb, w, h, image::ColorType::Rgb8)
+        .map_err(|e| anyhow::anyhow!("encoding a PNG image: {e}"))?;
+    Ok(out)
 }
 
 /// Renders `figure` as an SVG document in memory (for pages that embed figures inline).

@@ -14,7 +14,7 @@ use sandslope::{Robot, SpeedObservation};
 use super::palette;
 use super::{font, ChartSetup, Figure};
 use crate::error::plot_err;
-use crate::output::write_via_temp;
+use crate::output::write_output;
 
 /// Tripod colours: tripod 0 blue, tripod 1 orange (legs of one tripod share the colour,
 /// front to rear from dark to light).
@@ -327,15 +327,53 @@ pub fn save_gif(path: &Path, anim: &Animation<'_>) -> Result<()> {
     let frames: Vec<usize> =
         (0..tr.time_s.len()).step_by(every).take_while(|&i| tr.time_s[i] <= GIF_MAX_S + 1e-9).collect();
     let delay = (1000.0 / GIF_FPS) as u32;
-    write_via_temp(path, |tmp| {
-        let root = BitMapBackend::gif(tmp, (800, 450), delay).map_err(plot_err)?.into_drawing_area();
+    write_output(path, |file| {
+        let mut gif = GifWriter::new(file, GIF_SIZE, delay)?;
+        let mut rgb = vec![0u8; GIF_SIZE.0 as usize * GIF_SIZE.1 as usize * 3];
         for &i in &frames {
-            root.fill(&WHITE).map_err(plot_err)?;
-            draw_frame(&root, anim, i)?;
-            root.present().map_err(plot_err)?;
+            {
+                let root = BitMapBackend::with_buffer(&mut rgb, GIF_SIZE).into_drawing_area();
+                root.fill(&WHITE).map_err(plot_err)?;
+                draw_frame(&root, anim, i)?;
+                root.present().map_err(plot_err)?;
+            }
+            gif.frame(&rgb)?;
         }
         Ok(())
     })
+}
+
+/// Frame size of the animation, pixels.
+const GIF_SIZE: (u32, u32) = (800, 450);
+
+/// An animated GIF written frame by frame into any writer, as plotters' own GIF backend
+/// encodes it (the `gif` crate, looping forever, speed 10), but without a file path of its
+/// own, so that it goes through the one output writer.
+struct GifWriter<W: std::io::Write> {
+    encoder: gif::Encoder<W>,
+    size: (u16, u16),
+    /// Frame delay, hundredths of a second.
+    delay: u16,
+}
+
+impl<W: std::io::Write> GifWriter<W> {
+    fn new(out: W, (w, h): (u32, u32), delay_ms: u32) -> Result<Self> {
+        let size = (u16::try_from(w)?, u16::try_from(h)?);
+        let mut encoder = gif::Encoder::new(out, size.0, size.1, &[]).map_err(gif_err)?;
+        encoder.set_repeat(gif::Repeat::Infinite).map_err(gif_err)?;
+        Ok(GifWriter { encoder, size, delay: u16::try_from((delay_ms + 5) / 10).unwrap_or(u16::MAX) })
+    }
+
+    /// Appends one frame (RGB, the writer's size).
+    fn frame(&mut self, rgb: &[u8]) -> Result<()> {
+        let mut frame = gif::Frame::from_rgb_speed(self.size.0, self.size.1, rgb, 10);
+        frame.delay = self.delay;
+        self.encoder.write_frame(&frame).map_err(gif_err)
+    }
+}
+
+fn gif_err(e: gif::EncodingError) -> anyhow::Error {
+    anyhow::anyhow!("encoding the GIF: {e}")
 }
 
 /// One frame: world view (slope rising to the right), sand, body, legs and force arrows.

@@ -461,8 +461,7 @@ pub fn write_two_band_geotiff(
     band2: &[f32],
 ) -> Result<()> {
     let name = path.display().to_string();
-    crate::files::write_via_temp(path, |tmp| {
-        let file = File::create(tmp).with_context(|| format!("cannot write {name}"))?;
+    crate::files::write_output(path, |file| {
         let err = |e: tiff::TiffError| anyhow!("{name}: {e}");
         let mut enc = TiffEncoder::new(BufWriter::new(file))
             .map_err(err)?

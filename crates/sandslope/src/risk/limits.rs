@@ -247,10 +247,17 @@ pub fn max_safe_mass(
 }
 
 /// The masses [`max_safe_mass`] scans from the robot's own `m0`: growing by
-/// [`MASS_SCAN_FACTOR`] up to [`MAX_MASS_FACTOR`] times `m0`.
+/// [`MASS_SCAN_FACTOR`] up to [`MAX_MASS_FACTOR`] times `m0`, and no further than the
+/// plausible robot's mass (docs/model.md §2), which is the last mass scanned.
 fn mass_scan(m0: f64) -> Vec<f64> {
+    let heaviest = crate::robot::Plausible::of("mass_kg").map_or(f64::INFINITY, |p| p.max);
     let n = (MAX_MASS_FACTOR.ln() / MASS_SCAN_FACTOR.ln()).ceil() as i32;
-    (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).collect()
+    let mut masses: Vec<f64> =
+        (0..=n).map(|i| m0 * MASS_SCAN_FACTOR.powi(i)).take_while(|&m| m < heaviest).collect();
+    if masses.len() <= n as usize {
+        masses.push(heaviest.max(m0));
+    }
+    masses
 }
 
 /// The heaviest safe mass at one slope of a [`PayloadEnvelope`].

@@ -188,7 +188,7 @@ pub const PLAUSIBLE: &[Plausible] = &[
 ];
 
 /// Fewest and most legs in stance at once a robot file may give.
-pub const STANCE_LEGS_RANGE: (u32, u32) = (1, 64);
+pub const STANCE_LEGS_RANGE: (u32, u32) = (1, 128);
 
 impl Plausible {
     /// The range for `key`, if the robot file has such a real-valued key.
@@ -509,8 +509,8 @@ mod tests {
         spec.leg_speed_rad_s = 310_445.0;
         assert!(Robot::new(spec).unwrap_err().to_string().contains("between 0.01 and 100 rad/s"));
         let mut spec = paper_spec();
-        spec.stance_legs = 65;
-        assert!(Robot::new(spec).unwrap_err().to_string().contains("from 1 to 64"));
+        spec.stance_legs = 129;
+        assert!(Robot::new(spec).unwrap_err().to_string().contains("from 1 to 128"));
         // The edges themselves are plausible.
         let mut spec = paper_spec();
         spec.mass_kg = 250.0;

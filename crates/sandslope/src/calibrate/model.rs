@@ -219,8 +219,13 @@ mod tests {
             assert_eq!(e, CalibrationError::NotASimulatorInput { name: key.name().into() });
             assert!(e.to_string().contains(key.name()));
         }
-        // A robot the simulator would refuse (65 legs per tripod) is refused as a robot first.
         let spec = RobotSpec { stance_legs: 65, ..paper_robot().spec().clone() };
-        assert_eq!(Robot::new(spec).unwrap_err().key, "stance_legs");
+        let s = JointSetup { robot: Robot::new(spec).unwrap(), ..setup(vec![]) };
+        match calibrate_jointly_with(&s, short_walks()) {
+            Err(CalibrationError::Simulator { reason }) => {
+                assert!(reason.contains("stance_legs"), "{reason}")
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -159,7 +159,7 @@ fn a_step_serialises_the_gait_step_in_place() {
 fn a_robot_with_a_billion_legs_is_refused_before_allocating() {
     let spec = RobotSpec { stance_legs: 1_000_000_000, ..paper_robot().spec().clone() };
     let e = Robot::new(spec).unwrap_err().to_string();
-    assert!(e.contains("stance_legs = 1000000000 must be a whole number from 1 to 64"), "{e}");
+    assert!(e.contains("stance_legs = 1000000000 must be a whole number from 1 to 128"), "{e}");
 }
 
 /// On stiff level sand (k_n = k_s = 1e8 N/m^3, d_n = 0.03 mm) the simulated C-legs roll on

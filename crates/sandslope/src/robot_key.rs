@@ -3,11 +3,13 @@
 //! unit, the command-line flag that overrides it where there is one, and how to read and set
 //! it on a [`RobotSpec`]. Calibration frees the continuous ones ([`RobotKey::FITTABLE`]), a
 //! design study varies any of them, and the command line maps the library's error on a key
-//! back to the flag that set it ([`RobotKey::flag`]).
+//! back to the flag that set it ([`RobotKey::flag`]). Each key's valid range is the robot's
+//! own ([`RobotKey::plausible`], [`RobotKey::valid_range`]): the ranges of plausibility of
+//! [`crate::robot::PLAUSIBLE`], which [`crate::Robot::new`] checks.
 
 use serde::{Deserialize, Serialize};
 
-use crate::robot::RobotSpec;
+use crate::robot::{Plausible, RobotSpec, STANCE_LEGS_RANGE};
 
 /// A key of the robot file (docs/model.md §2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -142,6 +144,25 @@ impl RobotKey {
         self.row().flag
     }
 
+    /// The key's range of plausibility ([`crate::robot::PLAUSIBLE`]); `None` for
+    /// `stance_legs` (a whole number in [`STANCE_LEGS_RANGE`]) and `hip_height_m` (between 0
+    /// and 2 `leg_radius_m`, docs/model.md §2).
+    pub fn plausible(self) -> Option<&'static Plausible> {
+        Plausible::of(self.name())
+    }
+
+    /// The key's valid range in words, as [`crate::Robot::new`] checks it.
+    pub fn valid_range(self) -> String {
+        match (self, self.plausible()) {
+            (_, Some(p)) => format!("from {} to {} {}", p.min, p.max, p.unit),
+            (RobotKey::StanceLegs, None) => {
+                let (lo, hi) = STANCE_LEGS_RANGE;
+                format!("a whole number from {lo} to {hi}")
+            }
+            (_, None) => "from 0 to 2 leg_radius_m".to_string(),
+        }
+    }
+
     /// The key named `name` in robot files.
     pub fn from_name(name: &str) -> Option<RobotKey> {
         Self::ALL.into_iter().find(|k| k.name() == name)
@@ -215,5 +236,19 @@ mod tests {
             assert_eq!(json[k.name()], 2.0, "{k}: {json}");
         }
         assert_eq!(RobotKey::from_name("legs"), None);
+    }
+
+    /// The table's units are the ranges' units, and every key but the two with a rule of their
+    /// own has a range of plausibility (so a new key cannot go unchecked).
+    #[test]
+    fn every_key_has_its_range_in_the_units_of_the_table() {
+        for k in RobotKey::ALL {
+            match k.plausible() {
+                Some(p) => assert_eq!(p.unit, k.unit(), "{k}"),
+                None => assert!(matches!(k, RobotKey::StanceLegs | RobotKey::HipHeightM), "{k} has no range"),
+            }
+        }
+        assert_eq!(RobotKey::MassKg.valid_range(), "from 0.001 to 250 kg");
+        assert_eq!(RobotKey::StanceLegs.valid_range(), "a whole number from 1 to 128");
     }
 }

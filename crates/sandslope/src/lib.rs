@@ -53,6 +53,7 @@ pub mod risk;
 pub mod robot;
 pub mod robot_key;
 pub mod scenario;
+pub mod servo;
 pub mod simulate;
 pub mod slope;
 pub mod terrain;

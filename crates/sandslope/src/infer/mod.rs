@@ -36,6 +36,7 @@ use crate::slope::Slope;
 use crate::terrain::{Ground, Terrain};
 
 mod law;
+pub mod servo;
 
 pub use law::{law_posterior, Credible, InferLaw, LawPosterior, RiskPrediction, LAW_GRID_POINTS};
 

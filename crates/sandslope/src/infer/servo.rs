@@ -1,0 +1,508 @@
+//! The robot as a sensor (docs/model.md §19): what the servos' stance-phase currents say about
+//! the sand's shear strength k_s at the slope being climbed, and the live risk of slippage.
+//!
+//! A leg's drive torque during stance is what the sand resists with. Where the sand holds, the
+//! torque carries the body's load (slope and acceleration) and hardly depends on k_s; where it
+//! yields, the torque is the sand's capacity at the leg's depth and grows with k_s. The
+//! currents are compared, stance bin by stance bin, with the stride simulator's
+//! (docs/model.md §15-§18) on a grid of k_s at the same slope and k_n:
+//!
+//! - statistic: for each stride and tripod, the mean drive torque `tau = K_t I` of the tripod's
+//!   legs in each of `bins` equal parts of the stance (legs placed in their stance by their
+//!   angle, [`GaitSchedule::stride_position`]); the run-up stride is left out;
+//! - likelihood: Gaussian, per bin, around the simulator's mean profile at k_s, with variance
+//!   the observed mean's (stride-to-stride scatter over the number of strides) plus the
+//!   simulated mean's (its own scatter over its strides) plus a floor;
+//! - prior: log-uniform on `[k_s_min, k_s_max]`, as the gait inference's;
+//! - answer: the posterior median of k_s, its 90% credible interval (flagged when the data do
+//!   not bound a side, [`Bound`]), the leg's shear load (the simulator's along-slope sand force
+//!   per stance leg, posterior mean), and the probability that the walk is in the slippage
+//!   regime at this slope (posterior weight of the grid's simulated walks that slip).
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::{Bound, LogUniformPrior};
+use crate::regime::Regime;
+use crate::robot::Robot;
+use crate::scenario::Scenario;
+use crate::servo::GaitSchedule;
+use crate::simulate::{simulate, SimSettings};
+use crate::terrain::Terrain;
+
+/// Why currents cannot be turned into k_s.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CurrentInferenceError {
+    /// Too few complete strides in the log.
+    #[error("the log holds {found} complete stride(s) after the run-up; at least {needed} are needed to estimate k_s from the currents (drive longer: --strides)")]
+    TooFewStrides {
+        /// Complete strides found.
+        found: usize,
+        /// Strides needed.
+        needed: usize,
+    },
+    /// The simulator refused the robot, slope or terrain.
+    #[error("the stride simulator cannot model this walk: {0}")]
+    Simulator(String),
+    /// A setting outside its range.
+    #[error("{0}")]
+    Setting(String),
+}
+
+/// One leg's record: its tripod, angle in the gait's frame and drive torque.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LegTrace {
+    /// Leg angle, rad, in the gait's frame (unwrapped).
+    pub angle_rad: Vec<f64>,
+    /// Drive torque the servo exerts in the leg's direction of rotation, N m.
+    pub torque_n_m: Vec<f64>,
+}
+
+/// Settings of the current inference.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CurrentInferenceSettings {
+    /// Prior on k_s.
+    pub prior: LogUniformPrior,
+    /// k_s values simulated (log-spaced over the prior).
+    pub grid_points: usize,
+    /// Stance bins of the profile.
+    pub bins: usize,
+    /// Strides the simulator walks per grid point (the first is left out).
+    pub simulated_strides: usize,
+    /// Standard deviation added to every bin's, N m (the current's quantisation, 1 mA, and
+    /// what the simulator cannot reproduce).
+    pub floor_n_m: f64,
+}
+
+impl Default for CurrentInferenceSettings {
+    fn default() -> Self {
+        CurrentInferenceSettings {
+            prior: LogUniformPrior::new(3e4, 3e7).expect("valid"),
+            grid_points: 31,
+            bins: 6,
+            simulated_strides: 8,
+            floor_n_m: 0.002,
+        }
+    }
+}
+
+/// Per-stride stance profiles: `profiles[s][k * bins + b]` is tripod k's mean drive torque in
+/// stance bin b of stride `strides[s]`, N m (`None` where no sample fell in the bin).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StanceProfiles {
+    /// Stride numbers.
+    pub strides: Vec<i64>,
+    /// Bin means, tripod-major.
+    pub profiles: Vec<Vec<Option<f64>>>,
+    /// Samples behind each bin mean.
+    pub counts: Vec<Vec<usize>>,
+}
+
+/// Bins the stance-phase torques of `legs` by stride and stance bin.
+pub fn stance_profiles(schedule: &GaitSchedule, legs: &[LegTrace], bins: usize) -> StanceProfiles {
+    let half = 0.5 * schedule.period_s;
+    let mut by_stride: std::collections::BTreeMap<i64, (Vec<f64>, Vec<usize>)> = Default::default();
+    for (j, leg) in legs.iter().enumerate().take(schedule.legs()) {
+        let k = schedule.tripods[j];
+        for (&a, &tau) in leg.angle_rad.iter().zip(&leg.torque_n_m) {
+            if !(a.is_finite() && tau.is_finite()) {
+                continue;
+            }
+            let (stride, since) = schedule.stride_position(j, a);
+            if since >= half {
+                continue;
+            }
+            let b = ((since / half * bins as f64) as usize).min(bins - 1);
+            let e = by_stride.entry(stride).or_insert_with(|| (vec![0.0; 2 * bins], vec![0; 2 * bins]));
+            e.0[k * bins + b] += tau;
+            e.1[k * bins + b] += 1;
+        }
+    }
+    let mut out = StanceProfiles { strides: vec![], profiles: vec![], counts: vec![] };
+    for (s, (sum, n)) in by_stride {
+        out.strides.push(s);
+        out.profiles.push(sum.iter().zip(&n).map(|(&x, &c)| (c > 0).then(|| x / c as f64)).collect());
+        out.counts.push(n);
+    }
+    out
+}
+
+/// The simulator's stance profiles over a grid of k_s at one slope (what the currents are
+/// compared with); build once per run with [`model_grid`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModelGrid {
+    /// Slope, degrees.
+    pub slope_deg: f64,
+    /// k_n used, N/m^3.
+    pub k_n: f64,
+    /// k_s values, N/m^3 (log-spaced).
+    pub k_s: Vec<f64>,
+    /// Mean profile per k_s (tripod-major bins), N m.
+    pub mean: Vec<Vec<f64>>,
+    /// Stride-to-stride SD per bin, N m.
+    pub sd: Vec<Vec<f64>>,
+    /// Strides behind each mean.
+    pub strides: usize,
+    /// The simulated walk's regime per k_s.
+    pub regime: Vec<Regime>,
+    /// Mean along-slope sand force per stance leg over the stance, N.
+    pub shear_load_n: Vec<f64>,
+    /// Bins per tripod.
+    pub bins: usize,
+}
+
+/// Simulates `robot` at `slope_deg` on constant ground `k_n` and each k_s of the settings'
+/// grid (in parallel) and bins each walk's stance torques as [`stance_profiles`] bins a log.
+pub fn model_grid(
+    robot: &Robot,
+    k_n: f64,
+    slope_deg: f64,
+    settings: &CurrentInferenceSettings,
+) -> Result<ModelGrid, CurrentInferenceError> {
+    if settings.grid_points < 3 || settings.bins < 1 || settings.simulated_strides < 4 {
+        return Err(CurrentInferenceError::Setting(format!(
+            "grid_points (at least 3), bins (at least 1) and simulated_strides (at least 4) are {}, {}, {}",
+            settings.grid_points, settings.bins, settings.simulated_strides
+        )));
+    }
+    let schedule = GaitSchedule::new(robot, 2 * robot.stance_legs() as usize)
+        .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
+    let (lo, hi) = (settings.prior.min().ln(), settings.prior.max().ln());
+    let n = settings.grid_points;
+    let k_s: Vec<f64> = (0..n).map(|i| (lo + (hi - lo) * i as f64 / (n - 1) as f64).exp()).collect();
+    let duration = settings.simulated_strides as f64 * schedule.period_s;
+    let sim_settings = SimSettings::new(duration)
+        .and_then(|s| s.with_sample_rate(200.0))
+        .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
+    let bins = settings.bins;
+    let walks: Vec<Result<_, CurrentInferenceError>> = k_s
+        .par_iter()
+        .map(|&ks| {
+            let terrain = Terrain::constant(k_n, ks).map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
+            let scenario = Scenario::new(robot.clone(), terrain, None, None)
+                .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
+            let sim = simulate(&scenario, slope_deg, &sim_settings)
+                .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
+            let legs = simulated_legs(&schedule, &sim);
+            let profiles = stance_profiles(&schedule, &legs, bins);
+            let (mean, sd, strides) = profile_statistics(&profiles, 2 * bins);
+            let shear = stance_shear_load(&schedule, &sim);
+            Ok((mean, sd, strides, sim.summary.regime, shear))
+        })
+        .collect();
+    let mut grid = ModelGrid {
+        slope_deg,
+        k_n,
+        k_s,
+        mean: vec![],
+        sd: vec![],
+        strides: usize::MAX,
+        regime: vec![],
+        shear_load_n: vec![],
+        bins,
+    };
+    for w in walks {
+        let (mean, sd, strides, regime, shear) = w?;
+        grid.mean.push(mean);
+        grid.sd.push(sd);
+        grid.strides = grid.strides.min(strides);
+        grid.regime.push(regime);
+        grid.shear_load_n.push(shear);
+    }
+    Ok(grid)
+}
+
+/// The simulated legs as the servos would report them: leg j of the schedule is the
+/// simulator's leg of the same tripod and rank, its drive torque the sand's resisting torque
+/// about the hip (`-leg_torque_n_m`, the simulator's sign being the servo's torque on the leg
+/// in the plane's positive sense).
+pub fn simulated_legs(schedule: &GaitSchedule, sim: &crate::simulate::Simulation) -> Vec<LegTrace> {
+    let tr = &sim.trajectory;
+    let mapping = leg_mapping(schedule, &sim.geometry.tripod);
+    mapping
+        .iter()
+        .map(|&m| LegTrace {
+            angle_rad: tr.leg_angle_rad[m].clone(),
+            torque_n_m: tr.leg_torque_n_m[m].iter().map(|t| -t).collect(),
+        })
+        .collect()
+}
+
+/// For each schedule leg, the simulator leg of the same tripod and rank within the tripod.
+pub fn leg_mapping(schedule: &GaitSchedule, sim_tripods: &[usize]) -> Vec<usize> {
+    let mut seen = [0usize; 2];
+    (0..schedule.legs())
+        .map(|j| {
+            let k = schedule.tripods[j];
+            let rank = seen[k];
+            seen[k] += 1;
+            sim_tripods
+                .iter()
+                .enumerate()
+                .filter(|(_, &t)| t == k)
+                .map(|(i, _)| i)
+                .nth(rank)
+                .unwrap_or(k)
+        })
+        .collect()
+}
+
+fn stance_shear_load(schedule: &GaitSchedule, sim: &crate::simulate::Simulation) -> f64 {
+    let tr = &sim.trajectory;
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (j, tripod) in sim.geometry.tripod.iter().enumerate() {
+        let leg = (0..schedule.legs()).find(|&l| schedule.tripods[l] == *tripod).unwrap_or(0);
+        for (i, &a) in tr.leg_angle_rad[j].iter().enumerate() {
+            let (stride, _) = schedule.stride_position(leg, a);
+            if stride >= 1 && schedule.in_stance(leg, a) {
+                sum += tr.leg_force_x_n[j][i];
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
+}
+
+/// Mean and SD over complete strides (stride >= 1) of each bin; the number of strides.
+fn profile_statistics(p: &StanceProfiles, width: usize) -> (Vec<f64>, Vec<f64>, usize) {
+    let rows: Vec<Vec<f64>> = p
+        .strides
+        .iter()
+        .zip(&p.profiles)
+        .filter(|(&s, row)| s >= 1 && row.len() == width && row.iter().all(Option::is_some))
+        .map(|(_, row)| row.iter().map(|v| v.unwrap_or(0.0)).collect())
+        .collect();
+    let n = rows.len();
+    let mut mean = vec![0.0; width];
+    let mut sd = vec![0.0; width];
+    if n == 0 {
+        return (mean, sd, 0);
+    }
+    for r in &rows {
+        for (m, v) in mean.iter_mut().zip(r) {
+            *m += v / n as f64;
+        }
+    }
+    if n > 1 {
+        for r in &rows {
+            for ((s, v), m) in sd.iter_mut().zip(r).zip(&mean) {
+                *s += (v - m).powi(2) / (n - 1) as f64;
+            }
+        }
+        sd.iter_mut().for_each(|s| *s = s.sqrt());
+    }
+    (mean, sd, n)
+}
+
+/// What the currents say about the sand: k_s with its 90% interval, the leg's shear load and
+/// the risk of slippage at the slope.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CurrentInference {
+    /// Slope, degrees.
+    pub slope_deg: f64,
+    /// k_n assumed (the terrain's at the slope), N/m^3.
+    pub k_n: f64,
+    /// Posterior median of k_s, N/m^3.
+    pub k_s: f64,
+    /// 5% posterior quantile, N/m^3.
+    pub k_s_lo: f64,
+    /// 95% posterior quantile, N/m^3.
+    pub k_s_hi: f64,
+    /// Which sides of the interval the data bound.
+    pub bound: Bound,
+    /// The leg's along-slope shear load during stance, N (posterior mean of the simulator's).
+    pub shear_load_n: f64,
+    /// The closed form's shear load per leg, `m (g sin theta + R omega / dt) / n`, N (§4).
+    pub closed_form_shear_load_n: f64,
+    /// Probability of the slippage regime at this slope.
+    pub p_slippage: f64,
+    /// Strides (or, live, stances) used.
+    pub strides: usize,
+    /// Mean measured stance profile, N m (tripod-major bins).
+    pub measured_profile_n_m: Vec<f64>,
+    /// The grid's k_s, N/m^3, and the posterior probability of each.
+    pub posterior: Vec<(f64, f64)>,
+}
+
+/// Infers k_s from a whole log's stance currents (`infer --servo-log`). Needs at least three
+/// complete strides after the run-up.
+pub fn infer_from_currents(
+    robot: &Robot,
+    grid: &ModelGrid,
+    legs: &[LegTrace],
+) -> Result<CurrentInference, CurrentInferenceError> {
+    let schedule = GaitSchedule::new(robot, legs.len()).map_err(|e| CurrentInferenceError::Setting(e.to_string()))?;
+    let width = 2 * grid.bins;
+    let profiles = stance_profiles(&schedule, legs, grid.bins);
+    let (mean, sd, n) = profile_statistics(&profiles, width);
+    if n < 3 {
+        return Err(CurrentInferenceError::TooFewStrides { found: n, needed: 3 });
+    }
+    let var_obs: Vec<f64> = sd.iter().map(|s| s * s / n as f64).collect();
+    let bins: Vec<usize> = (0..width).collect();
+    Ok(posterior_answer(robot, grid, &mean, &var_obs, &bins, n))
+}
+
+/// Live update after one stance: the posterior from tripod `tripod`'s bins of one stance
+/// (`profile`, its `counts`), with `noise_sd_n_m` the torque noise of one sample.
+pub fn infer_from_stance(
+    robot: &Robot,
+    grid: &ModelGrid,
+    tripod: usize,
+    profile: &[Option<f64>],
+    counts: &[usize],
+    noise_sd_n_m: f64,
+) -> Option<CurrentInference> {
+    let b = grid.bins;
+    let mut mean = vec![0.0; 2 * b];
+    let mut var = vec![0.0; 2 * b];
+    let mut used = vec![];
+    for i in 0..b {
+        let idx = tripod * b + i;
+        let (Some(v), c) = (profile.get(idx).copied().flatten(), counts.get(idx).copied().unwrap_or(0)) else {
+            continue;
+        };
+        if c == 0 {
+            continue;
+        }
+        mean[idx] = v;
+        var[idx] = noise_sd_n_m * noise_sd_n_m / c as f64;
+        used.push(idx);
+    }
+    if used.len() < b {
+        return None;
+    }
+    // One stance is one draw of the simulator's stride-to-stride scatter, not a mean over many.
+    let mut answer = posterior_answer_single(robot, grid, &mean, &var, &used);
+    answer.strides = 1;
+    Some(answer)
+}
+
+fn posterior_answer_single(robot: &Robot, grid: &ModelGrid, mean: &[f64], var_obs: &[f64], bins: &[usize]) -> CurrentInference {
+    // The simulated stance scatters from stride to stride as a single stance does: its full
+    // SD, not the SD of its mean.
+    let g = ModelGrid { strides: 1, ..grid.clone() };
+    posterior_answer(robot, &g, mean, var_obs, bins, 1)
+}
+
+fn posterior_answer(
+    robot: &Robot,
+    grid: &ModelGrid,
+    mean: &[f64],
+    var_obs: &[f64],
+    bins: &[usize],
+    strides: usize,
+) -> CurrentInference {
+    let floor = CurrentInferenceSettings::default().floor_n_m;
+    let sim_n = grid.strides.max(1) as f64;
+    let loglik: Vec<f64> = (0..grid.k_s.len())
+        .map(|i| {
+            bins.iter()
+                .map(|&b| {
+                    let v = var_obs[b] + grid.sd[i][b].powi(2) / sim_n + floor * floor;
+                    let r = mean[b] - grid.mean[i][b];
+                    -0.5 * (r * r / v + v.ln())
+                })
+                .sum()
+        })
+        .collect();
+    let top = loglik.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let w: Vec<f64> = loglik.iter().map(|l| (l - top).exp()).collect();
+    let total: f64 = w.iter().sum();
+    let p: Vec<f64> = w.iter().map(|x| x / total).collect();
+    let ln: Vec<f64> = grid.k_s.iter().map(|k| k.ln()).collect();
+    let q = |level: f64| quantile(&ln, &p, level).exp();
+    let (lo, med, hi) = (q(0.05), q(0.5), q(0.95));
+    let last = p.len() - 1;
+    let upper_open = w[last] > super::UNBOUNDED_LIKELIHOOD;
+    let lower_open = w[0] > super::UNBOUNDED_LIKELIHOOD;
+    let bound = match (lower_open, upper_open) {
+        (false, false) => Bound::TwoSided,
+        (false, true) => Bound::LowerOnly,
+        (true, false) => Bound::UpperOnly,
+        (true, true) => Bound::Neither,
+    };
+    let p_slip = p.iter().zip(&grid.regime).filter(|(_, r)| **r == Regime::Slippage).map(|(x, _)| x).sum();
+    let shear = p.iter().zip(&grid.shear_load_n).map(|(x, f)| x * f).sum();
+    let slope = grid.slope_deg.abs().to_radians();
+    let closed = robot.mass() * (crate::model::G * slope.sin() + robot.leg_radius() * robot.leg_speed() / robot.response_time())
+        / f64::from(robot.stance_legs());
+    CurrentInference {
+        slope_deg: grid.slope_deg,
+        k_n: grid.k_n,
+        k_s: med,
+        k_s_lo: lo,
+        k_s_hi: hi,
+        bound,
+        shear_load_n: shear,
+        closed_form_shear_load_n: closed,
+        p_slippage: p_slip,
+        strides,
+        measured_profile_n_m: mean.to_vec(),
+        posterior: grid.k_s.iter().copied().zip(p).collect(),
+    }
+}
+
+/// Quantile of a distribution given as probabilities at grid points `x` (each point's mass
+/// spread evenly over its cell, cells meeting half-way between points).
+fn quantile(x: &[f64], p: &[f64], level: f64) -> f64 {
+    let n = x.len();
+    let edge = |i: usize| -> f64 {
+        if i == 0 {
+            x[0] - 0.5 * (x[1] - x[0])
+        } else if i == n {
+            x[n - 1] + 0.5 * (x[n - 1] - x[n - 2])
+        } else {
+            0.5 * (x[i - 1] + x[i])
+        }
+    };
+    let mut acc = 0.0;
+    for i in 0..n {
+        if acc + p[i] >= level && p[i] > 0.0 {
+            let f = (level - acc) / p[i];
+            return edge(i) + f * (edge(i + 1) - edge(i));
+        }
+        acc += p[i];
+    }
+    edge(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::robot::RobotSpec;
+
+    #[test]
+    fn quantiles_of_a_flat_distribution_by_hand() {
+        // Four equal cells over [-0.5, 3.5]: the median is 1.5, the 5% quantile 0.2 - 0.5.
+        let x = [0.0, 1.0, 2.0, 3.0];
+        let p = [0.25; 4];
+        assert!((quantile(&x, &p, 0.5) - 1.5).abs() < 1e-12);
+        assert!((quantile(&x, &p, 0.05) - (-0.5 + 0.2)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn binning_places_samples_by_angle() {
+        let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
+        let s = GaitSchedule::new(&robot, 6).unwrap();
+        // Leg 0 (tripod 0) at 1/8 of the way through stance of stride 2 with torque 0.1, and
+        // in its swing (ignored); leg 1 (tripod 1) at 7/8 of its stance with 0.3.
+        let a0 = s.start_angle(0) + 2.0 * 2.0 * std::f64::consts::PI + std::f64::consts::PI / 8.0;
+        let a0_swing = a0 + std::f64::consts::PI;
+        let a1 = s.touchdown_angle_rad + 2.0 * 2.0 * std::f64::consts::PI + 7.0 * std::f64::consts::PI / 8.0;
+        let legs = vec![
+            LegTrace { angle_rad: vec![a0, a0_swing], torque_n_m: vec![0.1, 9.0] },
+            LegTrace { angle_rad: vec![a1], torque_n_m: vec![0.3] },
+        ];
+        let p = stance_profiles(&s, &legs, 4);
+        assert_eq!(p.strides, vec![2]);
+        // 1/8 of stance is bin 0 of 4; 7/8 is bin 3, tripod 1's bins start at 4.
+        assert_eq!(p.profiles[0][0], Some(0.1));
+        assert_eq!(p.profiles[0][7], Some(0.3));
+        assert_eq!(p.counts[0].iter().sum::<usize>(), 2);
+    }
+}

@@ -30,6 +30,7 @@ pub mod presets;
 pub mod raster;
 pub mod robot_terrain;
 pub mod routes;
+pub mod servo_log;
 pub mod speeds;
 pub mod trajectory;
 

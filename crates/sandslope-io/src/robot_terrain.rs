@@ -39,8 +39,19 @@ pub fn load_robot(arg: &str) -> Result<Robot> {
 
 /// Parses and validates a robot.
 pub fn robot_from_toml(text: &str, source: &Source) -> Result<Robot> {
-    let spec: RobotSpec = parse_toml(text, source)?;
+    // The optional `[servos]` table (servo_log.rs, docs/drive.md) is the driver's, not the model's.
+    let (text, _servos) = crate::servo_log::split_servos_table(text);
+    let spec: RobotSpec = parse_toml(&text, source)?;
     Robot::new(spec).map_err(|e| anyhow!("{source}: {e}"))
+}
+
+/// The `[servos]` table of a robot file or preset, if it has one (docs/drive.md).
+pub fn load_servos(arg: &str) -> Result<Option<crate::servo_log::Servos>> {
+    let (source, text) = resolve(arg, PresetKind::Robot)?;
+    match crate::servo_log::split_servos_table(&text).1 {
+        Some(table) => crate::servo_log::parse_servos(&table, &source).map(Some),
+        None => Ok(None),
+    }
 }
 
 /// Loads a terrain from a file or preset name.

@@ -1,0 +1,642 @@
+//! The gait driver: the commanded alternating tripod sent to XL330s over Protocol 2.0, the
+//! servos' state read back every cycle, and the safety logic (docs/drive.md).
+//!
+//! One cycle: a Sync Write of every servo's goal (Goal Position in extended position mode, or
+//! Goal Velocity with a phase correction in velocity mode), then a Sync Read of the block from
+//! Present Current (126) to Present Temperature (146). Safety:
+//! - before moving: every ID must answer a ping with an XL330 model number; the current and
+//!   temperature limits, the operating mode, the velocity-based profile and the servos' own
+//!   Bus Watchdog are written while the torque is off;
+//! - torque off on every exit: the end of the run, Ctrl-C (the caller's stop flag), a servo
+//!   that stops answering or whose packets keep failing their CRC (three cycles in a row), a
+//!   cycle slower than the driver's watchdog, and an error writing the log;
+//! - the servos' Bus Watchdog stops them by themselves if the driver dies without a word;
+//! - `stop_on_risk`: the gait halts when the live risk of slippage passes the threshold; the
+//!   torque stays on and the legs hold where they are (the stance tripod planted) for
+//!   `hold_s`, then the torque goes off.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use dynamixel2::instructions::SyncWriteData;
+use dynamixel2::{Bus, ReadError};
+use sandslope::infer::servo::{infer_from_stance, CurrentInference, ModelGrid};
+use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::Robot;
+use serde::Serialize;
+
+use crate::table::{self as t, mode, PresentState};
+
+/// One servo as mounted on the robot (the robot file's `[servos]` table).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct ServoConfig {
+    /// Dynamixel ID, 0 to 252.
+    pub id: u8,
+    /// +1 if a positive shaft turn drives the leg forward, -1 if mounted mirrored.
+    pub direction: i8,
+    /// Shaft position, pulses, at which the leg is at gait angle 0 (the C's circle centre
+    /// straight ahead of the axle).
+    pub zero_offset_pulses: i32,
+}
+
+impl ServoConfig {
+    /// Goal position, pulses, for leg angle `angle` rad.
+    pub fn pulses(&self, angle: f64) -> i32 {
+        let p = self.zero_offset_pulses as f64 + f64::from(self.direction) * angle / xl330::RAD_PER_PULSE;
+        p.round().clamp(i32::MIN as f64, i32::MAX as f64) as i32
+    }
+
+    /// Leg angle, rad, at shaft position `pulses`.
+    pub fn angle(&self, pulses: i32) -> f64 {
+        f64::from(self.direction) * f64::from(pulses - self.zero_offset_pulses) * xl330::RAD_PER_PULSE
+    }
+}
+
+/// How the gait is commanded (the XL330's velocity-based profile either way).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Profile {
+    /// Extended position mode: the schedule's angle every cycle, Profile Velocity 1.5 omega
+    /// (a lagging leg catches up at most that fast, as in the simulator).
+    Position,
+    /// Velocity mode: the schedule's speed plus `4/s` times the phase error every cycle.
+    Velocity,
+}
+
+/// Settings of one run.
+#[derive(Debug, Clone, Serialize)]
+pub struct DriveSettings {
+    /// Servos in leg order.
+    pub servos: Vec<ServoConfig>,
+    /// Position or velocity commands.
+    pub profile: Profile,
+    /// Gait time, s (after standing up).
+    pub duration_s: f64,
+    /// Cycles per second the driver aims at.
+    pub rate_hz: f64,
+    /// Current Limit written to every servo, mA (at most 1750).
+    pub current_limit_ma: u16,
+    /// Temperature Limit written to every servo, degC (at most 70).
+    pub temperature_limit_c: u8,
+    /// Longest cycle the driver accepts before it stops everything, s.
+    pub watchdog_s: f64,
+    /// The servos' own Bus Watchdog, s (20 ms units, 1 to 127).
+    pub bus_watchdog_s: f64,
+    /// Halt when the live risk of slippage passes this probability.
+    pub stop_on_risk: Option<f64>,
+    /// After a halt, how long the legs are held before the torque goes off, s.
+    pub hold_s: f64,
+    /// Time allowed to stand up to the start pose, s.
+    pub stand_s: f64,
+}
+
+/// One servo's state in one cycle: what the log holds.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ServoSample {
+    /// Time since the gait started, s (negative while standing up).
+    pub time_s: f64,
+    /// Leg index.
+    pub leg: usize,
+    /// Tripod.
+    pub tripod: usize,
+    /// Dynamixel ID.
+    pub id: u8,
+    /// Present values.
+    #[serde(skip)]
+    pub state: PresentState,
+    /// Hardware Error Status (read when the status packet's alert bit is set), else 0.
+    pub hardware_error: u8,
+    /// Goal position sent this cycle, pulses (the velocity profile: the schedule's angle).
+    pub goal_position: i32,
+    /// Leg angle in the gait's frame, rad.
+    pub leg_angle_rad: f64,
+    /// Drive torque `K_t I` in the leg's direction of rotation, N m (docs/model.md §19).
+    pub drive_torque_n_m: f64,
+}
+
+/// One live estimate, after one stance.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LiveEstimate {
+    /// Gait time at the end of the stance, s.
+    pub time_s: f64,
+    /// Tripod.
+    pub tripod: usize,
+    /// The estimate.
+    pub inference: CurrentInference,
+}
+
+/// How a run ended without error.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "outcome", rename_all = "snake_case")]
+pub enum DriveOutcome {
+    /// The gait ran its duration.
+    Completed {
+        /// Gait time, s.
+        time_s: f64,
+    },
+    /// Ctrl-C (or the caller's stop flag).
+    Interrupted {
+        /// Gait time, s.
+        time_s: f64,
+    },
+    /// `stop_on_risk` halted the gait.
+    Halted {
+        /// Gait time of the halt, s.
+        time_s: f64,
+        /// The risk that passed the threshold.
+        p_slippage: f64,
+    },
+}
+
+/// Why a run failed. [`DriveError::exit_code`] is 2 for what was wrong before anything moved
+/// (the setup: port, IDs, models) and 3 for a bus that failed during the run.
+#[derive(Debug, thiserror::Error)]
+pub enum DriveError {
+    /// A servo did not answer a ping.
+    #[error("servo ID {id} (leg {leg}) did not answer a ping at {baud} baud; IDs that answered: {answered}. Fix: check its cable and power, or set its ID in the robot file's [servos] ids (Dynamixel Wizard shows the IDs on the bus)")]
+    Missing {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// Baud rate.
+        baud: u32,
+        /// IDs that did answer, listed.
+        answered: String,
+    },
+    /// A servo answered with another model's number.
+    #[error("servo ID {id} (leg {leg}) is model {model}, not an XL330-M288 ({expected}); its control table may differ. Fix: use XL330-M288s, or check the ID")]
+    WrongModel {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// Model number reported.
+        model: u16,
+        /// Model expected.
+        expected: u16,
+    },
+    /// A setup write failed.
+    #[error("servo ID {id} (leg {leg}) refused {what}: {reason}. Fix: {fix}")]
+    Setup {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// What was written.
+        what: &'static str,
+        /// The error.
+        reason: String,
+        /// What to do.
+        fix: &'static str,
+    },
+    /// A servo stopped answering during the run.
+    #[error("servo ID {id} (leg {leg}) stopped answering at t = {time_s:.3} s ({cycles} cycles in a row without a status packet: {reason}). Fix: check its cable, connector and power; the torque was turned off on every servo that answers")]
+    Lost {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// Gait time, s.
+        time_s: f64,
+        /// Failed cycles.
+        cycles: usize,
+        /// The last error.
+        reason: String,
+    },
+    /// A servo's status packets kept failing their CRC.
+    #[error("servo ID {id} (leg {leg}) sent corrupt packets at t = {time_s:.3} s ({cycles} cycles in a row failed their CRC). Fix: check the bus wiring and connectors, that only one adapter drives the bus, and that every servo uses the same baud rate; the torque was turned off")]
+    Corrupt {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// Gait time, s.
+        time_s: f64,
+        /// Failed cycles.
+        cycles: usize,
+    },
+    /// A cycle took longer than the watchdog allows.
+    #[error("the driver's watchdog fired at t = {time_s:.3} s: one cycle took {cycle_s:.3} s, more than --watchdog {limit_s} s. Fix: lower --rate, raise the baud rate, or find what stalls the bus; the torque was turned off")]
+    Watchdog {
+        /// Gait time, s.
+        time_s: f64,
+        /// The cycle's length, s.
+        cycle_s: f64,
+        /// The limit, s.
+        limit_s: f64,
+    },
+    /// The bus itself failed (the port went away).
+    #[error("the bus failed at t = {time_s:.3} s: {reason}. Fix: check the USB adapter's connection; the torque was turned off on every servo that answers")]
+    Bus {
+        /// Gait time, s.
+        time_s: f64,
+        /// The error.
+        reason: String,
+    },
+    /// The log could not be written.
+    #[error("the servo log could not be written at t = {time_s:.3} s: {reason}; the torque was turned off")]
+    Log {
+        /// Gait time, s.
+        time_s: f64,
+        /// The error.
+        reason: String,
+    },
+}
+
+impl DriveError {
+    /// 2: the setup was wrong before anything moved; 3: the bus or the log failed mid-run.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            DriveError::Missing { .. } | DriveError::WrongModel { .. } | DriveError::Setup { .. } => 2,
+            _ => 3,
+        }
+    }
+}
+
+/// What the driver leaves behind: the torque state it confirmed on the way out.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct TorqueOff {
+    /// IDs whose Torque Enable read back 0.
+    pub confirmed: Vec<u8>,
+    /// IDs that did not answer the read-back.
+    pub unconfirmed: Vec<u8>,
+}
+
+/// The whole run's answer.
+#[derive(Debug, Serialize)]
+pub struct DriveReport {
+    /// How it ended.
+    pub outcome: Result<DriveOutcome, String>,
+    /// Cycles run.
+    pub cycles: usize,
+    /// Mean cycle rate, Hz.
+    pub rate_hz: f64,
+    /// Live estimates, one per stance (with a monitor).
+    pub live: Vec<LiveEstimate>,
+    /// The torque on the way out.
+    pub torque_off: TorqueOff,
+}
+
+/// The live monitor: the robot, the simulator's grid at the slope, and one sample's torque
+/// noise, N m.
+#[derive(Debug, Clone)]
+pub struct Monitor<'a> {
+    /// The robot.
+    pub robot: &'a Robot,
+    /// The grid of simulated stance profiles.
+    pub grid: &'a ModelGrid,
+    /// SD of one torque sample, N m.
+    pub noise_sd_n_m: f64,
+}
+
+/// Accumulates each tripod's current stance into bins.
+#[derive(Debug)]
+struct StanceBins {
+    bins: usize,
+    key: [Option<i64>; 2],
+    sum: [Vec<f64>; 2],
+    count: [Vec<usize>; 2],
+}
+
+impl StanceBins {
+    fn new(bins: usize) -> StanceBins {
+        StanceBins { bins, key: [None, None], sum: [vec![0.0; bins], vec![0.0; bins]], count: [vec![0; bins], vec![0; bins]] }
+    }
+
+    /// Adds one sample; returns a completed stance's profile `(tripod, profile, counts)`.
+    #[allow(clippy::type_complexity)]
+    fn add(&mut self, schedule: &GaitSchedule, leg: usize, angle: f64, tau: f64) -> Option<(usize, Vec<Option<f64>>, Vec<usize>)> {
+        let k = schedule.tripods[leg];
+        let (stride, since) = schedule.stride_position(leg, angle);
+        let half = 0.5 * schedule.period_s;
+        let in_stance = since < half && stride >= 1;
+        let mut done = None;
+        if self.key[k].is_some() && (self.key[k] != Some(stride) || !in_stance) {
+            done = Some(self.flush(k));
+        }
+        if in_stance {
+            self.key[k] = Some(stride);
+            let b = ((since / half * self.bins as f64) as usize).min(self.bins - 1);
+            self.sum[k][b] += tau;
+            self.count[k][b] += 1;
+        }
+        done
+    }
+
+    fn flush(&mut self, k: usize) -> (usize, Vec<Option<f64>>, Vec<usize>) {
+        let b = self.bins;
+        let mut profile = vec![None; 2 * b];
+        let mut counts = vec![0; 2 * b];
+        for i in 0..b {
+            let c = self.count[k][i];
+            counts[k * b + i] = c;
+            profile[k * b + i] = (c > 0).then(|| self.sum[k][i] / c as f64);
+        }
+        self.key[k] = None;
+        self.sum[k] = vec![0.0; b];
+        self.count[k] = vec![0; b];
+        (k, profile, counts)
+    }
+}
+
+/// Phase correction of the velocity profile: speed added per radian of lag, 1/s.
+pub const PHASE_GAIN_PER_S: f64 = 4.0;
+
+/// The bus type the driver runs on.
+pub type DynamixelBus = Bus<Vec<u8>, Vec<u8>>;
+
+/// Runs the gait on `bus`: setup, stand up, walk for the settings' duration (or until `stop`
+/// is set, a halt on risk, or an error), then torque off. `on_sample` receives every servo's
+/// state every cycle (the log); an error from it stops the run. Returns the report; its
+/// `outcome` is the error's message on failure, and the error itself is returned beside it.
+pub fn drive(
+    bus: &mut DynamixelBus,
+    schedule: &GaitSchedule,
+    settings: &DriveSettings,
+    monitor: Option<Monitor<'_>>,
+    stop: &AtomicBool,
+    on_sample: &mut dyn FnMut(&ServoSample) -> std::io::Result<()>,
+    on_live: &mut dyn FnMut(&LiveEstimate),
+) -> (DriveReport, Option<DriveError>) {
+    let mut report = DriveReport { outcome: Err(String::new()), cycles: 0, rate_hz: 0.0, live: vec![], torque_off: TorqueOff::default() };
+    let result = setup(bus, schedule, settings).and_then(|()| run(bus, schedule, settings, monitor, stop, on_sample, on_live, &mut report));
+    report.torque_off = torque_off(bus, &settings.servos);
+    match result {
+        Ok(o) => {
+            report.outcome = Ok(o);
+            (report, None)
+        }
+        Err(e) => {
+            report.outcome = Err(e.to_string());
+            (report, Some(e))
+        }
+    }
+}
+
+fn setup(bus: &mut DynamixelBus, schedule: &GaitSchedule, settings: &DriveSettings) -> Result<(), DriveError> {
+    let baud = bus.baud_rate();
+    let mut answered = vec![];
+    let mut missing = None;
+    for (leg, s) in settings.servos.iter().enumerate() {
+        match bus.ping(s.id) {
+            Ok(r) => {
+                if r.data.model != xl330::MODEL_NUMBER {
+                    return Err(DriveError::WrongModel { id: s.id, leg, model: r.data.model, expected: xl330::MODEL_NUMBER });
+                }
+                answered.push(s.id);
+            }
+            Err(_) => {
+                if missing.is_none() {
+                    missing = Some((s.id, leg));
+                }
+            }
+        }
+    }
+    if let Some((id, leg)) = missing {
+        // Which IDs are on the bus at all: a broadcast ping.
+        let mut found: Vec<u8> = bus
+            .scan()
+            .map(|v| v.into_iter().filter_map(|r| r.ok().map(|r| r.motor_id)).collect())
+            .unwrap_or_default();
+        found.sort_unstable();
+        found.dedup();
+        let answered = if found.is_empty() { "none".to_string() } else { found.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ") };
+        return Err(DriveError::Missing { id, leg, baud, answered });
+    }
+    let omega = schedule.leg_speed_rad_s;
+    let op = match settings.profile {
+        Profile::Position => mode::EXTENDED_POSITION,
+        Profile::Velocity => mode::VELOCITY,
+    };
+    let accel = ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT).round().clamp(1.0, 32767.0) as u32;
+    let prof_v = (1.5 * omega / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, 32767.0) as u32;
+    let vel_limit = (2.0 * omega / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, 2047.0) as u32;
+    let watchdog = (settings.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round().clamp(1.0, 127.0) as u8;
+    for (leg, s) in settings.servos.iter().enumerate() {
+        let id = s.id;
+        let w = |bus: &mut DynamixelBus, addr: u16, data: &[u8], what: &'static str, fix: &'static str| {
+            bus.write(id, addr, data).map(|_| ()).map_err(|e| DriveError::Setup { id, leg, what, reason: e.to_string(), fix })
+        };
+        w(bus, t::TORQUE_ENABLE, &[0], "Torque Enable = 0", "power-cycle the servo")?;
+        w(bus, t::BUS_WATCHDOG, &[0], "Bus Watchdog = 0", "reboot the servo (Dynamixel Wizard)")?;
+        w(bus, t::OPERATING_MODE, &[op], "Operating Mode", "check the model is an XL330")?;
+        w(bus, t::DRIVE_MODE, &[0], "Drive Mode = 0 (velocity-based profile)", "check the model is an XL330")?;
+        w(bus, t::CURRENT_LIMIT, &settings.current_limit_ma.to_le_bytes(), "Current Limit", "use --current-limit within 0 to 1750 mA")?;
+        w(bus, t::TEMPERATURE_LIMIT, &[settings.temperature_limit_c], "Temperature Limit", "use --temperature-limit within 0 to 70 degC")?;
+        w(bus, t::VELOCITY_LIMIT, &vel_limit.to_le_bytes(), "Velocity Limit", "lower leg_speed_rad_s")?;
+        w(bus, t::PROFILE_ACCELERATION, &accel.to_le_bytes(), "Profile Acceleration", "raise response_time_s")?;
+        w(bus, t::PROFILE_VELOCITY, &prof_v.to_le_bytes(), "Profile Velocity", "lower leg_speed_rad_s")?;
+        w(bus, t::BUS_WATCHDOG, &[watchdog], "Bus Watchdog", "reboot the servo (Dynamixel Wizard)")?;
+    }
+    Ok(())
+}
+
+/// Reads every servo's state block; per servo `Ok((state, alert))` or the read error.
+fn read_states(bus: &mut DynamixelBus, ids: &[u8]) -> Result<Vec<Result<(PresentState, bool), ReadError>>, String> {
+    let mut out: Vec<Option<Result<(PresentState, bool), ReadError>>> = (0..ids.len()).map(|_| None).collect();
+    bus.sync_read_cb(ids, t::STATE_BLOCK.0, t::STATE_BLOCK.1, |r| match r {
+        Ok(resp) => {
+            if let Some(i) = ids.iter().position(|&x| x == resp.motor_id) {
+                out[i] = Some(PresentState::decode(resp.data).map(|s| (s, resp.alert)).ok_or_else(|| {
+                    ReadError::Io(std::io::Error::new(std::io::ErrorKind::InvalidData, "short state block"))
+                }));
+            }
+        }
+        Err(e) => {
+            if let Some(slot) = out.iter_mut().find(|s| s.is_none()) {
+                *slot = Some(Err(e));
+            }
+        }
+    })
+    .map_err(|e| e.to_string())?;
+    Ok(out.into_iter().map(|o| o.unwrap_or_else(|| Err(ReadError::Io(std::io::ErrorKind::TimedOut.into())))).collect())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run(
+    bus: &mut DynamixelBus,
+    schedule: &GaitSchedule,
+    settings: &DriveSettings,
+    monitor: Option<Monitor<'_>>,
+    stop: &AtomicBool,
+    on_sample: &mut dyn FnMut(&ServoSample) -> std::io::Result<()>,
+    on_live: &mut dyn FnMut(&LiveEstimate),
+    report: &mut DriveReport,
+) -> Result<DriveOutcome, DriveError> {
+    let ids: Vec<u8> = settings.servos.iter().map(|s| s.id).collect();
+    let period = Duration::from_secs_f64(1.0 / settings.rate_hz);
+    let stand_s = settings.stand_s;
+    let mut failures = vec![(0usize, false); ids.len()];
+    let mut last_pos: Vec<Option<i32>> = vec![None; ids.len()];
+    let mut bins = monitor.as_ref().map(|m| StanceBins::new(m.grid.bins));
+    // Stand up: torque on, then the start pose from where each leg is, forward only.
+    let states = read_states(bus, &ids).map_err(|reason| DriveError::Bus { time_s: -stand_s, reason })?;
+    let mut start_goal = vec![0i32; ids.len()];
+    for (j, s) in settings.servos.iter().enumerate() {
+        let here = match &states[j] {
+            Ok((st, _)) => s.angle(st.position),
+            Err(e) => return Err(DriveError::Lost { id: s.id, leg: j, time_s: -stand_s, cycles: 1, reason: e.to_string() }),
+        };
+        let start = schedule.start_angle(j);
+        let turns = ((here - start) / (2.0 * std::f64::consts::PI)).ceil();
+        start_goal[j] = s.pulses(start + turns * 2.0 * std::f64::consts::PI);
+    }
+    // Every angle from here on is relative to the start pose found: shift the schedule by it.
+    let shift: Vec<f64> = settings
+        .servos
+        .iter()
+        .enumerate()
+        .map(|(j, s)| s.angle(start_goal[j]) - schedule.start_angle(j))
+        .collect();
+    let torque_on: Vec<SyncWriteData<[u8; 1]>> = ids.iter().map(|&id| SyncWriteData { motor_id: id, data: [1] }).collect();
+    bus.sync_write(t::TORQUE_ENABLE, 1, &torque_on).map_err(|e| DriveError::Bus { time_s: -stand_s, reason: e.to_string() })?;
+    let begin = Instant::now();
+    let mut last_cycle = Instant::now();
+    let mut halted: Option<(f64, f64)> = None;
+    let mut halt_goal: Vec<i32> = vec![];
+    loop {
+        let elapsed = begin.elapsed().as_secs_f64();
+        let time = elapsed - stand_s;
+        let cycle = last_cycle.elapsed().as_secs_f64();
+        last_cycle = Instant::now();
+        if report.cycles > 0 && cycle > settings.watchdog_s {
+            return Err(DriveError::Watchdog { time_s: time, cycle_s: cycle, limit_s: settings.watchdog_s });
+        }
+        if stop.load(Ordering::Relaxed) {
+            return Ok(DriveOutcome::Interrupted { time_s: time });
+        }
+        if let Some((at, p)) = halted {
+            if time - at >= settings.hold_s {
+                return Ok(DriveOutcome::Halted { time_s: at, p_slippage: p });
+            }
+        } else if time >= settings.duration_s {
+            return Ok(DriveOutcome::Completed { time_s: time });
+        }
+        // Goals.
+        let goals: Vec<(i32, i32)> = settings
+            .servos
+            .iter()
+            .enumerate()
+            .map(|(j, s)| {
+                if halted.is_some() {
+                    return (halt_goal[j], 0);
+                }
+                if time < 0.0 {
+                    return (start_goal[j], 0);
+                }
+                let c = schedule.command(j, time);
+                let goal = s.pulses(c.angle_rad + shift[j]);
+                (goal, 0)
+            })
+            .collect();
+        let result = match settings.profile {
+            Profile::Position => {
+                let data: Vec<SyncWriteData<[u8; 4]>> =
+                    ids.iter().zip(&goals).map(|(&id, g)| SyncWriteData { motor_id: id, data: g.0.to_le_bytes() }).collect();
+                bus.sync_write(t::GOAL_POSITION, 4, &data)
+            }
+            Profile::Velocity => {
+                // Velocity mode: the schedule's speed plus a phase correction, from the last
+                // read position (below); standing and halted: position error only.
+                let data: Vec<SyncWriteData<[u8; 4]>> = ids
+                    .iter()
+                    .enumerate()
+                    .map(|(j, &id)| {
+                        let s = settings.servos[j];
+                        let cmd_v = if time >= 0.0 && halted.is_none() { schedule.command(j, time).velocity_rad_s } else { 0.0 };
+                        let err = last_pos[j].map_or(0.0, |p| s.angle(goals[j].0) - s.angle(p));
+                        let v = f64::from(s.direction) * (cmd_v + PHASE_GAIN_PER_S * err);
+                        let units = xl330::velocity_units_from_rad_s(v).clamp(-2047, 2047) as i32;
+                        SyncWriteData { motor_id: id, data: units.to_le_bytes() }
+                    })
+                    .collect();
+                bus.sync_write(t::GOAL_VELOCITY, 4, &data)
+            }
+        };
+        result.map_err(|e| DriveError::Bus { time_s: time, reason: e.to_string() })?;
+        let states = read_states(bus, &ids).map_err(|reason| DriveError::Bus { time_s: time, reason })?;
+        report.cycles += 1;
+        for (j, st) in states.into_iter().enumerate() {
+            let s = settings.servos[j];
+            match st {
+                Ok((state, alert)) => {
+                    failures[j] = (0, false);
+                    last_pos[j] = Some(state.position);
+                    let hardware_error = if alert { bus.read_u8(s.id, t::HARDWARE_ERROR_STATUS).map(|r| r.data).unwrap_or(0xFF) } else { 0 };
+                    let angle = s.angle(state.position) - shift[j];
+                    let tau = f64::from(s.direction) * xl330::torque_from_current(f64::from(state.current_ma));
+                    let sample = ServoSample {
+                        time_s: time,
+                        leg: j,
+                        tripod: schedule.tripods[j],
+                        id: s.id,
+                        state,
+                        hardware_error,
+                        goal_position: goals[j].0,
+                        leg_angle_rad: angle,
+                        drive_torque_n_m: tau,
+                    };
+                    on_sample(&sample).map_err(|e| DriveError::Log { time_s: time, reason: e.to_string() })?;
+                    if let (Some(b), Some(m)) = (bins.as_mut(), monitor.as_ref()) {
+                        if let Some((k, profile, counts)) = b.add(schedule, j, angle, tau) {
+                            if let Some(inf) = infer_from_stance(m.robot, m.grid, k, &profile, &counts, m.noise_sd_n_m) {
+                                let live = LiveEstimate { time_s: time, tripod: k, inference: inf };
+                                on_live(&live);
+                                let p = live.inference.p_slippage;
+                                report.live.push(live);
+                                if let (Some(limit), None) = (settings.stop_on_risk, halted) {
+                                    if p > limit {
+                                        halted = Some((time, p));
+                                        // Hold every leg where it was last read: the stance
+                                        // tripod stays planted.
+                                        halt_goal = last_pos.iter().zip(&goals).map(|(p, g)| p.unwrap_or(g.0)).collect();
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                Err(e) => {
+                    let corrupt = matches!(e, ReadError::InvalidMessage(_));
+                    let n = if failures[j].1 == corrupt { failures[j].0 + 1 } else { 1 };
+                    failures[j] = (n, corrupt);
+                    if n >= 3 {
+                        return Err(if corrupt {
+                            DriveError::Corrupt { id: s.id, leg: j, time_s: time, cycles: n }
+                        } else {
+                            DriveError::Lost { id: s.id, leg: j, time_s: time, cycles: n, reason: e.to_string() }
+                        });
+                    }
+                }
+            }
+        }
+        let spent = last_cycle.elapsed();
+        if spent < period {
+            std::thread::sleep(period - spent);
+        }
+        report.rate_hz = report.cycles as f64 / begin.elapsed().as_secs_f64().max(1e-9);
+    }
+}
+
+/// Torque off on every servo (a Sync Write, then each servo written and read back alone).
+pub fn torque_off(bus: &mut DynamixelBus, servos: &[ServoConfig]) -> TorqueOff {
+    let data: Vec<SyncWriteData<[u8; 1]>> = servos.iter().map(|s| SyncWriteData { motor_id: s.id, data: [0] }).collect();
+    bus.sync_write(t::TORQUE_ENABLE, 1, &data).ok();
+    let mut out = TorqueOff::default();
+    for s in servos {
+        let mut ok = false;
+        for _ in 0..3 {
+            if bus.write_u8(s.id, t::TORQUE_ENABLE, 0).is_ok() && matches!(bus.read_u8(s.id, t::TORQUE_ENABLE), Ok(r) if r.data == 0) {
+                ok = true;
+                break;
+            }
+        }
+        if ok {
+            out.confirmed.push(s.id);
+        } else {
+            out.unconfirmed.push(s.id);
+        }
+    }
+    out
+}

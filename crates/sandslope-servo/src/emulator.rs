@@ -1,0 +1,631 @@
+//! A bus of virtual XL330-M288s on a pseudo-terminal (docs/drive.md, "The emulator").
+//!
+//! Each virtual servo keeps the XL330's control table, answers Protocol 2.0 byte for byte
+//! ([`crate::packet`]), moves its shaft as its operating mode and goal say (velocity-based
+//! profile: velocity and acceleration limits from Profile Velocity and Profile Acceleration,
+//! or the Velocity Limit) and reports as Present Current the torque its leg needs in the sand,
+//! `I = tau / K_t` (docs/model.md §19), plus Gaussian sensor noise. The torque comes from a
+//! walk of the stride simulator (`sandslope::simulate`) on the given terrain and slope, looked
+//! up by the leg's angle: a leg at angle psi feels what the simulated leg of the same tripod
+//! felt at that angle of its stride, stride after stride (the simulated strides played in
+//! turn). The driver talks to it through the same `dynamixel2::Bus` over a `serial2` port as
+//! to a real bus; only the opening differs (a pty pair instead of a device path).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use sandslope::infer::servo::{simulated_legs, LegTrace};
+use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::simulate::{simulate, SimSettings};
+use sandslope::{Robot, Scenario, Terrain};
+use serial2::SerialPort;
+
+use crate::driver::ServoConfig;
+use crate::packet::{self, error, inst, Instruction, Parsed, Parser};
+use crate::table::{self as t, mode};
+
+/// Faults the emulator can be told to show, for tests and demonstrations.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EmulatorFaults {
+    /// `(id, s)`: servo `id` stops answering (and obeying) `s` seconds after the start.
+    pub silent: Option<(u8, f64)>,
+    /// `(id, s)`: servo `id`'s status packets fail their CRC from `s` seconds on.
+    pub corrupt: Option<(u8, f64)>,
+    /// `(s, length)`: the bus hangs for `length` seconds from `s` (nothing is answered).
+    pub freeze: Option<(f64, f64)>,
+    /// `(s, k_s)`: the sand weakens to shear strength `k_s` N/m^3 `s` seconds after the start.
+    pub weaken: Option<(f64, f64)>,
+}
+
+/// What the emulator emulates.
+#[derive(Debug, Clone)]
+pub struct EmulatorConfig {
+    /// The servos as mounted (IDs, directions, zero offsets), in leg order.
+    pub servos: Vec<ServoConfig>,
+    /// The robot.
+    pub robot: Robot,
+    /// The terrain.
+    pub terrain: Terrain,
+    /// Slope, degrees.
+    pub slope_deg: f64,
+    /// Present Current noise, mA (standard deviation).
+    pub current_noise_ma: f64,
+    /// Seed of the noise.
+    pub seed: u64,
+    /// Strides the stride simulator walks (played in turn, the first left out).
+    pub simulated_strides: usize,
+    /// Faults to show.
+    pub faults: EmulatorFaults,
+    /// Model number reported (1200, the XL330-M288; tests may set the e-Manual example's).
+    pub model_number: u16,
+    /// Firmware version reported.
+    pub firmware: u8,
+}
+
+impl EmulatorConfig {
+    /// Six XL330-M288s (IDs 1-6, directions +1, zero offsets 0) under the robot on the terrain.
+    pub fn new(robot: Robot, terrain: Terrain, slope_deg: f64, servos: Vec<ServoConfig>) -> EmulatorConfig {
+        EmulatorConfig {
+            servos,
+            robot,
+            terrain,
+            slope_deg,
+            current_noise_ma: 10.0,
+            seed: 1,
+            simulated_strides: 8,
+            faults: EmulatorFaults::default(),
+            model_number: xl330::MODEL_NUMBER,
+            firmware: 46,
+        }
+    }
+}
+
+/// Why the emulator could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum EmulatorError {
+    /// The pseudo-terminal pair could not be opened.
+    #[error("cannot open a pseudo-terminal pair for the emulator: {0}")]
+    Pty(std::io::Error),
+    /// The stride simulator refused the walk.
+    #[error("the emulator's stride simulator cannot walk this robot on this terrain: {0}")]
+    Simulator(String),
+}
+
+/// What the emulator saw, returned when it stops: the state of each servo's torque as its own
+/// control table holds it (not as the driver believes).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EmulatorReport {
+    /// `(id, torque enabled)` per servo at the end.
+    pub torque_enabled: Vec<(u8, bool)>,
+    /// Instruction packets received with a valid CRC.
+    pub packets: usize,
+    /// Packets received with a bad CRC.
+    pub bad_crc: usize,
+    /// Each servo's Bus Watchdog at the end (100: it fired).
+    pub watchdog: Vec<(u8, u8)>,
+}
+
+/// A walk of the stride simulator, as the legs' drive torque against their angle.
+#[derive(Debug, Clone)]
+struct Walk {
+    legs: Vec<LegTrace>,
+    rate_hz: f64,
+}
+
+impl Walk {
+    fn new(robot: &Robot, terrain: Terrain, slope_deg: f64, strides: usize) -> Result<Walk, EmulatorError> {
+        let schedule = GaitSchedule::new(robot, 2 * robot.stance_legs() as usize)
+            .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+        let rate_hz = 500.0;
+        let settings = SimSettings::new(strides.max(3) as f64 * schedule.period_s)
+            .and_then(|s| s.with_sample_rate(rate_hz))
+            .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+        let scenario = Scenario::new(robot.clone(), terrain, None, None).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+        let sim = simulate(&scenario, slope_deg, &settings).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+        Ok(Walk { legs: simulated_legs(&schedule, &sim), rate_hz })
+    }
+
+    /// Drive torque of leg `leg` at gait angle `angle` (N m): the simulated leg's at the same
+    /// angle, strides beyond the simulated ones wrapped back onto strides 1 and later.
+    fn torque(&self, leg: usize, angle: f64) -> f64 {
+        let trace = &self.legs[leg];
+        let n = trace.angle_rad.len();
+        if n < 2 {
+            return 0.0;
+        }
+        let a0 = trace.angle_rad[0];
+        let span = trace.angle_rad[n - 1] - a0;
+        let turn = 2.0 * std::f64::consts::PI;
+        let mut rel = angle - a0;
+        if rel > span {
+            // Play strides 1.. again: wrap by whole turns into [turn, span].
+            let usable = ((span - turn) / turn).floor().max(1.0) * turn;
+            rel = turn + (rel - turn).rem_euclid(usable);
+        }
+        // The simulated angle grows at omega from a0: the sample index follows the angle.
+        let frac = (rel.max(0.0) / span).min(1.0);
+        let i = ((frac * (n - 1) as f64).round() as usize).min(n - 1);
+        let _ = self.rate_hz;
+        trace.torque_n_m[i]
+    }
+}
+
+/// One virtual XL330.
+#[derive(Debug, Clone)]
+struct VirtualServo {
+    table: [u8; t::TABLE_SIZE],
+    /// Shaft position, pulses (multi-turn).
+    position: f64,
+    /// Shaft velocity, rad/s.
+    velocity: f64,
+    last_update: f64,
+    last_seen: f64,
+    current_ema: f64,
+    config: ServoConfig,
+    leg: usize,
+}
+
+impl VirtualServo {
+    fn new(config: ServoConfig, leg: usize, model: u16, firmware: u8) -> VirtualServo {
+        let mut table = [0u8; t::TABLE_SIZE];
+        let mut s = VirtualServo {
+            table: [0; t::TABLE_SIZE],
+            position: f64::from(config.zero_offset_pulses),
+            velocity: 0.0,
+            last_update: 0.0,
+            last_seen: 0.0,
+            current_ema: 0.0,
+            config,
+            leg,
+        };
+        table[0..2].copy_from_slice(&model.to_le_bytes());
+        table[t::FIRMWARE_VERSION as usize] = firmware;
+        table[t::ID as usize] = config.id;
+        table[t::BAUD_RATE as usize] = 3;
+        table[t::RETURN_DELAY_TIME as usize] = 250;
+        table[t::OPERATING_MODE as usize] = mode::POSITION;
+        table[t::TEMPERATURE_LIMIT as usize] = 70;
+        table[t::MAX_VOLTAGE_LIMIT as usize..][..2].copy_from_slice(&70u16.to_le_bytes());
+        table[t::MIN_VOLTAGE_LIMIT as usize..][..2].copy_from_slice(&35u16.to_le_bytes());
+        table[t::CURRENT_LIMIT as usize..][..2].copy_from_slice(&1750u16.to_le_bytes());
+        table[t::VELOCITY_LIMIT as usize..][..4].copy_from_slice(&445u32.to_le_bytes());
+        table[t::SHUTDOWN as usize] = 53;
+        table[t::STATUS_RETURN_LEVEL as usize] = 2;
+        s.table = table;
+        s
+    }
+
+    fn u8_at(&self, a: u16) -> u8 {
+        self.table[a as usize]
+    }
+    fn u16_at(&self, a: u16) -> u16 {
+        u16::from_le_bytes([self.table[a as usize], self.table[a as usize + 1]])
+    }
+    fn i32_at(&self, a: u16) -> i32 {
+        let a = a as usize;
+        i32::from_le_bytes([self.table[a], self.table[a + 1], self.table[a + 2], self.table[a + 3]])
+    }
+    fn put(&mut self, a: u16, bytes: &[u8]) {
+        self.table[a as usize..][..bytes.len()].copy_from_slice(bytes);
+    }
+    fn torque_on(&self) -> bool {
+        self.u8_at(t::TORQUE_ENABLE) == 1
+    }
+
+    /// Leg angle in the gait's frame, rad.
+    fn leg_angle(&self) -> f64 {
+        f64::from(self.config.direction) * (self.position - f64::from(self.config.zero_offset_pulses)) * xl330::RAD_PER_PULSE
+    }
+
+    /// Moves the shaft to time `now` and refreshes the present values.
+    fn advance(&mut self, now: f64, walk: &Walk, noise: &mut Noise, noise_ma: f64) {
+        let dt = (now - self.last_update).max(0.0);
+        self.last_update = now;
+        let wd = self.u8_at(t::BUS_WATCHDOG);
+        if self.torque_on() && (1..=127).contains(&wd) && now - self.last_seen > f64::from(wd) * xl330::WATCHDOG_UNIT_S {
+            // The watchdog fired: the servo stops where it is and marks it (e-Manual, Bus Watchdog).
+            self.table[t::BUS_WATCHDOG as usize] = t::WATCHDOG_FIRED;
+            let here = self.position.round() as i32;
+            self.put(t::GOAL_POSITION, &here.to_le_bytes());
+            self.put(t::GOAL_VELOCITY, &0i32.to_le_bytes());
+        }
+        let vel_limit = f64::from(self.i32_at(t::VELOCITY_LIMIT)) * xl330::RAD_S_PER_VELOCITY_UNIT;
+        let acc = f64::from(self.i32_at(t::PROFILE_ACCELERATION)) * xl330::RAD_S2_PER_ACCELERATION_UNIT;
+        let prof_v = f64::from(self.i32_at(t::PROFILE_VELOCITY)) * xl330::RAD_S_PER_VELOCITY_UNIT;
+        let fired = self.u8_at(t::BUS_WATCHDOG) == t::WATCHDOG_FIRED;
+        let target_v = if !self.torque_on() {
+            0.0
+        } else if self.u8_at(t::OPERATING_MODE) == mode::VELOCITY {
+            if fired {
+                0.0
+            } else {
+                (f64::from(self.i32_at(t::GOAL_VELOCITY)) * xl330::RAD_S_PER_VELOCITY_UNIT).clamp(-vel_limit, vel_limit)
+            }
+        } else {
+            let vmax = if prof_v > 0.0 { prof_v.min(vel_limit) } else { vel_limit };
+            let to_go = (f64::from(self.i32_at(t::GOAL_POSITION)) - self.position) * xl330::RAD_PER_PULSE;
+            if dt > 0.0 {
+                (to_go / dt).clamp(-vmax, vmax)
+            } else {
+                self.velocity
+            }
+        };
+        if self.torque_on() && acc > 0.0 {
+            let dv = (target_v - self.velocity).clamp(-acc * dt, acc * dt);
+            self.velocity += dv;
+        } else {
+            self.velocity = target_v;
+        }
+        if !self.torque_on() {
+            self.velocity = 0.0;
+        }
+        self.position += self.velocity * dt / xl330::RAD_PER_PULSE;
+        // The leg's drive torque in the sand, as the servo's current (its own sign).
+        let tau = if self.torque_on() { walk.torque(self.leg, self.leg_angle()) } else { 0.0 };
+        let dir = f64::from(self.config.direction);
+        let current = dir * xl330::current_from_torque(tau) + noise.gauss() * noise_ma;
+        let limit = f64::from(self.u16_at(t::CURRENT_LIMIT));
+        let current = current.clamp(-limit, limit);
+        self.current_ema += (current * current - self.current_ema) * (dt / 30.0).min(1.0);
+        let temp = 28.0 + 25.0 * self.current_ema / (1470.0f64 * 1470.0);
+        let voltage = 50.0 - (current.abs() / 500.0).round() + noise.gauss().round().clamp(-1.0, 1.0);
+        self.put(t::PRESENT_CURRENT, &(current.round() as i16).to_le_bytes());
+        let v_units = (self.velocity / xl330::RAD_S_PER_VELOCITY_UNIT).round() as i32;
+        self.put(t::PRESENT_VELOCITY, &v_units.to_le_bytes());
+        self.put(t::PRESENT_POSITION, &(self.position.round() as i32).to_le_bytes());
+        self.put(t::PRESENT_INPUT_VOLTAGE, &(voltage.max(0.0) as u16).to_le_bytes());
+        self.table[t::PRESENT_TEMPERATURE as usize] = temp.round().clamp(0.0, 255.0) as u8;
+        self.table[t::MOVING as usize] = u8::from(self.velocity.abs() > 0.01);
+        if temp.round() > f64::from(self.u8_at(t::TEMPERATURE_LIMIT)) {
+            self.table[t::HARDWARE_ERROR_STATUS as usize] |= 1 << 2;
+            self.table[t::TORQUE_ENABLE as usize] = 0;
+        }
+    }
+
+    fn error_byte(&self, e: u8) -> u8 {
+        if self.u8_at(t::HARDWARE_ERROR_STATUS) != 0 {
+            e | error::ALERT
+        } else {
+            e
+        }
+    }
+
+    /// Writes `data` at `addr` as a Write instruction does; the status error number.
+    fn write(&mut self, addr: u16, data: &[u8]) -> u8 {
+        let end = usize::from(addr) + data.len();
+        if end > t::TABLE_SIZE || data.is_empty() {
+            return error::DATA_LENGTH;
+        }
+        if addr < t::TORQUE_ENABLE && self.torque_on() {
+            return error::ACCESS;
+        }
+        if (addr..addr + data.len() as u16).any(|a| a < 64 && matches!(a, 0..=6)) {
+            return error::ACCESS;
+        }
+        if self.u8_at(t::BUS_WATCHDOG) == t::WATCHDOG_FIRED
+            && (addr == t::GOAL_POSITION || addr == t::GOAL_VELOCITY)
+        {
+            return error::DATA_RANGE;
+        }
+        self.put(addr, data);
+        if addr <= t::CURRENT_LIMIT && end > usize::from(t::CURRENT_LIMIT) {
+            let c = self.u16_at(t::CURRENT_LIMIT).min(xl330::MAX_CURRENT_LIMIT_MA);
+            self.put(t::CURRENT_LIMIT, &c.to_le_bytes());
+        }
+        if addr == t::TORQUE_ENABLE && data[0] == 1 {
+            // Torque on holds the present position (as a real servo's goal follows it).
+            let here = self.position.round() as i32;
+            self.put(t::GOAL_POSITION, &here.to_le_bytes());
+        }
+        0
+    }
+
+    fn read(&self, addr: u16, len: u16) -> Result<Vec<u8>, u8> {
+        let end = usize::from(addr) + usize::from(len);
+        if end > t::TABLE_SIZE {
+            return Err(error::DATA_LENGTH);
+        }
+        Ok(self.table[usize::from(addr)..end].to_vec())
+    }
+}
+
+/// Gaussian noise from a seeded generator (splitmix64 and Box-Muller).
+#[derive(Debug, Clone)]
+struct Noise(u64);
+
+impl Noise {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn uniform(&mut self) -> f64 {
+        ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+    fn gauss(&mut self) -> f64 {
+        let (u, v) = (self.uniform(), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+    }
+}
+
+/// The virtual bus: servos, walks and faults; answers instruction packets.
+#[derive(Debug, Clone)]
+pub struct VirtualBus {
+    servos: Vec<VirtualServo>,
+    walk: Walk,
+    weak_walk: Option<Walk>,
+    faults: EmulatorFaults,
+    noise: Noise,
+    noise_ma: f64,
+    parser_packets: usize,
+    bad_crc: usize,
+}
+
+impl VirtualBus {
+    /// The bus of `config` (runs the stride simulator once, twice with a weakening).
+    pub fn new(config: &EmulatorConfig) -> Result<VirtualBus, EmulatorError> {
+        let walk = Walk::new(&config.robot, config.terrain.clone(), config.slope_deg, config.simulated_strides)?;
+        let weak_walk = match config.faults.weaken {
+            Some((_, k_s)) => {
+                let k_n = config.terrain.at(sandslope::Slope::from_signed_degrees(config.slope_deg.abs()).map_err(|e| EmulatorError::Simulator(e.to_string()))?).k_n;
+                let weak = Terrain::constant(k_n, k_s).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+                Some(Walk::new(&config.robot, weak, config.slope_deg, config.simulated_strides)?)
+            }
+            None => None,
+        };
+        let servos = config
+            .servos
+            .iter()
+            .enumerate()
+            .map(|(leg, c)| VirtualServo::new(*c, leg, config.model_number, config.firmware))
+            .collect();
+        Ok(VirtualBus {
+            servos,
+            walk,
+            weak_walk,
+            faults: config.faults,
+            noise: Noise(config.seed),
+            noise_ma: config.current_noise_ma,
+            parser_packets: 0,
+            bad_crc: 0,
+        })
+    }
+
+    fn advance_all(&mut self, now: f64) {
+        let walk = match (&self.weak_walk, self.faults.weaken) {
+            (Some(w), Some((at, _))) if now >= at => w,
+            _ => &self.walk,
+        };
+        let silent = self.faults.silent;
+        for s in &mut self.servos {
+            if !matches!(silent, Some((sid, at)) if sid == s.config.id && now >= at) {
+                s.advance(now, walk, &mut self.noise, self.noise_ma);
+            }
+        }
+    }
+
+    fn silent(&self, id: u8, now: f64) -> bool {
+        matches!(self.faults.silent, Some((sid, at)) if sid == id && now >= at)
+    }
+
+    /// Whether the bus is frozen at `now`.
+    pub fn frozen(&self, now: f64) -> bool {
+        matches!(self.faults.freeze, Some((at, len)) if now >= at && now < at + len)
+    }
+
+    /// The bytes the servos send back for one parsed packet received at `now` s.
+    pub fn respond(&mut self, parsed: Parsed, now: f64) -> Vec<u8> {
+        self.advance_all(now);
+        let ins = match parsed {
+            Parsed::BadCrc { .. } => {
+                self.bad_crc += 1;
+                return vec![];
+            }
+            Parsed::Instruction(i) => i,
+        };
+        self.parser_packets += 1;
+        let mut out = Vec::new();
+        let ids: Vec<u8> = self.servos.iter().map(|s| s.config.id).collect();
+        for (k, id) in ids.iter().enumerate() {
+            if self.silent(*id, now) {
+                continue;
+            }
+            let reply = self.handle_one(k, &ins, now);
+            if let Some(mut bytes) = reply {
+                if matches!(self.faults.corrupt, Some((cid, at)) if cid == *id && now >= at) {
+                    let n = bytes.len();
+                    bytes[n - 1] ^= 0x5A;
+                }
+                out.push((order_of(&ins, *id), bytes));
+            }
+        }
+        out.sort_by_key(|(o, _)| *o);
+        out.into_iter().flat_map(|(_, b)| b).collect()
+    }
+
+    /// Servo `k`'s reply to `ins`, if it answers.
+    fn handle_one(&mut self, k: usize, ins: &Instruction, now: f64) -> Option<Vec<u8>> {
+        let id = self.servos[k].config.id;
+        let p = &ins.params;
+        let addressed = ins.id == id || ins.id == packet::BROADCAST;
+        let u16p = |i: usize| u16::from_le_bytes([p[i], p[i + 1]]);
+        match ins.instruction {
+            inst::PING if addressed => {
+                self.servos[k].last_seen = now;
+                let s = &self.servos[k];
+                Some(packet::status(id, s.error_byte(0), &[s.table[0], s.table[1], s.table[t::FIRMWARE_VERSION as usize]]))
+            }
+            inst::READ if ins.id == id => {
+                self.servos[k].last_seen = now;
+                let s = &self.servos[k];
+                if p.len() != 4 {
+                    return Some(packet::status(id, s.error_byte(error::DATA_LENGTH), &[]));
+                }
+                Some(match s.read(u16p(0), u16p(2)) {
+                    Ok(data) => packet::status(id, s.error_byte(0), &data),
+                    Err(e) => packet::status(id, s.error_byte(e), &[]),
+                })
+            }
+            inst::WRITE if addressed => {
+                self.servos[k].last_seen = now;
+                if p.len() < 3 {
+                    return (ins.id == id).then(|| packet::status(id, error::DATA_LENGTH, &[]));
+                }
+                let e = self.servos[k].write(u16p(0), &p[2..]);
+                (ins.id == id).then(|| packet::status(id, self.servos[k].error_byte(e), &[]))
+            }
+            inst::REBOOT if addressed => {
+                let s = &mut self.servos[k];
+                s.last_seen = now;
+                s.table[t::TORQUE_ENABLE as usize] = 0;
+                s.table[t::HARDWARE_ERROR_STATUS as usize] = 0;
+                s.table[t::BUS_WATCHDOG as usize] = 0;
+                (ins.id == id).then(|| packet::status(id, 0, &[]))
+            }
+            inst::SYNC_READ if ins.id == packet::BROADCAST && p.len() >= 4 => {
+                if !p[4..].contains(&id) {
+                    return None;
+                }
+                self.servos[k].last_seen = now;
+                let s = &self.servos[k];
+                Some(match s.read(u16p(0), u16p(2)) {
+                    Ok(data) => packet::status(id, s.error_byte(0), &data),
+                    Err(e) => packet::status(id, s.error_byte(e), &[]),
+                })
+            }
+            inst::SYNC_WRITE if ins.id == packet::BROADCAST && p.len() >= 4 => {
+                let (addr, len) = (u16p(0), usize::from(u16p(2)));
+                for chunk in p[4..].chunks(len + 1) {
+                    if chunk.len() == len + 1 && chunk[0] == id {
+                        self.servos[k].last_seen = now;
+                        self.servos[k].write(addr, &chunk[1..]);
+                    }
+                }
+                None
+            }
+            inst::BULK_READ if ins.id == packet::BROADCAST => {
+                let entry = p.chunks(5).find(|c| c.len() == 5 && c[0] == id)?;
+                self.servos[k].last_seen = now;
+                let s = &self.servos[k];
+                let (addr, len) = (u16::from_le_bytes([entry[1], entry[2]]), u16::from_le_bytes([entry[3], entry[4]]));
+                Some(match s.read(addr, len) {
+                    Ok(data) => packet::status(id, s.error_byte(0), &data),
+                    Err(e) => packet::status(id, s.error_byte(e), &[]),
+                })
+            }
+            inst::BULK_WRITE if ins.id == packet::BROADCAST => {
+                let mut i = 0;
+                while i + 5 <= p.len() {
+                    let (sid, addr, len) = (p[i], u16p(i + 1), usize::from(u16p(i + 3)));
+                    let data = p.get(i + 5..i + 5 + len)?;
+                    if sid == id {
+                        self.servos[k].last_seen = now;
+                        self.servos[k].write(addr, data);
+                    }
+                    i += 5 + len;
+                }
+                None
+            }
+            _ if ins.id == id => Some(packet::status(id, error::INSTRUCTION, &[])),
+            _ => None,
+        }
+    }
+
+    /// The torque state and watchdogs as the servos' tables hold them.
+    pub fn report(&self) -> EmulatorReport {
+        EmulatorReport {
+            torque_enabled: self.servos.iter().map(|s| (s.config.id, s.torque_on())).collect(),
+            packets: self.parser_packets,
+            bad_crc: self.bad_crc,
+            watchdog: self.servos.iter().map(|s| (s.config.id, s.u8_at(t::BUS_WATCHDOG))).collect(),
+        }
+    }
+
+    /// Refreshes every servo to `now` s (the watchdog, the shafts).
+    pub fn tick(&mut self, now: f64) {
+        self.advance_all(now);
+    }
+}
+
+/// Where `id` answers in a multi-servo read: its place in the instruction's list.
+fn order_of(ins: &Instruction, id: u8) -> usize {
+    match ins.instruction {
+        inst::SYNC_READ => ins.params.iter().skip(4).position(|&x| x == id).unwrap_or(usize::MAX),
+        inst::BULK_READ => ins.params.chunks(5).position(|c| c[0] == id).unwrap_or(usize::MAX),
+        _ => 0,
+    }
+}
+
+/// A running emulator: a thread serving the pty's master side.
+#[derive(Debug)]
+pub struct Emulator {
+    stop: Arc<AtomicBool>,
+    handle: Option<JoinHandle<EmulatorReport>>,
+}
+
+impl Emulator {
+    /// Starts the emulator; returns it and the serial port the driver opens the bus on.
+    pub fn start(config: &EmulatorConfig) -> Result<(Emulator, SerialPort), EmulatorError> {
+        let mut bus = VirtualBus::new(config)?;
+        let (mut master, mut slave) = SerialPort::pair().map_err(EmulatorError::Pty)?;
+        for port in [&mut master, &mut slave] {
+            if let Ok(mut s) = port.get_configuration() {
+                // A pty accepts any rate; the bus computes its read timeouts from it.
+                if s.set_baud_rate(1_000_000).is_ok() {
+                    port.set_configuration(&s).ok();
+                }
+            }
+        }
+        master.set_read_timeout(Duration::from_millis(2)).map_err(EmulatorError::Pty)?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = stop.clone();
+        let handle = std::thread::Builder::new()
+            .name("xl330-emulator".into())
+            .spawn(move || {
+                let start = Instant::now();
+                let mut parser = Parser::default();
+                let mut buf = [0u8; 1024];
+                while !flag.load(Ordering::Relaxed) {
+                    let now = start.elapsed().as_secs_f64();
+                    if bus.frozen(now) {
+                        std::thread::sleep(Duration::from_millis(2));
+                        continue;
+                    }
+                    match master.read(&mut buf) {
+                        Ok(n) if n > 0 => parser.push(&buf[..n]),
+                        _ => {}
+                    }
+                    while let Some(p) = parser.next_packet() {
+                        let now = start.elapsed().as_secs_f64();
+                        let reply = bus.respond(p, now);
+                        if !reply.is_empty() {
+                            master.write_all(&reply).ok();
+                        }
+                    }
+                    bus.tick(start.elapsed().as_secs_f64());
+                }
+                bus.report()
+            })
+            .map_err(EmulatorError::Pty)?;
+        Ok((Emulator { stop, handle: Some(handle) }, slave))
+    }
+
+    /// Stops the emulator and returns what its servos' tables hold.
+    pub fn stop(mut self) -> EmulatorReport {
+        self.stop.store(true, Ordering::Relaxed);
+        self.handle.take().and_then(|h| h.join().ok()).unwrap_or_default()
+    }
+}
+
+impl Drop for Emulator {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(h) = self.handle.take() {
+            h.join().ok();
+        }
+    }
+}

@@ -1,0 +1,21 @@
+//! Dynamixel Protocol 2.0 for sandslope (docs/drive.md): the robot in the loop.
+//!
+//! - [`table`]: the XL330's control table addresses and the register values the driver writes;
+//! - [`packet`]: the device side of Protocol 2.0 (instruction parsing, status encoding with
+//!   byte stuffing and the CRC of `dynamixel2::checksum`), what the emulator speaks;
+//! - [`driver`]: the alternating tripod of [`sandslope::servo::GaitSchedule`] sent to the
+//!   servos over a `dynamixel2::Bus` (sync write of goals, sync read of the present state), with
+//!   its safety logic: torque off on every exit, Ctrl-C, a lost servo and a watchdog;
+//! - [`emulator`]: a bus of virtual XL330s on a pseudo-terminal, whose shafts move as commanded
+//!   and whose currents come from the stride simulator (`sandslope::simulate`).
+//!
+//! The bus is the one place this crate touches hardware; the physics (the schedule, the
+//! servo's torque constant, the inference from currents) is the library's.
+
+pub mod driver;
+pub mod emulator;
+pub mod packet;
+pub mod table;
+
+pub use driver::{drive, DriveError, DriveOutcome, DriveSettings, Profile, ServoConfig, ServoSample};
+pub use emulator::{Emulator, EmulatorConfig, EmulatorFaults, EmulatorReport};

@@ -1,0 +1,112 @@
+//! The XL330-M288's control table (ROBOTIS e-Manual, XL330-M288-T): the addresses the driver
+//! and the emulator use, and their sizes.
+
+/// Model Number (2 bytes, read-only; 1200 for the XL330-M288).
+pub const MODEL_NUMBER: u16 = 0;
+/// Firmware Version (1).
+pub const FIRMWARE_VERSION: u16 = 6;
+/// ID (1).
+pub const ID: u16 = 7;
+/// Baud Rate (1): 0 9600, 1 57600, 2 115200, 3 1M, 4 2M, 5 3M, 6 4M.
+pub const BAUD_RATE: u16 = 8;
+/// Return Delay Time (1), 2 us units.
+pub const RETURN_DELAY_TIME: u16 = 9;
+/// Drive Mode (1): bit 0 reverse, bit 2 time-based profile (0: velocity-based).
+pub const DRIVE_MODE: u16 = 10;
+/// Operating Mode (1): 0 current, 1 velocity, 3 position, 4 extended position, 5
+/// current-based position, 16 PWM.
+pub const OPERATING_MODE: u16 = 11;
+/// Homing Offset (4), pulses.
+pub const HOMING_OFFSET: u16 = 20;
+/// Temperature Limit (1), degC (0 to 100; 70 by default).
+pub const TEMPERATURE_LIMIT: u16 = 31;
+/// Max Voltage Limit (2), 0.1 V.
+pub const MAX_VOLTAGE_LIMIT: u16 = 32;
+/// Min Voltage Limit (2), 0.1 V.
+pub const MIN_VOLTAGE_LIMIT: u16 = 34;
+/// Current Limit (2), mA (0 to 1750).
+pub const CURRENT_LIMIT: u16 = 38;
+/// Velocity Limit (4), 0.229 rev/min (0 to 2047; 445 by default).
+pub const VELOCITY_LIMIT: u16 = 44;
+/// Shutdown (1): which hardware errors turn the torque off.
+pub const SHUTDOWN: u16 = 63;
+/// Torque Enable (1); the EEPROM area (below 64) can be written only while it is 0.
+pub const TORQUE_ENABLE: u16 = 64;
+/// Status Return Level (1).
+pub const STATUS_RETURN_LEVEL: u16 = 68;
+/// Hardware Error Status (1): bit 0 input voltage, 2 overheating, 3 motor encoder, 4
+/// electrical shock, 5 overload.
+pub const HARDWARE_ERROR_STATUS: u16 = 70;
+/// Bus Watchdog (1), 20 ms units (0 off; the servo sets 100 when it has fired).
+pub const BUS_WATCHDOG: u16 = 98;
+/// Goal Velocity (4), 0.229 rev/min.
+pub const GOAL_VELOCITY: u16 = 104;
+/// Profile Acceleration (4), 214.577 rev/min^2 (velocity-based profile).
+pub const PROFILE_ACCELERATION: u16 = 108;
+/// Profile Velocity (4), 0.229 rev/min (velocity-based profile).
+pub const PROFILE_VELOCITY: u16 = 112;
+/// Goal Position (4), pulses.
+pub const GOAL_POSITION: u16 = 116;
+/// Moving (1).
+pub const MOVING: u16 = 122;
+/// Present Current (2, signed), mA.
+pub const PRESENT_CURRENT: u16 = 126;
+/// Present Velocity (4, signed), 0.229 rev/min.
+pub const PRESENT_VELOCITY: u16 = 128;
+/// Present Position (4, signed), pulses.
+pub const PRESENT_POSITION: u16 = 132;
+/// Present Input Voltage (2), 0.1 V.
+pub const PRESENT_INPUT_VOLTAGE: u16 = 144;
+/// Present Temperature (1), degC.
+pub const PRESENT_TEMPERATURE: u16 = 146;
+/// Size of the table the emulator keeps (addresses 0 to 227).
+pub const TABLE_SIZE: usize = 228;
+
+/// The block the driver reads every cycle: Present Current (126) to Present Temperature (146).
+pub const STATE_BLOCK: (u16, u16) = (PRESENT_CURRENT, PRESENT_TEMPERATURE + 1 - PRESENT_CURRENT);
+
+/// Bus Watchdog value a servo sets after the watchdog fired.
+pub const WATCHDOG_FIRED: u8 = 100;
+
+/// Operating modes the driver uses.
+pub mod mode {
+    /// Velocity control.
+    pub const VELOCITY: u8 = 1;
+    /// Position control within one turn.
+    pub const POSITION: u8 = 3;
+    /// Extended (multi-turn) position control.
+    pub const EXTENDED_POSITION: u8 = 4;
+}
+
+/// The present state decoded from [`STATE_BLOCK`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PresentState {
+    /// Present Current, mA.
+    pub current_ma: i16,
+    /// Present Velocity, 0.229 rev/min.
+    pub velocity: i32,
+    /// Present Position, pulses.
+    pub position: i32,
+    /// Present Input Voltage, 0.1 V.
+    pub voltage: u16,
+    /// Present Temperature, degC.
+    pub temperature_c: u8,
+}
+
+impl PresentState {
+    /// Decodes the bytes read from [`STATE_BLOCK`]; `None` if there are too few.
+    pub fn decode(b: &[u8]) -> Option<PresentState> {
+        let at = |a: u16| usize::from(a - PRESENT_CURRENT);
+        if b.len() < usize::from(STATE_BLOCK.1) {
+            return None;
+        }
+        let u32_at = |a| u32::from_le_bytes([b[at(a)], b[at(a) + 1], b[at(a) + 2], b[at(a) + 3]]);
+        Some(PresentState {
+            current_ma: i16::from_le_bytes([b[0], b[1]]),
+            velocity: u32_at(PRESENT_VELOCITY) as i32,
+            position: u32_at(PRESENT_POSITION) as i32,
+            voltage: u16::from_le_bytes([b[at(PRESENT_INPUT_VOLTAGE)], b[at(PRESENT_INPUT_VOLTAGE) + 1]]),
+            temperature_c: b[at(PRESENT_TEMPERATURE)],
+        })
+    }
+}

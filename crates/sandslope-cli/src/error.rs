@@ -9,11 +9,13 @@
 //! | 2 | bad input: a flag, value, key or file the tool cannot accept (a file that does not exist, a malformed or implausible one); clap's usage errors |
 //! | 3 | the system failed: an output (file, folder, stdout or stderr) could not be written (disk full, no permission), or an input that exists could not be read (no permission, I/O error) |
 //! | 4 | `report --strict`: the report was written, but it carries warnings |
+//! | 5 | `drive --stop-on-risk`: the gait was halted on risk (legs held, then torque off; log kept) |
 //! | 130, 143, 129 | interrupted by SIGINT (Ctrl-C), SIGTERM or SIGHUP (128 + the signal); temporary files removed, no output left |
 //!
 //! Whatever the code, a run that does not succeed leaves no output behind
-//! (`sandslope_io::files::discard_outputs`); the one exception is code 4, whose outputs are
-//! written and whose failure is the verdict on them.
+//! (`sandslope_io::files::discard_outputs`); the exceptions are code 4, whose outputs are
+//! written and whose failure is the verdict on them, and `drive`, whose log is kept on every
+//! exit (it is the record of what the robot did; [`KeepLog`]).
 
 use std::io::ErrorKind;
 
@@ -26,6 +28,27 @@ pub const EXIT_USAGE: i32 = 2;
 pub const EXIT_OUTPUT: i32 = 3;
 /// Exit code of `report --strict` when the report was written but carries warnings.
 pub const EXIT_WARNINGS: i32 = 4;
+/// Exit code after SIGINT (128 + 2), as shells report it.
+pub const EXIT_SIGINT: i32 = 130;
+/// Exit code of `drive --stop-on-risk` when the risk halted the gait.
+pub const EXIT_HALTED: i32 = 5;
+
+/// Set while `drive` runs: Ctrl-C then asks it to stop ([`STOP`]) instead of ending the process,
+/// so that the torque is turned off and the log kept.
+pub static DRIVING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+/// Set by Ctrl-C while [`DRIVING`].
+pub static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// `drive` ended other than by completing its run (a failed bus, Ctrl-C, a halt on risk): its
+/// outputs (the log) are kept and the process exits with `code`.
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
+pub struct KeepLog {
+    /// Exit code.
+    pub code: i32,
+    /// What happened.
+    pub message: String,
+}
 
 /// `report --strict`: the outputs were written, but the report carries this many warnings.
 #[derive(Debug, thiserror::Error)]
@@ -36,7 +59,7 @@ pub struct Strict(pub usize);
 
 /// Whether `e` is a verdict on outputs that are nonetheless kept ([`Strict`]).
 pub fn keeps_outputs(e: &anyhow::Error) -> bool {
-    e.chain().any(|c| c.is::<Strict>())
+    e.chain().any(|c| c.is::<Strict>() || c.is::<KeepLog>())
 }
 /// The I/O error kinds that mean the input is wrong rather than the system failing.
 fn is_input_kind(kind: ErrorKind) -> bool {
@@ -69,6 +92,9 @@ fn io_kind(e: &anyhow::Error) -> Option<ErrorKind> {
 
 /// The exit code for a failed run (see the module documentation).
 pub fn exit_code(e: &anyhow::Error) -> i32 {
+    if let Some(k) = e.chain().find_map(|c| c.downcast_ref::<KeepLog>()) {
+        return k.code;
+    }
     match io_kind(e) {
         Some(ErrorKind::BrokenPipe) => EXIT_OK,
         _ if e.chain().any(|c| c.is::<sandslope_io::WriteError>()) => EXIT_OUTPUT,
@@ -126,7 +152,12 @@ pub fn clean_up_on_signals() {
         return;
     };
     let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
-        if let Some(signal) = signals.forever().next() {
+        for signal in signals.forever() {
+            if DRIVING.load(std::sync::atomic::Ordering::SeqCst) {
+                // `drive` stops the gait, turns the torque off, keeps its log and exits 130.
+                STOP.store(true, std::sync::atomic::Ordering::SeqCst);
+                continue;
+            }
             sandslope_io::files::discard_outputs();
             std::process::exit(128 + signal);
         }

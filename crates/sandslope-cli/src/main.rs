@@ -53,6 +53,8 @@ enum Command {
     Report(commands::report::ReportArgs),
     /// Terrain inference from the gait: posterior of k_s per observed slope, and risk at slopes not walked.
     Infer(commands::infer::InferArgs),
+    /// The robot in the loop: drive Dynamixel XL330s with the gait, log their state, read the sand from their currents (docs/drive.md).
+    Drive(commands::drive::DriveArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),
     /// A local web explorer (model, risk, routes on a DEM) and a JSON API equal to `--json`.
@@ -73,6 +75,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Design(a) => commands::design::run(a),
         Command::Report(a) => commands::report::run(a),
         Command::Infer(a) => commands::infer::run(a),
+        Command::Drive(a) => commands::drive::run(a),
         Command::Presets(a) => commands::presets::run(a),
         Command::Serve(a) => serve::run(a),
     }

@@ -470,7 +470,7 @@ fn run(
     let mut failures = vec![(0usize, false); ids.len()];
     let mut last_pos: Vec<Option<i32>> = vec![None; ids.len()];
     let mut bins = monitor.as_ref().map(|m| StanceBins::new(m.grid.bins));
-    // Stand up: torque on, then the start pose from where each leg is, forward only.
+    // Stand up: torque on, then the start pose nearest to where each leg is.
     let states = read_states(bus, &ids).map_err(|reason| DriveError::Bus { time_s: -stand_s, reason })?;
     let mut start_goal = vec![0i32; ids.len()];
     for (j, s) in settings.servos.iter().enumerate() {
@@ -479,7 +479,8 @@ fn run(
             Err(e) => return Err(DriveError::Lost { id: s.id, leg: j, time_s: -stand_s, cycles: 1, reason: e.to_string() }),
         };
         let start = schedule.start_angle(j);
-        let turns = ((here - start) / (2.0 * std::f64::consts::PI)).ceil();
+        // The nearest turn of the start angle: at most half a turn of travel.
+        let turns = ((here - start) / (2.0 * std::f64::consts::PI)).round();
         start_goal[j] = s.pulses(start + turns * 2.0 * std::f64::consts::PI);
     }
     // Every angle from here on is relative to the start pose found: shift the schedule by it.

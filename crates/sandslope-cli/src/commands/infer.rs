@@ -35,12 +35,23 @@ pub enum LawArg {
 pub struct InferArgs {
     /// Observed speeds: CSV `slope_deg,speed_m_s,speed_sd_m_s[,n]` (as `track --speeds-out` writes;
     /// with n, the mean's standard error is sd/sqrt(n)).
-    #[arg(long, value_name = "FILE", required_unless_present = "steps")]
+    #[arg(long, value_name = "FILE", required_unless_present_any = ["steps", "servo_log"])]
     pub observed: Option<PathBuf>,
     /// Per-step output of `track --csv` at one slope, DEG=FILE (repeat for several slopes): speed
     /// and anchoring time t1 of every step.
     #[arg(long, value_name = "DEG=FILE", conflicts_with = "observed")]
     pub steps: Vec<String>,
+    /// A servo log of `sandslope drive --log` (docs/drive.md): k_s at its slope from the
+    /// stance-phase currents, with the leg's shear load and the risk of slippage
+    /// (docs/model.md §19).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["observed", "steps", "law"])]
+    pub servo_log: Option<PathBuf>,
+    /// The slope of the --servo-log run, degrees (default: the log's `slope_deg` header).
+    #[arg(long, value_name = "DEG", requires = "servo_log", allow_negative_numbers = true)]
+    pub slope: Option<f64>,
+    /// k_s values the stride simulator walks for --servo-log (log-spaced over --k-s-prior).
+    #[arg(long, value_name = "N", default_value_t = 41, requires = "servo_log")]
+    pub grid_points: usize,
     #[command(flatten)]
     pub robot: RobotArgs,
     /// Terrain giving k_n (and the angle of repose) at each slope; its k_s is not used except
@@ -126,8 +137,75 @@ fn bound_note(b: Bound) -> &'static str {
     }
 }
 
+/// `infer --servo-log`: k_s from the stance currents of a `drive` log (docs/model.md §19).
+fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
+    use sandslope::infer::servo::{infer_from_currents, model_grid, CurrentInferenceSettings, LegTrace};
+    let robot = args.robot.load()?;
+    let prior = parse_prior(&args.k_s_prior)?;
+    if !(3..=1000).contains(&args.grid_points) {
+        bail!("--grid-points = {} must be within 3 to 1000", args.grid_points);
+    }
+    let log = sandslope_io::servo_log::read_servo_log(path)?;
+    let slope_deg = match (args.slope, log.meta_f64("slope_deg", path)?) {
+        (Some(s), _) | (None, Some(s)) => s,
+        (None, None) => bail!("{}: the log has no `# slope_deg = ...` header line; give the run's slope with --slope", path.display()),
+    };
+    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+    let terrain = args.terrain.load()?;
+    let k_n = sandslope::Scenario::new(robot.clone(), terrain, None, None)?.ground_at(slope).0.k_n;
+    let legs = 2 * robot.stance_legs() as usize;
+    let mut traces = vec![LegTrace::default(); legs];
+    for (i, r) in log.rows.iter().enumerate() {
+        let t = traces.get_mut(r.leg).ok_or_else(|| {
+            anyhow!("{}: row {} has leg {}, but the robot has {legs} legs (2 * stance_legs)", path.display(), i + 1, r.leg)
+        })?;
+        t.angle_rad.push(r.leg_angle_rad);
+        t.torque_n_m.push(r.drive_torque_n_m);
+    }
+    let settings = CurrentInferenceSettings { prior, grid_points: args.grid_points, ..Default::default() };
+    let grid = model_grid(&robot, k_n, slope_deg, &settings).map_err(|e| anyhow!("{e}"))?;
+    let answer = infer_from_currents(&robot, &grid, &traces).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    if args.json {
+        return print_json(&answer);
+    }
+    println!(
+        "k_s at {slope_deg} deg from the stance currents of {} strides: {} N/m^3, 90% interval {} - {}{}",
+        answer.strides,
+        sci(answer.k_s),
+        sci(answer.k_s_lo),
+        sci(answer.k_s_hi),
+        match bound_note_servo(answer.bound) {
+            "" => String::new(),
+            n => format!(" ({n})"),
+        }
+    );
+    println!(
+        "shear load per stance leg: {:.3} N (the stride simulator at that k_s; the closed form's m (g sin theta + R omega / dt) / n is {:.3} N)",
+        answer.shear_load_n, answer.closed_form_shear_load_n
+    );
+    println!("P(slippage) at {slope_deg} deg: {:.3}", answer.p_slippage);
+    println!(
+        "k_n {} N/m^3 from the terrain; stance torque K_t I against the stride simulator on {} k_s values (docs/model.md \u{a7}19)",
+        sci(k_n),
+        args.grid_points
+    );
+    Ok(())
+}
+
+fn bound_note_servo(b: Bound) -> &'static str {
+    match b {
+        Bound::TwoSided => "",
+        Bound::LowerOnly => "only a lower bound: the currents look alike for any stronger sand",
+        Bound::UpperOnly => "only an upper bound: the currents look alike for any weaker sand",
+        Bound::Neither => "not bounded: the currents hardly depend on k_s at this slope",
+    }
+}
+
 /// Runs `sandslope infer`.
 pub fn run(args: InferArgs) -> Result<()> {
+    if let Some(path) = args.servo_log.clone() {
+        return run_servo_log(&args, &path);
+    }
     let robot = args.robot.load()?;
     let prior = parse_prior(&args.k_s_prior)?;
     let predict = if args.law.is_some() { parse_slopes(&args.predict)? } else { Vec::new() };

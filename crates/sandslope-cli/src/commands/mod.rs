@@ -2,6 +2,7 @@
 
 pub mod calibrate;
 pub mod design;
+pub mod drive;
 pub mod fit;
 pub mod infer;
 pub mod phase;

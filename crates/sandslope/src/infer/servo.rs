@@ -12,7 +12,9 @@
 //!   angle, [`GaitSchedule::stride_position`]); the run-up stride is left out;
 //! - likelihood: Gaussian, per bin, around the simulator's mean profile at k_s, with variance
 //!   the observed mean's (stride-to-stride scatter over the number of strides) plus the
-//!   simulated mean's (its own scatter over its strides) plus a floor;
+//!   simulated mean's (its own scatter over its strides) plus the grid's resolution (the
+//!   profile's larger change to a neighbouring grid point, squared: the truth lies between
+//!   grid points, and the simulated walk is not smooth in k_s) plus a floor;
 //! - prior: log-uniform on `[k_s_min, k_s_max]`, as the gait inference's;
 //! - answer: the posterior median of k_s, its 90% credible interval (flagged when the data do
 //!   not bound a side, [`Bound`]), the leg's shear load (the simulator's along-slope sand force
@@ -34,7 +36,7 @@ use crate::terrain::Terrain;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CurrentInferenceError {
     /// Too few complete strides in the log.
-    #[error("the log holds {found} complete stride(s) after the run-up; at least {needed} are needed to estimate k_s from the currents (drive longer: --strides)")]
+    #[error("the log holds {found} complete stride(s) after the run-up; at least {needed} are needed to estimate k_s from the currents (drive longer: --duration)")]
     TooFewStrides {
         /// Complete strides found.
         found: usize,
@@ -399,11 +401,20 @@ fn posterior_answer(
 ) -> CurrentInference {
     let floor = CurrentInferenceSettings::default().floor_n_m;
     let sim_n = grid.strides.max(1) as f64;
-    let loglik: Vec<f64> = (0..grid.k_s.len())
+    let n = grid.k_s.len();
+    // The grid's resolution: a k_s between two grid points gives a profile anywhere between
+    // theirs, and the simulator's walk is not smooth in k_s (a stride's slip can switch between
+    // neighbouring k_s): SD the larger step to a neighbour.
+    let step = |i: usize, b: usize| -> f64 {
+        let up = if i + 1 < n { (grid.mean[i + 1][b] - grid.mean[i][b]).abs() } else { 0.0 };
+        let down = if i > 0 { (grid.mean[i][b] - grid.mean[i - 1][b]).abs() } else { 0.0 };
+        up.max(down)
+    };
+    let loglik: Vec<f64> = (0..n)
         .map(|i| {
             bins.iter()
                 .map(|&b| {
-                    let v = var_obs[b] + grid.sd[i][b].powi(2) / sim_n + floor * floor;
+                    let v = var_obs[b] + grid.sd[i][b].powi(2) / sim_n + step(i, b).powi(2) + floor * floor;
                     let r = mean[b] - grid.mean[i][b];
                     -0.5 * (r * r / v + v.ln())
                 })
@@ -426,7 +437,8 @@ fn posterior_answer(
         (true, false) => Bound::UpperOnly,
         (true, true) => Bound::Neither,
     };
-    let p_slip = p.iter().zip(&grid.regime).filter(|(_, r)| **r == Regime::Slippage).map(|(x, _)| x).sum();
+    // (`0.0 +`: an empty sum of floats is -0.0.)
+    let p_slip = 0.0 + p.iter().zip(&grid.regime).filter(|(_, r)| **r == Regime::Slippage).map(|(x, _)| x).sum::<f64>();
     let shear = p.iter().zip(&grid.shear_load_n).map(|(x, f)| x * f).sum();
     let slope = grid.slope_deg.abs().to_radians();
     let closed = robot.mass() * (crate::model::G * slope.sin() + robot.leg_radius() * robot.leg_speed() / robot.response_time())

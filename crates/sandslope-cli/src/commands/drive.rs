@@ -1,0 +1,450 @@
+//! `sandslope drive`: the robot in the loop (docs/drive.md). The alternating tripod of the
+//! robot file's timing sent to Dynamixel XL330s over Protocol 2.0 (`sandslope-servo`), every
+//! servo's state logged at the bus's rate, and, with `--live` or `--stop-on-risk`, the sand's
+//! k_s and the risk of slippage read from the stance currents after every stance
+//! (`sandslope::infer::servo`). `--emulate` drives a bus of virtual XL330s on a
+//! pseudo-terminal through the same code; `--dry-run` prints the commands without a bus.
+
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+
+use anyhow::{anyhow, bail, Context, Result};
+use clap::{Args, ValueEnum};
+
+use sandslope::infer::servo::{model_grid, CurrentInferenceSettings};
+use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::Slope;
+use sandslope_io::robot_terrain::load_servos;
+use sandslope_io::servo_log::{ServoLogRow, ServoLogWriter, DEFAULT_BAUD_RATE};
+use sandslope_servo::driver::{drive, DriveReport, LiveEstimate, Monitor, ServoSample};
+use sandslope_servo::emulator::EmulatorFaults;
+use sandslope_servo::table as t;
+use sandslope_servo::{DriveSettings, Emulator, EmulatorConfig, Profile, ServoConfig};
+
+use crate::args::{check_flag, RobotArgs, TerrainArgs};
+use crate::error::{KeepLog, EXIT_HALTED, EXIT_SIGINT};
+use crate::output::{check_parent_exists, print_json, write_via_temp};
+
+/// `--profile`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ProfileArg {
+    /// Extended position mode: the schedule's angle every cycle.
+    Position,
+    /// Velocity mode: the schedule's speed with a phase correction.
+    Velocity,
+}
+
+/// Arguments of `sandslope drive`.
+#[derive(Debug, Args)]
+pub struct DriveArgs {
+    /// Serial port of the Protocol 2.0 adapter (U2D2 or any): /dev/ttyUSB0, /dev/ttyACM0, COM3.
+    #[arg(long, value_name = "PATH", required_unless_present_any = ["emulate", "dry_run"])]
+    pub port: Option<PathBuf>,
+    /// Drive a bus of emulated XL330s (a pseudo-terminal; currents from the stride simulator on
+    /// --terrain at --slope) instead of a port.
+    #[arg(long, conflicts_with = "port")]
+    pub emulate: bool,
+    /// Print the commands (setup writes, then every cycle's goals as CSV) without opening a bus.
+    #[arg(long, conflicts_with_all = ["port", "emulate"])]
+    pub dry_run: bool,
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// Terrain: k_n at the slope for the live estimate, and the emulated sand.
+    #[command(flatten)]
+    pub terrain: TerrainArgs,
+    /// The slope being climbed, degrees (for the live estimate, the log's header and the emulator).
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_negative_numbers = true)]
+    pub slope: f64,
+    /// Gait time, s (after standing up).
+    #[arg(long, value_name = "S", default_value_t = 10.0)]
+    pub duration: f64,
+    /// Bus cycles per second aimed at (each: a Sync Write of goals and a Sync Read of state).
+    #[arg(long, value_name = "HZ", default_value_t = 50.0)]
+    pub rate: f64,
+    /// How the gait is commanded.
+    #[arg(long, value_enum, default_value = "position")]
+    pub profile: ProfileArg,
+    /// Baud rate (default: the robot file's [servos] baud_rate, else 57600; the emulator ignores it).
+    #[arg(long, value_name = "BAUD")]
+    pub baud: Option<u32>,
+    /// Write every servo's state every cycle to this CSV (docs/drive.md, "The log").
+    #[arg(long, value_name = "FILE")]
+    pub log: Option<PathBuf>,
+    /// Halt the gait (torque held, legs planted) when the live risk of slippage passes P.
+    #[arg(long, value_name = "P")]
+    pub stop_on_risk: Option<f64>,
+    /// After a halt, seconds the legs are held before the torque goes off.
+    #[arg(long, value_name = "S", default_value_t = 2.0)]
+    pub hold: f64,
+    /// Print the live estimate of k_s and the risk after every stance (implied by --stop-on-risk).
+    #[arg(long)]
+    pub live: bool,
+    /// Current Limit written to every servo, mA (0 to 1750; 1470 is the stall current at 5 V).
+    #[arg(long, value_name = "MA", default_value_t = 1470)]
+    pub current_limit: u16,
+    /// Temperature Limit written to every servo, degC (0 to 70).
+    #[arg(long, value_name = "DEGC", default_value_t = 65)]
+    pub temperature_limit: u8,
+    /// Longest bus cycle accepted before everything stops, s.
+    #[arg(long, value_name = "S", default_value_t = 0.25)]
+    pub watchdog: f64,
+    /// The servos' own Bus Watchdog, s (0.02 to 2.54): they stop by themselves if the driver goes quiet.
+    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    pub bus_watchdog: f64,
+    /// Emulator: Present Current noise, mA (standard deviation).
+    #[arg(long, value_name = "MA", default_value_t = 10.0, requires = "emulate")]
+    pub emulate_noise: f64,
+    /// Emulator: seed of the noise.
+    #[arg(long, value_name = "N", default_value_t = 1, requires = "emulate")]
+    pub emulate_seed: u64,
+    /// Emulator: the sand's k_s (N/m^3) instead of the terrain's at the slope.
+    #[arg(long, value_name = "N/M^3", requires = "emulate")]
+    pub emulate_k_s: Option<f64>,
+    /// Emulator: the sand weakens to K_S N/m^3 at S seconds after the start, S:K_S.
+    #[arg(long, value_name = "S:K_S", requires = "emulate")]
+    pub emulate_weaken: Option<String>,
+    /// Emulator: a fault, silent:ID:S (servo ID stops answering at S s), corrupt:ID:S (its
+    /// packets fail their CRC from S s) or freeze:S:LEN (the bus hangs for LEN s from S s).
+    #[arg(long, value_name = "KIND:..", requires = "emulate")]
+    pub emulate_fault: Option<String>,
+    /// Print the run's report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn number(flag: &str, text: &str, whole: &str) -> Result<f64> {
+    text.trim().parse::<f64>().map_err(|_| anyhow!("{flag}: `{text}` is not a number (in {whole})"))
+}
+
+fn parse_faults(args: &DriveArgs) -> Result<EmulatorFaults> {
+    let mut f = EmulatorFaults::default();
+    if let Some(w) = &args.emulate_weaken {
+        let (s, k) = w.split_once(':').ok_or_else(|| anyhow!("--emulate-weaken `{w}` must be S:K_S, e.g. 3:2e5"))?;
+        let (s, k) = (number("--emulate-weaken", s, w)?, number("--emulate-weaken", k, w)?);
+        if !(s >= 0.0 && k > 0.0 && k.is_finite() && s.is_finite()) {
+            bail!("--emulate-weaken `{w}`: S must be at least 0 and K_S a finite number above 0");
+        }
+        f.weaken = Some((s, k));
+    }
+    if let Some(text) = &args.emulate_fault {
+        let parts: Vec<&str> = text.split(':').collect();
+        let id = |s: &str| -> Result<u8> {
+            s.trim().parse::<u8>().ok().filter(|&i| i <= 252).ok_or_else(|| anyhow!("--emulate-fault: `{s}` is not a servo ID from 0 to 252 (in {text})"))
+        };
+        match parts.as_slice() {
+            ["silent", i, s] => f.silent = Some((id(i)?, number("--emulate-fault", s, text)?)),
+            ["corrupt", i, s] => f.corrupt = Some((id(i)?, number("--emulate-fault", s, text)?)),
+            ["freeze", s, len] => f.freeze = Some((number("--emulate-fault", s, text)?, number("--emulate-fault", len, text)?)),
+            _ => bail!("--emulate-fault `{text}` must be silent:ID:S, corrupt:ID:S or freeze:S:LEN"),
+        }
+    }
+    Ok(f)
+}
+
+/// The servos: the robot file's `[servos]` table, or IDs 1 to 2n with the left side (the first
+/// n) turning positive and the right side mirrored.
+fn servos(args: &DriveArgs, legs: usize) -> Result<(Vec<ServoConfig>, u32)> {
+    let table = load_servos(&args.robot.robot)?;
+    let (list, baud) = match table {
+        Some(s) => (
+            s.mounts
+                .iter()
+                .map(|m| ServoConfig { id: m.id, direction: m.direction, zero_offset_pulses: m.zero_offset_pulses })
+                .collect::<Vec<_>>(),
+            s.baud_rate,
+        ),
+        None => (
+            (0..legs)
+                .map(|j| ServoConfig { id: j as u8 + 1, direction: if j < legs / 2 { 1 } else { -1 }, zero_offset_pulses: 0 })
+                .collect(),
+            DEFAULT_BAUD_RATE,
+        ),
+    };
+    if list.len() != legs {
+        bail!(
+            "{}: [servos] ids lists {} servos; the alternating tripod of this robot (stance_legs = {}) needs {legs}",
+            args.robot.robot,
+            list.len(),
+            legs / 2
+        );
+    }
+    Ok((list, args.baud.unwrap_or(baud)))
+}
+
+/// Runs `sandslope drive`.
+pub fn run(args: DriveArgs) -> Result<()> {
+    let robot = args.robot.load()?;
+    let terrain = args.terrain.load()?;
+    let slope = Slope::from_signed_degrees(args.slope).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+    check_flag("--duration", args.duration, 0.0, 86_400.0)?;
+    check_flag("--rate", args.rate, 1.0, 1000.0)?;
+    check_flag("--hold", args.hold, 0.0, 3600.0)?;
+    check_flag("--watchdog", args.watchdog, 0.01, 10.0)?;
+    check_flag("--bus-watchdog", args.bus_watchdog, 0.02, 2.54)?;
+    if args.current_limit > xl330::MAX_CURRENT_LIMIT_MA {
+        bail!("--current-limit = {} must be within 0 to {} mA (the XL330's Current Limit range)", args.current_limit, xl330::MAX_CURRENT_LIMIT_MA);
+    }
+    if args.temperature_limit > xl330::MAX_TEMPERATURE_C {
+        bail!("--temperature-limit = {} must be within 0 to {} degC (the XL330's rated range)", args.temperature_limit, xl330::MAX_TEMPERATURE_C);
+    }
+    if let Some(p) = args.stop_on_risk {
+        check_flag("--stop-on-risk", p, 0.0, 1.0)?;
+    }
+    if args.emulate {
+        check_flag("--emulate-noise", args.emulate_noise, 0.0, 1000.0)?;
+    }
+    let faults = if args.emulate { parse_faults(&args)? } else { EmulatorFaults::default() };
+    let legs = 2 * robot.stance_legs() as usize;
+    let schedule = GaitSchedule::new(&robot, legs).map_err(|e| anyhow!("{}: {e}", args.robot.robot))?;
+    let (servos, baud) = servos(&args, legs)?;
+    if let Some(b) = args.baud {
+        if !sandslope_io::servo_log::BAUD_RATES.contains(&b) {
+            bail!("--baud = {b} must be one the XL330 supports: {:?}", sandslope_io::servo_log::BAUD_RATES);
+        }
+    }
+    let settings = DriveSettings {
+        servos: servos.clone(),
+        profile: match args.profile {
+            ProfileArg::Position => Profile::Position,
+            ProfileArg::Velocity => Profile::Velocity,
+        },
+        duration_s: args.duration,
+        rate_hz: args.rate,
+        current_limit_ma: args.current_limit,
+        temperature_limit_c: args.temperature_limit,
+        watchdog_s: args.watchdog,
+        bus_watchdog_s: args.bus_watchdog,
+        stop_on_risk: args.stop_on_risk,
+        hold_s: args.hold,
+        stand_s: 1.0,
+    };
+    if args.dry_run {
+        return dry_run(&schedule, &settings);
+    }
+    if let Some(p) = &args.log {
+        check_parent_exists(p)?;
+    }
+    let (ground, _) = sandslope::Scenario::new(robot.clone(), terrain.clone(), None, None)?.ground_at(slope);
+    let k_n = ground.k_n;
+    // The live monitor's grid of simulated stance profiles at this slope (before anything moves).
+    let monitoring = args.live || args.stop_on_risk.is_some();
+    let grid = if monitoring {
+        let inference = CurrentInferenceSettings { simulated_strides: 6, ..Default::default() };
+        Some(model_grid(&robot, k_n, args.slope, &inference).map_err(|e| anyhow!("live estimate: {e}"))?)
+    } else {
+        None
+    };
+    // The bus: an emulator on a pty, or the port.
+    let mut emulator = None;
+    let port = if args.emulate {
+        let emulated_terrain = match args.emulate_k_s {
+            Some(k) => sandslope::Terrain::constant(k_n, k).map_err(|e| anyhow!("{}", e.renamed("--emulate-k-s")))?,
+            None => sandslope::Terrain::constant(k_n, ground.k_s)?,
+        };
+        let mut cfg = EmulatorConfig::new(robot.clone(), emulated_terrain, args.slope, servos.clone());
+        cfg.current_noise_ma = args.emulate_noise;
+        cfg.seed = args.emulate_seed;
+        cfg.faults = faults;
+        let (emu, port) = Emulator::start(&cfg).map_err(|e| anyhow!("--emulate: {e}"))?;
+        emulator = Some(emu);
+        port
+    } else {
+        let path = args.port.as_ref().expect("clap requires --port");
+        serial2::SerialPort::open(path, baud).map_err(|e| {
+            anyhow!(
+                "cannot open the serial port {}: {e}. Fix: plug in the U2D2 (or other Protocol 2.0 adapter) and check the path (ls /dev/ttyUSB* /dev/ttyACM*), that you may use it (the dialout group), or try --emulate",
+                path.display()
+            )
+        })?
+    };
+    let mut bus = dynamixel2::Bus::new(port).map_err(|e| anyhow!("cannot configure the serial port: {e:?}"))?;
+    // Ctrl-C from here on stops the gait and turns the torque off rather than ending the process.
+    crate::error::DRIVING.store(true, Ordering::SeqCst);
+    let noise_sd = xl330::torque_from_current(if args.emulate { args.emulate_noise.max(1.0) } else { 10.0 });
+    let monitor = grid.as_ref().map(|g| Monitor { robot: &robot, grid: g, noise_sd_n_m: noise_sd });
+    let meta = vec![
+        ("robot", args.robot.robot.clone()),
+        ("terrain", args.terrain.terrain.clone()),
+        ("slope_deg", format!("{}", args.slope)),
+        ("k_n", format!("{k_n}")),
+        ("leg_speed_rad_s", format!("{}", schedule.leg_speed_rad_s)),
+        ("period_s", format!("{}", schedule.period_s)),
+        ("run_up_s", format!("{}", schedule.run_up_s)),
+        ("ids", servos.iter().map(|s| s.id.to_string()).collect::<Vec<_>>().join(" ")),
+        ("directions", servos.iter().map(|s| s.direction.to_string()).collect::<Vec<_>>().join(" ")),
+        ("zero_offsets", servos.iter().map(|s| s.zero_offset_pulses.to_string()).collect::<Vec<_>>().join(" ")),
+        ("profile", format!("{:?}", settings.profile).to_lowercase()),
+        ("emulated", args.emulate.to_string()),
+    ];
+    let quiet = args.json;
+    let mut on_live = |l: &LiveEstimate| {
+        if !quiet {
+            let i = &l.inference;
+            eprintln!(
+                "t = {:.2} s, tripod {}: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(slippage) {:.3}",
+                l.time_s, l.tripod, i.k_s, i.k_s_lo, i.k_s_hi, i.p_slippage
+            );
+        }
+    };
+    let stop = &crate::error::STOP;
+    let (report, failure) = match &args.log {
+        Some(path) => {
+            let mut outcome = None;
+            write_via_temp(path, |tmp| {
+                let file = std::fs::OpenOptions::new()
+                    .write(true)
+                    .create_new(true)
+                    .open(tmp)
+                    .with_context(|| format!("cannot create {}", tmp.display()))?;
+                let mut log = ServoLogWriter::new(std::io::BufWriter::new(file), &meta)?;
+                let mut on_sample = |s: &ServoSample| log.write(&row(s));
+                let r = drive(&mut bus, &schedule, &settings, monitor.clone(), stop, &mut on_sample, &mut on_live);
+                // The log is the record of what happened: flushed and kept on every exit.
+                log.finish().map_err(|e| sandslope_io::WriteError { path: path.clone(), source: e })?;
+                outcome = Some(r);
+                Ok(())
+            })?;
+            outcome.expect("set in the closure")
+        }
+        None => drive(&mut bus, &schedule, &settings, monitor.clone(), stop, &mut |_| Ok(()), &mut on_live),
+    };
+    crate::error::DRIVING.store(false, Ordering::SeqCst);
+    drop(bus);
+    if let Some(emu) = emulator {
+        let r = emu.stop();
+        let on: Vec<String> = r.torque_enabled.iter().filter(|(_, on)| *on).map(|(id, _)| id.to_string()).collect();
+        eprintln!(
+            "emulator: torque {} ({} packets, {} with a bad CRC)",
+            if on.is_empty() { "off on every servo".to_string() } else { format!("still ON on servos {}", on.join(", ")) },
+            r.packets,
+            r.bad_crc
+        );
+    }
+    summarise(&report, quiet)?;
+    if args.json {
+        print_json(&report)?;
+    }
+    match (failure, &report.outcome) {
+        (Some(e), _) => {
+            let code = e.exit_code();
+            Err(KeepLog { code, message: e.to_string() }.into())
+        }
+        (None, Ok(sandslope_servo::DriveOutcome::Interrupted { time_s })) => Err(KeepLog {
+            code: EXIT_SIGINT,
+            message: format!("interrupted (Ctrl-C) at t = {time_s:.2} s; the torque was turned off"),
+        }
+        .into()),
+        (None, Ok(sandslope_servo::DriveOutcome::Halted { time_s, p_slippage })) => Err(KeepLog {
+            code: EXIT_HALTED,
+            message: format!(
+                "--stop-on-risk: halted at t = {time_s:.2} s, P(slippage) = {p_slippage:.3} > {}; the legs were held {} s, then the torque was turned off",
+                args.stop_on_risk.unwrap_or(1.0),
+                args.hold
+            ),
+        }
+        .into()),
+        _ => Ok(()),
+    }
+}
+
+fn row(s: &ServoSample) -> ServoLogRow {
+    ServoLogRow {
+        time_s: s.time_s,
+        id: s.id,
+        leg: s.leg,
+        tripod: s.tripod,
+        present_position: s.state.position,
+        present_velocity: s.state.velocity,
+        present_current_ma: i32::from(s.state.current_ma),
+        load_percent: 100.0 * f64::from(s.state.current_ma) / (xl330::STALL_CURRENT_A * 1000.0),
+        input_voltage_v: f64::from(s.state.voltage) / (1.0 / xl330::VOLT_PER_VOLTAGE_UNIT).round(),
+        temperature_c: i32::from(s.state.temperature_c),
+        hardware_error: s.hardware_error,
+        goal_position: s.goal_position,
+        leg_angle_rad: s.leg_angle_rad,
+        drive_torque_n_m: s.drive_torque_n_m,
+    }
+}
+
+fn summarise(r: &DriveReport, quiet: bool) -> Result<()> {
+    if quiet {
+        return Ok(());
+    }
+    let off = &r.torque_off;
+    eprintln!(
+        "{} cycles at {:.1} Hz; torque off confirmed on servos {}{}",
+        r.cycles,
+        r.rate_hz,
+        if off.confirmed.is_empty() { "none".into() } else { off.confirmed.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ") },
+        if off.unconfirmed.is_empty() {
+            String::new()
+        } else {
+            format!(" (NOT confirmed on {}: they did not answer; their Bus Watchdog stops them)", off.unconfirmed.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", "))
+        }
+    );
+    if let Some(last) = r.live.last() {
+        let i = &last.inference;
+        println!(
+            "last estimate: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(slippage) {:.3} at {} deg",
+            i.k_s, i.k_s_lo, i.k_s_hi, i.p_slippage, i.slope_deg
+        );
+    }
+    Ok(())
+}
+
+/// `--dry-run`: the setup writes, then every cycle's goals as CSV on stdout.
+fn dry_run(schedule: &GaitSchedule, s: &DriveSettings) -> Result<()> {
+    let ids: Vec<String> = s.servos.iter().map(|c| c.id.to_string()).collect();
+    println!("# dry run: no bus opened; the commands `sandslope drive` sends (docs/drive.md)");
+    println!("# ping IDs {} (model {} expected)", ids.join(", "), xl330::MODEL_NUMBER);
+    let omega = schedule.leg_speed_rad_s;
+    let mode = match s.profile {
+        Profile::Position => t::mode::EXTENDED_POSITION,
+        Profile::Velocity => t::mode::VELOCITY,
+    };
+    for (name, addr, value) in [
+        ("Torque Enable", t::TORQUE_ENABLE, "0".to_string()),
+        ("Operating Mode", t::OPERATING_MODE, mode.to_string()),
+        ("Drive Mode (velocity-based profile)", t::DRIVE_MODE, "0".into()),
+        ("Current Limit (mA)", t::CURRENT_LIMIT, s.current_limit_ma.to_string()),
+        ("Temperature Limit (degC)", t::TEMPERATURE_LIMIT, s.temperature_limit_c.to_string()),
+        ("Velocity Limit", t::VELOCITY_LIMIT, xl330::velocity_units_from_rad_s(2.0 * omega).to_string()),
+        (
+            "Profile Acceleration",
+            t::PROFILE_ACCELERATION,
+            ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT).round().to_string(),
+        ),
+        ("Profile Velocity", t::PROFILE_VELOCITY, xl330::velocity_units_from_rad_s(1.5 * omega).to_string()),
+        ("Bus Watchdog (20 ms)", t::BUS_WATCHDOG, ((s.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round()).to_string()),
+        ("Torque Enable", t::TORQUE_ENABLE, "1".into()),
+    ] {
+        println!("# write {name} ({addr}) = {value} on IDs {}", ids.join(", "));
+    }
+    let goal = match s.profile {
+        Profile::Position => "goal_position",
+        Profile::Velocity => "goal_velocity",
+    };
+    println!("time_s,id,leg,tripod,leg_angle_rad,{goal}");
+    let n = (s.duration_s * s.rate_hz).floor() as usize;
+    if n > 10_000_000 {
+        bail!("--dry-run: {n} cycles is more than 10,000,000 lines; shorten --duration or lower --rate");
+    }
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    for k in 0..=n {
+        let time = k as f64 / s.rate_hz;
+        for (j, c) in s.servos.iter().enumerate() {
+            let cmd = schedule.command(j, time);
+            let value = match s.profile {
+                Profile::Position => i64::from(c.pulses(cmd.angle_rad)),
+                Profile::Velocity => xl330::velocity_units_from_rad_s(f64::from(c.direction) * cmd.velocity_rad_s),
+            };
+            std::io::Write::write_fmt(
+                &mut out,
+                format_args!("{time:.4},{},{j},{},{:.6},{value}\n", c.id, schedule.tripods[j], cmd.angle_rad),
+            )?;
+        }
+    }
+    std::io::Write::flush(&mut out)?;
+    println!("# write Torque Enable (64) = 0 on IDs {} (every exit)", ids.join(", "));
+    Ok(())
+}

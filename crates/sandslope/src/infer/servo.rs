@@ -300,6 +300,11 @@ fn profile_statistics(p: &StanceProfiles, width: usize) -> (Vec<f64>, Vec<f64>, 
     (mean, sd, n)
 }
 
+/// Grid points on either side whose profiles bound the grid's resolution term (docs/model.md
+/// §19): the simulated walk switches between stride patterns from one k_s to the next, so one
+/// neighbour is not enough (calibrated against the emulator, docs/drive.md).
+pub const RESOLUTION_REACH: usize = 1;
+
 /// What the currents say about the sand: k_s with its 90% interval, the leg's shear load and
 /// the risk of slippage at the slope.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -405,11 +410,16 @@ fn posterior_answer(
     // The grid's resolution: a k_s between two grid points gives a profile anywhere between
     // theirs, and the simulator's walk is not smooth in k_s (a stride's slip can switch between
     // neighbouring k_s): SD the larger step to a neighbour.
-    let step = |i: usize, b: usize| -> f64 {
-        let up = if i + 1 < n { (grid.mean[i + 1][b] - grid.mean[i][b]).abs() } else { 0.0 };
-        let down = if i > 0 { (grid.mean[i][b] - grid.mean[i - 1][b]).abs() } else { 0.0 };
-        up.max(down)
-    };
+    // One variance for every grid point (a variance that differs between points would favour
+    // the smooth stretches of the grid): the mean square of the profile's change between
+    // neighbouring grid points, bin by bin.
+    let model_var: Vec<f64> = (0..mean.len())
+        .map(|b| {
+            let d: Vec<f64> = (1..n).map(|i| (grid.mean[i][b] - grid.mean[i - 1][b]).powi(2)).collect();
+            d.iter().sum::<f64>() / d.len().max(1) as f64
+        })
+        .collect();
+    let step = |_i: usize, b: usize| -> f64 { model_var[b].sqrt() };
     let loglik: Vec<f64> = (0..n)
         .map(|i| {
             bins.iter()

@@ -74,7 +74,10 @@ pub struct ServoLogWriter<W: Write> {
 impl<W: Write> ServoLogWriter<W> {
     /// Starts a log on `out` with `meta` as `# key = value` lines.
     pub fn new(mut out: W, meta: &[(&str, String)]) -> Result<ServoLogWriter<W>> {
-        writeln!(out, "# sandslope servo log (docs/drive.md); read with pandas.read_csv(path, comment=\"#\")")?;
+        writeln!(
+            out,
+            "# sandslope servo log (docs/drive.md); read with pandas.read_csv(path, comment=\"#\")"
+        )?;
         for (k, v) in meta {
             writeln!(out, "# {k} = {v}")?;
         }
@@ -129,7 +132,8 @@ pub const MAX_ROWS: usize = 5_000_000;
 
 /// Reads a servo log; errors name the file, the line and the column.
 pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read servo log {}", path.display()))?;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read servo log {}", path.display()))?;
     let mut meta = BTreeMap::new();
     let mut header_lines = 0usize;
     for line in text.lines() {
@@ -141,7 +145,8 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
     }
     let body: String = text.lines().skip(header_lines).collect::<Vec<_>>().join("\n");
     let mut reader = csv::ReaderBuilder::new().from_reader(body.as_bytes());
-    let headers = reader.headers().with_context(|| format!("{}: no column header line", path.display()))?.clone();
+    let headers =
+        reader.headers().with_context(|| format!("{}: no column header line", path.display()))?.clone();
     for want in ["time_s", "id", "leg", "leg_angle_rad", "drive_torque_n_m"] {
         if !headers.iter().any(|h| h == want) {
             bail!("{}: the column `{want}` is missing (a servo log as `sandslope drive --log` writes it has {})", path.display(), COLUMNS.join(","));
@@ -150,9 +155,13 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
     let mut rows = Vec::new();
     for (i, rec) in reader.deserialize::<ServoLogRow>().enumerate() {
         let line = header_lines + 2 + i;
-        let row = rec.map_err(|e| anyhow!("{}: line {line}: {}", path.display(), e.to_string().trim_end()))?;
+        let row =
+            rec.map_err(|e| anyhow!("{}: line {line}: {}", path.display(), e.to_string().trim_end()))?;
         if !(row.time_s.is_finite() && row.leg_angle_rad.is_finite() && row.drive_torque_n_m.is_finite()) {
-            bail!("{}: line {line}: time_s, leg_angle_rad and drive_torque_n_m must be finite numbers", path.display());
+            bail!(
+                "{}: line {line}: time_s, leg_angle_rad and drive_torque_n_m must be finite numbers",
+                path.display()
+            );
         }
         rows.push(row);
         if rows.len() > MAX_ROWS {
@@ -255,7 +264,8 @@ pub fn parse_servos(table: &str, source: &Source) -> Result<Servos> {
     struct Wrapper {
         servos: ServosTable,
     }
-    let w: Wrapper = toml::from_str(table).map_err(|e| anyhow!("{source}: [servos]: {}", e.to_string().trim_end()))?;
+    let w: Wrapper =
+        toml::from_str(table).map_err(|e| anyhow!("{source}: [servos]: {}", e.to_string().trim_end()))?;
     let t = w.servos;
     let n = t.ids.len();
     if n == 0 {
@@ -272,7 +282,10 @@ pub fn parse_servos(table: &str, source: &Source) -> Result<Servos> {
         let direction = match &t.directions {
             None => 1,
             Some(d) if d.len() != n => {
-                bail!("{source}: [servos] directions has {} entries, ids has {n}; give one per servo", d.len())
+                bail!(
+                    "{source}: [servos] directions has {} entries, ids has {n}; give one per servo",
+                    d.len()
+                )
             }
             Some(d) if d[i] == 1 || d[i] == -1 => d[i] as i8,
             Some(d) => bail!("{source}: [servos] directions[{i}] = {} must be 1 or -1", d[i]),
@@ -280,10 +293,16 @@ pub fn parse_servos(table: &str, source: &Source) -> Result<Servos> {
         let zero = match &t.zero_offsets {
             None => 0,
             Some(z) if z.len() != n => {
-                bail!("{source}: [servos] zero_offsets has {} entries, ids has {n}; give one per servo", z.len())
+                bail!(
+                    "{source}: [servos] zero_offsets has {} entries, ids has {n}; give one per servo",
+                    z.len()
+                )
             }
             Some(z) if (-1_044_479..=1_044_479).contains(&z[i]) => z[i] as i32,
-            Some(z) => bail!("{source}: [servos] zero_offsets[{i}] = {} must be within -1044479 to 1044479 pulses", z[i]),
+            Some(z) => bail!(
+                "{source}: [servos] zero_offsets[{i}] = {} must be within -1044479 to 1044479 pulses",
+                z[i]
+            ),
         };
         mounts.push(ServoMount { id: id as u8, direction, zero_offset_pulses: zero });
     }
@@ -310,7 +329,9 @@ mod tests {
         assert!(bad.contains("ids[1] = 1 appears twice"), "{bad}");
         let bad = parse_servos("[servos]\nids = [1, 300]\n", &Source::Preset("t")).unwrap_err().to_string();
         assert!(bad.contains("0 to 252"), "{bad}");
-        let bad = parse_servos("[servos]\nids = [1]\ndirections = [2]\n", &Source::Preset("t")).unwrap_err().to_string();
+        let bad = parse_servos("[servos]\nids = [1]\ndirections = [2]\n", &Source::Preset("t"))
+            .unwrap_err()
+            .to_string();
         assert!(bad.contains("must be 1 or -1"), "{bad}");
     }
 
@@ -334,7 +355,8 @@ mod tests {
             leg_angle_rad: 1.5,
             drive_torque_n_m: 0.042,
         };
-        let mut w = ServoLogWriter::new(std::fs::File::create(&path).unwrap(), &[("slope_deg", "20".into())]).unwrap();
+        let mut w = ServoLogWriter::new(std::fs::File::create(&path).unwrap(), &[("slope_deg", "20".into())])
+            .unwrap();
         w.write(&row).unwrap();
         w.finish().unwrap();
         let text = std::fs::read_to_string(&path).unwrap();

@@ -301,12 +301,23 @@ struct StanceBins {
 
 impl StanceBins {
     fn new(bins: usize) -> StanceBins {
-        StanceBins { bins, key: [None, None], sum: [vec![0.0; bins], vec![0.0; bins]], count: [vec![0; bins], vec![0; bins]] }
+        StanceBins {
+            bins,
+            key: [None, None],
+            sum: [vec![0.0; bins], vec![0.0; bins]],
+            count: [vec![0; bins], vec![0; bins]],
+        }
     }
 
     /// Adds one sample; returns a completed stance's profile `(tripod, profile, counts)`.
     #[allow(clippy::type_complexity)]
-    fn add(&mut self, schedule: &GaitSchedule, leg: usize, angle: f64, tau: f64) -> Option<(usize, Vec<Option<f64>>, Vec<usize>)> {
+    fn add(
+        &mut self,
+        schedule: &GaitSchedule,
+        leg: usize,
+        angle: f64,
+        tau: f64,
+    ) -> Option<(usize, Vec<Option<f64>>, Vec<usize>)> {
         let k = schedule.tripods[leg];
         let (stride, since) = schedule.stride_position(leg, angle);
         let half = 0.5 * schedule.period_s;
@@ -359,8 +370,15 @@ pub fn drive(
     on_sample: &mut dyn FnMut(&ServoSample) -> std::io::Result<()>,
     on_live: &mut dyn FnMut(&LiveEstimate),
 ) -> (DriveReport, Option<DriveError>) {
-    let mut report = DriveReport { outcome: Err(String::new()), cycles: 0, rate_hz: 0.0, live: vec![], torque_off: TorqueOff::default() };
-    let result = setup(bus, schedule, settings).and_then(|()| run(bus, schedule, settings, monitor, stop, on_sample, on_live, &mut report));
+    let mut report = DriveReport {
+        outcome: Err(String::new()),
+        cycles: 0,
+        rate_hz: 0.0,
+        live: vec![],
+        torque_off: TorqueOff::default(),
+    };
+    let result = setup(bus, schedule, settings)
+        .and_then(|()| run(bus, schedule, settings, monitor, stop, on_sample, on_live, &mut report));
     report.torque_off = torque_off(bus, &settings.servos);
     match result {
         Ok(o) => {
@@ -374,7 +392,11 @@ pub fn drive(
     }
 }
 
-fn setup(bus: &mut DynamixelBus, schedule: &GaitSchedule, settings: &DriveSettings) -> Result<(), DriveError> {
+fn setup(
+    bus: &mut DynamixelBus,
+    schedule: &GaitSchedule,
+    settings: &DriveSettings,
+) -> Result<(), DriveError> {
     let baud = bus.baud_rate();
     let mut answered = vec![];
     let mut missing = None;
@@ -382,7 +404,12 @@ fn setup(bus: &mut DynamixelBus, schedule: &GaitSchedule, settings: &DriveSettin
         match bus.ping(s.id) {
             Ok(r) => {
                 if r.data.model != xl330::MODEL_NUMBER {
-                    return Err(DriveError::WrongModel { id: s.id, leg, model: r.data.model, expected: xl330::MODEL_NUMBER });
+                    return Err(DriveError::WrongModel {
+                        id: s.id,
+                        leg,
+                        model: r.data.model,
+                        expected: xl330::MODEL_NUMBER,
+                    });
                 }
                 answered.push(s.id);
             }
@@ -401,7 +428,11 @@ fn setup(bus: &mut DynamixelBus, schedule: &GaitSchedule, settings: &DriveSettin
             .unwrap_or_default();
         found.sort_unstable();
         found.dedup();
-        let answered = if found.is_empty() { "none".to_string() } else { found.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ") };
+        let answered = if found.is_empty() {
+            "none".to_string()
+        } else {
+            found.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ")
+        };
         return Err(DriveError::Missing { id, leg, baud, answered });
     }
     let omega = schedule.leg_speed_rad_s;
@@ -409,48 +440,93 @@ fn setup(bus: &mut DynamixelBus, schedule: &GaitSchedule, settings: &DriveSettin
         Profile::Position => mode::EXTENDED_POSITION,
         Profile::Velocity => mode::VELOCITY,
     };
-    let accel = ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT).round().clamp(1.0, 32767.0) as u32;
+    // The schedule's own run-up limits the acceleration in position mode (a servo profile
+    // that brakes for every streamed goal would lag); in velocity mode the servo's profile
+    // acceleration is the run-up's, omega / dt.
+    let accel = match settings.profile {
+        Profile::Position => 0,
+        Profile::Velocity => ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT)
+            .round()
+            .clamp(1.0, 32767.0) as u32,
+    };
     let prof_v = (1.5 * omega / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, 32767.0) as u32;
     let vel_limit = (2.0 * omega / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, 2047.0) as u32;
     let watchdog = (settings.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round().clamp(1.0, 127.0) as u8;
     for (leg, s) in settings.servos.iter().enumerate() {
         let id = s.id;
         let w = |bus: &mut DynamixelBus, addr: u16, data: &[u8], what: &'static str, fix: &'static str| {
-            bus.write(id, addr, data).map(|_| ()).map_err(|e| DriveError::Setup { id, leg, what, reason: e.to_string(), fix })
+            bus.write(id, addr, data).map(|_| ()).map_err(|e| DriveError::Setup {
+                id,
+                leg,
+                what,
+                reason: e.to_string(),
+                fix,
+            })
         };
         w(bus, t::TORQUE_ENABLE, &[0], "Torque Enable = 0", "power-cycle the servo")?;
         w(bus, t::BUS_WATCHDOG, &[0], "Bus Watchdog = 0", "reboot the servo (Dynamixel Wizard)")?;
         w(bus, t::OPERATING_MODE, &[op], "Operating Mode", "check the model is an XL330")?;
-        w(bus, t::DRIVE_MODE, &[0], "Drive Mode = 0 (velocity-based profile)", "check the model is an XL330")?;
-        w(bus, t::CURRENT_LIMIT, &settings.current_limit_ma.to_le_bytes(), "Current Limit", "use --current-limit within 0 to 1750 mA")?;
-        w(bus, t::TEMPERATURE_LIMIT, &[settings.temperature_limit_c], "Temperature Limit", "use --temperature-limit within 0 to 70 degC")?;
+        w(
+            bus,
+            t::DRIVE_MODE,
+            &[0],
+            "Drive Mode = 0 (velocity-based profile)",
+            "check the model is an XL330",
+        )?;
+        w(
+            bus,
+            t::CURRENT_LIMIT,
+            &settings.current_limit_ma.to_le_bytes(),
+            "Current Limit",
+            "use --current-limit within 0 to 1750 mA",
+        )?;
+        w(
+            bus,
+            t::TEMPERATURE_LIMIT,
+            &[settings.temperature_limit_c],
+            "Temperature Limit",
+            "use --temperature-limit within 0 to 70 degC",
+        )?;
         w(bus, t::VELOCITY_LIMIT, &vel_limit.to_le_bytes(), "Velocity Limit", "lower leg_speed_rad_s")?;
-        w(bus, t::PROFILE_ACCELERATION, &accel.to_le_bytes(), "Profile Acceleration", "raise response_time_s")?;
+        w(
+            bus,
+            t::PROFILE_ACCELERATION,
+            &accel.to_le_bytes(),
+            "Profile Acceleration",
+            "raise response_time_s",
+        )?;
         w(bus, t::PROFILE_VELOCITY, &prof_v.to_le_bytes(), "Profile Velocity", "lower leg_speed_rad_s")?;
         w(bus, t::BUS_WATCHDOG, &[watchdog], "Bus Watchdog", "reboot the servo (Dynamixel Wizard)")?;
     }
     Ok(())
 }
 
+/// One servo's read: its state and the status packet's alert bit, or the read error.
+type StateRead = Result<(PresentState, bool), ReadError>;
+
 /// Reads every servo's state block; per servo `Ok((state, alert))` or the read error.
-fn read_states(bus: &mut DynamixelBus, ids: &[u8]) -> Result<Vec<Result<(PresentState, bool), ReadError>>, String> {
-    let mut out: Vec<Option<Result<(PresentState, bool), ReadError>>> = (0..ids.len()).map(|_| None).collect();
-    bus.sync_read_cb(ids, t::STATE_BLOCK.0, t::STATE_BLOCK.1, |r| match r {
-        Ok(resp) => {
-            if let Some(i) = ids.iter().position(|&x| x == resp.motor_id) {
-                out[i] = Some(PresentState::decode(resp.data).map(|s| (s, resp.alert)).ok_or_else(|| {
-                    ReadError::Io(std::io::Error::new(std::io::ErrorKind::InvalidData, "short state block"))
-                }));
-            }
-        }
-        Err(e) => {
-            if let Some(slot) = out.iter_mut().find(|s| s.is_none()) {
-                *slot = Some(Err(e));
-            }
+fn read_states(bus: &mut DynamixelBus, ids: &[u8]) -> Result<Vec<StateRead>, String> {
+    // dynamixel2 calls back once per ID, in the order asked: the k-th call is ids[k]'s.
+    let mut out: Vec<Option<StateRead>> = (0..ids.len()).map(|_| None).collect();
+    let mut k = 0usize;
+    bus.sync_read_cb(ids, t::STATE_BLOCK.0, t::STATE_BLOCK.1, |r| {
+        let slot = k;
+        k += 1;
+        let value = match r {
+            Ok(resp) => PresentState::decode(resp.data).map(|s| (s, resp.alert)).ok_or_else(|| {
+                ReadError::Io(std::io::Error::new(std::io::ErrorKind::InvalidData, "short state block"))
+            }),
+            Err(e) => Err(e),
+        };
+        if let Some(o) = out.get_mut(slot) {
+            *o = Some(value);
         }
     })
     .map_err(|e| e.to_string())?;
-    Ok(out.into_iter().map(|o| o.unwrap_or_else(|| Err(ReadError::Io(std::io::ErrorKind::TimedOut.into())))).collect())
+    Ok(out
+        .into_iter()
+        .map(|o| o.unwrap_or_else(|| Err(ReadError::Io(std::io::ErrorKind::TimedOut.into()))))
+        .collect())
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -476,7 +552,15 @@ fn run(
     for (j, s) in settings.servos.iter().enumerate() {
         let here = match &states[j] {
             Ok((st, _)) => s.angle(st.position),
-            Err(e) => return Err(DriveError::Lost { id: s.id, leg: j, time_s: -stand_s, cycles: 1, reason: e.to_string() }),
+            Err(e) => {
+                return Err(DriveError::Lost {
+                    id: s.id,
+                    leg: j,
+                    time_s: -stand_s,
+                    cycles: 1,
+                    reason: e.to_string(),
+                })
+            }
         };
         let start = schedule.start_angle(j);
         // The nearest turn of the start angle: at most half a turn of travel.
@@ -490,8 +574,10 @@ fn run(
         .enumerate()
         .map(|(j, s)| s.angle(start_goal[j]) - schedule.start_angle(j))
         .collect();
-    let torque_on: Vec<SyncWriteData<[u8; 1]>> = ids.iter().map(|&id| SyncWriteData { motor_id: id, data: [1] }).collect();
-    bus.sync_write(t::TORQUE_ENABLE, 1, &torque_on).map_err(|e| DriveError::Bus { time_s: -stand_s, reason: e.to_string() })?;
+    let torque_on: Vec<SyncWriteData<[u8; 1]>> =
+        ids.iter().map(|&id| SyncWriteData { motor_id: id, data: [1] }).collect();
+    bus.sync_write(t::TORQUE_ENABLE, 1, &torque_on)
+        .map_err(|e| DriveError::Bus { time_s: -stand_s, reason: e.to_string() })?;
     let begin = Instant::now();
     let mut last_cycle = Instant::now();
     let mut halted: Option<(f64, f64)> = None;
@@ -533,8 +619,11 @@ fn run(
             .collect();
         let result = match settings.profile {
             Profile::Position => {
-                let data: Vec<SyncWriteData<[u8; 4]>> =
-                    ids.iter().zip(&goals).map(|(&id, g)| SyncWriteData { motor_id: id, data: g.0.to_le_bytes() }).collect();
+                let data: Vec<SyncWriteData<[u8; 4]>> = ids
+                    .iter()
+                    .zip(&goals)
+                    .map(|(&id, g)| SyncWriteData { motor_id: id, data: g.0.to_le_bytes() })
+                    .collect();
                 bus.sync_write(t::GOAL_POSITION, 4, &data)
             }
             Profile::Velocity => {
@@ -545,7 +634,11 @@ fn run(
                     .enumerate()
                     .map(|(j, &id)| {
                         let s = settings.servos[j];
-                        let cmd_v = if time >= 0.0 && halted.is_none() { schedule.command(j, time).velocity_rad_s } else { 0.0 };
+                        let cmd_v = if time >= 0.0 && halted.is_none() {
+                            schedule.command(j, time).velocity_rad_s
+                        } else {
+                            0.0
+                        };
                         let err = last_pos[j].map_or(0.0, |p| s.angle(goals[j].0) - s.angle(p));
                         let v = f64::from(s.direction) * (cmd_v + PHASE_GAIN_PER_S * err);
                         let units = xl330::velocity_units_from_rad_s(v).clamp(-2047, 2047) as i32;
@@ -564,9 +657,14 @@ fn run(
                 Ok((state, alert)) => {
                     failures[j] = (0, false);
                     last_pos[j] = Some(state.position);
-                    let hardware_error = if alert { bus.read_u8(s.id, t::HARDWARE_ERROR_STATUS).map(|r| r.data).unwrap_or(0xFF) } else { 0 };
+                    let hardware_error = if alert {
+                        bus.read_u8(s.id, t::HARDWARE_ERROR_STATUS).map(|r| r.data).unwrap_or(0xFF)
+                    } else {
+                        0
+                    };
                     let angle = s.angle(state.position) - shift[j];
-                    let tau = f64::from(s.direction) * xl330::torque_from_current(f64::from(state.current_ma));
+                    let tau =
+                        f64::from(s.direction) * xl330::torque_from_current(f64::from(state.current_ma));
                     let sample = ServoSample {
                         time_s: time,
                         leg: j,
@@ -578,10 +676,13 @@ fn run(
                         leg_angle_rad: angle,
                         drive_torque_n_m: tau,
                     };
-                    on_sample(&sample).map_err(|e| DriveError::Log { time_s: time, reason: e.to_string() })?;
+                    on_sample(&sample)
+                        .map_err(|e| DriveError::Log { time_s: time, reason: e.to_string() })?;
                     if let (Some(b), Some(m)) = (bins.as_mut(), monitor.as_ref()) {
                         if let Some((k, profile, counts)) = b.add(schedule, j, angle, tau) {
-                            if let Some(inf) = infer_from_stance(m.robot, m.grid, k, &profile, &counts, m.noise_sd_n_m) {
+                            if let Some(inf) =
+                                infer_from_stance(m.robot, m.grid, k, &profile, &counts, m.noise_sd_n_m)
+                            {
                                 let live = LiveEstimate { time_s: time, tripod: k, inference: inf };
                                 on_live(&live);
                                 let p = live.inference.p_slippage;
@@ -591,7 +692,11 @@ fn run(
                                         halted = Some((time, p));
                                         // Hold every leg where it was last read: the stance
                                         // tripod stays planted.
-                                        halt_goal = last_pos.iter().zip(&goals).map(|(p, g)| p.unwrap_or(g.0)).collect();
+                                        halt_goal = last_pos
+                                            .iter()
+                                            .zip(&goals)
+                                            .map(|(p, g)| p.unwrap_or(g.0))
+                                            .collect();
                                     }
                                 }
                             }
@@ -599,14 +704,25 @@ fn run(
                     }
                 }
                 Err(e) => {
-                    let corrupt = matches!(e, ReadError::InvalidMessage(_));
+                    // A failed CRC is corruption; silence, or the next servo's packet in this
+                    // one's place, is a servo that did not answer.
+                    let corrupt = matches!(
+                        e,
+                        ReadError::InvalidMessage(dynamixel2::InvalidMessage::InvalidChecksum(_))
+                    );
                     let n = if failures[j].1 == corrupt { failures[j].0 + 1 } else { 1 };
                     failures[j] = (n, corrupt);
                     if n >= 3 {
                         return Err(if corrupt {
                             DriveError::Corrupt { id: s.id, leg: j, time_s: time, cycles: n }
                         } else {
-                            DriveError::Lost { id: s.id, leg: j, time_s: time, cycles: n, reason: e.to_string() }
+                            DriveError::Lost {
+                                id: s.id,
+                                leg: j,
+                                time_s: time,
+                                cycles: n,
+                                reason: e.to_string(),
+                            }
                         });
                     }
                 }
@@ -622,13 +738,16 @@ fn run(
 
 /// Torque off on every servo (a Sync Write, then each servo written and read back alone).
 pub fn torque_off(bus: &mut DynamixelBus, servos: &[ServoConfig]) -> TorqueOff {
-    let data: Vec<SyncWriteData<[u8; 1]>> = servos.iter().map(|s| SyncWriteData { motor_id: s.id, data: [0] }).collect();
+    let data: Vec<SyncWriteData<[u8; 1]>> =
+        servos.iter().map(|s| SyncWriteData { motor_id: s.id, data: [0] }).collect();
     bus.sync_write(t::TORQUE_ENABLE, 1, &data).ok();
     let mut out = TorqueOff::default();
     for s in servos {
         let mut ok = false;
         for _ in 0..3 {
-            if bus.write_u8(s.id, t::TORQUE_ENABLE, 0).is_ok() && matches!(bus.read_u8(s.id, t::TORQUE_ENABLE), Ok(r) if r.data == 0) {
+            if bus.write_u8(s.id, t::TORQUE_ENABLE, 0).is_ok()
+                && matches!(bus.read_u8(s.id, t::TORQUE_ENABLE), Ok(r) if r.data == 0)
+            {
                 ok = true;
                 break;
             }

@@ -122,8 +122,10 @@ impl Walk {
         let settings = SimSettings::new(strides.max(3) as f64 * schedule.period_s)
             .and_then(|s| s.with_sample_rate(rate_hz))
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
-        let scenario = Scenario::new(robot.clone(), terrain, None, None).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
-        let sim = simulate(&scenario, slope_deg, &settings).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+        let scenario = Scenario::new(robot.clone(), terrain, None, None)
+            .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+        let sim =
+            simulate(&scenario, slope_deg, &settings).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         Ok(Walk { legs: simulated_legs(&schedule, &sim), rate_hz })
     }
 
@@ -151,6 +153,10 @@ impl Walk {
         trace.torque_n_m[i]
     }
 }
+
+/// The emulated position loop's gain, 1/s: a shaft 0.1 rad behind its goal turns at 4 rad/s
+/// (a time constant of 25 ms, the order of an XL330's step response at its default gains).
+pub const POSITION_GAIN_PER_S: f64 = 40.0;
 
 /// One virtual XL330.
 #[derive(Debug, Clone)]
@@ -216,7 +222,9 @@ impl VirtualServo {
 
     /// Leg angle in the gait's frame, rad.
     fn leg_angle(&self) -> f64 {
-        f64::from(self.config.direction) * (self.position - f64::from(self.config.zero_offset_pulses)) * xl330::RAD_PER_PULSE
+        f64::from(self.config.direction)
+            * (self.position - f64::from(self.config.zero_offset_pulses))
+            * xl330::RAD_PER_PULSE
     }
 
     /// Moves the shaft to time `now` and refreshes the present values.
@@ -224,7 +232,10 @@ impl VirtualServo {
         let dt = (now - self.last_update).max(0.0);
         self.last_update = now;
         let wd = self.u8_at(t::BUS_WATCHDOG);
-        if self.torque_on() && (1..=127).contains(&wd) && now - self.last_seen > f64::from(wd) * xl330::WATCHDOG_UNIT_S {
+        if self.torque_on()
+            && (1..=127).contains(&wd)
+            && now - self.last_seen > f64::from(wd) * xl330::WATCHDOG_UNIT_S
+        {
             // The watchdog fired: the servo stops where it is and marks it (e-Manual, Bus Watchdog).
             self.table[t::BUS_WATCHDOG as usize] = t::WATCHDOG_FIRED;
             let here = self.position.round() as i32;
@@ -241,16 +252,17 @@ impl VirtualServo {
             if fired {
                 0.0
             } else {
-                (f64::from(self.i32_at(t::GOAL_VELOCITY)) * xl330::RAD_S_PER_VELOCITY_UNIT).clamp(-vel_limit, vel_limit)
+                (f64::from(self.i32_at(t::GOAL_VELOCITY)) * xl330::RAD_S_PER_VELOCITY_UNIT)
+                    .clamp(-vel_limit, vel_limit)
             }
         } else {
+            // Position control: a proportional pull on the error (POSITION_GAIN_PER_S), capped
+            // by the profile velocity, and by the speed from which the profile acceleration
+            // can still stop at the goal (a trapezoidal profile: no overshoot).
             let vmax = if prof_v > 0.0 { prof_v.min(vel_limit) } else { vel_limit };
             let to_go = (f64::from(self.i32_at(t::GOAL_POSITION)) - self.position) * xl330::RAD_PER_PULSE;
-            if dt > 0.0 {
-                (to_go / dt).clamp(-vmax, vmax)
-            } else {
-                self.velocity
-            }
+            let brake = if acc > 0.0 { (2.0 * acc * to_go.abs()).sqrt() } else { f64::INFINITY };
+            (POSITION_GAIN_PER_S * to_go).clamp(-vmax.min(brake), vmax.min(brake))
         };
         if self.torque_on() && acc > 0.0 {
             let dv = (target_v - self.velocity).clamp(-acc * dt, acc * dt);
@@ -368,11 +380,17 @@ pub struct VirtualBus {
 impl VirtualBus {
     /// The bus of `config` (runs the stride simulator once, twice with a weakening).
     pub fn new(config: &EmulatorConfig) -> Result<VirtualBus, EmulatorError> {
-        let walk = Walk::new(&config.robot, config.terrain.clone(), config.slope_deg, config.simulated_strides)?;
+        let walk =
+            Walk::new(&config.robot, config.terrain.clone(), config.slope_deg, config.simulated_strides)?;
         let weak_walk = match config.faults.weaken {
             Some((_, k_s)) => {
-                let k_n = config.terrain.at(sandslope::Slope::from_signed_degrees(config.slope_deg.abs()).map_err(|e| EmulatorError::Simulator(e.to_string()))?).k_n;
-                let weak = Terrain::constant(k_n, k_s).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+                let k_n = config
+                    .terrain
+                    .at(sandslope::Slope::from_signed_degrees(config.slope_deg.abs())
+                        .map_err(|e| EmulatorError::Simulator(e.to_string()))?)
+                    .k_n;
+                let weak =
+                    Terrain::constant(k_n, k_s).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
                 Some(Walk::new(&config.robot, weak, config.slope_deg, config.simulated_strides)?)
             }
             None => None,
@@ -400,11 +418,9 @@ impl VirtualBus {
             (Some(w), Some((at, _))) if now >= at => w,
             _ => &self.walk,
         };
-        let silent = self.faults.silent;
+        // A silent servo still runs (its data line is what failed): its watchdog stops it.
         for s in &mut self.servos {
-            if !matches!(silent, Some((sid, at)) if sid == s.config.id && now >= at) {
-                s.advance(now, walk, &mut self.noise, self.noise_ma);
-            }
+            s.advance(now, walk, &mut self.noise, self.noise_ma);
         }
     }
 
@@ -457,7 +473,11 @@ impl VirtualBus {
             inst::PING if addressed => {
                 self.servos[k].last_seen = now;
                 let s = &self.servos[k];
-                Some(packet::status(id, s.error_byte(0), &[s.table[0], s.table[1], s.table[t::FIRMWARE_VERSION as usize]]))
+                Some(packet::status(
+                    id,
+                    s.error_byte(0),
+                    &[s.table[0], s.table[1], s.table[t::FIRMWARE_VERSION as usize]],
+                ))
             }
             inst::READ if ins.id == id => {
                 self.servos[k].last_seen = now;
@@ -511,7 +531,8 @@ impl VirtualBus {
                 let entry = p.chunks(5).find(|c| c.len() == 5 && c[0] == id)?;
                 self.servos[k].last_seen = now;
                 let s = &self.servos[k];
-                let (addr, len) = (u16::from_le_bytes([entry[1], entry[2]]), u16::from_le_bytes([entry[3], entry[4]]));
+                let (addr, len) =
+                    (u16::from_le_bytes([entry[1], entry[2]]), u16::from_le_bytes([entry[3], entry[4]]));
                 Some(match s.read(addr, len) {
                     Ok(data) => packet::status(id, s.error_byte(0), &data),
                     Err(e) => packet::status(id, s.error_byte(e), &[]),

@@ -165,7 +165,8 @@ impl Parser {
                 None => {
                     // Keep a possible partial header at the end; drop everything before it.
                     let n = self.buf.len();
-                    let keep = (1..=3).rev().find(|&k| n >= k && self.buf[n - k..] == HEADER[..k]).unwrap_or(0);
+                    let keep =
+                        (1..=3).rev().find(|&k| n >= k && self.buf[n - k..] == HEADER[..k]).unwrap_or(0);
                     self.buf.drain(..n - keep);
                     return None;
                 }
@@ -220,7 +221,10 @@ mod tests {
         p.push(&ping[1..6]);
         assert_eq!(p.next_packet(), None);
         p.push(&ping[6..]);
-        assert_eq!(p.next_packet(), Some(Parsed::Instruction(Instruction { id: 1, instruction: inst::PING, params: vec![] })));
+        assert_eq!(
+            p.next_packet(),
+            Some(Parsed::Instruction(Instruction { id: 1, instruction: inst::PING, params: vec![] }))
+        );
         // The same packet with its CRC's last byte flipped.
         let mut bad = ping;
         bad[9] ^= 0xFF;

@@ -44,7 +44,10 @@ fn hand_written_packets_from_the_protocol_documentation() {
     assert_eq!(reply, [0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x07, 0x00, 0x55, 0x00, 0x06, 0x04, 0x26, 0x65, 0x5D]);
     // Ping, broadcast: both answer, ID 1 first.
     let reply = exchange(&mut bus, &[0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x03, 0x00, 0x01, 0x31, 0x42]);
-    assert_eq!(&reply[..14], [0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x07, 0x00, 0x55, 0x00, 0x06, 0x04, 0x26, 0x65, 0x5D]);
+    assert_eq!(
+        &reply[..14],
+        [0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x07, 0x00, 0x55, 0x00, 0x06, 0x04, 0x26, 0x65, 0x5D]
+    );
     assert_eq!(reply[4 + 14], 0x02);
     // Sync Read of Present Position (132, 4 bytes) from IDs 1 and 2.
     let reply = exchange(
@@ -58,8 +61,8 @@ fn hand_written_packets_from_the_protocol_documentation() {
     let reply = exchange(
         &mut bus,
         &[
-            0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x11, 0x00, 0x83, 0x74, 0x00, 0x04, 0x00, 0x01, 0x96, 0x00, 0x00, 0x00, 0x02,
-            0xAA, 0x00, 0x00, 0x00, 0x82, 0x87,
+            0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x11, 0x00, 0x83, 0x74, 0x00, 0x04, 0x00, 0x01, 0x96, 0x00, 0x00,
+            0x00, 0x02, 0xAA, 0x00, 0x00, 0x00, 0x82, 0x87,
         ],
     );
     assert!(reply.is_empty());
@@ -76,8 +79,8 @@ fn hand_written_packets_from_the_protocol_documentation() {
     let reply = exchange(
         &mut bus,
         &[
-            0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x92, 0x01, 0x90, 0x00, 0x02, 0x00, 0x02, 0x92, 0x00, 0x01, 0x00,
-            0x1A, 0x05,
+            0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x0D, 0x00, 0x92, 0x01, 0x90, 0x00, 0x02, 0x00, 0x02, 0x92, 0x00,
+            0x01, 0x00, 0x1A, 0x05,
         ],
     );
     assert_eq!(&reply[..9], [0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x06, 0x00, 0x55, 0x00]);
@@ -99,7 +102,10 @@ fn hand_written_packets_from_the_protocol_documentation() {
     p.push(&[0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x09, 0x00, 0x82, 0x84, 0x00, 0x04, 0x00, 0x01, 0x02, 0xCE, 0xFA]);
     match p.next_packet() {
         Some(Parsed::Instruction(i)) => {
-            assert_eq!((i.id, i.instruction, i.params), (0xFE, 0x82, vec![0x84, 0x00, 0x04, 0x00, 0x01, 0x02]))
+            assert_eq!(
+                (i.id, i.instruction, i.params),
+                (0xFE, 0x82, vec![0x84, 0x00, 0x04, 0x00, 0x01, 0x02])
+            )
         }
         other => panic!("{other:?}"),
     }
@@ -124,16 +130,23 @@ fn the_dynamixel2_client_talks_to_the_emulator_over_a_pty() {
     assert_eq!(bus.read_u16(2, t::CURRENT_LIMIT).unwrap().data, 900);
     // Sync write and sync read.
     let data: Vec<_> = (1..=6u8)
-        .map(|id| dynamixel2::instructions::SyncWriteData { motor_id: id, data: (1000 + u32::from(id)).to_le_bytes() })
+        .map(|id| dynamixel2::instructions::SyncWriteData {
+            motor_id: id,
+            data: (1000 + u32::from(id)).to_le_bytes(),
+        })
         .collect();
     bus.sync_write(t::PROFILE_VELOCITY, 4, &data).unwrap();
     let back = bus.sync_read_u32(&[6, 1, 4], t::PROFILE_VELOCITY).unwrap();
-    assert_eq!(back.iter().map(|r| (r.motor_id, r.data)).collect::<Vec<_>>(), vec![(6, 1006), (1, 1001), (4, 1004)]);
+    assert_eq!(
+        back.iter().map(|r| (r.motor_id, r.data)).collect::<Vec<_>>(),
+        vec![(6, 1006), (1, 1001), (4, 1004)]
+    );
     // Bulk read. dynamixel2 0.9.1 writes the k-th entry at parameter offset k instead of 5 k
     // (instructions/bulk_read.rs: `&mut buffer[i..][..5]`), so only a one-servo Bulk Read is
     // well formed; the driver uses Sync Read, and the e-Manual's two-servo Bulk Read is
     // checked by hand in the test above.
-    let reads = [dynamixel2::instructions::BulkReadData { motor_id: 5, address: t::TEMPERATURE_LIMIT, count: 1 }];
+    let reads =
+        [dynamixel2::instructions::BulkReadData { motor_id: 5, address: t::TEMPERATURE_LIMIT, count: 1 }];
     let got = bus.bulk_read(&reads).unwrap();
     assert_eq!((got[0].motor_id, got[0].data.clone()), (5, vec![70]));
     // A parameter that needs byte stuffing: FF FF FD written into a 4-byte register.
@@ -143,4 +156,22 @@ fn the_dynamixel2_client_talks_to_the_emulator_over_a_pty() {
     let report = emulator.stop();
     assert_eq!(report.bad_crc, 0);
     assert!(report.packets >= 10);
+}
+
+/// The Bus Watchdog (98, 20 ms units): a servo with the torque on that hears nothing for
+/// longer stops and sets it to 100 (e-Manual, Bus Watchdog).
+#[test]
+fn the_bus_watchdog_fires_on_a_quiet_bus() {
+    let mut bus = VirtualBus::new(&config(1200, 46, &[0])).unwrap();
+    let write = |addr: u8, v: u8| packet::encode(1, packet::inst::WRITE, &[addr, 0, v]);
+    let mut p = Parser::default();
+    p.push(&write(t::BUS_WATCHDOG as u8, 5));
+    p.push(&write(t::TORQUE_ENABLE as u8, 1));
+    while let Some(x) = p.next_packet() {
+        bus.respond(x, 0.0);
+    }
+    bus.tick(0.09);
+    assert_eq!(bus.report().watchdog, vec![(1, 5)], "0.09 s of silence is within 5 x 20 ms");
+    bus.tick(0.11);
+    assert_eq!(bus.report().watchdog, vec![(1, 100)]);
 }

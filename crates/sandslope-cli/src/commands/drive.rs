@@ -119,7 +119,8 @@ fn number(flag: &str, text: &str, whole: &str) -> Result<f64> {
 fn parse_faults(args: &DriveArgs) -> Result<EmulatorFaults> {
     let mut f = EmulatorFaults::default();
     if let Some(w) = &args.emulate_weaken {
-        let (s, k) = w.split_once(':').ok_or_else(|| anyhow!("--emulate-weaken `{w}` must be S:K_S, e.g. 3:2e5"))?;
+        let (s, k) =
+            w.split_once(':').ok_or_else(|| anyhow!("--emulate-weaken `{w}` must be S:K_S, e.g. 3:2e5"))?;
         let (s, k) = (number("--emulate-weaken", s, w)?, number("--emulate-weaken", k, w)?);
         if !(s >= 0.0 && k > 0.0 && k.is_finite() && s.is_finite()) {
             bail!("--emulate-weaken `{w}`: S must be at least 0 and K_S a finite number above 0");
@@ -128,13 +129,18 @@ fn parse_faults(args: &DriveArgs) -> Result<EmulatorFaults> {
     }
     if let Some(text) = &args.emulate_fault {
         let parts: Vec<&str> = text.split(':').collect();
-        let id = |s: &str| -> Result<u8> {
-            s.trim().parse::<u8>().ok().filter(|&i| i <= 252).ok_or_else(|| anyhow!("--emulate-fault: `{s}` is not a servo ID from 0 to 252 (in {text})"))
-        };
+        let id =
+            |s: &str| -> Result<u8> {
+                s.trim().parse::<u8>().ok().filter(|&i| i <= 252).ok_or_else(|| {
+                    anyhow!("--emulate-fault: `{s}` is not a servo ID from 0 to 252 (in {text})")
+                })
+            };
         match parts.as_slice() {
             ["silent", i, s] => f.silent = Some((id(i)?, number("--emulate-fault", s, text)?)),
             ["corrupt", i, s] => f.corrupt = Some((id(i)?, number("--emulate-fault", s, text)?)),
-            ["freeze", s, len] => f.freeze = Some((number("--emulate-fault", s, text)?, number("--emulate-fault", len, text)?)),
+            ["freeze", s, len] => {
+                f.freeze = Some((number("--emulate-fault", s, text)?, number("--emulate-fault", len, text)?))
+            }
             _ => bail!("--emulate-fault `{text}` must be silent:ID:S, corrupt:ID:S or freeze:S:LEN"),
         }
     }
@@ -149,13 +155,21 @@ fn servos(args: &DriveArgs, legs: usize) -> Result<(Vec<ServoConfig>, u32)> {
         Some(s) => (
             s.mounts
                 .iter()
-                .map(|m| ServoConfig { id: m.id, direction: m.direction, zero_offset_pulses: m.zero_offset_pulses })
+                .map(|m| ServoConfig {
+                    id: m.id,
+                    direction: m.direction,
+                    zero_offset_pulses: m.zero_offset_pulses,
+                })
                 .collect::<Vec<_>>(),
             s.baud_rate,
         ),
         None => (
             (0..legs)
-                .map(|j| ServoConfig { id: j as u8 + 1, direction: if j < legs / 2 { 1 } else { -1 }, zero_offset_pulses: 0 })
+                .map(|j| ServoConfig {
+                    id: j as u8 + 1,
+                    direction: if j < legs / 2 { 1 } else { -1 },
+                    zero_offset_pulses: 0,
+                })
                 .collect(),
             DEFAULT_BAUD_RATE,
         ),
@@ -182,10 +196,18 @@ pub fn run(args: DriveArgs) -> Result<()> {
     check_flag("--watchdog", args.watchdog, 0.01, 10.0)?;
     check_flag("--bus-watchdog", args.bus_watchdog, 0.02, 2.54)?;
     if args.current_limit > xl330::MAX_CURRENT_LIMIT_MA {
-        bail!("--current-limit = {} must be within 0 to {} mA (the XL330's Current Limit range)", args.current_limit, xl330::MAX_CURRENT_LIMIT_MA);
+        bail!(
+            "--current-limit = {} must be within 0 to {} mA (the XL330's Current Limit range)",
+            args.current_limit,
+            xl330::MAX_CURRENT_LIMIT_MA
+        );
     }
     if args.temperature_limit > xl330::MAX_TEMPERATURE_C {
-        bail!("--temperature-limit = {} must be within 0 to {} degC (the XL330's rated range)", args.temperature_limit, xl330::MAX_TEMPERATURE_C);
+        bail!(
+            "--temperature-limit = {} must be within 0 to {} degC (the XL330's rated range)",
+            args.temperature_limit,
+            xl330::MAX_TEMPERATURE_C
+        );
     }
     if let Some(p) = args.stop_on_risk {
         check_flag("--stop-on-risk", p, 0.0, 1.0)?;
@@ -238,7 +260,9 @@ pub fn run(args: DriveArgs) -> Result<()> {
     let mut emulator = None;
     let port = if args.emulate {
         let emulated_terrain = match args.emulate_k_s {
-            Some(k) => sandslope::Terrain::constant(k_n, k).map_err(|e| anyhow!("{}", e.renamed("--emulate-k-s")))?,
+            Some(k) => {
+                sandslope::Terrain::constant(k_n, k).map_err(|e| anyhow!("{}", e.renamed("--emulate-k-s")))?
+            }
             None => sandslope::Terrain::constant(k_n, ground.k_s)?,
         };
         let mut cfg = EmulatorConfig::new(robot.clone(), emulated_terrain, args.slope, servos.clone());
@@ -257,7 +281,8 @@ pub fn run(args: DriveArgs) -> Result<()> {
             )
         })?
     };
-    let mut bus = dynamixel2::Bus::new(port).map_err(|e| anyhow!("cannot configure the serial port: {e:?}"))?;
+    let mut bus =
+        dynamixel2::Bus::new(port).map_err(|e| anyhow!("cannot configure the serial port: {e:?}"))?;
     // Ctrl-C from here on stops the gait and turns the torque off rather than ending the process.
     crate::error::DRIVING.store(true, Ordering::SeqCst);
     let noise_sd = xl330::torque_from_current(if args.emulate { args.emulate_noise.max(1.0) } else { 10.0 });
@@ -272,7 +297,10 @@ pub fn run(args: DriveArgs) -> Result<()> {
         ("run_up_s", format!("{}", schedule.run_up_s)),
         ("ids", servos.iter().map(|s| s.id.to_string()).collect::<Vec<_>>().join(" ")),
         ("directions", servos.iter().map(|s| s.direction.to_string()).collect::<Vec<_>>().join(" ")),
-        ("zero_offsets", servos.iter().map(|s| s.zero_offset_pulses.to_string()).collect::<Vec<_>>().join(" ")),
+        (
+            "zero_offsets",
+            servos.iter().map(|s| s.zero_offset_pulses.to_string()).collect::<Vec<_>>().join(" "),
+        ),
         ("profile", format!("{:?}", settings.profile).to_lowercase()),
         ("emulated", args.emulate.to_string()),
     ];
@@ -298,7 +326,15 @@ pub fn run(args: DriveArgs) -> Result<()> {
                     .with_context(|| format!("cannot create {}", tmp.display()))?;
                 let mut log = ServoLogWriter::new(std::io::BufWriter::new(file), &meta)?;
                 let mut on_sample = |s: &ServoSample| log.write(&row(s));
-                let r = drive(&mut bus, &schedule, &settings, monitor.clone(), stop, &mut on_sample, &mut on_live);
+                let r = drive(
+                    &mut bus,
+                    &schedule,
+                    &settings,
+                    monitor.clone(),
+                    stop,
+                    &mut on_sample,
+                    &mut on_live,
+                );
                 // The log is the record of what happened: flushed and kept on every exit.
                 log.finish().map_err(|e| sandslope_io::WriteError { path: path.clone(), source: e })?;
                 outcome = Some(r);
@@ -312,10 +348,26 @@ pub fn run(args: DriveArgs) -> Result<()> {
     drop(bus);
     if let Some(emu) = emulator {
         let r = emu.stop();
-        let on: Vec<String> = r.torque_enabled.iter().filter(|(_, on)| *on).map(|(id, _)| id.to_string()).collect();
+        let on: Vec<String> =
+            r.torque_enabled.iter().filter(|(_, on)| *on).map(|(id, _)| id.to_string()).collect();
+        let fired: Vec<String> = r
+            .watchdog
+            .iter()
+            .filter(|(_, w)| *w == t::WATCHDOG_FIRED)
+            .map(|(id, _)| id.to_string())
+            .collect();
         eprintln!(
-            "emulator: torque {} ({} packets, {} with a bad CRC)",
-            if on.is_empty() { "off on every servo".to_string() } else { format!("still ON on servos {}", on.join(", ")) },
+            "emulator: torque {}{} ({} packets, {} with a bad CRC)",
+            if on.is_empty() {
+                "off on every servo".to_string()
+            } else {
+                format!("still ON on servos {}", on.join(", "))
+            },
+            if fired.is_empty() {
+                String::new()
+            } else {
+                format!("; Bus Watchdog fired on servos {} (stopped)", fired.join(", "))
+            },
             r.packets,
             r.bad_crc
         );
@@ -375,11 +427,18 @@ fn summarise(r: &DriveReport, quiet: bool) -> Result<()> {
         "{} cycles at {:.1} Hz; torque off confirmed on servos {}{}",
         r.cycles,
         r.rate_hz,
-        if off.confirmed.is_empty() { "none".into() } else { off.confirmed.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ") },
+        if off.confirmed.is_empty() {
+            "none".into()
+        } else {
+            off.confirmed.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ")
+        },
         if off.unconfirmed.is_empty() {
             String::new()
         } else {
-            format!(" (NOT confirmed on {}: they did not answer; their Bus Watchdog stops them)", off.unconfirmed.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", "))
+            format!(
+                " (NOT confirmed on {}: they did not answer; their Bus Watchdog stops them)",
+                off.unconfirmed.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ")
+            )
         }
     );
     if let Some(last) = r.live.last() {
@@ -412,10 +471,19 @@ fn dry_run(schedule: &GaitSchedule, s: &DriveSettings) -> Result<()> {
         (
             "Profile Acceleration",
             t::PROFILE_ACCELERATION,
-            ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT).round().to_string(),
+            match s.profile {
+                Profile::Position => "0".to_string(),
+                Profile::Velocity => {
+                    ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT).round().to_string()
+                }
+            },
         ),
         ("Profile Velocity", t::PROFILE_VELOCITY, xl330::velocity_units_from_rad_s(1.5 * omega).to_string()),
-        ("Bus Watchdog (20 ms)", t::BUS_WATCHDOG, ((s.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round()).to_string()),
+        (
+            "Bus Watchdog (20 ms)",
+            t::BUS_WATCHDOG,
+            ((s.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round()).to_string(),
+        ),
         ("Torque Enable", t::TORQUE_ENABLE, "1".into()),
     ] {
         println!("# write {name} ({addr}) = {value} on IDs {}", ids.join(", "));
@@ -436,7 +504,9 @@ fn dry_run(schedule: &GaitSchedule, s: &DriveSettings) -> Result<()> {
             let cmd = schedule.command(j, time);
             let value = match s.profile {
                 Profile::Position => i64::from(c.pulses(cmd.angle_rad)),
-                Profile::Velocity => xl330::velocity_units_from_rad_s(f64::from(c.direction) * cmd.velocity_rad_s),
+                Profile::Velocity => {
+                    xl330::velocity_units_from_rad_s(f64::from(c.direction) * cmd.velocity_rad_s)
+                }
             };
             std::io::Write::write_fmt(
                 &mut out,

@@ -148,7 +148,10 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
     let log = sandslope_io::servo_log::read_servo_log(path)?;
     let slope_deg = match (args.slope, log.meta_f64("slope_deg", path)?) {
         (Some(s), _) | (None, Some(s)) => s,
-        (None, None) => bail!("{}: the log has no `# slope_deg = ...` header line; give the run's slope with --slope", path.display()),
+        (None, None) => bail!(
+            "{}: the log has no `# slope_deg = ...` header line; give the run's slope with --slope",
+            path.display()
+        ),
     };
     let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
     let terrain = args.terrain.load()?;
@@ -157,14 +160,20 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
     let mut traces = vec![LegTrace::default(); legs];
     for (i, r) in log.rows.iter().enumerate() {
         let t = traces.get_mut(r.leg).ok_or_else(|| {
-            anyhow!("{}: row {} has leg {}, but the robot has {legs} legs (2 * stance_legs)", path.display(), i + 1, r.leg)
+            anyhow!(
+                "{}: row {} has leg {}, but the robot has {legs} legs (2 * stance_legs)",
+                path.display(),
+                i + 1,
+                r.leg
+            )
         })?;
         t.angle_rad.push(r.leg_angle_rad);
         t.torque_n_m.push(r.drive_torque_n_m);
     }
     let settings = CurrentInferenceSettings { prior, grid_points: args.grid_points, ..Default::default() };
     let grid = model_grid(&robot, k_n, slope_deg, &settings).map_err(|e| anyhow!("{e}"))?;
-    let answer = infer_from_currents(&robot, &grid, &traces).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    let answer =
+        infer_from_currents(&robot, &grid, &traces).map_err(|e| anyhow!("{}: {e}", path.display()))?;
     if args.json {
         return print_json(&answer);
     }

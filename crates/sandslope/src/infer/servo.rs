@@ -180,7 +180,8 @@ pub fn model_grid(
     let walks: Vec<Result<_, CurrentInferenceError>> = k_s
         .par_iter()
         .map(|&ks| {
-            let terrain = Terrain::constant(k_n, ks).map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
+            let terrain =
+                Terrain::constant(k_n, ks).map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
             let scenario = Scenario::new(robot.clone(), terrain, None, None)
                 .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
             let sim = simulate(&scenario, slope_deg, &sim_settings)
@@ -238,13 +239,7 @@ pub fn leg_mapping(schedule: &GaitSchedule, sim_tripods: &[usize]) -> Vec<usize>
             let k = schedule.tripods[j];
             let rank = seen[k];
             seen[k] += 1;
-            sim_tripods
-                .iter()
-                .enumerate()
-                .filter(|(_, &t)| t == k)
-                .map(|(i, _)| i)
-                .nth(rank)
-                .unwrap_or(k)
+            sim_tripods.iter().enumerate().filter(|(_, &t)| t == k).map(|(i, _)| i).nth(rank).unwrap_or(k)
         })
         .collect()
 }
@@ -342,7 +337,8 @@ pub fn infer_from_currents(
     grid: &ModelGrid,
     legs: &[LegTrace],
 ) -> Result<CurrentInference, CurrentInferenceError> {
-    let schedule = GaitSchedule::new(robot, legs.len()).map_err(|e| CurrentInferenceError::Setting(e.to_string()))?;
+    let schedule =
+        GaitSchedule::new(robot, legs.len()).map_err(|e| CurrentInferenceError::Setting(e.to_string()))?;
     let width = 2 * grid.bins;
     let profiles = stance_profiles(&schedule, legs, grid.bins);
     let (mean, sd, n) = profile_statistics(&profiles, width);
@@ -370,7 +366,8 @@ pub fn infer_from_stance(
     let mut used = vec![];
     for i in 0..b {
         let idx = tripod * b + i;
-        let (Some(v), c) = (profile.get(idx).copied().flatten(), counts.get(idx).copied().unwrap_or(0)) else {
+        let (Some(v), c) = (profile.get(idx).copied().flatten(), counts.get(idx).copied().unwrap_or(0))
+        else {
             continue;
         };
         if c == 0 {
@@ -389,7 +386,13 @@ pub fn infer_from_stance(
     Some(answer)
 }
 
-fn posterior_answer_single(robot: &Robot, grid: &ModelGrid, mean: &[f64], var_obs: &[f64], bins: &[usize]) -> CurrentInference {
+fn posterior_answer_single(
+    robot: &Robot,
+    grid: &ModelGrid,
+    mean: &[f64],
+    var_obs: &[f64],
+    bins: &[usize],
+) -> CurrentInference {
     // The simulated stance scatters from stride to stride as a single stance does: its full
     // SD, not the SD of its mean.
     let g = ModelGrid { strides: 1, ..grid.clone() };
@@ -448,10 +451,12 @@ fn posterior_answer(
         (true, true) => Bound::Neither,
     };
     // (`0.0 +`: an empty sum of floats is -0.0.)
-    let p_slip = 0.0 + p.iter().zip(&grid.regime).filter(|(_, r)| **r == Regime::Slippage).map(|(x, _)| x).sum::<f64>();
+    let p_slip = 0.0
+        + p.iter().zip(&grid.regime).filter(|(_, r)| **r == Regime::Slippage).map(|(x, _)| x).sum::<f64>();
     let shear = p.iter().zip(&grid.shear_load_n).map(|(x, f)| x * f).sum();
     let slope = grid.slope_deg.abs().to_radians();
-    let closed = robot.mass() * (crate::model::G * slope.sin() + robot.leg_radius() * robot.leg_speed() / robot.response_time())
+    let closed = robot.mass()
+        * (crate::model::G * slope.sin() + robot.leg_radius() * robot.leg_speed() / robot.response_time())
         / f64::from(robot.stance_legs());
     CurrentInference {
         slope_deg: grid.slope_deg,
@@ -483,12 +488,12 @@ fn quantile(x: &[f64], p: &[f64], level: f64) -> f64 {
         }
     };
     let mut acc = 0.0;
-    for i in 0..n {
-        if acc + p[i] >= level && p[i] > 0.0 {
-            let f = (level - acc) / p[i];
+    for (i, &pi) in p.iter().enumerate().take(n) {
+        if acc + pi >= level && pi > 0.0 {
+            let f = (level - acc) / pi;
             return edge(i) + f * (edge(i + 1) - edge(i));
         }
-        acc += p[i];
+        acc += pi;
     }
     edge(n)
 }

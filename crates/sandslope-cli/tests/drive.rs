@@ -1,0 +1,329 @@
+//! `sandslope drive` against the emulator, through the same `dynamixel2` bus over a serial port
+//! (a pseudo-terminal) as a real robot (docs/drive.md): the commanded gait's timing, k_s
+//! recovered from the currents, the halt on risk, torque off on every exit path, bad input.
+
+mod common;
+
+use std::f64::consts::PI;
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_sandslope"))
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+/// The log's rows as `(time_s, leg, goal_position, present_position, leg_angle_rad)`, read by
+/// column name (not through the crate's reader).
+fn log_rows(path: &Path) -> Vec<(f64, usize, i64, i64, f64)> {
+    let body: String = std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let mut r = csv::Reader::from_reader(body.as_bytes());
+    let h = r.headers().unwrap().clone();
+    let col = |n: &str| h.iter().position(|x| x == n).unwrap();
+    let (t, leg, goal, pos, ang) =
+        (col("time_s"), col("leg"), col("goal_position"), col("present_position"), col("leg_angle_rad"));
+    r.records()
+        .map(|rec| {
+            let rec = rec.unwrap();
+            (
+                rec[t].parse().unwrap(),
+                rec[leg].parse().unwrap(),
+                rec[goal].parse().unwrap(),
+                rec[pos].parse().unwrap(),
+                rec[ang].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Least-squares line `y = a + b x`.
+fn fit(x: &[f64], y: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let b = x.iter().zip(y).map(|(a, c)| (a - mx) * (c - my)).sum::<f64>()
+        / x.iter().map(|a| (a - mx).powi(2)).sum::<f64>();
+    (my - b * mx, b)
+}
+
+/// The paper's robot: omega = 2 pi rad/s, so T = 1 s; dt = 0.2 s run-up; phi0 =
+/// asin((0.03 - 0.04) / 0.04). Tripod 0 touches down at dt/2 + m T = 0.1 s + m, tripod 1 half
+/// a period later. Checked on the commanded angles (the goals sent, in the gait's frame) and on
+/// the measured ones (which lag by about one bus cycle).
+#[test]
+fn commanded_gait_has_the_robot_files_period_and_phase() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("gait.csv");
+    let out = bin()
+        .args(["drive", "--emulate", "--duration", "3.2", "--watchdog", "2", "--log"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    let rows = log_rows(&log);
+    let phi0 = (-0.25f64).asin();
+    let rad = 2.0 * PI / 4096.0;
+    // Directions of the default servos: legs 0-2 +1, legs 3-5 -1.
+    let dir_of = |leg: usize| if leg < 3 { 1.0 } else { -1.0 };
+    for leg in 0..6 {
+        let sel: Vec<_> = rows.iter().filter(|r| r.1 == leg && r.0 >= 0.3).collect();
+        let t: Vec<f64> = sel.iter().map(|r| r.0).collect();
+        // Commanded angle in the gait's frame: the measured one plus the goal's lead.
+        let cmd: Vec<f64> = sel.iter().map(|r| r.4 + dir_of(leg) * (r.2 - r.3) as f64 * rad).collect();
+        let (a, w) = fit(&t, &cmd);
+        let period = 2.0 * PI / w;
+        assert!((period - 1.0).abs() < 0.01, "leg {leg}: commanded period {period} s");
+        // Touchdown: the angle passes phi0 (tripod 0) or phi0 + pi (tripod 1, its start is
+        // half a turn on) at t = (angle - a) / w.
+        let tripod = (leg % 2) as f64;
+        let first = (phi0 + tripod * PI - a) / w;
+        assert!(
+            (first - 0.1).abs() < 0.01,
+            "leg {leg}: commanded touchdown offset {first} s, expected 0.1 s (dt / 2)"
+        );
+        // The shaft, held back by the run-up's acceleration limit, has caught up after 1 s.
+        let late: Vec<_> = sel.iter().filter(|r| r.0 >= 1.0).collect();
+        let tl: Vec<f64> = late.iter().map(|r| r.0).collect();
+        let measured: Vec<f64> = late.iter().map(|r| r.4).collect();
+        let (am, wm) = fit(&tl, &measured);
+        assert!((2.0 * PI / wm - 1.0).abs() < 0.01, "leg {leg}: measured period {}", 2.0 * PI / wm);
+        // Tripod 1 half a period behind tripod 0 in touchdown time: within 1% of T.
+        let lag = (a - am) / w;
+        assert!(lag.abs() < 0.05, "leg {leg}: shaft lags its command by {lag} s");
+    }
+}
+
+/// Ten emulated runs at 20 degrees on sand of k_s = 2.5e5 N/m^3 (between the inference's grid
+/// points), with 10 mA of current noise and ten seeds: `infer --servo-log` must put the true
+/// k_s inside its 90% interval in at least 9, with intervals narrower than the prior's three
+/// decades.
+#[test]
+fn infer_servo_log_recovers_the_emulated_k_s() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = 2.5e5;
+    // Five drives at a time (each is an emulator and a driver in real time).
+    let mut logs = vec![];
+    for batch in [1..=5, 6..=10] {
+        let runs: Vec<_> = batch
+            .map(|seed| {
+                let log = dir.path().join(format!("run{seed}.csv"));
+                let child = bin()
+                    .args([
+                        "drive",
+                        "--emulate",
+                        "--slope",
+                        "20",
+                        "--duration",
+                        "5",
+                        "--emulate-k-s",
+                        "2.5e5",
+                    ])
+                    .args([
+                        "--emulate-noise",
+                        "10",
+                        "--emulate-seed",
+                        &seed.to_string(),
+                        "--watchdog",
+                        "3",
+                        "--log",
+                    ])
+                    .arg(&log)
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::piped())
+                    .spawn()
+                    .unwrap();
+                (log, child)
+            })
+            .collect();
+        for (log, child) in runs {
+            let out = child.wait_with_output().unwrap();
+            assert!(out.status.success(), "{}", text(&out));
+            logs.push(log);
+        }
+    }
+    let mut inside = 0;
+    let mut widths = vec![];
+    for pair in logs.chunks(2) {
+        let children: Vec<_> = pair
+            .iter()
+            .map(|log| {
+                bin()
+                    .args(["infer", "--servo-log"])
+                    .arg(log)
+                    .args(["--grid-points", "25", "--k-s-prior", "3e4:3e7", "--json"])
+                    .stdout(Stdio::piped())
+                    .stderr(Stdio::piped())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        for c in children {
+            let out = c.wait_with_output().unwrap();
+            assert!(out.status.success(), "{}", text(&out));
+            let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            let (lo, hi) = (v["k_s_lo"].as_f64().unwrap(), v["k_s_hi"].as_f64().unwrap());
+            if lo <= truth && truth <= hi {
+                inside += 1;
+            }
+            widths.push(hi / lo);
+        }
+    }
+    widths.sort_by(f64::total_cmp);
+    assert!(inside >= 9, "true k_s inside the 90% interval in {inside} of 10 runs");
+    assert!(widths[5] < 100.0, "intervals as wide as the prior: median hi/lo {}", widths[5]);
+}
+
+/// The sand weakens (k_s 2e6 to 1.5e4 N/m^3) 4 s after the emulator starts, 3 s into the gait
+/// less the setup's few milliseconds; `--stop-on-risk 0.5` must halt within one stride (1 s),
+/// not before, hold the legs where they are, and exit 5 with the torque off.
+#[test]
+fn stop_on_risk_halts_within_one_stride_of_the_sand_weakening() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("halt.csv");
+    let out = bin()
+        .args(["drive", "--emulate", "--slope", "15", "--emulate-k-s", "2e6", "--emulate-weaken", "4:1.5e4"])
+        .args(["--duration", "8", "--stop-on-risk", "0.5", "--hold", "0.4", "--watchdog", "2", "--log"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(5), "{all}");
+    let at: f64 = all.split("halted at t = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!((2.8..=4.0).contains(&at), "halted at {at} s; the sand weakened at about 2.95 s: {all}");
+    assert!(all.contains("emulator: torque off on every servo"), "{all}");
+    // Legs held: after the halt every servo's goal stays put.
+    let rows = log_rows(&log);
+    for leg in 0..6 {
+        let goals: Vec<i64> = rows.iter().filter(|r| r.1 == leg && r.0 > at + 0.05).map(|r| r.2).collect();
+        assert!(goals.len() >= 5, "{goals:?}");
+        assert!(goals.windows(2).all(|w| w[0] == w[1]), "leg {leg} moved after the halt: {goals:?}");
+    }
+}
+
+fn drive_with(extra: &[&str]) -> (Option<i32>, String, std::path::PathBuf, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("log.csv");
+    // A generous cycle watchdog unless the test sets one: the test binaries share two cores.
+    let watchdog = if extra.contains(&"--watchdog") { vec![] } else { vec!["--watchdog", "2"] };
+    let out = bin()
+        .args(["drive", "--emulate", "--duration", "3", "--log"])
+        .arg(&log)
+        .args(&watchdog)
+        .args(extra)
+        .output()
+        .unwrap();
+    (out.status.code(), text(&out), log, dir)
+}
+
+#[test]
+fn torque_off_when_the_run_completes() {
+    let (code, all, log, _d) = drive_with(&[]);
+    assert_eq!(code, Some(0), "{all}");
+    assert!(all.contains("emulator: torque off on every servo"), "{all}");
+    assert!(all.contains("torque off confirmed on servos 1, 2, 3, 4, 5, 6"), "{all}");
+    assert!(log_rows(&log).len() > 6 * 100);
+}
+
+#[test]
+fn torque_off_on_ctrl_c() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("log.csv");
+    let child = bin()
+        .args(["drive", "--emulate", "--duration", "30", "--watchdog", "2", "--log"])
+        .arg(&log)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_secs(4));
+    let killed = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(130), "{all}");
+    assert!(all.contains("interrupted (Ctrl-C)"), "{all}");
+    assert!(all.contains("emulator: torque off on every servo"), "{all}");
+    assert!(!log_rows(&log).is_empty(), "the log is kept");
+}
+
+#[test]
+fn torque_off_when_a_servo_is_lost() {
+    // A short Bus Watchdog (0.1 s) so that it fires on the lost servo before the run ends.
+    let (code, all, log, _d) = drive_with(&["--emulate-fault", "silent:3:2.5", "--bus-watchdog", "0.1"]);
+    assert_eq!(code, Some(3), "{all}");
+    assert!(all.contains("servo ID 3 (leg 2) stopped answering"), "{all}");
+    assert!(all.contains("check its cable"), "{all}");
+    // The others are off; servo 3 cannot be reached, and its own Bus Watchdog stopped it.
+    assert!(all.contains("still ON on servos 3; Bus Watchdog fired on servos 3"), "{all}");
+    assert!(all.contains("NOT confirmed on 3"), "{all}");
+    assert!(!log_rows(&log).is_empty(), "the log is kept");
+}
+
+#[test]
+fn torque_off_on_corrupt_packets() {
+    let (code, all, _log, _d) = drive_with(&["--emulate-fault", "corrupt:4:2.5"]);
+    assert_eq!(code, Some(3), "{all}");
+    assert!(all.contains("servo ID 4 (leg 3) sent corrupt packets"), "{all}");
+    assert!(all.contains("check the bus wiring"), "{all}");
+    // Torque Enable written: the servo obeys packets whose CRC it checks; only its replies fail.
+    assert!(all.contains("emulator: torque off on every servo"), "{all}");
+}
+
+#[test]
+fn torque_off_when_the_watchdog_fires() {
+    let (code, all, _log, _d) = drive_with(&["--emulate-fault", "freeze:2.5:0.6", "--watchdog", "0.15"]);
+    assert_eq!(code, Some(3), "{all}");
+    assert!(all.contains("watchdog fired"), "{all}");
+    assert!(all.contains("emulator: torque off on every servo"), "{all}");
+}
+
+#[test]
+fn a_servo_missing_at_the_start_is_named_with_the_fix() {
+    let (code, all, _log, _d) = drive_with(&["--emulate-fault", "silent:6:0"]);
+    assert_eq!(code, Some(2), "{all}");
+    assert!(all.contains("servo ID 6 (leg 5) did not answer a ping"), "{all}");
+    assert!(all.contains("IDs that answered: 1, 2, 3, 4, 5"), "{all}");
+}
+
+#[test]
+fn a_missing_port_is_exit_2_with_the_fix() {
+    let out =
+        bin().args(["drive", "--port", "/dev/ttyUSB-sandslope-none", "--duration", "1"]).output().unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{all}");
+    assert!(all.contains("cannot open the serial port /dev/ttyUSB-sandslope-none"), "{all}");
+    assert!(all.contains("--emulate"), "{all}");
+}
+
+/// `--dry-run`: the first goal of leg 0 is its touchdown angle phi0 = asin(-0.25) =
+/// -0.25268 rad = -164.7 pulses, so -165; leg 1 (tripod 1) half a turn on, 2048 pulses later.
+#[test]
+fn dry_run_prints_the_commands() {
+    let out = bin().args(["drive", "--dry-run", "--duration", "1", "--rate", "10"]).output().unwrap();
+    assert!(out.status.success(), "{}", text(&out));
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(s.contains("# write Current Limit (mA) (38) = 1470"), "{s}");
+    let rows: Vec<&str> = s.lines().filter(|l| !l.starts_with('#') && !l.starts_with("time_s")).collect();
+    assert_eq!(rows.len(), 11 * 6);
+    assert!(rows[0].starts_with("0.0000,1,0,0,"), "{}", rows[0]);
+    assert!(rows[0].ends_with(",-165"), "{}", rows[0]);
+    assert!(rows[1].ends_with(&format!(",{}", -165 + 2048)), "{}", rows[1]);
+}
+
+#[test]
+fn infer_servo_log_rejects_a_log_without_the_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("bad.csv");
+    std::fs::write(&p, "# slope_deg = 10\ntime_s,id\n0,1\n").unwrap();
+    let out = bin().args(["infer", "--servo-log"]).arg(&p).output().unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{all}");
+    assert!(all.contains("the column `leg` is missing"), "{all}");
+}

@@ -37,6 +37,10 @@ const SKIPPED: &[(&str, &str)] = &[
     ("python -c", "Python: crates/sandslope-py/tests/test_docs_examples.py runs it"),
     ("python3 bench/", "a benchmark against NumPy, minutes long; run by hand"),
     ("curl ", "needs a running `sandslope serve`; tests/serve.rs calls every endpoint"),
+    (
+        "sandslope drive --port",
+        "needs a robot on a serial port; tests/drive.rs drives the emulator through the same code",
+    ),
 ];
 
 /// One fenced code block: where it is, its language tag and its text.

@@ -401,7 +401,14 @@ fn setup(
     let mut answered = vec![];
     let mut missing = None;
     for (leg, s) in settings.servos.iter().enumerate() {
-        match bus.ping(s.id) {
+        let mut ping = bus.ping(s.id);
+        for _ in 0..2 {
+            if ping.is_ok() {
+                break;
+            }
+            ping = bus.ping(s.id);
+        }
+        match ping {
             Ok(r) => {
                 if r.data.model != xl330::MODEL_NUMBER {
                     return Err(DriveError::WrongModel {
@@ -454,14 +461,16 @@ fn setup(
     let watchdog = (settings.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round().clamp(1.0, 127.0) as u8;
     for (leg, s) in settings.servos.iter().enumerate() {
         let id = s.id;
+        // Each write up to three times: a busy USB adapter (or machine) can miss one reply.
         let w = |bus: &mut DynamixelBus, addr: u16, data: &[u8], what: &'static str, fix: &'static str| {
-            bus.write(id, addr, data).map(|_| ()).map_err(|e| DriveError::Setup {
-                id,
-                leg,
-                what,
-                reason: e.to_string(),
-                fix,
-            })
+            let mut last = None;
+            for _ in 0..3 {
+                match bus.write(id, addr, data) {
+                    Ok(_) => return Ok(()),
+                    Err(e) => last = Some(e.to_string()),
+                }
+            }
+            Err(DriveError::Setup { id, leg, what, reason: last.unwrap_or_default(), fix })
         };
         w(bus, t::TORQUE_ENABLE, &[0], "Torque Enable = 0", "power-cycle the servo")?;
         w(bus, t::BUS_WATCHDOG, &[0], "Bus Watchdog = 0", "reboot the servo (Dynamixel Wizard)")?;
@@ -547,7 +556,19 @@ fn run(
     let mut last_pos: Vec<Option<i32>> = vec![None; ids.len()];
     let mut bins = monitor.as_ref().map(|m| StanceBins::new(m.grid.bins));
     // Stand up: torque on, then the start pose nearest to where each leg is.
-    let states = read_states(bus, &ids).map_err(|reason| DriveError::Bus { time_s: -stand_s, reason })?;
+    // Where the legs are: up to three tries per servo, as during the run.
+    let mut states = read_states(bus, &ids).map_err(|reason| DriveError::Bus { time_s: -stand_s, reason })?;
+    for _ in 0..2 {
+        if states.iter().all(Result::is_ok) {
+            break;
+        }
+        let again = read_states(bus, &ids).map_err(|reason| DriveError::Bus { time_s: -stand_s, reason })?;
+        for (s, a) in states.iter_mut().zip(again) {
+            if s.is_err() {
+                *s = a;
+            }
+        }
+    }
     let mut start_goal = vec![0i32; ids.len()];
     for (j, s) in settings.servos.iter().enumerate() {
         let here = match &states[j] {

@@ -8,7 +8,7 @@
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 
 use sandslope::infer::servo::{model_grid, CurrentInferenceSettings};
@@ -23,7 +23,7 @@ use sandslope_servo::{DriveSettings, Emulator, EmulatorConfig, Profile, ServoCon
 
 use crate::args::{check_flag, RobotArgs, TerrainArgs};
 use crate::error::{KeepLog, EXIT_HALTED, EXIT_SIGINT};
-use crate::output::{check_parent_exists, print_json, write_via_temp};
+use crate::output::{check_parent_exists, print_json, write_output};
 
 /// `--profile`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -318,12 +318,7 @@ pub fn run(args: DriveArgs) -> Result<()> {
     let (report, failure) = match &args.log {
         Some(path) => {
             let mut outcome = None;
-            write_via_temp(path, |tmp| {
-                let file = std::fs::OpenOptions::new()
-                    .write(true)
-                    .create_new(true)
-                    .open(tmp)
-                    .with_context(|| format!("cannot create {}", tmp.display()))?;
+            write_output(path, |file| {
                 let mut log = ServoLogWriter::new(std::io::BufWriter::new(file), &meta)?;
                 let mut on_sample = |s: &ServoSample| log.write(&row(s));
                 let r = drive(

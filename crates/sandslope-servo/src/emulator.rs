@@ -581,6 +581,9 @@ fn order_of(ins: &Instruction, id: u8) -> usize {
     }
 }
 
+/// The pty's nominal baud rate (see [`Emulator::start`]).
+pub const EMULATED_BAUD: u32 = 9600;
+
 /// A running emulator: a thread serving the pty's master side.
 #[derive(Debug)]
 pub struct Emulator {
@@ -595,8 +598,10 @@ impl Emulator {
         let (mut master, mut slave) = SerialPort::pair().map_err(EmulatorError::Pty)?;
         for port in [&mut master, &mut slave] {
             if let Ok(mut s) = port.get_configuration() {
-                // A pty accepts any rate; the bus computes its read timeouts from it.
-                if s.set_baud_rate(1_000_000).is_ok() {
+                // A pty moves bytes at once whatever its nominal rate, but dynamixel2 sets its
+                // reply timeouts from that rate (the transfer time plus 34 ms): 9600 baud gives
+                // 67 ms for a 32-byte reply, room for a loaded machine's scheduling.
+                if s.set_baud_rate(EMULATED_BAUD).is_ok() {
                     port.set_configuration(&s).ok();
                 }
             }

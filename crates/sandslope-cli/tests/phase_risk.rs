@@ -669,4 +669,57 @@ fn a_safe_slope_limit_at_the_angle_of_repose_is_named_as_such() {
     assert!(below.contains("safe-slope limit") && !below.contains("repose"), "{below}");
     let v = json(&["risk", "--solve", "slope", "--max-risk", "0.001", "--json"]);
     assert!(v["safe_slope_deg"].as_f64().unwrap() < 24.0, "{v}");
+    assert_eq!(v["limit"]["kind"], "limit", "{v}");
+    // A program tells the repose from a risk limit by `limit.kind`, and reads the repose itself.
+    let v = json(&["risk", "--solve", "slope", "--json"]);
+    assert_eq!(v["limit"]["kind"], "repose", "{v}");
+    assert_eq!(v["limit"]["repose_deg"], 25.0, "{v}");
+    assert_eq!(v["safe_slope_deg"], 25.0, "{v}");
+}
+
+/// "How steep can we go?" has two answers and both are given, named apart: on the built-in
+/// terrain the median robot is metastable from about 18 degrees (`predict`), so the slope up
+/// to which it climbs (P(not success) < 0.05) lies below that, far below the repose that caps
+/// p_fail. With no uncertainty the success limit is where `predict` stops saying success.
+#[test]
+fn risk_solve_slope_gives_the_success_limit_beside_the_safe_slope_limit() {
+    let regime = |t: Option<&str>, d: f64| {
+        let mut a = vec!["predict".to_string(), "--slope".into(), format!("{d}"), "--json".into()];
+        if let Some(t) = t {
+            a.extend(["--terrain".into(), t.into()]);
+        }
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        json(&a)["regime"].as_str().unwrap().to_string()
+    };
+    // The built-in terrain: where the median robot stops succeeding, found by predict alone.
+    let metastable_from = (0..=120).map(|i| i as f64 * 0.25).find(|&d| regime(None, d) != "success").unwrap();
+    assert!((15.0..=20.0).contains(&metastable_from), "{metastable_from}");
+    let v = json(&["risk", "--solve", "slope", "--json"]);
+    let success = v["success_slope_deg"].as_f64().unwrap();
+    assert!(success < metastable_from && success > 5.0, "{v}");
+    assert!(
+        v["success_limit"]["kind"] == "limit" && v["success_limit"]["p_fail"].as_f64().unwrap() < 0.05,
+        "{v}"
+    );
+    let table = sandslope().args(["risk", "--solve", "slope"]).assert().success();
+    let text = String::from_utf8(table.get_output().stdout.clone()).unwrap();
+    assert!(
+        text.contains(&format!("climbs (success limit, P(not success) < 0.05): up to {success:.1} deg")),
+        "{text}"
+    );
+    assert!(text.contains("does not fail (safe-slope limit") && text.contains("metastable"), "{text}");
+    // No uncertainty: P(not success) is 0 or 1, so the limit is predict's own transition.
+    let dir = tempfile::tempdir().unwrap();
+    let t = write(dir.path(), "sand.toml", UNCERTAIN);
+    let v = json(&["risk", "--terrain", &t, "--cv-n", "0", "--cv-s", "0", "--solve", "slope", "--json"]);
+    let s = v["success_slope_deg"].as_f64().unwrap();
+    assert_eq!(regime(Some(&t), s - 0.01), "success");
+    assert_ne!(regime(Some(&t), s + 0.01), "success");
+    let csv = sandslope().args(["risk", "--solve", "slope", "--csv"]).assert().success();
+    let csv = String::from_utf8(csv.get_output().stdout.clone()).unwrap();
+    assert!(
+        csv.starts_with("max_risk,success_slope_deg,success_limit_kind,safe_slope_deg,safe_limit_kind\n"),
+        "{csv}"
+    );
+    assert!(csv.contains(",limit,25.0,repose"), "{csv}");
 }

@@ -612,6 +612,14 @@ fn the_risk_tab_draws_risks_safe_slope_limit_and_payload_envelope() {
     let shown = attribute(&dom, "id=\"risk-summary\"", "data-safe-slope-deg").expect("no safe-slope limit");
     let cli: f64 = raw_number(&raw, "safe_slope_deg", 0).parse().unwrap();
     assert_eq!(shown.parse::<f64>().unwrap(), cli);
+    // The success limit beside it, and the safe-slope limit's kind (the repose, not "24.999").
+    let shown = attribute(&dom, "id=\"risk-summary\"", "data-success-slope-deg").expect("no success limit");
+    let cli: f64 = raw_number(&raw, "success_slope_deg", 0).parse().unwrap();
+    assert_eq!(shown.parse::<f64>().unwrap(), cli);
+    let kind = attribute(&dom, "id=\"risk-summary\"", "data-limit-kind").expect("no limit kind");
+    let cli_kind = raw_number(&raw, "kind", raw.find("\"limit\":").unwrap());
+    assert_eq!(format!("\"{kind}\""), cli_kind);
+    assert!(!dom.contains("24.999"), "the repose shown as a risk threshold");
     // The dashed limit line is drawn where the limit is (within the 0-30 deg chart).
     assert!(dom.contains("id=\"safe-slope\""), "no safe-slope line");
     // The payload envelope's points are risk --solve mass's over 0:30:7.

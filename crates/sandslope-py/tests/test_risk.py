@@ -64,6 +64,12 @@ def test_solvers_match_cli(cli, robot, root):
     got = sandslope.safe_slope(robot, terrain=uncertain, max_risk=0.1)
     # One library value: the same keys and the same numbers, bit for bit.
     assert got == want
+    # Both limits, named apart: the robot stops climbing (metastable) before it fails.
+    assert got["success_slope_deg"] < got["safe_slope_deg"]
+    assert got["success_limit"]["kind"] == "limit"
+    # On the built-in glass beads p_fail stays low up to the repose: kind "repose", not 24.999.
+    builtin = sandslope.safe_slope(robot, terrain="glass-beads-300um")
+    assert builtin["limit"]["kind"] == "repose" and builtin["safe_slope_deg"] == 25.0
     want = cli.json("risk", "--terrain", uncertain, "--slope", 10, "--solve", "mass")
     got = sandslope.safe_mass(robot, 10, terrain=uncertain)
     assert got == want

@@ -106,11 +106,7 @@ struct StudyRecord {
 }
 
 fn limit_kind(l: &SafeLimit) -> &'static str {
-    match l {
-        SafeLimit::Limit { .. } => "limit",
-        SafeLimit::NoneSafe { .. } => "none_safe",
-        SafeLimit::BeyondRange { .. } => "beyond_range",
-    }
+    l.kind()
 }
 
 fn record(keys: &[RobotKey], d: &Design) -> DesignRecord {
@@ -257,6 +253,7 @@ fn print_table(study: &DesignStudy, show: usize, notes: &[String]) {
                     SafeLimit::NoneSafe { .. } => "none".into(),
                     SafeLimit::BeyondRange { up_to, .. } => format!(">= {up_to}"),
                     SafeLimit::Limit { value, .. } => format!("{value:.3}"),
+                    SafeLimit::Repose { repose_deg, .. } => format!("{repose_deg} (repose)"),
                 },
                 num(p.speed_m_s.map(|v| 100.0 * v), 2),
                 format!("{:.4}", p.p_fail),

@@ -13,8 +13,8 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 
 use sandslope::risk::{
-    payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, safe_slope_limit, DefaultsUsed,
-    PayloadEnvelope, RiskAnswer, RiskCurve, RiskMap, RiskPoint, SafeLimit, SafeMass, UncertainTerrain,
+    payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, DefaultsUsed, PayloadEnvelope, RiskAnswer,
+    RiskCurve, RiskMap, RiskPoint, SafeLimit, SafeMass, SafeSlope, UncertainTerrain,
 };
 use sandslope::{Robot, Slope};
 
@@ -150,38 +150,45 @@ fn slope_of(deg: f64) -> Result<Slope> {
     Slope::from_signed_degrees(deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))
 }
 
-/// The terrain's angle of repose, degrees, if it has one.
-fn repose_of(terrain: &UncertainTerrain) -> Option<f64> {
-    terrain.terrain().spec().repose_deg
-}
-
-/// The safe-slope limit in words; `repose_deg` is the terrain's angle of repose, at which
-/// p_fail jumps to 1 (the sand flows): a limit the search finds there is the repose, not the
-/// risk threshold, and is said so.
-fn describe_slope_limit(limit: &SafeLimit, max_risk: f64, repose_deg: Option<f64>) -> String {
-    match limit {
+/// One slope limit in words: `p` names the probability it bounds (`p_fail` or
+/// `P(not success)`). A limit at the angle of repose ([`SafeLimit::Repose`]: there p_fail
+/// jumps to 1, the sand flows) is named as the repose, not as a risk threshold.
+fn describe_limit(limit: &SafeLimit, p: &str, max_risk: f64) -> String {
+    match *limit {
         SafeLimit::NoneSafe { p_fail } => {
-            format!("no slope is safe: p_fail = {p_fail:.4} >= {max_risk} already on level ground")
+            format!("no slope: {p} = {p_fail:.4} >= {max_risk} already on level ground")
         }
-        // The search bisects to SLOPE_TOLERANCE_DEG below the jump.
-        SafeLimit::Limit { value, p_fail }
-            if repose_deg.is_some_and(|r| r - value <= 2.0 * sandslope::risk::SLOPE_TOLERANCE_DEG) =>
-        {
-            format!(
-                "safe-slope limit: p_fail < {max_risk} from level up to the angle of repose, {} deg (p_fail {p_fail:.4} \
-                 at {value:.3} deg; at and beyond repose the sand flows and p_fail = 1)",
-                repose_deg.unwrap_or(*value)
-            )
+        SafeLimit::Limit { value, p_fail } => {
+            format!("up to {value:.1} deg ({p} < {max_risk} from level up to {value:.3} deg, {p_fail:.4} there)")
         }
-        SafeLimit::Limit { value, p_fail } => format!(
-            "safe-slope limit: p_fail < {max_risk} from level up to {value:.3} deg (p_fail there {p_fail:.4})"
+        SafeLimit::Repose { repose_deg, p_fail } => format!(
+            "up to the angle of repose, {repose_deg} deg ({p} < {max_risk} below it, {p_fail:.4} just below; at and \
+             beyond repose the sand flows and every regime is slippage)"
         ),
         SafeLimit::BeyondRange { up_to, p_fail } => {
-            format!(
-                "p_fail < {max_risk} at every slope up to {up_to} deg searched (p_fail there {p_fail:.4})"
-            )
+            format!("beyond {up_to} deg, the end of the search ({p} there {p_fail:.4} < {max_risk})")
         }
     }
+}
+
+/// The two slope limits of `sol` in words, the success limit first (it answers "how steep
+/// can we go?"), each named by what it bounds, and what lies between them.
+fn describe_slope_limits(sol: &SafeSlope) -> String {
+    let r = sol.max_risk;
+    let mut out = format!(
+        "climbs (success limit, P(not success) < {r}): {}\ndoes not fail (safe-slope limit, p_fail = P(sinkage or slippage) < {r}): {}",
+        describe_limit(&sol.success_limit, "P(not success)", r),
+        describe_limit(&sol.limit, "p_fail", r)
+    );
+    if let (Some(a), Some(b)) = (sol.success_slope_deg, sol.safe_slope_deg) {
+        if b - a >= 0.05 {
+            out.push_str(&format!(
+                "\nbetween {a:.1} and {b:.1} deg the robot is likely metastable: it neither sinks nor slips back for good, \
+                 but each step is shorter than the minimum and it stalls in its own trench (docs/model.md §5)"
+            ));
+        }
+    }
+    out
 }
 
 /// Runs `sandslope risk`.
@@ -231,8 +238,8 @@ pub fn run(args: RiskArgs) -> Result<()> {
             note_defaults(terrain.defaults_used_at(slope_of(slopes[0])?));
             let sol = safe_mass(&robot, slopes[0], &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
             if args.plot.is_some() {
-                let s_limit = safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
-                draw_curve(&args, &robot, &terrain, &slopes, max_risk, &s_limit, json)?;
+                let limits = safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
+                draw_curve(&args, &robot, &terrain, &slopes, &limits, json)?;
             }
             return match format {
                 Format::Json => print_json(&RiskAnswer::Mass(Box::new(sol))),
@@ -250,21 +257,31 @@ pub fn run(args: RiskArgs) -> Result<()> {
             note_defaults(terrain.defaults_used());
             let sol = safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
             if args.plot.is_some() {
-                draw_curve(&args, &robot, &terrain, &slopes, max_risk, &sol.limit, json)?;
+                draw_curve(&args, &robot, &terrain, &slopes, &sol, json)?;
             }
             return match format {
                 Format::Json => print_json(&RiskAnswer::Slope(Box::new(sol))),
                 Format::Csv => {
                     #[derive(Serialize)]
-                    struct Row {
+                    struct Row<'a> {
                         max_risk: f64,
+                        success_slope_deg: Option<f64>,
+                        success_limit_kind: &'a str,
                         safe_slope_deg: Option<f64>,
+                        safe_limit_kind: &'a str,
                     }
-                    print!("{}", csv_string(&[Row { max_risk, safe_slope_deg: sol.safe_slope_deg }])?);
+                    let row = Row {
+                        max_risk,
+                        success_slope_deg: sol.success_slope_deg,
+                        success_limit_kind: sol.success_limit.kind(),
+                        safe_slope_deg: sol.safe_slope_deg,
+                        safe_limit_kind: sol.limit.kind(),
+                    };
+                    print!("{}", csv_string(&[row])?);
                     Ok(())
                 }
                 Format::Table => {
-                    println!("{}", describe_slope_limit(&sol.limit, max_risk, repose_of(&terrain)));
+                    println!("{}", describe_slope_limits(&sol));
                     Ok(())
                 }
             };
@@ -276,15 +293,15 @@ pub fn run(args: RiskArgs) -> Result<()> {
     let curve = risk_curve(&robot, &terrain, &slopes).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
     note_defaults(curve.defaults_used);
     let need_limit = format == Format::Table || args.plot.is_some();
-    let limit = if need_limit {
-        Some(safe_slope_limit(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?)
+    let limits = if need_limit {
+        Some(safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?)
     } else {
         None
     };
-    if let (Some(limit), Some(_)) = (&limit, &args.plot) {
-        draw_curve(&args, &robot, &terrain, &slopes, max_risk, limit, json)?;
+    if let (Some(limits), Some(_)) = (&limits, &args.plot) {
+        draw_curve(&args, &robot, &terrain, &slopes, limits, json)?;
     }
-    print_curve(curve, limit.as_ref().map(|l| (l, repose_of(&terrain))), max_risk, format)
+    print_curve(curve, limits.as_ref(), format)
 }
 
 /// Limits of one [`answer`] call (the server's; the command line's are the library's).
@@ -376,14 +393,9 @@ fn robot_title(robot: &Robot, terrain: &UncertainTerrain) -> String {
     format!("m = {} kg on {}", robot.mass(), terrain.terrain().name().unwrap_or("terrain"))
 }
 
-/// Prints the risk curve, and in a table the safe-slope limit (with the terrain's repose) if
-/// it was searched.
-fn print_curve(
-    curve: RiskCurve,
-    limit: Option<(&SafeLimit, Option<f64>)>,
-    max_risk: f64,
-    format: Format,
-) -> Result<()> {
+/// Prints the risk curve, and in a table the success and safe-slope limits if they were
+/// searched.
+fn print_curve(curve: RiskCurve, limits: Option<&SafeSlope>, format: Format) -> Result<()> {
     match format {
         Format::Json => print_json(&RiskAnswer::of_points(curve.points)),
         Format::Csv => {
@@ -419,8 +431,8 @@ fn print_curve(
                 ]);
             }
             println!("{t}");
-            if let Some((limit, repose_deg)) = limit {
-                println!("{}", describe_slope_limit(limit, max_risk, repose_deg));
+            if let Some(limits) = limits {
+                println!("{}", describe_slope_limits(limits));
             }
             if let Some(note) = curve.defaults_used.note() {
                 println!("note: {note}");
@@ -459,7 +471,8 @@ fn print_envelope(env: PayloadEnvelope, format: Format) -> Result<()> {
                     SafeLimit::NoneSafe { p_fail } => {
                         Some(format!("none safe: p_fail {p_fail:.4} already at the robot's own mass"))
                     }
-                    SafeLimit::Limit { .. } => None,
+                    // (A mass search never ends at a repose: that is a slope's.)
+                    SafeLimit::Limit { .. } | SafeLimit::Repose { .. } => None,
                     SafeLimit::BeyondRange { up_to, .. } => {
                         Some(format!("safe up to {up_to:.3} kg, the end of the search"))
                     }
@@ -499,7 +512,8 @@ fn describe_mass_limit(sol: &SafeMass) -> String {
             "no payload is safe at {} deg: p_fail = {p_fail:.4} >= {} already at the robot's own {} kg",
             sol.slope_deg, sol.max_risk, sol.robot_mass_kg
         ),
-        SafeLimit::Limit { value, p_fail } => format!(
+        // (A mass search never ends at a repose: that is a slope's.)
+        SafeLimit::Limit { value, p_fail } | SafeLimit::Repose { repose_deg: value, p_fail } => format!(
             "heaviest safe total mass at {} deg: {value:.4} kg (payload {:.4} kg over the robot's {} kg), p_fail {p_fail:.4} < {}",
             sol.slope_deg,
             value - sol.robot_mass_kg,
@@ -529,14 +543,13 @@ fn draw_curve(
     robot: &Robot,
     terrain: &UncertainTerrain,
     slopes: &[f64],
-    max_risk: f64,
-    limit: &SafeLimit,
+    limits: &SafeSlope,
     quiet: bool,
 ) -> Result<()> {
     let Some(path) = &args.plot else { return Ok(()) };
     let requested_max = slopes.iter().fold(0.0f64, |a, &d| a.max(d.abs()));
     let mut hi = requested_max.max(30.0);
-    if let Some(v) = limit.value() {
+    if let Some(v) = limits.limit.value() {
         hi = hi.max(v * 1.25);
     }
     if let Some(r) = terrain.terrain().repose() {
@@ -553,8 +566,9 @@ fn draw_curve(
         curve: curve.points.iter().map(|p| (p.slope_deg, p.probabilities)).collect(),
         points: requested.points.iter().map(|p| (p.slope_deg.abs(), p.p_fail)).collect(),
         hi,
-        max_risk,
-        limit: *limit,
+        max_risk: limits.max_risk,
+        limit: limits.limit,
+        success_limit: limits.success_limit,
         title: format!("Failure risk: {}", robot_title(robot, terrain)),
     };
     save(path, &figure)

@@ -1,4 +1,4 @@
-//! Risk figures: p_fail and p_not_success against slope with the safe-slope limit; the
+//! Risk figures: p_fail and p_not_success against slope with the success and safe-slope limits; the
 //! p_fail heat map over median (k_n, k_s) with the max-risk contour and the terrain's star;
 //! and the payload envelope (heaviest safe mass against slope).
 
@@ -27,14 +27,31 @@ const RISK_CURVES: ChartSetup<'static> = ChartSetup {
     ..ChartSetup::PANEL
 };
 
-/// p_fail and p_not_success against slope.
+/// p_fail and p_not_success against slope, with the success limit (P(not success) below
+/// `max_risk`: the robot climbs) and the safe-slope limit (p_fail below it: the robot does not
+/// fail) marked and named apart.
 pub struct CurveFigure {
     pub curve: Vec<(f64, RegimeProbabilities)>,
     pub points: Vec<(f64, f64)>,
     pub hi: f64,
     pub max_risk: f64,
+    /// The safe-slope (p_fail) limit.
     pub limit: SafeLimit,
+    /// The success (P(not success)) limit.
+    pub success_limit: SafeLimit,
     pub title: String,
+}
+
+/// A slope limit's label in a legend: `what` and its slope, one decimal (the search's
+/// tolerance would show as 24.999 below a 25 deg repose), "= repose" at the angle of repose.
+fn limit_label(what: &str, limit: &SafeLimit) -> Option<(f64, String)> {
+    match *limit {
+        SafeLimit::Limit { value, .. } => Some((value, format!("{what} {value:.1}°"))),
+        SafeLimit::Repose { repose_deg, .. } => {
+            Some((repose_deg, format!("{what} {repose_deg}° (the angle of repose)")))
+        }
+        _ => None,
+    }
 }
 
 impl Figure for CurveFigure {
@@ -92,16 +109,23 @@ impl Figure for CurveFigure {
                 .label("requested slopes")
                 .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
         }
-        if let SafeLimit::Limit { value, .. } = self.limit {
-            let blue = palette::MODEL_BLUE;
+        let limits = [
+            (limit_label("climbs up to (P(not success) < risk)", &self.success_limit), orange, true),
+            (limit_label("no failure up to (p_fail < risk)", &self.limit), palette::MODEL_BLUE, false),
+        ];
+        for (label, colour, dashed) in limits {
+            let Some((value, label)) = label else { continue };
+            let line = vec![(value, -0.015), (value, 1.02)];
+            let series = if dashed {
+                chart.draw_series(DashedLineSeries::new(line, 10, 5, colour.stroke_width(3))).map_err(e)?
+            } else {
+                chart.draw_series(LineSeries::new(line, colour.stroke_width(2))).map_err(e)?
+            };
+            series
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3)));
             chart
-                .draw_series(LineSeries::new(vec![(value, -0.015), (value, 1.02)], blue.stroke_width(2)))
-                .map_err(e)?
-                // One decimal: the search's tolerance shows as 24.999 below a 25 deg repose.
-                .label(format!("safe-slope limit {value:.1}°"))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(2)));
-            chart
-                .draw_series(std::iter::once(Circle::new((value, self.max_risk), 7, blue.stroke_width(3))))
+                .draw_series(std::iter::once(Circle::new((value, self.max_risk), 7, colour.stroke_width(3))))
                 .map_err(e)?;
         }
         super::legend(&mut chart, SeriesLabelPosition::UpperLeft, 16.0)?;
@@ -222,7 +246,9 @@ impl Figure for EnvelopeFigure<'_> {
             .points
             .iter()
             .map(|p| match p.limit {
-                SafeLimit::Limit { value, .. } => (p.slope_deg.abs(), value, 0),
+                SafeLimit::Limit { value, .. } | SafeLimit::Repose { repose_deg: value, .. } => {
+                    (p.slope_deg.abs(), value, 0)
+                }
                 SafeLimit::NoneSafe { .. } => (p.slope_deg.abs(), own, 1),
                 SafeLimit::BeyondRange { up_to, .. } => (p.slope_deg.abs(), up_to, 2),
             })

@@ -62,6 +62,7 @@ pub fn page_figures(report: &Report) -> Result<Vec<PageFigure>> {
         hi: 30.0,
         max_risk: p.max_risk,
         limit: p.safe_limit,
+        success_limit: p.success_limit,
         title: format!("Failure risk of the {} kg robot", p.mass_kg),
     };
     let note = p.risk.defaults_used.note().map(|n| format!(" {n}.")).unwrap_or_default();
@@ -70,8 +71,10 @@ pub fn page_figures(report: &Report) -> Result<Vec<PageFigure>> {
         report,
         "risk",
         format!(
-            "p_fail = P(sinkage or slippage) with log-normal k_n, k_s (docs/model.md §9), and the safe-slope limit at p_fail < {}.{note}",
-            p.max_risk
+            "p_fail = P(sinkage or slippage) and P(not success) (sinkage, slippage or metastable) with log-normal k_n, k_s (docs/model.md §9). Two limits at risk {r}: {}; {}. Between them the robot neither sinks nor slips back for good but is likely metastable: it stalls in its own trench.{note}",
+            limit_words("the robot climbs (P(not success) < risk)", &p.success_limit),
+            limit_words("it does not fail (p_fail < risk)", &p.safe_limit),
+            r = p.max_risk
         ),
         to_svg(&fig)?,
     );
@@ -288,5 +291,17 @@ fn model_label(report: &Report) -> &'static str {
         "model calibrated on your observations"
     } else {
         "model on the terrain"
+    }
+}
+
+/// One slope limit of the risk figure in words: `what` "up to X°" (one decimal), at the angle of
+/// repose named so, or why there is none.
+fn limit_words(what: &str, limit: &sandslope::risk::SafeLimit) -> String {
+    use sandslope::risk::SafeLimit;
+    match *limit {
+        SafeLimit::Limit { value, .. } => format!("{what} up to {value:.1}°"),
+        SafeLimit::Repose { repose_deg, .. } => format!("{what} up to the angle of repose, {repose_deg}°"),
+        SafeLimit::NoneSafe { .. } => format!("{what} on no slope, not even level ground"),
+        SafeLimit::BeyondRange { up_to, .. } => format!("{what} at every slope searched, up to {up_to}°"),
     }
 }

@@ -328,12 +328,18 @@ def safe_slope(
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
 ) -> Dict[str, Any]:
-    """The safe-slope limit (``sandslope risk --solve slope --json``): the steepest slope with
-    ``p_fail < max_risk`` at every slope from level up to it (scan every 0.5 deg, then
-    bisection to 0.001 deg). ``limit["kind"]`` is ``"limit"``, ``"none_safe"`` or
-    ``"beyond_range"``; ``safe_slope_deg`` is None unless a limit was found; ``cv_n``, ``cv_s``
-    and their sources are those where ``limit["p_fail"]`` was evaluated, ``defaults_used`` says
-    whether a default CV was used anywhere in the table. The same keys as the CLI's JSON."""
+    """The two slope limits (``sandslope risk --solve slope --json``), named apart:
+    ``success_slope_deg``, the steepest slope with P(not success) < ``max_risk`` from level up
+    (the robot climbs: it neither sinks, slips nor stalls metastable; "how steep can we go?"),
+    and ``safe_slope_deg``, the steepest with ``p_fail`` = P(sinkage or slippage) < ``max_risk``
+    (it does not fail outright; between the two it is likely metastable). Each search scans
+    every 0.5 deg, then bisects to 0.001 deg. ``limit["kind"]`` (and ``success_limit["kind"]``)
+    is ``"limit"`` (the threshold crossed), ``"repose"`` (below the threshold up to the angle of
+    repose, ``limit["repose_deg"]``, where the sand flows), ``"none_safe"`` or
+    ``"beyond_range"``; a ``*_slope_deg`` is None unless a limit or the repose was found;
+    ``cv_n``, ``cv_s`` and their sources are those where ``limit["p_fail"]`` was evaluated,
+    ``defaults_used`` says whether a default CV was used anywhere in the table. The same keys
+    as the CLI's JSON."""
     return _sandslope.safe_slope(
         _robot(robot), _terrain(terrain), max_risk=float(max_risk), cv_n=cv_n, cv_s=cv_s
     )

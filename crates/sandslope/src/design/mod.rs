@@ -280,6 +280,7 @@ impl Performance {
     pub fn safe_slope_rank(&self) -> f64 {
         match self.safe_limit {
             SafeLimit::Limit { value, .. } => value,
+            SafeLimit::Repose { repose_deg, .. } => repose_deg,
             SafeLimit::BeyondRange { up_to, .. } => up_to,
             SafeLimit::NoneSafe { .. } => -1.0,
         }

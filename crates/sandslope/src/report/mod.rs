@@ -26,7 +26,9 @@ use crate::gait::track::TrackResult;
 use crate::model::{predict, Prediction};
 use crate::paper::{self, compare_with_paper, Basis, ComparisonContext, PaperComparison};
 use crate::phase::PhasePanel;
-use crate::risk::{risk_curve, safe_slope_limit, RiskCurve, SafeLimit, UncertainTerrain};
+use crate::risk::{
+    risk_curve, safe_slope_limit, success_slope_limit, RiskCurve, SafeLimit, UncertainTerrain,
+};
 use crate::robot::Robot;
 use crate::slope::Slope;
 use crate::terrain::{Terrain, TerrainPoint};
@@ -180,8 +182,10 @@ pub struct Plots {
     pub phase: Vec<PhasePanel>,
     /// p_fail against slope, 0 to 30 degrees every 0.5.
     pub risk: RiskCurve,
-    /// The safe-slope limit at `max_risk`.
+    /// The safe-slope limit at `max_risk` (p_fail: no sinkage or slippage).
     pub safe_limit: SafeLimit,
+    /// The success limit at `max_risk` (P(not success): the robot climbs, not metastable).
+    pub success_limit: SafeLimit,
     /// The risk threshold.
     pub max_risk: f64,
     /// The calibrated model's speed, 0 to 24.5 degrees (empty without a calibration).
@@ -569,6 +573,7 @@ fn plots(
         phase,
         risk: risk_curve(robot, &uncertain, &risk_slopes)?,
         safe_limit: safe_slope_limit(robot, &uncertain, evidence.max_risk)?,
+        success_limit: success_slope_limit(robot, &uncertain, evidence.max_risk)?,
         max_risk: evidence.max_risk,
         calibrated_speed,
         step_budget: audit::step_budget(

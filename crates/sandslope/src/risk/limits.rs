@@ -45,6 +45,16 @@ pub enum SafeLimit {
         /// p_fail at `value`.
         p_fail: f64,
     },
+    /// A slope search only: `p_fail < max_risk` from the start up to the terrain's angle of
+    /// repose, where p_fail jumps to 1 (the surface itself flows, docs/model.md §8): the limit
+    /// is the repose, not a risk threshold crossed by the terrain's uncertainty.
+    Repose {
+        /// The terrain's angle of repose there, degrees (the slope search's answer).
+        repose_deg: f64,
+        /// p_fail just below the repose (within the search tolerance), where the search
+        /// stopped.
+        p_fail: f64,
+    },
     /// `p_fail < max_risk` over the whole range searched.
     BeyondRange {
         /// The end of the range searched (degrees or kg).
@@ -59,7 +69,28 @@ impl SafeLimit {
     pub fn value(&self) -> Option<f64> {
         match self {
             SafeLimit::Limit { value, .. } => Some(*value),
+            SafeLimit::Repose { repose_deg, .. } => Some(*repose_deg),
             _ => None,
+        }
+    }
+
+    /// `kind` as serialised: `"limit"`, `"repose"`, `"none_safe"` or `"beyond_range"`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            SafeLimit::NoneSafe { .. } => "none_safe",
+            SafeLimit::Limit { .. } => "limit",
+            SafeLimit::Repose { .. } => "repose",
+            SafeLimit::BeyondRange { .. } => "beyond_range",
+        }
+    }
+
+    /// p_fail (or, for a success limit, P(not success)) where the search stopped.
+    pub fn p_at_end(&self) -> f64 {
+        match *self {
+            SafeLimit::NoneSafe { p_fail }
+            | SafeLimit::Limit { p_fail, .. }
+            | SafeLimit::Repose { p_fail, .. }
+            | SafeLimit::BeyondRange { p_fail, .. } => p_fail,
         }
     }
 
@@ -210,7 +241,51 @@ pub(crate) fn safe_slope_search(
             ReportedPFail::Reference => failure_risk(robot, s, terrain).p_fail(),
         }
     };
-    first_crossing(&decide, &p_fail, &scan, SLOPE_TOLERANCE_DEG, 1)
+    at_repose(first_crossing(&decide, &p_fail, &scan, SLOPE_TOLERANCE_DEG, 1), terrain)
+}
+
+/// Names a slope search's crossing [`SafeLimit::Repose`] when it lies at the terrain's angle
+/// of repose (within two search tolerances below it: p_fail jumps to 1 there, so the bisection
+/// ends just below it), else returns it as found.
+fn at_repose(limit: SafeLimit, terrain: &UncertainTerrain) -> SafeLimit {
+    let SafeLimit::Limit { value, p_fail } = limit else { return limit };
+    let above = value + 2.0 * SLOPE_TOLERANCE_DEG;
+    let repose = Slope::from_degrees(above).ok().and_then(|s| terrain.at(s).0.repose).map(|r| r.degrees());
+    match repose {
+        Some(r) if r > value && r <= above => SafeLimit::Repose { repose_deg: r, p_fail },
+        _ => limit,
+    }
+}
+
+/// The success limit: the steepest slope (degrees) such that P(not success) = P(sinkage,
+/// slippage or metastable) < `max_risk` at every slope from level up to it, the terrain
+/// interpolated per slope (docs/model.md §9). Where the safe-slope limit ([`safe_slope_limit`])
+/// says up to where the robot does not fail, this says up to where it climbs: between the two
+/// the robot is metastable (it progresses by less than the minimum step, s < s_min, and gets
+/// stuck in its own trench, docs/model.md §5).
+///
+/// The same scan and bisection as [`safe_slope_limit`] ([`SLOPE_SCAN_STEP_DEG`],
+/// [`SLOPE_TOLERANCE_DEG`]), each point decided by the reference quadrature (there is no fast
+/// P(not success)), a few points in parallel at a time; a crossing at the angle of repose is
+/// [`SafeLimit::Repose`]. `max_risk` must be in (0, 1).
+pub fn success_slope_limit(
+    robot: &Robot,
+    terrain: &UncertainTerrain,
+    max_risk: f64,
+) -> Result<SafeLimit, ParamError> {
+    let max_risk = check_risk(max_risk)?;
+    let n = (MAX_SCAN_SLOPE_DEG / SLOPE_SCAN_STEP_DEG).round() as usize;
+    let scan: Vec<f64> = (0..=n).map(|i| i as f64 * SLOPE_SCAN_STEP_DEG).collect();
+    let p_not_success = |deg: f64| match Slope::from_degrees(deg) {
+        Ok(s) => failure_risk(robot, s, terrain).p_not_success(),
+        Err(_) => 1.0,
+    };
+    let decide = |deg: f64| -> Verdict {
+        let p = p_not_success(deg);
+        (p >= max_risk, Some(p))
+    };
+    let batch = 2 * rayon::current_num_threads().max(1);
+    Ok(at_repose(first_crossing(&decide, &p_not_success, &scan, SLOPE_TOLERANCE_DEG, batch), terrain))
 }
 
 /// Growth factor between scanned masses in [`max_safe_mass`].
@@ -328,6 +403,7 @@ mod tests {
     use super::*;
     use crate::critical::{critical_shear_strength, StepTarget};
     use crate::model::{predict, tests::paper_robot};
+    use crate::regime::Regime;
     use crate::risk::uncertainty::tests::table;
     use crate::terrain::Terrain;
 
@@ -354,6 +430,33 @@ mod tests {
             predict(&r, s, &t.terrain().at(s)).regime
         };
         assert!(!regime(value - 0.01).is_failure() && regime(value + 0.01).is_failure(), "limit {value}");
+    }
+
+    /// With no uncertainty P(not success) is 0 or 1, so the success limit is where `predict`
+    /// stops giving success; on this sand the robot is metastable next, and fails only higher
+    /// up, so the success limit lies below the safe-slope limit by a metastable band.
+    #[test]
+    fn certain_terrain_success_limit_is_where_predict_stops_succeeding() {
+        let r = paper_robot();
+        let t = UncertainTerrain::new(
+            table(&[(0.0, 7e5, 2e6, None, None), (20.0, 7e5, 4e5, None, None)], None),
+            Some(0.0),
+            Some(0.0),
+        )
+        .unwrap();
+        let SafeLimit::Limit { value, p_fail } = success_slope_limit(&r, &t, 0.05).unwrap() else {
+            panic!("no limit")
+        };
+        assert_eq!(p_fail, 0.0);
+        let regime = |d: f64| {
+            let s = slope(d);
+            predict(&r, s, &t.terrain().at(s)).regime
+        };
+        assert_eq!(regime(value - 0.01), Regime::Success, "limit {value}");
+        assert_eq!(regime(value + 0.01), Regime::Metastable, "limit {value}");
+        let safe = safe_slope_limit(&r, &t, 0.05).unwrap().value().unwrap();
+        assert!(safe > value + 0.1, "safe {safe}, success {value}");
+        assert!(matches!(success_slope_limit(&r, &t, 0.0), Err(ParamError { .. })));
     }
 
     /// Symmetric case: at 20 deg the median k_s sits exactly on the progress boundary and k_n
@@ -437,7 +540,7 @@ mod tests {
         let kinds: Vec<&str> = cases
             .par_iter()
             .map(|(r, t, max_risk)| {
-                let want = reference_safe_slope(r, t, *max_risk);
+                let want = at_repose(reference_safe_slope(r, t, *max_risk), t);
                 assert_eq!(safe_slope_limit(r, t, *max_risk).unwrap(), want);
                 let fast = safe_slope_search(r, t, *max_risk, ReportedPFail::Fast);
                 match (want, fast) {
@@ -452,6 +555,14 @@ mod tests {
                         let over = failure_risk(r, slope(a + 2.0 * SLOPE_TOLERANCE_DEG), t).p_fail();
                         assert!(over >= *max_risk, "{a}: {over}");
                         "limit"
+                    }
+                    (
+                        SafeLimit::Repose { repose_deg: a, p_fail: pa },
+                        SafeLimit::Repose { repose_deg: b, p_fail: pb },
+                    ) => {
+                        assert_eq!(a, b);
+                        assert!((pa - pb).abs() < 2e-9 && pa < *max_risk, "{pa} vs {pb}");
+                        "repose"
                     }
                     (SafeLimit::NoneSafe { p_fail: pa }, SafeLimit::NoneSafe { p_fail: pb }) => {
                         assert!((pa - pb).abs() < 2e-9 && pa >= *max_risk, "{pa} vs {pb}");
@@ -480,8 +591,16 @@ mod tests {
         let t =
             UncertainTerrain::new(table(&[(0.0, 7e5, 1e8, None, None)], Some(25.0)), Some(0.1), Some(0.1))
                 .unwrap();
-        let limit = safe_slope_limit(&r, &t, 0.05).unwrap().value().unwrap();
-        assert!(limit < 25.0 && limit > 25.0 - 2.0 * SLOPE_TOLERANCE_DEG, "{limit}");
+        // Strong sand: p_fail stays near 0 up to the repose, where it jumps to 1; the limit is
+        // named the repose (kind "repose", the repose itself), not a threshold at 24.999 deg.
+        let SafeLimit::Repose { repose_deg, p_fail } = safe_slope_limit(&r, &t, 0.05).unwrap() else {
+            panic!("not the repose")
+        };
+        assert_eq!(repose_deg, 25.0);
+        assert!(p_fail < 0.05, "{p_fail}");
+        let json = serde_json::to_value(SafeLimit::Repose { repose_deg, p_fail }).unwrap();
+        assert_eq!(json["kind"], "repose");
+        assert_eq!(safe_slope_limit(&r, &t, 0.05).unwrap().value(), Some(25.0));
         assert!(matches!(max_safe_mass(&r, slope(26.0), &t, 0.05).unwrap(), SafeLimit::NoneSafe { .. }));
     }
 

@@ -14,7 +14,8 @@
 //!   `design` decide with.
 //! - [`safe_slope_limit`] (steepest slope below a failure-risk threshold), [`max_safe_mass`]
 //!   (heaviest safe robot at a slope) and [`payload_envelope`] (that mass at each slope): one
-//!   scan-and-bisect search ([`limits`]).
+//!   scan-and-bisect search ([`limits`]); [`success_slope_limit`] (steepest slope below a
+//!   risk threshold of not succeeding: not metastable either) is the same search.
 //! - [`RiskMap`]: p_fail and p_not_success over a grid of median (k_n, k_s).
 //! - [`safe_slope`], [`safe_mass`], [`risk_map`] ([`RiskMapAnswer`]: the cells and their
 //!   summary): the solving modes' answers with the uncertainty they used ([`results`]), what
@@ -35,8 +36,8 @@ pub mod uncertainty;
 pub use curve::{risk_curve, RiskCurve, RiskPoint};
 pub use failure_probability::p_fail;
 pub use limits::{
-    failure_risk, max_safe_mass, payload_envelope, safe_slope_limit, PayloadEnvelope, PayloadPoint,
-    SafeLimit, MASS_SCAN_FACTOR, MAX_MASS_FACTOR, MAX_SCAN_SLOPE_DEG, SLOPE_SCAN_STEP_DEG,
+    failure_risk, max_safe_mass, payload_envelope, safe_slope_limit, success_slope_limit, PayloadEnvelope,
+    PayloadPoint, SafeLimit, MASS_SCAN_FACTOR, MAX_MASS_FACTOR, MAX_SCAN_SLOPE_DEG, SLOPE_SCAN_STEP_DEG,
     SLOPE_TOLERANCE_DEG,
 };
 pub use map::RiskMap;

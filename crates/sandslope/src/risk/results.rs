@@ -7,7 +7,7 @@ use serde::ser::{SerializeSeq, SerializeStruct};
 use serde::{Deserialize, Serialize, Serializer};
 
 use super::curve::RiskPoint;
-use super::limits::{max_safe_mass, safe_slope_limit, PayloadEnvelope, SafeLimit};
+use super::limits::{max_safe_mass, safe_slope_limit, success_slope_limit, PayloadEnvelope, SafeLimit};
 use super::map::RiskMap;
 use super::uncertainty::{DefaultsUsed, UncertainTerrain, UsedUncertainty};
 use crate::error::ParamError;
@@ -46,16 +46,32 @@ impl RiskAnswer {
     }
 }
 
-/// The safe-slope limit with what it assumed (`risk --solve slope`).
+/// The two slope limits with what they assumed (`risk --solve slope`): up to where the robot
+/// does not fail (`safe_slope_deg`, p_fail = P(sinkage or slippage) below `max_risk`) and up to
+/// where it climbs (`success_slope_deg`, P(not success) below `max_risk`: not metastable
+/// either). Between the two the model says the robot neither sinks nor slips back for good but
+/// makes less than the minimum step: it gets stuck (metastable, docs/model.md §5). "How steep can
+/// we go?" is answered by the success limit; the safe-slope limit says where the robot starts to
+/// fail outright.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SafeSlope {
-    /// The failure-risk threshold.
+    /// The risk threshold of both limits.
     pub max_risk: f64,
-    /// The steepest safe slope, degrees, or `None` when the search found no crossing (see
-    /// `limit`).
+    /// The safe-slope (no-failure) limit, degrees: p_fail < `max_risk` from level up to it; the
+    /// angle of repose when `limit.kind` is `"repose"`; `None` when the search found no
+    /// crossing (see `limit`).
     pub safe_slope_deg: Option<f64>,
-    /// What the search found.
+    /// What the p_fail search found: `kind` `"limit"` (the risk threshold crossed),
+    /// `"repose"` (p_fail stays below it up to the angle of repose, where the sand flows),
+    /// `"none_safe"` or `"beyond_range"`.
     pub limit: SafeLimit,
+    /// The success limit, degrees: P(not success) < `max_risk` from level up to it (the robot
+    /// climbs: it does not sink, slip or get stuck metastable); `None` when the search found
+    /// no crossing (see `success_limit`).
+    pub success_slope_deg: Option<f64>,
+    /// What the P(not success) search found ([`success_slope_limit`]; its `p_fail` field is
+    /// P(not success) where the search stopped).
+    pub success_limit: SafeLimit,
     /// The uncertainty at the slope where `limit.p_fail` was evaluated (the safe slope, level
     /// ground when none is safe, the end of the search when all are).
     #[serde(flatten)]
@@ -68,10 +84,13 @@ pub struct SafeSlope {
 /// ([`safe_slope_limit`]), with the uncertainty it used.
 pub fn safe_slope(robot: &Robot, terrain: &UncertainTerrain, max_risk: f64) -> Result<SafeSlope, ParamError> {
     let limit = safe_slope_limit(robot, terrain, max_risk)?;
+    let success_limit = success_slope_limit(robot, terrain, max_risk)?;
     // Where the search evaluated `limit.p_fail`: it scans up from level ground.
     let at = match limit {
         SafeLimit::NoneSafe { .. } => 0.0,
         SafeLimit::Limit { value, .. } => value,
+        // The search stopped just below the repose.
+        SafeLimit::Repose { repose_deg, .. } => repose_deg - 2.0 * super::limits::SLOPE_TOLERANCE_DEG,
         SafeLimit::BeyondRange { up_to, .. } => up_to,
     };
     let at = Slope::from_signed_degrees(at).map_err(|e| e.renamed("safe_slope_deg"))?;
@@ -79,6 +98,8 @@ pub fn safe_slope(robot: &Robot, terrain: &UncertainTerrain, max_risk: f64) -> R
         max_risk,
         safe_slope_deg: limit.value(),
         limit,
+        success_slope_deg: success_limit.value(),
+        success_limit,
         uncertainty: terrain.sample(at).used(),
         defaults_used: terrain.defaults_used(),
     })

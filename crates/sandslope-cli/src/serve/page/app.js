@@ -336,19 +336,38 @@ function drawRisk({ curve, limit }) {
   const maxRisk = limit.max_risk;
   el("line", { x1: f.x(0), x2: f.x(30), y1: f.y(maxRisk), y2: f.y(maxRisk), stroke: "#555", "stroke-dasharray": "2 3" }, svg);
   text(svg, f.x(0.5), f.y(maxRisk) - 4, `max risk ${maxRisk}`);
+  // Two limits, named apart (risk --solve slope): up to where the robot climbs (P(not success)
+  // below the threshold) and up to where it does not fail (p_fail below it); a limit of kind
+  // "repose" is the angle of repose itself, where the sand flows, not a risk threshold.
   const safe = limit.safe_slope_deg;
-  let summary;
-  if (safe !== null && safe <= 30) {
-    el("line", { x1: f.x(safe), x2: f.x(safe), y1: f.m.t, y2: f.h - f.m.b, stroke: "#000", "stroke-width": 2, "stroke-dasharray": "6 4", id: "safe-slope" }, svg);
-    text(svg, f.x(safe) + 4, f.m.t + 14, `safe up to ${safe.toFixed(2)} deg`);
+  const success = limit.success_slope_deg;
+  const marks = [
+    [success, "success-slope", "#b07800", "climbs to"],
+    [safe, "safe-slope", "#000", limit.limit.kind === "repose" ? "repose" : "no failure to"],
+  ];
+  let row = 0;
+  for (const [deg, id, colour, label] of marks) {
+    if (deg === null || deg > 30) continue;
+    el("line", { x1: f.x(deg), x2: f.x(deg), y1: f.m.t, y2: f.h - f.m.b, stroke: colour, "stroke-width": 2, "stroke-dasharray": "6 4", id }, svg);
+    text(svg, f.x(deg) + 4, f.m.t + 14 + 16 * row++, `${label} ${deg.toFixed(1)} deg`);
   }
-  if (limit.limit.kind === "limit") summary = `safe-slope limit: p_fail < ${maxRisk} up to ${safe.toFixed(3)} deg`;
-  else if (limit.limit.kind === "none_safe") summary = `no slope is safe: p_fail = ${limit.limit.p_fail.toFixed(4)} already on level ground`;
-  else summary = `p_fail < ${maxRisk} at every slope searched (up to ${limit.limit.up_to} deg)`;
+  const describe = (l, p) => {
+    if (l.kind === "limit") return `up to ${l.value.toFixed(1)} deg (${p} < ${maxRisk})`;
+    if (l.kind === "repose") return `up to the angle of repose, ${l.repose_deg} deg (${p} < ${maxRisk} below it; beyond it the sand flows)`;
+    if (l.kind === "none_safe") return `on no slope (${p} = ${l.p_fail.toFixed(4)} already on level ground)`;
+    return `at every slope searched, up to ${l.up_to} deg (${p} < ${maxRisk})`;
+  };
+  let summary = `climbs (success limit) ${describe(limit.success_limit, "P(not success)")}; ` +
+    `does not fail (safe-slope limit) ${describe(limit.limit, "p_fail")}`;
+  if (success !== null && safe !== null && safe - success >= 0.05) {
+    summary += `; between ${success.toFixed(1)} and ${safe.toFixed(1)} deg it is likely metastable (stalls in its own trench)`;
+  }
   const first = curve[0];
   summary += `; CVs used: k_n ${first.cv_n.toFixed(3)} (${first.cv_n_source}), k_s ${first.cv_s.toFixed(3)} (${first.cv_s_source}) at level`;
   $("risk-summary").textContent = summary;
   $("risk-summary").dataset.safeSlopeDeg = String(safe);
+  $("risk-summary").dataset.successSlopeDeg = String(success);
+  $("risk-summary").dataset.limitKind = limit.limit.kind;
   if ($("cv-auto").checked) {
     $("cv-n-out").textContent = first.cv_n.toFixed(3);
     $("cv-s-out").textContent = first.cv_s.toFixed(3);

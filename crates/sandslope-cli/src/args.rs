@@ -269,10 +269,24 @@ pub fn parse_slope_list(flag: &str, text: &str, sign: SlopeSign, max: usize) -> 
         let [lo, hi, n] = parts.as_slice() else {
             bail!("{flag} = {text} must be DEG, a comma list DEG,DEG,... or MIN:MAX:N (e.g. 0:24:13)");
         };
-        let n: usize = n.trim().parse().ok().filter(|n| (2..=max).contains(n)).ok_or_else(|| {
-            anyhow!("{flag}: N `{}` must be a whole number from 2 to {max} (in {text})", n.trim())
-        })?;
+        let count = n.trim();
         let (lo, hi) = (number(lo)?, number(hi)?);
+        let n: usize = count.parse().ok().filter(|n| (2..=max).contains(n)).ok_or_else(|| {
+            // The third field is a count, not a step: `0:30:1` most likely meant 1-degree
+            // steps, which is the count (MAX - MIN) / step + 1, suggested where whole.
+            let step: Option<f64> = count.parse().ok().filter(|s: &f64| *s > 0.0 && hi > lo);
+            let hint = step
+                .map(|step| (hi - lo) / step + 1.0)
+                .filter(|k| (k - k.round()).abs() < 1e-9 && (2.0..=max as f64).contains(&k.round()))
+                .map(|k| {
+                    format!(
+                        "; the third field is the number of slopes, not a step: for steps of {count} deg from {lo} to {hi} write {lo}:{hi}:{}",
+                        k.round()
+                    )
+                })
+                .unwrap_or_else(|| "; the third field is the number of slopes, not a step".into());
+            anyhow!("{flag}: N `{count}` must be a whole number from 2 to {max} (in {text}){hint}")
+        })?;
         if hi <= lo {
             bail!("{flag} = {text}: MAX must be greater than MIN");
         }

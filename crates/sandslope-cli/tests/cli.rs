@@ -369,3 +369,29 @@ fn robot_quantity_flags_equal_a_robot_file_with_those_values() {
         predicates::str::contains("--hip-height = 0.03 must be between 0 and 2 * leg_radius_m = 0.02"),
     );
 }
+
+/// `MIN:MAX:N` takes a count: `0:30:1`, meant as steps of 1 degree, is refused (exit 2) with
+/// the count that gives those steps, (30 - 0) / 1 + 1 = 31; a step that does not divide the
+/// range gets the explanation without a suggestion.
+#[test]
+fn a_slope_range_with_a_step_for_a_count_suggests_the_count() {
+    for (cmd, flag) in [("simulate", "--slopes"), ("risk", "--slope")] {
+        sandslope()
+            .args([cmd, flag, "0:30:1"])
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains("the third field is the number of slopes, not a step"))
+            .stderr(predicate::str::contains("write 0:30:31"));
+    }
+    // Steps of 0.5 deg from 10 to 20: (20 - 10) / 0.5 + 1 = 21 slopes (0.5 is not a count).
+    sandslope()
+        .args(["risk", "--slope", "10:20:0.5"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("write 10:20:21"));
+    sandslope()
+        .args(["risk", "--slope", "0:10:0"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("number of slopes").and(predicate::str::contains("write").not()));
+}

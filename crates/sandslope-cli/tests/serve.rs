@@ -620,6 +620,8 @@ fn the_risk_tab_draws_risks_safe_slope_limit_and_payload_envelope() {
     let cli_kind = raw_number(&raw, "kind", raw.find("\"limit\":").unwrap());
     assert_eq!(format!("\"{kind}\""), cli_kind);
     assert!(!dom.contains("24.999"), "the repose shown as a risk threshold");
+    // The paper robot's leg speed, 2 pi rad/s, shown as 6.28319, not cut to "6.28318530".
+    assert_eq!(attribute(&dom, "id=\"leg-speed\"", "value").as_deref(), Some("6.28319"));
     // The dashed limit line is drawn where the limit is (within the 0-30 deg chart).
     assert!(dom.contains("id=\"safe-slope\""), "no safe-slope line");
     // The payload envelope's points are risk --solve mass's over 0:30:7.

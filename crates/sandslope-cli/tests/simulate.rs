@@ -165,3 +165,18 @@ fn slopes_run_in_parallel_and_draw_against_observations() {
     let svg = std::fs::read_to_string(&plot).unwrap();
     assert!(svg.contains("observed") && svg.contains("closed form"));
 }
+
+/// Every table that puts simulated and closed-form numbers side by side says they are known
+/// to disagree and where that is explained.
+#[test]
+fn simulate_tables_say_the_two_models_are_known_to_disagree() {
+    for args in [
+        vec!["simulate", "--slope", "10", "--duration", "2"],
+        vec!["simulate", "--slopes", "0,10", "--duration", "2"],
+    ] {
+        let out = sandslope().args(&args).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert!(text.contains("known to disagree") && text.contains("docs/simulate.md"), "{args:?}: {text}");
+    }
+}

@@ -205,6 +205,8 @@ pub fn run(args: DesignArgs) -> Result<()> {
     let bar = progress_bar(space.len() as u64, args.json, "designs");
     let study = explore(&space, &terrain, &goal, &|| bar.inc(1));
     bar.finish_and_clear();
+    let mut notes = notes;
+    notes.extend(front_at_bounds(&study, &space));
 
     if let Some(path) = &args.csv {
         write_atomic(path, csv_text(&study)?.as_bytes())
@@ -228,6 +230,32 @@ pub fn run(args: DesignArgs) -> Result<()> {
     }
     print_table(&study, args.show, &notes);
     Ok(())
+}
+
+/// A note for each varied key whose smallest or largest value holds designs of the Pareto
+/// front: the front is then cut by the range searched, and a better design may lie beyond it.
+fn front_at_bounds(study: &DesignStudy, space: &DesignSpace) -> Vec<String> {
+    let front = study.front();
+    let mut notes = Vec::new();
+    for (i, range) in space.ranges().iter().enumerate() {
+        let values = range.values();
+        let (Some(&lo), Some(&hi)) = (values.first(), values.last()) else { continue };
+        if values.len() < 2 {
+            continue;
+        }
+        for (value, end) in [(lo, "smallest"), (hi, "largest")] {
+            let at = front.iter().filter(|d| d.params[i] == value).count();
+            if at > 0 {
+                notes.push(format!(
+                    "the Pareto front is at the bound of --vary: {at} of its {} designs have {} = {value}, the {end} value \
+                     searched; a better design may lie beyond it (widen the range to see)",
+                    front.len(),
+                    range.key().name()
+                ));
+            }
+        }
+    }
+    notes
 }
 
 fn print_table(study: &DesignStudy, show: usize, notes: &[String]) {

@@ -284,6 +284,12 @@ fn run_one(args: &SimulateArgs, scenario: &Scenario, slope: f64, settings: &SimS
     Ok(())
 }
 
+/// Printed under every table that puts simulated and closed-form numbers side by side.
+const DISAGREE_NOTE: &str =
+    "note: the simulator and the closed form are known to disagree; docs/simulate.md \
+(\"Simulator against closed form\") lists where and why. Read the two columns as a test of the closed form's \
+assumptions, not as two estimates of one speed.";
+
 fn print_one(sim: &Simulation) {
     let m = &sim.summary;
     let p = &m.closed_form.prediction;
@@ -314,6 +320,7 @@ fn print_one(sim: &Simulation) {
     t.add_row(["regime", m.regime.name(), p.regime.name()]);
     t.add_row(["cause", m.cause.name(), p.cause.name()]);
     println!("{t}");
+    println!("{DISAGREE_NOTE}");
     if m.rft_scaling == RftScaling::Components {
         println!("resistive force theory scaled by components (--rft-scaling components, docs/model.md §16)");
     }
@@ -432,6 +439,7 @@ fn run_slopes(
                 ]);
             }
             println!("{t}");
+            println!("{DISAGREE_NOTE}");
             if settings.body_pitch == BodyPitch::Locked {
                 println!("body pitch locked at 0 (--body-pitch locked), as the closed form assumes");
             }

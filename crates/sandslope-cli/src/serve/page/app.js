@@ -833,7 +833,11 @@ async function start() {
     for (const name of list) if (name !== current) select.append(new Option(name, name));
   }
   for (const flag of ROBOT_FLAGS) {
-    state.defaults[flag] = String(served.robot[SPEC_KEYS[flag]]);
+    // Shown to 6 significant digits (2 pi rad/s as 6.28319, not 6.283185307179586 cut to
+    // "6.28318530" by the box); an unchanged box sends no flag, so the served robot's exact
+    // value is what the server uses.
+    state.defaults[flag] = String(Number(Number(served.robot[SPEC_KEYS[flag]]).toPrecision(6)));
+    $(flag).defaultValue = state.defaults[flag];
     $(flag).value = state.defaults[flag];
   }
   syncMassSlider();

@@ -118,7 +118,16 @@ pub fn track_files(
         touchdowns.iter().map(|p| sandslope_io::mocap::load_touchdowns(p)).collect::<Result<_>>()?;
     let recordings: Vec<Recording> =
         captures.iter().enumerate().map(|(i, c)| c.recording(touchdowns.get(i).map(Vec::as_slice))).collect();
-    let result = track(&recordings, options, slope).map_err(|e| match e {
+    // Upslope rises along the capture frame's vertical axis, when the files agree on one.
+    let mut options = *options;
+    if let [first, rest @ ..] = captures.as_slice() {
+        if options.vertical().is_none() && rest.iter().all(|c| c.format == first.format) {
+            if let Ok(up) = sandslope::gait::Upslope::new(first.format.vertical_axis()) {
+                options = options.with_vertical(up);
+            }
+        }
+    }
+    let result = track(&recordings, &options, slope).map_err(|e| match e {
         sandslope::GaitError::Param { index, source } => {
             let source = match read.cutoff_flag {
                 Some(flag) if source.key == "cutoff_hz" => source.renamed(flag),

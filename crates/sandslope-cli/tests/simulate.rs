@@ -180,3 +180,48 @@ fn simulate_tables_say_the_two_models_are_known_to_disagree() {
         assert!(text.contains("known to disagree") && text.contains("docs/simulate.md"), "{args:?}: {text}");
     }
 }
+
+/// A walk that slides down (20 degrees on sand with a fifth of the built-in k_s): `track`
+/// takes upslope from the capture frame's vertical axis and `--slope`, not from the net
+/// motion, so it reports the simulator's negative speed, within 1% with the simulator's
+/// touchdowns, and negative with the default settings (issue 38, item 6).
+#[test]
+fn track_recovers_the_negative_speed_of_a_walk_that_slides_down() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("slide.csv");
+    let sim = json(&[
+        "simulate",
+        "--slope",
+        "20",
+        "--k-s",
+        "4e5",
+        "--duration",
+        "10",
+        "--json",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    let steps = sim["steps"].as_array().unwrap();
+    let sim_speed = mean(steps.iter().map(|s| s["speed_m_s"].as_f64().unwrap()));
+    assert!(sim_speed < -0.01, "the walk does not slide down: {sim_speed}");
+    let touchdowns: Vec<String> = steps.iter().map(|s| s["touchdown_s"].to_string()).collect();
+    let td = write_arg(dir.path(), "touchdowns.txt", &(touchdowns.join("\n") + "\n"));
+    let tracked = json(&[
+        "track",
+        csv.to_str().unwrap(),
+        "--slope",
+        "20",
+        "--json",
+        "--touchdowns",
+        &td,
+        "--cutoff",
+        "30",
+    ]);
+    let track_speed = tracked["speed_m_s"].as_f64().unwrap();
+    assert!((track_speed / sim_speed - 1.0).abs() < 0.01, "{track_speed} vs {sim_speed}");
+    // Upslope is +x rising along +z (the plain format's vertical), as simulate --out writes.
+    let u = tracked["upslope"].as_array().unwrap();
+    assert!(u[0].as_f64().unwrap() > 0.9 && u[2].as_f64().unwrap() > 0.3, "{u:?}");
+    let default = json(&["track", csv.to_str().unwrap(), "--slope", "20", "--json"]);
+    assert!(default["speed_m_s"].as_f64().unwrap() < 0.0, "{}", default["speed_m_s"]);
+}

@@ -85,7 +85,8 @@ struct DesignRecord {
     /// Why the robot is not valid (docs/model.md §2), null when it is.
     invalid_reason: Option<String>,
     safe_slope_deg: Option<f64>,
-    /// `limit`, `none_safe` (not even level ground) or `beyond_range` (every slope searched).
+    /// `limit`, `repose` (up to the angle of repose), `none_safe` (not even level ground) or
+    /// `beyond_range` (every slope searched).
     safe_limit: Option<&'static str>,
     speed_m_s: Option<f64>,
     p_fail: Option<f64>,

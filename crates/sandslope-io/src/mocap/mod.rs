@@ -37,6 +37,16 @@ impl MocapFormat {
     /// Every format, in the order they are documented.
     pub const ALL: [MocapFormat; 3] = [MocapFormat::Motive, MocapFormat::Vicon, MocapFormat::Plain];
 
+    /// The vertical (up) axis of the format's capture frame, `[x, y, z]`: Motive's default
+    /// axis convention is Y up; Vicon Nexus is Z up; the plain format is Z up (as `simulate
+    /// --out` writes it). `track` orients upslope by it (rising with a positive `--slope`).
+    pub fn vertical_axis(self) -> [f64; 3] {
+        match self {
+            MocapFormat::Motive => [0.0, 1.0, 0.0],
+            MocapFormat::Vicon | MocapFormat::Plain => [0.0, 0.0, 1.0],
+        }
+    }
+
     /// Display name.
     pub fn name(self) -> &'static str {
         match self {

@@ -80,6 +80,29 @@ pub fn principal_direction(recordings: &[&[[f64; 3]]]) -> Option<Upslope> {
     Upslope::new([u.x, u.y, u.z]).ok()
 }
 
+/// Smallest slope, degrees, at which [`orient_by_height`] trusts the rise of the direction of
+/// travel to tell upslope from downslope.
+pub const MIN_ORIENTING_SLOPE_DEG: f64 = 1.0;
+
+/// The direction of travel `travel` oriented upslope by height: on a slope of `slope_deg`
+/// (> [`MIN_ORIENTING_SLOPE_DEG`]) a line of travel in the slope's plane rises by up to
+/// sin(theta) per unit length, and upslope is the sense in which it rises along `up` (the
+/// capture frame's vertical axis). Whether the robot progressed or slid down does not enter.
+/// `None` (orient otherwise) on near-level ground, or when the travel rises by less than a
+/// quarter of sin(theta) per unit length (it runs across the slope, or `up` is not the
+/// frame's vertical axis).
+pub fn orient_by_height(travel: Upslope, up: Upslope, slope_deg: f64) -> Option<Upslope> {
+    if !(slope_deg.abs() >= MIN_ORIENTING_SLOPE_DEG) {
+        return None;
+    }
+    let rise = travel.along(up.vector());
+    if rise.abs() < 0.25 * slope_deg.abs().to_radians().sin() {
+        return None;
+    }
+    let [x, y, z] = travel.vector();
+    Some(if rise > 0.0 { travel } else { Upslope { unit: [-x, -y, -z] } })
+}
+
 /// Projects every position on `upslope`; missing frames (any non-finite coordinate) give NaN.
 pub fn project(positions: &[[f64; 3]], upslope: Upslope) -> Vec<f64> {
     positions
@@ -91,6 +114,24 @@ pub fn project(positions: &[[f64; 3]], upslope: Upslope) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// On a 20 deg slope a line of travel in the slope's plane rises by sin 20 = 0.342 per unit
+    /// length along the vertical: upslope is the rising sense whichever way the travel was
+    /// estimated; level ground, travel across the slope, or a wrong vertical leave it undecided.
+    #[test]
+    fn orient_by_height_points_upslope_where_the_travel_rises() {
+        let (s, c) = 20f64.to_radians().sin_cos();
+        let up = Upslope::new([0.0, 0.0, 1.0]).unwrap();
+        let rising = Upslope::new([c, 0.0, s]).unwrap();
+        let falling = Upslope::new([-c, 0.0, -s]).unwrap();
+        assert_eq!(orient_by_height(rising, up, 20.0), Some(rising));
+        assert_eq!(orient_by_height(falling, up, 20.0).unwrap().vector(), rising.vector());
+        assert_eq!(orient_by_height(rising, up, 0.5), None);
+        let across = Upslope::new([0.0, 1.0, 0.0]).unwrap();
+        assert_eq!(orient_by_height(across, up, 20.0), None);
+        // Y-up taken for this Z-up frame: the travel does not rise along y.
+        assert_eq!(orient_by_height(rising, Upslope::new([0.0, 1.0, 0.0]).unwrap(), 20.0), None);
+    }
 
     #[test]
     fn normalises_and_rejects_zero() {

@@ -47,6 +47,7 @@ pub struct GaitOptions {
     cutoff_hz: f64,
     max_gap_frames: usize,
     upslope: Option<Upslope>,
+    vertical: Option<Upslope>,
     curve_points: usize,
 }
 
@@ -59,6 +60,7 @@ impl GaitOptions {
             cutoff_hz: DEFAULT_CUTOFF_HZ,
             max_gap_frames: DEFAULT_MAX_GAP,
             upslope: None,
+            vertical: None,
             curve_points: DEFAULT_CURVE_POINTS,
         })
     }
@@ -76,6 +78,23 @@ impl GaitOptions {
     /// A fixed upslope direction instead of the estimate.
     pub fn with_upslope(self, upslope: Upslope) -> GaitOptions {
         GaitOptions { upslope: Some(upslope), ..self }
+    }
+
+    /// The capture frame's vertical (up) axis. With it and a known slope, [`track()`] orients
+    /// the estimated direction of travel so that upslope rises ([`direction::orient_by_height`]),
+    /// never by the net motion, so a walk that slides down reports a negative speed.
+    pub fn with_vertical(self, up: Upslope) -> GaitOptions {
+        GaitOptions { vertical: Some(up), ..self }
+    }
+
+    /// The capture frame's vertical axis, if given.
+    pub fn vertical(&self) -> Option<Upslope> {
+        self.vertical
+    }
+
+    /// The fixed upslope direction, if given.
+    pub fn upslope(&self) -> Option<Upslope> {
+        self.upslope
     }
 
     /// Points of the stride-averaged speed curve (at least 2).

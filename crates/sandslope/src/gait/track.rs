@@ -99,7 +99,24 @@ pub fn track(
     options: &GaitOptions,
     slope: Option<Slope>,
 ) -> Result<TrackResult, GaitError> {
-    let a = analyse(recordings, options)?;
+    // Upslope from the frame's vertical axis and the slope when both are known: a walk that
+    // slides down then reports a negative speed, where orienting the direction of travel by
+    // the net motion (analyse's fallback) would call the slide progress.
+    let by_height = match (options.upslope(), options.vertical(), slope) {
+        (None, Some(up), Some(s)) => {
+            let all: Vec<&[[f64; 3]]> = recordings.iter().map(|r| r.positions).collect();
+            super::direction::principal_direction(&all)
+                .and_then(|travel| super::direction::orient_by_height(travel, up, s.degrees()))
+        }
+        _ => None,
+    };
+    let mut a = match by_height {
+        Some(u) => analyse(recordings, &options.with_upslope(u))?,
+        None => analyse(recordings, options)?,
+    };
+    if by_height.is_some() {
+        a.upslope_estimated = true;
+    }
     let summaries = recordings
         .iter()
         .zip(&a.recordings)

@@ -92,7 +92,7 @@ pub const MIN_ORIENTING_SLOPE_DEG: f64 = 1.0;
 /// quarter of sin(theta) per unit length (it runs across the slope, or `up` is not the
 /// frame's vertical axis).
 pub fn orient_by_height(travel: Upslope, up: Upslope, slope_deg: f64) -> Option<Upslope> {
-    if !(slope_deg.abs() >= MIN_ORIENTING_SLOPE_DEG) {
+    if slope_deg.is_nan() || slope_deg.abs() < MIN_ORIENTING_SLOPE_DEG {
         return None;
     }
     let rise = travel.along(up.vector());

@@ -490,7 +490,7 @@ fn load_mix(
         "/api/simulate?slopes=0:20:5&duration=3",
         "/api/risk?slope=0:24:25",
         "/api/phase?slope=10&k-n=1e4:1e7:300&k-s=1e3:1e8:300",
-        "/data/risk-map?rule=best",
+        "/api/risk?solve=mass&slope=0:20:3",
     ];
     {
         let (addr, stop) = (addr.clone(), Arc::clone(&stop));

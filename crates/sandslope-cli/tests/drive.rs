@@ -62,7 +62,17 @@ fn commanded_gait_has_the_robot_files_period_and_phase() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("gait.csv");
     let out = bin()
-        .args(["drive", "--emulate", "--duration", "3.2", "--watchdog", "2", "--log"])
+        .args([
+            "drive",
+            "--emulate",
+            "--duration",
+            "3.2",
+            "--watchdog",
+            "10",
+            "--bus-watchdog",
+            "2.54",
+            "--log",
+        ])
         .arg(&log)
         .output()
         .unwrap();
@@ -262,8 +272,10 @@ fn torque_off_when_a_servo_is_lost() {
     assert!(all.contains("check its cable"), "{all}");
     // The others are off; servo 3 cannot be reached, and its own Bus Watchdog stopped it.
     assert!(all.contains("still ON on servos 3; Bus Watchdog fired on servos"), "{all}");
-    let fired = all.split("Bus Watchdog fired on servos ").nth(1).unwrap().split(' ').next().unwrap_or("");
-    assert!(all.contains("Bus Watchdog fired on servos 3 ") || fired.contains('3'), "{all}");
+    // Its own Bus Watchdog fired (on a loaded machine others' may have too, between cycles).
+    let fired =
+        all.split("Bus Watchdog fired on servos ").nth(1).unwrap().split(" (stopped)").next().unwrap();
+    assert!(fired.split(", ").any(|id| id == "3"), "{all}");
     assert!(all.contains("NOT confirmed on 3"), "{all}");
     assert!(!log_rows(&log).is_empty(), "the log is kept");
 }

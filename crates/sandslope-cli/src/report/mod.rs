@@ -65,6 +65,7 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
     });
     h.push_str(&format!("<style>{STYLE}</style></head><body>\n"));
     h.push_str(&sections::header(report));
+    h.push_str(&sections::plain_answer(report));
     h.push_str(&sections::warnings(report));
     h.push_str(&sections::inputs(report));
     h.push_str(&sections::disagreements(report));

@@ -34,6 +34,17 @@ pub fn header(report: &Report) -> String {
     h
 }
 
+/// The plain answer, first: how steep and how fast the robot climbs on this terrain, where it
+/// turns metastable and where it fails; the evidence follows.
+pub fn plain_answer(report: &Report) -> String {
+    format!(
+        "<h2 id=\"answer\">The answer</h2>\n<p class=\"answer\"><b>{}</b></p>\n<p>The rest of the page is the evidence: \
+         the inputs and where they come from, where the model and the data disagree, every number the paper reports \
+         beside the model's, the calibration and the figures.</p>\n",
+        escape(&report.plain_answer.text)
+    )
+}
+
 /// The top-level warnings, before anything else is read.
 pub fn warnings(report: &Report) -> String {
     report

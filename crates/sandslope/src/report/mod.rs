@@ -209,6 +209,9 @@ pub struct Report {
     /// user's observations, or the built-in terrain, which is that calibration); otherwise the
     /// terrain as given, and the calibration is shown beside it.
     pub model_is_calibration: bool,
+    /// The plain answer for the report's robot and terrain, before the evidence: how steep it
+    /// climbs and how fast, where it turns metastable and where it fails.
+    pub plain_answer: PlainAnswer,
     /// The figures, in page order (panels of one figure each listed).
     pub figures: Vec<FigureRecord>,
     /// Observed against model speeds.
@@ -254,6 +257,99 @@ pub struct Report {
     /// The figures' data.
     #[serde(skip)]
     pub plots: Plots,
+}
+
+/// The report's plain answer for its robot and terrain (the model every table and figure
+/// uses), from the closed form at the terrain's medians every 0.25 degrees from level to 30
+/// degrees (docs/model.md §5-§6) and the two risk limits (§9).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlainAnswer {
+    /// The robot's mass, kg.
+    pub mass_kg: f64,
+    /// The terrain's name.
+    pub terrain: String,
+    /// The steepest slope of the grid up to which every slope from level is success, degrees
+    /// (`None` when level ground is not).
+    pub climbs_up_to_deg: Option<f64>,
+    /// The speed on level ground, m/s.
+    pub level_speed_m_s: Option<f64>,
+    /// The speed at `climbs_up_to_deg`, m/s.
+    pub speed_at_limit_m_s: Option<f64>,
+    /// The first slope of the grid whose regime is not success, degrees, and that regime.
+    pub first_not_success: Option<(f64, crate::regime::Regime)>,
+    /// The first slope of the grid whose regime is a failure (sinkage or slippage), degrees,
+    /// and that regime.
+    pub first_failure: Option<(f64, crate::regime::Regime)>,
+    /// The success limit with the terrain's uncertainty (P(not success) < `max_risk`).
+    pub success_limit: SafeLimit,
+    /// The safe-slope limit with the terrain's uncertainty (p_fail < `max_risk`).
+    pub safe_limit: SafeLimit,
+    /// The risk threshold of both limits.
+    pub max_risk: f64,
+    /// The answer in one paragraph.
+    pub text: String,
+}
+
+fn plain_answer(plots: &Plots) -> PlainAnswer {
+    let grid = &plots.model;
+    let deg = |p: &Prediction| p.slope.degrees();
+    let success = |p: &&Prediction| p.regime == crate::regime::Regime::Success;
+    let first_not = grid.iter().find(|p| !success(p));
+    let first_fail = grid.iter().find(|p| p.regime.is_failure());
+    let last_success = match grid.iter().position(|p| !success(&p)) {
+        Some(0) => None,
+        Some(i) => grid.get(i - 1),
+        None => grid.last(),
+    };
+    let level = grid.first().and_then(|p| p.speed);
+    let cm = |v: f64| format!("{:.1} cm/s", 100.0 * v);
+    let mut text = format!("On {} the {} kg robot ", plots.terrain_name, plots.mass_kg);
+    match last_success {
+        Some(p) => text.push_str(&format!(
+            "climbs up to {:.2}° ({} on level ground, {} there)",
+            deg(p),
+            level.map_or("-".into(), cm),
+            p.speed.map_or("-".into(), cm)
+        )),
+        None => text.push_str("does not climb even level ground"),
+    }
+    if let Some(p) = first_not.filter(|p| !p.regime.is_failure()) {
+        text.push_str(&format!(
+            "; from {:.2}° it is {} (it progresses by less than the minimum step and stalls in its own trench)",
+            deg(p),
+            p.regime.name()
+        ));
+    }
+    if let Some(p) = first_fail {
+        let why = if plots.repose_deg.is_some_and(|r| deg(p) >= r) { " (the angle of repose)" } else { "" };
+        text.push_str(&format!("; from {:.2}°{why} it fails ({})", deg(p), p.regime.name()));
+    }
+    text.push_str(" (the model at the terrain's medians, docs/model.md §5-§6).");
+    let words = |l: &SafeLimit| match *l {
+        SafeLimit::Limit { value, .. } => format!("up to {value:.1}°"),
+        SafeLimit::Repose { repose_deg, .. } => format!("up to the angle of repose, {repose_deg}°"),
+        SafeLimit::NoneSafe { .. } => "on no slope".into(),
+        SafeLimit::BeyondRange { up_to, .. } => format!("at every slope up to {up_to}°"),
+    };
+    text.push_str(&format!(
+        " With the terrain's uncertainty, it climbs with P(not success) < {r} {} and does not fail (p_fail < {r}) {} (§9).",
+        words(&plots.success_limit),
+        words(&plots.safe_limit),
+        r = plots.max_risk
+    ));
+    PlainAnswer {
+        mass_kg: plots.mass_kg,
+        terrain: plots.terrain_name.clone(),
+        climbs_up_to_deg: last_success.map(deg),
+        level_speed_m_s: level,
+        speed_at_limit_m_s: last_success.and_then(|p| p.speed),
+        first_not_success: first_not.map(|p| (deg(p), p.regime)),
+        first_failure: first_fail.map(|p| (deg(p), p.regime)),
+        success_limit: plots.success_limit,
+        safe_limit: plots.safe_limit,
+        max_risk: plots.max_risk,
+        text,
+    }
 }
 
 /// The report's joint calibration: the fit itself (flattened: the keys of `calibrate --json`)
@@ -401,6 +497,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     };
     let disagreements: Vec<String> = observations.into_iter().chain(disagreements).collect();
     Ok(Report {
+        plain_answer: plain_answer(&plots),
         own_observations: own,
         model_is_calibration: own || evidence.builtin_terrain,
         figures: figure_records(&plots, calibration.is_some()),
@@ -709,6 +806,29 @@ mod tests {
         assert!(r.track_notes.iter().all(|n| n.contains("20°")));
         assert_eq!(r.figures[1].id, "fig3b");
         assert_eq!(r.plots.strides.len(), 2);
+    }
+
+    /// The plain answer, checked against `predict` slope by slope: success up to the stated
+    /// slope and not just above it, the speeds there, and the regime that follows.
+    #[test]
+    fn the_plain_answer_is_predicts_regimes_read_off_the_slope_grid() {
+        let r = report(&evidence()).unwrap();
+        let a = &r.plain_answer;
+        let t = terrain();
+        let at = |d: f64| {
+            predict(&paper_robot(), Slope::from_degrees(d).unwrap(), &t.at(Slope::from_degrees(d).unwrap()))
+        };
+        let top = a.climbs_up_to_deg.unwrap();
+        assert!((0..=(top / 0.25).round() as usize)
+            .all(|i| at(i as f64 * 0.25).regime == crate::regime::Regime::Success));
+        let (next, regime) = a.first_not_success.unwrap();
+        assert_eq!(next, top + 0.25);
+        assert_eq!(at(next).regime, regime);
+        assert_eq!(a.level_speed_m_s, at(0.0).speed);
+        assert_eq!(a.speed_at_limit_m_s, at(top).speed);
+        assert!(a.text.contains(&format!("climbs up to {top:.2}°")), "{}", a.text);
+        // Repose 25 deg: at and beyond it the regime is slippage.
+        assert!(a.first_failure.unwrap().0 <= 25.0);
     }
 
     #[test]

@@ -86,7 +86,7 @@ pub struct DriveArgs {
     #[arg(long, value_name = "DEGC", default_value_t = 65)]
     pub temperature_limit: u8,
     /// Longest bus cycle accepted before everything stops, s.
-    #[arg(long, value_name = "S", default_value_t = 0.25)]
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
     pub watchdog: f64,
     /// The servos' own Bus Watchdog, s (0.02 to 2.54): they stop by themselves if the driver goes quiet.
     #[arg(long, value_name = "S", default_value_t = 0.5)]

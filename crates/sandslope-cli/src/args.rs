@@ -101,7 +101,10 @@ impl UncertaintyArgs {
     /// flag: `--cv-n = -1 must be a finite number of at least 0`.
     pub fn apply(&self, terrain: Terrain) -> Result<(UncertainTerrain, Option<String>)> {
         self.check()?;
-        let u = UncertainTerrain::new(terrain, self.cv_n, self.cv_s).map_err(|e| anyhow!("{e}"))?;
+        let u = UncertainTerrain::new(terrain, self.cv_n, self.cv_s).map_err(|e| {
+            let flag = if e.key == "cv_s" { "--cv-s" } else { "--cv-n" };
+            anyhow!("{}", e.renamed(flag))
+        })?;
         let note = u.defaults_used().note();
         Ok((u, note))
     }

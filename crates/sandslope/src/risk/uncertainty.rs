@@ -179,20 +179,31 @@ pub struct UncertainTerrain {
     cv_s: Option<f64>,
 }
 
+/// Largest coefficient of variation a user may give (`--cv-n`, `--cv-s`, Python's `cv_n`):
+/// sigma = sqrt(ln(1 + 100^2)) = 3.03 in ln k, a factor of 20 per standard deviation, beyond
+/// any measurement. A CV of 1e308 made sigma infinite and the risk map's integration never end
+/// (the server fuzz, issue 39).
+pub const MAX_GIVEN_CV: f64 = 100.0;
+
 impl UncertainTerrain {
-    /// `terrain` with user-given coefficients of variation `cv_n`, `cv_s` (each finite and at
-    /// least 0; errors name `cv_n` / `cv_s`), or `None` to use the table's SDs, or the
+    /// `terrain` with user-given coefficients of variation `cv_n`, `cv_s` (each finite, from 0
+    /// to [`MAX_GIVEN_CV`]; errors name `cv_n` / `cv_s`), or `None` to use the table's SDs, or the
     /// defaults where the table has none.
     pub fn new(
         terrain: Terrain,
         cv_n: Option<f64>,
         cv_s: Option<f64>,
     ) -> Result<UncertainTerrain, ParamError> {
-        if let Some(cv) = cv_n {
-            non_negative("cv_n", cv)?;
-        }
-        if let Some(cv) = cv_s {
-            non_negative("cv_s", cv)?;
+        for (key, cv) in [("cv_n", cv_n), ("cv_s", cv_s)] {
+            if let Some(cv) = cv {
+                if non_negative(key, cv)? > MAX_GIVEN_CV {
+                    return Err(ParamError::new(
+                        key,
+                        cv,
+                        format!("at most {MAX_GIVEN_CV} (a standard deviation {MAX_GIVEN_CV} times the value; docs/model.md §9)"),
+                    ));
+                }
+            }
         }
         Ok(UncertainTerrain { terrain, cv_n, cv_s })
     }
@@ -258,6 +269,18 @@ impl UncertainTerrain {
 
 #[cfg(test)]
 pub(crate) mod tests {
+    /// The server fuzz's hang (a risk map with --cv-n 1e308 ran for ever) is refused at the
+    /// edge with the range; 100 itself is accepted.
+    #[test]
+    fn a_given_cv_beyond_100_is_refused() {
+        let t = Terrain::constant(7e5, 2e6).unwrap();
+        let e = UncertainTerrain::new(t.clone(), Some(1e308), None).unwrap_err();
+        assert_eq!(e.key, "cv_n");
+        assert!(e.to_string().contains("at most 100"), "{e}");
+        assert_eq!(UncertainTerrain::new(t.clone(), None, Some(100.5)).unwrap_err().key, "cv_s");
+        assert!(UncertainTerrain::new(t, Some(100.0), Some(0.0)).is_ok());
+    }
+
     use super::*;
     use crate::terrain::{TerrainPoint, TerrainSpec};
 

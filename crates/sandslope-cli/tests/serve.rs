@@ -262,7 +262,7 @@ fn simulate_endpoint_equals_simulate_json_and_feeds_the_animation() {
         ("/api/simulate?duration=5", "slope", "--slope"),
         ("/api/simulate?slope=10&animate=%2Ftmp%2Fa.gif", "animate", "no file"),
         ("/api/simulate?slope=10&out=walk.csv", "out", "no file"),
-        ("/api/simulate?slope=10&yield=NaN", "yield", "yield"),
+        ("/api/simulate?slope=10&creep=NaN", "creep", "creep"),
         ("/data/simulation?slopes=0:10:2", "slopes", "one walk"),
         ("/data/simulation?slope=10&duration=60&rate=1000", "rate", "7200"),
     ] {

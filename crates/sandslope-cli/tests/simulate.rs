@@ -60,13 +60,19 @@ fn json_has_the_summary_keys_and_the_closed_form_is_predicts() {
     assert_eq!(sim["closed_form"], predict);
 }
 
-/// `--body-pitch locked` (the closed form's no-pitch assumption): the walk that tumbles at 20
-/// degrees keeps its pitch at zero, and --json says which setting ran.
+/// `--body-pitch locked` (the closed form's no-pitch assumption): the walk whose body rears up
+/// at 20 degrees keeps its pitch at zero, and --json says which setting ran; so do
+/// `--rft-scaling` (li2013 included), `--creep` and the servo limit.
 #[test]
 fn body_pitch_locked_holds_the_body_parallel_to_the_slope() {
     let free = json(&["simulate", "--slope", "20", "--duration", "3", "--json"]);
     assert_eq!(free["body_pitch"], "free");
-    assert!(free["max_pitch_deg"].as_f64().unwrap() > 90.0);
+    assert!(free["max_pitch_deg"].as_f64().unwrap() > 5.0);
+    assert_eq!(free["creep_m_s"], 1e-7);
+    assert!(free["servo_torque_limit_n_m"].is_null());
+    let li = json(&["simulate", "--slope", "20", "--duration", "1.5", "--json", "--rft-scaling", "li2013"]);
+    assert_eq!(li["rft_scaling"], "li2013");
+    assert_ne!(li["speed_m_s"], free["speed_m_s"]);
     let locked = json(&["simulate", "--slope", "20", "--duration", "3", "--json", "--body-pitch", "locked"]);
     assert_eq!(locked["body_pitch"], "locked");
     assert_eq!(locked["max_pitch_deg"], 0.0);
@@ -121,7 +127,9 @@ fn bad_input_exits_2_naming_the_value_and_range_and_writes_nothing() {
         (vec!["--slope", "10", "--duration", "1"], "at least 1.5 T"),
         (vec!["--slopes", "0:95:5"], "--slopes"),
         (vec!["--slope", "10", "--body-pitch", "fixed"], "possible values: free, locked"),
-        (vec!["--slope", "10", "--rft-scaling", "stress"], "possible values: motion, components"),
+        (vec!["--slope", "10", "--rft-scaling", "stress"], "possible values: motion, components, li2013"),
+        (vec!["--slope", "10", "--creep", "0"], "--creep = 0 must be between 1e-9 and 1e-3 m/s"),
+        (vec!["--slope", "10", "--creep", "NaN"], "--creep = NaN"),
     ];
     for (args, needle) in cases {
         sandslope()

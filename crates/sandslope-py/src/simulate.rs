@@ -18,7 +18,7 @@ use crate::value_error;
 /// `leg{j}_depth_m`, `leg{j}_force_x_n`, `leg{j}_force_z_n`, `leg{j}_torque_n_m`) to a 1-D
 /// array; `summary` is `sandslope simulate --json`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, yield_m=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="free", rft_scaling="motion"))]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, creep_m_s=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="free", rft_scaling="motion", servo_limit=true))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -29,10 +29,11 @@ pub fn simulate<'py>(
     k_n: Option<f64>,
     k_s: Option<f64>,
     dt_s: Option<f64>,
-    yield_m: Option<f64>,
+    creep_m_s: Option<f64>,
     sample_rate_hz: f64,
     body_pitch: &str,
     rft_scaling: &str,
+    servo_limit: bool,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     let scenario =
         Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
@@ -40,9 +41,10 @@ pub fn simulate<'py>(
     if let Some(dt) = dt_s {
         settings = settings.with_dt(dt).map_err(value_error)?;
     }
-    if let Some(y) = yield_m {
-        settings = settings.with_yield(y).map_err(value_error)?;
+    if let Some(c) = creep_m_s {
+        settings = settings.with_creep(c).map_err(value_error)?;
     }
+    settings = settings.with_servo_limit(servo_limit);
     settings = settings.with_sample_rate(sample_rate_hz).map_err(value_error)?;
     settings = settings
         .with_body_pitch(choose(
@@ -53,7 +55,11 @@ pub fn simulate<'py>(
         .with_rft_scaling(choose(
             "rft_scaling",
             rft_scaling,
-            &[("motion", RftScaling::Motion), ("components", RftScaling::Components)],
+            &[
+                ("motion", RftScaling::Motion),
+                ("components", RftScaling::Components),
+                ("li2013", RftScaling::Li2013),
+            ],
         )?);
     let sim = py.detach(|| run(&scenario, slope_deg, &settings)).map_err(|e| match e {
         SimulateError::Param(p) => value_error(p),

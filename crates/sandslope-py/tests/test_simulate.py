@@ -41,7 +41,8 @@ def test_bad_input_is_a_value_error_naming_the_value_and_range(cli):
 
 
 def test_stiff_level_sand_steps_the_rigid_rolling_step():
-    # A physical limit worked out by hand (docs/simulate.md, "On level sand the legs roll"): on
+    # A physical limit worked out by hand (docs/simulate.md, "On level sand the legs roll"), with
+    # the body's pitch locked (the free body somersaults on such sand): on
     # sand so stiff that the legs barely sink (k_n = k_s = 1e8 N/m^3, d_n = 0.03 mm) a C-leg of
     # radius R = 0.04 m with the belly h = 0.03 m below the hips rolls on its arc from
     # touchdown (phi0 = asin((h - R)/R)) until its tip points down, then pivots on its tip until
@@ -50,7 +51,9 @@ def test_stiff_level_sand_steps_the_rigid_rolling_step():
     r, h = 0.04, 0.03
     phi0 = math.asin((h - r) / r)
     rolling = r * (math.pi / 2 - phi0) + r * math.cos(phi0) + 2 * r * math.sqrt(1 - (h / (2 * r)) ** 2)
-    traj, m = sandslope.simulate("paper-hexapod", "glass-beads-300um", 0, 2.5, k_n=1e8, k_s=1e8, yield_m=1e-4)
+    traj, m = sandslope.simulate(
+        "paper-hexapod", "glass-beads-300um", 0, 2.5, k_n=1e8, k_s=1e8, body_pitch="locked"
+    )
     assert m["step_m"] == pytest.approx(rolling, rel=0.03)
     assert m["closed_form"]["level_step_m"] == pytest.approx(2 * math.sqrt(r * r - (h - r) ** 2), rel=1e-3)
     # The body vaults: at the tip's pivot the axle line is up to 2R above the sand.

@@ -442,10 +442,10 @@ fn print_side_by_side(closed: &JointCalibration, sim: &JointCalibration) {
     println!();
     println!(
         "The same evidence fitted by the closed form and by the simulator ({} s walks at dt = {} ms, \
-         yield slip {} mm; {} walks):",
+         creep speed {:e} m/s; {} walks):",
         settings.duration_s,
         settings.dt_s.map_or("default".into(), |d| format!("{}", d * 1e3)),
-        settings.yield_m * 1e3,
+        settings.creep_m_s,
         sim.walks
     );
     let mut t =

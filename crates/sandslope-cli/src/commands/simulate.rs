@@ -41,19 +41,26 @@ pub struct SimulateArgs {
     /// then steps to measure).
     #[arg(long, value_name = "S", default_value_t = 10.0, allow_negative_numbers = true)]
     pub duration: f64,
-    /// Integration step, s (default: min(1 ms, 0.25 / omega_n, T / 200), docs/model.md §17).
+    /// Time step, s (default: T / 2000, 0.5 ms for the paper's robot; at most T / 100;
+    /// docs/model.md §17).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub dt: Option<f64>,
-    /// Elastic slip at which the sand's stress is fully mobilised, m (docs/model.md §16).
-    #[arg(long = "yield", value_name = "M", allow_negative_numbers = true)]
-    pub yield_m: Option<f64>,
+    /// Creep speed of the contact law's smoothing at rest, m/s (default 1e-7; 1e-9 to 1e-3;
+    /// docs/model.md §17): a numerical setting, which moves no converged answer.
+    #[arg(long, value_name = "M/S", allow_negative_numbers = true)]
+    pub creep: Option<f64>,
+    /// Drive the legs as ideal position servos even where the robot file gives a servo torque
+    /// limit (by default the limit applies, docs/model.md §15).
+    #[arg(long)]
+    pub no_servo_limit: bool,
     /// Whether the body may pitch: `locked` holds it parallel to the slope, the closed form's
     /// assumption, to see what the pitch does to a walk (docs/simulate.md).
     #[arg(long, value_name = "MODE", value_enum, default_value_t = PitchArg::Free)]
     pub body_pitch: PitchArg,
     /// How resistive force theory is scaled to the terrain's k_n and k_s: `motion` (one scale
-    /// that follows the direction of motion) or `components` (normal stress by k_n, shear
-    /// stress by k_s), docs/model.md §16.
+    /// that follows the direction of motion), `components` (normal stress by k_n, shear
+    /// stress by k_s) or `li2013` (Li, Zhang and Goldman 2013: one factor from k_n, k_s
+    /// unused), docs/model.md §16.
     #[arg(long, value_name = "MODE", value_enum, default_value_t = ScalingArg::Motion)]
     pub rft_scaling: ScalingArg,
     /// Trajectory sample rate for --out, --plot and --animate, Hz.
@@ -107,6 +114,8 @@ pub enum ScalingArg {
     Motion,
     /// Normal stress by k_n, along-surface stress by k_s.
     Components,
+    /// Li, Zhang and Goldman (2013): one factor from k_n for every stress.
+    Li2013,
 }
 
 impl From<ScalingArg> for RftScaling {
@@ -114,6 +123,7 @@ impl From<ScalingArg> for RftScaling {
         match p {
             ScalingArg::Motion => RftScaling::Motion,
             ScalingArg::Components => RftScaling::Components,
+            ScalingArg::Li2013 => RftScaling::Li2013,
         }
     }
 }
@@ -124,7 +134,7 @@ fn flagged(e: ParamError) -> anyhow::Error {
         "duration_s" => "--duration",
         "dt_s" => "--dt",
         "slope_deg" => "--slope",
-        "yield_m" => "--yield",
+        "creep_m_s" => "--creep",
         "sample_rate_hz" => "--rate",
         "step" | "from" => "--slopes",
         other => return anyhow!("{}", e.clone().renamed(other)),
@@ -144,9 +154,10 @@ fn settings(args: &SimulateArgs) -> Result<SimSettings> {
     if let Some(dt) = args.dt {
         s = s.with_dt(dt).map_err(flagged)?;
     }
-    if let Some(y) = args.yield_m {
-        s = s.with_yield(y).map_err(flagged)?;
+    if let Some(c) = args.creep {
+        s = s.with_creep(c).map_err(flagged)?;
     }
+    s = s.with_servo_limit(!args.no_servo_limit);
     s = s.with_body_pitch(args.body_pitch.into()).with_rft_scaling(args.rft_scaling.into());
     s.with_sample_rate(args.rate).map_err(flagged)
 }
@@ -321,8 +332,21 @@ fn print_one(sim: &Simulation) {
     t.add_row(["cause", m.cause.name(), p.cause.name()]);
     println!("{t}");
     println!("{DISAGREE_NOTE}");
-    if m.rft_scaling == RftScaling::Components {
-        println!("resistive force theory scaled by components (--rft-scaling components, docs/model.md §16)");
+    if m.rft_scaling != RftScaling::Motion {
+        println!(
+            "resistive force theory scaled by {} (--rft-scaling {}, docs/model.md §16)",
+            m.rft_scaling.name(),
+            m.rft_scaling.name()
+        );
+    }
+    if let Some(limit) = m.servo_torque_limit_n_m {
+        println!("servo torque limit {limit} N m (the robot file's; --no-servo-limit drives ideal servos)");
+    }
+    if m.unconverged_steps > 0 {
+        println!(
+            "{} time step(s) ended their implicit solve unconverged (docs/simulate.md, \"Convergence\")",
+            m.unconverged_steps
+        );
     }
     if let Some(at) = m.pitch_over_s {
         println!(
@@ -443,8 +467,12 @@ fn run_slopes(
             if settings.body_pitch == BodyPitch::Locked {
                 println!("body pitch locked at 0 (--body-pitch locked), as the closed form assumes");
             }
-            if settings.rft_scaling == RftScaling::Components {
-                println!("resistive force theory scaled by components (--rft-scaling components, docs/model.md §16)");
+            if settings.rft_scaling != RftScaling::Motion {
+                println!(
+                    "resistive force theory scaled by {} (--rft-scaling {}, docs/model.md §16)",
+                    settings.rft_scaling.name(),
+                    settings.rft_scaling.name()
+                );
             }
         }
     }

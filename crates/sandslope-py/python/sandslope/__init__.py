@@ -711,22 +711,25 @@ def simulate(
     k_n: Optional[float] = None,
     k_s: Optional[float] = None,
     dt_s: Optional[float] = None,
-    yield_m: Optional[float] = None,
+    creep_m_s: Optional[float] = None,
     sample_rate_hz: float = 120.0,
     body_pitch: str = "free",
     rft_scaling: str = "motion",
+    servo_limit: bool = True,
 ) -> Tuple[Any, Dict[str, Any]]:
     """Simulates the robot walking for ``duration_s`` seconds on ``terrain`` at ``slope_deg``
     (``sandslope simulate``, docs/model.md §15-§18).
 
     A planar body on C-legs in the alternating tripod, the sand pushing on every leg element by
     resistive force theory scaled to the terrain's k_n and k_s (``k_n``/``k_s`` override them at
-    every slope, as ``--k-n``/``--k-s``); ``dt_s`` fixes the integration step, ``yield_m`` the
-    elastic slip at which the sand's stress is fully mobilised, ``sample_rate_hz`` the
-    trajectory's sampling; ``body_pitch="locked"`` holds the body parallel to the slope, as the
-    closed form assumes (``--body-pitch locked``); ``rft_scaling="components"`` scales the sand's
-    normal stress by k_n and its shear stress by k_s instead of one scale following the motion
-    (``--rft-scaling``, docs/model.md §16). Negative slopes walk downhill.
+    every slope, as ``--k-n``/``--k-s``); ``dt_s`` fixes the time step, ``creep_m_s`` the creep
+    speed of the contact law's smoothing at rest (``--creep``, docs/model.md §17),
+    ``sample_rate_hz`` the trajectory's sampling; ``body_pitch="locked"`` holds the body parallel
+    to the slope, as the closed form assumes (``--body-pitch locked``);
+    ``rft_scaling="components"`` scales the sand's normal stress by k_n and its shear stress by
+    k_s, ``"li2013"`` everything by one factor from k_n, instead of one scale following the
+    motion (``--rft-scaling``, docs/model.md §16); ``servo_limit=False`` ignores the robot
+    file's servo torque limit (``--no-servo-limit``). Negative slopes walk downhill.
 
     Returns ``(trajectory, summary)``: ``trajectory`` a pandas DataFrame (a dict of NumPy
     columns without pandas) with ``time_s``, ``x_m``, ``z_m``, ``pitch_rad``, ``vx_m_s``,
@@ -743,10 +746,11 @@ def simulate(
         k_n=None if k_n is None else float(k_n),
         k_s=None if k_s is None else float(k_s),
         dt_s=None if dt_s is None else float(dt_s),
-        yield_m=None if yield_m is None else float(yield_m),
+        creep_m_s=None if creep_m_s is None else float(creep_m_s),
         sample_rate_hz=float(sample_rate_hz),
         body_pitch=str(body_pitch),
         rft_scaling=str(rft_scaling),
+        servo_limit=bool(servo_limit),
     )
     try:
         import pandas as pd

@@ -26,10 +26,6 @@ use crate::terrain::Terrain;
 
 /// The fit's walk length, s: one stride of warm-up and three strides measured (six steps).
 pub const FIT_DURATION_S: f64 = 4.0;
-/// The fit's integration step, s: twice the default 1 ms (docs/model.md §17); on the built-in
-/// robot and terrain it moves the simulated speeds by at most a few tenths of a cm/s
-/// (docs/simulate.md gives the measured differences).
-pub const FIT_DT_S: f64 = 2e-3;
 
 /// The model a calibration fits with.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -45,12 +41,10 @@ pub enum SpeedModel {
 }
 
 impl SpeedModel {
-    /// The simulator with the fit's coarse setting: [`FIT_DURATION_S`] walks at
-    /// [`FIT_DT_S`], the default yield slip and element count.
+    /// The simulator with the fit's setting: [`FIT_DURATION_S`] walks at the default (converged,
+    /// docs/model.md §17) time step, creep speed and element count.
     pub fn simulator_for_fit() -> SpeedModel {
-        let settings = SimSettings::new(FIT_DURATION_S)
-            .and_then(|s| s.with_dt(FIT_DT_S))
-            .expect("the fit's constant setting is valid");
+        let settings = SimSettings::new(FIT_DURATION_S).expect("the fit's constant setting is valid");
         SpeedModel::Simulator { settings }
     }
 

@@ -68,65 +68,35 @@ pub(crate) fn leg_nodes(robot: &Robot, shape: LegShape, elements: usize) -> Vec<
         .collect()
 }
 
-/// Resistive-force memory of one element (docs/model.md §16: the elastic slip vector).
-pub(crate) type Memory = [f64; 2];
-
-/// The generalized force, damping and stiffness a contact adds to the body's equations.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Assembly {
-    /// Generalized force (F_x, F_z, torque about the centre of mass).
-    pub q: [f64; 3],
-    /// `d(-Q)/d(qdot)` times dt-weighted factors (implicit damping), 3x3.
-    pub c: [[f64; 3]; 3],
-    /// `d(-Q)/dq` (stiffness), 3x3.
-    pub k: [[f64; 3]; 3],
-}
-
-/// One element's contribution, kept for the memory update after the step.
+/// What one element feels from the sand this step (docs/model.md §16-§17): its submerged
+/// part's geometry at the start of the step, which the implicit velocity step holds fixed.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Touch {
-    /// Where its memory lives (leg index or the belly, element index).
-    pub slot: usize,
-    /// Point of application relative to the centre of mass, m.
+pub(crate) struct Contact {
+    /// Width times the depth integral over the submerged part, m^3: the force is this times
+    /// the stress per unit depth (N/m^3).
+    pub weight: f64,
+    /// Unit tangent of the element `(tx, tz)` (a to b).
+    pub tangent: [f64; 2],
+    /// Point of application (depth-weighted centroid) relative to the centre of mass, m.
     pub rel: [f64; 2],
-    /// Its velocity before the step, m/s.
-    pub vel: [f64; 2],
-}
-
-/// A straight element between world points `a` and `b` with velocities `va`, `vb`, width `w`.
-pub(crate) struct Element {
-    pub a: [f64; 2],
-    pub b: [f64; 2],
-    pub va: [f64; 2],
-    pub vb: [f64; 2],
-    pub w: f64,
-}
-
-/// What one element feels: force, its point, the velocity there and the implicit Jacobians.
-pub(crate) struct ElementForce {
-    pub force: [f64; 2],
-    pub point: [f64; 2],
-    pub vel: [f64; 2],
-    /// Isotropic damping coefficient for the implicit step, N s/m.
-    pub damping: f64,
-    /// `dF/d(depth)` (vector), N/m: force gained per metre the element moves down.
-    pub depth_gain: [f64; 2],
+    /// The same point relative to the leg's hip, m (zero for the belly).
+    pub arm: [f64; 2],
+    /// The leg it belongs to; [`BELLY`] for the belly.
+    pub leg: usize,
     /// Deepest point, m.
     pub depth: f64,
 }
 
-/// Sand force on an element (docs/model.md §16), updating nothing: `memory` is the element's
-/// elastic slip, `yield_m` the slip at which the stress reaches its resistive-force value,
-/// `dt` the step. `None` when the element is out of the sand.
+/// [`Contact::leg`] of a belly element.
+pub(crate) const BELLY: usize = usize::MAX;
+
+/// The submerged part of the straight element from world point `a` to `b` of width `w`,
+/// clipped at the surface `z = 0` exactly: `(weight, point, tangent, depth)` with `weight`
+/// the width times the depth integral (m^3), `point` the depth-weighted centroid. `None` when
+/// the element is out of the sand.
 #[inline(always)]
-pub(crate) fn element_force(
-    rft: &Rft,
-    el: &Element,
-    memory: Memory,
-    yield_m: f64,
-    dt: f64,
-) -> Option<ElementForce> {
-    let (za, zb) = (el.a[1], el.b[1]);
+pub(crate) fn submerged(a: [f64; 2], b: [f64; 2], w: f64) -> Option<(f64, [f64; 2], [f64; 2], f64)> {
+    let (za, zb) = (a[1], b[1]);
     if za >= 0.0 && zb >= 0.0 {
         return None;
     }
@@ -141,72 +111,133 @@ pub(crate) fn element_force(
             (t0, 1.0)
         }
     };
-    let d = [el.b[0] - el.a[0], el.b[1] - el.a[1]];
+    let d = [b[0] - a[0], b[1] - a[1]];
     let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
     if len <= 0.0 {
         return None;
     }
     let da = -(za + ta * d[1]).min(0.0);
     let db = -(za + tb * d[1]).min(0.0);
-    let sub = (tb - ta) * len;
-    let depth_integral = 0.5 * sub * (da + db);
+    let depth_integral = 0.5 * (tb - ta) * len * (da + db);
     if depth_integral <= 0.0 {
         return None;
     }
     // Depth-weighted centroid of the submerged part.
     let tc = ta + (tb - ta) * (da + 2.0 * db) / (3.0 * (da + db));
-    let point = [el.a[0] + tc * d[0], el.a[1] + tc * d[1]];
-    let vel = [el.va[0] + tc * (el.vb[0] - el.va[0]), el.va[1] + tc * (el.vb[1] - el.va[1])];
-    let trial = [memory[0] + dt * vel[0], memory[1] + dt * vel[1]];
-    let m = (trial[0] * trial[0] + trial[1] * trial[1]).sqrt();
-    if m <= 0.0 {
-        return None;
-    }
-    let (ex, ez) = (trial[0] / m, trial[1] / m);
-    let (sx, sz) = rft.stress(d[0] / len, d[1] / len, ex, ez);
-    let full = el.w * depth_integral;
-    let sat = (m / yield_m).min(1.0);
-    let force = [sx * full * sat, sz * full * sat];
-    let magnitude = (sx * sx + sz * sz).sqrt() * full;
-    let gain = sub / depth_integral;
-    Some(ElementForce {
-        force,
-        point,
-        vel,
-        damping: dt * magnitude / yield_m.max(m),
-        depth_gain: [force[0] * gain, force[1] * gain],
-        depth: da.max(db),
-    })
+    let point = [a[0] + tc * d[0], a[1] + tc * d[1]];
+    Some((w * depth_integral, point, [d[0] / len, d[1] / len], da.max(db)))
 }
 
-/// Adds an element force acting at `rel` (from the centre of mass) to the body's assembly.
-///
-/// With the velocity Jacobian rows `jx = (1, 0, -rel_z)`, `jz = (0, 1, rel_x)` the damping adds
-/// `c (jx jx^T + jz jz^T)` and the depth gain `(J^T dF/d(depth)) jz^T`; the entries are written
-/// out with the Jacobians' zeros and ones already applied (the products with exact 0 and 1 the
-/// general 3 x 3 loop formed change nothing, so the sums are the same numbers; perf: the loop
-/// was a fifth of the step).
-#[inline]
-pub(crate) fn assemble(asm: &mut Assembly, f: &ElementForce, rel: [f64; 2]) {
-    let (rx, rz) = (rel[0], rel[1]);
-    asm.q[0] += f.force[0];
-    asm.q[1] += f.force[1];
-    asm.q[2] += rx * f.force[1] - rz * f.force[0];
-    let c = f.damping;
-    // c (jx jx^T + jz jz^T): [[1, 0, -rz], [0, 1, rx], [-rz, rx, rz^2 + rx^2]] times c.
-    let (c02, c12, c22) = (c * -rz, c * rx, c * (rz * rz + rx * rx));
-    asm.c[0][0] += c;
-    asm.c[0][2] += c02;
-    asm.c[1][1] += c;
-    asm.c[1][2] += c12;
-    asm.c[2][0] += c02;
-    asm.c[2][1] += c12;
-    asm.c[2][2] += c22;
-    // Generalized depth gain g = J^T dF/d(depth) = (g_x, g_z, -rz g_x + rx g_z); K += g jz^T,
-    // whose first column is zero.
-    let g = [f.depth_gain[0], f.depth_gain[1], -rz * f.depth_gain[0] + rx * f.depth_gain[1]];
-    for (row, gi) in asm.k.iter_mut().zip(g) {
-        row[1] += gi;
-        row[2] += gi * rx;
+/// The associated stand-in for [`element_force`] (the start of its solve where Newton's method
+/// on the law itself fails, docs/model.md §17): the force on one element moving at `u` (m/s) as
+/// the gradient of its dissipation
+/// potential (docs/model.md §16-§17): `F = -weight * grad sigma(u)` with
+/// `sigma(u) = (sqrt(|u|^2 + eps^2) - eps) d(u / |u|)` and `d(e) = -S(e).e >= 0` the
+/// resistive-force stress's own dissipation per unit speed in direction `e` (`S` the passive
+/// stress per unit depth). Far above the creep speed `eps` the force opposes the motion with
+/// exactly resistive force theory's component along it, `d`, and has `-d'` across it (the
+/// associated flow rule); at rest it is smoothed over `eps`. Returns the force, the potential
+/// `weight * sigma` and its Hessian `weight * Hess sigma` with negative curvature clamped to
+/// zero (for the minimisation's Newton steps).
+#[inline(always)]
+pub(crate) fn associated_force(
+    rft: &Rft,
+    c: &Contact,
+    u: [f64; 2],
+    eps: f64,
+) -> ([f64; 2], f64, [[f64; 2]; 2]) {
+    let (tx, tz) = (c.tangent[0], c.tangent[1]);
+    let s = (u[0] * u[0] + u[1] * u[1]).sqrt();
+    // The direction (any at rest: the Hessian at u = 0 is then isotropic, d / eps).
+    let e = if s > 1e-300 { [u[0] / s, u[1] / s] } else { [1.0, 0.0] };
+    let n = [-e[1], e[0]];
+    let dissipation = |ex: f64, ez: f64| {
+        let (sx, sz) = rft.passive_stress(tx, tz, ex, ez);
+        -(sx * ex + sz * ez)
+    };
+    const DELTA: f64 = 1e-4;
+    let (sd, cd) = (DELTA.sin(), DELTA.cos());
+    let d0 = dissipation(e[0], e[1]);
+    let dp = dissipation(e[0] * cd - e[1] * sd, e[0] * sd + e[1] * cd);
+    let dm = dissipation(e[0] * cd + e[1] * sd, -e[0] * sd + e[1] * cd);
+    let d1 = (dp - dm) / (2.0 * DELTA);
+    let d2 = (dp - 2.0 * d0 + dm) / (DELTA * DELTA);
+    let rho = (s * s + eps * eps).sqrt();
+    let g = rho - eps;
+    let g1 = s / rho;
+    let g2 = eps * eps / (rho * rho * rho);
+    // g / s and g / s^2 without 0 / 0 at rest: g = s^2 / (rho + eps).
+    let g_s = s / (rho + eps);
+    let g_ss = 1.0 / (rho + eps);
+    let w = c.weight;
+    let force = [-w * (g1 * d0 * e[0] + g_s * d1 * n[0]), -w * (g1 * d0 * e[1] + g_s * d1 * n[1])];
+    // Hessian in the (e, n) frame: [[g'' d, g' d'/s - g d'/s^2], [., g' d/s + g d''/s^2]].
+    let ee = g2 * d0;
+    let g1_s = 1.0 / rho; // g' / s
+    let nn = g1_s * d0 + g_ss * d2;
+    let en = (g1_s - g_ss) * d1;
+    // Clamp to positive semidefinite (eigenvalues of the symmetric 2 x 2 below zero to zero).
+    let (mean, diff) = (0.5 * (ee + nn), 0.5 * (ee - nn));
+    let rad = (diff * diff + en * en).sqrt();
+    let (l1, l2) = (mean + rad, (mean - rad).max(0.0));
+    let (ee, nn, en) = if mean - rad >= 0.0 {
+        (ee, nn, en)
+    } else if rad > 0.0 {
+        // Keep only the positive eigenvalue's projector: l1 v v^T.
+        let (vx, vy) = if diff >= 0.0 { (diff + rad, en) } else { (en, rad - diff) };
+        let norm = vx * vx + vy * vy;
+        if norm > 0.0 {
+            (l1 * vx * vx / norm + l2, l1 * vy * vy / norm + l2, l1 * vx * vy / norm)
+        } else {
+            (l1.max(0.0), l1.max(0.0), 0.0)
+        }
+    } else {
+        (0.0, 0.0, 0.0)
+    };
+    // Back to x-z: H = ee e e^T + nn n n^T + en (e n^T + n e^T), times the weight.
+    let mut hess = [[0.0; 2]; 2];
+    for i in 0..2 {
+        for j in 0..2 {
+            hess[i][j] = w * (ee * e[i] * e[j] + nn * n[i] * n[j] + en * (e[i] * n[j] + n[i] * e[j]));
+        }
     }
+    (force, w * g * d0, hess)
+}
+
+/// The sand's force on one element moving at `u` (m/s), and its Jacobian `dF/du`
+/// (docs/model.md §16-§17): `F = weight * phi(|u| / eps) * S(u / |u|)`, where `S` is the
+/// passive resistive-force stress per unit depth in the direction of motion and
+/// `phi(r) = r / sqrt(1 + r^2)` smooths the set-valued law at rest over the creep speed `eps`.
+/// At `u = 0` the force is zero and the Jacobian isotropic.
+#[inline(always)]
+pub(crate) fn element_force(rft: &Rft, c: &Contact, u: [f64; 2], eps: f64) -> ([f64; 2], [[f64; 2]; 2]) {
+    let s = (u[0] * u[0] + u[1] * u[1]).sqrt();
+    let (tx, tz) = (c.tangent[0], c.tangent[1]);
+    if s <= 1e-300 {
+        let k = c.weight * rft.scale_n() / eps;
+        return ([0.0; 2], [[-k, 0.0], [0.0, -k]]);
+    }
+    let e = [u[0] / s, u[1] / s];
+    let st = rft.passive_stress(tx, tz, e[0], e[1]);
+    let r = s / eps;
+    let root = (1.0 + r * r).sqrt();
+    let phi = r / root;
+    let force = [c.weight * phi * st.0, c.weight * phi * st.1];
+    // dS/d(angle of e) by central differences; de/d(angle) = n = (-e_z, e_x).
+    const DELTA: f64 = 1e-5;
+    let (sd, cd) = (DELTA.sin(), DELTA.cos());
+    let sp = rft.passive_stress(tx, tz, e[0] * cd - e[1] * sd, e[0] * sd + e[1] * cd);
+    let sm = rft.passive_stress(tx, tz, e[0] * cd + e[1] * sd, -e[0] * sd + e[1] * cd);
+    let ds = [(sp.0 - sm.0) / (2.0 * DELTA), (sp.1 - sm.1) / (2.0 * DELTA)];
+    let n = [-e[1], e[0]];
+    // d phi / du = phi'(r) / eps e with phi'(r) = 1 / root^3; d e / du = n n^T / s.
+    let radial = c.weight / (eps * root * root * root);
+    let tangential = c.weight * phi / s;
+    let stress = [st.0, st.1];
+    let mut jac = [[0.0; 2]; 2];
+    for (row, (si, dsi)) in jac.iter_mut().zip(stress.iter().zip(ds)) {
+        row[0] = radial * si * e[0] + tangential * dsi * n[0];
+        row[1] = radial * si * e[1] + tangential * dsi * n[1];
+    }
+    (force, jac)
 }

@@ -1,14 +1,18 @@
-//! The equations of motion and the fixed-step integrator (docs/model.md §17).
+//! The equations of motion and the time stepping (docs/model.md §17).
 //!
-//! State: centre of mass `(x, z)` in the slope frame, pitch `phi`, their rates, each leg's
-//! angle, and each resistive-force element's elastic slip. Gravity has both components,
-//! `(-g sin theta, -g cos theta)`. Legs are massless and follow their servo; the sand forces on
-//! them act on the body. One step is linearly implicit Euler:
-//! `(M + dt C + dt^2 K)(v1 - v0) = dt (Q(q0, v0) - dt K v0)`, `q1 = q0 + dt v1`, with `C` the
-//! velocity and `K` the position Jacobian of the sand forces (depth gain), so the stiff contact
-//! neither rings nor blows up at bead-bed stiffness.
+//! State: centre of mass `(x, z)` in the slope frame, pitch `phi`, their rates and each leg's
+//! angle. Gravity has both components, `(-g sin theta, -g cos theta)`. Legs are massless and
+//! follow their servo; the sand forces on them act on the body. Resistive force theory is
+//! rate-independent (the stress follows the direction of an element's motion, not its speed),
+//! so it is stepped like Coulomb friction in Moreau-Jean time stepping: each step holds the
+//! geometry of the submerged elements at the start of the step and solves implicitly for the
+//! velocity at its end,
+//! `M (v1 - v0) = h (M g + sum_i J_i^T F_i(J_i v1 + w_i))`, then `q1 = q0 + h v1`, with
+//! every element's force taken at its own new velocity (Newton's method on the 3 body rates).
+//! The force never has a component along the element's motion, so with the legs held the step
+//! cannot create energy whatever `h` (docs/model.md §17 proves it; a test checks it).
 
-use super::body::{assemble, element_force, leg_nodes, Assembly, BodyPitch, Element, Memory, Touch};
+use super::body::{associated_force, element_force, leg_nodes, submerged, BodyPitch, Contact, BELLY};
 use super::rft::Rft;
 use super::{Geometry, SimSettings, Trajectory};
 use crate::model::G;
@@ -20,6 +24,11 @@ use std::f64::consts::PI;
 const BELLY_ELEMENTS: usize = 8;
 /// A servo that lags its command catches up at this rate, 1/s, up to 1.5 omega.
 const CATCH_UP_PER_S: f64 = 20.0;
+/// Most Newton iterations of one velocity step.
+const MAX_NEWTON: usize = 30;
+/// Newton's method has converged when no body rate changes by more than this fraction of
+/// the creep speed (a velocity error far below the creep the smoothing itself allows).
+const NEWTON_TOL: f64 = 1e-3;
 
 /// Per-step (per tripod stance) peaks.
 #[derive(Debug, Clone, Copy, Default)]
@@ -42,9 +51,11 @@ pub(crate) struct Run {
     pub max_abs_pitch: f64,
     /// First time |pitch| exceeded [`super::PITCH_OVER_RAD`], s.
     pub pitch_over_s: Option<f64>,
+    /// Steps whose Newton iteration stopped at its limit before converging.
+    pub unconverged_steps: usize,
 }
 
-/// Per-leg outputs of one force evaluation.
+/// Per-leg outputs of one step.
 #[derive(Debug, Clone, Copy, Default)]
 struct LegOut {
     force: [f64; 2],
@@ -64,7 +75,8 @@ pub(crate) struct Walker {
     width: f64,
     belly_width: f64,
     torque_limit: Option<f64>,
-    yield_m: f64,
+    /// Creep speed of the smoothed set-valued law, m/s (docs/model.md §17).
+    eps: f64,
     dt: f64,
     locked: Option<f64>,
     /// The body's pitch is held at zero (§15, `BodyPitch::Locked`).
@@ -78,17 +90,18 @@ pub(crate) struct Walker {
     q: [f64; 3],
     v: [f64; 3],
     psi: Vec<f64>,
-    memory: Vec<Memory>,
-    touching: Vec<bool>,
-    touches: Vec<Touch>,
+    /// The submerged elements of this step.
+    contacts: Vec<Contact>,
+    /// Their forces at the solved velocity.
+    forces: Vec<[f64; 2]>,
+    /// Each leg's rate this step (rad/s).
+    rates: Vec<f64>,
     /// Scratch: the current leg's node heights.
     heights: Vec<f64>,
     /// The leg nodes turned to `turned_angle` (relative to the hip), kept for the next leg.
     turned: Vec<[f64; 2]>,
     /// The bits of the angle `turned` is for (`None`: none yet).
     turned_angle: Option<u64>,
-    /// The elements that touched the sand in the last step.
-    prev_slots: Vec<usize>,
     /// Per leg, the angle relative to the body and the lowest node's height relative to the
     /// hip when its nodes were last placed (NaN: never).
     leg_ref: Vec<(f64, f64)>,
@@ -98,6 +111,7 @@ pub(crate) struct Walker {
     stalled: Vec<bool>,
     time: f64,
     gravity_scale: f64,
+    unconverged: usize,
 }
 
 impl Walker {
@@ -130,8 +144,8 @@ impl Walker {
             psi0: robot.touchdown_angle(),
             width: robot.leg_width(),
             belly_width: robot.body_width(),
-            torque_limit: robot.servo_torque_limit(),
-            yield_m: settings.yield_m,
+            torque_limit: if settings.servo_limit { robot.servo_torque_limit() } else { None },
+            eps: settings.creep_m_s,
             dt,
             locked: settings.locked_leg_angle,
             pitch_locked: settings.body_pitch == BodyPitch::Locked,
@@ -144,19 +158,19 @@ impl Walker {
             q: [0.0; 3],
             v: [0.0; 3],
             psi: vec![0.0; legs],
-            memory: vec![[0.0; 2]; slots],
-            touching: vec![false; slots],
-            touches: Vec::with_capacity(slots),
+            contacts: Vec::with_capacity(slots),
+            forces: Vec::with_capacity(slots),
+            rates: vec![0.0; legs],
             heights: Vec::with_capacity(elements + 1),
             turned: Vec::with_capacity(elements + 1),
             turned_angle: None,
-            prev_slots: Vec::with_capacity(slots),
             leg_ref: vec![(f64::NAN, f64::NAN); legs],
             reach: 0.0,
             legs_out: vec![LegOut::default(); legs],
             stalled: vec![false; legs],
             time: 0.0,
             gravity_scale: 1.0,
+            unconverged: 0,
         };
         w.reach = w.nodes.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) * (1.0 + 1e-9);
         for j in 0..legs {
@@ -197,26 +211,11 @@ impl Walker {
         self.v = [0.0, 0.0, 0.0];
     }
 
-    /// World position of body point `p` (body frame) and of the centre of mass offset.
-    #[inline]
-    fn rot(&self, c: f64, s: f64, p: [f64; 2]) -> [f64; 2] {
-        [c * p[0] - s * p[1], s * p[0] + c * p[1]]
-    }
-
-    /// Sand forces on leg `j` at angle `psi` turning at `rate`, assembled into `asm`; records
-    /// touching elements when `record`.
-    /// `pitch_sc`: the body pitch's `(sin, cos)`, computed once per step by the caller.
-    fn leg_forces(
-        &mut self,
-        j: usize,
-        psi: f64,
-        rate: f64,
-        pitch_sc: (f64, f64),
-        asm: &mut Assembly,
-        record: bool,
-    ) -> LegOut {
+    /// Records the submerged elements of leg `j` at angle `psi` (body pitch `(sin, cos)`
+    /// `pitch_sc`, computed once per step by the caller) in `contacts`; returns the leg's depth.
+    fn leg_contacts(&mut self, j: usize, psi: f64, pitch_sc: (f64, f64)) {
         let (sp, cp) = pitch_sc;
-        let hip_rel = self.rot(cp, sp, [self.hips[j], 0.0]);
+        let hip_rel = [cp * self.hips[j], sp * self.hips[j]];
         let hip = [self.q[0] + hip_rel[0], self.q[1] + hip_rel[1]];
         let angle = self.q[2] - psi;
         let elements = self.nodes.len() - 1;
@@ -224,20 +223,15 @@ impl Walker {
         // above it now: a node's height changes by at most `reach` per radian the leg turns
         // relative to the body, plus the hip's own rise or fall. The test leaves a margin of
         // 1e-12 m, far above the nodes' round-off, so it skips a leg only when the full test
-        // below would have found every node above the surface: the same forces, bit for bit,
-        // without the leg's sine and cosine and node placement (perf: `sincos` was 9% and the
-        // nodes a quarter of the step).
+        // below would have found every node above the surface (perf: half the legs are in
+        // swing at any time).
         let (ref_angle, ref_low) = self.leg_ref[j];
         if hip[1] + ref_low - self.reach * (angle - ref_angle).abs() > 1e-12 {
-            if record {
-                self.touching[j * elements..(j + 1) * elements].fill(false);
-            }
-            return LegOut::default();
+            return;
         }
         // The nodes turned to the leg's angle. The legs of a tripod turn together (the same psi,
         // bit for bit, unless a servo stalls), so the legs after the first of a tripod find
-        // their angle's nodes already turned: the same numbers without their sine, cosine and
-        // rotations (perf: `sincos` was 5% of the walk).
+        // their angle's nodes already turned.
         let mut turned = std::mem::take(&mut self.turned);
         if self.turned_angle != Some(angle.to_bits()) {
             let (sa, ca) = angle.sin_cos();
@@ -245,212 +239,304 @@ impl Walker {
             turned.extend(self.nodes.iter().map(|p| [ca * p[0] - sa * p[1], sa * p[0] + ca * p[1]]));
             self.turned_angle = Some(angle.to_bits());
         }
-        let (q, v) = (self.q, self.v);
-        let point = |r: [f64; 2]| {
-            let rel = [hip_rel[0] + r[0], hip_rel[1] + r[1]];
-            // v = V + w J rel - rate J (r - hip), J(a, b) = (-b, a).
-            let vel = [v[0] - v[2] * rel[1] + rate * r[1], v[1] + v[2] * rel[0] - rate * r[0]];
-            ([hip[0] + r[0], hip[1] + r[1]], rel, vel)
-        };
-        let _ = q;
-        let mut out = LegOut::default();
-        // Each node's height, computed exactly as `point` computes it. A leg wholly above the
-        // surface feels nothing (every element would return `None`); half the legs are in swing
-        // at any time. Within a leg in the sand, an element with both nodes above the surface
-        // is skipped the same way, before its nodes' velocities are formed (perf: the node
-        // transforms were a quarter of the step).
         let mut heights = std::mem::take(&mut self.heights);
         heights.clear();
         heights.extend(turned.iter().map(|r| hip[1] + r[1]));
-        // The reference for the swing test above: the lowest node relative to the hip now.
-        // (From the heights: within round-off of the exact value, far inside the 1e-12 margin.)
         let low = heights.iter().fold(f64::INFINITY, |a, &z| a.min(z)) - hip[1];
         self.leg_ref[j] = (angle, low);
-        if heights.iter().all(|&z| z >= 0.0) {
-            if record {
-                self.touching[j * elements..(j + 1) * elements].fill(false);
-            }
-            self.heights = heights;
-            self.turned = turned;
-            return out;
-        }
-        // The last node transformed, shared by consecutive submerged elements.
-        let mut last: Option<(usize, [f64; 2], [f64; 2])> = None;
-        for k in 0..elements {
-            let slot = j * elements + k;
-            if heights[k] >= 0.0 && heights[k + 1] >= 0.0 {
-                if record {
-                    self.touching[slot] = false;
+        if heights.iter().any(|&z| z < 0.0) {
+            for k in 0..elements {
+                if heights[k] >= 0.0 && heights[k + 1] >= 0.0 {
+                    continue;
                 }
-                continue;
-            }
-            let (pa, va) = match last {
-                Some((i, p, v)) if i == k => (p, v),
-                _ => {
-                    let (p, _, v) = point(turned[k]);
-                    (p, v)
+                let a = [hip[0] + turned[k][0], heights[k]];
+                let b = [hip[0] + turned[k + 1][0], heights[k + 1]];
+                if let Some((weight, point, tangent, depth)) = submerged(a, b, self.width) {
+                    self.contacts.push(Contact {
+                        weight,
+                        tangent,
+                        rel: [point[0] - self.q[0], point[1] - self.q[1]],
+                        arm: [point[0] - hip[0], point[1] - hip[1]],
+                        leg: j,
+                        depth,
+                    });
                 }
-            };
-            let (pb, _, vb) = point(turned[k + 1]);
-            last = Some((k + 1, pb, vb));
-            let el = Element { a: pa, b: pb, va, vb, w: self.width };
-            match element_force(&self.rft, &el, self.memory[slot], self.yield_m, self.dt) {
-                Some(f) => {
-                    let rel = [f.point[0] - self.q[0], f.point[1] - self.q[1]];
-                    assemble(asm, &f, rel);
-                    out.force[0] += f.force[0];
-                    out.force[1] += f.force[1];
-                    out.torque += (f.point[0] - hip[0]) * f.force[1] - (f.point[1] - hip[1]) * f.force[0];
-                    out.depth = out.depth.max(f.depth);
-                    if record {
-                        self.touches.push(Touch { slot, rel, vel: f.vel });
-                        self.touching[slot] = true;
-                    }
-                }
-                None if record => self.touching[slot] = false,
-                None => {}
             }
         }
         self.heights = heights;
         self.turned = turned;
-        out
     }
 
-    /// The belly's sand forces.
-    /// `pitch_sc`: the body pitch's `(sin, cos)`, computed once per step by the caller.
-    fn belly_forces(&mut self, asm: &mut Assembly, pitch_sc: (f64, f64)) {
+    /// Records the belly's submerged elements.
+    fn belly_contacts(&mut self, pitch_sc: (f64, f64)) {
         let (sp, cp) = pitch_sc;
-        let (q, v) = (self.q, self.v);
-        let base = self.memory.len() - BELLY_ELEMENTS;
-        let point = |p: [f64; 2]| {
-            let rel = [cp * p[0] - sp * p[1], sp * p[0] + cp * p[1]];
-            ([q[0] + rel[0], q[1] + rel[1]], [v[0] - v[2] * rel[1], v[1] + v[2] * rel[0]])
-        };
-        // The belly is a straight plate: its lowest point is one of its ends. With both ends
-        // more than 1e-12 m above the surface (far above the nodes' round-off) every node is
-        // above it, and every element would feel nothing: skipped, the same forces bit for bit
-        // (perf: the belly is out of the sand most of a walk, and its eight elements were
-        // placed every step).
+        let q = self.q;
+        let point = |p: [f64; 2]| [q[0] + cp * p[0] - sp * p[1], q[1] + sp * p[0] + cp * p[1]];
+        // The belly is a straight plate: its lowest point is one of its ends.
         let end_height = |p: [f64; 2]| q[1] + (sp * p[0] + cp * p[1]);
         if end_height(self.belly[0]).min(end_height(self.belly[BELLY_ELEMENTS])) > 1e-12 {
-            self.touching[base..].fill(false);
             return;
         }
         for k in 0..BELLY_ELEMENTS {
-            let (a, va) = point(self.belly[k]);
-            let (b, vb) = point(self.belly[k + 1]);
-            let slot = base + k;
-            let el = Element { a, b, va, vb, w: self.belly_width };
-            match element_force(&self.rft, &el, self.memory[slot], self.yield_m, self.dt) {
-                Some(f) => {
-                    let rel = [f.point[0] - self.q[0], f.point[1] - self.q[1]];
-                    assemble(asm, &f, rel);
-                    self.touches.push(Touch { slot, rel, vel: f.vel });
-                    self.touching[slot] = true;
-                }
-                None => self.touching[slot] = false,
+            let (a, b) = (point(self.belly[k]), point(self.belly[k + 1]));
+            if let Some((weight, p, tangent, depth)) = submerged(a, b, self.belly_width) {
+                self.contacts.push(Contact {
+                    weight,
+                    tangent,
+                    rel: [p[0] - q[0], p[1] - q[1]],
+                    arm: [0.0; 2],
+                    leg: BELLY,
+                    depth,
+                });
             }
         }
     }
 
-    /// One integration step; `gait`: legs follow the gait (else held).
+    /// Element `c`'s velocity when the body moves at `v`: `J v + w`, with the leg's own
+    /// rotation at `rate` (clockwise positive) about the hip.
+    #[inline(always)]
+    fn element_velocity(c: &Contact, v: [f64; 3], rate: f64) -> [f64; 2] {
+        [v[0] - v[2] * c.rel[1] + rate * c.arm[1], v[1] + v[2] * c.rel[0] - rate * c.arm[0]]
+    }
+
+    /// The implicit velocity step (docs/model.md §17): the body rates `v1` with
+    /// `G(v1) = M (v1 - v_free) - h sum_i J_i^T F_i(J_i v1 + w_i) = 0`, by Newton's method
+    /// from the last step's rates with a backtracking line search on `|G|^2_{M^-1}`. Where that
+    /// fails, the associated law's solution (a convex minimisation, always solvable) is the
+    /// start of a second attempt; where that fails too, the iterate with the smallest residual
+    /// is kept and the step counted. The forces are left in `self.forces`.
+    fn solve(&mut self, v_free: [f64; 3], m: [f64; 3]) -> bool {
+        let mut v = self.v;
+        if self.pitch_locked {
+            v[2] = 0.0;
+        }
+        let (first, ok, r1) = self.newton(v, v_free, m, false);
+        if ok {
+            return self.finish(first, v_free, m, true);
+        }
+        let (start, _, _) = self.newton(v, v_free, m, true);
+        let (second, ok, r2) = self.newton(start, v_free, m, false);
+        let best = if ok || r2 <= r1 { second } else { first };
+        self.finish(best, v_free, m, ok)
+    }
+
+    /// Takes `v` as the step's rates (leaving its forces in `self.forces`).
+    fn finish(&mut self, v: [f64; 3], v_free: [f64; 3], m: [f64; 3], ok: bool) -> bool {
+        let _ = self.evaluate(v, v_free, m, None, false);
+        self.v = v;
+        ok
+    }
+
+    /// Newton's method from `v` on the law itself (`associated`: false; line search on
+    /// `|G|^2_{M^-1}`) or on the associated law (line search on its potential `Phi`): the last
+    /// iterate, whether it converged (a Newton step below [`NEWTON_TOL`] times the creep
+    /// speed) and the smallest merit seen.
+    fn newton(
+        &mut self,
+        mut v: [f64; 3],
+        v_free: [f64; 3],
+        m: [f64; 3],
+        associated: bool,
+    ) -> ([f64; 3], bool, f64) {
+        let dofs = if self.pitch_locked { 2 } else { 3 };
+        let merit = |r: &[f64; 3]| (0..dofs).map(|i| r[i] * r[i] / m[i]).sum::<f64>();
+        let value = |phi: f64, r: &[f64; 3]| if associated { phi } else { merit(r) };
+        let tol = NEWTON_TOL * self.eps;
+        let mut jac = [[0.0; 3]; 3];
+        let (phi, mut grad) = self.evaluate(v, v_free, m, Some(&mut jac), associated);
+        let mut f0 = value(phi, &grad);
+        let (mut best, mut best_merit) = (v, merit(&grad));
+        for _ in 0..MAX_NEWTON {
+            let delta = solve_dofs(&jac, &grad, dofs);
+            let size = (0..dofs).map(|i| delta[i].abs()).fold(0.0, f64::max);
+            if size < tol {
+                return (v, true, merit(&grad));
+            }
+            // The decrease a full step promises (Phi: G.delta; |G|^2: 2 |G|^2).
+            let slope =
+                if associated { (0..dofs).map(|i| grad[i] * delta[i]).sum::<f64>() } else { 2.0 * f0 };
+            let mut lambda = 1.0;
+            let mut accepted = false;
+            for _ in 0..40 {
+                let mut trial = v;
+                for i in 0..dofs {
+                    trial[i] -= lambda * delta[i];
+                }
+                let (pt, rt) = self.evaluate(trial, v_free, m, None, associated);
+                let ft = value(pt, &rt);
+                if ft <= f0 - 1e-4 * lambda * slope.max(0.0) {
+                    v = trial;
+                    accepted = true;
+                    break;
+                }
+                lambda *= 0.5;
+            }
+            if !accepted {
+                return (best, false, best_merit);
+            }
+            let (phi, g) = self.evaluate(v, v_free, m, Some(&mut jac), associated);
+            grad = g;
+            f0 = value(phi, &grad);
+            let mr = merit(&grad);
+            if mr < best_merit {
+                (best, best_merit) = (v, mr);
+            }
+        }
+        (best, false, best_merit)
+    }
+
+    /// The step's gradient `G(v) = M (v - v_free) - h sum_i J_i^T F_i` under the law
+    /// (`associated`: its associated stand-in, with the potential `Phi(v)` as well) and, when
+    /// asked, its Jacobian `M - h sum_i J_i^T dF_i/du J_i`; the forces are left in `forces`.
+    fn evaluate(
+        &mut self,
+        v: [f64; 3],
+        v_free: [f64; 3],
+        m: [f64; 3],
+        jac: Option<&mut [[f64; 3]; 3]>,
+        associated: bool,
+    ) -> (f64, [f64; 3]) {
+        let h = self.dt;
+        let (contacts, forces, rates, rft, eps) =
+            (&self.contacts, &mut self.forces, &self.rates, &self.rft, self.eps);
+        let mut g = [0.0; 3];
+        let mut k = [[0.0; 3]; 3];
+        let mut potential = 0.0;
+        let want = jac.is_some();
+        forces.clear();
+        for c in contacts {
+            let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
+            let u = Walker::element_velocity(c, v, rate);
+            let (f, d) = if associated {
+                let (f, p, hess) = associated_force(rft, c, u, eps);
+                potential += p;
+                (f, [[-hess[0][0], -hess[0][1]], [-hess[1][0], -hess[1][1]]])
+            } else {
+                element_force(rft, c, u, eps)
+            };
+            forces.push(f);
+            let (rx, rz) = (c.rel[0], c.rel[1]);
+            g[0] += f[0];
+            g[1] += f[1];
+            g[2] += rx * f[1] - rz * f[0];
+            if want {
+                // J = [[1, 0, -rz], [0, 1, rx]]; K += J^T D J.
+                let dj = [
+                    [d[0][0], d[0][1], -rz * d[0][0] + rx * d[0][1]],
+                    [d[1][0], d[1][1], -rz * d[1][0] + rx * d[1][1]],
+                ];
+                for col in 0..3 {
+                    k[0][col] += dj[0][col];
+                    k[1][col] += dj[1][col];
+                    k[2][col] += -rz * dj[0][col] + rx * dj[1][col];
+                }
+            }
+        }
+        let mut r = [0.0; 3];
+        let mut phi = h * potential;
+        for i in 0..3 {
+            r[i] = m[i] * (v[i] - v_free[i]) - h * g[i];
+            phi += 0.5 * m[i] * (v[i] - v_free[i]).powi(2);
+        }
+        if let Some(jac) = jac {
+            for i in 0..3 {
+                for col in 0..3 {
+                    jac[i][col] = -h * k[i][col];
+                }
+                jac[i][i] += m[i];
+            }
+        }
+        (phi, r)
+    }
+
+    /// One time step; `gait`: legs follow the gait (else held).
     fn step(&mut self, gait: bool) {
         let dt = self.dt;
-        self.touches.clear();
-        let mut asm = Assembly::default();
         let legs = self.psi.len();
         let pitch_sc = self.q[2].sin_cos();
+        self.contacts.clear();
         for j in 0..legs {
-            let (psi, rate) = if gait {
+            let psi = self.psi[j];
+            self.leg_contacts(j, psi, pitch_sc);
+        }
+        self.belly_contacts(pitch_sc);
+        for j in 0..legs {
+            self.stalled[j] = false;
+            self.rates[j] = if gait {
                 let cmd = self.command(j, self.time);
-                let desired = if self.locked.is_some() {
+                if self.locked.is_some() {
                     0.0
                 } else if self.torque_limit.is_some() {
                     (self.omega + (cmd - self.psi[j]) * CATCH_UP_PER_S).clamp(0.0, 1.5 * self.omega)
                 } else {
                     self.omega
-                };
-                (self.psi[j], desired)
-            } else {
-                (self.psi[j], 0.0)
-            };
-            self.stalled[j] = false;
-            let out = match self.torque_limit {
-                // An ideal servo: the leg's forces go straight into the assembly.
-                None => self.leg_forces(j, psi, rate, pitch_sc, &mut asm, true),
-                Some(limit) => {
-                    let mut trial = asm;
-                    let start = self.touches.len();
-                    let mut out = self.leg_forces(j, psi, rate, pitch_sc, &mut trial, true);
-                    // The sand's torque about the hip resists the rotation when positive (the
-                    // leg turns clockwise); beyond the limit the servo stalls and holds its angle.
-                    if rate > 0.0 && out.torque > limit {
-                        self.touches.truncate(start);
-                        trial = asm;
-                        out = self.leg_forces(j, psi, 0.0, pitch_sc, &mut trial, true);
-                        self.stalled[j] = true;
-                    }
-                    asm = trial;
-                    out
                 }
+            } else {
+                0.0
             };
-            self.legs_out[j] = out;
-            let used = if self.stalled[j] { 0.0 } else { rate };
-            if gait {
-                self.psi[j] = psi + used * dt;
-            }
         }
-        self.belly_forces(&mut asm, pitch_sc);
-        // Gravity.
-        asm.q[0] += self.mass * self.gx * self.gravity_scale;
-        asm.q[1] += self.mass * self.gz * self.gravity_scale;
-        // (M + dt C + dt^2 K) dv = dt (Q - dt K v)
         let m = [self.mass, self.mass, self.inertia];
-        let mut a = [[0.0; 3]; 3];
-        let mut rhs = [0.0; 3];
-        for i in 0..3 {
-            let kv: f64 = asm.k[i].iter().zip(&self.v).map(|(k, v)| k * v).sum();
-            for (aik, (c, k)) in a[i].iter_mut().zip(asm.c[i].iter().zip(&asm.k[i])) {
-                *aik = dt * c + dt * dt * k;
-            }
-            a[i][i] += m[i];
-            rhs[i] = dt * (asm.q[i] - dt * kv);
-        }
-        if self.pitch_locked {
-            // The constraint phi = 0 carries the pitch moment: the third equation becomes
-            // dv_phi = 0 (the pitch rate stays at its initial zero).
-            a[2] = [0.0, 0.0, 1.0];
-            rhs[2] = 0.0;
-        }
-        let dv = solve3(a, rhs);
-        for ((v, q), d) in self.v.iter_mut().zip(self.q.iter_mut()).zip(dv) {
-            *v += d;
-            *q += dt * *v;
-        }
-        // Memory: each touching element's slip grows by its new velocity, capped at yield.
-        let y = self.yield_m;
-        for t in &self.touches {
-            let vel = [t.vel[0] + dv[0] - dv[2] * t.rel[1], t.vel[1] + dv[1] + dv[2] * t.rel[0]];
-            let e = &mut self.memory[t.slot];
-            e[0] += dt * vel[0];
-            e[1] += dt * vel[1];
-            let n = (e[0] * e[0] + e[1] * e[1]).sqrt();
-            if n > y {
-                e[0] *= y / n;
-                e[1] *= y / n;
+        let gs = self.gravity_scale;
+        let v_free = [self.v[0] + dt * self.gx * gs, self.v[1] + dt * self.gz * gs, self.v[2]];
+        let v0 = self.v;
+        let mut converged = self.solve(v_free, m);
+        // A torque-limited servo whose leg the sand resists by more than its limit at the solved
+        // motion stalls for the step (holds its angle); the step is solved again without it.
+        if let Some(limit) = self.torque_limit {
+            for _ in 0..legs {
+                self.leg_outputs();
+                let mut more = false;
+                for j in 0..legs {
+                    if self.rates[j] > 0.0 && self.legs_out[j].torque > limit {
+                        self.rates[j] = 0.0;
+                        self.stalled[j] = true;
+                        more = true;
+                    }
+                }
+                if !more {
+                    break;
+                }
+                self.v = v0;
+                converged = self.solve(v_free, m);
             }
         }
-        // An element that left the sand forgets its slip. Only an element that touched in the
-        // last step can hold one (every other was zeroed when it left), so only those are
-        // looked at (perf: the loop over every element was a tenth of the step).
-        for &slot in &self.prev_slots {
-            if !self.touching[slot] {
-                self.memory[slot] = [0.0; 2];
+        if !converged {
+            self.unconverged += 1;
+        }
+        self.leg_outputs();
+        for (q, v) in self.q.iter_mut().zip(self.v) {
+            *q += dt * v;
+        }
+        if gait {
+            for (psi, rate) in self.psi.iter_mut().zip(&self.rates) {
+                *psi += rate * dt;
             }
         }
-        self.prev_slots.clear();
-        self.prev_slots.extend(self.touches.iter().map(|t| t.slot));
         self.time += dt;
+    }
+
+    /// Each leg's sand force, torque about its hip (positive: resisting the leg's clockwise
+    /// turn) and depth, from the solved forces.
+    fn leg_outputs(&mut self) {
+        self.legs_out.iter_mut().for_each(|o| *o = LegOut::default());
+        for (c, f) in self.contacts.iter().zip(&self.forces) {
+            if c.leg == BELLY {
+                continue;
+            }
+            let o = &mut self.legs_out[c.leg];
+            o.force[0] += f[0];
+            o.force[1] += f[1];
+            o.torque += c.arm[0] * f[1] - c.arm[1] * f[0];
+            o.depth = o.depth.max(c.depth);
+        }
+    }
+
+    /// Total mechanical energy, J: kinetic plus gravity's potential (tests).
+    #[cfg(test)]
+    pub(crate) fn energy(&self) -> f64 {
+        let kinetic = 0.5 * self.mass * (self.v[0].powi(2) + self.v[1].powi(2))
+            + 0.5 * self.inertia * self.v[2].powi(2);
+        kinetic - self.mass * (self.gx * self.q[0] + self.gz * self.q[1])
     }
 
     /// Walks `n_steps` integration steps from t = 0, recording the full-rate along-slope
@@ -477,6 +563,7 @@ impl Walker {
             leg_torque_n_m: vec![Vec::with_capacity(samples); legs],
         };
         let mut next_sample = 0usize;
+        self.unconverged = 0;
         let mut prev = (self.q, self.v, 0.0);
         let mut max_abs_pitch = self.q[2].abs();
         let mut pitch_over_s = None;
@@ -545,7 +632,17 @@ impl Walker {
             body_length_m: self.body_length,
             hip_height_m: self.hip_height,
         };
-        Run { x, vx, trajectory: tr, geometry, per_step, stalled_by_step, max_abs_pitch, pitch_over_s }
+        Run {
+            x,
+            vx,
+            trajectory: tr,
+            geometry,
+            per_step,
+            stalled_by_step,
+            max_abs_pitch,
+            pitch_over_s,
+            unconverged_steps: self.unconverged,
+        }
     }
 
     /// Current state `(x, z, pitch)` and rates (tests).
@@ -569,21 +666,33 @@ impl Walker {
     }
 }
 
-/// Solves the 3x3 system `a x = b` by Cramer's rule (the matrix is the mass matrix plus
-/// small positive terms, so it is well conditioned).
-fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
-    let det = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(&a);
-    let mut x = [0.0; 3];
-    for (c, xc) in x.iter_mut().enumerate() {
-        let mut m = a;
-        for r in 0..3 {
-            m[r][c] = b[r];
+/// Solves the first `dofs` rows and columns of `a x = b` (Gaussian elimination with partial
+/// pivoting; `dofs` is 2 or 3), the rest of `x` zero.
+fn solve_dofs(a: &[[f64; 3]; 3], b: &[f64; 3], dofs: usize) -> [f64; 3] {
+    let mut m = [[0.0; 4]; 3];
+    for i in 0..dofs {
+        m[i][..dofs].copy_from_slice(&a[i][..dofs]);
+        m[i][3] = b[i];
+    }
+    for col in 0..dofs {
+        let p = (col..dofs).max_by(|&x, &y| m[x][col].abs().total_cmp(&m[y][col].abs())).unwrap_or(col);
+        m.swap(col, p);
+        let piv = m[col][col];
+        if piv == 0.0 || !piv.is_finite() {
+            return [0.0; 3];
         }
-        *xc = det(&m) / d;
+        let pivot_row = m[col];
+        for row in m.iter_mut().take(dofs).skip(col + 1) {
+            let f = row[col] / piv;
+            for (x, p) in row.iter_mut().zip(pivot_row).skip(col) {
+                *x -= f * p;
+            }
+        }
+    }
+    let mut x = [0.0; 3];
+    for i in (0..dofs).rev() {
+        let s: f64 = (i + 1..dofs).map(|k| m[i][k] * x[k]).sum();
+        x[i] = (m[i][3] - s) / m[i][i];
     }
     x
 }

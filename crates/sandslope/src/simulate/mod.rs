@@ -28,9 +28,12 @@ use crate::regime::{classify, Cause, Regime};
 use crate::scenario::{Scenario, SlopeEvaluation};
 use crate::slope::Slope;
 
-/// Default elastic slip at which the sand's stress reaches its resistive-force value, m
-/// (docs/model.md §16; a few bead diameters of the paper's 300 um beads).
-pub const DEFAULT_YIELD_M: f64 = 1e-3;
+/// Default creep speed of the set-valued resistive-force law's smoothing, m/s (docs/model.md
+/// §17): an element loaded below its resistive-force limit creeps at most this fast. A tenth of
+/// it moves no converged answer (a test on the built-in robot and terrain).
+pub const DEFAULT_CREEP_M_S: f64 = 1e-7;
+/// Smallest and largest creep speed a walk takes, m/s.
+pub const CREEP_RANGE_M_S: (f64, f64) = (1e-9, 1e-3);
 /// Default output sample rate, Hz (the paper's motion capture).
 pub const DEFAULT_SAMPLE_RATE_HZ: f64 = 120.0;
 /// Pitch beyond which the body has pitched over (tumbled), rad: 90 degrees, the body standing
@@ -54,8 +57,10 @@ pub struct SimSettings {
     pub dt_s: Option<f64>,
     /// Trajectory sample rate, Hz.
     pub sample_rate_hz: f64,
-    /// Elastic slip at which the stress reaches its resistive-force value, m.
-    pub yield_m: f64,
+    /// Creep speed of the smoothed set-valued contact law, m/s (docs/model.md §17).
+    pub creep_m_s: f64,
+    /// Whether the robot file's servo torque limit applies (default: yes, where it gives one).
+    pub servo_limit: bool,
     /// Settling time before the gait starts (gravity ramps in), s.
     pub settle_s: f64,
     /// Leg shape.
@@ -83,7 +88,8 @@ impl SimSettings {
             duration_s,
             dt_s: None,
             sample_rate_hz: DEFAULT_SAMPLE_RATE_HZ,
-            yield_m: DEFAULT_YIELD_M,
+            creep_m_s: DEFAULT_CREEP_M_S,
+            servo_limit: true,
             settle_s: DEFAULT_SETTLE_S,
             shape: LegShape::CLeg,
             locked_leg_angle: None,
@@ -105,12 +111,19 @@ impl SimSettings {
         Ok(SimSettings { sample_rate_hz: hz, ..self })
     }
 
-    /// The yield slip, m (1e-6 to 0.01).
-    pub fn with_yield(self, yield_m: f64) -> Result<SimSettings, ParamError> {
-        if !(yield_m.is_finite() && (1e-6..=1e-2).contains(&yield_m)) {
-            return Err(ParamError::new("yield_m", yield_m, "between 1e-6 and 0.01 m"));
+    /// The creep speed of the contact law's smoothing, m/s (1e-9 to 1e-3; docs/model.md §17).
+    pub fn with_creep(self, creep_m_s: f64) -> Result<SimSettings, ParamError> {
+        let (lo, hi) = CREEP_RANGE_M_S;
+        if !(creep_m_s.is_finite() && (lo..=hi).contains(&creep_m_s)) {
+            return Err(ParamError::new("creep_m_s", creep_m_s, format!("between {lo:e} and {hi:e} m/s")));
         }
-        Ok(SimSettings { yield_m, ..self })
+        Ok(SimSettings { creep_m_s, ..self })
+    }
+
+    /// Applies the robot file's servo torque limit (`true`, the default) or drives the legs
+    /// as ideal position servos whatever the file says (`false`).
+    pub fn with_servo_limit(self, servo_limit: bool) -> SimSettings {
+        SimSettings { servo_limit, ..self }
     }
 
     /// The settling time, s (0 to 60).
@@ -303,8 +316,12 @@ pub struct SimSummary {
     pub leg_elements: u32,
     /// Leg shape.
     pub shape: LegShape,
-    /// Elastic slip to full stress, m.
-    pub yield_m: f64,
+    /// Creep speed of the contact law's smoothing, m/s.
+    pub creep_m_s: f64,
+    /// The servo torque limit applied, N m (`None`: ideal position servos).
+    pub servo_torque_limit_n_m: Option<f64>,
+    /// Time steps whose implicit velocity solve stopped before converging (0 in a sound walk).
+    pub unconverged_steps: usize,
     /// Whether the body could pitch (`locked`: held parallel to the slope).
     pub body_pitch: BodyPitch,
     /// How resistive force theory was scaled to the terrain.
@@ -364,25 +381,24 @@ pub enum SimulateError {
     Param(#[from] ParamError),
 }
 
-/// The integration step for `scenario` at `slope`: the given one, checked, or the default
-/// `min(1 ms, 0.25 / omega_n, T / 200)` (docs/model.md §17).
-pub fn integration_step(scenario: &Scenario, slope: Slope, given: Option<f64>) -> Result<f64, ParamError> {
-    let robot = scenario.robot();
-    let (ground, _) = scenario.ground_at(slope);
-    let omega_n = (f64::from(robot.stance_legs()) * ground.k_n * robot.contact_area() / robot.mass()).sqrt();
-    let period = robot.stride_period();
-    let limit = (0.5 / omega_n).min(period / 100.0);
+/// The default time step as a fraction of the stride period T (docs/model.md §17).
+pub const DEFAULT_STEPS_PER_STRIDE: f64 = 2000.0;
+/// The coarsest time step a walk takes, as a fraction of T.
+pub const MIN_STEPS_PER_STRIDE: f64 = 100.0;
+
+/// The time step for `scenario`: the given one, checked, or the default `T / 2000`
+/// (docs/model.md §17). The contact sets no stability limit (the step is passive for any
+/// length); the limit `T / 100` is one of accuracy, a leg turning 3.6 degrees per step.
+pub fn integration_step(scenario: &Scenario, _slope: Slope, given: Option<f64>) -> Result<f64, ParamError> {
+    let period = scenario.robot().stride_period();
+    let limit = period / MIN_STEPS_PER_STRIDE;
     match given {
-        None => Ok(1e-3f64.min(0.25 / omega_n).min(period / 200.0)),
+        None => Ok(period / DEFAULT_STEPS_PER_STRIDE),
         Some(dt) if dt.is_finite() && dt > 0.0 && dt <= limit => Ok(dt),
         Some(dt) => Err(ParamError::new(
             "dt_s",
             dt,
-            format!(
-                "greater than 0 and at most {limit:.3e} s for this robot and ground (0.5 / omega_n with omega_n = \
-                 sqrt(n k_n A_c / m) = {omega_n:.1} rad/s, and T / 100 = {:.3e} s)",
-                period / 100.0
-            ),
+            format!("greater than 0 and at most T / {MIN_STEPS_PER_STRIDE} = {limit:.3e} s for this robot's stride"),
         )),
     }
 }
@@ -484,8 +500,18 @@ pub fn simulate(
         });
     }
     let pitch = Pitch { max_abs_rad: run.max_abs_pitch, over_s: run.pitch_over_s };
-    let summary =
-        summarise(scenario, slope, &ground, settings, dt, steps, closed_form, &run.stalled_by_step, pitch);
+    let summary = summarise(
+        scenario,
+        slope,
+        &ground,
+        settings,
+        dt,
+        steps,
+        closed_form,
+        &run.stalled_by_step,
+        pitch,
+        run.unconverged_steps,
+    );
     Ok(Simulation { summary, trajectory: run.trajectory, geometry: run.geometry })
 }
 
@@ -526,6 +552,7 @@ fn summarise(
     closed_form: SlopeEvaluation,
     stalled_by_step: &[Vec<usize>],
     pitch: Pitch,
+    unconverged_steps: usize,
 ) -> SimSummary {
     let robot = scenario.robot();
     let measured: Vec<&SimStep> = steps.iter().filter(|s| !s.warmup).collect();
@@ -567,7 +594,9 @@ fn summarise(
         dt_s: dt,
         leg_elements: robot.leg_elements(),
         shape: settings.shape,
-        yield_m: settings.yield_m,
+        creep_m_s: settings.creep_m_s,
+        servo_torque_limit_n_m: if settings.servo_limit { robot.servo_torque_limit() } else { None },
+        unconverged_steps,
         body_pitch: settings.body_pitch,
         rft_scaling: settings.rft_scaling,
         speed_m_s: speed,

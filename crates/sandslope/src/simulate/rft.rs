@@ -49,7 +49,13 @@ pub enum RftScaling {
     Motion,
     /// The normal stress scaled by `zeta_n` and the along-surface stress by `zeta_s`, whatever
     /// the motion: normal stresses by the penetration tests, shear stresses by the shear tests.
+    /// Unlike the other two it can push along the motion; the passive projection
+    /// ([`Rft::passive_stress`]) removes that part.
     Components,
+    /// Li, Zhang and Goldman (2013)'s own scaling: one factor `zeta_n = k_n / alpha_z(0, pi/2)`
+    /// for both stresses and every motion (the generic coefficients unchanged). The terrain's
+    /// k_s is not used: the slope enters through gravity only.
+    Li2013,
 }
 
 impl RftScaling {
@@ -58,6 +64,7 @@ impl RftScaling {
         match self {
             RftScaling::Motion => "motion",
             RftScaling::Components => "components",
+            RftScaling::Li2013 => "li2013",
         }
     }
 }
@@ -83,7 +90,33 @@ impl Rft {
         let (az_down, _) = generic(1.0, 0.0, 0.0, 1.0);
         // Vertical plate (beta = pi/2, so 2 beta = pi) pushed sideways (gamma = 0).
         let (_, ax_side) = generic(-1.0, 0.0, 1.0, 0.0);
-        Rft { zeta_z: k_n / az_down, zeta_x: 2.0 * k_s / ax_side, scaling }
+        let zeta_z = k_n / az_down;
+        let zeta_x = match scaling {
+            RftScaling::Li2013 => zeta_z,
+            _ => 2.0 * k_s / ax_side,
+        };
+        Rft { zeta_z, zeta_x, scaling }
+    }
+
+    /// The stress per unit depth of a horizontal plate pushed straight down, N/m^3 (k_n).
+    #[inline]
+    pub fn scale_n(&self) -> f64 {
+        self.zeta_z
+    }
+
+    /// [`Rft::stress`] made passive (docs/model.md §16): its component along the motion, where
+    /// it has one, removed, `S - max(0, S.e) e`, so the sand never pushes an element along its
+    /// own motion. Under `Motion` and `Li2013` the generic form is already passive (a test
+    /// checks it over every orientation and direction), so this changes only `Components`.
+    #[inline]
+    pub fn passive_stress(&self, tx: f64, tz: f64, ex: f64, ez: f64) -> (f64, f64) {
+        let (sx, sz) = self.stress(tx, tz, ex, ez);
+        let along = sx * ex + sz * ez;
+        if along > 0.0 {
+            (sx - along * ex, sz - along * ez)
+        } else {
+            (sx, sz)
+        }
     }
 
     /// Stress per unit depth `(sigma_x, sigma_z)`, N/m^3 (force per unit area per unit depth),
@@ -101,6 +134,8 @@ impl Rft {
                 let zeta = self.zeta_z * ez * ez + self.zeta_x * ex * ex;
                 (-s * zeta * ax, zeta * az)
             }
+            // One scale for everything (zeta_x = zeta_z).
+            RftScaling::Li2013 => (-s * self.zeta_z * ax, self.zeta_z * az),
             // Normal stress k_n, along-surface stress k_s.
             RftScaling::Components => (-s * self.zeta_x * ax, self.zeta_z * az),
         }
@@ -168,5 +203,69 @@ mod tests {
         assert!((ratio(RftScaling::Motion).atan().to_degrees() - 19.93).abs() < 0.01);
         let by_hand = (2.0 * k_s / 0.370) * 0.136 / (k_n * 0.375);
         assert!((ratio(RftScaling::Components) / by_hand - 1.0).abs() < 1e-12);
+    }
+}
+
+#[cfg(test)]
+mod passivity_tests {
+    use super::*;
+
+    /// The share of a (beta, gamma) grid (1 degree, every orientation and direction) where the
+    /// raw stress has a component along the motion, and the largest such component relative
+    /// to the stress.
+    fn active_share(rft: &Rft, passive: bool) -> (f64, f64) {
+        let (mut along, mut worst, mut n) = (0usize, 0.0f64, 0usize);
+        for b in 0..180 {
+            let beta = (b as f64).to_radians();
+            let (tx, tz) = (beta.cos(), beta.sin());
+            for g in 0..360 {
+                let gamma = (g as f64 + 0.5).to_radians();
+                let (ex, ez) = (gamma.cos(), gamma.sin());
+                let (sx, sz) =
+                    if passive { rft.passive_stress(tx, tz, ex, ez) } else { rft.stress(tx, tz, ex, ez) };
+                let dot = sx * ex + sz * ez;
+                if dot > 1e-9 * sx.hypot(sz) {
+                    along += 1;
+                    worst = worst.max(dot / sx.hypot(sz));
+                }
+                n += 1;
+            }
+        }
+        (along as f64 / n as f64, worst)
+    }
+
+    /// docs/model.md §16's passivity: the generic form itself never pushes along the motion, so
+    /// `Motion` (a positive scalar times it) and `Li2013` (one factor) are passive as they stand
+    /// at every k_s / k_n; `Components` is not (the audit of issue 38: 4.6% of directions at the
+    /// built-in k_s/k_n = 4.66, more at k_s/k_n = 0.01), and its passive projection is.
+    #[test]
+    fn every_scaling_is_passive_and_components_only_after_projection() {
+        for ratio in [0.01, 0.1, 1.0, 4.66, 100.0] {
+            let k_n = 7e5;
+            for scaling in [RftScaling::Motion, RftScaling::Li2013] {
+                let (share, _) = active_share(&Rft::with_scaling(k_n, ratio * k_n, scaling), false);
+                assert_eq!(share, 0.0, "{scaling:?} at k_s/k_n = {ratio}");
+            }
+            let comp = Rft::with_scaling(k_n, ratio * k_n, RftScaling::Components);
+            assert_eq!(active_share(&comp, true).0, 0.0, "projected components at {ratio}");
+        }
+        let (share, worst) = active_share(&Rft::with_scaling(7e5, 3.26e6, RftScaling::Components), false);
+        assert!(share > 0.01 && worst > 0.01, "components raw: {share} {worst}");
+        let (low, _) = active_share(&Rft::with_scaling(7e5, 7e3, RftScaling::Components), false);
+        assert!(low > share, "{low} vs {share}");
+    }
+
+    /// Li et al. 2013's single factor: k_n straight down, and a vertical plate dragged sideways
+    /// feels the generic 0.370 k_n per unit depth, whatever k_s (by hand from the coefficients:
+    /// 0.124 + 0.253 - 0.007 = 0.370).
+    #[test]
+    fn li2013_uses_one_factor_from_k_n() {
+        for k_s in [1e4, 3e6] {
+            let rft = Rft::with_scaling(7e5, k_s, RftScaling::Li2013);
+            let (sx, sz) = rft.stress(1.0, 0.0, 0.0, -1.0);
+            assert!(sx.abs() < 1e-6 && (sz - 7e5).abs() < 1e-6);
+            let (sx, _) = rft.stress(0.0, 1.0, 1.0, 0.0);
+            assert!((sx + 0.370 * 7e5).abs() < 1e-6, "{sx}");
+        }
     }
 }

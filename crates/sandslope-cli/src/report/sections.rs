@@ -259,7 +259,7 @@ pub fn simulator(report: &Report) -> String {
          held fixed by solidified sand, and steps s*. Resistive force theory has no term that holds the \
          circle: this is the two models' different kinematics, not a parameter. <i>Tumbled</i>: the body, lifted \
          on one tripod, pitched over backwards, a failure the closed form cannot show; with the pitch free the \
-         walks on the slopes are not converged in the time step (docs/simulate.md, "Convergence"). <i>Pitch locked</i>: the same walks with the body held \
+         walks on the slopes are not converged in the time step (docs/simulate.md, Convergence). <i>Pitch locked</i>: the same walks with the body held \
          parallel to the slope, as the closed form assumes (<code>--body-pitch locked</code>): no walk tumbles, so \
          this column shows what the simulator says once the pitch is taken out.</p>\n",
         sandslope::report::REPORT_WALK_S,

@@ -213,10 +213,11 @@ def simulate(
     k_n: Optional[float] = None,
     k_s: Optional[float] = None,
     dt_s: Optional[float] = None,
-    yield_m: Optional[float] = None,
+    creep_m_s: Optional[float] = None,
     sample_rate_hz: float = 120.0,
     body_pitch: str = "free",
     rft_scaling: str = "motion",
+    servo_limit: bool = True,
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 
 def read_touchdowns(path: _Path) -> List[float]: ...

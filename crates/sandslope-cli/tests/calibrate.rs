@@ -194,9 +194,7 @@ fn model_simulate_fits_the_walks_and_shows_the_closed_form_beside() {
     assert_eq!(v["model"]["settings"]["duration_s"], 4.0);
     assert_eq!(v["walks"], 1);
     let walk = json(
-        sandslope()
-            .args(["simulate", "--slope", "0", "--duration", "4", "--json", "--terrain"])
-            .arg(&forces),
+        sandslope().args(["simulate", "--slope", "0", "--duration", "4", "--json", "--terrain"]).arg(&forces),
     );
     let model = v["pulls"][0]["model"].as_f64().unwrap();
     assert_eq!(model, walk["speed_m_s"].as_f64().unwrap());

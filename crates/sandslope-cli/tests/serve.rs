@@ -1081,7 +1081,7 @@ fn a_client_that_reads_nothing_is_dropped_after_the_send_timeout() {
     }
 }
 
-/// Behind 10 open `/api/simulate?slopes=0:24:25&duration=60` (each minutes of a debug build's
+/// Behind 10 open `/api/simulate?slopes=0:24:25&duration=30` (1.5e6 steps at the 0.5 ms default, inside the server's 2e6) (each minutes of a debug build's
 /// computing), `predict`, `sweep` and the page are answered within 0.5 s: they have their own
 /// threads. Before, a predict waited 13.6 s behind 6 and 33 s behind 10.
 #[test]
@@ -1093,7 +1093,7 @@ fn predict_sweep_and_the_page_are_fast_behind_ten_heavy_simulations() {
             let mut s = TcpStream::connect(&server.addr).unwrap();
             write!(
                 s,
-                "GET /api/simulate?slopes=0:24:25&duration=60 HTTP/1.1\r\nHost: {}\r\n\r\n",
+                "GET /api/simulate?slopes=0:24:25&duration=30 HTTP/1.1\r\nHost: {}\r\n\r\n",
                 server.addr
             )
             .unwrap();

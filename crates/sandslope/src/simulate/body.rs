@@ -208,9 +208,17 @@ pub(crate) fn associated_force(
 /// (docs/model.md §16-§17): `F = weight * phi(|u| / eps) * S(u / |u|)`, where `S` is the
 /// passive resistive-force stress per unit depth in the direction of motion and
 /// `phi(r) = r / sqrt(1 + r^2)` smooths the set-valued law at rest over the creep speed `eps`.
-/// At `u = 0` the force is zero and the Jacobian isotropic.
+/// At `u = 0` the force is zero and the Jacobian isotropic. Without `want_jacobian` the
+/// Jacobian is left zero (a line search's trial points need only the force: it saves the two
+/// extra stress evaluations of the derivative).
 #[inline(always)]
-pub(crate) fn element_force(rft: &Rft, c: &Contact, u: [f64; 2], eps: f64) -> ([f64; 2], [[f64; 2]; 2]) {
+pub(crate) fn element_force(
+    rft: &Rft,
+    c: &Contact,
+    u: [f64; 2],
+    eps: f64,
+    want_jacobian: bool,
+) -> ([f64; 2], [[f64; 2]; 2]) {
     let s = (u[0] * u[0] + u[1] * u[1]).sqrt();
     let (tx, tz) = (c.tangent[0], c.tangent[1]);
     if s <= 1e-300 {
@@ -223,6 +231,9 @@ pub(crate) fn element_force(rft: &Rft, c: &Contact, u: [f64; 2], eps: f64) -> ([
     let root = (1.0 + r * r).sqrt();
     let phi = r / root;
     let force = [c.weight * phi * st.0, c.weight * phi * st.1];
+    if !want_jacobian {
+        return (force, [[0.0; 2]; 2]);
+    }
     // dS/d(angle of e) by central differences; de/d(angle) = n = (-e_z, e_x).
     const DELTA: f64 = 1e-5;
     let (sd, cd) = (DELTA.sin(), DELTA.cos());

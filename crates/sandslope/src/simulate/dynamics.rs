@@ -24,8 +24,13 @@ use std::f64::consts::PI;
 const BELLY_ELEMENTS: usize = 8;
 /// A servo that lags its command catches up at this rate, 1/s, up to 1.5 omega.
 const CATCH_UP_PER_S: f64 = 20.0;
-/// Most Newton iterations of one velocity step.
-const MAX_NEWTON: usize = 30;
+/// Most Newton iterations of one velocity solve (one stage of the continuation).
+const MAX_NEWTON: usize = 12;
+/// Most halvings of one Newton step in its line search.
+const MAX_HALVINGS: usize = 12;
+/// The creep speed the continuation starts from, m/s: far above the creep a walk uses, where
+/// the smoothed law is gentle enough for Newton's method from a poor start (docs/model.md §17).
+const CONTINUATION_START_M_S: f64 = 1e-2;
 /// Newton's method has converged when no body rate changes by more than this fraction of
 /// the creep speed (a velocity error far below the creep the smoothing itself allows).
 const NEWTON_TOL: f64 = 1e-3;
@@ -302,27 +307,49 @@ impl Walker {
     /// The implicit velocity step (docs/model.md §17): the body rates `v1` with
     /// `G(v1) = M (v1 - v_free) - h sum_i J_i^T F_i(J_i v1 + w_i) = 0`, by Newton's method
     /// from the last step's rates with a backtracking line search on `|G|^2_{M^-1}`. Where that
-    /// fails, the associated law's solution (a convex minimisation, always solvable) is the
-    /// start of a second attempt; where that fails too, the iterate with the smallest residual
-    /// is kept and the step counted. The forces are left in `self.forces`.
+    /// fails, the same equation is solved along a continuation in the creep speed (from
+    /// [`CONTINUATION_START_M_S`] down by tenfold stages to the walk's own, each stage started
+    /// from the last); where that fails, the associated law's solution (a convex minimisation,
+    /// always solvable) starts a last attempt; where that fails too, the iterate with the
+    /// smallest residual is kept and the step counted. The forces are left in `self.forces`.
     fn solve(&mut self, v_free: [f64; 3], m: [f64; 3]) -> bool {
         let mut v = self.v;
         if self.pitch_locked {
             v[2] = 0.0;
         }
-        let (first, ok, r1) = self.newton(v, v_free, m, false);
+        let eps = self.eps;
+        let (first, ok, r1) = self.newton(v, v_free, m, eps, false);
         if ok {
             return self.finish(first, v_free, m, true);
         }
-        let (start, _, _) = self.newton(v, v_free, m, true);
-        let (second, ok, r2) = self.newton(start, v_free, m, false);
-        let best = if ok || r2 <= r1 { second } else { first };
+        let (mut best, mut best_merit) = (first, r1);
+        let mut stage = v;
+        let mut e = CONTINUATION_START_M_S.max(eps);
+        loop {
+            let (next, ok, r) = self.newton(stage, v_free, m, e, false);
+            if e <= eps {
+                if ok {
+                    return self.finish(next, v_free, m, true);
+                }
+                if r < best_merit {
+                    (best, best_merit) = (next, r);
+                }
+                break;
+            }
+            stage = next;
+            e = (0.1 * e).max(eps);
+        }
+        let (start, _, _) = self.newton(v, v_free, m, eps, true);
+        let (second, ok, r2) = self.newton(start, v_free, m, eps, false);
+        if ok || r2 <= best_merit {
+            best = second;
+        }
         self.finish(best, v_free, m, ok)
     }
 
     /// Takes `v` as the step's rates (leaving its forces in `self.forces`).
     fn finish(&mut self, v: [f64; 3], v_free: [f64; 3], m: [f64; 3], ok: bool) -> bool {
-        let _ = self.evaluate(v, v_free, m, None, false);
+        let _ = self.evaluate(v, v_free, m, self.eps, None, false);
         self.v = v;
         ok
     }
@@ -336,14 +363,15 @@ impl Walker {
         mut v: [f64; 3],
         v_free: [f64; 3],
         m: [f64; 3],
+        eps: f64,
         associated: bool,
     ) -> ([f64; 3], bool, f64) {
         let dofs = if self.pitch_locked { 2 } else { 3 };
         let merit = |r: &[f64; 3]| (0..dofs).map(|i| r[i] * r[i] / m[i]).sum::<f64>();
         let value = |phi: f64, r: &[f64; 3]| if associated { phi } else { merit(r) };
-        let tol = NEWTON_TOL * self.eps;
+        let tol = NEWTON_TOL * eps;
         let mut jac = [[0.0; 3]; 3];
-        let (phi, mut grad) = self.evaluate(v, v_free, m, Some(&mut jac), associated);
+        let (phi, mut grad) = self.evaluate(v, v_free, m, eps, Some(&mut jac), associated);
         let mut f0 = value(phi, &grad);
         let (mut best, mut best_merit) = (v, merit(&grad));
         for _ in 0..MAX_NEWTON {
@@ -357,12 +385,12 @@ impl Walker {
                 if associated { (0..dofs).map(|i| grad[i] * delta[i]).sum::<f64>() } else { 2.0 * f0 };
             let mut lambda = 1.0;
             let mut accepted = false;
-            for _ in 0..40 {
+            for _ in 0..MAX_HALVINGS {
                 let mut trial = v;
                 for i in 0..dofs {
                     trial[i] -= lambda * delta[i];
                 }
-                let (pt, rt) = self.evaluate(trial, v_free, m, None, associated);
+                let (pt, rt) = self.evaluate(trial, v_free, m, eps, None, associated);
                 let ft = value(pt, &rt);
                 if ft <= f0 - 1e-4 * lambda * slope.max(0.0) {
                     v = trial;
@@ -374,7 +402,7 @@ impl Walker {
             if !accepted {
                 return (best, false, best_merit);
             }
-            let (phi, g) = self.evaluate(v, v_free, m, Some(&mut jac), associated);
+            let (phi, g) = self.evaluate(v, v_free, m, eps, Some(&mut jac), associated);
             grad = g;
             f0 = value(phi, &grad);
             let mr = merit(&grad);
@@ -393,12 +421,12 @@ impl Walker {
         v: [f64; 3],
         v_free: [f64; 3],
         m: [f64; 3],
+        eps: f64,
         jac: Option<&mut [[f64; 3]; 3]>,
         associated: bool,
     ) -> (f64, [f64; 3]) {
         let h = self.dt;
-        let (contacts, forces, rates, rft, eps) =
-            (&self.contacts, &mut self.forces, &self.rates, &self.rft, self.eps);
+        let (contacts, forces, rates, rft) = (&self.contacts, &mut self.forces, &self.rates, &self.rft);
         let mut g = [0.0; 3];
         let mut k = [[0.0; 3]; 3];
         let mut potential = 0.0;
@@ -412,7 +440,7 @@ impl Walker {
                 potential += p;
                 (f, [[-hess[0][0], -hess[0][1]], [-hess[1][0], -hess[1][1]]])
             } else {
-                element_force(rft, c, u, eps)
+                element_force(rft, c, u, eps, want)
             };
             forces.push(f);
             let (rx, rz) = (c.rel[0], c.rel[1]);

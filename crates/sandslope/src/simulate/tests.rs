@@ -60,7 +60,7 @@ fn spoke_dragged_sideways_feels_k_s_w_d_squared() {
                 submerged(world[k], world[k + 1], robot.leg_width())
             {
                 let c = Contact { weight, tangent, rel: point, arm: point, leg: 0, depth };
-                fx += element_force(&rft, &c, [0.05, 0.0], DEFAULT_CREEP_M_S).0[0];
+                fx += element_force(&rft, &c, [0.05, 0.0], DEFAULT_CREEP_M_S, false).0[0];
             }
         }
         let expected = 2e6 * 0.01 * d * d;

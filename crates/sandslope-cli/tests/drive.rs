@@ -245,18 +245,35 @@ fn torque_off_when_the_run_completes() {
 fn torque_off_on_ctrl_c() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("log.csv");
-    let child = bin()
+    let mut child = bin()
         .args(["drive", "--emulate", "--duration", "30", "--watchdog", "2", "--log"])
         .arg(&log)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(std::time::Duration::from_secs(4));
+    // Ctrl-C once the gait runs (the setup's simulated walks take seconds on a loaded machine;
+    // an interrupt before it ends the process with nothing moved), then a second into it.
+    let mut stderr = child.stderr.take().unwrap();
+    let mut seen = Vec::new();
+    let started = std::time::Instant::now();
+    while !String::from_utf8_lossy(&seen).contains("Ctrl-C stops the gait") {
+        let mut buf = [0u8; 256];
+        let n = std::io::Read::read(&mut stderr, &mut buf).unwrap();
+        assert!(
+            n > 0 && started.elapsed().as_secs() < 120,
+            "the gait never started: {}",
+            String::from_utf8_lossy(&seen)
+        );
+        seen.extend_from_slice(&buf[..n]);
+    }
+    std::thread::sleep(std::time::Duration::from_secs(1));
     let killed = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
     assert!(killed.success());
     let out = child.wait_with_output().unwrap();
-    let all = text(&out);
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut stderr, &mut rest).unwrap();
+    let all = format!("{}{}{rest}", text(&out), String::from_utf8_lossy(&seen));
     assert_eq!(out.status.code(), Some(130), "{all}");
     assert!(all.contains("interrupted (Ctrl-C)"), "{all}");
     assert!(all.contains("emulator: torque off on every servo"), "{all}");

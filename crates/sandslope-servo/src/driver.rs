@@ -11,7 +11,7 @@
 //!   that stops answering or whose packets keep failing their CRC (three cycles in a row), a
 //!   cycle slower than the driver's watchdog, and an error writing the log;
 //! - the servos' Bus Watchdog stops them by themselves if the driver dies without a word;
-//! - `stop_on_risk`: the gait halts when the live risk of slippage passes the threshold; the
+//! - `stop_on_risk`: the gait halts when the live risk that the walk fails (slippage or sinkage) passes the threshold; the
 //!   torque stays on and the legs hold where they are (the stance tripod planted) for
 //!   `hold_s`, then the torque goes off.
 
@@ -82,7 +82,7 @@ pub struct DriveSettings {
     pub watchdog_s: f64,
     /// The servos' own Bus Watchdog, s (20 ms units, 1 to 127).
     pub bus_watchdog_s: f64,
-    /// Halt when the live risk of slippage passes this probability.
+    /// Halt when the live risk that the walk fails (slippage or sinkage) passes this probability.
     pub stop_on_risk: Option<f64>,
     /// After a halt, how long the legs are held before the torque goes off, s.
     pub hold_s: f64,
@@ -143,8 +143,8 @@ pub enum DriveOutcome {
     Halted {
         /// Gait time of the halt, s.
         time_s: f64,
-        /// The risk that passed the threshold.
-        p_slippage: f64,
+        /// The risk that passed the threshold (the probability that the walk fails).
+        p_fail: f64,
     },
 }
 
@@ -616,7 +616,7 @@ fn run(
         }
         if let Some((at, p)) = halted {
             if time - at >= settings.hold_s {
-                return Ok(DriveOutcome::Halted { time_s: at, p_slippage: p });
+                return Ok(DriveOutcome::Halted { time_s: at, p_fail: p });
             }
         } else if time >= settings.duration_s {
             return Ok(DriveOutcome::Completed { time_s: time });
@@ -706,7 +706,7 @@ fn run(
                             {
                                 let live = LiveEstimate { time_s: time, tripod: k, inference: inf };
                                 on_live(&live);
-                                let p = live.inference.p_slippage;
+                                let p = live.inference.p_fail;
                                 report.live.push(live);
                                 if let (Some(limit), None) = (settings.stop_on_risk, halted) {
                                     if p > limit {

@@ -16,9 +16,9 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use sandslope::infer::servo::{simulated_legs, LegTrace};
+use sandslope::infer::servo::{sensor_walk_settings, simulated_legs, LegTrace};
 use sandslope::servo::{xl330, GaitSchedule};
-use sandslope::simulate::{simulate, SimSettings};
+use sandslope::simulate::simulate;
 use sandslope::{Robot, Scenario, Terrain};
 use serial2::SerialPort;
 
@@ -119,8 +119,7 @@ impl Walk {
         let schedule = GaitSchedule::new(robot, 2 * robot.stance_legs() as usize)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let rate_hz = 500.0;
-        let settings = SimSettings::new(strides.max(3) as f64 * schedule.period_s)
-            .and_then(|s| s.with_sample_rate(rate_hz))
+        let settings = sensor_walk_settings(strides.max(3) as f64 * schedule.period_s, rate_hz)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let scenario = Scenario::new(robot.clone(), terrain, None, None)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;

@@ -1,7 +1,7 @@
 //! `sandslope drive`: the robot in the loop (docs/drive.md). The alternating tripod of the
 //! robot file's timing sent to Dynamixel XL330s over Protocol 2.0 (`sandslope-servo`), every
 //! servo's state logged at the bus's rate, and, with `--live` or `--stop-on-risk`, the sand's
-//! k_s and the risk of slippage read from the stance currents after every stance
+//! k_s and the risk that the walk fails (slippage or sinkage) read from the stance currents after every stance
 //! (`sandslope::infer::servo`). `--emulate` drives a bus of virtual XL330s on a
 //! pseudo-terminal through the same code; `--dry-run` prints the commands without a bus.
 
@@ -70,7 +70,7 @@ pub struct DriveArgs {
     /// Write every servo's state every cycle to this CSV (docs/drive.md, "The log").
     #[arg(long, value_name = "FILE")]
     pub log: Option<PathBuf>,
-    /// Halt the gait (torque held, legs planted) when the live risk of slippage passes P.
+    /// Halt the gait (torque held, legs planted) when the live risk that the walk fails (slippage or sinkage) passes P.
     #[arg(long, value_name = "P")]
     pub stop_on_risk: Option<f64>,
     /// After a halt, seconds the legs are held before the torque goes off.
@@ -285,6 +285,13 @@ pub fn run(args: DriveArgs) -> Result<()> {
         dynamixel2::Bus::new(port).map_err(|e| anyhow!("cannot configure the serial port: {e:?}"))?;
     // Ctrl-C from here on stops the gait and turns the torque off rather than ending the process.
     crate::error::DRIVING.store(true, Ordering::SeqCst);
+    // The setup above (the emulator's and the monitor's simulated walks) can take seconds; say
+    // when the servos are about to move and how to stop them.
+    eprintln!(
+        "driving {} servos for {} s: Ctrl-C stops the gait and turns the torque off",
+        servos.len(),
+        args.duration
+    );
     let noise_sd = xl330::torque_from_current(if args.emulate { args.emulate_noise.max(1.0) } else { 10.0 });
     let monitor = grid.as_ref().map(|g| Monitor { robot: &robot, grid: g, noise_sd_n_m: noise_sd });
     let meta = vec![
@@ -309,8 +316,8 @@ pub fn run(args: DriveArgs) -> Result<()> {
         if !quiet {
             let i = &l.inference;
             eprintln!(
-                "t = {:.2} s, tripod {}: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(slippage) {:.3}",
-                l.time_s, l.tripod, i.k_s, i.k_s_lo, i.k_s_hi, i.p_slippage
+                "t = {:.2} s, tripod {}: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(fail) {:.3} (slippage {:.3}, sinkage {:.3})",
+                l.time_s, l.tripod, i.k_s, i.k_s_lo, i.k_s_hi, i.p_fail, i.p_slippage, i.p_sinkage
             );
         }
     };
@@ -381,10 +388,10 @@ pub fn run(args: DriveArgs) -> Result<()> {
             message: format!("interrupted (Ctrl-C) at t = {time_s:.2} s; the torque was turned off"),
         }
         .into()),
-        (None, Ok(sandslope_servo::DriveOutcome::Halted { time_s, p_slippage })) => Err(KeepLog {
+        (None, Ok(sandslope_servo::DriveOutcome::Halted { time_s, p_fail })) => Err(KeepLog {
             code: EXIT_HALTED,
             message: format!(
-                "--stop-on-risk: halted at t = {time_s:.2} s, P(slippage) = {p_slippage:.3} > {}; the legs were held {} s, then the torque was turned off",
+                "--stop-on-risk: halted at t = {time_s:.2} s, P(fail) = {p_fail:.3} > {}; the legs were held {} s, then the torque was turned off",
                 args.stop_on_risk.unwrap_or(1.0),
                 args.hold
             ),
@@ -439,8 +446,8 @@ fn summarise(r: &DriveReport, quiet: bool) -> Result<()> {
     if let Some(last) = r.live.last() {
         let i = &last.inference;
         println!(
-            "last estimate: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(slippage) {:.3} at {} deg",
-            i.k_s, i.k_s_lo, i.k_s_hi, i.p_slippage, i.slope_deg
+            "last estimate: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(fail) {:.3} (slippage {:.3}, sinkage {:.3}) at {} deg",
+            i.k_s, i.k_s_lo, i.k_s_hi, i.p_fail, i.p_slippage, i.p_sinkage, i.slope_deg
         );
     }
     Ok(())

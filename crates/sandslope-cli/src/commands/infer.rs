@@ -192,7 +192,10 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
         "shear load per stance leg: {:.3} N (the stride simulator at that k_s; the closed form's m (g sin theta + R omega / dt) / n is {:.3} N)",
         answer.shear_load_n, answer.closed_form_shear_load_n
     );
-    println!("P(slippage) at {slope_deg} deg: {:.3}", answer.p_slippage);
+    println!(
+        "P(fail) at {slope_deg} deg: {:.3} (slippage {:.3}, sinkage {:.3})",
+        answer.p_fail, answer.p_slippage, answer.p_sinkage
+    );
     println!(
         "k_n {} N/m^3 from the terrain; stance torque K_t I against the stride simulator on {} k_s values (docs/model.md \u{a7}19)",
         sci(k_n),

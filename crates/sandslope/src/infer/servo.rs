@@ -153,6 +153,17 @@ pub struct ModelGrid {
     pub bins: usize,
 }
 
+/// The stride simulator's settings for the servo sensor's walks, `duration_s` long and sampled
+/// at `rate_hz`: the emulator's currents and the inference's model profiles both come from
+/// these, with the body pitch locked, the setting whose answers converge on the built-in
+/// terrain (docs/simulate.md: the free body's walks on slopes change with the time step, so a
+/// sensor read against them would read the integrator, not the sand).
+pub fn sensor_walk_settings(duration_s: f64, rate_hz: f64) -> Result<SimSettings, crate::error::ParamError> {
+    Ok(SimSettings::new(duration_s)?
+        .with_sample_rate(rate_hz)?
+        .with_body_pitch(crate::simulate::BodyPitch::Locked))
+}
+
 /// Simulates `robot` at `slope_deg` on constant ground `k_n` and each k_s of the settings'
 /// grid (in parallel) and bins each walk's stance torques as [`stance_profiles`] bins a log.
 pub fn model_grid(
@@ -173,9 +184,8 @@ pub fn model_grid(
     let n = settings.grid_points;
     let k_s: Vec<f64> = (0..n).map(|i| (lo + (hi - lo) * i as f64 / (n - 1) as f64).exp()).collect();
     let duration = settings.simulated_strides as f64 * schedule.period_s;
-    let sim_settings = SimSettings::new(duration)
-        .and_then(|s| s.with_sample_rate(200.0))
-        .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
+    let sim_settings =
+        sensor_walk_settings(duration, 200.0).map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
     let bins = settings.bins;
     let walks: Vec<Result<_, CurrentInferenceError>> = k_s
         .par_iter()
@@ -322,6 +332,12 @@ pub struct CurrentInference {
     pub closed_form_shear_load_n: f64,
     /// Probability of the slippage regime at this slope.
     pub p_slippage: f64,
+    /// Probability of the sinkage regime at this slope.
+    pub p_sinkage: f64,
+    /// Probability that the walk fails at this slope (slippage or sinkage, §18; the metastable
+    /// regime, which still climbs, left out as `risk`'s p_fail leaves it out): the risk
+    /// `drive --stop-on-risk` watches.
+    pub p_fail: f64,
     /// Strides (or, live, stances) used.
     pub strides: usize,
     /// Mean measured stance profile, N m (tripod-major bins).
@@ -451,8 +467,10 @@ fn posterior_answer(
         (true, true) => Bound::Neither,
     };
     // (`0.0 +`: an empty sum of floats is -0.0.)
-    let p_slip = 0.0
-        + p.iter().zip(&grid.regime).filter(|(_, r)| **r == Regime::Slippage).map(|(x, _)| x).sum::<f64>();
+    let weight_of = |regime: Regime| {
+        0.0 + p.iter().zip(&grid.regime).filter(|(_, r)| **r == regime).map(|(x, _)| x).sum::<f64>()
+    };
+    let (p_slip, p_sink) = (weight_of(Regime::Slippage), weight_of(Regime::Sinkage));
     let shear = p.iter().zip(&grid.shear_load_n).map(|(x, f)| x * f).sum();
     let slope = grid.slope_deg.abs().to_radians();
     let closed = robot.mass()
@@ -468,6 +486,8 @@ fn posterior_answer(
         shear_load_n: shear,
         closed_form_shear_load_n: closed,
         p_slippage: p_slip,
+        p_sinkage: p_sink,
+        p_fail: p_slip + p_sink,
         strides,
         measured_profile_n_m: mean.to_vec(),
         posterior: grid.k_s.iter().copied().zip(p).collect(),

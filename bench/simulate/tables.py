@@ -1,24 +1,40 @@
 #!/usr/bin/env python3
 """The tables of docs/simulate.md, regenerated from `sandslope simulate --json`.
 
-Usage: python3 bench/simulate/tables.py [--sandslope target/release/sandslope]
+Usage: python3 bench/simulate/tables.py [--sandslope target/release/sandslope] [--only NAME]
 
-Prints, in the order docs/simulate.md shows them:
-1. simulator against closed form on the built-in robot and terrain at 0, 5, 10, 15, 20 and 24
-   degrees (10 s walks, the defaults);
-2. the simulated speed for five yield slips e_y (`--yield`), pitch-overs marked;
-3. the regimes in (k_s, slope) against the closed form's (the phase diagram's) at k_n = 7e5.
-Every number comes from the CLI's JSON; nothing here computes physics.
+Prints, in the order docs/simulate.md shows them (NAME in brackets):
+1. [closed] simulator (body pitch locked, the converged setting) against the closed form on the
+   built-in robot and terrain at 0, 5, 10, 15, 20 and 24 degrees, 10 s walks, with the speed
+   and t1 again at a quarter of the default step (the convergence check beside every number);
+2. [free] the same walks with the body pitch free, at the default step and a quarter of it;
+3. [regimes] the regimes in (k_s, slope) against the closed form's at k_n = 7e5, pitch locked;
+4. [level] the level stride against the paper's 15.7 cm/s: one switch at a time (issue 38
+   item 4), each at the default step and a quarter of it;
+5. [shape] the level walk's within-stride speed, from `simulate --out` sampled at 120 Hz as
+   the paper's motion capture was.
+Every number comes from the CLI's JSON or CSV; nothing here computes physics beyond a finite
+difference of the sampled positions.
 """
 
 import argparse
+import csv
 import json
+import os
 import subprocess
+import tempfile
+
+PAPER_LEVEL_CM_S = (15.7, 0.97)
 
 
 def run(exe, args):
     out = subprocess.run([exe, "simulate", *args, "--json"], capture_output=True, text=True, check=True)
     return json.loads(out.stdout)
+
+
+def one(exe, args):
+    d = run(exe, args)
+    return d[0] if isinstance(d, list) else d
 
 
 def f(v, k=1):
@@ -29,36 +45,28 @@ def scaled(v, s):
     return None if v is None else v * s
 
 
-def against_closed_form(exe):
+def quarter_dt(exe, args):
+    """The walk's default step, and the same walk at a quarter of it."""
+    d = one(exe, args)
+    q = one(exe, [*args, "--dt", repr(d["dt_s"] / 4)])
+    return d, q
+
+
+def against_closed_form(exe, pitch):
     print(
-        "| slope deg | speed cm/s sim | closed form | t1 ms sim | closed form | slip mm sim | closed form "
-        "| step mm sim | closed form | largest pitch deg | regime (cause) sim | closed form |"
+        "| slope deg | speed cm/s sim | at dt/4 | closed form | t1 ms sim | at dt/4 | closed form "
+        "| step mm sim | closed form | largest pitch deg | regime (cause) sim | at dt/4 | closed form |"
     )
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|")
-    for d in run(exe, ["--slopes", "0,5,10,15,20,24"]):
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---|")
+    for s in [0, 5, 10, 15, 20, 24]:
+        d, q = quarter_dt(exe, ["--slope", str(s), "--body-pitch", pitch])
         c = d["closed_form"]
         print(
-            f"| {d['slope_deg']:g} | {f(d['speed_m_s'] * 100)} | {f(scaled(c['speed_m_s'], 100))} "
-            f"| {f(scaled(d['t1_s'], 1e3))} | {f(scaled(c['t1_s'], 1e3))} "
-            f"| {f(scaled(d['slip_m'], 1e3))} | {f(scaled(c['slip_m'], 1e3))} "
+            f"| {s} | {f(d['speed_m_s'] * 100)} | {f(q['speed_m_s'] * 100)} | {f(scaled(c['speed_m_s'], 100))} "
+            f"| {f(scaled(d['t1_s'], 1e3))} | {f(scaled(q['t1_s'], 1e3))} | {f(scaled(c['t1_s'], 1e3))} "
             f"| {f(d['step_m'] * 1e3)} | {f(scaled(c['step_m'], 1e3))} | {f(d['max_pitch_deg'], 0)} "
-            f"| {d['regime']} ({d['cause']}) | {c['regime']} |"
+            f"| {d['regime']} ({d['cause']}) | {q['regime']} | {c['regime']} |"
         )
-
-
-def yield_sensitivity(exe):
-    ys = ["1e-3", "3e-4", "1e-4", "3e-5", "1e-5"]
-    slopes = [0, 10, 15, 20, 24]
-    print("| slope deg | " + " | ".join(f"e_y = {y} m" for y in ys) + " |")
-    print("|---:|" + "---|" * len(ys))
-    res = {y: run(exe, ["--slopes", ",".join(map(str, slopes)), "--yield", y]) for y in ys}
-    for i, s in enumerate(slopes):
-        cells = []
-        for y in ys:
-            d = res[y][i]
-            tumble = " (pitched over)" if d["pitch_over_s"] is not None else ""
-            cells.append(f"{f(d['speed_m_s'] * 100)} cm/s{tumble}")
-        print(f"| {s} | " + " | ".join(cells) + " |")
 
 
 def regimes(exe):
@@ -69,25 +77,127 @@ def regimes(exe):
     agree = total = 0
     for k in ks:
         cells = []
-        for d in run(exe, ["--slopes", "0:24:7", "--k-s", k, "--duration", "6"]):
-            tumbled = d["pitch_over_s"] is not None
+        for d in run(exe, ["--slopes", "0:24:7", "--k-s", k, "--duration", "6", "--body-pitch", "locked"]):
             cf = d["closed_form"]["regime"]
             total += 1
-            agree += d["regime"] == cf and not tumbled
-            cells.append(f"{letter[d['regime']]}{'^' if tumbled else ''} / {letter[cf]}")
+            agree += d["regime"] == cf
+            cells.append(f"{letter[d['regime']]} / {letter[cf]}")
         print(f"| {k} | " + " | ".join(cells) + " |")
     print(f"\n{agree} of {total} cells agree.")
+
+
+def robot_file(directory, name, extra):
+    """The built-in robot's file with `extra` lines appended (a switch of the level study)."""
+    path = os.path.join(directory, f"{name}.toml")
+    with open(path, "w") as fh:
+        fh.write(
+            "mass_kg = 0.35\nleg_radius_m = 0.04\nleg_width_m = 0.01\nhip_height_m = 0.03\n"
+            "leg_speed_rad_s = 6.283185307179586\nstance_legs = 3\nresponse_time_s = 0.2\n" + extra
+        )
+    return path
+
+
+def level_stride(exe):
+    lo, hi = PAPER_LEVEL_CM_S[0] - 2 * PAPER_LEVEL_CM_S[1], PAPER_LEVEL_CM_S[0] + 2 * PAPER_LEVEL_CM_S[1]
+    with tempfile.TemporaryDirectory() as tmp:
+        rows = [
+            ("the defaults (pitch locked)", []),
+            ("pitch free", ["--body-pitch", "free"]),
+            ("`--rft-scaling components`", ["--rft-scaling", "components"]),
+            ("`--rft-scaling li2013` (k_s not used)", ["--rft-scaling", "li2013"]),
+            ("Li et al.'s ratio, k_s = 0.185 k_n", ["--k-s", repr(0.185 * 7e5)]),
+            ("k_n halved (3.5e5)", ["--k-n", "3.5e5"]),
+            ("k_n / 10 (7e4)", ["--k-n", "7e4"]),
+            ("hip height h = 0.02 m", ["--hip-height", "0.02"]),
+            ("hip height h = 0.05 m", ["--hip-height", "0.05"]),
+            ("hip height h = 0.07 m (belly 1 cm above the leg tips)", ["--hip-height", "0.07"]),
+            (
+                "XL330-M288 torque limit, 0.52 N m",
+                ["--robot", robot_file(tmp, "m288", "servo_torque_limit_n_m = 0.52\n")],
+            ),
+            (
+                "XL330-M077 torque limit, 0.215 N m",
+                ["--robot", robot_file(tmp, "m077", "servo_torque_limit_n_m = 0.215\n")],
+            ),
+        ]
+        print(
+            "| switch (level sand, one at a time) | speed cm/s | at dt/4 | step mm | t1 ms | largest depth mm "
+            "| peak servo torque N m | stalled s per step | regime |"
+        )
+        print("|---|---:|---:|---:|---:|---:|---:|---:|---|")
+        for name, args in rows:
+            a = ["--slope", "0", *args]
+            if "--body-pitch" not in a:
+                a += ["--body-pitch", "locked"]
+            d, q = quarter_dt(exe, a)
+            steps = [s for s in d["steps"] if not s["warmup"]]
+            torque = max((s["peak_servo_torque_n_m"] for s in steps), default=None)
+            stall = sum(s["stall_s"] for s in steps) / max(len(steps), 1)
+            inside = " (within 2 SD)" if lo <= d["speed_m_s"] * 100 <= hi else ""
+            print(
+                f"| {name} | {f(d['speed_m_s'] * 100)}{inside} | {f(q['speed_m_s'] * 100)} | {f(d['step_m'] * 1e3)} "
+                f"| {f(scaled(d['t1_s'], 1e3))} | {f(d['max_depth_m'] * 1e3)} | {f(torque, 3)} | {f(stall, 3)} "
+                f"| {d['regime']} |"
+            )
+    print(f"\nThe paper: {PAPER_LEVEL_CM_S[0]} +/- {PAPER_LEVEL_CM_S[1]} cm/s (2 SD: {lo:.1f} to {hi:.1f}).")
+
+
+def shape(exe):
+    """Within-stride speed of the level walk at 120 Hz, the steps after the first stride
+    averaged: its minimum, its peak and when it comes after touchdown, and the share of the
+    step spent below 20% of the mean speed."""
+    print(
+        "| level walk | mean cm/s | min cm/s | peak cm/s | peak at ms after touchdown "
+        "| share of the step below 20% of the mean |"
+    )
+    print("|---|---:|---:|---:|---:|---:|")
+    for name, extra in [("the defaults (h = 0.03 m)", []), ("hip height h = 0.07 m", ["--hip-height", "0.07"])]:
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "walk.csv")
+            subprocess.run(
+                [exe, "simulate", "--slope", "0", "--body-pitch", "locked", "--out", out, *extra],
+                capture_output=True,
+                check=True,
+            )
+            with open(out) as fh:
+                rows = [(float(r["time_s"]), float(r["x_m"])) for r in csv.DictReader(fh)]
+        v = [
+            (rows[i][0], (rows[i + 1][1] - rows[i - 1][1]) / (rows[i + 1][0] - rows[i - 1][0]))
+            for i in range(1, len(rows) - 1)
+        ]
+        half, k, stats = 0.5, 2, []
+        while (k + 1) * half <= v[-1][0]:
+            seg = [(t - k * half, s) for t, s in v if k * half <= t < (k + 1) * half]
+            mean = sum(s for _, s in seg) / len(seg)
+            peak_t, peak = max(seg, key=lambda p: p[1])
+            low = sum(1 for _, s in seg if s < 0.2 * mean) / len(seg)
+            stats.append((mean, min(s for _, s in seg), peak, peak_t, low))
+            k += 1
+        m = [sum(x[i] for x in stats) / len(stats) for i in range(5)]
+        print(
+            f"| {name} | {m[0] * 100:.1f} | {m[1] * 100:.1f} | {m[2] * 100:.1f} | {m[3] * 1e3:.0f} "
+            f"| {m[4] * 100:.0f}% |"
+        )
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sandslope", default="target/release/sandslope")
-    exe = ap.parse_args().sandslope
-    against_closed_form(exe)
-    print()
-    yield_sensitivity(exe)
-    print()
-    regimes(exe)
+    ap.add_argument("--only", choices=["closed", "free", "regimes", "level", "shape"])
+    a = ap.parse_args()
+    exe = a.sandslope
+    tables = {
+        "closed": lambda: against_closed_form(exe, "locked"),
+        "free": lambda: against_closed_form(exe, "free"),
+        "regimes": lambda: regimes(exe),
+        "level": lambda: level_stride(exe),
+        "shape": lambda: shape(exe),
+    }
+    for name, table in tables.items():
+        if a.only in (None, name):
+            print(f"## {name}\n")
+            table()
+            print()
 
 
 if __name__ == "__main__":

@@ -115,9 +115,11 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
             let by_hand = 0.5 * 9.81 * r["slope_deg"].as_f64().unwrap().to_radians().sin() * t1 * t1;
             assert!((slip - by_hand).abs() <= 1e-9 + 1e-6 * by_hand, "{r}");
         }
+        // The pitch is locked in the simulated columns (the default); the free body's walk,
+        // its own columns, is the one that may pitch over.
+        assert_ne!(r["simulated_cause"], "pitch_over");
         if !r["pitch_over_s"].is_null() {
-            assert_eq!(r["agree"], false);
-            assert_eq!(r["simulated_cause"], "pitch_over");
+            assert_eq!(r["pitch_free_cause"], "pitch_over");
         }
         let why = r["why"].as_str().unwrap().replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
         assert!(html.contains(&why.replace('"', "&quot;")), "{why}");
@@ -133,10 +135,10 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
         assert_eq!(sim[0][col], walk[key], "{col}");
     }
     assert_eq!(sim[0]["closed_form_step_m"], walk["closed_form"]["step_m"]);
-    // The pitch-locked column is `simulate --body-pitch locked` at the same slope.
-    let locked: serde_json::Value = serde_json::from_slice(
+    // The pitch-free column is `simulate --body-pitch free` at the same slope.
+    let free: serde_json::Value = serde_json::from_slice(
         &sandslope()
-            .args(["simulate", "--slope", "20", "--body-pitch", "locked", "--json"])
+            .args(["simulate", "--slope", "20", "--body-pitch", "free", "--json"])
             .assert()
             .success()
             .get_output()
@@ -144,8 +146,8 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
     )
     .unwrap();
     let at20 = sim.iter().find(|r| r["slope_deg"] == 20.0).unwrap();
-    assert_eq!(at20["pitch_locked_m_s"], locked["speed_m_s"]);
-    assert_eq!(at20["pitch_locked_regime"], locked["regime"]);
+    assert_eq!(at20["pitch_free_m_s"], free["speed_m_s"]);
+    assert_eq!(at20["pitch_free_regime"], free["regime"]);
     assert!(html.contains("The stride simulator against the closed form"));
     // The simulator's joint fit costs about 90 s of CPU: left out unless asked for, and the page
     // names the flag that adds it.

@@ -60,13 +60,16 @@ fn json_has_the_summary_keys_and_the_closed_form_is_predicts() {
     assert_eq!(sim["closed_form"], predict);
 }
 
-/// `--body-pitch locked` (the closed form's no-pitch assumption): the walk whose body rears up
-/// at 20 degrees keeps its pitch at zero, and --json says which setting ran; so do
-/// `--rft-scaling` (li2013 included), `--creep` and the servo limit.
+/// `--body-pitch locked` (the closed form's no-pitch assumption, and the default): the walk
+/// whose body rears up at 20 degrees with `--body-pitch free` keeps its pitch at zero, and
+/// --json says which setting ran; so do `--rft-scaling` (li2013 included), `--creep` and the
+/// servo limit.
 #[test]
 fn body_pitch_locked_holds_the_body_parallel_to_the_slope() {
-    let free = json(&["simulate", "--slope", "20", "--duration", "3", "--json"]);
+    let free = json(&["simulate", "--slope", "20", "--duration", "3", "--json", "--body-pitch", "free"]);
     assert_eq!(free["body_pitch"], "free");
+    let default = json(&["simulate", "--slope", "20", "--duration", "3", "--json"]);
+    assert_eq!(default["body_pitch"], "locked");
     assert!(free["max_pitch_deg"].as_f64().unwrap() > 5.0);
     assert_eq!(free["creep_m_s"], 1e-7);
     assert!(free["servo_torque_limit_n_m"].is_null());

@@ -18,7 +18,7 @@ use crate::value_error;
 /// `leg{j}_depth_m`, `leg{j}_force_x_n`, `leg{j}_force_z_n`, `leg{j}_torque_n_m`) to a 1-D
 /// array; `summary` is `sandslope simulate --json`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, creep_m_s=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="free", rft_scaling="motion", servo_limit=true))]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, creep_m_s=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="locked", rft_scaling="motion", servo_limit=true))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,

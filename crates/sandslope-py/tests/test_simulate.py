@@ -68,6 +68,9 @@ def test_body_pitch_locked_is_the_cli_flag(cli):
     assert got["body_pitch"] == want["body_pitch"] == "locked"
     assert got["speed_m_s"] == pytest.approx(want["speed_m_s"], rel=1e-12)
     assert (traj["pitch_rad"] == 0.0).all() and got["max_pitch_deg"] == 0.0
+    # Locked is the default, in Python as on the command line.
+    _, default = sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3)
+    assert default["body_pitch"] == "locked" and default["speed_m_s"] == got["speed_m_s"]
     with pytest.raises(ValueError, match=r'body_pitch = "sideways": expected "free" or "locked"'):
         sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, body_pitch="sideways")
 

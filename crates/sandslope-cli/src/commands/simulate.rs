@@ -53,9 +53,10 @@ pub struct SimulateArgs {
     /// limit (by default the limit applies, docs/model.md §15).
     #[arg(long)]
     pub no_servo_limit: bool,
-    /// Whether the body may pitch: `locked` holds it parallel to the slope, the closed form's
-    /// assumption, to see what the pitch does to a walk (docs/simulate.md).
-    #[arg(long, value_name = "MODE", value_enum, default_value_t = PitchArg::Free)]
+    /// Whether the body may pitch: `locked` (the default) holds it parallel to the slope, the
+    /// closed form's assumption and the setting whose answers converge; `free` lets it pitch,
+    /// rear and tumble, not converged on slopes (docs/simulate.md).
+    #[arg(long, value_name = "MODE", value_enum, default_value_t = PitchArg::Locked)]
     pub body_pitch: PitchArg,
     /// How resistive force theory is scaled to the terrain's k_n and k_s: `motion` (one scale
     /// that follows the direction of motion), `components` (normal stress by k_n, shear
@@ -92,9 +93,9 @@ pub struct SimulateArgs {
 /// `--body-pitch`: the library's [`BodyPitch`] as a flag value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum PitchArg {
-    /// The body pitches under the sand's and gravity's moments (default).
+    /// The body pitches under the sand's and gravity's moments (not converged on slopes).
     Free,
-    /// The body is held parallel to the slope, as the closed form assumes.
+    /// The body is held parallel to the slope, as the closed form assumes (default).
     Locked,
 }
 
@@ -342,6 +343,11 @@ fn print_one(sim: &Simulation) {
     if let Some(limit) = m.servo_torque_limit_n_m {
         println!("servo torque limit {limit} N m (the robot file's; --no-servo-limit drives ideal servos)");
     }
+    if m.body_pitch == BodyPitch::Free {
+        println!(
+            "body pitch free (--body-pitch free): not converged on slopes, the answers there change with --dt (docs/simulate.md)"
+        );
+    }
     if m.unconverged_steps > 0 {
         println!(
             "{} time step(s) ended their implicit solve unconverged (docs/simulate.md, \"Convergence\")",
@@ -464,8 +470,10 @@ fn run_slopes(
             }
             println!("{t}");
             println!("{DISAGREE_NOTE}");
-            if settings.body_pitch == BodyPitch::Locked {
-                println!("body pitch locked at 0 (--body-pitch locked), as the closed form assumes");
+            if settings.body_pitch == BodyPitch::Free {
+                println!(
+                    "body pitch free (--body-pitch free): not converged on slopes, the answers there change with --dt (docs/simulate.md)"
+                );
             }
             if settings.rft_scaling != RftScaling::Motion {
                 println!(

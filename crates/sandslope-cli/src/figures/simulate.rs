@@ -255,14 +255,14 @@ impl Figure for SlopesFigure<'_> {
         .label(if self.sims.first().is_some_and(|m| m.body_pitch == BodyPitch::Locked) {
             "simulated, pitch locked (docs/model.md §15-§18)"
         } else {
-            "simulated (docs/model.md §15-§18)"
+            "simulated, pitch free (not converged on slopes; docs/simulate.md)"
         })
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(3)));
         c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, blue.filled()))).map_err(plot_err)?;
         if !locked.is_empty() {
             c.draw_series(DashedLineSeries::new(locked.iter().copied(), 8, 5, blue.stroke_width(2)))
                 .map_err(plot_err)?
-                .label("simulated, body pitch locked (the closed form's assumption)")
+                .label("simulated, body pitch locked (converged; the closed form's assumption)")
                 .legend(move |(x, y)| {
                     // Two dashes, as the curve draws them.
                     EmptyElement::at((x, y))

@@ -713,7 +713,7 @@ def simulate(
     dt_s: Optional[float] = None,
     creep_m_s: Optional[float] = None,
     sample_rate_hz: float = 120.0,
-    body_pitch: str = "free",
+    body_pitch: str = "locked",
     rft_scaling: str = "motion",
     servo_limit: bool = True,
 ) -> Tuple[Any, Dict[str, Any]]:
@@ -724,8 +724,9 @@ def simulate(
     resistive force theory scaled to the terrain's k_n and k_s (``k_n``/``k_s`` override them at
     every slope, as ``--k-n``/``--k-s``); ``dt_s`` fixes the time step, ``creep_m_s`` the creep
     speed of the contact law's smoothing at rest (``--creep``, docs/model.md §17),
-    ``sample_rate_hz`` the trajectory's sampling; ``body_pitch="locked"`` holds the body parallel
-    to the slope, as the closed form assumes (``--body-pitch locked``);
+    ``sample_rate_hz`` the trajectory's sampling; ``body_pitch="locked"`` (the default) holds the
+    body parallel to the slope, as the closed form assumes, the setting whose answers converge;
+    ``"free"`` lets it pitch (``--body-pitch free``; not converged on slopes, docs/simulate.md);
     ``rft_scaling="components"`` scales the sand's normal stress by k_n and its shear stress by
     k_s, ``"li2013"`` everything by one factor from k_n, instead of one scale following the
     motion (``--rft-scaling``, docs/model.md §16); ``servo_limit=False`` ignores the robot

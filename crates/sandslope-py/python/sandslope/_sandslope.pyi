@@ -215,7 +215,7 @@ def simulate(
     dt_s: Optional[float] = None,
     creep_m_s: Optional[float] = None,
     sample_rate_hz: float = 120.0,
-    body_pitch: str = "free",
+    body_pitch: str = "locked",
     rft_scaling: str = "motion",
     servo_limit: bool = True,
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...

@@ -32,7 +32,8 @@ pub struct SimulatorRecord {
     pub observed_m_s: Option<f64>,
     /// Its SD, m/s.
     pub observed_sd_m_s: Option<f64>,
-    /// The simulator's mean step speed, m/s (describes a tumbling body when it pitched over).
+    /// The simulator's mean step speed with the body's pitch locked (its default, the setting
+    /// whose answers converge; the closed form's no-pitch assumption, docs/model.md §15), m/s.
     pub simulated_m_s: f64,
     /// The closed form's speed (`null` where its regime rules a speed out), m/s.
     pub closed_form_m_s: Option<f64>,
@@ -55,17 +56,18 @@ pub struct SimulatorRecord {
     pub simulated_step_m: f64,
     /// The closed form's net step s, m.
     pub closed_form_step_m: Option<f64>,
-    /// Largest |pitch| of the simulated body, degrees.
+    /// Largest |pitch| of the body in the walk with the pitch free, degrees.
     pub max_pitch_deg: f64,
-    /// When the simulated body pitched past 90 degrees, s (`null`: it did not).
+    /// When the body of the walk with the pitch free pitched past 90 degrees, s (`null`: it
+    /// did not).
     pub pitch_over_s: Option<f64>,
-    /// The simulator's mean step speed with the body's pitch locked (the closed form's
-    /// no-pitch assumption, docs/model.md §15), m/s.
-    pub pitch_locked_m_s: f64,
+    /// The simulator's mean step speed with the body free to pitch (not converged on slopes,
+    /// docs/simulate.md: shown for what the pitch does, not as a result), m/s.
+    pub pitch_free_m_s: f64,
     /// The regime of that walk.
-    pub pitch_locked_regime: Regime,
+    pub pitch_free_regime: Regime,
     /// Its cause.
-    pub pitch_locked_cause: MotionCause,
+    pub pitch_free_cause: MotionCause,
     /// Whether the two agree: same regime and, where both have a speed, within 15%.
     pub agree: bool,
     /// Where they part and why, in words.
@@ -84,8 +86,8 @@ pub fn section_slopes(speeds: &[SpeedObservation], terrain: &Terrain) -> Vec<f64
     slopes
 }
 
-/// The section's walks: every slope of [`section_slopes`] with the body free to pitch and
-/// with its pitch locked, and the table's records.
+/// The section's walks: every slope of [`section_slopes`] with the body's pitch locked (the
+/// records' simulated columns) and free to pitch, and the table's records.
 #[derive(Debug, Clone)]
 pub struct SimulatorWalks {
     /// One record per slope.
@@ -97,8 +99,8 @@ pub struct SimulatorWalks {
 }
 
 /// Simulates `robot` on `terrain` at every slope of [`section_slopes`] (10 s walks, the
-/// simulator's defaults), once with the body free to pitch and once with its pitch locked,
-/// and sets each beside the closed form and the observed speed.
+/// simulator's defaults), once with the body's pitch locked (the default, converged) and once
+/// free to pitch, and sets each beside the closed form and the observed speed.
 pub fn simulator_section(
     robot: &Robot,
     terrain: &Terrain,
@@ -113,15 +115,15 @@ pub fn simulator_section(
         })?;
         Ok(sims.into_iter().map(|s| s.summary).collect())
     };
-    let free = walk(&settings)?;
+    let free = walk(&settings.with_body_pitch(BodyPitch::Free))?;
     let pitch_locked = walk(&settings.with_body_pitch(BodyPitch::Locked))?;
     let rolling = crate::simulate::rigid_rolling_step(robot);
-    let records = free
+    let records = pitch_locked
         .iter()
-        .zip(&pitch_locked)
-        .map(|(m, locked)| {
+        .zip(&free)
+        .map(|(m, free)| {
             let observed = speeds.iter().find(|o| (o.slope.degrees() - m.slope_deg).abs() < 1e-9);
-            record(m, locked, observed, rolling)
+            record(m, free, observed, rolling)
         })
         .collect();
     Ok(SimulatorWalks { records, free, pitch_locked })
@@ -129,21 +131,13 @@ pub fn simulator_section(
 
 fn record(
     m: &SimSummary,
-    locked: &SimSummary,
+    free: &SimSummary,
     observed: Option<&SpeedObservation>,
     rolling: f64,
 ) -> SimulatorRecord {
     let cf = m.closed_form.speed();
     let cf_regime = m.closed_form.prediction.regime;
-    let (agree, mut why) = reason(m, cf, cf_regime, rolling);
-    if m.pitch_over_s.is_some() {
-        why.push_str(&format!(
-            "; with the pitch locked: {:.1} cm/s, {} ({})",
-            locked.speed_m_s * 100.0,
-            locked.regime.name(),
-            locked.cause.name()
-        ));
-    }
+    let (agree, why) = reason(m, cf, cf_regime, rolling);
     SimulatorRecord {
         slope_deg: m.slope_deg,
         observed_m_s: observed.map(|o| o.speed),
@@ -159,11 +153,11 @@ fn record(
         closed_form_slip_m: m.closed_form.prediction.slip,
         simulated_step_m: m.step_m,
         closed_form_step_m: m.closed_form.prediction.step,
-        max_pitch_deg: m.max_pitch_deg,
-        pitch_over_s: m.pitch_over_s,
-        pitch_locked_m_s: locked.speed_m_s,
-        pitch_locked_regime: locked.regime,
-        pitch_locked_cause: locked.cause,
+        max_pitch_deg: free.max_pitch_deg,
+        pitch_over_s: free.pitch_over_s,
+        pitch_free_m_s: free.speed_m_s,
+        pitch_free_regime: free.regime,
+        pitch_free_cause: free.cause,
         agree,
         why,
     }

@@ -24,16 +24,19 @@ pub enum LegShape {
 
 /// Whether the body may pitch (docs/model.md §15). The closed form has no body pitch; locking
 /// it in the simulator removes that one difference, so a comparison of the two settings tells
-/// what the pitch does to a walk (docs/simulate.md).
+/// what the pitch does to a walk (docs/simulate.md). Locked is the default: its answers
+/// converge on the built-in robot and terrain, the free body's on slopes do not (it rears and
+/// tumbles from 15 degrees, and whether it does changes with the time step; docs/simulate.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BodyPitch {
-    /// The body pitches under the moments of the sand and gravity (the default).
-    #[default]
+    /// The body pitches under the moments of the sand and gravity (not converged on slopes:
+    /// its answers there are not results).
     Free,
     /// The body keeps its pitch at zero (parallel to the slope), as the closed form assumes:
     /// the moments are carried by a constraint and the body moves along and normal to the slope
-    /// only.
+    /// only (the default).
+    #[default]
     Locked,
 }
 

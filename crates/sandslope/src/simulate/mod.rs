@@ -93,7 +93,7 @@ impl SimSettings {
             settle_s: DEFAULT_SETTLE_S,
             shape: LegShape::CLeg,
             locked_leg_angle: None,
-            body_pitch: BodyPitch::Free,
+            body_pitch: BodyPitch::default(),
             rft_scaling: RftScaling::Motion,
         })
     }

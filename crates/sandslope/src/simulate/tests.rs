@@ -317,7 +317,7 @@ fn pitch_over_outranks_every_cause_but_repose() {
 /// slippage its steps alone would say.
 #[test]
 fn a_body_that_pitches_past_ninety_degrees_is_reported_as_pitched_over() {
-    let settings = SimSettings::new(3.0).unwrap().with_dt(1e-3).unwrap();
+    let settings = SimSettings::new(3.0).unwrap().with_dt(1e-3).unwrap().with_body_pitch(BodyPitch::Free);
     let level = simulate(&scenario(7e5, 3.26e6), 0.0, &settings).unwrap().summary;
     assert!(level.pitch_over_s.is_none() && level.max_pitch_deg < 15.0, "{}", level.max_pitch_deg);
     assert_ne!(level.cause, MotionCause::PitchOver);
@@ -332,7 +332,7 @@ fn a_body_that_pitches_past_ninety_degrees_is_reported_as_pitched_over() {
 /// over, while the free body of the same walk passes 90 degrees.
 #[test]
 fn a_locked_body_keeps_its_pitch_at_zero_where_the_free_one_tumbles() {
-    let free = SimSettings::new(3.0).unwrap().with_dt(1e-3).unwrap();
+    let free = SimSettings::new(3.0).unwrap().with_dt(1e-3).unwrap().with_body_pitch(BodyPitch::Free);
     let locked = free.with_body_pitch(BodyPitch::Locked);
     let s = scenario(7e5, 1.51e6);
     assert!(simulate(&s, 20.0, &free).unwrap().summary.pitch_over_s.is_some());
@@ -412,6 +412,7 @@ fn a_robot_with_held_legs_never_gains_energy() {
                 let settings = SimSettings::new(1.0)
                     .unwrap()
                     .with_locked_legs(heavy.touchdown_angle())
+                    .with_body_pitch(BodyPitch::Free)
                     .with_rft_scaling(scaling);
                 let ground = Ground::new(k_n, k_s).unwrap();
                 let mut w = Walker::new(&heavy, &ground, 10f64.to_radians(), &settings, dt);

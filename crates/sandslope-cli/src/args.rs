@@ -5,12 +5,13 @@
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use sandslope::{LevelStep, Robot, Scenario, Slope, Terrain};
+use sandslope_request::{RobotRequest, ScenarioRequest};
 
 use sandslope::risk::UncertainTerrain;
 use sandslope::robot_key::RobotKey;
 use sandslope::{Axis, AxisScale};
+use sandslope_io::load_terrain;
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
-use sandslope_io::{load_robot, load_terrain};
 
 /// `--robot` and `--mass`.
 #[derive(Debug, Clone, Args)]
@@ -26,13 +27,15 @@ pub struct RobotArgs {
 }
 
 impl RobotArgs {
-    /// Loads the robot and applies `--mass` and the other robot quantities given.
+    /// The request these flags make: the robot, `--mass` and the other robot quantities given.
+    pub fn request(&self) -> RobotRequest {
+        RobotRequest { robot: self.robot.clone(), mass: self.mass, overrides: self.quantities.overrides() }
+    }
+
+    /// Loads the robot and applies `--mass` and the other robot quantities given (the request
+    /// layer's one robot validation, errors naming the flag).
     pub fn load(&self) -> Result<Robot> {
-        let robot = self.quantities.apply(load_robot(&self.robot)?)?;
-        match self.mass {
-            Some(m) => robot.with_mass(m).map_err(|e| anyhow!("{}", e.renamed("--mass"))),
-            None => Ok(robot),
-        }
+        Ok(self.request().load()?)
     }
 }
 
@@ -43,16 +46,8 @@ pub struct LevelStepArgs {
     /// open): `slope` takes d_n at the slope, with its cos(theta) (the default); `level` takes
     /// d_n on level sand, the paper's definition of s*. Up to 0.7% in speed on the built-in
     /// robot and terrain. No effect on a robot with `level_step_m`.
-    #[arg(long, value_name = "slope|level", default_value = "slope", value_parser = parse_level_step)]
+    #[arg(long, value_name = "slope|level", default_value = "slope", value_parser = sandslope_request::scenario::parse_level_step)]
     pub level_step: LevelStep,
-}
-
-fn parse_level_step(s: &str) -> Result<LevelStep, String> {
-    match s {
-        "slope" => Ok(LevelStep::Slope),
-        "level" => Ok(LevelStep::Level),
-        other => Err(format!("`{other}` is not a level-step rule: expected `slope` (d_n at the slope) or `level` (d_n on level sand)")),
-    }
 }
 
 /// `--terrain`.
@@ -137,25 +132,31 @@ pub struct RobotQuantityArgs {
 }
 
 impl RobotQuantityArgs {
-    /// `robot` with the given quantities replaced, validated again as a whole; an error on
-    /// one of these keys names its flag (from the library's table, [`RobotKey::flag`]).
-    pub fn apply(&self, robot: Robot) -> Result<Robot> {
-        let mut spec = robot.spec().clone();
-        let given = [
+    /// The quantities given, by the library's robot key.
+    pub fn overrides(&self) -> Vec<(RobotKey, f64)> {
+        [
             (RobotKey::LegRadiusM, self.leg_radius),
             (RobotKey::LegWidthM, self.leg_width),
             (RobotKey::HipHeightM, self.hip_height),
             (RobotKey::LegSpeedRadS, self.leg_speed),
             (RobotKey::StanceLegs, self.stance_legs.map(f64::from)),
             (RobotKey::ResponseTimeS, self.response_time),
-        ];
-        for (key, value) in given {
-            if let Some(v) = value {
-                key.set(&mut spec, v);
-            }
+        ]
+        .into_iter()
+        .filter_map(|(key, value)| value.map(|v| (key, v)))
+        .collect()
+    }
+
+    /// `robot` with the given quantities replaced, validated again as a whole; an error on
+    /// one of these keys names its flag (from the library's table, [`RobotKey::flag`]).
+    pub fn apply(&self, robot: Robot) -> Result<Robot> {
+        let mut spec = robot.spec().clone();
+        let overrides = self.overrides();
+        for &(key, v) in &overrides {
+            key.set(&mut spec, v);
         }
         Robot::new(spec).map_err(|e| {
-            let flag = given.iter().find(|(key, _)| key.name() == e.key).and_then(|(key, _)| key.flag());
+            let flag = overrides.iter().find(|(key, _)| key.name() == e.key).and_then(|(key, _)| key.flag());
             match flag {
                 Some(flag) => anyhow!("{}", e.renamed(flag)),
                 None => anyhow!("{e}"),
@@ -179,12 +180,21 @@ pub struct OverrideArgs {
 }
 
 impl OverrideArgs {
-    /// The scenario `predict` and `sweep` evaluate: robot, terrain and these overrides.
+    /// The scenario request of `predict` and `sweep`: robot, terrain and these overrides.
+    pub fn request(&self, robot: &RobotArgs, terrain: &TerrainArgs) -> ScenarioRequest {
+        ScenarioRequest {
+            robot: robot.request(),
+            terrain: terrain.terrain.clone(),
+            k_n: self.k_n,
+            k_s: self.k_s,
+            level_step: self.level.level_step,
+        }
+    }
+
+    /// The scenario `predict`, `sweep` and `simulate` evaluate: robot, terrain and these
+    /// overrides, checked by the request layer.
     pub fn scenario(&self, robot: &RobotArgs, terrain: &TerrainArgs) -> Result<Scenario> {
-        let k_n = self.k_n.map(|v| check_positive("--k-n", v)).transpose()?;
-        let k_s = self.k_s.map(|v| check_positive("--k-s", v)).transpose()?;
-        let robot = robot.load()?.with_level_step(self.level.level_step);
-        Scenario::new(robot, terrain.load()?, k_n, k_s).map_err(|e| anyhow!("{e}"))
+        Ok(self.request(robot, terrain).scenario()?)
     }
 }
 

@@ -17,8 +17,9 @@ use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
 use super::data::{DemInfo, Reply};
-use crate::commands::{phase, plan, predict, risk, simulate, sweep};
+use crate::commands::{phase, plan, risk, simulate};
 use sandslope_io::presets::{self, PresetKind};
+use sandslope_request::{PredictRequest, RequestError, SweepRequest};
 
 /// Most slopes one `/api/sweep` request evaluates.
 pub const MAX_SWEEP_SLOPES: usize = 10_000;
@@ -129,6 +130,53 @@ impl ApiError {
     }
 }
 
+impl From<RequestError> for ApiError {
+    /// A refused request: 400, the field the request layer names.
+    fn from(e: RequestError) -> ApiError {
+        ApiError::bad(e.field().map(str::to_string), e.message())
+    }
+}
+
+/// A request's parameters as the request layer reads them: output flags and names that are
+/// not built-in presets refused (a request writes no file and reads none), the served robot
+/// and terrain added where the request names none.
+fn request_params(params: &[(String, String)], served: &Served) -> Result<Vec<(String, String)>, ApiError> {
+    for (key, value) in params {
+        if OUTPUT_FLAGS.contains(&key.as_str()) {
+            return Err(ApiError::bad(
+                Some(key.clone()),
+                format!(
+                    "{key}: the API answers JSON and writes no file; this flag is for the command line only"
+                ),
+            ));
+        }
+        if let Some(kind) = preset_kind(key) {
+            check_preset(key, value, kind)?;
+        }
+    }
+    let mut params = params.to_vec();
+    for (key, served_value) in [("robot", &served.robot), ("terrain", &served.terrain)] {
+        if !params.iter().any(|(k, _)| k == key) {
+            params.push((key.to_string(), served_value.clone()));
+        }
+    }
+    Ok(params)
+}
+
+/// Refuses a robot or terrain that is not a built-in preset: a request cannot name a file.
+fn check_preset(key: &str, value: &str, kind: PresetKind) -> Result<(), ApiError> {
+    if presets::find(value, kind).is_none() {
+        return Err(ApiError::bad(
+            Some(key.into()),
+            format!(
+                "{key} = `{value}` is not a built-in preset ({}); a request cannot name a file",
+                presets::names(kind)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The first `--flag` named in `text`, without the dashes.
 fn flag_named_in(text: &str) -> Option<String> {
     let start = text.find("--")? + 2;
@@ -142,12 +190,12 @@ fn flag_named_in(text: &str) -> Option<String> {
 pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
     match command {
         "predict" => {
-            let args: predict::PredictArgs = parse("predict", params, served)?;
-            Ok(Reply::pretty(predict::answer(&args).map_err(|e| ApiError::from_command(&e))?))
+            let request = PredictRequest::from_params(&request_params(params, served)?)?;
+            Ok(Reply::pretty(request.answer()?))
         }
         "sweep" => {
-            let args: sweep::SweepArgs = parse("sweep", params, served)?;
-            let n = sweep::slope_count(&args).map_err(|e| ApiError::from_command(&e))?;
+            let request = SweepRequest::from_params(&request_params(params, served)?)?;
+            let n = request.slopes()?.len();
             if n > MAX_SWEEP_SLOPES {
                 return Err(ApiError::bad(
                     Some("step".to_string()),
@@ -156,7 +204,7 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
                     ),
                 ));
             }
-            Ok(Reply::pretty(sweep::answer(&args).map_err(|e| ApiError::from_command(&e))?))
+            Ok(Reply::pretty(request.answer()?))
         }
         "phase" => {
             let args: phase::PhaseArgs = parse("phase", params, served)?;
@@ -280,15 +328,7 @@ pub fn parse<T: clap::Args + FromArgMatches>(
             ));
         };
         if let Some(kind) = preset_kind(key) {
-            if presets::find(value, kind).is_none() {
-                return Err(ApiError::bad(
-                    Some(key.into()),
-                    format!(
-                        "{key} = `{value}` is not a built-in preset ({}); a request cannot name a file",
-                        presets::names(kind)
-                    ),
-                ));
-            }
+            check_preset(key, value, kind)?;
         }
         if matches!(arg.get_action(), ArgAction::SetTrue) {
             match value.as_str() {

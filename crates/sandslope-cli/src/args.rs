@@ -150,18 +150,8 @@ impl RobotQuantityArgs {
     /// `robot` with the given quantities replaced, validated again as a whole; an error on
     /// one of these keys names its flag (from the library's table, [`RobotKey::flag`]).
     pub fn apply(&self, robot: Robot) -> Result<Robot> {
-        let mut spec = robot.spec().clone();
-        let overrides = self.overrides();
-        for &(key, v) in &overrides {
-            key.set(&mut spec, v);
-        }
-        Robot::new(spec).map_err(|e| {
-            let flag = overrides.iter().find(|(key, _)| key.name() == e.key).and_then(|(key, _)| key.flag());
-            match flag {
-                Some(flag) => anyhow!("{}", e.renamed(flag)),
-                None => anyhow!("{e}"),
-            }
-        })
+        let request = RobotRequest { overrides: self.overrides(), ..RobotRequest::default() };
+        Ok(request.apply(robot)?)
     }
 }
 

@@ -58,30 +58,35 @@ impl RobotRequest {
         Ok(RobotRequest { robot, mass, overrides })
     }
 
-    /// The robot: read, its quantities replaced and validated again as a whole, then the
-    /// mass. An error on an overridden key names its field (from [`RobotKey::flag`]).
+    /// `robot` with this request's quantities replaced (not the mass), validated again as a
+    /// whole. An error on a key a request can override names its field (from
+    /// [`RobotKey::flag`]), even when another override broke it (`leg-radius` made too small
+    /// for the file's hip height names `hip-height`).
+    pub fn apply(&self, robot: Robot) -> Result<Robot> {
+        if self.overrides.is_empty() {
+            return Ok(robot);
+        }
+        let mut spec = robot.spec().clone();
+        for &(key, value) in &self.overrides {
+            key.set(&mut spec, value);
+        }
+        Robot::new(spec).map_err(|e| match override_fields().find(|(key, _)| key.name() == e.key) {
+            Some((key, field)) => {
+                let flag = key.flag().unwrap_or(field);
+                RequestError::invalid(field, e.renamed(flag))
+            }
+            None => RequestError::from_error(None, anyhow::anyhow!("{e}")),
+        })
+    }
+
+    /// The robot: read, its quantities replaced and validated again as a whole ([`apply`]),
+    /// then the mass.
+    ///
+    /// [`apply`]: RobotRequest::apply
     pub fn load(&self) -> Result<Robot> {
         let robot =
             sandslope_io::load_robot(&self.robot).map_err(|e| RequestError::from_error(Some("robot"), e))?;
-        let robot = if self.overrides.is_empty() {
-            robot
-        } else {
-            let mut spec = robot.spec().clone();
-            for &(key, value) in &self.overrides {
-                key.set(&mut spec, value);
-            }
-            Robot::new(spec).map_err(|e| {
-                let flag = self
-                    .overrides
-                    .iter()
-                    .find(|(key, _)| key.name() == e.key)
-                    .and_then(|(key, _)| key.flag());
-                match flag {
-                    Some(flag) => RequestError::invalid(field_of(flag), e.renamed(flag)),
-                    None => RequestError::from_error(None, anyhow::anyhow!("{e}")),
-                }
-            })?
-        };
+        let robot = self.apply(robot)?;
         match self.mass {
             Some(m) => robot.with_mass(m).map_err(|e| RequestError::invalid("mass", e.renamed("--mass"))),
             None => Ok(robot),

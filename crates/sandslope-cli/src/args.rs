@@ -2,10 +2,10 @@
 //! `--k-n`, `--k-s`, grid axes) and the checks of flag values. Commands share code through
 //! this module, never through each other.
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{anyhow, Result};
 use clap::Args;
-use sandslope::{LevelStep, Robot, Scenario, Slope, Terrain};
-use sandslope_request::{RobotRequest, ScenarioRequest};
+use sandslope::{LevelStep, Robot, Scenario, Terrain};
+use sandslope_request::{grammar, RobotRequest, ScenarioRequest};
 
 use sandslope::risk::UncertainTerrain;
 use sandslope::robot_key::RobotKey;
@@ -83,25 +83,14 @@ pub struct UncertaintyArgs {
 impl UncertaintyArgs {
     /// Checks the flags alone, before any file is read: each CV a finite number of at least 0.
     pub fn check(&self) -> Result<()> {
-        for (flag, cv) in [("--cv-n", self.cv_n), ("--cv-s", self.cv_s)] {
-            if let Some(cv) = cv {
-                check_flag(flag, cv, 0.0, f64::INFINITY)?;
-            }
-        }
-        Ok(())
+        Ok(grammar::check_cvs(self.cv_n, self.cv_s)?)
     }
 
     /// The terrain read as uncertain (a flag's CV, else the table's SDs, else the default CV),
     /// with the note to print when a default is used anywhere on the table. Errors name the
     /// flag: `--cv-n = -1 must be a finite number of at least 0`.
     pub fn apply(&self, terrain: Terrain) -> Result<(UncertainTerrain, Option<String>)> {
-        self.check()?;
-        let u = UncertainTerrain::new(terrain, self.cv_n, self.cv_s).map_err(|e| {
-            let flag = if e.key == "cv_s" { "--cv-s" } else { "--cv-n" };
-            anyhow!("{}", e.renamed(flag))
-        })?;
-        let note = u.defaults_used().note();
-        Ok((u, note))
+        Ok(grammar::uncertain_terrain(terrain, self.cv_n, self.cv_s)?)
     }
 }
 
@@ -221,148 +210,39 @@ pub fn beyond_last_point(terrain: &Terrain, slopes_deg: &[f64]) -> Vec<f64> {
 /// Checks a command-line number: finite and within `lo..=hi`, naming the flag (`hi` infinite:
 /// no upper bound).
 pub fn check_flag(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
-    if value.is_finite() && value >= lo && value <= hi {
-        Ok(value)
-    } else if hi == f64::INFINITY {
-        bail!("{flag} = {value} must be a finite number of at least {lo}")
-    } else {
-        bail!("{flag} = {value} must be between {lo} and {hi}")
-    }
+    Ok(sandslope_request::error::check_range(flag.trim_start_matches('-'), value, lo, hi)?)
 }
 
-/// Parses `--max-risk` (clap's value parser, so every command that takes it says the same):
-/// a failure probability strictly between 0 and 1.
-pub fn parse_max_risk(text: &str) -> Result<f64, String> {
-    match text.trim().parse::<f64>() {
-        Ok(p) if p > 0.0 && p < 1.0 => Ok(p),
-        Ok(p) => Err(format!("{p} is not a failure probability strictly between 0 and 1 (e.g. 0.05)")),
-        Err(_) => Err(format!(
-            "`{text}` is not a number: expected a failure probability strictly between 0 and 1 (e.g. 0.05)"
-        )),
-    }
-}
+pub use sandslope_request::grammar::{parse_max_risk, AxisRange, SlopeSign};
 
-/// Which slopes a slope list accepts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SlopeSign {
-    /// Climbing only: 0 <= deg < 90.
-    Uphill,
-    /// Signed inclinations, -90 < deg < 90 (a descent is felt as the climb of its size,
-    /// docs/model.md §8).
-    Signed,
-}
-
-/// Parses a slope list given to `flag`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N` (N evenly spaced
-/// slopes, both ends included), in degrees, with at most `max` slopes. N and the list's length
-/// are checked against `max` before anything is expanded (`0:24:99999999999` is refused at
-/// once, not after allocating 800 GB). The one slope-list grammar of every command.
+/// Parses a slope list given to `flag`: the one slope-list grammar of every front end
+/// ([`grammar::parse_slope_list`]: `DEG`, `DEG,DEG,...` or `MIN:MAX:N`, at most `max`).
 pub fn parse_slope_list(flag: &str, text: &str, sign: SlopeSign, max: usize) -> Result<Vec<f64>> {
-    let number = |s: &str| -> Result<f64> {
-        let v: f64 =
-            s.trim().parse().map_err(|_| anyhow!("{flag}: `{}` is not a number (in {text})", s.trim()))?;
-        match sign {
-            SlopeSign::Uphill => Slope::from_degrees(v).map(|_| ()),
-            SlopeSign::Signed => Slope::from_signed_degrees(v).map(|_| ()),
-        }
-        .map_err(|e| anyhow!("{}", e.renamed(flag)))?;
-        Ok(v)
-    };
-    if text.contains(':') {
-        let parts: Vec<&str> = text.split(':').collect();
-        let [lo, hi, n] = parts.as_slice() else {
-            bail!("{flag} = {text} must be DEG, a comma list DEG,DEG,... or MIN:MAX:N (e.g. 0:24:13)");
-        };
-        let count = n.trim();
-        let (lo, hi) = (number(lo)?, number(hi)?);
-        let n: usize = count.parse().ok().filter(|n| (2..=max).contains(n)).ok_or_else(|| {
-            // The third field is a count, not a step: `0:30:1` most likely meant 1-degree
-            // steps, which is the count (MAX - MIN) / step + 1, suggested where whole.
-            let step: Option<f64> = count.parse().ok().filter(|s: &f64| *s > 0.0 && hi > lo);
-            let hint = step
-                .map(|step| (hi - lo) / step + 1.0)
-                .filter(|k| (k - k.round()).abs() < 1e-9 && (2.0..=max as f64).contains(&k.round()))
-                .map(|k| {
-                    format!(
-                        "; the third field is the number of slopes, not a step: for steps of {count} deg from {lo} to {hi} write {lo}:{hi}:{}",
-                        k.round()
-                    )
-                })
-                .unwrap_or_else(|| "; the third field is the number of slopes, not a step".into());
-            anyhow!("{flag}: N `{count}` must be a whole number from 2 to {max} (in {text}){hint}")
-        })?;
-        if hi <= lo {
-            bail!("{flag} = {text}: MAX must be greater than MIN");
-        }
-        return Ok((0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect());
-    }
-    let count = text.split(',').count();
-    if count > max {
-        bail!("{flag} lists {count} slopes; at most {max} are allowed");
-    }
-    text.split(',').map(number).collect()
+    Ok(grammar::parse_slope_list(flag.trim_start_matches('-'), text, sign, max)?)
 }
 
 /// Checks a command-line number is finite and strictly positive, naming the flag.
 pub fn check_positive(flag: &str, value: f64) -> Result<f64> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        bail!("{flag} = {value} must be a finite number greater than 0")
-    }
+    Ok(sandslope_request::error::check_positive(flag.trim_start_matches('-'), value)?)
 }
 
 /// Parses a grid axis `MIN:MAX:N[:log|:lin]` given to `flag` (log spacing by default: the
-/// strengths k_n and k_s span decades).
+/// strengths k_n and k_s span decades), by the one axis grammar of every front end.
 pub fn parse_axis(flag: &str, text: &str) -> Result<Axis> {
-    let range = parse_axis_range(text, AxisScale::Log, &format!("{flag}:"), text)?.ok_or_else(|| {
-        anyhow!("{flag} = {text} must be MIN:MAX:N or MIN:MAX:N:log or MIN:MAX:N:lin (e.g. 1e4:1e7:400)")
-    })?;
-    Axis::new(flag, range.min, range.max, range.n, range.scale).map_err(|e| anyhow!("{e}"))
+    let field = flag.trim_start_matches('-');
+    Ok(grammar::axis(field, grammar::parse_strength_axis(field, text)?)?)
 }
 
-/// The numbers of an axis `MIN:MAX:N[:log|:lin]`, before the library checks their ranges.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AxisRange {
-    /// First value.
-    pub min: f64,
-    /// Last value.
-    pub max: f64,
-    /// Number of values, as written (each use checks it is at least 2).
-    pub n: usize,
-    /// Spacing.
-    pub scale: AxisScale,
-}
-
-/// The one grammar of a grid axis on the command line, `MIN:MAX:N[:log|:lin]`, for every flag
-/// that takes one (`--k-n`, `--k-s`, `design --vary KEY=...`); `default` is the spacing when
-/// none is written, stated by each use (log for strengths, linear for robot quantities).
-/// `None` when `text` is not of that shape (each use names its own forms); errors begin with
-/// `prefix` and quote `context`.
+/// The one grammar of a grid axis, `MIN:MAX:N[:log|:lin]` ([`grammar::parse_axis_range`]);
+/// errors begin with `prefix`, whose first word is the flag.
 pub fn parse_axis_range(
     text: &str,
     default: AxisScale,
     prefix: &str,
     context: &str,
 ) -> Result<Option<AxisRange>> {
-    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
-    if !(3..=4).contains(&parts.len()) {
-        return Ok(None);
-    }
-    let number = |what: &str, s: &str| -> Result<f64> {
-        s.parse::<f64>().map_err(|_| anyhow!("{prefix} {what} `{s}` is not a number (in {context})"))
-    };
-    let (min, max) = (number("MIN", parts[0])?, number("MAX", parts[1])?);
-    // N < 2 is left to the use: the library's axis names its own key (`--k-n points = 0`).
-    let n: usize = parts[2].parse().map_err(|_| {
-        anyhow!("{prefix} N `{}` must be a whole number of at least 2 (in {context})", parts[2])
-    })?;
-    let scale = match parts.get(3).map(|s| s.to_ascii_lowercase()).as_deref() {
-        None => default,
-        Some("log") => AxisScale::Log,
-        Some("lin") | Some("linear") => AxisScale::Linear,
-        Some(other) => bail!("{prefix} spacing `{other}` must be `log` or `lin` (in {context})"),
-    };
-    Ok(Some(AxisRange { min, max, n, scale }))
+    let field = prefix.split([':', ' ']).next().unwrap_or(prefix).trim_start_matches('-');
+    Ok(grammar::parse_axis_range(field, text, default, prefix, context)?)
 }
 
 /// A log axis from `lo / down` to `hi * up` around positive terrain values, with `n` points.

@@ -17,13 +17,16 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod grammar;
 pub mod params;
 pub mod predict;
+pub mod risk;
 pub mod scenario;
 pub mod sweep;
 
 pub use error::{RequestError, Result};
 pub use params::Params;
 pub use predict::PredictRequest;
+pub use risk::RiskRequest;
 pub use scenario::{RobotRequest, ScenarioRequest};
 pub use sweep::SweepRequest;

@@ -17,9 +17,10 @@ use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
 use super::data::{DemInfo, Reply};
-use crate::commands::{phase, plan, risk, simulate};
+use crate::commands::{phase, plan, simulate};
 use sandslope_io::presets::{self, PresetKind};
-use sandslope_request::{PredictRequest, RequestError, SweepRequest};
+use sandslope_request::risk::AnswerLimits;
+use sandslope_request::{PredictRequest, RequestError, RiskRequest, SweepRequest};
 
 /// Most slopes one `/api/sweep` request evaluates.
 pub const MAX_SWEEP_SLOPES: usize = 10_000;
@@ -29,8 +30,8 @@ pub const MAX_PHASE_CELLS: u128 = 1 << 20;
 /// What one `/api/risk` request may ask for: at most 1000 slopes of a p_fail curve (a
 /// quadrature each, a few ms), 100 slopes of a payload envelope (a search over masses each)
 /// and 2^20 `--map` cells (the command line allows 65536 slopes and 2^24 cells).
-pub const RISK_LIMITS: risk::AnswerLimits =
-    risk::AnswerLimits { curve_slopes: 1000, envelope_slopes: 100, map_cells: 1 << 20 };
+pub const RISK_LIMITS: AnswerLimits =
+    AnswerLimits { curve_slopes: 1000, envelope_slopes: 100, map_cells: 1 << 20 };
 
 /// Longest walk one `/api/simulate` request simulates, s (the command line has no limit but
 /// the library's 2e7 integration steps).
@@ -211,8 +212,8 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
             Ok(Reply::pretty(phase::answer(&args, MAX_PHASE_CELLS).map_err(|e| ApiError::from_command(&e))?))
         }
         "risk" => {
-            let args: risk::RiskArgs = parse("risk", params, served)?;
-            Ok(Reply::pretty(risk::answer(&args, RISK_LIMITS).map_err(|e| ApiError::from_command(&e))?))
+            let request = RiskRequest::from_params(&request_params(params, served)?)?;
+            Ok(Reply::pretty(request.answer(RISK_LIMITS)?))
         }
         "simulate" => {
             let walks = simulate_walks(params, served)?;

@@ -93,3 +93,24 @@ fn requests_round_trip_through_json() {
     let text = serde_json::to_string(&r).unwrap();
     assert_eq!(serde_json::from_str::<PredictRequest>(&text).unwrap(), r);
 }
+
+#[test]
+fn risk_refusals_name_their_field_and_the_default_is_seven_slopes() {
+    use sandslope_request::risk::{AnswerLimits, RiskRequest};
+    let risk = |list: &[(&str, &str)]| RiskRequest::from_params(&pairs(list));
+    assert_eq!(field(risk(&[("slope", "0:24:q")])), "slope");
+    assert_eq!(field(risk(&[("max-risk", "1.5")])), "max-risk");
+    assert_eq!(field(risk(&[("solve", "speed")])), "solve");
+    assert_eq!(field(risk(&[("k-n", "1e4:1e7:20")])), "k-n");
+    assert_eq!(field(risk(&[("map", "maybe")])), "map");
+    assert_eq!(field(risk(&[("map", ""), ("solve", "mass")])), "solve");
+    let limits = AnswerLimits { curve_slopes: 3, envelope_slopes: 3, map_cells: 100 };
+    let answer = |list: &[(&str, &str)]| risk(list).unwrap().answer(limits);
+    assert_eq!(field(answer(&[("cv-s", "-1")])), "cv-s");
+    assert_eq!(field(answer(&[("slope", "0:24:4")])), "slope");
+    assert_eq!(field(answer(&[("map", ""), ("slope", "10"), ("k-n", "1e4:1e7:11"), ("k-s", "1e3:1e6:10")])), "k-n");
+    // 0:24:7 is 0, 4, ..., 24 degrees: seven points of the curve, in order.
+    let default = RiskRequest::from_params(&[]).unwrap();
+    assert_eq!(default.slopes, vec![0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 24.0]);
+    assert_eq!((default.max_risk, default.solve, default.map), (0.05, None, None));
+}

@@ -108,7 +108,10 @@ fn risk_refusals_name_their_field_and_the_default_is_seven_slopes() {
     let answer = |list: &[(&str, &str)]| risk(list).unwrap().answer(limits);
     assert_eq!(field(answer(&[("cv-s", "-1")])), "cv-s");
     assert_eq!(field(answer(&[("slope", "0:24:4")])), "slope");
-    assert_eq!(field(answer(&[("map", ""), ("slope", "10"), ("k-n", "1e4:1e7:11"), ("k-s", "1e3:1e6:10")])), "k-n");
+    assert_eq!(
+        field(answer(&[("map", ""), ("slope", "10"), ("k-n", "1e4:1e7:11"), ("k-s", "1e3:1e6:10")])),
+        "k-n"
+    );
     // 0:24:7 is 0, 4, ..., 24 degrees: seven points of the curve, in order.
     let default = RiskRequest::from_params(&[]).unwrap();
     assert_eq!(default.slopes, vec![0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 24.0]);

@@ -2,14 +2,14 @@
 //! `--k-n`, `--k-s`, grid axes) and the checks of flag values. Commands share code through
 //! this module, never through each other.
 
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use clap::Args;
 use sandslope::{LevelStep, Robot, Scenario, Terrain};
 use sandslope_request::{grammar, RobotRequest, ScenarioRequest};
 
 use sandslope::risk::UncertainTerrain;
 use sandslope::robot_key::RobotKey;
-use sandslope::{Axis, AxisScale};
+use sandslope::AxisScale;
 use sandslope_io::load_terrain;
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 
@@ -135,13 +135,6 @@ impl RobotQuantityArgs {
         .filter_map(|(key, value)| value.map(|v| (key, v)))
         .collect()
     }
-
-    /// `robot` with the given quantities replaced, validated again as a whole; an error on
-    /// one of these keys names its flag (from the library's table, [`RobotKey::flag`]).
-    pub fn apply(&self, robot: Robot) -> Result<Robot> {
-        let request = RobotRequest { overrides: self.overrides(), ..RobotRequest::default() };
-        Ok(request.apply(robot)?)
-    }
 }
 
 /// `--k-n` and `--k-s`: fixed resistances overriding the terrain's at every slope; and
@@ -226,13 +219,6 @@ pub fn check_positive(flag: &str, value: f64) -> Result<f64> {
     Ok(sandslope_request::error::check_positive(flag.trim_start_matches('-'), value)?)
 }
 
-/// Parses a grid axis `MIN:MAX:N[:log|:lin]` given to `flag` (log spacing by default: the
-/// strengths k_n and k_s span decades), by the one axis grammar of every front end.
-pub fn parse_axis(flag: &str, text: &str) -> Result<Axis> {
-    let field = flag.trim_start_matches('-');
-    Ok(grammar::axis(field, grammar::parse_strength_axis(field, text)?)?)
-}
-
 /// The one grammar of a grid axis, `MIN:MAX:N[:log|:lin]` ([`grammar::parse_axis_range`]);
 /// errors begin with `prefix`, whose first word is the flag.
 pub fn parse_axis_range(
@@ -245,26 +231,9 @@ pub fn parse_axis_range(
     Ok(grammar::parse_axis_range(field, text, default, prefix, context)?)
 }
 
-/// A log axis from `lo / down` to `hi * up` around positive terrain values, with `n` points.
-pub fn default_axis(flag: &str, values: &[f64], down: f64, up: f64, n: usize) -> Result<Axis> {
-    Axis::log_around(flag, values, down, up, n).map_err(|e| anyhow!("{e}"))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn axis_flags_parse_and_reject_bad_input() {
-        let a = parse_axis("--k-n", "1e4:1e7:31").unwrap();
-        assert_eq!((a.min(), a.max(), a.len(), a.scale()), (1e4, 1e7, 31, AxisScale::Log));
-        assert_eq!(parse_axis("--k-n", "0:10:11:lin").unwrap().scale(), AxisScale::Linear);
-        for bad in ["1e4:1e7", "a:1e7:3", "1e4:1e7:x", "1e4:1e7:3:cubic", "0:1e7:3", "1e7:1e4:3", "1e4:1e7:1"]
-        {
-            let msg = parse_axis("--k-n", bad).unwrap_err().to_string();
-            assert!(msg.contains("--k-n"), "{bad}: {msg}");
-        }
-    }
 
     /// One grammar for every slope list: N is refused before any expansion (an N of 1e11
     /// would have asked for 800 GB), each slope by the library's rule, named by its flag.

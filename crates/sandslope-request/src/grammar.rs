@@ -187,3 +187,25 @@ pub fn check_cvs(cv_n: Option<f64>, cv_s: Option<f64>) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse_axis(field: &str, text: &str) -> Result<Axis> {
+        axis(field, parse_strength_axis(field, text)?)
+    }
+
+    #[test]
+    fn axes_parse_and_reject_bad_input_naming_the_field() {
+        let a = parse_axis("k-n", "1e4:1e7:31").unwrap();
+        assert_eq!((a.min(), a.max(), a.len(), a.scale()), (1e4, 1e7, 31, AxisScale::Log));
+        assert_eq!(parse_axis("k-n", "0:10:11:lin").unwrap().scale(), AxisScale::Linear);
+        for bad in ["1e4:1e7", "a:1e7:3", "1e4:1e7:x", "1e4:1e7:3:cubic", "0:1e7:3", "1e7:1e4:3", "1e4:1e7:1"]
+        {
+            let e = parse_axis("k-n", bad).unwrap_err();
+            assert_eq!(e.field(), Some("k-n"), "{bad}");
+            assert!(e.message().contains("--k-n"), "{bad}: {}", e.message());
+        }
+    }
+}

@@ -19,6 +19,7 @@
 pub mod error;
 pub mod grammar;
 pub mod params;
+pub mod phase;
 pub mod predict;
 pub mod risk;
 pub mod scenario;
@@ -26,6 +27,7 @@ pub mod sweep;
 
 pub use error::{RequestError, Result};
 pub use params::Params;
+pub use phase::PhaseRequest;
 pub use predict::PredictRequest;
 pub use risk::RiskRequest;
 pub use scenario::{RobotRequest, ScenarioRequest};

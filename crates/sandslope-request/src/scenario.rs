@@ -47,6 +47,12 @@ impl RobotRequest {
     pub fn from_params(p: &mut Params<'_>) -> Result<RobotRequest> {
         let robot = p.text_or("robot", DEFAULT_ROBOT)?;
         let mass = p.number("mass")?;
+        let overrides = Self::overrides_from_params(p)?;
+        Ok(RobotRequest { robot, mass, overrides })
+    }
+
+    /// Reads the override fields alone (`leg-radius`, ..., from [`RobotKey::TABLE`]).
+    pub fn overrides_from_params(p: &mut Params<'_>) -> Result<Vec<(RobotKey, f64)>> {
         let mut overrides = Vec::new();
         for (key, field) in override_fields() {
             let value =
@@ -55,7 +61,7 @@ impl RobotRequest {
                 overrides.push((key, v));
             }
         }
-        Ok(RobotRequest { robot, mass, overrides })
+        Ok(overrides)
     }
 
     /// `robot` with this request's quantities replaced (not the mass), validated again as a

@@ -17,10 +17,10 @@ use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
 use super::data::{DemInfo, Reply};
-use crate::commands::{phase, plan, simulate};
+use crate::commands::{plan, simulate};
 use sandslope_io::presets::{self, PresetKind};
 use sandslope_request::risk::AnswerLimits;
-use sandslope_request::{PredictRequest, RequestError, RiskRequest, SweepRequest};
+use sandslope_request::{PhaseRequest, PredictRequest, RequestError, RiskRequest, SweepRequest};
 
 /// Most slopes one `/api/sweep` request evaluates.
 pub const MAX_SWEEP_SLOPES: usize = 10_000;
@@ -141,7 +141,10 @@ impl From<RequestError> for ApiError {
 /// A request's parameters as the request layer reads them: output flags and names that are
 /// not built-in presets refused (a request writes no file and reads none), the served robot
 /// and terrain added where the request names none.
-fn request_params(params: &[(String, String)], served: &Served) -> Result<Vec<(String, String)>, ApiError> {
+pub fn request_params(
+    params: &[(String, String)],
+    served: &Served,
+) -> Result<Vec<(String, String)>, ApiError> {
     for (key, value) in params {
         if OUTPUT_FLAGS.contains(&key.as_str()) {
             return Err(ApiError::bad(
@@ -208,8 +211,8 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
             Ok(Reply::pretty(request.answer()?))
         }
         "phase" => {
-            let args: phase::PhaseArgs = parse("phase", params, served)?;
-            Ok(Reply::pretty(phase::answer(&args, MAX_PHASE_CELLS).map_err(|e| ApiError::from_command(&e))?))
+            let request = PhaseRequest::from_params(&request_params(params, served)?)?;
+            Ok(Reply::pretty(request.answer(MAX_PHASE_CELLS)?))
         }
         "risk" => {
             let request = RiskRequest::from_params(&request_params(params, served)?)?;

@@ -7,10 +7,11 @@ use std::io::Write;
 use serde::Serialize;
 
 use super::api::{self, ApiError, Served};
-use crate::commands::{phase, plan};
+use crate::commands::plan;
 use sandslope::Cause;
 use sandslope_io::presets::{PresetKind, PRESETS};
 use sandslope_io::raster::{read_raster, write_two_band_geotiff};
+use sandslope_request::PhaseRequest;
 
 /// Most cells of a `/data/phase-map` (the page asks for about 160 x 160).
 pub const MAX_MAP_CELLS: u128 = 1 << 18;
@@ -247,12 +248,9 @@ fn phase_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiE
         regimes: String,
         summary: sandslope::PanelSummary,
     }
-    let args: phase::PhaseArgs = api::parse("phase", params, served)?;
-    let panels = phase::compute(&args, MAX_MAP_CELLS, true, false).map_err(|e| {
-        let error = format!("{e:#}");
-        ApiError::bad(Some("k-n".to_string()), error)
-    })?;
-    let Some(p) = panels.panels.first() else {
+    let request = PhaseRequest::from_params(&api::request_params(params, served)?)?;
+    let panels = request.grid(MAX_MAP_CELLS)?.compute(&|| {})?;
+    let Some(p) = panels.first() else {
         return Err(ApiError::bad(Some("slope".to_string()), "no panel: give a slope"));
     };
     let (nx, ny) = (p.map.k_n().len(), p.map.k_s().len());

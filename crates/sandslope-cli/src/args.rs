@@ -81,11 +81,6 @@ pub struct UncertaintyArgs {
 }
 
 impl UncertaintyArgs {
-    /// Checks the flags alone, before any file is read: each CV a finite number of at least 0.
-    pub fn check(&self) -> Result<()> {
-        Ok(grammar::check_cvs(self.cv_n, self.cv_s)?)
-    }
-
     /// The terrain read as uncertain (a flag's CV, else the table's SDs, else the default CV),
     /// with the note to print when a default is used anywhere on the table. Errors name the
     /// flag: `--cv-n = -1 must be a finite number of at least 0`.

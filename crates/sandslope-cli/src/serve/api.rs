@@ -17,10 +17,10 @@ use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
 use super::data::{DemInfo, Reply};
-use crate::commands::{plan, simulate};
+use crate::commands::simulate;
 use sandslope_io::presets::{self, PresetKind};
 use sandslope_request::risk::AnswerLimits;
-use sandslope_request::{PhaseRequest, PredictRequest, RequestError, RiskRequest, SweepRequest};
+use sandslope_request::{PhaseRequest, PlanRequest, PredictRequest, RequestError, RiskRequest, SweepRequest};
 
 /// Most slopes one `/api/sweep` request evaluates.
 pub const MAX_SWEEP_SLOPES: usize = 10_000;
@@ -167,6 +167,27 @@ pub fn request_params(
     Ok(params)
 }
 
+/// A plan request's parameters: those of [`request_params`] and the served DEM, the only one
+/// a request may plan on (naming another is refused; without one, a 404).
+pub fn plan_params(params: &[(String, String)], served: &Served) -> Result<Vec<(String, String)>, ApiError> {
+    if params.iter().any(|(k, _)| k == "dem") {
+        return Err(ApiError::bad(
+            Some("dem".into()),
+            "dem: a request cannot name a file; the server plans on the DEM it was started with (serve --dem)",
+        ));
+    }
+    let Some(dem) = &served.dem else {
+        return Err(ApiError {
+            status: 404,
+            field: None,
+            error: "/api/plan needs an elevation model: start the server with --dem FILE".to_string(),
+        });
+    };
+    let mut params = request_params(params, served)?;
+    params.push(("dem".to_string(), dem.display().to_string()));
+    Ok(params)
+}
+
 /// Refuses a robot or terrain that is not a built-in preset: a request cannot name a file.
 fn check_preset(key: &str, value: &str, kind: PresetKind) -> Result<(), ApiError> {
     if presets::find(value, kind).is_none() {
@@ -224,9 +245,8 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
             Ok(Reply::pretty(walks.answer(sims)))
         }
         "plan" => {
-            let args: plan::PlanArgs = parse("plan", params, served)?;
-            let planned = plan::compute(&args, false, true).map_err(|e| ApiError::from_command(&e))?;
-            Ok(Reply::pretty(plan::answer(&planned)))
+            let request = PlanRequest::from_params(&plan_params(params, served)?)?;
+            Ok(Reply::pretty(request.answer()?))
         }
         _ => Err(ApiError {
             status: 404,

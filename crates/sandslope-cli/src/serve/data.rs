@@ -7,11 +7,11 @@ use std::io::Write;
 use serde::Serialize;
 
 use super::api::{self, ApiError, Served};
-use crate::commands::plan;
 use sandslope::Cause;
 use sandslope_io::presets::{PresetKind, PRESETS};
 use sandslope_io::raster::{read_raster, write_two_band_geotiff};
 use sandslope_request::PhaseRequest;
+use sandslope_request::PlanRequest;
 
 /// Most cells of a `/data/phase-map` (the page asks for about 160 x 160).
 pub const MAX_MAP_CELLS: u128 = 1 << 18;
@@ -100,8 +100,8 @@ pub fn download(name: &str, params: &[(String, String)], served: &Served) -> Res
             ))
         }
     };
-    let args: plan::PlanArgs = api::parse("plan", params, served)?;
-    let planned = plan::compute(&args, file == "risk-map.tif", true).map_err(|e| failed(&e))?;
+    let request = PlanRequest::from_params(&api::plan_params(params, served)?)?;
+    let planned = request.plan(file == "risk-map.tif", &|_| {}, &|_, _, _| {})?;
     let dir = tempfile::tempdir().map_err(|e| ApiError { status: 500, field: None, error: e.to_string() })?;
     let path = dir.path().join(file);
     let geo = &planned.dem.geo;
@@ -289,9 +289,9 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiEr
             format!("rule = `{rule}` must be best (lowest over 16 headings) or fall-line (straight up)"),
         ));
     }
-    let args: plan::PlanArgs = api::parse("plan", &rest, served)?;
-    let inputs = plan::Inputs::read(&args, true).map_err(|e| ApiError::from_command(&e))?;
-    let planner = inputs.planner(&args).map_err(|e| failed(&e))?;
+    let request = PlanRequest::from_params(&api::plan_params(&rest, served)?)?;
+    let inputs = request.inputs(&|_| {})?;
+    let planner = inputs.planner()?;
     let (cols, rows) = (inputs.dem.cols, inputs.dem.rows);
     let p_fail: Vec<f32> = match rule.as_str() {
         "best" => planner.risk_map().0,

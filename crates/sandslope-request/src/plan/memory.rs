@@ -2,21 +2,24 @@
 //! choice of full-resolution or corridor search that follows from the DEM's size, made from
 //! its header before its samples are read.
 
-use anyhow::{bail, Result};
+use anyhow::bail;
 
 use sandslope::plan::Objective;
 
-use super::{PlanArgs, Search, SearchArg, AUTO_FULL_MAX_CELLS};
-use crate::args::check_flag;
+use super::{PlanRequest, PlanSearch, Search, AUTO_FULL_MAX_CELLS};
+use crate::error::{check_range, RequestError, Result};
 
 /// The memory limit: `--max-memory` (checked), else what the machine has available; `None`
 /// where that cannot be read.
-fn memory_limit(args: &PlanArgs) -> Result<Option<(f64, &'static str)>> {
+fn memory_limit(args: &PlanRequest) -> Result<Option<(f64, &'static str)>> {
     Ok(match args.max_memory {
         Some(gib) => {
-            let gib = check_flag("--max-memory", gib, 0.0, f64::INFINITY)?;
+            let gib = check_range("max-memory", gib, 0.0, f64::INFINITY)?;
             if gib <= 0.0 {
-                bail!("--max-memory = {gib} must be a number of GiB greater than 0");
+                return Err(RequestError::invalid(
+                    "max-memory",
+                    format!("--max-memory = {gib} must be a number of GiB greater than 0"),
+                ));
             }
             Some((gib * GIB, "the --max-memory limit"))
         }
@@ -36,12 +39,12 @@ const GIB: f64 = (1u64 << 30) as f64;
 /// `--max-memory` (default: what the machine has available), naming the limit and the bytes a
 /// cell; called from the DEM's header, before its samples are read.
 pub(super) fn choose_search(
-    args: &PlanArgs,
+    args: &PlanRequest,
     cols: usize,
     rows: usize,
     objectives: &[Objective],
     full_only: bool,
-) -> Result<Search> {
+) -> anyhow::Result<Search> {
     let mut objectives = objectives.to_vec();
     objectives.push(Objective::Distance);
     objectives.sort();
@@ -49,11 +52,11 @@ pub(super) fn choose_search(
     let searches = objectives.len().min(rayon::current_num_threads().max(1)) as u64;
     let cells = cols as u64 * rows as u64;
     let corridor = match args.search {
-        SearchArg::Full => false,
-        SearchArg::Corridor => true,
-        SearchArg::Auto => !full_only && cells > AUTO_FULL_MAX_CELLS,
+        PlanSearch::Full => false,
+        PlanSearch::Corridor => true,
+        PlanSearch::Auto => !full_only && cells > AUTO_FULL_MAX_CELLS,
     };
-    let limit = memory_limit(args)?;
+    let limit = memory_limit(args).map_err(RequestError::into_anyhow)?;
     if !corridor {
         let per_cell = sandslope::plan::bytes_per_cell(searches);
         let need = (cells * per_cell) as f64;

@@ -117,3 +117,21 @@ fn risk_refusals_name_their_field_and_the_default_is_seven_slopes() {
     assert_eq!(default.slopes, vec![0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 24.0]);
     assert_eq!((default.max_risk, default.solve, default.map), (0.05, None, None));
 }
+
+#[test]
+fn plan_refusals_name_their_field() {
+    use sandslope_request::PlanRequest;
+    let plan = |list: &[(&str, &str)]| PlanRequest::from_params(&pairs(list));
+    let dem = ("dem", "dune.asc");
+    assert_eq!(field(plan(&[dem, ("goal", "1,1")])), "start");
+    assert_eq!(field(plan(&[dem, ("start", "1,1"), ("start-px", "1,1"), ("goal", "2,2")])), "start-px");
+    assert_eq!(
+        field(plan(&[dem, ("start", "1,1"), ("goal", "2,2"), ("objective", "time,fun")])),
+        "objective"
+    );
+    assert_eq!(field(plan(&[dem, ("start", "1,1"), ("goal", "2,2"), ("search", "dfs")])), "search");
+    let r = plan(&[dem, ("start", "1,1"), ("goal", "2,2"), ("max-roll", "95")]).unwrap();
+    assert_eq!(field(r.settings()), "max-roll");
+    let r = plan(&[dem, ("start-px", "1,1"), ("goal-px", "2,2"), ("coarse-factor", "65")]).unwrap();
+    assert_eq!(field(r.check_corridor()), "coarse-factor");
+}

@@ -4,7 +4,7 @@
 
 use anyhow::Result;
 use clap::Args;
-use sandslope::{LevelStep, Robot, Scenario, Terrain};
+use sandslope::{LevelStep, Robot, Terrain};
 use sandslope_request::{grammar, RobotRequest, ScenarioRequest};
 
 use sandslope::risk::UncertainTerrain;
@@ -156,12 +156,6 @@ impl OverrideArgs {
             k_s: self.k_s,
             level_step: self.level.level_step,
         }
-    }
-
-    /// The scenario `predict`, `sweep` and `simulate` evaluate: robot, terrain and these
-    /// overrides, checked by the request layer.
-    pub fn scenario(&self, robot: &RobotArgs, terrain: &TerrainArgs) -> Result<Scenario> {
-        Ok(self.request(robot, terrain).scenario()?)
     }
 }
 

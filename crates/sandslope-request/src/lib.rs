@@ -24,6 +24,7 @@ pub mod plan;
 pub mod predict;
 pub mod risk;
 pub mod scenario;
+pub mod simulate;
 pub mod sweep;
 
 pub use error::{RequestError, Result};
@@ -33,4 +34,5 @@ pub use plan::PlanRequest;
 pub use predict::PredictRequest;
 pub use risk::RiskRequest;
 pub use scenario::{RobotRequest, ScenarioRequest};
+pub use simulate::SimulateRequest;
 pub use sweep::SweepRequest;

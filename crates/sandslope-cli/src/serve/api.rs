@@ -1,10 +1,11 @@
 //! The JSON API: `GET /api/<command>?<flag>=<value>&...` answered with exactly what
 //! `sandslope <command> <flags> --json` prints.
 //!
-//! A request's parameters become the command's argument list (`slope=20` -> `--slope=20`),
-//! which the command's own clap `Args` parses, so flags, defaults, checks and messages are the
-//! command line's. The answer is the value the command's `answer` function returns (the one its
-//! `run` prints with `--json`), serialised as `print_json` does: pretty JSON and a newline.
+//! A request's parameters are read into the command's typed request (`sandslope-request`:
+//! `slope=20` is the field `slope` of `PredictRequest`), the one the command line builds from
+//! its flags, so fields, defaults, checks and messages are the command line's, and the field at
+//! fault comes from the request layer's error. The answer is the request's `answer`, the value
+//! the command prints with `--json`, serialised as `print_json` does: pretty JSON and a newline.
 //!
 //! What a request may not do: name a file (robots and terrains are built-in presets or the
 //! ones the server was started with; `plan` plans on the served DEM), ask for an output file
@@ -12,15 +13,15 @@
 
 use std::path::PathBuf;
 
-use clap::error::{ContextKind, ContextValue};
-use clap::{ArgAction, FromArgMatches};
 use serde::Serialize;
 
 use super::data::{DemInfo, Reply};
-use crate::commands::simulate;
 use sandslope_io::presets::{self, PresetKind};
 use sandslope_request::risk::AnswerLimits;
-use sandslope_request::{PhaseRequest, PlanRequest, PredictRequest, RequestError, RiskRequest, SweepRequest};
+use sandslope_request::simulate::Walks;
+use sandslope_request::{
+    PhaseRequest, PlanRequest, PredictRequest, RequestError, RiskRequest, SimulateRequest, SweepRequest,
+};
 
 /// Most slopes one `/api/sweep` request evaluates.
 pub const MAX_SWEEP_SLOPES: usize = 10_000;
@@ -107,28 +108,6 @@ impl ApiError {
     pub fn bad(field: impl Into<Option<String>>, error: impl Into<String>) -> ApiError {
         ApiError { status: 400, field: field.into(), error: error.into() }
     }
-
-    /// A command's error (a checked flag value): 400, the field read from the `--flag` the
-    /// message names first.
-    pub fn from_command(e: &anyhow::Error) -> ApiError {
-        let error = format!("{e:#}");
-        ApiError::bad(flag_named_in(&error), error)
-    }
-
-    /// A clap parse error: 400, the field from clap's context.
-    fn from_clap(e: &clap::Error) -> ApiError {
-        let field = match e.get(ContextKind::InvalidArg) {
-            Some(ContextValue::String(s)) => flag_named_in(s),
-            Some(ContextValue::Strings(v)) => v.first().and_then(|s| flag_named_in(s)),
-            _ => None,
-        };
-        // clap's message up to its usage lines, on one line.
-        let text = e.to_string();
-        let lines: Vec<&str> = text.lines().take_while(|l| !l.trim().is_empty()).map(str::trim).collect();
-        let joined = lines.join(" ");
-        let error = joined.strip_prefix("error: ").unwrap_or(&joined).to_string();
-        ApiError::bad(field, error)
-    }
 }
 
 impl From<RequestError> for ApiError {
@@ -202,14 +181,6 @@ fn check_preset(key: &str, value: &str, kind: PresetKind) -> Result<(), ApiError
     Ok(())
 }
 
-/// The first `--flag` named in `text`, without the dashes.
-fn flag_named_in(text: &str) -> Option<String> {
-    let start = text.find("--")? + 2;
-    let name: String =
-        text[start..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_').collect();
-    (!name.is_empty()).then_some(name)
-}
-
 /// Answers `/api/<command>` with these parameters (in request order): the JSON body, written
 /// as it is sent.
 pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
@@ -241,7 +212,7 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
         }
         "simulate" => {
             let walks = simulate_walks(params, served)?;
-            let sims = walks.simulate().map_err(|e| ApiError::from_command(&e))?;
+            let sims = walks.simulate()?;
             Ok(Reply::pretty(walks.answer(sims)))
         }
         "plan" => {
@@ -259,9 +230,9 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
 /// The walks a `simulate` request asks for, checked by the command's own flags and then
 /// against the server's limits ([`MAX_SIM_DURATION_S`], [`MAX_SIM_SLOPES`],
 /// [`MAX_SIM_RATE_HZ`], [`MAX_SIM_STEPS`]), each refusal naming its flag and limit.
-pub fn simulate_walks(params: &[(String, String)], served: &Served) -> Result<simulate::Walks, ApiError> {
-    let args: simulate::SimulateArgs = parse("simulate", params, served)?;
-    let walks = simulate::Walks::prepare(&args).map_err(|e| ApiError::from_command(&e))?;
+pub fn simulate_walks(params: &[(String, String)], served: &Served) -> Result<Walks, ApiError> {
+    let request = SimulateRequest::from_params(&request_params(params, served)?)?;
+    let walks = request.walks()?;
     let duration = walks.settings.duration_s;
     if duration > MAX_SIM_DURATION_S {
         return Err(ApiError::bad(
@@ -280,15 +251,15 @@ pub fn simulate_walks(params: &[(String, String)], served: &Served) -> Result<si
             ),
         ));
     }
-    if args.rate > MAX_SIM_RATE_HZ {
+    if request.rate_hz > MAX_SIM_RATE_HZ {
         return Err(ApiError::bad(
             Some("rate".to_string()),
-            format!("--rate = {} Hz: the server samples at most {MAX_SIM_RATE_HZ} Hz", args.rate),
+            format!("--rate = {} Hz: the server samples at most {MAX_SIM_RATE_HZ} Hz", request.rate_hz),
         ));
     }
-    let steps = walks.integration_steps().map_err(|e| ApiError::from_command(&e))?;
+    let steps = walks.integration_steps()?;
     if steps > MAX_SIM_STEPS {
-        let flag = if args.dt.is_some() { "dt" } else { "duration" };
+        let flag = if request.dt_s.is_some() { "dt" } else { "duration" };
         return Err(ApiError::bad(
             Some(flag.to_string()),
             format!(
@@ -309,85 +280,6 @@ pub fn json<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
     })?;
     body.push(b'\n');
     Ok(body)
-}
-
-/// Parses `params` as `sandslope <name> --<key>=<value>...` with the command's own `Args`,
-/// adding the served robot and terrain when the request names none.
-pub fn parse<T: clap::Args + FromArgMatches>(
-    name: &'static str,
-    params: &[(String, String)],
-    served: &Served,
-) -> Result<T, ApiError> {
-    let cmd = T::augment_args(clap::Command::new(name).no_binary_name(true).disable_help_flag(true));
-    let args: Vec<&clap::Arg> = cmd.get_arguments().filter(|a| a.get_long().is_some()).collect();
-    let takes = |key: &str| args.iter().find(|a| a.get_long() == Some(key)).copied();
-    let accepted = || {
-        args.iter()
-            .filter_map(|a| a.get_long())
-            .filter(|l| !OUTPUT_FLAGS.contains(l) && *l != "dem")
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let mut argv: Vec<String> = Vec::new();
-    for (key, value) in params {
-        let key = key.as_str();
-        if key == "dem" && takes(key).is_some() {
-            return Err(ApiError::bad(
-                Some("dem".into()),
-                "dem: a request cannot name a file; the server plans on the DEM it was started with (serve --dem)",
-            ));
-        }
-        if OUTPUT_FLAGS.contains(&key) && takes(key).is_some() {
-            return Err(ApiError::bad(
-                Some(key.into()),
-                format!(
-                    "{key}: the API answers JSON and writes no file; this flag is for the command line only"
-                ),
-            ));
-        }
-        let Some(arg) = takes(key) else {
-            return Err(ApiError::bad(
-                Some(key.into()),
-                format!("unknown parameter `{key}`: {name} takes {}", accepted()),
-            ));
-        };
-        if let Some(kind) = preset_kind(key) {
-            check_preset(key, value, kind)?;
-        }
-        if matches!(arg.get_action(), ArgAction::SetTrue) {
-            match value.as_str() {
-                "" | "true" | "1" => argv.push(format!("--{key}")),
-                "false" | "0" => {}
-                _ => {
-                    return Err(ApiError::bad(
-                        Some(key.into()),
-                        format!("{key} = `{value}` must be true or false (or empty: true)"),
-                    ))
-                }
-            }
-        } else {
-            argv.push(format!("--{key}={value}"));
-        }
-    }
-    for (key, served_value) in [("robot", &served.robot), ("terrain", &served.terrain)] {
-        if takes(key).is_some() && !params.iter().any(|(k, _)| k == key) {
-            argv.push(format!("--{key}={served_value}"));
-        }
-    }
-    if takes("dem").is_some() {
-        match &served.dem {
-            Some(dem) => argv.push(format!("--dem={}", dem.display())),
-            None => {
-                return Err(ApiError {
-                    status: 404,
-                    field: None,
-                    error: format!("/api/{name} needs an elevation model: start the server with --dem FILE"),
-                })
-            }
-        }
-    }
-    let matches = cmd.try_get_matches_from(argv).map_err(|e| ApiError::from_clap(&e))?;
-    T::from_arg_matches(&matches).map_err(|e| ApiError::from_clap(&e))
 }
 
 /// Parameters whose value must be a built-in preset of this kind.

@@ -332,7 +332,7 @@ fn simulation(params: &[(String, String)], served: &Served) -> Result<Reply, Api
             ),
         ));
     }
-    let sim = walks.simulate().map_err(|e| ApiError::from_command(&e))?.pop();
+    let sim = walks.simulate()?.pop();
     let Some(sim) = sim else {
         return Err(ApiError::bad(Some("slope".to_string()), "no walk: give a slope"));
     };

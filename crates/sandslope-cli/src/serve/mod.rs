@@ -1,14 +1,15 @@
 //! `sandslope serve`: a local web explorer and a JSON API over the commands (docs/serve.md).
 //!
 //! The server is a second front end beside `main`: a request `GET /api/<command>?<flag>=<value>`
-//! is turned into the command's own argument list, parsed by the command's own clap `Args`
-//! (same flags, defaults, checks and messages), and answered with the same library value the
-//! command's `--json` prints, serialised the same way, so the two bodies are equal byte for
-//! byte. Commands know nothing of the server ([`api`]); the HTTP layer ([`http`]) parses
-//! requests, refuses what is too big or not addressed to this server, and runs every API call
-//! on one of two bounded pools of compute threads (light and heavy), off the threads that
-//! accept and read requests; [`conn`] caps the connections and times them out. The page ([`page`]) and its scripts
-//! are embedded in the binary: nothing is fetched from the network.
+//! (or a POST of a JSON object) is read into the command's typed request of
+//! `sandslope-request`, the one the command line builds from its flags (same fields, defaults,
+//! checks and messages), and answered with the same library value the command's `--json`
+//! prints, serialised the same way, so the two bodies are equal byte for byte. Neither clap nor
+//! the command modules are used below this file ([`api`], [`data`]); the HTTP layer ([`http`])
+//! parses requests, refuses what is too big or not addressed to this server, and runs every
+//! API call on one of two bounded pools of compute threads (light and heavy), off the threads
+//! that accept and read requests; [`conn`] caps the connections and times them out. The page
+//! ([`page`]) and its scripts are embedded in the binary: nothing is fetched from the network.
 
 pub mod api;
 pub mod conn;

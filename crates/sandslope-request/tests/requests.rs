@@ -135,3 +135,21 @@ fn plan_refusals_name_their_field() {
     let r = plan(&[dem, ("start-px", "1,1"), ("goal-px", "2,2"), ("coarse-factor", "65")]).unwrap();
     assert_eq!(field(r.check_corridor()), "coarse-factor");
 }
+
+#[test]
+fn simulate_takes_one_slope_or_a_list_and_the_librarys_defaults() {
+    use sandslope::simulate::{BodyPitch, RftScaling};
+    use sandslope_request::simulate::SimSlopes;
+    use sandslope_request::SimulateRequest;
+    let sim = |list: &[(&str, &str)]| SimulateRequest::from_params(&pairs(list));
+    assert_eq!(field(sim(&[])), "slope");
+    assert_eq!(field(sim(&[("slope", "5"), ("slopes", "0,5")])), "slopes");
+    assert_eq!(field(sim(&[("slopes", "0:10:1")])), "slopes");
+    assert_eq!(field(sim(&[("slope", "5"), ("body-pitch", "wobbly")])), "body-pitch");
+    assert_eq!(field(sim(&[("slope", "90")]).unwrap().walks()), "slope");
+    assert_eq!(field(sim(&[("slope", "5"), ("duration", "-1")]).unwrap().walks()), "duration");
+    let r = sim(&[("slopes", "0:10:3")]).unwrap();
+    assert_eq!(r.slopes, SimSlopes::Many(vec![0.0, 5.0, 10.0]));
+    assert_eq!((r.body_pitch, r.rft_scaling), (BodyPitch::default(), RftScaling::default()));
+    assert_eq!((r.duration_s, r.rate_hz, r.dt_s), (10.0, 120.0, None));
+}

@@ -34,7 +34,17 @@ use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::{Notify, Semaphore};
 use tokio::time::Sleep;
 
-use super::http::{self, App};
+/// What answers a connection's requests: called with each request and the mark that keeps
+/// its connection busy for as long as the answer lives (the HTTP layer, `http::handle`, given
+/// here so that this file needs nothing of it).
+pub type Handler<B> = Arc<
+    dyn Fn(hyper::Request<hyper::body::Incoming>, Busy) -> Pin<Box<dyn Future<Output = Answer<B>> + Send>>
+        + Send
+        + Sync,
+>;
+
+/// A handler's answer (never an error: failures are answered as error responses).
+pub type Answer<B> = Result<hyper::Response<B>, std::convert::Infallible>;
 
 /// File descriptors kept free of connections: standard streams, the runtime's, the listener,
 /// and the files computations open (the DEM, a download's temporary file).
@@ -151,7 +161,12 @@ impl Drop for Busy {
 }
 
 /// Accepts connections until the process ends, serving each on its own task.
-pub async fn accept_loop(listener: TcpListener, app: Arc<App>, limits: ConnLimits) {
+pub async fn accept_loop<B>(listener: TcpListener, handler: Handler<B>, limits: ConnLimits)
+where
+    B: hyper::body::Body + Send + 'static,
+    B::Data: Send,
+    B::Error: Into<Box<dyn std::error::Error + Send + Sync>>,
+{
     let slots = Arc::new(Semaphore::new(limits.max_connections));
     let registry =
         Arc::new(Registry { epoch: Instant::now(), next: AtomicU64::new(0), open: Mutex::default() });
@@ -192,10 +207,10 @@ pub async fn accept_loop(listener: TcpListener, app: Arc<App>, limits: ConnLimit
         let Some(slot) = slot else { return };
         let _ = stream.set_nodelay(true);
         let (id, conn) = registry.add();
-        let (app, registry, builder, send_timeout) =
-            (Arc::clone(&app), Arc::clone(&registry), Arc::clone(&builder), limits.send_timeout);
+        let (handler, registry, builder, send_timeout) =
+            (Arc::clone(&handler), Arc::clone(&registry), Arc::clone(&builder), limits.send_timeout);
         tokio::spawn(async move {
-            serve_connection(stream, &conn, &registry, app, &builder, send_timeout).await;
+            serve_connection(stream, &conn, &registry, handler, &builder, send_timeout).await;
             registry.lock().remove(&id);
             drop(slot);
         });
@@ -230,19 +245,23 @@ async fn accept_failed(
 }
 
 /// Serves one connection until it closes, it times out, or it is told to make room while idle.
-async fn serve_connection(
+async fn serve_connection<B>(
     stream: TcpStream,
     conn: &Arc<Conn>,
     registry: &Arc<Registry>,
-    app: Arc<App>,
+    handler: Handler<B>,
     builder: &http1::Builder,
     send_timeout: Duration,
-) {
+) where
+    B: hyper::body::Body + Send + 'static,
+    B::Data: Send,
+    B::Error: Into<Box<dyn std::error::Error + Send + Sync>>,
+{
     let io = TokioIo::new(SendTimeout::new(stream, send_timeout));
     let (busy_conn, busy_registry) = (Arc::clone(conn), Arc::clone(registry));
     let service = hyper::service::service_fn(move |request| {
         let busy = Busy::new(&busy_conn, &busy_registry);
-        http::handle(Arc::clone(&app), request, busy)
+        handler(request, busy)
     });
     let served = builder.serve_connection(io, service);
     tokio::pin!(served);

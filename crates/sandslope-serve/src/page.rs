@@ -2,7 +2,7 @@
 //! (docs/serve.md). The script draws every chart itself on SVG and canvas, so nothing is
 //! fetched from anywhere but this server.
 
-use super::api::Served;
+use crate::served::Served;
 
 const INDEX: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/app.js");

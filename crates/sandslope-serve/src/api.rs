@@ -11,16 +11,13 @@
 //! ones the server was started with; `plan` plans on the served DEM), ask for an output file
 //! (`--plot`, `--csv`, ...), or ask for more work than the limits below.
 
-use std::path::PathBuf;
-
-use serde::Serialize;
-
-use super::data::{DemInfo, Reply};
+use crate::reply::{ApiError, Reply};
+use crate::served::Served;
 use sandslope_io::presets::{self, PresetKind};
 use sandslope_request::risk::AnswerLimits;
 use sandslope_request::simulate::Walks;
 use sandslope_request::{
-    PhaseRequest, PlanRequest, PredictRequest, RequestError, RiskRequest, SimulateRequest, SweepRequest,
+    PhaseRequest, PlanRequest, PredictRequest, RiskRequest, SimulateRequest, SweepRequest,
 };
 
 /// Most slopes one `/api/sweep` request evaluates.
@@ -45,33 +42,6 @@ pub const MAX_SIM_RATE_HZ: f64 = 1000.0;
 /// default 1 ms step is 100 slopes of 10 s or 33 of 60 s: about 2 s of one core, release build).
 pub const MAX_SIM_STEPS: f64 = 2e6;
 
-/// The files the server was started with; requests that name none use these.
-#[derive(Debug, Clone)]
-pub struct Served {
-    /// `--robot` of `serve`: a file or a preset.
-    pub robot: String,
-    /// `--terrain` of `serve`: a file or a preset.
-    pub terrain: String,
-    /// `--dem` of `serve`, the only elevation model `/api/plan` uses.
-    pub dem: Option<PathBuf>,
-    /// The DEM's size and georeference, read at start.
-    pub dem_info: Option<DemInfo>,
-}
-
-impl Served {
-    /// Reads everything the server will use now, so a bad file fails at start, not per request.
-    pub fn load(robot: String, terrain: String, dem: Option<PathBuf>) -> anyhow::Result<Served> {
-        use anyhow::Context;
-        sandslope_io::load_robot(&robot).context("--robot")?;
-        sandslope_io::load_terrain(&terrain).context("--terrain")?;
-        let dem_info = match &dem {
-            Some(path) => Some(DemInfo::of(&sandslope_io::raster::read_raster(path)?)),
-            None => None,
-        };
-        Ok(Served { robot, terrain, dem, dem_info })
-    }
-}
-
 /// The commands the API answers, in the order docs/serve.md lists them.
 pub const COMMANDS: [&str; 6] = ["predict", "sweep", "phase", "risk", "simulate", "plan"];
 
@@ -90,32 +60,6 @@ const OUTPUT_FLAGS: [&str; 11] = [
     "class-terrain",
     "animate",
 ];
-
-/// A refused request: the HTTP status, the parameter at fault (when one is) and why.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ApiError {
-    /// HTTP status code (400 bad input, 404 no such endpoint, 413/414 too big, ...).
-    #[serde(skip)]
-    pub status: u16,
-    /// The request parameter the error is about, without `--` (`slope`), when there is one.
-    pub field: Option<String>,
-    /// What is wrong and what is accepted, as the command line says it.
-    pub error: String,
-}
-
-impl ApiError {
-    /// A 400 about `field`.
-    pub fn bad(field: impl Into<Option<String>>, error: impl Into<String>) -> ApiError {
-        ApiError { status: 400, field: field.into(), error: error.into() }
-    }
-}
-
-impl From<RequestError> for ApiError {
-    /// A refused request: 400, the field the request layer names.
-    fn from(e: RequestError) -> ApiError {
-        ApiError::bad(e.field().map(str::to_string), e.message())
-    }
-}
 
 /// A request's parameters as the request layer reads them: output flags and names that are
 /// not built-in presets refused (a request writes no file and reads none), the served robot
@@ -269,17 +213,6 @@ pub fn simulate_walks(params: &[(String, String)], served: &Served) -> Result<Wa
         ));
     }
     Ok(walks)
-}
-
-/// `value` as `print_json` prints it: pretty JSON and a newline.
-pub fn json<T: Serialize>(value: &T) -> Result<Vec<u8>, ApiError> {
-    let mut body = serde_json::to_vec_pretty(value).map_err(|e| ApiError {
-        status: 500,
-        field: None,
-        error: format!("serialising the answer: {e}"),
-    })?;
-    body.push(b'\n');
-    Ok(body)
 }
 
 /// Parameters whose value must be a built-in preset of this kind.

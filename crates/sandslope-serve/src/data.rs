@@ -6,64 +6,19 @@ use std::io::Write;
 
 use serde::Serialize;
 
-use super::api::{self, ApiError, Served};
+use crate::api;
+use crate::reply::{ApiError, Reply};
+use crate::served::{stride, DemInfo, Served};
 use sandslope::Cause;
 use sandslope_io::presets::{PresetKind, PRESETS};
 use sandslope_io::raster::{read_raster, write_two_band_geotiff};
-use sandslope_request::PhaseRequest;
-use sandslope_request::PlanRequest;
+use sandslope_request::{PhaseRequest, PlanRequest};
 
 /// Most cells of a `/data/phase-map` (the page asks for about 160 x 160).
 pub const MAX_MAP_CELLS: u128 = 1 << 18;
 /// Most trajectory samples of a `/data/simulation` (duration x rate: 60 s at 120 Hz; the page
 /// asks for 30 Hz).
 pub const MAX_SIM_SAMPLES: f64 = 7200.0;
-/// Most cells sent for the DEM and its risk raster; a larger DEM is sent every `stride`-th
-/// cell in each direction.
-pub const MAX_DISPLAY_CELLS: usize = 1 << 20;
-
-/// How a reply's body is made: written into the response as the client reads it (http.rs
-/// sends it in 64 KiB chunks), so a large answer (the 44 MB of a 2^20-cell `risk --map`) is
-/// never whole in memory: a client that does not read holds the computed value and a few
-/// chunks.
-pub type Writer = Box<dyn FnOnce(&mut dyn Write) -> std::io::Result<()> + Send>;
-
-/// An answer: its body, type, and the file name a download is saved under.
-pub struct Reply {
-    /// The body.
-    pub body: Writer,
-    /// Its content type.
-    pub content_type: &'static str,
-    /// For downloads: the suggested file name.
-    pub filename: Option<&'static str>,
-}
-
-impl Reply {
-    /// `value` as `print_json` prints it (pretty JSON and a newline), written as it is sent.
-    pub fn pretty<T: Serialize + Send + 'static>(value: T) -> Reply {
-        let write = move |w: &mut dyn Write| {
-            serde_json::to_writer_pretty(&mut *w, &value)?;
-            w.write_all(b"\n")
-        };
-        Reply { body: Box::new(write), content_type: "application/json", filename: None }
-    }
-
-    /// `value` as compact JSON (the page's data need not read like `--json`, only be small),
-    /// written as it is sent.
-    pub fn compact<T: Serialize + Send + 'static>(value: T) -> Reply {
-        let write = move |w: &mut dyn Write| Ok(serde_json::to_writer(&mut *w, &value)?);
-        Reply { body: Box::new(write), content_type: "application/json", filename: None }
-    }
-
-    /// The whole body in memory.
-    #[cfg(test)]
-    pub fn into_bytes(self) -> std::io::Result<Vec<u8>> {
-        let mut out = Vec::new();
-        (self.body)(&mut out)?;
-        Ok(out)
-    }
-}
-
 fn not_found(what: &str, names: &str) -> ApiError {
     ApiError { status: 404, field: None, error: format!("no {what}; there are {names}") }
 }
@@ -132,40 +87,6 @@ pub fn download(name: &str, params: &[(String, String)], served: &Served) -> Res
     Ok(Reply { body: Box::new(write), content_type, filename: Some(file) })
 }
 
-/// The served DEM's size and georeference, read once when the server starts.
-#[derive(Debug, Clone, Serialize)]
-pub struct DemInfo {
-    cols: usize,
-    rows: usize,
-    /// Cell size in map units (degrees for a geographic DEM).
-    cell_x: f64,
-    cell_y: f64,
-    /// Ground size of a cell, metres (for the hillshade).
-    cell_x_m: f64,
-    cell_y_m: f64,
-    west: f64,
-    north: f64,
-    /// Every how many cells the page is sent.
-    stride: usize,
-}
-
-impl DemInfo {
-    /// What the page is told about this DEM.
-    pub fn of(r: &sandslope_io::raster::Raster) -> DemInfo {
-        DemInfo {
-            cols: r.cols,
-            rows: r.rows,
-            cell_x: r.geo.cell_x,
-            cell_y: r.geo.cell_y,
-            cell_x_m: r.cell_m.0,
-            cell_y_m: r.cell_m.1,
-            west: r.geo.west,
-            north: r.geo.north,
-            stride: stride(r.cols, r.rows),
-        }
-    }
-}
-
 /// The served robot (its file keys), terrain name, the presets and the DEM's size.
 fn served_info(served: &Served) -> Result<Reply, ApiError> {
     #[derive(Serialize)]
@@ -191,16 +112,6 @@ fn served_info(served: &Served) -> Result<Reply, ApiError> {
         causes: Cause::ALL.iter().map(|c| (c.name(), c.explain())).collect(),
         dem: served.dem_info.clone(),
     }))
-}
-
-/// Every how many cells the page is sent for a DEM of this size.
-fn stride(cols: usize, rows: usize) -> usize {
-    let cells = cols * rows;
-    let mut s = 1;
-    while cells.div_ceil(s * s) > MAX_DISPLAY_CELLS {
-        s += 1;
-    }
-    s
 }
 
 /// Values at every `stride`-th cell, NaN as null.

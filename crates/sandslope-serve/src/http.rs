@@ -43,10 +43,10 @@ use hyper::header::{self, HeaderValue};
 use hyper::{Method, Request, Response, StatusCode, Version};
 use tokio::sync::{mpsc, oneshot, Semaphore};
 
-use super::api::{self, ApiError, Served};
-use super::conn::{self, Busy, ConnLimits};
-use super::data::{self, Reply};
-use super::page;
+use crate::conn::{self, Busy, ConnLimits};
+use crate::reply::{self, ApiError, Reply};
+use crate::served::Served;
+use crate::{api, data, page};
 
 /// Longest request URL accepted, bytes.
 pub const MAX_URL: usize = 8192;
@@ -143,7 +143,9 @@ impl Server {
     /// Answers requests until the process ends.
     pub fn serve(self) -> Result<()> {
         let Server { runtime, listener, app, limits } = self;
-        runtime.block_on(conn::accept_loop(listener, app, limits));
+        let handler: conn::Handler<Body> =
+            Arc::new(move |request, busy| Box::pin(handle(Arc::clone(&app), request, busy)));
+        runtime.block_on(conn::accept_loop(listener, handler, limits));
         anyhow::bail!("the server stopped")
     }
 }
@@ -307,7 +309,7 @@ impl Write for ChunkWriter {
 }
 
 fn error_head(e: &ApiError) -> Head {
-    let body = api::json(e).unwrap_or_else(|_| b"{}\n".to_vec());
+    let body = reply::json(e).unwrap_or_else(|_| b"{}\n".to_vec());
     Head {
         status: e.status,
         content_type: "application/json",

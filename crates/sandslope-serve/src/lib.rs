@@ -1,74 +1,64 @@
+//! # sandslope-serve
+//!
 //! `sandslope serve`: a local web explorer and a JSON API over the commands (docs/serve.md).
 //!
-//! The server is a second front end beside `main`: a request `GET /api/<command>?<flag>=<value>`
+//! The server is a front end beside the command line: a request `GET /api/<command>?<flag>=<value>`
 //! (or a POST of a JSON object) is read into the command's typed request of
 //! `sandslope-request`, the one the command line builds from its flags (same fields, defaults,
 //! checks and messages), and answered with the same library value the command's `--json`
-//! prints, serialised the same way, so the two bodies are equal byte for byte. Neither clap nor
-//! the command modules are used below this file ([`api`], [`data`]); the HTTP layer ([`http`])
-//! parses requests, refuses what is too big or not addressed to this server, and runs every
-//! API call on one of two bounded pools of compute threads (light and heavy), off the threads
-//! that accept and read requests; [`conn`] caps the connections and times them out. The page
-//! ([`page`]) and its scripts are embedded in the binary: nothing is fetched from the network.
+//! prints, serialised the same way, so the two bodies are equal byte for byte. This crate
+//! knows neither clap nor the command line: the CLI's `serve` only parses its flags into a
+//! [`ServeConfig`] and calls [`run`].
+//!
+//! Files, from the bottom up: [`reply`] (what every route answers with) and [`served`] (what
+//! the server was started with); [`api`] (`/api/<command>`), [`data`] (`/data/...` and
+//! `/download/...`, the page's extras) and [`page`] (the embedded page); [`conn`] (the accept
+//! loop, the cap on connections and their timeouts, handed the HTTP layer as a function) and
+//! [`http`] (requests: Host and Origin checks, the light and heavy compute pools, answers
+//! streamed in chunks). The page and its scripts are embedded in the binary: nothing is
+//! fetched from the network.
+
+#![warn(missing_docs)]
 
 pub mod api;
 pub mod conn;
 pub mod data;
 pub mod http;
 pub mod page;
+pub mod reply;
+pub mod served;
 
 use std::net::IpAddr;
 use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
-use clap::Args;
 
-use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
-
-/// Arguments of `sandslope serve`.
-#[derive(Debug, Args)]
-pub struct ServeArgs {
-    /// Elevation model the Routes tab and `/api/plan` plan on (GeoTIFF or ESRI ASCII grid);
-    /// the only file the server reads after starting. Without it, the Routes tab is off.
-    #[arg(long, value_name = "FILE")]
+/// How a server is run: what `sandslope serve`'s flags give (each field is the flag of its
+/// name; docs/serve.md).
+#[derive(Debug, Clone)]
+pub struct ServeConfig {
+    /// The elevation model the Routes tab and `/api/plan` plan on (`--dem`).
     pub dem: Option<PathBuf>,
-    /// Robot the page starts with and API requests use when they name none: a TOML file or a
-    /// built-in preset. Requests may name built-in presets only.
-    #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_ROBOT)]
+    /// Robot file or preset requests use when they name none (`--robot`).
     pub robot: String,
-    /// Terrain the page starts with and API requests use when they name none: a TOML file or a
-    /// built-in preset. Requests may name built-in presets only.
-    #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_TERRAIN)]
+    /// Terrain file or preset requests use when they name none (`--terrain`).
     pub terrain: String,
-    /// Port to listen on; 0 picks any free port (the URL is printed either way).
-    #[arg(long, value_name = "N", default_value_t = 8750)]
+    /// Port to listen on; 0 picks any free port (`--port`).
     pub port: u16,
-    /// Address to listen on. Anything but a loopback address exposes the server, which has
-    /// no authentication, to the network.
-    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1")]
+    /// Address to listen on (`--host`).
     pub host: IpAddr,
-    /// Open the page in the default web browser once the server listens.
-    #[arg(long)]
+    /// Open the page in the default web browser once the server listens (`--open`).
     pub open: bool,
-    /// Threads that compute the heavy answers: phase maps, risk, simulations, plans, the DEM and
-    /// downloads (default: the machine's cores). `predict`, `sweep` and the page have their own.
-    #[arg(long, value_name = "N")]
+    /// Threads that compute the heavy answers (`--threads`; default the machine's cores).
     pub threads: Option<usize>,
-    /// Seconds a connection has to send a request's head, from opening or from the previous
-    /// answer's end (so also how long an idle kept-alive connection stays open).
-    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+    /// Seconds a connection has to send a request's head (`--header-timeout`).
     pub header_timeout: f64,
-    /// Seconds a client may read nothing of an answer before its connection is closed.
-    #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
+    /// Seconds a client may read nothing of an answer (`--send-timeout`).
     pub send_timeout: f64,
-    /// Most connections open at once (at most the open-file limit, `ulimit -n`, less 64); past
-    /// it the connection idle longest is closed to make room.
-    #[arg(long, value_name = "N", default_value_t = 512)]
+    /// Most connections open at once (`--max-connections`).
     pub max_connections: usize,
-    /// Another name the server may be reached by (the Host header), besides localhost and the
-    /// address it listens on: a machine name or a reverse proxy's. Repeat for several.
-    #[arg(long, value_name = "NAME")]
+    /// Other names the server may be reached by (`--allow-host`).
     pub allow_host: Vec<String>,
 }
 
@@ -80,8 +70,9 @@ fn seconds(flag: &str, value: f64) -> Result<Duration> {
     Ok(Duration::from_secs_f64(value))
 }
 
-/// Runs `sandslope serve` until the process is stopped.
-pub fn run(args: ServeArgs) -> Result<()> {
+/// Runs the server until the process is stopped: checks the configuration (errors name its
+/// flag), reads the robot, terrain and DEM, listens and prints the URL.
+pub fn run(args: ServeConfig) -> Result<()> {
     let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
     let threads = match args.threads {
         Some(0) => bail!("--threads = 0 must be at least 1"),
@@ -114,7 +105,7 @@ pub fn run(args: ServeArgs) -> Result<()> {
         allowed_hosts: args.allow_host.clone(),
     };
     // Read everything the server will use now, so a bad file fails at start, not per request.
-    let served = api::Served::load(args.robot.clone(), args.terrain.clone(), args.dem.clone())?;
+    let served = served::Served::load(args.robot.clone(), args.terrain.clone(), args.dem.clone())?;
     let server = http::Server::bind(args.host, args.port, served, limits)?;
     let url = format!("http://{}/", server.address());
     if !args.host.is_loopback() {

@@ -247,6 +247,39 @@ mod tests {
         assert!(err("a", SlopeSign::Uphill).contains("`a` is not a number"));
     }
 
+    /// The robot flags are the library's table of robot keys: every key with a flag is one
+    /// of `RobotArgs`' flags and sets its key (so the server's parameters, which the request
+    /// layer reads by the table, and the page's list, which `/data/served` gives from it, are
+    /// the command line's flags).
+    #[test]
+    fn robot_flags_are_the_tables() {
+        use clap::{Args as _, Command};
+        let cmd = RobotArgs::augment_args(Command::new("x"));
+        let longs: Vec<&str> =
+            cmd.get_arguments().filter_map(|a| a.get_long()).filter(|l| *l != "robot").collect();
+        let table: Vec<&str> = sandslope_request::scenario::robot_fields().map(|(_, f)| f).collect();
+        assert_eq!(longs, table);
+        let q = RobotQuantityArgs {
+            leg_radius: Some(1.0),
+            leg_width: Some(2.0),
+            hip_height: Some(3.0),
+            leg_speed: Some(4.0),
+            stance_legs: Some(5),
+            response_time: Some(6.0),
+        };
+        let mut spec = load_robot_spec();
+        for (key, v) in q.overrides() {
+            key.set(&mut spec, v);
+        }
+        let set: Vec<f64> =
+            sandslope_request::scenario::override_fields().map(|(k, _)| k.get(&spec).unwrap()).collect();
+        assert_eq!(set, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    }
+
+    fn load_robot_spec() -> sandslope::RobotSpec {
+        sandslope_io::load_robot(DEFAULT_ROBOT).unwrap().spec().clone()
+    }
+
     #[test]
     fn max_risk_is_a_probability_strictly_inside_0_1() {
         assert_eq!(parse_max_risk("0.05"), Ok(0.05));

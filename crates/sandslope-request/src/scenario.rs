@@ -33,6 +33,13 @@ fn field_of(flag: &'static str) -> &'static str {
     flag.trim_start_matches('-')
 }
 
+/// Every key a request may set, with its field: the rows of [`RobotKey::TABLE`] that have a
+/// flag, the mass first (what the command line's flags, the server's parameters and the
+/// explorer page's robot panel are; the page reads this list from `/data/served`).
+pub fn robot_fields() -> impl Iterator<Item = (RobotKey, &'static str)> {
+    RobotKey::ALL.into_iter().filter_map(|k| k.flag().map(|f| (k, field_of(f))))
+}
+
 /// The keys a request may override besides the mass, with their fields: the table's rows
 /// that have a flag.
 pub fn override_fields() -> impl Iterator<Item = (RobotKey, &'static str)> {

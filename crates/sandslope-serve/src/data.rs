@@ -12,6 +12,7 @@ use crate::served::{stride, DemInfo, Served};
 use sandslope::Cause;
 use sandslope_io::presets::{PresetKind, PRESETS};
 use sandslope_io::raster::{read_raster, write_two_band_geotiff};
+use sandslope_request::scenario::robot_fields;
 use sandslope_request::{PhaseRequest, PlanRequest};
 
 /// Most cells of a `/data/phase-map` (the page asks for about 160 x 160).
@@ -98,7 +99,18 @@ fn served_info(served: &Served) -> Result<Reply, ApiError> {
         terrains: Vec<&'static str>,
         /// Each regime cause's name and its one-line explanation.
         causes: Vec<(&'static str, &'static str)>,
+        /// The robot quantities a request may set, from the library's table of robot keys.
+        robot_keys: Vec<RobotField>,
         dem: Option<DemInfo>,
+    }
+    /// One robot quantity a request may set: its parameter, its key in robot files (and in
+    /// `robot`), its unit and what it is.
+    #[derive(Serialize)]
+    struct RobotField {
+        field: &'static str,
+        key: &'static str,
+        unit: &'static str,
+        description: &'static str,
     }
     let robot = sandslope_io::load_robot(&served.robot).map_err(|e| failed(&e))?;
     let terrain = sandslope_io::load_terrain(&served.terrain).map_err(|e| failed(&e))?;
@@ -110,6 +122,12 @@ fn served_info(served: &Served) -> Result<Reply, ApiError> {
         robots: names(PresetKind::Robot),
         terrains: names(PresetKind::Terrain),
         causes: Cause::ALL.iter().map(|c| (c.name(), c.explain())).collect(),
+        robot_keys: robot_fields()
+            .map(|(key, field)| {
+                let row = key.row();
+                RobotField { field, key: row.name, unit: row.unit, description: row.description }
+            })
+            .collect(),
         dem: served.dem_info.clone(),
     }))
 }

@@ -9,11 +9,10 @@ const COLOURS = { sinkage: "#426ec9", slippage: "#d63830", metastable: "#f7d643"
 const CODES = ["sinkage", "slippage", "metastable", "success"];
 const ROUTE_COLOURS = { time: "#0b6e2f", risk: "#7b2cbf", distance: "#111111" };
 const ROUTE_ORDER = ["time", "risk", "distance"];
-const ROBOT_FLAGS = ["mass", "leg-radius", "leg-width", "hip-height", "leg-speed", "stance-legs", "response-time"];
-const SPEC_KEYS = {
-  mass: "mass_kg", "leg-radius": "leg_radius_m", "leg-width": "leg_width_m", "hip-height": "hip_height_m",
-  "leg-speed": "leg_speed_rad_s", "stance-legs": "stance_legs", "response-time": "response_time_s",
-};
+// The robot quantities a request may set (parameter -> robot-file key), from the library's
+// table of robot keys as /data/served lists it; filled by start().
+const ROBOT_FLAGS = [];
+const SPEC_KEYS = {};
 const SVGNS = "http://www.w3.org/2000/svg";
 const $ = (id) => document.getElementById(id);
 const pageUrl = new URLSearchParams(location.search);
@@ -827,6 +826,14 @@ async function start() {
   const served = await get("/data/served");
   state.served = served;
   state.causes = Object.fromEntries(served.causes);
+  for (const { field, key } of served.robot_keys) {
+    if (!$(field)) {
+      logError(`the page has no control for the robot quantity ${field} (${key})`);
+      continue;
+    }
+    ROBOT_FLAGS.push(field);
+    SPEC_KEYS[field] = key;
+  }
   for (const [id, list, current] of [["robot", served.robots, served.robot_name], ["terrain", served.terrains, served.terrain_name]]) {
     const select = $(id);
     select.append(new Option(`${current} (served)`, ""));

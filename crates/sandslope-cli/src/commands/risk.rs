@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use sandslope::risk::{
     payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, DefaultsUsed, PayloadEnvelope, RiskAnswer,
-    RiskCurve, RiskMap, RiskPoint, SafeLimit, SafeMass, SafeSlope, UncertainTerrain,
+    RiskCurve, RiskPoint, SafeLimit, SafeMass, SafeSlope, UncertainTerrain,
 };
 use sandslope::{Robot, Slope};
 
@@ -23,7 +23,7 @@ use crate::args::{
 };
 use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
-use crate::output::{csv_string, num, print_json, sci, table, write_output, Format};
+use crate::output::{csv_string, num, print_json, sci, table, Format};
 use crate::progress::progress_bar;
 use sandslope_request::risk::RiskMapGrid;
 
@@ -530,7 +530,7 @@ fn run_map(
     bar.finish_and_clear();
     let map = &answer.map;
     if let Some(Some(path)) = &args.csv {
-        write_map_csv(path, map)?;
+        sandslope_render::tables::write_risk_map_csv(path, map)?;
     }
     if let Some(dir) = &args.npy {
         use sandslope_io::npy::{write_npy_dir, NpyData};
@@ -568,7 +568,9 @@ fn run_map(
         Format::Csv => match &args.csv {
             Some(None) => {
                 let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-                map_csv(map, &mut out).and_then(|_| out.flush()).context("cannot write to stdout")
+                sandslope_render::tables::risk_map_csv(map, &mut out)
+                    .and_then(|_| out.flush())
+                    .context("cannot write to stdout")
             }
             _ => Ok(()),
         },
@@ -598,35 +600,6 @@ fn run_map(
             Ok(())
         }
     }
-}
-
-/// Every cell of `map`, one row each, k_n-major: `k_n,k_s,p_fail,p_not_success`.
-fn map_csv(map: &RiskMap, out: &mut dyn std::io::Write) -> std::io::Result<()> {
-    use sandslope_io::grid_csv::{push_f64, write_rows};
-    let (k_n, k_s) = (map.k_n_axis.values(), map.k_s_axis.values());
-    let ny = k_s.len();
-    write_rows(out, MAP_CSV_HEADER, k_n.len() * ny, &|c, buf| {
-        let (i, j) = (c / ny, c % ny);
-        for (k, v) in
-            [k_n[i], k_s[j], map.p_fail_at(i, j), map.p_not_success_at(i, j)].into_iter().enumerate()
-        {
-            if k > 0 {
-                buf.push(b',');
-            }
-            push_f64(buf, v);
-        }
-    })
-}
-
-const MAP_CSV_HEADER: &str = "k_n,k_s,p_fail,p_not_success";
-
-fn write_map_csv(path: &std::path::Path, map: &RiskMap) -> Result<()> {
-    write_output(path, |file| {
-        let mut w = std::io::BufWriter::with_capacity(1 << 22, file);
-        map_csv(map, &mut w)
-            .and_then(|_| w.flush())
-            .map_err(|source| sandslope_io::WriteError { path: path.to_path_buf(), source }.into())
-    })
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use sandslope::report::StepBudget;
 use super::palette;
 use super::slope_curves::swatch_gap;
 use super::{ChartSetup, Figure};
-use crate::error::plot_err;
+use crate::plot_err;
 
 /// The step budget over a slope grid (entries without anchoring are gaps).
 pub struct StepBudgetFigure<'a> {

@@ -9,6 +9,8 @@ pub use figures::page_figures;
 
 use sandslope::report::{Report, TrackRecord};
 
+use crate::figures::palette;
+
 /// One figure of the page, by the paper's figure number.
 pub struct PageFigure {
     /// The paper's id (`fig3a`, ...), or a name for figures the paper does not have.
@@ -44,13 +46,29 @@ fn inline_svg(svg: &str) -> &str {
     }
 }
 
-const STYLE: &str = "body{font-family:'DejaVu Sans',Verdana,sans-serif;max-width:1100px;margin:2em auto;\
-padding:0 1em;color:#222;line-height:1.45}h1{font-size:1.7em}h2{margin-top:2em;border-bottom:1px solid #ccc}\
-table{border-collapse:collapse;margin:1em 0;font-size:0.92em}td,th{border:1px solid #ccc;padding:4px 8px;\
-text-align:left}th{background:#f3f3f3}tr.no td{background:#fdecea}tr.yes td.v{color:#1b6e2a}\
-figure{margin:1.5em 0;display:inline-block;vertical-align:top;max-width:100%}\
-figure svg{max-width:100%;height:auto;border:1px solid #eee}figcaption{font-size:0.9em;color:#444;max-width:760px}\
-.warn{background:#fff8e1;border-left:4px solid #e0a800;padding:0.5em 1em}code{background:#f4f4f4;padding:0 3px}";
+/// The page's style sheet, its colours from [`palette`] (`#222` is [`palette::PAGE_INK`]).
+fn style() -> String {
+    use palette::css;
+    format!(
+        "body{{font-family:'DejaVu Sans',Verdana,sans-serif;max-width:1100px;margin:2em auto;\
+padding:0 1em;color:{ink};line-height:1.45}}h1{{font-size:1.7em}}h2{{margin-top:2em;border-bottom:1px solid {rule}}}\
+table{{border-collapse:collapse;margin:1em 0;font-size:0.92em}}td,th{{border:1px solid {rule};padding:4px 8px;\
+text-align:left}}th{{background:{th}}}tr.no td{{background:{no}}}tr.yes td.v{{color:{yes}}}\
+figure{{margin:1.5em 0;display:inline-block;vertical-align:top;max-width:100%}}\
+figure svg{{max-width:100%;height:auto;border:1px solid {fig}}}figcaption{{font-size:0.9em;color:{cap};max-width:760px}}\
+.warn{{background:{warn};border-left:4px solid {bar};padding:0.5em 1em}}code{{background:{code};padding:0 3px}}",
+        ink = css(palette::PAGE_INK),
+        rule = css(palette::PAGE_RULE),
+        th = css(palette::PAGE_HEADER_BG),
+        no = css(palette::PAGE_DISAGREE_BG),
+        yes = css(palette::PAGE_AGREE_INK),
+        fig = css(palette::PAGE_FIGURE_BORDER),
+        cap = css(palette::PAGE_CAPTION),
+        warn = css(palette::PAGE_WARN_BG),
+        bar = css(palette::PAGE_WARN_BAR),
+        code = css(palette::PAGE_CODE_BG),
+    )
+}
 
 /// The whole page.
 pub fn page(report: &Report, figures: &[PageFigure]) -> String {
@@ -63,7 +81,7 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
     } else {
         "<title>sandslope report: the paper reproduced and confronted</title>"
     });
-    h.push_str(&format!("<style>{STYLE}</style></head><body>\n"));
+    h.push_str(&format!("<style>{}</style></head><body>\n", style()));
     h.push_str(&sections::header(report));
     h.push_str(&sections::plain_answer(report));
     h.push_str(&sections::warnings(report));

@@ -10,7 +10,7 @@ use sandslope::SlopeEvaluation;
 
 use super::palette;
 use super::{range, ChartSetup, Figure};
-use crate::error::plot_err;
+use crate::plot_err;
 use sandslope_io::SpeedRow;
 
 /// What the stride panel draws, in plotting units (s, cm/s).

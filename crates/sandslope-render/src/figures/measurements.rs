@@ -13,7 +13,7 @@ use sandslope::measure::{Campaign, Origin, SlopeEstimate, SlopeStat, TrialFit, T
 
 use super::palette;
 use super::{range, save, ChartSetup, Figure};
-use crate::error::plot_err;
+use crate::plot_err;
 
 /// Which panel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

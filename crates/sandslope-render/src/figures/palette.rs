@@ -1,5 +1,5 @@
-//! The one regime palette of every figure, after the paper's Fig. 6: blue sinkage, red
-//! slippage, yellow metastable, light green success.
+//! The one palette of every figure and page, after the paper's Fig. 6: blue sinkage, red
+//! slippage, yellow metastable, light green success; then every other colour by its role.
 
 use plotters::style::{RGBAColor, RGBColor};
 
@@ -92,3 +92,85 @@ pub const SLIP_ORANGE: RGBColor = RGBColor(230, 150, 20);
 pub const CLOSED_FORM_RED: RGBColor = RGBColor(255, 0, 0);
 /// The tracked stride-averaged speed and its band (plotters' pure blue).
 pub const TRACKED_BLUE: RGBColor = RGBColor(0, 0, 255);
+
+/// The pages' colours (the report page's CSS, the explorer's custom properties), by role.
+/// Body text.
+pub const PAGE_INK: RGBColor = RGBColor(34, 34, 34);
+/// Secondary text: figure captions.
+pub const PAGE_CAPTION: RGBColor = RGBColor(68, 68, 68);
+/// Rules: table borders, under section headings.
+pub const PAGE_RULE: RGBColor = RGBColor(204, 204, 204);
+/// The border of an embedded figure.
+pub const PAGE_FIGURE_BORDER: RGBColor = RGBColor(238, 238, 238);
+/// Table header cells.
+pub const PAGE_HEADER_BG: RGBColor = RGBColor(243, 243, 243);
+/// Inline code.
+pub const PAGE_CODE_BG: RGBColor = RGBColor(244, 244, 244);
+/// A table row where the model and the evidence disagree (a light tint of slippage red).
+pub const PAGE_DISAGREE_BG: RGBColor = RGBColor(253, 236, 234);
+/// A verdict cell where they agree (a dark tint of success green).
+pub const PAGE_AGREE_INK: RGBColor = RGBColor(27, 110, 42);
+/// A warning box's background.
+pub const PAGE_WARN_BG: RGBColor = RGBColor(255, 248, 225);
+/// A warning box's bar.
+pub const PAGE_WARN_BAR: RGBColor = RGBColor(224, 168, 0);
+
+/// `c` as a CSS hex colour, in the three-digit form when it has one (`#ccc`, `#1b6e2a`).
+pub fn css(c: RGBColor) -> String {
+    let RGBColor(r, g, b) = c;
+    let short = |v: u8| v >> 4 == v & 15;
+    if short(r) && short(g) && short(b) {
+        format!("#{:x}{:x}{:x}", r & 15, g & 15, b & 15)
+    } else {
+        format!("#{r:02x}{g:02x}{b:02x}")
+    }
+}
+
+/// The colours a web page draws in, as CSS custom properties on `:root` (`--sinkage: #426ec9;`
+/// ...): the regimes, the routes and the other roles a page shares with the figures. The
+/// explorer's page reads them with `getComputedStyle`, so it restates no colour.
+pub fn css_custom_properties() -> String {
+    let roles: [(&str, RGBColor); 11] = [
+        ("sinkage", SINKAGE),
+        ("slippage", SLIPPAGE),
+        ("metastable", METASTABLE),
+        ("success", SUCCESS),
+        ("route-time", ROUTE_TIME),
+        ("route-risk", ROUTE_RISK),
+        ("route-distance", ROUTE_DISTANCE),
+        ("not-success", NOT_SUCCESS_ORANGE),
+        ("model", MODEL_BLUE),
+        ("closed-form", CLOSED_FORM_RED),
+        ("sand-surface", SAND_SURFACE),
+    ];
+    let mut s = String::from(":root {");
+    for (name, c) in roles {
+        s.push_str(&format!(" --{name}: {};", css(c)));
+    }
+    s.push_str(" }\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn css_colours_use_the_short_form_only_when_exact() {
+        assert_eq!(css(PAGE_RULE), "#ccc");
+        assert_eq!(css(RGBColor(0, 0, 0)), "#000");
+        assert_eq!(css(PAGE_AGREE_INK), "#1b6e2a");
+        // 0x0b is not 0xbb: no short form.
+        assert_eq!(css(RGBColor(11, 110, 47)), "#0b6e2f");
+        assert_eq!(css(SINKAGE), "#426ec9");
+    }
+
+    #[test]
+    fn custom_properties_carry_the_figures_colours() {
+        let p = css_custom_properties();
+        assert!(p.starts_with(":root {"), "{p}");
+        assert!(p.contains("--sinkage: #426ec9;"), "{p}");
+        // The fastest route: the plan figure's blue (0, 90, 220), not a green.
+        assert!(p.contains("--route-time: #005adc;"), "{p}");
+    }
+}

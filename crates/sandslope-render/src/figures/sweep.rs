@@ -9,7 +9,7 @@ use sandslope::SpeedObservation;
 
 use super::palette;
 use super::{ChartSetup, Figure};
-use crate::error::plot_err;
+use crate::plot_err;
 use sandslope::SlopeEvaluation;
 
 /// Speed, anchoring time and step length against slope, stacked in three panels.

@@ -35,7 +35,7 @@ impl Figure for InferFigure {
     where
         DB::ErrorType: 'static,
     {
-        let e = crate::error::plot_err;
+        let e = crate::plot_err;
         let root = root.titled(&self.title, font(22.0)).map_err(e)?;
         let (left, right) = match self.law {
             Some(_) => {
@@ -67,7 +67,7 @@ impl InferFigure {
     where
         DB::ErrorType: 'static,
     {
-        let e = crate::error::plot_err;
+        let e = crate::plot_err;
         // k_s range: the intervals (open ends clipped to a decade beyond the bounded values).
         // Open ends (a quantile that is the prior's) do not set the range: they get an arrow.
         let mut ks: Vec<f64> = self
@@ -168,7 +168,7 @@ fn draw_p_fail<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let e = crate::error::plot_err;
+    let e = crate::plot_err;
     let setup = ChartSetup { y_label_area: 60, ..ChartSetup::PANEL };
     let mut c = setup.build(area, x0..x1, 0.0..1.02, "slope (deg)", "p_fail")?;
     let red = palette::SLIPPAGE;

@@ -199,7 +199,7 @@ where
     X::CoordDescType: ValueFormatter<f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
-    let e = crate::error::plot_err;
+    let e = crate::plot_err;
     let setup = ChartSetup {
         caption: Some((title, 20.0)),
         margin: 12,
@@ -262,7 +262,7 @@ fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, terrain: &str,
 where
     DB::ErrorType: 'static,
 {
-    let e = crate::error::plot_err;
+    let e = crate::plot_err;
     let style = font(16.0);
     let mut x = 20;
     let mut y = 25;

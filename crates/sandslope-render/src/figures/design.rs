@@ -45,7 +45,7 @@ impl Figure for DesignFigure {
     where
         DB::ErrorType: 'static,
     {
-        let e = crate::error::plot_err;
+        let e = crate::plot_err;
         let root = root.titled(&self.title, font(22.0)).map_err(e)?;
         let (left, right) = match &self.map {
             Some(_) => {
@@ -127,7 +127,7 @@ fn draw_map<DB: DrawingBackend>(map: &SafeSlopeMap, area: &DrawingArea<DB, Shift
 where
     DB::ErrorType: 'static,
 {
-    let e = crate::error::plot_err;
+    let e = crate::plot_err;
     let (main, bar) = area.split_horizontally(600);
     let (xe, ye) = (edges(&map.x), edges(&map.y));
     let setup = ChartSetup {

@@ -14,7 +14,7 @@ use sandslope_io::raster::GeoRef;
 
 use super::palette;
 use super::{font, ChartSetup, Figure};
-use crate::error::plot_err;
+use crate::plot_err;
 
 /// Longest side of the map raster as drawn, in blocks (large DEMs are subsampled).
 const MAX_BLOCKS: usize = 600;

@@ -8,7 +8,7 @@ use plotters::prelude::*;
 
 use super::palette;
 use super::{ChartSetup, Figure};
-use crate::error::plot_err;
+use crate::plot_err;
 
 /// A legend swatch is two segments 20 px long in all: `(0, a)` and `(b, 20)`. Touching for a
 /// solid line; with a gap for a dashed one, so the legend looks like the line it names:

@@ -9,7 +9,7 @@ use sandslope::calibrate::{ObservationKind, Pull};
 
 use super::palette;
 use super::{ChartSetup, Figure};
-use crate::error::plot_err;
+use crate::plot_err;
 
 /// The speed observations among a joint calibration's pulls: the points this figure draws
 /// (anchoring times and force tests are not drawn in it).

@@ -95,9 +95,9 @@ pub fn to_png(figure: &impl Figure) -> Result<Vec<u8>> {
     let mut rgb = vec![0u8; w as usize * h as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(crate::error::plot_err)?;
+        root.fill(&WHITE).map_err(crate::plot_err)?;
         figure.draw(&root)?;
-        root.present().map_err(crate::error::plot_err)?;
+        root.present().map_err(crate::plot_err)?;
     }
     png_bytes(&rgb, w, h)
 }
@@ -119,9 +119,9 @@ pub fn to_svg(figure: &impl Figure) -> Result<String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        root.fill(&WHITE).map_err(crate::error::plot_err)?;
+        root.fill(&WHITE).map_err(crate::plot_err)?;
         figure.draw(&root)?;
-        root.present().map_err(crate::error::plot_err)?;
+        root.present().map_err(crate::plot_err)?;
     }
     Ok(svg)
 }
@@ -254,7 +254,7 @@ impl<'s> ChartSetup<'s> {
         X::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
         Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
-        let e = crate::error::plot_err;
+        let e = crate::plot_err;
         let mut builder = ChartBuilder::on(area);
         if let Some((text, pt)) = self.caption {
             builder.caption(text, font(pt));
@@ -304,7 +304,7 @@ pub fn colour_bar<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let e = crate::error::plot_err;
+    let e = crate::plot_err;
     let mut cb = ChartBuilder::on(area)
         .margin_top(45)
         .margin_bottom(65)
@@ -383,7 +383,7 @@ where
         .border_style(BLACK.mix(style.border))
         .label_font(font(pt))
         .draw()
-        .map_err(crate::error::plot_err)?;
+        .map_err(crate::plot_err)?;
     Ok(())
 }
 
@@ -413,7 +413,7 @@ where
         let shade = palette::SHADE_GREY.mix(0.45);
         chart
             .draw_series([Rectangle::new([(repose.max(x.0), y.0), (x.1, y.1)], shade.filled())])
-            .map_err(crate::error::plot_err)?
+            .map_err(crate::plot_err)?
             .label(label)
             .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
     }
@@ -434,7 +434,7 @@ where
     let grey = palette::DATA_GREY;
     chart
         .draw_series(DashedLineSeries::new([(x.0, level), (x.1, level)], 8, 5, grey.stroke_width(2)))
-        .map_err(crate::error::plot_err)?
+        .map_err(crate::plot_err)?
         .label(label)
         .legend(move |(x, y)| {
             // Dashed like the line it names.

@@ -59,7 +59,7 @@ impl Figure for CurveFigure {
     where
         DB::ErrorType: 'static,
     {
-        let e = crate::error::plot_err;
+        let e = crate::plot_err;
         let setup = ChartSetup { caption: Some((&self.title, 24.0)), ..RISK_CURVES };
         let mut chart = setup.build(
             root,
@@ -153,7 +153,7 @@ impl Figure for MapFigure {
     where
         DB::ErrorType: 'static,
     {
-        let e = crate::error::plot_err;
+        let e = crate::plot_err;
         let (main, bar_area) = root.split_horizontally(780);
         let (xe, ye) = (cell_edges(&self.k_n_axis), cell_edges(&self.k_s_axis));
         if self.k_n_axis.scale() != sandslope::AxisScale::Log
@@ -238,7 +238,7 @@ impl Figure for EnvelopeFigure<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let e = crate::error::plot_err;
+        let e = crate::plot_err;
         let own = self.env.robot_mass_kg;
         // Each point: (slope, mass drawn, kind) with kind 0 limit, 1 none safe, 2 beyond range.
         let pts: Vec<(f64, f64, u8)> = self

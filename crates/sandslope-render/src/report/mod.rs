@@ -7,7 +7,10 @@ mod sections;
 
 pub use figures::page_figures;
 
+use std::path::Path;
+
 use sandslope::report::{Report, TrackRecord};
+use sandslope_io::files::{create_output_dir, write_atomic};
 
 use crate::figures::palette;
 
@@ -115,6 +118,20 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
     h.push_str("<p><small>Made by <code>sandslope report</code>. Self-contained: no scripts, no network.</small></p>");
     h.push_str("</body></html>\n");
     h
+}
+
+/// Writes `report` into the folder `dir`, made with its missing parents: `index.html`, the
+/// [`page`] with every figure of [`page_figures`], and `report.json`, the value as pretty JSON.
+/// What `sandslope report --out DIR` and Python's `sandslope.report(html=DIR)` write. Page and
+/// JSON are rendered before any folder or file is made, and each file is written through the
+/// one output writer (a temporary file renamed into place).
+pub fn write_dir(dir: &Path, report: &Report) -> anyhow::Result<()> {
+    let figures = page_figures(report)?;
+    let html = page(report, &figures);
+    let json = serde_json::to_string_pretty(report)?;
+    create_output_dir(dir)?;
+    write_atomic(&dir.join("report.json"), json.as_bytes())?;
+    write_atomic(&dir.join("index.html"), html.as_bytes())
 }
 
 /// `mean ± SD` scaled for display, `mean` alone without an SD, `-` without a mean.

@@ -79,6 +79,10 @@ pub const STEP_MARK_GREY: RGBColor = RGBColor(170, 170, 170);
 pub const SIMULATED_BLUE: RGBColor = RGBColor(31, 90, 180);
 /// Simulation figure: a walk whose body pitched over.
 pub const TUMBLE_ORANGE: RGBColor = RGBColor(230, 120, 0);
+/// Simulation figures and animation: the first tripod's legs (the simulated speeds' blue).
+pub const TRIPOD_A: RGBColor = SIMULATED_BLUE;
+/// Simulation figures and animation: the second tripod's legs.
+pub const TRIPOD_B: RGBColor = RGBColor(230, 120, 20);
 /// Simulation animation: the sand.
 pub const SAND: RGBColor = RGBColor(230, 205, 150);
 /// Simulation animation: the sand's surface.
@@ -127,10 +131,11 @@ pub fn css(c: RGBColor) -> String {
 }
 
 /// The colours a web page draws in, as CSS custom properties on `:root` (`--sinkage: #426ec9;`
-/// ...): the regimes, the routes and the other roles a page shares with the figures. The
-/// explorer's page reads them with `getComputedStyle`, so it restates no colour.
+/// ...), always as six hex digits: the regimes, the routes and the other roles a page shares
+/// with the figures. The explorer's page reads them with `getComputedStyle`, so it restates
+/// no colour.
 pub fn css_custom_properties() -> String {
-    let roles: [(&str, RGBColor); 11] = [
+    let roles: [(&str, RGBColor); 15] = [
         ("sinkage", SINKAGE),
         ("slippage", SLIPPAGE),
         ("metastable", METASTABLE),
@@ -141,11 +146,15 @@ pub fn css_custom_properties() -> String {
         ("not-success", NOT_SUCCESS_ORANGE),
         ("model", MODEL_BLUE),
         ("closed-form", CLOSED_FORM_RED),
+        ("data", DATA_GREY),
+        ("sand", SAND),
         ("sand-surface", SAND_SURFACE),
+        ("tripod-a", TRIPOD_A),
+        ("tripod-b", TRIPOD_B),
     ];
     let mut s = String::from(":root {");
-    for (name, c) in roles {
-        s.push_str(&format!(" --{name}: {};", css(c)));
+    for (name, RGBColor(r, g, b)) in roles {
+        s.push_str(&format!(" --{name}: #{r:02x}{g:02x}{b:02x};"));
     }
     s.push_str(" }\n");
     s
@@ -172,5 +181,7 @@ mod tests {
         assert!(p.contains("--sinkage: #426ec9;"), "{p}");
         // The fastest route: the plan figure's blue (0, 90, 220), not a green.
         assert!(p.contains("--route-time: #005adc;"), "{p}");
+        // Six digits even where a short form exists (the page parses them as #rrggbb).
+        assert!(p.contains("--route-distance: #000000;"), "{p}");
     }
 }

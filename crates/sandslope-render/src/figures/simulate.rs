@@ -19,10 +19,10 @@ use sandslope_io::files::write_output;
 /// Tripod colours: tripod 0 blue, tripod 1 orange (legs of one tripod share the colour,
 /// front to rear from dark to light).
 fn leg_colour(tripod: usize, rank: usize, n: usize) -> RGBColor {
-    let base = if tripod == 0 { (31.0, 90.0, 180.0) } else { (230.0, 120.0, 20.0) };
+    let RGBColor(r, g, b) = if tripod == 0 { palette::TRIPOD_A } else { palette::TRIPOD_B };
     let f = if n > 1 { 0.45 * rank as f64 / (n - 1) as f64 } else { 0.0 };
-    let mix = |c: f64| (c + (255.0 - c) * f) as u8;
-    RGBColor(mix(base.0), mix(base.1), mix(base.2))
+    let mix = |c: u8| (c as f64 + (255.0 - c as f64) * f) as u8;
+    RGBColor(mix(r), mix(g), mix(b))
 }
 
 /// Position along the slope, leg depths and leg forces against time, stacked.

@@ -2,13 +2,20 @@
 // The explorer page of `sandslope serve` (docs/serve.md). Every number comes from the server:
 // /api/<command> answers exactly what `sandslope <command> --json` prints for the same flags,
 // /data/... gives what the charts need beyond that. The charts are drawn here, on SVG and
-// canvas, in the regime palette of the command line's figures (src/figures/palette.rs).
-// Nothing is loaded from anywhere but this server.
+// canvas, in the colours of the command line's figures: the server writes the palette
+// (crates/sandslope-render/src/figures/palette.rs) into style.css as custom properties on
+// :root (--sinkage, --route-time, ...), read here as #rrggbb; no meaningful colour is written
+// in this file. Nothing is loaded from anywhere but this server.
 
-const COLOURS = { sinkage: "#426ec9", slippage: "#d63830", metastable: "#f7d643", success: "#a8e296" };
+const palette = (name) => getComputedStyle(document.documentElement).getPropertyValue(`--${name}`).trim();
 const CODES = ["sinkage", "slippage", "metastable", "success"];
-const ROUTE_COLOURS = { time: "#0b6e2f", risk: "#7b2cbf", distance: "#111111" };
+const COLOURS = Object.fromEntries(CODES.map((c) => [c, palette(c)]));
 const ROUTE_ORDER = ["time", "risk", "distance"];
+const ROUTE_COLOURS = Object.fromEntries(ROUTE_ORDER.map((r) => [r, palette(`route-${r}`)]));
+const SIM_COLOURS = Object.fromEntries(
+  ["sand", "sand-surface", "data", "closed-form", "tripod-a", "tripod-b", "not-success"].map((r) => [r, palette(r)]),
+);
+const rgbOf = (hex) => [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
 // The robot quantities a request may set (parameter -> robot-file key), from the library's
 // table of robot keys as /data/served lists it; filled by start().
 const ROBOT_FLAGS = [];
@@ -267,7 +274,7 @@ function drawPhase() {
   canvas.height = ny;
   const ctx = canvas.getContext("2d");
   const img = ctx.createImageData(nx, ny);
-  const rgb = CODES.map((c) => [1, 3, 5].map((i) => parseInt(COLOURS[c].slice(i, i + 2), 16)));
+  const rgb = CODES.map((c) => rgbOf(COLOURS[c]));
   for (let j = 0; j < ny; j++) {
     for (let i = 0; i < nx; i++) {
       const c = rgb[map.regimes.charCodeAt(j * nx + i) - 48];
@@ -341,7 +348,7 @@ function drawRisk({ curve, limit }) {
   const safe = limit.safe_slope_deg;
   const success = limit.success_slope_deg;
   const marks = [
-    [success, "success-slope", "#b07800", "climbs to"],
+    [success, "success-slope", SIM_COLOURS["not-success"], "climbs to"],
     [safe, "safe-slope", "#000", limit.limit.kind === "repose" ? "repose" : "no failure to"],
   ];
   let row = 0;
@@ -626,7 +633,7 @@ function drawTable(json) {
 // The walk comes whole from /data/simulation (the library's Simulation: the summary
 // `simulate --json` prints, the trajectory sampled at SIM_RATE_HZ, the legs' outline and hips);
 // the page only places the body and legs where the trajectory says, as the GIF of
-// `simulate --animate` does (src/figures/simulate.rs draw_frame).
+// `simulate --animate` does (crates/sandslope-render/src/figures/simulate.rs draw_frame).
 const SIM_RATE_HZ = 30;
 const sim = { walk: null, pos: 0, playing: true, timer: null };
 function simFlags() {
@@ -670,7 +677,7 @@ function showSimulation(walk) {
   drawSimFrame();
 }
 function legColour(tripod, rank, n) {
-  const base = tripod === 0 ? [31, 90, 180] : [230, 120, 20];
+  const base = rgbOf(SIM_COLOURS[tripod === 0 ? "tripod-a" : "tripod-b"]);
   const f = n > 1 ? (0.45 * rank) / (n - 1) : 0;
   return `rgb(${base.map((c) => Math.floor(c + (255 - c) * f)).join(",")})`;
 }
@@ -714,10 +721,10 @@ function drawSimFrame() {
   // Sand: the slope frame below its surface, turned into the world.
   const far = 2;
   path([world([x - far, 0]), world([x + far, 0]), world([x + far, -far]), world([x - far, -far])], true);
-  ctx.fillStyle = "rgb(230,205,150)";
+  ctx.fillStyle = SIM_COLOURS.sand;
   ctx.fill();
   path([world([x - far, 0]), world([x + far, 0])], false);
-  ctx.strokeStyle = "rgb(150,120,60)";
+  ctx.strokeStyle = SIM_COLOURS["sand-surface"];
   ctx.lineWidth = 2;
   ctx.stroke();
   // Marks on the sand every 5 cm along the slope, so the walk shows against the ground.
@@ -733,8 +740,10 @@ function drawSimFrame() {
   const l = g.body_length_m;
   const h = g.hip_height_m;
   path([[-l / 2, -h], [l / 2, -h], [l / 2, 0.3 * h], [-l / 2, 0.3 * h]].map(body), true);
-  ctx.fillStyle = "rgba(90,90,90,0.8)";
+  ctx.fillStyle = SIM_COLOURS.data;
+  ctx.globalAlpha = 0.8;
   ctx.fill();
+  ctx.globalAlpha = 1;
   const legs = g.hip_x_m.length;
   const half = Math.max(1, Math.floor(legs / 2));
   const scale = 0.02; // m of arrow per N
@@ -755,11 +764,11 @@ function drawSimFrame() {
       for (const p of pts) if (-p[0] * s + p[1] * c < -lowest[0] * s + lowest[1] * c) lowest = p;
       const tip = [lowest[0] + scale * (fx * c - fz * s), lowest[1] + scale * (fx * s + fz * c)];
       path([lowest, tip], false);
-      ctx.strokeStyle = "#d00";
+      ctx.strokeStyle = SIM_COLOURS["closed-form"];
       ctx.lineWidth = 2;
       ctx.stroke();
       const [u, v] = px(tip);
-      ctx.fillStyle = "#d00";
+      ctx.fillStyle = SIM_COLOURS["closed-form"];
       ctx.beginPath();
       ctx.arc(u, v, 3, 0, 2 * Math.PI);
       ctx.fill();

@@ -15,6 +15,7 @@ use crate::figures::simulate::{Animation, SimulateFigure, SlopesFigure};
 use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
+use crate::progress::{progress_bar, spinner};
 use sandslope::simulate::{BodyPitch, RftScaling, SimSummary, Simulation};
 use sandslope_io::load_speeds;
 use sandslope_io::trajectory::plain_mocap_csv;
@@ -63,7 +64,9 @@ pub struct SimulateArgs {
     /// Observed speeds (CSV: slope_deg,speed_m_s,speed_sd_m_s) for the --slopes figure.
     #[arg(long, value_name = "CSV", requires_all = ["slopes", "plot"])]
     pub observed: Option<PathBuf>,
-    /// Side-view animation (slope, sand, body, legs, force arrows) to FILE.gif.
+    /// Side-view animation to FILE.gif: slope, sand with a mark every 5 cm, the body's trace,
+    /// legs and force arrows; the whole walk at 20 frames per simulated second, in real time,
+    /// up to its first 60 s (1200 frames).
     #[arg(long, value_name = "FILE.gif")]
     pub animate: Option<PathBuf>,
     #[command(flatten)]
@@ -159,7 +162,13 @@ pub fn run(args: SimulateArgs) -> Result<()> {
 
 fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     let (scenario, slope) = (&walks.scenario, walks.slopes[0]);
-    let Some(sim) = walks.simulate()?.pop() else { bail!("no walk was simulated") };
+    // Progress on stderr (a terminal's, not with --json or --csv): a 10 s walk with its GIF
+    // takes tens of seconds.
+    let quiet = args.format.format() != Format::Table;
+    let spin = spinner(quiet, &format!("simulating {} s at {slope} deg", walks.settings.duration_s));
+    let sims = walks.simulate();
+    spin.finish_and_clear();
+    let Some(sim) = sims?.pop() else { bail!("no walk was simulated") };
     if sim.summary.closed_form.extrapolated {
         warn_extrapolated(scenario.terrain(), &[slope]);
     }
@@ -169,7 +178,10 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
         figures::save(path, &SimulateFigure { sim: &sim, robot: scenario.robot() })?;
     }
     if let Some(path) = &args.animate {
-        figures::simulate::save_gif(path, &Animation { sim: &sim, slope_deg: slope })?;
+        let anim = Animation { sim: &sim, slope_deg: slope };
+        let bar = progress_bar(anim.frames().len() as u64, quiet, &format!("drawing {}", path.display()));
+        figures::simulate::save_gif(path, &anim, &mut || bar.inc(1))?;
+        bar.finish_and_clear();
     }
     if let (Some(path), Some(csv)) = (&args.out, &csv) {
         write_atomic(path, csv.as_bytes())?;
@@ -263,7 +275,11 @@ struct SlopeRow {
 
 fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedObservation]) -> Result<()> {
     let (scenario, settings) = (&walks.scenario, &walks.settings);
-    let sims = walks.simulate()?;
+    let quiet = args.format.format() != Format::Table;
+    let spin = spinner(quiet, &format!("simulating {} slopes", walks.slopes.len()));
+    let sims = walks.simulate();
+    spin.finish_and_clear();
+    let sims = sims?;
     let beyond: Vec<f64> =
         sims.iter().filter(|s| s.summary.closed_form.extrapolated).map(|s| s.summary.slope_deg).collect();
     if !beyond.is_empty() {

@@ -85,7 +85,10 @@ pub const TRIPOD_A: RGBColor = SIMULATED_BLUE;
 pub const TRIPOD_B: RGBColor = RGBColor(230, 120, 20);
 /// Simulation animation: the sand.
 pub const SAND: RGBColor = RGBColor(230, 205, 150);
-/// Simulation animation: the sand's surface.
+/// Simulation animation: the trace of the body's centre (the safest route's purple: apart
+/// from the tripods' blue and orange, the forces' red and the sand).
+pub const BODY_TRACE: RGBColor = ROUTE_RISK;
+/// Simulation animation: the sand's surface and the marks on it.
 pub const SAND_SURFACE: RGBColor = RGBColor(150, 120, 60);
 /// Step budget: the net step.
 pub const NET_STEP: RGBColor = RGBColor(20, 20, 20);

@@ -313,19 +313,32 @@ pub struct Animation<'a> {
     pub slope_deg: f64,
 }
 
-/// Frames per second of the animation (every sample at 120 Hz would make huge files).
-const GIF_FPS: f64 = 20.0;
-/// Longest animation, s of simulated time.
-const GIF_MAX_S: f64 = 6.0;
+/// Frames per second of simulated time in the animation, played in real time (every sample
+/// at 120 Hz would make huge files).
+pub const GIF_FPS: f64 = 20.0;
+/// Longest animation, s of simulated time: a longer walk is animated over its first
+/// `GIF_MAX_S` seconds (`GIF_MAX_S * GIF_FPS` = 1200 frames, about 60 MB of GIF); `simulate
+/// --help` and docs/simulate.md name the cap.
+pub const GIF_MAX_S: f64 = 60.0;
+/// Spacing of the marks on the sand, m along the slope (as the explorer's page draws them).
+pub const GROUND_MARK_M: f64 = 0.05;
 
-/// Writes `anim` as an animated GIF to `path`, atomically.
-pub fn save_gif(path: &Path, anim: &Animation<'_>) -> Result<()> {
+impl Animation<'_> {
+    /// The trajectory samples drawn as frames: one per 1/[`GIF_FPS`] s of the whole walk, up
+    /// to [`GIF_MAX_S`].
+    pub fn frames(&self) -> Vec<usize> {
+        let tr = &self.sim.trajectory;
+        let rate = if tr.time_s.len() > 1 { 1.0 / (tr.time_s[1] - tr.time_s[0]) } else { GIF_FPS };
+        let every = ((rate / GIF_FPS).round() as usize).max(1);
+        (0..tr.time_s.len()).step_by(every).take_while(|&i| tr.time_s[i] <= GIF_MAX_S + 1e-9).collect()
+    }
+}
+
+/// Writes `anim` as an animated GIF to `path`, atomically, calling `on_frame` after each frame
+/// (of [`Animation::frames`]) is encoded, for a progress bar.
+pub fn save_gif(path: &Path, anim: &Animation<'_>, on_frame: &mut dyn FnMut()) -> Result<()> {
     super::register_fonts();
-    let tr = &anim.sim.trajectory;
-    let rate = if tr.time_s.len() > 1 { 1.0 / (tr.time_s[1] - tr.time_s[0]) } else { GIF_FPS };
-    let every = ((rate / GIF_FPS).round() as usize).max(1);
-    let frames: Vec<usize> =
-        (0..tr.time_s.len()).step_by(every).take_while(|&i| tr.time_s[i] <= GIF_MAX_S + 1e-9).collect();
+    let frames = anim.frames();
     let delay = (1000.0 / GIF_FPS) as u32;
     write_output(path, |file| {
         let mut gif = GifWriter::new(file, GIF_SIZE, delay)?;
@@ -338,6 +351,7 @@ pub fn save_gif(path: &Path, anim: &Animation<'_>) -> Result<()> {
                 root.present().map_err(plot_err)?;
             }
             gif.frame(&rgb)?;
+            on_frame();
         }
         Ok(())
     })
@@ -418,6 +432,27 @@ where
     if surface.len() == 2 {
         chart
             .draw_series([PathElement::new(surface, palette::SAND_SURFACE.stroke_width(2))])
+            .map_err(plot_err)?;
+    }
+    // Marks on the sand every GROUND_MARK_M along the slope, fixed to the sand (the camera
+    // follows the body, so the marks are what shows it move, and slip as marks standing still
+    // under an anchored leg); only marks wholly in view (plotters clamps points outside it).
+    let inside = |p: Point| (p.0 - centre.0).abs() <= half_w && (p.1 - centre.1).abs() <= half_h;
+    let reach = 2.0 * half_w;
+    let first = ((x - reach) / GROUND_MARK_M).floor() as i64;
+    let last = ((x + reach) / GROUND_MARK_M).ceil() as i64;
+    let marks: Vec<Vec<Point>> = (first..=last)
+        .map(|k| vec![world([k as f64 * GROUND_MARK_M, 0.0]), world([k as f64 * GROUND_MARK_M, -0.012])])
+        .filter(|m| m.iter().all(|&p| inside(p)))
+        .collect();
+    chart
+        .draw_series(marks.into_iter().map(|m| PathElement::new(m, palette::SAND_SURFACE.stroke_width(1))))
+        .map_err(plot_err)?;
+    // The body's path so far: its centre's trace, the part in view.
+    let trace: Vec<Point> = (0..=i).map(|k| world([tr.x_m[k], tr.z_m[k]])).filter(|&p| inside(p)).collect();
+    if trace.len() >= 2 {
+        chart
+            .draw_series([PathElement::new(trace, palette::BODY_TRACE.stroke_width(2))])
             .map_err(plot_err)?;
     }
     // Body: a box from the belly (h below the axle) to h above it, pitched.
@@ -512,6 +547,89 @@ mod tests {
         assert!(poly.contains(&(1.0, -1.0)) && !poly.contains(&(-1.0, 1.0)));
     }
 
+    fn walk(slope_deg: f64, duration_s: f64) -> Simulation {
+        let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
+        let s = Scenario::new(robot, Terrain::constant(7e5, 2e6).unwrap(), None, None).unwrap();
+        simulate(&s, slope_deg, &SimSettings::new(duration_s).unwrap()).unwrap()
+    }
+
+    /// One frame as RGB pixels, 800 x 450.
+    fn frame_rgb(anim: &Animation<'_>, i: usize) -> Vec<u8> {
+        super::super::register_fonts();
+        let mut rgb = vec![0u8; 800 * 450 * 3];
+        {
+            let root = BitMapBackend::with_buffer(&mut rgb, GIF_SIZE).into_drawing_area();
+            root.fill(&WHITE).unwrap();
+            draw_frame(&root, anim, i).unwrap();
+            root.present().unwrap();
+        }
+        rgb
+    }
+
+    fn is(rgb: &[u8], col: usize, row: usize, c: RGBColor) -> bool {
+        let k = 3 * (row * 800 + col);
+        rgb[k..k + 3] == [c.0, c.1, c.2]
+    }
+
+    /// The whole walk is animated (a 7 s walk at 120 Hz: 7 s x 20 frames/s + the frame at
+    /// t = 0 = 141 frames, every 6th sample, the last at 7.00 s), not its first 6 s.
+    #[test]
+    fn the_whole_walk_is_animated() {
+        let sim = walk(10.0, 7.0);
+        let anim = Animation { sim: &sim, slope_deg: 10.0 };
+        let frames = anim.frames();
+        assert_eq!(frames.len(), 141);
+        assert!(frames.windows(2).all(|w| w[1] - w[0] == 6), "{frames:?}");
+        assert!((sim.trajectory.time_s[*frames.last().unwrap()] - 7.0).abs() < 1e-9);
+    }
+
+    /// On level sand the marks stand vertical below the surface, one every 5 cm: at 800 px
+    /// less two 8 px margins for a 0.5 m wide view, 784 px / 0.5 m x 0.05 m = 78.4 px apart.
+    /// They are fixed to the sand: a mark's pixel plus the body's advance in pixels is the
+    /// same, modulo 78.4 px, in every frame. The body's trace shows once the body has moved.
+    #[test]
+    fn ground_marks_every_5_cm_fixed_to_the_sand_and_the_trace() {
+        let sim = walk(0.0, 1.5);
+        let anim = Animation { sim: &sim, slope_deg: 0.0 };
+        let px_per_m = 784.0 / 0.5;
+        let spacing = GROUND_MARK_M * px_per_m;
+        let mut phases = Vec::new();
+        for i in [0usize, 90, 174] {
+            let rgb = frame_rgb(&anim, i);
+            // The surface: the first sand-surface pixel down the left edge's column 20.
+            let top = (0..450).find(|&r| is(&rgb, 20, r, palette::SAND_SURFACE)).expect("surface line");
+            let row = top + 6;
+            let cols: Vec<usize> = (0..800).filter(|&c| is(&rgb, c, row, palette::SAND_SURFACE)).collect();
+            // Runs of mark pixels, by their centres.
+            let mut centres: Vec<f64> = Vec::new();
+            let mut run: Vec<usize> = Vec::new();
+            for &c in &cols {
+                if run.last().is_some_and(|&l| c != l + 1) {
+                    centres.push(run.iter().sum::<usize>() as f64 / run.len() as f64);
+                    run.clear();
+                }
+                run.push(c);
+            }
+            if !run.is_empty() {
+                centres.push(run.iter().sum::<usize>() as f64 / run.len() as f64);
+            }
+            assert!(centres.len() >= 6, "frame {i}: marks at {centres:?}");
+            for w in centres.windows(2) {
+                let n = (w[1] - w[0]) / spacing;
+                assert!((n - n.round()).abs() < 0.03 && n.round() >= 1.0, "frame {i}: {centres:?}");
+            }
+            let shift = sim.trajectory.x_m[i] * px_per_m;
+            phases.push((centres[0] + shift).rem_euclid(spacing));
+            let traced = (0..800 * 450).any(|k| is(&rgb, k % 800, k / 800, palette::BODY_TRACE));
+            assert_eq!(traced, i > 0, "frame {i}: trace drawn {traced}");
+        }
+        assert!(sim.trajectory.x_m[174] - sim.trajectory.x_m[0] > 0.1, "the walk must move");
+        for p in &phases {
+            let d = (p - phases[0]).abs();
+            assert!(d.min(spacing - d) < 1.5, "marks move with the camera, not the sand: {phases:?}");
+        }
+    }
+
     #[test]
     fn animation_frames_draw_and_the_gif_is_written() {
         let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
@@ -534,7 +652,9 @@ mod tests {
             assert!(std::fs::metadata(&path).unwrap().len() > 1000);
         }
         let gif = dir.join("sandslope-sim-test.gif");
-        save_gif(&gif, &anim).unwrap();
+        let mut frames = 0;
+        save_gif(&gif, &anim, &mut || frames += 1).unwrap();
+        assert_eq!(frames, anim.frames().len());
         let bytes = std::fs::read(&gif).unwrap();
         assert_eq!(&bytes[..6], b"GIF89a");
     }

@@ -117,6 +117,8 @@ pub const PAGE_CODE_BG: RGBColor = RGBColor(244, 244, 244);
 pub const PAGE_DISAGREE_BG: RGBColor = RGBColor(253, 236, 234);
 /// A verdict cell where they agree (a dark tint of success green).
 pub const PAGE_AGREE_INK: RGBColor = RGBColor(27, 110, 42);
+/// Where the simulator and the closed form part (a dark tint of slippage red, for text).
+pub const PAGE_PART_INK: RGBColor = RGBColor(165, 40, 34);
 /// A warning box's background.
 pub const PAGE_WARN_BG: RGBColor = RGBColor(255, 248, 225);
 /// A warning box's bar.

@@ -59,7 +59,10 @@ table{{border-collapse:collapse;margin:1em 0;font-size:0.92em}}td,th{{border:1px
 text-align:left}}th{{background:{th}}}tr.no td{{background:{no}}}tr.yes td.v{{color:{yes}}}\
 figure{{margin:1.5em 0;display:inline-block;vertical-align:top;max-width:100%}}\
 figure svg{{max-width:100%;height:auto;border:1px solid {fig}}}figcaption{{font-size:0.9em;color:{cap};max-width:760px}}\
-.warn{{background:{warn};border-left:4px solid {bar};padding:0.5em 1em}}code{{background:{code};padding:0 3px}}",
+.warn{{background:{warn};border-left:4px solid {bar};padding:0.5em 1em}}code{{background:{code};padding:0 3px}}\
+table.sim{{table-layout:fixed;width:100%;font-size:0.85em}}table.sim td,table.sim th{{overflow-wrap:anywhere}}\
+table.sim th:first-child{{width:7%}}table.sim th:last-child{{width:26%}}td.part summary{{color:{part}}}td.agree summary{{color:{yes}}}\
+details summary{{cursor:pointer}}details[open]{{font-size:0.92em}}",
         ink = css(palette::PAGE_INK),
         rule = css(palette::PAGE_RULE),
         th = css(palette::PAGE_HEADER_BG),
@@ -70,6 +73,7 @@ figure svg{{max-width:100%;height:auto;border:1px solid {fig}}}figcaption{{font-
         warn = css(palette::PAGE_WARN_BG),
         bar = css(palette::PAGE_WARN_BAR),
         code = css(palette::PAGE_CODE_BG),
+        part = css(palette::PAGE_PART_INK),
     )
 }
 

@@ -267,32 +267,52 @@ pub fn simulator(report: &Report) -> String {
         report.simulator.len()
     ));
     h.push_str(
-        "<table><tr><th>slope (°)</th><th>observed (cm/s)</th><th>closed form (cm/s)</th><th>simulated (cm/s)</th><th>simulated, pitch locked (cm/s)</th>\
-         <th>t1 (ms): simulated / closed form</th><th>slip (mm): simulated / closed form</th><th>step (mm): simulated / closed form</th>\
-         <th>regime: closed form</th><th>regime: simulated (cause)</th><th>largest pitch (°)</th><th>where they part, and why</th></tr>",
+        "<p>Speeds in cm/s. Each row's last cell says whether the two agree or, in a word, where they part; \
+         open it for the why and the step's parts (t1, slip and step, simulated / closed form).</p>\n\
+         <table class=\"sim\"><tr><th>slope (°)</th><th>observed</th><th>closed form</th><th>simulated</th>\
+         <th>pitch locked</th><th>regime: closed form / simulated</th><th>largest pitch (°)</th><th>verdict</th></tr>",
     );
     for r in &report.simulator {
         h.push_str(&format!(
-            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1} ({})</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} ({})</td><td>{:.0}</td><td>{}</td></tr>",
-            if r.agree { "yes" } else { "no" },
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{} / {}</td><td>{:.0}</td>{}</tr>",
             r.slope_deg,
             plus_minus(r.observed_m_s.map(|v| v * 100.0), r.observed_sd_m_s.map(|v| v * 100.0), 1.0, 1),
             r.closed_form_m_s.map_or("- (ruled out)".into(), |v| format!("{:.1}", v * 100.0)),
             if r.pitch_over_s.is_some() { "- (tumbled)".to_string() } else { format!("{:.1}", r.simulated_m_s * 100.0) },
             r.pitch_locked_m_s * 100.0,
-            r.pitch_locked_regime.name(),
-            pair(r.simulated_t1_s, r.closed_form_t1_s, 1e3, 1),
-            pair(r.simulated_slip_m, r.closed_form_slip_m, 1e3, 1),
-            pair(Some(r.simulated_step_m), r.closed_form_step_m, 1e3, 0),
             r.closed_form_regime.name(),
             r.simulated_regime.name(),
-            r.simulated_cause.name(),
             r.max_pitch_deg,
-            escape(&r.why),
+            verdict_cell(r),
         ));
     }
     h.push_str("</table>\n");
     h
+}
+
+/// The simulator table's last cell: "agree", or where the two part in a few words (the text
+/// of `why` before its first colon), with the rest of `why` and the step's parts in a
+/// collapsible note, so that no cell holds a paragraph.
+fn verdict_cell(r: &sandslope::report::SimulatorRecord) -> String {
+    let (label, detail) = r.why.split_once(": ").unwrap_or((r.why.as_str(), ""));
+    let label = if r.agree { "agree" } else { label };
+    let mut note = String::new();
+    if !detail.is_empty() {
+        note.push_str(&format!("{}. ", escape(detail)));
+    }
+    note.push_str(&format!(
+        "Simulated cause: {}; pitch locked: {}. t1 (ms) {}; slip (mm) {}; step (mm) {} (simulated / closed form).",
+        r.simulated_cause.name().replace('_', " "),
+        r.pitch_locked_regime.name(),
+        pair(r.simulated_t1_s, r.closed_form_t1_s, 1e3, 1),
+        pair(r.simulated_slip_m, r.closed_form_slip_m, 1e3, 1),
+        pair(Some(r.simulated_step_m), r.closed_form_step_m, 1e3, 0),
+    ));
+    format!(
+        "<td class=\"{}\"><details><summary>{}</summary>{note}</details></td>",
+        if r.agree { "agree" } else { "part" },
+        escape(label)
+    )
 }
 
 /// The stride simulator's joint fit beside the closed form's (`report --simulator-fit`), or

@@ -291,14 +291,13 @@ pub fn simulator(report: &Report) -> String {
 }
 
 /// The simulator table's last cell: "agree", or where the two part in a few words (the text
-/// of `why` before its first colon), with the rest of `why` and the step's parts in a
+/// of `why` before its first colon), with the whole of `why` and the step's parts in a
 /// collapsible note, so that no cell holds a paragraph.
 fn verdict_cell(r: &sandslope::report::SimulatorRecord) -> String {
-    let (label, detail) = r.why.split_once(": ").unwrap_or((r.why.as_str(), ""));
-    let label = if r.agree { "agree" } else { label };
+    let label = if r.agree { "agree" } else { r.why.split_once(": ").map_or(r.why.as_str(), |(l, _)| l) };
     let mut note = String::new();
-    if !detail.is_empty() {
-        note.push_str(&format!("{}. ", escape(detail)));
+    if !r.why.is_empty() {
+        note.push_str(&format!("{}. ", escape(&r.why)));
     }
     note.push_str(&format!(
         "Simulated cause: {}; pitch locked: {}. t1 (ms) {}; slip (mm) {}; step (mm) {} (simulated / closed form).",

@@ -56,7 +56,7 @@ except ImportError:
     plt = None
     print("matplotlib is not installed: the phase-map figure is skipped (pip install matplotlib)")
 if plt is not None:
-    # The CLI's regime palette (crates/sandslope-cli/src/figures/palette.rs).
+    # The CLI's regime palette (crates/sandslope-render/src/figures/palette.rs).
     colours = ListedColormap(["#426ec9", "#d63830", "#f7d643", "#a8e296"])
     fig, ax = plt.subplots(figsize=(6, 5), dpi=120)
     mesh = ax.pcolormesh(m["k_n"], m["k_s"], m["regime"].T, cmap=colours,

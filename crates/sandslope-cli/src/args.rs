@@ -2,15 +2,16 @@
 //! `--k-n`, `--k-s`, grid axes) and the checks of flag values. Commands share code through
 //! this module, never through each other.
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::Result;
 use clap::Args;
-use sandslope::{LevelStep, Robot, Scenario, Slope, Terrain};
+use sandslope::{LevelStep, Robot, Terrain};
+use sandslope_request::{grammar, RobotRequest, ScenarioRequest};
 
 use sandslope::risk::UncertainTerrain;
 use sandslope::robot_key::RobotKey;
-use sandslope::{Axis, AxisScale};
+use sandslope::AxisScale;
+use sandslope_io::load_terrain;
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
-use sandslope_io::{load_robot, load_terrain};
 
 /// `--robot` and `--mass`.
 #[derive(Debug, Clone, Args)]
@@ -26,13 +27,15 @@ pub struct RobotArgs {
 }
 
 impl RobotArgs {
-    /// Loads the robot and applies `--mass` and the other robot quantities given.
+    /// The request these flags make: the robot, `--mass` and the other robot quantities given.
+    pub fn request(&self) -> RobotRequest {
+        RobotRequest { robot: self.robot.clone(), mass: self.mass, overrides: self.quantities.overrides() }
+    }
+
+    /// Loads the robot and applies `--mass` and the other robot quantities given (the request
+    /// layer's one robot validation, errors naming the flag).
     pub fn load(&self) -> Result<Robot> {
-        let robot = self.quantities.apply(load_robot(&self.robot)?)?;
-        match self.mass {
-            Some(m) => robot.with_mass(m).map_err(|e| anyhow!("{}", e.renamed("--mass"))),
-            None => Ok(robot),
-        }
+        Ok(self.request().load()?)
     }
 }
 
@@ -43,16 +46,8 @@ pub struct LevelStepArgs {
     /// open): `slope` takes d_n at the slope, with its cos(theta) (the default); `level` takes
     /// d_n on level sand, the paper's definition of s*. Up to 0.7% in speed on the built-in
     /// robot and terrain. No effect on a robot with `level_step_m`.
-    #[arg(long, value_name = "slope|level", default_value = "slope", value_parser = parse_level_step)]
+    #[arg(long, value_name = "slope|level", default_value = "slope", value_parser = sandslope_request::scenario::parse_level_step)]
     pub level_step: LevelStep,
-}
-
-fn parse_level_step(s: &str) -> Result<LevelStep, String> {
-    match s {
-        "slope" => Ok(LevelStep::Slope),
-        "level" => Ok(LevelStep::Level),
-        other => Err(format!("`{other}` is not a level-step rule: expected `slope` (d_n at the slope) or `level` (d_n on level sand)")),
-    }
 }
 
 /// `--terrain`.
@@ -86,27 +81,11 @@ pub struct UncertaintyArgs {
 }
 
 impl UncertaintyArgs {
-    /// Checks the flags alone, before any file is read: each CV a finite number of at least 0.
-    pub fn check(&self) -> Result<()> {
-        for (flag, cv) in [("--cv-n", self.cv_n), ("--cv-s", self.cv_s)] {
-            if let Some(cv) = cv {
-                check_flag(flag, cv, 0.0, f64::INFINITY)?;
-            }
-        }
-        Ok(())
-    }
-
     /// The terrain read as uncertain (a flag's CV, else the table's SDs, else the default CV),
     /// with the note to print when a default is used anywhere on the table. Errors name the
     /// flag: `--cv-n = -1 must be a finite number of at least 0`.
     pub fn apply(&self, terrain: Terrain) -> Result<(UncertainTerrain, Option<String>)> {
-        self.check()?;
-        let u = UncertainTerrain::new(terrain, self.cv_n, self.cv_s).map_err(|e| {
-            let flag = if e.key == "cv_s" { "--cv-s" } else { "--cv-n" };
-            anyhow!("{}", e.renamed(flag))
-        })?;
-        let note = u.defaults_used().note();
-        Ok((u, note))
+        Ok(grammar::uncertain_terrain(terrain, self.cv_n, self.cv_s)?)
     }
 }
 
@@ -137,30 +116,19 @@ pub struct RobotQuantityArgs {
 }
 
 impl RobotQuantityArgs {
-    /// `robot` with the given quantities replaced, validated again as a whole; an error on
-    /// one of these keys names its flag (from the library's table, [`RobotKey::flag`]).
-    pub fn apply(&self, robot: Robot) -> Result<Robot> {
-        let mut spec = robot.spec().clone();
-        let given = [
+    /// The quantities given, by the library's robot key.
+    pub fn overrides(&self) -> Vec<(RobotKey, f64)> {
+        [
             (RobotKey::LegRadiusM, self.leg_radius),
             (RobotKey::LegWidthM, self.leg_width),
             (RobotKey::HipHeightM, self.hip_height),
             (RobotKey::LegSpeedRadS, self.leg_speed),
             (RobotKey::StanceLegs, self.stance_legs.map(f64::from)),
             (RobotKey::ResponseTimeS, self.response_time),
-        ];
-        for (key, value) in given {
-            if let Some(v) = value {
-                key.set(&mut spec, v);
-            }
-        }
-        Robot::new(spec).map_err(|e| {
-            let flag = given.iter().find(|(key, _)| key.name() == e.key).and_then(|(key, _)| key.flag());
-            match flag {
-                Some(flag) => anyhow!("{}", e.renamed(flag)),
-                None => anyhow!("{e}"),
-            }
-        })
+        ]
+        .into_iter()
+        .filter_map(|(key, value)| value.map(|v| (key, v)))
+        .collect()
     }
 }
 
@@ -179,12 +147,15 @@ pub struct OverrideArgs {
 }
 
 impl OverrideArgs {
-    /// The scenario `predict` and `sweep` evaluate: robot, terrain and these overrides.
-    pub fn scenario(&self, robot: &RobotArgs, terrain: &TerrainArgs) -> Result<Scenario> {
-        let k_n = self.k_n.map(|v| check_positive("--k-n", v)).transpose()?;
-        let k_s = self.k_s.map(|v| check_positive("--k-s", v)).transpose()?;
-        let robot = robot.load()?.with_level_step(self.level.level_step);
-        Scenario::new(robot, terrain.load()?, k_n, k_s).map_err(|e| anyhow!("{e}"))
+    /// The scenario request of `predict` and `sweep`: robot, terrain and these overrides.
+    pub fn request(&self, robot: &RobotArgs, terrain: &TerrainArgs) -> ScenarioRequest {
+        ScenarioRequest {
+            robot: robot.request(),
+            terrain: terrain.terrain.clone(),
+            k_n: self.k_n,
+            k_s: self.k_s,
+            level_step: self.level.level_step,
+        }
     }
 }
 
@@ -221,170 +192,37 @@ pub fn beyond_last_point(terrain: &Terrain, slopes_deg: &[f64]) -> Vec<f64> {
 /// Checks a command-line number: finite and within `lo..=hi`, naming the flag (`hi` infinite:
 /// no upper bound).
 pub fn check_flag(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
-    if value.is_finite() && value >= lo && value <= hi {
-        Ok(value)
-    } else if hi == f64::INFINITY {
-        bail!("{flag} = {value} must be a finite number of at least {lo}")
-    } else {
-        bail!("{flag} = {value} must be between {lo} and {hi}")
-    }
+    Ok(sandslope_request::error::check_range(flag.trim_start_matches('-'), value, lo, hi)?)
 }
 
-/// Parses `--max-risk` (clap's value parser, so every command that takes it says the same):
-/// a failure probability strictly between 0 and 1.
-pub fn parse_max_risk(text: &str) -> Result<f64, String> {
-    match text.trim().parse::<f64>() {
-        Ok(p) if p > 0.0 && p < 1.0 => Ok(p),
-        Ok(p) => Err(format!("{p} is not a failure probability strictly between 0 and 1 (e.g. 0.05)")),
-        Err(_) => Err(format!(
-            "`{text}` is not a number: expected a failure probability strictly between 0 and 1 (e.g. 0.05)"
-        )),
-    }
-}
+pub use sandslope_request::grammar::{parse_max_risk, AxisRange, SlopeSign};
 
-/// Which slopes a slope list accepts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SlopeSign {
-    /// Climbing only: 0 <= deg < 90.
-    Uphill,
-    /// Signed inclinations, -90 < deg < 90 (a descent is felt as the climb of its size,
-    /// docs/model.md §8).
-    Signed,
-}
-
-/// Parses a slope list given to `flag`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N` (N evenly spaced
-/// slopes, both ends included), in degrees, with at most `max` slopes. N and the list's length
-/// are checked against `max` before anything is expanded (`0:24:99999999999` is refused at
-/// once, not after allocating 800 GB). The one slope-list grammar of every command.
+/// Parses a slope list given to `flag`: the one slope-list grammar of every front end
+/// ([`grammar::parse_slope_list`]: `DEG`, `DEG,DEG,...` or `MIN:MAX:N`, at most `max`).
 pub fn parse_slope_list(flag: &str, text: &str, sign: SlopeSign, max: usize) -> Result<Vec<f64>> {
-    let number = |s: &str| -> Result<f64> {
-        let v: f64 =
-            s.trim().parse().map_err(|_| anyhow!("{flag}: `{}` is not a number (in {text})", s.trim()))?;
-        match sign {
-            SlopeSign::Uphill => Slope::from_degrees(v).map(|_| ()),
-            SlopeSign::Signed => Slope::from_signed_degrees(v).map(|_| ()),
-        }
-        .map_err(|e| anyhow!("{}", e.renamed(flag)))?;
-        Ok(v)
-    };
-    if text.contains(':') {
-        let parts: Vec<&str> = text.split(':').collect();
-        let [lo, hi, n] = parts.as_slice() else {
-            bail!("{flag} = {text} must be DEG, a comma list DEG,DEG,... or MIN:MAX:N (e.g. 0:24:13)");
-        };
-        let count = n.trim();
-        let (lo, hi) = (number(lo)?, number(hi)?);
-        let n: usize = count.parse().ok().filter(|n| (2..=max).contains(n)).ok_or_else(|| {
-            // The third field is a count, not a step: `0:30:1` most likely meant 1-degree
-            // steps, which is the count (MAX - MIN) / step + 1, suggested where whole.
-            let step: Option<f64> = count.parse().ok().filter(|s: &f64| *s > 0.0 && hi > lo);
-            let hint = step
-                .map(|step| (hi - lo) / step + 1.0)
-                .filter(|k| (k - k.round()).abs() < 1e-9 && (2.0..=max as f64).contains(&k.round()))
-                .map(|k| {
-                    format!(
-                        "; the third field is the number of slopes, not a step: for steps of {count} deg from {lo} to {hi} write {lo}:{hi}:{}",
-                        k.round()
-                    )
-                })
-                .unwrap_or_else(|| "; the third field is the number of slopes, not a step".into());
-            anyhow!("{flag}: N `{count}` must be a whole number from 2 to {max} (in {text}){hint}")
-        })?;
-        if hi <= lo {
-            bail!("{flag} = {text}: MAX must be greater than MIN");
-        }
-        return Ok((0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect());
-    }
-    let count = text.split(',').count();
-    if count > max {
-        bail!("{flag} lists {count} slopes; at most {max} are allowed");
-    }
-    text.split(',').map(number).collect()
+    Ok(grammar::parse_slope_list(flag.trim_start_matches('-'), text, sign, max)?)
 }
 
 /// Checks a command-line number is finite and strictly positive, naming the flag.
 pub fn check_positive(flag: &str, value: f64) -> Result<f64> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        bail!("{flag} = {value} must be a finite number greater than 0")
-    }
+    Ok(sandslope_request::error::check_positive(flag.trim_start_matches('-'), value)?)
 }
 
-/// Parses a grid axis `MIN:MAX:N[:log|:lin]` given to `flag` (log spacing by default: the
-/// strengths k_n and k_s span decades).
-pub fn parse_axis(flag: &str, text: &str) -> Result<Axis> {
-    let range = parse_axis_range(text, AxisScale::Log, &format!("{flag}:"), text)?.ok_or_else(|| {
-        anyhow!("{flag} = {text} must be MIN:MAX:N or MIN:MAX:N:log or MIN:MAX:N:lin (e.g. 1e4:1e7:400)")
-    })?;
-    Axis::new(flag, range.min, range.max, range.n, range.scale).map_err(|e| anyhow!("{e}"))
-}
-
-/// The numbers of an axis `MIN:MAX:N[:log|:lin]`, before the library checks their ranges.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AxisRange {
-    /// First value.
-    pub min: f64,
-    /// Last value.
-    pub max: f64,
-    /// Number of values, as written (each use checks it is at least 2).
-    pub n: usize,
-    /// Spacing.
-    pub scale: AxisScale,
-}
-
-/// The one grammar of a grid axis on the command line, `MIN:MAX:N[:log|:lin]`, for every flag
-/// that takes one (`--k-n`, `--k-s`, `design --vary KEY=...`); `default` is the spacing when
-/// none is written, stated by each use (log for strengths, linear for robot quantities).
-/// `None` when `text` is not of that shape (each use names its own forms); errors begin with
-/// `prefix` and quote `context`.
+/// The one grammar of a grid axis, `MIN:MAX:N[:log|:lin]` ([`grammar::parse_axis_range`]);
+/// errors begin with `prefix`, whose first word is the flag.
 pub fn parse_axis_range(
     text: &str,
     default: AxisScale,
     prefix: &str,
     context: &str,
 ) -> Result<Option<AxisRange>> {
-    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
-    if !(3..=4).contains(&parts.len()) {
-        return Ok(None);
-    }
-    let number = |what: &str, s: &str| -> Result<f64> {
-        s.parse::<f64>().map_err(|_| anyhow!("{prefix} {what} `{s}` is not a number (in {context})"))
-    };
-    let (min, max) = (number("MIN", parts[0])?, number("MAX", parts[1])?);
-    // N < 2 is left to the use: the library's axis names its own key (`--k-n points = 0`).
-    let n: usize = parts[2].parse().map_err(|_| {
-        anyhow!("{prefix} N `{}` must be a whole number of at least 2 (in {context})", parts[2])
-    })?;
-    let scale = match parts.get(3).map(|s| s.to_ascii_lowercase()).as_deref() {
-        None => default,
-        Some("log") => AxisScale::Log,
-        Some("lin") | Some("linear") => AxisScale::Linear,
-        Some(other) => bail!("{prefix} spacing `{other}` must be `log` or `lin` (in {context})"),
-    };
-    Ok(Some(AxisRange { min, max, n, scale }))
-}
-
-/// A log axis from `lo / down` to `hi * up` around positive terrain values, with `n` points.
-pub fn default_axis(flag: &str, values: &[f64], down: f64, up: f64, n: usize) -> Result<Axis> {
-    Axis::log_around(flag, values, down, up, n).map_err(|e| anyhow!("{e}"))
+    let field = prefix.split([':', ' ']).next().unwrap_or(prefix).trim_start_matches('-');
+    Ok(grammar::parse_axis_range(field, text, default, prefix, context)?)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn axis_flags_parse_and_reject_bad_input() {
-        let a = parse_axis("--k-n", "1e4:1e7:31").unwrap();
-        assert_eq!((a.min(), a.max(), a.len(), a.scale()), (1e4, 1e7, 31, AxisScale::Log));
-        assert_eq!(parse_axis("--k-n", "0:10:11:lin").unwrap().scale(), AxisScale::Linear);
-        for bad in ["1e4:1e7", "a:1e7:3", "1e4:1e7:x", "1e4:1e7:3:cubic", "0:1e7:3", "1e7:1e4:3", "1e4:1e7:1"]
-        {
-            let msg = parse_axis("--k-n", bad).unwrap_err().to_string();
-            assert!(msg.contains("--k-n"), "{bad}: {msg}");
-        }
-    }
 
     /// One grammar for every slope list: N is refused before any expansion (an N of 1e11
     /// would have asked for 800 GB), each slope by the library's rule, named by its flag.
@@ -407,6 +245,39 @@ mod tests {
         assert!(err("10:5:3", SlopeSign::Uphill).contains("MAX must be greater than MIN"));
         assert!(err("0:24", SlopeSign::Uphill).contains("MIN:MAX:N"));
         assert!(err("a", SlopeSign::Uphill).contains("`a` is not a number"));
+    }
+
+    /// The robot flags are the library's table of robot keys: every key with a flag is one
+    /// of `RobotArgs`' flags and sets its key (so the server's parameters, which the request
+    /// layer reads by the table, and the page's list, which `/data/served` gives from it, are
+    /// the command line's flags).
+    #[test]
+    fn robot_flags_are_the_tables() {
+        use clap::{Args as _, Command};
+        let cmd = RobotArgs::augment_args(Command::new("x"));
+        let longs: Vec<&str> =
+            cmd.get_arguments().filter_map(|a| a.get_long()).filter(|l| *l != "robot").collect();
+        let table: Vec<&str> = sandslope_request::scenario::robot_fields().map(|(_, f)| f).collect();
+        assert_eq!(longs, table);
+        let q = RobotQuantityArgs {
+            leg_radius: Some(1.0),
+            leg_width: Some(2.0),
+            hip_height: Some(3.0),
+            leg_speed: Some(4.0),
+            stance_legs: Some(5),
+            response_time: Some(6.0),
+        };
+        let mut spec = load_robot_spec();
+        for (key, v) in q.overrides() {
+            key.set(&mut spec, v);
+        }
+        let set: Vec<f64> =
+            sandslope_request::scenario::override_fields().map(|(k, _)| k.get(&spec).unwrap()).collect();
+        assert_eq!(set, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    }
+
+    fn load_robot_spec() -> sandslope::RobotSpec {
+        sandslope_io::load_robot(DEFAULT_ROBOT).unwrap().spec().clone()
     }
 
     #[test]

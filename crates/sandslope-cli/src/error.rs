@@ -163,8 +163,3 @@ pub fn clean_up_on_signals() {
         }
     });
 }
-
-/// Turns a plotting backend error (not `Send + Sync` in general) into an `anyhow::Error`.
-pub fn plot_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
-    anyhow::anyhow!("drawing failed: {e}")
-}

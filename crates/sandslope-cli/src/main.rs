@@ -6,12 +6,13 @@
 mod args;
 mod commands;
 mod error;
-mod figures;
 mod mocap_input;
 mod output;
 mod progress;
-mod report;
 mod serve;
+
+// The figures and the report page are the render crate's, shared with Python and the server.
+use sandslope_render::{figures, report};
 
 use std::io::Write;
 

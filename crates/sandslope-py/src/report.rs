@@ -23,8 +23,10 @@ use crate::{anyhow_error, value_error};
 /// `terrain_source` name the robot and terrain as the inputs table shows them; without
 /// `forces`, the built-in terrain is reported with the paper's force tests. `tracks`: one
 /// `(slope_deg, paths)` per slope; `simulator_fit`: also the simulator's joint fit (about 90 s).
+/// `html`: a folder to write the page into, `index.html` and `report.json`, byte for byte what
+/// `sandslope report --out` writes (the render crate's `report::write_dir`).
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, robot_source, terrain_source, observed=None, forces=None, t1=None, tracks=None, tracks_format=None, tracks_body=None, tracks_upslope=None, max_risk=0.05, simulator_fit=false))]
+#[pyo3(signature = (robot, terrain, robot_source, terrain_source, observed=None, forces=None, t1=None, tracks=None, tracks_format=None, tracks_body=None, tracks_upslope=None, max_risk=0.05, simulator_fit=false, html=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn report(
     py: Python<'_>,
@@ -41,7 +43,11 @@ pub fn report(
     tracks_upslope: Option<[f64; 3]>,
     max_risk: f64,
     simulator_fit: bool,
+    html: Option<PathBuf>,
 ) -> PyResult<String> {
+    if let Some(dir) = html.as_ref().filter(|d| d.exists() && !d.is_dir()) {
+        return Err(value_error(format!("html = {}: exists and is not a folder", dir.display())));
+    }
     if !(max_risk > 0.0 && max_risk < 1.0) {
         return Err(value_error(format!(
             "max_risk = {max_risk} must be a probability strictly between 0 and 1"
@@ -93,7 +99,11 @@ pub fn report(
                 terrain,
                 terrain_source,
             };
-            Ok(build_report(&evidence)?)
+            let value = build_report(&evidence)?;
+            if let Some(dir) = &html {
+                sandslope_render::report::write_dir(dir, &value)?;
+            }
+            Ok(value)
         })
         .map_err(anyhow_error)?;
     serde_json::to_string(&value).map_err(value_error)

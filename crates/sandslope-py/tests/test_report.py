@@ -30,3 +30,30 @@ def test_report_on_own_tracks_equals_report_json(cli, tmp_path, root):
 def test_report_errors_name_the_python_argument():
     with pytest.raises(ValueError, match="max_risk"):
         sandslope.report(max_risk=1.5)
+
+
+def test_report_html_is_the_clis_page(cli, tmp_path):
+    # The page Python writes is the CLI's, byte for byte, for the same (default) inputs.
+    value = sandslope.report(html=tmp_path / "py")
+    cli.run("report", "--out", tmp_path / "cli")
+    page = (tmp_path / "py" / "index.html").read_bytes()
+    assert page == (tmp_path / "cli" / "index.html").read_bytes()
+    assert (tmp_path / "py" / "report.json").read_bytes() == (tmp_path / "cli" / "report.json").read_bytes()
+    assert json.loads((tmp_path / "py" / "report.json").read_text()) == value
+    # Its sections, in the order a reader meets them: the plain answer before the evidence.
+    text = page.decode()
+    ids = ["answer", "numbers", "simulator-table", "figures"]
+    at = [text.find(f'id="{i}"') for i in ids]
+    assert all(a >= 0 for a in at), dict(zip(ids, at))
+    assert at == sorted(at), dict(zip(ids, at))
+    # Self-contained: figures inline, no scripts, no network.
+    assert text.count("<svg") == text.count("<figure ") >= 5
+    assert "<script" not in text and "http://" not in text.replace("http://www.w3.org", "")
+
+
+def test_report_html_refuses_a_file(tmp_path):
+    f = tmp_path / "page.html"
+    f.write_text("mine")
+    with pytest.raises(ValueError, match="html"):
+        sandslope.report(html=f)
+    assert f.read_text() == "mine"

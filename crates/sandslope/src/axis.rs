@@ -1,12 +1,12 @@
 //! The values of one grid axis, evenly spaced or log-spaced: the k_n and k_s axes of phase
 //! diagrams and risk maps, and the varied keys of a design grid.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::ParamError;
 
 /// Spacing of grid values along an axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum AxisScale {
     /// Evenly spaced values.

@@ -140,44 +140,6 @@ fn record(keys: &[RobotKey], d: &Design) -> DesignRecord {
     }
 }
 
-fn csv_text(study: &DesignStudy) -> Result<String> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<String> = study.keys.iter().map(|k| k.name().to_string()).collect();
-    header.extend(
-        [
-            "valid",
-            "invalid_reason",
-            "safe_slope_deg",
-            "safe_limit",
-            "speed_m_s",
-            "p_fail",
-            "regime",
-            "k_s_margin",
-            "pareto",
-        ]
-        .map(String::from),
-    );
-    w.write_record(&header)?;
-    let opt = |x: Option<f64>| x.map(|v| format!("{v}")).unwrap_or_default();
-    for d in &study.designs {
-        let r = record(&study.keys, d);
-        let mut row: Vec<String> = d.params.iter().map(|v| format!("{v}")).collect();
-        row.extend([
-            r.valid.to_string(),
-            r.invalid_reason.unwrap_or_default(),
-            opt(r.safe_slope_deg),
-            r.safe_limit.unwrap_or_default().to_string(),
-            opt(r.speed_m_s),
-            opt(r.p_fail),
-            r.regime.unwrap_or_default().to_string(),
-            opt(r.k_s_margin),
-            r.pareto.to_string(),
-        ]);
-        w.write_record(&row)?;
-    }
-    Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow!("{e}"))?)?)
-}
-
 /// Runs `sandslope design`.
 pub fn run(args: DesignArgs) -> Result<()> {
     let robot = args.robot.load()?;
@@ -210,7 +172,7 @@ pub fn run(args: DesignArgs) -> Result<()> {
     notes.extend(front_at_bounds(&study, &space));
 
     if let Some(path) = &args.csv {
-        write_atomic(path, csv_text(&study)?.as_bytes())
+        write_atomic(path, sandslope_render::tables::design_csv(&study)?.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {

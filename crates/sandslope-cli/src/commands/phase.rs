@@ -7,23 +7,18 @@
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 
-use sandslope::{Axis, PanelSummary, PhasePanel, Regime, Robot, Slope, Terrain};
+use sandslope::{Axis, PanelSummary, PhasePanel, Regime, Terrain};
 
-use crate::args::{
-    beyond_last_point, default_axis, parse_axis, warn_extrapolated, RobotQuantityArgs, TerrainArgs,
-};
+use crate::args::{beyond_last_point, warn_extrapolated, RobotQuantityArgs, TerrainArgs};
 use crate::figures::phase::PhaseFigure;
 use crate::figures::save;
 use crate::output::{print_json, sci, table};
 use crate::progress::progress_bar;
-use sandslope_io::load_robot;
 use sandslope_io::presets::DEFAULT_ROBOT;
-
-/// Default number of grid points per axis of `sandslope phase`.
-pub const DEFAULT_POINTS: usize = 400;
+use sandslope_request::{PhaseRequest, RobotRequest};
 
 /// Arguments of `sandslope phase`.
 #[derive(Debug, Args)]
@@ -96,83 +91,56 @@ pub struct Panels {
     pub k_s_axis: Axis,
 }
 
-/// The value `phase --json` prints (and `serve`'s `/api/phase` returns): each panel's summary.
-/// At most `max_cells` grid cells are computed.
-pub fn answer(args: &PhaseArgs, max_cells: u128) -> Result<Vec<PanelSummary>> {
-    Ok(compute(args, max_cells, true, false)?.panels.iter().map(PhasePanel::summary).collect())
+impl PhaseArgs {
+    /// The request these flags make (the one `serve`'s `/api/phase` builds too).
+    pub fn request(&self) -> Result<PhaseRequest> {
+        let axis = |field: &str, text: &Option<String>| {
+            text.as_ref().map(|t| sandslope_request::grammar::parse_strength_axis(field, t)).transpose()
+        };
+        Ok(PhaseRequest {
+            k_n: axis("k-n", &self.k_n)?,
+            k_s: axis("k-s", &self.k_s)?,
+            slopes: self.slope.clone(),
+            masses: self.mass.clone(),
+            robot: RobotRequest {
+                robot: self.robot.clone(),
+                mass: None,
+                overrides: self.quantities.overrides(),
+            },
+            terrain: self.terrain.terrain.clone(),
+        })
+    }
 }
 
-/// Reads the robot and terrain, checks the flags and computes every panel (at most
-/// `max_cells` cells; a progress bar on a terminal unless `quiet`; the extrapolation warning
-/// on stderr when `warn`).
-pub fn compute(args: &PhaseArgs, max_cells: u128, quiet: bool, warn: bool) -> Result<Panels> {
-    let base = args.quantities.apply(load_robot(&args.robot)?)?;
-    let terrain = args.terrain.load()?;
-    let masses = if args.mass.is_empty() { vec![base.mass()] } else { args.mass.clone() };
-    let robots = masses
-        .iter()
-        .map(|&m| base.with_mass(m).map_err(|e| anyhow!("{}", e.renamed("--mass"))))
-        .collect::<Result<Vec<Robot>>>()?;
-    let slopes = args
-        .slope
-        .iter()
-        .map(|&d| Slope::from_signed_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--slope"))))
-        .collect::<Result<Vec<Slope>>>()?;
-    let grounds: Vec<_> = slopes.iter().map(|&s| terrain.at(s)).collect();
-    let extrapolated = beyond_last_point(&terrain, &args.slope);
+/// Checks the flags and computes every panel by the request layer (at most `max_cells` cells;
+/// a progress bar on a terminal unless `quiet`; the extrapolation warning on stderr when
+/// `warn`).
+fn compute(args: &PhaseArgs, max_cells: u128, quiet: bool, warn: bool) -> Result<Panels> {
+    let grid = args.request()?.grid(max_cells)?;
+    let extrapolated = beyond_last_point(&grid.terrain, &args.slope);
     if !extrapolated.is_empty() && warn {
-        warn_extrapolated(&terrain, &extrapolated);
+        warn_extrapolated(&grid.terrain, &extrapolated);
     }
-    let k_n_axis = match &args.k_n {
-        Some(t) => parse_axis("--k-n", t)?,
-        None => default_axis(
-            "--k-n",
-            &grounds.iter().map(|g| g.k_n).collect::<Vec<_>>(),
-            100.0,
-            100.0,
-            DEFAULT_POINTS,
-        )?,
-    };
-    let k_s_axis = match &args.k_s {
-        Some(t) => parse_axis("--k-s", t)?,
-        None => default_axis(
-            "--k-s",
-            &grounds.iter().map(|g| g.k_s).collect::<Vec<_>>(),
-            1000.0,
-            100.0,
-            DEFAULT_POINTS,
-        )?,
-    };
     if let Some(p) = &args.plot {
         crate::figures::format_of(p)?;
     }
-    // Guards against a typo such as 100000 points per axis: the maps are kept in memory at two
-    // bits per cell, and every cell is a CSV row of about 60 bytes.
-    let cells = (robots.len() * slopes.len()) as u128 * k_n_axis.len() as u128 * k_s_axis.len() as u128;
-    if cells > max_cells {
-        let side = if max_cells >= 4096 * 4096 { 4096 } else { 1u128 << (max_cells.max(1).ilog2() / 2) };
-        bail!(
-            "--k-n and --k-s give {cells} cells over {} panel(s); at most {max_cells} are allowed (e.g. {side} x {side} per panel is {})",
-            robots.len() * slopes.len(),
-            side * side
-        );
-    }
+    // Every cell is a CSV row of about 60 bytes.
+    let cells = grid.cells();
     if args.csv.is_some() && cells > MAX_CSV_CELLS {
         bail!("--csv would write {cells} rows; at most {MAX_CSV_CELLS} are allowed: use fewer --k-n/--k-s points");
     }
-
-    let rows = (robots.len() * slopes.len() * k_s_axis.len()) as u64;
-    let bar = progress_bar(rows, quiet, "phase map");
-    let mut panels = Vec::new();
-    for robot in &robots {
-        for &slope_deg in &args.slope {
-            let panel = PhasePanel::compute(robot, slope_deg, &terrain, &k_n_axis, &k_s_axis, &|| bar.inc(1))
-                .map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
-            panels.push(panel);
-        }
-    }
+    let bar = progress_bar(grid.rows(), quiet, "phase map");
+    let panels = grid.compute(&|| bar.inc(1))?;
     bar.finish_and_clear();
-    Ok(Panels { panels, masses, slopes: slopes.len(), terrain, k_n_axis, k_s_axis })
+    let slopes = grid.slopes_deg.len();
+    Ok(Panels {
+        panels,
+        masses: grid.masses,
+        slopes,
+        terrain: grid.terrain,
+        k_n_axis: grid.k_n_axis,
+        k_s_axis: grid.k_s_axis,
+    })
 }
 
 /// Runs `sandslope phase`.

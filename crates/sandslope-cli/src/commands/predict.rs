@@ -1,8 +1,9 @@
 //! `sandslope predict`: every model quantity for one robot, terrain and slope.
 
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use clap::Args;
-use sandslope::{Scenario, SlopeEvaluation};
+use sandslope_request::predict::evaluate;
+use sandslope_request::PredictRequest;
 
 use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::output::{
@@ -26,19 +27,16 @@ pub struct PredictArgs {
     pub format: FormatArgs,
 }
 
-/// The value `predict --json` prints (and `serve`'s `/api/predict` returns): the library's
-/// evaluation of the scenario at `--slope`.
-pub fn answer(args: &PredictArgs) -> Result<SlopeEvaluation> {
-    evaluate(&args.over.scenario(&args.robot, &args.terrain)?, args.slope)
+impl PredictArgs {
+    /// The request these flags make (the one `serve`'s `/api/predict` and Python build too).
+    pub fn request(&self) -> PredictRequest {
+        PredictRequest { slope: self.slope, scenario: self.over.request(&self.robot, &self.terrain) }
+    }
 }
 
-fn evaluate(scenario: &Scenario, slope: f64) -> Result<SlopeEvaluation> {
-    scenario.evaluate(slope).map_err(|e| anyhow!("{}", e.renamed("--slope")))
-}
-
-/// Runs `sandslope predict`.
+/// Runs `sandslope predict`: the request's answer, written as a table, JSON or CSV.
 pub fn run(args: PredictArgs) -> Result<()> {
-    let scenario = args.over.scenario(&args.robot, &args.terrain)?;
+    let scenario = args.request().scenario.scenario()?;
     let e = evaluate(&scenario, args.slope)?;
     if e.extrapolated {
         warn_extrapolated(scenario.terrain(), &[args.slope]);

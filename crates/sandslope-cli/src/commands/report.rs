@@ -19,8 +19,6 @@ use sandslope_io::{load_anchoring_times, load_speeds};
 
 use crate::args::{parse_max_risk, LevelStepArgs, RobotArgs, TerrainArgs};
 use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions};
-use crate::output::write_atomic;
-use crate::report::{page, page_figures};
 
 /// Arguments of `sandslope report`.
 #[derive(Debug, Args)]
@@ -159,12 +157,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
     for w in &report.warnings {
         eprintln!("warning: {w}");
     }
-    let figures = page_figures(&report)?;
-    let html = page(&report, &figures);
-    let json = serde_json::to_string_pretty(&report)?;
-    sandslope_io::files::create_output_dir(&args.out)?;
-    write_atomic(&args.out.join("report.json"), json.as_bytes())?;
-    write_atomic(&args.out.join("index.html"), html.as_bytes())?;
+    crate::report::write_dir(&args.out, &report)?;
     println!(
         "{} figures; {}; {} disagreement(s) listed",
         report.figures.len(),

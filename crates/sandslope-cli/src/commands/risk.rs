@@ -14,18 +14,18 @@ use serde::Serialize;
 
 use sandslope::risk::{
     payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, DefaultsUsed, PayloadEnvelope, RiskAnswer,
-    RiskCurve, RiskMap, RiskPoint, SafeLimit, SafeMass, SafeSlope, UncertainTerrain,
+    RiskCurve, RiskPoint, SafeLimit, SafeMass, SafeSlope, UncertainTerrain,
 };
 use sandslope::{Robot, Slope};
 
 use crate::args::{
-    beyond_last_point, parse_axis, parse_max_risk, parse_slope_list, warn_extrapolated, RobotArgs, SlopeSign,
-    TerrainArgs, UncertaintyArgs,
+    beyond_last_point, parse_max_risk, warn_extrapolated, RobotArgs, TerrainArgs, UncertaintyArgs,
 };
 use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
-use crate::output::{csv_string, num, print_json, sci, table, write_output, Format};
+use crate::output::{csv_string, num, print_json, sci, table, Format};
 use crate::progress::progress_bar;
+use sandslope_request::risk::RiskMapGrid;
 
 /// Most `--map` cells (the library's cap, as Python's).
 const MAX_MAP_CELLS: u128 = sandslope::limits::MAX_RISK_MAP_CELLS as u128;
@@ -97,13 +97,10 @@ impl RiskArgs {
     }
 }
 
-/// Most slopes one run evaluates (each a quadrature of a few ms).
-const MAX_QUADRATURES: usize = sandslope::limits::MAX_RISK_SLOPES;
-
-/// Parses `--slope` (the slope-list grammar of `args::parse_slope_list`, signed: a descent is
-/// felt as the climb of its size).
+/// Parses `--slope` (the one slope-list grammar, signed: a descent is felt as the climb of
+/// its size), as every front end does.
 pub fn parse_slopes(text: &str) -> Result<Vec<f64>> {
-    parse_slope_list("--slope", text, SlopeSign::Signed, MAX_QUADRATURES)
+    Ok(sandslope_request::risk::parse_slopes(text)?)
 }
 
 /// One slope as printed by `--csv`: [`RiskPoint`] flattened.
@@ -304,82 +301,20 @@ pub fn run(args: RiskArgs) -> Result<()> {
     print_curve(curve, limits.as_ref(), format)
 }
 
-/// Limits of one [`answer`] call (the server's; the command line's are the library's).
-#[derive(Debug, Clone, Copy)]
-pub struct AnswerLimits {
-    /// Most slopes of a p_fail curve (each a quadrature).
-    pub curve_slopes: usize,
-    /// Most slopes of a payload envelope (each a search over masses).
-    pub envelope_slopes: usize,
-    /// Most `--map` cells.
-    pub map_cells: u128,
-}
-
-/// The value `risk --json` prints for these flags (what `serve`'s `/api/risk` returns), by
-/// the same library calls as [`run`], without its notes, figures and files; more work than
-/// `limits` allows is an error naming the limit.
-pub fn answer(args: &RiskArgs, limits: AnswerLimits) -> Result<RiskAnswer> {
-    let robot = args.robot.load()?;
-    let slopes = parse_slopes(&args.slope)?;
-    let max_risk = args.max_risk;
-    let (terrain, _) = args.uncertainty.apply(args.terrain.load()?)?;
-    let too_many = |n: usize, most: usize, what: &str| {
-        anyhow!("--slope gives {n} slopes; at most {most} are allowed for {what} here")
-    };
-    if args.map {
-        let (k_n_axis, k_s_axis) = map_axes(args, &terrain, slopes[0], limits.map_cells)?;
-        let map = risk_map(&robot, slopes[0], &terrain, (&k_n_axis, &k_s_axis), max_risk, &|| {})
-            .map_err(|e| anyhow!("{e}"))?;
-        return Ok(RiskAnswer::Map(Box::new(map)));
-    }
-    Ok(match args.solve {
-        Some(Solve::Mass) if slopes.len() > 1 => {
-            if slopes.len() > limits.envelope_slopes {
-                return Err(too_many(slopes.len(), limits.envelope_slopes, "--solve mass"));
-            }
-            let env = payload_envelope(&robot, &terrain, &slopes, max_risk).map_err(|e| anyhow!("{e}"))?;
-            RiskAnswer::Envelope(Box::new(env))
-        }
-        Some(Solve::Mass) => {
-            slope_of(slopes[0])?;
-            let sol = safe_mass(&robot, slopes[0], &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
-            RiskAnswer::Mass(Box::new(sol))
-        }
-        Some(Solve::Slope) => {
-            RiskAnswer::Slope(Box::new(safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?))
-        }
-        None => {
-            if slopes.len() > limits.curve_slopes {
-                return Err(too_many(slopes.len(), limits.curve_slopes, "a p_fail curve"));
-            }
-            let curve =
-                risk_curve(&robot, &terrain, &slopes).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
-            RiskAnswer::of_points(curve.points)
-        }
-    })
-}
-
 /// The `--map` axes (the flags', else the defaults around the terrain's medians at
-/// `slope_deg`, an error naming `--slope` if it is out of range), at most `max_cells` cells.
+/// `slope_deg`, an error naming `--slope` if it is out of range), at most `max_cells` cells:
+/// the request layer's, which `serve`'s `/api/risk` uses too.
 fn map_axes(
     args: &RiskArgs,
     terrain: &UncertainTerrain,
     slope_deg: f64,
     max_cells: u128,
 ) -> Result<(sandslope::Axis, sandslope::Axis)> {
-    slope_of(slope_deg)?;
-    let given = |flag: &str, text: &Option<String>| text.as_ref().map(|t| parse_axis(flag, t)).transpose();
-    let (k_n_axis, k_s_axis) =
-        sandslope::risk::map_axes(terrain, slope_deg, given("--k-n", &args.k_n)?, given("--k-s", &args.k_s)?)
-            .map_err(|e| anyhow!("{e}"))?;
-    let cells = k_n_axis.len() as u128 * k_s_axis.len() as u128;
-    if cells > max_cells {
-        let side = (max_cells as f64).sqrt().floor();
-        bail!(
-            "--k-n and --k-s give {cells} map cells; at most {max_cells} are allowed (e.g. {side} x {side}), to keep the map in memory"
-        );
-    }
-    Ok((k_n_axis, k_s_axis))
+    let axis = |field: &str, text: &Option<String>| {
+        text.as_ref().map(|t| sandslope_request::grammar::parse_strength_axis(field, t)).transpose()
+    };
+    let grid = RiskMapGrid { k_n: axis("k-n", &args.k_n)?, k_s: axis("k-s", &args.k_s)? };
+    Ok(sandslope_request::risk::map_axes(&grid, terrain, slope_deg, max_cells)?)
 }
 
 /// Tells the user on stderr when a default CV was used (docs/model.md §9).
@@ -595,7 +530,7 @@ fn run_map(
     bar.finish_and_clear();
     let map = &answer.map;
     if let Some(Some(path)) = &args.csv {
-        write_map_csv(path, map)?;
+        sandslope_render::tables::write_risk_map_csv(path, map)?;
     }
     if let Some(dir) = &args.npy {
         use sandslope_io::npy::{write_npy_dir, NpyData};
@@ -633,7 +568,9 @@ fn run_map(
         Format::Csv => match &args.csv {
             Some(None) => {
                 let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-                map_csv(map, &mut out).and_then(|_| out.flush()).context("cannot write to stdout")
+                sandslope_render::tables::risk_map_csv(map, &mut out)
+                    .and_then(|_| out.flush())
+                    .context("cannot write to stdout")
             }
             _ => Ok(()),
         },
@@ -663,35 +600,6 @@ fn run_map(
             Ok(())
         }
     }
-}
-
-/// Every cell of `map`, one row each, k_n-major: `k_n,k_s,p_fail,p_not_success`.
-fn map_csv(map: &RiskMap, out: &mut dyn std::io::Write) -> std::io::Result<()> {
-    use sandslope_io::grid_csv::{push_f64, write_rows};
-    let (k_n, k_s) = (map.k_n_axis.values(), map.k_s_axis.values());
-    let ny = k_s.len();
-    write_rows(out, MAP_CSV_HEADER, k_n.len() * ny, &|c, buf| {
-        let (i, j) = (c / ny, c % ny);
-        for (k, v) in
-            [k_n[i], k_s[j], map.p_fail_at(i, j), map.p_not_success_at(i, j)].into_iter().enumerate()
-        {
-            if k > 0 {
-                buf.push(b',');
-            }
-            push_f64(buf, v);
-        }
-    })
-}
-
-const MAP_CSV_HEADER: &str = "k_n,k_s,p_fail,p_not_success";
-
-fn write_map_csv(path: &std::path::Path, map: &RiskMap) -> Result<()> {
-    write_output(path, |file| {
-        let mut w = std::io::BufWriter::with_capacity(1 << 22, file);
-        map_csv(map, &mut w)
-            .and_then(|_| w.flush())
-            .map_err(|source| sandslope_io::WriteError { path: path.to_path_buf(), source }.into())
-    })
 }
 
 #[cfg(test)]

@@ -5,27 +5,22 @@
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 
-use crate::args::{
-    check_flag, parse_slope_list, warn_extrapolated, OverrideArgs, RobotArgs, SlopeSign, TerrainArgs,
-};
+use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::figures;
 use crate::figures::simulate::{Animation, SimulateFigure, SlopesFigure};
 use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
-use sandslope::simulate::{
-    simulate, simulate_slopes, BodyPitch, RftScaling, SimSettings, SimSummary, SimulateError, Simulation,
-};
-use sandslope::{ParamError, Scenario};
+use crate::progress::{progress_bar, spinner};
+use sandslope::simulate::{BodyPitch, RftScaling, SimSummary, Simulation};
 use sandslope_io::load_speeds;
 use sandslope_io::trajectory::plain_mocap_csv;
-
-/// Most slopes one `--slopes` run simulates.
-const MAX_SLOPES: usize = 1000;
+use sandslope_request::simulate::{parse_slopes, Answer, SimSlopes, Walks};
+use sandslope_request::SimulateRequest;
 
 /// Arguments of `sandslope simulate`.
 #[derive(Debug, Args)]
@@ -77,7 +72,9 @@ pub struct SimulateArgs {
     /// Observed speeds (CSV: slope_deg,speed_m_s,speed_sd_m_s) for the --slopes figure.
     #[arg(long, value_name = "CSV", requires_all = ["slopes", "plot"])]
     pub observed: Option<PathBuf>,
-    /// Side-view animation (slope, sand, body, legs, force arrows) to FILE.gif.
+    /// Side-view animation to FILE.gif: slope, sand with a mark every 5 cm, the body's trace,
+    /// legs and force arrows; the whole walk at 20 frames per simulated second, in real time,
+    /// up to its first 60 s (1200 frames).
     #[arg(long, value_name = "FILE.gif")]
     pub animate: Option<PathBuf>,
     #[command(flatten)]
@@ -129,127 +126,32 @@ impl From<ScalingArg> for RftScaling {
     }
 }
 
-/// A library error with its keys renamed to this command's flags.
-fn flagged(e: ParamError) -> anyhow::Error {
-    let flag = match e.key.as_str() {
-        "duration_s" => "--duration",
-        "dt_s" => "--dt",
-        "slope_deg" => "--slope",
-        "creep_m_s" => "--creep",
-        "sample_rate_hz" => "--rate",
-        "step" | "from" => "--slopes",
-        other => return anyhow!("{}", e.clone().renamed(other)),
-    };
-    anyhow!("{}", e.renamed(flag))
-}
-
-fn sim_err(e: SimulateError) -> anyhow::Error {
-    match e {
-        SimulateError::Param(p) => flagged(p),
-    }
-}
-
-/// The settings the flags ask for, checked.
-fn settings(args: &SimulateArgs) -> Result<SimSettings> {
-    let mut s = SimSettings::new(args.duration).map_err(flagged)?;
-    if let Some(dt) = args.dt {
-        s = s.with_dt(dt).map_err(flagged)?;
-    }
-    if let Some(c) = args.creep {
-        s = s.with_creep(c).map_err(flagged)?;
-    }
-    s = s.with_servo_limit(!args.no_servo_limit);
-    s = s.with_body_pitch(args.body_pitch.into()).with_rft_scaling(args.rft_scaling.into());
-    s.with_sample_rate(args.rate).map_err(flagged)
-}
-
-/// Parses `--slopes` (the slope-list grammar of `args::parse_slope_list`: DEG, a comma list
-/// or MIN:MAX:N, signed: negative is downhill).
-fn parse_slopes(text: &str) -> Result<Vec<f64>> {
-    parse_slope_list("--slopes", text, SlopeSign::Signed, MAX_SLOPES)
-}
-
-/// What `simulate --json` prints: one walk's summary, or one per slope.
-#[derive(Debug, Serialize)]
-#[serde(untagged)]
-pub enum Answer {
-    /// `--slope`.
-    One(Box<SimSummary>),
-    /// `--slopes`.
-    Many(Vec<SimSummary>),
-}
-
-/// The walks `simulate` runs for its flags, checked as [`run`] checks them: what `serve`'s
-/// `/api/simulate` weighs against its limits before running them.
-#[derive(Debug)]
-pub struct Walks {
-    /// The robot on its terrain.
-    pub scenario: Scenario,
-    /// The slopes, degrees: `--slopes`, or the one `--slope`.
-    pub slopes: Vec<f64>,
-    /// Whether they came from `--slopes` (the answer is then a list, even of one).
-    pub many: bool,
-    /// The checked settings.
-    pub settings: SimSettings,
-}
-
-impl Walks {
-    /// Reads the robot and terrain and checks every flag but the output files.
-    pub fn prepare(args: &SimulateArgs) -> Result<Walks> {
-        let settings = settings(args)?;
-        let slopes = args.slopes.as_deref().map(parse_slopes).transpose()?;
-        let scenario = args.over.scenario(&args.robot, &args.terrain)?;
-        let (slopes, many) = match slopes {
-            Some(slopes) => (slopes, true),
-            None => {
-                let slope = args.slope.ok_or_else(|| anyhow!("--slope or --slopes is required"))?;
-                check_flag("--slope", slope, -89.999_999, 89.999_999)
-                    .map_err(|_| anyhow!("--slope = {slope} must be strictly between -90 and 90 degrees"))?;
-                (vec![slope], false)
-            }
+impl SimulateArgs {
+    /// The request these flags make (the one `serve`'s `/api/simulate` builds too).
+    pub fn request(&self) -> Result<SimulateRequest> {
+        let slopes = match (&self.slopes, self.slope) {
+            (Some(text), _) => SimSlopes::Many(parse_slopes(text)?),
+            (None, Some(slope)) => SimSlopes::One(slope),
+            (None, None) => bail!("--slope or --slopes is required"),
         };
-        Ok(Walks { scenario, slopes, many, settings })
-    }
-
-    /// Integration steps of all the walks, settling included (what they cost to run).
-    pub fn integration_steps(&self) -> Result<f64> {
-        let mut steps = 0.0;
-        for &deg in &self.slopes {
-            let slope = sandslope::Slope::from_signed_degrees(deg)
-                .map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
-            let dt = sandslope::simulate::integration_step(&self.scenario, slope, self.settings.dt_s)
-                .map_err(flagged)?;
-            steps += (self.settings.duration_s + self.settings.settle_s) / dt;
-        }
-        Ok(steps)
-    }
-
-    /// Runs the walks (several in parallel), as `run` does.
-    pub fn simulate(&self) -> Result<Vec<Simulation>> {
-        if self.many {
-            simulate_slopes(&self.scenario, &self.slopes, &self.settings).map_err(sim_err)
-        } else {
-            Ok(vec![simulate(&self.scenario, self.slopes[0], &self.settings).map_err(sim_err)?])
-        }
-    }
-
-    /// The value `simulate --json` prints for these walks' results.
-    pub fn answer(&self, sims: Vec<Simulation>) -> Answer {
-        let mut summaries: Vec<SimSummary> = sims.into_iter().map(|s| s.summary).collect();
-        match (self.many, summaries.pop()) {
-            (false, Some(one)) if summaries.is_empty() => Answer::One(Box::new(one)),
-            (_, last) => {
-                summaries.extend(last);
-                Answer::Many(summaries)
-            }
-        }
+        Ok(SimulateRequest {
+            slopes,
+            scenario: self.over.request(&self.robot, &self.terrain),
+            duration_s: self.duration,
+            dt_s: self.dt,
+            creep_m_s: self.creep,
+            servo_limit: !self.no_servo_limit,
+            body_pitch: self.body_pitch.into(),
+            rft_scaling: self.rft_scaling.into(),
+            rate_hz: self.rate,
+        })
     }
 }
 
 /// Runs `sandslope simulate`.
 pub fn run(args: SimulateArgs) -> Result<()> {
-    let settings = settings(&args)?;
-    let slopes = args.slopes.as_deref().map(parse_slopes).transpose()?;
+    let request = args.request()?;
+    request.settings()?;
     for path in [&args.out, &args.plot, &args.animate].into_iter().flatten() {
         check_parent_exists(path)?;
     }
@@ -262,17 +164,23 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         }
     }
     let observed = args.observed.as_deref().map(load_speeds).transpose()?;
-    let scenario = args.over.scenario(&args.robot, &args.terrain)?;
-    match slopes {
-        Some(slopes) => run_slopes(&args, &scenario, &slopes, &settings, observed.as_deref().unwrap_or(&[])),
-        None => run_one(&args, &scenario, args.slope.expect("clap requires --slope or --slopes"), &settings),
+    let walks = request.walks()?;
+    if walks.many {
+        run_slopes(&args, &walks, observed.as_deref().unwrap_or(&[]))
+    } else {
+        run_one(&args, &walks)
     }
 }
 
-fn run_one(args: &SimulateArgs, scenario: &Scenario, slope: f64, settings: &SimSettings) -> Result<()> {
-    check_flag("--slope", slope, -89.999_999, 89.999_999)
-        .map_err(|_| anyhow!("--slope = {slope} must be strictly between -90 and 90 degrees"))?;
-    let sim = simulate(scenario, slope, settings).map_err(sim_err)?;
+fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
+    let (scenario, slope) = (&walks.scenario, walks.slopes[0]);
+    // Progress on stderr (a terminal's, not with --json or --csv): a 10 s walk with its GIF
+    // takes tens of seconds.
+    let quiet = args.format.format() != Format::Table;
+    let spin = spinner(quiet, &format!("simulating {} s at {slope} deg", walks.settings.duration_s));
+    let sims = walks.simulate();
+    spin.finish_and_clear();
+    let Some(sim) = sims?.pop() else { bail!("no walk was simulated") };
     if sim.summary.closed_form.extrapolated {
         warn_extrapolated(scenario.terrain(), &[slope]);
     }
@@ -282,7 +190,10 @@ fn run_one(args: &SimulateArgs, scenario: &Scenario, slope: f64, settings: &SimS
         figures::save(path, &SimulateFigure { sim: &sim, robot: scenario.robot() })?;
     }
     if let Some(path) = &args.animate {
-        figures::simulate::save_gif(path, &Animation { sim: &sim, slope_deg: slope })?;
+        let anim = Animation { sim: &sim, slope_deg: slope };
+        let bar = progress_bar(anim.frames().len() as u64, quiet, &format!("drawing {}", path.display()));
+        figures::simulate::save_gif(path, &anim, &mut || bar.inc(1))?;
+        bar.finish_and_clear();
     }
     if let (Some(path), Some(csv)) = (&args.out, &csv) {
         write_atomic(path, csv.as_bytes())?;
@@ -392,14 +303,13 @@ struct SlopeRow {
     closed_form_regime: &'static str,
 }
 
-fn run_slopes(
-    args: &SimulateArgs,
-    scenario: &Scenario,
-    slopes: &[f64],
-    settings: &SimSettings,
-    observed: &[sandslope::SpeedObservation],
-) -> Result<()> {
-    let sims = simulate_slopes(scenario, slopes, settings).map_err(sim_err)?;
+fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedObservation]) -> Result<()> {
+    let (scenario, settings) = (&walks.scenario, &walks.settings);
+    let quiet = args.format.format() != Format::Table;
+    let spin = spinner(quiet, &format!("simulating {} slopes", walks.slopes.len()));
+    let sims = walks.simulate();
+    spin.finish_and_clear();
+    let sims = sims?;
     let beyond: Vec<f64> =
         sims.iter().filter(|s| s.summary.closed_form.extrapolated).map(|s| s.summary.slope_deg).collect();
     if !beyond.is_empty() {

@@ -2,19 +2,16 @@
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use clap::Args;
 
 use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::figures;
 use crate::figures::sweep::SweepFigure;
 use crate::output::{csv_string, num, print_json, ruled_out_note, speed_cell, table, Format, FormatArgs};
-use sandslope::scenario::slope_range;
-use sandslope::{Scenario, SlopeEvaluation};
 use sandslope_io::load_speeds;
-
-/// Most slopes a sweep evaluates (a guard against `--step 1e-9`).
-const MAX_SLOPES: usize = 100_000;
+use sandslope_request::sweep::evaluate;
+use sandslope_request::SweepRequest;
 
 /// Arguments of `sandslope sweep`.
 #[derive(Debug, Args)]
@@ -44,33 +41,23 @@ pub struct SweepArgs {
     pub format: FormatArgs,
 }
 
-/// The slopes `from, from + step, ..., <= to`, with the library's keys renamed to the flags.
-fn slopes(args: &SweepArgs) -> Result<Vec<f64>> {
-    slope_range(args.from, args.to, args.step, MAX_SLOPES).map_err(|e| {
-        let flag = format!("--{}", e.key);
-        anyhow!("{}", e.renamed(flag))
-    })
-}
-
-/// The value `sweep --json` prints (and `serve`'s `/api/sweep` returns): the library's
-/// evaluation of the scenario at every slope of the range.
-pub fn answer(args: &SweepArgs) -> Result<Vec<SlopeEvaluation>> {
-    evaluate(&args.over.scenario(&args.robot, &args.terrain)?, &slopes(args)?)
-}
-
-fn evaluate(scenario: &Scenario, slopes: &[f64]) -> Result<Vec<SlopeEvaluation>> {
-    scenario.sweep(slopes).map_err(|e| anyhow!("{}", e.renamed("--from/--to")))
-}
-
-/// How many slopes the range of `args` holds, or the error naming the flag.
-pub fn slope_count(args: &SweepArgs) -> Result<usize> {
-    Ok(slopes(args)?.len())
+impl SweepArgs {
+    /// The request these flags make (the one `serve`'s `/api/sweep` builds too).
+    pub fn request(&self) -> SweepRequest {
+        SweepRequest {
+            from: self.from,
+            to: self.to,
+            step: self.step,
+            scenario: self.over.request(&self.robot, &self.terrain),
+        }
+    }
 }
 
 /// Runs `sandslope sweep`.
 pub fn run(args: SweepArgs) -> Result<()> {
-    let slopes = slopes(&args)?;
-    let scenario = args.over.scenario(&args.robot, &args.terrain)?;
+    let request = args.request();
+    let slopes = request.slopes()?;
+    let scenario = request.scenario.scenario()?;
     let evals = evaluate(&scenario, &slopes)?;
     let observed = args.observed.as_deref().map(load_speeds).transpose()?;
     let extrapolated: Vec<f64> = evals.iter().filter(|e| e.extrapolated).map(|e| e.slope_deg).collect();
@@ -139,6 +126,7 @@ mod tests {
     #[test]
     fn range_errors_name_the_flags() {
         let parse = |a: &[&str]| Cli::parse_from([&["x"], a].concat()).sweep;
+        let slopes = |args: &SweepArgs| args.request().slopes();
         let msg = slopes(&parse(&["--from", "10", "--to", "0"])).unwrap_err().to_string();
         assert!(msg.starts_with("--from = 10"), "{msg}");
         let msg = slopes(&parse(&["--step", "-1"])).unwrap_err().to_string();

@@ -661,6 +661,7 @@ def report(
     tracks_upslope: Optional[Sequence[float]] = None,
     max_risk: float = 0.05,
     simulator_fit: bool = False,
+    html: Optional[_PathLike] = None,
 ) -> Dict[str, Any]:
     """The paper reproduced and confronted (``sandslope report``), as ``report.json``'s dict.
 
@@ -671,6 +672,9 @@ def report(
     them) make it a report on your own campaign, as the CLI's flags of the same names.
     ``simulator_fit=True`` (``report --simulator-fit``) adds the stride simulator's joint fit of
     the same evidence (``simulator_fit``; about 90 s of CPU on the paper's evidence).
+    ``html="out/"`` also writes the page into that folder (made if missing): ``out/index.html``
+    and ``out/report.json``, byte for byte what ``sandslope report --out out/`` writes for the
+    same inputs.
 
     Returns exactly the keys and values of ``report.json`` (README.md, ``sandslope report``): ``figures``,
     ``speeds``, ``tracks``, ``calibration``, ``paper_vs_model``, ``disagreements``, ``inputs``.
@@ -698,6 +702,7 @@ def report(
         tracks_upslope=None if tracks_upslope is None else [float(v) for v in tracks_upslope],
         max_risk=float(max_risk),
         simulator_fit=bool(simulator_fit),
+        html=None if html is None else os.fspath(html),
     )
     return json.loads(text)
 

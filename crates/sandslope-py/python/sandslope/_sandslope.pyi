@@ -204,6 +204,7 @@ def report(
     tracks_upslope: Optional[List[float]] = None,
     max_risk: float = 0.05,
     simulator_fit: bool = False,
+    html: Optional[_Path] = None,
 ) -> str: ...
 def simulate(
     robot: Robot,

@@ -1,0 +1,75 @@
+//! `sandslope serve`: its flags, parsed into the configuration of `sandslope-serve`, which is
+//! the server (docs/serve.md).
+
+use std::net::IpAddr;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+
+use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
+use sandslope_serve::ServeConfig;
+
+/// Arguments of `sandslope serve`.
+#[derive(Debug, Args)]
+pub struct ServeArgs {
+    /// Elevation model the Routes tab and `/api/plan` plan on (GeoTIFF or ESRI ASCII grid);
+    /// the only file the server reads after starting. Without it, the Routes tab is off.
+    #[arg(long, value_name = "FILE")]
+    pub dem: Option<PathBuf>,
+    /// Robot the page starts with and API requests use when they name none: a TOML file or a
+    /// built-in preset. Requests may name built-in presets only.
+    #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_ROBOT)]
+    pub robot: String,
+    /// Terrain the page starts with and API requests use when they name none: a TOML file or a
+    /// built-in preset. Requests may name built-in presets only.
+    #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_TERRAIN)]
+    pub terrain: String,
+    /// Port to listen on; 0 picks any free port (the URL is printed either way).
+    #[arg(long, value_name = "N", default_value_t = 8750)]
+    pub port: u16,
+    /// Address to listen on. Anything but a loopback address exposes the server, which has
+    /// no authentication, to the network.
+    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1")]
+    pub host: IpAddr,
+    /// Open the page in the default web browser once the server listens.
+    #[arg(long)]
+    pub open: bool,
+    /// Threads that compute the heavy answers: phase maps, risk, simulations, plans, the DEM and
+    /// downloads (default: the machine's cores). `predict`, `sweep` and the page have their own.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Seconds a connection has to send a request's head, from opening or from the previous
+    /// answer's end (so also how long an idle kept-alive connection stays open).
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+    pub header_timeout: f64,
+    /// Seconds a client may read nothing of an answer before its connection is closed.
+    #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
+    pub send_timeout: f64,
+    /// Most connections open at once (at most the open-file limit, `ulimit -n`, less 64); past
+    /// it the connection idle longest is closed to make room.
+    #[arg(long, value_name = "N", default_value_t = 512)]
+    pub max_connections: usize,
+    /// Another name the server may be reached by (the Host header), besides localhost and the
+    /// address it listens on: a machine name or a reverse proxy's. Repeat for several.
+    #[arg(long, value_name = "NAME")]
+    pub allow_host: Vec<String>,
+}
+
+/// Runs `sandslope serve` until the process is stopped: the flags into the server's
+/// configuration, checked and served by `sandslope-serve`.
+pub fn run(args: ServeArgs) -> Result<()> {
+    sandslope_serve::run(ServeConfig {
+        dem: args.dem,
+        robot: args.robot,
+        terrain: args.terrain,
+        port: args.port,
+        host: args.host,
+        open: args.open,
+        threads: args.threads,
+        header_timeout: args.header_timeout,
+        send_timeout: args.send_timeout,
+        max_connections: args.max_connections,
+        allow_host: args.allow_host,
+    })
+}

@@ -1,0 +1,38 @@
+//! # sandslope-request
+//!
+//! The typed requests under every front end of sandslope. Each command's inputs are one serde
+//! type ([`PredictRequest`], [`SweepRequest`], ...) that names files and presets as a user
+//! does, validated once into the library's types (reading the robot and terrain through
+//! `sandslope-io`) and answered by one function returning the library's value, the one the
+//! command prints with `--json`. The command line (clap), the server (a URL query or a JSON
+//! body, read by [`Params`]) and Python translate into these types and nothing else, so a
+//! check, a default or an answer is written once.
+//!
+//! Errors are [`RequestError`]s: the field at fault (the flag's name without dashes, which is
+//! also the HTTP parameter) and a message naming it and its valid range.
+//!
+//! This crate sits between `sandslope-io` and the front ends (docs/architecture.md): requests
+//! name files, which the physics library does not read.
+
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod grammar;
+pub mod params;
+pub mod phase;
+pub mod plan;
+pub mod predict;
+pub mod risk;
+pub mod scenario;
+pub mod simulate;
+pub mod sweep;
+
+pub use error::{RequestError, Result};
+pub use params::Params;
+pub use phase::PhaseRequest;
+pub use plan::PlanRequest;
+pub use predict::PredictRequest;
+pub use risk::RiskRequest;
+pub use scenario::{RobotRequest, ScenarioRequest};
+pub use simulate::SimulateRequest;
+pub use sweep::SweepRequest;

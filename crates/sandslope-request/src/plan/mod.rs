@@ -1,0 +1,579 @@
+//! [`PlanRequest`]: heading-aware routes and risk maps over an elevation model (docs/model.md
+//! §8, docs/planning.md): the DEM, start and goal, objectives, robot, terrain (one, or a class
+//! raster with a terrain per class) and the search's settings, checked once, and the routes
+//! planned at full resolution or in corridors.
+
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Context};
+use serde::{Deserialize, Serialize};
+
+use sandslope::plan::{
+    plan, plan_corridor, Cell, CorridorPlan, CorridorSettings, Descent, ElevationGrid, Objective, PlanResult,
+    PlanSettings, Planner,
+};
+use sandslope::risk::{DefaultsUsed, UncertainTerrain};
+use sandslope::Robot;
+use sandslope_io::presets::DEFAULT_TERRAIN;
+use sandslope_io::raster::{read_heights_within, read_raster, Raster};
+
+use crate::error::{check_range, RequestError, Result};
+use crate::grammar;
+use crate::params::Params;
+use crate::scenario::RobotRequest;
+
+mod answer;
+mod memory;
+
+pub use answer::{answer, corridor_answer, records, CorridorJson, PlanJson, RouteRecord};
+use memory::choose_search;
+
+/// `search = auto` searches maps of up to this many cells at full resolution (4096 x 4096)
+/// and larger ones in a corridor.
+pub const AUTO_FULL_MAX_CELLS: u64 = 1 << 24;
+
+/// How to search for the routes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PlanSearch {
+    /// Full resolution for maps of up to 4096 x 4096 cells, corridor above.
+    #[default]
+    Auto,
+    /// The exact optimum over every cell of the map.
+    Full,
+    /// Coarse-to-fine: the exact optimum inside a corridor around a route planned on a
+    /// coarsened map.
+    Corridor,
+}
+
+/// How the routes are searched for, as decided from the DEM's size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Search {
+    Full,
+    /// With the bytes each corridor may take.
+    Corridor(Option<u64>),
+}
+
+/// The inputs of `plan` (and `/api/plan`, whose DEM is the server's).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanRequest {
+    /// Elevation model: GeoTIFF, ESRI ASCII grid or PDS3 DTM (field `dem`).
+    pub dem: PathBuf,
+    /// Start in map coordinates, `X,Y` as written (field `start`).
+    pub start: Option<String>,
+    /// Goal in map coordinates, `X,Y` as written (field `goal`).
+    pub goal: Option<String>,
+    /// Start as a cell, `COL,ROW` from the north-west corner as written (field `start-px`).
+    pub start_px: Option<String>,
+    /// Goal as a cell, `COL,ROW` as written (field `goal-px`).
+    pub goal_px: Option<String>,
+    /// What to minimise; the distance route is always added (field `objective`, a comma list
+    /// of time, risk, distance; default time).
+    pub objectives: Vec<Objective>,
+    /// The robot.
+    pub robot: RobotRequest,
+    /// A terrain file or preset, used everywhere without `classes` (field `terrain`).
+    pub terrain: String,
+    /// An integer raster aligned with the DEM giving each cell's terrain class (field
+    /// `classes`), and each class's terrain, `CLASS=TERRAIN,...` as written (field
+    /// `class-terrain`).
+    pub classes: Option<(PathBuf, String)>,
+    /// Let the time objective use metastable edges (field `allow-metastable`).
+    pub allow_metastable: bool,
+    /// Risk objective: weight of travel time, per second (field `time-weight`).
+    pub time_weight: f64,
+    /// Cross-slope (roll) limit, degrees (field `max-roll`, default 20).
+    pub max_roll: f64,
+    /// How descending edges are evaluated (field `descent`: symmetric or level).
+    pub descent: Descent,
+    /// Coefficient of variation of k_n instead of the terrain's (field `cv-n`).
+    pub cv_n: Option<f64>,
+    /// Coefficient of variation of k_s instead of the terrain's (field `cv-s`).
+    pub cv_s: Option<f64>,
+    /// Refuse a DEM whose planning would need more than this many GiB (field `max-memory`;
+    /// default the memory available).
+    pub max_memory: Option<f64>,
+    /// How to search (field `search`).
+    pub search: PlanSearch,
+    /// Corridor search: fine cells per coarse cell along each axis, 2 to 64 (field
+    /// `coarse-factor`, default 8).
+    pub coarse_factor: usize,
+    /// Corridor search: the corridor's half-width in coarse cells, 1 to 256 (field
+    /// `corridor-width`, default 8).
+    pub corridor_width: usize,
+}
+
+/// A yes/no field: empty, `true` or `1` is yes; `false` or `0` no.
+fn yes_no(p: &mut Params<'_>, key: &'static str) -> Result<bool> {
+    match p.text(key)? {
+        None => Ok(false),
+        Some("" | "true" | "1") => Ok(true),
+        Some("false" | "0") => Ok(false),
+        Some(other) => Err(RequestError::invalid(
+            key,
+            format!("{key} = `{other}` must be true or false (or empty: true)"),
+        )),
+    }
+}
+
+/// A whole-number field, `default` when not given.
+fn count(p: &mut Params<'_>, key: &'static str, default: usize) -> Result<usize> {
+    match p.text(key)? {
+        None => Ok(default),
+        Some(text) => text.trim().parse().map_err(|_| {
+            RequestError::invalid(key, format!("--{key} = `{text}` is not a whole number of at least 0"))
+        }),
+    }
+}
+
+impl PlanRequest {
+    /// Reads the fields of a plan request; refuses any other key.
+    pub fn from_params(params: &[(String, String)]) -> Result<PlanRequest> {
+        let mut p = Params::new("plan", params);
+        let dem = PathBuf::from(p.text("dem")?.unwrap_or_default());
+        let mut text = |key: &'static str| p.text(key).map(|t| t.map(str::to_string));
+        let (start, goal, start_px, goal_px) =
+            (text("start")?, text("goal")?, text("start-px")?, text("goal-px")?);
+        for (which, map, px) in [("start", &start, &start_px), ("goal", &goal, &goal_px)] {
+            match (map, px) {
+                (None, None) => {
+                    return Err(RequestError::invalid(
+                        which,
+                        format!("give --{which} X,Y or --{which}-px COL,ROW"),
+                    ))
+                }
+                (Some(_), Some(_)) => {
+                    return Err(RequestError::invalid(
+                        format!("{which}-px"),
+                        format!("--{which}-px cannot be used with --{which}: give one"),
+                    ))
+                }
+                _ => {}
+            }
+        }
+        let objectives = match p.text("objective")? {
+            None => vec![Objective::Time],
+            Some(list) => list
+                .split(',')
+                .map(|o| match o.trim() {
+                    "time" => Ok(Objective::Time),
+                    "risk" => Ok(Objective::Risk),
+                    "distance" => Ok(Objective::Distance),
+                    other => Err(RequestError::invalid(
+                        "objective",
+                        format!("--objective: `{other}` is not an objective: time, risk or distance"),
+                    )),
+                })
+                .collect::<Result<Vec<_>>>()?,
+        };
+        let robot = RobotRequest::from_params(&mut p)?;
+        let terrain = p.text_or("terrain", DEFAULT_TERRAIN)?;
+        let allow_metastable = yes_no(&mut p, "allow-metastable")?;
+        let time_weight = p.number_or("time-weight", sandslope::plan::DEFAULT_TIME_WEIGHT)?;
+        let max_roll = p.number_or("max-roll", 20.0)?;
+        let descent = match p.text("descent")? {
+            None | Some("symmetric") => Descent::Symmetric,
+            Some("level") => Descent::Level,
+            Some(other) => {
+                return Err(RequestError::invalid(
+                    "descent",
+                    format!("--descent = `{other}` must be symmetric (as climbing |pitch|) or level"),
+                ))
+            }
+        };
+        let (cv_n, cv_s) = (p.number("cv-n")?, p.number("cv-s")?);
+        let max_memory = p.number("max-memory")?;
+        let search = match p.text("search")? {
+            None | Some("auto") => PlanSearch::Auto,
+            Some("full") => PlanSearch::Full,
+            Some("corridor") => PlanSearch::Corridor,
+            Some(other) => {
+                return Err(RequestError::invalid(
+                    "search",
+                    format!("--search = `{other}` must be auto, full or corridor"),
+                ))
+            }
+        };
+        let coarse_factor = count(&mut p, "coarse-factor", 8)?;
+        let corridor_width = count(&mut p, "corridor-width", 8)?;
+        p.finish()?;
+        Ok(PlanRequest {
+            dem,
+            start,
+            goal,
+            start_px,
+            goal_px,
+            objectives,
+            robot,
+            terrain,
+            classes: None,
+            allow_metastable,
+            time_weight,
+            max_roll,
+            descent,
+            cv_n,
+            cv_s,
+            max_memory,
+            search,
+            coarse_factor,
+            corridor_width,
+        })
+    }
+
+    /// The settings the fields give, checked.
+    pub fn settings(&self) -> Result<PlanSettings> {
+        let max_roll = check_range("max-roll", self.max_roll, 0.0, 90.0)?;
+        if max_roll <= 0.0 || max_roll >= 90.0 {
+            return Err(RequestError::invalid(
+                "max-roll",
+                format!("--max-roll = {max_roll} must be strictly between 0 and 90 degrees"),
+            ));
+        }
+        let time_weight = check_range("time-weight", self.time_weight, 0.0, f64::INFINITY)?;
+        grammar::check_cvs(self.cv_n, self.cv_s)?;
+        PlanSettings::new(max_roll, self.descent, self.allow_metastable, time_weight)
+            .map_err(|e| RequestError::from_error(None, anyhow!("{e}")))
+    }
+
+    /// Checks the corridor search's fields (2 to 64 cells a coarse cell, 1 to 256 coarse
+    /// cells of half-width).
+    pub fn check_corridor(&self) -> Result<()> {
+        if !(2..=64).contains(&self.coarse_factor) {
+            return Err(RequestError::invalid(
+                "coarse-factor",
+                format!("--coarse-factor = {} must be between 2 and 64", self.coarse_factor),
+            ));
+        }
+        if !(1..=256).contains(&self.corridor_width) {
+            return Err(RequestError::invalid(
+                "corridor-width",
+                format!("--corridor-width = {} must be between 1 and 256 coarse cells", self.corridor_width),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Reads and checks everything but the endpoints: what a per-cell map without routes
+    /// needs. `note` is told each note for the user (the DEM's, the default CVs').
+    pub fn inputs(&self, note: &dyn Fn(&str)) -> Result<Inputs> {
+        let robot = self.robot.load()?;
+        let settings = self.settings()?;
+        let dem = read_raster(&self.dem).map_err(|e| RequestError::from_error(Some("dem"), e))?;
+        let (classes, terrains) =
+            self.classes_of(&dem, note).map_err(|e| RequestError::from_error(None, e))?;
+        Ok(Inputs { dem, robot, classes, terrains, settings, dem_path: self.dem.clone() })
+    }
+
+    /// Reads the inputs, places start and goal and plans every objective at full resolution,
+    /// with the risk raster when `risk_map`; a search the DEM's size sends to a corridor is
+    /// refused.
+    pub fn plan(
+        &self,
+        risk_map: bool,
+        note: &dyn Fn(&str),
+        progress: &(dyn Fn(Objective, u64, u64) + Sync),
+    ) -> Result<Planned> {
+        match self.compute(risk_map, true, note, progress)? {
+            Computed::Full(planned) => Ok(*planned),
+            Computed::Corridor(_) => Err(RequestError::invalid(
+                "search",
+                "search = corridor: only the full-resolution search is available here",
+            )),
+        }
+    }
+
+    /// The answer (what `plan --json` prints) of the full-resolution search.
+    pub fn answer(&self) -> Result<PlanJson> {
+        Ok(answer::answer(&self.plan(false, &|_| {}, &|_, _, _| {})?))
+    }
+
+    /// Plans by the search [`PlanRequest::search`] chooses for the DEM's size (`full_only`:
+    /// always the full one, which a risk raster, a figure and terrain classes need), telling
+    /// `progress` `(objective, cells settled, cells in all)` as each search goes and `note`
+    /// each note for the user.
+    ///
+    /// Plans by the search [`PlanRequest::search`] chooses for the DEM's size (`full_only`:
+    /// always the full one, which a risk raster, a figure and terrain classes need). The size
+    /// is checked against the memory limit from the file's header, before its samples are
+    /// read (a 16384 x 16384 DEM is refused in a moment instead of after reading 3 GiB).
+    pub fn compute(
+        &self,
+        risk_map: bool,
+        full_only: bool,
+        note: &dyn Fn(&str),
+        progress: &(dyn Fn(Objective, u64, u64) + Sync),
+    ) -> Result<Computed> {
+        let robot = self.robot.load()?;
+        let settings = self.settings()?;
+        let chosen = std::cell::Cell::new(Search::Full);
+        let full_only = full_only || risk_map || self.classes.is_some();
+        let (dem, heights) = read_heights_within(&self.dem, &|cols, rows| {
+            chosen.set(choose_search(self, cols, rows, &self.objectives, full_only)?);
+            Ok(())
+        })
+        .map_err(|e| RequestError::from_error(Some("dem"), e))?;
+        for n in &dem.notes {
+            note(n);
+        }
+        let anyhow_err = |e: anyhow::Error| RequestError::from_error(None, e);
+        // The planner works in metres: the cell's ground size, not its size in map units
+        // (degrees for a geographic DEM, feet for some projected ones). Heights are f32, nodata NaN.
+        let grid = ElevationGrid::new(dem.cols, dem.rows, dem.cell_m.0, dem.cell_m.1, heights, None);
+        let grid = self.with_rows_of(&dem, grid).map_err(anyhow_err)?;
+        let start = endpoint(&dem, &grid, "start", &self.start, &self.start_px)?;
+        let goal = endpoint(&dem, &grid, "goal", &self.goal, &self.goal_px)?;
+        let (classes, terrains) = self.classes_of(&dem, note).map_err(anyhow_err)?;
+        let request =
+            sandslope::plan::PlanRequest { start, goal, objectives: self.objectives.clone(), risk_map };
+        let progress = |obj: Objective, n: u64, total: u64| {
+            progress(obj, n, total);
+            std::ops::ControlFlow::Continue(())
+        };
+        let in_dem = |e: &dyn std::fmt::Display| {
+            RequestError::from_error(None, anyhow!("{}: {e}", self.dem.display()))
+        };
+        Ok(match chosen.get() {
+            Search::Full => {
+                let result = plan(grid, classes, &terrains, &robot, settings, &request, &progress)
+                    .map_err(|e| in_dem(&e))?;
+                Computed::Full(Box::new(Planned { dem, result }))
+            }
+            Search::Corridor(max_bytes) => {
+                let (None, [terrain]) = (&classes, terrains.as_slice()) else {
+                    return Err(RequestError::invalid(
+                        "classes",
+                        "--classes needs the full-resolution search (--search full)",
+                    ));
+                };
+                let corridor = CorridorSettings::new(self.coarse_factor, self.corridor_width, max_bytes)
+                    .map_err(|e| RequestError::from_error(None, anyhow!("{e}")))?;
+                let plan = plan_corridor(&grid, terrain, &robot, settings, &request, &corridor, &progress)
+                    .map_err(|e| in_dem(&e))?;
+                Computed::Corridor(Box::new(CorridorPlanned { dem, grid, plan, settings: corridor }))
+            }
+        })
+    }
+
+    /// `grid` with the east-west ground size of each of `dem`'s rows where they differ (a
+    /// geographic or equirectangular DEM: the cells narrow towards the pole).
+    fn with_rows_of(
+        &self,
+        dem: &Raster,
+        grid: std::result::Result<ElevationGrid, sandslope::plan::PlanError>,
+    ) -> anyhow::Result<ElevationGrid> {
+        let grid = match &dem.row_widths_m {
+            Some(w) => grid.and_then(|g| g.with_row_widths(w.clone())),
+            None => grid,
+        };
+        grid.map_err(|e| anyhow!("{}: {e}", self.dem.display()))
+    }
+
+    /// The terrain classes with the note on default CVs (docs/model.md §9) told once.
+    fn classes_of(
+        &self,
+        dem: &Raster,
+        note: &dyn Fn(&str),
+    ) -> anyhow::Result<(Option<Vec<u8>>, Vec<UncertainTerrain>)> {
+        let (classes, terrains) = self.load_classes(dem)?;
+        let defaults = terrains.iter().fold(DefaultsUsed::default(), |a, t| a.or(t.defaults_used()));
+        if let Some(n) = defaults.note() {
+            note(&n);
+        }
+        Ok((classes, terrains))
+    }
+
+    /// Loads the terrain classes: one terrain everywhere, or a class raster with its terrains.
+    fn load_classes(&self, dem: &Raster) -> anyhow::Result<(Option<Vec<u8>>, Vec<UncertainTerrain>)> {
+        let uncertain = |t| {
+            grammar::uncertain_terrain(t, self.cv_n, self.cv_s)
+                .map(|(u, _note)| u)
+                .map_err(RequestError::into_anyhow)
+        };
+        let load = |t: &str| sandslope_io::load_terrain(t);
+        let Some((path, spec)) = &self.classes else {
+            return Ok((None, vec![uncertain(load(&self.terrain)?)?]));
+        };
+        let mut values = Vec::new();
+        let mut terrains = Vec::new();
+        for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let (k, t) = item.split_once('=').ok_or_else(|| {
+                anyhow!("--class-terrain: `{item}` must be CLASS=TERRAIN, e.g. 1=dune.toml")
+            })?;
+            let k: i64 =
+                k.trim().parse().map_err(|_| anyhow!("--class-terrain: class `{k}` must be an integer"))?;
+            if values.contains(&k) {
+                bail!("--class-terrain: class {k} is given twice");
+            }
+            let terrain = load(t.trim()).with_context(|| format!("--class-terrain: class {k}"))?;
+            values.push(k);
+            terrains.push(uncertain(terrain)?);
+        }
+        if terrains.is_empty() || terrains.len() > 254 {
+            bail!("--class-terrain: give between 1 and 254 CLASS=TERRAIN pairs");
+        }
+        let classes = read_raster(path)?;
+        if classes.cols != dem.cols || classes.rows != dem.rows || !classes.geo.aligned(&dem.geo) {
+            bail!(
+                "{}: the class raster ({} x {}) must be aligned with the DEM ({} x {}): same size, origin and cell size",
+                path.display(),
+                classes.cols,
+                classes.rows,
+                dem.cols,
+                dem.rows
+            );
+        }
+        let idx = sandslope::plan::class_indices(&classes.values, |i| classes.is_nodata(i), &values)
+            .map_err(|e| {
+                anyhow!(
+                    "{}: class {} ({} cells) has no terrain; add it to --class-terrain (given: {})",
+                    path.display(),
+                    e.value,
+                    e.cells,
+                    e.given
+                )
+            })?;
+        Ok((Some(idx), terrains))
+    }
+}
+
+fn parse_pair(flag: &str, s: &str) -> anyhow::Result<(f64, f64)> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    match parts.as_slice() {
+        [a, b] => match (a.parse::<f64>(), b.parse::<f64>()) {
+            (Ok(a), Ok(b)) if a.is_finite() && b.is_finite() => Ok((a, b)),
+            _ => bail!("{flag} = `{s}` must be two numbers separated by a comma"),
+        },
+        _ => bail!("{flag} = `{s}` must be two numbers separated by a comma"),
+    }
+}
+
+/// The cell of an endpoint given in map coordinates (`map`) or as a cell (`px`), inside the
+/// map and not on nodata; errors name the field.
+fn endpoint(
+    raster: &Raster,
+    grid: &ElevationGrid,
+    which: &str,
+    map: &Option<String>,
+    px: &Option<String>,
+) -> Result<Cell> {
+    let field = if px.is_some() { format!("{which}-px") } else { which.to_string() };
+    endpoint_cell(raster, grid, which, map, px).map_err(|e| RequestError::from_error(Some(&field), e))
+}
+
+fn endpoint_cell(
+    raster: &Raster,
+    grid: &ElevationGrid,
+    which: &str,
+    map: &Option<String>,
+    px: &Option<String>,
+) -> anyhow::Result<Cell> {
+    let (cols, rows) = (raster.cols, raster.rows);
+    let g = &raster.geo;
+    let (east, south) = (g.west + cols as f64 * g.cell_x, g.north - rows as f64 * g.cell_y);
+    let (x, y) = if raster.crs.is_geographic() { ("longitude", "latitude") } else { ("x", "y") };
+    let round_coord = sandslope_io::routes::round_coordinate;
+    let extent = format!(
+        "{x} {} to {} and {y} {} to {}, columns 0 to {} and rows 0 to {}",
+        round_coord(g.west),
+        round_coord(east),
+        round_coord(south),
+        round_coord(g.north),
+        cols - 1,
+        rows - 1
+    );
+    let (c, r, what, on_edge) = if let Some(s) = px {
+        let (c, r) = parse_pair(&format!("--{which}-px"), s)?;
+        if c.fract() != 0.0 || r.fract() != 0.0 {
+            bail!("--{which}-px = `{s}` must be whole column and row numbers");
+        }
+        (c, r, format!("--{which}-px {s}"), false)
+    } else if let Some(s) = map {
+        let (x, y) = parse_pair(&format!("--{which}"), s)?;
+        let (c, r) = g.cell_of(x, y);
+        // On the map's outline (e.g. its corner 0,0): inside the closed extent, but not in any cell.
+        let on_edge = (g.west..=east).contains(&x) && (south..=g.north).contains(&y);
+        (c, r, format!("--{which} {s}"), on_edge)
+    } else {
+        bail!("give --{which} X,Y or --{which}-px COL,ROW");
+    };
+    let outside = c < 0.0 || r < 0.0 || c >= cols as f64 || r >= rows as f64;
+    if outside && on_edge {
+        bail!(
+            "{what} lies on the edge of the map ({extent}); the border is impassable, no slope can be computed \
+             there: pick a point at least one cell ({} m) inside",
+            round_coord(g.cell_x.max(g.cell_y))
+        );
+    }
+    if outside {
+        bail!("{what} is outside the map: {extent}");
+    }
+    let cell = Cell { col: c as usize, row: r as usize };
+    if !grid.is_valid(cell.row * cols + cell.col) {
+        bail!("{what} lies on a nodata cell (column {}, row {}) of the DEM", cell.col, cell.row);
+    }
+    Ok(cell)
+}
+
+/// What `plan` reads and checks before any search: the DEM, the robot, the terrain classes and
+/// the settings (the planner's inputs), shared by the routes and by risk maps without routes.
+pub struct Inputs {
+    /// The elevation model as read.
+    pub dem: Raster,
+    /// The robot.
+    pub robot: Robot,
+    /// Per-cell terrain class indices, when classes are given.
+    pub classes: Option<Vec<u8>>,
+    /// The terrain of each class, with its uncertainty (docs/model.md §9).
+    pub terrains: Vec<UncertainTerrain>,
+    /// Roll limit, descent rule, metastable edges and time weight.
+    pub settings: PlanSettings,
+    dem_path: PathBuf,
+}
+
+impl Inputs {
+    /// The planner over the whole DEM (for per-cell maps without routes).
+    pub fn planner(&self) -> Result<Planner> {
+        let in_dem = |e: &dyn std::fmt::Display| {
+            RequestError::from_error(None, anyhow!("{}: {e}", self.dem_path.display()))
+        };
+        let dem = &self.dem;
+        let (cell_x, cell_y) = dem.cell_m;
+        let grid = ElevationGrid::from_heights(dem.cols, dem.rows, cell_x, cell_y, &dem.values, dem.nodata);
+        let grid = match &dem.row_widths_m {
+            Some(w) => grid.and_then(|g| g.with_row_widths(w.clone())),
+            None => grid,
+        }
+        .map_err(|e| in_dem(&e))?;
+        Planner::new(grid, self.classes.clone(), &self.terrains, &self.robot, self.settings)
+            .map_err(|e| in_dem(&e))
+    }
+}
+
+/// The routes `plan` found at full resolution and the DEM they were planned on.
+pub struct Planned {
+    /// The elevation model as read (its georeference places the routes), its `values` released
+    /// once the planner's grid holds the heights (`result.planner.grid()`).
+    pub dem: Raster,
+    /// The library's result.
+    pub result: PlanResult,
+}
+
+/// The routes `plan` found in corridors and what they were planned on.
+pub struct CorridorPlanned {
+    /// The elevation model's georeference (its heights are in `grid`).
+    pub dem: Raster,
+    /// The full-resolution grid.
+    pub grid: ElevationGrid,
+    /// The library's result.
+    pub plan: CorridorPlan,
+    /// How the corridors were made.
+    pub settings: CorridorSettings,
+}
+
+/// What `plan` computed, by the search chosen.
+pub enum Computed {
+    /// The full-resolution search.
+    Full(Box<Planned>),
+    /// The corridor search.
+    Corridor(Box<CorridorPlanned>),
+}

@@ -1,0 +1,178 @@
+//! The robot and terrain a request names, and the scenario `predict` and `sweep` evaluate.
+
+use serde::{Deserialize, Serialize};
+
+use sandslope::robot_key::RobotKey;
+use sandslope::{LevelStep, Robot, Scenario, Terrain};
+use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
+
+use crate::error::{check_positive, RequestError, Result};
+use crate::params::Params;
+
+/// The robot of a request: a file or built-in preset, with the robot quantities it overrides.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RobotRequest {
+    /// A robot TOML file or a built-in preset (field `robot`).
+    pub robot: String,
+    /// Total mass, kg, instead of the file's (field `mass`).
+    pub mass: Option<f64>,
+    /// Robot quantities instead of the file's, by key: those of [`RobotKey::TABLE`] with a
+    /// flag, other than the mass (fields `leg-radius`, `leg-width`, `hip-height`, `leg-speed`,
+    /// `stance-legs`, `response-time`).
+    pub overrides: Vec<(RobotKey, f64)>,
+}
+
+impl Default for RobotRequest {
+    fn default() -> RobotRequest {
+        RobotRequest { robot: DEFAULT_ROBOT.to_string(), mass: None, overrides: Vec::new() }
+    }
+}
+
+/// The request field of a key's flag (`--leg-radius` -> `leg-radius`).
+fn field_of(flag: &'static str) -> &'static str {
+    flag.trim_start_matches('-')
+}
+
+/// Every key a request may set, with its field: the rows of [`RobotKey::TABLE`] that have a
+/// flag, the mass first (what the command line's flags, the server's parameters and the
+/// explorer page's robot panel are; the page reads this list from `/data/served`).
+pub fn robot_fields() -> impl Iterator<Item = (RobotKey, &'static str)> {
+    RobotKey::ALL.into_iter().filter_map(|k| k.flag().map(|f| (k, field_of(f))))
+}
+
+/// The keys a request may override besides the mass, with their fields: the table's rows
+/// that have a flag.
+pub fn override_fields() -> impl Iterator<Item = (RobotKey, &'static str)> {
+    RobotKey::ALL
+        .into_iter()
+        .filter(|k| *k != RobotKey::MassKg)
+        .filter_map(|k| k.flag().map(|f| (k, field_of(f))))
+}
+
+impl RobotRequest {
+    /// Reads `robot`, `mass` and the override fields.
+    pub fn from_params(p: &mut Params<'_>) -> Result<RobotRequest> {
+        let robot = p.text_or("robot", DEFAULT_ROBOT)?;
+        let mass = p.number("mass")?;
+        let overrides = Self::overrides_from_params(p)?;
+        Ok(RobotRequest { robot, mass, overrides })
+    }
+
+    /// Reads the override fields alone (`leg-radius`, ..., from [`RobotKey::TABLE`]).
+    pub fn overrides_from_params(p: &mut Params<'_>) -> Result<Vec<(RobotKey, f64)>> {
+        let mut overrides = Vec::new();
+        for (key, field) in override_fields() {
+            let value =
+                if key == RobotKey::StanceLegs { p.whole(field)?.map(f64::from) } else { p.number(field)? };
+            if let Some(v) = value {
+                overrides.push((key, v));
+            }
+        }
+        Ok(overrides)
+    }
+
+    /// `robot` with this request's quantities replaced (not the mass), validated again as a
+    /// whole. An error on a key a request can override names its field (from
+    /// [`RobotKey::flag`]), even when another override broke it (`leg-radius` made too small
+    /// for the file's hip height names `hip-height`).
+    pub fn apply(&self, robot: Robot) -> Result<Robot> {
+        if self.overrides.is_empty() {
+            return Ok(robot);
+        }
+        let mut spec = robot.spec().clone();
+        for &(key, value) in &self.overrides {
+            key.set(&mut spec, value);
+        }
+        Robot::new(spec).map_err(|e| match override_fields().find(|(key, _)| key.name() == e.key) {
+            Some((key, field)) => {
+                let flag = key.flag().unwrap_or(field);
+                RequestError::invalid(field, e.renamed(flag))
+            }
+            None => RequestError::from_error(None, anyhow::anyhow!("{e}")),
+        })
+    }
+
+    /// The robot: read, its quantities replaced and validated again as a whole ([`apply`]),
+    /// then the mass.
+    ///
+    /// [`apply`]: RobotRequest::apply
+    pub fn load(&self) -> Result<Robot> {
+        let robot =
+            sandslope_io::load_robot(&self.robot).map_err(|e| RequestError::from_error(Some("robot"), e))?;
+        let robot = self.apply(robot)?;
+        match self.mass {
+            Some(m) => robot.with_mass(m).map_err(|e| RequestError::invalid("mass", e.renamed("--mass"))),
+            None => Ok(robot),
+        }
+    }
+}
+
+/// Reads a terrain file or preset, an error naming the field `terrain`.
+pub fn load_terrain(terrain: &str) -> Result<Terrain> {
+    sandslope_io::load_terrain(terrain).map_err(|e| RequestError::from_error(Some("terrain"), e))
+}
+
+/// Parses a level-step rule (`slope` or `level`, docs/model.md §3).
+pub fn parse_level_step(s: &str) -> std::result::Result<LevelStep, String> {
+    match s {
+        "slope" => Ok(LevelStep::Slope),
+        "level" => Ok(LevelStep::Level),
+        other => Err(format!(
+            "`{other}` is not a level-step rule: expected `slope` (d_n at the slope) or `level` (d_n on level sand)"
+        )),
+    }
+}
+
+/// A robot on a terrain with fixed resistances overriding the terrain's: what `predict` and
+/// `sweep` evaluate (the library's [`Scenario`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ScenarioRequest {
+    /// The robot.
+    pub robot: RobotRequest,
+    /// A terrain TOML file or a built-in preset (field `terrain`).
+    pub terrain: String,
+    /// Normal penetration resistance k_n, N/m^3, at every slope instead of the terrain's
+    /// (field `k-n`).
+    pub k_n: Option<f64>,
+    /// Shear strength k_s, N/m^3, at every slope instead of the terrain's (field `k-s`).
+    pub k_s: Option<f64>,
+    /// Which normal depth the derived level step s* uses (field `level-step`, docs/model.md §3).
+    pub level_step: LevelStep,
+}
+
+impl Default for ScenarioRequest {
+    fn default() -> ScenarioRequest {
+        ScenarioRequest {
+            robot: RobotRequest::default(),
+            terrain: DEFAULT_TERRAIN.to_string(),
+            k_n: None,
+            k_s: None,
+            level_step: LevelStep::Slope,
+        }
+    }
+}
+
+impl ScenarioRequest {
+    /// Reads the robot's fields, `terrain`, `k-n`, `k-s` and `level-step`.
+    pub fn from_params(p: &mut Params<'_>) -> Result<ScenarioRequest> {
+        let robot = RobotRequest::from_params(p)?;
+        let terrain = p.text_or("terrain", DEFAULT_TERRAIN)?;
+        let k_n = p.number("k-n")?;
+        let k_s = p.number("k-s")?;
+        let level_step = match p.text("level-step")? {
+            Some(text) => parse_level_step(text)
+                .map_err(|why| RequestError::invalid("level-step", format!("--level-step: {why}")))?,
+            None => LevelStep::Slope,
+        };
+        Ok(ScenarioRequest { robot, terrain, k_n, k_s, level_step })
+    }
+
+    /// The library's scenario: the resistances checked, the robot and terrain read.
+    pub fn scenario(&self) -> Result<Scenario> {
+        let k_n = self.k_n.map(|v| check_positive("k-n", v)).transpose()?;
+        let k_s = self.k_s.map(|v| check_positive("k-s", v)).transpose()?;
+        let robot = self.robot.load()?.with_level_step(self.level_step);
+        Scenario::new(robot, load_terrain(&self.terrain)?, k_n, k_s)
+            .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))
+    }
+}

@@ -152,4 +152,16 @@ fn simulate_takes_one_slope_or_a_list_and_the_librarys_defaults() {
     assert_eq!(r.slopes, SimSlopes::Many(vec![0.0, 5.0, 10.0]));
     assert_eq!((r.body_pitch, r.rft_scaling), (BodyPitch::default(), RftScaling::default()));
     assert_eq!((r.duration_s, r.rate_hz, r.dt_s), (10.0, 120.0, None));
+    // The locked body is the library's default (the converged setting, docs/simulate.md).
+    assert_eq!(r.body_pitch, BodyPitch::Locked);
+    // The servo limit applies unless `no-servo-limit` is given (bare, as a query string's
+    // `&no-servo-limit`, or true/1); the creep speed is checked against its range by name.
+    assert!(r.servo_limit && r.creep_m_s.is_none());
+    for on in ["", "true", "1"] {
+        assert!(!sim(&[("slope", "5"), ("no-servo-limit", on)]).unwrap().servo_limit, "{on:?}");
+    }
+    assert!(sim(&[("slope", "5"), ("no-servo-limit", "false")]).unwrap().servo_limit);
+    assert_eq!(field(sim(&[("slope", "5"), ("no-servo-limit", "maybe")])), "no-servo-limit");
+    assert_eq!(field(sim(&[("slope", "5"), ("creep", "1")]).unwrap().walks()), "creep");
+    assert_eq!(sim(&[("slope", "5"), ("rft-scaling", "li2013")]).unwrap().rft_scaling, RftScaling::Li2013);
 }

@@ -39,6 +39,8 @@ def test_the_docs_show_python_to_run():
     assert len(SNIPPETS) >= 2
 
 
+# A warning in a worked example is a worked example that misleads (issue 41): an error here.
+@pytest.mark.filterwarnings("error")
 @pytest.mark.parametrize("code", SNIPPETS)
 def test_doc_python_runs_as_written(code, tmp_path, monkeypatch):
     monkeypatch.chdir(ROOT)

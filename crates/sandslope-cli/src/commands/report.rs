@@ -157,6 +157,12 @@ pub fn run(args: ReportArgs) -> Result<()> {
     for w in &report.warnings {
         eprintln!("warning: {w}");
     }
+    if report.fit_diagnosis.is_some() {
+        eprintln!(
+            "why the calibration is unreliable, and what data would fix it: {}, section \"Why the calibration is unreliable\" (report.json: fit_diagnosis)",
+            args.out.join("index.html").display()
+        );
+    }
     crate::report::write_dir(&args.out, &report)?;
     println!(
         "{} figures; {}; {} disagreement(s) listed",

@@ -92,6 +92,7 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
     h.push_str(&sections::header(report));
     h.push_str(&sections::plain_answer(report));
     h.push_str(&sections::warnings(report));
+    h.push_str(&sections::fit_diagnosis(report));
     h.push_str(&sections::inputs(report));
     h.push_str(&sections::disagreements(report));
     h.push_str(&sections::comparison(report));

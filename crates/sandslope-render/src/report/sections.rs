@@ -45,6 +45,24 @@ pub fn plain_answer(report: &Report) -> String {
     )
 }
 
+/// Why the calibration is unreliable and what data would fix it, right after the answer it
+/// qualifies (only when the fit flags itself).
+pub fn fit_diagnosis(report: &Report) -> String {
+    let Some(d) = &report.fit_diagnosis else { return String::new() };
+    let mut h = format!(
+        "<h2 id=\"unreliable\">Why the calibration is unreliable</h2>\n<p class=\"warn\">{}</p>\n",
+        escape(&d.text)
+    );
+    if !d.remedies.is_empty() {
+        h.push_str("<p>What data would fix it:</p>\n<ul>");
+        for r in &d.remedies {
+            h.push_str(&format!("<li>{}</li>", escape(r)));
+        }
+        h.push_str("</ul>\n");
+    }
+    h
+}
+
 /// The top-level warnings, before anything else is read.
 pub fn warnings(report: &Report) -> String {
     report

@@ -8,6 +8,7 @@
 //! no file and draws nothing.
 
 mod audit;
+mod diagnosis;
 mod disagreements;
 mod provenance;
 mod simulator;
@@ -34,6 +35,7 @@ use crate::slope::Slope;
 use crate::terrain::{Terrain, TerrainPoint};
 
 pub use audit::{Extrapolation, NoFloorFit, SpeedInversion, StepBudget, PAPER_FRAME_RATE_HZ};
+pub use diagnosis::{FitDiagnosis, Miss, StepAtObservedT1, CONTRADICTION_SD};
 pub use provenance::{Input, Provenance, ProvenanceKind};
 pub use simulator::{
     simulator_fit_misses, SimulatorMiss, SimulatorRecord, SimulatorWalks, AGREE_WITHIN, MISS_SD, REACH_K_S,
@@ -212,6 +214,9 @@ pub struct Report {
     /// The plain answer for the report's robot and terrain, before the evidence: how steep it
     /// climbs and how fast, where it turns metastable and where it fails.
     pub plain_answer: PlainAnswer,
+    /// Why the joint calibration is unreliable and what data would fix it, when the fit flags
+    /// itself (a poor fit or a quantity at its search bound); `None` otherwise.
+    pub fit_diagnosis: Option<FitDiagnosis>,
     /// The figures, in page order (panels of one figure each listed).
     pub figures: Vec<FigureRecord>,
     /// Observed against model speeds.
@@ -290,7 +295,7 @@ pub struct PlainAnswer {
     pub text: String,
 }
 
-fn plain_answer(plots: &Plots) -> PlainAnswer {
+fn plain_answer(plots: &Plots, unreliable: bool) -> PlainAnswer {
     let grid = &plots.model;
     let deg = |p: &Prediction| p.slope.degrees();
     let success = |p: &&Prediction| p.regime == crate::regime::Regime::Success;
@@ -337,6 +342,11 @@ fn plain_answer(plots: &Plots) -> PlainAnswer {
         words(&plots.safe_limit),
         r = plots.max_risk
     ));
+    if unreliable {
+        text.push_str(
+            " These numbers rest on a calibration that does not fit its observations: read why, and what data would fix it, before using them.",
+        );
+    }
     PlainAnswer {
         mass_kg: plots.mass_kg,
         terrain: plots.terrain_name.clone(),
@@ -496,8 +506,18 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         Vec::new()
     };
     let disagreements: Vec<String> = observations.into_iter().chain(disagreements).collect();
+    let fit_diagnosis = calibration.as_ref().and_then(|c| {
+        diagnosis::diagnose(&diagnosis::DiagnosisInput {
+            fit: &c.fit,
+            no_floor: c.no_floor.as_ref(),
+            speeds: &speeds,
+            anchoring: &plots.anchoring,
+            tracks: &evidence.tracks,
+        })
+    });
     Ok(Report {
-        plain_answer: plain_answer(&plots),
+        plain_answer: plain_answer(&plots, fit_diagnosis.is_some()),
+        fit_diagnosis,
         own_observations: own,
         model_is_calibration: own || evidence.builtin_terrain,
         figures: figure_records(&plots, calibration.is_some()),
@@ -663,7 +683,11 @@ fn plots(
         repose_deg: terrain.spec().repose_deg,
         last_point_deg: (terrain.points().len() > 1)
             .then(|| terrain.points().last().map_or(0.0, |p| p.slope_deg)),
-        terrain_name: terrain.name().unwrap_or("terrain").to_string(),
+        terrain_name: match terrain.name() {
+            Some(name) => name.to_string(),
+            None if evidence.has_own_observations() => "the terrain calibrated on your observations".into(),
+            None => "this terrain".into(),
+        },
         stance_duration_s: robot.stance_duration(),
         min_step_m: robot.min_step(),
         mass_kg: robot.mass(),
@@ -829,6 +853,52 @@ mod tests {
         assert!(a.text.contains(&format!("climbs up to {top:.2}°")), "{}", a.text);
         // Repose 25 deg: at and beyond it the regime is slippage.
         assert!(a.first_failure.unwrap().0 <= 25.0);
+    }
+
+    /// Observations like the example tracks' (a long t1 at 20 deg with a positive speed)
+    /// contradict the model whatever k_s is: the page says so with the model's step at that
+    /// t1, worked by hand from docs/model.md §5, and the answer says it rests on a bad fit.
+    #[test]
+    fn a_speed_and_t1_the_model_cannot_both_meet_are_diagnosed_by_slope() {
+        let mut e = evidence();
+        let obs = |d: f64, v: f64| SpeedObservation { slope: at(d), speed: v, speed_sd: 0.0005 };
+        e.observed = Some(("speeds.csv".into(), vec![obs(0.0, 0.157), obs(10.0, 0.11), obs(20.0, 0.0498)]));
+        e.anchoring =
+            Some(("t1.csv".into(), vec![AnchoringObservation { slope: at(20.0), t1: 0.114, t1_sd: 0.01 }]));
+        let r = report(&e).unwrap();
+        let d = r.fit_diagnosis.as_ref().expect("the fit flags itself");
+        assert_eq!(d.contradictions.len(), 1, "{:?}", d.contradictions);
+        let c = &d.contradictions[0];
+        assert_eq!(c.slope_deg, 20.0);
+        // s* from the calibrated terrain's k_n (the test terrain's 7e5 is not refitted).
+        let fitted = Terrain::new(r.calibration.as_ref().unwrap().fit.terrain.clone()).unwrap();
+        let level = predict(&paper_robot(), at(20.0), &fitted.at(at(20.0))).level_step;
+        let by_hand =
+            level * (0.386f64 / 0.5).powi(2) - 0.5 * 9.81 * 20f64.to_radians().sin() * 0.114 * 0.886;
+        assert!((c.model_step_m - by_hand).abs() < 1e-9, "{} vs {by_hand}", c.model_step_m);
+        assert!((c.observed_step_m - 0.0249).abs() < 1e-12);
+        assert!(d.text.contains("at 20°") && d.text.contains("§5"), "{}", d.text);
+        assert!(d.remedies.iter().any(|m| m.contains("--touchdowns")), "{:?}", d.remedies);
+        assert!(r.plain_answer.text.contains("does not fit its observations"), "{}", r.plain_answer.text);
+        assert!(r.plain_answer.text.starts_with("On the terrain calibrated on your observations"));
+    }
+
+    /// The paper's own evidence on its terrain: nothing to diagnose when the fit does not flag
+    /// itself, and the answer carries no such sentence.
+    #[test]
+    fn a_fit_without_warnings_has_no_diagnosis() {
+        let r = report(&evidence()).unwrap();
+        let flagged = r.calibration.as_ref().is_some_and(|c| {
+            c.fit.warnings.iter().any(|w| {
+                matches!(
+                    w,
+                    crate::calibrate::CalibrationWarning::PoorFit { .. }
+                        | crate::calibrate::CalibrationWarning::ParameterAtBound { .. }
+                )
+            })
+        });
+        assert_eq!(r.fit_diagnosis.is_some(), flagged);
+        assert_eq!(r.plain_answer.text.contains("does not fit its observations"), flagged);
     }
 
     #[test]

@@ -218,6 +218,42 @@ fn run_document(seed: &Path, file: &str, ran: &AtomicUsize, skips_used: &[Atomic
             run(root, &script.join("\n"), &format!("the block at {}:{}", b.file, b.line));
         }
     }
+    if file == "docs/tracking.md" {
+        the_example_reports_diagnosis_is_what_the_docs_say(root);
+    }
+}
+
+/// docs/tracking.md's report on the example recordings: the slopes the calibration's
+/// diagnosis names and the numbers the doc (and the README, and docs/calibration.md) quote from
+/// it, read from the report.json its command wrote.
+fn the_example_reports_diagnosis_is_what_the_docs_say(root: &Path) {
+    let json =
+        std::fs::read_to_string(root.join("report/report.json")).expect("docs/tracking.md writes report/");
+    let r: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let d = &r["fit_diagnosis"];
+    let c = d["contradictions"].as_array().expect("the example's fit is diagnosed");
+    let slopes: Vec<f64> = c.iter().map(|c| c["slope_deg"].as_f64().unwrap()).collect();
+    assert_eq!(slopes, [10.0, 20.0], "{d}");
+    let flat = |rel: &str| {
+        std::fs::read_to_string(repo_file(rel)).unwrap().split_whitespace().collect::<Vec<_>>().join(" ")
+    };
+    let (tracking, calibration, readme) =
+        (flat("docs/tracking.md"), flat("docs/calibration.md"), flat("README.md"));
+    let cm = |v: &serde_json::Value| 100.0 * v.as_f64().unwrap();
+    let at10 = format!("{:.1} ± {:.1} cm", cm(&c[0]["model_step_m"]), cm(&c[0]["model_step_sd_m"]));
+    let at20 = format!("{:.1} ± {:.1} cm", cm(&c[1]["model_step_m"]), cm(&c[1]["model_step_sd_m"]));
+    let chi = format!("χ² = {:.0} on 5", r["calibration"]["no_floor"]["chi_squared"].as_f64().unwrap());
+    let t1 = format!("t1 = {:.0} ms", 1e3 * c[1]["t1_s"].as_f64().unwrap());
+    for (text, name, wanted) in [
+        (&tracking, "docs/tracking.md", vec![&at10, &at20, &chi]),
+        (&calibration, "docs/calibration.md", vec![&at20, &t1]),
+    ] {
+        for w in wanted {
+            assert!(text.contains(w.as_str()), "{name} should quote `{w}` from the example report");
+        }
+    }
+    let step20 = format!("step at 20° is {:.1} cm", cm(&c[1]["model_step_m"]));
+    assert!(readme.contains(&step20) && readme.contains(&t1), "README should quote `{step20}` and `{t1}`");
 }
 
 /// The documents run on one worker per core, each taking the next document when it is done:

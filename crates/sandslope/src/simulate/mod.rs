@@ -155,23 +155,16 @@ impl SimSettings {
     }
 }
 
-/// Why a walk ended in its regime: the closed form's causes (docs/model.md §6) read from the
-/// motion, plus a stalled servo.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
+/// Why a walk ended in its regime: one of the closed form's causes (docs/model.md §6) read
+/// from the motion, or one the closed form cannot have (a stalled servo, a pitch-over).
+/// Serialised as its snake_case name, the closed form's causes by [`Cause::name`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MotionCause {
-    /// A leg went deeper than `2R - h`: the body sank onto its belly.
-    NormalSinkage,
-    /// The slope is at or above the terrain's angle of repose.
-    AtOrAboveRepose,
-    /// No step anchored (the speed never turned from falling to rising) and no progress.
-    NoAnchoring,
-    /// Net backward motion over the measured steps.
-    NetBackwardStep,
-    /// Progress, but the mean step is shorter than s_min.
-    ShortStep,
-    /// Mean step at least s_min.
-    RobustStep,
+    /// A cause of docs/model.md §6, read from the motion: a leg deeper than `2R - h` is
+    /// [`Cause::NormalSinkage`], no step anchored (the speed never turned from falling to
+    /// rising) and no progress is [`Cause::NoAnchoring`], and the step causes come from the
+    /// measured steps' mean.
+    Model(Cause),
     /// A servo stalled (its torque limit bound) and the walk did not succeed.
     ServoStall,
     /// The body pitched past 90 degrees: the robot tumbled (docs/model.md §18). The closed
@@ -180,29 +173,19 @@ pub enum MotionCause {
 }
 
 impl MotionCause {
-    fn from_cause(c: Cause) -> MotionCause {
-        match c {
-            Cause::NormalSinkage => MotionCause::NormalSinkage,
-            Cause::AtOrAboveRepose => MotionCause::AtOrAboveRepose,
-            Cause::NoAnchoring => MotionCause::NoAnchoring,
-            Cause::NetBackwardStep => MotionCause::NetBackwardStep,
-            Cause::ShortStep => MotionCause::ShortStep,
-            Cause::RobustStep => MotionCause::RobustStep,
-        }
-    }
-
     /// The snake_case name used in JSON.
     pub fn name(self) -> &'static str {
         match self {
-            MotionCause::NormalSinkage => "normal_sinkage",
-            MotionCause::AtOrAboveRepose => "at_or_above_repose",
-            MotionCause::NoAnchoring => "no_anchoring",
-            MotionCause::NetBackwardStep => "net_backward_step",
-            MotionCause::ShortStep => "short_step",
-            MotionCause::RobustStep => "robust_step",
+            MotionCause::Model(cause) => cause.name(),
             MotionCause::ServoStall => "servo_stall",
             MotionCause::PitchOver => "pitch_over",
         }
+    }
+}
+
+impl Serialize for MotionCause {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
     }
 }
 
@@ -531,13 +514,13 @@ struct Pitch {
 /// a pitch-over, then a stalled servo when the walk did not succeed, then §6's causes.
 fn motion_cause(cause: Cause, pitched_over: bool, stalled: bool) -> MotionCause {
     if cause == Cause::AtOrAboveRepose {
-        MotionCause::AtOrAboveRepose
+        MotionCause::Model(cause)
     } else if pitched_over {
         MotionCause::PitchOver
     } else if stalled && cause.regime() != Regime::Success {
         MotionCause::ServoStall
     } else {
-        MotionCause::from_cause(cause)
+        MotionCause::Model(cause)
     }
 }
 

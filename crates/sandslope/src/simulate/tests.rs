@@ -301,12 +301,26 @@ fn builtin_terrain() -> Terrain {
 /// steps measured), then a stalled servo only when the walk failed.
 #[test]
 fn pitch_over_outranks_every_cause_but_repose() {
-    assert_eq!(motion_cause(Cause::AtOrAboveRepose, true, true), MotionCause::AtOrAboveRepose);
+    assert_eq!(motion_cause(Cause::AtOrAboveRepose, true, true), MotionCause::Model(Cause::AtOrAboveRepose));
     assert_eq!(motion_cause(Cause::RobustStep, true, false), MotionCause::PitchOver);
     assert_eq!(motion_cause(Cause::NormalSinkage, true, true), MotionCause::PitchOver);
     assert_eq!(motion_cause(Cause::NetBackwardStep, false, true), MotionCause::ServoStall);
-    assert_eq!(motion_cause(Cause::RobustStep, false, true), MotionCause::RobustStep);
-    assert_eq!(motion_cause(Cause::ShortStep, false, false), MotionCause::ShortStep);
+    assert_eq!(motion_cause(Cause::RobustStep, false, true), MotionCause::Model(Cause::RobustStep));
+    assert_eq!(motion_cause(Cause::ShortStep, false, false), MotionCause::Model(Cause::ShortStep));
+}
+
+/// A walk's cause keeps the names `simulate --json` has always printed: the closed form's
+/// causes by their own names, and the two only the simulator has.
+#[test]
+fn motion_causes_serialise_as_the_closed_forms_names() {
+    let json = |c: MotionCause| serde_json::to_value(c).unwrap();
+    assert_eq!(json(MotionCause::Model(Cause::NormalSinkage)), "normal_sinkage");
+    assert_eq!(json(MotionCause::Model(Cause::NetBackwardStep)), "net_backward_step");
+    assert_eq!(json(MotionCause::ServoStall), "servo_stall");
+    assert_eq!(json(MotionCause::PitchOver), "pitch_over");
+    for c in Cause::ALL {
+        assert_eq!(json(MotionCause::Model(c)), serde_json::to_value(c).unwrap());
+    }
 }
 
 /// A tumble is reported as one: on the built-in robot at 20 degrees with k_s(20) of the

@@ -8,28 +8,29 @@ use sandslope::{LevelStep, Robot, Terrain};
 use sandslope_request::{grammar, RobotRequest, ScenarioRequest};
 
 use sandslope::risk::UncertainTerrain;
-use sandslope::robot_key::RobotKey;
+use sandslope::robot_key::{RobotFlag, RobotKey};
 use sandslope::AxisScale;
 use sandslope_io::load_terrain;
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 
-/// `--robot` and `--mass`.
+/// `--robot` and the robot quantities that override its file's (`--mass`, `--leg-radius`, ...).
 #[derive(Debug, Clone, Args)]
 pub struct RobotArgs {
     /// Robot: a TOML file or a built-in preset (see `sandslope presets`).
     #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_ROBOT)]
     pub robot: String,
-    /// Override the robot's total mass, kg.
-    #[arg(long, value_name = "KG", allow_negative_numbers = true)]
-    pub mass: Option<f64>,
     #[command(flatten)]
-    pub quantities: RobotQuantityArgs,
+    pub quantities: RobotKeyArgs<true>,
 }
 
 impl RobotArgs {
     /// The request these flags make: the robot, `--mass` and the other robot quantities given.
     pub fn request(&self) -> RobotRequest {
-        RobotRequest { robot: self.robot.clone(), mass: self.mass, overrides: self.quantities.overrides() }
+        RobotRequest {
+            robot: self.robot.clone(),
+            mass: self.quantities.get(RobotKey::MassKg),
+            overrides: self.quantities.overrides(),
+        }
     }
 
     /// Loads the robot and applies `--mass` and the other robot quantities given (the request
@@ -89,46 +90,88 @@ impl UncertaintyArgs {
     }
 }
 
-/// `--leg-radius`, `--leg-width`, `--hip-height`, `--leg-speed`, `--stance-legs` and
-/// `--response-time`: robot quantities overriding the robot file's (docs/model.md §2), so a
-/// design question ("and with 5 cm legs?") needs no new file. Checked by the library's one
-/// robot validation, errors naming the flag.
-#[derive(Debug, Clone, Copy, Default, Args)]
-pub struct RobotQuantityArgs {
-    /// Override the C-leg radius R, m.
-    #[arg(long = "leg-radius", value_name = "M", allow_negative_numbers = true)]
-    pub leg_radius: Option<f64>,
-    /// Override the leg width W, m.
-    #[arg(long = "leg-width", value_name = "M", allow_negative_numbers = true)]
-    pub leg_width: Option<f64>,
-    /// Override the hip height h, m (between 0 and 2R).
-    #[arg(long = "hip-height", value_name = "M", allow_negative_numbers = true)]
-    pub hip_height: Option<f64>,
-    /// Override the leg angular speed omega, rad/s.
-    #[arg(long = "leg-speed", value_name = "RAD/S", allow_negative_numbers = true)]
-    pub leg_speed: Option<f64>,
-    /// Override the number of legs in stance at once.
-    #[arg(long = "stance-legs", value_name = "N")]
-    pub stance_legs: Option<u32>,
-    /// Override the elastic response time dt, s.
-    #[arg(long = "response-time", value_name = "S", allow_negative_numbers = true)]
-    pub response_time: Option<f64>,
+/// The robot quantities overriding the robot file's (docs/model.md §2), so a design question
+/// ("and with 5 cm legs?") needs no new file: one flag per row of the library's table of robot
+/// keys that has one ([`RobotKey::TABLE`], its flag, placeholder and help line), `--mass`
+/// among them when `MASS`. Checked by the request layer's one robot validation, errors naming
+/// the flag.
+#[derive(Debug, Clone, Default)]
+pub struct RobotKeyArgs<const MASS: bool> {
+    given: Vec<(RobotKey, f64)>,
 }
 
-impl RobotQuantityArgs {
-    /// The quantities given, by the library's robot key.
+/// `--leg-radius`, `--leg-width`, `--hip-height`, `--leg-speed`, `--stance-legs` and
+/// `--response-time` without `--mass` (for `phase`, whose `--mass` is a list of panels).
+pub type RobotQuantityArgs = RobotKeyArgs<false>;
+
+impl<const MASS: bool> RobotKeyArgs<MASS> {
+    /// The keys these flags set, with their flags, in the table's order.
+    fn flags() -> impl Iterator<Item = (RobotKey, RobotFlag)> {
+        RobotKey::TABLE
+            .iter()
+            .filter(|row| MASS || row.key != RobotKey::MassKg)
+            .filter_map(|row| row.flag.map(|f| (row.key, f)))
+    }
+
+    /// The value given for `key`, if its flag was.
+    pub fn get(&self, key: RobotKey) -> Option<f64> {
+        self.given.iter().find(|(k, _)| *k == key).map(|&(_, v)| v)
+    }
+
+    /// The quantities given other than the mass, by the library's robot key.
     pub fn overrides(&self) -> Vec<(RobotKey, f64)> {
-        [
-            (RobotKey::LegRadiusM, self.leg_radius),
-            (RobotKey::LegWidthM, self.leg_width),
-            (RobotKey::HipHeightM, self.hip_height),
-            (RobotKey::LegSpeedRadS, self.leg_speed),
-            (RobotKey::StanceLegs, self.stance_legs.map(f64::from)),
-            (RobotKey::ResponseTimeS, self.response_time),
-        ]
-        .into_iter()
-        .filter_map(|(key, value)| value.map(|v| (key, v)))
-        .collect()
+        self.given.iter().copied().filter(|(k, _)| *k != RobotKey::MassKg).collect()
+    }
+}
+
+impl<const MASS: bool> clap::Args for RobotKeyArgs<MASS> {
+    fn augment_args(mut cmd: clap::Command) -> clap::Command {
+        for (key, flag) in Self::flags() {
+            let arg = clap::Arg::new(key.name())
+                .long(flag.long.trim_start_matches('-'))
+                .value_name(flag.value_name)
+                .help(flag.help)
+                .action(clap::ArgAction::Set);
+            // A whole number: clap's parser, which refuses `2.5` and `-1` itself.
+            cmd = cmd.arg(if key == RobotKey::StanceLegs {
+                arg.value_parser(clap::value_parser!(u32))
+            } else {
+                arg.value_parser(clap::value_parser!(f64)).allow_negative_numbers(true)
+            });
+        }
+        cmd
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
+}
+
+impl<const MASS: bool> clap::FromArgMatches for RobotKeyArgs<MASS> {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> std::result::Result<Self, clap::Error> {
+        let mut args = RobotKeyArgs { given: Vec::new() };
+        args.update_from_arg_matches(matches)?;
+        Ok(args)
+    }
+
+    fn update_from_arg_matches(
+        &mut self,
+        matches: &clap::ArgMatches,
+    ) -> std::result::Result<(), clap::Error> {
+        let internal =
+            |e: clap::parser::MatchesError| clap::Error::raw(clap::error::ErrorKind::ArgumentConflict, e);
+        for (key, _) in Self::flags() {
+            let value = if key == RobotKey::StanceLegs {
+                matches.try_get_one::<u32>(key.name()).map_err(internal)?.map(|&v| f64::from(v))
+            } else {
+                matches.try_get_one::<f64>(key.name()).map_err(internal)?.copied()
+            };
+            if let Some(v) = value {
+                self.given.retain(|(k, _)| *k != key);
+                self.given.push((key, v));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -248,36 +291,34 @@ mod tests {
     }
 
     /// The robot flags are the library's table of robot keys: every key with a flag is one
-    /// of `RobotArgs`' flags and sets its key (so the server's parameters, which the request
-    /// layer reads by the table, and the page's list, which `/data/served` gives from it, are
-    /// the command line's flags).
+    /// of `RobotArgs`' flags, in the table's order (so the server's parameters, which the
+    /// request layer reads by the table, and the page's list, which `/data/served` gives from
+    /// it, are the command line's flags), and each flag sets the key it names.
     #[test]
     fn robot_flags_are_the_tables() {
-        use clap::{Args as _, Command};
+        use clap::{Args as _, Command, FromArgMatches as _};
         let cmd = RobotArgs::augment_args(Command::new("x"));
         let longs: Vec<&str> =
             cmd.get_arguments().filter_map(|a| a.get_long()).filter(|l| *l != "robot").collect();
         let table: Vec<&str> = sandslope_request::scenario::robot_fields().map(|(_, f)| f).collect();
         assert_eq!(longs, table);
-        let q = RobotQuantityArgs {
-            leg_radius: Some(1.0),
-            leg_width: Some(2.0),
-            hip_height: Some(3.0),
-            leg_speed: Some(4.0),
-            stance_legs: Some(5),
-            response_time: Some(6.0),
-        };
-        let mut spec = load_robot_spec();
-        for (key, v) in q.overrides() {
-            key.set(&mut spec, v);
-        }
-        let set: Vec<f64> =
-            sandslope_request::scenario::override_fields().map(|(k, _)| k.get(&spec).unwrap()).collect();
-        assert_eq!(set, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
-    }
-
-    fn load_robot_spec() -> sandslope::RobotSpec {
-        sandslope_io::load_robot(DEFAULT_ROBOT).unwrap().spec().clone()
+        let argv = "x --mass 7 --leg-radius 1 --leg-width 2 --hip-height 3 --leg-speed 4 --stance-legs 5 --response-time -6";
+        let args = RobotArgs::from_arg_matches(&cmd.get_matches_from(argv.split(' '))).unwrap();
+        let request = args.request();
+        assert_eq!(request.mass, Some(7.0));
+        let expected = [
+            (RobotKey::LegRadiusM, 1.0),
+            (RobotKey::LegWidthM, 2.0),
+            (RobotKey::HipHeightM, 3.0),
+            (RobotKey::LegSpeedRadS, 4.0),
+            (RobotKey::StanceLegs, 5.0),
+            (RobotKey::ResponseTimeS, -6.0),
+        ];
+        assert_eq!(request.overrides, expected);
+        // `phase`'s set has no `--mass` (its own is a list of panels).
+        let phase = RobotQuantityArgs::augment_args(Command::new("x"));
+        assert!(phase.get_arguments().all(|a| a.get_long() != Some("mass")));
+        assert_eq!(phase.get_arguments().count(), 6);
     }
 
     #[test]

@@ -83,12 +83,12 @@ impl RobotRequest {
         for &(key, value) in &self.overrides {
             key.set(&mut spec, value);
         }
-        Robot::new(spec).map_err(|e| match override_fields().find(|(key, _)| key.name() == e.key) {
-            Some((key, field)) => {
-                let flag = key.flag().unwrap_or(field);
-                RequestError::invalid(field, e.renamed(flag))
+        Robot::new(spec).map_err(|e| {
+            let key = RobotKey::of_error(&e).filter(|k| *k != RobotKey::MassKg);
+            match key.and_then(|k| k.flag()) {
+                Some(flag) => RequestError::invalid(field_of(flag), e.renamed(flag)),
+                None => RequestError::from_error(None, anyhow::anyhow!("{e}")),
             }
-            None => RequestError::from_error(None, anyhow::anyhow!("{e}")),
         })
     }
 

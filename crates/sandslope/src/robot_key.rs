@@ -47,37 +47,78 @@ pub struct RobotKeyRow {
     /// The unit of its value.
     pub unit: &'static str,
     /// The command-line flag that overrides it, where there is one.
-    pub flag: Option<&'static str>,
+    pub flag: Option<RobotFlag>,
     /// What it is, in words.
     pub description: &'static str,
+}
+
+/// The command-line flag that overrides a robot key: what the command line builds its flag
+/// from, the request layer its field (the flag without dashes, also the server's parameter)
+/// and the explorer page its robot panel.
+#[derive(Debug, Clone, Copy)]
+pub struct RobotFlag {
+    /// The flag, with its dashes (`--leg-radius`).
+    pub long: &'static str,
+    /// The placeholder of its value in `--help` (`M`).
+    pub value_name: &'static str,
+    /// Its line in `--help`.
+    pub help: &'static str,
+}
+
+const fn flag(long: &'static str, value_name: &'static str, help: &'static str) -> Option<RobotFlag> {
+    Some(RobotFlag { long, value_name, help })
 }
 
 impl RobotKey {
     /// The table: every key in the order of docs/model.md §2.
     pub const TABLE: [RobotKeyRow; 10] = [
-        row(RobotKey::MassKg, "mass_kg", "kg", Some("--mass"), "total robot mass m"),
-        row(RobotKey::LegRadiusM, "leg_radius_m", "m", Some("--leg-radius"), "C-leg radius R"),
-        row(RobotKey::LegWidthM, "leg_width_m", "m", Some("--leg-width"), "leg width W"),
+        row(
+            RobotKey::MassKg,
+            "mass_kg",
+            "kg",
+            flag("--mass", "KG", "Override the robot's total mass, kg"),
+            "total robot mass m",
+        ),
+        row(
+            RobotKey::LegRadiusM,
+            "leg_radius_m",
+            "m",
+            flag("--leg-radius", "M", "Override the C-leg radius R, m"),
+            "C-leg radius R",
+        ),
+        row(
+            RobotKey::LegWidthM,
+            "leg_width_m",
+            "m",
+            flag("--leg-width", "M", "Override the leg width W, m"),
+            "leg width W",
+        ),
         row(
             RobotKey::HipHeightM,
             "hip_height_m",
             "m",
-            Some("--hip-height"),
+            flag("--hip-height", "M", "Override the hip height h, m (between 0 and 2R)"),
             "hip height h (between 0 and 2R)",
         ),
         row(
             RobotKey::LegSpeedRadS,
             "leg_speed_rad_s",
             "rad/s",
-            Some("--leg-speed"),
+            flag("--leg-speed", "RAD/S", "Override the leg angular speed omega, rad/s"),
             "leg angular speed omega",
         ),
-        row(RobotKey::StanceLegs, "stance_legs", "legs", Some("--stance-legs"), "legs in stance at once n"),
+        row(
+            RobotKey::StanceLegs,
+            "stance_legs",
+            "legs",
+            flag("--stance-legs", "N", "Override the number of legs in stance at once"),
+            "legs in stance at once n",
+        ),
         row(
             RobotKey::ResponseTimeS,
             "response_time_s",
             "s",
-            Some("--response-time"),
+            flag("--response-time", "S", "Override the elastic response time dt, s"),
             "elastic response time dt",
         ),
         row(
@@ -141,7 +182,13 @@ impl RobotKey {
 
     /// The command-line flag that overrides the key, where there is one.
     pub fn flag(self) -> Option<&'static str> {
-        self.row().flag
+        self.row().flag.map(|f| f.long)
+    }
+
+    /// The key named in a library error on the robot ([`crate::Robot::new`]'s `ParamError`
+    /// names the robot file's key), where it is one.
+    pub fn of_error(error: &crate::error::ParamError) -> Option<RobotKey> {
+        Self::from_name(&error.key)
     }
 
     /// The key's range of plausibility ([`crate::robot::PLAUSIBLE`]); `None` for
@@ -212,7 +259,7 @@ const fn row(
     key: RobotKey,
     name: &'static str,
     unit: &'static str,
-    flag: Option<&'static str>,
+    flag: Option<RobotFlag>,
     description: &'static str,
 ) -> RobotKeyRow {
     RobotKeyRow { key, name, unit, flag, description }

@@ -4,8 +4,12 @@
 use std::net::IpAddr;
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 use clap::Args;
+use sandslope_serve::drive::SignalFlags;
+use sandslope_servo::session::DriveConfig;
+
+use crate::commands::drive::{BusFlag, DriveRunArgs};
 
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 use sandslope_serve::ServeConfig;
@@ -54,11 +58,58 @@ pub struct ServeArgs {
     /// address it listens on: a machine name or a reverse proxy's. Repeat for several.
     #[arg(long, value_name = "NAME")]
     pub allow_host: Vec<String>,
+    /// Drive the robot (--robot's [servos]) while serving: the page's Drive tab shows the run
+    /// live (time, leg speed, k_s with its 90% interval, the risk, a halt on risk) and can stop
+    /// it. Needs --drive-port or --emulate; the run's flags are `sandslope drive`'s.
+    #[arg(long, help_heading = "Driving (docs/drive.md)")]
+    pub drive: bool,
+    /// With --drive: the serial port of the Protocol 2.0 adapter (drive's --port).
+    #[arg(long, value_name = "PATH", requires = "drive", help_heading = "Driving (docs/drive.md)")]
+    pub drive_port: Option<PathBuf>,
+    /// With --drive: drive a bus of emulated XL330s on a pseudo-terminal instead of a port.
+    #[arg(long, requires = "drive", conflicts_with = "drive_port", help_heading = "Driving (docs/drive.md)")]
+    pub emulate: bool,
+    #[command(flatten, next_help_heading = "Driving (docs/drive.md)")]
+    pub drive_run: Option<DriveRunArgs>,
+}
+
+/// `drive`'s run flags at their defaults (no flag given): one parse of an empty command line
+/// with the same definitions, so no default is stated twice.
+fn default_run() -> Result<DriveRunArgs> {
+    use clap::{Arg, ArgAction, FromArgMatches};
+    let command = DriveRunArgs::augment_args(
+        clap::Command::new("drive").arg(Arg::new("emulate").long("emulate").action(ArgAction::SetTrue)),
+    );
+    Ok(DriveRunArgs::from_arg_matches(&command.try_get_matches_from(["drive"])?)?)
+}
+
+/// `--drive`'s typed run, built as `sandslope drive` builds it from the same flags.
+fn drive_config(args: &ServeArgs) -> Result<Option<DriveConfig>> {
+    if !args.drive {
+        if args.drive_run.is_some() {
+            bail!("the driving flags (--slope, --duration, --stop-on-risk, --emulate-*, ...) need --drive");
+        }
+        return Ok(None);
+    }
+    let bus = match (&args.drive_port, args.emulate) {
+        (Some(p), _) => BusFlag::Port(p.clone()),
+        (None, true) => BusFlag::Emulate,
+        (None, false) => bail!("--drive needs --drive-port PATH (the adapter's serial port) or --emulate"),
+    };
+    let run = match &args.drive_run {
+        Some(r) => r.clone(),
+        None => default_run()?,
+    };
+    let robot = sandslope_io::load_robot(&args.robot)?;
+    let terrain = sandslope_io::load_terrain(&args.terrain)?;
+    Ok(Some(crate::commands::drive::config(&run, robot, &args.robot, terrain, bus, true)?))
 }
 
 /// Runs `sandslope serve` until the process is stopped: the flags into the server's
 /// configuration, checked and served by `sandslope-serve`.
 pub fn run(args: ServeArgs) -> Result<()> {
+    let flags = SignalFlags { stop: &crate::error::STOP, driving: &crate::error::DRIVING };
+    let drive = drive_config(&args)?.map(|c| (c, flags));
     sandslope_serve::run(ServeConfig {
         dem: args.dem,
         robot: args.robot,
@@ -71,5 +122,6 @@ pub fn run(args: ServeArgs) -> Result<()> {
         send_timeout: args.send_timeout,
         max_connections: args.max_connections,
         allow_host: args.allow_host,
+        drive,
     })
 }

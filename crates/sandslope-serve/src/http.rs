@@ -44,6 +44,7 @@ use hyper::{Method, Request, Response, StatusCode, Version};
 use tokio::sync::{mpsc, oneshot, Semaphore};
 
 use crate::conn::{self, Busy, ConnLimits};
+use crate::drive::{self, LiveDrive};
 use crate::reply::{self, ApiError, Reply};
 use crate::served::Served;
 use crate::{api, data, page};
@@ -86,6 +87,8 @@ pub struct App {
     heavy: Pool,
     hosts: Hosts,
     body_timeout: Duration,
+    /// The robot driven while serving (`serve --drive`).
+    drive: Option<Arc<LiveDrive>>,
 }
 
 /// A bound server, ready to [`Server::serve`].
@@ -131,8 +134,16 @@ impl Server {
                 names: limits.allowed_hosts.iter().map(|h| h.to_ascii_lowercase()).collect(),
             },
             body_timeout: limits.conn.header_timeout,
+            drive: None,
         });
         Ok(Server { runtime, listener, app, limits: limits.conn })
+    }
+
+    /// Shows a driven run at `/api/drive/` (`serve --drive`); before [`Server::serve`].
+    pub fn show_drive(&mut self, live: Arc<LiveDrive>) {
+        if let Some(app) = Arc::get_mut(&mut self.app) {
+            app.drive = Some(live);
+        }
     }
 
     /// The address the server listens on (with the port chosen when 0 was asked).
@@ -412,6 +423,16 @@ async fn answer(app: &Arc<App>, request: Request<Incoming>) -> Response<Body> {
     }
     let (path, query) = url.split_once('?').unwrap_or((&url, ""));
     let method = request.method().clone();
+    // The driven run's status and stop: a lock and a copy, answered here, off the pools.
+    if let Some(name) = path.strip_prefix("/api/drive/") {
+        if !matches!(method, Method::GET | Method::HEAD | Method::POST) {
+            return refuse_method(&method, "GET, HEAD, POST");
+        }
+        return match drive::answer(name, method == Method::POST, app.drive.as_deref()) {
+            Ok(body) => response(200, "application/json", None, Body::whole(body)),
+            Err(e) => refused(&e),
+        };
+    }
     if !computed(path) {
         if method != Method::GET && method != Method::HEAD {
             return refuse_method(&method, "GET, HEAD");

@@ -15,7 +15,8 @@
 //! `/download/...`, the page's extras) and [`page`] (the embedded page); [`conn`] (the accept
 //! loop, the cap on connections and their timeouts, handed the HTTP layer as a function) and
 //! [`http`] (requests: Host and Origin checks, the light and heavy compute pools, answers
-//! streamed in chunks). The page and its scripts are embedded in the binary: nothing is
+//! streamed in chunks); [`drive`] is `--drive` (a run driven on a thread of its own, its status
+//! and stop). The page and its scripts are embedded in the binary: nothing is
 //! fetched from the network.
 
 #![warn(missing_docs)]
@@ -23,6 +24,7 @@
 pub mod api;
 pub mod conn;
 pub mod data;
+pub mod drive;
 pub mod http;
 pub mod page;
 pub mod reply;
@@ -33,6 +35,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
+use sandslope_servo::session::{emulator_summary, DriveConfig, Session};
 
 /// How a server is run: what `sandslope serve`'s flags give (each field is the flag of its
 /// name; docs/serve.md).
@@ -60,6 +63,9 @@ pub struct ServeConfig {
     pub max_connections: usize,
     /// Other names the server may be reached by (`--allow-host`).
     pub allow_host: Vec<String>,
+    /// The robot driven while serving (`--drive`): the run `sandslope drive` makes of the same
+    /// flags, and the signal handler's flags ([`drive`]).
+    pub drive: Option<(DriveConfig, drive::SignalFlags)>,
 }
 
 /// Checks a timeout flag: a finite number of seconds in 0.1..=86400.
@@ -106,7 +112,33 @@ pub fn run(args: ServeConfig) -> Result<()> {
     };
     // Read everything the server will use now, so a bad file fails at start, not per request.
     let served = served::Served::load(args.robot.clone(), args.terrain.clone(), args.dem.clone())?;
-    let server = http::Server::bind(args.host, args.port, served, limits)?;
+    // The run: its monitor's grid and its bus, before listening (a missing port fails here,
+    // nothing having moved).
+    let session = match args.drive {
+        Some((config, flags)) => Some((Session::open(config)?, flags)),
+        None => None,
+    };
+    let mut server = match http::Server::bind(args.host, args.port, served, limits) {
+        Ok(s) => s,
+        Err(e) => {
+            if let Some(r) = session.and_then(|(s, _)| s.close()) {
+                eprintln!("{}", emulator_summary(&r));
+            }
+            return Err(e);
+        }
+    };
+    let driving = match session {
+        Some((session, flags)) => {
+            let servos = session.config().settings.servos.len();
+            let thread = drive::DriveThread::start(session, flags)?;
+            server.show_drive(std::sync::Arc::clone(&thread.live));
+            eprintln!(
+                "driving {servos} servos: the page's Drive tab shows the run; its stop button or Ctrl-C stops the gait and turns the torque off"
+            );
+            Some(thread)
+        }
+        None => None,
+    };
     let url = format!("http://{}/", server.address());
     if !args.host.is_loopback() {
         eprintln!(
@@ -121,7 +153,12 @@ pub fn run(args: ServeConfig) -> Result<()> {
     if args.open {
         open_browser(&url);
     }
-    server.serve()
+    let result = server.serve();
+    // The server failed: stop the gait and turn the torque off before the process ends.
+    if let Some(thread) = driving {
+        thread.stop_and_join();
+    }
+    result
 }
 
 /// Asks the desktop to open `url`; a failure is a note, not an error (the URL is printed).

@@ -8,6 +8,7 @@ use crate::served::Served;
 
 const INDEX: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/app.js");
+const DRIVE_SCRIPT: &str = include_str!("page/drive.js");
 const STYLE: &str = include_str!("page/style.css");
 
 /// The page's file at `path`, with its content type, or `None` (404).
@@ -15,6 +16,7 @@ pub fn asset(path: &str, _served: &Served) -> Option<(Vec<u8>, &'static str)> {
     match path {
         "/" | "/index.html" => Some((INDEX.as_bytes().to_vec(), "text/html; charset=utf-8")),
         "/app.js" => Some((SCRIPT.as_bytes().to_vec(), "text/javascript; charset=utf-8")),
+        "/drive.js" => Some((DRIVE_SCRIPT.as_bytes().to_vec(), "text/javascript; charset=utf-8")),
         "/style.css" => {
             let css = sandslope_render::figures::palette::css_custom_properties() + STYLE;
             Some((css.into_bytes(), "text/css; charset=utf-8"))

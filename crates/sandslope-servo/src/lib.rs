@@ -6,6 +6,8 @@
 //! - [`driver`]: the alternating tripod of [`sandslope::servo::GaitSchedule`] sent to the
 //!   servos over a `dynamixel2::Bus` (sync write of goals, sync read of the present state), with
 //!   its safety logic: torque off on every exit, Ctrl-C, a lost servo and a watchdog;
+//! - [`session`]: one run as every front end starts it, from the typed [`session::DriveConfig`]
+//!   that `drive`'s and `serve --drive`'s flags are translated into;
 //! - [`emulator`]: a bus of virtual XL330s on a pseudo-terminal, whose shafts move as commanded
 //!   and whose currents come from the stride simulator (`sandslope::simulate`).
 //!
@@ -15,6 +17,7 @@
 pub mod driver;
 pub mod emulator;
 pub mod packet;
+pub mod session;
 pub mod table;
 
 pub use driver::{drive, DriveError, DriveOutcome, DriveSettings, Profile, ServoConfig, ServoSample};

@@ -11,15 +11,15 @@ use std::sync::atomic::Ordering;
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 
-use sandslope::infer::servo::{model_grid, CurrentInferenceSettings};
 use sandslope::servo::{xl330, GaitSchedule};
 use sandslope::Slope;
 use sandslope_io::robot_terrain::load_servos;
 use sandslope_io::servo_log::{ServoLogRow, ServoLogWriter, DEFAULT_BAUD_RATE};
-use sandslope_servo::driver::{drive, DriveReport, LiveEstimate, Monitor, ServoSample};
+use sandslope_servo::driver::{DriveReport, LiveEstimate, ServoSample};
 use sandslope_servo::emulator::EmulatorFaults;
+use sandslope_servo::session::{emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session};
 use sandslope_servo::table as t;
-use sandslope_servo::{DriveSettings, Emulator, EmulatorConfig, Profile, ServoConfig};
+use sandslope_servo::{DriveSettings, Profile, ServoConfig};
 
 use crate::args::{check_flag, RobotArgs, TerrainArgs};
 use crate::error::{KeepLog, EXIT_HALTED, EXIT_SIGINT};
@@ -52,6 +52,24 @@ pub struct DriveArgs {
     /// Terrain: k_n at the slope for the live estimate, and the emulated sand.
     #[command(flatten)]
     pub terrain: TerrainArgs,
+    #[command(flatten)]
+    pub run: DriveRunArgs,
+    /// Write every servo's state every cycle to this CSV (docs/drive.md, "The log").
+    #[arg(long, value_name = "FILE")]
+    pub log: Option<PathBuf>,
+    /// Print the live estimate of k_s and the risk after every stance (implied by --stop-on-risk).
+    #[arg(long)]
+    pub live: bool,
+    /// Print the run's report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The flags of a run that `drive` and `serve --drive` share: the gait, the limits, the halt on
+/// risk and the emulator's sand and faults. Each command adds its own bus flags (`drive --port`,
+/// `serve --drive-port`) and `--emulate`, which the `--emulate-*` flags require.
+#[derive(Debug, Clone, Args)]
+pub struct DriveRunArgs {
     /// The slope being climbed, degrees (for the live estimate, the log's header and the emulator).
     #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_negative_numbers = true)]
     pub slope: f64,
@@ -67,18 +85,12 @@ pub struct DriveArgs {
     /// Baud rate (default: the robot file's [servos] baud_rate, else 57600; the emulator ignores it).
     #[arg(long, value_name = "BAUD")]
     pub baud: Option<u32>,
-    /// Write every servo's state every cycle to this CSV (docs/drive.md, "The log").
-    #[arg(long, value_name = "FILE")]
-    pub log: Option<PathBuf>,
     /// Halt the gait (torque held, legs planted) when the live risk that the walk fails (slippage or sinkage) passes P.
     #[arg(long, value_name = "P")]
     pub stop_on_risk: Option<f64>,
     /// After a halt, seconds the legs are held before the torque goes off.
     #[arg(long, value_name = "S", default_value_t = 2.0)]
     pub hold: f64,
-    /// Print the live estimate of k_s and the risk after every stance (implied by --stop-on-risk).
-    #[arg(long)]
-    pub live: bool,
     /// Current Limit written to every servo, mA (0 to 1750; 1470 is the stall current at 5 V).
     #[arg(long, value_name = "MA", default_value_t = 1470)]
     pub current_limit: u16,
@@ -107,16 +119,24 @@ pub struct DriveArgs {
     /// packets fail their CRC from S s) or freeze:S:LEN (the bus hangs for LEN s from S s).
     #[arg(long, value_name = "KIND:..", requires = "emulate")]
     pub emulate_fault: Option<String>,
-    /// Print the run's report as JSON.
-    #[arg(long)]
-    pub json: bool,
+}
+
+/// Where a run's servos are, as the front end's flags say.
+#[derive(Debug, Clone)]
+pub enum BusFlag {
+    /// `--port` (`serve --drive-port`).
+    Port(PathBuf),
+    /// `--emulate`.
+    Emulate,
+    /// `--dry-run`: no bus.
+    None,
 }
 
 fn number(flag: &str, text: &str, whole: &str) -> Result<f64> {
     text.trim().parse::<f64>().map_err(|_| anyhow!("{flag}: `{text}` is not a number (in {whole})"))
 }
 
-fn parse_faults(args: &DriveArgs) -> Result<EmulatorFaults> {
+fn parse_faults(args: &DriveRunArgs) -> Result<EmulatorFaults> {
     let mut f = EmulatorFaults::default();
     if let Some(w) = &args.emulate_weaken {
         let (s, k) =
@@ -149,9 +169,9 @@ fn parse_faults(args: &DriveArgs) -> Result<EmulatorFaults> {
 
 /// The servos: the robot file's `[servos]` table, or IDs 1 to 2n with the left side (the first
 /// n) turning positive and the right side mirrored.
-fn servos(args: &DriveArgs, legs: usize) -> Result<(Vec<ServoConfig>, u32)> {
-    let table = load_servos(&args.robot.robot)?;
-    let (list, baud) = match table {
+fn servos(robot_spec: &str, baud: Option<u32>, legs: usize) -> Result<(Vec<ServoConfig>, u32)> {
+    let table = load_servos(robot_spec)?;
+    let (list, file_baud) = match table {
         Some(s) => (
             s.mounts
                 .iter()
@@ -176,129 +196,127 @@ fn servos(args: &DriveArgs, legs: usize) -> Result<(Vec<ServoConfig>, u32)> {
     };
     if list.len() != legs {
         bail!(
-            "{}: [servos] ids lists {} servos; the alternating tripod of this robot (stance_legs = {}) needs {legs}",
-            args.robot.robot,
+            "{robot_spec}: [servos] ids lists {} servos; the alternating tripod of this robot (stance_legs = {}) needs {legs}",
             list.len(),
             legs / 2
         );
     }
-    Ok((list, args.baud.unwrap_or(baud)))
+    Ok((list, baud.unwrap_or(file_baud)))
+}
+
+/// The typed run that `drive`'s flags (and `serve --drive`'s, the same [`DriveRunArgs`]) make:
+/// every flag checked against its range, the servos from the robot file `robot_spec`.
+pub fn config(
+    run: &DriveRunArgs,
+    robot: sandslope::Robot,
+    robot_spec: &str,
+    terrain: sandslope::Terrain,
+    bus: BusFlag,
+    monitor: bool,
+) -> Result<DriveConfig> {
+    Slope::from_signed_degrees(run.slope).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+    check_flag("--duration", run.duration, 0.0, 86_400.0)?;
+    check_flag("--rate", run.rate, 1.0, 1000.0)?;
+    check_flag("--hold", run.hold, 0.0, 3600.0)?;
+    check_flag("--watchdog", run.watchdog, 0.01, 10.0)?;
+    check_flag("--bus-watchdog", run.bus_watchdog, 0.02, 2.54)?;
+    if run.current_limit > xl330::MAX_CURRENT_LIMIT_MA {
+        bail!(
+            "--current-limit = {} must be within 0 to {} mA (the XL330's Current Limit range)",
+            run.current_limit,
+            xl330::MAX_CURRENT_LIMIT_MA
+        );
+    }
+    if run.temperature_limit > xl330::MAX_TEMPERATURE_C {
+        bail!(
+            "--temperature-limit = {} must be within 0 to {} degC (the XL330's rated range)",
+            run.temperature_limit,
+            xl330::MAX_TEMPERATURE_C
+        );
+    }
+    if let Some(p) = run.stop_on_risk {
+        check_flag("--stop-on-risk", p, 0.0, 1.0)?;
+    }
+    let emulate = matches!(bus, BusFlag::Emulate);
+    if emulate {
+        check_flag("--emulate-noise", run.emulate_noise, 0.0, 1000.0)?;
+    }
+    if let Some(k) = run.emulate_k_s {
+        sandslope::Terrain::constant(1.0, k).map_err(|e| anyhow!("{}", e.renamed("--emulate-k-s")))?;
+    }
+    let faults = if emulate { parse_faults(run)? } else { EmulatorFaults::default() };
+    let legs = 2 * robot.stance_legs() as usize;
+    GaitSchedule::new(&robot, legs).map_err(|e| anyhow!("{robot_spec}: {e}"))?;
+    let (servos, baud) = servos(robot_spec, run.baud, legs)?;
+    if let Some(b) = run.baud {
+        if !sandslope_io::servo_log::BAUD_RATES.contains(&b) {
+            bail!("--baud = {b} must be one the XL330 supports: {:?}", sandslope_io::servo_log::BAUD_RATES);
+        }
+    }
+    let settings = DriveSettings {
+        servos,
+        profile: match run.profile {
+            ProfileArg::Position => Profile::Position,
+            ProfileArg::Velocity => Profile::Velocity,
+        },
+        duration_s: run.duration,
+        rate_hz: run.rate,
+        current_limit_ma: run.current_limit,
+        temperature_limit_c: run.temperature_limit,
+        watchdog_s: run.watchdog,
+        bus_watchdog_s: run.bus_watchdog,
+        stop_on_risk: run.stop_on_risk,
+        hold_s: run.hold,
+        stand_s: 1.0,
+    };
+    let bus = match bus {
+        BusFlag::Port(path) => BusChoice::Port { path, baud },
+        BusFlag::Emulate | BusFlag::None => BusChoice::Emulate(EmulateOptions {
+            k_s: run.emulate_k_s,
+            noise_ma: run.emulate_noise,
+            seed: run.emulate_seed,
+            faults,
+        }),
+    };
+    Ok(DriveConfig { robot, terrain, slope_deg: run.slope, settings, bus, monitor })
 }
 
 /// Runs `sandslope drive`.
 pub fn run(args: DriveArgs) -> Result<()> {
     let robot = args.robot.load()?;
     let terrain = args.terrain.load()?;
-    let slope = Slope::from_signed_degrees(args.slope).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
-    check_flag("--duration", args.duration, 0.0, 86_400.0)?;
-    check_flag("--rate", args.rate, 1.0, 1000.0)?;
-    check_flag("--hold", args.hold, 0.0, 3600.0)?;
-    check_flag("--watchdog", args.watchdog, 0.01, 10.0)?;
-    check_flag("--bus-watchdog", args.bus_watchdog, 0.02, 2.54)?;
-    if args.current_limit > xl330::MAX_CURRENT_LIMIT_MA {
-        bail!(
-            "--current-limit = {} must be within 0 to {} mA (the XL330's Current Limit range)",
-            args.current_limit,
-            xl330::MAX_CURRENT_LIMIT_MA
-        );
-    }
-    if args.temperature_limit > xl330::MAX_TEMPERATURE_C {
-        bail!(
-            "--temperature-limit = {} must be within 0 to {} degC (the XL330's rated range)",
-            args.temperature_limit,
-            xl330::MAX_TEMPERATURE_C
-        );
-    }
-    if let Some(p) = args.stop_on_risk {
-        check_flag("--stop-on-risk", p, 0.0, 1.0)?;
-    }
-    if args.emulate {
-        check_flag("--emulate-noise", args.emulate_noise, 0.0, 1000.0)?;
-    }
-    let faults = if args.emulate { parse_faults(&args)? } else { EmulatorFaults::default() };
-    let legs = 2 * robot.stance_legs() as usize;
-    let schedule = GaitSchedule::new(&robot, legs).map_err(|e| anyhow!("{}: {e}", args.robot.robot))?;
-    let (servos, baud) = servos(&args, legs)?;
-    if let Some(b) = args.baud {
-        if !sandslope_io::servo_log::BAUD_RATES.contains(&b) {
-            bail!("--baud = {b} must be one the XL330 supports: {:?}", sandslope_io::servo_log::BAUD_RATES);
-        }
-    }
-    let settings = DriveSettings {
-        servos: servos.clone(),
-        profile: match args.profile {
-            ProfileArg::Position => Profile::Position,
-            ProfileArg::Velocity => Profile::Velocity,
-        },
-        duration_s: args.duration,
-        rate_hz: args.rate,
-        current_limit_ma: args.current_limit,
-        temperature_limit_c: args.temperature_limit,
-        watchdog_s: args.watchdog,
-        bus_watchdog_s: args.bus_watchdog,
-        stop_on_risk: args.stop_on_risk,
-        hold_s: args.hold,
-        stand_s: 1.0,
+    let bus = match (&args.port, args.emulate) {
+        (_, true) => BusFlag::Emulate,
+        (Some(p), false) => BusFlag::Port(p.clone()),
+        (None, false) => BusFlag::None,
     };
+    let monitor = args.live || args.run.stop_on_risk.is_some();
+    let config = config(&args.run, robot, &args.robot.robot, terrain, bus, monitor)?;
     if args.dry_run {
-        return dry_run(&schedule, &settings);
+        let schedule = GaitSchedule::new(&config.robot, config.settings.servos.len())?;
+        return dry_run(&schedule, &config.settings);
     }
     if let Some(p) = &args.log {
         check_parent_exists(p)?;
     }
-    let (ground, _) = sandslope::Scenario::new(robot.clone(), terrain.clone(), None, None)?.ground_at(slope);
-    let k_n = ground.k_n;
-    // The live monitor's grid of simulated stance profiles at this slope (before anything moves).
-    let monitoring = args.live || args.stop_on_risk.is_some();
-    let grid = if monitoring {
-        let inference = CurrentInferenceSettings { simulated_strides: 6, ..Default::default() };
-        Some(model_grid(&robot, k_n, args.slope, &inference).map_err(|e| anyhow!("live estimate: {e}"))?)
-    } else {
-        None
-    };
-    // The bus: an emulator on a pty, or the port.
-    let mut emulator = None;
-    let port = if args.emulate {
-        let emulated_terrain = match args.emulate_k_s {
-            Some(k) => {
-                sandslope::Terrain::constant(k_n, k).map_err(|e| anyhow!("{}", e.renamed("--emulate-k-s")))?
-            }
-            None => sandslope::Terrain::constant(k_n, ground.k_s)?,
-        };
-        let mut cfg = EmulatorConfig::new(robot.clone(), emulated_terrain, args.slope, servos.clone());
-        cfg.current_noise_ma = args.emulate_noise;
-        cfg.seed = args.emulate_seed;
-        cfg.faults = faults;
-        let (emu, port) = Emulator::start(&cfg).map_err(|e| anyhow!("--emulate: {e}"))?;
-        emulator = Some(emu);
-        port
-    } else {
-        let path = args.port.as_ref().expect("clap requires --port");
-        serial2::SerialPort::open(path, baud).map_err(|e| {
-            anyhow!(
-                "cannot open the serial port {}: {e}. Fix: plug in the U2D2 (or other Protocol 2.0 adapter) and check the path (ls /dev/ttyUSB* /dev/ttyACM*), that you may use it (the dialout group), or try --emulate",
-                path.display()
-            )
-        })?
-    };
-    let mut bus =
-        dynamixel2::Bus::new(port).map_err(|e| anyhow!("cannot configure the serial port: {e:?}"))?;
+    // The live monitor's grid of simulated stance profiles and the bus (the emulator's
+    // simulated walk), before anything moves.
+    let mut session = Session::open(config)?;
     // Ctrl-C from here on stops the gait and turns the torque off rather than ending the process.
     crate::error::DRIVING.store(true, Ordering::SeqCst);
-    // The setup above (the emulator's and the monitor's simulated walks) can take seconds; say
-    // when the servos are about to move and how to stop them.
+    // The setup above can take seconds; say when the servos are about to move and how to stop them.
+    let servos = session.config().settings.servos.clone();
     eprintln!(
         "driving {} servos for {} s: Ctrl-C stops the gait and turns the torque off",
         servos.len(),
-        args.duration
+        args.run.duration
     );
-    let noise_sd = xl330::torque_from_current(if args.emulate { args.emulate_noise.max(1.0) } else { 10.0 });
-    let monitor = grid.as_ref().map(|g| Monitor { robot: &robot, grid: g, noise_sd_n_m: noise_sd });
+    let schedule = &session.schedule;
     let meta = vec![
         ("robot", args.robot.robot.clone()),
         ("terrain", args.terrain.terrain.clone()),
-        ("slope_deg", format!("{}", args.slope)),
-        ("k_n", format!("{k_n}")),
+        ("slope_deg", format!("{}", args.run.slope)),
+        ("k_n", format!("{}", session.k_n)),
         ("leg_speed_rad_s", format!("{}", schedule.leg_speed_rad_s)),
         ("period_s", format!("{}", schedule.period_s)),
         ("run_up_s", format!("{}", schedule.run_up_s)),
@@ -308,8 +326,8 @@ pub fn run(args: DriveArgs) -> Result<()> {
             "zero_offsets",
             servos.iter().map(|s| s.zero_offset_pulses.to_string()).collect::<Vec<_>>().join(" "),
         ),
-        ("profile", format!("{:?}", settings.profile).to_lowercase()),
-        ("emulated", args.emulate.to_string()),
+        ("profile", format!("{:?}", session.config().settings.profile).to_lowercase()),
+        ("emulated", session.emulated().to_string()),
     ];
     let quiet = args.json;
     let mut on_live = |l: &LiveEstimate| {
@@ -328,15 +346,7 @@ pub fn run(args: DriveArgs) -> Result<()> {
             write_output(path, |file| {
                 let mut log = ServoLogWriter::new(std::io::BufWriter::new(file), &meta)?;
                 let mut on_sample = |s: &ServoSample| log.write(&row(s));
-                let r = drive(
-                    &mut bus,
-                    &schedule,
-                    &settings,
-                    monitor.clone(),
-                    stop,
-                    &mut on_sample,
-                    &mut on_live,
-                );
+                let r = session.drive(stop, &mut on_sample, &mut on_live);
                 // The log is the record of what happened: flushed and kept on every exit.
                 log.finish().map_err(|e| sandslope_io::WriteError { path: path.clone(), source: e })?;
                 outcome = Some(r);
@@ -344,35 +354,11 @@ pub fn run(args: DriveArgs) -> Result<()> {
             })?;
             outcome.expect("set in the closure")
         }
-        None => drive(&mut bus, &schedule, &settings, monitor.clone(), stop, &mut |_| Ok(()), &mut on_live),
+        None => session.drive(stop, &mut |_| Ok(()), &mut on_live),
     };
     crate::error::DRIVING.store(false, Ordering::SeqCst);
-    drop(bus);
-    if let Some(emu) = emulator {
-        let r = emu.stop();
-        let on: Vec<String> =
-            r.torque_enabled.iter().filter(|(_, on)| *on).map(|(id, _)| id.to_string()).collect();
-        let fired: Vec<String> = r
-            .watchdog
-            .iter()
-            .filter(|(_, w)| *w == t::WATCHDOG_FIRED)
-            .map(|(id, _)| id.to_string())
-            .collect();
-        eprintln!(
-            "emulator: torque {}{} ({} packets, {} with a bad CRC)",
-            if on.is_empty() {
-                "off on every servo".to_string()
-            } else {
-                format!("still ON on servos {}", on.join(", "))
-            },
-            if fired.is_empty() {
-                String::new()
-            } else {
-                format!("; Bus Watchdog fired on servos {} (stopped)", fired.join(", "))
-            },
-            r.packets,
-            r.bad_crc
-        );
+    if let Some(r) = session.close() {
+        eprintln!("{}", emulator_summary(&r));
     }
     summarise(&report, quiet)?;
     if args.json {
@@ -392,8 +378,8 @@ pub fn run(args: DriveArgs) -> Result<()> {
             code: EXIT_HALTED,
             message: format!(
                 "--stop-on-risk: halted at t = {time_s:.2} s, P(fail) = {p_fail:.3} > {}; the legs were held {} s, then the torque was turned off",
-                args.stop_on_risk.unwrap_or(1.0),
-                args.hold
+                args.run.stop_on_risk.unwrap_or(1.0),
+                args.run.hold
             ),
         }
         .into()),

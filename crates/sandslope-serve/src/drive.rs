@@ -1,0 +1,271 @@
+//! `serve --drive`: the robot driven while the explorer shows the run (docs/drive.md, "Watching
+//! a run in the explorer").
+//!
+//! The run is the one `sandslope drive` makes: the server is handed the same typed
+//! [`DriveConfig`] the CLI's flags are translated into, opens it into a
+//! [`Session`] before it listens (the monitor's grid, the bus), and drives it once on a thread
+//! of its own, so the server's pools and timeouts are those of every other run. What the page
+//! reads:
+//! - `GET /api/drive/status`: a [`DriveStatus`], whose `live` is the last per-stance record
+//!   exactly as `drive --json`'s `live` list holds it;
+//! - `POST /api/drive/stop`: the operator's stop, the path the CLI's Ctrl-C takes (the gait
+//!   stops, the torque is turned off and read back).
+//!
+//! When the process is asked to end (the CLI's signal handler sets [`DriveThread`]'s `stop`
+//! while `driving` is set), or the server fails, the gait is stopped and the torque turned off
+//! before the process ends.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
+
+use serde::Serialize;
+
+use sandslope_servo::driver::{DriveReport, LiveEstimate, ServoSample, TorqueOff};
+use sandslope_servo::session::{emulator_summary, DriveConfig, Session};
+use sandslope_servo::{DriveError, DriveOutcome};
+
+use crate::reply::{json, ApiError};
+
+/// The window over which a leg's speed is measured from its positions, s.
+pub const LEG_SPEED_WINDOW_S: f64 = 0.25;
+
+/// What a served run is doing, as `/api/drive/status` answers it.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct DriveStatus {
+    /// `off` (the server drives no robot), `standing` (torque on, legs to the start pose), `driving`, then how it ended:
+    /// `completed`, `interrupted` (the stop button or the process ending), `halted`
+    /// (`--stop-on-risk`) or `failed` (a bus fault: `error` says which servo and the fix).
+    pub state: &'static str,
+    /// Gait time of the last cycle, s (negative while standing up).
+    pub time_s: f64,
+    /// Bus cycles run.
+    pub cycles: usize,
+    /// The gait's duration, s.
+    pub duration_s: f64,
+    /// The slope climbed, degrees.
+    pub slope_deg: f64,
+    /// Whether the bus is the emulator's.
+    pub emulated: bool,
+    /// Commanded leg speed omega, rad/s (the robot file's).
+    pub commanded_leg_speed_rad_s: f64,
+    /// Measured leg speed, rad/s: the mean over the legs of each one's turn over the last
+    /// quarter second, from Present Position.
+    pub leg_speed_rad_s: f64,
+    /// `--stop-on-risk`'s threshold on P(fail), if set.
+    pub stop_on_risk: Option<f64>,
+    /// Whether `--stop-on-risk` halted the gait (torque held, legs planted, then torque off).
+    pub halted: bool,
+    /// The last live estimate (one per stance), the record `drive --json` lists under `live`.
+    pub live: Option<LiveEstimate>,
+    /// Live estimates so far.
+    pub estimates: usize,
+    /// The run's error (which servo, and the fix), once it failed.
+    pub error: Option<String>,
+    /// The torque read back on the way out, once the run ended.
+    pub torque_off: Option<TorqueOff>,
+    /// The emulator's own tables on the way out (`emulator: torque off on every servo`).
+    pub emulator: Option<String>,
+}
+
+/// The served run: its status, and the flag the stop button sets.
+#[derive(Debug, Default)]
+pub struct LiveDrive {
+    status: Mutex<DriveStatus>,
+    stop: AtomicBool,
+}
+
+impl LiveDrive {
+    fn update(&self, f: impl FnOnce(&mut DriveStatus)) {
+        f(&mut self.status.lock().unwrap_or_else(PoisonError::into_inner));
+    }
+
+    /// A copy of the status now.
+    pub fn status(&self) -> DriveStatus {
+        self.status.lock().unwrap_or_else(PoisonError::into_inner).clone()
+    }
+}
+
+/// Answers `/api/drive/<name>`: `status` (GET) and `stop` (POST). Without a served run the
+/// status is `{"state": "off", ...}` (the page asks at every load and hides its Drive tab) and
+/// a stop is a 404.
+/// The body is pretty JSON, as `--json` prints.
+pub fn answer(name: &str, post: bool, drive: Option<&LiveDrive>) -> Result<Vec<u8>, ApiError> {
+    let Some(drive) = drive else {
+        if name == "status" {
+            return json(&DriveStatus { state: "off", ..Default::default() });
+        }
+        return Err(ApiError {
+            status: 404,
+            field: None,
+            error: "no robot is driven: start the server with --drive (and --drive-port PATH or --emulate)"
+                .into(),
+        });
+    };
+    match (name, post) {
+        ("status", _) => json(&drive.status()),
+        ("stop", true) => {
+            drive.stop.store(true, Ordering::SeqCst);
+            json(&serde_json::json!({ "stopping": true }))
+        }
+        ("stop", false) => Err(ApiError {
+            status: 405,
+            field: None,
+            error: "/api/drive/stop stops the robot: send it as a POST".into(),
+        }),
+        _ => Err(ApiError {
+            status: 404,
+            field: None,
+            error: format!("no page /api/drive/{name}: /api/drive/status and /api/drive/stop"),
+        }),
+    }
+}
+
+/// The thread that drives a served run.
+pub struct DriveThread {
+    /// What the page reads.
+    pub live: Arc<LiveDrive>,
+    handle: Option<JoinHandle<()>>,
+    /// Set by the process's signal handler (the CLI's Ctrl-C flag).
+    stop: &'static AtomicBool,
+}
+
+/// Flags shared with the process's signal handler: the handler sets `stop` instead of ending
+/// the process while `driving` is set, and the drive thread ends the process (exit 130) once
+/// the torque is off.
+#[derive(Debug, Clone, Copy)]
+pub struct SignalFlags {
+    /// Set by a signal while driving.
+    pub stop: &'static AtomicBool,
+    /// Set while the servos may have torque on.
+    pub driving: &'static AtomicBool,
+}
+
+impl DriveThread {
+    /// Starts driving an opened session on a thread of its own.
+    pub fn start(session: Session, flags: SignalFlags) -> std::io::Result<DriveThread> {
+        let config: &DriveConfig = session.config();
+        let live = Arc::new(LiveDrive {
+            status: Mutex::new(DriveStatus {
+                state: "standing",
+                duration_s: config.settings.duration_s,
+                slope_deg: config.slope_deg,
+                emulated: session.emulated(),
+                commanded_leg_speed_rad_s: session.schedule.leg_speed_rad_s,
+                stop_on_risk: config.settings.stop_on_risk,
+                time_s: -config.settings.stand_s,
+                ..Default::default()
+            }),
+            stop: AtomicBool::new(false),
+        });
+        flags.driving.store(true, Ordering::SeqCst);
+        let shared = Arc::clone(&live);
+        let handle = std::thread::Builder::new()
+            .name("drive".into())
+            .spawn(move || run(session, &shared, flags))
+            .inspect_err(|_| flags.driving.store(false, Ordering::SeqCst))?;
+        Ok(DriveThread { live, handle: Some(handle), stop: flags.stop })
+    }
+
+    /// Stops the gait (as Ctrl-C does) and waits until the torque is off.
+    pub fn stop_and_join(mut self) {
+        self.stop.store(true, Ordering::SeqCst);
+        self.live.stop.store(true, Ordering::SeqCst);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// The drive thread: the run, its status kept for the page, torque off, then (after a
+/// signal) the end of the process.
+fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags) {
+    // Either flag stops the gait: the stop button's or the signal handler's.
+    let stop = AtomicBool::new(false);
+    // Each leg's speed from its positions a quarter second apart (Present Velocity, read just
+    // after each cycle's new goal, is the position loop's peak, not the leg's mean speed).
+    let legs = session.config().settings.servos.len();
+    let mut anchor: Vec<Option<(f64, f64)>> = vec![None; legs];
+    let mut speeds: Vec<Option<f64>> = vec![None; legs];
+    let mut on_sample = |s: &ServoSample| {
+        if live.stop.load(Ordering::Relaxed) || flags.stop.load(Ordering::Relaxed) {
+            stop.store(true, Ordering::Relaxed);
+        }
+        if let Some(j) = (s.leg < legs).then_some(s.leg) {
+            match anchor[j] {
+                Some((t0, a0)) if s.time_s - t0 >= LEG_SPEED_WINDOW_S => {
+                    speeds[j] = Some((s.leg_angle_rad - a0) / (s.time_s - t0));
+                    anchor[j] = Some((s.time_s, s.leg_angle_rad));
+                }
+                Some(_) => {}
+                None => anchor[j] = Some((s.time_s, s.leg_angle_rad)),
+            }
+        }
+        let known: Vec<f64> = speeds.iter().flatten().copied().collect();
+        live.update(|st| {
+            if s.leg == 0 {
+                st.cycles += 1;
+            }
+            st.time_s = s.time_s;
+            if st.state == "standing" && s.time_s >= 0.0 {
+                st.state = "driving";
+            }
+            if !known.is_empty() {
+                st.leg_speed_rad_s = known.iter().sum::<f64>() / known.len() as f64;
+            }
+        });
+        Ok(())
+    };
+    let mut on_live = |l: &LiveEstimate| {
+        live.update(|st| {
+            st.estimates += 1;
+            if let Some(p) = st.stop_on_risk {
+                st.halted |= l.inference.p_fail > p;
+            }
+            st.live = Some(l.clone());
+        });
+    };
+    let (report, failure) = session.drive(&stop, &mut on_sample, &mut on_live);
+    let emulator = session.close().map(|r| emulator_summary(&r));
+    finish(live, &report, failure.as_ref(), emulator);
+    flags.driving.store(false, Ordering::SeqCst);
+    if flags.stop.load(Ordering::SeqCst) && !live.stop.load(Ordering::SeqCst) {
+        // A signal asked the process to end: the torque is off, so it may.
+        eprintln!("interrupted: the gait was stopped and the torque turned off");
+        std::process::exit(130);
+    }
+}
+
+/// The run's end in the status, and on stderr as `drive` says it.
+fn finish(live: &LiveDrive, report: &DriveReport, failure: Option<&DriveError>, emulator: Option<String>) {
+    let off = &report.torque_off;
+    let list = |ids: &[u8]| ids.iter().map(u8::to_string).collect::<Vec<_>>().join(", ");
+    eprintln!(
+        "drive: {} cycles; torque off confirmed on servos {}{}",
+        report.cycles,
+        if off.confirmed.is_empty() { "none".into() } else { list(&off.confirmed) },
+        if off.unconfirmed.is_empty() {
+            String::new()
+        } else {
+            format!(" (NOT confirmed on {}: their Bus Watchdog stops them)", list(&off.unconfirmed))
+        }
+    );
+    if let Some(e) = failure {
+        eprintln!("drive: {e}");
+    }
+    if let Some(e) = &emulator {
+        eprintln!("{e}");
+    }
+    live.update(|st| {
+        st.state = match (&report.outcome, failure) {
+            (_, Some(_)) | (Err(_), _) => "failed",
+            (Ok(DriveOutcome::Completed { .. }), None) => "completed",
+            (Ok(DriveOutcome::Interrupted { .. }), None) => "interrupted",
+            (Ok(DriveOutcome::Halted { .. }), None) => "halted",
+        };
+        st.halted = matches!(report.outcome, Ok(DriveOutcome::Halted { .. }));
+        st.error = failure.map(ToString::to_string);
+        st.torque_off = Some(off.clone());
+        st.emulator = emulator;
+    });
+}

@@ -1,0 +1,77 @@
+// The Drive tab (`serve --drive`, docs/drive.md): the run the server drives, polled from
+// /api/drive/status while it runs (the same per-stance record `drive --json` lists under
+// `live`), and a stop button that takes the CLI's Ctrl-C path (gait stopped, torque off).
+// Loaded after app.js, whose `$`, `get`, `busy`, `logError` and `showTab` it uses.
+const DRIVE_POLL_MS = 500;
+const DRIVE_FINAL = ["completed", "interrupted", "halted", "failed"];
+
+function sci(v) {
+  return v === null || v === undefined ? "-" : Number(v).toExponential(2);
+}
+function prob(v) {
+  if (v === null || v === undefined) return "-";
+  return v < 0.001 ? "< 0.001" : v.toFixed(3);
+}
+function showDrive(st) {
+  const tab = $("drive");
+  tab.dataset.state = st.state;
+  $("drive-state").textContent = st.state + (st.emulated ? " (emulated bus)" : "");
+  $("drive-time").textContent = `${st.time_s.toFixed(2)} / ${st.duration_s}`;
+  $("drive-speed").textContent = `${st.leg_speed_rad_s.toFixed(2)} (${st.commanded_leg_speed_rad_s.toFixed(2)})`;
+  $("drive-slope").textContent = String(st.slope_deg);
+  const live = st.live && st.live.inference;
+  const ks = $("drive-k-s");
+  ks.textContent = live ? `${sci(live.k_s)} [${sci(live.k_s_lo)} – ${sci(live.k_s_hi)}]` : "-";
+  for (const [key, id] of [["k_s", "drive-k-s"], ["p_slippage", "drive-p-slippage"], ["p_fail", "drive-p-fail"]]) {
+    if (live) $(id).dataset.value = String(live[key]);
+  }
+  if (live) ks.dataset.lo = String(live.k_s_lo), (ks.dataset.hi = String(live.k_s_hi));
+  $("drive-p-slippage").textContent = live ? prob(live.p_slippage) : "-";
+  $("drive-p-fail").textContent = live ? prob(live.p_fail) : "-";
+  $("drive-estimates").textContent = live
+    ? `${st.estimates} stances; the last, tripod ${st.live.tripod}, ended at t = ${st.live.time_s.toFixed(2)} s`
+    : "no stance finished yet";
+  const halt = st.stop_on_risk === null ? "off" : `P(fail) > ${st.stop_on_risk}`;
+  $("drive-halted").textContent = st.halted ? `halted (${halt})` : st.stop_on_risk === null ? "no halt set" : `not halted (${halt})`;
+  $("drive-halted").dataset.halted = String(st.halted);
+  const ended = DRIVE_FINAL.includes(st.state);
+  $("drive-stop").disabled = ended;
+  const off = st.torque_off;
+  let end = "";
+  if (st.error) end += `${st.error}. `;
+  if (off) end += `Torque off confirmed on servos ${off.confirmed.join(", ") || "none"}` +
+    (off.unconfirmed.length ? `; NOT confirmed on ${off.unconfirmed.join(", ")} (their Bus Watchdog stops them)` : "") + ". ";
+  if (st.emulator) end += st.emulator;
+  $("drive-end").textContent = end;
+  return ended;
+}
+async function pollDrive() {
+  let ended = false;
+  try {
+    ended = showDrive(await get("/api/drive/status"));
+  } catch (e) {
+    logError(`drive: ${e.message || e}`);
+    return;
+  }
+  if (!ended) setTimeout(pollDrive, DRIVE_POLL_MS);
+}
+async function stopDrive() {
+  $("drive-stop").disabled = true;
+  busy(1);
+  try {
+    const r = await fetch("/api/drive/stop", { method: "POST" });
+    if (!r.ok) logError(`drive stop: ${(await r.json()).error}`);
+  } finally {
+    busy(-1);
+  }
+}
+async function startDrive() {
+  // Only a server started with --drive has a run: the tab stays hidden otherwise ("off").
+  const first = await get("/api/drive/status");
+  if (first.state === "off") return;
+  document.querySelector('#tabs button[data-tab="drive"]').hidden = false;
+  $("drive-stop").addEventListener("click", stopDrive);
+  if (new URLSearchParams(location.search).get("tab") === "drive") showTab("drive");
+  if (!showDrive(first)) setTimeout(pollDrive, DRIVE_POLL_MS);
+}
+startDrive().catch((e) => logError(`drive: ${e.stack || e}`));

@@ -1,0 +1,217 @@
+//! One run of the robot as every front end starts it: the typed [`DriveConfig`] that `sandslope
+//! drive`'s flags and `sandslope serve --drive`'s are translated into, opened into a
+//! [`Session`] (the live monitor's grid simulated, the bus opened or the emulator started,
+//! before anything moves), driven once, and closed (the emulator's own tables read back).
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+
+use sandslope::infer::servo::{model_grid, CurrentInferenceSettings, ModelGrid};
+use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::{Robot, Scenario, Slope, Terrain};
+
+use crate::driver::{drive, DriveError, DriveReport, DynamixelBus, LiveEstimate, Monitor, ServoSample};
+use crate::emulator::{Emulator, EmulatorConfig, EmulatorFaults, EmulatorReport};
+use crate::DriveSettings;
+
+/// Where the servos are.
+#[derive(Debug, Clone)]
+pub enum BusChoice {
+    /// A Protocol 2.0 adapter's serial port at a baud rate.
+    Port {
+        /// `/dev/ttyUSB0`, `COM3`, ...
+        path: PathBuf,
+        /// Baud rate.
+        baud: u32,
+    },
+    /// A bus of virtual XL330s on a pseudo-terminal.
+    Emulate(EmulateOptions),
+}
+
+/// The emulator's sand and faults (`--emulate-*`).
+#[derive(Debug, Clone, Default)]
+pub struct EmulateOptions {
+    /// The sand's k_s, N/m^3; `None`: the terrain's at the slope.
+    pub k_s: Option<f64>,
+    /// Present Current noise, mA (standard deviation).
+    pub noise_ma: f64,
+    /// Seed of the noise.
+    pub seed: u64,
+    /// Mid-run weakening and bus faults.
+    pub faults: EmulatorFaults,
+}
+
+/// Everything one run needs, checked by the front end that built it.
+#[derive(Debug, Clone)]
+pub struct DriveConfig {
+    /// The robot (its gait timing; its mass and legs for the live estimate).
+    pub robot: Robot,
+    /// The terrain: k_n at the slope for the live estimate, and the emulated sand's default.
+    pub terrain: Terrain,
+    /// The slope climbed, degrees.
+    pub slope_deg: f64,
+    /// The driver's settings (servos in leg order, profile, duration, limits, halt on risk).
+    pub settings: DriveSettings,
+    /// The bus.
+    pub bus: BusChoice,
+    /// Estimate k_s and the risk after every stance (implied by `settings.stop_on_risk`).
+    pub monitor: bool,
+}
+
+/// Why a run could not start (nothing was sent to a servo).
+#[derive(Debug, thiserror::Error)]
+pub enum SessionError {
+    /// The robot's gait or the terrain at the slope is unusable.
+    #[error("{0}")]
+    Setting(String),
+    /// The live monitor's simulated grid failed.
+    #[error("live estimate: {0}")]
+    Grid(String),
+    /// The emulator did not start.
+    #[error("--emulate: {0}")]
+    Emulator(String),
+    /// The port could not be opened.
+    #[error("cannot open the serial port {path}: {reason}. Fix: plug in the U2D2 (or other Protocol 2.0 adapter) and check the path (ls /dev/ttyUSB* /dev/ttyACM*), that you may use it (the dialout group), or try --emulate")]
+    Port {
+        /// The port.
+        path: PathBuf,
+        /// The system's error.
+        reason: String,
+    },
+    /// The port opened but could not be configured.
+    #[error("cannot configure the serial port: {0}")]
+    Bus(String),
+}
+
+/// An opened run: the bus ready, the monitor's grid simulated.
+pub struct Session {
+    config: DriveConfig,
+    /// The commanded gait.
+    pub schedule: GaitSchedule,
+    /// The terrain's k_n at the slope, N/m^3.
+    pub k_n: f64,
+    grid: Option<ModelGrid>,
+    bus: DynamixelBus,
+    emulator: Option<Emulator>,
+}
+
+impl std::fmt::Debug for Session {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Session").field("k_n", &self.k_n).field("emulated", &self.emulator.is_some()).finish()
+    }
+}
+
+impl Session {
+    /// Prepares the run: the schedule, the terrain at the slope, the monitor's grid of
+    /// simulated stances (seconds of CPU), then the emulator or the port. Nothing moves yet.
+    pub fn open(config: DriveConfig) -> Result<Session, SessionError> {
+        let legs = config.settings.servos.len();
+        let schedule =
+            GaitSchedule::new(&config.robot, legs).map_err(|e| SessionError::Setting(e.to_string()))?;
+        let slope = Slope::from_signed_degrees(config.slope_deg)
+            .map_err(|e| SessionError::Setting(e.renamed("--slope").to_string()))?;
+        let (ground, _) = Scenario::new(config.robot.clone(), config.terrain.clone(), None, None)
+            .map_err(|e| SessionError::Setting(e.to_string()))?
+            .ground_at(slope);
+        let k_n = ground.k_n;
+        let grid = if config.monitor || config.settings.stop_on_risk.is_some() {
+            let inference = CurrentInferenceSettings { simulated_strides: 6, ..Default::default() };
+            Some(
+                model_grid(&config.robot, k_n, config.slope_deg, &inference)
+                    .map_err(|e| SessionError::Grid(e.to_string()))?,
+            )
+        } else {
+            None
+        };
+        let (port, emulator) = match &config.bus {
+            BusChoice::Emulate(o) => {
+                let k_s = o.k_s.unwrap_or(ground.k_s);
+                let sand = Terrain::constant(k_n, k_s)
+                    .map_err(|e| SessionError::Setting(e.renamed("--emulate-k-s").to_string()))?;
+                let mut cfg = EmulatorConfig::new(
+                    config.robot.clone(),
+                    sand,
+                    config.slope_deg,
+                    config.settings.servos.clone(),
+                );
+                cfg.current_noise_ma = o.noise_ma;
+                cfg.seed = o.seed;
+                cfg.faults = o.faults;
+                let (emu, port) = Emulator::start(&cfg).map_err(|e| SessionError::Emulator(e.to_string()))?;
+                (port, Some(emu))
+            }
+            BusChoice::Port { path, baud } => {
+                let port = serial2::SerialPort::open(path, *baud)
+                    .map_err(|e| SessionError::Port { path: path.clone(), reason: e.to_string() })?;
+                (port, None)
+            }
+        };
+        let bus = dynamixel2::Bus::new(port).map_err(|e| SessionError::Bus(format!("{e:?}")))?;
+        Ok(Session { config, schedule, k_n, grid, bus, emulator })
+    }
+
+    /// The configuration the session was opened with.
+    pub fn config(&self) -> &DriveConfig {
+        &self.config
+    }
+
+    /// Whether the bus is the emulator's.
+    pub fn emulated(&self) -> bool {
+        self.emulator.is_some()
+    }
+
+    /// Runs the gait once (see [`drive`]): until its duration, `stop`, a halt on risk or an
+    /// error, then torque off. `on_sample` gets every servo's state every cycle, `on_live`
+    /// every stance's estimate.
+    pub fn drive(
+        &mut self,
+        stop: &AtomicBool,
+        on_sample: &mut dyn FnMut(&ServoSample) -> std::io::Result<()>,
+        on_live: &mut dyn FnMut(&LiveEstimate),
+    ) -> (DriveReport, Option<DriveError>) {
+        let noise_ma = match &self.config.bus {
+            BusChoice::Emulate(o) => o.noise_ma.max(1.0),
+            BusChoice::Port { .. } => 10.0,
+        };
+        let monitor = self.grid.as_ref().map(|g| Monitor {
+            robot: &self.config.robot,
+            grid: g,
+            noise_sd_n_m: xl330::torque_from_current(noise_ma),
+        });
+        drive(&mut self.bus, &self.schedule, &self.config.settings, monitor, stop, on_sample, on_live)
+    }
+
+    /// Closes the bus; with the emulator, stops it and returns what its servos' tables hold.
+    pub fn close(self) -> Option<EmulatorReport> {
+        drop(self.bus);
+        self.emulator.map(Emulator::stop)
+    }
+}
+
+/// The emulator's last word, as `drive` prints it: whether any servo's torque is still on,
+/// whose Bus Watchdog fired, and the packet counts.
+pub fn emulator_summary(r: &EmulatorReport) -> String {
+    let on: Vec<String> =
+        r.torque_enabled.iter().filter(|(_, on)| *on).map(|(id, _)| id.to_string()).collect();
+    let fired: Vec<String> = r
+        .watchdog
+        .iter()
+        .filter(|(_, w)| *w == crate::table::WATCHDOG_FIRED)
+        .map(|(id, _)| id.to_string())
+        .collect();
+    format!(
+        "emulator: torque {}{} ({} packets, {} with a bad CRC)",
+        if on.is_empty() {
+            "off on every servo".to_string()
+        } else {
+            format!("still ON on servos {}", on.join(", "))
+        },
+        if fired.is_empty() {
+            String::new()
+        } else {
+            format!("; Bus Watchdog fired on servos {} (stopped)", fired.join(", "))
+        },
+        r.packets,
+        r.bad_crc
+    )
+}

@@ -9,7 +9,6 @@ use sandslope_request::{grammar, RobotRequest, ScenarioRequest};
 
 use sandslope::risk::UncertainTerrain;
 use sandslope::robot_key::{RobotFlag, RobotKey};
-use sandslope::AxisScale;
 use sandslope_io::load_terrain;
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 
@@ -238,7 +237,7 @@ pub fn check_flag(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
     Ok(sandslope_request::error::check_range(flag.trim_start_matches('-'), value, lo, hi)?)
 }
 
-pub use sandslope_request::grammar::{parse_max_risk, AxisRange, SlopeSign};
+pub use sandslope_request::grammar::{parse_max_risk, SlopeSign};
 
 /// Parses a slope list given to `flag`: the one slope-list grammar of every front end
 /// ([`grammar::parse_slope_list`]: `DEG`, `DEG,DEG,...` or `MIN:MAX:N`, at most `max`).
@@ -249,18 +248,6 @@ pub fn parse_slope_list(flag: &str, text: &str, sign: SlopeSign, max: usize) -> 
 /// Checks a command-line number is finite and strictly positive, naming the flag.
 pub fn check_positive(flag: &str, value: f64) -> Result<f64> {
     Ok(sandslope_request::error::check_positive(flag.trim_start_matches('-'), value)?)
-}
-
-/// The one grammar of a grid axis, `MIN:MAX:N[:log|:lin]` ([`grammar::parse_axis_range`]);
-/// errors begin with `prefix`, whose first word is the flag.
-pub fn parse_axis_range(
-    text: &str,
-    default: AxisScale,
-    prefix: &str,
-    context: &str,
-) -> Result<Option<AxisRange>> {
-    let field = prefix.split([':', ' ']).next().unwrap_or(prefix).trim_start_matches('-');
-    Ok(grammar::parse_axis_range(field, text, default, prefix, context)?)
 }
 
 #[cfg(test)]

@@ -87,15 +87,37 @@ pub struct AxisRange {
     pub scale: AxisScale,
 }
 
+/// What a grid axis spans, which decides its spacing when none is written: the one default
+/// rule of every axis (`--help` and docs/phase-and-risk.md, docs/design.md state it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AxisQuantity {
+    /// A strength, k_n or k_s (`phase --k-n`, `risk --map --k-s`): strengths span decades, so
+    /// log spacing unless `:lin` is written.
+    Strength,
+    /// A robot quantity (`design --vary KEY=...`): they vary over less than a decade, so linear
+    /// spacing unless `:log` is written.
+    Robot,
+}
+
+impl AxisQuantity {
+    /// The spacing of an axis of this quantity when none is written.
+    pub fn default_scale(self) -> AxisScale {
+        match self {
+            AxisQuantity::Strength => AxisScale::Log,
+            AxisQuantity::Robot => AxisScale::Linear,
+        }
+    }
+}
+
 /// The one grammar of a grid axis, `MIN:MAX:N[:log|:lin]`, for every field that takes one
-/// (`k-n`, `k-s`, `design --vary KEY=...`); `default` is the spacing when none is written,
-/// stated by each use (log for strengths, linear for robot quantities). `None` when `text` is
-/// not of that shape (each use names its own forms); errors name `field`, begin with `prefix`
-/// and quote `context`.
+/// (`k-n`, `k-s`, `design --vary KEY=...`); without `:log` or `:lin` the spacing is the one
+/// rule's for `quantity` ([`AxisQuantity::default_scale`]). `None` when `text` is not of that
+/// shape (each use names its own forms); errors name `field`, begin with `prefix` and quote
+/// `context`.
 pub fn parse_axis_range(
     field: &str,
     text: &str,
-    default: AxisScale,
+    quantity: AxisQuantity,
     prefix: &str,
     context: &str,
 ) -> Result<Option<AxisRange>> {
@@ -117,7 +139,7 @@ pub fn parse_axis_range(
         )
     })?;
     let scale = match parts.get(3).map(|s| s.to_ascii_lowercase()).as_deref() {
-        None => default,
+        None => quantity.default_scale(),
         Some("log") => AxisScale::Log,
         Some("lin") | Some("linear") => AxisScale::Linear,
         Some(other) => {
@@ -130,11 +152,11 @@ pub fn parse_axis_range(
     Ok(Some(AxisRange { min, max, n, scale }))
 }
 
-/// Parses a strength axis `MIN:MAX:N[:log|:lin]` given to `field` (log spacing by default:
-/// the strengths k_n and k_s span decades), into its numbers.
+/// Parses a strength axis `MIN:MAX:N[:log|:lin]` given to `field` (log spacing unless `:lin`,
+/// [`AxisQuantity::Strength`]), into its numbers.
 pub fn parse_strength_axis(field: &str, text: &str) -> Result<AxisRange> {
     let flag = format!("--{field}");
-    parse_axis_range(field, text, AxisScale::Log, &format!("{flag}:"), text)?.ok_or_else(|| {
+    parse_axis_range(field, text, AxisQuantity::Strength, &format!("{flag}:"), text)?.ok_or_else(|| {
         RequestError::invalid(
             field,
             format!("{flag} = {text} must be MIN:MAX:N or MIN:MAX:N:log or MIN:MAX:N:lin (e.g. 1e4:1e7:400)"),

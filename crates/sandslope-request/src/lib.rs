@@ -16,6 +16,7 @@
 
 #![warn(missing_docs)]
 
+pub mod design;
 pub mod error;
 pub mod grammar;
 pub mod params;
@@ -27,6 +28,7 @@ pub mod scenario;
 pub mod simulate;
 pub mod sweep;
 
+pub use design::DesignRequest;
 pub use error::{RequestError, Result};
 pub use params::Params;
 pub use phase::PhaseRequest;

@@ -6,16 +6,15 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
-use serde::Serialize;
 
-use sandslope::design::{design_key, explore, Design, DesignGoal, DesignRange, DesignSpace, DesignStudy};
+use sandslope::design::{Design, DesignSpace, DesignStudy};
 use sandslope::risk::SafeLimit;
-use sandslope::robot_key::RobotKey;
-use sandslope::{AxisScale, Slope};
+use sandslope_request::design::DesignAnswer;
+use sandslope_request::DesignRequest;
 
-use crate::args::{parse_axis_range, parse_max_risk, RobotArgs, TerrainArgs, UncertaintyArgs};
+use crate::args::{parse_max_risk, RobotArgs, TerrainArgs, UncertaintyArgs};
 use crate::figures::design::{DesignFigure, SafeSlopeMap};
 use crate::figures::{format_of, save};
 use crate::output::{check_parent_exists, num, print_json, table, write_atomic};
@@ -25,7 +24,9 @@ use crate::progress::progress_bar;
 #[derive(Debug, Args)]
 pub struct DesignArgs {
     /// Robot keys to vary: KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE, comma-separated or repeated
-    /// (e.g. leg_radius_m=0.03:0.06:7,mass_kg=0.3:1.5:9). Keys: the robot file's (docs/model.md §2).
+    /// (e.g. leg_radius_m=0.03:0.06:7,mass_kg=0.3:1.5:9), spaced linearly unless :log (robot
+    /// quantities; the strength axes of phase and risk are log unless :lin). Keys: the robot
+    /// file's (docs/model.md §2).
     #[arg(long, value_name = "KEY=MIN:MAX:N[:log],...", required = true)]
     pub vary: Vec<String>,
     /// The mission's target slope, degrees: speed, regime, p_fail and k_s margin are reported there.
@@ -54,108 +55,24 @@ pub struct DesignArgs {
     pub show: usize,
 }
 
-/// Parses one `KEY=MIN:MAX:N[:log|:lin]` or `KEY=VALUE` item of `--vary`.
-pub fn parse_vary_item(item: &str) -> Result<DesignRange> {
-    let (key, range) = item
-        .split_once('=')
-        .ok_or_else(|| anyhow!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"))?;
-    let key = design_key(key.trim()).map_err(|e| anyhow!("--vary: {e}"))?;
-    // Robot quantities vary over less than a decade: linear spacing unless `:log` is written.
-    let (min, max, n, scale) = if range.contains(':') {
-        let r = parse_axis_range(range, AxisScale::Linear, &format!("--vary: {key}"), item)?
-            .ok_or_else(|| anyhow!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"))?;
-        if r.n < 2 {
-            bail!("--vary: {key} N `{}` must be a whole number of at least 2 (in {item})", r.n);
+impl DesignArgs {
+    /// The request these flags make.
+    pub fn request(&self) -> DesignRequest {
+        DesignRequest {
+            vary: self.vary.clone(),
+            slope_target: self.slope_target,
+            robot: self.robot.request(),
+            terrain: self.terrain.terrain.clone(),
+            cv_n: self.uncertainty.cv_n,
+            cv_s: self.uncertainty.cv_s,
+            max_risk: self.max_risk,
         }
-        (r.min, r.max, r.n, r.scale)
-    } else {
-        let v = range.trim();
-        let v =
-            v.parse::<f64>().map_err(|_| anyhow!("--vary: {key} value `{v}` is not a number (in {item})"))?;
-        (v, v, 1, AxisScale::Linear)
-    };
-    DesignRange::new(key, min, max, n, scale).map_err(|e| anyhow!("--vary: {e}"))
-}
-
-/// One design as printed by `--json`.
-#[derive(Debug, Serialize)]
-struct DesignRecord {
-    params: BTreeMap<&'static str, f64>,
-    valid: bool,
-    /// Why the robot is not valid (docs/model.md §2), null when it is.
-    invalid_reason: Option<String>,
-    safe_slope_deg: Option<f64>,
-    /// `limit`, `repose` (up to the angle of repose), `none_safe` (not even level ground) or
-    /// `beyond_range` (every slope searched).
-    safe_limit: Option<&'static str>,
-    speed_m_s: Option<f64>,
-    p_fail: Option<f64>,
-    regime: Option<&'static str>,
-    k_s_margin: Option<f64>,
-    pareto: bool,
-}
-
-#[derive(Debug, Serialize)]
-struct StudyRecord {
-    slope_target_deg: f64,
-    max_risk: f64,
-    designs_evaluated: usize,
-    invalid: usize,
-    notes: Vec<String>,
-    template: DesignRecord,
-    designs: Vec<DesignRecord>,
-}
-
-fn limit_kind(l: &SafeLimit) -> &'static str {
-    l.kind()
-}
-
-fn record(keys: &[RobotKey], d: &Design) -> DesignRecord {
-    let params = keys.iter().zip(&d.params).map(|(k, v)| (k.name(), *v)).collect();
-    match &d.outcome {
-        Ok(p) => DesignRecord {
-            params,
-            valid: true,
-            invalid_reason: None,
-            safe_slope_deg: p.safe_slope_deg,
-            safe_limit: Some(limit_kind(&p.safe_limit)),
-            speed_m_s: p.speed_m_s,
-            p_fail: Some(p.p_fail),
-            regime: Some(p.regime.name()),
-            k_s_margin: p.k_s_margin,
-            pareto: d.pareto,
-        },
-        Err(reason) => DesignRecord {
-            params,
-            valid: false,
-            invalid_reason: Some(reason.clone()),
-            safe_slope_deg: None,
-            safe_limit: None,
-            speed_m_s: None,
-            p_fail: None,
-            regime: None,
-            k_s_margin: None,
-            pareto: false,
-        },
     }
 }
 
 /// Runs `sandslope design`.
 pub fn run(args: DesignArgs) -> Result<()> {
-    let robot = args.robot.load()?;
-    let mut ranges = Vec::new();
-    for text in &args.vary {
-        for item in text.split(',').filter(|s| !s.trim().is_empty()) {
-            ranges.push(parse_vary_item(item.trim())?);
-        }
-    }
-    let space = DesignSpace::new(robot.spec().clone(), ranges).map_err(|e| anyhow!("--vary: {e}"))?;
-    let max_risk = args.max_risk;
-    let target = Slope::from_signed_degrees(args.slope_target)
-        .map_err(|e| anyhow!("{}", e.renamed("--slope-target")))?;
-    let goal = DesignGoal::new(max_risk, target).map_err(|e| anyhow!("--max-risk: {e}"))?;
-    let (terrain, note) = args.uncertainty.apply(args.terrain.load()?)?;
-    let notes: Vec<String> = note.into_iter().collect();
+    let mut inputs = args.request().inputs()?;
     // Check every output before the work.
     if let Some(p) = &args.plot {
         format_of(p)?;
@@ -165,60 +82,24 @@ pub fn run(args: DesignArgs) -> Result<()> {
         check_parent_exists(p)?;
     }
 
-    let bar = progress_bar(space.len() as u64, args.json, "designs");
-    let study = explore(&space, &terrain, &goal, &|| bar.inc(1));
+    let bar = progress_bar(inputs.space.len() as u64, args.json, "designs");
+    let study = inputs.explore(&|| bar.inc(1));
     bar.finish_and_clear();
-    let mut notes = notes;
-    notes.extend(front_at_bounds(&study, &space));
 
     if let Some(path) = &args.csv {
         write_atomic(path, sandslope_render::tables::design_csv(&study)?.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        let name = terrain.terrain().name().map_or_else(|| args.terrain.terrain.clone(), str::to_string);
-        draw(&study, &space, &name, path)?;
+        let terrain = inputs.terrain.terrain();
+        let name = terrain.name().map_or_else(|| args.terrain.terrain.clone(), str::to_string);
+        draw(&study, &inputs.space, &name, path)?;
     }
     if args.json {
-        let keys = &study.keys;
-        return print_json(&StudyRecord {
-            slope_target_deg: study.slope_target_deg,
-            max_risk,
-            designs_evaluated: study.designs.len(),
-            invalid: study.invalid_count(),
-            notes,
-            template: record(keys, &study.template),
-            designs: study.designs.iter().map(|d| record(keys, d)).collect(),
-        });
+        return print_json(&DesignAnswer::new(&study, inputs.notes));
     }
-    print_table(&study, args.show, &notes);
+    print_table(&study, args.show, &inputs.notes);
     Ok(())
-}
-
-/// A note for each varied key whose smallest or largest value holds designs of the Pareto
-/// front: the front is then cut by the range searched, and a better design may lie beyond it.
-fn front_at_bounds(study: &DesignStudy, space: &DesignSpace) -> Vec<String> {
-    let front = study.front();
-    let mut notes = Vec::new();
-    for (i, range) in space.ranges().iter().enumerate() {
-        let values = range.values();
-        let (Some(&lo), Some(&hi)) = (values.first(), values.last()) else { continue };
-        if values.len() < 2 {
-            continue;
-        }
-        for (value, end) in [(lo, "smallest"), (hi, "largest")] {
-            let at = front.iter().filter(|d| d.params[i] == value).count();
-            if at > 0 {
-                notes.push(format!(
-                    "the Pareto front is at the bound of --vary: {at} of its {} designs have {} = {value}, the {end} value \
-                     searched; a better design may lie beyond it (widen the range to see)",
-                    front.len(),
-                    range.key().name()
-                ));
-            }
-        }
-    }
-    notes
 }
 
 fn print_table(study: &DesignStudy, show: usize, notes: &[String]) {

@@ -66,10 +66,12 @@ pub struct RiskArgs {
     /// p_fail and p_not_success over a grid of median (k_n, k_s) at the first --slope.
     #[arg(long, conflicts_with = "solve")]
     pub map: bool,
-    /// --map grid of median k_n, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 100 to x 100, 200 points).
+    /// --map grid of median k_n, N/m^3: MIN:MAX:N[:log|:lin], log unless :lin (default: terrain's / 100 to
+    /// x 100, 200 points).
     #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]", requires = "map", allow_hyphen_values = true)]
     pub k_n: Option<String>,
-    /// --map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin] (default: terrain's / 1000 to x 100, 200 points).
+    /// --map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin], log unless :lin (default: terrain's / 1000 to
+    /// x 100, 200 points).
     #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", requires = "map", allow_hyphen_values = true)]
     pub k_s: Option<String>,
     /// With --map: write NumPy arrays into this existing folder: p_fail.npy and

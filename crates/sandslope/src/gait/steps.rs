@@ -75,9 +75,13 @@ pub struct TouchdownOffset {
 /// speed at touchdown), and the paper describes the speed falling "toward zero" after
 /// lift-off until the next tripod touches down, then turning negative while the robot slips.
 /// So **(choice)** the touchdown is placed where the mean speed crosses zero downward before
-/// its minimum; if the mean never turns negative (no slip, as on level sand, where the speed
-/// rises immediately after touchdown) the touchdown is the minimum itself; if it never turns
-/// positive (the robot only slides down), it is the maximum. `None` when the tracks do not
+/// its minimum. If the mean never goes below zero by more than [`REST_FRACTION`] of its range
+/// (no slip: the robot rests until the next tripod pushes, as the stride simulator's walks do
+/// and as level sand does; the low pass's ringing can dip below zero), the touchdown is where
+/// the speed leaves that rest, rising through the minimum plus that fraction of the range
+/// (a placement at the minimum itself was up to 1.4 frames early on the simulator's walks, whose
+/// rest lasts about 50 ms); if it never turns positive (the robot only slides down), it is the
+/// maximum. `None` when the tracks do not
 /// fill every bin of the folded step (less than one step of data).
 pub fn estimate_touchdown_offset(tracks: &[SmoothTrack], step_s: f64) -> Option<TouchdownOffset> {
     let rate = tracks.first()?.frame_rate_hz;
@@ -115,8 +119,19 @@ pub fn estimate_touchdown_offset(tracks: &[SmoothTrack], step_s: f64) -> Option<
     let argmin = (0..bins).min_by(|&a, &b| mean[a].total_cmp(&mean[b]))?;
     let argmax = (0..bins).max_by(|&a, &b| mean[a].total_cmp(&mean[b]))?;
     let min = mean[argmin];
-    let offset = if min >= 0.0 {
-        vertex(argmin)
+    let range = mean[argmax] - min;
+    let offset = if min >= -REST_FRACTION * range && mean[argmax] > 0.0 {
+        // At rest before the step (no slip, or only the low pass's ringing below zero): the
+        // touchdown is where the speed leaves its rest, REST_FRACTION of the range above the
+        // minimum, walking forward from it.
+        let level = min + REST_FRACTION * range;
+        let mut j = argmin as isize;
+        while at(j + 1) < level {
+            j += 1;
+        }
+        let (a, b) = (at(j), at(j + 1));
+        let (ta, tb) = (time_of(j), time_of(j + 1));
+        ta + (tb - ta) * (level - a) / (b - a)
     } else if mean[argmax] <= 0.0 {
         vertex(argmax)
     } else {
@@ -131,6 +146,10 @@ pub fn estimate_touchdown_offset(tracks: &[SmoothTrack], step_s: f64) -> Option<
     };
     Some(TouchdownOffset { offset_s: offset.rem_euclid(step_s), min_mean_speed_m_s: min })
 }
+
+/// Below this fraction of the folded mean speed's range under zero, the minimum is rest (or
+/// the low pass's ringing), not slip.
+const REST_FRACTION: f64 = 0.1;
 
 /// Touchdown times `offset_s + k step_s` whose whole step lies inside `track`.
 pub fn touchdowns_in(track: &SmoothTrack, offset_s: f64, step_s: f64) -> Vec<f64> {

@@ -14,6 +14,11 @@ root=$PWD
 venv=${SANDSLOPE_VENV:-$root/.venv}
 python=${PYTHON:-python3}
 
+# A one-shot build: Cargo's incremental caches (GBs of target/debug/incremental, reused only by
+# the next edit-and-rebuild) are not written unless the caller asks for them
+# (CARGO_INCREMENTAL=1 bash scripts/test.sh). README.md states the disk this leaves.
+export CARGO_INCREMENTAL=${CARGO_INCREMENTAL:-0}
+
 seconds() { date +%s; }
 t0=$(seconds)
 
@@ -55,4 +60,5 @@ echo "== fuzz, short pass: 200 mutated inputs per reader, command and server tar
 FUZZ_PROFILE=debug FUZZ_TIMEOUT=60 SANDSLOPE_VENV="$venv" bash scripts/fuzz.sh 200
 t5=$(seconds)
 
+echo "== disk: target/ $(du -sh target 2>/dev/null | cut -f1), $venv $(du -sh "$venv" 2>/dev/null | cut -f1)"
 echo "== times: python tools $((t1 - t0)) s, cargo test $((t2 - t1)) s, extension build $((t3 - t2)) s, pytest $((t4 - t3)) s, fuzz $((t5 - t4)) s, total $((t5 - t0)) s"

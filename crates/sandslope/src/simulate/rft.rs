@@ -140,7 +140,31 @@ impl Rft {
             RftScaling::Components => (-s * self.zeta_x * ax, self.zeta_z * az),
         }
     }
+
+    /// Whether `force` (N) can hold an element of unit tangent `tangent` and weight `weight`
+    /// (m^3, [`super::body::Contact::weight`]) at rest: the rate-independent law is set-valued
+    /// there, and the set is the region bounded by `weight * sigma(e)` over every direction of
+    /// motion `e` (docs/model.md §17). Tested by the winding number of that closed curve,
+    /// sampled at [`SET_DIRECTIONS`] directions, about `force`.
+    pub fn holds_at_rest(&self, tangent: [f64; 2], weight: f64, force: [f64; 2]) -> bool {
+        let point = |k: usize| {
+            let a = std::f64::consts::TAU * k as f64 / SET_DIRECTIONS as f64;
+            let st = self.passive_stress(tangent[0], tangent[1], a.cos(), a.sin());
+            [weight * st.0 - force[0], weight * st.1 - force[1]]
+        };
+        let mut winding = 0.0;
+        let mut prev = point(0);
+        for k in 1..=SET_DIRECTIONS {
+            let next = point(k % SET_DIRECTIONS);
+            winding += (prev[0] * next[1] - prev[1] * next[0]).atan2(prev[0] * next[0] + prev[1] * next[1]);
+            prev = next;
+        }
+        winding.abs() > std::f64::consts::PI
+    }
 }
+
+/// Directions sampled for the set of stresses the law allows at rest ([`Rft::holds_at_rest`]).
+const SET_DIRECTIONS: usize = 360;
 
 #[cfg(test)]
 mod tests {
@@ -203,6 +227,31 @@ mod tests {
         assert!((ratio(RftScaling::Motion).atan().to_degrees() - 19.93).abs() < 0.01);
         let by_hand = (2.0 * k_s / 0.370) * 0.136 / (k_n * 0.375);
         assert!((ratio(RftScaling::Components) / by_hand - 1.0).abs() < 1e-12);
+    }
+}
+
+#[cfg(test)]
+mod rest_set_tests {
+    use super::*;
+
+    /// The set at rest, by its boundary: a horizontal plate's force straight up (what holds it
+    /// against being pushed down, k_n W d) is inside at half its size and outside at twice it;
+    /// a vertical plate held sideways likewise at 2 k_s; no force at all is inside (rest with no
+    /// load).
+    #[test]
+    fn the_rest_set_is_bounded_by_the_laws_stress_in_every_direction() {
+        let rft = Rft::new(7e5, 2e6);
+        let w = 1e-5;
+        assert!(rft.holds_at_rest([1.0, 0.0], w, [0.0, 0.5 * 7e5 * w]));
+        assert!(!rft.holds_at_rest([1.0, 0.0], w, [0.0, 2.0 * 7e5 * w]));
+        assert!(rft.holds_at_rest([0.0, 1.0], w, [-0.5 * 4e6 * w, 0.0]));
+        assert!(!rft.holds_at_rest([0.0, 1.0], w, [-2.0 * 4e6 * w, 0.0]));
+        assert!(rft.holds_at_rest([1.0, 0.0], w, [0.0, 0.0]));
+        // Lifted, a horizontal plate feels |alpha_z(0, -pi/2)| = 0.25 of the push's k_n (the
+        // generic form: 0.206 + 0.169 - 0.358 - 0.212 - 0.055): a downward force of 0.2 k_n W d
+        // holds it, 0.3 does not.
+        assert!(rft.holds_at_rest([1.0, 0.0], w, [0.0, -0.2 * 7e5 * w]));
+        assert!(!rft.holds_at_rest([1.0, 0.0], w, [0.0, -0.3 * 7e5 * w]));
     }
 }
 

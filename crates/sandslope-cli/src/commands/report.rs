@@ -153,7 +153,15 @@ pub fn run(args: ReportArgs) -> Result<()> {
         bail!("--out {}: exists and is not a folder", args.out.display());
     }
     let evidence = evidence(&args)?;
-    let report = report(&evidence).map_err(|e| anyhow!("{e}"))?;
+    // Seconds in a release build (the simulator section walks 14 slopes twice), a minute in a
+    // debug one: a spinner with the time on a terminal.
+    let spin = crate::progress::spinner(
+        false,
+        "building the report (the model, the calibration, the simulator's walks)",
+    );
+    let report = report(&evidence).map_err(|e| anyhow!("{e}"));
+    spin.finish_and_clear();
+    let report = report?;
     for w in &report.warnings {
         eprintln!("warning: {w}");
     }

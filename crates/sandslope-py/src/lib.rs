@@ -18,6 +18,7 @@ mod model;
 mod plan;
 mod report;
 mod risk;
+mod servo;
 mod simulate;
 mod types;
 
@@ -56,6 +57,9 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(measure::track, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
+    m.add_function(wrap_pyfunction!(servo::read_servo_log, m)?)?;
+    m.add_function(wrap_pyfunction!(servo::infer_servo_log, m)?)?;
+    m.add_function(wrap_pyfunction!(servo::drive, m)?)?;
     m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;
     m.add("CAUSES", sandslope::Cause::ALL.map(sandslope::Cause::name))?;
     Ok(())

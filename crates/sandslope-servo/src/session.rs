@@ -7,12 +7,17 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use sandslope::infer::servo::{model_grid, CurrentInferenceSettings, ModelGrid};
+use sandslope::infer::LogUniformPrior;
 use sandslope::servo::{xl330, GaitSchedule};
 use sandslope::{Robot, Scenario, Slope, Terrain};
 
 use crate::driver::{drive, DriveError, DriveReport, DynamixelBus, LiveEstimate, Monitor, ServoSample};
 use crate::emulator::{Emulator, EmulatorConfig, EmulatorFaults, EmulatorReport};
-use crate::DriveSettings;
+use crate::{DriveSettings, ServoConfig};
+
+/// The live monitor's log-uniform prior on k_s, N/m^3: from sand weak enough to sink the
+/// robot to the stiffest the grid's simulated walks stay reportable on.
+pub const LIVE_K_S_PRIOR: (f64, f64) = (1e4, 3e7);
 
 /// Where the servos are.
 #[derive(Debug, Clone)]
@@ -115,7 +120,11 @@ impl Session {
             .ground_at(slope);
         let k_n = ground.k_n;
         let grid = if config.monitor || config.settings.stop_on_risk.is_some() {
-            let inference = CurrentInferenceSettings { simulated_strides: 6, ..Default::default() };
+            // The prior reaches down to 1e4 N/m^3, below the library's default 3e4: sand that
+            // weak fails by sinkage at moderate slopes, and a monitor whose grid cannot hold it
+            // reads it as the weakest point it has, at the regimes' border (docs/drive.md).
+            let prior = LogUniformPrior::new(LIVE_K_S_PRIOR.0, LIVE_K_S_PRIOR.1).expect("a valid range");
+            let inference = CurrentInferenceSettings { simulated_strides: 6, prior, ..Default::default() };
             Some(
                 model_grid(&config.robot, k_n, config.slope_deg, &inference)
                     .map_err(|e| SessionError::Grid(e.to_string()))?,
@@ -186,6 +195,19 @@ impl Session {
         drop(self.bus);
         self.emulator.map(Emulator::stop)
     }
+}
+
+/// The servos of a robot file without a `[servos]` table: IDs 1 to `legs` in leg order, the
+/// first half (the left side) turning positive and the second half mirrored, zero offsets 0
+/// (docs/drive.md, "Wiring and IDs").
+pub fn default_servos(legs: usize) -> Vec<ServoConfig> {
+    (0..legs)
+        .map(|j| ServoConfig {
+            id: u8::try_from(j + 1).unwrap_or(u8::MAX),
+            direction: if j < legs / 2 { 1 } else { -1 },
+            zero_offset_pulses: 0,
+        })
+        .collect()
 }
 
 /// The emulator's last word, as `drive` prints it: whether any servo's torque is still on,

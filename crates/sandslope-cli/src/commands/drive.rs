@@ -17,7 +17,9 @@ use sandslope_io::robot_terrain::load_servos;
 use sandslope_io::servo_log::{ServoLogRow, ServoLogWriter, DEFAULT_BAUD_RATE};
 use sandslope_servo::driver::{DriveReport, LiveEstimate, ServoSample};
 use sandslope_servo::emulator::EmulatorFaults;
-use sandslope_servo::session::{emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session};
+use sandslope_servo::session::{
+    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session,
+};
 use sandslope_servo::table as t;
 use sandslope_servo::{DriveSettings, Profile, ServoConfig};
 
@@ -183,16 +185,7 @@ fn servos(robot_spec: &str, baud: Option<u32>, legs: usize) -> Result<(Vec<Servo
                 .collect::<Vec<_>>(),
             s.baud_rate,
         ),
-        None => (
-            (0..legs)
-                .map(|j| ServoConfig {
-                    id: j as u8 + 1,
-                    direction: if j < legs / 2 { 1 } else { -1 },
-                    zero_offset_pulses: 0,
-                })
-                .collect(),
-            DEFAULT_BAUD_RATE,
-        ),
+        None => (default_servos(legs), DEFAULT_BAUD_RATE),
     };
     if list.len() != legs {
         bail!(

@@ -139,7 +139,7 @@ fn bound_note(b: Bound) -> &'static str {
 
 /// `infer --servo-log`: k_s from the stance currents of a `drive` log (docs/model.md §19).
 fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
-    use sandslope::infer::servo::{infer_from_currents, model_grid, CurrentInferenceSettings, LegTrace};
+    use sandslope::infer::servo::{infer_servo_log, CurrentInferenceSettings, LegTrace};
     let robot = args.robot.load()?;
     let prior = parse_prior(&args.k_s_prior)?;
     if !(3..=1000).contains(&args.grid_points) {
@@ -153,9 +153,8 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
             path.display()
         ),
     };
-    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+    Slope::from_signed_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
     let terrain = args.terrain.load()?;
-    let k_n = sandslope::Scenario::new(robot.clone(), terrain, None, None)?.ground_at(slope).0.k_n;
     let legs = 2 * robot.stance_legs() as usize;
     let mut traces = vec![LegTrace::default(); legs];
     for (i, r) in log.rows.iter().enumerate() {
@@ -171,9 +170,13 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
         t.torque_n_m.push(r.drive_torque_n_m);
     }
     let settings = CurrentInferenceSettings { prior, grid_points: args.grid_points, ..Default::default() };
-    let grid = model_grid(&robot, k_n, slope_deg, &settings).map_err(|e| anyhow!("{e}"))?;
-    let answer =
-        infer_from_currents(&robot, &grid, &traces).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    let answer = infer_servo_log(&robot, &terrain, slope_deg, &traces, &settings).map_err(|e| match e {
+        sandslope::infer::servo::CurrentInferenceError::TooFewStrides { .. } => {
+            anyhow!("{}: {e}", path.display())
+        }
+        e => anyhow!("{e}"),
+    })?;
+    let k_n = answer.k_n;
     if args.json {
         return print_json(&answer);
     }

@@ -44,6 +44,7 @@ from ._inputs import (
     _terrain,
 )
 from ._sandslope import Robot, Terrain
+from ._servo import drive, infer_servo_log, read_servo_log
 
 __all__ = [
     "REGIMES",
@@ -65,6 +66,9 @@ __all__ = [
     "track",
     "simulate",
     "report",
+    "read_servo_log",
+    "infer_servo_log",
+    "drive",
 ]
 
 

@@ -220,5 +220,30 @@ def simulate(
     rft_scaling: str = "motion",
     servo_limit: bool = True,
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
+def read_servo_log(path: _Path) -> Tuple[Dict[str, np.ndarray], Dict[str, str]]: ...
+def infer_servo_log(
+    robot: Robot,
+    terrain: Terrain,
+    slope_deg: float,
+    leg: np.ndarray,
+    leg_angle_rad: np.ndarray,
+    drive_torque_n_m: np.ndarray,
+    k_s_prior: Tuple[float, float] = (1e4, 1e9),
+    grid_points: int = 41,
+) -> Dict[str, Any]: ...
+def drive(
+    robot: Robot,
+    terrain: Terrain,
+    slope_deg: float,
+    duration_s: float,
+    k_s: Optional[float] = None,
+    noise_ma: float = 10.0,
+    seed: int = 1,
+    weaken: Optional[Tuple[float, float]] = None,
+    stop_on_risk: Optional[float] = None,
+    hold_s: float = 2.0,
+    rate_hz: float = 50.0,
+    live: bool = True,
+) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 
 def read_touchdowns(path: _Path) -> List[float]: ...

@@ -366,6 +366,33 @@ pub fn infer_from_currents(
     Ok(posterior_answer(robot, grid, &mean, &var_obs, &bins, n))
 }
 
+/// `infer --servo-log` whole: k_n of `terrain` at `slope_deg`, the simulator's grid there, and
+/// the posterior of k_s from the legs' stance torques (`legs[j]`: leg j of the alternating
+/// tripod, 2 * stance_legs of them). The CLI reads a log into `legs`; Python passes arrays.
+pub fn infer_servo_log(
+    robot: &Robot,
+    terrain: &Terrain,
+    slope_deg: f64,
+    legs: &[LegTrace],
+    settings: &CurrentInferenceSettings,
+) -> Result<CurrentInference, CurrentInferenceError> {
+    let expected = 2 * robot.stance_legs() as usize;
+    if legs.len() != expected {
+        return Err(CurrentInferenceError::Setting(format!(
+            "{} legs given; the alternating tripod of this robot (stance_legs = {}) has {expected}",
+            legs.len(),
+            robot.stance_legs()
+        )));
+    }
+    let slope = crate::Slope::from_signed_degrees(slope_deg)
+        .map_err(|e| CurrentInferenceError::Setting(e.renamed("slope").to_string()))?;
+    let (ground, _) = Scenario::new(robot.clone(), terrain.clone(), None, None)
+        .map_err(|e| CurrentInferenceError::Setting(e.to_string()))?
+        .ground_at(slope);
+    let grid = model_grid(robot, ground.k_n, slope_deg, settings)?;
+    infer_from_currents(robot, &grid, legs)
+}
+
 /// Live update after one stance: the posterior from tripod `tripod`'s bins of one stance
 /// (`profile`, its `counts`), with `noise_sd_n_m` the torque noise of one sample.
 pub fn infer_from_stance(
@@ -431,10 +458,25 @@ fn posterior_answer(
     // neighbouring k_s): SD the larger step to a neighbour.
     // One variance for every grid point (a variance that differs between points would favour
     // the smooth stretches of the grid): the mean square of the profile's change between
-    // neighbouring grid points, bin by bin.
+    // neighbouring grid points, bin by bin, over the points whose walk a servo could report.
+    // At the stiff end of the grid (k_s >= 1.5e7 N/m^3 at 15 deg on the paper's robot) a few
+    // simulated walks spike to tens of N m in one tripod's bins (stride-to-stride SD up to
+    // 13 N m, 2026-11-28), beyond the XL330's stall torque, which no current can read; their
+    // jumps made the mean square 1e6 times the rest's for that tripod and flattened every
+    // stance of it (tripod 1's live estimates spanned the prior). They keep their own scatter
+    // in `grid.sd`.
+    let reportable = |i: usize| {
+        grid.mean[i]
+            .iter()
+            .zip(&grid.sd[i])
+            .all(|(m, sd)| m.abs() + sd <= crate::servo::xl330::STALL_TORQUE_N_M)
+    };
     let model_var: Vec<f64> = (0..mean.len())
         .map(|b| {
-            let d: Vec<f64> = (1..n).map(|i| (grid.mean[i][b] - grid.mean[i - 1][b]).powi(2)).collect();
+            let d: Vec<f64> = (1..n)
+                .filter(|&i| reportable(i) && reportable(i - 1))
+                .map(|i| (grid.mean[i][b] - grid.mean[i - 1][b]).powi(2))
+                .collect();
             d.iter().sum::<f64>() / d.len().max(1) as f64
         })
         .collect();

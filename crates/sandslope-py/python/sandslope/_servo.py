@@ -1,0 +1,133 @@
+"""The robot in the loop (docs/drive.md): servo logs, the stance-current inference of
+``sandslope infer --servo-log`` and a run of ``sandslope drive --emulate``. Imported into
+``sandslope``; the names are ``sandslope.read_servo_log``, ``sandslope.infer_servo_log`` and
+``sandslope.drive``."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Dict, Mapping, Optional, Tuple, Union
+
+import numpy as np
+
+from . import _sandslope
+from ._inputs import RobotLike, TerrainLike, _robot, _terrain
+
+#: The columns ``infer_servo_log`` reads from a log (docs/drive.md, "The log").
+SERVO_COLUMNS = ("leg", "leg_angle_rad", "drive_torque_n_m")
+
+
+def _frame(columns: Dict[str, np.ndarray]) -> Any:
+    try:
+        import pandas as pd
+    except ImportError:
+        return columns
+    return pd.DataFrame(columns)
+
+
+def read_servo_log(path: Union[str, "os.PathLike[str]"]) -> Tuple[Any, Dict[str, str]]:
+    """Reads a ``sandslope drive --log`` CSV: ``(log, meta)``, ``log`` a pandas DataFrame (a dict
+    of NumPy columns without pandas) with the log's columns, ``meta`` its ``# key = value``
+    header (``slope_deg``, ``k_n``, ``period_s``, ``ids``, ...). Errors name the file and line."""
+    columns, meta = _sandslope.read_servo_log(os.fspath(path))
+    return _frame(columns), dict(meta)
+
+
+def infer_servo_log(
+    log: Union[str, "os.PathLike[str]", Mapping[str, Any]],
+    robot: RobotLike = "paper-hexapod",
+    terrain: TerrainLike = "glass-beads-300um",
+    *,
+    slope_deg: Optional[float] = None,
+    k_s_prior: Tuple[float, float] = (1e4, 1e9),
+    grid_points: int = 41,
+) -> Dict[str, Any]:
+    """The sand's k_s at the run's slope from the servos' stance currents, as ``sandslope infer
+    --servo-log FILE --json`` (docs/model.md §19): the dict with ``k_s``, ``k_s_lo``, ``k_s_hi``
+    (the 90% interval), ``bound``, ``shear_load_n``, ``closed_form_shear_load_n``,
+    ``p_slippage``, ``p_sinkage``, ``p_fail``, ``strides``, ``posterior``, ...
+
+    ``log`` is a log's path or its columns (a DataFrame or a mapping of arrays with ``leg``,
+    ``leg_angle_rad`` and ``drive_torque_n_m``, one entry per servo per cycle, as
+    ``read_servo_log`` and ``drive`` return). ``slope_deg`` defaults to the log's
+    ``# slope_deg`` header (a path only). ``terrain`` gives k_n at the slope. The robot's
+    stride simulator walks ``grid_points`` values of k_s over ``k_s_prior`` (seconds of CPU, the
+    GIL released)."""
+    if isinstance(log, (str, os.PathLike)):
+        columns, meta = _sandslope.read_servo_log(os.fspath(log))
+        if slope_deg is None:
+            if "slope_deg" not in meta:
+                raise ValueError(
+                    f"{os.fspath(log)}: the log has no `# slope_deg = ...` header line; give slope_deg"
+                )
+            slope_deg = float(meta["slope_deg"])
+    else:
+        columns = log
+        if slope_deg is None:
+            raise ValueError("slope_deg: give the run's slope (degrees) with a log's columns")
+    missing = [c for c in SERVO_COLUMNS if c not in columns]
+    if missing:
+        raise ValueError(f"log: the column(s) {', '.join(missing)} are missing (docs/drive.md, 'The log')")
+    lo, hi = k_s_prior
+    return _sandslope.infer_servo_log(
+        _robot(robot),
+        _terrain(terrain),
+        float(slope_deg),
+        np.ascontiguousarray(columns["leg"], dtype=np.int64),
+        np.ascontiguousarray(columns["leg_angle_rad"], dtype=np.float64),
+        np.ascontiguousarray(columns["drive_torque_n_m"], dtype=np.float64),
+        k_s_prior=(float(lo), float(hi)),
+        grid_points=int(grid_points),
+    )
+
+
+def drive(
+    robot: RobotLike = "paper-hexapod",
+    terrain: TerrainLike = "glass-beads-300um",
+    slope_deg: float = 0.0,
+    duration_s: float = 10.0,
+    *,
+    emulate: bool = True,
+    k_s: Optional[float] = None,
+    noise_ma: float = 10.0,
+    seed: int = 1,
+    weaken: Optional[Tuple[float, float]] = None,
+    stop_on_risk: Optional[float] = None,
+    hold_s: float = 2.0,
+    rate_hz: float = 50.0,
+    live: bool = True,
+) -> Tuple[Any, Dict[str, Any]]:
+    """A run of ``sandslope drive --emulate`` (docs/drive.md): the robot's alternating tripod
+    sent to a bus of emulated XL330s on a pseudo-terminal, byte for byte Protocol 2.0 through
+    the same bus code as a robot, the servos' currents from the stride simulator on ``terrain``
+    at ``slope_deg`` (``k_s`` overrides the sand's, ``noise_ma`` the current noise's SD, ``seed``
+    its seed, ``weaken=(seconds, k_s)`` weakens it mid-run), with ``drive``'s defaults (position
+    profile, 1470 mA, 65 degC, a 1 s stand, the servos' IDs 1 to 6). ``live`` estimates k_s
+    after every stance; ``stop_on_risk`` halts the gait when P(fail) passes it.
+
+    Returns ``(log, report)``: ``log`` the servo log's columns (a pandas DataFrame, or a dict of
+    NumPy arrays without pandas; ``infer_servo_log`` reads it), ``report`` what ``drive --json``
+    prints (``outcome``, ``cycles``, ``rate_hz``, ``live``: one record per stance,
+    ``torque_off``) and ``emulator``, the virtual servos' last word. The run takes
+    ``duration_s`` plus a second of wall time and releases the GIL; it cannot be interrupted from
+    Python. A robot is driven from the command line (``sandslope drive --port``) only."""
+    if not emulate:
+        raise ValueError(
+            "emulate=False: sandslope.drive drives the emulator only; drive a robot with "
+            "`sandslope drive --port /dev/ttyUSB0` (its safety exits: Ctrl-C, signals, the log)"
+        )
+    columns, report = _sandslope.drive(
+        _robot(robot),
+        _terrain(terrain),
+        float(slope_deg),
+        float(duration_s),
+        k_s=None if k_s is None else float(k_s),
+        noise_ma=float(noise_ma),
+        seed=int(seed),
+        weaken=None if weaken is None else (float(weaken[0]), float(weaken[1])),
+        stop_on_risk=None if stop_on_risk is None else float(stop_on_risk),
+        hold_s=float(hold_s),
+        rate_hz=float(rate_hz),
+        live=bool(live),
+    )
+    return _frame(columns), report

@@ -1,0 +1,215 @@
+//! The robot in the loop from Python (docs/drive.md): a servo log read into NumPy columns,
+//! `infer --servo-log` on a log's arrays, and a run of `drive --emulate` (the emulator on a
+//! pseudo-terminal, driven through the same `dynamixel2` bus code as a robot) returning its log
+//! as columns and its report as `drive --json` prints it.
+
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use pythonize::pythonize;
+
+use sandslope::infer::servo::{infer_servo_log as infer, CurrentInferenceSettings, LegTrace};
+use sandslope::infer::LogUniformPrior;
+use sandslope::servo::xl330;
+use sandslope_servo::driver::ServoSample;
+use sandslope_servo::session::{
+    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session,
+};
+use sandslope_servo::{DriveSettings, EmulatorFaults, Profile};
+
+use crate::arrays::{put, values};
+use crate::types::{PyRobot, PyTerrain};
+use crate::{anyhow_error, value_error};
+
+/// Reads a `drive --log` CSV: `(columns, meta)`, `columns` the log's columns as 1-D arrays
+/// (docs/drive.md, "The log"), `meta` its `# key = value` header lines.
+#[pyfunction]
+pub fn read_servo_log<'py>(
+    py: Python<'py>,
+    path: std::path::PathBuf,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+    let log = py.detach(|| sandslope_io::servo_log::read_servo_log(&path)).map_err(anyhow_error)?;
+    let d = PyDict::new(py);
+    let r = &log.rows;
+    put(&d, "time_s", r.iter().map(|r| r.time_s).collect())?;
+    put(&d, "id", r.iter().map(|r| i64::from(r.id)).collect())?;
+    put(&d, "leg", r.iter().map(|r| r.leg as i64).collect())?;
+    put(&d, "tripod", r.iter().map(|r| r.tripod as i64).collect())?;
+    put(&d, "present_position", r.iter().map(|r| i64::from(r.present_position)).collect())?;
+    put(&d, "present_velocity", r.iter().map(|r| i64::from(r.present_velocity)).collect())?;
+    put(&d, "present_current_ma", r.iter().map(|r| i64::from(r.present_current_ma)).collect())?;
+    put(&d, "load_percent", r.iter().map(|r| r.load_percent).collect())?;
+    put(&d, "input_voltage_v", r.iter().map(|r| r.input_voltage_v).collect())?;
+    put(&d, "temperature_c", r.iter().map(|r| i64::from(r.temperature_c)).collect())?;
+    put(&d, "hardware_error", r.iter().map(|r| i64::from(r.hardware_error)).collect())?;
+    put(&d, "goal_position", r.iter().map(|r| i64::from(r.goal_position)).collect())?;
+    put(&d, "leg_angle_rad", r.iter().map(|r| r.leg_angle_rad).collect())?;
+    put(&d, "drive_torque_n_m", r.iter().map(|r| r.drive_torque_n_m).collect())?;
+    let meta = PyDict::new(py);
+    for (k, v) in &log.meta {
+        meta.set_item(k, v)?;
+    }
+    Ok((d, meta))
+}
+
+/// `infer --servo-log --json` on a log's columns: `leg` (0 to 2 * stance_legs - 1), the leg's
+/// angle in the gait's frame and its drive torque `K_t I`, one entry per servo per cycle.
+#[pyfunction]
+#[pyo3(signature = (robot, terrain, slope_deg, leg, leg_angle_rad, drive_torque_n_m, k_s_prior=(1e4, 1e9), grid_points=41))]
+#[allow(clippy::too_many_arguments)]
+pub fn infer_servo_log<'py>(
+    py: Python<'py>,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+    slope_deg: f64,
+    leg: PyReadonlyArray1<'py, i64>,
+    leg_angle_rad: PyReadonlyArray1<'py, f64>,
+    drive_torque_n_m: PyReadonlyArray1<'py, f64>,
+    k_s_prior: (f64, f64),
+    grid_points: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (leg, angle, torque) = (leg.as_slice()?.to_vec(), values(&leg_angle_rad), values(&drive_torque_n_m));
+    if leg.len() != angle.len() || leg.len() != torque.len() {
+        return Err(value_error(format!(
+            "leg, leg_angle_rad and drive_torque_n_m must have one length; they have {}, {} and {}",
+            leg.len(),
+            angle.len(),
+            torque.len()
+        )));
+    }
+    if !(3..=1000).contains(&grid_points) {
+        return Err(value_error(format!("grid_points = {grid_points} must be within 3 to 1000")));
+    }
+    let prior = LogUniformPrior::new(k_s_prior.0, k_s_prior.1)
+        .map_err(|e| value_error(format!("k_s_prior = {k_s_prior:?}: {e}")))?;
+    let legs = 2 * robot.inner.stance_legs() as usize;
+    let mut traces = vec![LegTrace::default(); legs];
+    for (i, &j) in leg.iter().enumerate() {
+        let t = usize::try_from(j).ok().and_then(|j| traces.get_mut(j)).ok_or_else(|| {
+            value_error(format!("leg[{i}] = {j}: the robot has {legs} legs (0 to {})", legs - 1))
+        })?;
+        t.angle_rad.push(angle[i]);
+        t.torque_n_m.push(torque[i]);
+    }
+    let settings = CurrentInferenceSettings { prior, grid_points, ..Default::default() };
+    let (robot, terrain) = (robot.inner.clone(), terrain.inner.clone());
+    let answer = py.detach(|| infer(&robot, &terrain, slope_deg, &traces, &settings)).map_err(value_error)?;
+    pythonize(py, &answer).map_err(value_error)
+}
+
+/// A run of `drive --emulate` with `drive`'s defaults (position profile, 1470 mA, 65 degC,
+/// watchdogs 1 s and 0.5 s, a 1 s stand): `(columns, report)`, `columns` the log's columns
+/// (as [`read_servo_log`]), `report` what `drive --json` prints, with the emulator's last word
+/// under `emulator`.
+#[pyfunction]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_s=None, noise_ma=10.0, seed=1, weaken=None, stop_on_risk=None, hold_s=2.0, rate_hz=50.0, live=true))]
+#[allow(clippy::too_many_arguments)]
+pub fn drive<'py>(
+    py: Python<'py>,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+    slope_deg: f64,
+    duration_s: f64,
+    k_s: Option<f64>,
+    noise_ma: f64,
+    seed: u64,
+    weaken: Option<(f64, f64)>,
+    stop_on_risk: Option<f64>,
+    hold_s: f64,
+    rate_hz: f64,
+    live: bool,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
+    let within = |key: &str, v: f64, lo: f64, hi: f64| {
+        if (lo..=hi).contains(&v) {
+            Ok(())
+        } else {
+            Err(value_error(format!("{key} = {v} must be within {lo} to {hi}")))
+        }
+    };
+    within("duration_s", duration_s, 0.0, 3600.0)?;
+    within("rate_hz", rate_hz, 1.0, 1000.0)?;
+    within("noise_ma", noise_ma, 0.0, 1000.0)?;
+    within("hold_s", hold_s, 0.0, 3600.0)?;
+    if let Some(p) = stop_on_risk {
+        within("stop_on_risk", p, 0.0, 1.0)?;
+    }
+    if let Some(k) = k_s {
+        sandslope::Terrain::constant(1.0, k).map_err(|e| value_error(e.renamed("k_s")))?;
+    }
+    if let Some((s, k)) = weaken {
+        if !(s >= 0.0 && s.is_finite() && k > 0.0 && k.is_finite()) {
+            return Err(value_error(format!(
+                "weaken = ({s}, {k}): (seconds at least 0, k_s above 0) expected"
+            )));
+        }
+    }
+    let legs = 2 * robot.inner.stance_legs() as usize;
+    let settings = DriveSettings {
+        servos: default_servos(legs),
+        profile: Profile::Position,
+        duration_s,
+        rate_hz,
+        current_limit_ma: 1470,
+        temperature_limit_c: 65,
+        watchdog_s: 1.0,
+        bus_watchdog_s: 0.5,
+        stop_on_risk,
+        hold_s,
+        stand_s: 1.0,
+    };
+    let faults = EmulatorFaults { weaken, ..Default::default() };
+    let config = DriveConfig {
+        robot: robot.inner.clone(),
+        terrain: terrain.inner.clone(),
+        slope_deg,
+        settings,
+        bus: BusChoice::Emulate(EmulateOptions { k_s, noise_ma, seed, faults }),
+        monitor: live,
+    };
+    let (samples, report, emulator) = py
+        .detach(move || -> Result<_, String> {
+            let mut session = Session::open(config).map_err(|e| e.to_string())?;
+            let mut samples: Vec<ServoSample> = vec![];
+            let stop = std::sync::atomic::AtomicBool::new(false);
+            let (report, _) = session.drive(
+                &stop,
+                &mut |s| {
+                    samples.push(*s);
+                    Ok(())
+                },
+                &mut |_| {},
+            );
+            let emulator = session.close().map(|r| emulator_summary(&r));
+            Ok((samples, report, emulator))
+        })
+        .map_err(value_error)?;
+    let d = PyDict::new(py);
+    let s = &samples;
+    put(&d, "time_s", s.iter().map(|s| s.time_s).collect())?;
+    put(&d, "id", s.iter().map(|s| i64::from(s.id)).collect())?;
+    put(&d, "leg", s.iter().map(|s| s.leg as i64).collect())?;
+    put(&d, "tripod", s.iter().map(|s| s.tripod as i64).collect())?;
+    put(&d, "present_position", s.iter().map(|s| i64::from(s.state.position)).collect())?;
+    put(&d, "present_velocity", s.iter().map(|s| i64::from(s.state.velocity)).collect())?;
+    put(&d, "present_current_ma", s.iter().map(|s| i64::from(s.state.current_ma)).collect())?;
+    put(
+        &d,
+        "load_percent",
+        s.iter().map(|s| 100.0 * f64::from(s.state.current_ma) / (xl330::STALL_CURRENT_A * 1000.0)).collect(),
+    )?;
+    put(
+        &d,
+        "input_voltage_v",
+        s.iter().map(|s| f64::from(s.state.voltage) * xl330::VOLT_PER_VOLTAGE_UNIT).collect(),
+    )?;
+    put(&d, "temperature_c", s.iter().map(|s| i64::from(s.state.temperature_c)).collect())?;
+    put(&d, "hardware_error", s.iter().map(|s| i64::from(s.hardware_error)).collect())?;
+    put(&d, "goal_position", s.iter().map(|s| i64::from(s.goal_position)).collect())?;
+    put(&d, "leg_angle_rad", s.iter().map(|s| s.leg_angle_rad).collect())?;
+    put(&d, "drive_torque_n_m", s.iter().map(|s| s.drive_torque_n_m).collect())?;
+    let report_py = pythonize(py, &report).map_err(value_error)?;
+    if let Ok(dict) = report_py.cast::<PyDict>() {
+        dict.set_item("emulator", emulator)?;
+    }
+    Ok((d, report_py))
+}

@@ -1,0 +1,97 @@
+"""The robot in the loop from Python (docs/drive.md): `sandslope.drive` runs the emulated
+XL330s through the same pty and bus code as `sandslope drive --emulate`, `infer_servo_log`
+returns what `infer --servo-log --json` prints, and bad input is a ValueError naming the
+argument."""
+
+import math
+
+import numpy as np
+import pytest
+
+import sandslope
+
+# The paper-hexapod's leg speed: one turn per second (the robot file's leg_speed, the paper's).
+OMEGA = 2 * math.pi
+
+
+def _columns(log):
+    return {k: np.asarray(log[k]) for k in ("time_s", "leg", "tripod", "leg_angle_rad", "drive_torque_n_m")}
+
+
+@pytest.fixture(scope="module")
+def run():
+    # 3 s at 20 deg on emulated sand of k_s = 2.5e5 N/m^3 (docs/drive.md's worked example).
+    return sandslope.drive(slope_deg=20, duration_s=3, k_s=2.5e5, seed=1)
+
+
+def test_drive_runs_the_gait_and_turns_the_torque_off(run):
+    log, report = run
+    c = _columns(log)
+    assert report["outcome"]["Ok"]["outcome"] == "completed", report["outcome"]
+    assert report["torque_off"]["confirmed"] == [1, 2, 3, 4, 5, 6]
+    assert report["emulator"].startswith("emulator: torque off on every servo")
+    # Every leg turns at the robot file's omega once walking (a least-squares slope of its
+    # angle over the gait, after the run-up): within 1%, the issue's tolerance.
+    walking = c["time_s"] > 0.5
+    for leg in range(6):
+        m = walking & (c["leg"] == leg)
+        slope = np.polyfit(c["time_s"][m], c["leg_angle_rad"][m], 1)[0]
+        assert abs(slope - OMEGA) < 0.01 * OMEGA, (leg, slope)
+    # Tripod 1 follows tripod 0 by half a period: half a turn, pi, behind at the same time.
+    t0 = c["time_s"][walking & (c["leg"] == 0)]
+    a0 = c["leg_angle_rad"][walking & (c["leg"] == 0)]
+    a1 = c["leg_angle_rad"][walking & (c["leg"] == 1)]
+    assert set(c["tripod"][c["leg"] == 1]) == {1}
+    lag = np.median(a0 - a1[: len(a0)])
+    assert abs(abs(lag) - math.pi) < 0.05 * math.pi, lag
+    # One live estimate per stance: two tripods, one stance each per 1 s period, after the
+    # first stride; about 4 in 3 s.
+    assert 2 <= len(report["live"]) <= 6, len(report["live"])
+    assert len(t0) > 100
+
+
+def test_infer_servo_log_equals_the_cli_on_the_same_log(cli, tmp_path):
+    path = tmp_path / "run.csv"
+    cli.run("drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "4",
+            "--watchdog", "2", "--log", path)
+    expected = cli.json("infer", "--servo-log", path, "--grid-points", "9", "--k-s-prior", "3e4:3e7")
+    got = sandslope.infer_servo_log(path, grid_points=9, k_s_prior=(3e4, 3e7))
+    assert sorted(got) == sorted(expected)
+    for key in ("k_s", "k_s_lo", "k_s_hi", "p_fail", "shear_load_n", "strides"):
+        assert got[key] == pytest.approx(expected[key], rel=1e-12), key
+    # The same from the log's columns, the slope given.
+    log, meta = sandslope.read_servo_log(path)
+    assert float(meta["slope_deg"]) == 20.0
+    again = sandslope.infer_servo_log(log, slope_deg=20, grid_points=9, k_s_prior=(3e4, 3e7))
+    assert again["k_s"] == pytest.approx(expected["k_s"], rel=1e-12)
+    # The emulated sand's k_s inside the 90% interval (docs/drive.md: 3 of 3 seeds).
+    assert got["k_s_lo"] <= 2.5e5 <= got["k_s_hi"], got
+
+
+def test_bad_input_names_the_argument(run):
+    log, _ = run
+    c = _columns(log)
+    with pytest.raises(ValueError, match="one length"):
+        sandslope.infer_servo_log({"leg": c["leg"], "leg_angle_rad": c["leg_angle_rad"][:-1],
+                                   "drive_torque_n_m": c["drive_torque_n_m"]}, slope_deg=20)
+    bad = dict(c)
+    bad["leg"] = c["leg"].copy()
+    bad["leg"][5] = 6
+    with pytest.raises(ValueError, match=r"leg\[5\] = 6: the robot has 6 legs"):
+        sandslope.infer_servo_log(bad, slope_deg=20, grid_points=3)
+    with pytest.raises(ValueError, match="drive_torque_n_m are missing"):
+        sandslope.infer_servo_log({"leg": c["leg"], "leg_angle_rad": c["leg_angle_rad"]}, slope_deg=20)
+    with pytest.raises(ValueError, match="slope_deg"):
+        sandslope.infer_servo_log(c)
+    with pytest.raises(ValueError, match="emulator only"):
+        sandslope.drive(emulate=False)
+    with pytest.raises(ValueError, match="stop_on_risk = 1.5 must be within 0 to 1"):
+        sandslope.drive(stop_on_risk=1.5)
+    with pytest.raises(ValueError, match="k_s"):
+        sandslope.drive(k_s=-1.0)
+
+
+def test_drive_releases_the_gil():
+    from test_gil import assert_releases_the_gil
+
+    assert_releases_the_gil(lambda: sandslope.drive(duration_s=1, live=False))

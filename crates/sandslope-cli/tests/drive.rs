@@ -8,6 +8,15 @@ use std::f64::consts::PI;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
+/// The tests that time a bus at 50 Hz run one at a time: on two cores shared with other test
+/// binaries, overlapping real-time drives starved each other's cycles (a log whose stance bins
+/// stayed empty: "0 complete strides", in a full `scripts/test.sh` run at load 8.6).
+static REAL_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn real_time() -> std::sync::MutexGuard<'static, ()> {
+    REAL_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_sandslope"))
 }
@@ -59,6 +68,7 @@ fn fit(x: &[f64], y: &[f64]) -> (f64, f64) {
 /// the measured ones (which lag by about one bus cycle).
 #[test]
 fn commanded_gait_has_the_robot_files_period_and_phase() {
+    let _one = real_time();
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("gait.csv");
     let out = bin()
@@ -116,11 +126,12 @@ fn commanded_gait_has_the_robot_files_period_and_phase() {
 /// decades.
 #[test]
 fn infer_servo_log_recovers_the_emulated_k_s() {
+    let _one = real_time();
     let dir = tempfile::tempdir().unwrap();
     let truth = 2.5e5;
-    // Five drives at a time (each is an emulator and a driver in real time).
+    // Two drives at a time (each is an emulator and a driver in real time).
     let mut logs = vec![];
-    for batch in [1..=5, 6..=10] {
+    for batch in [1..=2, 3..=4, 5..=6, 7..=8, 9..=10] {
         let runs: Vec<_> = batch
             .map(|seed| {
                 let log = dir.path().join(format!("run{seed}.csv"));
@@ -199,6 +210,7 @@ fn infer_servo_log_recovers_the_emulated_k_s() {
 /// to touch down and half a period of stance.
 #[test]
 fn stop_on_risk_halts_within_one_stride_of_the_sand_weakening() {
+    let _one = real_time();
     for seed in ["1", "2", "3"] {
         let dir = tempfile::tempdir().unwrap();
         let log = dir.path().join("halt.csv");
@@ -238,6 +250,7 @@ fn stop_on_risk_halts_within_one_stride_of_the_sand_weakening() {
 }
 
 fn drive_with(extra: &[&str]) -> (Option<i32>, String, std::path::PathBuf, tempfile::TempDir) {
+    let _one = real_time();
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("log.csv");
     // A generous cycle watchdog unless the test sets one: the test binaries share two cores.
@@ -263,6 +276,7 @@ fn torque_off_when_the_run_completes() {
 
 #[test]
 fn torque_off_on_ctrl_c() {
+    let _one = real_time();
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("log.csv");
     let mut child = bin()

@@ -10,10 +10,11 @@ use pyo3::types::PyDict;
 use pythonize::pythonize;
 
 use sandslope::gait::{track as track_recordings, GaitOptions, Recording, Upslope};
-use sandslope::measure::{fit_campaign, AirMode, CampaignError, FitOptions, Setup};
-use sandslope::{Slope, Terrain, TerrainSpec};
-use sandslope_io::measurements::{load_manifest, read_trials, ReadOptions};
+use sandslope::measure::AirMode;
+use sandslope::Slope;
 use sandslope_io::mocap::{self, MocapFormat};
+use sandslope_request::error::Words;
+use sandslope_request::fit::{FitAnswer, FitRequest};
 
 use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
@@ -31,52 +32,17 @@ pub fn fit<'py>(
     counts_per_newton: Option<f64>,
     skip_malformed: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if let Some((a, b)) = depth_window {
-        if !(a.is_finite() && b.is_finite() && a >= 0.0 && a < b) {
-            return Err(value_error(format!(
-                "depth_window = ({a}, {b}) must be (MIN, MAX) in metres with 0 <= MIN < MAX, e.g. (0.005, 0.03)"
-            )));
-        }
-    }
-    if let Some(x) = plateau_from.filter(|x| !(x.is_finite() && *x >= 0.0)) {
-        return Err(value_error(format!(
-            "plateau_from = {x} must be a displacement in metres of at least 0"
-        )));
-    }
     let air = match air {
         "auto" => AirMode::Auto,
         "curve" => AirMode::Curve,
         "mean" => AirMode::Mean,
         other => return Err(value_error(format!("air = {other:?} must be \"auto\", \"curve\" or \"mean\""))),
     };
-    if let Some(c) = counts_per_newton.filter(|c| !(c.is_finite() && *c > 0.0)) {
-        return Err(value_error(format!("counts_per_newton = {c} must be a finite number greater than 0")));
-    }
-    let options = FitOptions { depth_window, plateau_from, air };
-    let (campaign, terrain) = py
-        .detach(|| -> anyhow::Result<_> {
-            let manifest = load_manifest(&manifest)?;
-            let read = ReadOptions { counts_per_newton, skip_malformed };
-            let trials = read_trials(&manifest, read)?;
-            let setup = Setup { disk_area_m2: manifest.disk_area_m2, plate: manifest.plate };
-            let dir = manifest.path.parent().map(|d| d.join("")).unwrap_or_default();
-            let campaign = fit_campaign(&trials, &setup, &options).map_err(|e| match e {
-                CampaignError::Trial { .. } | CampaignError::TooFewRows { .. } => {
-                    anyhow::anyhow!("{}{e}", dir.display())
-                }
-                _ => anyhow::anyhow!("{}: {e}", manifest.path.display()),
-            })?;
-            let spec = TerrainSpec {
-                name: manifest.name.clone(),
-                repose_deg: manifest.repose_deg,
-                points: campaign.terrain_points(),
-            };
-            let terrain = Terrain::new(spec).map_err(|e| {
-                anyhow::anyhow!("{}: fitted terrain is invalid: {e}", manifest.path.display())
-            })?;
-            Ok((campaign, terrain))
-        })
-        .map_err(anyhow_error)?;
+    // The request `sandslope fit` makes: one check and one answer for both front ends.
+    let request = FitRequest { manifest, depth_window, plateau_from, air, counts_per_newton, skip_malformed };
+    request.check(Words::Keyword).map_err(|e| value_error(e.message()))?;
+    let FitAnswer { campaign, terrain, .. } =
+        py.detach(|| request.answer(Words::Keyword)).map_err(|e| anyhow_error(e.into()))?;
     let d = PyDict::new(py);
     d.set_item("trials", pythonize(py, &campaign.trials).map_err(value_error)?)?;
     d.set_item("points", pythonize(py, &campaign.points).map_err(value_error)?)?;

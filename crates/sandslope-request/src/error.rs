@@ -89,3 +89,23 @@ pub fn check_positive(field: &str, value: f64) -> Result<f64> {
         ))
     }
 }
+
+/// How a front end names a field in its messages: the command line's flag (`--plateau-from`)
+/// or Python's keyword (`plateau_from`). The field itself is the same (`plateau-from`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Words {
+    /// The command line's flag.
+    Flag,
+    /// Python's keyword.
+    Keyword,
+}
+
+impl Words {
+    /// `field` as this front end names it.
+    pub fn name(self, field: &str) -> String {
+        match self {
+            Words::Flag => format!("--{field}"),
+            Words::Keyword => field.replace('-', "_"),
+        }
+    }
+}

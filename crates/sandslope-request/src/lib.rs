@@ -18,6 +18,7 @@
 
 pub mod design;
 pub mod error;
+pub mod fit;
 pub mod grammar;
 pub mod params;
 pub mod phase;
@@ -30,6 +31,7 @@ pub mod sweep;
 
 pub use design::DesignRequest;
 pub use error::{RequestError, Result};
+pub use fit::FitRequest;
 pub use params::Params;
 pub use phase::PhaseRequest;
 pub use plan::PlanRequest;

@@ -4,18 +4,17 @@
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 
 use sandslope::measure::campaign::dropped_text;
-use sandslope::measure::{fit_campaign, AirMode, Campaign, CampaignError, FitOptions, Setup, TrialInput};
-use sandslope::{Terrain, TerrainSpec};
+use sandslope::measure::{AirMode, Campaign};
+use sandslope_request::error::Words;
+use sandslope_request::fit::{parse_depth_window, FitAnswer, FitRequest};
 
-use crate::args::check_positive;
 use crate::figures::measurements as figures;
 use crate::output::{csv_string, num, print_json, sci, table, write_atomic, Format, FormatArgs};
-use sandslope_io::measurements::{load_manifest, Manifest, ReadOptions};
 
 /// Arguments of `sandslope fit`.
 #[derive(Debug, Args)]
@@ -52,59 +51,23 @@ pub struct FitArgs {
     pub format: FormatArgs,
 }
 
-/// Parses `MIN:MAX` (metres, 0 <= MIN < MAX).
-fn parse_window(s: &str) -> Result<(f64, f64)> {
-    let bad =
-        || anyhow!("--depth-window `{s}` must be MIN:MAX in metres with 0 <= MIN < MAX, e.g. 0.005:0.03");
-    let (a, b) = s.split_once(':').ok_or_else(bad)?;
-    let a: f64 = a.trim().parse().map_err(|_| bad())?;
-    let b: f64 = b.trim().parse().map_err(|_| bad())?;
-    if !(a.is_finite() && b.is_finite() && a >= 0.0 && a < b) {
-        return Err(bad());
+impl FitArgs {
+    /// The request these flags make (`--depth-window` parsed by the request layer's grammar).
+    pub fn request(&self) -> Result<FitRequest> {
+        let air = match (self.air_curve, self.air_mean) {
+            (true, _) => AirMode::Curve,
+            (_, true) => AirMode::Mean,
+            _ => AirMode::Auto,
+        };
+        Ok(FitRequest {
+            manifest: self.manifest.clone(),
+            depth_window: self.depth_window.as_deref().map(parse_depth_window).transpose()?,
+            plateau_from: self.plateau_from,
+            air,
+            counts_per_newton: self.counts_per_newton,
+            skip_malformed: self.skip_malformed,
+        })
     }
-    Ok((a, b))
-}
-
-/// The options of the analysis from the flags.
-fn options(args: &FitArgs) -> Result<FitOptions> {
-    let depth_window = args.depth_window.as_deref().map(parse_window).transpose()?;
-    if let Some(x) = args.plateau_from {
-        if !(x.is_finite() && x >= 0.0) {
-            bail!("--plateau-from = {x} must be a displacement in metres of at least 0");
-        }
-    }
-    let air = match (args.air_curve, args.air_mean) {
-        (true, _) => AirMode::Curve,
-        (_, true) => AirMode::Mean,
-        _ => AirMode::Auto,
-    };
-    Ok(FitOptions { depth_window, plateau_from: args.plateau_from, air })
-}
-
-/// Reads every trial of a manifest.
-fn read_trials(manifest: &Manifest, args: &FitArgs) -> Result<Vec<TrialInput>> {
-    let counts_per_newton =
-        args.counts_per_newton.map(|c| check_positive("--counts-per-newton", c)).transpose()?;
-    let read = ReadOptions { counts_per_newton, skip_malformed: args.skip_malformed };
-    sandslope_io::measurements::read_trials(manifest, read).map_err(|e| {
-        if !args.skip_malformed && e.to_string().contains("is not a number") {
-            anyhow!("{e:#}; --skip-malformed skips such rows and counts them")
-        } else {
-            e
-        }
-    })
-}
-
-/// Reads and fits a manifest: the campaign result.
-pub fn fit_manifest(manifest: &Manifest, args: &FitArgs) -> Result<Campaign> {
-    let options = options(args)?;
-    let trials = read_trials(manifest, args)?;
-    let setup = Setup { disk_area_m2: manifest.disk_area_m2, plate: manifest.plate };
-    let dir = manifest.path.parent().map(|d| d.join("")).unwrap_or_default();
-    fit_campaign(&trials, &setup, &options).map_err(|e| match e {
-        CampaignError::Trial { .. } | CampaignError::TooFewRows { .. } => anyhow!("{}{e}", dir.display()),
-        _ => anyhow!("{}: {e}", manifest.path.display()),
-    })
 }
 
 /// Runs `sandslope fit`.
@@ -114,16 +77,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     if let Some(out) = &args.out {
         crate::output::check_parent_exists(out)?;
     }
-    options(&args)?;
-    let manifest = load_manifest(&args.manifest)?;
-    let campaign = fit_manifest(&manifest, &args)?;
-    let spec = TerrainSpec {
-        name: manifest.name.clone(),
-        repose_deg: manifest.repose_deg,
-        points: campaign.terrain_points(),
-    };
-    let terrain = Terrain::new(spec)
-        .map_err(|e| anyhow!("{}: fitted terrain is invalid: {e}", manifest.path.display()))?;
+    let FitAnswer { manifest, campaign, terrain } = args.request()?.answer(Words::Flag)?;
     for p in &campaign.points {
         for note in p.notes() {
             eprintln!("note: {} deg: {note} (not measured at this slope)", p.slope_deg);

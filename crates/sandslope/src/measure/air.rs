@@ -18,7 +18,7 @@ use super::line::line_fit;
 pub const TREND_ALPHA: f64 = 0.05;
 
 /// How the in-air offset is chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum AirMode {
     /// The mean, or the fitted line when the in-air run has a significant trend.

@@ -188,7 +188,7 @@ mod tests {
     #[test]
     fn depth_windows_parse_from_min_max() {
         assert_eq!(parse_depth_window("0.005:0.03").unwrap(), (0.005, 0.03));
-        for bad in ["0.03:0.01", "0.01", "a:0.03", "-0.01:0.03", "0.01:inf"] {
+        for bad in ["0.03:0.01", "0.01", "a:0.03", "-0.01:0.03", "0.01:inf", "0.01:0.01", "a:b"] {
             let e = parse_depth_window(bad).unwrap_err();
             assert_eq!(e.field(), Some("depth-window"), "{bad}");
             assert!(e.message().starts_with(&format!("--depth-window `{bad}` must be MIN:MAX")), "{bad}");

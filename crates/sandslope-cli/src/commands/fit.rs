@@ -212,16 +212,3 @@ fn print_tables(campaign: &Campaign) {
     println!("{t}");
     println!("SD = sqrt(SD across trials^2 + mean trial SE^2) (docs/measurements.md)");
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn depth_window_syntax() {
-        assert_eq!(parse_window("0.005:0.03").unwrap(), (0.005, 0.03));
-        for bad in ["0.03:0.005", "5", "a:b", "-1:2", "0.01:0.01"] {
-            assert!(parse_window(bad).is_err(), "{bad}");
-        }
-    }
-}

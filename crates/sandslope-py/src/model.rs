@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 
-use sandslope::{write_phase_rows, Cause, Regime, Scenario, Slope, SlopeEvaluation, Terrain};
+use sandslope::{write_phase_rows, Cause, Regime, Scenario, Slope, SlopeEvaluation, StrengthGrid, Terrain};
 
 use crate::arrays::{axis, put, scale_name, uninit, values};
 use crate::types::{PyRobot, PyTerrain};
@@ -199,7 +199,8 @@ pub fn phase<'py>(
         let span = rows.start * nx..rows.end * nx;
         let codes = &mut regime.spare_capacity_mut()[span.clone()];
         let steps = step.as_mut().map(|s| &mut s.spare_capacity_mut()[span]);
-        let c = py.detach(|| write_phase_rows(robot, slope, repose, &kn, &ks, rows.clone(), codes, steps));
+        let grid = StrengthGrid::new(robot, slope, repose, &kn, &ks);
+        let c = py.detach(|| write_phase_rows(&grid, rows.clone(), codes, steps));
         for (n, g) in counts.iter_mut().zip(sandslope::Regime::ALL) {
             *n += c.get(g);
         }

@@ -4,7 +4,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use sandslope::{
-    regime_probabilities, Axis, AxisScale, Ground, PhaseMap, RiskMap, Robot, RobotSpec, Slope, Uncertainty,
+    regime_probabilities, Axis, AxisScale, Ground, PhaseMap, RiskMap, Robot, RobotSpec, Slope, StrengthGrid,
+    Uncertainty,
 };
 
 /// The paper's hexapod (the library's `RobotSpec::paper_hexapod`).
@@ -19,7 +20,7 @@ fn bench(c: &mut Criterion) {
         let kn = Axis::new("k_n", 7e3, 7e7, n, AxisScale::Log).expect("axis");
         let ks = Axis::new("k_s", 2e3, 2e8, n, AxisScale::Log).expect("axis");
         c.bench_function(&format!("phase map {n} x {n}"), |b| {
-            b.iter(|| PhaseMap::compute(&robot, slope, None, &kn, &ks, &|| {}).counts())
+            b.iter(|| PhaseMap::compute(&StrengthGrid::new(&robot, slope, None, &kn, &ks), &|| {}).counts())
         });
     }
     // The target: a 1024 x 1024 risk map (p_fail and p_not_success) in under 1 s, at
@@ -32,7 +33,9 @@ fn bench(c: &mut Criterion) {
     for (cv_n, cv_s) in [(0.1, 0.2), (0.3, 0.5), (0.1, 0.01)] {
         let u = Uncertainty::new(cv_n, cv_s).expect("cv");
         group.bench_function(format!("1024 x 1024, cv {cv_n}/{cv_s}"), |b| {
-            b.iter(|| RiskMap::compute(&robot, slope, None, &kn, &ks, u, &|| {}).p_fail.len())
+            b.iter(|| {
+                RiskMap::compute(&StrengthGrid::new(&robot, slope, None, &kn, &ks), u, &|| {}).p_fail.len()
+            })
         });
     }
     group.finish();

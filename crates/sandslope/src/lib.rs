@@ -56,6 +56,7 @@ pub mod scenario;
 pub mod servo;
 pub mod simulate;
 pub mod slope;
+pub mod strength_grid;
 pub mod terrain;
 
 pub use axis::{Axis, AxisScale};
@@ -83,4 +84,5 @@ pub use robot::{LevelStep, Robot, RobotSpec};
 pub use scenario::{Scenario, SlopeEvaluation};
 pub use simulate::{simulate, simulate_slopes, SimSettings, SimSummary, Simulation};
 pub use slope::Slope;
+pub use strength_grid::StrengthGrid;
 pub use terrain::{Ground, Terrain, TerrainPoint, TerrainSpec};

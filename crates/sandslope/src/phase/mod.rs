@@ -28,6 +28,7 @@ use crate::model::{
 use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::slope::Slope;
+use crate::strength_grid::StrengthGrid;
 
 mod panel;
 
@@ -222,15 +223,11 @@ fn code(afloat: u8, rank: u32, r0: u32, r1: u32) -> u8 {
 /// # Panics
 /// If `codes` (or `steps`) is shorter than the grid.
 pub fn write_phase(
-    robot: &Robot,
-    slope: Slope,
-    repose: Option<Slope>,
-    k_n_axis: &Axis,
-    k_s_axis: &Axis,
+    grid: &StrengthGrid<'_>,
     codes: &mut [std::mem::MaybeUninit<i8>],
     steps: Option<&mut [std::mem::MaybeUninit<f64>]>,
 ) -> RegimeCounts {
-    write_phase_rows(robot, slope, repose, k_n_axis, k_s_axis, 0..k_s_axis.len(), codes, steps)
+    write_phase_rows(grid, 0..grid.k_s.len(), codes, steps)
 }
 
 /// [`write_phase`] for the k_s rows `rows` only: `codes` (and `steps`) hold those rows,
@@ -240,17 +237,13 @@ pub fn write_phase(
 ///
 /// # Panics
 /// If `rows` is not within the k_s axis, or a buffer is shorter than the rows.
-#[allow(clippy::too_many_arguments)]
 pub fn write_phase_rows(
-    robot: &Robot,
-    slope: Slope,
-    repose: Option<Slope>,
-    k_n_axis: &Axis,
-    k_s_axis: &Axis,
+    grid: &StrengthGrid<'_>,
     rows: std::ops::Range<usize>,
     codes: &mut [std::mem::MaybeUninit<i8>],
     steps: Option<&mut [std::mem::MaybeUninit<f64>]>,
 ) -> RegimeCounts {
+    let StrengthGrid { robot, slope, repose, k_n: k_n_axis, k_s: k_s_axis } = *grid;
     let (k_n, k_s) = (k_n_axis.values(), k_s_axis.values());
     // The row parts depend on the row's k_s alone: those of `rows` only.
     let parts = Parts::new(robot, slope, repose, &k_n, &k_s[rows.clone()]);
@@ -304,14 +297,8 @@ impl PhaseMap {
     /// terrain whose angle of repose is `repose` (at or beyond it every cell slips).
     ///
     /// `row_done` is called once per finished k_s row, from any thread (for progress bars).
-    pub fn compute(
-        robot: &Robot,
-        slope: Slope,
-        repose: Option<Slope>,
-        k_n_axis: &Axis,
-        k_s_axis: &Axis,
-        row_done: &(dyn Fn() + Sync),
-    ) -> PhaseMap {
+    pub fn compute(grid: &StrengthGrid<'_>, row_done: &(dyn Fn() + Sync)) -> PhaseMap {
+        let StrengthGrid { robot, slope, repose, k_n: k_n_axis, k_s: k_s_axis } = *grid;
         let k_n = k_n_axis.values();
         let k_s = k_s_axis.values();
         let parts = Parts::new(robot, slope, repose, &k_n, &k_s);
@@ -543,7 +530,7 @@ mod tests {
     }
 
     fn map(robot: &Robot, slope: Slope, kn: &Axis, ks: &Axis) -> PhaseMap {
-        PhaseMap::compute(robot, slope, None, kn, ks, &|| {})
+        PhaseMap::compute(&StrengthGrid::new(robot, slope, None, kn, ks), &|| {})
     }
 
     /// Every cell agrees with `predict`, regime and step bit for bit, including on a slope,
@@ -558,15 +545,16 @@ mod tests {
             [(&r, 0.0, None), (&r, 20.0, None), (&measured, 24.0, None), (&r, 26.0, Some(25.0))]
         {
             let repose = repose.map(deg);
-            let m = PhaseMap::compute(robot, deg(d), repose, &kn, &ks, &|| {});
+            let grid = StrengthGrid::new(robot, deg(d), repose, &kn, &ks);
+            let m = PhaseMap::compute(&grid, &|| {});
             // The one-pass writer into caller buffers, with and without the steps.
             let cells = kn.len() * ks.len();
             let mut all_codes = vec![std::mem::MaybeUninit::new(-1i8); cells];
             let mut all_steps = vec![std::mem::MaybeUninit::new(-1.0f64); cells];
             let mut only_codes = vec![std::mem::MaybeUninit::new(-1i8); cells];
-            let counts = write_phase(robot, deg(d), repose, &kn, &ks, &mut all_codes, Some(&mut all_steps));
+            let counts = write_phase(&grid, &mut all_codes, Some(&mut all_steps));
             assert_eq!(counts, m.counts());
-            assert_eq!(write_phase(robot, deg(d), repose, &kn, &ks, &mut only_codes, None), m.counts());
+            assert_eq!(write_phase(&grid, &mut only_codes, None), m.counts());
             // Block by block (Python's phase, checking for Ctrl-C between blocks): the same
             // cells, bit for bit, and the blocks' counts add up.
             let mut block_codes = vec![std::mem::MaybeUninit::new(-1i8); cells];
@@ -575,11 +563,7 @@ mod tests {
             for rows in [0..1, 1..8, 8..21, 21..ks.len()] {
                 let span = rows.start * kn.len()..rows.end * kn.len();
                 let c = write_phase_rows(
-                    robot,
-                    deg(d),
-                    repose,
-                    &kn,
-                    &ks,
+                    &grid,
                     rows,
                     &mut block_codes[span.clone()],
                     Some(&mut block_steps[span]),
@@ -780,7 +764,7 @@ mod tests {
         let kn = log_axis(1e4, 1e7, 30);
         let ks = log_axis(1e3, 1e8, 20);
         let rows = std::sync::atomic::AtomicUsize::new(0);
-        let m = PhaseMap::compute(&r, deg(10.0), None, &kn, &ks, &|| {
+        let m = PhaseMap::compute(&StrengthGrid::new(&r, deg(10.0), None, &kn, &ks), &|| {
             rows.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         });
         assert_eq!(rows.into_inner(), 20);

@@ -10,6 +10,7 @@ use crate::error::ParamError;
 use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::slope::Slope;
+use crate::strength_grid::StrengthGrid;
 use crate::terrain::{Ground, Terrain};
 
 /// One panel of a phase diagram: the map of one robot mass at one slope, with the terrain's
@@ -47,7 +48,10 @@ impl PhasePanel {
         row_done: &(dyn Fn() + Sync),
     ) -> Result<PhasePanel, ParamError> {
         let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
-        let map = PhaseMap::compute(robot, slope, terrain.repose(), k_n_axis, k_s_axis, row_done);
+        let map = PhaseMap::compute(
+            &StrengthGrid::new(robot, slope, terrain.repose(), k_n_axis, k_s_axis),
+            row_done,
+        );
         let g: Ground = terrain.at(slope);
         Ok(PhasePanel {
             slope_deg,

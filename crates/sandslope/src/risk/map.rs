@@ -55,6 +55,7 @@ use crate::contour::{contour_segments, ContourSegment};
 use crate::model::sinkage_threshold_k_n;
 use crate::robot::Robot;
 use crate::slope::Slope;
+use crate::strength_grid::StrengthGrid;
 use crate::terrain::Ground;
 
 /// p_fail and p_not_success over a `(k_n, k_s)` grid of medians, all cells with the same
@@ -235,41 +236,24 @@ impl RiskMap {
     /// of the module documentation (within 1e-6 of [`RiskMap::compute_by_quadrature`]).
     /// `row_done` is called once per finished k_s row, from any thread (for progress bars).
     pub fn compute(
-        robot: &Robot,
-        slope: Slope,
-        repose: Option<Slope>,
-        k_n_axis: &Axis,
-        k_s_axis: &Axis,
+        grid: &StrengthGrid<'_>,
         uncertainty: Uncertainty,
         row_done: &(dyn Fn() + Sync),
     ) -> RiskMap {
-        Self::compute_blocked(
-            robot,
-            slope,
-            repose,
-            k_n_axis,
-            k_s_axis,
-            uncertainty,
-            row_done,
-            Blocks { columns: COLUMN_BLOCK, rows: ROW_BLOCK },
-        )
+        Self::compute_blocked(grid, uncertainty, row_done, Blocks { columns: COLUMN_BLOCK, rows: ROW_BLOCK })
     }
 
     /// [`RiskMap::compute`] with the block sizes of the banded product given (the tests use
     /// small ones so that small grids cross block boundaries).
-    #[allow(clippy::too_many_arguments)]
     fn compute_blocked(
-        robot: &Robot,
-        slope: Slope,
-        repose: Option<Slope>,
-        k_n_axis: &Axis,
-        k_s_axis: &Axis,
+        grid: &StrengthGrid<'_>,
         uncertainty: Uncertainty,
         row_done: &(dyn Fn() + Sync),
         blocks: Blocks,
     ) -> RiskMap {
+        let StrengthGrid { robot, slope, k_n: k_n_axis, k_s: k_s_axis, .. } = *grid;
         let (nx, ny) = (k_n_axis.len(), k_s_axis.len());
-        let beyond_repose = repose.is_some_and(|r| slope.radians() >= r.radians());
+        let beyond_repose = grid.beyond_repose();
         let ln = |v: f64| if v > 0.0 { v.ln() } else { f64::NEG_INFINITY };
         let mu_n: Vec<f64> = k_n_axis.values().into_iter().map(ln).collect();
         let mu_s: Vec<f64> = k_s_axis.values().into_iter().map(ln).collect();
@@ -324,14 +308,11 @@ impl RiskMap {
     /// The same map by one adaptive quadrature per cell ([`super::regime_probabilities`]):
     /// the reference [`RiskMap::compute`] is tested against, a few milliseconds per cell.
     pub fn compute_by_quadrature(
-        robot: &Robot,
-        slope: Slope,
-        repose: Option<Slope>,
-        k_n_axis: &Axis,
-        k_s_axis: &Axis,
+        grid: &StrengthGrid<'_>,
         uncertainty: Uncertainty,
         row_done: &(dyn Fn() + Sync),
     ) -> RiskMap {
+        let StrengthGrid { robot, slope, repose, k_n: k_n_axis, k_s: k_s_axis } = *grid;
         let k_n = k_n_axis.values();
         let k_s = k_s_axis.values();
         let rows: Vec<(Vec<f64>, Vec<f64>)> = k_s
@@ -411,8 +392,9 @@ mod tests {
         let s = Slope::from_degrees(deg).unwrap();
         let repose = repose.map(|r| Slope::from_degrees(r).unwrap());
         let u = Uncertainty::new(cv.0, cv.1).unwrap();
-        let fast = RiskMap::compute(robot, s, repose, kn, ks, u, &|| {});
-        let slow = RiskMap::compute_by_quadrature(robot, s, repose, kn, ks, u, &|| {});
+        let grid = StrengthGrid::new(robot, s, repose, kn, ks);
+        let fast = RiskMap::compute(&grid, u, &|| {});
+        let slow = RiskMap::compute_by_quadrature(&grid, u, &|| {});
         largest_difference(&fast, &slow)
     }
 
@@ -473,7 +455,11 @@ mod tests {
         assert!(worst(&r, 10.0, None, &kn, &lin, (0.2, 0.3)) < 1e-6);
         // The first column sits exactly on the sinkage threshold: P(sinkage) = 1/2 there, and
         // just above it the level step is short, so slipping is likely too.
-        let m = RiskMap::compute(&r, s, None, &kn, &ks, Uncertainty::new(0.2, 0.2).unwrap(), &|| {});
+        let m = RiskMap::compute(
+            &StrengthGrid::new(&r, s, None, &kn, &ks),
+            Uncertainty::new(0.2, 0.2).unwrap(),
+            &|| {},
+        );
         assert!(m.p_fail_at(0, 6) > 0.5 && m.p_fail_at(0, 6) <= 1.0);
     }
 
@@ -483,8 +469,9 @@ mod tests {
         let r = paper_robot();
         let s = Slope::from_degrees(deg).unwrap();
         let u = Uncertainty::new(cv.0, cv.1).unwrap();
-        let fast = RiskMap::compute_blocked(&r, s, None, kn, ks, u, &|| {}, blocks);
-        let slow = RiskMap::compute_by_quadrature(&r, s, None, kn, ks, u, &|| {});
+        let grid = StrengthGrid::new(&r, s, None, kn, ks);
+        let fast = RiskMap::compute_blocked(&grid, u, &|| {}, blocks);
+        let slow = RiskMap::compute_by_quadrature(&grid, u, &|| {});
         largest_difference(&fast, &slow)
     }
 
@@ -528,7 +515,7 @@ mod tests {
         let ks = log_axis(1e5, 1e7, 3);
         let u = Uncertainty::new(0.2, 0.4).unwrap();
         let rows = std::sync::atomic::AtomicUsize::new(0);
-        let map = RiskMap::compute(&r, s, None, &kn, &ks, u, &|| {
+        let map = RiskMap::compute(&StrengthGrid::new(&r, s, None, &kn, &ks), u, &|| {
             rows.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         });
         assert_eq!(rows.into_inner(), 3);

@@ -13,6 +13,7 @@ use super::uncertainty::{DefaultsUsed, UncertainTerrain, UsedUncertainty};
 use crate::error::ParamError;
 use crate::robot::Robot;
 use crate::slope::Slope;
+use crate::strength_grid::StrengthGrid;
 use crate::Axis;
 
 /// What `sandslope risk --json` prints (and `serve`'s `/api/risk` returns), one variant per
@@ -297,15 +298,8 @@ pub fn risk_map(
     super::limits::check_risk(max_risk)?;
     let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
     let sample = terrain.sample(slope);
-    let map = RiskMap::compute(
-        robot,
-        slope,
-        sample.ground.repose,
-        k_n_axis,
-        k_s_axis,
-        sample.uncertainty,
-        row_done,
-    );
+    let grid = StrengthGrid::new(robot, slope, sample.ground.repose, k_n_axis, k_s_axis);
+    let map = RiskMap::compute(&grid, sample.uncertainty, row_done);
     let summary = RiskMapSummary::of(&map, robot, slope_deg, terrain, max_risk)?;
     Ok(RiskMapAnswer { summary, map })
 }

@@ -212,8 +212,7 @@ pub(crate) fn associated_force(
 /// passive resistive-force stress per unit depth in the direction of motion and
 /// `phi(r) = r / sqrt(1 + r^2)` smooths the set-valued law at rest over the creep speed `eps`.
 /// At `u = 0` the force is zero and the Jacobian isotropic. Without `want_jacobian` the
-/// Jacobian is left zero (a line search's trial points need only the force: it saves the two
-/// extra stress evaluations of the derivative).
+/// Jacobian is left zero (a line search's trial points need only the force).
 #[inline(always)]
 pub(crate) fn element_force(
     rft: &Rft,
@@ -229,20 +228,19 @@ pub(crate) fn element_force(
         return ([0.0; 2], [[-k, 0.0], [0.0, -k]]);
     }
     let e = [u[0] / s, u[1] / s];
-    let st = rft.passive_stress(tx, tz, e[0], e[1]);
+    if !want_jacobian {
+        let st = rft.passive_stress(tx, tz, e[0], e[1]);
+        let r = s / eps;
+        let phi = r / (1.0 + r * r).sqrt();
+        return ([c.weight * phi * st.0, c.weight * phi * st.1], [[0.0; 2]; 2]);
+    }
+    // S and dS/d(angle of e) (de/d(angle) = n = (-e_z, e_x)), the latter in closed form.
+    let (st, turn) = rft.passive_stress_and_turn(tx, tz, e[0], e[1]);
     let r = s / eps;
     let root = (1.0 + r * r).sqrt();
     let phi = r / root;
     let force = [c.weight * phi * st.0, c.weight * phi * st.1];
-    if !want_jacobian {
-        return (force, [[0.0; 2]; 2]);
-    }
-    // dS/d(angle of e) by central differences; de/d(angle) = n = (-e_z, e_x).
-    const DELTA: f64 = 1e-5;
-    let (sd, cd) = (DELTA.sin(), DELTA.cos());
-    let sp = rft.passive_stress(tx, tz, e[0] * cd - e[1] * sd, e[0] * sd + e[1] * cd);
-    let sm = rft.passive_stress(tx, tz, e[0] * cd + e[1] * sd, -e[0] * sd + e[1] * cd);
-    let ds = [(sp.0 - sm.0) / (2.0 * DELTA), (sp.1 - sm.1) / (2.0 * DELTA)];
+    let ds = [turn.0, turn.1];
     let n = [-e[1], e[0]];
     // d phi / du = phi'(r) / eps e with phi'(r) = 1 / root^3; d e / du = n n^T / s.
     let radial = c.weight / (eps * root * root * root);

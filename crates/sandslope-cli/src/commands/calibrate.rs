@@ -48,9 +48,9 @@ impl LawArg {
 pub enum ModelArg {
     /// The closed form (docs/model.md §3-§5).
     ClosedForm,
-    /// The stride simulator (docs/model.md §15-§18), with the fit's coarse setting: 4 s walks at
-    /// dt = 2 ms, one per observed slope and trial point, in parallel. Slower (a minute or more);
-    /// the closed form's fit is printed beside it.
+    /// The stride simulator (docs/model.md §15-§18): 4 s walks at the converged default step
+    /// (T / 2000), body pitch locked, one per observed slope and trial point, in parallel. Slower
+    /// (minutes: 8 min of CPU on the paper's evidence); the closed form's fit is printed beside it.
     Simulate,
 }
 

@@ -3,6 +3,8 @@
 //! recovered from the currents, the halt on risk, torque off on every exit path, bad input.
 
 mod common;
+#[path = "drive/messy.rs"]
+mod messy;
 
 use std::f64::consts::PI;
 use std::path::Path;
@@ -124,51 +126,63 @@ fn commanded_gait_has_the_robot_files_period_and_phase() {
 /// points), with 10 mA of current noise and ten seeds: `infer --servo-log` must put the true
 /// k_s inside its 90% interval in at least 9, with intervals narrower than the prior's three
 /// decades.
+/// The ten emulated logs behind the k_s tests (made once per test binary, two drives at a
+/// time: each is an emulator and a driver in real time), in Cargo's scratch directory for
+/// tests (a static's temporary directory would never be removed).
+fn emulated_logs() -> &'static [std::path::PathBuf] {
+    static LOGS: std::sync::OnceLock<Vec<std::path::PathBuf>> = std::sync::OnceLock::new();
+    LOGS.get_or_init(|| {
+        let _one = real_time();
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("drive-emulated-logs");
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut logs = vec![];
+        for batch in [1..=2, 3..=4, 5..=6, 7..=8, 9..=10] {
+            let runs: Vec<_> = batch
+                .map(|seed| {
+                    let log = dir.join(format!("run{seed}.csv"));
+                    let child = bin()
+                        .args([
+                            "drive",
+                            "--emulate",
+                            "--slope",
+                            "20",
+                            "--duration",
+                            "5",
+                            "--emulate-k-s",
+                            "2.5e5",
+                        ])
+                        .args([
+                            "--emulate-noise",
+                            "10",
+                            "--emulate-seed",
+                            &seed.to_string(),
+                            "--watchdog",
+                            "3",
+                        ])
+                        .arg("--log")
+                        .arg(&log)
+                        .stdout(Stdio::null())
+                        .stderr(Stdio::piped())
+                        .spawn()
+                        .unwrap();
+                    (log, child)
+                })
+                .collect();
+            for (log, child) in runs {
+                let out = child.wait_with_output().unwrap();
+                assert!(out.status.success(), "{}", text(&out));
+                logs.push(log);
+            }
+        }
+        logs
+    })
+}
+
 #[test]
 fn infer_servo_log_recovers_the_emulated_k_s() {
-    let _one = real_time();
-    let dir = tempfile::tempdir().unwrap();
     let truth = 2.5e5;
-    // Two drives at a time (each is an emulator and a driver in real time).
-    let mut logs = vec![];
-    for batch in [1..=2, 3..=4, 5..=6, 7..=8, 9..=10] {
-        let runs: Vec<_> = batch
-            .map(|seed| {
-                let log = dir.path().join(format!("run{seed}.csv"));
-                let child = bin()
-                    .args([
-                        "drive",
-                        "--emulate",
-                        "--slope",
-                        "20",
-                        "--duration",
-                        "5",
-                        "--emulate-k-s",
-                        "2.5e5",
-                    ])
-                    .args([
-                        "--emulate-noise",
-                        "10",
-                        "--emulate-seed",
-                        &seed.to_string(),
-                        "--watchdog",
-                        "3",
-                        "--log",
-                    ])
-                    .arg(&log)
-                    .stdout(Stdio::null())
-                    .stderr(Stdio::piped())
-                    .spawn()
-                    .unwrap();
-                (log, child)
-            })
-            .collect();
-        for (log, child) in runs {
-            let out = child.wait_with_output().unwrap();
-            assert!(out.status.success(), "{}", text(&out));
-            logs.push(log);
-        }
-    }
+    let logs = emulated_logs();
     let mut inside = 0;
     let mut widths = vec![];
     for pair in logs.chunks(2) {

@@ -105,13 +105,18 @@ impl<W: Write> ServoLogWriter<W> {
     }
 }
 
-/// A servo log read back: its header's `key = value` pairs and its rows.
+/// A servo log read back: its header's `key = value` pairs and its rows, in time order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ServoLog {
     /// `# key = value` lines of the header.
     pub meta: BTreeMap<String, String>,
-    /// The rows.
+    /// The rows, sorted by time (stably: a log's own order within a cycle is kept).
     pub rows: Vec<ServoLogRow>,
+    /// The file's line of each row.
+    pub lines: Vec<usize>,
+    /// What the reader repaired or left out (a cut last row, rows with missing values,
+    /// repeated rows, rows out of order, gaps in time), one sentence each.
+    pub notes: Vec<String>,
 }
 
 impl ServoLog {
@@ -125,12 +130,75 @@ impl ServoLog {
                 .map_err(|_| anyhow!("{}: header line `# {key} = {v}`: not a number", path.display())),
         }
     }
+
+    /// The rows as the current inference's leg traces (`legs` of them: leg angle and drive
+    /// torque per leg); a row whose leg the robot does not have is an error naming its line.
+    pub fn leg_traces(&self, legs: usize, path: &Path) -> Result<Vec<sandslope::infer::servo::LegTrace>> {
+        let mut traces = vec![sandslope::infer::servo::LegTrace::default(); legs];
+        for (r, line) in self.rows.iter().zip(&self.lines) {
+            let t = traces.get_mut(r.leg).ok_or_else(|| {
+                anyhow!(
+                    "{}: line {line} (servo ID {}): leg {}, but the robot has {legs} legs (0 to {}; 2 * stance_legs)",
+                    path.display(),
+                    r.id,
+                    r.leg,
+                    legs.saturating_sub(1)
+                )
+            })?;
+            t.angle_rad.push(r.leg_angle_rad);
+            t.torque_n_m.push(r.drive_torque_n_m);
+        }
+        Ok(traces)
+    }
 }
 
 /// Most rows a log may hold (an hour at 100 Hz on 12 servos).
 pub const MAX_ROWS: usize = 5_000_000;
 
-/// Reads a servo log; errors name the file, the line and the column.
+/// A gap in time longer than this many bus cycles is reported in [`ServoLog::notes`].
+const GAP_CYCLES: f64 = 3.0;
+
+/// One field of a row: `None` when empty or NaN (a value the logger did not get, as pandas
+/// writes it), an error naming the line, servo and column when it is not a number.
+fn field(rec: &csv::StringRecord, col: usize, name: &str, at: &dyn Fn() -> String) -> Result<Option<f64>> {
+    let text = rec.get(col).unwrap_or("").trim();
+    if text.is_empty() || text.eq_ignore_ascii_case("nan") {
+        return Ok(None);
+    }
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(Some(v)),
+        _ => bail!("{}: `{name}` = `{text}` is not a finite number", at()),
+    }
+}
+
+/// An integer column read as a number (pandas writes integer columns holding a NaN as floats:
+/// `3.0`), checked to be whole and within `lo..=hi`.
+fn whole(v: f64, name: &str, lo: i64, hi: i64, at: &dyn Fn() -> String) -> Result<i64> {
+    if v.fract() != 0.0 || v < lo as f64 || v > hi as f64 {
+        bail!("{}: `{name}` = {v} must be a whole number within {lo} to {hi}", at());
+    }
+    Ok(v as i64)
+}
+
+/// Line numbers for a note: the first few and how many more.
+fn some_lines(lines: &[usize]) -> String {
+    let shown: Vec<String> = lines.iter().take(5).map(|l| l.to_string()).collect();
+    match lines.len() {
+        n if n > 5 => format!("lines {} and {} more", shown.join(", "), n - 5),
+        1 => format!("line {}", shown[0]),
+        _ => format!("lines {}", shown.join(", ")),
+    }
+}
+
+/// Reads a servo log; errors name the file, the line, the servo and the column.
+///
+/// A real bus's log is messy, and the reader says what it did about each mess in
+/// [`ServoLog::notes`]: a last row cut short (the file does not end with a line end: a logger
+/// killed mid-write) is left out; a row with an empty or NaN measurement is left out (a value
+/// the logger did not get); a row repeated exactly is read once; rows out of time order are
+/// sorted; gaps in time (bus timeouts) are reported. It refuses, naming the lines: a row whose
+/// time, ID or leg is missing, a field that is not a number, a row with the wrong number of
+/// fields, one servo with two different rows at one time, one ID on two legs.
 pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read servo log {}", path.display()))?;
@@ -143,35 +211,168 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
             meta.insert(k.trim().to_string(), v.trim().to_string());
         }
     }
-    let body: String = text.lines().skip(header_lines).collect::<Vec<_>>().join("\n");
-    let mut reader = csv::ReaderBuilder::new().from_reader(body.as_bytes());
+    let mut notes = vec![];
+    let mut body_lines: Vec<&str> = text.lines().skip(header_lines).collect();
+    if !text.is_empty() && !text.ends_with('\n') && body_lines.len() > 1 {
+        let line = header_lines + body_lines.len();
+        body_lines.pop();
+        notes.push(format!(
+            "line {line}: the log ends mid-row (no line end after it: the logger stopped while writing); the row is left out"
+        ));
+    }
+    let body = body_lines.join("\n");
+    let mut reader = csv::ReaderBuilder::new().flexible(true).from_reader(body.as_bytes());
     let headers =
         reader.headers().with_context(|| format!("{}: no column header line", path.display()))?.clone();
-    for want in ["time_s", "id", "leg", "leg_angle_rad", "drive_torque_n_m"] {
-        if !headers.iter().any(|h| h == want) {
-            bail!("{}: the column `{want}` is missing (a servo log as `sandslope drive --log` writes it has {})", path.display(), COLUMNS.join(","));
-        }
+    let mut col = [0usize; 14];
+    for (c, want) in col.iter_mut().zip(COLUMNS) {
+        *c = headers.iter().position(|h| h.trim() == want).ok_or_else(|| {
+            anyhow!(
+                "{}: the column `{want}` is missing (a servo log as `sandslope drive --log` writes it has {})",
+                path.display(),
+                COLUMNS.join(",")
+            )
+        })?;
     }
-    let mut rows = Vec::new();
-    for (i, rec) in reader.deserialize::<ServoLogRow>().enumerate() {
+    let (mut rows, mut lines, mut missing) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, rec) in reader.records().enumerate() {
         let line = header_lines + 2 + i;
-        let row =
+        let rec =
             rec.map_err(|e| anyhow!("{}: line {line}: {}", path.display(), e.to_string().trim_end()))?;
-        if !(row.time_s.is_finite() && row.leg_angle_rad.is_finite() && row.drive_torque_n_m.is_finite()) {
+        let plain = |line: usize| format!("{}: line {line}", path.display());
+        let id = field(&rec, col[1], "id", &|| plain(line))?
+            .ok_or_else(|| anyhow!("{}: `id` is empty; every row needs its servo's ID", plain(line)))?;
+        let id = whole(id, "id", 0, 252, &|| plain(line))? as u8;
+        let at = || format!("{}: line {line} (servo ID {id})", path.display());
+        if rec.len() != headers.len() {
             bail!(
-                "{}: line {line}: time_s, leg_angle_rad and drive_torque_n_m must be finite numbers",
-                path.display()
+                "{}: {} fields, the header has {}; a row cut or joined (fix or delete the line)",
+                at(),
+                rec.len(),
+                headers.len()
             );
         }
-        rows.push(row);
+        let mut v = [0.0f64; 14];
+        let mut complete = true;
+        for (k, (&c, name)) in col.iter().zip(COLUMNS).enumerate() {
+            match field(&rec, c, name, &at)? {
+                Some(x) => v[k] = x,
+                None if k <= 2 => bail!("{}: `{name}` is empty; every row needs its time, ID and leg", at()),
+                None => complete = false,
+            }
+        }
+        if !complete {
+            missing.push(line);
+            continue;
+        }
+        let int = |k: usize, lo: i64, hi: i64| whole(v[k], COLUMNS[k], lo, hi, &at);
+        rows.push(ServoLogRow {
+            time_s: v[0],
+            id,
+            leg: int(2, 0, 251)? as usize,
+            tripod: int(3, 0, 1)? as usize,
+            present_position: int(4, i32::MIN.into(), i32::MAX.into())? as i32,
+            present_velocity: int(5, i32::MIN.into(), i32::MAX.into())? as i32,
+            present_current_ma: int(6, i32::MIN.into(), i32::MAX.into())? as i32,
+            load_percent: v[7],
+            input_voltage_v: v[8],
+            temperature_c: int(9, i32::MIN.into(), i32::MAX.into())? as i32,
+            hardware_error: int(10, 0, 255)? as u8,
+            goal_position: int(11, i32::MIN.into(), i32::MAX.into())? as i32,
+            leg_angle_rad: v[12],
+            drive_torque_n_m: v[13],
+        });
+        lines.push(line);
         if rows.len() > MAX_ROWS {
             bail!("{}: more than {MAX_ROWS} rows; split the log", path.display());
         }
     }
-    if rows.is_empty() {
-        bail!("{}: the log has no rows", path.display());
+    if !missing.is_empty() {
+        notes.push(format!(
+            "{} row(s) with an empty or NaN value left out ({}): a value the logger did not get",
+            missing.len(),
+            some_lines(&missing)
+        ));
     }
-    Ok(ServoLog { meta, rows })
+    let (rows, lines) = tidy(path, rows, lines, &mut notes)?;
+    if rows.is_empty() {
+        bail!("{}: the log has no complete rows", path.display());
+    }
+    Ok(ServoLog { meta, rows, lines, notes })
+}
+
+/// Sorts the rows by time, reads a repeated row once, refuses two different rows of one servo
+/// at one time or one ID on two legs, and reports gaps in time.
+fn tidy(
+    path: &Path,
+    rows: Vec<ServoLogRow>,
+    lines: Vec<usize>,
+    notes: &mut Vec<String>,
+) -> Result<(Vec<ServoLogRow>, Vec<usize>)> {
+    let mut order: Vec<usize> = (0..rows.len()).collect();
+    if rows.windows(2).any(|w| w[1].time_s < w[0].time_s) {
+        let first = rows.windows(2).position(|w| w[1].time_s < w[0].time_s).unwrap_or(0) + 1;
+        notes.push(format!("rows out of time order (first at line {}); read in time order", lines[first]));
+    }
+    order.sort_by(|&a, &b| rows[a].time_s.total_cmp(&rows[b].time_s));
+    let mut leg_of: BTreeMap<u8, (usize, usize)> = BTreeMap::new();
+    let mut seen: BTreeMap<(u8, u64), usize> = BTreeMap::new();
+    let (mut out, mut out_lines, mut repeated) = (Vec::with_capacity(rows.len()), vec![], vec![]);
+    for i in order {
+        let r = rows[i];
+        let &mut (leg, first) = leg_of.entry(r.id).or_insert((r.leg, lines[i]));
+        if leg != r.leg {
+            bail!(
+                "{}: line {} (servo ID {}): leg {}, but line {first} has it on leg {leg}; one servo drives one leg",
+                path.display(),
+                lines[i],
+                r.id,
+                r.leg
+            );
+        }
+        match seen.get(&(r.id, r.time_s.to_bits())) {
+            Some(&j) if rows[j] == r => repeated.push(lines[i]),
+            Some(&j) => bail!(
+                "{}: lines {} and {} (servo ID {}): two different rows at time_s = {}; keep the one the bus read",
+                path.display(),
+                lines[j],
+                lines[i],
+                r.id,
+                r.time_s
+            ),
+            None => {
+                seen.insert((r.id, r.time_s.to_bits()), i);
+                out.push(r);
+                out_lines.push(lines[i]);
+            }
+        }
+    }
+    if !repeated.is_empty() {
+        notes.push(format!("{} repeated row(s) read once ({})", repeated.len(), some_lines(&repeated)));
+    }
+    note_gaps(&out, notes);
+    Ok((out, out_lines))
+}
+
+/// Reports gaps in time longer than [`GAP_CYCLES`] bus cycles (the median step between the
+/// log's distinct times).
+fn note_gaps(rows: &[ServoLogRow], notes: &mut Vec<String>) {
+    let mut times: Vec<f64> = rows.iter().map(|r| r.time_s).collect();
+    times.dedup();
+    let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+    if steps.len() < 3 {
+        return;
+    }
+    steps.sort_by(f64::total_cmp);
+    let cycle = steps[steps.len() / 2];
+    let gaps: Vec<(f64, f64)> =
+        times.windows(2).filter(|w| w[1] - w[0] > GAP_CYCLES * cycle).map(|w| (w[0], w[1] - w[0])).collect();
+    if let Some(&(at, len)) = gaps.iter().max_by(|a, b| a.1.total_cmp(&b.1)) {
+        notes.push(format!(
+            "{} gap(s) in time longer than {GAP_CYCLES} bus cycles (the longest {len:.3} s, after t = {at:.3} s): bus timeouts; a stride left with an empty stance bin is left out of the estimate",
+            gaps.len()
+        ));
+    }
 }
 
 /// The log's columns in order.

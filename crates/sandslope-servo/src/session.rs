@@ -124,7 +124,12 @@ impl Session {
             // weak fails by sinkage at moderate slopes, and a monitor whose grid cannot hold it
             // reads it as the weakest point it has, at the regimes' border (docs/drive.md).
             let prior = LogUniformPrior::new(LIVE_K_S_PRIOR.0, LIVE_K_S_PRIOR.1).expect("a valid range");
-            let inference = CurrentInferenceSettings { simulated_strides: 6, prior, ..Default::default() };
+            let inference = CurrentInferenceSettings {
+                simulated_strides: 6,
+                prior,
+                swing_offset: false,
+                ..Default::default()
+            };
             Some(
                 model_grid(&config.robot, k_n, config.slope_deg, &inference)
                     .map_err(|e| SessionError::Grid(e.to_string()))?,

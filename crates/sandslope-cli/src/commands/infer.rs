@@ -139,7 +139,7 @@ fn bound_note(b: Bound) -> &'static str {
 
 /// `infer --servo-log`: k_s from the stance currents of a `drive` log (docs/model.md §19).
 fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
-    use sandslope::infer::servo::{infer_servo_log, CurrentInferenceSettings, LegTrace};
+    use sandslope::infer::servo::{infer_servo_log, CurrentInferenceSettings};
     let robot = args.robot.load()?;
     let prior = parse_prior(&args.k_s_prior)?;
     if !(3..=1000).contains(&args.grid_points) {
@@ -155,25 +155,14 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
     };
     Slope::from_signed_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
     let terrain = args.terrain.load()?;
-    let legs = 2 * robot.stance_legs() as usize;
-    let mut traces = vec![LegTrace::default(); legs];
-    for (i, r) in log.rows.iter().enumerate() {
-        let t = traces.get_mut(r.leg).ok_or_else(|| {
-            anyhow!(
-                "{}: row {} has leg {}, but the robot has {legs} legs (2 * stance_legs)",
-                path.display(),
-                i + 1,
-                r.leg
-            )
-        })?;
-        t.angle_rad.push(r.leg_angle_rad);
-        t.torque_n_m.push(r.drive_torque_n_m);
+    let traces = log.leg_traces(2 * robot.stance_legs() as usize, path)?;
+    for note in &log.notes {
+        eprintln!("note: {}: {note}", path.display());
     }
     let settings = CurrentInferenceSettings { prior, grid_points: args.grid_points, ..Default::default() };
     let answer = infer_servo_log(&robot, &terrain, slope_deg, &traces, &settings).map_err(|e| match e {
-        sandslope::infer::servo::CurrentInferenceError::TooFewStrides { .. } => {
-            anyhow!("{}: {e}", path.display())
-        }
+        sandslope::infer::servo::CurrentInferenceError::TooFewStrides { .. }
+        | sandslope::infer::servo::CurrentInferenceError::Setting(_) => anyhow!("{}: {e}", path.display()),
         e => anyhow!("{e}"),
     })?;
     let k_n = answer.k_n;
@@ -199,6 +188,18 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
         "P(fail) at {slope_deg} deg: {:.3} (slippage {:.3}, sinkage {:.3})",
         answer.p_fail, answer.p_slippage, answer.p_sinkage
     );
+    if !answer.swing_offset_n_m.is_empty() {
+        let ma: Vec<String> = answer
+            .swing_offset_n_m
+            .iter()
+            .map(|t| format!("{:.0}", 1000.0 * t / sandslope::servo::xl330::TORQUE_CONSTANT_N_M_PER_A))
+            .collect();
+        println!(
+            "current offsets read in the swings and removed, legs 0 to {}: {} mA (as drive torque, in each leg's sense)",
+            ma.len() - 1,
+            ma.join(", ")
+        );
+    }
     println!(
         "k_n {} N/m^3 from the terrain; stance torque K_t I against the stride simulator on {} k_s values (docs/model.md \u{a7}19)",
         sci(k_n),

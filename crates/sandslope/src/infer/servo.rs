@@ -74,6 +74,10 @@ pub struct CurrentInferenceSettings {
     /// Standard deviation added to every bin's, N m (the current's quantisation, 1 mA, and
     /// what the simulator cannot reproduce).
     pub floor_n_m: f64,
+    /// Remove each leg's swing-phase torque (the current sensor's zero offset and its drift,
+    /// [`remove_swing_offset`]) from the log and from the simulated walks alike. The live
+    /// monitor, which reads one stance at a time, leaves it off.
+    pub swing_offset: bool,
 }
 
 impl Default for CurrentInferenceSettings {
@@ -84,6 +88,7 @@ impl Default for CurrentInferenceSettings {
             bins: 6,
             simulated_strides: 8,
             floor_n_m: 0.002,
+            swing_offset: true,
         }
     }
 }
@@ -151,6 +156,74 @@ pub struct ModelGrid {
     pub shear_load_n: Vec<f64>,
     /// Bins per tripod.
     pub bins: usize,
+    /// Whether the profiles are taken after [`remove_swing_offset`] (and a log's must be).
+    pub swing_offset: bool,
+}
+
+/// Fewest samples a swing needs for its median to count as the leg's offset there.
+pub const MIN_SWING_SAMPLES: usize = 3;
+
+/// Removes each leg's current-sensor offset, estimated from its swings (docs/model.md §19).
+///
+/// In swing the C-leg turns through the air, and the drive torque it needs is its own inertia
+/// and friction, which the model (and the emulator) take as zero; what a servo reports then is
+/// its zero-current offset (a Hall sensor's bias, tens of mA on an XL330, and its slow drift
+/// as the servo warms). For each leg, the median torque of each swing after the stand (stride
+/// 0 on: before its first touchdown a leg of the tripod that stands is loaded) is placed at
+/// the swing's mean angle, and every sample's offset is interpolated linearly in the leg's
+/// angle between them (a constant beyond the first and last swing); the angle runs with time,
+/// so a drift slow against a stride is followed. Returns the corrected legs and each leg's
+/// mean offset, N m. A leg with no swing of [`MIN_SWING_SAMPLES`] samples is an error.
+pub fn remove_swing_offset(
+    schedule: &GaitSchedule,
+    legs: &[LegTrace],
+) -> Result<(Vec<LegTrace>, Vec<f64>), CurrentInferenceError> {
+    let half = 0.5 * schedule.period_s;
+    let mut out = Vec::with_capacity(legs.len());
+    let mut offsets = Vec::with_capacity(legs.len());
+    for (j, leg) in legs.iter().enumerate() {
+        let mut swings: std::collections::BTreeMap<i64, (Vec<f64>, Vec<f64>)> = Default::default();
+        for (&a, &tau) in leg.angle_rad.iter().zip(&leg.torque_n_m) {
+            let (stride, since) = schedule.stride_position(j, a);
+            if a.is_finite() && tau.is_finite() && stride >= 0 && since >= half {
+                let e = swings.entry(stride).or_default();
+                e.0.push(a);
+                e.1.push(tau);
+            }
+        }
+        let knots: Vec<(f64, f64)> = swings
+            .into_values()
+            .filter(|(a, _)| a.len() >= MIN_SWING_SAMPLES)
+            .map(|(a, mut tau)| {
+                tau.sort_by(f64::total_cmp);
+                let n = tau.len();
+                let median = if n % 2 == 1 { tau[n / 2] } else { 0.5 * (tau[n / 2 - 1] + tau[n / 2]) };
+                (a.iter().sum::<f64>() / n as f64, median)
+            })
+            .collect();
+        if knots.is_empty() {
+            return Err(CurrentInferenceError::Setting(format!(
+                "leg {j} has no swing with {MIN_SWING_SAMPLES} samples or more: its current sensor's offset cannot be told from its load (a log of whole strides, or a servo that answered in its swings, is needed)"
+            )));
+        }
+        let at = |a: f64| -> f64 {
+            let i = knots.partition_point(|k| k.0 <= a);
+            if i == 0 {
+                knots[0].1
+            } else if i == knots.len() {
+                knots[i - 1].1
+            } else {
+                let ((a0, m0), (a1, m1)) = (knots[i - 1], knots[i]);
+                m0 + (m1 - m0) * (a - a0) / (a1 - a0)
+            }
+        };
+        offsets.push(knots.iter().map(|k| k.1).sum::<f64>() / knots.len() as f64);
+        out.push(LegTrace {
+            angle_rad: leg.angle_rad.clone(),
+            torque_n_m: leg.angle_rad.iter().zip(&leg.torque_n_m).map(|(&a, &t)| t - at(a)).collect(),
+        });
+    }
+    Ok((out, offsets))
 }
 
 /// The stride simulator's settings for the servo sensor's walks, `duration_s` long and sampled
@@ -196,7 +269,10 @@ pub fn model_grid(
                 .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
             let sim = simulate(&scenario, slope_deg, &sim_settings)
                 .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
-            let legs = simulated_legs(&schedule, &sim);
+            let mut legs = simulated_legs(&schedule, &sim);
+            if settings.swing_offset {
+                legs = remove_swing_offset(&schedule, &legs)?.0;
+            }
             let profiles = stance_profiles(&schedule, &legs, bins);
             let (mean, sd, strides) = profile_statistics(&profiles, 2 * bins);
             let shear = stance_shear_load(&schedule, &sim);
@@ -213,6 +289,7 @@ pub fn model_grid(
         regime: vec![],
         shear_load_n: vec![],
         bins,
+        swing_offset: settings.swing_offset,
     };
     for w in walks {
         let (mean, sd, strides, regime, shear) = w?;
@@ -344,6 +421,9 @@ pub struct CurrentInference {
     pub measured_profile_n_m: Vec<f64>,
     /// The grid's k_s, N/m^3, and the posterior probability of each.
     pub posterior: Vec<(f64, f64)>,
+    /// Each leg's current-sensor offset removed, as drive torque (N m; the mean over its
+    /// swings, [`remove_swing_offset`]); empty when none was removed (the live monitor).
+    pub swing_offset_n_m: Vec<f64>,
 }
 
 /// Infers k_s from a whole log's stance currents (`infer --servo-log`). Needs at least three
@@ -356,14 +436,18 @@ pub fn infer_from_currents(
     let schedule =
         GaitSchedule::new(robot, legs.len()).map_err(|e| CurrentInferenceError::Setting(e.to_string()))?;
     let width = 2 * grid.bins;
-    let profiles = stance_profiles(&schedule, legs, grid.bins);
+    let (corrected, offsets) =
+        if grid.swing_offset { remove_swing_offset(&schedule, legs)? } else { (legs.to_vec(), vec![]) };
+    let profiles = stance_profiles(&schedule, &corrected, grid.bins);
     let (mean, sd, n) = profile_statistics(&profiles, width);
     if n < 3 {
         return Err(CurrentInferenceError::TooFewStrides { found: n, needed: 3 });
     }
     let var_obs: Vec<f64> = sd.iter().map(|s| s * s / n as f64).collect();
     let bins: Vec<usize> = (0..width).collect();
-    Ok(posterior_answer(robot, grid, &mean, &var_obs, &bins, n))
+    let mut answer = posterior_answer(robot, grid, &mean, &var_obs, &bins, n);
+    answer.swing_offset_n_m = offsets;
+    Ok(answer)
 }
 
 /// `infer --servo-log` whole: k_n of `terrain` at `slope_deg`, the simulator's grid there, and
@@ -533,6 +617,7 @@ fn posterior_answer(
         strides,
         measured_profile_n_m: mean.to_vec(),
         posterior: grid.k_s.iter().copied().zip(p).collect(),
+        swing_offset_n_m: vec![],
     }
 }
 
@@ -593,5 +678,30 @@ mod tests {
         assert_eq!(p.profiles[0][0], Some(0.1));
         assert_eq!(p.profiles[0][7], Some(0.3));
         assert_eq!(p.counts[0].iter().sum::<usize>(), 2);
+    }
+
+    #[test]
+    fn swing_offset_is_interpolated_between_swings_by_hand() {
+        let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
+        let s = GaitSchedule::new(&robot, 6).unwrap();
+        let td = s.touchdown_angle_rad;
+        // Swings of strides 0 and 1 (angle td + pi to td + 2 pi past each touchdown), three
+        // samples each at offsets 0.01 and 0.03 N m (medians of {0.01, 0.01, 0.5} and
+        // {0.03, -0.2, 0.03}), centred at td + 1.5 pi and td + 3.5 pi; a stance sample of 0.1
+        // N m at td + 2.5 pi, half-way, gets 0.02 removed; one before the first swing
+        // (stride -1's swing, not used) gets the first swing's 0.01; a leg with no swing fails.
+        let pi = std::f64::consts::PI;
+        let a = |x: f64| td + x * pi;
+        let leg = LegTrace {
+            angle_rad: vec![a(-0.5), a(1.25), a(1.5), a(1.75), a(2.5), a(3.25), a(3.5), a(3.75)],
+            torque_n_m: vec![0.7, 0.01, 0.01, 0.5, 0.1, 0.03, -0.2, 0.03],
+        };
+        let (out, offsets) = remove_swing_offset(&s, std::slice::from_ref(&leg)).unwrap();
+        let t = &out[0].torque_n_m;
+        assert!((t[4] - 0.08).abs() < 1e-12, "{t:?}");
+        assert!((t[0] - 0.69).abs() < 1e-12, "{t:?}");
+        assert!((offsets[0] - 0.02).abs() < 1e-12);
+        let stance_only = LegTrace { angle_rad: vec![a(0.5), a(2.5)], torque_n_m: vec![0.1, 0.1] };
+        assert!(remove_swing_offset(&s, &[stance_only]).is_err());
     }
 }

@@ -38,6 +38,18 @@ pub const EXIT_HALTED: i32 = 5;
 pub static DRIVING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 /// Set by Ctrl-C while [`DRIVING`].
 pub static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+/// The signal that set [`STOP`] (2 SIGINT, 15 SIGTERM, 1 SIGHUP): a stopped run exits with
+/// 128 plus it, as every other interrupted run of the tool does.
+pub static STOP_SIGNAL: std::sync::atomic::AtomicI32 = std::sync::atomic::AtomicI32::new(0);
+
+/// The exit code and the name of the signal that stopped a driven run ([`STOP_SIGNAL`]).
+pub fn stop_signal() -> (i32, &'static str) {
+    match STOP_SIGNAL.load(std::sync::atomic::Ordering::SeqCst) {
+        15 => (143, "SIGTERM"),
+        1 => (129, "SIGHUP"),
+        _ => (EXIT_SIGINT, "Ctrl-C"),
+    }
+}
 
 /// `drive` ended other than by completing its run (a failed bus, Ctrl-C, a halt on risk): its
 /// outputs (the log) are kept and the process exits with `code`.
@@ -154,7 +166,9 @@ pub fn clean_up_on_signals() {
     let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
         for signal in signals.forever() {
             if DRIVING.load(std::sync::atomic::Ordering::SeqCst) {
-                // `drive` stops the gait, turns the torque off, keeps its log and exits 130.
+                // `drive` stops the gait, turns the torque off, keeps its log and exits with
+                // 128 + the signal.
+                STOP_SIGNAL.store(signal, std::sync::atomic::Ordering::SeqCst);
                 STOP.store(true, std::sync::atomic::Ordering::SeqCst);
                 continue;
             }

@@ -108,7 +108,12 @@ fn drive_config(args: &ServeArgs) -> Result<Option<DriveConfig>> {
 /// Runs `sandslope serve` until the process is stopped: the flags into the server's
 /// configuration, checked and served by `sandslope-serve`.
 pub fn run(args: ServeArgs) -> Result<()> {
-    let flags = SignalFlags { stop: &crate::error::STOP, driving: &crate::error::DRIVING };
+    let flags = SignalFlags {
+        stop: &crate::error::STOP,
+        driving: &crate::error::DRIVING,
+        signal: &crate::error::STOP_SIGNAL,
+    };
+    let drive_log = args.drive_run.as_ref().and_then(|r| r.log.clone());
     let drive = drive_config(&args)?.map(|c| (c, flags));
     sandslope_serve::run(ServeConfig {
         dem: args.dem,
@@ -123,5 +128,6 @@ pub fn run(args: ServeArgs) -> Result<()> {
         max_connections: args.max_connections,
         allow_host: args.allow_host,
         drive,
+        drive_log,
     })
 }

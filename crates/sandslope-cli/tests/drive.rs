@@ -288,8 +288,11 @@ fn torque_off_when_the_run_completes() {
     assert!(log_rows(&log).len() > 6 * 100);
 }
 
-#[test]
-fn torque_off_on_ctrl_c() {
+/// A signal mid-run: the gait stops, the torque goes off, the log is kept whole (read back
+/// with nothing to repair), and the exit code is 128 + the signal: 130 for SIGINT (Ctrl-C),
+/// 143 for SIGTERM (docs/drive.md: as every interrupted run of the tool, so that a
+/// supervisor's stop is told from a person's).
+fn interrupted_by(signal: &str, code: i32, name: &str) {
     let _one = real_time();
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("log.csv");
@@ -300,8 +303,9 @@ fn torque_off_on_ctrl_c() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // Ctrl-C once the gait runs (the setup's simulated walks take seconds on a loaded machine;
-    // an interrupt before it ends the process with nothing moved), then a second into it.
+    // The signal once the servos move (the setup's simulated walks take seconds on a loaded
+    // machine; a signal before it ends the process with nothing moved), then a second into
+    // it: the 1 s stand, or the gait.
     let mut stderr = child.stderr.take().unwrap();
     let mut seen = Vec::new();
     let started = std::time::Instant::now();
@@ -316,16 +320,35 @@ fn torque_off_on_ctrl_c() {
         seen.extend_from_slice(&buf[..n]);
     }
     std::thread::sleep(std::time::Duration::from_secs(1));
-    let killed = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    let killed = Command::new("kill").args([signal, &child.id().to_string()]).status().unwrap();
     assert!(killed.success());
     let out = child.wait_with_output().unwrap();
     let mut rest = String::new();
     std::io::Read::read_to_string(&mut stderr, &mut rest).unwrap();
     let all = format!("{}{}{rest}", text(&out), String::from_utf8_lossy(&seen));
-    assert_eq!(out.status.code(), Some(130), "{all}");
-    assert!(all.contains("interrupted (Ctrl-C)"), "{all}");
+    assert_eq!(out.status.code(), Some(code), "{all}");
+    assert!(all.contains(&format!("interrupted ({name})")), "{all}");
     assert!(all.contains("emulator: torque off on every servo"), "{all}");
-    assert!(!log_rows(&log).is_empty(), "the log is kept");
+    assert!(std::fs::read_to_string(&log).unwrap().ends_with('\n'), "the log ends mid-row");
+    let read = sandslope_io::servo_log::read_servo_log(&log).unwrap();
+    assert!(read.notes.is_empty(), "{:?}", read.notes);
+    // Every servo's rows, up to the interruption (during the stand or the gait, on a loaded
+    // machine).
+    let mut ids: Vec<u8> = read.rows.iter().map(|r| r.id).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    assert_eq!(ids, vec![1, 2, 3, 4, 5, 6]);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "a temporary file was left");
+}
+
+#[test]
+fn torque_off_on_ctrl_c() {
+    interrupted_by("-INT", 130, "Ctrl-C");
+}
+
+#[test]
+fn torque_off_on_sigterm() {
+    interrupted_by("-TERM", 143, "SIGTERM");
 }
 
 #[test]

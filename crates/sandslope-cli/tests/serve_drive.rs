@@ -263,7 +263,9 @@ fn attribute(dom: &str, anchor: &str, name: &str) -> Option<String> {
 #[test]
 fn the_stop_endpoint_stops_the_gait_and_turns_the_torque_off() {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let server = Server::start(&["--duration", "60"]);
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("stopped.csv");
+    let server = Server::start(&["--duration", "60", "--log", log.to_str().unwrap()]);
     server.wait_for(Duration::from_secs(120), |s| s["state"] == "driving");
     // A GET does not stop a robot.
     assert_eq!(server.request("GET", "/api/drive/stop").0, 405);
@@ -276,28 +278,53 @@ fn the_stop_endpoint_stops_the_gait_and_turns_the_torque_off() {
     assert!(end["emulator"].as_str().unwrap().starts_with("emulator: torque off on every servo"), "{end}");
     let (code, _) = server.request("GET", "/api/predict?slope=10");
     assert_eq!(code, 200, "the server serves on after the stop");
+    // The log is in place while the server serves on (a later Ctrl-C would not take it back).
+    check_log(dir.path(), &log, 0.0);
 }
 
-fn signal_mid_run(signal: &str) {
+/// `--log`'s file after a run: in place, whole (its last row ends with a line end, the reader
+/// repaired nothing), every servo's rows up to at least `until` s, and nothing else left in
+/// its folder (no temporary file).
+fn check_log(dir: &std::path::Path, log: &std::path::Path, until: f64) {
+    let text = std::fs::read_to_string(log).unwrap();
+    assert!(text.ends_with('\n'), "the log ends mid-row");
+    let read = sandslope_io::servo_log::read_servo_log(log).unwrap();
+    assert!(read.notes.is_empty(), "{:?}", read.notes);
+    assert!(read.rows.last().unwrap().time_s >= until, "{} < {until}", read.rows.last().unwrap().time_s);
+    let mut ids: Vec<u8> = read.rows.iter().map(|r| r.id).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    assert_eq!(ids, vec![1, 2, 3, 4, 5, 6]);
+    let left: Vec<_> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+}
+
+/// A signal mid-run: the gait stops, the torque is turned off and read back, the log is put in
+/// place whole, and the server exits with 128 + the signal (130 for SIGINT, 143 for SIGTERM,
+/// as every interrupted run of the tool; docs/drive.md says why).
+fn signal_mid_run(signal: &str, expect: i32) {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let server = Server::start(&["--duration", "60"]);
-    server.wait_for(Duration::from_secs(120), |s| {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("served.csv");
+    let server = Server::start(&["--duration", "60", "--log", log.to_str().unwrap()]);
+    let (st, _) = server.wait_for(Duration::from_secs(120), |s| {
         s["state"] == "driving" && s["time_s"].as_f64().unwrap() > 0.5
     });
     let (code, stderr) = server.signal(signal);
-    assert_eq!(code, Some(130), "{stderr}");
+    assert_eq!(code, Some(expect), "{stderr}");
     assert!(stderr.contains("torque off confirmed on servos 1, 2, 3, 4, 5, 6"), "{stderr}");
     assert!(stderr.contains("emulator: torque off on every servo"), "{stderr}");
+    check_log(dir.path(), &log, st["time_s"].as_f64().unwrap());
 }
 
 #[test]
 fn ctrl_c_turns_the_torque_off_before_the_server_exits() {
-    signal_mid_run("-INT");
+    signal_mid_run("-INT", 130);
 }
 
 #[test]
 fn sigterm_turns_the_torque_off_before_the_server_exits() {
-    signal_mid_run("-TERM");
+    signal_mid_run("-TERM", 143);
 }
 
 /// A servo that stops answering mid-run: the run fails naming it, the torque goes off on the

@@ -15,15 +15,17 @@
 //! while `driving` is set), or the server fails, the gait is stopped and the torque turned off
 //! before the process ends.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 
 use serde::Serialize;
 
 use sandslope_servo::driver::{DriveReport, LiveEstimate, ServoSample, TorqueOff};
+use sandslope_servo::log::{drive_logged, LogTarget};
 use sandslope_servo::session::{emulator_summary, DriveConfig, Session};
-use sandslope_servo::{DriveError, DriveOutcome};
+use sandslope_servo::DriveOutcome;
 
 use crate::reply::{json, ApiError};
 
@@ -130,20 +132,34 @@ pub struct DriveThread {
     stop: &'static AtomicBool,
 }
 
-/// Flags shared with the process's signal handler: the handler sets `stop` instead of ending
-/// the process while `driving` is set, and the drive thread ends the process (exit 130) once
-/// the torque is off.
+/// Flags shared with the process's signal handler: the handler sets `stop` (and `signal`)
+/// instead of ending the process while `driving` is set, and the drive thread ends the process
+/// once the torque is off and the log is in place, with 128 + the signal (130 for SIGINT, 143
+/// for SIGTERM), as the CLI's every interrupted run exits.
 #[derive(Debug, Clone, Copy)]
 pub struct SignalFlags {
     /// Set by a signal while driving.
     pub stop: &'static AtomicBool,
     /// Set while the servos may have torque on.
     pub driving: &'static AtomicBool,
+    /// The signal's number (0 until one arrives).
+    pub signal: &'static AtomicI32,
+}
+
+/// The served run's log (`serve --drive --log`) and the names its header records.
+#[derive(Debug, Clone)]
+pub struct LogFile {
+    /// The log's path.
+    pub path: PathBuf,
+    /// The robot as named on the command line.
+    pub robot: String,
+    /// The terrain as named on the command line.
+    pub terrain: String,
 }
 
 impl DriveThread {
     /// Starts driving an opened session on a thread of its own.
-    pub fn start(session: Session, flags: SignalFlags) -> std::io::Result<DriveThread> {
+    pub fn start(session: Session, flags: SignalFlags, log: Option<LogFile>) -> std::io::Result<DriveThread> {
         let config: &DriveConfig = session.config();
         let live = Arc::new(LiveDrive {
             status: Mutex::new(DriveStatus {
@@ -162,7 +178,7 @@ impl DriveThread {
         let shared = Arc::clone(&live);
         let handle = std::thread::Builder::new()
             .name("drive".into())
-            .spawn(move || run(session, &shared, flags))
+            .spawn(move || run(session, &shared, flags, log))
             .inspect_err(|_| flags.driving.store(false, Ordering::SeqCst))?;
         Ok(DriveThread { live, handle: Some(handle), stop: flags.stop })
     }
@@ -179,7 +195,7 @@ impl DriveThread {
 
 /// The drive thread: the run, its status kept for the page, torque off, then (after a
 /// signal) the end of the process.
-fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags) {
+fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<LogFile>) {
     // Either flag stops the gait: the stop button's or the signal handler's.
     let stop = AtomicBool::new(false);
     // Each leg's speed from its positions a quarter second apart (Present Velocity, read just
@@ -202,6 +218,7 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags) {
             }
         }
         let known: Vec<f64> = speeds.iter().flatten().copied().collect();
+        let known = &known;
         live.update(|st| {
             if s.leg == 0 {
                 st.cycles += 1;
@@ -214,7 +231,6 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags) {
                 st.leg_speed_rad_s = known.iter().sum::<f64>() / known.len() as f64;
             }
         });
-        Ok(())
     };
     let mut on_live = |l: &LiveEstimate| {
         live.update(|st| {
@@ -225,19 +241,45 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags) {
             st.live = Some(l.clone());
         });
     };
-    let (report, failure) = session.drive(&stop, &mut on_sample, &mut on_live);
+    let target = log.as_ref().map(|l| LogTarget { path: &l.path, robot: &l.robot, terrain: &l.terrain });
+    let driven = drive_logged(&mut session, target, &stop, &mut on_sample, &mut on_live);
+    // The log in place now: the server serves on, and the outputs a later signal finds staged
+    // are discarded (the CLI stages every output until its run succeeds).
+    let committed = sandslope_io::files::commit_outputs();
     let emulator = session.close().map(|r| emulator_summary(&r));
-    finish(live, &report, failure.as_ref(), emulator);
+    let (report, mut failure) = match driven {
+        Ok((report, failure)) => (report, failure.map(|e| e.to_string())),
+        // The log could not be started (nothing moved).
+        Err(e) => (
+            DriveReport {
+                outcome: Err(format!("{e:#}")),
+                cycles: 0,
+                rate_hz: 0.0,
+                live: vec![],
+                torque_off: TorqueOff::default(),
+            },
+            Some(format!("the log could not be written: {e:#}")),
+        ),
+    };
+    if let (Err(e), None) = (committed, &failure) {
+        failure = Some(format!("the log could not be put in place: {e:#}"));
+    }
+    finish(live, &report, failure.as_deref(), emulator);
+    if let Some(l) = &log {
+        eprintln!("drive: log {}", l.path.display());
+    }
     flags.driving.store(false, Ordering::SeqCst);
     if flags.stop.load(Ordering::SeqCst) && !live.stop.load(Ordering::SeqCst) {
-        // A signal asked the process to end: the torque is off, so it may.
-        eprintln!("interrupted: the gait was stopped and the torque turned off");
-        std::process::exit(130);
+        // A signal asked the process to end: the torque is off and the log in place, so it may.
+        let signal = flags.signal.load(Ordering::SeqCst);
+        let code = 128 + if signal > 0 { signal } else { 2 };
+        eprintln!("interrupted (signal {signal}): the gait was stopped and the torque turned off");
+        std::process::exit(code);
     }
 }
 
 /// The run's end in the status, and on stderr as `drive` says it.
-fn finish(live: &LiveDrive, report: &DriveReport, failure: Option<&DriveError>, emulator: Option<String>) {
+fn finish(live: &LiveDrive, report: &DriveReport, failure: Option<&str>, emulator: Option<String>) {
     let off = &report.torque_off;
     let list = |ids: &[u8]| ids.iter().map(u8::to_string).collect::<Vec<_>>().join(", ");
     eprintln!(

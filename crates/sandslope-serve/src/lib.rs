@@ -66,6 +66,8 @@ pub struct ServeConfig {
     /// The robot driven while serving (`--drive`): the run `sandslope drive` makes of the same
     /// flags, and the signal handler's flags ([`drive`]).
     pub drive: Option<(DriveConfig, drive::SignalFlags)>,
+    /// The driven run's log (`--log`), written as `sandslope drive --log` writes it.
+    pub drive_log: Option<PathBuf>,
 }
 
 /// Checks a timeout flag: a finite number of seconds in 0.1..=86400.
@@ -114,6 +116,9 @@ pub fn run(args: ServeConfig) -> Result<()> {
     let served = served::Served::load(args.robot.clone(), args.terrain.clone(), args.dem.clone())?;
     // The run: its monitor's grid and its bus, before listening (a missing port fails here,
     // nothing having moved).
+    if let Some(p) = &args.drive_log {
+        sandslope_io::files::check_parent_exists(p)?;
+    }
     let session = match args.drive {
         Some((config, flags)) => Some((Session::open(config)?, flags)),
         None => None,
@@ -130,7 +135,12 @@ pub fn run(args: ServeConfig) -> Result<()> {
     let driving = match session {
         Some((session, flags)) => {
             let servos = session.config().settings.servos.len();
-            let thread = drive::DriveThread::start(session, flags)?;
+            let log = args.drive_log.clone().map(|path| drive::LogFile {
+                path,
+                robot: args.robot.clone(),
+                terrain: args.terrain.clone(),
+            });
+            let thread = drive::DriveThread::start(session, flags, log)?;
             server.show_drive(std::sync::Arc::clone(&thread.live));
             eprintln!(
                 "driving {servos} servos: the page's Drive tab shows the run; its stop button or Ctrl-C stops the gait and turns the torque off"

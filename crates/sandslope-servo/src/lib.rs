@@ -8,6 +8,7 @@
 //!   its safety logic: torque off on every exit, Ctrl-C, a lost servo and a watchdog;
 //! - [`session`]: one run as every front end starts it, from the typed [`session::DriveConfig`]
 //!   that `drive`'s and `serve --drive`'s flags are translated into;
+//! - [`log`]: the run's log as every front end writes it (header, rows, the output path);
 //! - [`emulator`]: a bus of virtual XL330s on a pseudo-terminal, whose shafts move as commanded
 //!   and whose currents come from the stride simulator (`sandslope::simulate`).
 //!
@@ -16,6 +17,7 @@
 
 pub mod driver;
 pub mod emulator;
+pub mod log;
 pub mod packet;
 pub mod session;
 pub mod table;

@@ -14,9 +14,10 @@ use clap::{Args, ValueEnum};
 use sandslope::servo::{xl330, GaitSchedule};
 use sandslope::Slope;
 use sandslope_io::robot_terrain::load_servos;
-use sandslope_io::servo_log::{ServoLogRow, ServoLogWriter, DEFAULT_BAUD_RATE};
-use sandslope_servo::driver::{DriveReport, LiveEstimate, ServoSample};
+use sandslope_io::servo_log::DEFAULT_BAUD_RATE;
+use sandslope_servo::driver::{DriveReport, LiveEstimate};
 use sandslope_servo::emulator::EmulatorFaults;
+use sandslope_servo::log::{drive_logged, LogTarget};
 use sandslope_servo::session::{
     default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session,
 };
@@ -24,8 +25,8 @@ use sandslope_servo::table as t;
 use sandslope_servo::{DriveSettings, Profile, ServoConfig};
 
 use crate::args::{check_flag, RobotArgs, TerrainArgs};
-use crate::error::{KeepLog, EXIT_HALTED, EXIT_SIGINT};
-use crate::output::{check_parent_exists, print_json, write_output};
+use crate::error::{KeepLog, EXIT_HALTED};
+use crate::output::{check_parent_exists, print_json};
 
 /// `--profile`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -56,9 +57,6 @@ pub struct DriveArgs {
     pub terrain: TerrainArgs,
     #[command(flatten)]
     pub run: DriveRunArgs,
-    /// Write every servo's state every cycle to this CSV (docs/drive.md, "The log").
-    #[arg(long, value_name = "FILE")]
-    pub log: Option<PathBuf>,
     /// Print the live estimate of k_s and the risk after every stance (implied by --stop-on-risk).
     #[arg(long)]
     pub live: bool,
@@ -72,6 +70,10 @@ pub struct DriveArgs {
 /// `serve --drive-port`) and `--emulate`, which the `--emulate-*` flags require.
 #[derive(Debug, Clone, Args)]
 pub struct DriveRunArgs {
+    /// Write every servo's state every cycle to this CSV (docs/drive.md, "The log"), kept on
+    /// every exit.
+    #[arg(long, value_name = "FILE")]
+    pub log: Option<PathBuf>,
     /// The slope being climbed, degrees (for the live estimate, the log's header and the emulator).
     #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_negative_numbers = true)]
     pub slope: f64,
@@ -289,7 +291,7 @@ pub fn run(args: DriveArgs) -> Result<()> {
         let schedule = GaitSchedule::new(&config.robot, config.settings.servos.len())?;
         return dry_run(&schedule, &config.settings);
     }
-    if let Some(p) = &args.log {
+    if let Some(p) = &args.run.log {
         check_parent_exists(p)?;
     }
     // The live monitor's grid of simulated stance profiles and the bus (the emulator's
@@ -304,24 +306,6 @@ pub fn run(args: DriveArgs) -> Result<()> {
         servos.len(),
         args.run.duration
     );
-    let schedule = &session.schedule;
-    let meta = vec![
-        ("robot", args.robot.robot.clone()),
-        ("terrain", args.terrain.terrain.clone()),
-        ("slope_deg", format!("{}", args.run.slope)),
-        ("k_n", format!("{}", session.k_n)),
-        ("leg_speed_rad_s", format!("{}", schedule.leg_speed_rad_s)),
-        ("period_s", format!("{}", schedule.period_s)),
-        ("run_up_s", format!("{}", schedule.run_up_s)),
-        ("ids", servos.iter().map(|s| s.id.to_string()).collect::<Vec<_>>().join(" ")),
-        ("directions", servos.iter().map(|s| s.direction.to_string()).collect::<Vec<_>>().join(" ")),
-        (
-            "zero_offsets",
-            servos.iter().map(|s| s.zero_offset_pulses.to_string()).collect::<Vec<_>>().join(" "),
-        ),
-        ("profile", format!("{:?}", session.config().settings.profile).to_lowercase()),
-        ("emulated", session.emulated().to_string()),
-    ];
     let quiet = args.json;
     let mut on_live = |l: &LiveEstimate| {
         if !quiet {
@@ -333,22 +317,12 @@ pub fn run(args: DriveArgs) -> Result<()> {
         }
     };
     let stop = &crate::error::STOP;
-    let (report, failure) = match &args.log {
-        Some(path) => {
-            let mut outcome = None;
-            write_output(path, |file| {
-                let mut log = ServoLogWriter::new(std::io::BufWriter::new(file), &meta)?;
-                let mut on_sample = |s: &ServoSample| log.write(&row(s));
-                let r = session.drive(stop, &mut on_sample, &mut on_live);
-                // The log is the record of what happened: flushed and kept on every exit.
-                log.finish().map_err(|e| sandslope_io::WriteError { path: path.clone(), source: e })?;
-                outcome = Some(r);
-                Ok(())
-            })?;
-            outcome.expect("set in the closure")
-        }
-        None => session.drive(stop, &mut |_| Ok(()), &mut on_live),
-    };
+    let log = args.run.log.as_deref().map(|path| LogTarget {
+        path,
+        robot: &args.robot.robot,
+        terrain: &args.terrain.terrain,
+    });
+    let (report, failure) = drive_logged(&mut session, log, stop, &mut |_| {}, &mut on_live)?;
     crate::error::DRIVING.store(false, Ordering::SeqCst);
     if let Some(r) = session.close() {
         eprintln!("{}", emulator_summary(&r));
@@ -362,11 +336,14 @@ pub fn run(args: DriveArgs) -> Result<()> {
             let code = e.exit_code();
             Err(KeepLog { code, message: e.to_string() }.into())
         }
-        (None, Ok(sandslope_servo::DriveOutcome::Interrupted { time_s })) => Err(KeepLog {
-            code: EXIT_SIGINT,
-            message: format!("interrupted (Ctrl-C) at t = {time_s:.2} s; the torque was turned off"),
+        (None, Ok(sandslope_servo::DriveOutcome::Interrupted { time_s })) => {
+            let (code, signal) = crate::error::stop_signal();
+            Err(KeepLog {
+                code,
+                message: format!("interrupted ({signal}) at t = {time_s:.2} s; the torque was turned off"),
+            }
+            .into())
         }
-        .into()),
         (None, Ok(sandslope_servo::DriveOutcome::Halted { time_s, p_fail })) => Err(KeepLog {
             code: EXIT_HALTED,
             message: format!(
@@ -377,25 +354,6 @@ pub fn run(args: DriveArgs) -> Result<()> {
         }
         .into()),
         _ => Ok(()),
-    }
-}
-
-fn row(s: &ServoSample) -> ServoLogRow {
-    ServoLogRow {
-        time_s: s.time_s,
-        id: s.id,
-        leg: s.leg,
-        tripod: s.tripod,
-        present_position: s.state.position,
-        present_velocity: s.state.velocity,
-        present_current_ma: i32::from(s.state.current_ma),
-        load_percent: 100.0 * f64::from(s.state.current_ma) / (xl330::STALL_CURRENT_A * 1000.0),
-        input_voltage_v: f64::from(s.state.voltage) / (1.0 / xl330::VOLT_PER_VOLTAGE_UNIT).round(),
-        temperature_c: i32::from(s.state.temperature_c),
-        hardware_error: s.hardware_error,
-        goal_position: s.goal_position,
-        leg_angle_rad: s.leg_angle_rad,
-        drive_torque_n_m: s.drive_torque_n_m,
     }
 }
 

@@ -430,24 +430,8 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
             .collect(),
     };
     let calibration = calibrate(evidence, &speeds, &anchoring);
-    let (simulator_fit, simulator_fit_failure) = if evidence.simulator_fit {
-        match calibrate_jointly_with(
-            &joint_setup(evidence, &speeds, &anchoring),
-            SpeedModel::simulator_for_fit(),
-        ) {
-            Ok(fit) => (Some(fit), None),
-            Err(e) => (None, Some(format!("the simulator's joint fit failed: {e}"))),
-        }
-    } else {
-        (None, None)
-    };
-    let (simulator_fit_misses, misses_failure) = match &simulator_fit {
-        None => (Vec::new(), None),
-        Some(fit) => match simulator_fit_misses(fit, &speeds) {
-            Ok(m) => (m, None),
-            Err(e) => (Vec::new(), Some(format!("the simulator fit's misses could not be walked: {e}"))),
-        },
-    };
+    let (simulator_fit, simulator_fit_misses, simulator_fit_warnings) =
+        simulator_fit_section(evidence, &speeds, &anchoring);
     let (robot, terrain) = model(evidence, calibration.as_ref())?;
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
     // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...): a
@@ -495,8 +479,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         .collect();
     let mut warnings = track_use.warnings;
     warnings.extend(simulator_refusal);
-    warnings.extend(simulator_fit_failure);
-    warnings.extend(misses_failure);
+    warnings.extend(simulator_fit_warnings);
     if let Some(c) = &calibration {
         warnings.extend(disagreements::calibration_warnings(c));
     }
@@ -538,6 +521,34 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         warnings,
         plots,
     })
+}
+
+/// The simulator's joint fit when the evidence asks for it: the fit, its misses walked with
+/// the simulator, and a warning for each part that failed (the report keeps the rest).
+fn simulator_fit_section(
+    evidence: &Evidence,
+    speeds: &[SpeedObservation],
+    anchoring: &[AnchoringObservation],
+) -> (Option<JointCalibration>, Vec<SimulatorMiss>, Vec<String>) {
+    let (simulator_fit, simulator_fit_failure) = if evidence.simulator_fit {
+        match calibrate_jointly_with(
+            &joint_setup(evidence, speeds, anchoring),
+            SpeedModel::simulator_for_fit(),
+        ) {
+            Ok(fit) => (Some(fit), None),
+            Err(e) => (None, Some(format!("the simulator's joint fit failed: {e}"))),
+        }
+    } else {
+        (None, None)
+    };
+    let (simulator_fit_misses, misses_failure) = match &simulator_fit {
+        None => (Vec::new(), None),
+        Some(fit) => match simulator_fit_misses(fit, speeds) {
+            Ok(m) => (m, None),
+            Err(e) => (Vec::new(), Some(format!("the simulator fit's misses could not be walked: {e}"))),
+        },
+    };
+    (simulator_fit, simulator_fit_misses, simulator_fit_failure.into_iter().chain(misses_failure).collect())
 }
 
 /// The robot and terrain every table and figure uses (see [`report`]).

@@ -9,12 +9,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
 
-use sandslope::gait::{track as track_recordings, GaitOptions, Recording, Upslope};
 use sandslope::measure::AirMode;
-use sandslope::Slope;
-use sandslope_io::mocap::{self, MocapFormat};
+use sandslope_io::mocap::MocapFormat;
 use sandslope_request::error::Words;
 use sandslope_request::fit::{FitAnswer, FitRequest};
+use sandslope_request::track::{Touchdowns, TrackRequest, Tracked};
 
 use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
@@ -90,28 +89,21 @@ pub fn track<'py>(
             ))
         }
     };
-    let mut options = GaitOptions::new(period)
-        .and_then(|o| o.with_cutoff(cutoff_hz))
-        .map_err(|e| value_error(e.renamed("cutoff_hz")))?
-        .with_max_gap(max_gap);
-    if let Some(u) = upslope {
-        options = options.with_upslope(Upslope::new(u).map_err(|e| value_error(e.renamed("upslope")))?);
-    }
-    let slope = slope_deg
-        .map(|d| Slope::from_degrees(d).map_err(|e| value_error(e.renamed("slope_deg"))))
-        .transpose()?;
-    if let Some(t) = &touchdowns {
-        if t.len() != paths.len() {
-            return Err(value_error(format!(
-                "touchdowns has {} lists for {} recordings: give one per recording, in order",
-                t.len(),
-                paths.len()
-            )));
-        }
-    }
-    let (captures, result) = py
-        .detach(|| read_and_track(&paths, format, body.as_deref(), touchdowns.as_deref(), &options, slope))
-        .map_err(anyhow_error)?;
+    // The request `sandslope track` makes: one check and one path from files to the library.
+    let request = TrackRequest {
+        files: paths,
+        format,
+        body,
+        upslope,
+        max_gap,
+        cutoff_hz,
+        touchdowns: touchdowns.map_or(Touchdowns::Estimated, Touchdowns::Times),
+        slope_deg,
+        stride_period_s: period,
+    };
+    request.options(Words::Keyword).map_err(|e| value_error(e.message()))?;
+    let Tracked { captures, result, .. } =
+        py.detach(|| request.answer(Words::Keyword, &mut || ())).map_err(|e| value_error(e.message()))?;
     let d = pythonize(py, &result).map_err(value_error)?.cast_into::<PyDict>()?;
     let missing = || value_error("track result without recordings or per_step");
     let recordings = d.get_item("recordings")?.ok_or_else(missing)?;
@@ -127,29 +119,4 @@ pub fn track<'py>(
         steps.get_item(i)?.set_item("file", &files[st.recording])?;
     }
     Ok(d)
-}
-
-/// Reads `paths` (touchdowns, when given, one list per path) and analyses them pooled at
-/// `slope`, as `sandslope track` does; errors name the file.
-pub(crate) fn read_and_track(
-    paths: &[PathBuf],
-    format: Option<MocapFormat>,
-    body: Option<&str>,
-    touchdowns: Option<&[Vec<f64>]>,
-    options: &GaitOptions,
-    slope: Option<Slope>,
-) -> anyhow::Result<(Vec<mocap::Capture>, sandslope::gait::TrackResult)> {
-    let captures: Vec<mocap::Capture> =
-        paths.iter().map(|p| mocap::read(p, format, body)).collect::<anyhow::Result<_>>()?;
-    let recordings: Vec<Recording> =
-        captures.iter().enumerate().map(|(i, c)| c.recording(touchdowns.map(|t| t[i].as_slice()))).collect();
-    let result = track_recordings(&recordings, options, slope).map_err(|e| match e {
-        sandslope::GaitError::Param { index, source } => anyhow::anyhow!(
-            "{}: {source} (at its frame rate {} Hz)",
-            captures[index].path.display(),
-            captures[index].frame_rate_hz
-        ),
-        other => anyhow::anyhow!("{other}"),
-    })?;
-    Ok((captures, result))
 }

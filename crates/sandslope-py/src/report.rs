@@ -1,20 +1,15 @@
 //! `sandslope.report(...)`: the report's one library value (`sandslope::report::report`) as a
-//! dict with exactly the keys and values of `report.json`. Files are read by `sandslope-io`,
-//! motion capture as `sandslope.track` reads it.
+//! dict with exactly the keys and values of `report.json`. The evidence is read by the request
+//! layer's `ReportRequest`, as `sandslope report` reads it (motion capture as `track` does).
 
 use std::path::PathBuf;
 
 use pyo3::prelude::*;
 
-use sandslope::gait::{GaitOptions, Upslope};
-use sandslope::report::{report as build_report, Evidence, TrackReading, TrackedSlope};
-use sandslope::Slope;
-use sandslope_io::force_tests::report_force_tests;
 use sandslope_io::mocap::MocapFormat;
-use sandslope_io::presets::{is_default, PresetKind};
-use sandslope_io::{load_anchoring_times, load_speeds};
+use sandslope_request::error::Words;
+use sandslope_request::report::{ReportRequest, TracksAt};
 
-use crate::measure::read_and_track;
 use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
 
@@ -48,58 +43,31 @@ pub fn report(
     if let Some(dir) = html.as_ref().filter(|d| d.exists() && !d.is_dir()) {
         return Err(value_error(format!("html = {}: exists and is not a folder", dir.display())));
     }
-    if !(max_risk > 0.0 && max_risk < 1.0) {
-        return Err(value_error(format!(
-            "max_risk = {max_risk} must be a probability strictly between 0 and 1"
-        )));
-    }
     let format: Option<MocapFormat> = tracks_format.map(str::parse).transpose().map_err(value_error)?;
-    let mut options = GaitOptions::new(robot.inner.stride_period()).map_err(value_error)?;
-    if let Some(u) = tracks_upslope {
-        options =
-            options.with_upslope(Upslope::new(u).map_err(|e| value_error(e.renamed("tracks_upslope")))?);
-    }
-    let mut tracks = tracks.unwrap_or_default();
-    tracks.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // The request `sandslope report` makes: its checks, its evidence and its answer.
+    let request = ReportRequest {
+        robot_source,
+        terrain_source,
+        observed,
+        forces,
+        t1,
+        tracks: tracks
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(slope_deg, files)| TracksAt { slope_deg, files })
+            .collect(),
+        tracks_format: format,
+        tracks_body,
+        tracks_upslope,
+        max_risk,
+        simulator_fit,
+    };
+    request.check(Words::Keyword).map_err(|e| value_error(e.message()))?;
     let robot = robot.inner.clone();
     let terrain = terrain.inner.clone();
     let value = py
         .detach(|| -> anyhow::Result<_> {
-            let mut tracked = Vec::new();
-            for (slope_deg, paths) in &tracks {
-                let slope = Slope::from_degrees(*slope_deg).map_err(|e| e.renamed("tracks slope"))?;
-                if paths.is_empty() {
-                    anyhow::bail!("tracks at {slope_deg} deg: no recording given");
-                }
-                let (captures, result) =
-                    read_and_track(paths, format, tracks_body.as_deref(), None, &options, Some(slope))?;
-                let files = captures.iter().map(|c| c.path.display().to_string()).collect();
-                tracked.push(TrackedSlope { slope_deg: *slope_deg, files, result });
-            }
-            let evidence = Evidence {
-                forces: report_force_tests(forces.as_deref(), &terrain_source)?,
-                observed: observed
-                    .map(|p| load_speeds(&p).map(|s| (p.display().to_string(), s)))
-                    .transpose()?,
-                anchoring: t1
-                    .map(|p| load_anchoring_times(&p).map(|a| (p.display().to_string(), a)))
-                    .transpose()?,
-                tracks: tracked,
-                track_reading: TrackReading {
-                    format: format.map(|f| f.name().to_string()),
-                    body: tracks_body.clone(),
-                    upslope: tracks_upslope.map(|u| Upslope::new(u).map_or(u, |u| u.vector())),
-                },
-                max_risk,
-                simulator_fit,
-                builtin_robot: is_default(&robot_source, PresetKind::Robot),
-                builtin_terrain: is_default(&terrain_source, PresetKind::Terrain),
-                robot,
-                robot_source,
-                terrain,
-                terrain_source,
-            };
-            let value = build_report(&evidence)?;
+            let value = request.answer(robot, terrain, Words::Keyword)?;
             if let Some(dir) = &html {
                 sandslope_render::report::write_dir(dir, &value)?;
             }

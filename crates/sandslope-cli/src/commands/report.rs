@@ -9,16 +9,15 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 
-use sandslope::gait::{GaitOptions, Upslope};
-use sandslope::report::{report, Evidence, TrackReading, TrackedSlope};
+use sandslope::gait::GaitOptions;
+use sandslope::report::{report, Evidence};
 use sandslope::Slope;
-use sandslope_io::force_tests::report_force_tests;
 use sandslope_io::mocap::MocapFormat;
-use sandslope_io::presets::{is_default, PresetKind};
-use sandslope_io::{load_anchoring_times, load_speeds};
+use sandslope_request::error::Words;
+use sandslope_request::report::{ReportRequest, TracksAt};
 
 use crate::args::{parse_max_risk, LevelStepArgs, RobotArgs, TerrainArgs};
-use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions};
+use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, warn_without_steps};
 
 /// Arguments of `sandslope report`.
 #[derive(Debug, Args)]
@@ -61,7 +60,7 @@ pub struct ReportArgs {
         allow_hyphen_values = true,
         requires = "tracks"
     )]
-    pub tracks_upslope: Option<Upslope>,
+    pub tracks_upslope: Option<[f64; 3]>,
     /// Risk threshold for the safe-slope limit.
     #[arg(long, allow_negative_numbers = true, value_name = "P", default_value = "0.05", value_parser = parse_max_risk)]
     pub max_risk: f64,
@@ -115,34 +114,25 @@ fn parse_tracks(s: &str) -> Result<TracksArg, String> {
     Ok(TracksArg { text: s.to_string(), slope_deg, pattern: pattern.to_string() })
 }
 
-/// Reads and analyses the `--tracks` recordings, one pooled analysis per slope, lowest slope
-/// first; `period` is the robot's stride period.
-fn load_tracks(args: &ReportArgs, period: f64) -> Result<Vec<TrackedSlope>> {
+/// The `--tracks` recordings per slope, lowest slope first: each slope's patterns expanded,
+/// a file named twice (a path and a glob that matches it) read once.
+fn tracks(args: &ReportArgs) -> Result<Vec<TracksAt>> {
     let mut slopes: Vec<f64> = args.tracks.iter().map(|t| t.slope_deg).collect();
     slopes.sort_by(f64::total_cmp);
     slopes.dedup();
-    let mut options = GaitOptions::new(period).map_err(|e| anyhow!("the robot's stride period: {e}"))?;
-    if let Some(u) = args.tracks_upslope {
-        options = options.with_upslope(u);
-    }
-    let read =
-        CaptureOptions { format: args.tracks_format, body: args.tracks_body.as_deref(), cutoff_flag: None };
     let mut out = Vec::new();
     for slope_deg in slopes {
         let mut files: Vec<PathBuf> = Vec::new();
         for t in args.tracks.iter().filter(|t| t.slope_deg == slope_deg) {
             let found = expand(std::slice::from_ref(&t.pattern))
                 .with_context(|| format!("--tracks `{}`: no recording to read ({TRACKS_FORM})", t.text))?;
-            // A file named twice (a path and a glob that matches it) is read once.
             for f in found {
                 if !files.contains(&f) {
                     files.push(f);
                 }
             }
         }
-        let slope = Slope::from_degrees(slope_deg).map_err(|e| anyhow!("--tracks: {e}"))?;
-        let tracked = track_files(&files, read, &[], &options, Some(slope))?;
-        out.push(TrackedSlope { slope_deg, files: tracked.names, result: tracked.result });
+        out.push(TracksAt { slope_deg, files });
     }
     Ok(out)
 }
@@ -184,39 +174,30 @@ pub fn run(args: ReportArgs) -> Result<()> {
     Ok(())
 }
 
-/// Reads the evidence the flags name: on the built-in terrain without --forces, the force
-/// tests are the paper's as its text reports them (the built-in terrain was calibrated from
-/// them).
+/// The evidence the flags name, read by the request layer (as Python's `report` reads it),
+/// with a warning on stderr for each recording without a complete step.
 fn evidence(args: &ReportArgs) -> Result<Evidence> {
     let robot = args.robot.load()?.with_level_step(args.level.level_step);
     let terrain = args.terrain.load()?;
-    let forces = report_force_tests(args.forces.as_deref(), &args.terrain.terrain)?;
-    let observed = match &args.observed {
-        Some(p) => Some((p.display().to_string(), load_speeds(p)?)),
-        None => None,
-    };
-    let anchoring = match &args.t1 {
-        Some(p) => Some((p.display().to_string(), load_anchoring_times(p)?)),
-        None => None,
-    };
-    let tracks = load_tracks(args, robot.stride_period())?;
-    Ok(Evidence {
+    let request = ReportRequest {
         robot_source: args.robot.robot.clone(),
         terrain_source: args.terrain.terrain.clone(),
-        observed,
-        forces,
-        anchoring,
-        tracks,
-        track_reading: TrackReading {
-            format: args.tracks_format.map(|f| f.name().to_string()),
-            body: args.tracks_body.clone(),
-            upslope: args.tracks_upslope.map(|u| u.vector()),
-        },
+        observed: args.observed.clone(),
+        forces: args.forces.clone(),
+        t1: args.t1.clone(),
+        tracks: tracks(args)?,
+        tracks_format: args.tracks_format,
+        tracks_body: args.tracks_body.clone(),
+        tracks_upslope: args.tracks_upslope,
         max_risk: args.max_risk,
         simulator_fit: args.simulator_fit,
-        builtin_robot: is_default(&args.robot.robot, PresetKind::Robot),
-        builtin_terrain: is_default(&args.terrain.terrain, PresetKind::Terrain),
-        robot,
-        terrain,
-    })
+    };
+    let period = robot.stride_period();
+    let evidence = request.evidence(robot, terrain, Words::Flag)?;
+    if let Ok(options) = GaitOptions::new(period) {
+        for t in &evidence.tracks {
+            warn_without_steps(&t.files, &t.result, &options);
+        }
+    }
+    Ok(evidence)
 }

@@ -9,13 +9,13 @@ use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
 
-use sandslope::gait::{
-    GaitOptions, RecordingSummary, TouchdownSource, TrackResult, Upslope, DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP,
-};
-use sandslope::{Scenario, Slope};
+use sandslope::gait::{RecordingSummary, TouchdownSource, TrackResult, DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP};
+use sandslope::Scenario;
+use sandslope_request::error::Words;
+use sandslope_request::track::{Touchdowns, TrackRequest, Tracked};
 
 use crate::args::{check_flag, RobotArgs, TerrainArgs};
-use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, track_files, CaptureOptions, Tracked};
+use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, warn_without_steps};
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
 use sandslope_io::mocap::{Capture, MocapFormat};
 use sandslope_io::{parse_speeds, SpeedRow};
@@ -40,7 +40,7 @@ pub struct TrackArgs {
         value_parser = |s: &str| parse_upslope(s, "--upslope"),
         allow_hyphen_values = true
     )]
-    pub upslope: Option<Upslope>,
+    pub upslope: Option<[f64; 3]>,
     /// Longest occlusion filled by linear interpolation, frames; longer gaps split the
     /// recording into segments analysed separately.
     #[arg(long, value_name = "FRAMES", default_value_t = DEFAULT_MAX_GAP, allow_negative_numbers = true)]
@@ -168,27 +168,31 @@ pub fn run(args: TrackArgs) -> Result<()> {
     if let Some(p) = &args.plot {
         crate::figures::format_of(p)?;
     }
-    let mut options = GaitOptions::new(period)
-        .and_then(|o| o.with_cutoff(args.cutoff))
-        .map_err(|e| anyhow!("{}", e.renamed("--cutoff")))?
-        .with_max_gap(args.max_gap);
-    if let Some(u) = args.upslope {
-        options = options.with_upslope(u);
-    }
     let files = expand(&args.files)?;
-    if !args.touchdowns.is_empty() && args.touchdowns.len() != files.len() {
-        bail!(
-            "--touchdowns was given {} times for {} recordings: give one touchdowns file per recording, in order",
-            args.touchdowns.len(),
-            files.len()
-        );
-    }
-    let slope_arg =
-        slope.map(|d| Slope::from_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--slope")))).transpose()?;
-    let read =
-        CaptureOptions { format: args.format, body: args.body.as_deref(), cutoff_flag: Some("--cutoff") };
-    let Tracked { captures, names, result } =
-        track_files(&files, read, &args.touchdowns, &options, slope_arg)?;
+    let request = TrackRequest {
+        files,
+        format: args.format,
+        body: args.body.clone(),
+        upslope: args.upslope,
+        max_gap: args.max_gap,
+        cutoff_hz: args.cutoff,
+        touchdowns: if args.touchdowns.is_empty() {
+            Touchdowns::Estimated
+        } else {
+            Touchdowns::Files(args.touchdowns.clone())
+        },
+        slope_deg: slope,
+        stride_period_s: period,
+    };
+    let (options, _) = request.options(Words::Flag)?;
+    // Large exports take a while to parse: a bar on a terminal, nothing when piped.
+    let n = request.files.len() as u64;
+    let bar = crate::progress::progress_bar(n, n < 2, "reading recordings");
+    let tracked = request.answer(Words::Flag, &mut || bar.inc(1));
+    bar.finish_and_clear();
+    let tracked = tracked?;
+    warn_without_steps(&tracked.names, &tracked.result, &options);
+    let Tracked { captures, names, result } = tracked;
 
     let mut campaign = None;
     if let (Some(path), Some(slope_deg)) = (&args.speeds_out, slope) {

@@ -12,8 +12,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Result};
 use csv::StringRecord;
 
-/// A file format `sandslope track` reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A file format `sandslope track` reads (serialised as its [`name`](MocapFormat::name)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum MocapFormat {
     /// OptiTrack Motive CSV export (format version 1.23 or 1.25).
     Motive,

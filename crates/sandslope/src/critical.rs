@@ -134,7 +134,7 @@ pub(crate) fn critical_closed_form(robot: &Robot, slope: Slope, level_step: f64,
     let b = -2.0 * level_step / tau - gs * tau;
     let c = level_step - target;
     let t1 = 2.0 * c / (-b + (b * b - 4.0 * a * c).max(0.0).sqrt());
-    let t_max = (std::f64::consts::FRAC_PI_2 - robot.touchdown_angle()) / robot.leg_speed();
+    let t_max = crate::leg::time_to_deepest(&robot.leg(), robot.leg_speed());
     let capped = t1 >= t_max;
     let d_s = if capped { robot.max_depth() } else { crate::model::leg_depth(robot, t1) };
     (shear_load_per_leg(robot, slope) / (robot.leg_width() * d_s * d_s), capped)

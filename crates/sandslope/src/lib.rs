@@ -40,6 +40,7 @@ pub mod design;
 pub mod error;
 pub mod gait;
 pub mod infer;
+pub mod leg;
 pub mod limits;
 pub mod measure;
 pub mod memory;

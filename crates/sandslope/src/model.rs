@@ -8,6 +8,7 @@
 //! load and shear-equilibrium depth `d_s`, anchoring time `t1`, backward slip `s1`,
 //! propulsion `s2`, net step `s = s2 - s1`, step-averaged speed `v = s / (T/2)`, and the regime.
 
+use crate::leg::{depth_after, time_to_depth, Leg};
 use crate::regime::{classify, Cause, Regime};
 use crate::robot::{LevelStep, Robot};
 use crate::slope::Slope;
@@ -52,9 +53,7 @@ pub fn level_step_length(robot: &Robot, slope: Slope, d_n: f64) -> f64 {
         LevelStep::Slope => d_n,
         LevelStep::Level => d_n / slope.cos(),
     };
-    let r = robot.leg_radius();
-    let x = d_n + robot.hip_height() - r;
-    2.0 * (r * r - x * x).max(0.0).sqrt()
+    robot.leg().level_step(d_n)
 }
 
 /// Applied downslope shear load per stance leg, `F_a = m (g sin(theta) + R omega / dt) / n`, N.
@@ -82,20 +81,14 @@ pub fn anchoring_threshold_k_s(robot: &Robot, slope: Slope) -> f64 {
 ///
 /// `d(0) = 0`; the maximum `2R - h` is reached at `omega t + phi0 = pi/2`.
 pub fn leg_depth(robot: &Robot, t: f64) -> f64 {
-    let r = robot.leg_radius();
-    r * (robot.leg_speed() * t + robot.touchdown_angle()).sin() + r - robot.hip_height()
+    depth_after(&robot.leg(), robot.leg_speed(), t)
 }
 
 /// Anchoring time, `t1 = (asin((d_s + h)/R - 1) - phi0) / omega`, s, in `[0, T/2]`.
 ///
 /// `None` when `d_s > d_max`: the leg never reaches shear equilibrium in this stance.
 pub fn anchoring_time(robot: &Robot, d_s: f64) -> Option<f64> {
-    if d_s > robot.max_depth() || d_s.is_nan() {
-        return None;
-    }
-    let r = robot.leg_radius();
-    let arg = ((d_s + robot.hip_height()) / r - 1.0).clamp(-1.0, 1.0);
-    Some((arg.asin() - robot.touchdown_angle()) / robot.leg_speed())
+    time_to_depth(&robot.leg(), robot.leg_speed(), d_s)
 }
 
 /// Anchoring time at `k_s`, continued at the anchoring limit: where the leg would not anchor

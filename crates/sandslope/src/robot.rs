@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 use crate::error::{positive, ParamError};
+use crate::leg::{CLeg, Leg};
 
 /// The robot as written in a file: the keys of docs/model.md §2, unknown keys rejected.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -450,15 +451,20 @@ impl Robot {
         0.5 * self.stride_period()
     }
 
-    /// Deepest reach of a leg below the surface, `d_max = 2R - h`, m.
-    pub fn max_depth(&self) -> f64 {
-        2.0 * self.spec.leg_radius_m - self.spec.hip_height_m
+    /// The geometry of the robot's legs, the paper's C-leg of radius R with the hip at h.
+    pub fn leg(&self) -> CLeg {
+        CLeg { radius: self.spec.leg_radius_m, hip_height: self.spec.hip_height_m }
     }
 
-    /// Touchdown angle `phi0 = asin((h - R) / R)`, rad, so that the leg depth is 0 at touchdown.
+    /// Deepest reach of a leg below the surface, `d_max = 2R - h`, m ([`Leg::max_depth`]).
+    pub fn max_depth(&self) -> f64 {
+        self.leg().max_depth()
+    }
+
+    /// Touchdown angle `phi0 = asin((h - R) / R)`, rad, so that the leg depth is 0 at touchdown
+    /// ([`Leg::touchdown_angle`]).
     pub fn touchdown_angle(&self) -> f64 {
-        let r = self.spec.leg_radius_m;
-        ((self.spec.hip_height_m - r) / r).clamp(-1.0, 1.0).asin()
+        self.leg().touchdown_angle()
     }
 }
 

@@ -7,14 +7,10 @@ use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
-use serde::Serialize;
 
-use sandslope::infer::{
-    law_posterior, posteriors, Bound, GaitObservation, InferLaw, LawPosterior, LogUniformPrior,
-    SlopePosterior,
-};
+use sandslope::infer::{Bound, InferLaw, LogUniformPrior};
 use sandslope::Slope;
-use sandslope_io::observations::{load_speed_observations, load_step_observation};
+use sandslope_request::infer::{self, GaitEvidence, InferAnswer, InferRequest};
 
 use crate::args::{parse_slope_list, RobotArgs, SlopeSign, TerrainArgs, UncertaintyArgs};
 use crate::figures::infer::InferFigure;
@@ -78,54 +74,38 @@ pub struct InferArgs {
 }
 
 fn parse_prior(text: &str) -> Result<LogUniformPrior> {
-    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
-    let [lo, hi] = parts.as_slice() else {
-        bail!("--k-s-prior = {text} must be MIN:MAX in N/m^3 (e.g. 1e4:1e9)");
-    };
-    let num =
-        |s: &str| s.parse::<f64>().map_err(|_| anyhow!("--k-s-prior: `{s}` is not a number (in {text})"));
-    LogUniformPrior::new(num(lo)?, num(hi)?).map_err(|e| anyhow!("--k-s-prior: {e}"))
+    Ok(infer::prior(infer::parse_prior(text)?)?)
 }
 
 /// Most slopes `--predict` evaluates.
 const MAX_PREDICT: usize = 10_000;
 
-/// Parses `--predict` (the slope-list grammar of `args::parse_slope_list`, climbing slopes).
-fn parse_slopes(text: &str) -> Result<Vec<Slope>> {
-    parse_slope_list("--predict", text, SlopeSign::Uphill, MAX_PREDICT)?
-        .into_iter()
-        .map(|d| Slope::from_degrees(d).map_err(|e| anyhow!("{}", e.renamed("--predict"))))
-        .collect()
-}
-
-fn observations(args: &InferArgs) -> Result<Vec<GaitObservation>> {
-    if let Some(path) = &args.observed {
-        return load_speed_observations(path);
-    }
-    args.steps
-        .iter()
-        .map(|item| {
-            let (deg, file) = item.split_once('=').ok_or_else(|| {
-                anyhow!("--steps `{item}` must be DEG=FILE (the slope of that track output)")
-            })?;
-            let deg: f64 = deg
-                .trim()
-                .parse()
-                .map_err(|_| anyhow!("--steps: slope `{deg}` is not a number (in {item})"))?;
-            let slope = Slope::from_degrees(deg).map_err(|e| anyhow!("{}", e.renamed("--steps slope")))?;
-            load_step_observation(std::path::Path::new(file.trim()), slope)
-        })
-        .collect()
-}
-
-/// The whole result as printed by `--json`.
-#[derive(Debug, Serialize)]
-struct InferRecord<'a> {
-    prior: LogUniformPrior,
-    points: &'a [SlopePosterior],
-    law: Option<&'a LawPosterior>,
-    prediction: &'a [sandslope::infer::RiskPrediction],
-    notes: Vec<String>,
+/// The request the flags make: the observations' source, the prior, the law and, with a
+/// law, the prediction slopes (the slope-list grammar of `args::parse_slope_list`, climbing).
+fn request(args: &InferArgs) -> Result<InferRequest> {
+    let law = args.law.map(|l| match l {
+        LawArg::Linear => InferLaw::Linear,
+        LawArg::Coulomb => InferLaw::Coulomb,
+    });
+    let k_s_prior = infer::parse_prior(&args.k_s_prior)?;
+    let request = InferRequest {
+        evidence: match &args.observed {
+            Some(path) => GaitEvidence::Observed(path.clone()),
+            None => GaitEvidence::Steps(args.steps.clone()),
+        },
+        k_s_prior,
+        law,
+        predict: Vec::new(),
+    };
+    request.prior()?;
+    let predict = if law.is_some() {
+        parse_slope_list("--predict", &args.predict, SlopeSign::Uphill, MAX_PREDICT)?
+    } else {
+        Vec::new()
+    };
+    let request = InferRequest { predict, ..request };
+    request.check()?;
+    Ok(request)
 }
 
 fn bound_note(b: Bound) -> &'static str {
@@ -223,32 +203,16 @@ pub fn run(args: InferArgs) -> Result<()> {
         return run_servo_log(&args, &path);
     }
     let robot = args.robot.load()?;
-    let prior = parse_prior(&args.k_s_prior)?;
-    let predict = if args.law.is_some() { parse_slopes(&args.predict)? } else { Vec::new() };
-    let obs = observations(&args)?;
+    let request = request(&args)?;
+    let obs = request.observations()?;
     let (terrain, note) = args.uncertainty.apply(args.terrain.load()?)?;
     if let Some(p) = &args.plot {
         format_of(p)?;
         check_parent_exists(p)?;
     }
-    let points = posteriors(&robot, terrain.terrain(), &obs, &prior).map_err(|e| anyhow!("{e}"))?;
-    let law = match args.law {
-        None => None,
-        Some(l) => {
-            let law = match l {
-                LawArg::Linear => InferLaw::Linear,
-                LawArg::Coulomb => InferLaw::Coulomb,
-            };
-            Some(
-                law_posterior(&robot, &terrain, &obs, &prior, law, &predict)
-                    .map_err(|e| anyhow!("--law: {e}"))?,
-            )
-        }
-    };
-    let mut notes: Vec<String> = Vec::new();
-    if law.is_some() {
-        notes.extend(note);
-    }
+    let answer = request.answer(&robot, &terrain, note, &obs)?;
+    let InferAnswer { prior, points, law, notes, .. } = &answer;
+    let prior = *prior;
     if let Some(path) = &args.plot {
         let figure = InferFigure {
             points: points.clone(),
@@ -263,12 +227,11 @@ pub fn run(args: InferArgs) -> Result<()> {
         };
         save(path, &figure)?;
     }
-    let prediction = law.as_ref().map_or(&[][..], |l| l.prediction.as_slice());
     if args.json {
-        return print_json(&InferRecord { prior, points: &points, law: law.as_ref(), prediction, notes });
+        return print_json(&answer);
     }
     let mut t = table(&["slope (deg)", "speed (m/s)", "k_n", "k_s median", "k_s 90% interval", "note"]);
-    for p in &points {
+    for p in points {
         t.add_row([
             format!("{}", p.slope_deg),
             format!("{:.4} ± {:.4}", p.speed_m_s, p.speed_se_m_s),
@@ -314,7 +277,7 @@ pub fn run(args: InferArgs) -> Result<()> {
         println!("{t}");
         println!("p_fail = P(sinkage or slippage) with the law's k_s as the median and the terrain's spread (docs/model.md \u{a7}9)");
     }
-    for n in &notes {
+    for n in notes {
         println!("note: {n}");
     }
     Ok(())

@@ -11,7 +11,7 @@ use crate::slope::Slope;
 use crate::terrain::Ground;
 
 /// A shear law tying k_s at different slopes together (as in docs/model.md §14).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum InferLaw {
     /// `k_s(theta) = k_s0 + b theta_deg`.

@@ -1,0 +1,213 @@
+//! `infer`'s request: what the robot's own gait says about the sand (docs/inference.md). From
+//! observed speeds (and anchoring times), the posterior of k_s at each observed slope
+//! ([`sandslope::infer::posteriors`]); with a shear law, the law's joint posterior and the
+//! predicted failure risk at slopes not walked ([`sandslope::infer::law_posterior`]). (`infer
+//! --servo-log`, k_s from a drive's currents, is the servo front end's.)
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use sandslope::infer::{
+    law_posterior, posteriors, GaitObservation, InferLaw, LawPosterior, LogUniformPrior, RiskPrediction,
+    SlopePosterior,
+};
+use sandslope::risk::UncertainTerrain;
+use sandslope::{Robot, Slope};
+use sandslope_io::observations::{load_speed_observations, load_step_observation};
+
+use crate::error::{RequestError, Result};
+
+/// Where the gait observations come from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GaitEvidence {
+    /// A CSV of observed speeds, `slope_deg,speed_m_s,speed_sd_m_s[,n]` (field `observed`).
+    Observed(PathBuf),
+    /// Per-step outputs of `track --csv`, one per slope, each `DEG=FILE` (field `steps`).
+    Steps(Vec<String>),
+}
+
+/// The inputs of `infer` from gait observations, besides the robot and terrain (the front end
+/// loads those, with its overrides and the terrain's uncertainty).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InferRequest {
+    /// The observations.
+    pub evidence: GaitEvidence,
+    /// Log-uniform prior range of k_s, `(MIN, MAX)`, N/m^3 (field `k-s-prior`).
+    pub k_s_prior: (f64, f64),
+    /// The shear law tying the slopes together, if any (field `law`).
+    pub law: Option<InferLaw>,
+    /// Slopes to predict k_s and p_fail at with a law, degrees (field `predict`).
+    pub predict: Vec<f64>,
+}
+
+/// The answer, as `infer --json` prints it.
+#[derive(Debug, Clone, Serialize)]
+pub struct InferAnswer {
+    /// The prior used.
+    pub prior: LogUniformPrior,
+    /// The posterior of k_s at each observed slope.
+    pub points: Vec<SlopePosterior>,
+    /// The law's joint posterior, with a law.
+    pub law: Option<LawPosterior>,
+    /// The law's predictions (empty without a law).
+    pub prediction: Vec<RiskPrediction>,
+    /// Notes on defaults used (the terrain's uncertainty, with a law).
+    pub notes: Vec<String>,
+}
+
+/// Parses the prior's command-line form `MIN:MAX`, N/m^3.
+pub fn parse_prior(text: &str) -> Result<(f64, f64)> {
+    let field = "k-s-prior";
+    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
+    let [lo, hi] = parts.as_slice() else {
+        return Err(RequestError::invalid(
+            field,
+            format!("--k-s-prior = {text} must be MIN:MAX in N/m^3 (e.g. 1e4:1e9)"),
+        ));
+    };
+    let num = |s: &str| {
+        s.parse::<f64>().map_err(|_| {
+            RequestError::invalid(field, format!("--k-s-prior: `{s}` is not a number (in {text})"))
+        })
+    };
+    Ok((num(lo)?, num(hi)?))
+}
+
+/// The log-uniform prior on `(MIN, MAX)`, checked (`0 < MIN < MAX`, finite); also what
+/// `infer --servo-log` takes.
+pub fn prior((lo, hi): (f64, f64)) -> Result<LogUniformPrior> {
+    LogUniformPrior::new(lo, hi).map_err(|e| RequestError::invalid("k-s-prior", format!("--k-s-prior: {e}")))
+}
+
+impl InferRequest {
+    /// The prior, checked ([`prior`]).
+    pub fn prior(&self) -> Result<LogUniformPrior> {
+        prior(self.k_s_prior)
+    }
+
+    /// The prediction slopes, checked (`0 <= slope < 90`); none without a law.
+    pub fn predict_slopes(&self) -> Result<Vec<Slope>> {
+        if self.law.is_none() {
+            return Ok(Vec::new());
+        }
+        self.predict
+            .iter()
+            .map(|&d| {
+                Slope::from_degrees(d).map_err(|e| RequestError::invalid("predict", e.renamed("--predict")))
+            })
+            .collect()
+    }
+
+    /// Every value checked before any file is read.
+    pub fn check(&self) -> Result<()> {
+        self.prior()?;
+        self.predict_slopes().map(|_| ())
+    }
+
+    /// Reads the observations; errors name the file (and line) or the `steps` item.
+    pub fn observations(&self) -> Result<Vec<GaitObservation>> {
+        let steps = match &self.evidence {
+            GaitEvidence::Observed(path) => {
+                return load_speed_observations(path)
+                    .map_err(|e| RequestError::from_error(Some("observed"), e));
+            }
+            GaitEvidence::Steps(steps) => steps,
+        };
+        let field = "steps";
+        steps
+            .iter()
+            .map(|item| {
+                let (deg, file) = item.split_once('=').ok_or_else(|| {
+                    RequestError::invalid(
+                        field,
+                        format!("--steps `{item}` must be DEG=FILE (the slope of that track output)"),
+                    )
+                })?;
+                let deg: f64 = deg.trim().parse().map_err(|_| {
+                    RequestError::invalid(
+                        field,
+                        format!("--steps: slope `{deg}` is not a number (in {item})"),
+                    )
+                })?;
+                let slope = Slope::from_degrees(deg)
+                    .map_err(|e| RequestError::invalid(field, e.renamed("--steps slope")))?;
+                load_step_observation(std::path::Path::new(file.trim()), slope)
+                    .map_err(|e| RequestError::from_error(Some(field), e))
+            })
+            .collect()
+    }
+
+    /// The posteriors for `robot` on `terrain` (its k_n at each slope; with a law, its spread
+    /// too), given the observations read by [`InferRequest::observations`]; `note` is the
+    /// terrain's uncertainty note, kept with a law.
+    pub fn answer(
+        &self,
+        robot: &Robot,
+        terrain: &UncertainTerrain,
+        note: Option<String>,
+        observations: &[GaitObservation],
+    ) -> Result<InferAnswer> {
+        let prior = self.prior()?;
+        let predict = self.predict_slopes()?;
+        let points = posteriors(robot, terrain.terrain(), observations, &prior)
+            .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))?;
+        let law = match self.law {
+            None => None,
+            Some(law) => Some(
+                law_posterior(robot, terrain, observations, &prior, law, &predict)
+                    .map_err(|e| RequestError::invalid("law", format!("--law: {e}")))?,
+            ),
+        };
+        let notes = if law.is_some() { note.into_iter().collect() } else { Vec::new() };
+        let prediction = law.as_ref().map_or_else(Vec::new, |l| l.prediction.clone());
+        Ok(InferAnswer { prior, points, law, prediction, notes })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn request() -> InferRequest {
+        InferRequest {
+            evidence: GaitEvidence::Steps(Vec::new()),
+            k_s_prior: (1e4, 1e9),
+            law: None,
+            predict: vec![0.0, 15.0, 30.0],
+        }
+    }
+
+    #[test]
+    fn checks_name_the_field() {
+        assert_eq!(parse_prior(" 1e4 : 1e9 ").unwrap(), (1e4, 1e9));
+        let e = parse_prior("1e4").unwrap_err();
+        assert_eq!(e.field(), Some("k-s-prior"));
+        assert_eq!(e.message(), "--k-s-prior = 1e4 must be MIN:MAX in N/m^3 (e.g. 1e4:1e9)");
+        assert_eq!(
+            parse_prior("1e4:x").unwrap_err().message(),
+            "--k-s-prior: `x` is not a number (in 1e4:x)"
+        );
+        let e = InferRequest { k_s_prior: (1e9, 1e4), ..request() }.check().unwrap_err();
+        assert_eq!(e.field(), Some("k-s-prior"));
+        // Prediction slopes are checked only with a law.
+        let bad = InferRequest { predict: vec![95.0], ..request() };
+        assert!(bad.check().is_ok());
+        let e = InferRequest { law: Some(InferLaw::Linear), ..bad }.check().unwrap_err();
+        assert_eq!(e.field(), Some("predict"));
+        assert!(e.message().starts_with("--predict = 95"), "{}", e.message());
+    }
+
+    #[test]
+    fn steps_items_name_what_is_wrong() {
+        let steps = |s: &str| InferRequest { evidence: GaitEvidence::Steps(vec![s.into()]), ..request() };
+        let e = steps("10deg.csv").observations().unwrap_err();
+        assert_eq!(e.message(), "--steps `10deg.csv` must be DEG=FILE (the slope of that track output)");
+        let e = steps("ten=a.csv").observations().unwrap_err();
+        assert_eq!(e.message(), "--steps: slope `ten` is not a number (in ten=a.csv)");
+        let e = steps("10=no-such-steps.csv").observations().unwrap_err();
+        assert_eq!(e.field(), Some("steps"));
+        assert!(e.message().contains("no-such-steps.csv"), "{}", e.message());
+    }
+}

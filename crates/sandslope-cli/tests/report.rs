@@ -149,7 +149,7 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
     assert_eq!(at20["pitch_free_m_s"], free["speed_m_s"]);
     assert_eq!(at20["pitch_free_regime"], free["regime"]);
     assert!(html.contains("The stride simulator against the closed form"));
-    // The simulator's joint fit costs an estimated hour of CPU or more: left out unless asked for, and the page
+    // The simulator's joint fit costs minutes of CPU (8 on the paper's evidence): left out unless asked for, and the page
     // names the flag that adds it.
     assert!(v["simulator_fit"].is_null());
     assert!(html.contains("<code>sandslope report --simulator-fit</code> adds it"));

@@ -236,7 +236,7 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
     let (mut cal, closed_form) = match args.model {
         ModelArg::ClosedForm => (closed_form_fit, None),
         ModelArg::Simulate => {
-            // An estimated hour of CPU or more (docs/calibration.md): a spinner with the time.
+            // About 8 minutes of CPU on the paper's evidence (docs/calibration.md): a spinner with the time.
             let spin = crate::progress::spinner(args.json, "fitting with the stride simulator");
             let sim = calibrate_jointly_with(&setup, SpeedModel::simulator_for_fit())
                 .map_err(|e| anyhow!("calibrate --model simulate: {e}"));

@@ -71,7 +71,7 @@ pub struct ReportArgs {
     pub strict: bool,
     /// Also fit the evidence with the stride simulator in place of the closed form
     /// (`calibrate --model simulate`) and show the two fits side by side. Left out by default:
-    /// its tens of thousands of walks take an estimated hour of CPU or more on the paper's evidence with the converged simulator (docs/calibration.md), where the
+    /// its thousands of walks take about 8 minutes of CPU on the paper's evidence with the converged simulator (docs/calibration.md), where the
     /// rest of the report takes under a second (docs/simulate.md).
     #[arg(long)]
     pub simulator_fit: bool,

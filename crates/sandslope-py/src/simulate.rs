@@ -6,8 +6,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
 
-use sandslope::simulate::{simulate as run, BodyPitch, RftScaling, SimSettings, SimulateError};
+use sandslope::simulate::{simulate as run, SimulateError};
 use sandslope::Scenario;
+use sandslope_request::error::Words;
+use sandslope_request::simulate::{parse_body_pitch, parse_rft_scaling, SettingsRequest};
 
 use crate::arrays::put;
 use crate::types::{PyRobot, PyTerrain};
@@ -37,30 +39,18 @@ pub fn simulate<'py>(
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     let scenario =
         Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
-    let mut settings = SimSettings::new(duration_s).map_err(value_error)?;
-    if let Some(dt) = dt_s {
-        settings = settings.with_dt(dt).map_err(value_error)?;
+    // The settings `sandslope simulate` checks, in Python's words.
+    let settings = SettingsRequest {
+        duration_s,
+        dt_s,
+        creep_m_s,
+        servo_limit,
+        body_pitch: parse_body_pitch(body_pitch, Words::Keyword).map_err(|e| value_error(e.message()))?,
+        rft_scaling: parse_rft_scaling(rft_scaling, Words::Keyword).map_err(|e| value_error(e.message()))?,
+        rate_hz: sample_rate_hz,
     }
-    if let Some(c) = creep_m_s {
-        settings = settings.with_creep(c).map_err(value_error)?;
-    }
-    settings = settings.with_servo_limit(servo_limit);
-    settings = settings.with_sample_rate(sample_rate_hz).map_err(value_error)?;
-    settings = settings
-        .with_body_pitch(choose(
-            "body_pitch",
-            body_pitch,
-            &[("free", BodyPitch::Free), ("locked", BodyPitch::Locked)],
-        )?)
-        .with_rft_scaling(choose(
-            "rft_scaling",
-            rft_scaling,
-            &[
-                ("motion", RftScaling::Motion),
-                ("components", RftScaling::Components),
-                ("li2013", RftScaling::Li2013),
-            ],
-        )?);
+    .settings(Words::Keyword)
+    .map_err(|e| value_error(e.message()))?;
     let sim = py.detach(|| run(&scenario, slope_deg, &settings)).map_err(|e| match e {
         SimulateError::Param(p) => value_error(p),
     })?;
@@ -89,13 +79,4 @@ pub fn simulate<'py>(
     }
     let summary = pythonize(py, &sim.summary).map_err(value_error)?;
     Ok((d, summary))
-}
-
-/// The option named `value` of a keyword argument `key` that takes one of `options`' names, or a
-/// ValueError naming the key, the value and the names it takes.
-fn choose<T: Copy>(key: &str, value: &str, options: &[(&str, T)]) -> PyResult<T> {
-    options.iter().find(|(name, _)| *name == value).map(|&(_, v)| v).ok_or_else(|| {
-        let names: Vec<String> = options.iter().map(|(name, _)| format!("{name:?}")).collect();
-        pyo3::exceptions::PyValueError::new_err(format!("{key} = {value:?}: expected {}", names.join(" or ")))
-    })
 }

@@ -8,7 +8,7 @@ use sandslope::simulate::{
 };
 use sandslope::{ParamError, Scenario};
 
-use crate::error::{check_range, RequestError, Result};
+use crate::error::{check_range, RequestError, Result, Words};
 use crate::grammar::{parse_slope_list, SlopeSign};
 use crate::params::Params;
 use crate::scenario::ScenarioRequest;
@@ -96,26 +96,11 @@ impl SimulateRequest {
         let servo_limit = !p.flag("no-servo-limit")?;
         let body_pitch = match p.text("body-pitch")? {
             None => BodyPitch::default(),
-            Some("free") => BodyPitch::Free,
-            Some("locked") => BodyPitch::Locked,
-            Some(other) => {
-                return Err(RequestError::invalid(
-                    "body-pitch",
-                    format!("--body-pitch = `{other}` must be free or locked"),
-                ))
-            }
+            Some(text) => parse_body_pitch(text, Words::Flag)?,
         };
         let rft_scaling = match p.text("rft-scaling")? {
             None => RftScaling::default(),
-            Some("motion") => RftScaling::Motion,
-            Some("components") => RftScaling::Components,
-            Some("li2013") => RftScaling::Li2013,
-            Some(other) => {
-                return Err(RequestError::invalid(
-                    "rft-scaling",
-                    format!("--rft-scaling = `{other}` must be motion, components or li2013"),
-                ))
-            }
+            Some(text) => parse_rft_scaling(text, Words::Flag)?,
         };
         let rate_hz = p.number_or("rate", 120.0)?;
         let scenario = ScenarioRequest::from_params(&mut p)?;
@@ -135,16 +120,20 @@ impl SimulateRequest {
 
     /// The settings the fields ask for, checked.
     pub fn settings(&self) -> Result<SimSettings> {
-        let mut s = SimSettings::new(self.duration_s).map_err(flagged)?;
-        if let Some(dt) = self.dt_s {
-            s = s.with_dt(dt).map_err(flagged)?;
+        self.settings_request().settings(Words::Flag)
+    }
+
+    /// The settings' fields alone.
+    pub fn settings_request(&self) -> SettingsRequest {
+        SettingsRequest {
+            duration_s: self.duration_s,
+            dt_s: self.dt_s,
+            creep_m_s: self.creep_m_s,
+            servo_limit: self.servo_limit,
+            body_pitch: self.body_pitch,
+            rft_scaling: self.rft_scaling,
+            rate_hz: self.rate_hz,
         }
-        if let Some(c) = self.creep_m_s {
-            s = s.with_creep(c).map_err(flagged)?;
-        }
-        s = s.with_servo_limit(self.servo_limit);
-        s = s.with_body_pitch(self.body_pitch).with_rft_scaling(self.rft_scaling);
-        s.with_sample_rate(self.rate_hz).map_err(flagged)
     }
 
     /// Reads the robot and terrain and checks every field: the walks to run.
@@ -164,6 +153,84 @@ impl SimulateRequest {
         let sims = walks.simulate()?;
         Ok(walks.answer(sims))
     }
+}
+
+/// A walk's settings as a request gives them: what `simulate`'s flags, the server's fields and
+/// Python's keywords set, checked once into the library's [`SimSettings`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SettingsRequest {
+    /// Simulated time after settling, s (field `duration`).
+    pub duration_s: f64,
+    /// Time step, s (field `dt`; default T / 2000).
+    pub dt_s: Option<f64>,
+    /// Creep speed of the contact law's smoothing at rest, m/s (field `creep`).
+    pub creep_m_s: Option<f64>,
+    /// Whether the robot file's servo torque limit applies.
+    pub servo_limit: bool,
+    /// Whether the body may pitch.
+    pub body_pitch: BodyPitch,
+    /// How resistive force theory is scaled to k_n and k_s.
+    pub rft_scaling: RftScaling,
+    /// Trajectory sample rate, Hz (field `rate`).
+    pub rate_hz: f64,
+}
+
+impl SettingsRequest {
+    /// The settings, checked; errors name the field in `words` (Python's keywords are the
+    /// library's own keys: `duration_s`, `dt_s`, `creep_m_s`, `sample_rate_hz`).
+    pub fn settings(&self, words: Words) -> Result<SimSettings> {
+        let err = |e: ParamError| match words {
+            Words::Flag => flagged(e),
+            Words::Keyword => RequestError::invalid(e.key.clone(), e),
+        };
+        let mut s = SimSettings::new(self.duration_s).map_err(err)?;
+        if let Some(dt) = self.dt_s {
+            s = s.with_dt(dt).map_err(err)?;
+        }
+        if let Some(c) = self.creep_m_s {
+            s = s.with_creep(c).map_err(err)?;
+        }
+        s = s.with_servo_limit(self.servo_limit);
+        s = s.with_body_pitch(self.body_pitch).with_rft_scaling(self.rft_scaling);
+        s.with_sample_rate(self.rate_hz).map_err(err)
+    }
+}
+
+/// The value `text` names among `options`, or an error naming the field in `words` and the
+/// names it takes.
+fn choose<T: Copy>(field: &str, text: &str, options: &[(&str, T)], words: Words) -> Result<T> {
+    if let Some(&(_, v)) = options.iter().find(|(name, _)| *name == text) {
+        return Ok(v);
+    }
+    let names: Vec<&str> = options.iter().map(|(name, _)| *name).collect();
+    let message = match words {
+        Words::Flag => {
+            let (last, rest) = names.split_last().unwrap_or((&"", &[]));
+            let list =
+                if rest.is_empty() { last.to_string() } else { format!("{} or {last}", rest.join(", ")) };
+            format!("--{field} = `{text}` must be {list}")
+        }
+        Words::Keyword => {
+            let quoted: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
+            format!("{} = {text:?}: expected {}", words.name(field), quoted.join(" or "))
+        }
+    };
+    Err(RequestError::invalid(field, message))
+}
+
+/// Parses a body-pitch setting: `free` or `locked`.
+pub fn parse_body_pitch(text: &str, words: Words) -> Result<BodyPitch> {
+    choose("body-pitch", text, &[("free", BodyPitch::Free), ("locked", BodyPitch::Locked)], words)
+}
+
+/// Parses an RFT scaling: `motion`, `components` or `li2013`.
+pub fn parse_rft_scaling(text: &str, words: Words) -> Result<RftScaling> {
+    let options = [
+        ("motion", RftScaling::Motion),
+        ("components", RftScaling::Components),
+        ("li2013", RftScaling::Li2013),
+    ];
+    choose("rft-scaling", text, &options, words)
 }
 
 /// One walk's slope: strictly between -90 and 90 degrees.
@@ -233,5 +300,44 @@ impl Walks {
                 Answer::Many(summaries)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The two setting names each front end spells its own way, from one list.
+    #[test]
+    fn settings_names_are_checked_once_in_each_front_ends_words() {
+        assert_eq!(parse_body_pitch("free", Words::Keyword).unwrap(), BodyPitch::Free);
+        assert_eq!(parse_rft_scaling("li2013", Words::Flag).unwrap(), RftScaling::Li2013);
+        let e = parse_body_pitch("sideways", Words::Flag).unwrap_err();
+        assert_eq!(e.field(), Some("body-pitch"));
+        assert_eq!(e.message(), "--body-pitch = `sideways` must be free or locked");
+        let e = parse_rft_scaling("shear", Words::Flag).unwrap_err();
+        assert_eq!(e.message(), "--rft-scaling = `shear` must be motion, components or li2013");
+        let e = parse_rft_scaling("shear", Words::Keyword).unwrap_err();
+        assert_eq!(e.message(), r#"rft_scaling = "shear": expected "motion" or "components" or "li2013""#);
+    }
+
+    /// Python's keywords are the library's keys; the command line's are its flags.
+    #[test]
+    fn settings_errors_name_the_field_as_each_front_end_does() {
+        let bad = SettingsRequest {
+            duration_s: -1.0,
+            dt_s: None,
+            creep_m_s: None,
+            servo_limit: true,
+            body_pitch: BodyPitch::Locked,
+            rft_scaling: RftScaling::Motion,
+            rate_hz: 120.0,
+        };
+        let e = bad.settings(Words::Keyword).unwrap_err();
+        assert_eq!(e.field(), Some("duration_s"));
+        assert!(e.message().starts_with("duration_s = -1 must be"), "{}", e.message());
+        let e = bad.settings(Words::Flag).unwrap_err();
+        assert_eq!(e.field(), Some("duration"));
+        assert!(e.message().starts_with("--duration = -1 must be"), "{}", e.message());
     }
 }

@@ -17,7 +17,7 @@ use crate::{anyhow_error, value_error};
 /// so the dict equals the file's, lists and nulls alike). `robot_source` and
 /// `terrain_source` name the robot and terrain as the inputs table shows them; without
 /// `forces`, the built-in terrain is reported with the paper's force tests. `tracks`: one
-/// `(slope_deg, paths)` per slope; `simulator_fit`: also the simulator's joint fit (an estimated hour of CPU or more with the converged simulator, docs/calibration.md).
+/// `(slope_deg, paths)` per slope; `simulator_fit`: also the simulator's joint fit (about 8 minutes of CPU on the paper's evidence, docs/calibration.md).
 /// `html`: a folder to write the page into, `index.html` and `report.json`, byte for byte what
 /// `sandslope report --out` writes (the render crate's `report::write_dir`).
 #[pyfunction]

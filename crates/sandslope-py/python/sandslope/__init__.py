@@ -675,7 +675,7 @@ def report(
     (``{slope_deg: path or [paths]}`` of motion-capture recordings, read as :func:`track` reads
     them) make it a report on your own campaign, as the CLI's flags of the same names.
     ``simulator_fit=True`` (``report --simulator-fit``) adds the stride simulator's joint fit of
-    the same evidence (``simulator_fit``; an estimated hour of CPU or more on the paper's evidence with the converged simulator, docs/calibration.md).
+    the same evidence (``simulator_fit``; about 8 minutes of CPU on the paper's evidence, docs/calibration.md).
     ``html="out/"`` also writes the page into that folder (made if missing): ``out/index.html``
     and ``out/report.json``, byte for byte what ``sandslope report --out out/`` writes for the
     same inputs.

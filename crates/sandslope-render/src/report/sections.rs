@@ -348,10 +348,10 @@ pub fn simulator_fit(report: &Report) -> String {
     let Some(sim) = &report.simulator_fit else {
         h.push_str(
             "<p>Not run for this page. The same joint calibration with the stride simulator in place of the \
-             closed form walks the robot tens of thousands of times (about 26,600 four-second walks on the paper's \
-             evidence, an estimated hour of CPU or more with the converged simulator), where the rest of this report takes under a second: \
+             closed form walks the robot thousands of times (5,722 four-second walks on the paper's evidence, about \
+             8 minutes of CPU), where the rest of this report takes under a second: \
              <code>sandslope report --simulator-fit</code> adds it here, and <code>sandslope calibrate --model \
-             simulate</code> prints it alone (docs/simulate.md gives its result on the paper's evidence).</p>\n",
+             simulate</code> prints it alone (docs/calibration.md gives its result on the paper's evidence).</p>\n",
         );
         return h;
     };

@@ -110,7 +110,7 @@ pub struct Evidence {
     /// speeds and force-test ratio).
     pub builtin_terrain: bool,
     /// Also fit the evidence with the stride simulator in place of the closed form
-    /// (`report --simulator-fit`, [`Report::simulator_fit`]): an estimated hour of CPU or more on the paper's
+    /// (`report --simulator-fit`, [`Report::simulator_fit`]): about 8 minutes of CPU on the paper's
     /// evidence, where the rest of the report takes under a second, so it is asked for.
     pub simulator_fit: bool,
 }
@@ -243,7 +243,7 @@ pub struct Report {
     pub simulator: Vec<SimulatorRecord>,
     /// The same joint calibration with the stride simulator in place of the closed form
     /// (`calibrate --model simulate`), beside [`Report::calibration`]; `null` unless asked for
-    /// ([`Evidence::simulator_fit`]: its tens of thousands of walks take an estimated hour of CPU or more with the converged simulator) or
+    /// ([`Evidence::simulator_fit`]: its thousands of walks take about 8 minutes of CPU on the paper's evidence) or
     /// when it failed (then a warning says why).
     pub simulator_fit: Option<JointCalibration>,
     /// The observed speeds that fit misses by more than [`MISS_SD`] of their own SD, each with

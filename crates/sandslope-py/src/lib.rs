@@ -59,6 +59,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add_function(wrap_pyfunction!(servo::read_servo_log, m)?)?;
     m.add_function(wrap_pyfunction!(servo::infer_servo_log, m)?)?;
+    m.add_function(wrap_pyfunction!(servo::drive_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(servo::drive, m)?)?;
     m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;
     m.add("CAUSES", sandslope::Cause::ALL.map(sandslope::Cause::name))?;

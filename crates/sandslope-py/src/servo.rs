@@ -13,7 +13,7 @@ use sandslope::infer::LogUniformPrior;
 use sandslope::servo::xl330;
 use sandslope_servo::driver::ServoSample;
 use sandslope_servo::session::{
-    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session,
+    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, RUN_DEFAULTS,
 };
 use sandslope_servo::{DriveSettings, EmulatorFaults, Profile};
 
@@ -55,7 +55,7 @@ pub fn read_servo_log<'py>(
 /// `infer --servo-log --json` on a log's columns: `leg` (0 to 2 * stance_legs - 1), the leg's
 /// angle in the gait's frame and its drive torque `K_t I`, one entry per servo per cycle.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, leg, leg_angle_rad, drive_torque_n_m, k_s_prior=(1e4, 1e9), grid_points=41))]
+#[pyo3(signature = (robot, terrain, slope_deg, leg, leg_angle_rad, drive_torque_n_m, k_s_prior=None, grid_points=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn infer_servo_log<'py>(
     py: Python<'py>,
@@ -65,9 +65,12 @@ pub fn infer_servo_log<'py>(
     leg: PyReadonlyArray1<'py, i64>,
     leg_angle_rad: PyReadonlyArray1<'py, f64>,
     drive_torque_n_m: PyReadonlyArray1<'py, f64>,
-    k_s_prior: (f64, f64),
-    grid_points: usize,
+    k_s_prior: Option<(f64, f64)>,
+    grid_points: Option<usize>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    // The CLI's defaults: one constant each in the library.
+    let k_s_prior = k_s_prior.unwrap_or(sandslope::infer::servo::SERVO_LOG_K_S_PRIOR);
+    let grid_points = grid_points.unwrap_or(sandslope::infer::servo::SERVO_LOG_GRID_POINTS);
     let (leg, angle, torque) = (leg.as_slice()?.to_vec(), values(&leg_angle_rad), values(&drive_torque_n_m));
     if leg.len() != angle.len() || leg.len() != torque.len() {
         return Err(value_error(format!(
@@ -97,28 +100,43 @@ pub fn infer_servo_log<'py>(
     pythonize(py, &answer).map_err(value_error)
 }
 
+/// `drive`'s defaults (`sandslope_servo::session::RUN_DEFAULTS`), as a dict: what
+/// `sandslope.drive` uses for an argument left out, and `sandslope drive --help` shows.
+#[pyfunction]
+pub fn drive_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    pythonize(py, &RUN_DEFAULTS).map_err(value_error)
+}
+
 /// A run of `drive --emulate` with `drive`'s defaults (position profile, 1470 mA, 65 degC,
 /// watchdogs 1 s and 0.5 s, a 1 s stand): `(columns, report)`, `columns` the log's columns
 /// (as [`read_servo_log`]), `report` what `drive --json` prints, with the emulator's last word
 /// under `emulator`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_s=None, noise_ma=10.0, seed=1, weaken=None, stop_on_risk=None, hold_s=2.0, rate_hz=50.0, live=true))]
+#[pyo3(signature = (robot, terrain, slope_deg=None, duration_s=None, k_s=None, noise_ma=None, seed=None, weaken=None, stop_on_risk=None, hold_s=None, rate_hz=None, live=true))]
 #[allow(clippy::too_many_arguments)]
 pub fn drive<'py>(
     py: Python<'py>,
     robot: &PyRobot,
     terrain: &PyTerrain,
-    slope_deg: f64,
-    duration_s: f64,
+    slope_deg: Option<f64>,
+    duration_s: Option<f64>,
     k_s: Option<f64>,
-    noise_ma: f64,
-    seed: u64,
+    noise_ma: Option<f64>,
+    seed: Option<u64>,
     weaken: Option<(f64, f64)>,
     stop_on_risk: Option<f64>,
-    hold_s: f64,
-    rate_hz: f64,
+    hold_s: Option<f64>,
+    rate_hz: Option<f64>,
     live: bool,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
+    // `drive`'s defaults, from the one typed set its flags take theirs from.
+    let d = RUN_DEFAULTS;
+    let slope_deg = slope_deg.unwrap_or(d.slope_deg);
+    let duration_s = duration_s.unwrap_or(d.duration_s);
+    let noise_ma = noise_ma.unwrap_or(d.emulate_noise_ma);
+    let seed = seed.unwrap_or(d.emulate_seed);
+    let hold_s = hold_s.unwrap_or(d.hold_s);
+    let rate_hz = rate_hz.unwrap_or(d.rate_hz);
     let within = |key: &str, v: f64, lo: f64, hi: f64| {
         if (lo..=hi).contains(&v) {
             Ok(())
@@ -149,13 +167,13 @@ pub fn drive<'py>(
         profile: Profile::Position,
         duration_s,
         rate_hz,
-        current_limit_ma: 1470,
-        temperature_limit_c: 65,
-        watchdog_s: 1.0,
-        bus_watchdog_s: 0.5,
+        current_limit_ma: d.current_limit_ma,
+        temperature_limit_c: d.temperature_limit_c,
+        watchdog_s: d.watchdog_s,
+        bus_watchdog_s: d.bus_watchdog_s,
         stop_on_risk,
         hold_s,
-        stand_s: 1.0,
+        stand_s: d.stand_s,
     };
     let faults = EmulatorFaults { weaken, ..Default::default() };
     let config = DriveConfig {

@@ -95,3 +95,52 @@ def test_drive_releases_the_gil():
     from test_gil import assert_releases_the_gil
 
     assert_releases_the_gil(lambda: sandslope.drive(duration_s=1, live=False))
+
+
+# `sandslope drive --help`'s flag for each of drive_defaults()'s keys (stand_s has no flag).
+_FLAGS = {
+    "slope_deg": "--slope", "duration_s": "--duration", "rate_hz": "--rate", "hold_s": "--hold",
+    "current_limit_ma": "--current-limit", "temperature_limit_c": "--temperature-limit",
+    "watchdog_s": "--watchdog", "bus_watchdog_s": "--bus-watchdog",
+    "emulate_noise_ma": "--emulate-noise", "emulate_seed": "--emulate-seed",
+}
+
+
+def _help_default(help_text, flag):
+    # clap renders `--rate <HZ>  ... [default: 50]`; the block of one flag runs to the next flag.
+    block = help_text.split(f"  {flag} ")[1].split("\n  -")[0]
+    return float(block.split("[default: ")[1].split("]")[0])
+
+
+def test_drive_defaults_are_the_clis(cli):
+    """Python's defaults are the CLI's, read from the CLI's own help, not restated."""
+    defaults = sandslope.drive_defaults()
+    assert set(defaults) == set(_FLAGS) | {"stand_s"}
+    help_text = cli.run("drive", "--help").stdout
+    for key, flag in _FLAGS.items():
+        assert defaults[key] == _help_default(help_text, flag), key
+    # And the Python function's signature states none of them.
+    import inspect
+    for name, p in inspect.signature(sandslope.drive).parameters.items():
+        if name not in ("robot", "terrain", "emulate", "live"):
+            assert p.default is None, (name, p.default)
+    for name in ("k_s_prior", "grid_points"):
+        assert inspect.signature(sandslope.infer_servo_log).parameters[name].default is None
+
+
+def test_drive_returns_the_keys_of_drive_json(cli, tmp_path):
+    """`sandslope.drive`'s report has the keys `drive --emulate --json` prints, at every level
+    (outcome, live record, inference, torque_off)."""
+    expected = cli.json("drive", "--emulate", "--slope", "20", "--duration", "3", "--live",
+                        "--watchdog", "2")
+    _, got = sandslope.drive(slope_deg=20, duration_s=3)
+
+    def shape(v):
+        if isinstance(v, dict):
+            return {k: shape(x) for k, x in v.items() if k != "posterior"}
+        if isinstance(v, list):
+            return [shape(v[0])] if v and isinstance(v[0], dict) else "list"
+        return "value"
+
+    assert shape(got) == shape(expected)
+    assert got["emulator"].startswith("emulator: torque off on every servo")

@@ -19,7 +19,7 @@ use sandslope_servo::driver::{DriveReport, LiveEstimate};
 use sandslope_servo::emulator::EmulatorFaults;
 use sandslope_servo::log::{drive_logged, LogTarget};
 use sandslope_servo::session::{
-    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session,
+    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, RUN_DEFAULTS,
 };
 use sandslope_servo::table as t;
 use sandslope_servo::{DriveSettings, Profile, ServoConfig};
@@ -75,13 +75,13 @@ pub struct DriveRunArgs {
     #[arg(long, value_name = "FILE")]
     pub log: Option<PathBuf>,
     /// The slope being climbed, degrees (for the live estimate, the log's header and the emulator).
-    #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, value_name = "DEG", default_value_t = RUN_DEFAULTS.slope_deg, allow_negative_numbers = true)]
     pub slope: f64,
     /// Gait time, s (after standing up).
-    #[arg(long, value_name = "S", default_value_t = 10.0)]
+    #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.duration_s)]
     pub duration: f64,
     /// Bus cycles per second aimed at (each: a Sync Write of goals and a Sync Read of state).
-    #[arg(long, value_name = "HZ", default_value_t = 50.0)]
+    #[arg(long, value_name = "HZ", default_value_t = RUN_DEFAULTS.rate_hz)]
     pub rate: f64,
     /// How the gait is commanded.
     #[arg(long, value_enum, default_value = "position")]
@@ -93,25 +93,25 @@ pub struct DriveRunArgs {
     #[arg(long, value_name = "P")]
     pub stop_on_risk: Option<f64>,
     /// After a halt, seconds the legs are held before the torque goes off.
-    #[arg(long, value_name = "S", default_value_t = 2.0)]
+    #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.hold_s)]
     pub hold: f64,
     /// Current Limit written to every servo, mA (0 to 1750; 1470 is the stall current at 5 V).
-    #[arg(long, value_name = "MA", default_value_t = 1470)]
+    #[arg(long, value_name = "MA", default_value_t = RUN_DEFAULTS.current_limit_ma)]
     pub current_limit: u16,
     /// Temperature Limit written to every servo, degC (0 to 70).
-    #[arg(long, value_name = "DEGC", default_value_t = 65)]
+    #[arg(long, value_name = "DEGC", default_value_t = RUN_DEFAULTS.temperature_limit_c)]
     pub temperature_limit: u8,
     /// Longest bus cycle accepted before everything stops, s.
-    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.watchdog_s)]
     pub watchdog: f64,
     /// The servos' own Bus Watchdog, s (0.02 to 2.54): they stop by themselves if the driver goes quiet.
-    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.bus_watchdog_s)]
     pub bus_watchdog: f64,
     /// Emulator: Present Current noise, mA (standard deviation).
-    #[arg(long, value_name = "MA", default_value_t = 10.0, requires = "emulate")]
+    #[arg(long, value_name = "MA", default_value_t = RUN_DEFAULTS.emulate_noise_ma, requires = "emulate")]
     pub emulate_noise: f64,
     /// Emulator: seed of the noise.
-    #[arg(long, value_name = "N", default_value_t = 1, requires = "emulate")]
+    #[arg(long, value_name = "N", default_value_t = RUN_DEFAULTS.emulate_seed, requires = "emulate")]
     pub emulate_seed: u64,
     /// Emulator: the sand's k_s (N/m^3) instead of the terrain's at the slope.
     #[arg(long, value_name = "N/M^3", requires = "emulate")]
@@ -262,7 +262,7 @@ pub fn config(
         bus_watchdog_s: run.bus_watchdog,
         stop_on_risk: run.stop_on_risk,
         hold_s: run.hold,
-        stand_s: 1.0,
+        stand_s: RUN_DEFAULTS.stand_s,
     };
     let bus = match bus {
         BusFlag::Port(path) => BusChoice::Port { path, baud },
@@ -324,12 +324,16 @@ pub fn run(args: DriveArgs) -> Result<()> {
     });
     let (report, failure) = drive_logged(&mut session, log, stop, &mut |_| {}, &mut on_live)?;
     crate::error::DRIVING.store(false, Ordering::SeqCst);
-    if let Some(r) = session.close() {
-        eprintln!("{}", emulator_summary(&r));
+    let emulator = session.close().map(|r| emulator_summary(&r));
+    if let Some(e) = &emulator {
+        eprintln!("{e}");
     }
     summarise(&report, quiet)?;
     if args.json {
-        print_json(&report)?;
+        // The report and the emulator's last word, the keys Python's `sandslope.drive` returns.
+        let mut value = serde_json::to_value(&report)?;
+        value["emulator"] = emulator.clone().into();
+        print_json(&value)?;
     }
     match (failure, &report.outcome) {
         (Some(e), _) => {

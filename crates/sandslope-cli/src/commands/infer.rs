@@ -46,7 +46,7 @@ pub struct InferArgs {
     #[arg(long, value_name = "DEG", requires = "servo_log", allow_negative_numbers = true)]
     pub slope: Option<f64>,
     /// k_s values the stride simulator walks for --servo-log (log-spaced over --k-s-prior).
-    #[arg(long, value_name = "N", default_value_t = 41, requires = "servo_log")]
+    #[arg(long, value_name = "N", default_value_t = sandslope::infer::servo::SERVO_LOG_GRID_POINTS, requires = "servo_log")]
     pub grid_points: usize,
     #[command(flatten)]
     pub robot: RobotArgs,
@@ -57,7 +57,7 @@ pub struct InferArgs {
     #[command(flatten)]
     pub uncertainty: UncertaintyArgs,
     /// Log-uniform prior range of k_s, N/m^3.
-    #[arg(long = "k-s-prior", value_name = "MIN:MAX", default_value = "1e4:1e9")]
+    #[arg(long = "k-s-prior", value_name = "MIN:MAX", default_value_t = default_prior())]
     pub k_s_prior: String,
     /// Tie the slopes together with a shear law and predict at --predict slopes.
     #[arg(long, value_enum)]
@@ -71,6 +71,15 @@ pub struct InferArgs {
     /// Draw the posterior bands (and with --law the predicted risk) to this .png or .svg file.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+}
+
+/// `--k-s-prior`'s default, `1e4:1e9` (the library's [`SERVO_LOG_K_S_PRIOR`], which the gait
+/// inference shares).
+///
+/// [`SERVO_LOG_K_S_PRIOR`]: sandslope::infer::servo::SERVO_LOG_K_S_PRIOR
+fn default_prior() -> String {
+    let (lo, hi) = sandslope::infer::servo::SERVO_LOG_K_S_PRIOR;
+    format!("{lo:e}:{hi:e}")
 }
 
 fn parse_prior(text: &str) -> Result<LogUniformPrior> {

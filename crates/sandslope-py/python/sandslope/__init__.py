@@ -44,7 +44,7 @@ from ._inputs import (
     _terrain,
 )
 from ._sandslope import Robot, Terrain
-from ._servo import drive, infer_servo_log, read_servo_log
+from ._servo import drive, drive_defaults, infer_servo_log, read_servo_log
 
 __all__ = [
     "REGIMES",
@@ -69,6 +69,7 @@ __all__ = [
     "read_servo_log",
     "infer_servo_log",
     "drive",
+    "drive_defaults",
 ]
 
 

@@ -228,21 +228,22 @@ def infer_servo_log(
     leg: np.ndarray,
     leg_angle_rad: np.ndarray,
     drive_torque_n_m: np.ndarray,
-    k_s_prior: Tuple[float, float] = (1e4, 1e9),
-    grid_points: int = 41,
+    k_s_prior: Optional[Tuple[float, float]] = None,
+    grid_points: Optional[int] = None,
 ) -> Dict[str, Any]: ...
+def drive_defaults() -> Dict[str, Any]: ...
 def drive(
     robot: Robot,
     terrain: Terrain,
-    slope_deg: float,
-    duration_s: float,
+    slope_deg: Optional[float] = None,
+    duration_s: Optional[float] = None,
     k_s: Optional[float] = None,
-    noise_ma: float = 10.0,
-    seed: int = 1,
+    noise_ma: Optional[float] = None,
+    seed: Optional[int] = None,
     weaken: Optional[Tuple[float, float]] = None,
     stop_on_risk: Optional[float] = None,
-    hold_s: float = 2.0,
-    rate_hz: float = 50.0,
+    hold_s: Optional[float] = None,
+    rate_hz: Optional[float] = None,
     live: bool = True,
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 

@@ -39,8 +39,8 @@ def infer_servo_log(
     terrain: TerrainLike = "glass-beads-300um",
     *,
     slope_deg: Optional[float] = None,
-    k_s_prior: Tuple[float, float] = (1e4, 1e9),
-    grid_points: int = 41,
+    k_s_prior: Optional[Tuple[float, float]] = None,
+    grid_points: Optional[int] = None,
 ) -> Dict[str, Any]:
     """The sand's k_s at the run's slope from the servos' stance currents, as ``sandslope infer
     --servo-log FILE --json`` (docs/model.md §19): the dict with ``k_s``, ``k_s_lo``, ``k_s_hi``
@@ -52,7 +52,8 @@ def infer_servo_log(
     ``read_servo_log`` and ``drive`` return). ``slope_deg`` defaults to the log's
     ``# slope_deg`` header (a path only). ``terrain`` gives k_n at the slope. The robot's
     stride simulator walks ``grid_points`` values of k_s over ``k_s_prior`` (seconds of CPU, the
-    GIL released)."""
+    GIL released); left out, they are the CLI's defaults (41 over 1e4 to 1e9 N/m^3, from the
+    library's constants)."""
     if isinstance(log, (str, os.PathLike)):
         columns, meta = _sandslope.read_servo_log(os.fspath(log))
         if slope_deg is None:
@@ -68,7 +69,6 @@ def infer_servo_log(
     missing = [c for c in SERVO_COLUMNS if c not in columns]
     if missing:
         raise ValueError(f"log: the column(s) {', '.join(missing)} are missing (docs/drive.md, 'The log')")
-    lo, hi = k_s_prior
     return _sandslope.infer_servo_log(
         _robot(robot),
         _terrain(terrain),
@@ -76,33 +76,42 @@ def infer_servo_log(
         np.ascontiguousarray(columns["leg"], dtype=np.int64),
         np.ascontiguousarray(columns["leg_angle_rad"], dtype=np.float64),
         np.ascontiguousarray(columns["drive_torque_n_m"], dtype=np.float64),
-        k_s_prior=(float(lo), float(hi)),
-        grid_points=int(grid_points),
+        k_s_prior=None if k_s_prior is None else (float(k_s_prior[0]), float(k_s_prior[1])),
+        grid_points=None if grid_points is None else int(grid_points),
     )
+
+
+def drive_defaults() -> Dict[str, Any]:
+    """``drive``'s defaults (``sandslope drive``'s flag defaults, from one typed set in the Rust
+    crate): ``slope_deg``, ``duration_s``, ``rate_hz``, ``hold_s``, ``current_limit_ma``,
+    ``temperature_limit_c``, ``watchdog_s``, ``bus_watchdog_s``, ``stand_s``,
+    ``emulate_noise_ma``, ``emulate_seed``."""
+    return dict(_sandslope.drive_defaults())
 
 
 def drive(
     robot: RobotLike = "paper-hexapod",
     terrain: TerrainLike = "glass-beads-300um",
-    slope_deg: float = 0.0,
-    duration_s: float = 10.0,
+    slope_deg: Optional[float] = None,
+    duration_s: Optional[float] = None,
     *,
     emulate: bool = True,
     k_s: Optional[float] = None,
-    noise_ma: float = 10.0,
-    seed: int = 1,
+    noise_ma: Optional[float] = None,
+    seed: Optional[int] = None,
     weaken: Optional[Tuple[float, float]] = None,
     stop_on_risk: Optional[float] = None,
-    hold_s: float = 2.0,
-    rate_hz: float = 50.0,
+    hold_s: Optional[float] = None,
+    rate_hz: Optional[float] = None,
     live: bool = True,
 ) -> Tuple[Any, Dict[str, Any]]:
     """A run of ``sandslope drive --emulate`` (docs/drive.md): the robot's alternating tripod
     sent to a bus of emulated XL330s on a pseudo-terminal, byte for byte Protocol 2.0 through
     the same bus code as a robot, the servos' currents from the stride simulator on ``terrain``
     at ``slope_deg`` (``k_s`` overrides the sand's, ``noise_ma`` the current noise's SD, ``seed``
-    its seed, ``weaken=(seconds, k_s)`` weakens it mid-run), with ``drive``'s defaults (position
-    profile, 1470 mA, 65 degC, a 1 s stand, the servos' IDs 1 to 6). ``live`` estimates k_s
+    its seed, ``weaken=(seconds, k_s)`` weakens it mid-run), with ``drive``'s defaults for
+    whatever is left out (``drive_defaults()``: the one typed set ``sandslope drive``'s flags
+    take theirs from; position profile, the servos' IDs 1 to 6). ``live`` estimates k_s
     after every stance; ``stop_on_risk`` halts the gait when P(fail) passes it.
 
     Returns ``(log, report)``: ``log`` the servo log's columns (a pandas DataFrame, or a dict of
@@ -119,15 +128,15 @@ def drive(
     columns, report = _sandslope.drive(
         _robot(robot),
         _terrain(terrain),
-        float(slope_deg),
-        float(duration_s),
+        None if slope_deg is None else float(slope_deg),
+        None if duration_s is None else float(duration_s),
         k_s=None if k_s is None else float(k_s),
-        noise_ma=float(noise_ma),
-        seed=int(seed),
+        noise_ma=None if noise_ma is None else float(noise_ma),
+        seed=None if seed is None else int(seed),
         weaken=None if weaken is None else (float(weaken[0]), float(weaken[1])),
         stop_on_risk=None if stop_on_risk is None else float(stop_on_risk),
-        hold_s=float(hold_s),
-        rate_hz=float(rate_hz),
+        hold_s=None if hold_s is None else float(hold_s),
+        rate_hz=None if rate_hz is None else float(rate_hz),
         live=bool(live),
     )
     return _frame(columns), report

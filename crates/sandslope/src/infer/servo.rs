@@ -51,6 +51,12 @@ pub enum CurrentInferenceError {
     Setting(String),
 }
 
+/// The default prior range of k_s for `infer --servo-log` (and Python's `infer_servo_log`),
+/// N/m^3: the gait inference's, `infer --k-s-prior`'s default.
+pub const SERVO_LOG_K_S_PRIOR: (f64, f64) = (1e4, 1e9);
+/// The default number of k_s values the simulator walks for `infer --servo-log`.
+pub const SERVO_LOG_GRID_POINTS: usize = 41;
+
 /// One leg's record: its tripod, angle in the gait's frame and drive torque.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LegTrace {

@@ -173,6 +173,16 @@ fn inject(defect: Defect, log: &mut Log, rng: &mut Rng) -> Option<Vec<f64>> {
     None
 }
 
+/// The longest step between successive row times of `log`, in median steps (bus cycles).
+fn longest_gap_cycles(log: &Log) -> f64 {
+    let t = log.col("time_s");
+    let mut times: Vec<f64> = log.rows.iter().map(|r| r[t].parse::<f64>().unwrap()).collect();
+    times.dedup();
+    let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+    steps.sort_by(f64::total_cmp);
+    steps.last().unwrap() / steps[steps.len() / 2]
+}
+
 fn write_defect(defect: Defect, log: &Log, dir: &Path, seed: usize, rng: &mut Rng) -> std::path::PathBuf {
     let mut text = log.text();
     if defect == Defect::Cut {
@@ -217,15 +227,23 @@ fn messy_logs_still_cover_the_emulated_k_s() {
         Defect::Nan,
         Defect::Cut,
     ];
-    let clean: Vec<f64> = emulated_logs()
+    // The clean logs' answers: k_s, and the offsets read from them, mA. A clean log's reading
+    // is the median of its swings' noise (10 mA a sample, ~25 samples a swing, a few swings:
+    // about 1.3 mA, but 4 mA seen once in CI, 2026-11-28, as the real-time emulator's sampling
+    // varies with load), so the check is on what an injected offset adds to the clean log's
+    // reading: for a constant offset the median moves by exactly that much.
+    let clean: Vec<(f64, Vec<f64>)> = emulated_logs()
         .iter()
         .map(|p| {
             let read = sandslope_io::servo_log::read_servo_log(p).unwrap();
-            infer_from_currents(&robot, &grid, &read.leg_traces(6, p).unwrap()).unwrap().k_s
+            let answer = infer_from_currents(&robot, &grid, &read.leg_traces(6, p).unwrap()).unwrap();
+            let ma =
+                answer.swing_offset_n_m.iter().enumerate().map(|(leg, &o)| 1000.0 * o / K_T * DIRECTION[leg]);
+            (answer.k_s, ma.collect())
         })
         .collect();
     for defect in defects {
-        let mut inside = 0;
+        let (mut inside, mut checked_notes) = (0, 0);
         for (seed, path) in emulated_logs().iter().enumerate() {
             let mut rng = Rng(1000 * seed as u64 + defect as u64);
             let mut log = Log::read(path);
@@ -237,11 +255,17 @@ fn messy_logs_still_cover_the_emulated_k_s() {
                 Defect::Nan => Some("with an empty or NaN value left out"),
                 Defect::Cut => Some("the log ends mid-row"),
                 Defect::Repeats => Some("repeated row(s) read once"),
-                Defect::Gaps => Some("gap(s) in time longer than 3 bus cycles"),
+                // Only where a gap of 3 or more dropped cycles was drawn (4 cycles between
+                // rows, clear of the 3-cycle threshold; a 2-cycle drop sits on it, to the
+                // emulator's real-time jitter).
+                Defect::Gaps if longest_gap_cycles(&log) > 3.5 => {
+                    Some("gap(s) in time longer than 3 bus cycles")
+                }
                 _ => None,
             };
             if let Some(e) = expect {
                 assert!(notes.contains(e), "{defect:?} seed {seed}: notes {notes}");
+                checked_notes += 1;
             }
             if defect == Defect::Repeats {
                 assert!(notes.contains("out of time order"), "{notes}");
@@ -252,23 +276,28 @@ fn messy_logs_still_cover_the_emulated_k_s() {
                 inside += 1;
             }
             if let Some(ma) = injected {
-                let moved = answer.k_s / clean[seed] - 1.0;
+                let (clean_k_s, clean_ma) = &clean[seed];
+                let moved = answer.k_s / clean_k_s - 1.0;
                 assert!(
                     moved.abs() < 0.05,
                     "{defect:?} seed {seed}: k_s {} against {} clean",
                     answer.k_s,
-                    clean[seed]
+                    clean_k_s
                 );
                 for (leg, (&got, want)) in answer.swing_offset_n_m.iter().zip(ma).enumerate() {
-                    let got_ma = 1000.0 * got / K_T * DIRECTION[leg];
+                    let got_ma = 1000.0 * got / K_T * DIRECTION[leg] - clean_ma[leg];
                     assert!(
                         (got_ma - want).abs() < 3.0,
-                        "{defect:?} seed {seed} leg {leg}: offset read {got_ma} mA, injected {want} mA"
+                        "{defect:?} seed {seed} leg {leg}: offset read {got_ma} mA over the clean log's {} mA, injected {want} mA",
+                        clean_ma[leg]
                     );
                 }
             }
         }
         assert!(inside >= 9, "{defect:?}: the true k_s inside the 90% interval in {inside} of 10 runs");
+        if defect == Defect::Gaps {
+            assert!(checked_notes >= 5, "a gap of 3 cycles or more drawn in only {checked_notes} of 10 logs");
+        }
     }
 }
 

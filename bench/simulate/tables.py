@@ -11,7 +11,9 @@ Prints, in the order docs/simulate.md shows them (NAME in brackets):
 3. [regimes] the regimes in (k_s, slope) against the closed form's at k_n = 7e5, pitch locked;
 4. [level] the level stride against the paper's 15.7 cm/s: one switch at a time (issue 38
    item 4), each at the default step and a quarter of it;
-5. [shape] the level walk's within-stride speed, from `simulate --out` sampled at 120 Hz as
+5. [mechanisms] each switch of docs/model.md §20 across the paper's slopes, at the default
+   step and a quarter of it;
+6. [shape] the level walk's within-stride speed, from `simulate --out` sampled at 120 Hz as
    the paper's motion capture was.
 Every number comes from the CLI's JSON or CSV; nothing here computes physics beyond a finite
 difference of the sampled positions.
@@ -97,6 +99,34 @@ def robot_file(directory, name, extra):
     return path
 
 
+def mechanism_rows(tmp):
+    """The switches of docs/model.md §20, one at a time (issue 38 item 4's candidates)."""
+    return [
+        ("leg-sand friction mu = 0.3 (`--leg-friction 0.3`)", ["--leg-friction", "0.3"]),
+        ("leg-sand friction mu = 0.1", ["--leg-friction", "0.1"]),
+        ("duty cycle 0.7: stance half turn slower (`--duty-cycle 0.7`)", ["--duty-cycle", "0.7"]),
+        ("duty cycle 0.3: stance half turn faster", ["--duty-cycle", "0.3"]),
+        ("disturbed sand at half strength (`--disturbed-sand 0.5`)", ["--disturbed-sand", "0.5"]),
+        ("disturbed sand at a tenth of its strength", ["--disturbed-sand", "0.1"]),
+    ]
+
+
+def mechanisms(exe):
+    """Each switch of docs/model.md §20 across the paper's slopes: speed at the default step
+    and at a quarter of it."""
+    slopes = [0, 10, 15, 20, 24]
+    print("| switch | " + " | ".join(f"{s} deg cm/s (dt/4)" for s in slopes) + " | regimes |")
+    print("|---|" + "---:|" * len(slopes) + "---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, args in [("the defaults", []), *mechanism_rows(tmp)]:
+            a = ["--slopes", ",".join(map(str, slopes)), "--body-pitch", "locked", *args]
+            d = run(exe, a)
+            q = run(exe, [*a, "--dt", repr(d[0]["dt_s"] / 4)])
+            cells = [f"{f(x['speed_m_s'] * 100)} ({f(y['speed_m_s'] * 100)})" for x, y in zip(d, q)]
+            regimes = "".join({"success": "+", "metastable": "M", "slippage": "S", "sinkage": "K"}[x["regime"]] for x in d)
+            print(f"| {name} | " + " | ".join(cells) + f" | {regimes} |")
+
+
 def level_stride(exe):
     lo, hi = PAPER_LEVEL_CM_S[0] - 2 * PAPER_LEVEL_CM_S[1], PAPER_LEVEL_CM_S[0] + 2 * PAPER_LEVEL_CM_S[1]
     with tempfile.TemporaryDirectory() as tmp:
@@ -119,6 +149,7 @@ def level_stride(exe):
                 "XL330-M077 torque limit, 0.215 N m",
                 ["--robot", robot_file(tmp, "m077", "servo_torque_limit_n_m = 0.215\n")],
             ),
+            *mechanism_rows(tmp),
         ]
         print(
             "| switch (level sand, one at a time) | speed cm/s | at dt/4 | step mm | t1 ms | largest depth mm "
@@ -183,7 +214,7 @@ def shape(exe):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sandslope", default="target/release/sandslope")
-    ap.add_argument("--only", choices=["closed", "free", "regimes", "level", "shape"])
+    ap.add_argument("--only", choices=["closed", "free", "regimes", "level", "mechanisms", "shape"])
     a = ap.parse_args()
     exe = a.sandslope
     tables = {
@@ -191,6 +222,7 @@ def main():
         "free": lambda: against_closed_form(exe, "free"),
         "regimes": lambda: regimes(exe),
         "level": lambda: level_stride(exe),
+        "mechanisms": lambda: mechanisms(exe),
         "shape": lambda: shape(exe),
     }
     for name, table in tables.items():

@@ -178,6 +178,12 @@ fn bad_input_exits_2_naming_the_value_and_range_and_writes_nothing() {
         (vec!["--slope", "10", "--rft-scaling", "stress"], "possible values: motion, components, li2013"),
         (vec!["--slope", "10", "--creep", "0"], "--creep = 0 must be between 1e-9 and 1e-3 m/s"),
         (vec!["--slope", "10", "--creep", "NaN"], "--creep = NaN"),
+        (vec!["--slope", "10", "--leg-friction", "-0.1"], "--leg-friction = -0.1 must be between 0 and 10"),
+        (vec!["--slope", "10", "--duty-cycle", "0.95"], "--duty-cycle = 0.95 must be between 0.1 and 0.9"),
+        (
+            vec!["--slope", "10", "--disturbed-sand", "0"],
+            "--disturbed-sand = 0 must be greater than 0 and at most 1",
+        ),
     ];
     for (args, needle) in cases {
         sandslope()

@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
 
-use sandslope::simulate::{simulate as run, SimulateError};
+use sandslope::simulate::{simulate as run, Mechanisms, SimulateError};
 use sandslope::Scenario;
 use sandslope_request::error::Words;
 use sandslope_request::simulate::{parse_body_pitch, parse_rft_scaling, SettingsRequest};
@@ -20,7 +20,7 @@ use crate::value_error;
 /// `leg{j}_depth_m`, `leg{j}_force_x_n`, `leg{j}_force_z_n`, `leg{j}_torque_n_m`) to a 1-D
 /// array; `summary` is `sandslope simulate --json`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, creep_m_s=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="locked", rft_scaling="motion", servo_limit=true))]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, creep_m_s=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=1.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -36,6 +36,9 @@ pub fn simulate<'py>(
     body_pitch: &str,
     rft_scaling: &str,
     servo_limit: bool,
+    leg_friction: Option<f64>,
+    duty_cycle: f64,
+    disturbed_sand: f64,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     let scenario =
         Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
@@ -47,6 +50,7 @@ pub fn simulate<'py>(
         servo_limit,
         body_pitch: parse_body_pitch(body_pitch, Words::Keyword).map_err(|e| value_error(e.message()))?,
         rft_scaling: parse_rft_scaling(rft_scaling, Words::Keyword).map_err(|e| value_error(e.message()))?,
+        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
         rate_hz: sample_rate_hz,
     }
     .settings(Words::Keyword)

@@ -82,3 +82,17 @@ def test_rft_scaling_is_the_cli_flag(cli):
     assert got["speed_m_s"] == pytest.approx(want["speed_m_s"], rel=1e-12)
     with pytest.raises(ValueError, match=r'rft_scaling = "shear": expected "motion" or "components"'):
         sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, rft_scaling="shear")
+
+
+def test_mechanisms_are_the_cli_flags(cli):
+    # docs/model.md §20's switches: the same walk as the CLI's flags, echoed under the same key.
+    want = cli.json(
+        "simulate", "--slope", 20, "--duration", 3, "--leg-friction", 0.3, "--duty-cycle", 0.6, "--disturbed-sand", 0.5
+    )
+    _, got = sandslope.simulate(
+        "paper-hexapod", "glass-beads-300um", 20, 3, leg_friction=0.3, duty_cycle=0.6, disturbed_sand=0.5
+    )
+    assert got["mechanisms"] == want["mechanisms"] == {"leg_friction": 0.3, "duty_cycle": 0.6, "disturbed_sand": 0.5}
+    assert got["speed_m_s"] == pytest.approx(want["speed_m_s"], rel=1e-12)
+    with pytest.raises(ValueError, match=r"duty_cycle = 0.95 must be between 0.1 and 0.9"):
+        sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, duty_cycle=0.95)

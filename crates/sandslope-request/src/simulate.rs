@@ -4,7 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use sandslope::simulate::{
-    simulate, simulate_slopes, BodyPitch, RftScaling, SimSettings, SimSummary, SimulateError, Simulation,
+    simulate, simulate_slopes, BodyPitch, Mechanisms, RftScaling, SimSettings, SimSummary, SimulateError,
+    Simulation,
 };
 use sandslope::{ParamError, Scenario};
 
@@ -47,6 +48,9 @@ pub struct SimulateRequest {
     /// How resistive force theory is scaled to k_n and k_s (field `rft-scaling`: motion or
     /// components or li2013; default the library's).
     pub rft_scaling: RftScaling,
+    /// The candidate mechanisms of docs/model.md §20 (fields `leg-friction`, `duty-cycle`,
+    /// `disturbed-sand`; all off by default).
+    pub mechanisms: Mechanisms,
     /// Trajectory sample rate, Hz (field `rate`, default 120).
     pub rate_hz: f64,
 }
@@ -64,6 +68,9 @@ fn flagged(e: ParamError) -> RequestError {
         "slope_deg" => "slope",
         "creep_m_s" => "creep",
         "sample_rate_hz" => "rate",
+        "leg_friction" => "leg-friction",
+        "duty_cycle" => "duty-cycle",
+        "disturbed_sand" => "disturbed-sand",
         "step" | "from" => "slopes",
         _ => return RequestError::from_error(None, anyhow::anyhow!("{e}")),
     };
@@ -102,6 +109,12 @@ impl SimulateRequest {
             None => RftScaling::default(),
             Some(text) => parse_rft_scaling(text, Words::Flag)?,
         };
+        let defaults = Mechanisms::default();
+        let mechanisms = Mechanisms {
+            leg_friction: p.number("leg-friction")?,
+            duty_cycle: p.number_or("duty-cycle", defaults.duty_cycle)?,
+            disturbed_sand: p.number_or("disturbed-sand", defaults.disturbed_sand)?,
+        };
         let rate_hz = p.number_or("rate", 120.0)?;
         let scenario = ScenarioRequest::from_params(&mut p)?;
         p.finish()?;
@@ -114,6 +127,7 @@ impl SimulateRequest {
             servo_limit,
             body_pitch,
             rft_scaling,
+            mechanisms,
             rate_hz,
         })
     }
@@ -132,6 +146,7 @@ impl SimulateRequest {
             servo_limit: self.servo_limit,
             body_pitch: self.body_pitch,
             rft_scaling: self.rft_scaling,
+            mechanisms: self.mechanisms,
             rate_hz: self.rate_hz,
         }
     }
@@ -171,6 +186,8 @@ pub struct SettingsRequest {
     pub body_pitch: BodyPitch,
     /// How resistive force theory is scaled to k_n and k_s.
     pub rft_scaling: RftScaling,
+    /// The candidate mechanisms of docs/model.md §20.
+    pub mechanisms: Mechanisms,
     /// Trajectory sample rate, Hz (field `rate`).
     pub rate_hz: f64,
 }
@@ -192,6 +209,7 @@ impl SettingsRequest {
         }
         s = s.with_servo_limit(self.servo_limit);
         s = s.with_body_pitch(self.body_pitch).with_rft_scaling(self.rft_scaling);
+        s = s.with_mechanisms(self.mechanisms).map_err(err)?;
         s.with_sample_rate(self.rate_hz).map_err(err)
     }
 }
@@ -331,6 +349,7 @@ mod tests {
             servo_limit: true,
             body_pitch: BodyPitch::Locked,
             rft_scaling: RftScaling::Motion,
+            mechanisms: Mechanisms::default(),
             rate_hz: 120.0,
         };
         let e = bad.settings(Words::Keyword).unwrap_err();

@@ -16,7 +16,7 @@ use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
 use crate::progress::{progress_bar, spinner};
-use sandslope::simulate::{BodyPitch, RftScaling, SimSummary, Simulation};
+use sandslope::simulate::{BodyPitch, Mechanisms, RftScaling, SimSummary, Simulation};
 use sandslope_io::load_speeds;
 use sandslope_io::trajectory::plain_mocap_csv;
 use sandslope_request::simulate::{parse_slopes, Answer, SimSlopes, Walks};
@@ -59,6 +59,20 @@ pub struct SimulateArgs {
     /// unused), docs/model.md §16.
     #[arg(long, value_name = "MODE", value_enum, default_value_t = ScalingArg::Motion)]
     pub rft_scaling: ScalingArg,
+    /// Leg-sand friction coefficient (0 to 10): the stress along a leg element's surface at
+    /// most MU times the stress normal to it (docs/model.md §20.1; default: none, resistive
+    /// force theory's stresses as they are).
+    #[arg(long, value_name = "MU", allow_negative_numbers = true)]
+    pub leg_friction: Option<f64>,
+    /// Share of the stride period over which a leg turns the half turn from its touchdown,
+    /// 0.1 to 0.9 (docs/model.md §20.2; default 0.5: one speed all round, the paper's gait).
+    #[arg(long, value_name = "D", default_value_t = sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, allow_negative_numbers = true)]
+    pub duty_cycle: f64,
+    /// Resistance of sand a leg passed through in an earlier stance, as a share of the
+    /// undisturbed sand's, greater than 0 and at most 1 (docs/model.md §20.3, the trench;
+    /// default 1: as strong as before).
+    #[arg(long, value_name = "F", default_value_t = 1.0, allow_negative_numbers = true)]
+    pub disturbed_sand: f64,
     /// Trajectory sample rate for --out, --plot and --animate, Hz.
     #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
     pub rate: f64,
@@ -143,6 +157,11 @@ impl SimulateArgs {
             servo_limit: !self.no_servo_limit,
             body_pitch: self.body_pitch.into(),
             rft_scaling: self.rft_scaling.into(),
+            mechanisms: Mechanisms {
+                leg_friction: self.leg_friction,
+                duty_cycle: self.duty_cycle,
+                disturbed_sand: self.disturbed_sand,
+            },
             rate_hz: self.rate,
         })
     }

@@ -13,6 +13,8 @@
 //! cannot create energy whatever `h` (docs/model.md §17 proves it; a test checks it).
 
 use super::body::{associated_force, element_force, leg_nodes, submerged, BodyPitch, Contact, BELLY};
+use super::linear::solve_dofs;
+use super::mechanisms::{gait_angle, Trench, CONSTANT_SPEED_DUTY};
 use super::rft::Rft;
 use super::{Geometry, SimSettings, Trajectory};
 use crate::model::G;
@@ -70,7 +72,9 @@ struct LegOut {
 
 /// The walking robot.
 pub(crate) struct Walker {
+    /// The sand's law on the legs (with leg-sand friction, §20.1) and on the belly (without).
     rft: Rft,
+    belly_rft: Rft,
     mass: f64,
     inertia: f64,
     gx: f64,
@@ -117,6 +121,11 @@ pub(crate) struct Walker {
     time: f64,
     gravity_scale: f64,
     unconverged: usize,
+    /// Stride period T, s, and duty cycle (docs/model.md §20.2).
+    period: f64,
+    duty: f64,
+    /// Disturbed sand (§20.3), if it resists less than undisturbed sand.
+    trench: Option<Trench>,
 }
 
 impl Walker {
@@ -140,7 +149,9 @@ impl Walker {
         let legs = 2 * n;
         let slots = legs * elements + BELLY_ELEMENTS;
         let mut w = Walker {
-            rft: Rft::with_scaling(ground.k_n, ground.k_s, settings.rft_scaling),
+            rft: Rft::with_scaling(ground.k_n, ground.k_s, settings.rft_scaling)
+                .with_friction(settings.mechanisms.leg_friction),
+            belly_rft: Rft::with_scaling(ground.k_n, ground.k_s, settings.rft_scaling),
             mass: robot.mass(),
             inertia: robot.pitch_inertia(),
             gx: -G * theta.sin(),
@@ -176,6 +187,10 @@ impl Walker {
             time: 0.0,
             gravity_scale: 1.0,
             unconverged: 0,
+            period: robot.stride_period(),
+            duty: settings.mechanisms.duty_cycle,
+            trench: (settings.mechanisms.disturbed_sand < 1.0)
+                .then(|| Trench::new(settings.mechanisms.disturbed_sand, legs)),
         };
         w.reach = w.nodes.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) * (1.0 + 1e-9);
         for j in 0..legs {
@@ -197,8 +212,15 @@ impl Walker {
         let offset = PI * self.tripod[j] as f64;
         match self.locked {
             Some(a) => a + offset,
-            None => self.psi0 + self.omega * t.max(0.0) + offset,
+            None if self.duty == CONSTANT_SPEED_DUTY => self.psi0 + self.omega * t.max(0.0) + offset,
+            None => self.psi0 + self.clock(j, t).0,
         }
+    }
+
+    /// The gait's clock for leg `j` at time `t` (§20.2): the angle turned since tripod 0's
+    /// first touchdown and the commanded rate; tripod 1 runs half a period ahead.
+    fn clock(&self, j: usize, t: f64) -> (f64, f64) {
+        gait_angle(t.max(0.0) + 0.5 * self.period * self.tripod[j] as f64, self.period, self.duty)
     }
 
     /// Settles the robot for `settle_s` seconds with its legs held at their t = 0 angles while
@@ -256,7 +278,11 @@ impl Walker {
                 }
                 let a = [hip[0] + turned[k][0], heights[k]];
                 let b = [hip[0] + turned[k + 1][0], heights[k + 1]];
-                if let Some((weight, point, tangent, depth)) = submerged(a, b, self.width) {
+                if let Some((mut weight, point, tangent, depth)) = submerged(a, b, self.width) {
+                    if let Some(trench) = &mut self.trench {
+                        weight *= trench.factor_at(point[0], -point[1]);
+                        trench.sweep(j, a, b);
+                    }
                     self.contacts.push(Contact {
                         weight,
                         tangent,
@@ -397,7 +423,8 @@ impl Walker {
             need[1] += self.forces[k][1];
             weight += self.contacts[k].weight;
         }
-        if weight <= 0.0 || !self.rft.holds_at_rest(c.tangent, weight, need) {
+        let rft = if c.leg == BELLY { &self.belly_rft } else { &self.rft };
+        if weight <= 0.0 || !rft.holds_at_rest(c.tangent, weight, need) {
             return false;
         }
         for &k in &group {
@@ -487,7 +514,8 @@ impl Walker {
         associated: bool,
     ) -> (f64, [f64; 3]) {
         let h = self.dt;
-        let (contacts, forces, rates, rft) = (&self.contacts, &mut self.forces, &self.rates, &self.rft);
+        let (contacts, forces, rates) = (&self.contacts, &mut self.forces, &self.rates);
+        let (leg_rft, belly_rft) = (&self.rft, &self.belly_rft);
         let mut g = [0.0; 3];
         let mut k = [[0.0; 3]; 3];
         let mut potential = 0.0;
@@ -497,11 +525,12 @@ impl Walker {
             let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
             let u = Walker::element_velocity(c, v, rate);
             let (f, d) = if associated {
+                let rft = if c.leg == BELLY { belly_rft } else { leg_rft };
                 let (f, p, hess) = associated_force(rft, c, u, eps);
                 potential += p;
                 (f, [[-hess[0][0], -hess[0][1]], [-hess[1][0], -hess[1][1]]])
             } else {
-                element_force(rft, c, u, eps, want)
+                element_force(if c.leg == BELLY { belly_rft } else { leg_rft }, c, u, eps, want)
             };
             forces.push(f);
             let (rx, rz) = (c.rel[0], c.rel[1]);
@@ -553,12 +582,18 @@ impl Walker {
             self.stalled[j] = false;
             self.rates[j] = if gait {
                 let cmd = self.command(j, self.time);
+                let nominal =
+                    if self.duty == CONSTANT_SPEED_DUTY { self.omega } else { self.clock(j, self.time).1 };
                 if self.locked.is_some() {
                     0.0
                 } else if self.torque_limit.is_some() {
-                    (self.omega + (cmd - self.psi[j]) * CATCH_UP_PER_S).clamp(0.0, 1.5 * self.omega)
-                } else {
+                    (nominal + (cmd - self.psi[j]) * CATCH_UP_PER_S).clamp(0.0, 1.5 * nominal)
+                } else if self.duty == CONSTANT_SPEED_DUTY {
                     self.omega
+                } else {
+                    // Exactly onto the command at the step's end (the clock's rate changes
+                    // within a step at the half turns).
+                    (self.command(j, self.time + dt) - self.psi[j]) / dt
                 }
             } else {
                 0.0
@@ -600,6 +635,9 @@ impl Walker {
             for (psi, rate) in self.psi.iter_mut().zip(&self.rates) {
                 *psi += rate * dt;
             }
+        }
+        if let Some(trench) = &mut self.trench {
+            trench.end_step();
         }
         self.time += dt;
     }
@@ -753,35 +791,4 @@ impl Walker {
     pub(crate) fn leg_depth(&self) -> f64 {
         self.legs_out.iter().map(|o| o.depth).fold(0.0, f64::max)
     }
-}
-
-/// Solves the first `dofs` rows and columns of `a x = b` (Gaussian elimination with partial
-/// pivoting; `dofs` is 2 or 3), the rest of `x` zero.
-fn solve_dofs(a: &[[f64; 3]; 3], b: &[f64; 3], dofs: usize) -> [f64; 3] {
-    let mut m = [[0.0; 4]; 3];
-    for i in 0..dofs {
-        m[i][..dofs].copy_from_slice(&a[i][..dofs]);
-        m[i][3] = b[i];
-    }
-    for col in 0..dofs {
-        let p = (col..dofs).max_by(|&x, &y| m[x][col].abs().total_cmp(&m[y][col].abs())).unwrap_or(col);
-        m.swap(col, p);
-        let piv = m[col][col];
-        if piv == 0.0 || !piv.is_finite() {
-            return [0.0; 3];
-        }
-        let pivot_row = m[col];
-        for row in m.iter_mut().take(dofs).skip(col + 1) {
-            let f = row[col] / piv;
-            for (x, p) in row.iter_mut().zip(pivot_row).skip(col) {
-                *x -= f * p;
-            }
-        }
-    }
-    let mut x = [0.0; 3];
-    for i in (0..dofs).rev() {
-        let s: f64 = (i + 1..dofs).map(|k| m[i][k] * x[k]).sum();
-        x[i] = (m[i][3] - s) / m[i][i];
-    }
-    x
 }

@@ -13,6 +13,8 @@
 
 pub mod body;
 pub mod dynamics;
+mod linear;
+pub mod mechanisms;
 pub mod rft;
 
 use rayon::prelude::*;
@@ -20,6 +22,7 @@ use serde::Serialize;
 
 pub use body::{BodyPitch, LegShape};
 use dynamics::Walker;
+pub use mechanisms::Mechanisms;
 pub use rft::RftScaling;
 
 use crate::error::ParamError;
@@ -71,6 +74,8 @@ pub struct SimSettings {
     pub body_pitch: BodyPitch,
     /// How resistive force theory is scaled to the terrain (default: by the direction of motion).
     pub rft_scaling: RftScaling,
+    /// The candidate mechanisms of docs/model.md §20, all off by default.
+    pub mechanisms: Mechanisms,
 }
 
 impl SimSettings {
@@ -95,7 +100,13 @@ impl SimSettings {
             locked_leg_angle: None,
             body_pitch: BodyPitch::default(),
             rft_scaling: RftScaling::Motion,
+            mechanisms: Mechanisms::default(),
         })
+    }
+
+    /// Switches on the mechanisms of docs/model.md §20 (checked: errors name the switch).
+    pub fn with_mechanisms(self, mechanisms: Mechanisms) -> Result<SimSettings, ParamError> {
+        Ok(SimSettings { mechanisms: mechanisms.checked()?, ..self })
     }
 
     /// A fixed integration step, s (checked against the stiffness by [`simulate`]).
@@ -309,6 +320,8 @@ pub struct SimSummary {
     pub body_pitch: BodyPitch,
     /// How resistive force theory was scaled to the terrain.
     pub rft_scaling: RftScaling,
+    /// The mechanisms of docs/model.md §20 the walk had switched on.
+    pub mechanisms: Mechanisms,
     /// Mean step speed over the measured steps, m/s.
     pub speed_m_s: f64,
     /// Mean anchoring time over the measured steps that anchored, s.
@@ -427,6 +440,7 @@ pub fn simulate(
     }
     let (ground, _) = scenario.ground_at(slope);
     let dt = integration_step(scenario, slope, settings.dt_s)?;
+    settings.mechanisms.checked()?;
     let half = robot.stance_duration();
     if settings.locked_leg_angle.is_none() && settings.duration_s < 3.0 * half {
         return Err(ParamError::new(
@@ -582,6 +596,7 @@ fn summarise(
         unconverged_steps,
         body_pitch: settings.body_pitch,
         rft_scaling: settings.rft_scaling,
+        mechanisms: settings.mechanisms,
         speed_m_s: speed,
         t1_s: t1,
         slip_m: slip,

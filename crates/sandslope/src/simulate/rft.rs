@@ -75,6 +75,8 @@ pub struct Rft {
     zeta_z: f64,
     zeta_x: f64,
     scaling: RftScaling,
+    /// Leg-sand friction coefficient capping the along-surface stress (§20.1), if any.
+    friction: Option<f64>,
 }
 
 impl Rft {
@@ -95,7 +97,13 @@ impl Rft {
             RftScaling::Li2013 => zeta_z,
             _ => 2.0 * k_s / ax_side,
         };
-        Rft { zeta_z, zeta_x, scaling }
+        Rft { zeta_z, zeta_x, scaling, friction: None }
+    }
+
+    /// The same law with leg-sand friction `mu` capping the stress along an element's surface
+    /// (docs/model.md §20.1); `None` leaves the law as it is.
+    pub fn with_friction(self, mu: Option<f64>) -> Rft {
+        Rft { friction: mu, ..self }
     }
 
     /// The stress per unit depth of a horizontal plate pushed straight down, N/m^3 (k_n).
@@ -128,7 +136,7 @@ impl Rft {
         let cos2b = tx * tx - tz * tz;
         let sin2b = s * 2.0 * tx * tz;
         let (az, ax) = generic(cos2b, sin2b, ex.abs(), -ez);
-        match self.scaling {
+        let st = match self.scaling {
             // The scale follows the direction of motion: normal motion k_n, along-slope motion k_s.
             RftScaling::Motion => {
                 let zeta = self.zeta_z * ez * ez + self.zeta_x * ex * ex;
@@ -138,6 +146,10 @@ impl Rft {
             RftScaling::Li2013 => (-s * self.zeta_z * ax, self.zeta_z * az),
             // Normal stress k_n, along-surface stress k_s.
             RftScaling::Components => (-s * self.zeta_x * ax, self.zeta_z * az),
+        };
+        match self.friction {
+            None => st,
+            Some(mu) => super::mechanisms::friction_cap(mu, tx, tz, st.0, st.1).0,
         }
     }
 
@@ -204,6 +216,17 @@ impl Rft {
             RftScaling::Components => {
                 ((-s * self.zeta_x * ax, self.zeta_z * az), (-s * self.zeta_x * dax, self.zeta_z * daz))
             }
+        };
+        // Leg-sand friction (§20.1): a capped along-surface stress follows the normal one.
+        let (st, dst) = match self.friction {
+            None => (st, dst),
+            Some(mu) => match super::mechanisms::friction_cap(mu, tx, tz, st.0, st.1) {
+                (capped, None) => (capped, dst),
+                (capped, Some(slope)) => {
+                    let dnormal = -dst.0 * tz + dst.1 * tx;
+                    (capped, (slope * dnormal * tx - dnormal * tz, slope * dnormal * tz + dnormal * tx))
+                }
+            },
         };
         let along = st.0 * ex + st.1 * ez;
         if along <= 0.0 {
@@ -302,17 +325,19 @@ mod tests {
 mod rest_set_tests {
     use super::*;
 
-    /// The set at rest, by its boundary: a horizontal plate's force straight up (what holds it
-    /// against being pushed down, k_n W d) is inside at half its size and outside at twice it;
-    /// a vertical plate held sideways likewise at 2 k_s; no force at all is inside (rest with no
-    /// load).
     /// The closed-form turn derivative against central differences of the stress itself, for
     /// every scaling, tangents round the circle and directions away from the two kinks (the
     /// mirror's seam e_x = 0 and the passive projection's edge S.e = 0).
     #[test]
     fn the_turn_derivative_is_the_stress_differentiated() {
-        for scaling in [RftScaling::Motion, RftScaling::Components, RftScaling::Li2013] {
-            let rft = Rft::with_scaling(7e5, 3e6, scaling);
+        for (scaling, mu) in [
+            (RftScaling::Motion, None),
+            (RftScaling::Components, None),
+            (RftScaling::Li2013, None),
+            (RftScaling::Motion, Some(0.3)),
+            (RftScaling::Li2013, Some(0.1)),
+        ] {
+            let rft = Rft::with_scaling(7e5, 3e6, scaling).with_friction(mu);
             let scale = rft.zeta_z.max(rft.zeta_x);
             for i in 0..24 {
                 let b = std::f64::consts::PI * (i as f64 + 0.3) / 24.0;
@@ -328,7 +353,16 @@ mod rest_set_tests {
                         rft.stress(tx, tz, (a - h).cos(), (a - h).sin()),
                     );
                     let along = |st: (f64, f64), t: f64| st.0 * t.cos() + st.1 * t.sin();
-                    if ex.abs() < 1e-3 || (along(sp, a + h) > 0.0) != (along(sm, a - h) > 0.0) {
+                    // The friction cap's edge is a kink too.
+                    let capped = |st: (f64, f64)| {
+                        mu.is_some_and(|mu| {
+                            (st.0 * tx + st.1 * tz).abs() >= mu * (st.1 * tx - st.0 * tz).abs() * 0.999_999
+                        })
+                    };
+                    if ex.abs() < 1e-3
+                        || (along(sp, a + h) > 0.0) != (along(sm, a - h) > 0.0)
+                        || capped(sp) != capped(sm)
+                    {
                         continue;
                     }
                     let (st, turn) = rft.passive_stress_and_turn(tx, tz, ex, ez);
@@ -379,6 +413,10 @@ mod rest_set_tests {
         }
     }
 
+    /// The set at rest, by its boundary: a horizontal plate's force straight up (what holds it
+    /// against being pushed down, k_n W d) is inside at half its size and outside at twice it;
+    /// a vertical plate held sideways likewise at 2 k_s; no force at all is inside (rest with no
+    /// load).
     #[test]
     fn the_rest_set_is_bounded_by_the_laws_stress_in_every_direction() {
         let rft = Rft::new(7e5, 2e6);

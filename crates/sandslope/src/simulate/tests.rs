@@ -460,4 +460,86 @@ fn a_robot_with_held_legs_never_gains_energy() {
             }
         }
     }
+    // With leg-sand friction (§20.1) as well: the cap, then the passive projection.
+    for (scaling, mu) in [(RftScaling::Motion, 0.3), (RftScaling::Motion, 0.05), (RftScaling::Li2013, 0.3)] {
+        for &(k_n, k_s) in &[(7e5, 3e6), (7e5, 1e4), (7e5, 1e8)] {
+            let settings = SimSettings::new(1.0)
+                .unwrap()
+                .with_locked_legs(heavy.touchdown_angle())
+                .with_body_pitch(BodyPitch::Free)
+                .with_rft_scaling(scaling)
+                .with_mechanisms(Mechanisms { leg_friction: Some(mu), ..Default::default() })
+                .unwrap();
+            let ground = Ground::new(k_n, k_s).unwrap();
+            let mut w = Walker::new(&heavy, &ground, 10f64.to_radians(), &settings, 1e-3);
+            let e0 = w.energy();
+            let (mut high, mut prev, mut worst_step) = (e0, e0, f64::NEG_INFINITY);
+            for _ in 0..1000 {
+                w.hold(1);
+                let e = w.energy();
+                worst_step = worst_step.max(e - prev);
+                high = high.max(e);
+                prev = e;
+            }
+            assert!(
+                high - e0 <= 1e-3 && worst_step <= 1e-6,
+                "{scaling:?} mu {mu} k_s {k_s}: gained {}",
+                high - e0
+            );
+            assert!(prev < e0 - 1e-3, "{scaling:?} mu {mu} k_s {k_s}: {e0} -> {prev}");
+        }
+    }
+}
+
+/// The mechanisms of docs/model.md §20 on the built-in robot and terrain.
+fn builtin_walk(slope_deg: f64, robot: Robot, mechanisms: Mechanisms, duration_s: f64) -> Simulation {
+    let s = Scenario::new(robot, builtin_terrain(), None, None).unwrap();
+    let settings = SimSettings::new(duration_s).unwrap().with_mechanisms(mechanisms).unwrap();
+    simulate(&s, slope_deg, &settings).unwrap()
+}
+
+/// §20.2 by hand: at duty cycle D = 0.7 (T = 1 s) an ideal servo's leg of tripod 0 has turned
+/// a quarter turn from touchdown at t = 0.35 s, half a turn at 0.7 s and three quarters at
+/// 0.85 s; tripod 1, half a period ahead, is 0.6 s into its stance half at t = 0.1 s (turned
+/// pi 0.6 / 0.7) and a sixth into its swing at t = 0.25 s (pi + pi 0.05 / 0.3).
+#[test]
+fn the_duty_cycle_turns_the_stance_half_slower() {
+    use std::f64::consts::PI;
+    let robot = paper_robot();
+    let phi0 = robot.touchdown_angle();
+    let sim = builtin_walk(0.0, robot, Mechanisms { duty_cycle: 0.7, ..Default::default() }, 1.5);
+    let tr = &sim.trajectory;
+    let at = |t: f64, leg: usize| {
+        let i = tr.time_s.iter().position(|&s| (s - t).abs() < 1e-9).unwrap();
+        tr.leg_angle_rad[leg][i]
+    };
+    for (t, turned) in [(0.35, 0.5 * PI), (0.7, PI), (0.85, 1.5 * PI), (1.35, 2.5 * PI)] {
+        assert!((at(t, 0) - phi0 - turned).abs() < 1e-6, "t = {t}: {} against {}", at(t, 0) - phi0, turned);
+    }
+    for (t, turned) in [(0.1, PI * 0.6 / 0.7), (0.25, PI + PI * 0.05 / 0.3)] {
+        assert!((at(t, 3) - phi0 - turned).abs() < 1e-6, "t = {t}: {} against {}", at(t, 3) - phi0, turned);
+    }
+}
+
+/// §20.3: on the built-in terrain at 20 degrees the steps are shorter than the hip spacing,
+/// so legs land in the trenches of earlier stances; sand there at a tenth of its strength lets
+/// them sink deeper and step less. On level sand the step (169 mm) carries every leg past the
+/// trenches (hips 70 mm apart) and nearly nothing changes. At F = 1 the walk is the default's
+/// bit for bit.
+#[test]
+fn disturbed_sand_shortens_the_step_where_legs_land_in_trenches() {
+    let robot = paper_robot();
+    let weak = Mechanisms { disturbed_sand: 0.1, ..Default::default() };
+    let plain = builtin_walk(20.0, robot.clone(), Mechanisms::default(), 3.0).summary;
+    let trench = builtin_walk(20.0, robot.clone(), weak, 3.0).summary;
+    assert!(plain.step_m < 0.14, "{}", plain.step_m);
+    assert!(
+        trench.max_depth_m > plain.max_depth_m * 1.05,
+        "{} against {}",
+        trench.max_depth_m,
+        plain.max_depth_m
+    );
+    assert!(trench.step_m < 0.9 * plain.step_m, "{} against {}", trench.step_m, plain.step_m);
+    let one = Mechanisms { disturbed_sand: 1.0, ..Default::default() };
+    assert_eq!(builtin_walk(20.0, robot, one, 3.0).summary.speed_m_s, plain.speed_m_s);
 }

@@ -275,7 +275,10 @@ pub fn simulator(report: &Report) -> String {
          the paper's below 24°, where the closed form's leg slides along its own circle held by solidified sand and \
          steps s*; resistive force theory has no term that holds the circle. <i>Anchoring</i>: the simulated legs \
          anchor within a few milliseconds, well before the closed form's t1. No switch of the simulator with a \
-         measured input brings the level speed to the paper's 15.7 cm/s (docs/simulate.md, \"The level stride\"). \
+         measured input brings the level speed to the paper's 15.7 cm/s (docs/simulate.md, \"The level stride\"), \
+         nor do leg-sand friction, a slower stance or sand weakened where earlier steps dug it (docs/model.md §20); \
+         the last slows the walk on slopes and leaves level sand as it was, as the trench the paper names for \
+         metastability would (docs/simulate.md, \"The mechanisms across the slopes\"). \
          The paper's own rise from 20° to 24° (+0.62 ± 1.63 cm/s, 0.4 SD) and its plateau from 10° to 15° (1.9 SD) \
          are within its scatter: neither model is asked to follow them. <i>Pitch free</i>: the pitch-free columns, \
          with the body free to pitch, are not converged on slopes (the body rears and, at {tumbles} of these slopes, \

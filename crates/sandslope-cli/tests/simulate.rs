@@ -116,6 +116,12 @@ fn body_pitch_locked_holds_the_body_parallel_to_the_slope() {
     let default = json(&["simulate", "--slope", "20", "--duration", "3", "--json"]);
     assert_eq!(default["body_pitch"], "locked");
     assert!(free["max_pitch_deg"].as_f64().unwrap() > 5.0);
+    // The text answer says what a free walk is: one draw of a spread (docs/simulate.md).
+    let out = sandslope()
+        .args(["simulate", "--slope", "20", "--duration", "1.5", "--body-pitch", "free"])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stdout).contains("one walk is one draw of a spread"));
     assert_eq!(free["creep_m_s"], 1e-7);
     assert!(free["servo_torque_limit_n_m"].is_null());
     let li = json(&["simulate", "--slope", "20", "--duration", "1.5", "--json", "--rft-scaling", "li2013"]);

@@ -50,7 +50,7 @@ pub struct SimulateArgs {
     pub no_servo_limit: bool,
     /// Whether the body may pitch: `locked` (the default) holds it parallel to the slope, the
     /// closed form's assumption and the setting whose answers converge; `free` lets it pitch,
-    /// rear and tumble, not converged on slopes (docs/simulate.md).
+    /// rear and tumble, chaotic on slopes: one walk is one draw of a spread (docs/simulate.md).
     #[arg(long, value_name = "MODE", value_enum, default_value_t = PitchArg::Locked)]
     pub body_pitch: PitchArg,
     /// How resistive force theory is scaled to the terrain's k_n and k_s: `motion` (one scale
@@ -104,7 +104,7 @@ pub struct SimulateArgs {
 /// `--body-pitch`: the library's [`BodyPitch`] as a flag value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum PitchArg {
-    /// The body pitches under the sand's and gravity's moments (not converged on slopes).
+    /// The body pitches under the sand's and gravity's moments (chaotic on slopes).
     Free,
     /// The body is held parallel to the slope, as the closed form assumes (default).
     Locked,
@@ -275,7 +275,7 @@ fn print_one(sim: &Simulation) {
     }
     if m.body_pitch == BodyPitch::Free {
         println!(
-            "body pitch free (--body-pitch free): not converged on slopes, the answers there change with --dt (docs/simulate.md)"
+            "body pitch free (--body-pitch free): the free body's pitch is unstable on slopes (walks 1e-9 apart part within seconds), so one walk is one draw of a spread; see the ensembles in docs/simulate.md"
         );
     }
     if m.unconverged_steps > 0 {
@@ -401,7 +401,7 @@ fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedOb
             println!("{DISAGREE_NOTE}");
             if settings.body_pitch == BodyPitch::Free {
                 println!(
-                    "body pitch free (--body-pitch free): not converged on slopes, the answers there change with --dt (docs/simulate.md)"
+                    "body pitch free (--body-pitch free): the free body's pitch is unstable on slopes (walks 1e-9 apart part within seconds), so one walk is one draw of a spread; see the ensembles in docs/simulate.md"
                 );
             }
             if settings.rft_scaling != RftScaling::Motion {

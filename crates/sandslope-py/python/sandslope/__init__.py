@@ -736,7 +736,7 @@ def simulate(
     speed of the contact law's smoothing at rest (``--creep``, docs/model.md §17),
     ``sample_rate_hz`` the trajectory's sampling; ``body_pitch="locked"`` (the default) holds the
     body parallel to the slope, as the closed form assumes, the setting whose answers converge;
-    ``"free"`` lets it pitch (``--body-pitch free``; not converged on slopes, docs/simulate.md);
+    ``"free"`` lets it pitch (``--body-pitch free``; chaotic on slopes, one walk is one draw of a spread, docs/simulate.md);
     ``rft_scaling="components"`` scales the sand's normal stress by k_n and its shear stress by
     k_s, ``"li2013"`` everything by one factor from k_n, instead of one scale following the
     motion (``--rft-scaling``, docs/model.md §16); ``servo_limit=False`` ignores the robot

@@ -255,7 +255,7 @@ impl Figure for SlopesFigure<'_> {
         .label(if self.sims.first().is_some_and(|m| m.body_pitch == BodyPitch::Locked) {
             "simulated, pitch locked (docs/model.md §15-§18)"
         } else {
-            "simulated, pitch free (not converged on slopes; docs/simulate.md)"
+            "simulated, pitch free (one draw of a chaotic walk on slopes; docs/simulate.md)"
         })
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(3)));
         c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, blue.filled()))).map_err(plot_err)?;

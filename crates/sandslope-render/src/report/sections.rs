@@ -281,8 +281,10 @@ pub fn simulator(report: &Report) -> String {
          metastability would (docs/simulate.md, \"The mechanisms across the slopes\"). \
          The paper's own rise from 20° to 24° (+0.62 ± 1.63 cm/s, 0.4 SD) and its plateau from 10° to 15° (1.9 SD) \
          are within its scatter: neither model is asked to follow them. <i>Pitch free</i>: the pitch-free columns, \
-         with the body free to pitch, are not converged on slopes (the body rears and, at {tumbles} of these slopes, \
-         tumbles, whether it does changing with the time step): they show what the pitch may do, not a result.</p>\n",
+         with the body free to pitch, are each one draw from a spread: the free body's pitch is unstable on slopes \
+         (two walks whose masses differ by a billionth part by degrees within seconds), so a single free walk cannot \
+         converge with the time step; over many such walks its speed and regime do, and from 15° nearly every one \
+         tumbles within 10 s (docs/simulate.md, \"Pitch free\"). Here {tumbles} of these slopes tumbled.</p>\n",
         sandslope::report::REPORT_WALK_S,
         sandslope::report::AGREE_WITHIN * 100.0,
         report.simulator.len()

@@ -61,8 +61,8 @@ pub struct SimulatorRecord {
     /// When the body of the walk with the pitch free pitched past 90 degrees, s (`null`: it
     /// did not).
     pub pitch_over_s: Option<f64>,
-    /// The simulator's mean step speed with the body free to pitch (not converged on slopes,
-    /// docs/simulate.md: shown for what the pitch does, not as a result), m/s.
+    /// The simulator's mean step speed with the body free to pitch (one draw from the spread
+    /// of a chaotic walk on slopes, docs/simulate.md: shown for what the pitch does), m/s.
     pub pitch_free_m_s: f64,
     /// The regime of that walk.
     pub pitch_free_regime: Regime,

@@ -30,8 +30,8 @@ pub enum LegShape {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BodyPitch {
-    /// The body pitches under the moments of the sand and gravity (not converged on slopes:
-    /// its answers there are not results).
+    /// The body pitches under the moments of the sand and gravity (chaotic on slopes: a walk
+    /// is one draw from a spread whose statistics converge, docs/simulate.md).
     Free,
     /// The body keeps its pitch at zero (parallel to the slope), as the closed form assumes:
     /// the moments are carried by a constraint and the body moves along and normal to the slope

@@ -296,3 +296,32 @@ fn track_recovers_the_negative_speed_of_a_walk_that_slides_down() {
     let default = json(&["track", csv.to_str().unwrap(), "--slope", "20", "--json"]);
     assert!(default["speed_m_s"].as_f64().unwrap() < 0.0, "{}", default["speed_m_s"]);
 }
+
+/// `--ensemble N` (docs/simulate.md, "Pitch free"): N walks at one slope, the mass perturbed
+/// by 1e-9 relative between them. With the pitch locked the walk is stable, so the walks agree
+/// to 1e-8 cm/s; the counts of regimes add up to N; the CSV has a row per walk with the mass
+/// each walked with.
+#[test]
+fn an_ensemble_gives_the_spread_of_n_walks() {
+    let v = json(&["simulate", "--slope", "10", "--duration", "2", "--ensemble", "3", "--json"]);
+    assert_eq!(v["walks"], 3);
+    assert_eq!(v["perturbation"], 1e-9);
+    assert_eq!(v["summaries"].as_array().unwrap().len(), 3);
+    assert!(v["speed_sd_m_s"].as_f64().unwrap() < 1e-8, "{v}");
+    let counts: u64 = v["regimes"].as_object().unwrap().values().map(|c| c.as_u64().unwrap()).sum();
+    assert_eq!(counts, 3);
+    assert_eq!(v["regimes"][v["regime"].as_str().unwrap()], 3);
+    let out = sandslope()
+        .args(["simulate", "--slope", "10", "--duration", "2", "--ensemble", "2", "--csv"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "walk,mass_kg,speed_m_s,t1_s,step_m,max_pitch_deg,pitch_over_s,regime,cause");
+    assert!(lines[2].starts_with("1,0.35000000035,"), "{text}");
+    sandslope()
+        .args(["simulate", "--slope", "10", "--ensemble", "1"])
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("--ensemble = 1 must be a whole number of walks from 2 to 1000"));
+}

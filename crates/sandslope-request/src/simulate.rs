@@ -4,8 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use sandslope::simulate::{
-    simulate, simulate_slopes, BodyPitch, Mechanisms, RftScaling, SimSettings, SimSummary, SimulateError,
-    Simulation,
+    simulate, simulate_ensemble, simulate_slopes, BodyPitch, Ensemble, Mechanisms, RftScaling, SimSettings,
+    SimSummary, SimulateError, Simulation,
 };
 use sandslope::{ParamError, Scenario};
 
@@ -53,6 +53,9 @@ pub struct SimulateRequest {
     pub mechanisms: Mechanisms,
     /// Trajectory sample rate, Hz (field `rate`, default 120).
     pub rate_hz: f64,
+    /// Walk the one slope this many times, the mass perturbed by 1e-9 relative between walks,
+    /// and answer the spread (field `ensemble`; docs/simulate.md, "Pitch free").
+    pub ensemble: Option<usize>,
 }
 
 /// Parses the field `slopes`: the one slope-list grammar, signed, at most [`MAX_SLOPES`].
@@ -68,6 +71,7 @@ fn flagged(e: ParamError) -> RequestError {
         "slope_deg" => "slope",
         "creep_m_s" => "creep",
         "sample_rate_hz" => "rate",
+        "ensemble" => "ensemble",
         "leg_friction" => "leg-friction",
         "duty_cycle" => "duty-cycle",
         "disturbed_sand" => "disturbed-sand",
@@ -116,6 +120,7 @@ impl SimulateRequest {
             disturbed_sand: p.number_or("disturbed-sand", defaults.disturbed_sand)?,
         };
         let rate_hz = p.number_or("rate", 120.0)?;
+        let ensemble = p.number("ensemble")?.map(|n| ensemble_size(n, &slopes)).transpose()?;
         let scenario = ScenarioRequest::from_params(&mut p)?;
         p.finish()?;
         Ok(SimulateRequest {
@@ -129,6 +134,7 @@ impl SimulateRequest {
             rft_scaling,
             mechanisms,
             rate_hz,
+            ensemble,
         })
     }
 
@@ -159,14 +165,12 @@ impl SimulateRequest {
             SimSlopes::Many(slopes) => (slopes.clone(), true),
             SimSlopes::One(slope) => (vec![check_slope(*slope)?], false),
         };
-        Ok(Walks { scenario, slopes, many, settings })
+        Ok(Walks { scenario, slopes, many, settings, ensemble: self.ensemble })
     }
 
     /// The answer (what `simulate --json` prints).
     pub fn answer(&self) -> Result<Answer> {
-        let walks = self.walks()?;
-        let sims = walks.simulate()?;
-        Ok(walks.answer(sims))
+        self.walks()?.respond()
     }
 }
 
@@ -251,6 +255,24 @@ pub fn parse_rft_scaling(text: &str, words: Words) -> Result<RftScaling> {
     choose("rft-scaling", text, &options, words)
 }
 
+/// Checks an ensemble's size (a whole number from 2 to 1000) and that it has one slope.
+pub fn ensemble_size(n: f64, slopes: &SimSlopes) -> Result<usize> {
+    let (lo, hi) = sandslope::simulate::ensemble::ENSEMBLE_RANGE;
+    if !(n.fract() == 0.0 && n >= lo as f64 && n <= hi as f64) {
+        return Err(RequestError::invalid(
+            "ensemble",
+            format!("--ensemble = {n} must be a whole number of walks from {lo} to {hi}"),
+        ));
+    }
+    if matches!(slopes, SimSlopes::Many(_)) {
+        return Err(RequestError::invalid(
+            "ensemble",
+            "--ensemble walks one slope: give --slope, not --slopes",
+        ));
+    }
+    Ok(n as usize)
+}
+
 /// One walk's slope: strictly between -90 and 90 degrees.
 pub fn check_slope(slope: f64) -> Result<f64> {
     check_range("slope", slope, -89.999_999, 89.999_999).map_err(|_| {
@@ -269,6 +291,8 @@ pub enum Answer {
     One(Box<SimSummary>),
     /// Several slopes.
     Many(Vec<SimSummary>),
+    /// An ensemble at one slope.
+    Ensemble(Box<Ensemble>),
 }
 
 /// The walks of a simulate request, checked: what a server weighs against its limits before
@@ -283,6 +307,8 @@ pub struct Walks {
     pub many: bool,
     /// The checked settings.
     pub settings: SimSettings,
+    /// Walks in an ensemble at the one slope, if asked.
+    pub ensemble: Option<usize>,
 }
 
 impl Walks {
@@ -296,7 +322,7 @@ impl Walks {
                 .map_err(flagged)?;
             steps += (self.settings.duration_s + self.settings.settle_s) / dt;
         }
-        Ok(steps)
+        Ok(steps * self.ensemble.unwrap_or(1) as f64)
     }
 
     /// Runs the walks (several in parallel).
@@ -306,6 +332,19 @@ impl Walks {
         } else {
             Ok(vec![simulate(&self.scenario, self.slopes[0], &self.settings).map_err(sim_err)?])
         }
+    }
+
+    /// Runs the walks, or the ensemble, and answers (what `simulate --json` prints).
+    pub fn respond(&self) -> Result<Answer> {
+        match self.ensemble {
+            Some(n) => Ok(Answer::Ensemble(Box::new(self.simulate_ensemble(n)?))),
+            None => Ok(self.answer(self.simulate()?)),
+        }
+    }
+
+    /// The ensemble of `n` walks at the one slope.
+    pub fn simulate_ensemble(&self, n: usize) -> Result<Ensemble> {
+        simulate_ensemble(&self.scenario, self.slopes[0], &self.settings, n).map_err(sim_err)
     }
 
     /// The value `simulate --json` prints for these walks' results.
@@ -324,6 +363,38 @@ impl Walks {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn params(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
+        pairs.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    /// `ensemble`: one slope, 2 to 1000 walks, and it multiplies what the walks cost (the
+    /// server weighs that against its step limit).
+    #[test]
+    fn an_ensemble_walks_one_slope_and_costs_n_walks() {
+        let one = SimulateRequest::from_params(&params(&[("slope", "10"), ("duration", "2")])).unwrap();
+        let three =
+            SimulateRequest::from_params(&params(&[("slope", "10"), ("duration", "2"), ("ensemble", "3")]))
+                .unwrap();
+        assert_eq!(three.ensemble, Some(3));
+        let (a, b) = (
+            one.walks().unwrap().integration_steps().unwrap(),
+            three.walks().unwrap().integration_steps().unwrap(),
+        );
+        assert!((b / a - 3.0).abs() < 1e-12, "{a} {b}");
+        for (pairs, needle) in [
+            (vec![("slopes", "0,10"), ("ensemble", "3")], "give --slope, not --slopes"),
+            (
+                vec![("slope", "10"), ("ensemble", "1")],
+                "--ensemble = 1 must be a whole number of walks from 2 to 1000",
+            ),
+            (vec![("slope", "10"), ("ensemble", "2.5")], "--ensemble = 2.5"),
+            (vec![("slope", "10"), ("ensemble", "1001")], "--ensemble = 1001"),
+        ] {
+            let e = SimulateRequest::from_params(&params(&pairs)).unwrap_err();
+            assert!(e.message().contains(needle), "{pairs:?}: {}", e.message());
+        }
+    }
 
     /// The two setting names each front end spells its own way, from one list.
     #[test]

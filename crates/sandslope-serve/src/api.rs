@@ -156,8 +156,7 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
         }
         "simulate" => {
             let walks = simulate_walks(params, served)?;
-            let sims = walks.simulate()?;
-            Ok(Reply::pretty(walks.answer(sims)))
+            Ok(Reply::pretty(walks.respond()?))
         }
         "plan" => {
             let request = PlanRequest::from_params(&plan_params(params, served)?)?;

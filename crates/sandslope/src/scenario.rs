@@ -42,6 +42,11 @@ impl Scenario {
         Ok(Scenario { robot, terrain, k_n, k_s })
     }
 
+    /// The same scenario with another robot (terrain and overrides kept).
+    pub fn with_robot(&self, robot: Robot) -> Scenario {
+        Scenario { robot, ..self.clone() }
+    }
+
     /// The robot.
     pub fn robot(&self) -> &Robot {
         &self.robot

@@ -19,7 +19,7 @@ use crate::progress::{progress_bar, spinner};
 use sandslope::simulate::{BodyPitch, Mechanisms, RftScaling, SimSummary, Simulation};
 use sandslope_io::load_speeds;
 use sandslope_io::trajectory::plain_mocap_csv;
-use sandslope_request::simulate::{parse_slopes, Answer, SimSlopes, Walks};
+use sandslope_request::simulate::{ensemble_size, parse_slopes, Answer, SimSlopes, Walks};
 use sandslope_request::SimulateRequest;
 
 /// Arguments of `sandslope simulate`.
@@ -73,6 +73,12 @@ pub struct SimulateArgs {
     /// default 1: as strong as before).
     #[arg(long, value_name = "F", default_value_t = 1.0, allow_negative_numbers = true)]
     pub disturbed_sand: f64,
+    /// Walk the one slope N times (2 to 1000), the robot's mass perturbed by 1e-9 relative
+    /// between walks, and give the spread: mean speed, its SD and standard error, mean t1, the
+    /// regimes' counts, how many pitched over. For the free body, whose walk on a slope is
+    /// chaotic, the spread is the answer (docs/simulate.md, "Pitch free").
+    #[arg(long, value_name = "N", conflicts_with_all = ["slopes", "out", "plot", "animate"])]
+    pub ensemble: Option<usize>,
     /// Trajectory sample rate for --out, --plot and --animate, Hz.
     #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
     pub rate: f64,
@@ -148,6 +154,7 @@ impl SimulateArgs {
             (None, Some(slope)) => SimSlopes::One(slope),
             (None, None) => bail!("--slope or --slopes is required"),
         };
+        let ensemble = self.ensemble.map(|n| ensemble_size(n as f64, &slopes)).transpose()?;
         Ok(SimulateRequest {
             slopes,
             scenario: self.over.request(&self.robot, &self.terrain),
@@ -163,6 +170,7 @@ impl SimulateArgs {
                 disturbed_sand: self.disturbed_sand,
             },
             rate_hz: self.rate,
+            ensemble,
         })
     }
 }
@@ -184,6 +192,9 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     }
     let observed = args.observed.as_deref().map(load_speeds).transpose()?;
     let walks = request.walks()?;
+    if let Some(n) = walks.ensemble {
+        return run_ensemble(&args, &walks, n);
+    }
     if walks.many {
         run_slopes(&args, &walks, observed.as_deref().unwrap_or(&[]))
     } else {
@@ -274,9 +285,7 @@ fn print_one(sim: &Simulation) {
         println!("servo torque limit {limit} N m (the robot file's; --no-servo-limit drives ideal servos)");
     }
     if m.body_pitch == BodyPitch::Free {
-        println!(
-            "body pitch free (--body-pitch free): the free body's pitch is unstable on slopes (walks 1e-9 apart part within seconds), so one walk is one draw of a spread; see the ensembles in docs/simulate.md"
-        );
+        println!("{FREE_NOTE}");
     }
     if m.unconverged_steps > 0 {
         println!(
@@ -320,6 +329,78 @@ struct SlopeRow {
     closed_form_slip_m: Option<f64>,
     closed_form_step_m: Option<f64>,
     closed_form_regime: &'static str,
+}
+
+/// What a walk with the body free to pitch is (docs/simulate.md, "Pitch free").
+const FREE_NOTE: &str = "body pitch free (--body-pitch free): the free body's pitch is unstable on slopes (walks 1e-9 apart part within seconds), so one walk is one draw of a spread; --ensemble N gives the spread (docs/simulate.md)";
+
+/// One row of `simulate --ensemble N --csv`: one walk.
+#[derive(Serialize)]
+struct EnsembleRow {
+    walk: usize,
+    mass_kg: f64,
+    speed_m_s: f64,
+    t1_s: Option<f64>,
+    step_m: f64,
+    max_pitch_deg: f64,
+    pitch_over_s: Option<f64>,
+    regime: &'static str,
+    cause: &'static str,
+}
+
+fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
+    let quiet = args.format.format() != Format::Table;
+    let spin = spinner(quiet, &format!("simulating {n} walks at {} deg", walks.slopes[0]));
+    let e = walks.simulate_ensemble(n);
+    spin.finish_and_clear();
+    let e = e?;
+    match args.format.format() {
+        Format::Json => print_json(&Answer::Ensemble(Box::new(e)))?,
+        Format::Csv => {
+            let mass = walks.scenario.robot().mass();
+            let rows: Vec<EnsembleRow> = e
+                .summaries
+                .iter()
+                .enumerate()
+                .map(|(k, m)| EnsembleRow {
+                    walk: k,
+                    mass_kg: mass * (1.0 + e.perturbation * k as f64),
+                    speed_m_s: m.speed_m_s,
+                    t1_s: m.t1_s,
+                    step_m: m.step_m,
+                    max_pitch_deg: m.max_pitch_deg,
+                    pitch_over_s: m.pitch_over_s,
+                    regime: m.regime.name(),
+                    cause: m.cause.name(),
+                })
+                .collect();
+            print!("{}", csv_string(&rows)?);
+        }
+        Format::Table => {
+            println!(
+                "{n} walks at {} deg (mass perturbed by {:e} relative between walks):",
+                walks.slopes[0], e.perturbation
+            );
+            println!(
+                "speed {:.2} +/- {:.2} cm/s (SD; standard error {:.2}), mean t1 {} ms",
+                e.speed_m_s * 100.0,
+                e.speed_sd_m_s * 100.0,
+                e.speed_se_m_s * 100.0,
+                num(e.t1_s.map(|t| t * 1e3), 1)
+            );
+            let counts: Vec<String> = e.regimes.iter().map(|(r, c)| format!("{} {c}", r.name())).collect();
+            println!(
+                "regimes: {} (most: {}); pitched over: {} of {n}",
+                counts.join(", "),
+                e.regime.name(),
+                e.pitched_over
+            );
+            if walks.settings.body_pitch == BodyPitch::Locked {
+                println!("body pitch locked: the walk is stable, so the walks differ by rounding (docs/simulate.md)");
+            }
+        }
+    }
+    Ok(())
 }
 
 fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedObservation]) -> Result<()> {
@@ -400,9 +481,7 @@ fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedOb
             println!("{t}");
             println!("{DISAGREE_NOTE}");
             if settings.body_pitch == BodyPitch::Free {
-                println!(
-                    "body pitch free (--body-pitch free): the free body's pitch is unstable on slopes (walks 1e-9 apart part within seconds), so one walk is one draw of a spread; see the ensembles in docs/simulate.md"
-                );
+                println!("{FREE_NOTE}");
             }
             if settings.rft_scaling != RftScaling::Motion {
                 println!(

@@ -726,6 +726,9 @@ def simulate(
     body_pitch: str = "locked",
     rft_scaling: str = "motion",
     servo_limit: bool = True,
+    leg_friction: Optional[float] = None,
+    duty_cycle: Optional[float] = None,
+    disturbed_sand: Optional[float] = None,
 ) -> Tuple[Any, Dict[str, Any]]:
     """Simulates the robot walking for ``duration_s`` seconds on ``terrain`` at ``slope_deg``
     (``sandslope simulate``, docs/model.md §15-§18).
@@ -740,7 +743,10 @@ def simulate(
     ``rft_scaling="components"`` scales the sand's normal stress by k_n and its shear stress by
     k_s, ``"li2013"`` everything by one factor from k_n, instead of one scale following the
     motion (``--rft-scaling``, docs/model.md §16); ``servo_limit=False`` ignores the robot
-    file's servo torque limit (``--no-servo-limit``). Negative slopes walk downhill.
+    file's servo torque limit (``--no-servo-limit``). ``leg_friction``, ``duty_cycle`` and
+    ``disturbed_sand`` switch on the candidate mechanisms of docs/model.md §20 (``--leg-friction``,
+    ``--duty-cycle``, ``--disturbed-sand``; left out, each takes the CLI's default: off).
+    Negative slopes walk downhill.
 
     Returns ``(trajectory, summary)``: ``trajectory`` a pandas DataFrame (a dict of NumPy
     columns without pandas) with ``time_s``, ``x_m``, ``z_m``, ``pitch_rad``, ``vx_m_s``,
@@ -762,6 +768,11 @@ def simulate(
         body_pitch=str(body_pitch),
         rft_scaling=str(rft_scaling),
         servo_limit=bool(servo_limit),
+        **{
+            k: float(v)
+            for k, v in (("leg_friction", leg_friction), ("duty_cycle", duty_cycle), ("disturbed_sand", disturbed_sand))
+            if v is not None
+        },
     )
     try:
         import pandas as pd

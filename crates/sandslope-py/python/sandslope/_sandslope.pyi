@@ -219,6 +219,9 @@ def simulate(
     body_pitch: str = "locked",
     rft_scaling: str = "motion",
     servo_limit: bool = True,
+    leg_friction: Optional[float] = None,
+    duty_cycle: float = 0.5,
+    disturbed_sand: float = 1.0,
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 def read_servo_log(path: _Path) -> Tuple[Dict[str, np.ndarray], Dict[str, str]]: ...
 def infer_servo_log(

@@ -13,6 +13,7 @@
 
 pub mod body;
 pub mod dynamics;
+pub mod ensemble;
 mod linear;
 pub mod mechanisms;
 pub mod rft;
@@ -22,6 +23,7 @@ use serde::Serialize;
 
 pub use body::{BodyPitch, LegShape};
 use dynamics::Walker;
+pub use ensemble::{simulate_ensemble, Ensemble};
 pub use mechanisms::Mechanisms;
 pub use rft::RftScaling;
 

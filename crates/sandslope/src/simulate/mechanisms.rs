@@ -133,18 +133,23 @@ impl DepthMap {
             self.start = cell;
         }
         if cell < self.start {
-            let more = (self.start - cell) as usize;
-            if self.depth.len() + more > MAX_TRENCH_CELLS {
+            // Grown at the front by at least its own length (a robot sliding downslope adds a
+            // cell or two a step; one at a time would move the whole map each step).
+            let need = (self.start - cell) as usize;
+            let room = MAX_TRENCH_CELLS.saturating_sub(self.depth.len());
+            if need > room {
                 return;
             }
+            let more = need.max(self.depth.len()).min(room);
             self.depth.splice(0..0, std::iter::repeat_n(0.0, more));
-            self.start = cell;
+            self.start -= more as i64;
         }
         let i = (cell - self.start) as usize;
         if i >= self.depth.len() {
             if i >= MAX_TRENCH_CELLS {
                 return;
             }
+            // `resize` grows the allocation geometrically, so a climb costs amortised O(1).
             self.depth.resize(i + 1, 0.0);
         }
         self.depth[i] = self.depth[i].max(d);
@@ -293,6 +298,27 @@ mod tests {
         assert_eq!(t.factor_at(0.002, 0.011), 1.0);
         assert_eq!(t.factor_at(0.006, 0.005), 1.0);
         assert_eq!(t.factor_at(-0.002, 0.005), 1.0);
+    }
+
+    /// A bed written from far downslope upwards and back (a robot sliding down, then
+    /// climbing) keeps every depth where it was written, and one beyond the cap is dropped.
+    #[test]
+    fn the_bed_grows_both_ways_and_keeps_its_depths() {
+        let mut m = DepthMap::default();
+        for c in (-5000..100).rev() {
+            m.raise(c, c as f64 + 1e4);
+        }
+        for c in 100..200 {
+            m.raise(c, 1.0);
+        }
+        assert_eq!(m.get(-5000), -5000.0 + 1e4);
+        assert_eq!(m.get(0), 1e4);
+        assert_eq!(m.get(150), 1.0);
+        assert_eq!(m.get(-6000), 0.0);
+        assert_eq!(m.get(500), 0.0);
+        assert!(m.depth.len() <= 2 * 5200 + 200, "{}", m.depth.len());
+        m.raise(-(MAX_TRENCH_CELLS as i64) - 10, 1.0);
+        assert_eq!(m.get(-(MAX_TRENCH_CELLS as i64) - 10), 0.0);
     }
 
     #[test]

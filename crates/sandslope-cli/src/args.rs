@@ -245,11 +245,6 @@ pub fn parse_slope_list(flag: &str, text: &str, sign: SlopeSign, max: usize) -> 
     Ok(grammar::parse_slope_list(flag.trim_start_matches('-'), text, sign, max)?)
 }
 
-/// Checks a command-line number is finite and strictly positive, naming the flag.
-pub fn check_positive(flag: &str, value: f64) -> Result<f64> {
-    Ok(sandslope_request::error::check_positive(flag.trim_start_matches('-'), value)?)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

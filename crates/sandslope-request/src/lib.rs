@@ -16,6 +16,7 @@
 
 #![warn(missing_docs)]
 
+pub mod calibrate;
 pub mod design;
 pub mod error;
 pub mod fit;
@@ -32,6 +33,7 @@ pub mod simulate;
 pub mod sweep;
 pub mod track;
 
+pub use calibrate::CalibrateRequest;
 pub use design::DesignRequest;
 pub use error::{RequestError, Result};
 pub use fit::FitRequest;

@@ -4,23 +4,23 @@
 //! terrain file (and robot file) every other command accepts.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
+use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::Result;
 use clap::{Args, ValueEnum};
-use serde::Serialize;
 
 use sandslope::calibrate::{Interval, ObservationKind, SpeedModel, SpeedObservation};
-use sandslope::{
-    calibrate_jointly, calibrate_jointly_with, invert_each_speed, predict, FreeParameter, JointCalibration,
-    JointSetup, Parameter, Quantity, ShearLaw, ShearShape, Slope, Terrain, TerrainPoint, TerrainSpec,
+use sandslope::{predict, JointCalibration, Parameter, Quantity, Slope, Terrain};
+use sandslope_request::calibrate::{
+    CalibrateAnswer, CalibrateLaw, CalibrateModel, CalibrateSource, JointAnswer, PerSlopeAnswer, ReposeRecord,
 };
+use sandslope_request::CalibrateRequest;
 
-use crate::args::{check_flag, check_positive, RobotArgs, TerrainArgs};
+use crate::args::{RobotArgs, TerrainArgs};
 use crate::figures::calibrate::{speed_pulls, CalibrationFigure};
 use crate::output::{check_parent_exists, print_json, table, write_atomic};
 use sandslope_io::robot_terrain::{robot_toml, terrain_toml};
-use sandslope_io::{load_anchoring_times, load_speeds, load_terrain};
 
 /// The law to fit, as named on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -31,16 +31,6 @@ pub enum LawArg {
     Coulomb,
     /// One k_s per observed slope, by root finding (speeds only).
     PerSlope,
-}
-
-impl LawArg {
-    fn name(self) -> &'static str {
-        match self {
-            LawArg::Linear => "linear",
-            LawArg::Coulomb => "coulomb",
-            LawArg::PerSlope => "per-slope",
-        }
-    }
 }
 
 /// The model whose speeds are fitted, as named on the command line.
@@ -110,87 +100,37 @@ pub struct CalibrateArgs {
     pub terrain: TerrainArgs,
 }
 
-/// Parses `--free` items: `KEY` or `KEY=MIN:MAX`.
-fn parse_free(items: &[String]) -> Result<Vec<FreeParameter>> {
-    let mut out = Vec::new();
-    for item in items.iter().map(|s| s.trim()).filter(|s| !s.is_empty()) {
-        let (key, bounds) = match item.split_once('=') {
-            Some((k, b)) => {
-                let (lo, hi) = b.split_once(':').ok_or_else(|| {
-                    anyhow!("--free {item}: bounds must be written MIN:MAX (e.g. hip_height_m=0.01:0.07)")
-                })?;
-                let num = |s: &str| {
-                    s.trim().parse::<f64>().map_err(|_| anyhow!("--free {item}: `{s}` is not a number"))
-                };
-                (k.trim(), Some((num(lo)?, num(hi)?)))
-            }
-            None => (item, None),
-        };
-        let parameter = Parameter::parse(key)
-            .ok_or_else(|| anyhow!("--free: unknown quantity `{key}` (valid: {})", Parameter::names()))?;
-        out.push(FreeParameter { parameter, bounds });
+/// The request the flags make.
+fn request(args: &CalibrateArgs) -> CalibrateRequest {
+    CalibrateRequest {
+        observed: args.observed.clone(),
+        forces: args.forces.clone(),
+        t1: args.t1.clone(),
+        free: args.free.clone(),
+        error_floor: args.error_floor,
+        law: match args.law {
+            LawArg::Linear => CalibrateLaw::Linear,
+            LawArg::Coulomb => CalibrateLaw::Coulomb,
+            LawArg::PerSlope => CalibrateLaw::PerSlope,
+        },
+        model: match args.model {
+            ModelArg::ClosedForm => CalibrateModel::ClosedForm,
+            ModelArg::Simulate => CalibrateModel::Simulate,
+        },
+        k_n: args.k_n,
+        name: args.name.clone(),
+        repose: args.repose,
     }
-    Ok(out)
 }
 
-/// Where the angle of repose written into the terrain came from.
-#[derive(Debug, Clone, Serialize)]
-struct ReposeRecord {
-    deg: Option<f64>,
-    source: String,
-}
-
-#[derive(Serialize)]
-struct JointRecord<'a> {
-    mode: &'static str,
-    #[serde(flatten)]
-    calibration: &'a JointCalibration,
-    repose: &'a ReposeRecord,
-    /// With `--model simulate`: the closed form's fit of the same evidence, for comparison.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    closed_form_fit: Option<&'a JointCalibration>,
-}
-
-#[derive(Serialize)]
-struct ResidualRecord {
-    slope_deg: f64,
-    k_n: f64,
-    k_s: f64,
-    observed_m_s: f64,
-    observed_sd_m_s: f64,
-    model_m_s: f64,
-    residual_m_s: f64,
-}
-
-#[derive(Serialize)]
-struct PerSlopeRecord<'a> {
-    mode: &'static str,
-    law: &'static str,
-    residuals: Vec<ResidualRecord>,
-    rmse_m_s: f64,
-    chi_squared: f64,
-    terrain: &'a TerrainSpec,
-    repose: &'a ReposeRecord,
-}
-
-/// Runs `sandslope calibrate`.
+/// Runs `sandslope calibrate`: the flags into a [`CalibrateRequest`], its answer into the
+/// files, the figure and the tables (or JSON).
 pub fn run(args: CalibrateArgs) -> Result<()> {
-    if args.model == ModelArg::Simulate && args.law == LawArg::PerSlope {
-        bail!("--law per-slope inverts the closed form only: with --model simulate use --law linear, --law coulomb or --forces");
-    }
+    let request = request(&args);
+    let checked = request.check()?;
     let robot = args.robot.load()?;
-    let free = parse_free(&args.free)?;
-    let fixed_k_n = args.k_n.map(|v| check_positive("--k-n", v)).transpose()?;
-    if let Some(r) = args.repose {
-        check_flag("--repose", r, 0.0, 90.0)?;
-    }
-    let error_floor = args.error_floor.map(|v| check_flag("--error-floor", v, 0.0, 1.0)).transpose()?;
-    if error_floor.is_some() && free.iter().any(|f| f.parameter == Parameter::ErrorFloor) {
-        bail!("--error-floor fixes the floor and --free error_floor fits it: give one of them");
-    }
-    let robot_free = free.iter().any(|f| matches!(f.parameter, Parameter::Robot(_)));
-    if args.robot_out.is_some() && !robot_free {
-        bail!("--robot-out: no robot key is in --free, so the robot would be written unchanged");
+    if args.robot_out.is_some() && !checked.fits_robot() {
+        anyhow::bail!("--robot-out: no robot key is in --free, so the robot would be written unchanged");
     }
     for out in [Some(&args.out), args.robot_out.as_ref(), args.plot.as_ref()].into_iter().flatten() {
         check_parent_exists(out)?;
@@ -198,104 +138,38 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
     if let Some(p) = &args.plot {
         crate::figures::format_of(p)?;
     }
-    let speeds = args.observed.as_deref().map(load_speeds).transpose()?.unwrap_or_default();
-    let anchoring = args.t1.as_deref().map(load_anchoring_times).transpose()?.unwrap_or_default();
-    let source = args.terrain.load()?;
-    let forces = args.forces.as_deref().map(load_terrain).transpose()?;
-
-    let repose = repose_record(&args, &source, forces.as_ref());
-    // k_n: --k-n, else the force tests', else the source terrain's.
-    let normal = match (fixed_k_n, &forces) {
-        (Some(k), _) => Terrain::constant(k, 1.0).map_err(|e| anyhow!("{}", e.renamed("--k-n")))?,
-        (None, Some(f)) => f.clone(),
-        (None, None) => source.clone(),
-    };
-
-    let shear = match (&forces, args.law) {
-        (Some(f), _) => ShearShape::ForceTests(f.clone()),
-        (None, LawArg::Linear) => ShearShape::Law(ShearLaw::Linear),
-        (None, LawArg::Coulomb) => ShearShape::Law(ShearLaw::Coulomb),
-        (None, LawArg::PerSlope) => {
-            if !free.is_empty() || !anchoring.is_empty() || error_floor.is_some() {
-                bail!("--law per-slope inverts each speed alone: it takes no --free, --t1 or --error-floor");
-            }
-            let Some(observed) = &args.observed else { bail!("--law per-slope needs --observed speeds") };
-            return run_per_slope(&args, &robot, &speeds, observed, &normal, &repose);
-        }
-    };
-    let setup = JointSetup {
-        robot: robot.clone(),
-        normal,
-        shear,
-        speeds: speeds.clone(),
-        anchoring,
-        free,
-        error_floor: error_floor.unwrap_or(0.0),
-    };
-    let closed_form_fit = calibrate_jointly(&setup).map_err(|e| anyhow!("calibrate: {e}"))?;
-    let (mut cal, closed_form) = match args.model {
-        ModelArg::ClosedForm => (closed_form_fit, None),
-        ModelArg::Simulate => {
-            // About 8 minutes of CPU on the paper's evidence (docs/calibration.md): a spinner with the time.
-            let spin = crate::progress::spinner(args.json, "fitting with the stride simulator");
-            let sim = calibrate_jointly_with(&setup, SpeedModel::simulator_for_fit())
-                .map_err(|e| anyhow!("calibrate --model simulate: {e}"));
-            spin.finish_and_clear();
-            let sim = sim?;
-            (sim, Some(closed_form_fit))
-        }
-    };
-    let default_name = if forces.is_some() {
-        "calibrated-forces".to_string()
-    } else {
-        format!("calibrated-{}", args.law.name())
-    };
-    cal.terrain.name = Some(args.name.clone().unwrap_or(default_name));
-    cal.terrain.repose_deg = repose.deg;
-    let terrain = Terrain::new(cal.terrain.clone()).map_err(|e| {
-        anyhow!("the calibrated terrain is not valid ({e}); a fitted k_s reached zero within the observed slopes: try --law coulomb or force tests")
-    })?;
-    let fitted_robot = sandslope::Robot::new(cal.robot.clone())
-        .map_err(|e| anyhow!("the fitted robot is not valid: {e}"))?;
-
-    // Outputs: the figure first (it is the likeliest to fail), then the files.
-    if let Some(path) = &args.plot {
-        draw_fit(path, &speeds, &terrain, &fitted_robot, &cal)?;
+    let terrain = args.terrain.load()?;
+    let source = CalibrateSource { robot: &robot, terrain: &terrain, terrain_name: &args.terrain.terrain };
+    // The simulator's fit takes about 8 minutes of CPU on the paper's evidence
+    // (docs/calibration.md): a spinner with the time.
+    let spin = (request.model == CalibrateModel::Simulate)
+        .then(|| crate::progress::spinner(args.json, "fitting with the stride simulator"));
+    let answer = request.answer(source);
+    if let Some(spin) = spin {
+        spin.finish_and_clear();
     }
-    write_files(&args, &cal, &repose)?;
-
-    if args.json {
-        return print_json(&JointRecord {
-            mode: "joint",
-            calibration: &cal,
-            repose: &repose,
-            closed_form_fit: closed_form.as_ref(),
-        });
+    match answer? {
+        CalibrateAnswer::Joint(joint) => write_joint(&args, &joint),
+        CalibrateAnswer::PerSlope(per_slope) => write_per_slope(&args, &per_slope),
     }
-    print_joint(&cal, &repose);
-    if let Some(cf) = &closed_form {
-        print_side_by_side(cf, &cal);
-    }
-    Ok(())
 }
 
-/// The angle of repose: `--repose`, else carried over from the force tests or the source
-/// terrain, with where it came from.
-fn repose_record(args: &CalibrateArgs, source: &Terrain, forces: Option<&Terrain>) -> ReposeRecord {
-    match (args.repose, forces) {
-        (Some(r), _) => ReposeRecord { deg: Some(r), source: "--repose".into() },
-        (None, Some(f)) if f.spec().repose_deg.is_some() => ReposeRecord {
-            deg: f.spec().repose_deg,
-            source: format!("carried over from --forces {}", args.forces.as_deref().unwrap_or("")),
-        },
-        _ => ReposeRecord {
-            deg: source.spec().repose_deg,
-            source: match source.spec().repose_deg {
-                Some(_) => format!("carried over from --terrain {}", args.terrain.terrain),
-                None => format!("none: --terrain {} has no repose_deg", args.terrain.terrain),
-            },
-        },
+/// A joint fit's outputs: the figure first (it is the likeliest to fail), then the files, then
+/// the tables or JSON.
+fn write_joint(args: &CalibrateArgs, joint: &JointAnswer) -> Result<()> {
+    let cal = &joint.calibration;
+    if let Some(path) = &args.plot {
+        draw_fit(path, &joint.speeds, &joint.terrain, &joint.robot, cal)?;
     }
+    write_files(args, cal, &joint.repose)?;
+    if args.json {
+        return print_json(joint);
+    }
+    print_joint(cal, &joint.repose);
+    if let Some(cf) = &joint.closed_form_fit {
+        print_side_by_side(cf, cal);
+    }
+    Ok(())
 }
 
 /// The `--plot` figure: observed speeds, the fitted model's curve, and the pulls.
@@ -508,71 +382,32 @@ fn print_side_by_side(closed: &JointCalibration, sim: &JointCalibration) {
     println!("{t}");
 }
 
-fn run_per_slope(
-    args: &CalibrateArgs,
-    robot: &sandslope::Robot,
-    observations: &[sandslope::SpeedObservation],
-    observed: &std::path::Path,
-    normal: &Terrain,
-    repose: &ReposeRecord,
-) -> Result<()> {
-    let cal =
-        invert_each_speed(robot, normal, observations).map_err(|e| anyhow!("{}: {e}", observed.display()))?;
-    let points = cal
-        .points
-        .iter()
-        .map(|r| TerrainPoint { slope_deg: r.slope_deg, k_n: r.k_n, k_s: r.k_s, k_n_sd: None, k_s_sd: None })
-        .collect();
-    let spec = TerrainSpec {
-        name: Some(args.name.clone().unwrap_or_else(|| "calibrated-per-slope".into())),
-        repose_deg: repose.deg,
-        points,
-    };
-    Terrain::new(spec.clone()).map_err(|e| anyhow!("the calibrated terrain is not valid ({e})"))?;
+/// `--law per-slope`'s outputs: the terrain file, then the table or JSON.
+fn write_per_slope(args: &CalibrateArgs, answer: &PerSlopeAnswer) -> Result<()> {
     let command: Vec<String> = std::env::args().skip(1).collect();
     let header = format!(
         "Written by: sandslope {}\nk_s per observed slope, inverted from each speed\nrepose_deg: {}",
         command.join(" "),
-        repose.source
+        answer.repose.source
     );
-    write_atomic(&args.out, terrain_toml(&spec, &header)?.as_bytes())?;
-    let residuals: Vec<ResidualRecord> = cal
-        .points
-        .iter()
-        .map(|r| ResidualRecord {
-            slope_deg: r.slope_deg,
-            k_n: r.k_n,
-            k_s: r.k_s,
-            observed_m_s: r.observed,
-            observed_sd_m_s: r.observed_sd,
-            model_m_s: r.model,
-            residual_m_s: r.residual(),
-        })
-        .collect();
+    write_atomic(&args.out, terrain_toml(&answer.terrain, &header)?.as_bytes())?;
     if args.json {
-        return print_json(&PerSlopeRecord {
-            mode: "per-slope",
-            law: "per-slope",
-            residuals,
-            rmse_m_s: cal.rmse(),
-            chi_squared: cal.chi_squared(),
-            terrain: &spec,
-            repose,
-        });
+        return print_json(answer);
     }
     println!("law: per-slope (each speed inverted by root finding)");
-    let level = cal.points.first().map(|r| r.k_s).filter(|k| *k > 0.0);
+    let level = answer.residuals.first().map(|r| r.k_s).filter(|k| *k > 0.0);
     let mut t = table(&["slope deg", "k_s N/m^3", "k_s / first", "observed cm/s", "model cm/s"]);
-    for r in &cal.points {
+    for r in &answer.residuals {
         t.add_row([
             format!("{}", r.slope_deg),
             format!("{:.4e}", r.k_s),
             level.map_or("-".into(), |l| format!("{:.3}", r.k_s / l)),
-            format!("{:.2} ± {:.2}", r.observed * 100.0, r.observed_sd * 100.0),
-            format!("{:.2}", r.model * 100.0),
+            format!("{:.2} ± {:.2}", r.observed_m_s * 100.0, r.observed_sd_m_s * 100.0),
+            format!("{:.2}", r.model_m_s * 100.0),
         ]);
     }
     println!("{t}");
+    let repose = &answer.repose;
     println!("repose_deg = {} ({})", repose.deg.map_or("none".into(), |r| format!("{r}")), repose.source);
     Ok(())
 }

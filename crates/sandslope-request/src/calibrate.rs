@@ -1,0 +1,526 @@
+//! `calibrate`'s request: fit the unmeasured quantities (k_s(theta), and any robot key, a
+//! plate-to-leg scale or a model-error floor) so that the model agrees with observed speeds,
+//! anchoring times and force tests together (docs/calibration.md), by one library call
+//! ([`sandslope::calibrate_jointly`], or [`sandslope::invert_each_speed`] for the per-slope
+//! law). The front end loads the robot and the source terrain (with its overrides) and writes
+//! the answer's terrain and robot files; every flag's check, default and the fit live here.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use sandslope::calibrate::{PerSlopeCalibration, SpeedModel, SpeedObservation};
+use sandslope::{
+    calibrate_jointly, calibrate_jointly_with, invert_each_speed, FreeParameter, JointCalibration,
+    JointSetup, Parameter, Robot, ShearLaw, ShearShape, Terrain, TerrainPoint, TerrainSpec,
+};
+use sandslope_io::{load_anchoring_times, load_speeds, load_terrain};
+
+use crate::error::{check_positive, check_range, RequestError, Result};
+
+/// The form of k_s(theta) fitted when there are no force tests (field `law`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CalibrateLaw {
+    /// k_s(theta) = k_s0 * (1 + (rho - 1) * theta_deg / 20), rho = k_s(20)/k_s(0).
+    Linear,
+    /// k_s(theta) = k_s0 * (cos theta - sin theta / tan phi), Mohr-Coulomb on an infinite slope.
+    Coulomb,
+    /// One k_s per observed slope, by root finding (speeds only).
+    PerSlope,
+}
+
+impl CalibrateLaw {
+    /// The law's name as the command line writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            CalibrateLaw::Linear => "linear",
+            CalibrateLaw::Coulomb => "coulomb",
+            CalibrateLaw::PerSlope => "per-slope",
+        }
+    }
+}
+
+/// The model whose speeds and anchoring times are fitted (field `model`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CalibrateModel {
+    /// The closed form (docs/model.md §3-§5).
+    ClosedForm,
+    /// The stride simulator (docs/model.md §15-§18), [`SpeedModel::simulator_for_fit`]; the
+    /// closed form's fit of the same evidence is answered beside it.
+    Simulate,
+}
+
+/// The inputs of `calibrate`, besides the robot and the source terrain (the front end loads
+/// those with its overrides).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CalibrateRequest {
+    /// Observed speeds: CSV `slope_deg,speed_m_s,speed_sd_m_s` (field `observed`).
+    pub observed: Option<PathBuf>,
+    /// Force tests: a terrain file or preset whose k_s(theta) gives k_s's shape (field `forces`).
+    pub forces: Option<String>,
+    /// Observed anchoring times: CSV `slope_deg,t1_s,t1_sd_s` (field `t1`).
+    pub t1: Option<PathBuf>,
+    /// Quantities to fit besides k_s, each `KEY` or `KEY=MIN:MAX` (field `free`).
+    pub free: Vec<String>,
+    /// A fixed model-error floor, m/s, `0..=1` (field `error-floor`).
+    pub error_floor: Option<f64>,
+    /// The law of k_s(theta) without force tests (field `law`).
+    pub law: CalibrateLaw,
+    /// The model fitted (field `model`).
+    pub model: CalibrateModel,
+    /// Normal resistance at every slope, N/m^3 (field `k-n`; default: the force tests' or the
+    /// source terrain's).
+    pub k_n: Option<f64>,
+    /// Name written into the terrain (field `name`; default `calibrated-<law>` or
+    /// `calibrated-forces`).
+    pub name: Option<String>,
+    /// Angle of repose written into the terrain, degrees, `0..=90` (field `repose`; default:
+    /// carried over from the force tests or the source terrain).
+    pub repose: Option<f64>,
+}
+
+/// The request's values, checked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckedCalibrate {
+    /// The quantities to fit besides k_s.
+    pub free: Vec<FreeParameter>,
+    /// The fixed k_n, if any.
+    pub k_n: Option<f64>,
+    /// The fixed error floor, if any.
+    pub error_floor: Option<f64>,
+}
+
+impl CheckedCalibrate {
+    /// Whether a robot key is fitted (so that a fitted robot differs from the one given).
+    pub fn fits_robot(&self) -> bool {
+        self.free.iter().any(|f| matches!(f.parameter, Parameter::Robot(_)))
+    }
+}
+
+/// Where the angle of repose written into the terrain came from.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReposeRecord {
+    /// The angle, degrees, or none.
+    pub deg: Option<f64>,
+    /// Where it came from, in the command line's words.
+    pub source: String,
+}
+
+/// The answer of a joint fit, as `calibrate --json` prints it (the terrain, robot and speeds
+/// are for the front end's files and figure).
+#[derive(Debug, Clone, Serialize)]
+pub struct JointAnswer {
+    /// `"joint"`.
+    pub mode: &'static str,
+    /// The fit, with the terrain's name and angle of repose set.
+    #[serde(flatten)]
+    pub calibration: JointCalibration,
+    /// Where the angle of repose came from.
+    pub repose: ReposeRecord,
+    /// With the simulator: the closed form's fit of the same evidence, for comparison.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub closed_form_fit: Option<JointCalibration>,
+    /// The calibrated terrain, validated.
+    #[serde(skip)]
+    pub terrain: Terrain,
+    /// The robot with its fitted keys, validated.
+    #[serde(skip)]
+    pub robot: Robot,
+    /// The observed speeds fitted.
+    #[serde(skip)]
+    pub speeds: Vec<SpeedObservation>,
+}
+
+/// One observed speed inverted alone.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ResidualRecord {
+    /// Slope, degrees.
+    pub slope_deg: f64,
+    /// Normal resistance used, N/m^3.
+    pub k_n: f64,
+    /// The k_s that reproduces the speed, N/m^3.
+    pub k_s: f64,
+    /// Observed speed, m/s.
+    pub observed_m_s: f64,
+    /// Observed SD, m/s.
+    pub observed_sd_m_s: f64,
+    /// Model speed at that k_s, m/s.
+    pub model_m_s: f64,
+    /// `observed - model`, m/s.
+    pub residual_m_s: f64,
+}
+
+/// The answer of `--law per-slope`, as `calibrate --json` prints it.
+#[derive(Debug, Clone, Serialize)]
+pub struct PerSlopeAnswer {
+    /// `"per-slope"`.
+    pub mode: &'static str,
+    /// `"per-slope"`.
+    pub law: &'static str,
+    /// One row per observed speed, by slope.
+    pub residuals: Vec<ResidualRecord>,
+    /// Root-mean-square residual, m/s.
+    pub rmse_m_s: f64,
+    /// `sum ((observed - model) / sd)^2`.
+    pub chi_squared: f64,
+    /// The calibrated terrain (validated).
+    pub terrain: TerrainSpec,
+    /// Where the angle of repose came from.
+    pub repose: ReposeRecord,
+}
+
+/// What `calibrate` answers.
+#[derive(Debug, Clone)]
+pub enum CalibrateAnswer {
+    /// A joint fit (linear or Coulomb law, or force tests).
+    Joint(Box<JointAnswer>),
+    /// Each speed inverted alone.
+    PerSlope(PerSlopeAnswer),
+}
+
+/// The robot and source terrain the front end loaded, and the source's name as the user gave
+/// it (for the repose record's words).
+#[derive(Debug, Clone, Copy)]
+pub struct CalibrateSource<'a> {
+    /// The robot, with its overrides.
+    pub robot: &'a Robot,
+    /// The source of k_n (without force tests or a fixed k_n) and of the angle of repose.
+    pub terrain: &'a Terrain,
+    /// The source terrain's file or preset name.
+    pub terrain_name: &'a str,
+}
+
+/// Parses `free` items: `KEY` or `KEY=MIN:MAX`.
+fn parse_free(items: &[String]) -> Result<Vec<FreeParameter>> {
+    let bad = |m: String| RequestError::invalid("free", m);
+    let mut out = Vec::new();
+    for item in items.iter().map(|s| s.trim()).filter(|s| !s.is_empty()) {
+        let (key, bounds) = match item.split_once('=') {
+            Some((k, b)) => {
+                let (lo, hi) = b.split_once(':').ok_or_else(|| {
+                    bad(format!(
+                        "--free {item}: bounds must be written MIN:MAX (e.g. hip_height_m=0.01:0.07)"
+                    ))
+                })?;
+                let num = |s: &str| {
+                    s.trim().parse::<f64>().map_err(|_| bad(format!("--free {item}: `{s}` is not a number")))
+                };
+                (k.trim(), Some((num(lo)?, num(hi)?)))
+            }
+            None => (item, None),
+        };
+        let parameter = Parameter::parse(key).ok_or_else(|| {
+            bad(format!("--free: unknown quantity `{key}` (valid: {})", Parameter::names()))
+        })?;
+        out.push(FreeParameter { parameter, bounds });
+    }
+    Ok(out)
+}
+
+impl CalibrateRequest {
+    /// Every value checked before any file is read; errors name the field as its flag.
+    pub fn check(&self) -> Result<CheckedCalibrate> {
+        if self.model == CalibrateModel::Simulate && self.law == CalibrateLaw::PerSlope {
+            return Err(RequestError::invalid(
+                "law",
+                "--law per-slope inverts the closed form only: with --model simulate use --law linear, --law coulomb or --forces",
+            ));
+        }
+        let free = parse_free(&self.free)?;
+        let k_n = self.k_n.map(|v| check_positive("k-n", v)).transpose()?;
+        if let Some(r) = self.repose {
+            check_range("repose", r, 0.0, 90.0)?;
+        }
+        let error_floor = self.error_floor.map(|v| check_range("error-floor", v, 0.0, 1.0)).transpose()?;
+        if error_floor.is_some() && free.iter().any(|f| f.parameter == Parameter::ErrorFloor) {
+            return Err(RequestError::invalid(
+                "error-floor",
+                "--error-floor fixes the floor and --free error_floor fits it: give one of them",
+            ));
+        }
+        if self.law == CalibrateLaw::PerSlope && self.forces.is_none() {
+            if !free.is_empty() || self.t1.is_some() || error_floor.is_some() {
+                return Err(RequestError::invalid(
+                    "law",
+                    "--law per-slope inverts each speed alone: it takes no --free, --t1 or --error-floor",
+                ));
+            }
+            if self.observed.is_none() {
+                return Err(RequestError::invalid("observed", "--law per-slope needs --observed speeds"));
+            }
+        }
+        Ok(CheckedCalibrate { free, k_n, error_floor })
+    }
+
+    /// Reads the evidence and fits it. Errors name the file (and line) or the field.
+    pub fn answer(&self, source: CalibrateSource) -> Result<CalibrateAnswer> {
+        let checked = self.check()?;
+        let speeds = match &self.observed {
+            Some(p) => load_speeds(p).map_err(|e| RequestError::from_error(Some("observed"), e))?,
+            None => Vec::new(),
+        };
+        let anchoring = match &self.t1 {
+            Some(p) => load_anchoring_times(p).map_err(|e| RequestError::from_error(Some("t1"), e))?,
+            None => Vec::new(),
+        };
+        let forces = match &self.forces {
+            Some(f) => Some(load_terrain(f).map_err(|e| RequestError::from_error(Some("forces"), e))?),
+            None => None,
+        };
+        let repose = self.repose_record(source, forces.as_ref());
+        // k_n: the fixed one, else the force tests', else the source terrain's.
+        let normal = match (checked.k_n, &forces) {
+            (Some(k), _) => {
+                Terrain::constant(k, 1.0).map_err(|e| RequestError::invalid("k-n", e.renamed("--k-n")))?
+            }
+            (None, Some(f)) => f.clone(),
+            (None, None) => source.terrain.clone(),
+        };
+        let shear = match (&forces, self.law) {
+            (Some(f), _) => ShearShape::ForceTests(f.clone()),
+            (None, CalibrateLaw::Linear) => ShearShape::Law(ShearLaw::Linear),
+            (None, CalibrateLaw::Coulomb) => ShearShape::Law(ShearLaw::Coulomb),
+            (None, CalibrateLaw::PerSlope) => {
+                return self.per_slope(source.robot, &speeds, &normal, repose).map(CalibrateAnswer::PerSlope);
+            }
+        };
+        let setup = JointSetup {
+            robot: source.robot.clone(),
+            normal,
+            shear,
+            speeds,
+            anchoring,
+            free: checked.free,
+            error_floor: checked.error_floor.unwrap_or(0.0),
+        };
+        let fail = |e: anyhow::Error| RequestError::from_error(None, e);
+        let closed_form_fit =
+            calibrate_jointly(&setup).map_err(|e| fail(anyhow::anyhow!("calibrate: {e}")))?;
+        let (mut calibration, closed_form_fit) = match self.model {
+            CalibrateModel::ClosedForm => (closed_form_fit, None),
+            CalibrateModel::Simulate => {
+                let sim = calibrate_jointly_with(&setup, SpeedModel::simulator_for_fit())
+                    .map_err(|e| fail(anyhow::anyhow!("calibrate --model simulate: {e}")))?;
+                (sim, Some(closed_form_fit))
+            }
+        };
+        let default_name = if forces.is_some() {
+            "calibrated-forces".to_string()
+        } else {
+            format!("calibrated-{}", self.law.name())
+        };
+        calibration.terrain.name = Some(self.name.clone().unwrap_or(default_name));
+        calibration.terrain.repose_deg = repose.deg;
+        let terrain = Terrain::new(calibration.terrain.clone()).map_err(|e| {
+            fail(anyhow::anyhow!("the calibrated terrain is not valid ({e}); a fitted k_s reached zero within the observed slopes: try --law coulomb or force tests"))
+        })?;
+        let robot = Robot::new(calibration.robot.clone())
+            .map_err(|e| fail(anyhow::anyhow!("the fitted robot is not valid: {e}")))?;
+        Ok(CalibrateAnswer::Joint(Box::new(JointAnswer {
+            mode: "joint",
+            calibration,
+            repose,
+            closed_form_fit,
+            terrain,
+            robot,
+            speeds: setup.speeds,
+        })))
+    }
+
+    /// The angle of repose: `repose`, else carried over from the force tests or the source
+    /// terrain, with where it came from.
+    fn repose_record(&self, source: CalibrateSource, forces: Option<&Terrain>) -> ReposeRecord {
+        match (self.repose, forces) {
+            (Some(r), _) => ReposeRecord { deg: Some(r), source: "--repose".into() },
+            (None, Some(f)) if f.spec().repose_deg.is_some() => ReposeRecord {
+                deg: f.spec().repose_deg,
+                source: format!("carried over from --forces {}", self.forces.as_deref().unwrap_or("")),
+            },
+            _ => {
+                let deg = source.terrain.spec().repose_deg;
+                let name = source.terrain_name;
+                ReposeRecord {
+                    deg,
+                    source: match deg {
+                        Some(_) => format!("carried over from --terrain {name}"),
+                        None => format!("none: --terrain {name} has no repose_deg"),
+                    },
+                }
+            }
+        }
+    }
+
+    /// `--law per-slope`: each observed speed inverted alone.
+    fn per_slope(
+        &self,
+        robot: &Robot,
+        speeds: &[SpeedObservation],
+        normal: &Terrain,
+        repose: ReposeRecord,
+    ) -> Result<PerSlopeAnswer> {
+        let observed = self.observed.as_deref().unwrap_or_else(|| std::path::Path::new(""));
+        let cal: PerSlopeCalibration = invert_each_speed(robot, normal, speeds).map_err(|e| {
+            RequestError::from_error(Some("observed"), anyhow::anyhow!("{}: {e}", observed.display()))
+        })?;
+        let points = cal
+            .points
+            .iter()
+            .map(|r| TerrainPoint {
+                slope_deg: r.slope_deg,
+                k_n: r.k_n,
+                k_s: r.k_s,
+                k_n_sd: None,
+                k_s_sd: None,
+            })
+            .collect();
+        let terrain = TerrainSpec {
+            name: Some(self.name.clone().unwrap_or_else(|| "calibrated-per-slope".into())),
+            repose_deg: repose.deg,
+            points,
+        };
+        Terrain::new(terrain.clone()).map_err(|e| {
+            RequestError::from_error(None, anyhow::anyhow!("the calibrated terrain is not valid ({e})"))
+        })?;
+        let residuals = cal
+            .points
+            .iter()
+            .map(|r| ResidualRecord {
+                slope_deg: r.slope_deg,
+                k_n: r.k_n,
+                k_s: r.k_s,
+                observed_m_s: r.observed,
+                observed_sd_m_s: r.observed_sd,
+                model_m_s: r.model,
+                residual_m_s: r.residual(),
+            })
+            .collect();
+        Ok(PerSlopeAnswer {
+            mode: "per-slope",
+            law: "per-slope",
+            residuals,
+            rmse_m_s: cal.rmse(),
+            chi_squared: cal.chi_squared(),
+            terrain,
+            repose,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sandslope::RobotKey;
+
+    fn request() -> CalibrateRequest {
+        CalibrateRequest {
+            observed: Some(PathBuf::from("no-such-speeds.csv")),
+            forces: None,
+            t1: None,
+            free: Vec::new(),
+            error_floor: None,
+            law: CalibrateLaw::Linear,
+            model: CalibrateModel::ClosedForm,
+            k_n: None,
+            name: None,
+            repose: None,
+        }
+    }
+
+    /// `KEY` takes the library's default bounds, `KEY=MIN:MAX` its own; a robot key makes
+    /// the fitted robot worth writing.
+    #[test]
+    fn free_items_parse_into_parameters_and_bounds() {
+        let r = CalibrateRequest {
+            free: vec![" hip_height_m=0.01:0.07".into(), "error_floor".into(), "".into()],
+            ..request()
+        };
+        let c = r.check().unwrap();
+        assert_eq!(c.free.len(), 2);
+        assert_eq!(c.free[0].parameter, Parameter::Robot(RobotKey::HipHeightM));
+        assert_eq!(c.free[0].bounds, Some((0.01, 0.07)));
+        assert_eq!(c.free[1], FreeParameter { parameter: Parameter::ErrorFloor, bounds: None });
+        assert!(c.fits_robot());
+        assert!(!request().check().unwrap().fits_robot());
+    }
+
+    /// Each refusal names its field and the valid range, before any file is read (the
+    /// observed file does not exist).
+    #[test]
+    fn checks_name_the_field_before_any_file_is_read() {
+        let cases: [(CalibrateRequest, &str, &str); 8] = [
+            (
+                CalibrateRequest { free: vec!["nope".into()], ..request() },
+                "free",
+                "--free: unknown quantity `nope`",
+            ),
+            (
+                CalibrateRequest { free: vec!["hip_height_m=1".into()], ..request() },
+                "free",
+                "--free hip_height_m=1: bounds must be written MIN:MAX",
+            ),
+            (
+                CalibrateRequest { k_n: Some(0.0), ..request() },
+                "k-n",
+                "--k-n = 0 must be a finite number greater than 0",
+            ),
+            (
+                CalibrateRequest { repose: Some(90.5), ..request() },
+                "repose",
+                "--repose = 90.5 must be between 0 and 90",
+            ),
+            (
+                CalibrateRequest { error_floor: Some(-0.1), ..request() },
+                "error-floor",
+                "--error-floor = -0.1 must be between 0 and 1",
+            ),
+            (
+                CalibrateRequest { error_floor: Some(0.1), free: vec!["error_floor".into()], ..request() },
+                "error-floor",
+                "--error-floor fixes the floor",
+            ),
+            (
+                CalibrateRequest {
+                    law: CalibrateLaw::PerSlope,
+                    model: CalibrateModel::Simulate,
+                    ..request()
+                },
+                "law",
+                "--law per-slope inverts the closed form only",
+            ),
+            (
+                CalibrateRequest { law: CalibrateLaw::PerSlope, t1: Some("t1.csv".into()), ..request() },
+                "law",
+                "--law per-slope inverts each speed alone",
+            ),
+        ];
+        for (r, field, start) in cases {
+            let e = r.check().unwrap_err();
+            assert_eq!(e.field(), Some(field), "{}", e.message());
+            assert!(e.message().starts_with(start), "{}", e.message());
+        }
+        let e = CalibrateRequest { law: CalibrateLaw::PerSlope, observed: None, ..request() }
+            .check()
+            .unwrap_err();
+        assert_eq!(
+            (e.field(), e.message().as_str()),
+            (Some("observed"), "--law per-slope needs --observed speeds")
+        );
+        // With force tests, per-slope is not the law used, so it refuses nothing.
+        let with_forces =
+            CalibrateRequest { law: CalibrateLaw::PerSlope, forces: Some("f.toml".into()), ..request() };
+        assert!(with_forces.check().is_ok());
+    }
+
+    /// A missing evidence file is reported against its field.
+    #[test]
+    fn a_missing_evidence_file_names_its_field() {
+        let robot = Robot::new(sandslope::RobotSpec::paper_hexapod()).unwrap();
+        let terrain = Terrain::constant(1e6, 1e6).unwrap();
+        let source = CalibrateSource { robot: &robot, terrain: &terrain, terrain_name: "t" };
+        let e = request().answer(source).unwrap_err();
+        assert_eq!(e.field(), Some("observed"));
+        assert!(e.message().contains("no-such-speeds.csv"), "{}", e.message());
+    }
+}

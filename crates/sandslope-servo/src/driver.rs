@@ -25,7 +25,8 @@ use sandslope::servo::{xl330, GaitSchedule};
 use sandslope::Robot;
 use serde::Serialize;
 
-use crate::table::{self as t, mode, PresentState};
+use crate::stance::StanceBins;
+use crate::table::{self as t, mode, read_states, PresentState};
 
 /// One servo as mounted on the robot (the robot file's `[servos]` table).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -290,67 +291,6 @@ pub struct Monitor<'a> {
     pub noise_sd_n_m: f64,
 }
 
-/// Accumulates each tripod's current stance into bins.
-#[derive(Debug)]
-struct StanceBins {
-    bins: usize,
-    key: [Option<i64>; 2],
-    sum: [Vec<f64>; 2],
-    count: [Vec<usize>; 2],
-}
-
-impl StanceBins {
-    fn new(bins: usize) -> StanceBins {
-        StanceBins {
-            bins,
-            key: [None, None],
-            sum: [vec![0.0; bins], vec![0.0; bins]],
-            count: [vec![0; bins], vec![0; bins]],
-        }
-    }
-
-    /// Adds one sample; returns a completed stance's profile `(tripod, profile, counts)`.
-    #[allow(clippy::type_complexity)]
-    fn add(
-        &mut self,
-        schedule: &GaitSchedule,
-        leg: usize,
-        angle: f64,
-        tau: f64,
-    ) -> Option<(usize, Vec<Option<f64>>, Vec<usize>)> {
-        let k = schedule.tripods[leg];
-        let (stride, since) = schedule.stride_position(leg, angle);
-        let half = 0.5 * schedule.period_s;
-        let in_stance = since < half && stride >= 1;
-        let mut done = None;
-        if self.key[k].is_some() && (self.key[k] != Some(stride) || !in_stance) {
-            done = Some(self.flush(k));
-        }
-        if in_stance {
-            self.key[k] = Some(stride);
-            let b = ((since / half * self.bins as f64) as usize).min(self.bins - 1);
-            self.sum[k][b] += tau;
-            self.count[k][b] += 1;
-        }
-        done
-    }
-
-    fn flush(&mut self, k: usize) -> (usize, Vec<Option<f64>>, Vec<usize>) {
-        let b = self.bins;
-        let mut profile = vec![None; 2 * b];
-        let mut counts = vec![0; 2 * b];
-        for i in 0..b {
-            let c = self.count[k][i];
-            counts[k * b + i] = c;
-            profile[k * b + i] = (c > 0).then(|| self.sum[k][i] / c as f64);
-        }
-        self.key[k] = None;
-        self.sum[k] = vec![0.0; b];
-        self.count[k] = vec![0; b];
-        (k, profile, counts)
-    }
-}
-
 /// Phase correction of the velocity profile: speed added per radian of lag, 1/s.
 pub const PHASE_GAIN_PER_S: f64 = 4.0;
 
@@ -510,32 +450,24 @@ fn setup(
     Ok(())
 }
 
-/// One servo's read: its state and the status packet's alert bit, or the read error.
-type StateRead = Result<(PresentState, bool), ReadError>;
+/// The start pose found when standing up: each leg's start goal (the nearest turn of its start
+/// angle) and the shift of the schedule's angles to it.
+struct Stand {
+    start_goal: Vec<i32>,
+    shift: Vec<f64>,
+}
 
-/// Reads every servo's state block; per servo `Ok((state, alert))` or the read error.
-fn read_states(bus: &mut DynamixelBus, ids: &[u8]) -> Result<Vec<StateRead>, String> {
-    // dynamixel2 calls back once per ID, in the order asked: the k-th call is ids[k]'s.
-    let mut out: Vec<Option<StateRead>> = (0..ids.len()).map(|_| None).collect();
-    let mut k = 0usize;
-    bus.sync_read_cb(ids, t::STATE_BLOCK.0, t::STATE_BLOCK.1, |r| {
-        let slot = k;
-        k += 1;
-        let value = match r {
-            Ok(resp) => PresentState::decode(resp.data).map(|s| (s, resp.alert)).ok_or_else(|| {
-                ReadError::Io(std::io::Error::new(std::io::ErrorKind::InvalidData, "short state block"))
-            }),
-            Err(e) => Err(e),
-        };
-        if let Some(o) = out.get_mut(slot) {
-            *o = Some(value);
-        }
-    })
-    .map_err(|e| e.to_string())?;
-    Ok(out
-        .into_iter()
-        .map(|o| o.unwrap_or_else(|| Err(ReadError::Io(std::io::ErrorKind::TimedOut.into()))))
-        .collect())
+/// The stride loop's state between cycles.
+struct Walk<'m> {
+    ids: Vec<u8>,
+    stand: Stand,
+    /// Per servo: failed reads in a row and whether they were CRC failures.
+    failures: Vec<(usize, bool)>,
+    last_pos: Vec<Option<i32>>,
+    monitor: Option<(Monitor<'m>, StanceBins)>,
+    /// `(time, p_fail)` of a halt on risk, and the goals held since.
+    halted: Option<(f64, f64)>,
+    halt_goal: Vec<i32>,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -550,19 +482,59 @@ fn run(
     report: &mut DriveReport,
 ) -> Result<DriveOutcome, DriveError> {
     let ids: Vec<u8> = settings.servos.iter().map(|s| s.id).collect();
+    let stand = stand_up(bus, schedule, settings, &ids)?;
+    let mut walk = Walk {
+        failures: vec![(0usize, false); ids.len()],
+        last_pos: vec![None; ids.len()],
+        monitor: monitor.map(|m| {
+            let bins = StanceBins::new(m.grid.bins);
+            (m, bins)
+        }),
+        ids,
+        stand,
+        halted: None,
+        halt_goal: vec![],
+    };
     let period = Duration::from_secs_f64(1.0 / settings.rate_hz);
+    let begin = Instant::now();
+    let mut last_cycle = Instant::now();
+    loop {
+        let time = begin.elapsed().as_secs_f64() - settings.stand_s;
+        let cycle = last_cycle.elapsed().as_secs_f64();
+        last_cycle = Instant::now();
+        if report.cycles > 0 && cycle > settings.watchdog_s {
+            return Err(DriveError::Watchdog { time_s: time, cycle_s: cycle, limit_s: settings.watchdog_s });
+        }
+        if let Some(outcome) = walk.finished(settings, stop, time) {
+            return Ok(outcome);
+        }
+        let goals = walk.goals(schedule, settings, time);
+        walk.write_goals(bus, schedule, settings, &goals, time)
+            .map_err(|e| DriveError::Bus { time_s: time, reason: e.to_string() })?;
+        walk.read_cycle(bus, schedule, settings, &goals, time, on_sample, on_live, report)?;
+        let spent = last_cycle.elapsed();
+        if spent < period {
+            std::thread::sleep(period - spent);
+        }
+        report.rate_hz = report.cycles as f64 / begin.elapsed().as_secs_f64().max(1e-9);
+    }
+}
+
+/// Stands up: reads where the legs are (up to three tries per servo, as during the run), takes
+/// the start pose nearest to it, and turns the torque on.
+fn stand_up(
+    bus: &mut DynamixelBus,
+    schedule: &GaitSchedule,
+    settings: &DriveSettings,
+    ids: &[u8],
+) -> Result<Stand, DriveError> {
     let stand_s = settings.stand_s;
-    let mut failures = vec![(0usize, false); ids.len()];
-    let mut last_pos: Vec<Option<i32>> = vec![None; ids.len()];
-    let mut bins = monitor.as_ref().map(|m| StanceBins::new(m.grid.bins));
-    // Stand up: torque on, then the start pose nearest to where each leg is.
-    // Where the legs are: up to three tries per servo, as during the run.
-    let mut states = read_states(bus, &ids).map_err(|reason| DriveError::Bus { time_s: -stand_s, reason })?;
+    let mut states = read_states(bus, ids).map_err(|reason| DriveError::Bus { time_s: -stand_s, reason })?;
     for _ in 0..2 {
         if states.iter().all(Result::is_ok) {
             break;
         }
-        let again = read_states(bus, &ids).map_err(|reason| DriveError::Bus { time_s: -stand_s, reason })?;
+        let again = read_states(bus, ids).map_err(|reason| DriveError::Bus { time_s: -stand_s, reason })?;
         for (s, a) in states.iter_mut().zip(again) {
             if s.is_err() {
                 *s = a;
@@ -599,91 +571,115 @@ fn run(
         ids.iter().map(|&id| SyncWriteData { motor_id: id, data: [1] }).collect();
     bus.sync_write(t::TORQUE_ENABLE, 1, &torque_on)
         .map_err(|e| DriveError::Bus { time_s: -stand_s, reason: e.to_string() })?;
-    let begin = Instant::now();
-    let mut last_cycle = Instant::now();
-    let mut halted: Option<(f64, f64)> = None;
-    let mut halt_goal: Vec<i32> = vec![];
-    loop {
-        let elapsed = begin.elapsed().as_secs_f64();
-        let time = elapsed - stand_s;
-        let cycle = last_cycle.elapsed().as_secs_f64();
-        last_cycle = Instant::now();
-        if report.cycles > 0 && cycle > settings.watchdog_s {
-            return Err(DriveError::Watchdog { time_s: time, cycle_s: cycle, limit_s: settings.watchdog_s });
-        }
+    Ok(Stand { start_goal, shift })
+}
+
+impl Walk<'_> {
+    /// How the run ends at `time`, if it does: the stop flag, the end of a halt's hold, or
+    /// the duration reached.
+    fn finished(&self, settings: &DriveSettings, stop: &AtomicBool, time: f64) -> Option<DriveOutcome> {
         if stop.load(Ordering::Relaxed) {
-            return Ok(DriveOutcome::Interrupted { time_s: time });
+            return Some(DriveOutcome::Interrupted { time_s: time });
         }
-        if let Some((at, p)) = halted {
-            if time - at >= settings.hold_s {
-                return Ok(DriveOutcome::Halted { time_s: at, p_fail: p });
+        match self.halted {
+            Some((at, p)) if time - at >= settings.hold_s => {
+                Some(DriveOutcome::Halted { time_s: at, p_fail: p })
             }
-        } else if time >= settings.duration_s {
-            return Ok(DriveOutcome::Completed { time_s: time });
+            None if time >= settings.duration_s => Some(DriveOutcome::Completed { time_s: time }),
+            _ => None,
         }
-        // Goals.
-        let goals: Vec<(i32, i32)> = settings
+    }
+
+    /// Every servo's goal position at `time`: the start pose while standing, the held pose
+    /// after a halt, the schedule's angle otherwise.
+    fn goals(&self, schedule: &GaitSchedule, settings: &DriveSettings, time: f64) -> Vec<i32> {
+        settings
             .servos
             .iter()
             .enumerate()
             .map(|(j, s)| {
-                if halted.is_some() {
-                    return (halt_goal[j], 0);
+                if self.halted.is_some() {
+                    self.halt_goal[j]
+                } else if time < 0.0 {
+                    self.stand.start_goal[j]
+                } else {
+                    s.pulses(schedule.command(j, time).angle_rad + self.stand.shift[j])
                 }
-                if time < 0.0 {
-                    return (start_goal[j], 0);
-                }
-                let c = schedule.command(j, time);
-                let goal = s.pulses(c.angle_rad + shift[j]);
-                (goal, 0)
             })
-            .collect();
-        let result = match settings.profile {
-            Profile::Position => {
-                let data: Vec<SyncWriteData<[u8; 4]>> = ids
-                    .iter()
-                    .zip(&goals)
-                    .map(|(&id, g)| SyncWriteData { motor_id: id, data: g.0.to_le_bytes() })
-                    .collect();
-                bus.sync_write(t::GOAL_POSITION, 4, &data)
-            }
-            Profile::Velocity => {
-                // Velocity mode: the schedule's speed plus a phase correction, from the last
-                // read position (below); standing and halted: position error only.
-                let data: Vec<SyncWriteData<[u8; 4]>> = ids
-                    .iter()
-                    .enumerate()
-                    .map(|(j, &id)| {
-                        let s = settings.servos[j];
-                        let cmd_v = if time >= 0.0 && halted.is_none() {
-                            schedule.command(j, time).velocity_rad_s
-                        } else {
-                            0.0
-                        };
-                        let err = last_pos[j].map_or(0.0, |p| s.angle(goals[j].0) - s.angle(p));
-                        let v = f64::from(s.direction) * (cmd_v + PHASE_GAIN_PER_S * err);
-                        let units = xl330::velocity_units_from_rad_s(v).clamp(-2047, 2047) as i32;
-                        SyncWriteData { motor_id: id, data: units.to_le_bytes() }
-                    })
-                    .collect();
-                bus.sync_write(t::GOAL_VELOCITY, 4, &data)
-            }
+            .collect()
+    }
+
+    /// One Sync Write of the goals: positions, or in velocity mode the schedule's speed plus a
+    /// phase correction from the last read position (standing and halted: position error only).
+    fn write_goals(
+        &self,
+        bus: &mut DynamixelBus,
+        schedule: &GaitSchedule,
+        settings: &DriveSettings,
+        goals: &[i32],
+        time: f64,
+    ) -> Result<(), dynamixel2::WriteError> {
+        let data: Vec<SyncWriteData<[u8; 4]>> = match settings.profile {
+            Profile::Position => self
+                .ids
+                .iter()
+                .zip(goals)
+                .map(|(&id, g)| SyncWriteData { motor_id: id, data: g.to_le_bytes() })
+                .collect(),
+            Profile::Velocity => self
+                .ids
+                .iter()
+                .enumerate()
+                .map(|(j, &id)| {
+                    let s = settings.servos[j];
+                    let cmd_v = if time >= 0.0 && self.halted.is_none() {
+                        schedule.command(j, time).velocity_rad_s
+                    } else {
+                        0.0
+                    };
+                    let err = self.last_pos[j].map_or(0.0, |p| s.angle(goals[j]) - s.angle(p));
+                    let v = f64::from(s.direction) * (cmd_v + PHASE_GAIN_PER_S * err);
+                    let units = xl330::velocity_units_from_rad_s(v).clamp(-2047, 2047) as i32;
+                    SyncWriteData { motor_id: id, data: units.to_le_bytes() }
+                })
+                .collect(),
         };
-        result.map_err(|e| DriveError::Bus { time_s: time, reason: e.to_string() })?;
-        let states = read_states(bus, &ids).map_err(|reason| DriveError::Bus { time_s: time, reason })?;
+        let address = match settings.profile {
+            Profile::Position => t::GOAL_POSITION,
+            Profile::Velocity => t::GOAL_VELOCITY,
+        };
+        bus.sync_write(address, 4, &data)
+    }
+
+    /// One Sync Read of every servo's state: each answer logged and fed to the monitor, each
+    /// failure counted (three in a row end the run).
+    #[allow(clippy::too_many_arguments)]
+    fn read_cycle(
+        &mut self,
+        bus: &mut DynamixelBus,
+        schedule: &GaitSchedule,
+        settings: &DriveSettings,
+        goals: &[i32],
+        time: f64,
+        on_sample: &mut dyn FnMut(&ServoSample) -> std::io::Result<()>,
+        on_live: &mut dyn FnMut(&LiveEstimate),
+        report: &mut DriveReport,
+    ) -> Result<(), DriveError> {
+        let states =
+            read_states(bus, &self.ids).map_err(|reason| DriveError::Bus { time_s: time, reason })?;
         report.cycles += 1;
         for (j, st) in states.into_iter().enumerate() {
             let s = settings.servos[j];
             match st {
                 Ok((state, alert)) => {
-                    failures[j] = (0, false);
-                    last_pos[j] = Some(state.position);
+                    self.failures[j] = (0, false);
+                    self.last_pos[j] = Some(state.position);
                     let hardware_error = if alert {
                         bus.read_u8(s.id, t::HARDWARE_ERROR_STATUS).map(|r| r.data).unwrap_or(0xFF)
                     } else {
                         0
                     };
-                    let angle = s.angle(state.position) - shift[j];
+                    let angle = s.angle(state.position) - self.stand.shift[j];
                     let tau =
                         f64::from(s.direction) * xl330::torque_from_current(f64::from(state.current_ma));
                     let sample = ServoSample {
@@ -693,67 +689,68 @@ fn run(
                         id: s.id,
                         state,
                         hardware_error,
-                        goal_position: goals[j].0,
+                        goal_position: goals[j],
                         leg_angle_rad: angle,
                         drive_torque_n_m: tau,
                     };
                     on_sample(&sample)
                         .map_err(|e| DriveError::Log { time_s: time, reason: e.to_string() })?;
-                    if let (Some(b), Some(m)) = (bins.as_mut(), monitor.as_ref()) {
-                        if let Some((k, profile, counts)) = b.add(schedule, j, angle, tau) {
-                            if let Some(inf) =
-                                infer_from_stance(m.robot, m.grid, k, &profile, &counts, m.noise_sd_n_m)
-                            {
-                                let live = LiveEstimate { time_s: time, tripod: k, inference: inf };
-                                on_live(&live);
-                                let p = live.inference.p_fail;
-                                report.live.push(live);
-                                if let (Some(limit), None) = (settings.stop_on_risk, halted) {
-                                    if p > limit {
-                                        halted = Some((time, p));
-                                        // Hold every leg where it was last read: the stance
-                                        // tripod stays planted.
-                                        halt_goal = last_pos
-                                            .iter()
-                                            .zip(&goals)
-                                            .map(|(p, g)| p.unwrap_or(g.0))
-                                            .collect();
-                                    }
-                                }
-                            }
-                        }
-                    }
+                    self.monitor_sample(schedule, settings, goals, j, angle, tau, time, on_live, report);
                 }
-                Err(e) => {
-                    // A failed CRC is corruption; silence, or the next servo's packet in this
-                    // one's place, is a servo that did not answer.
-                    let corrupt = matches!(
-                        e,
-                        ReadError::InvalidMessage(dynamixel2::InvalidMessage::InvalidChecksum(_))
-                    );
-                    let n = if failures[j].1 == corrupt { failures[j].0 + 1 } else { 1 };
-                    failures[j] = (n, corrupt);
-                    if n >= 3 {
-                        return Err(if corrupt {
-                            DriveError::Corrupt { id: s.id, leg: j, time_s: time, cycles: n }
-                        } else {
-                            DriveError::Lost {
-                                id: s.id,
-                                leg: j,
-                                time_s: time,
-                                cycles: n,
-                                reason: e.to_string(),
-                            }
-                        });
-                    }
-                }
+                Err(e) => self.count_failure(j, s.id, &e, time)?,
             }
         }
-        let spent = last_cycle.elapsed();
-        if spent < period {
-            std::thread::sleep(period - spent);
+        Ok(())
+    }
+
+    /// Feeds one sample to the live monitor; after a complete stance, the estimate (and a halt
+    /// when its risk passes `stop_on_risk`).
+    #[allow(clippy::too_many_arguments)]
+    fn monitor_sample(
+        &mut self,
+        schedule: &GaitSchedule,
+        settings: &DriveSettings,
+        goals: &[i32],
+        j: usize,
+        angle: f64,
+        tau: f64,
+        time: f64,
+        on_live: &mut dyn FnMut(&LiveEstimate),
+        report: &mut DriveReport,
+    ) {
+        let Some((m, bins)) = self.monitor.as_mut() else { return };
+        let Some((k, profile, counts)) = bins.add(schedule, j, angle, tau) else { return };
+        let Some(inf) = infer_from_stance(m.robot, m.grid, k, &profile, &counts, m.noise_sd_n_m) else {
+            return;
+        };
+        let live = LiveEstimate { time_s: time, tripod: k, inference: inf };
+        on_live(&live);
+        let p = live.inference.p_fail;
+        report.live.push(live);
+        if let (Some(limit), None) = (settings.stop_on_risk, self.halted) {
+            if p > limit {
+                self.halted = Some((time, p));
+                // Hold every leg where it was last read: the stance tripod stays planted.
+                self.halt_goal = self.last_pos.iter().zip(goals).map(|(p, &g)| p.unwrap_or(g)).collect();
+            }
         }
-        report.rate_hz = report.cycles as f64 / begin.elapsed().as_secs_f64().max(1e-9);
+    }
+
+    /// Counts servo `j`'s failed read; the third in a row of one kind ends the run.
+    fn count_failure(&mut self, j: usize, id: u8, e: &ReadError, time: f64) -> Result<(), DriveError> {
+        // A failed CRC is corruption; silence, or the next servo's packet in this one's place,
+        // is a servo that did not answer.
+        let corrupt = matches!(e, ReadError::InvalidMessage(dynamixel2::InvalidMessage::InvalidChecksum(_)));
+        let n = if self.failures[j].1 == corrupt { self.failures[j].0 + 1 } else { 1 };
+        self.failures[j] = (n, corrupt);
+        if n < 3 {
+            return Ok(());
+        }
+        Err(if corrupt {
+            DriveError::Corrupt { id, leg: j, time_s: time, cycles: n }
+        } else {
+            DriveError::Lost { id, leg: j, time_s: time, cycles: n, reason: e.to_string() }
+        })
     }
 }
 

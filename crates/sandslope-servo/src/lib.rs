@@ -20,6 +20,7 @@ pub mod emulator;
 pub mod log;
 pub mod packet;
 pub mod session;
+mod stance;
 pub mod table;
 
 pub use driver::{drive, DriveError, DriveOutcome, DriveSettings, Profile, ServoConfig, ServoSample};

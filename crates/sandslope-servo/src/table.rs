@@ -110,3 +110,37 @@ impl PresentState {
         })
     }
 }
+
+/// One servo's read: its state and the status packet's alert bit, or the read error.
+pub(crate) type StateRead = Result<(PresentState, bool), dynamixel2::ReadError>;
+
+/// Reads every servo's state block; per servo `Ok((state, alert))` or the read error.
+pub(crate) fn read_states(
+    bus: &mut dynamixel2::Bus<Vec<u8>, Vec<u8>>,
+    ids: &[u8],
+) -> Result<Vec<StateRead>, String> {
+    // dynamixel2 calls back once per ID, in the order asked: the k-th call is ids[k]'s.
+    let mut out: Vec<Option<StateRead>> = (0..ids.len()).map(|_| None).collect();
+    let mut k = 0usize;
+    bus.sync_read_cb(ids, STATE_BLOCK.0, STATE_BLOCK.1, |r| {
+        let slot = k;
+        k += 1;
+        let value = match r {
+            Ok(resp) => PresentState::decode(resp.data).map(|s| (s, resp.alert)).ok_or_else(|| {
+                dynamixel2::ReadError::Io(std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    "short state block",
+                ))
+            }),
+            Err(e) => Err(e),
+        };
+        if let Some(o) = out.get_mut(slot) {
+            *o = Some(value);
+        }
+    })
+    .map_err(|e| e.to_string())?;
+    Ok(out
+        .into_iter()
+        .map(|o| o.unwrap_or_else(|| Err(dynamixel2::ReadError::Io(std::io::ErrorKind::TimedOut.into()))))
+        .collect())
+}

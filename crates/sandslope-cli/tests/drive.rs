@@ -290,7 +290,7 @@ fn torque_off_when_the_run_completes() {
 
 /// A signal mid-run: the gait stops, the torque goes off, the log is kept whole (read back
 /// with nothing to repair), and the exit code is 128 + the signal: 130 for SIGINT (Ctrl-C),
-/// 143 for SIGTERM (docs/drive.md: as every interrupted run of the tool, so that a
+/// 143 for SIGTERM, 129 for SIGHUP (docs/drive.md: as every interrupted run of the tool, so that a
 /// supervisor's stop is told from a person's).
 fn interrupted_by(signal: &str, code: i32, name: &str) {
     let _one = real_time();
@@ -331,7 +331,11 @@ fn interrupted_by(signal: &str, code: i32, name: &str) {
     assert!(all.contains("emulator: torque off on every servo"), "{all}");
     assert!(std::fs::read_to_string(&log).unwrap().ends_with('\n'), "the log ends mid-row");
     let read = sandslope_io::servo_log::read_servo_log(&log).unwrap();
-    assert!(read.notes.is_empty(), "{:?}", read.notes);
+    // Nothing repaired: no cut row, no empty value, no repeated or disordered row. A gap in
+    // time is not damage to the log but a slow cycle it records truly (a loaded CI machine
+    // deschedules the driver for a few cycles), so it is the one note allowed.
+    let repaired: Vec<&String> = read.notes.iter().filter(|n| !n.contains("gap(s) in time")).collect();
+    assert!(repaired.is_empty(), "{:?}", read.notes);
     // Every servo's rows, up to the interruption (during the stand or the gait, on a loaded
     // machine).
     let mut ids: Vec<u8> = read.rows.iter().map(|r| r.id).collect();
@@ -349,6 +353,12 @@ fn torque_off_on_ctrl_c() {
 #[test]
 fn torque_off_on_sigterm() {
     interrupted_by("-TERM", 143, "SIGTERM");
+}
+
+/// The terminal closed (SIGHUP, 1): the same as Ctrl-C, exit 129.
+#[test]
+fn torque_off_on_sighup() {
+    interrupted_by("-HUP", 129, "SIGHUP");
 }
 
 #[test]

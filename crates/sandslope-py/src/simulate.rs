@@ -6,7 +6,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
 
-use sandslope::simulate::{simulate as run, Mechanisms, SimulateError};
+use sandslope::simulate::{
+    simulate as run, simulate_ensemble as run_ensemble, Mechanisms, SimSettings, SimulateError,
+};
 use sandslope::Scenario;
 use sandslope_request::error::Words;
 use sandslope_request::simulate::{parse_body_pitch, parse_rft_scaling, SettingsRequest};
@@ -42,7 +44,6 @@ pub fn simulate<'py>(
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     let scenario =
         Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
-    // The settings `sandslope simulate` checks, in Python's words.
     let settings = SettingsRequest {
         duration_s,
         dt_s,
@@ -52,9 +53,8 @@ pub fn simulate<'py>(
         rft_scaling: parse_rft_scaling(rft_scaling, Words::Keyword).map_err(|e| value_error(e.message()))?,
         mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
         rate_hz: sample_rate_hz,
-    }
-    .settings(Words::Keyword)
-    .map_err(|e| value_error(e.message()))?;
+    };
+    let settings = checked(settings)?;
     let sim = py.detach(|| run(&scenario, slope_deg, &settings)).map_err(|e| match e {
         SimulateError::Param(p) => value_error(p),
     })?;
@@ -83,4 +83,52 @@ pub fn simulate<'py>(
     }
     let summary = pythonize(py, &sim.summary).map_err(value_error)?;
     Ok((d, summary))
+}
+
+/// The settings `sandslope simulate` checks, in Python's words.
+fn checked(settings: SettingsRequest) -> PyResult<SimSettings> {
+    settings.settings(Words::Keyword).map_err(|e| value_error(e.message()))
+}
+
+/// Walks the robot `walks` times (2 to 1000) at one slope, the mass perturbed by 1e-9 relative
+/// between walks (`sandslope simulate --ensemble N --json`, docs/simulate.md "Pitch free"):
+/// the spread's dict, with every walk's summary under `summaries`.
+#[pyfunction]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, walks, k_n=None, k_s=None, dt_s=None, creep_m_s=None, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=1.0))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_ensemble<'py>(
+    py: Python<'py>,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+    slope_deg: f64,
+    duration_s: f64,
+    walks: usize,
+    k_n: Option<f64>,
+    k_s: Option<f64>,
+    dt_s: Option<f64>,
+    creep_m_s: Option<f64>,
+    body_pitch: &str,
+    rft_scaling: &str,
+    servo_limit: bool,
+    leg_friction: Option<f64>,
+    duty_cycle: f64,
+    disturbed_sand: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let scenario =
+        Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
+    let settings = checked(SettingsRequest {
+        duration_s,
+        dt_s,
+        creep_m_s,
+        servo_limit,
+        body_pitch: parse_body_pitch(body_pitch, Words::Keyword).map_err(|e| value_error(e.message()))?,
+        rft_scaling: parse_rft_scaling(rft_scaling, Words::Keyword).map_err(|e| value_error(e.message()))?,
+        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
+        rate_hz: sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ,
+    })?;
+    let e = py.detach(|| run_ensemble(&scenario, slope_deg, &settings, walks)).map_err(|e| match e {
+        SimulateError::Param(p) if p.key == "ensemble" => value_error(p.renamed("walks")),
+        SimulateError::Param(p) => value_error(p),
+    })?;
+    pythonize(py, &e).map_err(value_error)
 }

@@ -96,3 +96,16 @@ def test_mechanisms_are_the_cli_flags(cli):
     assert got["speed_m_s"] == pytest.approx(want["speed_m_s"], rel=1e-12)
     with pytest.raises(ValueError, match=r"duty_cycle = 0.95 must be between 0.1 and 0.9"):
         sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, duty_cycle=0.95)
+
+
+def test_an_ensemble_is_the_cli_ensemble(cli):
+    # `simulate --ensemble N --json`, key for key and number for number (docs/simulate.md,
+    # "Pitch free"): the free body at 10 degrees, three walks 1e-9 apart in mass.
+    want = cli.json("simulate", "--slope", 10, "--duration", 2, "--body-pitch", "free", "--ensemble", 3)
+    got = sandslope.simulate_ensemble("paper-hexapod", "glass-beads-300um", 10, 3, 2, body_pitch="free")
+    assert set(got) == set(want)
+    assert got["walks"] == 3 and len(got["summaries"]) == 3
+    assert got["speed_m_s"] == pytest.approx(want["speed_m_s"], rel=1e-12)
+    assert got["regimes"] == want["regimes"]
+    with pytest.raises(ValueError, match=r"walks = 1 must be a whole number of walks from 2 to 1000"):
+        sandslope.simulate_ensemble("paper-hexapod", "glass-beads-300um", 10, 1, 2)

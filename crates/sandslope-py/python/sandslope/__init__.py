@@ -65,6 +65,7 @@ __all__ = [
     "fit",
     "track",
     "simulate",
+    "simulate_ensemble",
     "report",
     "read_servo_log",
     "infer_servo_log",
@@ -710,6 +711,55 @@ def report(
         html=None if html is None else os.fspath(html),
     )
     return json.loads(text)
+
+
+def simulate_ensemble(
+    robot: RobotLike,
+    terrain: TerrainLike,
+    slope_deg: float,
+    walks: int,
+    duration_s: float = 10.0,
+    *,
+    k_n: Optional[float] = None,
+    k_s: Optional[float] = None,
+    dt_s: Optional[float] = None,
+    creep_m_s: Optional[float] = None,
+    body_pitch: str = "locked",
+    rft_scaling: str = "motion",
+    servo_limit: bool = True,
+    leg_friction: Optional[float] = None,
+    duty_cycle: Optional[float] = None,
+    disturbed_sand: Optional[float] = None,
+) -> Dict[str, Any]:
+    """Walks the robot ``walks`` times (2 to 1000) at ``slope_deg``, the mass of walk k
+    multiplied by ``1 + k 1e-9``, and returns the spread: the dict ``sandslope simulate
+    --ensemble N --json`` prints (``speed_m_s``, ``speed_sd_m_s``, ``speed_se_m_s``, ``t1_s``,
+    ``pitched_over``, ``regimes``, ``regime``, every walk's summary under ``summaries``).
+
+    With ``body_pitch="free"`` the walk on a slope is chaotic (two walks 1e-9 apart part by
+    tens of degrees of pitch within seconds), so the spread is the answer; with the pitch
+    locked the walks agree to rounding (docs/simulate.md, "Pitch free"). The other keywords are
+    :func:`simulate`'s.
+    """
+    return _sandslope.simulate_ensemble(
+        _robot(robot),
+        _terrain(terrain),
+        float(slope_deg),
+        float(duration_s),
+        int(walks),
+        k_n=None if k_n is None else float(k_n),
+        k_s=None if k_s is None else float(k_s),
+        dt_s=None if dt_s is None else float(dt_s),
+        creep_m_s=None if creep_m_s is None else float(creep_m_s),
+        body_pitch=str(body_pitch),
+        rft_scaling=str(rft_scaling),
+        servo_limit=bool(servo_limit),
+        **{
+            k: float(v)
+            for k, v in (("leg_friction", leg_friction), ("duty_cycle", duty_cycle), ("disturbed_sand", disturbed_sand))
+            if v is not None
+        },
+    )
 
 
 def simulate(

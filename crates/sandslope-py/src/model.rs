@@ -5,7 +5,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 
-use sandslope::{write_phase_rows, Cause, Regime, Scenario, Slope, SlopeEvaluation, StrengthGrid, Terrain};
+use sandslope::{write_phase_rows, Cause, Regime, Slope, SlopeEvaluation, StrengthGrid};
+use sandslope_request::predict::{point_terrain, PointRequest};
 
 use crate::arrays::{axis, put, scale_name, uninit, values};
 use crate::types::{PyRobot, PyTerrain};
@@ -71,8 +72,9 @@ impl Row {
     }
 }
 
-/// Every model quantity at each element of the (already broadcast, equally long) inputs, by
-/// the library's [`Scenario`] (what `sandslope predict` evaluates). Either `terrain` (looked up
+/// Every model quantity at each element of the (already broadcast, equally long) inputs, each
+/// the request layer's [`PointRequest`] (the library's scenario, what `sandslope predict`
+/// evaluates). Either `terrain` (looked up
 /// at each slope, `k_n`/`k_s` overriding it where given) or both `k_n` and `k_s`.
 #[pyfunction]
 #[pyo3(signature = (robot, slope_deg, k_n=None, k_s=None, terrain=None, mass_kg=None))]
@@ -96,26 +98,21 @@ pub fn predict<'py>(
             return Err(value_error(format!("{key} has {} values for {n} slopes", a.len())));
         }
     }
-    // Without a terrain, both resistances are given everywhere: the table only lends its
-    // (absent) angle of repose, and any valid one-point table will do.
-    let terrain: Terrain = match (terrain, k_n, k_s) {
-        (Some(t), _, _) => t.inner.clone(),
-        (None, Some(_), Some(_)) => Terrain::constant(1.0, 1.0).map_err(value_error)?,
-        _ => return Err(value_error("give both k_n and k_s, or a terrain (k_n and k_s then override it)")),
-    };
+    // The request layer's point: its overrides checked and named as this keyword's element.
+    let terrain = point_terrain(terrain.map(|t| &t.inner), k_n.is_some(), k_s.is_some())
+        .map_err(|e| value_error(e.message()))?;
     let robot = &robot.inner;
     let eval = |i: usize| -> Result<Row, String> {
-        let rename = |e: sandslope::ParamError| {
-            let key = e.key.clone();
-            e.renamed(element(&key, i, n)).to_string()
+        let point = PointRequest {
+            slope: slope[i],
+            k_n: k_n.map(|a| a[i]),
+            k_s: k_s.map(|a| a[i]),
+            mass: mass.map(|a| a[i]),
         };
-        let robot = match mass {
-            Some(m) => robot.with_mass(m[i]).map_err(|e| e.renamed(element("mass_kg", i, n)).to_string())?,
-            None => robot.clone(),
-        };
-        let scenario =
-            Scenario::new(robot, terrain.clone(), k_n.map(|a| a[i]), k_s.map(|a| a[i])).map_err(rename)?;
-        scenario.evaluate(slope[i]).map(|e| Row::from(&e)).map_err(rename)
+        point
+            .answer(robot, &terrain, |key| element(key, i, n))
+            .map(|e| Row::from(&e))
+            .map_err(|e| e.message())
     };
     let rows: Vec<Row> =
         py.detach(|| (0..n).into_par_iter().map(eval).collect::<Result<_, _>>()).map_err(value_error)?;

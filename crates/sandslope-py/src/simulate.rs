@@ -7,7 +7,8 @@ use pyo3::types::PyDict;
 use pythonize::pythonize;
 
 use sandslope::simulate::{
-    simulate as run, simulate_ensemble as run_ensemble, Mechanisms, SimSettings, SimulateError,
+    simulate as run, simulate_ensemble as run_ensemble, BodyPitch, Mechanisms, RftScaling, SimSettings,
+    SimulateError,
 };
 use sandslope::Scenario;
 use sandslope_request::error::Words;
@@ -44,17 +45,18 @@ pub fn simulate<'py>(
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     let scenario =
         Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
-    let settings = SettingsRequest {
+    let (body_pitch, rft_scaling) = modes(body_pitch, rft_scaling)?;
+    let mechanisms = Mechanisms { leg_friction, duty_cycle, disturbed_sand };
+    let settings = checked(SettingsRequest {
         duration_s,
         dt_s,
         creep_m_s,
         servo_limit,
-        body_pitch: parse_body_pitch(body_pitch, Words::Keyword).map_err(|e| value_error(e.message()))?,
-        rft_scaling: parse_rft_scaling(rft_scaling, Words::Keyword).map_err(|e| value_error(e.message()))?,
-        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
+        body_pitch,
+        rft_scaling,
+        mechanisms,
         rate_hz: sample_rate_hz,
-    };
-    let settings = checked(settings)?;
+    })?;
     let sim = py.detach(|| run(&scenario, slope_deg, &settings)).map_err(|e| match e {
         SimulateError::Param(p) => value_error(p),
     })?;
@@ -83,6 +85,15 @@ pub fn simulate<'py>(
     }
     let summary = pythonize(py, &sim.summary).map_err(value_error)?;
     Ok((d, summary))
+}
+
+/// The body-pitch and scaling keywords, parsed with the CLI's names, errors in Python's words.
+fn modes(body_pitch: &str, rft_scaling: &str) -> PyResult<(BodyPitch, RftScaling)> {
+    let err = |e: sandslope_request::RequestError| value_error(e.message());
+    Ok((
+        parse_body_pitch(body_pitch, Words::Keyword).map_err(err)?,
+        parse_rft_scaling(rft_scaling, Words::Keyword).map_err(err)?,
+    ))
 }
 
 /// The settings `sandslope simulate` checks, in Python's words.
@@ -116,15 +127,18 @@ pub fn simulate_ensemble<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let scenario =
         Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
+    let (body_pitch, rft_scaling) = modes(body_pitch, rft_scaling)?;
+    let mechanisms = Mechanisms { leg_friction, duty_cycle, disturbed_sand };
+    let rate_hz = sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ;
     let settings = checked(SettingsRequest {
         duration_s,
         dt_s,
         creep_m_s,
         servo_limit,
-        body_pitch: parse_body_pitch(body_pitch, Words::Keyword).map_err(|e| value_error(e.message()))?,
-        rft_scaling: parse_rft_scaling(rft_scaling, Words::Keyword).map_err(|e| value_error(e.message()))?,
-        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
-        rate_hz: sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ,
+        body_pitch,
+        rft_scaling,
+        mechanisms,
+        rate_hz,
     })?;
     let e = py.detach(|| run_ensemble(&scenario, slope_deg, &settings, walks)).map_err(|e| match e {
         SimulateError::Param(p) if p.key == "ensemble" => value_error(p.renamed("walks")),

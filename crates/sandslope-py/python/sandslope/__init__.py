@@ -713,6 +713,12 @@ def report(
     return json.loads(text)
 
 
+def _mechanisms(leg_friction, duty_cycle, disturbed_sand) -> Dict[str, float]:
+    """The docs/model.md §20 keywords that were given (the others take the Rust defaults)."""
+    given = (("leg_friction", leg_friction), ("duty_cycle", duty_cycle), ("disturbed_sand", disturbed_sand))
+    return {k: float(v) for k, v in given if v is not None}
+
+
 def simulate_ensemble(
     robot: RobotLike,
     terrain: TerrainLike,
@@ -754,11 +760,7 @@ def simulate_ensemble(
         body_pitch=str(body_pitch),
         rft_scaling=str(rft_scaling),
         servo_limit=bool(servo_limit),
-        **{
-            k: float(v)
-            for k, v in (("leg_friction", leg_friction), ("duty_cycle", duty_cycle), ("disturbed_sand", disturbed_sand))
-            if v is not None
-        },
+        **_mechanisms(leg_friction, duty_cycle, disturbed_sand),
     )
 
 
@@ -818,11 +820,7 @@ def simulate(
         body_pitch=str(body_pitch),
         rft_scaling=str(rft_scaling),
         servo_limit=bool(servo_limit),
-        **{
-            k: float(v)
-            for k, v in (("leg_friction", leg_friction), ("duty_cycle", duty_cycle), ("disturbed_sand", disturbed_sand))
-            if v is not None
-        },
+        **_mechanisms(leg_friction, duty_cycle, disturbed_sand),
     )
     try:
         import pandas as pd

@@ -181,7 +181,7 @@ pub fn drive<'py>(
         terrain: terrain.inner.clone(),
         slope_deg,
         settings,
-        bus: BusChoice::Emulate(EmulateOptions { k_s, noise_ma, seed, faults }),
+        bus: BusChoice::Emulate(EmulateOptions { k_s, noise_ma, seed, faults, current_offset_ma: vec![] }),
         monitor: live,
     };
     let (samples, report, emulator) = py

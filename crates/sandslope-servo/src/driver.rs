@@ -487,7 +487,7 @@ fn run(
         failures: vec![(0usize, false); ids.len()],
         last_pos: vec![None; ids.len()],
         monitor: monitor.map(|m| {
-            let bins = StanceBins::new(m.grid.bins);
+            let bins = StanceBins::new(m.grid.bins, settings.servos.len(), m.grid.swing_offset);
             (m, bins)
         }),
         ids,

@@ -54,6 +54,10 @@ pub struct EmulatorConfig {
     pub current_noise_ma: f64,
     /// Seed of the noise.
     pub seed: u64,
+    /// Present Current offset, mA: a current sensor's zero bias, added to every reading (the
+    /// torque-free swing then reads it too). Empty: none; one value: every servo; else one per
+    /// servo in leg order.
+    pub current_offset_ma: Vec<f64>,
     /// Strides the stride simulator walks (played in turn, the first left out).
     pub simulated_strides: usize,
     /// Faults to show.
@@ -74,6 +78,7 @@ impl EmulatorConfig {
             slope_deg,
             current_noise_ma: 10.0,
             seed: 1,
+            current_offset_ma: vec![],
             simulated_strides: 8,
             faults: EmulatorFaults::default(),
             model_number: xl330::MODEL_NUMBER,
@@ -168,6 +173,8 @@ struct VirtualServo {
     last_update: f64,
     last_seen: f64,
     current_ema: f64,
+    /// The current sensor's zero bias, mA.
+    offset_ma: f64,
     config: ServoConfig,
     leg: usize,
 }
@@ -182,6 +189,7 @@ impl VirtualServo {
             last_update: 0.0,
             last_seen: 0.0,
             current_ema: 0.0,
+            offset_ma: 0.0,
             config,
             leg,
         };
@@ -276,7 +284,7 @@ impl VirtualServo {
         // The leg's drive torque in the sand, as the servo's current (its own sign).
         let tau = if self.torque_on() { walk.torque(self.leg, self.leg_angle()) } else { 0.0 };
         let dir = f64::from(self.config.direction);
-        let current = dir * xl330::current_from_torque(tau) + noise.gauss() * noise_ma;
+        let current = dir * xl330::current_from_torque(tau) + noise.gauss() * noise_ma + self.offset_ma;
         let limit = f64::from(self.u16_at(t::CURRENT_LIMIT));
         let current = current.clamp(-limit, limit);
         self.current_ema += (current * current - self.current_ema) * (dt / 30.0).min(1.0);
@@ -398,7 +406,12 @@ impl VirtualBus {
             .servos
             .iter()
             .enumerate()
-            .map(|(leg, c)| VirtualServo::new(*c, leg, config.model_number, config.firmware))
+            .map(|(leg, c)| {
+                let mut s = VirtualServo::new(*c, leg, config.model_number, config.firmware);
+                let o = &config.current_offset_ma;
+                s.offset_ma = if o.len() == 1 { o[0] } else { o.get(leg).copied().unwrap_or(0.0) };
+                s
+            })
             .collect();
         Ok(VirtualBus {
             servos,

@@ -87,6 +87,8 @@ pub struct EmulateOptions {
     pub noise_ma: f64,
     /// Seed of the noise.
     pub seed: u64,
+    /// Present Current offsets, mA (`--emulate-offset`; [`EmulatorConfig::current_offset_ma`]).
+    pub current_offset_ma: Vec<f64>,
     /// Mid-run weakening and bus faults.
     pub faults: EmulatorFaults,
 }
@@ -172,7 +174,9 @@ impl Session {
             let inference = CurrentInferenceSettings {
                 simulated_strides: 6,
                 prior,
-                swing_offset: false,
+                // The live stance is read after its leg's last swing median, as a log's after
+                // its swings (docs/drive.md): the grid's walks are taken the same way.
+                swing_offset: true,
                 ..Default::default()
             };
             Some(
@@ -195,6 +199,7 @@ impl Session {
                 );
                 cfg.current_noise_ma = o.noise_ma;
                 cfg.seed = o.seed;
+                cfg.current_offset_ma = o.current_offset_ma.clone();
                 cfg.faults = o.faults;
                 let (emu, port) = Emulator::start(&cfg).map_err(|e| SessionError::Emulator(e.to_string()))?;
                 (port, Some(emu))

@@ -1,7 +1,35 @@
 //! The live monitor's view of the servos' torques: each tripod's stance binned as it happens
-//! (docs/model.md §19), the stance handed to the inference once it is complete.
+//! (docs/model.md §19), the stance handed to the inference once it is complete, and each leg's
+//! current-sensor offset removed online as `infer --servo-log` removes it afterwards
+//! (`sandslope::infer::servo::remove_swing_offset`): the median of the leg's swing, here its
+//! last complete one (the stance that follows cannot wait for the next swing without the
+//! estimate, and a halt on risk, coming half a stride later).
 
+use sandslope::infer::servo::MIN_SWING_SAMPLES;
 use sandslope::servo::GaitSchedule;
+
+/// One leg's swings: the one under way and the median of the last complete one.
+#[derive(Debug, Default)]
+struct LegSwing {
+    stride: Option<i64>,
+    tau: Vec<f64>,
+    median: Option<f64>,
+}
+
+impl LegSwing {
+    /// Ends the swing under way; its median becomes the leg's offset if it has
+    /// [`MIN_SWING_SAMPLES`] samples (a shorter one keeps the last).
+    fn finish(&mut self) {
+        if self.tau.len() >= MIN_SWING_SAMPLES {
+            self.tau.sort_by(f64::total_cmp);
+            let n = self.tau.len();
+            let m = if n % 2 == 1 { self.tau[n / 2] } else { 0.5 * (self.tau[n / 2 - 1] + self.tau[n / 2]) };
+            self.median = Some(m);
+        }
+        self.tau.clear();
+        self.stride = None;
+    }
+}
 
 /// Accumulates each tripod's current stance into bins.
 #[derive(Debug)]
@@ -10,11 +38,16 @@ pub(crate) struct StanceBins {
     key: [Option<i64>; 2],
     sum: [Vec<f64>; 2],
     count: [Vec<usize>; 2],
+    /// Per leg, when the swing offset is removed.
+    swing: Option<Vec<LegSwing>>,
 }
 
 impl StanceBins {
-    pub(crate) fn new(bins: usize) -> StanceBins {
+    /// `bins` per stance; with `swing_offset`, each of the `legs` has its last swing's median
+    /// torque taken off its stance samples (a stance before any complete swing is not binned).
+    pub(crate) fn new(bins: usize, legs: usize, swing_offset: bool) -> StanceBins {
         StanceBins {
+            swing: swing_offset.then(|| (0..legs).map(|_| LegSwing::default()).collect()),
             bins,
             key: [None, None],
             sum: [vec![0.0; bins], vec![0.0; bins]],
@@ -35,15 +68,31 @@ impl StanceBins {
         let (stride, since) = schedule.stride_position(leg, angle);
         let half = 0.5 * schedule.period_s;
         let in_stance = since < half && stride >= 1;
+        let tau = match self.swing.as_mut().and_then(|sw| sw.get_mut(leg)) {
+            None => Some(tau),
+            Some(sw) => {
+                let in_swing = stride >= 0 && since >= half && tau.is_finite();
+                if sw.stride.is_some() && (sw.stride != Some(stride) || !in_swing) {
+                    sw.finish();
+                }
+                if in_swing {
+                    sw.stride = Some(stride);
+                    sw.tau.push(tau);
+                }
+                sw.median.map(|m| tau - m)
+            }
+        };
         let mut done = None;
         if self.key[k].is_some() && (self.key[k] != Some(stride) || !in_stance) {
             done = Some(self.flush(k));
         }
         if in_stance {
             self.key[k] = Some(stride);
-            let b = ((since / half * self.bins as f64) as usize).min(self.bins - 1);
-            self.sum[k][b] += tau;
-            self.count[k][b] += 1;
+            if let Some(tau) = tau {
+                let b = ((since / half * self.bins as f64) as usize).min(self.bins - 1);
+                self.sum[k][b] += tau;
+                self.count[k][b] += 1;
+            }
         }
         done
     }

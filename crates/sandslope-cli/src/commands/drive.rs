@@ -123,6 +123,10 @@ pub struct DriveRunArgs {
     /// packets fail their CRC from S s) or freeze:S:LEN (the bus hangs for LEN s from S s).
     #[arg(long, value_name = "KIND:..", requires = "emulate")]
     pub emulate_fault: Option<String>,
+    /// Emulator: a current sensor's zero bias, mA added to every Present Current: one value for
+    /// every servo, or one per servo in leg order, comma-separated (within -500 to 500).
+    #[arg(long, value_name = "MA[,MA..]", requires = "emulate", allow_hyphen_values = true)]
+    pub emulate_offset: Option<String>,
 }
 
 /// Where a run's servos are, as the front end's flags say.
@@ -134,6 +138,21 @@ pub enum BusFlag {
     Emulate,
     /// `--dry-run`: no bus.
     None,
+}
+
+/// `--emulate-offset`: one value, or one per servo (`legs`), each within -500 to 500 mA.
+fn parse_offsets(text: &str, legs: usize) -> Result<Vec<f64>> {
+    let v: Vec<f64> = text.split(',').map(|x| number("--emulate-offset", x, text)).collect::<Result<_>>()?;
+    if v.len() != 1 && v.len() != legs {
+        bail!(
+            "--emulate-offset `{text}`: give one value (every servo) or {legs} (one per servo), not {}",
+            v.len()
+        );
+    }
+    if let Some(x) = v.iter().find(|x| !(-500.0..=500.0).contains(*x)) {
+        bail!("--emulate-offset `{text}`: {x} mA is outside -500 to 500 mA");
+    }
+    Ok(v)
 }
 
 fn number(flag: &str, text: &str, whole: &str) -> Result<f64> {
@@ -241,6 +260,10 @@ pub fn config(
     }
     let faults = if emulate { parse_faults(run)? } else { EmulatorFaults::default() };
     let legs = 2 * robot.stance_legs() as usize;
+    let current_offset_ma = match &run.emulate_offset {
+        Some(text) if emulate => parse_offsets(text, legs)?,
+        _ => vec![],
+    };
     GaitSchedule::new(&robot, legs).map_err(|e| anyhow!("{robot_spec}: {e}"))?;
     let (servos, baud) = servos(robot_spec, run.baud, legs)?;
     if let Some(b) = run.baud {
@@ -270,6 +293,7 @@ pub fn config(
             k_s: run.emulate_k_s,
             noise_ma: run.emulate_noise,
             seed: run.emulate_seed,
+            current_offset_ma,
             faults,
         }),
     };

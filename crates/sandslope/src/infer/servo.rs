@@ -82,7 +82,7 @@ pub struct CurrentInferenceSettings {
     pub floor_n_m: f64,
     /// Remove each leg's swing-phase torque (the current sensor's zero offset and its drift,
     /// [`remove_swing_offset`]) from the log and from the simulated walks alike. The live
-    /// monitor, which reads one stance at a time, leaves it off.
+    /// monitor's grid sets it too and takes each leg's last swing median off its stance itself.
     pub swing_offset: bool,
 }
 
@@ -428,7 +428,8 @@ pub struct CurrentInference {
     /// The grid's k_s, N/m^3, and the posterior probability of each.
     pub posterior: Vec<(f64, f64)>,
     /// Each leg's current-sensor offset removed, as drive torque (N m; the mean over its
-    /// swings, [`remove_swing_offset`]); empty when none was removed (the live monitor).
+    /// swings, [`remove_swing_offset`]); empty when none was removed, and live (the monitor
+    /// removes each leg's last swing median before the stance reaches the inference).
     pub swing_offset_n_m: Vec<f64>,
 }
 

@@ -9,7 +9,7 @@ use pythonize::pythonize;
 
 use sandslope::risk::uncertainty::CvSource;
 use sandslope::risk::{risk_curve, RegimeProbabilities, RiskPoint, UncertainTerrain, RISK_MAP_CELL_KEYS};
-use sandslope::{ParamError, Slope};
+use sandslope::{ParamError, SignedSlope, Slope};
 
 use crate::arrays::{axis, put, values};
 use crate::types::{PyRobot, PyTerrain};
@@ -129,9 +129,10 @@ pub fn risk_map<'py>(
         a.as_ref().map(|a| axis(key, &values(a))).transpose()
     };
     // The library's default grid where an axis is not given, as `risk --map` without --k-n/--k-s.
+    let slope = SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
     let (kn, ks) = sandslope::risk::map_axes(
         &terrain,
-        slope_deg,
+        slope,
         given("k_n_axis", &k_n_axis)?,
         given("k_s_axis", &k_s_axis)?,
     )
@@ -146,7 +147,7 @@ pub fn risk_map<'py>(
     .map_err(value_error)?;
     let robot = &robot.inner;
     let answer = py
-        .detach(|| sandslope::risk::risk_map(robot, slope_deg, &terrain, (&kn, &ks), max_risk, &|| {}))
+        .detach(|| sandslope::risk::risk_map(robot, slope, &terrain, (&kn, &ks), max_risk, &|| {}))
         .map_err(value_error)?;
     // The summary as `--json` serialises it, then the keys the answer adds, as arrays.
     let d = pythonize(py, &answer.summary).map_err(value_error)?.cast_into::<PyDict>()?;
@@ -192,10 +193,10 @@ pub fn safe_mass<'py>(
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let terrain = uncertain(terrain, cv_n, cv_s)?;
+    let slope = SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
     let robot = &robot.inner;
-    let answer = py
-        .detach(|| sandslope::risk::safe_mass(robot, slope_deg, &terrain, max_risk))
-        .map_err(value_error)?;
+    let answer =
+        py.detach(|| sandslope::risk::safe_mass(robot, slope, &terrain, max_risk)).map_err(value_error)?;
     Ok(pythonize(py, &answer).map_err(value_error)?.cast_into::<PyDict>()?)
 }
 

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use sandslope::{Axis, PanelSummary, PhasePanel, Robot, Slope, Terrain};
+use sandslope::{Axis, PanelSummary, PhasePanel, Robot, SignedSlope, Slope, Terrain};
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 
 use crate::error::{RequestError, Result};
@@ -154,15 +154,10 @@ impl PhaseGrid {
         let mut panels = Vec::with_capacity(self.robots.len() * self.slopes_deg.len());
         for robot in &self.robots {
             for &slope_deg in &self.slopes_deg {
-                let panel = PhasePanel::compute(
-                    robot,
-                    slope_deg,
-                    &self.terrain,
-                    &self.k_n_axis,
-                    &self.k_s_axis,
-                    on_row,
-                )
-                .map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))?;
+                let slope = SignedSlope::from_degrees(slope_deg)
+                    .map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))?;
+                let panel =
+                    PhasePanel::compute(robot, slope, &self.terrain, &self.k_n_axis, &self.k_s_axis, on_row);
                 panels.push(panel);
             }
         }

@@ -8,7 +8,7 @@ use sandslope::limits::{MAX_RISK_MAP_CELLS, MAX_RISK_SLOPES};
 use sandslope::risk::{
     payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, RiskAnswer, UncertainTerrain,
 };
-use sandslope::{Axis, Slope};
+use sandslope::{Axis, SignedSlope};
 use sandslope_io::presets::DEFAULT_TERRAIN;
 
 use crate::error::{RequestError, Result};
@@ -170,8 +170,9 @@ impl RiskRequest {
         };
         if let Some(grid) = &self.map {
             let (k_n_axis, k_s_axis) = map_axes(grid, &terrain, slopes[0], limits.map_cells)?;
-            let map = risk_map(&robot, slopes[0], &terrain, (&k_n_axis, &k_s_axis), max_risk, &|| {})
-                .map_err(|e| library(&e))?;
+            let map =
+                risk_map(&robot, slope_of(slopes[0])?, &terrain, (&k_n_axis, &k_s_axis), max_risk, &|| {})
+                    .map_err(|e| library(&e))?;
             return Ok(RiskAnswer::Map(Box::new(map)));
         }
         Ok(match self.solve {
@@ -183,8 +184,8 @@ impl RiskRequest {
                 RiskAnswer::Envelope(Box::new(env))
             }
             Some(Solve::Mass) => {
-                slope_of(slopes[0])?;
-                let sol = safe_mass(&robot, slopes[0], &terrain, max_risk).map_err(|e| library(&e))?;
+                let sol =
+                    safe_mass(&robot, slope_of(slopes[0])?, &terrain, max_risk).map_err(|e| library(&e))?;
                 RiskAnswer::Mass(Box::new(sol))
             }
             Some(Solve::Slope) => {
@@ -202,9 +203,9 @@ impl RiskRequest {
     }
 }
 
-/// A slope of the field `slope` as the library's type.
-pub fn slope_of(deg: f64) -> Result<Slope> {
-    Slope::from_signed_degrees(deg).map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))
+/// A slope of the field `slope` as the library's type (signed: answers print it as given).
+pub fn slope_of(deg: f64) -> Result<SignedSlope> {
+    SignedSlope::from_degrees(deg).map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))
 }
 
 /// The map's axes (the grid's, else the defaults around the terrain's medians at
@@ -215,10 +216,10 @@ pub fn map_axes(
     slope_deg: f64,
     max_cells: u128,
 ) -> Result<(Axis, Axis)> {
-    slope_of(slope_deg)?;
+    let slope = slope_of(slope_deg)?;
     let given = |field: &str, range: Option<AxisRange>| range.map(|r| grammar::axis(field, r)).transpose();
     let (k_n_axis, k_s_axis) =
-        sandslope::risk::map_axes(terrain, slope_deg, given("k-n", grid.k_n)?, given("k-s", grid.k_s)?)
+        sandslope::risk::map_axes(terrain, slope, given("k-n", grid.k_n)?, given("k-s", grid.k_s)?)
             .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))?;
     let cells = k_n_axis.len() as u128 * k_s_axis.len() as u128;
     if cells > max_cells {

@@ -84,6 +84,6 @@ pub use risk::{
 pub use robot::{LevelStep, Robot, RobotSpec};
 pub use scenario::{Scenario, SlopeEvaluation};
 pub use simulate::{simulate, simulate_slopes, SimSettings, SimSummary, Simulation};
-pub use slope::Slope;
+pub use slope::{SignedSlope, Slope};
 pub use strength_grid::StrengthGrid;
 pub use terrain::{Ground, Terrain, TerrainPoint, TerrainSpec};

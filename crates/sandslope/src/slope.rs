@@ -68,6 +68,33 @@ impl Slope {
     }
 }
 
+/// A slope along the direction of travel as a user gives it, in `(-90, 90)` degrees
+/// (negative: descending), validated once. Answers print it back as given; the physics takes
+/// the [`Slope`] it is [`felt`](SignedSlope::felt) as (docs/model.md §8: descent evaluated as
+/// the climb of its size).
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
+pub struct SignedSlope {
+    degrees: f64,
+}
+
+impl SignedSlope {
+    /// A signed slope from degrees; fails unless `-90 < degrees < 90` (the error of
+    /// [`Slope::from_signed_degrees`], key `slope_deg`).
+    pub fn from_degrees(degrees: f64) -> Result<SignedSlope, ParamError> {
+        Slope::from_signed_degrees(degrees).map(|_| SignedSlope { degrees })
+    }
+
+    /// The slope in degrees, as given.
+    pub fn degrees(self) -> f64 {
+        self.degrees
+    }
+
+    /// The slope the robot climbs: `|degrees|` (docs/model.md §8).
+    pub fn felt(self) -> Slope {
+        Slope { degrees: self.degrees.abs() }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -81,5 +108,20 @@ mod tests {
         assert!(Slope::from_degrees(90.0).is_err());
         assert!(Slope::from_degrees(f64::NAN).is_err());
         assert_eq!(Slope::from_signed_degrees(-12.0).unwrap(), Slope::from_degrees(12.0).unwrap());
+    }
+
+    /// A signed slope keeps its sign and is felt as its size; the same range as
+    /// `from_signed_degrees`, ends excluded.
+    #[test]
+    fn signed_slopes_keep_their_sign_and_are_felt_as_their_size() {
+        let s = SignedSlope::from_degrees(-12.5).unwrap();
+        assert_eq!(s.degrees(), -12.5);
+        assert_eq!(s.felt(), Slope::from_degrees(12.5).unwrap());
+        assert_eq!(SignedSlope::from_degrees(30.0).unwrap().felt().degrees(), 30.0);
+        for bad in [90.0, -90.0, f64::NAN, f64::INFINITY] {
+            let e = SignedSlope::from_degrees(bad).unwrap_err();
+            assert_eq!(e.key, "slope_deg");
+            assert_eq!(e.expected, "strictly between -90 and 90 degrees");
+        }
     }
 }

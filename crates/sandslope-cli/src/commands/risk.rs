@@ -16,7 +16,7 @@ use sandslope::risk::{
     payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, DefaultsUsed, PayloadEnvelope, RiskAnswer,
     RiskCurve, RiskPoint, SafeLimit, SafeMass, SafeSlope, UncertainTerrain,
 };
-use sandslope::{Robot, Slope};
+use sandslope::{Robot, SignedSlope, Slope};
 
 use crate::args::{
     beyond_last_point, parse_max_risk, warn_extrapolated, RobotArgs, TerrainArgs, UncertaintyArgs,
@@ -146,7 +146,12 @@ struct MassRow {
 }
 
 fn slope_of(deg: f64) -> Result<Slope> {
-    Slope::from_signed_degrees(deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))
+    Ok(signed_slope_of(deg)?.felt())
+}
+
+/// `--slope`'s value, checked once, its sign kept for the answer.
+fn signed_slope_of(deg: f64) -> Result<SignedSlope> {
+    SignedSlope::from_degrees(deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))
 }
 
 /// One slope limit in words: `p` names the probability it bounds (`p_fail` or
@@ -235,7 +240,8 @@ pub fn run(args: RiskArgs) -> Result<()> {
         }
         Some(Solve::Mass) => {
             note_defaults(terrain.defaults_used_at(slope_of(slopes[0])?));
-            let sol = safe_mass(&robot, slopes[0], &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
+            let sol = safe_mass(&robot, signed_slope_of(slopes[0])?, &terrain, max_risk)
+                .map_err(|e| anyhow!("{e}"))?;
             if args.plot.is_some() {
                 let limits = safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
                 draw_curve(&args, &robot, &terrain, &slopes, &limits, json)?;
@@ -527,7 +533,10 @@ fn run_map(
     let defaults = terrain.defaults_used_at(slope);
     note_defaults(defaults);
     let bar = progress_bar(k_s_axis.len() as u64, quiet, "p_fail map");
-    let answer = risk_map(robot, slope_deg, terrain, (&k_n_axis, &k_s_axis), max_risk, &|| bar.inc(1))
+    let answer =
+        risk_map(robot, signed_slope_of(slope_deg)?, terrain, (&k_n_axis, &k_s_axis), max_risk, &|| {
+            bar.inc(1)
+        })
         .map_err(|e| anyhow!("{e}"))?;
     bar.finish_and_clear();
     let map = &answer.map;

@@ -6,10 +6,9 @@ use serde::Serialize;
 
 use super::{PhaseMap, RegimeCounts};
 use crate::axis::Axis;
-use crate::error::ParamError;
 use crate::regime::Regime;
 use crate::robot::Robot;
-use crate::slope::Slope;
+use crate::slope::SignedSlope;
 use crate::strength_grid::StrengthGrid;
 use crate::terrain::{Ground, Terrain};
 
@@ -36,24 +35,23 @@ pub struct PhasePanel {
 }
 
 impl PhasePanel {
-    /// The panel of `robot` at `slope_deg` (in (-90, 90); negative slopes are evaluated as
-    /// their magnitude) on `terrain`, over `k_n_axis x k_s_axis`. `row_done` as in
-    /// [`PhaseMap::compute`]. Errors name the key `slope_deg`.
+    /// The panel of `robot` at `signed` (a descent evaluated as the climb of its size) on
+    /// `terrain`, over `k_n_axis x k_s_axis`. `row_done` as in [`PhaseMap::compute`].
     pub fn compute(
         robot: &Robot,
-        slope_deg: f64,
+        signed: SignedSlope,
         terrain: &Terrain,
         k_n_axis: &Axis,
         k_s_axis: &Axis,
         row_done: &(dyn Fn() + Sync),
-    ) -> Result<PhasePanel, ParamError> {
-        let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+    ) -> PhasePanel {
+        let (slope_deg, slope) = (signed.degrees(), signed.felt());
         let map = PhaseMap::compute(
             &StrengthGrid::new(robot, slope, terrain.repose(), k_n_axis, k_s_axis),
             row_done,
         );
         let g: Ground = terrain.at(slope);
-        Ok(PhasePanel {
+        PhasePanel {
             slope_deg,
             mass_kg: robot.mass(),
             map,
@@ -62,7 +60,7 @@ impl PhasePanel {
             terrain_regime: crate::model::predict(robot, slope, &g).regime,
             sinkage_threshold_k_n: crate::model::sinkage_threshold_k_n(robot, slope),
             anchoring_threshold_k_s: crate::model::anchoring_threshold_k_s(robot, slope),
-        })
+        }
     }
 }
 

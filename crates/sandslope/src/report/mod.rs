@@ -31,7 +31,7 @@ use crate::risk::{
     risk_curve, safe_slope_limit, success_slope_limit, RiskCurve, SafeLimit, UncertainTerrain,
 };
 use crate::robot::Robot;
-use crate::slope::Slope;
+use crate::slope::{SignedSlope, Slope};
 use crate::terrain::{Terrain, TerrainPoint};
 
 pub use audit::{Extrapolation, NoFloorFit, SpeedInversion, StepBudget, PAPER_FRAME_RATE_HZ};
@@ -663,7 +663,14 @@ fn plots(
     let mut phase = Vec::new();
     for (_, mass, slope_deg) in PHASE_PANELS {
         let r = robot.with_mass(mass)?;
-        phase.push(PhasePanel::compute(&r, slope_deg, terrain, &k_n_axis, &k_s_axis, &|| {})?);
+        phase.push(PhasePanel::compute(
+            &r,
+            SignedSlope::from_degrees(slope_deg)?,
+            terrain,
+            &k_n_axis,
+            &k_s_axis,
+            &|| {},
+        ));
     }
     let uncertain = UncertainTerrain::new(terrain.clone(), None, None)?;
     let risk_slopes: Vec<f64> = (0..=60).map(|i| i as f64 * 0.5).collect();

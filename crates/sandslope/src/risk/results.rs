@@ -12,7 +12,7 @@ use super::map::RiskMap;
 use super::uncertainty::{DefaultsUsed, UncertainTerrain, UsedUncertainty};
 use crate::error::ParamError;
 use crate::robot::Robot;
-use crate::slope::Slope;
+use crate::slope::{SignedSlope, Slope};
 use crate::strength_grid::StrengthGrid;
 use crate::Axis;
 
@@ -128,15 +128,15 @@ pub struct SafeMass {
     pub uncertainty: UsedUncertainty,
 }
 
-/// The heaviest total mass of `robot` with `p_fail < max_risk` at `slope_deg` (degrees, in
-/// (-90, 90)) on `terrain` ([`max_safe_mass`]), with the uncertainty it used.
+/// The heaviest total mass of `robot` with `p_fail < max_risk` at `slope` on `terrain`
+/// ([`max_safe_mass`]), with the uncertainty it used.
 pub fn safe_mass(
     robot: &Robot,
-    slope_deg: f64,
+    signed: SignedSlope,
     terrain: &UncertainTerrain,
     max_risk: f64,
 ) -> Result<SafeMass, ParamError> {
-    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+    let (slope_deg, slope) = (signed.degrees(), signed.felt());
     let limit = max_safe_mass(robot, slope, terrain, max_risk)?;
     let own = robot.mass();
     Ok(SafeMass {
@@ -179,18 +179,18 @@ pub struct RiskMapSummary {
 }
 
 impl RiskMapSummary {
-    /// The summary of `map`, computed for `robot` at `slope_deg` on `terrain`.
+    /// The summary of `map`, computed for `robot` at `slope` on `terrain`.
     pub fn of(
         map: &RiskMap,
         robot: &Robot,
-        slope_deg: f64,
+        signed: SignedSlope,
         terrain: &UncertainTerrain,
         max_risk: f64,
-    ) -> Result<RiskMapSummary, ParamError> {
-        let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+    ) -> RiskMapSummary {
+        let (slope_deg, slope) = (signed.degrees(), signed.felt());
         let sample = terrain.sample(slope);
         let ground = sample.ground;
-        Ok(RiskMapSummary {
+        RiskMapSummary {
             slope_deg,
             uncertainty: sample.used(),
             max_risk,
@@ -202,7 +202,7 @@ impl RiskMapSummary {
             terrain_k_s: ground.k_s,
             terrain_p_fail: super::failure_probability::p_fail(robot, slope, &ground, sample.uncertainty),
             defaults_used: terrain.defaults_used_at(slope),
-        })
+        }
     }
 }
 
@@ -260,18 +260,17 @@ fn serialize_cells<S: Serializer>(map: &RiskMap, s: S) -> Result<S::Ok, S::Error
 /// Points per axis of a risk map's default grid.
 pub const MAP_POINTS: usize = 200;
 
-/// The axes of a risk map at `slope_deg` (degrees, in (-90, 90)) on `terrain`: `k_n_axis` and
+/// The axes of a risk map at `slope` on `terrain`: `k_n_axis` and
 /// `k_s_axis` where given, else the default grid around the terrain's medians at that slope,
 /// [`MAP_POINTS`] log-spaced values of k_n from its median / 100 to x 100 and of k_s from
 /// / 1000 to x 100 (what `risk --map` and Python's `risk_map` use without axes).
 pub fn map_axes(
     terrain: &UncertainTerrain,
-    slope_deg: f64,
+    slope: SignedSlope,
     k_n_axis: Option<Axis>,
     k_s_axis: Option<Axis>,
 ) -> Result<(Axis, Axis), ParamError> {
-    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
-    let ground = terrain.sample(slope).ground;
+    let ground = terrain.sample(slope.felt()).ground;
     let k_n_axis = match k_n_axis {
         Some(a) => a,
         None => Axis::log_around("k_n_axis", &[ground.k_n], 100.0, 100.0, MAP_POINTS)?,
@@ -283,24 +282,24 @@ pub fn map_axes(
     Ok((k_n_axis, k_s_axis))
 }
 
-/// The risk map of `robot` at `slope_deg` (degrees, in (-90, 90)) on `terrain` over
+/// The risk map of `robot` at `slope` on `terrain` over
 /// `k_n_axis x k_s_axis`, each cell with the terrain's uncertainty and angle of repose at that
 /// slope ([`RiskMap::compute`]; `row_done` is called once per finished k_s row), and its
 /// summary against `max_risk`.
 pub fn risk_map(
     robot: &Robot,
-    slope_deg: f64,
+    signed: SignedSlope,
     terrain: &UncertainTerrain,
     (k_n_axis, k_s_axis): (&Axis, &Axis),
     max_risk: f64,
     row_done: &(dyn Fn() + Sync),
 ) -> Result<RiskMapAnswer, ParamError> {
     super::limits::check_risk(max_risk)?;
-    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+    let slope = signed.felt();
     let sample = terrain.sample(slope);
     let grid = StrengthGrid::new(robot, slope, sample.ground.repose, k_n_axis, k_s_axis);
     let map = RiskMap::compute(&grid, sample.uncertainty, row_done);
-    let summary = RiskMapSummary::of(&map, robot, slope_deg, terrain, max_risk)?;
+    let summary = RiskMapSummary::of(&map, robot, signed, terrain, max_risk);
     Ok(RiskMapAnswer { summary, map })
 }
 
@@ -311,6 +310,10 @@ mod tests {
     use crate::terrain::Terrain;
     use crate::AxisScale;
 
+    fn deg(d: f64) -> SignedSlope {
+        SignedSlope::from_degrees(d).unwrap()
+    }
+
     /// The cells come out indexed `[k_n][k_s]` after the summary's keys: a 3 x 2 map read back
     /// from its JSON cell by cell against the map's own row-major store.
     #[test]
@@ -318,7 +321,7 @@ mod tests {
         let t = UncertainTerrain::new(Terrain::constant(7e5, 1.5e6).unwrap(), None, None).unwrap();
         let kn = Axis::new("k_n", 1e5, 1e7, 3, AxisScale::Log).unwrap();
         let ks = Axis::new("k_s", 1e5, 1e7, 2, AxisScale::Log).unwrap();
-        let a = risk_map(&paper_robot(), 20.0, &t, (&kn, &ks), 0.05, &|| {}).unwrap();
+        let a = risk_map(&paper_robot(), deg(20.0), &t, (&kn, &ks), 0.05, &|| {}).unwrap();
         // The summary's text, then the cells' keys in order.
         let text = serde_json::to_string(&a).unwrap();
         let summary = serde_json::to_string(&a.summary).unwrap();
@@ -341,20 +344,22 @@ mod tests {
         );
         assert_eq!(v["p_fail"].as_array().unwrap().len(), 3);
         assert_eq!(v["k_s"], serde_json::json!([1e5, 1e7]));
-        assert_eq!(risk_map(&paper_robot(), 20.0, &t, (&kn, &ks), 1.0, &|| {}).unwrap_err().key, "max_risk");
+        assert_eq!(
+            risk_map(&paper_robot(), deg(20.0), &t, (&kn, &ks), 1.0, &|| {}).unwrap_err().key,
+            "max_risk"
+        );
     }
 
     /// A given axis is kept; a missing one is 200 log-spaced values around the terrain's median
-    /// at the slope (k_n / 100 to x 100, k_s / 1000 to x 100); a bad slope names `slope_deg`.
+    /// at the slope (k_n / 100 to x 100, k_s / 1000 to x 100); a descent's is its climb's.
     #[test]
     fn map_axes_default_around_the_medians() {
         let t = UncertainTerrain::new(Terrain::constant(7e5, 1.5e6).unwrap(), None, None).unwrap();
         let kn = Axis::new("k_n", 1e5, 1e7, 3, AxisScale::Log).unwrap();
-        let (a, b) = map_axes(&t, 20.0, Some(kn), None).unwrap();
+        let (a, b) = map_axes(&t, deg(20.0), Some(kn), None).unwrap();
         assert_eq!(a, kn);
         assert_eq!((b.min(), b.max(), b.len(), b.scale()), (1.5e3, 1.5e8, 200, AxisScale::Log));
-        let (a, _) = map_axes(&t, -20.0, None, None).unwrap();
+        let (a, _) = map_axes(&t, deg(-20.0), None, None).unwrap();
         assert_eq!((a.min(), a.max()), (7e3, 7e7));
-        assert_eq!(map_axes(&t, 95.0, None, None).unwrap_err().key, "slope_deg");
     }
 }

@@ -21,13 +21,15 @@ use crate::arrays::{put, values};
 use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
 
-/// Reads a `drive --log` CSV: `(columns, meta)`, `columns` the log's columns as 1-D arrays
-/// (docs/drive.md, "The log"), `meta` its `# key = value` header lines.
+/// Reads a `drive --log` CSV: `(columns, meta, notes)`, `columns` the log's columns as 1-D
+/// arrays (docs/drive.md, "The log"), `meta` its `# key = value` header lines, `notes` what the
+/// reader repaired (the CLI's `note:` lines and `infer --servo-log --json`'s `notes`).
 #[pyfunction]
+#[allow(clippy::type_complexity)]
 pub fn read_servo_log<'py>(
     py: Python<'py>,
     path: std::path::PathBuf,
-) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>, Vec<String>)> {
     let log = py.detach(|| sandslope_io::servo_log::read_servo_log(&path)).map_err(anyhow_error)?;
     let d = PyDict::new(py);
     let r = &log.rows;
@@ -49,7 +51,7 @@ pub fn read_servo_log<'py>(
     for (k, v) in &log.meta {
         meta.set_item(k, v)?;
     }
-    Ok((d, meta))
+    Ok((d, meta, log.notes))
 }
 
 /// `infer --servo-log --json` on a log's columns: `leg` (0 to 2 * stance_legs - 1), the leg's
@@ -112,7 +114,7 @@ pub fn drive_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
 /// (as [`read_servo_log`]), `report` what `drive --json` prints, with the emulator's last word
 /// under `emulator`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg=None, duration_s=None, k_s=None, noise_ma=None, seed=None, weaken=None, stop_on_risk=None, hold_s=None, rate_hz=None, live=true))]
+#[pyo3(signature = (robot, terrain, slope_deg=None, duration_s=None, k_s=None, noise_ma=None, seed=None, weaken=None, stop_on_risk=None, hold_s=None, rate_hz=None, live=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn drive<'py>(
     py: Python<'py>,
@@ -127,7 +129,7 @@ pub fn drive<'py>(
     stop_on_risk: Option<f64>,
     hold_s: Option<f64>,
     rate_hz: Option<f64>,
-    live: bool,
+    live: Option<bool>,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     // `drive`'s defaults, from the one typed set its flags take theirs from.
     let d = RUN_DEFAULTS;
@@ -137,6 +139,7 @@ pub fn drive<'py>(
     let seed = seed.unwrap_or(d.emulate_seed);
     let hold_s = hold_s.unwrap_or(d.hold_s);
     let rate_hz = rate_hz.unwrap_or(d.rate_hz);
+    let live = live.unwrap_or(d.live);
     let within = |key: &str, v: f64, lo: f64, hi: f64| {
         if (lo..=hi).contains(&v) {
             Ok(())

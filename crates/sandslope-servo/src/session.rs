@@ -47,6 +47,10 @@ pub struct RunDefaults {
     pub emulate_noise_ma: f64,
     /// The emulator's noise seed (`--emulate-seed`).
     pub emulate_seed: u64,
+    /// Estimate k_s and the risk after every stance (`drive --live`; `--stop-on-risk` implies
+    /// it and `serve --drive` always does it). Off: the monitor's grid costs seconds of CPU
+    /// before the robot moves.
+    pub live: bool,
 }
 
 /// The run's defaults ([`RunDefaults`]).
@@ -62,6 +66,7 @@ pub const RUN_DEFAULTS: RunDefaults = RunDefaults {
     stand_s: 1.0,
     emulate_noise_ma: 10.0,
     emulate_seed: 1,
+    live: false,
 };
 
 /// Where the servos are.

@@ -58,7 +58,7 @@ pub struct DriveArgs {
     #[command(flatten)]
     pub run: DriveRunArgs,
     /// Print the live estimate of k_s and the risk after every stance (implied by --stop-on-risk).
-    #[arg(long)]
+    #[arg(long, default_value_t = RUN_DEFAULTS.live)]
     pub live: bool,
     /// Print the run's report as JSON.
     #[arg(long)]

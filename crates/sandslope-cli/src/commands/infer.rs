@@ -156,7 +156,13 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
     })?;
     let k_n = answer.k_n;
     if args.json {
-        return print_json(&answer);
+        // The reader's repairs beside the answer (they are the file's, not the sand's), as
+        // Python's `infer_servo_log` returns them.
+        let mut v = serde_json::to_value(&answer)?;
+        if let Some(o) = v.as_object_mut() {
+            o.insert("notes".into(), serde_json::json!(log.notes));
+        }
+        return print_json(&v);
     }
     println!(
         "k_s at {slope_deg} deg from the stance currents of {} strides: {} N/m^3, 90% interval {} - {}{}",

@@ -325,6 +325,16 @@ fn a_messy_log_through_the_cli_says_what_it_repaired() {
     }
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["swing_offset_n_m"].as_array().unwrap().len(), 6, "{v}");
+    // The same repairs in `--json`'s `notes`, one each (a gap may be noted beside them).
+    let notes: Vec<&str> = v["notes"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
+    for note in ["ends mid-row", "empty or NaN", "repeated row", "out of time order"] {
+        assert_eq!(notes.iter().filter(|n| n.contains(note)).count(), 1, "{note}: {notes:?}");
+        assert!(all.contains(&format!(
+            "note: {}: {}",
+            path.display(),
+            notes.iter().find(|n| n.contains(note)).unwrap()
+        )));
+    }
 }
 
 /// What cannot be repaired is refused: exit 2, the file, line and servo named, nothing on

@@ -240,7 +240,7 @@ def simulate_ensemble(
     duty_cycle: float = 0.5,
     disturbed_sand: float = 1.0,
 ) -> Dict[str, Any]: ...
-def read_servo_log(path: _Path) -> Tuple[Dict[str, np.ndarray], Dict[str, str]]: ...
+def read_servo_log(path: _Path) -> Tuple[Dict[str, np.ndarray], Dict[str, str], List[str]]: ...
 def infer_servo_log(
     robot: Robot,
     terrain: Terrain,
@@ -264,7 +264,7 @@ def drive(
     stop_on_risk: Optional[float] = None,
     hold_s: Optional[float] = None,
     rate_hz: Optional[float] = None,
-    live: bool = True,
+    live: Optional[bool] = None,
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 
 def read_touchdowns(path: _Path) -> List[float]: ...

@@ -29,7 +29,7 @@ def read_servo_log(path: Union[str, "os.PathLike[str]"]) -> Tuple[Any, Dict[str,
     """Reads a ``sandslope drive --log`` CSV: ``(log, meta)``, ``log`` a pandas DataFrame (a dict
     of NumPy columns without pandas) with the log's columns, ``meta`` its ``# key = value``
     header (``slope_deg``, ``k_n``, ``period_s``, ``ids``, ...). Errors name the file and line."""
-    columns, meta = _sandslope.read_servo_log(os.fspath(path))
+    columns, meta, _notes = _sandslope.read_servo_log(os.fspath(path))
     return _frame(columns), dict(meta)
 
 
@@ -45,7 +45,9 @@ def infer_servo_log(
     """The sand's k_s at the run's slope from the servos' stance currents, as ``sandslope infer
     --servo-log FILE --json`` (docs/model.md §19): the dict with ``k_s``, ``k_s_lo``, ``k_s_hi``
     (the 90% interval), ``bound``, ``shear_load_n``, ``closed_form_shear_load_n``,
-    ``p_slippage``, ``p_sinkage``, ``p_fail``, ``strides``, ``posterior``, ...
+    ``p_slippage``, ``p_sinkage``, ``p_fail``, ``strides``, ``posterior``, ..., and ``notes``:
+    what the log's reader repaired (a cut last row, empty values, repeats, rows out of order,
+    gaps), the CLI's ``note:`` lines; empty for columns passed in.
 
     ``log`` is a log's path or its columns (a DataFrame or a mapping of arrays with ``leg``,
     ``leg_angle_rad`` and ``drive_torque_n_m``, one entry per servo per cycle, as
@@ -54,8 +56,9 @@ def infer_servo_log(
     stride simulator walks ``grid_points`` values of k_s over ``k_s_prior`` (seconds of CPU, the
     GIL released); left out, they are the CLI's defaults (41 over 1e4 to 1e9 N/m^3, from the
     library's constants)."""
+    notes: list = []
     if isinstance(log, (str, os.PathLike)):
-        columns, meta = _sandslope.read_servo_log(os.fspath(log))
+        columns, meta, notes = _sandslope.read_servo_log(os.fspath(log))
         if slope_deg is None:
             if "slope_deg" not in meta:
                 raise ValueError(
@@ -69,7 +72,7 @@ def infer_servo_log(
     missing = [c for c in SERVO_COLUMNS if c not in columns]
     if missing:
         raise ValueError(f"log: the column(s) {', '.join(missing)} are missing (docs/drive.md, 'The log')")
-    return _sandslope.infer_servo_log(
+    answer = _sandslope.infer_servo_log(
         _robot(robot),
         _terrain(terrain),
         float(slope_deg),
@@ -79,13 +82,15 @@ def infer_servo_log(
         k_s_prior=None if k_s_prior is None else (float(k_s_prior[0]), float(k_s_prior[1])),
         grid_points=None if grid_points is None else int(grid_points),
     )
+    answer["notes"] = list(notes)
+    return answer
 
 
 def drive_defaults() -> Dict[str, Any]:
     """``drive``'s defaults (``sandslope drive``'s flag defaults, from one typed set in the Rust
     crate): ``slope_deg``, ``duration_s``, ``rate_hz``, ``hold_s``, ``current_limit_ma``,
     ``temperature_limit_c``, ``watchdog_s``, ``bus_watchdog_s``, ``stand_s``,
-    ``emulate_noise_ma``, ``emulate_seed``."""
+    ``emulate_noise_ma``, ``emulate_seed``, ``live``."""
     return dict(_sandslope.drive_defaults())
 
 
@@ -103,7 +108,7 @@ def drive(
     stop_on_risk: Optional[float] = None,
     hold_s: Optional[float] = None,
     rate_hz: Optional[float] = None,
-    live: bool = True,
+    live: Optional[bool] = None,
 ) -> Tuple[Any, Dict[str, Any]]:
     """A run of ``sandslope drive --emulate`` (docs/drive.md): the robot's alternating tripod
     sent to a bus of emulated XL330s on a pseudo-terminal, byte for byte Protocol 2.0 through
@@ -112,7 +117,7 @@ def drive(
     its seed, ``weaken=(seconds, k_s)`` weakens it mid-run), with ``drive``'s defaults for
     whatever is left out (``drive_defaults()``: the one typed set ``sandslope drive``'s flags
     take theirs from; position profile, the servos' IDs 1 to 6). ``live`` estimates k_s
-    after every stance; ``stop_on_risk`` halts the gait when P(fail) passes it.
+    after every stance (off by default, as ``drive --live``); ``stop_on_risk`` halts the gait when P(fail) passes it.
 
     Returns ``(log, report)``: ``log`` the servo log's columns (a pandas DataFrame, or a dict of
     NumPy arrays without pandas; ``infer_servo_log`` reads it), ``report`` what ``drive --json``
@@ -137,6 +142,6 @@ def drive(
         stop_on_risk=None if stop_on_risk is None else float(stop_on_risk),
         hold_s=None if hold_s is None else float(hold_s),
         rate_hz=None if rate_hz is None else float(rate_hz),
-        live=bool(live),
+        live=None if live is None else bool(live),
     )
     return _frame(columns), report

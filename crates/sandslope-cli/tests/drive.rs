@@ -380,20 +380,28 @@ fn torque_off_when_a_servo_is_lost() {
 
 #[test]
 fn torque_off_on_corrupt_packets() {
-    let (code, all, _log, _d) = drive_with(&["--emulate-fault", "corrupt:4:2.5"]);
+    let (code, all, log, _d) = drive_with(&["--emulate-fault", "corrupt:4:2.5"]);
     assert_eq!(code, Some(3), "{all}");
     assert!(all.contains("servo ID 4 (leg 3) sent corrupt packets"), "{all}");
     assert!(all.contains("check the bus wiring"), "{all}");
     // Torque Enable written: the servo obeys packets whose CRC it checks; only its replies fail.
     assert!(all.contains("emulator: torque off on every servo"), "{all}");
+    log_kept_whole(&log);
+}
+
+/// The log of a failed run is kept, flushed to its last row (issue 42: "log flushed").
+fn log_kept_whole(log: &Path) {
+    assert!(std::fs::read_to_string(log).unwrap().ends_with('\n'), "the log ends mid-row");
+    assert!(log_rows(log).len() >= 6 * 50, "the log lost its rows: {}", log_rows(log).len());
 }
 
 #[test]
 fn torque_off_when_the_watchdog_fires() {
-    let (code, all, _log, _d) = drive_with(&["--emulate-fault", "freeze:2.5:0.6", "--watchdog", "0.15"]);
+    let (code, all, log, _d) = drive_with(&["--emulate-fault", "freeze:2.5:0.6", "--watchdog", "0.15"]);
     assert_eq!(code, Some(3), "{all}");
     assert!(all.contains("watchdog fired"), "{all}");
     assert!(all.contains("emulator: torque off on every servo"), "{all}");
+    log_kept_whole(&log);
 }
 
 #[test]

@@ -250,6 +250,12 @@ fn simulate_endpoint_equals_simulate_json_and_feeds_the_animation() {
     // --slopes: a list, even of one slope.
     assert_same(&server, "simulate", &[("slopes", "0:20:3".into()), ("duration", "3".into())]);
     assert_same(&server, "simulate", &[("slopes", "10".into()), ("duration", "2".into())]);
+    // --ensemble: the spread, as the CLI prints it.
+    assert_same(
+        &server,
+        "simulate",
+        &[("slope", "10".into()), ("duration", "2".into()), ("ensemble", "2".into())],
+    );
     // The server's limits and the command's own checks, each naming its flag.
     for (path, field, says) in [
         ("/api/simulate?slope=10&duration=61", "duration", "60"),
@@ -257,6 +263,9 @@ fn simulate_endpoint_equals_simulate_json_and_feeds_the_animation() {
         ("/api/simulate?slope=10&rate=5000", "rate", "1000"),
         ("/api/simulate?slope=10&dt=1e-5&duration=30", "dt", "2e6"),
         ("/api/simulate?slopes=0:20:100&duration=30", "duration", "2e6"),
+        // 40 walks of 30.5 s at 0.5 ms: 2.44e6 steps.
+        ("/api/simulate?slope=10&duration=30&ensemble=40", "ensemble", "2e6"),
+        ("/api/simulate?slopes=0,10&ensemble=2", "ensemble", "--slope, not --slopes"),
         ("/api/simulate?slope=10&duration=0.1", "duration", "1.5"),
         ("/api/simulate?slope=95", "slope", "90"),
         ("/api/simulate?duration=5", "slope", "--slope"),

@@ -23,7 +23,7 @@ use crate::value_error;
 /// `leg{j}_depth_m`, `leg{j}_force_x_n`, `leg{j}_force_z_n`, `leg{j}_torque_n_m`) to a 1-D
 /// array; `summary` is `sandslope simulate --json`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, creep_m_s=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=1.0))]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, creep_m_s=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=sandslope::simulate::mechanisms::UNDISTURBED_SAND))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -105,7 +105,7 @@ fn checked(settings: SettingsRequest) -> PyResult<SimSettings> {
 /// between walks (`sandslope simulate --ensemble N --json`, docs/simulate.md "Pitch free"):
 /// the spread's dict, with every walk's summary under `summaries`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, walks, k_n=None, k_s=None, dt_s=None, creep_m_s=None, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=1.0))]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, walks, k_n=None, k_s=None, dt_s=None, creep_m_s=None, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=sandslope::simulate::mechanisms::UNDISTURBED_SAND))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_ensemble<'py>(
     py: Python<'py>,

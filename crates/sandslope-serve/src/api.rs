@@ -202,11 +202,15 @@ pub fn simulate_walks(params: &[(String, String)], served: &Served) -> Result<Wa
     }
     let steps = walks.integration_steps()?;
     if steps > MAX_SIM_STEPS {
-        let flag = if request.dt_s.is_some() { "dt" } else { "duration" };
+        let flag = match (request.dt_s, request.ensemble) {
+            (Some(_), _) => "dt",
+            (None, Some(_)) => "ensemble",
+            (None, None) => "duration",
+        };
         return Err(ApiError::bad(
             Some(flag.to_string()),
             format!(
-                "--duration, --dt and the slopes ask for {steps:.3e} integration steps: the server takes at \
+                "--duration, --dt, the slopes and --ensemble ask for {steps:.3e} integration steps: the server takes at \
                  most {MAX_SIM_STEPS:e} per request"
             ),
         ));

@@ -16,6 +16,8 @@ use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
 use crate::progress::{progress_bar, spinner};
+use sandslope::simulate::ensemble::perturbed_mass;
+use sandslope::simulate::mechanisms::{CONSTANT_SPEED_DUTY, UNDISTURBED_SAND};
 use sandslope::simulate::{BodyPitch, Mechanisms, RftScaling, SimSummary, Simulation};
 use sandslope_io::load_speeds;
 use sandslope_io::trajectory::plain_mocap_csv;
@@ -66,12 +68,12 @@ pub struct SimulateArgs {
     pub leg_friction: Option<f64>,
     /// Share of the stride period over which a leg turns the half turn from its touchdown,
     /// 0.1 to 0.9 (docs/model.md §20.2; default 0.5: one speed all round, the paper's gait).
-    #[arg(long, value_name = "D", default_value_t = sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, allow_negative_numbers = true)]
+    #[arg(long, value_name = "D", default_value_t = CONSTANT_SPEED_DUTY, allow_negative_numbers = true)]
     pub duty_cycle: f64,
     /// Resistance of sand a leg passed through in an earlier stance, as a share of the
     /// undisturbed sand's, greater than 0 and at most 1 (docs/model.md §20.3, the trench;
     /// default 1: as strong as before).
-    #[arg(long, value_name = "F", default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(long, value_name = "F", default_value_t = UNDISTURBED_SAND, allow_negative_numbers = true)]
     pub disturbed_sand: f64,
     /// Walk the one slope N times (2 to 1000), the robot's mass perturbed by 1e-9 relative
     /// between walks, and give the spread: mean speed, its SD and standard error, mean t1, the
@@ -364,7 +366,7 @@ fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
                 .enumerate()
                 .map(|(k, m)| EnsembleRow {
                     walk: k,
-                    mass_kg: mass * (1.0 + e.perturbation * k as f64),
+                    mass_kg: perturbed_mass(mass, k),
                     speed_m_s: m.speed_m_s,
                     t1_s: m.t1_s,
                     step_m: m.step_m,

@@ -713,10 +713,21 @@ def report(
     return json.loads(text)
 
 
-def _mechanisms(leg_friction, duty_cycle, disturbed_sand) -> Dict[str, float]:
-    """The docs/model.md §20 keywords that were given (the others take the Rust defaults)."""
-    given = (("leg_friction", leg_friction), ("duty_cycle", duty_cycle), ("disturbed_sand", disturbed_sand))
-    return {k: float(v) for k, v in given if v is not None}
+def _walk_keywords(
+    k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
+) -> Dict[str, Any]:
+    """The keywords :func:`simulate` and :func:`simulate_ensemble` share, converted for the
+    extension; the docs/model.md §20 switches only where given (the others take the Rust
+    defaults)."""
+    optional = {"k_n": k_n, "k_s": k_s, "dt_s": dt_s, "creep_m_s": creep_m_s}
+    switches = {"leg_friction": leg_friction, "duty_cycle": duty_cycle, "disturbed_sand": disturbed_sand}
+    return {
+        **{k: None if v is None else float(v) for k, v in optional.items()},
+        "body_pitch": str(body_pitch),
+        "rft_scaling": str(rft_scaling),
+        "servo_limit": bool(servo_limit),
+        **{k: float(v) for k, v in switches.items() if v is not None},
+    }
 
 
 def simulate_ensemble(
@@ -753,14 +764,9 @@ def simulate_ensemble(
         float(slope_deg),
         float(duration_s),
         int(walks),
-        k_n=None if k_n is None else float(k_n),
-        k_s=None if k_s is None else float(k_s),
-        dt_s=None if dt_s is None else float(dt_s),
-        creep_m_s=None if creep_m_s is None else float(creep_m_s),
-        body_pitch=str(body_pitch),
-        rft_scaling=str(rft_scaling),
-        servo_limit=bool(servo_limit),
-        **_mechanisms(leg_friction, duty_cycle, disturbed_sand),
+        **_walk_keywords(
+            k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
+        ),
     )
 
 
@@ -812,15 +818,10 @@ def simulate(
         _terrain(terrain),
         float(slope_deg),
         float(duration_s),
-        k_n=None if k_n is None else float(k_n),
-        k_s=None if k_s is None else float(k_s),
-        dt_s=None if dt_s is None else float(dt_s),
-        creep_m_s=None if creep_m_s is None else float(creep_m_s),
         sample_rate_hz=float(sample_rate_hz),
-        body_pitch=str(body_pitch),
-        rft_scaling=str(rft_scaling),
-        servo_limit=bool(servo_limit),
-        **_mechanisms(leg_friction, duty_cycle, disturbed_sand),
+        **_walk_keywords(
+            k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
+        ),
     )
     try:
         import pandas as pd

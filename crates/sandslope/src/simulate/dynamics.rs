@@ -524,13 +524,13 @@ impl Walker {
         for c in contacts {
             let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
             let u = Walker::element_velocity(c, v, rate);
+            let rft = if c.leg == BELLY { belly_rft } else { leg_rft };
             let (f, d) = if associated {
-                let rft = if c.leg == BELLY { belly_rft } else { leg_rft };
                 let (f, p, hess) = associated_force(rft, c, u, eps);
                 potential += p;
                 (f, [[-hess[0][0], -hess[0][1]], [-hess[1][0], -hess[1][1]]])
             } else {
-                element_force(if c.leg == BELLY { belly_rft } else { leg_rft }, c, u, eps, want)
+                element_force(rft, c, u, eps, want)
             };
             forces.push(f);
             let (rx, rz) = (c.rel[0], c.rel[1]);

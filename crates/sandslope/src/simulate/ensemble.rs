@@ -10,6 +10,7 @@ use serde::Serialize;
 
 use super::{simulate, SimSettings, SimSummary, SimulateError};
 use crate::error::ParamError;
+use crate::gait::Stats;
 use crate::regime::Regime;
 use crate::scenario::Scenario;
 
@@ -17,6 +18,11 @@ use crate::scenario::Scenario;
 pub const ENSEMBLE_PERTURBATION: f64 = 1e-9;
 /// Smallest and largest ensemble.
 pub const ENSEMBLE_RANGE: (usize, usize) = (2, 1000);
+
+/// The mass of an ensemble's walk `k` for a robot of mass `mass`, kg: `mass (1 + k 1e-9)`.
+pub fn perturbed_mass(mass: f64, k: usize) -> f64 {
+    mass * (1.0 + ENSEMBLE_PERTURBATION * k as f64)
+}
 
 /// The walks of an ensemble and their statistics (what `simulate --ensemble N --json` prints).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -64,14 +70,14 @@ pub fn simulate_ensemble(
     let summaries: Vec<SimSummary> = (0..n)
         .into_par_iter()
         .map(|k| {
-            let robot = scenario.robot().with_mass(mass * (1.0 + ENSEMBLE_PERTURBATION * k as f64))?;
+            let robot = scenario.robot().with_mass(perturbed_mass(mass, k))?;
             Ok(simulate(&scenario.with_robot(robot), slope_deg, settings)?.summary)
         })
         .collect::<Result<_, SimulateError>>()?;
-    let speeds: Vec<f64> = summaries.iter().map(|s| s.speed_m_s).collect();
-    let mean = speeds.iter().sum::<f64>() / n as f64;
-    let sd = (speeds.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
-    let t1: Vec<f64> = summaries.iter().filter_map(|s| s.t1_s).collect();
+    // n >= 2 walks, so the mean and its SD exist.
+    let (mean, sd) = Stats::of(summaries.iter().map(|s| s.speed_m_s))
+        .map_or((0.0, 0.0), |s| (s.mean, s.sd.unwrap_or(0.0)));
+    let t1 = Stats::of(summaries.iter().filter_map(|s| s.t1_s));
     let mut regimes: std::collections::BTreeMap<Regime, usize> =
         [Regime::Success, Regime::Metastable, Regime::Slippage, Regime::Sinkage]
             .into_iter()
@@ -89,7 +95,7 @@ pub fn simulate_ensemble(
         speed_m_s: mean,
         speed_sd_m_s: sd,
         speed_se_m_s: sd / (n as f64).sqrt(),
-        t1_s: (!t1.is_empty()).then(|| t1.iter().sum::<f64>() / t1.len() as f64),
+        t1_s: t1.map(|t| t.mean),
         pitched_over: summaries.iter().filter(|s| s.pitch_over_s.is_some()).count(),
         regimes,
         regime,

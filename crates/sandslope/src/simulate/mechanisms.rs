@@ -24,6 +24,8 @@ pub const LEG_FRICTION_RANGE: (f64, f64) = (0.0, 10.0);
 pub const DUTY_CYCLE_RANGE: (f64, f64) = (0.1, 0.9);
 /// The paper's gait: both half turns at one speed.
 pub const CONSTANT_SPEED_DUTY: f64 = 0.5;
+/// Disturbed sand as strong as undisturbed: the trench switched off.
+pub const UNDISTURBED_SAND: f64 = 1.0;
 /// Width of the trench map's cells along the slope, m.
 pub const TRENCH_CELL_M: f64 = 1e-3;
 /// Most cells the trench map holds (80 MB of depths: 10 km of travel at 1 mm); sand beyond
@@ -47,7 +49,7 @@ pub struct Mechanisms {
 
 impl Default for Mechanisms {
     fn default() -> Mechanisms {
-        Mechanisms { leg_friction: None, duty_cycle: CONSTANT_SPEED_DUTY, disturbed_sand: 1.0 }
+        Mechanisms { leg_friction: None, duty_cycle: CONSTANT_SPEED_DUTY, disturbed_sand: UNDISTURBED_SAND }
     }
 }
 

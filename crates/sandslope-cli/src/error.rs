@@ -153,6 +153,20 @@ pub fn exit_cleanly_on_stream_errors() {
     }));
 }
 
+/// A write past the process's file-size limit (`ulimit -f`, a quota some clusters and robot
+/// images set) fails with "File too large" like a full disk, instead of SIGXFSZ ending the
+/// process where it stands: that left a `.partial` file behind and, in `drive`, the servos'
+/// torque on with only their Bus Watchdog to stop them. With the signal ignored, the failed
+/// write takes the run's ordinary error path (exit 3, outputs removed; `drive` turns the
+/// torque off and keeps what of its log could be written).
+pub fn fail_writes_past_the_file_size_limit() {
+    // A handler (a flag nobody reads) rather than SIG_IGN: the write fails with EFBIG all
+    // the same, and a program this one starts gets the default back. Failing to install it
+    // only loses this.
+    let seen = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, seen);
+}
+
 /// On SIGINT, SIGTERM or SIGHUP: remove this run's temporary files and exit with 128 plus the
 /// signal's number (130, 143, 129), as shells report a process the signal ended, so a killed
 /// run leaves nothing. The outputs of a run whose final renames have begun are all put in

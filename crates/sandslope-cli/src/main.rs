@@ -85,6 +85,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
 fn main() {
     error::exit_cleanly_on_stream_errors();
     error::clean_up_on_signals();
+    error::fail_writes_past_the_file_size_limit();
     let cli = Cli::parse();
     // Every output of a run is put in place together at the end, so a failure leaves none;
     // the server writes nothing of its own and serves for as long as it runs.

@@ -395,6 +395,42 @@ fn log_kept_whole(log: &Path) {
     assert!(log_rows(log).len() >= 6 * 50, "the log lost its rows: {}", log_rows(log).len());
 }
 
+/// The log fails mid-run (the file-size limit stands in for a full disk): exit 3 naming the
+/// log and the fix, torque off on every servo, and the rows written before the failure kept
+/// (the last one cut where the write stopped, which the log's reader leaves out).
+#[test]
+fn torque_off_when_the_log_cannot_be_written() {
+    let _one = real_time();
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("log.csv");
+    // About 110 bytes a row, six rows a cycle at 50 Hz: 48 KiB fill in about 1.5 s of a 3 s run.
+    let limit = 48 * 1024;
+    let mut cmd = bin();
+    cmd.args(["drive", "--emulate", "--duration", "3", "--watchdog", "2", "--log"]).arg(&log);
+    let out = common::with_file_size_limit(&mut cmd, limit).output().unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(3), "{all}");
+    assert!(all.contains("the servo log could not be written at t = "), "{all}");
+    assert!(all.contains(&format!("{}: File too large", log.display())), "{all}");
+    assert!(all.contains("ulimit -f"), "{all}");
+    assert!(all.contains("emulator: torque off on every servo"), "{all}");
+    assert!(all.contains("torque off confirmed on servos 1, 2, 3, 4, 5, 6"), "{all}");
+    // Kept: everything up to the limit, its last row cut short; the complete rows read back.
+    let bytes = std::fs::read(&log).unwrap();
+    assert_eq!(bytes.len() as u64, limit, "the log holds what could be written");
+    let whole = &bytes[..=bytes.iter().rposition(|&b| b == b'\n').unwrap()];
+    let kept = dir.path().join("kept.csv");
+    std::fs::write(&kept, whole).unwrap();
+    let rows = log_rows(&kept);
+    assert!(rows.len() >= 6 * 20, "{} rows", rows.len());
+    let failed_at: f64 =
+        all.split("could not be written at t = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!(rows.iter().all(|r| r.0 <= failed_at), "rows after the failure at {failed_at} s");
+    // The crate's reader says what it left out.
+    let read = bin().args(["infer", "--servo-log"]).arg(&log).output().unwrap();
+    assert!(text(&read).contains("the log ends mid-row"), "{}", text(&read));
+}
+
 #[test]
 fn torque_off_when_the_watchdog_fires() {
     let (code, all, log, _d) = drive_with(&["--emulate-fault", "freeze:2.5:0.6", "--watchdog", "0.15"]);

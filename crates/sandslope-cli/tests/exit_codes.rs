@@ -1,6 +1,8 @@
 //! Exit codes (README, "Exit codes"): 2 for bad input, 3 when an output cannot be written, and
 //! a quiet 0 when the reader of stdout goes away.
 
+mod common;
+
 use std::io::Read;
 use std::process::{Command, Stdio};
 
@@ -35,6 +37,26 @@ fn an_output_that_cannot_be_written_exits_3() {
         .unwrap();
     assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot write /proc/sandslope-test.toml"));
+}
+
+/// An output that outgrows the file-size limit (`ulimit -f`, as on clusters and robot images
+/// that set one) is a failed write like a full disk: exit 3 naming the file, nothing left
+/// behind. Without the handler SIGXFSZ ended the process (exit 153) and left a `.partial`.
+#[test]
+fn an_output_past_the_file_size_limit_exits_3_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let walk = dir.path().join("walk.csv");
+    // A 2 s walk's CSV is about 13 KB; the limit stops it at 4 KiB.
+    let out = common::with_file_size_limit(&mut sandslope(), 4 * 1024)
+        .args(["simulate", "--slope", "10", "--duration", "2", "--out"])
+        .arg(&walk)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(err.contains("walk.csv") && err.contains("File too large"), "{err}");
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
 }
 
 /// Runs `args` with stdout a pipe that the reader closes after the first bytes.

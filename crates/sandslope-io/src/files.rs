@@ -107,6 +107,16 @@ impl OutputFile {
     }
 }
 
+impl OutputFile {
+    /// Forgets the first write error met so far and returns it, so that what was written before
+    /// it is put in place rather than discarded. For a record whose every row up to a failure
+    /// is worth keeping (`drive`'s servo log when the disk fills mid-run: the rows are what the
+    /// robot did), never for a file that must be whole to be read.
+    pub fn take_failure(&mut self) -> Option<std::io::Error> {
+        self.failed.take()
+    }
+}
+
 impl std::io::Write for OutputFile {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
         let r = match &mut self.sink {

@@ -236,7 +236,7 @@ pub enum DriveError {
         reason: String,
     },
     /// The log could not be written.
-    #[error("the servo log could not be written at t = {time_s:.3} s: {reason}; the torque was turned off")]
+    #[error("the servo log could not be written at t = {time_s:.3} s: {reason}; the torque was turned off and the rows written before it are kept. Fix: free space on that disk (or raise the file-size limit, `ulimit -f`), or log to another one")]
     Log {
         /// Gait time, s.
         time_s: f64,

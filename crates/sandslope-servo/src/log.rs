@@ -70,9 +70,10 @@ pub struct LogTarget<'a> {
 /// Drives `session` once ([`Session::drive`]), every sample handed to `on_sample` and, with a
 /// `log`, written to it. The log is finished (flushed, synced) whatever ended the run, and
 /// put in place as every output is (staged until the binary commits its outputs, if it
-/// staged them). A log that fails once the run has begun (a full disk) is the run's failure,
-/// [`DriveError::Log`], beside its report; the error is a log that could not be started
-/// (nothing moved).
+/// staged them). A log that fails once the run has begun (a full disk, the file-size limit) is
+/// the run's failure, [`DriveError::Log`], beside its report, and what was written before the
+/// failure is kept (the last row may be cut short; the log's reader leaves it out and says
+/// so); the error is a log that could not be started (nothing moved).
 pub fn drive_logged(
     session: &mut Session,
     log: Option<LogTarget<'_>>,
@@ -92,29 +93,38 @@ pub fn drive_logged(
     };
     let meta = log_meta(session, target.robot, target.terrain);
     let mut outcome = None;
+    let mut lost = None;
     let written = sandslope_io::files::write_output(target.path, |file| {
-        let mut log = ServoLogWriter::new(std::io::BufWriter::new(file), &meta)?;
+        let mut log = ServoLogWriter::new(std::io::BufWriter::new(&mut *file), &meta)?;
         let mut write = |s: &ServoSample| {
             on_sample(s);
             log.write(&log_row(s))
+                .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", target.path.display())))
         };
         outcome = Some(session.drive(stop, &mut write, on_live));
-        // The log is the record of what happened: flushed and kept on every exit.
-        log.finish().map_err(|e| sandslope_io::WriteError { path: target.path.to_path_buf(), source: e })?;
+        // The log is the record of what happened: flushed and kept on every exit, also past a
+        // write that failed (a full disk, `ulimit -f`): the rows before it are what the robot
+        // did, and the reader drops a last row cut short (sandslope_io::servo_log).
+        let finished = log.finish();
+        let first = file.take_failure();
+        lost = first.or(finished.err());
         Ok(())
     });
-    match (written, outcome) {
-        (Ok(()), Some(r)) => Ok(r),
-        (Err(e), Some((report, failure))) => {
-            let time_s = match &report.outcome {
-                Ok(DriveOutcome::Completed { time_s })
-                | Ok(DriveOutcome::Interrupted { time_s })
-                | Ok(DriveOutcome::Halted { time_s, .. }) => *time_s,
-                Err(_) => 0.0,
-            };
-            Ok((report, failure.or(Some(DriveError::Log { time_s, reason: format!("{e:#}") }))))
-        }
-        (Err(e), None) => Err(e),
-        (Ok(()), None) => unreachable!("the writer drives before it returns Ok"),
-    }
+    let Some((report, failure)) = outcome else {
+        // The log could not be started: nothing moved.
+        return Err(written.err().unwrap_or_else(|| anyhow::anyhow!("the run did not start")));
+    };
+    let time_s = match &report.outcome {
+        Ok(DriveOutcome::Completed { time_s })
+        | Ok(DriveOutcome::Interrupted { time_s })
+        | Ok(DriveOutcome::Halted { time_s, .. }) => *time_s,
+        Err(_) => 0.0,
+    };
+    let log_failure = match (written, lost) {
+        (Err(e), _) => Some(format!("{e:#}")),
+        (Ok(()), Some(e)) => Some(format!("{}: {e}", target.path.display())),
+        (Ok(()), None) => None,
+    };
+    let log_failure = log_failure.map(|reason| DriveError::Log { time_s, reason });
+    Ok((report, failure.or(log_failure)))
 }

@@ -1,7 +1,7 @@
 //! `sandslope serve --drive`: the server drives the emulated XL330s through the same pty and
 //! `dynamixel2` bus code as a real port (issue 42), `/api/drive/status` follows the run with
 //! `drive --json`'s per-stance record, the page's Drive tab shows it, and the torque is off on
-//! every way out: the run's end, the page's stop button, Ctrl-C and SIGTERM, a lost servo, and
+//! every way out: the run's end, the page's stop button, Ctrl-C, SIGTERM and SIGHUP, a lost servo, and
 //! a server that cannot start.
 
 mod common;
@@ -301,7 +301,7 @@ fn check_log(dir: &std::path::Path, log: &std::path::Path, until: f64) {
 
 /// A signal mid-run: the gait stops, the torque is turned off and read back, the log is put in
 /// place whole, and the server exits with 128 + the signal (130 for SIGINT, 143 for SIGTERM,
-/// as every interrupted run of the tool; docs/drive.md says why).
+/// 129 for SIGHUP, as every interrupted run of the tool; docs/drive.md says why).
 fn signal_mid_run(signal: &str, expect: i32) {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().unwrap();
@@ -325,6 +325,12 @@ fn ctrl_c_turns_the_torque_off_before_the_server_exits() {
 #[test]
 fn sigterm_turns_the_torque_off_before_the_server_exits() {
     signal_mid_run("-TERM", 143);
+}
+
+/// The terminal that started the server closes (an ssh session to the robot drops).
+#[test]
+fn sighup_turns_the_torque_off_before_the_server_exits() {
+    signal_mid_run("-HUP", 129);
 }
 
 /// A servo that stops answering mid-run: the run fails naming it, the torque goes off on the

@@ -135,7 +135,7 @@ pub struct DriveThread {
 /// Flags shared with the process's signal handler: the handler sets `stop` (and `signal`)
 /// instead of ending the process while `driving` is set, and the drive thread ends the process
 /// once the torque is off and the log is in place, with 128 + the signal (130 for SIGINT, 143
-/// for SIGTERM), as the CLI's every interrupted run exits.
+/// for SIGTERM, 129 for SIGHUP), as the CLI's every interrupted run exits.
 #[derive(Debug, Clone, Copy)]
 pub struct SignalFlags {
     /// Set by a signal while driving.

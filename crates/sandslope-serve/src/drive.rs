@@ -257,6 +257,7 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
                 rate_hz: 0.0,
                 live: vec![],
                 torque_off: TorqueOff::default(),
+                gait_zero: None,
             },
             Some(format!("the log could not be written: {e:#}")),
         ),

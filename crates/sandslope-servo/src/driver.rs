@@ -277,6 +277,11 @@ pub struct DriveReport {
     pub live: Vec<LiveEstimate>,
     /// The torque on the way out.
     pub torque_off: TorqueOff,
+    /// The instant of gait time 0 (the legs stood up, `stand_s` after the walk's first
+    /// cycle), to put another clock on the log's (the emulator's weakening); `None` when the
+    /// run ended before it began.
+    #[serde(skip)]
+    pub gait_zero: Option<Instant>,
 }
 
 /// The live monitor: the robot, the simulator's grid at the slope, and one sample's torque
@@ -316,6 +321,7 @@ pub fn drive(
         rate_hz: 0.0,
         live: vec![],
         torque_off: TorqueOff::default(),
+        gait_zero: None,
     };
     let result = setup(bus, schedule, settings)
         .and_then(|()| run(bus, schedule, settings, monitor, stop, on_sample, on_live, &mut report));
@@ -497,6 +503,7 @@ fn run(
     };
     let period = Duration::from_secs_f64(1.0 / settings.rate_hz);
     let begin = Instant::now();
+    report.gait_zero = begin.checked_add(Duration::from_secs_f64(settings.stand_s));
     let mut last_cycle = Instant::now();
     loop {
         let time = begin.elapsed().as_secs_f64() - settings.stand_s;

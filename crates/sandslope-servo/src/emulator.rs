@@ -110,6 +110,9 @@ pub struct EmulatorReport {
     pub bad_crc: usize,
     /// Each servo's Bus Watchdog at the end (100: it fired).
     pub watchdog: Vec<(u8, u8)>,
+    /// `(t, k_s)`: the sand weakened to `k_s` N/m^3 at gait time `t` s (the log's `time_s`),
+    /// when `--emulate-weaken` set a weakening that the run reached and the gait started.
+    pub weakened: Option<(f64, f64)>,
 }
 
 /// A walk of the stride simulator, as the legs' drive torque against their angle.
@@ -575,6 +578,7 @@ impl VirtualBus {
             packets: self.parser_packets,
             bad_crc: self.bad_crc,
             watchdog: self.servos.iter().map(|s| (s.config.id, s.u8_at(t::BUS_WATCHDOG))).collect(),
+            weakened: None,
         }
     }
 
@@ -601,6 +605,10 @@ pub const EMULATED_BAUD: u32 = 9600;
 pub struct Emulator {
     stop: Arc<AtomicBool>,
     handle: Option<JoinHandle<EmulatorReport>>,
+    /// The emulator's time 0, which its fault and weakening times count from.
+    started: Instant,
+    /// When the sand weakens, s after `started`, and to what k_s, N/m^3.
+    weaken: Option<(f64, f64)>,
 }
 
 impl Emulator {
@@ -621,10 +629,11 @@ impl Emulator {
         master.set_read_timeout(Duration::from_millis(2)).map_err(EmulatorError::Pty)?;
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
+        let started = Instant::now();
         let handle = std::thread::Builder::new()
             .name("xl330-emulator".into())
             .spawn(move || {
-                let start = Instant::now();
+                let start = started;
                 let mut parser = Parser::default();
                 let mut buf = [0u8; 1024];
                 while !flag.load(Ordering::Relaxed) {
@@ -649,13 +658,23 @@ impl Emulator {
                 bus.report()
             })
             .map_err(EmulatorError::Pty)?;
-        Ok((Emulator { stop, handle: Some(handle) }, slave))
+        Ok((Emulator { stop, handle: Some(handle), started, weaken: config.faults.weaken }, slave))
     }
 
-    /// Stops the emulator and returns what its servos' tables hold.
-    pub fn stop(mut self) -> EmulatorReport {
+    /// Stops the emulator and returns what its servos' tables hold. `gait_zero`, the instant
+    /// of the driver's gait time 0, puts the weakening on the log's clock
+    /// ([`EmulatorReport::weakened`]).
+    pub fn stop(mut self, gait_zero: Option<Instant>) -> EmulatorReport {
         self.stop.store(true, Ordering::Relaxed);
-        self.handle.take().and_then(|h| h.join().ok()).unwrap_or_default()
+        let mut report = self.handle.take().and_then(|h| h.join().ok()).unwrap_or_default();
+        report.weakened = match (self.weaken, gait_zero) {
+            (Some((at, k_s)), Some(zero)) if self.started.elapsed().as_secs_f64() >= at => {
+                let offset = zero.saturating_duration_since(self.started).as_secs_f64();
+                Some((at - offset, k_s))
+            }
+            _ => None,
+        };
+        report
     }
 }
 

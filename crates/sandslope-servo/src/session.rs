@@ -150,6 +150,8 @@ pub struct Session {
     grid: Option<ModelGrid>,
     bus: DynamixelBus,
     emulator: Option<Emulator>,
+    /// The last drive's gait time 0 ([`DriveReport::gait_zero`]).
+    gait_zero: Option<std::time::Instant>,
 }
 
 impl std::fmt::Debug for Session {
@@ -216,7 +218,7 @@ impl Session {
             }
         };
         let bus = dynamixel2::Bus::new(port).map_err(|e| SessionError::Bus(format!("{e:?}")))?;
-        Ok(Session { config, schedule, k_n, grid, bus, emulator })
+        Ok(Session { config, schedule, k_n, grid, bus, emulator, gait_zero: None })
     }
 
     /// The configuration the session was opened with.
@@ -247,13 +249,17 @@ impl Session {
             grid: g,
             noise_sd_n_m: xl330::torque_from_current(noise_ma),
         });
-        drive(&mut self.bus, &self.schedule, &self.config.settings, monitor, stop, on_sample, on_live)
+        let (report, failure) =
+            drive(&mut self.bus, &self.schedule, &self.config.settings, monitor, stop, on_sample, on_live);
+        self.gait_zero = report.gait_zero;
+        (report, failure)
     }
 
     /// Closes the bus; with the emulator, stops it and returns what its servos' tables hold.
     pub fn close(self) -> Option<EmulatorReport> {
         drop(self.bus);
-        self.emulator.map(Emulator::stop)
+        let zero = self.gait_zero;
+        self.emulator.map(|e| e.stop(zero))
     }
 }
 
@@ -281,8 +287,12 @@ pub fn emulator_summary(r: &EmulatorReport) -> String {
         .filter(|(_, w)| *w == crate::table::WATCHDOG_FIRED)
         .map(|(id, _)| id.to_string())
         .collect();
+    let weakened = match r.weakened {
+        Some((t, k_s)) => format!("; the sand weakened to k_s {k_s:.3e} N/m^3 at t = {t:.2} s"),
+        None => String::new(),
+    };
     format!(
-        "emulator: torque {}{} ({} packets, {} with a bad CRC)",
+        "emulator: torque {}{} ({} packets, {} with a bad CRC){weakened}",
         if on.is_empty() {
             "off on every servo".to_string()
         } else {

@@ -153,7 +153,7 @@ fn the_dynamixel2_client_talks_to_the_emulator_over_a_pty() {
     bus.write_u32(1, t::GOAL_VELOCITY, u32::from_le_bytes([0xFF, 0xFF, 0xFD, 0x00])).unwrap();
     assert_eq!(bus.read(1, t::GOAL_VELOCITY, 4).unwrap().data, vec![0xFF, 0xFF, 0xFD, 0x00]);
     drop(bus);
-    let report = emulator.stop();
+    let report = emulator.stop(None);
     assert_eq!(report.bad_crc, 0);
     assert!(report.packets >= 10);
 }

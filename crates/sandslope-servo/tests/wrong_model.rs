@@ -44,6 +44,6 @@ fn a_servo_of_another_model_is_refused_before_anything_moves() {
     assert!(message.contains("Fix:"), "{message}");
     assert_eq!(report.cycles, 0, "nothing moved");
     drop(bus);
-    let tables = emulator.stop();
+    let tables = emulator.stop(None);
     assert!(tables.torque_enabled.iter().all(|(_, on)| !on), "{:?}", tables.torque_enabled);
 }

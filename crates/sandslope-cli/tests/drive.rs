@@ -440,6 +440,27 @@ fn torque_off_when_the_log_cannot_be_written() {
     assert!(text(&read).contains("the log ends mid-row"), "{}", text(&read));
 }
 
+/// A servo shuts itself down (its Temperature Limit, written below the emulated servo's 28 degC,
+/// trips its overheating error at once): the run stops naming it, its fault and the fix,
+/// rather than walking on with a leg gone limp, and the log records the Hardware Error Status.
+#[test]
+fn torque_off_when_a_servo_reports_a_hardware_error() {
+    let (code, all, log, _d) = drive_with(&["--temperature-limit", "20"]);
+    assert_eq!(code, Some(3), "{all}");
+    assert!(all.contains("servo ID 1 (leg 0) reported overheating"), "{all}");
+    assert!(all.contains("(Hardware Error Status 0x04)"), "{all}");
+    assert!(all.contains("let it cool"), "{all}");
+    assert!(all.contains("emulator: torque off on every servo"), "{all}");
+    assert!(all.contains("torque off confirmed on servos 1, 2, 3, 4, 5, 6"), "{all}");
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(text.ends_with('\n'), "the log ends mid-row");
+    let mut r = csv::ReaderBuilder::new().comment(Some(b'#')).from_reader(text.as_bytes());
+    let h = r.headers().unwrap().clone();
+    let (id, hw) =
+        (h.iter().position(|x| x == "id").unwrap(), h.iter().position(|x| x == "hardware_error").unwrap());
+    assert!(r.records().map(|x| x.unwrap()).any(|x| &x[id] == "1" && &x[hw] == "4"), "{text}");
+}
+
 #[test]
 fn torque_off_when_the_watchdog_fires() {
     let (code, all, log, _d) = drive_with(&["--emulate-fault", "freeze:2.5:0.6", "--watchdog", "0.15"]);

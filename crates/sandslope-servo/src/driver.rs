@@ -9,7 +9,8 @@
 //!   Bus Watchdog are written while the torque is off;
 //! - torque off on every exit: the end of the run, Ctrl-C (the caller's stop flag), a servo
 //!   that stops answering or whose packets keep failing their CRC (three cycles in a row), a
-//!   cycle slower than the driver's watchdog, and an error writing the log;
+//!   cycle slower than the driver's watchdog, a servo that raises its alert (a hardware error:
+//!   it shut itself down), and an error writing the log;
 //! - the servos' Bus Watchdog stops them by themselves if the driver dies without a word;
 //! - `stop_on_risk`: the gait halts when the live risk that the walk fails (slippage or sinkage) passes the threshold; the
 //!   torque stays on and the legs hold where they are (the stance tripod planted) for
@@ -25,6 +26,7 @@ use sandslope::servo::{xl330, GaitSchedule};
 use sandslope::Robot;
 use serde::Serialize;
 
+pub use crate::error::{hardware_faults, DriveError};
 use crate::stance::StanceBins;
 use crate::table::{self as t, mode, read_states, PresentState};
 
@@ -147,112 +149,6 @@ pub enum DriveOutcome {
         /// The risk that passed the threshold (the probability that the walk fails).
         p_fail: f64,
     },
-}
-
-/// Why a run failed. [`DriveError::exit_code`] is 2 for what was wrong before anything moved
-/// (the setup: port, IDs, models) and 3 for a bus that failed during the run.
-#[derive(Debug, thiserror::Error)]
-pub enum DriveError {
-    /// A servo did not answer a ping.
-    #[error("servo ID {id} (leg {leg}) did not answer a ping at {baud} baud; IDs that answered: {answered}. Fix: check its cable and power, or set its ID in the robot file's [servos] ids (Dynamixel Wizard shows the IDs on the bus)")]
-    Missing {
-        /// ID.
-        id: u8,
-        /// Leg.
-        leg: usize,
-        /// Baud rate.
-        baud: u32,
-        /// IDs that did answer, listed.
-        answered: String,
-    },
-    /// A servo answered with another model's number.
-    #[error("servo ID {id} (leg {leg}) is model {model}, not an XL330-M288 ({expected}); its control table may differ. Fix: use XL330-M288s, or check the ID")]
-    WrongModel {
-        /// ID.
-        id: u8,
-        /// Leg.
-        leg: usize,
-        /// Model number reported.
-        model: u16,
-        /// Model expected.
-        expected: u16,
-    },
-    /// A setup write failed.
-    #[error("servo ID {id} (leg {leg}) refused {what}: {reason}. Fix: {fix}")]
-    Setup {
-        /// ID.
-        id: u8,
-        /// Leg.
-        leg: usize,
-        /// What was written.
-        what: &'static str,
-        /// The error.
-        reason: String,
-        /// What to do.
-        fix: &'static str,
-    },
-    /// A servo stopped answering during the run.
-    #[error("servo ID {id} (leg {leg}) stopped answering at t = {time_s:.3} s ({cycles} cycles in a row without a status packet: {reason}). Fix: check its cable, connector and power; the torque was turned off on every servo that answers")]
-    Lost {
-        /// ID.
-        id: u8,
-        /// Leg.
-        leg: usize,
-        /// Gait time, s.
-        time_s: f64,
-        /// Failed cycles.
-        cycles: usize,
-        /// The last error.
-        reason: String,
-    },
-    /// A servo's status packets kept failing their CRC.
-    #[error("servo ID {id} (leg {leg}) sent corrupt packets at t = {time_s:.3} s ({cycles} cycles in a row failed their CRC). Fix: check the bus wiring and connectors, that only one adapter drives the bus, and that every servo uses the same baud rate; the torque was turned off")]
-    Corrupt {
-        /// ID.
-        id: u8,
-        /// Leg.
-        leg: usize,
-        /// Gait time, s.
-        time_s: f64,
-        /// Failed cycles.
-        cycles: usize,
-    },
-    /// A cycle took longer than the watchdog allows.
-    #[error("the driver's watchdog fired at t = {time_s:.3} s: one cycle took {cycle_s:.3} s, more than --watchdog {limit_s} s. Fix: lower --rate, raise the baud rate, or find what stalls the bus; the torque was turned off")]
-    Watchdog {
-        /// Gait time, s.
-        time_s: f64,
-        /// The cycle's length, s.
-        cycle_s: f64,
-        /// The limit, s.
-        limit_s: f64,
-    },
-    /// The bus itself failed (the port went away).
-    #[error("the bus failed at t = {time_s:.3} s: {reason}. Fix: check the USB adapter's connection; the torque was turned off on every servo that answers")]
-    Bus {
-        /// Gait time, s.
-        time_s: f64,
-        /// The error.
-        reason: String,
-    },
-    /// The log could not be written.
-    #[error("the servo log could not be written at t = {time_s:.3} s: {reason}; the torque was turned off and the rows written before it are kept. Fix: free space on that disk (or raise the file-size limit, `ulimit -f`), or log to another one")]
-    Log {
-        /// Gait time, s.
-        time_s: f64,
-        /// The error.
-        reason: String,
-    },
-}
-
-impl DriveError {
-    /// 2: the setup was wrong before anything moved; 3: the bus or the log failed mid-run.
-    pub fn exit_code(&self) -> i32 {
-        match self {
-            DriveError::Missing { .. } | DriveError::WrongModel { .. } | DriveError::Setup { .. } => 2,
-            _ => 3,
-        }
-    }
 }
 
 /// What the driver leaves behind: the torque state it confirmed on the way out.
@@ -702,6 +598,16 @@ impl Walk<'_> {
                     };
                     on_sample(&sample)
                         .map_err(|e| DriveError::Log { time_s: time, reason: e.to_string() })?;
+                    // The servo shut itself down (its Shutdown register): a walk on the other
+                    // legs is not the commanded gait, and the robot's team must know.
+                    if hardware_error != 0 {
+                        return Err(DriveError::Hardware {
+                            id: s.id,
+                            leg: j,
+                            time_s: time,
+                            bits: hardware_error,
+                        });
+                    }
                     self.monitor_sample(schedule, settings, goals, j, angle, tau, time, on_live, report);
                 }
                 Err(e) => self.count_failure(j, s.id, &e, time)?,

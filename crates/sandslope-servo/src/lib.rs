@@ -6,6 +6,7 @@
 //! - [`driver`]: the alternating tripod of [`sandslope::servo::GaitSchedule`] sent to the
 //!   servos over a `dynamixel2::Bus` (sync write of goals, sync read of the present state), with
 //!   its safety logic: torque off on every exit, Ctrl-C, a lost servo and a watchdog;
+//! - [`error`]: why a run failed, naming the servo and the fix, and its exit code;
 //! - [`session`]: one run as every front end starts it, from the typed [`session::DriveConfig`]
 //!   that `drive`'s and `serve --drive`'s flags are translated into;
 //! - [`log`]: the run's log as every front end writes it (header, rows, the output path);
@@ -17,6 +18,7 @@
 
 pub mod driver;
 pub mod emulator;
+pub mod error;
 pub mod log;
 pub mod packet;
 pub mod session;

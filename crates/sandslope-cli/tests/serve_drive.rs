@@ -191,6 +191,7 @@ fn the_status_endpoint_and_the_drive_tab_follow_an_emulated_run() {
     same_number(attribute(&dom, "id=\"drive-k-s\"", "data-value"), &inf["k_s"]);
     same_number(attribute(&dom, "id=\"drive-k-s\"", "data-lo"), &inf["k_s_lo"]);
     same_number(attribute(&dom, "id=\"drive-p-fail\"", "data-value"), &inf["p_fail"]);
+    same_number(attribute(&dom, "id=\"drive-climb\"", "data-value"), &inf["speed_m_s"]);
     let t = end["time_s"].as_f64().unwrap();
     assert_eq!(text_of(&dom, "drive-time"), format!("{t:.2} / 4"));
     assert!(text_of(&dom, "drive-end").contains("Torque off confirmed on servos 1, 2, 3, 4, 5, 6"));

@@ -335,8 +335,18 @@ pub fn run(args: DriveArgs) -> Result<()> {
         if !quiet {
             let i = &l.inference;
             eprintln!(
-                "t = {:.2} s, tripod {}: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(fail) {:.3} (slippage {:.3}, sinkage {:.3})",
-                l.time_s, l.tripod, i.k_s, i.k_s_lo, i.k_s_hi, i.p_fail, i.p_slippage, i.p_sinkage
+                "t = {:.2} s, tripod {}: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, speed {:.1} [{:.1} - {:.1}] cm/s, P(fail) {:.3} (slippage {:.3}, sinkage {:.3})",
+                l.time_s,
+                l.tripod,
+                i.k_s,
+                i.k_s_lo,
+                i.k_s_hi,
+                100.0 * i.speed_m_s,
+                100.0 * i.speed_lo_m_s,
+                100.0 * i.speed_hi_m_s,
+                i.p_fail,
+                i.p_slippage,
+                i.p_sinkage
             );
         }
     };

@@ -180,6 +180,12 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
         answer.shear_load_n, answer.closed_form_shear_load_n
     );
     println!(
+        "climbing speed those sands give: {:.1} cm/s, 90% interval {:.1} - {:.1} (the stride simulator's walks; the servos do not measure the speed over the ground)",
+        100.0 * answer.speed_m_s,
+        100.0 * answer.speed_lo_m_s,
+        100.0 * answer.speed_hi_m_s
+    );
+    println!(
         "P(fail) at {slope_deg} deg: {:.3} (slippage {:.3}, sinkage {:.3})",
         answer.p_fail, answer.p_slippage, answer.p_sinkage
     );

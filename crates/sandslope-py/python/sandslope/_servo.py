@@ -45,7 +45,8 @@ def infer_servo_log(
     """The sand's k_s at the run's slope from the servos' stance currents, as ``sandslope infer
     --servo-log FILE --json`` (docs/model.md §19): the dict with ``k_s``, ``k_s_lo``, ``k_s_hi``
     (the 90% interval), ``bound``, ``shear_load_n``, ``closed_form_shear_load_n``,
-    ``p_slippage``, ``p_sinkage``, ``p_fail``, ``strides``, ``posterior``, ..., and ``notes``:
+    ``speed_m_s``, ``speed_lo_m_s``, ``speed_hi_m_s`` (the climbing speed those sands give, with
+    its 90% interval), ``p_slippage``, ``p_sinkage``, ``p_fail``, ``strides``, ``posterior``, ..., and ``notes``:
     what the log's reader repaired (a cut last row, empty values, repeats, rows out of order,
     gaps), the CLI's ``note:`` lines; empty for columns passed in.
 

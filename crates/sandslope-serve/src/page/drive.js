@@ -26,6 +26,9 @@ function showDrive(st) {
     if (live) $(id).dataset.value = String(live[key]);
   }
   if (live) ks.dataset.lo = String(live.k_s_lo), (ks.dataset.hi = String(live.k_s_hi));
+  const cm = (v) => (100 * v).toFixed(1);
+  $("drive-climb").textContent = live ? `${cm(live.speed_m_s)} [${cm(live.speed_lo_m_s)} – ${cm(live.speed_hi_m_s)}]` : "-";
+  if (live) $("drive-climb").dataset.value = String(live.speed_m_s);
   $("drive-p-slippage").textContent = live ? prob(live.p_slippage) : "-";
   $("drive-p-fail").textContent = live ? prob(live.p_fail) : "-";
   $("drive-estimates").textContent = live

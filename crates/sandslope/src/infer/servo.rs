@@ -160,6 +160,8 @@ pub struct ModelGrid {
     pub regime: Vec<Regime>,
     /// Mean along-slope sand force per stance leg over the stance, N.
     pub shear_load_n: Vec<f64>,
+    /// The simulated walk's climbing speed per k_s (after its first stride), m/s.
+    pub speed_m_s: Vec<f64>,
     /// Bins per tripod.
     pub bins: usize,
     /// Whether the profiles are taken after [`remove_swing_offset`] (and a log's must be).
@@ -282,7 +284,7 @@ pub fn model_grid(
             let profiles = stance_profiles(&schedule, &legs, bins);
             let (mean, sd, strides) = profile_statistics(&profiles, 2 * bins);
             let shear = stance_shear_load(&schedule, &sim);
-            Ok((mean, sd, strides, sim.summary.regime, shear))
+            Ok((mean, sd, strides, sim.summary.regime, shear, sim.summary.speed_m_s))
         })
         .collect();
     let mut grid = ModelGrid {
@@ -294,16 +296,18 @@ pub fn model_grid(
         strides: usize::MAX,
         regime: vec![],
         shear_load_n: vec![],
+        speed_m_s: vec![],
         bins,
         swing_offset: settings.swing_offset,
     };
     for w in walks {
-        let (mean, sd, strides, regime, shear) = w?;
+        let (mean, sd, strides, regime, shear, speed) = w?;
         grid.mean.push(mean);
         grid.sd.push(sd);
         grid.strides = grid.strides.min(strides);
         grid.regime.push(regime);
         grid.shear_load_n.push(shear);
+        grid.speed_m_s.push(speed);
     }
     Ok(grid)
 }
@@ -413,6 +417,14 @@ pub struct CurrentInference {
     pub shear_load_n: f64,
     /// The closed form's shear load per leg, `m (g sin theta + R omega / dt) / n`, N (§4).
     pub closed_form_shear_load_n: f64,
+    /// The climbing speed these sands give (the posterior median of the simulated walks'
+    /// speeds), m/s: what the servos alone say of the speed over the ground, which they do not
+    /// measure.
+    pub speed_m_s: f64,
+    /// 5% posterior quantile of the climbing speed, m/s.
+    pub speed_lo_m_s: f64,
+    /// 95% posterior quantile of the climbing speed, m/s.
+    pub speed_hi_m_s: f64,
     /// Probability of the slippage regime at this slope.
     pub p_slippage: f64,
     /// Probability of the sinkage regime at this slope.
@@ -605,6 +617,7 @@ fn posterior_answer(
     };
     let (p_slip, p_sink) = (weight_of(Regime::Slippage), weight_of(Regime::Sinkage));
     let shear = p.iter().zip(&grid.shear_load_n).map(|(x, f)| x * f).sum();
+    let speed = |level: f64| weighted_quantile(&grid.speed_m_s, &p, level);
     let slope = grid.slope_deg.abs().to_radians();
     let closed = robot.mass()
         * (crate::model::G * slope.sin() + robot.leg_radius() * robot.leg_speed() / robot.response_time())
@@ -618,6 +631,9 @@ fn posterior_answer(
         bound,
         shear_load_n: shear,
         closed_form_shear_load_n: closed,
+        speed_m_s: speed(0.5),
+        speed_lo_m_s: speed(0.05),
+        speed_hi_m_s: speed(0.95),
         p_slippage: p_slip,
         p_sinkage: p_sink,
         p_fail: p_slip + p_sink,
@@ -626,6 +642,24 @@ fn posterior_answer(
         posterior: grid.k_s.iter().copied().zip(p).collect(),
         swing_offset_n_m: vec![],
     }
+}
+
+/// Quantile of the discrete distribution that puts probability `p[i]` on `values[i]`: the
+/// smallest value whose cumulative probability reaches `level`. For a quantity that is not
+/// monotone in the grid's k_s (a walk's speed can switch between neighbouring k_s), so the
+/// values are sorted rather than interpolated. NaN when there are none.
+fn weighted_quantile(values: &[f64], p: &[f64], level: f64) -> f64 {
+    let mut pairs: Vec<(f64, f64)> = values.iter().copied().zip(p.iter().copied()).collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let total: f64 = pairs.iter().map(|x| x.1).sum();
+    let mut cum = 0.0;
+    for &(v, w) in &pairs {
+        cum += w;
+        if cum >= level * total * (1.0 - 1e-12) {
+            return v;
+        }
+    }
+    pairs.last().map_or(f64::NAN, |x| x.0)
 }
 
 /// Quantile of a distribution given as probabilities at grid points `x` (each point's mass
@@ -664,6 +698,20 @@ mod tests {
         let p = [0.25; 4];
         assert!((quantile(&x, &p, 0.5) - 1.5).abs() < 1e-12);
         assert!((quantile(&x, &p, 0.05) - (-0.5 + 0.2)).abs() < 1e-12);
+    }
+
+    /// Speeds out of grid order (a walk's speed is not monotone in k_s), worked by hand:
+    /// sorted 0.10 (p 0.2), 0.20 (0.5), 0.30 (0.3); cumulative 0.2, 0.7, 1.0.
+    #[test]
+    fn weighted_quantiles_of_unsorted_speeds_by_hand() {
+        let v = [0.30, 0.10, 0.20];
+        let p = [0.3, 0.2, 0.5];
+        assert_eq!(weighted_quantile(&v, &p, 0.05), 0.10);
+        assert_eq!(weighted_quantile(&v, &p, 0.2), 0.10);
+        assert_eq!(weighted_quantile(&v, &p, 0.5), 0.20);
+        assert_eq!(weighted_quantile(&v, &p, 0.7), 0.20);
+        assert_eq!(weighted_quantile(&v, &p, 0.95), 0.30);
+        assert!(weighted_quantile(&[], &[], 0.5).is_nan());
     }
 
     #[test]

@@ -13,6 +13,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 mod arrays;
+mod calibrate;
 mod measure;
 mod model;
 mod plan;
@@ -55,6 +56,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(measure::read_touchdowns, m)?)?;
     m.add_function(wrap_pyfunction!(measure::fit, m)?)?;
     m.add_function(wrap_pyfunction!(measure::track, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate_ensemble, m)?)?;
     m.add_function(wrap_pyfunction!(report::report, m)?)?;

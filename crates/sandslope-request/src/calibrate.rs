@@ -16,7 +16,7 @@ use sandslope::{
 };
 use sandslope_io::{load_anchoring_times, load_speeds, load_terrain};
 
-use crate::error::{check_positive, check_range, RequestError, Result};
+use crate::error::{check_positive_in, check_range_in, RequestError, Result, Words};
 
 /// The form of k_s(theta) fitted when there are no force tests (field `law`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -31,6 +31,9 @@ pub enum CalibrateLaw {
 }
 
 impl CalibrateLaw {
+    /// Every law, in the command line's order.
+    pub const ALL: [CalibrateLaw; 3] = [CalibrateLaw::Linear, CalibrateLaw::Coulomb, CalibrateLaw::PerSlope];
+
     /// The law's name as the command line writes it.
     pub fn name(self) -> &'static str {
         match self {
@@ -50,6 +53,19 @@ pub enum CalibrateModel {
     /// The stride simulator (docs/model.md §15-§18), [`SpeedModel::simulator_for_fit`]; the
     /// closed form's fit of the same evidence is answered beside it.
     Simulate,
+}
+
+impl CalibrateModel {
+    /// Every model, in the command line's order.
+    pub const ALL: [CalibrateModel; 2] = [CalibrateModel::ClosedForm, CalibrateModel::Simulate];
+
+    /// The model's name as the command line writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            CalibrateModel::ClosedForm => "closed-form",
+            CalibrateModel::Simulate => "simulate",
+        }
+    }
 }
 
 /// The inputs of `calibrate`, besides the robot and the source terrain (the front end loads
@@ -192,27 +208,28 @@ pub struct CalibrateSource<'a> {
     pub terrain_name: &'a str,
 }
 
-/// Parses `free` items: `KEY` or `KEY=MIN:MAX`.
-fn parse_free(items: &[String]) -> Result<Vec<FreeParameter>> {
+/// Parses `free` items: `KEY` or `KEY=MIN:MAX`; errors name the field in `words`.
+fn parse_free(items: &[String], words: Words) -> Result<Vec<FreeParameter>> {
     let bad = |m: String| RequestError::invalid("free", m);
+    let free = words.name("free");
     let mut out = Vec::new();
     for item in items.iter().map(|s| s.trim()).filter(|s| !s.is_empty()) {
         let (key, bounds) = match item.split_once('=') {
             Some((k, b)) => {
                 let (lo, hi) = b.split_once(':').ok_or_else(|| {
                     bad(format!(
-                        "--free {item}: bounds must be written MIN:MAX (e.g. hip_height_m=0.01:0.07)"
+                        "{free} {item}: bounds must be written MIN:MAX (e.g. hip_height_m=0.01:0.07)"
                     ))
                 })?;
                 let num = |s: &str| {
-                    s.trim().parse::<f64>().map_err(|_| bad(format!("--free {item}: `{s}` is not a number")))
+                    s.trim().parse::<f64>().map_err(|_| bad(format!("{free} {item}: `{s}` is not a number")))
                 };
                 (k.trim(), Some((num(lo)?, num(hi)?)))
             }
             None => (item, None),
         };
         let parameter = Parameter::parse(key).ok_or_else(|| {
-            bad(format!("--free: unknown quantity `{key}` (valid: {})", Parameter::names()))
+            bad(format!("{free}: unknown quantity `{key}` (valid: {})", Parameter::names()))
         })?;
         out.push(FreeParameter { parameter, bounds });
     }
@@ -222,41 +239,69 @@ fn parse_free(items: &[String]) -> Result<Vec<FreeParameter>> {
 impl CalibrateRequest {
     /// Every value checked before any file is read; errors name the field as its flag.
     pub fn check(&self) -> Result<CheckedCalibrate> {
+        self.check_in(Words::Flag)
+    }
+
+    /// [`CalibrateRequest::check`], errors naming the field in the front end's `words`.
+    pub fn check_in(&self, words: Words) -> Result<CheckedCalibrate> {
+        let law = |l: &str| words.setting("law", l);
         if self.model == CalibrateModel::Simulate && self.law == CalibrateLaw::PerSlope {
             return Err(RequestError::invalid(
                 "law",
-                "--law per-slope inverts the closed form only: with --model simulate use --law linear, --law coulomb or --forces",
+                format!(
+                    "{} inverts the closed form only: with {} use {}, {} or {}",
+                    law("per-slope"),
+                    words.setting("model", "simulate"),
+                    law("linear"),
+                    law("coulomb"),
+                    words.name("forces")
+                ),
             ));
         }
-        let free = parse_free(&self.free)?;
-        let k_n = self.k_n.map(|v| check_positive("k-n", v)).transpose()?;
+        let free = parse_free(&self.free, words)?;
+        let k_n = self.k_n.map(|v| check_positive_in(words, "k-n", v)).transpose()?;
         if let Some(r) = self.repose {
-            check_range("repose", r, 0.0, 90.0)?;
+            check_range_in(words, "repose", r, 0.0, 90.0)?;
         }
-        let error_floor = self.error_floor.map(|v| check_range("error-floor", v, 0.0, 1.0)).transpose()?;
+        let error_floor =
+            self.error_floor.map(|v| check_range_in(words, "error-floor", v, 0.0, 1.0)).transpose()?;
         if error_floor.is_some() && free.iter().any(|f| f.parameter == Parameter::ErrorFloor) {
             return Err(RequestError::invalid(
                 "error-floor",
-                "--error-floor fixes the floor and --free error_floor fits it: give one of them",
+                format!(
+                    "{} fixes the floor and {} fits it: give one of them",
+                    words.name("error-floor"),
+                    words.setting("free", "error_floor")
+                ),
             ));
         }
         if self.law == CalibrateLaw::PerSlope && self.forces.is_none() {
             if !free.is_empty() || self.t1.is_some() || error_floor.is_some() {
                 return Err(RequestError::invalid(
                     "law",
-                    "--law per-slope inverts each speed alone: it takes no --free, --t1 or --error-floor",
+                    format!(
+                        "{} inverts each speed alone: it takes no {}, {} or {}",
+                        law("per-slope"),
+                        words.name("free"),
+                        words.name("t1"),
+                        words.name("error-floor")
+                    ),
                 ));
             }
             if self.observed.is_none() {
-                return Err(RequestError::invalid("observed", "--law per-slope needs --observed speeds"));
+                return Err(RequestError::invalid(
+                    "observed",
+                    format!("{} needs {} speeds", law("per-slope"), words.name("observed")),
+                ));
             }
         }
         Ok(CheckedCalibrate { free, k_n, error_floor })
     }
 
-    /// Reads the evidence and fits it. Errors name the file (and line) or the field.
-    pub fn answer(&self, source: CalibrateSource) -> Result<CalibrateAnswer> {
-        let checked = self.check()?;
+    /// Reads the evidence and fits it. Errors name the file (and line) or the field, in the
+    /// front end's `words`.
+    pub fn answer(&self, source: CalibrateSource, words: Words) -> Result<CalibrateAnswer> {
+        let checked = self.check_in(words)?;
         let speeds = match &self.observed {
             Some(p) => load_speeds(p).map_err(|e| RequestError::from_error(Some("observed"), e))?,
             None => Vec::new(),
@@ -272,9 +317,8 @@ impl CalibrateRequest {
         let repose = self.repose_record(source, forces.as_ref());
         // k_n: the fixed one, else the force tests', else the source terrain's.
         let normal = match (checked.k_n, &forces) {
-            (Some(k), _) => {
-                Terrain::constant(k, 1.0).map_err(|e| RequestError::invalid("k-n", e.renamed("--k-n")))?
-            }
+            (Some(k), _) => Terrain::constant(k, 1.0)
+                .map_err(|e| RequestError::invalid("k-n", e.renamed(words.name("k-n"))))?,
             (None, Some(f)) => f.clone(),
             (None, None) => source.terrain.clone(),
         };
@@ -314,7 +358,10 @@ impl CalibrateRequest {
         calibration.terrain.name = Some(self.name.clone().unwrap_or(default_name));
         calibration.terrain.repose_deg = repose.deg;
         let terrain = Terrain::new(calibration.terrain.clone()).map_err(|e| {
-            fail(anyhow::anyhow!("the calibrated terrain is not valid ({e}); a fitted k_s reached zero within the observed slopes: try --law coulomb or force tests"))
+            fail(anyhow::anyhow!(
+                "the calibrated terrain is not valid ({e}); a fitted k_s reached zero within the observed slopes: try {} or force tests",
+                words.setting("law", "coulomb")
+            ))
         })?;
         let robot = Robot::new(calibration.robot.clone())
             .map_err(|e| fail(anyhow::anyhow!("the fitted robot is not valid: {e}")))?;
@@ -513,13 +560,42 @@ mod tests {
         assert!(with_forces.check().is_ok());
     }
 
+    /// Python's words: the same refusals, each naming the keyword (`k_n`, `law="per-slope"`)
+    /// where the command line names the flag.
+    #[test]
+    fn checks_name_the_keyword_in_python_words() {
+        let cases: [(CalibrateRequest, &str); 5] = [
+            (CalibrateRequest { k_n: Some(-1.0), ..request() }, "k_n = -1 must be a finite number greater than 0"),
+            (CalibrateRequest { repose: Some(91.0), ..request() }, "repose = 91 must be between 0 and 90"),
+            (
+                CalibrateRequest { error_floor: Some(0.1), free: vec!["error_floor".into()], ..request() },
+                "error_floor fixes the floor and free=\"error_floor\" fits it: give one of them",
+            ),
+            (
+                CalibrateRequest { law: CalibrateLaw::PerSlope, model: CalibrateModel::Simulate, ..request() },
+                "law=\"per-slope\" inverts the closed form only: with model=\"simulate\" use law=\"linear\", law=\"coulomb\" or forces",
+            ),
+            (
+                CalibrateRequest { free: vec!["hip_height_m=a:1".into()], ..request() },
+                "free hip_height_m=a:1: `a` is not a number",
+            ),
+        ];
+        for (r, message) in cases {
+            assert_eq!(r.check_in(Words::Keyword).unwrap_err().message(), message);
+        }
+        // The names a front end matches keywords against are the command line's.
+        let laws: Vec<&str> = CalibrateLaw::ALL.iter().map(|l| l.name()).collect();
+        let models: Vec<&str> = CalibrateModel::ALL.iter().map(|m| m.name()).collect();
+        assert_eq!((laws, models), (vec!["linear", "coulomb", "per-slope"], vec!["closed-form", "simulate"]));
+    }
+
     /// A missing evidence file is reported against its field.
     #[test]
     fn a_missing_evidence_file_names_its_field() {
         let robot = Robot::new(sandslope::RobotSpec::paper_hexapod()).unwrap();
         let terrain = Terrain::constant(1e6, 1e6).unwrap();
         let source = CalibrateSource { robot: &robot, terrain: &terrain, terrain_name: "t" };
-        let e = request().answer(source).unwrap_err();
+        let e = request().answer(source, Words::Flag).unwrap_err();
         assert_eq!(e.field(), Some("observed"));
         assert!(e.message().contains("no-such-speeds.csv"), "{}", e.message());
     }

@@ -66,26 +66,37 @@ pub type Result<T> = std::result::Result<T, RequestError>;
 /// Checks a number is finite and within `lo..=hi`, naming the field as its flag (`hi`
 /// infinite: no upper bound).
 pub fn check_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
+    check_range_in(Words::Flag, field, value, lo, hi)
+}
+
+/// [`check_range`], naming the field in the front end's `words`.
+pub fn check_range_in(words: Words, field: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
+    let name = words.name(field);
     if value.is_finite() && value >= lo && value <= hi {
         Ok(value)
     } else if hi == f64::INFINITY {
         Err(RequestError::invalid(
             field,
-            format!("--{field} = {value} must be a finite number of at least {lo}"),
+            format!("{name} = {value} must be a finite number of at least {lo}"),
         ))
     } else {
-        Err(RequestError::invalid(field, format!("--{field} = {value} must be between {lo} and {hi}")))
+        Err(RequestError::invalid(field, format!("{name} = {value} must be between {lo} and {hi}")))
     }
 }
 
 /// Checks a number is finite and strictly positive, naming the field as its flag.
 pub fn check_positive(field: &str, value: f64) -> Result<f64> {
+    check_positive_in(Words::Flag, field, value)
+}
+
+/// [`check_positive`], naming the field in the front end's `words`.
+pub fn check_positive_in(words: Words, field: &str, value: f64) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
         Err(RequestError::invalid(
             field,
-            format!("--{field} = {value} must be a finite number greater than 0"),
+            format!("{} = {value} must be a finite number greater than 0", words.name(field)),
         ))
     }
 }
@@ -106,6 +117,15 @@ impl Words {
         match self {
             Words::Flag => format!("--{field}"),
             Words::Keyword => field.replace('-', "_"),
+        }
+    }
+
+    /// A field set to a word as this front end writes it: `--law per-slope` or
+    /// `law="per-slope"`.
+    pub fn setting(self, field: &str, value: &str) -> String {
+        match self {
+            Words::Flag => format!("--{field} {value}"),
+            Words::Keyword => format!("{}={value:?}", self.name(field)),
         }
     }
 }

@@ -15,6 +15,7 @@ use sandslope::{predict, JointCalibration, Parameter, Quantity, Slope, Terrain};
 use sandslope_request::calibrate::{
     CalibrateAnswer, CalibrateLaw, CalibrateModel, CalibrateSource, JointAnswer, PerSlopeAnswer, ReposeRecord,
 };
+use sandslope_request::error::Words;
 use sandslope_request::CalibrateRequest;
 
 use crate::args::{RobotArgs, TerrainArgs};
@@ -144,7 +145,7 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
     // (docs/calibration.md): a spinner with the time.
     let spin = (request.model == CalibrateModel::Simulate)
         .then(|| crate::progress::spinner(args.json, "fitting with the stride simulator"));
-    let answer = request.answer(source);
+    let answer = request.answer(source, Words::Flag);
     if let Some(spin) = spin {
         spin.finish_and_clear();
     }

@@ -41,8 +41,10 @@ from ._inputs import (
     _float_array,
     _robot,
     _row_widths,
+    _source,
     _terrain,
 )
+from ._calibrate import calibrate
 from ._sandslope import Robot, Terrain
 from ._servo import drive, drive_defaults, infer_servo_log, read_servo_log
 
@@ -64,6 +66,7 @@ __all__ = [
     "read_raster",
     "fit",
     "track",
+    "calibrate",
     "simulate",
     "simulate_ensemble",
     "report",
@@ -645,13 +648,6 @@ def _touchdown_times(ts: Any) -> list:
 
 
 _PathLike = Union[str, "os.PathLike[str]"]
-
-
-def _source(x: Any, default: str) -> str:
-    """How the report's inputs table names a robot or terrain: its preset name or path as given."""
-    if isinstance(x, (str, os.PathLike)):
-        return os.fspath(x)
-    return default
 
 
 def report(

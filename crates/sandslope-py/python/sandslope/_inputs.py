@@ -37,6 +37,13 @@ def _terrain(terrain: TerrainLike) -> Terrain:
     )
 
 
+def _source(x: Any, default: str) -> str:
+    """How an answer names a robot or terrain: its preset name or path as given, else `default`."""
+    if isinstance(x, (str, os.PathLike)):
+        return os.fspath(x)
+    return default
+
+
 def _float_array(name: str, x: Any) -> np.ndarray:
     _refuse_complex(name, x)
     try:

@@ -190,6 +190,21 @@ def track(
     leg_speed_rad_s: Optional[float] = None,
     touchdowns: Optional[List[List[float]]] = None,
 ) -> Dict[str, Any]: ...
+def calibrate(
+    robot: Robot,
+    terrain: Terrain,
+    terrain_source: str,
+    observed: Optional[_Path] = None,
+    forces: Optional[str] = None,
+    t1: Optional[_Path] = None,
+    free: List[str] = ...,
+    error_floor: Optional[float] = None,
+    law: str = "linear",
+    model: str = "closed-form",
+    k_n: Optional[float] = None,
+    name: Optional[str] = None,
+    repose: Optional[float] = None,
+) -> str: ...
 def report(
     robot: Robot,
     terrain: Terrain,

@@ -10,6 +10,8 @@ use pyo3::types::PyDict;
 use pythonize::pythonize;
 
 use sandslope::measure::AirMode;
+use sandslope::robot_key::RobotKey;
+use sandslope::Robot;
 use sandslope_io::mocap::MocapFormat;
 use sandslope_request::error::Words;
 use sandslope_request::fit::{FitAnswer, FitRequest};
@@ -58,13 +60,13 @@ pub fn read_touchdowns(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Vec
 }
 
 #[pyfunction]
-#[pyo3(signature = (paths, slope_deg=None, robot=None, format=None, body=None, upslope=None, max_gap=sandslope::gait::DEFAULT_MAX_GAP, cutoff_hz=sandslope::gait::DEFAULT_CUTOFF_HZ, leg_speed_rad_s=None, touchdowns=None))]
+#[pyo3(signature = (paths, robot, slope_deg=None, format=None, body=None, upslope=None, max_gap=sandslope::gait::DEFAULT_MAX_GAP, cutoff_hz=sandslope::gait::DEFAULT_CUTOFF_HZ, leg_speed_rad_s=None, touchdowns=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn track<'py>(
     py: Python<'py>,
     paths: Vec<PathBuf>,
+    robot: &PyRobot,
     slope_deg: Option<f64>,
-    robot: Option<&PyRobot>,
     format: Option<&str>,
     body: Option<String>,
     upslope: Option<[f64; 3]>,
@@ -77,18 +79,18 @@ pub fn track<'py>(
         return Err(value_error("paths is empty: give at least one recording"));
     }
     let format: Option<MocapFormat> = format.map(str::parse).transpose().map_err(value_error)?;
-    let period = match (leg_speed_rad_s, robot) {
-        (Some(w), _) if !(w.is_finite() && w > 0.0) => {
-            return Err(value_error(format!("leg_speed_rad_s = {w} must be a finite number greater than 0")))
+    // The stride period of the robot (with `leg_speed_rad_s` in place of its leg speed, by the
+    // robot key table and validated again as a whole, as the command line's `--leg-speed`):
+    // the library's T = 2 pi / omega, not restated here.
+    let robot = match leg_speed_rad_s {
+        Some(w) => {
+            let mut spec = robot.inner.spec().clone();
+            RobotKey::LegSpeedRadS.set(&mut spec, w);
+            Robot::new(spec).map_err(value_error)?
         }
-        (Some(w), _) => std::f64::consts::TAU / w,
-        (None, Some(r)) => r.inner.stride_period(),
-        (None, None) => {
-            return Err(value_error(
-                "give the robot (its leg speed sets the stride period) or leg_speed_rad_s",
-            ))
-        }
+        None => robot.inner.clone(),
     };
+    let period = robot.stride_period();
     // The request `sandslope track` makes: one check and one path from files to the library.
     let request = TrackRequest {
         files: paths,

@@ -42,11 +42,8 @@ fn inputs(
     allow_metastable: bool,
     time_weight: f64,
 ) -> PyResult<(ElevationGrid, UncertainTerrain, PlanSettings)> {
-    let descent = match descent {
-        "symmetric" => Descent::Symmetric,
-        "level" => Descent::Level,
-        other => return Err(value_error(format!("descent = {other:?} must be \"symmetric\" or \"level\""))),
-    };
+    let descent = Descent::parse(descent)
+        .ok_or_else(|| value_error(format!("descent = {descent:?} must be \"symmetric\" or \"level\"")))?;
     let settings =
         PlanSettings::new(max_roll_deg, descent, allow_metastable, time_weight).map_err(value_error)?;
     let terrain = crate::risk::uncertain(terrain, cv_n, cv_s)?;

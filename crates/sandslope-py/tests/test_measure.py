@@ -65,3 +65,18 @@ def test_track_estimated_touchdowns_and_bodies(cli, root):
         sandslope.track(f, 10)
     with pytest.raises(ValueError, match="cutoff_hz = -1 must be"):
         sandslope.track(f, 10, body="robot", cutoff_hz=-1)
+
+
+def test_track_leg_speed_is_the_cli_leg_speed_override(cli, root):
+    """`leg_speed_rad_s` replaces the robot's leg speed as `track --leg-speed` does: the stride
+    period is 2 pi / omega (3 rad/s: 2.0944 s, worked out by hand) and the answer the CLI's."""
+    f = root / TRACKING / "slope10-motive123.csv"
+    want = cli.json("track", f, "--body", "robot", "--slope", 10, "--leg-speed", 3)
+    got = sandslope.track(f, 10, body="robot", leg_speed_rad_s=3)
+    assert got["period_s"] == pytest.approx(2.0943951023931953, rel=1e-15)
+    for key in ("period_s", "speed_m_s", "steps", "t1_s"):
+        assert got[key] == pytest.approx(want[key], rel=1e-12), key
+    message = cli.error("track", f, "--body", "robot", "--slope", 10, "--leg-speed", 0)
+    with pytest.raises(ValueError) as e:
+        sandslope.track(f, 10, body="robot", leg_speed_rad_s=0)
+    assert str(e.value) == message.replace("--leg-speed", "leg_speed_rad_s")

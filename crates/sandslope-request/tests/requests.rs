@@ -134,6 +134,16 @@ fn plan_refusals_name_their_field() {
     assert_eq!(field(r.settings()), "max-roll");
     let r = plan(&[dem, ("start-px", "1,1"), ("goal-px", "2,2"), ("coarse-factor", "65")]).unwrap();
     assert_eq!(field(r.check_corridor()), "coarse-factor");
+    // The descent rule by its name (the library's, which Python parses too); symmetric unless given.
+    let ends = [dem, ("start", "1,1"), ("goal", "2,2")];
+    assert_eq!(plan(&ends).unwrap().descent, sandslope::plan::Descent::Symmetric);
+    let level = plan(&[ends[0], ends[1], ends[2], ("descent", "level")]).unwrap();
+    assert_eq!(level.descent, sandslope::plan::Descent::Level);
+    let e = plan(&[ends[0], ends[1], ends[2], ("descent", "down")]).unwrap_err();
+    assert_eq!(
+        (e.field(), e.message().as_str()),
+        (Some("descent"), "--descent = `down` must be symmetric (as climbing |pitch|) or level")
+    );
 }
 
 #[test]

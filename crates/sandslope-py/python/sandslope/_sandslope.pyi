@@ -180,8 +180,8 @@ def fit(
 ) -> Dict[str, Any]: ...
 def track(
     paths: List[_Path],
+    robot: Robot,
     slope_deg: Optional[float] = None,
-    robot: Optional[Robot] = None,
     format: Optional[str] = None,
     body: Optional[str] = None,
     upslope: Optional[List[float]] = None,

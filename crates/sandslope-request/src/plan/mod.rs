@@ -172,14 +172,13 @@ impl PlanRequest {
         let time_weight = p.number_or("time-weight", sandslope::plan::DEFAULT_TIME_WEIGHT)?;
         let max_roll = p.number_or("max-roll", 20.0)?;
         let descent = match p.text("descent")? {
-            None | Some("symmetric") => Descent::Symmetric,
-            Some("level") => Descent::Level,
-            Some(other) => {
-                return Err(RequestError::invalid(
+            None => Descent::default(),
+            Some(text) => Descent::parse(text).ok_or_else(|| {
+                RequestError::invalid(
                     "descent",
-                    format!("--descent = `{other}` must be symmetric (as climbing |pitch|) or level"),
-                ))
-            }
+                    format!("--descent = `{text}` must be symmetric (as climbing |pitch|) or level"),
+                )
+            })?,
         };
         let (cv_n, cv_s) = (p.number("cv-n")?, p.number("cv-s")?);
         let max_memory = p.number("max-memory")?;

@@ -96,6 +96,24 @@ pub enum Descent {
     Level,
 }
 
+impl Descent {
+    /// Every rule, the default first.
+    pub const ALL: [Descent; 2] = [Descent::Symmetric, Descent::Level];
+
+    /// The rule's name, as `--descent`, the server and Python write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Descent::Symmetric => "symmetric",
+            Descent::Level => "level",
+        }
+    }
+
+    /// The rule of that name, if any.
+    pub fn parse(name: &str) -> Option<Descent> {
+        Descent::ALL.into_iter().find(|d| d.name() == name)
+    }
+}
+
 /// With a time weight of zero, the risk objective breaks ties between equally safe routes by
 /// their 3-D length, at this cost per metre (in units of `-ln(survival)`): a kilometre adds
 /// 1e-6, a survival change of 0.0001 %. Without it, edges where `p_fail` is 0 would cost
@@ -227,5 +245,21 @@ impl NoRoute {
             }
             NoRoute::GoalUnreachable => "goal unreachable: no chain of passable edges joins start and goal",
         }
+    }
+}
+
+#[cfg(test)]
+mod descent_tests {
+    use super::Descent;
+
+    /// The names the front ends parse are the ones serde writes, and each parses back.
+    #[test]
+    fn descent_names_are_serde_names_and_parse_back() {
+        for d in Descent::ALL {
+            assert_eq!(serde_json::to_string(&d).unwrap(), format!("\"{}\"", d.name()));
+            assert_eq!(Descent::parse(d.name()), Some(d));
+        }
+        assert_eq!(Descent::ALL[0], Descent::default());
+        assert_eq!(Descent::parse("Level"), None);
     }
 }

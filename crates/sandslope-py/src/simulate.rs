@@ -57,7 +57,8 @@ pub fn simulate<'py>(
         mechanisms,
         rate_hz: sample_rate_hz,
     })?;
-    let sim = py.detach(|| run(&scenario, slope_deg, &settings)).map_err(|e| match e {
+    let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
+    let sim = py.detach(|| run(&scenario, slope, &settings)).map_err(|e| match e {
         SimulateError::Param(p) => value_error(p),
     })?;
     let tr = sim.trajectory;
@@ -140,7 +141,8 @@ pub fn simulate_ensemble<'py>(
         mechanisms,
         rate_hz,
     })?;
-    let e = py.detach(|| run_ensemble(&scenario, slope_deg, &settings, walks)).map_err(|e| match e {
+    let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
+    let e = py.detach(|| run_ensemble(&scenario, slope, &settings, walks)).map_err(|e| match e {
         SimulateError::Param(p) if p.key == "ensemble" => value_error(p.renamed("walks")),
         SimulateError::Param(p) => value_error(p),
     })?;

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use sandslope::{ParamError, Robot, Scenario, SlopeEvaluation, Terrain};
+use sandslope::{ParamError, Robot, Scenario, SignedSlope, SlopeEvaluation, Terrain};
 
 use crate::error::{RequestError, Result};
 use crate::params::Params;
@@ -36,7 +36,9 @@ impl PredictRequest {
 
 /// The scenario at one slope, an error naming the field `slope`.
 pub fn evaluate(scenario: &sandslope::Scenario, slope: f64) -> Result<SlopeEvaluation> {
-    scenario.evaluate(slope).map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))
+    let slope =
+        SignedSlope::from_degrees(slope).map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))?;
+    Ok(scenario.evaluate(slope))
 }
 
 /// One point of an array `predict` (Python's `sandslope.predict` answers one per element): a
@@ -85,7 +87,8 @@ impl PointRequest {
             None => robot.clone(),
         };
         let scenario = Scenario::new(robot, terrain.clone(), self.k_n, self.k_s).map_err(refuse)?;
-        scenario.evaluate(self.slope).map_err(refuse)
+        let slope = SignedSlope::from_degrees(self.slope).map_err(refuse)?;
+        Ok(scenario.evaluate(slope))
     }
 }
 
@@ -122,8 +125,7 @@ mod tests {
         let got = point.answer(&robot(), &terrain, str::to_string).unwrap();
         let by_hand = Scenario::new(robot().with_mass(1.0).unwrap(), terrain.clone(), None, Some(5e5))
             .unwrap()
-            .evaluate(10.0)
-            .unwrap();
+            .evaluate(SignedSlope::from_degrees(10.0).unwrap());
         assert_eq!(got.prediction.k_s, 5e5);
         assert_eq!(got.prediction.k_n, 3e6);
         assert_eq!(got, by_hand);

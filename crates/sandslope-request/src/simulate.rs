@@ -7,7 +7,7 @@ use sandslope::simulate::{
     simulate, simulate_ensemble, simulate_slopes, BodyPitch, Ensemble, Mechanisms, RftScaling, SimSettings,
     SimSummary, SimulateError, Simulation,
 };
-use sandslope::{ParamError, Scenario};
+use sandslope::{ParamError, Scenario, SignedSlope};
 
 use crate::error::{check_range, RequestError, Result, Words};
 use crate::grammar::{parse_slope_list, SlopeSign};
@@ -161,9 +161,15 @@ impl SimulateRequest {
     pub fn walks(&self) -> Result<Walks> {
         let settings = self.settings()?;
         let scenario = self.scenario.scenario()?;
+        let signed = |deg: f64, field: &'static str| {
+            SignedSlope::from_degrees(deg)
+                .map_err(|e| RequestError::invalid(field, e.renamed(format!("--{field}"))))
+        };
         let (slopes, many) = match &self.slopes {
-            SimSlopes::Many(slopes) => (slopes.clone(), true),
-            SimSlopes::One(slope) => (vec![check_slope(*slope)?], false),
+            SimSlopes::Many(slopes) => {
+                (slopes.iter().map(|&d| signed(d, "slopes")).collect::<Result<Vec<_>>>()?, true)
+            }
+            SimSlopes::One(slope) => (vec![signed(check_slope(*slope)?, "slope")?], false),
         };
         Ok(Walks { scenario, slopes, many, settings, ensemble: self.ensemble })
     }
@@ -301,8 +307,8 @@ pub enum Answer {
 pub struct Walks {
     /// The robot on its terrain.
     pub scenario: Scenario,
-    /// The slopes, degrees.
-    pub slopes: Vec<f64>,
+    /// The slopes (negative: downhill).
+    pub slopes: Vec<SignedSlope>,
     /// Whether they came from `slopes` (the answer is then a list, even of one).
     pub many: bool,
     /// The checked settings.
@@ -315,10 +321,8 @@ impl Walks {
     /// Integration steps of all the walks, settling included (what they cost to run).
     pub fn integration_steps(&self) -> Result<f64> {
         let mut steps = 0.0;
-        for &deg in &self.slopes {
-            let slope = sandslope::Slope::from_signed_degrees(deg)
-                .map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))?;
-            let dt = sandslope::simulate::integration_step(&self.scenario, slope, self.settings.dt_s)
+        for signed in &self.slopes {
+            let dt = sandslope::simulate::integration_step(&self.scenario, signed.felt(), self.settings.dt_s)
                 .map_err(flagged)?;
             steps += (self.settings.duration_s + self.settings.settle_s) / dt;
         }

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use sandslope::scenario::slope_range;
-use sandslope::{Scenario, SlopeEvaluation};
+use sandslope::{Scenario, SignedSlope, SlopeEvaluation};
 
 use crate::error::{RequestError, Result};
 use crate::params::Params;
@@ -56,5 +56,10 @@ impl SweepRequest {
 
 /// The scenario at every slope, an error naming `from` (the range's own fields).
 pub fn evaluate(scenario: &Scenario, slopes: &[f64]) -> Result<Vec<SlopeEvaluation>> {
-    scenario.sweep(slopes).map_err(|e| RequestError::invalid("from", e.renamed("--from/--to")))
+    let slopes = slopes
+        .iter()
+        .map(|&d| SignedSlope::from_degrees(d))
+        .collect::<std::result::Result<Vec<_>, _>>()
+        .map_err(|e| RequestError::invalid("from", e.renamed("--from/--to")))?;
+    Ok(scenario.sweep(&slopes))
 }

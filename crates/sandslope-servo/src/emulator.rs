@@ -131,8 +131,10 @@ impl Walk {
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let scenario = Scenario::new(robot.clone(), terrain, None, None)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+        let slope = sandslope::SignedSlope::from_degrees(slope_deg)
+            .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let sim =
-            simulate(&scenario, slope_deg, &settings).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+            simulate(&scenario, slope, &settings).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         Ok(Walk { legs: simulated_legs(&schedule, &sim), rate_hz })
     }
 

@@ -10,7 +10,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 
 use sandslope::{
-    simulate, simulate_slopes, RobotSpec, Scenario, SimSettings, Terrain, TerrainPoint, TerrainSpec,
+    simulate, simulate_slopes, RobotSpec, Scenario, SignedSlope, SimSettings, Terrain, TerrainPoint,
+    TerrainSpec,
 };
 
 /// The built-in `glass-beads-300um` preset (crates/sandslope-io/presets), rounded.
@@ -27,6 +28,10 @@ fn beads() -> Terrain {
     .expect("valid terrain")
 }
 
+fn deg(d: f64) -> SignedSlope {
+    SignedSlope::from_degrees(d).expect("a slope in (-90, 90)")
+}
+
 fn bench(c: &mut Criterion) {
     let robot = sandslope::Robot::new(RobotSpec::paper_hexapod()).expect("valid robot");
     let scenario = Scenario::new(robot, beads(), None, None).expect("valid scenario");
@@ -36,17 +41,17 @@ fn bench(c: &mut Criterion) {
     // 10 ms each), level and at 10 degrees, pitch free and locked.
     let walk10 = SimSettings::new(10.0).unwrap();
     group.bench_function("one 10 s walk, level, one core", |b| {
-        b.iter(|| simulate(black_box(&scenario), 0.0, &walk10).unwrap())
+        b.iter(|| simulate(black_box(&scenario), deg(0.0), &walk10).unwrap())
     });
     let locked = walk10.with_body_pitch(sandslope::simulate::BodyPitch::Locked);
     group.bench_function("one 10 s walk at 10 deg, pitch locked, one core", |b| {
-        b.iter(|| simulate(black_box(&scenario), 10.0, &locked).unwrap())
+        b.iter(|| simulate(black_box(&scenario), deg(10.0), &locked).unwrap())
     });
     group.bench_function("one 10 s walk at 10 deg, one core", |b| {
-        b.iter(|| simulate(black_box(&scenario), 10.0, &walk10).unwrap())
+        b.iter(|| simulate(black_box(&scenario), deg(10.0), &walk10).unwrap())
     });
     // Two cores (rayon): 31 slopes of 10 s walks, 0 to 30 degrees, as `simulate --slopes 0:30:31`.
-    let slopes: Vec<f64> = (0..31).map(f64::from).collect();
+    let slopes: Vec<SignedSlope> = (0..31).map(|d| deg(f64::from(d))).collect();
     group.bench_function("31 slopes x 10 s walks, all cores", |b| {
         b.iter(|| simulate_slopes(black_box(&scenario), &slopes, &walk10).unwrap())
     });

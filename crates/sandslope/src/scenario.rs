@@ -15,7 +15,7 @@ use crate::error::{positive, ParamError};
 use crate::model::{predict, Prediction};
 use crate::regime::{Cause, Regime};
 use crate::robot::Robot;
-use crate::slope::Slope;
+use crate::slope::{SignedSlope, Slope};
 use crate::terrain::{Ground, Terrain};
 
 /// A robot on a terrain, with optional fixed resistances overriding the terrain's at every
@@ -67,29 +67,29 @@ impl Scenario {
         (ground, extrapolated)
     }
 
-    /// The model at a signed slope in degrees (descending is evaluated as climbing |slope|,
-    /// docs/model.md §8). Fails (key `slope_deg`) unless `|slope_deg|` is in `[0, 90)`.
-    pub fn evaluate(&self, slope_deg: f64) -> Result<SlopeEvaluation, ParamError> {
-        let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
+    /// The model at a signed slope (descending is evaluated as climbing |slope|, docs/model.md
+    /// §8); the slope was validated where it was given ([`SignedSlope::from_degrees`]).
+    pub fn evaluate(&self, signed: SignedSlope) -> SlopeEvaluation {
+        let slope = signed.felt();
         let (ground, extrapolated) = self.ground_at(slope);
         let prediction = predict(&self.robot, slope, &ground);
         let critical = |target| {
             critical_shear_strength(&self.robot, slope, ground.k_n, ground.beyond_repose(slope), target)
         };
         let (progress, robust) = (critical(StepTarget::Progress), critical(StepTarget::Robust));
-        Ok(SlopeEvaluation {
-            slope_deg,
+        SlopeEvaluation {
+            slope_deg: signed.degrees(),
             k_s_margin: progress.as_ref().ok().map(|k| ground.k_s / k),
             prediction,
             critical_progress: progress,
             critical_robust: robust,
             extrapolated,
-        })
+        }
     }
 
-    /// The model at each slope of `slopes_deg`, in order (see [`Scenario::evaluate`]).
-    pub fn sweep(&self, slopes_deg: &[f64]) -> Result<Vec<SlopeEvaluation>, ParamError> {
-        slopes_deg.iter().map(|&d| self.evaluate(d)).collect()
+    /// The model at each of `slopes`, in order (see [`Scenario::evaluate`]).
+    pub fn sweep(&self, slopes: &[SignedSlope]) -> Vec<SlopeEvaluation> {
+        slopes.iter().map(|&s| self.evaluate(s)).collect()
     }
 }
 
@@ -225,6 +225,10 @@ mod tests {
     use crate::model::tests::paper_robot;
     use crate::terrain::{TerrainPoint, TerrainSpec};
 
+    fn deg(d: f64) -> SignedSlope {
+        SignedSlope::from_degrees(d).unwrap()
+    }
+
     fn dune(repose_deg: Option<f64>) -> Terrain {
         let pt = |slope_deg, k_s| TerrainPoint { slope_deg, k_n: 7e5, k_s, k_n_sd: None, k_s_sd: None };
         Terrain::new(TerrainSpec { name: None, repose_deg, points: vec![pt(0.0, 2e6), pt(20.0, 1e6)] })
@@ -236,7 +240,7 @@ mod tests {
         // 20 deg, k_n = 7e5, k_s = 1e6 (the table's own value at 20 deg): worked by hand in the
         // model's tests, s = 21.7682 mm, v = 4.35363 cm/s, metastable.
         let s = Scenario::new(paper_robot(), dune(None), None, None).unwrap();
-        let e = s.evaluate(20.0).unwrap();
+        let e = s.evaluate(deg(20.0));
         assert!((e.speed().unwrap() - 0.043_536_3).abs() < 1e-7);
         assert_eq!((e.regime(), e.cause()), (Regime::Metastable, Cause::ShortStep));
         // The margin is k_s over the critical k_s for progress: above 1, since s > 0.
@@ -244,12 +248,12 @@ mod tests {
         assert!((e.k_s_margin.unwrap() - 1e6 / k0).abs() < 1e-12 && e.k_s_margin.unwrap() > 1.0);
         // Overriding k_s with the critical value itself puts the margin at exactly 1.
         let at_critical = Scenario::new(paper_robot(), dune(None), None, Some(k0)).unwrap();
-        assert!((at_critical.evaluate(20.0).unwrap().k_s_margin.unwrap() - 1.0).abs() < 1e-12);
+        assert!((at_critical.evaluate(deg(20.0)).k_s_margin.unwrap() - 1.0).abs() < 1e-12);
         assert_eq!(Scenario::new(paper_robot(), dune(None), Some(-1.0), None).unwrap_err().key, "k_n");
         // Descending is evaluated as climbing.
-        let down = s.evaluate(-20.0).unwrap();
+        let down = s.evaluate(deg(-20.0));
         assert_eq!((down.slope_deg, down.prediction.speed), (-20.0, e.prediction.speed));
-        assert_eq!(s.evaluate(95.0).unwrap_err().key, "slope_deg");
+        assert_eq!(SignedSlope::from_degrees(95.0).unwrap_err().key, "slope_deg");
     }
 
     #[test]
@@ -257,7 +261,7 @@ mod tests {
         // Same ground with a repose of 18 deg: at 20 deg the stance model still gives its
         // positive speed, but the surface yields, so the robot makes none.
         let s = Scenario::new(paper_robot(), dune(Some(18.0)), None, None).unwrap();
-        let e = s.evaluate(20.0).unwrap();
+        let e = s.evaluate(deg(20.0));
         assert_eq!((e.regime(), e.cause()), (Regime::Slippage, Cause::AtOrAboveRepose));
         assert!((e.model_speed().unwrap() - 0.043_536_3).abs() < 1e-7);
         assert_eq!(e.speed(), None);
@@ -265,7 +269,7 @@ mod tests {
         assert_eq!(e.k_s_margin, None);
         // A weak k_s without repose: the leg anchors late and the net step is negative; that
         // negative speed is the model's answer (the robot loses ground) and is kept.
-        let weak = Scenario::new(paper_robot(), dune(None), None, Some(8e4)).unwrap().evaluate(20.0).unwrap();
+        let weak = Scenario::new(paper_robot(), dune(None), None, Some(8e4)).unwrap().evaluate(deg(20.0));
         assert_eq!(weak.cause(), Cause::NetBackwardStep);
         assert!(weak.speed().unwrap() < 0.0 && !weak.speed_ruled_out());
     }
@@ -273,13 +277,13 @@ mod tests {
     #[test]
     fn causes_along_a_sweep_and_extrapolation_unless_both_values_are_fixed() {
         let s = Scenario::new(paper_robot(), dune(Some(18.0)), None, None).unwrap();
-        let rows = s.sweep(&[10.0, 20.0, 25.0]).unwrap();
+        let rows = s.sweep(&[deg(10.0), deg(20.0), deg(25.0)]);
         let text = format!("{:?}", rows.iter().map(|r| r.cause()).collect::<Vec<_>>());
         assert_eq!(text, "[RobustStep, AtOrAboveRepose, AtOrAboveRepose]");
         // Extrapolated beyond the last point (20 deg) unless both values are overridden.
         assert!(rows[2].extrapolated && !rows[1].extrapolated);
         let fixed = Scenario::new(paper_robot(), dune(None), Some(7e5), Some(1e6)).unwrap();
-        assert!(!fixed.evaluate(25.0).unwrap().extrapolated);
+        assert!(!fixed.evaluate(deg(25.0)).extrapolated);
     }
 
     #[test]

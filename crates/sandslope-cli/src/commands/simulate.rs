@@ -205,7 +205,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
 }
 
 fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
-    let (scenario, slope) = (&walks.scenario, walks.slopes[0]);
+    let (scenario, slope) = (&walks.scenario, walks.slopes[0].degrees());
     // Progress on stderr (a terminal's, not with --json or --csv): a 10 s walk with its GIF
     // takes tens of seconds.
     let quiet = args.format.format() != Format::Table;
@@ -352,7 +352,7 @@ struct EnsembleRow {
 
 fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
     let quiet = args.format.format() != Format::Table;
-    let spin = spinner(quiet, &format!("simulating {n} walks at {} deg", walks.slopes[0]));
+    let spin = spinner(quiet, &format!("simulating {n} walks at {} deg", walks.slopes[0].degrees()));
     let e = walks.simulate_ensemble(n);
     spin.finish_and_clear();
     let e = e?;
@@ -381,7 +381,8 @@ fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
         Format::Table => {
             println!(
                 "{n} walks at {} deg (mass perturbed by {:e} relative between walks):",
-                walks.slopes[0], e.perturbation
+                walks.slopes[0].degrees(),
+                e.perturbation
             );
             println!(
                 "speed {:.2} +/- {:.2} cm/s (SD; standard error {:.2}), mean t1 {} ms",

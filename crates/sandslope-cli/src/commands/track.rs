@@ -222,8 +222,11 @@ pub fn run(args: TrackArgs) -> Result<()> {
                 let top = rows.iter().map(|r| r.slope_deg).fold(0.0, f64::max);
                 let scenario = Scenario::new(robot.clone(), args.terrain.load()?, None, None)
                     .map_err(|e| anyhow!("{e}"))?;
-                let slopes: Vec<f64> = (0..=400).map(|k| (top + 2.0).min(89.0) * k as f64 / 400.0).collect();
-                scenario.sweep(&slopes).map_err(|e| anyhow!("{e}"))?
+                let slopes = (0..=400)
+                    .map(|k| sandslope::SignedSlope::from_degrees((top + 2.0).min(89.0) * k as f64 / 400.0))
+                    .collect::<Result<Vec<_>, _>>()
+                    .map_err(|e| anyhow!("{e}"))?;
+                scenario.sweep(&slopes)
             }
             None => Vec::new(),
         };

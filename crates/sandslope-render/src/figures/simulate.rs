@@ -550,7 +550,12 @@ mod tests {
     fn walk(slope_deg: f64, duration_s: f64) -> Simulation {
         let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
         let s = Scenario::new(robot, Terrain::constant(7e5, 2e6).unwrap(), None, None).unwrap();
-        simulate(&s, slope_deg, &SimSettings::new(duration_s).unwrap()).unwrap()
+        simulate(
+            &s,
+            sandslope::SignedSlope::from_degrees(slope_deg).unwrap(),
+            &SimSettings::new(duration_s).unwrap(),
+        )
+        .unwrap()
     }
 
     /// One frame as RGB pixels, 800 x 450.
@@ -634,7 +639,8 @@ mod tests {
     fn animation_frames_draw_and_the_gif_is_written() {
         let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
         let s = Scenario::new(robot, Terrain::constant(7e5, 2e6).unwrap(), None, None).unwrap();
-        let sim = simulate(&s, 15.0, &SimSettings::new(2.0).unwrap()).unwrap();
+        let fifteen = sandslope::SignedSlope::from_degrees(15.0).unwrap();
+        let sim = simulate(&s, fifteen, &SimSettings::new(2.0).unwrap()).unwrap();
         let anim = Animation { sim: &sim, slope_deg: 15.0 };
         // A directory of its own: concurrent test runs (two checkouts) shared fixed names in
         // /tmp and removed each other's files.

@@ -80,7 +80,8 @@ pub(crate) fn walk_on_ground(
     settings: &SimSettings,
 ) -> Result<SimSummary, ParamError> {
     let scenario = Scenario::new(robot.clone(), Terrain::constant(k_n, k_s)?, None, None)?;
-    simulate(&scenario, slope_deg, settings).map(|s| s.summary).map_err(|e| match e {
+    let slope = crate::slope::SignedSlope::from_degrees(slope_deg)?;
+    simulate(&scenario, slope, settings).map(|s| s.summary).map_err(|e| match e {
         crate::simulate::SimulateError::Param(p) => p,
     })
 }
@@ -189,7 +190,10 @@ mod tests {
         {
             let scenario =
                 Scenario::new(paper_robot(), Terrain::constant(7e5, k_s).unwrap(), None, None).unwrap();
-            let walk = simulate(&scenario, deg, &settings).unwrap().summary.speed_m_s;
+            let walk = simulate(&scenario, crate::slope::SignedSlope::from_degrees(deg).unwrap(), &settings)
+                .unwrap()
+                .summary
+                .speed_m_s;
             assert_eq!(pull.model, walk, "{deg} deg");
             let expected = (observed - walk) / (sd * sd + 0.01f64 * 0.01).sqrt();
             assert!((pull.pull - expected).abs() < 1e-12, "{deg} deg: {} vs {expected}", pull.pull);

@@ -261,6 +261,8 @@ pub fn model_grid(
     }
     let schedule = GaitSchedule::new(robot, 2 * robot.stance_legs() as usize)
         .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
+    let slope = crate::slope::SignedSlope::from_degrees(slope_deg)
+        .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
     let (lo, hi) = (settings.prior.min().ln(), settings.prior.max().ln());
     let n = settings.grid_points;
     let k_s: Vec<f64> = (0..n).map(|i| (lo + (hi - lo) * i as f64 / (n - 1) as f64).exp()).collect();
@@ -275,7 +277,7 @@ pub fn model_grid(
                 Terrain::constant(k_n, ks).map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
             let scenario = Scenario::new(robot.clone(), terrain, None, None)
                 .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
-            let sim = simulate(&scenario, slope_deg, &sim_settings)
+            let sim = simulate(&scenario, slope, &sim_settings)
                 .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
             let mut legs = simulated_legs(&schedule, &sim);
             if settings.swing_offset {

@@ -106,7 +106,10 @@ pub fn simulator_section(
     terrain: &Terrain,
     speeds: &[SpeedObservation],
 ) -> Result<SimulatorWalks, ParamError> {
-    let slopes = section_slopes(speeds, terrain);
+    let slopes = section_slopes(speeds, terrain)
+        .into_iter()
+        .map(crate::slope::SignedSlope::from_degrees)
+        .collect::<Result<Vec<_>, _>>()?;
     let scenario = Scenario::new(robot.clone(), terrain.clone(), None, None)?;
     let settings = SimSettings::new(REPORT_WALK_S)?;
     let walk = |settings: &SimSettings| -> Result<Vec<SimSummary>, ParamError> {

@@ -13,6 +13,7 @@ use crate::error::ParamError;
 use crate::gait::Stats;
 use crate::regime::Regime;
 use crate::scenario::Scenario;
+use crate::slope::SignedSlope;
 
 /// The relative mass step between an ensemble's walks.
 pub const ENSEMBLE_PERTURBATION: f64 = 1e-9;
@@ -49,11 +50,11 @@ pub struct Ensemble {
     pub summaries: Vec<SimSummary>,
 }
 
-/// Walks `scenario`'s robot `n` times at `slope_deg` (2 to 1000; key `ensemble`), the mass of
+/// Walks `scenario`'s robot `n` times at `slope` (2 to 1000; key `ensemble`), the mass of
 /// walk `k` multiplied by `1 + k 1e-9`, in parallel, and summarises the spread.
 pub fn simulate_ensemble(
     scenario: &Scenario,
-    slope_deg: f64,
+    slope: SignedSlope,
     settings: &SimSettings,
     n: usize,
 ) -> Result<Ensemble, SimulateError> {
@@ -71,7 +72,7 @@ pub fn simulate_ensemble(
         .into_par_iter()
         .map(|k| {
             let robot = scenario.robot().with_mass(perturbed_mass(mass, k))?;
-            Ok(simulate(&scenario.with_robot(robot), slope_deg, settings)?.summary)
+            Ok(simulate(&scenario.with_robot(robot), slope, settings)?.summary)
         })
         .collect::<Result<_, SimulateError>>()?;
     // n >= 2 walks, so the mean and its SD exist.

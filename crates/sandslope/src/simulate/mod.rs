@@ -31,7 +31,7 @@ use crate::error::ParamError;
 use crate::gait::{measure_step, SmoothTrack, StepMeasure};
 use crate::regime::{classify, Cause, Regime};
 use crate::scenario::{Scenario, SlopeEvaluation};
-use crate::slope::Slope;
+use crate::slope::{SignedSlope, Slope};
 
 /// Default creep speed of the set-valued resistive-force law's smoothing, m/s (docs/model.md
 /// §17): an element loaded below its resistive-force limit creeps at most this fast. A tenth of
@@ -419,16 +419,17 @@ pub fn rigid_rolling_step(robot: &crate::robot::Robot) -> f64 {
 /// Most legs per tripod the simulator takes (a 128-legged robot).
 pub const MAX_STANCE_LEGS: u32 = 64;
 
-/// Simulates `scenario`'s robot walking on its terrain at `slope_deg` (signed: negative walks
-/// downhill; the terrain is read at |slope| as docs/model.md §8) for `settings.duration_s`
-/// seconds, and measures the walk (docs/model.md §15-§18).
+/// Simulates `scenario`'s robot walking on its terrain at `signed` (negative walks downhill;
+/// the terrain is read at |slope| as docs/model.md §8) for `settings.duration_s` seconds, and
+/// measures the walk (docs/model.md §15-§18).
 pub fn simulate(
     scenario: &Scenario,
-    slope_deg: f64,
+    signed: SignedSlope,
     settings: &SimSettings,
 ) -> Result<Simulation, SimulateError> {
-    let slope = Slope::from_signed_degrees(slope_deg).map_err(|e| e.renamed("slope_deg"))?;
-    let closed_form = scenario.evaluate(slope_deg)?;
+    let slope = signed.felt();
+    let slope_deg = signed.degrees();
+    let closed_form = scenario.evaluate(signed);
     let robot = scenario.robot();
     // Decided before the legs are made: 2 n legs of `leg_elements` elements each (a robot file
     // with stance_legs = 1e9 asked for 8 GB and aborted; found by scripts/fuzz.sh).
@@ -618,13 +619,13 @@ fn summarise(
     }
 }
 
-/// Simulates every slope of `slopes_deg` in parallel (rayon), in order.
+/// Simulates every one of `slopes` in parallel (rayon), in order.
 pub fn simulate_slopes(
     scenario: &Scenario,
-    slopes_deg: &[f64],
+    slopes: &[SignedSlope],
     settings: &SimSettings,
 ) -> Result<Vec<Simulation>, SimulateError> {
-    slopes_deg.par_iter().map(|&d| simulate(scenario, d, settings)).collect()
+    slopes.par_iter().map(|&s| simulate(scenario, s, settings)).collect()
 }
 
 #[cfg(test)]

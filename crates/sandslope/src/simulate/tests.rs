@@ -9,6 +9,11 @@ use crate::model::{normal_equilibrium_depth, G};
 use crate::robot::{Robot, RobotSpec};
 use crate::terrain::{Ground, Terrain};
 
+/// A walk at a slope in degrees, validated here as the front ends validate it.
+fn simulate_deg(s: &Scenario, slope_deg: f64, settings: &SimSettings) -> Result<Simulation, SimulateError> {
+    simulate(s, SignedSlope::from_degrees(slope_deg)?, settings)
+}
+
 fn scenario(k_n: f64, k_s: f64) -> Scenario {
     Scenario::new(paper_robot(), Terrain::constant(k_n, k_s).unwrap(), None, None).unwrap()
 }
@@ -81,9 +86,10 @@ fn converges_on_the_builtin_terrain_with_the_pitch_locked() {
     // By hand: T / 2000 with T = 2 pi / omega = 1 s.
     assert!((default_dt - 5e-4).abs() < 1e-15);
     for slope in [0.0, 10.0, 15.0, 20.0] {
-        let reference = simulate(&s, slope, &base).unwrap().summary;
-        let finer = simulate(&s, slope, &base.with_dt(default_dt / 4.0).unwrap()).unwrap().summary;
-        let creep = simulate(&s, slope, &base.with_creep(DEFAULT_CREEP_M_S / 10.0).unwrap()).unwrap().summary;
+        let reference = simulate_deg(&s, slope, &base).unwrap().summary;
+        let finer = simulate_deg(&s, slope, &base.with_dt(default_dt / 4.0).unwrap()).unwrap().summary;
+        let creep =
+            simulate_deg(&s, slope, &base.with_creep(DEFAULT_CREEP_M_S / 10.0).unwrap()).unwrap().summary;
         for (what, m) in [("dt / 4", &finer), ("creep / 10", &creep)] {
             let dv = (m.speed_m_s - reference.speed_m_s).abs();
             assert!(
@@ -108,7 +114,7 @@ fn converges_on_the_builtin_terrain_with_the_pitch_locked() {
 fn the_level_walk_solves_its_sticking_steps() {
     let s = Scenario::new(paper_robot(), builtin_terrain(), None, None).unwrap();
     let settings = SimSettings::new(2.0).unwrap().with_body_pitch(BodyPitch::Locked);
-    let run = simulate(&s, 0.0, &settings).unwrap().summary;
+    let run = simulate_deg(&s, 0.0, &settings).unwrap().summary;
     // 2 s at 0.5 ms plus the settling: over 4,000 solves.
     assert!(run.unconverged_steps <= 10, "{} steps unconverged", run.unconverged_steps);
 }
@@ -120,18 +126,17 @@ fn bad_input_names_the_value_and_range() {
     assert_eq!(e.key, "duration_s");
     assert!(e.to_string().contains("greater than 0"), "{e}");
     let s = scenario(7e5, 2e6);
-    let short = simulate(&s, 0.0, &SimSettings::new(1.0).unwrap()).unwrap_err().to_string();
+    let short = simulate_deg(&s, 0.0, &SimSettings::new(1.0).unwrap()).unwrap_err().to_string();
     assert!(short.contains("duration_s = 1") && short.contains("1.5 T = 1.5"), "{short}");
     let coarse = SimSettings::new(5.0).unwrap().with_dt(0.05).unwrap();
-    let msg = simulate(&s, 0.0, &coarse).unwrap_err().to_string();
+    let msg = simulate_deg(&s, 0.0, &coarse).unwrap_err().to_string();
     // T / 100 = 0.01 s.
     assert!(msg.starts_with("dt_s = 0.05") && msg.contains("T / 100 = 1.000e-2"), "{msg}");
-    let msg = simulate(&s, 90.0, &SimSettings::new(5.0).unwrap()).unwrap_err().to_string();
+    let msg = simulate_deg(&s, 90.0, &SimSettings::new(5.0).unwrap()).unwrap_err().to_string();
     assert!(msg.starts_with("slope_deg = 90"), "{msg}");
     // No stiffness limit: stiff sand takes the same step (the contact is passive at any step).
-    assert!(
-        simulate(&scenario(7e9, 2e6), 0.0, &SimSettings::new(1.6).unwrap().with_dt(1e-3).unwrap()).is_ok()
-    );
+    assert!(simulate_deg(&scenario(7e9, 2e6), 0.0, &SimSettings::new(1.6).unwrap().with_dt(1e-3).unwrap())
+        .is_ok());
     let e = SimSettings::new(5.0).unwrap().with_creep(0.0).unwrap_err();
     assert!(e.key == "creep_m_s" && e.to_string().contains("between 1e-9 and 1e-3"), "{e}");
 }
@@ -140,8 +145,8 @@ fn bad_input_names_the_value_and_range() {
 #[test]
 fn closed_form_is_predicts_answer() {
     let s = scenario(7e5, 2e6);
-    let sim = simulate(&s, 12.0, &SimSettings::new(2.0).unwrap()).unwrap();
-    assert_eq!(sim.summary.closed_form, s.evaluate(12.0).unwrap());
+    let sim = simulate_deg(&s, 12.0, &SimSettings::new(2.0).unwrap()).unwrap();
+    assert_eq!(sim.summary.closed_form, s.evaluate(SignedSlope::from_degrees(12.0).unwrap()));
     assert_eq!(sim.summary.steps.len(), 4);
     assert_eq!(sim.summary.steps_measured, 2);
     // 2 s at 120 Hz: 241 samples from t = 0.
@@ -153,7 +158,7 @@ fn closed_form_is_predicts_answer() {
 /// them by hand to keep `simulate --json`'s order), then the simulation's quantities.
 #[test]
 fn a_step_serialises_the_gait_step_in_place() {
-    let sim = simulate(&scenario(7e5, 2e6), 12.0, &SimSettings::new(2.0).unwrap()).unwrap();
+    let sim = simulate_deg(&scenario(7e5, 2e6), 12.0, &SimSettings::new(2.0).unwrap()).unwrap();
     let step = sim.summary.steps[3];
     let v = serde_json::to_value(step).unwrap();
     let gait = serde_json::to_value(step.step).unwrap();
@@ -218,10 +223,10 @@ fn a_weak_servo_stalls_and_is_named() {
     let weak =
         Robot::new(RobotSpec { servo_torque_limit_n_m: Some(0.01), ..RobotSpec::paper_hexapod() }).unwrap();
     let s = Scenario::new(weak, Terrain::constant(7e5, 2e6).unwrap(), None, None).unwrap();
-    let m = simulate(&s, 10.0, &SimSettings::new(3.0).unwrap()).unwrap().summary;
+    let m = simulate_deg(&s, 10.0, &SimSettings::new(3.0).unwrap()).unwrap().summary;
     assert!(!m.stalled_legs.is_empty());
     assert!(m.steps.iter().any(|st| st.stall_s > 0.0));
-    let strong = simulate(&scenario(7e5, 2e6), 10.0, &SimSettings::new(3.0).unwrap()).unwrap().summary;
+    let strong = simulate_deg(&scenario(7e5, 2e6), 10.0, &SimSettings::new(3.0).unwrap()).unwrap().summary;
     assert!(strong.stalled_legs.is_empty());
     assert!(m.speed_m_s < strong.speed_m_s);
 }
@@ -234,8 +239,9 @@ fn dt_series() {
     for (slope, k_s) in [(0.0, 1e5), (10.0, 7e4), (10.0, 2e6)] {
         let s = scenario(7e5, k_s);
         for dt in [2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4] {
-            let m =
-                simulate(&s, slope, &SimSettings::new(4.0).unwrap().with_dt(dt).unwrap()).unwrap().summary;
+            let m = simulate_deg(&s, slope, &SimSettings::new(4.0).unwrap().with_dt(dt).unwrap())
+                .unwrap()
+                .summary;
             let sp: Vec<String> = m.steps.iter().map(|s| format!("{:.3}", s.step.speed_m_s)).collect();
             println!(
                 "{slope} {k_s} {dt}: v={:.4} t1={:?} d={:.4} {}",
@@ -262,10 +268,10 @@ fn table() {
         for pitch in [BodyPitch::Free, BodyPitch::Locked] {
             let base = SimSettings::new(dur).unwrap().with_body_pitch(pitch);
             let t = std::time::Instant::now();
-            let m = simulate(&s, slope, &base).unwrap().summary;
+            let m = simulate_deg(&s, slope, &base).unwrap().summary;
             let wall = t.elapsed().as_secs_f64();
             let t = std::time::Instant::now();
-            let f = simulate(&s, slope, &base.with_dt(1.25e-4).unwrap()).unwrap().summary;
+            let f = simulate_deg(&s, slope, &base.with_dt(1.25e-4).unwrap()).unwrap().summary;
             let wall4 = t.elapsed().as_secs_f64();
             let p = &m.closed_form.prediction;
             let ms = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{:.1}", v * 1e3));
@@ -346,10 +352,10 @@ fn motion_causes_serialise_as_the_closed_forms_names() {
 #[test]
 fn a_body_that_pitches_past_ninety_degrees_is_reported_as_pitched_over() {
     let settings = SimSettings::new(3.0).unwrap().with_dt(1e-3).unwrap().with_body_pitch(BodyPitch::Free);
-    let level = simulate(&scenario(7e5, 3.26e6), 0.0, &settings).unwrap().summary;
+    let level = simulate_deg(&scenario(7e5, 3.26e6), 0.0, &settings).unwrap().summary;
     assert!(level.pitch_over_s.is_none() && level.max_pitch_deg < 15.0, "{}", level.max_pitch_deg);
     assert_ne!(level.cause, MotionCause::PitchOver);
-    let steep = simulate(&scenario(7e5, 1.51e6), 20.0, &settings).unwrap().summary;
+    let steep = simulate_deg(&scenario(7e5, 1.51e6), 20.0, &settings).unwrap().summary;
     let t = steep.pitch_over_s.expect("pitched over");
     assert!(t < 2.0 && steep.max_pitch_deg > 90.0, "{t} {}", steep.max_pitch_deg);
     assert_eq!((steep.cause, steep.regime), (MotionCause::PitchOver, Regime::Slippage));
@@ -363,8 +369,8 @@ fn a_locked_body_keeps_its_pitch_at_zero_where_the_free_one_tumbles() {
     let free = SimSettings::new(3.0).unwrap().with_dt(1e-3).unwrap().with_body_pitch(BodyPitch::Free);
     let locked = free.with_body_pitch(BodyPitch::Locked);
     let s = scenario(7e5, 1.51e6);
-    assert!(simulate(&s, 20.0, &free).unwrap().summary.pitch_over_s.is_some());
-    let sim = simulate(&s, 20.0, &locked).unwrap();
+    assert!(simulate_deg(&s, 20.0, &free).unwrap().summary.pitch_over_s.is_some());
+    let sim = simulate_deg(&s, 20.0, &locked).unwrap();
     assert!(sim.trajectory.pitch_rad.iter().all(|&p| p == 0.0));
     let m = sim.summary;
     assert_eq!((m.max_pitch_deg, m.pitch_over_s, m.body_pitch), (0.0, None, BodyPitch::Locked));
@@ -377,7 +383,7 @@ fn a_locked_body_keeps_its_pitch_at_zero_where_the_free_one_tumbles() {
 fn a_locked_body_on_stiff_level_sand_steps_the_rigid_rolling_step() {
     let by_hand = rigid_rolling_step(&paper_robot());
     let settings = SimSettings::new(2.5).unwrap().with_body_pitch(BodyPitch::Locked);
-    let m = simulate(&scenario(1e8, 1e8), 0.0, &settings).unwrap().summary;
+    let m = simulate_deg(&scenario(1e8, 1e8), 0.0, &settings).unwrap().summary;
     assert!(m.steps_measured >= 2);
     assert!((m.step_m / by_hand - 1.0).abs() < 0.02, "step {} m vs rolling {by_hand} m", m.step_m);
 }
@@ -411,7 +417,7 @@ fn explore() {
                     .with_body_pitch(pitch)
                     .with_creep(creep)
                     .unwrap();
-                let m = simulate(&s, slope, &set).unwrap().summary;
+                let m = simulate_deg(&s, slope, &set).unwrap().summary;
                 println!(
                     "{slope} {:?} dt={dt:e}: v={:.3} cm/s t1={:?} reg={:?} step={:.1}mm depth={:.1}mm pitch={:.1} unconv={} [{:.2}s]",
                     pitch, m.speed_m_s * 100.0, m.t1_s.map(|t| (t * 1e4).round() / 10.0), m.regime, m.step_m * 1e3,
@@ -495,7 +501,7 @@ fn a_robot_with_held_legs_never_gains_energy() {
 fn builtin_walk(slope_deg: f64, robot: Robot, mechanisms: Mechanisms, duration_s: f64) -> Simulation {
     let s = Scenario::new(robot, builtin_terrain(), None, None).unwrap();
     let settings = SimSettings::new(duration_s).unwrap().with_mechanisms(mechanisms).unwrap();
-    simulate(&s, slope_deg, &settings).unwrap()
+    simulate_deg(&s, slope_deg, &settings).unwrap()
 }
 
 /// §20.2 by hand: at duty cycle D = 0.7 (T = 1 s) an ideal servo's leg of tripod 0 has turned
@@ -552,7 +558,7 @@ fn pitch_trace() {
     let slope: f64 = std::env::var("SLOPE").ok().and_then(|x| x.parse().ok()).unwrap_or(10.0);
     for dt in [5e-4, 1.25e-4] {
         let set = SimSettings::new(3.0).unwrap().with_dt(dt).unwrap().with_body_pitch(BodyPitch::Free);
-        let sim = simulate(&s, slope, &set).unwrap();
+        let sim = simulate_deg(&s, slope, &set).unwrap();
         let tr = &sim.trajectory;
         println!("dt {dt}");
         for i in (0..tr.time_s.len()).step_by(3) {
@@ -591,7 +597,7 @@ fn free_pitch_ensemble() {
                     let s = Scenario::new(robot, builtin_terrain(), None, None).unwrap();
                     let set =
                         SimSettings::new(dur).unwrap().with_dt(dt).unwrap().with_body_pitch(BodyPitch::Free);
-                    simulate(&s, slope, &set).unwrap()
+                    simulate_deg(&s, slope, &set).unwrap()
                 })
                 .collect();
             let v: Vec<f64> = walks.iter().map(|w| w.summary.speed_m_s * 100.0).collect();
@@ -631,7 +637,7 @@ fn the_free_body_is_chaotic_and_its_ensemble_converges() {
         let robot = paper_robot().with_mass(0.35 * (1.0 + 1e-9 * k as f64)).unwrap();
         let s = Scenario::new(robot, builtin_terrain(), None, None).unwrap();
         let set = SimSettings::new(5.0).unwrap().with_dt(dt).unwrap().with_body_pitch(pitch);
-        simulate(&s, 10.0, &set).unwrap()
+        simulate_deg(&s, 10.0, &set).unwrap()
     };
     let dt = 5e-4;
     let (a, b) = (walk(0, dt, BodyPitch::Free), walk(1, dt, BodyPitch::Free));

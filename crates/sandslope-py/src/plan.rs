@@ -16,9 +16,9 @@ use sandslope::plan::{
     Cell, Descent, ElevationGrid, Objective, PitchTableCache, PlanRequest, PlanSettings, Planner, Route,
 };
 use sandslope::risk::UncertainTerrain;
-use sandslope::Regime;
 use sandslope_io::pds3::Pds3Dtm;
 use sandslope_io::raster::read_raster as read;
+use sandslope_request::plan::RouteRecord;
 
 use crate::arrays::put;
 use crate::types::{PyRobot, PyTerrain};
@@ -139,55 +139,38 @@ fn cell(which: &str, rc: (i64, i64), rows: usize, cols: usize) -> PyResult<Cell>
     Ok(Cell { col: c as usize, row: r as usize })
 }
 
+/// A route as `plan --json` prints it (the request layer's `RouteRecord`: every figure, null
+/// where no route exists), with the found route's cells, coordinates, heights and steps as arrays.
 fn route_dict<'py>(
     py: Python<'py>,
     r: &Result<Route, sandslope::plan::NoRoute>,
     planner: &Planner,
     origin: (f64, f64),
 ) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    match r {
-        Err(e) => {
-            d.set_item("found", false)?;
-            d.set_item("reason", pythonize::pythonize(py, e).map_err(value_error)?)?;
-            d.set_item("message", e.explain())?;
-        }
-        Ok(r) => {
-            let g = planner.grid();
-            d.set_item("found", true)?;
-            d.set_item("length_m", r.length_m)?;
-            d.set_item("time_s", r.time_s)?;
-            d.set_item("survival", r.survival)?;
-            d.set_item("max_pitch_deg", r.max_pitch_deg)?;
-            d.set_item("max_roll_deg", r.max_roll_deg)?;
-            d.set_item("edges_over_roll_limit", r.over_roll_limit)?;
-            let counts = PyDict::new(py);
-            for (g, n) in Regime::ALL.iter().zip(r.regimes) {
-                counts.set_item(g.name(), n)?;
-            }
-            d.set_item("regimes", counts)?;
-            put(&d, "rows", r.cells.iter().map(|c| c.row as i64).collect())?;
-            put(&d, "cols", r.cells.iter().map(|c| c.col as i64).collect())?;
-            // East of the west edge along the cell's own row: on a geographic DEM each row's
-            // cells have their own width (`row_widths_m`), on a uniform grid this is cell_x.
-            put(
-                &d,
-                "x_m",
-                r.cells.iter().map(|c| origin.0 + (c.col as f64 + 0.5) * g.cell_x_at(c.row)).collect(),
-            )?;
-            put(&d, "y_m", r.cells.iter().map(|c| origin.1 - (c.row as f64 + 0.5) * g.cell_y()).collect())?;
-            put(&d, "z_m", r.cells.iter().map(|&c| g.height(c).unwrap_or(f64::NAN)).collect())?;
-            let steps = PyDict::new(py);
-            put(&steps, "heading_deg", r.steps.iter().map(|s| s.heading_deg).collect())?;
-            put(&steps, "pitch_deg", r.steps.iter().map(|s| s.pitch_deg).collect())?;
-            put(&steps, "roll_deg", r.steps.iter().map(|s| s.roll_deg).collect())?;
-            put(&steps, "length_m", r.steps.iter().map(|s| s.length_m).collect())?;
-            put(&steps, "regime", r.steps.iter().map(|s| s.regime as i8).collect())?;
-            put(&steps, "speed_m_s", r.steps.iter().map(|s| s.speed.unwrap_or(f64::NAN)).collect())?;
-            put(&steps, "p_fail", r.steps.iter().map(|s| s.p_fail).collect())?;
-            put(&steps, "over_roll_limit", r.steps.iter().map(|s| s.over_roll_limit).collect())?;
-            d.set_item("steps", steps)?;
-        }
+    let d = pythonize::pythonize(py, &RouteRecord::from(r)).map_err(value_error)?.cast_into::<PyDict>()?;
+    if let Ok(r) = r {
+        let g = planner.grid();
+        put(&d, "rows", r.cells.iter().map(|c| c.row as i64).collect())?;
+        put(&d, "cols", r.cells.iter().map(|c| c.col as i64).collect())?;
+        // East of the west edge along the cell's own row: on a geographic DEM each row's
+        // cells have their own width (`row_widths_m`), on a uniform grid this is cell_x.
+        put(
+            &d,
+            "x_m",
+            r.cells.iter().map(|c| origin.0 + (c.col as f64 + 0.5) * g.cell_x_at(c.row)).collect(),
+        )?;
+        put(&d, "y_m", r.cells.iter().map(|c| origin.1 - (c.row as f64 + 0.5) * g.cell_y()).collect())?;
+        put(&d, "z_m", r.cells.iter().map(|&c| g.height(c).unwrap_or(f64::NAN)).collect())?;
+        let steps = PyDict::new(py);
+        put(&steps, "heading_deg", r.steps.iter().map(|s| s.heading_deg).collect())?;
+        put(&steps, "pitch_deg", r.steps.iter().map(|s| s.pitch_deg).collect())?;
+        put(&steps, "roll_deg", r.steps.iter().map(|s| s.roll_deg).collect())?;
+        put(&steps, "length_m", r.steps.iter().map(|s| s.length_m).collect())?;
+        put(&steps, "regime", r.steps.iter().map(|s| s.regime as i8).collect())?;
+        put(&steps, "speed_m_s", r.steps.iter().map(|s| s.speed.unwrap_or(f64::NAN)).collect())?;
+        put(&steps, "p_fail", r.steps.iter().map(|s| s.p_fail).collect())?;
+        put(&steps, "over_roll_limit", r.steps.iter().map(|s| s.over_roll_limit).collect())?;
+        d.set_item("steps", steps)?;
     }
     Ok(d)
 }

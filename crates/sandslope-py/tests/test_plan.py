@@ -164,3 +164,31 @@ def test_plan_with_terrain_classes_matches_the_cli(cli, robot, terrain, dune, tm
     with pytest.raises(ValueError, match=r"classes has shape \(3, 3\)"):
         sandslope.plan(z, 0.3, robot=robot, terrain=terrain, start=(100, 60), goal=(100, 140),
                        classes=np.ones((3, 3)), class_terrains={1: terrain})
+
+
+WALL = """ncols 6
+nrows 5
+xllcorner 0
+yllcorner 0
+cellsize 1
+""" + "0 0 3 6 6 6\n" * 5
+
+
+def test_a_route_not_found_has_the_keys_of_plan_json(cli, robot, terrain, tmp_path):
+    """A 3 m step per 1 m cell (71.6 deg, far above any repose): no time or risk route leaves the
+    start. Each route has exactly the keys and values of `plan --json` (nulls for the figures
+    of a route not found), the found distance route those keys plus its arrays."""
+    dem = tmp_path / "wall.asc"
+    dem.write_text(WALL)
+    want = cli.json("plan", "--dem", dem, "--start-px", "1,2", "--goal-px", "4,2", "--objective", "time,risk")
+    z, geo = sandslope.read_raster(dem)
+    got = sandslope.plan(z, 1.0, robot=robot, terrain=terrain, start=(2, 1), goal=(2, 4),
+                         objective=["time", "risk"])["routes"]
+    assert set(got) == set(want["routes"]) == {"time", "risk", "distance"}
+    for name in ("time", "risk"):
+        assert want["routes"][name]["found"] is False
+        assert got[name] == want["routes"][name], name
+    w, g = want["routes"]["distance"], got["distance"]
+    assert w["found"] and set(g) == set(w) | {"rows", "cols", "x_m", "y_m", "z_m", "steps"}
+    for k, v in w.items():
+        assert g[k] == (pytest.approx(v, rel=1e-12) if isinstance(v, float) else v), k

@@ -479,7 +479,8 @@ def plan(
     "last_point_deg"}}`` (set when a route climbs above the terrain's last measured point);
     each route has the figures of ``plan --json``
     (``found``, ``length_m``, ``time_s``, ``survival``, ``max_pitch_deg``, ``max_roll_deg``,
-    ``edges_over_roll_limit``, ``regimes``; or ``found=False`` with ``reason`` and ``message``),
+    ``edges_over_roll_limit``, ``regimes``; or ``found=False`` with ``reason`` and ``message``
+    and those figures None, as ``plan --json`` has them null),
     its cells (``rows``, ``cols``), their coordinates ``x_m``, ``y_m`` (cell centres; x east and
     y north of ``origin``, the map's north-west corner, default ``(0, rows * cell_y)``; with
     ``row_widths_m``, x is measured along the cell's own row, in that row's cell widths) and

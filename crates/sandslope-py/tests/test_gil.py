@@ -44,3 +44,15 @@ def test_simulate_releases_the_gil():
     assert_releases_the_gil(
         lambda: sandslope.simulate("paper-hexapod", "glass-beads-300um", 10, 150, sample_rate_hz=10)
     )
+
+
+def test_calibrate_releases_the_gil(root):
+    robot, terrain = sandslope.Robot.preset("paper-hexapod"), sandslope.Terrain.preset("glass-beads-300um")
+    speeds, forces = root / "data/paper-speeds.csv", str(root / "data/example-force-tests.toml")
+
+    def call():
+        # docs/calibration.md's joint fit, about 30 ms each (profile intervals included).
+        for _ in range(10):
+            sandslope.calibrate(robot, terrain, observed=speeds, forces=forces, free="plate_scale,error_floor")
+
+    assert_releases_the_gil(call)

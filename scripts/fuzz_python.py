@@ -26,6 +26,8 @@ TARGETS = {
     "py-terrain": ("read-terrain", "sandslope.Terrain.from_toml(path)"),
     "py-track": ("read-mocap", "sandslope.track([path], slope_deg=20.0)"),
     "py-fit": ("read-manifest", "sandslope.fit(path, counts_per_newton=2000.0)"),
+    # Each speed inverted alone (the cheapest fit): the reader and the inversion on mutated speeds.
+    "py-calibrate": ("read-speeds", "sandslope.calibrate(observed=path, law='per-slope')"),
 }
 EXPECTED = (ValueError, OSError, TypeError, KeyError)
 CHUNK = 200

@@ -77,7 +77,7 @@ static PITCH_TABLES: LazyLock<PitchTableCache> = LazyLock::new(PitchTableCache::
 /// climb (degrees from north), as `sandslope plan --risk-map` writes them: `2 * rows * cols`
 /// float32 values, band after band.
 #[pyfunction]
-#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, row_widths_m=None))]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, nodata=None, cv_n=None, cv_s=None, max_roll_deg=sandslope::plan::DEFAULT_MAX_ROLL_DEG, descent="symmetric", allow_metastable=false, row_widths_m=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn risk_raster<'py>(
     py: Python<'py>,
@@ -179,7 +179,7 @@ fn route_dict<'py>(
 /// `plan::plan` (what `sandslope plan` computes): `{"routes": {name: route}, "extrapolation":
 /// None or {max_pitch_deg, last_point_deg}}`.
 #[pyfunction]
-#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=20.0, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT, classes=None, class_terrains=None, row_widths_m=None))]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=sandslope::plan::DEFAULT_MAX_ROLL_DEG, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT, classes=None, class_terrains=None, row_widths_m=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan<'py>(
     py: Python<'py>,

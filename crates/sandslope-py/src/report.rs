@@ -21,7 +21,7 @@ use crate::{anyhow_error, value_error};
 /// `html`: a folder to write the page into, `index.html` and `report.json`, byte for byte what
 /// `sandslope report --out` writes (the render crate's `report::write_dir`).
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, robot_source, terrain_source, observed=None, forces=None, t1=None, tracks=None, tracks_format=None, tracks_body=None, tracks_upslope=None, max_risk=0.05, simulator_fit=false, html=None))]
+#[pyo3(signature = (robot, terrain, robot_source, terrain_source, observed=None, forces=None, t1=None, tracks=None, tracks_format=None, tracks_body=None, tracks_upslope=None, max_risk=sandslope::risk::DEFAULT_MAX_RISK, simulator_fit=false, html=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn report(
     py: Python<'_>,

@@ -111,7 +111,7 @@ pub fn risk<'py>(
 /// prints (the library's `RiskMapAnswer`, key for key), its axis values and cells as NumPy
 /// arrays (cells row-major, one row per k_s); an axis not given is the library's default.
 #[pyfunction]
-#[pyo3(signature = (robot, slope_deg, k_n_axis, k_s_axis, terrain, max_risk=0.05, cv_n=None, cv_s=None))]
+#[pyo3(signature = (robot, slope_deg, k_n_axis, k_s_axis, terrain, max_risk=sandslope::risk::DEFAULT_MAX_RISK, cv_n=None, cv_s=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn risk_map<'py>(
     py: Python<'py>,
@@ -164,7 +164,7 @@ pub fn risk_map<'py>(
 /// The safe-slope limit with the uncertainty it used: the value `sandslope risk --solve slope
 /// --json` prints.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, max_risk=0.05, cv_n=None, cv_s=None))]
+#[pyo3(signature = (robot, terrain, max_risk=sandslope::risk::DEFAULT_MAX_RISK, cv_n=None, cv_s=None))]
 pub fn safe_slope<'py>(
     py: Python<'py>,
     robot: &PyRobot,
@@ -182,7 +182,7 @@ pub fn safe_slope<'py>(
 /// The heaviest safe total mass at one slope, the payload it leaves and the uncertainty it used:
 /// the value `sandslope risk --solve mass --json` prints.
 #[pyfunction]
-#[pyo3(signature = (robot, slope_deg, terrain, max_risk=0.05, cv_n=None, cv_s=None))]
+#[pyo3(signature = (robot, slope_deg, terrain, max_risk=sandslope::risk::DEFAULT_MAX_RISK, cv_n=None, cv_s=None))]
 pub fn safe_mass<'py>(
     py: Python<'py>,
     robot: &PyRobot,
@@ -204,7 +204,7 @@ pub fn safe_mass<'py>(
 /// with the uncertainty used there: the value `sandslope risk --slope A,B,... --solve mass
 /// --json` prints.
 #[pyfunction]
-#[pyo3(signature = (robot, slope_deg, terrain, max_risk=0.05, cv_n=None, cv_s=None))]
+#[pyo3(signature = (robot, slope_deg, terrain, max_risk=sandslope::risk::DEFAULT_MAX_RISK, cv_n=None, cv_s=None))]
 pub fn payload_envelope<'py>(
     py: Python<'py>,
     robot: &PyRobot,

@@ -134,3 +134,19 @@ def test_risk_map_matches_pointwise_risk(robot):
             # The map shares the critical-strength curve between cells (docs/phase-and-risk.md);
             # the library keeps it within 1e-6 of the per-cell quadrature.
             assert m["p_fail"][i, j] == pytest.approx(float(one["p_fail"]), abs=1e-6)
+
+
+def test_defaults_are_the_documented_ones_everywhere(cli):
+    """max_risk 0.05 (docs/model.md §9) and max_roll_deg 20 (§8) are one constant each, which
+    every Python signature and the CLI's help show."""
+    import inspect
+
+    import sandslope.dask
+
+    for f in (sandslope.risk_map, sandslope.safe_slope, sandslope.safe_mass, sandslope.payload_envelope,
+              sandslope.report):
+        assert inspect.signature(f).parameters["max_risk"].default == 0.05, f.__name__
+    for f in (sandslope.plan, sandslope.risk_raster, sandslope.dask.risk_raster):
+        assert inspect.signature(f).parameters["max_roll_deg"].default == 20.0, f.__name__
+    assert "[default: 0.05]" in cli.run("risk", "--help").stdout
+    assert "[default: 20]" in cli.run("plan", "--help").stdout

@@ -45,7 +45,7 @@ impl Default for DesignRequest {
             terrain: DEFAULT_TERRAIN.to_string(),
             cv_n: None,
             cv_s: None,
-            max_risk: 0.05,
+            max_risk: sandslope::risk::DEFAULT_MAX_RISK,
         }
     }
 }

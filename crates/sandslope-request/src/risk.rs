@@ -112,7 +112,7 @@ impl RiskRequest {
         let max_risk = match p.text("max-risk")? {
             Some(text) => grammar::parse_max_risk(text)
                 .map_err(|why| RequestError::invalid("max-risk", format!("--max-risk = {text}: {why}")))?,
-            None => 0.05,
+            None => sandslope::risk::DEFAULT_MAX_RISK,
         };
         let solve = match p.text("solve")? {
             None => None,

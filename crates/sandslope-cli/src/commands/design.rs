@@ -39,7 +39,7 @@ pub struct DesignArgs {
     #[command(flatten)]
     pub uncertainty: UncertaintyArgs,
     /// Largest acceptable failure probability, for the safe-slope limit.
-    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value = "0.05", value_parser = parse_max_risk)]
+    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = sandslope::risk::DEFAULT_MAX_RISK, value_parser = parse_max_risk)]
     pub max_risk: f64,
     /// Print every design as JSON instead of the front as a table.
     #[arg(long)]

@@ -62,7 +62,7 @@ pub struct ReportArgs {
     )]
     pub tracks_upslope: Option<[f64; 3]>,
     /// Risk threshold for the safe-slope limit.
-    #[arg(long, allow_negative_numbers = true, value_name = "P", default_value = "0.05", value_parser = parse_max_risk)]
+    #[arg(long, allow_negative_numbers = true, value_name = "P", default_value_t = sandslope::risk::DEFAULT_MAX_RISK, value_parser = parse_max_risk)]
     pub max_risk: f64,
     /// Fail (exit code 4, after writing the page) when the report carries a warning: a
     /// calibration quantity at its search bound, chi^2/dof > 3, or tracks that could not be

@@ -53,7 +53,7 @@ pub struct RiskArgs {
     #[command(flatten)]
     pub uncertainty: UncertaintyArgs,
     /// Largest acceptable failure probability, for the safe-slope limit and --solve.
-    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value = "0.05", value_parser = parse_max_risk)]
+    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = sandslope::risk::DEFAULT_MAX_RISK, value_parser = parse_max_risk)]
     pub max_risk: f64,
     /// Solve for the safe-slope limit (`slope`) or the heaviest safe mass at each --slope
     /// (`mass`; several slopes give the payload envelope).

@@ -298,7 +298,7 @@ def risk_map(
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
     mass_kg: Optional[float] = None,
-    max_risk: float = 0.05,
+    max_risk: float = _sandslope.DEFAULT_MAX_RISK,
 ) -> Dict[str, Any]:
     """P(failure) over a grid of median ``(k_n, k_s)`` at one slope (``sandslope risk --map``).
 
@@ -333,7 +333,7 @@ def safe_slope(
     robot: RobotLike,
     *,
     terrain: TerrainLike,
-    max_risk: float = 0.05,
+    max_risk: float = _sandslope.DEFAULT_MAX_RISK,
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
 ) -> Dict[str, Any]:
@@ -359,7 +359,7 @@ def safe_mass(
     slope_deg: float,
     *,
     terrain: TerrainLike,
-    max_risk: float = 0.05,
+    max_risk: float = _sandslope.DEFAULT_MAX_RISK,
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
 ) -> Dict[str, Any]:
@@ -376,7 +376,7 @@ def payload_envelope(
     slope_deg: Any,
     *,
     terrain: TerrainLike,
-    max_risk: float = 0.05,
+    max_risk: float = _sandslope.DEFAULT_MAX_RISK,
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
 ) -> Dict[str, Any]:
@@ -400,7 +400,7 @@ def risk_raster(
     terrain: TerrainLike,
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
-    max_roll_deg: float = 20.0,
+    max_roll_deg: float = _sandslope.DEFAULT_MAX_ROLL_DEG,
     descent: str = "symmetric",
     allow_metastable: bool = False,
     nodata: Optional[float] = None,
@@ -458,7 +458,7 @@ def plan(
     objective: Union[str, Sequence[str]] = "time",
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
-    max_roll_deg: float = 20.0,
+    max_roll_deg: float = _sandslope.DEFAULT_MAX_ROLL_DEG,
     descent: str = "symmetric",
     allow_metastable: bool = False,
     time_weight: float = 1e-4,
@@ -662,7 +662,7 @@ def report(
     tracks_format: Optional[str] = None,
     tracks_body: Optional[str] = None,
     tracks_upslope: Optional[Sequence[float]] = None,
-    max_risk: float = 0.05,
+    max_risk: float = _sandslope.DEFAULT_MAX_RISK,
     simulator_fit: bool = False,
     html: Optional[_PathLike] = None,
 ) -> Dict[str, Any]:

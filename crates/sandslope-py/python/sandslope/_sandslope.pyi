@@ -12,6 +12,8 @@ _F64 = npt.NDArray[np.float64]
 
 REGIMES: Tuple[str, str, str, str]
 CAUSES: Tuple[str, ...]
+DEFAULT_MAX_RISK: float
+DEFAULT_MAX_ROLL_DEG: float
 
 class Robot:
     """A legged robot (docs/model.md §2), validated when built.

@@ -275,7 +275,7 @@ def risk_raster(
     terrain: Any,
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,
-    max_roll_deg: float = 20.0,
+    max_roll_deg: float = _sandslope.DEFAULT_MAX_ROLL_DEG,
     descent: str = "symmetric",
     allow_metastable: bool = False,
     nodata: Optional[float] = None,

@@ -170,7 +170,7 @@ impl PlanRequest {
         let terrain = p.text_or("terrain", DEFAULT_TERRAIN)?;
         let allow_metastable = yes_no(&mut p, "allow-metastable")?;
         let time_weight = p.number_or("time-weight", sandslope::plan::DEFAULT_TIME_WEIGHT)?;
-        let max_roll = p.number_or("max-roll", 20.0)?;
+        let max_roll = p.number_or("max-roll", sandslope::plan::DEFAULT_MAX_ROLL_DEG)?;
         let descent = match p.text("descent")? {
             None => Descent::default(),
             Some(text) => Descent::parse(text).ok_or_else(|| {

@@ -133,7 +133,7 @@ impl Default for PlanSettings {
     /// Roll limit 20 degrees, symmetric descent, success only, time weight 1e-4 per second.
     fn default() -> Self {
         PlanSettings {
-            max_roll: Slope::from_degrees(20.0).unwrap_or(Slope::LEVEL),
+            max_roll: Slope::from_degrees(DEFAULT_MAX_ROLL_DEG).unwrap_or(Slope::LEVEL),
             descent: Descent::Symmetric,
             allow_metastable: false,
             time_weight: DEFAULT_TIME_WEIGHT,
@@ -145,6 +145,10 @@ impl Default for PlanSettings {
 /// as much as a 1 % failure risk (`-ln(0.99) = 0.01`). A **choice** that breaks ties
 /// between equally safe routes in favour of the faster one.
 pub const DEFAULT_TIME_WEIGHT: f64 = 1e-4;
+
+/// The cross-slope (roll) limit when none is given, degrees (`--max-roll`, Python's
+/// `max_roll_deg`): steeper cross slopes are impassable (docs/model.md §8).
+pub const DEFAULT_MAX_ROLL_DEG: f64 = 20.0;
 
 impl PlanSettings {
     /// Settings: cross-slope limit `max_roll_deg` in `(0, 90)`, the descent rule, whether

@@ -33,6 +33,11 @@ pub mod quadrature;
 pub mod results;
 pub mod uncertainty;
 
+/// The largest acceptable failure probability when none is given (`--max-risk`, Python's
+/// `max_risk`): the safe-slope limit, the heaviest safe mass and a design's risk target are
+/// taken at p_fail = 0.05 (docs/model.md §9).
+pub const DEFAULT_MAX_RISK: f64 = 0.05;
+
 pub use curve::{risk_curve, RiskCurve, RiskPoint};
 pub use failure_probability::p_fail;
 pub use limits::{

@@ -104,7 +104,7 @@ pub struct PlanArgs {
     #[arg(long, allow_negative_numbers = true, value_name = "PER_S", default_value_t = sandslope::plan::DEFAULT_TIME_WEIGHT)]
     pub time_weight: f64,
     /// Cross-slope (roll) limit, degrees: steeper cross slopes are impassable.
-    #[arg(long, allow_negative_numbers = true, value_name = "DEG", default_value_t = 20.0)]
+    #[arg(long, allow_negative_numbers = true, value_name = "DEG", default_value_t = sandslope::plan::DEFAULT_MAX_ROLL_DEG)]
     pub max_roll: f64,
     /// How descending edges are evaluated.
     #[arg(long, value_enum, default_value = "symmetric")]

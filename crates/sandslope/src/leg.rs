@@ -35,6 +35,17 @@ pub trait Leg {
     /// s*): the horizontal distance the hip travels while the leg's lowest point is below that
     /// depth, the chord of the circle that point turns on, m; 0 when it never gets there.
     fn level_step(&self, d: f64) -> f64;
+
+    /// The leg's outline as the simulator discretises it (docs/model.md §15): `elements + 1`
+    /// nodes in the leg's own frame, x forward and z up from the hip, at crank angle 0; the
+    /// simulator turns them clockwise by the crank angle (angle pi/2 takes node `(x, 0)` to
+    /// `(0, -x)`), so a node `(x, z)` is `x sin(psi) - z cos(psi) - h` below the surface.
+    fn outline(&self, elements: usize) -> Vec<[f64; 2]>;
+}
+
+/// The fraction `k / elements` of node `k` along an outline.
+fn fractions(elements: usize) -> impl Iterator<Item = f64> {
+    (0..=elements).map(move |k| k as f64 / elements as f64)
 }
 
 /// The paper's C-leg (docs/model.md §4): a semicircular arc of radius `R` whose lowest point
@@ -84,6 +95,134 @@ impl Leg for CLeg {
         let r = self.radius;
         let x = d + self.hip_height - r;
         2.0 * (r * r - x * x).max(0.0).sqrt()
+    }
+
+    /// The semicircle from the hip to the tip `2R` ahead, its centre at `(R, 0)`.
+    fn outline(&self, elements: usize) -> Vec<[f64; 2]> {
+        let r = self.radius;
+        fractions(elements)
+            .map(|f| {
+                let u = std::f64::consts::PI * f;
+                [r * (1.0 - u.cos()), -r * u.sin()]
+            })
+            .collect()
+    }
+}
+
+/// A straight plate from the hip to `2R` along the C-leg's diameter (docs/model.md §15's
+/// spoke): its tip, the lowest point, is `2R sin(psi) - h` below the surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spoke {
+    /// Leg radius R (the spoke is 2R long), m.
+    pub radius: f64,
+    /// Hip height h above the undisturbed surface, m.
+    pub hip_height: f64,
+}
+
+impl Leg for Spoke {
+    /// `d(psi) = 2R sin(psi) - h`.
+    fn depth_at(&self, psi: f64) -> f64 {
+        2.0 * self.radius * psi.sin() - self.hip_height
+    }
+
+    /// `asin(h / 2R)`.
+    fn touchdown_angle(&self) -> f64 {
+        (self.hip_height / (2.0 * self.radius)).clamp(-1.0, 1.0).asin()
+    }
+
+    /// `pi / 2`: the spoke straight down.
+    fn deepest_angle(&self) -> f64 {
+        std::f64::consts::FRAC_PI_2
+    }
+
+    /// `asin((d + h) / 2R)`.
+    fn angle_at_depth(&self, d: f64) -> Option<f64> {
+        if d > self.max_depth() || d.is_nan() {
+            return None;
+        }
+        Some(((d + self.hip_height) / (2.0 * self.radius)).clamp(-1.0, 1.0).asin())
+    }
+
+    /// The tip's circle (radius 2R about the hip) cut `d + h` below the hip:
+    /// `2 sqrt((2R)^2 - (d + h)^2)`.
+    fn level_step(&self, d: f64) -> f64 {
+        let (l, x) = (2.0 * self.radius, d + self.hip_height);
+        2.0 * (l * l - x * x).max(0.0).sqrt()
+    }
+
+    /// Nodes from the hip to `(2R, 0)`.
+    fn outline(&self, elements: usize) -> Vec<[f64; 2]> {
+        let r = self.radius;
+        fractions(elements).map(|f| [2.0 * r * f, 0.0]).collect()
+    }
+}
+
+/// A flat foot of length `l` (the contact area over the leg width), `R` below the hip and
+/// centred under it at crank angle 0 (docs/model.md §3's contact, which the simulator's
+/// static oracle holds there). Turned by `psi` its lowest point is an end:
+/// `d(psi) = R cos(psi) + (l/2) |sin(psi)| - h`, deepest at `psi = -atan(l / 2R)` with the
+/// rear end `rho = sqrt(R^2 + l^2/4)` from the hip straight below it; the descent to it is
+/// that end's circle, `rho cos(psi + atan(l / 2R)) - h`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Foot {
+    /// Distance R of the foot below the hip, m.
+    pub radius: f64,
+    /// Foot length l, m.
+    pub length: f64,
+    /// Hip height h above the undisturbed surface, m.
+    pub hip_height: f64,
+}
+
+impl Foot {
+    /// The ends' distance from the hip, `sqrt(R^2 + l^2/4)`, m, and their angle off the
+    /// foot's centre, `atan(l / 2R)`, rad.
+    fn end(&self) -> (f64, f64) {
+        let half = 0.5 * self.length;
+        (self.radius.hypot(half), half.atan2(self.radius))
+    }
+}
+
+impl Leg for Foot {
+    /// `R cos(psi) + (l/2) |sin(psi)| - h`.
+    fn depth_at(&self, psi: f64) -> f64 {
+        self.radius * psi.cos() + 0.5 * self.length * psi.sin().abs() - self.hip_height
+    }
+
+    /// `-atan(l / 2R) - acos(h / rho)`: the rear end reaching the surface.
+    fn touchdown_angle(&self) -> f64 {
+        let (rho, a) = self.end();
+        -a - (self.hip_height / rho).clamp(-1.0, 1.0).acos()
+    }
+
+    /// `-atan(l / 2R)`.
+    fn deepest_angle(&self) -> f64 {
+        -self.end().1
+    }
+
+    /// `rho - h`.
+    fn max_depth(&self) -> f64 {
+        self.end().0 - self.hip_height
+    }
+
+    /// `-atan(l / 2R) - acos((d + h) / rho)`.
+    fn angle_at_depth(&self, d: f64) -> Option<f64> {
+        if d > self.max_depth() || d.is_nan() {
+            return None;
+        }
+        let (rho, a) = self.end();
+        Some(-a - ((d + self.hip_height) / rho).clamp(-1.0, 1.0).acos())
+    }
+
+    /// The rear end's circle (radius rho about the hip) cut `d + h` below the hip.
+    fn level_step(&self, d: f64) -> f64 {
+        let (rho, x) = (self.end().0, d + self.hip_height);
+        2.0 * (rho * rho - x * x).max(0.0).sqrt()
+    }
+
+    /// Nodes from `(-l/2, -R)` to `(l/2, -R)`.
+    fn outline(&self, elements: usize) -> Vec<[f64; 2]> {
+        let (l, r) = (self.length, self.radius);
+        fractions(elements).map(|f| [-0.5 * l + l * f, -r]).collect()
     }
 }
 
@@ -136,15 +275,67 @@ mod tests {
         close(time_to_deepest(&leg, 2.0 * PI), (FRAC_PI_2 + 0.25f64.asin()) / (2.0 * PI), 1e-15);
     }
 
+    /// The deepest node of `leg`'s outline turned by `psi` as the simulator turns it
+    /// (`x sin(psi) - z cos(psi) - h` below the surface), m.
+    fn outline_depth(leg: &impl Leg, h: f64, psi: f64) -> f64 {
+        let nodes = leg.outline(4000);
+        nodes.iter().map(|p| p[0] * psi.sin() - p[1] * psi.cos() - h).fold(f64::MIN, f64::max)
+    }
+
+    /// The simulator's outlines agree with the closed form's depth at every crank angle (to
+    /// the discretisation: nodes pi/4000 rad apart on a 4 cm arc
+    /// miss its lowest point by at most R (1 - cos(pi/8000)) = 3.1e-9 m),
+    /// over the half turn each closed form describes.
+    #[test]
+    fn outlines_reach_the_closed_form_depth() {
+        let c = CLeg { radius: 0.04, hip_height: 0.03 };
+        let spoke = Spoke { radius: 0.04, hip_height: 0.03 };
+        let foot = Foot { radius: 0.04, length: 0.04, hip_height: 0.03 };
+        for k in 0..=40 {
+            let psi = -1.5 + 3.0 * k as f64 / 40.0;
+            close(outline_depth(&c, 0.03, psi), c.depth_at(psi), 3.1e-9);
+            // The spoke's tip is its lowest point once it points below the hip (psi >= 0).
+            if psi >= 0.0 {
+                close(outline_depth(&spoke, 0.03, psi), spoke.depth_at(psi), 1e-15);
+            }
+            close(outline_depth(&foot, 0.03, psi), foot.depth_at(psi), 1e-15);
+        }
+    }
+
+    /// The spoke (2R = 8 cm, h = 3 cm) and the foot (R = 4 cm, l = 6 cm, h = 3 cm) by hand.
+    #[test]
+    fn spoke_and_foot_by_hand() {
+        let spoke = Spoke { radius: 0.04, hip_height: 0.03 };
+        close(spoke.touchdown_angle(), (3.0f64 / 8.0).asin(), 1e-15);
+        close(spoke.max_depth(), 0.05, 1e-15);
+        close(spoke.angle_at_depth(0.01).unwrap(), 0.5f64.asin(), 1e-15);
+        // Supported at 1 cm: the tip's 8 cm circle cut 4 cm below the hip, 2 sqrt(48) cm.
+        close(spoke.level_step(0.01), 0.02 * 48f64.sqrt(), 1e-15);
+        assert_eq!(spoke.angle_at_depth(0.0501), None);
+        // The foot's ends are 5 cm from the hip (3-4-5), atan(3/4) off its centre.
+        let foot = Foot { radius: 0.04, length: 0.06, hip_height: 0.03 };
+        let a = 0.75f64.atan();
+        close(foot.depth_at(0.0), 0.01, 1e-15);
+        close(foot.deepest_angle(), -a, 1e-15);
+        close(foot.max_depth(), 0.02, 1e-15);
+        close(foot.depth_at(-a), 0.02, 1e-15);
+        // The rear end touches down where 5 cos(psi + a) = 3: psi = -a - acos(3/5).
+        close(foot.touchdown_angle(), -a - 0.6f64.acos(), 1e-15);
+        close(foot.depth_at(foot.touchdown_angle()), 0.0, 1e-15);
+        close(foot.angle_at_depth(0.01).unwrap(), -a - 0.8f64.acos(), 1e-15);
+        // Supported at 1 cm: the 5 cm circle cut 4 cm below the hip, 6 cm.
+        close(foot.level_step(0.01), 0.06, 1e-15);
+    }
+
     /// A toy leg shape, added here alone: a straight spoke of length L turning about a hip at
     /// height h, its tip `L sin(psi) - h` below the surface. The closed form's times hold for
     /// it unchanged; each value below is worked by hand for L = 2h.
-    struct Spoke {
+    struct Stick {
         length: f64,
         hip_height: f64,
     }
 
-    impl Leg for Spoke {
+    impl Leg for Stick {
         fn depth_at(&self, psi: f64) -> f64 {
             self.length * psi.sin() - self.hip_height
         }
@@ -163,11 +354,14 @@ mod tests {
             let x = d + self.hip_height;
             2.0 * (self.length * self.length - x * x).max(0.0).sqrt()
         }
+        fn outline(&self, elements: usize) -> Vec<[f64; 2]> {
+            fractions(elements).map(|f| [self.length * f, 0.0]).collect()
+        }
     }
 
     #[test]
     fn a_toy_leg_shape_needs_only_its_geometry() {
-        let spoke = Spoke { length: 0.06, hip_height: 0.03 };
+        let spoke = Stick { length: 0.06, hip_height: 0.03 };
         // Touchdown where sin(psi) = h / L = 1/2: psi0 = pi/6; deepest L - h = 3 cm.
         close(spoke.touchdown_angle(), FRAC_PI_6, 1e-15);
         close(spoke.max_depth(), 0.03, 1e-15);

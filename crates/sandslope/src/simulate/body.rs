@@ -6,6 +6,7 @@
 //! axle line, halfway along; the belly is a flat plate `h` below the axle line.
 
 use super::rft::Rft;
+use crate::leg::{CLeg, Foot, Leg, Spoke};
 use crate::robot::Robot;
 
 /// The shape of every leg (docs/model.md §15): the robot's C-leg, or the plates the oracle
@@ -50,25 +51,18 @@ impl BodyPitch {
     }
 }
 
-/// Node positions of one leg in its own frame (angle 0: the C's circle centre at (R, 0)).
+/// Node positions of one leg in its own frame (angle 0: the C's circle centre at (R, 0)):
+/// the outline of the [`crate::leg::Leg`] the shape names (crate::leg holds each geometry).
 pub(crate) fn leg_nodes(robot: &Robot, shape: LegShape, elements: usize) -> Vec<[f64; 2]> {
-    let r = robot.leg_radius();
-    (0..=elements)
-        .map(|k| {
-            let f = k as f64 / elements as f64;
-            match shape {
-                LegShape::CLeg => {
-                    let u = std::f64::consts::PI * f;
-                    [r * (1.0 - u.cos()), -r * u.sin()]
-                }
-                LegShape::Spoke => [2.0 * r * f, 0.0],
-                LegShape::Foot => {
-                    let l = robot.contact_area() / robot.leg_width();
-                    [-0.5 * l + l * f, -r]
-                }
-            }
-        })
-        .collect()
+    let (radius, hip_height) = (robot.leg_radius(), robot.hip_height());
+    match shape {
+        LegShape::CLeg => CLeg { radius, hip_height }.outline(elements),
+        LegShape::Spoke => Spoke { radius, hip_height }.outline(elements),
+        LegShape::Foot => {
+            let length = robot.contact_area() / robot.leg_width();
+            Foot { radius, length, hip_height }.outline(elements)
+        }
+    }
 }
 
 /// What one element feels from the sand this step (docs/model.md §16-§17): its submerged

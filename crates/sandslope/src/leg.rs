@@ -41,6 +41,9 @@ pub trait Leg {
     /// simulator turns them clockwise by the crank angle (angle pi/2 takes node `(x, 0)` to
     /// `(0, -x)`), so a node `(x, z)` is `x sin(psi) - z cos(psi) - h` below the surface.
     fn outline(&self, elements: usize) -> Vec<[f64; 2]>;
+
+    /// The shape's name, as `simulate --json` prints it (`c_leg`, `spoke`, `foot`).
+    fn name(&self) -> &str;
 }
 
 /// The fraction `k / elements` of node `k` along an outline.
@@ -107,6 +110,10 @@ impl Leg for CLeg {
             })
             .collect()
     }
+
+    fn name(&self) -> &str {
+        "c_leg"
+    }
 }
 
 /// A straight plate from the hip to `2R` along the C-leg's diameter (docs/model.md §15's
@@ -154,6 +161,10 @@ impl Leg for Spoke {
     fn outline(&self, elements: usize) -> Vec<[f64; 2]> {
         let r = self.radius;
         fractions(elements).map(|f| [2.0 * r * f, 0.0]).collect()
+    }
+
+    fn name(&self) -> &str {
+        "spoke"
     }
 }
 
@@ -223,6 +234,10 @@ impl Leg for Foot {
     fn outline(&self, elements: usize) -> Vec<[f64; 2]> {
         let (l, r) = (self.length, self.radius);
         fractions(elements).map(|f| [-0.5 * l + l * f, -r]).collect()
+    }
+
+    fn name(&self) -> &str {
+        "foot"
     }
 }
 
@@ -357,6 +372,9 @@ mod tests {
         fn outline(&self, elements: usize) -> Vec<[f64; 2]> {
             fractions(elements).map(|f| [self.length * f, 0.0]).collect()
         }
+        fn name(&self) -> &str {
+            "stick"
+        }
     }
 
     #[test]
@@ -376,5 +394,44 @@ mod tests {
         // Supported at the surface: 2 sqrt(6^2 - 3^2) cm = 6 sqrt(3) cm; at its deepest, none.
         close(spoke.level_step(0.0), 0.06 * 3f64.sqrt(), 1e-15);
         close(spoke.level_step(0.03), 0.0, 1e-15);
+    }
+
+    /// The simulator walks the toy shape from its [`Leg`] alone (docs/model.md §15): a stick
+    /// as long as the spoke (2R) walks the spoke's walk sample for sample, and one of 1.5R, whose
+    /// tip reaches 1.5R - h = 3 cm below the surface against the spoke's 5 cm on the paper's
+    /// robot (R = 4 cm, h = 3 cm), makes progress on the built-in terrain's level sand, but less
+    /// than the spoke and than rigid ground allows: the chord its tip cuts at the surface,
+    /// 2 sqrt(6^2 - 3^2) = 10.4 cm, is shorter than the spoke's 2 sqrt(8^2 - 3^2) = 14.8 cm.
+    #[test]
+    fn the_simulator_walks_a_toy_leg_shape() {
+        use crate::scenario::Scenario;
+        use crate::simulate::{simulate, simulate_with_leg, LegShape, SimSettings};
+        use crate::slope::SignedSlope;
+        let robot = crate::model::tests::paper_robot();
+        let (r, h) = (robot.leg_radius(), robot.hip_height());
+        let terrain = crate::terrain::Terrain::constant(7e5, 3_260_672.8).unwrap();
+        let scenario = Scenario::new(robot, terrain, None, None).unwrap();
+        let settings = SimSettings::new(2.0).unwrap().with_shape(LegShape::Spoke);
+        let level = SignedSlope::from_degrees(0.0).unwrap();
+        let spoke = simulate(&scenario, level, &settings).unwrap();
+        let long = Stick { length: 2.0 * r, hip_height: h };
+        let same = simulate_with_leg(&scenario, level, &settings, &long).unwrap();
+        assert_eq!((spoke.summary.shape.as_str(), same.summary.shape.as_str()), ("spoke", "stick"));
+        assert_eq!(same.trajectory, spoke.trajectory);
+        assert_eq!(same.geometry, spoke.geometry);
+        let short = Stick { length: 1.5 * r, hip_height: h };
+        close(short.level_step(0.0), 0.06 * 3f64.sqrt(), 1e-15);
+        let walk = simulate_with_leg(&scenario, level, &settings, &short).unwrap().summary;
+        assert!(walk.max_depth_m <= short.max_depth() + 1e-3, "{} m deep", walk.max_depth_m);
+        // Nor faster than on rigid ground, where the hip (held at h by the belly) moves the
+        // chord, 10.4 cm, per half stride (T = 2 pi / omega = 1 s): 20.8 cm/s.
+        let half = 0.5 * 2.0 * PI / scenario.robot().leg_speed();
+        assert!(walk.speed_m_s < 1.02 * short.level_step(0.0) / half, "{} m/s", walk.speed_m_s);
+        assert!(
+            walk.speed_m_s > 0.0 && walk.speed_m_s < spoke.summary.speed_m_s,
+            "stick {} m/s, spoke {} m/s",
+            walk.speed_m_s,
+            spoke.summary.speed_m_s
+        );
     }
 }

@@ -23,6 +23,23 @@ pub enum LegShape {
     Foot,
 }
 
+impl LegShape {
+    /// The [`Leg`] this shape names on `robot` (radius R, hip height h; the foot's length is
+    /// the contact area over the leg width). The simulator walks any [`Leg`]
+    /// ([`super::simulate_with_leg`]); these are the shapes the front ends name.
+    pub fn leg(self, robot: &Robot) -> Box<dyn Leg + Send + Sync> {
+        let (radius, hip_height) = (robot.leg_radius(), robot.hip_height());
+        match self {
+            LegShape::CLeg => Box::new(CLeg { radius, hip_height }),
+            LegShape::Spoke => Box::new(Spoke { radius, hip_height }),
+            LegShape::Foot => {
+                let length = robot.contact_area() / robot.leg_width();
+                Box::new(Foot { radius, length, hip_height })
+            }
+        }
+    }
+}
+
 /// Whether the body may pitch (docs/model.md §15). The closed form has no body pitch; locking
 /// it in the simulator removes that one difference, so a comparison of the two settings tells
 /// what the pitch does to a walk (docs/simulate.md). Locked is the default: its answers
@@ -47,20 +64,6 @@ impl BodyPitch {
         match self {
             BodyPitch::Free => "free",
             BodyPitch::Locked => "locked",
-        }
-    }
-}
-
-/// Node positions of one leg in its own frame (angle 0: the C's circle centre at (R, 0)):
-/// the outline of the [`crate::leg::Leg`] the shape names (crate::leg holds each geometry).
-pub(crate) fn leg_nodes(robot: &Robot, shape: LegShape, elements: usize) -> Vec<[f64; 2]> {
-    let (radius, hip_height) = (robot.leg_radius(), robot.hip_height());
-    match shape {
-        LegShape::CLeg => CLeg { radius, hip_height }.outline(elements),
-        LegShape::Spoke => Spoke { radius, hip_height }.outline(elements),
-        LegShape::Foot => {
-            let length = robot.contact_area() / robot.leg_width();
-            Foot { radius, length, hip_height }.outline(elements)
         }
     }
 }

@@ -12,11 +12,12 @@
 //! The force never has a component along the element's motion, so with the legs held the step
 //! cannot create energy whatever `h` (docs/model.md §17 proves it; a test checks it).
 
-use super::body::{associated_force, element_force, leg_nodes, submerged, BodyPitch, Contact, BELLY};
+use super::body::{associated_force, element_force, submerged, BodyPitch, Contact, BELLY};
 use super::linear::solve_dofs;
 use super::mechanisms::{gait_angle, Trench, CONSTANT_SPEED_DUTY};
 use super::rft::Rft;
 use super::{Geometry, SimSettings, Trajectory};
+use crate::leg::Leg;
 use crate::model::G;
 use crate::robot::Robot;
 use crate::terrain::Ground;
@@ -129,7 +130,21 @@ pub(crate) struct Walker {
 }
 
 impl Walker {
+    /// A walker with `settings.shape`'s legs (the tests' way in).
+    #[cfg(test)]
     pub(crate) fn new(robot: &Robot, ground: &Ground, theta: f64, settings: &SimSettings, dt: f64) -> Walker {
+        Walker::with_leg(robot, ground, theta, settings, dt, &*settings.shape.leg(robot))
+    }
+
+    /// A walker whose legs are `leg`'s outline, `robot.leg_elements()` elements each.
+    pub(crate) fn with_leg(
+        robot: &Robot,
+        ground: &Ground,
+        theta: f64,
+        settings: &SimSettings,
+        dt: f64,
+        leg: &dyn Leg,
+    ) -> Walker {
         let n = robot.stance_legs() as usize;
         let elements = robot.leg_elements() as usize;
         let r = robot.leg_radius();
@@ -141,7 +156,7 @@ impl Walker {
         };
         let hips: Vec<f64> = (0..2 * n).map(|j| xs[j % n]).collect();
         let tripod: Vec<usize> = (0..2 * n).map(|j| j / n).collect();
-        let nodes = leg_nodes(robot, settings.shape, elements);
+        let nodes = leg.outline(elements);
         let h = robot.hip_height();
         let l = robot.body_length();
         let belly: Vec<[f64; 2]> =

@@ -310,8 +310,8 @@ pub struct SimSummary {
     pub dt_s: f64,
     /// Elements per leg.
     pub leg_elements: u32,
-    /// Leg shape.
-    pub shape: LegShape,
+    /// Leg shape ([`crate::leg::Leg::name`]: `c_leg`, `spoke`, `foot`, or a caller's own).
+    pub shape: String,
     /// Creep speed of the contact law's smoothing, m/s.
     pub creep_m_s: f64,
     /// The servo torque limit applied, N m (`None`: ideal position servos).
@@ -421,11 +421,23 @@ pub const MAX_STANCE_LEGS: u32 = 64;
 
 /// Simulates `scenario`'s robot walking on its terrain at `signed` (negative walks downhill;
 /// the terrain is read at |slope| as docs/model.md §8) for `settings.duration_s` seconds, and
-/// measures the walk (docs/model.md §15-§18).
+/// measures the walk (docs/model.md §15-§18), its legs of `settings.shape`.
 pub fn simulate(
     scenario: &Scenario,
     signed: SignedSlope,
     settings: &SimSettings,
+) -> Result<Simulation, SimulateError> {
+    simulate_with_leg(scenario, signed, settings, &*settings.shape.leg(scenario.robot()))
+}
+
+/// [`simulate`] with every leg of shape `leg` (its outline, docs/model.md §15) in place of
+/// `settings.shape`: a new leg shape is one type implementing [`crate::leg::Leg`], which the
+/// closed form and the simulator then both take.
+pub fn simulate_with_leg(
+    scenario: &Scenario,
+    signed: SignedSlope,
+    settings: &SimSettings,
+    leg: &dyn crate::leg::Leg,
 ) -> Result<Simulation, SimulateError> {
     let slope = signed.felt();
     let slope_deg = signed.degrees();
@@ -467,7 +479,7 @@ pub fn simulate(
     }
     let n_steps = n_steps as usize;
     let theta = slope_deg.to_radians();
-    let mut walker = Walker::new(robot, &ground, theta, settings, dt);
+    let mut walker = Walker::with_leg(robot, &ground, theta, settings, dt, leg);
     walker.settle(settings.settle_s);
     let run = walker.run(n_steps, half, settings.sample_rate_hz);
 
@@ -505,6 +517,7 @@ pub fn simulate(
         slope,
         &ground,
         settings,
+        leg.name(),
         dt,
         steps,
         closed_form,
@@ -547,6 +560,7 @@ fn summarise(
     slope: Slope,
     ground: &crate::terrain::Ground,
     settings: &SimSettings,
+    shape: &str,
     dt: f64,
     steps: Vec<SimStep>,
     closed_form: SlopeEvaluation,
@@ -593,7 +607,7 @@ fn summarise(
         duration_s: settings.duration_s,
         dt_s: dt,
         leg_elements: robot.leg_elements(),
-        shape: settings.shape,
+        shape: shape.to_string(),
         creep_m_s: settings.creep_m_s,
         servo_torque_limit_n_m: if settings.servo_limit { robot.servo_torque_limit() } else { None },
         unconverged_steps,

@@ -1,6 +1,6 @@
 //! Oracle tests of the simulator (docs/model.md §15-§18).
 
-use super::body::{element_force, leg_nodes, submerged, Contact};
+use super::body::{element_force, submerged, Contact};
 use super::dynamics::Walker;
 use super::rft::Rft;
 use super::*;
@@ -55,7 +55,7 @@ fn spoke_dragged_sideways_feels_k_s_w_d_squared() {
     let robot = paper_robot();
     let rft = Rft::new(7e5, 2e6);
     for (d, elements) in [(0.02, 16), (0.013, 7), (0.05, 64)] {
-        let nodes = leg_nodes(&robot, LegShape::Spoke, elements);
+        let nodes = LegShape::Spoke.leg(&robot).outline(elements);
         // Angle pi/2 turns the spoke straight down: node (x, 0) goes to (0, -x).
         let hip_z = 2.0 * robot.leg_radius() - d;
         let world: Vec<[f64; 2]> = nodes.iter().map(|p| [0.0, hip_z - p[0]]).collect();

@@ -151,6 +151,12 @@ pub fn estimate_touchdown_offset(tracks: &[SmoothTrack], step_s: f64) -> Option<
 /// the low pass's ringing), not slip.
 const REST_FRACTION: f64 = 0.1;
 
+/// A speed within this fraction of the track's noise SD of zero is rest: a body stopped at
+/// the minimum, whose anchoring is where it starts to move (docs/model.md §11). Far below a
+/// motion-capture track's noise (a minimum that close to zero is rare there); ten times the
+/// stride simulator's default creep speed (its noise is set to 1e-4 m/s).
+pub const REST_SPEED_FRACTION: f64 = 0.01;
+
 /// Touchdown times `offset_s + k step_s` whose whole step lies inside `track`.
 pub fn touchdowns_in(track: &SmoothTrack, offset_s: f64, step_s: f64) -> Vec<f64> {
     let first = ((track.start_time_s - offset_s) / step_s).ceil() as i64;
@@ -208,8 +214,23 @@ pub fn measure_step(track: &SmoothTrack, t0: f64, step_s: f64) -> StepMeasure {
             break;
         }
     }
+    // At rest at the minimum (the stride simulator's walks on level and gentle slopes stop
+    // before touchdown and stay stopped until the legs push): the minimum is the whole rest,
+    // and the acceleration turns positive where the speed leaves it. Within the rest the
+    // lowest frame is a rounding error's choice.
+    let rest = REST_SPEED_FRACTION * track.speed_noise_m_s;
+    let at_rest = anchored && v[lowest].abs() <= rest;
     let t1_abs = if !anchored {
         None
+    } else if at_rest {
+        let mut j = lowest;
+        while j + 1 < i && v[j + 1] <= rest {
+            j += 1;
+        }
+        // Where the speed rises through `rest` between frames j and j + 1.
+        let (a, b) = (v[j], v[j + 1]);
+        let off = if b > a { ((rest - a) / (b - a)).clamp(0.0, 1.0) } else { 0.0 };
+        Some(track.time(j) + off / rate)
     } else if lowest == first {
         // Rising from the first frame after touchdown: anchored at once (or at that frame,
         // if the speed was still falling between touchdown and it).

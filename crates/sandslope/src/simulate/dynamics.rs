@@ -122,6 +122,9 @@ pub(crate) struct Walker {
     time: f64,
     gravity_scale: f64,
     unconverged: usize,
+    /// Whether the last step ended in the active-set step for a sticking element
+    /// ([`Walker::sticking`]), which the next step then tries first.
+    stuck: bool,
     /// Stride period T, s, and duty cycle (docs/model.md §20.2).
     period: f64,
     duty: f64,
@@ -202,6 +205,7 @@ impl Walker {
             time: 0.0,
             gravity_scale: 1.0,
             unconverged: 0,
+            stuck: false,
             period: robot.stride_period(),
             duty: settings.mechanisms.duty_cycle,
             trench: (settings.mechanisms.disturbed_sand < 1.0)
@@ -347,8 +351,10 @@ impl Walker {
 
     /// The implicit velocity step (docs/model.md §17): the body rates `v1` with
     /// `G(v1) = M (v1 - v_free) - h sum_i J_i^T F_i(J_i v1 + w_i) = 0`, by Newton's method
-    /// from the last step's rates with a backtracking line search on `|G|^2_{M^-1}`. Where that
-    /// fails, the same equation is solved along a continuation in the creep speed (from
+    /// from the last step's rates with a backtracking line search on `|G|^2_{M^-1}`; where the
+    /// last step ended in the active-set step for a sticking element, that step is tried first
+    /// (an active set carried from step to step: a resting element stays at rest while the
+    /// force it needs stays in the law's set). Where Newton's method fails, the same equation is solved along a continuation in the creep speed (from
     /// [`CONTINUATION_START_M_S`] down by tenfold stages to the walk's own, each stage started
     /// from the last); where that fails, the associated law's solution (a convex minimisation,
     /// always solvable) starts a last attempt; where that fails too, the iterate with the
@@ -359,13 +365,22 @@ impl Walker {
             v[2] = 0.0;
         }
         let eps = self.eps;
+        if self.pitch_locked && self.stuck {
+            if self.sticking(v, v_free, m) {
+                return true;
+            }
+            self.stuck = false;
+        }
         let (first, ok, r1) = self.newton(v, v_free, m, eps, false);
         if ok {
+            self.stuck = false;
             return self.finish(first, v_free, m, true);
         }
         if self.pitch_locked && self.sticking(first, v_free, m) {
+            self.stuck = true;
             return true;
         }
+        self.stuck = false;
         let (mut best, mut best_merit) = (first, r1);
         let mut stage = v;
         let mut e = CONTINUATION_START_M_S.max(eps);

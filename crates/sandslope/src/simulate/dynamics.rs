@@ -503,15 +503,22 @@ impl Walker {
                 if associated { (0..dofs).map(|i| grad[i] * delta[i]).sum::<f64>() } else { 2.0 * f0 };
             let mut lambda = 1.0;
             let mut accepted = false;
+            // Each trial is evaluated with its Jacobian: an accepted trial is the next iterate,
+            // so its evaluation is not repeated (most full steps are accepted; the walk is the
+            // same to the bit, and a walk costs a third fewer force evaluations).
+            let mut trial_jac = [[0.0; 3]; 3];
             for _ in 0..MAX_HALVINGS {
                 let mut trial = v;
                 for i in 0..dofs {
                     trial[i] -= lambda * delta[i];
                 }
-                let (pt, rt) = self.evaluate(trial, v_free, m, eps, None, associated);
+                let (pt, rt) = self.evaluate(trial, v_free, m, eps, Some(&mut trial_jac), associated);
                 let ft = value(pt, &rt);
                 if ft <= f0 - 1e-4 * lambda * slope.max(0.0) {
                     v = trial;
+                    grad = rt;
+                    f0 = ft;
+                    jac = trial_jac;
                     accepted = true;
                     break;
                 }
@@ -520,9 +527,6 @@ impl Walker {
             if !accepted {
                 return (best, false, best_merit);
             }
-            let (phi, g) = self.evaluate(v, v_free, m, eps, Some(&mut jac), associated);
-            grad = g;
-            f0 = value(phi, &grad);
             let mr = merit(&grad);
             if mr < best_merit {
                 (best, best_merit) = (v, mr);

@@ -273,8 +273,10 @@ pub fn simulator(report: &Report) -> String {
          <p>What survives convergence. <i>Legs roll</i>: a simulated C-leg rolls on its arc like a wheel's rim, so \
          its step tends to the rigid-ground rolling step and its speed is two to three times the closed form's and \
          the paper's below 24°, where the closed form's leg slides along its own circle held by solidified sand and \
-         steps s*; resistive force theory has no term that holds the circle. <i>Anchoring</i>: the simulated legs \
-         anchor within a few milliseconds, well before the closed form's t1. No switch of the simulator with a \
+         steps s*; resistive force theory has no term that holds the circle. <i>Anchoring</i>: the simulated body does \
+         not slip back before its legs anchor; it rests after touchdown while they dig in (t1 is where it leaves \
+         that rest, docs/model.md §11), about as long as the closed form's t1 on level sand and about half of it on \
+         slopes. No switch of the simulator with a \
          measured input brings the level speed to the paper's 15.7 cm/s (docs/simulate.md, \"The level stride\"), \
          nor do leg-sand friction, a slower stance or sand weakened where earlier steps dug it (docs/model.md §20); \
          the last slows the walk on slopes and leaves level sand as it was, as the trench the paper names for \

@@ -272,3 +272,64 @@ fn terrain_spec(problem: &Problem, shear: &[ShearAtSlope]) -> TerrainSpec {
     };
     TerrainSpec { name: None, repose_deg, points }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibrate::model::walk_on_ground;
+    use crate::model::tests::paper_robot;
+    use crate::simulate::SimSettings;
+
+    /// The scan puts the simulator's fit in the basin of the leg strength that made the speeds:
+    /// speeds walked at `plate_scale` 0.4 (leg k_s 0.4 x the force tests' 1e5 at 0 deg and, by
+    /// hand, 0.4 x 7e4 at 10 deg, halfway to 4e4 at 20), observed with small SDs and fitted with
+    /// the scale and the error floor free from the closed form's start: the scan's start is
+    /// within one of its cells (a factor e^(ln(1e7)/13) = 3.5 on the bounds 1e-3 to 1e4) of 0.4,
+    /// where the given start (10, from the closed form) is not.
+    #[test]
+    fn the_scan_starts_the_simulators_fit_in_the_basin_of_the_strength_that_made_the_speeds() {
+        let settings = SimSettings::new(1.5).unwrap().with_dt(2e-3).unwrap();
+        let walked =
+            |deg: f64, k_s: f64| walk_on_ground(&paper_robot(), deg, 7e5, k_s, &settings).unwrap().speed_m_s;
+        let point = |slope_deg, k_s| TerrainPoint { slope_deg, k_n: 7e5, k_s, k_n_sd: None, k_s_sd: None };
+        let forces = Terrain::new(TerrainSpec {
+            name: None,
+            repose_deg: None,
+            points: vec![point(0.0, 1e5), point(20.0, 4e4)],
+        })
+        .unwrap();
+        let observed = |deg: f64, speed: f64| SpeedObservation {
+            slope: Slope::from_degrees(deg).unwrap(),
+            speed,
+            speed_sd: 0.002,
+        };
+        let free = |parameter| FreeParameter { parameter, bounds: None };
+        let setup = JointSetup {
+            robot: paper_robot(),
+            normal: forces.clone(),
+            shear: ShearShape::ForceTests(forces),
+            speeds: vec![observed(0.0, walked(0.0, 0.4 * 1e5)), observed(10.0, walked(10.0, 0.4 * 7e4))],
+            anchoring: vec![],
+            free: vec![free(Parameter::PlateScale), free(Parameter::ErrorFloor)],
+            error_floor: 0.0,
+        };
+        let problem = build(&setup, SpeedModel::Simulator { settings }).unwrap();
+        let scale = problem
+            .unknowns
+            .iter()
+            .position(|u| u.quantity == Quantity::Free(Parameter::PlateScale))
+            .unwrap();
+        let start: Vec<f64> = problem.unknowns.iter().map(|u| u.start).collect();
+        let scanned = scanned_start(&problem, &start).expect("a start other than the given one");
+        let u = &problem.unknowns[scale];
+        assert_eq!((u.lo, u.hi), (1e-3, 1e4));
+        let cell = (u.hi / u.lo).ln() / SCAN_POINTS as f64;
+        assert!((start[scale] / 0.4).ln().abs() > cell, "the given start {}", start[scale]);
+        assert!(
+            (scanned[scale] / 0.4).ln().abs() < cell,
+            "scanned start {} (given start {})",
+            scanned[scale],
+            start[scale]
+        );
+    }
+}

@@ -133,12 +133,6 @@ pub(crate) struct Walker {
 }
 
 impl Walker {
-    /// A walker with `settings.shape`'s legs (the tests' way in).
-    #[cfg(test)]
-    pub(crate) fn new(robot: &Robot, ground: &Ground, theta: f64, settings: &SimSettings, dt: f64) -> Walker {
-        Walker::with_leg(robot, ground, theta, settings, dt, &*settings.shape.leg(robot))
-    }
-
     /// A walker whose legs are `leg`'s outline, `robot.leg_elements()` elements each.
     pub(crate) fn with_leg(
         robot: &Robot,
@@ -365,22 +359,18 @@ impl Walker {
             v[2] = 0.0;
         }
         let eps = self.eps;
-        if self.pitch_locked && self.stuck {
-            if self.sticking(v, v_free, m) {
-                return true;
-            }
-            self.stuck = false;
+        if self.pitch_locked && self.stuck && self.sticking(v, v_free, m) {
+            return true;
         }
+        self.stuck = false;
         let (first, ok, r1) = self.newton(v, v_free, m, eps, false);
         if ok {
-            self.stuck = false;
             return self.finish(first, v_free, m, true);
         }
         if self.pitch_locked && self.sticking(first, v_free, m) {
             self.stuck = true;
             return true;
         }
-        self.stuck = false;
         let (mut best, mut best_merit) = (first, r1);
         let mut stage = v;
         let mut e = CONTINUATION_START_M_S.max(eps);
@@ -504,8 +494,7 @@ impl Walker {
             let mut lambda = 1.0;
             let mut accepted = false;
             // Each trial is evaluated with its Jacobian: an accepted trial is the next iterate,
-            // so its evaluation is not repeated (most full steps are accepted; the walk is the
-            // same to the bit, and a walk costs a third fewer force evaluations).
+            // whose evaluation is then not repeated (the walk is the same to the bit).
             let mut trial_jac = [[0.0; 3]; 3];
             for _ in 0..MAX_HALVINGS {
                 let mut trial = v;

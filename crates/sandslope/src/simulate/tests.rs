@@ -9,6 +9,11 @@ use crate::model::{normal_equilibrium_depth, G};
 use crate::robot::{Robot, RobotSpec};
 use crate::terrain::{Ground, Terrain};
 
+/// A walker with `settings.shape`'s legs.
+fn walker(robot: &Robot, ground: &Ground, theta: f64, settings: &SimSettings, dt: f64) -> Walker {
+    Walker::with_leg(robot, ground, theta, settings, dt, &*settings.shape.leg(robot))
+}
+
 /// A walk at a slope in degrees, validated here as the front ends validate it.
 fn simulate_deg(s: &Scenario, slope_deg: f64, settings: &SimSettings) -> Result<Simulation, SimulateError> {
     simulate(s, SignedSlope::from_degrees(slope_deg)?, settings)
@@ -34,7 +39,7 @@ fn locked_feet_settle_at_the_closed_form_depth() {
         .unwrap();
     for k_n in [4e5, 1e6, 3e6, 1e7, 4e7] {
         let ground = Ground::new(k_n, 2e6).unwrap();
-        let mut w = Walker::new(&robot, &ground, 0.0, &settings, 1e-3);
+        let mut w = walker(&robot, &ground, 0.0, &settings, 1e-3);
         w.settle(10.0);
         w.hold(500);
         // By hand: d_n = 0.35 * 9.81 / (3 * k_n * 4e-4).
@@ -449,7 +454,7 @@ fn a_robot_with_held_legs_never_gains_energy() {
                     .with_body_pitch(BodyPitch::Free)
                     .with_rft_scaling(scaling);
                 let ground = Ground::new(k_n, k_s).unwrap();
-                let mut w = Walker::new(&heavy, &ground, 10f64.to_radians(), &settings, dt);
+                let mut w = walker(&heavy, &ground, 10f64.to_radians(), &settings, dt);
                 let e0 = w.energy();
                 let (mut high, mut prev, mut worst_step) = (e0, e0, f64::NEG_INFINITY);
                 for _ in 0..(1.0 / dt) as usize {
@@ -477,7 +482,7 @@ fn a_robot_with_held_legs_never_gains_energy() {
                 .with_mechanisms(Mechanisms { leg_friction: Some(mu), ..Default::default() })
                 .unwrap();
             let ground = Ground::new(k_n, k_s).unwrap();
-            let mut w = Walker::new(&heavy, &ground, 10f64.to_radians(), &settings, 1e-3);
+            let mut w = walker(&heavy, &ground, 10f64.to_radians(), &settings, 1e-3);
             let e0 = w.energy();
             let (mut high, mut prev, mut worst_step) = (e0, e0, f64::NEG_INFINITY);
             for _ in 0..1000 {

@@ -163,3 +163,29 @@ def test_ctrl_c_stops_a_long_plan_call(sigint_raises):
     assert not call()["routes"]["distance"]["found"]  # no route: the goal is behind the missing column
     whole = time.monotonic() - start
     assert interrupted < 0.5 * whole, (interrupted, whole)
+
+
+def test_ctrl_c_stops_the_simulators_calibration(sigint_raises, root, monkeypatch):
+    """`calibrate(model="simulate")` runs for minutes (about 9 on two cores for the paper's
+    evidence, docs/calibration.md) with the GIL released, and ignored Ctrl-C to the end. The
+    fit now runs on its own thread while the caller's looks for a signal every 50 ms, and a
+    signal stops the simulator's walks: a SIGINT 1 s in raises KeyboardInterrupt within
+    seconds."""
+    import _thread
+    import threading
+
+    monkeypatch.chdir(root)
+    timer = threading.Timer(1.0, _thread.interrupt_main)  # simulates SIGINT (Ctrl-C)
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            sandslope.calibrate(
+                observed="data/paper-speeds.csv",
+                forces="data/example-force-tests.toml",
+                free=["plate_scale", "error_floor"],
+                model="simulate",
+            )
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 8.0

@@ -6,13 +6,16 @@
 //! the answer's terrain and robot files; every flag's check, default and the fit live here.
 
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
 use sandslope::calibrate::{PerSlopeCalibration, SpeedModel, SpeedObservation};
 use sandslope::{
-    calibrate_jointly, calibrate_jointly_with, invert_each_speed, FreeParameter, JointCalibration,
-    JointSetup, Parameter, Robot, ShearLaw, ShearShape, Terrain, TerrainPoint, TerrainSpec,
+    calibrate_jointly, calibrate_jointly_cancellable, calibrate_jointly_with, invert_each_speed,
+    FreeParameter, JointCalibration, JointSetup, Parameter, Robot, ShearLaw, ShearShape, Terrain,
+    TerrainPoint, TerrainSpec,
 };
 use sandslope_io::{load_anchoring_times, load_speeds, load_terrain};
 
@@ -301,6 +304,18 @@ impl CalibrateRequest {
     /// Reads the evidence and fits it. Errors name the file (and line) or the field, in the
     /// front end's `words`.
     pub fn answer(&self, source: CalibrateSource, words: Words) -> Result<CalibrateAnswer> {
+        self.answer_cancellable(source, words, None)
+    }
+
+    /// [`CalibrateRequest::answer`] whose simulator fit stops when `cancel` is raised (a front
+    /// end's Ctrl-C; `sandslope::calibrate_jointly_cancellable`): the error then says
+    /// `interrupted`.
+    pub fn answer_cancellable(
+        &self,
+        source: CalibrateSource,
+        words: Words,
+        cancel: Option<Arc<AtomicBool>>,
+    ) -> Result<CalibrateAnswer> {
         let checked = self.check_in(words)?;
         let speeds = match &self.observed {
             Some(p) => load_speeds(p).map_err(|e| RequestError::from_error(Some("observed"), e))?,
@@ -345,8 +360,12 @@ impl CalibrateRequest {
         let (mut calibration, closed_form_fit) = match self.model {
             CalibrateModel::ClosedForm => (closed_form_fit, None),
             CalibrateModel::Simulate => {
-                let sim = calibrate_jointly_with(&setup, SpeedModel::simulator_for_fit())
-                    .map_err(|e| fail(anyhow::anyhow!("calibrate --model simulate: {e}")))?;
+                let model = SpeedModel::simulator_for_fit();
+                let sim = match cancel {
+                    Some(cancel) => calibrate_jointly_cancellable(&setup, model, cancel),
+                    None => calibrate_jointly_with(&setup, model),
+                }
+                .map_err(|e| fail(anyhow::anyhow!("calibrate --model simulate: {e}")))?;
                 (sim, Some(closed_form_fit))
             }
         };

@@ -62,9 +62,10 @@ pub mod terrain;
 
 pub use axis::{Axis, AxisScale};
 pub use calibrate::{
-    calibrate_jointly, calibrate_jointly_with, invert_each_speed, AnchoringObservation, CalibrationError,
-    CalibrationWarning, FittedParameter, FreeParameter, JointCalibration, JointSetup, Parameter, Quantity,
-    RobotKey, ShearLaw, ShearShape, SpeedModel, SpeedObservation,
+    calibrate_jointly, calibrate_jointly_cancellable, calibrate_jointly_with, invert_each_speed,
+    AnchoringObservation, CalibrationError, CalibrationWarning, FittedParameter, FreeParameter,
+    JointCalibration, JointSetup, Parameter, Quantity, RobotKey, ShearLaw, ShearShape, SpeedModel,
+    SpeedObservation,
 };
 pub use constants::G;
 pub use contour::ContourSegment;

@@ -6,6 +6,9 @@ pub enum CalibrationError {
     /// No speeds and no anchoring times.
     #[error("nothing to calibrate against: give observed speeds or anchoring times")]
     NoObservations,
+    /// The caller's cancel flag was raised during the fit ([`super::calibrate_jointly_cancellable`]).
+    #[error("interrupted")]
+    Interrupted,
     /// More free parameters than observations.
     #[error("{parameters} free parameters but only {observations} observations: free fewer")]
     TooFewObservations {

@@ -2,6 +2,9 @@
 //! intervals, and the result with its calibrated terrain and robot (docs/model.md §14,
 //! docs/calibration.md).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
 use rayon::prelude::*;
 
 use super::model::SpeedModel;
@@ -50,7 +53,34 @@ pub fn calibrate_jointly_with(
     setup: &JointSetup,
     model: SpeedModel,
 ) -> Result<JointCalibration, CalibrationError> {
-    let problem = build(setup, model)?;
+    fit(setup, model, None)
+}
+
+/// [`calibrate_jointly_with`] that stops when `cancel` is raised (from another thread: a front
+/// end's Ctrl-C): the simulator's walks not yet run then fail at once, the search ends within
+/// the walks in flight, and the answer is [`CalibrationError::Interrupted`]. The closed form
+/// (milliseconds) does not look at the flag.
+pub fn calibrate_jointly_cancellable(
+    setup: &JointSetup,
+    model: SpeedModel,
+    cancel: Arc<AtomicBool>,
+) -> Result<JointCalibration, CalibrationError> {
+    fit(setup, model, Some(cancel))
+}
+
+fn fit(
+    setup: &JointSetup,
+    model: SpeedModel,
+    cancel: Option<Arc<AtomicBool>>,
+) -> Result<JointCalibration, CalibrationError> {
+    let interrupted = || cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed));
+    let problem = build(setup, model, cancel.clone()).map_err(|e| {
+        if interrupted() {
+            CalibrationError::Interrupted
+        } else {
+            e
+        }
+    })?;
     let n = problem.unknowns.len();
     let start: Vec<f64> = problem.unknowns.iter().map(|u| u.start).collect();
     // Several starts: the given one, and the scale-like quantities a decade either way.
@@ -85,6 +115,9 @@ pub fn calibrate_jointly_with(
     if v < s_min {
         (best, s_min) = (x, v);
     }
+    if interrupted() {
+        return Err(CalibrationError::Interrupted);
+    }
 
     // Profile intervals, one parameter per task.
     let intervals: Vec<Interval> =
@@ -116,6 +149,9 @@ pub fn calibrate_jointly_with(
     let shear = shear_table(&problem, &candidate, &robot);
     let terrain = terrain_spec(&problem, &shear);
     let warnings = warnings(&problem, &robot, &pulls, &shear, &parameters, chi_squared_per_dof);
+    if interrupted() {
+        return Err(CalibrationError::Interrupted);
+    }
     Ok(JointCalibration {
         parameters,
         chi_squared,
@@ -313,7 +349,7 @@ mod tests {
             free: vec![free(Parameter::PlateScale), free(Parameter::ErrorFloor)],
             error_floor: 0.0,
         };
-        let problem = build(&setup, SpeedModel::Simulator { settings }).unwrap();
+        let problem = build(&setup, SpeedModel::Simulator { settings }, None).unwrap();
         let scale = problem
             .unknowns
             .iter()

@@ -12,7 +12,8 @@
 //! walks when the optimiser varies them.
 
 use std::collections::HashMap;
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -90,11 +91,18 @@ pub(crate) fn walk_on_ground(
 pub(crate) struct SimulatedModel {
     settings: SimSettings,
     walks: Mutex<HashMap<String, Result<Walked, String>>>,
+    /// Raised by the caller to stop: every walk not yet run then fails at once.
+    cancel: Option<Arc<AtomicBool>>,
 }
 
 impl SimulatedModel {
-    pub fn new(settings: SimSettings) -> SimulatedModel {
-        SimulatedModel { settings, walks: Mutex::new(HashMap::new()) }
+    pub fn new(settings: SimSettings, cancel: Option<Arc<AtomicBool>>) -> SimulatedModel {
+        SimulatedModel { settings, walks: Mutex::new(HashMap::new()), cancel }
+    }
+
+    /// Whether the caller asked the fit to stop.
+    pub fn cancelled(&self) -> bool {
+        self.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed))
     }
 
     /// One walk of `robot` at `slope_deg` on ground `(k_n, k_s)`, remembered by its exact
@@ -104,6 +112,9 @@ impl SimulatedModel {
             format!("{:?}|{:x}|{:x}|{:x}", robot.spec(), slope_deg.to_bits(), k_n.to_bits(), k_s.to_bits());
         if let Some(w) = self.walks.lock().ok().and_then(|m| m.get(&key).cloned()) {
             return w;
+        }
+        if self.cancelled() {
+            return Err("interrupted".into());
         }
         let walked = walk_on_ground(robot, slope_deg, k_n, k_s, &self.settings)
             .map_err(|e| e.to_string())
@@ -205,6 +216,19 @@ mod tests {
         // No closed-form ceiling warning: the simulator has no s*/(T/2) ceiling.
         use crate::calibrate::CalibrationWarning as W;
         assert!(!cal.warnings.iter().any(|w| matches!(w, W::SpeedNearCeiling { .. })), "{:?}", cal.warnings);
+    }
+
+    /// A cancel flag raised before the fit stops it before any walk: the answer is
+    /// `Interrupted`, not a fit of the penalties the refused walks leave (Python raises it on
+    /// Ctrl-C, `calibrate_jointly_cancellable`).
+    #[test]
+    fn a_raised_cancel_flag_interrupts_the_simulators_fit() {
+        use crate::calibrate::calibrate_jointly_cancellable;
+        let free = vec![FreeParameter { parameter: Parameter::PlateScale, bounds: None }];
+        let cancel = Arc::new(AtomicBool::new(true));
+        let e = calibrate_jointly_cancellable(&setup(free), short_walks(), cancel).unwrap_err();
+        assert_eq!(e, CalibrationError::Interrupted);
+        assert_eq!(e.to_string(), "interrupted");
     }
 
     /// Robot keys the simulator does not read are refused by name before any walk; a robot

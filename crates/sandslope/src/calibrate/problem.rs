@@ -330,7 +330,11 @@ fn free_unknown(
 
 /// The problem for `setup`, with every check of the evidence, the freed parameters and their
 /// bounds, and the starting values (from the speeds inverted alone where they exist).
-pub(crate) fn build(setup: &JointSetup, model: SpeedModel) -> Result<Problem<'_>, CalibrationError> {
+pub(crate) fn build(
+    setup: &JointSetup,
+    model: SpeedModel,
+    cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+) -> Result<Problem<'_>, CalibrationError> {
     check_speeds(&setup.speeds)?;
     check_anchoring(&setup.anchoring)?;
     if setup.speeds.is_empty() && setup.anchoring.is_empty() {
@@ -412,7 +416,7 @@ pub(crate) fn build(setup: &JointSetup, model: SpeedModel) -> Result<Problem<'_>
     walk_slopes.dedup();
     let simulator = match model {
         SpeedModel::ClosedForm => None,
-        SpeedModel::Simulator { settings } => Some(SimulatedModel::new(settings)),
+        SpeedModel::Simulator { settings } => Some(SimulatedModel::new(settings, cancel)),
     };
     let problem =
         Problem { setup, unknowns, force_tests, force_test_unknown, law, n_obs, simulator, walk_slopes };

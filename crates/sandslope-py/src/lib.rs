@@ -14,6 +14,7 @@ use pyo3::prelude::*;
 
 mod arrays;
 mod calibrate;
+mod interrupt;
 mod measure;
 mod model;
 mod plan;

@@ -7,7 +7,6 @@
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
-use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
@@ -314,7 +313,7 @@ impl CalibrateRequest {
         &self,
         source: CalibrateSource,
         words: Words,
-        cancel: Option<Arc<AtomicBool>>,
+        cancel: Option<&AtomicBool>,
     ) -> Result<CalibrateAnswer> {
         let checked = self.check_in(words)?;
         let speeds = match &self.observed {

@@ -3,7 +3,6 @@
 //! docs/calibration.md).
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 use rayon::prelude::*;
 
@@ -63,7 +62,7 @@ pub fn calibrate_jointly_with(
 pub fn calibrate_jointly_cancellable(
     setup: &JointSetup,
     model: SpeedModel,
-    cancel: Arc<AtomicBool>,
+    cancel: &AtomicBool,
 ) -> Result<JointCalibration, CalibrationError> {
     fit(setup, model, Some(cancel))
 }
@@ -71,16 +70,19 @@ pub fn calibrate_jointly_cancellable(
 fn fit(
     setup: &JointSetup,
     model: SpeedModel,
-    cancel: Option<Arc<AtomicBool>>,
+    cancel: Option<&AtomicBool>,
 ) -> Result<JointCalibration, CalibrationError> {
-    let interrupted = || cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed));
-    let problem = build(setup, model, cancel.clone()).map_err(|e| {
-        if interrupted() {
-            CalibrationError::Interrupted
-        } else {
-            e
-        }
-    })?;
+    let interrupted = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
+    let problem =
+        build(setup, model, cancel).map_err(
+            |e| {
+                if interrupted() {
+                    CalibrationError::Interrupted
+                } else {
+                    e
+                }
+            },
+        )?;
     let n = problem.unknowns.len();
     let start: Vec<f64> = problem.unknowns.iter().map(|u| u.start).collect();
     // Several starts: the given one, and the scale-like quantities a decade either way.

@@ -13,7 +13,7 @@
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Mutex;
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -88,15 +88,15 @@ pub(crate) fn walk_on_ground(
 }
 
 /// The simulator as the fit's model: its settings and the walks already run.
-pub(crate) struct SimulatedModel {
+pub(crate) struct SimulatedModel<'a> {
     settings: SimSettings,
     walks: Mutex<HashMap<String, Result<Walked, String>>>,
     /// Raised by the caller to stop: every walk not yet run then fails at once.
-    cancel: Option<Arc<AtomicBool>>,
+    cancel: Option<&'a AtomicBool>,
 }
 
-impl SimulatedModel {
-    pub fn new(settings: SimSettings, cancel: Option<Arc<AtomicBool>>) -> SimulatedModel {
+impl<'a> SimulatedModel<'a> {
+    pub fn new(settings: SimSettings, cancel: Option<&'a AtomicBool>) -> SimulatedModel<'a> {
         SimulatedModel { settings, walks: Mutex::new(HashMap::new()), cancel }
     }
 
@@ -225,8 +225,8 @@ mod tests {
     fn a_raised_cancel_flag_interrupts_the_simulators_fit() {
         use crate::calibrate::calibrate_jointly_cancellable;
         let free = vec![FreeParameter { parameter: Parameter::PlateScale, bounds: None }];
-        let cancel = Arc::new(AtomicBool::new(true));
-        let e = calibrate_jointly_cancellable(&setup(free), short_walks(), cancel).unwrap_err();
+        let cancel = AtomicBool::new(true);
+        let e = calibrate_jointly_cancellable(&setup(free), short_walks(), &cancel).unwrap_err();
         assert_eq!(e, CalibrationError::Interrupted);
         assert_eq!(e.to_string(), "interrupted");
     }

@@ -88,7 +88,7 @@ pub(crate) struct Problem<'a> {
     /// Observations: speeds, anchoring times and force tests with SDs.
     pub n_obs: usize,
     /// The simulator when it is the model (`None`: the closed form).
-    pub simulator: Option<SimulatedModel>,
+    pub simulator: Option<SimulatedModel<'a>>,
     /// The distinct slopes of speeds and anchoring times, degrees (one walk each).
     pub walk_slopes: Vec<f64>,
 }
@@ -330,11 +330,11 @@ fn free_unknown(
 
 /// The problem for `setup`, with every check of the evidence, the freed parameters and their
 /// bounds, and the starting values (from the speeds inverted alone where they exist).
-pub(crate) fn build(
-    setup: &JointSetup,
+pub(crate) fn build<'a>(
+    setup: &'a JointSetup,
     model: SpeedModel,
-    cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
-) -> Result<Problem<'_>, CalibrationError> {
+    cancel: Option<&'a std::sync::atomic::AtomicBool>,
+) -> Result<Problem<'a>, CalibrationError> {
     check_speeds(&setup.speeds)?;
     check_anchoring(&setup.anchoring)?;
     if setup.speeds.is_empty() && setup.anchoring.is_empty() {

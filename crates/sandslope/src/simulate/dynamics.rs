@@ -23,6 +23,8 @@ use crate::robot::Robot;
 use crate::terrain::Ground;
 use std::f64::consts::PI;
 
+mod rest;
+
 /// Elements of the belly plate.
 const BELLY_ELEMENTS: usize = 8;
 /// A servo that lags its command catches up at this rate, 1/s, up to 1.5 omega.
@@ -359,7 +361,7 @@ impl Walker {
             v[2] = 0.0;
         }
         let eps = self.eps;
-        if self.pitch_locked && self.stuck && self.sticking(v, v_free, m) {
+        if self.stuck && self.sticking(v, v_free, m) {
             return true;
         }
         self.stuck = false;
@@ -367,7 +369,7 @@ impl Walker {
         if ok {
             return self.finish(first, v_free, m, true);
         }
-        if self.pitch_locked && self.sticking(first, v_free, m) {
+        if self.sticking(first, v_free, m) {
             self.stuck = true;
             return true;
         }
@@ -394,65 +396,6 @@ impl Walker {
             best = second;
         }
         self.finish(best, v_free, m, ok)
-    }
-
-    /// The active-set step for a sticking element (docs/model.md §17), body pitch locked: where
-    /// Newton's method stalls, it is usually circling a solution with one element (or one
-    /// element of each leg of a tripod, identical) at rest, its force inside the law's set like
-    /// a sticking Coulomb contact. Put the element nearest rest at `near` at rest exactly (with
-    /// the pitch locked that fixes the body's two rates), take the force the others leave to
-    /// it from the momentum balance, and accept the step if that force lies in the set the
-    /// rate-independent law allows at rest: the region bounded by `W sigma(e)` over all
-    /// directions e ([`Rft::holds_at_rest`]). The elements at
-    /// rest share the force by weight; they do no work, so the step stays passive.
-    fn sticking(&mut self, near: [f64; 3], v_free: [f64; 3], m: [f64; 3]) -> bool {
-        let speed = |c: &Contact, v: [f64; 3], rates: &[f64]| {
-            let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
-            let u = Walker::element_velocity(c, v, rate);
-            (u[0] * u[0] + u[1] * u[1]).sqrt()
-        };
-        let Some(pick) = (0..self.contacts.len()).min_by(|&a, &b| {
-            speed(&self.contacts[a], near, &self.rates).total_cmp(&speed(
-                &self.contacts[b],
-                near,
-                &self.rates,
-            ))
-        }) else {
-            return false;
-        };
-        let c = self.contacts[pick];
-        let rate = if c.leg == BELLY { 0.0 } else { self.rates[c.leg] };
-        // u = v + rate (arm_z, -arm_x) = 0 with the pitch rate zero.
-        let v = [-rate * c.arm[1], rate * c.arm[0], 0.0];
-        let group: Vec<usize> = (0..self.contacts.len())
-            .filter(|&k| speed(&self.contacts[k], v, &self.rates) <= 1e-3 * self.eps)
-            .collect();
-        let same_shape = group.iter().all(|&k| {
-            let t = self.contacts[k].tangent;
-            (t[0] - c.tangent[0]).abs() < 1e-9 && (t[1] - c.tangent[1]).abs() < 1e-9
-        });
-        if !same_shape {
-            return false;
-        }
-        let (_, r) = self.evaluate(v, v_free, m, self.eps, None, false);
-        // G = M (v - v_free) - h sum F = 0: the group must carry r/h beyond what it carries now.
-        let mut need = [r[0] / self.dt, r[1] / self.dt];
-        let mut weight = 0.0;
-        for &k in &group {
-            need[0] += self.forces[k][0];
-            need[1] += self.forces[k][1];
-            weight += self.contacts[k].weight;
-        }
-        let rft = if c.leg == BELLY { &self.belly_rft } else { &self.rft };
-        if weight <= 0.0 || !rft.holds_at_rest(c.tangent, weight, need) {
-            return false;
-        }
-        for &k in &group {
-            let share = self.contacts[k].weight / weight;
-            self.forces[k] = [need[0] * share, need[1] * share];
-        }
-        self.v = v;
-        true
     }
 
     /// Takes `v` as the step's rates (leaving its forces in `self.forces`).

@@ -156,33 +156,21 @@ impl Rft {
     /// Whether `force` (N) can hold an element of unit tangent `tangent` and weight `weight`
     /// (m^3, [`super::body::Contact::weight`]) at rest: the rate-independent law is set-valued
     /// there, and the set is the region bounded by `weight * sigma(e)` over every direction of
-    /// motion `e` (docs/model.md §17). Tested by the winding number of that closed curve,
-    /// sampled at [`SET_DIRECTIONS`] directions, about `force`: counted as signed crossings of a
-    /// ray (Sunday's rule, exact for the sampled polygon), which decides as the sum of the
-    /// edges' angles did without one `atan2` per edge (that sum and the directions' `sin_cos`
-    /// were a third of a level walk's time, measured with `perf` on 2026-11-28).
+    /// motion `e` (docs/model.md §17); [`RestSet`] tests it.
     pub fn holds_at_rest(&self, tangent: [f64; 2], weight: f64, force: [f64; 2]) -> bool {
-        let directions = set_directions();
-        let point = |e: &[f64; 2]| {
+        weight > 0.0 && self.rest_set(tangent).holds([force[0] / weight, force[1] / weight])
+    }
+
+    /// The stresses per unit depth (N/m^3) an element of unit tangent `tangent` can hold at
+    /// rest, sampled once at [`SET_DIRECTIONS`] directions of motion, for testing several
+    /// stresses against the same set (the elements of a resting group share a tangent).
+    pub fn rest_set(&self, tangent: [f64; 2]) -> RestSet {
+        let mut boundary = [[0.0; 2]; SET_DIRECTIONS];
+        for (b, e) in boundary.iter_mut().zip(set_directions()) {
             let st = self.passive_stress(tangent[0], tangent[1], e[0], e[1]);
-            [weight * st.0 - force[0], weight * st.1 - force[1]]
-        };
-        let mut winding = 0i32;
-        let mut prev = point(&directions[SET_DIRECTIONS - 1]);
-        for e in directions {
-            let next = point(e);
-            // Which side of the edge prev -> next the origin (the force) lies on.
-            let left = prev[0] * next[1] - prev[1] * next[0];
-            if prev[1] <= 0.0 {
-                if next[1] > 0.0 && left > 0.0 {
-                    winding += 1;
-                }
-            } else if next[1] <= 0.0 && left < 0.0 {
-                winding -= 1;
-            }
-            prev = next;
+            *b = [st.0, st.1];
         }
-        winding != 0
+        RestSet { boundary }
     }
 
     /// [`Rft::passive_stress`] and its derivative with respect to the angle of the direction
@@ -238,6 +226,40 @@ impl Rft {
             (st.0 - along * ex, st.1 - along * ez),
             (dst.0 - dalong * ex + along * ez, dst.1 - dalong * ez - along * ex),
         )
+    }
+}
+
+/// The set of stresses per unit depth an element can hold at rest (docs/model.md §17): the
+/// region bounded by the law's stress `sigma(e)` over every direction of motion `e`, sampled
+/// ([`Rft::rest_set`]).
+pub struct RestSet {
+    boundary: [[f64; 2]; SET_DIRECTIONS],
+}
+
+impl RestSet {
+    /// Whether the stress `stress` (N/m^3) lies in the set: the winding number of the sampled
+    /// boundary about it, counted as signed crossings of a ray (Sunday's rule, exact for the
+    /// sampled polygon), which decides as the sum of the edges' angles did without one `atan2`
+    /// per edge (that sum and the directions' `sin_cos` were a third of a level walk's time,
+    /// measured with `perf` on 2026-11-28).
+    pub fn holds(&self, stress: [f64; 2]) -> bool {
+        let point = |b: &[f64; 2]| [b[0] - stress[0], b[1] - stress[1]];
+        let mut winding = 0i32;
+        let mut prev = point(&self.boundary[SET_DIRECTIONS - 1]);
+        for b in &self.boundary {
+            let next = point(b);
+            // Which side of the edge prev -> next the origin (the stress) lies on.
+            let left = prev[0] * next[1] - prev[1] * next[0];
+            if prev[1] <= 0.0 {
+                if next[1] > 0.0 && left > 0.0 {
+                    winding += 1;
+                }
+            } else if next[1] <= 0.0 && left < 0.0 {
+                winding -= 1;
+            }
+            prev = next;
+        }
+        winding != 0
     }
 }
 

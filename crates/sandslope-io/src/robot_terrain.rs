@@ -117,9 +117,9 @@ mod tests {
     #[test]
     fn simulator_keys_are_optional_and_checked() {
         let r = read("").unwrap();
-        assert_eq!((r.leg_elements(), r.servo_torque_limit()), (16, None));
-        let r = read("body_length_m = 0.3\nservo_torque_limit_n_m = 0.52\nleg_elements = 32\n").unwrap();
-        assert_eq!((r.body_length(), r.servo_torque_limit(), r.leg_elements()), (0.3, Some(0.52), 32));
+        assert_eq!((r.leg_elements(), r.servo_torque_limit()), (32, None));
+        let r = read("body_length_m = 0.3\nservo_torque_limit_n_m = 0.52\nleg_elements = 64\n").unwrap();
+        assert_eq!((r.body_length(), r.servo_torque_limit(), r.leg_elements()), (0.3, Some(0.52), 64));
         // I = m L^2 / 12 with the given length: 0.35 * 0.09 / 12.
         assert!((r.pitch_inertia() - 2.625e-3).abs() < 1e-12);
         for (extra, key) in [

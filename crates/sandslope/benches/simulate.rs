@@ -1,6 +1,6 @@
 //! Criterion benchmarks of the stride simulator (`sandslope::simulate`, what `sandslope
 //! simulate`, its `--slopes` sweep and the Python `simulate` run), on the built-in robot and
-//! terrain at the default 16 elements per leg and the default integration step.
+//! terrain at the default 32 elements per leg and the default integration step.
 //!
 //! Targets of issues 23 and 38: at least 1000 simulated seconds per wall second on one core, and a
 //! 31-slope sweep of 10 s walks in under 2 s on 2 cores. `cargo bench -p sandslope --bench

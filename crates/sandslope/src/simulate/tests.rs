@@ -633,9 +633,10 @@ fn free_pitch_ensemble() {
 /// free"). Two walks at 10 degrees whose masses differ by 1e-9 relative part: their pitch
 /// differs by more than a degree within 5 s, while the same pair with the pitch locked differs
 /// by under 1e-8 cm/s. So a step change, itself a perturbation, moves a free walk as much as
-/// any other; the ensemble over such perturbations is what converges: at 5 degrees the mean
-/// speed of six walks at the default step and at a quarter of it within 3% and their mean t1
-/// within 1 ms (issue 38's criterion), and at 10 degrees every walk pitches over at both steps.
+/// any other; the ensemble over such perturbations is what converges: at 0 and 5 degrees the
+/// mean speed of six walks at the default step and at a quarter of it within 3% and their mean
+/// t1 within 1 ms (issue 38's criterion), and at 10 degrees every walk pitches over at both
+/// steps.
 #[test]
 fn the_free_body_is_chaotic_and_its_ensemble_converges() {
     let walk = |k: usize, dt: f64, pitch: BodyPitch, slope: f64| {
@@ -661,14 +662,17 @@ fn the_free_body_is_chaotic_and_its_ensemble_converges() {
     };
     let mean =
         |v: &[SimSummary], f: &dyn Fn(&SimSummary) -> f64| v.iter().map(f).sum::<f64>() / v.len() as f64;
-    let (coarse, fine) = (ensemble(dt, 5.0), ensemble(dt / 4.0, 5.0));
     let speed = |s: &SimSummary| s.speed_m_s;
     let t1 = |s: &SimSummary| s.t1_s.unwrap_or(f64::NAN);
-    let (v0, v1) = (mean(&coarse, &speed), mean(&fine, &speed));
-    let (t0, t1) = (mean(&coarse, &t1), mean(&fine, &t1));
-    println!("parted {parted} deg; 5 deg ensemble means {v0} and {v1} m/s, t1 {t0} and {t1} s");
-    assert!((v0 / v1 - 1.0).abs() < 0.03, "ensemble means {v0} and {v1} m/s");
-    assert!((t0 - t1).abs() < 1e-3, "ensemble t1 {t0} and {t1} s");
+    for slope in [0.0, 5.0] {
+        let (coarse, fine) = (ensemble(dt, slope), ensemble(dt / 4.0, slope));
+        let (v0, v1) = (mean(&coarse, &speed), mean(&fine, &speed));
+        let (t0, t1) = (mean(&coarse, &t1), mean(&fine, &t1));
+        println!("{slope} deg ensemble means {v0} and {v1} m/s, t1 {t0} and {t1} s");
+        assert!((v0 / v1 - 1.0).abs() < 0.03, "{slope} deg: ensemble means {v0} and {v1} m/s");
+        assert!((t0 - t1).abs() < 1e-3, "{slope} deg: ensemble t1 {t0} and {t1} s");
+    }
+    println!("parted {parted} deg");
     for dt in [dt, dt / 4.0] {
         let over = ensemble(dt, 10.0).iter().filter(|s| s.pitch_over_s.is_some()).count();
         assert_eq!(over, 6, "walks pitched over at 10 degrees, dt {dt}");

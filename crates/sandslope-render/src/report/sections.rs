@@ -285,8 +285,8 @@ pub fn simulator(report: &Report) -> String {
          are within its scatter: neither model is asked to follow them. <i>Pitch free</i>: the pitch-free columns, \
          with the body free to pitch, are each one draw from a spread: the free body's pitch is unstable on slopes \
          (two walks whose masses differ by a billionth part by degrees within seconds), so a single free walk cannot \
-         converge with the time step; over many such walks its speed and regime do, and from 15° nearly every one \
-         tumbles within 10 s (docs/simulate.md, \"Pitch free\"). Here {tumbles} of these slopes tumbled.</p>\n",
+         converge with the time step; over many such walks its speed, t1 and regime do, and from 10° every one \
+         tumbles within a few seconds (docs/simulate.md, \"Pitch free\"). Here {tumbles} of these slopes tumbled.</p>\n",
         sandslope::report::REPORT_WALK_S,
         sandslope::report::AGREE_WITHIN * 100.0,
         report.simulator.len()

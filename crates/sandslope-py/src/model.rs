@@ -5,10 +5,12 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 
-use sandslope::{write_phase_rows, Cause, Regime, Slope, SlopeEvaluation, StrengthGrid};
+use sandslope::{Cause, Regime, SlopeEvaluation};
+use sandslope_request::phase::PhaseMapRequest;
 use sandslope_request::predict::{point_terrain, PointRequest};
 
-use crate::arrays::{axis, put, scale_name, uninit, values};
+use crate::arrays::{put, scale_name, values};
+use crate::interrupt::interruptibly;
 use crate::types::{PyRobot, PyTerrain};
 use crate::value_error;
 
@@ -143,12 +145,12 @@ pub fn predict<'py>(
     Ok(d)
 }
 
-/// Cells `phase` computes between two checks for Ctrl-C (about 10 ms of one core).
-const PHASE_CELLS_PER_BLOCK: usize = 1 << 20;
-
 /// The phase map at one slope: regime codes (int8) and net step (m, NaN where the leg never
 /// anchors) of every cell, row-major with one row per k_s value (`(len(k_s), len(k_n))`);
-/// with `regime_only` the codes alone (no `step_m`).
+/// with `regime_only` the codes alone (no `step_m`). The request layer's [`PhaseMapRequest`]
+/// checks the keywords, refuses a map over the cap before allocating it and writes the cells
+/// straight into the buffers NumPy then owns, in blocks between which Ctrl-C is seen (issue
+/// 21: the cap, 2^28 cells, took minutes that only a kill could stop).
 #[pyfunction]
 #[pyo3(signature = (robot, slope_deg, k_n_axis, k_s_axis, repose_deg=None, regime_only=false))]
 #[allow(clippy::too_many_arguments)]
@@ -161,69 +163,31 @@ pub fn phase<'py>(
     repose_deg: Option<f64>,
     regime_only: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let slope = Slope::from_signed_degrees(slope_deg).map_err(value_error)?;
-    let repose = repose_deg
-        .map(|r| {
-            Slope::from_degrees(r).ok().filter(|_| r > 0.0).ok_or_else(|| {
-                value_error(format!("repose_deg = {r} must be strictly between 0 and 90 degrees"))
-            })
-        })
-        .transpose()?;
-    let kn = axis("k_n_axis", &values(&k_n_axis))?;
-    let ks = axis("k_s_axis", &values(&k_s_axis))?;
+    let request = PhaseMapRequest {
+        slope_deg,
+        k_n_axis: values(&k_n_axis),
+        k_s_axis: values(&k_s_axis),
+        repose_deg,
+        regime_only,
+    };
+    // Refused at once, before the worker thread: a bad keyword or a map over the cap.
+    request.check().map_err(|e| value_error(e.message()))?;
     let robot = &robot.inner;
-    let (nx, ny) = (kn.len(), ks.len());
-    let cells = sandslope::limits::grid_cells(
-        "len(k_n_axis) * len(k_s_axis)",
-        nx,
-        ny,
-        1,
-        sandslope::limits::MAX_PHASE_CELLS,
-    )
-    .map_err(value_error)?;
-    // Written row by row, in parallel, straight into the buffers NumPy will own, in one pass
-    // (`sandslope::phase::write_phase_rows`: no packed map to unpack afterwards, the row's
-    // step terms once for both arrays), no intermediate copies, no zeroing first; in blocks of
-    // about 2^20 cells with the GIL released for each and Ctrl-C checked between them (issue
-    // 21: the cap, 2^28 cells, took minutes that only a kill could stop).
-    let mut regime = uninit::<i8>(cells);
-    let mut step = (!regime_only).then(|| uninit::<f64>(cells));
-    let block = (PHASE_CELLS_PER_BLOCK / nx).max(1);
-    let mut counts = [0usize; 4];
-    let mut j0 = 0;
-    while j0 < ny {
-        let rows = j0..(j0 + block).min(ny);
-        let span = rows.start * nx..rows.end * nx;
-        let codes = &mut regime.spare_capacity_mut()[span.clone()];
-        let steps = step.as_mut().map(|s| &mut s.spare_capacity_mut()[span]);
-        let grid = StrengthGrid::new(robot, slope, repose, &kn, &ks);
-        let c = py.detach(|| write_phase_rows(&grid, rows.clone(), codes, steps));
-        for (n, g) in counts.iter_mut().zip(sandslope::Regime::ALL) {
-            *n += c.get(g);
-        }
-        j0 = rows.end;
-        py.check_signals()?;
-    }
-    // SAFETY: the blocks cover rows 0..ny, and `write_phase_rows` writes every one of its
-    // rows' elements of each buffer it is given; `cells` is within their capacities.
-    unsafe {
-        regime.set_len(cells);
-        if let Some(s) = step.as_mut() {
-            s.set_len(cells);
-        }
-    }
+    let answer =
+        interruptibly(py, |stop| request.answer(robot, Some(stop)))?.map_err(|e| value_error(e.message()))?;
     let d = PyDict::new(py);
-    put(&d, "regime", regime)?;
-    if let Some(step) = step {
+    put(&d, "regime", answer.regime)?;
+    if let Some(step) = answer.step_m {
         put(&d, "step_m", step)?;
     }
+    let (kn, ks) = (&answer.k_n_axis, &answer.k_s_axis);
     put(&d, "k_n", kn.values())?;
     put(&d, "k_s", ks.values())?;
-    d.set_item("k_n_scale", scale_name(&kn))?;
-    d.set_item("k_s_scale", scale_name(&ks))?;
+    d.set_item("k_n_scale", scale_name(kn))?;
+    d.set_item("k_s_scale", scale_name(ks))?;
     let c = PyDict::new(py);
-    for (g, n) in sandslope::Regime::ALL.into_iter().zip(counts) {
-        c.set_item(g.name(), n)?;
+    for g in sandslope::Regime::ALL {
+        c.set_item(g.name(), answer.counts.get(g))?;
     }
     d.set_item("counts", c)?;
     Ok(d)

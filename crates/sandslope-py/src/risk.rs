@@ -1,6 +1,8 @@
 //! Failure risk on uncertain terrain (docs/model.md §9), mirroring `sandslope risk`: regime
 //! probabilities per slope, the p_fail map over median (k_n, k_s), the safe-slope limit, the
-//! heaviest safe mass at a slope and the payload envelope over several.
+//! heaviest safe mass at a slope and the payload envelope over several. Each builds the request
+//! layer's [`RiskQuestion`] from its keywords and converts its answer: the checks, the chunks
+//! between which Ctrl-C is seen and the answer are the request layer's.
 
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
@@ -8,17 +10,22 @@ use pyo3::types::PyDict;
 use pythonize::pythonize;
 
 use sandslope::risk::uncertainty::CvSource;
-use sandslope::risk::{risk_curve, RegimeProbabilities, RiskPoint, UncertainTerrain, RISK_MAP_CELL_KEYS};
-use sandslope::{ParamError, SignedSlope, Slope};
+use sandslope::risk::{RegimeProbabilities, RiskAnswer, RiskPoint, UncertainTerrain, RISK_MAP_CELL_KEYS};
+use sandslope_request::error::Words;
+use sandslope_request::grammar::{axis_of_values, uncertain_terrain_in, AxisRange};
+use sandslope_request::risk::{AnswerLimits, RiskMapGrid, RiskQuestion, Solve};
 
-use crate::arrays::{axis, put, values};
+use crate::arrays::{put, values};
+use crate::interrupt::interruptibly;
 use crate::types::{PyRobot, PyTerrain};
 use crate::value_error;
 
 /// The terrain read as uncertain by the library's one rule (docs/model.md §9): a given CV,
 /// else the table's SD over its value, else the default CV.
 pub fn uncertain(terrain: &PyTerrain, cv_n: Option<f64>, cv_s: Option<f64>) -> PyResult<UncertainTerrain> {
-    UncertainTerrain::new(terrain.inner.clone(), cv_n, cv_s).map_err(value_error)
+    let (u, _note) = uncertain_terrain_in(Words::Keyword, terrain.inner.clone(), cv_n, cv_s)
+        .map_err(|e| value_error(e.message()))?;
+    Ok(u)
 }
 
 fn source(s: CvSource) -> &'static str {
@@ -29,42 +36,35 @@ fn source(s: CvSource) -> &'static str {
     }
 }
 
-/// Slopes per chunk of [`risk`], between which Ctrl-C is checked (about 0.1 s of work each on
-/// this 2-core machine).
-const RISK_SLOPES_PER_CHUNK: usize = 128;
-
-/// Slopes per chunk of [`payload_envelope`] (each slope a search over masses).
-const ENVELOPE_SLOPES_PER_CHUNK: usize = 8;
-
-/// `compute` over `degrees` in chunks of `per_chunk` slopes, the GIL released for each and
-/// Ctrl-C checked between them (at least one call, on no slopes when `degrees` is empty). A
-/// library error names the element (`slope_deg[i]`) when there are several slopes.
-fn in_chunks<T: Send>(
+/// The answer to `question` for `robot` on `terrain`, in Python's words, the GIL released and
+/// Ctrl-C seen while it computes ([`interruptibly`]: the request layer stops between chunks).
+fn answer(
     py: Python<'_>,
-    degrees: &[f64],
-    per_chunk: usize,
-    compute: impl Fn(&[f64]) -> Result<T, ParamError> + Sync,
-) -> PyResult<Vec<T>> {
-    sandslope::limits::count("len(slope_deg)", degrees.len(), sandslope::limits::MAX_RISK_SLOPES)
-        .map_err(value_error)?;
-    let chunks: Vec<&[f64]> =
-        if degrees.is_empty() { vec![degrees] } else { degrees.chunks(per_chunk).collect() };
-    let mut out = Vec::with_capacity(chunks.len());
-    for (c, chunk) in chunks.into_iter().enumerate() {
-        let part = py.detach(|| compute(chunk)).map_err(|e| {
-            // The library names the key; point at the element when there are several.
-            let at = c * per_chunk
-                + chunk.iter().position(|&d| Slope::from_signed_degrees(d).is_err()).unwrap_or(0);
-            value_error(if degrees.len() > 1 && e.key == "slope_deg" {
-                e.renamed(format!("slope_deg[{at}]"))
-            } else {
-                e
-            })
-        })?;
-        out.push(part);
-        py.check_signals()?;
-    }
-    Ok(out)
+    question: RiskQuestion,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+) -> PyResult<RiskAnswer> {
+    let (robot, terrain) = (&robot.inner, terrain.inner.clone());
+    interruptibly(py, |stop| {
+        question.answer_on(robot, terrain, AnswerLimits::LIBRARY, Words::Keyword, Some(stop))
+    })?
+    .map_err(|e| value_error(e.message()))
+}
+
+/// The question of every solver: the slopes, CVs and risk threshold given, no map.
+fn question(
+    slopes: Vec<f64>,
+    cv_n: Option<f64>,
+    cv_s: Option<f64>,
+    max_risk: f64,
+    solve: Option<Solve>,
+) -> RiskQuestion {
+    RiskQuestion { slopes, cv_n, cv_s, max_risk, solve, map: None }
+}
+
+/// A dict of what `--json` prints for `value`.
+fn dict<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<'py, PyDict>> {
+    Ok(pythonize(py, value).map_err(value_error)?.cast_into::<PyDict>()?)
 }
 
 /// Regime probabilities at each slope: the keys of `sandslope risk --json` as columns
@@ -80,14 +80,13 @@ pub fn risk<'py>(
     cv_n: Option<f64>,
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let terrain = uncertain(terrain, cv_n, cv_s)?;
     let degrees = values(&slope_deg);
-    let robot = &robot.inner;
-    // In chunks, the GIL released for each and Ctrl-C checked between them: 65,536 slopes (the
-    // cap) took 74 s in one call that only a kill could stop (issue 21); a chunk is a fraction
-    // of a second.
-    let parts = in_chunks(py, &degrees, RISK_SLOPES_PER_CHUNK, |chunk| risk_curve(robot, &terrain, chunk))?;
-    let pts: Vec<RiskPoint> = parts.into_iter().flat_map(|c| c.points).collect();
+    let q = question(degrees.clone(), cv_n, cv_s, sandslope::risk::DEFAULT_MAX_RISK, None);
+    let pts: Vec<RiskPoint> = match answer(py, q, robot, terrain)? {
+        RiskAnswer::Point(p) => vec![*p],
+        RiskAnswer::Curve(points) => points,
+        _ => unreachable!("a question without solve or map is answered by a curve"),
+    };
     let pts = &pts;
     let d = PyDict::new(py);
     put(&d, "slope_deg", degrees.clone())?;
@@ -124,38 +123,27 @@ pub fn risk_map<'py>(
     cv_n: Option<f64>,
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let terrain = uncertain(terrain, cv_n, cv_s)?;
+    // An axis given is matched to the library's; one not given is the library's default, as
+    // `risk --map` without --k-n/--k-s.
     let given = |key: &str, a: &Option<PyReadonlyArray1<'py, f64>>| {
-        a.as_ref().map(|a| axis(key, &values(a))).transpose()
+        a.as_ref()
+            .map(|a| axis_of_values(key, &values(a)).map(|axis| AxisRange::of(&axis)))
+            .transpose()
+            .map_err(|e| value_error(e.message()))
     };
-    // The library's default grid where an axis is not given, as `risk --map` without --k-n/--k-s.
-    let slope = SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
-    let (kn, ks) = sandslope::risk::map_axes(
-        &terrain,
-        slope,
-        given("k_n_axis", &k_n_axis)?,
-        given("k_s_axis", &k_s_axis)?,
-    )
-    .map_err(value_error)?;
-    sandslope::limits::grid_cells(
-        "len(k_n_axis) * len(k_s_axis)",
-        kn.len(),
-        ks.len(),
-        1,
-        sandslope::limits::MAX_RISK_MAP_CELLS,
-    )
-    .map_err(value_error)?;
-    let robot = &robot.inner;
-    let answer = py
-        .detach(|| sandslope::risk::risk_map(robot, slope, &terrain, (&kn, &ks), max_risk, &|| {}))
-        .map_err(value_error)?;
+    let grid = RiskMapGrid { k_n: given("k_n_axis", &k_n_axis)?, k_s: given("k_s_axis", &k_s_axis)? };
+    let q = RiskQuestion { map: Some(grid), ..question(vec![slope_deg], cv_n, cv_s, max_risk, None) };
+    let RiskAnswer::Map(answer) = answer(py, q, robot, terrain)? else {
+        unreachable!("a question with a map is answered by a map")
+    };
     // The summary as `--json` serialises it, then the keys the answer adds, as arrays.
-    let d = pythonize(py, &answer.summary).map_err(value_error)?.cast_into::<PyDict>()?;
+    let d = dict(py, &answer.summary)?;
     let map = answer.map;
+    let (kn, ks) = (map.k_n_axis.values(), map.k_s_axis.values());
     let [repose, k_n, k_s, p_fail, p_not_success] = RISK_MAP_CELL_KEYS;
     d.set_item(repose, map.beyond_repose)?;
-    put(&d, k_n, kn.values())?;
-    put(&d, k_s, ks.values())?;
+    put(&d, k_n, kn)?;
+    put(&d, k_s, ks)?;
     put(&d, p_fail, map.p_fail)?;
     put(&d, p_not_success, map.p_not_success)?;
     Ok(d)
@@ -173,10 +161,11 @@ pub fn safe_slope<'py>(
     cv_n: Option<f64>,
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let terrain = uncertain(terrain, cv_n, cv_s)?;
-    let robot = &robot.inner;
-    let answer = py.detach(|| sandslope::risk::safe_slope(robot, &terrain, max_risk)).map_err(value_error)?;
-    Ok(pythonize(py, &answer).map_err(value_error)?.cast_into::<PyDict>()?)
+    let q = question(Vec::new(), cv_n, cv_s, max_risk, Some(Solve::Slope));
+    match answer(py, q, robot, terrain)? {
+        RiskAnswer::Slope(limit) => dict(py, &limit),
+        _ => unreachable!("solve slope is answered by the safe-slope limit"),
+    }
 }
 
 /// The heaviest safe total mass at one slope, the payload it leaves and the uncertainty it used:
@@ -192,12 +181,11 @@ pub fn safe_mass<'py>(
     cv_n: Option<f64>,
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let terrain = uncertain(terrain, cv_n, cv_s)?;
-    let slope = SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
-    let robot = &robot.inner;
-    let answer =
-        py.detach(|| sandslope::risk::safe_mass(robot, slope, &terrain, max_risk)).map_err(value_error)?;
-    Ok(pythonize(py, &answer).map_err(value_error)?.cast_into::<PyDict>()?)
+    let q = question(vec![slope_deg], cv_n, cv_s, max_risk, Some(Solve::Mass));
+    match answer(py, q, robot, terrain)? {
+        RiskAnswer::Mass(mass) => dict(py, &mass),
+        _ => unreachable!("solve mass at one slope is answered by the heaviest safe mass"),
+    }
 }
 
 /// The payload envelope: the heaviest safe total mass and the payload it leaves at each slope,
@@ -214,17 +202,9 @@ pub fn payload_envelope<'py>(
     cv_n: Option<f64>,
     cv_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let terrain = uncertain(terrain, cv_n, cv_s)?;
-    let degrees = values(&slope_deg);
-    let robot = &robot.inner;
-    let parts = in_chunks(py, &degrees, ENVELOPE_SLOPES_PER_CHUNK, |chunk| {
-        sandslope::risk::payload_envelope(robot, &terrain, chunk, max_risk)
-    })?;
-    let mut parts = parts.into_iter();
-    let mut envelope = parts.next().expect("in_chunks calls at least once");
-    for part in parts {
-        envelope.points.extend(part.points);
-        envelope.defaults_used = envelope.defaults_used.or(part.defaults_used);
+    let q = question(values(&slope_deg), cv_n, cv_s, max_risk, Some(Solve::Envelope));
+    match answer(py, q, robot, terrain)? {
+        RiskAnswer::Envelope(envelope) => dict(py, &envelope),
+        _ => unreachable!("solve envelope is answered by the payload envelope"),
     }
-    Ok(pythonize(py, &envelope).map_err(value_error)?.cast_into::<PyDict>()?)
 }

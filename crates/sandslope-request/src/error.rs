@@ -32,6 +32,12 @@ impl RequestError {
         RequestError { field: field.map(str::to_string), error }
     }
 
+    /// A computation stopped on its stop flag (a front end's Ctrl-C) before its end: no field
+    /// is at fault, and the front end reports the signal instead.
+    pub fn interrupted() -> RequestError {
+        RequestError { field: None, error: anyhow::anyhow!("interrupted") }
+    }
+
     /// The request field at fault (`slope`, `k-n`), when there is one.
     pub fn field(&self) -> Option<&str> {
         self.field.as_deref()

@@ -6,7 +6,7 @@
 use sandslope::risk::UncertainTerrain;
 use sandslope::{Axis, AxisScale, Slope, Terrain};
 
-use crate::error::{check_range, RequestError, Result};
+use crate::error::{check_range_in, RequestError, Result, Words};
 
 /// Which slopes a slope list accepts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -170,6 +170,45 @@ pub fn axis(field: &str, range: AxisRange) -> Result<Axis> {
         .map_err(|e| RequestError::invalid(field, e))
 }
 
+/// The axis whose values are `v`, given as values (Python's NumPy axes): evenly spaced values
+/// (`np.linspace`) or evenly spaced logarithms (`np.geomspace`, `np.logspace`), to a relative
+/// 1e-9, so that maps run on exactly the library's grids. `key` names the values in errors and
+/// is the error's field.
+pub fn axis_of_values(key: &str, v: &[f64]) -> Result<Axis> {
+    let refuse = |message: String| RequestError::invalid(key, message);
+    if v.len() < 2 {
+        return Err(refuse(format!("{key} has {} values; at least 2 are needed", v.len())));
+    }
+    let (min, max) = (v[0], v[v.len() - 1]);
+    let matches = |a: &Axis| {
+        v.iter().enumerate().all(|(i, &x)| {
+            let y = a.value(i);
+            (x - y).abs() <= 1e-9 * x.abs().max(y.abs()).max(f64::MIN_POSITIVE)
+        })
+    };
+    let linear = Axis::new(key, min, max, v.len(), AxisScale::Linear).map_err(|e| refuse(e.to_string()))?;
+    if matches(&linear) {
+        return Ok(linear);
+    }
+    if min > 0.0 {
+        let log = Axis::new(key, min, max, v.len(), AxisScale::Log).map_err(|e| refuse(e.to_string()))?;
+        if matches(&log) {
+            return Ok(log);
+        }
+    }
+    Err(refuse(format!(
+        "{key} must be ascending and evenly spaced (np.linspace) or evenly spaced in logarithm \
+         (np.geomspace), from {min} to {max}"
+    )))
+}
+
+impl AxisRange {
+    /// The range of an axis already built (its values are the axis's own again).
+    pub fn of(axis: &Axis) -> AxisRange {
+        AxisRange { min: axis.min(), max: axis.max(), n: axis.len(), scale: axis.scale() }
+    }
+}
+
 /// Parses a failure probability: a number strictly between 0 and 1.
 pub fn parse_max_risk(text: &str) -> std::result::Result<f64, String> {
     match text.trim().parse::<f64>() {
@@ -189,11 +228,20 @@ pub fn uncertain_terrain(
     cv_n: Option<f64>,
     cv_s: Option<f64>,
 ) -> Result<(UncertainTerrain, Option<String>)> {
-    check_cvs(cv_n, cv_s)?;
+    uncertain_terrain_in(Words::Flag, terrain, cv_n, cv_s)
+}
+
+/// [`uncertain_terrain`], naming the CVs in the front end's `words` (`--cv-s`, `cv_s`).
+pub fn uncertain_terrain_in(
+    words: Words,
+    terrain: Terrain,
+    cv_n: Option<f64>,
+    cv_s: Option<f64>,
+) -> Result<(UncertainTerrain, Option<String>)> {
+    check_cvs_in(words, cv_n, cv_s)?;
     let u = UncertainTerrain::new(terrain, cv_n, cv_s).map_err(|e| {
         let field = if e.key == "cv_s" { "cv-s" } else { "cv-n" };
-        let flag = format!("--{field}");
-        RequestError::invalid(field, e.renamed(flag))
+        RequestError::invalid(field, e.renamed(words.name(field)))
     })?;
     let note = u.defaults_used().note();
     Ok((u, note))
@@ -202,9 +250,14 @@ pub fn uncertain_terrain(
 /// Checks the CVs alone, before any file is read: each a finite number of at least 0 (the
 /// library's [`UncertainTerrain::new`] has the upper bound).
 pub fn check_cvs(cv_n: Option<f64>, cv_s: Option<f64>) -> Result<()> {
+    check_cvs_in(Words::Flag, cv_n, cv_s)
+}
+
+/// [`check_cvs`], naming the CVs in the front end's `words`.
+pub fn check_cvs_in(words: Words, cv_n: Option<f64>, cv_s: Option<f64>) -> Result<()> {
     for (field, cv) in [("cv-n", cv_n), ("cv-s", cv_s)] {
         if let Some(cv) = cv {
-            check_range(field, cv, 0.0, f64::INFINITY)?;
+            check_range_in(words, field, cv, 0.0, f64::INFINITY)?;
         }
     }
     Ok(())

@@ -1,9 +1,17 @@
 //! [`PhaseRequest`]: phase diagrams, the regime of every terrain (k_n, k_s) on a grid, one
-//! panel per (mass, slope) (the paper's Section IV figure).
+//! panel per (mass, slope) (the paper's Section IV figure); [`PhaseMapRequest`]: one map over
+//! axes given as values (Python's `phase`).
+
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde::{Deserialize, Serialize};
 
-use sandslope::{Axis, PanelSummary, PhasePanel, Robot, SignedSlope, Slope, Terrain};
+use sandslope::limits::MAX_PHASE_CELLS;
+use sandslope::memory::uninit;
+use sandslope::{
+    write_phase_rows, Axis, PanelSummary, PhasePanel, RegimeCounts, Robot, SignedSlope, Slope, StrengthGrid,
+    Terrain,
+};
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 
 use crate::error::{RequestError, Result};
@@ -162,5 +170,112 @@ impl PhaseGrid {
             }
         }
         Ok(panels)
+    }
+}
+
+/// Cells a [`PhaseMapRequest`] computes between two looks at its stop flag (about 10 ms of one
+/// core).
+const PHASE_MAP_CELLS_PER_BLOCK: usize = 1 << 20;
+
+/// One phase map at one slope over axes given as values, no terrain table: Python's
+/// `sandslope.phase` (its NumPy axes and the cells' arrays have no command-line counterpart;
+/// `phase` draws panels from a terrain). The fields are the keywords, and messages name them so.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhaseMapRequest {
+    /// Slope along the direction of travel, degrees (negative: descending; `slope_deg`).
+    pub slope_deg: f64,
+    /// The k_n values, N/m^3, evenly spaced or evenly spaced in logarithm (`k_n_axis`).
+    pub k_n_axis: Vec<f64>,
+    /// The k_s values, N/m^3, likewise (`k_s_axis`).
+    pub k_s_axis: Vec<f64>,
+    /// Angle of repose, degrees, strictly between 0 and 90 (`repose_deg`; default none).
+    pub repose_deg: Option<f64>,
+    /// The regime codes alone, without the net step (`regime_only`).
+    pub regime_only: bool,
+}
+
+/// The answer to a [`PhaseMapRequest`]: every cell row-major, one row per k_s value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhaseMapAnswer {
+    /// Each cell's regime, its index in [`sandslope::Regime::ALL`].
+    pub regime: Vec<i8>,
+    /// Each cell's net step, m (NaN where the leg never anchors); none with `regime_only`.
+    pub step_m: Option<Vec<f64>>,
+    /// The k_n axis the values matched.
+    pub k_n_axis: Axis,
+    /// The k_s axis the values matched.
+    pub k_s_axis: Axis,
+    /// Cells per regime.
+    pub counts: RegimeCounts,
+}
+
+impl PhaseMapRequest {
+    /// Checks every field and the map's size (at most [`MAX_PHASE_CELLS`]) before anything is
+    /// allocated: the slope, the angle of repose and the axes as the library takes them.
+    pub fn check(&self) -> Result<(Slope, Option<Slope>, Axis, Axis)> {
+        let slope =
+            Slope::from_signed_degrees(self.slope_deg).map_err(|e| RequestError::invalid("slope-deg", e))?;
+        let repose = self
+            .repose_deg
+            .map(|r| {
+                Slope::from_degrees(r).ok().filter(|_| r > 0.0).ok_or_else(|| {
+                    RequestError::invalid(
+                        "repose-deg",
+                        format!("repose_deg = {r} must be strictly between 0 and 90 degrees"),
+                    )
+                })
+            })
+            .transpose()?;
+        let k_n = grammar::axis_of_values("k_n_axis", &self.k_n_axis)?;
+        let k_s = grammar::axis_of_values("k_s_axis", &self.k_s_axis)?;
+        sandslope::limits::grid_cells(
+            "len(k_n_axis) * len(k_s_axis)",
+            k_n.len(),
+            k_s.len(),
+            1,
+            MAX_PHASE_CELLS,
+        )
+        .map_err(|e| RequestError::invalid("k-n-axis", e))?;
+        Ok((slope, repose, k_n, k_s))
+    }
+
+    /// The map for `robot`, written row by row in parallel straight into the answer's buffers
+    /// (no zeroing first, no packed map to unpack: `sandslope::write_phase_rows`), in blocks of
+    /// about 2^20 cells with `stop` looked at between them: once it is raised the answer is
+    /// [`RequestError::interrupted`] (the cap, 2^28 cells, takes minutes).
+    pub fn answer(&self, robot: &Robot, stop: Option<&AtomicBool>) -> Result<PhaseMapAnswer> {
+        let (slope, repose, k_n_axis, k_s_axis) = self.check()?;
+        let (nx, ny) = (k_n_axis.len(), k_s_axis.len());
+        let cells = nx * ny;
+        let mut regime = uninit::<i8>(cells);
+        let mut step = (!self.regime_only).then(|| uninit::<f64>(cells));
+        let grid = StrengthGrid::new(robot, slope, repose, &k_n_axis, &k_s_axis);
+        let block = (PHASE_MAP_CELLS_PER_BLOCK / nx).max(1);
+        let mut counts = RegimeCounts::default();
+        let mut j0 = 0;
+        while j0 < ny {
+            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                return Err(RequestError::interrupted());
+            }
+            let rows = j0..(j0 + block).min(ny);
+            let span = rows.start * nx..rows.end * nx;
+            let codes = &mut regime.spare_capacity_mut()[span.clone()];
+            let steps = step.as_mut().map(|s| &mut s.spare_capacity_mut()[span]);
+            let c = write_phase_rows(&grid, rows.clone(), codes, steps);
+            counts.sinkage += c.sinkage;
+            counts.slippage += c.slippage;
+            counts.metastable += c.metastable;
+            counts.success += c.success;
+            j0 = rows.end;
+        }
+        // SAFETY: the blocks cover rows 0..ny, and `write_phase_rows` writes every one of its
+        // rows' elements of each buffer it is given; `cells` is within their capacities.
+        unsafe {
+            regime.set_len(cells);
+            if let Some(s) = step.as_mut() {
+                s.set_len(cells);
+            }
+        }
+        Ok(PhaseMapAnswer { regime, step_m: step, k_n_axis, k_s_axis, counts })
     }
 }

@@ -2,16 +2,18 @@
 //! p_fail curve over slopes, the safe-slope limit, the heaviest safe mass or payload envelope,
 //! or a map over median (k_n, k_s).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use serde::{Deserialize, Serialize};
 
 use sandslope::limits::{MAX_RISK_MAP_CELLS, MAX_RISK_SLOPES};
 use sandslope::risk::{
     payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, RiskAnswer, UncertainTerrain,
 };
-use sandslope::{Axis, SignedSlope};
+use sandslope::{Axis, ParamError, Robot, SignedSlope, Terrain};
 use sandslope_io::presets::DEFAULT_TERRAIN;
 
-use crate::error::{RequestError, Result};
+use crate::error::{RequestError, Result, Words};
 use crate::grammar::{self, parse_slope_list, AxisRange, SlopeSign};
 use crate::params::Params;
 use crate::scenario::{load_terrain, RobotRequest};
@@ -25,6 +27,9 @@ pub enum Solve {
     /// The heaviest total mass with p_fail below `max_risk` at each slope (several slopes:
     /// the payload envelope).
     Mass,
+    /// The payload envelope, even at one slope (Python's `payload_envelope`; the field
+    /// `solve` takes `slope` or `mass`).
+    Envelope,
 }
 
 /// The grid of a risk map over median (k_n, k_s): each axis given, or the default around the
@@ -37,15 +42,25 @@ pub struct RiskMapGrid {
     pub k_s: Option<AxisRange>,
 }
 
-/// The inputs of `risk` (and `/api/risk`).
+/// The inputs of `risk` (and `/api/risk`): the robot and terrain by name, and the question.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RiskRequest {
-    /// Slopes, degrees (field `slope`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N`; default 0:24:7).
-    pub slopes: Vec<f64>,
     /// The robot.
     pub robot: RobotRequest,
     /// A terrain TOML file or a built-in preset (field `terrain`).
     pub terrain: String,
+    /// What is asked about them.
+    #[serde(flatten)]
+    pub question: RiskQuestion,
+}
+
+/// What a risk request asks about a robot and a terrain, whichever way they were given: by
+/// name in a [`RiskRequest`], or already read (Python's `Robot` and `Terrain`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RiskQuestion {
+    /// Slopes, degrees (field `slope`: `DEG`, `DEG,DEG,...` or `MIN:MAX:N`; default 0:24:7;
+    /// Python's `slope_deg`).
+    pub slopes: Vec<f64>,
     /// Coefficient of variation of k_n at every slope instead of the terrain's (field `cv-n`).
     pub cv_n: Option<f64>,
     /// Coefficient of variation of k_s at every slope instead of the terrain's (field `cv-s`).
@@ -142,70 +157,200 @@ impl RiskRequest {
             return Err(RequestError::invalid("solve", "--solve cannot be used with --map"));
         }
         p.finish()?;
-        Ok(RiskRequest { slopes, robot, terrain, cv_n, cv_s, max_risk, solve, map: map.then_some(grid) })
+        let question = RiskQuestion { slopes, cv_n, cv_s, max_risk, solve, map: map.then_some(grid) };
+        Ok(RiskRequest { robot, terrain, question })
     }
 
     /// The terrain read as uncertain by the one rule of docs/model.md §9, with the note to
     /// print when a default CV is used anywhere on the table.
     pub fn uncertain_terrain(&self) -> Result<(UncertainTerrain, Option<String>)> {
-        grammar::uncertain_terrain(load_terrain(&self.terrain)?, self.cv_n, self.cv_s)
+        let q = &self.question;
+        grammar::uncertain_terrain(load_terrain(&self.terrain)?, q.cv_n, q.cv_s)
     }
 
     /// The answer (what `risk --json` prints), by the library's calls; more work than
     /// `limits` allows is an error naming the limit.
     pub fn answer(&self, limits: AnswerLimits) -> Result<RiskAnswer> {
         let robot = self.robot.load()?;
-        let slopes = &self.slopes;
-        if slopes.is_empty() {
-            return Err(RequestError::invalid("slope", "--slope gives no slope: give at least one"));
-        }
-        let max_risk = self.max_risk;
-        let (terrain, _) = self.uncertain_terrain()?;
+        let terrain = load_terrain(&self.terrain)?;
+        self.question.answer_on(&robot, terrain, limits, Words::Flag, None)
+    }
+}
+
+/// Slopes of a p_fail curve computed between two looks at the stop flag (about 0.1 s of work
+/// on 2 cores).
+const CURVE_SLOPES_PER_CHUNK: usize = 128;
+
+/// Slopes of a payload envelope computed between two looks at the stop flag (each a search
+/// over masses).
+const ENVELOPE_SLOPES_PER_CHUNK: usize = 8;
+
+impl RiskQuestion {
+    /// The answer for `robot` on `terrain` (what `risk --json` prints), by the library's calls,
+    /// messages naming the fields in `words`; more work than `limits` allows is an error
+    /// naming the limit. A curve or an envelope is computed in chunks of slopes with `stop`
+    /// looked at between them: once it is raised the answer is [`RequestError::interrupted`]
+    /// (the cap of 65,536 slopes takes over a minute). No slope is a curve or an envelope of
+    /// none; a map or one slope's mass needs one.
+    pub fn answer_on(
+        &self,
+        robot: &Robot,
+        terrain: Terrain,
+        limits: AnswerLimits,
+        words: Words,
+        stop: Option<&AtomicBool>,
+    ) -> Result<RiskAnswer> {
+        let (terrain, _) = grammar::uncertain_terrain_in(words, terrain, self.cv_n, self.cv_s)?;
+        let (slopes, max_risk) = (&self.slopes, self.max_risk);
         let library = |e: &dyn std::fmt::Display| RequestError::from_error(None, anyhow::anyhow!("{e}"));
-        let too_many = |n: usize, most: usize, what: &str| {
-            RequestError::invalid(
-                "slope",
-                format!("--slope gives {n} slopes; at most {most} are allowed for {what} here"),
-            )
+        let first = || {
+            slopes.first().copied().ok_or_else(|| {
+                RequestError::invalid(
+                    "slope",
+                    format!("{} gives no slope: give at least one", words.name("slope")),
+                )
+            })
         };
         if let Some(grid) = &self.map {
-            let (k_n_axis, k_s_axis) = map_axes(grid, &terrain, slopes[0], limits.map_cells)?;
-            let map =
-                risk_map(&robot, slope_of(slopes[0])?, &terrain, (&k_n_axis, &k_s_axis), max_risk, &|| {})
-                    .map_err(|e| library(&e))?;
+            let slope_deg = first()?;
+            let (k_n_axis, k_s_axis) = map_axes_in(words, grid, &terrain, slope_deg, limits.map_cells)?;
+            let slope = slope_in(words, slope_deg)?;
+            let map = risk_map(robot, slope, &terrain, (&k_n_axis, &k_s_axis), max_risk, &|| {})
+                .map_err(|e| library(&e))?;
             return Ok(RiskAnswer::Map(Box::new(map)));
         }
+        let chunks = |per_chunk: usize, most: usize, what: &str| {
+            too_many(words, slopes.len(), most, what)?;
+            Ok(SlopeChunks { slopes, per_chunk, words, stop })
+        };
         Ok(match self.solve {
-            Some(Solve::Mass) if slopes.len() > 1 => {
-                if slopes.len() > limits.envelope_slopes {
-                    return Err(too_many(slopes.len(), limits.envelope_slopes, "--solve mass"));
-                }
-                let env = payload_envelope(&robot, &terrain, slopes, max_risk).map_err(|e| library(&e))?;
-                RiskAnswer::Envelope(Box::new(env))
-            }
+            Some(Solve::Mass) if slopes.len() > 1 => envelope(
+                chunks(ENVELOPE_SLOPES_PER_CHUNK, limits.envelope_slopes, "--solve mass")?,
+                robot,
+                &terrain,
+                max_risk,
+            )?,
+            Some(Solve::Envelope) => envelope(
+                chunks(ENVELOPE_SLOPES_PER_CHUNK, limits.envelope_slopes, "--solve mass")?,
+                robot,
+                &terrain,
+                max_risk,
+            )?,
             Some(Solve::Mass) => {
-                let sol =
-                    safe_mass(&robot, slope_of(slopes[0])?, &terrain, max_risk).map_err(|e| library(&e))?;
+                let sol = safe_mass(robot, slope_in(words, first()?)?, &terrain, max_risk)
+                    .map_err(|e| library(&e))?;
                 RiskAnswer::Mass(Box::new(sol))
             }
             Some(Solve::Slope) => {
-                RiskAnswer::Slope(Box::new(safe_slope(&robot, &terrain, max_risk).map_err(|e| library(&e))?))
+                RiskAnswer::Slope(Box::new(safe_slope(robot, &terrain, max_risk).map_err(|e| library(&e))?))
             }
             None => {
-                if slopes.len() > limits.curve_slopes {
-                    return Err(too_many(slopes.len(), limits.curve_slopes, "a p_fail curve"));
-                }
-                let curve = risk_curve(&robot, &terrain, slopes)
-                    .map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))?;
-                RiskAnswer::of_points(curve.points)
+                let chunks = chunks(CURVE_SLOPES_PER_CHUNK, limits.curve_slopes, "a p_fail curve")?;
+                let parts = chunks.each(
+                    |chunk| risk_curve(robot, &terrain, chunk),
+                    |e| match words {
+                        Words::Flag => RequestError::invalid("slope", e.renamed("--slope")),
+                        Words::Keyword => RequestError::invalid("slope", e),
+                    },
+                )?;
+                RiskAnswer::of_points(parts.into_iter().flat_map(|c| c.points).collect())
             }
         })
     }
 }
 
+/// The payload envelope over `chunks`' slopes, in chunks.
+fn envelope(
+    chunks: SlopeChunks<'_>,
+    robot: &Robot,
+    terrain: &UncertainTerrain,
+    max_risk: f64,
+) -> Result<RiskAnswer> {
+    let words = chunks.words;
+    let parts = chunks.each(
+        |chunk| payload_envelope(robot, terrain, chunk, max_risk),
+        |e| match words {
+            // The command line's message as it always was: the library's, unnamed.
+            Words::Flag => RequestError::from_error(None, anyhow::anyhow!("{e}")),
+            Words::Keyword if e.key.starts_with("slope_deg") => RequestError::invalid("slope", e),
+            Words::Keyword => RequestError::from_error(None, anyhow::anyhow!("{e}")),
+        },
+    )?;
+    let mut parts = parts.into_iter();
+    let mut env = parts.next().expect("SlopeChunks::each computes at least once");
+    for part in parts {
+        env.points.extend(part.points);
+        env.defaults_used = env.defaults_used.or(part.defaults_used);
+    }
+    Ok(RiskAnswer::Envelope(Box::new(env)))
+}
+
+/// More than `most` slopes refused, in `words`.
+fn too_many(words: Words, n: usize, most: usize, what: &str) -> Result<()> {
+    match words {
+        _ if n <= most => Ok(()),
+        Words::Flag => Err(RequestError::invalid(
+            "slope",
+            format!("--slope gives {n} slopes; at most {most} are allowed for {what} here"),
+        )),
+        Words::Keyword => sandslope::limits::count("len(slope_deg)", n, most)
+            .map(|_| ())
+            .map_err(|e| RequestError::invalid("slope", e)),
+    }
+}
+
+/// A request's slopes in chunks, with the stop flag looked at between them.
+struct SlopeChunks<'a> {
+    slopes: &'a [f64],
+    per_chunk: usize,
+    words: Words,
+    stop: Option<&'a AtomicBool>,
+}
+
+impl SlopeChunks<'_> {
+    /// `compute` over each chunk (at least once, on no slopes when there are none); a library
+    /// error about a slope names it in Python's words when there are several (`slope_deg[i]`)
+    /// before `refuse` makes it the request's error.
+    fn each<T>(
+        &self,
+        compute: impl Fn(&[f64]) -> std::result::Result<T, ParamError>,
+        refuse: impl Fn(ParamError) -> RequestError,
+    ) -> Result<Vec<T>> {
+        let slopes = self.slopes;
+        let chunks: Vec<&[f64]> =
+            if slopes.is_empty() { vec![slopes] } else { slopes.chunks(self.per_chunk).collect() };
+        let mut out = Vec::with_capacity(chunks.len());
+        for (c, chunk) in chunks.into_iter().enumerate() {
+            if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                return Err(RequestError::interrupted());
+            }
+            let part = compute(chunk).map_err(|e| {
+                refuse(match self.words {
+                    Words::Keyword if slopes.len() > 1 && e.key == "slope_deg" => {
+                        let bad = chunk.iter().position(|&d| SignedSlope::from_degrees(d).is_err());
+                        e.renamed(format!("slope_deg[{}]", c * self.per_chunk + bad.unwrap_or(0)))
+                    }
+                    _ => e,
+                })
+            })?;
+            out.push(part);
+        }
+        Ok(out)
+    }
+}
+
+/// A slope as the library's type (signed: answers print it as given), an error naming the
+/// field `slope` in `words`.
+fn slope_in(words: Words, deg: f64) -> Result<SignedSlope> {
+    SignedSlope::from_degrees(deg).map_err(|e| match words {
+        Words::Flag => RequestError::invalid("slope", e.renamed("--slope")),
+        Words::Keyword => RequestError::invalid("slope", e),
+    })
+}
+
 /// A slope of the field `slope` as the library's type (signed: answers print it as given).
 pub fn slope_of(deg: f64) -> Result<SignedSlope> {
-    SignedSlope::from_degrees(deg).map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))
+    slope_in(Words::Flag, deg)
 }
 
 /// The map's axes (the grid's, else the defaults around the terrain's medians at
@@ -216,13 +361,31 @@ pub fn map_axes(
     slope_deg: f64,
     max_cells: u128,
 ) -> Result<(Axis, Axis)> {
-    let slope = slope_of(slope_deg)?;
+    map_axes_in(Words::Flag, grid, terrain, slope_deg, max_cells)
+}
+
+/// [`map_axes`], naming the fields in `words` (Python's keywords: `slope_deg`, `len(k_n_axis)
+/// * len(k_s_axis)`).
+pub fn map_axes_in(
+    words: Words,
+    grid: &RiskMapGrid,
+    terrain: &UncertainTerrain,
+    slope_deg: f64,
+    max_cells: u128,
+) -> Result<(Axis, Axis)> {
+    let slope = slope_in(words, slope_deg)?;
     let given = |field: &str, range: Option<AxisRange>| range.map(|r| grammar::axis(field, r)).transpose();
     let (k_n_axis, k_s_axis) =
         sandslope::risk::map_axes(terrain, slope, given("k-n", grid.k_n)?, given("k-s", grid.k_s)?)
             .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))?;
     let cells = k_n_axis.len() as u128 * k_s_axis.len() as u128;
     if cells > max_cells {
+        if words == Words::Keyword {
+            let (nx, ny, most) =
+                (k_n_axis.len(), k_s_axis.len(), usize::try_from(max_cells).unwrap_or(usize::MAX));
+            let e = sandslope::limits::grid_cells("len(k_n_axis) * len(k_s_axis)", nx, ny, 1, most);
+            return Err(RequestError::invalid("k-n", e.expect_err("over the cap")));
+        }
         let side = (max_cells as f64).sqrt().floor();
         return Err(RequestError::invalid(
             "k-n",

@@ -114,8 +114,9 @@ fn risk_refusals_name_their_field_and_the_default_is_seven_slopes() {
     );
     // 0:24:7 is 0, 4, ..., 24 degrees: seven points of the curve, in order.
     let default = RiskRequest::from_params(&[]).unwrap();
-    assert_eq!(default.slopes, vec![0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 24.0]);
-    assert_eq!((default.max_risk, default.solve, default.map), (0.05, None, None));
+    let q = &default.question;
+    assert_eq!(q.slopes, vec![0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 24.0]);
+    assert_eq!((q.max_risk, q.solve, q.map), (0.05, None, None));
 }
 
 #[test]

@@ -1,80 +1,66 @@
 //! Elevation models (docs/model.md §8): the two-band risk raster of `sandslope plan
-//! --risk-map`, routes of `sandslope plan --json` with their cells, and the raster reader.
+//! --risk-map`, routes of `sandslope plan --json` with their cells (both the request layer's
+//! grid requests: NumPy heights in, columns out), and the raster readers.
 
-use std::ops::ControlFlow;
+use std::borrow::Cow;
 use std::path::PathBuf;
-use std::sync::atomic::Ordering;
-use std::sync::LazyLock;
 
 use numpy::{PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use sandslope::plan::{
-    Cell, Descent, ElevationGrid, Objective, PitchTableCache, PlanRequest, PlanSettings, Planner, Route,
-};
-use sandslope::risk::UncertainTerrain;
 use sandslope_io::pds3::Pds3Dtm;
 use sandslope_io::raster::read_raster as read;
-use sandslope_request::plan::RouteRecord;
+use sandslope_request::plan::{ClassesSource, GridPlanRequest, GridRequest, GridSource, RouteRecord};
 
 use crate::arrays::put;
 use crate::interrupt::interruptibly;
 use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
 
-/// The grid, terrain and settings of a NumPy DEM (row 0 = north; NaN or `nodata` = missing
-/// heights, used as float32 like the CLI), as `sandslope plan` builds them; `row_widths`, the
-/// east-west ground size of each row's cells where they differ (a geographic DEM's).
+/// The values of a 2-D array row-major, borrowed when it is contiguous, and its shape.
+fn row_major<'a>(a: &'a PyReadonlyArray2<'_, f64>) -> (Cow<'a, [f64]>, (usize, usize)) {
+    let a = a.as_array();
+    let shape = (a.shape()[0], a.shape()[1]);
+    match a.to_slice() {
+        Some(v) => (Cow::Borrowed(v), shape),
+        None => (Cow::Owned(a.iter().copied().collect()), shape),
+    }
+}
+
+/// The request layer's grid request of the keywords every elevation call shares.
 #[allow(clippy::too_many_arguments)]
-fn inputs(
-    dem: &PyReadonlyArray2<'_, f64>,
+fn grid_request(
     cell_x: f64,
     cell_y: f64,
-    row_widths: Option<Vec<f64>>,
+    row_widths_m: Option<Vec<f64>>,
     nodata: Option<f64>,
-    terrain: &PyTerrain,
     cv_n: Option<f64>,
     cv_s: Option<f64>,
     max_roll_deg: f64,
     descent: &str,
     allow_metastable: bool,
     time_weight: f64,
-) -> PyResult<(ElevationGrid, UncertainTerrain, PlanSettings)> {
-    let descent = Descent::parse(descent)
-        .ok_or_else(|| value_error(format!("descent = {descent:?} must be \"symmetric\" or \"level\"")))?;
-    let settings =
-        PlanSettings::new(max_roll_deg, descent, allow_metastable, time_weight).map_err(value_error)?;
-    let terrain = crate::risk::uncertain(terrain, cv_n, cv_s)?;
-    let a = dem.as_array();
-    let (rows, cols) = (a.shape()[0], a.shape()[1]);
-    let grid = match a.as_slice() {
-        Some(z) => ElevationGrid::from_heights(cols, rows, cell_x, cell_y, z, nodata),
-        None => ElevationGrid::from_heights(
-            cols,
-            rows,
-            cell_x,
-            cell_y,
-            &a.iter().copied().collect::<Vec<_>>(),
-            nodata,
-        ),
+) -> GridRequest {
+    let descent = descent.to_string();
+    GridRequest {
+        cell_x,
+        cell_y,
+        row_widths_m,
+        nodata,
+        cv_n,
+        cv_s,
+        max_roll_deg,
+        descent,
+        allow_metastable,
+        time_weight,
     }
-    .and_then(|g| match row_widths {
-        Some(w) => g.with_row_widths(w),
-        None => Ok(g),
-    })
-    .map_err(|e| value_error(format!("{e} (row_widths_m: one width per row of the dem, in metres)")))?;
-    Ok((grid, terrain, settings))
 }
-
-/// The pitch tables of this process, shared by every `risk_raster` call: the tiles of a Dask
-/// raster on one worker tabulate the model once, not once per tile (the table was 60% of a
-/// 1024 x 1024 tile's time); results are bit for bit those of a fresh table.
-static PITCH_TABLES: LazyLock<PitchTableCache> = LazyLock::new(PitchTableCache::new);
 
 /// Per cell, the lowest p_fail over the 16 headings and the azimuth of the steepest usable
 /// climb (degrees from north), as `sandslope plan --risk-map` writes them: `2 * rows * cols`
-/// float32 values, band after band.
+/// float32 values, band after band (the request layer's [`GridRequest::risk_raster`], the DEM
+/// row 0 = north, NaN or `nodata` = missing heights, used as float32 like the CLI).
 #[pyfunction]
 #[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, nodata=None, cv_n=None, cv_s=None, max_roll_deg=sandslope::plan::DEFAULT_MAX_ROLL_DEG, descent="symmetric", allow_metastable=false, row_widths_m=None))]
 #[allow(clippy::too_many_arguments)]
@@ -93,90 +79,31 @@ pub fn risk_raster<'py>(
     allow_metastable: bool,
     row_widths_m: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, numpy::PyArray1<f32>>> {
-    let (grid, terrain, settings) = inputs(
-        &dem,
+    let time_weight = sandslope::plan::DEFAULT_TIME_WEIGHT;
+    let request = grid_request(
         cell_x,
         cell_y,
         row_widths_m,
         nodata,
-        terrain,
         cv_n,
         cv_s,
         max_roll_deg,
         descent,
         allow_metastable,
-        sandslope::plan::DEFAULT_TIME_WEIGHT,
-    )?;
-    let robot = &robot.inner;
-    let bands = py
-        .detach(move || {
-            let planner = Planner::with_cache(grid, None, &[terrain], robot, settings, &PITCH_TABLES)?;
-            let (mut p_fail, climb) = planner.risk_map();
-            drop(planner);
-            p_fail.extend_from_slice(&climb);
-            Ok::<_, sandslope::plan::PlanError>(p_fail)
-        })
-        .map_err(value_error)?;
+        time_weight,
+    );
+    let (heights, (rows, cols)) = row_major(&dem);
+    let (robot, terrain) = (&robot.inner, &terrain.inner);
+    let source = GridSource { heights: &heights, rows, cols, robot, terrain, classes: None };
+    let bands = py.detach(|| request.risk_raster(&source)).map_err(|e| value_error(e.message()))?;
     Ok(crate::arrays::array(py, bands))
 }
 
-fn objective(name: &str) -> PyResult<Objective> {
-    Objective::ALL.into_iter().find(|o| o.name() == name).ok_or_else(|| {
-        value_error(format!("objective = {name:?} must be \"time\", \"risk\" or \"distance\""))
-    })
-}
-
-fn cell(which: &str, rc: (i64, i64), rows: usize, cols: usize) -> PyResult<Cell> {
-    let (r, c) = rc;
-    if r < 0 || c < 0 || r as usize >= rows || c as usize >= cols {
-        return Err(value_error(format!(
-            "{which} = ({r}, {c}) is outside the map: rows 0 to {}, columns 0 to {}",
-            rows - 1,
-            cols - 1
-        )));
-    }
-    Ok(Cell { col: c as usize, row: r as usize })
-}
-
-/// A route as `plan --json` prints it (the request layer's `RouteRecord`: every figure, null
-/// where no route exists), with the found route's cells, coordinates, heights and steps as arrays.
-fn route_dict<'py>(
-    py: Python<'py>,
-    r: &Result<Route, sandslope::plan::NoRoute>,
-    planner: &Planner,
-    origin: (f64, f64),
-) -> PyResult<Bound<'py, PyDict>> {
-    let d = pythonize::pythonize(py, &RouteRecord::from(r)).map_err(value_error)?.cast_into::<PyDict>()?;
-    if let Ok(r) = r {
-        let g = planner.grid();
-        put(&d, "rows", r.cells.iter().map(|c| c.row as i64).collect())?;
-        put(&d, "cols", r.cells.iter().map(|c| c.col as i64).collect())?;
-        // East of the west edge along the cell's own row: on a geographic DEM each row's
-        // cells have their own width (`row_widths_m`), on a uniform grid this is cell_x.
-        put(
-            &d,
-            "x_m",
-            r.cells.iter().map(|c| origin.0 + (c.col as f64 + 0.5) * g.cell_x_at(c.row)).collect(),
-        )?;
-        put(&d, "y_m", r.cells.iter().map(|c| origin.1 - (c.row as f64 + 0.5) * g.cell_y()).collect())?;
-        put(&d, "z_m", r.cells.iter().map(|&c| g.height(c).unwrap_or(f64::NAN)).collect())?;
-        let steps = PyDict::new(py);
-        put(&steps, "heading_deg", r.steps.iter().map(|s| s.heading_deg).collect())?;
-        put(&steps, "pitch_deg", r.steps.iter().map(|s| s.pitch_deg).collect())?;
-        put(&steps, "roll_deg", r.steps.iter().map(|s| s.roll_deg).collect())?;
-        put(&steps, "length_m", r.steps.iter().map(|s| s.length_m).collect())?;
-        put(&steps, "regime", r.steps.iter().map(|s| s.regime as i8).collect())?;
-        put(&steps, "speed_m_s", r.steps.iter().map(|s| s.speed.unwrap_or(f64::NAN)).collect())?;
-        put(&steps, "p_fail", r.steps.iter().map(|s| s.p_fail).collect())?;
-        put(&steps, "over_roll_limit", r.steps.iter().map(|s| s.over_roll_limit).collect())?;
-        d.set_item("steps", steps)?;
-    }
-    Ok(d)
-}
-
-/// Routes from `start` to `goal` (each `(row, col)`) for each objective, by the library's
-/// `plan::plan` (what `sandslope plan` computes): `{"routes": {name: route}, "extrapolation":
-/// None or {max_pitch_deg, last_point_deg}}`.
+/// Routes from `start` to `goal` (each `(row, col)`) for each objective, by the request
+/// layer's [`GridPlanRequest`] (the library's `plan::plan`, what `sandslope plan` computes):
+/// `{"routes": {name: route}, "extrapolation": None or {max_pitch_deg, last_point_deg}}`, each
+/// route as `plan --json` prints it (`RouteRecord`: every figure, null where no route exists)
+/// with a found route's cells, coordinates, heights and steps as arrays.
 #[pyfunction]
 #[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=sandslope::plan::DEFAULT_MAX_ROLL_DEG, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT, classes=None, class_terrains=None, row_widths_m=None))]
 #[allow(clippy::too_many_arguments)]
@@ -202,52 +129,43 @@ pub fn plan<'py>(
     class_terrains: Option<Vec<(i64, PyRef<'py, PyTerrain>)>>,
     row_widths_m: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let objectives: Vec<Objective> = objectives.iter().map(|o| objective(o)).collect::<PyResult<_>>()?;
-    let (grid, terrain, settings) = inputs(
-        &dem,
+    let grid = grid_request(
         cell_x,
         cell_y,
         row_widths_m,
         nodata,
-        terrain,
         cv_n,
         cv_s,
         max_roll_deg,
         descent,
         allow_metastable,
         time_weight,
-    )?;
-    let (rows, cols) = (grid.rows(), grid.cols());
-    let request = PlanRequest {
-        start: cell("start", start, rows, cols)?,
-        goal: cell("goal", goal, rows, cols)?,
-        objectives,
-        risk_map: false,
-    };
-    let (classes, terrains) = match (classes, class_terrains) {
-        (None, None) => (None, vec![terrain]),
-        (Some(c), Some(t)) => {
-            let (indices, terrains) = class_inputs(&c, &t, rows, cols, cv_n, cv_s)?;
-            (Some(indices), terrains)
+    );
+    let request = GridPlanRequest { grid, start, goal, objectives, origin };
+    let (heights, (rows, cols)) = row_major(&dem);
+    let class_values = classes.as_ref().map(row_major);
+    let classes = match (&class_values, &class_terrains) {
+        (None, None) => None,
+        (Some((values, shape)), Some(pairs)) => {
+            let terrains = pairs.iter().map(|(k, t)| (*k, &t.inner)).collect();
+            Some(ClassesSource { values, shape: *shape, terrains })
         }
         _ => return Err(value_error("classes and class_terrains go together: give both or neither")),
     };
-    let robot = &robot.inner;
+    let (robot, terrain) = (&robot.inner, &terrain.inner);
+    let source = GridSource { heights: &heights, rows, cols, robot, terrain, classes };
     // The search runs on a thread of its own so that Ctrl-C, checked here, can stop it
     // (issue 21: a 4096^2 plan ran to its end, seconds to minutes, before Python saw the signal).
-    let result = interruptibly(py, |stop| {
-        sandslope::plan::plan(grid, classes, &terrains, robot, settings, &request, &|_, _, _| {
-            if stop.load(Ordering::Relaxed) {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        })
-    })?
-    .map_err(value_error)?;
+    let result = interruptibly(py, |stop| request.answer(&source, Some(stop)))?
+        .map_err(|e| value_error(e.message()))?;
     let routes = PyDict::new(py);
     for (o, r) in &result.routes {
-        routes.set_item(o.name(), route_dict(py, r, &result.planner, origin)?)?;
+        let d =
+            pythonize::pythonize(py, &RouteRecord::from(r)).map_err(value_error)?.cast_into::<PyDict>()?;
+        if let Ok(route) = r {
+            route_arrays(&d, request.route_cells(route, &result.planner))?;
+        }
+        routes.set_item(o.name(), d)?;
     }
     let d = PyDict::new(py);
     d.set_item("routes", routes)?;
@@ -255,37 +173,23 @@ pub fn plan<'py>(
     Ok(d)
 }
 
-/// A class array (aligned with the DEM; NaN: no class) and `(class, terrain)` pairs as the
-/// planner takes them: each cell's index into the terrains, and the terrains with their
-/// uncertainty, by the rule of `sandslope plan --classes --class-terrain`.
-fn class_inputs(
-    classes: &PyReadonlyArray2<'_, f64>,
-    class_terrains: &[(i64, PyRef<'_, PyTerrain>)],
-    rows: usize,
-    cols: usize,
-    cv_n: Option<f64>,
-    cv_s: Option<f64>,
-) -> PyResult<(Vec<u8>, Vec<UncertainTerrain>)> {
-    let a = classes.as_array();
-    if a.shape() != [rows, cols] {
-        let shape = a.shape();
-        return Err(value_error(format!(
-            "classes has shape ({}, {}); it must be the DEM's ({rows}, {cols})",
-            shape[0], shape[1]
-        )));
-    }
-    if class_terrains.is_empty() || class_terrains.len() >= usize::from(sandslope::plan::NO_CLASS) {
-        return Err(value_error("class_terrains: give between 1 and 254 {class: terrain} pairs"));
-    }
-    let keys: Vec<i64> = class_terrains.iter().map(|(k, _)| *k).collect();
-    let terrains = class_terrains
-        .iter()
-        .map(|(_, t)| crate::risk::uncertain(t, cv_n, cv_s))
-        .collect::<PyResult<Vec<_>>>()?;
-    let values: Vec<f64> = a.iter().copied().collect();
-    let indices = sandslope::plan::class_indices(&values, |i| !values[i].is_finite(), &keys)
-        .map_err(|e| value_error(format!("classes: {e}; add it to class_terrains")))?;
-    Ok((indices, terrains))
+/// A found route's cells and steps put into its dict as arrays.
+fn route_arrays(d: &Bound<'_, PyDict>, c: sandslope_request::plan::RouteCells) -> PyResult<()> {
+    put(d, "rows", c.rows)?;
+    put(d, "cols", c.cols)?;
+    put(d, "x_m", c.x_m)?;
+    put(d, "y_m", c.y_m)?;
+    put(d, "z_m", c.z_m)?;
+    let steps = PyDict::new(d.py());
+    put(&steps, "heading_deg", c.heading_deg)?;
+    put(&steps, "pitch_deg", c.pitch_deg)?;
+    put(&steps, "roll_deg", c.roll_deg)?;
+    put(&steps, "length_m", c.length_m)?;
+    put(&steps, "regime", c.regime)?;
+    put(&steps, "speed_m_s", c.speed_m_s)?;
+    put(&steps, "p_fail", c.p_fail)?;
+    put(&steps, "over_roll_limit", c.over_roll_limit)?;
+    d.set_item("steps", steps)
 }
 
 /// The GDAL_NODATA value of a GeoTIFF (None when it has none), read from its tags only, as

@@ -10,23 +10,15 @@ use pyo3::types::PyDict;
 use pythonize::pythonize;
 
 use sandslope::risk::uncertainty::CvSource;
-use sandslope::risk::{RegimeProbabilities, RiskAnswer, RiskPoint, UncertainTerrain, RISK_MAP_CELL_KEYS};
+use sandslope::risk::{RegimeProbabilities, RiskAnswer, RiskPoint, RISK_MAP_CELL_KEYS};
 use sandslope_request::error::Words;
-use sandslope_request::grammar::{axis_of_values, uncertain_terrain_in, AxisRange};
+use sandslope_request::grammar::{axis_of_values, AxisRange};
 use sandslope_request::risk::{AnswerLimits, RiskMapGrid, RiskQuestion, Solve};
 
 use crate::arrays::{put, values};
 use crate::interrupt::interruptibly;
 use crate::types::{PyRobot, PyTerrain};
 use crate::value_error;
-
-/// The terrain read as uncertain by the library's one rule (docs/model.md §9): a given CV,
-/// else the table's SD over its value, else the default CV.
-pub fn uncertain(terrain: &PyTerrain, cv_n: Option<f64>, cv_s: Option<f64>) -> PyResult<UncertainTerrain> {
-    let (u, _note) = uncertain_terrain_in(Words::Keyword, terrain.inner.clone(), cv_n, cv_s)
-        .map_err(|e| value_error(e.message()))?;
-    Ok(u)
-}
 
 fn source(s: CvSource) -> &'static str {
     match s {

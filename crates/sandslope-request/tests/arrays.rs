@@ -1,4 +1,5 @@
-//! The requests Python answers over arrays (`phase` over NumPy axes, `risk` over NumPy slopes):
+//! The requests Python answers over arrays (`phase` over NumPy axes, `risk` over NumPy slopes,
+//! `plan` over a NumPy DEM):
 //! the same cells and points as the library's own calls, refusals named as Python names its
 //! keywords, and a raised stop flag ending the work between chunks.
 
@@ -8,6 +9,7 @@ use sandslope::risk::{risk_curve, RiskAnswer, UncertainTerrain};
 use sandslope::{Axis, AxisScale, Robot, RobotSpec, Terrain};
 use sandslope_request::error::Words;
 use sandslope_request::phase::PhaseMapRequest;
+use sandslope_request::plan::{GridPlanRequest, GridRequest, GridSource};
 use sandslope_request::risk::{AnswerLimits, RiskQuestion, Solve};
 
 fn robot() -> Robot {
@@ -111,4 +113,56 @@ fn an_envelope_at_one_slope_is_the_safe_mass_there() {
     };
     assert_eq!(env.points.len(), 1);
     assert_eq!(env.points[0].max_mass_kg, mass.max_mass_kg);
+}
+
+/// A plan over heights in memory (Python's `plan`): a tilted plane, 12 x 12 cells of 1 m.
+fn grid_plan() -> (GridPlanRequest, Vec<f64>) {
+    let heights: Vec<f64> = (0..144).map(|i| f64::from(i / 12) * 0.05 + f64::from(i % 12) * 0.02).collect();
+    let grid = GridRequest {
+        cell_x: 1.0,
+        cell_y: 1.0,
+        row_widths_m: None,
+        nodata: None,
+        cv_n: None,
+        cv_s: None,
+        max_roll_deg: 20.0,
+        descent: "symmetric".into(),
+        allow_metastable: false,
+        time_weight: 0.0,
+    };
+    let objectives = vec!["time".to_string(), "distance".to_string()];
+    (GridPlanRequest { grid, start: (1, 1), goal: (10, 10), objectives, origin: (100.0, 50.0) }, heights)
+}
+
+#[test]
+fn a_plan_over_heights_finds_its_routes_and_refuses_in_python_words() {
+    let (request, heights) = grid_plan();
+    let (robot, terrain) = (robot(), terrain());
+    let source =
+        GridSource { heights: &heights, rows: 12, cols: 12, robot: &robot, terrain: &terrain, classes: None };
+    let result = request.answer(&source, None).unwrap();
+    let (_, route) = result.routes.iter().find(|(o, _)| o.name() == "distance").unwrap();
+    let cells = request.route_cells(route.as_ref().unwrap(), &result.planner);
+    assert_eq!((cells.rows[0], cells.cols[0]), (1, 1));
+    assert_eq!((cells.x_m[0], cells.y_m[0]), (101.5, 48.5));
+    assert_eq!(cells.heading_deg.len() + 1, cells.rows.len());
+    let refused = |r: GridPlanRequest| r.answer(&source, None).unwrap_err().message();
+    let fast = GridPlanRequest { objectives: vec!["fast".into()], ..request.clone() };
+    assert_eq!(refused(fast), r#"objective = "fast" must be "time", "risk" or "distance""#);
+    let steep = GridPlanRequest {
+        grid: GridRequest { max_roll_deg: 95.0, ..request.grid.clone() },
+        ..request.clone()
+    };
+    assert!(refused(steep).starts_with("max_roll_deg = 95 must be strictly between 0 and 90"));
+    let down = GridPlanRequest {
+        grid: GridRequest { descent: "down".into(), ..request.grid.clone() },
+        ..request.clone()
+    };
+    assert_eq!(refused(down), r#"descent = "down" must be "symmetric" or "level""#);
+    let outside = GridPlanRequest { start: (500, 3), ..request.clone() };
+    assert_eq!(refused(outside), "start = (500, 3) is outside the map: rows 0 to 11, columns 0 to 11");
+    let raised = AtomicBool::new(true);
+    assert_eq!(request.answer(&source, Some(&raised)).unwrap_err().message(), "interrupted");
+    let bands = request.grid.risk_raster(&source).unwrap();
+    assert_eq!(bands.len(), 2 * 144);
 }

@@ -1,5 +1,6 @@
 //! Long calls that stop on Ctrl-C: the work on a thread of its own, the caller's thread
-//! looking for a signal meanwhile (`plan`'s searches, `calibrate`'s simulator fit).
+//! looking for a signal meanwhile (`phase`'s blocks, `risk`'s chunks, `plan`'s searches,
+//! `calibrate`'s simulator fit).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::Thread;

@@ -1,7 +1,8 @@
 //! `sandslope._sandslope`: the compiled core of the `sandslope` Python package.
 //!
-//! A thin layer over the `sandslope` library and the `sandslope-io` readers: it converts
-//! Python values into the library's validated types, releases the GIL while the library
+//! A thin layer over the `sandslope` library, the `sandslope-io` readers and the
+//! `sandslope-request` requests: it converts Python values into a request's fields (which the
+//! request checks into the library's types and answers), releases the GIL while the library
 //! computes (in parallel, with rayon), and hands the results back as NumPy arrays that own
 //! the Rust buffers (no copy). It computes nothing itself. The pure-Python package
 //! (`python/sandslope/`) adds NumPy broadcasting, reshaping, docstrings and the Dask layer.

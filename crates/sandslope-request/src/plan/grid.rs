@@ -18,7 +18,7 @@ use sandslope::{Robot, Terrain};
 use crate::error::{RequestError, Result, Words};
 use crate::grammar::uncertain_terrain_in;
 
-use super::{parse_descent, parse_objective, settings_in};
+use super::settings::{parse_descent, parse_objective, settings_in};
 
 /// The DEM's geometry and the planner's settings: what a risk raster needs (Python's
 /// `risk_raster`), and the part of a [`GridPlanRequest`] that is not its route.

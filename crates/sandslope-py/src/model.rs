@@ -170,8 +170,6 @@ pub fn phase<'py>(
         repose_deg,
         regime_only,
     };
-    // Refused at once, before the worker thread: a bad keyword or a map over the cap.
-    request.check().map_err(|e| value_error(e.message()))?;
     let robot = &robot.inner;
     let answer =
         interruptibly(py, |stop| request.answer(robot, Some(stop)))?.map_err(|e| value_error(e.message()))?;

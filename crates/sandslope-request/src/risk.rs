@@ -224,23 +224,18 @@ impl RiskQuestion {
             Ok(SlopeChunks { slopes, per_chunk, words, stop })
         };
         Ok(match self.solve {
-            Some(Solve::Mass) if slopes.len() > 1 => envelope(
-                chunks(ENVELOPE_SLOPES_PER_CHUNK, limits.envelope_slopes, "--solve mass")?,
-                robot,
-                &terrain,
-                max_risk,
-            )?,
-            Some(Solve::Envelope) => envelope(
-                chunks(ENVELOPE_SLOPES_PER_CHUNK, limits.envelope_slopes, "--solve mass")?,
-                robot,
-                &terrain,
-                max_risk,
-            )?,
-            Some(Solve::Mass) => {
+            Some(Solve::Mass) if slopes.len() <= 1 => {
                 let sol = safe_mass(robot, slope_in(words, first()?)?, &terrain, max_risk)
                     .map_err(|e| library(&e))?;
                 RiskAnswer::Mass(Box::new(sol))
             }
+            // `solve mass` at several slopes is the envelope over them; Python's asks for it at any.
+            Some(Solve::Mass | Solve::Envelope) => envelope(
+                chunks(ENVELOPE_SLOPES_PER_CHUNK, limits.envelope_slopes, "--solve mass")?,
+                robot,
+                &terrain,
+                max_risk,
+            )?,
             Some(Solve::Slope) => {
                 RiskAnswer::Slope(Box::new(safe_slope(robot, &terrain, max_risk).map_err(|e| library(&e))?))
             }

@@ -147,12 +147,13 @@ pub fn predict<'py>(
 
 /// The phase map at one slope: regime codes (int8) and net step (m, NaN where the leg never
 /// anchors) of every cell, row-major with one row per k_s value (`(len(k_s), len(k_n))`);
-/// with `regime_only` the codes alone (no `step_m`). The request layer's [`PhaseMapRequest`]
+/// with `regime_only` the codes alone (no `step_m`); `terrain` lends its angle of repose where
+/// `repose_deg` is not given. The request layer's [`PhaseMapRequest`]
 /// checks the keywords, refuses a map over the cap before allocating it and writes the cells
 /// straight into the buffers NumPy then owns, in blocks between which Ctrl-C is seen (issue
 /// 21: the cap, 2^28 cells, took minutes that only a kill could stop).
 #[pyfunction]
-#[pyo3(signature = (robot, slope_deg, k_n_axis, k_s_axis, repose_deg=None, regime_only=false))]
+#[pyo3(signature = (robot, slope_deg, k_n_axis, k_s_axis, terrain=None, repose_deg=None, regime_only=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn phase<'py>(
     py: Python<'py>,
@@ -160,6 +161,7 @@ pub fn phase<'py>(
     slope_deg: f64,
     k_n_axis: PyReadonlyArray1<'py, f64>,
     k_s_axis: PyReadonlyArray1<'py, f64>,
+    terrain: Option<&PyTerrain>,
     repose_deg: Option<f64>,
     regime_only: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -170,9 +172,9 @@ pub fn phase<'py>(
         repose_deg,
         regime_only,
     };
-    let robot = &robot.inner;
-    let answer =
-        interruptibly(py, |stop| request.answer(robot, Some(stop)))?.map_err(|e| value_error(e.message()))?;
+    let (robot, terrain) = (&robot.inner, terrain.map(|t| &t.inner));
+    let answer = interruptibly(py, |stop| request.answer(robot, terrain, Some(stop)))?
+        .map_err(|e| value_error(e.message()))?;
     let d = PyDict::new(py);
     put(&d, "regime", answer.regime)?;
     if let Some(step) = answer.step_m {

@@ -188,7 +188,8 @@ pub struct PhaseMapRequest {
     pub k_n_axis: Vec<f64>,
     /// The k_s values, N/m^3, likewise (`k_s_axis`).
     pub k_s_axis: Vec<f64>,
-    /// Angle of repose, degrees, strictly between 0 and 90 (`repose_deg`; default none).
+    /// Angle of repose, degrees, strictly between 0 and 90, at or beyond which every cell slips
+    /// (`repose_deg`; default the terrain's, when one is given, as `phase --terrain` has it).
     pub repose_deg: Option<f64>,
     /// The regime codes alone, without the net step (`regime_only`).
     pub regime_only: bool,
@@ -211,8 +212,9 @@ pub struct PhaseMapAnswer {
 
 impl PhaseMapRequest {
     /// Checks every field and the map's size (at most [`MAX_PHASE_CELLS`]) before anything is
-    /// allocated: the slope, the angle of repose and the axes as the library takes them.
-    pub fn check(&self) -> Result<(Slope, Option<Slope>, Axis, Axis)> {
+    /// allocated: the slope, the angle of repose (`terrain`'s when none is given) and the axes
+    /// as the library takes them.
+    pub fn check(&self, terrain: Option<&Terrain>) -> Result<(Slope, Option<Slope>, Axis, Axis)> {
         let slope =
             Slope::from_signed_degrees(self.slope_deg).map_err(|e| RequestError::invalid("slope-deg", e))?;
         let repose = self
@@ -225,7 +227,8 @@ impl PhaseMapRequest {
                     )
                 })
             })
-            .transpose()?;
+            .transpose()?
+            .or_else(|| terrain.and_then(Terrain::repose));
         let k_n = grammar::axis_of_values("k_n_axis", &self.k_n_axis)?;
         let k_s = grammar::axis_of_values("k_s_axis", &self.k_s_axis)?;
         sandslope::limits::grid_cells(
@@ -239,12 +242,17 @@ impl PhaseMapRequest {
         Ok((slope, repose, k_n, k_s))
     }
 
-    /// The map for `robot`, written row by row in parallel straight into the answer's buffers
+    /// The map for `robot` (on `terrain`, which lends its angle of repose alone), written row by row in parallel straight into the answer's buffers
     /// (no zeroing first, no packed map to unpack: `sandslope::write_phase_rows`), in blocks of
     /// about 2^20 cells with `stop` looked at between them: once it is raised the answer is
     /// [`RequestError::interrupted`] (the cap, 2^28 cells, takes minutes).
-    pub fn answer(&self, robot: &Robot, stop: Option<&AtomicBool>) -> Result<PhaseMapAnswer> {
-        let (slope, repose, k_n_axis, k_s_axis) = self.check()?;
+    pub fn answer(
+        &self,
+        robot: &Robot,
+        terrain: Option<&Terrain>,
+        stop: Option<&AtomicBool>,
+    ) -> Result<PhaseMapAnswer> {
+        let (slope, repose, k_n_axis, k_s_axis) = self.check(terrain)?;
         let (nx, ny) = (k_n_axis.len(), k_s_axis.len());
         let cells = nx * ny;
         let mut regime = uninit::<i8>(cells);

@@ -31,7 +31,7 @@ fn phase_map(n: usize) -> PhaseMapRequest {
 #[test]
 fn a_phase_map_over_values_is_the_library_grid() {
     let request = phase_map(7);
-    let answer = request.answer(&robot(), None).unwrap();
+    let answer = request.answer(&robot(), None, None).unwrap();
     assert_eq!(answer.k_n_axis.scale(), AxisScale::Log);
     assert_eq!(answer.k_s_axis.scale(), AxisScale::Linear);
     assert_eq!(answer.counts.total(), 7 * 8);
@@ -45,13 +45,25 @@ fn a_phase_map_over_values_is_the_library_grid() {
             assert_eq!(answer.regime[j * 7 + i], code, "cell ({i}, {j})");
         }
     }
-    let only = PhaseMapRequest { regime_only: true, ..request }.answer(&robot(), None).unwrap();
-    assert_eq!((only.regime, only.step_m), (answer.regime, None));
+    let only = PhaseMapRequest { regime_only: true, ..request.clone() }.answer(&robot(), None, None).unwrap();
+    assert_eq!((&only.regime, only.step_m), (&answer.regime, None));
+    // A terrain lends its angle of repose, unless one is given: at 10 degrees, a repose of 10
+    // makes cells slip that climbed without one.
+    let table = sandslope::TerrainSpec { repose_deg: Some(10.0), ..terrain().spec().clone() };
+    let steep = Terrain::new(table).unwrap();
+    let map = |r: &PhaseMapRequest, t| r.answer(&robot(), t, None).unwrap().regime;
+    let at_ten = map(&PhaseMapRequest { repose_deg: Some(10.0), ..request.clone() }, None);
+    assert_ne!(at_ten, answer.regime);
+    assert_eq!(map(&request, Some(&steep)), at_ten);
+    assert_eq!(
+        map(&PhaseMapRequest { repose_deg: Some(40.0), ..request.clone() }, Some(&steep)),
+        answer.regime
+    );
 }
 
 #[test]
 fn a_phase_map_refuses_in_python_words_and_stops_on_its_flag() {
-    let message = |r: PhaseMapRequest| r.check().unwrap_err().message();
+    let message = |r: PhaseMapRequest| r.check(None).unwrap_err().message();
     assert!(message(PhaseMapRequest { repose_deg: Some(0.0), ..phase_map(3) })
         .starts_with("repose_deg = 0 must be"));
     assert!(
@@ -66,7 +78,7 @@ fn a_phase_map_refuses_in_python_words_and_stops_on_its_flag() {
     let huge = PhaseMapRequest { k_n_axis: huge.clone(), k_s_axis: huge, ..phase_map(3) };
     assert!(message(huge).contains("at most 268435456 cells (here 20000 x 20000)"));
     let raised = AtomicBool::new(true);
-    let e = phase_map(3).answer(&robot(), Some(&raised)).unwrap_err();
+    let e = phase_map(3).answer(&robot(), None, Some(&raised)).unwrap_err();
     assert_eq!((e.field(), e.message().as_str()), (None, "interrupted"));
 }
 

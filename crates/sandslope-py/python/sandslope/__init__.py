@@ -244,10 +244,9 @@ def phase(
     robot = _robot(robot)
     if mass_kg is not None:
         robot = robot.with_mass(float(mass_kg))
-    if repose_deg is None and terrain is not None:
-        repose_deg = _terrain(terrain).repose_deg
     kn, ks = _axis("k_n_axis", k_n_axis), _axis("k_s_axis", k_s_axis)
-    out = _sandslope.phase(robot, float(slope_deg), kn, ks, repose_deg=repose_deg, regime_only=bool(regime_only))
+    terrain = None if terrain is None else _terrain(terrain)
+    out = _sandslope.phase(robot, float(slope_deg), kn, ks, terrain=terrain, repose_deg=repose_deg, regime_only=bool(regime_only))
     shape = (len(out["k_s"]), len(out["k_n"]))
     out["regime"] = out["regime"].reshape(shape).T
     if "step_m" in out:

@@ -95,6 +95,7 @@ def phase(
     slope_deg: float,
     k_n_axis: _F64,
     k_s_axis: _F64,
+    terrain: Optional[Terrain] = None,
     repose_deg: Optional[float] = None,
     regime_only: bool = False,
 ) -> Dict[str, Any]: ...

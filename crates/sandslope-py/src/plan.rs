@@ -11,7 +11,7 @@ use pyo3::types::PyDict;
 
 use sandslope_io::pds3::Pds3Dtm;
 use sandslope_io::raster::read_raster as read;
-use sandslope_request::plan::{ClassesSource, GridPlanRequest, GridRequest, GridSource, RouteRecord};
+use sandslope_request::plan::{ClassRaster, GridPlanRequest, GridRequest, GridSource, RouteRecord};
 
 use crate::arrays::put;
 use crate::interrupt::interruptibly;
@@ -94,7 +94,8 @@ pub fn risk_raster<'py>(
     );
     let (heights, (rows, cols)) = row_major(&dem);
     let (robot, terrain) = (&robot.inner, &terrain.inner);
-    let source = GridSource { heights: &heights, rows, cols, robot, terrain, classes: None };
+    let source =
+        GridSource { heights: &heights, rows, cols, robot, terrain, classes: None, class_terrains: None };
     let bands = py.detach(|| request.risk_raster(&source)).map_err(|e| value_error(e.message()))?;
     Ok(crate::arrays::array(py, bands))
 }
@@ -117,7 +118,7 @@ pub fn plan<'py>(
     start: (i64, i64),
     goal: (i64, i64),
     objectives: Vec<String>,
-    origin: (f64, f64),
+    origin: Option<(f64, f64)>,
     nodata: Option<f64>,
     cv_n: Option<f64>,
     cv_s: Option<f64>,
@@ -144,16 +145,10 @@ pub fn plan<'py>(
     let request = GridPlanRequest { grid, start, goal, objectives, origin };
     let (heights, (rows, cols)) = row_major(&dem);
     let class_values = classes.as_ref().map(row_major);
-    let classes = match (&class_values, &class_terrains) {
-        (None, None) => None,
-        (Some((values, shape)), Some(pairs)) => {
-            let terrains = pairs.iter().map(|(k, t)| (*k, &t.inner)).collect();
-            Some(ClassesSource { values, shape: *shape, terrains })
-        }
-        _ => return Err(value_error("classes and class_terrains go together: give both or neither")),
-    };
+    let classes = class_values.as_ref().map(|(values, shape)| ClassRaster { values, shape: *shape });
+    let class_terrains = class_terrains.as_ref().map(|p| p.iter().map(|(k, t)| (*k, &t.inner)).collect());
     let (robot, terrain) = (&robot.inner, &terrain.inner);
-    let source = GridSource { heights: &heights, rows, cols, robot, terrain, classes };
+    let source = GridSource { heights: &heights, rows, cols, robot, terrain, classes, class_terrains };
     // The search runs on a thread of its own so that Ctrl-C, checked here, can stop it
     // (issue 21: a 4096^2 plan ran to its end, seconds to minutes, before Python saw the signal).
     let result = interruptibly(py, |stop| request.answer(&source, Some(stop)))?

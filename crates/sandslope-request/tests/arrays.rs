@@ -9,7 +9,7 @@ use sandslope::risk::{risk_curve, RiskAnswer, UncertainTerrain};
 use sandslope::{Axis, AxisScale, Robot, RobotSpec, Terrain};
 use sandslope_request::error::Words;
 use sandslope_request::phase::PhaseMapRequest;
-use sandslope_request::plan::{GridPlanRequest, GridRequest, GridSource};
+use sandslope_request::plan::{ClassRaster, GridPlanRequest, GridRequest, GridSource};
 use sandslope_request::risk::{AnswerLimits, RiskQuestion, Solve};
 
 fn robot() -> Robot {
@@ -143,21 +143,40 @@ fn grid_plan() -> (GridPlanRequest, Vec<f64>) {
         time_weight: 0.0,
     };
     let objectives = vec!["time".to_string(), "distance".to_string()];
-    (GridPlanRequest { grid, start: (1, 1), goal: (10, 10), objectives, origin: (100.0, 50.0) }, heights)
+    (
+        GridPlanRequest { grid, start: (1, 1), goal: (10, 10), objectives, origin: Some((100.0, 50.0)) },
+        heights,
+    )
 }
 
 #[test]
 fn a_plan_over_heights_finds_its_routes_and_refuses_in_python_words() {
     let (request, heights) = grid_plan();
     let (robot, terrain) = (robot(), terrain());
-    let source =
-        GridSource { heights: &heights, rows: 12, cols: 12, robot: &robot, terrain: &terrain, classes: None };
+    let source = GridSource {
+        heights: &heights,
+        rows: 12,
+        cols: 12,
+        robot: &robot,
+        terrain: &terrain,
+        classes: None,
+        class_terrains: None,
+    };
     let result = request.answer(&source, None).unwrap();
     let (_, route) = result.routes.iter().find(|(o, _)| o.name() == "distance").unwrap();
     let cells = request.route_cells(route.as_ref().unwrap(), &result.planner);
     assert_eq!((cells.rows[0], cells.cols[0]), (1, 1));
     assert_eq!((cells.x_m[0], cells.y_m[0]), (101.5, 48.5));
     assert_eq!(cells.heading_deg.len() + 1, cells.rows.len());
+    // Without an origin the south-west corner is at (0, 0): the first cell's centre 10.5 m north.
+    let south_west = GridPlanRequest { origin: None, ..request.clone() };
+    let cells = south_west.route_cells(route.as_ref().unwrap(), &result.planner);
+    assert_eq!((cells.x_m[0], cells.y_m[0]), (1.5, 10.5));
+    let classes = Some(ClassRaster { values: &heights, shape: (12, 12) });
+    let half = GridSource { classes, class_terrains: None, ..source };
+    let e = request.answer(&half, None).unwrap_err();
+    assert_eq!(e.message(), "classes and class_terrains go together: give both or neither");
+    let source = GridSource { classes: None, ..half };
     let refused = |r: GridPlanRequest| r.answer(&source, None).unwrap_err().message();
     let fast = GridPlanRequest { objectives: vec!["fast".into()], ..request.clone() };
     assert_eq!(refused(fast), r#"objective = "fast" must be "time", "risk" or "distance""#);

@@ -496,16 +496,12 @@ def plan(
     """
     z = _dem(dem)
     cx, cy = _cell_size(cell_size_m)
-    if (classes is None) != (class_terrains is None):
-        raise ValueError("classes and class_terrains go together: give both or neither")
     class_args: Dict[str, Any] = {}
     if classes is not None:
         class_args["classes"] = _float_array("classes", classes)
+    if class_terrains is not None:
         class_args["class_terrains"] = [(int(k), _terrain(t)) for k, t in dict(class_terrains).items()]
     names = [objective] if isinstance(objective, str) else [str(o) for o in objective]
-    names = list(dict.fromkeys(names + ["distance"]))
-    if origin is None:
-        origin = (0.0, z.shape[0] * cy)
     return _sandslope.plan(
         z,
         cx,
@@ -515,7 +511,7 @@ def plan(
         (int(start[0]), int(start[1])),
         (int(goal[0]), int(goal[1])),
         names,
-        (float(origin[0]), float(origin[1])),
+        None if origin is None else (float(origin[0]), float(origin[1])),
         nodata=None if nodata is None else float(nodata),
         cv_n=cv_n,
         cv_s=cv_s,

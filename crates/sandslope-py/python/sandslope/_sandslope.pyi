@@ -154,7 +154,7 @@ def plan(
     start: Tuple[int, int],
     goal: Tuple[int, int],
     objectives: List[str],
-    origin: Tuple[float, float],
+    origin: Optional[Tuple[float, float]],
     nodata: Optional[float] = None,
     cv_n: Optional[float] = None,
     cv_s: Optional[float] = None,

@@ -60,19 +60,18 @@ pub struct GridPlanRequest {
     pub goal: (i64, i64),
     /// What to minimise: `time`, `risk` or `distance` (`objectives`).
     pub objectives: Vec<String>,
-    /// Map coordinates of the DEM's north-west corner, m (`origin`): the routes' `x_m`, `y_m`.
-    pub origin: (f64, f64),
+    /// Map coordinates of the DEM's north-west corner, m (`origin`): the routes' `x_m`, `y_m`;
+    /// default `(0, rows * cell_y)`, the south-west corner at the origin.
+    pub origin: Option<(f64, f64)>,
 }
 
 /// A terrain class raster as a front end holds it: one value per DEM cell (row-major; NaN: no
-/// class) with its shape, and each class's terrain.
-pub struct ClassesSource<'a> {
+/// class) with its shape.
+pub struct ClassRaster<'a> {
     /// The class of each cell.
     pub values: &'a [f64],
     /// `(rows, cols)` of the class raster.
     pub shape: (usize, usize),
-    /// `(class, terrain)` pairs.
-    pub terrains: Vec<(i64, &'a Terrain)>,
 }
 
 /// What a grid request is answered on: the heights (row-major, row 0 north), the robot, the
@@ -88,8 +87,10 @@ pub struct GridSource<'a> {
     pub robot: &'a Robot,
     /// The terrain everywhere without classes.
     pub terrain: &'a Terrain,
-    /// The class raster and its terrains (`classes`, `class_terrains`), given both or neither.
-    pub classes: Option<ClassesSource<'a>>,
+    /// The class raster (`classes`), given with `class_terrains` or not at all.
+    pub classes: Option<ClassRaster<'a>>,
+    /// Each class's terrain, `(class, terrain)` pairs (`class_terrains`).
+    pub class_terrains: Option<Vec<(i64, &'a Terrain)>>,
 }
 
 /// The pitch tables of this process, shared by every risk raster: the tiles of a Dask raster
@@ -158,8 +159,15 @@ impl GridRequest {
     /// Each cell's index into the terrains and the terrains with their uncertainty: `source`'s
     /// one terrain, or its classes by the rule of `sandslope plan --classes --class-terrain`.
     fn terrains(&self, source: &GridSource<'_>) -> Result<(Option<Vec<u8>>, Vec<UncertainTerrain>)> {
-        let Some(classes) = &source.classes else {
-            return Ok((None, vec![self.uncertain(source.terrain)?]));
+        let (classes, pairs) = match (&source.classes, &source.class_terrains) {
+            (None, None) => return Ok((None, vec![self.uncertain(source.terrain)?])),
+            (Some(classes), Some(pairs)) => (classes, pairs),
+            _ => {
+                return Err(RequestError::invalid(
+                    "classes",
+                    "classes and class_terrains go together: give both or neither",
+                ))
+            }
         };
         let (rows, cols) = (source.rows, source.cols);
         if classes.shape != (rows, cols) {
@@ -169,14 +177,14 @@ impl GridRequest {
                 format!("classes has shape ({r}, {c}); it must be the DEM's ({rows}, {cols})"),
             ));
         }
-        if classes.terrains.is_empty() || classes.terrains.len() >= usize::from(sandslope::plan::NO_CLASS) {
+        if pairs.is_empty() || pairs.len() >= usize::from(sandslope::plan::NO_CLASS) {
             return Err(RequestError::invalid(
                 "class-terrains",
                 "class_terrains: give between 1 and 254 {class: terrain} pairs",
             ));
         }
-        let keys: Vec<i64> = classes.terrains.iter().map(|(k, _)| *k).collect();
-        let terrains = classes.terrains.iter().map(|(_, t)| self.uncertain(t)).collect::<Result<Vec<_>>>()?;
+        let keys: Vec<i64> = pairs.iter().map(|(k, _)| *k).collect();
+        let terrains = pairs.iter().map(|(_, t)| self.uncertain(t)).collect::<Result<Vec<_>>>()?;
         let values = classes.values;
         let indices =
             sandslope::plan::class_indices(values, |i| !values[i].is_finite(), &keys).map_err(|e| {
@@ -233,7 +241,7 @@ impl GridPlanRequest {
     /// each step.
     pub fn route_cells(&self, route: &Route, planner: &Planner) -> RouteCells {
         let g = planner.grid();
-        let (x0, y0) = self.origin;
+        let (x0, y0) = self.origin.unwrap_or((0.0, g.rows() as f64 * g.cell_y()));
         let steps = &route.steps;
         RouteCells {
             rows: route.cells.iter().map(|c| c.row as i64).collect(),

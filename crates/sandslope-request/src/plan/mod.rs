@@ -28,7 +28,7 @@ mod memory;
 mod settings;
 
 pub use answer::{answer, corridor_answer, records, CorridorJson, PlanJson, RouteRecord};
-pub use grid::{ClassesSource, GridPlanRequest, GridRequest, GridSource, RouteCells};
+pub use grid::{ClassRaster, GridPlanRequest, GridRequest, GridSource, RouteCells};
 use memory::choose_search;
 pub use settings::{parse_descent, parse_objective, settings_in};
 

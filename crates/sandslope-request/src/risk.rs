@@ -8,7 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use sandslope::limits::{MAX_RISK_MAP_CELLS, MAX_RISK_SLOPES};
 use sandslope::risk::{
-    payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, RiskAnswer, UncertainTerrain,
+    payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, DefaultsUsed, RiskAnswer, RiskPoint,
+    SafeSlope, UncertainTerrain,
 };
 use sandslope::{Axis, ParamError, Robot, SignedSlope, Terrain};
 use sandslope_io::presets::DEFAULT_TERRAIN;
@@ -161,13 +162,6 @@ impl RiskRequest {
         Ok(RiskRequest { robot, terrain, question })
     }
 
-    /// The terrain read as uncertain by the one rule of docs/model.md §9, with the note to
-    /// print when a default CV is used anywhere on the table.
-    pub fn uncertain_terrain(&self) -> Result<(UncertainTerrain, Option<String>)> {
-        let q = &self.question;
-        grammar::uncertain_terrain(load_terrain(&self.terrain)?, q.cv_n, q.cv_s)
-    }
-
     /// The answer (what `risk --json` prints), by the library's calls; more work than
     /// `limits` allows is an error naming the limit.
     pub fn answer(&self, limits: AnswerLimits) -> Result<RiskAnswer> {
@@ -186,6 +180,13 @@ const CURVE_SLOPES_PER_CHUNK: usize = 128;
 const ENVELOPE_SLOPES_PER_CHUNK: usize = 8;
 
 impl RiskQuestion {
+    /// The question put to `robot` on `terrain`: the CVs checked and the terrain read as
+    /// uncertain by the one rule of docs/model.md §9, messages naming the fields in `words`.
+    pub fn on(self, robot: &Robot, terrain: Terrain, words: Words) -> Result<RiskProblem<'_>> {
+        let (terrain, _) = grammar::uncertain_terrain_in(words, terrain, self.cv_n, self.cv_s)?;
+        Ok(RiskProblem { robot, terrain, question: self, words })
+    }
+
     /// The answer for `robot` on `terrain` (what `risk --json` prints), by the library's calls,
     /// messages naming the fields in `words`; more work than `limits` allows is an error
     /// naming the limit. A curve or an envelope is computed in chunks of slopes with `stop`
@@ -200,9 +201,78 @@ impl RiskQuestion {
         words: Words,
         stop: Option<&AtomicBool>,
     ) -> Result<RiskAnswer> {
-        let (terrain, _) = grammar::uncertain_terrain_in(words, terrain, self.cv_n, self.cv_s)?;
-        let (slopes, max_risk) = (&self.slopes, self.max_risk);
-        let library = |e: &dyn std::fmt::Display| RequestError::from_error(None, anyhow::anyhow!("{e}"));
+        self.clone().on(robot, terrain, words)?.answer(limits, stop, &NoProgress)
+    }
+}
+
+/// Told how a long answer is getting on (the command line's progress bar over a map's rows).
+pub trait Progress: Sync {
+    /// The work is `steps` steps long.
+    fn start(&self, steps: u64);
+    /// One more step is done.
+    fn step(&self);
+}
+
+/// No one is told: [`Progress`] that shows nothing.
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn start(&self, _steps: u64) {}
+    fn step(&self) {}
+}
+
+/// A [`RiskQuestion`] put to a robot and a terrain already read ([`RiskQuestion::on`]): the
+/// CVs checked, the terrain read as uncertain. [`RiskProblem::answer`] is the answer every
+/// front end gives; the command line also asks for the slope limits beside a curve
+/// ([`RiskProblem::slope_limits`]) and for what its figure of the curve draws
+/// ([`RiskProblem::curve_samples`]).
+#[derive(Debug)]
+pub struct RiskProblem<'a> {
+    robot: &'a Robot,
+    terrain: UncertainTerrain,
+    question: RiskQuestion,
+    words: Words,
+}
+
+/// The error of a library call whose inputs were checked before: its message alone.
+fn library(e: &dyn std::fmt::Display) -> RequestError {
+    RequestError::from_error(None, anyhow::anyhow!("{e}"))
+}
+
+impl<'a> RiskProblem<'a> {
+    /// The robot.
+    pub fn robot(&self) -> &'a Robot {
+        self.robot
+    }
+
+    /// The terrain read as uncertain.
+    pub fn terrain(&self) -> &UncertainTerrain {
+        &self.terrain
+    }
+
+    /// The question.
+    pub fn question(&self) -> &RiskQuestion {
+        &self.question
+    }
+
+    /// Asks for the map over `grid` instead (the command line reads `--k-n` and `--k-s` after
+    /// checking its outputs); its axes are checked by [`RiskProblem::answer`].
+    pub fn map_over(&mut self, grid: RiskMapGrid) {
+        self.question.map = Some(grid);
+    }
+
+    /// The answer (what `risk --json` prints), by the library's calls; more work than
+    /// `limits` allows is an error naming the limit. A curve or an envelope is computed in
+    /// chunks of slopes with `stop` looked at between them (then the answer is
+    /// [`RequestError::interrupted`]); a map tells `progress` its rows.
+    pub fn answer(
+        &self,
+        limits: AnswerLimits,
+        stop: Option<&AtomicBool>,
+        progress: &dyn Progress,
+    ) -> Result<RiskAnswer> {
+        let (robot, terrain, words) = (self.robot, &self.terrain, self.words);
+        let (slopes, max_risk) = (&self.question.slopes, self.question.max_risk);
         let first = || {
             slopes.first().copied().ok_or_else(|| {
                 RequestError::invalid(
@@ -211,11 +281,12 @@ impl RiskQuestion {
                 )
             })
         };
-        if let Some(grid) = &self.map {
+        if let Some(grid) = &self.question.map {
             let slope_deg = first()?;
-            let (k_n_axis, k_s_axis) = map_axes_in(words, grid, &terrain, slope_deg, limits.map_cells)?;
+            let (k_n_axis, k_s_axis) = map_axes_in(words, grid, terrain, slope_deg, limits.map_cells)?;
             let slope = slope_in(words, slope_deg)?;
-            let map = risk_map(robot, slope, &terrain, (&k_n_axis, &k_s_axis), max_risk, &|| {})
+            progress.start(k_s_axis.len() as u64);
+            let map = risk_map(robot, slope, terrain, (&k_n_axis, &k_s_axis), max_risk, &|| progress.step())
                 .map_err(|e| library(&e))?;
             return Ok(RiskAnswer::Map(Box::new(map)));
         }
@@ -223,9 +294,9 @@ impl RiskQuestion {
             too_many(words, slopes.len(), most, what)?;
             Ok(SlopeChunks { slopes, per_chunk, words, stop })
         };
-        Ok(match self.solve {
+        Ok(match self.question.solve {
             Some(Solve::Mass) if slopes.len() <= 1 => {
-                let sol = safe_mass(robot, slope_in(words, first()?)?, &terrain, max_risk)
+                let sol = safe_mass(robot, slope_in(words, first()?)?, terrain, max_risk)
                     .map_err(|e| library(&e))?;
                 RiskAnswer::Mass(Box::new(sol))
             }
@@ -233,16 +304,14 @@ impl RiskQuestion {
             Some(Solve::Mass | Solve::Envelope) => envelope(
                 chunks(ENVELOPE_SLOPES_PER_CHUNK, limits.envelope_slopes, "--solve mass")?,
                 robot,
-                &terrain,
+                terrain,
                 max_risk,
             )?,
-            Some(Solve::Slope) => {
-                RiskAnswer::Slope(Box::new(safe_slope(robot, &terrain, max_risk).map_err(|e| library(&e))?))
-            }
+            Some(Solve::Slope) => RiskAnswer::Slope(Box::new(self.slope_limits()?)),
             None => {
                 let chunks = chunks(CURVE_SLOPES_PER_CHUNK, limits.curve_slopes, "a p_fail curve")?;
                 let parts = chunks.each(
-                    |chunk| risk_curve(robot, &terrain, chunk),
+                    |chunk| risk_curve(robot, terrain, chunk),
                     |e| match words {
                         Words::Flag => RequestError::invalid("slope", e.renamed("--slope")),
                         Words::Keyword => RequestError::invalid("slope", e),
@@ -251,6 +320,62 @@ impl RiskQuestion {
                 RiskAnswer::of_points(parts.into_iter().flat_map(|c| c.points).collect())
             }
         })
+    }
+
+    /// The safe-slope and success limits at the question's `max_risk` (the answer of
+    /// `solve slope`, and what the command line's table prints under a curve).
+    pub fn slope_limits(&self) -> Result<SafeSlope> {
+        safe_slope(self.robot, &self.terrain, self.question.max_risk).map_err(|e| library(&e))
+    }
+
+    /// What a figure of p_fail against slope draws beside `limits`: the curve every
+    /// [`CURVE_FIGURE_STEP_DEG`] from level up to past the steepest slope asked, the safe-slope
+    /// limit and the angle of repose (at least 30 degrees, at most 89.5), and the points at the
+    /// slopes asked.
+    pub fn curve_samples(&self, limits: &SafeSlope) -> Result<CurveSamples> {
+        let slopes = &self.question.slopes;
+        let mut hi = slopes.iter().fold(0.0f64, |a, &d| a.max(d.abs())).max(30.0);
+        if let Some(v) = limits.limit.value() {
+            hi = hi.max(v * 1.25);
+        }
+        if let Some(r) = self.terrain.terrain().repose() {
+            hi = hi.max(r.degrees() + 3.0);
+        }
+        let hi = hi.min(89.5);
+        let n = (hi / CURVE_FIGURE_STEP_DEG).round() as usize;
+        let fine: Vec<f64> = (0..=n).map(|i| hi * i as f64 / n as f64).collect();
+        let curve = |slopes: &[f64]| risk_curve(self.robot, &self.terrain, slopes).map_err(|e| library(&e));
+        Ok(CurveSamples { hi, fine: curve(&fine)?.points, requested: curve(slopes)?.points })
+    }
+}
+
+/// Spacing of the curve in [`CurveSamples`], degrees.
+pub const CURVE_FIGURE_STEP_DEG: f64 = 0.25;
+
+/// What a figure of p_fail against slope draws ([`RiskProblem::curve_samples`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveSamples {
+    /// The steepest slope drawn, degrees.
+    pub hi: f64,
+    /// The curve from level to `hi`.
+    pub fine: Vec<RiskPoint>,
+    /// The points at the slopes asked, in their order.
+    pub requested: Vec<RiskPoint>,
+}
+
+/// Whether a default CV was used where `answer` was evaluated (docs/model.md §9): at its
+/// slopes, over the whole table for the slope limits (their search covers it).
+pub fn defaults_used(answer: &RiskAnswer) -> DefaultsUsed {
+    let over = |points: &[RiskPoint]| {
+        points.iter().fold(DefaultsUsed::default(), |a, p| a.or(p.uncertainty.defaults_used()))
+    };
+    match answer {
+        RiskAnswer::Point(p) => p.uncertainty.defaults_used(),
+        RiskAnswer::Curve(points) => over(points),
+        RiskAnswer::Slope(sol) => sol.defaults_used,
+        RiskAnswer::Mass(sol) => sol.uncertainty.defaults_used(),
+        RiskAnswer::Envelope(env) => env.defaults_used,
+        RiskAnswer::Map(map) => map.summary.defaults_used,
     }
 }
 

@@ -468,24 +468,10 @@ fn slope_in(words: Words, deg: f64) -> Result<SignedSlope> {
     })
 }
 
-/// A slope of the field `slope` as the library's type (signed: answers print it as given).
-pub fn slope_of(deg: f64) -> Result<SignedSlope> {
-    slope_in(Words::Flag, deg)
-}
-
 /// The map's axes (the grid's, else the defaults around the terrain's medians at
-/// `slope_deg`, an error naming `slope` if it is out of range), at most `max_cells` cells.
-pub fn map_axes(
-    grid: &RiskMapGrid,
-    terrain: &UncertainTerrain,
-    slope_deg: f64,
-    max_cells: u128,
-) -> Result<(Axis, Axis)> {
-    map_axes_in(Words::Flag, grid, terrain, slope_deg, max_cells)
-}
-
-/// [`map_axes`], naming the fields in `words` (Python's keywords: `slope_deg`, `len(k_n_axis)
-/// * len(k_s_axis)`).
+/// `slope_deg`, an error naming `slope` if it is out of range), at most `max_cells` cells,
+/// naming the fields in `words` (Python's keywords: `slope_deg`, `len(k_n_axis) *
+/// len(k_s_axis)`).
 pub fn map_axes_in(
     words: Words,
     grid: &RiskMapGrid,

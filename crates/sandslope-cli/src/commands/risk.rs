@@ -2,21 +2,27 @@
 //! §9): per slope, p_fail = P(sinkage or slippage) and P(not success); the safe-slope limit
 //! (steepest slope below `--max-risk`); the heaviest safe mass at one slope, or at each slope
 //! (the payload envelope, `--solve mass`); with `--map`, p_fail over median (k_n, k_s).
-//! Parses, calls `sandslope::risk`, and hands the results to printers, writers and figures.
-
-use std::path::PathBuf;
+//! Translates its flags into the request layer's [`RiskQuestion`], takes the answer from
+//! [`RiskProblem`] (every check, and the answer `serve`'s `/api/risk` and Python give), and
+//! hands it to printers, writers and figures.
 
 use std::io::Write;
+use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
+use indicatif::ProgressBar;
 use serde::Serialize;
 
 use sandslope::risk::{
-    payload_envelope, risk_curve, risk_map, safe_mass, safe_slope, DefaultsUsed, PayloadEnvelope, RiskAnswer,
-    RiskCurve, RiskPoint, SafeLimit, SafeMass, SafeSlope, UncertainTerrain,
+    DefaultsUsed, PayloadEnvelope, RiskAnswer, RiskMapAnswer, RiskPoint, SafeLimit, SafeMass, SafeSlope,
 };
-use sandslope::{Robot, SignedSlope, Slope};
+use sandslope::Robot;
+use sandslope_request::error::Words;
+use sandslope_request::grammar::parse_strength_axis;
+use sandslope_request::risk::{
+    self as request, AnswerLimits, Progress, RiskMapGrid, RiskProblem, RiskQuestion,
+};
 
 use crate::args::{
     beyond_last_point, parse_max_risk, warn_extrapolated, RobotArgs, TerrainArgs, UncertaintyArgs,
@@ -25,10 +31,6 @@ use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
 use crate::output::{csv_string, num, print_json, sci, table, Format};
 use crate::progress::progress_bar;
-use sandslope_request::risk::RiskMapGrid;
-
-/// Most `--map` cells (the library's cap, as Python's).
-const MAX_MAP_CELLS: u128 = sandslope::limits::MAX_RISK_MAP_CELLS as u128;
 
 /// What `--solve` finds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -97,12 +99,64 @@ impl RiskArgs {
             Format::Table
         }
     }
+
+    /// The question these flags ask (the `--map` grid apart: [`RiskArgs::grid`]), its slopes
+    /// read by the request layer's one grammar.
+    fn question(&self) -> Result<RiskQuestion> {
+        Ok(RiskQuestion {
+            slopes: request::parse_slopes(&self.slope)?,
+            cv_n: self.uncertainty.cv_n,
+            cv_s: self.uncertainty.cv_s,
+            max_risk: self.max_risk,
+            solve: self.solve.map(|s| match s {
+                Solve::Slope => request::Solve::Slope,
+                Solve::Mass => request::Solve::Mass,
+            }),
+            map: None,
+        })
+    }
+
+    /// The `--map` grid given by `--k-n` and `--k-s` (the request layer's axis grammar).
+    fn grid(&self) -> Result<RiskMapGrid> {
+        let axis = |field: &str, text: &Option<String>| {
+            text.as_ref().map(|t| parse_strength_axis(field, t)).transpose()
+        };
+        Ok(RiskMapGrid { k_n: axis("k-n", &self.k_n)?, k_s: axis("k-s", &self.k_s)? })
+    }
+
+    /// Checks the output flags before anything is computed: the figure's format and folder,
+    /// `--csv FILE` only with `--map`, the `--npy` folder.
+    fn check_outputs(&self) -> Result<()> {
+        if let Some(p) = &self.plot {
+            crate::figures::format_of(p)?;
+            crate::output::check_parent_exists(p)?;
+        }
+        if let Some(Some(p)) = &self.csv {
+            if !self.map {
+                bail!(
+                    "--csv FILE writes the cells of --map; without --map, --csv prints to stdout (give no FILE)"
+                );
+            }
+            crate::output::check_parent_exists(p)?;
+        }
+        if let Some(dir) = &self.npy {
+            sandslope_io::npy::prepare_npy_dir(dir)?;
+        }
+        Ok(())
+    }
 }
 
-/// Parses `--slope` (the one slope-list grammar, signed: a descent is felt as the climb of
-/// its size), as every front end does.
-pub fn parse_slopes(text: &str) -> Result<Vec<f64>> {
-    Ok(sandslope_request::risk::parse_slopes(text)?)
+/// A progress bar told a map's rows by the request layer.
+struct Bar(ProgressBar);
+
+impl Progress for Bar {
+    fn start(&self, steps: u64) {
+        self.0.set_length(steps);
+    }
+
+    fn step(&self) {
+        self.0.inc(1);
+    }
 }
 
 /// One slope as printed by `--csv`: [`RiskPoint`] flattened.
@@ -143,15 +197,6 @@ struct MassRow {
     robot_mass_kg: f64,
     max_mass_kg: Option<f64>,
     max_payload_kg: Option<f64>,
-}
-
-fn slope_of(deg: f64) -> Result<Slope> {
-    Ok(signed_slope_of(deg)?.felt())
-}
-
-/// `--slope`'s value, checked once, its sign kept for the answer.
-fn signed_slope_of(deg: f64) -> Result<SignedSlope> {
-    SignedSlope::from_degrees(deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))
 }
 
 /// One slope limit in words: `p` names the probability it bounds (`p_fail` or
@@ -198,56 +243,37 @@ fn describe_slope_limits(sol: &SafeSlope) -> String {
 /// Runs `sandslope risk`.
 pub fn run(args: RiskArgs) -> Result<()> {
     let robot = args.robot.load()?;
-    let slopes = parse_slopes(&args.slope)?;
-    let max_risk = args.max_risk;
-    // The note `apply` returns covers the whole table; each mode below notes the defaults at
-    // the slopes it evaluates instead.
-    let (terrain, _) = args.uncertainty.apply(args.terrain.load()?)?;
-    if let Some(p) = &args.plot {
-        crate::figures::format_of(p)?;
-        crate::output::check_parent_exists(p)?;
-    }
-    if let Some(Some(p)) = &args.csv {
-        if !args.map {
-            bail!(
-                "--csv FILE writes the cells of --map; without --map, --csv prints to stdout (give no FILE)"
-            );
-        }
-        crate::output::check_parent_exists(p)?;
-    }
-    if let Some(dir) = &args.npy {
-        sandslope_io::npy::prepare_npy_dir(dir)?;
-    }
-    let extrapolated = beyond_last_point(terrain.terrain(), &slopes);
+    let question = args.question()?;
+    let mut problem = question.on(&robot, args.terrain.load()?, Words::Flag)?;
+    args.check_outputs()?;
+    let extrapolated = beyond_last_point(problem.terrain().terrain(), &problem.question().slopes);
     if !extrapolated.is_empty() {
-        warn_extrapolated(terrain.terrain(), &extrapolated);
+        warn_extrapolated(problem.terrain().terrain(), &extrapolated);
+    }
+    if args.map {
+        problem.map_over(args.grid()?);
     }
     let format = args.format();
     let json = format == Format::Json;
-
-    if args.map {
-        return run_map(&args, &robot, &terrain, slopes[0], max_risk, json);
-    }
-
-    match args.solve {
-        Some(Solve::Mass) if slopes.len() > 1 => {
-            let env = payload_envelope(&robot, &terrain, &slopes, max_risk).map_err(|e| anyhow!("{e}"))?;
-            note_defaults(env.defaults_used);
+    let bar = Bar(if args.map { progress_bar(0, json, "p_fail map") } else { ProgressBar::hidden() });
+    let answer = problem.answer(AnswerLimits::LIBRARY, None, &bar)?;
+    bar.0.finish_and_clear();
+    let defaults = request::defaults_used(&answer);
+    note_defaults(defaults);
+    match answer {
+        RiskAnswer::Map(map) => print_map(&args, &robot, *map),
+        RiskAnswer::Envelope(env) => {
             if let Some(path) = &args.plot {
-                save(path, &EnvelopeFigure::new(&env, &robot_title(&robot, &terrain)))?;
+                save(path, &EnvelopeFigure::new(&env, &robot_title(&problem)))?;
             }
-            return print_envelope(env, format);
+            print_envelope(*env, format)
         }
-        Some(Solve::Mass) => {
-            note_defaults(terrain.defaults_used_at(slope_of(slopes[0])?));
-            let sol = safe_mass(&robot, signed_slope_of(slopes[0])?, &terrain, max_risk)
-                .map_err(|e| anyhow!("{e}"))?;
+        RiskAnswer::Mass(sol) => {
             if args.plot.is_some() {
-                let limits = safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
-                draw_curve(&args, &robot, &terrain, &slopes, &limits, json)?;
+                draw_curve(&args, &problem, &problem.slope_limits()?, json)?;
             }
-            return match format {
-                Format::Json => print_json(&RiskAnswer::Mass(Box::new(sol))),
+            match format {
+                Format::Json => print_json(&RiskAnswer::Mass(sol)),
                 Format::Csv => {
                     print!("{}", csv_string(&[mass_row(&sol)])?);
                     Ok(())
@@ -256,73 +282,64 @@ pub fn run(args: RiskArgs) -> Result<()> {
                     println!("{}", describe_mass_limit(&sol));
                     Ok(())
                 }
-            };
-        }
-        Some(Solve::Slope) => {
-            note_defaults(terrain.defaults_used());
-            let sol = safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?;
-            if args.plot.is_some() {
-                draw_curve(&args, &robot, &terrain, &slopes, &sol, json)?;
             }
-            return match format {
-                Format::Json => print_json(&RiskAnswer::Slope(Box::new(sol))),
-                Format::Csv => {
-                    #[derive(Serialize)]
-                    struct Row<'a> {
-                        max_risk: f64,
-                        success_slope_deg: Option<f64>,
-                        success_limit_kind: &'a str,
-                        safe_slope_deg: Option<f64>,
-                        safe_limit_kind: &'a str,
-                    }
-                    let row = Row {
-                        max_risk,
-                        success_slope_deg: sol.success_slope_deg,
-                        success_limit_kind: sol.success_limit.kind(),
-                        safe_slope_deg: sol.safe_slope_deg,
-                        safe_limit_kind: sol.limit.kind(),
-                    };
-                    print!("{}", csv_string(&[row])?);
-                    Ok(())
-                }
-                Format::Table => {
-                    println!("{}", describe_slope_limits(&sol));
-                    Ok(())
-                }
-            };
         }
-        None => {}
+        RiskAnswer::Slope(sol) => {
+            if args.plot.is_some() {
+                draw_curve(&args, &problem, &sol, json)?;
+            }
+            print_slope_limits(*sol, format)
+        }
+        RiskAnswer::Point(p) => curve(&args, &problem, vec![*p], defaults),
+        RiskAnswer::Curve(points) => curve(&args, &problem, points, defaults),
     }
-
-    // Probabilities at each requested slope.
-    let curve = risk_curve(&robot, &terrain, &slopes).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
-    note_defaults(curve.defaults_used);
-    let need_limit = format == Format::Table || args.plot.is_some();
-    let limits = if need_limit {
-        Some(safe_slope(&robot, &terrain, max_risk).map_err(|e| anyhow!("{e}"))?)
-    } else {
-        None
-    };
-    if let (Some(limits), Some(_)) = (&limits, &args.plot) {
-        draw_curve(&args, &robot, &terrain, &slopes, limits, json)?;
-    }
-    print_curve(curve, limits.as_ref(), format)
 }
 
-/// The `--map` axes (the flags', else the defaults around the terrain's medians at
-/// `slope_deg`, an error naming `--slope` if it is out of range), at most `max_cells` cells:
-/// the request layer's, which `serve`'s `/api/risk` uses too.
-fn map_axes(
+/// The p_fail curve at the slopes asked (`points`): drawn with the slope limits, and printed,
+/// in a table with the limits under it.
+fn curve(
     args: &RiskArgs,
-    terrain: &UncertainTerrain,
-    slope_deg: f64,
-    max_cells: u128,
-) -> Result<(sandslope::Axis, sandslope::Axis)> {
-    let axis = |field: &str, text: &Option<String>| {
-        text.as_ref().map(|t| sandslope_request::grammar::parse_strength_axis(field, t)).transpose()
-    };
-    let grid = RiskMapGrid { k_n: axis("k-n", &args.k_n)?, k_s: axis("k-s", &args.k_s)? };
-    Ok(sandslope_request::risk::map_axes(&grid, terrain, slope_deg, max_cells)?)
+    problem: &RiskProblem<'_>,
+    points: Vec<RiskPoint>,
+    defaults: DefaultsUsed,
+) -> Result<()> {
+    let format = args.format();
+    let limits =
+        if format == Format::Table || args.plot.is_some() { Some(problem.slope_limits()?) } else { None };
+    if let Some(limits) = &limits {
+        draw_curve(args, problem, limits, format == Format::Json)?;
+    }
+    print_curve(points, defaults, limits.as_ref(), format)
+}
+
+/// Prints the slope limits of `--solve slope`.
+fn print_slope_limits(sol: SafeSlope, format: Format) -> Result<()> {
+    match format {
+        Format::Json => print_json(&RiskAnswer::Slope(Box::new(sol))),
+        Format::Csv => {
+            #[derive(Serialize)]
+            struct Row<'a> {
+                max_risk: f64,
+                success_slope_deg: Option<f64>,
+                success_limit_kind: &'a str,
+                safe_slope_deg: Option<f64>,
+                safe_limit_kind: &'a str,
+            }
+            let row = Row {
+                max_risk: sol.max_risk,
+                success_slope_deg: sol.success_slope_deg,
+                success_limit_kind: sol.success_limit.kind(),
+                safe_slope_deg: sol.safe_slope_deg,
+                safe_limit_kind: sol.limit.kind(),
+            };
+            print!("{}", csv_string(&[row])?);
+            Ok(())
+        }
+        Format::Table => {
+            println!("{}", describe_slope_limits(&sol));
+            Ok(())
+        }
+    }
 }
 
 /// Tells the user on stderr when a default CV was used (docs/model.md §9).
@@ -332,17 +349,24 @@ fn note_defaults(defaults: DefaultsUsed) {
     }
 }
 
-fn robot_title(robot: &Robot, terrain: &UncertainTerrain) -> String {
-    format!("m = {} kg on {}", robot.mass(), terrain.terrain().name().unwrap_or("terrain"))
+/// The robot's mass and the terrain's name, for a figure's title.
+fn robot_title(problem: &RiskProblem<'_>) -> String {
+    let name = problem.terrain().terrain().name().unwrap_or("terrain");
+    format!("m = {} kg on {name}", problem.robot().mass())
 }
 
 /// Prints the risk curve, and in a table the success and safe-slope limits if they were
-/// searched.
-fn print_curve(curve: RiskCurve, limits: Option<&SafeSlope>, format: Format) -> Result<()> {
+/// searched and the note on the default CVs used.
+fn print_curve(
+    points: Vec<RiskPoint>,
+    defaults: DefaultsUsed,
+    limits: Option<&SafeSlope>,
+    format: Format,
+) -> Result<()> {
     match format {
-        Format::Json => print_json(&RiskAnswer::of_points(curve.points)),
+        Format::Json => print_json(&RiskAnswer::of_points(points)),
         Format::Csv => {
-            let rows: Vec<RiskRow> = curve.points.iter().map(RiskRow::of).collect();
+            let rows: Vec<RiskRow> = points.iter().map(RiskRow::of).collect();
             print!("{}", csv_string(&rows)?);
             Ok(())
         }
@@ -359,7 +383,7 @@ fn print_curve(curve: RiskCurve, limits: Option<&SafeSlope>, format: Format) -> 
                 "P(success)",
             ]);
             let f = |x: f64| format!("{x:.4}");
-            for p in &curve.points {
+            for p in &points {
                 let q = &p.probabilities;
                 t.add_row([
                     format!("{}", p.slope_deg),
@@ -377,7 +401,7 @@ fn print_curve(curve: RiskCurve, limits: Option<&SafeSlope>, format: Format) -> 
             if let Some(limits) = limits {
                 println!("{}", describe_slope_limits(limits));
             }
-            if let Some(note) = curve.defaults_used.note() {
+            if let Some(note) = defaults.note() {
                 println!("note: {note}");
             }
             println!("p_fail = P(sinkage or slippage); log-normal k_n, k_s (docs/model.md §9), deterministic quadrature");
@@ -480,72 +504,37 @@ fn mass_row(s: &SafeMass) -> MassRow {
     }
 }
 
-/// p_fail and p_not_success against slope, sampled every 0.25 degrees.
-fn draw_curve(
-    args: &RiskArgs,
-    robot: &Robot,
-    terrain: &UncertainTerrain,
-    slopes: &[f64],
-    limits: &SafeSlope,
-    quiet: bool,
-) -> Result<()> {
+/// p_fail and p_not_success against slope, sampled every 0.25 degrees (the request layer's
+/// samples), to `--plot`.
+fn draw_curve(args: &RiskArgs, problem: &RiskProblem<'_>, limits: &SafeSlope, quiet: bool) -> Result<()> {
     let Some(path) = &args.plot else { return Ok(()) };
-    let requested_max = slopes.iter().fold(0.0f64, |a, &d| a.max(d.abs()));
-    let mut hi = requested_max.max(30.0);
-    if let Some(v) = limits.limit.value() {
-        hi = hi.max(v * 1.25);
-    }
-    if let Some(r) = terrain.terrain().repose() {
-        hi = hi.max(r.degrees() + 3.0);
-    }
-    let hi = hi.min(89.5);
-    let n = (hi / 0.25).round() as usize;
     let bar = progress_bar(1, quiet, "p_fail curve");
-    let fine: Vec<f64> = (0..=n).map(|i| hi * i as f64 / n as f64).collect();
-    let curve = risk_curve(robot, terrain, &fine).map_err(|e| anyhow!("{e}"))?;
-    let requested = risk_curve(robot, terrain, slopes).map_err(|e| anyhow!("{e}"))?;
+    let samples = problem.curve_samples(limits)?;
     bar.finish_and_clear();
     let figure = CurveFigure {
-        curve: curve.points.iter().map(|p| (p.slope_deg, p.probabilities)).collect(),
-        points: requested.points.iter().map(|p| (p.slope_deg.abs(), p.p_fail)).collect(),
-        hi,
+        curve: samples.fine.iter().map(|p| (p.slope_deg, p.probabilities)).collect(),
+        points: samples.requested.iter().map(|p| (p.slope_deg.abs(), p.p_fail)).collect(),
+        hi: samples.hi,
         max_risk: limits.max_risk,
         limit: limits.limit,
         success_limit: limits.success_limit,
-        title: format!("Failure risk: {}", robot_title(robot, terrain)),
+        title: format!("Failure risk: {}", robot_title(problem)),
     };
     save(path, &figure)
 }
 
-/// `--map`: p_fail and p_not_success over median (k_n, k_s) at one slope.
-fn run_map(
-    args: &RiskArgs,
-    robot: &Robot,
-    terrain: &UncertainTerrain,
-    slope_deg: f64,
-    max_risk: f64,
-    quiet: bool,
-) -> Result<()> {
-    let (k_n_axis, k_s_axis) = map_axes(args, terrain, slope_deg, MAX_MAP_CELLS)?;
-    let slope = slope_of(slope_deg)?;
-    let sample = terrain.sample(slope);
-    let (ground, u) = (sample.ground, sample.uncertainty);
-    let defaults = terrain.defaults_used_at(slope);
-    note_defaults(defaults);
-    let bar = progress_bar(k_s_axis.len() as u64, quiet, "p_fail map");
-    let answer =
-        risk_map(robot, signed_slope_of(slope_deg)?, terrain, (&k_n_axis, &k_s_axis), max_risk, &|| {
-            bar.inc(1)
-        })
-        .map_err(|e| anyhow!("{e}"))?;
-    bar.finish_and_clear();
-    let map = &answer.map;
+/// `--map`: writes the cells (`--csv FILE`, `--npy`) and the figure, and prints p_fail and
+/// p_not_success over median (k_n, k_s) at one slope.
+fn print_map(args: &RiskArgs, robot: &Robot, answer: RiskMapAnswer) -> Result<()> {
+    let (map, summary) = (&answer.map, &answer.summary);
+    let (slope_deg, max_risk, u) = (summary.slope_deg, summary.max_risk, summary.uncertainty);
+    let (k_n_axis, k_s_axis) = (map.k_n_axis, map.k_s_axis);
     if let Some(Some(path)) = &args.csv {
         sandslope_render::tables::write_risk_map_csv(path, map)?;
     }
     if let Some(dir) = &args.npy {
         use sandslope_io::npy::{write_npy_dir, NpyData};
-        let (k_n, k_s) = (map.k_n_axis.values(), map.k_s_axis.values());
+        let (k_n, k_s) = (k_n_axis.values(), k_s_axis.values());
         let shape = vec![k_s.len(), k_n.len()];
         write_npy_dir(
             dir,
@@ -563,13 +552,13 @@ fn run_map(
             k_s_axis,
             p_fail: map.p_fail.clone(),
             contour: map.p_fail_contour(max_risk),
-            star: (ground.k_n, ground.k_s),
+            star: (summary.terrain_k_n, summary.terrain_k_s),
             max_risk,
             title: format!(
                 "p_fail at {slope_deg}\u{b0}, m = {} kg, cv k_n = {:.2}, cv k_s = {:.2}",
                 robot.mass(),
-                u.cv_n(),
-                u.cv_s()
+                u.cv_n,
+                u.cv_s
             ),
         };
         save(path, &figure)?;
@@ -594,18 +583,18 @@ fn run_map(
                 sci(k_n_axis.max()),
                 sci(k_s_axis.min()),
                 sci(k_s_axis.max()),
-                u.cv_n(),
-                u.cv_s()
+                u.cv_n,
+                u.cv_s
             );
             println!(
                 "{} of {} cells have p_fail < {max_risk}; the terrain's own medians (k_n {}, k_s {}) have p_fail {:.4}",
-                answer.summary.cells_below_max_risk,
-                answer.summary.cells,
-                sci(ground.k_n),
-                sci(ground.k_s),
-                answer.summary.terrain_p_fail
+                summary.cells_below_max_risk,
+                summary.cells,
+                sci(summary.terrain_k_n),
+                sci(summary.terrain_k_s),
+                summary.terrain_p_fail
             );
-            if let Some(note) = defaults.note() {
+            if let Some(note) = summary.defaults_used.note() {
                 println!("note: {note}");
             }
             Ok(())
@@ -619,6 +608,7 @@ mod tests {
 
     #[test]
     fn slope_lists_and_ranges() {
+        let parse_slopes = request::parse_slopes;
         assert_eq!(parse_slopes("20").unwrap(), vec![20.0]);
         assert_eq!(parse_slopes("0, 10,20").unwrap(), vec![0.0, 10.0, 20.0]);
         assert_eq!(parse_slopes("0:24:4").unwrap(), vec![0.0, 8.0, 16.0, 24.0]);

@@ -119,6 +119,74 @@ fn risk_refusals_name_their_field_and_the_default_is_seven_slopes() {
     assert_eq!((q.max_risk, q.solve, q.map), (0.05, None, None));
 }
 
+/// What the command line asks of a risk problem beside the answer comes from the same checked
+/// question: `solve slope`'s answer is `slope_limits`, the curve figure's points at the slopes
+/// asked are the curve's, a map tells its progress its rows, and `defaults_used` names the
+/// default CVs where the library's own curve does.
+#[test]
+fn a_risk_problem_answers_the_command_lines_other_questions_from_one_check() {
+    use sandslope::risk::{risk_curve, RiskAnswer, UncertainTerrain};
+    use sandslope::Terrain;
+    use sandslope_request::error::Words;
+    use sandslope_request::risk::{defaults_used, AnswerLimits, Progress, RiskMapGrid, RiskQuestion, Solve};
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    let robot =
+        sandslope_request::RobotRequest { robot: "paper-hexapod".into(), mass: None, overrides: vec![] }
+            .load()
+            .unwrap();
+    // No SDs and no CV given: both defaults are used.
+    let bare = || Terrain::constant(7e5, 1.5e6).unwrap();
+    let question = |solve: Option<Solve>| RiskQuestion {
+        slopes: vec![0.0, 10.0, -20.0],
+        cv_n: None,
+        cv_s: None,
+        max_risk: 0.05,
+        solve,
+        map: None,
+    };
+    let lib = AnswerLimits::LIBRARY;
+    let curve = question(None).on(&robot, bare(), Words::Flag).unwrap();
+    let RiskAnswer::Curve(points) = curve.answer(lib, None, &sandslope_request::risk::NoProgress).unwrap()
+    else {
+        panic!("three slopes are a curve")
+    };
+    let own =
+        risk_curve(&robot, &UncertainTerrain::new(bare(), None, None).unwrap(), &[0.0, 10.0, -20.0]).unwrap();
+    assert_eq!(points, own.points);
+    assert_eq!(defaults_used(&RiskAnswer::Curve(points.clone())), own.defaults_used);
+    assert!(own.defaults_used.k_n && own.defaults_used.k_s);
+    let limits = curve.slope_limits().unwrap();
+    let samples = curve.curve_samples(&limits).unwrap();
+    assert_eq!(samples.requested, points);
+    assert_eq!(samples.fine.first().map(|p| p.slope_deg), Some(0.0));
+    assert_eq!(samples.fine.last().map(|p| p.slope_deg), Some(samples.hi));
+
+    let slope = question(Some(Solve::Slope)).on(&robot, bare(), Words::Flag).unwrap();
+    assert_eq!(
+        slope.answer(lib, None, &sandslope_request::risk::NoProgress).unwrap(),
+        RiskAnswer::Slope(Box::new(limits))
+    );
+
+    struct Rows(AtomicU64, AtomicU64);
+    impl Progress for Rows {
+        fn start(&self, steps: u64) {
+            self.0.store(steps, Ordering::Relaxed);
+        }
+        fn step(&self) {
+            self.1.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+    let mut map = question(None).on(&robot, bare(), Words::Flag).unwrap();
+    let axis = |t: &str| Some(sandslope_request::grammar::parse_strength_axis("k-n", t).unwrap());
+    map.map_over(RiskMapGrid { k_n: axis("1e5:1e7:3"), k_s: axis("1e5:1e7:4") });
+    let rows = Rows(AtomicU64::new(0), AtomicU64::new(0));
+    let RiskAnswer::Map(answer) = map.answer(lib, None, &rows).unwrap() else { panic!("a map") };
+    assert_eq!(answer.summary.slope_deg, 0.0);
+    assert_eq!((rows.0.into_inner(), rows.1.into_inner()), (4, 4));
+    assert_eq!(defaults_used(&RiskAnswer::Map(answer)), own.defaults_used);
+}
+
 #[test]
 fn plan_refusals_name_their_field() {
     use sandslope_request::PlanRequest;

@@ -166,9 +166,14 @@ impl ReportRequest {
 
     /// The report (what `report --out DIR` writes as `report.json`) for `robot` and `terrain`.
     pub fn answer(&self, robot: Robot, terrain: Terrain, words: Words) -> Result<Report> {
-        let evidence = self.evidence(robot, terrain, words)?;
-        report(&evidence).map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))
+        answer_evidence(&self.evidence(robot, terrain, words)?)
     }
+}
+
+/// The report on `evidence` already read ([`ReportRequest::evidence`]): the command line reads
+/// the evidence first, to warn about its recordings before the long part.
+pub fn answer_evidence(evidence: &Evidence) -> Result<Report> {
+    report(evidence).map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))
 }
 
 #[cfg(test)]

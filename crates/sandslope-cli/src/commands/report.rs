@@ -6,15 +6,15 @@
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use sandslope::gait::GaitOptions;
-use sandslope::report::{report, Evidence};
+use sandslope::report::Evidence;
 use sandslope::Slope;
 use sandslope_io::mocap::MocapFormat;
 use sandslope_request::error::Words;
-use sandslope_request::report::{ReportRequest, TracksAt};
+use sandslope_request::report::{answer_evidence, ReportRequest, TracksAt};
 
 use crate::args::{parse_max_risk, LevelStepArgs, RobotArgs, TerrainArgs};
 use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, warn_without_steps};
@@ -149,7 +149,7 @@ pub fn run(args: ReportArgs) -> Result<()> {
         false,
         "building the report (the model, the calibration, the simulator's walks)",
     );
-    let report = report(&evidence).map_err(|e| anyhow!("{e}"));
+    let report = answer_evidence(&evidence);
     spin.finish_and_clear();
     let report = report?;
     for w in &report.warnings {

@@ -9,8 +9,9 @@ use pyo3::types::PyDict;
 use pythonize::pythonize;
 
 use sandslope::infer::servo::{infer_servo_log as infer, CurrentInferenceSettings, LegTrace};
-use sandslope::infer::LogUniformPrior;
 use sandslope::servo::xl330;
+use sandslope_request::error::Words;
+use sandslope_request::infer::{prior_in, servo_grid_points};
 use sandslope_servo::driver::ServoSample;
 use sandslope_servo::session::{
     default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, RUN_DEFAULTS,
@@ -82,11 +83,8 @@ pub fn infer_servo_log<'py>(
             torque.len()
         )));
     }
-    if !(3..=1000).contains(&grid_points) {
-        return Err(value_error(format!("grid_points = {grid_points} must be within 3 to 1000")));
-    }
-    let prior = LogUniformPrior::new(k_s_prior.0, k_s_prior.1)
-        .map_err(|e| value_error(format!("k_s_prior = {k_s_prior:?}: {e}")))?;
+    let grid_points = servo_grid_points(Words::Keyword, grid_points).map_err(|e| value_error(e.message()))?;
+    let prior = prior_in(Words::Keyword, k_s_prior).map_err(|e| value_error(e.message()))?;
     let legs = 2 * robot.inner.stance_legs() as usize;
     let mut traces = vec![LegTrace::default(); legs];
     for (i, &j) in leg.iter().enumerate() {

@@ -2,7 +2,8 @@
 //! observed speeds (and anchoring times), the posterior of k_s at each observed slope
 //! ([`sandslope::infer::posteriors`]); with a shear law, the law's joint posterior and the
 //! predicted failure risk at slopes not walked ([`sandslope::infer::law_posterior`]). (`infer
-//! --servo-log`, k_s from a drive's currents, is the servo front end's.)
+//! --servo-log`, k_s from a drive's currents, is the servo front end's; its prior and grid are
+//! checked here, [`prior_in`] and [`servo_grid_points`], for it and Python's `infer_servo_log`.)
 
 use std::path::PathBuf;
 
@@ -16,7 +17,7 @@ use sandslope::risk::UncertainTerrain;
 use sandslope::{Robot, Slope};
 use sandslope_io::observations::{load_speed_observations, load_step_observation};
 
-use crate::error::{RequestError, Result};
+use crate::error::{RequestError, Result, Words};
 
 /// Where the gait observations come from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -77,8 +78,36 @@ pub fn parse_prior(text: &str) -> Result<(f64, f64)> {
 
 /// The log-uniform prior on `(MIN, MAX)`, checked (`0 < MIN < MAX`, finite); also what
 /// `infer --servo-log` takes.
-pub fn prior((lo, hi): (f64, f64)) -> Result<LogUniformPrior> {
-    LogUniformPrior::new(lo, hi).map_err(|e| RequestError::invalid("k-s-prior", format!("--k-s-prior: {e}")))
+pub fn prior(range: (f64, f64)) -> Result<LogUniformPrior> {
+    prior_in(Words::Flag, range)
+}
+
+/// [`prior`], naming the field in `words` (Python's `k_s_prior = (MIN, MAX)`).
+pub fn prior_in(words: Words, (lo, hi): (f64, f64)) -> Result<LogUniformPrior> {
+    LogUniformPrior::new(lo, hi).map_err(|e| {
+        let message = match words {
+            Words::Flag => format!("--k-s-prior: {e}"),
+            Words::Keyword => format!("k_s_prior = ({lo:?}, {hi:?}): {e}"),
+        };
+        RequestError::invalid("k-s-prior", message)
+    })
+}
+
+/// The most points of the servo-log inference's k_s grid (`infer --servo-log --grid-points`,
+/// Python's `infer_servo_log(grid_points=...)`); at least 3.
+pub const MAX_SERVO_GRID_POINTS: usize = 1000;
+
+/// The servo-log inference's number of grid points, checked (3 to
+/// [`MAX_SERVO_GRID_POINTS`]), the message naming the field in `words`.
+pub fn servo_grid_points(words: Words, n: usize) -> Result<usize> {
+    if (3..=MAX_SERVO_GRID_POINTS).contains(&n) {
+        Ok(n)
+    } else {
+        Err(RequestError::invalid(
+            "grid-points",
+            format!("{} = {n} must be within 3 to {MAX_SERVO_GRID_POINTS}", words.name("grid-points")),
+        ))
+    }
 }
 
 impl InferRequest {

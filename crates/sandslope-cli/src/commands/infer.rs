@@ -10,6 +10,7 @@ use clap::{Args, ValueEnum};
 
 use sandslope::infer::{Bound, InferLaw, LogUniformPrior};
 use sandslope::Slope;
+use sandslope_request::error::Words;
 use sandslope_request::infer::{self, GaitEvidence, InferAnswer, InferRequest};
 
 use crate::args::{parse_slope_list, RobotArgs, SlopeSign, TerrainArgs, UncertaintyArgs};
@@ -131,9 +132,7 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
     use sandslope::infer::servo::{infer_servo_log, CurrentInferenceSettings};
     let robot = args.robot.load()?;
     let prior = parse_prior(&args.k_s_prior)?;
-    if !(3..=1000).contains(&args.grid_points) {
-        bail!("--grid-points = {} must be within 3 to 1000", args.grid_points);
-    }
+    infer::servo_grid_points(Words::Flag, args.grid_points)?;
     let log = sandslope_io::servo_log::read_servo_log(path)?;
     let slope_deg = match (args.slope, log.meta_f64("slope_deg", path)?) {
         (Some(s), _) | (None, Some(s)) => s,

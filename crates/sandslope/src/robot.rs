@@ -52,7 +52,7 @@ pub struct RobotSpec {
     /// Servo torque limit per leg, N m (simulator only); default none (ideal position servo).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub servo_torque_limit_n_m: Option<f64>,
-    /// Resistive-force-theory elements per C-leg (simulator only); default 16, 4 to 256.
+    /// Resistive-force-theory elements per C-leg (simulator only); default 32 ([`DEFAULT_LEG_ELEMENTS`]), 4 to 256.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub leg_elements: Option<u32>,
 }

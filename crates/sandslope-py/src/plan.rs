@@ -28,35 +28,6 @@ fn row_major<'a>(a: &'a PyReadonlyArray2<'_, f64>) -> (Cow<'a, [f64]>, (usize, u
     }
 }
 
-/// The request layer's grid request of the keywords every elevation call shares.
-#[allow(clippy::too_many_arguments)]
-fn grid_request(
-    cell_x: f64,
-    cell_y: f64,
-    row_widths_m: Option<Vec<f64>>,
-    nodata: Option<f64>,
-    cv_n: Option<f64>,
-    cv_s: Option<f64>,
-    max_roll_deg: f64,
-    descent: &str,
-    allow_metastable: bool,
-    time_weight: f64,
-) -> GridRequest {
-    let descent = descent.to_string();
-    GridRequest {
-        cell_x,
-        cell_y,
-        row_widths_m,
-        nodata,
-        cv_n,
-        cv_s,
-        max_roll_deg,
-        descent,
-        allow_metastable,
-        time_weight,
-    }
-}
-
 /// Per cell, the lowest p_fail over the 16 headings and the azimuth of the steepest usable
 /// climb (degrees from north), as `sandslope plan --risk-map` writes them: `2 * rows * cols`
 /// float32 values, band after band (the request layer's [`GridRequest::risk_raster`], the DEM
@@ -80,7 +51,7 @@ pub fn risk_raster<'py>(
     row_widths_m: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, numpy::PyArray1<f32>>> {
     let time_weight = sandslope::plan::DEFAULT_TIME_WEIGHT;
-    let request = grid_request(
+    let request = GridRequest {
         cell_x,
         cell_y,
         row_widths_m,
@@ -88,10 +59,10 @@ pub fn risk_raster<'py>(
         cv_n,
         cv_s,
         max_roll_deg,
-        descent,
+        descent: descent.to_string(),
         allow_metastable,
         time_weight,
-    );
+    };
     let (heights, (rows, cols)) = row_major(&dem);
     let (robot, terrain) = (&robot.inner, &terrain.inner);
     let source =
@@ -130,7 +101,7 @@ pub fn plan<'py>(
     class_terrains: Option<Vec<(i64, PyRef<'py, PyTerrain>)>>,
     row_widths_m: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let grid = grid_request(
+    let grid = GridRequest {
         cell_x,
         cell_y,
         row_widths_m,
@@ -138,10 +109,10 @@ pub fn plan<'py>(
         cv_n,
         cv_s,
         max_roll_deg,
-        descent,
+        descent: descent.to_string(),
         allow_metastable,
         time_weight,
-    );
+    };
     let request = GridPlanRequest { grid, start, goal, objectives, origin };
     let (heights, (rows, cols)) = row_major(&dem);
     let class_values = classes.as_ref().map(row_major);

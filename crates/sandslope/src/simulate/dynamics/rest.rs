@@ -3,7 +3,7 @@
 //! exactly, their forces inside the set the rate-independent law allows there, as a sticking
 //! Coulomb contact. These steps put them there and check the set.
 
-use super::super::body::{Contact, BELLY};
+use super::super::body::BELLY;
 use super::super::rft::RestSet;
 use super::{Walker, MAX_HALVINGS, MAX_NEWTON, NEWTON_TOL};
 
@@ -19,38 +19,31 @@ impl Walker {
     /// `sigma(e)` over all directions e ([`super::rft::RestSet`]). The elements at rest do no
     /// work, so the step stays passive.
     pub(super) fn sticking(&mut self, near: [f64; 3], v_free: [f64; 3], m: [f64; 3]) -> bool {
-        let speed = |c: &Contact, v: [f64; 3], rates: &[f64]| {
-            let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
-            let u = Walker::element_velocity(c, v, rate);
-            (u[0] * u[0] + u[1] * u[1]).sqrt()
-        };
-        let Some(pick) = (0..self.contacts.len()).min_by(|&a, &b| {
-            speed(&self.contacts[a], near, &self.rates).total_cmp(&speed(
-                &self.contacts[b],
-                near,
-                &self.rates,
-            ))
-        }) else {
+        let Some(pick) = (0..self.contacts.len())
+            .min_by(|&a, &b| self.element_speed(a, near).total_cmp(&self.element_speed(b, near)))
+        else {
             return false;
         };
         self.rest_group(pick, v_free, m) || (!self.pitch_locked && self.pivot(pick, near, v_free, m))
     }
 
+    /// The speed of contact `k` when the body moves at `v`, its leg turning at its rate.
+    fn element_speed(&self, k: usize, v: [f64; 3]) -> f64 {
+        let c = &self.contacts[k];
+        let rate = if c.leg == BELLY { 0.0 } else { self.rates[c.leg] };
+        let u = Walker::element_velocity(c, v, rate);
+        (u[0] * u[0] + u[1] * u[1]).sqrt()
+    }
+
     /// The resting group of [`Walker::sticking`]: element `pick` at rest with the pitch rate
     /// zero, and with it every element at rest at those body rates (of one shape, else no).
     fn rest_group(&mut self, pick: usize, v_free: [f64; 3], m: [f64; 3]) -> bool {
-        let speed = |c: &Contact, v: [f64; 3], rates: &[f64]| {
-            let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
-            let u = Walker::element_velocity(c, v, rate);
-            (u[0] * u[0] + u[1] * u[1]).sqrt()
-        };
         let c = self.contacts[pick];
         let rate = if c.leg == BELLY { 0.0 } else { self.rates[c.leg] };
         // u = v + rate (arm_z, -arm_x) = 0 with the pitch rate zero.
         let v = [-rate * c.arm[1], rate * c.arm[0], 0.0];
-        let group: Vec<usize> = (0..self.contacts.len())
-            .filter(|&k| speed(&self.contacts[k], v, &self.rates) <= 1e-3 * self.eps)
-            .collect();
+        let group: Vec<usize> =
+            (0..self.contacts.len()).filter(|&k| self.element_speed(k, v) <= 1e-3 * self.eps).collect();
         let same_shape = group.iter().all(|&k| {
             let t = self.contacts[k].tangent;
             (t[0] - c.tangent[0]).abs() < 1e-9 && (t[1] - c.tangent[1]).abs() < 1e-9

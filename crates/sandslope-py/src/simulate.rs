@@ -6,13 +6,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
 
-use sandslope::simulate::{
-    simulate as run, simulate_ensemble as run_ensemble, BodyPitch, Mechanisms, RftScaling, SimSettings,
-    SimulateError,
-};
+use sandslope::simulate::{BodyPitch, Mechanisms, RftScaling, SimSettings};
 use sandslope::Scenario;
 use sandslope_request::error::Words;
-use sandslope_request::simulate::{parse_body_pitch, parse_rft_scaling, SettingsRequest};
+use sandslope_request::simulate::{parse_body_pitch, parse_rft_scaling, SettingsRequest, Walks};
+use sandslope_request::RequestError;
 
 use crate::arrays::put;
 use crate::types::{PyRobot, PyTerrain};
@@ -58,9 +56,9 @@ pub fn simulate<'py>(
         rate_hz: sample_rate_hz,
     })?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
-    let sim = py.detach(|| run(&scenario, slope, &settings)).map_err(|e| match e {
-        SimulateError::Param(p) => value_error(p),
-    })?;
+    let walks = Walks::at(scenario, slope, settings, None);
+    let mut sims = py.detach(|| walks.simulate()).map_err(request_error)?;
+    let sim = sims.pop().ok_or_else(|| value_error("the walk gave no result"))?;
     let tr = sim.trajectory;
     let d = PyDict::new(py);
     put(&d, "time_s", tr.time_s)?;
@@ -88,18 +86,22 @@ pub fn simulate<'py>(
     Ok((d, summary))
 }
 
+/// A refused request as Python's `ValueError`, its message in Python's words.
+fn request_error(e: RequestError) -> PyErr {
+    value_error(e.message())
+}
+
 /// The body-pitch and scaling keywords, parsed with the CLI's names, errors in Python's words.
 fn modes(body_pitch: &str, rft_scaling: &str) -> PyResult<(BodyPitch, RftScaling)> {
-    let err = |e: sandslope_request::RequestError| value_error(e.message());
     Ok((
-        parse_body_pitch(body_pitch, Words::Keyword).map_err(err)?,
-        parse_rft_scaling(rft_scaling, Words::Keyword).map_err(err)?,
+        parse_body_pitch(body_pitch, Words::Keyword).map_err(request_error)?,
+        parse_rft_scaling(rft_scaling, Words::Keyword).map_err(request_error)?,
     ))
 }
 
 /// The settings `sandslope simulate` checks, in Python's words.
 fn checked(settings: SettingsRequest) -> PyResult<SimSettings> {
-    settings.settings(Words::Keyword).map_err(|e| value_error(e.message()))
+    settings.settings(Words::Keyword).map_err(request_error)
 }
 
 /// Walks the robot `walks` times (2 to 1000) at one slope, the mass perturbed by 1e-9 relative
@@ -142,9 +144,7 @@ pub fn simulate_ensemble<'py>(
         rate_hz,
     })?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
-    let e = py.detach(|| run_ensemble(&scenario, slope, &settings, walks)).map_err(|e| match e {
-        SimulateError::Param(p) if p.key == "ensemble" => value_error(p.renamed("walks")),
-        SimulateError::Param(p) => value_error(p),
-    })?;
+    let request = Walks::at(scenario, slope, settings, Some(walks));
+    let e = py.detach(|| request.simulate_ensemble(walks)).map_err(request_error)?;
     pythonize(py, &e).map_err(value_error)
 }

@@ -82,9 +82,16 @@ fn flagged(e: ParamError) -> RequestError {
     RequestError::invalid(field, e.renamed(flag))
 }
 
-fn sim_err(e: SimulateError) -> RequestError {
-    match e {
-        SimulateError::Param(p) => flagged(p),
+/// A library error with its key as Python's keyword (the ensemble's size is `walks` there).
+fn keyworded(e: ParamError) -> RequestError {
+    let field = if e.key == "ensemble" { "walks".to_string() } else { e.key.clone() };
+    RequestError::invalid(field.clone(), e.renamed(field))
+}
+
+fn sim_err(e: SimulateError, words: Words) -> RequestError {
+    match (e, words) {
+        (SimulateError::Param(p), Words::Flag) => flagged(p),
+        (SimulateError::Param(p), Words::Keyword) => keyworded(p),
     }
 }
 
@@ -171,7 +178,7 @@ impl SimulateRequest {
             }
             SimSlopes::One(slope) => (vec![signed(check_slope(*slope)?, "slope")?], false),
         };
-        Ok(Walks { scenario, slopes, many, settings, ensemble: self.ensemble })
+        Ok(Walks { scenario, slopes, many, settings, ensemble: self.ensemble, words: Words::Flag })
     }
 
     /// The answer (what `simulate --json` prints).
@@ -315,15 +322,30 @@ pub struct Walks {
     pub settings: SimSettings,
     /// Walks in an ensemble at the one slope, if asked.
     pub ensemble: Option<usize>,
+    /// How the library's errors name their field: the command line's flags and the server's
+    /// fields, or Python's keywords.
+    pub words: Words,
 }
 
 impl Walks {
+    /// One slope's walk, or an ensemble of `ensemble` walks there, of a robot and terrain a
+    /// front end built itself (Python's objects, whose settings [`SettingsRequest`] checked);
+    /// the library's errors name Python's keywords (`dt_s`, `walks`).
+    pub fn at(
+        scenario: Scenario,
+        slope: SignedSlope,
+        settings: SimSettings,
+        ensemble: Option<usize>,
+    ) -> Walks {
+        Walks { scenario, slopes: vec![slope], many: false, settings, ensemble, words: Words::Keyword }
+    }
+
     /// Integration steps of all the walks, settling included (what they cost to run).
     pub fn integration_steps(&self) -> Result<f64> {
         let mut steps = 0.0;
         for signed in &self.slopes {
             let dt = sandslope::simulate::integration_step(&self.scenario, signed.felt(), self.settings.dt_s)
-                .map_err(flagged)?;
+                .map_err(|e| sim_err(SimulateError::Param(e), self.words))?;
             steps += (self.settings.duration_s + self.settings.settle_s) / dt;
         }
         Ok(steps * self.ensemble.unwrap_or(1) as f64)
@@ -332,9 +354,11 @@ impl Walks {
     /// Runs the walks (several in parallel).
     pub fn simulate(&self) -> Result<Vec<Simulation>> {
         if self.many {
-            simulate_slopes(&self.scenario, &self.slopes, &self.settings).map_err(sim_err)
+            simulate_slopes(&self.scenario, &self.slopes, &self.settings).map_err(|e| sim_err(e, self.words))
         } else {
-            Ok(vec![simulate(&self.scenario, self.slopes[0], &self.settings).map_err(sim_err)?])
+            let sim = simulate(&self.scenario, self.slopes[0], &self.settings)
+                .map_err(|e| sim_err(e, self.words))?;
+            Ok(vec![sim])
         }
     }
 
@@ -348,7 +372,8 @@ impl Walks {
 
     /// The ensemble of `n` walks at the one slope.
     pub fn simulate_ensemble(&self, n: usize) -> Result<Ensemble> {
-        simulate_ensemble(&self.scenario, self.slopes[0], &self.settings, n).map_err(sim_err)
+        simulate_ensemble(&self.scenario, self.slopes[0], &self.settings, n)
+            .map_err(|e| sim_err(e, self.words))
     }
 
     /// The value `simulate --json` prints for these walks' results.

@@ -203,33 +203,12 @@ impl OverrideArgs {
 
 /// Prints a warning to stderr when terrain values were extrapolated (docs/model.md §7).
 pub fn warn_extrapolated(terrain: &Terrain, slopes: &[f64]) {
-    if let (Some(last), false) = (terrain.points().last(), slopes.is_empty()) {
-        let list = slope_list_text(slopes);
-        eprintln!(
-            "warning: slope(s) {list} deg are above the terrain's last measured point ({} deg); k_n and k_s are \
-             extrapolated linearly and floored at zero",
-            last.slope_deg
-        );
+    if let Some(warning) = sandslope_request::scenario::extrapolation_warning(terrain, slopes) {
+        eprintln!("warning: {warning}");
     }
 }
 
-/// Slopes for a message: all of them up to six, else the first and last and how many (a
-/// `sweep --step 0.001` warning listed 10,000 slopes on one 59 KB line).
-fn slope_list_text(slopes: &[f64]) -> String {
-    match slopes {
-        [first, .., last] if slopes.len() > 6 => format!("{first} to {last} ({} slopes)", slopes.len()),
-        _ => slopes.iter().map(|s| format!("{s}")).collect::<Vec<_>>().join(", "),
-    }
-}
-
-/// The slopes (degrees, signed as given) strictly above the terrain's last measured point,
-/// where docs/model.md §7 extrapolates.
-pub fn beyond_last_point(terrain: &Terrain, slopes_deg: &[f64]) -> Vec<f64> {
-    // One rule for "extrapolated": the library's (docs/model.md §7).
-    let extrapolated =
-        |d: f64| sandslope::Slope::from_signed_degrees(d).is_ok_and(|s| terrain.extrapolates(s));
-    slopes_deg.iter().copied().filter(|&d| extrapolated(d)).collect()
-}
+pub use sandslope_request::scenario::beyond_last_point;
 
 /// Checks a command-line number: finite and within `lo..=hi`, naming the flag (`hi` infinite:
 /// no upper bound).
@@ -310,12 +289,5 @@ mod tests {
             assert!(parse_max_risk(bad).unwrap_err().contains("strictly between 0 and 1"), "{bad}");
         }
         assert!(parse_max_risk("x").unwrap_err().contains("`x` is not a number"));
-    }
-
-    #[test]
-    fn long_slope_lists_are_summarised_in_messages() {
-        assert_eq!(slope_list_text(&[25.0, 26.0]), "25, 26");
-        let many: Vec<f64> = (0..1000).map(|i| 25.0 + f64::from(i) * 0.001).collect();
-        assert_eq!(slope_list_text(&many), format!("25 to {} (1000 slopes)", many[999]));
     }
 }

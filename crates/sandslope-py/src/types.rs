@@ -233,6 +233,13 @@ impl PyTerrain {
         Ok(d)
     }
 
+    /// The warning every front end gives for answers at `slopes_deg` above the last measured
+    /// point (docs/model.md §7), or None: the request layer's rule and message.
+    fn _extrapolation_warning(&self, slopes_deg: Vec<f64>) -> Option<String> {
+        let beyond = sandslope_request::scenario::beyond_last_point(&self.inner, &slopes_deg);
+        sandslope_request::scenario::extrapolation_warning(&self.inner, &beyond)
+    }
+
     fn __repr__(&self) -> String {
         let spec = self.inner.spec();
         let points: Vec<String> = spec

@@ -112,6 +112,34 @@ pub fn load_terrain(terrain: &str) -> Result<Terrain> {
     sandslope_io::load_terrain(terrain).map_err(|e| RequestError::from_error(Some("terrain"), e))
 }
 
+/// The slopes (degrees, signed as given) strictly above the terrain's last measured point,
+/// where docs/model.md §7 extrapolates: the library's rule ([`Terrain::extrapolates`]).
+pub fn beyond_last_point(terrain: &Terrain, slopes_deg: &[f64]) -> Vec<f64> {
+    let extrapolated =
+        |d: f64| sandslope::Slope::from_signed_degrees(d).is_ok_and(|s| terrain.extrapolates(s));
+    slopes_deg.iter().copied().filter(|&d| extrapolated(d)).collect()
+}
+
+/// The warning every front end gives when it answers at `slopes_deg` (already found beyond
+/// the last point by [`beyond_last_point`]): none when there are none or the terrain has no
+/// points. The slopes are listed up to six, else as the first and last and how many (a
+/// `sweep --step 0.001` warning once listed 10,000 slopes on one 59 KB line).
+pub fn extrapolation_warning(terrain: &Terrain, slopes_deg: &[f64]) -> Option<String> {
+    let last = terrain.points().last()?;
+    let list = match slopes_deg {
+        [] => return None,
+        [first, .., last] if slopes_deg.len() > 6 => {
+            format!("{first} to {last} ({} slopes)", slopes_deg.len())
+        }
+        _ => slopes_deg.iter().map(|s| format!("{s}")).collect::<Vec<_>>().join(", "),
+    };
+    Some(format!(
+        "slope(s) {list} deg are above the terrain's last measured point ({} deg); k_n and k_s are \
+         extrapolated linearly and floored at zero (docs/model.md §7)",
+        last.slope_deg
+    ))
+}
+
 /// Parses a level-step rule (`slope` or `level`, docs/model.md §3).
 pub fn parse_level_step(s: &str) -> std::result::Result<LevelStep, String> {
     match s {
@@ -174,5 +202,27 @@ impl ScenarioRequest {
         let robot = self.robot.load()?.with_level_step(self.level_step);
         Scenario::new(robot, load_terrain(&self.terrain)?, k_n, k_s)
             .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rule is the library's (strictly above the last point, 24 degrees on the built-in
+    /// sand, either sign) and long lists are summarised in the message.
+    #[test]
+    fn extrapolated_slopes_are_found_once_and_summarised() {
+        let terrain = load_terrain(DEFAULT_TERRAIN).unwrap();
+        assert_eq!(beyond_last_point(&terrain, &[10.0, 24.0, 25.0, -26.0]), vec![25.0, -26.0]);
+        assert_eq!(extrapolation_warning(&terrain, &[]), None);
+        let two = extrapolation_warning(&terrain, &[25.0, 26.0]).unwrap();
+        assert!(
+            two.starts_with("slope(s) 25, 26 deg are above the terrain's last measured point (24 deg)"),
+            "{two}"
+        );
+        let many: Vec<f64> = (0..1000).map(|i| 25.0 + f64::from(i) * 0.001).collect();
+        let text = extrapolation_warning(&terrain, &many).unwrap();
+        assert!(text.starts_with(&format!("slope(s) 25 to {} (1000 slopes) deg", many[999])), "{text}");
     }
 }

@@ -184,21 +184,12 @@ def predict(
 
 
 def _warn_extrapolated(terrain: Terrain, slopes: np.ndarray) -> None:
-    """The CLI's warning when slopes lie above the terrain's last measured point (docs/model.md §7)."""
-    points = terrain.to_dict()["points"]
-    if not points:
-        return
-    last = max(p["slope_deg"] for p in points)
-    beyond = np.unique(np.abs(slopes[np.isfinite(slopes)]))
-    beyond = beyond[beyond > last]
-    if beyond.size:
-        shown = ", ".join(f"{v:g}" for v in beyond[:6]) + (f" ... ({beyond.size} slopes)" if beyond.size > 6 else "")
-        _warnings.warn(
-            f"slope(s) {shown} deg are above the terrain's last measured point ({last:g} deg); k_n and k_s are "
-            "extrapolated linearly and floored at zero (docs/model.md §7)",
-            UserWarning,
-            stacklevel=3,
-        )
+    """The CLI's warning when slopes lie above the terrain's last measured point (docs/model.md §7):
+    the rule and the message are the request layer's; each slope is named once."""
+    distinct = np.unique(np.abs(slopes[np.isfinite(slopes)]))
+    warning = terrain._extrapolation_warning(distinct.tolist())
+    if warning is not None:
+        _warnings.warn(warning, UserWarning, stacklevel=3)
 
 
 def _axis(name: str, x: Any) -> np.ndarray:

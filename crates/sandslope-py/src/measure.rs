@@ -15,7 +15,7 @@ use sandslope::Robot;
 use sandslope_io::mocap::MocapFormat;
 use sandslope_request::error::Words;
 use sandslope_request::fit::{FitAnswer, FitRequest};
-use sandslope_request::track::{Touchdowns, TrackRequest, Tracked};
+use sandslope_request::track::{Touchdowns, TrackRequest};
 
 use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
@@ -104,21 +104,10 @@ pub fn track<'py>(
         stride_period_s: period,
     };
     request.options(Words::Keyword).map_err(|e| value_error(e.message()))?;
-    let Tracked { captures, result, .. } =
+    let tracked =
         py.detach(|| request.answer(Words::Keyword, &mut || ())).map_err(|e| value_error(e.message()))?;
-    let d = pythonize(py, &result).map_err(value_error)?.cast_into::<PyDict>()?;
-    let missing = || value_error("track result without recordings or per_step");
-    let recordings = d.get_item("recordings")?.ok_or_else(missing)?;
-    for (i, c) in captures.iter().enumerate() {
-        let r = recordings.get_item(i)?;
-        r.set_item("file", c.path.display().to_string())?;
-        r.set_item("format", c.format.name())?;
-        r.set_item("body", &c.body)?;
-    }
-    let files: Vec<String> = captures.iter().map(|c| c.path.display().to_string()).collect();
-    let steps = d.get_item("per_step")?.ok_or_else(missing)?;
-    for (i, st) in result.per_step.iter().enumerate() {
-        steps.get_item(i)?.set_item("file", &files[st.recording])?;
-    }
+    // The answer `track --json` prints, assembled once in the request layer.
+    let answer = tracked.answer().map_err(value_error)?;
+    let d = pythonize(py, &answer).map_err(value_error)?.cast_into::<PyDict>()?;
     Ok(d)
 }

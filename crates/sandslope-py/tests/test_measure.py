@@ -51,6 +51,10 @@ def test_track_matches_cli(cli, root):
     assert isinstance(got["per_step"], pd.DataFrame) and len(got["per_step"]) == want["steps"]
     np.testing.assert_allclose(got["per_step"]["speed_m_s"], [s["speed_m_s"] for s in want["per_step"]], rtol=1e-12)
     assert got["recordings"]["format"][0] == "vicon"
+    # The same keys as --json, down to each step's and recording's (one answer, issue 40).
+    assert set(got) == set(want)
+    assert list(got["per_step"].columns) == list(want["per_step"][0])
+    assert list(got["recordings"].columns) == list(want["recordings"][0])
     # The paper's 4.98 cm/s at 20 degrees (examples/tracking/truth.csv), to within the noise.
     assert got["speed_m_s"] == pytest.approx(0.0498, abs=0.003)
 

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use sandslope::gait::{track, GaitOptions, Recording, TrackResult, Upslope};
+use sandslope::gait::{track, GaitOptions, Recording, RecordingSummary, TrackResult, Upslope};
 use sandslope::{GaitError, Slope};
 use sandslope_io::mocap::{self, Capture, MocapFormat};
 
@@ -62,6 +62,73 @@ pub struct Tracked {
     pub names: Vec<String>,
     /// The pooled analysis.
     pub result: TrackResult,
+}
+
+/// One step as every front end prints it (`track --csv`, the `per_step` of `--json` and of
+/// Python's `track`): the library's row with its recording's file instead of its index.
+#[derive(Debug, Clone, Serialize)]
+pub struct StepRecord<'a> {
+    /// The recording's file, as displayed.
+    pub file: &'a str,
+    /// Touchdown time t0, s (recording clock).
+    pub touchdown_s: f64,
+    /// Anchoring time t1 - t0, s, if the step anchored.
+    pub t1_s: Option<f64>,
+    /// Backward slip between t0 and t1, m.
+    pub slip_m: Option<f64>,
+    /// Net displacement upslope over the step, m.
+    pub step_m: f64,
+    /// Step-averaged speed, m/s.
+    pub speed_m_s: f64,
+}
+
+/// One recording as printed: where it came from, then the library's summary.
+#[derive(Debug, Clone, Serialize)]
+struct RecordingRecord<'a> {
+    file: &'a str,
+    format: &'static str,
+    body: &'a str,
+    #[serde(flatten)]
+    summary: &'a RecordingSummary,
+}
+
+impl Tracked {
+    /// Every step with its file instead of its recording's index.
+    pub fn step_records(&self) -> Vec<StepRecord<'_>> {
+        self.result
+            .per_step
+            .iter()
+            .map(|st| StepRecord {
+                file: &self.names[st.recording],
+                touchdown_s: st.step.touchdown_s,
+                t1_s: st.step.anchoring_time_s,
+                slip_m: st.step.slip_m,
+                step_m: st.step.step_m,
+                speed_m_s: st.step.speed_m_s,
+            })
+            .collect()
+    }
+
+    /// The answer (what `track --json` prints and Python's `track` returns): the library's
+    /// value, with each recording's file, format and body, and each step's file.
+    pub fn answer(&self) -> serde_json::Result<serde_json::Value> {
+        let mut v = serde_json::to_value(&self.result)?;
+        let recordings: Vec<RecordingRecord> = self
+            .captures
+            .iter()
+            .zip(&self.names)
+            .zip(&self.result.recordings)
+            .map(|((c, f), summary)| RecordingRecord {
+                file: f,
+                format: c.format.name(),
+                body: &c.body,
+                summary,
+            })
+            .collect();
+        v["recordings"] = serde_json::to_value(recordings)?;
+        v["per_step"] = serde_json::to_value(self.step_records())?;
+        Ok(v)
+    }
 }
 
 /// How each front end names this request's fields: the command line's flags are the

@@ -7,14 +7,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
-use serde::Serialize;
 
-use sandslope::gait::{RecordingSummary, TouchdownSource, TrackResult, DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP};
+use sandslope::gait::{TouchdownSource, TrackResult, DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP};
 use sandslope::Scenario;
 use sandslope_request::error::Words;
-use sandslope_request::track::{Touchdowns, TrackRequest, Tracked};
+use sandslope_request::track::{Touchdowns, TrackRequest};
 
-use crate::args::{check_flag, RobotArgs, TerrainArgs};
+use crate::args::{RobotArgs, TerrainArgs};
 use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, warn_without_steps};
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
 use sandslope_io::mocap::{Capture, MocapFormat};
@@ -72,57 +71,6 @@ pub struct TrackArgs {
     pub format_args: FormatArgs,
 }
 
-/// One step as printed by `--csv`: the library's row with its file instead of its index.
-#[derive(Debug, Clone, Serialize)]
-struct StepRecord<'a> {
-    file: &'a str,
-    touchdown_s: f64,
-    t1_s: Option<f64>,
-    slip_m: Option<f64>,
-    step_m: f64,
-    speed_m_s: f64,
-}
-
-/// One recording as printed: where it came from, then the library's summary.
-#[derive(Debug, Clone, Serialize)]
-struct RecordingRecord<'a> {
-    file: &'a str,
-    format: &'static str,
-    body: &'a str,
-    #[serde(flatten)]
-    summary: &'a RecordingSummary,
-}
-
-/// The result as printed by `--json`: the library's value, with each recording's file,
-/// format and body, and each step's file.
-fn json_value(captures: &[Capture], files: &[String], r: &TrackResult) -> Result<serde_json::Value> {
-    let mut v = serde_json::to_value(r)?;
-    let recordings: Vec<RecordingRecord> = captures
-        .iter()
-        .zip(files)
-        .zip(&r.recordings)
-        .map(|((c, f), summary)| RecordingRecord { file: f, format: c.format.name(), body: &c.body, summary })
-        .collect();
-    v["recordings"] = serde_json::to_value(recordings)?;
-    v["per_step"] = serde_json::to_value(step_records(files, r))?;
-    Ok(v)
-}
-
-/// Every step with its file instead of its recording's index.
-fn step_records<'a>(files: &'a [String], r: &TrackResult) -> Vec<StepRecord<'a>> {
-    r.per_step
-        .iter()
-        .map(|st| StepRecord {
-            file: &files[st.recording],
-            touchdown_s: st.step.touchdown_s,
-            t1_s: st.step.anchoring_time_s,
-            slip_m: st.step.slip_m,
-            step_m: st.step.step_m,
-            speed_m_s: st.step.speed_m_s,
-        })
-        .collect()
-}
-
 /// Appends one row to a speeds file (creating it with its header), atomically, after checking
 /// that the existing file is one `sandslope calibrate` can read; returns all rows now in it.
 fn append_speed(path: &Path, row: SpeedRow) -> Result<Vec<SpeedRow>> {
@@ -161,7 +109,8 @@ pub fn run(args: TrackArgs) -> Result<()> {
     // and the model curve of --plot is that robot's too.
     let robot = args.robot.load()?;
     let period = robot.stride_period();
-    let slope = args.slope.map(|d| check_flag("--slope", d, 0.0, 89.999)).transpose()?;
+    // --slope is checked once, by the request (a slope from 0 to below 90 degrees).
+    let slope = args.slope;
     if args.speeds_out.is_some() && slope.is_none() {
         bail!("--speeds-out needs --slope (the slope of these recordings, degrees)");
     }
@@ -192,7 +141,7 @@ pub fn run(args: TrackArgs) -> Result<()> {
     bar.finish_and_clear();
     let tracked = tracked?;
     warn_without_steps(&tracked.names, &tracked.result, &options);
-    let Tracked { captures, names, result } = tracked;
+    let result = &tracked.result;
 
     let mut campaign = None;
     if let (Some(path), Some(slope_deg)) = (&args.speeds_out, slope) {
@@ -230,18 +179,18 @@ pub fn run(args: TrackArgs) -> Result<()> {
             }
             None => Vec::new(),
         };
-        let fig = crate::figures::track::TrackFigure::new(&result, overlay, &model);
+        let fig = crate::figures::track::TrackFigure::new(result, overlay, &model);
         crate::figures::save(path, &fig)?;
     }
 
     match args.format_args.format() {
-        Format::Json => print_json(&json_value(&captures, &names, &result)?),
+        Format::Json => print_json(&tracked.answer()?),
         Format::Csv => {
-            print!("{}", csv_string(&step_records(&names, &result))?);
+            print!("{}", csv_string(&tracked.step_records())?);
             Ok(())
         }
         Format::Table => {
-            print_table(&result, &captures, &names);
+            print_table(result, &tracked.captures, &tracked.names);
             Ok(())
         }
     }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use serde::Serialize;
+use sandslope_render::rows::FitRow;
 
 use sandslope::measure::campaign::dropped_text;
 use sandslope::measure::{AirMode, Campaign};
@@ -110,31 +110,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     match args.format.format() {
         Format::Json => print_json(&campaign),
         Format::Csv => {
-            #[derive(Serialize)]
-            struct Row {
-                slope_deg: f64,
-                k_n: f64,
-                k_n_sd: f64,
-                k_s: f64,
-                k_s_sd: f64,
-                trials_penetration: usize,
-                trials_shear: usize,
-                interpolated: String,
-            }
-            let rows: Vec<Row> = campaign
-                .points
-                .iter()
-                .map(|p| Row {
-                    slope_deg: p.slope_deg,
-                    k_n: p.k_n.mean,
-                    k_n_sd: p.k_n.sd,
-                    k_s: p.k_s.mean,
-                    k_s_sd: p.k_s.sd,
-                    trials_penetration: p.k_n.trials,
-                    trials_shear: p.k_s.trials,
-                    interpolated: p.notes().join("; "),
-                })
-                .collect();
+            let rows: Vec<FitRow> = campaign.points.iter().map(FitRow::of).collect();
             print!("{}", csv_string(&rows)?);
             Ok(())
         }

@@ -12,7 +12,6 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::ProgressBar;
-use serde::Serialize;
 
 use sandslope::risk::{
     DefaultsUsed, PayloadEnvelope, RiskAnswer, RiskMapAnswer, RiskPoint, SafeLimit, SafeMass, SafeSlope,
@@ -31,6 +30,7 @@ use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
 use crate::output::{csv_string, num, print_json, sci, table, Format};
 use crate::progress::progress_bar;
+use sandslope_render::rows::{MassRow, RiskRow, SafeSlopeRow};
 
 /// What `--solve` finds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -159,46 +159,6 @@ impl Progress for Bar {
     }
 }
 
-/// One slope as printed by `--csv`: [`RiskPoint`] flattened.
-#[derive(Debug, Clone, Serialize)]
-struct RiskRow {
-    slope_deg: f64,
-    cv_n: f64,
-    cv_s: f64,
-    p_fail: f64,
-    p_not_success: f64,
-    p_success: f64,
-    p_metastable: f64,
-    p_slippage: f64,
-    p_sinkage: f64,
-}
-
-impl RiskRow {
-    fn of(p: &RiskPoint) -> RiskRow {
-        RiskRow {
-            slope_deg: p.slope_deg,
-            cv_n: p.uncertainty.cv_n,
-            cv_s: p.uncertainty.cv_s,
-            p_fail: p.p_fail,
-            p_not_success: p.p_not_success,
-            p_success: p.probabilities.success,
-            p_metastable: p.probabilities.metastable,
-            p_slippage: p.probabilities.slippage,
-            p_sinkage: p.probabilities.sinkage,
-        }
-    }
-}
-
-/// One slope of `--solve mass` as printed by `--csv`.
-#[derive(Serialize)]
-struct MassRow {
-    slope_deg: f64,
-    max_risk: f64,
-    robot_mass_kg: f64,
-    max_mass_kg: Option<f64>,
-    max_payload_kg: Option<f64>,
-}
-
 /// One slope limit in words: `p` names the probability it bounds (`p_fail` or
 /// `P(not success)`). A limit at the angle of repose ([`SafeLimit::Repose`]: there p_fail
 /// jumps to 1, the sand flows) is named as the repose, not as a risk threshold.
@@ -275,7 +235,7 @@ pub fn run(args: RiskArgs) -> Result<()> {
             match format {
                 Format::Json => print_json(&RiskAnswer::Mass(sol)),
                 Format::Csv => {
-                    print!("{}", csv_string(&[mass_row(&sol)])?);
+                    print!("{}", csv_string(&[MassRow::of(&sol)])?);
                     Ok(())
                 }
                 Format::Table => {
@@ -317,21 +277,7 @@ fn print_slope_limits(sol: SafeSlope, format: Format) -> Result<()> {
     match format {
         Format::Json => print_json(&RiskAnswer::Slope(Box::new(sol))),
         Format::Csv => {
-            #[derive(Serialize)]
-            struct Row<'a> {
-                max_risk: f64,
-                success_slope_deg: Option<f64>,
-                success_limit_kind: &'a str,
-                safe_slope_deg: Option<f64>,
-                safe_limit_kind: &'a str,
-            }
-            let row = Row {
-                max_risk: sol.max_risk,
-                success_slope_deg: sol.success_slope_deg,
-                success_limit_kind: sol.success_limit.kind(),
-                safe_slope_deg: sol.safe_slope_deg,
-                safe_limit_kind: sol.limit.kind(),
-            };
+            let row = SafeSlopeRow::of(&sol);
             print!("{}", csv_string(&[row])?);
             Ok(())
         }
@@ -414,17 +360,7 @@ fn print_envelope(env: PayloadEnvelope, format: Format) -> Result<()> {
     match format {
         Format::Json => print_json(&RiskAnswer::Envelope(Box::new(env))),
         Format::Csv => {
-            let rows: Vec<MassRow> = env
-                .points
-                .iter()
-                .map(|p| MassRow {
-                    slope_deg: p.slope_deg,
-                    max_risk: env.max_risk,
-                    robot_mass_kg: env.robot_mass_kg,
-                    max_mass_kg: p.max_mass_kg,
-                    max_payload_kg: p.max_payload_kg,
-                })
-                .collect();
+            let rows = MassRow::envelope(&env);
             print!("{}", csv_string(&rows)?);
             Ok(())
         }
@@ -491,16 +427,6 @@ fn describe_mass_limit(sol: &SafeMass) -> String {
             "p_fail < {} at {} deg for every total mass up to {up_to:.4} kg searched (p_fail there {p_fail:.4})",
             sol.max_risk, sol.slope_deg
         ),
-    }
-}
-
-fn mass_row(s: &SafeMass) -> MassRow {
-    MassRow {
-        slope_deg: s.slope_deg,
-        max_risk: s.max_risk,
-        robot_mass_kg: s.robot_mass_kg,
-        max_mass_kg: s.max_mass_kg,
-        max_payload_kg: s.max_payload_kg,
     }
 }
 

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
-use serde::Serialize;
+use sandslope_render::rows::{EnsembleRow, SimSlopeRow};
 
 use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::figures;
@@ -16,7 +16,6 @@ use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
 use crate::progress::{progress_bar, spinner};
-use sandslope::simulate::ensemble::perturbed_mass;
 use sandslope::simulate::mechanisms::{CONSTANT_SPEED_DUTY, UNDISTURBED_SAND};
 use sandslope::simulate::{BodyPitch, Mechanisms, RftScaling, SimSummary, Simulation};
 use sandslope_io::load_speeds;
@@ -313,42 +312,8 @@ fn print_one(sim: &Simulation) {
     }
 }
 
-/// One row of `simulate --slopes --csv`.
-#[derive(Serialize)]
-struct SlopeRow {
-    slope_deg: f64,
-    speed_m_s: f64,
-    t1_s: Option<f64>,
-    slip_m: Option<f64>,
-    step_m: f64,
-    max_depth_m: f64,
-    max_pitch_deg: f64,
-    pitch_over_s: Option<f64>,
-    regime: &'static str,
-    cause: &'static str,
-    closed_form_speed_m_s: Option<f64>,
-    closed_form_t1_s: Option<f64>,
-    closed_form_slip_m: Option<f64>,
-    closed_form_step_m: Option<f64>,
-    closed_form_regime: &'static str,
-}
-
 /// What a walk with the body free to pitch is (docs/simulate.md, "Pitch free").
 const FREE_NOTE: &str = "body pitch free (--body-pitch free): the free body's pitch is unstable on slopes (walks 1e-9 apart part within seconds), so one walk is one draw of a spread; --ensemble N gives the spread (docs/simulate.md)";
-
-/// One row of `simulate --ensemble N --csv`: one walk.
-#[derive(Serialize)]
-struct EnsembleRow {
-    walk: usize,
-    mass_kg: f64,
-    speed_m_s: f64,
-    t1_s: Option<f64>,
-    step_m: f64,
-    max_pitch_deg: f64,
-    pitch_over_s: Option<f64>,
-    regime: &'static str,
-    cause: &'static str,
-}
 
 fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
     let quiet = args.format.format() != Format::Table;
@@ -359,23 +324,7 @@ fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
     match args.format.format() {
         Format::Json => print_json(&Answer::Ensemble(Box::new(e)))?,
         Format::Csv => {
-            let mass = walks.scenario.robot().mass();
-            let rows: Vec<EnsembleRow> = e
-                .summaries
-                .iter()
-                .enumerate()
-                .map(|(k, m)| EnsembleRow {
-                    walk: k,
-                    mass_kg: perturbed_mass(mass, k),
-                    speed_m_s: m.speed_m_s,
-                    t1_s: m.t1_s,
-                    step_m: m.step_m,
-                    max_pitch_deg: m.max_pitch_deg,
-                    pitch_over_s: m.pitch_over_s,
-                    regime: m.regime.name(),
-                    cause: m.cause.name(),
-                })
-                .collect();
+            let rows = EnsembleRow::rows(&e, walks.scenario.robot().mass());
             print!("{}", csv_string(&rows)?);
         }
         Format::Table => {
@@ -426,29 +375,7 @@ fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedOb
     match args.format.format() {
         Format::Json => print_json(&Answer::Many(summaries))?,
         Format::Csv => {
-            let rows: Vec<SlopeRow> = summaries
-                .iter()
-                .map(|m| {
-                    let p = &m.closed_form.prediction;
-                    SlopeRow {
-                        slope_deg: m.slope_deg,
-                        speed_m_s: m.speed_m_s,
-                        t1_s: m.t1_s,
-                        slip_m: m.slip_m,
-                        step_m: m.step_m,
-                        max_depth_m: m.max_depth_m,
-                        max_pitch_deg: m.max_pitch_deg,
-                        pitch_over_s: m.pitch_over_s,
-                        regime: m.regime.name(),
-                        cause: m.cause.name(),
-                        closed_form_speed_m_s: m.closed_form.speed(),
-                        closed_form_t1_s: p.anchoring_time,
-                        closed_form_slip_m: p.slip,
-                        closed_form_step_m: p.step,
-                        closed_form_regime: p.regime.name(),
-                    }
-                })
-                .collect();
+            let rows: Vec<SimSlopeRow> = summaries.iter().map(SimSlopeRow::of).collect();
             print!("{}", csv_string(&rows)?);
         }
         Format::Table => {

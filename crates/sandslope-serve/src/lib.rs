@@ -7,8 +7,8 @@
 //! `sandslope-request`, the one the command line builds from its flags (same fields, defaults,
 //! checks and messages), and answered with the same library value the command's `--json`
 //! prints, serialised the same way, so the two bodies are equal byte for byte. This crate
-//! knows neither clap nor the command line: the CLI's `serve` only parses its flags into a
-//! [`ServeConfig`] and calls [`run`].
+//! depends on neither the command-line crate nor its argument parser: the CLI's `serve` only
+//! parses its flags into a [`ServeConfig`] and calls [`run`].
 //!
 //! Files, from the bottom up: [`reply`] (what every route answers with) and [`served`] (what
 //! the server was started with); [`api`] (`/api/<command>`), [`data`] (`/data/...` and

@@ -132,6 +132,13 @@ pub(crate) struct Walker {
     duty: f64,
     /// Disturbed sand (§20.3), if it resists less than undisturbed sand.
     trench: Option<Trench>,
+    /// Per leg, the leg whose contacts stand for it this step: itself, or with the pitch
+    /// locked the first leg of its tripod at the same angle (coincident legs, docs/model.md
+    /// §17), whose contacts then carry the group's summed weight.
+    twin: Vec<usize>,
+    /// The body rates (bits) at which `forces` were last evaluated under the walk's own law
+    /// (its creep, not the associated stand-in) in this solve, if they were.
+    forces_at: Option<[u64; 3]>,
 }
 
 impl Walker {
@@ -206,6 +213,8 @@ impl Walker {
             duty: settings.mechanisms.duty_cycle,
             trench: (settings.mechanisms.disturbed_sand < 1.0)
                 .then(|| Trench::new(settings.mechanisms.disturbed_sand, legs)),
+            twin: (0..legs).collect(),
+            forces_at: None,
         };
         w.reach = w.nodes.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) * (1.0 + 1e-9);
         for j in 0..legs {
@@ -313,6 +322,28 @@ impl Walker {
         self.turned = turned;
     }
 
+    /// Gives each leg's contacts the weight of the legs it stands for ([`Walker::twin`]) and
+    /// moves their point of application along the body to the group's mean hip (the pitch is
+    /// zero, so the body's axis is the slope's x): the group's summed force and moment.
+    fn carry_twins(&mut self) {
+        let legs = self.twin.len();
+        for first in 0..legs {
+            let (mut count, mut offset) = (0usize, 0.0);
+            for j in (first..legs).filter(|&j| self.twin[j] == first) {
+                count += 1;
+                offset += self.hips[j] - self.hips[first];
+            }
+            if count < 2 {
+                continue;
+            }
+            let (n, shift) = (count as f64, offset / count as f64);
+            for c in self.contacts.iter_mut().filter(|c| c.leg == first) {
+                c.weight *= n;
+                c.rel[0] += shift;
+            }
+        }
+    }
+
     /// Records the belly's submerged elements.
     fn belly_contacts(&mut self, pitch_sc: (f64, f64)) {
         let (sp, cp) = pitch_sc;
@@ -361,6 +392,7 @@ impl Walker {
             v[2] = 0.0;
         }
         let eps = self.eps;
+        self.forces_at = None;
         if self.stuck && self.sticking(v, v_free, m) {
             return true;
         }
@@ -400,7 +432,10 @@ impl Walker {
 
     /// Takes `v` as the step's rates (leaving its forces in `self.forces`).
     fn finish(&mut self, v: [f64; 3], v_free: [f64; 3], m: [f64; 3], ok: bool) -> bool {
-        let _ = self.evaluate(v, v_free, m, self.eps, None, false);
+        // A converged Newton iterate was the last point evaluated: its forces are in place.
+        if self.forces_at != Some(v.map(f64::to_bits)) {
+            let _ = self.evaluate(v, v_free, m, self.eps, None, false);
+        }
         self.v = v;
         ok
     }
@@ -517,6 +552,7 @@ impl Walker {
             }
         }
         let mut r = [0.0; 3];
+        self.forces_at = (eps == self.eps && !associated).then(|| v.map(f64::to_bits));
         let mut phi = h * potential;
         for i in 0..3 {
             r[i] = m[i] * (v[i] - v_free[i]) - h * g[i];
@@ -539,9 +575,30 @@ impl Walker {
         let legs = self.psi.len();
         let pitch_sc = self.q[2].sin_cos();
         self.contacts.clear();
+        // Coincident legs (docs/model.md §17): with the pitch locked (exactly zero, so every
+        // hip at the same height) a tripod's legs at the same angle have the same submerged
+        // elements, tangents and arms, differing only by their hips' along-body offsets, and
+        // (the pitch rate being zero) the same element velocities, so the same stresses. Their
+        // forces are then one leg's times their number, and their moment about the centre of
+        // mass that force at their mean offset: the first leg's contacts carry the group, and
+        // the others are not placed at all (a third of the force evaluations; disturbed sand,
+        // which tells the legs' tracks apart, keeps every leg).
+        let merge = self.pitch_locked && self.trench.is_none();
         for j in 0..legs {
             let psi = self.psi[j];
-            self.leg_contacts(j, psi, pitch_sc);
+            let first = (0..j).find(|&i| {
+                merge
+                    && self.twin[i] == i
+                    && self.tripod[i] == self.tripod[j]
+                    && self.psi[i].to_bits() == psi.to_bits()
+            });
+            self.twin[j] = first.unwrap_or(j);
+            if first.is_none() {
+                self.leg_contacts(j, psi, pitch_sc);
+            }
+        }
+        if merge {
+            self.carry_twins();
         }
         self.belly_contacts(pitch_sc);
         for j in 0..legs {
@@ -621,6 +678,24 @@ impl Walker {
             o.force[1] += f[1];
             o.torque += c.arm[0] * f[1] - c.arm[1] * f[0];
             o.depth = o.depth.max(c.depth);
+        }
+        // Coincident legs share their first leg's contacts: each carries an equal part.
+        let legs = self.twin.len();
+        for first in 0..legs {
+            let count = self.twin.iter().filter(|&&t| t == first).count();
+            if count < 2 {
+                continue;
+            }
+            let n = count as f64;
+            let o = &mut self.legs_out[first];
+            o.force = [o.force[0] / n, o.force[1] / n];
+            o.torque /= n;
+            let share = *o;
+            for j in first + 1..legs {
+                if self.twin[j] == first {
+                    self.legs_out[j] = share;
+                }
+            }
         }
     }
 

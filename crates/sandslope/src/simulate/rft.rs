@@ -170,13 +170,28 @@ impl Rft {
         }
         let (tx, tz) = (tangent[0], tangent[1]);
         let (cos2b, sin2b) = (tx * tx - tz * tz, 2.0 * tx * tz);
-        for (b, d) in boundary.iter_mut().zip(direction_terms()) {
+        // One loop per scaling, without branches (the projection's `max` is `passive`'s test:
+        // a component along the motion of zero or less leaves the stress as it is, to the bit).
+        let point = |d: &DirectionTerms, kx: f64, kz: f64| {
             let sin2b = d.mirror * sin2b;
             let az = d.az[0] + cos2b * d.az[1] + sin2b * d.az[2];
             let ax = d.ax[0] + cos2b * d.ax[1] + sin2b * d.ax[2];
-            let (kx, kz) = self.scales(d.e[0], d.e[1]);
-            let st = passive((-d.mirror * kx * ax, kz * az), d.e[0], d.e[1]);
-            *b = [st.0, st.1];
+            let (sx, sz) = (-d.mirror * kx * ax, kz * az);
+            let [ex, ez] = d.e;
+            let along = (sx * ex + sz * ez).max(0.0);
+            [sx - along * ex, sz - along * ez]
+        };
+        let terms = direction_terms();
+        let (zx, zz) = (self.zeta_x, self.zeta_z);
+        match self.scaling {
+            RftScaling::Motion => {
+                for (b, d) in boundary.iter_mut().zip(terms) {
+                    let zeta = zz * d.e[1] * d.e[1] + zx * d.e[0] * d.e[0];
+                    *b = point(d, zeta, zeta);
+                }
+            }
+            RftScaling::Li2013 => boundary.iter_mut().zip(terms).for_each(|(b, d)| *b = point(d, zz, zz)),
+            RftScaling::Components => boundary.iter_mut().zip(terms).for_each(|(b, d)| *b = point(d, zx, zz)),
         }
         RestSet { boundary }
     }

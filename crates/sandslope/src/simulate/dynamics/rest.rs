@@ -76,8 +76,15 @@ impl Walker {
             return false;
         };
         let set = self.rest_set(c.leg == BELLY, c.tangent);
-        if !shares.iter().all(|&s| set.holds(s)) {
-            return false;
+        // Equal shares (the pitch locked: every element takes the mean) are tested once.
+        let mut tested: Option<[f64; 2]> = None;
+        for &s in &shares {
+            if tested != Some(s) {
+                if !set.holds(s) {
+                    return false;
+                }
+                tested = Some(s);
+            }
         }
         for (&k, s) in group.iter().zip(&shares) {
             let w = self.contacts[k].weight;

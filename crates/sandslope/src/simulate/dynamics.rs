@@ -304,7 +304,8 @@ impl Walker {
                 let b = [hip[0] + turned[k + 1][0], heights[k + 1]];
                 if let Some((mut weight, point, tangent, depth)) = submerged(a, b, self.width) {
                     if let Some(trench) = &mut self.trench {
-                        weight *= trench.factor_at(point[0], -point[1]);
+                        let (da, db) = (-a[1], -b[1]);
+                        weight *= trench.factor_over(point[0], da.min(db).max(0.0), da.max(db));
                         trench.sweep(j, a, b);
                     }
                     self.contacts.push(Contact {

@@ -190,13 +190,22 @@ impl Trench {
         (x / TRENCH_CELL_M).floor() as i64
     }
 
-    /// The resistance factor for an element of leg `_leg` whose centroid is at `x` and
-    /// `depth` below the surface: `factor` inside sand an earlier stance disturbed, else 1.
-    pub(crate) fn factor_at(&self, x: f64, depth: f64) -> f64 {
-        if depth <= self.done.get(Trench::cell(x)) {
+    /// The resistance factor for an element whose centroid is at `x` and whose submerged part
+    /// spans depths `lo` to `hi` (m below the surface): the share of its depth integral above
+    /// the disturbed depth `D` there resists at `factor`, the rest at 1 (docs/model.md §20.3).
+    /// Along a straight element the depth integral up to depth z grows as z^2, so that share is
+    /// `(D^2 - lo^2) / (hi^2 - lo^2)`, clamped to 0 and 1: the factor changes continuously as
+    /// an element digs past the trench's bottom (a step in it, at the centroid, made the walks
+    /// at 24 degrees move with the time step).
+    pub(crate) fn factor_over(&self, x: f64, lo: f64, hi: f64) -> f64 {
+        let d = self.done.get(Trench::cell(x));
+        if d <= lo {
+            1.0
+        } else if d >= hi {
             self.factor
         } else {
-            1.0
+            let share = (d * d - lo * lo) / (hi * hi - lo * lo);
+            1.0 - (1.0 - self.factor) * share
         }
     }
 
@@ -290,16 +299,21 @@ mod tests {
         t.end_step();
         // Still in the sand this step: nothing disturbed yet.
         t.sweep(0, [0.0, -0.01], [0.004, -0.01]);
-        assert_eq!(t.factor_at(0.002, 0.005), 1.0);
+        assert_eq!(t.factor_over(0.002, 0.004, 0.005), 1.0);
         t.end_step();
         // Leg 0 lifts out: its trench is done.
         t.end_step();
-        assert_eq!(t.factor_at(0.002, 0.005), 0.5);
-        assert_eq!(t.factor_at(0.002, 0.0099), 0.5);
+        assert_eq!(t.factor_over(0.002, 0.004, 0.005), 0.5);
+        assert_eq!(t.factor_over(0.002, 0.0, 0.01), 0.5);
         // Deeper than the trench, or beside it: undisturbed.
-        assert_eq!(t.factor_at(0.002, 0.011), 1.0);
-        assert_eq!(t.factor_at(0.006, 0.005), 1.0);
-        assert_eq!(t.factor_at(-0.002, 0.005), 1.0);
+        assert_eq!(t.factor_over(0.002, 0.011, 0.012), 1.0);
+        assert_eq!(t.factor_over(0.006, 0.004, 0.005), 1.0);
+        assert_eq!(t.factor_over(-0.002, 0.004, 0.005), 1.0);
+        // Across the bottom (10 mm), by hand: an element from the surface to 20 mm has a
+        // quarter of its depth integral (10^2 / 20^2) in the trench, so 1 - 0.5 / 4 = 0.875;
+        // from 5 to 15 mm, (100 - 25) / (225 - 25) = 0.375 of it, so 1 - 0.5 * 0.375 = 0.8125.
+        assert!((t.factor_over(0.002, 0.0, 0.02) - 0.875).abs() < 1e-12);
+        assert!((t.factor_over(0.002, 0.005, 0.015) - 0.8125).abs() < 1e-12);
     }
 
     /// A bed written from far downslope upwards and back (a robot sliding down, then

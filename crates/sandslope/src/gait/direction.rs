@@ -4,6 +4,7 @@
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::error::ParamError;
+use crate::Slope;
 
 /// A unit vector pointing upslope in the motion-capture frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,19 +85,19 @@ pub fn principal_direction(recordings: &[&[[f64; 3]]]) -> Option<Upslope> {
 /// travel to tell upslope from downslope.
 pub const MIN_ORIENTING_SLOPE_DEG: f64 = 1.0;
 
-/// The direction of travel `travel` oriented upslope by height: on a slope of `slope_deg`
-/// (> [`MIN_ORIENTING_SLOPE_DEG`]) a line of travel in the slope's plane rises by up to
+/// The direction of travel `travel` oriented upslope by height: on a slope `slope` (of at
+/// least [`MIN_ORIENTING_SLOPE_DEG`]) a line of travel in the slope's plane rises by up to
 /// sin(theta) per unit length, and upslope is the sense in which it rises along `up` (the
 /// capture frame's vertical axis). Whether the robot progressed or slid down does not enter.
 /// `None` (orient otherwise) on near-level ground, or when the travel rises by less than a
 /// quarter of sin(theta) per unit length (it runs across the slope, or `up` is not the
 /// frame's vertical axis).
-pub fn orient_by_height(travel: Upslope, up: Upslope, slope_deg: f64) -> Option<Upslope> {
-    if slope_deg.is_nan() || slope_deg.abs() < MIN_ORIENTING_SLOPE_DEG {
+pub fn orient_by_height(travel: Upslope, up: Upslope, slope: Slope) -> Option<Upslope> {
+    if slope.degrees() < MIN_ORIENTING_SLOPE_DEG {
         return None;
     }
     let rise = travel.along(up.vector());
-    if rise.abs() < 0.25 * slope_deg.abs().to_radians().sin() {
+    if rise.abs() < 0.25 * slope.sin() {
         return None;
     }
     let [x, y, z] = travel.vector();
@@ -124,13 +125,14 @@ mod tests {
         let up = Upslope::new([0.0, 0.0, 1.0]).unwrap();
         let rising = Upslope::new([c, 0.0, s]).unwrap();
         let falling = Upslope::new([-c, 0.0, -s]).unwrap();
-        assert_eq!(orient_by_height(rising, up, 20.0), Some(rising));
-        assert_eq!(orient_by_height(falling, up, 20.0).unwrap().vector(), rising.vector());
-        assert_eq!(orient_by_height(rising, up, 0.5), None);
+        let deg = |d: f64| Slope::from_degrees(d).unwrap();
+        assert_eq!(orient_by_height(rising, up, deg(20.0)), Some(rising));
+        assert_eq!(orient_by_height(falling, up, deg(20.0)).unwrap().vector(), rising.vector());
+        assert_eq!(orient_by_height(rising, up, deg(0.5)), None);
         let across = Upslope::new([0.0, 1.0, 0.0]).unwrap();
-        assert_eq!(orient_by_height(across, up, 20.0), None);
+        assert_eq!(orient_by_height(across, up, deg(20.0)), None);
         // Y-up taken for this Z-up frame: the travel does not rise along y.
-        assert_eq!(orient_by_height(rising, Upslope::new([0.0, 1.0, 0.0]).unwrap(), 20.0), None);
+        assert_eq!(orient_by_height(rising, Upslope::new([0.0, 1.0, 0.0]).unwrap(), deg(20.0)), None);
     }
 
     #[test]

@@ -106,7 +106,7 @@ pub fn track(
         (None, Some(up), Some(s)) => {
             let all: Vec<&[[f64; 3]]> = recordings.iter().map(|r| r.positions).collect();
             super::direction::principal_direction(&all)
-                .and_then(|travel| super::direction::orient_by_height(travel, up, s.degrees()))
+                .and_then(|travel| super::direction::orient_by_height(travel, up, s))
         }
         _ => None,
     };

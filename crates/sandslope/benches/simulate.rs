@@ -38,7 +38,7 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("simulate");
     group.sample_size(10);
     // One core: 10 s walks (the 1000 simulated seconds per wall second target means under
-    // 10 ms each), level and at 10 degrees, pitch free and locked.
+    // 10 ms each), level and at 10 degrees, pitch locked (the default) and free.
     let walk10 = SimSettings::new(10.0).unwrap();
     group.bench_function("one 10 s walk, level, one core", |b| {
         b.iter(|| simulate(black_box(&scenario), deg(0.0), &walk10).unwrap())
@@ -47,8 +47,9 @@ fn bench(c: &mut Criterion) {
     group.bench_function("one 10 s walk at 10 deg, pitch locked, one core", |b| {
         b.iter(|| simulate(black_box(&scenario), deg(10.0), &locked).unwrap())
     });
-    group.bench_function("one 10 s walk at 10 deg, one core", |b| {
-        b.iter(|| simulate(black_box(&scenario), deg(10.0), &walk10).unwrap())
+    let free = walk10.with_body_pitch(sandslope::simulate::BodyPitch::Free);
+    group.bench_function("one 10 s walk at 10 deg, pitch free, one core", |b| {
+        b.iter(|| simulate(black_box(&scenario), deg(10.0), &free).unwrap())
     });
     // Two cores (rayon): 31 slopes of 10 s walks, 0 to 30 degrees, as `simulate --slopes 0:30:31`.
     let slopes: Vec<SignedSlope> = (0..31).map(|d| deg(f64::from(d))).collect();

@@ -40,8 +40,8 @@ pub fn report(
     simulator_fit: bool,
     html: Option<PathBuf>,
 ) -> PyResult<String> {
-    if let Some(dir) = html.as_ref().filter(|d| d.exists() && !d.is_dir()) {
-        return Err(value_error(format!("html = {}: exists and is not a folder", dir.display())));
+    if let Some(dir) = &html {
+        sandslope_render::report::check_dir("html =", dir).map_err(value_error)?;
     }
     let format: Option<MocapFormat> = tracks_format.map(str::parse).transpose().map_err(value_error)?;
     // The request `sandslope report` makes: its checks, its evidence and its answer.

@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use pythonize::{depythonize, pythonize};
 
+use sandslope::robot_key::RobotKey;
 use sandslope::{Robot, RobotSpec, Slope, Terrain, TerrainSpec};
 use sandslope_io::files::{read_text, Source};
 use sandslope_io::presets::{self, PresetKind};
@@ -119,25 +120,18 @@ impl PyRobot {
     }
 
     fn __repr__(&self) -> String {
+        // The robot keys, from their one table (docs/model.md §2), optional ones where set.
         let s = self.inner.spec();
-        let mut parts = vec![
-            format!("mass_kg={}", py_float(s.mass_kg)),
-            format!("leg_radius_m={}", py_float(s.leg_radius_m)),
-            format!("leg_width_m={}", py_float(s.leg_width_m)),
-            format!("hip_height_m={}", py_float(s.hip_height_m)),
-            format!("leg_speed_rad_s={}", py_float(s.leg_speed_rad_s)),
-            format!("stance_legs={}", s.stance_legs),
-            format!("response_time_s={}", py_float(s.response_time_s)),
-        ];
-        for (k, v) in [
-            ("leg_contact_area_m2", s.leg_contact_area_m2),
-            ("level_step_m", s.level_step_m),
-            ("min_step_m", s.min_step_m),
-        ] {
-            if let Some(v) = v {
-                parts.push(format!("{k}={}", py_float(v)));
-            }
-        }
+        let parts: Vec<String> = RobotKey::ALL
+            .into_iter()
+            .filter_map(|k| {
+                let v = k.get(s)?;
+                Some(match k {
+                    RobotKey::StanceLegs => format!("{}={}", k.name(), s.stance_legs),
+                    _ => format!("{}={}", k.name(), py_float(v)),
+                })
+            })
+            .collect();
         format!("Robot({})", parts.join(", "))
     }
 

@@ -6,12 +6,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
+use sandslope::Slope;
 
 use sandslope::gait::GaitOptions;
 use sandslope::report::Evidence;
-use sandslope::Slope;
 use sandslope_io::mocap::MocapFormat;
 use sandslope_request::error::Words;
 use sandslope_request::report::{answer_evidence, ReportRequest, TracksAt};
@@ -105,6 +105,8 @@ fn parse_tracks(s: &str) -> Result<TracksArg, String> {
     };
     let slope_deg: f64 =
         deg.trim().parse().map_err(|_| format!("`{deg}` is not a slope in degrees; {TRACKS_FORM}"))?;
+    // Checked here too, before any pattern is expanded (ReportRequest checks it for every
+    // front end, after the files are found): a bad slope is named with the flag's form.
     if Slope::from_degrees(slope_deg).is_err() {
         return Err(format!("slope {slope_deg} is outside 0 to 90 degrees; {TRACKS_FORM}"));
     }
@@ -139,9 +141,7 @@ fn tracks(args: &ReportArgs) -> Result<Vec<TracksAt>> {
 
 /// Runs `sandslope report`.
 pub fn run(args: ReportArgs) -> Result<()> {
-    if args.out.exists() && !args.out.is_dir() {
-        bail!("--out {}: exists and is not a folder", args.out.display());
-    }
+    sandslope_render::report::check_dir("--out", &args.out)?;
     let evidence = evidence(&args)?;
     // Seconds in a release build (the simulator section walks 14 slopes twice), a minute in a
     // debug one: a spinner with the time on a terminal.

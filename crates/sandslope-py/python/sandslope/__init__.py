@@ -158,8 +158,7 @@ def predict(
     """
     robot = _robot(robot)
     terrain = None if terrain is None else _terrain(terrain)
-    if terrain is None and (k_n is None or k_s is None):
-        raise ValueError("give both k_n and k_s, or a terrain (k_n and k_s then override it)")
+    # Without a terrain both k_n and k_s are needed: the request layer checks it (point_terrain).
     inputs = {"slope_deg": _float_array("slope_deg", slope_deg)}
     for name, value in (("k_n", k_n), ("k_s", k_s), ("mass_kg", mass_kg)):
         if value is not None:

@@ -125,6 +125,15 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
     h
 }
 
+/// Refuses a report folder that exists and is not a folder, naming it as the front end does
+/// (`--out`, `html =`): checked before the report is built, which takes seconds.
+pub fn check_dir(name: &str, dir: &Path) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        anyhow::bail!("{name} {}: exists and is not a folder", dir.display());
+    }
+    Ok(())
+}
+
 /// Writes `report` into the folder `dir`, made with its missing parents: `index.html`, the
 /// [`page`] with every figure of [`page_figures`], and `report.json`, the value as pretty JSON.
 /// What `sandslope report --out DIR` and Python's `sandslope.report(html=DIR)` write. Page and

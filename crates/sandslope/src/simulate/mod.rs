@@ -517,7 +517,7 @@ pub fn simulate_with_leg(
         slope,
         &ground,
         settings,
-        leg.name(),
+        leg,
         dt,
         steps,
         closed_form,
@@ -560,7 +560,7 @@ fn summarise(
     slope: Slope,
     ground: &crate::terrain::Ground,
     settings: &SimSettings,
-    shape: &str,
+    leg: &dyn crate::leg::Leg,
     dt: f64,
     steps: Vec<SimStep>,
     closed_form: SlopeEvaluation,
@@ -586,8 +586,9 @@ fn summarise(
     let t1 = mean_of(&|s| s.anchoring_time_s.unwrap_or(0.0));
     let slip = mean_of(&|s| s.slip_m.unwrap_or(0.0));
     let max_depth = measured.iter().map(|s| s.max_depth_m).fold(0.0, f64::max);
-    let d_max = robot.max_depth();
-    // Sinkage: in most measured steps a leg went deeper than its reach from the rest height.
+    // Sinkage: in most measured steps a leg went deeper than its reach from the rest height
+    // (the walked leg's own reach, docs/model.md §3: a C-leg's 2R - h).
+    let d_max = leg.max_depth();
     let sunk_steps = measured.iter().filter(|s| s.max_depth_m > d_max * (1.0 + 1e-3)).count();
     let sunk = 2 * sunk_steps > measured.len();
     let step_for_regime = if anchored.is_empty() && step <= 0.0 { None } else { Some(step) };
@@ -607,7 +608,7 @@ fn summarise(
         duration_s: settings.duration_s,
         dt_s: dt,
         leg_elements: robot.leg_elements(),
-        shape: shape.to_string(),
+        shape: leg.name().to_string(),
         creep_m_s: settings.creep_m_s,
         servo_torque_limit_n_m: if settings.servo_limit { robot.servo_torque_limit() } else { None },
         unconverged_steps,

@@ -95,8 +95,10 @@ pub fn infer_servo_log<'py>(
         t.torque_n_m.push(torque[i]);
     }
     let settings = CurrentInferenceSettings { prior, grid_points, ..Default::default() };
+    let slope =
+        sandslope::SignedSlope::from_degrees(slope_deg).map_err(|e| value_error(e.renamed("slope_deg")))?;
     let (robot, terrain) = (robot.inner.clone(), terrain.inner.clone());
-    let answer = py.detach(|| infer(&robot, &terrain, slope_deg, &traces, &settings)).map_err(value_error)?;
+    let answer = py.detach(|| infer(&robot, &terrain, slope, &traces, &settings)).map_err(value_error)?;
     pythonize(py, &answer).map_err(value_error)
 }
 

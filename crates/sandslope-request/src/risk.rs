@@ -311,7 +311,7 @@ impl<'a> RiskProblem<'a> {
             None => {
                 let chunks = chunks(CURVE_SLOPES_PER_CHUNK, limits.curve_slopes, "a p_fail curve")?;
                 let parts = chunks.each(
-                    |chunk| risk_curve(robot, terrain, chunk),
+                    |chunk| Ok(risk_curve(robot, terrain, &signed(chunk)?)),
                     |e| match words {
                         Words::Flag => RequestError::invalid("slope", e.renamed("--slope")),
                         Words::Keyword => RequestError::invalid("slope", e),
@@ -344,7 +344,13 @@ impl<'a> RiskProblem<'a> {
         let hi = hi.min(89.5);
         let n = (hi / CURVE_FIGURE_STEP_DEG).round() as usize;
         let fine: Vec<f64> = (0..=n).map(|i| hi * i as f64 / n as f64).collect();
-        let curve = |slopes: &[f64]| risk_curve(self.robot, &self.terrain, slopes).map_err(|e| library(&e));
+        let curve = |slopes: &[f64]| {
+            Ok::<_, RequestError>(risk_curve(
+                self.robot,
+                &self.terrain,
+                &signed(slopes).map_err(|e| library(&e))?,
+            ))
+        };
         Ok(CurveSamples { hi, fine: curve(&fine)?.points, requested: curve(slopes)?.points })
     }
 }
@@ -388,7 +394,7 @@ fn envelope(
 ) -> Result<RiskAnswer> {
     let words = chunks.words;
     let parts = chunks.each(
-        |chunk| payload_envelope(robot, terrain, chunk, max_risk),
+        |chunk| payload_envelope(robot, terrain, &signed(chunk)?, max_risk),
         |e| match words {
             // The command line's message as it always was: the library's, unnamed.
             Words::Flag => RequestError::from_error(None, anyhow::anyhow!("{e}")),
@@ -501,4 +507,10 @@ pub fn map_axes_in(
         ));
     }
     Ok((k_n_axis, k_s_axis))
+}
+
+/// The slopes as the library takes them, each checked (an error keyed `slope_deg`, which the
+/// callers name as their front end does).
+fn signed(slopes: &[f64]) -> std::result::Result<Vec<SignedSlope>, ParamError> {
+    slopes.iter().map(|&d| SignedSlope::from_degrees(d).map_err(|e| e.renamed("slope_deg"))).collect()
 }

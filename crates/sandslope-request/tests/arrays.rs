@@ -95,7 +95,9 @@ fn a_risk_curve_in_chunks_is_the_whole_curve() {
     let answer = question(slopes.clone(), None).answer_on(&robot(), terrain(), limits, Words::Keyword, None);
     let RiskAnswer::Curve(points) = answer.unwrap() else { panic!("a curve") };
     let uncertain = UncertainTerrain::new(terrain(), None, None).unwrap();
-    assert_eq!(points, risk_curve(&robot(), &uncertain, &slopes).unwrap().points);
+    let signed: Vec<sandslope::SignedSlope> =
+        slopes.iter().map(|&d| sandslope::SignedSlope::from_degrees(d).unwrap()).collect();
+    assert_eq!(points, risk_curve(&robot(), &uncertain, &signed).points);
     let mut bad = slopes;
     bad[200] = 95.0;
     let e =

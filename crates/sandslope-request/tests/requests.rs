@@ -151,8 +151,9 @@ fn a_risk_problem_answers_the_command_lines_other_questions_from_one_check() {
     else {
         panic!("three slopes are a curve")
     };
-    let own =
-        risk_curve(&robot, &UncertainTerrain::new(bare(), None, None).unwrap(), &[0.0, 10.0, -20.0]).unwrap();
+    let slopes: Vec<sandslope::SignedSlope> =
+        [0.0, 10.0, -20.0].iter().map(|&d| sandslope::SignedSlope::from_degrees(d).unwrap()).collect();
+    let own = risk_curve(&robot, &UncertainTerrain::new(bare(), None, None).unwrap(), &slopes);
     assert_eq!(points, own.points);
     assert_eq!(defaults_used(&RiskAnswer::Curve(points.clone())), own.defaults_used);
     assert!(own.defaults_used.k_n && own.defaults_used.k_s);

@@ -9,7 +9,7 @@ use std::sync::atomic::AtomicBool;
 use sandslope::infer::servo::{model_grid, CurrentInferenceSettings, ModelGrid};
 use sandslope::infer::LogUniformPrior;
 use sandslope::servo::{xl330, GaitSchedule};
-use sandslope::{Robot, Scenario, Slope, Terrain};
+use sandslope::{Robot, Scenario, SignedSlope, Terrain};
 
 use crate::driver::{drive, DriveError, DriveReport, DynamixelBus, LiveEstimate, Monitor, ServoSample};
 use crate::emulator::{Emulator, EmulatorConfig, EmulatorFaults, EmulatorReport};
@@ -167,11 +167,11 @@ impl Session {
         let legs = config.settings.servos.len();
         let schedule =
             GaitSchedule::new(&config.robot, legs).map_err(|e| SessionError::Setting(e.to_string()))?;
-        let slope = Slope::from_signed_degrees(config.slope_deg)
+        let signed = SignedSlope::from_degrees(config.slope_deg)
             .map_err(|e| SessionError::Setting(e.renamed("--slope").to_string()))?;
         let (ground, _) = Scenario::new(config.robot.clone(), config.terrain.clone(), None, None)
             .map_err(|e| SessionError::Setting(e.to_string()))?
-            .ground_at(slope);
+            .ground_at(signed.felt());
         let k_n = ground.k_n;
         let grid = if config.monitor || config.settings.stop_on_risk.is_some() {
             // The prior reaches down to 1e4 N/m^3, below the library's default 3e4: sand that
@@ -187,7 +187,7 @@ impl Session {
                 ..Default::default()
             };
             Some(
-                model_grid(&config.robot, k_n, config.slope_deg, &inference)
+                model_grid(&config.robot, k_n, signed, &inference)
                     .map_err(|e| SessionError::Grid(e.to_string()))?,
             )
         } else {

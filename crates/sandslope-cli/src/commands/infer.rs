@@ -9,7 +9,7 @@ use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 
 use sandslope::infer::{Bound, InferLaw, LogUniformPrior};
-use sandslope::Slope;
+use sandslope::SignedSlope;
 use sandslope_request::error::Words;
 use sandslope_request::infer::{self, GaitEvidence, InferAnswer, InferRequest};
 
@@ -141,14 +141,14 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
             path.display()
         ),
     };
-    Slope::from_signed_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+    let slope = SignedSlope::from_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
     let terrain = args.terrain.load()?;
     let traces = log.leg_traces(2 * robot.stance_legs() as usize, path)?;
     for note in &log.notes {
         eprintln!("note: {}: {note}", path.display());
     }
     let settings = CurrentInferenceSettings { prior, grid_points: args.grid_points, ..Default::default() };
-    let answer = infer_servo_log(&robot, &terrain, slope_deg, &traces, &settings).map_err(|e| match e {
+    let answer = infer_servo_log(&robot, &terrain, slope, &traces, &settings).map_err(|e| match e {
         sandslope::infer::servo::CurrentInferenceError::TooFewStrides { .. }
         | sandslope::infer::servo::CurrentInferenceError::Setting(_) => anyhow!("{}: {e}", path.display()),
         e => anyhow!("{e}"),

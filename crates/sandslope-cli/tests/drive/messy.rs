@@ -203,7 +203,7 @@ fn grid(swing_offset: bool) -> ModelGrid {
         ..Default::default()
     };
     // k_n of the built-in terrain (glass beads) as the logs' header records it.
-    model_grid(&robot, 7e5, 20.0, &settings).unwrap()
+    model_grid(&robot, 7e5, sandslope::SignedSlope::from_degrees(20.0).unwrap(), &settings).unwrap()
 }
 
 /// Per defect, the 90% interval must hold the emulator's k_s in 9 of the 10 runs, and the

@@ -274,7 +274,7 @@ fn shear_table(problem: &Problem, candidate: &Candidate, robot: &Robot) -> Vec<S
         .into_iter()
         .filter_map(|deg| Slope::from_degrees(deg).ok().map(|s| (deg, s)))
         .map(|(deg, slope)| {
-            let k_s = problem.k_s(candidate, deg);
+            let k_s = problem.k_s(candidate, slope);
             ShearAtSlope {
                 slope_deg: deg,
                 k_n: problem.k_n(slope),

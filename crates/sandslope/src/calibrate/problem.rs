@@ -130,11 +130,11 @@ impl Problem<'_> {
         c
     }
 
-    /// The leg's k_s at `deg` degrees.
-    pub fn k_s(&self, c: &Candidate, deg: f64) -> f64 {
+    /// The leg's k_s at `slope`.
+    pub fn k_s(&self, c: &Candidate, slope: Slope) -> f64 {
         match self.law {
-            Some(law) => law.k_s(c.law, deg),
-            None => c.plate_scale * interpolate(&c.plate, deg),
+            Some(law) => law.k_s(c.law, slope),
+            None => c.plate_scale * interpolate(&c.plate, slope.degrees()),
         }
     }
 
@@ -166,10 +166,11 @@ impl Problem<'_> {
             .walk_slopes
             .iter()
             .map(|&deg| {
-                let k_n = self.k_n(Slope::from_degrees(deg).unwrap_or(Slope::LEVEL));
+                let slope = Slope::from_degrees(deg).unwrap_or(Slope::LEVEL);
+                let k_n = self.k_n(slope);
                 // A law or an extrapolated table can reach k_s <= 0 (no strength); the simulator
                 // needs a positive value, and 1 N/m^3 is no strength at all for a 0.35 kg robot.
-                (deg, k_n, self.k_s(c, deg).max(MIN_SIMULATED_K_S))
+                (deg, k_n, self.k_s(c, slope).max(MIN_SIMULATED_K_S))
             })
             .collect();
         Some(sim.walks(robot, &grounds))
@@ -203,12 +204,9 @@ impl Problem<'_> {
         for o in &self.setup.speeds {
             let model = match &walks {
                 Some(w) => self.walk_at(w, o.slope.degrees())?.speed,
-                None => continued_speed(
-                    robot,
-                    o.slope,
-                    self.level_step(robot, o.slope),
-                    self.k_s(&c, o.slope.degrees()),
-                ),
+                None => {
+                    continued_speed(robot, o.slope, self.level_step(robot, o.slope), self.k_s(&c, o.slope))
+                }
             };
             out.push(pull(
                 ObservationKind::Speed,
@@ -222,7 +220,7 @@ impl Problem<'_> {
         for o in &self.setup.anchoring {
             let model = match &walks {
                 Some(w) => self.walk_at(w, o.slope.degrees())?.t1,
-                None => continued_anchoring_time(robot, o.slope, self.k_s(&c, o.slope.degrees())),
+                None => continued_anchoring_time(robot, o.slope, self.k_s(&c, o.slope)),
             };
             out.push(pull(ObservationKind::AnchoringTime, o.slope, o.t1, o.t1_sd, o.t1_sd, model));
         }
@@ -265,9 +263,9 @@ impl Problem<'_> {
     /// k_s(20)/k_s(0) at `x`.
     pub fn ratio(&self, x: &[f64]) -> f64 {
         let c = self.candidate(x);
-        let level = self.k_s(&c, 0.0);
+        let level = self.k_s(&c, Slope::LEVEL);
         if level > 0.0 {
-            self.k_s(&c, 20.0) / level
+            self.k_s(&c, Slope::from_degrees(20.0).unwrap_or(Slope::LEVEL)) / level
         } else {
             f64::NAN
         }

@@ -124,7 +124,8 @@ pub(crate) fn ratio_interval(
     match problem.law {
         Some(ShearLaw::Linear) => find(Quantity::ShearRatio20).map(|p| p.estimate),
         Some(ShearLaw::Coulomb) => find(Quantity::FrictionAngle).map(|p| {
-            let r = |phi: f64| ShearLaw::Coulomb.k_s([1.0, phi], 20.0);
+            let twenty = crate::Slope::from_degrees(20.0).unwrap_or(crate::Slope::LEVEL);
+            let r = |phi: f64| ShearLaw::Coulomb.k_s([1.0, phi], twenty);
             Interval { value, lower: r(p.estimate.lower), upper: r(p.estimate.upper), ..p.estimate }
         }),
         None => {

@@ -2,6 +2,7 @@
 //! a smooth law of two parameters (docs/model.md §14).
 
 use crate::terrain::Terrain;
+use crate::Slope;
 
 /// A smooth law of k_s(theta) with two parameters, fitted when there are no force tests.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -15,15 +16,15 @@ pub enum ShearLaw {
 }
 
 impl ShearLaw {
-    /// k_s at `deg` degrees for the law's parameters `[k_s0, rho]` (linear) or `[k_s0, phi_deg]`
+    /// k_s at `slope` for the law's parameters `[k_s0, rho]` (linear) or `[k_s0, phi_deg]`
     /// (Coulomb), floored at 0, N/m^3.
-    pub fn k_s(self, params: [f64; 2], deg: f64) -> f64 {
+    pub fn k_s(self, params: [f64; 2], slope: Slope) -> f64 {
         match self {
             ShearLaw::Coulomb => {
-                let t = deg.to_radians();
+                let t = slope.radians();
                 (params[0] * (t.cos() - t.sin() / params[1].to_radians().tan())).max(0.0)
             }
-            ShearLaw::Linear => (params[0] * (1.0 + (params[1] - 1.0) * deg / 20.0)).max(0.0),
+            ShearLaw::Linear => (params[0] * (1.0 + (params[1] - 1.0) * slope.degrees() / 20.0)).max(0.0),
         }
     }
 }

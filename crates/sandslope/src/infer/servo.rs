@@ -245,12 +245,12 @@ pub fn sensor_walk_settings(duration_s: f64, rate_hz: f64) -> Result<SimSettings
         .with_body_pitch(crate::simulate::BodyPitch::Locked))
 }
 
-/// Simulates `robot` at `slope_deg` on constant ground `k_n` and each k_s of the settings'
+/// Simulates `robot` at `slope` on constant ground `k_n` and each k_s of the settings'
 /// grid (in parallel) and bins each walk's stance torques as [`stance_profiles`] bins a log.
 pub fn model_grid(
     robot: &Robot,
     k_n: f64,
-    slope_deg: f64,
+    slope: crate::slope::SignedSlope,
     settings: &CurrentInferenceSettings,
 ) -> Result<ModelGrid, CurrentInferenceError> {
     if settings.grid_points < 3 || settings.bins < 1 || settings.simulated_strides < 4 {
@@ -260,8 +260,6 @@ pub fn model_grid(
         )));
     }
     let schedule = GaitSchedule::new(robot, 2 * robot.stance_legs() as usize)
-        .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
-    let slope = crate::slope::SignedSlope::from_degrees(slope_deg)
         .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
     let (lo, hi) = (settings.prior.min().ln(), settings.prior.max().ln());
     let n = settings.grid_points;
@@ -290,7 +288,7 @@ pub fn model_grid(
         })
         .collect();
     let mut grid = ModelGrid {
-        slope_deg,
+        slope_deg: slope.degrees(),
         k_n,
         k_s,
         mean: vec![],
@@ -471,13 +469,13 @@ pub fn infer_from_currents(
     Ok(answer)
 }
 
-/// `infer --servo-log` whole: k_n of `terrain` at `slope_deg`, the simulator's grid there, and
+/// `infer --servo-log` whole: k_n of `terrain` at `slope`, the simulator's grid there, and
 /// the posterior of k_s from the legs' stance torques (`legs[j]`: leg j of the alternating
 /// tripod, 2 * stance_legs of them). The CLI reads a log into `legs`; Python passes arrays.
 pub fn infer_servo_log(
     robot: &Robot,
     terrain: &Terrain,
-    slope_deg: f64,
+    slope: crate::slope::SignedSlope,
     legs: &[LegTrace],
     settings: &CurrentInferenceSettings,
 ) -> Result<CurrentInference, CurrentInferenceError> {
@@ -489,12 +487,10 @@ pub fn infer_servo_log(
             robot.stance_legs()
         )));
     }
-    let slope = crate::Slope::from_signed_degrees(slope_deg)
-        .map_err(|e| CurrentInferenceError::Setting(e.renamed("slope").to_string()))?;
     let (ground, _) = Scenario::new(robot.clone(), terrain.clone(), None, None)
         .map_err(|e| CurrentInferenceError::Setting(e.to_string()))?
-        .ground_at(slope);
-    let grid = model_grid(robot, ground.k_n, slope_deg, settings)?;
+        .ground_at(slope.felt());
+    let grid = model_grid(robot, ground.k_n, slope, settings)?;
     infer_from_currents(robot, &grid, legs)
 }
 

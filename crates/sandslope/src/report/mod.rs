@@ -673,7 +673,8 @@ fn plots(
         ));
     }
     let uncertain = UncertainTerrain::new(terrain.clone(), None, None)?;
-    let risk_slopes: Vec<f64> = (0..=60).map(|i| i as f64 * 0.5).collect();
+    let risk_slopes =
+        (0..=60).map(|i| SignedSlope::from_degrees(i as f64 * 0.5)).collect::<Result<Vec<_>, _>>()?;
     let calibrated_speed = match calibration {
         Some(c) => {
             let fitted_robot = Robot::new(c.fit.robot.clone())?;
@@ -710,7 +711,7 @@ fn plots(
         min_step_m: robot.min_step(),
         mass_kg: robot.mass(),
         phase,
-        risk: risk_curve(robot, &uncertain, &risk_slopes)?,
+        risk: risk_curve(robot, &uncertain, &risk_slopes),
         safe_limit: safe_slope_limit(robot, &uncertain, evidence.max_risk)?,
         success_limit: success_slope_limit(robot, &uncertain, evidence.max_risk)?,
         max_risk: evidence.max_risk,

@@ -17,7 +17,7 @@ use super::uncertainty::{DefaultsUsed, UncertainTerrain, UsedUncertainty};
 use super::RegimeProbabilities;
 use crate::error::ParamError;
 use crate::robot::Robot;
-use crate::slope::Slope;
+use crate::slope::{SignedSlope, Slope};
 
 /// The regime probabilities of `robot` at `slope` on an uncertain terrain (one reference
 /// quadrature: all four regimes; for p_fail alone [`super::p_fail()`] is about a hundred times
@@ -365,27 +365,23 @@ pub struct PayloadEnvelope {
     pub defaults_used: DefaultsUsed,
 }
 
-/// The heaviest safe mass ([`max_safe_mass`]) at each of `slopes_deg` (degrees, in
-/// (-90, 90); negative slopes are evaluated as their magnitude, docs/model.md §8).
+/// The heaviest safe mass ([`max_safe_mass`]) at each of `slopes` (negative slopes are
+/// evaluated as their magnitude, docs/model.md §8; each point reports its slope as given).
 pub fn payload_envelope(
     robot: &Robot,
     terrain: &UncertainTerrain,
-    slopes_deg: &[f64],
+    slopes: &[SignedSlope],
     max_risk: f64,
 ) -> Result<PayloadEnvelope, ParamError> {
     check_risk(max_risk)?;
-    let slopes = slopes_deg
-        .iter()
-        .map(|&d| Slope::from_signed_degrees(d).map_err(|e| e.renamed("slope_deg")))
-        .collect::<Result<Vec<Slope>, ParamError>>()?;
     let own = robot.mass();
     let points = slopes
         .par_iter()
-        .zip(slopes_deg.par_iter())
-        .map(|(&s, &slope_deg)| {
+        .map(|&signed| {
+            let s = signed.felt();
             let limit = max_safe_mass(robot, s, terrain, max_risk)?;
             Ok(PayloadPoint {
-                slope_deg,
+                slope_deg: signed.degrees(),
                 max_mass_kg: limit.value(),
                 max_payload_kg: limit.payload_over(own),
                 limit,
@@ -394,7 +390,7 @@ pub fn payload_envelope(
         })
         .collect::<Result<Vec<_>, ParamError>>()?;
     let defaults_used =
-        slopes.iter().fold(DefaultsUsed::default(), |a, &s| a.or(terrain.defaults_used_at(s)));
+        slopes.iter().fold(DefaultsUsed::default(), |a, &s| a.or(terrain.defaults_used_at(s.felt())));
     Ok(PayloadEnvelope { max_risk, robot_mass_kg: own, points, defaults_used })
 }
 
@@ -615,7 +611,9 @@ mod tests {
             None,
         )
         .unwrap();
-        let env = payload_envelope(&r, &t, &[0.0, 10.0, 20.0], 0.05).unwrap();
+        let slopes: Vec<SignedSlope> =
+            [0.0, 10.0, 20.0].iter().map(|&d| SignedSlope::from_degrees(d).unwrap()).collect();
+        let env = payload_envelope(&r, &t, &slopes, 0.05).unwrap();
         assert_eq!(env.points.len(), 3);
         assert!(env.defaults_used.k_s && !env.defaults_used.k_n);
         let mut last = f64::INFINITY;
@@ -627,7 +625,6 @@ mod tests {
             assert!(v <= last + 1e-9, "{v} > {last}");
             last = v;
         }
-        assert_eq!(payload_envelope(&r, &t, &[95.0], 0.05).unwrap_err().key, "slope_deg");
     }
 
     /// The mass search decides with the fast p_fail (issue 26); the reference search, deciding

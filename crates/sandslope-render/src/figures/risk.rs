@@ -5,7 +5,6 @@
 use anyhow::{bail, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 
 use sandslope::risk::{PayloadEnvelope, SafeLimit};
 use sandslope::{Axis, RegimeProbabilities};
@@ -184,7 +183,7 @@ impl Figure for MapFigure {
                 xc.iter().enumerate().map(move |(ii, &i)| {
                     Rectangle::new(
                         [(xe[xs[ii]], ye[ys[jj]]), (xe[xs[ii + 1]], ye[ys[jj + 1]])],
-                        ViridisRGB.get_color(self.p_fail[j * nx + i] as f32).filled(),
+                        palette::p_fail_colour(self.p_fail[j * nx + i]).filled(),
                     )
                 })
             }))
@@ -214,7 +213,7 @@ impl Figure for MapFigure {
         }
         super::legend(&mut chart, SeriesLabelPosition::LowerRight, 15.0)?;
         super::colour_bar(&bar_area, (0.0, 1.0), 44, "p_fail", None, (14.0, 16.0), &|k| {
-            ViridisRGB.get_color((k as f64 / 100.0 + 0.005) as f32)
+            palette::p_fail_colour(k as f64 / 100.0 + 0.005)
         })?;
         Ok(())
     }

@@ -4,8 +4,9 @@
 // /data/... gives what the charts need beyond that. The charts are drawn here, on SVG and
 // canvas, in the colours of the command line's figures: the server writes the palette
 // (crates/sandslope-render/src/figures/palette.rs) into style.css as custom properties on
-// :root (--sinkage, --route-time, ...), read here as #rrggbb; no meaningful colour is written
-// in this file. Nothing is loaded from anywhere but this server.
+// :root (--sinkage, --route-time, --figure-ink, ...), read here as #rrggbb; no colour is
+// written in this file (a test in page.rs holds it so). Nothing is loaded from anywhere but
+// this server.
 
 const palette = (name) => getComputedStyle(document.documentElement).getPropertyValue(`--${name}`).trim();
 const CODES = ["sinkage", "slippage", "metastable", "success"];
@@ -13,9 +14,21 @@ const COLOURS = Object.fromEntries(CODES.map((c) => [c, palette(c)]));
 const ROUTE_ORDER = ["time", "risk", "distance"];
 const ROUTE_COLOURS = Object.fromEntries(ROUTE_ORDER.map((r) => [r, palette(`route-${r}`)]));
 const SIM_COLOURS = Object.fromEntries(
-  ["sand", "sand-surface", "data", "closed-form", "tripod-a", "tripod-b", "not-success"].map((r) => [r, palette(r)]),
+  ["sand", "sand-surface", "data", "closed-form", "tripod-a", "tripod-b", "not-success", "model"].map((r) => [r, palette(r)]),
 );
+// The charts' own marks, by the figures' roles: black axes and markers (--figure-ink) on white
+// (--paper), the light grid lines, the page's rules and ink, the terrain's star, nodata.
+const INK = palette("figure-ink");
+const PAPER = palette("paper");
+const GRID = palette("grid");
+const RULE = palette("page-rule");
+const STAR = palette("star");
 const rgbOf = (hex) => [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
+const hexOf = (rgb) => `#${rgb.map((v) => Math.round(v).toString(16).padStart(2, "0")).join("")}`;
+const NODATA = rgbOf(palette("nodata"));
+// The risk map's colour map (`risk --map`, plotters' viridis), by its stops --p-fail-0, ...
+const P_FAIL_STOPS = [];
+for (let k = 0; palette(`p-fail-${k}`); k++) P_FAIL_STOPS.push(rgbOf(palette(`p-fail-${k}`)));
 // The robot quantities a request may set (parameter -> robot-file key), from the library's
 // table of robot keys as /data/served lists it; filled by start().
 const ROBOT_FLAGS = [];
@@ -171,15 +184,15 @@ function frame(svg, xDomain, yDomain, xLabel, yLabel, margin) {
   const h = Number(svg.getAttribute("height"));
   const x = linear(xDomain[0], xDomain[1], m.l, w - m.r);
   const y = linear(yDomain[0], yDomain[1], h - m.b, m.t);
-  el("rect", { x: m.l, y: m.t, width: w - m.l - m.r, height: h - m.t - m.b, fill: "#fff", stroke: "#aab" }, svg);
+  el("rect", { x: m.l, y: m.t, width: w - m.l - m.r, height: h - m.t - m.b, fill: PAPER, stroke: RULE }, svg);
   for (const t of niceTicks(xDomain[0], xDomain[1], 8)) {
-    el("line", { x1: x(t), x2: x(t), y1: h - m.b, y2: h - m.b + 4, stroke: "#333" }, svg);
-    el("line", { x1: x(t), x2: x(t), y1: m.t, y2: h - m.b, stroke: "#eef" }, svg);
+    el("line", { x1: x(t), x2: x(t), y1: h - m.b, y2: h - m.b + 4, stroke: INK }, svg);
+    el("line", { x1: x(t), x2: x(t), y1: m.t, y2: h - m.b, stroke: GRID }, svg);
     text(svg, x(t), h - m.b + 16, String(t), { "text-anchor": "middle" });
   }
   for (const t of niceTicks(yDomain[0], yDomain[1], 6)) {
-    el("line", { x1: m.l - 4, x2: m.l, y1: y(t), y2: y(t), stroke: "#333" }, svg);
-    el("line", { x1: m.l, x2: w - m.r, y1: y(t), y2: y(t), stroke: "#eef" }, svg);
+    el("line", { x1: m.l - 4, x2: m.l, y1: y(t), y2: y(t), stroke: INK }, svg);
+    el("line", { x1: m.l, x2: w - m.r, y1: y(t), y2: y(t), stroke: GRID }, svg);
     text(svg, m.l - 7, y(t) + 4, String(t), { "text-anchor": "end" });
   }
   text(svg, (m.l + w - m.r) / 2, h - 8, xLabel, { "text-anchor": "middle" });
@@ -235,7 +248,7 @@ function drawSweep() {
   const top = Math.max(1, ...finite);
   const bottom = Math.min(0, ...finite);
   const f = frame(svg, [-30, 40], [bottom, top * 1.08], "slope (deg)", "speed (cm/s)");
-  el("line", { x1: f.x(-30), x2: f.x(40), y1: f.y(0), y2: f.y(0), stroke: "#999" }, svg);
+  el("line", { x1: f.x(-30), x2: f.x(40), y1: f.y(0), y2: f.y(0), stroke: INK }, svg);
   for (let i = 1; i < rows.length; i++) {
     if (speeds[i - 1] === null || speeds[i] === null) continue;
     el("line", {
@@ -245,9 +258,9 @@ function drawSweep() {
   }
   const p = state.point;
   if (p) {
-    el("line", { x1: f.x(p.slope_deg), x2: f.x(p.slope_deg), y1: f.m.t, y2: f.h - f.m.b, stroke: "#333", "stroke-dasharray": "4 3" }, svg);
+    el("line", { x1: f.x(p.slope_deg), x2: f.x(p.slope_deg), y1: f.m.t, y2: f.h - f.m.b, stroke: INK, "stroke-dasharray": "4 3" }, svg);
     if (p.speed_m_s !== null) {
-      el("circle", { cx: f.x(p.slope_deg), cy: f.y(p.speed_m_s * 100), r: 6, fill: COLOURS[p.regime], stroke: "#000", "stroke-width": 2, id: "sweep-marker" }, svg);
+      el("circle", { cx: f.x(p.slope_deg), cy: f.y(p.speed_m_s * 100), r: 6, fill: COLOURS[p.regime], stroke: INK, "stroke-width": 2, id: "sweep-marker" }, svg);
     }
   }
 }
@@ -294,13 +307,13 @@ function drawPhaseMarker() {
   svg.replaceChildren();
   const x = linear(lx[0], lx[1], 60, 400);
   const y = linear(ly[0], ly[1], 270, 10);
-  el("rect", { x: 60, y: 10, width: 340, height: 260, fill: "none", stroke: "#333" }, svg);
+  el("rect", { x: 60, y: 10, width: 340, height: 260, fill: "none", stroke: INK }, svg);
   for (let d = Math.ceil(lx[0]); d <= lx[1]; d++) {
-    el("line", { x1: x(d), x2: x(d), y1: 270, y2: 275, stroke: "#333" }, svg);
+    el("line", { x1: x(d), x2: x(d), y1: 270, y2: 275, stroke: INK }, svg);
     text(svg, x(d), 288, `1e${d}`, { "text-anchor": "middle" });
   }
   for (let d = Math.ceil(ly[0]); d <= ly[1]; d++) {
-    el("line", { x1: 55, x2: 60, y1: y(d), y2: y(d), stroke: "#333" }, svg);
+    el("line", { x1: 55, x2: 60, y1: y(d), y2: y(d), stroke: INK }, svg);
     text(svg, 52, y(d) + 4, `1e${d}`, { "text-anchor": "end" });
   }
   text(svg, 230, 312, "normal resistance k_n (N/m³)", { "text-anchor": "middle" });
@@ -309,8 +322,9 @@ function drawPhaseMarker() {
   if (p && p.k_n > 0 && p.k_s > 0) {
     const cx = x(Math.log10(p.k_n));
     const cy = y(Math.log10(p.k_s));
-    el("circle", { cx, cy, r: 7, fill: "none", stroke: "#000", "stroke-width": 2.5, id: "phase-marker" }, svg);
-    el("circle", { cx, cy, r: 2, fill: "#000" }, svg);
+    // The terrain's (k_n, k_s) in the colours of the figures' star: green, outlined black.
+    el("circle", { cx, cy, r: 7, fill: STAR, stroke: INK, "stroke-width": 2.5, id: "phase-marker" }, svg);
+    el("circle", { cx, cy, r: 2, fill: INK }, svg);
   }
 }
 function updateExplore() {
@@ -340,16 +354,18 @@ function drawRisk({ curve, limit }) {
   el("polyline", { points: pts, fill: "none", stroke: COLOURS.slippage, "stroke-width": 2.5 }, svg);
   for (const r of curve) el("circle", { cx: f.x(r.slope_deg), cy: f.y(r.p_fail), r: 2.5, fill: COLOURS.slippage }, svg);
   const maxRisk = limit.max_risk;
-  el("line", { x1: f.x(0), x2: f.x(30), y1: f.y(maxRisk), y2: f.y(maxRisk), stroke: "#555", "stroke-dasharray": "2 3" }, svg);
+  el("line", { x1: f.x(0), x2: f.x(30), y1: f.y(maxRisk), y2: f.y(maxRisk), stroke: SIM_COLOURS.data, "stroke-dasharray": "2 3" }, svg);
   text(svg, f.x(0.5), f.y(maxRisk) - 4, `max risk ${maxRisk}`);
   // Two limits, named apart (risk --solve slope): up to where the robot climbs (P(not success)
   // below the threshold) and up to where it does not fail (p_fail below it); a limit of kind
   // "repose" is the angle of repose itself, where the sand flows, not a risk threshold.
   const safe = limit.safe_slope_deg;
   const success = limit.success_slope_deg;
+  // In the risk curve's colours: the success limit in P(not success)'s orange, the safe-slope
+  // limit in the model's blue, the threshold in the reference lines' grey.
   const marks = [
     [success, "success-slope", SIM_COLOURS["not-success"], "climbs to"],
-    [safe, "safe-slope", "#000", limit.limit.kind === "repose" ? "repose" : "no failure to"],
+    [safe, "safe-slope", SIM_COLOURS.model, limit.limit.kind === "repose" ? "repose" : "no failure to"],
   ];
   let row = 0;
   for (const [deg, id, colour, label] of marks) {
@@ -473,11 +489,15 @@ function hillshade(dem, w, h) {
   }
   return shade;
 }
-// The overlay's colour and weight for a p_fail: invisible below 1e-6, then yellow to red on a
-// log scale up to 1 (most of a dune is safe; what matters is where it is not).
+// The overlay's colour and weight for a p_fail: invisible below 1e-6, then the risk map's colour
+// map (dark purple to yellow, linear between its stops) on a log scale up to 1 (most of a dune
+// is safe; what matters is where it is not).
 function rampRisk(p) {
   const t = Math.min(1, Math.max(0, (Math.log10(Math.max(p, 1e-12)) + 6) / 6));
-  return { rgb: [255, 220 - 200 * t, 40], alpha: t === 0 ? 0 : 0.25 + 0.6 * t };
+  const x = t * (P_FAIL_STOPS.length - 1);
+  const k = Math.min(P_FAIL_STOPS.length - 2, Math.floor(x));
+  const [a, b] = [P_FAIL_STOPS[k], P_FAIL_STOPS[k + 1]];
+  return { rgb: a.map((v, i) => v + (x - k) * (b[i] - v)), alpha: t === 0 ? 0 : 0.25 + 0.6 * t };
 }
 function drawMap() {
   const dem = state.dem;
@@ -489,7 +509,7 @@ function drawMap() {
   const overlay = $("rule").value === "none" ? null : state.overlay;
   for (let i = 0; i < w * h; i++) {
     const s = state.hillshade[i];
-    let rgb = Number.isNaN(s) ? [255, 255, 255] : [40 + 200 * s, 40 + 200 * s, 40 + 200 * s];
+    let rgb = Number.isNaN(s) ? NODATA : [40 + 200 * s, 40 + 200 * s, 40 + 200 * s];
     if (overlay && overlay.values[i] !== null && !Number.isNaN(s)) {
       const { rgb: c, alpha } = rampRisk(overlay.values[i]);
       rgb = rgb.map((v, k) => (1 - alpha) * v + alpha * c[k]);
@@ -514,7 +534,7 @@ function drawRoutes(ctx) {
     const order = (f) => ROUTE_ORDER.indexOf(f.properties.objective);
     for (const feature of [...state.routes.features].sort((a, b) => order(a) - order(b))) {
       const name = feature.properties.objective;
-      ctx.strokeStyle = ROUTE_COLOURS[name] || "#000";
+      ctx.strokeStyle = ROUTE_COLOURS[name] || INK;
       // time under risk under distance, so coinciding routes all show
       ctx.lineWidth = { time: 7, risk: 3, distance: 2 }[name] || 3;
       ctx.setLineDash(name === "distance" ? [6, 4] : []);
@@ -528,17 +548,18 @@ function drawRoutes(ctx) {
     }
     ctx.setLineDash([]);
   }
-  for (const [cell, colour, label] of [[state.start, "#fff", "S"], [state.goal, "#000", "G"]]) {
+  // As the plan figure marks them: the start white outlined black, the goal black on white.
+  for (const [cell, colour, other, label] of [[state.start, PAPER, INK, "S"], [state.goal, INK, PAPER, "G"]]) {
     if (!cell) continue;
     const [px, py] = cellToPixel(cell[0], cell[1]);
     ctx.fillStyle = colour;
-    ctx.strokeStyle = colour === "#fff" ? "#000" : "#fff";
+    ctx.strokeStyle = other;
     ctx.lineWidth = 2;
     ctx.beginPath();
     ctx.arc(px, py, 7, 0, 2 * Math.PI);
     ctx.fill();
     ctx.stroke();
-    ctx.fillStyle = colour === "#fff" ? "#000" : "#fff";
+    ctx.fillStyle = other;
     ctx.font = "bold 10px sans-serif";
     ctx.textAlign = "center";
     ctx.fillText(label, px, py + 3.5);
@@ -679,7 +700,7 @@ function showSimulation(walk) {
 function legColour(tripod, rank, n) {
   const base = rgbOf(SIM_COLOURS[tripod === 0 ? "tripod-a" : "tripod-b"]);
   const f = n > 1 ? (0.45 * rank) / (n - 1) : 0;
-  return `rgb(${base.map((c) => Math.floor(c + (255 - c) * f)).join(",")})`;
+  return hexOf(base.map((c) => Math.floor(c + (255 - c) * f)));
 }
 function drawSimFrame() {
   const walk = sim.walk;
@@ -716,7 +737,7 @@ function drawSimFrame() {
     });
     if (close) ctx.closePath();
   };
-  ctx.fillStyle = "#fff";
+  ctx.fillStyle = PAPER;
   ctx.fillRect(0, 0, W, H);
   // Sand: the slope frame below its surface, turned into the world.
   const far = 2;
@@ -775,7 +796,7 @@ function drawSimFrame() {
     }
   }
   const [u, v] = px(centre);
-  ctx.fillStyle = "#000";
+  ctx.fillStyle = INK;
   ctx.beginPath();
   ctx.arc(u, v, 4, 0, 2 * Math.PI);
   ctx.fill();

@@ -210,12 +210,6 @@ pub fn warn_extrapolated(terrain: &Terrain, slopes: &[f64]) {
 
 pub use sandslope_request::scenario::beyond_last_point;
 
-/// Checks a command-line number: finite and within `lo..=hi`, naming the flag (`hi` infinite:
-/// no upper bound).
-pub fn check_flag(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
-    Ok(sandslope_request::error::check_range(flag.trim_start_matches('-'), value, lo, hi)?)
-}
-
 pub use sandslope_request::grammar::{parse_max_risk, SlopeSign};
 
 /// Parses a slope list given to `flag`: the one slope-list grammar of every front end

@@ -10,6 +10,7 @@ use pythonize::pythonize;
 
 use sandslope::infer::servo::{infer_servo_log as infer, CurrentInferenceSettings, LegTrace};
 use sandslope::servo::xl330;
+use sandslope_request::drive::DriveRun;
 use sandslope_request::error::Words;
 use sandslope_request::infer::{prior_in, servo_grid_points};
 use sandslope_servo::driver::ServoSample;
@@ -140,23 +141,23 @@ pub fn drive<'py>(
     let hold_s = hold_s.unwrap_or(d.hold_s);
     let rate_hz = rate_hz.unwrap_or(d.rate_hz);
     let live = live.unwrap_or(d.live);
-    let within = |key: &str, v: f64, lo: f64, hi: f64| {
-        if (lo..=hi).contains(&v) {
-            Ok(())
-        } else {
-            Err(value_error(format!("{key} = {v} must be within {lo} to {hi}")))
-        }
-    };
-    within("duration_s", duration_s, 0.0, 3600.0)?;
-    within("rate_hz", rate_hz, 1.0, 1000.0)?;
-    within("noise_ma", noise_ma, 0.0, 1000.0)?;
-    within("hold_s", hold_s, 0.0, 3600.0)?;
-    if let Some(p) = stop_on_risk {
-        within("stop_on_risk", p, 0.0, 1.0)?;
+    // Every number checked once, by the request layer, in Python's words (the command line's
+    // ranges and limits; the watchdogs and limits Python does not expose at their defaults).
+    DriveRun {
+        slope_deg,
+        duration_s,
+        rate_hz,
+        hold_s,
+        watchdog_s: d.watchdog_s,
+        bus_watchdog_s: d.bus_watchdog_s,
+        current_limit_ma: d.current_limit_ma,
+        temperature_limit_c: d.temperature_limit_c,
+        stop_on_risk,
+        emulate_noise_ma: Some(noise_ma),
+        emulate_k_s: k_s,
     }
-    if let Some(k) = k_s {
-        sandslope::Terrain::constant(1.0, k).map_err(|e| value_error(e.renamed("k_s")))?;
-    }
+    .check(Words::Keyword)
+    .map_err(|e| value_error(e.message()))?;
     if let Some((s, k)) = weaken {
         if !(s >= 0.0 && s.is_finite() && k > 0.0 && k.is_finite()) {
             return Err(value_error(format!(

@@ -102,7 +102,7 @@ def test_bad_input_names_the_argument(run):
         sandslope.infer_servo_log(c)
     with pytest.raises(ValueError, match="emulator only"):
         sandslope.drive(emulate=False)
-    with pytest.raises(ValueError, match="stop_on_risk = 1.5 must be within 0 to 1"):
+    with pytest.raises(ValueError, match="stop_on_risk = 1.5 must be between 0 and 1"):
         sandslope.drive(stop_on_risk=1.5)
     with pytest.raises(ValueError, match="k_s"):
         sandslope.drive(k_s=-1.0)

@@ -18,6 +18,7 @@
 
 pub mod calibrate;
 pub mod design;
+pub mod drive;
 pub mod error;
 pub mod fit;
 pub mod grammar;

@@ -12,9 +12,10 @@ use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 
 use sandslope::servo::{xl330, GaitSchedule};
-use sandslope::Slope;
 use sandslope_io::robot_terrain::load_servos;
 use sandslope_io::servo_log::DEFAULT_BAUD_RATE;
+use sandslope_request::drive::DriveRun;
+use sandslope_request::error::Words;
 use sandslope_servo::driver::{DriveReport, LiveEstimate};
 use sandslope_servo::emulator::EmulatorFaults;
 use sandslope_servo::log::{drive_logged, LogTarget};
@@ -24,7 +25,7 @@ use sandslope_servo::session::{
 use sandslope_servo::table as t;
 use sandslope_servo::{DriveSettings, Profile, ServoConfig};
 
-use crate::args::{check_flag, RobotArgs, TerrainArgs};
+use crate::args::{RobotArgs, TerrainArgs};
 use crate::error::{KeepLog, EXIT_HALTED};
 use crate::output::{check_parent_exists, print_json};
 
@@ -228,36 +229,22 @@ pub fn config(
     bus: BusFlag,
     monitor: bool,
 ) -> Result<DriveConfig> {
-    Slope::from_signed_degrees(run.slope).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
-    check_flag("--duration", run.duration, 0.0, 86_400.0)?;
-    check_flag("--rate", run.rate, 1.0, 1000.0)?;
-    check_flag("--hold", run.hold, 0.0, 3600.0)?;
-    check_flag("--watchdog", run.watchdog, 0.01, 10.0)?;
-    check_flag("--bus-watchdog", run.bus_watchdog, 0.02, 2.54)?;
-    if run.current_limit > xl330::MAX_CURRENT_LIMIT_MA {
-        bail!(
-            "--current-limit = {} must be within 0 to {} mA (the XL330's Current Limit range)",
-            run.current_limit,
-            xl330::MAX_CURRENT_LIMIT_MA
-        );
-    }
-    if run.temperature_limit > xl330::MAX_TEMPERATURE_C {
-        bail!(
-            "--temperature-limit = {} must be within 0 to {} degC (the XL330's rated range)",
-            run.temperature_limit,
-            xl330::MAX_TEMPERATURE_C
-        );
-    }
-    if let Some(p) = run.stop_on_risk {
-        check_flag("--stop-on-risk", p, 0.0, 1.0)?;
-    }
     let emulate = matches!(bus, BusFlag::Emulate);
-    if emulate {
-        check_flag("--emulate-noise", run.emulate_noise, 0.0, 1000.0)?;
+    // Every number checked once, by the request layer, in the command line's words.
+    DriveRun {
+        slope_deg: run.slope,
+        duration_s: run.duration,
+        rate_hz: run.rate,
+        hold_s: run.hold,
+        watchdog_s: run.watchdog,
+        bus_watchdog_s: run.bus_watchdog,
+        current_limit_ma: run.current_limit,
+        temperature_limit_c: run.temperature_limit,
+        stop_on_risk: run.stop_on_risk,
+        emulate_noise_ma: emulate.then_some(run.emulate_noise),
+        emulate_k_s: run.emulate_k_s,
     }
-    if let Some(k) = run.emulate_k_s {
-        sandslope::Terrain::constant(1.0, k).map_err(|e| anyhow!("{}", e.renamed("--emulate-k-s")))?;
-    }
+    .check(Words::Flag)?;
     let faults = if emulate { parse_faults(run)? } else { EmulatorFaults::default() };
     let legs = 2 * robot.stance_legs() as usize;
     let current_offset_ma = match &run.emulate_offset {

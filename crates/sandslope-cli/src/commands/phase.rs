@@ -155,10 +155,10 @@ pub fn run(args: PhaseArgs) -> Result<()> {
         compute(&args, MAX_CELLS, args.json, true)?;
 
     if let Some(path) = &args.csv {
-        write_cells(path, &panels, args.regime_only)?;
+        sandslope_render::tables::write_phase_csv(path, &panels, args.regime_only)?;
     }
     if let Some(dir) = &args.npy {
-        write_npy(dir, &panels, &masses, &args.slope, args.regime_only)?;
+        sandslope_render::tables::write_phase_npy(dir, &panels, &masses, &args.slope, args.regime_only)?;
     }
     if let Some(path) = &args.plot {
         let figure = PhaseFigure::new(&panels, slopes, terrain_label(&terrain));
@@ -211,138 +211,4 @@ pub fn run(args: PhaseArgs) -> Result<()> {
 
 fn terrain_label(terrain: &Terrain) -> String {
     terrain.name().map(str::to_string).unwrap_or_else(|| "terrain".into())
-}
-
-/// Writes every cell of every panel, atomically, formatted in parallel
-/// (`sandslope_io::grid_csv`), one row per cell: `k_n,k_s,slope_deg,mass_kg,regime,step_m` (step empty
-/// where the leg never anchors; no step column with `regime_only`).
-///
-/// Each axis value is formatted once per panel, not once per row: `phase --csv` on a 4096 x
-/// 4096 grid spent two thirds of its formatting on `k_n` and `k_s` (two ryu calls a row
-/// against one for the step), docs/phase-and-risk.md gives the times.
-fn write_cells(path: &std::path::Path, panels: &[PhasePanel], regime_only: bool) -> Result<()> {
-    use sandslope_io::grid_csv::{push_f64, write_rows_file};
-    let per_panel: Vec<usize> = panels.iter().map(|p| p.map.k_n().len() * p.map.k_s().len()).collect();
-    let starts: Vec<usize> = per_panel
-        .iter()
-        .scan(0, |a, &n| {
-            let s = *a;
-            *a += n;
-            Some(s)
-        })
-        .collect();
-    let total = per_panel.iter().sum();
-    // Per panel, the constant text ",slope,mass,".
-    let mids: Vec<Vec<u8>> = panels
-        .iter()
-        .map(|p| {
-            let mut b = vec![b','];
-            push_f64(&mut b, p.slope_deg);
-            b.push(b',');
-            push_f64(&mut b, p.mass_kg);
-            b.push(b',');
-            b
-        })
-        .collect();
-    // Per panel, every axis value's text: "k_n," per column and "k_s" per row.
-    let texts = |values: &[f64], comma: bool| -> Vec<Vec<u8>> {
-        values
-            .iter()
-            .map(|&v| {
-                let mut b = Vec::with_capacity(24);
-                push_f64(&mut b, v);
-                if comma {
-                    b.push(b',');
-                }
-                b
-            })
-            .collect()
-    };
-    let k_n_texts: Vec<Vec<Vec<u8>>> = panels.iter().map(|p| texts(p.map.k_n(), true)).collect();
-    let k_s_texts: Vec<Vec<Vec<u8>>> = panels.iter().map(|p| texts(p.map.k_s(), false)).collect();
-    // The regime names with the separator that follows them.
-    let names: Vec<Vec<u8>> = Regime::ALL
-        .iter()
-        .map(|r| {
-            let mut b = r.name().as_bytes().to_vec();
-            if !regime_only {
-                b.push(b',');
-            }
-            b
-        })
-        .collect();
-    let header = if regime_only {
-        "k_n,k_s,slope_deg,mass_kg,regime"
-    } else {
-        "k_n,k_s,slope_deg,mass_kg,regime,step_m"
-    };
-    write_rows_file(path, header, total, &|c, buf| {
-        let k = starts.partition_point(|&s| s <= c) - 1;
-        let (p, cell) = (&panels[k], c - starts[k]);
-        let nx = p.map.k_n().len();
-        let (i, j) = (cell % nx, cell / nx);
-        buf.extend_from_slice(&k_n_texts[k][i]);
-        buf.extend_from_slice(&k_s_texts[k][j]);
-        buf.extend_from_slice(&mids[k]);
-        buf.extend_from_slice(&names[p.map.regime(i, j) as usize]);
-        if !regime_only {
-            if let Some(step) = p.map.step(i, j) {
-                push_f64(buf, step);
-            }
-        }
-    })
-}
-
-/// Writes the maps as NumPy arrays into `dir` (checked before any work).
-fn write_npy(
-    dir: &std::path::Path,
-    panels: &[PhasePanel],
-    masses: &[f64],
-    slopes: &[f64],
-    regime_only: bool,
-) -> Result<()> {
-    use rayon::prelude::*;
-    use sandslope_io::npy::{write_npy_dir, NpyData};
-    let first = &panels[0].map;
-    let (k_n, k_s) = (first.k_n(), first.k_s());
-    let (nx, cells) = (k_n.len(), k_n.len() * k_s.len());
-    let n = cells * panels.len();
-    let mut regime: Vec<i8> = Vec::with_capacity(n);
-    let mut step: Vec<f64> = Vec::with_capacity(if regime_only { 0 } else { n });
-    // One pass per row over both arrays (PhaseMap::write_row), rows in parallel.
-    let map_row = |r: usize| (&panels[r / k_s.len()].map, r % k_s.len());
-    let codes = regime.spare_capacity_mut()[..n].par_chunks_mut(nx);
-    if regime_only {
-        codes.enumerate().for_each(|(r, codes)| {
-            let (map, j) = map_row(r);
-            map.write_row(j, codes, None);
-        });
-    } else {
-        codes.zip(step.spare_capacity_mut()[..n].par_chunks_mut(nx)).enumerate().for_each(
-            |(r, (codes, steps))| {
-                let (map, j) = map_row(r);
-                map.write_row(j, codes, Some(steps));
-            },
-        );
-    }
-    // SAFETY: `write_row` writes every element of each row of `nx` codes (and steps); the rows
-    // cover the first `n` elements, and `n` is within both capacities.
-    unsafe {
-        regime.set_len(n);
-        if !regime_only {
-            step.set_len(n);
-        }
-    }
-    let shape = vec![masses.len(), slopes.len(), k_s.len(), k_n.len()];
-    let mut files = vec![("regime.npy", shape.clone(), NpyData::I8(&regime))];
-    if !regime_only {
-        files.push(("step_m.npy", shape, NpyData::F64(&step)));
-    }
-    files.extend([
-        ("k_n.npy", vec![k_n.len()], NpyData::F64(k_n)),
-        ("k_s.npy", vec![k_s.len()], NpyData::F64(k_s)),
-        ("slope_deg.npy", vec![slopes.len()], NpyData::F64(slopes)),
-        ("mass_kg.npy", vec![masses.len()], NpyData::F64(masses)),
-    ]);
-    write_npy_dir(dir, &files)
 }

@@ -459,18 +459,7 @@ fn print_map(args: &RiskArgs, robot: &Robot, answer: RiskMapAnswer) -> Result<()
         sandslope_render::tables::write_risk_map_csv(path, map)?;
     }
     if let Some(dir) = &args.npy {
-        use sandslope_io::npy::{write_npy_dir, NpyData};
-        let (k_n, k_s) = (k_n_axis.values(), k_s_axis.values());
-        let shape = vec![k_s.len(), k_n.len()];
-        write_npy_dir(
-            dir,
-            &[
-                ("p_fail.npy", shape.clone(), NpyData::F64(&map.p_fail)),
-                ("p_not_success.npy", shape, NpyData::F64(&map.p_not_success)),
-                ("k_n.npy", vec![k_n.len()], NpyData::F64(&k_n)),
-                ("k_s.npy", vec![k_s.len()], NpyData::F64(&k_s)),
-            ],
-        )?;
+        sandslope_render::tables::write_risk_map_npy(dir, map)?;
     }
     if let Some(path) = &args.plot {
         let figure = MapFigure {

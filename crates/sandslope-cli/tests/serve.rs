@@ -366,6 +366,19 @@ fn plan_endpoint_and_downloads_equal_plans_json_and_files() {
         }
     }
     assert!(passable > 30_000, "{passable} passable cells");
+    // The head-on climb's raster is the same grid (on this DEM null on the same cells);
+    // another rule is refused, naming it.
+    let (status, body) = server.get("/data/risk-map?rule=fall-line");
+    assert_eq!(status, 200);
+    let v: serde_json::Value = serde_json::from_slice(&body).unwrap();
+    let fall_line = v["values"].as_array().unwrap();
+    assert_eq!(fall_line.len(), overlay.len());
+    for (best, head_on) in overlay.iter().zip(fall_line) {
+        assert_eq!(best.is_null(), head_on.is_null());
+    }
+    let (status, body) = server.get("/data/risk-map?rule=sideways");
+    assert_eq!(status, 400);
+    assert!(String::from_utf8_lossy(&body).contains("rule = `sideways` must be best"));
     // A request naming another DEM is refused.
     let (status, _) = server.get("/api/plan?dem=%2Fetc%2Fpasswd&start-px=40,100&goal-px=160,100");
     assert_eq!(status, 400);

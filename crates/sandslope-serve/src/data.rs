@@ -200,11 +200,24 @@ fn phase_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiE
 /// `rule=fall-line` (climbing straight up the cell's fall line). Start and goal are not
 /// needed (any given are ignored).
 fn risk_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
-    let mut rule = "best".to_string();
+    let mut fall_line = false;
     let mut rest: Vec<(String, String)> = Vec::new();
     for (k, v) in params {
         match k.as_str() {
-            "rule" => rule = v.clone(),
+            "rule" => {
+                fall_line = match v.as_str() {
+                    "best" => false,
+                    "fall-line" => true,
+                    _ => {
+                        return Err(ApiError::bad(
+                            Some("rule".to_string()),
+                            format!(
+                            "rule = `{v}` must be best (lowest over 16 headings) or fall-line (straight up)"
+                        ),
+                        ))
+                    }
+                }
+            }
             "start" | "goal" | "start-px" | "goal-px" | "objective" => {}
             _ => rest.push((k.clone(), v.clone())),
         }
@@ -212,31 +225,11 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiEr
     // The planner's inputs need no endpoints; plan's flags require some, so any cell will do.
     rest.push(("start-px".into(), "0,0".into()));
     rest.push(("goal-px".into(), "0,0".into()));
-    if !["best", "fall-line"].contains(&rule.as_str()) {
-        return Err(ApiError::bad(
-            Some("rule".to_string()),
-            format!("rule = `{rule}` must be best (lowest over 16 headings) or fall-line (straight up)"),
-        ));
-    }
     let request = PlanRequest::from_params(&api::plan_params(&rest, served)?)?;
     let inputs = request.inputs(&|_| {})?;
     let planner = inputs.planner()?;
     let (cols, rows) = (inputs.dem.cols, inputs.dem.rows);
-    let p_fail: Vec<f32> = match rule.as_str() {
-        "best" => planner.risk_map().0,
-        "fall-line" => {
-            let grid = planner.grid();
-            (0..grid.len())
-                .map(|i| planner.fall_line(grid.cell(i)).map_or(f32::NAN, |(_, p)| p as f32))
-                .collect()
-        }
-        _ => {
-            return Err(ApiError::bad(
-                Some("rule".to_string()),
-                format!("rule = `{rule}` must be best (lowest over 16 headings) or fall-line (straight up)"),
-            ))
-        }
-    };
+    let p_fail = if fall_line { planner.fall_line_map() } else { planner.risk_map().0 };
     let stride = stride(cols, rows);
     Ok(Reply::compact(Grid { cols, rows, stride, values: sampled(&p_fail, cols, rows, stride) }))
 }

@@ -21,6 +21,13 @@ impl Planner {
         Some((t.regime(k), t.p_fail(k)))
     }
 
+    /// Per cell, P(failure) of climbing it head-on ([`Planner::fall_line`]); NaN where the cell
+    /// is impassable. The explorer's `rule=fall-line` raster.
+    pub fn fall_line_map(&self) -> Vec<f32> {
+        let grid = self.grid();
+        (0..grid.len()).map(|i| self.fall_line(grid.cell(i)).map_or(f32::NAN, |(_, p)| p as f32)).collect()
+    }
+
     /// Per cell, the lowest P(failure) over the 16 headings (roll over the limit counts as
     /// failure), and the azimuth (degrees clockwise from north) of the steepest climbing
     /// heading the time objective may use; NaN where the cell is impassable or no heading

@@ -1,6 +1,7 @@
-//! The explorer page: one HTML file, its script and its style sheet, embedded in the binary
-//! (docs/serve.md). The script draws every chart itself on SVG and canvas, so nothing is
-//! fetched from anywhere but this server. The style sheet opens with the palette's colours
+//! The explorer page: one HTML file, its scripts (`app.js`: helpers, Explore and Risk;
+//! `routes.js`: Routes, Simulate and the wiring; `drive.js`: Drive) and its style sheet,
+//! embedded in the binary (docs/serve.md). The scripts draw every chart themselves on SVG and
+//! canvas, so nothing is fetched from anywhere but this server. The style sheet opens with the palette's colours
 //! as CSS custom properties (`sandslope_render::figures::palette::css_custom_properties`),
 //! which the script reads, so the page draws in the figures' colours and restates none.
 
@@ -8,6 +9,7 @@ use crate::served::Served;
 
 const INDEX: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/app.js");
+const ROUTES_SCRIPT: &str = include_str!("page/routes.js");
 const DRIVE_SCRIPT: &str = include_str!("page/drive.js");
 const STYLE: &str = include_str!("page/style.css");
 
@@ -16,6 +18,7 @@ pub fn asset(path: &str, _served: &Served) -> Option<(Vec<u8>, &'static str)> {
     match path {
         "/" | "/index.html" => Some((INDEX.as_bytes().to_vec(), "text/html; charset=utf-8")),
         "/app.js" => Some((SCRIPT.as_bytes().to_vec(), "text/javascript; charset=utf-8")),
+        "/routes.js" => Some((ROUTES_SCRIPT.as_bytes().to_vec(), "text/javascript; charset=utf-8")),
         "/drive.js" => Some((DRIVE_SCRIPT.as_bytes().to_vec(), "text/javascript; charset=utf-8")),
         "/style.css" => {
             let css = sandslope_render::figures::palette::css_custom_properties() + STYLE;
@@ -31,8 +34,13 @@ mod tests {
     use sandslope_render::figures::palette;
 
     /// The page's files as they are embedded, by name.
-    const FILES: [(&str, &str); 4] =
-        [("index.html", INDEX), ("app.js", SCRIPT), ("drive.js", DRIVE_SCRIPT), ("style.css", STYLE)];
+    const FILES: [(&str, &str); 5] = [
+        ("index.html", INDEX),
+        ("app.js", SCRIPT),
+        ("routes.js", ROUTES_SCRIPT),
+        ("drive.js", DRIVE_SCRIPT),
+        ("style.css", STYLE),
+    ];
 
     /// `text` without its comments: `/* ... */`, `<!-- ... -->`, and `//` to the end of the line
     /// where it follows a space or starts one (not the `//` of a URL).
@@ -109,7 +117,7 @@ mod tests {
             .match_indices("var(--")
             .map(|(i, m)| css[i + m.len()..].split(')').next().unwrap().to_string())
             .collect();
-        let script = without_comments(SCRIPT);
+        let script = [SCRIPT, ROUTES_SCRIPT, DRIVE_SCRIPT].map(without_comments).concat();
         for open in ["palette(\"", "palette(`"] {
             for (i, m) in script.match_indices(open) {
                 let name: String =

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""The size limits of issue 40: no non-test Rust source file over 800 lines and no function
-over 120 lines.
+"""The size limits of issue 40: no non-test source file over 800 lines and no function over
+120 lines.
 
 Usage: python3 scripts/check_sizes.py [--files N] [--fns N] [ROOT]
 
@@ -8,9 +8,13 @@ Walks ROOT/crates/*/src (default ROOT: the repository holding this script), leav
 `#[cfg(test)]` items (the test modules kept inside a source file) and files named `tests.rs`
 or `*_tests.rs` that only a `#[cfg(test)] mod` declares, and counts physical lines. A function
 is `fn NAME ... { ... }`; its length runs from the line of `fn` to the line of its closing
-brace. Braces inside comments, strings, raw strings and char literals do not count. Prints
-every file and function over its limit and exits 1 if there is any, 0 otherwise.
+brace. Braces inside comments, strings, raw strings and char literals do not count. The
+page's scripts (`.js` under crates/*/src) and the Python package (`.py` under crates/*/python)
+are held to the file limit too, and Python's functions (by its own parser) to the function
+limit. Prints every file and function over its limit and exits 1 if there is any, 0 otherwise.
 """
+
+import ast
 
 import argparse
 import os
@@ -149,6 +153,34 @@ def test_only_files(root):
     return found
 
 
+def other_sources(args):
+    """The page's scripts and the Python package: files over the line limit, and Python
+    functions over the function limit; returns how many, having printed each."""
+    over = 0
+    crates = os.path.join(args.root, "crates")
+    for crate in sorted(os.listdir(crates)):
+        for sub, ext in (("src", ".js"), ("python", ".py")):
+            top = os.path.join(crates, crate, sub)
+            for dirpath, _, names in sorted(os.walk(top)):
+                for name in sorted(n for n in names if n.endswith(ext)):
+                    path = os.path.join(dirpath, name)
+                    rel = os.path.relpath(path, args.root)
+                    with open(path, encoding="utf-8") as f:
+                        text = f.read()
+                    lines = text.count("\n") + (0 if text.endswith("\n") or not text else 1)
+                    if lines > args.files:
+                        print(f"{rel}: {lines} lines (limit {args.files})")
+                        over += 1
+                    if ext == ".py":
+                        for node in ast.walk(ast.parse(text, filename=path)):
+                            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                                length = node.end_lineno - node.lineno + 1
+                                if length > args.fns:
+                                    print(f"{rel}:{node.lineno}: def {node.name} is {length} lines (limit {args.fns})")
+                                    over += 1
+    return over
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("root", nargs="?", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
@@ -176,6 +208,7 @@ def main():
                     if length > args.fns:
                         print(f"{rel}:{first}: fn {fn} is {length} lines (limit {args.fns})")
                         over += 1
+    over += other_sources(args)
     if over:
         print(f"{over} over the limits", file=sys.stderr)
         return 1

@@ -267,6 +267,26 @@ def _store_shape(source: Any) -> Tuple[Tuple[int, int], Optional[Tuple[int, int]
     return (int(shape[0]), int(shape[1])), native
 
 
+def _pds3_cell_size(dem: Any, row_widths_m: Any) -> tuple:
+    """``cell_size_m = None``: the cell size from a PDS3 DTM's label, and its row widths when
+    none are given (an equirectangular DTM's rows narrow towards the pole)."""
+    if not _is_pds3(dem):
+        raise ValueError("cell_size_m = None takes the cell size from a PDS3 DTM's label; give it in metres for any other dem")
+    if not os.path.exists(dem):
+        raise ValueError(f"dem = {os.fspath(dem)!r}: no such file or folder")
+    info = _sandslope.pds3_info(os.fspath(dem))
+    return (info["cell_x_m"], info["cell_y_m"]), info["row_widths_m"] if row_widths_m is None else row_widths_m
+
+
+def _check_widths(widths: Optional[np.ndarray], rows: int) -> None:
+    """One finite, positive row width per row of the DEM, when widths are given."""
+    if widths is not None and not (len(widths) == rows and np.all(np.isfinite(widths)) and np.all(widths > 0)):
+        raise ValueError(
+            f"row_widths_m must hold one finite width greater than 0 (m) per row of the dem: "
+            f"{len(widths)} values for {rows} rows"
+        )
+
+
 def risk_raster(
     dem: Any,
     cell_size_m: Any,
@@ -320,23 +340,9 @@ def risk_raster(
     ``.store`` to evaluate.
     """
     if cell_size_m is None:
-        if not _is_pds3(dem):
-            raise ValueError("cell_size_m = None takes the cell size from a PDS3 DTM's label; give it in metres for any other dem")
-        if not os.path.exists(dem):
-            raise ValueError(f"dem = {os.fspath(dem)!r}: no such file or folder")
-        info = _sandslope.pds3_info(os.fspath(dem))
-        cell_size_m = (info["cell_x_m"], info["cell_y_m"])
-        if row_widths_m is None:
-            row_widths_m = info["row_widths_m"]
+        cell_size_m, row_widths_m = _pds3_cell_size(dem, row_widths_m)
     cx, cy = _cell_size(cell_size_m)
     widths = None if row_widths_m is None else np.asarray(_row_widths(row_widths_m), dtype=np.float64)
-
-    def check_widths(rows: int) -> None:
-        if widths is not None and not (len(widths) == rows and np.all(np.isfinite(widths)) and np.all(widths > 0)):
-            raise ValueError(
-                f"row_widths_m must hold one finite width greater than 0 (m) per row of the dem: "
-                f"{len(widths)} values for {rows} rows"
-            )
 
     options = dict(
         robot=_robot(robot),
@@ -367,7 +373,7 @@ def risk_raster(
             z = z.rechunk(DEFAULT_TILE)
         if not np.issubdtype(z.dtype, np.floating):
             z = z.astype(np.float64)  # room for the NaN padding
-        check_widths(z.shape[0])
+        _check_widths(widths, z.shape[0])
         padded = da.overlap.overlap(z, depth={0: 1, 1: 1}, boundary={0: np.nan, 1: np.nan})
         return padded.map_blocks(
             _overlap_tile,
@@ -384,7 +390,7 @@ def risk_raster(
 
     # A store: one independent task per tile, each reading its own window.
     shape, native = _store_shape(dem)
-    check_widths(shape[0])
+    _check_widths(widths, shape[0])
     if nodata is None:
         options["nodata"] = _tiff_nodata(dem)
     tiles = _tiles(chunks if chunks is not None else (native or DEFAULT_TILE), shape)

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use sandslope::gait::{track, GaitOptions, Recording, RecordingSummary, TrackResult, Upslope};
-use sandslope::{GaitError, Slope};
+use sandslope::{GaitError, Slope, SlopeEvaluation};
 use sandslope_io::mocap::{self, Capture, MocapFormat};
 
 use crate::error::{RequestError, Result, Words};
@@ -129,6 +129,24 @@ impl Tracked {
         v["per_step"] = serde_json::to_value(self.step_records())?;
         Ok(v)
     }
+}
+
+/// The model's speed against slope beside a campaign of tracked speeds (the paper's Fig. 3a,
+/// `track --plot` with a `--speeds-out` file of several slopes): the closed form of `robot` on
+/// `terrain` at 401 slopes from level to 2 degrees past the steepest observed (at most 89).
+pub fn model_curve(
+    robot: &sandslope::Robot,
+    terrain: sandslope::Terrain,
+    steepest_deg: f64,
+) -> Result<Vec<SlopeEvaluation>> {
+    let scenario = sandslope::Scenario::new(robot.clone(), terrain, None, None)
+        .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))?;
+    let top = (steepest_deg.max(0.0) + 2.0).min(89.0);
+    let slopes = (0..=400)
+        .map(|k| sandslope::SignedSlope::from_degrees(top * k as f64 / 400.0))
+        .collect::<std::result::Result<Vec<_>, _>>()
+        .map_err(|e| RequestError::invalid("slope", e))?;
+    Ok(scenario.sweep(&slopes))
 }
 
 /// How each front end names this request's fields: the command line's flags are the

@@ -11,7 +11,7 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 
 use sandslope::calibrate::{Interval, ObservationKind, SpeedModel, SpeedObservation};
-use sandslope::{predict, JointCalibration, Parameter, Quantity, Slope, Terrain};
+use sandslope::{JointCalibration, Parameter, Quantity, Terrain};
 use sandslope_request::calibrate::{
     CalibrateAnswer, CalibrateLaw, CalibrateModel, CalibrateSource, JointAnswer, PerSlopeAnswer, ReposeRecord,
 };
@@ -183,15 +183,7 @@ fn draw_fit(
 ) -> Result<()> {
     let lo = speeds.iter().map(|o| o.slope.degrees()).fold(0.0, f64::min);
     let hi = speeds.iter().map(|o| o.slope.degrees()).fold(lo + 1.0, f64::max);
-    let curve: Vec<(f64, Option<f64>)> = (0..=200)
-        .map(|i| lo + (hi - lo) * i as f64 / 200.0)
-        .filter_map(|d| Slope::from_degrees(d).ok().map(|s| (d, s)))
-        .map(|(d, s)| {
-            let mut ground = terrain.at(s);
-            ground.repose = None; // the fit ignores repose: an observed speed shows the robot moved
-            (d, predict(fitted_robot, s, &ground).speed)
-        })
-        .collect();
+    let curve = sandslope::calibrate::speed_curve(fitted_robot, terrain, lo, hi, 200);
     let points = speed_pulls(&cal.pulls);
     let title = format!(
         "chi^2/dof = {}, k_s(20)/k_s(0) = {:.2}",

@@ -9,7 +9,6 @@ use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 
 use sandslope::gait::{TouchdownSource, TrackResult, DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP};
-use sandslope::Scenario;
 use sandslope_request::error::Words;
 use sandslope_request::track::{Touchdowns, TrackRequest};
 
@@ -169,13 +168,7 @@ pub fn run(args: TrackArgs) -> Result<()> {
         let model = match &overlay {
             Some(rows) => {
                 let top = rows.iter().map(|r| r.slope_deg).fold(0.0, f64::max);
-                let scenario = Scenario::new(robot.clone(), args.terrain.load()?, None, None)
-                    .map_err(|e| anyhow!("{e}"))?;
-                let slopes = (0..=400)
-                    .map(|k| sandslope::SignedSlope::from_degrees((top + 2.0).min(89.0) * k as f64 / 400.0))
-                    .collect::<Result<Vec<_>, _>>()
-                    .map_err(|e| anyhow!("{e}"))?;
-                scenario.sweep(&slopes)
+                sandslope_request::track::model_curve(&robot, args.terrain.load()?, top)?
             }
             None => Vec::new(),
         };

@@ -39,6 +39,28 @@ pub struct JointSetup {
     pub error_floor: f64,
 }
 
+/// The closed form's speed of `robot` on `terrain` at `points + 1` slopes evenly from `lo_deg`
+/// to `hi_deg` (those from 0 to below 90 degrees; `None` where the leg never anchors), through
+/// the terrain's angle of repose as the fit takes it (an observed speed shows the robot moved):
+/// the fitted model's curve `calibrate --plot` draws beside the observed speeds.
+pub fn speed_curve(
+    robot: &Robot,
+    terrain: &Terrain,
+    lo_deg: f64,
+    hi_deg: f64,
+    points: usize,
+) -> Vec<(f64, Option<f64>)> {
+    (0..=points)
+        .map(|i| lo_deg + (hi_deg - lo_deg) * i as f64 / points as f64)
+        .filter_map(|d| Slope::from_degrees(d).ok().map(|s| (d, s)))
+        .map(|(d, s)| {
+            let mut ground = terrain.at(s);
+            ground.repose = None;
+            (d, crate::model::predict(robot, s, &ground).speed)
+        })
+        .collect()
+}
+
 /// Fits the free quantities of `setup` to all its evidence at once with the closed form; see
 /// the module docs.
 pub fn calibrate_jointly(setup: &JointSetup) -> Result<JointCalibration, CalibrationError> {
@@ -317,6 +339,28 @@ mod tests {
     use crate::calibrate::model::walk_on_ground;
     use crate::model::tests::paper_robot;
     use crate::simulate::SimSettings;
+
+    /// The plotted curve is the closed form's speed through the angle of repose, as the fit
+    /// takes it: on sand that flows from 15 degrees the closed form calls 30 degrees slippage
+    /// (docs/model.md §6) but still gives the speed its k_n and k_s make, and the curve draws
+    /// that; its slopes are the ends and the evenly spaced ones between.
+    #[test]
+    fn the_speed_curve_runs_through_the_angle_of_repose() {
+        let robot = paper_robot();
+        let spec = TerrainSpec {
+            name: None,
+            repose_deg: Some(15.0),
+            points: vec![TerrainPoint { slope_deg: 0.0, k_n: 7e5, k_s: 3e6, k_n_sd: None, k_s_sd: None }],
+        };
+        let terrain = Terrain::new(spec).unwrap();
+        let curve = speed_curve(&robot, &terrain, 0.0, 30.0, 2);
+        assert_eq!(curve.iter().map(|p| p.0).collect::<Vec<_>>(), vec![0.0, 15.0, 30.0]);
+        let thirty = Slope::from_degrees(30.0).unwrap();
+        let closed = crate::model::predict(&robot, thirty, &terrain.at(thirty));
+        assert_eq!(closed.regime, crate::regime::Regime::Slippage);
+        assert_eq!(curve[2].1, closed.speed);
+        assert!(curve[2].1.is_some_and(|v| v > 0.0), "{curve:?}");
+    }
 
     /// The scan puts the simulator's fit in the basin of the leg strength that made the speeds:
     /// speeds walked at `plate_scale` 0.4 (leg k_s 0.4 x the force tests' 1e5 at 0 deg and, by

@@ -42,7 +42,9 @@ pub mod shear;
 pub use error::CalibrationError;
 pub use evidence::{AnchoringObservation, SpeedObservation};
 pub use inversion::{invert_each_speed, shear_strength_for_speed, InvertedSpeed, PerSlopeCalibration};
-pub use joint::{calibrate_jointly, calibrate_jointly_cancellable, calibrate_jointly_with, JointSetup};
+pub use joint::{
+    calibrate_jointly, calibrate_jointly_cancellable, calibrate_jointly_with, speed_curve, JointSetup,
+};
 pub use model::SpeedModel;
 pub use parameter::{FreeParameter, Parameter, Quantity, RobotKey};
 pub use result::{

@@ -64,6 +64,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add_function(wrap_pyfunction!(servo::read_servo_log, m)?)?;
     m.add_function(wrap_pyfunction!(servo::infer_servo_log, m)?)?;
+    m.add_function(wrap_pyfunction!(servo::infer_servo_log_file, m)?)?;
     m.add_function(wrap_pyfunction!(servo::drive_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(servo::drive, m)?)?;
     m.add("DEFAULT_MAX_RISK", sandslope::risk::DEFAULT_MAX_RISK)?;

@@ -12,7 +12,7 @@ use sandslope::infer::servo::{infer_servo_log as infer, CurrentInferenceSettings
 use sandslope::servo::xl330;
 use sandslope_request::drive::DriveRun;
 use sandslope_request::error::Words;
-use sandslope_request::infer::{prior_in, servo_grid_points};
+use sandslope_request::infer::{prior_in, servo_grid_points, ServoLogRequest};
 use sandslope_servo::driver::ServoSample;
 use sandslope_servo::session::{
     default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, RUN_DEFAULTS,
@@ -101,6 +101,32 @@ pub fn infer_servo_log<'py>(
     let (robot, terrain) = (robot.inner.clone(), terrain.inner.clone());
     let answer = py.detach(|| infer(&robot, &terrain, slope, &traces, &settings)).map_err(value_error)?;
     pythonize(py, &answer).map_err(value_error)
+}
+
+/// `infer_servo_log` of a log's path: the request `sandslope infer --servo-log FILE` makes
+/// (the log read, the slope from `slope_deg` or the log's header, the prior and grid checked),
+/// answered; returns `(answer, notes)`, `notes` what the log's reader repaired.
+#[pyfunction]
+#[pyo3(signature = (robot, terrain, path, slope_deg=None, k_s_prior=None, grid_points=None))]
+pub fn infer_servo_log_file<'py>(
+    py: Python<'py>,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+    path: std::path::PathBuf,
+    slope_deg: Option<f64>,
+    k_s_prior: Option<(f64, f64)>,
+    grid_points: Option<usize>,
+) -> PyResult<(Bound<'py, PyAny>, Vec<String>)> {
+    let request = ServoLogRequest {
+        path,
+        slope_deg,
+        k_s_prior: k_s_prior.unwrap_or(sandslope::infer::servo::SERVO_LOG_K_S_PRIOR),
+        grid_points: grid_points.unwrap_or(sandslope::infer::servo::SERVO_LOG_GRID_POINTS),
+    };
+    let (robot, terrain) = (robot.inner.clone(), terrain.inner.clone());
+    let run = py.detach(|| request.read(&robot, Words::Keyword)).map_err(|e| value_error(e.message()))?;
+    let answer = py.detach(|| run.answer(&robot, &terrain)).map_err(|e| value_error(e.message()))?;
+    Ok((pythonize(py, &answer).map_err(value_error)?, run.notes))
 }
 
 /// `drive`'s defaults (`sandslope_servo::session::RUN_DEFAULTS`), as a dict: what

@@ -1,20 +1,24 @@
 //! `infer`'s request: what the robot's own gait says about the sand (docs/inference.md). From
 //! observed speeds (and anchoring times), the posterior of k_s at each observed slope
 //! ([`sandslope::infer::posteriors`]); with a shear law, the law's joint posterior and the
-//! predicted failure risk at slopes not walked ([`sandslope::infer::law_posterior`]). (`infer
-//! --servo-log`, k_s from a drive's currents, is the servo front end's; its prior and grid are
-//! checked here, [`prior_in`] and [`servo_grid_points`], for it and Python's `infer_servo_log`.)
+//! predicted failure risk at slopes not walked ([`sandslope::infer::law_posterior`]). And
+//! `infer --servo-log`, k_s from a drive's currents ([`ServoLogRequest`]): the log read, its
+//! slope taken from the request or the log's header, its prior and grid checked, for the
+//! command line and Python's `infer_servo_log` of a log's path.
 
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
+use sandslope::infer::servo::{
+    infer_servo_log, CurrentInference, CurrentInferenceError, CurrentInferenceSettings, LegTrace,
+};
 use sandslope::infer::{
     law_posterior, posteriors, GaitObservation, InferLaw, LawPosterior, LogUniformPrior, RiskPrediction,
     SlopePosterior,
 };
 use sandslope::risk::UncertainTerrain;
-use sandslope::{Robot, Slope};
+use sandslope::{Robot, SignedSlope, Slope, Terrain};
 use sandslope_io::observations::{load_speed_observations, load_step_observation};
 
 use crate::error::{RequestError, Result, Words};
@@ -192,6 +196,85 @@ impl InferRequest {
         let notes = if law.is_some() { note.into_iter().collect() } else { Vec::new() };
         let prediction = law.as_ref().map_or_else(Vec::new, |l| l.prediction.clone());
         Ok(InferAnswer { prior, points, law, prediction, notes })
+    }
+}
+
+/// `infer --servo-log FILE` (and Python's `infer_servo_log` of a log's path): k_s from the
+/// stance currents a `drive` run logged (docs/model.md §19).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ServoLogRequest {
+    /// The log, as `drive --log` writes it.
+    pub path: PathBuf,
+    /// The run's slope, degrees (field `slope`); the log's `# slope_deg` header when `None`.
+    pub slope_deg: Option<f64>,
+    /// The prior's range of k_s, N/m^3 (field `k-s-prior`).
+    pub k_s_prior: (f64, f64),
+    /// Points of the simulator's k_s grid (field `grid-points`).
+    pub grid_points: usize,
+}
+
+/// A servo log read and checked: what the inference runs on.
+#[derive(Debug, Clone)]
+pub struct ServoLogRun {
+    /// The log's path (errors name it).
+    pub path: PathBuf,
+    /// The run's slope.
+    pub slope: SignedSlope,
+    /// Each leg's stance trace.
+    pub traces: Vec<LegTrace>,
+    /// What the reader repaired (the CLI's `note:` lines, Python's `notes`).
+    pub notes: Vec<String>,
+    /// The prior and grid.
+    pub settings: CurrentInferenceSettings,
+}
+
+impl ServoLogRequest {
+    /// Checks the prior and grid, reads the log for `robot`'s legs and takes the slope (the
+    /// request's, else the log's header); errors name the file and the field in `words`.
+    pub fn read(&self, robot: &Robot, words: Words) -> Result<ServoLogRun> {
+        let prior = prior_in(words, self.k_s_prior)?;
+        let grid_points = servo_grid_points(words, self.grid_points)?;
+        let path = self.path.as_path();
+        let file_error = |e: anyhow::Error| RequestError::from_error(Some("servo-log"), e);
+        let log = sandslope_io::servo_log::read_servo_log(path).map_err(file_error)?;
+        let slope_name = match words {
+            Words::Flag => "--slope",
+            Words::Keyword => "slope_deg",
+        };
+        let slope_deg = match (self.slope_deg, log.meta_f64("slope_deg", path).map_err(file_error)?) {
+            (Some(s), _) | (None, Some(s)) => s,
+            (None, None) => {
+                let give = match words {
+                    Words::Flag => "give the run's slope with --slope",
+                    Words::Keyword => "give slope_deg",
+                };
+                return Err(RequestError::invalid(
+                    "slope",
+                    format!("{}: the log has no `# slope_deg = ...` header line; {give}", path.display()),
+                ));
+            }
+        };
+        let slope = SignedSlope::from_degrees(slope_deg)
+            .map_err(|e| RequestError::invalid("slope", e.renamed(slope_name)))?;
+        let traces = log.leg_traces(2 * robot.stance_legs() as usize, path).map_err(file_error)?;
+        let settings = CurrentInferenceSettings { prior, grid_points, ..Default::default() };
+        Ok(ServoLogRun { path: path.to_path_buf(), slope, traces, notes: log.notes, settings })
+    }
+}
+
+impl ServoLogRun {
+    /// The posterior of k_s (seconds of CPU: the stride simulator walks the grid); an error
+    /// about the log names it.
+    pub fn answer(&self, robot: &Robot, terrain: &Terrain) -> Result<CurrentInference> {
+        infer_servo_log(robot, terrain, self.slope, &self.traces, &self.settings).map_err(|e| {
+            let message = match e {
+                CurrentInferenceError::TooFewStrides { .. } | CurrentInferenceError::Setting(_) => {
+                    format!("{}: {e}", self.path.display())
+                }
+                e => e.to_string(),
+            };
+            RequestError::from_error(None, anyhow::anyhow!("{message}"))
+        })
     }
 }
 

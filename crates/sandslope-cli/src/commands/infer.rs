@@ -5,13 +5,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::Result;
 use clap::{Args, ValueEnum};
 
-use sandslope::infer::{Bound, InferLaw, LogUniformPrior};
-use sandslope::SignedSlope;
+use sandslope::infer::{Bound, InferLaw};
 use sandslope_request::error::Words;
-use sandslope_request::infer::{self, GaitEvidence, InferAnswer, InferRequest};
+use sandslope_request::infer::{self, GaitEvidence, InferAnswer, InferRequest, ServoLogRequest};
 
 use crate::args::{parse_slope_list, RobotArgs, SlopeSign, TerrainArgs, UncertaintyArgs};
 use crate::figures::infer::InferFigure;
@@ -83,10 +82,6 @@ fn default_prior() -> String {
     format!("{lo:e}:{hi:e}")
 }
 
-fn parse_prior(text: &str) -> Result<LogUniformPrior> {
-    Ok(infer::prior(infer::parse_prior(text)?)?)
-}
-
 /// Most slopes `--predict` evaluates.
 const MAX_PREDICT: usize = 10_000;
 
@@ -129,37 +124,28 @@ fn bound_note(b: Bound) -> &'static str {
 
 /// `infer --servo-log`: k_s from the stance currents of a `drive` log (docs/model.md §19).
 fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
-    use sandslope::infer::servo::{infer_servo_log, CurrentInferenceSettings};
     let robot = args.robot.load()?;
-    let prior = parse_prior(&args.k_s_prior)?;
-    infer::servo_grid_points(Words::Flag, args.grid_points)?;
-    let log = sandslope_io::servo_log::read_servo_log(path)?;
-    let slope_deg = match (args.slope, log.meta_f64("slope_deg", path)?) {
-        (Some(s), _) | (None, Some(s)) => s,
-        (None, None) => bail!(
-            "{}: the log has no `# slope_deg = ...` header line; give the run's slope with --slope",
-            path.display()
-        ),
+    // The log read and checked, its slope taken, by the request layer (as Python's is).
+    let request = ServoLogRequest {
+        path: path.to_path_buf(),
+        slope_deg: args.slope,
+        k_s_prior: infer::parse_prior(&args.k_s_prior)?,
+        grid_points: args.grid_points,
     };
-    let slope = SignedSlope::from_degrees(slope_deg).map_err(|e| anyhow!("{}", e.renamed("--slope")))?;
+    let run = request.read(&robot, Words::Flag)?;
     let terrain = args.terrain.load()?;
-    let traces = log.leg_traces(2 * robot.stance_legs() as usize, path)?;
-    for note in &log.notes {
+    for note in &run.notes {
         eprintln!("note: {}: {note}", path.display());
     }
-    let settings = CurrentInferenceSettings { prior, grid_points: args.grid_points, ..Default::default() };
-    let answer = infer_servo_log(&robot, &terrain, slope, &traces, &settings).map_err(|e| match e {
-        sandslope::infer::servo::CurrentInferenceError::TooFewStrides { .. }
-        | sandslope::infer::servo::CurrentInferenceError::Setting(_) => anyhow!("{}: {e}", path.display()),
-        e => anyhow!("{e}"),
-    })?;
+    let answer = run.answer(&robot, &terrain)?;
+    let slope_deg = run.slope.degrees();
     let k_n = answer.k_n;
     if args.json {
         // The reader's repairs beside the answer (they are the file's, not the sand's), as
         // Python's `infer_servo_log` returns them.
         let mut v = serde_json::to_value(&answer)?;
         if let Some(o) = v.as_object_mut() {
-            o.insert("notes".into(), serde_json::json!(log.notes));
+            o.insert("notes".into(), serde_json::json!(run.notes));
         }
         return print_json(&v);
     }

@@ -269,6 +269,14 @@ def infer_servo_log(
     k_s_prior: Optional[Tuple[float, float]] = None,
     grid_points: Optional[int] = None,
 ) -> Dict[str, Any]: ...
+def infer_servo_log_file(
+    robot: Robot,
+    terrain: Terrain,
+    path: _Path,
+    slope_deg: Optional[float] = None,
+    k_s_prior: Optional[Tuple[float, float]] = None,
+    grid_points: Optional[int] = None,
+) -> Tuple[Dict[str, Any], List[str]]: ...
 def drive_defaults() -> Dict[str, Any]: ...
 def drive(
     robot: Robot,

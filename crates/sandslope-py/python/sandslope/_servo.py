@@ -57,19 +57,23 @@ def infer_servo_log(
     stride simulator walks ``grid_points`` values of k_s over ``k_s_prior`` (seconds of CPU, the
     GIL released); left out, they are the CLI's defaults (41 over 1e4 to 1e9 N/m^3, from the
     library's constants)."""
-    notes: list = []
+    prior = None if k_s_prior is None else (float(k_s_prior[0]), float(k_s_prior[1]))
+    points = None if grid_points is None else int(grid_points)
     if isinstance(log, (str, os.PathLike)):
-        columns, meta, notes = _sandslope.read_servo_log(os.fspath(log))
-        if slope_deg is None:
-            if "slope_deg" not in meta:
-                raise ValueError(
-                    f"{os.fspath(log)}: the log has no `# slope_deg = ...` header line; give slope_deg"
-                )
-            slope_deg = float(meta["slope_deg"])
-    else:
-        columns = log
-        if slope_deg is None:
-            raise ValueError("slope_deg: give the run's slope (degrees) with a log's columns")
+        # A log's path: the request `infer --servo-log FILE` makes, read and answered in Rust.
+        answer, notes = _sandslope.infer_servo_log_file(
+            _robot(robot),
+            _terrain(terrain),
+            os.fspath(log),
+            slope_deg=None if slope_deg is None else float(slope_deg),
+            k_s_prior=prior,
+            grid_points=points,
+        )
+        answer["notes"] = list(notes)
+        return answer
+    columns = log
+    if slope_deg is None:
+        raise ValueError("slope_deg: give the run's slope (degrees) with a log's columns")
     missing = [c for c in SERVO_COLUMNS if c not in columns]
     if missing:
         raise ValueError(f"log: the column(s) {', '.join(missing)} are missing (docs/drive.md, 'The log')")
@@ -80,10 +84,10 @@ def infer_servo_log(
         np.ascontiguousarray(columns["leg"], dtype=np.int64),
         np.ascontiguousarray(columns["leg_angle_rad"], dtype=np.float64),
         np.ascontiguousarray(columns["drive_torque_n_m"], dtype=np.float64),
-        k_s_prior=None if k_s_prior is None else (float(k_s_prior[0]), float(k_s_prior[1])),
-        grid_points=None if grid_points is None else int(grid_points),
+        k_s_prior=prior,
+        grid_points=points,
     )
-    answer["notes"] = list(notes)
+    answer["notes"] = []
     return answer
 
 

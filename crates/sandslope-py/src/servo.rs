@@ -9,7 +9,7 @@ use pyo3::types::PyDict;
 use pythonize::pythonize;
 
 use sandslope::infer::servo::{infer_servo_log as infer, CurrentInferenceSettings, LegTrace};
-use sandslope::servo::xl330;
+use sandslope_io::servo_log::ServoLogRow;
 use sandslope_request::drive::DriveRun;
 use sandslope_request::error::Words;
 use sandslope_request::infer::{prior_in, servo_grid_points, ServoLogRequest};
@@ -23,18 +23,9 @@ use crate::arrays::{put, values};
 use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
 
-/// Reads a `drive --log` CSV: `(columns, meta, notes)`, `columns` the log's columns as 1-D
-/// arrays (docs/drive.md, "The log"), `meta` its `# key = value` header lines, `notes` what the
-/// reader repaired (the CLI's `note:` lines and `infer --servo-log --json`'s `notes`).
-#[pyfunction]
-#[allow(clippy::type_complexity)]
-pub fn read_servo_log<'py>(
-    py: Python<'py>,
-    path: std::path::PathBuf,
-) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>, Vec<String>)> {
-    let log = py.detach(|| sandslope_io::servo_log::read_servo_log(&path)).map_err(anyhow_error)?;
+/// A servo log's rows as its columns, 1-D arrays by column name (docs/drive.md, "The log").
+fn log_columns<'py>(py: Python<'py>, r: &[ServoLogRow]) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let r = &log.rows;
     put(&d, "time_s", r.iter().map(|r| r.time_s).collect())?;
     put(&d, "id", r.iter().map(|r| i64::from(r.id)).collect())?;
     put(&d, "leg", r.iter().map(|r| r.leg as i64).collect())?;
@@ -49,6 +40,20 @@ pub fn read_servo_log<'py>(
     put(&d, "goal_position", r.iter().map(|r| i64::from(r.goal_position)).collect())?;
     put(&d, "leg_angle_rad", r.iter().map(|r| r.leg_angle_rad).collect())?;
     put(&d, "drive_torque_n_m", r.iter().map(|r| r.drive_torque_n_m).collect())?;
+    Ok(d)
+}
+
+/// Reads a `drive --log` CSV: `(columns, meta, notes)`, `columns` the log's columns as 1-D
+/// arrays (docs/drive.md, "The log"), `meta` its `# key = value` header lines, `notes` what the
+/// reader repaired (the CLI's `note:` lines and `infer --servo-log --json`'s `notes`).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+pub fn read_servo_log<'py>(
+    py: Python<'py>,
+    path: std::path::PathBuf,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>, Vec<String>)> {
+    let log = py.detach(|| sandslope_io::servo_log::read_servo_log(&path)).map_err(anyhow_error)?;
+    let d = log_columns(py, &log.rows)?;
     let meta = PyDict::new(py);
     for (k, v) in &log.meta {
         meta.set_item(k, v)?;
@@ -231,30 +236,9 @@ pub fn drive<'py>(
             Ok((samples, report, emulator))
         })
         .map_err(value_error)?;
-    let d = PyDict::new(py);
-    let s = &samples;
-    put(&d, "time_s", s.iter().map(|s| s.time_s).collect())?;
-    put(&d, "id", s.iter().map(|s| i64::from(s.id)).collect())?;
-    put(&d, "leg", s.iter().map(|s| s.leg as i64).collect())?;
-    put(&d, "tripod", s.iter().map(|s| s.tripod as i64).collect())?;
-    put(&d, "present_position", s.iter().map(|s| i64::from(s.state.position)).collect())?;
-    put(&d, "present_velocity", s.iter().map(|s| i64::from(s.state.velocity)).collect())?;
-    put(&d, "present_current_ma", s.iter().map(|s| i64::from(s.state.current_ma)).collect())?;
-    put(
-        &d,
-        "load_percent",
-        s.iter().map(|s| 100.0 * f64::from(s.state.current_ma) / (xl330::STALL_CURRENT_A * 1000.0)).collect(),
-    )?;
-    put(
-        &d,
-        "input_voltage_v",
-        s.iter().map(|s| f64::from(s.state.voltage) * xl330::VOLT_PER_VOLTAGE_UNIT).collect(),
-    )?;
-    put(&d, "temperature_c", s.iter().map(|s| i64::from(s.state.temperature_c)).collect())?;
-    put(&d, "hardware_error", s.iter().map(|s| i64::from(s.hardware_error)).collect())?;
-    put(&d, "goal_position", s.iter().map(|s| i64::from(s.goal_position)).collect())?;
-    put(&d, "leg_angle_rad", s.iter().map(|s| s.leg_angle_rad).collect())?;
-    put(&d, "drive_torque_n_m", s.iter().map(|s| s.drive_torque_n_m).collect())?;
+    // The rows the run's log holds, from the one row builder `drive --log` writes with.
+    let rows: Vec<ServoLogRow> = samples.iter().map(sandslope_servo::log::log_row).collect();
+    let d = log_columns(py, &rows)?;
     let report_py = pythonize(py, &report).map_err(value_error)?;
     if let Ok(dict) = report_py.cast::<PyDict>() {
         dict.set_item("emulator", emulator)?;

@@ -284,14 +284,58 @@ fn setup(
         };
         return Err(DriveError::Missing { id, leg, baud, answered });
     }
+    let writes = setup_writes(schedule, settings);
+    for (leg, s) in settings.servos.iter().enumerate() {
+        let id = s.id;
+        // Each write up to three times: a busy USB adapter (or machine) can miss one reply.
+        for write in &writes {
+            let data = &write.value.to_le_bytes()[..write.width];
+            let mut last = None;
+            for _ in 0..3 {
+                match bus.write(id, write.addr, data) {
+                    Ok(_) => {
+                        last = None;
+                        break;
+                    }
+                    Err(e) => last = Some(e.to_string()),
+                }
+            }
+            if let Some(reason) = last {
+                return Err(DriveError::Setup { id, leg, what: write.what, reason, fix: write.fix });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One control-table write of a servo's setup, before it stands.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SetupWrite {
+    /// The register's name, as `drive --dry-run` prints it.
+    pub name: &'static str,
+    /// The register's address.
+    pub addr: u16,
+    /// The value written, little-endian in `width` bytes.
+    pub value: u32,
+    /// The register's width, bytes (1, 2 or 4).
+    pub width: usize,
+    /// What a failed write names.
+    pub what: &'static str,
+    /// What to do about it.
+    pub fix: &'static str,
+}
+
+/// Every servo's setup, in the order written (docs/drive.md): torque off, the bus watchdog
+/// cleared, the operating mode for the profile, a velocity-based profile, the current and
+/// temperature limits, the velocity limit (2 omega), the profile's acceleration (position: 0,
+/// the schedule's own run-up limits it; velocity: omega over the run-up) and velocity
+/// (1.5 omega), and the bus watchdog; what `drive` writes and `drive --dry-run` prints.
+pub fn setup_writes(schedule: &GaitSchedule, settings: &DriveSettings) -> Vec<SetupWrite> {
     let omega = schedule.leg_speed_rad_s;
     let op = match settings.profile {
         Profile::Position => mode::EXTENDED_POSITION,
         Profile::Velocity => mode::VELOCITY,
     };
-    // The schedule's own run-up limits the acceleration in position mode (a servo profile
-    // that brakes for every streamed goal would lag); in velocity mode the servo's profile
-    // acceleration is the run-up's, omega / dt.
     let accel = match settings.profile {
         Profile::Position => 0,
         Profile::Velocity => ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT)
@@ -300,59 +344,65 @@ fn setup(
     };
     let prof_v = (1.5 * omega / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, 32767.0) as u32;
     let vel_limit = (2.0 * omega / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, 2047.0) as u32;
-    let watchdog = (settings.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round().clamp(1.0, 127.0) as u8;
-    for (leg, s) in settings.servos.iter().enumerate() {
-        let id = s.id;
-        // Each write up to three times: a busy USB adapter (or machine) can miss one reply.
-        let w = |bus: &mut DynamixelBus, addr: u16, data: &[u8], what: &'static str, fix: &'static str| {
-            let mut last = None;
-            for _ in 0..3 {
-                match bus.write(id, addr, data) {
-                    Ok(_) => return Ok(()),
-                    Err(e) => last = Some(e.to_string()),
-                }
-            }
-            Err(DriveError::Setup { id, leg, what, reason: last.unwrap_or_default(), fix })
-        };
-        w(bus, t::TORQUE_ENABLE, &[0], "Torque Enable = 0", "power-cycle the servo")?;
-        w(bus, t::BUS_WATCHDOG, &[0], "Bus Watchdog = 0", "reboot the servo (Dynamixel Wizard)")?;
-        w(bus, t::OPERATING_MODE, &[op], "Operating Mode", "check the model is an XL330")?;
+    let watchdog = (settings.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round().clamp(1.0, 127.0) as u32;
+    let w = |name, addr, value, width, what, fix| SetupWrite { name, addr, value, width, what, fix };
+    vec![
+        w("Torque Enable", t::TORQUE_ENABLE, 0, 1, "Torque Enable = 0", "power-cycle the servo"),
+        w("Bus Watchdog", t::BUS_WATCHDOG, 0, 1, "Bus Watchdog = 0", "reboot the servo (Dynamixel Wizard)"),
         w(
-            bus,
+            "Operating Mode",
+            t::OPERATING_MODE,
+            u32::from(op),
+            1,
+            "Operating Mode",
+            "check the model is an XL330",
+        ),
+        w(
+            "Drive Mode (velocity-based profile)",
             t::DRIVE_MODE,
-            &[0],
+            0,
+            1,
             "Drive Mode = 0 (velocity-based profile)",
             "check the model is an XL330",
-        )?;
+        ),
         w(
-            bus,
+            "Current Limit (mA)",
             t::CURRENT_LIMIT,
-            &settings.current_limit_ma.to_le_bytes(),
+            u32::from(settings.current_limit_ma),
+            2,
             "Current Limit",
             "use --current-limit within 0 to 1750 mA",
-        )?;
+        ),
         w(
-            bus,
+            "Temperature Limit (degC)",
             t::TEMPERATURE_LIMIT,
-            &[settings.temperature_limit_c],
+            u32::from(settings.temperature_limit_c),
+            1,
             "Temperature Limit",
             "use --temperature-limit within 0 to 70 degC",
-        )?;
-        w(bus, t::VELOCITY_LIMIT, &vel_limit.to_le_bytes(), "Velocity Limit", "lower leg_speed_rad_s")?;
+        ),
+        w("Velocity Limit", t::VELOCITY_LIMIT, vel_limit, 4, "Velocity Limit", "lower leg_speed_rad_s"),
         w(
-            bus,
+            "Profile Acceleration",
             t::PROFILE_ACCELERATION,
-            &accel.to_le_bytes(),
+            accel,
+            4,
             "Profile Acceleration",
             "raise response_time_s",
-        )?;
-        w(bus, t::PROFILE_VELOCITY, &prof_v.to_le_bytes(), "Profile Velocity", "lower leg_speed_rad_s")?;
-        w(bus, t::BUS_WATCHDOG, &[watchdog], "Bus Watchdog", "reboot the servo (Dynamixel Wizard)")?;
-    }
-    Ok(())
+        ),
+        w("Profile Velocity", t::PROFILE_VELOCITY, prof_v, 4, "Profile Velocity", "lower leg_speed_rad_s"),
+        w(
+            "Bus Watchdog (20 ms)",
+            t::BUS_WATCHDOG,
+            watchdog,
+            1,
+            "Bus Watchdog",
+            "reboot the servo (Dynamixel Wizard)",
+        ),
+    ]
 }
 
-/// The start pose found when standing up: each leg's start goal (the nearest turn of its start
+/// The start pose found when standing up/// The start pose found when standing up: each leg's start goal (the nearest turn of its start
 /// angle) and the shift of the schedule's angles to it.
 struct Stand {
     start_goal: Vec<i32>,

@@ -420,38 +420,11 @@ fn dry_run(schedule: &GaitSchedule, s: &DriveSettings) -> Result<()> {
     let ids: Vec<String> = s.servos.iter().map(|c| c.id.to_string()).collect();
     println!("# dry run: no bus opened; the commands `sandslope drive` sends (docs/drive.md)");
     println!("# ping IDs {} (model {} expected)", ids.join(", "), xl330::MODEL_NUMBER);
-    let omega = schedule.leg_speed_rad_s;
-    let mode = match s.profile {
-        Profile::Position => t::mode::EXTENDED_POSITION,
-        Profile::Velocity => t::mode::VELOCITY,
-    };
-    for (name, addr, value) in [
-        ("Torque Enable", t::TORQUE_ENABLE, "0".to_string()),
-        ("Operating Mode", t::OPERATING_MODE, mode.to_string()),
-        ("Drive Mode (velocity-based profile)", t::DRIVE_MODE, "0".into()),
-        ("Current Limit (mA)", t::CURRENT_LIMIT, s.current_limit_ma.to_string()),
-        ("Temperature Limit (degC)", t::TEMPERATURE_LIMIT, s.temperature_limit_c.to_string()),
-        ("Velocity Limit", t::VELOCITY_LIMIT, xl330::velocity_units_from_rad_s(2.0 * omega).to_string()),
-        (
-            "Profile Acceleration",
-            t::PROFILE_ACCELERATION,
-            match s.profile {
-                Profile::Position => "0".to_string(),
-                Profile::Velocity => {
-                    ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT).round().to_string()
-                }
-            },
-        ),
-        ("Profile Velocity", t::PROFILE_VELOCITY, xl330::velocity_units_from_rad_s(1.5 * omega).to_string()),
-        (
-            "Bus Watchdog (20 ms)",
-            t::BUS_WATCHDOG,
-            ((s.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round()).to_string(),
-        ),
-        ("Torque Enable", t::TORQUE_ENABLE, "1".into()),
-    ] {
-        println!("# write {name} ({addr}) = {value} on IDs {}", ids.join(", "));
+    // The driver's own setup list: what `drive` writes is what the dry run prints.
+    for w in sandslope_servo::driver::setup_writes(schedule, s) {
+        println!("# write {} ({}) = {} on IDs {}", w.name, w.addr, w.value, ids.join(", "));
     }
+    println!("# write Torque Enable ({}) = 1 on IDs {}", t::TORQUE_ENABLE, ids.join(", "));
     let goal = match s.profile {
         Profile::Position => "goal_position",
         Profile::Velocity => "goal_velocity",

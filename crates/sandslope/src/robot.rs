@@ -285,7 +285,7 @@ impl Robot {
                 "response_time_s",
                 dt,
                 format!(
-                    "large enough that the shear load mass_kg * (9.81 + leg_radius_m * leg_speed_rad_s / response_time_s) \
+                    "large enough that the shear load mass_kg * (g + leg_radius_m * leg_speed_rad_s / response_time_s) \
                      is a finite number (here {shear_load}); the paper's robot has 0.2 s"
                 ),
             ));

@@ -557,6 +557,10 @@ fn live_estimate_reads_through_a_biased_current_sensor() {
     let all = text(&out);
     assert_eq!(out.status.code(), Some(0), "{all}");
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The legs' measured speed is the gait's: the paper's robot turns them at 2 pi rad/s
+    // (one stride a second), and the emulated servos follow their goals.
+    let w = v["leg_speed_rad_s"].as_f64().unwrap();
+    assert!((w / std::f64::consts::TAU - 1.0).abs() < 0.05, "measured leg speed {w} rad/s: {all}");
     let live = v["live"].as_array().unwrap();
     // Eight seconds: 16 stances (the first after the run-up); a loaded machine may lose some.
     assert!(live.len() >= 10, "{} stances estimated: {all}", live.len());

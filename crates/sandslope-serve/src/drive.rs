@@ -25,12 +25,10 @@ use serde::Serialize;
 use sandslope_servo::driver::{DriveReport, LiveEstimate, ServoSample, TorqueOff};
 use sandslope_servo::log::{drive_logged, LogTarget};
 use sandslope_servo::session::{emulator_summary, DriveConfig, Session};
+use sandslope_servo::speed::LegSpeedMeter;
 use sandslope_servo::DriveOutcome;
 
 use crate::reply::{json, ApiError};
-
-/// The window over which a leg's speed is measured from its positions, s.
-pub const LEG_SPEED_WINDOW_S: f64 = 0.25;
 
 /// What a served run is doing, as `/api/drive/status` answers it.
 #[derive(Debug, Clone, Default, Serialize)]
@@ -198,27 +196,14 @@ impl DriveThread {
 fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<LogFile>) {
     // Either flag stops the gait: the stop button's or the signal handler's.
     let stop = AtomicBool::new(false);
-    // Each leg's speed from its positions a quarter second apart (Present Velocity, read just
-    // after each cycle's new goal, is the position loop's peak, not the leg's mean speed).
-    let legs = session.config().settings.servos.len();
-    let mut anchor: Vec<Option<(f64, f64)>> = vec![None; legs];
-    let mut speeds: Vec<Option<f64>> = vec![None; legs];
+    // Each leg's speed from its positions a quarter second apart, as the run's report gives it.
+    let mut meter = LegSpeedMeter::new(session.config().settings.servos.len());
     let mut on_sample = |s: &ServoSample| {
         if live.stop.load(Ordering::Relaxed) || flags.stop.load(Ordering::Relaxed) {
             stop.store(true, Ordering::Relaxed);
         }
-        if let Some(j) = (s.leg < legs).then_some(s.leg) {
-            match anchor[j] {
-                Some((t0, a0)) if s.time_s - t0 >= LEG_SPEED_WINDOW_S => {
-                    speeds[j] = Some((s.leg_angle_rad - a0) / (s.time_s - t0));
-                    anchor[j] = Some((s.time_s, s.leg_angle_rad));
-                }
-                Some(_) => {}
-                None => anchor[j] = Some((s.time_s, s.leg_angle_rad)),
-            }
-        }
-        let known: Vec<f64> = speeds.iter().flatten().copied().collect();
-        let known = &known;
+        meter.observe(s);
+        let speed = meter.mean();
         live.update(|st| {
             if s.leg == 0 {
                 st.cycles += 1;
@@ -227,8 +212,8 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
             if st.state == "standing" && s.time_s >= 0.0 {
                 st.state = "driving";
             }
-            if !known.is_empty() {
-                st.leg_speed_rad_s = known.iter().sum::<f64>() / known.len() as f64;
+            if let Some(w) = speed {
+                st.leg_speed_rad_s = w;
             }
         });
     };
@@ -256,6 +241,7 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
                 cycles: 0,
                 rate_hz: 0.0,
                 live: vec![],
+                leg_speed_rad_s: None,
                 torque_off: TorqueOff::default(),
                 gait_zero: None,
             },

@@ -94,7 +94,7 @@ pub struct DriveSettings {
 }
 
 /// One servo's state in one cycle: what the log holds.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct ServoSample {
     /// Time since the gait started, s (negative while standing up).
     pub time_s: f64,
@@ -171,6 +171,10 @@ pub struct DriveReport {
     pub rate_hz: f64,
     /// Live estimates, one per stance (with a monitor).
     pub live: Vec<LiveEstimate>,
+    /// The legs' mean speed over the run's last quarter second as their positions give it,
+    /// rad/s ([`crate::speed::LegSpeedMeter`]; the gait commands the robot's leg speed);
+    /// `None` when no leg ran a quarter second.
+    pub leg_speed_rad_s: Option<f64>,
     /// The torque on the way out.
     pub torque_off: TorqueOff,
     /// The instant of gait time 0 (the legs stood up, `stand_s` after the walk's first
@@ -216,11 +220,20 @@ pub fn drive(
         cycles: 0,
         rate_hz: 0.0,
         live: vec![],
+        leg_speed_rad_s: None,
         torque_off: TorqueOff::default(),
         gait_zero: None,
     };
-    let result = setup(bus, schedule, settings)
-        .and_then(|()| run(bus, schedule, settings, monitor, stop, on_sample, on_live, &mut report));
+    let mut meter = crate::speed::LegSpeedMeter::new(settings.servos.len());
+    let result = {
+        let mut observed = |s: &ServoSample| {
+            meter.observe(s);
+            on_sample(s)
+        };
+        setup(bus, schedule, settings)
+            .and_then(|()| run(bus, schedule, settings, monitor, stop, &mut observed, on_live, &mut report))
+    };
+    report.leg_speed_rad_s = meter.mean();
     report.torque_off = torque_off(bus, &settings.servos);
     match result {
         Ok(o) => {

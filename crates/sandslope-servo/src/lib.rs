@@ -22,6 +22,7 @@ pub mod error;
 pub mod log;
 pub mod packet;
 pub mod session;
+pub mod speed;
 mod stance;
 pub mod table;
 

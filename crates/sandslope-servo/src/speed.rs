@@ -1,0 +1,74 @@
+//! The legs' speed as the servos measure it: each leg's turn between two of its positions a
+//! window apart. Present Velocity, read just after each cycle's new goal, is the position
+//! loop's peak, not the leg's mean speed, so the speed is taken from the positions.
+
+use crate::driver::ServoSample;
+
+/// The window over which a leg's speed is measured from its positions, s.
+pub const LEG_SPEED_WINDOW_S: f64 = 0.25;
+
+/// Each leg's latest speed over [`LEG_SPEED_WINDOW_S`], from the samples it is shown.
+#[derive(Debug, Clone)]
+pub struct LegSpeedMeter {
+    /// Per leg, the time and angle the current window started at.
+    anchor: Vec<Option<(f64, f64)>>,
+    /// Per leg, its speed over the last full window, rad/s.
+    speeds: Vec<Option<f64>>,
+}
+
+impl LegSpeedMeter {
+    /// A meter for `legs` legs, no window measured yet.
+    pub fn new(legs: usize) -> LegSpeedMeter {
+        LegSpeedMeter { anchor: vec![None; legs], speeds: vec![None; legs] }
+    }
+
+    /// Takes one servo's sample (a leg beyond the meter's is ignored).
+    pub fn observe(&mut self, s: &ServoSample) {
+        let Some(anchor) = self.anchor.get_mut(s.leg) else { return };
+        match *anchor {
+            Some((t0, a0)) if s.time_s - t0 >= LEG_SPEED_WINDOW_S => {
+                self.speeds[s.leg] = Some((s.leg_angle_rad - a0) / (s.time_s - t0));
+                *anchor = Some((s.time_s, s.leg_angle_rad));
+            }
+            Some(_) => {}
+            None => *anchor = Some((s.time_s, s.leg_angle_rad)),
+        }
+    }
+
+    /// The mean of the legs' latest speeds, rad/s; `None` before any leg's first window.
+    pub fn mean(&self) -> Option<f64> {
+        let known: Vec<f64> = self.speeds.iter().flatten().copied().collect();
+        (!known.is_empty()).then(|| known.iter().sum::<f64>() / known.len() as f64)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(leg: usize, time_s: f64, leg_angle_rad: f64) -> ServoSample {
+        ServoSample { time_s, leg, leg_angle_rad, ..ServoSample::default() }
+    }
+
+    /// Two legs turning at 2 pi and pi rad/s, sampled at 50 Hz: no speed before a window has
+    /// passed, then each leg's own, and their mean 1.5 pi; a leg the meter does not have is
+    /// ignored.
+    #[test]
+    fn the_meter_takes_each_legs_turn_over_its_window() {
+        let mut m = LegSpeedMeter::new(2);
+        let pi = std::f64::consts::PI;
+        for k in 0..=10 {
+            let t = k as f64 * 0.02;
+            m.observe(&sample(0, t, 2.0 * pi * t));
+            m.observe(&sample(1, t, pi * t));
+            m.observe(&sample(5, t, 100.0 * t));
+        }
+        assert_eq!(m.mean(), None);
+        for k in 11..=30 {
+            let t = k as f64 * 0.02;
+            m.observe(&sample(0, t, 2.0 * pi * t));
+            m.observe(&sample(1, t, pi * t));
+        }
+        assert!((m.mean().unwrap() - 1.5 * pi).abs() < 1e-9, "{:?}", m.mean());
+    }
+}

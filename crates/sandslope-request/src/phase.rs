@@ -10,7 +10,7 @@ use sandslope::limits::MAX_PHASE_CELLS;
 use sandslope::memory::uninit;
 use sandslope::{
     write_phase_rows, Axis, PanelSummary, PhasePanel, RegimeCounts, Robot, SignedSlope, Slope, StrengthGrid,
-    Terrain,
+    Terrain, TerrainGrid,
 };
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 
@@ -164,8 +164,8 @@ impl PhaseGrid {
             for &slope_deg in &self.slopes_deg {
                 let slope = SignedSlope::from_degrees(slope_deg)
                     .map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))?;
-                let panel =
-                    PhasePanel::compute(robot, slope, &self.terrain, &self.k_n_axis, &self.k_s_axis, on_row);
+                let on = TerrainGrid { terrain: &self.terrain, k_n: &self.k_n_axis, k_s: &self.k_s_axis };
+                let panel = PhasePanel::compute(robot, slope, on, on_row);
                 panels.push(panel);
             }
         }

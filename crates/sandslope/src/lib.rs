@@ -75,7 +75,7 @@ pub use gait::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording, Upslope
 pub use measure::{MeasureError, SlopeEstimate};
 pub use model::{predict, Prediction};
 pub use phase::{
-    write_phase, write_phase_rows, PanelGround, PanelSummary, PhaseMap, PhasePanel, RegimeCounts,
+    write_phase, write_phase_rows, PanelGround, PanelSummary, PhaseMap, PhasePanel, RegimeCounts, TerrainGrid,
 };
 pub use plan::{ElevationGrid, Objective, PlanSettings, Planner};
 pub use regime::{Cause, Regime};

@@ -32,7 +32,7 @@ use crate::strength_grid::StrengthGrid;
 
 mod panel;
 
-pub use panel::{PanelGround, PanelSummary, PhasePanel};
+pub use panel::{PanelGround, PanelSummary, PhasePanel, TerrainGrid};
 
 /// The k_s-only part of the net step at one grid row: `s = s* scale - drag - slip`.
 #[derive(Debug, Clone, Copy, PartialEq)]

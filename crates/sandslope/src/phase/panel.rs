@@ -34,22 +34,32 @@ pub struct PhasePanel {
     pub anchoring_threshold_k_s: f64,
 }
 
+/// A terrain and the strength grid its phase diagrams are drawn over: `k_n` the columns and
+/// `k_s` the rows, N/m^3; the terrain's own point at each slope is marked on them and its angle
+/// of repose bounds them.
+#[derive(Debug, Clone, Copy)]
+pub struct TerrainGrid<'a> {
+    /// The terrain.
+    pub terrain: &'a Terrain,
+    /// The normal resistances k_n: the grid's columns.
+    pub k_n: &'a Axis,
+    /// The shear strengths k_s: the grid's rows.
+    pub k_s: &'a Axis,
+}
+
 impl PhasePanel {
     /// The panel of `robot` at `signed` (a descent evaluated as the climb of its size) on
-    /// `terrain`, over `k_n_axis x k_s_axis`. `row_done` as in [`PhaseMap::compute`].
+    /// `on`'s terrain over its grid. `row_done` as in [`PhaseMap::compute`].
     pub fn compute(
         robot: &Robot,
         signed: SignedSlope,
-        terrain: &Terrain,
-        k_n_axis: &Axis,
-        k_s_axis: &Axis,
+        on: TerrainGrid<'_>,
         row_done: &(dyn Fn() + Sync),
     ) -> PhasePanel {
         let (slope_deg, slope) = (signed.degrees(), signed.felt());
-        let map = PhaseMap::compute(
-            &StrengthGrid::new(robot, slope, terrain.repose(), k_n_axis, k_s_axis),
-            row_done,
-        );
+        let terrain = on.terrain;
+        let map =
+            PhaseMap::compute(&StrengthGrid::new(robot, slope, terrain.repose(), on.k_n, on.k_s), row_done);
         let g: Ground = terrain.at(slope);
         PhasePanel {
             slope_deg,

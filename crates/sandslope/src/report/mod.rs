@@ -26,7 +26,7 @@ use crate::error::ParamError;
 use crate::gait::track::TrackResult;
 use crate::model::{predict, Prediction};
 use crate::paper::{self, compare_with_paper, Basis, ComparisonContext, PaperComparison};
-use crate::phase::PhasePanel;
+use crate::phase::{PhasePanel, TerrainGrid};
 use crate::risk::{
     risk_curve, safe_slope_limit, success_slope_limit, RiskCurve, SafeLimit, UncertainTerrain,
 };
@@ -663,14 +663,8 @@ fn plots(
     let mut phase = Vec::new();
     for (_, mass, slope_deg) in PHASE_PANELS {
         let r = robot.with_mass(mass)?;
-        phase.push(PhasePanel::compute(
-            &r,
-            SignedSlope::from_degrees(slope_deg)?,
-            terrain,
-            &k_n_axis,
-            &k_s_axis,
-            &|| {},
-        ));
+        let on = TerrainGrid { terrain, k_n: &k_n_axis, k_s: &k_s_axis };
+        phase.push(PhasePanel::compute(&r, SignedSlope::from_degrees(slope_deg)?, on, &|| {}));
     }
     let uncertain = UncertainTerrain::new(terrain.clone(), None, None)?;
     let risk_slopes =

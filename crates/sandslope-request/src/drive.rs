@@ -2,13 +2,15 @@
 //! and Python's `drive` keywords set (docs/drive.md), each against its range and named as each
 //! front end names it. The servo crate builds the run from them (`DriveConfig`).
 
+use serde::{Deserialize, Serialize};
+
 use sandslope::servo::xl330;
 use sandslope::{SignedSlope, Terrain};
 
 use crate::error::{RequestError, Result, Words};
 
 /// The numbers of one drive run, as a front end gives them.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DriveRun {
     /// Slope of the run, degrees (negative: downhill).
     pub slope_deg: f64,

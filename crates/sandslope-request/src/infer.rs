@@ -201,7 +201,7 @@ impl InferRequest {
 
 /// `infer --servo-log FILE` (and Python's `infer_servo_log` of a log's path): k_s from the
 /// stance currents a `drive` run logged (docs/model.md §19).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ServoLogRequest {
     /// The log, as `drive --log` writes it.
     pub path: PathBuf,

@@ -202,7 +202,7 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
         if live.stop.load(Ordering::Relaxed) || flags.stop.load(Ordering::Relaxed) {
             stop.store(true, Ordering::Relaxed);
         }
-        meter.observe(s);
+        meter.observe(s.leg, s.time_s, s.leg_angle_rad);
         let speed = meter.mean();
         live.update(|st| {
             if s.leg == 0 {

@@ -94,7 +94,7 @@ pub struct DriveSettings {
 }
 
 /// One servo's state in one cycle: what the log holds.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ServoSample {
     /// Time since the gait started, s (negative while standing up).
     pub time_s: f64,
@@ -227,7 +227,7 @@ pub fn drive(
     let mut meter = crate::speed::LegSpeedMeter::new(settings.servos.len());
     let result = {
         let mut observed = |s: &ServoSample| {
-            meter.observe(s);
+            meter.observe(s.leg, s.time_s, s.leg_angle_rad);
             on_sample(s)
         };
         setup(bus, schedule, settings)

@@ -2,8 +2,6 @@
 //! window apart. Present Velocity, read just after each cycle's new goal, is the position
 //! loop's peak, not the leg's mean speed, so the speed is taken from the positions.
 
-use crate::driver::ServoSample;
-
 /// The window over which a leg's speed is measured from its positions, s.
 pub const LEG_SPEED_WINDOW_S: f64 = 0.25;
 
@@ -22,16 +20,17 @@ impl LegSpeedMeter {
         LegSpeedMeter { anchor: vec![None; legs], speeds: vec![None; legs] }
     }
 
-    /// Takes one servo's sample (a leg beyond the meter's is ignored).
-    pub fn observe(&mut self, s: &ServoSample) {
-        let Some(anchor) = self.anchor.get_mut(s.leg) else { return };
+    /// Takes leg `leg`'s angle `angle_rad` at time `time_s` (one servo's sample: its
+    /// `leg`, `time_s` and `leg_angle_rad`); a leg beyond the meter's is ignored.
+    pub fn observe(&mut self, leg: usize, time_s: f64, angle_rad: f64) {
+        let Some(anchor) = self.anchor.get_mut(leg) else { return };
         match *anchor {
-            Some((t0, a0)) if s.time_s - t0 >= LEG_SPEED_WINDOW_S => {
-                self.speeds[s.leg] = Some((s.leg_angle_rad - a0) / (s.time_s - t0));
-                *anchor = Some((s.time_s, s.leg_angle_rad));
+            Some((t0, a0)) if time_s - t0 >= LEG_SPEED_WINDOW_S => {
+                self.speeds[leg] = Some((angle_rad - a0) / (time_s - t0));
+                *anchor = Some((time_s, angle_rad));
             }
             Some(_) => {}
-            None => *anchor = Some((s.time_s, s.leg_angle_rad)),
+            None => *anchor = Some((time_s, angle_rad)),
         }
     }
 
@@ -46,10 +45,6 @@ impl LegSpeedMeter {
 mod tests {
     use super::*;
 
-    fn sample(leg: usize, time_s: f64, leg_angle_rad: f64) -> ServoSample {
-        ServoSample { time_s, leg, leg_angle_rad, ..ServoSample::default() }
-    }
-
     /// Two legs turning at 2 pi and pi rad/s, sampled at 50 Hz: no speed before a window has
     /// passed, then each leg's own, and their mean 1.5 pi; a leg the meter does not have is
     /// ignored.
@@ -59,15 +54,15 @@ mod tests {
         let pi = std::f64::consts::PI;
         for k in 0..=10 {
             let t = k as f64 * 0.02;
-            m.observe(&sample(0, t, 2.0 * pi * t));
-            m.observe(&sample(1, t, pi * t));
-            m.observe(&sample(5, t, 100.0 * t));
+            m.observe(0, t, 2.0 * pi * t);
+            m.observe(1, t, pi * t);
+            m.observe(5, t, 100.0 * t);
         }
         assert_eq!(m.mean(), None);
         for k in 11..=30 {
             let t = k as f64 * 0.02;
-            m.observe(&sample(0, t, 2.0 * pi * t));
-            m.observe(&sample(1, t, pi * t));
+            m.observe(0, t, 2.0 * pi * t);
+            m.observe(1, t, pi * t);
         }
         assert!((m.mean().unwrap() - 1.5 * pi).abs() < 1e-9, "{:?}", m.mean());
     }

@@ -140,6 +140,8 @@ pub(crate) struct Walker {
     /// The body rates (bits) at which `forces` were last evaluated under the walk's own law
     /// (its creep, not the associated stand-in) in this solve, if they were.
     forces_at: Option<[u64; 3]>,
+    /// Whether coincident legs are merged (tests compare a walk without).
+    merge_coincident: bool,
 }
 
 impl Walker {
@@ -216,6 +218,7 @@ impl Walker {
                 .then(|| Trench::new(settings.mechanisms.disturbed_sand, legs)),
             twin: (0..legs).collect(),
             forces_at: None,
+            merge_coincident: true,
         };
         w.reach = w.nodes.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) * (1.0 + 1e-9);
         for j in 0..legs {
@@ -585,7 +588,12 @@ impl Walker {
         // mass that force at their mean offset: the first leg's contacts carry the group, and
         // the others are not placed at all (a third of the force evaluations; disturbed sand,
         // which tells the legs' tracks apart, keeps every leg).
-        let merge = self.pitch_locked && self.trench.is_none();
+        // The pitch and its rate are checked, not assumed, to be exactly zero.
+        let merge = self.merge_coincident
+            && self.pitch_locked
+            && self.q[2] == 0.0
+            && self.v[2] == 0.0
+            && self.trench.is_none();
         for j in 0..legs {
             let psi = self.psi[j];
             let first = (0..j).find(|&i| {
@@ -721,6 +729,18 @@ impl Walker {
         for _ in 0..steps {
             self.step(false);
         }
+    }
+
+    /// The same walker placing every leg, coincident or not (tests).
+    #[cfg(test)]
+    pub(crate) fn placing_every_leg(self) -> Walker {
+        Walker { merge_coincident: false, ..self }
+    }
+
+    /// How many legs the last step let another leg's contacts stand for (tests).
+    #[cfg(test)]
+    pub(crate) fn coincident_legs(&self) -> usize {
+        self.twin.iter().enumerate().filter(|&(j, &t)| t != j).count()
     }
 
     /// Deepest leg point below the surface now, m (tests).

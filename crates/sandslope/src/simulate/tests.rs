@@ -678,3 +678,34 @@ fn the_free_body_is_chaotic_and_its_ensemble_converges() {
         assert_eq!(over, 6, "walks pitched over at 10 degrees, dt {dt}");
     }
 }
+
+/// Coincident legs (docs/model.md §17) are exact: on the built-in robot and terrain at 10 and
+/// 20 degrees, pitch locked, a 2 s walk whose tripods' three legs stand as one (4 of the 6 legs
+/// merged, 2 per tripod, counted by hand) follows the walk that places every leg to round-off:
+/// position within 1e-9 m at every step, and every leg's sampled force within 1e-9 N.
+#[test]
+fn coincident_legs_walk_as_every_leg_placed() {
+    let robot = paper_robot();
+    let terrain = builtin_terrain();
+    let settings = SimSettings::new(2.0).unwrap();
+    for deg in [10.0_f64, 20.0] {
+        let slope = Slope::from_degrees(deg).unwrap();
+        let ground = terrain.at(slope);
+        let dt = robot.stride_period() / 2000.0;
+        let n = (2.0 / dt).round() as usize;
+        let mut merged = walker(&robot, &ground, deg.to_radians(), &settings, dt);
+        let mut placed = walker(&robot, &ground, deg.to_radians(), &settings, dt).placing_every_leg();
+        merged.settle(settings.settle_s);
+        placed.settle(settings.settle_s);
+        assert_eq!((merged.coincident_legs(), placed.coincident_legs()), (4, 0), "{deg} deg");
+        let half = robot.stance_duration();
+        let (a, b) = (merged.run(n, half, 120.0), placed.run(n, half, 120.0));
+        let worst = a.x.iter().zip(&b.x).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        assert!(worst < 1e-9, "{deg} deg: positions part by {worst} m");
+        assert!(a.x.last().unwrap() - a.x[0] > 0.05, "{deg} deg: the walk climbs");
+        for (fa, fb) in a.trajectory.leg_force_z_n.iter().zip(&b.trajectory.leg_force_z_n) {
+            let worst = fa.iter().zip(fb).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+            assert!(worst < 1e-9, "{deg} deg: a leg's force parts by {worst} N");
+        }
+    }
+}

@@ -20,7 +20,7 @@ pub use direction::{principal_direction, project, Upslope};
 pub use signal::{split_at_gaps, LowPass, Segment, Segmentation};
 pub use steps::{
     estimate_touchdown_offset, measure_step, stride_curve, summarize, touchdowns_in, GaitSummary,
-    SmoothTrack, Stats, StepMeasure, StrideCurve, TouchdownOffset,
+    SmoothTrack, Stats, StepMeasure, StrideCurve, TouchdownOffset, REST_SPEED_FRACTION,
 };
 pub use track::{track, RecordingSummary, StepRow, TouchdownSource, TrackResult};
 
@@ -229,6 +229,7 @@ pub fn analyse(recordings: &[Recording<'_>], options: &GaitOptions) -> Result<Ga
                 let speed_noise_m_s = filter.speed_noise(&s.along, &position);
                 SmoothTrack {
                     speed_noise_m_s,
+                    rest_speed_m_s: REST_SPEED_FRACTION * speed_noise_m_s,
                     start_time_s: rec.start_time_s + s.start as f64 / rec.frame_rate_hz,
                     frame_rate_hz: rec.frame_rate_hz,
                     position,

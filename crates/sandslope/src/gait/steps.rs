@@ -19,6 +19,10 @@ pub struct SmoothTrack {
     /// [`crate::gait::LowPass::speed_noise`]); a speed minimum counts as the anchoring time
     /// only if the speed then rises by more than three times this.
     pub speed_noise_m_s: f64,
+    /// A speed within this of zero is rest, m/s (docs/model.md §11): a motion-capture track's
+    /// is [`REST_SPEED_FRACTION`] of its noise SD; the stride simulator's is that or its
+    /// creep speed, whichever is more, since a resting body creeps (§18).
+    pub rest_speed_m_s: f64,
 }
 
 impl SmoothTrack {
@@ -154,7 +158,8 @@ const REST_FRACTION: f64 = 0.1;
 /// A speed within this fraction of the track's noise SD of zero is rest: a body stopped at
 /// the minimum, whose anchoring is where it starts to move (docs/model.md §11). Far below a
 /// motion-capture track's noise (a minimum that close to zero is rare there); ten times the
-/// stride simulator's default creep speed (its noise is set to 1e-4 m/s).
+/// stride simulator's default creep speed (its noise is set to 1e-4 m/s; a larger creep
+/// widens it, [`SmoothTrack::rest_speed_m_s`]).
 pub const REST_SPEED_FRACTION: f64 = 0.01;
 
 /// Touchdown times `offset_s + k step_s` whose whole step lies inside `track`.
@@ -218,7 +223,7 @@ pub fn measure_step(track: &SmoothTrack, t0: f64, step_s: f64) -> StepMeasure {
     // before touchdown and stay stopped until the legs push): the minimum is the whole rest,
     // and the acceleration turns positive where the speed leaves it. Within the rest the
     // lowest frame is a rounding error's choice.
-    let rest = REST_SPEED_FRACTION * track.speed_noise_m_s;
+    let rest = track.rest_speed_m_s;
     let at_rest = anchored && v[lowest].abs() <= rest;
     let t1_abs = if !anchored {
         None

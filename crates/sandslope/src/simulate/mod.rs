@@ -28,7 +28,7 @@ pub use mechanisms::Mechanisms;
 pub use rft::RftScaling;
 
 use crate::error::ParamError;
-use crate::gait::{measure_step, SmoothTrack, StepMeasure};
+use crate::gait::{measure_step, SmoothTrack, StepMeasure, REST_SPEED_FRACTION};
 use crate::regime::{classify, Cause, Regime};
 use crate::scenario::{Scenario, SlopeEvaluation};
 use crate::slope::{SignedSlope, Slope};
@@ -490,6 +490,9 @@ pub fn simulate_with_leg(
         position: run.x,
         speed: run.vx,
         speed_noise_m_s: SPEED_RISE_M_S / 3.0,
+        // 1 um/s, or the creep speed if more (docs/model.md §18): a resting body creeps.
+        rest_speed_m_s: (REST_SPEED_FRACTION * (SPEED_RISE_M_S / 3.0))
+            .max(REST_CREEP_FRACTION * settings.creep_m_s),
     };
     let duration = n_steps as f64 * dt;
     let n_meas = ((duration + 1e-9) / half).floor() as usize;
@@ -532,6 +535,14 @@ pub fn simulate_with_leg(
 /// this, m/s (docs/model.md §18; the simulated speed has no noise, but resistive-force
 /// elements entering the sand leave sub-millimetre-per-second ripples).
 pub const SPEED_RISE_M_S: f64 = 3e-4;
+
+/// A simulated walk is at rest within this fraction of the creep speed of zero, where that is
+/// more than a motion-capture track's rest (docs/model.md §18). Below the creep speed an
+/// element feels less than 1/sqrt(2) of the law's stress (the smoothing of §17,
+/// `phi(1) = 1/sqrt(2)`): it is in the law's smoothed rest, not moving under the law, and a
+/// body held there creeps (on level sand with the creep 1e-4 m/s at up to 0.6 of it before
+/// the legs push). At the default creep the 1 um/s of [`REST_SPEED_FRACTION`] is the larger.
+pub const REST_CREEP_FRACTION: f64 = 1.0;
 
 /// How far the body pitched over a walk.
 #[derive(Debug, Clone, Copy)]

@@ -142,6 +142,8 @@ pub(crate) struct Walker {
     forces_at: Option<[u64; 3]>,
     /// Whether coincident legs are merged (tests compare a walk without).
     merge_coincident: bool,
+    /// Steps ended by an active-set step at rest ([`Walker::sticking`]; tests count them).
+    rest_steps: usize,
 }
 
 impl Walker {
@@ -219,6 +221,7 @@ impl Walker {
             twin: (0..legs).collect(),
             forces_at: None,
             merge_coincident: true,
+            rest_steps: 0,
         };
         w.reach = w.nodes.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) * (1.0 + 1e-9);
         for j in 0..legs {
@@ -399,6 +402,7 @@ impl Walker {
         let eps = self.eps;
         self.forces_at = None;
         if self.stuck && self.sticking(v, v_free, m) {
+            self.rest_steps += 1;
             return true;
         }
         self.stuck = false;
@@ -408,6 +412,7 @@ impl Walker {
         }
         if self.sticking(first, v_free, m) {
             self.stuck = true;
+            self.rest_steps += 1;
             return true;
         }
         let (mut best, mut best_merit) = (first, r1);
@@ -735,6 +740,12 @@ impl Walker {
     #[cfg(test)]
     pub(crate) fn placing_every_leg(self) -> Walker {
         Walker { merge_coincident: false, ..self }
+    }
+
+    /// How many steps so far ended at rest by the active-set step (tests).
+    #[cfg(test)]
+    pub(crate) fn rest_steps(&self) -> usize {
+        self.rest_steps
     }
 
     /// How many legs the last step let another leg's contacts stand for (tests).

@@ -342,3 +342,40 @@ fn an_ensemble_gives_the_spread_of_n_walks() {
         .code(2)
         .stderr(predicates::str::contains("--ensemble = 1 must be a whole number of walks from 2 to 1000"));
 }
+
+/// `--check-convergence` (docs/simulate.md, "Checking convergence"): the walk again at a
+/// quarter of the step and a tenth of the creep speed. The quarter step's dt is the walk's
+/// over four and the creep's a tenth, by construction; the built-in robot at 10 degrees passes
+/// (docs/simulate.md's table: 30.4 cm/s at both steps); the CSV has a row per walk; with
+/// --slopes it is refused naming the flag.
+#[test]
+fn the_convergence_check_walks_a_quarter_step_and_a_tenth_of_the_creep() {
+    let v = json(&["simulate", "--slope", "10", "--duration", "3", "--check-convergence", "--json"]);
+    assert_eq!(v["walks"], 1);
+    assert_eq!(v["converged"], true, "{v}");
+    let dt = v["walk"]["dt_s"].as_f64().unwrap();
+    assert_eq!(v["refinements"][0]["refinement"], "quarter_step");
+    assert_eq!(v["refinements"][0]["answer"]["dt_s"].as_f64().unwrap(), dt / 4.0);
+    assert_eq!(v["refinements"][1]["refinement"], "tenth_creep");
+    assert_eq!(v["refinements"][1]["answer"]["creep_m_s"].as_f64().unwrap(), 1e-8);
+    let out = sandslope()
+        .args(["simulate", "--slope", "10", "--duration", "2", "--check-convergence", "--csv"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(
+        lines[0],
+        "walk,dt_s,creep_m_s,speed_m_s,speed_se_m_s,t1_s,regime,speed_change_m_s,t1_change_s,converged"
+    );
+    assert!(
+        lines[1].starts_with("as_asked,0.0005,") && lines[2].starts_with("quarter_step,0.000125,"),
+        "{text}"
+    );
+    assert_eq!(lines.len(), 4, "{text}");
+    sandslope()
+        .args(["simulate", "--slopes", "0,10", "--check-convergence"])
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("--check-convergence"));
+}

@@ -148,3 +148,49 @@ pub fn simulate_ensemble<'py>(
     let e = py.detach(|| request.simulate_ensemble(walks)).map_err(request_error)?;
     pythonize(py, &e).map_err(value_error)
 }
+
+/// Whether one slope's walk is converged (`sandslope simulate --check-convergence --json`,
+/// docs/simulate.md "Checking convergence"): the walk as asked, again at a quarter of its step
+/// and at a tenth of its creep speed, held to issue 38's tolerances; with `walks`, each setting
+/// is an ensemble of that many walks and their means are compared.
+#[pyfunction]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, walks=None, k_n=None, k_s=None, dt_s=None, creep_m_s=None, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=sandslope::simulate::mechanisms::UNDISTURBED_SAND))]
+#[allow(clippy::too_many_arguments)]
+pub fn check_convergence<'py>(
+    py: Python<'py>,
+    robot: &PyRobot,
+    terrain: &PyTerrain,
+    slope_deg: f64,
+    duration_s: f64,
+    walks: Option<usize>,
+    k_n: Option<f64>,
+    k_s: Option<f64>,
+    dt_s: Option<f64>,
+    creep_m_s: Option<f64>,
+    body_pitch: &str,
+    rft_scaling: &str,
+    servo_limit: bool,
+    leg_friction: Option<f64>,
+    duty_cycle: f64,
+    disturbed_sand: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let scenario =
+        Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
+    let (body_pitch, rft_scaling) = modes(body_pitch, rft_scaling)?;
+    let mechanisms = Mechanisms { leg_friction, duty_cycle, disturbed_sand };
+    let rate_hz = sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ;
+    let settings = checked(SettingsRequest {
+        duration_s,
+        dt_s,
+        creep_m_s,
+        servo_limit,
+        body_pitch,
+        rft_scaling,
+        mechanisms,
+        rate_hz,
+    })?;
+    let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
+    let request = Walks::at(scenario, slope, settings, walks).checking_convergence();
+    let c = py.detach(|| request.check_convergence()).map_err(request_error)?;
+    pythonize(py, &c).map_err(value_error)
+}

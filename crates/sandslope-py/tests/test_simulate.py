@@ -109,3 +109,17 @@ def test_an_ensemble_is_the_cli_ensemble(cli):
     assert got["regimes"] == want["regimes"]
     with pytest.raises(ValueError, match=r"walks = 1 must be a whole number of walks from 2 to 1000"):
         sandslope.simulate_ensemble("paper-hexapod", "glass-beads-300um", 10, 1, 2)
+
+
+def test_the_convergence_check_is_the_cli_check(cli):
+    # `simulate --check-convergence --json`, key for key: the built-in robot at 10 degrees,
+    # pitch locked, 3 s walks at the default step, a quarter of it and a tenth of the creep.
+    want = cli.json("simulate", "--slope", 10, "--duration", 3, "--check-convergence")
+    got = sandslope.check_convergence("paper-hexapod", "glass-beads-300um", 10, 3)
+    assert set(got) == set(want)
+    assert [r["refinement"] for r in got["refinements"]] == ["quarter_step", "tenth_creep"]
+    assert got["refinements"][0]["answer"]["dt_s"] == pytest.approx(got["walk"]["dt_s"] / 4, rel=1e-15)
+    assert got["walk"]["speed_m_s"] == pytest.approx(want["walk"]["speed_m_s"], rel=1e-12)
+    assert got["converged"] is want["converged"] is True
+    with pytest.raises(ValueError, match=r"walks = 1 must be a whole number of walks from 2 to 1000"):
+        sandslope.check_convergence("paper-hexapod", "glass-beads-300um", 10, 2, walks=1)

@@ -7,8 +7,9 @@ use serde::Serialize;
 
 use sandslope::measure::SlopeEstimate;
 use sandslope::risk::{PayloadEnvelope, RiskPoint, SafeMass, SafeSlope};
+use sandslope::simulate::convergence::{Refinement, WalkAnswer};
 use sandslope::simulate::ensemble::perturbed_mass;
-use sandslope::simulate::{Ensemble, SimSummary};
+use sandslope::simulate::{ConvergenceCheck, Ensemble, SimSummary};
 
 /// One slope of `risk --csv`: [`RiskPoint`] flattened.
 #[derive(Debug, Clone, Serialize)]
@@ -257,5 +258,63 @@ impl EnsembleRow {
                 cause: m.cause.name(),
             })
             .collect()
+    }
+}
+
+/// One setting of `simulate --check-convergence --csv`: the walk as asked, then each refined
+/// walk against it.
+#[derive(Debug, Clone, Serialize)]
+pub struct ConvergenceRow {
+    /// `as_asked`, `quarter_step` or `tenth_creep`.
+    pub walk: &'static str,
+    /// Time step, s.
+    pub dt_s: f64,
+    /// Creep speed, m/s.
+    pub creep_m_s: f64,
+    /// Mean speed, m/s (an ensemble's mean).
+    pub speed_m_s: f64,
+    /// The ensemble mean's standard error, m/s (empty for one walk).
+    pub speed_se_m_s: Option<f64>,
+    /// Mean anchoring time, s.
+    pub t1_s: Option<f64>,
+    /// Regime.
+    pub regime: &'static str,
+    /// Speed minus the walk as asked, m/s (empty on its own row).
+    pub speed_change_m_s: Option<f64>,
+    /// t1 minus the walk as asked, s.
+    pub t1_change_s: Option<f64>,
+    /// Within the tolerances (empty on the walk's own row).
+    pub converged: Option<bool>,
+}
+
+impl ConvergenceRow {
+    /// The walk's row, then one per refinement.
+    pub fn rows(c: &ConvergenceCheck) -> Vec<ConvergenceRow> {
+        let row = |walk, a: &WalkAnswer| ConvergenceRow {
+            walk,
+            dt_s: a.dt_s,
+            creep_m_s: a.creep_m_s,
+            speed_m_s: a.speed_m_s,
+            speed_se_m_s: a.speed_se_m_s,
+            t1_s: a.t1_s,
+            regime: a.regime.name(),
+            speed_change_m_s: None,
+            t1_change_s: None,
+            converged: None,
+        };
+        let mut rows = vec![row("as_asked", &c.walk)];
+        for r in &c.refinements {
+            let name = match r.refinement {
+                Refinement::QuarterStep => "quarter_step",
+                Refinement::TenthCreep => "tenth_creep",
+            };
+            rows.push(ConvergenceRow {
+                speed_change_m_s: Some(r.speed_change_m_s),
+                t1_change_s: r.t1_change_s,
+                converged: Some(r.converged),
+                ..row(name, &r.answer)
+            });
+        }
+        rows
     }
 }

@@ -3,9 +3,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use sandslope::simulate::convergence::{CREEP_REFINEMENT, STEP_REFINEMENT};
 use sandslope::simulate::{
-    simulate, simulate_ensemble, simulate_slopes, BodyPitch, Ensemble, Mechanisms, RftScaling, SimSettings,
-    SimSummary, SimulateError, Simulation,
+    check_convergence, simulate, simulate_ensemble, simulate_slopes, BodyPitch, ConvergenceCheck, Ensemble,
+    Mechanisms, RftScaling, SimSettings, SimSummary, SimulateError, Simulation, CREEP_RANGE_M_S,
 };
 use sandslope::{ParamError, Scenario, SignedSlope};
 
@@ -56,6 +57,11 @@ pub struct SimulateRequest {
     /// Walk the one slope this many times, the mass perturbed by 1e-9 relative between walks,
     /// and answer the spread (field `ensemble`; docs/simulate.md, "Pitch free").
     pub ensemble: Option<usize>,
+    /// Walk the one slope again at a quarter of the step and at a tenth of the creep speed
+    /// and answer whether the walk is converged (field `check-convergence`, a flag;
+    /// docs/simulate.md, "Checking convergence").
+    #[serde(default)]
+    pub check_convergence: bool,
 }
 
 /// Parses the field `slopes`: the one slope-list grammar, signed, at most [`MAX_SLOPES`].
@@ -128,6 +134,10 @@ impl SimulateRequest {
         };
         let rate_hz = p.number_or("rate", 120.0)?;
         let ensemble = p.number("ensemble")?.map(|n| ensemble_size(n, &slopes)).transpose()?;
+        let check_convergence = p.flag("check-convergence")?;
+        if check_convergence {
+            one_slope_to_check(&slopes)?;
+        }
         let scenario = ScenarioRequest::from_params(&mut p)?;
         p.finish()?;
         Ok(SimulateRequest {
@@ -142,6 +152,7 @@ impl SimulateRequest {
             mechanisms,
             rate_hz,
             ensemble,
+            check_convergence,
         })
     }
 
@@ -178,7 +189,18 @@ impl SimulateRequest {
             }
             SimSlopes::One(slope) => (vec![signed(check_slope(*slope)?, "slope")?], false),
         };
-        Ok(Walks { scenario, slopes, many, settings, ensemble: self.ensemble, words: Words::Flag })
+        if self.check_convergence {
+            one_slope_to_check(&self.slopes)?;
+        }
+        Ok(Walks {
+            scenario,
+            slopes,
+            many,
+            settings,
+            ensemble: self.ensemble,
+            check_convergence: self.check_convergence,
+            words: Words::Flag,
+        })
     }
 
     /// The answer (what `simulate --json` prints).
@@ -286,6 +308,17 @@ pub fn ensemble_size(n: f64, slopes: &SimSlopes) -> Result<usize> {
     Ok(n as usize)
 }
 
+/// The convergence check walks one slope.
+fn one_slope_to_check(slopes: &SimSlopes) -> Result<()> {
+    match slopes {
+        SimSlopes::One(_) => Ok(()),
+        SimSlopes::Many(_) => Err(RequestError::invalid(
+            "check-convergence",
+            "--check-convergence walks one slope: give --slope, not --slopes",
+        )),
+    }
+}
+
 /// One walk's slope: strictly between -90 and 90 degrees.
 pub fn check_slope(slope: f64) -> Result<f64> {
     check_range("slope", slope, -89.999_999, 89.999_999).map_err(|_| {
@@ -306,6 +339,8 @@ pub enum Answer {
     Many(Vec<SimSummary>),
     /// An ensemble at one slope.
     Ensemble(Box<Ensemble>),
+    /// The convergence check at one slope.
+    Convergence(Box<ConvergenceCheck>),
 }
 
 /// The walks of a simulate request, checked: what a server weighs against its limits before
@@ -322,6 +357,8 @@ pub struct Walks {
     pub settings: SimSettings,
     /// Walks in an ensemble at the one slope, if asked.
     pub ensemble: Option<usize>,
+    /// Whether the one slope's walk (or ensemble) is checked for convergence instead.
+    pub check_convergence: bool,
     /// How the library's errors name their field: the command line's flags and the server's
     /// fields, or Python's keywords.
     pub words: Words,
@@ -337,7 +374,21 @@ impl Walks {
         settings: SimSettings,
         ensemble: Option<usize>,
     ) -> Walks {
-        Walks { scenario, slopes: vec![slope], many: false, settings, ensemble, words: Words::Keyword }
+        Walks {
+            scenario,
+            slopes: vec![slope],
+            many: false,
+            settings,
+            ensemble,
+            check_convergence: false,
+            words: Words::Keyword,
+        }
+    }
+
+    /// The same walks checked for convergence instead ([`Walks::respond`] then answers
+    /// [`Answer::Convergence`]).
+    pub fn checking_convergence(self) -> Walks {
+        Walks { check_convergence: true, ..self }
     }
 
     /// Integration steps of all the walks, settling included (what they cost to run).
@@ -348,7 +399,15 @@ impl Walks {
                 .map_err(|e| sim_err(SimulateError::Param(e), self.words))?;
             steps += (self.settings.duration_s + self.settings.settle_s) / dt;
         }
-        Ok(steps * self.ensemble.unwrap_or(1) as f64)
+        // The check walks again at a quarter of the step and, where there is a tenth of the
+        // creep to walk at, at the step itself.
+        let checks = if self.check_convergence {
+            let tenth = self.settings.creep_m_s / CREEP_REFINEMENT >= CREEP_RANGE_M_S.0;
+            1.0 + STEP_REFINEMENT + if tenth { 1.0 } else { 0.0 }
+        } else {
+            1.0
+        };
+        Ok(steps * checks * self.ensemble.unwrap_or(1) as f64)
     }
 
     /// Runs the walks (several in parallel).
@@ -364,6 +423,9 @@ impl Walks {
 
     /// Runs the walks, or the ensemble, and answers (what `simulate --json` prints).
     pub fn respond(&self) -> Result<Answer> {
+        if self.check_convergence {
+            return Ok(Answer::Convergence(Box::new(self.check_convergence()?)));
+        }
         match self.ensemble {
             Some(n) => Ok(Answer::Ensemble(Box::new(self.simulate_ensemble(n)?))),
             None => Ok(self.answer(self.simulate()?)),
@@ -373,6 +435,13 @@ impl Walks {
     /// The ensemble of `n` walks at the one slope.
     pub fn simulate_ensemble(&self, n: usize) -> Result<Ensemble> {
         simulate_ensemble(&self.scenario, self.slopes[0], &self.settings, n)
+            .map_err(|e| sim_err(e, self.words))
+    }
+
+    /// The convergence check of the one slope's walk (or ensemble): the walk, at a quarter of
+    /// its step and at a tenth of its creep speed, held to issue 38's tolerances.
+    pub fn check_convergence(&self) -> Result<ConvergenceCheck> {
+        check_convergence(&self.scenario, self.slopes[0], &self.settings, self.ensemble)
             .map_err(|e| sim_err(e, self.words))
     }
 

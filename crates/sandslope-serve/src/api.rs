@@ -202,16 +202,17 @@ pub fn simulate_walks(params: &[(String, String)], served: &Served) -> Result<Wa
     }
     let steps = walks.integration_steps()?;
     if steps > MAX_SIM_STEPS {
-        let flag = match (request.dt_s, request.ensemble) {
-            (Some(_), _) => "dt",
-            (None, Some(_)) => "ensemble",
-            (None, None) => "duration",
+        let flag = match (request.dt_s, request.ensemble, request.check_convergence) {
+            (Some(_), _, _) => "dt",
+            (None, Some(_), _) => "ensemble",
+            (None, None, true) => "check-convergence",
+            (None, None, false) => "duration",
         };
         return Err(ApiError::bad(
             Some(flag.to_string()),
             format!(
-                "--duration, --dt, the slopes and --ensemble ask for {steps:.3e} integration steps: the server takes at \
-                 most {MAX_SIM_STEPS:e} per request"
+                "--duration, --dt, the slopes, --ensemble and --check-convergence ask for {steps:.3e} integration \
+                 steps: the server takes at most {MAX_SIM_STEPS:e} per request"
             ),
         ));
     }

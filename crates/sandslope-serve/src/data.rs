@@ -245,6 +245,12 @@ fn simulation(params: &[(String, String)], served: &Served) -> Result<Reply, Api
         ));
     }
     let walks = api::simulate_walks(params, served)?;
+    if walks.check_convergence || walks.ensemble.is_some() {
+        return Err(ApiError::bad(
+            Some(if walks.check_convergence { "check-convergence" } else { "ensemble" }.to_string()),
+            "/data/simulation animates one walk: /api/simulate takes ensemble and check-convergence",
+        ));
+    }
     let samples = walks.settings.duration_s * walks.settings.sample_rate_hz;
     if samples > MAX_SIM_SAMPLES {
         return Err(ApiError::bad(

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
-use sandslope_render::rows::{EnsembleRow, SimSlopeRow};
+use sandslope_render::rows::{ConvergenceRow, EnsembleRow, SimSlopeRow};
 
 use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::figures;
@@ -80,6 +80,14 @@ pub struct SimulateArgs {
     /// chaotic, the spread is the answer (docs/simulate.md, "Pitch free").
     #[arg(long, value_name = "N", conflicts_with_all = ["slopes", "out", "plot", "animate"])]
     pub ensemble: Option<usize>,
+    /// Walk the one slope again at a quarter of the time step and at a tenth of the creep
+    /// speed, and say whether the answer is converged: speed within 3% (or 0.3 cm/s), t1
+    /// within 1 ms and the same regime (issue 38's test; docs/simulate.md, "Checking
+    /// convergence"). The default step is shown converged for the built-in robot and terrain
+    /// only; check your own. With --ensemble N each setting is N walks, their means compared
+    /// (a single free-pitch walk on a slope is chaotic and cannot converge).
+    #[arg(long, conflicts_with_all = ["slopes", "out", "plot", "animate"])]
+    pub check_convergence: bool,
     /// Trajectory sample rate for --out, --plot and --animate, Hz.
     #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
     pub rate: f64,
@@ -172,6 +180,7 @@ impl SimulateArgs {
             },
             rate_hz: self.rate,
             ensemble,
+            check_convergence: self.check_convergence,
         })
     }
 }
@@ -193,6 +202,9 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     }
     let observed = args.observed.as_deref().map(load_speeds).transpose()?;
     let walks = request.walks()?;
+    if walks.check_convergence {
+        return run_check(&args, &walks);
+    }
     if let Some(n) = walks.ensemble {
         return run_ensemble(&args, &walks, n);
     }
@@ -349,6 +361,91 @@ fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
             );
             if walks.settings.body_pitch == BodyPitch::Locked {
                 println!("body pitch locked: the walk is stable, so the walks differ by rounding (docs/simulate.md)");
+            }
+        }
+    }
+    Ok(())
+}
+
+fn run_check(args: &SimulateArgs, walks: &Walks) -> Result<()> {
+    let quiet = args.format.format() != Format::Table;
+    let slope = walks.slopes[0].degrees();
+    let spin = spinner(
+        quiet,
+        &format!("checking the walk at {slope} deg at a quarter of its step and a tenth of its creep"),
+    );
+    let c = walks.check_convergence();
+    spin.finish_and_clear();
+    let c = c?;
+    match args.format.format() {
+        Format::Json => print_json(&Answer::Convergence(Box::new(c)))?,
+        Format::Csv => print!("{}", csv_string(&ConvergenceRow::rows(&c))?),
+        Format::Table => {
+            let walks_word =
+                if c.walks == 1 { "one walk".to_string() } else { format!("means of {} walks", c.walks) };
+            println!(
+                "convergence at {slope} deg ({walks_word} a setting, {} s each): {}",
+                walks.settings.duration_s,
+                if c.converged { "converged" } else { "NOT converged" }
+            );
+            let mut t =
+                table(&["walk", "dt ms", "creep m/s", "speed cm/s", "t1 ms", "regime", "change", "within"]);
+            let cells = |a: &sandslope::simulate::convergence::WalkAnswer| {
+                let speed = match a.speed_se_m_s {
+                    Some(se) => format!("{:.2} ± {:.2}", a.speed_m_s * 100.0, se * 100.0),
+                    None => format!("{:.2}", a.speed_m_s * 100.0),
+                };
+                [
+                    format!("{:.4}", a.dt_s * 1e3),
+                    format!("{:.0e}", a.creep_m_s),
+                    speed,
+                    num(a.t1_s.map(|t| t * 1e3), 2),
+                    a.regime.name().to_string(),
+                ]
+            };
+            let [dt, creep, speed, t1, regime] = cells(&c.walk);
+            t.add_row(["as asked".to_string(), dt, creep, speed, t1, regime, String::new(), String::new()]);
+            for r in &c.refinements {
+                let [dt, creep, speed, t1, regime] = cells(&r.answer);
+                let pct = if c.walk.speed_m_s != 0.0 {
+                    format!(" ({:+.1}%)", 100.0 * r.speed_change_m_s / c.walk.speed_m_s.abs())
+                } else {
+                    String::new()
+                };
+                let change = format!(
+                    "speed {:+.2} cm/s{pct}, t1 {} ms",
+                    r.speed_change_m_s * 100.0,
+                    r.t1_change_s.map_or("-".to_string(), |d| format!("{:+.2}", d * 1e3))
+                );
+                let mut failed = Vec::new();
+                if !r.speed_within {
+                    failed.push("speed");
+                }
+                if !r.t1_within {
+                    failed.push("t1");
+                }
+                if !r.same_regime {
+                    failed.push("regime");
+                }
+                let within =
+                    if failed.is_empty() { "yes".to_string() } else { format!("no: {}", failed.join(", ")) };
+                t.add_row([r.refinement.label().to_string(), dt, creep, speed, t1, regime, change, within]);
+            }
+            println!("{t}");
+            println!(
+                "tolerances: speed within {:.0}% or {:.1} cm/s, t1 within {:.0} ms, the same regime (docs/simulate.md, \"Checking convergence\")",
+                c.speed_tolerance * 100.0,
+                c.speed_tolerance_m_s * 100.0,
+                c.t1_tolerance_s * 1e3
+            );
+            if c.walks > 1 {
+                println!("speeds are the ensembles' means +/- their standard errors");
+            }
+            if c.refinements.len() == 1 {
+                println!("the creep speed is at its smallest (1e-9 m/s): no tenth of it to walk");
+            }
+            if walks.settings.body_pitch == BodyPitch::Free && c.walks == 1 {
+                println!("{FREE_NOTE}");
             }
         }
     }

@@ -69,6 +69,7 @@ __all__ = [
     "calibrate",
     "simulate",
     "simulate_ensemble",
+    "check_convergence",
     "report",
     "read_servo_log",
     "infer_servo_log",
@@ -636,7 +637,8 @@ def _touchdown_times(ts: Any) -> list:
 def _walk_keywords(
     k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
 ) -> Dict[str, Any]:
-    """The keywords :func:`simulate` and :func:`simulate_ensemble` share, converted for the
+    """The keywords :func:`simulate`, :func:`simulate_ensemble` and :func:`check_convergence`
+    share, converted for the
     extension; the docs/model.md §20 switches only where given (the others take the Rust
     defaults)."""
     optional = {"k_n": k_n, "k_s": k_s, "dt_s": dt_s, "creep_m_s": creep_m_s}
@@ -684,6 +686,48 @@ def simulate_ensemble(
         float(slope_deg),
         float(duration_s),
         int(walks),
+        **_walk_keywords(
+            k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
+        ),
+    )
+
+
+def check_convergence(
+    robot: RobotLike,
+    terrain: TerrainLike,
+    slope_deg: float,
+    duration_s: float = 10.0,
+    *,
+    walks: Optional[int] = None,
+    k_n: Optional[float] = None,
+    k_s: Optional[float] = None,
+    dt_s: Optional[float] = None,
+    creep_m_s: Optional[float] = None,
+    body_pitch: str = "locked",
+    rft_scaling: str = "motion",
+    servo_limit: bool = True,
+    leg_friction: Optional[float] = None,
+    duty_cycle: Optional[float] = None,
+    disturbed_sand: Optional[float] = None,
+) -> Dict[str, Any]:
+    """Whether the walk at ``slope_deg`` is converged: the dict ``sandslope simulate
+    --check-convergence --json`` prints. The walk as asked (``walk``), again at a quarter of
+    its time step and at a tenth of its creep speed (``refinements``, each with its answer, its
+    changes and whether speed, t1 and regime are within issue 38's tolerances: 3% or 0.3 cm/s,
+    1 ms, the same), and ``converged`` if both are.
+
+    The default step is shown converged for the built-in robot and terrain only
+    (docs/simulate.md, "Checking convergence"); check a robot, terrain or mechanism of your
+    own. With ``walks=N`` each setting is an ensemble of N walks and their means are compared:
+    a single walk with ``body_pitch="free"`` on a slope is chaotic and cannot converge. The
+    other keywords are :func:`simulate`'s.
+    """
+    return _sandslope.check_convergence(
+        _robot(robot),
+        _terrain(terrain),
+        float(slope_deg),
+        float(duration_s),
+        None if walks is None else int(walks),
         **_walk_keywords(
             k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
         ),

@@ -258,6 +258,23 @@ def simulate_ensemble(
     duty_cycle: float = 0.5,
     disturbed_sand: float = 1.0,
 ) -> Dict[str, Any]: ...
+def check_convergence(
+    robot: Robot,
+    terrain: Terrain,
+    slope_deg: float,
+    duration_s: float,
+    walks: Optional[int] = None,
+    k_n: Optional[float] = None,
+    k_s: Optional[float] = None,
+    dt_s: Optional[float] = None,
+    creep_m_s: Optional[float] = None,
+    body_pitch: str = "locked",
+    rft_scaling: str = "motion",
+    servo_limit: bool = True,
+    leg_friction: Optional[float] = None,
+    duty_cycle: float = 0.5,
+    disturbed_sand: float = 1.0,
+) -> Dict[str, Any]: ...
 def read_servo_log(path: _Path) -> Tuple[Dict[str, np.ndarray], Dict[str, str], List[str]]: ...
 def infer_servo_log(
     robot: Robot,

@@ -12,6 +12,7 @@
 //! parallel.
 
 pub mod body;
+pub mod convergence;
 pub mod dynamics;
 pub mod ensemble;
 mod linear;
@@ -22,6 +23,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use body::{BodyPitch, LegShape};
+pub use convergence::{check_convergence, ConvergenceCheck};
 use dynamics::Walker;
 pub use ensemble::{simulate_ensemble, Ensemble};
 pub use mechanisms::Mechanisms;

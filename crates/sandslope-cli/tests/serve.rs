@@ -772,6 +772,25 @@ fn the_simulate_tab_animates_simulates_walk() {
     assert_eq!(attribute(&dom, "id=\"sim-canvas\"", "data-frames").as_deref(), Some("121"));
     let frame: usize = attribute(&dom, "id=\"sim-canvas\"", "data-frame").unwrap().parse().unwrap();
     assert!(frame > 0, "the animation did not advance");
+    // The convergence check, clicked: the answer /api/simulate?check-convergence gives.
+    let checked = "/?tab=simulate&sim-slope=12.5&sim-duration=4&sim-check";
+    let (dom, console) = browse(&browser, &server, checked, None);
+    assert_clean(&server, &dom, &console);
+    let raw = String::from_utf8(cli_stdout(&[
+        "simulate".into(),
+        "--slope=12.5".into(),
+        "--duration=4".into(),
+        "--check-convergence".into(),
+        "--json".into(),
+    ]))
+    .unwrap();
+    let converged = serde_json::from_str::<serde_json::Value>(&raw).unwrap()["converged"].as_bool().unwrap();
+    let verdict =
+        attribute(&dom, "id=\"sim-convergence\"", "data-converged").expect("no convergence check shown");
+    assert_eq!(verdict, converged.to_string());
+    assert!(
+        dom.contains("a quarter of the step: speed") && dom.contains("a tenth of the creep speed: speed")
+    );
     let dir = tempfile::tempdir().unwrap();
     let shot = dir.path().join("simulate.png");
     browse(&browser, &server, page, Some(&shot));

@@ -235,7 +235,33 @@ function simFlags() {
   return { ...exploreFlags(), slope: $("sim-slope").value, duration: $("sim-duration").value, rate: String(SIM_RATE_HZ) };
 }
 function updateSimulation() {
+  // A check of the walk before is dropped with its answer (it was for other inputs).
+  tickets.convergence = (tickets.convergence || 0) + 1;
+  $("sim-convergence").textContent = "";
+  delete $("sim-convergence").dataset.converged;
   fresh("simulate", () => get("/data/simulation", simFlags()), showSimulation);
+}
+// The walk again at a quarter of its step and a tenth of its creep speed (`simulate
+// --check-convergence`, docs/simulate.md "Checking convergence"), on the user's click: six
+// walks' time, so not on every change of the inputs.
+function checkConvergence() {
+  const { rate, ...flags } = simFlags();
+  $("sim-convergence").textContent = "checking: the walk again at a quarter of its step and a tenth of its creep speed ...";
+  fresh("convergence", () => get("/api/simulate", { ...flags, "check-convergence": "" }), showConvergence);
+}
+function showConvergence(c) {
+  const out = $("sim-convergence");
+  const signed = (v, digits) => (v >= 0 ? "+" : "") + fmt(v, digits);
+  const parts = c.refinements.map((r) => {
+    const pct = c.walk.speed_m_s !== 0 ? ` (${signed((100 * r.speed_change_m_s) / Math.abs(c.walk.speed_m_s), 1)}%)` : "";
+    const t1 = r.t1_change_s === null ? "-" : signed(r.t1_change_s * 1e3, 2);
+    const failed = [["speed", r.speed_within], ["t1", r.t1_within], ["regime", r.same_regime]].filter((f) => !f[1]).map((f) => f[0]);
+    const verdict = failed.length ? `outside the tolerance in ${failed.join(", ")}` : "within";
+    const label = r.refinement === "quarter_step" ? "a quarter of the step" : "a tenth of the creep speed";
+    return `${label}: speed ${signed(r.speed_change_m_s * 100, 2)} cm/s${pct}, t1 ${t1} ms, ${r.answer.regime} (${verdict})`;
+  });
+  out.textContent = `${c.converged ? "Converged" : "Not converged"} at ${c.slope_deg} deg: ${parts.join("; ")}. Tolerances: speed ${fmt(c.speed_tolerance * 100, 0)}% or ${fmt(c.speed_tolerance_m_s * 100, 1)} cm/s, t1 ${fmt(c.t1_tolerance_s * 1e3, 0)} ms, the same regime.`;
+  out.dataset.converged = String(c.converged);
 }
 function both(a, b, scale, digits) {
   const f = (v) => (v === null || v === undefined ? "-" : fmt(v * scale, digits));
@@ -514,6 +540,7 @@ async function start() {
     sim.playing = !sim.playing;
     $("sim-play").textContent = sim.playing ? "pause" : "play";
   });
+  $("sim-check").addEventListener("click", checkConvergence);
   $("sim-time").addEventListener("input", () => {
     sim.pos = Number($("sim-time").value);
     drawSimFrame();
@@ -532,6 +559,8 @@ async function start() {
   $("sim-slope-num").value = $("sim-slope").value;
   const tab = pageUrl.get("tab");
   if (["risk", "routes", "simulate"].includes(tab)) showTab(tab);
+  // ?tab=simulate&sim-check: the convergence check, clicked as a user would.
+  if (tab === "simulate" && pageUrl.has("sim-check")) $("sim-check").click();
   if (tab === "routes" && pageUrl.has("start-px") && pageUrl.has("goal-px")) {
     await state.mapReady;
     for (const key of ["start-px", "goal-px"]) {

@@ -7,7 +7,8 @@
 use serde::Serialize;
 
 use super::ensemble::simulate_ensemble;
-use super::{integration_step, simulate, SimSettings, SimulateError, CREEP_RANGE_M_S};
+use super::{integration_step, simulate, SimSettings, SimulateError, CREEP_RANGE_M_S, MAX_STEPS};
+use crate::error::ParamError;
 use crate::regime::Regime;
 use crate::scenario::Scenario;
 use crate::slope::SignedSlope;
@@ -118,6 +119,20 @@ pub fn check_convergence(
     ensemble: Option<usize>,
 ) -> Result<ConvergenceCheck, SimulateError> {
     let dt = integration_step(scenario, slope.felt(), settings.dt_s)?;
+    // The quarter step's walk is the longest: its limit, said as the check's (before any walk).
+    let fine = dt / STEP_REFINEMENT;
+    if (settings.duration_s + settings.settle_s) / fine > MAX_STEPS {
+        let most = (MAX_STEPS * fine - settings.settle_s).max(0.0).floor();
+        return Err(ParamError::new(
+            "duration_s",
+            settings.duration_s,
+            format!(
+                "at most {most:.0} s for the convergence check: its walk at a quarter of the step ({fine:.3e} s) \
+                 may take at most {MAX_STEPS:e} integration steps (settling included)"
+            ),
+        )
+        .into());
+    }
     let at = SimSettings { dt_s: Some(dt), ..*settings };
     let quarter = at.with_dt(dt / STEP_REFINEMENT)?;
     let creep = settings.creep_m_s / CREEP_REFINEMENT;

@@ -161,6 +161,13 @@ fn the_convergence_check_passes_the_default_and_fails_a_coarse_step() {
     let coarse = settings.with_dt(s.robot().stride_period() / 200.0).unwrap();
     let bad = check_convergence(&s, SignedSlope::from_degrees(20.0).unwrap(), &coarse, None).unwrap();
     assert!(!bad.converged && !bad.refinements[0].converged, "{bad:?}");
+    // The quarter step's walk has the step limit: refused before any walk, naming the check.
+    let long = SimSettings::new(3000.0).unwrap();
+    let e = check_convergence(&s, SignedSlope::from_degrees(10.0).unwrap(), &long, None).unwrap_err();
+    let SimulateError::Param(p) = e;
+    assert_eq!(p.key, "duration_s");
+    // 2e7 steps of 0.125 ms: 2500 s, less the 0.5 s of settling, in whole seconds.
+    assert!(p.to_string().contains("at most 2499 s for the convergence check"), "{p}");
     // At the smallest creep speed there is no tenth of it to walk.
     let least = settings.with_creep(CREEP_RANGE_M_S.0).unwrap();
     let one = check_convergence(&s, SignedSlope::from_degrees(0.0).unwrap(), &least, None).unwrap();

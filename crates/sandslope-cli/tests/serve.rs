@@ -256,11 +256,16 @@ fn simulate_endpoint_equals_simulate_json_and_feeds_the_animation() {
         "simulate",
         &[("slope", "10".into()), ("duration", "2".into()), ("ensemble", "2".into())],
     );
-    // --check-convergence: the check, as the CLI prints it.
+    // --check-convergence: the check, as the CLI prints it, at one slope and at several.
     assert_same(
         &server,
         "simulate",
         &[("slope", "10".into()), ("duration", "2".into()), ("check-convergence", String::new())],
+    );
+    assert_same(
+        &server,
+        "simulate",
+        &[("slopes", "0,15".into()), ("duration", "2".into()), ("check-convergence", String::new())],
     );
     // The server's limits and the command's own checks, each naming its flag.
     for (path, field, says) in [
@@ -268,7 +273,6 @@ fn simulate_endpoint_equals_simulate_json_and_feeds_the_animation() {
         // with a step of 0.1 ms, 3.6e6.
         ("/api/simulate?slope=10&duration=60&dt=1e-4&check-convergence", "dt", "2e6"),
         ("/api/simulate?slope=10&duration=60&check-convergence&ensemble=3", "ensemble", "2e6"),
-        ("/api/simulate?slopes=0,10&check-convergence", "check-convergence", "--slope, not --slopes"),
         ("/data/simulation?slope=10&check-convergence", "check-convergence", "one walk"),
         ("/api/simulate?slope=10&duration=61", "duration", "60"),
         ("/api/simulate?slopes=0:20:101&duration=2", "slopes", "100"),

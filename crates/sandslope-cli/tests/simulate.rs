@@ -346,8 +346,8 @@ fn an_ensemble_gives_the_spread_of_n_walks() {
 /// `--check-convergence` (docs/simulate.md, "Checking convergence"): the walk again at a
 /// quarter of the step and a tenth of the creep speed. The quarter step's dt is the walk's
 /// over four and the creep's a tenth, by construction; the built-in robot at 10 degrees passes
-/// (docs/simulate.md's table: 30.4 cm/s at both steps); the CSV has a row per walk; with
-/// --slopes it is refused naming the flag.
+/// (docs/simulate.md's table: 30.4 cm/s at both steps); the CSV has a row per walk; --slopes
+/// checks each slope; with --out it is refused naming the flag.
 #[test]
 fn the_convergence_check_walks_a_quarter_step_and_a_tenth_of_the_creep() {
     let v = json(&["simulate", "--slope", "10", "--duration", "3", "--check-convergence", "--json"]);
@@ -366,15 +366,20 @@ fn the_convergence_check_walks_a_quarter_step_and_a_tenth_of_the_creep() {
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
         lines[0],
-        "walk,dt_s,creep_m_s,speed_m_s,speed_se_m_s,t1_s,regime,speed_change_m_s,t1_change_s,converged"
+        "slope_deg,walk,dt_s,creep_m_s,speed_m_s,speed_se_m_s,t1_s,regime,speed_change_m_s,t1_change_s,converged"
     );
-    assert!(
-        lines[1].starts_with("as_asked,0.0005,") && lines[2].starts_with("quarter_step,0.000125,"),
-        "{text}"
-    );
+    assert!(lines[1].starts_with("10.0,as_asked,0.0005,"), "{text}");
+    assert!(lines[2].starts_with("10.0,quarter_step,0.000125,"), "{text}");
     assert_eq!(lines.len(), 4, "{text}");
+    // Issue 38's test, at 0, 10, 15 and 20 degrees in one call: a list, each slope's check as
+    // the one-slope check gives it.
+    let all =
+        json(&["simulate", "--slopes", "0,10,15,20", "--duration", "3", "--check-convergence", "--json"]);
+    let all = all.as_array().unwrap();
+    assert_eq!(all.len(), 4);
+    assert_eq!(all[1], v, "the 10 degree check differs from the one-slope check");
     sandslope()
-        .args(["simulate", "--slopes", "0,10", "--check-convergence"])
+        .args(["simulate", "--slope", "10", "--check-convergence", "--out", "walk.csv"])
         .assert()
         .code(2)
         .stderr(predicates::str::contains("--check-convergence"));

@@ -191,6 +191,7 @@ pub fn check_convergence<'py>(
     })?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
     let request = Walks::at(scenario, slope, settings, walks).checking_convergence();
-    let c = py.detach(|| request.check_convergence()).map_err(request_error)?;
+    let mut checks = py.detach(|| request.check_convergence()).map_err(request_error)?;
+    let c = checks.pop().ok_or_else(|| value_error("the check gave no result"))?;
     pythonize(py, &c).map_err(value_error)
 }

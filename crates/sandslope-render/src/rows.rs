@@ -261,10 +261,12 @@ impl EnsembleRow {
     }
 }
 
-/// One setting of `simulate --check-convergence --csv`: the walk as asked, then each refined
-/// walk against it.
+/// One setting of `simulate --check-convergence --csv`: at each slope the walk as asked, then
+/// each refined walk against it.
 #[derive(Debug, Clone, Serialize)]
 pub struct ConvergenceRow {
+    /// Slope, degrees.
+    pub slope_deg: f64,
     /// `as_asked`, `quarter_step` or `tenth_creep`.
     pub walk: &'static str,
     /// Time step, s.
@@ -291,6 +293,7 @@ impl ConvergenceRow {
     /// The walk's row, then one per refinement.
     pub fn rows(c: &ConvergenceCheck) -> Vec<ConvergenceRow> {
         let row = |walk, a: &WalkAnswer| ConvergenceRow {
+            slope_deg: c.slope_deg,
             walk,
             dt_s: a.dt_s,
             creep_m_s: a.creep_m_s,

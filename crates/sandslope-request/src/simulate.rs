@@ -5,8 +5,9 @@ use serde::{Deserialize, Serialize};
 
 use sandslope::simulate::convergence::{CREEP_REFINEMENT, STEP_REFINEMENT};
 use sandslope::simulate::{
-    check_convergence, simulate, simulate_ensemble, simulate_slopes, BodyPitch, ConvergenceCheck, Ensemble,
-    Mechanisms, RftScaling, SimSettings, SimSummary, SimulateError, Simulation, CREEP_RANGE_M_S,
+    check_convergence, check_convergence_slopes, simulate, simulate_ensemble, simulate_slopes, BodyPitch,
+    ConvergenceCheck, Ensemble, Mechanisms, RftScaling, SimSettings, SimSummary, SimulateError, Simulation,
+    CREEP_RANGE_M_S,
 };
 use sandslope::{ParamError, Scenario, SignedSlope};
 
@@ -57,8 +58,8 @@ pub struct SimulateRequest {
     /// Walk the one slope this many times, the mass perturbed by 1e-9 relative between walks,
     /// and answer the spread (field `ensemble`; docs/simulate.md, "Pitch free").
     pub ensemble: Option<usize>,
-    /// Walk the one slope again at a quarter of the step and at a tenth of the creep speed
-    /// and answer whether the walk is converged (field `check-convergence`, a flag;
+    /// Walk each slope again at a quarter of the step and at a tenth of the creep speed and
+    /// answer whether the walk is converged (field `check-convergence`, a flag;
     /// docs/simulate.md, "Checking convergence").
     #[serde(default)]
     pub check_convergence: bool,
@@ -135,9 +136,6 @@ impl SimulateRequest {
         let rate_hz = p.number_or("rate", 120.0)?;
         let ensemble = p.number("ensemble")?.map(|n| ensemble_size(n, &slopes)).transpose()?;
         let check_convergence = p.flag("check-convergence")?;
-        if check_convergence {
-            one_slope_to_check(&slopes)?;
-        }
         let scenario = ScenarioRequest::from_params(&mut p)?;
         p.finish()?;
         Ok(SimulateRequest {
@@ -189,9 +187,6 @@ impl SimulateRequest {
             }
             SimSlopes::One(slope) => (vec![signed(check_slope(*slope)?, "slope")?], false),
         };
-        if self.check_convergence {
-            one_slope_to_check(&self.slopes)?;
-        }
         Ok(Walks {
             scenario,
             slopes,
@@ -308,17 +303,6 @@ pub fn ensemble_size(n: f64, slopes: &SimSlopes) -> Result<usize> {
     Ok(n as usize)
 }
 
-/// The convergence check walks one slope.
-fn one_slope_to_check(slopes: &SimSlopes) -> Result<()> {
-    match slopes {
-        SimSlopes::One(_) => Ok(()),
-        SimSlopes::Many(_) => Err(RequestError::invalid(
-            "check-convergence",
-            "--check-convergence walks one slope: give --slope, not --slopes",
-        )),
-    }
-}
-
 /// One walk's slope: strictly between -90 and 90 degrees.
 pub fn check_slope(slope: f64) -> Result<f64> {
     check_range("slope", slope, -89.999_999, 89.999_999).map_err(|_| {
@@ -341,6 +325,8 @@ pub enum Answer {
     Ensemble(Box<Ensemble>),
     /// The convergence check at one slope.
     Convergence(Box<ConvergenceCheck>),
+    /// The convergence check at each of several slopes.
+    Convergences(Vec<ConvergenceCheck>),
 }
 
 /// The walks of a simulate request, checked: what a server weighs against its limits before
@@ -357,7 +343,7 @@ pub struct Walks {
     pub settings: SimSettings,
     /// Walks in an ensemble at the one slope, if asked.
     pub ensemble: Option<usize>,
-    /// Whether the one slope's walk (or ensemble) is checked for convergence instead.
+    /// Whether the walks (or the one slope's ensemble) are checked for convergence instead.
     pub check_convergence: bool,
     /// How the library's errors name their field: the command line's flags and the server's
     /// fields, or Python's keywords.
@@ -424,7 +410,10 @@ impl Walks {
     /// Runs the walks, or the ensemble, and answers (what `simulate --json` prints).
     pub fn respond(&self) -> Result<Answer> {
         if self.check_convergence {
-            return Ok(Answer::Convergence(Box::new(self.check_convergence()?)));
+            return Ok(match (self.many, self.check_convergence()?) {
+                (false, mut one) if one.len() == 1 => Answer::Convergence(Box::new(one.remove(0))),
+                (_, checks) => Answer::Convergences(checks),
+            });
         }
         match self.ensemble {
             Some(n) => Ok(Answer::Ensemble(Box::new(self.simulate_ensemble(n)?))),
@@ -438,11 +427,16 @@ impl Walks {
             .map_err(|e| sim_err(e, self.words))
     }
 
-    /// The convergence check of the one slope's walk (or ensemble): the walk, at a quarter of
-    /// its step and at a tenth of its creep speed, held to issue 38's tolerances.
-    pub fn check_convergence(&self) -> Result<ConvergenceCheck> {
-        check_convergence(&self.scenario, self.slopes[0], &self.settings, self.ensemble)
-            .map_err(|e| sim_err(e, self.words))
+    /// The convergence check of each slope's walk (or of the one slope's ensemble): the walk,
+    /// at a quarter of its step and at a tenth of its creep speed, held to issue 38's
+    /// tolerances; the slopes in parallel.
+    pub fn check_convergence(&self) -> Result<Vec<ConvergenceCheck>> {
+        let checks = if self.many {
+            check_convergence_slopes(&self.scenario, &self.slopes, &self.settings)
+        } else {
+            check_convergence(&self.scenario, self.slopes[0], &self.settings, self.ensemble).map(|c| vec![c])
+        };
+        checks.map_err(|e| sim_err(e, self.words))
     }
 
     /// The value `simulate --json` prints for these walks' results.

@@ -16,8 +16,9 @@ use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
 use crate::progress::{progress_bar, spinner};
+use sandslope::simulate::convergence::{RefinedWalk, Refinement, WalkAnswer};
 use sandslope::simulate::mechanisms::{CONSTANT_SPEED_DUTY, UNDISTURBED_SAND};
-use sandslope::simulate::{BodyPitch, Mechanisms, RftScaling, SimSummary, Simulation};
+use sandslope::simulate::{BodyPitch, ConvergenceCheck, Mechanisms, RftScaling, SimSummary, Simulation};
 use sandslope_io::load_speeds;
 use sandslope_io::trajectory::plain_mocap_csv;
 use sandslope_request::simulate::{ensemble_size, parse_slopes, Answer, SimSlopes, Walks};
@@ -80,13 +81,13 @@ pub struct SimulateArgs {
     /// chaotic, the spread is the answer (docs/simulate.md, "Pitch free").
     #[arg(long, value_name = "N", conflicts_with_all = ["slopes", "out", "plot", "animate"])]
     pub ensemble: Option<usize>,
-    /// Walk the one slope again at a quarter of the time step and at a tenth of the creep
-    /// speed, and say whether the answer is converged: speed within 3% (or 0.3 cm/s), t1
-    /// within 1 ms and the same regime (issue 38's test; docs/simulate.md, "Checking
-    /// convergence"). The default step is shown converged for the built-in robot and terrain
-    /// only; check your own. With --ensemble N each setting is N walks, their means compared
-    /// (a single free-pitch walk on a slope is chaotic and cannot converge).
-    #[arg(long, conflicts_with_all = ["slopes", "out", "plot", "animate"])]
+    /// Walk the slope (or each of --slopes) again at a quarter of the time step and at a tenth
+    /// of the creep speed, and say whether the answer is converged: speed within 3% (or
+    /// 0.3 cm/s), t1 within 1 ms and the same regime (issue 38's test; docs/simulate.md,
+    /// "Checking convergence"). The default step is shown converged for the built-in robot
+    /// and terrain only; check your own. With --ensemble N each setting is N walks, their
+    /// means compared (a single free-pitch walk on a slope is chaotic and cannot converge).
+    #[arg(long, conflicts_with_all = ["out", "plot", "animate"])]
     pub check_convergence: bool,
     /// Trajectory sample rate for --out, --plot and --animate, Hz.
     #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
@@ -369,87 +370,148 @@ fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
 
 fn run_check(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     let quiet = args.format.format() != Format::Table;
-    let slope = walks.slopes[0].degrees();
-    let spin = spinner(
-        quiet,
-        &format!("checking the walk at {slope} deg at a quarter of its step and a tenth of its creep"),
-    );
-    let c = walks.check_convergence();
+    let what = match walks.slopes.as_slice() {
+        [one] => format!("the walk at {} deg", one.degrees()),
+        many => format!("the walks at {} slopes", many.len()),
+    };
+    let spin = spinner(quiet, &format!("checking {what} at a quarter of the step and a tenth of the creep"));
+    let answer = walks.respond();
     spin.finish_and_clear();
-    let c = c?;
+    let answer = answer?;
+    let checks: Vec<&ConvergenceCheck> = match &answer {
+        Answer::Convergence(c) => vec![c],
+        Answer::Convergences(all) => all.iter().collect(),
+        _ => bail!("the convergence check gave no answer"),
+    };
     match args.format.format() {
-        Format::Json => print_json(&Answer::Convergence(Box::new(c)))?,
-        Format::Csv => print!("{}", csv_string(&ConvergenceRow::rows(&c))?),
-        Format::Table => {
-            let walks_word =
-                if c.walks == 1 { "one walk".to_string() } else { format!("means of {} walks", c.walks) };
-            println!(
-                "convergence at {slope} deg ({walks_word} a setting, {} s each): {}",
-                walks.settings.duration_s,
-                if c.converged { "converged" } else { "NOT converged" }
-            );
-            let mut t =
-                table(&["walk", "dt ms", "creep m/s", "speed cm/s", "t1 ms", "regime", "change", "within"]);
-            let cells = |a: &sandslope::simulate::convergence::WalkAnswer| {
-                let speed = match a.speed_se_m_s {
-                    Some(se) => format!("{:.2} ± {:.2}", a.speed_m_s * 100.0, se * 100.0),
-                    None => format!("{:.2}", a.speed_m_s * 100.0),
-                };
-                [
-                    format!("{:.4}", a.dt_s * 1e3),
-                    format!("{:.0e}", a.creep_m_s),
-                    speed,
-                    num(a.t1_s.map(|t| t * 1e3), 2),
-                    a.regime.name().to_string(),
-                ]
-            };
-            let [dt, creep, speed, t1, regime] = cells(&c.walk);
-            t.add_row(["as asked".to_string(), dt, creep, speed, t1, regime, String::new(), String::new()]);
-            for r in &c.refinements {
-                let [dt, creep, speed, t1, regime] = cells(&r.answer);
-                let pct = if c.walk.speed_m_s != 0.0 {
-                    format!(" ({:+.1}%)", 100.0 * r.speed_change_m_s / c.walk.speed_m_s.abs())
-                } else {
-                    String::new()
-                };
-                let change = format!(
-                    "speed {:+.2} cm/s{pct}, t1 {} ms",
-                    r.speed_change_m_s * 100.0,
-                    r.t1_change_s.map_or("-".to_string(), |d| format!("{:+.2}", d * 1e3))
-                );
-                let mut failed = Vec::new();
-                if !r.speed_within {
-                    failed.push("speed");
-                }
-                if !r.t1_within {
-                    failed.push("t1");
-                }
-                if !r.same_regime {
-                    failed.push("regime");
-                }
-                let within =
-                    if failed.is_empty() { "yes".to_string() } else { format!("no: {}", failed.join(", ")) };
-                t.add_row([r.refinement.label().to_string(), dt, creep, speed, t1, regime, change, within]);
-            }
-            println!("{t}");
-            println!(
-                "tolerances: speed within {:.0}% or {:.1} cm/s, t1 within {:.0} ms, the same regime (docs/simulate.md, \"Checking convergence\")",
-                c.speed_tolerance * 100.0,
-                c.speed_tolerance_m_s * 100.0,
-                c.t1_tolerance_s * 1e3
-            );
-            if c.walks > 1 {
-                println!("speeds are the ensembles' means +/- their standard errors");
-            }
-            if c.refinements.len() == 1 {
-                println!("the creep speed is at its smallest (1e-9 m/s): no tenth of it to walk");
-            }
-            if walks.settings.body_pitch == BodyPitch::Free && c.walks == 1 {
-                println!("{FREE_NOTE}");
-            }
+        Format::Json => print_json(&answer)?,
+        Format::Csv => {
+            let rows: Vec<ConvergenceRow> = checks.iter().flat_map(|c| ConvergenceRow::rows(c)).collect();
+            print!("{}", csv_string(&rows)?);
         }
+        Format::Table if walks.many => print_checks(&checks, walks),
+        Format::Table => print_check(checks[0], walks),
     }
     Ok(())
+}
+
+/// A refinement's change as the tables print it: speed (and its share of the walk's), t1.
+fn change_cell(c: &ConvergenceCheck, r: &RefinedWalk) -> String {
+    let pct = if c.walk.speed_m_s != 0.0 {
+        format!(" ({:+.1}%)", 100.0 * r.speed_change_m_s / c.walk.speed_m_s.abs())
+    } else {
+        String::new()
+    };
+    let t1 = r.t1_change_s.map_or("-".to_string(), |d| format!("{:+.2}", d * 1e3));
+    format!("speed {:+.2} cm/s{pct}, t1 {t1} ms", r.speed_change_m_s * 100.0)
+}
+
+/// "yes", or what fell outside the tolerances.
+fn within_cell(r: &RefinedWalk) -> String {
+    let failed: Vec<&str> = [("speed", r.speed_within), ("t1", r.t1_within), ("regime", r.same_regime)]
+        .into_iter()
+        .filter(|(_, ok)| !ok)
+        .map(|(what, _)| what)
+        .collect();
+    if failed.is_empty() {
+        "yes".to_string()
+    } else {
+        format!("no: {}", failed.join(", "))
+    }
+}
+
+/// The tolerances line under the convergence tables.
+fn tolerances_note(c: &ConvergenceCheck) -> String {
+    format!(
+        "tolerances: speed within {:.0}% or {:.1} cm/s, t1 within {:.0} ms, the same regime (docs/simulate.md, \"Checking convergence\")",
+        c.speed_tolerance * 100.0,
+        c.speed_tolerance_m_s * 100.0,
+        c.t1_tolerance_s * 1e3
+    )
+}
+
+fn print_check(c: &ConvergenceCheck, walks: &Walks) {
+    let walks_word =
+        if c.walks == 1 { "one walk".to_string() } else { format!("means of {} walks", c.walks) };
+    println!(
+        "convergence at {} deg ({walks_word} a setting, {} s each): {}",
+        c.slope_deg,
+        walks.settings.duration_s,
+        if c.converged { "converged" } else { "NOT converged" }
+    );
+    let mut t = table(&["walk", "dt ms", "creep m/s", "speed cm/s", "t1 ms", "regime", "change", "within"]);
+    let cells = |a: &WalkAnswer| {
+        let speed = match a.speed_se_m_s {
+            Some(se) => format!("{:.2} ± {:.2}", a.speed_m_s * 100.0, se * 100.0),
+            None => format!("{:.2}", a.speed_m_s * 100.0),
+        };
+        [
+            format!("{:.4}", a.dt_s * 1e3),
+            format!("{:.0e}", a.creep_m_s),
+            speed,
+            num(a.t1_s.map(|t| t * 1e3), 2),
+            a.regime.name().to_string(),
+        ]
+    };
+    let [dt, creep, speed, t1, regime] = cells(&c.walk);
+    t.add_row(["as asked".to_string(), dt, creep, speed, t1, regime, String::new(), String::new()]);
+    for r in &c.refinements {
+        let [dt, creep, speed, t1, regime] = cells(&r.answer);
+        t.add_row([
+            r.refinement.label().to_string(),
+            dt,
+            creep,
+            speed,
+            t1,
+            regime,
+            change_cell(c, r),
+            within_cell(r),
+        ]);
+    }
+    println!("{t}");
+    println!("{}", tolerances_note(c));
+    if c.walks > 1 {
+        println!("speeds are the ensembles' means +/- their standard errors");
+    }
+    if c.refinements.len() == 1 {
+        println!("the creep speed is at its smallest (1e-9 m/s): no tenth of it to walk");
+    }
+    if walks.settings.body_pitch == BodyPitch::Free && c.walks == 1 {
+        println!("{FREE_NOTE}");
+    }
+}
+
+fn print_checks(checks: &[&ConvergenceCheck], walks: &Walks) {
+    let passed = checks.iter().filter(|c| c.converged).count();
+    println!(
+        "convergence at {} slopes (one walk a setting, {} s each): {passed} converged, {} not",
+        checks.len(),
+        walks.settings.duration_s,
+        checks.len() - passed
+    );
+    let mut t = table(&["slope deg", "speed cm/s", "t1 ms", "regime", "dt / 4", "creep / 10", "converged"]);
+    for c in checks {
+        let at = |k: Refinement| c.refinements.iter().find(|r| r.refinement == k);
+        let cell = |k: Refinement| {
+            at(k).map_or("-".to_string(), |r| format!("{} ({})", change_cell(c, r), within_cell(r)))
+        };
+        t.add_row([
+            format!("{}", c.slope_deg),
+            format!("{:.2}", c.walk.speed_m_s * 100.0),
+            num(c.walk.t1_s.map(|t| t * 1e3), 2),
+            c.walk.regime.name().to_string(),
+            cell(Refinement::QuarterStep),
+            cell(Refinement::TenthCreep),
+            if c.converged { "yes" } else { "NO" }.to_string(),
+        ]);
+    }
+    println!("{t}");
+    if let Some(c) = checks.first() {
+        println!("{}", tolerances_note(c));
+    }
+    if walks.settings.body_pitch == BodyPitch::Free {
+        println!("{FREE_NOTE}");
+    }
 }
 
 fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedObservation]) -> Result<()> {

@@ -157,6 +157,17 @@ pub fn check_convergence(
     })
 }
 
+/// [`check_convergence`] at each of `slopes`, in parallel, one walk a setting (issue 38's test
+/// at 0, 10, 15 and 20 degrees is `slopes = [0, 10, 15, 20]`).
+pub fn check_convergence_slopes(
+    scenario: &Scenario,
+    slopes: &[SignedSlope],
+    settings: &SimSettings,
+) -> Result<Vec<ConvergenceCheck>, SimulateError> {
+    use rayon::prelude::*;
+    slopes.par_iter().map(|&s| check_convergence(scenario, s, settings, None)).collect()
+}
+
 /// One setting's answer: a walk, or an ensemble's means.
 fn answer(
     scenario: &Scenario,

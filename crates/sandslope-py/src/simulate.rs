@@ -149,10 +149,12 @@ pub fn simulate_ensemble<'py>(
     pythonize(py, &e).map_err(value_error)
 }
 
-/// Whether one slope's walk is converged (`sandslope simulate --check-convergence --json`,
+/// Whether a walk is converged (`sandslope simulate --check-convergence --json`,
 /// docs/simulate.md "Checking convergence"): the walk as asked, again at a quarter of its step
 /// and at a tenth of its creep speed, held to issue 38's tolerances; with `walks`, each setting
-/// is an ensemble of that many walks and their means are compared.
+/// is an ensemble of that many walks and their means are compared. `slope_deg` is one slope
+/// (answered by one dict) or a sequence of slopes (`--slopes`: a list of dicts, the slopes
+/// in parallel; not with `walks`).
 #[pyfunction]
 #[pyo3(signature = (robot, terrain, slope_deg, duration_s, walks=None, k_n=None, k_s=None, dt_s=None, creep_m_s=None, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=sandslope::simulate::mechanisms::UNDISTURBED_SAND))]
 #[allow(clippy::too_many_arguments)]
@@ -160,7 +162,7 @@ pub fn check_convergence<'py>(
     py: Python<'py>,
     robot: &PyRobot,
     terrain: &PyTerrain,
-    slope_deg: f64,
+    slope_deg: &Bound<'py, PyAny>,
     duration_s: f64,
     walks: Option<usize>,
     k_n: Option<f64>,
@@ -189,9 +191,33 @@ pub fn check_convergence<'py>(
         mechanisms,
         rate_hz,
     })?;
-    let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
-    let request = Walks::at(scenario, slope, settings, walks).checking_convergence();
+    let signed = |deg: f64| sandslope::SignedSlope::from_degrees(deg).map_err(value_error);
+    let request = match slope_deg.extract::<f64>() {
+        Ok(deg) => Walks::at(scenario, signed(deg)?, settings, walks),
+        Err(_) => {
+            let degs: Vec<f64> = slope_deg
+                .extract()
+                .map_err(|_| value_error("slope_deg must be a number of degrees or a sequence of them"))?;
+            if walks.is_some() {
+                return Err(value_error("walks: an ensemble walks one slope; give slope_deg as a number"));
+            }
+            if degs.is_empty() || degs.len() > sandslope_request::simulate::MAX_SLOPES {
+                return Err(value_error(format!(
+                    "slope_deg holds {} slopes: give 1 to {}",
+                    degs.len(),
+                    sandslope_request::simulate::MAX_SLOPES
+                )));
+            }
+            let slopes = degs.into_iter().map(signed).collect::<PyResult<Vec<_>>>()?;
+            Walks::at_slopes(scenario, slopes, settings)
+        }
+    }
+    .checking_convergence();
+    let many = request.many;
     let mut checks = py.detach(|| request.check_convergence()).map_err(request_error)?;
+    if many {
+        return pythonize(py, &checks).map_err(value_error);
+    }
     let c = checks.pop().ok_or_else(|| value_error("the check gave no result"))?;
     pythonize(py, &c).map_err(value_error)
 }

@@ -123,3 +123,9 @@ def test_the_convergence_check_is_the_cli_check(cli):
     assert got["converged"] is want["converged"] is True
     with pytest.raises(ValueError, match=r"walks = 1 must be a whole number of walks from 2 to 1000"):
         sandslope.check_convergence("paper-hexapod", "glass-beads-300um", 10, 2, walks=1)
+    # Several slopes: the list `--slopes` prints, each the one-slope check.
+    many = sandslope.check_convergence("paper-hexapod", "glass-beads-300um", [0, 10], 3)
+    assert isinstance(many, list) and [c["slope_deg"] for c in many] == [0.0, 10.0]
+    assert many[1] == got
+    with pytest.raises(ValueError, match=r"an ensemble walks one slope"):
+        sandslope.check_convergence("paper-hexapod", "glass-beads-300um", [0, 10], 2, walks=2)

@@ -371,6 +371,20 @@ impl Walks {
         }
     }
 
+    /// Walks at each of `slopes` (answered as a list, even of one) of a robot and terrain a
+    /// front end built itself, as [`Walks::at`]; errors name Python's keywords.
+    pub fn at_slopes(scenario: Scenario, slopes: Vec<SignedSlope>, settings: SimSettings) -> Walks {
+        Walks {
+            scenario,
+            slopes,
+            many: true,
+            settings,
+            ensemble: None,
+            check_convergence: false,
+            words: Words::Keyword,
+        }
+    }
+
     /// The same walks checked for convergence instead ([`Walks::respond`] then answers
     /// [`Answer::Convergence`]).
     pub fn checking_convergence(self) -> Walks {

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import os
 import warnings as _warnings
-from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -695,7 +695,7 @@ def simulate_ensemble(
 def check_convergence(
     robot: RobotLike,
     terrain: TerrainLike,
-    slope_deg: float,
+    slope_deg: Union[float, Sequence[float]],
     duration_s: float = 10.0,
     *,
     walks: Optional[int] = None,
@@ -709,9 +709,10 @@ def check_convergence(
     leg_friction: Optional[float] = None,
     duty_cycle: Optional[float] = None,
     disturbed_sand: Optional[float] = None,
-) -> Dict[str, Any]:
+) -> Union[Dict[str, Any], List[Dict[str, Any]]]:
     """Whether the walk at ``slope_deg`` is converged: the dict ``sandslope simulate
-    --check-convergence --json`` prints. The walk as asked (``walk``), again at a quarter of
+    --check-convergence --json`` prints (a sequence of slopes: the list ``--slopes`` prints,
+    the slopes checked in parallel). The walk as asked (``walk``), again at a quarter of
     its time step and at a tenth of its creep speed (``refinements``, each with its answer, its
     changes and whether speed, t1 and regime are within issue 38's tolerances: 3% or 0.3 cm/s,
     1 ms, the same), and ``converged`` if both are.
@@ -722,10 +723,11 @@ def check_convergence(
     a single walk with ``body_pitch="free"`` on a slope is chaotic and cannot converge. The
     other keywords are :func:`simulate`'s.
     """
+    slopes = [float(s) for s in slope_deg] if isinstance(slope_deg, (list, tuple, np.ndarray)) else float(slope_deg)
     return _sandslope.check_convergence(
         _robot(robot),
         _terrain(terrain),
-        float(slope_deg),
+        slopes,
         float(duration_s),
         None if walks is None else int(walks),
         **_walk_keywords(

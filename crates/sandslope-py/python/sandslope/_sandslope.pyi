@@ -261,7 +261,7 @@ def simulate_ensemble(
 def check_convergence(
     robot: Robot,
     terrain: Terrain,
-    slope_deg: float,
+    slope_deg: Union[float, List[float]],
     duration_s: float,
     walks: Optional[int] = None,
     k_n: Optional[float] = None,
@@ -274,7 +274,7 @@ def check_convergence(
     leg_friction: Optional[float] = None,
     duty_cycle: float = 0.5,
     disturbed_sand: float = 1.0,
-) -> Dict[str, Any]: ...
+) -> Union[Dict[str, Any], List[Dict[str, Any]]]: ...
 def read_servo_log(path: _Path) -> Tuple[Dict[str, np.ndarray], Dict[str, str], List[str]]: ...
 def infer_servo_log(
     robot: Robot,

@@ -41,20 +41,19 @@ pub fn simulate<'py>(
     duty_cycle: f64,
     disturbed_sand: f64,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
-    let scenario =
-        Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
-    let (body_pitch, rft_scaling) = modes(body_pitch, rft_scaling)?;
-    let mechanisms = Mechanisms { leg_friction, duty_cycle, disturbed_sand };
-    let settings = checked(SettingsRequest {
+    let (scenario, settings) = WalkKeywords {
+        k_n,
+        k_s,
         duration_s,
         dt_s,
         creep_m_s,
-        servo_limit,
+        rate_hz: sample_rate_hz,
         body_pitch,
         rft_scaling,
-        mechanisms,
-        rate_hz: sample_rate_hz,
-    })?;
+        servo_limit,
+        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
+    }
+    .setup(robot, terrain)?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
     let walks = Walks::at(scenario, slope, settings, None);
     let mut sims = py.detach(|| walks.simulate()).map_err(request_error)?;
@@ -99,9 +98,40 @@ fn modes(body_pitch: &str, rft_scaling: &str) -> PyResult<(BodyPitch, RftScaling
     ))
 }
 
-/// The settings `sandslope simulate` checks, in Python's words.
-fn checked(settings: SettingsRequest) -> PyResult<SimSettings> {
-    settings.settings(Words::Keyword).map_err(request_error)
+/// The keywords every walk takes, as Python passes them.
+struct WalkKeywords<'a> {
+    k_n: Option<f64>,
+    k_s: Option<f64>,
+    duration_s: f64,
+    dt_s: Option<f64>,
+    creep_m_s: Option<f64>,
+    rate_hz: f64,
+    body_pitch: &'a str,
+    rft_scaling: &'a str,
+    servo_limit: bool,
+    mechanisms: Mechanisms,
+}
+
+impl WalkKeywords<'_> {
+    /// The robot on its terrain and the settings `sandslope simulate` checks, in Python's words.
+    fn setup(&self, robot: &PyRobot, terrain: &PyTerrain) -> PyResult<(Scenario, SimSettings)> {
+        let scenario = Scenario::new(robot.inner.clone(), terrain.inner.clone(), self.k_n, self.k_s)
+            .map_err(value_error)?;
+        let (body_pitch, rft_scaling) = modes(self.body_pitch, self.rft_scaling)?;
+        let settings = SettingsRequest {
+            duration_s: self.duration_s,
+            dt_s: self.dt_s,
+            creep_m_s: self.creep_m_s,
+            servo_limit: self.servo_limit,
+            body_pitch,
+            rft_scaling,
+            mechanisms: self.mechanisms,
+            rate_hz: self.rate_hz,
+        }
+        .settings(Words::Keyword)
+        .map_err(request_error)?;
+        Ok((scenario, settings))
+    }
 }
 
 /// Walks the robot `walks` times (2 to 1000) at one slope, the mass perturbed by 1e-9 relative
@@ -128,21 +158,19 @@ pub fn simulate_ensemble<'py>(
     duty_cycle: f64,
     disturbed_sand: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let scenario =
-        Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
-    let (body_pitch, rft_scaling) = modes(body_pitch, rft_scaling)?;
-    let mechanisms = Mechanisms { leg_friction, duty_cycle, disturbed_sand };
-    let rate_hz = sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ;
-    let settings = checked(SettingsRequest {
+    let (scenario, settings) = WalkKeywords {
+        k_n,
+        k_s,
         duration_s,
         dt_s,
         creep_m_s,
-        servo_limit,
+        rate_hz: sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ,
         body_pitch,
         rft_scaling,
-        mechanisms,
-        rate_hz,
-    })?;
+        servo_limit,
+        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
+    }
+    .setup(robot, terrain)?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
     let request = Walks::at(scenario, slope, settings, Some(walks));
     let e = py.detach(|| request.simulate_ensemble(walks)).map_err(request_error)?;
@@ -176,21 +204,19 @@ pub fn check_convergence<'py>(
     duty_cycle: f64,
     disturbed_sand: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let scenario =
-        Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
-    let (body_pitch, rft_scaling) = modes(body_pitch, rft_scaling)?;
-    let mechanisms = Mechanisms { leg_friction, duty_cycle, disturbed_sand };
-    let rate_hz = sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ;
-    let settings = checked(SettingsRequest {
+    let (scenario, settings) = WalkKeywords {
+        k_n,
+        k_s,
         duration_s,
         dt_s,
         creep_m_s,
-        servo_limit,
+        rate_hz: sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ,
         body_pitch,
         rft_scaling,
-        mechanisms,
-        rate_hz,
-    })?;
+        servo_limit,
+        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
+    }
+    .setup(robot, terrain)?;
     let signed = |deg: f64| sandslope::SignedSlope::from_degrees(deg).map_err(value_error);
     let request = match slope_deg.extract::<f64>() {
         Ok(deg) => Walks::at(scenario, signed(deg)?, settings, walks),

@@ -135,6 +135,24 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
         assert_eq!(sim[0][col], walk[key], "{col}");
     }
     assert_eq!(sim[0]["closed_form_step_m"], walk["closed_form"]["step_m"]);
+    // Each pitch-locked walk checked for convergence, as `simulate --check-convergence` checks
+    // it (the 20 degree check is the command's, number for number), and the page says what the
+    // checks found instead of assuming it.
+    let checks = v["simulator_convergence"].as_array().unwrap();
+    assert_eq!(checks.len(), sim.len());
+    let check: serde_json::Value = serde_json::from_slice(
+        &sandslope()
+            .args(["simulate", "--slope", "20", "--check-convergence", "--json"])
+            .assert()
+            .success()
+            .get_output()
+            .stdout,
+    )
+    .unwrap();
+    let at = checks.iter().find(|c| c["slope_deg"] == 20.0).unwrap();
+    assert_eq!(at, &check);
+    let all = checks.iter().all(|c| c["converged"] == true);
+    assert_eq!(html.contains("Each of these 14 walks is converged, checked here"), all);
     // The pitch-free column is `simulate --body-pitch free` at the same slope.
     let free: serde_json::Value = serde_json::from_slice(
         &sandslope()

@@ -241,6 +241,9 @@ pub struct Report {
     /// The stride simulator beside the closed form and the observations, slope by slope, with
     /// where and why the two part (docs/simulate.md).
     pub simulator: Vec<SimulatorRecord>,
+    /// Each of those pitch-locked walks checked for convergence (`simulate
+    /// --check-convergence`, docs/simulate.md "Checking convergence"), in slope order.
+    pub simulator_convergence: Vec<crate::simulate::ConvergenceCheck>,
     /// The same joint calibration with the stride simulator in place of the closed form
     /// (`calibrate --model simulate`), beside [`Report::calibration`]; `null` unless asked for
     /// ([`Evidence::simulator_fit`]: its thousands of walks take about 8 minutes of CPU on the paper's evidence) or
@@ -436,14 +439,19 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
     // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...): a
     // robot it refuses loses this section, with a warning, not the report.
-    let (simulator, simulator_refusal) = match simulator::simulator_section(&robot, &terrain, &speeds) {
-        Ok(walks) => {
-            plots.simulated = walks.free;
-            plots.simulated_pitch_locked = walks.pitch_locked;
-            (walks.records, None)
-        }
-        Err(e) => (Vec::new(), Some(format!("the stride simulator section is left out: {e}"))),
-    };
+    let (simulator, simulator_convergence, simulator_refusal) =
+        match simulator::simulator_section(&robot, &terrain, &speeds) {
+            Ok(walks) => {
+                plots.simulated = walks.free;
+                plots.simulated_pitch_locked = walks.pitch_locked;
+                (walks.records, walks.convergence, None)
+            }
+            Err(e) => {
+                (Vec::new(), Vec::new(), Some(format!("the stride simulator section is left out: {e}")))
+            }
+        };
+    let unconverged: Vec<String> =
+        simulator_convergence.iter().filter(|c| !c.converged).map(|c| format!("{}°", c.slope_deg)).collect();
     let own = evidence.has_own_observations();
     let context = ComparisonContext {
         fitted_to_paper_speeds: !own && evidence.builtin_terrain,
@@ -479,6 +487,14 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         .collect();
     let mut warnings = track_use.warnings;
     warnings.extend(simulator_refusal);
+    if !unconverged.is_empty() {
+        warnings.push(format!(
+            "the stride simulator's pitch-locked walk is not converged at {} (a quarter of the time step or a \
+             tenth of the creep speed moves its speed by more than 3% and 0.3 cm/s, its t1 by more than 1 ms or its \
+             regime; docs/simulate.md, \"Checking convergence\"): read those rows with care",
+            unconverged.join(", ")
+        ));
+    }
     warnings.extend(simulator_fit_warnings);
     if let Some(c) = &calibration {
         warnings.extend(disagreements::calibration_warnings(c));
@@ -514,6 +530,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         extrapolations,
         step_budget,
         simulator,
+        simulator_convergence,
         simulator_fit,
         simulator_fit_misses,
         inputs: provenance::inputs(evidence, !track_use.anchoring.is_empty()),

@@ -12,7 +12,9 @@ use crate::error::ParamError;
 use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::scenario::Scenario;
-use crate::simulate::{simulate_slopes, BodyPitch, MotionCause, SimSettings, SimSummary};
+use crate::simulate::{
+    check_walked, simulate_slopes, BodyPitch, ConvergenceCheck, MotionCause, SimSettings, SimSummary,
+};
 use crate::slope::Slope;
 use crate::terrain::Terrain;
 
@@ -96,11 +98,15 @@ pub struct SimulatorWalks {
     pub free: Vec<SimSummary>,
     /// The same walks with the pitch locked.
     pub pitch_locked: Vec<SimSummary>,
+    /// Each pitch-locked walk checked: again at a quarter of the step and a tenth of the creep
+    /// speed ([`crate::simulate::check_walked`]), in slope order.
+    pub convergence: Vec<ConvergenceCheck>,
 }
 
 /// Simulates `robot` on `terrain` at every slope of [`section_slopes`] (10 s walks, the
-/// simulator's defaults), once with the body's pitch locked (the default, converged) and once
-/// free to pitch, and sets each beside the closed form and the observed speed.
+/// simulator's defaults), once with the body's pitch locked (the default) and once free to
+/// pitch, sets each beside the closed form and the observed speed, and checks each locked walk
+/// for convergence (again at a quarter of the step and a tenth of the creep speed).
 pub fn simulator_section(
     robot: &Robot,
     terrain: &Terrain,
@@ -119,7 +125,17 @@ pub fn simulator_section(
         Ok(sims.into_iter().map(|s| s.summary).collect())
     };
     let free = walk(&settings.with_body_pitch(BodyPitch::Free))?;
-    let pitch_locked = walk(&settings.with_body_pitch(BodyPitch::Locked))?;
+    let locked = settings.with_body_pitch(BodyPitch::Locked);
+    let pitch_locked = walk(&locked)?;
+    // The locked answers are the section's: each is checked, not assumed, to be converged.
+    let convergence = slopes
+        .par_iter()
+        .zip(&pitch_locked)
+        .map(|(&slope, m)| check_walked(&scenario, slope, &locked, m))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| match e {
+            crate::simulate::SimulateError::Param(p) => p,
+        })?;
     let rolling = crate::simulate::rigid_rolling_step(robot);
     let records = pitch_locked
         .iter()
@@ -129,7 +145,7 @@ pub fn simulator_section(
             record(m, free, observed, rolling)
         })
         .collect();
-    Ok(SimulatorWalks { records, free, pitch_locked })
+    Ok(SimulatorWalks { records, free, pitch_locked, convergence })
 }
 
 fn record(

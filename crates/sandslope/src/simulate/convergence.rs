@@ -7,7 +7,7 @@
 use serde::Serialize;
 
 use super::ensemble::simulate_ensemble;
-use super::{integration_step, simulate, SimSettings, SimulateError, CREEP_RANGE_M_S, MAX_STEPS};
+use super::{integration_step, simulate, SimSettings, SimSummary, SimulateError, CREEP_RANGE_M_S, MAX_STEPS};
 use crate::error::ParamError;
 use crate::regime::Regime;
 use crate::scenario::Scenario;
@@ -118,43 +118,98 @@ pub fn check_convergence(
     settings: &SimSettings,
     ensemble: Option<usize>,
 ) -> Result<ConvergenceCheck, SimulateError> {
-    let dt = integration_step(scenario, slope.felt(), settings.dt_s)?;
-    // The quarter step's walk is the longest: its limit, said as the check's (before any walk).
-    let fine = dt / STEP_REFINEMENT;
-    if (settings.duration_s + settings.settle_s) / fine > MAX_STEPS {
-        let most = (MAX_STEPS * fine - settings.settle_s).max(0.0).floor();
-        return Err(ParamError::new(
-            "duration_s",
-            settings.duration_s,
-            format!(
-                "at most {most:.0} s for the convergence check: its walk at a quarter of the step ({fine:.3e} s) \
-                 may take at most {MAX_STEPS:e} integration steps (settling included)"
-            ),
-        )
-        .into());
-    }
-    let at = SimSettings { dt_s: Some(dt), ..*settings };
-    let quarter = at.with_dt(dt / STEP_REFINEMENT)?;
-    let creep = settings.creep_m_s / CREEP_REFINEMENT;
-    let tenth = (creep >= CREEP_RANGE_M_S.0).then(|| at.with_creep(creep)).transpose()?;
+    let plan = Plan::new(scenario, slope, settings)?;
     let walk = |s: &SimSettings| answer(scenario, slope, s, ensemble);
-    let (base, (refined_step, refined_creep)) =
-        rayon::join(|| walk(&at), || rayon::join(|| walk(&quarter), || tenth.as_ref().map(walk).transpose()));
-    let base = base?;
-    let mut refinements = vec![refined(&base, Refinement::QuarterStep, refined_step?)];
-    if let Some(a) = refined_creep? {
-        refinements.push(refined(&base, Refinement::TenthCreep, a));
+    let (base, (refined_step, refined_creep)) = rayon::join(
+        || walk(&plan.at),
+        || rayon::join(|| walk(&plan.quarter), || plan.tenth.as_ref().map(walk).transpose()),
+    );
+    Ok(plan.check(slope, ensemble.unwrap_or(1), base?, refined_step?, refined_creep?))
+}
+
+/// [`check_convergence`] of a walk already walked at `settings` (its summary `walked`): only
+/// the refined walks run (the report's simulator section checks its own walks this way).
+pub fn check_walked(
+    scenario: &Scenario,
+    slope: SignedSlope,
+    settings: &SimSettings,
+    walked: &SimSummary,
+) -> Result<ConvergenceCheck, SimulateError> {
+    let plan = Plan::new(scenario, slope, settings)?;
+    let walk = |s: &SimSettings| answer(scenario, slope, s, None);
+    let (refined_step, refined_creep) =
+        rayon::join(|| walk(&plan.quarter), || plan.tenth.as_ref().map(walk).transpose());
+    let base = WalkAnswer {
+        dt_s: walked.dt_s,
+        creep_m_s: walked.creep_m_s,
+        speed_m_s: walked.speed_m_s,
+        speed_se_m_s: None,
+        t1_s: walked.t1_s,
+        regime: walked.regime,
+    };
+    Ok(plan.check(slope, 1, base, refined_step?, refined_creep?))
+}
+
+/// The walks of a check: the settings as asked (with their step made explicit), at a quarter
+/// of the step, and at a tenth of the creep speed where there is one.
+struct Plan {
+    at: SimSettings,
+    quarter: SimSettings,
+    tenth: Option<SimSettings>,
+}
+
+impl Plan {
+    /// The check's settings; refused before any walk when the quarter step's walk would pass
+    /// the step limit (its message names the check).
+    fn new(scenario: &Scenario, slope: SignedSlope, settings: &SimSettings) -> Result<Plan, SimulateError> {
+        let dt = integration_step(scenario, slope.felt(), settings.dt_s)?;
+        // The quarter step's walk is the longest: its limit, said as the check's.
+        let fine = dt / STEP_REFINEMENT;
+        if (settings.duration_s + settings.settle_s) / fine > MAX_STEPS {
+            let most = (MAX_STEPS * fine - settings.settle_s).max(0.0).floor();
+            return Err(ParamError::new(
+                "duration_s",
+                settings.duration_s,
+                format!(
+                    "at most {most:.0} s for the convergence check: its walk at a quarter of the step ({fine:.3e} s) \
+                     may take at most {MAX_STEPS:e} integration steps (settling included)"
+                ),
+            )
+            .into());
+        }
+        let at = SimSettings { dt_s: Some(dt), ..*settings };
+        let creep = settings.creep_m_s / CREEP_REFINEMENT;
+        Ok(Plan {
+            quarter: at.with_dt(fine)?,
+            tenth: (creep >= CREEP_RANGE_M_S.0).then(|| at.with_creep(creep)).transpose()?,
+            at,
+        })
     }
-    Ok(ConvergenceCheck {
-        slope_deg: slope.degrees(),
-        walks: ensemble.unwrap_or(1),
-        walk: base,
-        converged: refinements.iter().all(|r| r.converged),
-        refinements,
-        speed_tolerance: SPEED_TOLERANCE,
-        speed_tolerance_m_s: SPEED_TOLERANCE_M_S,
-        t1_tolerance_s: T1_TOLERANCE_S,
-    })
+
+    /// The refined answers held against `base`.
+    fn check(
+        &self,
+        slope: SignedSlope,
+        walks: usize,
+        base: WalkAnswer,
+        refined_step: WalkAnswer,
+        refined_creep: Option<WalkAnswer>,
+    ) -> ConvergenceCheck {
+        let mut refinements = vec![refined(&base, Refinement::QuarterStep, refined_step)];
+        if let Some(a) = refined_creep {
+            refinements.push(refined(&base, Refinement::TenthCreep, a));
+        }
+        ConvergenceCheck {
+            slope_deg: slope.degrees(),
+            walks,
+            walk: base,
+            converged: refinements.iter().all(|r| r.converged),
+            refinements,
+            speed_tolerance: SPEED_TOLERANCE,
+            speed_tolerance_m_s: SPEED_TOLERANCE_M_S,
+            t1_tolerance_s: T1_TOLERANCE_S,
+        }
+    }
 }
 
 /// [`check_convergence`] at each of `slopes`, in parallel, one walk a setting (issue 38's test

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use body::{BodyPitch, LegShape};
-pub use convergence::{check_convergence, check_convergence_slopes, ConvergenceCheck};
+pub use convergence::{check_convergence, check_convergence_slopes, check_walked, ConvergenceCheck};
 use dynamics::Walker;
 pub use ensemble::{simulate_ensemble, Ensemble};
 pub use mechanisms::Mechanisms;

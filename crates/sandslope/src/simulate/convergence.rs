@@ -98,7 +98,7 @@ pub struct ConvergenceCheck {
     pub refinements: Vec<RefinedWalk>,
     /// Every refinement converged.
     pub converged: bool,
-    /// The tolerances held to: speed (fraction, m/s) and t1 (s).
+    /// The speed tolerance as a fraction of the walk's speed ([`SPEED_TOLERANCE`]).
     pub speed_tolerance: f64,
     /// See [`SPEED_TOLERANCE_M_S`].
     pub speed_tolerance_m_s: f64,

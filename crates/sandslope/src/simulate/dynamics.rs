@@ -15,7 +15,7 @@
 use super::body::{associated_force, element_force, submerged, BodyPitch, Contact, BELLY};
 use super::linear::solve_dofs;
 use super::mechanisms::{gait_angle, Trench, CONSTANT_SPEED_DUTY};
-use super::rft::Rft;
+use super::rft::{RestSet, Rft};
 use super::{Geometry, SimSettings, Trajectory};
 use crate::leg::Leg;
 use crate::model::G;
@@ -23,6 +23,7 @@ use crate::robot::Robot;
 use crate::terrain::Ground;
 use std::f64::consts::PI;
 
+mod lanes;
 mod rest;
 mod run;
 
@@ -144,6 +145,14 @@ pub(crate) struct Walker {
     merge_coincident: bool,
     /// Steps ended by an active-set step at rest ([`Walker::sticking`]; tests count them).
     rest_steps: usize,
+    /// The step's contacts prepared for the default law's evaluation several at a time.
+    lanes: lanes::Lanes,
+    /// Whether [`Walker::lanes`] evaluates this solve's forces (the default law).
+    use_lanes: bool,
+    /// The last set at rest built ([`Walker::rest_set`]) and the element it is for: belly or
+    /// leg, and the tangent's bits.
+    last_rest_set: RestSet,
+    rest_set_for: Option<(bool, [u64; 2])>,
 }
 
 impl Walker {
@@ -222,6 +231,10 @@ impl Walker {
             forces_at: None,
             merge_coincident: true,
             rest_steps: 0,
+            lanes: lanes::Lanes::default(),
+            use_lanes: false,
+            last_rest_set: RestSet::default(),
+            rest_set_for: None,
         };
         w.reach = w.nodes.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) * (1.0 + 1e-9);
         for j in 0..legs {
@@ -401,6 +414,7 @@ impl Walker {
         }
         let eps = self.eps;
         self.forces_at = None;
+        self.use_lanes = self.lanes.prepare(&self.contacts, &self.rates, &self.rft, &self.belly_rft);
         if self.stuck && self.sticking(v, v_free, m) {
             self.rest_steps += 1;
             return true;
@@ -531,17 +545,26 @@ impl Walker {
         let mut k = [[0.0; 3]; 3];
         let mut potential = 0.0;
         let want = jac.is_some();
+        // The default law's forces several elements at a time (the same to the bit).
+        let lanes = !associated && self.use_lanes;
+        if lanes {
+            self.lanes.evaluate(v, eps);
+        }
         forces.clear();
-        for c in contacts {
-            let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
-            let u = Walker::element_velocity(c, v, rate);
-            let rft = if c.leg == BELLY { belly_rft } else { leg_rft };
-            let (f, d) = if associated {
-                let (f, p, hess) = associated_force(rft, c, u, eps);
-                potential += p;
-                (f, [[-hess[0][0], -hess[0][1]], [-hess[1][0], -hess[1][1]]])
+        for (i, c) in contacts.iter().enumerate() {
+            let (f, d) = if lanes {
+                self.lanes.get(i)
             } else {
-                element_force(rft, c, u, eps, want)
+                let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
+                let u = Walker::element_velocity(c, v, rate);
+                let rft = if c.leg == BELLY { belly_rft } else { leg_rft };
+                if associated {
+                    let (f, p, hess) = associated_force(rft, c, u, eps);
+                    potential += p;
+                    (f, [[-hess[0][0], -hess[0][1]], [-hess[1][0], -hess[1][1]]])
+                } else {
+                    element_force(rft, c, u, eps, want)
+                }
             };
             forces.push(f);
             let (rx, rz) = (c.rel[0], c.rel[1]);

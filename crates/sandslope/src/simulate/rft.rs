@@ -10,17 +10,19 @@
 //! a vertical plate of width W spanning the surface to depth d, pushed sideways, feels
 //! `k_s W d^2` (the paper's F_s, §4), i.e. `alpha_x(pi/2, 0) = 2 k_s`.
 
+use wide::{f64x4, CmpGt, CmpLe, CmpLt};
+
 /// Coefficients of the generic form (Li, Zhang and Goldman 2013, Fig. 2 and supplement):
 /// `A00, A10, B01, B11, B-11` of alpha_z and `C01, C11, C-11, D10` of alpha_x.
-const A00: f64 = 0.206;
-const A10: f64 = 0.169;
-const B01: f64 = 0.358;
-const B11: f64 = 0.212;
-const BM11: f64 = 0.055;
-const C01: f64 = 0.253;
-const C11: f64 = -0.124;
-const CM11: f64 = 0.007;
-const D10: f64 = 0.088;
+pub(crate) const A00: f64 = 0.206;
+pub(crate) const A10: f64 = 0.169;
+pub(crate) const B01: f64 = 0.358;
+pub(crate) const B11: f64 = 0.212;
+pub(crate) const BM11: f64 = 0.055;
+pub(crate) const C01: f64 = 0.253;
+pub(crate) const C11: f64 = -0.124;
+pub(crate) const CM11: f64 = 0.007;
+pub(crate) const D10: f64 = 0.088;
 
 /// The generic (unscaled) `(alpha_z, alpha_x)` for an element whose tangent makes `2 beta`
 /// with `(cos 2beta, sin 2beta)` and whose motion has `(cos gamma, sin gamma)`, gamma > 0
@@ -106,6 +108,12 @@ impl Rft {
         Rft { friction: mu, ..self }
     }
 
+    /// `(zeta_z, zeta_x)` where the law is the default scaling ([`RftScaling::Motion`]) without
+    /// friction: the one law the simulator evaluates several elements at a time.
+    pub(crate) fn motion_scales(&self) -> Option<(f64, f64)> {
+        (self.scaling == RftScaling::Motion && self.friction.is_none()).then_some((self.zeta_z, self.zeta_x))
+    }
+
     /// The stress per unit depth of a horizontal plate pushed straight down, N/m^3 (k_n).
     #[inline]
     pub fn scale_n(&self) -> f64 {
@@ -160,40 +168,43 @@ impl Rft {
     /// agrees with the law's own stress to round-off, a test checks it). Friction caps the
     /// stress nonlinearly in the tangent, so with friction every direction takes the law.
     pub fn rest_set(&self, tangent: [f64; 2]) -> RestSet {
-        let mut boundary = [[0.0; 2]; SET_DIRECTIONS];
+        let mut set = RestSet::default();
         if self.friction.is_some() {
-            for (b, e) in boundary.iter_mut().zip(set_directions()) {
+            for (k, e) in set_directions().iter().enumerate() {
                 let st = self.passive_stress(tangent[0], tangent[1], e[0], e[1]);
-                *b = [st.0, st.1];
+                set.x[k / 4].as_array_mut()[k % 4] = st.0;
+                set.z[k / 4].as_array_mut()[k % 4] = st.1;
             }
-            return RestSet { boundary };
+            return set;
         }
         let (tx, tz) = (tangent[0], tangent[1]);
-        let (cos2b, sin2b) = (tx * tx - tz * tz, 2.0 * tx * tz);
-        // One loop per scaling, without branches (the projection's `max` is `passive`'s test:
-        // a component along the motion of zero or less leaves the stress as it is, to the bit).
-        let point = |d: &DirectionTerms, kx: f64, kz: f64| {
-            let sin2b = d.mirror * sin2b;
+        let (cos2b, sin2b) = (f64x4::splat(tx * tx - tz * tz), f64x4::splat(2.0 * tx * tz));
+        let (zx, zz) = (f64x4::splat(self.zeta_x), f64x4::splat(self.zeta_z));
+        let zero = f64x4::splat(0.0);
+        let terms = direction_terms();
+        // Four directions at a time, the operations of the scalar law in its order (a test
+        // compares them with the law); the projection's `max` is `passive`'s test: a component
+        // along the motion of zero or less leaves the stress as it is.
+        for (k, d) in terms.iter().enumerate() {
+            let (ex, ez, mirror) = (d.ex, d.ez, d.mirror);
+            let (kx, kz) = match self.scaling {
+                RftScaling::Motion => {
+                    let zeta = zz * ez * ez + zx * ex * ex;
+                    (zeta, zeta)
+                }
+                RftScaling::Li2013 => (zz, zz),
+                RftScaling::Components => (zx, zz),
+            };
+            let sin2b = mirror * sin2b;
             let az = d.az[0] + cos2b * d.az[1] + sin2b * d.az[2];
             let ax = d.ax[0] + cos2b * d.ax[1] + sin2b * d.ax[2];
-            let (sx, sz) = (-d.mirror * kx * ax, kz * az);
-            let [ex, ez] = d.e;
-            let along = (sx * ex + sz * ez).max(0.0);
-            [sx - along * ex, sz - along * ez]
-        };
-        let terms = direction_terms();
-        let (zx, zz) = (self.zeta_x, self.zeta_z);
-        match self.scaling {
-            RftScaling::Motion => {
-                for (b, d) in boundary.iter_mut().zip(terms) {
-                    let zeta = zz * d.e[1] * d.e[1] + zx * d.e[0] * d.e[0];
-                    *b = point(d, zeta, zeta);
-                }
-            }
-            RftScaling::Li2013 => boundary.iter_mut().zip(terms).for_each(|(b, d)| *b = point(d, zz, zz)),
-            RftScaling::Components => boundary.iter_mut().zip(terms).for_each(|(b, d)| *b = point(d, zx, zz)),
+            let (sx, sz) = ((mirror ^ f64x4::splat(-0.0)) * kx * ax, kz * az);
+            let along = sx * ex + sz * ez;
+            let along = along.cmp_gt(zero).blend(along, zero);
+            set.x[k] = sx - along * ex;
+            set.z[k] = sz - along * ez;
         }
-        RestSet { boundary }
+        set
     }
 
     /// The scale factors `(x, z)` of the generic form's two stresses for motion in the unit
@@ -268,9 +279,20 @@ impl Rft {
 
 /// The set of stresses per unit depth an element can hold at rest (docs/model.md §17): the
 /// region bounded by the law's stress `sigma(e)` over every direction of motion `e`, sampled
-/// ([`Rft::rest_set`]).
+/// ([`Rft::rest_set`]), its points' x and z components apart (for four at a time).
 pub struct RestSet {
-    boundary: [[f64; 2]; SET_DIRECTIONS],
+    x: [f64x4; CHUNKS],
+    z: [f64x4; CHUNKS],
+}
+
+/// The sampled directions in fours.
+const CHUNKS: usize = SET_DIRECTIONS / 4;
+
+impl Default for RestSet {
+    /// The set of an element that holds nothing (every boundary point at zero).
+    fn default() -> RestSet {
+        RestSet { x: [f64x4::splat(0.0); CHUNKS], z: [f64x4::splat(0.0); CHUNKS] }
+    }
 }
 
 impl RestSet {
@@ -278,25 +300,37 @@ impl RestSet {
     /// boundary about it, counted as signed crossings of a ray (Sunday's rule, exact for the
     /// sampled polygon), which decides as the sum of the edges' angles did without one `atan2`
     /// per edge (that sum and the directions' `sin_cos` were a third of a level walk's time,
-    /// measured with `perf` on 2026-11-28).
+    /// measured with `perf` on 2026-11-28). Four edges at a time: the test of each edge is
+    /// the same comparisons on the same products as one edge at a time, and the crossings are
+    /// counted lane by lane (small whole numbers, exact in `f64`).
     pub fn holds(&self, stress: [f64; 2]) -> bool {
-        let point = |b: &[f64; 2]| [b[0] - stress[0], b[1] - stress[1]];
-        let mut winding = 0i32;
-        let mut prev = point(&self.boundary[SET_DIRECTIONS - 1]);
-        for b in &self.boundary {
-            let next = point(b);
-            // Which side of the edge prev -> next the origin (the stress) lies on.
-            let left = prev[0] * next[1] - prev[1] * next[0];
-            if prev[1] <= 0.0 {
-                if next[1] > 0.0 && left > 0.0 {
-                    winding += 1;
-                }
-            } else if next[1] <= 0.0 && left < 0.0 {
-                winding -= 1;
-            }
-            prev = next;
+        let (sx, sz) = (f64x4::splat(stress[0]), f64x4::splat(stress[1]));
+        let (zero, one) = (f64x4::splat(0.0), f64x4::splat(1.0));
+        let mut winding = zero;
+        // Point k - 1 of each lane: the last point of the chunk before, then this chunk's first
+        // three.
+        let last = |a: &f64x4| a.to_array()[3];
+        let (mut px, mut pz) = (last(&self.x[CHUNKS - 1]), last(&self.z[CHUNKS - 1]));
+        for (x, z) in self.x.iter().zip(&self.z) {
+            let (xa, za) = (x.to_array(), z.to_array());
+            let p0 = f64x4::from([px, xa[0], xa[1], xa[2]]) - sx;
+            let p1 = f64x4::from([pz, za[0], za[1], za[2]]) - sz;
+            (px, pz) = (xa[3], za[3]);
+            let (n0, n1) = (*x - sx, *z - sz);
+            // Which side of the edge prev -> next the stress lies on.
+            let left = p0 * n1 - p1 * n0;
+            let below = p1.cmp_le(zero);
+            let up = below & n1.cmp_gt(zero) & left.cmp_gt(zero);
+            let down = !below & n1.cmp_le(zero) & left.cmp_lt(zero);
+            winding = winding + up.blend(one, zero) - down.blend(one, zero);
         }
-        winding != 0
+        winding.reduce_add() != 0.0
+    }
+
+    /// Boundary point `k`, `(x, z)`.
+    #[cfg(test)]
+    fn point(&self, k: usize) -> [f64; 2] {
+        [self.x[k / 4].to_array()[k % 4], self.z[k / 4].to_array()[k % 4]]
     }
 }
 
@@ -325,35 +359,41 @@ fn passive(st: (f64, f64), ex: f64, ez: f64) -> (f64, f64) {
     }
 }
 
-/// The generic form at one sampled direction of motion, as terms of the element's
+/// The generic form at four sampled directions of motion, as terms of the element's
 /// `(1, cos 2beta, mirror * sin 2beta)`: `alpha_z = az . (1, cos 2beta, mirror sin 2beta)`
-/// and likewise `alpha_x` ([`generic`] is linear in the two).
+/// and likewise `alpha_x` ([`generic`] is linear in the two), each term lane by lane.
 struct DirectionTerms {
-    /// The unit direction of motion `(ex, ez)`.
-    e: [f64; 2],
+    /// The unit directions of motion `(ex, ez)`.
+    ex: f64x4,
+    ez: f64x4,
     /// -1 for motion towards -x (mirrored onto +x, as [`Rft::stress`] does), else 1.
-    mirror: f64,
-    az: [f64; 3],
-    ax: [f64; 3],
+    mirror: f64x4,
+    az: [f64x4; 3],
+    ax: [f64x4; 3],
 }
 
-/// [`DirectionTerms`] of the [`SET_DIRECTIONS`] sampled directions, computed once from
-/// [`generic`] at `(cos 2beta, sin 2beta)` = (0, 0), (1, 0) and (0, 1).
+/// [`DirectionTerms`] of the [`SET_DIRECTIONS`] sampled directions in fours, computed once
+/// from [`generic`] at `(cos 2beta, sin 2beta)` = (0, 0), (1, 0) and (0, 1).
 fn direction_terms() -> &'static [DirectionTerms] {
     static TABLE: std::sync::OnceLock<Vec<DirectionTerms>> = std::sync::OnceLock::new();
     TABLE.get_or_init(|| {
         set_directions()
-            .iter()
-            .map(|&[ex, ez]| {
-                let (cosg, sing) = (ex.abs(), -ez);
-                let (az0, ax0) = generic(0.0, 0.0, cosg, sing);
-                let (azc, axc) = generic(1.0, 0.0, cosg, sing);
-                let (azs, axs) = generic(0.0, 1.0, cosg, sing);
+            .chunks_exact(4)
+            .map(|four| {
+                let lanes = |f: &dyn Fn([f64; 2]) -> f64| f64x4::from([0, 1, 2, 3].map(|i| f(four[i])));
+                let terms = |e: [f64; 2]| {
+                    let (cosg, sing) = (e[0].abs(), -e[1]);
+                    let (az0, ax0) = generic(0.0, 0.0, cosg, sing);
+                    let (azc, axc) = generic(1.0, 0.0, cosg, sing);
+                    let (azs, axs) = generic(0.0, 1.0, cosg, sing);
+                    ([az0, azc - az0, azs - az0], [ax0, axc - ax0, axs - ax0])
+                };
                 DirectionTerms {
-                    e: [ex, ez],
-                    mirror: if ex < 0.0 { -1.0 } else { 1.0 },
-                    az: [az0, azc - az0, azs - az0],
-                    ax: [ax0, axc - ax0, axs - ax0],
+                    ex: lanes(&|e| e[0]),
+                    ez: lanes(&|e| e[1]),
+                    mirror: lanes(&|e| if e[0] < 0.0 { -1.0 } else { 1.0 }),
+                    az: [0, 1, 2].map(|j| lanes(&|e| terms(e).0[j])),
+                    ax: [0, 1, 2].map(|j| lanes(&|e| terms(e).1[j])),
                 }
             })
             .collect()
@@ -362,6 +402,7 @@ fn direction_terms() -> &'static [DirectionTerms] {
 
 /// Directions sampled for the set of stresses the law allows at rest ([`Rft::holds_at_rest`]).
 const SET_DIRECTIONS: usize = 360;
+const _: () = assert!(SET_DIRECTIONS % 4 == 0, "the set is built four directions at a time");
 
 #[cfg(test)]
 mod tests {
@@ -556,7 +597,8 @@ mod rest_set_tests {
                 let b = std::f64::consts::PI * i as f64 / 36.0 + if i % 5 == 1 { 0.013 } else { 0.0 };
                 let (tx, tz) = (b.cos(), b.sin());
                 let set = rft.rest_set([tx, tz]);
-                for (point, e) in set.boundary.iter().zip(set_directions()) {
+                for (k, e) in set_directions().iter().enumerate() {
+                    let point = set.point(k);
                     let law = rft.passive_stress(tx, tz, e[0], e[1]);
                     assert!(
                         (point[0] - law.0).abs() <= 1e-12 * scale

@@ -95,10 +95,18 @@ impl Walker {
     }
 
     /// The set at rest of an element of the belly (`belly`) or of a leg with unit tangent
-    /// `tangent` ([`super::super::rft::Rft::rest_set`]).
-    fn rest_set(&self, belly: bool, tangent: [f64; 2]) -> RestSet {
-        let rft = if belly { &self.belly_rft } else { &self.rft };
-        rft.rest_set(tangent)
+    /// `tangent` ([`super::super::rft::Rft::rest_set`]). The last set built is kept: a body
+    /// resting on its belly (with the pitch locked, at one tangent step after step) tests its
+    /// load against the same set every step, and building it was a quarter of a level walk's
+    /// time (`perf`, 2026-12-02).
+    fn rest_set(&mut self, belly: bool, tangent: [f64; 2]) -> &RestSet {
+        let key = (belly, tangent.map(f64::to_bits));
+        if self.rest_set_for != Some(key) {
+            let rft = if belly { &self.belly_rft } else { &self.rft };
+            self.last_rest_set = rft.rest_set(tangent);
+            self.rest_set_for = Some(key);
+        }
+        &self.last_rest_set
     }
 
     /// How a resting group (the elements `group`, of summed weight `weight` and weighted

@@ -153,6 +153,8 @@ pub(crate) struct Walker {
     /// leg, and the tangent's bits.
     last_rest_set: RestSet,
     rest_set_for: Option<(bool, [u64; 2])>,
+    /// Scratch: a resting group's elements ([`Walker::rest_group`]).
+    rest_group_scratch: Vec<usize>,
 }
 
 impl Walker {
@@ -235,6 +237,7 @@ impl Walker {
             use_lanes: false,
             last_rest_set: RestSet::default(),
             rest_set_for: None,
+            rest_group_scratch: Vec::new(),
         };
         w.reach = w.nodes.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) * (1.0 + 1e-9);
         for j in 0..legs {

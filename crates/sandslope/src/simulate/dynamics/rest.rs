@@ -3,7 +3,7 @@
 //! exactly, their forces inside the set the rate-independent law allows there, as a sticking
 //! Coulomb contact. These steps put them there and check the set.
 
-use super::super::body::BELLY;
+use super::super::body::{Contact, BELLY};
 use super::super::rft::RestSet;
 use super::{Walker, MAX_HALVINGS, MAX_NEWTON, NEWTON_TOL};
 
@@ -19,9 +19,15 @@ impl Walker {
     /// `sigma(e)` over all directions e ([`super::rft::RestSet`]). The elements at rest do no
     /// work, so the step stays passive.
     pub(super) fn sticking(&mut self, near: [f64; 3], v_free: [f64; 3], m: [f64; 3]) -> bool {
-        let Some(pick) = (0..self.contacts.len())
-            .min_by(|&a, &b| self.element_speed(a, near).total_cmp(&self.element_speed(b, near)))
-        else {
+        // The first of the slowest (as `Iterator::min_by` picks), each speed computed once.
+        let mut slowest: Option<(usize, f64)> = None;
+        for k in 0..self.contacts.len() {
+            let speed = self.element_speed(k, near);
+            if slowest.is_none_or(|(_, s)| speed.total_cmp(&s).is_lt()) {
+                slowest = Some((k, speed));
+            }
+        }
+        let Some((pick, _)) = slowest else {
             return false;
         };
         self.rest_group(pick, v_free, m) || (!self.pitch_locked && self.pivot(pick, near, v_free, m))
@@ -42,8 +48,23 @@ impl Walker {
         let rate = if c.leg == BELLY { 0.0 } else { self.rates[c.leg] };
         // u = v + rate (arm_z, -arm_x) = 0 with the pitch rate zero.
         let v = [-rate * c.arm[1], rate * c.arm[0], 0.0];
-        let group: Vec<usize> =
-            (0..self.contacts.len()).filter(|&k| self.element_speed(k, v) <= 1e-3 * self.eps).collect();
+        let mut group = std::mem::take(&mut self.rest_group_scratch);
+        group.clear();
+        group.extend((0..self.contacts.len()).filter(|&k| self.element_speed(k, v) <= 1e-3 * self.eps));
+        let held = self.hold_group(&group, c, v, v_free, m);
+        self.rest_group_scratch = group;
+        held
+    }
+
+    /// [`Walker::rest_group`]'s test of `group` (resting with `c`, the body at `v`).
+    fn hold_group(
+        &mut self,
+        group: &[usize],
+        c: Contact,
+        v: [f64; 3],
+        v_free: [f64; 3],
+        m: [f64; 3],
+    ) -> bool {
         let same_shape = group.iter().all(|&k| {
             let t = self.contacts[k].tangent;
             (t[0] - c.tangent[0]).abs() < 1e-9 && (t[1] - c.tangent[1]).abs() < 1e-9
@@ -57,7 +78,7 @@ impl Walker {
         let mut need = [r[0] / self.dt, r[1] / self.dt];
         let mut moment = r[2] / self.dt;
         let (mut weight, mut centre) = (0.0, [0.0; 2]);
-        for &k in &group {
+        for &k in group {
             let (f, ck) = (self.forces[k], &self.contacts[k]);
             need[0] += f[0];
             need[1] += f[1];
@@ -71,7 +92,7 @@ impl Walker {
         }
         let mean = [need[0] / weight, need[1] / weight];
         let Some(shares) =
-            self.rest_split(&group, weight, [centre[0] / weight, centre[1] / weight], mean, moment)
+            self.rest_split(group, weight, [centre[0] / weight, centre[1] / weight], mean, moment)
         else {
             return false;
         };
@@ -103,7 +124,7 @@ impl Walker {
         let key = (belly, tangent.map(f64::to_bits));
         if self.rest_set_for != Some(key) {
             let rft = if belly { &self.belly_rft } else { &self.rft };
-            self.last_rest_set = rft.rest_set(tangent);
+            rft.rest_set_into(tangent, &mut self.last_rest_set);
             self.rest_set_for = Some(key);
         }
         &self.last_rest_set

@@ -366,7 +366,7 @@ fn the_convergence_check_walks_a_quarter_step_and_a_tenth_of_the_creep() {
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
         lines[0],
-        "slope_deg,walk,dt_s,creep_m_s,speed_m_s,speed_se_m_s,t1_s,regime,speed_change_m_s,t1_change_s,converged"
+        "slope_deg,walk,dt_s,creep_m_s,speed_m_s,speed_se_m_s,step_speed_sd_m_s,t1_s,regime,speed_change_m_s,t1_change_s,step_speed_sd_change_m_s,converged"
     );
     assert!(lines[1].starts_with("10.0,as_asked,0.0005,"), "{text}");
     assert!(lines[2].starts_with("10.0,quarter_step,0.000125,"), "{text}");

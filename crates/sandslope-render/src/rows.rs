@@ -277,6 +277,8 @@ pub struct ConvergenceRow {
     pub speed_m_s: f64,
     /// The ensemble mean's standard error, m/s (empty for one walk).
     pub speed_se_m_s: Option<f64>,
+    /// The spread of the steps' speeds (standard deviation), m/s (an ensemble's mean).
+    pub step_speed_sd_m_s: f64,
     /// Mean anchoring time, s.
     pub t1_s: Option<f64>,
     /// Regime.
@@ -285,6 +287,8 @@ pub struct ConvergenceRow {
     pub speed_change_m_s: Option<f64>,
     /// t1 minus the walk as asked, s.
     pub t1_change_s: Option<f64>,
+    /// The steps' spread minus the walk as asked's, m/s.
+    pub step_speed_sd_change_m_s: Option<f64>,
     /// Within the tolerances (empty on the walk's own row).
     pub converged: Option<bool>,
 }
@@ -299,10 +303,12 @@ impl ConvergenceRow {
             creep_m_s: a.creep_m_s,
             speed_m_s: a.speed_m_s,
             speed_se_m_s: a.speed_se_m_s,
+            step_speed_sd_m_s: a.step_speed_sd_m_s,
             t1_s: a.t1_s,
             regime: a.regime.name(),
             speed_change_m_s: None,
             t1_change_s: None,
+            step_speed_sd_change_m_s: None,
             converged: None,
         };
         let mut rows = vec![row("as_asked", &c.walk)];
@@ -314,6 +320,7 @@ impl ConvergenceRow {
             rows.push(ConvergenceRow {
                 speed_change_m_s: Some(r.speed_change_m_s),
                 t1_change_s: r.t1_change_s,
+                step_speed_sd_change_m_s: Some(r.step_speed_sd_change_m_s),
                 converged: Some(r.converged),
                 ..row(name, &r.answer)
             });

@@ -395,7 +395,8 @@ fn run_check(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     Ok(())
 }
 
-/// A refinement's change as the tables print it: speed (and its share of the walk's), t1.
+/// A refinement's change as the tables print it: speed (and its share of the walk's), the
+/// steps' spread, t1.
 fn change_cell(c: &ConvergenceCheck, r: &RefinedWalk) -> String {
     let pct = if c.walk.speed_m_s != 0.0 {
         format!(" ({:+.1}%)", 100.0 * r.speed_change_m_s / c.walk.speed_m_s.abs())
@@ -403,16 +404,25 @@ fn change_cell(c: &ConvergenceCheck, r: &RefinedWalk) -> String {
         String::new()
     };
     let t1 = r.t1_change_s.map_or("-".to_string(), |d| format!("{:+.2}", d * 1e3));
-    format!("speed {:+.2} cm/s{pct}, t1 {t1} ms", r.speed_change_m_s * 100.0)
+    format!(
+        "speed {:+.2} cm/s{pct}, spread {:+.2} cm/s, t1 {t1} ms",
+        r.speed_change_m_s * 100.0,
+        r.step_speed_sd_change_m_s * 100.0
+    )
 }
 
 /// "yes", or what fell outside the tolerances.
 fn within_cell(r: &RefinedWalk) -> String {
-    let failed: Vec<&str> = [("speed", r.speed_within), ("t1", r.t1_within), ("regime", r.same_regime)]
-        .into_iter()
-        .filter(|(_, ok)| !ok)
-        .map(|(what, _)| what)
-        .collect();
+    let failed: Vec<&str> = [
+        ("speed", r.speed_within),
+        ("spread", r.spread_within),
+        ("t1", r.t1_within),
+        ("regime", r.same_regime),
+    ]
+    .into_iter()
+    .filter(|(_, ok)| !ok)
+    .map(|(what, _)| what)
+    .collect();
     if failed.is_empty() {
         "yes".to_string()
     } else {
@@ -423,7 +433,7 @@ fn within_cell(r: &RefinedWalk) -> String {
 /// The tolerances line under the convergence tables.
 fn tolerances_note(c: &ConvergenceCheck) -> String {
     format!(
-        "tolerances: speed within {:.0}% or {:.1} cm/s, t1 within {:.0} ms, the same regime (docs/simulate.md, \"Checking convergence\")",
+        "tolerances: speed and the steps' spread within {:.0}% or {:.1} cm/s, t1 within {:.0} ms, the same regime (docs/simulate.md, \"Checking convergence\")",
         c.speed_tolerance * 100.0,
         c.speed_tolerance_m_s * 100.0,
         c.t1_tolerance_s * 1e3

@@ -273,6 +273,7 @@ fn convergence_sentence(checks: &[sandslope::simulate::ConvergenceCheck]) -> Str
         )
         .fold(0.0, f64::max);
     let t1 = changes().filter_map(|(_, r)| r.t1_change_s).map(f64::abs).fold(0.0, f64::max);
+    let spread = changes().map(|(_, r)| r.step_speed_sd_change_m_s.abs()).fold(0.0, f64::max);
     let regimes = changes().filter(|(_, r)| !r.same_regime).count();
     let converged = checks.iter().filter(|c| c.converged).count();
     let verdict = if converged == checks.len() {
@@ -289,9 +290,11 @@ fn convergence_sentence(checks: &[sandslope::simulate::ConvergenceCheck]) -> Str
     };
     format!(
         "{verdict}: walked again at a quarter of the time step and at a tenth of the creep speed, no speed moved by \
-         more than {:.1}%, no t1 by more than {:.2} ms, and {} (tolerances 3% or 0.3 cm/s, 1 ms, the same regime; \
+         more than {:.1}%, no spread of a walk's step speeds by more than {:.2} cm/s, no t1 by more than {:.2} ms, \
+         and {} (tolerances 3% or 0.3 cm/s for the speed and the spread, 1 ms, the same regime; \
          <code>simulate --check-convergence</code>, docs/simulate.md).",
         speed * 100.0,
+        spread * 100.0,
         t1 * 1e3,
         if regimes == 0 { "no regime changed".to_string() } else { format!("{regimes} regime(s) changed") }
     )

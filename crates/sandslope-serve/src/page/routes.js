@@ -255,12 +255,12 @@ function showConvergence(c) {
   const parts = c.refinements.map((r) => {
     const pct = c.walk.speed_m_s !== 0 ? ` (${signed((100 * r.speed_change_m_s) / Math.abs(c.walk.speed_m_s), 1)}%)` : "";
     const t1 = r.t1_change_s === null ? "-" : signed(r.t1_change_s * 1e3, 2);
-    const failed = [["speed", r.speed_within], ["t1", r.t1_within], ["regime", r.same_regime]].filter((f) => !f[1]).map((f) => f[0]);
+    const failed = [["speed", r.speed_within], ["spread", r.spread_within], ["t1", r.t1_within], ["regime", r.same_regime]].filter((f) => !f[1]).map((f) => f[0]);
     const verdict = failed.length ? `outside the tolerance in ${failed.join(", ")}` : "within";
     const label = r.refinement === "quarter_step" ? "a quarter of the step" : "a tenth of the creep speed";
-    return `${label}: speed ${signed(r.speed_change_m_s * 100, 2)} cm/s${pct}, t1 ${t1} ms, ${r.answer.regime} (${verdict})`;
+    return `${label}: speed ${signed(r.speed_change_m_s * 100, 2)} cm/s${pct}, steps' spread ${signed(r.step_speed_sd_change_m_s * 100, 2)} cm/s, t1 ${t1} ms, ${r.answer.regime} (${verdict})`;
   });
-  out.textContent = `${c.converged ? "Converged" : "Not converged"} at ${c.slope_deg} deg: ${parts.join("; ")}. Tolerances: speed ${fmt(c.speed_tolerance * 100, 0)}% or ${fmt(c.speed_tolerance_m_s * 100, 1)} cm/s, t1 ${fmt(c.t1_tolerance_s * 1e3, 0)} ms, the same regime.`;
+  out.textContent = `${c.converged ? "Converged" : "Not converged"} at ${c.slope_deg} deg: ${parts.join("; ")}. Tolerances: speed and the steps' spread ${fmt(c.speed_tolerance * 100, 0)}% or ${fmt(c.speed_tolerance_m_s * 100, 1)} cm/s, t1 ${fmt(c.t1_tolerance_s * 1e3, 0)} ms, the same regime.`;
   out.dataset.converged = String(c.converged);
 }
 function both(a, b, scale, digits) {

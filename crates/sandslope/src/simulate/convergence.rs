@@ -1,6 +1,6 @@
 //! Whether a simulated answer is converged (docs/simulate.md, "Checking convergence"): the
 //! walk again at a quarter of its time step and at a tenth of its creep speed, held to issue
-//! 38's tolerances. The default step is shown converged on the built-in robot and terrain
+//! 38's tolerances, and its steps' spread to the same tolerance as its speed. The default step is shown converged on the built-in robot and terrain
 //! only; a caller's own robot, terrain, slope or mechanism is checked by
 //! [`check_convergence`] (`simulate --check-convergence`).
 
@@ -57,6 +57,9 @@ pub struct WalkAnswer {
     pub speed_m_s: f64,
     /// The ensemble mean's standard error, m/s (`None` for one walk).
     pub speed_se_m_s: Option<f64>,
+    /// The spread of its steps' speeds (their standard deviation over the measured steps),
+    /// m/s; an ensemble's: the mean over its walks.
+    pub step_speed_sd_m_s: f64,
     /// Mean anchoring time, s (`None`: no measured step anchored).
     pub t1_s: Option<f64>,
     /// The regime (an ensemble's: the one most walks ended in).
@@ -74,13 +77,19 @@ pub struct RefinedWalk {
     pub speed_change_m_s: f64,
     /// Its t1 minus the walk's, s (`None` when either did not anchor).
     pub t1_change_s: Option<f64>,
+    /// Its steps' spread minus the walk's, m/s.
+    pub step_speed_sd_change_m_s: f64,
     /// Whether the speed is within [`SPEED_TOLERANCE`] (or [`SPEED_TOLERANCE_M_S`]).
     pub speed_within: bool,
     /// Whether t1 is within [`T1_TOLERANCE_S`] (both anchored), or neither anchored.
     pub t1_within: bool,
     /// Whether the regime is the same.
     pub same_regime: bool,
-    /// All three.
+    /// Whether the steps' spread is within the speed's tolerance ([`SPEED_TOLERANCE`] of the
+    /// walk's speed, or [`SPEED_TOLERANCE_M_S`]): a walk whose steps alternate at a coarse step
+    /// and not at the finer one is not converged, whatever its mean.
+    pub spread_within: bool,
+    /// All four.
     pub converged: bool,
 }
 
@@ -108,7 +117,8 @@ pub struct ConvergenceCheck {
 
 /// Walks `scenario`'s robot at `slope` as `settings` ask, again at a quarter of the time step
 /// and at a tenth of the creep speed, and holds the two refined answers to issue 38's
-/// tolerances: speed within 3% (or 0.3 cm/s), t1 within 1 ms, the same regime. With
+/// tolerances: speed within 3% (or 0.3 cm/s), t1 within 1 ms, the same regime; and the steps'
+/// spread (their speeds' standard deviation) within the speed's tolerance. With
 /// `ensemble = Some(n)` each setting is an ensemble of `n` walks and their means are compared
 /// (the free body's walk on a slope is chaotic, so a single free walk is one draw of a spread
 /// and cannot converge, docs/simulate.md "Pitch free"). The walks run in parallel.
@@ -144,6 +154,7 @@ pub fn check_walked(
         creep_m_s: walked.creep_m_s,
         speed_m_s: walked.speed_m_s,
         speed_se_m_s: None,
+        step_speed_sd_m_s: walked.speed_sd_m_s,
         t1_s: walked.t1_s,
         regime: walked.regime,
     };
@@ -239,6 +250,7 @@ fn answer(
                 creep_m_s: settings.creep_m_s,
                 speed_m_s: s.speed_m_s,
                 speed_se_m_s: None,
+                step_speed_sd_m_s: s.speed_sd_m_s,
                 t1_s: s.t1_s,
                 regime: s.regime,
             }
@@ -250,6 +262,8 @@ fn answer(
                 creep_m_s: settings.creep_m_s,
                 speed_m_s: e.speed_m_s,
                 speed_se_m_s: Some(e.speed_se_m_s),
+                step_speed_sd_m_s: e.summaries.iter().map(|w| w.speed_sd_m_s).sum::<f64>()
+                    / e.summaries.len().max(1) as f64,
                 t1_s: e.t1_s,
                 regime: e.regime,
             }
@@ -260,8 +274,10 @@ fn answer(
 /// `refined` held against `base`.
 fn refined(base: &WalkAnswer, refinement: Refinement, refined: WalkAnswer) -> RefinedWalk {
     let speed_change_m_s = refined.speed_m_s - base.speed_m_s;
-    let speed_within =
-        speed_change_m_s.abs() <= (SPEED_TOLERANCE * base.speed_m_s.abs()).max(SPEED_TOLERANCE_M_S);
+    let tolerance = (SPEED_TOLERANCE * base.speed_m_s.abs()).max(SPEED_TOLERANCE_M_S);
+    let speed_within = speed_change_m_s.abs() <= tolerance;
+    let step_speed_sd_change_m_s = refined.step_speed_sd_m_s - base.step_speed_sd_m_s;
+    let spread_within = step_speed_sd_change_m_s.abs() <= tolerance;
     let t1_change_s = base.t1_s.zip(refined.t1_s).map(|(a, b)| b - a);
     let t1_within = match t1_change_s {
         Some(d) => d.abs() <= T1_TOLERANCE_S,
@@ -273,10 +289,12 @@ fn refined(base: &WalkAnswer, refinement: Refinement, refined: WalkAnswer) -> Re
         answer: refined,
         speed_change_m_s,
         t1_change_s,
+        step_speed_sd_change_m_s,
         speed_within,
         t1_within,
         same_regime,
-        converged: speed_within && t1_within && same_regime,
+        spread_within,
+        converged: speed_within && t1_within && same_regime && spread_within,
     }
 }
 
@@ -285,7 +303,32 @@ mod tests {
     use super::*;
 
     fn walk(speed: f64, t1: Option<f64>, regime: Regime) -> WalkAnswer {
-        WalkAnswer { dt_s: 5e-4, creep_m_s: 1e-7, speed_m_s: speed, speed_se_m_s: None, t1_s: t1, regime }
+        WalkAnswer {
+            dt_s: 5e-4,
+            creep_m_s: 1e-7,
+            speed_m_s: speed,
+            speed_se_m_s: None,
+            step_speed_sd_m_s: 0.001,
+            t1_s: t1,
+            regime,
+        }
+    }
+
+    /// The steps' spread by hand, to the speed's tolerance: the built-in 20 degree walk at
+    /// `--dt 0.002` (speed 17.94 cm/s, steps spread by 1.00 cm/s as they alternate) against
+    /// its quarter step (0.03 cm/s): a change of 0.97 cm/s, past 3% of 17.94 = 0.54; the same
+    /// change of 0.5 cm/s passes. On a slow walk the 0.3 cm/s floor holds.
+    #[test]
+    fn a_refined_walk_whose_steps_spread_differently_is_not_converged() {
+        let coarse = WalkAnswer { step_speed_sd_m_s: 0.0100, ..walk(0.1794, Some(0.011), Regime::Success) };
+        let fine = |sd| WalkAnswer { step_speed_sd_m_s: sd, ..walk(0.1759, Some(0.011), Regime::Success) };
+        let r = refined(&coarse, Refinement::QuarterStep, fine(0.0003));
+        assert!(r.speed_within && r.t1_within && r.same_regime && !r.spread_within && !r.converged);
+        assert!((r.step_speed_sd_change_m_s + 0.0097).abs() < 1e-12);
+        assert!(refined(&coarse, Refinement::QuarterStep, fine(0.0050)).spread_within);
+        let slow = WalkAnswer { step_speed_sd_m_s: 0.0, ..walk(0.05, Some(0.01), Regime::Success) };
+        let s = |sd| refined(&slow, Refinement::TenthCreep, WalkAnswer { step_speed_sd_m_s: sd, ..slow });
+        assert!(s(0.0029).spread_within && !s(0.0031).spread_within);
     }
 
     /// The tolerances by hand: 3% of 0.20 m/s is 6 mm/s; of 0.05 m/s, 1.5 mm/s, below the

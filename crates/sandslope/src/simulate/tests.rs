@@ -161,6 +161,14 @@ fn the_convergence_check_passes_the_default_and_fails_a_coarse_step() {
     let coarse = settings.with_dt(s.robot().stride_period() / 200.0).unwrap();
     let bad = check_convergence(&s, SignedSlope::from_degrees(20.0).unwrap(), &coarse, None).unwrap();
     assert!(!bad.converged && !bad.refinements[0].converged, "{bad:?}");
+    // At T / 500 the 10 s walk at 20 degrees keeps its mean speed within 3% of the quarter
+    // step's (1.9%), but its steps alternate (their speeds spread by about 1 cm/s against
+    // 0.03 at the quarter step, past 3% of the 17.9 cm/s walk): caught by the spread alone.
+    let ten = SimSettings::new(10.0).unwrap().with_dt(s.robot().stride_period() / 500.0).unwrap();
+    let alternating = check_convergence(&s, SignedSlope::from_degrees(20.0).unwrap(), &ten, None).unwrap();
+    let quarter = &alternating.refinements[0];
+    assert!(quarter.speed_within && !quarter.spread_within && !alternating.converged, "{alternating:?}");
+    assert!(alternating.walk.step_speed_sd_m_s > 0.005 && quarter.answer.step_speed_sd_m_s < 0.001);
     // The quarter step's walk has the step limit: refused before any walk, naming the check.
     let long = SimSettings::new(3000.0).unwrap();
     let e = check_convergence(&s, SignedSlope::from_degrees(10.0).unwrap(), &long, None).unwrap_err();

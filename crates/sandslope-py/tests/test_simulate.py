@@ -121,6 +121,8 @@ def test_the_convergence_check_is_the_cli_check(cli):
     assert got["refinements"][0]["answer"]["dt_s"] == pytest.approx(got["walk"]["dt_s"] / 4, rel=1e-15)
     assert got["walk"]["speed_m_s"] == pytest.approx(want["walk"]["speed_m_s"], rel=1e-12)
     assert got["converged"] is want["converged"] is True
+    assert got["refinements"][0]["spread_within"] is want["refinements"][0]["spread_within"] is True
+    assert got["walk"]["step_speed_sd_m_s"] == pytest.approx(want["walk"]["step_speed_sd_m_s"], rel=1e-12, abs=1e-15)
     with pytest.raises(ValueError, match=r"walks = 1 must be a whole number of walks from 2 to 1000"):
         sandslope.check_convergence("paper-hexapod", "glass-beads-300um", 10, 2, walks=1)
     # Several slopes: the list `--slopes` prints, each the one-slope check.

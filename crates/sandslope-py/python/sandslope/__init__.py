@@ -714,8 +714,8 @@ def check_convergence(
     --check-convergence --json`` prints (a sequence of slopes: the list ``--slopes`` prints,
     the slopes checked in parallel). The walk as asked (``walk``), again at a quarter of
     its time step and at a tenth of its creep speed (``refinements``, each with its answer, its
-    changes and whether speed, t1 and regime are within issue 38's tolerances: 3% or 0.3 cm/s,
-    1 ms, the same), and ``converged`` if both are.
+    changes and whether speed, the steps' spread, t1 and regime are within issue 38's tolerances:
+    3% or 0.3 cm/s for speed and spread, 1 ms, the same), and ``converged`` if both are.
 
     The default step is shown converged for the built-in robot and terrain only
     (docs/simulate.md, "Checking convergence"); check a robot, terrain or mechanism of your

@@ -161,15 +161,19 @@ fn group(g: &Group, out: &mut Out, v: [f64; 3], eps: f64, zz: f64, zx: f64, scal
     let j01 = radial * st0 * ez + tangential * turn0 * n1;
     let j10 = radial * st1 * ex + tangential * turn1 * n0;
     let j11 = radial * st1 * ez + tangential * turn1 * n1;
-    // At rest: no force, an isotropic Jacobian.
+    // At rest: no force, an isotropic Jacobian (rare, so its division only where a lane rests).
+    let (fx, fz) = (w * phi * st0, w * phi * st1);
     let rest = s.cmp_le(k(1e-300));
-    let stiff = neg(w * k(scale_n) / eps_v);
-    out.fx = rest.blend(zero, w * phi * st0).to_array();
-    out.fz = rest.blend(zero, w * phi * st1).to_array();
-    out.d[0][0] = rest.blend(stiff, j00).to_array();
-    out.d[0][1] = rest.blend(zero, j01).to_array();
-    out.d[1][0] = rest.blend(zero, j10).to_array();
-    out.d[1][1] = rest.blend(stiff, j11).to_array();
+    let (fx, fz, j00, j01, j10, j11) = if rest.none() {
+        (fx, fz, j00, j01, j10, j11)
+    } else {
+        let stiff = neg(w * k(scale_n) / eps_v);
+        let r = |at: f64x4, moving: f64x4| rest.blend(at, moving);
+        (r(zero, fx), r(zero, fz), r(stiff, j00), r(zero, j01), r(zero, j10), r(stiff, j11))
+    };
+    out.fx = fx.to_array();
+    out.fz = fz.to_array();
+    out.d = [[j00.to_array(), j01.to_array()], [j10.to_array(), j11.to_array()]];
 }
 
 #[cfg(test)]

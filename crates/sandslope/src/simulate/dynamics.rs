@@ -548,26 +548,24 @@ impl Walker {
         let mut k = [[0.0; 3]; 3];
         let mut potential = 0.0;
         let want = jac.is_some();
-        // The default law's forces several elements at a time (the same to the bit).
+        forces.clear();
+        // The default law's forces several elements at a time, and their sums (the same to
+        // the bit as the loop below).
         let lanes = !associated && self.use_lanes;
         if lanes {
             self.lanes.evaluate(v, eps);
+            self.lanes.accumulate(contacts.len(), forces, &mut g, &mut k, want);
         }
-        forces.clear();
-        for (i, c) in contacts.iter().enumerate() {
-            let (f, d) = if lanes {
-                self.lanes.get(i)
+        for c in contacts.iter().filter(|_| !lanes) {
+            let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
+            let u = Walker::element_velocity(c, v, rate);
+            let rft = if c.leg == BELLY { belly_rft } else { leg_rft };
+            let (f, d) = if associated {
+                let (f, p, hess) = associated_force(rft, c, u, eps);
+                potential += p;
+                (f, [[-hess[0][0], -hess[0][1]], [-hess[1][0], -hess[1][1]]])
             } else {
-                let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
-                let u = Walker::element_velocity(c, v, rate);
-                let rft = if c.leg == BELLY { belly_rft } else { leg_rft };
-                if associated {
-                    let (f, p, hess) = associated_force(rft, c, u, eps);
-                    potential += p;
-                    (f, [[-hess[0][0], -hess[0][1]], [-hess[1][0], -hess[1][1]]])
-                } else {
-                    element_force(rft, c, u, eps, want)
-                }
+                element_force(rft, c, u, eps, want)
             };
             forces.push(f);
             let (rx, rz) = (c.rel[0], c.rel[1]);

@@ -36,12 +36,17 @@ struct Group {
     sin2b: [f64; LANES],
 }
 
-/// A group's forces and Jacobians, lane by lane.
+/// A group's forces and Jacobians, lane by lane, with what each adds to the body's sums
+/// ([`Lanes::accumulate`]): the moment `rx fz - rz fx`, the Jacobian's third column
+/// `-rz d_i0 + rx d_i1` and third row.
 #[derive(Debug, Clone, Copy, Default)]
 struct Out {
     fx: [f64; LANES],
     fz: [f64; LANES],
     d: [[[f64; LANES]; 2]; 2],
+    moment: [f64; LANES],
+    third_column: [[f64; LANES]; 2],
+    third_row: [[f64; LANES]; 3],
 }
 
 /// The step's contacts prepared for [`Lanes::evaluate`], and its last answers.
@@ -92,9 +97,42 @@ impl Lanes {
         }
     }
 
-    /// Element `k`'s force and Jacobian from the last [`Lanes::evaluate`].
-    #[inline(always)]
-    pub(super) fn get(&self, k: usize) -> ([f64; 2], [[f64; 2]; 2]) {
+    /// Adds the last [`Lanes::evaluate`]'s forces of the first `n` elements to `forces`, their
+    /// force and moment about the centre of mass to `g` and (with `jacobian`) `J^T D J` to `k`,
+    /// `J = [[1, 0, -rz], [0, 1, rx]]`: one element after another, the order and the
+    /// operations of the scalar path in `Walker::evaluate` (its products formed lane by lane),
+    /// so the sums are its to the bit.
+    pub(super) fn accumulate(
+        &self,
+        n: usize,
+        forces: &mut Vec<[f64; 2]>,
+        g: &mut [f64; 3],
+        k: &mut [[f64; 3]; 3],
+        jacobian: bool,
+    ) {
+        for i in 0..n {
+            let (o, l) = (&self.out[i / LANES], i % LANES);
+            forces.push([o.fx[l], o.fz[l]]);
+            g[0] += o.fx[l];
+            g[1] += o.fz[l];
+            g[2] += o.moment[l];
+            if jacobian {
+                k[0][0] += o.d[0][0][l];
+                k[0][1] += o.d[0][1][l];
+                k[0][2] += o.third_column[0][l];
+                k[1][0] += o.d[1][0][l];
+                k[1][1] += o.d[1][1][l];
+                k[1][2] += o.third_column[1][l];
+                k[2][0] += o.third_row[0][l];
+                k[2][1] += o.third_row[1][l];
+                k[2][2] += o.third_row[2][l];
+            }
+        }
+    }
+
+    /// Element `k`'s force and Jacobian from the last [`Lanes::evaluate`] (tests).
+    #[cfg(test)]
+    fn get(&self, k: usize) -> ([f64; 2], [[f64; 2]; 2]) {
         let (o, l) = (&self.out[k / LANES], k % LANES);
         ([o.fx[l], o.fz[l]], [[o.d[0][0][l], o.d[0][1][l]], [o.d[1][0][l], o.d[1][1][l]]])
     }
@@ -174,6 +212,16 @@ fn group(g: &Group, out: &mut Out, v: [f64; 3], eps: f64, zz: f64, zx: f64, scal
     out.fx = fx.to_array();
     out.fz = fz.to_array();
     out.d = [[j00.to_array(), j01.to_array()], [j10.to_array(), j11.to_array()]];
+    // Walker::evaluate's sums: the moment, and J^T D J's third column and row.
+    let neg_rz = neg(rel_z);
+    out.moment = (rel_x * fz - rel_z * fx).to_array();
+    let (c0, c1) = (neg_rz * j00 + rel_x * j01, neg_rz * j10 + rel_x * j11);
+    out.third_column = [c0.to_array(), c1.to_array()];
+    out.third_row = [
+        (neg_rz * j00 + rel_x * j10).to_array(),
+        (neg_rz * j01 + rel_x * j11).to_array(),
+        (neg_rz * c0 + rel_x * c1).to_array(),
+    ];
 }
 
 #[cfg(test)]
@@ -182,10 +230,11 @@ mod tests {
     use super::super::super::rft::RftScaling;
     use super::*;
 
-    /// The lanes are the scalar path to the bit: elements round the circle (and the reference
-    /// plates), legs turning and the belly, body rates in every direction and at speeds from
-    /// 1e3 times the creep down to exact rest, so every branch (mirror, projection, rest) is
-    /// taken in some lane next to lanes that do not take it.
+    /// The lanes are the scalar path to the bit, each element's force and Jacobian and their
+    /// sums: elements round the circle (and the reference plates), legs turning and the belly,
+    /// body rates in every direction and at speeds from 1e3 times the creep down to exact
+    /// rest, so every branch (mirror, projection, rest) is taken in some lane next to lanes
+    /// that do not take it.
     #[test]
     fn the_lanes_are_the_scalar_path_to_the_bit() {
         let rft = Rft::with_scaling(7e5, 3.26e6, RftScaling::Motion);
@@ -212,6 +261,8 @@ mod tests {
                 for spin in [0.0, -2.0, 0.7] {
                     let v = [speed * a.cos(), speed * a.sin(), spin * speed];
                     lanes.evaluate(v, eps);
+                    // The sums as Walker::evaluate's scalar loop forms them.
+                    let (mut g, mut k) = ([0.0; 3], [[0.0; 3]; 3]);
                     for (i, c) in contacts.iter().enumerate() {
                         let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
                         let u = super::super::Walker::element_velocity(c, v, rate);
@@ -223,8 +274,26 @@ mod tests {
                             d.map(|r| r.map(f64::to_bits)),
                             "{i} {v:?}"
                         );
+                        let (rx, rz) = (c.rel[0], c.rel[1]);
+                        g[0] += f[0];
+                        g[1] += f[1];
+                        g[2] += rx * f[1] - rz * f[0];
+                        let dj = [
+                            [d[0][0], d[0][1], -rz * d[0][0] + rx * d[0][1]],
+                            [d[1][0], d[1][1], -rz * d[1][0] + rx * d[1][1]],
+                        ];
+                        for col in 0..3 {
+                            k[0][col] += dj[0][col];
+                            k[1][col] += dj[1][col];
+                            k[2][col] += -rz * dj[0][col] + rx * dj[1][col];
+                        }
                         count += 1;
                     }
+                    let (mut forces, mut lg, mut lk) = (Vec::new(), [0.0; 3], [[0.0; 3]; 3]);
+                    lanes.accumulate(contacts.len(), &mut forces, &mut lg, &mut lk, true);
+                    assert_eq!(forces.len(), contacts.len());
+                    assert_eq!(lg.map(f64::to_bits), g.map(f64::to_bits), "{v:?}");
+                    assert_eq!(lk.map(|r| r.map(f64::to_bits)), k.map(|r| r.map(f64::to_bits)), "{v:?}");
                 }
             }
         }

@@ -157,6 +157,34 @@ pub(crate) struct Walker {
     rest_group_scratch: Vec<usize>,
 }
 
+/// Adds an element at `rel` from the centre of mass, with force `f` and (when the Jacobian is
+/// wanted) force Jacobian `d`, to the body's force and moment `g` and to `k += J^T d J`,
+/// `J = [[1, 0, -rz], [0, 1, rx]]` (the element's velocity's Jacobian in the body's rates).
+#[inline(always)]
+fn add_element(
+    g: &mut [f64; 3],
+    k: &mut [[f64; 3]; 3],
+    rel: [f64; 2],
+    f: [f64; 2],
+    d: Option<[[f64; 2]; 2]>,
+) {
+    let (rx, rz) = (rel[0], rel[1]);
+    g[0] += f[0];
+    g[1] += f[1];
+    g[2] += rx * f[1] - rz * f[0];
+    if let Some(d) = d {
+        let dj = [
+            [d[0][0], d[0][1], -rz * d[0][0] + rx * d[0][1]],
+            [d[1][0], d[1][1], -rz * d[1][0] + rx * d[1][1]],
+        ];
+        for col in 0..3 {
+            k[0][col] += dj[0][col];
+            k[1][col] += dj[1][col];
+            k[2][col] += -rz * dj[0][col] + rx * dj[1][col];
+        }
+    }
+}
+
 impl Walker {
     /// A walker whose legs are `leg`'s outline, `robot.leg_elements()` elements each.
     pub(crate) fn with_leg(
@@ -568,22 +596,7 @@ impl Walker {
                 element_force(rft, c, u, eps, want)
             };
             forces.push(f);
-            let (rx, rz) = (c.rel[0], c.rel[1]);
-            g[0] += f[0];
-            g[1] += f[1];
-            g[2] += rx * f[1] - rz * f[0];
-            if want {
-                // J = [[1, 0, -rz], [0, 1, rx]]; K += J^T D J.
-                let dj = [
-                    [d[0][0], d[0][1], -rz * d[0][0] + rx * d[0][1]],
-                    [d[1][0], d[1][1], -rz * d[1][0] + rx * d[1][1]],
-                ];
-                for col in 0..3 {
-                    k[0][col] += dj[0][col];
-                    k[1][col] += dj[1][col];
-                    k[2][col] += -rz * dj[0][col] + rx * dj[1][col];
-                }
-            }
+            add_element(&mut g, &mut k, c.rel, f, want.then_some(d));
         }
         let mut r = [0.0; 3];
         self.forces_at = (eps == self.eps && !associated).then(|| v.map(f64::to_bits));

@@ -261,7 +261,7 @@ mod tests {
                 for spin in [0.0, -2.0, 0.7] {
                     let v = [speed * a.cos(), speed * a.sin(), spin * speed];
                     lanes.evaluate(v, eps);
-                    // The sums as Walker::evaluate's scalar loop forms them.
+                    // The sums as Walker::evaluate's scalar path forms them.
                     let (mut g, mut k) = ([0.0; 3], [[0.0; 3]; 3]);
                     for (i, c) in contacts.iter().enumerate() {
                         let rate = if c.leg == BELLY { 0.0 } else { rates[c.leg] };
@@ -274,19 +274,7 @@ mod tests {
                             d.map(|r| r.map(f64::to_bits)),
                             "{i} {v:?}"
                         );
-                        let (rx, rz) = (c.rel[0], c.rel[1]);
-                        g[0] += f[0];
-                        g[1] += f[1];
-                        g[2] += rx * f[1] - rz * f[0];
-                        let dj = [
-                            [d[0][0], d[0][1], -rz * d[0][0] + rx * d[0][1]],
-                            [d[1][0], d[1][1], -rz * d[1][0] + rx * d[1][1]],
-                        ];
-                        for col in 0..3 {
-                            k[0][col] += dj[0][col];
-                            k[1][col] += dj[1][col];
-                            k[2][col] += -rz * dj[0][col] + rx * dj[1][col];
-                        }
+                        super::super::add_element(&mut g, &mut k, c.rel, f, Some(d));
                         count += 1;
                     }
                     let (mut forces, mut lg, mut lk) = (Vec::new(), [0.0; 3], [[0.0; 3]; 3]);

@@ -395,19 +395,30 @@ fn run_check(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     Ok(())
 }
 
+/// A change with its sign and `digits` decimals; one that rounds to zero is "+0.00", not
+/// "-0.00".
+fn signed(v: f64, digits: usize) -> String {
+    let s = format!("{v:+.digits$}");
+    if s.trim_start_matches(['-', '+', '0', '.']).is_empty() {
+        s.replacen('-', "+", 1)
+    } else {
+        s
+    }
+}
+
 /// A refinement's change as the tables print it: speed (and its share of the walk's), the
 /// steps' spread, t1.
 fn change_cell(c: &ConvergenceCheck, r: &RefinedWalk) -> String {
     let pct = if c.walk.speed_m_s != 0.0 {
-        format!(" ({:+.1}%)", 100.0 * r.speed_change_m_s / c.walk.speed_m_s.abs())
+        format!(" ({}%)", signed(100.0 * r.speed_change_m_s / c.walk.speed_m_s.abs(), 1))
     } else {
         String::new()
     };
-    let t1 = r.t1_change_s.map_or("-".to_string(), |d| format!("{:+.2}", d * 1e3));
+    let t1 = r.t1_change_s.map_or("-".to_string(), |d| signed(d * 1e3, 2));
     format!(
-        "speed {:+.2} cm/s{pct}, spread {:+.2} cm/s, t1 {t1} ms",
-        r.speed_change_m_s * 100.0,
-        r.step_speed_sd_change_m_s * 100.0
+        "speed {} cm/s{pct}, spread {} cm/s, t1 {t1} ms",
+        signed(r.speed_change_m_s * 100.0, 2),
+        signed(r.step_speed_sd_change_m_s * 100.0, 2)
     )
 }
 
@@ -606,5 +617,17 @@ mod tests {
             let msg = parse_slopes(bad).unwrap_err().to_string();
             assert!(msg.starts_with("--slopes"), "{bad}: {msg}");
         }
+    }
+
+    /// A change that rounds to zero prints "+0.00" whatever its sign; others keep theirs.
+    #[test]
+    fn a_change_that_rounds_to_zero_has_no_minus() {
+        assert_eq!(signed(-0.001, 2), "+0.00");
+        assert_eq!(signed(-0.0, 2), "+0.00");
+        assert_eq!(signed(0.004, 2), "+0.00");
+        assert_eq!(signed(-0.04, 1), "+0.0");
+        assert_eq!(signed(-0.5, 2), "-0.50");
+        assert_eq!(signed(0.14, 1), "+0.1");
+        assert_eq!(signed(-12.346, 2), "-12.35");
     }
 }

@@ -251,7 +251,11 @@ function checkConvergence() {
 }
 function showConvergence(c) {
   const out = $("sim-convergence");
-  const signed = (v, digits) => (v >= 0 ? "+" : "") + fmt(v, digits);
+  // A change that rounds to zero is "+0.00", not "-0.00".
+  const signed = (v, digits) => {
+    const s = fmt(v, digits);
+    return /^-?[0.]+$/.test(s) ? s.replace("-", "+").replace(/^(?!\+)/, "+") : (v >= 0 ? "+" : "") + s;
+  };
   const parts = c.refinements.map((r) => {
     const pct = c.walk.speed_m_s !== 0 ? ` (${signed((100 * r.speed_change_m_s) / Math.abs(c.walk.speed_m_s), 1)}%)` : "";
     const t1 = r.t1_change_s === null ? "-" : signed(r.t1_change_s * 1e3, 2);

@@ -82,9 +82,9 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "N", conflicts_with_all = ["slopes", "out", "plot", "animate"])]
     pub ensemble: Option<usize>,
     /// Walk the slope (or each of --slopes) again at a quarter of the time step and at a tenth
-    /// of the creep speed, and say whether the answer is converged: speed within 3% (or
-    /// 0.3 cm/s), t1 within 1 ms and the same regime (issue 38's test; docs/simulate.md,
-    /// "Checking convergence"). The default step is shown converged for the built-in robot
+    /// of the creep speed, and say whether the answer is converged: speed, and the spread of
+    /// the steps' speeds, within 3% (or 0.3 cm/s), t1 within 1 ms and the same regime (issue
+    /// 38's test; docs/simulate.md, "Checking convergence"). The default step is shown converged for the built-in robot
     /// and terrain only; check your own. With --ensemble N each setting is N walks, their
     /// means compared (a single free-pitch walk on a slope is chaotic and cannot converge).
     #[arg(long, conflicts_with_all = ["out", "plot", "animate"])]

@@ -16,7 +16,7 @@ python=${PYTHON:-python3}
 
 # A one-shot build: Cargo's incremental caches (GBs of target/debug/incremental, reused only by
 # the next edit-and-rebuild) are not written unless the caller asks for them
-# (CARGO_INCREMENTAL=1 bash scripts/test.sh). README.md states the disk this leaves.
+# (CARGO_INCREMENTAL=1 bash scripts/test.sh). docs/building.md states the disk this leaves.
 export CARGO_INCREMENTAL=${CARGO_INCREMENTAL:-0}
 
 seconds() { date +%s; }

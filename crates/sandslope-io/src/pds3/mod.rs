@@ -15,6 +15,7 @@
 //! [`label`] parses the ODL label, [`image`] reads the IMAGE object, [`projection`] the
 //! IMAGE_MAP_PROJECTION.
 
+mod cylindrical;
 mod image;
 mod label;
 mod projection;
@@ -25,7 +26,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context, Result};
 
-use crate::crs::Crs;
 use crate::raster::grid::{Raster, SizeCheck};
 use label::{parse_label, Item, Label, Value};
 
@@ -55,14 +55,14 @@ pub fn read_pds3_within(path: &Path, fits: SizeCheck) -> Result<Raster> {
     let Described { label, data_path, offset, layout, mut notes } = describe(path)?;
     fits(layout.cols as usize, layout.rows as usize)?;
     let values = image::read_samples(&layout, &label.name, &data_path, offset, &mut notes)?;
-    let (geo, cells) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
+    let (geo, cells, crs) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
     Ok(Raster {
         cols: layout.cols as usize,
         rows: layout.rows as usize,
         values,
         nodata: None,
         geo,
-        crs: Crs::Projected { metres_per_unit: 1.0, unit: "metre" },
+        crs,
         cell_m: cells.cell_m,
         row_widths_m: cells.row_widths_m,
         notes,
@@ -124,7 +124,7 @@ impl Pds3Dtm {
             offset,
             &image::Window { rows: 0..0, cols: 0..0 },
         )?;
-        let (_, cells) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
+        let (_, cells, _) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
         Ok(Pds3Dtm {
             name: label.name.clone(),
             data_path,
@@ -261,6 +261,7 @@ mod tests {
     //! below. Expected values come from the script's formulas, worked here by hand.
     use super::label::*;
     use super::*;
+    use crate::crs::Crs;
 
     fn fixture_path(name: &str) -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pds3").join(name)
@@ -579,3 +580,6 @@ mod mutated {
         }
     }
 }
+
+#[cfg(test)]
+mod megdr_tests;

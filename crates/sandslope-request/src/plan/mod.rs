@@ -469,6 +469,13 @@ fn endpoint_cell(
         (c, r, format!("--{which}-px {s}"), false)
     } else if let Some(s) = map {
         let (x, y) = parse_pair(&format!("--{which}"), s)?;
+        // A longitude is the same place 360 degrees on: -10 on a map of 0 to 360 east (a MOLA
+        // MEGDR's) is 350.
+        let x = if raster.crs.is_geographic() && !(g.west..=east).contains(&x) {
+            [x + 360.0, x - 360.0].into_iter().find(|v| (g.west..=east).contains(v)).unwrap_or(x)
+        } else {
+            x
+        };
         let (c, r) = g.cell_of(x, y);
         // On the map's outline (e.g. its corner 0,0): inside the closed extent, but not in any cell.
         let on_edge = (g.west..=east).contains(&x) && (south..=g.north).contains(&y);

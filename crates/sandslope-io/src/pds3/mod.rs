@@ -447,7 +447,7 @@ mod tests {
             "{err}"
         );
         let err = edited("LINES = 48\r", "LINES = 2000000000\r");
-        assert!(err.contains("cells is more than the"), "{err}");
+        assert!(err.contains("LINES = 2000000000 lines of 240 bytes"), "{err}");
         let err = edited("LINE_SAMPLES = 60", "LINE_SAMPLES = 60.5");
         assert!(err.contains("IMAGE.LINE_SAMPLES = 60.5 must be a whole number"), "{err}");
     }

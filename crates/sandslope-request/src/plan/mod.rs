@@ -287,6 +287,10 @@ impl PlanRequest {
         let settings = self.settings()?;
         let chosen = std::cell::Cell::new(Search::Full);
         let full_only = full_only || risk_map || self.classes.is_some();
+        // The readers check what they allocate against the same limit.
+        sandslope_io::raster::set_memory_limit(
+            self.max_memory.filter(|gib| *gib > 0.0).map(|gib| (gib * (1u64 << 30) as f64) as u64),
+        );
         let (dem, heights) = read_heights_within(&self.dem, &|cols, rows| {
             chosen.set(choose_search(self, cols, rows, &self.objectives, full_only)?);
             Ok(())

@@ -69,6 +69,26 @@ pub fn read_pds3_within(path: &Path, fits: SizeCheck) -> Result<Raster> {
     })
 }
 
+/// A DTM opened for window reads (`raster::open_height_windows`): the raster [`read_pds3`]
+/// gives without its samples (georeference, CRS, ground cells, notes), and the DTM.
+pub(crate) fn open_windows(path: &Path) -> Result<(Raster, Pds3Dtm)> {
+    let dtm = Pds3Dtm::open(path)?;
+    let Described { label, layout, mut notes, .. } = describe(path)?;
+    let (geo, cells, crs) = projection::georef(&label, layout.rows, layout.cols, &mut notes)?;
+    let raster = Raster {
+        cols: dtm.cols,
+        rows: dtm.rows,
+        values: Vec::new(),
+        nodata: None,
+        geo,
+        crs,
+        cell_m: cells.cell_m,
+        row_widths_m: cells.row_widths_m,
+        notes,
+    };
+    Ok((raster, dtm))
+}
+
 /// What a DTM's label says before any sample is read: the label, where the image's bytes are
 /// (file and offset), its layout, and the notes so far.
 struct Described {

@@ -213,15 +213,30 @@ pub(super) fn read_geotiff(
         bits.max(8) / 8 + if in_place { 0 } else { out_bytes },
     )?;
     fits(w as usize, h as usize)?;
+    let (raster, vertical) = header(path, &mut dec)?;
+    let image = decode_samples(&name, path, &mut dec, bits)?;
+    Ok((raster, vertical, image))
+}
+
+/// A GeoTIFF's raster (its `values` left empty) and the factor converting its heights to
+/// metres, from its directory alone: no sample is read.
+pub(super) fn read_geotiff_header(path: &Path) -> Result<(Raster, f64)> {
+    header(path, &mut open_full_resolution(path)?)
+}
+
+/// The raster and vertical factor of the image `dec` is at (see [`read_geotiff_header`]).
+fn header(path: &Path, dec: &mut Decoder<BufReader<File>>) -> Result<(Raster, f64)> {
+    let name = path.display();
+    let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
+    let bits: u64 = dec.find_tag_unsigned(Tag::BitsPerSample).ok().flatten().unwrap_or(64);
     let file_bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
     check_claimed_bytes(&name, u64::from(w), u64::from(h), bits, file_bytes)?;
     let samples: u16 = dec.find_tag_unsigned(Tag::SamplesPerPixel).ok().flatten().unwrap_or(1);
     if samples != 1 {
         bail!("{name}: has {samples} bands (SamplesPerPixel = {samples}); an elevation or class raster must have exactly 1");
     }
-    let tags = GeoTags::read(&name, &mut dec)?;
+    let tags = GeoTags::read(&name, dec)?;
     let (west, north, cell_x, cell_y) = tags.origin_and_cell(&name)?;
-    let image = decode_samples(&name, path, &mut dec, bits)?;
     let (cols, rows) = (w as usize, h as usize);
     let mut notes = Vec::new();
     let GeoTags { geokeys, geodoubles, geoascii, nodata, .. } = tags;
@@ -244,7 +259,7 @@ pub(super) fn read_geotiff(
         row_widths_m: None,
         notes,
     };
-    Ok((raster, vertical, image))
+    Ok((raster, vertical))
 }
 
 /// The GDAL_NODATA value of a GeoTIFF, from its tags alone (the samples are not decoded), as

@@ -13,6 +13,7 @@ mod ascii;
 mod chunks;
 pub mod geotiff;
 pub mod grid;
+mod windows;
 
 use ascii::read_asc;
 pub use geotiff::{geotiff_nodata, write_two_band_geotiff, MAX_TIFF_TAG_BYTES};
@@ -20,6 +21,7 @@ use geotiff::{read_geotiff, samples_as};
 pub use grid::{
     available_memory, memory_limit, set_memory_limit, GeoRef, Raster, SizeCheck, DEFAULT_MEMORY_LIMIT,
 };
+pub use windows::{open_height_windows, HeightWindows};
 
 /// Reads a GeoTIFF (`.tif`, `.tiff`), an ESRI ASCII grid (`.asc`) or a PDS3 DTM (`.img` with
 /// its label attached or a `.lbl` beside it, or the `.lbl`; any file beginning with a PDS3

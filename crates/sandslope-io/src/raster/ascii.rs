@@ -47,8 +47,8 @@ pub(super) fn read_asc(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
         }
     };
     let (cols, rows) = (count("ncols")?, count("nrows")?);
-    check_raster_size(&name, cols as u64, rows as u64, 8)?;
     fits(cols, rows)?;
+    check_raster_size(&name, cols as u64, rows as u64, 8)?;
     // Every value takes at least two bytes (a digit and a separator): a header that claims more
     // cells than the file can hold is refused before the grid is allocated.
     if cols.saturating_mul(rows) > text.len() / 2 + 1 {

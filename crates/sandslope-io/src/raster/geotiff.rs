@@ -206,13 +206,13 @@ pub(super) fn read_geotiff(
     let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
     let bits: u64 = dec.find_tag_unsigned(Tag::BitsPerSample).ok().flatten().unwrap_or(64);
     let in_place = out_bytes == 4 && bits == 32;
+    fits(w as usize, h as usize)?;
     check_raster_size(
         &name,
         u64::from(w),
         u64::from(h),
         bits.max(8) / 8 + if in_place { 0 } else { out_bytes },
     )?;
-    fits(w as usize, h as usize)?;
     let (raster, vertical) = header(path, &mut dec)?;
     let image = decode_samples(&name, path, &mut dec, bits)?;
     Ok((raster, vertical, image))

@@ -21,7 +21,7 @@ use geotiff::{read_geotiff, samples_as};
 pub use grid::{
     available_memory, memory_limit, set_memory_limit, GeoRef, Raster, SizeCheck, DEFAULT_MEMORY_LIMIT,
 };
-pub use windows::{open_height_windows, HeightWindows};
+pub use windows::{open_height_windows, HeightWindows, WindowsCheck};
 
 /// Reads a GeoTIFF (`.tif`, `.tiff`), an ESRI ASCII grid (`.asc`) or a PDS3 DTM (`.img` with
 /// its label attached or a `.lbl` beside it, or the `.lbl`; any file beginning with a PDS3

@@ -59,32 +59,38 @@ struct TiffChunks {
     cache_chunks: usize,
 }
 
+/// What a caller checks a raster opened for window reads against, from its header and before
+/// any sample is read: `fits(cols, rows, whole)`, `whole` when the heights will be read whole
+/// (an ASCII grid). Its error refuses the raster.
+pub type WindowsCheck<'a> = &'a dyn Fn(usize, usize, bool) -> Result<()>;
+
 /// Opens the raster at `path` for window reads: its georeference and notes (its `values`
 /// empty) and the windows. Reads the header (a GeoTIFF's directory, a PDS3 label, whose every
-/// chunk or line is checked to lie inside the file), not the samples; an ASCII grid is read
-/// whole.
-pub fn open_height_windows(path: &Path) -> Result<(Raster, HeightWindows)> {
+/// chunk or line is checked to lie inside the file), then calls `fits`, and reads no sample;
+/// an ASCII grid is read whole after `fits`.
+pub fn open_height_windows(path: &Path, fits: WindowsCheck) -> Result<(Raster, HeightWindows)> {
     let name = path.display().to_string();
+    let whole = |fits: WindowsCheck| -> Result<(Raster, Kind)> {
+        let (raster, heights) = super::read_heights_within(path, &|c, r| fits(c, r, true))?;
+        Ok((raster, Kind::Memory(heights)))
+    };
     let (raster, kind) = match Format::of(path)? {
         Format::GeoTiff => {
-            let (raster, vertical, chunks) = open_tiff(path)?;
-            let _ = vertical;
+            let (raster, _, chunks) = open_tiff(path)?;
             match chunks {
-                Some(c) => (raster, Kind::Tiff(Box::new(c))),
-                None => {
-                    let (raster, heights) = super::read_heights_within(path, &|_, _| Ok(()))?;
-                    (raster, Kind::Memory(heights))
+                Some(c) => {
+                    fits(raster.cols, raster.rows, false)?;
+                    (raster, Kind::Tiff(Box::new(c)))
                 }
+                None => whole(fits)?,
             }
         }
         Format::Pds3 => {
             let (raster, dtm) = crate::pds3::open_windows(path)?;
+            fits(raster.cols, raster.rows, false)?;
             (raster, Kind::Pds3(Box::new(dtm)))
         }
-        Format::Asc => {
-            let (raster, heights) = super::read_heights_within(path, &|_, _| Ok(()))?;
-            (raster, Kind::Memory(heights))
-        }
+        Format::Asc => whole(fits)?,
     };
     // As the planner's grid takes them: rows all of one width are a uniform grid of that width.
     let (mut cell_m, mut row_widths) = (raster.cell_m, raster.row_widths_m.clone());

@@ -29,7 +29,8 @@ fn every_window_of_every_layout_is_the_whole_read_s_heights() {
     for (dir, name, tiff_chunks) in files {
         let path = fixture(dir, name);
         let (whole, heights) = crate::raster::read_heights_within(&path, &|_, _| Ok(())).unwrap();
-        let (raster, w) = open_height_windows(&path).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+        let (raster, w) =
+            open_height_windows(&path, &|_, _, _| Ok(())).unwrap_or_else(|e| panic!("{name}: {e:#}"));
         assert_eq!(
             (raster.cols, raster.rows, &raster.geo, &raster.row_widths_m),
             (whole.cols, whole.rows, &whole.geo, &whole.row_widths_m),
@@ -72,7 +73,8 @@ fn every_window_of_every_layout_is_the_whole_read_s_heights() {
 fn a_tile_past_the_end_of_the_file_is_refused_naming_it_and_its_offset() {
     let src = std::fs::read(fixture("gdal", "f32-deflate-pred3-tiled.tif")).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let (raster, w) = open_height_windows(&fixture("gdal", "f32-deflate-pred3-tiled.tif")).unwrap();
+    let (raster, w) =
+        open_height_windows(&fixture("gdal", "f32-deflate-pred3-tiled.tif"), &|_, _, _| Ok(())).unwrap();
     let Kind::Tiff(t) = &w.kind else { panic!("tiled") };
     let chunks = t.across * raster.rows.div_ceil(t.ch);
     // The last tile's data is the last thing GDAL writes before any overview: cut the file
@@ -82,6 +84,6 @@ fn a_tile_past_the_end_of_the_file_is_refused_naming_it_and_its_offset() {
     let cut = (offsets[..chunks].iter().max().unwrap() + 1) as usize;
     let path = dir.path().join("cut.tif");
     std::fs::write(&path, &src[..cut.min(src.len())]).unwrap();
-    let e = open_height_windows(&path).err().map(|e| format!("{e:#}")).unwrap_or_default();
+    let e = open_height_windows(&path, &|_, _, _| Ok(())).err().map(|e| format!("{e:#}")).unwrap_or_default();
     assert!(e.contains("cut.tif") && e.contains("past the end of the") && e.contains("at byte"), "{e}");
 }

@@ -90,6 +90,17 @@ pub struct CorridorStats {
     /// Whether the corridor was the whole map (the route is then the full optimum, and no
     /// route means none exists).
     pub whole: bool,
+    /// The route's cost (the objective's units), if one was found.
+    pub cost: Option<f64>,
+    /// A lower bound on the cost of any route between the endpoints over the whole map: the
+    /// straight line between them, east-west at the map's narrowest row width, times the
+    /// cheapest cost per metre of the pitch tables (the A* heuristic at the start). The full
+    /// optimum lies between it and `cost`.
+    pub lower_bound: f64,
+    /// `cost / lower_bound - 1`: the most the route can cost above the full optimum, as a
+    /// fraction (a bound, often loose where routes must switch back; `null` without a route
+    /// or a zero bound). 0 when the corridor was the whole map.
+    pub gap_at_most: Option<f64>,
 }
 
 /// What [`plan_corridor`] computed.
@@ -186,12 +197,22 @@ pub fn plan_corridor_from(
                 let r = p.route(obj, request.start, request.goal, &|n| progress(obj, n, passable))?;
                 // Only the final position of the bar; a stop asked now changes nothing.
                 let _ = progress(obj, passable, passable);
+                let cost = r.as_ref().ok().map(|route| p.cost_of_route(obj, &route.cells));
+                let lower_bound = straight_line_bound(&p, obj, request, source);
+                let gap_at_most = match cost {
+                    Some(_) if whole => Some(0.0),
+                    Some(c) if lower_bound > 0.0 => Some((c / lower_bound - 1.0).max(0.0)),
+                    _ => None,
+                };
                 let stats = CorridorStats {
                     objective: obj,
                     coarse_cost,
                     half_width: wider.half_width,
                     corridor_cells,
                     whole,
+                    cost,
+                    lower_bound,
+                    gap_at_most,
                 };
                 let done = r.is_ok() || whole;
                 if done {
@@ -210,6 +231,26 @@ pub fn plan_corridor_from(
         coarse_size: (coarse.grid().cols(), coarse.grid().rows()),
         extrapolation,
     })
+}
+
+/// A lower bound on the cost of every route of `objective` from the request's start to its
+/// goal over the whole map `source`: the straight line between the cells' centres, east-west
+/// at the narrowest row's width (every row is at least that wide), times the planner `p`'s
+/// cheapest cost per metre (its A* heuristic, which never overestimates). The tables of `p`
+/// reach the corridor's steepest gradient; every cost per metre of the model grows with the
+/// pitch (slower, longer, riskier), so the cheapest is at the level and the same for the
+/// whole map's tables.
+fn straight_line_bound(
+    p: &Planner,
+    objective: Objective,
+    request: &PlanRequest,
+    source: &dyn HeightSource,
+) -> f64 {
+    let min_width =
+        source.row_widths().map_or(source.cell_x(), |w| w.iter().copied().fold(f64::INFINITY, f64::min));
+    let dc = request.start.col.abs_diff(request.goal.col) as f64;
+    let dr = request.start.row.abs_diff(request.goal.row) as f64;
+    p.min_cost[objective as usize] * (dc * min_width).hypot(dr * source.cell_y())
 }
 
 /// The coarse route of `objective` between the coarse cells of the request's start and goal;
@@ -346,6 +387,12 @@ impl Planner {
             grid = grid.with_row_widths(w[layout.row0..layout.row0 + rows].to_vec())?;
         }
         Planner::build(grid, Some((layout, grad)), None, terrains, robot, settings, Some(cache))
+    }
+
+    /// [`Planner::cost_of_route`], for the tests of the windowed search.
+    #[cfg(test)]
+    pub(super) fn cost_of_route_for_tests(&self, objective: Objective, cells: &[Cell]) -> f64 {
+        self.cost_of_route(objective, cells)
     }
 
     /// The cost of the chain of cells `cells` for `objective` (infinite if an edge is missing).

@@ -179,3 +179,40 @@ fn the_windowed_corridor_search_plans_the_in_memory_routes_reading_only_its_corr
         "{read} cells read, corridors {corridor_cells}"
     );
 }
+
+/// The optimality gap each corridor route states (issue 56): its lower bound is at most the
+/// full search's optimum on the map (planned here at full resolution, the independent
+/// reference), its cost is the route's, and so the stated bound on the gap is at least the
+/// route's real excess over the optimum; a corridor that is the whole map states 0.
+#[test]
+fn every_corridor_route_states_a_gap_bound_that_holds() {
+    let grid = dunes(96);
+    let (s, t) = (Cell { col: 4, row: 90 }, Cell { col: 90, row: 6 });
+    let robot = paper_robot();
+    let full = Planner::new(grid.clone(), None, &[terrain()], &robot, PlanSettings::default()).unwrap();
+    let go = |_: crate::plan::Objective, _: u64, _: u64| ControlFlow::Continue(());
+    for (half_width, whole) in [(1, false), (64, true)] {
+        let settings = CorridorSettings::new(4, half_width, None).unwrap();
+        let objectives = vec![crate::plan::Objective::Time, crate::plan::Objective::Risk];
+        let req = PlanRequest { start: s, goal: t, objectives, risk_map: false };
+        let plan =
+            plan_corridor(&grid, &terrain(), &robot, PlanSettings::default(), &req, &settings, &go).unwrap();
+        for (stats, (obj, route)) in plan.corridors.iter().zip(&plan.routes) {
+            let best = full.route(*obj, s, t, &|_| ControlFlow::Continue(())).unwrap().unwrap();
+            let optimum = full.cost_of_route_for_tests(*obj, &best.cells);
+            let cost = full.cost_of_route_for_tests(*obj, &route.as_ref().unwrap().cells);
+            assert_eq!(stats.whole, whole);
+            assert!((stats.cost.unwrap() - cost).abs() <= 1e-9 * cost, "{obj:?}: {:?} vs {cost}", stats.cost);
+            assert!(
+                stats.lower_bound > 0.0 && stats.lower_bound <= optimum,
+                "{obj:?}: {} vs {optimum}",
+                stats.lower_bound
+            );
+            let gap = stats.gap_at_most.unwrap();
+            assert!(gap >= cost / optimum - 1.0 - 1e-12, "{obj:?}: {gap} vs {}", cost / optimum - 1.0);
+            if whole {
+                assert_eq!(gap, 0.0);
+            }
+        }
+    }
+}

@@ -304,12 +304,12 @@ fn run_full(args: &PlanArgs, planned: &Planned) -> Result<()> {
 
 /// Writes and prints what the corridor search found, saying how it was found.
 fn run_corridor(args: &PlanArgs, planned: &CorridorPlanned) -> Result<()> {
-    let CorridorPlanned { dem, grid, plan, settings } = planned;
+    let CorridorPlanned { dem, heights, plan, settings } = planned;
     if let Some(p) = &args.out.geojson {
         writers::write_geojson(p, &dem.geo, &plan.routes)?;
     }
     if let Some(p) = &args.out.csv {
-        writers::write_csv(p, &dem.geo, grid, &plan.routes)?;
+        writers::write_csv(p, &dem.geo, heights, &plan.routes)?;
     }
     warn_extrapolation(plan.extrapolation);
     if args.out.json {

@@ -16,6 +16,7 @@
 #![warn(missing_docs)]
 
 pub mod anchoring;
+pub mod bag;
 pub mod crs;
 pub mod files;
 pub mod force_tests;

@@ -239,7 +239,9 @@ fn regular(path: &Path, topic: &str, mut samples: Vec<(i64, [f64; 3])>) -> Resul
             }
         }
     }
-    Ok((1.0 / dt, t0 as f64 * 1e-9, positions))
+    // The recording's clock starts at its first position (a bag's stamps are wall-clock
+    // nanoseconds, 1.7e9 s, where a double's step is 0.24 us).
+    Ok((1.0 / dt, 0.0, positions))
 }
 
 /// What a `JointState`'s `effort` holds.

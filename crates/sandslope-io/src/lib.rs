@@ -23,6 +23,7 @@ pub mod force_tests;
 pub mod grid_csv;
 mod lzw_tiles;
 pub mod measurements;
+pub mod mcap_out;
 pub mod mocap;
 pub mod npy;
 pub mod observations;

@@ -101,7 +101,10 @@ pub(super) fn scan_mcap(
                 }
                 _ => e.to_string(),
             };
-            anyhow!("{here}: {why}")
+            match topic {
+                Some(t) => anyhow!("{here} (reading topic `{t}`): {why}"),
+                None => anyhow!("{here}: {why}"),
+            }
         })?;
         let channel = &message.channel;
         let type_name = channel.schema.as_ref().map_or("", |s| s.name.as_str());

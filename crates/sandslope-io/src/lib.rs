@@ -25,6 +25,7 @@ mod lzw_tiles;
 pub mod measurements;
 pub mod mcap_out;
 pub mod mocap;
+pub mod nav2_map;
 pub mod npy;
 pub mod observations;
 pub mod pds3;

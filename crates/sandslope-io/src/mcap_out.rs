@@ -175,6 +175,108 @@ pub fn simulation_mcap(
     out.finish()
 }
 
+/// One live estimate of a `drive` run (docs/model.md §19), as `/sandslope/live` carries it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LiveRecord {
+    /// Gait time at the end of the stance, s.
+    pub time_s: f64,
+    /// The numbers, in the order of [`LIVE_FIELDS`].
+    pub values: [f64; 10],
+}
+
+/// The live estimate's numbers as `/sandslope/live`'s `Float64MultiArray` orders them (its
+/// one dimension's label lists them).
+pub const LIVE_FIELDS: [&str; 10] = [
+    "tripod",
+    "k_s_n_m3",
+    "k_s_lo_n_m3",
+    "k_s_hi_n_m3",
+    "speed_m_s",
+    "speed_lo_m_s",
+    "speed_hi_m_s",
+    "p_fail",
+    "p_slippage",
+    "p_sinkage",
+];
+
+/// A `drive` run as MCAP (`drive --log run.mcap`; docs/drive.md's log as ROS 2 messages),
+/// from the rows of its servo log (one per servo per bus cycle), its live estimates, its
+/// header's `key = value` pairs and its outcome:
+///
+/// - `/sandslope/run` (`std_msgs/String`, at the start): the header, one `key = value` a line;
+/// - `/joint_states` (`sensor_msgs/JointState`, one per cycle): joints `leg_0` ... in leg
+///   order, position the leg angle in the gait's frame (rad), velocity from Present Velocity
+///   (rad/s, the shaft's sense), effort the drive torque `K_t I` (N m) — what
+///   `infer --servo-log run.mcap` reads back;
+/// - `/sandslope/commands` (`sensor_msgs/JointState`, one per cycle): the goal position sent,
+///   as the shaft's angle (rad, Goal Position x 2 pi / 4096);
+/// - `/sandslope/live` (`std_msgs/Float64MultiArray`, one per stance with `--live`):
+///   [`LIVE_FIELDS`];
+/// - `/sandslope/verdict` (`std_msgs/String`, at the end): how the run ended.
+///
+/// Times are gait times, the clock started at the first row (the stand-up's negative times
+/// kept in order).
+pub fn drive_mcap(
+    rows: &[crate::servo_log::ServoLogRow],
+    live: &[LiveRecord],
+    meta: &[(&str, String)],
+    verdict: &str,
+) -> Result<Vec<u8>> {
+    use crate::bag::messages::{ArrayDimension, ArrayLayout, Float64Array, StringMsg};
+    use sandslope::servo::xl330;
+    let offset = rows.iter().map(|r| r.time_s).fold(0.0f64, f64::min).abs();
+    let legs = rows.iter().map(|r| r.leg + 1).max().unwrap_or(0);
+    let names: Vec<String> = (0..legs).map(|j| format!("leg_{j}")).collect();
+    let mut out = McapOut::new()?;
+    let text: String = meta.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
+    out.write("/sandslope/run", ns(rows.first().map_or(0.0, |r| r.time_s), offset), &StringMsg { data: text })?;
+    let mut live = live.iter().peekable();
+    let mut end = 0;
+    let mut last_ns = 0;
+    while end < rows.len() {
+        // One bus cycle: the rows at one time.
+        let start = end;
+        while end < rows.len() && rows[end].time_s == rows[start].time_s {
+            end += 1;
+        }
+        let cycle = &rows[start..end];
+        let t_ns = ns(cycle[0].time_s, offset).max(last_ns);
+        while let Some(l) = live.next_if(|l| l.time_s <= cycle[0].time_s) {
+            let at = ns(l.time_s, offset).max(last_ns);
+            let layout = ArrayLayout {
+                dim: vec![ArrayDimension { label: LIVE_FIELDS.join(","), size: 10, stride: 10 }],
+                data_offset: 0,
+            };
+            out.write("/sandslope/live", at, &Float64Array { layout, data: l.values.to_vec() })?;
+            last_ns = at;
+        }
+        let t_ns = t_ns.max(last_ns);
+        let mut state = JointState { header: header(t_ns, ""), ..JointState::default() };
+        let mut command = JointState { header: header(t_ns, ""), ..JointState::default() };
+        for r in cycle {
+            let name = names[r.leg].clone();
+            state.name.push(name.clone());
+            state.position.push(r.leg_angle_rad);
+            state.velocity.push(f64::from(r.present_velocity) * xl330::RAD_S_PER_VELOCITY_UNIT);
+            state.effort.push(r.drive_torque_n_m);
+            command.name.push(name);
+            command.position.push(f64::from(r.goal_position) * xl330::RAD_PER_PULSE);
+        }
+        out.write("/joint_states", t_ns, &state)?;
+        out.write("/sandslope/commands", t_ns, &command)?;
+        last_ns = t_ns;
+    }
+    for l in live {
+        let at = ns(l.time_s, offset).max(last_ns);
+        let layout =
+            ArrayLayout { dim: vec![ArrayDimension { label: LIVE_FIELDS.join(","), size: 10, stride: 10 }], data_offset: 0 };
+        out.write("/sandslope/live", at, &Float64Array { layout, data: l.values.to_vec() })?;
+        last_ns = at;
+    }
+    out.write("/sandslope/verdict", last_ns, &StringMsg { data: verdict.to_string() })?;
+    out.finish()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

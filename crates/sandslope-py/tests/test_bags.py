@@ -289,3 +289,78 @@ def test_bad_bags_name_file_topic_and_offset(walk, tmp_path):
     (forged / "metadata.yaml").write_text(meta.replace(f"message_count: {len(rows)}", "message_count: 1000000000"))
     err = run("track", forged, "--topic", "/pose", code=2).stderr
     assert "metadata.yaml" in err and "1000000000" in err, err
+
+
+def read_back(path):
+    """Every message of an MCAP file sandslope wrote, decoded by `mcap` + `mcap-ros2-support` and
+    by `rosbags`: {topic: [(log_time, message), ...]} from the first, the count from the second."""
+    from rosbags.highlevel import AnyReader
+    topics = {}
+    with open(path, "rb") as f:
+        for _schema, channel, message, decoded in make_reader(f, decoder_factories=[DecoderFactory()]).iter_decoded_messages():
+            assert channel.message_encoding == "cdr" and _schema.encoding == "ros2msg"
+            topics.setdefault(channel.topic, []).append((message.log_time, decoded))
+    with AnyReader([Path(path)]) as r:
+        decoded = sum(1 for c, _t, raw in r.messages() if r.deserialize(raw, c.msgtype) is not None)
+    assert decoded == sum(len(v) for v in topics.values())
+    for items in topics.values():
+        times = [t for t, _ in items]
+        assert times == sorted(times), "log times must not go back"
+    return topics
+
+
+def test_simulate_out_mcap_reads_back_and_tracks_as_the_csv(walk):
+    d, _, rows, expected = walk
+    path = d / "walk.mcap"
+    run("simulate", "--slope", "10", "--duration", "6", "--out", path)
+    topics = read_back(path)
+    assert set(topics) == {"/sandslope/pose", "/tf", "/joint_states", "/sandslope/leg_forces"}
+    assert all(len(v) == len(rows) for v in topics.values())
+    # The pose is the CSV's position; the TF tree is world -> base_link -> leg_0..leg_5.
+    _, last = topics["/sandslope/pose"][-1]
+    assert [last.pose.position.x, last.pose.position.y, last.pose.position.z] == pytest.approx(list(rows[-1][1]), abs=1e-12)
+    _, tf = topics["/tf"][0]
+    assert [t.child_frame_id for t in tf.transforms] == ["base_link"] + [f"leg_{j}" for j in range(6)]
+    assert_same_track(run_json("track", path, "--topic", "/sandslope/pose", "--slope", "10"), expected)
+
+
+def test_drive_log_mcap_reads_back_and_infers(tmp_path):
+    path = tmp_path / "run.mcap"
+    run("drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "4", "--live", "--log", path)
+    topics = read_back(path)
+    assert {"/sandslope/run", "/joint_states", "/sandslope/commands", "/sandslope/verdict"} <= set(topics)
+    assert len(topics["/joint_states"]) == len(topics["/sandslope/commands"]) > 100
+    assert "slope_deg = 20" in topics["/sandslope/run"][0][1].data
+    assert len(topics.get("/sandslope/live", [])) >= 1
+    _, js = topics["/joint_states"][-1]
+    assert list(js.name) == [f"leg_{j}" for j in range(6)]
+    got = run_json("infer", "--servo-log", path, *INFER)
+    assert got["k_s_lo"] < got["k_s"] < got["k_s_hi"]
+
+
+def test_plan_risk_map_as_nav2_map_and_occupancy_grid(tmp_path):
+    import sandslope
+    from ruamel.yaml import YAML  # installed with rosbags
+    dem = ROOT / "examples" / "planning" / "dune.asc"
+    args = ("plan", "--dem", dem, "--start", "52,30", "--goal", "30,30", "--objective", "time,risk")
+    run(*args, "--risk-map", tmp_path / "risk.tif")
+    run(*args, "--risk-map", tmp_path / "risk.yaml")
+    run(*args, "--risk-map", tmp_path / "risk.mcap")
+    p_fail, _geo = sandslope.read_raster(tmp_path / "risk.tif")
+    meta = YAML(typ="safe").load((tmp_path / "risk.yaml").read_text())
+    assert meta["image"] == "risk.pgm" and meta["mode"] == "raw" and meta["negate"] == 0
+    assert meta["resolution"] == pytest.approx(0.3) and meta["origin"] == [0.0, 0.0, 0.0]
+    assert meta["occupied_thresh"] == 0.05 and meta["free_thresh"] == 0.0
+    pgm = (tmp_path / "risk.pgm").read_bytes()
+    assert pgm.startswith(b"P5\n")
+    body = pgm.split(b"\n255\n", 1)[1]
+    pixels = np.frombuffer(body, np.uint8).reshape(200, 200)
+    want = np.where(np.isfinite(p_fail), np.round(100 * np.nan_to_num(p_fail)), 255)
+    assert (pixels == want.reshape(200, 200)).all()
+    topics = read_back(tmp_path / "risk.mcap")
+    _, grid = topics["/sandslope/risk_map"][0]
+    assert (grid.info.width, grid.info.height) == (200, 200) and grid.info.resolution == pytest.approx(0.3)
+    # OccupancyGrid's row 0 is the south edge: the image's last row.
+    data = np.asarray(grid.data, np.int16).reshape(200, 200)
+    assert (data[0] == np.where(pixels[-1] == 255, -1, pixels[-1])).all()
+    assert {"/sandslope/route/time", "/sandslope/route/risk"} <= set(topics)

@@ -285,7 +285,8 @@ impl EffortUnit {
 /// How joint states become a servo log.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointOptions<'a> {
-    /// The `JointState` topic; the only one when `None`.
+    /// The `JointState` topic; when `None`, `/joint_states` if the bag has it, else the only
+    /// `JointState` topic.
     pub topic: Option<&'a str>,
     /// Joint names in leg order (leg 0 first); the message's own order when `None` and it
     /// names exactly `legs` joints.
@@ -306,7 +307,14 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
     let types = [JointState::TYPE];
     let name = match options.topic {
         Some(t) => t.to_string(),
-        None => pick_topic(path, &scan(&bag, None, &mut |_| Ok(()))?, None, &types, "--topic")?.name,
+        None => {
+            // ROS's own name for the robot's joint states wins among several.
+            let all = scan(&bag, None, &mut |_| Ok(()))?;
+            match all.iter().find(|t| t.name == "/joint_states" && messages::same_type(&t.type_name, JointState::TYPE)) {
+                Some(t) => t.name.clone(),
+                None => pick_topic(path, &all, None, &types, "--topic")?.name,
+            }
+        }
     };
     let legs = options.legs;
     let mut map: Option<Vec<String>> = options.joints.map(<[String]>::to_vec);

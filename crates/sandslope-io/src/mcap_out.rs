@@ -50,7 +50,10 @@ impl McapOut {
         let schema = match self.schemas.get(T::TYPE) {
             Some(&id) => id,
             None => {
-                let id = self.writer.add_schema(T::TYPE, "ros2msg", T::definition().as_bytes()).map_err(mcap_error)?;
+                let id = self
+                    .writer
+                    .add_schema(T::TYPE, "ros2msg", T::definition().as_bytes())
+                    .map_err(mcap_error)?;
                 self.schemas.insert(T::TYPE, id);
                 id
             }
@@ -58,13 +61,18 @@ impl McapOut {
         let (channel, sequence) = match self.channels.get(topic) {
             Some(&c) => c,
             None => {
-                let id = self.writer.add_channel(schema, topic, "cdr", &BTreeMap::new()).map_err(mcap_error)?;
+                let id =
+                    self.writer.add_channel(schema, topic, "cdr", &BTreeMap::new()).map_err(mcap_error)?;
                 (id, 0)
             }
         };
         self.channels.insert(topic.to_string(), (channel, sequence.wrapping_add(1)));
-        let header =
-            mcap::records::MessageHeader { channel_id: channel, sequence, log_time: time_ns, publish_time: time_ns };
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence,
+            log_time: time_ns,
+            publish_time: time_ns,
+        };
         self.writer.write_to_known_channel(&header, &msg::encode(message)).map_err(mcap_error)
     }
 
@@ -116,7 +124,8 @@ pub fn simulation_mcap(
     let names: Vec<String> = (0..legs).map(|j| format!("leg_{j}")).collect();
     let offset = trajectory.time_s.first().map_or(0.0, |t| (-t).max(0.0));
     let mut out = McapOut::new()?;
-    let at = |v: &Vec<Vec<f64>>, j: usize, i: usize| v.get(j).and_then(|l| l.get(i)).copied().unwrap_or(f64::NAN);
+    let at =
+        |v: &Vec<Vec<f64>>, j: usize, i: usize| v.get(j).and_then(|l| l.get(i)).copied().unwrap_or(f64::NAN);
     for (i, &t) in trajectory.time_s.iter().enumerate() {
         let t_ns = ns(t, offset);
         let (wx, wz) = world(trajectory.x_m[i], trajectory.z_m[i]);
@@ -229,7 +238,11 @@ pub fn drive_mcap(
     let names: Vec<String> = (0..legs).map(|j| format!("leg_{j}")).collect();
     let mut out = McapOut::new()?;
     let text: String = meta.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
-    out.write("/sandslope/run", ns(rows.first().map_or(0.0, |r| r.time_s), offset), &StringMsg { data: text })?;
+    out.write(
+        "/sandslope/run",
+        ns(rows.first().map_or(0.0, |r| r.time_s), offset),
+        &StringMsg { data: text },
+    )?;
     let mut live = live.iter().peekable();
     let mut end = 0;
     let mut last_ns = 0;
@@ -268,8 +281,10 @@ pub fn drive_mcap(
     }
     for l in live {
         let at = ns(l.time_s, offset).max(last_ns);
-        let layout =
-            ArrayLayout { dim: vec![ArrayDimension { label: LIVE_FIELDS.join(","), size: 10, stride: 10 }], data_offset: 0 };
+        let layout = ArrayLayout {
+            dim: vec![ArrayDimension { label: LIVE_FIELDS.join(","), size: 10, stride: 10 }],
+            data_offset: 0,
+        };
         out.write("/sandslope/live", at, &Float64Array { layout, data: l.values.to_vec() })?;
         last_ns = at;
     }
@@ -328,5 +343,4 @@ mod tests {
         // Pitched nose-up by 30 degrees: a rotation about y by -30 degrees.
         assert!((p.pose.orientation.y - (-15f64.to_radians()).sin()).abs() < 1e-12);
     }
-
 }

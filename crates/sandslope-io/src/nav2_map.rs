@@ -62,8 +62,11 @@ pub fn write_nav2_map(yaml: &Path, dem: &Raster, p_fail: &[f32]) -> Result<()> {
     let (resolution, west, south, _) = geometry(dem)?;
     let pgm = pgm_path(yaml);
     let image = pgm.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let mut bytes = format!("P5\n# sandslope plan --risk-map: 100 p_fail per cell, 255 no value\n{} {}\n255\n", dem.cols, dem.rows)
-        .into_bytes();
+    let mut bytes = format!(
+        "P5\n# sandslope plan --risk-map: 100 p_fail per cell, 255 no value\n{} {}\n255\n",
+        dem.cols, dem.rows
+    )
+    .into_bytes();
     bytes.extend(p_fail.iter().map(|&p| match occupancy(f64::from(p)) {
         -1 => 255u8,
         v => v as u8,
@@ -76,16 +79,24 @@ pub fn write_nav2_map(yaml: &Path, dem: &Raster, p_fail: &[f32]) -> Result<()> {
          occupied_thresh: {}\nfree_thresh: 0.0\n",
         sandslope::risk::DEFAULT_MAX_RISK
     );
-    write_output(&pgm, |out| out.write_all(&bytes).map_err(|source| WriteError { path: pgm.clone(), source }.into()))?;
+    write_output(&pgm, |out| {
+        out.write_all(&bytes).map_err(|source| WriteError { path: pgm.clone(), source }.into())
+    })?;
     write_output(yaml, |out| {
-        out.write_all(text.as_bytes()).map_err(|source| WriteError { path: yaml.to_path_buf(), source }.into())
+        out.write_all(text.as_bytes())
+            .map_err(|source| WriteError { path: yaml.to_path_buf(), source }.into())
     })
 }
 
 /// The risk raster as a `nav_msgs/OccupancyGrid` on `/sandslope/risk_map` in [`MAP_FRAME`]
 /// (row 0 south) and each route found as a `nav_msgs/Path` of its cell centres on
 /// `/sandslope/route/<objective>`, written to an MCAP file at time 0.
-pub fn write_map_mcap(path: &Path, dem: &Raster, p_fail: &[f32], routes: &crate::routes::Routes) -> Result<()> {
+pub fn write_map_mcap(
+    path: &Path,
+    dem: &Raster,
+    p_fail: &[f32],
+    routes: &crate::routes::Routes,
+) -> Result<()> {
     let (resolution, west, south, per_unit) = geometry(dem)?;
     let mut data = Vec::with_capacity(p_fail.len());
     for row in (0..dem.rows).rev() {
@@ -114,11 +125,17 @@ pub fn write_map_mcap(path: &Path, dem: &Raster, p_fail: &[f32], routes: &crate:
                 let (x, y) = dem.geo.centre(c.col, c.row);
                 PoseStamped {
                     header: header.clone(),
-                    pose: Pose { position: Point { x: x * per_unit, y: y * per_unit, z: 0.0 }, ..Pose::default() },
+                    pose: Pose {
+                        position: Point { x: x * per_unit, y: y * per_unit, z: 0.0 },
+                        ..Pose::default()
+                    },
                 }
             })
             .collect();
-        let topic = format!("/sandslope/route/{}", objective.name().replace(|c: char| !c.is_ascii_alphanumeric(), "_"));
+        let topic = format!(
+            "/sandslope/route/{}",
+            objective.name().replace(|c: char| !c.is_ascii_alphanumeric(), "_")
+        );
         out.write(&topic, 0, &NavPath { header: header.clone(), poses })?;
     }
     let bytes = out.finish()?;

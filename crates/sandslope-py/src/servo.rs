@@ -294,6 +294,7 @@ pub fn read_bag_joints<'py>(
         legs,
         effort,
     };
-    let log = py.detach(|| sandslope_io::bag::series::read_joint_states(&path, &options)).map_err(anyhow_error)?;
+    let log =
+        py.detach(|| sandslope_io::bag::series::read_joint_states(&path, &options)).map_err(anyhow_error)?;
     Ok((log_columns(py, &log.rows)?, log.notes))
 }

@@ -241,7 +241,12 @@ impl ServoLogRequest {
 
     /// As [`read`](Self::read), for a log already read (a ROS 2 bag's joint states,
     /// `sandslope_io::bag::series::read_joint_states`); `path` names it in errors.
-    pub fn read_log(&self, log: sandslope_io::servo_log::ServoLog, robot: &Robot, words: Words) -> Result<ServoLogRun> {
+    pub fn read_log(
+        &self,
+        log: sandslope_io::servo_log::ServoLog,
+        robot: &Robot,
+        words: Words,
+    ) -> Result<ServoLogRun> {
         let prior = prior_in(words, self.k_s_prior)?;
         let grid_points = servo_grid_points(words, self.grid_points)?;
         let path = self.path.as_path();

@@ -351,8 +351,7 @@ pub fn same_type(recorded: &str, ours: &str) -> bool {
     recorded == ours || recorded.replace("/msg/", "/") == ours.replace("/msg/", "/")
 }
 
-const SEPARATOR: &str =
-    "================================================================================\n";
+const SEPARATOR: &str = "================================================================================\n";
 
 fn with_deps(own: &str, deps: &[&str]) -> String {
     let mut s = own.to_string();
@@ -415,17 +414,99 @@ macro_rules! ros_message {
 }
 
 const STAMP_DEPS: [&str; 2] = ["std_msgs/Header", "builtin_interfaces/Time"];
-ros_message!(PoseStamped, "geometry_msgs/msg/PoseStamped", POSE_STAMPED, [STAMP_DEPS[0], STAMP_DEPS[1], "geometry_msgs/Pose", "geometry_msgs/Point", "geometry_msgs/Quaternion"]);
-ros_message!(TransformStamped, "geometry_msgs/msg/TransformStamped", TRANSFORM_STAMPED, [STAMP_DEPS[0], STAMP_DEPS[1], "geometry_msgs/Transform", "geometry_msgs/Vector3", "geometry_msgs/Quaternion"]);
-ros_message!(TfMessage, "tf2_msgs/msg/TFMessage", "geometry_msgs/TransformStamped[] transforms\n", ["geometry_msgs/TransformStamped", STAMP_DEPS[0], STAMP_DEPS[1], "geometry_msgs/Transform", "geometry_msgs/Vector3", "geometry_msgs/Quaternion"]);
+ros_message!(
+    PoseStamped,
+    "geometry_msgs/msg/PoseStamped",
+    POSE_STAMPED,
+    [STAMP_DEPS[0], STAMP_DEPS[1], "geometry_msgs/Pose", "geometry_msgs/Point", "geometry_msgs/Quaternion"]
+);
+ros_message!(
+    TransformStamped,
+    "geometry_msgs/msg/TransformStamped",
+    TRANSFORM_STAMPED,
+    [
+        STAMP_DEPS[0],
+        STAMP_DEPS[1],
+        "geometry_msgs/Transform",
+        "geometry_msgs/Vector3",
+        "geometry_msgs/Quaternion"
+    ]
+);
+ros_message!(
+    TfMessage,
+    "tf2_msgs/msg/TFMessage",
+    "geometry_msgs/TransformStamped[] transforms\n",
+    [
+        "geometry_msgs/TransformStamped",
+        STAMP_DEPS[0],
+        STAMP_DEPS[1],
+        "geometry_msgs/Transform",
+        "geometry_msgs/Vector3",
+        "geometry_msgs/Quaternion"
+    ]
+);
 ros_message!(Odometry, "nav_msgs/msg/Odometry", "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/PoseWithCovariance pose\ngeometry_msgs/TwistWithCovariance twist\n", [STAMP_DEPS[0], STAMP_DEPS[1], "geometry_msgs/PoseWithCovariance", "geometry_msgs/Pose", "geometry_msgs/Point", "geometry_msgs/Quaternion", "geometry_msgs/TwistWithCovariance", "geometry_msgs/Twist", "geometry_msgs/Vector3"]);
-ros_message!(JointState, "sensor_msgs/msg/JointState", "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n", [STAMP_DEPS[0], STAMP_DEPS[1]]);
-ros_message!(WrenchStamped, "geometry_msgs/msg/WrenchStamped", "std_msgs/Header header\ngeometry_msgs/Wrench wrench\n", [STAMP_DEPS[0], STAMP_DEPS[1], "geometry_msgs/Wrench", "geometry_msgs/Vector3"]);
-ros_message!(OccupancyGrid, "nav_msgs/msg/OccupancyGrid", "std_msgs/Header header\nnav_msgs/MapMetaData info\nint8[] data\n", [STAMP_DEPS[0], STAMP_DEPS[1], "nav_msgs/MapMetaData", "geometry_msgs/Pose", "geometry_msgs/Point", "geometry_msgs/Quaternion"]);
-ros_message!(NavPath, "nav_msgs/msg/Path", "std_msgs/Header header\ngeometry_msgs/PoseStamped[] poses\n", [STAMP_DEPS[0], STAMP_DEPS[1], "geometry_msgs/PoseStamped", "geometry_msgs/Pose", "geometry_msgs/Point", "geometry_msgs/Quaternion"]);
-ros_message!(MarkerArray, "visualization_msgs/msg/MarkerArray", "visualization_msgs/Marker[] markers\n", ["visualization_msgs/Marker", STAMP_DEPS[0], STAMP_DEPS[1], "builtin_interfaces/Duration", "geometry_msgs/Pose", "geometry_msgs/Point", "geometry_msgs/Quaternion", "geometry_msgs/Vector3", "std_msgs/ColorRGBA"]);
+ros_message!(
+    JointState,
+    "sensor_msgs/msg/JointState",
+    "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n",
+    [STAMP_DEPS[0], STAMP_DEPS[1]]
+);
+ros_message!(
+    WrenchStamped,
+    "geometry_msgs/msg/WrenchStamped",
+    "std_msgs/Header header\ngeometry_msgs/Wrench wrench\n",
+    [STAMP_DEPS[0], STAMP_DEPS[1], "geometry_msgs/Wrench", "geometry_msgs/Vector3"]
+);
+ros_message!(
+    OccupancyGrid,
+    "nav_msgs/msg/OccupancyGrid",
+    "std_msgs/Header header\nnav_msgs/MapMetaData info\nint8[] data\n",
+    [
+        STAMP_DEPS[0],
+        STAMP_DEPS[1],
+        "nav_msgs/MapMetaData",
+        "geometry_msgs/Pose",
+        "geometry_msgs/Point",
+        "geometry_msgs/Quaternion"
+    ]
+);
+ros_message!(
+    NavPath,
+    "nav_msgs/msg/Path",
+    "std_msgs/Header header\ngeometry_msgs/PoseStamped[] poses\n",
+    [
+        STAMP_DEPS[0],
+        STAMP_DEPS[1],
+        "geometry_msgs/PoseStamped",
+        "geometry_msgs/Pose",
+        "geometry_msgs/Point",
+        "geometry_msgs/Quaternion"
+    ]
+);
+ros_message!(
+    MarkerArray,
+    "visualization_msgs/msg/MarkerArray",
+    "visualization_msgs/Marker[] markers\n",
+    [
+        "visualization_msgs/Marker",
+        STAMP_DEPS[0],
+        STAMP_DEPS[1],
+        "builtin_interfaces/Duration",
+        "geometry_msgs/Pose",
+        "geometry_msgs/Point",
+        "geometry_msgs/Quaternion",
+        "geometry_msgs/Vector3",
+        "std_msgs/ColorRGBA"
+    ]
+);
 ros_message!(StringMsg, "std_msgs/msg/String", "string data\n", []);
-ros_message!(Float64Array, "std_msgs/msg/Float64MultiArray", "std_msgs/MultiArrayLayout layout\nfloat64[] data\n", ["std_msgs/MultiArrayLayout", "std_msgs/MultiArrayDimension"]);
+ros_message!(
+    Float64Array,
+    "std_msgs/msg/Float64MultiArray",
+    "std_msgs/MultiArrayLayout layout\nfloat64[] data\n",
+    ["std_msgs/MultiArrayLayout", "std_msgs/MultiArrayDimension"]
+);
 
 /// Why a message's bytes are not the type they should be.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -226,13 +226,19 @@ fn open_folder(dir: &Path) -> Result<Bag> {
         let name = rel_path.file_name().ok_or_else(|| {
             anyhow!("{}: relative_file_paths entry `{rel}` is not a file name", meta_path.display())
         })?;
-        if rel_path.components().any(|c| matches!(c, std::path::Component::ParentDir)) || rel_path.is_absolute() {
+        if rel_path.components().any(|c| matches!(c, std::path::Component::ParentDir))
+            || rel_path.is_absolute()
+        {
             bail!("{}: relative_file_paths entry `{rel}` points out of the bag folder", meta_path.display());
         }
         let file = dir.join(name);
         let len = std::fs::metadata(&file)
             .map_err(|e| {
-                anyhow!("{}: relative_file_paths names `{rel}`, but {}: {e}", meta_path.display(), file.display())
+                anyhow!(
+                    "{}: relative_file_paths names `{rel}`, but {}: {e}",
+                    meta_path.display(),
+                    file.display()
+                )
             })?
             .len();
         bytes += len;

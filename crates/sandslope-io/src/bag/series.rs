@@ -8,13 +8,16 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
 
-use super::messages::{self, decode, JointState, Odometry, PoseStamped, RosMessage, TfMessage, TransformStamped};
+use super::messages::{
+    self, decode, JointState, Odometry, PoseStamped, RosMessage, TfMessage, TransformStamped,
+};
 use super::{describe_topics, open, scan, BagMessage, BagTopic};
 use crate::mocap::{Capture, MocapFormat};
 use crate::servo_log::{ServoLog, ServoLogRow};
 
 /// The message types `track --topic` reads a body's position from.
-pub const POSE_TYPES: [&str; 4] = [PoseStamped::TYPE, Odometry::TYPE, TfMessage::TYPE, TransformStamped::TYPE];
+pub const POSE_TYPES: [&str; 4] =
+    [PoseStamped::TYPE, Odometry::TYPE, TfMessage::TYPE, TransformStamped::TYPE];
 
 fn stamp_ns(header: &messages::Header, m: &BagMessage<'_>) -> i64 {
     match header.stamp.nanos() {
@@ -29,7 +32,13 @@ fn decode_at<T: RosMessage>(m: &BagMessage<'_>) -> Result<T> {
 
 /// Picks the topic: the one named (checked to exist and be of one of `types`), or the only
 /// one of those types; otherwise an error listing the candidates. `flag` names the option.
-fn pick_topic(path: &Path, topics: &[BagTopic], wanted: Option<&str>, types: &[&str], flag: &str) -> Result<BagTopic> {
+fn pick_topic(
+    path: &Path,
+    topics: &[BagTopic],
+    wanted: Option<&str>,
+    types: &[&str],
+    flag: &str,
+) -> Result<BagTopic> {
     let fits = |t: &BagTopic| types.iter().any(|w| messages::same_type(&t.type_name, w));
     match wanted {
         Some(w) => {
@@ -134,7 +143,12 @@ pub fn read_capture(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Re
             }
         }
         if samples.len() as u64 > super::MAX_MESSAGES {
-            bail!("{}: topic `{}`: more than {} positions; split the bag", m.at, m.topic, super::MAX_MESSAGES);
+            bail!(
+                "{}: topic `{}`: more than {} positions; split the bag",
+                m.at,
+                m.topic,
+                super::MAX_MESSAGES
+            );
         }
         Ok(())
     })?;
@@ -156,7 +170,11 @@ pub fn read_capture(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Re
     }
     if let Some(f) = &frame {
         if messages::same_type(&t.type_name, PoseStamped::TYPE) {
-            bail!("{}: --frame selects a child frame, but topic `{name}` is {} (no child frame)", path.display(), t.type_name);
+            bail!(
+                "{}: --frame selects a child frame, but topic `{name}` is {} (no child frame)",
+                path.display(),
+                t.type_name
+            );
         }
         if samples.is_empty() {
             bail!("{}: topic `{name}` has no child frame `{f}`; it has: {}", path.display(), list_frames());
@@ -164,7 +182,14 @@ pub fn read_capture(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Re
         body = format!("{name} {f}");
     }
     let (frame_rate_hz, start_time_s, positions) = regular(path, &name, samples)?;
-    Ok(Capture { path: path.to_path_buf(), format: MocapFormat::Plain, body, frame_rate_hz, start_time_s, positions })
+    Ok(Capture {
+        path: path.to_path_buf(),
+        format: MocapFormat::Plain,
+        body,
+        frame_rate_hz,
+        start_time_s,
+        positions,
+    })
 }
 
 fn point(p: messages::Point) -> [f64; 3] {
@@ -310,7 +335,10 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
         None => {
             // ROS's own name for the robot's joint states wins among several.
             let all = scan(&bag, None, &mut |_| Ok(()))?;
-            match all.iter().find(|t| t.name == "/joint_states" && messages::same_type(&t.type_name, JointState::TYPE)) {
+            match all
+                .iter()
+                .find(|t| t.name == "/joint_states" && messages::same_type(&t.type_name, JointState::TYPE))
+            {
                 Some(t) => t.name.clone(),
                 None => pick_topic(path, &all, None, &types, "--topic")?.name,
             }
@@ -369,8 +397,10 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
                     id: leg.min(252) as u8,
                     leg,
                     tripod: leg % 2,
-                    present_position: xl330::pulses_from_rad(angle).clamp(i32::MIN.into(), i32::MAX.into()) as i32,
-                    present_velocity: (velocity / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(-1e9, 1e9) as i32,
+                    present_position: xl330::pulses_from_rad(angle).clamp(i32::MIN.into(), i32::MAX.into())
+                        as i32,
+                    present_velocity: (velocity / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(-1e9, 1e9)
+                        as i32,
                     present_current_ma: current_ma.round().clamp(-1e9, 1e9) as i32,
                     load_percent: 100.0 * current_ma / (xl330::STALL_CURRENT_A * 1000.0),
                     input_voltage_v: 0.0,

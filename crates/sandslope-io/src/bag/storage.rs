@@ -34,7 +34,13 @@ fn record_limit(file_len: u64) -> usize {
 }
 
 /// Counts a message on `name`, checking that the topic keeps one type; returns its index.
-fn count(topics: &mut Vec<BagTopic>, name: &str, type_name: &str, encoding: &str, at: &Location) -> Result<u64> {
+fn count(
+    topics: &mut Vec<BagTopic>,
+    name: &str,
+    type_name: &str,
+    encoding: &str,
+    at: &Location,
+) -> Result<u64> {
     match topics.iter_mut().find(|t| t.name == name) {
         Some(t) => {
             if t.type_name != type_name {
@@ -137,10 +143,12 @@ pub(super) fn scan_sqlite(
     let db_error = |e: rusqlite::Error| {
         anyhow!("{}: {e} (not a rosbag2 SQLite3 storage file, or a damaged one)", path.display())
     };
-    let conn = Connection::open_with_flags(path, OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX)
+    let conn =
+        Connection::open_with_flags(path, OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX)
+            .map_err(db_error)?;
+    let mut stmt = conn
+        .prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id")
         .map_err(db_error)?;
-    let mut stmt =
-        conn.prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id").map_err(db_error)?;
     let declared: Vec<(i64, String, String, String)> = stmt
         .query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?, r.get(3)?)))
         .map_err(db_error)?

@@ -295,7 +295,14 @@ fn run_full(args: &PlanArgs, planned: &Planned) -> Result<()> {
         match p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
             Some("yaml" | "yml") => sandslope_io::nav2_map::write_nav2_map(p, dem, &risk.p_fail)?,
             Some("mcap") => sandslope_io::nav2_map::write_map_mcap(p, dem, &risk.p_fail, &result.routes)?,
-            _ => write_two_band_geotiff(p, dem.cols, dem.rows, &dem.geo, &risk.p_fail, &risk.climb_azimuth_deg)?,
+            _ => write_two_band_geotiff(
+                p,
+                dem.cols,
+                dem.rows,
+                &dem.geo,
+                &risk.p_fail,
+                &risk.climb_azimuth_deg,
+            )?,
         }
     }
     if let (Some(p), Some(risk)) = (&args.out.plot, &result.risk) {

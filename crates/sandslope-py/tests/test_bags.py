@@ -339,14 +339,15 @@ def test_drive_log_mcap_reads_back_and_infers(tmp_path):
 
 
 def test_plan_risk_map_as_nav2_map_and_occupancy_grid(tmp_path):
-    import sandslope
+    import tifffile
     from ruamel.yaml import YAML  # installed with rosbags
     dem = ROOT / "examples" / "planning" / "dune.asc"
     args = ("plan", "--dem", dem, "--start", "52,30", "--goal", "30,30", "--objective", "time,risk")
     run(*args, "--risk-map", tmp_path / "risk.tif")
     run(*args, "--risk-map", tmp_path / "risk.yaml")
     run(*args, "--risk-map", tmp_path / "risk.mcap")
-    p_fail, _geo = sandslope.read_raster(tmp_path / "risk.tif")
+    bands = tifffile.imread(tmp_path / "risk.tif")  # (rows, cols, 2): p_fail, climb azimuth
+    p_fail = bands[..., 0].astype(np.float64)
     meta = YAML(typ="safe").load((tmp_path / "risk.yaml").read_text())
     assert meta["image"] == "risk.pgm" and meta["mode"] == "raw" and meta["negate"] == 0
     assert meta["resolution"] == pytest.approx(0.3) and meta["origin"] == [0.0, 0.0, 0.0]
@@ -362,5 +363,33 @@ def test_plan_risk_map_as_nav2_map_and_occupancy_grid(tmp_path):
     assert (grid.info.width, grid.info.height) == (200, 200) and grid.info.resolution == pytest.approx(0.3)
     # OccupancyGrid's row 0 is the south edge: the image's last row.
     data = np.asarray(grid.data, np.int16).reshape(200, 200)
-    assert (data[0] == np.where(pixels[-1] == 255, -1, pixels[-1])).all()
+    south = pixels[-1].astype(np.int16)
+    assert (data[0] == np.where(south == 255, -1, south)).all()
     assert {"/sandslope/route/time", "/sandslope/route/risk"} <= set(topics)
+
+
+def test_read_bag_gives_the_csv_columns(walk, servo_run):
+    import sandslope
+    d, csv, rows, _ = walk
+    bag = d / "poses_mcap"  # written by test_track_reads_poses_from_an_mcap_bag_as_from_the_csv
+    if not bag.exists():
+        write_rosbags(bag, StoragePlugin.MCAP, {
+            "/mocap/robot/pose": ("geometry_msgs/msg/PoseStamped", [(ns, pose_stamped(ns, p)) for ns, p in rows])})
+    topics = sandslope.read_bag(bag)
+    assert "/mocap/robot/pose" in list(topics["name"])
+    poses = sandslope.read_bag(bag, "/mocap/robot/pose")
+    expected = pd.read_csv(csv)
+    assert list(poses.columns) == ["time_s", "x_m", "y_m", "z_m"]
+    assert len(poses) == len(expected)
+    for c in ("time_s", "x_m", "y_m", "z_m"):
+        assert np.allclose(poses[c], expected[c], rtol=0, atol=1e-9), c
+    dd, _log, frame = servo_run
+    jbag = dd / "joints_py"
+    write_rosbags(jbag, StoragePlugin.MCAP,
+                  {"/joint_states": ("sensor_msgs/msg/JointState", joint_states(frame, lambda r: r.drive_torque_n_m))})
+    got = sandslope.read_bag(jbag, "/joint_states")
+    want, _meta = sandslope.read_servo_log(_log)
+    for c in ("leg", "leg_angle_rad", "drive_torque_n_m"):
+        assert np.array_equal(got[c].to_numpy(), want[c].to_numpy()), c
+    with pytest.raises(ValueError, match="no topic `/nope`"):
+        sandslope.read_bag(bag, "/nope")

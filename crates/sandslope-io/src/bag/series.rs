@@ -157,8 +157,8 @@ pub fn read_capture(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Re
     let list_frames = || frames.iter().map(|(f, n)| format!("{f} ({n})")).collect::<Vec<_>>().join(", ");
     let is_tf = messages::same_type(&t.type_name, TfMessage::TYPE);
     let mut body = name.clone();
-    if is_tf && frame.is_none() {
-        // No frame given: the only child frame, read again; else the list.
+    if frame.is_none() && (frames.len() > 1 || (is_tf && frames.len() == 1)) {
+        // No frame given: on a TF topic the only child frame, read again; else the list.
         match frames.keys().collect::<Vec<_>>().as_slice() {
             [only] => return read_capture(path, Some(&name), Some(only)),
             _ => bail!(
@@ -445,4 +445,46 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
         })
         .collect();
     Ok(ServoLog { meta: BTreeMap::new(), rows, lines, notes })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Stamps within a quarter step of the grid are snapped (the values kept exactly); one
+    /// off it makes every frame an interpolation, which on a straight line at 1 m/s gives
+    /// x = t at every frame (worked by hand: steps 10, 13, 7, 10 ms, median 10 ms, span 40 ms).
+    #[test]
+    fn positions_are_put_on_the_median_grid() {
+        let path = Path::new("b.mcap");
+        let at = |ms: i64, x: f64| (ms * 1_000_000, [x, 0.0, 0.0]);
+        let (hz, t0, p) =
+            regular(path, "/p", vec![at(0, 5.0), at(11, 6.0), at(19, 7.0), at(30, 8.0)]).unwrap();
+        assert_eq!((hz, t0), (100.0, 0.0));
+        assert_eq!(p.iter().map(|p| p[0]).collect::<Vec<_>>(), vec![5.0, 6.0, 7.0, 8.0]);
+        let line = [0, 10, 23, 30, 40].map(|ms| at(ms, ms as f64 * 1e-3));
+        let (hz, _, p) = regular(path, "/p", line.to_vec()).unwrap();
+        assert!((hz - 100.0).abs() < 1e-9);
+        for (k, v) in p.iter().enumerate() {
+            assert!((v[0] - k as f64 * 0.01).abs() < 1e-15, "frame {k}: {}", v[0]);
+        }
+        // A gap of more than two steps is left as an occlusion, snapped or interpolated (53 ms
+        // is off the 10 ms grid by 0.3 of a step).
+        let (_, _, p) = regular(path, "/p", [0, 10, 20, 50, 60, 70].map(|ms| at(ms, 1.0)).to_vec()).unwrap();
+        assert!(p[3][0].is_nan() && p[4][0].is_nan() && p[2][0] == 1.0 && p[5][0] == 1.0);
+        let (_, _, p) = regular(path, "/p", [0, 10, 20, 53, 60, 70].map(|ms| at(ms, 1.0)).to_vec()).unwrap();
+        assert!(p[3..=5].iter().all(|v| v[0].is_nan()) && p[2][0] == 1.0 && p[6][0] == 1.0);
+        let e = regular(path, "/p", vec![at(0, 1.0)]).unwrap_err().to_string();
+        assert!(e.contains("b.mcap: topic `/p`: 1 position(s)"), "{e}");
+    }
+
+    #[test]
+    fn efforts_become_torques() {
+        assert_eq!("MA".parse::<EffortUnit>().unwrap(), EffortUnit::Milliampere);
+        // K_t = 0.52 N m / 1.47 A: 1.47 A is the stall torque.
+        assert!((EffortUnit::Ampere.torque_n_m(1.47) - 0.52).abs() < 1e-12);
+        assert!((EffortUnit::Milliampere.torque_n_m(1470.0) - 0.52).abs() < 1e-12);
+        assert_eq!(EffortUnit::NewtonMetre.torque_n_m(0.3), 0.3);
+        assert!("volts".parse::<EffortUnit>().is_err());
+    }
 }

@@ -32,7 +32,8 @@ export PATH="$venv/bin:$PATH"
 echo "== installing the Python test tools into $venv"
 "$py" -m pip install --quiet --disable-pip-version-check \
   "maturin>=1.9,<2" "pytest>=7" "numpy>=1.21" "dask[array]>=2023.1" "distributed>=2023.1" \
-  "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1" "rasterio>=1.3"
+  "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1" "rasterio>=1.3" \
+  "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5"
 t1=$(seconds)
 
 echo "== cargo test --workspace --locked"

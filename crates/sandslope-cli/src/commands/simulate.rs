@@ -92,8 +92,10 @@ pub struct SimulateArgs {
     /// Trajectory sample rate for --out, --plot and --animate, Hz.
     #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
     pub rate: f64,
-    /// Write the body's centre as plain motion capture (time_s,x_m,y_m,z_m) for `track`.
-    #[arg(long, value_name = "CSV")]
+    /// Write the body's centre as plain motion capture (time_s,x_m,y_m,z_m) for `track`; a
+    /// name ending .mcap writes ROS 2 messages for Foxglove instead (pose, legs as TF, joint
+    /// states, forces as markers; docs/bags.md).
+    #[arg(long, value_name = "CSV|MCAP")]
     pub out: Option<PathBuf>,
     /// Draw position, leg depths and leg forces against time (one slope), or simulated,
     /// closed-form and observed speeds against slope (--slopes), to FILE (.png or .svg).
@@ -229,7 +231,14 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
         warn_extrapolated(scenario.terrain(), &[slope]);
     }
     // Every output is rendered before any is written, so a failure leaves nothing behind.
-    let csv = args.out.as_ref().map(|_| plain_mocap_csv(&sim.trajectory, slope));
+    // `--out walk.mcap`: ROS 2 messages for Foxglove (docs/bags.md); otherwise the plain CSV.
+    let csv = match &args.out {
+        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("mcap")) => {
+            Some(sandslope_io::mcap_out::simulation_mcap(&sim.trajectory, &sim.geometry, slope)?)
+        }
+        Some(_) => Some(plain_mocap_csv(&sim.trajectory, slope).into_bytes()),
+        None => None,
+    };
     if let Some(path) = &args.plot {
         figures::save(path, &SimulateFigure { sim: &sim, robot: scenario.robot() })?;
     }
@@ -240,7 +249,7 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
         bar.finish_and_clear();
     }
     if let (Some(path), Some(csv)) = (&args.out, &csv) {
-        write_atomic(path, csv.as_bytes())?;
+        write_atomic(path, csv)?;
     }
     let m = &sim.summary;
     match args.format.format() {

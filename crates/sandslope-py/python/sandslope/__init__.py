@@ -46,7 +46,7 @@ from ._inputs import (
 from ._calibrate import calibrate
 from ._report import report
 from ._sandslope import Robot, Terrain
-from ._servo import drive, drive_defaults, infer_servo_log, read_servo_log
+from ._servo import drive, drive_defaults, infer_servo_log, read_bag, read_servo_log
 
 __all__ = [
     "REGIMES",
@@ -75,6 +75,7 @@ __all__ = [
     "infer_servo_log",
     "drive",
     "drive_defaults",
+    "read_bag",
 ]
 
 

@@ -94,6 +94,11 @@ impl<W: Write> ServoLogWriter<W> {
         Ok(())
     }
 
+    /// Flushes the rows written so far to the file (the flight recorder does after every row).
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        self.writer.flush()
+    }
+
     /// Rows written.
     pub fn rows(&self) -> usize {
         self.rows
@@ -102,6 +107,100 @@ impl<W: Write> ServoLogWriter<W> {
     /// Flushes everything.
     pub fn finish(mut self) -> std::io::Result<()> {
         self.writer.flush()
+    }
+}
+
+/// Width of each of the flight recorder's status lines, bytes with the line end: rewritten in
+/// place when the run ends.
+const STATUS_LINE: usize = 100;
+
+/// The status lines' keys, in order: `status` (`incomplete` until the run ends, then how it
+/// ended), the achieved cycle rate and the cycles' jitter.
+pub const STATUS_KEYS: [&str; 4] = ["status", "achieved_rate_hz", "cycle_jitter_ms", "max_cycle_ms"];
+
+/// The value a log's `status` line holds while its run is under way (or after it was killed).
+pub const INCOMPLETE: &str =
+    "incomplete (the run had not ended when this was written: killed, or power lost)";
+
+/// The servo log as a flight recorder (docs/drive.md, "The log"): written under its own name
+/// from the first cycle, every row flushed to the file as it comes and the file synced to the
+/// disk every second, so that a process killed without a word (SIGKILL, the OOM killer) or a
+/// machine that loses power leaves every cycle up to the last second readable. Its first lines
+/// are fixed-width status lines, `# status = incomplete ...` until [`FlightLog::finish`]
+/// rewrites them in place with how the run ended, its achieved rate and jitter.
+#[derive(Debug)]
+pub struct FlightLog {
+    file: std::fs::File,
+    writer: ServoLogWriter<std::io::BufWriter<std::fs::File>>,
+    last_sync: std::time::Instant,
+}
+
+fn status_line(key: &str, value: &str) -> Vec<u8> {
+    let mut line = format!("# {key} = {value}");
+    line.truncate(STATUS_LINE - 1);
+    let mut bytes = format!("{line:<width$}\n", width = STATUS_LINE - 1).into_bytes();
+    bytes.truncate(STATUS_LINE);
+    bytes
+}
+
+impl FlightLog {
+    /// Creates the log at `path` with `meta` as its header. A file already there is replaced
+    /// (removed, then a new one created `O_EXCL`, so nothing planted in between is opened); a
+    /// symbolic link, a folder or a device at `path` is refused.
+    pub fn create(path: &Path, meta: &[(&str, String)]) -> Result<FlightLog> {
+        match std::fs::symlink_metadata(path) {
+            Ok(m) if m.file_type().is_symlink() => bail!(
+                "--log {}: a symbolic link; give the log's own path (a link could point at a file that is not a log)",
+                path.display()
+            ),
+            Ok(m) if !m.is_file() => {
+                bail!("--log {}: not a regular file (a folder or a device); give a file's path", path.display())
+            }
+            Ok(_) => std::fs::remove_file(path)
+                .with_context(|| format!("cannot replace the servo log {}", path.display()))?,
+            Err(_) => {}
+        }
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(path)
+            .map_err(|source| crate::WriteError { path: path.to_path_buf(), source })?;
+        let mut out = std::io::BufWriter::new(file.try_clone()?);
+        for key in STATUS_KEYS {
+            out.write_all(&status_line(key, if key == "status" { INCOMPLETE } else { "" }))?;
+        }
+        let mut writer = ServoLogWriter::new(out, meta)?;
+        writer.flush()?;
+        Ok(FlightLog { file, writer, last_sync: std::time::Instant::now() })
+    }
+
+    /// Appends a row, flushed to the file at once and synced to the disk once a second.
+    pub fn write(&mut self, row: &ServoLogRow) -> std::io::Result<()> {
+        self.writer.write(row)?;
+        self.writer.flush()?;
+        if self.last_sync.elapsed().as_secs_f64() >= 1.0 {
+            self.file.sync_data()?;
+            self.last_sync = std::time::Instant::now();
+        }
+        Ok(())
+    }
+
+    /// Rows written.
+    pub fn rows(&self) -> usize {
+        self.writer.rows()
+    }
+
+    /// Ends the log: the rows flushed, the status lines rewritten with `status` (the values of
+    /// [`STATUS_KEYS`] in order), and the file synced.
+    pub fn finish(self, status: &[String; 4]) -> std::io::Result<()> {
+        let FlightLog { file, writer, .. } = self;
+        writer.finish()?;
+        let mut head = Vec::with_capacity(4 * STATUS_LINE);
+        for (key, value) in STATUS_KEYS.iter().zip(status) {
+            head.extend(status_line(key, value));
+        }
+        std::os::unix::fs::FileExt::write_all_at(&file, &head, 0)?;
+        file.sync_all()
     }
 }
 
@@ -200,8 +299,8 @@ fn some_lines(lines: &[usize]) -> String {
 /// time, ID or leg is missing, a field that is not a number, a row with the wrong number of
 /// fields, one servo with two different rows at one time, one ID on two legs.
 pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read servo log {}", path.display()))?;
+    let text = read_log_text(path)?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let mut meta = BTreeMap::new();
     let mut header_lines = 0usize;
     for line in text.lines() {
@@ -212,6 +311,12 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
         }
     }
     let mut notes = vec![];
+    if meta.get("status").is_some_and(|v| v.starts_with("incomplete")) {
+        notes.push(
+            "the log is marked incomplete: its run did not end (the process was killed or the machine lost power); its rows are what was written up to then"
+                .to_string(),
+        );
+    }
     let mut body_lines: Vec<&str> = text.lines().skip(header_lines).collect();
     if !text.is_empty() && !text.ends_with('\n') && body_lines.len() > 1 {
         let line = header_lines + body_lines.len();
@@ -265,6 +370,18 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
             missing.push(line);
             continue;
         }
+        if let Some((k, (lo, hi, unit))) = PLAUSIBLE
+            .iter()
+            .enumerate()
+            .find_map(|(k, r)| r.filter(|(lo, hi, _)| !(*lo..=*hi).contains(&v[k])).map(|r| (k, r)))
+        {
+            bail!(
+                "{}: `{}` = {} is outside {lo} to {hi} {unit}, the plausible range of a Dynamixel's reading (is the column in the log's unit?)",
+                at(),
+                COLUMNS[k],
+                v[k]
+            );
+        }
         let int = |k: usize, lo: i64, hi: i64| whole(v[k], COLUMNS[k], lo, hi, &at);
         rows.push(ServoLogRow {
             time_s: v[0],
@@ -299,6 +416,68 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
         bail!("{}: the log has no complete rows", path.display());
     }
     Ok(ServoLog { meta, rows, lines, notes })
+}
+
+/// The plausible range of each column, in the order of [`COLUMNS`] (`None`: any finite value):
+/// wide enough for every Dynamixel X servo (the XM430-W350 stalls at 4.1 N m, 2.3 A, and runs
+/// on up to 14.8 V), narrow enough to catch a column in the wrong unit (torque in N mm, current
+/// in A) or garbage such as 1e300.
+const PLAUSIBLE: [Option<(f64, f64, &str)>; 14] = [
+    Some((-1e6, 1e6, "s")),
+    None,
+    None,
+    None,
+    None,
+    None,
+    Some((-10_000.0, 10_000.0, "mA")),
+    Some((-1000.0, 1000.0, "%")),
+    Some((0.0, 30.0, "V")),
+    Some((-40.0, 150.0, "degC")),
+    None,
+    None,
+    Some((-1e7, 1e7, "rad")),
+    Some((-20.0, 20.0, "N m")),
+];
+
+/// Largest servo log read, bytes (a little above [`MAX_ROWS`] rows of about 120 bytes).
+pub const MAX_LOG_BYTES: u64 = 1 << 30;
+
+/// Longest line of a servo log, bytes (a row is about 120).
+pub const MAX_LINE_BYTES: usize = 64 * 1024;
+
+/// The log's text, its size checked before anything is read and every line's length as it is
+/// read (a file of no line ends is refused at its first 64 KiB, not read whole).
+fn read_log_text(path: &Path) -> Result<String> {
+    use std::io::BufRead;
+    let cannot = || format!("cannot read servo log {}", path.display());
+    let file = std::fs::File::open(path).with_context(cannot)?;
+    let size = file.metadata().with_context(cannot)?.len();
+    if size > MAX_LOG_BYTES {
+        bail!(
+            "{}: {size} bytes, more than the {MAX_LOG_BYTES} a servo log may hold ({MAX_ROWS} rows); split the log",
+            path.display()
+        );
+    }
+    let mut reader = std::io::BufReader::new(file);
+    let mut bytes = Vec::with_capacity(size as usize);
+    let mut line = 0usize;
+    loop {
+        line += 1;
+        let before = bytes.len();
+        let n = std::io::Read::take(&mut reader, MAX_LINE_BYTES as u64 + 1)
+            .read_until(b'\n', &mut bytes)
+            .with_context(cannot)?;
+        if n == 0 {
+            break;
+        }
+        if bytes.len() - before > MAX_LINE_BYTES && bytes.last() != Some(&b'\n') {
+            bail!(
+                "{}: line {line} is longer than {MAX_LINE_BYTES} bytes (a row is about 120): not a servo log, or its line ends are missing",
+                path.display()
+            );
+        }
+    }
+    String::from_utf8(bytes).map_err(|e| anyhow!("{}: not UTF-8 text ({e})", path.display()))
 }
 
 /// Sorts the rows by time, reads a repeated row once, refuses two different rows of one servo

@@ -235,18 +235,9 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
     let (report, mut failure) = match driven {
         Ok((report, failure)) => (report, failure.map(|e| e.to_string())),
         // The log could not be started (nothing moved).
-        Err(e) => (
-            DriveReport {
-                outcome: Err(format!("{e:#}")),
-                cycles: 0,
-                rate_hz: 0.0,
-                live: vec![],
-                leg_speed_rad_s: None,
-                torque_off: TorqueOff::default(),
-                gait_zero: None,
-            },
-            Some(format!("the log could not be written: {e:#}")),
-        ),
+        Err(e) => {
+            (DriveReport::not_started(format!("{e:#}")), Some(format!("the log could not be written: {e:#}")))
+        }
     };
     if let (Err(e), None) = (committed, &failure) {
         failure = Some(format!("the log could not be put in place: {e:#}"));

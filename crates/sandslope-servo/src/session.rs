@@ -226,6 +226,14 @@ impl Session {
         &self.config
     }
 
+    /// What the bus can carry ([`crate::plan::bus_budget`]): the serial port's baud rate, the
+    /// servos, Return Delay Time 0 (the setup writes it) and the adapter's latency timer (as
+    /// Linux shows it; 16 ms, the FTDI driver's default, where it does not say); `None` for the
+    /// emulator, whose pseudo-terminal moves bytes at once.
+    pub fn bus_budget(&self) -> Option<crate::plan::BusBudget> {
+        bus_budget_of(&self.config)
+    }
+
     /// Whether the bus is the emulator's.
     pub fn emulated(&self) -> bool {
         self.emulator.is_some()
@@ -262,6 +270,21 @@ impl Session {
         self.emulator.map(|e| e.stop(zero))
     }
 }
+
+/// [`Session::bus_budget`] of a run not yet opened.
+pub fn bus_budget_of(config: &DriveConfig) -> Option<crate::plan::BusBudget> {
+    match &config.bus {
+        BusChoice::Emulate(_) => None,
+        BusChoice::Port { path, baud } => {
+            let latency = crate::plan::usb_latency_s(path).unwrap_or(DEFAULT_USB_LATENCY_S);
+            Some(crate::plan::bus_budget(*baud, config.settings.servos.len(), 0.0, latency))
+        }
+    }
+}
+
+/// The USB-serial latency timer assumed where the system does not show it, s: 16 ms, the Linux
+/// FTDI driver's default (the U2D2 is an FTDI FT232H).
+pub const DEFAULT_USB_LATENCY_S: f64 = 0.016;
 
 /// The servos of a robot file without a `[servos]` table: IDs 1 to `legs` in leg order, the
 /// first half (the left side) turning positive and the second half mirrored, zero offsets 0

@@ -39,6 +39,8 @@ pub const STATUS_RETURN_LEVEL: u16 = 68;
 pub const HARDWARE_ERROR_STATUS: u16 = 70;
 /// Bus Watchdog (1), 20 ms units (0 off; the servo sets 100 when it has fired).
 pub const BUS_WATCHDOG: u16 = 98;
+/// Goal Current (2, signed), mA (within plus or minus the Current Limit).
+pub const GOAL_CURRENT: u16 = 102;
 /// Goal Velocity (4), 0.229 rev/min.
 pub const GOAL_VELOCITY: u16 = 104;
 /// Profile Acceleration (4), 214.577 rev/min^2 (velocity-based profile).
@@ -115,7 +117,40 @@ impl PresentState {
 pub(crate) type StateRead = Result<(PresentState, bool), dynamixel2::ReadError>;
 
 /// Reads every servo's state block; per servo `Ok((state, alert))` or the read error.
+///
+/// The replies are matched to their IDs: when a servo does not answer, `dynamixel2` reads the
+/// next servo's reply in its place (and refuses it, a wrong packet ID), so every servo after a
+/// silent one would lose its row. The IDs whose replies were seen in another's place answered:
+/// they are read again on their own Sync Read, and only the silent servo loses its row.
 pub(crate) fn read_states(
+    bus: &mut dynamixel2::Bus<Vec<u8>, Vec<u8>>,
+    ids: &[u8],
+) -> Result<Vec<StateRead>, String> {
+    let mut out = read_states_once(bus, ids)?;
+    let answered: Vec<u8> = out
+        .iter()
+        .filter_map(|r| match r {
+            Err(dynamixel2::ReadError::InvalidMessage(dynamixel2::InvalidMessage::InvalidPacketId(e))) => {
+                Some(e.actual)
+            }
+            _ => None,
+        })
+        .collect();
+    let again: Vec<usize> =
+        (0..ids.len()).filter(|&k| out[k].is_err() && answered.contains(&ids[k])).collect();
+    if !again.is_empty() && again.len() < ids.len() {
+        let retry: Vec<u8> = again.iter().map(|&k| ids[k]).collect();
+        for (&k, r) in again.iter().zip(read_states_once(bus, &retry)?) {
+            if r.is_ok() {
+                out[k] = r;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// One Sync Read of the state block, each reply in its ID's slot in the order asked.
+fn read_states_once(
     bus: &mut dynamixel2::Bus<Vec<u8>, Vec<u8>>,
     ids: &[u8],
 ) -> Result<Vec<StateRead>, String> {

@@ -379,7 +379,7 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
                 "{}: `{}` = {} is outside {lo} to {hi} {unit}, the plausible range of a Dynamixel's reading (is the column in the log's unit?)",
                 at(),
                 COLUMNS[k],
-                v[k]
+                if v[k].abs() >= 1e6 { format!("{:e}", v[k]) } else { v[k].to_string() }
             );
         }
         let int = |k: usize, lo: i64, hi: i64| whole(v[k], COLUMNS[k], lo, hi, &at);
@@ -747,5 +747,70 @@ mod tests {
         std::fs::write(&path, format!("{}\n1,x,0,0,0,0,0,0,0,0,0,0,0,0\n", COLUMNS.join(","))).unwrap();
         let e = read_servo_log(&path).unwrap_err().to_string();
         assert!(e.contains("line 2"), "{e}");
+    }
+
+    fn row(t: f64) -> ServoLogRow {
+        ServoLogRow {
+            time_s: t,
+            id: 1,
+            leg: 0,
+            tripod: 0,
+            present_position: 0,
+            present_velocity: 0,
+            present_current_ma: 100,
+            load_percent: 6.8,
+            input_voltage_v: 5.0,
+            temperature_c: 30,
+            hardware_error: 0,
+            goal_position: 0,
+            leg_angle_rad: 0.1,
+            drive_torque_n_m: 0.035,
+        }
+    }
+
+    /// The flight recorder: rows on disk as they come, `incomplete` until finished, then the
+    /// status lines rewritten in place (the rows untouched); a symbolic link refused.
+    #[test]
+    fn the_flight_log_is_readable_before_it_is_finished() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("run.csv");
+        let mut log = FlightLog::create(&path, &[("slope_deg", "10".into())]).unwrap();
+        log.write(&row(0.0)).unwrap();
+        log.write(&row(0.02)).unwrap();
+        // Read while the run is under way (as after a SIGKILL): both rows, and a note.
+        let read = read_servo_log(&path).unwrap();
+        assert_eq!(read.rows.len(), 2);
+        assert!(read.meta["status"].starts_with("incomplete"));
+        assert!(read.notes.iter().any(|n| n.contains("marked incomplete")), "{:?}", read.notes);
+        let before = std::fs::read(&path).unwrap().len();
+        log.finish(&["completed".into(), "49.90".into(), "0.40".into(), "22.0".into()]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text.len(), before, "the status lines are rewritten in place");
+        let read = read_servo_log(&path).unwrap();
+        assert_eq!(read.meta["status"], "completed");
+        assert_eq!(read.meta["achieved_rate_hz"], "49.90");
+        assert!(read.notes.is_empty(), "{:?}", read.notes);
+        let link = dir.path().join("link.csv");
+        std::os::unix::fs::symlink(&path, &link).unwrap();
+        let e = FlightLog::create(&link, &[]).unwrap_err().to_string();
+        assert!(e.contains("a symbolic link"), "{e}");
+    }
+
+    /// A UTF-8 BOM (a spreadsheet's export) does not hide `time_s`; a line of 64 KiB and more is
+    /// refused at once, naming it; values far outside a servo's range name the column and unit.
+    #[test]
+    fn the_reader_takes_a_bom_and_refuses_long_lines_and_implausible_values() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("log.csv");
+        let good = "0,1,0,0,0,0,100,6.8,5,30,0,0,0.1,0.035\n";
+        std::fs::write(&path, format!("\u{feff}{}\n{good}", COLUMNS.join(","))).unwrap();
+        assert_eq!(read_servo_log(&path).unwrap().rows, vec![row(0.0)]);
+        std::fs::write(&path, "x".repeat(200_000)).unwrap();
+        let e = read_servo_log(&path).unwrap_err().to_string();
+        assert!(e.contains("line 1 is longer than 65536 bytes"), "{e}");
+        let huge = good.replace("0.035", "1e300");
+        std::fs::write(&path, format!("{}\n{huge}", COLUMNS.join(","))).unwrap();
+        let e = read_servo_log(&path).unwrap_err().to_string();
+        assert!(e.contains("line 2") && e.contains("`drive_torque_n_m` = 1e300 is outside -20 to 20 N m"), "{e}");
     }
 }

@@ -127,3 +127,34 @@ pub fn velocity_goal(speed_rad_s: f64, limit_units: u32) -> i32 {
     let l = i64::from(limit_units);
     xl330::velocity_units_from_rad_s(speed_rad_s).clamp(-l, l) as i32
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A quarter turn and more for more than half a second is a fault; less, or shorter, is not.
+    #[test]
+    fn a_following_error_must_last_to_be_a_fault() {
+        let mut f = Following::new(2);
+        assert!(f.check(0, 1, 1.0, 1.6).is_ok(), "1.6 rad passes pi/2 = 1.571: the clock starts");
+        assert!(f.check(0, 1, 1.5, -2.0).is_ok(), "0.5 s is not more than 0.5 s");
+        assert!(f.check(1, 2, 1.5, 1.5).is_ok(), "1.5 rad is within a quarter turn");
+        match f.check(0, 1, 1.52, 3.0) {
+            Err(DriveError::Following { id: 1, leg: 0, since_s, .. }) => assert_eq!(since_s, 1.0),
+            other => panic!("{other:?}"),
+        }
+        // Back within the limit: the clock restarts.
+        assert!(f.check(1, 2, 1.6, 0.1).is_ok());
+        assert!(f.check(1, 2, 1.7, 2.0).is_ok());
+        assert!(f.check(1, 2, 2.1, 2.0).is_ok());
+    }
+
+    /// Goal Velocity within the Velocity Limit: 2 omega = 524 units at the paper's 2 pi rad/s
+    /// (60 rev/min / 0.229 = 262.0 units a leg speed).
+    #[test]
+    fn velocity_goals_stay_within_the_limit() {
+        assert_eq!(velocity_goal(2.0 * std::f64::consts::PI, 524), 262);
+        assert_eq!(velocity_goal(100.0, 524), 524);
+        assert_eq!(velocity_goal(-100.0, 524), -524);
+    }
+}

@@ -162,8 +162,10 @@ pub struct TorqueOff {
     pub unconfirmed: Vec<u8>,
 }
 
-/// The whole run's answer.
-#[derive(Debug, Serialize)]
+/// The whole run's answer. As JSON (`drive --json`, Python's `drive`), how it ended is flat:
+/// `outcome` (`completed`, `interrupted`, `halted` or `failed`), `time_s`, `p_fail` for a
+/// halt and `error` for a failure, beside the other fields (`crate::report`).
+#[derive(Debug)]
 pub struct DriveReport {
     /// How it ended.
     pub outcome: Result<DriveOutcome, String>,
@@ -189,7 +191,6 @@ pub struct DriveReport {
     /// The instant of gait time 0 (the legs stood up, `stand_s` after the walk's first
     /// cycle), to put another clock on the log's (the emulator's weakening); `None` when the
     /// run ended before it began.
-    #[serde(skip)]
     pub gait_zero: Option<Instant>,
 }
 

@@ -357,7 +357,7 @@ impl VirtualServo {
         // Data Range Error, and nothing of the write is kept.
         let before = self.table;
         self.put(addr, data);
-        if self.out_of_range(addr, end).is_some() {
+        if t::out_of_range(&self.table, addr, end).is_some() {
             self.table = before;
             return error::DATA_RANGE;
         }
@@ -367,81 +367,6 @@ impl VirtualServo {
             self.put(t::GOAL_POSITION, &here.to_le_bytes());
         }
         0
-    }
-
-    /// The first register written in `addr..end` whose new value lies outside its range
-    /// (ROBOTIS e-Manual, XL330-M288-T control table), by name.
-    fn out_of_range(&self, addr: u16, end: usize) -> Option<&'static str> {
-        let touched =
-            |reg: u16, width: usize| usize::from(addr) < usize::from(reg) + width && end > usize::from(reg);
-        let i32_at = |a: u16| self.i32_at(a);
-        let i16_at = |a: u16| i16::from_le_bytes([self.table[a as usize], self.table[a as usize + 1]]);
-        let mode = self.u8_at(t::OPERATING_MODE);
-        let checks: [(&'static str, u16, usize, bool); 13] = [
-            (
-                "Return Delay Time",
-                t::RETURN_DELAY_TIME,
-                1,
-                self.u8_at(t::RETURN_DELAY_TIME) <= xl330::MAX_RETURN_DELAY,
-            ),
-            ("Operating Mode", t::OPERATING_MODE, 1, matches!(mode, 0 | 1 | 3 | 4 | 5 | 16)),
-            (
-                "Temperature Limit",
-                t::TEMPERATURE_LIMIT,
-                1,
-                self.u8_at(t::TEMPERATURE_LIMIT) <= xl330::MAX_TEMPERATURE_LIMIT_REGISTER,
-            ),
-            (
-                "Current Limit",
-                t::CURRENT_LIMIT,
-                2,
-                self.u16_at(t::CURRENT_LIMIT) <= xl330::MAX_CURRENT_LIMIT_MA,
-            ),
-            (
-                "Velocity Limit",
-                t::VELOCITY_LIMIT,
-                4,
-                (0..=xl330::MAX_VELOCITY_LIMIT as i32).contains(&i32_at(t::VELOCITY_LIMIT)),
-            ),
-            ("Torque Enable", t::TORQUE_ENABLE, 1, self.u8_at(t::TORQUE_ENABLE) <= 1),
-            ("Status Return Level", t::STATUS_RETURN_LEVEL, 1, self.u8_at(t::STATUS_RETURN_LEVEL) <= 2),
-            ("Bus Watchdog", t::BUS_WATCHDOG, 1, self.u8_at(t::BUS_WATCHDOG) <= xl330::MAX_BUS_WATCHDOG),
-            (
-                "Goal Current",
-                t::GOAL_CURRENT,
-                2,
-                i32::from(i16_at(t::GOAL_CURRENT)).abs() <= i32::from(self.u16_at(t::CURRENT_LIMIT)),
-            ),
-            (
-                "Goal Velocity",
-                t::GOAL_VELOCITY,
-                4,
-                i32_at(t::GOAL_VELOCITY).unsigned_abs() <= i32_at(t::VELOCITY_LIMIT).unsigned_abs(),
-            ),
-            (
-                "Profile Acceleration",
-                t::PROFILE_ACCELERATION,
-                4,
-                (0..=xl330::MAX_PROFILE as i32).contains(&i32_at(t::PROFILE_ACCELERATION)),
-            ),
-            (
-                "Profile Velocity",
-                t::PROFILE_VELOCITY,
-                4,
-                (0..=xl330::MAX_PROFILE as i32).contains(&i32_at(t::PROFILE_VELOCITY)),
-            ),
-            ("Goal Position", t::GOAL_POSITION, 4, {
-                let g = i32_at(t::GOAL_POSITION);
-                let l = xl330::EXTENDED_GOAL_LIMIT_PULSES;
-                let (lo, hi) = xl330::POSITION_GOAL_RANGE_PULSES;
-                match mode {
-                    mode::EXTENDED_POSITION | 5 => (-l..=l).contains(&g),
-                    mode::POSITION => (lo..=hi).contains(&g),
-                    _ => true,
-                }
-            }),
-        ];
-        checks.iter().find(|(_, reg, width, ok)| touched(*reg, *width) && !ok).map(|c| c.0)
     }
 
     /// The Clear instruction: the revolution counter back within one turn (0 to 4095), only

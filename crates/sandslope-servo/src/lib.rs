@@ -23,6 +23,7 @@ pub mod guard;
 pub mod log;
 pub mod packet;
 pub mod plan;
+mod report;
 pub mod session;
 pub mod setup;
 pub mod speed;

@@ -70,6 +70,88 @@ pub const STATE_BLOCK: (u16, u16) = (PRESENT_CURRENT, PRESENT_TEMPERATURE + 1 - 
 /// Bus Watchdog value a servo sets after the watchdog fired.
 pub const WATCHDOG_FIRED: u8 = 100;
 
+/// The first register written in `addr..end` whose new value lies outside its range
+/// (ROBOTIS e-Manual, XL330-M288-T control table), by name.
+pub(crate) fn out_of_range(table: &[u8; TABLE_SIZE], addr: u16, end: usize) -> Option<&'static str> {
+    use sandslope::servo::xl330;
+    let u8_at = |a: u16| table[a as usize];
+    let u16_at = |a: u16| u16::from_le_bytes([table[a as usize], table[a as usize + 1]]);
+    let i32_le = |a: u16| {
+        let a = a as usize;
+        i32::from_le_bytes([table[a], table[a + 1], table[a + 2], table[a + 3]])
+    };
+    let touched =
+        |reg: u16, width: usize| usize::from(addr) < usize::from(reg) + width && end > usize::from(reg);
+    let i32_at = |a: u16| i32_le(a);
+    let i16_at = |a: u16| i16::from_le_bytes([table[a as usize], table[a as usize + 1]]);
+    let mode = u8_at(OPERATING_MODE);
+    let checks: [(&'static str, u16, usize, bool); 13] = [
+        (
+            "Return Delay Time",
+            RETURN_DELAY_TIME,
+            1,
+            u8_at(RETURN_DELAY_TIME) <= xl330::MAX_RETURN_DELAY,
+        ),
+        ("Operating Mode", OPERATING_MODE, 1, matches!(mode, 0 | 1 | 3 | 4 | 5 | 16)),
+        (
+            "Temperature Limit",
+            TEMPERATURE_LIMIT,
+            1,
+            u8_at(TEMPERATURE_LIMIT) <= xl330::MAX_TEMPERATURE_LIMIT_REGISTER,
+        ),
+        (
+            "Current Limit",
+            CURRENT_LIMIT,
+            2,
+            u16_at(CURRENT_LIMIT) <= xl330::MAX_CURRENT_LIMIT_MA,
+        ),
+        (
+            "Velocity Limit",
+            VELOCITY_LIMIT,
+            4,
+            (0..=xl330::MAX_VELOCITY_LIMIT as i32).contains(&i32_at(VELOCITY_LIMIT)),
+        ),
+        ("Torque Enable", TORQUE_ENABLE, 1, u8_at(TORQUE_ENABLE) <= 1),
+        ("Status Return Level", STATUS_RETURN_LEVEL, 1, u8_at(STATUS_RETURN_LEVEL) <= 2),
+        ("Bus Watchdog", BUS_WATCHDOG, 1, u8_at(BUS_WATCHDOG) <= xl330::MAX_BUS_WATCHDOG),
+        (
+            "Goal Current",
+            GOAL_CURRENT,
+            2,
+            i32::from(i16_at(GOAL_CURRENT)).abs() <= i32::from(u16_at(CURRENT_LIMIT)),
+        ),
+        (
+            "Goal Velocity",
+            GOAL_VELOCITY,
+            4,
+            i32_at(GOAL_VELOCITY).unsigned_abs() <= i32_at(VELOCITY_LIMIT).unsigned_abs(),
+        ),
+        (
+            "Profile Acceleration",
+            PROFILE_ACCELERATION,
+            4,
+            (0..=xl330::MAX_PROFILE as i32).contains(&i32_at(PROFILE_ACCELERATION)),
+        ),
+        (
+            "Profile Velocity",
+            PROFILE_VELOCITY,
+            4,
+            (0..=xl330::MAX_PROFILE as i32).contains(&i32_at(PROFILE_VELOCITY)),
+        ),
+        ("Goal Position", GOAL_POSITION, 4, {
+            let g = i32_at(GOAL_POSITION);
+            let l = xl330::EXTENDED_GOAL_LIMIT_PULSES;
+            let (lo, hi) = xl330::POSITION_GOAL_RANGE_PULSES;
+            match mode {
+                mode::EXTENDED_POSITION | 5 => (-l..=l).contains(&g),
+                mode::POSITION => (lo..=hi).contains(&g),
+                _ => true,
+            }
+        }),
+    ];
+    checks.iter().find(|(_, reg, width, ok)| touched(*reg, *width) && !ok).map(|c| c.0)
+}
+
 /// Operating modes the driver uses.
 pub mod mode {
     /// Velocity control.

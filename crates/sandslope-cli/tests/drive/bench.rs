@@ -247,3 +247,41 @@ fn a_rate_the_bus_cannot_carry_is_warned_with_the_fix() {
         .unwrap();
     assert!(!text(&out).contains("warning"), "{}", text(&out));
 }
+
+/// Issue 58: a log whose header says `# slope_deg = NaN` is named as the header's fault, not
+/// `--slope` (which was not given); `--slope 89` without `--emulate-k-s` says the terrain has
+/// no sand there instead of naming the flag not given.
+#[test]
+fn messages_name_what_was_given() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("nan.csv");
+    let header = "# slope_deg = NaN\n";
+    let body = "time_s,id,leg,tripod,present_position,present_velocity,present_current_ma,load_percent,input_voltage_v,temperature_c,hardware_error,goal_position,leg_angle_rad,drive_torque_n_m\n0,1,0,0,0,0,100,6.8,5,30,0,0,0.1,0.035\n";
+    std::fs::write(&log, format!("{header}{body}")).unwrap();
+    let out = bin().args(["infer", "--servo-log"]).arg(&log).output().unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{all}");
+    assert!(all.contains("header line `# slope_deg` = NaN must be strictly between -90 and 90"), "{all}");
+    assert!(all.contains("give the run's slope with --slope"), "{all}");
+    let out = bin().args(["drive", "--emulate", "--slope", "89", "--duration", "1"]).output().unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{all}");
+    assert!(all.contains("--slope 89: the terrain's sand has no shear strength"), "{all}");
+    assert!(!all.contains("--emulate-k-s = "), "{all}");
+}
+
+/// A silent servo loses only its own row: the servos after it on the bus keep theirs in the
+/// cycles before the run stops (dynamixel2 would read each next servo's reply in the silent
+/// one's place).
+#[test]
+fn a_silent_servo_loses_only_its_own_row() {
+    let (code, all, log, _d) = super::drive_with(&["--emulate-fault", "silent:3:2.5"]);
+    assert_eq!(code, Some(3), "{all}");
+    let rows = super::log_rows(&log);
+    let last3 = rows.iter().filter(|r| r.1 == 2).map(|r| r.0).fold(f64::MIN, f64::max);
+    let after: Vec<usize> = rows.iter().filter(|r| r.0 > last3).map(|r| r.1).collect();
+    // Three cycles without servo 3 (leg 2) before the run stops, each with legs 0, 1, 3, 4, 5.
+    for leg in [0, 1, 3, 4, 5] {
+        assert!(after.iter().filter(|&&l| l == leg).count() >= 2, "leg {leg}: {after:?}");
+    }
+}

@@ -22,8 +22,10 @@ use std::time::{Duration, Instant};
 use dynamixel2::instructions::SyncWriteData;
 use dynamixel2::{Bus, ReadError};
 use sandslope::infer::servo::{infer_from_stance, CurrentInference, ModelGrid};
+use sandslope::risk::UncertainTerrain;
+use sandslope::servo::verdict::{pool, prior_p_fail, PooledEstimate};
 use sandslope::servo::{xl330, GaitSchedule};
-use sandslope::Robot;
+use sandslope::{Robot, Slope};
 use serde::Serialize;
 
 pub use crate::error::{hardware_faults, DriveError};
@@ -126,8 +128,12 @@ pub struct LiveEstimate {
     pub time_s: f64,
     /// Tripod.
     pub tripod: usize,
-    /// The estimate.
+    /// The estimate from this stance alone.
     pub inference: CurrentInference,
+    /// The stances so far pooled (the last `window` of them with a moving window), with the
+    /// simulator's and the closed form's verdicts and the decision, the larger of the two
+    /// (`sandslope::servo::verdict`): what `--stop-on-risk` watches.
+    pub pooled: Option<PooledEstimate>,
 }
 
 /// How a run ended without error.
@@ -182,6 +188,9 @@ pub struct DriveReport {
     pub setup: SetupDone,
     /// Live estimates, one per stance (with a monitor).
     pub live: Vec<LiveEstimate>,
+    /// The closed form's p_fail at the terrain's own uncertain k_s, the decision before the
+    /// first stance is estimated (with a monitor).
+    pub prior_p_fail: Option<f64>,
     /// The legs' mean speed over the run's last quarter second as their positions give it,
     /// rad/s ([`crate::speed::LegSpeedMeter`]; the gait commands the robot's leg speed);
     /// `None` when no leg ran a quarter second.
@@ -205,6 +214,7 @@ impl DriveReport {
             max_cycle_ms: 0.0,
             setup: SetupDone::default(),
             live: vec![],
+            prior_p_fail: None,
             leg_speed_rad_s: None,
             torque_off: TorqueOff::default(),
             gait_zero: None,
@@ -222,6 +232,13 @@ pub struct Monitor<'a> {
     pub grid: &'a ModelGrid,
     /// SD of one torque sample, N m.
     pub noise_sd_n_m: f64,
+    /// The terrain with its uncertainty (the closed form's verdict and the prior's).
+    pub terrain: &'a UncertainTerrain,
+    /// The slope as the closed form takes it.
+    pub slope: Slope,
+    /// Pool the last this many stances (a moving window that follows changing sand); `None`:
+    /// every stance so far.
+    pub window: Option<usize>,
 }
 
 /// Phase correction of the velocity profile: speed added per radian of lag, 1/s.
@@ -290,6 +307,8 @@ struct Walk<'m> {
     /// The goal registers' readback and the following error.
     goal_check: GoalCheck,
     following: Following,
+    /// Each stance's posterior over the grid, for the pooled estimate.
+    stances: Vec<Vec<f64>>,
 }
 
 /// The spread of the times between cycle starts.
@@ -341,6 +360,7 @@ fn run(
         }),
         goal_check: GoalCheck::default(),
         following: Following::new(ids.len()),
+        stances: vec![],
         ids,
         stand,
         halted: None,
@@ -364,6 +384,18 @@ fn run(
         }
         if let Some(outcome) = walk.finished(settings, stop, time) {
             return Ok(outcome);
+        }
+        // Before the first stance is estimated the prior decides: the closed form on the
+        // terrain's own uncertain k_s at the slope.
+        if time >= 0.0 && report.prior_p_fail.is_none() {
+            if let Some((m, _)) = &walk.monitor {
+                let p = prior_p_fail(m.robot, m.terrain, m.slope);
+                report.prior_p_fail = Some(p);
+                if settings.stop_on_risk.is_some_and(|limit| p > limit) {
+                    walk.halted = Some((time, p));
+                    walk.halt_goal = walk.last_pos.iter().zip(&walk.stand.start_goal).map(|(p, &g)| p.unwrap_or(g)).collect();
+                }
+            }
         }
         let goals = walk.goals(schedule, settings, time);
         let sent = walk
@@ -639,9 +671,13 @@ impl Walk<'_> {
         let Some(inf) = infer_from_stance(m.robot, m.grid, k, &profile, &counts, m.noise_sd_n_m) else {
             return;
         };
-        let live = LiveEstimate { time_s: time, tripod: k, inference: inf };
+        self.stances.push(inf.posterior.iter().map(|x| x.1).collect());
+        let from = m.window.map_or(0, |w| self.stances.len().saturating_sub(w.max(1)));
+        let pooled_in: Vec<&[f64]> = self.stances[from..].iter().map(Vec::as_slice).collect();
+        let pooled = pool(m.robot, m.terrain, m.slope, m.grid, &pooled_in);
+        let p = pooled.as_ref().map_or(inf.p_fail, |x| x.p_fail);
+        let live = LiveEstimate { time_s: time, tripod: k, inference: inf, pooled };
         on_live(&live);
-        let p = live.inference.p_fail;
         report.live.push(live);
         if let (Some(limit), None) = (settings.stop_on_risk, self.halted) {
             if p > limit {

@@ -21,6 +21,7 @@ struct Flat<'a> {
     max_cycle_ms: f64,
     setup: &'a SetupDone,
     live: &'a [LiveEstimate],
+    prior_p_fail: Option<f64>,
     leg_speed_rad_s: Option<f64>,
     torque_off: &'a TorqueOff,
 }
@@ -44,6 +45,7 @@ impl Serialize for DriveReport {
             max_cycle_ms: self.max_cycle_ms,
             setup: &self.setup,
             live: &self.live,
+            prior_p_fail: self.prior_p_fail,
             leg_speed_rad_s: self.leg_speed_rad_s,
             torque_off: &self.torque_off,
         }

@@ -8,6 +8,7 @@ use std::sync::atomic::AtomicBool;
 
 use sandslope::infer::servo::{model_grid, CurrentInferenceSettings, ModelGrid};
 use sandslope::infer::LogUniformPrior;
+use sandslope::risk::{safe_slope_limit, SafeLimit, UncertainTerrain};
 use sandslope::servo::{xl330, GaitSchedule};
 use sandslope::{Robot, Scenario, SignedSlope, Terrain};
 
@@ -113,6 +114,11 @@ pub struct DriveConfig {
     pub bus: BusChoice,
     /// Estimate k_s and the risk after every stance (implied by `settings.stop_on_risk`).
     pub monitor: bool,
+    /// Pool the live estimate over the last this many stances (`--live-window`); `None`: all.
+    pub window: Option<usize>,
+    /// Drive beyond the calibrated safe slope (`--force`); without it such a run is refused
+    /// before anything moves.
+    pub force: bool,
 }
 
 /// Why a run could not start (nothing was sent to a servo).
@@ -148,6 +154,8 @@ pub struct Session {
     /// The terrain's k_n at the slope, N/m^3.
     pub k_n: f64,
     grid: Option<ModelGrid>,
+    uncertain: UncertainTerrain,
+    slope: sandslope::Slope,
     bus: DynamixelBus,
     emulator: Option<Emulator>,
     /// The last drive's gait time 0 ([`DriveReport::gait_zero`]).
@@ -173,6 +181,11 @@ impl Session {
             .map_err(|e| SessionError::Setting(e.to_string()))?
             .ground_at(signed.felt());
         let k_n = ground.k_n;
+        let uncertain = UncertainTerrain::new(config.terrain.clone(), None, None)
+            .map_err(|e| SessionError::Setting(e.to_string()))?;
+        if !config.force {
+            check_safe_slope(&config, &uncertain, signed.felt())?;
+        }
         let grid = if config.monitor || config.settings.stop_on_risk.is_some() {
             // The prior reaches down to 1e4 N/m^3, below the library's default 3e4: sand that
             // weak fails by sinkage at moderate slopes, and a monitor whose grid cannot hold it
@@ -224,7 +237,8 @@ impl Session {
             }
         };
         let bus = dynamixel2::Bus::new(port).map_err(|e| SessionError::Bus(format!("{e:?}")))?;
-        Ok(Session { config, schedule, k_n, grid, bus, emulator, gait_zero: None })
+        let slope = signed.felt();
+        Ok(Session { config, schedule, k_n, grid, uncertain, slope, bus, emulator, gait_zero: None })
     }
 
     /// The configuration the session was opened with.
@@ -262,6 +276,9 @@ impl Session {
             robot: &self.config.robot,
             grid: g,
             noise_sd_n_m: xl330::torque_from_current(noise_ma),
+            terrain: &self.uncertain,
+            slope: self.slope,
+            window: self.config.window,
         });
         let (report, failure) =
             drive(&mut self.bus, &self.schedule, &self.config.settings, monitor, stop, on_sample, on_live);
@@ -274,6 +291,32 @@ impl Session {
         drop(self.bus);
         let zero = self.gait_zero;
         self.emulator.map(|e| e.stop(zero))
+    }
+}
+
+/// The risk the safe slope is searched at when `--stop-on-risk` does not give one.
+pub const SAFE_SLOPE_RISK: f64 = 0.5;
+
+/// Refuses a slope beyond the calibrated safe-slope limit (`risk --solve slope`: p_fail below
+/// `--stop-on-risk`, else 0.5, from level up to it), naming the limit and `--force`.
+fn check_safe_slope(config: &DriveConfig, terrain: &UncertainTerrain, slope: sandslope::Slope) -> Result<(), SessionError> {
+    let risk = config.settings.stop_on_risk.filter(|p| *p > 0.0 && *p < 1.0).unwrap_or(SAFE_SLOPE_RISK);
+    let limit = safe_slope_limit(&config.robot, terrain, risk).map_err(|e| SessionError::Setting(e.to_string()))?;
+    let deg = slope.degrees();
+    let beyond = match limit {
+        SafeLimit::NoneSafe { .. } => Some("no slope is (p_fail is above it from level)".to_string()),
+        SafeLimit::Limit { value, .. } if deg > value => Some(format!("the limit is {value:.1} deg")),
+        SafeLimit::Repose { repose_deg, .. } if deg >= repose_deg => {
+            Some(format!("the limit is the sand's angle of repose, {repose_deg:.1} deg"))
+        }
+        _ => None,
+    };
+    match beyond {
+        Some(why) => Err(SessionError::Setting(format!(
+            "--slope {} is beyond the calibrated safe slope for this robot on this terrain (p_fail < {risk} from level up to it; `sandslope risk --solve slope --max-risk {risk}`): {why}. Nothing was moved. Fix: a shallower --slope, or --force to drive anyway (expect the legs to slip or sink; --stop-on-risk halts the gait when the live risk passes it)",
+            config.slope_deg
+        ))),
+        None => Ok(()),
     }
 }
 

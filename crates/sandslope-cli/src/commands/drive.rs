@@ -94,6 +94,14 @@ pub struct DriveRunArgs {
     /// Halt the gait (torque held, legs planted) when the live risk that the walk fails (slippage or sinkage) passes P.
     #[arg(long, value_name = "P")]
     pub stop_on_risk: Option<f64>,
+    /// Drive beyond the calibrated safe slope (`risk --solve slope`); without it such a run is
+    /// refused before anything moves, naming the limit.
+    #[arg(long)]
+    pub force: bool,
+    /// Pool the live estimate over the last N stances (a moving window, to follow sand that
+    /// changes); without it every stance so far is pooled.
+    #[arg(long, value_name = "N")]
+    pub live_window: Option<usize>,
     /// After a halt, seconds the legs are held before the torque goes off.
     #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.hold_s)]
     pub hold: f64,
@@ -329,7 +337,19 @@ pub fn config(
             faults,
         }),
     };
-    Ok(DriveConfig { robot, terrain, slope_deg: run.slope, settings, bus, monitor })
+    if run.live_window == Some(0) {
+        bail!("--live-window = 0 must be at least 1 stance (leave it out to pool every stance)");
+    }
+    Ok(DriveConfig {
+        robot,
+        terrain,
+        slope_deg: run.slope,
+        settings,
+        bus,
+        monitor,
+        window: run.live_window,
+        force: run.force,
+    })
 }
 
 /// Runs `sandslope drive`.
@@ -382,6 +402,12 @@ pub fn run(args: DriveArgs) -> Result<()> {
                 i.p_slippage,
                 i.p_sinkage
             ));
+            if let Some(p) = &l.pooled {
+                say(format_args!(
+                    "  pooled over {} stance(s): k_s {:.3e} [{:.3e} - {:.3e}] N/m^3; P(fail) {:.3} (simulator {:.3}, closed form {:.3})",
+                    p.stances, p.k_s, p.k_s_lo, p.k_s_hi, p.p_fail, p.p_fail_simulator, p.p_fail_closed_form
+                ));
+            }
         }
     };
     let stop = &crate::error::STOP;

@@ -128,6 +128,8 @@ def drive(
     hold_s: Optional[float] = None,
     rate_hz: Optional[float] = None,
     live: Optional[bool] = None,
+    force: bool = False,
+    window: Optional[int] = None,
 ) -> Tuple[Any, Dict[str, Any]]:
     """A run of ``sandslope drive --emulate`` (docs/drive.md): the robot's alternating tripod
     sent to a bus of emulated XL330s on a pseudo-terminal, byte for byte Protocol 2.0 through
@@ -136,7 +138,10 @@ def drive(
     its seed, ``weaken=(seconds, k_s)`` weakens it mid-run), with ``drive``'s defaults for
     whatever is left out (``drive_defaults()``: the one typed set ``sandslope drive``'s flags
     take theirs from; position profile, the servos' IDs 1 to 6). ``live`` estimates k_s
-    after every stance (off by default, as ``drive --live``); ``stop_on_risk`` halts the gait when P(fail) passes it.
+    after every stance (off by default, as ``drive --live``), pooled over every stance so far
+    or the last ``window``; ``stop_on_risk`` halts the gait when the pooled P(fail), the larger
+    of the simulator's and the closed form's, passes it. A slope beyond the calibrated safe
+    slope is refused unless ``force=True`` (as ``drive --force``).
 
     Returns ``(log, report)``: ``log`` the servo log's columns (a pandas DataFrame, or a dict of
     NumPy arrays without pandas; ``infer_servo_log`` reads it), ``report`` what ``drive --json``
@@ -164,6 +169,8 @@ def drive(
         hold_s=None if hold_s is None else float(hold_s),
         rate_hz=None if rate_hz is None else float(rate_hz),
         live=None if live is None else bool(live),
+        force=bool(force),
+        window=None if window is None else int(window),
     )
     slope = float(drive_defaults()["slope_deg"] if slope_deg is None else slope_deg)
     return _frame(columns, {"slope_deg": repr(slope)}), report

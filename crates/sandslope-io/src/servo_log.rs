@@ -81,7 +81,7 @@ impl<W: Write> ServoLogWriter<W> {
         for (k, v) in meta {
             writeln!(out, "# {k} = {v}")?;
         }
-        Ok(ServoLogWriter { writer: csv::Writer::from_writer(out), rows: 0 })
+        Ok(ServoLogWriter { writer: csv::WriterBuilder::new().flexible(true).from_writer(out), rows: 0 })
     }
 
     /// Appends a row (flushing every 60 rows, ten cycles of six servos).
@@ -92,6 +92,13 @@ impl<W: Write> ServoLogWriter<W> {
             self.writer.flush()?;
         }
         Ok(())
+    }
+
+    /// Writes `# key = value` between the rows (a live estimate as it came; `pandas.read_csv`
+    /// with `comment="#"` and [`read_servo_log`] skip it). Commas in `value` become semicolons.
+    pub fn note(&mut self, key: &str, value: &str) -> std::io::Result<()> {
+        let line = format!("# {key} = {}", value.replace([',', '"', '\n', '\r'], ";"));
+        self.writer.write_record([line.as_str()]).map_err(std::io::Error::other)
     }
 
     /// Flushes the rows written so far to the file (the flight recorder does after every row).
@@ -188,6 +195,12 @@ impl FlightLog {
     /// Rows written.
     pub fn rows(&self) -> usize {
         self.writer.rows()
+    }
+
+    /// Writes a `# key = value` note between the rows, flushed at once ([`ServoLogWriter::note`]).
+    pub fn note(&mut self, key: &str, value: &str) -> std::io::Result<()> {
+        self.writer.note(key, value)?;
+        self.writer.flush()
     }
 
     /// Ends the log: the rows flushed, the status lines rewritten with `status` (the values of
@@ -326,7 +339,7 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
         ));
     }
     let body = body_lines.join("\n");
-    let mut reader = csv::ReaderBuilder::new().flexible(true).from_reader(body.as_bytes());
+    let mut reader = csv::ReaderBuilder::new().flexible(true).comment(Some(b'#')).from_reader(body.as_bytes());
     let headers =
         reader.headers().with_context(|| format!("{}: no column header line", path.display()))?.clone();
     let mut col = [0usize; 14];
@@ -341,7 +354,11 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
     }
     let (mut rows, mut lines, mut missing) = (Vec::new(), Vec::new(), Vec::new());
     for (i, rec) in reader.records().enumerate() {
-        let line = header_lines + 2 + i;
+        // The file's line: the body's (notes between rows are skipped) after the header's.
+        let line = match &rec {
+            Ok(r) => r.position().map_or(header_lines + 2 + i, |p| header_lines + p.line() as usize),
+            Err(_) => header_lines + 2 + i,
+        };
         let rec =
             rec.map_err(|e| anyhow!("{}: line {line}: {}", path.display(), e.to_string().trim_end()))?;
         let plain = |line: usize| format!("{}: line {line}", path.display());

@@ -307,8 +307,9 @@ struct Walk<'m> {
     /// The goal registers' readback and the following error.
     goal_check: GoalCheck,
     following: Following,
-    /// Each stance's posterior over the grid, for the pooled estimate.
+    /// Each stance's posterior over the grid and its median, for the pooled estimate.
     stances: Vec<Vec<f64>>,
+    medians: Vec<f64>,
 }
 
 /// The spread of the times between cycle starts.
@@ -361,6 +362,7 @@ fn run(
         goal_check: GoalCheck::default(),
         following: Following::new(ids.len()),
         stances: vec![],
+        medians: vec![],
         ids,
         stand,
         halted: None,
@@ -674,7 +676,8 @@ impl Walk<'_> {
         self.stances.push(inf.posterior.iter().map(|x| x.1).collect());
         let from = m.window.map_or(0, |w| self.stances.len().saturating_sub(w.max(1)));
         let pooled_in: Vec<&[f64]> = self.stances[from..].iter().map(Vec::as_slice).collect();
-        let pooled = pool(m.robot, m.terrain, m.slope, m.grid, &pooled_in);
+        self.medians.push(inf.k_s);
+        let pooled = pool(m.robot, m.terrain, m.slope, m.grid, &pooled_in, &self.medians[from..]);
         let p = pooled.as_ref().map_or(inf.p_fail, |x| x.p_fail);
         let live = LiveEstimate { time_s: time, tripod: k, inference: inf, pooled };
         on_live(&live);

@@ -102,20 +102,25 @@ pub fn drive_logged(
         ));
     };
     let meta = log_meta(session, target.robot, target.terrain);
-    let mut log = FlightLog::create(target.path, &meta)?;
+    let log = std::cell::RefCell::new(FlightLog::create(target.path, &meta)?);
     let mut first_failure: Option<std::io::Error> = None;
     let (report, failure) = session.drive(
         stop,
         &mut |s: &ServoSample| {
             on_sample(s);
-            log.write(&log_row(s)).map_err(|e| {
+            log.borrow_mut().write(&log_row(s)).map_err(|e| {
                 let e = std::io::Error::new(e.kind(), format!("{}: {e}", target.path.display()));
                 first_failure.get_or_insert_with(|| std::io::Error::new(e.kind(), e.to_string()));
                 e
             })
         },
-        on_live,
+        &mut |l: &LiveEstimate| {
+            on_live(l);
+            // Both verdicts in the log, as they came (a failed note is the next row's failure).
+            log.borrow_mut().note("live", &live_note(l)).ok();
+        },
     );
+    let log = log.into_inner();
     let time_s = match &report.outcome {
         Ok(DriveOutcome::Completed { time_s })
         | Ok(DriveOutcome::Interrupted { time_s })
@@ -148,6 +153,23 @@ pub fn drive_logged(
     };
     let log_failure = log_failure.map(|reason| DriveError::Log { time_s, reason });
     Ok((report, failure.or(log_failure)))
+}
+
+/// A live estimate as the log's note: the stance's own estimate, the pooled one and both
+/// verdicts with the decision.
+pub fn live_note(l: &LiveEstimate) -> String {
+    let i = &l.inference;
+    let mut text = format!(
+        "t {:.3} s; tripod {}; stance k_s {:.4e} [{:.4e} {:.4e}]; stance p_fail {:.4}",
+        l.time_s, l.tripod, i.k_s, i.k_s_lo, i.k_s_hi, i.p_fail
+    );
+    if let Some(p) = &l.pooled {
+        text += &format!(
+            "; pooled over {} k_s {:.4e} [{:.4e} {:.4e}]; p_fail simulator {:.4}; p_fail closed form {:.4}; decision {:.4}",
+            p.stances, p.k_s, p.k_s_lo, p.k_s_hi, p.p_fail_simulator, p.p_fail_closed_form, p.p_fail
+        );
+    }
+    text
 }
 
 /// The failure's first clause, for the log's one status line.

@@ -565,11 +565,24 @@ fn summarise(r: &DriveReport, quiet: bool) {
             )
         }
     ));
+    if let Some(p) = r.live.last().and_then(|l| l.pooled.as_ref()) {
+        let _ = writeln!(
+            std::io::stdout(),
+            "pooled estimate over {} stance(s): k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(fail) {:.3} (simulator {:.3}, closed form {:.3})",
+            p.stances,
+            p.k_s,
+            p.k_s_lo,
+            p.k_s_hi,
+            p.p_fail,
+            p.p_fail_simulator,
+            p.p_fail_closed_form
+        );
+    }
     if let Some(last) = r.live.last() {
         let i = &last.inference;
         let _ = writeln!(
             std::io::stdout(),
-            "last estimate: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(fail) {:.3} (slippage {:.3}, sinkage {:.3}) at {} deg",
+            "last stance's estimate: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(fail) {:.3} (slippage {:.3}, sinkage {:.3}) at {} deg",
             i.k_s,
             i.k_s_lo,
             i.k_s_hi,

@@ -134,6 +134,10 @@ pub struct LiveEstimate {
     /// simulator's and the closed form's verdicts and the decision, the larger of the two
     /// (`sandslope::servo::verdict`): what `--stop-on-risk` watches.
     pub pooled: Option<PooledEstimate>,
+    /// The risk `--stop-on-risk` compares: the largest of the pooled estimate's two verdicts
+    /// and this stance's own simulator verdict (so that sand that weakens mid-run halts the
+    /// gait on its first stance, before the pooled estimate follows it).
+    pub decision_p_fail: f64,
 }
 
 /// How a run ended without error.
@@ -678,8 +682,8 @@ impl Walk<'_> {
         let pooled_in: Vec<&[f64]> = self.stances[from..].iter().map(Vec::as_slice).collect();
         self.medians.push(inf.k_s);
         let pooled = pool(m.robot, m.terrain, m.slope, m.grid, &pooled_in, &self.medians[from..]);
-        let p = pooled.as_ref().map_or(inf.p_fail, |x| x.p_fail);
-        let live = LiveEstimate { time_s: time, tripod: k, inference: inf, pooled };
+        let p = pooled.as_ref().map_or(inf.p_fail, |x| x.p_fail.max(inf.p_fail));
+        let live = LiveEstimate { time_s: time, tripod: k, inference: inf, pooled, decision_p_fail: p };
         on_live(&live);
         report.live.push(live);
         if let (Some(limit), None) = (settings.stop_on_risk, self.halted) {

@@ -285,3 +285,82 @@ fn a_silent_servo_loses_only_its_own_row() {
         assert!(after.iter().filter(|&&l| l == leg).count() >= 2, "leg {leg}: {after:?}");
     }
 }
+
+/// `drive --slope 28` on the default terrain (glass beads, angle of repose 25 deg) is beyond
+/// the calibrated safe slope: refused, exit 2, naming the limit and --force, nothing moved;
+/// with --force (and sand the emulator can walk on) it runs.
+#[test]
+fn a_slope_beyond_the_safe_limit_needs_force() {
+    let out = bin().args(["drive", "--emulate", "--slope", "28", "--duration", "1"]).output().unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{all}");
+    assert!(all.contains("--slope 28 is beyond the calibrated safe slope"), "{all}");
+    assert!(all.contains("the sand's angle of repose, 25.0 deg"), "{all}");
+    assert!(all.contains("--force"), "{all}");
+    assert!(!all.contains("driving"), "{all}");
+    let _one = real_time();
+    let out = bin()
+        .args(["drive", "--emulate", "--slope", "28", "--force", "--emulate-k-s", "2e6", "--duration", "1"])
+        .args(["--watchdog", "2"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+}
+
+/// On sand of k_s 2.5e5 N/m^3 at 20 deg the calibrated closed form says slippage (k_s margin
+/// 0.49), the stride simulator success: `--stop-on-risk 0.5` halts on the closed form's
+/// verdict at the first stance estimated (tripod 1's first, which ends at 0.6 + 0.5 = 1.1 s;
+/// tripod 0's, the run-up's, is not estimated), exit 5; the JSON carries both verdicts.
+#[test]
+fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
+    let _one = real_time();
+    let out = bin()
+        .args(["drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "6"])
+        .args(["--stop-on-risk", "0.5", "--hold", "0.2", "--watchdog", "2", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(5), "{}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["outcome"], "halted");
+    let t = v["time_s"].as_f64().unwrap();
+    assert!(t < 1.3, "halted at {t} s");
+    let p = &v["live"][0]["pooled"];
+    let (sim, closed) = (p["p_fail_simulator"].as_f64().unwrap(), p["p_fail_closed_form"].as_f64().unwrap());
+    assert!(closed > 0.5 && closed > sim, "{p}");
+    assert_eq!(p["p_fail"].as_f64().unwrap(), closed.max(sim));
+    // The prior (the terrain's own k_s at 20 deg, inside its safe slope) did not halt it.
+    assert!(v["prior_p_fail"].as_f64().unwrap() < 0.5, "{v}");
+}
+
+/// Twenty emulated runs on constant sand (k_s 1.95e6 N/m^3, 20 deg, 6 s, seeds 1-20): the
+/// pooled 90% interval at the end covers the truth in at least 16 (nominal 90% less 10 points).
+#[test]
+fn the_pooled_interval_covers_the_truth_at_its_rate() {
+    let _one = real_time();
+    let mut covered = 0;
+    let mut seen = vec![];
+    for batch in (1..=20).collect::<Vec<u32>>().chunks(2) {
+        let children: Vec<_> = batch
+            .iter()
+            .map(|seed| {
+                bin()
+                    .args(["drive", "--emulate", "--slope", "20", "--emulate-k-s", "1.95e6", "--duration", "6"])
+                    .args(["--live", "--json", "--watchdog", "2", "--emulate-seed", &seed.to_string()])
+                    .stdout(Stdio::piped())
+                    .stderr(Stdio::null())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        for c in children {
+            let out = c.wait_with_output().unwrap();
+            assert!(out.status.success());
+            let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            let p = &v["live"].as_array().unwrap().last().unwrap()["pooled"];
+            let (lo, hi) = (p["k_s_lo"].as_f64().unwrap(), p["k_s_hi"].as_f64().unwrap());
+            covered += usize::from(lo <= 1.95e6 && 1.95e6 <= hi);
+            seen.push((lo, hi));
+        }
+    }
+    assert!(covered >= 16, "{covered} of 20: {seen:?}");
+}

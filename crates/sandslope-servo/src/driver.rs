@@ -195,7 +195,7 @@ pub struct DriveReport {
     /// The closed form's p_fail at the terrain's own uncertain k_s, the decision before the
     /// first stance is estimated (with a monitor).
     pub prior_p_fail: Option<f64>,
-    /// The legs' mean speed over the run's last quarter second as their positions give it,
+    /// The legs' mean speed over the run's last stride period as their positions give it,
     /// rad/s ([`crate::speed::LegSpeedMeter`]; the gait commands the robot's leg speed);
     /// `None` when no leg ran a quarter second.
     pub leg_speed_rad_s: Option<f64>,
@@ -265,7 +265,7 @@ pub fn drive(
     on_live: &mut dyn FnMut(&LiveEstimate),
 ) -> (DriveReport, Option<DriveError>) {
     let mut report = DriveReport::not_started(String::new());
-    let mut meter = crate::speed::LegSpeedMeter::new(settings.servos.len());
+    let mut meter = crate::speed::LegSpeedMeter::with_window(settings.servos.len(), schedule.period_s);
     let result = {
         let mut observed = |s: &ServoSample| {
             meter.observe(s.leg, s.time_s, s.leg_angle_rad);

@@ -3,6 +3,8 @@
 //! recovered from the currents, the halt on risk, torque off on every exit path, bad input.
 
 mod common;
+#[path = "drive/bench.rs"]
+mod bench;
 #[path = "drive/messy.rs"]
 mod messy;
 
@@ -297,8 +299,11 @@ fn drive_with(extra: &[&str]) -> (Option<i32>, String, std::path::PathBuf, tempf
     let log = dir.path().join("log.csv");
     // A generous cycle watchdog unless the test sets one: the test binaries share two cores.
     let watchdog = if extra.contains(&"--watchdog") { vec![] } else { vec!["--watchdog", "2"] };
+    let duration = if extra.contains(&"--duration") { vec![] } else { vec!["--duration", "3"] };
     let out = bin()
-        .args(["drive", "--emulate", "--duration", "3", "--log"])
+        .args(["drive", "--emulate"])
+        .args(&duration)
+        .arg("--log")
         .arg(&log)
         .args(&watchdog)
         .args(extra)

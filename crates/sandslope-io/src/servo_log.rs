@@ -81,7 +81,7 @@ impl<W: Write> ServoLogWriter<W> {
         for (k, v) in meta {
             writeln!(out, "# {k} = {v}")?;
         }
-        Ok(ServoLogWriter { writer: csv::Writer::from_writer(out), rows: 0 })
+        Ok(ServoLogWriter { writer: csv::WriterBuilder::new().flexible(true).from_writer(out), rows: 0 })
     }
 
     /// Appends a row (flushing every 60 rows, ten cycles of six servos).
@@ -94,6 +94,18 @@ impl<W: Write> ServoLogWriter<W> {
         Ok(())
     }
 
+    /// Writes `# key = value` between the rows (a live estimate as it came; `pandas.read_csv`
+    /// with `comment="#"` and [`read_servo_log`] skip it). Commas in `value` become semicolons.
+    pub fn note(&mut self, key: &str, value: &str) -> std::io::Result<()> {
+        let line = format!("# {key} = {}", value.replace([',', '"', '\n', '\r'], ";"));
+        self.writer.write_record([line.as_str()]).map_err(std::io::Error::other)
+    }
+
+    /// Flushes the rows written so far to the file (the flight recorder does after every row).
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        self.writer.flush()
+    }
+
     /// Rows written.
     pub fn rows(&self) -> usize {
         self.rows
@@ -102,6 +114,106 @@ impl<W: Write> ServoLogWriter<W> {
     /// Flushes everything.
     pub fn finish(mut self) -> std::io::Result<()> {
         self.writer.flush()
+    }
+}
+
+/// Width of each of the flight recorder's status lines, bytes with the line end: rewritten in
+/// place when the run ends.
+const STATUS_LINE: usize = 100;
+
+/// The status lines' keys, in order: `status` (`incomplete` until the run ends, then how it
+/// ended), the achieved cycle rate and the cycles' jitter.
+pub const STATUS_KEYS: [&str; 4] = ["status", "achieved_rate_hz", "cycle_jitter_ms", "max_cycle_ms"];
+
+/// The value a log's `status` line holds while its run is under way (or after it was killed).
+pub const INCOMPLETE: &str =
+    "incomplete (the run had not ended when this was written: killed, or power lost)";
+
+/// The servo log as a flight recorder (docs/drive.md, "The log"): written under its own name
+/// from the first cycle, every row flushed to the file as it comes and the file synced to the
+/// disk every second, so that a process killed without a word (SIGKILL, the OOM killer) or a
+/// machine that loses power leaves every cycle up to the last second readable. Its first lines
+/// are fixed-width status lines, `# status = incomplete ...` until [`FlightLog::finish`]
+/// rewrites them in place with how the run ended, its achieved rate and jitter.
+#[derive(Debug)]
+pub struct FlightLog {
+    file: std::fs::File,
+    writer: ServoLogWriter<std::io::BufWriter<std::fs::File>>,
+    last_sync: std::time::Instant,
+}
+
+fn status_line(key: &str, value: &str) -> Vec<u8> {
+    let mut line = format!("# {key} = {value}");
+    line.truncate(STATUS_LINE - 1);
+    let mut bytes = format!("{line:<width$}\n", width = STATUS_LINE - 1).into_bytes();
+    bytes.truncate(STATUS_LINE);
+    bytes
+}
+
+impl FlightLog {
+    /// Creates the log at `path` with `meta` as its header. A file already there is replaced
+    /// (removed, then a new one created `O_EXCL`, so nothing planted in between is opened); a
+    /// symbolic link, a folder or a device at `path` is refused.
+    pub fn create(path: &Path, meta: &[(&str, String)]) -> Result<FlightLog> {
+        match std::fs::symlink_metadata(path) {
+            Ok(m) if m.file_type().is_symlink() => bail!(
+                "--log {}: a symbolic link; give the log's own path (a link could point at a file that is not a log)",
+                path.display()
+            ),
+            Ok(m) if !m.is_file() => {
+                bail!("--log {}: not a regular file (a folder or a device); give a file's path", path.display())
+            }
+            Ok(_) => std::fs::remove_file(path)
+                .with_context(|| format!("cannot replace the servo log {}", path.display()))?,
+            Err(_) => {}
+        }
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(path)
+            .map_err(|source| crate::WriteError { path: path.to_path_buf(), source })?;
+        let mut out = std::io::BufWriter::new(file.try_clone()?);
+        for key in STATUS_KEYS {
+            out.write_all(&status_line(key, if key == "status" { INCOMPLETE } else { "" }))?;
+        }
+        let mut writer = ServoLogWriter::new(out, meta)?;
+        writer.flush()?;
+        Ok(FlightLog { file, writer, last_sync: std::time::Instant::now() })
+    }
+
+    /// Appends a row, flushed to the file at once and synced to the disk once a second.
+    pub fn write(&mut self, row: &ServoLogRow) -> std::io::Result<()> {
+        self.writer.write(row)?;
+        self.writer.flush()?;
+        if self.last_sync.elapsed().as_secs_f64() >= 1.0 {
+            self.file.sync_data()?;
+            self.last_sync = std::time::Instant::now();
+        }
+        Ok(())
+    }
+
+    /// Rows written.
+    pub fn rows(&self) -> usize {
+        self.writer.rows()
+    }
+
+    /// Writes a `# key = value` note between the rows, flushed at once ([`ServoLogWriter::note`]).
+    pub fn note(&mut self, key: &str, value: &str) -> std::io::Result<()> {
+        self.writer.note(key, value)?;
+        self.writer.flush()
+    }
+
+    /// Ends the log: the rows flushed, the status lines rewritten with `status` (the values of
+    /// [`STATUS_KEYS`] in order), and the file synced.
+    pub fn finish(self, status: &[String; 4]) -> std::io::Result<()> {
+        let FlightLog { file, writer, .. } = self;
+        writer.finish()?;
+        let mut head = Vec::with_capacity(4 * STATUS_LINE);
+        for (key, value) in STATUS_KEYS.iter().zip(status) {
+            head.extend(status_line(key, value));
+        }
+        std::os::unix::fs::FileExt::write_all_at(&file, &head, 0)?;
+        file.sync_all()
     }
 }
 
@@ -200,8 +312,8 @@ fn some_lines(lines: &[usize]) -> String {
 /// time, ID or leg is missing, a field that is not a number, a row with the wrong number of
 /// fields, one servo with two different rows at one time, one ID on two legs.
 pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read servo log {}", path.display()))?;
+    let text = read_log_text(path)?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let mut meta = BTreeMap::new();
     let mut header_lines = 0usize;
     for line in text.lines() {
@@ -212,6 +324,12 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
         }
     }
     let mut notes = vec![];
+    if meta.get("status").is_some_and(|v| v.starts_with("incomplete")) {
+        notes.push(
+            "the log is marked incomplete: its run did not end (the process was killed or the machine lost power); its rows are what was written up to then"
+                .to_string(),
+        );
+    }
     let mut body_lines: Vec<&str> = text.lines().skip(header_lines).collect();
     if !text.is_empty() && !text.ends_with('\n') && body_lines.len() > 1 {
         let line = header_lines + body_lines.len();
@@ -221,7 +339,7 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
         ));
     }
     let body = body_lines.join("\n");
-    let mut reader = csv::ReaderBuilder::new().flexible(true).from_reader(body.as_bytes());
+    let mut reader = csv::ReaderBuilder::new().flexible(true).comment(Some(b'#')).from_reader(body.as_bytes());
     let headers =
         reader.headers().with_context(|| format!("{}: no column header line", path.display()))?.clone();
     let mut col = [0usize; 14];
@@ -236,7 +354,11 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
     }
     let (mut rows, mut lines, mut missing) = (Vec::new(), Vec::new(), Vec::new());
     for (i, rec) in reader.records().enumerate() {
-        let line = header_lines + 2 + i;
+        // The file's line: the body's (notes between rows are skipped) after the header's.
+        let line = match &rec {
+            Ok(r) => r.position().map_or(header_lines + 2 + i, |p| header_lines + p.line() as usize),
+            Err(_) => header_lines + 2 + i,
+        };
         let rec =
             rec.map_err(|e| anyhow!("{}: line {line}: {}", path.display(), e.to_string().trim_end()))?;
         let plain = |line: usize| format!("{}: line {line}", path.display());
@@ -264,6 +386,18 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
         if !complete {
             missing.push(line);
             continue;
+        }
+        if let Some((k, (lo, hi, unit))) = PLAUSIBLE
+            .iter()
+            .enumerate()
+            .find_map(|(k, r)| r.filter(|(lo, hi, _)| !(*lo..=*hi).contains(&v[k])).map(|r| (k, r)))
+        {
+            bail!(
+                "{}: `{}` = {} is outside {lo} to {hi} {unit}, the plausible range of a Dynamixel's reading (is the column in the log's unit?)",
+                at(),
+                COLUMNS[k],
+                if v[k].abs() >= 1e6 { format!("{:e}", v[k]) } else { v[k].to_string() }
+            );
         }
         let int = |k: usize, lo: i64, hi: i64| whole(v[k], COLUMNS[k], lo, hi, &at);
         rows.push(ServoLogRow {
@@ -299,6 +433,68 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
         bail!("{}: the log has no complete rows", path.display());
     }
     Ok(ServoLog { meta, rows, lines, notes })
+}
+
+/// The plausible range of each column, in the order of [`COLUMNS`] (`None`: any finite value):
+/// wide enough for every Dynamixel X servo (the XM430-W350 stalls at 4.1 N m, 2.3 A, and runs
+/// on up to 14.8 V), narrow enough to catch a column in the wrong unit (torque in N mm, current
+/// in A) or garbage such as 1e300.
+const PLAUSIBLE: [Option<(f64, f64, &str)>; 14] = [
+    Some((-1e6, 1e6, "s")),
+    None,
+    None,
+    None,
+    None,
+    None,
+    Some((-10_000.0, 10_000.0, "mA")),
+    Some((-1000.0, 1000.0, "%")),
+    Some((0.0, 30.0, "V")),
+    Some((-40.0, 150.0, "degC")),
+    None,
+    None,
+    Some((-1e7, 1e7, "rad")),
+    Some((-20.0, 20.0, "N m")),
+];
+
+/// Largest servo log read, bytes (a little above [`MAX_ROWS`] rows of about 120 bytes).
+pub const MAX_LOG_BYTES: u64 = 1 << 30;
+
+/// Longest line of a servo log, bytes (a row is about 120).
+pub const MAX_LINE_BYTES: usize = 64 * 1024;
+
+/// The log's text, its size checked before anything is read and every line's length as it is
+/// read (a file of no line ends is refused at its first 64 KiB, not read whole).
+fn read_log_text(path: &Path) -> Result<String> {
+    use std::io::BufRead;
+    let cannot = || format!("cannot read servo log {}", path.display());
+    let file = std::fs::File::open(path).with_context(cannot)?;
+    let size = file.metadata().with_context(cannot)?.len();
+    if size > MAX_LOG_BYTES {
+        bail!(
+            "{}: {size} bytes, more than the {MAX_LOG_BYTES} a servo log may hold ({MAX_ROWS} rows); split the log",
+            path.display()
+        );
+    }
+    let mut reader = std::io::BufReader::new(file);
+    let mut bytes = Vec::with_capacity(size as usize);
+    let mut line = 0usize;
+    loop {
+        line += 1;
+        let before = bytes.len();
+        let n = std::io::Read::take(&mut reader, MAX_LINE_BYTES as u64 + 1)
+            .read_until(b'\n', &mut bytes)
+            .with_context(cannot)?;
+        if n == 0 {
+            break;
+        }
+        if bytes.len() - before > MAX_LINE_BYTES && bytes.last() != Some(&b'\n') {
+            bail!(
+                "{}: line {line} is longer than {MAX_LINE_BYTES} bytes (a row is about 120): not a servo log, or its line ends are missing",
+                path.display()
+            );
+        }
+    }
+    String::from_utf8(bytes).map_err(|e| anyhow!("{}: not UTF-8 text ({e})", path.display()))
 }
 
 /// Sorts the rows by time, reads a repeated row once, refuses two different rows of one servo
@@ -568,5 +764,70 @@ mod tests {
         std::fs::write(&path, format!("{}\n1,x,0,0,0,0,0,0,0,0,0,0,0,0\n", COLUMNS.join(","))).unwrap();
         let e = read_servo_log(&path).unwrap_err().to_string();
         assert!(e.contains("line 2"), "{e}");
+    }
+
+    fn row(t: f64) -> ServoLogRow {
+        ServoLogRow {
+            time_s: t,
+            id: 1,
+            leg: 0,
+            tripod: 0,
+            present_position: 0,
+            present_velocity: 0,
+            present_current_ma: 100,
+            load_percent: 6.8,
+            input_voltage_v: 5.0,
+            temperature_c: 30,
+            hardware_error: 0,
+            goal_position: 0,
+            leg_angle_rad: 0.1,
+            drive_torque_n_m: 0.035,
+        }
+    }
+
+    /// The flight recorder: rows on disk as they come, `incomplete` until finished, then the
+    /// status lines rewritten in place (the rows untouched); a symbolic link refused.
+    #[test]
+    fn the_flight_log_is_readable_before_it_is_finished() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("run.csv");
+        let mut log = FlightLog::create(&path, &[("slope_deg", "10".into())]).unwrap();
+        log.write(&row(0.0)).unwrap();
+        log.write(&row(0.02)).unwrap();
+        // Read while the run is under way (as after a SIGKILL): both rows, and a note.
+        let read = read_servo_log(&path).unwrap();
+        assert_eq!(read.rows.len(), 2);
+        assert!(read.meta["status"].starts_with("incomplete"));
+        assert!(read.notes.iter().any(|n| n.contains("marked incomplete")), "{:?}", read.notes);
+        let before = std::fs::read(&path).unwrap().len();
+        log.finish(&["completed".into(), "49.90".into(), "0.40".into(), "22.0".into()]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text.len(), before, "the status lines are rewritten in place");
+        let read = read_servo_log(&path).unwrap();
+        assert_eq!(read.meta["status"], "completed");
+        assert_eq!(read.meta["achieved_rate_hz"], "49.90");
+        assert!(read.notes.is_empty(), "{:?}", read.notes);
+        let link = dir.path().join("link.csv");
+        std::os::unix::fs::symlink(&path, &link).unwrap();
+        let e = FlightLog::create(&link, &[]).unwrap_err().to_string();
+        assert!(e.contains("a symbolic link"), "{e}");
+    }
+
+    /// A UTF-8 BOM (a spreadsheet's export) does not hide `time_s`; a line of 64 KiB and more is
+    /// refused at once, naming it; values far outside a servo's range name the column and unit.
+    #[test]
+    fn the_reader_takes_a_bom_and_refuses_long_lines_and_implausible_values() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("log.csv");
+        let good = "0,1,0,0,0,0,100,6.8,5,30,0,0,0.1,0.035\n";
+        std::fs::write(&path, format!("\u{feff}{}\n{good}", COLUMNS.join(","))).unwrap();
+        assert_eq!(read_servo_log(&path).unwrap().rows, vec![row(0.0)]);
+        std::fs::write(&path, "x".repeat(200_000)).unwrap();
+        let e = read_servo_log(&path).unwrap_err().to_string();
+        assert!(e.contains("line 1 is longer than 65536 bytes"), "{e}");
+        let huge = good.replace("0.035", "1e300");
+        std::fs::write(&path, format!("{}\n{huge}", COLUMNS.join(","))).unwrap();
+        let e = read_servo_log(&path).unwrap_err().to_string();
+        assert!(e.contains("line 2") && e.contains("`drive_torque_n_m` = 1e300 is outside -20 to 20 N m"), "{e}");
     }
 }

@@ -146,7 +146,7 @@ pub fn drive_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
 /// (as [`read_servo_log`]), `report` what `drive --json` prints, with the emulator's last word
 /// under `emulator`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg=None, duration_s=None, k_s=None, noise_ma=None, seed=None, weaken=None, stop_on_risk=None, hold_s=None, rate_hz=None, live=None))]
+#[pyo3(signature = (robot, terrain, slope_deg=None, duration_s=None, k_s=None, noise_ma=None, seed=None, weaken=None, stop_on_risk=None, hold_s=None, rate_hz=None, live=None, force=None, window=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn drive<'py>(
     py: Python<'py>,
@@ -162,7 +162,12 @@ pub fn drive<'py>(
     hold_s: Option<f64>,
     rate_hz: Option<f64>,
     live: Option<bool>,
+    force: Option<bool>,
+    window: Option<usize>,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
+    if window == Some(0) {
+        return Err(value_error("window = 0 must be at least 1 stance (None pools every stance)"));
+    }
     // `drive`'s defaults, from the one typed set its flags take theirs from.
     let d = RUN_DEFAULTS;
     let slope_deg = slope_deg.unwrap_or(d.slope_deg);
@@ -218,6 +223,8 @@ pub fn drive<'py>(
         settings,
         bus: BusChoice::Emulate(EmulateOptions { k_s, noise_ma, seed, faults, current_offset_ma: vec![] }),
         monitor: live,
+        window,
+        force: force.unwrap_or(false),
     };
     let (samples, report, emulator) = py
         .detach(move || -> Result<_, String> {

@@ -255,8 +255,9 @@ impl ServoLogRequest {
             Words::Flag => "--slope",
             Words::Keyword => "slope_deg",
         };
-        let slope_deg = match (self.slope_deg, log.meta_f64("slope_deg", path).map_err(file_error)?) {
-            (Some(s), _) | (None, Some(s)) => s,
+        let (slope_deg, from_header) = match (self.slope_deg, log.meta_f64("slope_deg", path).map_err(file_error)?) {
+            (Some(s), _) => (s, false),
+            (None, Some(s)) => (s, true),
             (None, None) => {
                 let give = match words {
                     Words::Flag => "give the run's slope with --slope",
@@ -268,8 +269,15 @@ impl ServoLogRequest {
                 ));
             }
         };
-        let slope = SignedSlope::from_degrees(slope_deg)
-            .map_err(|e| RequestError::invalid("slope", e.renamed(slope_name)))?;
+        // A bad slope read from the header is the header's, not a flag the user did not give.
+        let slope = SignedSlope::from_degrees(slope_deg).map_err(|e| {
+            if from_header {
+                let e = e.renamed(format!("{}: header line `# slope_deg`", path.display()));
+                RequestError::invalid("slope", format!("{e}; give the run's slope with {slope_name}"))
+            } else {
+                RequestError::invalid("slope", e.renamed(slope_name))
+            }
+        })?;
         let traces = log.leg_traces(2 * robot.stance_legs() as usize, path).map_err(file_error)?;
         let settings = CurrentInferenceSettings { prior, grid_points, ..Default::default() };
         Ok(ServoLogRun { path: path.to_path_buf(), slope, traces, notes: log.notes, settings })

@@ -50,7 +50,7 @@ pub struct DriveStatus {
     /// Commanded leg speed omega, rad/s (the robot file's).
     pub commanded_leg_speed_rad_s: f64,
     /// Measured leg speed, rad/s: the mean over the legs of each one's turn over the last
-    /// quarter second, from Present Position.
+    /// stride period, from Present Position.
     pub leg_speed_rad_s: f64,
     /// `--stop-on-risk`'s threshold on P(fail), if set.
     pub stop_on_risk: Option<f64>,
@@ -191,13 +191,21 @@ impl DriveThread {
     }
 }
 
+/// A line on stderr that a closed stderr does not turn into a panic (the torque-off and the
+/// process's exit code come first).
+macro_rules! say {
+    ($($t:tt)*) => {{
+        let _ = std::io::Write::write_fmt(&mut std::io::stderr(), format_args!("{}\n", format_args!($($t)*)));
+    }};
+}
+
 /// The drive thread: the run, its status kept for the page, torque off, then (after a
 /// signal) the end of the process.
 fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<LogFile>) {
     // Either flag stops the gait: the stop button's or the signal handler's.
     let stop = AtomicBool::new(false);
-    // Each leg's speed from its positions a quarter second apart, as the run's report gives it.
-    let mut meter = LegSpeedMeter::new(session.config().settings.servos.len());
+    // Each leg's speed from its positions a stride period apart, as the run's report gives it.
+    let mut meter = LegSpeedMeter::with_window(session.config().settings.servos.len(), session.schedule.period_s);
     let mut on_sample = |s: &ServoSample| {
         if live.stop.load(Ordering::Relaxed) || flags.stop.load(Ordering::Relaxed) {
             stop.store(true, Ordering::Relaxed);
@@ -221,7 +229,7 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
         live.update(|st| {
             st.estimates += 1;
             if let Some(p) = st.stop_on_risk {
-                st.halted |= l.inference.p_fail > p;
+                st.halted |= l.decision_p_fail > p;
             }
             st.live = Some(l.clone());
         });
@@ -235,32 +243,25 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
     let (report, mut failure) = match driven {
         Ok((report, failure)) => (report, failure.map(|e| e.to_string())),
         // The log could not be started (nothing moved).
-        Err(e) => (
-            DriveReport {
-                outcome: Err(format!("{e:#}")),
-                cycles: 0,
-                rate_hz: 0.0,
-                live: vec![],
-                leg_speed_rad_s: None,
-                torque_off: TorqueOff::default(),
-                gait_zero: None,
-            },
-            Some(format!("the log could not be written: {e:#}")),
-        ),
+        Err(e) => {
+            (DriveReport::not_started(format!("{e:#}")), Some(format!("the log could not be written: {e:#}")))
+        }
     };
     if let (Err(e), None) = (committed, &failure) {
         failure = Some(format!("the log could not be put in place: {e:#}"));
     }
     finish(live, &report, failure.as_deref(), emulator);
     if let Some(l) = &log {
-        eprintln!("drive: log {}", l.path.display());
+        say!("drive: log {}", l.path.display());
     }
     flags.driving.store(false, Ordering::SeqCst);
-    if flags.stop.load(Ordering::SeqCst) && !live.stop.load(Ordering::SeqCst) {
-        // A signal asked the process to end: the torque is off and the log in place, so it may.
+    // A signal asked the process to end: the torque is off and the log in place, so it may;
+    // also when the stop button had stopped the gait just before (a SIGTERM a few ms after
+    // the button was lost when only the button's flag was looked at).
+    if flags.stop.load(Ordering::SeqCst) {
         let signal = flags.signal.load(Ordering::SeqCst);
         let code = 128 + if signal > 0 { signal } else { 2 };
-        eprintln!("interrupted (signal {signal}): the gait was stopped and the torque turned off");
+        say!("interrupted (signal {signal}): the gait was stopped and the torque turned off");
         std::process::exit(code);
     }
 }
@@ -269,7 +270,7 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
 fn finish(live: &LiveDrive, report: &DriveReport, failure: Option<&str>, emulator: Option<String>) {
     let off = &report.torque_off;
     let list = |ids: &[u8]| ids.iter().map(u8::to_string).collect::<Vec<_>>().join(", ");
-    eprintln!(
+    say!(
         "drive: {} cycles; torque off confirmed on servos {}{}",
         report.cycles,
         if off.confirmed.is_empty() { "none".into() } else { list(&off.confirmed) },
@@ -280,10 +281,10 @@ fn finish(live: &LiveDrive, report: &DriveReport, failure: Option<&str>, emulato
         }
     );
     if let Some(e) = failure {
-        eprintln!("drive: {e}");
+        say!("drive: {e}");
     }
     if let Some(e) = &emulator {
-        eprintln!("{e}");
+        say!("{e}");
     }
     live.update(|st| {
         st.state = match (&report.outcome, failure) {

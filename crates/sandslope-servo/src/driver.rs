@@ -22,13 +22,17 @@ use std::time::{Duration, Instant};
 use dynamixel2::instructions::SyncWriteData;
 use dynamixel2::{Bus, ReadError};
 use sandslope::infer::servo::{infer_from_stance, CurrentInference, ModelGrid};
+use sandslope::risk::UncertainTerrain;
+use sandslope::servo::verdict::{pool, prior_p_fail, PooledEstimate};
 use sandslope::servo::{xl330, GaitSchedule};
-use sandslope::Robot;
+use sandslope::{Robot, Slope};
 use serde::Serialize;
 
 pub use crate::error::{hardware_faults, DriveError};
+use crate::guard::{Following, GoalCheck};
+pub use crate::setup::{setup_writes, velocity_limit_units, SetupDone, SetupWrite};
 use crate::stance::StanceBins;
-use crate::table::{self as t, mode, read_states, PresentState};
+use crate::table::{self as t, read_states, PresentState};
 
 /// One servo as mounted on the robot (the robot file's `[servos]` table).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -124,8 +128,16 @@ pub struct LiveEstimate {
     pub time_s: f64,
     /// Tripod.
     pub tripod: usize,
-    /// The estimate.
+    /// The estimate from this stance alone.
     pub inference: CurrentInference,
+    /// The stances so far pooled (the last `window` of them with a moving window), with the
+    /// simulator's and the closed form's verdicts and the decision, the larger of the two
+    /// (`sandslope::servo::verdict`): what `--stop-on-risk` watches.
+    pub pooled: Option<PooledEstimate>,
+    /// The risk `--stop-on-risk` compares: the largest of the pooled estimate's two verdicts
+    /// and this stance's own simulator verdict (so that sand that weakens mid-run halts the
+    /// gait on its first stance, before the pooled estimate follows it).
+    pub decision_p_fail: f64,
 }
 
 /// How a run ended without error.
@@ -160,8 +172,10 @@ pub struct TorqueOff {
     pub unconfirmed: Vec<u8>,
 }
 
-/// The whole run's answer.
-#[derive(Debug, Serialize)]
+/// The whole run's answer. As JSON (`drive --json`, Python's `drive`), how it ended is flat:
+/// `outcome` (`completed`, `interrupted`, `halted` or `failed`), `time_s`, `p_fail` for a
+/// halt and `error` for a failure, beside the other fields (`crate::report`).
+#[derive(Debug)]
 pub struct DriveReport {
     /// How it ended.
     pub outcome: Result<DriveOutcome, String>,
@@ -169,9 +183,19 @@ pub struct DriveReport {
     pub cycles: usize,
     /// Mean cycle rate, Hz.
     pub rate_hz: f64,
+    /// The cycles' spread: the standard deviation of the time between cycle starts, ms.
+    pub cycle_jitter_ms: f64,
+    /// The longest time between cycle starts, ms.
+    pub max_cycle_ms: f64,
+    /// What the setup wrote (EEPROM writes made and kept) and whether the revolution counters
+    /// were cleared.
+    pub setup: SetupDone,
     /// Live estimates, one per stance (with a monitor).
     pub live: Vec<LiveEstimate>,
-    /// The legs' mean speed over the run's last quarter second as their positions give it,
+    /// The closed form's p_fail at the terrain's own uncertain k_s, the decision before the
+    /// first stance is estimated (with a monitor).
+    pub prior_p_fail: Option<f64>,
+    /// The legs' mean speed over the run's last stride period as their positions give it,
     /// rad/s ([`crate::speed::LegSpeedMeter`]; the gait commands the robot's leg speed);
     /// `None` when no leg ran a quarter second.
     pub leg_speed_rad_s: Option<f64>,
@@ -180,8 +204,26 @@ pub struct DriveReport {
     /// The instant of gait time 0 (the legs stood up, `stand_s` after the walk's first
     /// cycle), to put another clock on the log's (the emulator's weakening); `None` when the
     /// run ended before it began.
-    #[serde(skip)]
     pub gait_zero: Option<Instant>,
+}
+
+impl DriveReport {
+    /// The report of a run that never started (the log could not be opened: nothing moved).
+    pub fn not_started(message: String) -> DriveReport {
+        DriveReport {
+            outcome: Err(message),
+            cycles: 0,
+            rate_hz: 0.0,
+            cycle_jitter_ms: 0.0,
+            max_cycle_ms: 0.0,
+            setup: SetupDone::default(),
+            live: vec![],
+            prior_p_fail: None,
+            leg_speed_rad_s: None,
+            torque_off: TorqueOff::default(),
+            gait_zero: None,
+        }
+    }
 }
 
 /// The live monitor: the robot, the simulator's grid at the slope, and one sample's torque
@@ -194,6 +236,13 @@ pub struct Monitor<'a> {
     pub grid: &'a ModelGrid,
     /// SD of one torque sample, N m.
     pub noise_sd_n_m: f64,
+    /// The terrain with its uncertainty (the closed form's verdict and the prior's).
+    pub terrain: &'a UncertainTerrain,
+    /// The slope as the closed form takes it.
+    pub slope: Slope,
+    /// Pool the last this many stances (a moving window that follows changing sand); `None`:
+    /// every stance so far.
+    pub window: Option<usize>,
 }
 
 /// Phase correction of the velocity profile: speed added per radian of lag, 1/s.
@@ -215,23 +264,17 @@ pub fn drive(
     on_sample: &mut dyn FnMut(&ServoSample) -> std::io::Result<()>,
     on_live: &mut dyn FnMut(&LiveEstimate),
 ) -> (DriveReport, Option<DriveError>) {
-    let mut report = DriveReport {
-        outcome: Err(String::new()),
-        cycles: 0,
-        rate_hz: 0.0,
-        live: vec![],
-        leg_speed_rad_s: None,
-        torque_off: TorqueOff::default(),
-        gait_zero: None,
-    };
-    let mut meter = crate::speed::LegSpeedMeter::new(settings.servos.len());
+    let mut report = DriveReport::not_started(String::new());
+    let mut meter = crate::speed::LegSpeedMeter::with_window(settings.servos.len(), schedule.period_s);
     let result = {
         let mut observed = |s: &ServoSample| {
             meter.observe(s.leg, s.time_s, s.leg_angle_rad);
             on_sample(s)
         };
-        setup(bus, schedule, settings)
-            .and_then(|()| run(bus, schedule, settings, monitor, stop, &mut observed, on_live, &mut report))
+        crate::setup::setup(bus, schedule, settings).and_then(|done| {
+            report.setup = done;
+            run(bus, schedule, settings, monitor, stop, &mut observed, on_live, &mut report)
+        })
     };
     report.leg_speed_rad_s = meter.mean();
     report.torque_off = torque_off(bus, &settings.servos);
@@ -247,175 +290,7 @@ pub fn drive(
     }
 }
 
-fn setup(
-    bus: &mut DynamixelBus,
-    schedule: &GaitSchedule,
-    settings: &DriveSettings,
-) -> Result<(), DriveError> {
-    let baud = bus.baud_rate();
-    let mut answered = vec![];
-    let mut missing = None;
-    for (leg, s) in settings.servos.iter().enumerate() {
-        let mut ping = bus.ping(s.id);
-        for _ in 0..2 {
-            if ping.is_ok() {
-                break;
-            }
-            ping = bus.ping(s.id);
-        }
-        match ping {
-            Ok(r) => {
-                if r.data.model != xl330::MODEL_NUMBER {
-                    return Err(DriveError::WrongModel {
-                        id: s.id,
-                        leg,
-                        model: r.data.model,
-                        expected: xl330::MODEL_NUMBER,
-                    });
-                }
-                answered.push(s.id);
-            }
-            Err(_) => {
-                if missing.is_none() {
-                    missing = Some((s.id, leg));
-                }
-            }
-        }
-    }
-    if let Some((id, leg)) = missing {
-        // Which IDs are on the bus at all: a broadcast ping.
-        let mut found: Vec<u8> = bus
-            .scan()
-            .map(|v| v.into_iter().filter_map(|r| r.ok().map(|r| r.motor_id)).collect())
-            .unwrap_or_default();
-        found.sort_unstable();
-        found.dedup();
-        let answered = if found.is_empty() {
-            "none".to_string()
-        } else {
-            found.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ")
-        };
-        return Err(DriveError::Missing { id, leg, baud, answered });
-    }
-    let writes = setup_writes(schedule, settings);
-    for (leg, s) in settings.servos.iter().enumerate() {
-        let id = s.id;
-        // Each write up to three times: a busy USB adapter (or machine) can miss one reply.
-        for write in &writes {
-            let data = &write.value.to_le_bytes()[..write.width];
-            let mut last = None;
-            for _ in 0..3 {
-                match bus.write(id, write.addr, data) {
-                    Ok(_) => {
-                        last = None;
-                        break;
-                    }
-                    Err(e) => last = Some(e.to_string()),
-                }
-            }
-            if let Some(reason) = last {
-                return Err(DriveError::Setup { id, leg, what: write.what, reason, fix: write.fix });
-            }
-        }
-    }
-    Ok(())
-}
-
-/// One control-table write of a servo's setup, before it stands.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SetupWrite {
-    /// The register's name, as `drive --dry-run` prints it.
-    pub name: &'static str,
-    /// The register's address.
-    pub addr: u16,
-    /// The value written, little-endian in `width` bytes.
-    pub value: u32,
-    /// The register's width, bytes (1, 2 or 4).
-    pub width: usize,
-    /// What a failed write names.
-    pub what: &'static str,
-    /// What to do about it.
-    pub fix: &'static str,
-}
-
-/// Every servo's setup, in the order written (docs/drive.md): torque off, the bus watchdog
-/// cleared, the operating mode for the profile, a velocity-based profile, the current and
-/// temperature limits, the velocity limit (2 omega), the profile's acceleration (position: 0,
-/// the schedule's own run-up limits it; velocity: omega over the run-up) and velocity
-/// (1.5 omega), and the bus watchdog; what `drive` writes and `drive --dry-run` prints.
-pub fn setup_writes(schedule: &GaitSchedule, settings: &DriveSettings) -> Vec<SetupWrite> {
-    let omega = schedule.leg_speed_rad_s;
-    let op = match settings.profile {
-        Profile::Position => mode::EXTENDED_POSITION,
-        Profile::Velocity => mode::VELOCITY,
-    };
-    let accel = match settings.profile {
-        Profile::Position => 0,
-        Profile::Velocity => ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT)
-            .round()
-            .clamp(1.0, 32767.0) as u32,
-    };
-    let prof_v = (1.5 * omega / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, 32767.0) as u32;
-    let vel_limit = (2.0 * omega / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, 2047.0) as u32;
-    let watchdog = (settings.bus_watchdog_s / xl330::WATCHDOG_UNIT_S).round().clamp(1.0, 127.0) as u32;
-    let w = |name, addr, value, width, what, fix| SetupWrite { name, addr, value, width, what, fix };
-    vec![
-        w("Torque Enable", t::TORQUE_ENABLE, 0, 1, "Torque Enable = 0", "power-cycle the servo"),
-        w("Bus Watchdog", t::BUS_WATCHDOG, 0, 1, "Bus Watchdog = 0", "reboot the servo (Dynamixel Wizard)"),
-        w(
-            "Operating Mode",
-            t::OPERATING_MODE,
-            u32::from(op),
-            1,
-            "Operating Mode",
-            "check the model is an XL330",
-        ),
-        w(
-            "Drive Mode (velocity-based profile)",
-            t::DRIVE_MODE,
-            0,
-            1,
-            "Drive Mode = 0 (velocity-based profile)",
-            "check the model is an XL330",
-        ),
-        w(
-            "Current Limit (mA)",
-            t::CURRENT_LIMIT,
-            u32::from(settings.current_limit_ma),
-            2,
-            "Current Limit",
-            "use --current-limit within 0 to 1750 mA",
-        ),
-        w(
-            "Temperature Limit (degC)",
-            t::TEMPERATURE_LIMIT,
-            u32::from(settings.temperature_limit_c),
-            1,
-            "Temperature Limit",
-            "use --temperature-limit within 0 to 70 degC",
-        ),
-        w("Velocity Limit", t::VELOCITY_LIMIT, vel_limit, 4, "Velocity Limit", "lower leg_speed_rad_s"),
-        w(
-            "Profile Acceleration",
-            t::PROFILE_ACCELERATION,
-            accel,
-            4,
-            "Profile Acceleration",
-            "raise response_time_s",
-        ),
-        w("Profile Velocity", t::PROFILE_VELOCITY, prof_v, 4, "Profile Velocity", "lower leg_speed_rad_s"),
-        w(
-            "Bus Watchdog (20 ms)",
-            t::BUS_WATCHDOG,
-            watchdog,
-            1,
-            "Bus Watchdog",
-            "reboot the servo (Dynamixel Wizard)",
-        ),
-    ]
-}
-
-/// The start pose found when standing up/// The start pose found when standing up: each leg's start goal (the nearest turn of its start
+/// The start pose found when standing up: each leg's start goal (the nearest turn of its start
 /// angle) and the shift of the schedule's angles to it.
 struct Stand {
     start_goal: Vec<i32>,
@@ -433,6 +308,39 @@ struct Walk<'m> {
     /// `(time, p_fail)` of a halt on risk, and the goals held since.
     halted: Option<(f64, f64)>,
     halt_goal: Vec<i32>,
+    /// The goal registers' readback and the following error.
+    goal_check: GoalCheck,
+    following: Following,
+    /// Each stance's posterior over the grid and its median, for the pooled estimate.
+    stances: Vec<Vec<f64>>,
+    medians: Vec<f64>,
+}
+
+/// The spread of the times between cycle starts.
+#[derive(Debug, Default)]
+struct Jitter {
+    n: usize,
+    sum: f64,
+    sum_sq: f64,
+    max: f64,
+}
+
+impl Jitter {
+    fn add(&mut self, dt: f64) {
+        self.n += 1;
+        self.sum += dt;
+        self.sum_sq += dt * dt;
+        self.max = self.max.max(dt);
+    }
+    /// Standard deviation and maximum, ms.
+    fn ms(&self) -> (f64, f64) {
+        if self.n < 2 {
+            return (0.0, 1e3 * self.max);
+        }
+        let n = self.n as f64;
+        let var = (self.sum_sq - self.sum * self.sum / n) / (n - 1.0);
+        (1e3 * var.max(0.0).sqrt(), 1e3 * self.max)
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -455,11 +363,16 @@ fn run(
             let bins = StanceBins::new(m.grid.bins, settings.servos.len(), m.grid.swing_offset);
             (m, bins)
         }),
+        goal_check: GoalCheck::default(),
+        following: Following::new(ids.len()),
+        stances: vec![],
+        medians: vec![],
         ids,
         stand,
         halted: None,
         halt_goal: vec![],
     };
+    let mut jitter = Jitter::default();
     let period = Duration::from_secs_f64(1.0 / settings.rate_hz);
     let begin = Instant::now();
     report.gait_zero = begin.checked_add(Duration::from_secs_f64(settings.stand_s));
@@ -468,16 +381,41 @@ fn run(
         let time = begin.elapsed().as_secs_f64() - settings.stand_s;
         let cycle = last_cycle.elapsed().as_secs_f64();
         last_cycle = Instant::now();
+        if report.cycles > 0 {
+            jitter.add(cycle);
+            (report.cycle_jitter_ms, report.max_cycle_ms) = jitter.ms();
+        }
         if report.cycles > 0 && cycle > settings.watchdog_s {
             return Err(DriveError::Watchdog { time_s: time, cycle_s: cycle, limit_s: settings.watchdog_s });
         }
         if let Some(outcome) = walk.finished(settings, stop, time) {
             return Ok(outcome);
         }
+        // Before the first stance is estimated the prior decides: the closed form on the
+        // terrain's own uncertain k_s at the slope.
+        if time >= 0.0 && report.prior_p_fail.is_none() {
+            if let Some((m, _)) = &walk.monitor {
+                let p = prior_p_fail(m.robot, m.terrain, m.slope);
+                report.prior_p_fail = Some(p);
+                if settings.stop_on_risk.is_some_and(|limit| p > limit) {
+                    walk.halted = Some((time, p));
+                    walk.halt_goal = walk.last_pos.iter().zip(&walk.stand.start_goal).map(|(p, &g)| p.unwrap_or(g)).collect();
+                }
+            }
+        }
         let goals = walk.goals(schedule, settings, time);
-        walk.write_goals(bus, schedule, settings, &goals, time)
+        let sent = walk
+            .write_goals(bus, schedule, settings, &goals, time)
             .map_err(|e| DriveError::Bus { time_s: time, reason: e.to_string() })?;
         walk.read_cycle(bus, schedule, settings, &goals, time, on_sample, on_live, report)?;
+        // The goals read back (a Sync Write's refusal is silent): every second of the gait.
+        if time >= 0.0 && walk.goal_check.due(time) {
+            let address = match settings.profile {
+                Profile::Position => t::GOAL_POSITION,
+                Profile::Velocity => t::GOAL_VELOCITY,
+            };
+            GoalCheck::check(bus, &settings.servos, address, &sent, time)?;
+        }
         let spent = last_cycle.elapsed();
         if spent < period {
             std::thread::sleep(period - spent);
@@ -525,6 +463,25 @@ fn stand_up(
         // The nearest turn of the start angle: at most half a turn of travel.
         let turns = ((here - start) / (2.0 * std::f64::consts::PI)).round();
         start_goal[j] = s.pulses(start + turns * 2.0 * std::f64::consts::PI);
+    }
+    // Every goal of the run within the extended position mode's range, from where the legs
+    // stand (the setup cleared the revolution counters; a servo that kept its count is
+    // checked here): refused before the torque goes on.
+    if let Err(short) = crate::plan::check_goal_range(
+        schedule,
+        &settings.servos,
+        settings.profile,
+        settings.duration_s,
+        Some(&start_goal),
+    ) {
+        let s = settings.servos[short.leg];
+        return Err(DriveError::Range {
+            id: s.id,
+            leg: short.leg,
+            start: start_goal[short.leg],
+            duration_s: settings.duration_s,
+            longest_s: short.longest_s,
+        });
     }
     // Every angle from here on is relative to the start pose found: shift the schedule by it.
     let shift: Vec<f64> = settings
@@ -576,7 +533,8 @@ impl Walk<'_> {
     }
 
     /// One Sync Write of the goals: positions, or in velocity mode the schedule's speed plus a
-    /// phase correction from the last read position (standing and halted: position error only).
+    /// phase correction from the last read position (standing and halted: position error
+    /// only), within the Velocity Limit written. Returns the register values sent.
     fn write_goals(
         &self,
         bus: &mut DynamixelBus,
@@ -584,19 +542,15 @@ impl Walk<'_> {
         settings: &DriveSettings,
         goals: &[i32],
         time: f64,
-    ) -> Result<(), dynamixel2::WriteError> {
-        let data: Vec<SyncWriteData<[u8; 4]>> = match settings.profile {
-            Profile::Position => self
-                .ids
-                .iter()
-                .zip(goals)
-                .map(|(&id, g)| SyncWriteData { motor_id: id, data: g.to_le_bytes() })
-                .collect(),
+    ) -> Result<Vec<i32>, dynamixel2::WriteError> {
+        let limit = velocity_limit_units(schedule);
+        let values: Vec<i32> = match settings.profile {
+            Profile::Position => goals.to_vec(),
             Profile::Velocity => self
                 .ids
                 .iter()
                 .enumerate()
-                .map(|(j, &id)| {
+                .map(|(j, _)| {
                     let s = settings.servos[j];
                     let cmd_v = if time >= 0.0 && self.halted.is_none() {
                         schedule.command(j, time).velocity_rad_s
@@ -605,16 +559,22 @@ impl Walk<'_> {
                     };
                     let err = self.last_pos[j].map_or(0.0, |p| s.angle(goals[j]) - s.angle(p));
                     let v = f64::from(s.direction) * (cmd_v + PHASE_GAIN_PER_S * err);
-                    let units = xl330::velocity_units_from_rad_s(v).clamp(-2047, 2047) as i32;
-                    SyncWriteData { motor_id: id, data: units.to_le_bytes() }
+                    crate::guard::velocity_goal(v, limit)
                 })
                 .collect(),
         };
+        let data: Vec<SyncWriteData<[u8; 4]>> = self
+            .ids
+            .iter()
+            .zip(&values)
+            .map(|(&id, v)| SyncWriteData { motor_id: id, data: v.to_le_bytes() })
+            .collect();
         let address = match settings.profile {
             Profile::Position => t::GOAL_POSITION,
             Profile::Velocity => t::GOAL_VELOCITY,
         };
-        bus.sync_write(address, 4, &data)
+        bus.sync_write(address, 4, &data)?;
+        Ok(values)
     }
 
     /// One Sync Read of every servo's state: each answer logged and fed to the monitor, each
@@ -671,7 +631,25 @@ impl Walk<'_> {
                             bits: hardware_error,
                         });
                     }
+                    if time >= 0.0 {
+                        let error = s.angle(goals[j]) - s.angle(state.position);
+                        self.following.check(j, s.id, time, error)?;
+                    }
                     self.monitor_sample(schedule, settings, goals, j, angle, tau, time, on_live, report);
+                }
+                // The servo answered with an error number: not a lost packet but a refusal.
+                Err(ReadError::MotorError(e)) if e.error_number() != 0 => {
+                    return Err(DriveError::Status {
+                        id: s.id,
+                        leg: j,
+                        time_s: time,
+                        register: "Present Current (126) to Present Temperature (146)",
+                        error: format!(
+                            "{} (error number {})",
+                            crate::setup::status_error_name(e.error_number()),
+                            e.error_number()
+                        ),
+                    })
                 }
                 Err(e) => self.count_failure(j, s.id, &e, time)?,
             }
@@ -699,9 +677,14 @@ impl Walk<'_> {
         let Some(inf) = infer_from_stance(m.robot, m.grid, k, &profile, &counts, m.noise_sd_n_m) else {
             return;
         };
-        let live = LiveEstimate { time_s: time, tripod: k, inference: inf };
+        self.stances.push(inf.posterior.iter().map(|x| x.1).collect());
+        let from = m.window.map_or(0, |w| self.stances.len().saturating_sub(w.max(1)));
+        let pooled_in: Vec<&[f64]> = self.stances[from..].iter().map(Vec::as_slice).collect();
+        self.medians.push(inf.k_s);
+        let pooled = pool(m.robot, m.terrain, m.slope, m.grid, &pooled_in, &self.medians[from..]);
+        let p = pooled.as_ref().map_or(inf.p_fail, |x| x.p_fail.max(inf.p_fail));
+        let live = LiveEstimate { time_s: time, tripod: k, inference: inf, pooled, decision_p_fail: p };
         on_live(&live);
-        let p = live.inference.p_fail;
         report.live.push(live);
         if let (Some(limit), None) = (settings.stop_on_risk, self.halted) {
             if p > limit {
@@ -730,7 +713,9 @@ impl Walk<'_> {
     }
 }
 
-/// Torque off on every servo (a Sync Write, then each servo written and read back alone).
+/// Torque off on every servo (a Sync Write, then each servo written and read back alone), and
+/// the Bus Watchdog cleared (0), so that a servo left on the bus after the run takes a later
+/// program's goals (a fired watchdog refuses them).
 pub fn torque_off(bus: &mut DynamixelBus, servos: &[ServoConfig]) -> TorqueOff {
     let data: Vec<SyncWriteData<[u8; 1]>> =
         servos.iter().map(|s| SyncWriteData { motor_id: s.id, data: [0] }).collect();
@@ -747,6 +732,7 @@ pub fn torque_off(bus: &mut DynamixelBus, servos: &[ServoConfig]) -> TorqueOff {
             }
         }
         if ok {
+            bus.write_u8(s.id, t::BUS_WATCHDOG, 0).ok();
             out.confirmed.push(s.id);
         } else {
             out.unconfirmed.push(s.id);

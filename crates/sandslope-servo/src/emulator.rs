@@ -37,6 +37,12 @@ pub struct EmulatorFaults {
     pub freeze: Option<(f64, f64)>,
     /// `(s, k_s)`: the sand weakens to shear strength `k_s` N/m^3 `s` seconds after the start.
     pub weaken: Option<(f64, f64)>,
+    /// `(id, s)`: servo `id` refuses every goal from `s` seconds on with a Data Range Error, as
+    /// a servo refuses a goal outside its range (a Sync Write's refusal is silent).
+    pub reject: Option<(u8, f64)>,
+    /// `(id, bits)`: servo `id` starts with a hardware error latched (Hardware Error Status
+    /// `bits`, its alert bit set in every status packet), as one left overloaded by an earlier run.
+    pub latched: Option<(u8, u8)>,
 }
 
 /// What the emulator emulates.
@@ -66,6 +72,12 @@ pub struct EmulatorConfig {
     pub model_number: u16,
     /// Firmware version reported.
     pub firmware: u8,
+    /// Whole turns every shaft starts away from its zero offset (a revolution count kept from
+    /// earlier runs in extended position mode; 0: within the first turn).
+    pub initial_turns: i32,
+    /// Whether the servos know the Clear instruction (firmware 42 and later do); `false`
+    /// emulates older firmware, which answers it with an Instruction Error.
+    pub clear_supported: bool,
 }
 
 impl EmulatorConfig {
@@ -83,6 +95,8 @@ impl EmulatorConfig {
             faults: EmulatorFaults::default(),
             model_number: xl330::MODEL_NUMBER,
             firmware: 46,
+            initial_turns: 0,
+            clear_supported: true,
         }
     }
 }
@@ -182,6 +196,10 @@ struct VirtualServo {
     offset_ma: f64,
     config: ServoConfig,
     leg: usize,
+    /// Refuses every goal (the `reject` fault).
+    refuse_goals: bool,
+    /// Knows the Clear instruction.
+    clear_supported: bool,
 }
 
 impl VirtualServo {
@@ -197,6 +215,8 @@ impl VirtualServo {
             offset_ma: 0.0,
             config,
             leg,
+            refuse_goals: false,
+            clear_supported: true,
         };
         table[0..2].copy_from_slice(&model.to_le_bytes());
         table[t::FIRMWARE_VERSION as usize] = firmware;
@@ -328,21 +348,35 @@ impl VirtualServo {
         if (addr..addr + data.len() as u16).any(|a| a < 64 && matches!(a, 0..=6)) {
             return error::ACCESS;
         }
-        if self.u8_at(t::BUS_WATCHDOG) == t::WATCHDOG_FIRED
+        if (self.u8_at(t::BUS_WATCHDOG) == t::WATCHDOG_FIRED || self.refuse_goals)
             && (addr == t::GOAL_POSITION || addr == t::GOAL_VELOCITY)
         {
             return error::DATA_RANGE;
         }
+        // The e-Manual's ranges: a value outside its register's range is refused whole, with a
+        // Data Range Error, and nothing of the write is kept.
+        let before = self.table;
         self.put(addr, data);
-        if addr <= t::CURRENT_LIMIT && end > usize::from(t::CURRENT_LIMIT) {
-            let c = self.u16_at(t::CURRENT_LIMIT).min(xl330::MAX_CURRENT_LIMIT_MA);
-            self.put(t::CURRENT_LIMIT, &c.to_le_bytes());
+        if t::out_of_range(&self.table, addr, end).is_some() {
+            self.table = before;
+            return error::DATA_RANGE;
         }
         if addr == t::TORQUE_ENABLE && data[0] == 1 {
             // Torque on holds the present position (as a real servo's goal follows it).
             let here = self.position.round() as i32;
             self.put(t::GOAL_POSITION, &here.to_le_bytes());
         }
+        0
+    }
+
+    /// The Clear instruction: the revolution counter back within one turn (0 to 4095), only
+    /// while the shaft is still (else Result Fail).
+    fn clear(&mut self) -> u8 {
+        if self.velocity.abs() > 0.01 {
+            return error::RESULT_FAIL;
+        }
+        self.position = self.position.rem_euclid(xl330::PULSES_PER_REV);
+        self.put(t::PRESENT_POSITION, &(self.position.round() as i32).to_le_bytes());
         0
     }
 
@@ -415,6 +449,13 @@ impl VirtualBus {
                 let mut s = VirtualServo::new(*c, leg, config.model_number, config.firmware);
                 let o = &config.current_offset_ma;
                 s.offset_ma = if o.len() == 1 { o[0] } else { o.get(leg).copied().unwrap_or(0.0) };
+                s.position += f64::from(config.initial_turns) * xl330::PULSES_PER_REV;
+                s.clear_supported = config.clear_supported;
+                if let Some((id, bits)) = config.faults.latched {
+                    if id == c.id {
+                        s.table[t::HARDWARE_ERROR_STATUS as usize] = bits;
+                    }
+                }
                 s
             })
             .collect();
@@ -467,6 +508,8 @@ impl VirtualBus {
             if self.silent(*id, now) {
                 continue;
             }
+            self.servos[k].refuse_goals =
+                matches!(self.faults.reject, Some((rid, at)) if rid == *id && now >= at);
             let reply = self.handle_one(k, &ins, now);
             if let Some(mut bytes) = reply {
                 if matches!(self.faults.corrupt, Some((cid, at)) if cid == *id && now >= at) {
@@ -522,6 +565,18 @@ impl VirtualBus {
                 s.table[t::HARDWARE_ERROR_STATUS as usize] = 0;
                 s.table[t::BUS_WATCHDOG as usize] = 0;
                 (ins.id == id).then(|| packet::status(id, 0, &[]))
+            }
+            inst::CLEAR if addressed => {
+                let s = &mut self.servos[k];
+                s.last_seen = now;
+                let e = if !s.clear_supported {
+                    error::INSTRUCTION
+                } else if p.as_slice() != packet::CLEAR_MULTI_TURN {
+                    error::DATA_RANGE
+                } else {
+                    s.clear()
+                };
+                (ins.id == id).then(|| packet::status(id, s.error_byte(e), &[]))
             }
             inst::SYNC_READ if ins.id == packet::BROADCAST && p.len() >= 4 => {
                 if !p[4..].contains(&id) {

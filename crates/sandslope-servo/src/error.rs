@@ -2,7 +2,7 @@
 //! and the exit code a front end gives it.
 
 /// Why a run failed. [`DriveError::exit_code`] is 2 for what was wrong before anything moved
-/// (the setup: port, IDs, models) and 3 for a bus that failed during the run.
+/// (the setup: port, IDs, models, a latched hardware error, goals out of range) and 3 for a bus that failed during the run.
 #[derive(Debug, thiserror::Error)]
 pub enum DriveError {
     /// A servo did not answer a ping.
@@ -82,6 +82,76 @@ pub enum DriveError {
         /// Hardware Error Status (70); 0xFF when it could not be read.
         bits: u8,
     },
+    /// A servo's Hardware Error Status was set before the run (its alert bit at ping).
+    #[error("servo ID {id} (leg {leg}) has a hardware error latched from before the run: {} (Hardware Error Status {bits:#04x}); nothing was moved. Fix: {}; then clear it by rebooting the servo (power it off and on, or Dynamixel Wizard's Reboot)", hardware_faults(*.bits), hardware_fix(*.bits))]
+    Latched {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// Hardware Error Status (70); 0xFF when it could not be read.
+        bits: u8,
+    },
+    /// The run's goals would leave the extended position mode's range from where a leg stands.
+    #[error("--duration {duration_s} s would carry servo ID {id} (leg {leg}) past Goal Position's range in extended position mode (-1,048,575 to 1,048,575 pulses, 256 turns) from {start} pulses, where it stands: the longest run that fits is {longest_s:.1} s; nothing was moved. Fix: --duration {:.0} or less, --profile velocity (no position goal), or power-cycle the servo (its revolution count restarts within one turn)", longest_s.floor())]
+    Range {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// The start goal, pulses.
+        start: i32,
+        /// Requested duration, s.
+        duration_s: f64,
+        /// Longest that fits, s.
+        longest_s: f64,
+    },
+    /// A servo holds another goal than the one sent (a Sync Write's goal refused in silence).
+    #[error("servo ID {id} (leg {leg}) did not take its goal at t = {time_s:.3} s: {register} = {sent} was sent, it holds {holds}; {cause}. The run was stopped and the torque turned off")]
+    Rejected {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// Gait time, s.
+        time_s: f64,
+        /// The register, named with its address.
+        register: &'static str,
+        /// The goal sent.
+        sent: i32,
+        /// What the servo holds.
+        holds: i32,
+        /// Why, as far as the driver can tell.
+        cause: &'static str,
+    },
+    /// A servo answered a read with an error number in its status packet.
+    #[error("servo ID {id} (leg {leg}) answered the read of {register} with a {error} at t = {time_s:.3} s. The run was stopped and the torque turned off. Fix: check the servo's model and firmware (Dynamixel Wizard)")]
+    Status {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// Gait time, s.
+        time_s: f64,
+        /// The register(s) read.
+        register: &'static str,
+        /// The error's name and number.
+        error: String,
+    },
+    /// A servo's shaft stopped following its command.
+    #[error("servo ID {id} (leg {leg}) stopped following its goal: at t = {time_s:.3} s its shaft was {error_rad:.2} rad ({:.2} turns) from the command, beyond a quarter turn since t = {since_s:.3} s (more than 0.5 s). Fix: free the leg (stuck in the sand or against the frame), check its power and that its torque is on; the torque was turned off", error_rad / std::f64::consts::TAU)]
+    Following {
+        /// ID.
+        id: u8,
+        /// Leg.
+        leg: usize,
+        /// Gait time, s.
+        time_s: f64,
+        /// The error, rad (command minus shaft).
+        error_rad: f64,
+        /// When it passed the limit, s.
+        since_s: f64,
+    },
     /// A cycle took longer than the watchdog allows.
     #[error("the driver's watchdog fired at t = {time_s:.3} s: one cycle took {cycle_s:.3} s, more than --watchdog {limit_s} s. Fix: lower --rate, raise the baud rate, or find what stalls the bus; the torque was turned off")]
     Watchdog {
@@ -152,7 +222,11 @@ impl DriveError {
     /// 2: the setup was wrong before anything moved; 3: the bus or the log failed mid-run.
     pub fn exit_code(&self) -> i32 {
         match self {
-            DriveError::Missing { .. } | DriveError::WrongModel { .. } | DriveError::Setup { .. } => 2,
+            DriveError::Missing { .. }
+            | DriveError::WrongModel { .. }
+            | DriveError::Setup { .. }
+            | DriveError::Latched { .. }
+            | DriveError::Range { .. } => 2,
             _ => 3,
         }
     }

@@ -19,9 +19,13 @@
 pub mod driver;
 pub mod emulator;
 pub mod error;
+pub mod guard;
 pub mod log;
 pub mod packet;
+pub mod plan;
+mod report;
 pub mod session;
+pub mod setup;
 pub mod speed;
 mod stance;
 pub mod table;

@@ -14,6 +14,10 @@ pub const HEADER: [u8; 4] = [0xFF, 0xFF, 0xFD, 0x00];
 /// Broadcast ID.
 pub const BROADCAST: u8 = 0xFE;
 
+/// The Clear instruction's parameters that clear the revolution counter (e-Manual, Protocol
+/// 2.0, "Clear").
+pub const CLEAR_MULTI_TURN: [u8; 5] = [0x01, 0x44, 0x58, 0x4C, 0x22];
+
 /// Instruction codes.
 pub mod inst {
     /// Ping.
@@ -24,6 +28,8 @@ pub mod inst {
     pub const WRITE: u8 = 0x03;
     /// Reboot.
     pub const REBOOT: u8 = 0x08;
+    /// Clear (the revolution counter, with the parameters [`super::CLEAR_MULTI_TURN`]).
+    pub const CLEAR: u8 = 0x10;
     /// Sync Read.
     pub const SYNC_READ: u8 = 0x82;
     /// Sync Write.

@@ -8,6 +8,7 @@ use std::sync::atomic::AtomicBool;
 
 use sandslope::infer::servo::{model_grid, CurrentInferenceSettings, ModelGrid};
 use sandslope::infer::LogUniformPrior;
+use sandslope::risk::{safe_slope_limit, SafeLimit, UncertainTerrain};
 use sandslope::servo::{xl330, GaitSchedule};
 use sandslope::{Robot, Scenario, SignedSlope, Terrain};
 
@@ -113,6 +114,11 @@ pub struct DriveConfig {
     pub bus: BusChoice,
     /// Estimate k_s and the risk after every stance (implied by `settings.stop_on_risk`).
     pub monitor: bool,
+    /// Pool the live estimate over the last this many stances (`--live-window`); `None`: all.
+    pub window: Option<usize>,
+    /// Drive beyond the calibrated safe slope (`--force`); without it such a run is refused
+    /// before anything moves.
+    pub force: bool,
 }
 
 /// Why a run could not start (nothing was sent to a servo).
@@ -148,6 +154,8 @@ pub struct Session {
     /// The terrain's k_n at the slope, N/m^3.
     pub k_n: f64,
     grid: Option<ModelGrid>,
+    uncertain: UncertainTerrain,
+    slope: sandslope::Slope,
     bus: DynamixelBus,
     emulator: Option<Emulator>,
     /// The last drive's gait time 0 ([`DriveReport::gait_zero`]).
@@ -173,6 +181,11 @@ impl Session {
             .map_err(|e| SessionError::Setting(e.to_string()))?
             .ground_at(signed.felt());
         let k_n = ground.k_n;
+        let uncertain = UncertainTerrain::new(config.terrain.clone(), None, None)
+            .map_err(|e| SessionError::Setting(e.to_string()))?;
+        if !config.force {
+            check_safe_slope(&config, &uncertain, signed.felt())?;
+        }
         let grid = if config.monitor || config.settings.stop_on_risk.is_some() {
             // The prior reaches down to 1e4 N/m^3, below the library's default 3e4: sand that
             // weak fails by sinkage at moderate slopes, and a monitor whose grid cannot hold it
@@ -195,6 +208,12 @@ impl Session {
         };
         let (port, emulator) = match &config.bus {
             BusChoice::Emulate(o) => {
+                if o.k_s.is_none() && !(ground.k_s > 0.0) {
+                    return Err(SessionError::Setting(format!(
+                        "--slope {}: the terrain's sand has no shear strength at this slope (k_s = {}: at or beyond its angle of repose), so the emulator has no sand to walk on; give the emulated sand's k_s with --emulate-k-s, or a shallower --slope",
+                        config.slope_deg, ground.k_s
+                    )));
+                }
                 let k_s = o.k_s.unwrap_or(ground.k_s);
                 let sand = Terrain::constant(k_n, k_s)
                     .map_err(|e| SessionError::Setting(e.renamed("--emulate-k-s").to_string()))?;
@@ -218,12 +237,21 @@ impl Session {
             }
         };
         let bus = dynamixel2::Bus::new(port).map_err(|e| SessionError::Bus(format!("{e:?}")))?;
-        Ok(Session { config, schedule, k_n, grid, bus, emulator, gait_zero: None })
+        let slope = signed.felt();
+        Ok(Session { config, schedule, k_n, grid, uncertain, slope, bus, emulator, gait_zero: None })
     }
 
     /// The configuration the session was opened with.
     pub fn config(&self) -> &DriveConfig {
         &self.config
+    }
+
+    /// What the bus can carry ([`crate::plan::bus_budget`]): the serial port's baud rate, the
+    /// servos, Return Delay Time 0 (the setup writes it) and the adapter's latency timer (as
+    /// Linux shows it; 16 ms, the FTDI driver's default, where it does not say); `None` for the
+    /// emulator, whose pseudo-terminal moves bytes at once.
+    pub fn bus_budget(&self) -> Option<crate::plan::BusBudget> {
+        bus_budget_of(&self.config)
     }
 
     /// Whether the bus is the emulator's.
@@ -248,6 +276,9 @@ impl Session {
             robot: &self.config.robot,
             grid: g,
             noise_sd_n_m: xl330::torque_from_current(noise_ma),
+            terrain: &self.uncertain,
+            slope: self.slope,
+            window: self.config.window,
         });
         let (report, failure) =
             drive(&mut self.bus, &self.schedule, &self.config.settings, monitor, stop, on_sample, on_live);
@@ -262,6 +293,47 @@ impl Session {
         self.emulator.map(|e| e.stop(zero))
     }
 }
+
+/// The risk the safe slope is searched at when `--stop-on-risk` does not give one.
+pub const SAFE_SLOPE_RISK: f64 = 0.5;
+
+/// Refuses a slope beyond the calibrated safe-slope limit (`risk --solve slope`: p_fail below
+/// `--stop-on-risk`, else 0.5, from level up to it), naming the limit and `--force`.
+fn check_safe_slope(config: &DriveConfig, terrain: &UncertainTerrain, slope: sandslope::Slope) -> Result<(), SessionError> {
+    let risk = config.settings.stop_on_risk.filter(|p| *p > 0.0 && *p < 1.0).unwrap_or(SAFE_SLOPE_RISK);
+    let limit = safe_slope_limit(&config.robot, terrain, risk).map_err(|e| SessionError::Setting(e.to_string()))?;
+    let deg = slope.degrees();
+    let beyond = match limit {
+        SafeLimit::NoneSafe { .. } => Some("no slope is (p_fail is above it from level)".to_string()),
+        SafeLimit::Limit { value, .. } if deg > value => Some(format!("the limit is {value:.1} deg")),
+        SafeLimit::Repose { repose_deg, .. } if deg >= repose_deg => {
+            Some(format!("the limit is the sand's angle of repose, {repose_deg:.1} deg"))
+        }
+        _ => None,
+    };
+    match beyond {
+        Some(why) => Err(SessionError::Setting(format!(
+            "--slope {} is beyond the calibrated safe slope for this robot on this terrain (p_fail < {risk} from level up to it; `sandslope risk --solve slope --max-risk {risk}`): {why}. Nothing was moved. Fix: a shallower --slope, or --force to drive anyway (expect the legs to slip or sink; --stop-on-risk halts the gait when the live risk passes it)",
+            config.slope_deg
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// [`Session::bus_budget`] of a run not yet opened.
+pub fn bus_budget_of(config: &DriveConfig) -> Option<crate::plan::BusBudget> {
+    match &config.bus {
+        BusChoice::Emulate(_) => None,
+        BusChoice::Port { path, baud } => {
+            let latency = crate::plan::usb_latency_s(path).unwrap_or(DEFAULT_USB_LATENCY_S);
+            Some(crate::plan::bus_budget(*baud, config.settings.servos.len(), 0.0, latency))
+        }
+    }
+}
+
+/// The USB-serial latency timer assumed where the system does not show it, s: 16 ms, the Linux
+/// FTDI driver's default (the U2D2 is an FTDI FT232H).
+pub const DEFAULT_USB_LATENCY_S: f64 = 0.016;
 
 /// The servos of a robot file without a `[servos]` table: IDs 1 to `legs` in leg order, the
 /// first half (the left side) turning positive and the second half mirrored, zero offsets 0

@@ -39,6 +39,8 @@ pub const STATUS_RETURN_LEVEL: u16 = 68;
 pub const HARDWARE_ERROR_STATUS: u16 = 70;
 /// Bus Watchdog (1), 20 ms units (0 off; the servo sets 100 when it has fired).
 pub const BUS_WATCHDOG: u16 = 98;
+/// Goal Current (2, signed), mA (within plus or minus the Current Limit).
+pub const GOAL_CURRENT: u16 = 102;
 /// Goal Velocity (4), 0.229 rev/min.
 pub const GOAL_VELOCITY: u16 = 104;
 /// Profile Acceleration (4), 214.577 rev/min^2 (velocity-based profile).
@@ -67,6 +69,88 @@ pub const STATE_BLOCK: (u16, u16) = (PRESENT_CURRENT, PRESENT_TEMPERATURE + 1 - 
 
 /// Bus Watchdog value a servo sets after the watchdog fired.
 pub const WATCHDOG_FIRED: u8 = 100;
+
+/// The first register written in `addr..end` whose new value lies outside its range
+/// (ROBOTIS e-Manual, XL330-M288-T control table), by name.
+pub(crate) fn out_of_range(table: &[u8; TABLE_SIZE], addr: u16, end: usize) -> Option<&'static str> {
+    use sandslope::servo::xl330;
+    let u8_at = |a: u16| table[a as usize];
+    let u16_at = |a: u16| u16::from_le_bytes([table[a as usize], table[a as usize + 1]]);
+    let i32_le = |a: u16| {
+        let a = a as usize;
+        i32::from_le_bytes([table[a], table[a + 1], table[a + 2], table[a + 3]])
+    };
+    let touched =
+        |reg: u16, width: usize| usize::from(addr) < usize::from(reg) + width && end > usize::from(reg);
+    let i32_at = |a: u16| i32_le(a);
+    let i16_at = |a: u16| i16::from_le_bytes([table[a as usize], table[a as usize + 1]]);
+    let mode = u8_at(OPERATING_MODE);
+    let checks: [(&'static str, u16, usize, bool); 13] = [
+        (
+            "Return Delay Time",
+            RETURN_DELAY_TIME,
+            1,
+            u8_at(RETURN_DELAY_TIME) <= xl330::MAX_RETURN_DELAY,
+        ),
+        ("Operating Mode", OPERATING_MODE, 1, matches!(mode, 0 | 1 | 3 | 4 | 5 | 16)),
+        (
+            "Temperature Limit",
+            TEMPERATURE_LIMIT,
+            1,
+            u8_at(TEMPERATURE_LIMIT) <= xl330::MAX_TEMPERATURE_LIMIT_REGISTER,
+        ),
+        (
+            "Current Limit",
+            CURRENT_LIMIT,
+            2,
+            u16_at(CURRENT_LIMIT) <= xl330::MAX_CURRENT_LIMIT_MA,
+        ),
+        (
+            "Velocity Limit",
+            VELOCITY_LIMIT,
+            4,
+            (0..=xl330::MAX_VELOCITY_LIMIT as i32).contains(&i32_at(VELOCITY_LIMIT)),
+        ),
+        ("Torque Enable", TORQUE_ENABLE, 1, u8_at(TORQUE_ENABLE) <= 1),
+        ("Status Return Level", STATUS_RETURN_LEVEL, 1, u8_at(STATUS_RETURN_LEVEL) <= 2),
+        ("Bus Watchdog", BUS_WATCHDOG, 1, u8_at(BUS_WATCHDOG) <= xl330::MAX_BUS_WATCHDOG),
+        (
+            "Goal Current",
+            GOAL_CURRENT,
+            2,
+            i32::from(i16_at(GOAL_CURRENT)).abs() <= i32::from(u16_at(CURRENT_LIMIT)),
+        ),
+        (
+            "Goal Velocity",
+            GOAL_VELOCITY,
+            4,
+            i32_at(GOAL_VELOCITY).unsigned_abs() <= i32_at(VELOCITY_LIMIT).unsigned_abs(),
+        ),
+        (
+            "Profile Acceleration",
+            PROFILE_ACCELERATION,
+            4,
+            (0..=xl330::MAX_PROFILE as i32).contains(&i32_at(PROFILE_ACCELERATION)),
+        ),
+        (
+            "Profile Velocity",
+            PROFILE_VELOCITY,
+            4,
+            (0..=xl330::MAX_PROFILE as i32).contains(&i32_at(PROFILE_VELOCITY)),
+        ),
+        ("Goal Position", GOAL_POSITION, 4, {
+            let g = i32_at(GOAL_POSITION);
+            let l = xl330::EXTENDED_GOAL_LIMIT_PULSES;
+            let (lo, hi) = xl330::POSITION_GOAL_RANGE_PULSES;
+            match mode {
+                mode::EXTENDED_POSITION | 5 => (-l..=l).contains(&g),
+                mode::POSITION => (lo..=hi).contains(&g),
+                _ => true,
+            }
+        }),
+    ];
+    checks.iter().find(|(_, reg, width, ok)| touched(*reg, *width) && !ok).map(|c| c.0)
+}
 
 /// Operating modes the driver uses.
 pub mod mode {
@@ -115,7 +199,40 @@ impl PresentState {
 pub(crate) type StateRead = Result<(PresentState, bool), dynamixel2::ReadError>;
 
 /// Reads every servo's state block; per servo `Ok((state, alert))` or the read error.
+///
+/// The replies are matched to their IDs: when a servo does not answer, `dynamixel2` reads the
+/// next servo's reply in its place (and refuses it, a wrong packet ID), so every servo after a
+/// silent one would lose its row. The IDs whose replies were seen in another's place answered:
+/// they are read again on their own Sync Read, and only the silent servo loses its row.
 pub(crate) fn read_states(
+    bus: &mut dynamixel2::Bus<Vec<u8>, Vec<u8>>,
+    ids: &[u8],
+) -> Result<Vec<StateRead>, String> {
+    let mut out = read_states_once(bus, ids)?;
+    let answered: Vec<u8> = out
+        .iter()
+        .filter_map(|r| match r {
+            Err(dynamixel2::ReadError::InvalidMessage(dynamixel2::InvalidMessage::InvalidPacketId(e))) => {
+                Some(e.actual)
+            }
+            _ => None,
+        })
+        .collect();
+    let again: Vec<usize> =
+        (0..ids.len()).filter(|&k| out[k].is_err() && answered.contains(&ids[k])).collect();
+    if !again.is_empty() && again.len() < ids.len() {
+        let retry: Vec<u8> = again.iter().map(|&k| ids[k]).collect();
+        for (&k, r) in again.iter().zip(read_states_once(bus, &retry)?) {
+            if r.is_ok() {
+                out[k] = r;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// One Sync Read of the state block, each reply in its ID's slot in the order asked.
+fn read_states_once(
     bus: &mut dynamixel2::Bus<Vec<u8>, Vec<u8>>,
     ids: &[u8],
 ) -> Result<Vec<StateRead>, String> {

@@ -149,9 +149,29 @@ fn the_dynamixel2_client_talks_to_the_emulator_over_a_pty() {
         [dynamixel2::instructions::BulkReadData { motor_id: 5, address: t::TEMPERATURE_LIMIT, count: 1 }];
     let got = bus.bulk_read(&reads).unwrap();
     assert_eq!((got[0].motor_id, got[0].data.clone()), (5, vec![70]));
-    // A parameter that needs byte stuffing: FF FF FD written into a 4-byte register.
-    bus.write_u32(1, t::GOAL_VELOCITY, u32::from_le_bytes([0xFF, 0xFF, 0xFD, 0x00])).unwrap();
-    assert_eq!(bus.read(1, t::GOAL_VELOCITY, 4).unwrap().data, vec![0xFF, 0xFF, 0xFD, 0x00]);
+    // A parameter that needs byte stuffing: FF FF FD written into a 4-byte register (Goal
+    // Position -131,073 pulses, within the extended position mode's range).
+    bus.write_u8(1, t::OPERATING_MODE, 4).unwrap();
+    bus.write_u32(1, t::GOAL_POSITION, u32::from_le_bytes([0xFF, 0xFF, 0xFD, 0xFF])).unwrap();
+    assert_eq!(bus.read(1, t::GOAL_POSITION, 4).unwrap().data, vec![0xFF, 0xFF, 0xFD, 0xFF]);
+    // The e-Manual's ranges, answered with a Data Range Error (4) and nothing written:
+    // Goal Position beyond 1,048,575 in extended position mode, Goal Velocity above the
+    // Velocity Limit (445 by default), Current Limit above 1750 mA.
+    let range_error = |r: Result<dynamixel2::Response<()>, dynamixel2::TransferError>| match r {
+        Err(dynamixel2::TransferError::ReadError(dynamixel2::ReadError::MotorError(e))) => e.error_number(),
+        other => panic!("expected a Data Range Error, got {other:?}"),
+    };
+    assert_eq!(range_error(bus.write_u32(1, t::GOAL_POSITION, 1_048_576)), 4);
+    assert_eq!(range_error(bus.write_u32(1, t::GOAL_POSITION, (-1_048_576i32) as u32)), 4);
+    assert!(bus.write_u32(1, t::GOAL_POSITION, 1_048_575).is_ok());
+    assert_eq!(bus.read_u32(1, t::GOAL_POSITION).unwrap().data, 1_048_575);
+    assert_eq!(range_error(bus.write_u32(1, t::GOAL_VELOCITY, 446)), 4);
+    assert!(bus.write_u32(1, t::GOAL_VELOCITY, 445).is_ok());
+    assert_eq!(range_error(bus.write_u16(1, t::CURRENT_LIMIT, 1751)), 4);
+    assert_eq!(bus.read_u16(1, t::CURRENT_LIMIT).unwrap().data, 1750);
+    assert_eq!(range_error(bus.write_u8(1, t::OPERATING_MODE, 2)), 4);
+    // The Clear instruction brings the revolution counter back within one turn.
+    assert!(bus.clear_revolution_counter(1).is_ok());
     drop(bus);
     let report = emulator.stop(None);
     assert_eq!(report.bad_crc, 0);

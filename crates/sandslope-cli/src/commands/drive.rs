@@ -5,6 +5,7 @@
 //! (`sandslope::infer::servo`). `--emulate` drives a bus of virtual XL330s on a
 //! pseudo-terminal through the same code; `--dry-run` prints the commands without a bus.
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
@@ -93,6 +94,14 @@ pub struct DriveRunArgs {
     /// Halt the gait (torque held, legs planted) when the live risk that the walk fails (slippage or sinkage) passes P.
     #[arg(long, value_name = "P")]
     pub stop_on_risk: Option<f64>,
+    /// Drive beyond the calibrated safe slope (`risk --solve slope`); without it such a run is
+    /// refused before anything moves, naming the limit.
+    #[arg(long)]
+    pub force: bool,
+    /// Pool the live estimate over the last N stances (a moving window, to follow sand that
+    /// changes); without it every stance so far is pooled.
+    #[arg(long, value_name = "N")]
+    pub live_window: Option<usize>,
     /// After a halt, seconds the legs are held before the torque goes off.
     #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.hold_s)]
     pub hold: f64,
@@ -160,7 +169,16 @@ fn number(flag: &str, text: &str, whole: &str) -> Result<f64> {
     text.trim().parse::<f64>().map_err(|_| anyhow!("{flag}: `{text}` is not a number (in {whole})"))
 }
 
-fn parse_faults(args: &DriveRunArgs) -> Result<EmulatorFaults> {
+/// A fault's time, s: a finite number at least 0.
+fn fault_time(text: &str, whole: &str) -> Result<f64> {
+    let t = number("--emulate-fault", text, whole)?;
+    if !(t.is_finite() && t >= 0.0) {
+        bail!("--emulate-fault `{whole}`: the time `{text}` must be a finite number of seconds, at least 0");
+    }
+    Ok(t)
+}
+
+fn parse_faults(args: &DriveRunArgs, servos: &[ServoConfig]) -> Result<EmulatorFaults> {
     let mut f = EmulatorFaults::default();
     if let Some(w) = &args.emulate_weaken {
         let (s, k) =
@@ -173,19 +191,35 @@ fn parse_faults(args: &DriveRunArgs) -> Result<EmulatorFaults> {
     }
     if let Some(text) = &args.emulate_fault {
         let parts: Vec<&str> = text.split(':').collect();
-        let id =
-            |s: &str| -> Result<u8> {
-                s.trim().parse::<u8>().ok().filter(|&i| i <= 252).ok_or_else(|| {
-                    anyhow!("--emulate-fault: `{s}` is not a servo ID from 0 to 252 (in {text})")
-                })
-            };
-        match parts.as_slice() {
-            ["silent", i, s] => f.silent = Some((id(i)?, number("--emulate-fault", s, text)?)),
-            ["corrupt", i, s] => f.corrupt = Some((id(i)?, number("--emulate-fault", s, text)?)),
-            ["freeze", s, len] => {
-                f.freeze = Some((number("--emulate-fault", s, text)?, number("--emulate-fault", len, text)?))
+        let on_bus: Vec<String> = servos.iter().map(|s| s.id.to_string()).collect();
+        let id = |s: &str| -> Result<u8> {
+            let id = s.trim().parse::<u8>().ok().filter(|&i| i <= 252).ok_or_else(|| {
+                anyhow!("--emulate-fault: `{s}` is not a servo ID from 0 to 252 (in {text})")
+            })?;
+            if !servos.iter().any(|c| c.id == id) {
+                bail!(
+                    "--emulate-fault `{text}`: servo ID {id} is not on the bus (the robot's servos are IDs {})",
+                    on_bus.join(", ")
+                );
             }
-            _ => bail!("--emulate-fault `{text}` must be silent:ID:S, corrupt:ID:S or freeze:S:LEN"),
+            Ok(id)
+        };
+        let t = |s: &str| fault_time(s, text);
+        match parts.as_slice() {
+            ["silent", i, s] => f.silent = Some((id(i)?, t(s)?)),
+            ["corrupt", i, s] => f.corrupt = Some((id(i)?, t(s)?)),
+            ["reject", i, s] => f.reject = Some((id(i)?, t(s)?)),
+            ["latched", i] => f.latched = Some((id(i)?, 1 << 5)),
+            ["freeze", s, len] => {
+                let len = t(len)?;
+                if len <= 0.0 {
+                    bail!("--emulate-fault `{text}`: LEN must be above 0 s");
+                }
+                f.freeze = Some((t(s)?, len))
+            }
+            _ => bail!(
+                "--emulate-fault `{text}` must be silent:ID:S, corrupt:ID:S, reject:ID:S, latched:ID or freeze:S:LEN"
+            ),
         }
     }
     Ok(f)
@@ -245,7 +279,6 @@ pub fn config(
         emulate_k_s: run.emulate_k_s,
     }
     .check(Words::Flag)?;
-    let faults = if emulate { parse_faults(run)? } else { EmulatorFaults::default() };
     let legs = 2 * robot.stance_legs() as usize;
     let current_offset_ma = match &run.emulate_offset {
         Some(text) if emulate => parse_offsets(text, legs)?,
@@ -253,6 +286,7 @@ pub fn config(
     };
     GaitSchedule::new(&robot, legs).map_err(|e| anyhow!("{robot_spec}: {e}"))?;
     let (servos, baud) = servos(robot_spec, run.baud, legs)?;
+    let faults = if emulate { parse_faults(run, &servos)? } else { EmulatorFaults::default() };
     if let Some(b) = run.baud {
         if !sandslope_io::servo_log::BAUD_RATES.contains(&b) {
             bail!("--baud = {b} must be one the XL330 supports: {:?}", sandslope_io::servo_log::BAUD_RATES);
@@ -274,6 +308,25 @@ pub fn config(
         hold_s: run.hold,
         stand_s: RUN_DEFAULTS.stand_s,
     };
+    // Every goal within the servos' ranges for the whole run, from the worst start a cleared
+    // revolution counter allows (the driver checks again from where the legs stand).
+    let schedule = GaitSchedule::new(&robot, legs)?;
+    if let Err(short) = sandslope_servo::plan::check_goal_range(
+        &schedule,
+        &settings.servos,
+        settings.profile,
+        settings.duration_s,
+        None,
+    ) {
+        bail!(
+            "--duration = {} s is longer than the position profile's goals can reach: in extended position mode a servo's Goal Position must stay within -1,048,575 to 1,048,575 pulses (256 turns), which at {:.3} rad/s ({:.3} turns/s) lasts {:.1} s from the start pose. Fix: --duration {:.0} or less, or --profile velocity (no position goal; Goal Velocity stays within the Velocity Limit)",
+            run.duration,
+            schedule.leg_speed_rad_s,
+            schedule.leg_speed_rad_s / std::f64::consts::TAU,
+            short.longest_s,
+            short.longest_s.floor()
+        );
+    }
     let bus = match bus {
         BusFlag::Port(path) => BusChoice::Port { path, baud },
         BusFlag::Emulate | BusFlag::None => BusChoice::Emulate(EmulateOptions {
@@ -284,7 +337,19 @@ pub fn config(
             faults,
         }),
     };
-    Ok(DriveConfig { robot, terrain, slope_deg: run.slope, settings, bus, monitor })
+    if run.live_window == Some(0) {
+        bail!("--live-window = 0 must be at least 1 stance (leave it out to pool every stance)");
+    }
+    Ok(DriveConfig {
+        robot,
+        terrain,
+        slope_deg: run.slope,
+        settings,
+        bus,
+        monitor,
+        window: run.live_window,
+        force: run.force,
+    })
 }
 
 /// Runs `sandslope drive`.
@@ -304,7 +369,9 @@ pub fn run(args: DriveArgs) -> Result<()> {
     }
     if let Some(p) = &args.run.log {
         check_parent_exists(p)?;
+        refuse_input_as_log(p, &[(&args.robot.robot, "--robot"), (&args.terrain.terrain, "--terrain")])?;
     }
+    check_bus_budget(&config)?;
     // The live monitor's grid of simulated stance profiles and the bus (the emulator's
     // simulated walk), before anything moves.
     let mut session = Session::open(config)?;
@@ -312,16 +379,16 @@ pub fn run(args: DriveArgs) -> Result<()> {
     crate::error::DRIVING.store(true, Ordering::SeqCst);
     // The setup above can take seconds; say when the servos are about to move and how to stop them.
     let servos = session.config().settings.servos.clone();
-    eprintln!(
+    say(format_args!(
         "driving {} servos for {} s: Ctrl-C stops the gait and turns the torque off",
         servos.len(),
         args.run.duration
-    );
+    ));
     let quiet = args.json;
     let mut on_live = |l: &LiveEstimate| {
         if !quiet {
             let i = &l.inference;
-            eprintln!(
+            say(format_args!(
                 "t = {:.2} s, tripod {}: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, speed {:.1} [{:.1} - {:.1}] cm/s, P(fail) {:.3} (slippage {:.3}, sinkage {:.3})",
                 l.time_s,
                 l.tripod,
@@ -334,7 +401,13 @@ pub fn run(args: DriveArgs) -> Result<()> {
                 i.p_fail,
                 i.p_slippage,
                 i.p_sinkage
-            );
+            ));
+            if let Some(p) = &l.pooled {
+                say(format_args!(
+                    "  pooled over {} stance(s): k_s {:.3e} [{:.3e} - {:.3e}] N/m^3; P(fail) {:.3} (simulator {:.3}, closed form {:.3})",
+                    p.stances, p.k_s, p.k_s_lo, p.k_s_hi, p.p_fail, p.p_fail_simulator, p.p_fail_closed_form
+                ));
+            }
         }
     };
     let stop = &crate::error::STOP;
@@ -378,17 +451,37 @@ pub fn run(args: DriveArgs) -> Result<()> {
         sandslope_io::write_atomic(path, &drive_mcap(&rows, &live, &meta, &verdict)?)?;
     }
     crate::error::DRIVING.store(false, Ordering::SeqCst);
+    let budget = session.bus_budget();
     let emulator = session.close().map(|r| emulator_summary(&r));
     if let Some(e) = &emulator {
-        eprintln!("{e}");
+        say(format_args!("{e}"));
     }
-    summarise(&report, quiet)?;
-    if args.json {
+    summarise(&report, quiet);
+    // Everything said from here on may meet a closed stdout or stderr (a pipe's reader gone, a
+    // hung-up terminal): the torque is off and the log finished, and the exit code is the
+    // run's own.
+    let printed = if args.json {
         // The report and the emulator's last word, the keys Python's `sandslope.drive` returns.
         let mut value = serde_json::to_value(&report)?;
         value["emulator"] = emulator.clone().into();
-        print_json(&value)?;
+        value["bus_max_rate_hz"] = budget.map(|b| b.max_rate_hz).into();
+        print_json(&value)
+    } else {
+        Ok(())
+    };
+    let verdict = verdict(failure, &report, &args.run);
+    match (verdict, printed) {
+        (Err(e), _) => Err(e),
+        (Ok(()), printed) => printed,
     }
+}
+
+/// The run's exit: its failure, a signal's code, a halt's, or success.
+fn verdict(
+    failure: Option<sandslope_servo::DriveError>,
+    report: &DriveReport,
+    run: &DriveRunArgs,
+) -> Result<()> {
     match (failure, &report.outcome) {
         (Some(e), _) => {
             let code = e.exit_code();
@@ -406,8 +499,8 @@ pub fn run(args: DriveArgs) -> Result<()> {
             code: EXIT_HALTED,
             message: format!(
                 "--stop-on-risk: halted at t = {time_s:.2} s, P(fail) = {p_fail:.3} > {}; the legs were held {} s, then the torque was turned off",
-                args.run.stop_on_risk.unwrap_or(1.0),
-                args.run.hold
+                run.stop_on_risk.unwrap_or(1.0),
+                run.hold
             ),
         }
         .into()),
@@ -415,15 +508,82 @@ pub fn run(args: DriveArgs) -> Result<()> {
     }
 }
 
-fn summarise(r: &DriveReport, quiet: bool) -> Result<()> {
+/// One line on stderr that never fails the run: a closed stderr (a pipe's reader gone, a
+/// hung-up terminal) must not skip the torque-off nor change the exit code (`eprintln!`
+/// would panic).
+fn say(text: std::fmt::Arguments<'_>) {
+    let _ = writeln!(std::io::stderr(), "{text}");
+}
+
+/// Refuses a log path that is one of the run's inputs (`--log r.toml --robot r.toml` would
+/// replace the robot file with the log).
+fn refuse_input_as_log(log: &std::path::Path, inputs: &[(&str, &str)]) -> Result<()> {
+    let resolved = |p: &std::path::Path| -> Option<PathBuf> {
+        p.canonicalize().ok().or_else(|| {
+            let parent =
+                p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+            Some(parent.canonicalize().ok()?.join(p.file_name()?))
+        })
+    };
+    let Some(out) = resolved(log) else { return Ok(()) };
+    for (input, flag) in inputs {
+        let path = std::path::Path::new(input);
+        if path.is_file() && path.canonicalize().ok().as_ref() == Some(&out) {
+            bail!(
+                "--log {}: that is the run's {flag} file; the log would replace it. Give the log another path",
+                log.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// What the bus can carry at its baud rate against `--rate` (docs/drive.md, "The loop rate"):
+/// a warning with the fix before anything moves when it cannot keep up, refused when one
+/// cycle would take longer than `--watchdog`.
+fn check_bus_budget(config: &DriveConfig) -> Result<()> {
+    let Some(b) = sandslope_servo::session::bus_budget_of(config) else { return Ok(()) };
+    let rate = config.settings.rate_hz;
+    let fix = format!(
+        "Fix: a faster baud rate (--baud 1000000, set in each servo's Baud Rate (8) with Dynamixel Wizard and in the robot file's [servos] baud_rate), the adapter's USB latency timer at 1 ms (Linux: echo 1 | sudo tee /sys/bus/usb-serial/devices/ttyUSB0/latency_timer; it is {:.0} ms), or a lower --rate; drive sets Return Delay Time to 0",
+        1e3 * b.latency_s
+    );
+    if b.cycle_s > config.settings.watchdog_s {
+        bail!(
+            "at {} baud one cycle of {} servos takes {:.0} ms ({} bytes and the adapter's latency), more than --watchdog {} s: the run would stop at its first cycle. {fix}",
+            b.baud,
+            b.servos,
+            1e3 * b.cycle_s,
+            b.bytes,
+            config.settings.watchdog_s
+        );
+    }
+    if b.max_rate_hz < rate {
+        say(format_args!(
+            "warning: --rate {rate} Hz asks for {:.1} ms cycles, but at {} baud one cycle of {} servos takes {:.1} ms ({} bytes, and {:.0} ms of USB latency): the loop will run at about {:.1} Hz at most. {fix}",
+            1e3 / rate,
+            b.baud,
+            b.servos,
+            1e3 * b.cycle_s,
+            b.bytes,
+            1e3 * b.latency_s,
+            b.max_rate_hz
+        ));
+    }
+    Ok(())
+}
+
+fn summarise(r: &DriveReport, quiet: bool) {
     if quiet {
-        return Ok(());
+        return;
     }
     let off = &r.torque_off;
-    eprintln!(
-        "{} cycles at {:.1} Hz; torque off confirmed on servos {}{}",
+    say(format_args!(
+        "{} cycles at {:.1} Hz (jitter {:.1} ms, longest cycle {:.0} ms); torque off confirmed on servos {}{}",
         r.cycles,
         r.rate_hz,
+        r.cycle_jitter_ms,
+        r.max_cycle_ms,
         if off.confirmed.is_empty() {
             "none".into()
         } else {
@@ -437,15 +597,34 @@ fn summarise(r: &DriveReport, quiet: bool) -> Result<()> {
                 off.unconfirmed.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ")
             )
         }
-    );
-    if let Some(last) = r.live.last() {
-        let i = &last.inference;
-        println!(
-            "last estimate: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(fail) {:.3} (slippage {:.3}, sinkage {:.3}) at {} deg",
-            i.k_s, i.k_s_lo, i.k_s_hi, i.p_fail, i.p_slippage, i.p_sinkage, i.slope_deg
+    ));
+    if let Some(p) = r.live.last().and_then(|l| l.pooled.as_ref()) {
+        let _ = writeln!(
+            std::io::stdout(),
+            "pooled estimate over {} stance(s): k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(fail) {:.3} (simulator {:.3}, closed form {:.3})",
+            p.stances,
+            p.k_s,
+            p.k_s_lo,
+            p.k_s_hi,
+            p.p_fail,
+            p.p_fail_simulator,
+            p.p_fail_closed_form
         );
     }
-    Ok(())
+    if let Some(last) = r.live.last() {
+        let i = &last.inference;
+        let _ = writeln!(
+            std::io::stdout(),
+            "last stance's estimate: k_s {:.3e} [{:.3e} - {:.3e}] N/m^3, P(fail) {:.3} (slippage {:.3}, sinkage {:.3}) at {} deg",
+            i.k_s,
+            i.k_s_lo,
+            i.k_s_hi,
+            i.p_fail,
+            i.p_slippage,
+            i.p_sinkage,
+            i.slope_deg
+        );
+    }
 }
 
 /// `--dry-run`: the setup writes, then every cycle's goals as CSV on stdout.
@@ -457,7 +636,11 @@ fn dry_run(schedule: &GaitSchedule, s: &DriveSettings) -> Result<()> {
     for w in sandslope_servo::driver::setup_writes(schedule, s) {
         println!("# write {} ({}) = {} on IDs {}", w.name, w.addr, w.value, ids.join(", "));
     }
+    if s.profile == Profile::Position {
+        println!("# clear the revolution counter (Clear instruction) on IDs {}", ids.join(", "));
+    }
     println!("# write Torque Enable ({}) = 1 on IDs {}", t::TORQUE_ENABLE, ids.join(", "));
+    let limit = sandslope_servo::driver::velocity_limit_units(schedule);
     let goal = match s.profile {
         Profile::Position => "goal_position",
         Profile::Velocity => "goal_velocity",
@@ -474,9 +657,10 @@ fn dry_run(schedule: &GaitSchedule, s: &DriveSettings) -> Result<()> {
             let cmd = schedule.command(j, time);
             let value = match s.profile {
                 Profile::Position => i64::from(c.pulses(cmd.angle_rad)),
-                Profile::Velocity => {
-                    xl330::velocity_units_from_rad_s(f64::from(c.direction) * cmd.velocity_rad_s)
-                }
+                Profile::Velocity => i64::from(sandslope_servo::guard::velocity_goal(
+                    f64::from(c.direction) * cmd.velocity_rad_s,
+                    limit,
+                )),
             };
             std::io::Write::write_fmt(
                 &mut out,

@@ -308,6 +308,8 @@ def drive(
     hold_s: Optional[float] = None,
     rate_hz: Optional[float] = None,
     live: Optional[bool] = None,
+    force: Optional[bool] = None,
+    window: Optional[int] = None,
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 
 def read_touchdowns(path: _Path) -> List[float]: ...

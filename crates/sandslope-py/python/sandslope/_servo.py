@@ -17,12 +17,16 @@ from ._inputs import RobotLike, TerrainLike, _robot, _terrain
 SERVO_COLUMNS = ("leg", "leg_angle_rad", "drive_torque_n_m")
 
 
-def _frame(columns: Dict[str, np.ndarray]) -> Any:
+def _frame(columns: Dict[str, np.ndarray], meta: Optional[Dict[str, str]] = None) -> Any:
+    """The columns as a DataFrame whose ``attrs`` carry the log's header (``slope_deg``, ...),
+    so that ``infer_servo_log`` finds the run's slope; a dict without pandas."""
     try:
         import pandas as pd
     except ImportError:
         return columns
-    return pd.DataFrame(columns)
+    frame = pd.DataFrame(columns)
+    frame.attrs.update(meta or {})
+    return frame
 
 
 def read_servo_log(path: Union[str, "os.PathLike[str]"]) -> Tuple[Any, Dict[str, str]]:
@@ -30,7 +34,7 @@ def read_servo_log(path: Union[str, "os.PathLike[str]"]) -> Tuple[Any, Dict[str,
     of NumPy columns without pandas) with the log's columns, ``meta`` its ``# key = value``
     header (``slope_deg``, ``k_n``, ``period_s``, ``ids``, ...). Errors name the file and line."""
     columns, meta, _notes = _sandslope.read_servo_log(os.fspath(path))
-    return _frame(columns), dict(meta)
+    return _frame(columns, dict(meta)), dict(meta)
 
 
 def infer_servo_log(
@@ -73,7 +77,17 @@ def infer_servo_log(
         return answer
     columns = log
     if slope_deg is None:
-        raise ValueError("slope_deg: give the run's slope (degrees) with a log's columns")
+        # A DataFrame from `read_servo_log` or `drive` carries its log's header in `attrs`.
+        header = getattr(columns, "attrs", {}).get("slope_deg")
+        if header is None:
+            raise ValueError(
+                "slope_deg: give the run's slope (degrees); these columns carry no log header "
+                "(a DataFrame from read_servo_log or drive does, in its attrs)"
+            )
+        try:
+            slope_deg = float(header)
+        except ValueError:
+            raise ValueError(f"slope_deg: the log's header says slope_deg = {header!r}, not a number") from None
     missing = [c for c in SERVO_COLUMNS if c not in columns]
     if missing:
         raise ValueError(f"log: the column(s) {', '.join(missing)} are missing (docs/drive.md, 'The log')")
@@ -114,6 +128,8 @@ def drive(
     hold_s: Optional[float] = None,
     rate_hz: Optional[float] = None,
     live: Optional[bool] = None,
+    force: bool = False,
+    window: Optional[int] = None,
 ) -> Tuple[Any, Dict[str, Any]]:
     """A run of ``sandslope drive --emulate`` (docs/drive.md): the robot's alternating tripod
     sent to a bus of emulated XL330s on a pseudo-terminal, byte for byte Protocol 2.0 through
@@ -122,11 +138,16 @@ def drive(
     its seed, ``weaken=(seconds, k_s)`` weakens it mid-run), with ``drive``'s defaults for
     whatever is left out (``drive_defaults()``: the one typed set ``sandslope drive``'s flags
     take theirs from; position profile, the servos' IDs 1 to 6). ``live`` estimates k_s
-    after every stance (off by default, as ``drive --live``); ``stop_on_risk`` halts the gait when P(fail) passes it.
+    after every stance (off by default, as ``drive --live``), pooled over every stance so far
+    or the last ``window``; ``stop_on_risk`` halts the gait when the pooled P(fail), the larger
+    of the simulator's and the closed form's, passes it. A slope beyond the calibrated safe
+    slope is refused unless ``force=True`` (as ``drive --force``).
 
     Returns ``(log, report)``: ``log`` the servo log's columns (a pandas DataFrame, or a dict of
     NumPy arrays without pandas; ``infer_servo_log`` reads it), ``report`` what ``drive --json``
-    prints (``outcome``, ``cycles``, ``rate_hz``, ``live``: one record per stance,
+    prints (``outcome``: ``completed``, ``interrupted``, ``halted`` or ``failed``, with
+    ``time_s``, and ``p_fail`` or ``error``; ``cycles``, ``rate_hz``, ``cycle_jitter_ms``,
+    ``max_cycle_ms``, ``setup``, ``live``: one record per stance,
     ``torque_off``) and ``emulator``, the virtual servos' last word. The run takes
     ``duration_s`` plus a second of wall time and releases the GIL; it cannot be interrupted from
     Python. A robot is driven from the command line (``sandslope drive --port``) only."""
@@ -148,8 +169,11 @@ def drive(
         hold_s=None if hold_s is None else float(hold_s),
         rate_hz=None if rate_hz is None else float(rate_hz),
         live=None if live is None else bool(live),
+        force=bool(force),
+        window=None if window is None else int(window),
     )
-    return _frame(columns), report
+    slope = float(drive_defaults()["slope_deg"] if slope_deg is None else slope_deg)
+    return _frame(columns, {"slope_deg": repr(slope)}), report
 
 
 def read_bag(

@@ -34,11 +34,16 @@ function showDrive(st) {
   $("drive-estimates").textContent = live
     ? `${st.estimates} stances; the last, tripod ${st.live.tripod}, ended at t = ${st.live.time_s.toFixed(2)} s`
     : "no stance finished yet";
-  const halt = st.stop_on_risk === null ? "off" : `P(fail) > ${st.stop_on_risk}`;
-  $("drive-halted").textContent = st.halted ? `halted (${halt})` : st.stop_on_risk === null ? "no halt set" : `not halted (${halt})`;
+  // Said as what happened and what is watched, not as a comparison that reads as true.
+  $("drive-halted").textContent = st.stop_on_risk === null
+    ? "off (no --stop-on-risk)"
+    : st.halted
+      ? `HALTED: P(fail) passed ${st.stop_on_risk}`
+      : `watching: halts if P(fail) passes ${st.stop_on_risk}`;
   $("drive-halted").dataset.halted = String(st.halted);
   const ended = DRIVE_FINAL.includes(st.state);
   $("drive-stop").disabled = ended;
+  if (ended) $("drive-stop").textContent = "Stopped: torque off";
   const off = st.torque_off;
   let end = "";
   if (st.error) end += `${st.error}. `;
@@ -60,6 +65,7 @@ async function pollDrive() {
 }
 async function stopDrive() {
   $("drive-stop").disabled = true;
+  $("drive-stop").textContent = "Stopping…";
   busy(1);
   try {
     const r = await fetch("/api/drive/stop", { method: "POST" });

@@ -662,7 +662,7 @@ fn weighted_quantile(values: &[f64], p: &[f64], level: f64) -> f64 {
 
 /// Quantile of a distribution given as probabilities at grid points `x` (each point's mass
 /// spread evenly over its cell, cells meeting half-way between points).
-fn quantile(x: &[f64], p: &[f64], level: f64) -> f64 {
+pub(crate) fn quantile(x: &[f64], p: &[f64], level: f64) -> f64 {
     let n = x.len();
     let edge = |i: usize| -> f64 {
         if i == 0 {

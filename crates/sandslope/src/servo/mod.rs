@@ -7,6 +7,7 @@
 //! say about the sand is [`crate::infer::servo`].
 
 mod schedule;
+pub mod verdict;
 pub mod xl330;
 
 pub use schedule::{GaitSchedule, LegCommand, ScheduleError};

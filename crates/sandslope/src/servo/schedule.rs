@@ -98,6 +98,20 @@ impl GaitSchedule {
         }
     }
 
+    /// The gait time at which a leg has turned `travel_rad` from its start angle (the inverse
+    /// of [`GaitSchedule::command`]'s angle: `sqrt(2 dt travel / omega)` within the run-up,
+    /// `dt/2 + travel / omega` after it); 0 for no travel.
+    pub fn time_to_travel(&self, travel_rad: f64) -> f64 {
+        let (w, r) = (self.leg_speed_rad_s, self.run_up_s);
+        if travel_rad <= 0.0 {
+            0.0
+        } else if travel_rad < 0.5 * w * r {
+            (2.0 * r * travel_rad / w).sqrt()
+        } else {
+            0.5 * r + travel_rad / w
+        }
+    }
+
     /// Every leg's command at gait time `t`.
     pub fn commands(&self, t: f64) -> Vec<LegCommand> {
         (0..self.legs()).map(|j| self.command(j, t)).collect()
@@ -132,6 +146,16 @@ mod tests {
 
     fn paper() -> GaitSchedule {
         GaitSchedule::new(&Robot::new(RobotSpec::paper_hexapod()).unwrap(), 6).unwrap()
+    }
+
+    #[test]
+    fn time_to_travel_inverts_the_command() {
+        let s = paper();
+        // 256 turns at 1 turn/s after the 0.2 s run-up: 0.1 + 256 = 256.1 s.
+        assert!((s.time_to_travel(256.0 * 2.0 * PI) - 256.1).abs() < 1e-9);
+        // Within the run-up: 0.05 pi at t = 0.1 s (a quarter of the run-up's 0.2 pi).
+        assert!((s.time_to_travel(0.05 * PI) - 0.1).abs() < 1e-12);
+        assert_eq!(s.time_to_travel(0.0), 0.0);
     }
 
     #[test]

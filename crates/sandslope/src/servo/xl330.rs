@@ -41,6 +41,25 @@ pub const MAX_CURRENT_LIMIT_MA: u16 = 1750;
 pub const MAX_TEMPERATURE_C: u8 = 70;
 /// Input voltage range, V.
 pub const VOLTAGE_RANGE_V: (f64, f64) = (3.7, 6.0);
+/// Goal Position's range in Extended Position Control Mode (Operating Mode 4), pulses: -1,048,575
+/// to 1,048,575, 256 turns either way (e-Manual, Goal Position (116)). A goal outside it is
+/// refused with a Data Range Error (by a Sync Write, silently: no status packet).
+pub const EXTENDED_GOAL_LIMIT_PULSES: i32 = 1_048_575;
+/// Goal Position's range in Position Control Mode (Operating Mode 3), pulses: 0 to 4095.
+pub const POSITION_GOAL_RANGE_PULSES: (i32, i32) = (0, 4095);
+/// Largest Velocity Limit (44) the control table accepts, 0.229 rev/min units; Goal Velocity
+/// (104) must lie within plus or minus the Velocity Limit written.
+pub const MAX_VELOCITY_LIMIT: u32 = 2047;
+/// Largest Profile Velocity (112) and Profile Acceleration (108), in their units.
+pub const MAX_PROFILE: u32 = 32767;
+/// Largest Return Delay Time (9), 2 us units.
+pub const MAX_RETURN_DELAY: u8 = 254;
+/// One Return Delay Time unit, s.
+pub const RETURN_DELAY_UNIT_S: f64 = 2e-6;
+/// Largest Bus Watchdog (98) a host writes, 20 ms units (100 is what the servo sets when it fired).
+pub const MAX_BUS_WATCHDOG: u8 = 127;
+/// Largest Temperature Limit (31) the control table accepts, degC (the rated range ends at 70).
+pub const MAX_TEMPERATURE_LIMIT_REGISTER: u8 = 100;
 
 /// Shaft torque from a Present Current reading, N m (`tau = K_t I`, §19).
 pub fn torque_from_current(current_ma: f64) -> f64 {

@@ -75,6 +75,11 @@ pub struct SimulateArgs {
     /// default 1: as strong as before).
     #[arg(long, value_name = "F", default_value_t = UNDISTURBED_SAND, allow_negative_numbers = true)]
     pub disturbed_sand: f64,
+    /// The belly as the body's underside, sand below it only: it pushes and never pulls the
+    /// body down, its drag capped by its push (docs/model.md §20.5; default: a plate in sand
+    /// on both faces, as resistive force theory's plates were).
+    #[arg(long)]
+    pub one_sided_belly: bool,
     /// Walk the one slope N times (2 to 1000), the robot's mass perturbed by 1e-9 relative
     /// between walks, and give the spread: mean speed, its SD and standard error, mean t1, the
     /// regimes' counts, how many pitched over. For the free body, whose walk on a slope is
@@ -178,6 +183,7 @@ impl SimulateArgs {
                 leg_friction: self.leg_friction,
                 duty_cycle: self.duty_cycle,
                 disturbed_sand: self.disturbed_sand,
+                one_sided_belly: self.one_sided_belly,
             },
             rate_hz: self.rate,
             ensemble,

@@ -679,4 +679,6 @@ pub fn simulate_slopes(
 }
 
 #[cfg(test)]
+mod phase1_tests;
+#[cfg(test)]
 mod tests;

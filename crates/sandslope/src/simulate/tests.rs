@@ -10,7 +10,7 @@ use crate::robot::{Robot, RobotSpec};
 use crate::terrain::{Ground, Terrain};
 
 /// A walker with `settings.shape`'s legs.
-fn walker(robot: &Robot, ground: &Ground, theta: f64, settings: &SimSettings, dt: f64) -> Walker {
+pub(super) fn walker(robot: &Robot, ground: &Ground, theta: f64, settings: &SimSettings, dt: f64) -> Walker {
     Walker::with_leg(robot, ground, theta, settings, dt, &*settings.shape.leg(robot))
 }
 
@@ -363,7 +363,7 @@ fn table() {
 }
 
 /// The built-in glass-beads terrain (crates/sandslope-io/presets/glass-beads-300um.toml).
-fn builtin_terrain() -> Terrain {
+pub(super) fn builtin_terrain() -> Terrain {
     use crate::terrain::{TerrainPoint, TerrainSpec};
     let pt = |slope_deg, k_s| TerrainPoint { slope_deg, k_n: 7e5, k_s, k_n_sd: None, k_s_sd: None };
     Terrain::new(TerrainSpec {

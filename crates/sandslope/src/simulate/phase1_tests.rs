@@ -157,7 +157,7 @@ fn builtin(slope_deg: f64, one_sided_belly: bool, dt: Option<f64>) -> SimSummary
 
 /// What holds the body in phase 1 on the built-in robot and terrain, pitch locked (the
 /// mechanism of docs/simulate.md, "Phase 1"). With the belly two-faced (the default) the body
-/// does not slip back at 10 to 24 degrees (s1 below 1 nm) although the new tripod alone pushes
+/// does not slip back at 10 to 24 degrees (s1 below 10 nm) although the new tripod alone pushes
 /// up the slope by less than gravity pulls down it, m g sin(theta): the belly holds the rest,
 /// and at 20 and 24 degrees it does so while the sand holds it *down* (its normal force is
 /// negative: the new legs lift the body and the belly, a plate in sand on both faces, resists
@@ -172,7 +172,7 @@ fn the_two_faced_belly_holds_the_body_in_phase_1_and_the_one_sided_one_lets_it_s
         let pull = weight * f64::to_radians(slope_deg).sin();
         let two = builtin(slope_deg, false, None);
         let p = two.phase1.unwrap();
-        assert!(two.slip_m.unwrap() < 1e-9, "{slope_deg}: {:?}", two.slip_m);
+        assert!(two.slip_m.unwrap() < 1e-8, "{slope_deg}: {:?}", two.slip_m);
         assert_eq!(p.old_tripod_n, [0.0, 0.0]);
         if slope_deg > 0.0 {
             assert!(p.new_tripod_n[0] < 0.8 * pull, "{slope_deg}: {p:?}");

@@ -279,6 +279,14 @@ fn print_one(sim: &Simulation) {
     ]);
     t.add_row(["t1 ms".into(), num(m.t1_s.map(|v| v * 1e3), 1), num(p.anchoring_time.map(|v| v * 1e3), 1)]);
     t.add_row(["slip mm".into(), num(m.slip_m.map(|v| v * 1e3), 2), num(p.slip.map(|v| v * 1e3), 2)]);
+    // Phase 1's lowest speed; the closed form's body slides from rest at g sin(theta) until t1
+    // (its s1 = 1/2 g sin(theta) t1^2), so its lowest speed is -g sin(theta) t1 (docs/model.md §18).
+    let cf_low = p.anchoring_time.map(|t1| -sandslope::G * m.slope_deg.to_radians().sin() * t1);
+    t.add_row([
+        "lowest speed in phase 1 cm/s".into(),
+        num(m.phase1.map(|q| q.min_speed_m_s * 100.0), 2),
+        num(cf_low.map(|v| v * 100.0), 2),
+    ]);
     t.add_row(["step mm".into(), format!("{:.2}", m.step_m * 1e3), num(p.step.map(|v| v * 1e3), 2)]);
     t.add_row([
         "deepest leg mm".into(),

@@ -50,8 +50,9 @@ pub struct Mechanisms {
     /// The belly as the body's underside (§20.5): sand below it only, so it pushes and never
     /// pulls, its along-surface stress capped by its push. `false` (the default): a plate in
     /// sand on both faces, as resistive force theory's plates were, which holds a body being
-    /// lifted off the sand (docs/simulate.md, "Phase 1").
-    #[serde(default)]
+    /// lifted off the sand (docs/simulate.md, "Phase 1"). Serialised only when on, so a walk
+    /// without it reads as before.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub one_sided_belly: bool,
 }
 

@@ -75,6 +75,11 @@ pub struct SimulateArgs {
     /// default 1: as strong as before).
     #[arg(long, value_name = "F", default_value_t = UNDISTURBED_SAND, allow_negative_numbers = true)]
     pub disturbed_sand: f64,
+    /// The belly as the body's underside, sand below it only: it pushes and never pulls the
+    /// body down, its drag capped by its push (docs/model.md §20.5; default: a plate in sand
+    /// on both faces, as resistive force theory's plates were).
+    #[arg(long)]
+    pub one_sided_belly: bool,
     /// Walk the one slope N times (2 to 1000), the robot's mass perturbed by 1e-9 relative
     /// between walks, and give the spread: mean speed, its SD and standard error, mean t1, the
     /// regimes' counts, how many pitched over. For the free body, whose walk on a slope is
@@ -180,6 +185,7 @@ impl SimulateArgs {
                 leg_friction: self.leg_friction,
                 duty_cycle: self.duty_cycle,
                 disturbed_sand: self.disturbed_sand,
+                one_sided_belly: self.one_sided_belly,
             },
             rate_hz: self.rate,
             ensemble,
@@ -282,6 +288,14 @@ fn print_one(sim: &Simulation) {
     ]);
     t.add_row(["t1 ms".into(), num(m.t1_s.map(|v| v * 1e3), 1), num(p.anchoring_time.map(|v| v * 1e3), 1)]);
     t.add_row(["slip mm".into(), num(m.slip_m.map(|v| v * 1e3), 2), num(p.slip.map(|v| v * 1e3), 2)]);
+    // Phase 1's lowest speed; the closed form's body slides from rest at g sin(theta) until t1
+    // (its s1 = 1/2 g sin(theta) t1^2), so its lowest speed is -g sin(theta) t1 (docs/model.md §18).
+    let cf_low = p.anchoring_time.map(|t1| -sandslope::G * m.slope_deg.to_radians().sin() * t1);
+    t.add_row([
+        "lowest speed in phase 1 cm/s".into(),
+        num(m.phase1.map(|q| q.min_speed_m_s * 100.0), 2),
+        num(cf_low.map(|v| v * 100.0), 2),
+    ]);
     t.add_row(["step mm".into(), format!("{:.2}", m.step_m * 1e3), num(p.step.map(|v| v * 1e3), 2)]);
     t.add_row([
         "deepest leg mm".into(),

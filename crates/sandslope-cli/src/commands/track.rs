@@ -40,7 +40,8 @@ pub struct TrackArgs {
     #[arg(long, value_name = "FRAME")]
     pub frame: Option<String>,
     /// Upslope direction in the capture frame: +x, -x, +y, -y, +z, -z or a vector such as
-    /// `0.91,0,0.41`; estimated as the principal direction of travel when omitted.
+    /// `0.91,0,0.41`; when omitted, the principal direction of travel, pointed the way it
+    /// rises along the format's vertical axis (a slide down reads as a negative speed).
     #[arg(
         long,
         value_name = "AXIS|X,Y,Z",

@@ -50,6 +50,7 @@ from ._servo import drive, drive_defaults, infer_servo_log, read_servo_log
 
 __all__ = [
     "REGIMES",
+    "OUTCOMES",
     "CAUSES",
     "Robot",
     "Terrain",
@@ -86,6 +87,12 @@ __version__ = "0.1.0"
 
 #: Regime names; every ``regime`` array holds int8 indices into this tuple.
 REGIMES: Tuple[str, str, str, str] = tuple(_sandslope.REGIMES)  # type: ignore[assignment]
+
+#: What the robot does in each regime, in a field engineer's words (docs/model.md §6,
+#: "Outcomes"), aligned with :data:`REGIMES`: ``OUTCOMES[i]`` is what ``REGIMES[i]`` means on the
+#: slope (``"metastable"``: ``"climbs slowly and may stall"``). The report, the CLI's tables and the
+#: explorer use the same words.
+OUTCOMES: Tuple[str, str, str, str] = tuple(_sandslope.OUTCOMES)  # type: ignore[assignment]
 
 #: Finer reasons for a regime; ``predict(...)["cause"]`` holds int8 indices into this tuple
 #: (the library's ``Cause::ALL``, so the two cannot drift).

@@ -300,7 +300,9 @@ impl Figure for SlopesFigure<'_> {
                     + Circle::new((0, 0), 4, BLACK.stroke_width(2))
             });
         }
-        super::legend_box(&mut c, SeriesLabelPosition::LowerLeft, 15.0, super::LegendBox::LIGHT)?;
+        // Upper right: the speeds fall with slope, and the tumble marks lie on the zero line,
+        // which a legend in the lower left covered.
+        super::legend_box(&mut c, SeriesLabelPosition::UpperRight, 15.0, super::LegendBox::LIGHT)?;
         Ok(())
     }
 }
@@ -450,25 +452,48 @@ where
         .map_err(plot_err)?;
     // The body's path so far: its centre's trace, the part in view.
     let trace: Vec<Point> = (0..=i).map(|k| world([tr.x_m[k], tr.z_m[k]])).filter(|&p| inside(p)).collect();
-    if trace.len() >= 2 {
-        chart
-            .draw_series([PathElement::new(trace, palette::BODY_TRACE.stroke_width(2))])
-            .map_err(plot_err)?;
-    }
-    // Body: a box from the belly (h below the axle) to h above it, pitched.
+    let trace_colour = palette::BODY_TRACE;
+    chart
+        .draw_series([PathElement::new(if trace.len() >= 2 { trace } else { Vec::new() }, trace_colour.stroke_width(2))])
+        .map_err(plot_err)?
+        .label("path of the body's centre (black dot)")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], trace_colour.stroke_width(2)));
+    // Body: a box from the belly (h below the axle) to h above it, pitched, drawn above the
+    // sand surface only: at a touchdown the belly presses a few mm into the yielding sand
+    // (resistive force theory, docs/model.md §16), which drawn whole looked like the body
+    // sinking into the ground; the legs below the surface are drawn whole.
     let (sp, cp) = phi.sin_cos();
     let body = |p: [f64; 2]| world([x + cp * p[0] - sp * p[1], z + sp * p[0] + cp * p[1]]);
     let (l, h) = (g.body_length_m, g.hip_height_m);
     let corners = [[-l / 2.0, -h], [l / 2.0, -h], [l / 2.0, 0.3 * h], [-l / 2.0, 0.3 * h]];
+    let outline: Vec<Point> = corners.iter().map(|&p| body(p)).collect();
+    let (above, _) = below_line(&outline, (s, -c));
+    let grey = palette::DATA_GREY.mix(0.8);
     chart
-        .draw_series([Polygon::new(
-            corners.iter().map(|&p| body(p)).collect::<Vec<_>>(),
-            palette::DATA_GREY.mix(0.8).filled(),
-        )])
-        .map_err(plot_err)?;
+        .draw_series([Polygon::new(above, grey.filled())])
+        .map_err(plot_err)?
+        .label("body (belly to axle; drawn above the sand)")
+        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], grey.filled()));
     let legs = g.hip_x_m.len();
     let n = (legs / 2).max(1);
     let scale = 0.02; // m of arrow per N
+    // The legend's entries for the legs and forces (empty series: the marks are drawn below).
+    for (tripod, name) in [(0, "tripod A legs"), (1, "tripod B legs")] {
+        let col = leg_colour(tripod, 0, n);
+        chart
+            .draw_series(std::iter::empty::<PathElement<Point>>())
+            .map_err(plot_err)?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(3)));
+    }
+    chart
+        .draw_series(std::iter::empty::<PathElement<Point>>())
+        .map_err(plot_err)?
+        .label(format!("sand's force on a leg ({:.0} mm per N)", scale * 1e3))
+        .legend(|(x, y)| {
+            PathElement::new(vec![(x, y), (x + 16, y)], palette::CLOSED_FORM_RED.stroke_width(2))
+                + Circle::new((x + 17, y), 3, palette::CLOSED_FORM_RED.filled())
+        });
     for j in 0..legs {
         let psi = tr.leg_angle_rad[j][i];
         let (sa, ca) = (phi - psi).sin_cos();
@@ -501,6 +526,7 @@ where
         }
     }
     chart.draw_series([Circle::new(world([x, z]), 4, BLACK.filled())]).map_err(plot_err)?;
+    super::legend_box(&mut chart, SeriesLabelPosition::UpperLeft, 12.0, super::LegendBox::LIGHT)?;
     Ok(())
 }
 

@@ -350,20 +350,30 @@ pub fn simulator(report: &Report) -> String {
             format!("{:.1}", r.pitch_free_m_s * 100.0)
         };
         h.push_str(&format!(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{} / {}</td><td>{:.0}</td>{}</tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{} / {}</td><td>{}</td>{}</tr>",
             r.slope_deg,
             plus_minus(r.observed_m_s.map(|v| v * 100.0), r.observed_sd_m_s.map(|v| v * 100.0), 1.0, 1),
             r.closed_form_m_s.map_or("- (ruled out)".into(), |v| format!("{:.1}", v * 100.0)),
             r.simulated_m_s * 100.0,
             free,
-            r.closed_form_regime.name(),
-            r.simulated_regime.name(),
-            r.max_pitch_deg,
+            r.closed_form_regime.in_words(),
+            r.simulated_regime.in_words(),
+            largest_pitch(r),
             verdict_cell(r),
         ));
     }
     h.push_str("</table>\n");
     h
+}
+
+/// The pitch-free walk's largest pitch as the table shows it: in degrees while the body stays
+/// upright, else "tumbled" with when (the summed rotation of a body rolling over, thousands of
+/// degrees, is no angle a reader can picture).
+fn largest_pitch(r: &sandslope::report::SimulatorRecord) -> String {
+    match r.pitch_over_s {
+        Some(t) => format!("tumbled (past 90° at {t:.1} s)"),
+        None => format!("{:.0}", r.max_pitch_deg),
+    }
 }
 
 /// The simulator table's last cell: "agree", or where the two part in a few words (the text

@@ -244,10 +244,10 @@ impl Plausible {
     }
 }
 
-/// A range's end as written in docs/model.md's tables: plainly from 10^-4 to below 10^5
+/// A range's end as written in docs/model.md's tables: plainly from 10^-4 to below 10^3
 /// (0.001, 250), else as a power of ten (1e-8, 1e10) rather than a row of zeros.
 fn short(x: f64) -> String {
-    if x != 0.0 && !(1e-4..1e5).contains(&x.abs()) {
+    if x != 0.0 && !(1e-4..1e3).contains(&x.abs()) {
         format!("{x:e}")
     } else {
         format!("{x}")

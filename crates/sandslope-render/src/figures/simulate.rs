@@ -477,23 +477,7 @@ where
     let legs = g.hip_x_m.len();
     let n = (legs / 2).max(1);
     let scale = 0.02; // m of arrow per N
-    // The legend's entries for the legs and forces (empty series: the marks are drawn below).
-    for (tripod, name) in [(0, "tripod A legs"), (1, "tripod B legs")] {
-        let col = leg_colour(tripod, 0, n);
-        chart
-            .draw_series(std::iter::empty::<PathElement<Point>>())
-            .map_err(plot_err)?
-            .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(3)));
-    }
-    chart
-        .draw_series(std::iter::empty::<PathElement<Point>>())
-        .map_err(plot_err)?
-        .label(format!("sand's force on a leg ({:.0} mm per N)", scale * 1e3))
-        .legend(|(x, y)| {
-            PathElement::new(vec![(x, y), (x + 16, y)], palette::CLOSED_FORM_RED.stroke_width(2))
-                + Circle::new((x + 17, y), 3, palette::CLOSED_FORM_RED.filled())
-        });
+    legs_legend(&mut chart, n, scale)?;
     for j in 0..legs {
         let psi = tr.leg_angle_rad[j][i];
         let (sa, ca) = (phi - psi).sin_cos();
@@ -527,6 +511,36 @@ where
     }
     chart.draw_series([Circle::new(world([x, z]), 4, BLACK.filled())]).map_err(plot_err)?;
     super::legend_box(&mut chart, SeriesLabelPosition::UpperLeft, 12.0, super::LegendBox::LIGHT)?;
+    Ok(())
+}
+
+/// The animation legend's entries for the legs of each tripod and the sand's force on a leg
+/// (`scale` m of arrow per N), as empty series: the marks themselves are drawn per leg.
+fn legs_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut super::SlopeChart<'a, DB>,
+    n: usize,
+    scale: f64,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    for (tripod, name) in [(0, "tripod A legs"), (1, "tripod B legs")] {
+        let col = leg_colour(tripod, 0, n);
+        chart
+            .draw_series(std::iter::empty::<PathElement<Point>>())
+            .map_err(plot_err)?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(3)));
+    }
+    chart
+        .draw_series(std::iter::empty::<PathElement<Point>>())
+        .map_err(plot_err)?
+        .label(format!("sand's force on a leg ({:.0} mm per N)", scale * 1e3))
+        .legend(|(x, y)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (16, 0)], palette::CLOSED_FORM_RED.stroke_width(2))
+                + Circle::new((17, 0), 3, palette::CLOSED_FORM_RED.filled())
+        });
     Ok(())
 }
 

@@ -341,7 +341,7 @@ pub fn simulator(report: &Report) -> String {
         "<p>Speeds in cm/s. Each row's last cell says whether the two agree or, in a word, where they part; \
          open it for the why and the step's parts (t1, slip and step, simulated / closed form).</p>\n\
          <table class=\"sim\"><tr><th>slope (°)</th><th>observed</th><th>closed form</th><th>simulated</th>\
-         <th>pitch free</th><th>regime: closed form / simulated</th><th>pitch free: largest pitch (°)</th><th>verdict</th></tr>",
+         <th>pitch free</th><th>outcome: closed form / simulated</th><th>pitch free: largest pitch (°)</th><th>verdict</th></tr>",
     );
     for r in &report.simulator {
         let free = if r.pitch_over_s.is_some() {
@@ -356,8 +356,8 @@ pub fn simulator(report: &Report) -> String {
             r.closed_form_m_s.map_or("- (ruled out)".into(), |v| format!("{:.1}", v * 100.0)),
             r.simulated_m_s * 100.0,
             free,
-            r.closed_form_regime.in_words(),
-            r.simulated_regime.in_words(),
+            r.closed_form_regime.outcome(),
+            r.simulated_regime.outcome(),
             largest_pitch(r),
             verdict_cell(r),
         ));

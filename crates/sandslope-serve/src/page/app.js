@@ -376,8 +376,8 @@ function drawRisk({ curve, limit }) {
   // In the risk curve's colours: the success limit in P(not success)'s orange, the safe-slope
   // limit in the model's blue, the threshold in the reference lines' grey.
   const marks = [
-    [success, "success-slope", SIM_COLOURS["not-success"], "climbs to"],
-    [safe, "safe-slope", SIM_COLOURS.model, limit.limit.kind === "repose" ? "repose" : "no failure to"],
+    [success, "success-slope", SIM_COLOURS["not-success"], "climbs steadily to"],
+    [safe, "safe-slope", SIM_COLOURS.model, limit.limit.kind === "repose" ? "repose" : "safe to"],
   ];
   let row = 0;
   for (const [deg, id, colour, label] of marks) {
@@ -391,10 +391,11 @@ function drawRisk({ curve, limit }) {
     if (l.kind === "none_safe") return `on no slope (${p} = ${l.p_fail.toFixed(4)} already on level ground)`;
     return `at every slope searched, up to ${l.up_to} deg (${p} < ${maxRisk})`;
   };
-  let summary = `climbs (success limit) ${describe(limit.success_limit, "P(not success)")}; ` +
-    `does not fail (safe-slope limit) ${describe(limit.limit, "p_fail")}`;
+  // "Safe" as docs/model.md §9 defines it, the words of docs/model.md §6.
+  let summary = `climbs steadily (success limit) ${describe(limit.success_limit, "P(not climbing steadily)")}; ` +
+    `safe (safe-slope limit) ${describe(limit.limit, "P(sinks or slides back)")}`;
   if (success !== null && safe !== null && safe - success >= 0.05) {
-    summary += `; between ${success.toFixed(1)} and ${safe.toFixed(1)} deg it is likely metastable (stalls in its own trench)`;
+    summary += `; between ${success.toFixed(1)} and ${safe.toFixed(1)} deg it likely climbs slowly and may stall (metastable: it can stall in its own trench)`;
   }
   const first = curve[0];
   summary += `; CVs used: k_n ${first.cv_n.toFixed(3)} (${first.cv_n_source}), k_s ${first.cv_s.toFixed(3)} (${first.cv_s_source}) at level`;

@@ -11,6 +11,7 @@ mod audit;
 mod diagnosis;
 mod disagreements;
 mod provenance;
+mod scope;
 mod simulator;
 mod tracks;
 
@@ -25,7 +26,7 @@ use crate::calibrate::{
 use crate::error::ParamError;
 use crate::gait::track::TrackResult;
 use crate::model::{predict, Prediction};
-use crate::paper::{self, compare_with_paper, Basis, ComparisonContext, PaperComparison};
+use crate::paper::{self, compare_with_paper, ComparisonContext, PaperComparison};
 use crate::phase::{PhasePanel, TerrainGrid};
 use crate::risk::{
     risk_curve, safe_slope_limit, success_slope_limit, RiskCurve, SafeLimit, UncertainTerrain,
@@ -41,6 +42,8 @@ pub use simulator::{
     simulator_fit_misses, SimulatorMiss, SimulatorRecord, SimulatorWalks, AGREE_WITHIN, MISS_SD, REACH_K_S,
     REPORT_WALK_S,
 };
+pub use scope::Summary;
+use scope::{another_robot_without_observations, summary, terrain_rows_only};
 use tracks::TrackUse;
 pub use tracks::{TrackRecord, TrackedSlope};
 
@@ -381,47 +384,6 @@ pub struct ReportCalibration {
     pub goodness_of_fit: String,
 }
 
-/// The comparison table summed up.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Summary {
-    /// Comparisons whose basis is independent.
-    pub independent: usize,
-    /// Of those, how many agree.
-    pub independent_agree: usize,
-    /// Comparisons that agree by construction (input, tuned, consequence).
-    pub by_construction_agree: usize,
-    /// All comparisons.
-    pub total: usize,
-    /// The summary sentence.
-    pub text: String,
-}
-
-fn summary(rows: &[PaperComparison]) -> Summary {
-    let independent = rows.iter().filter(|r| r.basis == Basis::Independent).count();
-    let independent_agree = rows.iter().filter(|r| r.basis == Basis::Independent && r.agrees).count();
-    let by_construction_agree = rows.iter().filter(|r| r.basis != Basis::Independent && r.agrees).count();
-    let construction = format!(
-        "{by_construction_agree} more agree by construction (inputs, tuned values, consequences of the model's form), out of {} compared",
-        rows.len()
-    );
-    let text = match independent {
-        0 => format!("none of the paper's numbers tests the model independently here; {construction}"),
-        // One number: name it, rather than "0 of the paper's 1 independent numbers".
-        1 => {
-            let row = rows.iter().find(|r| r.basis == Basis::Independent).expect("one independent row");
-            format!(
-                "one of the paper's numbers tests the model independently, the {}: paper {}, model {}, so the model {} it; {construction}",
-                row.quantity,
-                row.paper,
-                row.model,
-                if row.agrees { "agrees with" } else { "disagrees with" }
-            )
-        }
-        n => format!("the model agrees with {independent_agree} of the paper's {n} independent numbers; {construction}"),
-    };
-    Summary { independent, independent_agree, by_construction_agree, total: rows.len(), text }
-}
-
 /// Slopes of the model curves: 0 to 30 deg every 0.25 deg.
 fn slope_grid() -> Vec<Slope> {
     (0..=120).map(|i| at(i as f64 * 0.25)).collect()
@@ -444,42 +406,19 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     anchoring.extend(track_use.anchoring.iter().copied());
     let papers_robot = paper::is_papers_robot(&evidence.robot);
     let other_robot = another_robot_without_observations(evidence);
-    let speeds: Vec<SpeedObservation> = match &evidence.observed {
-        Some((_, s)) => s.clone(),
-        None if !evidence.tracks.is_empty() => track_use.speeds.clone(),
-        // The paper's speeds are of its 0.35 kg robot: another robot is not fitted to them.
-        None if !papers_robot => Vec::new(),
-        None => paper::SPEEDS
-            .iter()
-            .map(|&(d, v, sd)| SpeedObservation { slope: at(d), speed: v, speed_sd: sd })
-            .collect(),
-    };
+    let speeds = observed_speeds(evidence, &track_use.speeds, papers_robot);
     let calibration = calibrate(evidence, &speeds, &anchoring);
     let (simulator_fit, simulator_fit_misses, simulator_fit_warnings) =
         simulator_fit_section(evidence, &speeds, &anchoring);
     let (robot, terrain) = model(evidence, calibration.as_ref())?;
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
-    // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...): a
-    // robot it refuses loses this section, with a warning, not the report.
-    // Nor does it walk a terrain outside the plausible range (docs/model.md §7), which only a
-    // fit run to its search bound makes (one outlier speed took plate_scale to 10^4 and k_s to
-    // 3 x 10^10 N/m^3): there its walks took minutes of CPU where the rest takes seconds.
-    let k = crate::terrain::K_PLAUSIBLE;
-    let implausible = terrain.points().iter().find_map(|p| {
-        [("k_n", p.k_n), ("k_s", p.k_s)]
-            .into_iter()
-            .find(|(_, v)| !(k.min..=k.max).contains(v))
-            .map(|(name, v)| (name, v, p.slope_deg))
-    });
-    let section = match implausible {
-        Some((name, v, deg)) => Err(format!(
-            "the model's terrain ({}) has {name} = {v:.3e} N/m^3 at {deg}°, outside the plausible {:e} to {:e} \
-             N/m^3 (docs/model.md §7), where the simulator's walks take minutes; a calibration run to a search \
-             bound puts it there (see its warnings)",
-            plots.terrain_name, k.min, k.max
-        )),
-        None => simulator::simulator_section(&robot, &terrain, &speeds).map_err(|e| e.to_string()),
-    };
+    // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...) and
+    // walks no implausible terrain: either loses this section, with a warning, not the report.
+    let at_bound = calibration
+        .as_ref()
+        .filter(|_| evidence.has_own_observations())
+        .and_then(|c| scope::terrain_at_bound(&c.fit));
+    let section = scope::simulator_walks(&robot, &terrain, &speeds, &plots.terrain_name, at_bound);
     let (simulator, simulator_convergence, simulator_refusal) = match section {
         Ok(walks) => {
             plots.simulated = walks.free;
@@ -582,41 +521,18 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     })
 }
 
-/// The warning of a report on a robot other than the paper's ([`paper::is_papers_robot`])
-/// without observations of its own (`--observed`, `--t1`, `--tracks`); `None` otherwise. Then
-/// the paper's speeds, anchoring trend, step period and heavy-robot claim, all numbers about its
-/// 0.35 kg robot, are neither fitted nor compared: the report is the model for this robot on
-/// this terrain, and only the terrain's ratios are set beside the paper's.
-fn another_robot_without_observations(evidence: &Evidence) -> Option<String> {
-    if evidence.has_own_observations() || paper::is_papers_robot(&evidence.robot) {
-        return None;
+/// The speeds the report fits and compares: the user's (`--observed`, else the tracks'), else
+/// the paper's five, which are of its 0.35 kg robot and so none on another robot.
+fn observed_speeds(evidence: &Evidence, tracks: &[SpeedObservation], papers_robot: bool) -> Vec<SpeedObservation> {
+    match &evidence.observed {
+        Some((_, s)) => s.clone(),
+        None if !evidence.tracks.is_empty() => tracks.to_vec(),
+        None if !papers_robot => Vec::new(),
+        None => paper::SPEEDS
+            .iter()
+            .map(|&(d, v, sd)| SpeedObservation { slope: at(d), speed: v, speed_sd: sd })
+            .collect(),
     }
-    let r = &evidence.robot;
-    let (mass, ..) = paper::ROBOT;
-    Some(format!(
-        "your robot ({}, {} kg, R = {} cm) is not the paper's ({mass} kg, R = 4 cm) and you gave no observations \
-         of it (--observed, --t1, --tracks): the paper's speeds, anchoring trend, step period and heavy-robot claim \
-         are of the paper's robot, so this report neither fits nor compares them; it is the model's prediction \
-         for your robot on {}, untested. Give its measured speeds with --observed to test and calibrate it",
-        evidence.robot_source,
-        r.mass(),
-        r.leg_radius() * 100.0,
-        evidence.terrain_source
-    ))
-}
-
-/// The comparison rows that stand whatever the robot ([`paper::TERRAIN_ROWS`]), each labelled
-/// as the terrain's against the paper's glass beads.
-fn terrain_rows_only(rows: Vec<PaperComparison>) -> Vec<PaperComparison> {
-    rows.into_iter()
-        .filter(|r| paper::TERRAIN_ROWS.contains(&r.id.as_str()))
-        .map(|mut r| {
-            r.quantity = format!("{} (the terrain, against the paper's glass beads)", r.quantity);
-            r.basis_note =
-                format!("a property of the terrain alone, so it stands for any robot; {}", r.basis_note);
-            r
-        })
-        .collect()
 }
 
 /// The simulator's joint fit when the evidence asks for it: the fit, its misses walked with
@@ -846,6 +762,7 @@ fn figure_records(plots: &Plots, calibrated: bool) -> Vec<FigureRecord> {
 mod tests {
     use super::*;
     use crate::model::tests::paper_robot;
+    use crate::paper::Basis;
     use crate::terrain::TerrainSpec;
 
     /// k_n constant, k_s falling to 40% at 20 deg, repose 25 deg.
@@ -1045,9 +962,8 @@ mod tests {
     }
 
     /// One outlier speed (5 m/s at 10 degrees, 30 times the model's ceiling of about 16 cm/s)
-    /// runs the fit's plate_scale to its bound, and the model's k_s far past the plausible
-    /// 1e10 N/m^3: the simulator section, whose walks there took 90 s, is left out with a
-    /// warning that names the value and the range.
+    /// runs the fit's plate_scale to its bound: the simulator section, whose walks on that
+    /// stiff terrain took 115 s of CPU, is left out with a warning that says why.
     #[test]
     fn an_outlier_speed_does_not_walk_an_implausible_terrain() {
         let mut e = evidence();
@@ -1058,11 +974,11 @@ mod tests {
         ));
         let start = std::time::Instant::now();
         let r = report(&e).unwrap();
-        let fitted = &r.calibration.as_ref().unwrap().fit.terrain;
-        assert!(fitted.points.iter().any(|p| p.k_s > 1e10), "{fitted:?}");
+        let fit = &r.calibration.as_ref().unwrap().fit;
+        assert!(scope::terrain_at_bound(fit).is_some_and(|(name, _)| name == "plate_scale"), "{:?}", fit.warnings);
         assert!(r.simulator.is_empty() && r.plots.simulated.is_empty());
         let w = r.warnings.iter().find(|w| w.contains("simulator section is left out")).expect("a warning");
-        assert!(w.contains("k_s = ") && w.contains("1e3 to 1e10"), "{w}");
+        assert!(w.contains("plate_scale ran to its search bound"), "{w}");
         assert!(start.elapsed().as_secs() < 60, "{:?}", start.elapsed());
     }
 

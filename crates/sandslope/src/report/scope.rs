@@ -142,3 +142,22 @@ pub(crate) fn simulator_walks(
         None => simulator::simulator_section(robot, terrain, speeds).map_err(|e| e.to_string()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::tests::paper_robot;
+
+    /// A model terrain whose k_s is 3e10 N/m^3 (what a plate_scale of 10^4 makes of a 3e6
+    /// table) lies beyond the plausible 1e10: no walk is made, and the reason names the value,
+    /// the slope and the range; a fit at its bound is named before any walk too.
+    #[test]
+    fn no_walk_on_an_implausible_terrain_or_a_fit_at_its_bound() {
+        let stiff = Terrain::constant(7e5, 3e10).unwrap();
+        let why = simulator_walks(&paper_robot(), &stiff, &[], "stiff", None).unwrap_err();
+        assert!(why.contains("k_s = 3.000e10 N/m^3 at 0°") && why.contains("1e3 to 1e10"), "{why}");
+        let sand = Terrain::constant(7e5, 2e6).unwrap();
+        let why = simulator_walks(&paper_robot(), &sand, &[], "sand", Some(("plate_scale".into(), 1e4))).unwrap_err();
+        assert!(why.contains("plate_scale ran to its search bound (1.000e4)"), "{why}");
+    }
+}

@@ -365,6 +365,38 @@ fn report_renders_in_a_real_browser() {
         std::fs::copy(&shot, keep).unwrap();
     }
     assert_shows_content(&shot);
+
+    // At 600 px nothing runs off the right edge (issue 58): the wide tables scroll inside a
+    // box of the page's width. The body's padding is 1em (16 px) on each side, so the last 10
+    // columns of a window tall enough to need no scrollbar are white in every row; before
+    // the boxes, the comparison and simulator tables painted them.
+    let narrow = dir.path().join("narrow.png");
+    let status = std::process::Command::new(chromium_or_skip("report_renders_in_a_real_browser").unwrap())
+        .args(CHROMIUM_FLAGS)
+        .arg("--window-size=600,16000")
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .arg(format!("--screenshot={}", narrow.display()))
+        .arg(format!("file://{}", out.join("index.html").display()))
+        .output()
+        .unwrap();
+    assert!(narrow.exists(), "no screenshot: {}", String::from_utf8_lossy(&status.stderr));
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&narrow).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let channels = info.line_size / info.width as usize;
+    assert_eq!(info.width, 600);
+    let painted: Vec<(usize, usize)> = (0..info.height as usize)
+        .flat_map(|y| (590..600).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let k = y * info.line_size + x * channels;
+            buf[k..k + 3] != [255, 255, 255]
+        })
+        .collect();
+    assert!(painted.is_empty(), "content runs off the right edge at 600 px: {} pixels, first {:?}", painted.len(), painted.first());
+    // And the page's tables are each in a scrolling box.
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert_eq!(html.matches("<table").count(), html.matches("<div class=\"scroll\"><table").count());
 }
 
 /// The upslope unit vector of a slope of `deg` degrees in the capture frame (x along the

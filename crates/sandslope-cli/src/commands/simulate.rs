@@ -15,7 +15,7 @@ use crate::figures::simulate::{Animation, SimulateFigure, SlopesFigure};
 use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
-use crate::progress::{progress_bar, spinner};
+use crate::progress::{spinner, Progress};
 use sandslope::simulate::convergence::{RefinedWalk, Refinement, WalkAnswer};
 use sandslope::simulate::mechanisms::{CONSTANT_SPEED_DUTY, UNDISTURBED_SAND};
 use sandslope::simulate::{BodyPitch, ConvergenceCheck, Mechanisms, RftScaling, SimSummary, Simulation};
@@ -229,9 +229,9 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     // Progress on stderr (a terminal's, not with --json or --csv): a 10 s walk with its GIF
     // takes tens of seconds.
     let quiet = args.format.format() != Format::Table;
-    let spin = spinner(quiet, &format!("simulating {} s at {slope} deg", walks.settings.duration_s));
+    let spin = Progress::new(0, quiet, &format!("simulating {} s at {slope} deg", walks.settings.duration_s));
     let sims = walks.simulate();
-    spin.finish_and_clear();
+    spin.finish();
     let Some(sim) = sims?.pop() else { bail!("no walk was simulated") };
     if sim.summary.closed_form.extrapolated {
         warn_extrapolated(scenario.terrain(), &[slope]);
@@ -250,9 +250,9 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     }
     if let Some(path) = &args.animate {
         let anim = Animation { sim: &sim, slope_deg: slope };
-        let bar = progress_bar(anim.frames().len() as u64, quiet, &format!("drawing {}", path.display()));
-        figures::simulate::save_gif(path, &anim, &mut || bar.inc(1))?;
-        bar.finish_and_clear();
+        let mut bar = Progress::new(anim.frames().len() as u64, quiet, &format!("drawing {}", path.display()));
+        figures::simulate::save_gif(path, &anim, &mut || bar.inc())?;
+        bar.finish();
     }
     if let (Some(path), Some(csv)) = (&args.out, &csv) {
         write_atomic(path, csv)?;

@@ -11,6 +11,7 @@ _Path = Union[str, "os.PathLike[str]"]
 _F64 = npt.NDArray[np.float64]
 
 REGIMES: Tuple[str, str, str, str]
+OUTCOMES: Tuple[str, str, str, str]
 CAUSES: Tuple[str, ...]
 DEFAULT_MAX_RISK: float
 DEFAULT_MAX_ROLL_DEG: float

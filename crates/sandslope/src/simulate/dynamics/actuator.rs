@@ -72,7 +72,6 @@ impl Walker {
         m: [f64; 3],
         v0: [f64; 3],
     ) -> bool {
-        let legs = self.psi.len();
         let mut converged = true;
         let mut settled = false;
         for it in 0..MAX_ITERATIONS {
@@ -81,11 +80,11 @@ impl Walker {
             // Damped after a few iterations: the map is decreasing in r (more rate, more torque,
             // less rate allowed), so undamped it can swing.
             let relax = if it < 4 { 1.0 } else { 0.5 };
-            for j in 0..legs {
-                let target = motor.rate(demand[j], self.legs_out[j].torque);
-                let next = self.rates[j] + relax * (target - self.rates[j]);
-                change = change.max((next - self.rates[j]).abs());
-                self.rates[j] = next;
+            for ((rate, out), &asked) in self.rates.iter_mut().zip(&self.legs_out).zip(demand) {
+                let target = motor.rate(asked, out.torque);
+                let next = *rate + relax * (target - *rate);
+                change = change.max((next - *rate).abs());
+                *rate = next;
             }
             if change < RATE_TOL {
                 settled = true;
@@ -94,8 +93,8 @@ impl Walker {
             self.v = v0;
             converged = self.solve(v_free, m);
         }
-        for j in 0..legs {
-            self.stalled[j] = self.rates[j] <= 0.0 && demand[j] > 0.0;
+        for ((stalled, &rate), &asked) in self.stalled.iter_mut().zip(&self.rates).zip(demand) {
+            *stalled = rate <= 0.0 && asked > 0.0;
         }
         converged && settled
     }

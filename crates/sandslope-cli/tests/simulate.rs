@@ -199,6 +199,7 @@ fn bad_input_exits_2_naming_the_value_and_range_and_writes_nothing() {
         (vec!["--slopes", "0:95:5"], "--slopes"),
         (vec!["--slope", "10", "--body-pitch", "fixed"], "possible values: free, locked"),
         (vec!["--slope", "10", "--rft-scaling", "stress"], "possible values: motion, components, li2013"),
+        (vec!["--slope", "10", "--actuator", "stepper"], "possible values: ideal, servo"),
         (vec!["--slope", "10", "--creep", "0"], "--creep = 0 must be between 1e-9 and 1e-3 m/s"),
         (vec!["--slope", "10", "--creep", "NaN"], "--creep = NaN"),
         (vec!["--slope", "10", "--leg-friction", "-0.1"], "--leg-friction = -0.1 must be between 0 and 10"),

@@ -133,6 +133,16 @@ impl SimulateRequest {
             duty_cycle: p.number_or("duty-cycle", defaults.duty_cycle)?,
             disturbed_sand: p.number_or("disturbed-sand", defaults.disturbed_sand)?,
             one_sided_belly: p.flag("one-sided-belly")?,
+            servo_actuator: match p.text("actuator")? {
+                None | Some("ideal") => false,
+                Some("servo") => true,
+                Some(other) => {
+                    return Err(RequestError::invalid(
+                        "actuator",
+                        format!("--actuator = `{other}` must be one of: ideal, servo"),
+                    ))
+                }
+            },
         };
         let rate_hz = p.number_or("rate", 120.0)?;
         let ensemble = p.number("ensemble")?.map(|n| ensemble_size(n, &slopes)).transpose()?;

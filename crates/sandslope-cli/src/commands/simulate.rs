@@ -80,6 +80,11 @@ pub struct SimulateArgs {
     /// on both faces, as resistive force theory's plates were).
     #[arg(long)]
     pub one_sided_belly: bool,
+    /// What turns the legs: `ideal` (position sources that follow the gait whatever the sand
+    /// resists, the default) or `servo` (the XL330-M288's motor, its torque-speed line and
+    /// current limit, the leg rates solved with the body's; docs/model.md §20.6).
+    #[arg(long, value_name = "ideal|servo", value_enum, default_value_t = ActuatorArg::Ideal)]
+    pub actuator: ActuatorArg,
     /// Walk the one slope N times (2 to 1000), the robot's mass perturbed by 1e-9 relative
     /// between walks, and give the spread: mean speed, its SD and standard error, mean t1, the
     /// regimes' counts, how many pitched over. For the free body, whose walk on a slope is
@@ -142,6 +147,15 @@ impl From<PitchArg> for BodyPitch {
     }
 }
 
+/// `--actuator`: what turns the legs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ActuatorArg {
+    /// Ideal position sources (default).
+    Ideal,
+    /// The XL330-M288's motor (docs/model.md §20.6).
+    Servo,
+}
+
 /// `--rft-scaling`: the library's [`RftScaling`] as a flag value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ScalingArg {
@@ -186,6 +200,7 @@ impl SimulateArgs {
                 duty_cycle: self.duty_cycle,
                 disturbed_sand: self.disturbed_sand,
                 one_sided_belly: self.one_sided_belly,
+                servo_actuator: self.actuator == ActuatorArg::Servo,
             },
             rate_hz: self.rate,
             ensemble,

@@ -23,6 +23,7 @@ use crate::robot::Robot;
 use crate::terrain::Ground;
 use std::f64::consts::PI;
 
+mod actuator;
 mod groups;
 mod lanes;
 #[cfg(test)]
@@ -54,6 +55,8 @@ pub(crate) struct StepPeaks {
     pub peak_force: f64,
     pub peak_torque: f64,
     pub stall_s: f64,
+    /// Largest lag of a leg behind its commanded angle, rad.
+    pub peak_lag: f64,
 }
 
 /// What a run produced.
@@ -97,6 +100,8 @@ pub(crate) struct Walker {
     width: f64,
     belly_width: f64,
     torque_limit: Option<f64>,
+    /// The servo as an actuator (§20.6), if on.
+    motor: Option<actuator::Motor>,
     /// Creep speed of the smoothed set-valued law, m/s (docs/model.md §17).
     eps: f64,
     dt: f64,
@@ -241,6 +246,7 @@ impl Walker {
             width: robot.leg_width(),
             belly_width: robot.body_width(),
             torque_limit: if settings.servo_limit { robot.servo_torque_limit() } else { None },
+            motor: settings.mechanisms.servo_actuator.then(actuator::Motor::xl330),
             eps: settings.creep_m_s,
             dt,
             locked: settings.locked_leg_angle,
@@ -676,6 +682,8 @@ impl Walker {
                     if self.duty == CONSTANT_SPEED_DUTY { self.omega } else { self.clock(j, self.time).1 };
                 if self.locked.is_some() {
                     0.0
+                } else if let Some(motor) = self.motor {
+                    self.demanded_rate(j, &motor)
                 } else if self.torque_limit.is_some() {
                     (nominal + (cmd - self.psi[j]) * CATCH_UP_PER_S).clamp(0.0, 1.5 * nominal)
                 } else if self.duty == CONSTANT_SPEED_DUTY {
@@ -694,6 +702,10 @@ impl Walker {
         let v_free = [self.v[0] + dt * self.gx * gs, self.v[1] + dt * self.gz * gs, self.v[2]];
         let v0 = self.v;
         let mut converged = self.solve(v_free, m);
+        if let (Some(motor), true) = (self.motor, gait && self.locked.is_none()) {
+            let demand = self.rates.clone();
+            converged = self.actuate(motor, &demand, v_free, m, v0);
+        }
         // A torque-limited servo whose leg the sand resists by more than its limit at the solved
         // motion stalls for the step (holds its angle); the step is solved again without it.
         if let Some(limit) = self.torque_limit {

@@ -10,11 +10,14 @@
 //!   (§20.2).
 //! - [`Mechanisms::one_sided_belly`]: the belly has sand below it only, so it never holds the
 //!   body down (§20.5, issue 59).
+//! - [`Mechanisms::servo_actuator`]: the legs driven by the servo's motor, not ideal position
+//!   sources (§20.6, issue 59).
 //! - [`Mechanisms::disturbed_sand`]: sand a leg has already passed through resists less (the
 //!   trench, §20.3): [`Trench`].
 //!
-//! The servo's speed-torque curve is not among them: applied to the leg rates between velocity
-//! solves its answer moved from 34.1 to 22.9 cm/s as the step was refined (docs/model.md §20.4).
+//! The servo's speed-torque curve applied to the leg rates between velocity solves moved its
+//! answer from 34.1 to 22.9 cm/s as the step was refined (docs/model.md §20.4); solved with
+//! them, it is [`Mechanisms::servo_actuator`].
 
 use serde::{Deserialize, Serialize};
 
@@ -54,6 +57,11 @@ pub struct Mechanisms {
     /// without it reads as before.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub one_sided_belly: bool,
+    /// Each leg driven by the XL330-M288's motor (its torque-speed line and current limit),
+    /// its rate solved with the body's in the implicit step (§20.6), instead of an ideal
+    /// position source. Serialised only when on.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub servo_actuator: bool,
 }
 
 impl Default for Mechanisms {
@@ -63,6 +71,7 @@ impl Default for Mechanisms {
             duty_cycle: CONSTANT_SPEED_DUTY,
             disturbed_sand: UNDISTURBED_SAND,
             one_sided_belly: false,
+            servo_actuator: false,
         }
     }
 }

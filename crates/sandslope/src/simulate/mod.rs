@@ -233,6 +233,9 @@ pub struct SimStep {
     pub peak_servo_torque_n_m: f64,
     /// Time servos spent stalled, summed over legs, s.
     pub stall_s: f64,
+    /// Largest lag of a leg behind its commanded angle, rad (0 for ideal servos; with the
+    /// servo actuator, docs/model.md §20.6, the motor's shortfall).
+    pub peak_lag_rad: f64,
     /// Phase 1 (touchdown to t1): the lowest speed and what held the body (issue 59).
     pub phase1: PhaseOne,
 }
@@ -241,7 +244,7 @@ impl Serialize for SimStep {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeStruct;
         let m = &self.step;
-        let mut st = s.serialize_struct("SimStep", 19)?;
+        let mut st = s.serialize_struct("SimStep", 20)?;
         st.serialize_field("index", &self.index)?;
         st.serialize_field("tripod", &self.tripod)?;
         st.serialize_field("touchdown_s", &m.touchdown_s)?;
@@ -255,6 +258,7 @@ impl Serialize for SimStep {
         st.serialize_field("peak_leg_force_n", &self.peak_leg_force_n)?;
         st.serialize_field("peak_servo_torque_n_m", &self.peak_servo_torque_n_m)?;
         st.serialize_field("stall_s", &self.stall_s)?;
+        st.serialize_field("peak_lag_rad", &self.peak_lag_rad)?;
         let p = &self.phase1;
         st.serialize_field("phase1_min_speed_m_s", &p.min_speed_m_s)?;
         st.serialize_field("phase1_belly_x_n", &p.belly_n[0])?;
@@ -532,6 +536,7 @@ pub fn simulate_with_leg(
             peak_leg_force_n: acc.peak_force,
             peak_servo_torque_n_m: acc.peak_torque,
             stall_s: acc.stall_s,
+            peak_lag_rad: acc.peak_lag,
             phase1,
         });
     }

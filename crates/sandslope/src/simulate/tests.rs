@@ -233,8 +233,8 @@ fn a_step_serialises_the_gait_step_in_place() {
         ["index", "tripod", "touchdown_s", "warmup", "t1_s", "slip_m", "step_m", "speed_m_s", "max_depth_m"];
     let at: Vec<usize> = order.iter().map(|k| text.find(&format!("\"{k}\":")).unwrap()).collect();
     assert!(at.windows(2).all(|w| w[0] < w[1]), "{text}");
-    // 12 fields, then phase 1's seven (issue 59) after them.
-    assert_eq!(v.as_object().unwrap().len(), 19);
+    // 12 fields, then the lag and phase 1's seven (issue 59) after them.
+    assert_eq!(v.as_object().unwrap().len(), 20);
     assert!(text.find("\"stall_s\":").unwrap() < text.find("\"phase1_min_speed_m_s\":").unwrap(), "{text}");
     // The fourth step touches down at 3 T/2 = 1.5 s (T = 1 s for this robot) on tripod 1.
     assert_eq!(

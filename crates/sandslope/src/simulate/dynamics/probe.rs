@@ -48,4 +48,16 @@ impl Walker {
     pub(crate) fn leg_depth(&self) -> f64 {
         self.legs_out.iter().map(|o| o.depth).fold(0.0, f64::max)
     }
+
+    /// Walks `steps` gait steps from the current state and returns the motors' work over
+    /// them, J: the sum over steps and legs of the sand's torque resisting the leg (what the
+    /// massless leg's motor gives) times the leg's rate times the step (tests).
+    pub(crate) fn walk_with_work(&mut self, steps: usize) -> f64 {
+        let mut work = 0.0;
+        for _ in 0..steps {
+            self.step(true);
+            work += self.legs_out.iter().zip(&self.rates).map(|(o, r)| o.torque * r).sum::<f64>() * self.dt;
+        }
+        work
+    }
 }

@@ -56,6 +56,9 @@ impl Walker {
                     // correctly rounded, so the root of the largest is the largest root).
                     p.peak_force = p.peak_force.max(o.force[0].powi(2) + o.force[1].powi(2));
                     p.peak_torque = p.peak_torque.max(o.torque.abs());
+                    if self.locked.is_none() {
+                        p.peak_lag = p.peak_lag.max(self.command(j, self.time) - self.psi[j]);
+                    }
                     if self.stalled[j] {
                         p.stall_s += self.dt;
                         if !stalled_by_step[k].contains(&j) {

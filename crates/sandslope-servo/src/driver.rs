@@ -399,7 +399,12 @@ fn run(
                 report.prior_p_fail = Some(p);
                 if settings.stop_on_risk.is_some_and(|limit| p > limit) {
                     walk.halted = Some((time, p));
-                    walk.halt_goal = walk.last_pos.iter().zip(&walk.stand.start_goal).map(|(p, &g)| p.unwrap_or(g)).collect();
+                    walk.halt_goal = walk
+                        .last_pos
+                        .iter()
+                        .zip(&walk.stand.start_goal)
+                        .map(|(p, &g)| p.unwrap_or(g))
+                        .collect();
                 }
             }
         }

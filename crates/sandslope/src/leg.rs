@@ -9,6 +9,20 @@
 //! stance's descent, over which the leg anchors). A new leg shape is one more type
 //! implementing [`Leg`]; the closed-form functions of this module then hold for it unchanged.
 
+/// The shape of every leg (docs/model.md §15): the robot's C-leg, or the plates the oracle
+/// tests use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LegShape {
+    /// A semicircular arc of radius R from the axle to a tip 2R away (the paper's C-leg).
+    CLeg,
+    /// A straight plate from the axle to 2R along the C's diameter (a spoke).
+    Spoke,
+    /// A flat foot of area A_c (length A_c / W), R below the axle and centred under it at
+    /// angle 0 (the closed form's contact, docs/model.md §3).
+    Foot,
+}
+
 /// A leg shape's geometry, as the closed form needs it.
 pub trait Leg {
     /// Depth of the leg's lowest point below the undisturbed surface at crank angle `psi`,

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 use crate::error::{positive, ParamError};
-use crate::leg::{CLeg, Leg};
+use crate::leg::{CLeg, Foot, Leg, LegShape, Spoke};
 
 /// The robot as written in a file: the keys of docs/model.md §2, unknown keys rejected.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -497,6 +497,25 @@ impl Robot {
     /// ([`Leg::touchdown_angle`]).
     pub fn touchdown_angle(&self) -> f64 {
         self.leg().touchdown_angle()
+    }
+}
+
+/// The shape's leg on a robot: [`LegShape`] is named in `leg.rs` with the geometry, built here
+/// from the robot's radius, hip height and contact area (so `leg` needs no robot).
+impl LegShape {
+    /// The [`Leg`] this shape names on `robot` (radius R, hip height h; the foot's length is
+    /// the contact area over the leg width). The simulator walks any [`Leg`]
+    /// ([`crate::simulate::simulate_with_leg`]); these are the shapes the front ends name.
+    pub fn leg(self, robot: &Robot) -> Box<dyn Leg + Send + Sync> {
+        let (radius, hip_height) = (robot.leg_radius(), robot.hip_height());
+        match self {
+            LegShape::CLeg => Box::new(CLeg { radius, hip_height }),
+            LegShape::Spoke => Box::new(Spoke { radius, hip_height }),
+            LegShape::Foot => {
+                let length = robot.contact_area() / robot.leg_width();
+                Box::new(Foot { radius, length, hip_height })
+            }
+        }
     }
 }
 

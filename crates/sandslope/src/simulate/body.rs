@@ -6,39 +6,6 @@
 //! axle line, halfway along; the belly is a flat plate `h` below the axle line.
 
 use super::rft::Rft;
-use crate::leg::{CLeg, Foot, Leg, Spoke};
-use crate::robot::Robot;
-
-/// The shape of every leg (docs/model.md §15): the robot's C-leg, or the plates the oracle
-/// tests use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum LegShape {
-    /// A semicircular arc of radius R from the axle to a tip 2R away (the paper's C-leg).
-    CLeg,
-    /// A straight plate from the axle to 2R along the C's diameter (a spoke).
-    Spoke,
-    /// A flat foot of area A_c (length A_c / W), R below the axle and centred under it at
-    /// angle 0 (the closed form's contact, docs/model.md §3).
-    Foot,
-}
-
-impl LegShape {
-    /// The [`Leg`] this shape names on `robot` (radius R, hip height h; the foot's length is
-    /// the contact area over the leg width). The simulator walks any [`Leg`]
-    /// ([`super::simulate_with_leg`]); these are the shapes the front ends name.
-    pub fn leg(self, robot: &Robot) -> Box<dyn Leg + Send + Sync> {
-        let (radius, hip_height) = (robot.leg_radius(), robot.hip_height());
-        match self {
-            LegShape::CLeg => Box::new(CLeg { radius, hip_height }),
-            LegShape::Spoke => Box::new(Spoke { radius, hip_height }),
-            LegShape::Foot => {
-                let length = robot.contact_area() / robot.leg_width();
-                Box::new(Foot { radius, length, hip_height })
-            }
-        }
-    }
-}
 
 /// Whether the body may pitch (docs/model.md §15). The closed form has no body pitch; locking
 /// it in the simulator removes that one difference, so a comparison of the two settings tells

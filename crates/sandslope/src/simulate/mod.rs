@@ -23,7 +23,8 @@ pub mod rft;
 use rayon::prelude::*;
 use serde::Serialize;
 
-pub use body::{BodyPitch, LegShape};
+pub use crate::leg::LegShape;
+pub use body::BodyPitch;
 pub use convergence::{check_convergence, check_convergence_slopes, check_walked, ConvergenceCheck};
 use dynamics::Walker;
 pub use ensemble::{simulate_ensemble, Ensemble};

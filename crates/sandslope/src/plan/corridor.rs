@@ -443,7 +443,7 @@ fn corridor_layout(
     let width = fine[first..=last].iter().map(|s| s.1 - s.0).max().unwrap_or(0);
     let spans: Vec<(usize, usize)> = (row0..row1).map(|r| fine[r / f]).collect();
     let col0 = spans.iter().map(|s| s.0.min(map_cols - width) as isize).collect();
-    let layout = Layout { row0, col0, width, map_cols: map_cols, map_rows: map_rows };
+    let layout = Layout { row0, col0, width, map_cols, map_rows };
     let bytes = layout.cells() as u64 * CORRIDOR_BYTES_PER_CELL;
     if let Some(limit) = corridor.max_bytes.filter(|&l| bytes > l) {
         return Err(PlanError::Grid(format!(

@@ -72,46 +72,7 @@ pub(super) fn simple_cylindrical(
         }
     };
     let cell = 1.0 / res;
-    let (lpo, _) = label.need_number(&map("LINE_PROJECTION_OFFSET"), "where the map's origin is")?;
-    let (spo, _) = label.need_number(&map("SAMPLE_PROJECTION_OFFSET"), "where the map's origin is")?;
-    let (clat, _) = label.need_number(&map("CENTER_LATITUDE"), "the latitude of the map's origin")?;
-    let (clon, _) = label.need_number(&map("CENTER_LONGITUDE"), "the longitude of the map's origin")?;
-    // The west and north edges by the standard's 1-based convention (the edge of sample 1
-    // is at sample 0.5) and by the 0-based one (HiRISE, ISIS, GDAL's default).
-    let one_based = (clon + (0.5 - spo) * cell, clat + (lpo - 0.5) * cell);
-    let zero_based = (clon + (-0.5 - spo) * cell, clat + (lpo + 0.5) * cell);
-    let stated_west = label.number(&map("WESTERNMOST_LONGITUDE"))?.map(|v| v.0);
-    let stated_north = label.number(&map("MAXIMUM_LATITUDE"))?.map(|v| v.0);
-    let agrees = |(west, north): (f64, f64)| {
-        let tol = EXTENT_TOLERANCE_PIXELS * cell;
-        let lon_ok = |w: f64| {
-            let d = (west - w).rem_euclid(360.0);
-            d.min(360.0 - d) <= tol
-        };
-        stated_west.is_none_or(lon_ok) && stated_north.is_none_or(|n| (north - n).abs() <= tol)
-    };
-    let (west, north) = if agrees(one_based) {
-        one_based
-    } else if agrees(zero_based) {
-        notes.push(format!(
-            "{name}: the projection offsets are read from the north-west pixel's centre counted from 0 (as \
-             HiRISE and ISIS write them), which is what reproduces the label's WESTERNMOST_LONGITUDE and \
-             MAXIMUM_LATITUDE"
-        ));
-        zero_based
-    } else {
-        bail!(
-            "{name}: SAMPLE_PROJECTION_OFFSET = {spo} and LINE_PROJECTION_OFFSET = {lpo} put the north-west corner at \
-             longitude {:.6}, latitude {:.6} (samples and lines from 1, the PDS3 standard's convention) or {:.6}, \
-             {:.6} (from 0), but the label states WESTERNMOST_LONGITUDE = {} and MAXIMUM_LATITUDE = {}",
-            one_based.0,
-            one_based.1,
-            zero_based.0,
-            zero_based.1,
-            stated_west.map_or_else(|| "(none)".into(), |v| v.to_string()),
-            stated_north.map_or_else(|| "(none)".into(), |v| v.to_string()),
-        );
-    };
+    let (west, north) = north_west_corner(label, cell, notes)?;
     let south = north - rows as f64 * cell;
     let tol = 1e-9 * (1.0 + cell);
     if north > 90.0 + tol || south < -90.0 - tol {
@@ -165,6 +126,54 @@ pub(super) fn simple_cylindrical(
     let (keys, doubles, ascii) = geographic_geokeys(radius_m, static_body);
     let geo = GeoRef::north_up((west, north, cell, cell), keys, doubles, ascii);
     Ok((geo, GroundCells { cell_m: (gx, ns), row_widths_m: Some(widths) }, Crs::Geographic { ellipsoid }))
+}
+
+/// The north-west corner (longitude, latitude) of a SIMPLE CYLINDRICAL map of `cell` degrees:
+/// by the 1-based convention, or the 0-based one where only that reproduces the label's stated
+/// extent (with a note); refused when neither does.
+fn north_west_corner(label: &Label, cell: f64, notes: &mut Vec<String>) -> Result<(f64, f64)> {
+    let name = &label.name;
+    let map = |key: &str| format!("IMAGE_MAP_PROJECTION.{key}");
+    let (lpo, _) = label.need_number(&map("LINE_PROJECTION_OFFSET"), "where the map's origin is")?;
+    let (spo, _) = label.need_number(&map("SAMPLE_PROJECTION_OFFSET"), "where the map's origin is")?;
+    let (clat, _) = label.need_number(&map("CENTER_LATITUDE"), "the latitude of the map's origin")?;
+    let (clon, _) = label.need_number(&map("CENTER_LONGITUDE"), "the longitude of the map's origin")?;
+    // The west and north edges by the standard's 1-based convention (the edge of sample 1
+    // is at sample 0.5) and by the 0-based one (HiRISE, ISIS, GDAL's default).
+    let one_based = (clon + (0.5 - spo) * cell, clat + (lpo - 0.5) * cell);
+    let zero_based = (clon + (-0.5 - spo) * cell, clat + (lpo + 0.5) * cell);
+    let stated_west = label.number(&map("WESTERNMOST_LONGITUDE"))?.map(|v| v.0);
+    let stated_north = label.number(&map("MAXIMUM_LATITUDE"))?.map(|v| v.0);
+    let agrees = |(west, north): (f64, f64)| {
+        let tol = EXTENT_TOLERANCE_PIXELS * cell;
+        let lon_ok = |w: f64| {
+            let d = (west - w).rem_euclid(360.0);
+            d.min(360.0 - d) <= tol
+        };
+        stated_west.is_none_or(lon_ok) && stated_north.is_none_or(|n| (north - n).abs() <= tol)
+    };
+    if agrees(one_based) {
+        Ok(one_based)
+    } else if agrees(zero_based) {
+        notes.push(format!(
+            "{name}: the projection offsets are read from the north-west pixel's centre counted from 0 (as \
+             HiRISE and ISIS write them), which is what reproduces the label's WESTERNMOST_LONGITUDE and \
+             MAXIMUM_LATITUDE"
+        ));
+        Ok(zero_based)
+    } else {
+        bail!(
+            "{name}: SAMPLE_PROJECTION_OFFSET = {spo} and LINE_PROJECTION_OFFSET = {lpo} put the north-west corner at \
+             longitude {:.6}, latitude {:.6} (samples and lines from 1, the PDS3 standard's convention) or {:.6}, \
+             {:.6} (from 0), but the label states WESTERNMOST_LONGITUDE = {} and MAXIMUM_LATITUDE = {}",
+            one_based.0,
+            one_based.1,
+            zero_based.0,
+            zero_based.1,
+            stated_west.map_or_else(|| "(none)".into(), |v| v.to_string()),
+            stated_north.map_or_else(|| "(none)".into(), |v| v.to_string()),
+        );
+    }
 }
 
 /// MAP_SCALE in metres a pixel, if the label gives it (KM/PIXEL when it has no unit).

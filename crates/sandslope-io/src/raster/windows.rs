@@ -44,6 +44,13 @@ enum Kind {
     Memory(Vec<f32>),
 }
 
+/// Decoded chunks' heights by chunk index, and the indices in the order they came (the first
+/// is evicted first).
+type ChunkCache = (HashMap<u32, Chunk>, VecDeque<u32>);
+
+/// A chunk's heights, shared by the windows that read it.
+type Chunk = Arc<Vec<f32>>;
+
 /// A GeoTIFF's chunks: where they are, how to decode them, and the cache.
 struct TiffChunks {
     path: PathBuf,
@@ -55,7 +62,7 @@ struct TiffChunks {
     raster: Raster,
     vertical: f64,
     decoders: Mutex<Vec<Decoder<BufReader<File>>>>,
-    cache: Mutex<(HashMap<u32, Arc<Vec<f32>>>, VecDeque<u32>)>,
+    cache: Mutex<ChunkCache>,
     cache_chunks: usize,
 }
 
@@ -257,7 +264,7 @@ impl TiffChunks {
             if self.across > 1 { (cols.start / self.cw, (cols.end - 1) / self.cw) } else { (0, 0) };
         let wanted: Vec<(usize, usize)> =
             (band0..=band1).flat_map(|b| (a0..=a1).map(move |a| (b, a))).collect();
-        let decoded: Vec<((usize, usize), Arc<Vec<f32>>)> = wanted
+        let decoded: Vec<((usize, usize), Chunk)> = wanted
             .into_par_iter()
             .map(|(b, a)| Ok(((b, a), self.chunk(name, w, h, b, a)?)))
             .collect::<Result<_>>()?;

@@ -234,23 +234,46 @@ pub fn plan_corridor_from(
 }
 
 /// A lower bound on the cost of every route of `objective` from the request's start to its
-/// goal over the whole map `source`: the straight line between the cells' centres, east-west
-/// at the narrowest row's width (every row is at least that wide), times the planner `p`'s
-/// cheapest cost per metre (its A* heuristic, which never overestimates). The tables of `p`
-/// reach the corridor's steepest gradient; every cost per metre of the model grows with the
-/// pitch (slower, longer, riskier), so the cheapest is at the level and the same for the
+/// goal over the whole map `source`: its horizontal length at least, times the planner `p`'s
+/// cheapest cost per metre (its A* heuristic's factor, which never overestimates). The tables
+/// of `p` reach the corridor's steepest gradient; every cost per metre of the model grows with
+/// the pitch (slower, longer, riskier), so the cheapest is at the level and the same for the
 /// whole map's tables.
+///
+/// The length: a route's moves sum at least |dc| cells east-west, each at least as wide as the
+/// narrowest row the route visits (a move's width is the mean of its two rows'), and |dr| + 2k
+/// rows north-south when it strays k rows beyond the endpoints' rows (there and back), so its
+/// length is at least `hypot(|dc| w_k, (|dr| + 2k) cell_y)` with `w_k` the narrowest row within
+/// k rows of the endpoints' (the sum of the moves' lengths is at least the length of their
+/// sum); the bound is the least of these over k. On a uniform grid that is the straight line;
+/// on a geographic one it does not take the poles' width for a route that stays far from them.
 fn straight_line_bound(
     p: &Planner,
     objective: Objective,
     request: &PlanRequest,
     source: &dyn HeightSource,
 ) -> f64 {
-    let min_width =
-        source.row_widths().map_or(source.cell_x(), |w| w.iter().copied().fold(f64::INFINITY, f64::min));
     let dc = request.start.col.abs_diff(request.goal.col) as f64;
-    let dr = request.start.row.abs_diff(request.goal.row) as f64;
-    p.min_cost[objective as usize] * (dc * min_width).hypot(dr * source.cell_y())
+    let (r0, r1) = (request.start.row.min(request.goal.row), request.start.row.max(request.goal.row));
+    let cy = source.cell_y();
+    let length = match source.row_widths() {
+        None => (dc * source.cell_x()).hypot((r1 - r0) as f64 * cy),
+        Some(w) => {
+            let mut narrowest = w[r0..=r1].iter().copied().fold(f64::INFINITY, f64::min);
+            let mut best = (dc * narrowest).hypot((r1 - r0) as f64 * cy);
+            for k in 1..w.len() {
+                let (above, below) = (r0.checked_sub(k), w.get(r1 + k));
+                if above.is_none() && below.is_none() {
+                    break;
+                }
+                narrowest = above.map_or(narrowest, |a| narrowest.min(w[a]));
+                narrowest = below.map_or(narrowest, |&b| narrowest.min(b));
+                best = best.min((dc * narrowest).hypot((r1 - r0 + 2 * k) as f64 * cy));
+            }
+            best
+        }
+    };
+    p.min_cost[objective as usize] * length
 }
 
 /// The coarse route of `objective` between the coarse cells of the request's start and goal;
@@ -443,7 +466,7 @@ fn corridor_layout(
     let width = fine[first..=last].iter().map(|s| s.1 - s.0).max().unwrap_or(0);
     let spans: Vec<(usize, usize)> = (row0..row1).map(|r| fine[r / f]).collect();
     let col0 = spans.iter().map(|s| s.0.min(map_cols - width) as isize).collect();
-    let layout = Layout { row0, col0, width, map_cols: map_cols, map_rows: map_rows };
+    let layout = Layout { row0, col0, width, map_cols, map_rows };
     let bytes = layout.cells() as u64 * CORRIDOR_BYTES_PER_CELL;
     if let Some(limit) = corridor.max_bytes.filter(|&l| bytes > l) {
         return Err(PlanError::Grid(format!(

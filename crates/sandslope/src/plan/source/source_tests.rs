@@ -186,8 +186,16 @@ fn the_windowed_corridor_search_plans_the_in_memory_routes_reading_only_its_corr
 /// route's real excess over the optimum; a corridor that is the whole map states 0.
 #[test]
 fn every_corridor_route_states_a_gap_bound_that_holds() {
-    let grid = dunes(96);
-    let (s, t) = (Cell { col: 4, row: 90 }, Cell { col: 90, row: 6 });
+    // Also with rows of different widths, narrowing fivefold to the north as towards a pole
+    // (the bound takes the narrowest row a route could reach).
+    let widths: Vec<f64> = (0..96).map(|r| 0.1 + 0.4 * r as f64 / 95.0).collect();
+    for grid in [dunes(96), dunes(96).with_row_widths(widths).unwrap()] {
+        gap_bounds_hold(grid);
+    }
+}
+
+fn gap_bounds_hold(grid: ElevationGrid) {
+    let (s, t) = (Cell { col: 4, row: 90 }, Cell { col: 90, row: 40 });
     let robot = paper_robot();
     let full = Planner::new(grid.clone(), None, &[terrain()], &robot, PlanSettings::default()).unwrap();
     let go = |_: crate::plan::Objective, _: u64, _: u64| ControlFlow::Continue(());

@@ -9,7 +9,7 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Result};
 
 use super::messages::{
-    self, decode, JointState, Odometry, PoseStamped, RosMessage, TfMessage, TransformStamped,
+    self, decode, JointState, Odometry, PoseStamped, RosMessage, StringMsg, TfMessage, TransformStamped,
 };
 use super::{describe_topics, open, scan, BagMessage, BagTopic};
 use crate::mocap::{Capture, MocapFormat};
@@ -269,6 +269,9 @@ fn regular(path: &Path, topic: &str, mut samples: Vec<(i64, [f64; 3])>) -> Resul
     Ok((1.0 / dt, 0.0, positions))
 }
 
+/// The topic `drive --log run.mcap` writes its log's header on.
+pub const RUN_TOPIC: &str = "/sandslope/run";
+
 /// What a `JointState`'s `effort` holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum EffortUnit {
@@ -418,6 +421,20 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
         Ok(())
     })?;
     pick_topic(path, &all, Some(&name), &types, "--topic")?;
+    // A bag `drive --log run.mcap` wrote carries its log's header on `/sandslope/run`
+    // (`key = value` lines: the slope, k_n, the servos), read as the CSV log's header.
+    let mut meta = BTreeMap::new();
+    if all.iter().any(|t| t.name == RUN_TOPIC && messages::same_type(&t.type_name, StringMsg::TYPE)) {
+        scan(&bag, Some(RUN_TOPIC), &mut |m| {
+            let text: StringMsg = decode_at(m)?;
+            for line in text.data.lines() {
+                if let Some((k, v)) = line.split_once('=') {
+                    meta.insert(k.trim().to_string(), v.trim().to_string());
+                }
+            }
+            Ok(())
+        })?;
+    }
     let order = map.unwrap_or_default();
     for (leg, joint) in order.iter().enumerate() {
         if !rows.iter().any(|r| r.2.leg == leg) {
@@ -444,7 +461,7 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
             r
         })
         .collect();
-    Ok(ServoLog { meta: BTreeMap::new(), rows, lines, notes })
+    Ok(ServoLog { meta, rows, lines, notes })
 }
 
 #[cfg(test)]

@@ -187,10 +187,10 @@ def test_several_pose_topics_are_listed_when_none_is_chosen(walk):
 
 @pytest.fixture(scope="module")
 def servo_run(tmp_path_factory):
-    """An emulated 4 s drive at 20 degrees on sand of k_s = 2.5e5 N/m^3, logged as CSV."""
+    """An emulated 6 s drive at 20 degrees on sand of k_s = 2.5e5 N/m^3, logged as CSV."""
     d = tmp_path_factory.mktemp("drive")
     log = d / "run.csv"
-    run("drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "4", "--log", log)
+    run("drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "6", "--log", log)
     return d, log, pd.read_csv(log, comment="#")
 
 
@@ -326,7 +326,7 @@ def test_simulate_out_mcap_reads_back_and_tracks_as_the_csv(walk):
 
 def test_drive_log_mcap_reads_back_and_infers(tmp_path):
     path = tmp_path / "run.mcap"
-    run("drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "4", "--live", "--log", path)
+    run("drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "6", "--live", "--log", path)
     topics = read_back(path)
     assert {"/sandslope/run", "/joint_states", "/sandslope/commands", "/sandslope/verdict"} <= set(topics)
     assert len(topics["/joint_states"]) == len(topics["/sandslope/commands"]) > 100

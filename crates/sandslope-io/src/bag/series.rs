@@ -421,20 +421,7 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
         Ok(())
     })?;
     pick_topic(path, &all, Some(&name), &types, "--topic")?;
-    // A bag `drive --log run.mcap` wrote carries its log's header on `/sandslope/run`
-    // (`key = value` lines: the slope, k_n, the servos), read as the CSV log's header.
-    let mut meta = BTreeMap::new();
-    if all.iter().any(|t| t.name == RUN_TOPIC && messages::same_type(&t.type_name, StringMsg::TYPE)) {
-        scan(&bag, Some(RUN_TOPIC), &mut |m| {
-            let text: StringMsg = decode_at(m)?;
-            for line in text.data.lines() {
-                if let Some((k, v)) = line.split_once('=') {
-                    meta.insert(k.trim().to_string(), v.trim().to_string());
-                }
-            }
-            Ok(())
-        })?;
-    }
+    let meta = run_header(&bag, &all)?;
     let order = map.unwrap_or_default();
     for (leg, joint) in order.iter().enumerate() {
         if !rows.iter().any(|r| r.2.leg == leg) {
@@ -462,6 +449,24 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
         })
         .collect();
     Ok(ServoLog { meta, rows, lines, notes })
+}
+
+/// The `key = value` lines of a bag's [`RUN_TOPIC`] (what `drive --log run.mcap` writes
+/// there: the CSV log's header, the slope among them); empty when the bag has none.
+fn run_header(bag: &super::Bag, topics: &[BagTopic]) -> Result<BTreeMap<String, String>> {
+    let mut meta = BTreeMap::new();
+    if topics.iter().any(|t| t.name == RUN_TOPIC && messages::same_type(&t.type_name, StringMsg::TYPE)) {
+        scan(bag, Some(RUN_TOPIC), &mut |m| {
+            let text: StringMsg = decode_at(m)?;
+            for line in text.data.lines() {
+                if let Some((k, v)) = line.split_once('=') {
+                    meta.insert(k.trim().to_string(), v.trim().to_string());
+                }
+            }
+            Ok(())
+        })?;
+    }
+    Ok(meta)
 }
 
 #[cfg(test)]

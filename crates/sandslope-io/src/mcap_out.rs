@@ -239,7 +239,7 @@ pub fn drive_mcap(
     let mut out = McapOut::new()?;
     let text: String = meta.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
     out.write(
-        "/sandslope/run",
+        crate::bag::series::RUN_TOPIC,
         ns(rows.first().map_or(0.0, |r| r.time_s), offset),
         &StringMsg { data: text },
     )?;

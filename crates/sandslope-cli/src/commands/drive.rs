@@ -426,29 +426,7 @@ pub fn run(args: DriveArgs) -> Result<()> {
     };
     let (report, failure) = drive_logged(&mut session, log, stop, on_sample, &mut on_live)?;
     if let Some(path) = mcap {
-        use sandslope_io::mcap_out::{drive_mcap, LiveRecord};
-        let live: Vec<LiveRecord> = (report.live.iter())
-            .map(|l| (l.time_s, l.tripod as f64, &l.inference))
-            .map(|(time_s, tripod, i)| LiveRecord {
-                time_s,
-                values: [
-                    tripod,
-                    i.k_s,
-                    i.k_s_lo,
-                    i.k_s_hi,
-                    i.speed_m_s,
-                    i.speed_lo_m_s,
-                    i.speed_hi_m_s,
-                    i.p_fail,
-                    i.p_slippage,
-                    i.p_sinkage,
-                ],
-            })
-            .collect();
-        let verdict = failure
-            .as_ref()
-            .map_or_else(|| serde_json::to_string(&report.outcome).unwrap_or_default(), |e| e.to_string());
-        sandslope_io::write_atomic(path, &drive_mcap(&rows, &live, &meta, &verdict)?)?;
+        write_mcap_log(path, &rows, &report, &meta, failure.as_ref())?;
     }
     crate::error::DRIVING.store(false, Ordering::SeqCst);
     let budget = session.bus_budget();
@@ -671,4 +649,37 @@ fn dry_run(schedule: &GaitSchedule, s: &DriveSettings) -> Result<()> {
     std::io::Write::flush(&mut out)?;
     println!("# write Torque Enable (64) = 0 on IDs {} (every exit)", ids.join(", "));
     Ok(())
+}
+
+/// `--log run.mcap`: the run's rows, live estimates and outcome as ROS 2 messages
+/// (`sandslope_io::mcap_out::drive_mcap`, docs/bags.md).
+fn write_mcap_log(
+    path: &std::path::Path,
+    rows: &[sandslope_io::servo_log::ServoLogRow],
+    report: &DriveReport,
+    meta: &[(&str, String)],
+    failure: Option<&sandslope_servo::DriveError>,
+) -> Result<()> {
+    use sandslope_io::mcap_out::{drive_mcap, LiveRecord};
+    let live: Vec<LiveRecord> = (report.live.iter())
+        .map(|l| (l.time_s, l.tripod as f64, &l.inference))
+        .map(|(time_s, tripod, i)| LiveRecord {
+            time_s,
+            values: [
+                tripod,
+                i.k_s,
+                i.k_s_lo,
+                i.k_s_hi,
+                i.speed_m_s,
+                i.speed_lo_m_s,
+                i.speed_hi_m_s,
+                i.p_fail,
+                i.p_slippage,
+                i.p_sinkage,
+            ],
+        })
+        .collect();
+    let verdict =
+        failure.map_or_else(|| serde_json::to_string(&report.outcome).unwrap_or_default(), |e| e.to_string());
+    sandslope_io::write_atomic(path, &drive_mcap(rows, &live, meta, &verdict)?)
 }

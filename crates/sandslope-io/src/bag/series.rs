@@ -9,7 +9,7 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Result};
 
 use super::messages::{
-    self, decode, JointState, Odometry, PoseStamped, RosMessage, TfMessage, TransformStamped,
+    self, decode, JointState, Odometry, PoseStamped, RosMessage, StringMsg, TfMessage, TransformStamped,
 };
 use super::{describe_topics, open, scan, BagMessage, BagTopic};
 use crate::mocap::{Capture, MocapFormat};
@@ -269,6 +269,9 @@ fn regular(path: &Path, topic: &str, mut samples: Vec<(i64, [f64; 3])>) -> Resul
     Ok((1.0 / dt, 0.0, positions))
 }
 
+/// The topic `drive --log run.mcap` writes its log's header on.
+pub const RUN_TOPIC: &str = "/sandslope/run";
+
 /// What a `JointState`'s `effort` holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum EffortUnit {
@@ -418,6 +421,7 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
         Ok(())
     })?;
     pick_topic(path, &all, Some(&name), &types, "--topic")?;
+    let meta = run_header(&bag, &all)?;
     let order = map.unwrap_or_default();
     for (leg, joint) in order.iter().enumerate() {
         if !rows.iter().any(|r| r.2.leg == leg) {
@@ -444,7 +448,25 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
             r
         })
         .collect();
-    Ok(ServoLog { meta: BTreeMap::new(), rows, lines, notes })
+    Ok(ServoLog { meta, rows, lines, notes })
+}
+
+/// The `key = value` lines of a bag's [`RUN_TOPIC`] (what `drive --log run.mcap` writes
+/// there: the CSV log's header, the slope among them); empty when the bag has none.
+fn run_header(bag: &super::Bag, topics: &[BagTopic]) -> Result<BTreeMap<String, String>> {
+    let mut meta = BTreeMap::new();
+    if topics.iter().any(|t| t.name == RUN_TOPIC && messages::same_type(&t.type_name, StringMsg::TYPE)) {
+        scan(bag, Some(RUN_TOPIC), &mut |m| {
+            let text: StringMsg = decode_at(m)?;
+            for line in text.data.lines() {
+                if let Some((k, v)) = line.split_once('=') {
+                    meta.insert(k.trim().to_string(), v.trim().to_string());
+                }
+            }
+            Ok(())
+        })?;
+    }
+    Ok(meta)
 }
 
 #[cfg(test)]

@@ -452,19 +452,15 @@ where
         .map_err(plot_err)?;
     // The body's path so far: its centre's trace, the part in view.
     let trace: Vec<Point> = (0..=i).map(|k| world([tr.x_m[k], tr.z_m[k]])).filter(|&p| inside(p)).collect();
-    let trace_colour = palette::BODY_TRACE;
+    let (trace_colour, trace) = (palette::BODY_TRACE, if trace.len() >= 2 { trace } else { Vec::new() });
     chart
-        .draw_series([PathElement::new(
-            if trace.len() >= 2 { trace } else { Vec::new() },
-            trace_colour.stroke_width(2),
-        )])
+        .draw_series([PathElement::new(trace, trace_colour.stroke_width(2))])
         .map_err(plot_err)?
         .label("path of the body's centre (black dot)")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], trace_colour.stroke_width(2)));
-    // Body: a box from the belly (h below the axle) to h above it, pitched, drawn above the
-    // sand surface only: at a touchdown the belly presses a few mm into the yielding sand
-    // (resistive force theory, docs/model.md §16), which drawn whole looked like the body
-    // sinking into the ground; the legs below the surface are drawn whole.
+    // Body: belly (h below the axle) to 0.3 h above it, pitched, drawn above the sand only: at
+    // a touchdown the belly presses a few mm into the yielding sand (docs/model.md §16), which
+    // drawn whole looked like the body sinking into the ground.
     let (sp, cp) = phi.sin_cos();
     let body = |p: [f64; 2]| world([x + cp * p[0] - sp * p[1], z + sp * p[0] + cp * p[1]]);
     let (l, h) = (g.body_length_m, g.hip_height_m);

@@ -414,10 +414,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
     // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...) and
     // walks no implausible terrain: either loses this section, with a warning, not the report.
-    let at_bound = calibration
-        .as_ref()
-        .filter(|_| evidence.has_own_observations())
-        .and_then(|c| scope::terrain_at_bound(&c.fit));
+    let at_bound = calibration.as_ref().and_then(|c| scope::terrain_at_bound(&c.fit, evidence));
     let section = scope::simulator_walks(&robot, &terrain, &speeds, &plots.terrain_name, at_bound);
     let (simulator, simulator_convergence, simulator_refusal) = match section {
         Ok(walks) => {

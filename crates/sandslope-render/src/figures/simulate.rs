@@ -462,7 +462,6 @@ where
     // a touchdown the belly presses a few mm into the yielding sand (docs/model.md §16), which
     // drawn whole looked like the body sinking into the ground.
     let (sp, cp) = phi.sin_cos();
-    let body = |p: [f64; 2]| world([x + cp * p[0] - sp * p[1], z + sp * p[0] + cp * p[1]]);
     let above = body_above_sand(anim, i);
     let grey = palette::DATA_GREY.mix(0.8);
     chart

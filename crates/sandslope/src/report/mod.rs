@@ -997,7 +997,7 @@ mod tests {
         let r = report(&e).unwrap();
         let fit = &r.calibration.as_ref().unwrap().fit;
         assert!(
-            scope::terrain_at_bound(fit).is_some_and(|(name, _)| name == "plate_scale"),
+            scope::terrain_at_bound(fit, &e).is_some_and(|(name, _)| name == "plate_scale"),
             "{:?}",
             fit.warnings
         );

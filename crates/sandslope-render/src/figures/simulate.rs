@@ -225,6 +225,9 @@ impl Figure for SlopesFigure<'_> {
                 .chain([0.0]),
             (0.0, 16.0),
         );
+        // Headroom above the data for the legend in the upper right (in the lower left it
+        // covered the tumble marks on the zero line; over the data, the pitch-locked curve).
+        let yr = (yr.0, yr.1 + 0.5 * (yr.1 - yr.0));
         let setup = ChartSetup {
             caption: Some(("Step-averaged speed: simulator, closed form and observations", 22.0)),
             margin: 14,
@@ -300,8 +303,7 @@ impl Figure for SlopesFigure<'_> {
                     + Circle::new((0, 0), 4, BLACK.stroke_width(2))
             });
         }
-        // Upper right: the speeds fall with slope, and the tumble marks lie on the zero line,
-        // which a legend in the lower left covered.
+        // Upper right, in the headroom: the tumble marks lie on the zero line.
         super::legend_box(&mut c, SeriesLabelPosition::UpperRight, 15.0, super::LegendBox::LIGHT)?;
         Ok(())
     }

@@ -133,7 +133,7 @@ def test_bad_chunks_name_the_argument_and_the_valid_form(robot, terrain, tmp_pat
 
 
 def test_store_errors_name_the_source(robot, terrain, tmp_path):
-    with pytest.raises(ValueError, match="nope.npy'?: no such file"):
+    with pytest.raises(FileNotFoundError, match="nope.npy'?: no such file"):
         sdask.risk_raster(tmp_path / "nope.npy", 0.5, robot=robot, terrain=terrain)
     np.save(tmp_path / "cube.npy", np.zeros((2, 3, 4)))
     with pytest.raises(ValueError, match=r"2-D array .*got shape \(2, 3, 4\)"):

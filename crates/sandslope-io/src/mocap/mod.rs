@@ -9,7 +9,7 @@ mod vicon;
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use csv::StringRecord;
 
 /// A file format `sandslope track` reads (serialised as its [`name`](MocapFormat::name)).
@@ -96,7 +96,8 @@ pub(crate) struct Rows {
 
 impl Rows {
     fn read(path: &Path) -> Result<Rows> {
-        let file = std::fs::File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        // The OS error kept as the cause (not only its text): Python raises FileNotFoundError on it.
+        let file = std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)

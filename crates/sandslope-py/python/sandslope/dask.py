@@ -32,6 +32,7 @@ tiles agree with each other and with the eager raster.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import sys
 from typing import Any, Callable, Optional, Tuple, TypeVar
@@ -244,7 +245,7 @@ def _store_behind(z: da.Array) -> Any:
 def _store_shape(source: Any) -> Tuple[Tuple[int, int], Optional[Tuple[int, int]]]:
     """Shape and native chunks of a store, checked here, on the client."""
     if isinstance(source, (str, os.PathLike)) and not os.path.exists(source):
-        raise ValueError(f"dem = {os.fspath(source)!r}: no such file or folder")
+        raise FileNotFoundError(errno.ENOENT, f"dem = {os.fspath(source)!r}: no such file or folder", os.fspath(source))
     try:
         if _is_pds3(source):
             info = _sandslope.pds3_info(os.fspath(source))
@@ -273,7 +274,7 @@ def _pds3_cell_size(dem: Any, row_widths_m: Any) -> tuple:
     if not _is_pds3(dem):
         raise ValueError("cell_size_m = None takes the cell size from a PDS3 DTM's label; give it in metres for any other dem")
     if not os.path.exists(dem):
-        raise ValueError(f"dem = {os.fspath(dem)!r}: no such file or folder")
+        raise FileNotFoundError(errno.ENOENT, f"dem = {os.fspath(dem)!r}: no such file or folder", os.fspath(dem))
     info = _sandslope.pds3_info(os.fspath(dem))
     return (info["cell_x_m"], info["cell_y_m"]), info["row_widths_m"] if row_widths_m is None else row_widths_m
 

@@ -301,7 +301,7 @@ pub struct PlainAnswer {
     pub text: String,
 }
 
-fn plain_answer(plots: &Plots, unreliable: bool) -> PlainAnswer {
+fn plain_answer(plots: &Plots, unreliable: bool, untested: bool) -> PlainAnswer {
     let grid = &plots.model;
     let deg = |p: &Prediction| p.slope.degrees();
     let success = |p: &&Prediction| p.regime == crate::regime::Regime::Success;
@@ -351,6 +351,11 @@ fn plain_answer(plots: &Plots, unreliable: bool) -> PlainAnswer {
         words(&plots.safe_limit),
         r = plots.max_risk
     ));
+    if untested {
+        text.push_str(
+            " This is the model's prediction for your robot, untested: the paper's speeds are of its 0.35 kg robot, and you gave no observations of yours.",
+        );
+    }
     if unreliable {
         text.push_str(
             " These numbers rest on a calibration that does not fit its observations: read why, and what data would fix it, before using them.",
@@ -414,10 +419,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
     // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...) and
     // walks no implausible terrain: either loses this section, with a warning, not the report.
-    let at_bound = calibration
-        .as_ref()
-        .filter(|_| evidence.has_own_observations())
-        .and_then(|c| scope::terrain_at_bound(&c.fit));
+    let at_bound = calibration.as_ref().and_then(|c| scope::terrain_at_bound(&c.fit, evidence));
     let section = scope::simulator_walks(&robot, &terrain, &speeds, &plots.terrain_name, at_bound);
     let (simulator, simulator_convergence, simulator_refusal) = match section {
         Ok(walks) => {
@@ -465,6 +467,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
             model_m_s: predict(&robot, o.slope, &terrain.at(o.slope)).speed,
         })
         .collect();
+    let untested = other_robot.is_some();
     let mut warnings: Vec<String> = other_robot.into_iter().collect();
     warnings.extend(track_use.warnings);
     warnings.extend(simulator_refusal);
@@ -496,7 +499,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         })
     });
     Ok(Report {
-        plain_answer: plain_answer(&plots, fit_diagnosis.is_some()),
+        plain_answer: plain_answer(&plots, fit_diagnosis.is_some(), untested),
         fit_diagnosis,
         own_observations: own,
         model_is_calibration: own || evidence.builtin_terrain,
@@ -951,6 +954,11 @@ mod tests {
             r.warnings
         );
         assert!(r.speeds.is_empty() && r.calibration.is_none());
+        assert!(
+            r.plain_answer.text.contains("prediction for your robot, untested"),
+            "{}",
+            r.plain_answer.text
+        );
         let ids: Vec<&str> = r.paper_vs_model.iter().map(|c| c.id.as_str()).collect();
         assert_eq!(ids, paper::TERRAIN_ROWS);
         assert!(r.paper_vs_model.iter().all(|c| !c.quantity.contains("0.35") && c.agrees));
@@ -989,7 +997,7 @@ mod tests {
         let r = report(&e).unwrap();
         let fit = &r.calibration.as_ref().unwrap().fit;
         assert!(
-            scope::terrain_at_bound(fit).is_some_and(|(name, _)| name == "plate_scale"),
+            scope::terrain_at_bound(fit, &e).is_some_and(|(name, _)| name == "plate_scale"),
             "{:?}",
             fit.warnings
         );

@@ -92,8 +92,12 @@ pub(crate) fn terrain_rows_only(rows: Vec<PaperComparison>) -> Vec<PaperComparis
 }
 
 /// The quantity of `fit` that scales the terrain (any but the error floor) stopped at its search
-/// bound, when the report's model is that fit: `(name, value)`.
-pub(crate) fn terrain_at_bound(fit: &JointCalibration) -> Option<(String, f64)> {
+/// bound, when the report's model is that fit (the evidence has observations of the user's):
+/// `(name, value)`.
+pub(crate) fn terrain_at_bound(fit: &JointCalibration, evidence: &Evidence) -> Option<(String, f64)> {
+    if !evidence.has_own_observations() {
+        return None;
+    }
     fit.warnings.iter().find_map(|w| match w {
         CalibrationWarning::ParameterAtBound { name, value, .. } if name != "error_floor" => {
             Some((name.clone(), *value))

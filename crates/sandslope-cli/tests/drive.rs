@@ -2,9 +2,9 @@
 //! (a pseudo-terminal) as a real robot (docs/drive.md): the commanded gait's timing, k_s
 //! recovered from the currents, the halt on risk, torque off on every exit path, bad input.
 
-mod common;
 #[path = "drive/bench.rs"]
 mod bench;
+mod common;
 #[path = "drive/messy.rs"]
 mod messy;
 

@@ -339,7 +339,8 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
         ));
     }
     let body = body_lines.join("\n");
-    let mut reader = csv::ReaderBuilder::new().flexible(true).comment(Some(b'#')).from_reader(body.as_bytes());
+    let mut reader =
+        csv::ReaderBuilder::new().flexible(true).comment(Some(b'#')).from_reader(body.as_bytes());
     let headers =
         reader.headers().with_context(|| format!("{}: no column header line", path.display()))?.clone();
     let mut col = [0usize; 14];
@@ -828,6 +829,9 @@ mod tests {
         let huge = good.replace("0.035", "1e300");
         std::fs::write(&path, format!("{}\n{huge}", COLUMNS.join(","))).unwrap();
         let e = read_servo_log(&path).unwrap_err().to_string();
-        assert!(e.contains("line 2") && e.contains("`drive_torque_n_m` = 1e300 is outside -20 to 20 N m"), "{e}");
+        assert!(
+            e.contains("line 2") && e.contains("`drive_torque_n_m` = 1e300 is outside -20 to 20 N m"),
+            "{e}"
+        );
     }
 }

@@ -241,20 +241,21 @@ impl ServoLogRequest {
             Words::Flag => "--slope",
             Words::Keyword => "slope_deg",
         };
-        let (slope_deg, from_header) = match (self.slope_deg, log.meta_f64("slope_deg", path).map_err(file_error)?) {
-            (Some(s), _) => (s, false),
-            (None, Some(s)) => (s, true),
-            (None, None) => {
-                let give = match words {
-                    Words::Flag => "give the run's slope with --slope",
-                    Words::Keyword => "give slope_deg",
-                };
-                return Err(RequestError::invalid(
-                    "slope",
-                    format!("{}: the log has no `# slope_deg = ...` header line; {give}", path.display()),
-                ));
-            }
-        };
+        let (slope_deg, from_header) =
+            match (self.slope_deg, log.meta_f64("slope_deg", path).map_err(file_error)?) {
+                (Some(s), _) => (s, false),
+                (None, Some(s)) => (s, true),
+                (None, None) => {
+                    let give = match words {
+                        Words::Flag => "give the run's slope with --slope",
+                        Words::Keyword => "give slope_deg",
+                    };
+                    return Err(RequestError::invalid(
+                        "slope",
+                        format!("{}: the log has no `# slope_deg = ...` header line; {give}", path.display()),
+                    ));
+                }
+            };
         // A bad slope read from the header is the header's, not a flag the user did not give.
         let slope = SignedSlope::from_degrees(slope_deg).map_err(|e| {
             if from_header {

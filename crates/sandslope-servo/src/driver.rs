@@ -265,7 +265,8 @@ pub fn drive(
     on_live: &mut dyn FnMut(&LiveEstimate),
 ) -> (DriveReport, Option<DriveError>) {
     let mut report = DriveReport::not_started(String::new());
-    let mut meter = crate::speed::LegSpeedMeter::with_window(settings.servos.len(), schedule.period_s);
+    let mut meter =
+        crate::speed::LegSpeedMeter::with_window(settings.servos.len(), schedule.period_s, schedule.run_up_s);
     let result = {
         let mut observed = |s: &ServoSample| {
             meter.observe(s.leg, s.time_s, s.leg_angle_rad);
@@ -399,7 +400,12 @@ fn run(
                 report.prior_p_fail = Some(p);
                 if settings.stop_on_risk.is_some_and(|limit| p > limit) {
                     walk.halted = Some((time, p));
-                    walk.halt_goal = walk.last_pos.iter().zip(&walk.stand.start_goal).map(|(p, &g)| p.unwrap_or(g)).collect();
+                    walk.halt_goal = walk
+                        .last_pos
+                        .iter()
+                        .zip(&walk.stand.start_goal)
+                        .map(|(p, &g)| p.unwrap_or(g))
+                        .collect();
                 }
             }
         }

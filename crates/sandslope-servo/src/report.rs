@@ -65,7 +65,10 @@ mod tests {
         assert_eq!(v["error"], "no bus");
         r.outcome = Ok(DriveOutcome::Halted { time_s: 1.5, p_fail: 0.7 });
         let v = serde_json::to_value(&r).unwrap();
-        assert_eq!((v["outcome"].as_str(), v["time_s"].as_f64(), v["p_fail"].as_f64()), (Some("halted"), Some(1.5), Some(0.7)));
+        assert_eq!(
+            (v["outcome"].as_str(), v["time_s"].as_f64(), v["p_fail"].as_f64()),
+            (Some("halted"), Some(1.5), Some(0.7))
+        );
         assert!(v.get("Ok").is_none() && v.get("error").is_none());
     }
 }

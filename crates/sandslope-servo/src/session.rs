@@ -299,9 +299,14 @@ pub const SAFE_SLOPE_RISK: f64 = 0.5;
 
 /// Refuses a slope beyond the calibrated safe-slope limit (`risk --solve slope`: p_fail below
 /// `--stop-on-risk`, else 0.5, from level up to it), naming the limit and `--force`.
-fn check_safe_slope(config: &DriveConfig, terrain: &UncertainTerrain, slope: sandslope::Slope) -> Result<(), SessionError> {
+fn check_safe_slope(
+    config: &DriveConfig,
+    terrain: &UncertainTerrain,
+    slope: sandslope::Slope,
+) -> Result<(), SessionError> {
     let risk = config.settings.stop_on_risk.filter(|p| *p > 0.0 && *p < 1.0).unwrap_or(SAFE_SLOPE_RISK);
-    let limit = safe_slope_limit(&config.robot, terrain, risk).map_err(|e| SessionError::Setting(e.to_string()))?;
+    let limit =
+        safe_slope_limit(&config.robot, terrain, risk).map_err(|e| SessionError::Setting(e.to_string()))?;
     let deg = slope.degrees();
     let beyond = match limit {
         SafeLimit::NoneSafe { .. } => Some("no slope is (p_fail is above it from level)".to_string()),

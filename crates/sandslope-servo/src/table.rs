@@ -86,12 +86,7 @@ pub(crate) fn out_of_range(table: &[u8; TABLE_SIZE], addr: u16, end: usize) -> O
     let i16_at = |a: u16| i16::from_le_bytes([table[a as usize], table[a as usize + 1]]);
     let mode = u8_at(OPERATING_MODE);
     let checks: [(&'static str, u16, usize, bool); 13] = [
-        (
-            "Return Delay Time",
-            RETURN_DELAY_TIME,
-            1,
-            u8_at(RETURN_DELAY_TIME) <= xl330::MAX_RETURN_DELAY,
-        ),
+        ("Return Delay Time", RETURN_DELAY_TIME, 1, u8_at(RETURN_DELAY_TIME) <= xl330::MAX_RETURN_DELAY),
         ("Operating Mode", OPERATING_MODE, 1, matches!(mode, 0 | 1 | 3 | 4 | 5 | 16)),
         (
             "Temperature Limit",
@@ -99,12 +94,7 @@ pub(crate) fn out_of_range(table: &[u8; TABLE_SIZE], addr: u16, end: usize) -> O
             1,
             u8_at(TEMPERATURE_LIMIT) <= xl330::MAX_TEMPERATURE_LIMIT_REGISTER,
         ),
-        (
-            "Current Limit",
-            CURRENT_LIMIT,
-            2,
-            u16_at(CURRENT_LIMIT) <= xl330::MAX_CURRENT_LIMIT_MA,
-        ),
+        ("Current Limit", CURRENT_LIMIT, 2, u16_at(CURRENT_LIMIT) <= xl330::MAX_CURRENT_LIMIT_MA),
         (
             "Velocity Limit",
             VELOCITY_LIMIT,

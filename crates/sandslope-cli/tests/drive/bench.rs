@@ -22,7 +22,11 @@ fn wait_driving(child: &mut Child) -> (std::process::ChildStderr, String) {
     while !String::from_utf8_lossy(&seen).contains("Ctrl-C stops the gait") {
         let mut buf = [0u8; 256];
         let n = stderr.read(&mut buf).unwrap();
-        assert!(n > 0 && started.elapsed().as_secs() < 120, "never drove: {}", String::from_utf8_lossy(&seen));
+        assert!(
+            n > 0 && started.elapsed().as_secs() < 120,
+            "never drove: {}",
+            String::from_utf8_lossy(&seen)
+        );
         seen.extend_from_slice(&buf[..n]);
     }
     (stderr, String::from_utf8_lossy(&seen).into_owned())
@@ -145,7 +149,10 @@ fn a_closed_stderr_skips_neither_torque_off_nor_the_log() {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stdout));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["torque_off"]["confirmed"], serde_json::json!([1, 2, 3, 4, 5, 6]));
-    assert_eq!(v["emulator"].as_str().unwrap().split(" (").next().unwrap(), "emulator: torque off on every servo");
+    assert_eq!(
+        v["emulator"].as_str().unwrap().split(" (").next().unwrap(),
+        "emulator: torque off on every servo"
+    );
     assert_eq!(status(&log), "completed");
     assert!(std::fs::read_to_string(&log).unwrap().ends_with('\n'));
 }
@@ -206,7 +213,8 @@ fn emulate_fault_refuses_nan_times_and_ids_off_the_bus() {
         ("corrupt:2:NaN", "the time `NaN` must be a finite number of seconds, at least 0"),
         ("freeze:1:-2", "the time `-2` must be a finite number"),
     ] {
-        let out = bin().args(["drive", "--emulate", "--duration", "1", "--emulate-fault", fault]).output().unwrap();
+        let out =
+            bin().args(["drive", "--emulate", "--duration", "1", "--emulate-fault", fault]).output().unwrap();
         let all = text(&out);
         assert_eq!(out.status.code(), Some(2), "{fault}: {all}");
         assert!(all.contains(says), "{fault}: {all}");
@@ -220,7 +228,10 @@ fn emulate_fault_refuses_nan_times_and_ids_off_the_bus() {
 fn a_latched_hardware_error_is_refused_at_ping() {
     let (code, all, log, _d) = super::drive_with(&["--emulate-fault", "latched:3"]);
     assert_eq!(code, Some(2), "{all}");
-    assert!(all.contains("servo ID 3 (leg 2) has a hardware error latched from before the run: an overload"), "{all}");
+    assert!(
+        all.contains("servo ID 3 (leg 2) has a hardware error latched from before the run: an overload"),
+        "{all}"
+    );
     assert!(all.contains("nothing was moved"), "{all}");
     assert!(all.contains("emulator: torque off on every servo"), "{all}");
     assert!(!log.exists(), "a log of a run that never moved");
@@ -233,7 +244,8 @@ fn a_latched_hardware_error_is_refused_at_ping() {
 /// (absent here) is opened.
 #[test]
 fn a_rate_the_bus_cannot_carry_is_warned_with_the_fix() {
-    let out = bin().args(["drive", "--port", "/dev/ttyUSB-sandslope-none", "--duration", "1"]).output().unwrap();
+    let out =
+        bin().args(["drive", "--port", "/dev/ttyUSB-sandslope-none", "--duration", "1"]).output().unwrap();
     let all = text(&out);
     assert_eq!(out.status.code(), Some(2), "{all}");
     assert!(all.contains("warning: --rate 50 Hz asks for 20.0 ms cycles, but at 57600 baud"), "{all}");
@@ -344,7 +356,16 @@ fn the_pooled_interval_covers_the_truth_at_its_rate() {
             .iter()
             .map(|seed| {
                 bin()
-                    .args(["drive", "--emulate", "--slope", "20", "--emulate-k-s", "1.95e6", "--duration", "6"])
+                    .args([
+                        "drive",
+                        "--emulate",
+                        "--slope",
+                        "20",
+                        "--emulate-k-s",
+                        "1.95e6",
+                        "--duration",
+                        "6",
+                    ])
                     .args(["--live", "--json", "--watchdog", "2", "--emulate-seed", &seed.to_string()])
                     .stdout(Stdio::piped())
                     .stderr(Stdio::null())

@@ -63,15 +63,15 @@ pub fn pool(
     }
     // Sum of log-probabilities, floored so that one stance's zero does not veto a point for
     // good (1e-300: below any weight the likelihood's exponent gives a sensible fit).
-    let log: Vec<f64> =
-        (0..n).map(|i| stances.iter().map(|p| p[i].max(1e-300).ln()).sum::<f64>()).collect();
+    let log: Vec<f64> = (0..n).map(|i| stances.iter().map(|p| p[i].max(1e-300).ln()).sum::<f64>()).collect();
     let top = log.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     let w: Vec<f64> = log.iter().map(|l| (l - top).exp()).collect();
     let total: f64 = w.iter().sum();
     let p: Vec<f64> = w.iter().map(|x| x / total).collect();
     let ln: Vec<f64> = grid.k_s.iter().map(|k| k.ln()).collect();
     let q = |level: f64| quantile(&ln, &p, level).exp();
-    let weight = |r: Regime| 0.0 + p.iter().zip(&grid.regime).filter(|(_, g)| **g == r).map(|(x, _)| x).sum::<f64>();
+    let weight =
+        |r: Regime| 0.0 + p.iter().zip(&grid.regime).filter(|(_, g)| **g == r).map(|(x, _)| x).sum::<f64>();
     let (k_s, mut k_s_lo, mut k_s_hi) = (q(0.5), q(0.05), q(0.95));
     let logs: Vec<f64> = medians.iter().filter(|m| **m > 0.0).map(|m| m.ln()).collect();
     if logs.len() >= 2 {
@@ -101,8 +101,9 @@ pub fn pool(
 /// normal's beyond).
 pub fn student_t95(dof: usize) -> f64 {
     const T: [f64; 30] = [
-        6.314, 2.920, 2.353, 2.132, 2.015, 1.943, 1.895, 1.860, 1.833, 1.812, 1.796, 1.782, 1.771, 1.761, 1.753,
-        1.746, 1.740, 1.734, 1.729, 1.725, 1.721, 1.717, 1.714, 1.711, 1.708, 1.706, 1.703, 1.701, 1.699, 1.697,
+        6.314, 2.920, 2.353, 2.132, 2.015, 1.943, 1.895, 1.860, 1.833, 1.812, 1.796, 1.782, 1.771, 1.761,
+        1.753, 1.746, 1.740, 1.734, 1.729, 1.725, 1.721, 1.717, 1.714, 1.711, 1.708, 1.706, 1.703, 1.701,
+        1.699, 1.697,
     ];
     match dof {
         0 => f64::INFINITY,

@@ -340,6 +340,12 @@ fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
     let (sim, closed) = (p["p_fail_simulator"].as_f64().unwrap(), p["p_fail_closed_form"].as_f64().unwrap());
     assert!(closed > 0.5 && closed > sim, "{p}");
     assert_eq!(p["p_fail"].as_f64().unwrap(), closed.max(sim));
+    // The EEPROM written only where it differs: against the emulator's factory tables (Return
+    // Delay Time 250, Operating Mode 3, Temperature Limit 70, Current Limit 1750, Velocity
+    // Limit 445, Drive Mode 0) five registers a servo differ and one holds: 30 written, 6 kept.
+    assert_eq!(v["setup"]["eeprom_written"], 30, "{}", v["setup"]);
+    assert_eq!(v["setup"]["eeprom_kept"], 6, "{}", v["setup"]);
+    assert_eq!(v["setup"]["counter_cleared"], true);
     // The prior (the terrain's own k_s at 20 deg, inside its safe slope) did not halt it.
     assert!(v["prior_p_fail"].as_f64().unwrap() < 0.5, "{v}");
 }

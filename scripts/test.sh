@@ -16,7 +16,7 @@ python=${PYTHON:-python3}
 
 # A one-shot build: Cargo's incremental caches (GBs of target/debug/incremental, reused only by
 # the next edit-and-rebuild) are not written unless the caller asks for them
-# (CARGO_INCREMENTAL=1 bash scripts/test.sh). README.md states the disk this leaves.
+# (CARGO_INCREMENTAL=1 bash scripts/test.sh). docs/building.md states the disk this leaves.
 export CARGO_INCREMENTAL=${CARGO_INCREMENTAL:-0}
 
 seconds() { date +%s; }
@@ -32,7 +32,8 @@ export PATH="$venv/bin:$PATH"
 echo "== installing the Python test tools into $venv"
 "$py" -m pip install --quiet --disable-pip-version-check \
   "maturin>=1.9,<2" "pytest>=7" "numpy>=1.21" "dask[array]>=2023.1" "distributed>=2023.1" \
-  "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1" "rasterio>=1.3"
+  "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1" "rasterio>=1.3" \
+  "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5"
 t1=$(seconds)
 
 echo "== cargo test --workspace --locked"

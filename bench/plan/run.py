@@ -24,7 +24,7 @@ What it does (run from anywhere; takes a few minutes the first time):
 The binary is `target/release/sandslope`, or `$CARGO_TARGET_DIR/release/sandslope` when that
 is set (the script builds it there). bench/plan/README.md has the last measurements.
 
-Usage: python3 bench/plan/run.py [--size 4096] [--repeat 5] [--max-memory GIB] [--no-mcp]
+Usage: python3 bench/plan/run.py [--size 4096] [--repeat 5] [--max-memory GIB] [--no-mcp] [--work DIR]
                                   [--search auto|full|corridor] [--coarse-factor N] [--corridor-width CELLS]
                                   [--gap] [--baseline EXE]
 
@@ -74,6 +74,8 @@ def main():
     ap.add_argument("--corridor-width", type=int, help="passed to sandslope plan")
     ap.add_argument("--gap", action="store_true", help="compare --search full and --search corridor")
     ap.add_argument("--baseline", help="another sandslope binary, timed in turn with this one (and its --json compared)")
+    ap.add_argument("--work", default=os.path.join(ROOT, "target", "bench-plan"),
+                    help="where the DEM is written (default target/bench-plan)")
     args = ap.parse_args()
     ensure([("numpy", "numpy"), ("tifffile", "tifffile"), ("skimage", "scikit-image")])
     import numpy as np
@@ -83,7 +85,7 @@ def main():
     exe = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")), "release", "sandslope")
 
     n, cell = args.size, args.cell
-    work = os.path.join(ROOT, "target", "bench-plan")
+    work = args.work
     os.makedirs(work, exist_ok=True)
     dem_path = os.path.join(work, f"dunes-v2-{n}.tif")
     def heights(r0, r1):

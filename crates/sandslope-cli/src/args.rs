@@ -34,8 +34,14 @@ impl RobotArgs {
 
     /// Loads the robot and applies `--mass` and the other robot quantities given (the request
     /// layer's one robot validation, errors naming the flag).
+    /// Prints a note on stderr when the robot's `stance_legs` may count every leg rather than
+    /// those in stance at once ([`sandslope::robot::stance_legs_note`]).
     pub fn load(&self) -> Result<Robot> {
-        Ok(self.request().load()?)
+        let robot = self.request().load()?;
+        if let Some(note) = sandslope::robot::stance_legs_note(robot.stance_legs()) {
+            eprintln!("note: {note}");
+        }
+        Ok(robot)
     }
 }
 

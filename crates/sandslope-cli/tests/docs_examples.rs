@@ -224,7 +224,7 @@ fn run_document(seed: &Path, file: &str, ran: &AtomicUsize, skips_used: &[Atomic
 }
 
 /// docs/tracking.md's report on the example recordings: the slopes the calibration's
-/// diagnosis names and the numbers the doc (and the README, and docs/calibration.md) quote from
+/// diagnosis names and the numbers the doc (and docs/commands.md, and docs/calibration.md) quote from
 /// it, read from the report.json its command wrote.
 fn the_example_reports_diagnosis_is_what_the_docs_say(root: &Path) {
     let json =
@@ -237,8 +237,8 @@ fn the_example_reports_diagnosis_is_what_the_docs_say(root: &Path) {
     let flat = |rel: &str| {
         std::fs::read_to_string(repo_file(rel)).unwrap().split_whitespace().collect::<Vec<_>>().join(" ")
     };
-    let (tracking, calibration, readme) =
-        (flat("docs/tracking.md"), flat("docs/calibration.md"), flat("README.md"));
+    let (tracking, calibration, commands) =
+        (flat("docs/tracking.md"), flat("docs/calibration.md"), flat("docs/commands.md"));
     let cm = |v: &serde_json::Value| 100.0 * v.as_f64().unwrap();
     let at10 = format!("{:.1} ± {:.1} cm", cm(&c[0]["model_step_m"]), cm(&c[0]["model_step_sd_m"]));
     let at20 = format!("{:.1} ± {:.1} cm", cm(&c[1]["model_step_m"]), cm(&c[1]["model_step_sd_m"]));
@@ -254,7 +254,10 @@ fn the_example_reports_diagnosis_is_what_the_docs_say(root: &Path) {
         }
     }
     let step20 = format!("step at 20° is {:.1} cm", cm(&c[1]["model_step_m"]));
-    assert!(readme.contains(&step20) && readme.contains(&t1), "README should quote `{step20}` and `{t1}`");
+    assert!(
+        commands.contains(&step20) && commands.contains(&t1),
+        "docs/commands.md should quote `{step20}` and `{t1}`"
+    );
 }
 
 /// The documents run on one worker per core, each taking the next document when it is done:

@@ -750,9 +750,10 @@ fn the_memory_check_comes_from_the_header_before_the_samples_are_read() {
     let (code, err) = run("100", "full");
     assert_eq!(code, Some(2));
     assert!(!err.contains("--max-memory") && err.contains("huge.asc"), "{err}");
-    // In a corridor (auto's choice above 4096 x 4096 cells) the map holds 5 bytes a cell and
-    // the coarse planner 48 for each of 625 x 625 coarse cells: 0.116 + 0.017 GiB, above 0.1
-    // GiB and below 0.5.
+    // In a corridor (auto's choice above 4096 x 4096 cells) an ASCII grid is held whole, 4
+    // bytes a cell (0.093 GiB), the coarse planner 48 + 4 bytes for each of 625 x 625 coarse
+    // cells (0.019 GiB) and the coarse pass two bands of 512 rows of 4-byte heights (0.019
+    // GiB): 0.131 GiB, above 0.1 GiB and below 0.5.
     for search in ["corridor", "auto"] {
         let (code, err) = run("0.1", search);
         assert_eq!(code, Some(2));
@@ -809,4 +810,136 @@ fn corridor_search_is_never_better_than_the_full_optimum_and_says_so() {
     let out = run(&["--search", "corridor", "--coarse-factor", "1"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--coarse-factor = 1 must be between 2 and 64"));
+}
+
+/// Issue 56: the corridor search reads its DEM window by window (GeoTIFF tiles and strips,
+/// PDS3 lines; an ASCII grid is read whole and cut). With a corridor as wide as the map it is
+/// the full search, which holds the whole map: the same routes on every layout; and on one hill
+/// written in several layouts, the narrow corridors' routes are the same number for number.
+#[test]
+fn the_windowed_corridor_search_finds_the_full_optimum_on_every_layout() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let fixtures = root.join("crates/sandslope-io/tests/fixtures");
+    let run = |dem: &Path, start: &str, goal: &str, extra: &[&str]| -> Value {
+        let out = Command::cargo_bin("sandslope")
+            .unwrap()
+            .args(["plan", "--objective", "distance,time", "--json", "--start-px", start, "--goal-px", goal])
+            .arg("--dem")
+            .arg(dem)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}: {}", dem.display(), String::from_utf8_lossy(&out.stderr));
+        json_of(&out.stdout)
+    };
+    let whole = ["--search", "corridor", "--coarse-factor", "2", "--corridor-width", "256"];
+    for (dem, start, goal) in [
+        (fixtures.join("gdal/f32-deflate-pred3-tiled.tif"), "6,8", "36,26"),
+        (fixtures.join("gdal/i16-lzw-pred2-strips.tif"), "6,8", "36,26"),
+        (fixtures.join("gdal/bigtiff-lzw-pred3-tiled.tif"), "5,10", "55,40"),
+        (fixtures.join("pds3/dtm-attached.img"), "5,10", "55,40"),
+        (fixtures.join("pds3/dtm-detached.lbl"), "3,3", "36,26"),
+        (root.join("examples/planning/dune.asc"), "173,100", "100,100"),
+    ] {
+        let full = run(&dem, start, goal, &["--search", "full"]);
+        let corridor = run(&dem, start, goal, &whole);
+        assert_eq!(corridor["search"]["mode"], "corridor", "{}", dem.display());
+        for objective in ["distance", "time"] {
+            let (a, b) = (&corridor["routes"][objective], &full["routes"][objective]);
+            assert_eq!(a["found"], b["found"], "{} {objective}", dem.display());
+            if b["found"] == true {
+                let (la, lb) = (a["length_m"].as_f64().unwrap(), b["length_m"].as_f64().unwrap());
+                assert!((la - lb).abs() <= 1e-9 * lb, "{} {objective}: {la} vs {lb}", dem.display());
+            }
+        }
+    }
+    let narrow = ["--search", "corridor", "--coarse-factor", "4", "--corridor-width", "1"];
+    let reference = run(&fixtures.join("gdal/geo-wgs84.tif"), "5,10", "55,40", &narrow);
+    for dem in [
+        "zstd-pred3-tiled.tif",
+        "bigtiff-deflate-tiled.tif",
+        "bigtiff-lzw-pred3-tiled.tif",
+        "cog-overviews.tif",
+    ] {
+        let got = run(&fixtures.join("gdal").join(dem), "5,10", "55,40", &narrow);
+        assert_eq!(got["routes"], reference["routes"], "{dem}");
+        assert_eq!(got["search"], reference["search"], "{dem}");
+    }
+}
+
+/// A MOLA MEGDR as published (issue 56): a detached label over MSB 16-bit heights, "SIMPLE
+/// CYLINDRICAL" at 4 pixels a degree, the whole globe (1440 x 720, longitudes 0 to 360 east).
+/// `--start -10,5` is longitude 350 (the map's own range; latitude 5 is the edge between two
+/// rows, and the cell south of it holds it, centred at 4.875); the distance route's length agrees
+/// with the haversine length of its GeoJSON polyline on the label's 3396 km sphere within
+/// 0.5% (the heights rise 3 m a cell of 14.8 km: the surface adds 2e-8); and the corridor
+/// search, reading the .IMG window by window, finds a route at least as long.
+#[test]
+fn a_global_mola_megdr_plans_in_longitude_and_latitude() {
+    let dir = tempfile::tempdir().unwrap();
+    let (lines, samples) = (720usize, 1440usize);
+    let label = format!(
+        "PDS_VERSION_ID = PDS3\r\nRECORD_TYPE = FIXED_LENGTH\r\nRECORD_BYTES = 2880\r\nFILE_RECORDS = 720\r\n\
+         ^IMAGE = \"MEGT90N000CB.IMG\"\r\nTARGET_NAME = MARS\r\nOBJECT = IMAGE\r\n  LINES = {lines}\r\n\
+         LINE_SAMPLES = {samples}\r\n  SAMPLE_TYPE = MSB_INTEGER\r\n  SAMPLE_BITS = 16\r\n  UNIT = METER\r\n\
+         SCALING_FACTOR = 1\r\n  OFFSET = 0\r\nEND_OBJECT = IMAGE\r\nOBJECT = IMAGE_MAP_PROJECTION\r\n\
+         MAP_PROJECTION_TYPE = \"SIMPLE CYLINDRICAL\"\r\n  A_AXIS_RADIUS = 3396.0 <KM>\r\n\
+         POSITIVE_LONGITUDE_DIRECTION = \"EAST\"\r\n  CENTER_LATITUDE = 0.0 <DEGREE>\r\n\
+         CENTER_LONGITUDE = 180.0 <DEGREE>\r\n  MAP_RESOLUTION = 4 <PIXEL/DEGREE>\r\n\
+         MAP_SCALE = 14.818 <KM/PIXEL>\r\n  MAXIMUM_LATITUDE = 90.0 <DEGREE>\r\n\
+         WESTERNMOST_LONGITUDE = 0.0 <DEGREE>\r\n  LINE_PROJECTION_OFFSET = 360.5 <PIXEL>\r\n\
+         SAMPLE_PROJECTION_OFFSET = 720.5 <PIXEL>\r\nEND_OBJECT = IMAGE_MAP_PROJECTION\r\nEND\r\n"
+    );
+    std::fs::write(dir.path().join("MEGT90N000CB.LBL"), label).unwrap();
+    let img: Vec<u8> = (0..lines * samples)
+        .flat_map(|i| (((i % samples) as i16 - (i / samples) as i16) * 3 - 8000).to_be_bytes())
+        .collect();
+    std::fs::write(dir.path().join("MEGT90N000CB.IMG"), img).unwrap();
+    let geojson = dir.path().join("routes.geojson");
+    let run = |extra: &[&str]| {
+        let out = Command::cargo_bin("sandslope")
+            .unwrap()
+            .args([
+                "plan",
+                "--start",
+                "-10,5",
+                "--goal",
+                "345,8",
+                "--objective",
+                "distance",
+                "--json",
+                "--dem",
+            ])
+            .arg(dir.path().join("MEGT90N000CB.LBL"))
+            .arg("--geojson")
+            .arg(&geojson)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        (json_of(&out.stdout), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (full, notes) = run(&[]);
+    assert!(notes.contains("simple cylindrical map on Mars") && notes.contains("do not wrap"), "{notes}");
+    let length = full["routes"]["distance"]["length_m"].as_f64().unwrap();
+    let g: Value = serde_json::from_str(&std::fs::read_to_string(&geojson).unwrap()).unwrap();
+    let line: Vec<(f64, f64)> = g["features"][0]["geometry"]["coordinates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect();
+    // Cell centres: longitude 350.125, latitude 4.875 at the start; 345.125, 7.875 at the goal.
+    assert_eq!((line[0], *line.last().unwrap()), ((350.125, 4.875), (345.125, 7.875)));
+    let haversine = |a: (f64, f64), b: (f64, f64)| {
+        let (p1, p2) = (a.1.to_radians(), b.1.to_radians());
+        let (dp, dl) = (p2 - p1, (b.0 - a.0).to_radians());
+        let h = (dp / 2.0).sin().powi(2) + p1.cos() * p2.cos() * (dl / 2.0).sin().powi(2);
+        2.0 * 3_396_000.0 * h.sqrt().asin()
+    };
+    let along: f64 = line.windows(2).map(|w| haversine(w[0], w[1])).sum();
+    assert!((length / along - 1.0).abs() < 0.005, "{length} m vs haversine {along} m");
+    let (corridor, _) = run(&["--search", "corridor"]);
+    let l = corridor["routes"]["distance"]["length_m"].as_f64().unwrap();
+    assert!(l >= length * (1.0 - 1e-12) && l < length * 1.01, "{l} vs {length}");
 }

@@ -212,9 +212,13 @@ fn the_default_report_says_where_every_number_comes_from() {
     assert_eq!(independent, ["heavy_robot_24"]);
     assert_eq!(v["summary"]["independent"], 1);
     assert_eq!(v["summary"]["independent_agree"], 0);
+    // One independent number is named, not counted ("0 of the paper's 1 independent numbers").
+    let html = html.replace("&#x27;", "'");
     assert!(
-        html.contains("agrees with 0 of the paper&#x27;s 1 independent")
-            || html.contains("agrees with 0 of the paper's 1 independent")
+        html.contains("one of the paper's numbers tests the model independently, the regime of a 1 kg robot at 24 deg")
+            && html.contains("so the model disagrees with it"),
+        "{}",
+        v["summary"]["text"]
     );
     // The fit without the floor is the test: chi^2 76.1 on 4 dof (docs/calibration.md's table),
     // p = P(chi^2_4 >= 76.1) = e^(-x/2) (1 + x/2) = 1.18e-15 by the closed form for 4 dof.
@@ -361,6 +365,38 @@ fn report_renders_in_a_real_browser() {
         std::fs::copy(&shot, keep).unwrap();
     }
     assert_shows_content(&shot);
+
+    // At 600 px nothing runs off the right edge (issue 58): the wide tables scroll inside a
+    // box of the page's width. The body's padding is 1em (16 px) on each side, so the last 10
+    // columns of a window tall enough to need no scrollbar are white in every row; before
+    // the boxes, the comparison and simulator tables painted them.
+    let narrow = dir.path().join("narrow.png");
+    let status = std::process::Command::new(chromium_or_skip("report_renders_in_a_real_browser").unwrap())
+        .args(CHROMIUM_FLAGS)
+        .arg("--window-size=600,16000")
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .arg(format!("--screenshot={}", narrow.display()))
+        .arg(format!("file://{}", out.join("index.html").display()))
+        .output()
+        .unwrap();
+    assert!(narrow.exists(), "no screenshot: {}", String::from_utf8_lossy(&status.stderr));
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&narrow).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let channels = info.line_size / info.width as usize;
+    assert_eq!(info.width, 600);
+    let painted: Vec<(usize, usize)> = (0..info.height as usize)
+        .flat_map(|y| (590..600).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let k = y * info.line_size + x * channels;
+            buf[k..k + 3] != [255, 255, 255]
+        })
+        .collect();
+    assert!(painted.is_empty(), "content runs off the right edge at 600 px: {} pixels, first {:?}", painted.len(), painted.first());
+    // And the page's tables are each in a scrolling box.
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert_eq!(html.matches("<table").count(), html.matches("<div class=\"scroll\"><table").count());
 }
 
 /// The upslope unit vector of a slope of `deg` degrees in the capture frame (x along the
@@ -633,4 +669,54 @@ fn a_robot_the_simulator_refuses_still_gets_its_report() {
     assert!(v["figures"].as_array().unwrap().iter().all(|f| f["id"] != "simulator"));
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(!html.contains("<figure id=\"simulator\">"));
+}
+
+/// A new user's own 1.2 kg robot on their own sand, without observations (issue 58): the
+/// report says on stderr and first in report.json's warnings that the robot is not the paper's,
+/// fits and compares none of the paper's 0.35 kg robot's speeds, and sets only the sand's
+/// ratios beside the paper's. By hand on this sand: k_s(20)/k_s(0) = 1.2e6 / 2e6 = 0.60, 0.20
+/// from the paper's 0.40, beyond its 0.10 (disagrees); k_n(20)/k_n(0) = 1 (agrees).
+#[test]
+fn a_report_on_another_robot_without_observations_compares_no_speeds() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = dir.path().join("mine.toml");
+    std::fs::write(
+        &robot,
+        "mass_kg = 1.2\nleg_radius_m = 0.05\nleg_width_m = 0.015\nhip_height_m = 0.04\n\
+         leg_speed_rad_s = 6.283185307179586\nstance_legs = 3\nresponse_time_s = 0.2\n",
+    )
+    .unwrap();
+    let sand = dir.path().join("mysand.toml");
+    std::fs::write(
+        &sand,
+        "repose_deg = 30.0\n[[points]]\nslope_deg = 0.0\nk_n = 9e5\nk_s = 2e6\n\
+         [[points]]\nslope_deg = 20.0\nk_n = 9e5\nk_s = 1.2e6\n",
+    )
+    .unwrap();
+    let out = dir.path().join("report");
+    let run = sandslope()
+        .args(["report", "--robot"])
+        .arg(&robot)
+        .arg("--terrain")
+        .arg(&sand)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("warning: your robot") && stderr.contains("is not the paper's"), "{stderr}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert!(v["warnings"][0].as_str().unwrap().contains("1.2 kg"), "{}", v["warnings"]);
+    assert_eq!(v["speeds"].as_array().unwrap().len(), 0);
+    assert!(v["calibration"].is_null());
+    let rows = v["paper_vs_model"].as_array().unwrap();
+    let ids: Vec<&str> = rows.iter().map(|r| r["id"].as_str().unwrap()).collect();
+    assert_eq!(ids, ["shear_ratio_20", "normal_ratio_20"]);
+    assert!(rows.iter().all(|r| !r["quantity"].as_str().unwrap().contains("0.35")));
+    assert!((rows[0]["model_value"].as_f64().unwrap() - 0.6).abs() < 1e-12 && rows[0]["agrees"] == false);
+    assert!(rows[1]["agrees"] == true);
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap().replace("&#x27;", "'");
+    assert!(html.contains("is not the paper's"));
 }

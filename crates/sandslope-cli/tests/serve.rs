@@ -625,8 +625,38 @@ fn the_page_shows_predicts_speed_after_the_slope_slider_moves() {
                 assert_eq!(text, format!("({:.2})", model * 100.0), "slope {slope}");
             }
         }
-        assert_eq!(text_of(&dom, "regime"), cli["regime"].as_str().unwrap());
+        // The outcome in a field engineer's words, the regime beside it (docs/model.md §6).
+        let regime = cli["regime"].as_str().unwrap();
+        let words = match regime {
+            "success" => "climbs steadily",
+            "metastable" => "climbs slowly and may stall",
+            "slippage" => "slides back",
+            "sinkage" => "sinks",
+            other => panic!("regime {other}"),
+        };
+        assert_eq!(text_of(&dom, "regime"), format!("{words} ({regime})"));
     }
+}
+
+/// A bad parameter in the address (`?mass=1200`, beyond the plausible 250 kg) refuses the
+/// predict, sweep and phase requests alike: the banner under the header says so once, not
+/// three times, and the tab buttons stay on one row beside the title.
+#[test]
+fn a_bad_parameter_is_shown_once_in_a_banner_that_leaves_the_tabs_in_a_row() {
+    let Some(browser) = common::chromium_or_skip("a_bad_parameter_is_shown_once_in_a_banner_that_leaves_the_tabs_in_a_row")
+    else {
+        return;
+    };
+    let server = Server::start(&[]);
+    let (dom, _) = browse(&browser, &server, "/?mass=1200", None);
+    let banner = text_of(&dom, "status");
+    assert_eq!(banner.matches("--mass = 1200 must be between").count(), 1, "{banner}");
+    assert_eq!(banner.lines().count(), 1, "{banner}");
+    assert!(banner.contains("250 kg"), "{banner}");
+    assert_eq!(attribute(&dom, "id=\"tabs\"", "data-rows").as_deref(), Some("1"), "the tabs wrapped");
+    // The banner is its own block after the header, not inside it.
+    let header_end = dom.find("</header>").unwrap();
+    assert!(dom.find("id=\"status\"").unwrap() > header_end);
 }
 
 #[test]

@@ -270,7 +270,8 @@ fn simulate_tables_say_the_two_models_are_known_to_disagree() {
 /// to pitch: the locked body climbs there): `track`
 /// takes upslope from the capture frame's vertical axis and `--slope`, not from the net
 /// motion, so it reports the simulator's negative speed, within 1% with the simulator's
-/// touchdowns, and negative with the default settings (issue 38, item 6).
+/// touchdowns, and negative with the default settings (issue 38, item 6); without `--slope`
+/// from the travel's rise along that vertical (issue 59, item 6).
 #[test]
 fn track_recovers_the_negative_speed_of_a_walk_that_slides_down() {
     let dir = tempfile::tempdir().unwrap();
@@ -312,6 +313,14 @@ fn track_recovers_the_negative_speed_of_a_walk_that_slides_down() {
     assert!(u[0].as_f64().unwrap() > 0.9 && u[2].as_f64().unwrap() > 0.3, "{u:?}");
     let default = json(&["track", csv.to_str().unwrap(), "--slope", "20", "--json"]);
     assert!(default["speed_m_s"].as_f64().unwrap() < 0.0, "{}", default["speed_m_s"]);
+    // Without --slope: upslope is where the travel rises along the vertical (issue 59, item 6),
+    // so the same negative speed, within 1%, and the same +x upslope.
+    let unlabelled = json(&["track", csv.to_str().unwrap(), "--json", "--touchdowns", &td, "--cutoff", "30"]);
+    let speed = unlabelled["speed_m_s"].as_f64().unwrap();
+    assert!((speed / sim_speed - 1.0).abs() < 0.01, "without --slope: {speed} vs {sim_speed}");
+    assert!(unlabelled["upslope"][0].as_f64().unwrap() > 0.9, "{}", unlabelled["upslope"]);
+    let plain = json(&["track", csv.to_str().unwrap(), "--json"]);
+    assert!(plain["speed_m_s"].as_f64().unwrap() < 0.0, "{}", plain["speed_m_s"]);
 }
 
 /// `--ensemble N` (docs/simulate.md, "Pitch free"): N walks at one slope, the mass perturbed

@@ -35,9 +35,36 @@ pub fn read_text(path: &Path) -> Result<String> {
     std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
 }
 
-/// Parses TOML into `T`, naming the source; unknown keys are rejected by `T`'s definition.
+/// Parses TOML into `T`, naming the source; unknown keys are rejected by `T`'s definition,
+/// with the key the user most likely meant ([`did_you_mean`]).
 pub fn parse_toml<T: DeserializeOwned>(text: &str, source: &Source) -> Result<T> {
-    toml::from_str(text).map_err(|e| anyhow!("{source}: {}", e.to_string().trim_end()))
+    toml::from_str(text).map_err(|e| {
+        let message = e.to_string();
+        let hint = did_you_mean(&message).map(|k| format!("; did you mean `{k}`?")).unwrap_or_default();
+        anyhow!("{source}: {}{hint}", message.trim_end())
+    })
+}
+
+/// For serde's "unknown field `KEY`, expected one of `A`, `B`, ..." (or "expected `A`"), the
+/// valid key the user most likely meant: one with KEY as a whole word (`legs`: `stance_legs`;
+/// `mass`: `mass_kg`), else the nearest by Jaro-Winkler similarity of at least 0.8
+/// (`mass_kgs`: `mass_kg`); `None` for any other message or when nothing is near.
+pub fn did_you_mean(message: &str) -> Option<String> {
+    let rest = &message[message.find("unknown field `")? + "unknown field `".len()..];
+    let (key, rest) = rest.split_once('`')?;
+    let expected = &rest[rest.find("expected")?..];
+    let valid: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
+    let key = key.to_ascii_lowercase();
+    let word = valid.iter().filter(|v| v.split('_').any(|w| w == key)).collect::<Vec<_>>();
+    if let [one] = word.as_slice() {
+        return Some(one.to_string());
+    }
+    valid
+        .iter()
+        .map(|v| (strsim::jaro_winkler(&key, v), v))
+        .filter(|(score, _)| *score >= 0.8)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, v)| v.to_string())
 }
 
 /// An output file that could not be written: the environment's fault, not the input's.

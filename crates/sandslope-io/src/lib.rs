@@ -16,13 +16,16 @@
 #![warn(missing_docs)]
 
 pub mod anchoring;
+pub mod bag;
 pub mod crs;
 pub mod files;
 pub mod force_tests;
 pub mod grid_csv;
 mod lzw_tiles;
+pub mod mcap_out;
 pub mod measurements;
 pub mod mocap;
+pub mod nav2_map;
 pub mod npy;
 pub mod observations;
 pub mod pds3;

@@ -240,6 +240,15 @@ pub fn read_trials(manifest: &Manifest, options: ReadOptions) -> Result<Vec<Tria
     Ok(out)
 }
 
+/// A recording's cell that is not a number (the file, line and column in the message): the
+/// error [`read_trials`] and [`read_recording`] return for it, so a front end can offer to skip
+/// such rows ([`ReadOptions::skip_malformed`]) by its type rather than by its words.
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
+pub struct MalformedCell {
+    message: String,
+}
+
 /// Reads one trial CSV. `counts_per_newton` converts a `force_counts` column. A cell that is
 /// not a number is an error naming the file, line and column.
 pub fn read_recording(path: &Path, kind: Kind, counts_per_newton: Option<f64>) -> Result<Recording> {
@@ -294,12 +303,14 @@ pub fn read_recording_with(path: &Path, kind: Kind, options: ReadOptions) -> Res
             match record.get(col) {
                 None | Some("") => Ok(None),
                 Some(s) => s.parse::<f64>().map(|v| Some(v * scale)).map_err(|_| {
-                    anyhow!(
-                        "{here}: line {line}, column {} ({}): `{s}` is not a number (blank cells and NaN are \
-                         accepted and dropped)",
-                        col + 1,
-                        names[col]
-                    )
+                    anyhow::Error::new(MalformedCell {
+                        message: format!(
+                            "{here}: line {line}, column {} ({}): `{s}` is not a number (blank cells and NaN \
+                             are accepted and dropped)",
+                            col + 1,
+                            names[col]
+                        ),
+                    })
                 }),
             }
         };

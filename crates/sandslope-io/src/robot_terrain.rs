@@ -60,10 +60,15 @@ pub fn load_terrain(arg: &str) -> Result<Terrain> {
     terrain_from_toml(&text, &source)
 }
 
-/// Parses and validates a terrain.
+/// Parses and validates a terrain, its k_n and k_s held to their plausible range
+/// ([`sandslope::terrain::K_PLAUSIBLE`]).
 pub fn terrain_from_toml(text: &str, source: &Source) -> Result<Terrain> {
     let spec: TerrainSpec = parse_toml(text, source)?;
-    Terrain::new(spec).map_err(|e| anyhow!("{source}: {e}"))
+    let terrain = Terrain::new(spec.clone()).map_err(|e| anyhow!("{source}: {e}"))?;
+    // Beyond validity, a file's resistances must be plausible (docs/model.md §7): k_n = 1e308
+    // was accepted and a live drive then spent 32 s before its first step.
+    spec.check_plausible().map_err(|e| anyhow!("{source}: {e}"))?;
+    Ok(terrain)
 }
 
 /// `header` as `# ` comment lines (each may itself hold several lines), then `body`.
@@ -134,6 +139,37 @@ mod tests {
         let msg = format!("{:#}", read("leg_elements = 2.5\n").unwrap_err());
         assert!(msg.contains("leg_elements"), "{msg}");
         let msg = format!("{:#}", read("leg_element = 8\n").unwrap_err());
-        assert!(msg.contains("leg_element"), "{msg}");
+        assert!(msg.contains("leg_element") && msg.ends_with("did you mean `leg_elements`?"), "{msg}");
+    }
+
+    /// An unknown key names the key meant: `legs` is a whole word of `stance_legs` only (not of
+    /// `leg_radius_m`, whose word is `leg`); `mass` of `mass_kg`; a typo `leg_radus_m` is nearest
+    /// `leg_radius_m`; `colour` is near nothing and gets no guess.
+    #[test]
+    fn an_unknown_key_names_the_key_most_likely_meant() {
+        let bad = |line: &str| {
+            let text = PAPER.replace("stance_legs = 3\n", "").replace("mass_kg = 0.35\n", "");
+            let text = format!("{text}stance_legs = 3\nmass_kg = 0.35\n{line}\n");
+            format!("{:#}", robot_from_toml(&text, &Source::File("mine.toml".into())).unwrap_err())
+        };
+        assert!(bad("legs = 6").ends_with("did you mean `stance_legs`?"), "{}", bad("legs = 6"));
+        assert!(bad("mass = 1.2").ends_with("did you mean `mass_kg`?"));
+        assert!(bad("leg_radus_m = 0.04").ends_with("did you mean `leg_radius_m`?"));
+        assert!(!bad("colour = 1").contains("did you mean"), "{}", bad("colour = 1"));
+        let terrain = "[[points]]\nslope_deg = 0.0\nk_n = 7e5\nk_s = 2e6\nks_sd = 1e5\n";
+        let msg = format!("{:#}", terrain_from_toml(terrain, &Source::File("t.toml".into())).unwrap_err());
+        assert!(msg.ends_with("did you mean `k_s_sd`?"), "{msg}");
+    }
+
+    /// A terrain file's k_n of 1e308 (the issue's) is refused with the file, the key as the
+    /// file has it and the plausible range; 0.7 given in N/cm^3 is named as 700000 N/m^3.
+    #[test]
+    fn implausible_terrain_resistances_are_refused_naming_the_file_and_key() {
+        let text = |k_n: &str| format!("[[points]]\nslope_deg = 0.0\nk_n = {k_n}\nk_s = 2e6\n");
+        let err = |k_n: &str| format!("{:#}", terrain_from_toml(&text(k_n), &Source::File("sand.toml".into())).unwrap_err());
+        let msg = err("1e308");
+        assert!(msg.starts_with("sand.toml: points[0].k_n = 1e308 must be between 1e3 and 1e10 N/m^3"), "{msg}");
+        assert!(err("0.7").contains("that is 700000 N/m^3"), "{}", err("0.7"));
+        assert!(terrain_from_toml(&text("7e5"), &Source::File("sand.toml".into())).is_ok());
     }
 }

@@ -7,7 +7,7 @@ use anyhow::Result;
 use geojson::{Feature, FeatureCollection, Geometry, GeometryValue};
 use serde::Serialize;
 
-use sandslope::plan::{ElevationGrid, NoRoute, Objective, Route};
+use sandslope::plan::{HeightSource, NoRoute, Objective, Route};
 
 use crate::files::{csv_string, write_atomic};
 use crate::raster::GeoRef;
@@ -90,7 +90,8 @@ struct VertexRow {
 }
 
 /// Writes one row per route vertex; the edge columns describe the edge leaving the vertex.
-pub fn write_csv(path: &Path, geo: &GeoRef, grid: &ElevationGrid, routes: &Routes) -> Result<()> {
+/// The heights come from `grid`: the planner's grid, or a map read window by window.
+pub fn write_csv(path: &Path, geo: &GeoRef, grid: &dyn HeightSource, routes: &Routes) -> Result<()> {
     let mut rows = Vec::new();
     for (obj, r) in routes {
         let Ok(r) = r else { continue };
@@ -102,7 +103,11 @@ pub fn write_csv(path: &Path, geo: &GeoRef, grid: &ElevationGrid, routes: &Route
                 vertex: i,
                 x,
                 y,
-                z: grid.height(*c).unwrap_or(f64::NAN),
+                z: grid
+                    .window(c.row..c.row + 1, c.col..c.col + 1)
+                    .ok()
+                    .and_then(|v| v.first().copied())
+                    .map_or(f64::NAN, f64::from),
                 heading_deg: s.map(|s| s.heading_deg),
                 pitch_deg: s.map(|s| s.pitch_deg),
                 roll_deg: s.map(|s| s.roll_deg),

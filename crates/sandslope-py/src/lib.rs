@@ -8,7 +8,8 @@
 //! (`python/sandslope/`) adds NumPy broadcasting, reshaping, docstrings and the Dask layer.
 //!
 //! Errors are `ValueError`s carrying the message the CLI would print for the same input:
-//! the key (here the Python argument name), the value and the valid range (docs/model.md).
+//! the key (here the Python argument name), the value and the valid range (docs/model.md); a
+//! missing input file is a `FileNotFoundError`.
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -31,10 +32,22 @@ pub(crate) fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-/// A `ValueError` from an `anyhow` error, causes joined by `: ` as the CLI prints them.
+/// A `ValueError` from an `anyhow` error, causes joined by `: ` as the CLI prints them; a
+/// file that is not there is a `FileNotFoundError` (errno 2, the message, the path when the
+/// reader named it), as Python's own `open` raises.
 pub(crate) fn anyhow_error(e: anyhow::Error) -> PyErr {
+    let not_found = e
+        .chain()
+        .filter_map(|c| c.downcast_ref::<std::io::Error>())
+        .any(|io| io.kind() == std::io::ErrorKind::NotFound);
+    if not_found {
+        return pyo3::exceptions::PyFileNotFoundError::new_err((ENOENT, format!("{e:#}")));
+    }
     PyValueError::new_err(format!("{e:#}"))
 }
+
+/// `ENOENT`, the errno of a missing file on every platform Python runs on.
+const ENOENT: i32 = 2;
 
 /// The compiled module.
 #[pymodule]
@@ -68,9 +81,13 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(servo::infer_servo_log_file, m)?)?;
     m.add_function(wrap_pyfunction!(servo::drive_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(servo::drive, m)?)?;
+    m.add_function(wrap_pyfunction!(servo::bag_topics, m)?)?;
+    m.add_function(wrap_pyfunction!(servo::read_bag_poses, m)?)?;
+    m.add_function(wrap_pyfunction!(servo::read_bag_joints, m)?)?;
     m.add("DEFAULT_MAX_RISK", sandslope::risk::DEFAULT_MAX_RISK)?;
     m.add("DEFAULT_MAX_ROLL_DEG", sandslope::plan::DEFAULT_MAX_ROLL_DEG)?;
     m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;
+    m.add("OUTCOMES", sandslope::Regime::ALL.map(sandslope::Regime::outcome))?;
     m.add("CAUSES", sandslope::Cause::ALL.map(sandslope::Cause::name))?;
     Ok(())
 }

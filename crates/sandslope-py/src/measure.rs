@@ -102,6 +102,8 @@ pub fn track<'py>(
         touchdowns: touchdowns.map_or(Touchdowns::Estimated, Touchdowns::Times),
         slope_deg,
         stride_period_s: period,
+        topic: None,
+        frame: None,
     };
     request.options(Words::Keyword).map_err(|e| value_error(e.message()))?;
     let tracked =

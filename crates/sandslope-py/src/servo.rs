@@ -252,3 +252,56 @@ pub fn drive<'py>(
     }
     Ok((d, report_py))
 }
+
+/// A ROS 2 bag's topics (docs/bags.md): `(name, type, encoding, messages)` each.
+#[pyfunction]
+pub fn bag_topics(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Vec<(String, String, String, u64)>> {
+    let topics = py.detach(|| sandslope_io::bag::topics(&path)).map_err(anyhow_error)?;
+    Ok(topics.into_iter().map(|t| (t.name, t.type_name, t.encoding, t.messages)).collect())
+}
+
+/// A bag's pose topic as `track` reads it: `(columns, body)`, the plain motion-capture
+/// columns `time_s, x_m, y_m, z_m` (NaN where no position) on the regular grid `track` uses.
+#[pyfunction]
+#[pyo3(signature = (path, topic=None, frame=None))]
+pub fn read_bag_poses<'py>(
+    py: Python<'py>,
+    path: std::path::PathBuf,
+    topic: Option<String>,
+    frame: Option<String>,
+) -> PyResult<(Bound<'py, PyDict>, String)> {
+    let c = py
+        .detach(|| sandslope_io::bag::series::read_capture(&path, topic.as_deref(), frame.as_deref()))
+        .map_err(anyhow_error)?;
+    let d = PyDict::new(py);
+    let n = c.positions.len();
+    put(&d, "time_s", (0..n).map(|k| c.start_time_s + k as f64 / c.frame_rate_hz).collect())?;
+    for (i, name) in ["x_m", "y_m", "z_m"].into_iter().enumerate() {
+        put(&d, name, c.positions.iter().map(|p| p[i]).collect())?;
+    }
+    Ok((d, c.body))
+}
+
+/// A bag's `JointState` topic as `infer --servo-log` reads it: `(columns, notes)`, the servo
+/// log's columns (docs/drive.md), `effort_unit` `n_m`, `a` or `ma`.
+#[pyfunction]
+#[pyo3(signature = (path, legs, topic=None, joints=None, effort_unit="n_m"))]
+pub fn read_bag_joints<'py>(
+    py: Python<'py>,
+    path: std::path::PathBuf,
+    legs: usize,
+    topic: Option<String>,
+    joints: Option<Vec<String>>,
+    effort_unit: &str,
+) -> PyResult<(Bound<'py, PyDict>, Vec<String>)> {
+    let effort = effort_unit.parse().map_err(value_error)?;
+    let options = sandslope_io::bag::series::JointOptions {
+        topic: topic.as_deref(),
+        joints: joints.as_deref(),
+        legs,
+        effort,
+    };
+    let log =
+        py.detach(|| sandslope_io::bag::series::read_joint_states(&path, &options)).map_err(anyhow_error)?;
+    Ok((log_columns(py, &log.rows)?, log.notes))
+}

@@ -51,7 +51,7 @@ pub fn simulate<'py>(
         body_pitch,
         rft_scaling,
         servo_limit,
-        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
+        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand, ..Default::default() },
     }
     .setup(robot, terrain)?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
@@ -168,7 +168,7 @@ pub fn simulate_ensemble<'py>(
         body_pitch,
         rft_scaling,
         servo_limit,
-        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
+        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand, ..Default::default() },
     }
     .setup(robot, terrain)?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
@@ -214,7 +214,7 @@ pub fn check_convergence<'py>(
         body_pitch,
         rft_scaling,
         servo_limit,
-        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand },
+        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand, ..Default::default() },
     }
     .setup(robot, terrain)?;
     let signed = |deg: f64| sandslope::SignedSlope::from_degrees(deg).map_err(value_error);

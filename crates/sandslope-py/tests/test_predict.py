@@ -20,6 +20,9 @@ def same(a, b):
 
 def test_regimes_contract():
     assert sandslope.REGIMES == ("sinkage", "slippage", "metastable", "success")
+    # The field engineer's words of docs/model.md §6, one per regime, in the same order.
+    assert sandslope.OUTCOMES == ("sinks", "slides back", "climbs slowly and may stall", "climbs steadily")
+    assert "OUTCOMES" in dir(sandslope)
 
 
 @pytest.mark.parametrize("slope", [0, 7.5, 20, 24, -12, 26, 40])

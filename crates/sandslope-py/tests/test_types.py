@@ -1,6 +1,7 @@
 """Robot and Terrain: construction, files, presets, repr, dicts, equality, pickling, errors."""
 
 import copy
+import errno
 import pickle
 
 import pytest
@@ -88,8 +89,9 @@ def test_file_or_preset_follows_the_cli_rule(tmp_path, monkeypatch, cli):
     with pytest.raises(ValueError) as e:
         sandslope.predict("no-such-robot", 10)
     assert str(e.value) == cli.error("predict", "--slope", "10", "--robot", "no-such-robot")
-    with pytest.raises(ValueError, match="cannot read missing.toml"):
+    with pytest.raises(FileNotFoundError, match="cannot read missing.toml") as e:
         Terrain.load("missing.toml")  # ends in .toml: a file, and it is not there
+    assert not isinstance(e.value, ValueError) and e.value.errno == errno.ENOENT
 
 
 def test_errors_carry_the_cli_message(tmp_path, cli):
@@ -117,5 +119,9 @@ def test_errors_carry_the_cli_message(tmp_path, cli):
         Robot.preset("nope")
     with pytest.raises(ValueError, match="mass_kg = 0 must be"):
         Robot(**PAPER).with_mass(0)
-    with pytest.raises(ValueError, match="cannot read"):
+    with pytest.raises(FileNotFoundError, match="cannot read"):
         Terrain.from_toml(tmp_path / "missing.toml")
+    with pytest.raises(FileNotFoundError, match="cannot read"):
+        Robot.from_toml(tmp_path / "missing.toml")
+    with pytest.raises(FileNotFoundError):
+        sandslope.report(observed=tmp_path / "missing.csv")

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use sandslope::measure::{fit_campaign, AirMode, Campaign, CampaignError, FitOptions, Setup};
 use sandslope::{Terrain, TerrainSpec};
-use sandslope_io::measurements::{load_manifest, read_trials, Manifest, ReadOptions};
+use sandslope_io::measurements::{load_manifest, read_trials, MalformedCell, Manifest, ReadOptions};
 
 use crate::error::{RequestError, Result, Words};
 
@@ -114,7 +114,7 @@ impl FitRequest {
             load_manifest(&self.manifest).map_err(|e| RequestError::from_error(Some("manifest"), e))?;
         let read = self.read_options(words)?;
         let trials = read_trials(&manifest, read).map_err(|e| {
-            if !self.skip_malformed && e.to_string().contains("is not a number") {
+            if !self.skip_malformed && e.downcast_ref::<MalformedCell>().is_some() {
                 let hint = words.name("skip-malformed");
                 RequestError::from_error(
                     Some("manifest"),

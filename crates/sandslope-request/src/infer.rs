@@ -232,11 +232,25 @@ impl ServoLogRequest {
     /// Checks the prior and grid, reads the log for `robot`'s legs and takes the slope (the
     /// request's, else the log's header); errors name the file and the field in `words`.
     pub fn read(&self, robot: &Robot, words: Words) -> Result<ServoLogRun> {
+        prior_in(words, self.k_s_prior)?;
+        servo_grid_points(words, self.grid_points)?;
+        let log = sandslope_io::servo_log::read_servo_log(&self.path)
+            .map_err(|e| RequestError::from_error(Some("servo-log"), e))?;
+        self.read_log(log, robot, words)
+    }
+
+    /// As [`read`](Self::read), for a log already read (a ROS 2 bag's joint states,
+    /// `sandslope_io::bag::series::read_joint_states`); `path` names it in errors.
+    pub fn read_log(
+        &self,
+        log: sandslope_io::servo_log::ServoLog,
+        robot: &Robot,
+        words: Words,
+    ) -> Result<ServoLogRun> {
         let prior = prior_in(words, self.k_s_prior)?;
         let grid_points = servo_grid_points(words, self.grid_points)?;
         let path = self.path.as_path();
         let file_error = |e: anyhow::Error| RequestError::from_error(Some("servo-log"), e);
-        let log = sandslope_io::servo_log::read_servo_log(path).map_err(file_error)?;
         let slope_name = match words {
             Words::Flag => "--slope",
             Words::Keyword => "slope_deg",

@@ -134,8 +134,13 @@ impl ReportRequest {
         }
         let mut tracks: Vec<&TracksAt> = self.tracks.iter().collect();
         tracks.sort_by(|a, b| a.slope_deg.total_cmp(&b.slope_deg));
-        let read =
-            CaptureRead { format: self.tracks_format, body: self.tracks_body.as_deref(), cutoff_name: None };
+        let read = CaptureRead {
+            format: self.tracks_format,
+            body: self.tracks_body.as_deref(),
+            cutoff_name: None,
+            topic: None,
+            frame: None,
+        };
         let mut out = Vec::new();
         for t in tracks {
             let slope = Slope::from_degrees(t.slope_deg).map_err(|e| {

@@ -197,12 +197,19 @@ impl ScenarioRequest {
 
     /// The library's scenario: the resistances checked, the robot and terrain read.
     pub fn scenario(&self) -> Result<Scenario> {
-        let k_n = self.k_n.map(|v| check_positive("k-n", v)).transpose()?;
-        let k_s = self.k_s.map(|v| check_positive("k-s", v)).transpose()?;
+        let k_n = self.k_n.map(|v| check_resistance("k-n", v)).transpose()?;
+        let k_s = self.k_s.map(|v| check_resistance("k-s", v)).transpose()?;
         let robot = self.robot.load()?.with_level_step(self.level_step);
         Scenario::new(robot, load_terrain(&self.terrain)?, k_n, k_s)
             .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))
     }
+}
+
+/// A `--k-n`/`--k-s` override: finite and positive, then plausible (docs/model.md §7).
+fn check_resistance(field: &str, value: f64) -> Result<f64> {
+    let v = check_positive(field, value)?;
+    sandslope::terrain::check_plausible_resistance(&format!("--{field}"), v)
+        .map_err(|e| RequestError::invalid(field, e.to_string()))
 }
 
 #[cfg(test)]

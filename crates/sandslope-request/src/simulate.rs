@@ -132,6 +132,7 @@ impl SimulateRequest {
             leg_friction: p.number("leg-friction")?,
             duty_cycle: p.number_or("duty-cycle", defaults.duty_cycle)?,
             disturbed_sand: p.number_or("disturbed-sand", defaults.disturbed_sand)?,
+            one_sided_belly: p.flag("one-sided-belly")?,
         };
         let rate_hz = p.number_or("rate", 120.0)?;
         let ensemble = p.number("ensemble")?.map(|n| ensemble_size(n, &slopes)).transpose()?;

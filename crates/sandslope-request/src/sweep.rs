@@ -6,12 +6,19 @@ use sandslope::scenario::slope_range;
 use sandslope::{Scenario, SignedSlope, SlopeEvaluation};
 
 use crate::error::{RequestError, Result};
+use crate::grammar::{parse_slope_list, SlopeSign};
 use crate::params::Params;
 use crate::scenario::ScenarioRequest;
 
-/// The inputs of `sweep` (and `/api/sweep`): the slopes `from, from + step, ..., <= to`.
+/// The inputs of `sweep` (and `/api/sweep`): the slopes of `slope` in the one slope grammar of
+/// every command (`DEG`, `DEG,DEG,...`, `MIN:MAX:N`, [`crate::grammar::parse_slope_list`]),
+/// else `from, from + step, ..., <= to` (the older flags, kept as a shorthand).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepRequest {
+    /// The slopes, degrees, as `risk --slope` and `phase --slope` take them (field `slope`):
+    /// when given, `from`, `to` and `step` are not used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slope: Option<String>,
     /// First slope, degrees (field `from`, default 0).
     pub from: f64,
     /// Last slope, degrees, included when the steps land on it (field `to`, default 30).
@@ -26,20 +33,24 @@ impl SweepRequest {
     /// Most slopes a sweep evaluates (a guard against `step = 1e-9`).
     pub const MAX_SLOPES: usize = 100_000;
 
-    /// Reads `from`, `to`, `step` and the scenario's fields; refuses any other key.
+    /// Reads `slope` (or `from`, `to`, `step`) and the scenario's fields; refuses any other key.
     pub fn from_params(params: &[(String, String)]) -> Result<SweepRequest> {
         let mut p = Params::new("sweep", params);
+        let slope = p.text("slope")?.map(str::to_string);
         let from = p.number_or("from", 0.0)?;
         let to = p.number_or("to", 30.0)?;
         let step = p.number_or("step", 1.0)?;
         let scenario = ScenarioRequest::from_params(&mut p)?;
         p.finish()?;
-        Ok(SweepRequest { from, to, step, scenario })
+        Ok(SweepRequest { slope, from, to, step, scenario })
     }
 
-    /// The slopes of the range, at most [`SweepRequest::MAX_SLOPES`]; errors name `from`, `to`
-    /// or `step`.
+    /// The slopes of `slope`, else of the range, at most [`SweepRequest::MAX_SLOPES`]; errors
+    /// name `slope`, `from`, `to` or `step`.
     pub fn slopes(&self) -> Result<Vec<f64>> {
+        if let Some(text) = &self.slope {
+            return parse_slope_list("slope", text, SlopeSign::Signed, Self::MAX_SLOPES);
+        }
         slope_range(self.from, self.to, self.step, Self::MAX_SLOPES).map_err(|e| {
             let field = e.key.clone();
             let flag = format!("--{field}");

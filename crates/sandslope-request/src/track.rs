@@ -51,6 +51,13 @@ pub struct TrackRequest {
     pub slope_deg: Option<f64>,
     /// The robot's stride period T = 2 pi / omega, s (from the robot's leg speed).
     pub stride_period_s: f64,
+    /// A ROS 2 bag's topic of poses, odometry or transforms (field `topic`); the bag's only
+    /// such topic when `None` (docs/bags.md).
+    #[serde(default)]
+    pub topic: Option<String>,
+    /// The child frame on a TF topic (field `frame`).
+    #[serde(default)]
+    pub frame: Option<String>,
 }
 
 /// Recordings read and analysed together.
@@ -240,6 +247,8 @@ impl TrackRequest {
             format: self.format,
             body: self.body.as_deref(),
             cutoff_name: Some(name(words, "cutoff")),
+            topic: self.topic.as_deref(),
+            frame: self.frame.as_deref(),
         };
         track_captures(&self.files, read, &self.touchdowns, &options, slope, on_read)
     }
@@ -254,6 +263,10 @@ pub struct CaptureRead<'a> {
     pub body: Option<&'a str>,
     /// The cutoff's name in an error about it (`None`: as the library names it).
     pub cutoff_name: Option<String>,
+    /// A ROS 2 bag's topic (docs/bags.md); the bag's only pose topic when `None`.
+    pub topic: Option<&'a str>,
+    /// The child frame on a bag's TF topic.
+    pub frame: Option<&'a str>,
 }
 
 /// Reads `files` and analyses them pooled with `options` at `slope` (if known): the one path
@@ -271,7 +284,12 @@ pub fn track_captures(
     let captures: Vec<Capture> = files
         .iter()
         .map(|f| {
-            let c = mocap::read(f, read.format, read.body);
+            // A ROS 2 bag (a folder with metadata.yaml, an .mcap or .db3 file) by its topic.
+            let c = if sandslope_io::bag::is_bag(f) {
+                sandslope_io::bag::series::read_capture(f, read.topic, read.frame)
+            } else {
+                mocap::read(f, read.format, read.body)
+            };
             on_read();
             c
         })
@@ -341,6 +359,8 @@ mod tests {
             touchdowns: Touchdowns::Estimated,
             slope_deg: None,
             stride_period_s: 1.0,
+            topic: None,
+            frame: None,
         }
     }
 

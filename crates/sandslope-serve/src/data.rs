@@ -99,6 +99,8 @@ fn served_info(served: &Served) -> Result<Reply, ApiError> {
         terrains: Vec<&'static str>,
         /// Each regime cause's name and its one-line explanation.
         causes: Vec<(&'static str, &'static str)>,
+        /// Each regime's name and what the robot does in it (docs/model.md §6, "Outcomes").
+        outcomes: Vec<(&'static str, &'static str)>,
         /// The robot quantities a request may set, from the library's table of robot keys.
         robot_keys: Vec<RobotField>,
         dem: Option<DemInfo>,
@@ -122,6 +124,7 @@ fn served_info(served: &Served) -> Result<Reply, ApiError> {
         robots: names(PresetKind::Robot),
         terrains: names(PresetKind::Terrain),
         causes: Cause::ALL.iter().map(|c| (c.name(), c.explain())).collect(),
+        outcomes: sandslope::Regime::ALL.iter().map(|r| (r.name(), r.outcome())).collect(),
         robot_keys: robot_fields()
             .map(|(key, field)| {
                 let row = key.row();

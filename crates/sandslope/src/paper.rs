@@ -54,6 +54,31 @@ pub const TOUCHDOWNS_S: [f64; 2] = [0.0, 0.5];
 /// is metastable.
 pub const HEAVY_ROBOT_CLAIM: (f64, f64, Regime) = (1.0, 24.0, Regime::Metastable);
 
+/// The paper's robot as the paper reports it (docs/model.md §2, column "paper"): mass kg, leg
+/// radius m, leg width m, leg speed rad/s, legs in stance, response time s. Its hip height is
+/// not reported (the built-in robot's is tuned to the level speed).
+pub const ROBOT: (f64, f64, f64, f64, u32, f64) = (0.35, 0.04, 0.01, std::f64::consts::TAU, 3, 0.2);
+
+/// Whether `robot` is the paper's robot ([`ROBOT`], each quantity within 0.1%), whatever its
+/// hip height and wherever it was read from: only then are the paper's speeds, step period and
+/// heavy-robot claim numbers about it. Another robot (a user's 1.2 kg one) is not compared
+/// with them (`report` says so and compares only the terrain's ratios).
+pub fn is_papers_robot(robot: &Robot) -> bool {
+    let (m, r, w, omega, n, dt) = ROBOT;
+    let near = |a: f64, b: f64| (a / b - 1.0).abs() <= 1e-3;
+    near(robot.mass(), m)
+        && near(robot.leg_radius(), r)
+        && near(robot.leg_width(), w)
+        && near(robot.leg_speed(), omega)
+        && robot.stance_legs() == n
+        && near(robot.response_time(), dt)
+}
+
+/// The ids of [`compare_with_paper`]'s rows that are properties of the terrain alone (its
+/// resistances' ratios at 20 and 0 degrees), which stand whatever the robot; every other row
+/// is a number about the paper's 0.35 kg robot.
+pub const TERRAIN_ROWS: [&str; 2] = ["shear_ratio_20", "normal_ratio_20"];
+
 /// The plate force a shear strength k_s gives on the paper's shear plate,
 /// `F = k_s W_p d_p^2`, N (docs/model.md §10).
 pub fn plate_force(k_s: f64) -> f64 {

@@ -36,6 +36,26 @@ impl Regime {
         }
     }
 
+    /// What the robot does, in a field engineer's words (docs/model.md §6, "Outcomes"): `climbs
+    /// steadily` (success), `climbs slowly and may stall` (metastable: it progresses, but by
+    /// less than a robust step, each foothold in sand the last one disturbed), `slides back`
+    /// (slippage), `sinks` (sinkage). The one vocabulary of every page, table and sentence;
+    /// files and JSON keep [`Regime::name`].
+    pub fn outcome(self) -> &'static str {
+        match self {
+            Regime::Sinkage => "sinks",
+            Regime::Slippage => "slides back",
+            Regime::Metastable => "climbs slowly and may stall",
+            Regime::Success => "climbs steadily",
+        }
+    }
+
+    /// The outcome with the paper's regime name beside it: `climbs slowly and may stall
+    /// (metastable)`.
+    pub fn in_words(self) -> String {
+        format!("{} ({})", self.outcome(), self.name())
+    }
+
     /// Whether this regime counts as failure (sinkage or slippage; docs/model.md §9).
     pub fn is_failure(self) -> bool {
         matches!(self, Regime::Sinkage | Regime::Slippage)

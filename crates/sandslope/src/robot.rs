@@ -190,6 +190,21 @@ pub const PLAUSIBLE: &[Plausible] = &[
     },
 ];
 
+/// The note a robot with `stance_legs = n` of 4 or more gets (shown, not an error): n is the
+/// legs in stance *at once*, half the legs of an alternating gait, so a hexapod walking a
+/// tripod gait (the paper's robot) has 3, and 6 is a hexapod with every leg down at once (or a
+/// twelve-legged robot). `None` below 4.
+pub fn stance_legs_note(n: u32) -> Option<String> {
+    (n >= 4).then(|| {
+        format!(
+            "stance_legs = {n} is the number of legs in stance at once, which share the robot's weight (docs/model.md §2): \
+             in an alternating gait it is half the legs, so a hexapod walking a tripod gait (the paper's robot) has \
+             stance_legs = 3 and a quadruped trotting 2; {n} means {} legs in all in an alternating gait",
+            2 * n
+        )
+    })
+}
+
 /// Fewest and most legs in stance at once a robot file may give.
 pub const STANCE_LEGS_RANGE: (u32, u32) = (1, 128);
 
@@ -201,13 +216,18 @@ impl Plausible {
 
     /// Checks `value`; the error names the range and, where one fits, the likely unit mistake.
     pub fn check(&self, value: f64) -> Result<f64, ParamError> {
+        self.check_as(value, "a plausible legged robot (docs/model.md §2)")
+    }
+
+    /// [`Plausible::check`] for a quantity of something else than a robot: the error says the
+    /// value must lie in the range "to be `what`" (a terrain's resistances,
+    /// [`crate::terrain::K_PLAUSIBLE`]).
+    pub fn check_as(&self, value: f64, what: &str) -> Result<f64, ParamError> {
         if (self.min..=self.max).contains(&value) {
             return Ok(value);
         }
-        let mut expected = format!(
-            "between {} and {} {} to be a plausible legged robot (docs/model.md §2)",
-            self.min, self.max, self.unit
-        );
+        let mut expected =
+            format!("between {} and {} {} to be {what}", short(self.min), short(self.max), self.unit);
         let fits: Vec<String> = self
             .mistakes
             .iter()
@@ -221,6 +241,16 @@ impl Plausible {
             expected.push_str(&fits.join("; "));
         }
         Err(ParamError::new(self.key, value, expected))
+    }
+}
+
+/// A range's end as written in docs/model.md's tables: plainly from 10^-4 to below 10^3
+/// (0.001, 250), else as a power of ten (1e-8, 1e10) rather than a row of zeros.
+fn short(x: f64) -> String {
+    if x != 0.0 && !(1e-4..1e3).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
     }
 }
 

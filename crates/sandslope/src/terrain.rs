@@ -75,6 +75,44 @@ impl Ground {
     }
 }
 
+/// The range of plausibility of a terrain's resistances k_n and k_s (docs/model.md §7), read
+/// from a terrain file or given as `--k-n`/`--k-s`: 10^3 to 10^10 N/m^3, about four decades
+/// either side of the paper's glass beads (k_n 7e5, k_s 2e6 to 3e6). Below 10^3 every robot of
+/// [`crate::robot::PLAUSIBLE`] sinks (the paper's sinks metres deep); above 10^10 the sand is
+/// stiffer than any granular bed, and the simulator's contact solve slows without bound (a
+/// k_n of 1e308 kept a live drive 32 s before its first step). A value outside is far more
+/// often a unit mistake (0.7 "N/m^3" that was 0.7 N/cm^3) than a terrain, and the message names
+/// the unit it fits. The key printed is the one checked (`points[0].k_n`, `--k-s`).
+pub const K_PLAUSIBLE: crate::robot::Plausible = crate::robot::Plausible {
+    key: "k_n",
+    min: 1e3,
+    max: 1e10,
+    unit: "N/m^3",
+    mistakes: &[("kN/m^3", 1e3), ("N/cm^3 (= MN/m^3)", 1e6), ("N/mm^3", 1e9)],
+};
+
+/// Checks a resistance given by the user (a terrain file's `k_n` or `k_s`, a `--k-n` or
+/// `--k-s` override) against [`K_PLAUSIBLE`]; the error names `key`, the range and the unit it
+/// was likely given in.
+pub fn check_plausible_resistance(key: &str, value: f64) -> Result<f64, ParamError> {
+    K_PLAUSIBLE
+        .check_as(value, "a plausible granular terrain (docs/model.md §7)")
+        .map_err(|e| e.renamed(key))
+}
+
+impl TerrainSpec {
+    /// Checks every point's k_n and k_s against [`K_PLAUSIBLE`] (what a terrain file must
+    /// meet beyond [`Terrain::new`]'s validity; fitted and scaled terrains built in the
+    /// library are not held to it). Errors name `points[i].k_n` as the file has it.
+    pub fn check_plausible(&self) -> Result<(), ParamError> {
+        for (i, p) in self.points.iter().enumerate() {
+            check_plausible_resistance(&format!("points[{i}].k_n"), p.k_n)?;
+            check_plausible_resistance(&format!("points[{i}].k_s"), p.k_s)?;
+        }
+        Ok(())
+    }
+}
+
 /// A validated terrain table, points sorted by slope. Build it with [`Terrain::new`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Terrain {
@@ -239,6 +277,27 @@ mod tests {
     fn at(t: &Terrain, deg: f64) -> (Ground, bool) {
         let s = Slope::from_degrees(deg).unwrap();
         (t.at(s), t.extrapolates(s))
+    }
+
+    /// The range is 1e3 to 1e10 N/m^3, edges included; k_n = 1e308 (the file) is
+    /// refused under the file's key, and 0.7 given in N/cm^3 is named as 0.7 * 1e6 = 700000
+    /// N/m^3 (700 given in kN/m^3 likewise), while 1e308 fits no unit.
+    #[test]
+    fn implausible_resistances_are_refused_with_the_range_and_the_likely_unit() {
+        let spec = |k_n: f64, k_s: f64| TerrainSpec { name: None, repose_deg: None, points: vec![pt(0.0, k_n, k_s)] };
+        assert!(spec(1e3, 1e10).check_plausible().is_ok());
+        assert!(spec(7e5, 2e6).check_plausible().is_ok());
+        let e = spec(1e308, 2e6).check_plausible().unwrap_err();
+        assert_eq!(e.key, "points[0].k_n");
+        let text = e.to_string();
+        assert!(text.contains("between 1e3 and 1e10 N/m^3") && !text.contains("if it was given"), "{text}");
+        let e = spec(7e5, 0.7).check_plausible().unwrap_err();
+        assert_eq!(e.key, "points[0].k_s");
+        assert!(e.to_string().contains("if it was given in N/cm^3 (= MN/m^3), that is 700000 N/m^3"), "{e}");
+        let e = check_plausible_resistance("--k-n", 700.0).unwrap_err().to_string();
+        assert!(e.starts_with("--k-n = 700 must be") && e.contains("in kN/m^3, that is 700000 N/m^3"), "{e}");
+        assert!(check_plausible_resistance("k", 9.99e2).is_err());
+        assert!(check_plausible_resistance("k", 1.01e10).is_err());
     }
 
     #[test]

@@ -411,12 +411,45 @@ pub fn run(args: DriveArgs) -> Result<()> {
         }
     };
     let stop = &crate::error::STOP;
-    let log = args.run.log.as_deref().map(|path| LogTarget {
+    // `--log run.mcap`: the rows kept in memory and written as ROS 2 messages (docs/bags.md).
+    let mcap =
+        args.run.log.as_deref().filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("mcap")));
+    let log = args.run.log.as_deref().filter(|_| mcap.is_none()).map(|path| LogTarget {
         path,
         robot: &args.robot.robot,
         terrain: &args.terrain.terrain,
     });
-    let (report, failure) = drive_logged(&mut session, log, stop, &mut |_| {}, &mut on_live)?;
+    let (mut rows, meta) =
+        (Vec::new(), sandslope_servo::log::log_meta(&session, &args.robot.robot, &args.terrain.terrain));
+    let on_sample = &mut |s: &sandslope_servo::driver::ServoSample| {
+        rows.extend(mcap.map(|_| sandslope_servo::log::log_row(s)))
+    };
+    let (report, failure) = drive_logged(&mut session, log, stop, on_sample, &mut on_live)?;
+    if let Some(path) = mcap {
+        use sandslope_io::mcap_out::{drive_mcap, LiveRecord};
+        let live: Vec<LiveRecord> = (report.live.iter())
+            .map(|l| (l.time_s, l.tripod as f64, &l.inference))
+            .map(|(time_s, tripod, i)| LiveRecord {
+                time_s,
+                values: [
+                    tripod,
+                    i.k_s,
+                    i.k_s_lo,
+                    i.k_s_hi,
+                    i.speed_m_s,
+                    i.speed_lo_m_s,
+                    i.speed_hi_m_s,
+                    i.p_fail,
+                    i.p_slippage,
+                    i.p_sinkage,
+                ],
+            })
+            .collect();
+        let verdict = failure
+            .as_ref()
+            .map_or_else(|| serde_json::to_string(&report.outcome).unwrap_or_default(), |e| e.to_string());
+        sandslope_io::write_atomic(path, &drive_mcap(&rows, &live, &meta, &verdict)?)?;
+    }
     crate::error::DRIVING.store(false, Ordering::SeqCst);
     let budget = session.bus_budget();
     let emulator = session.close().map(|r| emulator_summary(&r));

@@ -42,6 +42,18 @@ pub struct InferArgs {
     /// (docs/model.md §19).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["observed", "steps", "law"])]
     pub servo_log: Option<PathBuf>,
+    /// A ROS 2 bag's sensor_msgs/JointState topic for --servo-log (docs/bags.md); the bag's
+    /// only one when omitted.
+    #[arg(long, value_name = "TOPIC", requires = "servo_log")]
+    pub topic: Option<String>,
+    /// The bag's joint names in leg order (leg 0 first), comma-separated; the message's own
+    /// order when omitted.
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',', requires = "servo_log")]
+    pub joints: Vec<String>,
+    /// What the bag's JointState effort holds: n_m (torque, the message's unit), a or ma
+    /// (current, turned into torque with the XL330's K_t, docs/model.md §19).
+    #[arg(long, value_name = "n_m|a|ma", default_value = "n_m", requires = "servo_log")]
+    pub effort_unit: sandslope_io::bag::series::EffortUnit,
     /// The slope of the --servo-log run, degrees (default: the log's `slope_deg` header).
     #[arg(long, value_name = "DEG", requires = "servo_log", allow_negative_numbers = true)]
     pub slope: Option<f64>,
@@ -132,7 +144,25 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
         k_s_prior: infer::parse_prior(&args.k_s_prior)?,
         grid_points: args.grid_points,
     };
-    let run = request.read(&robot, Words::Flag)?;
+    let run = if sandslope_io::bag::is_bag(path) {
+        // A ROS 2 bag's joint states, read as the servo log's leg angles and torques.
+        let options = sandslope_io::bag::series::JointOptions {
+            topic: args.topic.as_deref(),
+            joints: (!args.joints.is_empty()).then_some(args.joints.as_slice()),
+            legs: 2 * robot.stance_legs() as usize,
+            effort: args.effort_unit,
+        };
+        let log = sandslope_io::bag::series::read_joint_states(path, &options)?;
+        request.read_log(log, &robot, Words::Flag)?
+    } else {
+        if args.topic.is_some() || !args.joints.is_empty() {
+            anyhow::bail!(
+                "--topic and --joints read a ROS 2 bag (a folder with metadata.yaml, an .mcap or .db3 file), but {} is not one",
+                path.display()
+            );
+        }
+        request.read(&robot, Words::Flag)?
+    };
     let terrain = args.terrain.load()?;
     for note in &run.notes {
         eprintln!("note: {}: {note}", path.display());

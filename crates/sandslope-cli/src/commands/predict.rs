@@ -78,14 +78,14 @@ pub fn run(args: PredictArgs) -> Result<()> {
                     "N/m^3".into(),
                 ],
                 ["k_s margin (k_s / critical k_s for progress)".into(), num(e.k_s_margin, 2), "".into()],
-                ["regime".into(), p.regime.name().into(), "".into()],
+                ["outcome (regime)".into(), p.regime.in_words(), "".into()],
                 ["cause".into(), p.cause.name().into(), "".into()],
             ];
             for r in rows {
                 t.add_row(r);
             }
             println!("{t}");
-            println!("{}: {}", p.regime, p.cause.explain());
+            println!("{}: {}", p.regime.in_words(), p.cause.explain());
             if e.speed_ruled_out() {
                 println!("{}", ruled_out_note());
             }

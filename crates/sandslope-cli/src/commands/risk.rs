@@ -35,10 +35,11 @@ use sandslope_render::rows::{MassRow, RiskRow, SafeSlopeRow};
 /// What `--solve` finds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Solve {
-    /// The safe-slope limit: the steepest slope with p_fail below --max-risk.
+    /// The safe-slope limit: the steepest slope up to which the robot is safe (p_fail below
+    /// --max-risk), and the success limit beside it.
     Slope,
-    /// The heaviest total mass with p_fail below --max-risk at each --slope (several slopes:
-    /// the payload envelope).
+    /// The heaviest total mass that is safe (p_fail below --max-risk) at each --slope (several
+    /// slopes: the payload envelope).
     Mass,
 }
 
@@ -54,7 +55,10 @@ pub struct RiskArgs {
     pub terrain: TerrainArgs,
     #[command(flatten)]
     pub uncertainty: UncertaintyArgs,
-    /// Largest acceptable failure probability, for the safe-slope limit and --solve.
+    /// Largest acceptable failure probability. "Safe" has one meaning, for the safe-slope limit
+    /// and --solve mass alike (docs/model.md §9): p_fail = P(it sinks or slides back) below
+    /// this. A safe robot may still climb slowly and stall (metastable); the success limit
+    /// bounds P(it does not climb steadily) instead.
     #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = sandslope::risk::DEFAULT_MAX_RISK, value_parser = parse_max_risk)]
     pub max_risk: f64,
     /// Solve for the safe-slope limit (`slope`) or the heaviest safe mass at each --slope
@@ -192,8 +196,8 @@ fn describe_slope_limits(sol: &SafeSlope) -> String {
     if let (Some(a), Some(b)) = (sol.success_slope_deg, sol.safe_slope_deg) {
         if b - a >= 0.05 {
             out.push_str(&format!(
-                "\nbetween {a:.1} and {b:.1} deg the robot is likely metastable: it neither sinks nor slips back for good, \
-                 but each step is shorter than the minimum and it stalls in its own trench (docs/model.md §5)"
+                "\nbetween {a:.1} and {b:.1} deg the robot likely climbs slowly and may stall (metastable): it neither sinks \
+                 nor slides back, but each step is shorter than the minimum and it can stall in its own trench (docs/model.md §5)"
             ));
         }
     }
@@ -397,8 +401,8 @@ fn print_envelope(env: PayloadEnvelope, format: Format) -> Result<()> {
             }
             println!("{t}");
             println!(
-                "payload envelope: heaviest total mass with p_fail < {} (robot's own mass {} kg; at each \
-                 limit p_fail reaches the threshold)",
+                "payload envelope: heaviest total mass with p_fail = P(sinks or slides back) < {} (robot's own mass {} kg; \
+                 at each limit p_fail reaches the threshold; a safe mass may still climb slowly and stall, docs/model.md §9)",
                 env.max_risk, env.robot_mass_kg
             );
             if let Some(note) = env.defaults_used.note() {
@@ -417,7 +421,8 @@ fn describe_mass_limit(sol: &SafeMass) -> String {
         ),
         // (A mass search never ends at a repose: that is a slope's.)
         SafeLimit::Limit { value, p_fail } | SafeLimit::Repose { repose_deg: value, p_fail } => format!(
-            "heaviest safe total mass at {} deg: {value:.4} kg (payload {:.4} kg over the robot's {} kg), p_fail {p_fail:.4} < {}",
+            "heaviest safe total mass at {} deg: {value:.4} kg (payload {:.4} kg over the robot's {} kg), p_fail {p_fail:.4} < {} \
+             (safe: it does not sink or slide back; at this mass it may still climb slowly and stall, docs/model.md §9)",
             sol.slope_deg,
             value - sol.robot_mass_kg,
             sol.robot_mass_kg,

@@ -15,7 +15,7 @@ use crate::figures::simulate::{Animation, SimulateFigure, SlopesFigure};
 use crate::output::{
     check_parent_exists, csv_string, num, print_json, table, write_atomic, Format, FormatArgs,
 };
-use crate::progress::{progress_bar, spinner};
+use crate::progress::{spinner, Progress};
 use sandslope::simulate::convergence::{RefinedWalk, Refinement, WalkAnswer};
 use sandslope::simulate::mechanisms::{CONSTANT_SPEED_DUTY, UNDISTURBED_SAND};
 use sandslope::simulate::{BodyPitch, ConvergenceCheck, Mechanisms, RftScaling, SimSummary, Simulation};
@@ -75,6 +75,11 @@ pub struct SimulateArgs {
     /// default 1: as strong as before).
     #[arg(long, value_name = "F", default_value_t = UNDISTURBED_SAND, allow_negative_numbers = true)]
     pub disturbed_sand: f64,
+    /// The belly as the body's underside, sand below it only: it pushes and never pulls the
+    /// body down, its drag capped by its push (docs/model.md §20.5; default: a plate in sand
+    /// on both faces, as resistive force theory's plates were).
+    #[arg(long)]
+    pub one_sided_belly: bool,
     /// Walk the one slope N times (2 to 1000), the robot's mass perturbed by 1e-9 relative
     /// between walks, and give the spread: mean speed, its SD and standard error, mean t1, the
     /// regimes' counts, how many pitched over. For the free body, whose walk on a slope is
@@ -92,8 +97,10 @@ pub struct SimulateArgs {
     /// Trajectory sample rate for --out, --plot and --animate, Hz.
     #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
     pub rate: f64,
-    /// Write the body's centre as plain motion capture (time_s,x_m,y_m,z_m) for `track`.
-    #[arg(long, value_name = "CSV")]
+    /// Write the body's centre as plain motion capture (time_s,x_m,y_m,z_m) for `track`; a
+    /// name ending .mcap writes ROS 2 messages for Foxglove instead (pose, legs as TF, joint
+    /// states, forces as markers; docs/bags.md).
+    #[arg(long, value_name = "CSV|MCAP")]
     pub out: Option<PathBuf>,
     /// Draw position, leg depths and leg forces against time (one slope), or simulated,
     /// closed-form and observed speeds against slope (--slopes), to FILE (.png or .svg).
@@ -178,6 +185,7 @@ impl SimulateArgs {
                 leg_friction: self.leg_friction,
                 duty_cycle: self.duty_cycle,
                 disturbed_sand: self.disturbed_sand,
+                one_sided_belly: self.one_sided_belly,
             },
             rate_hz: self.rate,
             ensemble,
@@ -221,26 +229,33 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     // Progress on stderr (a terminal's, not with --json or --csv): a 10 s walk with its GIF
     // takes tens of seconds.
     let quiet = args.format.format() != Format::Table;
-    let spin = spinner(quiet, &format!("simulating {} s at {slope} deg", walks.settings.duration_s));
+    let spin = Progress::new(0, quiet, &format!("simulating {} s at {slope} deg", walks.settings.duration_s));
     let sims = walks.simulate();
-    spin.finish_and_clear();
+    spin.finish();
     let Some(sim) = sims?.pop() else { bail!("no walk was simulated") };
     if sim.summary.closed_form.extrapolated {
         warn_extrapolated(scenario.terrain(), &[slope]);
     }
     // Every output is rendered before any is written, so a failure leaves nothing behind.
-    let csv = args.out.as_ref().map(|_| plain_mocap_csv(&sim.trajectory, slope));
+    // `--out walk.mcap`: ROS 2 messages for Foxglove (docs/bags.md); otherwise the plain CSV.
+    let csv = match &args.out {
+        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("mcap")) => {
+            Some(sandslope_io::mcap_out::simulation_mcap(&sim.trajectory, &sim.geometry, slope)?)
+        }
+        Some(_) => Some(plain_mocap_csv(&sim.trajectory, slope).into_bytes()),
+        None => None,
+    };
     if let Some(path) = &args.plot {
         figures::save(path, &SimulateFigure { sim: &sim, robot: scenario.robot() })?;
     }
     if let Some(path) = &args.animate {
         let anim = Animation { sim: &sim, slope_deg: slope };
-        let bar = progress_bar(anim.frames().len() as u64, quiet, &format!("drawing {}", path.display()));
-        figures::simulate::save_gif(path, &anim, &mut || bar.inc(1))?;
-        bar.finish_and_clear();
+        let mut bar = Progress::new(anim.frames().len() as u64, quiet, &format!("drawing {}", path.display()));
+        figures::simulate::save_gif(path, &anim, &mut || bar.inc())?;
+        bar.finish();
     }
     if let (Some(path), Some(csv)) = (&args.out, &csv) {
-        write_atomic(path, csv.as_bytes())?;
+        write_atomic(path, csv)?;
     }
     let m = &sim.summary;
     match args.format.format() {
@@ -273,6 +288,14 @@ fn print_one(sim: &Simulation) {
     ]);
     t.add_row(["t1 ms".into(), num(m.t1_s.map(|v| v * 1e3), 1), num(p.anchoring_time.map(|v| v * 1e3), 1)]);
     t.add_row(["slip mm".into(), num(m.slip_m.map(|v| v * 1e3), 2), num(p.slip.map(|v| v * 1e3), 2)]);
+    // Phase 1's lowest speed; the closed form's body slides from rest at g sin(theta) until t1
+    // (its s1 = 1/2 g sin(theta) t1^2), so its lowest speed is -g sin(theta) t1 (docs/model.md §18).
+    let cf_low = p.anchoring_time.map(|t1| -sandslope::G * m.slope_deg.to_radians().sin() * t1);
+    t.add_row([
+        "lowest speed in phase 1 cm/s".into(),
+        num(m.phase1.map(|q| q.min_speed_m_s * 100.0), 2),
+        num(cf_low.map(|v| v * 100.0), 2),
+    ]);
     t.add_row(["step mm".into(), format!("{:.2}", m.step_m * 1e3), num(p.step.map(|v| v * 1e3), 2)]);
     t.add_row([
         "deepest leg mm".into(),

@@ -16,13 +16,18 @@ use sandslope_request::SweepRequest;
 /// Arguments of `sandslope sweep`.
 #[derive(Debug, Args)]
 pub struct SweepArgs {
-    /// First slope, degrees.
+    /// Slope(s), degrees, in the one slope grammar of every command (as `risk --slope` and
+    /// `phase --slope`): one value, a comma list (0,10,20) or MIN:MAX:N, N slopes evenly spaced
+    /// with both ends included (0:30:31 is every degree). Without it, --from/--to/--step.
+    #[arg(long, value_name = "DEG|LIST|MIN:MAX:N", allow_hyphen_values = true, conflicts_with_all = ["from", "to", "step"])]
+    pub slope: Option<String>,
+    /// First slope, degrees (the older shorthand for --slope FROM:TO:N).
     #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_negative_numbers = true)]
     pub from: f64,
-    /// Last slope, degrees (included when the steps land on it).
+    /// Last slope, degrees, included when the steps land on it (shorthand, see --slope).
     #[arg(long, value_name = "DEG", default_value_t = 30.0, allow_negative_numbers = true)]
     pub to: f64,
-    /// Slope increment, degrees.
+    /// Slope increment, degrees (shorthand, see --slope).
     #[arg(long, value_name = "DEG", default_value_t = 1.0, allow_negative_numbers = true)]
     pub step: f64,
     /// Draw speed, anchoring time and step length against slope into FILE (.png or .svg).
@@ -45,6 +50,7 @@ impl SweepArgs {
     /// The request these flags make (the one `serve`'s `/api/sweep` builds too).
     pub fn request(&self) -> SweepRequest {
         SweepRequest {
+            slope: self.slope.clone(),
             from: self.from,
             to: self.to,
             step: self.step,
@@ -86,7 +92,7 @@ pub fn run(args: SweepArgs) -> Result<()> {
                 "slip mm",
                 "step mm",
                 "speed cm/s",
-                "regime",
+                "outcome (regime)",
                 "cause",
             ]);
             for e in &evals {
@@ -99,7 +105,7 @@ pub fn run(args: SweepArgs) -> Result<()> {
                     num(p.slip.map(|s| s * 1e3), 2),
                     num(p.step.map(|s| s * 1e3), 2),
                     speed_cell(e),
-                    p.regime.name().to_string(),
+                    p.regime.in_words(),
                     p.cause.name().to_string(),
                 ]);
             }
@@ -137,5 +143,19 @@ mod tests {
             slopes(&parse(&["--from", "-5", "--to", "5", "--step", "5"])).unwrap(),
             vec![-5.0, 0.0, 5.0]
         );
+    }
+
+    /// `--slope` takes the grammar of `risk` and `phase`: -5:5:3 is three slopes, -5, 0 and 5,
+    /// the same as the shorthand above; a list is taken as given; with --from it is refused.
+    #[test]
+    fn slope_takes_the_one_grammar_of_every_command() {
+        let parse = |a: &[&str]| Cli::try_parse_from([&["x"], a].concat()).map(|c| c.sweep);
+        let slopes = |a: &[&str]| parse(a).unwrap().request().slopes().unwrap();
+        assert_eq!(slopes(&["--slope", "-5:5:3"]), vec![-5.0, 0.0, 5.0]);
+        assert_eq!(slopes(&["--slope", "0,12.5,24"]), vec![0.0, 12.5, 24.0]);
+        assert_eq!(slopes(&["--slope", "0:30:31"]).len(), 31);
+        assert!(parse(&["--slope", "0:30:31", "--from", "5"]).is_err());
+        let msg = parse(&["--slope", "0:30:1"]).unwrap().request().slopes().unwrap_err().to_string();
+        assert!(msg.contains("write 0:30:31"), "{msg}");
     }
 }

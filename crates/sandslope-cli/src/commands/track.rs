@@ -30,8 +30,18 @@ pub struct TrackArgs {
     /// Rigid body, marker or model output to track (required when a file has several).
     #[arg(long, value_name = "NAME")]
     pub body: Option<String>,
+    /// A ROS 2 bag's topic of geometry_msgs/PoseStamped, nav_msgs/Odometry,
+    /// geometry_msgs/TransformStamped or tf2_msgs/TFMessage (a bag is a folder with
+    /// metadata.yaml, or an .mcap or .db3 file; docs/bags.md); the bag's only such topic when
+    /// omitted, else the error lists the candidates.
+    #[arg(long, value_name = "TOPIC")]
+    pub topic: Option<String>,
+    /// The child frame to track on a bag's TF topic (e.g. `base_link`); the only one when omitted.
+    #[arg(long, value_name = "FRAME")]
+    pub frame: Option<String>,
     /// Upslope direction in the capture frame: +x, -x, +y, -y, +z, -z or a vector such as
-    /// `0.91,0,0.41`; estimated as the principal direction of travel when omitted.
+    /// `0.91,0,0.41`; when omitted, the principal direction of travel, pointed the way it
+    /// rises along the format's vertical axis (a slide down reads as a negative speed).
     #[arg(
         long,
         value_name = "AXIS|X,Y,Z",
@@ -131,6 +141,8 @@ pub fn run(args: TrackArgs) -> Result<()> {
         },
         slope_deg: slope,
         stride_period_s: period,
+        topic: args.topic.clone(),
+        frame: args.frame.clone(),
     };
     let (options, _) = request.options(Words::Flag)?;
     // Large exports take a while to parse: a bar on a terminal, nothing when piped.

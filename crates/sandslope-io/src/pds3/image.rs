@@ -163,7 +163,6 @@ pub(super) fn read_window(
 ) -> Result<(Vec<f64>, usize, usize)> {
     let Layout { rows, cols, kind, bits, bytes, prefix, suffix, add, scale, missing } = *layout;
     // Sizes, checked before anything is allocated.
-    check_raster_size(&name, cols, rows)?;
     let line_bytes = prefix + cols * bytes as u64 + suffix;
     let data_name = data_path.display();
     let file_len = std::fs::metadata(data_path).with_context(|| format!("cannot read {data_name}"))?.len();
@@ -187,6 +186,8 @@ pub(super) fn read_window(
         );
     }
 
+    // The window's heights (`f64`) and one line's bytes, against the memory limit.
+    check_raster_size(&name, wc.end - wc.start, wr.end - wr.start, 8)?;
     // The samples.
     let mut file = BufReader::new(File::open(data_path).with_context(|| format!("cannot read {data_name}"))?);
     let width = (wc.end - wc.start) as usize;

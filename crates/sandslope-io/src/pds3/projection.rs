@@ -4,7 +4,7 @@
 use anyhow::{anyhow, bail, Result};
 
 use super::label::Label;
-use crate::crs::GroundCells;
+use crate::crs::{Crs, GroundCells};
 use crate::raster::grid::GeoRef;
 
 /// Where the DTM lies on its projection (projected metres) and on which sphere.
@@ -32,7 +32,7 @@ pub(super) fn georef(
     rows: u64,
     cols: u64,
     notes: &mut Vec<String>,
-) -> Result<(GeoRef, GroundCells)> {
+) -> Result<(GeoRef, GroundCells, Crs)> {
     let name = &label.name;
     let map = |key: &str| format!("IMAGE_MAP_PROJECTION.{key}");
     if !label
@@ -49,10 +49,11 @@ pub(super) fn georef(
         .word(&map("MAP_PROJECTION_TYPE"))
         .ok_or_else(|| anyhow!("{name}: the label has no IMAGE_MAP_PROJECTION.MAP_PROJECTION_TYPE"))?;
     let projection = ptype.replace([' ', '_'], "");
-    if !matches!(projection.as_str(), "EQUIRECTANGULAR" | "POLARSTEREOGRAPHIC") {
+    if !matches!(projection.as_str(), "EQUIRECTANGULAR" | "POLARSTEREOGRAPHIC" | "SIMPLECYLINDRICAL") {
         bail!(
             "{name}: line {pline}: MAP_PROJECTION_TYPE = {ptype} is not supported (EQUIRECTANGULAR or \
-             POLARSTEREOGRAPHIC, the projections of HiRISE DTMs); reproject it (gdalwarp) to one of those or to a GeoTIFF"
+             POLARSTEREOGRAPHIC, the projections of HiRISE and CTX DTMs, or SIMPLE CYLINDRICAL, MOLA's); reproject \
+             it (gdalwarp) to one of those or to a GeoTIFF"
         );
     }
     if let Some((rot, _)) = label.number(&map("MAP_PROJECTION_ROTATION"))? {
@@ -68,6 +69,10 @@ pub(super) fn georef(
     };
     if !(1e3..=1e8).contains(&radius_m) {
         bail!("{name}: A_AXIS_RADIUS = {radius} ({radius_m} m) must be from 1 to 100000 km");
+    }
+    if projection == "SIMPLECYLINDRICAL" {
+        let body = body_name(label, radius_m);
+        return super::cylindrical::simple_cylindrical(label, rows, cols, radius_m, &body, notes);
     }
     let (map_scale, sunit) = label.need_number(&map("MAP_SCALE"), "the cell size")?;
     let cell = match sunit.as_deref().map(|u| u.replace(' ', "")).as_deref() {
@@ -103,7 +108,8 @@ pub(super) fn georef(
     };
     let clon = label.number(&map("CENTER_LONGITUDE"))?.map_or(0.0, |v| v.0);
     let (keys, doubles, ascii) = geokeys(&projection, radius_m, clat, clon, &body);
-    Ok((GeoRef::north_up((west, north, cell, cell), keys, doubles, ascii), cells))
+    let crs = Crs::Projected { metres_per_unit: 1.0, unit: "metre" };
+    Ok((GeoRef::north_up((west, north, cell, cell), keys, doubles, ascii), cells, crs))
 }
 
 /// Ground cell sizes of an equirectangular map (y = R lat): MAP_SCALE north-south; east-west

@@ -4,16 +4,17 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
 
-use super::grid::{check_raster_size, GeoRef, Raster, SizeCheck, MAX_RASTER_CELLS};
+use super::grid::{check_raster_size, memory_limit, GeoRef, Raster, SizeCheck};
 
 /// An ESRI ASCII grid (its CRS from a `.prj` beside it, if any), and the factor converting its
 /// heights to metres.
 pub(super) fn read_asc(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
     let name = path.display();
     let bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
-    // 24 bytes a value is more than any ASCII grid writer uses (`-1234.567890123456789 `).
-    if bytes > MAX_RASTER_CELLS as u64 * 24 {
-        bail!("{name}: {bytes} bytes is larger than an ESRI ASCII grid within the {MAX_RASTER_CELLS}-cell limit");
+    // The text is held whole while it is parsed.
+    let (limit, what) = memory_limit();
+    if bytes > limit {
+        bail!("{name}: {bytes} bytes of text is more than {what} of {limit} bytes; convert it to a GeoTIFF");
     }
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {name}"))?;
     let mut header = std::collections::HashMap::new();
@@ -46,8 +47,8 @@ pub(super) fn read_asc(path: &Path, fits: SizeCheck) -> Result<(Raster, f64)> {
         }
     };
     let (cols, rows) = (count("ncols")?, count("nrows")?);
-    check_raster_size(&name, cols as u64, rows as u64)?;
     fits(cols, rows)?;
+    check_raster_size(&name, cols as u64, rows as u64, 8)?;
     // Every value takes at least two bytes (a digit and a separator): a header that claims more
     // cells than the file can hold is refused before the grid is allocated.
     if cols.saturating_mul(rows) > text.len() / 2 + 1 {

@@ -13,7 +13,7 @@ use tiff::encoder::{colortype::Gray32Float, compression::DeflateLevel, Compressi
 use tiff::tags::{ExtraSamples, Tag};
 
 use super::chunks;
-use super::grid::{check_raster_size, GeoRef, Raster, SizeCheck, MAX_RASTER_CELLS};
+use super::grid::{check_raster_size, memory_limit, GeoRef, Raster, SizeCheck};
 
 /// The largest GeoTIFF tag value (GeoKeys, strip offsets, ...) read, in bytes. A tag whose
 /// count claims more is refused before its value is allocated.
@@ -179,11 +179,11 @@ fn check_entries(
     Ok(())
 }
 
-/// The decoder's limits: the image at most [`MAX_RASTER_CELLS`] 8-byte samples, any tag
-/// value at most [`MAX_TIFF_TAG_BYTES`].
+/// The decoder's limits: the image at most the memory limit ([`memory_limit`]), any tag value
+/// at most [`MAX_TIFF_TAG_BYTES`].
 fn tiff_limits() -> Limits {
     let mut limits = Limits::default();
-    limits.decoding_buffer_size = MAX_RASTER_CELLS * 8;
+    limits.decoding_buffer_size = usize::try_from(memory_limit().0).unwrap_or(usize::MAX);
     limits.ifd_value_size = MAX_TIFF_TAG_BYTES;
     limits
 }
@@ -193,13 +193,41 @@ const GT_RASTER_TYPE: u16 = 1025;
 const PIXEL_IS_POINT: u16 = 2;
 
 /// A GeoTIFF (its `values` left empty), the factor converting its heights to metres, and its
-/// decoded samples.
-pub(super) fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64, DecodingResult)> {
+/// decoded samples; `out_bytes` a cell are what the caller converts the samples to (8 for
+/// `f64` values, 4 for `f32` heights, converted in place from float32 samples), checked with
+/// the samples against the memory limit.
+pub(super) fn read_geotiff(
+    path: &Path,
+    fits: SizeCheck,
+    out_bytes: u64,
+) -> Result<(Raster, f64, DecodingResult)> {
     let name = path.display();
     let mut dec = open_full_resolution(path)?;
     let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
-    check_raster_size(&name, u64::from(w), u64::from(h))?;
+    let bits: u64 = dec.find_tag_unsigned(Tag::BitsPerSample).ok().flatten().unwrap_or(64);
+    let in_place = out_bytes == 4 && bits == 32;
     fits(w as usize, h as usize)?;
+    check_raster_size(
+        &name,
+        u64::from(w),
+        u64::from(h),
+        bits.max(8) / 8 + if in_place { 0 } else { out_bytes },
+    )?;
+    let (raster, vertical) = header(path, &mut dec)?;
+    let image = decode_samples(&name, path, &mut dec, bits)?;
+    Ok((raster, vertical, image))
+}
+
+/// A GeoTIFF's raster (its `values` left empty) and the factor converting its heights to
+/// metres, from its directory alone: no sample is read.
+pub(super) fn read_geotiff_header(path: &Path) -> Result<(Raster, f64)> {
+    header(path, &mut open_full_resolution(path)?)
+}
+
+/// The raster and vertical factor of the image `dec` is at (see [`read_geotiff_header`]).
+fn header(path: &Path, dec: &mut Decoder<BufReader<File>>) -> Result<(Raster, f64)> {
+    let name = path.display();
+    let (w, h) = dec.dimensions().map_err(|e| anyhow!("{name}: {e}"))?;
     let bits: u64 = dec.find_tag_unsigned(Tag::BitsPerSample).ok().flatten().unwrap_or(64);
     let file_bytes = std::fs::metadata(path).with_context(|| format!("cannot read {name}"))?.len();
     check_claimed_bytes(&name, u64::from(w), u64::from(h), bits, file_bytes)?;
@@ -207,9 +235,8 @@ pub(super) fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64,
     if samples != 1 {
         bail!("{name}: has {samples} bands (SamplesPerPixel = {samples}); an elevation or class raster must have exactly 1");
     }
-    let tags = GeoTags::read(&name, &mut dec)?;
+    let tags = GeoTags::read(&name, dec)?;
     let (west, north, cell_x, cell_y) = tags.origin_and_cell(&name)?;
-    let image = decode_samples(&name, path, &mut dec, bits)?;
     let (cols, rows) = (w as usize, h as usize);
     let mut notes = Vec::new();
     let GeoTags { geokeys, geodoubles, geoascii, nodata, .. } = tags;
@@ -232,7 +259,7 @@ pub(super) fn read_geotiff(path: &Path, fits: SizeCheck) -> Result<(Raster, f64,
         row_widths_m: None,
         notes,
     };
-    Ok((raster, vertical, image))
+    Ok((raster, vertical))
 }
 
 /// The GDAL_NODATA value of a GeoTIFF, from its tags alone (the samples are not decoded), as

@@ -6,18 +6,69 @@ use anyhow::{bail, Result};
 
 use crate::crs::Crs;
 
-/// The most cells a raster may have: 2^29 (about 23,000 x 23,000; 4 GiB as f64). The size a
-/// file claims is checked against it before anything is allocated, so a small file that claims
-/// a huge image is refused at once instead of exhausting memory.
-pub const MAX_RASTER_CELLS: usize = 1 << 29;
+/// The memory a raster read may take, bytes: set by the front end ([`set_memory_limit`], from
+/// `--max-memory`), else three quarters of what the machine has available when asked
+/// (`MemAvailable` in /proc/meminfo), else 4 GiB (the old 2^29 cells of 8 bytes) where that
+/// cannot be read. The size a file claims is checked against it before anything of that size
+/// is allocated, so a small file that claims a huge image is refused at once instead of
+/// exhausting memory, and a large DEM is refused naming what it would need.
+pub fn memory_limit() -> (u64, &'static str) {
+    let set = MEMORY_LIMIT.with(std::cell::Cell::get);
+    if set != 0 {
+        return (set, "the --max-memory limit");
+    }
+    match available_memory() {
+        Some(bytes) => (
+            bytes / 4 * 3,
+            "three quarters of the memory available (MemAvailable in /proc/meminfo; --max-memory sets another limit)",
+        ),
+        None => (DEFAULT_MEMORY_LIMIT, "the default limit (the machine's memory cannot be read)"),
+    }
+}
 
-/// Refuses a `cols` x `rows` raster with more than [`MAX_RASTER_CELLS`] cells, naming the file.
-pub(crate) fn check_raster_size(name: &dyn std::fmt::Display, cols: u64, rows: u64) -> Result<()> {
+/// The memory limit where the machine's cannot be read: 4 GiB.
+pub const DEFAULT_MEMORY_LIMIT: u64 = 4 << 30;
+
+thread_local! {
+    /// The limit set on this thread, bytes (0: none set).
+    static MEMORY_LIMIT: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Sets the memory limit of the raster reads made on the calling thread ([`memory_limit`]),
+/// in bytes (`None`: back to the machine's available memory). Per thread, so that a server or
+/// a test suite reading on several threads keeps each request's own limit.
+pub fn set_memory_limit(bytes: Option<u64>) {
+    MEMORY_LIMIT.with(|m| m.set(bytes.map_or(0, |b| b.max(1))));
+}
+
+/// The memory the kernel says is available for new allocations (MemAvailable), in bytes;
+/// `None` where /proc/meminfo cannot be read (not Linux).
+pub fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb.saturating_mul(1024))
+}
+
+/// Refuses a `cols` x `rows` raster whose read would hold more than [`memory_limit`] bytes at
+/// `bytes_per_cell` bytes a cell, naming the file, what it needs and the limit.
+pub(crate) fn check_raster_size(
+    name: &dyn std::fmt::Display,
+    cols: u64,
+    rows: u64,
+    bytes_per_cell: u64,
+) -> Result<()> {
     let cells = cols.saturating_mul(rows);
-    if cells > MAX_RASTER_CELLS as u64 {
+    let need = cells.saturating_mul(bytes_per_cell);
+    let (limit, what) = memory_limit();
+    if need > limit {
+        let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
         bail!(
-            "{name}: {cols} x {rows} = {cells} cells is more than the {MAX_RASTER_CELLS}-cell limit \
-             (2^29); crop or resample the raster (for example with gdal_translate -srcwin or -tr)"
+            "{name}: {cols} x {rows} = {cells} cells need {:.3} GiB to read ({bytes_per_cell} bytes a cell), more \
+             than {what} of {:.3} GiB; crop or resample the raster (for example with gdal_translate -srcwin or -tr), \
+             or give a larger --max-memory",
+            gib(need),
+            gib(limit)
         );
     }
     Ok(())

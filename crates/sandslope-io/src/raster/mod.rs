@@ -13,11 +13,15 @@ mod ascii;
 mod chunks;
 pub mod geotiff;
 pub mod grid;
+mod windows;
 
 use ascii::read_asc;
 pub use geotiff::{geotiff_nodata, write_two_band_geotiff, MAX_TIFF_TAG_BYTES};
 use geotiff::{read_geotiff, samples_as};
-pub use grid::{GeoRef, Raster, SizeCheck, MAX_RASTER_CELLS};
+pub use grid::{
+    available_memory, memory_limit, set_memory_limit, GeoRef, Raster, SizeCheck, DEFAULT_MEMORY_LIMIT,
+};
+pub use windows::{open_height_windows, HeightWindows, WindowsCheck};
 
 /// Reads a GeoTIFF (`.tif`, `.tiff`), an ESRI ASCII grid (`.asc`) or a PDS3 DTM (`.img` with
 /// its label attached or a `.lbl` beside it, or the `.lbl`; any file beginning with a PDS3
@@ -31,7 +35,7 @@ pub fn read_raster(path: &Path) -> Result<Raster> {
 pub fn read_raster_within(path: &Path, fits: SizeCheck) -> Result<Raster> {
     let (mut raster, vertical) = match Format::of(path)? {
         Format::GeoTiff => {
-            let (mut raster, vertical, image) = read_geotiff(path, fits)?;
+            let (mut raster, vertical, image) = read_geotiff(path, fits, 8)?;
             let n = raster.cols * raster.rows;
             raster.values =
                 samples_as(&path.display(), image, n, |v| v, |v| v.into_iter().map(f64::from).collect())?;
@@ -63,7 +67,7 @@ pub fn read_heights_within(path: &Path, fits: SizeCheck) -> Result<(Raster, Vec<
         let heights = values.iter().map(|&v| to_f32(&raster, v)).collect();
         return Ok((raster, heights));
     }
-    let (raster, vertical, image) = read_geotiff(path, fits)?;
+    let (raster, vertical, image) = read_geotiff(path, fits, 4)?;
     let raster = finish(path, raster, vertical)?;
     let height = |v: f64| to_f32(&raster, if v.is_finite() { v * vertical } else { v });
     let n = raster.cols * raster.rows;

@@ -46,10 +46,11 @@ from ._inputs import (
 from ._calibrate import calibrate
 from ._report import report
 from ._sandslope import Robot, Terrain
-from ._servo import drive, drive_defaults, infer_servo_log, read_servo_log
+from ._servo import drive, drive_defaults, infer_servo_log, read_bag, read_servo_log
 
 __all__ = [
     "REGIMES",
+    "OUTCOMES",
     "CAUSES",
     "Robot",
     "Terrain",
@@ -75,6 +76,7 @@ __all__ = [
     "infer_servo_log",
     "drive",
     "drive_defaults",
+    "read_bag",
 ]
 
 
@@ -86,6 +88,9 @@ __version__ = "0.1.0"
 
 #: Regime names; every ``regime`` array holds int8 indices into this tuple.
 REGIMES: Tuple[str, str, str, str] = tuple(_sandslope.REGIMES)  # type: ignore[assignment]
+
+#: What ``REGIMES[i]`` means on the slope in a field engineer's words (docs/model.md §6).
+OUTCOMES: Tuple[str, str, str, str] = tuple(_sandslope.OUTCOMES)  # type: ignore[assignment]
 
 #: Finer reasons for a regime; ``predict(...)["cause"]`` holds int8 indices into this tuple
 #: (the library's ``Cause::ALL``, so the two cannot drift).
@@ -329,9 +334,9 @@ def safe_slope(
 ) -> Dict[str, Any]:
     """The two slope limits (``sandslope risk --solve slope --json``), named apart:
     ``success_slope_deg``, the steepest slope with P(not success) < ``max_risk`` from level up
-    (the robot climbs: it neither sinks, slips nor stalls metastable; "how steep can we go?"),
-    and ``safe_slope_deg``, the steepest with ``p_fail`` = P(sinkage or slippage) < ``max_risk``
-    (it does not fail outright; between the two it is likely metastable). Each search scans
+    (it climbs steadily: it neither sinks, slides back nor may stall; "how steep can we go?"),
+    and ``safe_slope_deg``, the steepest that is safe, ``p_fail`` = P(sinks or slides back) <
+    ``max_risk`` (docs/model.md §9; between the two it climbs slowly and may stall). Each search scans
     every 0.5 deg, then bisects to 0.001 deg. ``limit["kind"]`` (and ``success_limit["kind"]``)
     is ``"limit"`` (the threshold crossed), ``"repose"`` (below the threshold up to the angle of
     repose, ``limit["repose_deg"]``, where the sand flows), ``"none_safe"`` or

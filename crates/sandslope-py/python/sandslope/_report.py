@@ -41,7 +41,7 @@ def report(
     and ``out/report.json``, byte for byte what ``sandslope report --out out/`` writes for the
     same inputs.
 
-    Returns exactly the keys and values of ``report.json`` (README.md, ``sandslope report``): ``figures``,
+    Returns exactly the keys and values of ``report.json`` (docs/commands.md, ``sandslope report``): ``figures``,
     ``speeds``, ``tracks``, ``calibration``, ``paper_vs_model``, ``disagreements``, ``inputs``.
     """
     track_list = None

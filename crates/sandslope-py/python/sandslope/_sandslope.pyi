@@ -11,6 +11,7 @@ _Path = Union[str, "os.PathLike[str]"]
 _F64 = npt.NDArray[np.float64]
 
 REGIMES: Tuple[str, str, str, str]
+OUTCOMES: Tuple[str, str, str, str]
 CAUSES: Tuple[str, ...]
 DEFAULT_MAX_RISK: float
 DEFAULT_MAX_ROLL_DEG: float
@@ -313,3 +314,14 @@ def drive(
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 
 def read_touchdowns(path: _Path) -> List[float]: ...
+def bag_topics(path: _Path) -> List[Tuple[str, str, str, int]]: ...
+def read_bag_poses(
+    path: _Path, topic: Optional[str] = None, frame: Optional[str] = None
+) -> Tuple[Dict[str, np.ndarray], str]: ...
+def read_bag_joints(
+    path: _Path,
+    legs: int,
+    topic: Optional[str] = None,
+    joints: Optional[List[str]] = None,
+    effort_unit: str = "n_m",
+) -> Tuple[Dict[str, np.ndarray], List[str]]: ...

@@ -174,3 +174,47 @@ def drive(
     )
     slope = float(drive_defaults()["slope_deg"] if slope_deg is None else slope_deg)
     return _frame(columns, {"slope_deg": repr(slope)}), report
+
+
+def read_bag(
+    path: Union[str, "os.PathLike[str]"],
+    topic: Optional[str] = None,
+    *,
+    frame: Optional[str] = None,
+    joints: Optional[Any] = None,
+    effort_unit: str = "n_m",
+    legs: int = 6,
+) -> Any:
+    """Reads a ROS 2 bag (a folder with ``metadata.yaml``, or an ``.mcap`` or ``.db3`` file;
+    docs/bags.md) as ``sandslope track`` and ``sandslope infer --servo-log`` read it, into a
+    pandas DataFrame (a dict of NumPy columns without pandas):
+
+    - a pose topic (``geometry_msgs/PoseStamped``, ``nav_msgs/Odometry``,
+      ``geometry_msgs/TransformStamped``, ``tf2_msgs/TFMessage`` with ``frame`` the child
+      frame): the plain motion-capture columns ``time_s, x_m, y_m, z_m``, on the regular grid
+      of frames ``track`` analyses (NaN where no position); ``df.attrs["body"]`` names it;
+    - a ``sensor_msgs/JointState`` topic: the servo log's columns (``leg``,
+      ``leg_angle_rad``, ``drive_torque_n_m``, ...), ``joints`` the joint names in leg order,
+      ``effort_unit`` ``"n_m"``, ``"a"`` or ``"ma"``, ``legs`` the robot's 2 * stance_legs;
+      ``df.attrs["notes"]`` says how the joints were mapped;
+    - no ``topic``: the bag's topics (``name, type, encoding, messages``).
+
+    Errors (a ValueError) name the file, the topic and where in the file."""
+    p = os.fspath(path)
+    if topic is None:
+        rows = _sandslope.bag_topics(p)
+        cols = {k: [r[i] for r in rows] for i, k in enumerate(("name", "type", "encoding", "messages"))}
+        return _frame(cols)
+    kinds = {name: typ for name, typ, _, _ in _sandslope.bag_topics(p)}
+    if kinds.get(topic, "").replace("/msg/", "/") == "sensor_msgs/JointState":
+        names = None if joints is None else [str(j) for j in joints]
+        columns, notes = _sandslope.read_bag_joints(p, int(legs), topic, names, str(effort_unit))
+        df = _frame(columns)
+        if hasattr(df, "attrs"):
+            df.attrs["notes"] = notes
+        return df
+    columns, body = _sandslope.read_bag_poses(p, topic, frame)
+    df = _frame(columns)
+    if hasattr(df, "attrs"):
+        df.attrs["body"] = body
+    return df

@@ -109,8 +109,8 @@ impl Figure for CurveFigure {
                 .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.filled()));
         }
         let limits = [
-            (limit_label("climbs up to (P(not success) < risk)", &self.success_limit), orange, true),
-            (limit_label("no failure up to (p_fail < risk)", &self.limit), palette::MODEL_BLUE, false),
+            (limit_label("climbs steadily up to (P(not success) < risk)", &self.success_limit), orange, true),
+            (limit_label("safe up to (p_fail = P(sinks or slides back) < risk)", &self.limit), palette::MODEL_BLUE, false),
         ];
         for (label, colour, dashed) in limits {
             let Some((value, label)) = label else { continue };

@@ -300,7 +300,9 @@ impl Figure for SlopesFigure<'_> {
                     + Circle::new((0, 0), 4, BLACK.stroke_width(2))
             });
         }
-        super::legend_box(&mut c, SeriesLabelPosition::LowerLeft, 15.0, super::LegendBox::LIGHT)?;
+        // Upper right: the speeds fall with slope, and the tumble marks lie on the zero line,
+        // which a legend in the lower left covered.
+        super::legend_box(&mut c, SeriesLabelPosition::UpperRight, 15.0, super::LegendBox::LIGHT)?;
         Ok(())
     }
 }
@@ -450,25 +452,32 @@ where
         .map_err(plot_err)?;
     // The body's path so far: its centre's trace, the part in view.
     let trace: Vec<Point> = (0..=i).map(|k| world([tr.x_m[k], tr.z_m[k]])).filter(|&p| inside(p)).collect();
-    if trace.len() >= 2 {
-        chart
-            .draw_series([PathElement::new(trace, palette::BODY_TRACE.stroke_width(2))])
-            .map_err(plot_err)?;
-    }
-    // Body: a box from the belly (h below the axle) to h above it, pitched.
+    let trace_colour = palette::BODY_TRACE;
+    chart
+        .draw_series([PathElement::new(if trace.len() >= 2 { trace } else { Vec::new() }, trace_colour.stroke_width(2))])
+        .map_err(plot_err)?
+        .label("path of the body's centre (black dot)")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], trace_colour.stroke_width(2)));
+    // Body: a box from the belly (h below the axle) to h above it, pitched, drawn above the
+    // sand surface only: at a touchdown the belly presses a few mm into the yielding sand
+    // (resistive force theory, docs/model.md §16), which drawn whole looked like the body
+    // sinking into the ground; the legs below the surface are drawn whole.
     let (sp, cp) = phi.sin_cos();
     let body = |p: [f64; 2]| world([x + cp * p[0] - sp * p[1], z + sp * p[0] + cp * p[1]]);
     let (l, h) = (g.body_length_m, g.hip_height_m);
     let corners = [[-l / 2.0, -h], [l / 2.0, -h], [l / 2.0, 0.3 * h], [-l / 2.0, 0.3 * h]];
+    let outline: Vec<Point> = corners.iter().map(|&p| body(p)).collect();
+    let (above, _) = below_line(&outline, (s, -c));
+    let grey = palette::DATA_GREY.mix(0.8);
     chart
-        .draw_series([Polygon::new(
-            corners.iter().map(|&p| body(p)).collect::<Vec<_>>(),
-            palette::DATA_GREY.mix(0.8).filled(),
-        )])
-        .map_err(plot_err)?;
+        .draw_series([Polygon::new(above, grey.filled())])
+        .map_err(plot_err)?
+        .label("body (drawn above the sand surface)")
+        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], grey.filled()));
     let legs = g.hip_x_m.len();
     let n = (legs / 2).max(1);
     let scale = 0.02; // m of arrow per N
+    legs_legend(&mut chart, n, scale)?;
     for j in 0..legs {
         let psi = tr.leg_angle_rad[j][i];
         let (sa, ca) = (phi - psi).sin_cos();
@@ -501,6 +510,37 @@ where
         }
     }
     chart.draw_series([Circle::new(world([x, z]), 4, BLACK.filled())]).map_err(plot_err)?;
+    super::legend_box(&mut chart, SeriesLabelPosition::UpperLeft, 12.0, super::LegendBox::LIGHT)?;
+    Ok(())
+}
+
+/// The animation legend's entries for the legs of each tripod and the sand's force on a leg
+/// (`scale` m of arrow per N), as empty series: the marks themselves are drawn per leg.
+fn legs_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut super::SlopeChart<'a, DB>,
+    n: usize,
+    scale: f64,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    for (tripod, name) in [(0, "tripod A legs"), (1, "tripod B legs")] {
+        let col = leg_colour(tripod, 0, n);
+        chart
+            .draw_series(std::iter::empty::<PathElement<Point>>())
+            .map_err(plot_err)?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(3)));
+    }
+    chart
+        .draw_series(std::iter::empty::<PathElement<Point>>())
+        .map_err(plot_err)?
+        .label(format!("sand's force on a leg ({:.0} mm per N)", scale * 1e3))
+        .legend(|(x, y)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (16, 0)], palette::CLOSED_FORM_RED.stroke_width(2))
+                + Circle::new((17, 0), 3, palette::CLOSED_FORM_RED.filled())
+        });
     Ok(())
 }
 
@@ -625,13 +665,46 @@ mod tests {
             }
             let shift = sim.trajectory.x_m[i] * px_per_m;
             phases.push((centres[0] + shift).rem_euclid(spacing));
-            let traced = (0..800 * 450).any(|k| is(&rgb, k % 800, k / 800, palette::BODY_TRACE));
+            // (Outside the legend in the upper left, whose swatch has the trace's colour.)
+            let legend = |k: usize| k % 800 < 320 && k / 800 < 160;
+            let traced = (0..800 * 450).any(|k| !legend(k) && is(&rgb, k % 800, k / 800, palette::BODY_TRACE));
             assert_eq!(traced, i > 0, "frame {i}: trace drawn {traced}");
         }
         assert!(sim.trajectory.x_m[174] - sim.trajectory.x_m[0] > 0.1, "the walk must move");
         for p in &phases {
             let d = (p - phases[0]).abs();
             assert!(d.min(spacing - d) < 1.5, "marks move with the camera, not the sand: {phases:?}");
+        }
+    }
+
+    /// The frame's legend names what is drawn, and the body is drawn above the sand only. On
+    /// level sand at t = 0 (the body at rest, belly on the surface), no pixel of the body's grey
+    /// lies below the surface line's row in any column (the body is the only grey mark), and
+    /// the legend's box in the upper left holds the swatch of every mark: the trace's purple,
+    /// the tripods' blue and orange and the force's red.
+    #[test]
+    fn the_legend_names_every_mark_and_the_body_stays_above_the_sand() {
+        let sim = walk(0.0, 1.5);
+        let anim = Animation { sim: &sim, slope_deg: 0.0 };
+        for i in [0usize, 30, 60, 90] {
+            let rgb = frame_rgb(&anim, i);
+            let surface = (0..450).find(|&r| is(&rgb, 20, r, palette::SAND_SURFACE)).expect("surface line");
+            // The grey blended on the sand: 0.8 grey + 0.2 sand.
+            let on_sand = |c: u8, s: u8| (0.8 * f64::from(c) + 0.2 * f64::from(s)).round() as i32;
+            let (g, sand) = (palette::DATA_GREY, palette::SAND);
+            let body_on_sand = [on_sand(g.0, sand.0), on_sand(g.1, sand.1), on_sand(g.2, sand.2)];
+            let below = (surface + 2..450).any(|r| {
+                (0..800).any(|c| {
+                    let k = 3 * (r * 800 + c);
+                    body_on_sand.iter().zip(&rgb[k..k + 3]).all(|(a, &b)| (a - i32::from(b)).abs() <= 1)
+                })
+            });
+            assert!(!below, "frame {i}: the body is drawn in the sand");
+        }
+        let rgb = frame_rgb(&anim, 0);
+        let in_legend = |c: RGBColor| (0..160).any(|r| (0..320).any(|col| is(&rgb, col, r, c)));
+        for c in [palette::BODY_TRACE, palette::TRIPOD_A, palette::TRIPOD_B, palette::CLOSED_FORM_RED] {
+            assert!(in_legend(c), "{c:?} missing from the legend");
         }
     }
 
@@ -647,15 +720,8 @@ mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let dir = tmp.path();
         for i in [30usize, 54] {
-            let path = dir.join(format!("sandslope-sim-frame{i}.png"));
-            {
-                let root = BitMapBackend::new(&path, (800, 450)).into_drawing_area();
-                root.fill(&WHITE).unwrap();
-                super::super::register_fonts();
-                draw_frame(&root, &anim, i).unwrap();
-                root.present().unwrap();
-            }
-            assert!(std::fs::metadata(&path).unwrap().len() > 1000);
+            let rgb = frame_rgb(&anim, i);
+            assert!(rgb.chunks(3).filter(|p| p != &[255, 255, 255]).count() > 800 * 450 / 10, "frame {i}");
         }
         let gif = dir.join("sandslope-sim-test.gif");
         let mut frames = 0;

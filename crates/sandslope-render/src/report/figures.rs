@@ -71,9 +71,9 @@ pub fn page_figures(report: &Report) -> Result<Vec<PageFigure>> {
         report,
         "risk",
         format!(
-            "p_fail = P(sinkage or slippage) and P(not success) (sinkage, slippage or metastable) with log-normal k_n, k_s (docs/model.md §9). Two limits at risk {r}: {}; {}. Between them the robot neither sinks nor slips back for good but is likely metastable: it stalls in its own trench.{note}",
-            limit_words("the robot climbs (P(not success) < risk)", &p.success_limit),
-            limit_words("it does not fail (p_fail < risk)", &p.safe_limit),
+            "p_fail = P(it sinks or slides back) and P(it does not climb steadily) (it sinks, slides back, or climbs slowly and may stall) with log-normal k_n, k_s (docs/model.md §9). Two limits at risk {r}: {}; {}. Between them the robot neither sinks nor slides back but likely climbs slowly and may stall (metastable): it can stall in its own trench.{note}",
+            limit_words("the robot climbs steadily (P(not climbing steadily) < risk)", &p.success_limit),
+            limit_words("it is safe (P(sinks or slides back) < risk)", &p.safe_limit),
             r = p.max_risk
         ),
         to_svg(&fig)?,

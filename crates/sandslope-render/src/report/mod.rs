@@ -58,9 +58,11 @@ padding:0 1em;color:{ink};line-height:1.45}}h1{{font-size:1.7em}}h2{{margin-top:
 table{{border-collapse:collapse;margin:1em 0;font-size:0.92em}}td,th{{border:1px solid {rule};padding:4px 8px;\
 text-align:left}}th{{background:{th}}}tr.no td{{background:{no}}}tr.yes td.v{{color:{yes}}}\
 figure{{margin:1.5em 0;display:inline-block;vertical-align:top;max-width:100%}}\
-figure svg{{max-width:100%;height:auto;border:1px solid {fig}}}figcaption{{font-size:0.9em;color:{cap};max-width:760px}}\
+figure svg{{max-width:100%;height:auto;border:1px solid {fig}}}figcaption{{font-size:0.9em;color:{cap};max-width:900px}}\
+figure{{display:block}}figure svg{{width:100%}}\
+div.scroll{{overflow-x:auto;max-width:100%}}div.scroll table{{margin:0.5em 0}}\
 .warn{{background:{warn};border-left:4px solid {bar};padding:0.5em 1em}}code{{background:{code};padding:0 3px}}\
-table.sim{{table-layout:fixed;width:100%;font-size:0.85em}}table.sim td,table.sim th{{overflow-wrap:anywhere}}\
+table.sim{{table-layout:fixed;width:100%;min-width:1000px;font-size:0.85em}}table.sim td,table.sim th{{overflow-wrap:anywhere}}\
 table.sim th:first-child{{width:7%}}table.sim th:last-child{{width:26%}}td.part summary{{color:{part}}}td.agree summary{{color:{yes}}}\
 details summary{{cursor:pointer}}details[open]{{font-size:0.92em}}",
         ink = css(palette::PAGE_INK),
@@ -107,6 +109,9 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
         h.push_str(&tracks_section(&tracks));
     }
 
+    // Every table in a box of the page's width that scrolls sideways: at 600 px the wide
+    // tables (the comparison, the simulator's) ran off the right edge of the page.
+    let mut h = h.replace("<table", "<div class=\"scroll\"><table").replace("</table>", "</table></div>");
     h.push_str("<h2 id=\"figures\">Figures</h2>\n");
     for f in figures {
         let anchors: String =

@@ -341,7 +341,7 @@ pub fn simulator(report: &Report) -> String {
         "<p>Speeds in cm/s. Each row's last cell says whether the two agree or, in a word, where they part; \
          open it for the why and the step's parts (t1, slip and step, simulated / closed form).</p>\n\
          <table class=\"sim\"><tr><th>slope (°)</th><th>observed</th><th>closed form</th><th>simulated</th>\
-         <th>pitch free</th><th>regime: closed form / simulated</th><th>pitch free: largest pitch (°)</th><th>verdict</th></tr>",
+         <th>pitch free</th><th>regime: closed form / simulated (hover: the outcome)</th><th>pitch free: largest pitch (°)</th><th>verdict</th></tr>",
     );
     for r in &report.simulator {
         let free = if r.pitch_over_s.is_some() {
@@ -350,20 +350,32 @@ pub fn simulator(report: &Report) -> String {
             format!("{:.1}", r.pitch_free_m_s * 100.0)
         };
         h.push_str(&format!(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{} / {}</td><td>{:.0}</td>{}</tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td><abbr title=\"{} / {}\">{} / {}</abbr></td><td>{}</td>{}</tr>",
             r.slope_deg,
             plus_minus(r.observed_m_s.map(|v| v * 100.0), r.observed_sd_m_s.map(|v| v * 100.0), 1.0, 1),
             r.closed_form_m_s.map_or("- (ruled out)".into(), |v| format!("{:.1}", v * 100.0)),
             r.simulated_m_s * 100.0,
             free,
+            r.closed_form_regime.outcome(),
+            r.simulated_regime.outcome(),
             r.closed_form_regime.name(),
             r.simulated_regime.name(),
-            r.max_pitch_deg,
+            largest_pitch(r),
             verdict_cell(r),
         ));
     }
     h.push_str("</table>\n");
     h
+}
+
+/// The pitch-free walk's largest pitch as the table shows it: in degrees while the body stays
+/// upright, else "tumbled" with when (the summed rotation of a body rolling over, thousands of
+/// degrees, is no angle a reader can picture).
+fn largest_pitch(r: &sandslope::report::SimulatorRecord) -> String {
+    match r.pitch_over_s {
+        Some(t) => format!("tumbled (past 90° at {t:.1} s)"),
+        None => format!("{:.0}", r.max_pitch_deg),
+    }
 }
 
 /// The simulator table's last cell: "agree", or where the two part in a few words (the text

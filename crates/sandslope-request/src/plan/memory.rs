@@ -34,6 +34,12 @@ fn memory_limit(args: &PlanRequest) -> Result<Option<(f64, &'static str)>> {
 
 const GIB: f64 = (1u64 << 30) as f64;
 
+/// Rows the corridor search's coarse pass reads at once (at most: a band of strips or tiles).
+const STREAM_BAND_ROWS: u64 = 512;
+
+/// The cache of decoded chunks of a GeoTIFF read window by window, at most (`raster/windows.rs`).
+const STREAM_CACHE_BYTES: u64 = 160 << 20;
+
 /// Decides how a `cols` x `rows` DEM is searched (`--search`; `full_only` when an output needs
 /// the full-resolution planner) and refuses it when that would need more memory than
 /// `--max-memory` (default: what the machine has available), naming the limit and the bytes a
@@ -44,6 +50,7 @@ pub(super) fn choose_search(
     rows: usize,
     objectives: &[Objective],
     full_only: bool,
+    in_memory: bool,
 ) -> anyhow::Result<Search> {
     let mut objectives = objectives.to_vec();
     objectives.push(Objective::Distance);
@@ -77,23 +84,30 @@ pub(super) fn choose_search(
         }
         return Ok(Search::Full);
     }
-    // The grid at full resolution and the coarse planner with its searches; what is left is
-    // shared by the corridors searched at once.
+    // The coarse planner with its searches, the coarse pass's band of rows (its window and
+    // the decoded chunks it spans, `f32`), the cache of decoded chunks, and the heights where a
+    // file is read whole (an ASCII grid); what is left is shared by the corridors searched at
+    // once. The full-resolution map is never held.
     let f = args.coarse_factor.max(1) as u64;
     let coarse = cols.div_ceil(f as usize) as u64 * rows.div_ceil(f as usize) as u64;
-    let need = cells * sandslope::plan::CORRIDOR_MAP_BYTES_PER_CELL
-        + coarse * sandslope::plan::bytes_per_cell(searches);
+    let held = if in_memory { cells * 4 } else { 0 };
+    let cache = if in_memory { 0 } else { STREAM_CACHE_BYTES };
+    let stream = cols as u64 * STREAM_BAND_ROWS * 4 * 2 + cache;
+    let need = held + stream + coarse * (sandslope::plan::bytes_per_cell(searches) + 4);
     let Some((limit, what)) = limit else { return Ok(Search::Corridor(None)) };
     if need as f64 > limit {
         bail!(
-            "{}: planning on {} x {} cells in a corridor needs about {:.3} GiB before the corridors ({} bytes a \
-             cell for the heights, and the coarse planner), more than {what} of {:.3} GiB; crop or resample the \
-             DEM (for example with gdal_translate -srcwin or -tr)",
+            "{}: planning on {} x {} cells in a corridor needs about {:.3} GiB before the corridors (the coarse \
+             planner of {coarse} cells at {} bytes a cell, {:.3} GiB of rows read at once{}), more than {what} of \
+             {:.3} GiB; coarsen more (--coarse-factor), or crop or resample the DEM (for example with \
+             gdal_translate -srcwin or -tr)",
             args.dem.display(),
             cols,
             rows,
             need as f64 / GIB,
-            sandslope::plan::CORRIDOR_MAP_BYTES_PER_CELL,
+            sandslope::plan::bytes_per_cell(searches) + 4,
+            stream as f64 / GIB,
+            if in_memory { format!(", and the heights read whole, {:.3} GiB", held as f64 / GIB) } else { String::new() },
             limit / GIB
         );
     }

@@ -9,13 +9,13 @@ use anyhow::{anyhow, bail, Context};
 use serde::{Deserialize, Serialize};
 
 use sandslope::plan::{
-    plan, plan_corridor, Cell, CorridorPlan, CorridorSettings, Descent, ElevationGrid, Objective, PlanResult,
-    PlanSettings, Planner,
+    plan, plan_corridor_from, Cell, CorridorPlan, CorridorSettings, Descent, ElevationGrid, Objective,
+    PlanResult, PlanSettings, Planner,
 };
 use sandslope::risk::{DefaultsUsed, UncertainTerrain};
 use sandslope::Robot;
 use sandslope_io::presets::DEFAULT_TERRAIN;
-use sandslope_io::raster::{read_heights_within, read_raster, Raster};
+use sandslope_io::raster::{open_height_windows, read_heights_within, read_raster, HeightWindows, Raster};
 
 use crate::error::{RequestError, Result, Words};
 use crate::grammar;
@@ -285,26 +285,28 @@ impl PlanRequest {
     ) -> Result<Computed> {
         let robot = self.robot.load()?;
         let settings = self.settings()?;
-        let chosen = std::cell::Cell::new(Search::Full);
         let full_only = full_only || risk_map || self.classes.is_some();
-        let (dem, heights) = read_heights_within(&self.dem, &|cols, rows| {
-            chosen.set(choose_search(self, cols, rows, &self.objectives, full_only)?);
+        let dem_err = |e| RequestError::from_error(Some("dem"), e);
+        // The readers check what they allocate against the same limit.
+        sandslope_io::raster::set_memory_limit(
+            self.max_memory.filter(|gib| *gib > 0.0).map(|gib| (gib * (1u64 << 30) as f64) as u64),
+        );
+        // The header only (an ASCII grid is read whole): the search is chosen, and the DEM's
+        // size checked against the memory limit, before any sample is read.
+        let chosen = std::cell::Cell::new(Search::Full);
+        let (head, windows) = open_height_windows(&self.dem, &|cols, rows, whole| {
+            chosen.set(choose_search(self, cols, rows, &self.objectives, full_only, whole)?);
             Ok(())
         })
-        .map_err(|e| RequestError::from_error(Some("dem"), e))?;
-        for n in &dem.notes {
-            note(n);
-        }
+        .map_err(dem_err)?;
+        let chosen = chosen.get();
         let anyhow_err = |e: anyhow::Error| RequestError::from_error(None, e);
-        // The planner works in metres: the cell's ground size, not its size in map units
-        // (degrees for a geographic DEM, feet for some projected ones). Heights are f32, nodata NaN.
-        let grid = ElevationGrid::new(dem.cols, dem.rows, dem.cell_m.0, dem.cell_m.1, heights, None);
-        let grid = self.with_rows_of(&dem, grid).map_err(anyhow_err)?;
-        let start = endpoint(&dem, &grid, "start", &self.start, &self.start_px)?;
-        let goal = endpoint(&dem, &grid, "goal", &self.goal, &self.goal_px)?;
-        let (classes, terrains) = self.classes_of(&dem, note).map_err(anyhow_err)?;
-        let request =
-            sandslope::plan::PlanRequest { start, goal, objectives: self.objectives.clone(), risk_map };
+        let request = |start, goal| sandslope::plan::PlanRequest {
+            start,
+            goal,
+            objectives: self.objectives.clone(),
+            risk_map,
+        };
         let progress = |obj: Objective, n: u64, total: u64| {
             progress(obj, n, total);
             std::ops::ControlFlow::Continue(())
@@ -312,26 +314,56 @@ impl PlanRequest {
         let in_dem = |e: &dyn std::fmt::Display| {
             RequestError::from_error(None, anyhow!("{}: {e}", self.dem.display()))
         };
-        Ok(match chosen.get() {
-            Search::Full => {
-                let result = plan(grid, classes, &terrains, &robot, settings, &request, &progress)
-                    .map_err(|e| in_dem(&e))?;
-                Computed::Full(Box::new(Planned { dem, result }))
+        let Search::Corridor(max_bytes) = chosen else {
+            let (dem, heights) = match windows.into_heights() {
+                Some(heights) => (head, heights),
+                None => read_heights_within(&self.dem, &|_, _| Ok(())).map_err(dem_err)?,
+            };
+            for n in &dem.notes {
+                note(n);
             }
-            Search::Corridor(max_bytes) => {
-                let (None, [terrain]) = (&classes, terrains.as_slice()) else {
-                    return Err(RequestError::invalid(
-                        "classes",
-                        "--classes needs the full-resolution search (--search full)",
-                    ));
-                };
-                let corridor = CorridorSettings::new(self.coarse_factor, self.corridor_width, max_bytes)
-                    .map_err(|e| RequestError::from_error(None, anyhow!("{e}")))?;
-                let plan = plan_corridor(&grid, terrain, &robot, settings, &request, &corridor, &progress)
-                    .map_err(|e| in_dem(&e))?;
-                Computed::Corridor(Box::new(CorridorPlanned { dem, grid, plan, settings: corridor }))
-            }
-        })
+            // The planner works in metres: the cell's ground size, not its size in map units
+            // (degrees for a geographic DEM, feet for some projected ones). Heights are f32,
+            // nodata NaN.
+            let grid = ElevationGrid::new(dem.cols, dem.rows, dem.cell_m.0, dem.cell_m.1, heights, None);
+            let grid = self.with_rows_of(&dem, grid).map_err(anyhow_err)?;
+            let valid = |c: Cell| grid.is_valid(c.row * grid.cols() + c.col);
+            let start = endpoint(&dem, &valid, "start", &self.start, &self.start_px)?;
+            let goal = endpoint(&dem, &valid, "goal", &self.goal, &self.goal_px)?;
+            let (classes, terrains) = self.classes_of(&dem, note).map_err(anyhow_err)?;
+            let result = plan(grid, classes, &terrains, &robot, settings, &request(start, goal), &progress)
+                .map_err(|e| in_dem(&e))?;
+            return Ok(Computed::Full(Box::new(Planned { dem, result })));
+        };
+        let dem = head;
+        for n in &dem.notes {
+            note(n);
+        }
+        // Only the endpoints' cells are read here; the corridor search reads its windows.
+        let valid =
+            |c: Cell| windows.read(c.row..c.row + 1, c.col..c.col + 1).is_ok_and(|h| h[0].is_finite());
+        let start = endpoint(&dem, &valid, "start", &self.start, &self.start_px)?;
+        let goal = endpoint(&dem, &valid, "goal", &self.goal, &self.goal_px)?;
+        let (classes, terrains) = self.classes_of(&dem, note).map_err(anyhow_err)?;
+        let (None, [terrain]) = (&classes, terrains.as_slice()) else {
+            return Err(RequestError::invalid(
+                "classes",
+                "--classes needs the full-resolution search (--search full)",
+            ));
+        };
+        let corridor = CorridorSettings::new(self.coarse_factor, self.corridor_width, max_bytes)
+            .map_err(|e| RequestError::from_error(None, anyhow!("{e}")))?;
+        let plan = plan_corridor_from(
+            &windows,
+            terrain,
+            &robot,
+            settings,
+            &request(start, goal),
+            &corridor,
+            &progress,
+        )
+        .map_err(|e| in_dem(&e))?;
+        Ok(Computed::Corridor(Box::new(CorridorPlanned { dem, heights: windows, plan, settings: corridor })))
     }
 
     /// `grid` with the east-west ground size of each of `dem`'s rows where they differ (a
@@ -431,18 +463,18 @@ fn parse_pair(flag: &str, s: &str) -> anyhow::Result<(f64, f64)> {
 /// map and not on nodata; errors name the field.
 fn endpoint(
     raster: &Raster,
-    grid: &ElevationGrid,
+    valid: &dyn Fn(Cell) -> bool,
     which: &str,
     map: &Option<String>,
     px: &Option<String>,
 ) -> Result<Cell> {
     let field = if px.is_some() { format!("{which}-px") } else { which.to_string() };
-    endpoint_cell(raster, grid, which, map, px).map_err(|e| RequestError::from_error(Some(&field), e))
+    endpoint_cell(raster, valid, which, map, px).map_err(|e| RequestError::from_error(Some(&field), e))
 }
 
 fn endpoint_cell(
     raster: &Raster,
-    grid: &ElevationGrid,
+    valid: &dyn Fn(Cell) -> bool,
     which: &str,
     map: &Option<String>,
     px: &Option<String>,
@@ -469,6 +501,13 @@ fn endpoint_cell(
         (c, r, format!("--{which}-px {s}"), false)
     } else if let Some(s) = map {
         let (x, y) = parse_pair(&format!("--{which}"), s)?;
+        // A longitude is the same place 360 degrees on: -10 on a map of 0 to 360 east (a MOLA
+        // MEGDR's) is 350.
+        let x = if raster.crs.is_geographic() && !(g.west..=east).contains(&x) {
+            [x + 360.0, x - 360.0].into_iter().find(|v| (g.west..=east).contains(v)).unwrap_or(x)
+        } else {
+            x
+        };
         let (c, r) = g.cell_of(x, y);
         // On the map's outline (e.g. its corner 0,0): inside the closed extent, but not in any cell.
         let on_edge = (g.west..=east).contains(&x) && (south..=g.north).contains(&y);
@@ -488,7 +527,7 @@ fn endpoint_cell(
         bail!("{what} is outside the map: {extent}");
     }
     let cell = Cell { col: c as usize, row: r as usize };
-    if !grid.is_valid(cell.row * cols + cell.col) {
+    if !valid(cell) {
         bail!("{what} lies on a nodata cell (column {}, row {}) of the DEM", cell.col, cell.row);
     }
     Ok(cell)
@@ -542,8 +581,8 @@ pub struct Planned {
 pub struct CorridorPlanned {
     /// The elevation model's georeference (its heights are in `grid`).
     pub dem: Raster,
-    /// The full-resolution grid.
-    pub grid: ElevationGrid,
+    /// The map's heights, read window by window (the corridor search never holds them whole).
+    pub heights: HeightWindows,
     /// The library's result.
     pub plan: CorridorPlan,
     /// How the corridors were made.

@@ -81,10 +81,19 @@ async function get(path, params) {
 // line (it is the user's to fix), anything else is a page error.
 const tickets = {};
 const statuses = {};
+// One bad input refuses every request that carries it (predict, sweep and phase for ?mass=1200):
+// the banner shows each distinct message once, one per line. #tabs' data-rows counts the rows the
+// tab buttons take (read by the browser tests: 1, however long the message).
 function setStatus(key, text) {
   statuses[key] = text;
-  $("status").textContent = Object.values(statuses).filter(Boolean).join(" · ");
+  $("status").textContent = [...new Set(Object.values(statuses).filter(Boolean))].join("\n");
+  countTabRows();
 }
+function countTabRows() {
+  const tops = [...document.querySelectorAll("#tabs button")].filter((b) => !b.hidden).map((b) => b.offsetTop);
+  $("tabs").dataset.rows = String(new Set(tops).size);
+}
+window.addEventListener("resize", countTabRows);
 async function fresh(key, fetcher, draw) {
   const ticket = (tickets[key] = (tickets[key] || 0) + 1);
   try {
@@ -94,7 +103,7 @@ async function fresh(key, fetcher, draw) {
     draw(data);
   } catch (e) {
     if (ticket !== tickets[key]) return;
-    if (e instanceof RequestError) setStatus(key, `${key}: ${e.message}`);
+    if (e instanceof RequestError) setStatus(key, e.message);
     else logError(`${key}: ${e.stack || e}`);
   } finally {
     logResources();
@@ -110,6 +119,7 @@ function soon(key, fn, ms = 80) {
 const state = {
   served: null,
   causes: {},
+  outcomes: {},
   defaults: {},
   level: null, // the served terrain at 0 deg: fixes the phase diagram's axes
   sweep: null,
@@ -206,7 +216,9 @@ function fmt(v, digits) {
 // ---- Explore ----
 function showPrediction(e) {
   const badge = $("regime");
-  badge.textContent = e.regime;
+  // What the robot does, the paper's regime name beside it (docs/model.md §6, "Outcomes").
+  badge.textContent = `${state.outcomes[e.regime] || e.regime} (${e.regime})`;
+  badge.dataset.regime = e.regime;
   badge.style.background = COLOURS[e.regime];
   const speed = $("speed");
   if (e.speed_m_s !== null) speed.textContent = fmt(e.speed_m_s * 100, 2);
@@ -364,8 +376,8 @@ function drawRisk({ curve, limit }) {
   // In the risk curve's colours: the success limit in P(not success)'s orange, the safe-slope
   // limit in the model's blue, the threshold in the reference lines' grey.
   const marks = [
-    [success, "success-slope", SIM_COLOURS["not-success"], "climbs to"],
-    [safe, "safe-slope", SIM_COLOURS.model, limit.limit.kind === "repose" ? "repose" : "no failure to"],
+    [success, "success-slope", SIM_COLOURS["not-success"], "climbs steadily to"],
+    [safe, "safe-slope", SIM_COLOURS.model, limit.limit.kind === "repose" ? "repose" : "safe to"],
   ];
   let row = 0;
   for (const [deg, id, colour, label] of marks) {
@@ -379,10 +391,11 @@ function drawRisk({ curve, limit }) {
     if (l.kind === "none_safe") return `on no slope (${p} = ${l.p_fail.toFixed(4)} already on level ground)`;
     return `at every slope searched, up to ${l.up_to} deg (${p} < ${maxRisk})`;
   };
-  let summary = `climbs (success limit) ${describe(limit.success_limit, "P(not success)")}; ` +
-    `does not fail (safe-slope limit) ${describe(limit.limit, "p_fail")}`;
+  // "Safe" as docs/model.md §9 defines it, the words of docs/model.md §6.
+  let summary = `climbs steadily (success limit) ${describe(limit.success_limit, "P(not climbing steadily)")}; ` +
+    `safe (safe-slope limit) ${describe(limit.limit, "P(sinks or slides back)")}`;
   if (success !== null && safe !== null && safe - success >= 0.05) {
-    summary += `; between ${success.toFixed(1)} and ${safe.toFixed(1)} deg it is likely metastable (stalls in its own trench)`;
+    summary += `; between ${success.toFixed(1)} and ${safe.toFixed(1)} deg it likely climbs slowly and may stall (metastable: it can stall in its own trench)`;
   }
   const first = curve[0];
   summary += `; CVs used: k_n ${first.cv_n.toFixed(3)} (${first.cv_n_source}), k_s ${first.cv_s.toFixed(3)} (${first.cv_s_source}) at level`;

@@ -460,6 +460,7 @@ async function start() {
   const served = await get("/data/served");
   state.served = served;
   state.causes = Object.fromEntries(served.causes);
+  state.outcomes = Object.fromEntries(served.outcomes);
   for (const { field, key } of served.robot_keys) {
     if (!$(field)) {
       logError(`the page has no control for the robot quantity ${field} (${key})`);

@@ -104,6 +104,21 @@ pub fn orient_by_height(travel: Upslope, up: Upslope, slope: Slope) -> Option<Up
     Some(if rise > 0.0 { travel } else { Upslope { unit: [-x, -y, -z] } })
 }
 
+/// The direction of travel `travel` oriented upslope by its own rise along `up` (the capture
+/// frame's vertical axis), for recordings whose slope is not given: a line of travel on a slope
+/// rises along the vertical in the upslope sense, whichever way the robot went (progress or a
+/// slide down). `None` (orient otherwise) when the travel is inclined by less than
+/// [`MIN_ORIENTING_SLOPE_DEG`] to the horizontal: level ground has no upslope, and a travel
+/// across the slope or a wrong vertical does not rise.
+pub fn orient_by_rise(travel: Upslope, up: Upslope) -> Option<Upslope> {
+    let rise = travel.along(up.vector());
+    if rise.abs() < MIN_ORIENTING_SLOPE_DEG.to_radians().sin() {
+        return None;
+    }
+    let [x, y, z] = travel.vector();
+    Some(if rise > 0.0 { travel } else { Upslope { unit: [-x, -y, -z] } })
+}
+
 /// Projects every position on `upslope`; missing frames (any non-finite coordinate) give NaN.
 pub fn project(positions: &[[f64; 3]], upslope: Upslope) -> Vec<f64> {
     positions
@@ -133,6 +148,24 @@ mod tests {
         assert_eq!(orient_by_height(across, up, deg(20.0)), None);
         // Y-up taken for this Z-up frame: the travel does not rise along y.
         assert_eq!(orient_by_height(rising, Upslope::new([0.0, 1.0, 0.0]).unwrap(), deg(20.0)), None);
+    }
+
+    /// Without a slope, the travel's own rise orients it: a line inclined 20 deg (rise
+    /// sin 20 = 0.342 per unit length) points upslope whichever way it was estimated; a line
+    /// inclined 0.5 deg (below the 1 deg limit) or running level is left to the net motion.
+    #[test]
+    fn orient_by_rise_points_upslope_without_a_slope() {
+        let (s, c) = 20f64.to_radians().sin_cos();
+        let up = Upslope::new([0.0, 0.0, 1.0]).unwrap();
+        let rising = Upslope::new([c, 0.0, s]).unwrap();
+        let falling = Upslope::new([-c, 0.0, -s]).unwrap();
+        assert_eq!(orient_by_rise(rising, up), Some(rising));
+        assert_eq!(orient_by_rise(falling, up).unwrap().vector(), rising.vector());
+        let (s5, c5) = 0.5f64.to_radians().sin_cos();
+        assert_eq!(orient_by_rise(Upslope::new([-c5, 0.0, -s5]).unwrap(), up), None);
+        let (s2, c2) = 2f64.to_radians().sin_cos();
+        assert!(orient_by_rise(Upslope::new([-c2, 0.0, -s2]).unwrap(), up).unwrap().vector()[0] > 0.99);
+        assert_eq!(orient_by_rise(Upslope::new([0.0, 1.0, 0.0]).unwrap(), up), None);
     }
 
     #[test]

@@ -80,9 +80,10 @@ impl GaitOptions {
         GaitOptions { upslope: Some(upslope), ..self }
     }
 
-    /// The capture frame's vertical (up) axis. With it and a known slope, [`track()`] orients
-    /// the estimated direction of travel so that upslope rises ([`direction::orient_by_height`]),
-    /// never by the net motion, so a walk that slides down reports a negative speed.
+    /// The capture frame's vertical (up) axis. With it, [`track()`] orients the estimated
+    /// direction of travel so that upslope rises: by the known slope
+    /// ([`direction::orient_by_height`]) or, without one, by the travel's own rise
+    /// ([`direction::orient_by_rise`]); never by the net motion on a slope.
     pub fn with_vertical(self, up: Upslope) -> GaitOptions {
         GaitOptions { vertical: Some(up), ..self }
     }

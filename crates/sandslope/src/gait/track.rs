@@ -99,14 +99,18 @@ pub fn track(
     options: &GaitOptions,
     slope: Option<Slope>,
 ) -> Result<TrackResult, GaitError> {
-    // Upslope from the frame's vertical axis and the slope when both are known: a walk that
-    // slides down then reports a negative speed, where orienting the direction of travel by
-    // the net motion (analyse's fallback) would call the slide progress.
-    let by_height = match (options.upslope(), options.vertical(), slope) {
-        (None, Some(up), Some(s)) => {
+    // Upslope from the frame's vertical axis (with the slope when known, otherwise from the
+    // travel's own rise along it): a walk that slides down then reports a negative speed, where
+    // orienting the direction of travel by the net motion (analyse's fallback, kept only for
+    // level ground and travel across the slope, which have no upslope) would call the slide
+    // progress.
+    let by_height = match (options.upslope(), options.vertical()) {
+        (None, Some(up)) => {
             let all: Vec<&[[f64; 3]]> = recordings.iter().map(|r| r.positions).collect();
-            super::direction::principal_direction(&all)
-                .and_then(|travel| super::direction::orient_by_height(travel, up, s))
+            super::direction::principal_direction(&all).and_then(|travel| match slope {
+                Some(s) => super::direction::orient_by_height(travel, up, s),
+                None => super::direction::orient_by_rise(travel, up),
+            })
         }
         _ => None,
     };

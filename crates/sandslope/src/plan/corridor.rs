@@ -24,6 +24,7 @@ use super::grid::{Cell, ElevationGrid};
 use super::planner::{Layout, Planner};
 use super::result::{extrapolation_of, Extrapolation, PlanRequest};
 use super::route::Route;
+use super::source::{coarsened_from, HeightSource};
 use super::table::PitchTableCache;
 use super::{NoRoute, Objective, PlanError, PlanSettings, PLANNER_BYTES_PER_CELL, SEARCH_BYTES_PER_CELL};
 use crate::risk::UncertainTerrain;
@@ -89,6 +90,17 @@ pub struct CorridorStats {
     /// Whether the corridor was the whole map (the route is then the full optimum, and no
     /// route means none exists).
     pub whole: bool,
+    /// The route's cost (the objective's units), if one was found.
+    pub cost: Option<f64>,
+    /// A lower bound on the cost of any route between the endpoints over the whole map: the
+    /// straight line between them, east-west at the map's narrowest row width, times the
+    /// cheapest cost per metre of the pitch tables (the A* heuristic at the start). The full
+    /// optimum lies between it and `cost`.
+    pub lower_bound: f64,
+    /// `cost / lower_bound - 1`: the most the route can cost above the full optimum, as a
+    /// fraction (a bound, often loose where routes must switch back; `null` without a route
+    /// or a zero bound). 0 when the corridor was the whole map.
+    pub gap_at_most: Option<f64>,
 }
 
 /// What [`plan_corridor`] computed.
@@ -122,15 +134,39 @@ pub fn plan_corridor(
     corridor: &CorridorSettings,
     progress: &(dyn Fn(Objective, u64, u64) -> ControlFlow<()> + Sync),
 ) -> Result<CorridorPlan, PlanError> {
+    plan_corridor_from(grid, terrain, robot, settings, request, corridor, progress)
+}
+
+/// [`plan_corridor`] on a map read window by window ([`HeightSource`], issue 56): the coarse
+/// grid from one pass over bands of rows ([`coarsened_from`]), each corridor from the windows
+/// its rows cover; the whole map is never held. On the same heights it plans exactly what
+/// [`plan_corridor`] plans on a grid holding them (the same coarse grid, heights and Horn
+/// gradients, bit for bit).
+pub fn plan_corridor_from(
+    source: &dyn HeightSource,
+    terrain: &UncertainTerrain,
+    robot: &Robot,
+    settings: PlanSettings,
+    request: &PlanRequest,
+    corridor: &CorridorSettings,
+    progress: &(dyn Fn(Objective, u64, u64) -> ControlFlow<()> + Sync),
+) -> Result<CorridorPlan, PlanError> {
+    let (cols, rows) = (source.cols(), source.rows());
     for (which, cell) in [("start", request.start), ("goal", request.goal)] {
-        if grid.index(cell).is_none() {
-            return Err(PlanError::Outside { which, cell, cols: grid.cols(), rows: grid.rows() });
+        if cell.col >= cols || cell.row >= rows {
+            return Err(PlanError::Outside { which, cell, cols, rows });
         }
     }
     let terrains = std::slice::from_ref(terrain);
     let cache = PitchTableCache::new();
-    let coarse =
-        Planner::with_cache(grid.coarsened(corridor.factor)?, None, terrains, robot, settings, &cache)?;
+    let coarse = Planner::with_cache(
+        coarsened_from(source, corridor.factor)?,
+        None,
+        terrains,
+        robot,
+        settings,
+        &cache,
+    )?;
     let mut objectives = request.objectives.clone();
     objectives.push(Objective::Distance);
     objectives.sort();
@@ -147,7 +183,7 @@ pub fn plan_corridor(
             let mut wider = *corridor;
             let mut found = None;
             loop {
-                let (layout, spans) = match corridor_layout(grid, &cells, request, &wider) {
+                let (layout, spans) = match corridor_layout((cols, rows), &cells, request, &wider) {
                     Ok(corridor) => corridor,
                     Err(e) => match found {
                         Some(found) => break Ok(found),
@@ -155,18 +191,28 @@ pub fn plan_corridor(
                     },
                 };
                 let corridor_cells = spans.iter().map(|s| s.1 - s.0).sum();
-                let whole = corridor_cells == grid.len();
-                let p = Planner::corridor(grid, layout, &spans, terrains, robot, settings, &cache)?;
+                let whole = corridor_cells == cols * rows;
+                let p = Planner::corridor_from(source, layout, &spans, terrains, robot, settings, &cache)?;
                 let passable = p.passable_cells() as u64;
                 let r = p.route(obj, request.start, request.goal, &|n| progress(obj, n, passable))?;
                 // Only the final position of the bar; a stop asked now changes nothing.
                 let _ = progress(obj, passable, passable);
+                let cost = r.as_ref().ok().map(|route| p.cost_of_route(obj, &route.cells));
+                let lower_bound = straight_line_bound(&p, obj, request, source);
+                let gap_at_most = match cost {
+                    Some(_) if whole => Some(0.0),
+                    Some(c) if lower_bound > 0.0 => Some((c / lower_bound - 1.0).max(0.0)),
+                    _ => None,
+                };
                 let stats = CorridorStats {
                     objective: obj,
                     coarse_cost,
                     half_width: wider.half_width,
                     corridor_cells,
                     whole,
+                    cost,
+                    lower_bound,
+                    gap_at_most,
                 };
                 let done = r.is_ok() || whole;
                 if done {
@@ -185,6 +231,26 @@ pub fn plan_corridor(
         coarse_size: (coarse.grid().cols(), coarse.grid().rows()),
         extrapolation,
     })
+}
+
+/// A lower bound on the cost of every route of `objective` from the request's start to its
+/// goal over the whole map `source`: the straight line between the cells' centres, east-west
+/// at the narrowest row's width (every row is at least that wide), times the planner `p`'s
+/// cheapest cost per metre (its A* heuristic, which never overestimates). The tables of `p`
+/// reach the corridor's steepest gradient; every cost per metre of the model grows with the
+/// pitch (slower, longer, riskier), so the cheapest is at the level and the same for the
+/// whole map's tables.
+fn straight_line_bound(
+    p: &Planner,
+    objective: Objective,
+    request: &PlanRequest,
+    source: &dyn HeightSource,
+) -> f64 {
+    let min_width =
+        source.row_widths().map_or(source.cell_x(), |w| w.iter().copied().fold(f64::INFINITY, f64::min));
+    let dc = request.start.col.abs_diff(request.goal.col) as f64;
+    let dr = request.start.row.abs_diff(request.goal.row) as f64;
+    p.min_cost[objective as usize] * (dc * min_width).hypot(dr * source.cell_y())
 }
 
 /// The coarse route of `objective` between the coarse cells of the request's start and goal;
@@ -223,12 +289,74 @@ fn coarse_route(
     Ok(coarse.route(objective, *s, *t, progress)?.ok())
 }
 
+/// Layout rows a corridor planner reads as one window (with a margin of one cell).
+const CORRIDOR_BAND_ROWS: usize = 64;
+
 impl Planner {
     /// The planner on the corridor `spans` (map columns `[start, end)` of each of the layout's
-    /// rows) of the map `map`: its heights, and the map's own Horn gradients, so that every edge
-    /// inside the corridor is the full planner's edge; the layout's cells outside the spans
-    /// are nodata.
-    fn corridor(
+    /// rows) of the map `source`: its heights, and the map's own Horn gradients, so that every
+    /// edge inside the corridor is the full planner's edge; the layout's cells outside the
+    /// spans are nodata. The map is read in windows of [`CORRIDOR_BAND_ROWS`] rows with a
+    /// margin of one cell, and each window's Horn gradients are [`ElevationGrid::horn_at`]'s on
+    /// it: the whole map's, bit for bit (the margin holds every cell a window's interior needs,
+    /// and a window's edge is the map's border wherever it has no margin).
+    pub(super) fn corridor_from(
+        source: &dyn HeightSource,
+        layout: Layout,
+        spans: &[(usize, usize)],
+        terrains: &[UncertainTerrain],
+        robot: &Robot,
+        settings: PlanSettings,
+        cache: &PitchTableCache,
+    ) -> Result<Planner, PlanError> {
+        let (width, rows) = (layout.width, layout.col0.len());
+        let (map_cols, map_rows) = (source.cols(), source.rows());
+        let mut z = vec![f32::NAN; width * rows];
+        let mut grad = vec![[f32::NAN; 2]; width * rows];
+        let band = CORRIDOR_BAND_ROWS * width;
+        z.par_chunks_mut(band).zip(grad.par_chunks_mut(band)).enumerate().try_for_each(
+            |(b, (z, grad))| -> Result<(), PlanError> {
+                let first = b * CORRIDOR_BAND_ROWS;
+                let n = z.len() / width.max(1);
+                let band_spans = &spans[first..first + n];
+                let (lo, hi) = band_spans
+                    .iter()
+                    .filter(|s| s.1 > s.0)
+                    .fold((usize::MAX, 0), |(lo, hi), s| (lo.min(s.0), hi.max(s.1)));
+                if lo >= hi {
+                    return Ok(());
+                }
+                let row_a = layout.row0 + first;
+                let wr = super::source::with_margin(row_a, row_a + n, map_rows);
+                let wc = super::source::with_margin(lo, hi, map_cols);
+                let local = super::source::window_grid(source, wr.clone(), wc.clone())?;
+                for (k, &(start, end)) in band_spans.iter().enumerate() {
+                    let (row, c0) = (row_a + k, layout.col0[first + k] as usize);
+                    let lr = row - wr.start;
+                    for c in start..end {
+                        let j = k * width + c - c0;
+                        let lc = c - wc.start;
+                        let li = lr * wc.len() + lc;
+                        if local.is_valid(li) {
+                            z[j] = local.heights()[li];
+                        }
+                        grad[j] = local.horn_at(lc, lr);
+                    }
+                }
+                Ok(())
+            },
+        )?;
+        let mut grid = ElevationGrid::new(width, rows, source.cell_x(), source.cell_y(), z, None)?;
+        if let Some(w) = source.row_widths() {
+            grid = grid.with_row_widths(w[layout.row0..layout.row0 + rows].to_vec())?;
+        }
+        Planner::build(grid, Some((layout, grad)), None, terrains, robot, settings, Some(cache))
+    }
+
+    /// The corridor planner from a map held whole, cell by cell: the reference the windowed
+    /// [`Planner::corridor_from`] is tested against.
+    #[cfg(test)]
+    pub(super) fn corridor(
         map: &ElevationGrid,
         layout: Layout,
         spans: &[(usize, usize)],
@@ -261,6 +389,12 @@ impl Planner {
         Planner::build(grid, Some((layout, grad)), None, terrains, robot, settings, Some(cache))
     }
 
+    /// [`Planner::cost_of_route`], for the tests of the windowed search.
+    #[cfg(test)]
+    pub(super) fn cost_of_route_for_tests(&self, objective: Objective, cells: &[Cell]) -> f64 {
+        self.cost_of_route(objective, cells)
+    }
+
     /// The cost of the chain of cells `cells` for `objective` (infinite if an edge is missing).
     fn cost_of_route(&self, objective: Objective, cells: &[Cell]) -> f64 {
         cells
@@ -282,13 +416,13 @@ impl Planner {
 /// (`[start, end)`), and the layout that holds them: rows as wide as the widest span, each
 /// starting at its span (or further west, to stay inside the map).
 fn corridor_layout(
-    grid: &ElevationGrid,
+    (map_cols, map_rows): (usize, usize),
     route: &[Cell],
     request: &PlanRequest,
     corridor: &CorridorSettings,
 ) -> Result<(Layout, Vec<(usize, usize)>), PlanError> {
     let (f, w) = (corridor.factor, corridor.half_width);
-    let (cc, cr) = (grid.cols().div_ceil(f), grid.rows().div_ceil(f));
+    let (cc, cr) = (map_cols.div_ceil(f), map_rows.div_ceil(f));
     // Per coarse row, the smallest and largest coarse column within the corridor.
     let mut span = vec![(usize::MAX, 0usize); cr];
     let ends = [request.start, request.goal].map(|c| Cell { col: c.col / f, row: c.row / f });
@@ -301,15 +435,15 @@ fn corridor_layout(
     // The fine columns of each coarse row's span (none where the corridor misses the row).
     let fine: Vec<(usize, usize)> = span
         .iter()
-        .map(|&(c0, c1)| if c0 == usize::MAX { (0, 0) } else { (c0 * f, ((c1 + 1) * f).min(grid.cols())) })
+        .map(|&(c0, c1)| if c0 == usize::MAX { (0, 0) } else { (c0 * f, ((c1 + 1) * f).min(map_cols)) })
         .collect();
     let first = fine.iter().position(|s| s.1 > s.0).unwrap_or(0);
     let last = fine.iter().rposition(|s| s.1 > s.0).unwrap_or(0);
-    let (row0, row1) = (first * f, ((last + 1) * f).min(grid.rows()));
+    let (row0, row1) = (first * f, ((last + 1) * f).min(map_rows));
     let width = fine[first..=last].iter().map(|s| s.1 - s.0).max().unwrap_or(0);
     let spans: Vec<(usize, usize)> = (row0..row1).map(|r| fine[r / f]).collect();
-    let col0 = spans.iter().map(|s| s.0.min(grid.cols() - width) as isize).collect();
-    let layout = Layout { row0, col0, width, map_cols: grid.cols(), map_rows: grid.rows() };
+    let col0 = spans.iter().map(|s| s.0.min(map_cols - width) as isize).collect();
+    let layout = Layout { row0, col0, width, map_cols: map_cols, map_rows: map_rows };
     let bytes = layout.cells() as u64 * CORRIDOR_BYTES_PER_CELL;
     if let Some(limit) = corridor.max_bytes.filter(|&l| bytes > l) {
         return Err(PlanError::Grid(format!(
@@ -325,14 +459,25 @@ fn corridor_layout(
     Ok((layout, spans))
 }
 
+/// [`corridor_layout`] for the tests of the windowed search.
 #[cfg(test)]
-mod tests {
+pub(super) fn corridor_layout_for_tests(
+    map: (usize, usize),
+    route: &[Cell],
+    request: &PlanRequest,
+    corridor: &CorridorSettings,
+) -> (Layout, Vec<(usize, usize)>) {
+    corridor_layout(map, route, request, corridor).unwrap()
+}
+
+#[cfg(test)]
+pub(super) mod tests {
     use super::*;
     use crate::model::tests::paper_robot;
     use crate::risk::Uncertainty;
     use crate::terrain::Terrain;
 
-    fn terrain() -> UncertainTerrain {
+    pub(in crate::plan) fn terrain() -> UncertainTerrain {
         UncertainTerrain::with_uncertainty(
             Terrain::constant(7e5, 2e6).unwrap(),
             Uncertainty::new(0.1, 0.2).unwrap(),
@@ -340,7 +485,7 @@ mod tests {
     }
 
     /// Dunes from a few sines, 0.5 m cells, slopes up to about 25 degrees: routes must wind.
-    fn dunes(n: usize) -> ElevationGrid {
+    pub(in crate::plan) fn dunes(n: usize) -> ElevationGrid {
         let z = (0..n * n)
             .map(|i| {
                 let (x, y) = (0.5 * (i % n) as f64, 0.5 * (i / n) as f64);
@@ -478,7 +623,7 @@ mod tests {
         let route: Vec<Cell> = (1..9).map(|i| Cell { col: i, row: i }).collect();
         let settings = CorridorSettings::new(4, 1, None).unwrap();
         let req = request(Cell { col: 5, row: 5 }, Cell { col: 34, row: 34 });
-        let (layout, spans) = corridor_layout(&grid, &route, &req, &settings).unwrap();
+        let (layout, spans) = corridor_layout((grid.cols(), grid.rows()), &route, &req, &settings).unwrap();
         // Coarse cells within 1 of a diagonal route cell: in coarse row R those of rows R - 1 to
         // R + 1 reach columns R - 2 to R + 2, 5 coarse columns = 20 fine ones a row, all rows.
         assert_eq!((layout.row0, layout.col0.len(), layout.width), (0, 40, 20));
@@ -513,7 +658,7 @@ mod tests {
         }
         // Too small a byte limit is refused before anything is built.
         let tight = CorridorSettings::new(4, 1, Some(1000)).unwrap();
-        let e = corridor_layout(&grid, &route, &req, &tight).unwrap_err().to_string();
+        let e = corridor_layout((grid.cols(), grid.rows()), &route, &req, &tight).unwrap_err().to_string();
         assert!(e.contains("40 rows of 20 cells"), "{e}");
     }
 }

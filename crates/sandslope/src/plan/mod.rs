@@ -26,17 +26,19 @@ mod result;
 mod risk_map;
 mod route;
 mod search;
+mod source;
 mod table;
 
 pub use classes::{class_indices, UnmappedClass};
 pub use corridor::{
-    plan_corridor, CorridorPlan, CorridorSettings, CorridorStats, CORRIDOR_BYTES_PER_CELL,
-    CORRIDOR_MAP_BYTES_PER_CELL,
+    plan_corridor, plan_corridor_from, CorridorPlan, CorridorSettings, CorridorStats,
+    CORRIDOR_BYTES_PER_CELL, CORRIDOR_MAP_BYTES_PER_CELL,
 };
 pub use grid::{Cell, ElevationGrid};
 pub use planner::{heading_offsets, Planner, HEADINGS, NO_CLASS};
 pub use result::{plan, Extrapolation, PlanRequest, PlanResult, RiskRaster};
 pub use route::{Route, RouteStep};
+pub use source::{coarsened_from, HeightSource};
 pub use table::{PitchTable, PitchTableCache, MAX_PITCH_DEG, P_FAIL_STEP_DEG, TAN_STEP};
 
 use serde::{Deserialize, Serialize};

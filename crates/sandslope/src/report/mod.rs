@@ -11,6 +11,7 @@ mod audit;
 mod diagnosis;
 mod disagreements;
 mod provenance;
+mod scope;
 mod simulator;
 mod tracks;
 
@@ -25,7 +26,7 @@ use crate::calibrate::{
 use crate::error::ParamError;
 use crate::gait::track::TrackResult;
 use crate::model::{predict, Prediction};
-use crate::paper::{self, compare_with_paper, Basis, ComparisonContext, PaperComparison};
+use crate::paper::{self, compare_with_paper, ComparisonContext, PaperComparison};
 use crate::phase::{PhasePanel, TerrainGrid};
 use crate::risk::{
     risk_curve, safe_slope_limit, success_slope_limit, RiskCurve, SafeLimit, UncertainTerrain,
@@ -41,6 +42,8 @@ pub use simulator::{
     simulator_fit_misses, SimulatorMiss, SimulatorRecord, SimulatorWalks, AGREE_WITHIN, MISS_SD, REACH_K_S,
     REPORT_WALK_S,
 };
+pub use scope::Summary;
+use scope::{another_robot_without_observations, summary, terrain_rows_only};
 use tracks::TrackUse;
 pub use tracks::{TrackRecord, TrackedSlope};
 
@@ -314,23 +317,26 @@ fn plain_answer(plots: &Plots, unreliable: bool) -> PlainAnswer {
     let mut text = format!("On {} the {} kg robot ", plots.terrain_name, plots.mass_kg);
     match last_success {
         Some(p) => text.push_str(&format!(
-            "climbs up to {:.2}° ({} on level ground, {} there)",
+            "climbs steadily up to {:.2}° ({} on level ground, {} there)",
             deg(p),
             level.map_or("-".into(), cm),
             p.speed.map_or("-".into(), cm)
         )),
-        None => text.push_str("does not climb even level ground"),
+        None => text.push_str("does not climb steadily even on level ground"),
     }
     if let Some(p) = first_not.filter(|p| !p.regime.is_failure()) {
         text.push_str(&format!(
-            "; from {:.2}° it is {} (it progresses by less than the minimum step and stalls in its own trench)",
+            "; from {:.2}° it {} (the paper's \"{}\": it still moves up, {} there, but each step is shorter than \
+             the robust step, so the next foothold lands in sand the last one disturbed and it can stall in its own trench)",
             deg(p),
-            p.regime.name()
+            p.regime.outcome(),
+            p.regime.name(),
+            p.speed.map_or("-".into(), cm)
         ));
     }
     if let Some(p) = first_fail {
         let why = if plots.repose_deg.is_some_and(|r| deg(p) >= r) { " (the angle of repose)" } else { "" };
-        text.push_str(&format!("; from {:.2}°{why} it fails ({})", deg(p), p.regime.name()));
+        text.push_str(&format!("; from {:.2}°{why} it {} ({})", deg(p), p.regime.outcome(), p.regime.name()));
     }
     text.push_str(" (the model at the terrain's medians, docs/model.md §5-§6).");
     let words = |l: &SafeLimit| match *l {
@@ -340,7 +346,7 @@ fn plain_answer(plots: &Plots, unreliable: bool) -> PlainAnswer {
         SafeLimit::BeyondRange { up_to, .. } => format!("at every slope up to {up_to}°"),
     };
     text.push_str(&format!(
-        " With the terrain's uncertainty, it climbs with P(not success) < {r} {} and does not fail (p_fail < {r}) {} (§9).",
+        " With the terrain's uncertainty, it climbs steadily (P(not climbing steadily) < {r}) {} and is safe (P(sinks or slides back) < {r}) {} (§9).",
         words(&plots.success_limit),
         words(&plots.safe_limit),
         r = plots.max_risk
@@ -378,32 +384,6 @@ pub struct ReportCalibration {
     pub goodness_of_fit: String,
 }
 
-/// The comparison table summed up.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Summary {
-    /// Comparisons whose basis is independent.
-    pub independent: usize,
-    /// Of those, how many agree.
-    pub independent_agree: usize,
-    /// Comparisons that agree by construction (input, tuned, consequence).
-    pub by_construction_agree: usize,
-    /// All comparisons.
-    pub total: usize,
-    /// The summary sentence.
-    pub text: String,
-}
-
-fn summary(rows: &[PaperComparison]) -> Summary {
-    let independent = rows.iter().filter(|r| r.basis == Basis::Independent).count();
-    let independent_agree = rows.iter().filter(|r| r.basis == Basis::Independent && r.agrees).count();
-    let by_construction_agree = rows.iter().filter(|r| r.basis != Basis::Independent && r.agrees).count();
-    let text = format!(
-        "the model agrees with {independent_agree} of the paper's {independent} independent numbers; {by_construction_agree} more agree by construction (inputs, tuned values, consequences of the model's form), out of {} compared",
-        rows.len()
-    );
-    Summary { independent, independent_agree, by_construction_agree, total: rows.len(), text }
-}
-
 /// Slopes of the model curves: 0 to 30 deg every 0.25 deg.
 fn slope_grid() -> Vec<Slope> {
     (0..=120).map(|i| at(i as f64 * 0.25)).collect()
@@ -424,32 +404,29 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     let mut anchoring: Vec<AnchoringObservation> =
         evidence.anchoring.as_ref().map(|(_, a)| a.clone()).unwrap_or_default();
     anchoring.extend(track_use.anchoring.iter().copied());
-    let speeds: Vec<SpeedObservation> = match &evidence.observed {
-        Some((_, s)) => s.clone(),
-        None if !evidence.tracks.is_empty() => track_use.speeds.clone(),
-        None => paper::SPEEDS
-            .iter()
-            .map(|&(d, v, sd)| SpeedObservation { slope: at(d), speed: v, speed_sd: sd })
-            .collect(),
-    };
+    let papers_robot = paper::is_papers_robot(&evidence.robot);
+    let other_robot = another_robot_without_observations(evidence);
+    let speeds = observed_speeds(evidence, &track_use.speeds, papers_robot);
     let calibration = calibrate(evidence, &speeds, &anchoring);
     let (simulator_fit, simulator_fit_misses, simulator_fit_warnings) =
         simulator_fit_section(evidence, &speeds, &anchoring);
     let (robot, terrain) = model(evidence, calibration.as_ref())?;
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
-    // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...): a
-    // robot it refuses loses this section, with a warning, not the report.
-    let (simulator, simulator_convergence, simulator_refusal) =
-        match simulator::simulator_section(&robot, &terrain, &speeds) {
-            Ok(walks) => {
-                plots.simulated = walks.free;
-                plots.simulated_pitch_locked = walks.pitch_locked;
-                (walks.records, walks.convergence, None)
-            }
-            Err(e) => {
-                (Vec::new(), Vec::new(), Some(format!("the stride simulator section is left out: {e}")))
-            }
-        };
+    // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...) and
+    // walks no implausible terrain: either loses this section, with a warning, not the report.
+    let at_bound = calibration
+        .as_ref()
+        .filter(|_| evidence.has_own_observations())
+        .and_then(|c| scope::terrain_at_bound(&c.fit));
+    let section = scope::simulator_walks(&robot, &terrain, &speeds, &plots.terrain_name, at_bound);
+    let (simulator, simulator_convergence, simulator_refusal) = match section {
+        Ok(walks) => {
+            plots.simulated = walks.free;
+            plots.simulated_pitch_locked = walks.pitch_locked;
+            (walks.records, walks.convergence, None)
+        }
+        Err(e) => (Vec::new(), Vec::new(), Some(format!("the stride simulator section is left out: {e}"))),
+    };
     let unconverged: Vec<String> =
         simulator_convergence.iter().filter(|c| !c.converged).map(|c| format!("{}°", c.slope_deg)).collect();
     let own = evidence.has_own_observations();
@@ -459,7 +436,10 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         shear_ratio_input: matches!(evidence.forces, ForceTests::Paper(_)),
         normal_ratio_input: evidence.builtin_terrain || matches!(evidence.forces, ForceTests::Paper(_)),
     };
-    let paper_vs_model = compare_with_paper(&robot, &terrain, context);
+    let mut paper_vs_model = compare_with_paper(&robot, &terrain, context);
+    if !papers_robot {
+        paper_vs_model = terrain_rows_only(paper_vs_model);
+    }
     let speed_inversion = audit::invert_speeds(&robot, &terrain, &speeds);
     let measured: Vec<f64> = plots.table.iter().map(|p| p.slope_deg).collect();
     let extrapolations: Vec<Extrapolation> =
@@ -485,7 +465,8 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
             model_m_s: predict(&robot, o.slope, &terrain.at(o.slope)).speed,
         })
         .collect();
-    let mut warnings = track_use.warnings;
+    let mut warnings: Vec<String> = other_robot.into_iter().collect();
+    warnings.extend(track_use.warnings);
     warnings.extend(simulator_refusal);
     if !unconverged.is_empty() {
         warnings.push(format!(
@@ -538,6 +519,20 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         warnings,
         plots,
     })
+}
+
+/// The speeds the report fits and compares: the user's (`--observed`, else the tracks'), else
+/// the paper's five, which are of its 0.35 kg robot and so none on another robot.
+fn observed_speeds(evidence: &Evidence, tracks: &[SpeedObservation], papers_robot: bool) -> Vec<SpeedObservation> {
+    match &evidence.observed {
+        Some((_, s)) => s.clone(),
+        None if !evidence.tracks.is_empty() => tracks.to_vec(),
+        None if !papers_robot => Vec::new(),
+        None => paper::SPEEDS
+            .iter()
+            .map(|&(d, v, sd)| SpeedObservation { slope: at(d), speed: v, speed_sd: sd })
+            .collect(),
+    }
 }
 
 /// The simulator's joint fit when the evidence asks for it: the fit, its misses walked with
@@ -767,6 +762,7 @@ fn figure_records(plots: &Plots, calibrated: bool) -> Vec<FigureRecord> {
 mod tests {
     use super::*;
     use crate::model::tests::paper_robot;
+    use crate::paper::Basis;
     use crate::terrain::TerrainSpec;
 
     /// k_n constant, k_s falling to 40% at 20 deg, repose 25 deg.
@@ -880,7 +876,9 @@ mod tests {
         assert_eq!(at(next).regime, regime);
         assert_eq!(a.level_speed_m_s, at(0.0).speed);
         assert_eq!(a.speed_at_limit_m_s, at(top).speed);
-        assert!(a.text.contains(&format!("climbs up to {top:.2}°")), "{}", a.text);
+        assert!(a.text.contains(&format!("climbs steadily up to {top:.2}°")), "{}", a.text);
+        // The next slope in a field engineer's words, the paper's name beside them.
+        assert!(a.text.contains(&format!("from {next:.2}° it {}", regime.outcome())), "{}", a.text);
         // Repose 25 deg: at and beyond it the regime is slippage.
         assert!(a.first_failure.unwrap().0 <= 25.0);
     }
@@ -929,6 +927,59 @@ mod tests {
         });
         assert_eq!(r.fit_diagnosis.is_some(), flagged);
         assert_eq!(r.plain_answer.text.contains("does not fit its observations"), flagged);
+    }
+
+    /// A 1.2 kg robot without observations: nothing about the paper's 0.35 kg robot is fitted
+    /// or compared, a warning says so first, and only the terrain's ratios stand. On the test
+    /// terrain by hand: k_s(20)/k_s(0) = 8e5 / 2e6 = 0.40, within 0.10 of the paper's 0.40;
+    /// k_n(20)/k_n(0) = 7e5 / 7e5 = 1, within 0.15 of 1: two independent numbers, both agree.
+    /// With observed speeds of its own, those are compared with the model instead.
+    #[test]
+    fn another_robot_is_not_compared_with_the_papers_speeds() {
+        let mut e = evidence();
+        e.robot = paper_robot().with_mass(1.2).unwrap();
+        e.robot_source = "mine.toml".into();
+        assert!(paper::is_papers_robot(&paper_robot()) && !paper::is_papers_robot(&e.robot));
+        let r = report(&e).unwrap();
+        assert!(r.warnings[0].contains("is not the paper's") && r.warnings[0].contains("1.2 kg"), "{:?}", r.warnings);
+        assert!(r.speeds.is_empty() && r.calibration.is_none());
+        let ids: Vec<&str> = r.paper_vs_model.iter().map(|c| c.id.as_str()).collect();
+        assert_eq!(ids, paper::TERRAIN_ROWS);
+        assert!(r.paper_vs_model.iter().all(|c| !c.quantity.contains("0.35") && c.agrees));
+        assert!((r.paper_vs_model[0].model_value.unwrap() - 0.4).abs() < 1e-12);
+        assert_eq!((r.summary.independent, r.summary.independent_agree), (2, 2));
+        let speeds = r.inputs.iter().find(|i| i.name == "observed speeds").unwrap();
+        assert!(speeds.value.starts_with("none"), "{}", speeds.value);
+
+        let obs = |d: f64, v: f64| SpeedObservation { slope: at(d), speed: v, speed_sd: 0.01 };
+        e.observed = Some(("mine.csv".into(), vec![obs(0.0, 0.12), obs(10.0, 0.08), obs(20.0, 0.04)]));
+        let r = report(&e).unwrap();
+        assert!(r.warnings.iter().all(|w| !w.contains("is not the paper's")), "{:?}", r.warnings);
+        let observed: Vec<f64> = r.speeds.iter().map(|s| s.observed_m_s).collect();
+        assert_eq!(observed, [0.12, 0.08, 0.04]);
+        assert!(r.speeds.iter().all(|s| s.model_m_s.is_some()));
+        assert_eq!(r.paper_vs_model.len(), 2);
+    }
+
+    /// One outlier speed (5 m/s at 10 degrees, 30 times the model's ceiling of about 16 cm/s)
+    /// runs the fit's plate_scale to its bound: the simulator section, whose walks on that
+    /// stiff terrain took 115 s of CPU, is left out with a warning that says why.
+    #[test]
+    fn an_outlier_speed_does_not_walk_an_implausible_terrain() {
+        let mut e = evidence();
+        let obs = |d: f64, v: f64, sd: f64| SpeedObservation { slope: at(d), speed: v, speed_sd: sd };
+        e.observed = Some((
+            "outlier.csv".into(),
+            vec![obs(0.0, 0.157, 0.0097), obs(10.0, 5.0, 0.0014), obs(15.0, 0.105, 0.0023), obs(20.0, 0.0498, 0.0032)],
+        ));
+        let start = std::time::Instant::now();
+        let r = report(&e).unwrap();
+        let fit = &r.calibration.as_ref().unwrap().fit;
+        assert!(scope::terrain_at_bound(fit).is_some_and(|(name, _)| name == "plate_scale"), "{:?}", fit.warnings);
+        assert!(r.simulator.is_empty() && r.plots.simulated.is_empty());
+        let w = r.warnings.iter().find(|w| w.contains("simulator section is left out")).expect("a warning");
+        assert!(w.contains("plate_scale ran to its search bound"), "{w}");
+        assert!(start.elapsed().as_secs() < 60, "{:?}", start.elapsed());
     }
 
     #[test]

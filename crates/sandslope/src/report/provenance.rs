@@ -154,6 +154,12 @@ fn evidence_rows(e: &Evidence, tracks_give_t1: bool) -> Vec<Input> {
             Measured,
             "your recordings, analysed as sandslope track does (docs/model.md §11)",
         ),
+        (None, true) if !crate::paper::is_papers_robot(&e.robot) => row(
+            "observed speeds",
+            "none (the paper's five are of its 0.35 kg robot, not yours)",
+            Assumed,
+            "give your robot's measured speeds with --observed to test the model on it",
+        ),
         (None, true) => row(
             "observed speeds",
             "the paper's five (docs/model.md §12)",

@@ -8,6 +8,8 @@
 //!   along an element's surface (§20.1).
 //! - [`Mechanisms::duty_cycle`]: a gait that turns the stance half turn slower than the swing
 //!   (§20.2).
+//! - [`Mechanisms::one_sided_belly`]: the belly has sand below it only, so it never holds the
+//!   body down (§20.5, issue 59).
 //! - [`Mechanisms::disturbed_sand`]: sand a leg has already passed through resists less (the
 //!   trench, §20.3): [`Trench`].
 //!
@@ -45,11 +47,23 @@ pub struct Mechanisms {
     /// Resistance of sand that a leg passed through in an earlier stance, as a share of the
     /// undisturbed sand's (§20.3); 1 (the default): the sand is as strong as before.
     pub disturbed_sand: f64,
+    /// The belly as the body's underside (§20.5): sand below it only, so it pushes and never
+    /// pulls, its along-surface stress capped by its push. `false` (the default): a plate in
+    /// sand on both faces, as resistive force theory's plates were, which holds a body being
+    /// lifted off the sand (docs/simulate.md, "Phase 1"). Serialised only when on, so a walk
+    /// without it reads as before.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub one_sided_belly: bool,
 }
 
 impl Default for Mechanisms {
     fn default() -> Mechanisms {
-        Mechanisms { leg_friction: None, duty_cycle: CONSTANT_SPEED_DUTY, disturbed_sand: UNDISTURBED_SAND }
+        Mechanisms {
+            leg_friction: None,
+            duty_cycle: CONSTANT_SPEED_DUTY,
+            disturbed_sand: UNDISTURBED_SAND,
+            one_sided_belly: false,
+        }
     }
 }
 
@@ -111,6 +125,38 @@ pub(crate) fn friction_cap(mu: f64, tx: f64, tz: f64, sx: f64, sz: f64) -> ((f64
     let capped = cap.copysign(along);
     let slope = mu * along.signum() * normal.signum();
     ((capped * tx + normal * nx, capped * tz + normal * nz), Some(slope))
+}
+
+/// How [`one_sided_cap`] changed a stress, for its derivative.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Capped {
+    /// Not at all.
+    Free,
+    /// To zero (the law would pull): its derivative is zero.
+    Zero,
+    /// The along-surface part capped at `mu` times the push: it follows the normal part with
+    /// this factor (`mu sign(s_t)`).
+    Along(f64),
+}
+
+/// The stress `(sx, sz)` on a one-sided element of unit tangent `(tx, tz)`, the sand on its
+/// right-hand side (docs/model.md §20.5): its component along `n = (-tz, tx)` (the push) at
+/// least 0, and its component along the surface at most `mu` times that push. Continuous in
+/// the stress: as the push falls to zero, so does the along-surface part.
+#[inline]
+pub(crate) fn one_sided_cap(mu: f64, tx: f64, tz: f64, sx: f64, sz: f64) -> ((f64, f64), Capped) {
+    let (nx, nz) = (-tz, tx);
+    let along = sx * tx + sz * tz;
+    let normal = sx * nx + sz * nz;
+    if normal <= 0.0 {
+        return ((0.0, 0.0), Capped::Zero);
+    }
+    let cap = mu * normal;
+    if along.abs() <= cap {
+        return ((sx, sz), Capped::Free);
+    }
+    let capped = cap.copysign(along);
+    ((capped * tx + normal * nx, capped * tz + normal * nz), Capped::Along(mu * along.signum()))
 }
 
 /// A depth per cell along the slope, grown to the cells written (at most

@@ -17,6 +17,7 @@ pub mod dynamics;
 pub mod ensemble;
 mod linear;
 pub mod mechanisms;
+pub mod phase1;
 pub mod rft;
 
 use rayon::prelude::*;
@@ -27,6 +28,7 @@ pub use convergence::{check_convergence, check_convergence_slopes, check_walked,
 use dynamics::Walker;
 pub use ensemble::{simulate_ensemble, Ensemble};
 pub use mechanisms::Mechanisms;
+pub use phase1::PhaseOne;
 pub use rft::RftScaling;
 
 use crate::error::ParamError;
@@ -231,13 +233,15 @@ pub struct SimStep {
     pub peak_servo_torque_n_m: f64,
     /// Time servos spent stalled, summed over legs, s.
     pub stall_s: f64,
+    /// Phase 1 (touchdown to t1): the lowest speed and what held the body (issue 59).
+    pub phase1: PhaseOne,
 }
 
 impl Serialize for SimStep {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeStruct;
         let m = &self.step;
-        let mut st = s.serialize_struct("SimStep", 12)?;
+        let mut st = s.serialize_struct("SimStep", 19)?;
         st.serialize_field("index", &self.index)?;
         st.serialize_field("tripod", &self.tripod)?;
         st.serialize_field("touchdown_s", &m.touchdown_s)?;
@@ -251,6 +255,14 @@ impl Serialize for SimStep {
         st.serialize_field("peak_leg_force_n", &self.peak_leg_force_n)?;
         st.serialize_field("peak_servo_torque_n_m", &self.peak_servo_torque_n_m)?;
         st.serialize_field("stall_s", &self.stall_s)?;
+        let p = &self.phase1;
+        st.serialize_field("phase1_min_speed_m_s", &p.min_speed_m_s)?;
+        st.serialize_field("phase1_belly_x_n", &p.belly_n[0])?;
+        st.serialize_field("phase1_belly_z_n", &p.belly_n[1])?;
+        st.serialize_field("phase1_old_tripod_x_n", &p.old_tripod_n[0])?;
+        st.serialize_field("phase1_old_tripod_z_n", &p.old_tripod_n[1])?;
+        st.serialize_field("phase1_new_tripod_x_n", &p.new_tripod_n[0])?;
+        st.serialize_field("phase1_new_tripod_z_n", &p.new_tripod_n[1])?;
         st.end()
     }
 }
@@ -332,6 +344,10 @@ pub struct SimSummary {
     pub t1_s: Option<f64>,
     /// Mean backward slip over the measured steps that anchored, m.
     pub slip_m: Option<f64>,
+    /// Phase 1 (touchdown to t1, docs/model.md §11) averaged over the measured steps that
+    /// anchored: the lowest speed and the sand's forces on the belly and the two tripods.
+    /// Its t1 and slip are `t1_s` and `slip_m`; the closed form's are in `closed_form`.
+    pub phase1: Option<PhaseOne>,
     /// Mean net step over the measured steps, m.
     pub step_m: f64,
     /// Standard deviation of the step speed across measured steps, m/s.
@@ -505,15 +521,18 @@ pub fn simulate_with_leg(
             break;
         }
         let acc = run.per_step.get(k).copied().unwrap_or_default();
+        let step = measure_step(&track, t0, half);
+        let phase1 = phase1::phase_one(&track.speed, &run.groups, dt, t0, step.anchoring_time_s, half, k % 2);
         steps.push(SimStep {
             index: k,
             tripod: k % 2,
             warmup: k < WARMUP_STEPS,
-            step: measure_step(&track, t0, half),
+            step,
             max_depth_m: acc.max_depth,
             peak_leg_force_n: acc.peak_force,
             peak_servo_torque_n_m: acc.peak_torque,
             stall_s: acc.stall_s,
+            phase1,
         });
     }
     let pitch = Pitch { max_abs_rad: run.max_abs_pitch, over_s: run.pitch_over_s };
@@ -598,6 +617,8 @@ fn summarise(
     };
     let t1 = mean_of(&|s| s.anchoring_time_s.unwrap_or(0.0));
     let slip = mean_of(&|s| s.slip_m.unwrap_or(0.0));
+    let phase1 =
+        phase1::mean(measured.iter().filter(|s| s.step.anchoring_time_s.is_some()).map(|s| &s.phase1));
     let max_depth = measured.iter().map(|s| s.max_depth_m).fold(0.0, f64::max);
     // Sinkage: in most measured steps a leg went deeper than its reach from the rest height
     // (the walked leg's own reach, docs/model.md §3: a C-leg's 2R - h).
@@ -631,6 +652,7 @@ fn summarise(
         speed_m_s: speed,
         t1_s: t1,
         slip_m: slip,
+        phase1,
         step_m: step,
         speed_sd_m_s: speed_sd,
         steps_measured: measured.len(),
@@ -656,5 +678,7 @@ pub fn simulate_slopes(
     slopes.par_iter().map(|&s| simulate(scenario, s, settings)).collect()
 }
 
+#[cfg(test)]
+mod phase1_tests;
 #[cfg(test)]
 mod tests;

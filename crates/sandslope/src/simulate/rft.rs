@@ -79,6 +79,11 @@ pub struct Rft {
     scaling: RftScaling,
     /// Leg-sand friction coefficient capping the along-surface stress (§20.1), if any.
     friction: Option<f64>,
+    /// A one-sided contact (the belly, §20.5): the sand only on the element's right-hand side
+    /// (`-n`, `n = (-t_z, t_x)`), so it pushes along `n` and never pulls, and the stress along
+    /// the surface is at most this coefficient times that push. `None`: a plate in sand on
+    /// both faces, as resistive force theory's plates were.
+    unilateral: Option<f64>,
 }
 
 impl Rft {
@@ -99,7 +104,7 @@ impl Rft {
             RftScaling::Li2013 => zeta_z,
             _ => 2.0 * k_s / ax_side,
         };
-        Rft { zeta_z, zeta_x, scaling, friction: None }
+        Rft { zeta_z, zeta_x, scaling, friction: None, unilateral: None }
     }
 
     /// The same law with leg-sand friction `mu` capping the stress along an element's surface
@@ -108,10 +113,27 @@ impl Rft {
         Rft { friction: mu, ..self }
     }
 
+    /// The same law on a one-sided element (docs/model.md §20.5): the sand, on the element's
+    /// right-hand side only, never pulls it (the stress's component along `n = (-t_z, t_x)`
+    /// is at least 0), and the stress along the surface is at most the law's own ratio for a
+    /// flat plate dragged along the surface, `mu = sigma_x / sigma_z` (0.363 = tan 19.9 deg
+    /// under `Motion` and `Li2013`), times that push: a dragged, pressed plate is unchanged,
+    /// a lifted one is let go, continuously.
+    pub fn one_sided(self) -> Rft {
+        let (sx, sz) = self.stress(1.0, 0.0, 1.0, 0.0);
+        Rft { unilateral: Some((sx / sz).abs()), ..self }
+    }
+
+    /// The one-sided contact's friction coefficient, if the law is one-sided.
+    pub fn one_sided_friction(&self) -> Option<f64> {
+        self.unilateral
+    }
+
     /// `(zeta_z, zeta_x)` where the law is the default scaling ([`RftScaling::Motion`]) without
     /// friction: the one law the simulator evaluates several elements at a time.
     pub(crate) fn motion_scales(&self) -> Option<(f64, f64)> {
-        (self.scaling == RftScaling::Motion && self.friction.is_none()).then_some((self.zeta_z, self.zeta_x))
+        (self.scaling == RftScaling::Motion && self.friction.is_none() && self.unilateral.is_none())
+            .then_some((self.zeta_z, self.zeta_x))
     }
 
     /// The stress per unit depth of a horizontal plate pushed straight down, N/m^3 (k_n).
@@ -143,9 +165,13 @@ impl Rft {
         // along-surface stress k_s.
         let (kx, kz) = self.scales(ex, ez);
         let st = (-s * kx * ax, kz * az);
-        match self.friction {
+        let st = match self.friction {
             None => st,
             Some(mu) => super::mechanisms::friction_cap(mu, tx, tz, st.0, st.1).0,
+        };
+        match self.unilateral {
+            None => st,
+            Some(mu) => super::mechanisms::one_sided_cap(mu, tx, tz, st.0, st.1).0,
         }
     }
 
@@ -175,7 +201,7 @@ impl Rft {
 
     /// [`Rft::rest_set`] written into `set` (a walk keeps one, [`RestSet`] being 5.8 kB).
     pub fn rest_set_into(&self, tangent: [f64; 2], set: &mut RestSet) {
-        if self.friction.is_some() {
+        if self.friction.is_some() || self.unilateral.is_some() {
             for (k, e) in set_directions().iter().enumerate() {
                 let st = self.passive_stress(tangent[0], tangent[1], e[0], e[1]);
                 set.x[k / 4].as_array_mut()[k % 4] = st.0;
@@ -264,6 +290,18 @@ impl Rft {
             Some(mu) => match super::mechanisms::friction_cap(mu, tx, tz, st.0, st.1) {
                 (capped, None) => (capped, dst),
                 (capped, Some(slope)) => {
+                    let dnormal = -dst.0 * tz + dst.1 * tx;
+                    (capped, (slope * dnormal * tx - dnormal * tz, slope * dnormal * tz + dnormal * tx))
+                }
+            },
+        };
+        // One-sided contact (§20.5): no pull, and the along-surface stress capped by the push.
+        let (st, dst) = match self.unilateral {
+            None => (st, dst),
+            Some(mu) => match super::mechanisms::one_sided_cap(mu, tx, tz, st.0, st.1) {
+                (capped, super::mechanisms::Capped::Free) => (capped, dst),
+                (capped, super::mechanisms::Capped::Zero) => (capped, (0.0, 0.0)),
+                (capped, super::mechanisms::Capped::Along(slope)) => {
                     let dnormal = -dst.0 * tz + dst.1 * tx;
                     (capped, (slope * dnormal * tx - dnormal * tz, slope * dnormal * tz + dnormal * tx))
                 }

@@ -10,7 +10,7 @@ use crate::robot::{Robot, RobotSpec};
 use crate::terrain::{Ground, Terrain};
 
 /// A walker with `settings.shape`'s legs.
-fn walker(robot: &Robot, ground: &Ground, theta: f64, settings: &SimSettings, dt: f64) -> Walker {
+pub(super) fn walker(robot: &Robot, ground: &Ground, theta: f64, settings: &SimSettings, dt: f64) -> Walker {
     Walker::with_leg(robot, ground, theta, settings, dt, &*settings.shape.leg(robot))
 }
 
@@ -233,7 +233,9 @@ fn a_step_serialises_the_gait_step_in_place() {
         ["index", "tripod", "touchdown_s", "warmup", "t1_s", "slip_m", "step_m", "speed_m_s", "max_depth_m"];
     let at: Vec<usize> = order.iter().map(|k| text.find(&format!("\"{k}\":")).unwrap()).collect();
     assert!(at.windows(2).all(|w| w[0] < w[1]), "{text}");
-    assert_eq!(v.as_object().unwrap().len(), 12);
+    // 12 fields, then phase 1's seven (issue 59) after them.
+    assert_eq!(v.as_object().unwrap().len(), 19);
+    assert!(text.find("\"stall_s\":").unwrap() < text.find("\"phase1_min_speed_m_s\":").unwrap(), "{text}");
     // The fourth step touches down at 3 T/2 = 1.5 s (T = 1 s for this robot) on tripod 1.
     assert_eq!(
         (v["index"].as_u64(), v["tripod"].as_u64(), v["warmup"].as_bool()),
@@ -363,7 +365,7 @@ fn table() {
 }
 
 /// The built-in glass-beads terrain (crates/sandslope-io/presets/glass-beads-300um.toml).
-fn builtin_terrain() -> Terrain {
+pub(super) fn builtin_terrain() -> Terrain {
     use crate::terrain::{TerrainPoint, TerrainSpec};
     let pt = |slope_deg, k_s| TerrainPoint { slope_deg, k_n: 7e5, k_s, k_n_sd: None, k_s_sd: None };
     Terrain::new(TerrainSpec {

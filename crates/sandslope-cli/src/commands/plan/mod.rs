@@ -145,7 +145,9 @@ pub struct OutputArgs {
     /// Draw hillshade, risk layer and routes (PNG or SVG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    /// Write a 2-band GeoTIFF: best-heading p_fail, steepest safe climb azimuth (deg from north).
+    /// Write a 2-band GeoTIFF: best-heading p_fail, steepest safe climb azimuth (deg from north);
+    /// a name ending .yaml writes a Nav2 map_server pair (.yaml + .pgm), .mcap an
+    /// OccupancyGrid with the routes as Paths (docs/bags.md).
     #[arg(long, value_name = "FILE")]
     pub risk_map: Option<PathBuf>,
     /// Print JSON instead of a table.
@@ -289,7 +291,19 @@ fn run_full(args: &PlanArgs, planned: &Planned) -> Result<()> {
         writers::write_csv(p, &dem.geo, result.planner.grid(), &result.routes)?;
     }
     if let (Some(p), Some(risk)) = (&args.out.risk_map, &result.risk) {
-        write_two_band_geotiff(p, dem.cols, dem.rows, &dem.geo, &risk.p_fail, &risk.climb_azimuth_deg)?;
+        // `.yaml`: a Nav2 map_server pair; `.mcap`: OccupancyGrid and the routes (docs/bags.md).
+        match p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("yaml" | "yml") => sandslope_io::nav2_map::write_nav2_map(p, dem, &risk.p_fail)?,
+            Some("mcap") => sandslope_io::nav2_map::write_map_mcap(p, dem, &risk.p_fail, &result.routes)?,
+            _ => write_two_band_geotiff(
+                p,
+                dem.cols,
+                dem.rows,
+                &dem.geo,
+                &risk.p_fail,
+                &risk.climb_azimuth_deg,
+            )?,
+        }
     }
     if let (Some(p), Some(risk)) = (&args.out.plot, &result.risk) {
         crate::figures::save(p, &PlanFigure::new(result, &dem.geo, &risk.p_fail))?;
@@ -304,12 +318,12 @@ fn run_full(args: &PlanArgs, planned: &Planned) -> Result<()> {
 
 /// Writes and prints what the corridor search found, saying how it was found.
 fn run_corridor(args: &PlanArgs, planned: &CorridorPlanned) -> Result<()> {
-    let CorridorPlanned { dem, grid, plan, settings } = planned;
+    let CorridorPlanned { dem, heights, plan, settings } = planned;
     if let Some(p) = &args.out.geojson {
         writers::write_geojson(p, &dem.geo, &plan.routes)?;
     }
     if let Some(p) = &args.out.csv {
-        writers::write_csv(p, &dem.geo, grid, &plan.routes)?;
+        writers::write_csv(p, &dem.geo, heights, &plan.routes)?;
     }
     warn_extrapolation(plan.extrapolation);
     if args.out.json {

@@ -2,7 +2,7 @@
 //! step measures and sampled at the trajectory's rate.
 
 use super::super::{Geometry, Trajectory};
-use super::{Run, StepPeaks, Walker};
+use super::{GroupForces, Run, StepPeaks, Walker};
 
 impl Walker {
     /// Walks `n_steps` integration steps from t = 0, recording the full-rate along-slope
@@ -14,6 +14,7 @@ impl Walker {
         let mut stalled_by_step: Vec<Vec<usize>> = vec![Vec::new(); n_gait_steps];
         let mut x = Vec::with_capacity(n_steps + 1);
         let mut vx = Vec::with_capacity(n_steps + 1);
+        let mut groups: Vec<GroupForces> = Vec::with_capacity(n_steps);
         let samples = ((n_steps as f64 * self.dt) * rate_hz).floor() as usize + 1;
         let mut tr = Trajectory {
             time_s: Vec::with_capacity(samples),
@@ -40,6 +41,7 @@ impl Walker {
             self.step(true);
             x.push(self.q[0]);
             vx.push(self.v[0]);
+            groups.push(self.group_forces());
             let t = (i + 1) as f64 * self.dt;
             max_abs_pitch = max_abs_pitch.max(self.q[2].abs());
             if pitch_over_s.is_none() && self.q[2].abs() > super::super::PITCH_OVER_RAD {
@@ -108,6 +110,7 @@ impl Walker {
             max_abs_pitch,
             pitch_over_s,
             unconverged_steps: self.unconverged,
+            groups,
         }
     }
 }

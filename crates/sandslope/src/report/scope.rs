@@ -1,0 +1,163 @@
+//! What the report compares and walks, given the evidence: on a robot other than the paper's
+//! no number about the paper's 0.35 kg robot ([`another_robot_without_observations`],
+//! [`terrain_rows_only`]); the summary of the comparisons ([`summary`]); and the simulator's
+//! walks only on a plausible terrain ([`simulator_walks`]).
+
+use serde::Serialize;
+
+use super::simulator::{self, SimulatorWalks};
+use super::Evidence;
+use crate::calibrate::{CalibrationWarning, JointCalibration, SpeedObservation};
+use crate::paper::{self, Basis, PaperComparison};
+use crate::robot::Robot;
+use crate::terrain::Terrain;
+
+/// The comparison table summed up.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// Comparisons whose basis is independent.
+    pub independent: usize,
+    /// Of those, how many agree.
+    pub independent_agree: usize,
+    /// Comparisons that agree by construction (input, tuned, consequence).
+    pub by_construction_agree: usize,
+    /// All comparisons.
+    pub total: usize,
+    /// The summary sentence.
+    pub text: String,
+}
+
+/// The summary of `rows`: independent agreements counted, one independent number named.
+pub(crate) fn summary(rows: &[PaperComparison]) -> Summary {
+    let independent = rows.iter().filter(|r| r.basis == Basis::Independent).count();
+    let independent_agree = rows.iter().filter(|r| r.basis == Basis::Independent && r.agrees).count();
+    let by_construction_agree = rows.iter().filter(|r| r.basis != Basis::Independent && r.agrees).count();
+    let construction = format!(
+        "{by_construction_agree} more agree by construction (inputs, tuned values, consequences of the model's form), out of {} compared",
+        rows.len()
+    );
+    let text = match independent {
+        0 => format!("none of the paper's numbers tests the model independently here; {construction}"),
+        // One number: name it, rather than "0 of the paper's 1 independent numbers".
+        1 => {
+            let row = rows.iter().find(|r| r.basis == Basis::Independent).expect("one independent row");
+            format!(
+                "one of the paper's numbers tests the model independently, the {}: paper {}, model {}, so the model {} it; {construction}",
+                row.quantity,
+                row.paper,
+                row.model,
+                if row.agrees { "agrees with" } else { "disagrees with" }
+            )
+        }
+        n => format!("the model agrees with {independent_agree} of the paper's {n} independent numbers; {construction}"),
+    };
+    Summary { independent, independent_agree, by_construction_agree, total: rows.len(), text }
+}
+
+/// The warning of a report on a robot other than the paper's ([`paper::is_papers_robot`])
+/// without observations of its own (`--observed`, `--t1`, `--tracks`); `None` otherwise. Then
+/// the paper's speeds, anchoring trend, step period and heavy-robot claim, all numbers about its
+/// 0.35 kg robot, are neither fitted nor compared: the report is the model for this robot on
+/// this terrain, and only the terrain's ratios are set beside the paper's.
+pub(crate) fn another_robot_without_observations(evidence: &Evidence) -> Option<String> {
+    if evidence.has_own_observations() || paper::is_papers_robot(&evidence.robot) {
+        return None;
+    }
+    let r = &evidence.robot;
+    let (mass, ..) = paper::ROBOT;
+    Some(format!(
+        "your robot ({}, {} kg, R = {} cm) is not the paper's ({mass} kg, R = 4 cm) and you gave no observations \
+         of it (--observed, --t1, --tracks): the paper's speeds, anchoring trend, step period and heavy-robot claim \
+         are of the paper's robot, so this report neither fits nor compares them; it is the model's prediction \
+         for your robot on {}, untested. Give its measured speeds with --observed to test and calibrate it",
+        evidence.robot_source,
+        r.mass(),
+        r.leg_radius() * 100.0,
+        evidence.terrain_source
+    ))
+}
+
+/// The comparison rows that stand whatever the robot ([`paper::TERRAIN_ROWS`]), each labelled
+/// as the terrain's against the paper's glass beads.
+pub(crate) fn terrain_rows_only(rows: Vec<PaperComparison>) -> Vec<PaperComparison> {
+    rows.into_iter()
+        .filter(|r| paper::TERRAIN_ROWS.contains(&r.id.as_str()))
+        .map(|mut r| {
+            r.quantity = format!("{} (the terrain, against the paper's glass beads)", r.quantity);
+            r.basis_note =
+                format!("a property of the terrain alone, so it stands for any robot; {}", r.basis_note);
+            r
+        })
+        .collect()
+}
+
+/// The quantity of `fit` that scales the terrain (any but the error floor) stopped at its search
+/// bound, when the report's model is that fit: `(name, value)`.
+pub(crate) fn terrain_at_bound(fit: &JointCalibration) -> Option<(String, f64)> {
+    fit.warnings.iter().find_map(|w| match w {
+        CalibrationWarning::ParameterAtBound { name, value, .. } if name != "error_floor" => {
+            Some((name.clone(), *value))
+        }
+        _ => None,
+    })
+}
+
+/// The simulator section's walks ([`simulator::simulator_section`]), or why they are left out:
+/// the simulator refuses the robot; the model is a calibration whose terrain scale ran to its
+/// search bound (`at_bound`, [`terrain_at_bound`]); or the model's terrain lies outside the
+/// plausible range. The last two are no terrain of the user's, and stiff: one outlier speed
+/// (5 m/s at 10 degrees among the paper's) took plate_scale to its bound 10^4 and k_s to 10^9
+/// N/m^3, where the section's 70 walks took 115 s of CPU against 5 s for the whole clean report.
+pub(crate) fn simulator_walks(
+    robot: &Robot,
+    terrain: &Terrain,
+    speeds: &[SpeedObservation],
+    terrain_name: &str,
+    at_bound: Option<(String, f64)>,
+) -> Result<SimulatorWalks, String> {
+    if let Some((name, value)) = at_bound {
+        return Err(format!(
+            "the model is the calibration on your observations, and its {name} ran to its search bound ({value:.3e}): \
+             no terrain of yours, and so stiff that the simulator's walks would take minutes (see the calibration's \
+             warnings and why it is unreliable)"
+        ));
+    }
+    // No walk on a terrain outside the plausible range (docs/model.md §7), which only a fit run
+    // to its search bound makes (one outlier speed took plate_scale to 10^4 and k_s to 3 x
+    // 10^10 N/m^3): there its walks took minutes of CPU where the rest takes seconds.
+    let k = crate::terrain::K_PLAUSIBLE;
+    let implausible = terrain.points().iter().find_map(|p| {
+        [("k_n", p.k_n), ("k_s", p.k_s)]
+            .into_iter()
+            .find(|(_, v)| !(k.min..=k.max).contains(v))
+            .map(|(name, v)| (name, v, p.slope_deg))
+    });
+    match implausible {
+        Some((name, v, deg)) => Err(format!(
+            "the model's terrain ({}) has {name} = {v:.3e} N/m^3 at {deg}°, outside the plausible {:e} to {:e} \
+             N/m^3 (docs/model.md §7), where the simulator's walks take minutes; a calibration run to a search \
+             bound puts it there (see its warnings)",
+            terrain_name, k.min, k.max
+        )),
+        None => simulator::simulator_section(robot, terrain, speeds).map_err(|e| e.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::tests::paper_robot;
+
+    /// A model terrain whose k_s is 3e10 N/m^3 (what a plate_scale of 10^4 makes of a 3e6
+    /// table) lies beyond the plausible 1e10: no walk is made, and the reason names the value,
+    /// the slope and the range; a fit at its bound is named before any walk too.
+    #[test]
+    fn no_walk_on_an_implausible_terrain_or_a_fit_at_its_bound() {
+        let stiff = Terrain::constant(7e5, 3e10).unwrap();
+        let why = simulator_walks(&paper_robot(), &stiff, &[], "stiff", None).unwrap_err();
+        assert!(why.contains("k_s = 3.000e10 N/m^3 at 0°") && why.contains("1e3 to 1e10"), "{why}");
+        let sand = Terrain::constant(7e5, 2e6).unwrap();
+        let why = simulator_walks(&paper_robot(), &sand, &[], "sand", Some(("plate_scale".into(), 1e4))).unwrap_err();
+        assert!(why.contains("plate_scale ran to its search bound (1.000e4)"), "{why}");
+    }
+}

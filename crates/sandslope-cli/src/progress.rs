@@ -63,7 +63,11 @@ impl Progress {
     /// Progress of `len` steps (`len` 0: a task of unknown length, shown as a spinner).
     pub fn new(len: u64, quiet: bool, what: &str) -> Progress {
         if quiet || shown(false) {
-            return Progress::Bar(if len == 0 { spinner(quiet, what) } else { progress_bar(len, quiet, what) });
+            return Progress::Bar(if len == 0 {
+                spinner(quiet, what)
+            } else {
+                progress_bar(len, quiet, what)
+            });
         }
         if std::io::stderr().is_terminal() {
             // A terminal on stderr while stdout is piped: the bar, on stderr.

@@ -215,8 +215,9 @@ fn the_default_report_says_where_every_number_comes_from() {
     // One independent number is named, not counted ("0 of the paper's 1 independent numbers").
     let html = html.replace("&#x27;", "'");
     assert!(
-        html.contains("one of the paper's numbers tests the model independently, the regime of a 1 kg robot at 24 deg")
-            && html.contains("so the model disagrees with it"),
+        html.contains(
+            "one of the paper's numbers tests the model independently, the regime of a 1 kg robot at 24 deg"
+        ) && html.contains("so the model disagrees with it"),
         "{}",
         v["summary"]["text"]
     );
@@ -393,7 +394,12 @@ fn report_renders_in_a_real_browser() {
             buf[k..k + 3] != [255, 255, 255]
         })
         .collect();
-    assert!(painted.is_empty(), "content runs off the right edge at 600 px: {} pixels, first {:?}", painted.len(), painted.first());
+    assert!(
+        painted.is_empty(),
+        "content runs off the right edge at 600 px: {} pixels, first {:?}",
+        painted.len(),
+        painted.first()
+    );
     // And the page's tables are each in a scrolling box.
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert_eq!(html.matches("<table").count(), html.matches("<div class=\"scroll\"><table").count());

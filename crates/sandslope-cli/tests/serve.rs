@@ -643,7 +643,8 @@ fn the_page_shows_predicts_speed_after_the_slope_slider_moves() {
 /// three times, and the tab buttons stay on one row beside the title.
 #[test]
 fn a_bad_parameter_is_shown_once_in_a_banner_that_leaves_the_tabs_in_a_row() {
-    let Some(browser) = common::chromium_or_skip("a_bad_parameter_is_shown_once_in_a_banner_that_leaves_the_tabs_in_a_row")
+    let Some(browser) =
+        common::chromium_or_skip("a_bad_parameter_is_shown_once_in_a_banner_that_leaves_the_tabs_in_a_row")
     else {
         return;
     };

@@ -317,7 +317,11 @@ pub const TARGETS: &[Target] = &[
         // With the paper's speeds but one outlier (5 m/s at 10 deg, issue 58): the fit runs
         // plate_scale to its bound, and the report took 92 s against 5 s (a "hang" here) until
         // it stopped walking the simulator on a terrain outside the plausible range.
-        seeds: &["data/paper-speeds.csv", "examples/inference/walk-1kg.csv", "crates/sandslope-fuzz/seeds/speeds-outlier.csv"],
+        seeds: &[
+            "data/paper-speeds.csv",
+            "examples/inference/walk-1kg.csv",
+            "crates/sandslope-fuzz/seeds/speeds-outlier.csv",
+        ],
         file_name: "speeds.csv",
         companions: &[],
         run: Run::Command(&["report", "--observed", "{in}", "--out", "{dir}/report"]),

@@ -166,9 +166,14 @@ mod tests {
     #[test]
     fn implausible_terrain_resistances_are_refused_naming_the_file_and_key() {
         let text = |k_n: &str| format!("[[points]]\nslope_deg = 0.0\nk_n = {k_n}\nk_s = 2e6\n");
-        let err = |k_n: &str| format!("{:#}", terrain_from_toml(&text(k_n), &Source::File("sand.toml".into())).unwrap_err());
+        let err = |k_n: &str| {
+            format!("{:#}", terrain_from_toml(&text(k_n), &Source::File("sand.toml".into())).unwrap_err())
+        };
         let msg = err("1e308");
-        assert!(msg.starts_with("sand.toml: points[0].k_n = 1e308 must be between 1e3 and 1e10 N/m^3"), "{msg}");
+        assert!(
+            msg.starts_with("sand.toml: points[0].k_n = 1e308 must be between 1e3 and 1e10 N/m^3"),
+            "{msg}"
+        );
         assert!(err("0.7").contains("that is 700000 N/m^3"), "{}", err("0.7"));
         assert!(terrain_from_toml(&text("7e5"), &Source::File("sand.toml".into())).is_ok());
     }

@@ -95,9 +95,7 @@ pub const K_PLAUSIBLE: crate::robot::Plausible = crate::robot::Plausible {
 /// `--k-s` override) against [`K_PLAUSIBLE`]; the error names `key`, the range and the unit it
 /// was likely given in.
 pub fn check_plausible_resistance(key: &str, value: f64) -> Result<f64, ParamError> {
-    K_PLAUSIBLE
-        .check_as(value, "a plausible granular terrain (docs/model.md §7)")
-        .map_err(|e| e.renamed(key))
+    K_PLAUSIBLE.check_as(value, "a plausible granular terrain (docs/model.md §7)").map_err(|e| e.renamed(key))
 }
 
 impl TerrainSpec {
@@ -284,7 +282,11 @@ mod tests {
     /// N/m^3 (700 given in kN/m^3 likewise), while 1e308 fits no unit.
     #[test]
     fn implausible_resistances_are_refused_with_the_range_and_the_likely_unit() {
-        let spec = |k_n: f64, k_s: f64| TerrainSpec { name: None, repose_deg: None, points: vec![pt(0.0, k_n, k_s)] };
+        let spec = |k_n: f64, k_s: f64| TerrainSpec {
+            name: None,
+            repose_deg: None,
+            points: vec![pt(0.0, k_n, k_s)],
+        };
         assert!(spec(1e3, 1e10).check_plausible().is_ok());
         assert!(spec(7e5, 2e6).check_plausible().is_ok());
         let e = spec(1e308, 2e6).check_plausible().unwrap_err();

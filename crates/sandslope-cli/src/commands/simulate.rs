@@ -250,7 +250,8 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     }
     if let Some(path) = &args.animate {
         let anim = Animation { sim: &sim, slope_deg: slope };
-        let mut bar = Progress::new(anim.frames().len() as u64, quiet, &format!("drawing {}", path.display()));
+        let mut bar =
+            Progress::new(anim.frames().len() as u64, quiet, &format!("drawing {}", path.display()));
         figures::simulate::save_gif(path, &anim, &mut || bar.inc())?;
         bar.finish();
     }

@@ -275,7 +275,14 @@ fn messages_name_what_was_given() {
     assert_eq!(out.status.code(), Some(2), "{all}");
     assert!(all.contains("header line `# slope_deg` = NaN must be strictly between -90 and 90"), "{all}");
     assert!(all.contains("give the run's slope with --slope"), "{all}");
+    // Without --force the safe slope refuses it first (the sand's repose, 25 deg); with it, the
+    // emulator says the terrain has no sand there.
     let out = bin().args(["drive", "--emulate", "--slope", "89", "--duration", "1"]).output().unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{all}");
+    assert!(all.contains("--slope 89 is beyond the calibrated safe slope"), "{all}");
+    let out =
+        bin().args(["drive", "--emulate", "--slope", "89", "--force", "--duration", "1"]).output().unwrap();
     let all = text(&out);
     assert_eq!(out.status.code(), Some(2), "{all}");
     assert!(all.contains("--slope 89: the terrain's sand has no shear strength"), "{all}");

@@ -110,7 +110,11 @@ impl Figure for CurveFigure {
         }
         let limits = [
             (limit_label("climbs steadily up to (P(not success) < risk)", &self.success_limit), orange, true),
-            (limit_label("safe up to (p_fail = P(sinks or slides back) < risk)", &self.limit), palette::MODEL_BLUE, false),
+            (
+                limit_label("safe up to (p_fail = P(sinks or slides back) < risk)", &self.limit),
+                palette::MODEL_BLUE,
+                false,
+            ),
         ];
         for (label, colour, dashed) in limits {
             let Some((value, label)) = label else { continue };

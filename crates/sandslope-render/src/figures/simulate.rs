@@ -454,7 +454,10 @@ where
     let trace: Vec<Point> = (0..=i).map(|k| world([tr.x_m[k], tr.z_m[k]])).filter(|&p| inside(p)).collect();
     let trace_colour = palette::BODY_TRACE;
     chart
-        .draw_series([PathElement::new(if trace.len() >= 2 { trace } else { Vec::new() }, trace_colour.stroke_width(2))])
+        .draw_series([PathElement::new(
+            if trace.len() >= 2 { trace } else { Vec::new() },
+            trace_colour.stroke_width(2),
+        )])
         .map_err(plot_err)?
         .label("path of the body's centre (black dot)")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], trace_colour.stroke_width(2)));
@@ -667,7 +670,8 @@ mod tests {
             phases.push((centres[0] + shift).rem_euclid(spacing));
             // (Outside the legend in the upper left, whose swatch has the trace's colour.)
             let legend = |k: usize| k % 800 < 320 && k / 800 < 160;
-            let traced = (0..800 * 450).any(|k| !legend(k) && is(&rgb, k % 800, k / 800, palette::BODY_TRACE));
+            let traced =
+                (0..800 * 450).any(|k| !legend(k) && is(&rgb, k % 800, k / 800, palette::BODY_TRACE));
             assert_eq!(traced, i > 0, "frame {i}: trace drawn {traced}");
         }
         assert!(sim.trajectory.x_m[174] - sim.trajectory.x_m[0] > 0.1, "the walk must move");

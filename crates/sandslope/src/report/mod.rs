@@ -38,12 +38,12 @@ use crate::terrain::{Terrain, TerrainPoint};
 pub use audit::{Extrapolation, NoFloorFit, SpeedInversion, StepBudget, PAPER_FRAME_RATE_HZ};
 pub use diagnosis::{FitDiagnosis, Miss, StepAtObservedT1, CONTRADICTION_SD};
 pub use provenance::{Input, Provenance, ProvenanceKind};
+pub use scope::Summary;
+use scope::{another_robot_without_observations, summary, terrain_rows_only};
 pub use simulator::{
     simulator_fit_misses, SimulatorMiss, SimulatorRecord, SimulatorWalks, AGREE_WITHIN, MISS_SD, REACH_K_S,
     REPORT_WALK_S,
 };
-pub use scope::Summary;
-use scope::{another_robot_without_observations, summary, terrain_rows_only};
 use tracks::TrackUse;
 pub use tracks::{TrackRecord, TrackedSlope};
 
@@ -523,7 +523,11 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
 
 /// The speeds the report fits and compares: the user's (`--observed`, else the tracks'), else
 /// the paper's five, which are of its 0.35 kg robot and so none on another robot.
-fn observed_speeds(evidence: &Evidence, tracks: &[SpeedObservation], papers_robot: bool) -> Vec<SpeedObservation> {
+fn observed_speeds(
+    evidence: &Evidence,
+    tracks: &[SpeedObservation],
+    papers_robot: bool,
+) -> Vec<SpeedObservation> {
     match &evidence.observed {
         Some((_, s)) => s.clone(),
         None if !evidence.tracks.is_empty() => tracks.to_vec(),
@@ -941,7 +945,11 @@ mod tests {
         e.robot_source = "mine.toml".into();
         assert!(paper::is_papers_robot(&paper_robot()) && !paper::is_papers_robot(&e.robot));
         let r = report(&e).unwrap();
-        assert!(r.warnings[0].contains("is not the paper's") && r.warnings[0].contains("1.2 kg"), "{:?}", r.warnings);
+        assert!(
+            r.warnings[0].contains("is not the paper's") && r.warnings[0].contains("1.2 kg"),
+            "{:?}",
+            r.warnings
+        );
         assert!(r.speeds.is_empty() && r.calibration.is_none());
         let ids: Vec<&str> = r.paper_vs_model.iter().map(|c| c.id.as_str()).collect();
         assert_eq!(ids, paper::TERRAIN_ROWS);
@@ -970,12 +978,21 @@ mod tests {
         let obs = |d: f64, v: f64, sd: f64| SpeedObservation { slope: at(d), speed: v, speed_sd: sd };
         e.observed = Some((
             "outlier.csv".into(),
-            vec![obs(0.0, 0.157, 0.0097), obs(10.0, 5.0, 0.0014), obs(15.0, 0.105, 0.0023), obs(20.0, 0.0498, 0.0032)],
+            vec![
+                obs(0.0, 0.157, 0.0097),
+                obs(10.0, 5.0, 0.0014),
+                obs(15.0, 0.105, 0.0023),
+                obs(20.0, 0.0498, 0.0032),
+            ],
         ));
         let start = std::time::Instant::now();
         let r = report(&e).unwrap();
         let fit = &r.calibration.as_ref().unwrap().fit;
-        assert!(scope::terrain_at_bound(fit).is_some_and(|(name, _)| name == "plate_scale"), "{:?}", fit.warnings);
+        assert!(
+            scope::terrain_at_bound(fit).is_some_and(|(name, _)| name == "plate_scale"),
+            "{:?}",
+            fit.warnings
+        );
         assert!(r.simulator.is_empty() && r.plots.simulated.is_empty());
         let w = r.warnings.iter().find(|w| w.contains("simulator section is left out")).expect("a warning");
         assert!(w.contains("plate_scale ran to its search bound"), "{w}");

@@ -157,7 +157,8 @@ mod tests {
         let why = simulator_walks(&paper_robot(), &stiff, &[], "stiff", None).unwrap_err();
         assert!(why.contains("k_s = 3.000e10 N/m^3 at 0°") && why.contains("1e3 to 1e10"), "{why}");
         let sand = Terrain::constant(7e5, 2e6).unwrap();
-        let why = simulator_walks(&paper_robot(), &sand, &[], "sand", Some(("plate_scale".into(), 1e4))).unwrap_err();
+        let why = simulator_walks(&paper_robot(), &sand, &[], "sand", Some(("plate_scale".into(), 1e4)))
+            .unwrap_err();
         assert!(why.contains("plate_scale ran to its search bound (1.000e4)"), "{why}");
     }
 }

@@ -130,7 +130,7 @@ fn the_status_endpoint_and_the_drive_tab_follow_an_emulated_run() {
     let (mid, _) = server.wait_for(Duration::from_secs(120), |s| s["estimates"].as_u64().unwrap() >= 2);
     assert_eq!(mid["state"], "driving", "{mid}");
     // The leg speed measured from the servos' positions is the robot file's omega: the
-    // emulated shafts follow the commanded gait (within 5%: a quarter second of positions).
+    // emulated shafts follow the commanded gait (within 5%: a stride period of positions after the run-up).
     let speed = mid["leg_speed_rad_s"].as_f64().unwrap();
     assert!((speed - OMEGA).abs() < 0.05 * OMEGA, "leg speed {speed} rad/s against {OMEGA}");
     assert!((mid["commanded_leg_speed_rad_s"].as_f64().unwrap() - OMEGA).abs() < 1e-9);

@@ -388,18 +388,7 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
             missing.push(line);
             continue;
         }
-        if let Some((k, (lo, hi, unit))) = PLAUSIBLE
-            .iter()
-            .enumerate()
-            .find_map(|(k, r)| r.filter(|(lo, hi, _)| !(*lo..=*hi).contains(&v[k])).map(|r| (k, r)))
-        {
-            bail!(
-                "{}: `{}` = {} is outside {lo} to {hi} {unit}, the plausible range of a Dynamixel's reading (is the column in the log's unit?)",
-                at(),
-                COLUMNS[k],
-                if v[k].abs() >= 1e6 { format!("{:e}", v[k]) } else { v[k].to_string() }
-            );
-        }
+        plausible(&v, &at)?;
         let int = |k: usize, lo: i64, hi: i64| whole(v[k], COLUMNS[k], lo, hi, &at);
         rows.push(ServoLogRow {
             time_s: v[0],
@@ -434,6 +423,24 @@ pub fn read_servo_log(path: &Path) -> Result<ServoLog> {
         bail!("{}: the log has no complete rows", path.display());
     }
     Ok(ServoLog { meta, rows, lines, notes })
+}
+
+/// Refuses a row's value outside its column's plausible range ([`PLAUSIBLE`]), naming the
+/// column, the range and its unit.
+fn plausible(v: &[f64; 14], at: &dyn Fn() -> String) -> Result<()> {
+    if let Some((k, (lo, hi, unit))) = PLAUSIBLE
+        .iter()
+        .enumerate()
+        .find_map(|(k, r)| r.filter(|(lo, hi, _)| !(*lo..=*hi).contains(&v[k])).map(|r| (k, r)))
+    {
+        bail!(
+            "{}: `{}` = {} is outside {lo} to {hi} {unit}, the plausible range of a Dynamixel's reading (is the column in the log's unit?)",
+            at(),
+            COLUMNS[k],
+            if v[k].abs() >= 1e6 { format!("{:e}", v[k]) } else { v[k].to_string() }
+        );
+    }
+    Ok(())
 }
 
 /// The plausible range of each column, in the order of [`COLUMNS`] (`None`: any finite value):

@@ -73,7 +73,9 @@ def test_infer_servo_log_equals_the_cli_on_the_same_log(cli, tmp_path):
     # The emulated sand's k_s inside the 90% interval (docs/drive.md: 3 of 3 seeds).
     assert got["k_s_lo"] <= 2.5e5 <= got["k_s_hi"], got
     # A clean log: nothing repaired; columns passed in: nothing read, nothing repaired.
-    assert got["notes"] == [] and again["notes"] == []
+    # (A time gap is a slow cycle of the emulated run on a loaded machine, recorded truly, not
+    # damage: the one note allowed, as in crates/sandslope-cli/tests/drive.rs.)
+    assert [n for n in got["notes"] if "gap(s) in time" not in n] == [] and again["notes"] == []
     # A messy one: two rows written twice and the last row cut mid-way. The reader says so in
     # `notes`, the same list as the CLI's `--json`.
     lines = path.read_text().splitlines(keepends=True)

@@ -205,8 +205,11 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
     // Either flag stops the gait: the stop button's or the signal handler's.
     let stop = AtomicBool::new(false);
     // Each leg's speed from its positions a stride period apart, as the run's report gives it.
-    let mut meter =
-        LegSpeedMeter::with_window(session.config().settings.servos.len(), session.schedule.period_s);
+    let mut meter = LegSpeedMeter::with_window(
+        session.config().settings.servos.len(),
+        session.schedule.period_s,
+        session.schedule.run_up_s,
+    );
     let mut on_sample = |s: &ServoSample| {
         if live.stop.load(Ordering::Relaxed) || flags.stop.load(Ordering::Relaxed) {
             stop.store(true, Ordering::Relaxed);

@@ -265,7 +265,8 @@ pub fn drive(
     on_live: &mut dyn FnMut(&LiveEstimate),
 ) -> (DriveReport, Option<DriveError>) {
     let mut report = DriveReport::not_started(String::new());
-    let mut meter = crate::speed::LegSpeedMeter::with_window(settings.servos.len(), schedule.period_s);
+    let mut meter =
+        crate::speed::LegSpeedMeter::with_window(settings.servos.len(), schedule.period_s, schedule.run_up_s);
     let result = {
         let mut observed = |s: &ServoSample| {
             meter.observe(s.leg, s.time_s, s.leg_angle_rad);

@@ -208,7 +208,7 @@ impl Session {
         };
         let (port, emulator) = match &config.bus {
             BusChoice::Emulate(o) => {
-                if o.k_s.is_none() && !(ground.k_s > 0.0) {
+                if o.k_s.is_none() && ground.k_s.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                     return Err(SessionError::Setting(format!(
                         "--slope {}: the terrain's sand has no shear strength at this slope (k_s = {}: at or beyond its angle of repose), so the emulator has no sand to walk on; give the emulated sand's k_s with --emulate-k-s, or a shallower --slope",
                         config.slope_deg, ground.k_s

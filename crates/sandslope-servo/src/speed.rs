@@ -13,27 +13,34 @@ pub struct LegSpeedMeter {
     /// Per leg, its speed over the last full window, rad/s.
     speeds: Vec<Option<f64>>,
     window_s: f64,
+    start_s: f64,
 }
 
 impl LegSpeedMeter {
     /// A meter for `legs` legs, no window measured yet.
     pub fn new(legs: usize) -> LegSpeedMeter {
-        LegSpeedMeter::with_window(legs, LEG_SPEED_WINDOW_S)
+        LegSpeedMeter::with_window(legs, LEG_SPEED_WINDOW_S, 0.0)
     }
 
     /// A meter over windows of `window_s`: one stride period (`drive` and `serve --drive`
     /// use the gait's) takes the leg's mean over its whole turn, steady though a servo slows in
     /// stance and catches up in swing, where a shorter window swings with the stride's phase.
-    /// Samples while standing (`time_s < 0`) are left out.
-    pub fn with_window(legs: usize, window_s: f64) -> LegSpeedMeter {
-        LegSpeedMeter { anchor: vec![None; legs], speeds: vec![None; legs], window_s }
+    /// Samples before `start_s` (standing, and the gait's run-up, whose speed is not the
+    /// leg speed yet) are left out.
+    pub fn with_window(legs: usize, window_s: f64, start_s: f64) -> LegSpeedMeter {
+        LegSpeedMeter {
+            anchor: vec![None; legs],
+            speeds: vec![None; legs],
+            window_s,
+            start_s: start_s.max(0.0),
+        }
     }
 
     /// Takes leg `leg`'s angle `angle_rad` at time `time_s` (one servo's sample: its
     /// `leg`, `time_s` and `leg_angle_rad`); a leg beyond the meter's is ignored.
     pub fn observe(&mut self, leg: usize, time_s: f64, angle_rad: f64) {
         let Some(anchor) = self.anchor.get_mut(leg) else { return };
-        if time_s < 0.0 {
+        if time_s < self.start_s {
             return;
         }
         match *anchor {

@@ -275,7 +275,14 @@ fn messages_name_what_was_given() {
     assert_eq!(out.status.code(), Some(2), "{all}");
     assert!(all.contains("header line `# slope_deg` = NaN must be strictly between -90 and 90"), "{all}");
     assert!(all.contains("give the run's slope with --slope"), "{all}");
+    // Without --force the safe slope refuses it first (the sand's repose, 25 deg); with it, the
+    // emulator says the terrain has no sand there.
     let out = bin().args(["drive", "--emulate", "--slope", "89", "--duration", "1"]).output().unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{all}");
+    assert!(all.contains("--slope 89 is beyond the calibrated safe slope"), "{all}");
+    let out =
+        bin().args(["drive", "--emulate", "--slope", "89", "--force", "--duration", "1"]).output().unwrap();
     let all = text(&out);
     assert_eq!(out.status.code(), Some(2), "{all}");
     assert!(all.contains("--slope 89: the terrain's sand has no shear strength"), "{all}");
@@ -340,6 +347,12 @@ fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
     let (sim, closed) = (p["p_fail_simulator"].as_f64().unwrap(), p["p_fail_closed_form"].as_f64().unwrap());
     assert!(closed > 0.5 && closed > sim, "{p}");
     assert_eq!(p["p_fail"].as_f64().unwrap(), closed.max(sim));
+    // The EEPROM written only where it differs: against the emulator's factory tables (Return
+    // Delay Time 250, Operating Mode 3, Temperature Limit 70, Current Limit 1750, Velocity
+    // Limit 445, Drive Mode 0) five registers a servo differ and one holds: 30 written, 6 kept.
+    assert_eq!(v["setup"]["eeprom_written"], 30, "{}", v["setup"]);
+    assert_eq!(v["setup"]["eeprom_kept"], 6, "{}", v["setup"]);
+    assert_eq!(v["setup"]["counter_cleared"], true);
     // The prior (the terrain's own k_s at 20 deg, inside its safe slope) did not halt it.
     assert!(v["prior_p_fail"].as_f64().unwrap() < 0.5, "{v}");
 }

@@ -128,7 +128,7 @@ def drive(
     hold_s: Optional[float] = None,
     rate_hz: Optional[float] = None,
     live: Optional[bool] = None,
-    force: bool = False,
+    force: Optional[bool] = None,
     window: Optional[int] = None,
 ) -> Tuple[Any, Dict[str, Any]]:
     """A run of ``sandslope drive --emulate`` (docs/drive.md): the robot's alternating tripod
@@ -141,7 +141,7 @@ def drive(
     after every stance (off by default, as ``drive --live``), pooled over every stance so far
     or the last ``window``; ``stop_on_risk`` halts the gait when the pooled P(fail), the larger
     of the simulator's and the closed form's, passes it. A slope beyond the calibrated safe
-    slope is refused unless ``force=True`` (as ``drive --force``).
+    slope is refused unless ``force=True`` (as ``drive --force``; off when left out).
 
     Returns ``(log, report)``: ``log`` the servo log's columns (a pandas DataFrame, or a dict of
     NumPy arrays without pandas; ``infer_servo_log`` reads it), ``report`` what ``drive --json``
@@ -169,9 +169,11 @@ def drive(
         hold_s=None if hold_s is None else float(hold_s),
         rate_hz=None if rate_hz is None else float(rate_hz),
         live=None if live is None else bool(live),
-        force=bool(force),
+        force=None if force is None else bool(force),
         window=None if window is None else int(window),
     )
+    # `drive --json`'s bus budget: none for the emulator, whose pseudo-terminal is not limited.
+    report.setdefault("bus_max_rate_hz", None)
     slope = float(drive_defaults()["slope_deg"] if slope_deg is None else slope_deg)
     return _frame(columns, {"slope_deg": repr(slope)}), report
 

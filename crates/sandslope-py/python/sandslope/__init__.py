@@ -19,8 +19,7 @@ Units are SI throughout: kg, m, s, N/m^3 for ``k_n`` and ``k_s``; angles in degr
 Regimes are returned as ``int8`` codes, indices into :data:`REGIMES`.
 
 Errors in inputs raise :class:`ValueError` with the CLI's message: the key, the value and the
-valid range (and the file, for TOML files).
-
+valid range (and the file, for TOML files); a missing file raises :class:`FileNotFoundError`.
 Heavy calls release the GIL and run in parallel on all cores.
 """
 

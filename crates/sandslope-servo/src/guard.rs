@@ -10,7 +10,7 @@
 
 use sandslope::servo::xl330;
 
-use crate::driver::{DynamixelBus, ServoConfig};
+use crate::config::{DynamixelBus, ServoConfig};
 use crate::error::DriveError;
 use crate::table as t;
 

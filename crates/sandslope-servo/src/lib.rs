@@ -16,6 +16,7 @@
 //! The bus is the one place this crate touches hardware; the physics (the schedule, the
 //! servo's torque constant, the inference from currents) is the library's.
 
+pub mod config;
 pub mod driver;
 pub mod emulator;
 pub mod error;

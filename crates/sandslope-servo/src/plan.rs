@@ -4,7 +4,7 @@
 
 use sandslope::servo::{xl330, GaitSchedule};
 
-use crate::driver::{Profile, ServoConfig};
+use crate::config::{Profile, ServoConfig};
 
 /// The widest a leg's start goal can lie from zero once its revolution counter is cleared: the
 /// CLEAR instruction puts Present Position within one turn (0 to 4095), and the stand-up goes

@@ -7,7 +7,7 @@
 use dynamixel2::ReadError;
 use sandslope::servo::{xl330, GaitSchedule};
 
-use crate::driver::{DriveSettings, DynamixelBus, Profile};
+use crate::config::{DriveSettings, DynamixelBus, Profile};
 use crate::error::DriveError;
 use crate::table::{self as t, mode};
 

@@ -332,6 +332,9 @@ def test_drive_log_mcap_reads_back_and_infers(tmp_path):
     assert len(topics["/joint_states"]) == len(topics["/sandslope/commands"]) > 100
     assert "slope_deg = 20" in topics["/sandslope/run"][0][1].data
     assert len(topics.get("/sandslope/live", [])) >= 1
+    # The verdict is the outcome as `drive --json` gives it, not Rust's Result wrapper.
+    verdict = json.loads(topics["/sandslope/verdict"][-1][1].data)
+    assert "Ok" not in verdict and verdict["outcome"] == "completed", verdict
     _, js = topics["/joint_states"][-1]
     assert list(js.name) == [f"leg_{j}" for j in range(6)]
     # The slope from the bag's /sandslope/run header, as from a CSV log's `# slope_deg` line.

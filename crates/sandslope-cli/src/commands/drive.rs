@@ -679,7 +679,11 @@ fn write_mcap_log(
             ],
         })
         .collect();
-    let verdict =
-        failure.map_or_else(|| serde_json::to_string(&report.outcome).unwrap_or_default(), |e| e.to_string());
+    // The outcome as `--json` gives it (`{"outcome": "completed", ...}`), never Rust's `Result`.
+    let verdict = match (failure, &report.outcome) {
+        (Some(e), _) => e.to_string(),
+        (None, Ok(outcome)) => serde_json::to_string(outcome)?,
+        (None, Err(why)) => why.clone(),
+    };
     sandslope_io::write_atomic(path, &drive_mcap(rows, &live, meta, &verdict)?)
 }

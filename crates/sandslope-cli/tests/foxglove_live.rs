@@ -1,0 +1,174 @@
+//! `drive --foxglove` (docs/bags.md, "Watch live"): a Foxglove WebSocket client on loopback
+//! (tungstenite, speaking `foxglove.websocket.v1` as Foxglove does) subscribes to every
+//! channel a 5 s emulated drive advertises and checks the schemas, the framing of
+//! `messageData`, and that `/joint_states` comes once a bus cycle.
+
+use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use sandslope_io::bag::messages::{decode, JointState, StringMsg};
+use serde_json::{json, Value};
+use tungstenite::{ClientRequestBuilder, Message};
+
+/// A channel as advertised: topic, schema name, schema encoding, schema.
+type Advertised = (String, String, String, String);
+
+#[test]
+fn a_drive_streams_its_channels_once_a_cycle() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sandslope"))
+        .args([
+            "drive",
+            "--emulate",
+            "--slope",
+            "10",
+            "--duration",
+            "5",
+            "--json",
+            "--foxglove",
+            "127.0.0.1:0",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    // Bounded: the drive is killed after 90 s whatever happens (it takes about 8 s).
+    let watchdog = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_secs(90));
+        let _ = Command::new("kill").arg(pid.to_string()).status();
+    });
+    let _ = watchdog;
+    // The address, from the line the drive prints on stderr (port 0: a free one).
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut url = None;
+    let mut said = String::new();
+    for _ in 0..50 {
+        let mut line = String::new();
+        if stderr.read_line(&mut line).unwrap() == 0 {
+            break;
+        }
+        said.push_str(&line);
+        if let Some(rest) = line.strip_prefix("foxglove: streaming on ") {
+            url = rest.split_whitespace().next().map(str::to_string);
+            break;
+        }
+    }
+    let url = url.unwrap_or_else(|| panic!("no address said: {said}"));
+    assert!(url.starts_with("ws://127.0.0.1:"), "{url}");
+    let drain = std::thread::spawn(move || std::io::read_to_string(stderr).unwrap_or_default());
+
+    let request = ClientRequestBuilder::new(url.parse().unwrap()).with_sub_protocol("foxglove.websocket.v1");
+    let (mut ws, response) = tungstenite::connect(request).unwrap();
+    assert_eq!(response.headers()["Sec-WebSocket-Protocol"], "foxglove.websocket.v1");
+
+    let mut channels: BTreeMap<u64, Advertised> = BTreeMap::new();
+    let mut server_info = None;
+    // Per subscription (1000 + channel id): (messageData time, payload).
+    let mut received: BTreeMap<u64, Vec<(u64, Vec<u8>)>> = BTreeMap::new();
+    let start = Instant::now();
+    loop {
+        let m = match ws.read() {
+            Ok(m) => m,
+            Err(_) => break, // the drive ended and closed the connection
+        };
+        match m {
+            Message::Text(t) => {
+                let v: Value = serde_json::from_str(t.as_str()).unwrap();
+                match v["op"].as_str().unwrap() {
+                    "serverInfo" => server_info = Some(v),
+                    "advertise" => {
+                        let mut subs = Vec::new();
+                        for c in v["channels"].as_array().unwrap() {
+                            let id = c["id"].as_u64().unwrap();
+                            assert_eq!(c["encoding"], "cdr");
+                            let s = |k: &str| c[k].as_str().unwrap().to_string();
+                            channels
+                                .insert(id, (s("topic"), s("schemaName"), s("schemaEncoding"), s("schema")));
+                            subs.push(json!({"id": 1000 + id, "channelId": id}));
+                        }
+                        let sub = json!({"op": "subscribe", "subscriptions": subs}).to_string();
+                        ws.send(Message::Text(sub.into())).unwrap();
+                    }
+                    other => panic!("unexpected op {other}"),
+                }
+            }
+            Message::Binary(b) => {
+                // messageData: opcode 1, u32 subscription id, u64 time (ns), the message.
+                assert_eq!(b[0], 1, "opcode");
+                let sub = u32::from_le_bytes(b[1..5].try_into().unwrap()) as u64;
+                let t = u64::from_le_bytes(b[5..13].try_into().unwrap());
+                received.entry(sub).or_default().push((t, b[13..].to_vec()));
+            }
+            Message::Close(_) => break,
+            _ => {}
+        }
+    }
+    let out = child.wait_with_output().unwrap();
+    let said = said + &drain.join().unwrap();
+    assert!(out.status.success(), "{said}");
+    assert!(start.elapsed() < Duration::from_secs(80), "the drive did not stop by itself");
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+
+    let info = server_info.expect("serverInfo first");
+    assert_eq!(info["name"], "sandslope drive");
+    let topic_id = |topic: &str| {
+        let (&id, c) =
+            channels.iter().find(|(_, c)| c.0 == topic).unwrap_or_else(|| panic!("{topic} not advertised"));
+        assert_eq!(c.2, "ros2msg", "{topic}");
+        (id, c)
+    };
+    let (js, js_channel) = topic_id("/joint_states");
+    assert_eq!(js_channel.1, "sensor_msgs/msg/JointState");
+    // The ros2msg definition of sensor_msgs/JointState and its nested std_msgs/Header.
+    for field in [
+        "float64[] position",
+        "float64[] velocity",
+        "float64[] effort",
+        "string[] name",
+        "MSG: std_msgs/Header",
+    ] {
+        assert!(js_channel.3.contains(field), "schema lacks {field}: {}", js_channel.3);
+    }
+    let (commands, c) = topic_id("/sandslope/commands");
+    assert_eq!(c.1, "sensor_msgs/msg/JointState");
+    let (run, c) = topic_id("/sandslope/run");
+    assert_eq!(c.1, "std_msgs/msg/String");
+    let (verdict, _) = topic_id("/sandslope/verdict");
+
+    // The run's header, latched: its slope.
+    let header = &received[&(1000 + run)];
+    assert_eq!(header.len(), 1);
+    assert!(decode::<StringMsg>(&header[0].1).unwrap().data.contains("slope_deg = 10\n"));
+    assert_eq!(received[&(1000 + verdict)].len(), 1);
+
+    // Once a cycle: 50 Hz (docs/drive.md's default --rate), six legs named in leg order, the
+    // message's time its header's stamp, times increasing.
+    let states = &received[&(1000 + js)];
+    assert_eq!(received[&(1000 + commands)].len(), states.len());
+    let mut last = 0;
+    for (t, bytes) in states {
+        let m: JointState = decode(bytes).unwrap();
+        let names: Vec<String> = (0..6).map(|j| format!("leg_{j}")).collect();
+        assert_eq!(m.name, names);
+        assert_eq!((m.position.len(), m.effort.len()), (6, 6));
+        let stamp = m.header.stamp.sec as u64 * 1_000_000_000 + m.header.stamp.nanosec as u64;
+        assert_eq!(stamp, *t);
+        assert!(*t > last, "times not increasing");
+        last = *t;
+    }
+    let cycles = report["cycles"].as_u64().unwrap();
+    let span_s = (states.last().unwrap().0 - states[0].0) as f64 * 1e-9;
+    // The gait's 5 s were covered (the client subscribes before the servos move).
+    assert!(span_s >= 4.9, "{span_s} s streamed");
+    // Every cycle of the stretch received, none twice: one message per 20 ms of gait time.
+    let expected = span_s / 0.02 + 1.0;
+    assert!(
+        (states.len() as f64 - expected).abs() <= 0.02 * expected,
+        "{} messages over {span_s} s, expected {expected} (one per 20 ms cycle)",
+        states.len()
+    );
+    assert!(states.len() as u64 <= cycles, "{} messages, {cycles} cycles", states.len());
+    eprintln!("{} JointState messages over {span_s:.3} s; the drive reported {cycles} cycles", states.len());
+}

@@ -244,6 +244,8 @@ fn handshake(stream: TcpStream) -> Option<WebSocket<TcpStream>> {
     stream.set_nonblocking(false).ok()?;
     stream.set_read_timeout(Some(Duration::from_secs(5))).ok()?;
     stream.set_write_timeout(Some(Duration::from_secs(2))).ok()?;
+    // The closure's type is tungstenite's handshake callback; its error is an HTTP response.
+    #[allow(clippy::result_large_err)]
     let check = |request: &Request, mut response: Response| -> Result<Response, ErrorResponse> {
         let asks = request
             .headers()

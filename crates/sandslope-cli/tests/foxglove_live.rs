@@ -1,7 +1,7 @@
-//! `drive --foxglove` (docs/bags.md, "Watch live"): a Foxglove WebSocket client on loopback
-//! (tungstenite, speaking `foxglove.websocket.v1` as Foxglove does) subscribes to every
-//! channel a 5 s emulated drive advertises and checks the schemas, the framing of
-//! `messageData`, and that `/joint_states` comes once a bus cycle.
+//! `drive --foxglove` and `simulate --foxglove` (docs/bags.md, "Watch live"): a Foxglove
+//! WebSocket client on loopback (tungstenite, speaking `foxglove.websocket.v1` as Foxglove
+//! does) subscribes to every channel a run advertises and checks the schemas, the framing of
+//! `messageData`, and that a 5 s emulated drive's `/joint_states` comes once a bus cycle.
 
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
@@ -15,31 +15,49 @@ use tungstenite::{ClientRequestBuilder, Message};
 /// A channel as advertised: topic, schema name, schema encoding, schema.
 type Advertised = (String, String, String, String);
 
-#[test]
-fn a_drive_streams_its_channels_once_a_cycle() {
+/// What a viewer saw of a run: serverInfo, the channels by id, the messages by subscription
+/// (1000 + channel id) as (messageData time, payload), and the run's stdout.
+struct Watched {
+    info: Value,
+    channels: BTreeMap<u64, Advertised>,
+    received: BTreeMap<u64, Vec<(u64, Vec<u8>)>>,
+    stdout: Vec<u8>,
+}
+
+impl Watched {
+    /// The id and advertisement of `topic`'s channel (schema encoding ros2msg checked).
+    fn channel(&self, topic: &str) -> (u64, &Advertised) {
+        let (&id, c) = self
+            .channels
+            .iter()
+            .find(|(_, c)| c.0 == topic)
+            .unwrap_or_else(|| panic!("{topic} not advertised"));
+        assert_eq!(c.2, "ros2msg", "{topic}");
+        (id, c)
+    }
+
+    /// The messages received on `topic`.
+    fn on(&self, topic: &str) -> &[(u64, Vec<u8>)] {
+        self.received.get(&(1000 + self.channel(topic).0)).map_or(&[], |v| v.as_slice())
+    }
+}
+
+/// Runs `sandslope ARGS --foxglove 127.0.0.1:0`, connects to the address it says as a
+/// Foxglove client, subscribes to every channel advertised and reads until the run closes the
+/// connection. Bounded: the run is killed after 90 s whatever happens.
+fn watch(args: &[&str]) -> Watched {
     let mut child = Command::new(env!("CARGO_BIN_EXE_sandslope"))
-        .args([
-            "drive",
-            "--emulate",
-            "--slope",
-            "10",
-            "--duration",
-            "5",
-            "--json",
-            "--foxglove",
-            "127.0.0.1:0",
-        ])
+        .args(args)
+        .args(["--foxglove", "127.0.0.1:0"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
     let pid = child.id();
-    // Bounded: the drive is killed after 90 s whatever happens (it takes about 8 s).
-    let watchdog = std::thread::spawn(move || {
+    std::thread::spawn(move || {
         std::thread::sleep(Duration::from_secs(90));
         let _ = Command::new("kill").arg(pid.to_string()).status();
     });
-    let _ = watchdog;
     // The address, from the line the drive prints on stderr (port 0: a free one).
     let mut stderr = BufReader::new(child.stderr.take().unwrap());
     let mut url = None;
@@ -109,17 +127,17 @@ fn a_drive_streams_its_channels_once_a_cycle() {
     let said = said + &drain.join().unwrap();
     assert!(out.status.success(), "{said}");
     assert!(start.elapsed() < Duration::from_secs(80), "the drive did not stop by itself");
-    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
-
     let info = server_info.expect("serverInfo first");
-    assert_eq!(info["name"], "sandslope drive");
-    let topic_id = |topic: &str| {
-        let (&id, c) =
-            channels.iter().find(|(_, c)| c.0 == topic).unwrap_or_else(|| panic!("{topic} not advertised"));
-        assert_eq!(c.2, "ros2msg", "{topic}");
-        (id, c)
-    };
-    let (js, js_channel) = topic_id("/joint_states");
+    Watched { info, channels, received, stdout: out.stdout }
+}
+
+#[test]
+fn a_drive_streams_its_channels_once_a_cycle() {
+    let w = watch(&["drive", "--emulate", "--slope", "10", "--duration", "5", "--json"]);
+    let report: Value = serde_json::from_slice(&w.stdout).unwrap();
+
+    assert_eq!(w.info["name"], "sandslope drive");
+    let (_, js_channel) = w.channel("/joint_states");
     assert_eq!(js_channel.1, "sensor_msgs/msg/JointState");
     // The ros2msg definition of sensor_msgs/JointState and its nested std_msgs/Header.
     for field in [
@@ -131,22 +149,19 @@ fn a_drive_streams_its_channels_once_a_cycle() {
     ] {
         assert!(js_channel.3.contains(field), "schema lacks {field}: {}", js_channel.3);
     }
-    let (commands, c) = topic_id("/sandslope/commands");
-    assert_eq!(c.1, "sensor_msgs/msg/JointState");
-    let (run, c) = topic_id("/sandslope/run");
-    assert_eq!(c.1, "std_msgs/msg/String");
-    let (verdict, _) = topic_id("/sandslope/verdict");
+    assert_eq!(w.channel("/sandslope/commands").1 .1, "sensor_msgs/msg/JointState");
+    assert_eq!(w.channel("/sandslope/run").1 .1, "std_msgs/msg/String");
 
     // The run's header, latched: its slope.
-    let header = &received[&(1000 + run)];
+    let header = w.on("/sandslope/run");
     assert_eq!(header.len(), 1);
     assert!(decode::<StringMsg>(&header[0].1).unwrap().data.contains("slope_deg = 10\n"));
-    assert_eq!(received[&(1000 + verdict)].len(), 1);
+    assert_eq!(w.on("/sandslope/verdict").len(), 1);
 
     // Once a cycle: 50 Hz (docs/drive.md's default --rate), six legs named in leg order, the
     // message's time its header's stamp, times increasing.
-    let states = &received[&(1000 + js)];
-    assert_eq!(received[&(1000 + commands)].len(), states.len());
+    let states = w.on("/joint_states");
+    assert_eq!(w.on("/sandslope/commands").len(), states.len());
     let mut last = 0;
     for (t, bytes) in states {
         let m: JointState = decode(bytes).unwrap();
@@ -171,4 +186,30 @@ fn a_drive_streams_its_channels_once_a_cycle() {
     );
     assert!(states.len() as u64 <= cycles, "{} messages, {cycles} cycles", states.len());
     eprintln!("{} JointState messages over {span_s:.3} s; the drive reported {cycles} cycles", states.len());
+}
+
+/// `simulate --foxglove`: the walk of `--out walk.mcap` played once a viewer subscribes, every
+/// sample of the 120 Hz trajectory on each of its four channels, in real time.
+#[test]
+fn a_simulated_walk_plays_to_a_viewer() {
+    let started = Instant::now();
+    let w = watch(&["simulate", "--slope", "10", "--duration", "1.5", "--json"]);
+    assert_eq!(w.info["name"], "sandslope simulate");
+    let types = [
+        ("/sandslope/pose", "geometry_msgs/msg/PoseStamped"),
+        ("/tf", "tf2_msgs/msg/TFMessage"),
+        ("/joint_states", "sensor_msgs/msg/JointState"),
+        ("/sandslope/leg_forces", "visualization_msgs/msg/MarkerArray"),
+    ];
+    let poses = w.on("/sandslope/pose");
+    for (topic, ty) in types {
+        assert_eq!(w.channel(topic).1 .1, ty);
+        assert_eq!(w.on(topic).len(), poses.len(), "{topic}");
+    }
+    // 1.5 s at 120 Hz (--rate's default): samples 1/120 s apart from 0 to 1.5 s.
+    assert!((180..=181).contains(&poses.len()), "{} poses", poses.len());
+    let span_s = (poses.last().unwrap().0 - poses[0].0) as f64 * 1e-9;
+    assert!((span_s - 1.5).abs() < 0.01, "{span_s}");
+    // Played in real time: the run lasted at least the walk's 1.5 s.
+    assert!(started.elapsed() >= Duration::from_millis(1500));
 }

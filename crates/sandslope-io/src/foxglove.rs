@@ -183,7 +183,12 @@ pub fn play_simulation(
     slope_deg: f64,
     wait_s: f64,
 ) -> Result<()> {
+    use crate::bag::messages::{JointState, MarkerArray, PoseStamped, TfMessage};
     let mut server = LiveServer::start(addr, "sandslope simulate")?;
+    server.advertise::<PoseStamped>("/sandslope/pose");
+    server.advertise::<TfMessage>("/tf");
+    server.advertise::<JointState>("/joint_states");
+    server.advertise::<MarkerArray>("/sandslope/leg_forces");
     eprintln!("foxglove: streaming on ws://{} (in Foxglove: Open connection)", server.local_addr());
     server.wait_for_subscriber(std::time::Duration::from_secs_f64(wait_s.max(0.0)));
     let mut paced = Paced { server: &mut server, start: std::time::Instant::now(), wall0: now_ns() };

@@ -213,3 +213,22 @@ fn a_simulated_walk_plays_to_a_viewer() {
     // Played in real time: the run lasted at least the walk's 1.5 s.
     assert!(started.elapsed() >= Duration::from_millis(1500));
 }
+
+/// A port already taken: exit 2 naming the address, before the servos move, no log left.
+#[test]
+fn a_taken_port_stops_the_drive_before_it_moves() {
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = taken.local_addr().unwrap().to_string();
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("run.mcap");
+    let out = Command::new(env!("CARGO_BIN_EXE_sandslope"))
+        .args(["drive", "--emulate", "--duration", "2", "--foxglove", &addr, "--log"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(&format!("--foxglove {addr}")) && err.contains("cannot listen"), "{err}");
+    assert!(!err.contains("driving"), "the servos were started: {err}");
+    assert!(!log.exists());
+}

@@ -287,11 +287,12 @@ fn serve(mut ws: WebSocket<TcpStream>, shared: &Shared) {
         id
     };
     let _ = ws.get_ref().set_read_timeout(Some(Duration::from_millis(10)));
-    loop {
+    // A write that fails (the viewer gone, or not reading for the 2 s write timeout) ends it.
+    'serve: loop {
         let mut wrote = false;
         while let Ok(m) = rx.try_recv() {
             if ws.write(m).is_err() {
-                break;
+                break 'serve;
             }
             wrote = true;
         }
@@ -301,7 +302,9 @@ fn serve(mut ws: WebSocket<TcpStream>, shared: &Shared) {
         if shared.stop.load(Ordering::SeqCst) {
             // Whatever was published before the stop is in the queue: send it, then close.
             while let Ok(m) = rx.try_recv() {
-                let _ = ws.write(m);
+                if ws.write(m).is_err() {
+                    break 'serve;
+                }
             }
             let _ = ws.close(None);
             let _ = ws.flush();

@@ -177,13 +177,18 @@ fn a_drive_streams_its_channels_once_a_cycle() {
     let span_s = (states.last().unwrap().0 - states[0].0) as f64 * 1e-9;
     // The gait's 5 s were covered (the client subscribes before the servos move).
     assert!(span_s >= 4.9, "{span_s} s streamed");
-    // Every cycle of the stretch received, none twice: one message per 20 ms of gait time.
-    let expected = span_s / 0.02 + 1.0;
+    // Every cycle of the stretch received, none twice: as many messages as cycles at the
+    // rate the drive achieved (50 Hz, docs/drive.md's default --rate, on an idle machine;
+    // cycle times are measured, so a loaded machine's late cycles are fewer, not missing).
+    let rate_hz = report["rate_hz"].as_f64().unwrap();
+    let expected = span_s * rate_hz + 1.0;
     assert!(
-        (states.len() as f64 - expected).abs() <= 0.02 * expected,
-        "{} messages over {span_s} s, expected {expected} (one per 20 ms cycle)",
+        (states.len() as f64 - expected).abs() <= 0.03 * expected,
+        "{} messages over {span_s} s, expected {expected} (one a cycle at {rate_hz} Hz)",
         states.len()
     );
+    // At most the first second of the run (the client connecting) missed.
+    assert!(states.len() as f64 >= cycles as f64 - rate_hz, "{} messages, {cycles} cycles", states.len());
     assert!(states.len() as u64 <= cycles, "{} messages, {cycles} cycles", states.len());
     eprintln!("{} JointState messages over {span_s:.3} s; the drive reported {cycles} cycles", states.len());
 }

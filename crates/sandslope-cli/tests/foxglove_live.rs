@@ -8,7 +8,7 @@ use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use sandslope_io::bag::messages::{decode, JointState, StringMsg};
+use sandslope_io::bag::messages::{decode, Float64Array, JointState, StringMsg};
 use serde_json::{json, Value};
 use tungstenite::{ClientRequestBuilder, Message};
 
@@ -133,7 +133,7 @@ fn watch(args: &[&str]) -> Watched {
 
 #[test]
 fn a_drive_streams_its_channels_once_a_cycle() {
-    let w = watch(&["drive", "--emulate", "--slope", "10", "--duration", "5", "--json"]);
+    let w = watch(&["drive", "--emulate", "--slope", "10", "--duration", "5", "--live", "--json"]);
     let report: Value = serde_json::from_slice(&w.stdout).unwrap();
 
     assert_eq!(w.info["name"], "sandslope drive");
@@ -157,6 +157,15 @@ fn a_drive_streams_its_channels_once_a_cycle() {
     assert_eq!(header.len(), 1);
     assert!(decode::<StringMsg>(&header[0].1).unwrap().data.contains("slope_deg = 10\n"));
     assert_eq!(w.on("/sandslope/verdict").len(), 1);
+    // `--live`: one /sandslope/live a stance the report lists, its ten labelled numbers.
+    let live = w.on("/sandslope/live");
+    assert_eq!(live.len(), report["live"].as_array().unwrap().len());
+    assert!(!live.is_empty());
+    for (_, bytes) in live {
+        let m: Float64Array = decode(bytes).unwrap();
+        assert_eq!(m.data.len(), 10);
+        assert!(m.layout.dim[0].label.starts_with("tripod,k_s_n_m3,"));
+    }
 
     // Once a cycle: 50 Hz (docs/drive.md's default --rate), six legs named in leg order, the
     // message's time its header's stamp, times increasing.
@@ -190,7 +199,11 @@ fn a_drive_streams_its_channels_once_a_cycle() {
     // At most the first second of the run (the client connecting) missed.
     assert!(states.len() as f64 >= cycles as f64 - rate_hz, "{} messages, {cycles} cycles", states.len());
     assert!(states.len() as u64 <= cycles, "{} messages, {cycles} cycles", states.len());
-    eprintln!("{} JointState messages over {span_s:.3} s; the drive reported {cycles} cycles", states.len());
+    eprintln!(
+        "{} JointState messages over {span_s:.3} s; the drive reported {cycles} cycles; {} live estimates",
+        states.len(),
+        live.len()
+    );
 }
 
 /// `simulate --foxglove`: the walk of `--out walk.mcap` played once a viewer subscribes, every

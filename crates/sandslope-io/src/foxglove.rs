@@ -150,10 +150,10 @@ impl DriveStream {
         cycle.rows.push(row);
     }
 
-    /// A live estimate, as `/sandslope/live`.
+    /// A live estimate, as `/sandslope/live` (it may come amid a cycle's rows, which stay
+    /// gathered; times never go back, as in `drive --log run.mcap`).
     pub fn live(&self, record: &LiveRecord) {
         let mut cycle = self.cycle();
-        cycle.flush(&self.server);
         let t_ns = cycle.time_ns(record.time_s);
         self.server.publish("/sandslope/live", t_ns, &live_message(record));
     }

@@ -20,6 +20,7 @@ pub mod bag;
 pub mod crs;
 pub mod files;
 pub mod force_tests;
+pub mod foxglove;
 pub mod grid_csv;
 mod lzw_tiles;
 pub mod mcap_out;

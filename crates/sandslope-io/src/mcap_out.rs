@@ -117,13 +117,36 @@ pub fn simulation_mcap(
     geometry: &sandslope::simulate::Geometry,
     slope_deg: f64,
 ) -> Result<Vec<u8>> {
+    let mut out = McapOut::new()?;
+    simulation_messages(trajectory, geometry, slope_deg, &mut out)?;
+    out.finish()
+}
+
+/// Where ROS 2 messages go: an MCAP file ([`McapOut`]) or a live stream (`foxglove`).
+pub trait RosSink {
+    /// Sends `message` on `topic` at `time_ns`.
+    fn send<T: RosMessage>(&mut self, topic: &str, time_ns: u64, message: &T) -> Result<()>;
+}
+
+impl RosSink for McapOut {
+    fn send<T: RosMessage>(&mut self, topic: &str, time_ns: u64, message: &T) -> Result<()> {
+        self.write(topic, time_ns, message)
+    }
+}
+
+/// The messages of [`simulation_mcap`], in time order, to any [`RosSink`].
+pub fn simulation_messages<S: RosSink>(
+    trajectory: &sandslope::simulate::Trajectory,
+    geometry: &sandslope::simulate::Geometry,
+    slope_deg: f64,
+    out: &mut S,
+) -> Result<()> {
     let theta = slope_deg.to_radians();
     let (s, c) = theta.sin_cos();
     let world = |x: f64, z: f64| (x * c - z * s, x * s + z * c);
     let legs = geometry.hip_x_m.len();
     let names: Vec<String> = (0..legs).map(|j| format!("leg_{j}")).collect();
     let offset = trajectory.time_s.first().map_or(0.0, |t| (-t).max(0.0));
-    let mut out = McapOut::new()?;
     let at =
         |v: &Vec<Vec<f64>>, j: usize, i: usize| v.get(j).and_then(|l| l.get(i)).copied().unwrap_or(f64::NAN);
     for (i, &t) in trajectory.time_s.iter().enumerate() {
@@ -131,7 +154,7 @@ pub fn simulation_mcap(
         let (wx, wz) = world(trajectory.x_m[i], trajectory.z_m[i]);
         let attitude = Quaternion::about([0.0, 1.0, 0.0], -(theta + trajectory.pitch_rad[i]));
         let pose = Pose { position: Point { x: wx, y: 0.0, z: wz }, orientation: attitude };
-        out.write("/sandslope/pose", t_ns, &PoseStamped { header: header(t_ns, "world"), pose })?;
+        out.send("/sandslope/pose", t_ns, &PoseStamped { header: header(t_ns, "world"), pose })?;
         let mut transforms = vec![TransformStamped {
             header: header(t_ns, "world"),
             child_frame_id: "base_link".into(),
@@ -147,7 +170,7 @@ pub fn simulation_mcap(
                 },
             });
         }
-        out.write("/tf", t_ns, &TfMessage { transforms })?;
+        out.send("/tf", t_ns, &TfMessage { transforms })?;
         let joint = JointState {
             header: header(t_ns, ""),
             name: names.clone(),
@@ -155,7 +178,7 @@ pub fn simulation_mcap(
             velocity: Vec::new(),
             effort: (0..legs).map(|j| at(&trajectory.leg_torque_n_m, j, i)).collect(),
         };
-        out.write("/joint_states", t_ns, &joint)?;
+        out.send("/joint_states", t_ns, &joint)?;
         let pitch = trajectory.pitch_rad[i];
         let markers = (0..legs)
             .map(|j| {
@@ -179,9 +202,9 @@ pub fn simulation_mcap(
                 }
             })
             .collect();
-        out.write("/sandslope/leg_forces", t_ns, &MarkerArray { markers })?;
+        out.send("/sandslope/leg_forces", t_ns, &MarkerArray { markers })?;
     }
-    out.finish()
+    Ok(())
 }
 
 /// One live estimate of a `drive` run (docs/model.md §19), as `/sandslope/live` carries it.
@@ -231,11 +254,8 @@ pub fn drive_mcap(
     meta: &[(&str, String)],
     verdict: &str,
 ) -> Result<Vec<u8>> {
-    use crate::bag::messages::{ArrayDimension, ArrayLayout, Float64Array, StringMsg};
-    use sandslope::servo::xl330;
+    use crate::bag::messages::StringMsg;
     let offset = rows.iter().map(|r| r.time_s).fold(0.0f64, f64::min).abs();
-    let legs = rows.iter().map(|r| r.leg + 1).max().unwrap_or(0);
-    let names: Vec<String> = (0..legs).map(|j| format!("leg_{j}")).collect();
     let mut out = McapOut::new()?;
     let text: String = meta.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
     out.write(
@@ -256,40 +276,52 @@ pub fn drive_mcap(
         let t_ns = ns(cycle[0].time_s, offset).max(last_ns);
         while let Some(l) = live.next_if(|l| l.time_s <= cycle[0].time_s) {
             let at = ns(l.time_s, offset).max(last_ns);
-            let layout = ArrayLayout {
-                dim: vec![ArrayDimension { label: LIVE_FIELDS.join(","), size: 10, stride: 10 }],
-                data_offset: 0,
-            };
-            out.write("/sandslope/live", at, &Float64Array { layout, data: l.values.to_vec() })?;
+            out.write("/sandslope/live", at, &live_message(l))?;
             last_ns = at;
         }
         let t_ns = t_ns.max(last_ns);
-        let mut state = JointState { header: header(t_ns, ""), ..JointState::default() };
-        let mut command = JointState { header: header(t_ns, ""), ..JointState::default() };
-        for r in cycle {
-            let name = names[r.leg].clone();
-            state.name.push(name.clone());
-            state.position.push(r.leg_angle_rad);
-            state.velocity.push(f64::from(r.present_velocity) * xl330::RAD_S_PER_VELOCITY_UNIT);
-            state.effort.push(r.drive_torque_n_m);
-            command.name.push(name);
-            command.position.push(f64::from(r.goal_position) * xl330::RAD_PER_PULSE);
-        }
+        let (state, command) = cycle_joint_states(cycle, t_ns);
         out.write("/joint_states", t_ns, &state)?;
         out.write("/sandslope/commands", t_ns, &command)?;
         last_ns = t_ns;
     }
     for l in live {
         let at = ns(l.time_s, offset).max(last_ns);
-        let layout = ArrayLayout {
-            dim: vec![ArrayDimension { label: LIVE_FIELDS.join(","), size: 10, stride: 10 }],
-            data_offset: 0,
-        };
-        out.write("/sandslope/live", at, &Float64Array { layout, data: l.values.to_vec() })?;
+        out.write("/sandslope/live", at, &live_message(l))?;
         last_ns = at;
     }
     out.write("/sandslope/verdict", last_ns, &StringMsg { data: verdict.to_string() })?;
     out.finish()
+}
+
+/// One bus cycle's rows (one per servo) as `/joint_states` (leg angle in the gait's frame,
+/// the shaft's velocity in rad/s, the drive torque in N m) and `/sandslope/commands` (the goal
+/// position as the shaft's angle, rad), both stamped `t_ns`: what [`drive_mcap`] writes a
+/// cycle and `foxglove::DriveStream` sends live.
+pub fn cycle_joint_states(cycle: &[crate::servo_log::ServoLogRow], t_ns: u64) -> (JointState, JointState) {
+    use sandslope::servo::xl330;
+    let mut state = JointState { header: header(t_ns, ""), ..JointState::default() };
+    let mut command = JointState { header: header(t_ns, ""), ..JointState::default() };
+    for r in cycle {
+        let name = format!("leg_{}", r.leg);
+        state.name.push(name.clone());
+        state.position.push(r.leg_angle_rad);
+        state.velocity.push(f64::from(r.present_velocity) * xl330::RAD_S_PER_VELOCITY_UNIT);
+        state.effort.push(r.drive_torque_n_m);
+        command.name.push(name);
+        command.position.push(f64::from(r.goal_position) * xl330::RAD_PER_PULSE);
+    }
+    (state, command)
+}
+
+/// A live estimate as `/sandslope/live` carries it (one dimension labelled [`LIVE_FIELDS`]).
+pub fn live_message(l: &LiveRecord) -> crate::bag::messages::Float64Array {
+    use crate::bag::messages::{ArrayDimension, ArrayLayout, Float64Array};
+    let layout = ArrayLayout {
+        dim: vec![ArrayDimension { label: LIVE_FIELDS.join(","), size: 10, stride: 10 }],
+        data_offset: 0,
+    };
+    Float64Array { layout, data: l.values.to_vec() }
 }
 
 #[cfg(test)]

@@ -65,6 +65,10 @@ pub struct DriveArgs {
     /// Print the run's report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Stream the channels of `--log run.mcap` live to Foxglove over its WebSocket protocol
+    /// on ADDR (default 127.0.0.1:8765, loopback only; docs/bags.md, "Watch live").
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = sandslope_io::foxglove::DEFAULT_ADDR)]
+    pub foxglove: Option<String>,
 }
 
 /// The flags of a run that `drive` and `serve --drive` share: the gait, the limits, the halt on
@@ -374,6 +378,7 @@ pub fn run(args: DriveArgs) -> Result<()> {
     check_bus_budget(&config)?;
     // The live monitor's grid of simulated stance profiles and the bus (the emulator's
     // simulated walk), before anything moves.
+    let foxglove = args.foxglove.as_deref().map(sandslope_io::foxglove::DriveStream::start).transpose()?;
     let mut session = Session::open(config)?;
     // Ctrl-C from here on stops the gait and turns the torque off rather than ending the process.
     crate::error::DRIVING.store(true, Ordering::SeqCst);
@@ -409,6 +414,7 @@ pub fn run(args: DriveArgs) -> Result<()> {
                 ));
             }
         }
+        foxglove.iter().for_each(|f| f.live(&live_record(l)));
     };
     let stop = &crate::error::STOP;
     // `--log run.mcap`: the rows kept in memory and written as ROS 2 messages (docs/bags.md).
@@ -421,10 +427,13 @@ pub fn run(args: DriveArgs) -> Result<()> {
     });
     let (mut rows, meta) =
         (Vec::new(), sandslope_servo::log::log_meta(&session, &args.robot.robot, &args.terrain.terrain));
+    foxglove.iter().for_each(|f| f.header(&meta));
     let on_sample = &mut |s: &sandslope_servo::driver::ServoSample| {
-        rows.extend(mcap.map(|_| sandslope_servo::log::log_row(s)))
+        rows.extend(mcap.map(|_| sandslope_servo::log::log_row(s)));
+        foxglove.iter().for_each(|f| f.row(sandslope_servo::log::log_row(s)));
     };
     let (report, failure) = drive_logged(&mut session, log, stop, on_sample, &mut on_live)?;
+    foxglove.into_iter().for_each(|f| f.finish(&verdict_text(&report, failure.as_ref())));
     if let Some(path) = mcap {
         write_mcap_log(path, &rows, &report, &meta, failure.as_ref())?;
     }
@@ -661,29 +670,37 @@ fn write_mcap_log(
     failure: Option<&sandslope_servo::DriveError>,
 ) -> Result<()> {
     use sandslope_io::mcap_out::{drive_mcap, LiveRecord};
-    let live: Vec<LiveRecord> = (report.live.iter())
-        .map(|l| (l.time_s, l.tripod as f64, &l.inference))
-        .map(|(time_s, tripod, i)| LiveRecord {
-            time_s,
-            values: [
-                tripod,
-                i.k_s,
-                i.k_s_lo,
-                i.k_s_hi,
-                i.speed_m_s,
-                i.speed_lo_m_s,
-                i.speed_hi_m_s,
-                i.p_fail,
-                i.p_slippage,
-                i.p_sinkage,
-            ],
-        })
-        .collect();
-    // The outcome as `--json` gives it (`{"outcome": "completed", ...}`), never Rust's `Result`.
-    let verdict = match (failure, &report.outcome) {
-        (Some(e), _) => e.to_string(),
-        (None, Ok(outcome)) => serde_json::to_string(outcome)?,
-        (None, Err(why)) => why.clone(),
-    };
+    let live: Vec<LiveRecord> = report.live.iter().map(live_record).collect();
+    let verdict = verdict_text(report, failure);
     sandslope_io::write_atomic(path, &drive_mcap(rows, &live, meta, &verdict)?)
+}
+
+/// A live estimate as `/sandslope/live` carries it (`--log run.mcap`, `--foxglove`).
+fn live_record(l: &LiveEstimate) -> sandslope_io::mcap_out::LiveRecord {
+    let i = &l.inference;
+    sandslope_io::mcap_out::LiveRecord {
+        time_s: l.time_s,
+        values: [
+            l.tripod as f64,
+            i.k_s,
+            i.k_s_lo,
+            i.k_s_hi,
+            i.speed_m_s,
+            i.speed_lo_m_s,
+            i.speed_hi_m_s,
+            i.p_fail,
+            i.p_slippage,
+            i.p_sinkage,
+        ],
+    }
+}
+
+/// How the run ended, as `/sandslope/verdict` says it.
+fn verdict_text(report: &DriveReport, failure: Option<&sandslope_servo::DriveError>) -> String {
+    // The outcome as `--json` gives it (`{"outcome": "completed", ...}`), never Rust's `Result`.
+    match (failure, &report.outcome) {
+        (Some(e), _) => e.to_string(),
+        (None, Ok(outcome)) => serde_json::to_string(outcome).unwrap_or_default(),
+        (None, Err(why)) => why.clone(),
+    }
 }

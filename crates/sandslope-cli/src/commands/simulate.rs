@@ -107,6 +107,12 @@ pub struct SimulateArgs {
     /// states, forces as markers; docs/bags.md).
     #[arg(long, value_name = "CSV|MCAP")]
     pub out: Option<PathBuf>,
+    /// After the walk, play the channels of --out walk.mcap in real time to Foxglove over its
+    /// WebSocket protocol on ADDR (default 127.0.0.1:8765, loopback only), waiting up to 30 s
+    /// for a viewer to subscribe first (docs/bags.md, "Watch live").
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, conflicts_with_all = ["slopes", "check_convergence"],
+        default_missing_value = sandslope_io::foxglove::DEFAULT_ADDR)]
+    pub foxglove: Option<String>,
     /// Draw position, leg depths and leg forces against time (one slope), or simulated,
     /// closed-form and observed speeds against slope (--slopes), to FILE (.png or .svg).
     #[arg(long, value_name = "FILE")]
@@ -278,6 +284,9 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
         Format::Json => print_json(&Answer::One(Box::new(m.clone())))?,
         Format::Csv => print!("{}", csv_string(&m.steps)?),
         Format::Table => print_one(&sim),
+    }
+    if let Some(addr) = &args.foxglove {
+        sandslope_io::foxglove::play_simulation(addr, &sim.trajectory, &sim.geometry, slope, 30.0)?;
     }
     Ok(())
 }

@@ -72,6 +72,8 @@ def main():
     ap.add_argument("--search", choices=["auto", "full", "corridor"], help="passed to sandslope plan")
     ap.add_argument("--coarse-factor", type=int, help="passed to sandslope plan")
     ap.add_argument("--corridor-width", type=int, help="passed to sandslope plan")
+    ap.add_argument("--risk-map", action="store_true",
+                    help="also write the --risk-map GeoTIFF (streamed band by band with the corridor search)")
     ap.add_argument("--gap", action="store_true", help="compare --search full and --search corridor")
     ap.add_argument("--baseline", help="another sandslope binary, timed in turn with this one (and its --json compared)")
     ap.add_argument("--work", default=os.path.join(ROOT, "target", "bench-plan"),
@@ -134,6 +136,8 @@ def main():
     if args.search is not None:
         cmd += ["--search", args.search]
     cmd += corridor
+    if args.risk_map:
+        cmd += ["--risk-map", os.path.join(work, f"risk-{n}.tif")]
     mcp = None if args.no_mcp or n > 8192 else mcp_runner(heights(0, n), cell, start, goal)
     # sandslope, its baseline (--baseline) and MCP_Geometric take turns, so that each pair of
     # timings sees the same load from whatever else runs on the machine.

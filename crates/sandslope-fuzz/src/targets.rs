@@ -341,7 +341,66 @@ pub const TARGETS: &[Target] = &[
         companions: &[],
         run: Run::Serve(crate::serve::Kind::Connections),
     },
+    // Issue 56: rasters read window by window (a header promising more than the file holds,
+    // tiles past its end): every window read or refused with an error, never a panic, an abort
+    // or an allocation the file cannot back; `plan` streaming the risk map exits 2 on them
+    // and leaves no risk map.
+    Target {
+        name: "read-raster-windows",
+        seeds: RASTERS,
+        file_name: "dem.tif",
+        companions: &[],
+        run: Run::Reader(read_windows),
+    },
+    Target {
+        name: "plan-risk-map-streamed",
+        seeds: RASTERS,
+        file_name: "dem.tif",
+        companions: &[],
+        run: Run::Command(&[
+            "plan",
+            "--dem",
+            "{in}",
+            "--search",
+            "corridor",
+            "--coarse-factor",
+            "2",
+            "--start-px",
+            "1,1",
+            "--goal-px",
+            "6,5",
+            "--risk-map",
+            "{dir}/risk.tif",
+        ]),
+    },
 ];
+
+/// A raster opened for window reads (as a GeoTIFF and as a PDS3 image) and read in bands of
+/// 7 rows and in a window at each corner; maps over 2^22 cells are refused from the header,
+/// as `--max-memory` would refuse them.
+fn read_windows(p: &Path) -> Result<()> {
+    use sandslope_io::raster::open_height_windows;
+    let read = |p: &Path| -> Result<()> {
+        let fits = |c: usize, r: usize, _whole: bool| -> Result<()> {
+            anyhow::ensure!(c.saturating_mul(r) <= 1 << 22, "{c} x {r} cells is more than 2^22");
+            Ok(())
+        };
+        let (_, w) = open_height_windows(p, &fits)?;
+        let (cols, rows) = (sandslope::plan::HeightSource::cols(&w), sandslope::plan::HeightSource::rows(&w));
+        for r0 in (0..rows).step_by(7) {
+            w.read(r0..(r0 + 7).min(rows), 0..cols)?;
+        }
+        let (c, r) = (cols.min(5), rows.min(5));
+        for (rs, cs) in [(0..r, 0..c), (rows - r..rows, cols - c..cols), (0..r, cols - c..cols)] {
+            w.read(rs, cs)?;
+        }
+        Ok(())
+    };
+    let other = p.with_extension("img");
+    std::fs::copy(p, &other)?;
+    let _ = read(&other);
+    read(p)
+}
 
 /// The target called `name`.
 pub fn find(name: &str) -> Option<&'static Target> {

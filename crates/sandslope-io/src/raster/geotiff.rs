@@ -496,23 +496,31 @@ pub fn write_two_band_geotiff(
         let (w, h) = (u32::try_from(cols)?, u32::try_from(rows)?);
         let mut img = enc.new_image::<Gray32Float>(w, h).map_err(err)?;
         img.extra_samples(&[ExtraSamples::Unspecified]).map_err(err)?;
-        let d = img.encoder();
-        d.write_tag(Tag::ModelPixelScaleTag, &[geo.cell_x, geo.cell_y, 0.0][..]).map_err(err)?;
-        d.write_tag(Tag::ModelTiepointTag, &[0.0, 0.0, 0.0, geo.west, geo.north, 0.0][..]).map_err(err)?;
-        // Our tie point is the corner of the corner cell: declare PixelIsArea, keep the rest.
-        let keys = with_pixel_is_area(geo.geokeys.as_deref());
-        d.write_tag(Tag::GeoKeyDirectoryTag, &keys[..]).map_err(err)?;
-        if let Some(dbl) = &geo.geodoubles {
-            d.write_tag(Tag::GeoDoubleParamsTag, &dbl[..]).map_err(err)?;
-        }
-        if let Some(a) = &geo.geoascii {
-            d.write_tag(Tag::GeoAsciiParamsTag, a.as_str()).map_err(err)?;
-        }
-        d.write_tag(Tag::GdalNodata, "nan").map_err(err)?;
+        write_geo_tags(img.encoder(), geo).map_err(err)?;
         let data: Vec<f32> = band1.iter().zip(band2).flat_map(|(&a, &b)| [a, b]).collect();
         img.write_data(&data).map_err(err)?;
         Ok(())
     })
+}
+
+/// The georeference tags of a raster written like `geo`'s input (pixel scale, tie point,
+/// GeoKeys with PixelIsArea, their parameters) and GDAL's nodata, NaN.
+pub(super) fn write_geo_tags<W: std::io::Write + std::io::Seek, K: tiff::encoder::TiffKind>(
+    d: &mut tiff::encoder::DirectoryEncoder<'_, W, K>,
+    geo: &GeoRef,
+) -> tiff::TiffResult<()> {
+    d.write_tag(Tag::ModelPixelScaleTag, &[geo.cell_x, geo.cell_y, 0.0][..])?;
+    d.write_tag(Tag::ModelTiepointTag, &[0.0, 0.0, 0.0, geo.west, geo.north, 0.0][..])?;
+    // Our tie point is the corner of the corner cell: declare PixelIsArea, keep the rest.
+    let keys = with_pixel_is_area(geo.geokeys.as_deref());
+    d.write_tag(Tag::GeoKeyDirectoryTag, &keys[..])?;
+    if let Some(dbl) = &geo.geodoubles {
+        d.write_tag(Tag::GeoDoubleParamsTag, &dbl[..])?;
+    }
+    if let Some(a) = &geo.geoascii {
+        d.write_tag(Tag::GeoAsciiParamsTag, a.as_str())?;
+    }
+    d.write_tag(Tag::GdalNodata, "nan")
 }
 
 /// A GeoKeyDirectory with GTRasterTypeGeoKey = PixelIsArea (added or replaced).

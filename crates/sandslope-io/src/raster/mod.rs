@@ -13,6 +13,7 @@ mod ascii;
 mod chunks;
 pub mod geotiff;
 pub mod grid;
+mod tiles;
 mod windows;
 
 use ascii::read_asc;
@@ -21,6 +22,7 @@ use geotiff::{read_geotiff, samples_as};
 pub use grid::{
     available_memory, memory_limit, set_memory_limit, GeoRef, Raster, SizeCheck, DEFAULT_MEMORY_LIMIT,
 };
+pub use tiles::{write_two_band_geotiff_by_rows, TILE};
 pub use windows::{open_height_windows, HeightWindows, WindowsCheck};
 
 /// Reads a GeoTIFF (`.tif`, `.tiff`), an ESRI ASCII grid (`.asc`) or a PDS3 DTM (`.img` with

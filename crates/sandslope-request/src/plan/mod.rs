@@ -25,11 +25,13 @@ use crate::scenario::RobotRequest;
 mod answer;
 mod grid;
 mod memory;
+mod risk_raster;
 mod settings;
 
 pub use answer::{answer, corridor_answer, records, CorridorJson, PlanJson, RouteRecord};
 pub use grid::{ClassRaster, GridPlanRequest, GridRequest, GridSource, RouteCells};
 use memory::choose_search;
+pub use risk_raster::risk_band_rows;
 pub use settings::{parse_descent, parse_objective, settings_in};
 
 /// `search = auto` searches maps of up to this many cells at full resolution (4096 x 4096)

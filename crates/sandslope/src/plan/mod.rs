@@ -37,6 +37,7 @@ pub use corridor::{
 pub use grid::{Cell, ElevationGrid};
 pub use planner::{heading_offsets, Planner, HEADINGS, NO_CLASS};
 pub use result::{plan, Extrapolation, PlanRequest, PlanResult, RiskRaster};
+pub use risk_map::{risk_map_from, RISK_BAND_CELLS};
 pub use route::{Route, RouteStep};
 pub use source::{coarsened_from, HeightSource};
 pub use table::{PitchTable, PitchTableCache, MAX_PITCH_DEG, P_FAIL_STEP_DEG, TAN_STEP};

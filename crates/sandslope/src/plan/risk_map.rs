@@ -1,11 +1,54 @@
 //! Per-cell risk over all headings (the `--risk-map` raster) and the head-on climb of a cell
 //! (the plan figure's tint), from the planner's gradients and pitch tables.
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 
 use super::grid::Cell;
 use super::planner::{EdgeGeom, MoveGeom, Planner, HEADINGS};
+use super::source::{window_grid, with_margin, HeightSource};
+use super::{PitchTableCache, PlanError, PlanSettings};
 use crate::regime::Regime;
+use crate::risk::UncertainTerrain;
+use crate::Robot;
+
+/// Cells a band of [`risk_map_from`] holds at most, about (2^23: 256 rows of a 32,768-column
+/// map; the band's planner takes some 30 bytes a cell, so about 250 MB).
+pub const RISK_BAND_CELLS: usize = 1 << 23;
+
+/// [`Planner::risk_map`] of a map read window by window, for maps too large to hold: the rows
+/// are taken `band_rows` at a time (at least 1), each band read from `source` with a margin of
+/// one row on each side (the whole width, so the map's own west and east borders), its planner
+/// built on that window (one terrain everywhere) and its risk map cut to the band's rows.
+/// A cell's values depend on its 3 x 3 window and its row's width alone, and the pitch tables
+/// of a window are a prefix of the whole map's (the same step), so every band is the whole
+/// map's [`Planner::risk_map`] rows bit for bit. `sink` is given each band's rows, its
+/// best-heading P(failure) and its steepest-climb azimuth (row-major), in order from the north;
+/// its error stops the pass and is returned.
+pub fn risk_map_from<E: From<PlanError>>(
+    source: &dyn HeightSource,
+    terrain: &UncertainTerrain,
+    robot: &Robot,
+    settings: PlanSettings,
+    band_rows: usize,
+    mut sink: impl FnMut(Range<usize>, &[f32], &[f32]) -> Result<(), E>,
+) -> Result<(), E> {
+    let (cols, rows) = (source.cols(), source.rows());
+    let band = band_rows.max(1);
+    let cache = PitchTableCache::new();
+    let terrains = std::slice::from_ref(terrain);
+    for r0 in (0..rows).step_by(band) {
+        let r1 = (r0 + band).min(rows);
+        let wr = with_margin(r0, r1, rows);
+        let grid = window_grid(source, wr.clone(), 0..cols)?;
+        let planner = Planner::with_cache(grid, None, terrains, robot, settings, &cache)?;
+        let (p_fail, azimuth) = planner.risk_map();
+        let cut = (r0 - wr.start) * cols..(r1 - wr.start) * cols;
+        sink(r0..r1, &p_fail[cut.clone()], &azimuth[cut])?;
+    }
+    Ok(())
+}
 
 impl Planner {
     /// The regime and P(failure) of climbing `cell` head-on, straight up its fall line

@@ -119,8 +119,8 @@ pub struct PlanArgs {
     /// coarse-to-fine for maps too large or slow for that: the routes planned on the map
     /// averaged over --coarse-factor cells, then the exact optimum at full resolution inside a
     /// corridor of --corridor-width coarse cells on each side of the coarse route (an upper
-    /// bound on the full optimum; docs/planning.md measures the gap; one terrain, no --plot or
-    /// --risk-map); `auto`, full for maps of up to 4096 x 4096 cells, corridor above.
+    /// bound on the full optimum; docs/planning.md measures the gap; one terrain, no --plot,
+    /// --risk-map as a GeoTIFF only, computed band by band); `auto`, full for maps of up to 4096 x 4096 cells, corridor above.
     #[arg(long, value_enum, default_value = "auto")]
     pub search: SearchArg,
     /// Corridor search: fine cells per coarse cell along each axis (2 to 64).
@@ -262,10 +262,14 @@ pub fn run(args: PlanArgs) -> Result<()> {
     for p in [&args.out.geojson, &args.out.csv, &args.out.plot, &args.out.risk_map].into_iter().flatten() {
         crate::output::check_parent_exists(p)?;
     }
+    // A GeoTIFF risk map is computed band by band from the heights read window by window
+    // when the routes are searched in corridors (a DEM larger than memory); a Nav2 or MCAP map
+    // and terrain classes need the full-resolution planner.
+    let streamed_risk = args.out.risk_map.as_deref().is_some_and(is_geotiff) && args.classes.is_none();
     if args.search == SearchArg::Corridor {
         for (flag, given) in [
             ("--plot", args.out.plot.is_some()),
-            ("--risk-map", args.out.risk_map.is_some()),
+            ("--risk-map", args.out.risk_map.is_some() && !streamed_risk),
             ("--classes", args.classes.is_some()),
         ] {
             if given {
@@ -275,10 +279,38 @@ pub fn run(args: PlanArgs) -> Result<()> {
     }
     request.check_corridor()?;
     let full_only = args.out.plot.is_some();
-    match compute_any(&request, args.out.risk_map.is_some() || args.out.plot.is_some(), full_only, false)? {
+    let risk_in_planner = (args.out.risk_map.is_some() && !streamed_risk) || args.out.plot.is_some();
+    match compute_any(&request, risk_in_planner, full_only, false)? {
         Computed::Full(planned) => run_full(&args, &planned),
-        Computed::Corridor(planned) => run_corridor(&args, &planned),
+        Computed::Corridor(planned) => {
+            if let Some(p) = &args.out.risk_map {
+                write_streamed_risk_map(&request, &planned, p, args.out.json)?;
+            }
+            run_corridor(&args, &planned)
+        }
     }
+}
+
+/// Whether `path` names a GeoTIFF risk map (not a Nav2 `.yaml` pair or an `.mcap`).
+fn is_geotiff(path: &std::path::Path) -> bool {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    !matches!(ext.as_deref(), Some("yaml" | "yml" | "mcap"))
+}
+
+/// The risk map of a DEM searched in corridors, computed and written band by band with a
+/// progress bar of rows on a terminal (none when `quiet`).
+fn write_streamed_risk_map(
+    request: &PlanRequest,
+    planned: &CorridorPlanned,
+    path: &std::path::Path,
+    quiet: bool,
+) -> Result<()> {
+    let rows = planned.dem.rows as u64;
+    let bar = crate::progress::progress_bar(rows, quiet, "risk map rows");
+    request
+        .write_streamed_risk_map(&planned.dem, &planned.heights, path, &|done, _| bar.set_position(done))?;
+    bar.finish_and_clear();
+    Ok(())
 }
 
 /// Writes and prints what the full-resolution search found.
@@ -290,7 +322,19 @@ fn run_full(args: &PlanArgs, planned: &Planned) -> Result<()> {
     if let Some(p) = &args.out.csv {
         writers::write_csv(p, &dem.geo, result.planner.grid(), &result.routes)?;
     }
-    if let (Some(p), Some(risk)) = (&args.out.risk_map, &result.risk) {
+    // A GeoTIFF risk map the planner was not asked for (it would have been streamed had the
+    // routes been searched in corridors): the planner holds the map, so it is computed here.
+    let computed;
+    let risk = match &result.risk {
+        Some(r) => Some(r),
+        None if args.out.risk_map.is_some() => {
+            let (p_fail, climb_azimuth_deg) = result.planner.risk_map();
+            computed = sandslope::plan::RiskRaster { p_fail, climb_azimuth_deg };
+            Some(&computed)
+        }
+        None => None,
+    };
+    if let (Some(p), Some(risk)) = (&args.out.risk_map, risk) {
         // `.yaml`: a Nav2 map_server pair; `.mcap`: OccupancyGrid and the routes (docs/bags.md).
         match p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
             Some("yaml" | "yml") => sandslope_io::nav2_map::write_nav2_map(p, dem, &risk.p_fail)?,
@@ -305,7 +349,7 @@ fn run_full(args: &PlanArgs, planned: &Planned) -> Result<()> {
             )?,
         }
     }
-    if let (Some(p), Some(risk)) = (&args.out.plot, &result.risk) {
+    if let (Some(p), Some(risk)) = (&args.out.plot, risk) {
         crate::figures::save(p, &PlanFigure::new(result, &dem.geo, &risk.p_fail))?;
     }
     warn_extrapolation(result.extrapolation);

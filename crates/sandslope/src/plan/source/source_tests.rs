@@ -9,7 +9,8 @@ use super::*;
 use crate::model::tests::paper_robot;
 use crate::plan::corridor::tests::{dunes, terrain};
 use crate::plan::{
-    plan_corridor, plan_corridor_from, Cell, CorridorSettings, PlanRequest, PlanSettings, Planner,
+    plan_corridor, plan_corridor_from, risk_map_from, Cell, CorridorSettings, PlanError, PlanRequest,
+    PlanSettings, Planner,
 };
 
 /// A grid read through windows, bands of `band` rows, counting the cells read.
@@ -223,4 +224,97 @@ fn gap_bounds_hold(grid: ElevationGrid) {
             }
         }
     }
+}
+
+/// The risk raster computed band by band from a windowed source is the whole grid's
+/// [`Planner::risk_map`] bit for bit, for uniform grids and grids of per-row widths, with
+/// nodata, for steep and gentle maps and for bands of 1 row to more than the map.
+#[test]
+fn the_streamed_risk_map_is_the_in_memory_one_bit_for_bit() {
+    let (robot, t) = (paper_robot(), terrain());
+    for widths in [false, true] {
+        for scale in [1.0_f32, 0.15] {
+            let g = bumpy(widths);
+            let z: Vec<f32> = g.heights().iter().map(|h| h * scale).collect();
+            let mask: Vec<bool> = (0..g.len()).map(|i| !g.is_valid(i)).collect();
+            let mut grid =
+                ElevationGrid::new(g.cols(), g.rows(), g.cell_x(), g.cell_y(), z, Some(&mask)).unwrap();
+            if let Some(w) = g.row_widths() {
+                grid = grid.with_row_widths(w.to_vec()).unwrap();
+            }
+            let settings = PlanSettings::default();
+            let whole = Planner::new(grid.clone(), None, std::slice::from_ref(&t), &robot, settings).unwrap();
+            let (want_p, want_a) = whole.risk_map();
+            // Some cells are passable and some are not: the test compares values, not NaNs alone.
+            let finite = want_p.iter().filter(|p| p.is_finite()).count();
+            assert!(finite > 100 && finite < want_p.len(), "{finite} finite cells");
+            for band in [1, 2, 5, 16, 61, 500] {
+                let source = windowed(grid.clone(), band);
+                let (mut got_p, mut got_a, mut next) = (Vec::new(), Vec::new(), 0);
+                risk_map_from::<PlanError>(&source, &t, &robot, settings, band, |rows, p, a| {
+                    assert_eq!(rows.start, next);
+                    assert_eq!(p.len(), rows.len() * grid.cols());
+                    next = rows.end;
+                    got_p.extend_from_slice(p);
+                    got_a.extend_from_slice(a);
+                    Ok(())
+                })
+                .unwrap();
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(
+                    bits(&got_p),
+                    bits(&want_p),
+                    "p_fail, widths {widths}, scale {scale}, band {band}"
+                );
+                assert_eq!(
+                    bits(&got_a),
+                    bits(&want_a),
+                    "azimuth, widths {widths}, scale {scale}, band {band}"
+                );
+                // Each band reads its rows and at most two rows of margin.
+                let read = source.read.load(Ordering::Relaxed);
+                assert!(read <= grid.len() + 2 * grid.cols() * grid.rows().div_ceil(band) + 2 * grid.cols());
+            }
+        }
+    }
+}
+
+#[test]
+fn a_failing_read_stops_the_streamed_risk_map_with_its_error() {
+    struct Broken(ElevationGrid);
+    impl HeightSource for Broken {
+        fn cols(&self) -> usize {
+            self.0.cols()
+        }
+        fn rows(&self) -> usize {
+            self.0.rows()
+        }
+        fn cell_x(&self) -> f64 {
+            self.0.cell_x()
+        }
+        fn cell_y(&self) -> f64 {
+            self.0.cell_y()
+        }
+        fn row_widths(&self) -> Option<&[f64]> {
+            None
+        }
+        fn window(&self, rows: Range<usize>, _: Range<usize>) -> Result<Vec<f32>, String> {
+            Err(format!("rows {rows:?}: tile 3 at byte 4096 is past the end of the file"))
+        }
+    }
+    let mut bands = 0;
+    let err = risk_map_from::<PlanError>(
+        &Broken(bumpy(false)),
+        &terrain(),
+        &paper_robot(),
+        PlanSettings::default(),
+        8,
+        |_, _, _| {
+            bands += 1;
+            Ok(())
+        },
+    )
+    .unwrap_err();
+    assert_eq!(bands, 0);
+    assert!(err.to_string().contains("at byte 4096"), "{err}");
 }

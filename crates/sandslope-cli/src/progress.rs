@@ -29,13 +29,7 @@ pub fn spinner(quiet: bool, what: &str) -> ProgressBar {
     if !shown(quiet) {
         return ProgressBar::hidden();
     }
-    let bar = ProgressBar::new_spinner();
-    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
-        bar.set_style(style);
-    }
-    bar.set_message(what.to_string());
-    bar.enable_steady_tick(std::time::Duration::from_millis(100));
-    bar
+    terminal_spinner(what)
 }
 
 /// Progress that is never silent unless asked to be: a bar or spinner on a terminal (as

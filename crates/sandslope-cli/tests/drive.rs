@@ -458,7 +458,9 @@ fn torque_off_when_the_log_cannot_be_written() {
     assert!(rows.len() >= 6 * 20, "{} rows", rows.len());
     let failed_at: f64 =
         all.split("could not be written at t = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
-    assert!(rows.iter().all(|r| r.0 <= failed_at), "rows after the failure at {failed_at} s");
+    // The message gives the time to the millisecond; the failing cycle's earlier servos were
+    // written whole at that cycle's unrounded time.
+    assert!(rows.iter().all(|r| r.0 <= failed_at + 5e-4), "rows after the failure at {failed_at} s");
     // The crate's reader says what it left out.
     let read = bin().args(["infer", "--servo-log"]).arg(&log).output().unwrap();
     assert!(text(&read).contains("the log ends mid-row"), "{}", text(&read));

@@ -10,7 +10,7 @@ use sandslope_request::scenario::{K_N, K_S, LEVEL_STEP, ROBOT, TERRAIN};
 use sandslope_request::{grammar, RobotRequest, ScenarioRequest};
 
 use sandslope::risk::UncertainTerrain;
-use sandslope::robot_key::{RobotFlag, RobotKey};
+use sandslope::robot_key::RobotKey;
 use sandslope_io::load_terrain;
 
 /// `--robot` and the robot quantities that override its file's (`--mass`, `--leg-radius`, ...).
@@ -95,7 +95,7 @@ impl UncertaintyArgs {
 
 /// The robot quantities overriding the robot file's (docs/model.md §2), so a design question
 /// ("and with 5 cm legs?") needs no new file: one flag per row of the library's table of robot
-/// keys that has one ([`RobotKey::TABLE`], its flag, placeholder and help line), `--mass`
+/// quantities ([`sandslope_request::scenario::ROBOT_QUANTITIES`], its flag, placeholder and help line), `--mass`
 /// among them when `MASS`. Checked by the request layer's one robot validation, errors naming
 /// the flag.
 #[derive(Debug, Clone, Default)]
@@ -108,12 +108,12 @@ pub struct RobotKeyArgs<const MASS: bool> {
 pub type RobotQuantityArgs = RobotKeyArgs<false>;
 
 impl<const MASS: bool> RobotKeyArgs<MASS> {
-    /// The keys these flags set, with their flags, in the table's order.
-    fn flags() -> impl Iterator<Item = (RobotKey, RobotFlag)> {
-        RobotKey::TABLE
-            .iter()
-            .filter(|row| MASS || row.key != RobotKey::MassKg)
-            .filter_map(|row| row.flag.map(|f| (row.key, f)))
+    /// The keys these flags set, with their fields, in the table's order.
+    fn flags() -> impl Iterator<Item = (RobotKey, &'static Field)> {
+        RobotKey::ALL
+            .into_iter()
+            .filter(|k| MASS || *k != RobotKey::MassKg)
+            .filter_map(|k| sandslope_request::scenario::robot_field(k).map(|f| (k, f)))
     }
 
     /// The value given for `key`, if its flag was.
@@ -129,11 +129,11 @@ impl<const MASS: bool> RobotKeyArgs<MASS> {
 
 impl<const MASS: bool> clap::Args for RobotKeyArgs<MASS> {
     fn augment_args(mut cmd: clap::Command) -> clap::Command {
-        for (key, flag) in Self::flags() {
+        for (key, field) in Self::flags() {
             let arg = clap::Arg::new(key.name())
-                .long(flag.long.trim_start_matches('-'))
-                .value_name(flag.value_name)
-                .help(flag.help)
+                .long(field.flag)
+                .value_name(field.value_name)
+                .help(field.help)
                 .action(clap::ArgAction::Set);
             // A whole number: clap's parser, which refuses `2.5` and `-1` itself.
             cmd = cmd.arg(if key == RobotKey::StanceLegs {

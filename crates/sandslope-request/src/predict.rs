@@ -7,7 +7,7 @@ use sandslope::{ParamError, Robot, Scenario, SignedSlope, SlopeEvaluation, Terra
 use crate::error::{RequestError, Result};
 use crate::field::{Field, Fields, Table};
 use crate::params::Params;
-use crate::scenario::{ScenarioRequest, K_N, K_S, TERRAIN};
+use crate::scenario::{ScenarioRequest, K_N, K_S, ROBOT_QUANTITIES, TERRAIN};
 
 /// `--slope`: the one slope of a prediction (Python's `slope_deg`, the library's key).
 pub const SLOPE: Field = Field::number("slope", "DEG")
@@ -91,12 +91,7 @@ pub struct PointRequest {
 /// The request field of a library key (`k_n` -> `k-n`, `slope_deg` -> `slope`, `mass_kg` ->
 /// `mass`): a lookup in the tables, `None` for a key no field sets.
 fn field_of_key(key: &str) -> Option<&'static str> {
-    let robot = sandslope::robot_key::RobotKey::ALL.into_iter().find(|k| k.name() == key);
-    [SLOPE, K_N, K_S]
-        .into_iter()
-        .find(|f| f.key == key)
-        .map(|f| f.flag)
-        .or_else(|| robot.and_then(|k| k.flag()).map(|f| f.trim_start_matches('-')))
+    [SLOPE, K_N, K_S].iter().chain(ROBOT_QUANTITIES.fields).find(|f| f.key == key).map(|f| f.flag)
 }
 
 impl PointRequest {

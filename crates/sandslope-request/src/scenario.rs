@@ -43,6 +43,49 @@ pub const LEVEL_STEP: Field =
          robot and terrain. No effect on a robot with `level_step_m`.",
     );
 
+/// A robot quantity's field: its flag overrides the robot file's key of the same name.
+const fn quantity(
+    flag: &'static str,
+    key: &'static str,
+    unit: &'static str,
+    value_name: &'static str,
+) -> Field {
+    Field::number(flag, value_name).keyword(key).key(key).unit(unit)
+}
+
+/// `--mass`: the robot's total mass instead of the file's.
+pub const MASS: Field = quantity("mass", "mass_kg", "kg", "KG").help("Override the robot's total mass, kg");
+
+/// The robot quantities a request may override (docs/model.md §2), the mass first: the
+/// command line's flags, the server's fields and the explorer page's robot panel (which reads
+/// this list from `/data/served`). Each field's key is the library's robot key
+/// ([`RobotKey::name`]) and its keyword Python's.
+pub const ROBOT_QUANTITIES: Table = Table {
+    command: "robot",
+    fields: &[
+        MASS,
+        quantity("leg-radius", "leg_radius_m", "m", "M").help("Override the C-leg radius R, m"),
+        quantity("leg-width", "leg_width_m", "m", "M").help("Override the leg width W, m"),
+        quantity("hip-height", "hip_height_m", "m", "M")
+            .range("between 0 and 2R")
+            .help("Override the hip height h, m (between 0 and 2R)"),
+        quantity("leg-speed", "leg_speed_rad_s", "rad/s", "RAD/S")
+            .help("Override the leg angular speed omega, rad/s"),
+        Field::new("stance-legs", Kind::Whole, "N")
+            .keyword("stance_legs")
+            .key("stance_legs")
+            .unit("legs")
+            .help("Override the number of legs in stance at once"),
+        quantity("response-time", "response_time_s", "s", "S")
+            .help("Override the elastic response time dt, s"),
+    ],
+};
+
+/// The field overriding the robot key `key`, where a request may.
+pub fn robot_field(key: RobotKey) -> Option<&'static Field> {
+    ROBOT_QUANTITIES.by_key(key.name())
+}
+
 /// The fields of a scenario besides the robot's quantities (those are the library's table of
 /// robot keys, [`robot_fields`]): what `predict`, `sweep` and `simulate` share.
 pub const FIELDS: Table = Table { command: "scenario", fields: &[ROBOT, TERRAIN, K_N, K_S, LEVEL_STEP] };
@@ -66,32 +109,24 @@ impl Default for RobotRequest {
     }
 }
 
-/// The request field of a key's flag (`--leg-radius` -> `leg-radius`).
-fn field_of(flag: &'static str) -> &'static str {
-    flag.trim_start_matches('-')
-}
-
 /// Every key a request may set, with its field: the rows of [`RobotKey::TABLE`] that have a
 /// flag, the mass first (what the command line's flags, the server's parameters and the
 /// explorer page's robot panel are; the page reads this list from `/data/served`).
 pub fn robot_fields() -> impl Iterator<Item = (RobotKey, &'static str)> {
-    RobotKey::ALL.into_iter().filter_map(|k| k.flag().map(|f| (k, field_of(f))))
+    RobotKey::ALL.into_iter().filter_map(|k| robot_field(k).map(|f| (k, f.flag)))
 }
 
 /// The keys a request may override besides the mass, with their fields: the table's rows
 /// that have a flag.
 pub fn override_fields() -> impl Iterator<Item = (RobotKey, &'static str)> {
-    RobotKey::ALL
-        .into_iter()
-        .filter(|k| *k != RobotKey::MassKg)
-        .filter_map(|k| k.flag().map(|f| (k, field_of(f))))
+    robot_fields().filter(|(k, _)| *k != RobotKey::MassKg)
 }
 
 impl RobotRequest {
     /// Reads `robot`, `mass` and the override fields.
     pub fn from_params(p: &mut Params<'_>) -> Result<RobotRequest> {
         let robot = ROBOT.text_in(p)?.unwrap_or(DEFAULT_ROBOT).to_string();
-        let mass = p.number("mass")?;
+        let mass = MASS.number_in(p)?;
         let overrides = Self::overrides_from_params(p)?;
         Ok(RobotRequest { robot, mass, overrides })
     }
@@ -111,7 +146,7 @@ impl RobotRequest {
 
     /// `robot` with this request's quantities replaced (not the mass), validated again as a
     /// whole. An error on a key a request can override names its field (from
-    /// [`RobotKey::flag`]), even when another override broke it (`leg-radius` made too small
+    /// [`robot_field`]), even when another override broke it (`leg-radius` made too small
     /// for the file's hip height names `hip-height`).
     pub fn apply(&self, robot: Robot) -> Result<Robot> {
         if self.overrides.is_empty() {
@@ -123,8 +158,8 @@ impl RobotRequest {
         }
         Robot::new(spec).map_err(|e| {
             let key = RobotKey::of_error(&e).filter(|k| *k != RobotKey::MassKg);
-            match key.and_then(|k| k.flag()) {
-                Some(flag) => RequestError::invalid(field_of(flag), e.renamed(flag)),
+            match key.and_then(robot_field) {
+                Some(f) => RequestError::invalid(f.flag, e.renamed(f.long())),
                 None => RequestError::from_error(None, anyhow::anyhow!("{e}")),
             }
         })
@@ -139,7 +174,9 @@ impl RobotRequest {
             .map_err(|e| RequestError::from_error(Some(ROBOT.flag), e))?;
         let robot = self.apply(robot)?;
         match self.mass {
-            Some(m) => robot.with_mass(m).map_err(|e| RequestError::invalid("mass", e.renamed("--mass"))),
+            Some(m) => {
+                robot.with_mass(m).map_err(|e| RequestError::invalid(MASS.flag, e.renamed(MASS.long())))
+            }
             None => Ok(robot),
         }
     }

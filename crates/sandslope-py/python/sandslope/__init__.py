@@ -646,7 +646,6 @@ def simulate_ensemble(
     slope_deg: float,
     walks: int,
     duration_s: float = 10.0,
-    *,
     **settings: Any,
 ) -> Dict[str, Any]:
     """Walks the robot ``walks`` times (2 to 1000) at ``slope_deg``, the mass of walk k
@@ -707,7 +706,6 @@ def simulate(
     terrain: TerrainLike,
     slope_deg: float,
     duration_s: float = 10.0,
-    *,
     **settings: Any,
 ) -> Tuple[Any, Dict[str, Any]]:
     """Simulates the robot walking for ``duration_s`` seconds on ``terrain`` at ``slope_deg``

@@ -108,8 +108,14 @@ impl SweepRequest {
 
     /// The answer (what `sweep --json` prints): the library's evaluation at every slope.
     pub fn answer(&self) -> Result<Vec<SlopeEvaluation>> {
+        self.answer_in(&self.scenario.scenario()?)
+    }
+
+    /// The answer on a scenario already read from this request's (the command line keeps it
+    /// to draw the figure).
+    pub fn answer_in(&self, scenario: &Scenario) -> Result<Vec<SlopeEvaluation>> {
         let slopes = self.slopes()?;
-        evaluate(&self.scenario.scenario()?, &slopes)
+        evaluate(scenario, &slopes)
     }
 }
 

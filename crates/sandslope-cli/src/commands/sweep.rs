@@ -10,7 +10,6 @@ use crate::figures;
 use crate::figures::sweep::SweepFigure;
 use crate::output::{csv_string, num, print_json, ruled_out_note, speed_cell, table, Format, FormatArgs};
 use sandslope_io::load_speeds;
-use sandslope_request::sweep::evaluate;
 use sandslope_request::SweepRequest;
 
 /// Arguments of `sandslope sweep`.
@@ -46,9 +45,9 @@ impl SweepArgs {
 /// Runs `sandslope sweep`.
 pub fn run(args: SweepArgs) -> Result<()> {
     let request = args.request()?;
-    let slopes = request.slopes()?;
+    request.slopes()?;
     let scenario = request.scenario.scenario()?;
-    let evals = evaluate(&scenario, &slopes)?;
+    let evals = request.answer_in(&scenario)?;
     let observed = args.observed.as_deref().map(load_speeds).transpose()?;
     let extrapolated: Vec<f64> = evals.iter().filter(|e| e.extrapolated).map(|e| e.slope_deg).collect();
     if !extrapolated.is_empty() {

@@ -9,7 +9,7 @@ use std::sync::atomic::AtomicBool;
 use sandslope::infer::servo::{model_grid, CurrentInferenceSettings, ModelGrid};
 use sandslope::infer::LogUniformPrior;
 use sandslope::risk::{safe_slope_limit, SafeLimit, UncertainTerrain};
-use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::servo::{GaitSchedule, ServoModel};
 use sandslope::{Robot, Scenario, SignedSlope, Terrain};
 
 use crate::driver::{drive, DriveError, DriveReport, DynamixelBus, LiveEstimate, Monitor, ServoSample};
@@ -33,8 +33,9 @@ pub struct RunDefaults {
     pub rate_hz: f64,
     /// Seconds the legs are held after a halt on risk (`--hold`).
     pub hold_s: f64,
-    /// Current Limit written to every servo, mA (`--current-limit`): the XL330's stall current
-    /// at 5 V, 1.47 A (`sandslope::servo::xl330::STALL_CURRENT_A`).
+    /// Current Limit written to every servo, mA (`--current-limit`): the paper's XL330-M288's
+    /// stall current at 5 V, 1.47 A (`ServoModel::XL330_M288.stall_current_a`; below the
+    /// XM430-W350's 2.3 A, so safe on every supported model with current control).
     pub current_limit_ma: u16,
     /// Temperature Limit written to every servo, degC (`--temperature-limit`).
     pub temperature_limit_c: u8,
@@ -60,7 +61,7 @@ pub const RUN_DEFAULTS: RunDefaults = RunDefaults {
     duration_s: 10.0,
     rate_hz: 50.0,
     hold_s: 2.0,
-    current_limit_ma: (xl330::STALL_CURRENT_A * 1000.0) as u16,
+    current_limit_ma: (ServoModel::XL330_M288.stall_current_a * 1000.0) as u16,
     temperature_limit_c: 65,
     watchdog_s: 1.0,
     bus_watchdog_s: 0.5,
@@ -80,7 +81,7 @@ pub enum BusChoice {
         /// Baud rate.
         baud: u32,
     },
-    /// A bus of virtual XL330s on a pseudo-terminal.
+    /// A bus of virtual servos (the robot file's model, else XL330-M288s) on a pseudo-terminal.
     Emulate(EmulateOptions),
 }
 
@@ -227,6 +228,7 @@ impl Session {
                 cfg.seed = o.seed;
                 cfg.current_offset_ma = o.current_offset_ma.clone();
                 cfg.faults = o.faults;
+                cfg.model_number = config.settings.servo.map_or(cfg.model_number, |m| m.model_number);
                 let (emu, port) = Emulator::start(&cfg).map_err(|e| SessionError::Emulator(e.to_string()))?;
                 (port, Some(emu))
             }
@@ -254,6 +256,12 @@ impl Session {
         bus_budget_of(&self.config)
     }
 
+    /// The servos' model as the run knows it before the ping: the robot file's, else the
+    /// paper's XL330-M288.
+    pub fn servo_model(&self) -> &'static ServoModel {
+        self.config.settings.servo.unwrap_or(&ServoModel::XL330_M288)
+    }
+
     /// Whether the bus is the emulator's.
     pub fn emulated(&self) -> bool {
         self.emulator.is_some()
@@ -272,10 +280,11 @@ impl Session {
             BusChoice::Emulate(o) => o.noise_ma.max(1.0),
             BusChoice::Port { .. } => 10.0,
         };
+        let noise_sd_n_m = self.servo_model().torque_from_current_ma(noise_ma);
         let monitor = self.grid.as_ref().map(|g| Monitor {
             robot: &self.config.robot,
             grid: g,
-            noise_sd_n_m: xl330::torque_from_current(noise_ma),
+            noise_sd_n_m,
             terrain: &self.uncertain,
             slope: self.slope,
             window: self.config.window,

@@ -677,6 +677,14 @@ fn order_of(ins: &Instruction, id: u8) -> usize {
     }
 }
 
+/// The path of the pseudo-terminal `port` (the slave side [`Emulator::start`] returns), e.g.
+/// `/dev/pts/3`, that another program (Dynamixel Wizard, the ROBOTIS SDK) opens as a serial
+/// port; `None` where the system does not say (Linux reads it from `/proc/self/fd`).
+pub fn pty_path(port: &SerialPort) -> Option<std::path::PathBuf> {
+    use std::os::unix::io::AsRawFd;
+    std::fs::read_link(format!("/proc/self/fd/{}", port.as_raw_fd())).ok()
+}
+
 /// The pty's nominal baud rate (see [`Emulator::start`]).
 pub const EMULATED_BAUD: u32 = 9600;
 

@@ -33,6 +33,7 @@ pub mod setup;
 pub mod speed;
 mod stance;
 pub mod table;
+pub mod zero;
 
 pub use driver::{drive, DriveError, DriveOutcome, DriveSettings, Profile, ServoConfig, ServoSample};
 pub use emulator::{Emulator, EmulatorConfig, EmulatorFaults, EmulatorReport};

@@ -209,26 +209,7 @@ impl Session {
         };
         let (port, emulator) = match &config.bus {
             BusChoice::Emulate(o) => {
-                if o.k_s.is_none() && ground.k_s.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                    return Err(SessionError::Setting(format!(
-                        "--slope {}: the terrain's sand has no shear strength at this slope (k_s = {}: at or beyond its angle of repose), so the emulator has no sand to walk on; give the emulated sand's k_s with --emulate-k-s, or a shallower --slope",
-                        config.slope_deg, ground.k_s
-                    )));
-                }
-                let k_s = o.k_s.unwrap_or(ground.k_s);
-                let sand = Terrain::constant(k_n, k_s)
-                    .map_err(|e| SessionError::Setting(e.renamed("--emulate-k-s").to_string()))?;
-                let mut cfg = EmulatorConfig::new(
-                    config.robot.clone(),
-                    sand,
-                    config.slope_deg,
-                    config.settings.servos.clone(),
-                );
-                cfg.current_noise_ma = o.noise_ma;
-                cfg.seed = o.seed;
-                cfg.current_offset_ma = o.current_offset_ma.clone();
-                cfg.faults = o.faults;
-                cfg.model_number = config.settings.servo.map_or(cfg.model_number, |m| m.model_number);
+                let cfg = emulator_config(&config, o)?;
                 let (emu, port) = Emulator::start(&cfg).map_err(|e| SessionError::Emulator(e.to_string()))?;
                 (port, Some(emu))
             }
@@ -301,6 +282,35 @@ impl Session {
         let zero = self.gait_zero;
         self.emulator.map(|e| e.stop(zero))
     }
+}
+
+/// The emulator a run on `--emulate` starts (and `drive --emulate-pty` serves alone): the
+/// run's servos, robot and slope, the sand `o.k_s` or the terrain's at the slope, the
+/// options' noise, offsets and faults, and the robot file's servo model.
+pub fn emulator_config(config: &DriveConfig, o: &EmulateOptions) -> Result<EmulatorConfig, SessionError> {
+    let signed = SignedSlope::from_degrees(config.slope_deg)
+        .map_err(|e| SessionError::Setting(e.renamed("--slope").to_string()))?;
+    let (ground, _) = Scenario::new(config.robot.clone(), config.terrain.clone(), None, None)
+        .map_err(|e| SessionError::Setting(e.to_string()))?
+        .ground_at(signed.felt());
+    let (k_n, ground_k_s) = (ground.k_n, ground.k_s);
+    if o.k_s.is_none() && ground_k_s.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return Err(SessionError::Setting(format!(
+                "--slope {}: the terrain's sand has no shear strength at this slope (k_s = {}: at or beyond its angle of repose), so the emulator has no sand to walk on; give the emulated sand's k_s with --emulate-k-s, or a shallower --slope",
+                config.slope_deg, ground_k_s
+            )));
+    }
+    let k_s = o.k_s.unwrap_or(ground_k_s);
+    let sand = Terrain::constant(k_n, k_s)
+        .map_err(|e| SessionError::Setting(e.renamed("--emulate-k-s").to_string()))?;
+    let mut cfg =
+        EmulatorConfig::new(config.robot.clone(), sand, config.slope_deg, config.settings.servos.clone());
+    cfg.current_noise_ma = o.noise_ma;
+    cfg.seed = o.seed;
+    cfg.current_offset_ma = o.current_offset_ma.clone();
+    cfg.faults = o.faults;
+    cfg.model_number = config.settings.servo.map_or(cfg.model_number, |m| m.model_number);
+    Ok(cfg)
 }
 
 /// The risk the safe slope is searched at when `--stop-on-risk` does not give one.

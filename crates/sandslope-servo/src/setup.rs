@@ -167,7 +167,7 @@ pub fn setup(
     schedule: &GaitSchedule,
     settings: &DriveSettings,
 ) -> Result<SetupDone, DriveError> {
-    let model = ping_all(bus, settings)?;
+    let model = ping_all(bus, &settings.servos, settings.servo)?;
     check_limits(settings, model)?;
     let writes = setup_writes(schedule, settings, ControlTable::of(model));
     let mut done = SetupDone { servo: model.name, model: Some(model), ..SetupDone::default() };
@@ -266,12 +266,15 @@ fn check_limits(settings: &DriveSettings, model: &'static ServoModel) -> Result<
 /// one of a model the driver does not know, of another model than the robot file names or
 /// than the servos before it, or with its alert bit set (a hardware error latched before the
 /// run: overheating, overload, ...), is refused before anything is written. The servos' model.
-fn ping_all(bus: &mut DynamixelBus, settings: &DriveSettings) -> Result<&'static ServoModel, DriveError> {
+pub(crate) fn ping_all(
+    bus: &mut DynamixelBus,
+    servos: &[crate::config::ServoConfig],
+    named: Option<&'static ServoModel>,
+) -> Result<&'static ServoModel, DriveError> {
     let baud = bus.baud_rate();
     let mut missing = None;
-    let mut found_model: Option<(&'static ServoModel, u8, usize)> =
-        settings.servo.map(|m| (m, 0, usize::MAX));
-    for (leg, s) in settings.servos.iter().enumerate() {
+    let mut found_model: Option<(&'static ServoModel, u8, usize)> = named.map(|m| (m, 0, usize::MAX));
+    for (leg, s) in servos.iter().enumerate() {
         let mut ping = bus.ping(s.id);
         for _ in 0..2 {
             if ping.is_ok() {

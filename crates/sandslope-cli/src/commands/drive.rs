@@ -27,6 +27,9 @@ use sandslope_servo::session::{
 use sandslope_servo::table as t;
 use sandslope_servo::{DriveSettings, Profile, ServoConfig};
 
+#[path = "drive_bench.rs"]
+mod bench;
+
 use crate::args::{RobotArgs, TerrainArgs};
 use crate::error::{KeepLog, EXIT_HALTED};
 use crate::output::{check_parent_exists, print_json};
@@ -53,6 +56,16 @@ pub struct DriveArgs {
     /// Print the commands (setup writes, then every cycle's goals as CSV) without opening a bus.
     #[arg(long, conflicts_with_all = ["port", "emulate"])]
     pub dry_run: bool,
+    /// With every leg set by hand at leg angle 0 (the torque off), read each servo's Present
+    /// Position and write them into the robot file's [servos] zero_offsets; nothing moves
+    /// (docs/drive.md, "On the bench").
+    #[arg(long, conflicts_with_all = ["dry_run", "pty"])]
+    pub zero: bool,
+    /// With --emulate: serve the emulated servos alone on a pseudo-terminal, its path the first
+    /// line on stdout, for Dynamixel Wizard or the ROBOTIS SDK, for S seconds (left out or 0:
+    /// until Ctrl-C); no gait is driven.
+    #[arg(long, value_name = "S", num_args = 0..=1, default_missing_value = "0", requires = "emulate")]
+    pub pty: Option<f64>,
     #[command(flatten)]
     pub robot: RobotArgs,
     /// Terrain: k_n at the slope for the live estimate, and the emulated sand.
@@ -375,6 +388,15 @@ pub fn run(args: DriveArgs) -> Result<()> {
     };
     let monitor = args.live || args.run.stop_on_risk.is_some();
     let config = config(&args.run, robot, &args.robot.robot, terrain, bus, monitor)?;
+    if args.zero {
+        return bench::zero(&config, &args.robot.robot);
+    }
+    if let Some(seconds) = args.pty {
+        if !(seconds.is_finite() && (0.0..=86_400.0).contains(&seconds)) {
+            bail!("--pty {seconds} must be between 0 and 86400 s (0: until Ctrl-C)");
+        }
+        return bench::serve_pty(&config, seconds);
+    }
     if args.dry_run {
         let schedule = GaitSchedule::new(&config.robot, config.settings.servos.len())?;
         return dry_run(&schedule, &config.settings);

@@ -3,7 +3,7 @@
 #
 # Needs the Rust toolchain and Python 3.9+ with pip (venv module). Creates .venv/ at the
 # repository root (reused on later runs), installs maturin, pytest, numpy, dask, distributed,
-# pandas, tifffile, zarr, xarray and rasterio (whose wheels carry GDAL: the tests write every
+# pandas, tifffile, zarr, xarray, dynamixel-sdk (the servo emulator's referee) and rasterio (whose wheels carry GDAL: the tests write every
 # GeoTIFF layout with it) into it from PyPI, builds and installs crates/sandslope-py into it, and
 # runs `cargo test --workspace --locked` and pytest. Environment:
 #   PYTHON=python3.11   interpreter that creates the venv (default: python3)
@@ -33,7 +33,7 @@ echo "== installing the Python test tools into $venv"
 "$py" -m pip install --quiet --disable-pip-version-check \
   "maturin>=1.9,<2" "pytest>=7" "numpy>=1.21" "dask[array]>=2023.1" "distributed>=2023.1" \
   "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1" "rasterio>=1.3" \
-  "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5"
+  "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5" "dynamixel-sdk>=4.1"
 t1=$(seconds)
 
 echo "== cargo test --workspace --locked"

@@ -214,6 +214,7 @@ pub fn drive<'py>(
         stop_on_risk,
         hold_s,
         stand_s: d.stand_s,
+        servo: None,
     };
     let faults = EmulatorFaults { weaken, ..Default::default() };
     let config = DriveConfig {

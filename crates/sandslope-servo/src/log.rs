@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use sandslope::servo::xl330;
+use sandslope::servo::model::VOLT_PER_VOLTAGE_UNIT;
 use sandslope_io::servo_log::{FlightLog, ServoLogRow};
 
 use crate::driver::{DriveError, DriveOutcome, DriveReport, LiveEstimate, ServoSample};
@@ -22,9 +22,9 @@ pub fn log_row(s: &ServoSample) -> ServoLogRow {
         tripod: s.tripod,
         present_position: s.state.position,
         present_velocity: s.state.velocity,
-        present_current_ma: i32::from(s.state.current_ma),
-        load_percent: 100.0 * f64::from(s.state.current_ma) / (xl330::STALL_CURRENT_A * 1000.0),
-        input_voltage_v: f64::from(s.state.voltage) / (1.0 / xl330::VOLT_PER_VOLTAGE_UNIT).round(),
+        present_current_ma: s.current_ma.round() as i32,
+        load_percent: s.load_percent,
+        input_voltage_v: f64::from(s.state.voltage) / (1.0 / VOLT_PER_VOLTAGE_UNIT).round(),
         temperature_c: i32::from(s.state.temperature_c),
         hardware_error: s.hardware_error,
         goal_position: s.goal_position,

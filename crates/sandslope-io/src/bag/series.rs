@@ -299,13 +299,14 @@ impl std::str::FromStr for EffortUnit {
 }
 
 impl EffortUnit {
-    /// The drive torque, N m, of an effort in this unit (`K_t I` for currents).
+    /// The drive torque, N m, of an effort in this unit (`K_t I` for currents, by the paper's
+    /// XL330-M288).
     pub fn torque_n_m(self, effort: f64) -> f64 {
-        use sandslope::servo::xl330;
+        let servo = &sandslope::servo::ServoModel::XL330_M288;
         match self {
             EffortUnit::NewtonMetre => effort,
-            EffortUnit::Ampere => xl330::TORQUE_CONSTANT_N_M_PER_A * effort,
-            EffortUnit::Milliampere => xl330::torque_from_current(effort),
+            EffortUnit::Ampere => servo.torque_from_current_ma(1000.0 * effort),
+            EffortUnit::Milliampere => servo.torque_from_current_ma(effort),
         }
     }
 }
@@ -390,8 +391,9 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
             }
             let torque = options.effort.torque_n_m(effort);
             let velocity = js.velocity.get(k).copied().unwrap_or(0.0);
-            use sandslope::servo::xl330;
-            let current_ma = xl330::current_from_torque(torque);
+            use sandslope::servo::model as x;
+            let servo = &sandslope::servo::ServoModel::XL330_M288;
+            let current_ma = servo.current_ma_from_torque(torque);
             rows.push((
                 t,
                 m.index,
@@ -400,12 +402,11 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
                     id: leg.min(252) as u8,
                     leg,
                     tripod: leg % 2,
-                    present_position: xl330::pulses_from_rad(angle).clamp(i32::MIN.into(), i32::MAX.into())
+                    present_position: x::pulses_from_rad(angle).clamp(i32::MIN.into(), i32::MAX.into())
                         as i32,
-                    present_velocity: (velocity / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(-1e9, 1e9)
-                        as i32,
+                    present_velocity: (velocity / x::RAD_S_PER_VELOCITY_UNIT).round().clamp(-1e9, 1e9) as i32,
                     present_current_ma: current_ma.round().clamp(-1e9, 1e9) as i32,
-                    load_percent: 100.0 * current_ma / (xl330::STALL_CURRENT_A * 1000.0),
+                    load_percent: 100.0 * current_ma / (servo.stall_current_a * 1000.0),
                     input_voltage_v: 0.0,
                     temperature_c: 0,
                     hardware_error: 0,

@@ -193,6 +193,8 @@ def track(
     cutoff_hz: float = 10.0,
     leg_speed_rad_s: Optional[float] = None,
     touchdowns: Optional[List[List[float]]] = None,
+    topic: Optional[str] = None,
+    frame: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def calibrate(
     robot: Robot,

@@ -1,5 +1,6 @@
 //! A bag's topic as what a command takes: a body's trajectory for `track` (poses, odometry or
-//! a TF child frame), a servo log for `infer --servo-log` (joint states). Times are the
+//! a TF child frame, composed up its tree), a servo log for `infer --servo-log` (joint
+//! states). Times are the
 //! messages' header stamps (the measurement's time), or the recorder's log time where a
 //! stamp is zero (a driver that does not set it).
 

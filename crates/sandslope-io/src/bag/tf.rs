@@ -155,7 +155,7 @@ pub(super) fn in_root(
                             m.index
                         )
                     })?;
-                    series.push((t.header.stamp.nanos(), iso));
+                    series.push((super::series::stamp_ns(&t.header, m), iso));
                     kept += 1;
                 }
             }

@@ -554,7 +554,8 @@ def fit(
     """k_n and k_s per slope from load-cell recordings (``sandslope fit``, docs/model.md §10).
 
     ``manifest`` is the TOML manifest of the campaign (docs/measurements.md): disk area, shear
-    plate, and one ``[[trial]]`` per CSV (kind, slope, in-air or not). k_n is the slope of force
+    plate, and one ``[[trial]]`` per CSV or ROS 2 bag (kind, slope, in-air or not; a bag's
+    wrench and pose topics as docs/bags.md describes). k_n is the slope of force
     against depth over its linear part, divided by the disk area; k_s comes from the
     quasi-static shear plateau; in-air runs are subtracted (``air``: ``"auto"``, ``"curve"``
     or ``"mean"``). ``depth_window=(min, max)`` (m) and ``plateau_from`` (m) override the

@@ -506,6 +506,15 @@ def test_fit_reads_wrenches_and_poses_from_bags_as_the_csv(tmp_path):
     import sandslope
     py = sandslope.fit(tmp_path / "bag.toml")
     assert py["points"]["k_n"][0] == pytest.approx(pc["k_n"], rel=1e-9)
+    # read_bag gives the trial's columns as fit reads them: the CSV's, to the stamps' nanosecond.
+    _kind, _slope, _air, t, depth, force = trials[1]
+    cols = sandslope.read_bag(tmp_path / "penetration-1", "/load_cell/wrench", force_axis="-z")
+    assert list(cols.columns) == ["time_s", "position_m", "force_n"] and cols.attrs["body"] == "/rig/disk"
+    assert np.allclose(cols["time_s"], t, rtol=0, atol=1e-9)
+    assert np.allclose(cols["position_m"], depth, rtol=0, atol=1e-10)
+    assert np.array_equal(cols["force_n"], force)
+    with pytest.raises(ValueError, match="force_axis"):
+        sandslope.read_bag(tmp_path / "penetration-1", "/load_cell/wrench")
     # A bag trial without force_axis, and CSV trials with bag keys, are refused by name.
     bad = tmp_path / "bad.toml"
     write_manifest(bad, [(f, "") for f, _ in bag_files])

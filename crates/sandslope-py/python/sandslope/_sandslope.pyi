@@ -327,3 +327,11 @@ def read_bag_joints(
     joints: Optional[List[str]] = None,
     effort_unit: str = "n_m",
 ) -> Tuple[Dict[str, np.ndarray], List[str]]: ...
+def read_bag_load_cell(
+    path: _Path,
+    force_axis: str,
+    force_topic: Optional[str] = None,
+    position_topic: Optional[str] = None,
+    frame: Optional[str] = None,
+    position_axis: Optional[str] = None,
+) -> Tuple[Dict[str, np.ndarray], str]: ...

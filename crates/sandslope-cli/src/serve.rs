@@ -69,6 +69,11 @@ pub struct ServeArgs {
     /// With --drive: drive a bus of emulated XL330s on a pseudo-terminal instead of a port.
     #[arg(long, requires = "drive", conflicts_with = "drive_port", help_heading = "Driving (docs/drive.md)")]
     pub emulate: bool,
+    /// With --drive: stream the run to Foxglove over its WebSocket protocol on ADDR
+    /// (127.0.0.1:8765 when none is given), as `drive --foxglove` does (docs/bags.md).
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, requires = "drive",
+        default_missing_value = sandslope_io::foxglove::DEFAULT_ADDR, help_heading = "Driving (docs/drive.md)")]
+    pub foxglove: Option<String>,
     #[command(flatten, next_help_heading = "Driving (docs/drive.md)")]
     pub drive_run: Option<DriveRunArgs>,
 }
@@ -129,5 +134,6 @@ pub fn run(args: ServeArgs) -> Result<()> {
         allow_host: args.allow_host,
         drive,
         drive_log,
+        drive_foxglove: args.foxglove,
     })
 }

@@ -376,3 +376,17 @@ mod tests {
         assert!((p.pose.orientation.y - (-15f64.to_radians()).sin()).abs() < 1e-12);
     }
 }
+
+/// How a run ended, as `/sandslope/verdict` says it: the failure when there is one, else the
+/// outcome as `drive --json` gives it (`{"outcome": "completed", ...}`, never Rust's
+/// `Result`), else why it did not start.
+pub fn verdict_text<T: serde::Serialize>(
+    outcome: &std::result::Result<T, String>,
+    failure: Option<&dyn std::fmt::Display>,
+) -> String {
+    match (failure, outcome) {
+        (Some(e), _) => e.to_string(),
+        (None, Ok(outcome)) => serde_json::to_string(outcome).unwrap_or_default(),
+        (None, Err(why)) => why.clone(),
+    }
+}

@@ -556,7 +556,8 @@ def fit(
     """k_n and k_s per slope from load-cell recordings (``sandslope fit``, docs/model.md §10).
 
     ``manifest`` is the TOML manifest of the campaign (docs/measurements.md): disk area, shear
-    plate, and one ``[[trial]]`` per CSV (kind, slope, in-air or not). k_n is the slope of force
+    plate, and one ``[[trial]]`` per CSV or ROS 2 bag (kind, slope, in-air or not; a bag's
+    wrench and pose topics as docs/bags.md describes). k_n is the slope of force
     against depth over its linear part, divided by the disk area; k_s comes from the
     quasi-static shear plateau; in-air runs are subtracted (``air``: ``"auto"``, ``"curve"``
     or ``"mean"``). ``depth_window=(min, max)`` (m) and ``plateau_from`` (m) override the
@@ -591,6 +592,8 @@ def track(
     cutoff_hz: float = 10.0,
     leg_speed_rad_s: Optional[float] = None,
     touchdowns: Optional[Sequence[Any]] = None,
+    topic: Optional[str] = None,
+    frame: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Speed, anchoring time and slip from motion capture (``sandslope track``, docs/model.md §11).
 
@@ -602,7 +605,10 @@ def track(
     ``leg_speed_rad_s``) come from ``touchdowns`` (per recording, a list of times in s or the
     path of a touchdowns file, as ``track --touchdowns`` reads) or are
     estimated from the speed signal. ``upslope`` (x, y, z) fixes the upslope direction
-    (estimated from the travel otherwise).
+    (estimated from the travel otherwise). A ROS 2 bag (a bag folder, ``.mcap`` or ``.db3``,
+    docs/bags.md) is read as ``track --topic --frame`` reads it: ``topic`` a pose, odometry or
+    TF topic (the bag's only one when omitted), ``frame`` the child frame on a TF topic,
+    composed up its tree to the root.
 
     Returns the fields of ``sandslope track --json``: pooled means and SDs (``speed_m_s``,
     ``t1_s``, ``slip_m``, ``step_m``, ...), and ``recordings`` and ``per_step`` as pandas
@@ -621,6 +627,8 @@ def track(
         cutoff_hz=float(cutoff_hz),
         leg_speed_rad_s=None if leg_speed_rad_s is None else float(leg_speed_rad_s),
         touchdowns=None if touchdowns is None else [_touchdown_times(ts) for ts in touchdowns],
+        topic=topic,
+        frame=frame,
     )
     out["recordings"] = _frame(out["recordings"])
     out["per_step"] = _frame(out["per_step"])

@@ -196,6 +196,8 @@ def track(
     cutoff_hz: float = 10.0,
     leg_speed_rad_s: Optional[float] = None,
     touchdowns: Optional[List[List[float]]] = None,
+    topic: Optional[str] = None,
+    frame: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def calibrate(
     robot: Robot,
@@ -301,3 +303,11 @@ def read_bag_joints(
     joints: Optional[List[str]] = None,
     effort_unit: str = "n_m",
 ) -> Tuple[Dict[str, np.ndarray], List[str]]: ...
+def read_bag_load_cell(
+    path: _Path,
+    force_axis: str,
+    force_topic: Optional[str] = None,
+    position_topic: Optional[str] = None,
+    frame: Optional[str] = None,
+    position_axis: Optional[str] = None,
+) -> Tuple[Dict[str, np.ndarray], str]: ...

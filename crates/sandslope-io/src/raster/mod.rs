@@ -13,6 +13,7 @@ mod ascii;
 mod chunks;
 pub mod geotiff;
 pub mod grid;
+mod seam;
 mod tiles;
 mod windows;
 
@@ -22,6 +23,7 @@ use geotiff::{read_geotiff, samples_as};
 pub use grid::{
     available_memory, memory_limit, set_memory_limit, GeoRef, Raster, SizeCheck, DEFAULT_MEMORY_LIMIT,
 };
+pub use seam::{rolled_column, seam_roll, wraps_in_longitude};
 pub use tiles::{write_two_band_geotiff_by_rows, TILE};
 pub use windows::{open_height_windows, HeightWindows, WindowsCheck};
 

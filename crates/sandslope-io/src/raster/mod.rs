@@ -97,6 +97,13 @@ impl Format {
             Some("asc") => Format::Asc,
             Some("img" | "lbl") => Format::Pds3,
             _ if crate::pds3::starts_with_label(path) => Format::Pds3,
+            // ISIS3 cubes (CTX DTMs made with ISIS are often shared as .cub): not read.
+            Some("cub") => bail!(
+                "{}: an ISIS cube (.cub) is not read; export it to a GeoTIFF (ISIS isis2std format=tiff, or \
+                 gdal_translate -of GTiff) or to a PDS3 .IMG (ISIS isis2pds), which are: GeoTIFF (.tif, .tiff), \
+                 ESRI ASCII grid (.asc), PDS3 DTM (.img, .lbl)",
+                path.display()
+            ),
             _ => bail!(
                 "{}: unknown raster format; use a GeoTIFF (.tif, .tiff), an ESRI ASCII grid (.asc) or a PDS3 DTM \
                  (.img, .lbl)",

@@ -213,3 +213,35 @@ fn a_ctx_dtm_from_isis_reads_as_equirectangular_rows() {
     let e = format!("{:#}", read_raster(&dir.path().join("ctx.cub")).unwrap_err());
     assert!(e.contains("ISIS cube") && e.contains("isis2std") && e.contains("GeoTIFF (.tif"), "{e}");
 }
+
+/// A GeoTIFF in the equirectangular projection (as GDAL and ISIS export CTX DTMs, and as
+/// `plan --risk-map` writes over a PDS3 equirectangular DTM) has the rows of the PDS3 DTM it
+/// came from: the GeoKeys (CT_Equirectangular, standard parallel 15, Mars' sphere) of the
+/// HiRISE-layout fixture give each row the width its label gives, 20 cos(lat) / cos(15 deg):
+/// 19.4558 m at row 0 (latitude 20.0084, worked in docs/planning.md).
+#[test]
+fn an_equirectangular_geotiff_has_the_rows_of_its_pds3_twin() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pds3/dtm-attached.img");
+    let r = read_raster(&path).unwrap();
+    let g = &r.geo;
+    let mut notes = Vec::new();
+    let cells = crate::crs::equirectangular_rows(
+        &"twin.tif",
+        g.geokeys.as_deref(),
+        g.geodoubles.as_deref(),
+        1.0,
+        (g.cell_x, g.cell_y),
+        g.north,
+        r.rows,
+        &mut notes,
+    )
+    .unwrap()
+    .unwrap();
+    let (want, got) = (r.row_widths_m.as_ref().unwrap(), cells.row_widths_m.as_ref().unwrap());
+    assert_eq!(want.len(), got.len());
+    for (a, b) in want.iter().zip(got) {
+        assert!((a - b).abs() <= 1e-12 * a, "{a} vs {b}");
+    }
+    assert!((got[0] - 19.4558).abs() < 1e-4 && cells.cell_m.1 == 20.0, "{} {:?}", got[0], cells.cell_m);
+    assert!(notes[0].contains("standard parallel 15 degrees"), "{notes:?}");
+}

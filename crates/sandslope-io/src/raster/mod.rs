@@ -132,6 +132,22 @@ fn finish(path: &Path, mut raster: Raster, vertical: f64) -> Result<Raster> {
         &mut raster.notes,
     )?;
     (raster.cell_m, raster.row_widths_m) = (cells.cell_m, cells.row_widths_m);
+    // An equirectangular map in metres (a CTX DTM from ISIS or GDAL): each row its own width.
+    if let Crs::Projected { metres_per_unit, .. } = raster.crs {
+        let rows = crate::crs::equirectangular_rows(
+            &path.display(),
+            g.geokeys.as_deref(),
+            g.geodoubles.as_deref(),
+            metres_per_unit,
+            (g.cell_x, g.cell_y),
+            g.north,
+            raster.rows,
+            &mut raster.notes,
+        )?;
+        if let Some(cells) = rows {
+            (raster.cell_m, raster.row_widths_m) = (cells.cell_m, cells.row_widths_m);
+        }
+    }
     if !raster.crs.is_geographic()
         && g.cell_x < 0.01
         && g.west.abs() <= 180.0

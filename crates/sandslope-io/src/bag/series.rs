@@ -129,8 +129,7 @@ pub(super) fn read_positions(path: &Path, topic: Option<&str>, frame: Option<&st
     let mut frames: BTreeMap<String, u64> = BTreeMap::new();
     let mut samples: Vec<(i64, [f64; 3])> = Vec::new();
     // On a TF topic: every child frame's parent, and the frame's own transforms.
-    let mut parents: BTreeMap<String, String> = BTreeMap::new();
-    let mut tf_samples: Vec<(i64, nalgebra::Isometry3<f64>)> = Vec::new();
+    let mut tf = super::tf::TfFrames::default();
     let mut kind: Option<String> = None;
     let all = scan(&bag, Some(&name), &mut |m| {
         let type_name = m.type_name;
@@ -162,31 +161,7 @@ pub(super) fn read_positions(path: &Path, topic: Option<&str>, frame: Option<&st
             }
             *frames.entry(t.child_frame_id).or_default() += 1;
         } else {
-            let tf: TfMessage = decode_at(m)?;
-            for t in tf.transforms {
-                let child = t.child_frame_id.trim_start_matches('/').to_string();
-                let parent = t.header.frame_id.trim_start_matches('/');
-                let first = parents.entry(child.clone()).or_insert_with(|| parent.to_string());
-                if frame.as_deref() == Some(child.as_str()) {
-                    if first != parent {
-                        bail!(
-                            "{}: topic `{}`, message {}: frame `{child}` changes parent from `{first}` to `{parent}`",
-                            m.at,
-                            m.topic,
-                            m.index
-                        );
-                    }
-                    let iso = super::tf::isometry(&t.transform).unwrap_or_else(|| {
-                        // A zero rotation: the translation is still the frame's position.
-                        let v = t.transform.translation;
-                        nalgebra::Isometry3::translation(v.x, v.y, v.z)
-                    });
-                    let ns = stamp_ns(&t.header, m);
-                    samples.push((ns, point(t.transform.translation)));
-                    tf_samples.push((ns, iso));
-                }
-                *frames.entry(child).or_default() += 1;
-            }
+            tf.add(decode_at(m)?, m, frame.as_deref(), &mut samples, &mut frames)?;
         }
         if samples.len() as u64 > super::MAX_MESSAGES {
             bail!(
@@ -227,9 +202,9 @@ pub(super) fn read_positions(path: &Path, topic: Option<&str>, frame: Option<&st
         }
         body = format!("{name} {f}");
         if is_tf {
-            let parent = parents.get(f).cloned().unwrap_or_default();
-            let target = super::tf::FrameSamples { frame: f, parent: &parent, samples: tf_samples };
-            let (composed, root) = super::tf::in_root(&bag, path, &name, &all, target, &parents)?;
+            let parent = tf.parents.get(f).cloned().unwrap_or_default();
+            let target = super::tf::FrameSamples { frame: f, parent: &parent, samples: tf.samples };
+            let (composed, root) = super::tf::in_root(&bag, path, &name, &all, target, &tf.parents)?;
             if root != parent {
                 body = format!("{name} {f} in {root}");
                 samples = composed
@@ -242,7 +217,8 @@ pub(super) fn read_positions(path: &Path, topic: Option<&str>, frame: Option<&st
     Ok(Positions { name, body, samples })
 }
 
-fn point(p: messages::Point) -> [f64; 3] {
+/// A position, NaN in every coordinate when one is not finite.
+pub(super) fn point(p: messages::Point) -> [f64; 3] {
     let v = [p.x, p.y, p.z];
     if v.iter().all(|x| x.is_finite()) {
         v

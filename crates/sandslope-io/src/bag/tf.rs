@@ -12,7 +12,7 @@ use anyhow::{anyhow, bail, Result};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 
 use super::messages::{self, decode, RosMessage, TfMessage, Transform};
-use super::{scan, Bag, BagTopic, MAX_MESSAGES};
+use super::{scan, Bag, BagMessage, BagTopic, MAX_MESSAGES};
 
 /// The topic static transforms are published on, read with `/tf`.
 pub const TF_STATIC: &str = "/tf_static";
@@ -66,6 +66,54 @@ fn read_static(bag: &Bag, path: &Path) -> Result<BTreeMap<String, (String, Isome
         Ok(())
     })?;
     Ok(out)
+}
+
+/// What a TF topic's messages leave for [`in_root`]: every child frame's parent (the first
+/// seen), and the tracked frame's own transforms.
+#[derive(Default)]
+pub(super) struct TfFrames {
+    /// Child frame to parent.
+    pub parents: BTreeMap<String, String>,
+    /// The tracked frame's transforms to its parent, with their stamps (ns).
+    pub samples: Vec<(i64, Isometry3<f64>)>,
+}
+
+impl TfFrames {
+    /// Takes one `TFMessage` read at `m`: each child frame's parent, counted in `frames`; for
+    /// `frame`, its transform kept and its translation pushed to `positions` (an error if its
+    /// parent changes).
+    pub(super) fn add(
+        &mut self,
+        tf: TfMessage,
+        m: &BagMessage<'_>,
+        frame: Option<&str>,
+        positions: &mut Vec<(i64, [f64; 3])>,
+        frames: &mut BTreeMap<String, u64>,
+    ) -> Result<()> {
+        for t in tf.transforms {
+            let child = t.child_frame_id.trim_start_matches('/').to_string();
+            let parent = t.header.frame_id.trim_start_matches('/');
+            let first = self.parents.entry(child.clone()).or_insert_with(|| parent.to_string());
+            if frame == Some(child.as_str()) {
+                if first != parent {
+                    bail!(
+                        "{}: topic `{}`, message {}: frame `{child}` changes parent from `{first}` to `{parent}`",
+                        m.at,
+                        m.topic,
+                        m.index
+                    );
+                }
+                // A zero rotation: the translation is still the frame's position.
+                let v = t.transform.translation;
+                let iso = isometry(&t.transform).unwrap_or_else(|| Isometry3::translation(v.x, v.y, v.z));
+                let ns = super::series::stamp_ns(&t.header, m);
+                positions.push((ns, super::series::point(v)));
+                self.samples.push((ns, iso));
+            }
+            *frames.entry(child).or_default() += 1;
+        }
+        Ok(())
+    }
 }
 
 /// One TF frame as read from its topic: the frame, its parent, its stamped transforms.

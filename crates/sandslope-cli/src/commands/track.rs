@@ -36,7 +36,8 @@ pub struct TrackArgs {
     /// omitted, else the error lists the candidates.
     #[arg(long, value_name = "TOPIC")]
     pub topic: Option<String>,
-    /// The child frame to track on a bag's TF topic (e.g. `base_link`); the only one when omitted.
+    /// The child frame to track on a bag's TF topic (e.g. `base_link`), placed in the root of
+    /// its TF tree (docs/bags.md); the only one when omitted.
     #[arg(long, value_name = "FRAME")]
     pub frame: Option<String>,
     /// Upslope direction in the capture frame: +x, -x, +y, -y, +z, -z or a vector such as

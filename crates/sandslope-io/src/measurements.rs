@@ -306,7 +306,14 @@ pub fn read_trials(manifest: &Manifest, options: ReadOptions) -> Result<Vec<Tria
             );
         }
         let rec = match &trial.bag {
-            Some(keys) => read_bag_recording(&trial.path, keys)?,
+            Some(keys) => read_bag_recording(&trial.path, keys).map_err(|e| {
+                anyhow!(
+                    "{}: [[trial]] #{} ({}): {e:#}",
+                    manifest.path.display(),
+                    trial.index,
+                    trial.file.display()
+                )
+            })?,
             None => read_recording_with(&trial.path, trial.kind, options)?,
         };
         out.push(TrialInput {

@@ -523,6 +523,13 @@ def test_fit_reads_wrenches_and_poses_from_bags_as_the_csv(tmp_path):
     write_manifest(bad, [(f, 'force_axis = "z"\n') for f, _ in csv_files])
     err = run("fit", bad, code=2).stderr
     assert "force_axis are keys of a ROS 2 bag trial" in err, err
+    # A bag that is not there, and a force topic of another type: the trial, the file and the topic.
+    write_manifest(bad, [("missing.mcap", 'force_axis = "z"\n')] + bag_files[1:])
+    err = run("fit", bad, code=2).stderr
+    assert "[[trial]] #1 (missing.mcap)" in err and "missing.mcap" in err, err
+    write_manifest(bad, [(bag_files[0][0], 'force_axis = "z"\nforce_topic = "/rig/disk"\n')] + bag_files[1:])
+    err = run("fit", bad, code=2).stderr
+    assert "[[trial]] #1" in err and "`/rig/disk` is geometry_msgs/msg/PoseStamped" in err, err
 
 
 def test_track_composes_a_tf_frame_up_its_tree(walk):

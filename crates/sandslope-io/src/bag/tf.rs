@@ -130,6 +130,9 @@ pub(super) struct FrameSamples<'a> {
 /// every child frame seen on `topic` to its parent. A position is NaN (an occlusion to the
 /// analysis) where a moving parent has no transform around the stamp (no extrapolation, as
 /// in `tf2`).
+/// Positions of a frame in the tree's root frame: (log time, ns; position, m).
+type Positions = Vec<(i64, [f64; 3])>;
+
 pub(super) fn in_root(
     bag: &Bag,
     path: &Path,
@@ -137,7 +140,7 @@ pub(super) fn in_root(
     topics: &[BagTopic],
     target: FrameSamples<'_>,
     parents: &BTreeMap<String, String>,
-) -> Result<(Vec<(i64, [f64; 3])>, String)> {
+) -> Result<(Positions, String)> {
     // The chain of parents: each link from a frame to its own parent.
     let has_static = topic == "/tf" && topics.iter().any(|t| t.name == TF_STATIC);
     let mut fixed: Option<BTreeMap<String, (String, Isometry3<f64>)>> = None;

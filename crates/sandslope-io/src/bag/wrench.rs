@@ -133,7 +133,7 @@ pub fn read_load_cell(path: &Path, options: &LoadCellOptions<'_>) -> Result<Load
                 }
             });
             let len = dot(far, far).sqrt();
-            if !(len > 0.0) {
+            if len.is_nan() || len <= 0.0 {
                 bail!(
                     "{}: topic `{}`: the intruder never moves from ({}, {}, {}) m",
                     path.display(),

@@ -140,8 +140,14 @@ fn watch_until(args: &[&str], ends_itself: bool) -> Watched {
     Watched { info, channels, received, stdout: out.stdout }
 }
 
+/// The emulated drives of this file run one at a time: two 50 Hz bus loops at once on a
+/// loaded 2-core machine make each other's cycles late (the once-a-cycle counts failed once
+/// in four runs so).
+static ONE_DRIVE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 #[test]
 fn a_drive_streams_its_channels_once_a_cycle() {
+    let _one = ONE_DRIVE.lock().unwrap_or_else(|e| e.into_inner());
     let w = watch(&["drive", "--emulate", "--slope", "10", "--duration", "5", "--live", "--json"]);
     let report: Value = serde_json::from_slice(&w.stdout).unwrap();
 
@@ -220,6 +226,7 @@ fn a_drive_streams_its_channels_once_a_cycle() {
 /// serves on).
 #[test]
 fn a_served_drive_streams_its_channels() {
+    let _one = ONE_DRIVE.lock().unwrap_or_else(|e| e.into_inner());
     let w = watch_until(
         &["serve", "--port", "0", "--drive", "--emulate", "--slope", "10", "--duration", "3"],
         false,

@@ -41,11 +41,17 @@ cargo test --workspace --locked
 t2=$(seconds)
 
 # Built in place (pip builds local directories in-tree), so Cargo uses the workspace's
-# target/ and its lock file; the profile is [profile.python-ext] of Cargo.toml.
-echo "== building and installing crates/sandslope-py: Cargo compiles the extension (profile python-ext);"
-echo "   minutes on a cold build, seconds when target/python-ext is warm; pip says when the wheel is built"
-"$py" -m pip install --disable-pip-version-check --no-build-isolation --no-deps \
-  --force-reinstall ./crates/sandslope-py
+# target/ and its lock file. The tests build it in Cargo's dev profile, on the dependencies
+# `cargo test` just compiled (the library itself is opt-level 2 in dev, Cargo.toml): 79 s of
+# CPU against a full optimised rebuild of every dependency in the shipped profile
+# ([profile.python-ext], what `pip install ./crates/sandslope-py` uses), which took 154 s wall
+# of CI's 837 s; pytest's 112 tests took 63 s of CPU on it (measured 2026-12-07, load ~12).
+# SANDSLOPE_PY_PROFILE=python-ext tests the shipped profile instead.
+profile=${SANDSLOPE_PY_PROFILE:-dev}
+echo "== building and installing crates/sandslope-py: Cargo compiles the extension (profile $profile);"
+echo "   pip says when the wheel is built"
+MATURIN_PEP517_ARGS="--profile $profile" "$py" -m pip install --disable-pip-version-check \
+  --no-build-isolation --no-deps --force-reinstall ./crates/sandslope-py
 t3=$(seconds)
 
 echo "== pytest crates/sandslope-py/tests"

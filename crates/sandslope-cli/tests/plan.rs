@@ -920,7 +920,10 @@ fn a_global_mola_megdr_plans_in_longitude_and_latitude() {
         (json_of(&out.stdout), String::from_utf8_lossy(&out.stderr).into_owned())
     };
     let (full, notes) = run(&[]);
-    assert!(notes.contains("simple cylindrical map on Mars") && notes.contains("do not wrap"), "{notes}");
+    assert!(
+        notes.contains("simple cylindrical map on Mars") && notes.contains("routes wrap across its edges"),
+        "{notes}"
+    );
     let length = full["routes"]["distance"]["length_m"].as_f64().unwrap();
     let g: Value = serde_json::from_str(&std::fs::read_to_string(&geojson).unwrap()).unwrap();
     let line: Vec<(f64, f64)> = g["features"][0]["geometry"]["coordinates"]

@@ -30,6 +30,14 @@ const PROJ_LINEAR_UNITS: u16 = 3076;
 const PROJECTED_CS_TYPE: u16 = 3072;
 /// VerticalUnitsGeoKey.
 const VERTICAL_UNITS: u16 = 4099;
+/// ProjCoordTransGeoKey, and its CT_Equirectangular.
+const PROJ_COORD_TRANS: u16 = 3075;
+const CT_EQUIRECTANGULAR: u16 = 17;
+/// ProjStdParallel1GeoKey, ProjNatOriginLatGeoKey, ProjFalseNorthingGeoKey, ProjCenterLatGeoKey.
+const PROJ_STD_PARALLEL1: u16 = 3078;
+const PROJ_NAT_ORIGIN_LAT: u16 = 3081;
+const PROJ_FALSE_NORTHING: u16 = 3083;
+const PROJ_CENTER_LAT: u16 = 3089;
 
 /// WGS84: a = 6 378 137 m, 1/f = 298.257223563.
 pub const WGS84: Ellipsoid =
@@ -331,6 +339,73 @@ pub fn ground_cell_size(
             Ok(GroundCells { cell_m: (gx, gy), row_widths_m: Some(widths) })
         }
     }
+}
+
+/// The ground cells of a projected map in the equirectangular projection on a sphere
+/// (`ProjCoordTransGeoKey` CT_Equirectangular, as ISIS and GDAL write planetary DTMs, CTX ones
+/// among them: x = R (lon - lon0) cos(lat_ts), y = R (lat - lat0) + false northing): north-south
+/// the map's cell everywhere; east-west the map's cell is true only at the standard parallel
+/// `lat_ts`, so each row's cells are `cell_x cos(lat) / cos(lat_ts)` wide at the row's central
+/// latitude, as for a PDS3 equirectangular DTM (the reference cell at the mid-latitude). `None`
+/// for any other projection, or without the sphere's radius (GeogSemiMajorAxisGeoKey, or an
+/// ellipsoid by code: its semi-major axis is taken, with a note). Refused within a degree of a
+/// pole.
+#[allow(clippy::too_many_arguments)]
+pub fn equirectangular_rows(
+    name: &dyn std::fmt::Display,
+    dir: Option<&[u16]>,
+    doubles: Option<&[f64]>,
+    metres_per_unit: f64,
+    (cell_x, cell_y): (f64, f64),
+    north: f64,
+    rows: usize,
+    notes: &mut Vec<String>,
+) -> Result<Option<GroundCells>> {
+    let Some(dir) = dir else { return Ok(None) };
+    let keys = Keys { dir, doubles: doubles.unwrap_or(&[]), ascii: "" };
+    if keys.short(PROJ_COORD_TRANS) != Some(CT_EQUIRECTANGULAR) {
+        return Ok(None);
+    }
+    let (radius, flattened) = match keys.double(GEOG_SEMI_MAJOR).filter(|a| a.is_finite() && *a > 1000.0) {
+        Some(a) => (a, keys.double(GEOG_INV_FLATTENING).is_some_and(|f| f > 0.0)),
+        None => match keys
+            .short(GEOGRAPHIC_TYPE)
+            .and_then(geographic)
+            .or_else(|| keys.short(GEOG_ELLIPSOID).and_then(ellipsoid))
+        {
+            Some(e) => (e.semi_major_m, e.inverse_flattening > 0.0),
+            None => return Ok(None),
+        },
+    };
+    let lat_ts = keys.double(PROJ_STD_PARALLEL1).unwrap_or(0.0);
+    let lat0 = keys.double(PROJ_CENTER_LAT).or_else(|| keys.double(PROJ_NAT_ORIGIN_LAT)).unwrap_or(0.0);
+    let false_northing = keys.double(PROJ_FALSE_NORTHING).unwrap_or(0.0);
+    let (cx, cy) = (cell_x * metres_per_unit, cell_y * metres_per_unit);
+    let lat = |y: f64| lat0 + ((y * metres_per_unit - false_northing) / radius).to_degrees();
+    let (lat_n, lat_s) = (lat(north), lat(north - rows as f64 * cell_y));
+    if lat_ts.abs() >= 89.0 || lat_n.abs() >= 89.0 || lat_s.abs() >= 89.0 {
+        bail!(
+            "{name}: an equirectangular map (ProjCoordTransGeoKey 17) with its standard parallel at {lat_ts} degrees \
+             and rows from latitude {lat_n:.4} to {lat_s:.4}: it must lie within 89 degrees of the equator; \
+             reproject to a polar stereographic CRS (gdalwarp -t_srs)"
+        );
+    }
+    let east = |phi: f64| cx * phi.to_radians().cos() / lat_ts.to_radians().cos();
+    let row_lat = |r: usize| lat(north - (r as f64 + 0.5) * cell_y);
+    let widths: Vec<f64> = (0..rows).map(|r| east(row_lat(r))).collect();
+    let last = rows.saturating_sub(1);
+    notes.push(format!(
+        "{name}: equirectangular map (ProjCoordTransGeoKey 17) on a sphere of radius {radius} m{}: the map's \
+         {cx} m are true east-west at the standard parallel {lat_ts} degrees; cells are {cy} m north-south and, \
+         east-west, each row's own width {cx} cos(latitude) / cos({lat_ts}), from {:.4} m (row 0, latitude \
+         {:.4}) to {:.4} m (row {last}, latitude {:.4})",
+        if flattened { " (the ellipsoid's semi-major axis)" } else { "" },
+        widths[0],
+        row_lat(0),
+        widths[last],
+        row_lat(last),
+    ));
+    Ok(Some(GroundCells { cell_m: (east(0.5 * (lat_n + lat_s)), cy), row_widths_m: Some(widths) }))
 }
 
 /// The CRS of an ESRI ASCII grid from the `.prj` (ESRI WKT) beside it: `GEOGCS` without

@@ -324,6 +324,20 @@ pub fn live_message(l: &LiveRecord) -> crate::bag::messages::Float64Array {
     Float64Array { layout, data: l.values.to_vec() }
 }
 
+/// How a run ended, as `/sandslope/verdict` says it: the failure when there is one, else the
+/// outcome as `drive --json` gives it (`{"outcome": "completed", ...}`, never Rust's
+/// `Result`), else why it did not start.
+pub fn verdict_text<T: serde::Serialize>(
+    outcome: &std::result::Result<T, String>,
+    failure: Option<&dyn std::fmt::Display>,
+) -> String {
+    match (failure, outcome) {
+        (Some(e), _) => e.to_string(),
+        (None, Ok(outcome)) => serde_json::to_string(outcome).unwrap_or_default(),
+        (None, Err(why)) => why.clone(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -33,6 +33,27 @@ pub fn log_row(s: &ServoSample) -> ServoLogRow {
     }
 }
 
+/// A live estimate as `/sandslope/live` carries it (`drive --log run.mcap`, `drive
+/// --foxglove`, `serve --drive --foxglove`; docs/bags.md).
+pub fn live_record(l: &LiveEstimate) -> sandslope_io::mcap_out::LiveRecord {
+    let i = &l.inference;
+    sandslope_io::mcap_out::LiveRecord {
+        time_s: l.time_s,
+        values: [
+            l.tripod as f64,
+            i.k_s,
+            i.k_s_lo,
+            i.k_s_hi,
+            i.speed_m_s,
+            i.speed_lo_m_s,
+            i.speed_hi_m_s,
+            i.p_fail,
+            i.p_slippage,
+            i.p_sinkage,
+        ],
+    }
+}
+
 /// The log's `# key = value` header: the run's robot and terrain (as named on the command
 /// line), slope, k_n, timing, servos, profile and whether the bus was emulated.
 pub fn log_meta(session: &Session, robot: &str, terrain: &str) -> Vec<(&'static str, String)> {

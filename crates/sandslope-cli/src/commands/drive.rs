@@ -20,7 +20,7 @@ use sandslope_request::drive::DriveRun;
 use sandslope_request::error::Words;
 use sandslope_servo::driver::{DriveReport, LiveEstimate};
 use sandslope_servo::emulator::EmulatorFaults;
-use sandslope_servo::log::{drive_logged, LogTarget};
+use sandslope_servo::log::{drive_logged, live_record, LogTarget};
 use sandslope_servo::session::{
     default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, RUN_DEFAULTS,
 };
@@ -463,7 +463,12 @@ pub fn run(args: DriveArgs) -> Result<()> {
         foxglove.iter().for_each(|f| f.row(sandslope_servo::log::log_row(s)));
     };
     let (report, failure) = drive_logged(&mut session, log, stop, on_sample, &mut on_live)?;
-    foxglove.into_iter().for_each(|f| f.finish(&verdict_text(&report, failure.as_ref())));
+    foxglove.into_iter().for_each(|f| {
+        f.finish(&sandslope_io::mcap_out::verdict_text(
+            &report.outcome,
+            failure.as_ref().map(|e| e as &dyn std::fmt::Display),
+        ))
+    });
     if let Some(path) = mcap {
         write_mcap_log(path, &rows, &report, &meta, failure.as_ref())?;
     }
@@ -713,36 +718,7 @@ fn write_mcap_log(
 ) -> Result<()> {
     use sandslope_io::mcap_out::{drive_mcap, LiveRecord};
     let live: Vec<LiveRecord> = report.live.iter().map(live_record).collect();
-    let verdict = verdict_text(report, failure);
+    let verdict =
+        sandslope_io::mcap_out::verdict_text(&report.outcome, failure.map(|e| e as &dyn std::fmt::Display));
     sandslope_io::write_atomic(path, &drive_mcap(rows, &live, meta, &verdict)?)
-}
-
-/// A live estimate as `/sandslope/live` carries it (`--log run.mcap`, `--foxglove`).
-fn live_record(l: &LiveEstimate) -> sandslope_io::mcap_out::LiveRecord {
-    let i = &l.inference;
-    sandslope_io::mcap_out::LiveRecord {
-        time_s: l.time_s,
-        values: [
-            l.tripod as f64,
-            i.k_s,
-            i.k_s_lo,
-            i.k_s_hi,
-            i.speed_m_s,
-            i.speed_lo_m_s,
-            i.speed_hi_m_s,
-            i.p_fail,
-            i.p_slippage,
-            i.p_sinkage,
-        ],
-    }
-}
-
-/// How the run ended, as `/sandslope/verdict` says it.
-fn verdict_text(report: &DriveReport, failure: Option<&sandslope_servo::DriveError>) -> String {
-    // The outcome as `--json` gives it (`{"outcome": "completed", ...}`), never Rust's `Result`.
-    match (failure, &report.outcome) {
-        (Some(e), _) => e.to_string(),
-        (None, Ok(outcome)) => serde_json::to_string(outcome).unwrap_or_default(),
-        (None, Err(why)) => why.clone(),
-    }
 }

@@ -103,13 +103,6 @@ pub(super) fn simple_cylindrical(
         widths.last().copied().unwrap_or(gx),
         row_lat(last),
     ));
-    if east - west >= 360.0 - tol {
-        notes.push(format!(
-            "{name}: the map spans all 360 degrees of longitude, but routes do not wrap across its western and \
-             eastern edges (longitude {west} = {east}): those columns are the map's border, as on any DEM; to \
-             plan across that meridian, plan on a product (or a mosaic) whose edges lie elsewhere"
-        ));
-    }
     if north > 89.0 || south < -89.0 {
         notes.push(format!(
             "{name}: rows within a degree of a pole are planned as rows of rectangles {:.4} m wide at the last row, \

@@ -480,8 +480,8 @@ mod tests {
         assert!(err.contains("SAMPLE_BITS = 16 with SAMPLE_TYPE = PC_REAL"), "{err}");
         let err = edited("MAP_PROJECTION_ROTATION = 0.0", "MAP_PROJECTION_ROTATION = 9.0");
         assert!(err.contains("MAP_PROJECTION_ROTATION = 9"), "{err}");
-        let err = edited("\"EQUIRECTANGULAR\"", "\"SINUSOIDAL\"     ");
-        assert!(err.contains("MAP_PROJECTION_TYPE = SINUSOIDAL is not supported"), "{err}");
+        let err = edited("\"EQUIRECTANGULAR\"", "\"MERCATOR\"       ");
+        assert!(err.contains("MAP_PROJECTION_TYPE = MERCATOR is not supported"), "{err}");
         let err = edited("MAP_SCALE = 20.0", "MAP_SKALE = 20.0");
         assert!(err.contains("no IMAGE_MAP_PROJECTION.MAP_SCALE"), "{err}");
         let err = edited("BANDS = 1", "BANDS = 3");
@@ -603,3 +603,6 @@ mod mutated {
 
 #[cfg(test)]
 mod megdr_tests;
+
+#[cfg(test)]
+mod archive_tests;

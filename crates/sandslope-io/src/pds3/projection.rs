@@ -1,5 +1,6 @@
-//! The IMAGE_MAP_PROJECTION of a PDS3 DTM: equirectangular or polar stereographic on the
-//! body's sphere, as projected-metre georeferencing, ground cell sizes, and GeoKeys.
+//! The IMAGE_MAP_PROJECTION of a PDS3 DTM: equirectangular (HiRISE, CTX), polar stereographic
+//! or sinusoidal (HRSC) on the body's sphere, as projected-metre georeferencing, ground cell
+//! sizes, and GeoKeys.
 
 use anyhow::{anyhow, bail, Result};
 
@@ -49,11 +50,14 @@ pub(super) fn georef(
         .word(&map("MAP_PROJECTION_TYPE"))
         .ok_or_else(|| anyhow!("{name}: the label has no IMAGE_MAP_PROJECTION.MAP_PROJECTION_TYPE"))?;
     let projection = ptype.replace([' ', '_'], "");
-    if !matches!(projection.as_str(), "EQUIRECTANGULAR" | "POLARSTEREOGRAPHIC" | "SIMPLECYLINDRICAL") {
+    if !matches!(
+        projection.as_str(),
+        "EQUIRECTANGULAR" | "POLARSTEREOGRAPHIC" | "SIMPLECYLINDRICAL" | "SINUSOIDAL"
+    ) {
         bail!(
             "{name}: line {pline}: MAP_PROJECTION_TYPE = {ptype} is not supported (EQUIRECTANGULAR or \
-             POLARSTEREOGRAPHIC, the projections of HiRISE and CTX DTMs, or SIMPLE CYLINDRICAL, MOLA's); reproject \
-             it (gdalwarp) to one of those or to a GeoTIFF"
+             POLARSTEREOGRAPHIC, the projections of HiRISE and CTX DTMs, SINUSOIDAL, HRSC's, or SIMPLE \
+             CYLINDRICAL, MOLA's); reproject it (gdalwarp) to one of those or to a GeoTIFF"
         );
     }
     if let Some((rot, _)) = label.number(&map("MAP_PROJECTION_ROTATION"))? {
@@ -101,12 +105,12 @@ pub(super) fn georef(
     let body = body_name(label, radius_m);
     let east = west + cols as f64 * cell;
     let extent = Extent { name, body: &body, radius_m, cell, clat, lpo, west, east, north, south };
-    let cells = if projection == "EQUIRECTANGULAR" {
-        equirectangular_cells(&extent, rows, notes)?
-    } else {
-        GroundCells::uniform(polar_cells(&extent, notes)?)
-    };
     let clon = label.number(&map("CENTER_LONGITUDE"))?.map_or(0.0, |v| v.0);
+    let cells = match projection.as_str() {
+        "EQUIRECTANGULAR" => equirectangular_cells(&extent, rows, notes)?,
+        "SINUSOIDAL" => GroundCells::uniform(sinusoidal_cells(&extent, clon, notes)?),
+        _ => GroundCells::uniform(polar_cells(&extent, notes)?),
+    };
     let (keys, doubles, ascii) = geokeys(&projection, radius_m, clat, clon, &body);
     let crs = Crs::Projected { metres_per_unit: 1.0, unit: "metre" };
     Ok((GeoRef::north_up((west, north, cell, cell), keys, doubles, ascii), cells, crs))
@@ -179,11 +183,64 @@ fn polar_cells(e: &Extent, notes: &mut Vec<String>) -> Result<(f64, f64)> {
     Ok((g, g))
 }
 
+/// Ground cell size of a sinusoidal map (x = R (lon - CENTER_LONGITUDE) cos(lat), y = R lat, as
+/// HRSC DTMs are projected about their strip's own central meridian): MAP_SCALE is true along
+/// every parallel, and along the meridians at the central one; away from it a meridian leans by
+/// `atan(t)` from the map's north and is `sqrt(1 + t^2)` longer than its map length, `t = (lon -
+/// CENTER_LONGITUDE) sin(lat)` (radians). Cells are taken as MAP_SCALE square, with a note of the
+/// largest `t` over the DTM's corners; a DTM reaching where `t` exceeds 0.05 (a 2.9-degree lean, 0.12%
+/// longer meridians; slopes off by as much) is refused, naming the keys.
+fn sinusoidal_cells(e: &Extent, clon: f64, notes: &mut Vec<String>) -> Result<(f64, f64)> {
+    let Extent { name, body, radius_m, cell, clat, lpo, west, east, north, south, .. } = *e;
+    if clat != 0.0 {
+        bail!(
+            "{name}: CENTER_LATITUDE = {clat}: a sinusoidal map's origin must be on the equator (CENTER_LATITUDE = \
+             0, as in HRSC DTMs)"
+        );
+    }
+    let lat = |y: f64| y / radius_m;
+    if lat(north).to_degrees().abs() >= 89.0 || lat(south).to_degrees().abs() >= 89.0 {
+        bail!(
+            "{name}: LINE_PROJECTION_OFFSET = {lpo} puts the rows at latitudes {:.3} to {:.3} degrees: a sinusoidal \
+             DTM must lie within 89 degrees of the equator",
+            lat(south).to_degrees(),
+            lat(north).to_degrees()
+        );
+    }
+    let lean = |x: f64, y: f64| (x / (radius_m * lat(y).cos()) * lat(y).sin()).abs();
+    let t = [(west, north), (east, north), (west, south), (east, south)]
+        .iter()
+        .map(|&(x, y)| lean(x, y))
+        .fold(0.0, f64::max);
+    let lon = |x: f64, y: f64| clon + (x / (radius_m * lat(y).cos())).to_degrees();
+    if t > 0.05 {
+        bail!(
+            "{name}: the DTM reaches from longitude {:.4} to {:.4} at latitude {:.4}, about CENTER_LONGITUDE = {clon}: \
+             there the sinusoidal projection's meridians lean by {:.2} degrees and its cells are sheared; only \
+             sinusoidal DTMs near their central meridian (lean up to 2.9 degrees, as HRSC DTMs about their strip's \
+             meridian) are read: reproject it (gdalwarp -t_srs with +proj=eqc) or crop it",
+            lon(west, if north.abs() > south.abs() { north } else { south }),
+            lon(east, if north.abs() > south.abs() { north } else { south }),
+            lat(if north.abs() > south.abs() { north } else { south }).to_degrees(),
+            t.atan().to_degrees()
+        );
+    }
+    notes.push(format!(
+        "{name}: PDS3 sinusoidal map on {body} (sphere of radius {radius_m} m) about CENTER_LONGITUDE {clon}: \
+         MAP_SCALE {cell} m is true along the parallels; cells taken as {cell} x {cell} m (at the DTM's corners \
+         the meridians lean by up to {:.3} degrees and are {:.4}% longer than on the map)",
+        t.atan().to_degrees(),
+        100.0 * ((1.0 + t * t).sqrt() - 1.0)
+    ));
+    Ok((cell, cell))
+}
+
 /// GeoTIFF keys (OGC 19-008r4) of the map's projected CRS, user-defined on the body's sphere,
 /// so that a GeoTIFF written over a PDS3 DTM (`plan --risk-map`) carries its projection: the
 /// GeoKeyDirectory, GeoDoubleParams and GeoAsciiParams. Equirectangular is CT_Equirectangular
 /// (17) with the standard parallel CENTER_LATITUDE and latitude of origin 0 (y = R lat); polar
-/// stereographic is CT_PolarStereographic (15) with origin at the pole and scale 1 there.
+/// stereographic is CT_PolarStereographic (15) with origin at the pole and scale 1 there;
+/// sinusoidal is CT_Sinusoidal (24) about CENTER_LONGITUDE.
 fn geokeys(
     projection: &str,
     radius_m: f64,
@@ -195,7 +252,13 @@ fn geokeys(
     const DOUBLES: u16 = 34736;
     const ASCII: u16 = 34737;
     let equi = projection == "EQUIRECTANGULAR";
-    let citation = format!("{} {body}|", if equi { "Equirectangular" } else { "Polar Stereographic" });
+    let sinusoidal = projection == "SINUSOIDAL";
+    let (transform, title) = match projection {
+        "EQUIRECTANGULAR" => (17, "Equirectangular"),
+        "SINUSOIDAL" => (24, "Sinusoidal"),
+        _ => (15, "Polar Stereographic"),
+    };
+    let citation = format!("{title} {body}|");
     let geog = format!("GCS {body} sphere|");
     let ascii = format!("{citation}{geog}");
     let mut doubles = vec![radius_m, radius_m];
@@ -205,15 +268,15 @@ fn geokeys(
         [1026, ASCII, citation.len() as u16, 0],
         [2048, 0, 1, USER], // GeographicTypeGeoKey
         [2049, ASCII, geog.len() as u16, citation.len() as u16],
-        [2050, 0, 1, USER],                       // GeogGeodeticDatumGeoKey
-        [2054, 0, 1, 9102],                       // GeogAngularUnitsGeoKey: degree
-        [2056, 0, 1, USER],                       // GeogEllipsoidGeoKey
-        [2057, DOUBLES, 1, 0],                    // GeogSemiMajorAxisGeoKey
-        [2058, DOUBLES, 1, 1],                    // GeogSemiMinorAxisGeoKey
-        [3072, 0, 1, USER],                       // ProjectedCSTypeGeoKey
-        [3074, 0, 1, USER],                       // ProjectionGeoKey
-        [3075, 0, 1, if equi { 17 } else { 15 }], // ProjCoordTransGeoKey
-        [3076, 0, 1, 9001],                       // ProjLinearUnitsGeoKey: metre
+        [2050, 0, 1, USER],      // GeogGeodeticDatumGeoKey
+        [2054, 0, 1, 9102],      // GeogAngularUnitsGeoKey: degree
+        [2056, 0, 1, USER],      // GeogEllipsoidGeoKey
+        [2057, DOUBLES, 1, 0],   // GeogSemiMajorAxisGeoKey
+        [2058, DOUBLES, 1, 1],   // GeogSemiMinorAxisGeoKey
+        [3072, 0, 1, USER],      // ProjectedCSTypeGeoKey
+        [3074, 0, 1, USER],      // ProjectionGeoKey
+        [3075, 0, 1, transform], // ProjCoordTransGeoKey
+        [3076, 0, 1, 9001],      // ProjLinearUnitsGeoKey: metre
     ];
     let mut param = |key: u16, v: f64| {
         entries.push([key, DOUBLES, 1, doubles.len() as u16]);
@@ -221,7 +284,9 @@ fn geokeys(
     };
     param(3082, 0.0); // ProjFalseEastingGeoKey
     param(3083, 0.0); // ProjFalseNorthingGeoKey
-    if equi {
+    if sinusoidal {
+        param(3088, clon); // ProjCenterLongGeoKey
+    } else if equi {
         param(3078, clat); // ProjStdParallel1GeoKey
         param(3088, clon); // ProjCenterLongGeoKey
         param(3089, 0.0); // ProjCenterLatGeoKey

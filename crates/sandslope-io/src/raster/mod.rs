@@ -13,6 +13,7 @@ mod ascii;
 mod chunks;
 pub mod geotiff;
 pub mod grid;
+mod seam;
 mod tiles;
 mod windows;
 
@@ -22,6 +23,7 @@ use geotiff::{read_geotiff, samples_as};
 pub use grid::{
     available_memory, memory_limit, set_memory_limit, GeoRef, Raster, SizeCheck, DEFAULT_MEMORY_LIMIT,
 };
+pub use seam::{rolled_column, seam_roll, wraps_in_longitude};
 pub use tiles::{write_two_band_geotiff_by_rows, TILE};
 pub use windows::{open_height_windows, HeightWindows, WindowsCheck};
 
@@ -95,6 +97,13 @@ impl Format {
             Some("asc") => Format::Asc,
             Some("img" | "lbl") => Format::Pds3,
             _ if crate::pds3::starts_with_label(path) => Format::Pds3,
+            // ISIS3 cubes (CTX DTMs made with ISIS are often shared as .cub): not read.
+            Some("cub") => bail!(
+                "{}: an ISIS cube (.cub) is not read; export it to a GeoTIFF (ISIS isis2std format=tiff, or \
+                 gdal_translate -of GTiff) or to a PDS3 .IMG (ISIS isis2pds), which are: GeoTIFF (.tif, .tiff), \
+                 ESRI ASCII grid (.asc), PDS3 DTM (.img, .lbl)",
+                path.display()
+            ),
             _ => bail!(
                 "{}: unknown raster format; use a GeoTIFF (.tif, .tiff), an ESRI ASCII grid (.asc) or a PDS3 DTM \
                  (.img, .lbl)",
@@ -123,6 +132,22 @@ fn finish(path: &Path, mut raster: Raster, vertical: f64) -> Result<Raster> {
         &mut raster.notes,
     )?;
     (raster.cell_m, raster.row_widths_m) = (cells.cell_m, cells.row_widths_m);
+    // An equirectangular map in metres (a CTX DTM from ISIS or GDAL): each row its own width.
+    if let Crs::Projected { metres_per_unit, .. } = raster.crs {
+        let rows = crate::crs::equirectangular_rows(
+            &path.display(),
+            g.geokeys.as_deref(),
+            g.geodoubles.as_deref(),
+            metres_per_unit,
+            (g.cell_x, g.cell_y),
+            g.north,
+            raster.rows,
+            &mut raster.notes,
+        )?;
+        if let Some(cells) = rows {
+            (raster.cell_m, raster.row_widths_m) = (cells.cell_m, cells.row_widths_m);
+        }
+    }
     if !raster.crs.is_geographic()
         && g.cell_x < 0.01
         && g.west.abs() <= 180.0

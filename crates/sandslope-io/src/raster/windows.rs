@@ -36,6 +36,9 @@ pub struct HeightWindows {
     cell_m: (f64, f64),
     row_widths: Option<Vec<f64>>,
     kind: Kind,
+    /// Columns rolled across the seam of a map that wraps in longitude (super::seam): column
+    /// `j` of the windows is the file's column `(j + roll) % cols`.
+    roll: usize,
 }
 
 enum Kind {
@@ -105,7 +108,8 @@ pub fn open_height_windows(path: &Path, fits: WindowsCheck) -> Result<(Raster, H
         cell_m.0 = w[0];
         row_widths = None;
     }
-    let windows = HeightWindows { name, cols: raster.cols, rows: raster.rows, cell_m, row_widths, kind };
+    let windows =
+        HeightWindows { name, cols: raster.cols, rows: raster.rows, cell_m, row_widths, kind, roll: 0 };
     Ok((raster, windows))
 }
 
@@ -116,12 +120,26 @@ impl HeightWindows {
         matches!(self.kind, Kind::Memory(_))
     }
 
-    /// The heights held in memory ([`HeightWindows::is_in_memory`]), row-major.
+    /// The heights held in memory ([`HeightWindows::is_in_memory`]), row-major (rolled as
+    /// the windows are).
     pub fn into_heights(self) -> Option<Vec<f32>> {
         match self.kind {
-            Kind::Memory(h) => Some(h),
+            Kind::Memory(mut h) => {
+                if self.roll != 0 {
+                    h.chunks_mut(self.cols).for_each(|row| row.rotate_left(self.roll));
+                }
+                Some(h)
+            }
             _ => None,
         }
+    }
+
+    /// The windows of the map with its columns rolled by `shift` across the seam of a map that
+    /// wraps in longitude (as [`Raster::rolled_columns`] rolls its georeference): column `j`
+    /// is the file's column `(j + shift) % cols`.
+    pub fn rolled_columns(mut self, shift: usize) -> HeightWindows {
+        self.roll = (self.roll + shift) % self.cols;
+        self
     }
 
     /// The heights of rows `rows` and columns `cols`, row-major, NaN where there is none.
@@ -134,6 +152,26 @@ impl HeightWindows {
                 self.rows
             );
         }
+        if self.roll != 0 {
+            // The file's columns of the window: one run, or two where it crosses the seam.
+            let (a, n) = ((cols.start + self.roll) % self.cols, cols.len());
+            if a + n <= self.cols {
+                return self.read_file(rows, a..a + n);
+            }
+            let (east, west) =
+                (self.read_file(rows.clone(), a..self.cols)?, self.read_file(rows, 0..a + n - self.cols)?);
+            let (e, w) = (self.cols - a, a + n - self.cols);
+            return Ok(east
+                .chunks(e)
+                .zip(west.chunks(w))
+                .flat_map(|(e, w)| e.iter().chain(w).copied())
+                .collect());
+        }
+        self.read_file(rows, cols)
+    }
+
+    /// [`HeightWindows::read`] in the file's own columns.
+    fn read_file(&self, rows: Range<usize>, cols: Range<usize>) -> Result<Vec<f32>> {
         match &self.kind {
             Kind::Memory(h) => Ok(rows
                 .flat_map(|r| h[r * self.cols + cols.start..r * self.cols + cols.end].iter().copied())

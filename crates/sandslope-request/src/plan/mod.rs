@@ -321,6 +321,22 @@ impl PlanRequest {
                 Some(heights) => (head, heights),
                 None => read_heights_within(&self.dem, &|_, _| Ok(())).map_err(dem_err)?,
             };
+            let valid = |c: Cell| heights[c.row * dem.cols + c.col].is_finite();
+            let start = endpoint(&dem, &valid, "start", &self.start, &self.start_px)?;
+            let goal = endpoint(&dem, &valid, "goal", &self.goal, &self.goal_px)?;
+            let (mut classes, terrains) = self.classes_of(&dem, note).map_err(anyhow_err)?;
+            // A map wrapping in longitude is planned with its columns rolled across the seam.
+            let (dem, heights, start, goal) = match across_seam(&dem, start, goal) {
+                None => (dem, heights, start, goal),
+                Some((shift, start, goal)) => {
+                    let mut heights = heights;
+                    heights.chunks_mut(dem.cols).for_each(|r| r.rotate_left(shift));
+                    if let Some(c) = classes.as_mut() {
+                        c.chunks_mut(dem.cols).for_each(|r| r.rotate_left(shift));
+                    }
+                    (dem.rolled_columns(shift), heights, start, goal)
+                }
+            };
             for n in &dem.notes {
                 note(n);
             }
@@ -329,23 +345,26 @@ impl PlanRequest {
             // nodata NaN.
             let grid = ElevationGrid::new(dem.cols, dem.rows, dem.cell_m.0, dem.cell_m.1, heights, None);
             let grid = self.with_rows_of(&dem, grid).map_err(anyhow_err)?;
-            let valid = |c: Cell| grid.is_valid(c.row * grid.cols() + c.col);
-            let start = endpoint(&dem, &valid, "start", &self.start, &self.start_px)?;
-            let goal = endpoint(&dem, &valid, "goal", &self.goal, &self.goal_px)?;
-            let (classes, terrains) = self.classes_of(&dem, note).map_err(anyhow_err)?;
             let result = plan(grid, classes, &terrains, &robot, settings, &request(start, goal), &progress)
                 .map_err(|e| in_dem(&e))?;
             return Ok(Computed::Full(Box::new(Planned { dem, result })));
         };
         let dem = head;
-        for n in &dem.notes {
-            note(n);
-        }
         // Only the endpoints' cells are read here; the corridor search reads its windows.
         let valid =
             |c: Cell| windows.read(c.row..c.row + 1, c.col..c.col + 1).is_ok_and(|h| h[0].is_finite());
         let start = endpoint(&dem, &valid, "start", &self.start, &self.start_px)?;
         let goal = endpoint(&dem, &valid, "goal", &self.goal, &self.goal_px)?;
+        // A map wrapping in longitude is planned with its columns rolled across the seam.
+        let (dem, windows, start, goal) = match across_seam(&dem, start, goal) {
+            None => (dem, windows, start, goal),
+            Some((shift, start, goal)) => {
+                (dem.rolled_columns(shift), windows.rolled_columns(shift), start, goal)
+            }
+        };
+        for n in &dem.notes {
+            note(n);
+        }
         let (classes, terrains) = self.classes_of(&dem, note).map_err(anyhow_err)?;
         let (None, [terrain]) = (&classes, terrains.as_slice()) else {
             return Err(RequestError::invalid(
@@ -448,6 +467,18 @@ impl PlanRequest {
             })?;
         Ok((Some(idx), terrains))
     }
+}
+
+/// For a map that wraps in longitude (sandslope_io::raster::wraps_in_longitude), the column
+/// roll that moves its edges opposite the endpoints, and the endpoints in the rolled map.
+fn across_seam(dem: &Raster, start: Cell, goal: Cell) -> Option<(usize, Cell, Cell)> {
+    use sandslope_io::raster::{rolled_column, seam_roll, wraps_in_longitude};
+    if !wraps_in_longitude(dem) {
+        return None;
+    }
+    let shift = seam_roll(dem.cols, start.col, goal.col);
+    let roll = |c: Cell| Cell { col: rolled_column(c.col, dem.cols, shift), row: c.row };
+    Some((shift, roll(start), roll(goal)))
 }
 
 fn parse_pair(flag: &str, s: &str) -> anyhow::Result<(f64, f64)> {

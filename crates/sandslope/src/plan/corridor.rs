@@ -214,7 +214,11 @@ pub fn plan_corridor_from(
                     lower_bound,
                     gap_at_most,
                 };
-                let done = r.is_ok() || whole;
+                // A start no edge leaves (or a goal none enters) is so on the whole map: every
+                // cell within two of it (its moves' reach) is in the corridor, which holds at
+                // least one coarse cell of at least two cells around it. Widening cannot help.
+                let ends = matches!(r, Err(NoRoute::StartImpassable | NoRoute::GoalImpassable));
+                let done = r.is_ok() || whole || ends;
                 if done {
                     break Ok(((obj, r), stats));
                 }
@@ -638,6 +642,25 @@ pub(super) mod tests {
             let best = full.route(*obj, s, t, &|_| ControlFlow::Continue(())).unwrap().unwrap().length_m;
             assert!((best - 92.0).abs() < 3.0 && (got - 151.0).abs() < 8.0, "{obj:?}: {best} and {got}");
         }
+    }
+
+    /// A plane 40 degrees steep: every heading either climbs at more than 37 degrees (beyond
+    /// slippage) or rolls more than 20 (tan 40 sin b <= tan 20 needs sin b <= 0.434, and then
+    /// the pitch is atan(tan 40 cos b) >= 37 degrees), so no time edge leaves the start. The
+    /// corridor is not widened for that (it holds the start's every move): the answer comes at
+    /// the width asked for.
+    #[test]
+    fn an_impassable_start_is_not_widened_for() {
+        let n = 64;
+        let tan = 40f64.to_radians().tan() as f32;
+        let z = (0..n * n).map(|i| tan * 0.5 * (i % n) as f32).collect();
+        let grid = ElevationGrid::new(n, n, 0.5, 0.5, z, None).unwrap();
+        let plan = corridor_plan(&grid, Cell { col: 5, row: 5 }, Cell { col: 58, row: 58 }, 4, 1);
+        let (obj, r) = &plan.routes[0];
+        assert_eq!((*obj, r.as_ref().err()), (Objective::Time, Some(&NoRoute::StartImpassable)));
+        let stats = &plan.corridors[0];
+        assert_eq!((stats.half_width, stats.whole), (1, false), "{stats:?}");
+        assert!(plan.routes[1].1.is_ok(), "the distance route exists");
     }
 
     #[test]

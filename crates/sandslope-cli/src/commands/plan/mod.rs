@@ -392,7 +392,8 @@ fn run_corridor(args: &PlanArgs, planned: &CorridorPlanned) -> Result<()> {
         cells.join("; "),
         f = settings.factor()
     );
-    if plan.routes.iter().zip(&plan.corridors).any(|((_, r), c)| r.is_err() && !c.whole) {
+    let unreached = |r: &Result<_, _>| matches!(r, Err(sandslope::plan::NoRoute::GoalUnreachable));
+    if plan.routes.iter().zip(&plan.corridors).any(|((_, r), c)| unreached(r) && !c.whole) {
         println!(
             "note: a route not found in its corridor may still exist on the whole map (the corridor could not be \
              widened to it within the memory limit): --search full decides"

@@ -54,7 +54,7 @@ enum Command {
     Report(commands::report::ReportArgs),
     /// Terrain inference from the gait: posterior of k_s per observed slope, and risk at slopes not walked.
     Infer(commands::infer::InferArgs),
-    /// The robot in the loop: drive Dynamixel XL330s with the gait, log their state, read the sand from their currents (docs/drive.md).
+    /// The robot in the loop: drive Dynamixel servos (XL330, XL430, XM430) with the gait, log their state, read the sand from their currents (docs/drive.md).
     Drive(commands::drive::DriveArgs),
     /// List built-in robots and terrains, or print one as TOML.
     Presets(commands::presets::PresetsArgs),

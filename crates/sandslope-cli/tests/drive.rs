@@ -16,11 +16,21 @@ use std::process::{Command, Output, Stdio};
 
 /// The tests that time a bus at 50 Hz run one at a time: on two cores shared with other test
 /// binaries, overlapping real-time drives starved each other's cycles (a log whose stance bins
-/// stayed empty: "0 complete strides", in a full `scripts/test.sh` run at load 8.6).
-static REAL_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+/// stayed empty: "0 complete strides", in a full `scripts/test.sh` run at load 8.6). Nor
+/// beside the tests that infer k_s from the emulated logs, which keep the cores busy for
+/// seconds: the biased-sensor run beside them missed 2 and 3 of its 13 intervals (allowed: 1),
+/// alone none (at load 14). The real-time tests take the lock alone ([`real_time`]), the
+/// CPU-bound ones together ([`cpu_bound`]).
+static REAL_TIME: std::sync::RwLock<()> = std::sync::RwLock::new(());
 
-fn real_time() -> std::sync::MutexGuard<'static, ()> {
-    REAL_TIME.lock().unwrap_or_else(|e| e.into_inner())
+fn real_time() -> std::sync::RwLockWriteGuard<'static, ()> {
+    REAL_TIME.write().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Held by a test that keeps the cores busy, after it has its [`emulated_logs`] (whose making
+/// takes [`real_time`]).
+fn cpu_bound() -> std::sync::RwLockReadGuard<'static, ()> {
+    REAL_TIME.read().unwrap_or_else(|e| e.into_inner())
 }
 
 fn bin() -> Command {
@@ -130,9 +140,10 @@ fn commanded_gait_has_the_robot_files_period_and_phase() {
 /// points), with 10 mA of current noise and ten seeds: `infer --servo-log` must put the true
 /// k_s inside its 90% interval in at least 9, with intervals narrower than the prior's three
 /// decades.
-/// The ten emulated logs behind the k_s tests (made once per test binary, two drives at a
-/// time: each is an emulator and a driver in real time), in Cargo's scratch directory for
-/// tests (a static's temporary directory would never be removed).
+/// The ten emulated logs behind the k_s tests (made once per test binary, five drives at a
+/// time: each is an emulator and a driver in real time, mostly waiting on its bus, about 0.16
+/// of a core), in Cargo's scratch directory for tests (a static's temporary directory would
+/// never be removed).
 fn emulated_logs() -> &'static [std::path::PathBuf] {
     static LOGS: std::sync::OnceLock<Vec<std::path::PathBuf>> = std::sync::OnceLock::new();
     LOGS.get_or_init(|| {
@@ -141,7 +152,7 @@ fn emulated_logs() -> &'static [std::path::PathBuf] {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         let mut logs = vec![];
-        for batch in [1..=2, 3..=4, 5..=6, 7..=8, 9..=10] {
+        for batch in [1..=5, 6..=10] {
             let runs: Vec<_> = batch
                 .map(|seed| {
                     let log = dir.join(format!("run{seed}.csv"));
@@ -190,6 +201,7 @@ fn emulated_logs() -> &'static [std::path::PathBuf] {
 fn infer_servo_log_recovers_the_emulated_k_s() {
     let truth = 2.5e5;
     let logs = emulated_logs();
+    let _cpu = cpu_bound();
     let walked = bin().args(["simulate", "--slope", "20", "--k-s", "2.5e5", "--json"]).output().unwrap();
     assert!(walked.status.success(), "{}", text(&walked));
     let walked: serde_json::Value = serde_json::from_slice(&walked.stdout).unwrap();
@@ -248,25 +260,45 @@ fn infer_servo_log_recovers_the_emulated_k_s() {
 #[test]
 fn stop_on_risk_halts_within_one_stride_of_the_sand_weakening() {
     let _one = real_time();
-    for seed in ["1", "2", "3"] {
-        let dir = tempfile::tempdir().unwrap();
-        let log = dir.path().join("halt.csv");
-        let out = bin()
-            .args([
-                "drive",
-                "--emulate",
-                "--slope",
-                "15",
-                "--emulate-k-s",
-                "2e6",
-                "--emulate-weaken",
-                "4:1.5e4",
-            ])
-            .args(["--duration", "6", "--stop-on-risk", "0.5", "--hold", "0.4", "--watchdog", "2", "--log"])
-            .arg(&log)
-            .args(["--emulate-seed", seed])
-            .output()
-            .unwrap();
+    // The three seeds at once (each run mostly waits on its bus).
+    let runs: Vec<_> = ["1", "2", "3"]
+        .into_iter()
+        .map(|seed| {
+            let dir = tempfile::tempdir().unwrap();
+            let log = dir.path().join("halt.csv");
+            let child = bin()
+                .args([
+                    "drive",
+                    "--emulate",
+                    "--slope",
+                    "15",
+                    "--emulate-k-s",
+                    "2e6",
+                    "--emulate-weaken",
+                    "4:1.5e4",
+                ])
+                .args([
+                    "--duration",
+                    "6",
+                    "--stop-on-risk",
+                    "0.5",
+                    "--hold",
+                    "0.4",
+                    "--watchdog",
+                    "2",
+                    "--log",
+                ])
+                .arg(&log)
+                .args(["--emulate-seed", seed])
+                .stdout(Stdio::piped())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap();
+            (seed, dir, log, child)
+        })
+        .collect();
+    for (seed, _dir, log, child) in runs {
+        let out = child.wait_with_output().unwrap();
         let all = text(&out);
         assert_eq!(out.status.code(), Some(5), "seed {seed}: {all}");
         let number = |after: &str| -> f64 {

@@ -215,6 +215,8 @@ fn grid(swing_offset: bool) -> ModelGrid {
 /// 10 of 10 (2026-11-28), so coverage alone cannot tell a correction from none.
 #[test]
 fn messy_logs_still_cover_the_emulated_k_s() {
+    emulated_logs();
+    let _cpu = super::cpu_bound();
     let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
     let grid = grid(true);
     let dir = tempfile::tempdir().unwrap();

@@ -512,6 +512,7 @@ fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedOb
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sandslope_request::simulate::parse_slopes;
 
     #[test]
     fn slope_ranges_name_the_flag() {

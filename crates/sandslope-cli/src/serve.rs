@@ -119,6 +119,16 @@ pub fn run(args: ServeArgs) -> Result<()> {
         signal: &crate::error::STOP_SIGNAL,
     };
     let drive_log = args.drive_run.as_ref().and_then(|r| r.log.clone());
+    // The served run writes its log as the CSV flight recorder only; `drive --log run.mcap`
+    // keeps the rows in memory and writes them as ROS 2 messages when the run ends.
+    if let Some(path) =
+        drive_log.as_ref().filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("mcap")))
+    {
+        bail!(
+            "--log {}: a served drive writes its log as CSV (the flight recorder, docs/drive.md); give a .csv path, or record an MCAP with `sandslope drive --log run.mcap`",
+            path.display()
+        );
+    }
     let drive = drive_config(&args)?.map(|c| (c, flags));
     sandslope_serve::run(ServeConfig {
         dem: args.dem,

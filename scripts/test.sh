@@ -3,7 +3,7 @@
 #
 # Needs the Rust toolchain and Python 3.9+ with pip (venv module). Creates .venv/ at the
 # repository root (reused on later runs), installs maturin, pytest, numpy, dask, distributed,
-# pandas, tifffile, zarr, xarray and rasterio (whose wheels carry GDAL: the tests write every
+# pandas, tifffile, zarr, xarray, dynamixel-sdk (the servo emulator's referee) and rasterio (whose wheels carry GDAL: the tests write every
 # GeoTIFF layout with it) into it from PyPI, builds and installs crates/sandslope-py into it, and
 # runs `cargo test --workspace --locked` and pytest. Environment:
 #   PYTHON=python3.11   interpreter that creates the venv (default: python3)
@@ -33,7 +33,7 @@ echo "== installing the Python test tools into $venv"
 "$py" -m pip install --quiet --disable-pip-version-check \
   "maturin>=1.9,<2" "pytest>=7" "numpy>=1.21" "dask[array]>=2023.1" "distributed>=2023.1" \
   "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1" "rasterio>=1.3" \
-  "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5"
+  "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5" "dynamixel-sdk>=4.1"
 t1=$(seconds)
 
 echo "== cargo test --workspace --locked"
@@ -41,11 +41,17 @@ cargo test --workspace --locked
 t2=$(seconds)
 
 # Built in place (pip builds local directories in-tree), so Cargo uses the workspace's
-# target/ and its lock file; the profile is [profile.python-ext] of Cargo.toml.
-echo "== building and installing crates/sandslope-py: Cargo compiles the extension (profile python-ext);"
-echo "   minutes on a cold build, seconds when target/python-ext is warm; pip says when the wheel is built"
-"$py" -m pip install --disable-pip-version-check --no-build-isolation --no-deps \
-  --force-reinstall ./crates/sandslope-py
+# target/ and its lock file. The tests build it in Cargo's dev profile, on the dependencies
+# `cargo test` just compiled (the library itself is opt-level 2 in dev, Cargo.toml): 79 s of
+# CPU against a full optimised rebuild of every dependency in the shipped profile
+# ([profile.python-ext], what `pip install ./crates/sandslope-py` uses), which took 154 s wall
+# of CI's 837 s; pytest's 112 tests took 63 s of CPU on it (measured 2026-12-07, load ~12).
+# SANDSLOPE_PY_PROFILE=python-ext tests the shipped profile instead.
+profile=${SANDSLOPE_PY_PROFILE:-dev}
+echo "== building and installing crates/sandslope-py: Cargo compiles the extension (profile $profile);"
+echo "   pip says when the wheel is built"
+MATURIN_PEP517_ARGS="--profile $profile" "$py" -m pip install --disable-pip-version-check \
+  --no-build-isolation --no-deps --force-reinstall ./crates/sandslope-py
 t3=$(seconds)
 
 echo "== pytest crates/sandslope-py/tests"

@@ -5,18 +5,19 @@
 use anyhow::Result;
 use clap::Args;
 use sandslope::{LevelStep, Robot, Terrain};
+use sandslope_request::field::{Field, Fields, Kind};
+use sandslope_request::scenario::{K_N, K_S, LEVEL_STEP, ROBOT, TERRAIN};
 use sandslope_request::{grammar, RobotRequest, ScenarioRequest};
 
 use sandslope::risk::UncertainTerrain;
-use sandslope::robot_key::{RobotFlag, RobotKey};
+use sandslope::robot_key::RobotKey;
 use sandslope_io::load_terrain;
-use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 
 /// `--robot` and the robot quantities that override its file's (`--mass`, `--leg-radius`, ...).
 #[derive(Debug, Clone, Args)]
 pub struct RobotArgs {
-    /// Robot: a TOML file or a built-in preset (see `sandslope presets`).
-    #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_ROBOT)]
+    /// `--robot` ([`ROBOT`]).
+    #[arg(long = ROBOT.flag, value_name = ROBOT.value_name, default_value = ROBOT.default, help = ROBOT.help)]
     pub robot: String,
     #[command(flatten)]
     pub quantities: RobotKeyArgs<true>,
@@ -48,19 +49,16 @@ impl RobotArgs {
 /// `--level-step`: which normal depth the derived level step s* uses (docs/model.md §3).
 #[derive(Debug, Clone, Copy, Args)]
 pub struct LevelStepArgs {
-    /// Normal depth of the derived level step s* (docs/model.md §3, a choice the paper leaves
-    /// open): `slope` takes d_n at the slope, with its cos(theta) (the default); `level` takes
-    /// d_n on level sand, the paper's definition of s*. Up to 0.7% in speed on the built-in
-    /// robot and terrain. No effect on a robot with `level_step_m`.
-    #[arg(long, value_name = "slope|level", default_value = "slope", value_parser = sandslope_request::scenario::parse_level_step)]
+    /// `--level-step` ([`LEVEL_STEP`]).
+    #[arg(long = LEVEL_STEP.flag, value_name = LEVEL_STEP.value_name, default_value = LEVEL_STEP.default, help = LEVEL_STEP.help, value_parser = sandslope_request::scenario::parse_level_step)]
     pub level_step: LevelStep,
 }
 
 /// `--terrain`.
 #[derive(Debug, Clone, Args)]
 pub struct TerrainArgs {
-    /// Terrain: a TOML file or a built-in preset (see `sandslope presets`).
-    #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_TERRAIN)]
+    /// `--terrain` ([`TERRAIN`]).
+    #[arg(long = TERRAIN.flag, value_name = TERRAIN.value_name, default_value = TERRAIN.default, help = TERRAIN.help)]
     pub terrain: String,
 }
 
@@ -97,7 +95,7 @@ impl UncertaintyArgs {
 
 /// The robot quantities overriding the robot file's (docs/model.md §2), so a design question
 /// ("and with 5 cm legs?") needs no new file: one flag per row of the library's table of robot
-/// keys that has one ([`RobotKey::TABLE`], its flag, placeholder and help line), `--mass`
+/// quantities ([`sandslope_request::scenario::ROBOT_QUANTITIES`], its flag, placeholder and help line), `--mass`
 /// among them when `MASS`. Checked by the request layer's one robot validation, errors naming
 /// the flag.
 #[derive(Debug, Clone, Default)]
@@ -110,12 +108,12 @@ pub struct RobotKeyArgs<const MASS: bool> {
 pub type RobotQuantityArgs = RobotKeyArgs<false>;
 
 impl<const MASS: bool> RobotKeyArgs<MASS> {
-    /// The keys these flags set, with their flags, in the table's order.
-    fn flags() -> impl Iterator<Item = (RobotKey, RobotFlag)> {
-        RobotKey::TABLE
-            .iter()
-            .filter(|row| MASS || row.key != RobotKey::MassKg)
-            .filter_map(|row| row.flag.map(|f| (row.key, f)))
+    /// The keys these flags set, with their fields, in the table's order.
+    fn flags() -> impl Iterator<Item = (RobotKey, &'static Field)> {
+        RobotKey::ALL
+            .into_iter()
+            .filter(|k| MASS || *k != RobotKey::MassKg)
+            .filter_map(|k| sandslope_request::scenario::robot_field(k).map(|f| (k, f)))
     }
 
     /// The value given for `key`, if its flag was.
@@ -131,11 +129,11 @@ impl<const MASS: bool> RobotKeyArgs<MASS> {
 
 impl<const MASS: bool> clap::Args for RobotKeyArgs<MASS> {
     fn augment_args(mut cmd: clap::Command) -> clap::Command {
-        for (key, flag) in Self::flags() {
+        for (key, field) in Self::flags() {
             let arg = clap::Arg::new(key.name())
-                .long(flag.long.trim_start_matches('-'))
-                .value_name(flag.value_name)
-                .help(flag.help)
+                .long(field.flag)
+                .value_name(field.value_name)
+                .help(field.help)
                 .action(clap::ArgAction::Set);
             // A whole number: clap's parser, which refuses `2.5` and `-1` itself.
             cmd = cmd.arg(if key == RobotKey::StanceLegs {
@@ -184,11 +182,11 @@ impl<const MASS: bool> clap::FromArgMatches for RobotKeyArgs<MASS> {
 /// `--level-step`, the model choice of docs/model.md §3.
 #[derive(Debug, Clone, Copy, Args)]
 pub struct OverrideArgs {
-    /// Normal penetration resistance k_n, N/m^3, instead of the terrain's.
-    #[arg(long = "k-n", value_name = "N/M^3", allow_negative_numbers = true)]
+    /// `--k-n` ([`K_N`]).
+    #[arg(long = K_N.flag, value_name = K_N.value_name, help = K_N.help, allow_negative_numbers = true)]
     pub k_n: Option<f64>,
-    /// Shear strength k_s, N/m^3, instead of the terrain's.
-    #[arg(long = "k-s", value_name = "N/M^3", allow_negative_numbers = true)]
+    /// `--k-s` ([`K_S`]).
+    #[arg(long = K_S.flag, value_name = K_S.value_name, help = K_S.help, allow_negative_numbers = true)]
     pub k_s: Option<f64>,
     #[command(flatten)]
     pub level: LevelStepArgs,
@@ -204,6 +202,73 @@ impl OverrideArgs {
             k_s: self.k_s,
             level_step: self.level.level_step,
         }
+    }
+}
+
+/// A request's own fields as flags, built from its field table ([`Fields::TABLE`]): the flags
+/// given, as the text pairs the request's `from_params` reads (the one step from raw text to
+/// the typed request that the server's fields take too). Defaults, ranges and checks are the
+/// table's and the request's; clap only splits the command line.
+#[derive(Debug, Clone)]
+pub struct FieldArgs<T> {
+    /// The flags given on the command line, without dashes, with their text.
+    pub pairs: Vec<(String, String)>,
+    request: std::marker::PhantomData<T>,
+}
+
+/// The clap argument of one field: its flag, placeholder, help, default (shown in `--help`),
+/// choices and conflicts from its row.
+pub fn field_arg(f: &'static Field) -> clap::Arg {
+    let arg =
+        clap::Arg::new(f.flag).long(f.flag).help(f.help).conflicts_with_all(f.conflicts).required(f.required);
+    match f.kind {
+        Kind::Switch => arg.action(clap::ArgAction::SetTrue),
+        kind => {
+            let arg = arg.action(clap::ArgAction::Set).value_name(f.value_name).default_value(f.default);
+            match kind {
+                Kind::Choice(words) => arg.value_parser(clap::builder::PossibleValuesParser::new(words)),
+                // A number, or a slope list in degrees, may start with a minus.
+                Kind::Number => arg.allow_negative_numbers(true),
+                _ if f.unit == "deg" => arg.allow_hyphen_values(true),
+                _ => arg,
+            }
+        }
+    }
+}
+
+impl<T: Fields> clap::Args for FieldArgs<T> {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        T::TABLE.fields.iter().fold(cmd, |cmd, f| cmd.arg(field_arg(f)))
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
+}
+
+impl<T: Fields> clap::FromArgMatches for FieldArgs<T> {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> std::result::Result<Self, clap::Error> {
+        let mut args = FieldArgs { pairs: Vec::new(), request: std::marker::PhantomData };
+        args.update_from_arg_matches(matches)?;
+        Ok(args)
+    }
+
+    fn update_from_arg_matches(
+        &mut self,
+        matches: &clap::ArgMatches,
+    ) -> std::result::Result<(), clap::Error> {
+        for f in T::TABLE.fields {
+            if matches.value_source(f.flag) != Some(clap::parser::ValueSource::CommandLine) {
+                continue;
+            }
+            let text = match f.kind {
+                Kind::Switch => "true".to_string(),
+                _ => matches.get_one::<String>(f.flag).cloned().unwrap_or_default(),
+            };
+            self.pairs.retain(|(k, _)| k != f.flag);
+            self.pairs.push((f.flag.to_string(), text));
+        }
+        Ok(())
     }
 }
 

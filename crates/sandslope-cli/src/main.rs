@@ -67,7 +67,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Predict(a) => commands::predict::run(a),
         Command::Simulate(a) => commands::simulate::run(a),
         Command::Sweep(a) => commands::sweep::run(a),
-        Command::Calibrate(a) => commands::calibrate::run(a),
+        Command::Calibrate(a) => {
+            let command_line = std::env::args().skip(1).collect();
+            commands::calibrate::run(commands::calibrate::CalibrateArgs { command_line, ..a })
+        }
         Command::Fit(a) => commands::fit::run(a),
         Command::Track(a) => commands::track::run(a),
         Command::Phase(a) => commands::phase::run(a),

@@ -11,7 +11,7 @@ use sandslope_servo::session::DriveConfig;
 
 use crate::commands::drive::{BusFlag, DriveRunArgs};
 
-use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
+use sandslope_request::scenario::{ROBOT, TERRAIN};
 use sandslope_serve::ServeConfig;
 
 /// Arguments of `sandslope serve`.
@@ -23,11 +23,11 @@ pub struct ServeArgs {
     pub dem: Option<PathBuf>,
     /// Robot the page starts with and API requests use when they name none: a TOML file or a
     /// built-in preset. Requests may name built-in presets only.
-    #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_ROBOT)]
+    #[arg(long = ROBOT.flag, value_name = ROBOT.value_name, default_value = ROBOT.default)]
     pub robot: String,
     /// Terrain the page starts with and API requests use when they name none: a TOML file or a
     /// built-in preset. Requests may name built-in presets only.
-    #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_TERRAIN)]
+    #[arg(long = TERRAIN.flag, value_name = TERRAIN.value_name, default_value = TERRAIN.default)]
     pub terrain: String,
     /// Port to listen on; 0 picks any free port (the URL is printed either way).
     #[arg(long, value_name = "N", default_value_t = 8750)]
@@ -69,6 +69,11 @@ pub struct ServeArgs {
     /// With --drive: drive a bus of emulated XL330s on a pseudo-terminal instead of a port.
     #[arg(long, requires = "drive", conflicts_with = "drive_port", help_heading = "Driving (docs/drive.md)")]
     pub emulate: bool,
+    /// With --drive: stream the run to Foxglove over its WebSocket protocol on ADDR
+    /// (127.0.0.1:8765 when none is given), as `drive --foxglove` does (docs/bags.md).
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, requires = "drive",
+        default_missing_value = sandslope_io::foxglove::DEFAULT_ADDR, help_heading = "Driving (docs/drive.md)")]
+    pub foxglove: Option<String>,
     #[command(flatten, next_help_heading = "Driving (docs/drive.md)")]
     pub drive_run: Option<DriveRunArgs>,
 }
@@ -129,5 +134,6 @@ pub fn run(args: ServeArgs) -> Result<()> {
         allow_host: args.allow_host,
         drive,
         drive_log,
+        drive_foxglove: args.foxglove,
     })
 }

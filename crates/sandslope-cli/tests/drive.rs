@@ -4,6 +4,8 @@
 
 #[path = "drive/bench.rs"]
 mod bench;
+#[path = "drive/chores.rs"]
+mod chores;
 mod common;
 #[path = "drive/messy.rs"]
 mod messy;

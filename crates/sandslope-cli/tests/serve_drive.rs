@@ -192,6 +192,22 @@ fn the_status_endpoint_and_the_drive_tab_follow_an_emulated_run() {
     same_number(attribute(&dom, "id=\"drive-k-s\"", "data-lo"), &inf["k_s_lo"]);
     same_number(attribute(&dom, "id=\"drive-p-fail\"", "data-value"), &inf["p_fail"]);
     same_number(attribute(&dom, "id=\"drive-climb\"", "data-value"), &inf["speed_m_s"]);
+    // Both pooled verdicts, and a note where they disagree: at 20 deg on k_s 2.5e5 N/m^3 the
+    // closed form says slippage (k_s margin 0.49) and the simulator success (docs/drive.md).
+    let pooled = &end["live"]["pooled"];
+    same_number(attribute(&dom, "id=\"drive-verdicts\"", "data-simulator"), &pooled["p_fail_simulator"]);
+    same_number(attribute(&dom, "id=\"drive-verdicts\"", "data-closed-form"), &pooled["p_fail_closed_form"]);
+    let (sim, cf) =
+        (pooled["p_fail_simulator"].as_f64().unwrap(), pooled["p_fail_closed_form"].as_f64().unwrap());
+    assert!(sim < 0.5 && cf >= 0.5, "the verdicts agree here: simulator {sim}, closed form {cf}");
+    assert_eq!(attribute(&dom, "id=\"drive-verdicts\"", "data-disagree").as_deref(), Some("true"));
+    assert!(attribute(&dom, "id=\"drive-disagree\"", "hidden").is_none(), "the note is hidden");
+    let note = text_of(&dom, "drive-disagree");
+    assert!(
+        note.contains("the simulator says the walk succeeds")
+            && note.contains("the closed form that it fails"),
+        "{note}"
+    );
     let t = end["time_s"].as_f64().unwrap();
     assert_eq!(text_of(&dom, "drive-time"), format!("{t:.2} / 4"));
     assert!(text_of(&dom, "drive-end").contains("Torque off confirmed on servos 1, 2, 3, 4, 5, 6"));

@@ -35,6 +35,7 @@ pub mod raster;
 pub mod robot_terrain;
 pub mod routes;
 pub mod servo_log;
+pub mod servo_zero;
 pub mod speeds;
 pub mod trajectory;
 

@@ -299,17 +299,17 @@ pub fn drive_mcap(
 /// position as the shaft's angle, rad), both stamped `t_ns`: what [`drive_mcap`] writes a
 /// cycle and `foxglove::DriveStream` sends live.
 pub fn cycle_joint_states(cycle: &[crate::servo_log::ServoLogRow], t_ns: u64) -> (JointState, JointState) {
-    use sandslope::servo::xl330;
+    use sandslope::servo::model as x;
     let mut state = JointState { header: header(t_ns, ""), ..JointState::default() };
     let mut command = JointState { header: header(t_ns, ""), ..JointState::default() };
     for r in cycle {
         let name = format!("leg_{}", r.leg);
         state.name.push(name.clone());
         state.position.push(r.leg_angle_rad);
-        state.velocity.push(f64::from(r.present_velocity) * xl330::RAD_S_PER_VELOCITY_UNIT);
+        state.velocity.push(f64::from(r.present_velocity) * x::RAD_S_PER_VELOCITY_UNIT);
         state.effort.push(r.drive_torque_n_m);
         command.name.push(name);
-        command.position.push(f64::from(r.goal_position) * xl330::RAD_PER_PULSE);
+        command.position.push(f64::from(r.goal_position) * x::RAD_PER_PULSE);
     }
     (state, command)
 }
@@ -322,6 +322,20 @@ pub fn live_message(l: &LiveRecord) -> crate::bag::messages::Float64Array {
         data_offset: 0,
     };
     Float64Array { layout, data: l.values.to_vec() }
+}
+
+/// How a run ended, as `/sandslope/verdict` says it: the failure when there is one, else the
+/// outcome as `drive --json` gives it (`{"outcome": "completed", ...}`, never Rust's
+/// `Result`), else why it did not start.
+pub fn verdict_text<T: serde::Serialize>(
+    outcome: &std::result::Result<T, String>,
+    failure: Option<&dyn std::fmt::Display>,
+) -> String {
+    match (failure, outcome) {
+        (Some(e), _) => e.to_string(),
+        (None, Ok(outcome)) => serde_json::to_string(outcome).unwrap_or_default(),
+        (None, Err(why)) => why.clone(),
+    }
 }
 
 #[cfg(test)]

@@ -69,6 +69,34 @@ pub struct TrialEntry {
     /// An in-air calibration run.
     #[serde(default)]
     pub air: bool,
+    /// A bag trial's `geometry_msgs/WrenchStamped` topic (docs/bags.md); the bag's only one
+    /// when absent.
+    pub force_topic: Option<String>,
+    /// A bag trial's intruder pose topic; the bag's only pose topic when absent.
+    pub position_topic: Option<String>,
+    /// A bag trial's child frame on a TF or odometry topic.
+    pub frame: Option<String>,
+    /// A bag trial's force component in the load cell's frame (`z`, `-z`, `x`, ...): required
+    /// for a bag.
+    pub force_axis: Option<String>,
+    /// A bag trial's axis of the depth or displacement in the pose topic's frame; the direction
+    /// of travel when absent.
+    pub position_axis: Option<String>,
+}
+
+/// How a trial's bag is read (docs/bags.md): the manifest's keys, axes parsed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BagKeys {
+    /// `force_topic`.
+    pub force_topic: Option<String>,
+    /// `position_topic`.
+    pub position_topic: Option<String>,
+    /// `frame`.
+    pub frame: Option<String>,
+    /// `force_axis`, a unit vector.
+    pub force_axis: [f64; 3],
+    /// `position_axis`, a unit vector.
+    pub position_axis: Option<[f64; 3]>,
 }
 
 /// The manifest file as written.
@@ -103,6 +131,8 @@ pub struct Trial {
     pub path: PathBuf,
     /// In-air calibration run.
     pub air: bool,
+    /// How to read it when the file is a ROS 2 bag (`None` for a CSV).
+    pub bag: Option<BagKeys>,
 }
 
 /// A validated manifest.
@@ -138,13 +168,17 @@ pub fn load_manifest(path: &Path) -> Result<Manifest> {
         let index = i + 1;
         Slope::from_degrees(t.slope_deg)
             .map_err(|e| anyhow!("{here}: [[trial]] #{index} ({}): {e}", t.file.display()))?;
+        let path = dir.join(&t.file);
+        let bag = bag_keys(t, &path)
+            .map_err(|e| anyhow!("{here}: [[trial]] #{index} ({}): {e}", t.file.display()))?;
         trials.push(Trial {
             index,
             kind: t.kind.into(),
             slope_deg: t.slope_deg,
             file: t.file.clone(),
-            path: dir.join(&t.file),
+            path,
             air: t.air,
+            bag,
         });
     }
     for kind in [Kind::Penetration, Kind::Shear] {
@@ -185,6 +219,50 @@ pub fn load_manifest(path: &Path) -> Result<Manifest> {
     })
 }
 
+/// A trial's bag keys: `None` for a CSV (which must have none of them), else the keys with
+/// their axes parsed (`force_axis` required).
+fn bag_keys(t: &TrialEntry, path: &Path) -> Result<Option<BagKeys>> {
+    let given: Vec<&str> = [
+        ("force_topic", t.force_topic.is_some()),
+        ("position_topic", t.position_topic.is_some()),
+        ("frame", t.frame.is_some()),
+        ("force_axis", t.force_axis.is_some()),
+        ("position_axis", t.position_axis.is_some()),
+    ]
+    .iter()
+    .filter(|k| k.1)
+    .map(|k| k.0)
+    .collect();
+    if !crate::bag::is_bag(path) {
+        if !given.is_empty() {
+            bail!(
+                "{} are keys of a ROS 2 bag trial (a bag folder, .mcap or .db3 file), but {} is not one",
+                given.join(", "),
+                path.display()
+            );
+        }
+        return Ok(None);
+    }
+    let axis = |key: &str, text: &str| {
+        crate::bag::wrench::parse_axis(text)
+            .ok_or_else(|| anyhow!("{key} = \"{text}\" must be one of x, y, z, -x, -y, -z"))
+    };
+    let force_axis = match &t.force_axis {
+        Some(a) => axis("force_axis", a)?,
+        None => bail!(
+            "a bag trial needs force_axis: the wrench's force component, in the load cell's frame, that the \
+             sand's resistance makes grow (e.g. force_axis = \"z\", or \"-z\" for a cell that reads it negative)"
+        ),
+    };
+    Ok(Some(BagKeys {
+        force_topic: t.force_topic.clone(),
+        position_topic: t.position_topic.clone(),
+        frame: t.frame.clone(),
+        force_axis,
+        position_axis: t.position_axis.as_deref().map(|a| axis("position_axis", a)).transpose()?,
+    }))
+}
+
 /// Metres per unit for a length-column suffix.
 fn unit_scale(unit: &str) -> Option<f64> {
     match unit {
@@ -218,7 +296,7 @@ pub struct ReadOptions {
 pub fn read_trials(manifest: &Manifest, options: ReadOptions) -> Result<Vec<TrialInput>> {
     let mut out = Vec::with_capacity(manifest.trials.len());
     for trial in &manifest.trials {
-        if !trial.path.is_file() {
+        if !(trial.path.is_file() || trial.bag.is_some()) {
             bail!(
                 "{}: [[trial]] #{} ({}): trial file {} does not exist",
                 manifest.path.display(),
@@ -227,7 +305,10 @@ pub fn read_trials(manifest: &Manifest, options: ReadOptions) -> Result<Vec<Tria
                 trial.path.display()
             );
         }
-        let rec = read_recording_with(&trial.path, trial.kind, options)?;
+        let rec = match &trial.bag {
+            Some(keys) => read_bag_recording(&trial.path, keys)?,
+            None => read_recording_with(&trial.path, trial.kind, options)?,
+        };
         out.push(TrialInput {
             file: trial.file.display().to_string(),
             kind: trial.kind,
@@ -238,6 +319,27 @@ pub fn read_trials(manifest: &Manifest, options: ReadOptions) -> Result<Vec<Tria
         });
     }
     Ok(out)
+}
+
+/// Reads one trial from a ROS 2 bag (docs/bags.md): one row per wrench message, its time, the
+/// intruder's position at its stamp and its force.
+pub fn read_bag_recording(path: &Path, keys: &BagKeys) -> Result<Recording> {
+    let options = crate::bag::wrench::LoadCellOptions {
+        force_topic: keys.force_topic.as_deref(),
+        position_topic: keys.position_topic.as_deref(),
+        frame: keys.frame.as_deref(),
+        force_axis: keys.force_axis,
+        position_axis: keys.position_axis,
+    };
+    let s = crate::bag::wrench::read_load_cell(path, &options)?;
+    let rows = s.time_s.len();
+    let raw = RawRecording {
+        time: Some(s.time_s.into_iter().map(Some).collect()),
+        position: s.position_m,
+        force: s.force_n.into_iter().map(Some).collect(),
+        malformed: 0,
+    };
+    Ok(Recording { raw, rows })
 }
 
 /// A recording's cell that is not a number (the file, line and column in the message): the

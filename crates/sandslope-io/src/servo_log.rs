@@ -619,20 +619,24 @@ struct ServosTable {
     zero_offsets: Option<Vec<i64>>,
     #[serde(default)]
     baud_rate: Option<u32>,
+    #[serde(default)]
+    model: Option<String>,
 }
 
 /// The servos of a robot file and their bus's baud rate.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Servos {
     /// Servos in leg order.
     pub mounts: Vec<ServoMount>,
-    /// Baud rate, one the XL330 supports.
+    /// Baud rate, one the servos support.
     pub baud_rate: u32,
+    /// The servos' model (`model = "XL430-W250"`); `None`: read from the servos at their ping.
+    pub model: Option<&'static sandslope::servo::ServoModel>,
 }
 
-/// Baud rates the XL330 supports (Baud Rate (8) values 0 to 6).
+/// Baud rates every supported servo has (Baud Rate (8) values 0 to 6).
 pub const BAUD_RATES: [u32; 7] = [9_600, 57_600, 115_200, 1_000_000, 2_000_000, 3_000_000, 4_000_000];
-/// The XL330's factory baud rate.
+/// The servos' factory baud rate.
 pub const DEFAULT_BAUD_RATE: u32 = 57_600;
 
 /// Splits a robot file's text into the robot's keys and its `[servos]` table: the table's lines
@@ -713,9 +717,16 @@ pub fn parse_servos(table: &str, source: &Source) -> Result<Servos> {
     }
     let baud_rate = t.baud_rate.unwrap_or(DEFAULT_BAUD_RATE);
     if !BAUD_RATES.contains(&baud_rate) {
-        bail!("{source}: [servos] baud_rate = {baud_rate} must be one the XL330 supports: {BAUD_RATES:?}");
+        bail!("{source}: [servos] baud_rate = {baud_rate} must be one the servos support: {BAUD_RATES:?}");
     }
-    Ok(Servos { mounts, baud_rate })
+    let model = match &t.model {
+        Some(name) => Some(
+            sandslope::servo::ServoModel::by_name(name)
+                .map_err(|e| anyhow!("{source}: [servos] model = {e}"))?,
+        ),
+        None => None,
+    };
+    Ok(Servos { mounts, baud_rate, model })
 }
 
 #[cfg(test)]

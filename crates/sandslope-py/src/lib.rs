@@ -75,6 +75,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate_ensemble, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::check_convergence, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::walk_keyword_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add_function(wrap_pyfunction!(servo::read_servo_log, m)?)?;
     m.add_function(wrap_pyfunction!(servo::infer_servo_log, m)?)?;
@@ -84,6 +85,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(servo::bag_topics, m)?)?;
     m.add_function(wrap_pyfunction!(servo::read_bag_poses, m)?)?;
     m.add_function(wrap_pyfunction!(servo::read_bag_joints, m)?)?;
+    m.add_function(wrap_pyfunction!(servo::read_bag_load_cell, m)?)?;
     m.add("DEFAULT_MAX_RISK", sandslope::risk::DEFAULT_MAX_RISK)?;
     m.add("DEFAULT_MAX_ROLL_DEG", sandslope::plan::DEFAULT_MAX_ROLL_DEG)?;
     m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;

@@ -60,7 +60,7 @@ pub fn read_touchdowns(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Vec
 }
 
 #[pyfunction]
-#[pyo3(signature = (paths, robot, slope_deg=None, format=None, body=None, upslope=None, max_gap=sandslope::gait::DEFAULT_MAX_GAP, cutoff_hz=sandslope::gait::DEFAULT_CUTOFF_HZ, leg_speed_rad_s=None, touchdowns=None))]
+#[pyo3(signature = (paths, robot, slope_deg=None, format=None, body=None, upslope=None, max_gap=sandslope::gait::DEFAULT_MAX_GAP, cutoff_hz=sandslope::gait::DEFAULT_CUTOFF_HZ, leg_speed_rad_s=None, touchdowns=None, topic=None, frame=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn track<'py>(
     py: Python<'py>,
@@ -74,6 +74,8 @@ pub fn track<'py>(
     cutoff_hz: f64,
     leg_speed_rad_s: Option<f64>,
     touchdowns: Option<Vec<Vec<f64>>>,
+    topic: Option<String>,
+    frame: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     if paths.is_empty() {
         return Err(value_error("paths is empty: give at least one recording"));
@@ -102,8 +104,8 @@ pub fn track<'py>(
         touchdowns: touchdowns.map_or(Touchdowns::Estimated, Touchdowns::Times),
         slope_deg,
         stride_period_s: period,
-        topic: None,
-        frame: None,
+        topic,
+        frame,
     };
     request.options(Words::Keyword).map_err(|e| value_error(e.message()))?;
     let tracked =

@@ -214,6 +214,7 @@ pub fn drive<'py>(
         stop_on_risk,
         hold_s,
         stand_s: d.stand_s,
+        servo: None,
     };
     let faults = EmulatorFaults { weaken, ..Default::default() };
     let config = DriveConfig {
@@ -280,6 +281,40 @@ pub fn read_bag_poses<'py>(
         put(&d, name, c.positions.iter().map(|p| p[i]).collect())?;
     }
     Ok((d, c.body))
+}
+
+/// A bag's load-cell trial as `fit` reads it (docs/bags.md): `(columns, position body)`,
+/// `time_s`, the intruder's travel `position_m` (NaN where no position brackets the stamp)
+/// and `force_n`; the axes `x`, `-z`, ...
+#[pyfunction]
+#[pyo3(signature = (path, force_axis, force_topic=None, position_topic=None, frame=None, position_axis=None))]
+pub fn read_bag_load_cell<'py>(
+    py: Python<'py>,
+    path: std::path::PathBuf,
+    force_axis: &str,
+    force_topic: Option<String>,
+    position_topic: Option<String>,
+    frame: Option<String>,
+    position_axis: Option<String>,
+) -> PyResult<(Bound<'py, PyDict>, String)> {
+    use sandslope_io::bag::wrench::{parse_axis, read_load_cell, LoadCellOptions};
+    let axis = |key: &str, text: &str| {
+        parse_axis(text)
+            .ok_or_else(|| value_error(format!("{key} = {text:?} must be one of x, y, z, -x, -y, -z")))
+    };
+    let options = LoadCellOptions {
+        force_topic: force_topic.as_deref(),
+        position_topic: position_topic.as_deref(),
+        frame: frame.as_deref(),
+        force_axis: axis("force_axis", force_axis)?,
+        position_axis: position_axis.as_deref().map(|a| axis("position_axis", a)).transpose()?,
+    };
+    let s = py.detach(|| read_load_cell(&path, &options)).map_err(anyhow_error)?;
+    let d = PyDict::new(py);
+    put(&d, "time_s", s.time_s)?;
+    put(&d, "position_m", s.position_m.into_iter().map(|p| p.unwrap_or(f64::NAN)).collect())?;
+    put(&d, "force_n", s.force_n)?;
+    Ok((d, s.position_body))
 }
 
 /// A bag's `JointState` topic as `infer --servo-log` reads it: `(columns, notes)`, the servo

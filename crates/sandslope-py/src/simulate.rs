@@ -6,11 +6,13 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
 
-use sandslope::simulate::{BodyPitch, Mechanisms, RftScaling, SimSettings};
+use sandslope::simulate::SimSettings;
 use sandslope::Scenario;
 use sandslope_request::error::Words;
-use sandslope_request::simulate::{parse_body_pitch, parse_rft_scaling, SettingsRequest, Walks};
-use sandslope_request::RequestError;
+use sandslope_request::field::{Field, Kind};
+use sandslope_request::scenario::{K_N, K_S};
+use sandslope_request::simulate::{SettingsRequest, Walks, DURATION, NO_SERVO_LIMIT, SETTINGS};
+use sandslope_request::{Params, RequestError};
 
 use crate::arrays::put;
 use crate::types::{PyRobot, PyTerrain};
@@ -21,39 +23,16 @@ use crate::value_error;
 /// `leg{j}_depth_m`, `leg{j}_force_x_n`, `leg{j}_force_z_n`, `leg{j}_torque_n_m`) to a 1-D
 /// array; `summary` is `sandslope simulate --json`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, k_n=None, k_s=None, dt_s=None, creep_m_s=None, sample_rate_hz=sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=sandslope::simulate::mechanisms::UNDISTURBED_SAND))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, **keywords))]
 pub fn simulate<'py>(
     py: Python<'py>,
     robot: &PyRobot,
     terrain: &PyTerrain,
     slope_deg: f64,
     duration_s: f64,
-    k_n: Option<f64>,
-    k_s: Option<f64>,
-    dt_s: Option<f64>,
-    creep_m_s: Option<f64>,
-    sample_rate_hz: f64,
-    body_pitch: &str,
-    rft_scaling: &str,
-    servo_limit: bool,
-    leg_friction: Option<f64>,
-    duty_cycle: f64,
-    disturbed_sand: f64,
+    keywords: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
-    let (scenario, settings) = WalkKeywords {
-        k_n,
-        k_s,
-        duration_s,
-        dt_s,
-        creep_m_s,
-        rate_hz: sample_rate_hz,
-        body_pitch,
-        rft_scaling,
-        servo_limit,
-        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand, ..Default::default() },
-    }
-    .setup(robot, terrain)?;
+    let (scenario, settings) = setup(robot, terrain, duration_s, keywords)?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
     let walks = Walks::at(scenario, slope, settings, None);
     let mut sims = py.detach(|| walks.simulate()).map_err(request_error)?;
@@ -90,56 +69,79 @@ fn request_error(e: RequestError) -> PyErr {
     value_error(e.message())
 }
 
-/// The body-pitch and scaling keywords, parsed with the CLI's names, errors in Python's words.
-fn modes(body_pitch: &str, rft_scaling: &str) -> PyResult<(BodyPitch, RftScaling)> {
-    Ok((
-        parse_body_pitch(body_pitch, Words::Keyword).map_err(request_error)?,
-        parse_rft_scaling(rft_scaling, Words::Keyword).map_err(request_error)?,
-    ))
+/// The keywords every walk takes (`simulate`, `simulate_ensemble` and `check_convergence`
+/// share them): `k_n` and `k_s`, and the settings' fields ([`SETTINGS`]) by their Python
+/// keyword, as `sandslope simulate`'s flags and `/api/simulate`'s fields are read, each absent
+/// or `None` keyword taking the table's default. `servo_limit=False` is the flag
+/// `--no-servo-limit`.
+pub fn walk_keywords() -> Vec<&'static Field> {
+    [&K_N, &K_S].into_iter().chain(SETTINGS.fields.iter().filter(|f| f.flag != DURATION.flag)).collect()
 }
 
-/// The keywords every walk takes, as Python passes them.
-struct WalkKeywords<'a> {
-    k_n: Option<f64>,
-    k_s: Option<f64>,
+/// The robot on its terrain and the settings `sandslope simulate` checks, in Python's words.
+fn setup(
+    robot: &PyRobot,
+    terrain: &PyTerrain,
     duration_s: f64,
-    dt_s: Option<f64>,
-    creep_m_s: Option<f64>,
-    rate_hz: f64,
-    body_pitch: &'a str,
-    rft_scaling: &'a str,
-    servo_limit: bool,
-    mechanisms: Mechanisms,
-}
-
-impl WalkKeywords<'_> {
-    /// The robot on its terrain and the settings `sandslope simulate` checks, in Python's words.
-    fn setup(&self, robot: &PyRobot, terrain: &PyTerrain) -> PyResult<(Scenario, SimSettings)> {
-        let scenario = Scenario::new(robot.inner.clone(), terrain.inner.clone(), self.k_n, self.k_s)
-            .map_err(value_error)?;
-        let (body_pitch, rft_scaling) = modes(self.body_pitch, self.rft_scaling)?;
-        let settings = SettingsRequest {
-            duration_s: self.duration_s,
-            dt_s: self.dt_s,
-            creep_m_s: self.creep_m_s,
-            servo_limit: self.servo_limit,
-            body_pitch,
-            rft_scaling,
-            mechanisms: self.mechanisms,
-            rate_hz: self.rate_hz,
+    keywords: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(Scenario, SimSettings)> {
+    let mut pairs = vec![(DURATION.flag.to_string(), format!("{duration_s}"))];
+    let (mut k_n, mut k_s) = (None, None);
+    let accepted = walk_keywords();
+    for (key, value) in keywords.into_iter().flat_map(|d| d.iter()) {
+        let key: String = key.extract()?;
+        let Some(field) = accepted.iter().find(|f| f.keyword == key) else {
+            let names: Vec<&str> = accepted.iter().map(|f| f.keyword).collect();
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "unexpected keyword argument '{key}': a walk takes {}",
+                names.join(", ")
+            )));
+        };
+        if value.is_none() {
+            continue;
         }
-        .settings(Words::Keyword)
-        .map_err(request_error)?;
-        Ok((scenario, settings))
+        let number =
+            || value.extract::<f64>().map_err(|_| value_error(format!("{key} = {value} is not a number")));
+        if field.flag == K_N.flag {
+            k_n = Some(number()?);
+            continue;
+        }
+        if field.flag == K_S.flag {
+            k_s = Some(number()?);
+            continue;
+        }
+        let text = match field.kind {
+            Kind::Switch => {
+                let on: bool =
+                    value.extract().map_err(|_| value_error(format!("{key} = {value} is not a bool")))?;
+                // `servo_limit` is the switch `no-servo-limit` the other way round.
+                if on == (field.flag == NO_SERVO_LIMIT.flag) {
+                    continue;
+                }
+                "true".to_string()
+            }
+            Kind::Number | Kind::Whole => format!("{}", number()?),
+            Kind::Text | Kind::Choice(_) => {
+                value.extract::<String>().map_err(|_| value_error(format!("{key} = {value} is not a str")))?
+            }
+        };
+        pairs.push((field.flag.to_string(), text));
     }
+    let scenario =
+        Scenario::new(robot.inner.clone(), terrain.inner.clone(), k_n, k_s).map_err(value_error)?;
+    let mut p = Params::new("simulate", &pairs);
+    let settings = SettingsRequest::read(&mut p, Words::Keyword)
+        .and_then(|s| s.settings(Words::Keyword))
+        .map_err(request_error)?;
+    p.finish().map_err(request_error)?;
+    Ok((scenario, settings))
 }
 
 /// Walks the robot `walks` times (2 to 1000) at one slope, the mass perturbed by 1e-9 relative
 /// between walks (`sandslope simulate --ensemble N --json`, docs/simulate.md "Pitch free"):
 /// the spread's dict, with every walk's summary under `summaries`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, walks, k_n=None, k_s=None, dt_s=None, creep_m_s=None, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=sandslope::simulate::mechanisms::UNDISTURBED_SAND))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, walks, **keywords))]
 pub fn simulate_ensemble<'py>(
     py: Python<'py>,
     robot: &PyRobot,
@@ -147,30 +149,9 @@ pub fn simulate_ensemble<'py>(
     slope_deg: f64,
     duration_s: f64,
     walks: usize,
-    k_n: Option<f64>,
-    k_s: Option<f64>,
-    dt_s: Option<f64>,
-    creep_m_s: Option<f64>,
-    body_pitch: &str,
-    rft_scaling: &str,
-    servo_limit: bool,
-    leg_friction: Option<f64>,
-    duty_cycle: f64,
-    disturbed_sand: f64,
+    keywords: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (scenario, settings) = WalkKeywords {
-        k_n,
-        k_s,
-        duration_s,
-        dt_s,
-        creep_m_s,
-        rate_hz: sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ,
-        body_pitch,
-        rft_scaling,
-        servo_limit,
-        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand, ..Default::default() },
-    }
-    .setup(robot, terrain)?;
+    let (scenario, settings) = setup(robot, terrain, duration_s, keywords)?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
     let request = Walks::at(scenario, slope, settings, Some(walks));
     let e = py.detach(|| request.simulate_ensemble(walks)).map_err(request_error)?;
@@ -184,8 +165,7 @@ pub fn simulate_ensemble<'py>(
 /// (answered by one dict) or a sequence of slopes (`--slopes`: a list of dicts, the slopes
 /// in parallel; not with `walks`).
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, walks=None, k_n=None, k_s=None, dt_s=None, creep_m_s=None, body_pitch="locked", rft_scaling="motion", servo_limit=true, leg_friction=None, duty_cycle=sandslope::simulate::mechanisms::CONSTANT_SPEED_DUTY, disturbed_sand=sandslope::simulate::mechanisms::UNDISTURBED_SAND))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, walks=None, **keywords))]
 pub fn check_convergence<'py>(
     py: Python<'py>,
     robot: &PyRobot,
@@ -193,30 +173,9 @@ pub fn check_convergence<'py>(
     slope_deg: &Bound<'py, PyAny>,
     duration_s: f64,
     walks: Option<usize>,
-    k_n: Option<f64>,
-    k_s: Option<f64>,
-    dt_s: Option<f64>,
-    creep_m_s: Option<f64>,
-    body_pitch: &str,
-    rft_scaling: &str,
-    servo_limit: bool,
-    leg_friction: Option<f64>,
-    duty_cycle: f64,
-    disturbed_sand: f64,
+    keywords: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (scenario, settings) = WalkKeywords {
-        k_n,
-        k_s,
-        duration_s,
-        dt_s,
-        creep_m_s,
-        rate_hz: sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ,
-        body_pitch,
-        rft_scaling,
-        servo_limit,
-        mechanisms: Mechanisms { leg_friction, duty_cycle, disturbed_sand, ..Default::default() },
-    }
-    .setup(robot, terrain)?;
+    let (scenario, settings) = setup(robot, terrain, duration_s, keywords)?;
     let signed = |deg: f64| sandslope::SignedSlope::from_degrees(deg).map_err(value_error);
     let request = match slope_deg.extract::<f64>() {
         Ok(deg) => Walks::at(scenario, signed(deg)?, settings, walks),
@@ -246,4 +205,12 @@ pub fn check_convergence<'py>(
     }
     let c = checks.pop().ok_or_else(|| value_error("the check gave no result"))?;
     pythonize(py, &c).map_err(value_error)
+}
+
+/// The keywords every walk takes, with their defaults as the table gives them (`None`: not
+/// set unless given): what the Python layer's `WalkSettings` and the stubs are checked
+/// against.
+#[pyfunction]
+pub fn walk_keyword_defaults() -> Vec<(&'static str, Option<&'static str>)> {
+    walk_keywords().into_iter().map(|f| (f.keyword, f.default)).collect()
 }

@@ -397,3 +397,157 @@ def test_read_bag_gives_the_csv_columns(walk, servo_run):
         assert np.array_equal(got[c].to_numpy(), want[c].to_numpy()), c
     with pytest.raises(ValueError, match="no topic `/nope`"):
         sandslope.read_bag(bag, "/nope")
+
+
+# --- fit from load-cell bags (WrenchStamped + the intruder's pose) -------------------------
+
+DISK_R = 0.01             # m: the disk's area pi r^2 (docs/measurements.md's manifest)
+PLATE_W, PLATE_D = 0.03, 0.02
+K_N, K_S = 7.0e5, 2.0e6   # N/m^3: the values the synthetic recordings are generated from
+
+
+def wrench(ns, fz, frame="load_cell"):
+    w = msg("geometry_msgs/msg/Wrench", force=vector(0.0, 0.0, fz), torque=vector(0, 0, 0))
+    return msg("geometry_msgs/msg/WrenchStamped", header=header(ns, frame), wrench=w)
+
+
+def quat_z(angle):
+    return msg("geometry_msgs/msg/Quaternion", x=0.0, y=0.0, z=float(np.sin(angle / 2)), w=float(np.cos(angle / 2)))
+
+
+def tf_stamped(ns, parent, child, p, q=None):
+    tr = msg("geometry_msgs/msg/Transform", translation=vector(*p), rotation=q or quat())
+    return msg("geometry_msgs/msg/TransformStamped", header=header(ns, parent), child_frame_id=child, transform=tr)
+
+
+def load_cell_trials(rng):
+    """Per trial (kind, slope, air, t, position, force): a disk pushed 40 mm at 5 cm/s, a plate
+    dragged 100 mm at 5 cm/s, load cells at 100 Hz with 0.02 N noise on a 0.3 N offset; the
+    measured runs' forces are k_n A d and k_s W_p d_p^2 (1 - exp(-x / 5 mm)) (docs/model.md §10)."""
+    area = np.pi * DISK_R**2
+    out = []
+    t = np.arange(0, 0.8, 0.01)
+    for air in (True, False):
+        depth = 0.05 * t
+        force = 0.3 + (0 if air else K_N * area * depth) + rng.normal(0, 0.02, t.size)
+        out.append(("penetration", 0.0, air, t, depth, force))
+    t = np.arange(0, 2.0, 0.01)
+    for air in (True, False):
+        x = 0.05 * t
+        force = 0.3 + (0 if air else K_S * PLATE_W * PLATE_D**2 * (1 - np.exp(-x / 0.005))) + rng.normal(0, 0.02, t.size)
+        out.append(("shear", 0.0, air, t, x, force))
+    return out
+
+
+def write_manifest(path, files):
+    lines = [f"[penetration]\ndisk_radius_m = {DISK_R}\n[shear]\nplate_width_m = {PLATE_W}\nplate_depth_m = {PLATE_D}\n"]
+    for (kind, slope, air, _t, _p, _f), (file, extra) in zip(load_cell_trials(np.random.default_rng(0)), files):
+        lines.append(f'[[trial]]\nkind = "{kind}"\nslope_deg = {slope}\nfile = "{file}"\nair = {str(air).lower()}\n{extra}')
+    path.write_text("\n".join(lines))
+
+
+def test_fit_reads_wrenches_and_poses_from_bags_as_the_csv(tmp_path):
+    trials = load_cell_trials(np.random.default_rng(7))
+    csv_files, bag_files = [], []
+    for i, (kind, _slope, _air, t, pos, force) in enumerate(trials):
+        name = f"{kind}-{i}"
+        col = "depth_m" if kind == "penetration" else "displacement_m"
+        pd.DataFrame({"time_s": t, col: pos, "force_n": force}).to_csv(tmp_path / f"{name}.csv", index=False)
+        csv_files.append((f"{name}.csv", ""))
+        # The load cell at 100 Hz, reading compression negative along its own z; the intruder
+        # tracked at 120 Hz by a clock 3 ms off the load cell's (so every force sample takes
+        # an interpolated position: exact here, the motion being uniform).
+        w_ns = [T0_NS + round(s * 1e9) for s in t]
+        p_t = np.arange(-0.05, t[-1] + 0.05, 1 / 120) + 0.003
+        speed = 0.05
+        wrenches = [(ns, wrench(ns, -f)) for ns, f in zip(w_ns, force)]
+        if kind == "penetration":
+            # A PoseStamped topic in the world frame: the disk goes down from z = 0.2 m.
+            poses = [(T0_NS + round(s * 1e9), pose_stamped(T0_NS + round(s * 1e9), (0.1, 0.0, 0.2 - speed * s)))
+                     for s in p_t]
+            write_rosbags(tmp_path / name, StoragePlugin.MCAP, {
+                "/load_cell/wrench": ("geometry_msgs/msg/WrenchStamped", wrenches),
+                "/rig/disk": ("geometry_msgs/msg/PoseStamped", poses),
+            })
+            bag_files.append((name, 'force_axis = "-z"\n'))
+        else:
+            # The plate as a TF frame two levels below the root: world -> (static, turned 90
+            # degrees about z) rig -> (moving) carriage -> (moving) plate. In world the plate
+            # moves along +y; the carriage carries the drag and the plate hangs 5 cm below it.
+            tf = []
+            for s in p_t:
+                ns = T0_NS + round(s * 1e9)
+                tf.append((ns, msg("tf2_msgs/msg/TFMessage", transforms=[
+                    tf_stamped(ns, "rig", "carriage", (speed * s, 0.0, 0.3)),
+                    tf_stamped(ns, "carriage", "plate", (0.0, 0.0, -0.05)),
+                ])))
+            static = [(T0_NS, msg("tf2_msgs/msg/TFMessage",
+                                  transforms=[tf_stamped(T0_NS, "world", "rig", (1.0, 2.0, 0.0), quat_z(np.pi / 2))]))]
+            write_rosbags(tmp_path / name, StoragePlugin.SQLITE3, {
+                "/ft": ("geometry_msgs/msg/WrenchStamped", wrenches),
+                "/tf": ("tf2_msgs/msg/TFMessage", tf),
+                "/tf_static": ("tf2_msgs/msg/TFMessage", static),
+            })
+            bag_files.append((name, 'force_topic = "/ft"\nposition_topic = "/tf"\nframe = "plate"\nforce_axis = "-z"\n'))
+    write_manifest(tmp_path / "csv.toml", csv_files)
+    write_manifest(tmp_path / "bag.toml", bag_files)
+    from_csv = run_json("fit", tmp_path / "csv.toml")
+    from_bag = run_json("fit", tmp_path / "bag.toml")
+    (pc,), (pb,) = from_csv["points"], from_bag["points"]
+    # The stamps are whole nanoseconds (0.5 ns is 25 pm of travel at 5 cm/s): the fitted values
+    # agree to 1e-9, their SDs (built from residuals of a few mN) to 1e-6.
+    for key, rel in (("k_n", 1e-9), ("k_s", 1e-9), ("k_n_sd", 1e-6), ("k_s_sd", 1e-6)):
+        assert pb[key] == pytest.approx(pc[key], rel=rel), (key, pb[key], pc[key])
+    for tc, tb in zip(from_csv["trials"], from_bag["trials"]):
+        assert (tb["rows"], tb["used"]) == (tc["rows"], tc["used"]), tb["file"]
+    # The values the recordings were generated from (the noise leaves well under 1%).
+    assert pb["k_n"] == pytest.approx(K_N, rel=0.01) and pb["k_s"] == pytest.approx(K_S, rel=0.01), pb
+    # The same from Python.
+    import sandslope
+    py = sandslope.fit(tmp_path / "bag.toml")
+    assert py["points"]["k_n"][0] == pytest.approx(pc["k_n"], rel=1e-9)
+    # read_bag gives the trial's columns as fit reads them: the CSV's, to the stamps' nanosecond.
+    _kind, _slope, _air, t, depth, force = trials[1]
+    cols = sandslope.read_bag(tmp_path / "penetration-1", "/load_cell/wrench", force_axis="-z")
+    assert list(cols.columns) == ["time_s", "position_m", "force_n"] and cols.attrs["body"] == "/rig/disk"
+    assert np.allclose(cols["time_s"], t, rtol=0, atol=1e-9)
+    assert np.allclose(cols["position_m"], depth, rtol=0, atol=1e-10)
+    assert np.array_equal(cols["force_n"], force)
+    with pytest.raises(ValueError, match="force_axis"):
+        sandslope.read_bag(tmp_path / "penetration-1", "/load_cell/wrench")
+    # A bag trial without force_axis, and CSV trials with bag keys, are refused by name.
+    bad = tmp_path / "bad.toml"
+    write_manifest(bad, [(f, "") for f, _ in bag_files])
+    err = run("fit", bad, code=2).stderr
+    assert "force_axis" in err and "[[trial]] #1" in err, err
+    write_manifest(bad, [(f, 'force_axis = "z"\n') for f, _ in csv_files])
+    err = run("fit", bad, code=2).stderr
+    assert "force_axis are keys of a ROS 2 bag trial" in err, err
+
+
+def test_track_composes_a_tf_frame_up_its_tree(walk):
+    """base_link two levels below world: world -> (on /tf_static, at (1, 2, 0) turned 90 degrees
+    about z) odom -> (on /tf, moving) carriage -> base_link. Composed, its position is the
+    walk's again, so track answers as on the CSV."""
+    d, _, rows, expected = walk
+    bag = d / "tf_tree"
+    tf = []
+    for ns, p in rows:
+        # The walk's world position w = (1, 2, 0) + R_z(90) q, so q = (w_y - 2, -(w_x - 1), w_z).
+        q = (p[1] - 2.0, -(p[0] - 1.0), p[2])
+        c = (0.5 * q[0], 0.01, 0.0)  # the carriage holds half of it
+        tf.append((ns, msg("tf2_msgs/msg/TFMessage", transforms=[
+            tf_stamped(ns, "odom", "carriage", c),
+            tf_stamped(ns, "carriage", "base_link", (q[0] - c[0], q[1] - c[1], q[2] - c[2])),
+        ])))
+    static = [(rows[0][0], msg("tf2_msgs/msg/TFMessage",
+                               transforms=[tf_stamped(rows[0][0], "world", "odom", (1.0, 2.0, 0.0), quat_z(np.pi / 2))]))]
+    write_rosbags(bag, StoragePlugin.MCAP, {"/tf": ("tf2_msgs/msg/TFMessage", tf), "/tf_static": ("tf2_msgs/msg/TFMessage", static)})
+    got = run_json("track", bag, "--topic", "/tf", "--frame", "base_link", "--slope", "10")
+    assert_same_track(got, expected)
+    assert got["recordings"][0]["body"] == "/tf base_link in world"
+    # Python's track reads the same bag, topic and frame.
+    import sandslope
+    py = sandslope.track(bag, 10, topic="/tf", frame="base_link")
+    assert py["speed_m_s"] == pytest.approx(got["speed_m_s"], rel=1e-12)
+    assert list(py["recordings"]["body"]) == ["/tf base_link in world"]

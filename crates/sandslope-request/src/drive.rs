@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use sandslope::servo::xl330;
+use sandslope::servo::ServoModel;
 use sandslope::{SignedSlope, Terrain};
 
 use crate::error::{RequestError, Result, Words};
@@ -24,9 +24,11 @@ pub struct DriveRun {
     pub watchdog_s: f64,
     /// The servos' own bus watchdog, s (0.02 to 2.54, its register's range).
     pub bus_watchdog_s: f64,
-    /// The servos' current limit, mA (at most the XL330's).
+    /// The servos' current limit, mA (at most the largest a supported model accepts; the
+    /// servos' own model is checked at their ping).
     pub current_limit_ma: u16,
-    /// The servos' temperature limit, degC (at most the XL330's).
+    /// The servos' temperature limit, degC (at most the highest a supported model is rated
+    /// for; the servos' own model is checked at their ping).
     pub temperature_limit_c: u8,
     /// Stop when the live risk reaches this probability (0 to 1), if given.
     pub stop_on_risk: Option<f64>,
@@ -80,25 +82,26 @@ impl DriveRun {
         within(words, "hold", self.hold_s, 0.0, 3600.0)?;
         within(words, "watchdog", self.watchdog_s, 0.01, 10.0)?;
         within(words, "bus-watchdog", self.bus_watchdog_s, 0.02, 2.54)?;
-        if self.current_limit_ma > xl330::MAX_CURRENT_LIMIT_MA {
+        let max_ma =
+            ServoModel::ALL.iter().filter_map(|m| m.max_current_limit_ma()).fold(0.0, f64::max).floor();
+        let max_c = ServoModel::ALL.iter().map(|m| m.max_temperature_c).max().unwrap_or(0);
+        if f64::from(self.current_limit_ma) > max_ma {
             return Err(RequestError::invalid(
                 "current-limit",
                 format!(
-                    "{} = {} must be within 0 to {} mA (the XL330's Current Limit range)",
+                    "{} = {} must be within 0 to {max_ma} mA (the largest Current Limit of a supported servo)",
                     name(words, "current-limit"),
                     self.current_limit_ma,
-                    xl330::MAX_CURRENT_LIMIT_MA
                 ),
             ));
         }
-        if self.temperature_limit_c > xl330::MAX_TEMPERATURE_C {
+        if self.temperature_limit_c > max_c {
             return Err(RequestError::invalid(
                 "temperature-limit",
                 format!(
-                    "{} = {} must be within 0 to {} degC (the XL330's rated range)",
+                    "{} = {} must be within 0 to {max_c} degC (the highest rating of a supported servo)",
                     name(words, "temperature-limit"),
                     self.temperature_limit_c,
-                    xl330::MAX_TEMPERATURE_C
                 ),
             ));
         }
@@ -158,12 +161,13 @@ mod tests {
         let e = steep.check(Words::Keyword).unwrap_err();
         assert_eq!(e.field(), Some("slope"));
         assert!(e.message().starts_with("slope_deg = 95"), "{}", e.message());
-        let hot = DriveRun { temperature_limit_c: 71, ..run() };
+        // The XM430-W350 is rated to 80 degC, the hottest supported servo.
+        let hot = DriveRun { temperature_limit_c: 81, ..run() };
         assert!(hot
             .check(Words::Flag)
             .unwrap_err()
             .message()
-            .starts_with("--temperature-limit = 71 must be within 0 to 70"));
+            .starts_with("--temperature-limit = 81 must be within 0 to 80"));
         let soft = DriveRun { emulate_k_s: Some(-1.0), ..run() };
         assert!(soft.check(Words::Keyword).unwrap_err().message().starts_with("k_s = -1"));
     }

@@ -20,6 +20,7 @@ pub mod calibrate;
 pub mod design;
 pub mod drive;
 pub mod error;
+pub mod field;
 pub mod fit;
 pub mod grammar;
 pub mod infer;

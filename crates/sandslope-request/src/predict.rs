@@ -5,8 +5,28 @@ use serde::{Deserialize, Serialize};
 use sandslope::{ParamError, Robot, Scenario, SignedSlope, SlopeEvaluation, Terrain};
 
 use crate::error::{RequestError, Result};
+use crate::field::{Field, Fields, Table};
 use crate::params::Params;
-use crate::scenario::ScenarioRequest;
+use crate::scenario::{ScenarioRequest, K_N, K_S, ROBOT_QUANTITIES, TERRAIN};
+
+/// `--slope`: the one slope of a prediction (Python's `slope_deg`, the library's key).
+pub const SLOPE: Field = Field::number("slope", "DEG")
+    .keyword("slope_deg")
+    .key("slope_deg")
+    .unit("deg")
+    .range("-90 to 90 (docs/model.md §8)")
+    .required()
+    .help(
+        "Slope along the direction of travel, degrees (negative: descending, evaluated as \
+         |slope|, docs/model.md §8)",
+    );
+
+/// `predict`'s own field (the robot's and terrain's are [`crate::scenario::FIELDS`]).
+pub const FIELDS: Table = Table { command: "predict", fields: &[SLOPE] };
+
+impl Fields for PredictRequest {
+    const TABLE: Table = FIELDS;
+}
 
 /// The inputs of `predict` (and `/api/predict`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -21,9 +41,22 @@ pub struct PredictRequest {
 impl PredictRequest {
     /// Reads `slope` (required) and the scenario's fields; refuses any other key.
     pub fn from_params(params: &[(String, String)]) -> Result<PredictRequest> {
-        let mut p = Params::new("predict", params);
-        let slope = p.required_number("slope", "the slope along the direction of travel, degrees")?;
-        let scenario = ScenarioRequest::from_params(&mut p)?;
+        Self::read(params, None)
+    }
+
+    /// The command line's request: its own fields from `params` (the flags given, by
+    /// [`FIELDS`]), the scenario already read from the flags it shares with other commands.
+    pub fn with_scenario(params: &[(String, String)], scenario: ScenarioRequest) -> Result<PredictRequest> {
+        Self::read(params, Some(scenario))
+    }
+
+    fn read(params: &[(String, String)], scenario: Option<ScenarioRequest>) -> Result<PredictRequest> {
+        let mut p = Params::new(FIELDS.command, params);
+        let slope = SLOPE.required_number_in(&mut p)?;
+        let scenario = match scenario {
+            Some(s) => s,
+            None => ScenarioRequest::from_params(&mut p)?,
+        };
         p.finish()?;
         Ok(PredictRequest { slope, scenario })
     }
@@ -36,8 +69,8 @@ impl PredictRequest {
 
 /// The scenario at one slope, an error naming the field `slope`.
 pub fn evaluate(scenario: &sandslope::Scenario, slope: f64) -> Result<SlopeEvaluation> {
-    let slope =
-        SignedSlope::from_degrees(slope).map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))?;
+    let slope = SignedSlope::from_degrees(slope)
+        .map_err(|e| RequestError::invalid(SLOPE.flag, e.renamed(SLOPE.long())))?;
     Ok(scenario.evaluate(slope))
 }
 
@@ -55,14 +88,10 @@ pub struct PointRequest {
     pub mass: Option<f64>,
 }
 
-/// The request field of a library key (`k_n` -> `k-n`, `slope_deg` -> `slope`).
-fn field_of_key(key: &str) -> &'static str {
-    match key {
-        "mass_kg" => "mass",
-        "k_n" => "k-n",
-        "k_s" => "k-s",
-        _ => "slope",
-    }
+/// The request field of a library key (`k_n` -> `k-n`, `slope_deg` -> `slope`, `mass_kg` ->
+/// `mass`): a lookup in the tables, `None` for a key no field sets.
+fn field_of_key(key: &str) -> Option<&'static str> {
+    [SLOPE, K_N, K_S].iter().chain(ROBOT_QUANTITIES.fields).find(|f| f.key == key).map(|f| f.flag)
 }
 
 impl PointRequest {
@@ -77,10 +106,12 @@ impl PointRequest {
         terrain: &Terrain,
         name: impl Fn(&str) -> String,
     ) -> Result<SlopeEvaluation> {
-        let refuse = |e: ParamError| {
-            let field = field_of_key(&e.key);
-            let key = name(&e.key);
-            RequestError::invalid(field, e.renamed(key))
+        let refuse = |e: ParamError| match field_of_key(&e.key) {
+            Some(field) => {
+                let key = name(&e.key);
+                RequestError::invalid(field, e.renamed(key))
+            }
+            None => RequestError::from_error(None, anyhow::anyhow!("{e}")),
         };
         let robot = match self.mass {
             Some(m) => robot.with_mass(m).map_err(|e| refuse(e.renamed("mass_kg")))?,
@@ -99,9 +130,9 @@ pub fn point_terrain(terrain: Option<&Terrain>, k_n_given: bool, k_s_given: bool
     match terrain {
         Some(t) => Ok(t.clone()),
         None if k_n_given && k_s_given => Terrain::constant(1.0, 1.0)
-            .map_err(|e| RequestError::from_error(Some("terrain"), anyhow::anyhow!("{e}"))),
+            .map_err(|e| RequestError::from_error(Some(TERRAIN.flag), anyhow::anyhow!("{e}"))),
         None => Err(RequestError::invalid(
-            "terrain",
+            TERRAIN.flag,
             "give both k_n and k_s, or a terrain (k_n and k_s then override it)",
         )),
     }

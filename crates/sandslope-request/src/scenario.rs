@@ -7,7 +7,88 @@ use sandslope::{LevelStep, Robot, Scenario, Terrain};
 use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 
 use crate::error::{check_positive, RequestError, Result};
+use crate::field::{Field, Kind, Table};
 use crate::params::Params;
+
+/// `--robot`: a robot file or preset.
+pub const ROBOT: Field = Field::text("robot", "FILE|PRESET")
+    .keyword("robot")
+    .default(DEFAULT_ROBOT)
+    .help("Robot: a TOML file or a built-in preset (see `sandslope presets`)");
+/// `--terrain`: a terrain file or preset.
+pub const TERRAIN: Field = Field::text("terrain", "FILE|PRESET")
+    .keyword("terrain")
+    .default(DEFAULT_TERRAIN)
+    .help("Terrain: a TOML file or a built-in preset (see `sandslope presets`)");
+/// `--k-n`: a fixed normal resistance.
+pub const K_N: Field = Field::number("k-n", "N/M^3")
+    .keyword("k_n")
+    .key("k_n")
+    .unit("N/m^3")
+    .range("greater than 0, plausible (docs/model.md §7)")
+    .help("Normal penetration resistance k_n, N/m^3, instead of the terrain's");
+/// `--k-s`: a fixed shear strength.
+pub const K_S: Field = Field::number("k-s", "N/M^3")
+    .keyword("k_s")
+    .key("k_s")
+    .unit("N/m^3")
+    .range("greater than 0, plausible (docs/model.md §7)")
+    .help("Shear strength k_s, N/m^3, instead of the terrain's");
+/// `--level-step`: which normal depth the derived level step uses.
+pub const LEVEL_STEP: Field =
+    Field::new("level-step", Kind::Choice(&["slope", "level"]), "slope|level").default("slope").help(
+        "Normal depth of the derived level step s* (docs/model.md §3, a choice the paper leaves \
+         open): `slope` takes d_n at the slope, with its cos(theta) (the default); `level` takes \
+         d_n on level sand, the paper's definition of s*. Up to 0.7% in speed on the built-in \
+         robot and terrain. No effect on a robot with `level_step_m`.",
+    );
+
+/// A robot quantity's field: its flag overrides the robot file's key of the same name.
+const fn quantity(
+    flag: &'static str,
+    key: &'static str,
+    unit: &'static str,
+    value_name: &'static str,
+) -> Field {
+    Field::number(flag, value_name).keyword(key).key(key).unit(unit)
+}
+
+/// `--mass`: the robot's total mass instead of the file's.
+pub const MASS: Field = quantity("mass", "mass_kg", "kg", "KG").help("Override the robot's total mass, kg");
+
+/// The robot quantities a request may override (docs/model.md §2), the mass first: the
+/// command line's flags, the server's fields and the explorer page's robot panel (which reads
+/// this list from `/data/served`). Each field's key is the library's robot key
+/// ([`RobotKey::name`]) and its keyword Python's.
+pub const ROBOT_QUANTITIES: Table = Table {
+    command: "robot",
+    fields: &[
+        MASS,
+        quantity("leg-radius", "leg_radius_m", "m", "M").help("Override the C-leg radius R, m"),
+        quantity("leg-width", "leg_width_m", "m", "M").help("Override the leg width W, m"),
+        quantity("hip-height", "hip_height_m", "m", "M")
+            .range("between 0 and 2R")
+            .help("Override the hip height h, m (between 0 and 2R)"),
+        quantity("leg-speed", "leg_speed_rad_s", "rad/s", "RAD/S")
+            .help("Override the leg angular speed omega, rad/s"),
+        Field::new("stance-legs", Kind::Whole, "N")
+            .keyword("stance_legs")
+            .key("stance_legs")
+            .unit("legs")
+            .help("Override the number of legs in stance at once"),
+        quantity("response-time", "response_time_s", "s", "S")
+            .help("Override the elastic response time dt, s"),
+    ],
+};
+
+/// The field overriding the robot key `key`, where a request may.
+pub fn robot_field(key: RobotKey) -> Option<&'static Field> {
+    ROBOT_QUANTITIES.by_key(key.name())
+}
+
+/// The fields of a scenario besides the robot's quantities (those are the library's table of
+/// robot keys, [`robot_fields`]): what `predict`, `sweep` and `simulate` share.
+pub const FIELDS: Table = Table { command: "scenario", fields: &[ROBOT, TERRAIN, K_N, K_S, LEVEL_STEP] };
 
 /// The robot of a request: a file or built-in preset, with the robot quantities it overrides.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -28,32 +109,24 @@ impl Default for RobotRequest {
     }
 }
 
-/// The request field of a key's flag (`--leg-radius` -> `leg-radius`).
-fn field_of(flag: &'static str) -> &'static str {
-    flag.trim_start_matches('-')
-}
-
 /// Every key a request may set, with its field: the rows of [`RobotKey::TABLE`] that have a
 /// flag, the mass first (what the command line's flags, the server's parameters and the
 /// explorer page's robot panel are; the page reads this list from `/data/served`).
 pub fn robot_fields() -> impl Iterator<Item = (RobotKey, &'static str)> {
-    RobotKey::ALL.into_iter().filter_map(|k| k.flag().map(|f| (k, field_of(f))))
+    RobotKey::ALL.into_iter().filter_map(|k| robot_field(k).map(|f| (k, f.flag)))
 }
 
 /// The keys a request may override besides the mass, with their fields: the table's rows
 /// that have a flag.
 pub fn override_fields() -> impl Iterator<Item = (RobotKey, &'static str)> {
-    RobotKey::ALL
-        .into_iter()
-        .filter(|k| *k != RobotKey::MassKg)
-        .filter_map(|k| k.flag().map(|f| (k, field_of(f))))
+    robot_fields().filter(|(k, _)| *k != RobotKey::MassKg)
 }
 
 impl RobotRequest {
     /// Reads `robot`, `mass` and the override fields.
     pub fn from_params(p: &mut Params<'_>) -> Result<RobotRequest> {
-        let robot = p.text_or("robot", DEFAULT_ROBOT)?;
-        let mass = p.number("mass")?;
+        let robot = ROBOT.text_in(p)?.unwrap_or(DEFAULT_ROBOT).to_string();
+        let mass = MASS.number_in(p)?;
         let overrides = Self::overrides_from_params(p)?;
         Ok(RobotRequest { robot, mass, overrides })
     }
@@ -73,7 +146,7 @@ impl RobotRequest {
 
     /// `robot` with this request's quantities replaced (not the mass), validated again as a
     /// whole. An error on a key a request can override names its field (from
-    /// [`RobotKey::flag`]), even when another override broke it (`leg-radius` made too small
+    /// [`robot_field`]), even when another override broke it (`leg-radius` made too small
     /// for the file's hip height names `hip-height`).
     pub fn apply(&self, robot: Robot) -> Result<Robot> {
         if self.overrides.is_empty() {
@@ -85,8 +158,8 @@ impl RobotRequest {
         }
         Robot::new(spec).map_err(|e| {
             let key = RobotKey::of_error(&e).filter(|k| *k != RobotKey::MassKg);
-            match key.and_then(|k| k.flag()) {
-                Some(flag) => RequestError::invalid(field_of(flag), e.renamed(flag)),
+            match key.and_then(robot_field) {
+                Some(f) => RequestError::invalid(f.flag, e.renamed(f.long())),
                 None => RequestError::from_error(None, anyhow::anyhow!("{e}")),
             }
         })
@@ -97,11 +170,13 @@ impl RobotRequest {
     ///
     /// [`apply`]: RobotRequest::apply
     pub fn load(&self) -> Result<Robot> {
-        let robot =
-            sandslope_io::load_robot(&self.robot).map_err(|e| RequestError::from_error(Some("robot"), e))?;
+        let robot = sandslope_io::load_robot(&self.robot)
+            .map_err(|e| RequestError::from_error(Some(ROBOT.flag), e))?;
         let robot = self.apply(robot)?;
         match self.mass {
-            Some(m) => robot.with_mass(m).map_err(|e| RequestError::invalid("mass", e.renamed("--mass"))),
+            Some(m) => {
+                robot.with_mass(m).map_err(|e| RequestError::invalid(MASS.flag, e.renamed(MASS.long())))
+            }
             None => Ok(robot),
         }
     }
@@ -109,7 +184,7 @@ impl RobotRequest {
 
 /// Reads a terrain file or preset, an error naming the field `terrain`.
 pub fn load_terrain(terrain: &str) -> Result<Terrain> {
-    sandslope_io::load_terrain(terrain).map_err(|e| RequestError::from_error(Some("terrain"), e))
+    sandslope_io::load_terrain(terrain).map_err(|e| RequestError::from_error(Some(TERRAIN.flag), e))
 }
 
 /// The slopes (degrees, signed as given) strictly above the terrain's last measured point,
@@ -184,12 +259,13 @@ impl ScenarioRequest {
     /// Reads the robot's fields, `terrain`, `k-n`, `k-s` and `level-step`.
     pub fn from_params(p: &mut Params<'_>) -> Result<ScenarioRequest> {
         let robot = RobotRequest::from_params(p)?;
-        let terrain = p.text_or("terrain", DEFAULT_TERRAIN)?;
-        let k_n = p.number("k-n")?;
-        let k_s = p.number("k-s")?;
-        let level_step = match p.text("level-step")? {
-            Some(text) => parse_level_step(text)
-                .map_err(|why| RequestError::invalid("level-step", format!("--level-step: {why}")))?,
+        let terrain = TERRAIN.text_in(p)?.unwrap_or(DEFAULT_TERRAIN).to_string();
+        let k_n = K_N.number_in(p)?;
+        let k_s = K_S.number_in(p)?;
+        let level_step = match LEVEL_STEP.text_in(p)? {
+            Some(text) => parse_level_step(text).map_err(|why| {
+                RequestError::invalid(LEVEL_STEP.flag, format!("{}: {why}", LEVEL_STEP.long()))
+            })?,
             None => LevelStep::Slope,
         };
         Ok(ScenarioRequest { robot, terrain, k_n, k_s, level_step })
@@ -197,8 +273,8 @@ impl ScenarioRequest {
 
     /// The library's scenario: the resistances checked, the robot and terrain read.
     pub fn scenario(&self) -> Result<Scenario> {
-        let k_n = self.k_n.map(|v| check_resistance("k-n", v)).transpose()?;
-        let k_s = self.k_s.map(|v| check_resistance("k-s", v)).transpose()?;
+        let k_n = self.k_n.map(|v| check_resistance(K_N.flag, v)).transpose()?;
+        let k_s = self.k_s.map(|v| check_resistance(K_S.flag, v)).transpose()?;
         let robot = self.robot.load()?.with_level_step(self.level_step);
         Scenario::new(robot, load_terrain(&self.terrain)?, k_n, k_s)
             .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))

@@ -12,9 +12,195 @@ use sandslope::simulate::{
 use sandslope::{ParamError, Scenario, SignedSlope};
 
 use crate::error::{check_range, RequestError, Result, Words};
+use crate::field::{Field, Fields, Kind, Table};
 use crate::grammar::{parse_slope_list, SlopeSign};
 use crate::params::Params;
 use crate::scenario::ScenarioRequest;
+
+/// `--slope`: one walk's slope.
+pub const SLOPE: Field = Field::number("slope", "DEG")
+    .keyword("slope_deg")
+    .key("slope_deg")
+    .unit("deg")
+    .range("strictly between -90 and 90")
+    .help("Slope, degrees (negative: walking downhill)");
+/// `--slopes`: walks in parallel.
+pub const SLOPES: Field = Field::text("slopes", "MIN:MAX:N").unit("deg").conflicts(&["slope"]).help(
+    "Slopes, degrees, simulated in parallel (instead of --slope): DEG,DEG,... or MIN:MAX:N \
+     (N evenly spaced, ends included), as risk --slope takes them.",
+);
+/// `--duration`: simulated time after settling.
+pub const DURATION: Field = Field::number("duration", "S")
+    .keyword("duration_s")
+    .key("duration_s")
+    .unit("s")
+    .default("10")
+    .range("at least 1.5 T")
+    .help(
+        "Simulated time after settling, s (at least 1.5 T: one stride to settle into the gait, \
+         then steps to measure).",
+    );
+/// `--dt`: the time step.
+pub const DT: Field =
+    Field::number("dt", "S").keyword("dt_s").key("dt_s").unit("s").range("at most T / 100").help(
+        "Time step, s (default: T / 2000, 0.5 ms for the paper's robot; at most T / 100; \
+     docs/model.md §17).",
+    );
+/// `--creep`: the contact law's creep speed.
+pub const CREEP: Field = Field::number("creep", "M/S")
+    .keyword("creep_m_s")
+    .key("creep_m_s")
+    .unit("m/s")
+    .range("1e-9 to 1e-3")
+    .help(
+        "Creep speed of the contact law's smoothing at rest, m/s (default 1e-7; 1e-9 to 1e-3; \
+         docs/model.md §17): a numerical setting, which moves no converged answer.",
+    );
+/// `--no-servo-limit` (Python: `servo_limit=False`).
+pub const NO_SERVO_LIMIT: Field = Field::switch("no-servo-limit").keyword("servo_limit").help(
+    "Drive the legs as ideal position servos even where the robot file gives a servo torque \
+     limit (by default the limit applies, docs/model.md §15).",
+);
+/// `--body-pitch`.
+pub const BODY_PITCH: Field = Field::new("body-pitch", Kind::Choice(&["free", "locked"]), "MODE")
+    .keyword("body_pitch")
+    .default("locked")
+    .help(
+        "Whether the body may pitch: `locked` (the default) holds it parallel to the slope, the \
+         closed form's assumption and the setting whose answers converge; `free` lets it pitch, \
+         rear and tumble, chaotic on slopes: one walk is one draw of a spread (docs/simulate.md).",
+    );
+/// `--rft-scaling`.
+pub const RFT_SCALING: Field =
+    Field::new("rft-scaling", Kind::Choice(&["motion", "components", "li2013"]), "MODE")
+        .keyword("rft_scaling")
+        .default("motion")
+        .help(
+            "How resistive force theory is scaled to the terrain's k_n and k_s: `motion` (one \
+             scale that follows the direction of motion), `components` (normal stress by k_n, \
+             shear stress by k_s) or `li2013` (Li, Zhang and Goldman 2013: one factor from k_n, \
+             k_s unused), docs/model.md §16.",
+        );
+/// `--leg-friction` (docs/model.md §20.1).
+pub const LEG_FRICTION: Field =
+    Field::number("leg-friction", "MU").keyword("leg_friction").key("leg_friction").range("0 to 10").help(
+        "Leg-sand friction coefficient (0 to 10): the stress along a leg element's surface at \
+         most MU times the stress normal to it (docs/model.md §20.1; default: none, resistive \
+         force theory's stresses as they are).",
+    );
+/// `--duty-cycle` (docs/model.md §20.2).
+pub const DUTY_CYCLE: Field = Field::number("duty-cycle", "D")
+    .keyword("duty_cycle")
+    .key("duty_cycle")
+    .default("0.5")
+    .range("0.1 to 0.9")
+    .help(
+        "Share of the stride period over which a leg turns the half turn from its touchdown, \
+         0.1 to 0.9 (docs/model.md §20.2; 0.5: one speed all round, the paper's gait).",
+    );
+/// `--disturbed-sand` (docs/model.md §20.3).
+pub const DISTURBED_SAND: Field = Field::number("disturbed-sand", "F")
+    .keyword("disturbed_sand")
+    .key("disturbed_sand")
+    .default("1")
+    .range("greater than 0, at most 1")
+    .help(
+        "Resistance of sand a leg passed through in an earlier stance, as a share of the \
+         undisturbed sand's, greater than 0 and at most 1 (docs/model.md §20.3, the trench; \
+         1: as strong as before).",
+    );
+/// `--one-sided-belly` (docs/model.md §20.5).
+pub const ONE_SIDED_BELLY: Field = Field::switch("one-sided-belly").keyword("one_sided_belly").help(
+    "The belly as the body's underside, sand below it only: it pushes and never pulls the \
+     body down, its drag capped by its push (docs/model.md §20.5; default: a plate in sand \
+     on both faces, as resistive force theory's plates were).",
+);
+/// `--actuator` (docs/model.md §20.6).
+pub const ACTUATOR: Field = Field::new("actuator", Kind::Choice(&["ideal", "servo"]), "ideal|servo")
+    .keyword("actuator")
+    .default("ideal")
+    .help(
+        "What turns the legs: `ideal` (position sources that follow the gait whatever the sand \
+         resists, the default) or `servo` (the XL330-M288's motor, its torque-speed line and \
+         current limit, the leg rates solved with the body's; docs/model.md §20.6).",
+    );
+/// `--ensemble` (Python: `walks`).
+pub const ENSEMBLE: Field = Field::number("ensemble", "N")
+    .keyword("walks")
+    .key("ensemble")
+    .range("a whole number from 2 to 1000")
+    .conflicts(&["slopes"])
+    .help(
+        "Walk the one slope N times (2 to 1000), the robot's mass perturbed by 1e-9 relative \
+         between walks, and give the spread: mean speed, its SD and standard error, mean t1, the \
+         regimes' counts, how many pitched over. For the free body, whose walk on a slope is \
+         chaotic, the spread is the answer (docs/simulate.md, \"Pitch free\").",
+    );
+/// `--check-convergence` (Python: `sandslope.check_convergence`).
+pub const CHECK_CONVERGENCE: Field = Field::switch("check-convergence").help(
+    "Walk the slope (or each of --slopes) again at a quarter of the time step and at a tenth \
+     of the creep speed, and say whether the answer is converged: speed, and the spread of the \
+     steps' speeds, within 3% (or 0.3 cm/s), t1 within 1 ms and the same regime \
+     (docs/simulate.md, \"Checking convergence\"). The default step is shown converged for the \
+     built-in robot and terrain only; check your own. With --ensemble N each setting is N \
+     walks, their means compared (a single free-pitch walk on a slope is chaotic and cannot \
+     converge).",
+);
+/// `--rate` (Python: `sample_rate_hz`).
+pub const RATE: Field = Field::number("rate", "HZ")
+    .keyword("sample_rate_hz")
+    .key("sample_rate_hz")
+    .unit("Hz")
+    .default("120")
+    .range("greater than 0")
+    .help("Trajectory sample rate for --out, --plot and --animate, Hz");
+
+/// `simulate`'s own fields (the robot's and terrain's are [`crate::scenario::FIELDS`]).
+pub const FIELDS: Table = Table {
+    command: "simulate",
+    fields: &[
+        SLOPE,
+        SLOPES,
+        DURATION,
+        DT,
+        CREEP,
+        NO_SERVO_LIMIT,
+        BODY_PITCH,
+        RFT_SCALING,
+        LEG_FRICTION,
+        DUTY_CYCLE,
+        DISTURBED_SAND,
+        ONE_SIDED_BELLY,
+        ACTUATOR,
+        ENSEMBLE,
+        CHECK_CONVERGENCE,
+        RATE,
+    ],
+};
+
+/// A walk's settings' fields (what [`SettingsRequest::read`] reads): every front end's, Python's
+/// three simulate functions' keywords among them.
+pub const SETTINGS: Table = Table {
+    command: "simulate",
+    fields: &[
+        DURATION,
+        DT,
+        CREEP,
+        NO_SERVO_LIMIT,
+        BODY_PITCH,
+        RFT_SCALING,
+        LEG_FRICTION,
+        DUTY_CYCLE,
+        DISTURBED_SAND,
+        ONE_SIDED_BELLY,
+        ACTUATOR,
+        RATE,
+    ],
+};
+
+impl Fields for SimulateRequest {
+    const TABLE: Table = FIELDS;
+}
 
 /// Most slopes one request simulates (the library's limit on the command line).
 pub const MAX_SLOPES: usize = 1000;
@@ -67,31 +253,26 @@ pub struct SimulateRequest {
 
 /// Parses the field `slopes`: the one slope-list grammar, signed, at most [`MAX_SLOPES`].
 pub fn parse_slopes(text: &str) -> Result<Vec<f64>> {
-    parse_slope_list("slopes", text, SlopeSign::Signed, MAX_SLOPES)
+    parse_slope_list(SLOPES.flag, text, SlopeSign::Signed, MAX_SLOPES)
 }
 
-/// A library error with its keys renamed to the request's fields.
+/// A library error with its key renamed to the request's field (by [`FIELDS`]; a slope
+/// range's `step` and `from` are the field `slopes`).
 fn flagged(e: ParamError) -> RequestError {
     let field = match e.key.as_str() {
-        "duration_s" => "duration",
-        "dt_s" => "dt",
-        "slope_deg" => "slope",
-        "creep_m_s" => "creep",
-        "sample_rate_hz" => "rate",
-        "ensemble" => "ensemble",
-        "leg_friction" => "leg-friction",
-        "duty_cycle" => "duty-cycle",
-        "disturbed_sand" => "disturbed-sand",
-        "step" | "from" => "slopes",
-        _ => return RequestError::from_error(None, anyhow::anyhow!("{e}")),
+        "step" | "from" => Some(&SLOPES),
+        key => FIELDS.by_key(key),
     };
-    let flag = format!("--{field}");
-    RequestError::invalid(field, e.renamed(flag))
+    match field {
+        Some(f) => RequestError::invalid(f.flag, e.renamed(f.long())),
+        None => RequestError::from_error(None, anyhow::anyhow!("{e}")),
+    }
 }
 
-/// A library error with its key as Python's keyword (the ensemble's size is `walks` there).
+/// A library error with its key as Python's keyword (by [`FIELDS`]: the ensemble's size is
+/// `walks` there).
 fn keyworded(e: ParamError) -> RequestError {
-    let field = if e.key == "ensemble" { "walks".to_string() } else { e.key.clone() };
+    let field = FIELDS.by_key(&e.key).map_or_else(|| e.key.clone(), |f| f.keyword.to_string());
     RequestError::invalid(field.clone(), e.renamed(field))
 }
 
@@ -103,52 +284,55 @@ fn sim_err(e: SimulateError, words: Words) -> RequestError {
 }
 
 impl SimulateRequest {
-    /// Reads the fields of a simulate request; refuses any other key.
+    /// Reads the fields of a simulate request, each by its row of [`FIELDS`]; refuses any
+    /// other key.
     pub fn from_params(params: &[(String, String)]) -> Result<SimulateRequest> {
-        let mut p = Params::new("simulate", params);
-        let slope = p.number("slope")?;
-        let slopes = match (slope, p.text("slopes")?) {
+        Self::read(params, None)
+    }
+
+    /// The command line's request: its own fields from `params` (the flags given, by
+    /// [`FIELDS`]), the scenario already read from the flags it shares with other commands.
+    pub fn with_scenario(params: &[(String, String)], scenario: ScenarioRequest) -> Result<SimulateRequest> {
+        Self::read(params, Some(scenario))
+    }
+
+    fn read(params: &[(String, String)], scenario: Option<ScenarioRequest>) -> Result<SimulateRequest> {
+        let mut p = Params::new(FIELDS.command, params);
+        let slope = SLOPE.number_in(&mut p)?;
+        let slopes = match (slope, SLOPES.text_in(&mut p)?) {
             (Some(_), Some(_)) => {
-                return Err(RequestError::invalid("slopes", "--slopes cannot be used with --slope: give one"))
+                return Err(RequestError::invalid(
+                    SLOPES.flag,
+                    format!("{} cannot be used with {}: give one", SLOPES.long(), SLOPE.long()),
+                ))
             }
             (Some(deg), None) => SimSlopes::One(deg),
             (None, Some(text)) => SimSlopes::Many(parse_slopes(text)?),
-            (None, None) => return Err(RequestError::invalid("slope", "--slope or --slopes is required")),
+            (None, None) => {
+                return Err(RequestError::invalid(
+                    SLOPE.flag,
+                    format!("{} or {} is required", SLOPE.long(), SLOPES.long()),
+                ))
+            }
         };
-        let duration_s = p.number_or("duration", 10.0)?;
-        let dt_s = p.number("dt")?;
-        let creep_m_s = p.number("creep")?;
-        let servo_limit = !p.flag("no-servo-limit")?;
-        let body_pitch = match p.text("body-pitch")? {
-            None => BodyPitch::default(),
-            Some(text) => parse_body_pitch(text, Words::Flag)?,
+        let settings = SettingsRequest::read(&mut p, Words::Flag)?;
+        let ensemble = ENSEMBLE.number_in(&mut p)?.map(|n| ensemble_size(n, &slopes)).transpose()?;
+        let check_convergence = CHECK_CONVERGENCE.switch_in(&mut p)?;
+        let scenario = match scenario {
+            Some(s) => s,
+            None => ScenarioRequest::from_params(&mut p)?,
         };
-        let rft_scaling = match p.text("rft-scaling")? {
-            None => RftScaling::default(),
-            Some(text) => parse_rft_scaling(text, Words::Flag)?,
-        };
-        let defaults = Mechanisms::default();
-        let mechanisms = Mechanisms {
-            leg_friction: p.number("leg-friction")?,
-            duty_cycle: p.number_or("duty-cycle", defaults.duty_cycle)?,
-            disturbed_sand: p.number_or("disturbed-sand", defaults.disturbed_sand)?,
-            one_sided_belly: p.flag("one-sided-belly")?,
-            servo_actuator: match p.text("actuator")? {
-                None | Some("ideal") => false,
-                Some("servo") => true,
-                Some(other) => {
-                    return Err(RequestError::invalid(
-                        "actuator",
-                        format!("--actuator = `{other}` must be one of: ideal, servo"),
-                    ))
-                }
-            },
-        };
-        let rate_hz = p.number_or("rate", 120.0)?;
-        let ensemble = p.number("ensemble")?.map(|n| ensemble_size(n, &slopes)).transpose()?;
-        let check_convergence = p.flag("check-convergence")?;
-        let scenario = ScenarioRequest::from_params(&mut p)?;
         p.finish()?;
+        let SettingsRequest {
+            duration_s,
+            dt_s,
+            creep_m_s,
+            servo_limit,
+            body_pitch,
+            rft_scaling,
+            mechanisms,
+            rate_hz,
+        } = settings;
         Ok(SimulateRequest {
             slopes,
             scenario,
@@ -194,9 +378,9 @@ impl SimulateRequest {
         };
         let (slopes, many) = match &self.slopes {
             SimSlopes::Many(slopes) => {
-                (slopes.iter().map(|&d| signed(d, "slopes")).collect::<Result<Vec<_>>>()?, true)
+                (slopes.iter().map(|&d| signed(d, SLOPES.flag)).collect::<Result<Vec<_>>>()?, true)
             }
-            SimSlopes::One(slope) => (vec![signed(check_slope(*slope)?, "slope")?], false),
+            SimSlopes::One(slope) => (vec![signed(check_slope(*slope)?, SLOPE.flag)?], false),
         };
         Ok(Walks {
             scenario,
@@ -238,6 +422,41 @@ pub struct SettingsRequest {
 }
 
 impl SettingsRequest {
+    /// Reads the settings' fields ([`SETTINGS`]) from `p`, each given or its default; a choice
+    /// not among its words is refused naming the field in `words`.
+    pub fn read(p: &mut Params<'_>, words: Words) -> Result<SettingsRequest> {
+        let number = |f: &Field, p: &mut Params<'_>| f.required_number_in(p);
+        let duration_s = number(&DURATION, p)?;
+        let dt_s = DT.number_in(p)?;
+        let creep_m_s = CREEP.number_in(p)?;
+        let servo_limit = !NO_SERVO_LIMIT.switch_in(p)?;
+        let body_pitch = parse_body_pitch(BODY_PITCH.text_in(p)?.unwrap_or_default(), words)?;
+        let rft_scaling = parse_rft_scaling(RFT_SCALING.text_in(p)?.unwrap_or_default(), words)?;
+        let mechanisms = Mechanisms {
+            leg_friction: LEG_FRICTION.number_in(p)?,
+            duty_cycle: number(&DUTY_CYCLE, p)?,
+            disturbed_sand: number(&DISTURBED_SAND, p)?,
+            one_sided_belly: ONE_SIDED_BELLY.switch_in(p)?,
+            servo_actuator: choose(
+                ACTUATOR.flag,
+                ACTUATOR.text_in(p)?.unwrap_or_default(),
+                &[("ideal", false), ("servo", true)],
+                words,
+            )?,
+        };
+        let rate_hz = number(&RATE, p)?;
+        Ok(SettingsRequest {
+            duration_s,
+            dt_s,
+            creep_m_s,
+            servo_limit,
+            body_pitch,
+            rft_scaling,
+            mechanisms,
+            rate_hz,
+        })
+    }
+
     /// The settings, checked; errors name the field in `words` (Python's keywords are the
     /// library's own keys: `duration_s`, `dt_s`, `creep_m_s`, `sample_rate_hz`).
     pub fn settings(&self, words: Words) -> Result<SimSettings> {
@@ -283,7 +502,7 @@ fn choose<T: Copy>(field: &str, text: &str, options: &[(&str, T)], words: Words)
 
 /// Parses a body-pitch setting: `free` or `locked`.
 pub fn parse_body_pitch(text: &str, words: Words) -> Result<BodyPitch> {
-    choose("body-pitch", text, &[("free", BodyPitch::Free), ("locked", BodyPitch::Locked)], words)
+    choose(BODY_PITCH.flag, text, &[("free", BodyPitch::Free), ("locked", BodyPitch::Locked)], words)
 }
 
 /// Parses an RFT scaling: `motion`, `components` or `li2013`.
@@ -293,7 +512,7 @@ pub fn parse_rft_scaling(text: &str, words: Words) -> Result<RftScaling> {
         ("components", RftScaling::Components),
         ("li2013", RftScaling::Li2013),
     ];
-    choose("rft-scaling", text, &options, words)
+    choose(RFT_SCALING.flag, text, &options, words)
 }
 
 /// Checks an ensemble's size (a whole number from 2 to 1000) and that it has one slope.
@@ -301,14 +520,14 @@ pub fn ensemble_size(n: f64, slopes: &SimSlopes) -> Result<usize> {
     let (lo, hi) = sandslope::simulate::ensemble::ENSEMBLE_RANGE;
     if !(n.fract() == 0.0 && n >= lo as f64 && n <= hi as f64) {
         return Err(RequestError::invalid(
-            "ensemble",
-            format!("--ensemble = {n} must be a whole number of walks from {lo} to {hi}"),
+            ENSEMBLE.flag,
+            format!("{} = {n} must be a whole number of walks from {lo} to {hi}", ENSEMBLE.long()),
         ));
     }
     if matches!(slopes, SimSlopes::Many(_)) {
         return Err(RequestError::invalid(
-            "ensemble",
-            "--ensemble walks one slope: give --slope, not --slopes",
+            ENSEMBLE.flag,
+            format!("{} walks one slope: give {}, not {}", ENSEMBLE.long(), SLOPE.long(), SLOPES.long()),
         ));
     }
     Ok(n as usize)
@@ -316,10 +535,10 @@ pub fn ensemble_size(n: f64, slopes: &SimSlopes) -> Result<usize> {
 
 /// One walk's slope: strictly between -90 and 90 degrees.
 pub fn check_slope(slope: f64) -> Result<f64> {
-    check_range("slope", slope, -89.999_999, 89.999_999).map_err(|_| {
+    check_range(SLOPE.flag, slope, -89.999_999, 89.999_999).map_err(|_| {
         RequestError::invalid(
-            "slope",
-            format!("--slope = {slope} must be strictly between -90 and 90 degrees"),
+            SLOPE.flag,
+            format!("{} = {slope} must be strictly between -90 and 90 degrees", SLOPE.long()),
         )
     })
 }
@@ -525,6 +744,30 @@ mod tests {
         assert_eq!(e.message(), "--rft-scaling = `shear` must be motion, components or li2013");
         let e = parse_rft_scaling("shear", Words::Keyword).unwrap_err();
         assert_eq!(e.message(), r#"rft_scaling = "shear": expected "motion" or "components" or "li2013""#);
+    }
+
+    /// The table's defaults are the library's: what a request without the field walks with is
+    /// what `SimSettings::new` and `Mechanisms::default` give.
+    #[test]
+    fn the_tables_defaults_are_the_librarys() {
+        let none = params(&[]);
+        let read = SettingsRequest::read(&mut Params::new("simulate", &none), Words::Flag).unwrap();
+        let library = SimSettings::new(10.0).unwrap();
+        assert_eq!(read.duration_s, 10.0);
+        assert_eq!(read.rate_hz, library.sample_rate_hz);
+        assert_eq!(read.rate_hz, sandslope::simulate::DEFAULT_SAMPLE_RATE_HZ);
+        assert_eq!(read.mechanisms, Mechanisms::default());
+        assert_eq!((read.body_pitch, read.rft_scaling), (BodyPitch::default(), RftScaling::default()));
+        assert!(read.servo_limit);
+        assert_eq!(read.settings(Words::Flag).unwrap(), library);
+        // Every library key the settings' checks name is a field's, the fallback gone.
+        for key in ["duration_s", "dt_s", "creep_m_s", "sample_rate_hz", "leg_friction", "duty_cycle"] {
+            assert!(FIELDS.by_key(key).is_some(), "{key}");
+        }
+        let e = flagged(ParamError::new("sample_rate_hz", -1.0, "greater than 0"));
+        assert_eq!(e.field(), Some("rate"));
+        assert!(e.message().starts_with("--rate = -1"), "{}", e.message());
+        assert_eq!(keyworded(ParamError::new("ensemble", 1.0, "2 to 1000")).field(), Some("walks"));
     }
 
     /// Python's keywords are the library's keys; the command line's are its flags.

@@ -22,8 +22,9 @@ use std::thread::JoinHandle;
 
 use serde::Serialize;
 
+use sandslope_io::foxglove::DriveStream;
 use sandslope_servo::driver::{DriveReport, LiveEstimate, ServoSample, TorqueOff};
-use sandslope_servo::log::{drive_logged, LogTarget};
+use sandslope_servo::log::{drive_logged, live_record, log_row, LogTarget};
 use sandslope_servo::session::{emulator_summary, DriveConfig, Session};
 use sandslope_servo::speed::LegSpeedMeter;
 use sandslope_servo::DriveOutcome;
@@ -157,7 +158,13 @@ pub struct LogFile {
 
 impl DriveThread {
     /// Starts driving an opened session on a thread of its own.
-    pub fn start(session: Session, flags: SignalFlags, log: Option<LogFile>) -> std::io::Result<DriveThread> {
+    /// `foxglove`, when given, streams the run (its header already sent) to Foxglove.
+    pub fn start(
+        session: Session,
+        flags: SignalFlags,
+        log: Option<LogFile>,
+        foxglove: Option<DriveStream>,
+    ) -> std::io::Result<DriveThread> {
         let config: &DriveConfig = session.config();
         let live = Arc::new(LiveDrive {
             status: Mutex::new(DriveStatus {
@@ -176,7 +183,7 @@ impl DriveThread {
         let shared = Arc::clone(&live);
         let handle = std::thread::Builder::new()
             .name("drive".into())
-            .spawn(move || run(session, &shared, flags, log))
+            .spawn(move || run(session, &shared, flags, log, foxglove))
             .inspect_err(|_| flags.driving.store(false, Ordering::SeqCst))?;
         Ok(DriveThread { live, handle: Some(handle), stop: flags.stop })
     }
@@ -201,7 +208,13 @@ macro_rules! say {
 
 /// The drive thread: the run, its status kept for the page, torque off, then (after a
 /// signal) the end of the process.
-fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<LogFile>) {
+fn run(
+    mut session: Session,
+    live: &LiveDrive,
+    flags: SignalFlags,
+    log: Option<LogFile>,
+    foxglove: Option<DriveStream>,
+) {
     // Either flag stops the gait: the stop button's or the signal handler's.
     let stop = AtomicBool::new(false);
     // Each leg's speed from its positions a stride period apart, as the run's report gives it.
@@ -213,6 +226,9 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
     let mut on_sample = |s: &ServoSample| {
         if live.stop.load(Ordering::Relaxed) || flags.stop.load(Ordering::Relaxed) {
             stop.store(true, Ordering::Relaxed);
+        }
+        if let Some(f) = &foxglove {
+            f.row(log_row(s));
         }
         meter.observe(s.leg, s.time_s, s.leg_angle_rad);
         let speed = meter.mean();
@@ -230,6 +246,9 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
         });
     };
     let mut on_live = |l: &LiveEstimate| {
+        if let Some(f) = &foxglove {
+            f.live(&live_record(l));
+        }
         live.update(|st| {
             st.estimates += 1;
             if let Some(p) = st.stop_on_risk {
@@ -253,6 +272,12 @@ fn run(mut session: Session, live: &LiveDrive, flags: SignalFlags, log: Option<L
     };
     if let (Err(e), None) = (committed, &failure) {
         failure = Some(format!("the log could not be put in place: {e:#}"));
+    }
+    if let Some(f) = foxglove {
+        f.finish(&sandslope_io::mcap_out::verdict_text(
+            &report.outcome,
+            failure.as_ref().map(|e| e as &dyn std::fmt::Display),
+        ));
     }
     finish(live, &report, failure.as_deref(), emulator);
     if let Some(l) = &log {

@@ -68,6 +68,9 @@ pub struct ServeConfig {
     pub drive: Option<(DriveConfig, drive::SignalFlags)>,
     /// The driven run's log (`--log`), written as `sandslope drive --log` writes it.
     pub drive_log: Option<PathBuf>,
+    /// Stream the driven run to Foxglove on this address (`--foxglove`), as `sandslope drive
+    /// --foxglove` does (docs/bags.md, "Watch live").
+    pub drive_foxglove: Option<String>,
 }
 
 /// Checks a timeout flag: a finite number of seconds in 0.1..=86400.
@@ -119,6 +122,11 @@ pub fn run(args: ServeConfig) -> Result<()> {
     if let Some(p) = &args.drive_log {
         sandslope_io::files::check_parent_exists(p)?;
     }
+    // The Foxglove server first: a port already taken stops the command before anything moves.
+    let foxglove = match (&args.drive, &args.drive_foxglove) {
+        (Some(_), Some(addr)) => Some(sandslope_io::foxglove::DriveStream::start(addr)?),
+        _ => None,
+    };
     let session = match args.drive {
         Some((config, flags)) => Some((Session::open(config)?, flags)),
         None => None,
@@ -140,7 +148,10 @@ pub fn run(args: ServeConfig) -> Result<()> {
                 robot: args.robot.clone(),
                 terrain: args.terrain.clone(),
             });
-            let thread = drive::DriveThread::start(session, flags, log)?;
+            if let Some(f) = &foxglove {
+                f.header(&sandslope_servo::log::log_meta(&session, &args.robot, &args.terrain));
+            }
+            let thread = drive::DriveThread::start(session, flags, log, foxglove)?;
             server.show_drive(std::sync::Arc::clone(&thread.live));
             eprintln!(
                 "driving {servos} servos: the page's Drive tab shows the run; its stop button or Ctrl-C stops the gait and turns the torque off"

@@ -26,8 +26,9 @@ impl Served {
     /// Reads everything the server will use now, so a bad file fails at start, not per request.
     pub fn load(robot: String, terrain: String, dem: Option<PathBuf>) -> anyhow::Result<Served> {
         use anyhow::Context;
-        sandslope_io::load_robot(&robot).context("--robot")?;
-        sandslope_io::load_terrain(&terrain).context("--terrain")?;
+        use sandslope_request::scenario::{ROBOT, TERRAIN};
+        sandslope_io::load_robot(&robot).with_context(|| ROBOT.long())?;
+        sandslope_io::load_terrain(&terrain).with_context(|| TERRAIN.long())?;
         let dem_info = match &dem {
             Some(path) => Some(DemInfo::of(&sandslope_io::raster::read_raster(path)?)),
             None => None,

@@ -3,7 +3,7 @@
 //! writes and its guards all read these; none of them is read back from the driver.
 
 use dynamixel2::Bus;
-use sandslope::servo::xl330;
+use sandslope::servo::{model::RAD_PER_PULSE, ServoModel};
 use serde::Serialize;
 
 /// One servo as mounted on the robot (the robot file's `[servos]` table).
@@ -21,17 +21,17 @@ pub struct ServoConfig {
 impl ServoConfig {
     /// Goal position, pulses, for leg angle `angle` rad.
     pub fn pulses(&self, angle: f64) -> i32 {
-        let p = self.zero_offset_pulses as f64 + f64::from(self.direction) * angle / xl330::RAD_PER_PULSE;
+        let p = self.zero_offset_pulses as f64 + f64::from(self.direction) * angle / RAD_PER_PULSE;
         p.round().clamp(i32::MIN as f64, i32::MAX as f64) as i32
     }
 
     /// Leg angle, rad, at shaft position `pulses`.
     pub fn angle(&self, pulses: i32) -> f64 {
-        f64::from(self.direction) * f64::from(pulses - self.zero_offset_pulses) * xl330::RAD_PER_PULSE
+        f64::from(self.direction) * f64::from(pulses - self.zero_offset_pulses) * RAD_PER_PULSE
     }
 }
 
-/// How the gait is commanded (the XL330's velocity-based profile either way).
+/// How the gait is commanded (the servo's velocity-based profile either way).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Profile {
@@ -53,9 +53,13 @@ pub struct DriveSettings {
     pub duration_s: f64,
     /// Cycles per second the driver aims at.
     pub rate_hz: f64,
-    /// Current Limit written to every servo, mA (at most 1750).
+    /// The servos' model as the robot file names it (`[servos] model`); `None`: the model the
+    /// servos report at their ping, whichever supported one it is. Every servo must be the same.
+    pub servo: Option<&'static ServoModel>,
+    /// Current Limit written to every servo, mA (at most the model's; not written to a model
+    /// without current control, the XL430-W250).
     pub current_limit_ma: u16,
-    /// Temperature Limit written to every servo, degC (at most 70).
+    /// Temperature Limit written to every servo, degC (at most the model's rated maximum).
     pub temperature_limit_c: u8,
     /// Longest cycle the driver accepts before it stops everything, s.
     pub watchdog_s: f64,

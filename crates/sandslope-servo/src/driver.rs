@@ -24,7 +24,7 @@ use dynamixel2::ReadError;
 use sandslope::infer::servo::{infer_from_stance, CurrentInference, ModelGrid};
 use sandslope::risk::UncertainTerrain;
 use sandslope::servo::verdict::{pool, prior_p_fail, PooledEstimate};
-use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::servo::{GaitSchedule, ServoModel};
 use sandslope::{Robot, Slope};
 use serde::Serialize;
 
@@ -55,8 +55,15 @@ pub struct ServoSample {
     pub goal_position: i32,
     /// Leg angle in the gait's frame, rad.
     pub leg_angle_rad: f64,
-    /// Drive torque `K_t I` in the leg's direction of rotation, N m (docs/model.md §19).
+    /// Drive torque `K_t I` in the leg's direction of rotation, N m (docs/model.md §19), by
+    /// the servos' model ([`ServoModel::torque_from_reading`]).
     pub drive_torque_n_m: f64,
+    /// The motor current the reading of address 126 stands for, mA (the servo's own sign).
+    #[serde(skip)]
+    pub current_ma: f64,
+    /// The reading as a share of the model's stall torque, % (the servo's own sign).
+    #[serde(skip)]
+    pub load_percent: f64,
 }
 
 /// One live estimate, after one stance.
@@ -235,6 +242,8 @@ struct Stand {
 
 /// The stride loop's state between cycles.
 struct Walk<'m> {
+    /// The servos' model, read at the ping.
+    model: &'static ServoModel,
     ids: Vec<u8>,
     stand: Stand,
     /// Per servo: failed reads in a row and whether they were CRC failures.
@@ -293,6 +302,7 @@ fn run(
     let ids: Vec<u8> = settings.servos.iter().map(|s| s.id).collect();
     let stand = stand_up(bus, schedule, settings, &ids)?;
     let mut walk = Walk {
+        model: report.setup.model.unwrap_or(&ServoModel::XL330_M288),
         failures: vec![(0usize, false); ids.len()],
         last_pos: vec![None; ids.len()],
         monitor: monitor.map(|m| {
@@ -484,7 +494,7 @@ impl Walk<'_> {
         goals: &[i32],
         time: f64,
     ) -> Result<Vec<i32>, dynamixel2::WriteError> {
-        let limit = velocity_limit_units(schedule);
+        let limit = velocity_limit_units(schedule, self.model);
         let values: Vec<i32> = match settings.profile {
             Profile::Position => goals.to_vec(),
             Profile::Velocity => self
@@ -547,8 +557,8 @@ impl Walk<'_> {
                         0
                     };
                     let angle = s.angle(state.position) - self.stand.shift[j];
-                    let tau =
-                        f64::from(s.direction) * xl330::torque_from_current(f64::from(state.current_ma));
+                    let raw = f64::from(state.current_ma);
+                    let tau = f64::from(s.direction) * self.model.torque_from_reading(raw);
                     let sample = ServoSample {
                         time_s: time,
                         leg: j,
@@ -559,6 +569,8 @@ impl Walk<'_> {
                         goal_position: goals[j],
                         leg_angle_rad: angle,
                         drive_torque_n_m: tau,
+                        current_ma: self.model.current_ma_from_reading(raw),
+                        load_percent: self.model.load_percent_from_reading(raw),
                     };
                     on_sample(&sample)
                         .map_err(|e| DriveError::Log { time_s: time, reason: e.to_string() })?;

@@ -1,6 +1,7 @@
-//! A bus of virtual XL330-M288s on a pseudo-terminal (docs/drive.md, "The emulator").
+//! A bus of virtual Dynamixel servos (XL330-M288s by default, any model of
+//! [`crate::models`]) on a pseudo-terminal (docs/drive.md, "The emulator").
 //!
-//! Each virtual servo keeps the XL330's control table, answers Protocol 2.0 byte for byte
+//! Each virtual servo keeps its model's control table ([`crate::models`]), answers Protocol 2.0 byte for byte
 //! ([`crate::packet`]), moves its shaft as its operating mode and goal say (velocity-based
 //! profile: velocity and acceleration limits from Profile Velocity and Profile Acceleration,
 //! or the Velocity Limit) and reports as Present Current the torque its leg needs in the sand,
@@ -17,12 +18,14 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use sandslope::infer::servo::{sensor_walk_settings, simulated_legs, LegTrace};
-use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::servo::model as x;
+use sandslope::servo::GaitSchedule;
 use sandslope::simulate::simulate;
 use sandslope::{Robot, Scenario, Terrain};
 use serial2::SerialPort;
 
 use crate::driver::ServoConfig;
+use crate::models::ControlTable;
 use crate::packet::{self, error, inst, Instruction, Parsed, Parser};
 use crate::table::{self as t, mode};
 
@@ -68,7 +71,9 @@ pub struct EmulatorConfig {
     pub simulated_strides: usize,
     /// Faults to show.
     pub faults: EmulatorFaults,
-    /// Model number reported (1200, the XL330-M288; tests may set the e-Manual example's).
+    /// Model number reported (1200, the XL330-M288): a supported model's number makes the
+    /// servos that model (its control table and figures); another number (a test of the
+    /// driver's refusal) reports it over an XL330-M288's table.
     pub model_number: u16,
     /// Firmware version reported.
     pub firmware: u8,
@@ -93,7 +98,7 @@ impl EmulatorConfig {
             current_offset_ma: vec![],
             simulated_strides: 8,
             faults: EmulatorFaults::default(),
-            model_number: xl330::MODEL_NUMBER,
+            model_number: sandslope::servo::ServoModel::XL330_M288.model_number,
             firmware: 46,
             initial_turns: 0,
             clear_supported: true,
@@ -178,10 +183,11 @@ impl Walk {
 }
 
 /// The emulated position loop's gain, 1/s: a shaft 0.1 rad behind its goal turns at 4 rad/s
-/// (a time constant of 25 ms, the order of an XL330's step response at its default gains).
+/// (a time constant of 25 ms, the order of an X-series servo's step response at its default
+/// gains).
 pub const POSITION_GAIN_PER_S: f64 = 40.0;
 
-/// One virtual XL330.
+/// One virtual servo.
 #[derive(Debug, Clone)]
 struct VirtualServo {
     table: [u8; t::TABLE_SIZE],
@@ -200,10 +206,14 @@ struct VirtualServo {
     refuse_goals: bool,
     /// Knows the Clear instruction.
     clear_supported: bool,
+    /// Its model's control table.
+    ct: &'static ControlTable,
 }
 
 impl VirtualServo {
     fn new(config: ServoConfig, leg: usize, model: u16, firmware: u8) -> VirtualServo {
+        let ct = sandslope::servo::ServoModel::from_model_number(model)
+            .map_or(&crate::models::XL330_M288, ControlTable::of);
         let mut table = [0u8; t::TABLE_SIZE];
         let mut s = VirtualServo {
             table: [0; t::TABLE_SIZE],
@@ -217,6 +227,7 @@ impl VirtualServo {
             leg,
             refuse_goals: false,
             clear_supported: true,
+            ct,
         };
         table[0..2].copy_from_slice(&model.to_le_bytes());
         table[t::FIRMWARE_VERSION as usize] = firmware;
@@ -224,12 +235,12 @@ impl VirtualServo {
         table[t::BAUD_RATE as usize] = 3;
         table[t::RETURN_DELAY_TIME as usize] = 250;
         table[t::OPERATING_MODE as usize] = mode::POSITION;
-        table[t::TEMPERATURE_LIMIT as usize] = 70;
-        table[t::MAX_VOLTAGE_LIMIT as usize..][..2].copy_from_slice(&70u16.to_le_bytes());
-        table[t::MIN_VOLTAGE_LIMIT as usize..][..2].copy_from_slice(&35u16.to_le_bytes());
-        table[t::CURRENT_LIMIT as usize..][..2].copy_from_slice(&1750u16.to_le_bytes());
-        table[t::VELOCITY_LIMIT as usize..][..4].copy_from_slice(&445u32.to_le_bytes());
-        table[t::SHUTDOWN as usize] = 53;
+        table[t::TEMPERATURE_LIMIT as usize] = ct.temperature_limit;
+        table[t::MAX_VOLTAGE_LIMIT as usize..][..2].copy_from_slice(&ct.voltage_limits.0.to_le_bytes());
+        table[t::MIN_VOLTAGE_LIMIT as usize..][..2].copy_from_slice(&ct.voltage_limits.1.to_le_bytes());
+        table[t::CURRENT_LIMIT as usize..][..2].copy_from_slice(&ct.current_limit.to_le_bytes());
+        table[t::VELOCITY_LIMIT as usize..][..4].copy_from_slice(&ct.velocity_limit.to_le_bytes());
+        table[t::SHUTDOWN as usize] = ct.shutdown;
         table[t::STATUS_RETURN_LEVEL as usize] = 2;
         s.table = table;
         s
@@ -256,7 +267,7 @@ impl VirtualServo {
     fn leg_angle(&self) -> f64 {
         f64::from(self.config.direction)
             * (self.position - f64::from(self.config.zero_offset_pulses))
-            * xl330::RAD_PER_PULSE
+            * x::RAD_PER_PULSE
     }
 
     /// Moves the shaft to time `now` and refreshes the present values.
@@ -266,7 +277,7 @@ impl VirtualServo {
         let wd = self.u8_at(t::BUS_WATCHDOG);
         if self.torque_on()
             && (1..=127).contains(&wd)
-            && now - self.last_seen > f64::from(wd) * xl330::WATCHDOG_UNIT_S
+            && now - self.last_seen > f64::from(wd) * x::WATCHDOG_UNIT_S
         {
             // The watchdog fired: the servo stops where it is and marks it (e-Manual, Bus Watchdog).
             self.table[t::BUS_WATCHDOG as usize] = t::WATCHDOG_FIRED;
@@ -274,9 +285,9 @@ impl VirtualServo {
             self.put(t::GOAL_POSITION, &here.to_le_bytes());
             self.put(t::GOAL_VELOCITY, &0i32.to_le_bytes());
         }
-        let vel_limit = f64::from(self.i32_at(t::VELOCITY_LIMIT)) * xl330::RAD_S_PER_VELOCITY_UNIT;
-        let acc = f64::from(self.i32_at(t::PROFILE_ACCELERATION)) * xl330::RAD_S2_PER_ACCELERATION_UNIT;
-        let prof_v = f64::from(self.i32_at(t::PROFILE_VELOCITY)) * xl330::RAD_S_PER_VELOCITY_UNIT;
+        let vel_limit = f64::from(self.i32_at(t::VELOCITY_LIMIT)) * x::RAD_S_PER_VELOCITY_UNIT;
+        let acc = f64::from(self.i32_at(t::PROFILE_ACCELERATION)) * x::RAD_S2_PER_ACCELERATION_UNIT;
+        let prof_v = f64::from(self.i32_at(t::PROFILE_VELOCITY)) * x::RAD_S_PER_VELOCITY_UNIT;
         let fired = self.u8_at(t::BUS_WATCHDOG) == t::WATCHDOG_FIRED;
         let target_v = if !self.torque_on() {
             0.0
@@ -284,7 +295,7 @@ impl VirtualServo {
             if fired {
                 0.0
             } else {
-                (f64::from(self.i32_at(t::GOAL_VELOCITY)) * xl330::RAD_S_PER_VELOCITY_UNIT)
+                (f64::from(self.i32_at(t::GOAL_VELOCITY)) * x::RAD_S_PER_VELOCITY_UNIT)
                     .clamp(-vel_limit, vel_limit)
             }
         } else {
@@ -292,7 +303,7 @@ impl VirtualServo {
             // by the profile velocity, and by the speed from which the profile acceleration
             // can still stop at the goal (a trapezoidal profile: no overshoot).
             let vmax = if prof_v > 0.0 { prof_v.min(vel_limit) } else { vel_limit };
-            let to_go = (f64::from(self.i32_at(t::GOAL_POSITION)) - self.position) * xl330::RAD_PER_PULSE;
+            let to_go = (f64::from(self.i32_at(t::GOAL_POSITION)) - self.position) * x::RAD_PER_PULSE;
             let brake = if acc > 0.0 { (2.0 * acc * to_go.abs()).sqrt() } else { f64::INFINITY };
             (POSITION_GAIN_PER_S * to_go).clamp(-vmax.min(brake), vmax.min(brake))
         };
@@ -305,18 +316,25 @@ impl VirtualServo {
         if !self.torque_on() {
             self.velocity = 0.0;
         }
-        self.position += self.velocity * dt / xl330::RAD_PER_PULSE;
+        self.position += self.velocity * dt / x::RAD_PER_PULSE;
         // The leg's drive torque in the sand, as the servo's current (its own sign).
         let tau = if self.torque_on() { walk.torque(self.leg, self.leg_angle()) } else { 0.0 };
         let dir = f64::from(self.config.direction);
-        let current = dir * xl330::current_from_torque(tau) + noise.gauss() * noise_ma + self.offset_ma;
-        let limit = f64::from(self.u16_at(t::CURRENT_LIMIT));
-        let current = current.clamp(-limit, limit);
+        // The sensor's noise and bias are in mA (as a torque by K_t on a load-reporting model);
+        // the reading is in the model's units of address 126, within its Current Limit (or
+        // the load's +/-100 %).
+        let model = self.ct.model;
+        let tau_read = dir * tau + model.torque_from_current_ma(noise.gauss() * noise_ma + self.offset_ma);
+        let limit = if self.ct.current_control { f64::from(self.u16_at(t::CURRENT_LIMIT)) } else { 1000.0 };
+        let reading = model.reading_from_torque(tau_read).clamp(-limit, limit);
+        let current = model.current_ma_from_reading(reading);
+        let stall_ma = 1000.0 * model.stall_current_a;
         self.current_ema += (current * current - self.current_ema) * (dt / 30.0).min(1.0);
-        let temp = 28.0 + 25.0 * self.current_ema / (1470.0f64 * 1470.0);
-        let voltage = 50.0 - (current.abs() / 500.0).round() + noise.gauss().round().clamp(-1.0, 1.0);
-        self.put(t::PRESENT_CURRENT, &(current.round() as i16).to_le_bytes());
-        let v_units = (self.velocity / xl330::RAD_S_PER_VELOCITY_UNIT).round() as i32;
+        let temp = 28.0 + 25.0 * self.current_ema / (stall_ma * stall_ma);
+        let voltage = (10.0 * model.nominal_voltage_v).round() - (current.abs() / 500.0).round()
+            + noise.gauss().round().clamp(-1.0, 1.0);
+        self.put(t::PRESENT_CURRENT, &(reading.round() as i16).to_le_bytes());
+        let v_units = (self.velocity / x::RAD_S_PER_VELOCITY_UNIT).round() as i32;
         self.put(t::PRESENT_VELOCITY, &v_units.to_le_bytes());
         self.put(t::PRESENT_POSITION, &(self.position.round() as i32).to_le_bytes());
         self.put(t::PRESENT_INPUT_VOLTAGE, &(voltage.max(0.0) as u16).to_le_bytes());
@@ -348,6 +366,11 @@ impl VirtualServo {
         if (addr..addr + data.len() as u16).any(|a| a < 64 && matches!(a, 0..=6)) {
             return error::ACCESS;
         }
+        // A register the model does not have (the XL430-W250's Current Limit and Goal Current).
+        let touches = |reg: u16, width: u16| addr < reg + width && end > usize::from(reg);
+        if !self.ct.current_control && (touches(t::CURRENT_LIMIT, 2) || touches(t::GOAL_CURRENT, 2)) {
+            return error::ACCESS;
+        }
         if (self.u8_at(t::BUS_WATCHDOG) == t::WATCHDOG_FIRED || self.refuse_goals)
             && (addr == t::GOAL_POSITION || addr == t::GOAL_VELOCITY)
         {
@@ -357,7 +380,7 @@ impl VirtualServo {
         // Data Range Error, and nothing of the write is kept.
         let before = self.table;
         self.put(addr, data);
-        if t::out_of_range(&self.table, addr, end).is_some() {
+        if t::out_of_range(&self.table, addr, end, self.ct).is_some() {
             self.table = before;
             return error::DATA_RANGE;
         }
@@ -375,7 +398,7 @@ impl VirtualServo {
         if self.velocity.abs() > 0.01 {
             return error::RESULT_FAIL;
         }
-        self.position = self.position.rem_euclid(xl330::PULSES_PER_REV);
+        self.position = self.position.rem_euclid(x::PULSES_PER_REV);
         self.put(t::PRESENT_POSITION, &(self.position.round() as i32).to_le_bytes());
         0
     }
@@ -449,7 +472,7 @@ impl VirtualBus {
                 let mut s = VirtualServo::new(*c, leg, config.model_number, config.firmware);
                 let o = &config.current_offset_ma;
                 s.offset_ma = if o.len() == 1 { o[0] } else { o.get(leg).copied().unwrap_or(0.0) };
-                s.position += f64::from(config.initial_turns) * xl330::PULSES_PER_REV;
+                s.position += f64::from(config.initial_turns) * x::PULSES_PER_REV;
                 s.clear_supported = config.clear_supported;
                 if let Some((id, bits)) = config.faults.latched {
                     if id == c.id {
@@ -652,6 +675,14 @@ fn order_of(ins: &Instruction, id: u8) -> usize {
         inst::BULK_READ => ins.params.chunks(5).position(|c| c[0] == id).unwrap_or(usize::MAX),
         _ => 0,
     }
+}
+
+/// The path of the pseudo-terminal `port` (the slave side [`Emulator::start`] returns), e.g.
+/// `/dev/pts/3`, that another program (Dynamixel Wizard, the ROBOTIS SDK) opens as a serial
+/// port; `None` where the system does not say (Linux reads it from `/proc/self/fd`).
+pub fn pty_path(port: &SerialPort) -> Option<std::path::PathBuf> {
+    use std::os::unix::io::AsRawFd;
+    std::fs::read_link(format!("/proc/self/fd/{}", port.as_raw_fd())).ok()
 }
 
 /// The pty's nominal baud rate (see [`Emulator::start`]).

@@ -17,8 +17,9 @@ pub enum DriveError {
         /// IDs that did answer, listed.
         answered: String,
     },
-    /// A servo answered with another model's number.
-    #[error("servo ID {id} (leg {leg}) is model {model}, not an XL330-M288 ({expected}); its control table may differ. Fix: use XL330-M288s, or check the ID")]
+    /// A servo answered with a model number the driver does not support, another model than
+    /// the robot file's `[servos] model`, or another model than the servos before it.
+    #[error("servo ID {id} (leg {leg}) reports model number {model}: {why}. Fix: {fix}")]
     WrongModel {
         /// ID.
         id: u8,
@@ -26,8 +27,25 @@ pub enum DriveError {
         leg: usize,
         /// Model number reported.
         model: u16,
-        /// Model expected.
-        expected: u16,
+        /// Why it is refused.
+        why: String,
+        /// What to do.
+        fix: String,
+    },
+    /// A setting beyond what the servos' model accepts (`--current-limit`,
+    /// `--temperature-limit`).
+    #[error("{what} = {value} is beyond what the {servo} accepts: {range}. Fix: {fix}")]
+    ModelLimit {
+        /// The setting, as the front end names it.
+        what: &'static str,
+        /// Its value.
+        value: f64,
+        /// The model.
+        servo: &'static str,
+        /// The model's range, in words.
+        range: String,
+        /// What to do.
+        fix: &'static str,
     },
     /// A setup write failed.
     #[error("servo ID {id} (leg {leg}) refused {what}: {reason}. Fix: {fix}")]
@@ -212,7 +230,7 @@ fn hardware_fix(bits: u8) -> &'static str {
     } else if bits & (1 << 5) != 0 {
         "free the leg (stuck in the sand or against the frame) and lower its load"
     } else if bits & 1 != 0 {
-        "check the supply: the XL330 runs on 3.7 to 6 V"
+        "check the supply (the XL330 runs on 3.7 to 6.0 V, the XL430-W250 on 6.5 to 12.0 V, the XM430-W350 on 10.0 to 14.8 V)"
     } else {
         "check its wiring and motor"
     }
@@ -224,6 +242,7 @@ impl DriveError {
         match self {
             DriveError::Missing { .. }
             | DriveError::WrongModel { .. }
+            | DriveError::ModelLimit { .. }
             | DriveError::Setup { .. }
             | DriveError::Latched { .. }
             | DriveError::Range { .. } => 2,

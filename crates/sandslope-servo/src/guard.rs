@@ -8,7 +8,7 @@
 //! its command for longer than [`FOLLOWING_TIME_S`] (a leg stuck, a servo stopped by its own
 //! watchdog or fault) ends the run as a fault, not as a completed walk.
 
-use sandslope::servo::xl330;
+use sandslope::servo::model::velocity_units_from_rad_s;
 
 use crate::config::{DynamixelBus, ServoConfig};
 use crate::error::DriveError;
@@ -125,7 +125,7 @@ impl Following {
 /// above it is refused with a Data Range Error).
 pub fn velocity_goal(speed_rad_s: f64, limit_units: u32) -> i32 {
     let l = i64::from(limit_units);
-    xl330::velocity_units_from_rad_s(speed_rad_s).clamp(-l, l) as i32
+    velocity_units_from_rad_s(speed_rad_s).clamp(-l, l) as i32
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use sandslope::servo::xl330;
+use sandslope::servo::model::VOLT_PER_VOLTAGE_UNIT;
 use sandslope_io::servo_log::{FlightLog, ServoLogRow};
 
 use crate::driver::{DriveError, DriveOutcome, DriveReport, LiveEstimate, ServoSample};
@@ -22,14 +22,35 @@ pub fn log_row(s: &ServoSample) -> ServoLogRow {
         tripod: s.tripod,
         present_position: s.state.position,
         present_velocity: s.state.velocity,
-        present_current_ma: i32::from(s.state.current_ma),
-        load_percent: 100.0 * f64::from(s.state.current_ma) / (xl330::STALL_CURRENT_A * 1000.0),
-        input_voltage_v: f64::from(s.state.voltage) / (1.0 / xl330::VOLT_PER_VOLTAGE_UNIT).round(),
+        present_current_ma: s.current_ma.round() as i32,
+        load_percent: s.load_percent,
+        input_voltage_v: f64::from(s.state.voltage) / (1.0 / VOLT_PER_VOLTAGE_UNIT).round(),
         temperature_c: i32::from(s.state.temperature_c),
         hardware_error: s.hardware_error,
         goal_position: s.goal_position,
         leg_angle_rad: s.leg_angle_rad,
         drive_torque_n_m: s.drive_torque_n_m,
+    }
+}
+
+/// A live estimate as `/sandslope/live` carries it (`drive --log run.mcap`, `drive
+/// --foxglove`, `serve --drive --foxglove`; docs/bags.md).
+pub fn live_record(l: &LiveEstimate) -> sandslope_io::mcap_out::LiveRecord {
+    let i = &l.inference;
+    sandslope_io::mcap_out::LiveRecord {
+        time_s: l.time_s,
+        values: [
+            l.tripod as f64,
+            i.k_s,
+            i.k_s_lo,
+            i.k_s_hi,
+            i.speed_m_s,
+            i.speed_lo_m_s,
+            i.speed_hi_m_s,
+            i.p_fail,
+            i.p_slippage,
+            i.p_sinkage,
+        ],
     }
 }
 

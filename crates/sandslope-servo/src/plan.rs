@@ -2,7 +2,8 @@
 //! (docs/drive.md, "Before it moves"): the range of every goal over the requested duration
 //! against the control table's ranges, and the cycle rate the bus can carry.
 
-use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::servo::model::{EXTENDED_GOAL_LIMIT_PULSES, RAD_PER_PULSE};
+use sandslope::servo::GaitSchedule;
 
 use crate::config::{Profile, ServoConfig};
 
@@ -12,7 +13,7 @@ use crate::config::{Profile, ServoConfig};
 pub const CLEARED_START_RANGE_PULSES: (i32, i32) = (-2048, 6143);
 
 /// The longest gait, s, that keeps every goal of the extended position mode within its range
-/// (`xl330::EXTENDED_GOAL_LIMIT_PULSES`), with each leg starting at `start_goal[j]` pulses;
+/// (`sandslope::servo::model::EXTENDED_GOAL_LIMIT_PULSES`, every supported model's), with each leg starting at `start_goal[j]` pulses;
 /// and the leg that limits it. The gait turns every leg forward (`omega > 0`), so a servo of
 /// direction +1 counts up and one of direction -1 down: the room is the limit minus the start
 /// goal in the direction of travel, less one pulse for rounding.
@@ -21,7 +22,7 @@ pub fn longest_position_run_s(
     servos: &[ServoConfig],
     start_goal: &[i32],
 ) -> (f64, usize) {
-    let limit = f64::from(xl330::EXTENDED_GOAL_LIMIT_PULSES);
+    let limit = f64::from(EXTENDED_GOAL_LIMIT_PULSES);
     servos
         .iter()
         .zip(start_goal)
@@ -29,7 +30,7 @@ pub fn longest_position_run_s(
         .map(|(j, (s, &g))| {
             let ahead = if s.direction >= 0 { f64::from(g) } else { -f64::from(g) };
             let room = (limit - ahead - 1.0).max(0.0);
-            (schedule.time_to_travel(room * xl330::RAD_PER_PULSE), j)
+            (schedule.time_to_travel(room * RAD_PER_PULSE), j)
         })
         .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
 }

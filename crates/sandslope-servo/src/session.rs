@@ -9,7 +9,7 @@ use std::sync::atomic::AtomicBool;
 use sandslope::infer::servo::{model_grid, CurrentInferenceSettings, ModelGrid};
 use sandslope::infer::LogUniformPrior;
 use sandslope::risk::{safe_slope_limit, SafeLimit, UncertainTerrain};
-use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::servo::{GaitSchedule, ServoModel};
 use sandslope::{Robot, Scenario, SignedSlope, Terrain};
 
 use crate::driver::{drive, DriveError, DriveReport, DynamixelBus, LiveEstimate, Monitor, ServoSample};
@@ -33,8 +33,9 @@ pub struct RunDefaults {
     pub rate_hz: f64,
     /// Seconds the legs are held after a halt on risk (`--hold`).
     pub hold_s: f64,
-    /// Current Limit written to every servo, mA (`--current-limit`): the XL330's stall current
-    /// at 5 V, 1.47 A (`sandslope::servo::xl330::STALL_CURRENT_A`).
+    /// Current Limit written to every servo, mA (`--current-limit`): the paper's XL330-M288's
+    /// stall current at 5 V, 1.47 A (`ServoModel::XL330_M288.stall_current_a`; below the
+    /// XM430-W350's 2.3 A, so safe on every supported model with current control).
     pub current_limit_ma: u16,
     /// Temperature Limit written to every servo, degC (`--temperature-limit`).
     pub temperature_limit_c: u8,
@@ -60,7 +61,7 @@ pub const RUN_DEFAULTS: RunDefaults = RunDefaults {
     duration_s: 10.0,
     rate_hz: 50.0,
     hold_s: 2.0,
-    current_limit_ma: (xl330::STALL_CURRENT_A * 1000.0) as u16,
+    current_limit_ma: (ServoModel::XL330_M288.stall_current_a * 1000.0) as u16,
     temperature_limit_c: 65,
     watchdog_s: 1.0,
     bus_watchdog_s: 0.5,
@@ -80,7 +81,7 @@ pub enum BusChoice {
         /// Baud rate.
         baud: u32,
     },
-    /// A bus of virtual XL330s on a pseudo-terminal.
+    /// A bus of virtual servos (the robot file's model, else XL330-M288s) on a pseudo-terminal.
     Emulate(EmulateOptions),
 }
 
@@ -208,25 +209,7 @@ impl Session {
         };
         let (port, emulator) = match &config.bus {
             BusChoice::Emulate(o) => {
-                if o.k_s.is_none() && ground.k_s.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                    return Err(SessionError::Setting(format!(
-                        "--slope {}: the terrain's sand has no shear strength at this slope (k_s = {}: at or beyond its angle of repose), so the emulator has no sand to walk on; give the emulated sand's k_s with --emulate-k-s, or a shallower --slope",
-                        config.slope_deg, ground.k_s
-                    )));
-                }
-                let k_s = o.k_s.unwrap_or(ground.k_s);
-                let sand = Terrain::constant(k_n, k_s)
-                    .map_err(|e| SessionError::Setting(e.renamed("--emulate-k-s").to_string()))?;
-                let mut cfg = EmulatorConfig::new(
-                    config.robot.clone(),
-                    sand,
-                    config.slope_deg,
-                    config.settings.servos.clone(),
-                );
-                cfg.current_noise_ma = o.noise_ma;
-                cfg.seed = o.seed;
-                cfg.current_offset_ma = o.current_offset_ma.clone();
-                cfg.faults = o.faults;
+                let cfg = emulator_config(&config, o)?;
                 let (emu, port) = Emulator::start(&cfg).map_err(|e| SessionError::Emulator(e.to_string()))?;
                 (port, Some(emu))
             }
@@ -254,6 +237,12 @@ impl Session {
         bus_budget_of(&self.config)
     }
 
+    /// The servos' model as the run knows it before the ping: the robot file's, else the
+    /// paper's XL330-M288.
+    pub fn servo_model(&self) -> &'static ServoModel {
+        self.config.settings.servo.unwrap_or(&ServoModel::XL330_M288)
+    }
+
     /// Whether the bus is the emulator's.
     pub fn emulated(&self) -> bool {
         self.emulator.is_some()
@@ -272,10 +261,11 @@ impl Session {
             BusChoice::Emulate(o) => o.noise_ma.max(1.0),
             BusChoice::Port { .. } => 10.0,
         };
+        let noise_sd_n_m = self.servo_model().torque_from_current_ma(noise_ma);
         let monitor = self.grid.as_ref().map(|g| Monitor {
             robot: &self.config.robot,
             grid: g,
-            noise_sd_n_m: xl330::torque_from_current(noise_ma),
+            noise_sd_n_m,
             terrain: &self.uncertain,
             slope: self.slope,
             window: self.config.window,
@@ -292,6 +282,35 @@ impl Session {
         let zero = self.gait_zero;
         self.emulator.map(|e| e.stop(zero))
     }
+}
+
+/// The emulator a run on `--emulate` starts (and `drive --emulate-pty` serves alone): the
+/// run's servos, robot and slope, the sand `o.k_s` or the terrain's at the slope, the
+/// options' noise, offsets and faults, and the robot file's servo model.
+pub fn emulator_config(config: &DriveConfig, o: &EmulateOptions) -> Result<EmulatorConfig, SessionError> {
+    let signed = SignedSlope::from_degrees(config.slope_deg)
+        .map_err(|e| SessionError::Setting(e.renamed("--slope").to_string()))?;
+    let (ground, _) = Scenario::new(config.robot.clone(), config.terrain.clone(), None, None)
+        .map_err(|e| SessionError::Setting(e.to_string()))?
+        .ground_at(signed.felt());
+    let (k_n, ground_k_s) = (ground.k_n, ground.k_s);
+    if o.k_s.is_none() && ground_k_s.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return Err(SessionError::Setting(format!(
+                "--slope {}: the terrain's sand has no shear strength at this slope (k_s = {}: at or beyond its angle of repose), so the emulator has no sand to walk on; give the emulated sand's k_s with --emulate-k-s, or a shallower --slope",
+                config.slope_deg, ground_k_s
+            )));
+    }
+    let k_s = o.k_s.unwrap_or(ground_k_s);
+    let sand = Terrain::constant(k_n, k_s)
+        .map_err(|e| SessionError::Setting(e.renamed("--emulate-k-s").to_string()))?;
+    let mut cfg =
+        EmulatorConfig::new(config.robot.clone(), sand, config.slope_deg, config.settings.servos.clone());
+    cfg.current_noise_ma = o.noise_ma;
+    cfg.seed = o.seed;
+    cfg.current_offset_ma = o.current_offset_ma.clone();
+    cfg.faults = o.faults;
+    cfg.model_number = config.settings.servo.map_or(cfg.model_number, |m| m.model_number);
+    Ok(cfg)
 }
 
 /// The risk the safe slope is searched at when `--stop-on-risk` does not give one.

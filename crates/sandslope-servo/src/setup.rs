@@ -5,10 +5,12 @@
 //! range.
 
 use dynamixel2::ReadError;
-use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::servo::model as x;
+use sandslope::servo::{GaitSchedule, ServoModel};
 
 use crate::config::{DriveSettings, DynamixelBus, Profile};
 use crate::error::DriveError;
+use crate::models::ControlTable;
 use crate::table::{self as t, mode};
 
 /// One control-table write of a servo's setup, before it stands.
@@ -32,11 +34,12 @@ pub struct SetupWrite {
 }
 
 /// The Velocity Limit the setup writes: twice the leg speed, in 0.229 rev/min units (1 to the
-/// table's 2047). Goal Velocity is kept within it.
-pub fn velocity_limit_units(schedule: &GaitSchedule) -> u32 {
-    (2.0 * schedule.leg_speed_rad_s / xl330::RAD_S_PER_VELOCITY_UNIT)
+/// model's largest, 2047 on the XL330s, 1023 on the XL430 and XM430). Goal Velocity is kept
+/// within it.
+pub fn velocity_limit_units(schedule: &GaitSchedule, model: &ServoModel) -> u32 {
+    (2.0 * schedule.leg_speed_rad_s / x::RAD_S_PER_VELOCITY_UNIT)
         .round()
-        .clamp(1.0, f64::from(xl330::MAX_VELOCITY_LIMIT)) as u32
+        .clamp(1.0, f64::from(model.max_velocity_limit)) as u32
 }
 
 /// Every servo's setup, in the order written (docs/drive.md): torque off, the bus watchdog
@@ -45,25 +48,27 @@ pub fn velocity_limit_units(schedule: &GaitSchedule) -> u32 {
 /// the current and temperature limits, the velocity limit (2 omega), the profile's
 /// acceleration (position: 0, the schedule's own run-up limits it; velocity: omega over the
 /// run-up) and velocity (1.5 omega), and the bus watchdog; what `drive` writes and `drive
-/// --dry-run` prints.
-pub fn setup_writes(schedule: &GaitSchedule, settings: &DriveSettings) -> Vec<SetupWrite> {
+/// --dry-run` prints, for the servos' model `ct` (Current Limit in its units, and not written
+/// where the model has no current control).
+pub fn setup_writes(schedule: &GaitSchedule, settings: &DriveSettings, ct: &ControlTable) -> Vec<SetupWrite> {
+    let model = ct.model;
     let omega = schedule.leg_speed_rad_s;
     let op = match settings.profile {
         Profile::Position => mode::EXTENDED_POSITION,
         Profile::Velocity => mode::VELOCITY,
     };
-    let max_profile = f64::from(xl330::MAX_PROFILE);
+    let max_profile = f64::from(x::MAX_PROFILE);
     let accel = match settings.profile {
         Profile::Position => 0,
-        Profile::Velocity => ((omega / schedule.run_up_s) / xl330::RAD_S2_PER_ACCELERATION_UNIT)
+        Profile::Velocity => ((omega / schedule.run_up_s) / x::RAD_S2_PER_ACCELERATION_UNIT)
             .round()
             .clamp(1.0, max_profile) as u32,
     };
-    let prof_v = (1.5 * omega / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, max_profile) as u32;
-    let vel_limit = velocity_limit_units(schedule);
-    let watchdog = (settings.bus_watchdog_s / xl330::WATCHDOG_UNIT_S)
+    let prof_v = (1.5 * omega / x::RAD_S_PER_VELOCITY_UNIT).round().clamp(1.0, max_profile) as u32;
+    let vel_limit = velocity_limit_units(schedule, model);
+    let watchdog = (settings.bus_watchdog_s / x::WATCHDOG_UNIT_S)
         .round()
-        .clamp(1.0, f64::from(xl330::MAX_BUS_WATCHDOG)) as u32;
+        .clamp(1.0, f64::from(x::MAX_BUS_WATCHDOG)) as u32;
     let w = |name, addr: u16, value, width, what, fix| SetupWrite {
         name,
         addr,
@@ -73,8 +78,8 @@ pub fn setup_writes(schedule: &GaitSchedule, settings: &DriveSettings) -> Vec<Se
         fix,
         eeprom: addr < t::TORQUE_ENABLE,
     };
-    let model = "check the model is an XL330";
-    vec![
+    let check_model = "check the model and its firmware (Dynamixel Wizard)";
+    let mut writes = vec![
         w("Torque Enable", t::TORQUE_ENABLE, 0, 1, "Torque Enable = 0", "power-cycle the servo"),
         w("Bus Watchdog", t::BUS_WATCHDOG, 0, 1, "Bus Watchdog = 0", "reboot the servo (Dynamixel Wizard)"),
         w(
@@ -85,23 +90,15 @@ pub fn setup_writes(schedule: &GaitSchedule, settings: &DriveSettings) -> Vec<Se
             "Status Return Level = 2",
             "set Status Return Level (68) to 2 in Dynamixel Wizard",
         ),
-        w("Return Delay Time (2 us)", t::RETURN_DELAY_TIME, 0, 1, "Return Delay Time = 0", model),
-        w("Operating Mode", t::OPERATING_MODE, u32::from(op), 1, "Operating Mode", model),
+        w("Return Delay Time (2 us)", t::RETURN_DELAY_TIME, 0, 1, "Return Delay Time = 0", check_model),
+        w("Operating Mode", t::OPERATING_MODE, u32::from(op), 1, "Operating Mode", check_model),
         w(
             "Drive Mode (velocity-based profile)",
             t::DRIVE_MODE,
             0,
             1,
             "Drive Mode = 0 (velocity-based profile)",
-            model,
-        ),
-        w(
-            "Current Limit (mA)",
-            t::CURRENT_LIMIT,
-            u32::from(settings.current_limit_ma),
-            2,
-            "Current Limit",
-            "use --current-limit within 0 to 1750 mA",
+            check_model,
         ),
         w(
             "Temperature Limit (degC)",
@@ -109,7 +106,7 @@ pub fn setup_writes(schedule: &GaitSchedule, settings: &DriveSettings) -> Vec<Se
             u32::from(settings.temperature_limit_c),
             1,
             "Temperature Limit",
-            "use --temperature-limit within 0 to 70 degC",
+            "use a lower --temperature-limit",
         ),
         w("Velocity Limit", t::VELOCITY_LIMIT, vel_limit, 4, "Velocity Limit", "lower leg_speed_rad_s"),
         w(
@@ -129,7 +126,19 @@ pub fn setup_writes(schedule: &GaitSchedule, settings: &DriveSettings) -> Vec<Se
             "Bus Watchdog",
             "reboot the servo (Dynamixel Wizard)",
         ),
-    ]
+    ];
+    if let Some(units) = model.current_limit_units(f64::from(settings.current_limit_ma)) {
+        let at = writes.iter().position(|w| w.addr == t::TEMPERATURE_LIMIT).unwrap_or(writes.len());
+        let name = match model.reading {
+            sandslope::servo::TorqueReading::Current { ma_per_unit } if ma_per_unit != 1.0 => {
+                "Current Limit (the model's current unit)"
+            }
+            _ => "Current Limit (mA)",
+        };
+        writes
+            .insert(at, w(name, t::CURRENT_LIMIT, units, 2, "Current Limit", "use a lower --current-limit"));
+    }
+    writes
 }
 
 /// What the setup did, for the report.
@@ -143,6 +152,11 @@ pub struct SetupDone {
     /// where a servo's firmware does not know it (the run's goals are then checked from where
     /// the legs stand).
     pub counter_cleared: bool,
+    /// The servos' model, as read at the ping (`XL330-M288`).
+    pub servo: &'static str,
+    /// Its figures (`None` before the ping).
+    #[serde(skip)]
+    pub model: Option<&'static ServoModel>,
 }
 
 /// Pings every servo (its model, and a hardware error latched before the run: refused, exit 2,
@@ -153,9 +167,10 @@ pub fn setup(
     schedule: &GaitSchedule,
     settings: &DriveSettings,
 ) -> Result<SetupDone, DriveError> {
-    ping_all(bus, settings)?;
-    let writes = setup_writes(schedule, settings);
-    let mut done = SetupDone::default();
+    let model = ping_all(bus, &settings.servos, settings.servo)?;
+    check_limits(settings, model)?;
+    let writes = setup_writes(schedule, settings, ControlTable::of(model));
+    let mut done = SetupDone { servo: model.name, model: Some(model), ..SetupDone::default() };
     for (leg, s) in settings.servos.iter().enumerate() {
         let id = s.id;
         // Each write up to three times: a busy USB adapter (or machine) can miss one reply.
@@ -222,13 +237,44 @@ pub fn status_error_name(number: u8) -> &'static str {
     }
 }
 
+/// The run's current and temperature limits against what the servos' `model` accepts.
+fn check_limits(settings: &DriveSettings, model: &'static ServoModel) -> Result<(), DriveError> {
+    if let Some(max) = model.max_current_limit_ma() {
+        if f64::from(settings.current_limit_ma) > max {
+            return Err(DriveError::ModelLimit {
+                what: "--current-limit",
+                value: f64::from(settings.current_limit_ma),
+                servo: model.name,
+                range: format!("0 to {max:.0} mA (its Current Limit (38))"),
+                fix: "a lower --current-limit",
+            });
+        }
+    }
+    if settings.temperature_limit_c > model.max_temperature_c {
+        return Err(DriveError::ModelLimit {
+            what: "--temperature-limit",
+            value: f64::from(settings.temperature_limit_c),
+            servo: model.name,
+            range: format!("0 to {} degC (its rated range)", model.max_temperature_c),
+            fix: "a lower --temperature-limit",
+        });
+    }
+    Ok(())
+}
+
 /// Pings every ID up to three times: one that does not answer is named with the IDs that do;
-/// one of another model, or with its alert bit set (a hardware error latched before the run:
-/// overheating, overload, ...), is refused before anything is written.
-fn ping_all(bus: &mut DynamixelBus, settings: &DriveSettings) -> Result<(), DriveError> {
+/// one of a model the driver does not know, of another model than the robot file names or
+/// than the servos before it, or with its alert bit set (a hardware error latched before the
+/// run: overheating, overload, ...), is refused before anything is written. The servos' model.
+pub(crate) fn ping_all(
+    bus: &mut DynamixelBus,
+    servos: &[crate::config::ServoConfig],
+    named: Option<&'static ServoModel>,
+) -> Result<&'static ServoModel, DriveError> {
     let baud = bus.baud_rate();
     let mut missing = None;
-    for (leg, s) in settings.servos.iter().enumerate() {
+    let mut found_model: Option<(&'static ServoModel, u8, usize)> = named.map(|m| (m, 0, usize::MAX));
+    for (leg, s) in servos.iter().enumerate() {
         let mut ping = bus.ping(s.id);
         for _ in 0..2 {
             if ping.is_ok() {
@@ -238,13 +284,40 @@ fn ping_all(bus: &mut DynamixelBus, settings: &DriveSettings) -> Result<(), Driv
         }
         match ping {
             Ok(r) => {
-                if r.data.model != xl330::MODEL_NUMBER {
-                    return Err(DriveError::WrongModel {
-                        id: s.id,
-                        leg,
-                        model: r.data.model,
-                        expected: xl330::MODEL_NUMBER,
-                    });
+                let wrong = |why: String, fix: String| DriveError::WrongModel {
+                    id: s.id,
+                    leg,
+                    model: r.data.model,
+                    why,
+                    fix,
+                };
+                let model = ServoModel::from_model_number(r.data.model).map_err(|_| {
+                    wrong(
+                        format!("not a supported servo (supported: {})", ServoModel::supported()),
+                        "use a supported model, or check the ID".into(),
+                    )
+                })?;
+                match found_model {
+                    Some((m, _, usize::MAX)) if m != model => {
+                        return Err(wrong(
+                            format!("an {}, but the robot file's [servos] model names the {}", model.name, m.name),
+                            format!(
+                                "set [servos] model = \"{}\" (or leave it out: the model is read from the servos)",
+                                model.name
+                            ),
+                        ))
+                    }
+                    Some((m, id, first)) if m != model => {
+                        return Err(wrong(
+                            format!("an {}, but servo ID {id} (leg {first}) is an {}", model.name, m.name),
+                            "use one model on every leg".into(),
+                        ))
+                    }
+                    Some(_) => {}
+                    None => found_model = Some((model, s.id, leg)),
+                }
+                if matches!(found_model, Some((_, _, usize::MAX))) {
+                    found_model = Some((model, s.id, leg));
                 }
                 if r.alert {
                     let bits = bus.read_u8(s.id, t::HARDWARE_ERROR_STATUS).map(|r| r.data).unwrap_or(0xFF);
@@ -273,5 +346,5 @@ fn ping_all(bus: &mut DynamixelBus, settings: &DriveSettings) -> Result<(), Driv
         };
         return Err(DriveError::Missing { id, leg, baud, answered });
     }
-    Ok(())
+    Ok(found_model.map_or(&ServoModel::XL330_M288, |(m, _, _)| m))
 }

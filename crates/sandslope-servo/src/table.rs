@@ -1,7 +1,9 @@
-//! The XL330-M288's control table (ROBOTIS e-Manual, XL330-M288-T): the addresses the driver
-//! and the emulator use, and their sizes.
+//! The Dynamixel X series' control table (ROBOTIS e-Manual, XL330-M288-T, XL330-M077-T,
+//! XL430-W250-T, XM430-W350-T): the addresses the driver and the emulator use, and their
+//! sizes, the same in every supported model. What differs between models (which registers a
+//! model has, its modes, ranges and factory values) is [`crate::models`].
 
-/// Model Number (2 bytes, read-only; 1200 for the XL330-M288).
+/// Model Number (2 bytes, read-only; `ServoModel::model_number`).
 pub const MODEL_NUMBER: u16 = 0;
 /// Firmware Version (1).
 pub const FIRMWARE_VERSION: u16 = 6;
@@ -24,9 +26,9 @@ pub const TEMPERATURE_LIMIT: u16 = 31;
 pub const MAX_VOLTAGE_LIMIT: u16 = 32;
 /// Min Voltage Limit (2), 0.1 V.
 pub const MIN_VOLTAGE_LIMIT: u16 = 34;
-/// Current Limit (2), mA (0 to 1750).
+/// Current Limit (2), the model's current unit (absent on the XL430-W250).
 pub const CURRENT_LIMIT: u16 = 38;
-/// Velocity Limit (4), 0.229 rev/min (0 to 2047; 445 by default).
+/// Velocity Limit (4), 0.229 rev/min (0 to the model's `max_velocity_limit`).
 pub const VELOCITY_LIMIT: u16 = 44;
 /// Shutdown (1): which hardware errors turn the torque off.
 pub const SHUTDOWN: u16 = 63;
@@ -39,7 +41,7 @@ pub const STATUS_RETURN_LEVEL: u16 = 68;
 pub const HARDWARE_ERROR_STATUS: u16 = 70;
 /// Bus Watchdog (1), 20 ms units (0 off; the servo sets 100 when it has fired).
 pub const BUS_WATCHDOG: u16 = 98;
-/// Goal Current (2, signed), mA (within plus or minus the Current Limit).
+/// Goal Current (2, signed), the model's current unit (within plus or minus the Current Limit).
 pub const GOAL_CURRENT: u16 = 102;
 /// Goal Velocity (4), 0.229 rev/min.
 pub const GOAL_VELOCITY: u16 = 104;
@@ -51,7 +53,8 @@ pub const PROFILE_VELOCITY: u16 = 112;
 pub const GOAL_POSITION: u16 = 116;
 /// Moving (1).
 pub const MOVING: u16 = 122;
-/// Present Current (2, signed), mA.
+/// Present Current (2, signed), the model's current unit (Present Load, 0.1 %, on the
+/// XL430-W250: `ServoModel::reading`).
 pub const PRESENT_CURRENT: u16 = 126;
 /// Present Velocity (4, signed), 0.229 rev/min.
 pub const PRESENT_VELOCITY: u16 = 128;
@@ -70,10 +73,16 @@ pub const STATE_BLOCK: (u16, u16) = (PRESENT_CURRENT, PRESENT_TEMPERATURE + 1 - 
 /// Bus Watchdog value a servo sets after the watchdog fired.
 pub const WATCHDOG_FIRED: u8 = 100;
 
-/// The first register written in `addr..end` whose new value lies outside its range
-/// (ROBOTIS e-Manual, XL330-M288-T control table), by name.
-pub(crate) fn out_of_range(table: &[u8; TABLE_SIZE], addr: u16, end: usize) -> Option<&'static str> {
-    use sandslope::servo::xl330;
+/// The first register written in `addr..end` whose new value lies outside its range in
+/// model `ct`'s control table (ROBOTIS e-Manual), by name.
+pub(crate) fn out_of_range(
+    table: &[u8; TABLE_SIZE],
+    addr: u16,
+    end: usize,
+    ct: &crate::models::ControlTable,
+) -> Option<&'static str> {
+    use sandslope::servo::model as x;
+    let max_current = ct.model.max_current_limit.unwrap_or(0);
     let u8_at = |a: u16| table[a as usize];
     let u16_at = |a: u16| u16::from_le_bytes([table[a as usize], table[a as usize + 1]]);
     let i32_le = |a: u16| {
@@ -86,24 +95,24 @@ pub(crate) fn out_of_range(table: &[u8; TABLE_SIZE], addr: u16, end: usize) -> O
     let i16_at = |a: u16| i16::from_le_bytes([table[a as usize], table[a as usize + 1]]);
     let mode = u8_at(OPERATING_MODE);
     let checks: [(&'static str, u16, usize, bool); 13] = [
-        ("Return Delay Time", RETURN_DELAY_TIME, 1, u8_at(RETURN_DELAY_TIME) <= xl330::MAX_RETURN_DELAY),
-        ("Operating Mode", OPERATING_MODE, 1, matches!(mode, 0 | 1 | 3 | 4 | 5 | 16)),
+        ("Return Delay Time", RETURN_DELAY_TIME, 1, u8_at(RETURN_DELAY_TIME) <= x::MAX_RETURN_DELAY),
+        ("Operating Mode", OPERATING_MODE, 1, ct.operating_modes.contains(&mode)),
         (
             "Temperature Limit",
             TEMPERATURE_LIMIT,
             1,
-            u8_at(TEMPERATURE_LIMIT) <= xl330::MAX_TEMPERATURE_LIMIT_REGISTER,
+            u8_at(TEMPERATURE_LIMIT) <= x::MAX_TEMPERATURE_LIMIT_REGISTER,
         ),
-        ("Current Limit", CURRENT_LIMIT, 2, u16_at(CURRENT_LIMIT) <= xl330::MAX_CURRENT_LIMIT_MA),
+        ("Current Limit", CURRENT_LIMIT, 2, u16_at(CURRENT_LIMIT) <= max_current),
         (
             "Velocity Limit",
             VELOCITY_LIMIT,
             4,
-            (0..=xl330::MAX_VELOCITY_LIMIT as i32).contains(&i32_at(VELOCITY_LIMIT)),
+            (0..=ct.model.max_velocity_limit as i32).contains(&i32_at(VELOCITY_LIMIT)),
         ),
         ("Torque Enable", TORQUE_ENABLE, 1, u8_at(TORQUE_ENABLE) <= 1),
         ("Status Return Level", STATUS_RETURN_LEVEL, 1, u8_at(STATUS_RETURN_LEVEL) <= 2),
-        ("Bus Watchdog", BUS_WATCHDOG, 1, u8_at(BUS_WATCHDOG) <= xl330::MAX_BUS_WATCHDOG),
+        ("Bus Watchdog", BUS_WATCHDOG, 1, u8_at(BUS_WATCHDOG) <= x::MAX_BUS_WATCHDOG),
         (
             "Goal Current",
             GOAL_CURRENT,
@@ -120,18 +129,18 @@ pub(crate) fn out_of_range(table: &[u8; TABLE_SIZE], addr: u16, end: usize) -> O
             "Profile Acceleration",
             PROFILE_ACCELERATION,
             4,
-            (0..=xl330::MAX_PROFILE as i32).contains(&i32_at(PROFILE_ACCELERATION)),
+            (0..=x::MAX_PROFILE as i32).contains(&i32_at(PROFILE_ACCELERATION)),
         ),
         (
             "Profile Velocity",
             PROFILE_VELOCITY,
             4,
-            (0..=xl330::MAX_PROFILE as i32).contains(&i32_at(PROFILE_VELOCITY)),
+            (0..=x::MAX_PROFILE as i32).contains(&i32_at(PROFILE_VELOCITY)),
         ),
         ("Goal Position", GOAL_POSITION, 4, {
             let g = i32_at(GOAL_POSITION);
-            let l = xl330::EXTENDED_GOAL_LIMIT_PULSES;
-            let (lo, hi) = xl330::POSITION_GOAL_RANGE_PULSES;
+            let l = x::EXTENDED_GOAL_LIMIT_PULSES;
+            let (lo, hi) = x::POSITION_GOAL_RANGE_PULSES;
             match mode {
                 mode::EXTENDED_POSITION | 5 => (-l..=l).contains(&g),
                 mode::POSITION => (lo..=hi).contains(&g),

@@ -115,7 +115,8 @@ fn hand_written_packets_from_the_protocol_documentation() {
 /// instruction the driver uses.
 #[test]
 fn the_dynamixel2_client_talks_to_the_emulator_over_a_pty() {
-    let cfg = config(sandslope::servo::xl330::MODEL_NUMBER, 46, &[100, 200, 300, 400, 500, 600]);
+    let cfg =
+        config(sandslope::servo::ServoModel::XL330_M288.model_number, 46, &[100, 200, 300, 400, 500, 600]);
     let (emulator, port) = Emulator::start(&cfg).unwrap();
     let mut bus = dynamixel2::Bus::new(port).unwrap();
     let ping = bus.ping(3).unwrap();

@@ -36,6 +36,7 @@ fn run(turns: i32, clear: bool, duration_s: f64) -> (Vec<i32>, Option<DriveError
         stop_on_risk: None,
         hold_s: 0.0,
         stand_s: 1.0,
+        servo: None,
     };
     let mut goals = vec![];
     let stop = AtomicBool::new(false);

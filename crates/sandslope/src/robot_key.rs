@@ -1,9 +1,9 @@
 //! The robot's keys (docs/model.md §2), named once: each key's file name (the TOML key, the
 //! JSON key and the Python keyword of `sandslope.Robot(**keys)`, which are one name), its
-//! unit, the command-line flag that overrides it where there is one, and how to read and set
-//! it on a [`RobotSpec`]. Calibration frees the continuous ones ([`RobotKey::FITTABLE`]), a
-//! design study varies any of them, and the command line maps the library's error on a key
-//! back to the flag that set it ([`RobotKey::flag`]). Each key's valid range is the robot's
+//! unit, and how to read and set it on a [`RobotSpec`]. Calibration frees the continuous ones
+//! ([`RobotKey::FITTABLE`]) and a design study varies any of them; the command-line flags
+//! that override some of them are the front ends' (the request layer's field table of robot
+//! quantities), mapped from the library's error by its key. Each key's valid range is the robot's
 //! own ([`RobotKey::plausible`], [`RobotKey::valid_range`]): the ranges of plausibility of
 //! [`crate::robot::PLAUSIBLE`], which [`crate::Robot::new`] checks.
 
@@ -46,96 +46,23 @@ pub struct RobotKeyRow {
     pub name: &'static str,
     /// The unit of its value.
     pub unit: &'static str,
-    /// The command-line flag that overrides it, where there is one.
-    pub flag: Option<RobotFlag>,
     /// What it is, in words.
     pub description: &'static str,
-}
-
-/// The command-line flag that overrides a robot key: what the command line builds its flag
-/// from, the request layer its field (the flag without dashes, also the server's parameter)
-/// and the explorer page its robot panel.
-#[derive(Debug, Clone, Copy)]
-pub struct RobotFlag {
-    /// The flag, with its dashes (`--leg-radius`).
-    pub long: &'static str,
-    /// The placeholder of its value in `--help` (`M`).
-    pub value_name: &'static str,
-    /// Its line in `--help`.
-    pub help: &'static str,
-}
-
-const fn flag(long: &'static str, value_name: &'static str, help: &'static str) -> Option<RobotFlag> {
-    Some(RobotFlag { long, value_name, help })
 }
 
 impl RobotKey {
     /// The table: every key in the order of docs/model.md §2.
     pub const TABLE: [RobotKeyRow; 10] = [
-        row(
-            RobotKey::MassKg,
-            "mass_kg",
-            "kg",
-            flag("--mass", "KG", "Override the robot's total mass, kg"),
-            "total robot mass m",
-        ),
-        row(
-            RobotKey::LegRadiusM,
-            "leg_radius_m",
-            "m",
-            flag("--leg-radius", "M", "Override the C-leg radius R, m"),
-            "C-leg radius R",
-        ),
-        row(
-            RobotKey::LegWidthM,
-            "leg_width_m",
-            "m",
-            flag("--leg-width", "M", "Override the leg width W, m"),
-            "leg width W",
-        ),
-        row(
-            RobotKey::HipHeightM,
-            "hip_height_m",
-            "m",
-            flag("--hip-height", "M", "Override the hip height h, m (between 0 and 2R)"),
-            "hip height h (between 0 and 2R)",
-        ),
-        row(
-            RobotKey::LegSpeedRadS,
-            "leg_speed_rad_s",
-            "rad/s",
-            flag("--leg-speed", "RAD/S", "Override the leg angular speed omega, rad/s"),
-            "leg angular speed omega",
-        ),
-        row(
-            RobotKey::StanceLegs,
-            "stance_legs",
-            "legs",
-            flag("--stance-legs", "N", "Override the number of legs in stance at once"),
-            "legs in stance at once n",
-        ),
-        row(
-            RobotKey::ResponseTimeS,
-            "response_time_s",
-            "s",
-            flag("--response-time", "S", "Override the elastic response time dt, s"),
-            "elastic response time dt",
-        ),
-        row(
-            RobotKey::LegContactAreaM2,
-            "leg_contact_area_m2",
-            "m^2",
-            None,
-            "leg contact area A_c (default W R)",
-        ),
-        row(
-            RobotKey::LevelStepM,
-            "level_step_m",
-            "m",
-            None,
-            "measured level-sand step s* (default: the model's)",
-        ),
-        row(RobotKey::MinStepM, "min_step_m", "m", None, "smallest step counted as success s_min"),
+        row(RobotKey::MassKg, "mass_kg", "kg", "total robot mass m"),
+        row(RobotKey::LegRadiusM, "leg_radius_m", "m", "C-leg radius R"),
+        row(RobotKey::LegWidthM, "leg_width_m", "m", "leg width W"),
+        row(RobotKey::HipHeightM, "hip_height_m", "m", "hip height h (between 0 and 2R)"),
+        row(RobotKey::LegSpeedRadS, "leg_speed_rad_s", "rad/s", "leg angular speed omega"),
+        row(RobotKey::StanceLegs, "stance_legs", "legs", "legs in stance at once n"),
+        row(RobotKey::ResponseTimeS, "response_time_s", "s", "elastic response time dt"),
+        row(RobotKey::LegContactAreaM2, "leg_contact_area_m2", "m^2", "leg contact area A_c (default W R)"),
+        row(RobotKey::LevelStepM, "level_step_m", "m", "measured level-sand step s* (default: the model's)"),
+        row(RobotKey::MinStepM, "min_step_m", "m", "smallest step counted as success s_min"),
     ];
 
     /// Every key, in the order of docs/model.md §2.
@@ -178,11 +105,6 @@ impl RobotKey {
     /// The unit of the key's value.
     pub fn unit(self) -> &'static str {
         self.row().unit
-    }
-
-    /// The command-line flag that overrides the key, where there is one.
-    pub fn flag(self) -> Option<&'static str> {
-        self.row().flag.map(|f| f.long)
     }
 
     /// The key named in a library error on the robot ([`crate::Robot::new`]'s `ParamError`
@@ -259,10 +181,9 @@ const fn row(
     key: RobotKey,
     name: &'static str,
     unit: &'static str,
-    flag: Option<RobotFlag>,
     description: &'static str,
 ) -> RobotKeyRow {
-    RobotKeyRow { key, name, unit, flag, description }
+    RobotKeyRow { key, name, unit, description }
 }
 
 #[cfg(test)]

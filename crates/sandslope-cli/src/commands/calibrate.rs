@@ -48,6 +48,10 @@ pub enum ModelArg {
 /// Arguments of `sandslope calibrate`.
 #[derive(Debug, Args)]
 pub struct CalibrateArgs {
+    /// The command line as run (its arguments after the program), for the written files'
+    /// `Written by:` header: given by `main`, which owns the process's arguments.
+    #[arg(skip)]
+    pub command_line: Vec<String>,
     /// Observed speeds: CSV with columns slope_deg,speed_m_s,speed_sd_m_s.
     #[arg(long, value_name = "CSV")]
     pub observed: Option<PathBuf>,
@@ -196,7 +200,7 @@ fn draw_fit(
 
 /// Writes `--out` (the calibrated terrain) and `--robot-out`, each with a header saying how.
 fn write_files(args: &CalibrateArgs, cal: &JointCalibration, repose: &ReposeRecord) -> Result<()> {
-    let command: Vec<String> = std::env::args().skip(1).collect();
+    let command = &args.command_line;
     let mut header = String::new();
     writeln!(header, "Written by: sandslope {}", command.join(" "))?;
     writeln!(
@@ -377,7 +381,7 @@ fn print_side_by_side(closed: &JointCalibration, sim: &JointCalibration) {
 
 /// `--law per-slope`'s outputs: the terrain file, then the table or JSON.
 fn write_per_slope(args: &CalibrateArgs, answer: &PerSlopeAnswer) -> Result<()> {
-    let command: Vec<String> = std::env::args().skip(1).collect();
+    let command = &args.command_line;
     let header = format!(
         "Written by: sandslope {}\nk_s per observed slope, inverted from each speed\nrepose_deg: {}",
         command.join(" "),

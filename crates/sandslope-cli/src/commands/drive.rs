@@ -1,8 +1,9 @@
 //! `sandslope drive`: the robot in the loop (docs/drive.md). The alternating tripod of the
-//! robot file's timing sent to Dynamixel XL330s over Protocol 2.0 (`sandslope-servo`), every
+//! robot file's timing sent to Dynamixel servos (XL330-M288s, or another model of
+//! `sandslope::servo::ServoModel`) over Protocol 2.0 (`sandslope-servo`), every
 //! servo's state logged at the bus's rate, and, with `--live` or `--stop-on-risk`, the sand's
 //! k_s and the risk that the walk fails (slippage or sinkage) read from the stance currents after every stance
-//! (`sandslope::infer::servo`). `--emulate` drives a bus of virtual XL330s on a
+//! (`sandslope::infer::servo`). `--emulate` drives a bus of virtual servos on a
 //! pseudo-terminal through the same code; `--dry-run` prints the commands without a bus.
 
 use std::io::Write;
@@ -12,19 +13,22 @@ use std::sync::atomic::Ordering;
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 
-use sandslope::servo::{xl330, GaitSchedule};
+use sandslope::servo::{GaitSchedule, ServoModel};
 use sandslope_io::robot_terrain::load_servos;
 use sandslope_io::servo_log::DEFAULT_BAUD_RATE;
 use sandslope_request::drive::DriveRun;
 use sandslope_request::error::Words;
 use sandslope_servo::driver::{DriveReport, LiveEstimate};
 use sandslope_servo::emulator::EmulatorFaults;
-use sandslope_servo::log::{drive_logged, LogTarget};
+use sandslope_servo::log::{drive_logged, live_record, LogTarget};
 use sandslope_servo::session::{
     default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, RUN_DEFAULTS,
 };
 use sandslope_servo::table as t;
 use sandslope_servo::{DriveSettings, Profile, ServoConfig};
+
+#[path = "drive_bench.rs"]
+mod bench;
 
 use crate::args::{RobotArgs, TerrainArgs};
 use crate::error::{KeepLog, EXIT_HALTED};
@@ -45,13 +49,23 @@ pub struct DriveArgs {
     /// Serial port of the Protocol 2.0 adapter (U2D2 or any): /dev/ttyUSB0, /dev/ttyACM0, COM3.
     #[arg(long, value_name = "PATH", required_unless_present_any = ["emulate", "dry_run"])]
     pub port: Option<PathBuf>,
-    /// Drive a bus of emulated XL330s (a pseudo-terminal; currents from the stride simulator on
+    /// Drive a bus of emulated servos (the robot file's [servos] model, else XL330-M288s; a pseudo-terminal; currents from the stride simulator on
     /// --terrain at --slope) instead of a port.
     #[arg(long, conflicts_with = "port")]
     pub emulate: bool,
     /// Print the commands (setup writes, then every cycle's goals as CSV) without opening a bus.
     #[arg(long, conflicts_with_all = ["port", "emulate"])]
     pub dry_run: bool,
+    /// With every leg set by hand at leg angle 0 (the torque off), read each servo's Present
+    /// Position and write them into the robot file's [servos] zero_offsets; nothing moves
+    /// (docs/drive.md, "On the bench").
+    #[arg(long, conflicts_with_all = ["dry_run", "pty"])]
+    pub zero: bool,
+    /// With --emulate: serve the emulated servos alone on a pseudo-terminal, its path the first
+    /// line on stdout, for Dynamixel Wizard or the ROBOTIS SDK, for S seconds (left out or 0:
+    /// until Ctrl-C); no gait is driven.
+    #[arg(long, value_name = "S", num_args = 0..=1, default_missing_value = "0", requires = "emulate")]
+    pub pty: Option<f64>,
     #[command(flatten)]
     pub robot: RobotArgs,
     /// Terrain: k_n at the slope for the live estimate, and the emulated sand.
@@ -109,10 +123,10 @@ pub struct DriveRunArgs {
     /// After a halt, seconds the legs are held before the torque goes off.
     #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.hold_s)]
     pub hold: f64,
-    /// Current Limit written to every servo, mA (0 to 1750; 1470 is the stall current at 5 V).
+    /// Current Limit written to every servo, mA (within the model's: 0 to 1750 on the XL330s, 0 to 3209 on the XM430-W350; 1470 is the XL330-M288's stall current at 5 V; the XL430-W250 has none).
     #[arg(long, value_name = "MA", default_value_t = RUN_DEFAULTS.current_limit_ma)]
     pub current_limit: u16,
-    /// Temperature Limit written to every servo, degC (0 to 70).
+    /// Temperature Limit written to every servo, degC (within the model's rated maximum: 70 on the XL330s, 72 on the XL430-W250, 80 on the XM430-W350).
     #[arg(long, value_name = "DEGC", default_value_t = RUN_DEFAULTS.temperature_limit_c)]
     pub temperature_limit: u8,
     /// Longest bus cycle accepted before everything stops, s.
@@ -231,8 +245,14 @@ fn parse_faults(args: &DriveRunArgs, servos: &[ServoConfig]) -> Result<EmulatorF
 
 /// The servos: the robot file's `[servos]` table, or IDs 1 to 2n with the left side (the first
 /// n) turning positive and the right side mirrored.
-fn servos(robot_spec: &str, baud: Option<u32>, legs: usize) -> Result<(Vec<ServoConfig>, u32)> {
+/// Also the `[servos] model` named there, if any.
+pub(crate) fn servos(
+    robot_spec: &str,
+    baud: Option<u32>,
+    legs: usize,
+) -> Result<(Vec<ServoConfig>, u32, Option<&'static ServoModel>)> {
     let table = load_servos(robot_spec)?;
+    let model = table.as_ref().and_then(|s| s.model);
     let (list, file_baud) = match table {
         Some(s) => (
             s.mounts
@@ -254,7 +274,7 @@ fn servos(robot_spec: &str, baud: Option<u32>, legs: usize) -> Result<(Vec<Servo
             legs / 2
         );
     }
-    Ok((list, baud.unwrap_or(file_baud)))
+    Ok((list, baud.unwrap_or(file_baud), model))
 }
 
 /// The typed run that `drive`'s flags (and `serve --drive`'s, the same [`DriveRunArgs`]) make:
@@ -289,11 +309,11 @@ pub fn config(
         _ => vec![],
     };
     GaitSchedule::new(&robot, legs).map_err(|e| anyhow!("{robot_spec}: {e}"))?;
-    let (servos, baud) = servos(robot_spec, run.baud, legs)?;
+    let (servos, baud, model) = servos(robot_spec, run.baud, legs)?;
     let faults = if emulate { parse_faults(run, &servos)? } else { EmulatorFaults::default() };
     if let Some(b) = run.baud {
         if !sandslope_io::servo_log::BAUD_RATES.contains(&b) {
-            bail!("--baud = {b} must be one the XL330 supports: {:?}", sandslope_io::servo_log::BAUD_RATES);
+            bail!("--baud = {b} must be one the servos support: {:?}", sandslope_io::servo_log::BAUD_RATES);
         }
     }
     let settings = DriveSettings {
@@ -311,6 +331,7 @@ pub fn config(
         stop_on_risk: run.stop_on_risk,
         hold_s: run.hold,
         stand_s: RUN_DEFAULTS.stand_s,
+        servo: model,
     };
     // Every goal within the servos' ranges for the whole run, from the worst start a cleared
     // revolution counter allows (the driver checks again from where the legs stand).
@@ -367,6 +388,15 @@ pub fn run(args: DriveArgs) -> Result<()> {
     };
     let monitor = args.live || args.run.stop_on_risk.is_some();
     let config = config(&args.run, robot, &args.robot.robot, terrain, bus, monitor)?;
+    if args.zero {
+        return bench::zero(&config, &args.robot.robot);
+    }
+    if let Some(seconds) = args.pty {
+        if !(seconds.is_finite() && (0.0..=86_400.0).contains(&seconds)) {
+            bail!("--pty {seconds} must be between 0 and 86400 s (0: until Ctrl-C)");
+        }
+        return bench::serve_pty(&config, seconds);
+    }
     if args.dry_run {
         let schedule = GaitSchedule::new(&config.robot, config.settings.servos.len())?;
         return dry_run(&schedule, &config.settings);
@@ -433,7 +463,12 @@ pub fn run(args: DriveArgs) -> Result<()> {
         foxglove.iter().for_each(|f| f.row(sandslope_servo::log::log_row(s)));
     };
     let (report, failure) = drive_logged(&mut session, log, stop, on_sample, &mut on_live)?;
-    foxglove.into_iter().for_each(|f| f.finish(&verdict_text(&report, failure.as_ref())));
+    foxglove.into_iter().for_each(|f| {
+        f.finish(&sandslope_io::mcap_out::verdict_text(
+            &report.outcome,
+            failure.as_ref().map(|e| e as &dyn std::fmt::Display),
+        ))
+    });
     if let Some(path) = mcap {
         write_mcap_log(path, &rows, &report, &meta, failure.as_ref())?;
     }
@@ -618,16 +653,28 @@ fn summarise(r: &DriveReport, quiet: bool) {
 fn dry_run(schedule: &GaitSchedule, s: &DriveSettings) -> Result<()> {
     let ids: Vec<String> = s.servos.iter().map(|c| c.id.to_string()).collect();
     println!("# dry run: no bus opened; the commands `sandslope drive` sends (docs/drive.md)");
-    println!("# ping IDs {} (model {} expected)", ids.join(", "), xl330::MODEL_NUMBER);
+    let model = s.servo.unwrap_or(&ServoModel::XL330_M288);
+    println!(
+        "# ping IDs {} (model {} expected: the {}{})",
+        ids.join(", "),
+        model.model_number,
+        model.name,
+        if s.servo.is_some() {
+            ", the robot file's [servos] model"
+        } else {
+            "; a run takes the model the servos report"
+        }
+    );
     // The driver's own setup list: what `drive` writes is what the dry run prints.
-    for w in sandslope_servo::driver::setup_writes(schedule, s) {
+    let table = sandslope_servo::models::ControlTable::of(model);
+    for w in sandslope_servo::driver::setup_writes(schedule, s, table) {
         println!("# write {} ({}) = {} on IDs {}", w.name, w.addr, w.value, ids.join(", "));
     }
     if s.profile == Profile::Position {
         println!("# clear the revolution counter (Clear instruction) on IDs {}", ids.join(", "));
     }
     println!("# write Torque Enable ({}) = 1 on IDs {}", t::TORQUE_ENABLE, ids.join(", "));
-    let limit = sandslope_servo::driver::velocity_limit_units(schedule);
+    let limit = sandslope_servo::driver::velocity_limit_units(schedule, model);
     let goal = match s.profile {
         Profile::Position => "goal_position",
         Profile::Velocity => "goal_velocity",
@@ -671,36 +718,7 @@ fn write_mcap_log(
 ) -> Result<()> {
     use sandslope_io::mcap_out::{drive_mcap, LiveRecord};
     let live: Vec<LiveRecord> = report.live.iter().map(live_record).collect();
-    let verdict = verdict_text(report, failure);
+    let verdict =
+        sandslope_io::mcap_out::verdict_text(&report.outcome, failure.map(|e| e as &dyn std::fmt::Display));
     sandslope_io::write_atomic(path, &drive_mcap(rows, &live, meta, &verdict)?)
-}
-
-/// A live estimate as `/sandslope/live` carries it (`--log run.mcap`, `--foxglove`).
-fn live_record(l: &LiveEstimate) -> sandslope_io::mcap_out::LiveRecord {
-    let i = &l.inference;
-    sandslope_io::mcap_out::LiveRecord {
-        time_s: l.time_s,
-        values: [
-            l.tripod as f64,
-            i.k_s,
-            i.k_s_lo,
-            i.k_s_hi,
-            i.speed_m_s,
-            i.speed_lo_m_s,
-            i.speed_hi_m_s,
-            i.p_fail,
-            i.p_slippage,
-            i.p_sinkage,
-        ],
-    }
-}
-
-/// How the run ended, as `/sandslope/verdict` says it.
-fn verdict_text(report: &DriveReport, failure: Option<&sandslope_servo::DriveError>) -> String {
-    // The outcome as `--json` gives it (`{"outcome": "completed", ...}`), never Rust's `Result`.
-    match (failure, &report.outcome) {
-        (Some(e), _) => e.to_string(),
-        (None, Ok(outcome)) => serde_json::to_string(outcome).unwrap_or_default(),
-        (None, Err(why)) => why.clone(),
-    }
 }

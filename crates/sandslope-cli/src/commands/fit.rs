@@ -19,7 +19,8 @@ use crate::output::{csv_string, num, print_json, sci, table, write_atomic, Forma
 /// Arguments of `sandslope fit`.
 #[derive(Debug, Args)]
 pub struct FitArgs {
-    /// Manifest (TOML) listing the trials; trial files are relative to it (docs/measurements.md).
+    /// Manifest (TOML) listing the trials; trial files (CSV, or ROS 2 bags: docs/bags.md) are
+    /// relative to it (docs/measurements.md).
     #[arg(value_name = "MANIFEST")]
     pub manifest: PathBuf,
     /// Write the fitted terrain (docs/model.md §7 format, with k_n_sd/k_s_sd) to this TOML file.

@@ -208,7 +208,7 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
         let ma: Vec<String> = answer
             .swing_offset_n_m
             .iter()
-            .map(|t| format!("{:.0}", 1000.0 * t / sandslope::servo::xl330::TORQUE_CONSTANT_N_M_PER_A))
+            .map(|t| format!("{:.0}", sandslope::servo::ServoModel::XL330_M288.current_ma_from_torque(*t)))
             .collect();
         println!(
             "current offsets read in the swings and removed, legs 0 to {}: {} mA (as drive torque, in each leg's sense)",

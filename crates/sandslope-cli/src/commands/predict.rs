@@ -2,10 +2,10 @@
 
 use anyhow::Result;
 use clap::Args;
-use sandslope_request::predict::evaluate;
+use sandslope_request::scenario::load_terrain;
 use sandslope_request::PredictRequest;
 
-use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
+use crate::args::{warn_extrapolated, FieldArgs, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::output::{
     csv_string, num, print_json, ruled_out_note, sci, speed_cell, table, Format, FormatArgs,
 };
@@ -13,10 +13,9 @@ use crate::output::{
 /// Arguments of `sandslope predict`.
 #[derive(Debug, Args)]
 pub struct PredictArgs {
-    /// Slope along the direction of travel, degrees (negative: descending, evaluated as |slope|,
-    /// docs/model.md §8).
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
-    pub slope: f64,
+    /// `--slope`: the request's own field ([`sandslope_request::predict::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<PredictRequest>,
     #[command(flatten)]
     pub robot: RobotArgs,
     #[command(flatten)]
@@ -29,23 +28,25 @@ pub struct PredictArgs {
 
 impl PredictArgs {
     /// The request these flags make (the one `serve`'s `/api/predict` and Python build too).
-    pub fn request(&self) -> PredictRequest {
-        PredictRequest { slope: self.slope, scenario: self.over.request(&self.robot, &self.terrain) }
+    pub fn request(&self) -> sandslope_request::Result<PredictRequest> {
+        PredictRequest::with_scenario(&self.fields.pairs, self.over.request(&self.robot, &self.terrain))
     }
 }
 
-/// Runs `sandslope predict`: the request's answer, written as a table, JSON or CSV.
+/// Runs `sandslope predict`: the request's answer (the one `/api/predict` gives), written as a
+/// table, JSON or CSV.
 pub fn run(args: PredictArgs) -> Result<()> {
-    let scenario = args.request().scenario.scenario()?;
-    let e = evaluate(&scenario, args.slope)?;
+    let request = args.request()?;
+    let e = request.answer()?;
+    let slope = request.slope;
     if e.extrapolated {
-        warn_extrapolated(scenario.terrain(), &[args.slope]);
+        warn_extrapolated(&load_terrain(&request.scenario.terrain)?, &[slope]);
     }
-    if args.slope < 0.0 {
+    if slope < 0.0 {
         eprintln!(
             "note: descending {} deg is evaluated as climbing {} deg (docs/model.md §8)",
-            -args.slope,
-            args.slope.abs()
+            -slope,
+            slope.abs()
         );
     }
     match args.format.format() {
@@ -60,7 +61,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
             let crit = |c: &Result<f64, _>| c.as_ref().map_or_else(|_| "none".to_string(), |k| sci(*k));
             let mut t = table(&["quantity", "value", "unit"]);
             let rows: Vec<[String; 3]> = vec![
-                ["slope".into(), format!("{}", args.slope), "deg".into()],
+                ["slope".into(), format!("{slope}"), "deg".into()],
                 ["normal resistance k_n".into(), sci(p.k_n), "N/m^3".into()],
                 ["shear strength k_s".into(), sci(p.k_s), "N/m^3".into()],
                 ["normal equilibrium depth d_n".into(), mm(p.normal_depth), "mm".into()],

@@ -6,10 +6,10 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use sandslope_render::rows::{ConvergenceRow, EnsembleRow, SimSlopeRow};
 
-use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
+use crate::args::{warn_extrapolated, FieldArgs, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::figures;
 use crate::figures::simulate::{Animation, SimulateFigure, SlopesFigure};
 use crate::output::{
@@ -17,113 +17,41 @@ use crate::output::{
 };
 use crate::progress::{spinner, Progress};
 use sandslope::simulate::convergence::{RefinedWalk, Refinement, WalkAnswer};
-use sandslope::simulate::mechanisms::{CONSTANT_SPEED_DUTY, UNDISTURBED_SAND};
-use sandslope::simulate::{BodyPitch, ConvergenceCheck, Mechanisms, RftScaling, SimSummary, Simulation};
+use sandslope::simulate::{BodyPitch, ConvergenceCheck, RftScaling, SimSummary, Simulation};
 use sandslope_io::load_speeds;
 use sandslope_io::trajectory::plain_mocap_csv;
-use sandslope_request::simulate::{ensemble_size, parse_slopes, Answer, SimSlopes, Walks};
+use sandslope_request::simulate::{Answer, Walks, CHECK_CONVERGENCE, ENSEMBLE, SLOPES};
 use sandslope_request::SimulateRequest;
 
 /// Arguments of `sandslope simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Slope, degrees (negative: walking downhill).
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true, required_unless_present = "slopes")]
-    pub slope: Option<f64>,
-    /// Slopes, degrees, simulated in parallel (instead of --slope): DEG,DEG,... or MIN:MAX:N
-    /// (N evenly spaced, ends included), as risk --slope takes them.
-    #[arg(long, value_name = "MIN:MAX:N", conflicts_with_all = ["slope", "out", "animate"])]
-    pub slopes: Option<String>,
-    /// Simulated time after settling, s (at least 1.5 T: one stride to settle into the gait,
-    /// then steps to measure).
-    #[arg(long, value_name = "S", default_value_t = 10.0, allow_negative_numbers = true)]
-    pub duration: f64,
-    /// Time step, s (default: T / 2000, 0.5 ms for the paper's robot; at most T / 100;
-    /// docs/model.md §17).
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
-    pub dt: Option<f64>,
-    /// Creep speed of the contact law's smoothing at rest, m/s (default 1e-7; 1e-9 to 1e-3;
-    /// docs/model.md §17): a numerical setting, which moves no converged answer.
-    #[arg(long, value_name = "M/S", allow_negative_numbers = true)]
-    pub creep: Option<f64>,
-    /// Drive the legs as ideal position servos even where the robot file gives a servo torque
-    /// limit (by default the limit applies, docs/model.md §15).
-    #[arg(long)]
-    pub no_servo_limit: bool,
-    /// Whether the body may pitch: `locked` (the default) holds it parallel to the slope, the
-    /// closed form's assumption and the setting whose answers converge; `free` lets it pitch,
-    /// rear and tumble, chaotic on slopes: one walk is one draw of a spread (docs/simulate.md).
-    #[arg(long, value_name = "MODE", value_enum, default_value_t = PitchArg::Locked)]
-    pub body_pitch: PitchArg,
-    /// How resistive force theory is scaled to the terrain's k_n and k_s: `motion` (one scale
-    /// that follows the direction of motion), `components` (normal stress by k_n, shear
-    /// stress by k_s) or `li2013` (Li, Zhang and Goldman 2013: one factor from k_n, k_s
-    /// unused), docs/model.md §16.
-    #[arg(long, value_name = "MODE", value_enum, default_value_t = ScalingArg::Motion)]
-    pub rft_scaling: ScalingArg,
-    /// Leg-sand friction coefficient (0 to 10): the stress along a leg element's surface at
-    /// most MU times the stress normal to it (docs/model.md §20.1; default: none, resistive
-    /// force theory's stresses as they are).
-    #[arg(long, value_name = "MU", allow_negative_numbers = true)]
-    pub leg_friction: Option<f64>,
-    /// Share of the stride period over which a leg turns the half turn from its touchdown,
-    /// 0.1 to 0.9 (docs/model.md §20.2; default 0.5: one speed all round, the paper's gait).
-    #[arg(long, value_name = "D", default_value_t = CONSTANT_SPEED_DUTY, allow_negative_numbers = true)]
-    pub duty_cycle: f64,
-    /// Resistance of sand a leg passed through in an earlier stance, as a share of the
-    /// undisturbed sand's, greater than 0 and at most 1 (docs/model.md §20.3, the trench;
-    /// default 1: as strong as before).
-    #[arg(long, value_name = "F", default_value_t = UNDISTURBED_SAND, allow_negative_numbers = true)]
-    pub disturbed_sand: f64,
-    /// The belly as the body's underside, sand below it only: it pushes and never pulls the
-    /// body down, its drag capped by its push (docs/model.md §20.5; default: a plate in sand
-    /// on both faces, as resistive force theory's plates were).
-    #[arg(long)]
-    pub one_sided_belly: bool,
-    /// What turns the legs: `ideal` (position sources that follow the gait whatever the sand
-    /// resists, the default) or `servo` (the XL330-M288's motor, its torque-speed line and
-    /// current limit, the leg rates solved with the body's; docs/model.md §20.6).
-    #[arg(long, value_name = "ideal|servo", value_enum, default_value_t = ActuatorArg::Ideal)]
-    pub actuator: ActuatorArg,
-    /// Walk the one slope N times (2 to 1000), the robot's mass perturbed by 1e-9 relative
-    /// between walks, and give the spread: mean speed, its SD and standard error, mean t1, the
-    /// regimes' counts, how many pitched over. For the free body, whose walk on a slope is
-    /// chaotic, the spread is the answer (docs/simulate.md, "Pitch free").
-    #[arg(long, value_name = "N", conflicts_with_all = ["slopes", "out", "plot", "animate"])]
-    pub ensemble: Option<usize>,
-    /// Walk the slope (or each of --slopes) again at a quarter of the time step and at a tenth
-    /// of the creep speed, and say whether the answer is converged: speed, and the spread of
-    /// the steps' speeds, within 3% (or 0.3 cm/s), t1 within 1 ms and the same regime (issue
-    /// 38's test; docs/simulate.md, "Checking convergence"). The default step is shown converged for the built-in robot
-    /// and terrain only; check your own. With --ensemble N each setting is N walks, their
-    /// means compared (a single free-pitch walk on a slope is chaotic and cannot converge).
-    #[arg(long, conflicts_with_all = ["out", "plot", "animate"])]
-    pub check_convergence: bool,
-    /// Trajectory sample rate for --out, --plot and --animate, Hz.
-    #[arg(long, value_name = "HZ", default_value_t = 120.0, allow_negative_numbers = true)]
-    pub rate: f64,
+    /// The request's own fields, `--slope` to `--rate`
+    /// ([`sandslope_request::simulate::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<SimulateRequest>,
     /// Write the body's centre as plain motion capture (time_s,x_m,y_m,z_m) for `track`; a
     /// name ending .mcap writes ROS 2 messages for Foxglove instead (pose, legs as TF, joint
     /// states, forces as markers; docs/bags.md).
-    #[arg(long, value_name = "CSV|MCAP")]
+    #[arg(long, value_name = "CSV|MCAP", conflicts_with_all = [SLOPES.flag, ENSEMBLE.flag, CHECK_CONVERGENCE.flag])]
     pub out: Option<PathBuf>,
     /// After the walk, play the channels of --out walk.mcap in real time to Foxglove over its
     /// WebSocket protocol on ADDR (default 127.0.0.1:8765, loopback only), waiting up to 30 s
     /// for a viewer to subscribe first (docs/bags.md, "Watch live").
-    #[arg(long, value_name = "ADDR", num_args = 0..=1, conflicts_with_all = ["slopes", "check_convergence"],
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, conflicts_with_all = [SLOPES.flag, CHECK_CONVERGENCE.flag],
         default_missing_value = sandslope_io::foxglove::DEFAULT_ADDR)]
     pub foxglove: Option<String>,
     /// Draw position, leg depths and leg forces against time (one slope), or simulated,
     /// closed-form and observed speeds against slope (--slopes), to FILE (.png or .svg).
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with_all = [ENSEMBLE.flag, CHECK_CONVERGENCE.flag])]
     pub plot: Option<PathBuf>,
     /// Observed speeds (CSV: slope_deg,speed_m_s,speed_sd_m_s) for the --slopes figure.
-    #[arg(long, value_name = "CSV", requires_all = ["slopes", "plot"])]
+    #[arg(long, value_name = "CSV", requires_all = [SLOPES.flag, "plot"])]
     pub observed: Option<PathBuf>,
     /// Side-view animation to FILE.gif: slope, sand with a mark every 5 cm, the body's trace,
     /// legs and force arrows; the whole walk at 20 frames per simulated second, in real time,
     /// up to its first 60 s (1200 frames).
-    #[arg(long, value_name = "FILE.gif")]
+    #[arg(long, value_name = "FILE.gif", conflicts_with_all = [SLOPES.flag, ENSEMBLE.flag, CHECK_CONVERGENCE.flag])]
     pub animate: Option<PathBuf>,
     #[command(flatten)]
     pub robot: RobotArgs,
@@ -135,83 +63,11 @@ pub struct SimulateArgs {
     pub format: FormatArgs,
 }
 
-/// `--body-pitch`: the library's [`BodyPitch`] as a flag value.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum PitchArg {
-    /// The body pitches under the sand's and gravity's moments (chaotic on slopes).
-    Free,
-    /// The body is held parallel to the slope, as the closed form assumes (default).
-    Locked,
-}
-
-impl From<PitchArg> for BodyPitch {
-    fn from(p: PitchArg) -> BodyPitch {
-        match p {
-            PitchArg::Free => BodyPitch::Free,
-            PitchArg::Locked => BodyPitch::Locked,
-        }
-    }
-}
-
-/// `--actuator`: what turns the legs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ActuatorArg {
-    /// Ideal position sources (default).
-    Ideal,
-    /// The XL330-M288's motor (docs/model.md §20.6).
-    Servo,
-}
-
-/// `--rft-scaling`: the library's [`RftScaling`] as a flag value.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ScalingArg {
-    /// One scale that follows the direction of motion (default).
-    Motion,
-    /// Normal stress by k_n, along-surface stress by k_s.
-    Components,
-    /// Li, Zhang and Goldman (2013): one factor from k_n for every stress.
-    Li2013,
-}
-
-impl From<ScalingArg> for RftScaling {
-    fn from(p: ScalingArg) -> RftScaling {
-        match p {
-            ScalingArg::Motion => RftScaling::Motion,
-            ScalingArg::Components => RftScaling::Components,
-            ScalingArg::Li2013 => RftScaling::Li2013,
-        }
-    }
-}
-
 impl SimulateArgs {
-    /// The request these flags make (the one `serve`'s `/api/simulate` builds too).
+    /// The request these flags make: the flags given, read by the request as `/api/simulate`'s
+    /// fields are.
     pub fn request(&self) -> Result<SimulateRequest> {
-        let slopes = match (&self.slopes, self.slope) {
-            (Some(text), _) => SimSlopes::Many(parse_slopes(text)?),
-            (None, Some(slope)) => SimSlopes::One(slope),
-            (None, None) => bail!("--slope or --slopes is required"),
-        };
-        let ensemble = self.ensemble.map(|n| ensemble_size(n as f64, &slopes)).transpose()?;
-        Ok(SimulateRequest {
-            slopes,
-            scenario: self.over.request(&self.robot, &self.terrain),
-            duration_s: self.duration,
-            dt_s: self.dt,
-            creep_m_s: self.creep,
-            servo_limit: !self.no_servo_limit,
-            body_pitch: self.body_pitch.into(),
-            rft_scaling: self.rft_scaling.into(),
-            mechanisms: Mechanisms {
-                leg_friction: self.leg_friction,
-                duty_cycle: self.duty_cycle,
-                disturbed_sand: self.disturbed_sand,
-                one_sided_belly: self.one_sided_belly,
-                servo_actuator: self.actuator == ActuatorArg::Servo,
-            },
-            rate_hz: self.rate,
-            ensemble,
-            check_convergence: self.check_convergence,
-        })
+        Ok(SimulateRequest::with_scenario(&self.fields.pairs, self.over.request(&self.robot, &self.terrain))?)
     }
 }
 
@@ -656,6 +512,7 @@ fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedOb
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sandslope_request::simulate::parse_slopes;
 
     #[test]
     fn slope_ranges_name_the_flag() {

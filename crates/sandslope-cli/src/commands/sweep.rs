@@ -5,31 +5,20 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 
-use crate::args::{warn_extrapolated, OverrideArgs, RobotArgs, TerrainArgs};
+use crate::args::{warn_extrapolated, FieldArgs, OverrideArgs, RobotArgs, TerrainArgs};
 use crate::figures;
 use crate::figures::sweep::SweepFigure;
 use crate::output::{csv_string, num, print_json, ruled_out_note, speed_cell, table, Format, FormatArgs};
 use sandslope_io::load_speeds;
-use sandslope_request::sweep::evaluate;
 use sandslope_request::SweepRequest;
 
 /// Arguments of `sandslope sweep`.
 #[derive(Debug, Args)]
 pub struct SweepArgs {
-    /// Slope(s), degrees, in the one slope grammar of every command (as `risk --slope` and
-    /// `phase --slope`): one value, a comma list (0,10,20) or MIN:MAX:N, N slopes evenly spaced
-    /// with both ends included (0:30:31 is every degree). Without it, --from/--to/--step.
-    #[arg(long, value_name = "DEG|LIST|MIN:MAX:N", allow_hyphen_values = true, conflicts_with_all = ["from", "to", "step"])]
-    pub slope: Option<String>,
-    /// First slope, degrees (the older shorthand for --slope FROM:TO:N).
-    #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_negative_numbers = true)]
-    pub from: f64,
-    /// Last slope, degrees, included when the steps land on it (shorthand, see --slope).
-    #[arg(long, value_name = "DEG", default_value_t = 30.0, allow_negative_numbers = true)]
-    pub to: f64,
-    /// Slope increment, degrees (shorthand, see --slope).
-    #[arg(long, value_name = "DEG", default_value_t = 1.0, allow_negative_numbers = true)]
-    pub step: f64,
+    /// `--slope`, `--from`, `--to` and `--step`: the request's own fields
+    /// ([`sandslope_request::sweep::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<SweepRequest>,
     /// Draw speed, anchoring time and step length against slope into FILE (.png or .svg).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
@@ -48,23 +37,17 @@ pub struct SweepArgs {
 
 impl SweepArgs {
     /// The request these flags make (the one `serve`'s `/api/sweep` builds too).
-    pub fn request(&self) -> SweepRequest {
-        SweepRequest {
-            slope: self.slope.clone(),
-            from: self.from,
-            to: self.to,
-            step: self.step,
-            scenario: self.over.request(&self.robot, &self.terrain),
-        }
+    pub fn request(&self) -> sandslope_request::Result<SweepRequest> {
+        SweepRequest::with_scenario(&self.fields.pairs, self.over.request(&self.robot, &self.terrain))
     }
 }
 
 /// Runs `sandslope sweep`.
 pub fn run(args: SweepArgs) -> Result<()> {
-    let request = args.request();
-    let slopes = request.slopes()?;
+    let request = args.request()?;
+    request.slopes()?;
     let scenario = request.scenario.scenario()?;
-    let evals = evaluate(&scenario, &slopes)?;
+    let evals = request.answer_in(&scenario)?;
     let observed = args.observed.as_deref().map(load_speeds).transpose()?;
     let extrapolated: Vec<f64> = evals.iter().filter(|e| e.extrapolated).map(|e| e.slope_deg).collect();
     if !extrapolated.is_empty() {
@@ -132,7 +115,7 @@ mod tests {
     #[test]
     fn range_errors_name_the_flags() {
         let parse = |a: &[&str]| Cli::parse_from([&["x"], a].concat()).sweep;
-        let slopes = |args: &SweepArgs| args.request().slopes();
+        let slopes = |args: &SweepArgs| args.request().and_then(|r| r.slopes());
         let msg = slopes(&parse(&["--from", "10", "--to", "0"])).unwrap_err().to_string();
         assert!(msg.starts_with("--from = 10"), "{msg}");
         let msg = slopes(&parse(&["--step", "-1"])).unwrap_err().to_string();
@@ -150,12 +133,12 @@ mod tests {
     #[test]
     fn slope_takes_the_one_grammar_of_every_command() {
         let parse = |a: &[&str]| Cli::try_parse_from([&["x"], a].concat()).map(|c| c.sweep);
-        let slopes = |a: &[&str]| parse(a).unwrap().request().slopes().unwrap();
+        let slopes = |a: &[&str]| parse(a).unwrap().request().unwrap().slopes().unwrap();
         assert_eq!(slopes(&["--slope", "-5:5:3"]), vec![-5.0, 0.0, 5.0]);
         assert_eq!(slopes(&["--slope", "0,12.5,24"]), vec![0.0, 12.5, 24.0]);
         assert_eq!(slopes(&["--slope", "0:30:31"]).len(), 31);
         assert!(parse(&["--slope", "0:30:31", "--from", "5"]).is_err());
-        let msg = parse(&["--slope", "0:30:1"]).unwrap().request().slopes().unwrap_err().to_string();
+        let msg = parse(&["--slope", "0:30:1"]).unwrap().request().unwrap().slopes().unwrap_err().to_string();
         assert!(msg.contains("write 0:30:31"), "{msg}");
     }
 }

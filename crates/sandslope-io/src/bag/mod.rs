@@ -21,6 +21,8 @@
 pub mod messages;
 pub mod series;
 mod storage;
+mod tf;
+pub mod wrench;
 
 use std::path::{Path, PathBuf};
 

@@ -1,5 +1,6 @@
 //! A bag's topic as what a command takes: a body's trajectory for `track` (poses, odometry or
-//! a TF child frame), a servo log for `infer --servo-log` (joint states). Times are the
+//! a TF child frame, composed up its tree), a servo log for `infer --servo-log` (joint
+//! states). Times are the
 //! messages' header stamps (the measurement's time), or the recorder's log time where a
 //! stamp is zero (a driver that does not set it).
 
@@ -19,20 +20,20 @@ use crate::servo_log::{ServoLog, ServoLogRow};
 pub const POSE_TYPES: [&str; 4] =
     [PoseStamped::TYPE, Odometry::TYPE, TfMessage::TYPE, TransformStamped::TYPE];
 
-fn stamp_ns(header: &messages::Header, m: &BagMessage<'_>) -> i64 {
+pub(super) fn stamp_ns(header: &messages::Header, m: &BagMessage<'_>) -> i64 {
     match header.stamp.nanos() {
         0 => m.log_time_ns.min(i64::MAX as u64) as i64,
         ns => ns,
     }
 }
 
-fn decode_at<T: RosMessage>(m: &BagMessage<'_>) -> Result<T> {
+pub(super) fn decode_at<T: RosMessage>(m: &BagMessage<'_>) -> Result<T> {
     decode::<T>(m.data).map_err(|e| anyhow!("{}: topic `{}`, message {}: {e}", m.at, m.topic, m.index))
 }
 
 /// Picks the topic: the one named (checked to exist and be of one of `types`), or the only
 /// one of those types; otherwise an error listing the candidates. `flag` names the option.
-fn pick_topic(
+pub(super) fn pick_topic(
     path: &Path,
     topics: &[BagTopic],
     wanted: Option<&str>,
@@ -81,12 +82,37 @@ fn pick_topic(
 
 /// Reads one body's trajectory from a bag: the positions on `topic` (a `PoseStamped`,
 /// `Odometry`, `TransformStamped` or `TFMessage` topic; the only such topic when `None`),
-/// for `TFMessage` the child frame `frame` (the only one when `None`; for `Odometry` and
-/// `TransformStamped`, `frame` must be the child frame when given). Positions are put on the
-/// regular grid of the median time step (exactly, when every stamp lies within a quarter
-/// step of it; else interpolated linearly, a gap longer than two steps left as occlusion).
-/// The capture frame is ROS's: z up (REP 103), the plain format's.
+/// for `TFMessage` the child frame `frame` (the only one when `None`) composed up its tree to
+/// the root (docs/bags.md; for `Odometry` and `TransformStamped`, `frame` must be the child
+/// frame when given). Positions are put on the regular grid of the median time step
+/// (exactly, when every stamp lies within a quarter step of it; else interpolated linearly,
+/// a gap longer than two steps left as occlusion). The capture frame is ROS's: z up (REP
+/// 103), the plain format's.
 pub fn read_capture(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Result<Capture> {
+    let Positions { name, body, samples } = read_positions(path, topic, frame)?;
+    let (frame_rate_hz, start_time_s, positions) = regular(path, &name, samples)?;
+    Ok(Capture {
+        path: path.to_path_buf(),
+        format: MocapFormat::Plain,
+        body,
+        frame_rate_hz,
+        start_time_s,
+        positions,
+    })
+}
+
+/// A body's positions as read from a bag's topic, stamped (ns), not yet on a grid.
+pub(super) struct Positions {
+    /// The topic read.
+    pub name: String,
+    /// The body: the topic, with the child frame and, for a composed TF frame, its root.
+    pub body: String,
+    /// Stamp (ns) and position (m), in the order read.
+    pub samples: Vec<(i64, [f64; 3])>,
+}
+
+/// The positions [`read_capture`] puts on its grid (the same topic and frame rules).
+pub(super) fn read_positions(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Result<Positions> {
     let bag = open(path)?;
     let listed;
     let topics = match topic {
@@ -102,6 +128,9 @@ pub fn read_capture(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Re
     // Child frames seen on a TF topic (when no frame is given and several appear, the list).
     let mut frames: BTreeMap<String, u64> = BTreeMap::new();
     let mut samples: Vec<(i64, [f64; 3])> = Vec::new();
+    // On a TF topic: every child frame's parent, and the frame's own transforms.
+    let mut parents: BTreeMap<String, String> = BTreeMap::new();
+    let mut tf_samples: Vec<(i64, nalgebra::Isometry3<f64>)> = Vec::new();
     let mut kind: Option<String> = None;
     let all = scan(&bag, Some(&name), &mut |m| {
         let type_name = m.type_name;
@@ -136,8 +165,25 @@ pub fn read_capture(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Re
             let tf: TfMessage = decode_at(m)?;
             for t in tf.transforms {
                 let child = t.child_frame_id.trim_start_matches('/').to_string();
+                let parent = t.header.frame_id.trim_start_matches('/');
+                let first = parents.entry(child.clone()).or_insert_with(|| parent.to_string());
                 if frame.as_deref() == Some(child.as_str()) {
-                    samples.push((stamp_ns(&t.header, m), point(t.transform.translation)));
+                    if first != parent {
+                        bail!(
+                            "{}: topic `{}`, message {}: frame `{child}` changes parent from `{first}` to `{parent}`",
+                            m.at,
+                            m.topic,
+                            m.index
+                        );
+                    }
+                    let iso = super::tf::isometry(&t.transform).unwrap_or_else(|| {
+                        // A zero rotation: the translation is still the frame's position.
+                        let v = t.transform.translation;
+                        nalgebra::Isometry3::translation(v.x, v.y, v.z)
+                    });
+                    let ns = stamp_ns(&t.header, m);
+                    samples.push((ns, point(t.transform.translation)));
+                    tf_samples.push((ns, iso));
                 }
                 *frames.entry(child).or_default() += 1;
             }
@@ -160,7 +206,7 @@ pub fn read_capture(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Re
     if frame.is_none() && (frames.len() > 1 || (is_tf && frames.len() == 1)) {
         // No frame given: on a TF topic the only child frame, read again; else the list.
         match frames.keys().collect::<Vec<_>>().as_slice() {
-            [only] => return read_capture(path, Some(&name), Some(only)),
+            [only] => return read_positions(path, Some(&name), Some(only)),
             _ => bail!(
                 "{}: topic `{name}` carries several child frames; choose one with --frame: {}",
                 path.display(),
@@ -180,16 +226,20 @@ pub fn read_capture(path: &Path, topic: Option<&str>, frame: Option<&str>) -> Re
             bail!("{}: topic `{name}` has no child frame `{f}`; it has: {}", path.display(), list_frames());
         }
         body = format!("{name} {f}");
+        if is_tf {
+            let parent = parents.get(f).cloned().unwrap_or_default();
+            let target = super::tf::FrameSamples { frame: f, parent: &parent, samples: tf_samples };
+            let (composed, root) = super::tf::in_root(&bag, path, &name, &all, target, &parents)?;
+            if root != parent {
+                body = format!("{name} {f} in {root}");
+                samples = composed
+                    .into_iter()
+                    .map(|(t, p)| (t, point(messages::Point { x: p[0], y: p[1], z: p[2] })))
+                    .collect();
+            }
+        }
     }
-    let (frame_rate_hz, start_time_s, positions) = regular(path, &name, samples)?;
-    Ok(Capture {
-        path: path.to_path_buf(),
-        format: MocapFormat::Plain,
-        body,
-        frame_rate_hz,
-        start_time_s,
-        positions,
-    })
+    Ok(Positions { name, body, samples })
 }
 
 fn point(p: messages::Point) -> [f64; 3] {
@@ -299,13 +349,14 @@ impl std::str::FromStr for EffortUnit {
 }
 
 impl EffortUnit {
-    /// The drive torque, N m, of an effort in this unit (`K_t I` for currents).
+    /// The drive torque, N m, of an effort in this unit (`K_t I` for currents, by the paper's
+    /// XL330-M288).
     pub fn torque_n_m(self, effort: f64) -> f64 {
-        use sandslope::servo::xl330;
+        let servo = &sandslope::servo::ServoModel::XL330_M288;
         match self {
             EffortUnit::NewtonMetre => effort,
-            EffortUnit::Ampere => xl330::TORQUE_CONSTANT_N_M_PER_A * effort,
-            EffortUnit::Milliampere => xl330::torque_from_current(effort),
+            EffortUnit::Ampere => servo.torque_from_current_ma(1000.0 * effort),
+            EffortUnit::Milliampere => servo.torque_from_current_ma(effort),
         }
     }
 }
@@ -390,8 +441,9 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
             }
             let torque = options.effort.torque_n_m(effort);
             let velocity = js.velocity.get(k).copied().unwrap_or(0.0);
-            use sandslope::servo::xl330;
-            let current_ma = xl330::current_from_torque(torque);
+            use sandslope::servo::model as x;
+            let servo = &sandslope::servo::ServoModel::XL330_M288;
+            let current_ma = servo.current_ma_from_torque(torque);
             rows.push((
                 t,
                 m.index,
@@ -400,12 +452,11 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
                     id: leg.min(252) as u8,
                     leg,
                     tripod: leg % 2,
-                    present_position: xl330::pulses_from_rad(angle).clamp(i32::MIN.into(), i32::MAX.into())
+                    present_position: x::pulses_from_rad(angle).clamp(i32::MIN.into(), i32::MAX.into())
                         as i32,
-                    present_velocity: (velocity / xl330::RAD_S_PER_VELOCITY_UNIT).round().clamp(-1e9, 1e9)
-                        as i32,
+                    present_velocity: (velocity / x::RAD_S_PER_VELOCITY_UNIT).round().clamp(-1e9, 1e9) as i32,
                     present_current_ma: current_ma.round().clamp(-1e9, 1e9) as i32,
-                    load_percent: 100.0 * current_ma / (xl330::STALL_CURRENT_A * 1000.0),
+                    load_percent: 100.0 * current_ma / (servo.stall_current_a * 1000.0),
                     input_voltage_v: 0.0,
                     temperature_c: 0,
                     hardware_error: 0,

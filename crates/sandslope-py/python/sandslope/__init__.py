@@ -46,6 +46,7 @@ from ._calibrate import calibrate
 from ._report import report
 from ._sandslope import Robot, Terrain
 from ._servo import drive, drive_defaults, infer_servo_log, read_bag, read_servo_log
+from ._walk import WalkSettings
 
 __all__ = [
     "REGIMES",
@@ -76,6 +77,7 @@ __all__ = [
     "drive",
     "drive_defaults",
     "read_bag",
+    "WalkSettings",
 ]
 
 
@@ -554,7 +556,8 @@ def fit(
     """k_n and k_s per slope from load-cell recordings (``sandslope fit``, docs/model.md §10).
 
     ``manifest`` is the TOML manifest of the campaign (docs/measurements.md): disk area, shear
-    plate, and one ``[[trial]]`` per CSV (kind, slope, in-air or not). k_n is the slope of force
+    plate, and one ``[[trial]]`` per CSV or ROS 2 bag (kind, slope, in-air or not; a bag's
+    wrench and pose topics as docs/bags.md describes). k_n is the slope of force
     against depth over its linear part, divided by the disk area; k_s comes from the
     quasi-static shear plateau; in-air runs are subtracted (``air``: ``"auto"``, ``"curve"``
     or ``"mean"``). ``depth_window=(min, max)`` (m) and ``plateau_from`` (m) override the
@@ -589,6 +592,8 @@ def track(
     cutoff_hz: float = 10.0,
     leg_speed_rad_s: Optional[float] = None,
     touchdowns: Optional[Sequence[Any]] = None,
+    topic: Optional[str] = None,
+    frame: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Speed, anchoring time and slip from motion capture (``sandslope track``, docs/model.md §11).
 
@@ -600,7 +605,10 @@ def track(
     ``leg_speed_rad_s``) come from ``touchdowns`` (per recording, a list of times in s or the
     path of a touchdowns file, as ``track --touchdowns`` reads) or are
     estimated from the speed signal. ``upslope`` (x, y, z) fixes the upslope direction
-    (estimated from the travel otherwise).
+    (estimated from the travel otherwise). A ROS 2 bag (a bag folder, ``.mcap`` or ``.db3``,
+    docs/bags.md) is read as ``track --topic --frame`` reads it: ``topic`` a pose, odometry or
+    TF topic (the bag's only one when omitted), ``frame`` the child frame on a TF topic,
+    composed up its tree to the root.
 
     Returns the fields of ``sandslope track --json``: pooled means and SDs (``speed_m_s``,
     ``t1_s``, ``slip_m``, ``step_m``, ...), and ``recordings`` and ``per_step`` as pandas
@@ -619,6 +627,8 @@ def track(
         cutoff_hz=float(cutoff_hz),
         leg_speed_rad_s=None if leg_speed_rad_s is None else float(leg_speed_rad_s),
         touchdowns=None if touchdowns is None else [_touchdown_times(ts) for ts in touchdowns],
+        topic=topic,
+        frame=frame,
     )
     out["recordings"] = _frame(out["recordings"])
     out["per_step"] = _frame(out["per_step"])
@@ -638,41 +648,13 @@ def _touchdown_times(ts: Any) -> list:
         ) from None
 
 
-def _walk_keywords(
-    k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
-) -> Dict[str, Any]:
-    """The keywords :func:`simulate`, :func:`simulate_ensemble` and :func:`check_convergence`
-    share, converted for the
-    extension; the docs/model.md §20 switches only where given (the others take the Rust
-    defaults)."""
-    optional = {"k_n": k_n, "k_s": k_s, "dt_s": dt_s, "creep_m_s": creep_m_s}
-    switches = {"leg_friction": leg_friction, "duty_cycle": duty_cycle, "disturbed_sand": disturbed_sand}
-    return {
-        **{k: None if v is None else float(v) for k, v in optional.items()},
-        "body_pitch": str(body_pitch),
-        "rft_scaling": str(rft_scaling),
-        "servo_limit": bool(servo_limit),
-        **{k: float(v) for k, v in switches.items() if v is not None},
-    }
-
-
 def simulate_ensemble(
     robot: RobotLike,
     terrain: TerrainLike,
     slope_deg: float,
     walks: int,
     duration_s: float = 10.0,
-    *,
-    k_n: Optional[float] = None,
-    k_s: Optional[float] = None,
-    dt_s: Optional[float] = None,
-    creep_m_s: Optional[float] = None,
-    body_pitch: str = "locked",
-    rft_scaling: str = "motion",
-    servo_limit: bool = True,
-    leg_friction: Optional[float] = None,
-    duty_cycle: Optional[float] = None,
-    disturbed_sand: Optional[float] = None,
+    **settings: Any,
 ) -> Dict[str, Any]:
     """Walks the robot ``walks`` times (2 to 1000) at ``slope_deg``, the mass of walk k
     multiplied by ``1 + k 1e-9``, and returns the spread: the dict ``sandslope simulate
@@ -682,7 +664,7 @@ def simulate_ensemble(
     With ``body_pitch="free"`` the walk on a slope is chaotic (two walks 1e-9 apart part by
     tens of degrees of pitch within seconds), so the spread is the answer; with the pitch
     locked the walks agree to rounding (docs/simulate.md, "Pitch free"). The other keywords are
-    :func:`simulate`'s.
+    :func:`simulate`'s (:class:`WalkSettings`).
     """
     return _sandslope.simulate_ensemble(
         _robot(robot),
@@ -690,9 +672,7 @@ def simulate_ensemble(
         float(slope_deg),
         float(duration_s),
         int(walks),
-        **_walk_keywords(
-            k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
-        ),
+        **settings,
     )
 
 
@@ -703,16 +683,7 @@ def check_convergence(
     duration_s: float = 10.0,
     *,
     walks: Optional[int] = None,
-    k_n: Optional[float] = None,
-    k_s: Optional[float] = None,
-    dt_s: Optional[float] = None,
-    creep_m_s: Optional[float] = None,
-    body_pitch: str = "locked",
-    rft_scaling: str = "motion",
-    servo_limit: bool = True,
-    leg_friction: Optional[float] = None,
-    duty_cycle: Optional[float] = None,
-    disturbed_sand: Optional[float] = None,
+    **settings: Any,
 ) -> Union[Dict[str, Any], List[Dict[str, Any]]]:
     """Whether the walk at ``slope_deg`` is converged: the dict ``sandslope simulate
     --check-convergence --json`` prints (a sequence of slopes: the list ``--slopes`` prints,
@@ -725,7 +696,7 @@ def check_convergence(
     (docs/simulate.md, "Checking convergence"); check a robot, terrain or mechanism of your
     own. With ``walks=N`` each setting is an ensemble of N walks and their means are compared:
     a single walk with ``body_pitch="free"`` on a slope is chaotic and cannot converge. The
-    other keywords are :func:`simulate`'s.
+    other keywords are :func:`simulate`'s (:class:`WalkSettings`).
     """
     slopes = [float(s) for s in slope_deg] if isinstance(slope_deg, (list, tuple, np.ndarray)) else float(slope_deg)
     return _sandslope.check_convergence(
@@ -734,9 +705,7 @@ def check_convergence(
         slopes,
         float(duration_s),
         None if walks is None else int(walks),
-        **_walk_keywords(
-            k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
-        ),
+        **settings,
     )
 
 
@@ -745,18 +714,7 @@ def simulate(
     terrain: TerrainLike,
     slope_deg: float,
     duration_s: float = 10.0,
-    *,
-    k_n: Optional[float] = None,
-    k_s: Optional[float] = None,
-    dt_s: Optional[float] = None,
-    creep_m_s: Optional[float] = None,
-    sample_rate_hz: float = 120.0,
-    body_pitch: str = "locked",
-    rft_scaling: str = "motion",
-    servo_limit: bool = True,
-    leg_friction: Optional[float] = None,
-    duty_cycle: Optional[float] = None,
-    disturbed_sand: Optional[float] = None,
+    **settings: Any,
 ) -> Tuple[Any, Dict[str, Any]]:
     """Simulates the robot walking for ``duration_s`` seconds on ``terrain`` at ``slope_deg``
     (``sandslope simulate``, docs/model.md §15-§18).
@@ -773,8 +731,12 @@ def simulate(
     motion (``--rft-scaling``, docs/model.md §16); ``servo_limit=False`` ignores the robot
     file's servo torque limit (``--no-servo-limit``). ``leg_friction``, ``duty_cycle`` and
     ``disturbed_sand`` switch on the candidate mechanisms of docs/model.md §20 (``--leg-friction``,
-    ``--duty-cycle``, ``--disturbed-sand``; left out, each takes the CLI's default: off).
-    Negative slopes walk downhill.
+    ``--duty-cycle``, ``--disturbed-sand``; left out, each takes the CLI's default: off), as
+    do ``one_sided_belly=True`` (``--one-sided-belly``, §20.5) and ``actuator="servo"``
+    (``--actuator servo``, §20.6). The keywords are :class:`WalkSettings`, shared with
+    :func:`simulate_ensemble` and :func:`check_convergence`; the extension reads them by the
+    request layer's table, as ``sandslope simulate`` reads its flags. Negative slopes walk
+    downhill.
 
     Returns ``(trajectory, summary)``: ``trajectory`` a pandas DataFrame (a dict of NumPy
     columns without pandas) with ``time_s``, ``x_m``, ``z_m``, ``pitch_rad``, ``vx_m_s``,
@@ -788,10 +750,7 @@ def simulate(
         _terrain(terrain),
         float(slope_deg),
         float(duration_s),
-        sample_rate_hz=float(sample_rate_hz),
-        **_walk_keywords(
-            k_n, k_s, dt_s, creep_m_s, body_pitch, rft_scaling, servo_limit, leg_friction, duty_cycle, disturbed_sand
-        ),
+        **settings,
     )
     try:
         import pandas as pd

@@ -6,6 +6,9 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Unpack
+
+from ._walk import WalkSettings
 
 _Path = Union[str, "os.PathLike[str]"]
 _F64 = npt.NDArray[np.float64]
@@ -193,6 +196,8 @@ def track(
     cutoff_hz: float = 10.0,
     leg_speed_rad_s: Optional[float] = None,
     touchdowns: Optional[List[List[float]]] = None,
+    topic: Optional[str] = None,
+    frame: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def calibrate(
     robot: Robot,
@@ -225,22 +230,13 @@ def report(
     simulator_fit: bool = False,
     html: Optional[_Path] = None,
 ) -> str: ...
+def walk_keyword_defaults() -> List[Tuple[str, Optional[str]]]: ...
 def simulate(
     robot: Robot,
     terrain: Terrain,
     slope_deg: float,
     duration_s: float,
-    k_n: Optional[float] = None,
-    k_s: Optional[float] = None,
-    dt_s: Optional[float] = None,
-    creep_m_s: Optional[float] = None,
-    sample_rate_hz: float = 120.0,
-    body_pitch: str = "locked",
-    rft_scaling: str = "motion",
-    servo_limit: bool = True,
-    leg_friction: Optional[float] = None,
-    duty_cycle: float = 0.5,
-    disturbed_sand: float = 1.0,
+    **keywords: Unpack[WalkSettings],
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 def simulate_ensemble(
     robot: Robot,
@@ -248,16 +244,7 @@ def simulate_ensemble(
     slope_deg: float,
     duration_s: float,
     walks: int,
-    k_n: Optional[float] = None,
-    k_s: Optional[float] = None,
-    dt_s: Optional[float] = None,
-    creep_m_s: Optional[float] = None,
-    body_pitch: str = "locked",
-    rft_scaling: str = "motion",
-    servo_limit: bool = True,
-    leg_friction: Optional[float] = None,
-    duty_cycle: float = 0.5,
-    disturbed_sand: float = 1.0,
+    **keywords: Unpack[WalkSettings],
 ) -> Dict[str, Any]: ...
 def check_convergence(
     robot: Robot,
@@ -265,16 +252,7 @@ def check_convergence(
     slope_deg: Union[float, List[float]],
     duration_s: float,
     walks: Optional[int] = None,
-    k_n: Optional[float] = None,
-    k_s: Optional[float] = None,
-    dt_s: Optional[float] = None,
-    creep_m_s: Optional[float] = None,
-    body_pitch: str = "locked",
-    rft_scaling: str = "motion",
-    servo_limit: bool = True,
-    leg_friction: Optional[float] = None,
-    duty_cycle: float = 0.5,
-    disturbed_sand: float = 1.0,
+    **keywords: Unpack[WalkSettings],
 ) -> Union[Dict[str, Any], List[Dict[str, Any]]]: ...
 def read_servo_log(path: _Path) -> Tuple[Dict[str, np.ndarray], Dict[str, str], List[str]]: ...
 def infer_servo_log(
@@ -325,3 +303,11 @@ def read_bag_joints(
     joints: Optional[List[str]] = None,
     effort_unit: str = "n_m",
 ) -> Tuple[Dict[str, np.ndarray], List[str]]: ...
+def read_bag_load_cell(
+    path: _Path,
+    force_axis: str,
+    force_topic: Optional[str] = None,
+    position_topic: Optional[str] = None,
+    frame: Optional[str] = None,
+    position_axis: Optional[str] = None,
+) -> Tuple[Dict[str, np.ndarray], str]: ...

@@ -186,6 +186,9 @@ def read_bag(
     joints: Optional[Any] = None,
     effort_unit: str = "n_m",
     legs: int = 6,
+    force_axis: Optional[str] = None,
+    position_topic: Optional[str] = None,
+    position_axis: Optional[str] = None,
 ) -> Any:
     """Reads a ROS 2 bag (a folder with ``metadata.yaml``, or an ``.mcap`` or ``.db3`` file;
     docs/bags.md) as ``sandslope track`` and ``sandslope infer --servo-log`` read it, into a
@@ -199,6 +202,11 @@ def read_bag(
       ``leg_angle_rad``, ``drive_torque_n_m``, ...), ``joints`` the joint names in leg order,
       ``effort_unit`` ``"n_m"``, ``"a"`` or ``"ma"``, ``legs`` the robot's 2 * stance_legs;
       ``df.attrs["notes"]`` says how the joints were mapped;
+    - a ``geometry_msgs/WrenchStamped`` topic: a ``fit`` trial's columns ``time_s,
+      position_m, force_n`` (the force along ``force_axis``, required: ``"z"``, ``"-z"``,
+      ...; the intruder's travel on ``position_topic``, with ``frame`` and
+      ``position_axis``, as a bag trial's manifest keys say); ``df.attrs["body"]`` names the
+      position's topic;
     - no ``topic``: the bag's topics (``name, type, encoding, messages``).
 
     Errors (a ValueError) name the file, the topic and where in the file."""
@@ -215,7 +223,15 @@ def read_bag(
         if hasattr(df, "attrs"):
             df.attrs["notes"] = notes
         return df
-    columns, body = _sandslope.read_bag_poses(p, topic, frame)
+    if kinds.get(topic, "").replace("/msg/", "/") == "geometry_msgs/WrenchStamped":
+        if force_axis is None:
+            raise ValueError(
+                f"topic `{topic}` is a WrenchStamped: give force_axis, the force component that the sand's "
+                "resistance makes grow (\"z\", \"-z\", \"x\", ...)"
+            )
+        columns, body = _sandslope.read_bag_load_cell(p, force_axis, topic, position_topic, frame, position_axis)
+    else:
+        columns, body = _sandslope.read_bag_poses(p, topic, frame)
     df = _frame(columns)
     if hasattr(df, "attrs"):
         df.attrs["body"] = body

@@ -31,6 +31,7 @@ function showDrive(st) {
   if (live) $("drive-climb").dataset.value = String(live.speed_m_s);
   $("drive-p-slippage").textContent = live ? prob(live.p_slippage) : "-";
   $("drive-p-fail").textContent = live ? prob(live.p_fail) : "-";
+  showVerdicts(st.live && st.live.pooled);
   $("drive-estimates").textContent = live
     ? `${st.estimates} stances; the last, tripod ${st.live.tripod}, ended at t = ${st.live.time_s.toFixed(2)} s`
     : "no stance finished yet";
@@ -52,6 +53,32 @@ function showDrive(st) {
   if (st.emulator) end += st.emulator;
   $("drive-end").textContent = end;
   return ended;
+}
+// Both verdicts on the stances pooled so far (docs/drive.md, "The live estimate, pooled, and
+// the decision"): the simulator's (the grid walks' regimes) and the closed form's at the
+// pooled k_s; where one says the walk fails (P >= 0.5) and the other not, the page says so
+// and which one the decision took.
+function showVerdicts(pooled) {
+  const v = $("drive-verdicts");
+  const note = $("drive-disagree");
+  if (!pooled) {
+    v.textContent = "-";
+    note.hidden = true;
+    return;
+  }
+  const sim = pooled.p_fail_simulator;
+  const cf = pooled.p_fail_closed_form;
+  v.textContent = `${prob(sim)} / ${prob(cf)}`;
+  v.dataset.simulator = String(sim);
+  v.dataset.closedForm = String(cf);
+  const disagree = (sim >= 0.5) !== (cf >= 0.5);
+  v.dataset.disagree = String(disagree);
+  note.hidden = !disagree;
+  note.textContent = disagree
+    ? `The verdicts disagree over ${pooled.stances} stances: the simulator says the walk ` +
+      (sim >= 0.5 ? "fails" : "succeeds") + ` (P(fail) ${prob(sim)}), the closed form that it ` +
+      (cf >= 0.5 ? "fails" : "succeeds") + ` (P(fail) ${prob(cf)}); the decision takes the more pessimistic, ${prob(pooled.p_fail)}.`
+    : "";
 }
 async function pollDrive() {
   let ended = false;

@@ -570,7 +570,7 @@ fn posterior_answer(
         grid.mean[i]
             .iter()
             .zip(&grid.sd[i])
-            .all(|(m, sd)| m.abs() + sd <= crate::servo::xl330::STALL_TORQUE_N_M)
+            .all(|(m, sd)| m.abs() + sd <= crate::servo::ServoModel::XL330_M288.stall_torque_n_m)
     };
     let model_var: Vec<f64> = (0..mean.len())
         .map(|b| {

@@ -265,7 +265,7 @@ fn the_servo_actuator_lags_within_its_motor_and_converges() {
     let lag = a.steps.iter().map(|s| s.peak_lag_rad).fold(0.0, f64::max);
     assert!(lag > 0.01, "{lag}");
     let torque = a.steps.iter().map(|s| s.peak_servo_torque_n_m).fold(0.0, f64::max);
-    assert!(torque <= crate::servo::xl330::STALL_TORQUE_N_M + 1e-9, "{torque}");
+    assert!(torque <= crate::servo::ServoModel::XL330_M288.stall_torque_n_m + 1e-9, "{torque}");
     let ideal = builtin(20.0, false, None);
     assert!(ideal.steps.iter().all(|s| s.peak_lag_rad.abs() < 1e-9));
     let b = actuated(20.0, Some(a.dt_s / 4.0));

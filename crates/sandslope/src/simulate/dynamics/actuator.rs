@@ -16,14 +16,9 @@
 
 use super::Walker;
 
-/// The XL330-M288-T at 5 V (docs/model.md §19; `crate::servo::xl330`'s figures).
-pub(crate) const XL330_STALL_N_M: f64 = crate::servo::xl330::STALL_TORQUE_N_M;
-/// Its no-load speed, rad/s.
-pub(crate) const XL330_NO_LOAD_RAD_S: f64 = crate::servo::xl330::NO_LOAD_SPEED_RAD_S;
-/// Its torque at the largest Current Limit, N m (1.75 A times K_t = 0.354 N m/A: 0.62 N m,
-/// above the stall torque, so the torque-speed line binds first at 5 V).
-pub(crate) const XL330_CURRENT_LIMIT_N_M: f64 =
-    crate::servo::xl330::TORQUE_CONSTANT_N_M_PER_A * crate::servo::xl330::MAX_CURRENT_LIMIT_MA as f64 * 1e-3;
+/// The paper's servo, the XL330-M288-T at 5 V (docs/model.md §19): its figures, with their
+/// source, are `crate::servo::ServoModel::XL330_M288`'s.
+const PAPER_SERVO: &crate::servo::ServoModel = &crate::servo::ServoModel::XL330_M288;
 /// The position loop's lag correction, 1/s.
 pub(crate) const LAG_GAIN_PER_S: f64 = 20.0;
 /// The rates' fixed point has converged when no rate changes by more than this, rad/s.
@@ -39,9 +34,18 @@ pub(crate) struct Motor {
 }
 
 impl Motor {
-    /// The XL330-M288 at 5 V.
+    /// The XL330-M288 at 5 V (the paper's servo).
     pub(crate) fn xl330() -> Motor {
-        Motor { tau_max: XL330_STALL_N_M.min(XL330_CURRENT_LIMIT_N_M), omega_0: XL330_NO_LOAD_RAD_S }
+        Motor::of(PAPER_SERVO)
+    }
+
+    /// A servo model's motor at its nominal supply: the stall torque, capped by `K_t` times
+    /// the largest Current Limit where the model has one (for the XL330-M288, 1.75 A times
+    /// 0.354 N m/A = 0.62 N m, above the stall torque, so the torque-speed line binds first).
+    pub(crate) fn of(model: &crate::servo::ServoModel) -> Motor {
+        let by_current =
+            model.max_current_limit_ma().map_or(f64::INFINITY, |ma| model.torque_from_current_ma(ma));
+        Motor { tau_max: model.stall_torque_n_m.min(by_current), omega_0: model.no_load_speed_rad_s() }
     }
 
     /// The rate the motor holds against `torque` (N m, positive resisting), asked for `demand`.
@@ -117,6 +121,6 @@ mod tests {
         assert!((m.rate(two_pi, 0.345) - 3.630).abs() < 1e-3, "{}", m.rate(two_pi, 0.345));
         assert_eq!(m.rate(two_pi, 0.0), two_pi);
         assert_eq!(m.rate(two_pi, 0.6), 0.0);
-        assert!((XL330_CURRENT_LIMIT_N_M - 0.619).abs() < 1e-3);
+        assert!((PAPER_SERVO.torque_from_current_ma(1750.0) - 0.619).abs() < 1e-3);
     }
 }

@@ -132,7 +132,7 @@ impl SimulateRequest {
             leg_friction: p.number("leg-friction")?,
             duty_cycle: p.number_or("duty-cycle", defaults.duty_cycle)?,
             disturbed_sand: p.number_or("disturbed-sand", defaults.disturbed_sand)?,
-            one_sided_belly: p.flag("one-sided-belly")?,
+            one_sided_belly: p.flag("one-sided-belly")? | !p.flag("two-faced-belly")?,
             servo_actuator: match p.text("actuator")? {
                 None | Some("ideal") => false,
                 Some("servo") => true,

@@ -51,8 +51,9 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub no_servo_limit: bool,
     /// Whether the body may pitch: `locked` (the default) holds it parallel to the slope, the
-    /// closed form's assumption and the setting whose answers converge; `free` lets it pitch,
-    /// rear and tumble, chaotic on slopes: one walk is one draw of a spread (docs/simulate.md).
+    /// closed form's assumption and the setting whose answers converge at the default step;
+    /// `free` lets it pitch (on 15 and 20 degrees it needs a quarter of the step; with
+    /// --two-faced-belly it rears and tumbles, chaotic on slopes; docs/simulate.md).
     #[arg(long, value_name = "MODE", value_enum, default_value_t = PitchArg::Locked)]
     pub body_pitch: PitchArg,
     /// How resistive force theory is scaled to the terrain's k_n and k_s: `motion` (one scale
@@ -76,10 +77,14 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "F", default_value_t = UNDISTURBED_SAND, allow_negative_numbers = true)]
     pub disturbed_sand: f64,
     /// The belly as the body's underside, sand below it only: it pushes and never pulls the
-    /// body down, its drag capped by its push (docs/model.md §20.5; default: a plate in sand
-    /// on both faces, as resistive force theory's plates were).
-    #[arg(long)]
+    /// body down, its drag capped by its push (docs/model.md §20.5). The default since
+    /// 2026-12-07; the flag is kept so scripts that name it still run.
+    #[arg(long, conflicts_with = "two_faced_belly")]
     pub one_sided_belly: bool,
+    /// The belly as a plate in sand on both faces, as resistive force theory's plates were:
+    /// the sand may pull it down (the default before 2026-12-07; docs/simulate.md, "Phase 1").
+    #[arg(long)]
+    pub two_faced_belly: bool,
     /// What turns the legs: `ideal` (position sources that follow the gait whatever the sand
     /// resists, the default) or `servo` (the XL330-M288's motor, its torque-speed line and
     /// current limit, the leg rates solved with the body's; docs/model.md §20.6).
@@ -138,7 +143,8 @@ pub struct SimulateArgs {
 /// `--body-pitch`: the library's [`BodyPitch`] as a flag value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum PitchArg {
-    /// The body pitches under the sand's and gravity's moments (chaotic on slopes).
+    /// The body pitches under the sand's and gravity's moments (chaotic on slopes with the
+    /// two-faced belly).
     Free,
     /// The body is held parallel to the slope, as the closed form assumes (default).
     Locked,
@@ -205,7 +211,7 @@ impl SimulateArgs {
                 leg_friction: self.leg_friction,
                 duty_cycle: self.duty_cycle,
                 disturbed_sand: self.disturbed_sand,
-                one_sided_belly: self.one_sided_belly,
+                one_sided_belly: !self.two_faced_belly,
                 servo_actuator: self.actuator == ActuatorArg::Servo,
             },
             rate_hz: self.rate,
@@ -374,7 +380,7 @@ fn print_one(sim: &Simulation) {
 }
 
 /// What a walk with the body free to pitch is (docs/simulate.md, "Pitch free").
-const FREE_NOTE: &str = "body pitch free (--body-pitch free): the free body's pitch is unstable on slopes (walks 1e-9 apart part within seconds), so one walk is one draw of a spread; --ensemble N gives the spread (docs/simulate.md)";
+const FREE_NOTE: &str = "body pitch free (--body-pitch free): on 15 and 20 degrees the free body needs a quarter of the default step (--dt 0.000125) to converge, and with --two-faced-belly its pitch is unstable on slopes (one walk is one draw of a spread; --ensemble N gives it); check with --check-convergence (docs/simulate.md)";
 
 fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
     let quiet = args.format.format() != Format::Table;

@@ -6,7 +6,7 @@ Usage: python3 bench/simulate/phase1.py [--sandslope target/release/sandslope] [
 [holds] What holds the body in phase 1 (touchdown t0 to anchoring t1): the sand's mean
         along-slope and normal force on the belly, the old tripod and the new tripod, against
         m g sin(theta) and m g cos(theta), with the belly as resistive force theory's two-faced
-        plate (the default) and one-sided (--one-sided-belly), at the default step.
+        plate (--two-faced-belly) and one-sided (the default since 2026-12-07), at the default step.
 [phase1] Per slope: backward slip s1, the most negative speed in phase 1 and t1 (docs/model.md
         §11: dv/dt turning from negative to positive), each at the default step and at a
         quarter of it, beside the closed form's t1 and s1 = 1/2 g sin(theta) t1^2.
@@ -48,7 +48,7 @@ def holds(exe, pitch):
     print(f"pitch {pitch}: mean sand force over phase 1, N (along slope, normal to it)\n")
     print("| belly | slope deg | m g sin, m g cos | belly | old tripod | new tripod | s1 mm | lowest speed cm/s |")
     print("|---|---:|---|---|---|---|---:|---:|")
-    for label, extra in [("two-faced (default)", []), ("one-sided", ["--one-sided-belly"])]:
+    for label, extra in [("two-faced", ["--two-faced-belly"]), ("one-sided (default)", [])]:
         w = walks(exe, ["--body-pitch", pitch, *extra], False)
         for s in SLOPES:
             d = w[(s, False)]
@@ -70,7 +70,7 @@ def phase1(exe, pitch):
         "closed form t1 ms | closed form s1 mm | regime |"
     )
     print("|---|---:|---|---|---|---|---:|---:|---|")
-    for label, extra in [("two-faced (default)", []), ("one-sided", ["--one-sided-belly"])]:
+    for label, extra in [("two-faced", ["--two-faced-belly"]), ("one-sided (default)", [])]:
         w = walks(exe, ["--body-pitch", pitch, *extra], True)
         for s in SLOPES:
             d, q = w[(s, False)], w[(s, True)]

@@ -168,7 +168,7 @@ fn anchoring_times_alone_calibrate_k_s() {
 
 /// `--model simulate` (issue 23): one observed speed, force tests used exactly, only the error
 /// floor free. The simulator's model speed is what `simulate` gives for the same robot, ground
-/// and the fit's walk setting (4 s at the default step); with one speed the best floor solves
+/// and the fit's walk setting (4 s at T / 500, 2 ms for the paper's robot of T = 1 s); with one speed the best floor solves
 /// `sd^2 + f^2 = (observed - model)^2` (docs/calibration.md), so f is worked out from that
 /// speed alone; the closed form's fit is printed beside it. Refusals exit 2 naming the flag.
 #[test]
@@ -194,7 +194,9 @@ fn model_simulate_fits_the_walks_and_shows_the_closed_form_beside() {
     assert_eq!(v["model"]["settings"]["duration_s"], 4.0);
     assert_eq!(v["walks"], 1);
     let walk = json(
-        sandslope().args(["simulate", "--slope", "0", "--duration", "4", "--json", "--terrain"]).arg(&forces),
+        sandslope()
+            .args(["simulate", "--slope", "0", "--duration", "4", "--dt", "0.002", "--json", "--terrain"])
+            .arg(&forces),
     );
     let model = v["pulls"][0]["model"].as_f64().unwrap();
     assert_eq!(model, walk["speed_m_s"].as_f64().unwrap());

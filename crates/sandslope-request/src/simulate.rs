@@ -109,11 +109,18 @@ pub const DISTURBED_SAND: Field = Field::number("disturbed-sand", "F")
          undisturbed sand's, greater than 0 and at most 1 (docs/model.md §20.3, the trench; \
          1: as strong as before).",
     );
-/// `--one-sided-belly` (docs/model.md §20.5).
-pub const ONE_SIDED_BELLY: Field = Field::switch("one-sided-belly").keyword("one_sided_belly").help(
-    "The belly as the body's underside, sand below it only: it pushes and never pulls the \
-     body down, its drag capped by its push (docs/model.md §20.5; default: a plate in sand \
-     on both faces, as resistive force theory's plates were).",
+/// `--one-sided-belly` (docs/model.md §20.5): the default, kept as a flag for scripts that name it.
+pub const ONE_SIDED_BELLY: Field =
+    Field::switch("one-sided-belly").keyword("one_sided_belly").conflicts(&["two-faced-belly"]).help(
+        "The belly as the body's underside, sand below it only: it pushes and never pulls the \
+         body down, its drag capped by its push (docs/model.md §20.5). The default; the flag is \
+         kept so scripts that name it still run.",
+    );
+/// `--two-faced-belly` (docs/model.md §20.5).
+pub const TWO_FACED_BELLY: Field = Field::switch("two-faced-belly").keyword("two_faced_belly").help(
+    "The belly as a plate in sand on both faces, as resistive force theory's plates are: the \
+     sand may pull it down, and the body rests at touchdown with no backward slip \
+     (docs/simulate.md, \"The default belly\").",
 );
 /// `--actuator` (docs/model.md §20.6).
 pub const ACTUATOR: Field = Field::new("actuator", Kind::Choice(&["ideal", "servo"]), "ideal|servo")
@@ -171,6 +178,7 @@ pub const FIELDS: Table = Table {
         DUTY_CYCLE,
         DISTURBED_SAND,
         ONE_SIDED_BELLY,
+        TWO_FACED_BELLY,
         ACTUATOR,
         ENSEMBLE,
         CHECK_CONVERGENCE,
@@ -193,6 +201,7 @@ pub const SETTINGS: Table = Table {
         DUTY_CYCLE,
         DISTURBED_SAND,
         ONE_SIDED_BELLY,
+        TWO_FACED_BELLY,
         ACTUATOR,
         RATE,
     ],
@@ -436,7 +445,7 @@ impl SettingsRequest {
             leg_friction: LEG_FRICTION.number_in(p)?,
             duty_cycle: number(&DUTY_CYCLE, p)?,
             disturbed_sand: number(&DISTURBED_SAND, p)?,
-            one_sided_belly: ONE_SIDED_BELLY.switch_in(p)?,
+            one_sided_belly: ONE_SIDED_BELLY.switch_in(p)? | !TWO_FACED_BELLY.switch_in(p)?,
             servo_actuator: choose(
                 ACTUATOR.flag,
                 ACTUATOR.text_in(p)?.unwrap_or_default(),

@@ -732,7 +732,8 @@ def simulate(
     file's servo torque limit (``--no-servo-limit``). ``leg_friction``, ``duty_cycle`` and
     ``disturbed_sand`` switch on the candidate mechanisms of docs/model.md §20 (``--leg-friction``,
     ``--duty-cycle``, ``--disturbed-sand``; left out, each takes the CLI's default: off), as
-    do ``one_sided_belly=True`` (``--one-sided-belly``, §20.5) and ``actuator="servo"``
+    do ``two_faced_belly=True`` (``--two-faced-belly``: the belly pulled by the sand as well as
+    pushed, §20.5; the default belly only pushes) and ``actuator="servo"``
     (``--actuator servo``, §20.6). The keywords are :class:`WalkSettings`, shared with
     :func:`simulate_ensemble` and :func:`check_convergence`; the extension reads them by the
     request layer's table, as ``sandslope simulate`` reads its flags. Negative slopes walk

@@ -20,6 +20,7 @@ class WalkSettings(TypedDict, total=False):
     leg_friction: float  # --leg-friction: leg-sand friction coefficient, 0 to 10 (§20.1)
     duty_cycle: float  # --duty-cycle: 0.1 to 0.9 (§20.2; default 0.5)
     disturbed_sand: float  # --disturbed-sand: greater than 0, at most 1 (§20.3; default 1)
-    one_sided_belly: bool  # --one-sided-belly: the belly pushes only (§20.5)
+    one_sided_belly: bool  # --one-sided-belly: the belly pushes only (§20.5; the default)
+    two_faced_belly: bool  # --two-faced-belly: the belly a plate in sand on both faces (§20.5)
     actuator: str  # --actuator: "ideal" (default) or "servo", the XL330's motor (§20.6)
     sample_rate_hz: float  # --rate: trajectory sample rate, Hz (default 120)

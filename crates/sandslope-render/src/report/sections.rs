@@ -317,21 +317,21 @@ pub fn simulator(report: &Report) -> String {
          (same regime, speeds within {:.0}%) at {agree} of {} slopes.</p>\n\
          <p>What survives convergence. <i>Legs roll</i>: a simulated C-leg rolls on its arc like a wheel's rim, so \
          its step tends to the rigid-ground rolling step and its speed is two to three times the closed form's and \
-         the paper's below 24°, where the closed form's leg slides along its own circle held by solidified sand and \
-         steps s*; resistive force theory has no term that holds the circle. <i>Anchoring</i>: the simulated body does \
-         not slip back before its legs anchor; it rests after touchdown while they dig in (t1 is where it leaves \
-         that rest, docs/model.md §11), about as long as the closed form's t1 on level sand and about half of it on \
-         slopes. No switch of the simulator with a \
+         the paper's below 20°, where the closed form's leg slides along its own circle held by solidified sand and \
+         steps s*; resistive force theory has no term that holds the circle. <i>Anchoring</i>: on slopes the simulated body slips \
+         back after touchdown, as the paper's did, and on level sand it does not; its slip grows with the slope but \
+         is a fraction of the closed form's ½ g sin θ t1², because the new legs push up the slope from their first \
+         contact (the belly is the body's underside, which the sand pushes and never pulls down, docs/model.md \
+         §20.5; docs/simulate.md, \"Phase 1\"). No switch of the simulator with a \
          measured input brings the level speed to the paper's 15.7 cm/s (docs/simulate.md, \"The level stride\"), \
          nor do leg-sand friction, a slower stance or sand weakened where earlier steps dug it (docs/model.md §20); \
          the last slows the walk on slopes and leaves level sand as it was, as the trench the paper names for \
          metastability would (docs/simulate.md, \"The mechanisms across the slopes\"). \
          The paper's own rise from 20° to 24° (+0.62 ± 1.63 cm/s, 0.4 SD) and its plateau from 10° to 15° (1.9 SD) \
          are within its scatter: neither model is asked to follow them. <i>Pitch free</i>: the pitch-free columns, \
-         with the body free to pitch, are each one draw from a spread: the free body's pitch is unstable on slopes \
-         (two walks whose masses differ by a billionth part by degrees within seconds), so a single free walk cannot \
-         converge with the time step; over many such walks its speed, t1 and regime do, and from 10° every one \
-         tumbles within a few seconds (docs/simulate.md, \"Pitch free\"). Here {tumbles} of these slopes tumbled.</p>\n",
+         with the body free to pitch, climb from 0° to 20° without tumbling, but on 15° and 20° their speed and t1 \
+         need a quarter of the default step to converge, so they are not the section's answers (docs/simulate.md, \
+         \"The free body with the one-sided belly\"). Here {tumbles} of these slopes tumbled.</p>\n",
         sandslope::report::REPORT_WALK_S,
         convergence_sentence(&report.simulator_convergence),
         sandslope::report::AGREE_WITHIN * 100.0,

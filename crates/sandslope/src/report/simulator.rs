@@ -220,6 +220,18 @@ fn reason(m: &SimSummary, cf: Option<f64>, cf_regime: Regime, rolling: f64) -> (
                         mm(Some(s_star))
                     ),
                 )
+            } else if m.step_m < 0.0 {
+                (
+                    false,
+                    format!(
+                        "slides back ({:+.0}%): net step {}, slip before anchoring {} against {} \
+                         (docs/simulate.md, \"The mechanisms across the slopes\")",
+                        rel * 100.0,
+                        mm(Some(m.step_m)),
+                        mm(m.slip_m),
+                        mm(m.closed_form.prediction.slip)
+                    ),
+                )
             } else {
                 (
                     false,

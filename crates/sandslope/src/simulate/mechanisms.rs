@@ -2,7 +2,8 @@
 //! that each add one piece of physics resistive force theory as the simulator has it leaves
 //! out, so that their effect on the walk can be tabled one at a time (docs/simulate.md
 //! "The level stride against the paper"). Every switch is off by default, and off it leaves
-//! the walk bit for bit as it was.
+//! the walk bit for bit as it was, except the one-sided belly, on by default since
+//! 2026-12-07 (docs/simulate.md, "Phase 1": the evidence).
 //!
 //! - [`Mechanisms::leg_friction`]: Coulomb friction between leg and grains caps the stress
 //!   along an element's surface (§20.1).
@@ -51,11 +52,13 @@ pub struct Mechanisms {
     /// undisturbed sand's (§20.3); 1 (the default): the sand is as strong as before.
     pub disturbed_sand: f64,
     /// The belly as the body's underside (§20.5): sand below it only, so it pushes and never
-    /// pulls, its along-surface stress capped by its push. `false` (the default): a plate in
-    /// sand on both faces, as resistive force theory's plates were, which holds a body being
-    /// lifted off the sand (docs/simulate.md, "Phase 1"). Serialised only when on, so a walk
-    /// without it reads as before.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    /// pulls, its along-surface stress capped by its push. `true` (the default since
+    /// 2026-12-07, docs/simulate.md "Phase 1": the paper's backward slip after touchdown on
+    /// slopes and none on level sand, and a free body that climbs 0 to 20 degrees); `false`
+    /// (`--two-faced-belly`): a plate in sand on both faces, as resistive force theory's plates
+    /// were, which holds a body being lifted off the sand. Serialised only when off, so a
+    /// default walk's output keeps its keys; read as on when absent.
+    #[serde(default = "one_sided_by_default", skip_serializing_if = "is_on")]
     pub one_sided_belly: bool,
     /// Each leg driven by the XL330-M288's motor (its torque-speed line and current limit),
     /// its rate solved with the body's in the implicit step (§20.6), instead of an ideal
@@ -70,10 +73,20 @@ impl Default for Mechanisms {
             leg_friction: None,
             duty_cycle: CONSTANT_SPEED_DUTY,
             disturbed_sand: UNDISTURBED_SAND,
-            one_sided_belly: false,
+            one_sided_belly: true,
             servo_actuator: false,
         }
     }
+}
+
+/// The belly's default for serde: one-sided ([`Mechanisms::default`]).
+fn one_sided_by_default() -> bool {
+    true
+}
+
+/// Whether a switch is on (serde's `skip_serializing_if` for a default-on switch).
+fn is_on(on: &bool) -> bool {
+    *on
 }
 
 impl Mechanisms {

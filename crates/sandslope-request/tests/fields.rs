@@ -3,15 +3,18 @@
 //! in the user docs (docs/*.md or README.md), so an option list cannot leave one out.
 
 use sandslope_request::field::{Kind, Table};
-use sandslope_request::{predict, scenario, simulate, sweep};
+use sandslope_request::{predict, risk, scenario, simulate, sweep};
 
 /// Each request's tables: its own, then those it shares.
 fn requests() -> Vec<(&'static str, Vec<Table>)> {
     let shared = || vec![scenario::FIELDS, scenario::ROBOT_QUANTITIES];
+    // A request on the robot and terrain alone, without the overrides of k_n and k_s.
+    let robot_and_terrain = Table { command: "scenario", fields: &[scenario::ROBOT, scenario::TERRAIN] };
     vec![
         ("sweep", [vec![sweep::FIELDS], shared()].concat()),
         ("predict", [vec![predict::FIELDS], shared()].concat()),
         ("simulate", [vec![simulate::FIELDS], shared()].concat()),
+        ("risk", vec![risk::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
     ]
 }
 

@@ -3,7 +3,7 @@
 //! in the user docs (docs/*.md or README.md), so an option list cannot leave one out.
 
 use sandslope_request::field::{Kind, Table};
-use sandslope_request::{phase, predict, risk, scenario, simulate, sweep};
+use sandslope_request::{drive, phase, predict, risk, scenario, simulate, sweep};
 
 /// Each request's tables: its own, then those it shares.
 fn requests() -> Vec<(&'static str, Vec<Table>)> {
@@ -20,6 +20,7 @@ fn requests() -> Vec<(&'static str, Vec<Table>)> {
         ("risk", vec![risk::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         // phase's masses are its panels', not the robot's override.
         ("phase", vec![phase::FIELDS, robot_and_terrain, without_mass]),
+        ("drive", vec![drive::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
     ]
 }
 

@@ -227,9 +227,10 @@ pub fn field_arg(f: &'static Field) -> clap::Arg {
             let arg = arg.action(clap::ArgAction::Set).value_name(f.value_name).default_value(f.default);
             match kind {
                 Kind::Choice(words) => arg.value_parser(clap::builder::PossibleValuesParser::new(words)),
-                // A number, or a slope list in degrees, may start with a minus.
+                // A number, or a list or axis of numbers in a unit, may start with a minus (the
+                // request then names what is wrong with it).
                 Kind::Number => arg.allow_negative_numbers(true),
-                _ if f.unit == "deg" => arg.allow_hyphen_values(true),
+                Kind::Text if !f.unit.is_empty() => arg.allow_hyphen_values(true),
                 _ => arg,
             }
         }

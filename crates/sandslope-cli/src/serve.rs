@@ -75,23 +75,13 @@ pub struct ServeArgs {
         default_missing_value = sandslope_io::foxglove::DEFAULT_ADDR, help_heading = "Driving (docs/drive.md)")]
     pub foxglove: Option<String>,
     #[command(flatten, next_help_heading = "Driving (docs/drive.md)")]
-    pub drive_run: Option<DriveRunArgs>,
-}
-
-/// `drive`'s run flags at their defaults (no flag given): one parse of an empty command line
-/// with the same definitions, so no default is stated twice.
-fn default_run() -> Result<DriveRunArgs> {
-    use clap::{Arg, ArgAction, FromArgMatches};
-    let command = DriveRunArgs::augment_args(
-        clap::Command::new("drive").arg(Arg::new("emulate").long("emulate").action(ArgAction::SetTrue)),
-    );
-    Ok(DriveRunArgs::from_arg_matches(&command.try_get_matches_from(["drive"])?)?)
+    pub drive_run: DriveRunArgs,
 }
 
 /// `--drive`'s typed run, built as `sandslope drive` builds it from the same flags.
 fn drive_config(args: &ServeArgs) -> Result<Option<DriveConfig>> {
     if !args.drive {
-        if args.drive_run.is_some() {
+        if args.drive_run.given() {
             bail!("the driving flags (--slope, --duration, --stop-on-risk, --emulate-*, ...) need --drive");
         }
         return Ok(None);
@@ -101,13 +91,11 @@ fn drive_config(args: &ServeArgs) -> Result<Option<DriveConfig>> {
         (None, true) => BusFlag::Emulate,
         (None, false) => bail!("--drive needs --drive-port PATH (the adapter's serial port) or --emulate"),
     };
-    let run = match &args.drive_run {
-        Some(r) => r.clone(),
-        None => default_run()?,
-    };
+    // The run's flags given, else their defaults: the drive table's.
+    let fields = args.drive_run.fields(matches!(bus, BusFlag::Emulate))?;
     let robot = sandslope_io::load_robot(&args.robot)?;
     let terrain = sandslope_io::load_terrain(&args.terrain)?;
-    Ok(Some(crate::commands::drive::config(&run, robot, &args.robot, terrain, bus, true)?))
+    Ok(Some(crate::commands::drive::config(&fields, robot, &args.robot, terrain, bus, true)?))
 }
 
 /// Runs `sandslope serve` until the process is stopped: the flags into the server's
@@ -118,7 +106,7 @@ pub fn run(args: ServeArgs) -> Result<()> {
         driving: &crate::error::DRIVING,
         signal: &crate::error::STOP_SIGNAL,
     };
-    let drive_log = args.drive_run.as_ref().and_then(|r| r.log.clone());
+    let drive_log = args.drive_run.log.clone();
     // The served run writes its log as the CSV flight recorder only; `drive --log run.mcap`
     // keeps the rows in memory and writes them as ROS 2 messages when the run ends.
     if let Some(path) =

@@ -188,7 +188,7 @@ fn risk_uses_the_terrain_sds_interpolated_like_the_values() {
         .args(["risk", "--slope", "10", "--cv-n", "0.1", "--cv-s", "0.1", "--max-risk", "1.5"])
         .assert()
         .code(2)
-        .stderr(predicate::str::contains("--max-risk <P>': 1.5 is not a failure probability"));
+        .stderr(predicate::str::contains("--max-risk = 1.5: 1.5 is not a failure probability"));
 }
 
 /// Every `risk --json` result carries the CVs it used and where each came from (docs/model.md

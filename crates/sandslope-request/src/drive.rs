@@ -8,6 +8,8 @@ use sandslope::servo::ServoModel;
 use sandslope::{SignedSlope, Terrain};
 
 use crate::error::{RequestError, Result, Words};
+use crate::field::{Field, Fields, Kind, Table};
+use crate::params::Params;
 
 /// The numbers of one drive run, as a front end gives them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -38,35 +40,287 @@ pub struct DriveRun {
     pub emulate_k_s: Option<f64>,
 }
 
+/// `--slope`: the slope of the run.
+pub const SLOPE: Field = Field::number("slope", "DEG")
+    .keyword("slope_deg")
+    .key("slope_deg")
+    .unit("deg")
+    .default("0")
+    .range("-90 to 90")
+    .help("The slope being climbed, degrees (for the live estimate, the log's header and the emulator)");
+/// `--duration`: how long the legs turn.
+pub const DURATION: Field = Field::number("duration", "S")
+    .keyword("duration_s")
+    .unit("s")
+    .default("10")
+    .range("0 to 86400")
+    .help("Gait time, s (after standing up)");
+/// `--rate`: the bus cycles per second.
+pub const RATE: Field = Field::number("rate", "HZ")
+    .keyword("rate_hz")
+    .unit("Hz")
+    .default("50")
+    .range("1 to 1000")
+    .help("Bus cycles per second aimed at (each: a Sync Write of goals and a Sync Read of state)");
+/// `--profile`: how the gait is commanded.
+pub const PROFILE: Field =
+    Field::new("profile", Kind::Choice(&["position", "velocity"]), "position|velocity")
+        .default("position")
+        .help(
+            "How the gait is commanded: `position` (extended position mode, the schedule's angle every \
+         cycle) or `velocity` (velocity mode, the schedule's speed with a phase correction)",
+        );
+/// `--baud`: the bus's baud rate.
+pub const BAUD: Field = Field::new("baud", Kind::Whole, "BAUD")
+    .unit("baud")
+    .range("one the servos support")
+    .help("Baud rate (default: the robot file's [servos] baud_rate, else 57600; the emulator ignores it)");
+/// `--stop-on-risk`: halt when the live risk passes it.
+pub const STOP_ON_RISK: Field = Field::number("stop-on-risk", "P").keyword("stop_on_risk").range("0 to 1").help(
+    "Halt the gait (torque held, legs planted) when the live risk that the walk fails (slippage or sinkage) passes P",
+);
+/// `--force`: drive beyond the calibrated safe slope.
+pub const FORCE: Field = Field::switch("force").keyword("force").help(
+    "Drive beyond the calibrated safe slope (`risk --solve slope`); without it such a run is \
+     refused before anything moves, naming the limit",
+);
+/// `--live-window`: the stances the live estimate pools.
+pub const LIVE_WINDOW: Field =
+    Field::new("live-window", Kind::Whole, "N").keyword("window").unit("stances").range("at least 1").help(
+        "Pool the live estimate over the last N stances (a moving window, to follow sand that \
+         changes); without it every stance so far is pooled",
+    );
+/// `--hold`: the legs held after a halt.
+pub const HOLD: Field = Field::number("hold", "S")
+    .keyword("hold_s")
+    .unit("s")
+    .default("2")
+    .range("0 to 3600")
+    .help("After a halt, seconds the legs are held before the torque goes off");
+/// `--current-limit`: the servos' Current Limit.
+pub const CURRENT_LIMIT: Field = Field::new("current-limit", Kind::Whole, "MA")
+    .keyword("current_limit_ma")
+    .unit("mA")
+    .default("1470")
+    .range("within the model's")
+    .help(
+        "Current Limit written to every servo, mA (within the model's: 0 to 1750 on the XL330s, 0 \
+         to 3209 on the XM430-W350; 1470 is the XL330-M288's stall current at 5 V; the XL430-W250 \
+         has none)",
+    );
+/// `--temperature-limit`: the servos' Temperature Limit.
+pub const TEMPERATURE_LIMIT: Field = Field::new("temperature-limit", Kind::Whole, "DEGC")
+    .keyword("temperature_limit_c")
+    .unit("degC")
+    .default("65")
+    .range("within the model's rated maximum")
+    .help(
+        "Temperature Limit written to every servo, degC (within the model's rated maximum: 70 on \
+         the XL330s, 72 on the XL430-W250, 80 on the XM430-W350)",
+    );
+/// `--watchdog`: the host's watchdog.
+pub const WATCHDOG: Field = Field::number("watchdog", "S")
+    .keyword("watchdog_s")
+    .unit("s")
+    .default("1")
+    .range("0.01 to 10")
+    .help("Longest bus cycle accepted before everything stops, s");
+/// `--bus-watchdog`: the servos' own Bus Watchdog.
+pub const BUS_WATCHDOG: Field = Field::number("bus-watchdog", "S")
+    .keyword("bus_watchdog_s")
+    .unit("s")
+    .default("0.5")
+    .range("0.02 to 2.54")
+    .help("The servos' own Bus Watchdog, s (0.02 to 2.54): they stop by themselves if the driver goes quiet");
+/// `--emulate-noise`: the emulator's current noise.
+pub const EMULATE_NOISE: Field = Field::number("emulate-noise", "MA")
+    .keyword("noise_ma")
+    .unit("mA")
+    .default("10")
+    .range("0 to 1000")
+    .help("Emulator: Present Current noise, mA (standard deviation)");
+/// `--emulate-seed`: the seed of the emulator's noise (read as a whole number up to 2^64 - 1).
+pub const EMULATE_SEED: Field =
+    Field::text("emulate-seed", "N").keyword("seed").default("1").help("Emulator: seed of the noise");
+/// `--emulate-k-s`: the emulated sand's k_s.
+pub const EMULATE_K_S: Field = Field::number("emulate-k-s", "N/M^3")
+    .keyword("k_s")
+    .unit("N/m^3")
+    .range("greater than 0")
+    .help("Emulator: the sand's k_s (N/m^3) instead of the terrain's at the slope");
+/// `--emulate-weaken`: the emulated sand weakening during the run.
+pub const EMULATE_WEAKEN: Field = Field::text("emulate-weaken", "S:K_S")
+    .keyword("weaken")
+    .help("Emulator: the sand weakens to K_S N/m^3 at S seconds after the start, S:K_S");
+/// `--emulate-fault`: a fault of the emulated bus.
+pub const EMULATE_FAULT: Field = Field::text("emulate-fault", "KIND:..").help(
+    "Emulator: a fault, silent:ID:S (servo ID stops answering at S s), corrupt:ID:S (its \
+     packets fail their CRC from S s) or freeze:S:LEN (the bus hangs for LEN s from S s)",
+);
+/// `--emulate-offset`: the emulated current sensors' zero bias.
+pub const EMULATE_OFFSET: Field =
+    Field::text("emulate-offset", "MA[,MA..]").unit("mA").range("-500 to 500 each").help(
+        "Emulator: a current sensor's zero bias, mA added to every Present Current: one value for \
+     every servo, or one per servo in leg order, comma-separated (within -500 to 500)",
+    );
+
+/// `drive`'s run fields, which `serve --drive` shares (the robot's and the terrain's are
+/// [`crate::scenario`]'s; the bus flags and `--log` are each command's own).
+pub const FIELDS: Table = Table {
+    command: "drive",
+    fields: &[
+        SLOPE,
+        DURATION,
+        RATE,
+        PROFILE,
+        BAUD,
+        STOP_ON_RISK,
+        FORCE,
+        LIVE_WINDOW,
+        HOLD,
+        CURRENT_LIMIT,
+        TEMPERATURE_LIMIT,
+        WATCHDOG,
+        BUS_WATCHDOG,
+        EMULATE_NOISE,
+        EMULATE_SEED,
+        EMULATE_K_S,
+        EMULATE_WEAKEN,
+        EMULATE_FAULT,
+        EMULATE_OFFSET,
+    ],
+};
+
+/// The fields that only an emulated bus takes.
+const EMULATOR: [&Field; 6] =
+    [&EMULATE_NOISE, &EMULATE_SEED, &EMULATE_K_S, &EMULATE_WEAKEN, &EMULATE_FAULT, &EMULATE_OFFSET];
+
+/// Every field of a drive run, read from text by [`DriveFields::from_params`] and checked: the
+/// numbers in [`DriveRun`], the rest as the servo crate's run takes them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DriveFields {
+    /// The numbers, checked against their ranges.
+    pub run: DriveRun,
+    /// `--profile`: `position` or `velocity`.
+    pub profile: String,
+    /// `--baud`, if given.
+    pub baud: Option<u32>,
+    /// `--force`.
+    pub force: bool,
+    /// `--live-window`, if given (at least 1).
+    pub live_window: Option<usize>,
+    /// `--emulate-seed`.
+    pub emulate_seed: u64,
+    /// `--emulate-weaken`, unparsed (`S:K_S`).
+    pub emulate_weaken: Option<String>,
+    /// `--emulate-fault`, unparsed (`KIND:..`).
+    pub emulate_fault: Option<String>,
+    /// `--emulate-offset`, unparsed (one value or one per servo).
+    pub emulate_offset: Option<String>,
+}
+
+impl Fields for DriveFields {
+    const TABLE: Table = FIELDS;
+}
+
+impl DriveFields {
+    /// Reads a run's fields, each by its row of [`FIELDS`] (given, else its default), and
+    /// checks the numbers ([`DriveRun::check`]); the `--emulate-*` fields only when `emulate`
+    /// (the bus is emulated). Refuses any other key; errors name the flag.
+    pub fn from_params(params: &[(String, String)], emulate: bool) -> Result<DriveFields> {
+        let mut p = Params::new(FIELDS.command, params);
+        if !emulate {
+            if let Some((given, _)) = params.iter().find(|(k, _)| EMULATOR.iter().any(|f| f.flag == k)) {
+                return Err(RequestError::invalid(
+                    FIELDS.field(given).flag,
+                    format!("--{given} is the emulator's: give --emulate too"),
+                ));
+            }
+        }
+        let number = |p: &mut Params<'_>, f: &Field| f.required_number_in(p);
+        let whole = |p: &mut Params<'_>, f: &Field, most: u32| -> Result<Option<u32>> {
+            match f.whole_in(p)? {
+                Some(v) if v > most => Err(RequestError::invalid(
+                    f.flag,
+                    format!("{} = {v} must be within 0 to {most}", f.long()),
+                )),
+                v => Ok(v),
+            }
+        };
+        let current = whole(&mut p, &CURRENT_LIMIT, u32::from(u16::MAX))?.unwrap_or_default();
+        let temperature = whole(&mut p, &TEMPERATURE_LIMIT, u32::from(u8::MAX))?.unwrap_or_default();
+        let run = DriveRun {
+            slope_deg: number(&mut p, &SLOPE)?,
+            duration_s: number(&mut p, &DURATION)?,
+            rate_hz: number(&mut p, &RATE)?,
+            hold_s: number(&mut p, &HOLD)?,
+            watchdog_s: number(&mut p, &WATCHDOG)?,
+            bus_watchdog_s: number(&mut p, &BUS_WATCHDOG)?,
+            current_limit_ma: current as u16,
+            temperature_limit_c: temperature as u8,
+            stop_on_risk: STOP_ON_RISK.number_in(&mut p)?,
+            emulate_noise_ma: Some(number(&mut p, &EMULATE_NOISE)?).filter(|_| emulate),
+            emulate_k_s: EMULATE_K_S.number_in(&mut p)?,
+        };
+        let profile = PROFILE.choice_in(&mut p)?.unwrap_or_default().to_string();
+        let baud = BAUD.whole_in(&mut p)?;
+        let force = FORCE.switch_in(&mut p)?;
+        let live_window = match LIVE_WINDOW.whole_in(&mut p)? {
+            Some(0) => {
+                return Err(RequestError::invalid(
+                    LIVE_WINDOW.flag,
+                    format!(
+                        "{} = 0 must be at least 1 stance (leave it out to pool every stance)",
+                        LIVE_WINDOW.long()
+                    ),
+                ))
+            }
+            w => w.map(|w| w as usize),
+        };
+        let seed = EMULATE_SEED.text_in(&mut p)?.unwrap_or_default();
+        let emulate_seed = seed.trim().parse::<u64>().map_err(|_| {
+            RequestError::invalid(
+                EMULATE_SEED.flag,
+                format!("{} = `{seed}` is not a whole number from 0 to 2^64 - 1", EMULATE_SEED.long()),
+            )
+        })?;
+        let text = |p: &mut Params<'_>, f: &Field| Ok::<_, RequestError>(f.text_in(p)?.map(str::to_string));
+        let emulate_weaken = text(&mut p, &EMULATE_WEAKEN)?;
+        let emulate_fault = text(&mut p, &EMULATE_FAULT)?;
+        let emulate_offset = text(&mut p, &EMULATE_OFFSET)?;
+        p.finish()?;
+        run.check(Words::Flag)?;
+        Ok(DriveFields {
+            run,
+            profile,
+            baud,
+            force,
+            live_window,
+            emulate_seed,
+            emulate_weaken,
+            emulate_fault,
+            emulate_offset,
+        })
+    }
+}
+
 /// A field as each front end names it: the command line's flag, or Python's keyword (which
-/// carries its unit).
-fn name(words: Words, field: &str) -> String {
-    let keyword = match field {
-        "slope" => "slope_deg",
-        "duration" => "duration_s",
-        "rate" => "rate_hz",
-        "hold" => "hold_s",
-        "watchdog" => "watchdog_s",
-        "bus-watchdog" => "bus_watchdog_s",
-        "current-limit" => "current_limit_ma",
-        "temperature-limit" => "temperature_limit_c",
-        "emulate-noise" => "noise_ma",
-        "emulate-k-s" => "k_s",
-        other => return words.name(other),
-    };
+/// carries its unit), from its row of [`FIELDS`].
+fn name(words: Words, field: &Field) -> String {
     match words {
-        Words::Flag => format!("--{field}"),
-        Words::Keyword => keyword.to_string(),
+        Words::Flag => field.long(),
+        Words::Keyword if field.keyword.is_empty() => words.name(field.flag),
+        Words::Keyword => field.keyword.to_string(),
     }
 }
 
 /// `value` within `lo..=hi`, else an error naming the field and the range.
-fn within(words: Words, field: &str, value: f64, lo: f64, hi: f64) -> Result<()> {
+fn within(words: Words, field: &Field, value: f64, lo: f64, hi: f64) -> Result<()> {
     if value.is_finite() && (lo..=hi).contains(&value) {
         Ok(())
     } else {
         Err(RequestError::invalid(
-            field,
+            field.flag,
             format!("{} = {value} must be between {lo} and {hi}", name(words, field)),
         ))
     }
@@ -76,44 +330,44 @@ impl DriveRun {
     /// Checks every number against its range; errors name the field in `words`.
     pub fn check(&self, words: Words) -> Result<()> {
         SignedSlope::from_degrees(self.slope_deg)
-            .map_err(|e| RequestError::invalid("slope", e.renamed(name(words, "slope"))))?;
-        within(words, "duration", self.duration_s, 0.0, 86_400.0)?;
-        within(words, "rate", self.rate_hz, 1.0, 1000.0)?;
-        within(words, "hold", self.hold_s, 0.0, 3600.0)?;
-        within(words, "watchdog", self.watchdog_s, 0.01, 10.0)?;
-        within(words, "bus-watchdog", self.bus_watchdog_s, 0.02, 2.54)?;
+            .map_err(|e| RequestError::invalid(SLOPE.flag, e.renamed(name(words, &SLOPE))))?;
+        within(words, &DURATION, self.duration_s, 0.0, 86_400.0)?;
+        within(words, &RATE, self.rate_hz, 1.0, 1000.0)?;
+        within(words, &HOLD, self.hold_s, 0.0, 3600.0)?;
+        within(words, &WATCHDOG, self.watchdog_s, 0.01, 10.0)?;
+        within(words, &BUS_WATCHDOG, self.bus_watchdog_s, 0.02, 2.54)?;
         let max_ma =
             ServoModel::ALL.iter().filter_map(|m| m.max_current_limit_ma()).fold(0.0, f64::max).floor();
         let max_c = ServoModel::ALL.iter().map(|m| m.max_temperature_c).max().unwrap_or(0);
         if f64::from(self.current_limit_ma) > max_ma {
             return Err(RequestError::invalid(
-                "current-limit",
+                CURRENT_LIMIT.flag,
                 format!(
                     "{} = {} must be within 0 to {max_ma} mA (the largest Current Limit of a supported servo)",
-                    name(words, "current-limit"),
+                    name(words, &CURRENT_LIMIT),
                     self.current_limit_ma,
                 ),
             ));
         }
         if self.temperature_limit_c > max_c {
             return Err(RequestError::invalid(
-                "temperature-limit",
+                TEMPERATURE_LIMIT.flag,
                 format!(
                     "{} = {} must be within 0 to {max_c} degC (the highest rating of a supported servo)",
-                    name(words, "temperature-limit"),
+                    name(words, &TEMPERATURE_LIMIT),
                     self.temperature_limit_c,
                 ),
             ));
         }
         if let Some(p) = self.stop_on_risk {
-            within(words, "stop-on-risk", p, 0.0, 1.0)?;
+            within(words, &STOP_ON_RISK, p, 0.0, 1.0)?;
         }
         if let Some(noise) = self.emulate_noise_ma {
-            within(words, "emulate-noise", noise, 0.0, 1000.0)?;
+            within(words, &EMULATE_NOISE, noise, 0.0, 1000.0)?;
         }
         if let Some(k) = self.emulate_k_s {
             Terrain::constant(1.0, k)
-                .map_err(|e| RequestError::invalid("emulate-k-s", e.renamed(name(words, "emulate-k-s"))))?;
+                .map_err(|e| RequestError::invalid(EMULATE_K_S.flag, e.renamed(name(words, &EMULATE_K_S))))?;
         }
         Ok(())
     }
@@ -170,5 +424,52 @@ mod tests {
             .starts_with("--temperature-limit = 81 must be within 0 to 80"));
         let soft = DriveRun { emulate_k_s: Some(-1.0), ..run() };
         assert!(soft.check(Words::Keyword).unwrap_err().message().starts_with("k_s = -1"));
+    }
+
+    fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
+        list.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    /// No field given: the table's defaults (level, 10 s at 50 Hz, 2 s hold, the XL330-M288's
+    /// 1470 mA stall current, 65 degC, watchdogs 1 s and 0.5 s, the position profile); the
+    /// emulator's fields only with an emulated bus; each error names its flag.
+    #[test]
+    fn fields_read_given_else_their_defaults() {
+        let f = DriveFields::from_params(&[], true).unwrap();
+        let expected = DriveRun {
+            slope_deg: 0.0,
+            duration_s: 10.0,
+            rate_hz: 50.0,
+            hold_s: 2.0,
+            watchdog_s: 1.0,
+            bus_watchdog_s: 0.5,
+            current_limit_ma: 1470,
+            temperature_limit_c: 65,
+            stop_on_risk: None,
+            emulate_noise_ma: Some(10.0),
+            emulate_k_s: None,
+        };
+        assert_eq!(f.run, expected);
+        assert_eq!(
+            (f.profile.as_str(), f.baud, f.force, f.live_window, f.emulate_seed),
+            ("position", None, false, None, 1)
+        );
+        let f = DriveFields::from_params(
+            &pairs(&[("slope", "-5"), ("profile", "velocity"), ("force", "true")]),
+            false,
+        )
+        .unwrap();
+        assert_eq!(
+            (f.run.slope_deg, f.run.emulate_noise_ma, f.profile.as_str(), f.force),
+            (-5.0, None, "velocity", true)
+        );
+        let e = DriveFields::from_params(&pairs(&[("emulate-noise", "3")]), false).unwrap_err();
+        assert_eq!(e.message(), "--emulate-noise is the emulator's: give --emulate too");
+        let e = DriveFields::from_params(&pairs(&[("live-window", "0")]), false).unwrap_err();
+        assert_eq!(e.field(), Some("live-window"));
+        let e = DriveFields::from_params(&pairs(&[("current-limit", "70000")]), false).unwrap_err();
+        assert_eq!(e.message(), "--current-limit = 70000 must be within 0 to 65535");
+        let e = DriveFields::from_params(&pairs(&[("duration", "90000")]), false).unwrap_err();
+        assert_eq!(e.message(), "--duration = 90000 must be between 0 and 86400");
     }
 }

@@ -12,12 +12,12 @@ use sandslope::{
     write_phase_rows, Axis, PanelSummary, PhasePanel, RegimeCounts, Robot, SignedSlope, Slope, StrengthGrid,
     Terrain, TerrainGrid,
 };
-use sandslope_io::presets::{DEFAULT_ROBOT, DEFAULT_TERRAIN};
 
 use crate::error::{RequestError, Result};
+use crate::field::{Field, Fields, Table};
 use crate::grammar::{self, AxisRange};
 use crate::params::Params;
-use crate::scenario::{load_terrain, RobotRequest};
+use crate::scenario::{load_terrain, RobotRequest, ROBOT, TERRAIN};
 
 /// Default number of grid points per axis.
 pub const DEFAULT_POINTS: usize = 400;
@@ -58,13 +58,48 @@ pub struct PhaseGrid {
     pub k_s_axis: Axis,
 }
 
-/// Reads a comma list of numbers given to `key`.
-fn number_list(p: &mut Params<'_>, key: &'static str) -> Result<Option<Vec<f64>>> {
-    let Some(text) = p.text(key)? else { return Ok(None) };
+/// `--k-n`: the grid's normal-resistance axis.
+pub const K_N_AXIS: Field =
+    Field::text("k-n", "MIN:MAX:N[:log|:lin]").unit("N/m^3").range("0 < MIN < MAX, N at least 2").help(
+        "Normal-resistance axis, N/m^3: MIN:MAX:N with optional :log (default) or :lin. Default: \
+     the terrain's k_n / 100 to x 100, 400 points, log.",
+    );
+/// `--k-s`: the grid's shear-strength axis.
+pub const K_S_AXIS: Field =
+    Field::text("k-s", "MIN:MAX:N[:log|:lin]").unit("N/m^3").range("0 < MIN < MAX, N at least 2").help(
+        "Shear-strength axis, N/m^3: MIN:MAX:N with optional :log (default) or :lin. Default: the \
+     terrain's k_s / 1000 to x 100, 400 points, log.",
+    );
+/// `--slope`: the panels' slopes.
+pub const SLOPE: Field = Field::text("slope", "DEG[,DEG...]")
+    .unit("deg")
+    .default("0")
+    .range("-90 to 90 each")
+    .help("Slope(s) along the direction of travel, degrees, comma-separated (one panel each)");
+/// `--mass`: the panel rows' total masses.
+pub const MASS: Field = Field::text("mass", "KG[,KG...]")
+    .unit("kg")
+    .range("greater than 0 each")
+    .help("Total robot mass(es), kg, comma-separated (one panel row each). Default: the robot's.");
+
+/// `phase`'s own fields (the robot's, without its mass, and the terrain's are
+/// [`crate::scenario`]'s).
+pub const FIELDS: Table = Table { command: "phase", fields: &[K_N_AXIS, K_S_AXIS, SLOPE, MASS] };
+
+impl Fields for PhaseRequest {
+    const TABLE: Table = FIELDS;
+}
+
+/// Reads a comma list of numbers given to `field` (else its default).
+fn number_list(p: &mut Params<'_>, field: &Field) -> Result<Option<Vec<f64>>> {
+    let Some(text) = field.text_in(p)? else { return Ok(None) };
     text.split(',')
         .map(|s| {
             s.trim().parse::<f64>().map_err(|_| {
-                RequestError::invalid(key, format!("--{key}: `{}` is not a number (in {text})", s.trim()))
+                RequestError::invalid(
+                    field.flag,
+                    format!("{}: `{}` is not a number (in {text})", field.long(), s.trim()),
+                )
             })
         })
         .collect::<Result<Vec<f64>>>()
@@ -72,21 +107,39 @@ fn number_list(p: &mut Params<'_>, key: &'static str) -> Result<Option<Vec<f64>>
 }
 
 impl PhaseRequest {
-    /// Reads the fields of a phase request; refuses any other key.
+    /// Reads the fields of a phase request ([`FIELDS`], the robot's and the terrain's); refuses
+    /// any other key.
     pub fn from_params(params: &[(String, String)]) -> Result<PhaseRequest> {
-        let mut p = Params::new("phase", params);
-        let mut axis = |field: &'static str| -> Result<Option<AxisRange>> {
-            p.text(field)?.map(|t| grammar::parse_strength_axis(field, t)).transpose()
-        };
-        let (k_n, k_s) = (axis("k-n")?, axis("k-s")?);
-        let slopes = number_list(&mut p, "slope")?.unwrap_or_else(|| vec![0.0]);
-        let masses = number_list(&mut p, "mass")?.unwrap_or_default();
+        let mut p = Params::new(FIELDS.command, params);
         let robot = RobotRequest {
-            robot: p.text_or("robot", DEFAULT_ROBOT)?,
+            robot: ROBOT.text_in(&mut p)?.unwrap_or_default().to_string(),
             mass: None,
             overrides: RobotRequest::overrides_from_params(&mut p)?,
         };
-        let terrain = p.text_or("terrain", DEFAULT_TERRAIN)?;
+        let terrain = TERRAIN.text_in(&mut p)?.unwrap_or_default().to_string();
+        Self::read(p, robot, terrain)
+    }
+
+    /// The command line's request: its own fields from `params` (the flags given, by
+    /// [`FIELDS`]), the robot and the terrain already read from the flags it shares with other
+    /// commands.
+    pub fn with_robot(
+        params: &[(String, String)],
+        robot: RobotRequest,
+        terrain: String,
+    ) -> Result<PhaseRequest> {
+        Self::read(Params::new(FIELDS.command, params), robot, terrain)
+    }
+
+    /// Reads the request's own fields from `p`, each by its row of [`FIELDS`], and refuses any
+    /// key left.
+    fn read(mut p: Params<'_>, robot: RobotRequest, terrain: String) -> Result<PhaseRequest> {
+        let mut axis = |field: &'static Field| -> Result<Option<AxisRange>> {
+            field.text_in(&mut p)?.map(|t| grammar::parse_strength_axis(field.flag, t)).transpose()
+        };
+        let (k_n, k_s) = (axis(&K_N_AXIS)?, axis(&K_S_AXIS)?);
+        let slopes = number_list(&mut p, &SLOPE)?.unwrap_or_default();
+        let masses = number_list(&mut p, &MASS)?.unwrap_or_default();
         p.finish()?;
         Ok(PhaseRequest { k_n, k_s, slopes, masses, robot, terrain })
     }
@@ -99,27 +152,30 @@ impl PhaseRequest {
         let masses = if self.masses.is_empty() { vec![base.mass()] } else { self.masses.clone() };
         let robots = masses
             .iter()
-            .map(|&m| base.with_mass(m).map_err(|e| RequestError::invalid("mass", e.renamed("--mass"))))
+            .map(|&m| base.with_mass(m).map_err(|e| RequestError::invalid(MASS.flag, e.renamed(MASS.long()))))
             .collect::<Result<Vec<Robot>>>()?;
         if self.slopes.is_empty() {
-            return Err(RequestError::invalid("slope", "--slope gives no slope: give at least one"));
+            return Err(RequestError::invalid(
+                SLOPE.flag,
+                format!("{} gives no slope: give at least one", SLOPE.long()),
+            ));
         }
         let slopes = self
             .slopes
             .iter()
             .map(|&d| {
                 Slope::from_signed_degrees(d)
-                    .map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))
+                    .map_err(|e| RequestError::invalid(SLOPE.flag, e.renamed(SLOPE.long())))
             })
             .collect::<Result<Vec<Slope>>>()?;
         let grounds: Vec<_> = slopes.iter().map(|&s| terrain.at(s)).collect();
-        let axis = |field: &str, given: Option<AxisRange>, values: Vec<f64>, down: f64| match given {
-            Some(range) => grammar::axis(field, range),
-            None => Axis::log_around(&format!("--{field}"), &values, down, 100.0, DEFAULT_POINTS)
-                .map_err(|e| RequestError::invalid(field, e)),
+        let axis = |field: &Field, given: Option<AxisRange>, values: Vec<f64>, down: f64| match given {
+            Some(range) => grammar::axis(field.flag, range),
+            None => Axis::log_around(&field.long(), &values, down, 100.0, DEFAULT_POINTS)
+                .map_err(|e| RequestError::invalid(field.flag, e)),
         };
-        let k_n_axis = axis("k-n", self.k_n, grounds.iter().map(|g| g.k_n).collect(), 100.0)?;
-        let k_s_axis = axis("k-s", self.k_s, grounds.iter().map(|g| g.k_s).collect(), 1000.0)?;
+        let k_n_axis = axis(&K_N_AXIS, self.k_n, grounds.iter().map(|g| g.k_n).collect(), 100.0)?;
+        let k_s_axis = axis(&K_S_AXIS, self.k_s, grounds.iter().map(|g| g.k_s).collect(), 1000.0)?;
         // Guards against a typo such as 100000 points per axis: the maps are kept in memory
         // at two bits per cell.
         let panels = robots.len() * slopes.len();
@@ -127,9 +183,11 @@ impl PhaseRequest {
         if cells > max_cells {
             let side = if max_cells >= 4096 * 4096 { 4096 } else { 1u128 << (max_cells.max(1).ilog2() / 2) };
             return Err(RequestError::invalid(
-                "k-n",
+                K_N_AXIS.flag,
                 format!(
-                    "--k-n and --k-s give {cells} cells over {panels} panel(s); at most {max_cells} are allowed (e.g. {side} x {side} per panel is {})",
+                    "{} and {} give {cells} cells over {panels} panel(s); at most {max_cells} are allowed (e.g. {side} x {side} per panel is {})",
+                    K_N_AXIS.long(),
+                    K_S_AXIS.long(),
                     side * side
                 ),
             ));
@@ -163,7 +221,7 @@ impl PhaseGrid {
         for robot in &self.robots {
             for &slope_deg in &self.slopes_deg {
                 let slope = SignedSlope::from_degrees(slope_deg)
-                    .map_err(|e| RequestError::invalid("slope", e.renamed("--slope")))?;
+                    .map_err(|e| RequestError::invalid(SLOPE.flag, e.renamed(SLOPE.long())))?;
                 let on = TerrainGrid { terrain: &self.terrain, k_n: &self.k_n_axis, k_s: &self.k_s_axis };
                 let panel = PhasePanel::compute(robot, slope, on, on_row);
                 panels.push(panel);
@@ -285,5 +343,31 @@ impl PhaseMapRequest {
             }
         }
         Ok(PhaseMapAnswer { regime, step_m: step, k_n_axis, k_s_axis, counts })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
+        list.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    /// Without a field given: one panel on level ground at the robot's mass, the axes around
+    /// the terrain's; each list is read by its field's row, a bad entry named by its flag.
+    #[test]
+    fn fields_read_by_their_rows() {
+        let r = PhaseRequest::from_params(&[]).unwrap();
+        assert_eq!((r.slopes, r.masses, r.k_n, r.k_s), (vec![0.0], vec![], None, None));
+        let r = PhaseRequest::from_params(&pairs(&[("slope", "-5, 10"), ("mass", "0.5,1")])).unwrap();
+        assert_eq!((r.slopes, r.masses), (vec![-5.0, 10.0], vec![0.5, 1.0]));
+        let e = PhaseRequest::from_params(&pairs(&[("mass", "1,kg")])).unwrap_err();
+        assert_eq!(
+            (e.field(), e.message().as_str()),
+            (Some("mass"), "--mass: `kg` is not a number (in 1,kg)")
+        );
+        let e = PhaseRequest::from_params(&pairs(&[("solve", "mass")])).unwrap_err();
+        assert_eq!(e.field(), Some("solve"));
     }
 }

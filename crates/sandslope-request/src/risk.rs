@@ -12,12 +12,12 @@ use sandslope::risk::{
     SafeSlope, UncertainTerrain,
 };
 use sandslope::{Axis, ParamError, Robot, SignedSlope, Terrain};
-use sandslope_io::presets::DEFAULT_TERRAIN;
 
 use crate::error::{RequestError, Result, Words};
+use crate::field::{Field, Fields, Kind, Table};
 use crate::grammar::{self, parse_slope_list, AxisRange, SlopeSign};
 use crate::params::Params;
-use crate::scenario::{load_terrain, RobotRequest};
+use crate::scenario::{load_terrain, RobotRequest, TERRAIN};
 
 /// What a risk request solves for besides the curve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -94,71 +94,89 @@ impl AnswerLimits {
     };
 }
 
-/// The default slopes, `0:24:7`.
-pub const DEFAULT_SLOPES: &str = "0:24:7";
+/// `--slope`: the slopes of the curve (the map's is the first).
+pub const SLOPE: Field = Field::text("slope", "DEG|LIST|MIN:MAX:N")
+    .keyword("slope_deg")
+    .key("slope_deg")
+    .unit("deg")
+    .default("0:24:7")
+    .range("-90 to 90 each, at most 65,536 (docs/model.md §9)")
+    .help("Slope(s), degrees: one value, a comma list (0,10,20) or a range MIN:MAX:N (0:24:13)");
+/// `--cv-n`: the coefficient of variation of k_n instead of the terrain's.
+pub const CV_N: Field = Field::number("cv-n", "CV").keyword("cv_n").key("cv_n").range("at least 0").help(
+    "Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's \
+     k_n_sd; without either, 0.1 (docs/model.md §9)",
+);
+/// `--cv-s`: the coefficient of variation of k_s instead of the terrain's.
+pub const CV_S: Field = Field::number("cv-s", "CV").keyword("cv_s").key("cv_s").range("at least 0").help(
+    "Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's \
+     k_s_sd; without either, 0.2 (docs/model.md §9)",
+);
+/// `--max-risk`: the largest acceptable failure probability (the library's
+/// [`sandslope::risk::DEFAULT_MAX_RISK`] by default, a test checks).
+pub const MAX_RISK: Field = Field::number("max-risk", "P")
+    .keyword("max_risk")
+    .key("max_risk")
+    .default("0.05")
+    .range("strictly between 0 and 1")
+    .help(
+        "Largest acceptable failure probability. \"Safe\" has one meaning, for the safe-slope limit \
+         and --solve mass alike (docs/model.md §9): p_fail = P(it sinks or slides back) below \
+         this. A safe robot may still climb slowly and stall (metastable); the success limit \
+         bounds P(it does not climb steadily) instead.",
+    );
+/// `--solve`: what to solve for besides the curve.
+pub const SOLVE: Field =
+    Field::new("solve", Kind::Choice(&["slope", "mass"]), "slope|mass").conflicts(&["map"]).help(
+        "Solve for the safe-slope limit (`slope`: the steepest slope with p_fail below \
+         --max-risk, and the success limit beside it) or the heaviest safe mass at each --slope \
+         (`mass`; several slopes give the payload envelope)",
+    );
+/// `--map`: p_fail over a grid of median (k_n, k_s) instead of the curve.
+pub const MAP: Field = Field::switch("map")
+    .help("p_fail and p_not_success over a grid of median (k_n, k_s) at the first --slope");
+/// `--k-n`: the map's axis of median k_n.
+pub const K_N_AXIS: Field = Field::text("k-n", "MIN:MAX:N[:log|:lin]")
+    .keyword("k_n_axis")
+    .unit("N/m^3")
+    .range("0 < MIN < MAX, N at least 2")
+    .help(
+        "--map grid of median k_n, N/m^3: MIN:MAX:N[:log|:lin], log unless :lin (default: \
+         terrain's / 100 to x 100, 200 points)",
+    );
+/// `--k-s`: the map's axis of median k_s.
+pub const K_S_AXIS: Field = Field::text("k-s", "MIN:MAX:N[:log|:lin]")
+    .keyword("k_s_axis")
+    .unit("N/m^3")
+    .range("0 < MIN < MAX, N at least 2")
+    .help(
+        "--map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin], log unless :lin (default: \
+         terrain's / 1000 to x 100, 200 points)",
+    );
+
+/// `risk`'s own fields (the robot's and the terrain's are [`crate::scenario`]'s).
+pub const FIELDS: Table =
+    Table { command: "risk", fields: &[SLOPE, CV_N, CV_S, MAX_RISK, SOLVE, MAP, K_N_AXIS, K_S_AXIS] };
+
+impl Fields for RiskRequest {
+    const TABLE: Table = FIELDS;
+}
 
 /// Parses the field `slope`: the one slope-list grammar, signed (a descent is felt as the
 /// climb of its size), at most [`MAX_RISK_SLOPES`].
 pub fn parse_slopes(text: &str) -> Result<Vec<f64>> {
-    parse_slope_list("slope", text, SlopeSign::Signed, MAX_RISK_SLOPES)
-}
-
-/// A yes/no field: empty, `true` or `1` is yes; `false` or `0` no.
-fn flag(p: &mut Params<'_>, key: &'static str) -> Result<bool> {
-    match p.text(key)? {
-        None => Ok(false),
-        Some("" | "true" | "1") => Ok(true),
-        Some("false" | "0") => Ok(false),
-        Some(other) => Err(RequestError::invalid(
-            key,
-            format!("{key} = `{other}` must be true or false (or empty: true)"),
-        )),
-    }
+    parse_slope_list(SLOPE.flag, text, SlopeSign::Signed, MAX_RISK_SLOPES)
 }
 
 impl RiskRequest {
-    /// Reads the fields of a risk request; refuses any other key.
+    /// Reads the fields of a risk request ([`FIELDS`], the robot's and the terrain's); refuses
+    /// any other key.
     pub fn from_params(params: &[(String, String)]) -> Result<RiskRequest> {
-        let mut p = Params::new("risk", params);
-        let slopes = parse_slopes(p.text("slope")?.unwrap_or(DEFAULT_SLOPES))?;
+        let mut p = Params::new(FIELDS.command, params);
+        let question = RiskQuestion::read(&mut p)?;
         let robot = RobotRequest::from_params(&mut p)?;
-        let terrain = p.text_or("terrain", DEFAULT_TERRAIN)?;
-        let cv_n = p.number("cv-n")?;
-        let cv_s = p.number("cv-s")?;
-        let max_risk = match p.text("max-risk")? {
-            Some(text) => grammar::parse_max_risk(text)
-                .map_err(|why| RequestError::invalid("max-risk", format!("--max-risk = {text}: {why}")))?,
-            None => sandslope::risk::DEFAULT_MAX_RISK,
-        };
-        let solve = match p.text("solve")? {
-            None => None,
-            Some("slope") => Some(Solve::Slope),
-            Some("mass") => Some(Solve::Mass),
-            Some(other) => {
-                return Err(RequestError::invalid(
-                    "solve",
-                    format!("--solve = `{other}` must be slope (the safe-slope limit) or mass (the heaviest safe mass)"),
-                ))
-            }
-        };
-        let map = flag(&mut p, "map")?;
-        let mut grid = RiskMapGrid::default();
-        for (field, axis) in [("k-n", &mut grid.k_n), ("k-s", &mut grid.k_s)] {
-            if let Some(text) = p.text(field)? {
-                if !map {
-                    return Err(RequestError::invalid(
-                        field,
-                        format!("--{field} is the grid of --map: give map too"),
-                    ));
-                }
-                *axis = Some(grammar::parse_strength_axis(field, text)?);
-            }
-        }
-        if map && solve.is_some() {
-            return Err(RequestError::invalid("solve", "--solve cannot be used with --map"));
-        }
+        let terrain = TERRAIN.text_in(&mut p)?.unwrap_or_default().to_string();
         p.finish()?;
-        let question = RiskQuestion { slopes, cv_n, cv_s, max_risk, solve, map: map.then_some(grid) };
         Ok(RiskRequest { robot, terrain, question })
     }
 
@@ -180,6 +198,48 @@ const CURVE_SLOPES_PER_CHUNK: usize = 128;
 const ENVELOPE_SLOPES_PER_CHUNK: usize = 8;
 
 impl RiskQuestion {
+    /// The question of the command line's flags given, `params` ([`FIELDS`]), the robot and the
+    /// terrain read from the flags it shares with other commands; refuses any other key.
+    pub fn from_fields(params: &[(String, String)]) -> Result<RiskQuestion> {
+        let mut p = Params::new(FIELDS.command, params);
+        let question = Self::read(&mut p)?;
+        p.finish()?;
+        Ok(question)
+    }
+
+    /// Reads the question's fields from `p`, each by its row of [`FIELDS`]: the one
+    /// raw-to-typed step of every front end.
+    fn read(p: &mut Params<'_>) -> Result<RiskQuestion> {
+        let slopes = parse_slopes(SLOPE.text_in(p)?.unwrap_or_default())?;
+        let cv_n = CV_N.number_in(p)?;
+        let cv_s = CV_S.number_in(p)?;
+        let text = MAX_RISK.text_in(p)?.unwrap_or_default();
+        let max_risk = grammar::parse_max_risk(text).map_err(|why| {
+            RequestError::invalid(MAX_RISK.flag, format!("{} = {text}: {why}", MAX_RISK.long()))
+        })?;
+        let solve = SOLVE.choice_in(p)?.map(|word| if word == "mass" { Solve::Mass } else { Solve::Slope });
+        let map = MAP.switch_in(p)?;
+        let mut grid = RiskMapGrid::default();
+        for (field, axis) in [(&K_N_AXIS, &mut grid.k_n), (&K_S_AXIS, &mut grid.k_s)] {
+            if let Some(text) = field.text_in(p)? {
+                if !map {
+                    return Err(RequestError::invalid(
+                        field.flag,
+                        format!("{} is the grid of {}: give {} too", field.long(), MAP.long(), MAP.long()),
+                    ));
+                }
+                *axis = Some(grammar::parse_strength_axis(field.flag, text)?);
+            }
+        }
+        if map && solve.is_some() {
+            return Err(RequestError::invalid(
+                SOLVE.flag,
+                format!("{} cannot be used with {}", SOLVE.long(), MAP.long()),
+            ));
+        }
+        Ok(RiskQuestion { slopes, cv_n, cv_s, max_risk, solve, map: map.then_some(grid) })
+    }
+
     /// The question put to `robot` on `terrain`: the CVs checked and the terrain read as
     /// uncertain by the one rule of docs/model.md §9, messages naming the fields in `words`.
     pub fn on(self, robot: &Robot, terrain: Terrain, words: Words) -> Result<RiskProblem<'_>> {
@@ -276,8 +336,8 @@ impl<'a> RiskProblem<'a> {
         let first = || {
             slopes.first().copied().ok_or_else(|| {
                 RequestError::invalid(
-                    "slope",
-                    format!("{} gives no slope: give at least one", words.name("slope")),
+                    SLOPE.flag,
+                    format!("{} gives no slope: give at least one", words.name(SLOPE.flag)),
                 )
             })
         };
@@ -313,8 +373,8 @@ impl<'a> RiskProblem<'a> {
                 let parts = chunks.each(
                     |chunk| Ok(risk_curve(robot, terrain, &signed(chunk)?)),
                     |e| match words {
-                        Words::Flag => RequestError::invalid("slope", e.renamed("--slope")),
-                        Words::Keyword => RequestError::invalid("slope", e),
+                        Words::Flag => RequestError::invalid(SLOPE.flag, e.renamed(SLOPE.long())),
+                        Words::Keyword => RequestError::invalid(SLOPE.flag, e),
                     },
                 )?;
                 RiskAnswer::of_points(parts.into_iter().flat_map(|c| c.points).collect())
@@ -398,7 +458,7 @@ fn envelope(
         |e| match words {
             // The command line's message as it always was: the library's, unnamed.
             Words::Flag => RequestError::from_error(None, anyhow::anyhow!("{e}")),
-            Words::Keyword if e.key.starts_with("slope_deg") => RequestError::invalid("slope", e),
+            Words::Keyword if e.key.starts_with("slope_deg") => RequestError::invalid(SLOPE.flag, e),
             Words::Keyword => RequestError::from_error(None, anyhow::anyhow!("{e}")),
         },
     )?;
@@ -416,12 +476,12 @@ fn too_many(words: Words, n: usize, most: usize, what: &str) -> Result<()> {
     match words {
         _ if n <= most => Ok(()),
         Words::Flag => Err(RequestError::invalid(
-            "slope",
-            format!("--slope gives {n} slopes; at most {most} are allowed for {what} here"),
+            SLOPE.flag,
+            format!("{} gives {n} slopes; at most {most} are allowed for {what} here", SLOPE.long()),
         )),
         Words::Keyword => sandslope::limits::count("len(slope_deg)", n, most)
             .map(|_| ())
-            .map_err(|e| RequestError::invalid("slope", e)),
+            .map_err(|e| RequestError::invalid(SLOPE.flag, e)),
     }
 }
 
@@ -469,8 +529,8 @@ impl SlopeChunks<'_> {
 /// field `slope` in `words`.
 fn slope_in(words: Words, deg: f64) -> Result<SignedSlope> {
     SignedSlope::from_degrees(deg).map_err(|e| match words {
-        Words::Flag => RequestError::invalid("slope", e.renamed("--slope")),
-        Words::Keyword => RequestError::invalid("slope", e),
+        Words::Flag => RequestError::invalid(SLOPE.flag, e.renamed(SLOPE.long())),
+        Words::Keyword => RequestError::invalid(SLOPE.flag, e),
     })
 }
 
@@ -487,22 +547,28 @@ pub fn map_axes_in(
 ) -> Result<(Axis, Axis)> {
     let slope = slope_in(words, slope_deg)?;
     let given = |field: &str, range: Option<AxisRange>| range.map(|r| grammar::axis(field, r)).transpose();
-    let (k_n_axis, k_s_axis) =
-        sandslope::risk::map_axes(terrain, slope, given("k-n", grid.k_n)?, given("k-s", grid.k_s)?)
-            .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))?;
+    let (k_n_axis, k_s_axis) = sandslope::risk::map_axes(
+        terrain,
+        slope,
+        given(K_N_AXIS.flag, grid.k_n)?,
+        given(K_S_AXIS.flag, grid.k_s)?,
+    )
+    .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))?;
     let cells = k_n_axis.len() as u128 * k_s_axis.len() as u128;
     if cells > max_cells {
         if words == Words::Keyword {
             let (nx, ny, most) =
                 (k_n_axis.len(), k_s_axis.len(), usize::try_from(max_cells).unwrap_or(usize::MAX));
             let e = sandslope::limits::grid_cells("len(k_n_axis) * len(k_s_axis)", nx, ny, 1, most);
-            return Err(RequestError::invalid("k-n", e.expect_err("over the cap")));
+            return Err(RequestError::invalid(K_N_AXIS.flag, e.expect_err("over the cap")));
         }
         let side = (max_cells as f64).sqrt().floor();
         return Err(RequestError::invalid(
-            "k-n",
+            K_N_AXIS.flag,
             format!(
-                "--k-n and --k-s give {cells} map cells; at most {max_cells} are allowed (e.g. {side} x {side}), to keep the map in memory"
+                "{} and {} give {cells} map cells; at most {max_cells} are allowed (e.g. {side} x {side}), to keep the map in memory",
+                K_N_AXIS.long(),
+                K_S_AXIS.long()
             ),
         ));
     }
@@ -513,4 +579,44 @@ pub fn map_axes_in(
 /// callers name as their front end does).
 fn signed(slopes: &[f64]) -> std::result::Result<Vec<SignedSlope>, ParamError> {
     slopes.iter().map(|&d| SignedSlope::from_degrees(d).map_err(|e| e.renamed("slope_deg"))).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table's default of `--max-risk` is the library's, which Python's signatures take.
+    #[test]
+    fn max_risk_default_is_the_librarys() {
+        assert_eq!(MAX_RISK.default.map(str::parse::<f64>), Some(Ok(sandslope::risk::DEFAULT_MAX_RISK)));
+    }
+
+    /// Without a field given, the question is the default curve: 0 to 24 degrees in 7 slopes
+    /// (every 4 degrees), at p_fail 0.05, no CV override, no solve, no map.
+    #[test]
+    fn defaults_are_the_curve_over_0_to_24_degrees() {
+        let q = RiskQuestion::from_fields(&[]).unwrap();
+        assert_eq!(q.slopes, vec![0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 24.0]);
+        assert_eq!((q.max_risk, q.cv_n, q.cv_s, q.solve, q.map), (0.05, None, None, None, None));
+    }
+
+    /// The map's axes need the map; solve and map do not go together; each error names its
+    /// flag.
+    #[test]
+    fn map_fields_are_checked_together() {
+        let pairs = |list: &[(&str, &str)]| -> Vec<(String, String)> {
+            list.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+        };
+        let e = RiskQuestion::from_fields(&pairs(&[("k-n", "1e5:1e7:3")])).unwrap_err();
+        assert_eq!(e.message(), "--k-n is the grid of --map: give --map too");
+        let e = RiskQuestion::from_fields(&pairs(&[("map", "true"), ("solve", "mass")])).unwrap_err();
+        assert_eq!(e.message(), "--solve cannot be used with --map");
+        let e = RiskQuestion::from_fields(&pairs(&[("solve", "speed")])).unwrap_err();
+        assert_eq!(e.message(), "--solve = `speed` must be one of: slope, mass");
+        let e = RiskQuestion::from_fields(&pairs(&[("max-risk", "1")])).unwrap_err();
+        assert!(e.message().starts_with("--max-risk = 1: "), "{}", e.message());
+        let q = RiskQuestion::from_fields(&pairs(&[("map", ""), ("k-s", "1:10:2:lin")])).unwrap();
+        let grid = q.map.unwrap();
+        assert!(grid.k_n.is_none() && grid.k_s.is_some());
+    }
 }

@@ -3,15 +3,24 @@
 //! in the user docs (docs/*.md or README.md), so an option list cannot leave one out.
 
 use sandslope_request::field::{Kind, Table};
-use sandslope_request::{predict, scenario, simulate, sweep};
+use sandslope_request::{drive, phase, predict, risk, scenario, simulate, sweep};
 
 /// Each request's tables: its own, then those it shares.
 fn requests() -> Vec<(&'static str, Vec<Table>)> {
     let shared = || vec![scenario::FIELDS, scenario::ROBOT_QUANTITIES];
+    // A request on the robot and terrain alone, without the overrides of k_n and k_s.
+    let robot_and_terrain = Table { command: "scenario", fields: &[scenario::ROBOT, scenario::TERRAIN] };
+    let quantities = scenario::ROBOT_QUANTITIES.fields;
+    assert_eq!(quantities[0], scenario::MASS, "the mass is the first robot quantity");
+    let without_mass = Table { command: "robot", fields: &quantities[1..] };
     vec![
         ("sweep", [vec![sweep::FIELDS], shared()].concat()),
         ("predict", [vec![predict::FIELDS], shared()].concat()),
         ("simulate", [vec![simulate::FIELDS], shared()].concat()),
+        ("risk", vec![risk::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        // phase's masses are its panels', not the robot's override.
+        ("phase", vec![phase::FIELDS, robot_and_terrain, without_mass]),
+        ("drive", vec![drive::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
     ]
 }
 

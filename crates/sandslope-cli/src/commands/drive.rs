@@ -11,13 +11,14 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
 use anyhow::{anyhow, bail, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 
 use sandslope::servo::{GaitSchedule, ServoModel};
 use sandslope_io::robot_terrain::load_servos;
 use sandslope_io::servo_log::DEFAULT_BAUD_RATE;
-use sandslope_request::drive::DriveRun;
-use sandslope_request::error::Words;
+use sandslope_request::drive::{DriveFields, DriveRun, EMULATE_FAULT, EMULATE_OFFSET, EMULATE_WEAKEN};
+use sandslope_request::field::Field;
+use sandslope_request::scenario::{ROBOT, TERRAIN};
 use sandslope_servo::driver::{DriveReport, LiveEstimate};
 use sandslope_servo::emulator::EmulatorFaults;
 use sandslope_servo::log::{drive_logged, live_record, LogTarget};
@@ -30,18 +31,9 @@ use sandslope_servo::{DriveSettings, Profile, ServoConfig};
 #[path = "drive_bench.rs"]
 mod bench;
 
-use crate::args::{RobotArgs, TerrainArgs};
+use crate::args::{FieldArgs, RobotArgs, TerrainArgs};
 use crate::error::{KeepLog, EXIT_HALTED};
 use crate::output::{check_parent_exists, print_json};
-
-/// `--profile`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ProfileArg {
-    /// Extended position mode: the schedule's angle every cycle.
-    Position,
-    /// Velocity mode: the schedule's speed with a phase correction.
-    Velocity,
-}
 
 /// Arguments of `sandslope drive`.
 #[derive(Debug, Args)]
@@ -94,67 +86,22 @@ pub struct DriveRunArgs {
     /// every exit.
     #[arg(long, value_name = "FILE")]
     pub log: Option<PathBuf>,
-    /// The slope being climbed, degrees (for the live estimate, the log's header and the emulator).
-    #[arg(long, value_name = "DEG", default_value_t = RUN_DEFAULTS.slope_deg, allow_negative_numbers = true)]
-    pub slope: f64,
-    /// Gait time, s (after standing up).
-    #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.duration_s)]
-    pub duration: f64,
-    /// Bus cycles per second aimed at (each: a Sync Write of goals and a Sync Read of state).
-    #[arg(long, value_name = "HZ", default_value_t = RUN_DEFAULTS.rate_hz)]
-    pub rate: f64,
-    /// How the gait is commanded.
-    #[arg(long, value_enum, default_value = "position")]
-    pub profile: ProfileArg,
-    /// Baud rate (default: the robot file's [servos] baud_rate, else 57600; the emulator ignores it).
-    #[arg(long, value_name = "BAUD")]
-    pub baud: Option<u32>,
-    /// Halt the gait (torque held, legs planted) when the live risk that the walk fails (slippage or sinkage) passes P.
-    #[arg(long, value_name = "P")]
-    pub stop_on_risk: Option<f64>,
-    /// Drive beyond the calibrated safe slope (`risk --solve slope`); without it such a run is
-    /// refused before anything moves, naming the limit.
-    #[arg(long)]
-    pub force: bool,
-    /// Pool the live estimate over the last N stances (a moving window, to follow sand that
-    /// changes); without it every stance so far is pooled.
-    #[arg(long, value_name = "N")]
-    pub live_window: Option<usize>,
-    /// After a halt, seconds the legs are held before the torque goes off.
-    #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.hold_s)]
-    pub hold: f64,
-    /// Current Limit written to every servo, mA (within the model's: 0 to 1750 on the XL330s, 0 to 3209 on the XM430-W350; 1470 is the XL330-M288's stall current at 5 V; the XL430-W250 has none).
-    #[arg(long, value_name = "MA", default_value_t = RUN_DEFAULTS.current_limit_ma)]
-    pub current_limit: u16,
-    /// Temperature Limit written to every servo, degC (within the model's rated maximum: 70 on the XL330s, 72 on the XL430-W250, 80 on the XM430-W350).
-    #[arg(long, value_name = "DEGC", default_value_t = RUN_DEFAULTS.temperature_limit_c)]
-    pub temperature_limit: u8,
-    /// Longest bus cycle accepted before everything stops, s.
-    #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.watchdog_s)]
-    pub watchdog: f64,
-    /// The servos' own Bus Watchdog, s (0.02 to 2.54): they stop by themselves if the driver goes quiet.
-    #[arg(long, value_name = "S", default_value_t = RUN_DEFAULTS.bus_watchdog_s)]
-    pub bus_watchdog: f64,
-    /// Emulator: Present Current noise, mA (standard deviation).
-    #[arg(long, value_name = "MA", default_value_t = RUN_DEFAULTS.emulate_noise_ma, requires = "emulate")]
-    pub emulate_noise: f64,
-    /// Emulator: seed of the noise.
-    #[arg(long, value_name = "N", default_value_t = RUN_DEFAULTS.emulate_seed, requires = "emulate")]
-    pub emulate_seed: u64,
-    /// Emulator: the sand's k_s (N/m^3) instead of the terrain's at the slope.
-    #[arg(long, value_name = "N/M^3", requires = "emulate")]
-    pub emulate_k_s: Option<f64>,
-    /// Emulator: the sand weakens to K_S N/m^3 at S seconds after the start, S:K_S.
-    #[arg(long, value_name = "S:K_S", requires = "emulate")]
-    pub emulate_weaken: Option<String>,
-    /// Emulator: a fault, silent:ID:S (servo ID stops answering at S s), corrupt:ID:S (its
-    /// packets fail their CRC from S s) or freeze:S:LEN (the bus hangs for LEN s from S s).
-    #[arg(long, value_name = "KIND:..", requires = "emulate")]
-    pub emulate_fault: Option<String>,
-    /// Emulator: a current sensor's zero bias, mA added to every Present Current: one value for
-    /// every servo, or one per servo in leg order, comma-separated (within -500 to 500).
-    #[arg(long, value_name = "MA[,MA..]", requires = "emulate", allow_hyphen_values = true)]
-    pub emulate_offset: Option<String>,
+    /// The run's fields, `--slope` to `--emulate-offset` ([`sandslope_request::drive::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<DriveFields>,
+}
+
+impl DriveRunArgs {
+    /// Whether any of the run's flags was given.
+    pub fn given(&self) -> bool {
+        self.log.is_some() || !self.fields.pairs.is_empty()
+    }
+
+    /// The run's fields read by the request layer's one raw-to-typed step (defaults from its
+    /// table, every number checked); the `--emulate-*` flags only when `emulate`.
+    pub fn fields(&self, emulate: bool) -> Result<DriveFields> {
+        Ok(DriveFields::from_params(&self.fields.pairs, emulate)?)
+    }
 }
 
 /// Where a run's servos are, as the front end's flags say.
@@ -170,7 +117,7 @@ pub enum BusFlag {
 
 /// `--emulate-offset`: one value, or one per servo (`legs`), each within -500 to 500 mA.
 fn parse_offsets(text: &str, legs: usize) -> Result<Vec<f64>> {
-    let v: Vec<f64> = text.split(',').map(|x| number("--emulate-offset", x, text)).collect::<Result<_>>()?;
+    let v: Vec<f64> = text.split(',').map(|x| number(&EMULATE_OFFSET, x, text)).collect::<Result<_>>()?;
     if v.len() != 1 && v.len() != legs {
         bail!(
             "--emulate-offset `{text}`: give one value (every servo) or {legs} (one per servo), not {}",
@@ -183,25 +130,26 @@ fn parse_offsets(text: &str, legs: usize) -> Result<Vec<f64>> {
     Ok(v)
 }
 
-fn number(flag: &str, text: &str, whole: &str) -> Result<f64> {
-    text.trim().parse::<f64>().map_err(|_| anyhow!("{flag}: `{text}` is not a number (in {whole})"))
+/// One number of a list or pair given to `field`, an error naming its flag.
+fn number(field: &Field, text: &str, whole: &str) -> Result<f64> {
+    text.trim().parse::<f64>().map_err(|_| anyhow!("{}: `{text}` is not a number (in {whole})", field.long()))
 }
 
 /// A fault's time, s: a finite number at least 0.
 fn fault_time(text: &str, whole: &str) -> Result<f64> {
-    let t = number("--emulate-fault", text, whole)?;
+    let t = number(&EMULATE_FAULT, text, whole)?;
     if !(t.is_finite() && t >= 0.0) {
         bail!("--emulate-fault `{whole}`: the time `{text}` must be a finite number of seconds, at least 0");
     }
     Ok(t)
 }
 
-fn parse_faults(args: &DriveRunArgs, servos: &[ServoConfig]) -> Result<EmulatorFaults> {
+fn parse_faults(args: &DriveFields, servos: &[ServoConfig]) -> Result<EmulatorFaults> {
     let mut f = EmulatorFaults::default();
     if let Some(w) = &args.emulate_weaken {
         let (s, k) =
             w.split_once(':').ok_or_else(|| anyhow!("--emulate-weaken `{w}` must be S:K_S, e.g. 3:2e5"))?;
-        let (s, k) = (number("--emulate-weaken", s, w)?, number("--emulate-weaken", k, w)?);
+        let (s, k) = (number(&EMULATE_WEAKEN, s, w)?, number(&EMULATE_WEAKEN, k, w)?);
         if !(s >= 0.0 && k > 0.0 && k.is_finite() && s.is_finite()) {
             bail!("--emulate-weaken `{w}`: S must be at least 0 and K_S a finite number above 0");
         }
@@ -277,10 +225,11 @@ pub(crate) fn servos(
     Ok((list, baud.unwrap_or(file_baud), model))
 }
 
-/// The typed run that `drive`'s flags (and `serve --drive`'s, the same [`DriveRunArgs`]) make:
-/// every flag checked against its range, the servos from the robot file `robot_spec`.
+/// The typed run that `drive`'s flags (and `serve --drive`'s, the same [`DriveRunArgs`]) make,
+/// `fields` read and checked by the request layer ([`DriveRunArgs::fields`]); the servos from the
+/// robot file `robot_spec`.
 pub fn config(
-    run: &DriveRunArgs,
+    fields: &DriveFields,
     robot: sandslope::Robot,
     robot_spec: &str,
     terrain: sandslope::Terrain,
@@ -288,48 +237,31 @@ pub fn config(
     monitor: bool,
 ) -> Result<DriveConfig> {
     let emulate = matches!(bus, BusFlag::Emulate);
-    // Every number checked once, by the request layer, in the command line's words.
-    DriveRun {
-        slope_deg: run.slope,
-        duration_s: run.duration,
-        rate_hz: run.rate,
-        hold_s: run.hold,
-        watchdog_s: run.watchdog,
-        bus_watchdog_s: run.bus_watchdog,
-        current_limit_ma: run.current_limit,
-        temperature_limit_c: run.temperature_limit,
-        stop_on_risk: run.stop_on_risk,
-        emulate_noise_ma: emulate.then_some(run.emulate_noise),
-        emulate_k_s: run.emulate_k_s,
-    }
-    .check(Words::Flag)?;
+    let (run, args) = (&fields.run, fields);
     let legs = 2 * robot.stance_legs() as usize;
-    let current_offset_ma = match &run.emulate_offset {
+    let current_offset_ma = match &args.emulate_offset {
         Some(text) if emulate => parse_offsets(text, legs)?,
         _ => vec![],
     };
     GaitSchedule::new(&robot, legs).map_err(|e| anyhow!("{robot_spec}: {e}"))?;
-    let (servos, baud, model) = servos(robot_spec, run.baud, legs)?;
-    let faults = if emulate { parse_faults(run, &servos)? } else { EmulatorFaults::default() };
-    if let Some(b) = run.baud {
+    let (servos, baud, model) = servos(robot_spec, args.baud, legs)?;
+    let faults = if emulate { parse_faults(args, &servos)? } else { EmulatorFaults::default() };
+    if let Some(b) = args.baud {
         if !sandslope_io::servo_log::BAUD_RATES.contains(&b) {
             bail!("--baud = {b} must be one the servos support: {:?}", sandslope_io::servo_log::BAUD_RATES);
         }
     }
     let settings = DriveSettings {
         servos,
-        profile: match run.profile {
-            ProfileArg::Position => Profile::Position,
-            ProfileArg::Velocity => Profile::Velocity,
-        },
-        duration_s: run.duration,
-        rate_hz: run.rate,
-        current_limit_ma: run.current_limit,
-        temperature_limit_c: run.temperature_limit,
-        watchdog_s: run.watchdog,
-        bus_watchdog_s: run.bus_watchdog,
+        profile: if args.profile == "velocity" { Profile::Velocity } else { Profile::Position },
+        duration_s: run.duration_s,
+        rate_hz: run.rate_hz,
+        current_limit_ma: run.current_limit_ma,
+        temperature_limit_c: run.temperature_limit_c,
+        watchdog_s: run.watchdog_s,
+        bus_watchdog_s: run.bus_watchdog_s,
         stop_on_risk: run.stop_on_risk,
-        hold_s: run.hold,
+        hold_s: run.hold_s,
         stand_s: RUN_DEFAULTS.stand_s,
         servo: model,
     };
@@ -345,7 +277,7 @@ pub fn config(
     ) {
         bail!(
             "--duration = {} s is longer than the position profile's goals can reach: in extended position mode a servo's Goal Position must stay within -1,048,575 to 1,048,575 pulses (256 turns), which at {:.3} rad/s ({:.3} turns/s) lasts {:.1} s from the start pose. Fix: --duration {:.0} or less, or --profile velocity (no position goal; Goal Velocity stays within the Velocity Limit)",
-            run.duration,
+            run.duration_s,
             schedule.leg_speed_rad_s,
             schedule.leg_speed_rad_s / std::f64::consts::TAU,
             short.longest_s,
@@ -356,38 +288,43 @@ pub fn config(
         BusFlag::Port(path) => BusChoice::Port { path, baud },
         BusFlag::Emulate | BusFlag::None => BusChoice::Emulate(EmulateOptions {
             k_s: run.emulate_k_s,
-            noise_ma: run.emulate_noise,
-            seed: run.emulate_seed,
+            noise_ma: run.emulate_noise_ma.unwrap_or_default(),
+            seed: args.emulate_seed,
             current_offset_ma,
             faults,
         }),
     };
-    if run.live_window == Some(0) {
-        bail!("--live-window = 0 must be at least 1 stance (leave it out to pool every stance)");
-    }
     Ok(DriveConfig {
         robot,
         terrain,
-        slope_deg: run.slope,
+        slope_deg: run.slope_deg,
         settings,
         bus,
         monitor,
-        window: run.live_window,
-        force: run.force,
+        window: args.live_window,
+        force: args.force,
     })
+}
+
+impl DriveArgs {
+    /// Where the servos are: `--emulate`, `--port`, else none (`--dry-run`, `--zero`).
+    fn bus(&self) -> BusFlag {
+        match (&self.port, self.emulate) {
+            (_, true) => BusFlag::Emulate,
+            (Some(p), false) => BusFlag::Port(p.clone()),
+            (None, false) => BusFlag::None,
+        }
+    }
 }
 
 /// Runs `sandslope drive`.
 pub fn run(args: DriveArgs) -> Result<()> {
     let robot = args.robot.load()?;
     let terrain = args.terrain.load()?;
-    let bus = match (&args.port, args.emulate) {
-        (_, true) => BusFlag::Emulate,
-        (Some(p), false) => BusFlag::Port(p.clone()),
-        (None, false) => BusFlag::None,
-    };
-    let monitor = args.live || args.run.stop_on_risk.is_some();
-    let config = config(&args.run, robot, &args.robot.robot, terrain, bus, monitor)?;
+    let bus = args.bus();
+    let fields = args.run.fields(matches!(bus, BusFlag::Emulate))?;
+    let monitor = args.live || fields.run.stop_on_risk.is_some();
+    let config = config(&fields, robot, &args.robot.robot, terrain, bus, monitor)?;
     if args.zero {
         return bench::zero(&config, &args.robot.robot);
     }
@@ -403,7 +340,10 @@ pub fn run(args: DriveArgs) -> Result<()> {
     }
     if let Some(p) = &args.run.log {
         check_parent_exists(p)?;
-        refuse_input_as_log(p, &[(&args.robot.robot, "--robot"), (&args.terrain.terrain, "--terrain")])?;
+        refuse_input_as_log(
+            p,
+            &[(&args.robot.robot, &ROBOT.long()), (&args.terrain.terrain, &TERRAIN.long())],
+        )?;
     }
     check_bus_budget(&config)?;
     // The live monitor's grid of simulated stance profiles and the bus (the emulator's
@@ -417,7 +357,7 @@ pub fn run(args: DriveArgs) -> Result<()> {
     say(format_args!(
         "driving {} servos for {} s: Ctrl-C stops the gait and turns the torque off",
         servos.len(),
-        args.run.duration
+        fields.run.duration_s
     ));
     let quiet = args.json;
     let mut on_live = |l: &LiveEstimate| {
@@ -491,7 +431,7 @@ pub fn run(args: DriveArgs) -> Result<()> {
     } else {
         Ok(())
     };
-    let verdict = verdict(failure, &report, &args.run);
+    let verdict = verdict(failure, &report, &fields.run);
     match (verdict, printed) {
         (Err(e), _) => Err(e),
         (Ok(()), printed) => printed,
@@ -499,11 +439,7 @@ pub fn run(args: DriveArgs) -> Result<()> {
 }
 
 /// The run's exit: its failure, a signal's code, a halt's, or success.
-fn verdict(
-    failure: Option<sandslope_servo::DriveError>,
-    report: &DriveReport,
-    run: &DriveRunArgs,
-) -> Result<()> {
+fn verdict(failure: Option<sandslope_servo::DriveError>, report: &DriveReport, run: &DriveRun) -> Result<()> {
     match (failure, &report.outcome) {
         (Some(e), _) => {
             let code = e.exit_code();
@@ -522,7 +458,7 @@ fn verdict(
             message: format!(
                 "--stop-on-risk: halted at t = {time_s:.2} s, P(fail) = {p_fail:.3} > {}; the legs were held {} s, then the torque was turned off",
                 run.stop_on_risk.unwrap_or(1.0),
-                run.hold
+                run.hold_s
             ),
         }
         .into()),
@@ -721,4 +657,27 @@ fn write_mcap_log(
     let verdict =
         sandslope_io::mcap_out::verdict_text(&report.outcome, failure.map(|e| e as &dyn std::fmt::Display));
     sandslope_io::write_atomic(path, &drive_mcap(rows, &live, meta, &verdict)?)
+}
+
+#[cfg(test)]
+mod table_tests {
+    use super::*;
+
+    /// The drive table's defaults are the servo crate's [`RUN_DEFAULTS`] (which Python's
+    /// `drive` and `drive_defaults()` take), so the two cannot drift apart.
+    #[test]
+    fn the_tables_defaults_are_the_run_defaults() {
+        let f = DriveFields::from_params(&[], true).unwrap();
+        let d = RUN_DEFAULTS;
+        assert_eq!(
+            (f.run.slope_deg, f.run.duration_s, f.run.rate_hz, f.run.hold_s),
+            (d.slope_deg, d.duration_s, d.rate_hz, d.hold_s)
+        );
+        assert_eq!((f.run.watchdog_s, f.run.bus_watchdog_s), (d.watchdog_s, d.bus_watchdog_s));
+        assert_eq!(
+            (f.run.current_limit_ma, f.run.temperature_limit_c),
+            (d.current_limit_ma, d.temperature_limit_c)
+        );
+        assert_eq!((f.run.emulate_noise_ma, f.emulate_seed), (Some(d.emulate_noise_ma), d.emulate_seed));
+    }
 }

@@ -12,39 +12,23 @@ use clap::Args;
 
 use sandslope::{Axis, PanelSummary, PhasePanel, Regime, Terrain};
 
-use crate::args::{beyond_last_point, warn_extrapolated, RobotQuantityArgs, TerrainArgs};
+use crate::args::{beyond_last_point, warn_extrapolated, FieldArgs, RobotQuantityArgs, TerrainArgs};
 use crate::figures::phase::PhaseFigure;
 use crate::figures::save;
 use crate::output::{print_json, sci, table};
 use crate::progress::progress_bar;
-use sandslope_io::presets::DEFAULT_ROBOT;
+use sandslope_request::scenario::ROBOT;
 use sandslope_request::{PhaseRequest, RobotRequest};
 
 /// Arguments of `sandslope phase`.
 #[derive(Debug, Args)]
 pub struct PhaseArgs {
-    /// Normal-resistance axis, N/m^3: MIN:MAX:N with optional :log (default) or :lin.
-    /// Default: the terrain's k_n / 100 to x 100, 400 points, log.
-    #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]", allow_hyphen_values = true)]
-    pub k_n: Option<String>,
-    /// Shear-strength axis, N/m^3: MIN:MAX:N with optional :log (default) or :lin.
-    /// Default: the terrain's k_s / 1000 to x 100, 400 points, log.
-    #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", allow_hyphen_values = true)]
-    pub k_s: Option<String>,
-    /// Slope(s) along the direction of travel, degrees, comma-separated (one panel each).
-    #[arg(
-        long,
-        value_name = "DEG[,DEG...]",
-        value_delimiter = ',',
-        default_value = "0",
-        allow_negative_numbers = true
-    )]
-    pub slope: Vec<f64>,
-    /// Total robot mass(es), kg, comma-separated (one panel row each). Default: the robot's.
-    #[arg(long, value_name = "KG[,KG...]", value_delimiter = ',', allow_hyphen_values = true)]
-    pub mass: Vec<f64>,
-    /// Robot: a TOML file or a built-in preset (see `sandslope presets`).
-    #[arg(long, value_name = "FILE|PRESET", default_value = DEFAULT_ROBOT)]
+    /// `--k-n`, `--k-s`, `--slope` and `--mass`: the request's own fields
+    /// ([`sandslope_request::phase::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<PhaseRequest>,
+    /// `--robot` ([`ROBOT`]; its mass is the panels').
+    #[arg(long = ROBOT.flag, value_name = ROBOT.value_name, default_value = ROBOT.default, help = ROBOT.help)]
     pub robot: String,
     #[command(flatten)]
     pub quantities: RobotQuantityArgs,
@@ -81,8 +65,8 @@ pub struct Panels {
     pub panels: Vec<PhasePanel>,
     /// The masses, kg.
     pub masses: Vec<f64>,
-    /// How many slopes each mass has.
-    pub slopes: usize,
+    /// The slopes each mass has, degrees as given.
+    pub slopes_deg: Vec<f64>,
     /// The terrain read from `--terrain`.
     pub terrain: Terrain,
     /// The grid's k_n axis.
@@ -92,23 +76,12 @@ pub struct Panels {
 }
 
 impl PhaseArgs {
-    /// The request these flags make (the one `serve`'s `/api/phase` builds too).
+    /// The request these flags make (the one `serve`'s `/api/phase` builds too): the
+    /// request's own fields read by its one raw-to-typed step.
     pub fn request(&self) -> Result<PhaseRequest> {
-        let axis = |field: &str, text: &Option<String>| {
-            text.as_ref().map(|t| sandslope_request::grammar::parse_strength_axis(field, t)).transpose()
-        };
-        Ok(PhaseRequest {
-            k_n: axis("k-n", &self.k_n)?,
-            k_s: axis("k-s", &self.k_s)?,
-            slopes: self.slope.clone(),
-            masses: self.mass.clone(),
-            robot: RobotRequest {
-                robot: self.robot.clone(),
-                mass: None,
-                overrides: self.quantities.overrides(),
-            },
-            terrain: self.terrain.terrain.clone(),
-        })
+        let robot =
+            RobotRequest { robot: self.robot.clone(), mass: None, overrides: self.quantities.overrides() };
+        Ok(PhaseRequest::with_robot(&self.fields.pairs, robot, self.terrain.terrain.clone())?)
     }
 }
 
@@ -117,7 +90,7 @@ impl PhaseArgs {
 /// `warn`).
 fn compute(args: &PhaseArgs, max_cells: u128, quiet: bool, warn: bool) -> Result<Panels> {
     let grid = args.request()?.grid(max_cells)?;
-    let extrapolated = beyond_last_point(&grid.terrain, &args.slope);
+    let extrapolated = beyond_last_point(&grid.terrain, &grid.slopes_deg);
     if !extrapolated.is_empty() && warn {
         warn_extrapolated(&grid.terrain, &extrapolated);
     }
@@ -132,11 +105,10 @@ fn compute(args: &PhaseArgs, max_cells: u128, quiet: bool, warn: bool) -> Result
     let bar = progress_bar(grid.rows(), quiet, "phase map");
     let panels = grid.compute(&|| bar.inc(1))?;
     bar.finish_and_clear();
-    let slopes = grid.slopes_deg.len();
     Ok(Panels {
         panels,
         masses: grid.masses,
-        slopes,
+        slopes_deg: grid.slopes_deg,
         terrain: grid.terrain,
         k_n_axis: grid.k_n_axis,
         k_s_axis: grid.k_s_axis,
@@ -151,17 +123,17 @@ pub fn run(args: PhaseArgs) -> Result<()> {
     if let Some(dir) = &args.npy {
         sandslope_io::npy::prepare_npy_dir(dir)?;
     }
-    let Panels { panels, masses, slopes, terrain, k_n_axis, k_s_axis } =
+    let Panels { panels, masses, slopes_deg, terrain, k_n_axis, k_s_axis } =
         compute(&args, MAX_CELLS, args.json, true)?;
 
     if let Some(path) = &args.csv {
         sandslope_render::tables::write_phase_csv(path, &panels, args.regime_only)?;
     }
     if let Some(dir) = &args.npy {
-        sandslope_render::tables::write_phase_npy(dir, &panels, &masses, &args.slope, args.regime_only)?;
+        sandslope_render::tables::write_phase_npy(dir, &panels, &masses, &slopes_deg, args.regime_only)?;
     }
     if let Some(path) = &args.plot {
-        let figure = PhaseFigure::new(&panels, slopes, terrain_label(&terrain));
+        let figure = PhaseFigure::new(&panels, slopes_deg.len(), terrain_label(&terrain));
         save(path, &figure)?;
     }
     if args.json {

@@ -10,7 +10,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use indicatif::ProgressBar;
 
 use sandslope::risk::{
@@ -18,68 +18,31 @@ use sandslope::risk::{
 };
 use sandslope::Robot;
 use sandslope_request::error::Words;
-use sandslope_request::grammar::parse_strength_axis;
-use sandslope_request::risk::{
-    self as request, AnswerLimits, Progress, RiskMapGrid, RiskProblem, RiskQuestion,
-};
+use sandslope_request::risk::{self as request, AnswerLimits, Progress, RiskProblem, RiskQuestion};
+use sandslope_request::RiskRequest;
 
-use crate::args::{
-    beyond_last_point, parse_max_risk, warn_extrapolated, RobotArgs, TerrainArgs, UncertaintyArgs,
-};
+use crate::args::{beyond_last_point, warn_extrapolated, FieldArgs, RobotArgs, TerrainArgs};
 use crate::figures::risk::{CurveFigure, EnvelopeFigure, MapFigure};
 use crate::figures::save;
 use crate::output::{csv_string, num, print_json, sci, table, Format};
 use crate::progress::progress_bar;
 use sandslope_render::rows::{MassRow, RiskRow, SafeSlopeRow};
 
-/// What `--solve` finds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Solve {
-    /// The safe-slope limit: the steepest slope up to which the robot is safe (p_fail below
-    /// --max-risk), and the success limit beside it.
-    Slope,
-    /// The heaviest total mass that is safe (p_fail below --max-risk) at each --slope (several
-    /// slopes: the payload envelope).
-    Mass,
-}
-
 /// Arguments of `sandslope risk`.
 #[derive(Debug, Args)]
 pub struct RiskArgs {
-    /// Slope(s), degrees: one value, a comma list (0,10,20) or a range MIN:MAX:N (0:24:13).
-    #[arg(long, value_name = "DEG|LIST|MIN:MAX:N", default_value = "0:24:7", allow_hyphen_values = true)]
-    pub slope: String,
+    /// `--slope`, `--cv-n`, `--cv-s`, `--max-risk`, `--solve`, `--map`, `--k-n` and `--k-s`:
+    /// the request's own fields ([`sandslope_request::risk::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<RiskRequest>,
     #[command(flatten)]
     pub robot: RobotArgs,
     #[command(flatten)]
     pub terrain: TerrainArgs,
-    #[command(flatten)]
-    pub uncertainty: UncertaintyArgs,
-    /// Largest acceptable failure probability. "Safe" has one meaning, for the safe-slope limit
-    /// and --solve mass alike (docs/model.md §9): p_fail = P(it sinks or slides back) below
-    /// this. A safe robot may still climb slowly and stall (metastable); the success limit
-    /// bounds P(it does not climb steadily) instead.
-    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = sandslope::risk::DEFAULT_MAX_RISK, value_parser = parse_max_risk)]
-    pub max_risk: f64,
-    /// Solve for the safe-slope limit (`slope`) or the heaviest safe mass at each --slope
-    /// (`mass`; several slopes give the payload envelope).
-    #[arg(long, value_enum)]
-    pub solve: Option<Solve>,
     /// Draw p_fail against slope (with --map: over (k_n, k_s); with --solve mass over several
     /// slopes: the payload envelope) to this .png or .svg file.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    /// p_fail and p_not_success over a grid of median (k_n, k_s) at the first --slope.
-    #[arg(long, conflicts_with = "solve")]
-    pub map: bool,
-    /// --map grid of median k_n, N/m^3: MIN:MAX:N[:log|:lin], log unless :lin (default: terrain's / 100 to
-    /// x 100, 200 points).
-    #[arg(long = "k-n", value_name = "MIN:MAX:N[:log|:lin]", requires = "map", allow_hyphen_values = true)]
-    pub k_n: Option<String>,
-    /// --map grid of median k_s, N/m^3: MIN:MAX:N[:log|:lin], log unless :lin (default: terrain's / 1000 to
-    /// x 100, 200 points).
-    #[arg(long = "k-s", value_name = "MIN:MAX:N[:log|:lin]", requires = "map", allow_hyphen_values = true)]
-    pub k_s: Option<String>,
     /// With --map: write NumPy arrays into this existing folder: p_fail.npy and
     /// p_not_success.npy (float64, shape k_s x k_n), k_n.npy, k_s.npy.
     #[arg(long, value_name = "DIR", requires = "map")]
@@ -104,39 +67,21 @@ impl RiskArgs {
         }
     }
 
-    /// The question these flags ask (the `--map` grid apart: [`RiskArgs::grid`]), its slopes
-    /// read by the request layer's one grammar.
+    /// The question these flags ask, read by the request layer's one raw-to-typed step (the
+    /// one `/api/risk` takes).
     fn question(&self) -> Result<RiskQuestion> {
-        Ok(RiskQuestion {
-            slopes: request::parse_slopes(&self.slope)?,
-            cv_n: self.uncertainty.cv_n,
-            cv_s: self.uncertainty.cv_s,
-            max_risk: self.max_risk,
-            solve: self.solve.map(|s| match s {
-                Solve::Slope => request::Solve::Slope,
-                Solve::Mass => request::Solve::Mass,
-            }),
-            map: None,
-        })
-    }
-
-    /// The `--map` grid given by `--k-n` and `--k-s` (the request layer's axis grammar).
-    fn grid(&self) -> Result<RiskMapGrid> {
-        let axis = |field: &str, text: &Option<String>| {
-            text.as_ref().map(|t| parse_strength_axis(field, t)).transpose()
-        };
-        Ok(RiskMapGrid { k_n: axis("k-n", &self.k_n)?, k_s: axis("k-s", &self.k_s)? })
+        Ok(RiskQuestion::from_fields(&self.fields.pairs)?)
     }
 
     /// Checks the output flags before anything is computed: the figure's format and folder,
     /// `--csv FILE` only with `--map`, the `--npy` folder.
-    fn check_outputs(&self) -> Result<()> {
+    fn check_outputs(&self, map: bool) -> Result<()> {
         if let Some(p) = &self.plot {
             crate::figures::format_of(p)?;
             crate::output::check_parent_exists(p)?;
         }
         if let Some(Some(p)) = &self.csv {
-            if !self.map {
+            if !map {
                 bail!(
                     "--csv FILE writes the cells of --map; without --map, --csv prints to stdout (give no FILE)"
                 );
@@ -208,18 +153,16 @@ fn describe_slope_limits(sol: &SafeSlope) -> String {
 pub fn run(args: RiskArgs) -> Result<()> {
     let robot = args.robot.load()?;
     let question = args.question()?;
-    let mut problem = question.on(&robot, args.terrain.load()?, Words::Flag)?;
-    args.check_outputs()?;
+    let map = question.map.is_some();
+    let problem = question.on(&robot, args.terrain.load()?, Words::Flag)?;
+    args.check_outputs(map)?;
     let extrapolated = beyond_last_point(problem.terrain().terrain(), &problem.question().slopes);
     if !extrapolated.is_empty() {
         warn_extrapolated(problem.terrain().terrain(), &extrapolated);
     }
-    if args.map {
-        problem.map_over(args.grid()?);
-    }
     let format = args.format();
     let json = format == Format::Json;
-    let bar = Bar(if args.map { progress_bar(0, json, "p_fail map") } else { ProgressBar::hidden() });
+    let bar = Bar(if map { progress_bar(0, json, "p_fail map") } else { ProgressBar::hidden() });
     let answer = problem.answer(AnswerLimits::LIBRARY, None, &bar)?;
     bar.0.finish_and_clear();
     let defaults = request::defaults_used(&answer);

@@ -330,6 +330,11 @@ fn a_slope_beyond_the_safe_limit_needs_force() {
 /// 0.49), the stride simulator success: `--stop-on-risk 0.5` halts on the closed form's
 /// verdict at the first stance estimated (tripod 1's first, which ends at 0.6 + 0.5 = 1.1 s;
 /// tripod 0's, the run-up's, is not estimated), exit 5; the JSON carries both verdicts.
+/// So the halt comes at the end of the first stride, after 1.1 s: read at the leg's measured
+/// angle, which lags its goal by the position loop's 25 ms (0.16 rad at 1 turn/s), and at the
+/// next 50 Hz cycle, about 1.14 s; the bound leaves five cycles (0.1 s) for a loaded machine.
+/// Not earlier: the run-up stance does not tell this sand from safe sand (docs/drive.md, "Why
+/// not at the end of tripod 0's first stance"; estimated, it halted safe sand of 1.95e6).
 #[test]
 fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
     let _one = real_time();
@@ -342,7 +347,7 @@ fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["outcome"], "halted");
     let t = v["time_s"].as_f64().unwrap();
-    assert!(t < 1.3, "halted at {t} s");
+    assert!((1.1..1.25).contains(&t), "halted at {t} s");
     let p = &v["live"][0]["pooled"];
     let (sim, closed) = (p["p_fail_simulator"].as_f64().unwrap(), p["p_fail_closed_form"].as_f64().unwrap());
     assert!(closed > 0.5 && closed > sim, "{p}");

@@ -364,13 +364,14 @@ fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
 
 /// Twenty emulated runs on constant sand (k_s 1.95e6 N/m^3, 20 deg, 6 s, seeds 1-20): the
 /// pooled 90% interval at the end covers the truth in at least 16 (nominal 90% less 10 points).
-/// Four runs at a time: each mostly waits on its bus (about 0.16 of a core).
+/// Two runs at a time: each mostly waits on its bus, but starts with a burst of computing
+/// (four at once missed stances on two cores).
 #[test]
 fn the_pooled_interval_covers_the_truth_at_its_rate() {
     let _one = real_time();
     let mut covered = 0;
     let mut seen = vec![];
-    for batch in (1..=20).collect::<Vec<u32>>().chunks(4) {
+    for batch in (1..=20).collect::<Vec<u32>>().chunks(2) {
         let children: Vec<_> = batch
             .iter()
             .map(|seed| {

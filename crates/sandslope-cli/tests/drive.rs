@@ -197,13 +197,17 @@ fn emulated_logs() -> &'static [std::path::PathBuf] {
 
 /// The true k_s inside the 90% interval in at least 9 of 10 runs (issue 42), and so the
 /// climbing speed those sands give: the interval holds the stride simulator's own speed at the
-/// emulator's k_s, walked apart (`simulate --json`), in at least 9 of 10.
+/// emulator's k_s, walked apart (`simulate --json` with the sensor's walk: pitch locked and
+/// the two-faced belly, docs/model.md §19), in at least 9 of 10.
 #[test]
 fn infer_servo_log_recovers_the_emulated_k_s() {
     let truth = 2.5e5;
     let logs = emulated_logs();
     let _cpu = cpu_bound();
-    let walked = bin().args(["simulate", "--slope", "20", "--k-s", "2.5e5", "--json"]).output().unwrap();
+    let walked = bin()
+        .args(["simulate", "--slope", "20", "--k-s", "2.5e5", "--two-faced-belly", "--json"])
+        .output()
+        .unwrap();
     assert!(walked.status.success(), "{}", text(&walked));
     let walked: serde_json::Value = serde_json::from_slice(&walked.stdout).unwrap();
     let true_speed = walked["speed_m_s"].as_f64().unwrap();

@@ -545,6 +545,16 @@ pub fn encode<T: RosMessage>(message: &T) -> Vec<u8> {
     out
 }
 
+/// A position, NaN in every coordinate when one is not finite.
+pub(crate) fn point(p: Point) -> [f64; 3] {
+    let v = [p.x, p.y, p.z];
+    if v.iter().all(|x| x.is_finite()) {
+        v
+    } else {
+        [f64::NAN; 3]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

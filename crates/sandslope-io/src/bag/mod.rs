@@ -61,6 +61,15 @@ pub struct BagMessage<'a> {
     pub index: u64,
 }
 
+/// A message's time, ns: its header's stamp, or the time the recorder received it where the
+/// stamp is zero (a publisher that never set it).
+pub(crate) fn stamp_ns(header: &messages::Header, m: &BagMessage<'_>) -> i64 {
+    match header.stamp.nanos() {
+        0 => m.log_time_ns.min(i64::MAX as u64) as i64,
+        ns => ns,
+    }
+}
+
 /// Where a message or an error is in a bag.
 #[derive(Debug, Clone, Copy)]
 pub struct Location<'a> {

@@ -9,23 +9,17 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
 
+use super::messages::point;
 use super::messages::{
     self, decode, JointState, Odometry, PoseStamped, RosMessage, StringMsg, TfMessage, TransformStamped,
 };
-use super::{describe_topics, open, scan, BagMessage, BagTopic};
+use super::{describe_topics, open, scan, stamp_ns, BagMessage, BagTopic};
 use crate::mocap::{Capture, MocapFormat};
 use crate::servo_log::{ServoLog, ServoLogRow};
 
 /// The message types `track --topic` reads a body's position from.
 pub const POSE_TYPES: [&str; 4] =
     [PoseStamped::TYPE, Odometry::TYPE, TfMessage::TYPE, TransformStamped::TYPE];
-
-pub(super) fn stamp_ns(header: &messages::Header, m: &BagMessage<'_>) -> i64 {
-    match header.stamp.nanos() {
-        0 => m.log_time_ns.min(i64::MAX as u64) as i64,
-        ns => ns,
-    }
-}
 
 pub(super) fn decode_at<T: RosMessage>(m: &BagMessage<'_>) -> Result<T> {
     decode::<T>(m.data).map_err(|e| anyhow!("{}: topic `{}`, message {}: {e}", m.at, m.topic, m.index))
@@ -215,16 +209,6 @@ pub(super) fn read_positions(path: &Path, topic: Option<&str>, frame: Option<&st
         }
     }
     Ok(Positions { name, body, samples })
-}
-
-/// A position, NaN in every coordinate when one is not finite.
-pub(super) fn point(p: messages::Point) -> [f64; 3] {
-    let v = [p.x, p.y, p.z];
-    if v.iter().all(|x| x.is_finite()) {
-        v
-    } else {
-        [f64::NAN; 3]
-    }
 }
 
 /// Frames that may be missing per sample beyond [`MIN_MISSING_ALLOWED`] (as the plain

@@ -106,8 +106,8 @@ impl TfFrames {
                 // A zero rotation: the translation is still the frame's position.
                 let v = t.transform.translation;
                 let iso = isometry(&t.transform).unwrap_or_else(|| Isometry3::translation(v.x, v.y, v.z));
-                let ns = super::series::stamp_ns(&t.header, m);
-                positions.push((ns, super::series::point(v)));
+                let ns = super::stamp_ns(&t.header, m);
+                positions.push((ns, super::messages::point(v)));
                 self.samples.push((ns, iso));
             }
             *frames.entry(child).or_default() += 1;
@@ -206,7 +206,7 @@ pub(super) fn in_root(
                             m.index
                         )
                     })?;
-                    series.push((super::series::stamp_ns(&t.header, m), iso));
+                    series.push((super::stamp_ns(&t.header, m), iso));
                     kept += 1;
                 }
             }

@@ -22,7 +22,8 @@ use std::path::Path;
 use anyhow::{bail, Result};
 
 use super::messages::{self, RosMessage, WrenchStamped};
-use super::series::{decode_at, pick_topic, read_positions, stamp_ns, POSE_TYPES};
+use super::series::{decode_at, pick_topic, read_positions, POSE_TYPES};
+use super::stamp_ns;
 use super::{open, scan};
 
 /// Parses a signed axis, `x`, `+x`, `-x`, `y`, `+y`, `-y`, `z`, `+z` or `-z`, as a unit

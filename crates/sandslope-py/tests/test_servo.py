@@ -3,6 +3,7 @@ XL330s through the same pty and bus code as `sandslope drive --emulate`, `infer_
 returns what `infer --servo-log --json` prints, and bad input is a ValueError naming the
 argument."""
 
+import re
 import math
 
 import numpy as np
@@ -133,8 +134,9 @@ _FLAGS = {
 
 def _help_default(help_text, flag):
     # clap renders `--rate <HZ>  ... [default: 50]`; the block of one flag runs to the next flag.
+    # The help may wrap inside the brackets ("[default:" at a line's end, the value on the next).
     block = help_text.split(f"  {flag} ")[1].split("\n  -")[0]
-    return float(block.split("[default: ")[1].split("]")[0])
+    return float(re.search(r"\[default:\s+([^\]\s]+)\]", block).group(1))
 
 
 def test_drive_defaults_are_the_clis(cli):

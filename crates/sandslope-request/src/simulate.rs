@@ -441,11 +441,22 @@ impl SettingsRequest {
         let servo_limit = !NO_SERVO_LIMIT.switch_in(p)?;
         let body_pitch = parse_body_pitch(BODY_PITCH.text_in(p)?.unwrap_or_default(), words)?;
         let rft_scaling = parse_rft_scaling(RFT_SCALING.text_in(p)?.unwrap_or_default(), words)?;
+        let (one_sided, two_faced) = (ONE_SIDED_BELLY.switch_in(p)?, TWO_FACED_BELLY.switch_in(p)?);
+        if one_sided && two_faced {
+            return Err(RequestError::invalid(
+                TWO_FACED_BELLY.flag,
+                format!(
+                    "{} and {} name two bellies: give one (the one-sided belly is the default)",
+                    words.name(ONE_SIDED_BELLY.flag),
+                    words.name(TWO_FACED_BELLY.flag)
+                ),
+            ));
+        }
         let mechanisms = Mechanisms {
             leg_friction: LEG_FRICTION.number_in(p)?,
             duty_cycle: number(&DUTY_CYCLE, p)?,
             disturbed_sand: number(&DISTURBED_SAND, p)?,
-            one_sided_belly: ONE_SIDED_BELLY.switch_in(p)? | !TWO_FACED_BELLY.switch_in(p)?,
+            one_sided_belly: !two_faced,
             servo_actuator: choose(
                 ACTUATOR.flag,
                 ACTUATOR.text_in(p)?.unwrap_or_default(),

@@ -162,50 +162,39 @@ pub const RATE: Field = Field::number("rate", "HZ")
     .range("greater than 0")
     .help("Trajectory sample rate for --out, --plot and --animate, Hz");
 
+/// The fields of a walk's settings, named once, between `simulate`'s own fields before them
+/// and after them (so [`FIELDS`] keeps its order in `--help` and [`SETTINGS`] is the same rows).
+macro_rules! with_walk_settings {
+    ([$($before:ident),*], [$($after:ident),*]) => {
+        &[
+            $($before,)*
+            DURATION,
+            DT,
+            CREEP,
+            NO_SERVO_LIMIT,
+            BODY_PITCH,
+            RFT_SCALING,
+            LEG_FRICTION,
+            DUTY_CYCLE,
+            DISTURBED_SAND,
+            ONE_SIDED_BELLY,
+            TWO_FACED_BELLY,
+            ACTUATOR,
+            $($after,)*
+            RATE,
+        ]
+    };
+}
+
 /// `simulate`'s own fields (the robot's and terrain's are [`crate::scenario::FIELDS`]).
 pub const FIELDS: Table = Table {
     command: "simulate",
-    fields: &[
-        SLOPE,
-        SLOPES,
-        DURATION,
-        DT,
-        CREEP,
-        NO_SERVO_LIMIT,
-        BODY_PITCH,
-        RFT_SCALING,
-        LEG_FRICTION,
-        DUTY_CYCLE,
-        DISTURBED_SAND,
-        ONE_SIDED_BELLY,
-        TWO_FACED_BELLY,
-        ACTUATOR,
-        ENSEMBLE,
-        CHECK_CONVERGENCE,
-        RATE,
-    ],
+    fields: with_walk_settings!([SLOPE, SLOPES], [ENSEMBLE, CHECK_CONVERGENCE]),
 };
 
 /// A walk's settings' fields (what [`SettingsRequest::read`] reads): every front end's, Python's
 /// three simulate functions' keywords among them.
-pub const SETTINGS: Table = Table {
-    command: "simulate",
-    fields: &[
-        DURATION,
-        DT,
-        CREEP,
-        NO_SERVO_LIMIT,
-        BODY_PITCH,
-        RFT_SCALING,
-        LEG_FRICTION,
-        DUTY_CYCLE,
-        DISTURBED_SAND,
-        ONE_SIDED_BELLY,
-        TWO_FACED_BELLY,
-        ACTUATOR,
-        RATE,
-    ],
-};
+pub const SETTINGS: Table = Table { command: "simulate", fields: with_walk_settings!([], []) };
 
 impl Fields for SimulateRequest {
     const TABLE: Table = FIELDS;

@@ -3,7 +3,7 @@
 //! in the user docs (docs/*.md or README.md), so an option list cannot leave one out.
 
 use sandslope_request::field::{Kind, Table};
-use sandslope_request::{drive, phase, predict, risk, scenario, simulate, sweep};
+use sandslope_request::{calibrate, drive, fit, phase, predict, report, risk, scenario, simulate, sweep};
 
 /// Each request's tables: its own, then those it shares.
 fn requests() -> Vec<(&'static str, Vec<Table>)> {
@@ -21,6 +21,18 @@ fn requests() -> Vec<(&'static str, Vec<Table>)> {
         // phase's masses are its panels', not the robot's override.
         ("phase", vec![phase::FIELDS, robot_and_terrain, without_mass]),
         ("drive", vec![drive::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        ("fit", vec![fit::FIELDS]),
+        ("calibrate", vec![calibrate::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        // report's --tracks is given per slope, beside its once-given fields.
+        (
+            "report",
+            vec![
+                report::FIELDS,
+                Table { command: "report", fields: &[report::TRACKS, scenario::LEVEL_STEP] },
+                robot_and_terrain,
+                scenario::ROBOT_QUANTITIES,
+            ],
+        ),
     ]
 }
 

@@ -15,7 +15,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use sandslope::infer::servo::{sensor_walk_settings, simulated_legs, LegTrace};
 use sandslope::servo::model as x;
@@ -24,6 +24,7 @@ use sandslope::simulate::simulate;
 use sandslope::{Robot, Scenario, Terrain};
 use serial2::SerialPort;
 
+use crate::clock::{Clock, ClockKind, REPLY_TIMEOUT_S};
 use crate::driver::ServoConfig;
 use crate::models::ControlTable;
 use crate::packet::{self, error, inst, Instruction, Parsed, Parser};
@@ -83,6 +84,8 @@ pub struct EmulatorConfig {
     /// Whether the servos know the Clear instruction (firmware 42 and later do); `false`
     /// emulates older firmware, which answers it with an Instruction Error.
     pub clear_supported: bool,
+    /// The clock the servos keep (`--emulate-clock`; [`crate::clock`]).
+    pub clock: ClockKind,
 }
 
 impl EmulatorConfig {
@@ -102,6 +105,7 @@ impl EmulatorConfig {
             firmware: 46,
             initial_turns: 0,
             clear_supported: true,
+            clock: ClockKind::Real,
         }
     }
 }
@@ -444,6 +448,8 @@ pub struct VirtualBus {
     noise_ma: f64,
     parser_packets: usize,
     bad_crc: usize,
+    /// Replies a silent servo owed since [`VirtualBus::take_missed`] (each a reply timeout).
+    missed: usize,
 }
 
 impl VirtualBus {
@@ -491,18 +497,32 @@ impl VirtualBus {
             noise_ma: config.current_noise_ma,
             parser_packets: 0,
             bad_crc: 0,
+            missed: 0,
         })
     }
 
     fn advance_all(&mut self, now: f64) {
-        let walk = match (&self.weak_walk, self.faults.weaken) {
-            (Some(w), Some((at, _))) if now >= at => w,
-            _ => &self.walk,
-        };
-        // A silent servo still runs (its data line is what failed): its watchdog stops it.
-        for s in &mut self.servos {
-            s.advance(now, walk, &mut self.noise, self.noise_ma);
+        // In steps of at most 2 ms, as the real-time thread ticks: the virtual clock (and a
+        // stalled machine) moves a whole cycle at once.
+        let last = self.servos.iter().map(|s| s.last_update).fold(now, f64::min);
+        let steps = ((now - last) / 0.002).ceil().clamp(1.0, 1e6) as usize;
+        for i in 1..=steps {
+            let t = if i == steps { now } else { last + (now - last) * i as f64 / steps as f64 };
+            let walk = match (&self.weak_walk, self.faults.weaken) {
+                (Some(w), Some((at, _))) if t >= at => w,
+                _ => &self.walk,
+            };
+            // A silent servo still runs (its data line is what failed): its watchdog stops it.
+            for s in &mut self.servos {
+                s.advance(t, walk, &mut self.noise, self.noise_ma);
+            }
         }
+    }
+
+    /// The replies silent servos owed since the last call (the driver waited a reply timeout
+    /// for each): what the virtual clock moves on by.
+    pub fn take_missed(&mut self) -> usize {
+        std::mem::take(&mut self.missed)
     }
 
     fn silent(&self, id: u8, now: f64) -> bool {
@@ -529,6 +549,7 @@ impl VirtualBus {
         let ids: Vec<u8> = self.servos.iter().map(|s| s.config.id).collect();
         for (k, id) in ids.iter().enumerate() {
             if self.silent(*id, now) {
+                self.missed += usize::from(crate::clock::expects_reply(&ins, *id));
                 continue;
             }
             self.servos[k].refuse_goals =
@@ -539,7 +560,7 @@ impl VirtualBus {
                     let n = bytes.len();
                     bytes[n - 1] ^= 0x5A;
                 }
-                out.push((order_of(&ins, *id), bytes));
+                out.push((packet::order_of(&ins, *id), bytes));
             }
         }
         out.sort_by_key(|(o, _)| *o);
@@ -668,15 +689,6 @@ impl VirtualBus {
     }
 }
 
-/// Where `id` answers in a multi-servo read: its place in the instruction's list.
-fn order_of(ins: &Instruction, id: u8) -> usize {
-    match ins.instruction {
-        inst::SYNC_READ => ins.params.iter().skip(4).position(|&x| x == id).unwrap_or(usize::MAX),
-        inst::BULK_READ => ins.params.chunks(5).position(|c| c[0] == id).unwrap_or(usize::MAX),
-        _ => 0,
-    }
-}
-
 /// The path of the pseudo-terminal `port` (the slave side [`Emulator::start`] returns), e.g.
 /// `/dev/pts/3`, that another program (Dynamixel Wizard, the ROBOTIS SDK) opens as a serial
 /// port; `None` where the system does not say (Linux reads it from `/proc/self/fd`).
@@ -693,8 +705,8 @@ pub const EMULATED_BAUD: u32 = 9600;
 pub struct Emulator {
     stop: Arc<AtomicBool>,
     handle: Option<JoinHandle<EmulatorReport>>,
-    /// The emulator's time 0, which its fault and weakening times count from.
-    started: Instant,
+    /// The emulator's clock: its time 0 is the one its fault and weakening times count from.
+    clock: Clock,
     /// When the sand weakens, s after `started`, and to what k_s, N/m^3.
     weaken: Option<(f64, f64)>,
 }
@@ -717,17 +729,18 @@ impl Emulator {
         master.set_read_timeout(Duration::from_millis(2)).map_err(EmulatorError::Pty)?;
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
-        let started = Instant::now();
+        let clock = config.clock.start(config.seed);
+        let start = clock.clone();
         let handle = std::thread::Builder::new()
             .name("xl330-emulator".into())
             .spawn(move || {
-                let start = started;
                 let mut parser = Parser::default();
                 let mut buf = [0u8; 1024];
                 while !flag.load(Ordering::Relaxed) {
-                    let now = start.elapsed().as_secs_f64();
+                    let now = start.now();
                     if bus.frozen(now) {
-                        std::thread::sleep(Duration::from_millis(2));
+                        // The virtual clock moves through the freeze as the real one would.
+                        start.sleep(0.002);
                         continue;
                     }
                     match master.read(&mut buf) {
@@ -735,31 +748,35 @@ impl Emulator {
                         _ => {}
                     }
                     while let Some(p) = parser.next_packet() {
-                        let now = start.elapsed().as_secs_f64();
-                        let reply = bus.respond(p, now);
+                        let reply = bus.respond(p, start.now());
                         if !reply.is_empty() {
                             master.write_all(&reply).ok();
                         }
+                        if start.is_virtual() {
+                            start.sleep(bus.take_missed() as f64 * REPLY_TIMEOUT_S);
+                        }
                     }
-                    bus.tick(start.elapsed().as_secs_f64());
+                    bus.tick(start.now());
                 }
                 bus.report()
             })
             .map_err(EmulatorError::Pty)?;
-        Ok((Emulator { stop, handle: Some(handle), started, weaken: config.faults.weaken }, slave))
+        Ok((Emulator { stop, handle: Some(handle), clock, weaken: config.faults.weaken }, slave))
     }
 
-    /// Stops the emulator and returns what its servos' tables hold. `gait_zero`, the instant
-    /// of the driver's gait time 0, puts the weakening on the log's clock
+    /// The emulator's clock, which the driver's loop keeps too ([`crate::clock`]).
+    pub fn clock(&self) -> Clock {
+        self.clock.clone()
+    }
+
+    /// Stops the emulator and returns what its servos' tables hold. `gait_zero`, the driver's
+    /// gait time 0 on the emulator's [`Emulator::clock`], puts the weakening on the log's clock
     /// ([`EmulatorReport::weakened`]).
-    pub fn stop(mut self, gait_zero: Option<Instant>) -> EmulatorReport {
+    pub fn stop(mut self, gait_zero: Option<f64>) -> EmulatorReport {
         self.stop.store(true, Ordering::Relaxed);
         let mut report = self.handle.take().and_then(|h| h.join().ok()).unwrap_or_default();
         report.weakened = match (self.weaken, gait_zero) {
-            (Some((at, k_s)), Some(zero)) if self.started.elapsed().as_secs_f64() >= at => {
-                let offset = zero.saturating_duration_since(self.started).as_secs_f64();
-                Some((at - offset, k_s))
-            }
+            (Some((at, k_s)), Some(zero)) if self.clock.now() >= at => Some((at - zero.max(0.0), k_s)),
             _ => None,
         };
         report

@@ -5,7 +5,7 @@
 use std::io::Read;
 use std::process::{Child, Command, Stdio};
 
-use super::{bin, real_time, text};
+use super::{bin, cpu_bound, real_time, text, VIRTUAL};
 
 /// The log's `# status = ...` line (the flight recorder's first line).
 fn status(log: &std::path::Path) -> String {
@@ -317,10 +317,11 @@ fn a_slope_beyond_the_safe_limit_needs_force() {
     assert!(all.contains("the sand's angle of repose, 25.0 deg"), "{all}");
     assert!(all.contains("--force"), "{all}");
     assert!(!all.contains("driving"), "{all}");
-    let _one = real_time();
+    let _cpu = cpu_bound();
     let out = bin()
         .args(["drive", "--emulate", "--slope", "28", "--force", "--emulate-k-s", "2e6", "--duration", "1"])
         .args(["--watchdog", "2"])
+        .args(VIRTUAL)
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
@@ -337,9 +338,10 @@ fn a_slope_beyond_the_safe_limit_needs_force() {
 /// not at the end of tripod 0's first stance"; estimated, it halted safe sand of 1.95e6).
 #[test]
 fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
-    let _one = real_time();
+    let _cpu = cpu_bound();
     let out = bin()
         .args(["drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "6"])
+        .args(VIRTUAL)
         .args(["--stop-on-risk", "0.5", "--hold", "0.2", "--watchdog", "2", "--json"])
         .output()
         .unwrap();
@@ -364,11 +366,11 @@ fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
 
 /// Twenty emulated runs on constant sand (k_s 1.95e6 N/m^3, 20 deg, 6 s, seeds 1-20): the
 /// pooled 90% interval at the end covers the truth in at least 16 (nominal 90% less 10 points).
-/// Two runs at a time: each mostly waits on its bus, but starts with a burst of computing
-/// (four at once missed stances on two cores).
+/// On the virtual clock, two runs at a time (on the wall's clock four at once missed stances on
+/// two cores; on the virtual one two keep the cores busy).
 #[test]
 fn the_pooled_interval_covers_the_truth_at_its_rate() {
-    let _one = real_time();
+    let _cpu = cpu_bound();
     let mut covered = 0;
     let mut seen = vec![];
     for batch in (1..=20).collect::<Vec<u32>>().chunks(2) {
@@ -387,6 +389,7 @@ fn the_pooled_interval_covers_the_truth_at_its_rate() {
                         "6",
                     ])
                     .args(["--live", "--json", "--watchdog", "2", "--emulate-seed", &seed.to_string()])
+                    .args(VIRTUAL)
                     .stdout(Stdio::piped())
                     .stderr(Stdio::null())
                     .spawn()

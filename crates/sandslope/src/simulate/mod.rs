@@ -57,6 +57,8 @@ pub const MAX_DURATION_S: f64 = 3600.0;
 pub const MAX_STEPS: f64 = 2e7;
 /// Steps (one tripod stance each) left out of the means while the gait settles in.
 pub const WARMUP_STEPS: usize = 2;
+/// Longest run-up of the legs, s ([`SimSettings::with_ramp_up`]).
+pub const MAX_RAMP_UP_S: f64 = 10.0;
 
 /// How to run a walk. Build with [`SimSettings::new`] and the `with_` methods.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -83,6 +85,17 @@ pub struct SimSettings {
     pub rft_scaling: RftScaling,
     /// The candidate mechanisms of docs/model.md §20, all off by default.
     pub mechanisms: Mechanisms,
+    /// The legs' run-up, s: the constant-speed gait reaches omega at constant acceleration
+    /// over this time, as `sandslope drive` commands a robot (docs/model.md §19:
+    /// `omega t^2 / (2 r)`, then `omega (t - r / 2)`, every touchdown `r / 2` later). Default
+    /// 0: full speed from t = 0 (§15); the servo sensor's walks take the robot's response time.
+    /// Serialised only when set, so that every answer without it reads as before.
+    #[serde(skip_serializing_if = "no_ramp_up")]
+    pub ramp_up_s: f64,
+}
+
+fn no_ramp_up(ramp_up_s: &f64) -> bool {
+    *ramp_up_s == 0.0
 }
 
 impl SimSettings {
@@ -108,7 +121,16 @@ impl SimSettings {
             body_pitch: BodyPitch::default(),
             rft_scaling: RftScaling::Motion,
             mechanisms: Mechanisms::default(),
+            ramp_up_s: 0.0,
         })
+    }
+
+    /// The legs' run-up, s (0 to [`MAX_RAMP_UP_S`]; [`SimSettings::ramp_up_s`]).
+    pub fn with_ramp_up(self, ramp_up_s: f64) -> Result<SimSettings, ParamError> {
+        if !(ramp_up_s.is_finite() && (0.0..=MAX_RAMP_UP_S).contains(&ramp_up_s)) {
+            return Err(ParamError::new("ramp_up_s", ramp_up_s, format!("between 0 and {MAX_RAMP_UP_S} s")));
+        }
+        Ok(SimSettings { ramp_up_s, ..self })
     }
 
     /// Switches on the mechanisms of docs/model.md §20 (checked: errors name the switch).
@@ -479,6 +501,14 @@ pub fn simulate_with_leg(
     let (ground, _) = scenario.ground_at(slope);
     let dt = integration_step(scenario, slope, settings.dt_s)?;
     settings.mechanisms.checked()?;
+    if settings.ramp_up_s != 0.0 && settings.mechanisms.duty_cycle != mechanisms::CONSTANT_SPEED_DUTY {
+        return Err(ParamError::new(
+            "ramp_up_s",
+            settings.ramp_up_s,
+            "0 with a duty cycle other than 0.5 (the run-up is the constant-speed gait's)",
+        )
+        .into());
+    }
     let half = robot.stance_duration();
     if settings.locked_leg_angle.is_none() && settings.duration_s < 3.0 * half {
         return Err(ParamError::new(
@@ -518,10 +548,12 @@ pub fn simulate_with_leg(
             .max(REST_CREEP_FRACTION * settings.creep_m_s),
     };
     let duration = n_steps as f64 * dt;
-    let n_meas = ((duration + 1e-9) / half).floor() as usize;
+    // The steps start at the touchdowns, `r / 2` late after a run-up of `r`.
+    let delay = 0.5 * settings.ramp_up_s;
+    let n_meas = ((duration - delay + 1e-9) / half).floor() as usize;
     let mut steps = Vec::with_capacity(n_meas);
     for k in 0..n_meas {
-        let t0 = k as f64 * half;
+        let t0 = delay + k as f64 * half;
         if !track.covers(t0, half) {
             break;
         }

@@ -5,7 +5,7 @@
 //! tolerances: speed 1 mm/s, t1 15 ms, slip 20%) feed the speeds, fig5b, fig3b and the
 //! calibration.
 
-mod common;
+use crate::common;
 
 use predicates::str::contains;
 use sandslope::gait::synthetic::StepProfile;

@@ -3,7 +3,7 @@
 //! its fix: a range of 1e11 slopes or designs aborted the process after minutes and gigabytes,
 //! and a speeds table holding -1e308 hung `calibrate --plot` in the plotting library's tick loop.
 
-mod common;
+use crate::common;
 
 use std::time::{Duration, Instant};
 

@@ -170,6 +170,14 @@ pub struct ModelGrid {
     /// them), bin by bin, N m: the raw drive torque, no swing having come before it to read a
     /// sensor's offset from ([`infer_from_run_up`]).
     pub run_up_mean: Vec<Vec<f64>>,
+    /// The variance of the simulated torque within each bin of a steady stance (strides 1
+    /// on, tripod-major), N m^2, averaged over the grid: a stance sampled at the bus's rate
+    /// reads a bin's mean from a few samples of a profile that changes within the bin (the
+    /// touchdown's peak lasts a few tens of ms), and that sampling error is this over the
+    /// samples one leg takes ([`infer_from_stance`]).
+    pub within_var: Vec<f64>,
+    /// The same for tripod 0's run-up stance ([`infer_from_run_up`]).
+    pub run_up_within_var: Vec<f64>,
 }
 
 /// Fewest samples a swing needs for its median to count as the leg's offset there.
@@ -296,13 +304,16 @@ pub fn model_grid(
                 .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
             let mut legs = simulated_legs(&schedule, &sim);
             let run_up = run_up_profile(&schedule, &legs, bins);
+            let run_up_within = within_bin_variance(&schedule, &legs, bins, |s| s == 0);
             if settings.swing_offset {
                 legs = remove_swing_offset(&schedule, &legs)?.0;
             }
+            let within = within_bin_variance(&schedule, &legs, bins, |s| s >= 1);
             let profiles = stance_profiles(&schedule, &legs, bins);
             let (mean, sd, strides) = profile_statistics(&profiles, 2 * bins);
             let shear = stance_shear_load(&schedule, &sim);
-            Ok((mean, sd, strides, sim.summary.regime, shear, sim.summary.speed_m_s, run_up))
+            let speed = sim.summary.speed_m_s;
+            Ok((mean, sd, strides, sim.summary.regime, shear, speed, (run_up, within, run_up_within)))
         })
         .collect();
     let mut grid = ModelGrid {
@@ -318,10 +329,15 @@ pub fn model_grid(
         bins,
         swing_offset: settings.swing_offset,
         run_up_mean: vec![],
+        within_var: vec![0.0; 2 * bins],
+        run_up_within_var: vec![0.0; bins],
     };
+    let points = walks.len() as f64;
     for w in walks {
-        let (mean, sd, strides, regime, shear, speed, run_up) = w?;
+        let (mean, sd, strides, regime, shear, speed, (run_up, within, run_up_within)) = w?;
         grid.run_up_mean.push(run_up);
+        grid.within_var.iter_mut().zip(&within).for_each(|(g, w)| *g += w / points);
+        grid.run_up_within_var.iter_mut().zip(&run_up_within).for_each(|(g, w)| *g += w / points);
         grid.mean.push(mean);
         grid.sd.push(sd);
         grid.strides = grid.strides.min(strides);
@@ -330,6 +346,39 @@ pub fn model_grid(
         grid.speed_m_s.push(speed);
     }
     Ok(grid)
+}
+
+/// The pooled variance of `legs`' stance torques within each bin (tripod-major) of the
+/// strides `keep` takes, about each stride's bin mean, N m^2 (0 where a bin has too few).
+fn within_bin_variance(
+    schedule: &GaitSchedule,
+    legs: &[LegTrace],
+    bins: usize,
+    keep: impl Fn(i64) -> bool,
+) -> Vec<f64> {
+    let half = 0.5 * schedule.period_s;
+    // (stride, bin) -> (n, sum, sum of squares)
+    let mut groups: std::collections::BTreeMap<(i64, usize), (f64, f64, f64)> = Default::default();
+    for (j, leg) in legs.iter().enumerate().take(schedule.legs()) {
+        let k = schedule.tripods[j];
+        for (&a, &tau) in leg.angle_rad.iter().zip(&leg.torque_n_m) {
+            let (stride, since) = schedule.stride_position(j, a);
+            if a.is_finite() && tau.is_finite() && since < half && keep(stride) {
+                let b = ((since / half * bins as f64) as usize).min(bins - 1);
+                let g = groups.entry((stride, k * bins + b)).or_default();
+                *g = (g.0 + 1.0, g.1 + tau, g.2 + tau * tau);
+            }
+        }
+    }
+    let mut ss = vec![0.0; 2 * bins];
+    let mut dof = vec![0.0; 2 * bins];
+    for ((_, b), (n, sum, sq)) in groups {
+        if n >= 2.0 {
+            ss[b] += (sq - sum * sum / n).max(0.0);
+            dof[b] += n - 1.0;
+        }
+    }
+    ss.iter().zip(&dof).map(|(s, d)| if *d > 0.0 { s / d } else { 0.0 }).collect()
 }
 
 /// Tripod 0's run-up stance (stride 0) of `legs`, bin by bin (0 where a bin is empty).
@@ -521,6 +570,16 @@ pub fn infer_servo_log(
     infer_from_currents(robot, &grid, legs)
 }
 
+/// The variance of one stance's bin mean of `count` samples, N m^2: the sensor's noise over
+/// the samples, plus the profile's variance within the bin (`within_var`, the grid's) over the
+/// samples one leg took (a tripod's legs are read in the same bus cycles, at the same points
+/// of their common profile, so they do not sample it independently).
+fn stance_bin_variance(robot: &Robot, noise_sd_n_m: f64, within_var: Option<f64>, count: usize) -> f64 {
+    let c = count as f64;
+    let per_leg = (c / f64::from(robot.stance_legs())).max(1.0);
+    noise_sd_n_m * noise_sd_n_m / c + within_var.unwrap_or(0.0) / per_leg
+}
+
 /// Live update after one stance: the posterior from tripod `tripod`'s bins of one stance
 /// (`profile`, its `counts`), with `noise_sd_n_m` the torque noise of one sample.
 pub fn infer_from_stance(
@@ -545,7 +604,7 @@ pub fn infer_from_stance(
             continue;
         }
         mean[idx] = v;
-        var[idx] = noise_sd_n_m * noise_sd_n_m / c as f64;
+        var[idx] = stance_bin_variance(robot, noise_sd_n_m, grid.within_var.get(idx).copied(), c);
         used.push(idx);
     }
     if used.len() < b {
@@ -589,7 +648,7 @@ pub fn infer_from_run_up(
             return None;
         }
         mean[i] = v;
-        var[i] = noise_sd_n_m * noise_sd_n_m / c as f64;
+        var[i] = stance_bin_variance(robot, noise_sd_n_m, grid.run_up_within_var.get(i).copied(), c);
     }
     let pad = |m: &Vec<f64>| m.iter().copied().chain(std::iter::repeat(0.0)).take(2 * b).collect();
     let g = ModelGrid { strides: 1, mean: grid.run_up_mean.iter().map(pad).collect(), ..grid.clone() };

@@ -19,6 +19,7 @@ mod linear;
 pub mod mechanisms;
 pub mod phase1;
 pub mod rft;
+pub mod spread;
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -31,6 +32,7 @@ pub use ensemble::{simulate_ensemble, Ensemble};
 pub use mechanisms::Mechanisms;
 pub use phase1::PhaseOne;
 pub use rft::RftScaling;
+pub use spread::{scaling_spread, ScalingSpread};
 
 use crate::error::ParamError;
 use crate::gait::{measure_step, SmoothTrack, StepMeasure, REST_SPEED_FRACTION};

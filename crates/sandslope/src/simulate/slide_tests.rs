@@ -78,3 +78,30 @@ fn the_free_body_walks_at_a_quarter_of_the_locked_step_by_default() {
     let walked = simulate(&s, SignedSlope::from_degrees(15.0).unwrap(), &free).unwrap();
     assert_eq!(walked.summary.dt_s, t / 8000.0);
 }
+
+/// The scaling spread at 24 degrees (docs/simulate.md, "The scaling as model uncertainty"):
+/// each walk under its own scaling, the range spanning them, and the regimes apart, since under
+/// `motion` the stance tripod cannot hold the body there and under `components` it can (the
+/// test above, against gravity's pull by hand). `li2013` reads no k_s, so its walk is the same
+/// to the bit on sand of ten times the k_s.
+#[test]
+fn the_scaling_spread_walks_each_scaling_and_spans_them() {
+    let at = |k_s: f64| {
+        let s =
+            Scenario::new(paper_robot(), crate::terrain::Terrain::constant(7e5, k_s).unwrap(), None, None)
+                .unwrap();
+        spread::scaling_spread(&s, SignedSlope::from_degrees(24.0).unwrap(), &SimSettings::new(3.0).unwrap())
+            .unwrap()
+    };
+    let (a, b) = (at(1e6), at(1e7));
+    for (w, s) in a.walks.iter().zip(spread::SCALINGS) {
+        assert_eq!(w.rft_scaling, s);
+        assert!(a.min_speed_m_s <= w.speed_m_s && w.speed_m_s <= a.max_speed_m_s);
+    }
+    assert!(a.walks.iter().any(|w| w.speed_m_s == a.min_speed_m_s));
+    assert!(a.walks.iter().any(|w| w.speed_m_s == a.max_speed_m_s));
+    assert!(a.min_speed_m_s < 0.0 && a.max_speed_m_s > 0.0);
+    assert!(!a.regimes_agree);
+    assert_eq!(a.regimes[0], Regime::Slippage);
+    assert_eq!(a.walks[1].speed_m_s, b.walks[1].speed_m_s);
+}

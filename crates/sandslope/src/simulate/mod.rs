@@ -19,6 +19,7 @@ mod linear;
 pub mod mechanisms;
 pub mod phase1;
 pub mod rft;
+pub mod spread;
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -31,6 +32,7 @@ pub use ensemble::{simulate_ensemble, Ensemble};
 pub use mechanisms::Mechanisms;
 pub use phase1::PhaseOne;
 pub use rft::RftScaling;
+pub use spread::{scaling_spread, ScalingSpread};
 
 use crate::error::ParamError;
 use crate::gait::{measure_step, SmoothTrack, StepMeasure, REST_SPEED_FRACTION};
@@ -424,18 +426,44 @@ pub enum SimulateError {
     Param(#[from] ParamError),
 }
 
-/// The default time step as a fraction of the stride period T (docs/model.md §17).
+/// The default time step as a fraction of the stride period T (docs/model.md §17), pitch
+/// locked.
 pub const DEFAULT_STEPS_PER_STRIDE: f64 = 2000.0;
+/// The default time step of a walk with the body free to pitch, as a fraction of T
+/// (docs/model.md §17): a quarter of the locked walk's. At T / 2000 the free body's landing on
+/// its belly at the end of each step comes milliseconds early, and at 15 degrees its speed
+/// moves by 8% at a quarter of the step (docs/simulate.md, "The free body's step").
+pub const DEFAULT_STEPS_PER_STRIDE_FREE: f64 = 8000.0;
 /// The coarsest time step a walk takes, as a fraction of T.
 pub const MIN_STEPS_PER_STRIDE: f64 = 100.0;
 
 /// The time step for `scenario`: the given one, checked, or the default `T / 2000`
 /// (docs/model.md §17). The contact sets no stability limit (the step is passive for any
 /// length); the limit `T / 100` is one of accuracy, a leg turning 3.6 degrees per step.
-pub fn integration_step(scenario: &Scenario, _slope: Slope, given: Option<f64>) -> Result<f64, ParamError> {
+pub fn integration_step(scenario: &Scenario, slope: Slope, given: Option<f64>) -> Result<f64, ParamError> {
+    step_for(scenario, slope, given, BodyPitch::Locked)
+}
+
+/// The time step of a walk with `settings`: its own, checked, or the default for its body
+/// pitch (`T / 2000` locked, `T / 8000` free; docs/model.md §17).
+pub fn integration_step_for(
+    scenario: &Scenario,
+    slope: Slope,
+    settings: &SimSettings,
+) -> Result<f64, ParamError> {
+    step_for(scenario, slope, settings.dt_s, settings.body_pitch)
+}
+
+fn step_for(
+    scenario: &Scenario,
+    _slope: Slope,
+    given: Option<f64>,
+    pitch: BodyPitch,
+) -> Result<f64, ParamError> {
     let period = scenario.robot().stride_period();
     let limit = period / MIN_STEPS_PER_STRIDE;
     match given {
+        None if pitch == BodyPitch::Free => Ok(period / DEFAULT_STEPS_PER_STRIDE_FREE),
         None => Ok(period / DEFAULT_STEPS_PER_STRIDE),
         Some(dt) if dt.is_finite() && dt > 0.0 && dt <= limit => Ok(dt),
         Some(dt) => Err(ParamError::new(
@@ -499,7 +527,7 @@ pub fn simulate_with_leg(
         .into());
     }
     let (ground, _) = scenario.ground_at(slope);
-    let dt = integration_step(scenario, slope, settings.dt_s)?;
+    let dt = integration_step_for(scenario, slope, settings)?;
     settings.mechanisms.checked()?;
     if settings.ramp_up_s != 0.0 && settings.mechanisms.duty_cycle != mechanisms::CONSTANT_SPEED_DUTY {
         return Err(ParamError::new(
@@ -718,5 +746,9 @@ pub fn simulate_slopes(
 
 #[cfg(test)]
 mod phase1_tests;
+#[cfg(test)]
+mod slide_tests;
+#[cfg(test)]
+mod stride_probe;
 #[cfg(test)]
 mod tests;

@@ -67,7 +67,9 @@ fn at_24_degrees_the_stance_tripod_cannot_hold_the_body_whatever_k_s_under_motio
 fn the_free_body_walks_at_a_quarter_of_the_locked_step_by_default() {
     let s = Scenario::new(paper_robot(), super::tests::builtin_terrain(), None, None).unwrap();
     let slope = Slope::from_degrees(15.0).unwrap();
-    let t = 2.0 * std::f64::consts::PI / 6.283185307179586;
+    // T = 2 pi / omega = 1 s for the paper's robot (omega = 2 pi rad/s).
+    let t = paper_robot().stride_period();
+    assert!((t - 1.0).abs() < 1e-12);
     let locked = SimSettings::new(1.5).unwrap();
     let free = locked.with_body_pitch(BodyPitch::Free);
     assert_eq!(integration_step_for(&s, slope, &locked).unwrap(), t / 2000.0);

@@ -41,8 +41,6 @@ DEFAULT_BY_NAME = re.compile(r'\b(?:number_or|text_or)\(\s*"([^"]+)"')
 
 # Requests still reading their fields by name: (path, why). Shrinks as tables are added.
 PENDING = {
-    "crates/sandslope-request/src/plan/mod.rs": "plan's table not yet written",
-    "crates/sandslope-request/src/plan/settings.rs": "plan's table not yet written",
     "crates/sandslope-request/src/design.rs": "design's table not yet written",
     "crates/sandslope-request/src/infer.rs": "infer's table not yet written",
     "crates/sandslope-request/src/track.rs": "track's table not yet written",
@@ -50,7 +48,6 @@ PENDING = {
     "crates/sandslope-request/src/calibrate.rs": "calibrate's table not yet written",
     "crates/sandslope-request/src/report.rs": "report's table not yet written",
     "crates/sandslope-request/src/grammar.rs": "the slope and axis grammars take the field's name",
-    "crates/sandslope-cli/src/commands/plan/mod.rs": "plan's table not yet written",
     "crates/sandslope-cli/src/commands/design.rs": "design's table not yet written",
     "crates/sandslope-cli/src/commands/infer.rs": "infer's table not yet written",
     "crates/sandslope-cli/src/commands/track.rs": "track's table not yet written",
@@ -63,7 +60,6 @@ PENDING = {
     "crates/sandslope-serve/src/drive.rs": "the drive run is read by the CLI through drive's table; the server's own drive keys not yet",
     "crates/sandslope-fuzz/src/serve/requests.rs": "the fuzzer's key list is not yet read from the tables",
     "crates/sandslope-py/src/risk.rs": "risk's table not yet written",
-    "crates/sandslope-py/src/plan.rs": "plan's table not yet written",
     "crates/sandslope-py/src/calibrate.rs": "calibrate's table not yet written",
     "crates/sandslope-py/src/report.rs": "report's table not yet written",
     "crates/sandslope-py/src/measure.rs": "fit's and track's tables not yet written",

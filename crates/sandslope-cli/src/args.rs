@@ -223,6 +223,7 @@ pub fn field_arg(f: &'static Field) -> clap::Arg {
         clap::Arg::new(f.flag).long(f.flag).help(f.help).conflicts_with_all(f.conflicts).required(f.required);
     match f.kind {
         Kind::Switch => arg.action(clap::ArgAction::SetTrue),
+        Kind::List => arg.action(clap::ArgAction::Append).value_name(f.value_name),
         kind => {
             let arg = arg.action(clap::ArgAction::Set).value_name(f.value_name).default_value(f.default);
             match kind {
@@ -264,6 +265,11 @@ impl<T: Fields> clap::FromArgMatches for FieldArgs<T> {
             }
             let text = match f.kind {
                 Kind::Switch => "true".to_string(),
+                // Given more than once: one comma list, as HTTP and Python write it.
+                Kind::List => matches
+                    .get_many::<String>(f.flag)
+                    .map(|v| v.map(String::as_str).collect::<Vec<_>>().join(","))
+                    .unwrap_or_default(),
                 _ => matches.get_one::<String>(f.flag).cloned().unwrap_or_default(),
             };
             self.pairs.retain(|(k, _)| k != f.flag);

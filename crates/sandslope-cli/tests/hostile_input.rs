@@ -51,8 +51,10 @@ fn huge_ranges_are_refused_before_they_are_expanded() {
 
 #[test]
 fn max_risk_says_the_same_everywhere() {
-    for cmd in ["risk", "design", "report"] {
-        sandslope().args([cmd, "--max-risk", "1.5"]).assert().code(2).stderr(
+    // design's --vary and --slope-target are required: clap asks for them before any value is read.
+    let design = ["design", "--vary", "mass_kg=1", "--slope-target", "10"];
+    for cmd in [&["risk"][..], &design, &["report"]] {
+        sandslope().args(cmd).args(["--max-risk", "1.5"]).assert().code(2).stderr(
             contains("--max-risk").and(contains("1.5 is not a failure probability strictly between 0 and 1")),
         );
     }

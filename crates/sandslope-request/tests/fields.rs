@@ -3,7 +3,7 @@
 //! in the user docs (docs/*.md or README.md), so an option list cannot leave one out.
 
 use sandslope_request::field::{Kind, Table};
-use sandslope_request::{drive, phase, plan, predict, risk, scenario, simulate, sweep};
+use sandslope_request::{design, drive, phase, plan, predict, risk, scenario, simulate, sweep};
 
 /// Each request's tables: its own, then those it shares.
 fn requests() -> Vec<(&'static str, Vec<Table>)> {
@@ -22,6 +22,7 @@ fn requests() -> Vec<(&'static str, Vec<Table>)> {
         ("phase", vec![phase::FIELDS, robot_and_terrain, without_mass]),
         ("drive", vec![drive::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         ("plan", vec![plan::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        ("design", vec![design::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
     ]
 }
 
@@ -58,7 +59,7 @@ fn every_default_reads_with_its_fields_parser() {
                 Kind::Whole => assert!(default.parse::<u32>().is_ok(), "{command} --{}", f.flag),
                 Kind::Choice(words) => assert!(words.contains(&default), "{command} --{}", f.flag),
                 Kind::Switch => panic!("{command}: the switch --{} has a default", f.flag),
-                Kind::Text => {}
+                Kind::Text | Kind::List => {}
             }
         }
     }

@@ -3,7 +3,7 @@
 //! in the user docs (docs/*.md or README.md), so an option list cannot leave one out.
 
 use sandslope_request::field::{Kind, Table};
-use sandslope_request::{design, drive, phase, plan, predict, risk, scenario, simulate, sweep};
+use sandslope_request::{design, drive, infer, phase, plan, predict, risk, scenario, simulate, sweep};
 
 /// Each request's tables: its own, then those it shares.
 fn requests() -> Vec<(&'static str, Vec<Table>)> {
@@ -23,6 +23,7 @@ fn requests() -> Vec<(&'static str, Vec<Table>)> {
         ("drive", vec![drive::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         ("plan", vec![plan::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         ("design", vec![design::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        ("infer", vec![infer::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
     ]
 }
 
@@ -126,6 +127,8 @@ fn python_functions() -> Vec<(&'static str, &'static str, Table, Vec<&'static st
     vec![
         ("risk_raster", "plan.rs", plan::FIELDS, settings.to_vec()),
         ("plan", "plan.rs", plan::FIELDS, [&settings[..], &["time_weight", "objectives"]].concat()),
+        ("infer_servo_log_file", "servo.rs", infer::FIELDS, vec!["slope_deg", "k_s_prior", "grid_points"]),
+        ("infer_servo_log", "servo.rs", infer::FIELDS, vec!["slope_deg", "k_s_prior", "grid_points"]),
     ]
 }
 

@@ -3,7 +3,7 @@
 //! in the user docs (docs/*.md or README.md), so an option list cannot leave one out.
 
 use sandslope_request::field::{Kind, Table};
-use sandslope_request::{design, drive, infer, phase, plan, predict, risk, scenario, simulate, sweep};
+use sandslope_request::{design, drive, infer, phase, plan, predict, risk, scenario, simulate, sweep, track};
 
 /// Each request's tables: its own, then those it shares.
 fn requests() -> Vec<(&'static str, Vec<Table>)> {
@@ -24,6 +24,7 @@ fn requests() -> Vec<(&'static str, Vec<Table>)> {
         ("plan", vec![plan::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         ("design", vec![design::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         ("infer", vec![infer::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        ("track", vec![track::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
     ]
 }
 
@@ -129,6 +130,7 @@ fn python_functions() -> Vec<(&'static str, &'static str, Table, Vec<&'static st
         ("plan", "plan.rs", plan::FIELDS, [&settings[..], &["time_weight", "objectives"]].concat()),
         ("infer_servo_log_file", "servo.rs", infer::FIELDS, vec!["slope_deg", "k_s_prior", "grid_points"]),
         ("infer_servo_log", "servo.rs", infer::FIELDS, vec!["slope_deg", "k_s_prior", "grid_points"]),
+        ("track", "measure.rs", track::FIELDS, track::FIELDS.fields.iter().map(|f| f.keyword).collect()),
     ]
 }
 

@@ -12,6 +12,7 @@ use crate::served::{stride, DemInfo, Served};
 use sandslope::Cause;
 use sandslope_io::presets::{PresetKind, PRESETS};
 use sandslope_io::raster::{read_raster, write_two_band_geotiff};
+use sandslope_request::plan::{GOAL, GOAL_PX, OBJECTIVE, START, START_PX};
 use sandslope_request::scenario::robot_fields;
 use sandslope_request::{PhaseRequest, PlanRequest};
 
@@ -221,13 +222,13 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiEr
                     }
                 }
             }
-            "start" | "goal" | "start-px" | "goal-px" | "objective" => {}
+            k if [&START, &GOAL, &START_PX, &GOAL_PX, &OBJECTIVE].iter().any(|f| f.flag == k) => {}
             _ => rest.push((k.clone(), v.clone())),
         }
     }
     // The planner's inputs need no endpoints; plan's flags require some, so any cell will do.
-    rest.push(("start-px".into(), "0,0".into()));
-    rest.push(("goal-px".into(), "0,0".into()));
+    rest.push((START_PX.flag.into(), "0,0".into()));
+    rest.push((GOAL_PX.flag.into(), "0,0".into()));
     let request = PlanRequest::from_params(&api::plan_params(&rest, served)?)?;
     let inputs = request.inputs(&|_| {})?;
     let planner = inputs.planner()?;

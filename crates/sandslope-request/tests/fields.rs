@@ -4,7 +4,8 @@
 
 use sandslope_request::field::{Kind, Table};
 use sandslope_request::{
-    calibrate, design, drive, fit, infer, phase, plan, predict, report, risk, scenario, simulate, sweep, track,
+    calibrate, design, drive, fit, infer, phase, plan, predict, report, risk, scenario, simulate, sweep,
+    track,
 };
 
 /// Each request's tables: its own, then those it shares.

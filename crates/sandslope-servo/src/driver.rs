@@ -20,7 +20,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use dynamixel2::instructions::SyncWriteData;
 use dynamixel2::ReadError;
-use sandslope::infer::servo::{infer_from_stance, CurrentInference, ModelGrid};
+use sandslope::infer::servo::{
+    infer_from_run_up, infer_from_stance, CurrentInference, ModelGrid, RUN_UP_OFFSET_SD_MA,
+};
 use sandslope::risk::UncertainTerrain;
 use sandslope::servo::verdict::{pool, prior_p_fail, PooledEstimate};
 use sandslope::servo::{GaitSchedule, ServoModel};
@@ -324,7 +326,8 @@ fn run(
         failures: vec![(0usize, false); ids.len()],
         last_pos: vec![None; ids.len()],
         monitor: monitor.map(|m| {
-            let bins = StanceBins::new(m.grid.bins, settings.servos.len(), m.grid.swing_offset);
+            let run_up = !m.grid.run_up_mean.is_empty();
+            let bins = StanceBins::new(m.grid.bins, settings.servos.len(), m.grid.swing_offset, run_up);
             (m, bins)
         }),
         goal_check: GoalCheck::default(),
@@ -643,10 +646,17 @@ impl Walk<'_> {
         report: &mut DriveReport,
     ) {
         let Some((m, bins)) = self.monitor.as_mut() else { return };
-        let Some((k, profile, counts)) = bins.add(schedule, j, angle, tau) else { return };
-        let Some(inf) = infer_from_stance(m.robot, m.grid, k, &profile, &counts, m.noise_sd_n_m) else {
-            return;
+        let Some(stance) = bins.add(schedule, j, time, angle, tau) else { return };
+        let (k, profile, counts) = (stance.tripod, &stance.profile, &stance.counts);
+        // Tripod 0's run-up stance against the grid walks' own run-ups, its raw torques'
+        // unknown sensor offsets integrated out (docs/drive.md).
+        let inf = if stance.stride == 0 {
+            let offset_sd = self.model.torque_from_current_ma(RUN_UP_OFFSET_SD_MA);
+            infer_from_run_up(m.robot, m.grid, profile, counts, m.noise_sd_n_m, offset_sd)
+        } else {
+            infer_from_stance(m.robot, m.grid, k, profile, counts, m.noise_sd_n_m)
         };
+        let Some(inf) = inf else { return };
         self.stances.push(inf.posterior.iter().map(|x| x.1).collect());
         let from = m.window.map_or(0, |w| self.stances.len().saturating_sub(w.max(1)));
         let pooled_in: Vec<&[f64]> = self.stances[from..].iter().map(Vec::as_slice).collect();

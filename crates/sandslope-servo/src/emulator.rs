@@ -142,7 +142,6 @@ pub struct EmulatorReport {
 #[derive(Debug, Clone)]
 struct Walk {
     legs: Vec<LegTrace>,
-    rate_hz: f64,
 }
 
 impl Walk {
@@ -150,15 +149,20 @@ impl Walk {
         let schedule = GaitSchedule::new(robot, 2 * robot.stance_legs() as usize)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let rate_hz = 500.0;
-        let settings = sensor_walk_settings(strides.max(3) as f64 * schedule.period_s, rate_hz)
-            .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+        // The driver's run-up (docs/model.md §19) walked too, and the strides after it whole.
+        let settings = sensor_walk_settings(
+            strides.max(3) as f64 * schedule.period_s + schedule.run_up_s,
+            rate_hz,
+            schedule.run_up_s,
+        )
+        .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let scenario = Scenario::new(robot.clone(), terrain, None, None)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let slope = sandslope::SignedSlope::from_degrees(slope_deg)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let sim =
             simulate(&scenario, slope, &settings).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
-        Ok(Walk { legs: simulated_legs(&schedule, &sim), rate_hz })
+        Ok(Walk { legs: simulated_legs(&schedule, &sim) })
     }
 
     /// Drive torque of leg `leg` at gait angle `angle` (N m): the simulated leg's at the same
@@ -178,10 +182,13 @@ impl Walk {
             let usable = ((span - turn) / turn).floor().max(1.0) * turn;
             rel = turn + (rel - turn).rem_euclid(usable);
         }
-        // The simulated angle grows at omega from a0: the sample index follows the angle.
-        let frac = (rel.max(0.0) / span).min(1.0);
-        let i = ((frac * (n - 1) as f64).round() as usize).min(n - 1);
-        let _ = self.rate_hz;
+        // The sample nearest the angle: the simulated angle does not grow at omega from a0
+        // (the legs run up over the response time, as the driver commands them), so it is
+        // looked up, not computed from the time.
+        let target = a0 + rel.max(0.0);
+        let i = trace.angle_rad.partition_point(|&a| a < target).min(n - 1);
+        let i =
+            if i > 0 && target - trace.angle_rad[i - 1] < trace.angle_rad[i] - target { i - 1 } else { i };
         trace.torque_n_m[i]
     }
 }
@@ -790,5 +797,30 @@ impl Drop for Emulator {
         if let Some(h) = self.handle.take() {
             h.join().ok();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The playback follows the legs' angle through the run-up (docs/model.md §19), not the
+    /// time at full speed. A trace sampled every 0.05 s of the paper's run-up (omega = 2 pi
+    /// rad/s over dt = 0.2 s), each sample's torque its time: by hand, angle omega t^2 / (2 dt)
+    /// = 0.0125 pi at t = 0.05 s, 0.05 pi at 0.1 s, 0.2 pi at 0.2 s, 0.4 pi at 0.3 s. Read at
+    /// full speed from the start (the old playback) 0.05 pi would be t = 0.025 s, not 0.1 s.
+    #[test]
+    fn the_playback_follows_the_run_up_by_hand() {
+        let pi = std::f64::consts::PI;
+        let times = [0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3];
+        let angle = |t: f64| if t < 0.2 { pi * t * t / 0.2 } else { 2.0 * pi * (t - 0.1) };
+        let trace =
+            LegTrace { angle_rad: times.iter().map(|&t| angle(t)).collect(), torque_n_m: times.to_vec() };
+        let walk = Walk { legs: vec![trace] };
+        for (a, t) in [(0.0125 * pi, 0.05), (0.05 * pi, 0.1), (0.2 * pi, 0.2), (0.4 * pi, 0.3), (0.0, 0.0)] {
+            assert_eq!(walk.torque(0, a), t, "angle {a}");
+        }
+        // Between samples, the nearest: 0.06 pi lies between 0.05 pi (0.1 s) and 0.1125 pi (0.15 s).
+        assert_eq!(walk.torque(0, 0.06 * pi), 0.1);
     }
 }

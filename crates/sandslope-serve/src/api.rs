@@ -94,10 +94,11 @@ pub fn request_params(
 /// A plan request's parameters: those of [`request_params`] and the served DEM, the only one
 /// a request may plan on (naming another is refused; without one, a 404).
 pub fn plan_params(params: &[(String, String)], served: &Served) -> Result<Vec<(String, String)>, ApiError> {
-    if params.iter().any(|(k, _)| k == "dem") {
+    let dem_key = sandslope_request::plan::DEM.flag;
+    if params.iter().any(|(k, _)| k == dem_key) {
         return Err(ApiError::bad(
-            Some("dem".into()),
-            "dem: a request cannot name a file; the server plans on the DEM it was started with (serve --dem)",
+            Some(dem_key.into()),
+            format!("{dem_key}: a request cannot name a file; the server plans on the DEM it was started with (serve --dem)"),
         ));
     }
     let Some(dem) = &served.dem else {
@@ -108,7 +109,7 @@ pub fn plan_params(params: &[(String, String)], served: &Served) -> Result<Vec<(
         });
     };
     let mut params = request_params(params, served)?;
-    params.push(("dem".to_string(), dem.display().to_string()));
+    params.push((dem_key.to_string(), dem.display().to_string()));
     Ok(params)
 }
 

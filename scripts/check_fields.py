@@ -41,24 +41,13 @@ DEFAULT_BY_NAME = re.compile(r'\b(?:number_or|text_or)\(\s*"([^"]+)"')
 
 # Requests still reading their fields by name: (path, why). Shrinks as tables are added.
 PENDING = {
-    "crates/sandslope-request/src/fit.rs": "fit's table not yet written",
-    "crates/sandslope-request/src/calibrate.rs": "calibrate's table not yet written",
-    "crates/sandslope-request/src/report.rs": "report's table not yet written",
     "crates/sandslope-request/src/grammar.rs": "the slope and axis grammars take the field's name",
-    "crates/sandslope-cli/src/commands/fit.rs": "fit's table not yet written",
-    "crates/sandslope-cli/src/commands/calibrate.rs": "calibrate's table not yet written",
-    "crates/sandslope-cli/src/commands/report.rs": "report's table not yet written",
     "crates/sandslope-cli/src/commands/animate.rs": "simulate's table not yet written",
     "crates/sandslope-serve/src/api.rs": "serve's own keys (dem, output flags) beside the tables",
     "crates/sandslope-serve/src/data.rs": "serve's own keys beside the tables",
     "crates/sandslope-serve/src/drive.rs": "the drive run is read by the CLI through drive's table; the server's own drive keys not yet",
     "crates/sandslope-fuzz/src/serve/requests.rs": "the fuzzer's key list is not yet read from the tables",
-    "crates/sandslope-py/src/risk.rs": "risk's table not yet written",
-    "crates/sandslope-py/src/calibrate.rs": "calibrate's table not yet written",
-    "crates/sandslope-py/src/report.rs": "report's table not yet written",
-    "crates/sandslope-py/src/measure.rs": "fit's and track's tables not yet written",
     "crates/sandslope-py/src/servo.rs": "Python's drive keywords not yet checked against drive's table",
-    "crates/sandslope-py/src/model.rs": "phase's table not yet written",
 }
 
 

@@ -14,6 +14,9 @@
 #   FUZZ_TIMEOUT=SECONDS one input running longer is a hang (default 10, for release builds)
 #   SANDSLOPE_VENV=DIR   the venv with the Python package (default .venv); the Python targets
 #                        are skipped, with a note, when it has no sandslope
+#   FUZZ_PREBUILT=1      use the binaries already in target/ (scripts/test.sh builds them with
+#                        its tests' features: this script's own build, of two packages alone,
+#                        resolves other features and recompiles half the workspace)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-1000}
@@ -26,7 +29,9 @@ flag=--release
 dir=release
 if [ "$profile" = debug ]; then flag=; dir=debug; fi
 
-cargo build $flag --locked -p sandslope-cli -p sandslope-fuzz
+if [ "${FUZZ_PREBUILT:-0}" != 1 ]; then
+  cargo build $flag --locked -p sandslope-cli -p sandslope-fuzz
+fi
 bin=target/$dir
 rust_targets=()
 py_targets=()

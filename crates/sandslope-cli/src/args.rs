@@ -263,12 +263,10 @@ pub fn warn_extrapolated(terrain: &Terrain, slopes: &[f64]) {
 
 pub use sandslope_request::scenario::beyond_last_point;
 
-pub use sandslope_request::grammar::parse_max_risk;
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sandslope_request::grammar::{self, SlopeSign};
+    use sandslope_request::grammar::{self, parse_max_risk, SlopeSign};
 
     /// A slope list given to `flag`: the one slope-list grammar of every front end
     /// ([`grammar::parse_slope_list`]: `DEG`, `DEG,DEG,...` or `MIN:MAX:N`, at most `max`).

@@ -16,6 +16,7 @@ use pyo3::prelude::*;
 
 mod arrays;
 mod calibrate;
+mod fields;
 mod interrupt;
 mod measure;
 mod model;
@@ -76,6 +77,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate_ensemble, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::check_convergence, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::walk_keyword_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::request_keywords, m)?)?;
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add_function(wrap_pyfunction!(servo::read_servo_log, m)?)?;
     m.add_function(wrap_pyfunction!(servo::infer_servo_log, m)?)?;

@@ -9,7 +9,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pythonize::pythonize;
 
-use sandslope::measure::AirMode;
 use sandslope::robot_key::RobotKey;
 use sandslope::Robot;
 use sandslope_io::mocap::MocapFormat;
@@ -33,12 +32,7 @@ pub fn fit<'py>(
     counts_per_newton: Option<f64>,
     skip_malformed: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let air = match air {
-        "auto" => AirMode::Auto,
-        "curve" => AirMode::Curve,
-        "mean" => AirMode::Mean,
-        other => return Err(value_error(format!("air = {other:?} must be \"auto\", \"curve\" or \"mean\""))),
-    };
+    let air = FitRequest::air_mode(air).map_err(|e| value_error(e.message()))?;
     // The request `sandslope fit` makes: one check and one answer for both front ends.
     let request = FitRequest { manifest, depth_window, plateau_from, air, counts_per_newton, skip_malformed };
     request.check(Words::Keyword).map_err(|e| value_error(e.message()))?;

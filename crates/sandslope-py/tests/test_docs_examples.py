@@ -1,6 +1,6 @@
 """The Python the README and the docs show, run as written (issue 28): every ```python block
 of docs/*.md and README.md, and every `python -c "..."` line of their ```sh blocks (the
-`sandslope` commands are run by crates/sandslope-cli/tests/docs_examples.rs)."""
+`sandslope` commands are run by crates/sandslope-cli/tests/it/docs_examples.rs)."""
 
 import re
 import runpy

@@ -19,6 +19,84 @@ use sandslope::{
 use sandslope_io::{load_anchoring_times, load_speeds, load_terrain};
 
 use crate::error::{check_positive_in, check_range_in, RequestError, Result, Words};
+use crate::field::{Field, Fields, Kind, Table};
+use crate::params::Params;
+use crate::scenario::TERRAIN;
+
+/// The words of `--law`, in [`CalibrateLaw::ALL`]'s order.
+const LAW_WORDS: [&str; 3] = ["linear", "coulomb", "per-slope"];
+/// The words of `--model`, in [`CalibrateModel::ALL`]'s order.
+const MODEL_WORDS: [&str; 2] = ["closed-form", "simulate"];
+
+/// `--observed`: the observed speeds.
+pub const OBSERVED: Field = Field::text("observed", "CSV")
+    .keyword("observed")
+    .help("Observed speeds: CSV with columns slope_deg,speed_m_s,speed_sd_m_s");
+/// `--forces`: the force tests giving k_s's shape.
+pub const FORCES: Field = Field::text("forces", "FILE|PRESET").keyword("forces").help(
+    "Force tests: a terrain file (as `sandslope fit` writes) whose k_s(theta) and k_s_sd give the \
+     shape of k_s; its k_n is used too. Without it, k_s follows --law",
+);
+/// `--t1`: the observed anchoring times.
+pub const T1: Field = Field::text("t1", "CSV")
+    .keyword("t1")
+    .help("Observed anchoring times: CSV with columns slope_deg,t1_s,t1_sd_s");
+/// `--free`: the quantities fitted besides k_s.
+pub const FREE: Field = Field::text("free", "LIST").keyword("free").help(
+    "Quantities to fit besides k_s, comma-separated: any robot key (hip_height_m, level_step_m, \
+     response_time_s, leg_contact_area_m2, ...), plate_scale (k_s_leg = c * k_s_plate, needs \
+     --forces) and error_floor; each optionally with bounds, KEY=MIN:MAX",
+);
+/// `--error-floor`: a fixed model-error floor.
+pub const ERROR_FLOOR: Field = Field::number("error-floor", "M/S")
+    .keyword("error_floor")
+    .unit("m/s")
+    .range("0 to 1")
+    .help("A fixed model-error floor added in quadrature to every observed speed SD, m/s");
+/// `--law`: the form of k_s(theta) without force tests.
+pub const LAW: Field = Field::new("law", Kind::Choice(&LAW_WORDS), "linear|coulomb|per-slope")
+    .keyword("law")
+    .default("linear")
+    .help(
+        "Form of k_s(theta) to fit when there are no --forces: linear (k_s0 * (1 + (rho - 1) * \
+         theta_deg / 20)), coulomb (k_s0 * (cos theta - sin theta / tan phi)) or per-slope (one \
+         k_s per observed slope, by root finding; speeds only)",
+    );
+/// `--model`: the model whose speeds are fitted.
+pub const MODEL: Field = Field::new("model", Kind::Choice(&MODEL_WORDS), "closed-form|simulate")
+    .keyword("model")
+    .default("closed-form")
+    .help(
+        "The model whose speeds and anchoring times are fitted (docs/calibration.md): closed-form \
+         (docs/model.md §3-§5) or simulate (the stride simulator, docs/model.md §15-§18: one \
+         walk per observed slope and trial point, in parallel; minutes of CPU, the closed \
+         form's fit printed beside it)",
+    );
+/// `--k-n`: the normal resistance at every slope.
+pub const K_N: Field = Field::number("k-n", "N/M^3")
+    .keyword("k_n")
+    .unit("N/m^3")
+    .range("greater than 0")
+    .help("Normal resistance k_n, N/m^3, at every slope (default: the --forces' or --terrain's k_n)");
+/// `--name`: the name written into the terrain.
+pub const NAME: Field = Field::text("name", "NAME")
+    .keyword("name")
+    .help("Name written into the terrain file (default: `calibrated-<law>` or calibrated-forces)");
+/// `--repose`: the angle of repose written into the terrain.
+pub const REPOSE: Field = Field::number("repose", "DEG").keyword("repose").unit("deg").range("0 to 90").help(
+    "Angle of repose written into the terrain file, degrees (default: carried over from the \
+     --forces or --terrain file)",
+);
+
+/// `calibrate`'s own fields (the robot's and the source terrain's are [`crate::scenario`]'s).
+pub const FIELDS: Table = Table {
+    command: "calibrate",
+    fields: &[OBSERVED, FORCES, T1, FREE, ERROR_FLOOR, LAW, MODEL, K_N, NAME, REPOSE],
+};
+
+impl Fields for CalibrateRequest {
+    const TABLE: Table = FIELDS;
+}
 
 /// The form of k_s(theta) fitted when there are no force tests (field `law`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -38,11 +116,12 @@ impl CalibrateLaw {
 
     /// The law's name as the command line writes it.
     pub fn name(self) -> &'static str {
-        match self {
-            CalibrateLaw::Linear => "linear",
-            CalibrateLaw::Coulomb => "coulomb",
-            CalibrateLaw::PerSlope => "per-slope",
-        }
+        LAW_WORDS[self as usize]
+    }
+
+    /// The law named `word`, if any.
+    pub fn named(word: &str) -> Option<CalibrateLaw> {
+        Self::ALL.into_iter().find(|l| l.name() == word)
     }
 }
 
@@ -63,10 +142,12 @@ impl CalibrateModel {
 
     /// The model's name as the command line writes it.
     pub fn name(self) -> &'static str {
-        match self {
-            CalibrateModel::ClosedForm => "closed-form",
-            CalibrateModel::Simulate => "simulate",
-        }
+        MODEL_WORDS[self as usize]
+    }
+
+    /// The model named `word`, if any.
+    pub fn named(word: &str) -> Option<CalibrateModel> {
+        Self::ALL.into_iter().find(|m| m.name() == word)
     }
 }
 
@@ -212,8 +293,8 @@ pub struct CalibrateSource<'a> {
 
 /// Parses `free` items: `KEY` or `KEY=MIN:MAX`; errors name the field in `words`.
 fn parse_free(items: &[String], words: Words) -> Result<Vec<FreeParameter>> {
-    let bad = |m: String| RequestError::invalid("free", m);
-    let free = words.name("free");
+    let bad = |m: String| RequestError::invalid(FREE.flag, m);
+    let free = words.name(FREE.flag);
     let mut out = Vec::new();
     for item in items.iter().map(|s| s.trim()).filter(|s| !s.is_empty()) {
         let (key, bounds) = match item.split_once('=') {
@@ -239,6 +320,29 @@ fn parse_free(items: &[String], words: Words) -> Result<Vec<FreeParameter>> {
 }
 
 impl CalibrateRequest {
+    /// The request of the flags given, `params` ([`FIELDS`]): the one raw-to-typed step of the
+    /// command line. `--free`'s comma list is split into its items; refuses any other key.
+    pub fn from_fields(params: &[(String, String)]) -> Result<CalibrateRequest> {
+        let mut p = Params::new(FIELDS.command, params);
+        let path = |text: Option<&str>| text.map(PathBuf::from);
+        let observed = path(OBSERVED.text_in(&mut p)?);
+        let forces = FORCES.text_in(&mut p)?.map(str::to_string);
+        let t1 = path(T1.text_in(&mut p)?);
+        let free =
+            FREE.text_in(&mut p)?.map_or_else(Vec::new, |t| t.split(',').map(str::to_string).collect());
+        let error_floor = ERROR_FLOOR.number_in(&mut p)?;
+        // The choices' words are checked by `choice_in`, and their defaults are among them.
+        let unnamed = |f: &Field| RequestError::invalid(f.flag, format!("{} names nothing", f.long()));
+        let law = LAW.choice_in(&mut p)?.and_then(CalibrateLaw::named).ok_or_else(|| unnamed(&LAW))?;
+        let model =
+            MODEL.choice_in(&mut p)?.and_then(CalibrateModel::named).ok_or_else(|| unnamed(&MODEL))?;
+        let k_n = K_N.number_in(&mut p)?;
+        let name = NAME.text_in(&mut p)?.map(str::to_string);
+        let repose = REPOSE.number_in(&mut p)?;
+        p.finish()?;
+        Ok(CalibrateRequest { observed, forces, t1, free, error_floor, law, model, k_n, name, repose })
+    }
+
     /// Every value checked before any file is read; errors name the field as its flag.
     pub fn check(&self) -> Result<CheckedCalibrate> {
         self.check_in(Words::Flag)
@@ -246,54 +350,58 @@ impl CalibrateRequest {
 
     /// [`CalibrateRequest::check`], errors naming the field in the front end's `words`.
     pub fn check_in(&self, words: Words) -> Result<CheckedCalibrate> {
-        let law = |l: &str| words.setting("law", l);
+        let law = |l: &str| words.setting(LAW.flag, l);
         if self.model == CalibrateModel::Simulate && self.law == CalibrateLaw::PerSlope {
             return Err(RequestError::invalid(
-                "law",
+                LAW.flag,
                 format!(
                     "{} inverts the closed form only: with {} use {}, {} or {}",
-                    law("per-slope"),
-                    words.setting("model", "simulate"),
-                    law("linear"),
-                    law("coulomb"),
-                    words.name("forces")
+                    law(CalibrateLaw::PerSlope.name()),
+                    words.setting(MODEL.flag, CalibrateModel::Simulate.name()),
+                    law(CalibrateLaw::Linear.name()),
+                    law(CalibrateLaw::Coulomb.name()),
+                    words.name(FORCES.flag)
                 ),
             ));
         }
         let free = parse_free(&self.free, words)?;
-        let k_n = self.k_n.map(|v| check_positive_in(words, "k-n", v)).transpose()?;
+        let k_n = self.k_n.map(|v| check_positive_in(words, K_N.flag, v)).transpose()?;
         if let Some(r) = self.repose {
-            check_range_in(words, "repose", r, 0.0, 90.0)?;
+            check_range_in(words, REPOSE.flag, r, 0.0, 90.0)?;
         }
         let error_floor =
-            self.error_floor.map(|v| check_range_in(words, "error-floor", v, 0.0, 1.0)).transpose()?;
+            self.error_floor.map(|v| check_range_in(words, ERROR_FLOOR.flag, v, 0.0, 1.0)).transpose()?;
         if error_floor.is_some() && free.iter().any(|f| f.parameter == Parameter::ErrorFloor) {
             return Err(RequestError::invalid(
-                "error-floor",
+                ERROR_FLOOR.flag,
                 format!(
                     "{} fixes the floor and {} fits it: give one of them",
-                    words.name("error-floor"),
-                    words.setting("free", "error_floor")
+                    words.name(ERROR_FLOOR.flag),
+                    words.setting(FREE.flag, "error_floor")
                 ),
             ));
         }
         if self.law == CalibrateLaw::PerSlope && self.forces.is_none() {
             if !free.is_empty() || self.t1.is_some() || error_floor.is_some() {
                 return Err(RequestError::invalid(
-                    "law",
+                    LAW.flag,
                     format!(
                         "{} inverts each speed alone: it takes no {}, {} or {}",
-                        law("per-slope"),
-                        words.name("free"),
-                        words.name("t1"),
-                        words.name("error-floor")
+                        law(CalibrateLaw::PerSlope.name()),
+                        words.name(FREE.flag),
+                        words.name(T1.flag),
+                        words.name(ERROR_FLOOR.flag)
                     ),
                 ));
             }
             if self.observed.is_none() {
                 return Err(RequestError::invalid(
-                    "observed",
-                    format!("{} needs {} speeds", law("per-slope"), words.name("observed")),
+                    OBSERVED.flag,
+                    format!(
+                        "{} needs {} speeds",
+                        law(CalibrateLaw::PerSlope.name()),
+                        words.name(OBSERVED.flag)
+                    ),
                 ));
             }
         }
@@ -317,22 +425,22 @@ impl CalibrateRequest {
     ) -> Result<CalibrateAnswer> {
         let checked = self.check_in(words)?;
         let speeds = match &self.observed {
-            Some(p) => load_speeds(p).map_err(|e| RequestError::from_error(Some("observed"), e))?,
+            Some(p) => load_speeds(p).map_err(|e| RequestError::from_error(Some(OBSERVED.flag), e))?,
             None => Vec::new(),
         };
         let anchoring = match &self.t1 {
-            Some(p) => load_anchoring_times(p).map_err(|e| RequestError::from_error(Some("t1"), e))?,
+            Some(p) => load_anchoring_times(p).map_err(|e| RequestError::from_error(Some(T1.flag), e))?,
             None => Vec::new(),
         };
         let forces = match &self.forces {
-            Some(f) => Some(load_terrain(f).map_err(|e| RequestError::from_error(Some("forces"), e))?),
+            Some(f) => Some(load_terrain(f).map_err(|e| RequestError::from_error(Some(FORCES.flag), e))?),
             None => None,
         };
         let repose = self.repose_record(source, forces.as_ref());
         // k_n: the fixed one, else the force tests', else the source terrain's.
         let normal = match (checked.k_n, &forces) {
             (Some(k), _) => Terrain::constant(k, 1.0)
-                .map_err(|e| RequestError::invalid("k-n", e.renamed(words.name("k-n"))))?,
+                .map_err(|e| RequestError::invalid(K_N.flag, e.renamed(words.name(K_N.flag))))?,
             (None, Some(f)) => f.clone(),
             (None, None) => source.terrain.clone(),
         };
@@ -378,7 +486,7 @@ impl CalibrateRequest {
         let terrain = Terrain::new(calibration.terrain.clone()).map_err(|e| {
             fail(anyhow::anyhow!(
                 "the calibrated terrain is not valid ({e}); a fitted k_s reached zero within the observed slopes: try {} or force tests",
-                words.setting("law", "coulomb")
+                words.setting(LAW.flag, CalibrateLaw::Coulomb.name())
             ))
         })?;
         let robot = Robot::new(calibration.robot.clone())
@@ -398,10 +506,14 @@ impl CalibrateRequest {
     /// terrain, with where it came from.
     fn repose_record(&self, source: CalibrateSource, forces: Option<&Terrain>) -> ReposeRecord {
         match (self.repose, forces) {
-            (Some(r), _) => ReposeRecord { deg: Some(r), source: "--repose".into() },
+            (Some(r), _) => ReposeRecord { deg: Some(r), source: REPOSE.long() },
             (None, Some(f)) if f.spec().repose_deg.is_some() => ReposeRecord {
                 deg: f.spec().repose_deg,
-                source: format!("carried over from --forces {}", self.forces.as_deref().unwrap_or("")),
+                source: format!(
+                    "carried over from {} {}",
+                    FORCES.long(),
+                    self.forces.as_deref().unwrap_or("")
+                ),
             },
             _ => {
                 let deg = source.terrain.spec().repose_deg;
@@ -409,8 +521,8 @@ impl CalibrateRequest {
                 ReposeRecord {
                     deg,
                     source: match deg {
-                        Some(_) => format!("carried over from --terrain {name}"),
-                        None => format!("none: --terrain {name} has no repose_deg"),
+                        Some(_) => format!("carried over from {} {name}", TERRAIN.long()),
+                        None => format!("none: {} {name} has no repose_deg", TERRAIN.long()),
                     },
                 }
             }
@@ -427,7 +539,7 @@ impl CalibrateRequest {
     ) -> Result<PerSlopeAnswer> {
         let observed = self.observed.as_deref().unwrap_or_else(|| std::path::Path::new(""));
         let cal: PerSlopeCalibration = invert_each_speed(robot, normal, speeds).map_err(|e| {
-            RequestError::from_error(Some("observed"), anyhow::anyhow!("{}: {e}", observed.display()))
+            RequestError::from_error(Some(OBSERVED.flag), anyhow::anyhow!("{}: {e}", observed.display()))
         })?;
         let points = cal
             .points
@@ -605,6 +717,37 @@ mod tests {
         let laws: Vec<&str> = CalibrateLaw::ALL.iter().map(|l| l.name()).collect();
         let models: Vec<&str> = CalibrateModel::ALL.iter().map(|m| m.name()).collect();
         assert_eq!((laws, models), (vec!["linear", "coulomb", "per-slope"], vec!["closed-form", "simulate"]));
+    }
+
+    /// The flags read by the table: none given is the linear law on the closed form; `--free`'s
+    /// comma list is split; a word of no law is refused naming the flag and the words.
+    #[test]
+    fn flags_are_read_by_the_table() {
+        let none = CalibrateRequest::from_fields(&[]).unwrap();
+        assert_eq!(none, CalibrateRequest { observed: None, ..request() });
+        let pairs = |list: &[(&str, &str)]| -> Vec<(String, String)> {
+            list.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+        };
+        let given = pairs(&[
+            ("observed", "s.csv"),
+            ("free", "plate_scale,error_floor"),
+            ("law", "coulomb"),
+            ("model", "simulate"),
+            ("k-n", "2e6"),
+            ("repose", "25"),
+        ]);
+        let r = CalibrateRequest::from_fields(&given).unwrap();
+        assert_eq!(r.free, vec!["plate_scale".to_string(), "error_floor".to_string()]);
+        assert_eq!(
+            (r.law, r.model, r.k_n, r.repose),
+            (CalibrateLaw::Coulomb, CalibrateModel::Simulate, Some(2e6), Some(25.0))
+        );
+        assert_eq!(r.observed, Some(PathBuf::from("s.csv")));
+        let e = CalibrateRequest::from_fields(&pairs(&[("law", "cubic")])).unwrap_err();
+        assert_eq!(
+            (e.field(), e.message().as_str()),
+            (Some("law"), "--law = `cubic` must be one of: linear, coulomb, per-slope")
+        );
     }
 
     /// A missing evidence file is reported against its field.

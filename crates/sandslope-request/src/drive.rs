@@ -163,6 +163,12 @@ pub const EMULATE_OFFSET: Field =
         "Emulator: a current sensor's zero bias, mA added to every Present Current: one value for \
      every servo, or one per servo in leg order, comma-separated (within -500 to 500)",
     );
+/// `--emulate-clock`: the emulated run's clock, the wall's or a virtual one.
+pub const EMULATE_CLOCK: Field =
+    Field::new("emulate-clock", Kind::Choice(&["real", "virtual"]), "real|virtual").default("real").help(
+        "Emulator: `real` (a run of S seconds takes S seconds: the loop's real timing) or `virtual` \
+         (simulated time: the run takes its computing time, docs/drive.md)",
+    );
 
 /// `drive`'s run fields, which `serve --drive` shares (the robot's and the terrain's are
 /// [`crate::scenario`]'s; the bus flags and `--log` are each command's own).
@@ -188,12 +194,20 @@ pub const FIELDS: Table = Table {
         EMULATE_WEAKEN,
         EMULATE_FAULT,
         EMULATE_OFFSET,
+        EMULATE_CLOCK,
     ],
 };
 
 /// The fields that only an emulated bus takes.
-const EMULATOR: [&Field; 6] =
-    [&EMULATE_NOISE, &EMULATE_SEED, &EMULATE_K_S, &EMULATE_WEAKEN, &EMULATE_FAULT, &EMULATE_OFFSET];
+const EMULATOR: [&Field; 7] = [
+    &EMULATE_NOISE,
+    &EMULATE_SEED,
+    &EMULATE_K_S,
+    &EMULATE_WEAKEN,
+    &EMULATE_FAULT,
+    &EMULATE_OFFSET,
+    &EMULATE_CLOCK,
+];
 
 /// Every field of a drive run, read from text by [`DriveFields::from_params`] and checked: the
 /// numbers in [`DriveRun`], the rest as the servo crate's run takes them.
@@ -217,6 +231,8 @@ pub struct DriveFields {
     pub emulate_fault: Option<String>,
     /// `--emulate-offset`, unparsed (one value or one per servo).
     pub emulate_offset: Option<String>,
+    /// `--emulate-clock`: `real` or `virtual`.
+    pub emulate_clock: String,
 }
 
 impl Fields for DriveFields {
@@ -288,6 +304,7 @@ impl DriveFields {
         let emulate_weaken = text(&mut p, &EMULATE_WEAKEN)?;
         let emulate_fault = text(&mut p, &EMULATE_FAULT)?;
         let emulate_offset = text(&mut p, &EMULATE_OFFSET)?;
+        let emulate_clock = EMULATE_CLOCK.choice_in(&mut p)?.unwrap_or_default().to_string();
         p.finish()?;
         run.check(Words::Flag)?;
         Ok(DriveFields {
@@ -300,6 +317,7 @@ impl DriveFields {
             emulate_weaken,
             emulate_fault,
             emulate_offset,
+            emulate_clock,
         })
     }
 }

@@ -12,6 +12,8 @@ use sandslope::{Terrain, TerrainSpec};
 use sandslope_io::measurements::{load_manifest, read_trials, MalformedCell, Manifest, ReadOptions};
 
 use crate::error::{RequestError, Result, Words};
+use crate::field::{Field, Fields, Table};
+use crate::params::Params;
 
 /// The inputs of a load-cell fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -44,12 +46,61 @@ pub struct FitAnswer {
     pub terrain: Terrain,
 }
 
+/// `--depth-window`: k_n's depth window instead of the one found.
+pub const DEPTH_WINDOW: Field = Field::text("depth-window", "MIN:MAX")
+    .keyword("depth_window")
+    .unit("m")
+    .range("0 <= MIN < MAX")
+    .help("Fit k_n over this depth window, metres, instead of finding it (e.g. 0.005:0.03)");
+/// `--plateau-from`: where the shear plateau starts instead of where it is found.
+pub const PLATEAU_FROM: Field = Field::number("plateau-from", "M")
+    .keyword("plateau_from")
+    .unit("m")
+    .range("at least 0")
+    .help("Shear plateau starts at this displacement, metres, instead of being found (e.g. 0.02)");
+/// `--air-curve`: subtract the in-air run's curve (Python's `air="curve"`).
+pub const AIR_CURVE: Field = Field::switch("air-curve").conflicts(&["air-mean"]).help(
+    "Subtract the in-air run's force curve against position (default: its mean, or its fitted \
+     line when it has a significant trend)",
+);
+/// `--air-mean`: subtract the in-air run's mean (Python's `air="mean"`).
+pub const AIR_MEAN: Field = Field::switch("air-mean")
+    .help("Subtract the in-air run's mean force even when it has a significant trend");
+/// `--skip-malformed`: skip rows with a cell that is not a number.
+pub const SKIP_MALFORMED: Field = Field::switch("skip-malformed")
+    .keyword("skip_malformed")
+    .help("Skip rows with a cell that is not a number (counted per trial) instead of stopping");
+/// `--counts-per-newton`: the load cell's counts per newton.
+pub const COUNTS_PER_NEWTON: Field = Field::number("counts-per-newton", "COUNTS")
+    .keyword("counts_per_newton")
+    .range("greater than 0")
+    .help("Load-cell counts per newton, for recordings with a force_counts column");
+
+/// `fit`'s own fields (the manifest is its positional argument, Python's first). Python's
+/// `air` (`"auto"`, `"curve"` or `"mean"`) is the two switches `--air-curve` and `--air-mean`
+/// in one keyword.
+pub const FIELDS: Table = Table {
+    command: "fit",
+    fields: &[DEPTH_WINDOW, PLATEAU_FROM, AIR_CURVE, AIR_MEAN, SKIP_MALFORMED, COUNTS_PER_NEWTON],
+};
+
+impl Fields for FitRequest {
+    const TABLE: Table = FIELDS;
+}
+
+/// Python's `air` keyword: its words, in the order of [`AirMode`]'s variants.
+pub const AIR_WORDS: [(&str, AirMode); 3] =
+    [("auto", AirMode::Auto), ("curve", AirMode::Curve), ("mean", AirMode::Mean)];
+
 /// Parses a depth window `MIN:MAX`, metres, `0 <= MIN < MAX` (the command line's form).
 pub fn parse_depth_window(text: &str) -> Result<(f64, f64)> {
     let bad = || {
         RequestError::invalid(
-            "depth-window",
-            format!("--depth-window `{text}` must be MIN:MAX in metres with 0 <= MIN < MAX, e.g. 0.005:0.03"),
+            DEPTH_WINDOW.flag,
+            format!(
+                "{} `{text}` must be MIN:MAX in metres with 0 <= MIN < MAX, e.g. 0.005:0.03",
+                DEPTH_WINDOW.long()
+            ),
         )
     };
     let (a, b) = text.split_once(':').ok_or_else(bad)?;
@@ -66,23 +117,59 @@ fn window_is_valid((a, b): (f64, f64)) -> bool {
 }
 
 impl FitRequest {
+    /// The request of the flags given, `params` ([`FIELDS`]), on the campaign of `manifest`:
+    /// the one raw-to-typed step of the command line. Refuses any other key.
+    pub fn from_fields(manifest: PathBuf, params: &[(String, String)]) -> Result<FitRequest> {
+        let mut p = Params::new(FIELDS.command, params);
+        let depth_window = DEPTH_WINDOW.text_in(&mut p)?.map(parse_depth_window).transpose()?;
+        let plateau_from = PLATEAU_FROM.number_in(&mut p)?;
+        let air = match (AIR_CURVE.switch_in(&mut p)?, AIR_MEAN.switch_in(&mut p)?) {
+            (true, true) => {
+                return Err(RequestError::invalid(
+                    AIR_CURVE.flag,
+                    format!("{} cannot be used with {}", AIR_CURVE.long(), AIR_MEAN.long()),
+                ))
+            }
+            (true, false) => AirMode::Curve,
+            (false, true) => AirMode::Mean,
+            (false, false) => AirMode::Auto,
+        };
+        let counts_per_newton = COUNTS_PER_NEWTON.number_in(&mut p)?;
+        let skip_malformed = SKIP_MALFORMED.switch_in(&mut p)?;
+        p.finish()?;
+        Ok(FitRequest { manifest, depth_window, plateau_from, air, counts_per_newton, skip_malformed })
+    }
+
+    /// Python's `air` keyword as the mode it names, or an error listing its words.
+    pub fn air_mode(word: &str) -> Result<AirMode> {
+        AIR_WORDS.iter().find(|(w, _)| *w == word).map(|&(_, mode)| mode).ok_or_else(|| {
+            let words: Vec<String> = AIR_WORDS.iter().map(|(w, _)| format!("{w:?}")).collect();
+            let (last, rest) = words.split_last().expect("three words");
+            RequestError::invalid(
+                AIR_CURVE.flag,
+                format!("air = {word:?} must be {} or {last}", rest.join(", ")),
+            )
+        })
+    }
+
     /// The analysis's options, checked; errors name the field in `words`.
     pub fn options(&self, words: Words) -> Result<FitOptions> {
         if let Some((a, b)) = self.depth_window.filter(|w| !window_is_valid(*w)) {
-            let field = "depth-window";
             return Err(RequestError::invalid(
-                field,
+                DEPTH_WINDOW.flag,
                 format!(
                     "{} = ({a}, {b}) must be (MIN, MAX) in metres with 0 <= MIN < MAX, e.g. (0.005, 0.03)",
-                    words.name(field)
+                    words.name(DEPTH_WINDOW.flag)
                 ),
             ));
         }
         if let Some(x) = self.plateau_from.filter(|x| !(x.is_finite() && *x >= 0.0)) {
-            let field = "plateau-from";
             return Err(RequestError::invalid(
-                field,
-                format!("{} = {x} must be a displacement in metres of at least 0", words.name(field)),
+                PLATEAU_FROM.flag,
+                format!(
+                    "{} = {x} must be a displacement in metres of at least 0",
+                    words.name(PLATEAU_FROM.flag)
+                ),
             ));
         }
         Ok(FitOptions { depth_window: self.depth_window, plateau_from: self.plateau_from, air: self.air })
@@ -91,10 +178,12 @@ impl FitRequest {
     /// The reading options, checked.
     fn read_options(&self, words: Words) -> Result<ReadOptions> {
         if let Some(c) = self.counts_per_newton.filter(|c| !(c.is_finite() && *c > 0.0)) {
-            let field = "counts-per-newton";
             return Err(RequestError::invalid(
-                field,
-                format!("{} = {c} must be a finite number greater than 0", words.name(field)),
+                COUNTS_PER_NEWTON.flag,
+                format!(
+                    "{} = {c} must be a finite number greater than 0",
+                    words.name(COUNTS_PER_NEWTON.flag)
+                ),
             ));
         }
         Ok(ReadOptions { counts_per_newton: self.counts_per_newton, skip_malformed: self.skip_malformed })
@@ -115,7 +204,7 @@ impl FitRequest {
         let read = self.read_options(words)?;
         let trials = read_trials(&manifest, read).map_err(|e| {
             if !self.skip_malformed && e.downcast_ref::<MalformedCell>().is_some() {
-                let hint = words.name("skip-malformed");
+                let hint = words.name(SKIP_MALFORMED.flag);
                 RequestError::from_error(
                     Some("manifest"),
                     anyhow::anyhow!("{e:#}; {hint} skips such rows and counts them"),
@@ -183,6 +272,45 @@ mod tests {
         assert_eq!(e.message(), "--counts-per-newton = 0 must be a finite number greater than 0");
         assert!(request().check(Words::Flag).is_ok());
         assert_eq!(request().answer(Words::Flag).unwrap_err().field(), Some("manifest"));
+    }
+
+    fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
+        list.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    /// The flags read by the table: none given is the automatic analysis; each given flag
+    /// sets its value; the two air switches together, or a key of no field, are refused.
+    #[test]
+    fn flags_are_read_by_the_table() {
+        let manifest = PathBuf::from("m.toml");
+        assert_eq!(
+            FitRequest::from_fields(manifest.clone(), &[]).unwrap(),
+            FitRequest { manifest: manifest.clone(), ..request() }
+        );
+        let given = pairs(&[
+            ("depth-window", "0.005:0.03"),
+            ("plateau-from", "0.02"),
+            ("air-mean", "true"),
+            ("counts-per-newton", "2000"),
+            ("skip-malformed", "true"),
+        ]);
+        let r = FitRequest::from_fields(manifest.clone(), &given).unwrap();
+        assert_eq!(
+            (r.depth_window, r.plateau_from, r.air, r.counts_per_newton, r.skip_malformed),
+            (Some((0.005, 0.03)), Some(0.02), AirMode::Mean, Some(2000.0), true)
+        );
+        let both = pairs(&[("air-curve", "true"), ("air-mean", "true")]);
+        let e = FitRequest::from_fields(manifest.clone(), &both).unwrap_err();
+        assert_eq!(e.message(), "--air-curve cannot be used with --air-mean");
+        let e = FitRequest::from_fields(manifest.clone(), &pairs(&[("plateau-from", "x")])).unwrap_err();
+        assert_eq!(e.message(), "--plateau-from = `x` is not a number");
+        let e = FitRequest::from_fields(manifest, &pairs(&[("slope", "1")])).unwrap_err();
+        assert!(e.message().starts_with("unknown parameter `slope`: fit takes"), "{}", e.message());
+        assert_eq!(FitRequest::air_mode("curve").unwrap(), AirMode::Curve);
+        assert_eq!(
+            FitRequest::air_mode("x").unwrap_err().message(),
+            "air = \"x\" must be \"auto\", \"curve\" or \"mean\""
+        );
     }
 
     #[test]

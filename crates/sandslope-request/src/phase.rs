@@ -59,25 +59,33 @@ pub struct PhaseGrid {
 }
 
 /// `--k-n`: the grid's normal-resistance axis.
-pub const K_N_AXIS: Field =
-    Field::text("k-n", "MIN:MAX:N[:log|:lin]").unit("N/m^3").range("0 < MIN < MAX, N at least 2").help(
+pub const K_N_AXIS: Field = Field::text("k-n", "MIN:MAX:N[:log|:lin]")
+    .keyword("k_n_axis")
+    .unit("N/m^3")
+    .range("0 < MIN < MAX, N at least 2")
+    .help(
         "Normal-resistance axis, N/m^3: MIN:MAX:N with optional :log (default) or :lin. Default: \
      the terrain's k_n / 100 to x 100, 400 points, log.",
     );
 /// `--k-s`: the grid's shear-strength axis.
-pub const K_S_AXIS: Field =
-    Field::text("k-s", "MIN:MAX:N[:log|:lin]").unit("N/m^3").range("0 < MIN < MAX, N at least 2").help(
+pub const K_S_AXIS: Field = Field::text("k-s", "MIN:MAX:N[:log|:lin]")
+    .keyword("k_s_axis")
+    .unit("N/m^3")
+    .range("0 < MIN < MAX, N at least 2")
+    .help(
         "Shear-strength axis, N/m^3: MIN:MAX:N with optional :log (default) or :lin. Default: the \
      terrain's k_s / 1000 to x 100, 400 points, log.",
     );
 /// `--slope`: the panels' slopes.
 pub const SLOPE: Field = Field::text("slope", "DEG[,DEG...]")
+    .keyword("slope_deg")
     .unit("deg")
     .default("0")
     .range("-90 to 90 each")
     .help("Slope(s) along the direction of travel, degrees, comma-separated (one panel each)");
 /// `--mass`: the panel rows' total masses.
 pub const MASS: Field = Field::text("mass", "KG[,KG...]")
+    .keyword("mass_kg")
     .unit("kg")
     .range("greater than 0 each")
     .help("Total robot mass(es), kg, comma-separated (one panel row each). Default: the robot's.");

@@ -162,6 +162,14 @@ impl Fields for RiskRequest {
     const TABLE: Table = FIELDS;
 }
 
+/// Reads `--max-risk` from `p` (given, else its default): a failure probability strictly
+/// between 0 and 1, by [`grammar::parse_max_risk`]. What every request with this field reads.
+pub fn max_risk_in(p: &mut Params<'_>) -> Result<f64> {
+    let text = MAX_RISK.text_in(p)?.unwrap_or_default();
+    grammar::parse_max_risk(text)
+        .map_err(|why| RequestError::invalid(MAX_RISK.flag, format!("{} = {text}: {why}", MAX_RISK.long())))
+}
+
 /// Parses the field `slope`: the one slope-list grammar, signed (a descent is felt as the
 /// climb of its size), at most [`MAX_RISK_SLOPES`].
 pub fn parse_slopes(text: &str) -> Result<Vec<f64>> {
@@ -213,10 +221,7 @@ impl RiskQuestion {
         let slopes = parse_slopes(SLOPE.text_in(p)?.unwrap_or_default())?;
         let cv_n = CV_N.number_in(p)?;
         let cv_s = CV_S.number_in(p)?;
-        let text = MAX_RISK.text_in(p)?.unwrap_or_default();
-        let max_risk = grammar::parse_max_risk(text).map_err(|why| {
-            RequestError::invalid(MAX_RISK.flag, format!("{} = {text}: {why}", MAX_RISK.long()))
-        })?;
+        let max_risk = max_risk_in(p)?;
         let solve = SOLVE.choice_in(p)?.map(|word| if word == "mass" { Solve::Mass } else { Solve::Slope });
         let map = MAP.switch_in(p)?;
         let mut grid = RiskMapGrid::default();

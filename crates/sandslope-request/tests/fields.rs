@@ -3,7 +3,10 @@
 //! in the user docs (docs/*.md or README.md), so an option list cannot leave one out.
 
 use sandslope_request::field::{Kind, Table};
-use sandslope_request::{design, drive, infer, phase, plan, predict, risk, scenario, simulate, sweep, track};
+use sandslope_request::{
+    calibrate, design, drive, fit, infer, phase, plan, predict, report, risk, scenario, simulate, sweep,
+    track,
+};
 
 /// Each request's tables: its own, then those it shares.
 fn requests() -> Vec<(&'static str, Vec<Table>)> {
@@ -25,6 +28,18 @@ fn requests() -> Vec<(&'static str, Vec<Table>)> {
         ("design", vec![design::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         ("infer", vec![infer::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         ("track", vec![track::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        ("fit", vec![fit::FIELDS]),
+        ("calibrate", vec![calibrate::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        // report's --tracks is given per slope, beside its once-given fields.
+        (
+            "report",
+            vec![
+                report::FIELDS,
+                Table { command: "report", fields: &[report::TRACKS, scenario::LEVEL_STEP] },
+                robot_and_terrain,
+                scenario::ROBOT_QUANTITIES,
+            ],
+        ),
     ]
 }
 

@@ -17,17 +17,19 @@
 //!   `hold_s`, then the torque goes off.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
 
 use dynamixel2::instructions::SyncWriteData;
 use dynamixel2::ReadError;
-use sandslope::infer::servo::{infer_from_stance, CurrentInference, ModelGrid};
+use sandslope::infer::servo::{
+    infer_from_run_up, infer_from_stance, CurrentInference, ModelGrid, RUN_UP_OFFSET_SD_MA,
+};
 use sandslope::risk::UncertainTerrain;
 use sandslope::servo::verdict::{pool, prior_p_fail, PooledEstimate};
 use sandslope::servo::{GaitSchedule, ServoModel};
 use sandslope::{Robot, Slope};
 use serde::Serialize;
 
+use crate::clock::Clock;
 pub use crate::config::{DriveSettings, DynamixelBus, Profile, ServoConfig};
 pub use crate::error::{hardware_faults, DriveError};
 use crate::guard::{Following, GoalCheck};
@@ -146,10 +148,10 @@ pub struct DriveReport {
     pub leg_speed_rad_s: Option<f64>,
     /// The torque on the way out.
     pub torque_off: TorqueOff,
-    /// The instant of gait time 0 (the legs stood up, `stand_s` after the walk's first
+    /// Gait time 0 on the run's clock, s (the legs stood up, `stand_s` after the walk's first
     /// cycle), to put another clock on the log's (the emulator's weakening); `None` when the
     /// run ended before it began.
-    pub gait_zero: Option<Instant>,
+    pub gait_zero: Option<f64>,
 }
 
 impl DriveReport {
@@ -197,6 +199,7 @@ pub const PHASE_GAIN_PER_S: f64 = 4.0;
 /// is set, a halt on risk, or an error), then torque off. `on_sample` receives every servo's
 /// state every cycle (the log); an error from it stops the run. Returns the report; its
 /// `outcome` is the error's message on failure, and the error itself is returned beside it.
+/// The loop keeps the wall's clock ([`drive_on_clock`] takes another).
 pub fn drive(
     bus: &mut DynamixelBus,
     schedule: &GaitSchedule,
@@ -205,6 +208,22 @@ pub fn drive(
     stop: &AtomicBool,
     on_sample: &mut dyn FnMut(&ServoSample) -> std::io::Result<()>,
     on_live: &mut dyn FnMut(&LiveEstimate),
+) -> (DriveReport, Option<DriveError>) {
+    drive_on_clock(bus, schedule, settings, monitor, stop, on_sample, on_live, &Clock::real())
+}
+
+/// [`drive`] on `clock`: the emulator's ([`crate::Emulator::clock`]), whose virtual kind the
+/// loop moves on instead of sleeping between cycles ([`crate::clock`]).
+#[allow(clippy::too_many_arguments)]
+pub fn drive_on_clock(
+    bus: &mut DynamixelBus,
+    schedule: &GaitSchedule,
+    settings: &DriveSettings,
+    monitor: Option<Monitor<'_>>,
+    stop: &AtomicBool,
+    on_sample: &mut dyn FnMut(&ServoSample) -> std::io::Result<()>,
+    on_live: &mut dyn FnMut(&LiveEstimate),
+    clock: &Clock,
 ) -> (DriveReport, Option<DriveError>) {
     let mut report = DriveReport::not_started(String::new());
     let mut meter =
@@ -216,7 +235,7 @@ pub fn drive(
         };
         crate::setup::setup(bus, schedule, settings).and_then(|done| {
             report.setup = done;
-            run(bus, schedule, settings, monitor, stop, &mut observed, on_live, &mut report)
+            run(bus, schedule, settings, monitor, stop, clock, &mut observed, on_live, &mut report)
         })
     };
     report.leg_speed_rad_s = meter.mean();
@@ -295,6 +314,7 @@ fn run(
     settings: &DriveSettings,
     monitor: Option<Monitor<'_>>,
     stop: &AtomicBool,
+    clock: &Clock,
     on_sample: &mut dyn FnMut(&ServoSample) -> std::io::Result<()>,
     on_live: &mut dyn FnMut(&LiveEstimate),
     report: &mut DriveReport,
@@ -306,7 +326,8 @@ fn run(
         failures: vec![(0usize, false); ids.len()],
         last_pos: vec![None; ids.len()],
         monitor: monitor.map(|m| {
-            let bins = StanceBins::new(m.grid.bins, settings.servos.len(), m.grid.swing_offset);
+            let run_up = !m.grid.run_up_mean.is_empty();
+            let bins = StanceBins::new(m.grid.bins, settings.servos.len(), m.grid.swing_offset, run_up);
             (m, bins)
         }),
         goal_check: GoalCheck::default(),
@@ -319,14 +340,15 @@ fn run(
         halt_goal: vec![],
     };
     let mut jitter = Jitter::default();
-    let period = Duration::from_secs_f64(1.0 / settings.rate_hz);
-    let begin = Instant::now();
-    report.gait_zero = begin.checked_add(Duration::from_secs_f64(settings.stand_s));
-    let mut last_cycle = Instant::now();
+    let period = 1.0 / settings.rate_hz;
+    let begin = clock.now();
+    report.gait_zero = Some(begin + settings.stand_s);
+    let (mut last_cycle, mut waits) = (begin, 0);
     loop {
-        let time = begin.elapsed().as_secs_f64() - settings.stand_s;
-        let cycle = last_cycle.elapsed().as_secs_f64();
-        last_cycle = Instant::now();
+        let now = clock.now();
+        let time = now - begin - settings.stand_s;
+        let cycle = now - last_cycle;
+        last_cycle = now;
         if report.cycles > 0 {
             jitter.add(cycle);
             (report.cycle_jitter_ms, report.max_cycle_ms) = jitter.ms();
@@ -367,11 +389,9 @@ fn run(
             };
             GoalCheck::check(bus, &settings.servos, address, &sent, time)?;
         }
-        let spent = last_cycle.elapsed();
-        if spent < period {
-            std::thread::sleep(period - spent);
-        }
-        report.rate_hz = report.cycles as f64 / begin.elapsed().as_secs_f64().max(1e-9);
+        clock.wait_cycle(period, clock.now() - last_cycle, waits);
+        waits += 1;
+        report.rate_hz = report.cycles as f64 / (clock.now() - begin).max(1e-9);
     }
 }
 
@@ -626,10 +646,17 @@ impl Walk<'_> {
         report: &mut DriveReport,
     ) {
         let Some((m, bins)) = self.monitor.as_mut() else { return };
-        let Some((k, profile, counts)) = bins.add(schedule, j, angle, tau) else { return };
-        let Some(inf) = infer_from_stance(m.robot, m.grid, k, &profile, &counts, m.noise_sd_n_m) else {
-            return;
+        let Some(stance) = bins.add(schedule, j, time, angle, tau) else { return };
+        let (k, profile, counts) = (stance.tripod, &stance.profile, &stance.counts);
+        // Tripod 0's run-up stance against the grid walks' own run-ups, its raw torques'
+        // unknown sensor offsets integrated out (docs/drive.md).
+        let inf = if stance.stride == 0 {
+            let offset_sd = self.model.torque_from_current_ma(RUN_UP_OFFSET_SD_MA);
+            infer_from_run_up(m.robot, m.grid, profile, counts, m.noise_sd_n_m, offset_sd)
+        } else {
+            infer_from_stance(m.robot, m.grid, k, profile, counts, m.noise_sd_n_m)
         };
+        let Some(inf) = inf else { return };
         self.stances.push(inf.posterior.iter().map(|x| x.1).collect());
         let from = m.window.map_or(0, |w| self.stances.len().saturating_sub(w.max(1)));
         let pooled_in: Vec<&[f64]> = self.stances[from..].iter().map(Vec::as_slice).collect();

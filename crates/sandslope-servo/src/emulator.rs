@@ -15,7 +15,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use sandslope::infer::servo::{sensor_walk_settings, simulated_legs, LegTrace};
 use sandslope::servo::model as x;
@@ -24,6 +24,7 @@ use sandslope::simulate::simulate;
 use sandslope::{Robot, Scenario, Terrain};
 use serial2::SerialPort;
 
+use crate::clock::{Clock, ClockKind, REPLY_TIMEOUT_S};
 use crate::driver::ServoConfig;
 use crate::models::ControlTable;
 use crate::packet::{self, error, inst, Instruction, Parsed, Parser};
@@ -83,6 +84,8 @@ pub struct EmulatorConfig {
     /// Whether the servos know the Clear instruction (firmware 42 and later do); `false`
     /// emulates older firmware, which answers it with an Instruction Error.
     pub clear_supported: bool,
+    /// The clock the servos keep (`--emulate-clock`; [`crate::clock`]).
+    pub clock: ClockKind,
 }
 
 impl EmulatorConfig {
@@ -102,6 +105,7 @@ impl EmulatorConfig {
             firmware: 46,
             initial_turns: 0,
             clear_supported: true,
+            clock: ClockKind::Real,
         }
     }
 }
@@ -138,7 +142,6 @@ pub struct EmulatorReport {
 #[derive(Debug, Clone)]
 struct Walk {
     legs: Vec<LegTrace>,
-    rate_hz: f64,
 }
 
 impl Walk {
@@ -146,15 +149,20 @@ impl Walk {
         let schedule = GaitSchedule::new(robot, 2 * robot.stance_legs() as usize)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let rate_hz = 500.0;
-        let settings = sensor_walk_settings(strides.max(3) as f64 * schedule.period_s, rate_hz)
-            .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
+        // The driver's run-up (docs/model.md §19) walked too, and the strides after it whole.
+        let settings = sensor_walk_settings(
+            strides.max(3) as f64 * schedule.period_s + schedule.run_up_s,
+            rate_hz,
+            schedule.run_up_s,
+        )
+        .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let scenario = Scenario::new(robot.clone(), terrain, None, None)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let slope = sandslope::SignedSlope::from_degrees(slope_deg)
             .map_err(|e| EmulatorError::Simulator(e.to_string()))?;
         let sim =
             simulate(&scenario, slope, &settings).map_err(|e| EmulatorError::Simulator(e.to_string()))?;
-        Ok(Walk { legs: simulated_legs(&schedule, &sim), rate_hz })
+        Ok(Walk { legs: simulated_legs(&schedule, &sim) })
     }
 
     /// Drive torque of leg `leg` at gait angle `angle` (N m): the simulated leg's at the same
@@ -174,10 +182,13 @@ impl Walk {
             let usable = ((span - turn) / turn).floor().max(1.0) * turn;
             rel = turn + (rel - turn).rem_euclid(usable);
         }
-        // The simulated angle grows at omega from a0: the sample index follows the angle.
-        let frac = (rel.max(0.0) / span).min(1.0);
-        let i = ((frac * (n - 1) as f64).round() as usize).min(n - 1);
-        let _ = self.rate_hz;
+        // The sample nearest the angle: the simulated angle does not grow at omega from a0
+        // (the legs run up over the response time, as the driver commands them), so it is
+        // looked up, not computed from the time.
+        let target = a0 + rel.max(0.0);
+        let i = trace.angle_rad.partition_point(|&a| a < target).min(n - 1);
+        let i =
+            if i > 0 && target - trace.angle_rad[i - 1] < trace.angle_rad[i] - target { i - 1 } else { i };
         trace.torque_n_m[i]
     }
 }
@@ -444,6 +455,8 @@ pub struct VirtualBus {
     noise_ma: f64,
     parser_packets: usize,
     bad_crc: usize,
+    /// Replies a silent servo owed since [`VirtualBus::take_missed`] (each a reply timeout).
+    missed: usize,
 }
 
 impl VirtualBus {
@@ -491,18 +504,32 @@ impl VirtualBus {
             noise_ma: config.current_noise_ma,
             parser_packets: 0,
             bad_crc: 0,
+            missed: 0,
         })
     }
 
     fn advance_all(&mut self, now: f64) {
-        let walk = match (&self.weak_walk, self.faults.weaken) {
-            (Some(w), Some((at, _))) if now >= at => w,
-            _ => &self.walk,
-        };
-        // A silent servo still runs (its data line is what failed): its watchdog stops it.
-        for s in &mut self.servos {
-            s.advance(now, walk, &mut self.noise, self.noise_ma);
+        // In steps of at most 2 ms, as the real-time thread ticks: the virtual clock (and a
+        // stalled machine) moves a whole cycle at once.
+        let last = self.servos.iter().map(|s| s.last_update).fold(now, f64::min);
+        let steps = ((now - last) / 0.002).ceil().clamp(1.0, 1e6) as usize;
+        for i in 1..=steps {
+            let t = if i == steps { now } else { last + (now - last) * i as f64 / steps as f64 };
+            let walk = match (&self.weak_walk, self.faults.weaken) {
+                (Some(w), Some((at, _))) if t >= at => w,
+                _ => &self.walk,
+            };
+            // A silent servo still runs (its data line is what failed): its watchdog stops it.
+            for s in &mut self.servos {
+                s.advance(t, walk, &mut self.noise, self.noise_ma);
+            }
         }
+    }
+
+    /// The replies silent servos owed since the last call (the driver waited a reply timeout
+    /// for each): what the virtual clock moves on by.
+    pub fn take_missed(&mut self) -> usize {
+        std::mem::take(&mut self.missed)
     }
 
     fn silent(&self, id: u8, now: f64) -> bool {
@@ -529,6 +556,7 @@ impl VirtualBus {
         let ids: Vec<u8> = self.servos.iter().map(|s| s.config.id).collect();
         for (k, id) in ids.iter().enumerate() {
             if self.silent(*id, now) {
+                self.missed += usize::from(crate::clock::expects_reply(&ins, *id));
                 continue;
             }
             self.servos[k].refuse_goals =
@@ -539,7 +567,7 @@ impl VirtualBus {
                     let n = bytes.len();
                     bytes[n - 1] ^= 0x5A;
                 }
-                out.push((order_of(&ins, *id), bytes));
+                out.push((packet::order_of(&ins, *id), bytes));
             }
         }
         out.sort_by_key(|(o, _)| *o);
@@ -668,15 +696,6 @@ impl VirtualBus {
     }
 }
 
-/// Where `id` answers in a multi-servo read: its place in the instruction's list.
-fn order_of(ins: &Instruction, id: u8) -> usize {
-    match ins.instruction {
-        inst::SYNC_READ => ins.params.iter().skip(4).position(|&x| x == id).unwrap_or(usize::MAX),
-        inst::BULK_READ => ins.params.chunks(5).position(|c| c[0] == id).unwrap_or(usize::MAX),
-        _ => 0,
-    }
-}
-
 /// The path of the pseudo-terminal `port` (the slave side [`Emulator::start`] returns), e.g.
 /// `/dev/pts/3`, that another program (Dynamixel Wizard, the ROBOTIS SDK) opens as a serial
 /// port; `None` where the system does not say (Linux reads it from `/proc/self/fd`).
@@ -693,8 +712,8 @@ pub const EMULATED_BAUD: u32 = 9600;
 pub struct Emulator {
     stop: Arc<AtomicBool>,
     handle: Option<JoinHandle<EmulatorReport>>,
-    /// The emulator's time 0, which its fault and weakening times count from.
-    started: Instant,
+    /// The emulator's clock: its time 0 is the one its fault and weakening times count from.
+    clock: Clock,
     /// When the sand weakens, s after `started`, and to what k_s, N/m^3.
     weaken: Option<(f64, f64)>,
 }
@@ -717,17 +736,18 @@ impl Emulator {
         master.set_read_timeout(Duration::from_millis(2)).map_err(EmulatorError::Pty)?;
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
-        let started = Instant::now();
+        let clock = config.clock.start(config.seed);
+        let start = clock.clone();
         let handle = std::thread::Builder::new()
             .name("xl330-emulator".into())
             .spawn(move || {
-                let start = started;
                 let mut parser = Parser::default();
                 let mut buf = [0u8; 1024];
                 while !flag.load(Ordering::Relaxed) {
-                    let now = start.elapsed().as_secs_f64();
+                    let now = start.now();
                     if bus.frozen(now) {
-                        std::thread::sleep(Duration::from_millis(2));
+                        // The virtual clock moves through the freeze as the real one would.
+                        start.sleep(0.002);
                         continue;
                     }
                     match master.read(&mut buf) {
@@ -735,31 +755,35 @@ impl Emulator {
                         _ => {}
                     }
                     while let Some(p) = parser.next_packet() {
-                        let now = start.elapsed().as_secs_f64();
-                        let reply = bus.respond(p, now);
+                        let reply = bus.respond(p, start.now());
                         if !reply.is_empty() {
                             master.write_all(&reply).ok();
                         }
+                        if start.is_virtual() {
+                            start.sleep(bus.take_missed() as f64 * REPLY_TIMEOUT_S);
+                        }
                     }
-                    bus.tick(start.elapsed().as_secs_f64());
+                    bus.tick(start.now());
                 }
                 bus.report()
             })
             .map_err(EmulatorError::Pty)?;
-        Ok((Emulator { stop, handle: Some(handle), started, weaken: config.faults.weaken }, slave))
+        Ok((Emulator { stop, handle: Some(handle), clock, weaken: config.faults.weaken }, slave))
     }
 
-    /// Stops the emulator and returns what its servos' tables hold. `gait_zero`, the instant
-    /// of the driver's gait time 0, puts the weakening on the log's clock
+    /// The emulator's clock, which the driver's loop keeps too ([`crate::clock`]).
+    pub fn clock(&self) -> Clock {
+        self.clock.clone()
+    }
+
+    /// Stops the emulator and returns what its servos' tables hold. `gait_zero`, the driver's
+    /// gait time 0 on the emulator's [`Emulator::clock`], puts the weakening on the log's clock
     /// ([`EmulatorReport::weakened`]).
-    pub fn stop(mut self, gait_zero: Option<Instant>) -> EmulatorReport {
+    pub fn stop(mut self, gait_zero: Option<f64>) -> EmulatorReport {
         self.stop.store(true, Ordering::Relaxed);
         let mut report = self.handle.take().and_then(|h| h.join().ok()).unwrap_or_default();
         report.weakened = match (self.weaken, gait_zero) {
-            (Some((at, k_s)), Some(zero)) if self.started.elapsed().as_secs_f64() >= at => {
-                let offset = zero.saturating_duration_since(self.started).as_secs_f64();
-                Some((at - offset, k_s))
-            }
+            (Some((at, k_s)), Some(zero)) if self.clock.now() >= at => Some((at - zero.max(0.0), k_s)),
             _ => None,
         };
         report
@@ -772,5 +796,30 @@ impl Drop for Emulator {
         if let Some(h) = self.handle.take() {
             h.join().ok();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The playback follows the legs' angle through the run-up (docs/model.md §19), not the
+    /// time at full speed. A trace sampled every 0.05 s of the paper's run-up (omega = 2 pi
+    /// rad/s over dt = 0.2 s), each sample's torque its time: by hand, angle omega t^2 / (2 dt)
+    /// = 0.0125 pi at t = 0.05 s, 0.05 pi at 0.1 s, 0.2 pi at 0.2 s, 0.4 pi at 0.3 s. Read at
+    /// full speed from the start (the old playback) 0.05 pi would be t = 0.025 s, not 0.1 s.
+    #[test]
+    fn the_playback_follows_the_run_up_by_hand() {
+        let pi = std::f64::consts::PI;
+        let times = [0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3];
+        let angle = |t: f64| if t < 0.2 { pi * t * t / 0.2 } else { 2.0 * pi * (t - 0.1) };
+        let trace =
+            LegTrace { angle_rad: times.iter().map(|&t| angle(t)).collect(), torque_n_m: times.to_vec() };
+        let walk = Walk { legs: vec![trace] };
+        for (a, t) in [(0.0125 * pi, 0.05), (0.05 * pi, 0.1), (0.2 * pi, 0.2), (0.4 * pi, 0.3), (0.0, 0.0)] {
+            assert_eq!(walk.torque(0, a), t, "angle {a}");
+        }
+        // Between samples, the nearest: 0.06 pi lies between 0.05 pi (0.1 s) and 0.1125 pi (0.15 s).
+        assert_eq!(walk.torque(0, 0.06 * pi), 0.1);
     }
 }

@@ -11,6 +11,7 @@
 //! - [`error`]: why a run failed, naming the servo and the fix, and its exit code;
 //! - [`session`]: one run as every front end starts it, from the typed [`session::DriveConfig`]
 //!   that `drive`'s and `serve --drive`'s flags are translated into;
+//! - [`clock`]: the run's clock, the wall's or the emulator's virtual one;
 //! - [`log`]: the run's log as every front end writes it (header, rows, the output path);
 //! - [`emulator`]: a bus of virtual servos of any supported model on a pseudo-terminal, whose shafts move as commanded
 //!   and whose currents come from the stride simulator (`sandslope::simulate`).
@@ -18,6 +19,7 @@
 //! The bus is the one place this crate touches hardware; the physics (the schedule, the
 //! servo's torque constant, the inference from currents) is the library's.
 
+pub mod clock;
 pub mod config;
 pub mod driver;
 pub mod emulator;

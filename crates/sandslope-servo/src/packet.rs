@@ -205,6 +205,15 @@ impl Parser {
     }
 }
 
+/// Where `id` answers in a multi-servo read: its place in the instruction's list.
+pub(crate) fn order_of(ins: &Instruction, id: u8) -> usize {
+    match ins.instruction {
+        inst::SYNC_READ => ins.params.iter().skip(4).position(|&x| x == id).unwrap_or(usize::MAX),
+        inst::BULK_READ => ins.params.chunks(5).position(|c| c[0] == id).unwrap_or(usize::MAX),
+        _ => 0,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

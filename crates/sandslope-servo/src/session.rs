@@ -12,7 +12,10 @@ use sandslope::risk::{safe_slope_limit, SafeLimit, UncertainTerrain};
 use sandslope::servo::{GaitSchedule, ServoModel};
 use sandslope::{Robot, Scenario, SignedSlope, Terrain};
 
-use crate::driver::{drive, DriveError, DriveReport, DynamixelBus, LiveEstimate, Monitor, ServoSample};
+use crate::clock::{Clock, ClockKind};
+use crate::driver::{
+    drive_on_clock, DriveError, DriveReport, DynamixelBus, LiveEstimate, Monitor, ServoSample,
+};
 use crate::emulator::{Emulator, EmulatorConfig, EmulatorFaults, EmulatorReport};
 use crate::{DriveSettings, ServoConfig};
 
@@ -98,6 +101,8 @@ pub struct EmulateOptions {
     pub current_offset_ma: Vec<f64>,
     /// Mid-run weakening and bus faults.
     pub faults: EmulatorFaults,
+    /// The clock the emulated servos and the driver's loop keep (`--emulate-clock`).
+    pub clock: ClockKind,
 }
 
 /// Everything one run needs, checked by the front end that built it.
@@ -160,7 +165,7 @@ pub struct Session {
     bus: DynamixelBus,
     emulator: Option<Emulator>,
     /// The last drive's gait time 0 ([`DriveReport::gait_zero`]).
-    gait_zero: Option<std::time::Instant>,
+    gait_zero: Option<f64>,
 }
 
 impl std::fmt::Debug for Session {
@@ -270,8 +275,11 @@ impl Session {
             slope: self.slope,
             window: self.config.window,
         });
+        // The emulator's clock (virtual with `--emulate-clock virtual`), else the wall's.
+        let clock = self.emulator.as_ref().map_or_else(Clock::real, Emulator::clock);
+        let (bus, settings) = (&mut self.bus, &self.config.settings);
         let (report, failure) =
-            drive(&mut self.bus, &self.schedule, &self.config.settings, monitor, stop, on_sample, on_live);
+            drive_on_clock(bus, &self.schedule, settings, monitor, stop, on_sample, on_live, &clock);
         self.gait_zero = report.gait_zero;
         (report, failure)
     }
@@ -309,6 +317,7 @@ pub fn emulator_config(config: &DriveConfig, o: &EmulateOptions) -> Result<Emula
     cfg.seed = o.seed;
     cfg.current_offset_ma = o.current_offset_ma.clone();
     cfg.faults = o.faults;
+    cfg.clock = o.clock;
     cfg.model_number = config.settings.servo.map_or(cfg.model_number, |m| m.model_number);
     Ok(cfg)
 }

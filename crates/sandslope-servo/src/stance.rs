@@ -31,10 +31,25 @@ impl LegSwing {
     }
 }
 
+/// One complete stance, binned.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Stance {
+    /// The tripod.
+    pub tripod: usize,
+    /// Its stride: 0 is tripod 0's run-up stance, binned from the raw torques.
+    pub stride: i64,
+    /// Bin means, tripod-major over both tripods (the other tripod's `None`).
+    pub profile: Vec<Option<f64>>,
+    /// Samples per bin.
+    pub counts: Vec<usize>,
+}
+
 /// Accumulates each tripod's current stance into bins.
 #[derive(Debug)]
 pub(crate) struct StanceBins {
     bins: usize,
+    /// Whether tripod 0's run-up stance (stride 0) is binned too, raw (no swing before it).
+    run_up: bool,
     key: [Option<i64>; 2],
     sum: [Vec<f64>; 2],
     count: [Vec<usize>; 2],
@@ -44,30 +59,36 @@ pub(crate) struct StanceBins {
 
 impl StanceBins {
     /// `bins` per stance; with `swing_offset`, each of the `legs` has its last swing's median
-    /// torque taken off its stance samples (a stance before any complete swing is not binned).
-    pub(crate) fn new(bins: usize, legs: usize, swing_offset: bool) -> StanceBins {
+    /// torque taken off its stance samples (a stance before any complete swing is not binned,
+    /// but for the run-up stance with `run_up`, binned raw).
+    pub(crate) fn new(bins: usize, legs: usize, swing_offset: bool, run_up: bool) -> StanceBins {
         StanceBins {
             swing: swing_offset.then(|| (0..legs).map(|_| LegSwing::default()).collect()),
             bins,
+            run_up,
             key: [None, None],
             sum: [vec![0.0; bins], vec![0.0; bins]],
             count: [vec![0; bins], vec![0; bins]],
         }
     }
 
-    /// Adds one sample; returns a completed stance's profile `(tripod, profile, counts)`.
-    #[allow(clippy::type_complexity)]
+    /// Adds one sample at gait time `time`; returns a completed stance. The run-up stance
+    /// takes samples from the gait's start only (standing at the start angle, tripod 0 is at
+    /// its stance's first angle, where the simulated walks spend no time).
     pub(crate) fn add(
         &mut self,
         schedule: &GaitSchedule,
         leg: usize,
+        time: f64,
         angle: f64,
         tau: f64,
-    ) -> Option<(usize, Vec<Option<f64>>, Vec<usize>)> {
+    ) -> Option<Stance> {
         let k = schedule.tripods[leg];
         let (stride, since) = schedule.stride_position(leg, angle);
         let half = 0.5 * schedule.period_s;
-        let in_stance = since < half && stride >= 1;
+        let run_up = self.run_up && stride == 0 && k == 0 && time >= 0.0;
+        let in_stance = since < half && (stride >= 1 || run_up);
+        let raw = tau;
         let tau = match self.swing.as_mut().and_then(|sw| sw.get_mut(leg)) {
             None => Some(tau),
             Some(sw) => {
@@ -79,7 +100,11 @@ impl StanceBins {
                     sw.stride = Some(stride);
                     sw.tau.push(tau);
                 }
-                sw.median.map(|m| tau - m)
+                if run_up {
+                    Some(raw)
+                } else {
+                    sw.median.map(|m| tau - m)
+                }
             }
         };
         let mut done = None;
@@ -97,8 +122,9 @@ impl StanceBins {
         done
     }
 
-    fn flush(&mut self, k: usize) -> (usize, Vec<Option<f64>>, Vec<usize>) {
+    fn flush(&mut self, k: usize) -> Stance {
         let b = self.bins;
+        let stride = self.key[k].unwrap_or(0);
         let mut profile = vec![None; 2 * b];
         let mut counts = vec![0; 2 * b];
         for i in 0..b {
@@ -109,6 +135,6 @@ impl StanceBins {
         self.key[k] = None;
         self.sum[k] = vec![0.0; b];
         self.count[k] = vec![0; b];
-        (k, profile, counts)
+        Stance { tripod: k, stride, profile, counts }
     }
 }

@@ -8,42 +8,20 @@ use std::path::Path;
 use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::{Args, ValueEnum};
+use clap::Args;
 
 use sandslope::calibrate::{Interval, ObservationKind, SpeedModel, SpeedObservation};
 use sandslope::{JointCalibration, Parameter, Quantity, Terrain};
 use sandslope_request::calibrate::{
-    CalibrateAnswer, CalibrateLaw, CalibrateModel, CalibrateSource, JointAnswer, PerSlopeAnswer, ReposeRecord,
+    CalibrateAnswer, CalibrateModel, CalibrateSource, JointAnswer, PerSlopeAnswer, ReposeRecord,
 };
 use sandslope_request::error::Words;
 use sandslope_request::CalibrateRequest;
 
-use crate::args::{RobotArgs, TerrainArgs};
+use crate::args::{FieldArgs, RobotArgs, TerrainArgs};
 use crate::figures::calibrate::{speed_pulls, CalibrationFigure};
 use crate::output::{check_parent_exists, print_json, table, write_atomic};
 use sandslope_io::robot_terrain::{robot_toml, terrain_toml};
-
-/// The law to fit, as named on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum LawArg {
-    /// k_s(theta) = k_s0 * (1 + (rho - 1) * theta_deg / 20), rho = k_s(20)/k_s(0).
-    Linear,
-    /// k_s(theta) = k_s0 * (cos theta - sin theta / tan phi), Mohr-Coulomb on an infinite slope.
-    Coulomb,
-    /// One k_s per observed slope, by root finding (speeds only).
-    PerSlope,
-}
-
-/// The model whose speeds are fitted, as named on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ModelArg {
-    /// The closed form (docs/model.md §3-§5).
-    ClosedForm,
-    /// The stride simulator (docs/model.md §15-§18): 4 s walks at the converged default step
-    /// (T / 2000), body pitch locked, one per observed slope and trial point, in parallel. Slower
-    /// (minutes: 8 min of CPU on the paper's evidence); the closed form's fit is printed beside it.
-    Simulate,
-}
 
 /// Arguments of `sandslope calibrate`.
 #[derive(Debug, Args)]
@@ -52,30 +30,11 @@ pub struct CalibrateArgs {
     /// `Written by:` header: given by `main`, which owns the process's arguments.
     #[arg(skip)]
     pub command_line: Vec<String>,
-    /// Observed speeds: CSV with columns slope_deg,speed_m_s,speed_sd_m_s.
-    #[arg(long, value_name = "CSV")]
-    pub observed: Option<PathBuf>,
-    /// Force tests: a terrain file (as `sandslope fit` writes) whose k_s(theta) and k_s_sd give
-    /// the shape of k_s; its k_n is used too. Without it, k_s follows --law.
-    #[arg(long, value_name = "FILE|PRESET")]
-    pub forces: Option<String>,
-    /// Observed anchoring times: CSV with columns slope_deg,t1_s,t1_sd_s.
-    #[arg(long, value_name = "CSV")]
-    pub t1: Option<PathBuf>,
-    /// Quantities to fit besides k_s, comma-separated: any robot key (hip_height_m,
-    /// level_step_m, response_time_s, leg_contact_area_m2, ...), plate_scale (k_s_leg = c *
-    /// k_s_plate, needs --forces) and error_floor; each optionally with bounds, KEY=MIN:MAX.
-    #[arg(long, value_name = "LIST", value_delimiter = ',')]
-    pub free: Vec<String>,
-    /// A fixed model-error floor added in quadrature to every observed speed SD, m/s.
-    #[arg(long, value_name = "M/S", allow_negative_numbers = true)]
-    pub error_floor: Option<f64>,
-    /// Form of k_s(theta) to fit when there are no --forces.
-    #[arg(long, value_enum, default_value_t = LawArg::Linear)]
-    pub law: LawArg,
-    /// The model whose speeds and anchoring times are fitted (docs/calibration.md).
-    #[arg(long, value_enum, default_value_t = ModelArg::ClosedForm)]
-    pub model: ModelArg,
+    /// `--observed`, `--forces`, `--t1`, `--free`, `--error-floor`, `--law`, `--model`,
+    /// `--k-n`, `--name` and `--repose`: the request's own fields
+    /// ([`sandslope_request::calibrate::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<CalibrateRequest>,
     /// Write the calibrated terrain (docs/model.md §7 format) to this TOML file.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
@@ -85,16 +44,6 @@ pub struct CalibrateArgs {
     /// Draw observed against fitted speeds, with the pulls, to this PNG or SVG file.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    /// Normal resistance k_n, N/m^3, at every slope (default: the --forces' or --terrain's k_n).
-    #[arg(long = "k-n", value_name = "N/M^3", allow_negative_numbers = true)]
-    pub k_n: Option<f64>,
-    /// Name written into the terrain file (default: `calibrated-<law>` or calibrated-forces).
-    #[arg(long)]
-    pub name: Option<String>,
-    /// Angle of repose written into the terrain file, degrees (default: carried over from the
-    /// --forces or --terrain file).
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
-    pub repose: Option<f64>,
     /// Print the fit as JSON instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -105,33 +54,10 @@ pub struct CalibrateArgs {
     pub terrain: TerrainArgs,
 }
 
-/// The request the flags make.
-fn request(args: &CalibrateArgs) -> CalibrateRequest {
-    CalibrateRequest {
-        observed: args.observed.clone(),
-        forces: args.forces.clone(),
-        t1: args.t1.clone(),
-        free: args.free.clone(),
-        error_floor: args.error_floor,
-        law: match args.law {
-            LawArg::Linear => CalibrateLaw::Linear,
-            LawArg::Coulomb => CalibrateLaw::Coulomb,
-            LawArg::PerSlope => CalibrateLaw::PerSlope,
-        },
-        model: match args.model {
-            ModelArg::ClosedForm => CalibrateModel::ClosedForm,
-            ModelArg::Simulate => CalibrateModel::Simulate,
-        },
-        k_n: args.k_n,
-        name: args.name.clone(),
-        repose: args.repose,
-    }
-}
-
 /// Runs `sandslope calibrate`: the flags into a [`CalibrateRequest`], its answer into the
 /// files, the figure and the tables (or JSON).
 pub fn run(args: CalibrateArgs) -> Result<()> {
-    let request = request(&args);
+    let request = CalibrateRequest::from_fields(&args.fields.pairs)?;
     let checked = request.check()?;
     let robot = args.robot.load()?;
     if args.robot_out.is_some() && !checked.fits_robot() {

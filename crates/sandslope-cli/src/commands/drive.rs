@@ -19,6 +19,7 @@ use sandslope_io::servo_log::DEFAULT_BAUD_RATE;
 use sandslope_request::drive::{DriveFields, DriveRun, EMULATE_FAULT, EMULATE_OFFSET, EMULATE_WEAKEN};
 use sandslope_request::field::Field;
 use sandslope_request::scenario::{ROBOT, TERRAIN};
+use sandslope_servo::clock::ClockKind;
 use sandslope_servo::driver::{DriveReport, LiveEstimate};
 use sandslope_servo::emulator::EmulatorFaults;
 use sandslope_servo::log::{drive_logged, live_record, LogTarget};
@@ -292,6 +293,7 @@ pub fn config(
             seed: args.emulate_seed,
             current_offset_ma,
             faults,
+            clock: ClockKind::parse(&args.emulate_clock).unwrap_or_default(),
         }),
     };
     Ok(DriveConfig {

@@ -47,6 +47,9 @@ pub(super) fn zero(config: &DriveConfig, robot_path: &str) -> Result<()> {
 /// is the first line on stdout.
 pub(super) fn serve_pty(config: &DriveConfig, duration_s: f64) -> Result<()> {
     let BusChoice::Emulate(o) = &config.bus else { bail!("--pty needs --emulate") };
+    if o.clock == sandslope_servo::clock::ClockKind::Virtual {
+        bail!("--emulate-clock virtual: the virtual clock moves with this program's driving loop, and --pty leaves the driving to another program on the wall's clock. Fix: leave --emulate-clock out (real) with --pty");
+    }
     let cfg = emulator_config(config, o)?;
     let (emulator, port) = Emulator::start(&cfg)?;
     let path = pty_path(&port).ok_or_else(|| {

@@ -9,10 +9,11 @@ use clap::Args;
 use sandslope_render::rows::FitRow;
 
 use sandslope::measure::campaign::dropped_text;
-use sandslope::measure::{AirMode, Campaign};
+use sandslope::measure::Campaign;
 use sandslope_request::error::Words;
-use sandslope_request::fit::{parse_depth_window, FitAnswer, FitRequest};
+use sandslope_request::fit::{FitAnswer, FitRequest};
 
+use crate::args::FieldArgs;
 use crate::figures::measurements as figures;
 use crate::output::{csv_string, num, print_json, sci, table, write_atomic, Format, FormatArgs};
 
@@ -29,45 +30,18 @@ pub struct FitArgs {
     /// Write the force-measurement figures (PNG) into this folder (created if missing).
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
-    /// Fit k_n over this depth window, metres, instead of finding it (e.g. 0.005:0.03).
-    #[arg(long, value_name = "MIN:MAX", allow_hyphen_values = true)]
-    pub depth_window: Option<String>,
-    /// Shear plateau starts at this displacement, metres, instead of being found (e.g. 0.02).
-    #[arg(long, allow_negative_numbers = true, value_name = "M")]
-    pub plateau_from: Option<f64>,
-    /// Subtract the in-air run's force curve against position (default: its mean, or its
-    /// fitted line when it has a significant trend).
-    #[arg(long, conflicts_with = "air_mean")]
-    pub air_curve: bool,
-    /// Subtract the in-air run's mean force even when it has a significant trend.
-    #[arg(long)]
-    pub air_mean: bool,
-    /// Skip rows with a cell that is not a number (counted per trial) instead of stopping.
-    #[arg(long)]
-    pub skip_malformed: bool,
-    /// Load-cell counts per newton, for recordings with a force_counts column.
-    #[arg(long, allow_negative_numbers = true, value_name = "COUNTS")]
-    pub counts_per_newton: Option<f64>,
+    /// `--depth-window`, `--plateau-from`, `--air-curve`, `--air-mean`, `--skip-malformed` and
+    /// `--counts-per-newton`: the request's own fields ([`sandslope_request::fit::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<FitRequest>,
     #[command(flatten)]
     pub format: FormatArgs,
 }
 
 impl FitArgs {
-    /// The request these flags make (`--depth-window` parsed by the request layer's grammar).
+    /// The request these flags make, read by the request's one raw-to-typed step.
     pub fn request(&self) -> Result<FitRequest> {
-        let air = match (self.air_curve, self.air_mean) {
-            (true, _) => AirMode::Curve,
-            (_, true) => AirMode::Mean,
-            _ => AirMode::Auto,
-        };
-        Ok(FitRequest {
-            manifest: self.manifest.clone(),
-            depth_window: self.depth_window.as_deref().map(parse_depth_window).transpose()?,
-            plateau_from: self.plateau_from,
-            air,
-            counts_per_newton: self.counts_per_newton,
-            skip_malformed: self.skip_malformed,
-        })
+        Ok(FitRequest::from_fields(self.manifest.clone(), &self.fields.pairs)?)
     }
 }
 

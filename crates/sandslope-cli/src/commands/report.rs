@@ -12,12 +12,11 @@ use sandslope::Slope;
 
 use sandslope::gait::GaitOptions;
 use sandslope::report::Evidence;
-use sandslope_io::mocap::MocapFormat;
 use sandslope_request::error::Words;
-use sandslope_request::report::{answer_evidence, ReportRequest, TracksAt};
+use sandslope_request::report::{answer_evidence, ReportRequest, TracksAt, TRACKS};
 
-use crate::args::{parse_max_risk, LevelStepArgs, RobotArgs, TerrainArgs};
-use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, warn_without_steps};
+use crate::args::{FieldArgs, LevelStepArgs, RobotArgs, TerrainArgs};
+use crate::mocap_input::{expand, warn_without_steps};
 
 /// Arguments of `sandslope report`.
 #[derive(Debug, Args)]
@@ -25,56 +24,19 @@ pub struct ReportArgs {
     /// Folder to write index.html and report.json into (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Observed speeds (slope_deg,speed_m_s,speed_sd_m_s); default: the paper's five.
-    #[arg(long, value_name = "CSV")]
-    pub observed: Option<PathBuf>,
-    /// Force tests (a terrain file with k_s_sd, as `sandslope fit` writes): drawn in fig4d/h
-    /// and used as the k_s shape in the calibration; default: the terrain itself.
-    #[arg(long, value_name = "FILE|PRESET")]
-    pub forces: Option<String>,
-    /// Observed anchoring times (slope_deg,t1_s,t1_sd_s), drawn in fig5b and calibrated on.
-    #[arg(long, value_name = "CSV")]
-    pub t1: Option<PathBuf>,
-    /// Motion-capture recordings at one slope, `DEG=FILE|GLOB` (e.g. `10=runs/10deg-*.csv`);
-    /// repeat for more files or slopes. Each slope's files are pooled and analysed as
-    /// `sandslope track` does: their anchoring time t1 joins the observed ones (fig5b and the
-    /// calibration) and, without --observed, their mean speeds are the observed speeds. Adds
-    /// fig3b (speed within a stride) and a motion-capture table.
-    #[arg(long, value_name = "DEG=FILE|GLOB", value_parser = parse_tracks)]
+    /// `--tracks` ([`TRACKS`]): given once per slope or file, so not among `fields`.
+    #[arg(long = TRACKS.flag, value_name = TRACKS.value_name, help = TRACKS.help, value_parser = parse_tracks)]
     pub tracks: Vec<TracksArg>,
-    /// Format of the --tracks files: motive, vicon or plain; detected from each file's first
-    /// line when omitted.
-    #[arg(long, value_name = "motive|vicon|plain", value_parser = parse_mocap_format, requires = "tracks")]
-    pub tracks_format: Option<MocapFormat>,
-    /// Rigid body, marker or model output to track in the --tracks files (required when a
-    /// file has several).
-    #[arg(long, value_name = "NAME", requires = "tracks")]
-    pub tracks_body: Option<String>,
-    /// Upslope direction in the --tracks files' capture frame: +x, -x, +y, -y, +z, -z or a
-    /// vector such as `0.91,0,0.41`; estimated per slope from the direction of travel when
-    /// omitted.
-    #[arg(
-        long,
-        value_name = "AXIS|X,Y,Z",
-        value_parser = |s: &str| parse_upslope(s, "--tracks-upslope"),
-        allow_hyphen_values = true,
-        requires = "tracks"
-    )]
-    pub tracks_upslope: Option<[f64; 3]>,
-    /// Risk threshold for the safe-slope limit.
-    #[arg(long, allow_negative_numbers = true, value_name = "P", default_value_t = sandslope::risk::DEFAULT_MAX_RISK, value_parser = parse_max_risk)]
-    pub max_risk: f64,
+    /// `--observed`, `--forces`, `--t1`, `--tracks-format`, `--tracks-body`,
+    /// `--tracks-upslope`, `--max-risk` and `--simulator-fit`: the request's own fields
+    /// ([`sandslope_request::report::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<ReportRequest>,
     /// Fail (exit code 4, after writing the page) when the report carries a warning: a
     /// calibration quantity at its search bound, chi^2/dof > 3, or tracks that could not be
     /// used. Without it such a report exits 0 and prints the warnings on stderr.
     #[arg(long)]
     pub strict: bool,
-    /// Also fit the evidence with the stride simulator in place of the closed form
-    /// (`calibrate --model simulate`) and show the two fits side by side. Left out by default:
-    /// its thousands of walks take about 8 minutes of CPU on the paper's evidence with the converged simulator (docs/calibration.md), where the
-    /// rest of the report takes under a second (docs/simulate.md).
-    #[arg(long)]
-    pub simulator_fit: bool,
     #[command(flatten)]
     pub level: LevelStepArgs,
     #[command(flatten)]
@@ -141,8 +103,16 @@ fn tracks(args: &ReportArgs) -> Result<Vec<TracksAt>> {
 
 /// Runs `sandslope report`.
 pub fn run(args: ReportArgs) -> Result<()> {
+    // The flags read first (by the request's one raw-to-typed step), then the folder checked,
+    // then the evidence read: nothing is read or written on a bad flag.
+    let request = ReportRequest::from_fields(
+        args.robot.robot.clone(),
+        args.terrain.terrain.clone(),
+        tracks(&args)?,
+        &args.fields.pairs,
+    )?;
     sandslope_render::report::check_dir("--out", &args.out)?;
-    let evidence = evidence(&args)?;
+    let evidence = evidence(&args, request)?;
     // Seconds in a release build (the simulator section walks 14 slopes twice), a minute in a
     // debug one: a spinner with the time on a terminal.
     let spin = crate::progress::spinner(
@@ -174,24 +144,11 @@ pub fn run(args: ReportArgs) -> Result<()> {
     Ok(())
 }
 
-/// The evidence the flags name, read by the request layer (as Python's `report` reads it),
+/// The evidence `request` names, read by the request layer (as Python's `report` reads it),
 /// with a warning on stderr for each recording without a complete step.
-fn evidence(args: &ReportArgs) -> Result<Evidence> {
+fn evidence(args: &ReportArgs, request: ReportRequest) -> Result<Evidence> {
     let robot = args.robot.load()?.with_level_step(args.level.level_step);
     let terrain = args.terrain.load()?;
-    let request = ReportRequest {
-        robot_source: args.robot.robot.clone(),
-        terrain_source: args.terrain.terrain.clone(),
-        observed: args.observed.clone(),
-        forces: args.forces.clone(),
-        t1: args.t1.clone(),
-        tracks: tracks(args)?,
-        tracks_format: args.tracks_format,
-        tracks_body: args.tracks_body.clone(),
-        tracks_upslope: args.tracks_upslope,
-        max_risk: args.max_risk,
-        simulator_fit: args.simulator_fit,
-    };
     let period = robot.stride_period();
     let evidence = request.evidence(robot, terrain, Words::Flag)?;
     if let Ok(options) = GaitOptions::new(period) {

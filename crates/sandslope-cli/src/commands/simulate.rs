@@ -230,7 +230,7 @@ fn print_one(sim: &Simulation) {
 }
 
 /// What a walk with the body free to pitch is (docs/simulate.md, "Pitch free").
-const FREE_NOTE: &str = "body pitch free (--body-pitch free): on 15 and 20 degrees the free body needs a quarter of the default step (--dt 0.000125) to converge, and with --two-faced-belly its pitch is unstable on slopes (one walk is one draw of a spread; --ensemble N gives it); check with --check-convergence (docs/simulate.md)";
+const FREE_NOTE: &str = "body pitch free (--body-pitch free): its default step is a quarter of the locked walk's (T/8000), which its speeds on 15 and 20 degrees need to converge, and with --two-faced-belly its pitch is unstable on slopes (one walk is one draw of a spread; --ensemble N gives it); check with --check-convergence (docs/simulate.md)";
 
 fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
     let quiet = args.format.format() != Format::Table;

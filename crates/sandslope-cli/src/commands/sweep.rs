@@ -10,6 +10,7 @@ use crate::figures;
 use crate::figures::sweep::SweepFigure;
 use crate::output::{csv_string, num, print_json, ruled_out_note, speed_cell, table, Format, FormatArgs};
 use sandslope_io::load_speeds;
+use sandslope_request::calibrate::OBSERVED;
 use sandslope_request::SweepRequest;
 
 /// Arguments of `sandslope sweep`.
@@ -22,8 +23,9 @@ pub struct SweepArgs {
     /// Draw speed, anchoring time and step length against slope into FILE (.png or .svg).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    /// Overlay measured speeds (CSV: slope_deg,speed_m_s,speed_sd_m_s) on the speed panel.
-    #[arg(long, value_name = "CSV", requires = "plot")]
+    /// Overlay measured speeds (CSV: slope_deg,speed_m_s,speed_sd_m_s) on the speed panel
+    /// (the file of `calibrate`'s field [`OBSERVED`]).
+    #[arg(long = OBSERVED.flag, value_name = OBSERVED.value_name, requires = "plot")]
     pub observed: Option<PathBuf>,
     #[command(flatten)]
     pub robot: RobotArgs,

@@ -5,7 +5,7 @@
 use std::io::Read;
 use std::process::{Child, Command, Stdio};
 
-use super::{bin, real_time, text};
+use super::{bin, cpu_bound, real_time, text, VIRTUAL};
 
 /// The log's `# status = ...` line (the flight recorder's first line).
 fn status(log: &std::path::Path) -> String {
@@ -317,10 +317,11 @@ fn a_slope_beyond_the_safe_limit_needs_force() {
     assert!(all.contains("the sand's angle of repose, 25.0 deg"), "{all}");
     assert!(all.contains("--force"), "{all}");
     assert!(!all.contains("driving"), "{all}");
-    let _one = real_time();
+    let _cpu = cpu_bound();
     let out = bin()
         .args(["drive", "--emulate", "--slope", "28", "--force", "--emulate-k-s", "2e6", "--duration", "1"])
         .args(["--watchdog", "2"])
+        .args(VIRTUAL)
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
@@ -328,18 +329,19 @@ fn a_slope_beyond_the_safe_limit_needs_force() {
 
 /// On sand of k_s 2.5e5 N/m^3 at 20 deg the calibrated closed form says slippage (k_s margin
 /// 0.49), the stride simulator success: `--stop-on-risk 0.5` halts on the closed form's
-/// verdict at the first stance estimated (tripod 1's first, which ends at 0.6 + 0.5 = 1.1 s;
-/// tripod 0's, the run-up's, is not estimated), exit 5; the JSON carries both verdicts.
-/// So the halt comes at the end of the first stride, after 1.1 s: read at the leg's measured
-/// angle, which lags its goal by the position loop's 25 ms (0.16 rad at 1 turn/s), and at the
-/// next 50 Hz cycle, about 1.14 s; the bound leaves five cycles (0.1 s) for a loaded machine.
-/// Not earlier: the run-up stance does not tell this sand from safe sand (docs/drive.md, "Why
-/// not at the end of tripod 0's first stance"; estimated, it halted safe sand of 1.95e6).
+/// verdict at the first stance estimated, tripod 0's run-up stance (read against the grid
+/// walks' own run-ups, docs/drive.md), exit 5; the JSON carries both verdicts. That stance
+/// ends at 0.6 s (docs/model.md §19: 0.2 pi turned in the 0.2 s run-up, the remaining 0.8 pi
+/// at 2 pi rad/s, 0.4 s): read at the leg's measured angle, which lags its goal by the
+/// position loop's 25 ms, and at the next 50 Hz cycle, about 0.64 s; the bound leaves five
+/// cycles (0.1 s) for a loaded machine. Within the first stride (tripod 1's first stance ends
+/// at 1.1 s).
 #[test]
 fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
-    let _one = real_time();
+    let _cpu = cpu_bound();
     let out = bin()
         .args(["drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "6"])
+        .args(VIRTUAL)
         .args(["--stop-on-risk", "0.5", "--hold", "0.2", "--watchdog", "2", "--json"])
         .output()
         .unwrap();
@@ -347,7 +349,8 @@ fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["outcome"], "halted");
     let t = v["time_s"].as_f64().unwrap();
-    assert!((1.1..1.25).contains(&t), "halted at {t} s");
+    assert!((0.6..0.75).contains(&t), "halted at {t} s");
+    assert_eq!(v["live"][0]["tripod"], 0, "{}", v["live"]);
     let p = &v["live"][0]["pooled"];
     let (sim, closed) = (p["p_fail_simulator"].as_f64().unwrap(), p["p_fail_closed_form"].as_f64().unwrap());
     assert!(closed > 0.5 && closed > sim, "{p}");
@@ -364,11 +367,11 @@ fn stop_on_risk_halts_on_the_more_pessimistic_verdict() {
 
 /// Twenty emulated runs on constant sand (k_s 1.95e6 N/m^3, 20 deg, 6 s, seeds 1-20): the
 /// pooled 90% interval at the end covers the truth in at least 16 (nominal 90% less 10 points).
-/// Two runs at a time: each mostly waits on its bus, but starts with a burst of computing
-/// (four at once missed stances on two cores).
+/// On the virtual clock, two runs at a time (on the wall's clock four at once missed stances on
+/// two cores; on the virtual one two keep the cores busy).
 #[test]
 fn the_pooled_interval_covers_the_truth_at_its_rate() {
-    let _one = real_time();
+    let _cpu = cpu_bound();
     let mut covered = 0;
     let mut seen = vec![];
     for batch in (1..=20).collect::<Vec<u32>>().chunks(2) {
@@ -387,6 +390,7 @@ fn the_pooled_interval_covers_the_truth_at_its_rate() {
                         "6",
                     ])
                     .args(["--live", "--json", "--watchdog", "2", "--emulate-seed", &seed.to_string()])
+                    .args(VIRTUAL)
                     .stdout(Stdio::piped())
                     .stderr(Stdio::null())
                     .spawn()

@@ -124,12 +124,19 @@ fn fit(
             starts.push(s);
         }
     }
-    if problem.simulator.is_some() {
-        starts.extend(scanned_start(&problem, &start));
-    }
+    // Every start's search (and the simulator's scan, then a search from its best point) in
+    // parallel (rayon); the best is picked in the same order as one after another, so the
+    // answer is the same.
+    let (mut fits, scanned): (Vec<(Vec<f64>, f64)>, Option<(Vec<f64>, f64)>) = rayon::join(
+        || starts.par_iter().map(|s| minimise(&problem, s, &[], None)).collect(),
+        || {
+            let scanned = problem.simulator.as_ref().and_then(|_| scanned_start(&problem, &start));
+            scanned.map(|s| minimise(&problem, &s, &[], None))
+        },
+    );
+    fits.extend(scanned);
     let (mut best, mut s_min) = (start.clone(), f64::INFINITY);
-    for s in &starts {
-        let (x, v) = minimise(&problem, s, &[], None);
+    for (x, v) in fits {
         if v < s_min {
             (best, s_min) = (x, v);
         }
@@ -143,9 +150,17 @@ fn fit(
         return Err(CalibrationError::Interrupted);
     }
 
-    // Profile intervals, one parameter per task.
-    let intervals: Vec<Interval> =
-        (0..n).into_par_iter().map(|j| interval_for(&problem, Profiled::Unknown(j), &best, s_min)).collect();
+    // Profile intervals, one parameter per task, beside the profile of k_s(20)/k_s(0) where it
+    // is one (force tests: it needs no fitted parameter's interval).
+    let (intervals, ratio_profile): (Vec<Interval>, Option<Interval>) = rayon::join(
+        || {
+            (0..n)
+                .into_par_iter()
+                .map(|j| interval_for(&problem, Profiled::Unknown(j), &best, s_min))
+                .collect()
+        },
+        || problem.law.is_none().then(|| ratio_interval(&problem, &best, s_min, &[])),
+    );
     // A profile that found a lower minimum means the global fit was not global: take it.
     let parameters: Vec<FittedParameter> = problem
         .unknowns
@@ -162,7 +177,7 @@ fn fit(
         })
         .collect();
 
-    let shear_ratio_20 = ratio_interval(&problem, &best, s_min, &parameters);
+    let shear_ratio_20 = ratio_profile.unwrap_or_else(|| ratio_interval(&problem, &best, s_min, &parameters));
     let (pulls, _) = problem.pulls(&best).unwrap_or_default();
     let chi_squared: f64 = pulls.iter().map(|p| p.pull * p.pull).sum();
     let dof = problem.n_obs as i64 - n as i64;
@@ -216,18 +231,24 @@ fn scanned_start(problem: &Problem, start: &[f64]) -> Option<Vec<f64>> {
         if !strength {
             continue;
         }
-        for k in 0..SCAN_POINTS {
-            // Cell centres: a start on a bound has no unbounded coordinate.
-            let (a, b) = (u.search_coordinate(u.lo), u.search_coordinate(u.hi));
-            let q = a + (b - a) * (k as f64 + 0.5) / SCAN_POINTS as f64;
-            let mut x = start.to_vec();
-            x[i] = u.value_at_search(q);
-            let (x, v) = if floor.is_some() {
-                minimise(problem, &x, &others, None)
-            } else {
-                let v = problem.objective(&x);
-                (x, v)
-            };
+        // The grid's points in parallel (rayon), the best picked in their order.
+        let scanned: Vec<(Vec<f64>, f64)> = (0..SCAN_POINTS)
+            .into_par_iter()
+            .map(|k| {
+                // Cell centres: a start on a bound has no unbounded coordinate.
+                let (a, b) = (u.search_coordinate(u.lo), u.search_coordinate(u.hi));
+                let q = a + (b - a) * (k as f64 + 0.5) / SCAN_POINTS as f64;
+                let mut x = start.to_vec();
+                x[i] = u.value_at_search(q);
+                if floor.is_some() {
+                    minimise(problem, &x, &others, None)
+                } else {
+                    let v = problem.objective(&x);
+                    (x, v)
+                }
+            })
+            .collect();
+        for (x, v) in scanned {
             if best.as_ref().is_none_or(|(_, b)| v < *b) {
                 best = Some((x, v));
             }

@@ -4,6 +4,7 @@
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 
+use super::model::Walked;
 use super::problem::Problem;
 
 /// A penalty term `(ln ratio - target) / tolerance` that holds `ln k_s(20)/k_s(0)` at `target`.
@@ -34,10 +35,14 @@ impl LeastSquares<'_, '_> {
     }
 
     fn residuals_at(&self, u: &DVector<f64>) -> DVector<f64> {
-        let x = self.values_at(u);
-        let mut r = self.problem.residuals(&x);
+        self.residuals_of(&self.values_at(u), None)
+    }
+
+    /// The residuals at the values `x`, with the simulator's walks given or walked.
+    fn residuals_of(&self, x: &[f64], walks: Option<&[Walked]>) -> DVector<f64> {
+        let mut r = self.problem.residuals_with(x, walks);
         if let Some(RatioPenalty { target, tolerance }) = self.penalty {
-            let ln_ratio = self.problem.ratio(&x).ln();
+            let ln_ratio = self.problem.ratio(x).ln();
             r.push(if ln_ratio.is_finite() { (ln_ratio - target) / tolerance } else { 1e3 });
         }
         while r.len() < self.free.len() {
@@ -62,15 +67,97 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for LeastSquares<'_, '_> {
         Some(self.residuals_at(&self.u))
     }
     fn jacobian(&self) -> Option<DMatrix<f64>> {
+        if let Some(j) = self.chain_rule_jacobian() {
+            return Some(j);
+        }
         let base = self.residuals_at(&self.u);
         let mut j = DMatrix::zeros(base.len(), self.free.len());
         for c in 0..self.free.len() {
-            let h = self.problem.jacobian_step() * self.u[c].abs().max(1.0);
-            let (mut up, mut down) = (self.u.clone(), self.u.clone());
-            up[c] += h;
-            down[c] -= h;
+            let (up, down, h) = self.column_points(c);
             let col = (self.residuals_at(&up) - self.residuals_at(&down)) / (2.0 * h);
             j.set_column(c, &col);
+        }
+        Some(j)
+    }
+}
+
+/// The step in `ln k_s` of the two walks that give a walk's derivative in its leg k_s (the
+/// chain rule of [`LeastSquares::chain_rule_jacobian`]): 0.2%, the size of the steps in a
+/// leg's k_s the finite differences in the unbounded coordinates took before it (0.16% to
+/// 0.4% on the paper's evidence, [`Problem::jacobian_step`]), where a fixed-step walk is
+/// smooth in k_s (docs/calibration.md).
+pub(crate) const WALK_LN_K_S_STEP: f64 = 2e-3;
+
+impl LeastSquares<'_, '_> {
+    /// The two points of column `c`'s central difference and their half distance.
+    fn column_points(&self, c: usize) -> (DVector<f64>, DVector<f64>, f64) {
+        let h = self.problem.jacobian_step() * self.u[c].abs().max(1.0);
+        let (mut up, mut down) = (self.u.clone(), self.u.clone());
+        up[c] += h;
+        down[c] -= h;
+        (up, down, h)
+    }
+
+    /// The Jacobian by the chain rule through each walk's leg k_s, when the walks depend on the
+    /// free quantities only through it ([`Problem::walks_depend_only_on_k_s`]): every walk is
+    /// differentiated once in `ln k_s` (two walks at `k_s e^(+-WALK_LN_K_S_STEP)`, all slopes
+    /// in one parallel batch), and each column is the same central difference as without it,
+    /// with the walks continued linearly in `ln k_s` from the point's own walks instead of
+    /// walked again. On the paper's evidence that is 10 walks a Jacobian where the columns'
+    /// own walks were 26 (`plate_scale` moves all five slopes' k_s, each force-test value
+    /// four). `None` when it does not apply or a walk is refused (then the columns walk).
+    fn chain_rule_jacobian(&self) -> Option<DMatrix<f64>> {
+        let problem = self.problem;
+        let sim = problem.simulator.as_ref().filter(|_| problem.walks_depend_only_on_k_s())?;
+        let c0 = problem.candidate(&self.values_at(&self.u));
+        let robot = c0.robot.as_ref()?;
+        let g0 = problem.grounds(&c0);
+        let w0 = sim.walks(robot, &g0).ok()?;
+        // Each column's two points and the change in every walk's ln k_s there (no walks).
+        let d_ln_k_s = |x: &[f64]| -> Vec<f64> {
+            let g = problem.grounds(&problem.candidate(x));
+            g.iter().zip(&g0).map(|(g, g0)| (g.2 / g0.2).ln()).collect()
+        };
+        let columns: Vec<(f64, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> = (0..self.free.len())
+            .map(|c| {
+                let (up, down, h) = self.column_points(c);
+                let (xu, xd) = (self.values_at(&up), self.values_at(&down));
+                let (lu, ld) = (d_ln_k_s(&xu), d_ln_k_s(&xd));
+                (h, xu, lu, xd, ld)
+            })
+            .collect();
+        // The slopes whose k_s some column moves, each walked at k_s e^(+-step).
+        let moved: Vec<usize> = (0..g0.len())
+            .filter(|&i| columns.iter().any(|(_, _, lu, _, ld)| lu[i] != 0.0 || ld[i] != 0.0))
+            .collect();
+        let step = WALK_LN_K_S_STEP;
+        let grounds: Vec<(f64, f64, f64)> = moved
+            .iter()
+            .flat_map(|&i| {
+                let (deg, k_n, k_s) = g0[i];
+                [(deg, k_n, k_s * step.exp()), (deg, k_n, k_s * (-step).exp())]
+            })
+            .collect();
+        let walked = sim.walks(robot, &grounds).ok()?;
+        // d(speed)/d(ln k_s) and d(t1)/d(ln k_s) of every walk (zero where no column moves it).
+        let mut slope = vec![(0.0, 0.0); g0.len()];
+        for (pair, &i) in walked.chunks_exact(2).zip(&moved) {
+            let (a, b) = (pair[0], pair[1]);
+            slope[i] = ((a.speed - b.speed) / (2.0 * step), (a.t1 - b.t1) / (2.0 * step));
+        }
+        let continued = |dl: &[f64]| -> Vec<Walked> {
+            w0.iter()
+                .zip(&slope)
+                .zip(dl)
+                .map(|((w, d), l)| Walked { speed: w.speed + d.0 * l, t1: w.t1 + d.1 * l })
+                .collect()
+        };
+        let rows = self.residuals_of(&self.values_at(&self.u), Some(&w0)).len();
+        let mut j = DMatrix::zeros(rows, self.free.len());
+        for (c, (h, xu, lu, xd, ld)) in columns.iter().enumerate() {
+            let up = self.residuals_of(xu, Some(&continued(lu)));
+            let down = self.residuals_of(xd, Some(&continued(ld)));
+            j.set_column(c, &((up - down) / (2.0 * h)));
         }
         Some(j)
     }

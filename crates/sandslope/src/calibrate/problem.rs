@@ -158,12 +158,10 @@ impl Problem<'_> {
         }
     }
 
-    /// The simulator's walk at every observed slope for candidate `c` (`None` when the model is
-    /// the closed form; `Some(Err)` when the simulator refuses a walk).
-    fn walked(&self, robot: &Robot, c: &Candidate) -> Option<Result<Vec<Walked>, String>> {
-        let sim = self.simulator.as_ref()?;
-        let grounds: Vec<(f64, f64, f64)> = self
-            .walk_slopes
+    /// The ground `(slope_deg, k_n, k_s)` of the walk at every observed slope (in the order of
+    /// `walk_slopes`) for candidate `c`.
+    pub fn grounds(&self, c: &Candidate) -> Vec<(f64, f64, f64)> {
+        self.walk_slopes
             .iter()
             .map(|&deg| {
                 let slope = Slope::from_degrees(deg).unwrap_or(Slope::LEVEL);
@@ -172,8 +170,23 @@ impl Problem<'_> {
                 // needs a positive value, and 1 N/m^3 is no strength at all for a 0.35 kg robot.
                 (deg, k_n, self.k_s(c, slope).max(MIN_SIMULATED_K_S))
             })
-            .collect();
-        Some(sim.walks(robot, &grounds))
+            .collect()
+    }
+
+    /// The simulator's walk at every observed slope for candidate `c` (`None` when the model is
+    /// the closed form; `Some(Err)` when the simulator refuses a walk).
+    fn walked(&self, robot: &Robot, c: &Candidate) -> Option<Result<Vec<Walked>, String>> {
+        let sim = self.simulator.as_ref()?;
+        Some(sim.walks(robot, &self.grounds(c)))
+    }
+
+    /// Whether every walk depends on the free quantities only through its leg k_s (the
+    /// simulator is the model and no robot key is free): then a walk's derivative in them is its
+    /// derivative in its own k_s times the k_s's, the chain rule the optimiser's Jacobian uses
+    /// (docs/calibration.md).
+    pub fn walks_depend_only_on_k_s(&self) -> bool {
+        self.simulator.is_some()
+            && !self.unknowns.iter().any(|u| matches!(u.quantity, Quantity::Free(Parameter::Robot(_))))
     }
 
     /// The walk at `deg` among `walks` (in the order of `walk_slopes`).
@@ -184,12 +197,22 @@ impl Problem<'_> {
     /// Pulls of every observation (speeds, anchoring times, force tests) at `x`, and the
     /// floor's term `sum_speeds ln(1 + f^2 / sd_i^2)` of `-2 ln L`.
     pub fn pulls(&self, x: &[f64]) -> Option<(Vec<Pull>, f64)> {
+        self.pulls_with(x, None)
+    }
+
+    /// [`Problem::pulls`] with the simulator's walks at `x` given (`walks`, in the order of
+    /// `walk_slopes`) rather than walked: the optimiser's chain rule hands in walks continued
+    /// linearly from a walked point.
+    pub fn pulls_with(&self, x: &[f64], walks: Option<&[Walked]>) -> Option<(Vec<Pull>, f64)> {
         let c = self.candidate(x);
         let robot = c.robot.as_ref()?;
-        let walks = match self.walked(robot, &c) {
-            None => None,
-            Some(Ok(w)) => Some(w),
-            Some(Err(_)) => return None,
+        let walks = match walks {
+            Some(w) if self.simulator.is_some() => Some(w.to_vec()),
+            _ => match self.walked(robot, &c) {
+                None => None,
+                Some(Ok(w)) => Some(w),
+                Some(Err(_)) => return None,
+            },
         };
         let mut out = Vec::with_capacity(self.n_obs);
         let pull = |kind, slope: Slope, observed: f64, sd: f64, sd_total: f64, model: f64| Pull {
@@ -244,7 +267,12 @@ impl Problem<'_> {
 
     /// Residual vector whose sum of squares is `-2 ln L` (+ const).
     pub fn residuals(&self, x: &[f64]) -> Vec<f64> {
-        match self.pulls(x) {
+        self.residuals_with(x, None)
+    }
+
+    /// [`Problem::residuals`] with the walks given ([`Problem::pulls_with`]).
+    pub fn residuals_with(&self, x: &[f64], walks: Option<&[Walked]>) -> Vec<f64> {
+        match self.pulls_with(x, walks) {
             Some((pulls, log_det)) => {
                 let mut r: Vec<f64> = pulls.iter().map(|p| p.pull).collect();
                 r.push(log_det.max(0.0).sqrt());

@@ -125,10 +125,11 @@ pub(crate) fn interval_for(problem: &Problem, target: Profiled, best: &[f64], s_
             (r, r - 5.0, r + 3.0, 0.05)
         }
     };
-    let (q_lo, lower_open) =
-        interval_end(problem, target, best, s_min, Walk { q_best, limit: lo, step0: step, dir: -1.0 });
-    let (q_hi, upper_open) =
-        interval_end(problem, target, best, s_min, Walk { q_best, limit: hi, step0: step, dir: 1.0 });
+    // The two ends are independent searches: in parallel (rayon), the same answer as in turn.
+    let ((q_lo, lower_open), (q_hi, upper_open)) = rayon::join(
+        || interval_end(problem, target, best, s_min, Walk { q_best, limit: lo, step0: step, dir: -1.0 }),
+        || interval_end(problem, target, best, s_min, Walk { q_best, limit: hi, step0: step, dir: 1.0 }),
+    );
     let back = |q: f64| match target {
         Profiled::Unknown(j) => problem.unknowns[j].value_at_search(q),
         Profiled::LnShearRatio => q.exp(),

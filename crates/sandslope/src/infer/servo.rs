@@ -166,6 +166,18 @@ pub struct ModelGrid {
     pub bins: usize,
     /// Whether the profiles are taken after [`remove_swing_offset`] (and a log's must be).
     pub swing_offset: bool,
+    /// Per k_s, tripod 0's run-up stance (stride 0, the legs running up as the driver commands
+    /// them), bin by bin, N m: the raw drive torque, no swing having come before it to read a
+    /// sensor's offset from ([`infer_from_run_up`]).
+    pub run_up_mean: Vec<Vec<f64>>,
+    /// The variance of the simulated torque within each bin of a steady stance (strides 1
+    /// on, tripod-major), N m^2, averaged over the grid: a stance sampled at the bus's rate
+    /// reads a bin's mean from a few samples of a profile that changes within the bin (the
+    /// touchdown's peak lasts a few tens of ms), and that sampling error is this over the
+    /// samples one leg takes ([`infer_from_stance`]).
+    pub within_var: Vec<f64>,
+    /// The same for tripod 0's run-up stance ([`infer_from_run_up`]).
+    pub run_up_within_var: Vec<f64>,
 }
 
 /// Fewest samples a swing needs for its median to count as the leg's offset there.
@@ -234,8 +246,9 @@ pub fn remove_swing_offset(
     Ok((out, offsets))
 }
 
-/// The stride simulator's settings for the servo sensor's walks, `duration_s` long and sampled
-/// at `rate_hz`: the emulator's currents and the inference's model profiles both come from
+/// The stride simulator's settings for the servo sensor's walks, `duration_s` long, sampled
+/// at `rate_hz`, the legs running up over `ramp_up_s` as the driver commands them (the robot
+/// file's response time, docs/model.md §19; [`SimSettings::ramp_up_s`]): the emulator's currents and the inference's model profiles both come from
 /// these, with the body pitch locked, the setting whose answers converge on the built-in
 /// terrain (docs/simulate.md: the free body's walks on slopes change with the time step, so a
 /// sensor read against them would read the integrator, not the sand), and the two-faced belly
@@ -244,9 +257,14 @@ pub fn remove_swing_offset(
 /// default, the emulated currents' 90% intervals held the truth in 8 of 10 runs where 9 are
 /// required, the biased-sensor run missed 6 of 14, and the 20 degree halt came a stride late,
 /// measured in CI on 2026-12-07; the sensor waits for its re-tuning on the one-sided walk)**.
-pub fn sensor_walk_settings(duration_s: f64, rate_hz: f64) -> Result<SimSettings, crate::error::ParamError> {
+pub fn sensor_walk_settings(
+    duration_s: f64,
+    rate_hz: f64,
+    ramp_up_s: f64,
+) -> Result<SimSettings, crate::error::ParamError> {
     SimSettings::new(duration_s)?
         .with_sample_rate(rate_hz)?
+        .with_ramp_up(ramp_up_s)?
         .with_body_pitch(crate::simulate::BodyPitch::Locked)
         .with_mechanisms(crate::simulate::Mechanisms { one_sided_belly: false, ..Default::default() })
 }
@@ -270,9 +288,10 @@ pub fn model_grid(
     let (lo, hi) = (settings.prior.min().ln(), settings.prior.max().ln());
     let n = settings.grid_points;
     let k_s: Vec<f64> = (0..n).map(|i| (lo + (hi - lo) * i as f64 / (n - 1) as f64).exp()).collect();
-    let duration = settings.simulated_strides as f64 * schedule.period_s;
-    let sim_settings =
-        sensor_walk_settings(duration, 200.0).map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
+    // The robot's run-up walked too (the driver's, docs/model.md §19), and the strides after it whole.
+    let duration = settings.simulated_strides as f64 * schedule.period_s + schedule.run_up_s;
+    let sim_settings = sensor_walk_settings(duration, 200.0, schedule.run_up_s)
+        .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
     let bins = settings.bins;
     let walks: Vec<Result<_, CurrentInferenceError>> = k_s
         .par_iter()
@@ -284,13 +303,17 @@ pub fn model_grid(
             let sim = simulate(&scenario, slope, &sim_settings)
                 .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
             let mut legs = simulated_legs(&schedule, &sim);
+            let run_up = run_up_profile(&schedule, &legs, bins);
+            let run_up_within = within_bin_variance(&schedule, &legs, bins, |s| s == 0);
             if settings.swing_offset {
                 legs = remove_swing_offset(&schedule, &legs)?.0;
             }
+            let within = within_bin_variance(&schedule, &legs, bins, |s| s >= 1);
             let profiles = stance_profiles(&schedule, &legs, bins);
             let (mean, sd, strides) = profile_statistics(&profiles, 2 * bins);
             let shear = stance_shear_load(&schedule, &sim);
-            Ok((mean, sd, strides, sim.summary.regime, shear, sim.summary.speed_m_s))
+            let speed = sim.summary.speed_m_s;
+            Ok((mean, sd, strides, sim.summary.regime, shear, speed, (run_up, within, run_up_within)))
         })
         .collect();
     let mut grid = ModelGrid {
@@ -305,9 +328,16 @@ pub fn model_grid(
         speed_m_s: vec![],
         bins,
         swing_offset: settings.swing_offset,
+        run_up_mean: vec![],
+        within_var: vec![0.0; 2 * bins],
+        run_up_within_var: vec![0.0; bins],
     };
+    let points = walks.len() as f64;
     for w in walks {
-        let (mean, sd, strides, regime, shear, speed) = w?;
+        let (mean, sd, strides, regime, shear, speed, (run_up, within, run_up_within)) = w?;
+        grid.run_up_mean.push(run_up);
+        grid.within_var.iter_mut().zip(&within).for_each(|(g, w)| *g += w / points);
+        grid.run_up_within_var.iter_mut().zip(&run_up_within).for_each(|(g, w)| *g += w / points);
         grid.mean.push(mean);
         grid.sd.push(sd);
         grid.strides = grid.strides.min(strides);
@@ -316,6 +346,46 @@ pub fn model_grid(
         grid.speed_m_s.push(speed);
     }
     Ok(grid)
+}
+
+/// The pooled variance of `legs`' stance torques within each bin (tripod-major) of the
+/// strides `keep` takes, about each stride's bin mean, N m^2 (0 where a bin has too few).
+fn within_bin_variance(
+    schedule: &GaitSchedule,
+    legs: &[LegTrace],
+    bins: usize,
+    keep: impl Fn(i64) -> bool,
+) -> Vec<f64> {
+    let half = 0.5 * schedule.period_s;
+    // (stride, bin) -> (n, sum, sum of squares)
+    let mut groups: std::collections::BTreeMap<(i64, usize), (f64, f64, f64)> = Default::default();
+    for (j, leg) in legs.iter().enumerate().take(schedule.legs()) {
+        let k = schedule.tripods[j];
+        for (&a, &tau) in leg.angle_rad.iter().zip(&leg.torque_n_m) {
+            let (stride, since) = schedule.stride_position(j, a);
+            if a.is_finite() && tau.is_finite() && since < half && keep(stride) {
+                let b = ((since / half * bins as f64) as usize).min(bins - 1);
+                let g = groups.entry((stride, k * bins + b)).or_default();
+                *g = (g.0 + 1.0, g.1 + tau, g.2 + tau * tau);
+            }
+        }
+    }
+    let mut ss = vec![0.0; 2 * bins];
+    let mut dof = vec![0.0; 2 * bins];
+    for ((_, b), (n, sum, sq)) in groups {
+        if n >= 2.0 {
+            ss[b] += (sq - sum * sum / n).max(0.0);
+            dof[b] += n - 1.0;
+        }
+    }
+    ss.iter().zip(&dof).map(|(s, d)| if *d > 0.0 { s / d } else { 0.0 }).collect()
+}
+
+/// Tripod 0's run-up stance (stride 0) of `legs`, bin by bin (0 where a bin is empty).
+fn run_up_profile(schedule: &GaitSchedule, legs: &[LegTrace], bins: usize) -> Vec<f64> {
+    let p = stance_profiles(schedule, legs, bins);
+    let row = p.strides.iter().position(|&s| s == 0).map(|i| &p.profiles[i]);
+    (0..bins).map(|b| row.and_then(|r| r[b]).unwrap_or(0.0)).collect()
 }
 
 /// The simulated legs as the servos would report them: leg j of the schedule is the
@@ -500,6 +570,16 @@ pub fn infer_servo_log(
     infer_from_currents(robot, &grid, legs)
 }
 
+/// The variance of one stance's bin mean of `count` samples, N m^2: the sensor's noise over
+/// the samples, plus the profile's variance within the bin (`within_var`, the grid's) over the
+/// samples one leg took (a tripod's legs are read in the same bus cycles, at the same points
+/// of their common profile, so they do not sample it independently).
+fn stance_bin_variance(robot: &Robot, noise_sd_n_m: f64, within_var: Option<f64>, count: usize) -> f64 {
+    let c = count as f64;
+    let per_leg = (c / f64::from(robot.stance_legs())).max(1.0);
+    noise_sd_n_m * noise_sd_n_m / c + within_var.unwrap_or(0.0) / per_leg
+}
+
 /// Live update after one stance: the posterior from tripod `tripod`'s bins of one stance
 /// (`profile`, its `counts`), with `noise_sd_n_m` the torque noise of one sample.
 pub fn infer_from_stance(
@@ -524,7 +604,7 @@ pub fn infer_from_stance(
             continue;
         }
         mean[idx] = v;
-        var[idx] = noise_sd_n_m * noise_sd_n_m / c as f64;
+        var[idx] = stance_bin_variance(robot, noise_sd_n_m, grid.within_var.get(idx).copied(), c);
         used.push(idx);
     }
     if used.len() < b {
@@ -532,6 +612,49 @@ pub fn infer_from_stance(
     }
     // One stance is one draw of the simulator's stride-to-stride scatter, not a mean over many.
     let mut answer = posterior_answer_single(robot, grid, &mean, &var, &used);
+    answer.strides = 1;
+    Some(answer)
+}
+
+/// The current sensor's zero offset of one servo before any swing has shown it, as a
+/// standard deviation, mA: the offsets the log tests inject span -40 to 40 mA (docs/drive.md,
+/// "Messy logs"), a uniform spread's SD 40 / sqrt 3 = 23 mA, rounded up.
+pub const RUN_UP_OFFSET_SD_MA: f64 = 25.0;
+
+/// Live estimate from tripod 0's run-up stance (stride 0: the legs running up over the
+/// response time, docs/model.md §19), read against the grid walks' own run-up stances
+/// ([`ModelGrid::run_up_mean`]). No swing has come before it, so the torques are raw: each
+/// leg's unknown sensor offset (SD `offset_sd_n_m`) is integrated out, the tripod's mean
+/// offset shifting every bin alike (a covariance `offset_sd^2 / n` common to the bins). The
+/// simulated scatter is the steady stances' (one run-up per walk shows none of its own).
+/// `None` when the grid has no run-up or a bin is empty.
+pub fn infer_from_run_up(
+    robot: &Robot,
+    grid: &ModelGrid,
+    profile: &[Option<f64>],
+    counts: &[usize],
+    noise_sd_n_m: f64,
+    offset_sd_n_m: f64,
+) -> Option<CurrentInference> {
+    let b = grid.bins;
+    if grid.run_up_mean.len() != grid.k_s.len() {
+        return None;
+    }
+    let mut mean = vec![0.0; 2 * b];
+    let mut var = vec![0.0; 2 * b];
+    for i in 0..b {
+        let (v, c) = (profile.get(i).copied().flatten()?, counts.get(i).copied().unwrap_or(0));
+        if c == 0 {
+            return None;
+        }
+        mean[i] = v;
+        var[i] = stance_bin_variance(robot, noise_sd_n_m, grid.run_up_within_var.get(i).copied(), c);
+    }
+    let pad = |m: &Vec<f64>| m.iter().copied().chain(std::iter::repeat(0.0)).take(2 * b).collect();
+    let g = ModelGrid { strides: 1, mean: grid.run_up_mean.iter().map(pad).collect(), ..grid.clone() };
+    let common = offset_sd_n_m * offset_sd_n_m / f64::from(robot.stance_legs());
+    let used: Vec<usize> = (0..b).collect();
+    let mut answer = posterior_answer_common(robot, &g, &mean, &var, &used, 1, common);
     answer.strides = 1;
     Some(answer)
 }
@@ -556,6 +679,22 @@ fn posterior_answer(
     var_obs: &[f64],
     bins: &[usize],
     strides: usize,
+) -> CurrentInference {
+    posterior_answer_common(robot, grid, mean, var_obs, bins, strides, 0.0)
+}
+
+/// [`posterior_answer`] with a shift common to every bin of variance `common_var` integrated
+/// out (an unknown sensor offset): the covariance `diag(v) + c 1 1^T`, whose quadratic form
+/// and log-determinant are the independent bins' less `c (sum r/v)^2 / (1 + c sum 1/v)` and
+/// plus `ln(1 + c sum 1/v)` (the matrix determinant lemma and Sherman-Morrison).
+fn posterior_answer_common(
+    robot: &Robot,
+    grid: &ModelGrid,
+    mean: &[f64],
+    var_obs: &[f64],
+    bins: &[usize],
+    strides: usize,
+    common_var: f64,
 ) -> CurrentInference {
     let floor = CurrentInferenceSettings::default().floor_n_m;
     let sim_n = grid.strides.max(1) as f64;
@@ -590,13 +729,18 @@ fn posterior_answer(
     let step = |_i: usize, b: usize| -> f64 { model_var[b].sqrt() };
     let loglik: Vec<f64> = (0..n)
         .map(|i| {
-            bins.iter()
-                .map(|&b| {
-                    let v = var_obs[b] + grid.sd[i][b].powi(2) / sim_n + step(i, b).powi(2) + floor * floor;
-                    let r = mean[b] - grid.mean[i][b];
-                    -0.5 * (r * r / v + v.ln())
-                })
-                .sum()
+            let v =
+                |b: usize| var_obs[b] + grid.sd[i][b].powi(2) / sim_n + step(i, b).powi(2) + floor * floor;
+            let r = |b: usize| mean[b] - grid.mean[i][b];
+            let independent: f64 = bins.iter().map(|&b| -0.5 * (r(b) * r(b) / v(b) + v(b).ln())).sum();
+            if common_var > 0.0 {
+                let (sr, si) =
+                    bins.iter().fold((0.0, 0.0), |(sr, si), &b| (sr + r(b) / v(b), si + 1.0 / v(b)));
+                let d = 1.0 + common_var * si;
+                independent + 0.5 * (common_var * sr * sr / d - d.ln())
+            } else {
+                independent
+            }
         })
         .collect();
     let top = loglik.iter().cloned().fold(f64::NEG_INFINITY, f64::max);

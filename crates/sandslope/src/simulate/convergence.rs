@@ -7,7 +7,9 @@
 use serde::Serialize;
 
 use super::ensemble::simulate_ensemble;
-use super::{integration_step, simulate, SimSettings, SimSummary, SimulateError, CREEP_RANGE_M_S, MAX_STEPS};
+use super::{
+    integration_step_for, simulate, SimSettings, SimSummary, SimulateError, CREEP_RANGE_M_S, MAX_STEPS,
+};
 use crate::error::ParamError;
 use crate::regime::Regime;
 use crate::scenario::Scenario;
@@ -173,7 +175,7 @@ impl Plan {
     /// The check's settings; refused before any walk when the quarter step's walk would pass
     /// the step limit (its message names the check).
     fn new(scenario: &Scenario, slope: SignedSlope, settings: &SimSettings) -> Result<Plan, SimulateError> {
-        let dt = integration_step(scenario, slope.felt(), settings.dt_s)?;
+        let dt = integration_step_for(scenario, slope.felt(), settings)?;
         // The quarter step's walk is the longest: its limit, said as the check's.
         let fine = dt / STEP_REFINEMENT;
         if (settings.duration_s + settings.settle_s) / fine > MAX_STEPS {
@@ -241,7 +243,7 @@ fn answer(
     settings: &SimSettings,
     ensemble: Option<usize>,
 ) -> Result<WalkAnswer, SimulateError> {
-    let dt = integration_step(scenario, slope.felt(), settings.dt_s)?;
+    let dt = integration_step_for(scenario, slope.felt(), settings)?;
     Ok(match ensemble {
         None => {
             let s = simulate(scenario, slope, settings)?.summary;

@@ -14,7 +14,7 @@
 
 use super::body::{associated_force, element_force, submerged, BodyPitch, Contact, BELLY};
 use super::linear::solve_dofs;
-use super::mechanisms::{gait_angle, Trench, CONSTANT_SPEED_DUTY};
+use super::mechanisms::{gait_angle, run_up_angle, Trench, CONSTANT_SPEED_DUTY};
 use super::rft::{RestSet, Rft};
 use super::{Geometry, SimSettings, Trajectory};
 use crate::leg::Leg;
@@ -97,6 +97,8 @@ pub(crate) struct Walker {
     gz: f64,
     omega: f64,
     psi0: f64,
+    /// The run-up of the constant-speed gait, s (`SimSettings::ramp_up_s`; 0: full speed at once).
+    ramp: f64,
     width: f64,
     belly_width: f64,
     torque_limit: Option<f64>,
@@ -243,6 +245,7 @@ impl Walker {
             gz: -G * theta.cos(),
             omega: robot.leg_speed(),
             psi0: robot.touchdown_angle(),
+            ramp: settings.ramp_up_s,
             width: robot.leg_width(),
             belly_width: robot.body_width(),
             torque_limit: if settings.servo_limit { robot.servo_torque_limit() } else { None },
@@ -308,8 +311,19 @@ impl Walker {
         let offset = PI * self.tripod[j] as f64;
         match self.locked {
             Some(a) => a + offset,
-            None if self.duty == CONSTANT_SPEED_DUTY => self.psi0 + self.omega * t.max(0.0) + offset,
+            None if self.duty == CONSTANT_SPEED_DUTY => {
+                self.psi0 + run_up_angle(t, self.omega, self.ramp).0 + offset
+            }
             None => self.psi0 + self.clock(j, t).0,
+        }
+    }
+
+    /// The commanded rate of leg `j` at time `t` (the run-up's, then omega, or the clock's).
+    fn nominal_rate(&self, j: usize, t: f64) -> f64 {
+        if self.duty == CONSTANT_SPEED_DUTY {
+            run_up_angle(t, self.omega, self.ramp).1
+        } else {
+            self.clock(j, t).1
         }
     }
 
@@ -678,15 +692,14 @@ impl Walker {
             self.stalled[j] = false;
             self.rates[j] = if gait {
                 let cmd = self.command(j, self.time);
-                let nominal =
-                    if self.duty == CONSTANT_SPEED_DUTY { self.omega } else { self.clock(j, self.time).1 };
+                let nominal = self.nominal_rate(j, self.time);
                 if self.locked.is_some() {
                     0.0
                 } else if let Some(motor) = self.motor {
                     self.demanded_rate(j, &motor)
                 } else if self.torque_limit.is_some() {
                     (nominal + (cmd - self.psi[j]) * CATCH_UP_PER_S).clamp(0.0, 1.5 * nominal)
-                } else if self.duty == CONSTANT_SPEED_DUTY {
+                } else if self.duty == CONSTANT_SPEED_DUTY && self.ramp == 0.0 {
                     self.omega
                 } else {
                     // Exactly onto the command at the step's end (the clock's rate changes

@@ -130,6 +130,19 @@ pub fn gait_angle(t: f64, period: f64, duty: f64) -> (f64, f64) {
     (2.0 * PI * k + within, rate)
 }
 
+/// The constant-speed gait's angle turned `t` s after the gait starts, and its rate, with a
+/// run-up of `ramp` s at constant acceleration (docs/model.md §19, the command `sandslope
+/// drive` sends): `omega t^2 / (2 r)` and `omega t / r` for `t < r`, then `omega (t - r / 2)`
+/// and omega; `ramp = 0` is §15's `omega t`. Before the start (`t < 0`) the legs stand.
+pub fn run_up_angle(t: f64, omega: f64, ramp: f64) -> (f64, f64) {
+    let t = t.max(0.0);
+    if t < ramp {
+        (0.5 * omega * t * t / ramp, omega * t / ramp)
+    } else {
+        (omega * (t - 0.5 * ramp), omega)
+    }
+}
+
 /// Caps the stress `(sx, sz)` on an element of unit tangent `(tx, tz)` at leg-sand friction
 /// `mu` (docs/model.md §20.1): its component along the surface at most `mu` times the
 /// magnitude of its component normal to it. Returns the capped stress and, when capped, the

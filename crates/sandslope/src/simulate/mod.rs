@@ -19,6 +19,7 @@ mod linear;
 pub mod mechanisms;
 pub mod phase1;
 pub mod rft;
+pub mod spread;
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -31,6 +32,7 @@ pub use ensemble::{simulate_ensemble, Ensemble};
 pub use mechanisms::Mechanisms;
 pub use phase1::PhaseOne;
 pub use rft::RftScaling;
+pub use spread::{scaling_spread, ScalingSpread};
 
 use crate::error::ParamError;
 use crate::gait::{measure_step, SmoothTrack, StepMeasure, REST_SPEED_FRACTION};
@@ -57,6 +59,8 @@ pub const MAX_DURATION_S: f64 = 3600.0;
 pub const MAX_STEPS: f64 = 2e7;
 /// Steps (one tripod stance each) left out of the means while the gait settles in.
 pub const WARMUP_STEPS: usize = 2;
+/// Longest run-up of the legs, s ([`SimSettings::with_ramp_up`]).
+pub const MAX_RAMP_UP_S: f64 = 10.0;
 
 /// How to run a walk. Build with [`SimSettings::new`] and the `with_` methods.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -83,6 +87,17 @@ pub struct SimSettings {
     pub rft_scaling: RftScaling,
     /// The candidate mechanisms of docs/model.md §20, all off by default.
     pub mechanisms: Mechanisms,
+    /// The legs' run-up, s: the constant-speed gait reaches omega at constant acceleration
+    /// over this time, as `sandslope drive` commands a robot (docs/model.md §19:
+    /// `omega t^2 / (2 r)`, then `omega (t - r / 2)`, every touchdown `r / 2` later). Default
+    /// 0: full speed from t = 0 (§15); the servo sensor's walks take the robot's response time.
+    /// Serialised only when set, so that every answer without it reads as before.
+    #[serde(skip_serializing_if = "no_ramp_up")]
+    pub ramp_up_s: f64,
+}
+
+fn no_ramp_up(ramp_up_s: &f64) -> bool {
+    *ramp_up_s == 0.0
 }
 
 impl SimSettings {
@@ -108,7 +123,16 @@ impl SimSettings {
             body_pitch: BodyPitch::default(),
             rft_scaling: RftScaling::Motion,
             mechanisms: Mechanisms::default(),
+            ramp_up_s: 0.0,
         })
+    }
+
+    /// The legs' run-up, s (0 to [`MAX_RAMP_UP_S`]; [`SimSettings::ramp_up_s`]).
+    pub fn with_ramp_up(self, ramp_up_s: f64) -> Result<SimSettings, ParamError> {
+        if !(ramp_up_s.is_finite() && (0.0..=MAX_RAMP_UP_S).contains(&ramp_up_s)) {
+            return Err(ParamError::new("ramp_up_s", ramp_up_s, format!("between 0 and {MAX_RAMP_UP_S} s")));
+        }
+        Ok(SimSettings { ramp_up_s, ..self })
     }
 
     /// Switches on the mechanisms of docs/model.md §20 (checked: errors name the switch).
@@ -402,18 +426,44 @@ pub enum SimulateError {
     Param(#[from] ParamError),
 }
 
-/// The default time step as a fraction of the stride period T (docs/model.md §17).
+/// The default time step as a fraction of the stride period T (docs/model.md §17), pitch
+/// locked.
 pub const DEFAULT_STEPS_PER_STRIDE: f64 = 2000.0;
+/// The default time step of a walk with the body free to pitch, as a fraction of T
+/// (docs/model.md §17): a quarter of the locked walk's. At T / 2000 the free body's landing on
+/// its belly at the end of each step comes milliseconds early, and at 15 degrees its speed
+/// moves by 8% at a quarter of the step (docs/simulate.md, "The free body's step").
+pub const DEFAULT_STEPS_PER_STRIDE_FREE: f64 = 8000.0;
 /// The coarsest time step a walk takes, as a fraction of T.
 pub const MIN_STEPS_PER_STRIDE: f64 = 100.0;
 
 /// The time step for `scenario`: the given one, checked, or the default `T / 2000`
 /// (docs/model.md §17). The contact sets no stability limit (the step is passive for any
 /// length); the limit `T / 100` is one of accuracy, a leg turning 3.6 degrees per step.
-pub fn integration_step(scenario: &Scenario, _slope: Slope, given: Option<f64>) -> Result<f64, ParamError> {
+pub fn integration_step(scenario: &Scenario, slope: Slope, given: Option<f64>) -> Result<f64, ParamError> {
+    step_for(scenario, slope, given, BodyPitch::Locked)
+}
+
+/// The time step of a walk with `settings`: its own, checked, or the default for its body
+/// pitch (`T / 2000` locked, `T / 8000` free; docs/model.md §17).
+pub fn integration_step_for(
+    scenario: &Scenario,
+    slope: Slope,
+    settings: &SimSettings,
+) -> Result<f64, ParamError> {
+    step_for(scenario, slope, settings.dt_s, settings.body_pitch)
+}
+
+fn step_for(
+    scenario: &Scenario,
+    _slope: Slope,
+    given: Option<f64>,
+    pitch: BodyPitch,
+) -> Result<f64, ParamError> {
     let period = scenario.robot().stride_period();
     let limit = period / MIN_STEPS_PER_STRIDE;
     match given {
+        None if pitch == BodyPitch::Free => Ok(period / DEFAULT_STEPS_PER_STRIDE_FREE),
         None => Ok(period / DEFAULT_STEPS_PER_STRIDE),
         Some(dt) if dt.is_finite() && dt > 0.0 && dt <= limit => Ok(dt),
         Some(dt) => Err(ParamError::new(
@@ -477,8 +527,16 @@ pub fn simulate_with_leg(
         .into());
     }
     let (ground, _) = scenario.ground_at(slope);
-    let dt = integration_step(scenario, slope, settings.dt_s)?;
+    let dt = integration_step_for(scenario, slope, settings)?;
     settings.mechanisms.checked()?;
+    if settings.ramp_up_s != 0.0 && settings.mechanisms.duty_cycle != mechanisms::CONSTANT_SPEED_DUTY {
+        return Err(ParamError::new(
+            "ramp_up_s",
+            settings.ramp_up_s,
+            "0 with a duty cycle other than 0.5 (the run-up is the constant-speed gait's)",
+        )
+        .into());
+    }
     let half = robot.stance_duration();
     if settings.locked_leg_angle.is_none() && settings.duration_s < 3.0 * half {
         return Err(ParamError::new(
@@ -518,10 +576,12 @@ pub fn simulate_with_leg(
             .max(REST_CREEP_FRACTION * settings.creep_m_s),
     };
     let duration = n_steps as f64 * dt;
-    let n_meas = ((duration + 1e-9) / half).floor() as usize;
+    // The steps start at the touchdowns, `r / 2` late after a run-up of `r`.
+    let delay = 0.5 * settings.ramp_up_s;
+    let n_meas = ((duration - delay + 1e-9) / half).floor() as usize;
     let mut steps = Vec::with_capacity(n_meas);
     for k in 0..n_meas {
-        let t0 = k as f64 * half;
+        let t0 = delay + k as f64 * half;
         if !track.covers(t0, half) {
             break;
         }
@@ -686,5 +746,9 @@ pub fn simulate_slopes(
 
 #[cfg(test)]
 mod phase1_tests;
+#[cfg(test)]
+mod slide_tests;
+#[cfg(test)]
+mod stride_probe;
 #[cfg(test)]
 mod tests;

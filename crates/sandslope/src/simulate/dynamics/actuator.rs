@@ -58,8 +58,7 @@ impl Motor {
 impl Walker {
     /// The demanded rate of leg `j` this step (the position loop), rad/s.
     pub(crate) fn demanded_rate(&self, j: usize, motor: &Motor) -> f64 {
-        let nominal =
-            if self.duty == super::CONSTANT_SPEED_DUTY { self.omega } else { self.clock(j, self.time).1 };
+        let nominal = self.nominal_rate(j, self.time);
         let cmd = self.command(j, self.time);
         (nominal + LAG_GAIN_PER_S * (cmd - self.psi[j])).clamp(0.0, motor.omega_0)
     }

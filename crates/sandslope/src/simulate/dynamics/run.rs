@@ -47,7 +47,7 @@ impl Walker {
             if pitch_over_s.is_none() && self.q[2].abs() > super::super::PITCH_OVER_RAD {
                 pitch_over_s = Some(t);
             }
-            let k = ((t - 0.5 * self.dt) / half).floor().max(0.0) as usize;
+            let k = ((t - 0.5 * self.dt - 0.5 * self.ramp) / half).floor().max(0.0) as usize;
             if let Some(p) = per_step.get_mut(k) {
                 for j in 0..legs {
                     let o = self.legs_out[j];

@@ -1,6 +1,6 @@
 //! End-to-end tests of the foundation commands: predict, sweep, calibrate, presets.
 
-mod common;
+use crate::common;
 use common::{json_of as json, repo_file, sandslope};
 
 use predicates::prelude::*;
@@ -211,7 +211,7 @@ fn calibrate_reproduces_the_builtin_terrain() {
         .stdout(predicate::str::contains("k_s(20)/k_s(0)"));
     let fresh: toml::Value = toml::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     let preset: toml::Value =
-        toml::from_str(include_str!("../../sandslope-io/presets/glass-beads-300um.toml")).unwrap();
+        toml::from_str(include_str!("../../../sandslope-io/presets/glass-beads-300um.toml")).unwrap();
     assert_eq!(fresh["name"], preset["name"]);
     assert_eq!(fresh["repose_deg"], preset["repose_deg"]);
     let (a, b) = (fresh["points"].as_array().unwrap(), preset["points"].as_array().unwrap());

@@ -2,7 +2,7 @@
 //! offsets, transients, saturation and file defects) are fitted back; malformed inputs get
 //! clear errors and no output file; the terrain written loads in `sandslope predict`.
 
-mod common;
+use crate::common;
 use common::sandslope;
 
 #[path = "fit/synth.rs"]

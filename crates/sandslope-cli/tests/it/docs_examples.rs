@@ -16,7 +16,7 @@
 //! `runs/15deg-a.csv`, ...) are made from the example recordings and from `sandslope simulate
 //! --out`, the only inputs this test provides that the docs do not.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};

@@ -9,7 +9,7 @@
 //! moves a shallow minimum by ~15 ms), and the touchdowns are the simulator's: one frame
 //! (1/120 s).
 
-mod common;
+use crate::common;
 
 use common::{json, sandslope, write_arg};
 use predicates::str::contains;
@@ -183,12 +183,12 @@ fn bad_input_exits_2_naming_the_value_and_range_and_writes_nothing() {
     let robot = write_arg(
         dir.path(),
         "r.toml",
-        &format!("{}leg_elemnts = 8\n", include_str!("../../sandslope-io/presets/paper-hexapod.toml")),
+        &format!("{}leg_elemnts = 8\n", include_str!("../../../sandslope-io/presets/paper-hexapod.toml")),
     );
     let bad_elements = write_arg(
         dir.path(),
         "e.toml",
-        &format!("{}leg_elements = 2\n", include_str!("../../sandslope-io/presets/paper-hexapod.toml")),
+        &format!("{}leg_elements = 2\n", include_str!("../../../sandslope-io/presets/paper-hexapod.toml")),
     );
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (

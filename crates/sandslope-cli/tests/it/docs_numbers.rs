@@ -4,7 +4,7 @@
 //! fails this test instead of silently going stale. When it fails, rerun the command the
 //! assertion names and correct the doc.
 
-mod common;
+use crate::common;
 
 use common::{repo_file, sandslope};
 

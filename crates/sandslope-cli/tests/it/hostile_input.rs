@@ -3,7 +3,7 @@
 //! its fix: a range of 1e11 slopes or designs aborted the process after minutes and gigabytes,
 //! and a speeds table holding -1e308 hung `calibrate --plot` in the plotting library's tick loop.
 
-mod common;
+use crate::common;
 
 use std::time::{Duration, Instant};
 
@@ -51,13 +51,18 @@ fn huge_ranges_are_refused_before_they_are_expanded() {
 
 #[test]
 fn max_risk_says_the_same_everywhere() {
-    // design's --vary and --slope-target are required: clap asks for them before any value is read.
-    let design = ["design", "--vary", "mass_kg=1", "--slope-target", "10"];
-    for cmd in [&["risk"][..], &design, &["report"]] {
-        sandslope().args(cmd).args(["--max-risk", "1.5"]).assert().code(2).stderr(
+    // `report` needs its folder (`--out`, which clap requires first), design its --vary and
+    // --slope-target; the bad threshold is refused before the folder is made.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("report");
+    let out = out.to_str().unwrap();
+    let design = vec!["design", "--vary", "mass_kg=1", "--slope-target", "10"];
+    for args in [vec!["risk"], design, vec!["report", "--out", out]] {
+        sandslope().args(args).args(["--max-risk", "1.5"]).assert().code(2).stderr(
             contains("--max-risk").and(contains("1.5 is not a failure probability strictly between 0 and 1")),
         );
     }
+    assert!(!dir.path().join("report").exists());
 }
 
 #[test]

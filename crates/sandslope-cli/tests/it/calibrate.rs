@@ -1,7 +1,7 @@
 //! End-to-end tests of `sandslope calibrate`: the joint fit's outputs (terrain, robot, figure,
 //! JSON), the angle of repose carried over from the source terrain, and the refusals.
 
-mod common;
+use crate::common;
 use common::{json_of as json, repo_file, sandslope};
 
 use predicates::prelude::*;

@@ -1,7 +1,7 @@
 //! Exit codes (README, "Exit codes"): 2 for bad input, 3 when an output cannot be written, and
 //! a quiet 0 when the reader of stdout goes away.
 
-mod common;
+use crate::common;
 
 use std::io::Read;
 use std::process::{Command, Stdio};

@@ -4,7 +4,7 @@
 //! m, cm or mm at 80 to 100 Hz. k_n and k_s must come back within 3% at every slope (the mean
 //! of 3 trials), every window forced short must be flagged, and no other.
 
-mod common;
+use crate::common;
 use common::sandslope;
 
 #[path = "fit/synth.rs"]

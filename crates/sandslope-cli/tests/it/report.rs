@@ -1,11 +1,11 @@
 //! `sandslope report`: the page is self-contained, carries every figure id of the paper and the
 //! documented report.json; a real browser (headless Chromium, when installed) renders it to a
 //! screenshot that is not blank. With `--tracks`, motion-capture recordings generated from
-//! known step profiles (`sandslope::gait::synthetic::StepProfile`, see tests/track.rs for the
+//! known step profiles (`sandslope::gait::synthetic::StepProfile`, see tests/it/track.rs for the
 //! tolerances: speed 1 mm/s, t1 15 ms, slip 20%) feed the speeds, fig5b, fig3b and the
 //! calibration.
 
-mod common;
+use crate::common;
 
 use predicates::str::contains;
 use sandslope::gait::synthetic::StepProfile;

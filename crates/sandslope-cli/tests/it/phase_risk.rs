@@ -1,6 +1,6 @@
 //! End-to-end tests of `sandslope phase` and `sandslope risk`.
 
-mod common;
+use crate::common;
 use common::{json, sandslope, write_arg as write};
 
 use std::path::Path;

@@ -18,7 +18,7 @@ use predicates::str::contains;
 use sandslope::gait::synthetic::StepProfile;
 use serde_json::Value;
 
-mod common;
+use crate::common;
 
 use common::{motive, plain_mm, trajectory, vicon, write};
 

@@ -2,7 +2,7 @@
 //! at the page's width, eight columns, no row painted as a disagreement, and every cell short,
 //! the why of each row in a collapsible note.
 
-mod common;
+use crate::common;
 
 use common::sandslope;
 

@@ -2,7 +2,7 @@
 //! simulated second played in real time, and a terminal sees progress on stderr while the walk
 //! is simulated and drawn, a log (stderr not a terminal) plain lines, and --json nothing.
 
-mod common;
+use crate::common;
 
 use common::sandslope;
 

@@ -43,8 +43,7 @@ DEFAULT_BY_NAME = re.compile(r'\b(?:number_or|text_or)\(\s*"([^"]+)"')
 PENDING = {
     "crates/sandslope-request/src/grammar.rs": "the slope and axis grammars take the field's name",
     "crates/sandslope-cli/src/commands/animate.rs": "simulate's table not yet written",
-    "crates/sandslope-serve/src/api.rs": "serve's own keys (dem, output flags) beside the tables",
-    "crates/sandslope-serve/src/data.rs": "serve's own keys beside the tables",
+    "crates/sandslope-serve/src/data.rs": "the risk map's heading rule and plan's endpoints, read by name until plan's table",
     "crates/sandslope-serve/src/drive.rs": "the drive run is read by the CLI through drive's table; the server's own drive keys not yet",
     "crates/sandslope-fuzz/src/serve/requests.rs": "the fuzzer's key list is not yet read from the tables",
     "crates/sandslope-py/src/servo.rs": "Python's drive keywords not yet checked against drive's table",

@@ -1,8 +1,7 @@
 //! Motion-capture input shared by `sandslope track` and `sandslope report --tracks`: the
-//! expansion of file arguments (paths or glob patterns; the format and upslope flags are read
-//! by the request layer's tables), and the warnings around the request layer's one path from
-//! capture files to the library (`sandslope_request::track`, which Python takes too). Commands
-//! share this code through this module, never through each other.
+//! expansion of file arguments (paths or glob patterns) and the warnings around the request
+//! layer's one path from capture files to the library (`sandslope_request::track`, which Python
+//! takes too). Commands share this code through this module, never through each other.
 
 use std::path::{Path, PathBuf};
 

@@ -25,8 +25,7 @@ fn tables(command: &str) -> PyResult<Vec<Table>> {
     })
 }
 
-/// The name of a field's parser: `"number"`, `"whole"`, `"text"`, `"switch"`, `"choice"` or
-/// `"list"`.
+/// The name of a field's parser: `"number"`, `"whole"`, `"text"`, `"switch"`, `"choice"` or `"list"`.
 fn kind_name(kind: Kind) -> &'static str {
     match kind {
         Kind::Number => "number",

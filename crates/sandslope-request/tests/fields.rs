@@ -24,10 +24,6 @@ fn requests() -> Vec<(&'static str, Vec<Table>)> {
         // phase's masses are its panels', not the robot's override.
         ("phase", vec![phase::FIELDS, robot_and_terrain, without_mass]),
         ("drive", vec![drive::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
-        ("plan", vec![plan::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
-        ("design", vec![design::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
-        ("infer", vec![infer::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
-        ("track", vec![track::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         ("fit", vec![fit::FIELDS]),
         ("calibrate", vec![calibrate::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
         // report's --tracks is given per slope, beside its once-given fields.
@@ -40,6 +36,10 @@ fn requests() -> Vec<(&'static str, Vec<Table>)> {
                 scenario::ROBOT_QUANTITIES,
             ],
         ),
+        ("plan", vec![plan::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        ("design", vec![design::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        ("infer", vec![infer::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
+        ("track", vec![track::FIELDS, robot_and_terrain, scenario::ROBOT_QUANTITIES]),
     ]
 }
 

@@ -14,7 +14,7 @@ use sandslope_io::presets::{PresetKind, PRESETS};
 use sandslope_io::raster::{read_raster, write_two_band_geotiff};
 use sandslope_request::plan::{GOAL, GOAL_PX, OBJECTIVE, START, START_PX};
 use sandslope_request::scenario::robot_fields;
-use sandslope_request::{PhaseRequest, PlanRequest};
+use sandslope_request::{phase, simulate, PhaseRequest, PlanRequest};
 
 /// Most cells of a `/data/phase-map` (the page asks for about 160 x 160).
 pub const MAX_MAP_CELLS: u128 = 1 << 18;
@@ -184,7 +184,7 @@ fn phase_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiE
     let request = PhaseRequest::from_params(&api::request_params(params, served)?)?;
     let panels = request.grid(MAX_MAP_CELLS)?.compute(&|| {})?;
     let Some(p) = panels.first() else {
-        return Err(ApiError::bad(Some("slope".to_string()), "no panel: give a slope"));
+        return Err(ApiError::bad(Some(phase::SLOPE.flag.to_string()), "no panel: give a slope"));
     };
     let (nx, ny) = (p.map.k_n().len(), p.map.k_s().len());
     let regimes = (0..ny)
@@ -242,31 +242,43 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiEr
 /// `simulate --json` prints, the trajectory sampled at `rate` and the legs' geometry, for the
 /// page's animation (the library's [`sandslope::simulate::Simulation`], as compact JSON).
 fn simulation(params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
-    if params.iter().any(|(k, _)| k == "slopes") {
+    if params.iter().any(|(k, _)| k == simulate::SLOPES.flag) {
         return Err(ApiError::bad(
-            Some("slopes".to_string()),
-            "/data/simulation animates one walk: give slope, not slopes (/api/simulate takes slopes)",
+            Some(simulate::SLOPES.flag.to_string()),
+            format!(
+                "/data/simulation animates one walk: give {}, not {} (/api/simulate takes {})",
+                simulate::SLOPE.flag,
+                simulate::SLOPES.flag,
+                simulate::SLOPES.flag
+            ),
         ));
     }
     let walks = api::simulate_walks(params, served)?;
     if walks.check_convergence || walks.ensemble.is_some() {
+        let field = if walks.check_convergence { simulate::CHECK_CONVERGENCE } else { simulate::ENSEMBLE };
         return Err(ApiError::bad(
-            Some(if walks.check_convergence { "check-convergence" } else { "ensemble" }.to_string()),
-            "/data/simulation animates one walk: /api/simulate takes ensemble and check-convergence",
+            Some(field.flag.to_string()),
+            format!(
+                "/data/simulation animates one walk: /api/simulate takes {} and {}",
+                simulate::ENSEMBLE.flag,
+                simulate::CHECK_CONVERGENCE.flag
+            ),
         ));
     }
     let samples = walks.settings.duration_s * walks.settings.sample_rate_hz;
     if samples > MAX_SIM_SAMPLES {
         return Err(ApiError::bad(
-            Some("rate".to_string()),
+            Some(simulate::RATE.flag.to_string()),
             format!(
-                "--duration x --rate = {samples} trajectory samples: the page's animation takes at most {MAX_SIM_SAMPLES}"
+                "{} x {} = {samples} trajectory samples: the page's animation takes at most {MAX_SIM_SAMPLES}",
+                simulate::DURATION.long(),
+                simulate::RATE.long()
             ),
         ));
     }
     let sim = walks.simulate()?.pop();
     let Some(sim) = sim else {
-        return Err(ApiError::bad(Some("slope".to_string()), "no walk: give a slope"));
+        return Err(ApiError::bad(Some(simulate::SLOPE.flag.to_string()), "no walk: give a slope"));
     };
     Ok(Reply::compact(sim))
 }

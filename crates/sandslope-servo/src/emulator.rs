@@ -759,8 +759,9 @@ impl Emulator {
                         if !reply.is_empty() {
                             master.write_all(&reply).ok();
                         }
+                        let owed = bus.take_missed() as f64 * REPLY_TIMEOUT_S;
                         if start.is_virtual() {
-                            start.sleep(bus.take_missed() as f64 * REPLY_TIMEOUT_S);
+                            start.sleep(owed);
                         }
                     }
                     bus.tick(start.now());

@@ -192,7 +192,7 @@ impl PlanRequest {
         let allow_metastable = ALLOW_METASTABLE.switch_in(&mut p)?;
         let time_weight = TIME_WEIGHT.required_number_in(&mut p)?;
         let max_roll = MAX_ROLL.required_number_in(&mut p)?;
-        let descent = parse_descent(Words::Flag, DESCENT.choice_in(&mut p)?.unwrap_or_default())?;
+        let descent = parse_descent(Words::Flag, DESCENT.text_in(&mut p)?.unwrap_or_default())?;
         let (cv_n, cv_s) = (CV_N.number_in(&mut p)?, CV_S.number_in(&mut p)?);
         let max_memory = MAX_MEMORY.number_in(&mut p)?;
         let search = match SEARCH.choice_in(&mut p)? {

@@ -144,6 +144,10 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
         k_s_prior: infer::parse_prior(&args.k_s_prior)?,
         grid_points: args.grid_points,
     };
+    // The servos' model: the robot file's `[servos] model`, else the paper's XL330-M288.
+    let servo = sandslope_io::robot_terrain::load_servos(&args.robot.robot)?
+        .and_then(|s| s.model)
+        .unwrap_or(&sandslope::servo::ServoModel::XL330_M288);
     let run = if sandslope_io::bag::is_bag(path) {
         // A ROS 2 bag's joint states, read as the servo log's leg angles and torques.
         let options = sandslope_io::bag::series::JointOptions {
@@ -152,7 +156,7 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
             legs: 2 * robot.stance_legs() as usize,
             effort: args.effort_unit,
         };
-        let log = sandslope_io::bag::series::read_joint_states(path, &options)?;
+        let log = sandslope_io::bag::series::read_joint_states_of(path, &options, servo)?;
         request.read_log(log, &robot, Words::Flag)?
     } else {
         if args.topic.is_some() || !args.joints.is_empty() {
@@ -208,7 +212,7 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
         let ma: Vec<String> = answer
             .swing_offset_n_m
             .iter()
-            .map(|t| format!("{:.0}", sandslope::servo::ServoModel::XL330_M288.current_ma_from_torque(*t)))
+            .map(|t| format!("{:.0}", servo.current_ma_from_torque(*t)))
             .collect();
         println!(
             "current offsets read in the swings and removed, legs 0 to {}: {} mA (as drive torque, in each leg's sense)",

@@ -28,7 +28,7 @@ use super::{Bound, LogUniformPrior};
 use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::scenario::Scenario;
-use crate::servo::GaitSchedule;
+use crate::servo::{GaitSchedule, ServoModel};
 use crate::simulate::{simulate, SimSettings};
 use crate::terrain::Terrain;
 
@@ -84,6 +84,14 @@ pub struct CurrentInferenceSettings {
     /// [`remove_swing_offset`]) from the log and from the simulated walks alike. The live
     /// monitor's grid sets it too and takes each leg's last swing median off its stance itself.
     pub swing_offset: bool,
+    /// The servos' model (docs/drive.md, "Servo models"): its stall torque bounds the torques
+    /// a servo can report ([`ModelGrid::stall_torque_n_m`]). Default: the paper's XL330-M288.
+    #[serde(serialize_with = "servo_name")]
+    pub servo: &'static ServoModel,
+}
+
+fn servo_name<S: serde::Serializer>(servo: &&'static ServoModel, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(servo.name)
 }
 
 impl Default for CurrentInferenceSettings {
@@ -95,6 +103,7 @@ impl Default for CurrentInferenceSettings {
             simulated_strides: 8,
             floor_n_m: 0.002,
             swing_offset: true,
+            servo: &ServoModel::XL330_M288,
         }
     }
 }
@@ -178,6 +187,9 @@ pub struct ModelGrid {
     pub within_var: Vec<f64>,
     /// The same for tripod 0's run-up stance ([`infer_from_run_up`]).
     pub run_up_within_var: Vec<f64>,
+    /// The servos' stall torque, N m ([`CurrentInferenceSettings::servo`]): grid points whose
+    /// profile exceeds it are left out of the resolution term, as no current can read them.
+    pub stall_torque_n_m: f64,
 }
 
 /// Fewest samples a swing needs for its median to count as the leg's offset there.
@@ -328,6 +340,7 @@ pub fn model_grid(
         run_up_mean: vec![],
         within_var: vec![0.0; 2 * bins],
         run_up_within_var: vec![0.0; bins],
+        stall_torque_n_m: settings.servo.stall_torque_n_m,
     };
     let points = walks.len() as f64;
     for w in walks {
@@ -704,16 +717,12 @@ fn posterior_answer_common(
     // neighbouring grid points, bin by bin, over the points whose walk a servo could report.
     // At the stiff end of the grid (k_s >= 1.5e7 N/m^3 at 15 deg on the paper's robot) a few
     // simulated walks spike to tens of N m in one tripod's bins (stride-to-stride SD up to
-    // 13 N m, 2026-11-28), beyond the XL330's stall torque, which no current can read; their
+    // 13 N m, 2026-11-28), beyond the servo's stall torque, which no current can read; their
     // jumps made the mean square 1e6 times the rest's for that tripod and flattened every
     // stance of it (tripod 1's live estimates spanned the prior). They keep their own scatter
     // in `grid.sd`.
-    let reportable = |i: usize| {
-        grid.mean[i]
-            .iter()
-            .zip(&grid.sd[i])
-            .all(|(m, sd)| m.abs() + sd <= crate::servo::ServoModel::XL330_M288.stall_torque_n_m)
-    };
+    let reportable =
+        |i: usize| grid.mean[i].iter().zip(&grid.sd[i]).all(|(m, sd)| m.abs() + sd <= grid.stall_torque_n_m);
     let model_var: Vec<f64> = (0..mean.len())
         .map(|b| {
             let d: Vec<f64> = (1..n)
@@ -835,6 +844,80 @@ pub(crate) fn quantile(x: &[f64], p: &[f64], level: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::robot::RobotSpec;
+
+    /// The resolution term leaves out grid points a servo could not report, by the run's
+    /// servo model. Three points, one bin, profiles 0.1, 0.2 and 1.0 N m, a stance reading 0.2
+    /// with no noise: on the XL330-M288 (stall 0.52 N m) only the step 0.1 -> 0.2 counts, the
+    /// resolution variance is 0.01 and with the floor's 0.002^2 v = 0.010004; the weights
+    /// exp(-r^2 / 2v) are 0.6067, 1 and 1.3e-14, so the middle point has 1 / 1.6067 = 0.6224.
+    /// On the XM430-W350 (stall 4.1 N m) both steps count: v = (0.01 + 0.64) / 2 + 4e-6 =
+    /// 0.325004, weights 0.98473, 1 and 0.37360, the middle point 1 / 2.35833 = 0.42403.
+    #[test]
+    fn the_reportable_torque_is_the_servo_models_by_hand() {
+        let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
+        let grid = |servo: &'static ServoModel| ModelGrid {
+            slope_deg: 20.0,
+            k_n: 7e5,
+            k_s: vec![1e5, 2e5, 4e5],
+            mean: vec![vec![0.1, 0.0], vec![0.2, 0.0], vec![1.0, 0.0]],
+            sd: vec![vec![0.0; 2]; 3],
+            strides: 1,
+            regime: vec![Regime::Success; 3],
+            shear_load_n: vec![0.0; 3],
+            speed_m_s: vec![0.1; 3],
+            bins: 1,
+            swing_offset: false,
+            run_up_mean: vec![],
+            within_var: vec![0.0; 2],
+            run_up_within_var: vec![0.0; 1],
+            stall_torque_n_m: servo.stall_torque_n_m,
+        };
+        let p =
+            |servo| posterior_answer(&robot, &grid(servo), &[0.2, 0.0], &[0.0, 0.0], &[0], 1).posterior[1].1;
+        assert!((p(&ServoModel::XL330_M288) - 0.6224).abs() < 1e-4, "{}", p(&ServoModel::XL330_M288));
+        assert!((p(&ServoModel::XM430_W350) - 0.42403).abs() < 1e-4, "{}", p(&ServoModel::XM430_W350));
+    }
+
+    /// A stance's shift common to every bin (an unknown sensor offset) integrated out, by
+    /// hand: two grid points 0.01 N m apart in both of two bins, a reading on the first; each
+    /// bin's v is the resolution term 0.01^2 plus the floor 0.002^2, 1.04e-4. Independent bins
+    /// put the second point at ln(w1 / w0) = -0.5 x 2 x 0.01^2 / v; a common variance c adds
+    /// 0.5 c (sum r/v)^2 / (1 + c sum 1/v) there (the log-determinant term is the same at both
+    /// points): a shift that explains the residuals costs little.
+    #[test]
+    fn a_common_offset_is_integrated_out_by_hand() {
+        let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
+        let grid = ModelGrid {
+            slope_deg: 20.0,
+            k_n: 7e5,
+            k_s: vec![1e5, 2e5],
+            mean: vec![vec![0.11, 0.21], vec![0.1, 0.2]],
+            sd: vec![vec![0.0; 2]; 2],
+            strides: 1,
+            regime: vec![Regime::Success; 2],
+            shear_load_n: vec![0.0; 2],
+            speed_m_s: vec![0.1; 2],
+            bins: 2,
+            swing_offset: false,
+            run_up_mean: vec![],
+            within_var: vec![0.0; 2],
+            run_up_within_var: vec![0.0; 2],
+            stall_torque_n_m: 100.0,
+        };
+        let v: f64 = 1.04e-4;
+        let l = |c: f64| {
+            let a = posterior_answer_common(&robot, &grid, &[0.11, 0.21], &[0.0, 0.0], &[0, 1], 1, c);
+            (a.posterior[1].1 / a.posterior[0].1).ln()
+        };
+        let independent = -0.5 * (0.01f64.powi(2) / v) * 2.0;
+        assert!((l(0.0) - independent).abs() < 1e-9, "{} {independent}", l(0.0));
+        let (sr, si) = (2.0 * 0.01 / v, 2.0 / v);
+        let c = 1e-4;
+        let shift = 0.5 * c * sr * sr / (1.0 + c * si);
+        // ln(1 + c sum 1/v) is the same at both points: only the quadratic form differs.
+        assert!((l(c) - (independent + shift)).abs() < 1e-9, "{} {}", l(c), independent + shift);
+        assert!(l(c) > l(0.0));
+    }
 
     #[test]
     fn quantiles_of_a_flat_distribution_by_hand() {

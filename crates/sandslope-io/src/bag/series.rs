@@ -4,6 +4,7 @@
 //! messages' header stamps (the measurement's time), or the recorder's log time where a
 //! stamp is zero (a driver that does not set it).
 
+use sandslope::servo::ServoModel;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -346,17 +347,13 @@ pub struct JointOptions<'a> {
 /// time the stamp relative to the first message. Columns a `JointState` does not carry
 /// (voltage, temperature, goal) are zero. The mapping of joints to legs is in the notes.
 pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<ServoLog> {
-    read_joint_states_of(path, options, &sandslope::servo::ServoModel::XL330_M288)
+    read_joint_states_of(path, options, &ServoModel::XL330_M288)
 }
 
 /// [`read_joint_states`] for servos of model `servo` (the robot file's `[servos] model`): a
 /// current effort is turned into torque, and the log's current and load columns written, by
 /// its figures.
-pub fn read_joint_states_of(
-    path: &Path,
-    options: &JointOptions<'_>,
-    servo: &sandslope::servo::ServoModel,
-) -> Result<ServoLog> {
+pub fn read_joint_states_of(path: &Path, options: &JointOptions<'_>, servo: &ServoModel) -> Result<ServoLog> {
     let bag = open(path)?;
     let types = [JointState::TYPE];
     let name = match options.topic {

@@ -157,6 +157,9 @@ impl Session {
                 // The live stance is read after its leg's last swing median, as a log's after
                 // its swings (docs/drive.md): the grid's walks are taken the same way.
                 swing_offset: true,
+                // The robot file's model, else the paper's XL330-M288 (the ping may find
+                // another when the file names none).
+                servo: config.settings.servo.unwrap_or(&ServoModel::XL330_M288),
                 ..Default::default()
             };
             Some(

@@ -55,6 +55,10 @@ fn run_servo_log(args: &InferArgs, question: &ServoLogQuestion) -> Result<()> {
     // The log read and checked, its slope taken, by the request layer (as Python's is).
     let ServoLogQuestion { request, topic, joints, effort } = question;
     let path = request.path.as_path();
+    // The servos' model: the robot file's `[servos] model`, else the paper's XL330-M288.
+    let servo = sandslope_io::robot_terrain::load_servos(&args.robot.robot)?
+        .and_then(|s| s.model)
+        .unwrap_or(&sandslope::servo::ServoModel::XL330_M288);
     let run = if sandslope_io::bag::is_bag(path) {
         // A ROS 2 bag's joint states, read as the servo log's leg angles and torques.
         let options = sandslope_io::bag::series::JointOptions {
@@ -63,7 +67,7 @@ fn run_servo_log(args: &InferArgs, question: &ServoLogQuestion) -> Result<()> {
             legs: 2 * robot.stance_legs() as usize,
             effort: *effort,
         };
-        let log = sandslope_io::bag::series::read_joint_states(path, &options)?;
+        let log = sandslope_io::bag::series::read_joint_states_of(path, &options, servo)?;
         request.read_log(log, &robot, Words::Flag)?
     } else {
         if topic.is_some() || !joints.is_empty() {
@@ -121,7 +125,7 @@ fn run_servo_log(args: &InferArgs, question: &ServoLogQuestion) -> Result<()> {
         let ma: Vec<String> = answer
             .swing_offset_n_m
             .iter()
-            .map(|t| format!("{:.0}", sandslope::servo::ServoModel::XL330_M288.current_ma_from_torque(*t)))
+            .map(|t| format!("{:.0}", servo.current_ma_from_torque(*t)))
             .collect();
         println!(
             "current offsets read in the swings and removed, legs 0 to {}: {} mA (as drive torque, in each leg's sense)",

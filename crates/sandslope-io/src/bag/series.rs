@@ -4,6 +4,7 @@
 //! messages' header stamps (the measurement's time), or the recorder's log time where a
 //! stamp is zero (a driver that does not set it).
 
+use sandslope::servo::ServoModel;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -288,7 +289,7 @@ pub enum EffortUnit {
     /// Torque, N m (the message's documented unit).
     #[serde(rename = "n_m")]
     NewtonMetre,
-    /// Current, A, turned into torque with the XL330's K_t (docs/model.md §19).
+    /// Current, A, turned into torque with the servo model's K_t (docs/model.md §19).
     #[serde(rename = "a")]
     Ampere,
     /// Current, mA (as Dynamixel drivers publish Present Current).
@@ -310,9 +311,13 @@ impl std::str::FromStr for EffortUnit {
 
 impl EffortUnit {
     /// The drive torque, N m, of an effort in this unit (`K_t I` for currents, by the paper's
-    /// XL330-M288).
+    /// XL330-M288; [`EffortUnit::torque_n_m_of`] for another model).
     pub fn torque_n_m(self, effort: f64) -> f64 {
-        let servo = &sandslope::servo::ServoModel::XL330_M288;
+        self.torque_n_m_of(effort, &sandslope::servo::ServoModel::XL330_M288)
+    }
+
+    /// The drive torque, N m, of an effort in this unit, a current by `servo`'s K_t.
+    pub fn torque_n_m_of(self, effort: f64, servo: &sandslope::servo::ServoModel) -> f64 {
         match self {
             EffortUnit::NewtonMetre => effort,
             EffortUnit::Ampere => servo.torque_from_current_ma(1000.0 * effort),
@@ -342,6 +347,13 @@ pub struct JointOptions<'a> {
 /// time the stamp relative to the first message. Columns a `JointState` does not carry
 /// (voltage, temperature, goal) are zero. The mapping of joints to legs is in the notes.
 pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<ServoLog> {
+    read_joint_states_of(path, options, &ServoModel::XL330_M288)
+}
+
+/// [`read_joint_states`] for servos of model `servo` (the robot file's `[servos] model`): a
+/// current effort is turned into torque, and the log's current and load columns written, by
+/// its figures.
+pub fn read_joint_states_of(path: &Path, options: &JointOptions<'_>, servo: &ServoModel) -> Result<ServoLog> {
     let bag = open(path)?;
     let types = [JointState::TYPE];
     let name = match options.topic {
@@ -399,10 +411,9 @@ pub fn read_joint_states(path: &Path, options: &JointOptions<'_>) -> Result<Serv
             if !angle.is_finite() || !effort.is_finite() {
                 continue;
             }
-            let torque = options.effort.torque_n_m(effort);
+            let torque = options.effort.torque_n_m_of(effort, servo);
             let velocity = js.velocity.get(k).copied().unwrap_or(0.0);
             use sandslope::servo::model as x;
-            let servo = &sandslope::servo::ServoModel::XL330_M288;
             let current_ma = servo.current_ma_from_torque(torque);
             rows.push((
                 t,
@@ -519,5 +530,11 @@ mod tests {
         assert!((EffortUnit::Milliampere.torque_n_m(1470.0) - 0.52).abs() < 1e-12);
         assert_eq!(EffortUnit::NewtonMetre.torque_n_m(0.3), 0.3);
         assert!("volts".parse::<EffortUnit>().is_err());
+        // Another model's K_t (the robot file's [servos] model): the XM430-W350's 4.1 N m at
+        // 2.3 A, so 1.15 A is 2.05 N m; a torque stays a torque.
+        let xm = &sandslope::servo::ServoModel::XM430_W350;
+        assert!((EffortUnit::Ampere.torque_n_m_of(1.15, xm) - 2.05).abs() < 1e-12);
+        assert!((EffortUnit::Milliampere.torque_n_m_of(2300.0, xm) - 4.1).abs() < 1e-12);
+        assert_eq!(EffortUnit::NewtonMetre.torque_n_m_of(0.3, xm), 0.3);
     }
 }

@@ -25,12 +25,16 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::{Bound, LogUniformPrior};
+
+mod run_up;
 use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::scenario::Scenario;
-use crate::servo::GaitSchedule;
+use crate::servo::{GaitSchedule, ServoModel};
 use crate::simulate::{simulate, SimSettings};
 use crate::terrain::Terrain;
+pub use run_up::{infer_from_run_up, RUN_UP_OFFSET_SD_MA};
+use run_up::{run_up_profile, stance_bin_variance, within_bin_variance};
 
 /// Why currents cannot be turned into k_s.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -84,6 +88,14 @@ pub struct CurrentInferenceSettings {
     /// [`remove_swing_offset`]) from the log and from the simulated walks alike. The live
     /// monitor's grid sets it too and takes each leg's last swing median off its stance itself.
     pub swing_offset: bool,
+    /// The servos' model (docs/drive.md, "Servo models"): its stall torque bounds the torques
+    /// a servo can report ([`ModelGrid::stall_torque_n_m`]). Default: the paper's XL330-M288.
+    #[serde(serialize_with = "servo_name")]
+    pub servo: &'static ServoModel,
+}
+
+fn servo_name<S: serde::Serializer>(servo: &&'static ServoModel, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(servo.name)
 }
 
 impl Default for CurrentInferenceSettings {
@@ -95,6 +107,7 @@ impl Default for CurrentInferenceSettings {
             simulated_strides: 8,
             floor_n_m: 0.002,
             swing_offset: true,
+            servo: &ServoModel::XL330_M288,
         }
     }
 }
@@ -178,6 +191,9 @@ pub struct ModelGrid {
     pub within_var: Vec<f64>,
     /// The same for tripod 0's run-up stance ([`infer_from_run_up`]).
     pub run_up_within_var: Vec<f64>,
+    /// The servos' stall torque, N m ([`CurrentInferenceSettings::servo`]): grid points whose
+    /// profile exceeds it are left out of the resolution term, as no current can read them.
+    pub stall_torque_n_m: f64,
 }
 
 /// Fewest samples a swing needs for its median to count as the leg's offset there.
@@ -328,6 +344,7 @@ pub fn model_grid(
         run_up_mean: vec![],
         within_var: vec![0.0; 2 * bins],
         run_up_within_var: vec![0.0; bins],
+        stall_torque_n_m: settings.servo.stall_torque_n_m,
     };
     let points = walks.len() as f64;
     for w in walks {
@@ -343,46 +360,6 @@ pub fn model_grid(
         grid.speed_m_s.push(speed);
     }
     Ok(grid)
-}
-
-/// The pooled variance of `legs`' stance torques within each bin (tripod-major) of the
-/// strides `keep` takes, about each stride's bin mean, N m^2 (0 where a bin has too few).
-fn within_bin_variance(
-    schedule: &GaitSchedule,
-    legs: &[LegTrace],
-    bins: usize,
-    keep: impl Fn(i64) -> bool,
-) -> Vec<f64> {
-    let half = 0.5 * schedule.period_s;
-    // (stride, bin) -> (n, sum, sum of squares)
-    let mut groups: std::collections::BTreeMap<(i64, usize), (f64, f64, f64)> = Default::default();
-    for (j, leg) in legs.iter().enumerate().take(schedule.legs()) {
-        let k = schedule.tripods[j];
-        for (&a, &tau) in leg.angle_rad.iter().zip(&leg.torque_n_m) {
-            let (stride, since) = schedule.stride_position(j, a);
-            if a.is_finite() && tau.is_finite() && since < half && keep(stride) {
-                let b = ((since / half * bins as f64) as usize).min(bins - 1);
-                let g = groups.entry((stride, k * bins + b)).or_default();
-                *g = (g.0 + 1.0, g.1 + tau, g.2 + tau * tau);
-            }
-        }
-    }
-    let mut ss = vec![0.0; 2 * bins];
-    let mut dof = vec![0.0; 2 * bins];
-    for ((_, b), (n, sum, sq)) in groups {
-        if n >= 2.0 {
-            ss[b] += (sq - sum * sum / n).max(0.0);
-            dof[b] += n - 1.0;
-        }
-    }
-    ss.iter().zip(&dof).map(|(s, d)| if *d > 0.0 { s / d } else { 0.0 }).collect()
-}
-
-/// Tripod 0's run-up stance (stride 0) of `legs`, bin by bin (0 where a bin is empty).
-fn run_up_profile(schedule: &GaitSchedule, legs: &[LegTrace], bins: usize) -> Vec<f64> {
-    let p = stance_profiles(schedule, legs, bins);
-    let row = p.strides.iter().position(|&s| s == 0).map(|i| &p.profiles[i]);
-    (0..bins).map(|b| row.and_then(|r| r[b]).unwrap_or(0.0)).collect()
 }
 
 /// The simulated legs as the servos would report them: leg j of the schedule is the
@@ -567,16 +544,6 @@ pub fn infer_servo_log(
     infer_from_currents(robot, &grid, legs)
 }
 
-/// The variance of one stance's bin mean of `count` samples, N m^2: the sensor's noise over
-/// the samples, plus the profile's variance within the bin (`within_var`, the grid's) over the
-/// samples one leg took (a tripod's legs are read in the same bus cycles, at the same points
-/// of their common profile, so they do not sample it independently).
-fn stance_bin_variance(robot: &Robot, noise_sd_n_m: f64, within_var: Option<f64>, count: usize) -> f64 {
-    let c = count as f64;
-    let per_leg = (c / f64::from(robot.stance_legs())).max(1.0);
-    noise_sd_n_m * noise_sd_n_m / c + within_var.unwrap_or(0.0) / per_leg
-}
-
 /// Live update after one stance: the posterior from tripod `tripod`'s bins of one stance
 /// (`profile`, its `counts`), with `noise_sd_n_m` the torque noise of one sample.
 pub fn infer_from_stance(
@@ -609,49 +576,6 @@ pub fn infer_from_stance(
     }
     // One stance is one draw of the simulator's stride-to-stride scatter, not a mean over many.
     let mut answer = posterior_answer_single(robot, grid, &mean, &var, &used);
-    answer.strides = 1;
-    Some(answer)
-}
-
-/// The current sensor's zero offset of one servo before any swing has shown it, as a
-/// standard deviation, mA: the offsets the log tests inject span -40 to 40 mA (docs/drive.md,
-/// "Messy logs"), a uniform spread's SD 40 / sqrt 3 = 23 mA, rounded up.
-pub const RUN_UP_OFFSET_SD_MA: f64 = 25.0;
-
-/// Live estimate from tripod 0's run-up stance (stride 0: the legs running up over the
-/// response time, docs/model.md §19), read against the grid walks' own run-up stances
-/// ([`ModelGrid::run_up_mean`]). No swing has come before it, so the torques are raw: each
-/// leg's unknown sensor offset (SD `offset_sd_n_m`) is integrated out, the tripod's mean
-/// offset shifting every bin alike (a covariance `offset_sd^2 / n` common to the bins). The
-/// simulated scatter is the steady stances' (one run-up per walk shows none of its own).
-/// `None` when the grid has no run-up or a bin is empty.
-pub fn infer_from_run_up(
-    robot: &Robot,
-    grid: &ModelGrid,
-    profile: &[Option<f64>],
-    counts: &[usize],
-    noise_sd_n_m: f64,
-    offset_sd_n_m: f64,
-) -> Option<CurrentInference> {
-    let b = grid.bins;
-    if grid.run_up_mean.len() != grid.k_s.len() {
-        return None;
-    }
-    let mut mean = vec![0.0; 2 * b];
-    let mut var = vec![0.0; 2 * b];
-    for i in 0..b {
-        let (v, c) = (profile.get(i).copied().flatten()?, counts.get(i).copied().unwrap_or(0));
-        if c == 0 {
-            return None;
-        }
-        mean[i] = v;
-        var[i] = stance_bin_variance(robot, noise_sd_n_m, grid.run_up_within_var.get(i).copied(), c);
-    }
-    let pad = |m: &Vec<f64>| m.iter().copied().chain(std::iter::repeat(0.0)).take(2 * b).collect();
-    let g = ModelGrid { strides: 1, mean: grid.run_up_mean.iter().map(pad).collect(), ..grid.clone() };
-    let common = offset_sd_n_m * offset_sd_n_m / f64::from(robot.stance_legs());
-    let used: Vec<usize> = (0..b).collect();
-    let mut answer = posterior_answer_common(robot, &g, &mean, &var, &used, 1, common);
     answer.strides = 1;
     Some(answer)
 }
@@ -704,16 +628,12 @@ fn posterior_answer_common(
     // neighbouring grid points, bin by bin, over the points whose walk a servo could report.
     // At the stiff end of the grid (k_s >= 1.5e7 N/m^3 at 15 deg on the paper's robot) a few
     // simulated walks spike to tens of N m in one tripod's bins (stride-to-stride SD up to
-    // 13 N m, 2026-11-28), beyond the XL330's stall torque, which no current can read; their
+    // 13 N m, 2026-11-28), beyond the servo's stall torque, which no current can read; their
     // jumps made the mean square 1e6 times the rest's for that tripod and flattened every
     // stance of it (tripod 1's live estimates spanned the prior). They keep their own scatter
     // in `grid.sd`.
-    let reportable = |i: usize| {
-        grid.mean[i]
-            .iter()
-            .zip(&grid.sd[i])
-            .all(|(m, sd)| m.abs() + sd <= crate::servo::ServoModel::XL330_M288.stall_torque_n_m)
-    };
+    let reportable =
+        |i: usize| grid.mean[i].iter().zip(&grid.sd[i]).all(|(m, sd)| m.abs() + sd <= grid.stall_torque_n_m);
     let model_var: Vec<f64> = (0..mean.len())
         .map(|b| {
             let d: Vec<f64> = (1..n)
@@ -835,6 +755,80 @@ pub(crate) fn quantile(x: &[f64], p: &[f64], level: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::robot::RobotSpec;
+
+    /// The resolution term leaves out grid points a servo could not report, by the run's
+    /// servo model. Three points, one bin, profiles 0.1, 0.2 and 1.0 N m, a stance reading 0.2
+    /// with no noise: on the XL330-M288 (stall 0.52 N m) only the step 0.1 -> 0.2 counts, the
+    /// resolution variance is 0.01 and with the floor's 0.002^2 v = 0.010004; the weights
+    /// exp(-r^2 / 2v) are 0.6067, 1 and 1.3e-14, so the middle point has 1 / 1.6067 = 0.6224.
+    /// On the XM430-W350 (stall 4.1 N m) both steps count: v = (0.01 + 0.64) / 2 + 4e-6 =
+    /// 0.325004, weights 0.98473, 1 and 0.37360, the middle point 1 / 2.35833 = 0.42403.
+    #[test]
+    fn the_reportable_torque_is_the_servo_models_by_hand() {
+        let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
+        let grid = |servo: &'static ServoModel| ModelGrid {
+            slope_deg: 20.0,
+            k_n: 7e5,
+            k_s: vec![1e5, 2e5, 4e5],
+            mean: vec![vec![0.1, 0.0], vec![0.2, 0.0], vec![1.0, 0.0]],
+            sd: vec![vec![0.0; 2]; 3],
+            strides: 1,
+            regime: vec![Regime::Success; 3],
+            shear_load_n: vec![0.0; 3],
+            speed_m_s: vec![0.1; 3],
+            bins: 1,
+            swing_offset: false,
+            run_up_mean: vec![],
+            within_var: vec![0.0; 2],
+            run_up_within_var: vec![0.0; 1],
+            stall_torque_n_m: servo.stall_torque_n_m,
+        };
+        let p =
+            |servo| posterior_answer(&robot, &grid(servo), &[0.2, 0.0], &[0.0, 0.0], &[0], 1).posterior[1].1;
+        assert!((p(&ServoModel::XL330_M288) - 0.6224).abs() < 1e-4, "{}", p(&ServoModel::XL330_M288));
+        assert!((p(&ServoModel::XM430_W350) - 0.42403).abs() < 1e-4, "{}", p(&ServoModel::XM430_W350));
+    }
+
+    /// A stance's shift common to every bin (an unknown sensor offset) integrated out, by
+    /// hand: two grid points 0.01 N m apart in both of two bins, a reading on the first; each
+    /// bin's v is the resolution term 0.01^2 plus the floor 0.002^2, 1.04e-4. Independent bins
+    /// put the second point at ln(w1 / w0) = -0.5 x 2 x 0.01^2 / v; a common variance c adds
+    /// 0.5 c (sum r/v)^2 / (1 + c sum 1/v) there (the log-determinant term is the same at both
+    /// points): a shift that explains the residuals costs little.
+    #[test]
+    fn a_common_offset_is_integrated_out_by_hand() {
+        let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
+        let grid = ModelGrid {
+            slope_deg: 20.0,
+            k_n: 7e5,
+            k_s: vec![1e5, 2e5],
+            mean: vec![vec![0.11, 0.21], vec![0.1, 0.2]],
+            sd: vec![vec![0.0; 2]; 2],
+            strides: 1,
+            regime: vec![Regime::Success; 2],
+            shear_load_n: vec![0.0; 2],
+            speed_m_s: vec![0.1; 2],
+            bins: 2,
+            swing_offset: false,
+            run_up_mean: vec![],
+            within_var: vec![0.0; 2],
+            run_up_within_var: vec![0.0; 2],
+            stall_torque_n_m: 100.0,
+        };
+        let v: f64 = 1.04e-4;
+        let l = |c: f64| {
+            let a = posterior_answer_common(&robot, &grid, &[0.11, 0.21], &[0.0, 0.0], &[0, 1], 1, c);
+            (a.posterior[1].1 / a.posterior[0].1).ln()
+        };
+        let independent = -0.5 * (0.01f64.powi(2) / v) * 2.0;
+        assert!((l(0.0) - independent).abs() < 1e-9, "{} {independent}", l(0.0));
+        let (sr, si) = (2.0 * 0.01 / v, 2.0 / v);
+        let c = 1e-4;
+        let shift = 0.5 * c * sr * sr / (1.0 + c * si);
+        // ln(1 + c sum 1/v) is the same at both points: only the quadratic form differs.
+        assert!((l(c) - (independent + shift)).abs() < 1e-9, "{} {}", l(c), independent + shift);
+        assert!(l(c) > l(0.0));
+    }
 
     #[test]
     fn quantiles_of_a_flat_distribution_by_hand() {

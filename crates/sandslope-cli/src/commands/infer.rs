@@ -59,7 +59,7 @@ fn run_servo_log(args: &InferArgs, question: &ServoLogQuestion) -> Result<()> {
     let servo = sandslope_io::robot_terrain::load_servos(&args.robot.robot)?
         .and_then(|s| s.model)
         .unwrap_or(&sandslope::servo::ServoModel::XL330_M288);
-    let run = if sandslope_io::bag::is_bag(path) {
+    let mut run = if sandslope_io::bag::is_bag(path) {
         // A ROS 2 bag's joint states, read as the servo log's leg angles and torques.
         let options = sandslope_io::bag::series::JointOptions {
             topic: topic.as_deref(),
@@ -80,6 +80,8 @@ fn run_servo_log(args: &InferArgs, question: &ServoLogQuestion) -> Result<()> {
         }
         request.read(&robot, Words::Flag)?
     };
+    // The grid's reportable torque is the same servo's.
+    run.settings.servo = servo;
     let terrain = args.terrain.load()?;
     for note in &run.notes {
         eprintln!("note: {}: {note}", path.display());

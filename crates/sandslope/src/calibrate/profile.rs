@@ -31,32 +31,6 @@ fn profile_at(problem: &Problem, target: Profiled, q: f64, from: &[f64]) -> (Vec
     }
 }
 
-/// [`profile_at`] from `from`, and with the simulator, where that lands outside the interval
-/// (the profile 1 or more above the minimum `s_min`), again from the best point `best`, the
-/// lower of the two: the profile is a minimum over the other quantities, and the simulator's
-/// objective has basins (the legs holding, the legs sinking), so a warm start near the
-/// interval's end can settle in the higher one; a point is called outside only when neither
-/// start finds it inside (docs/calibration.md).
-fn profile_checked(
-    problem: &Problem,
-    target: Profiled,
-    q: f64,
-    from: &[f64],
-    best: &[f64],
-    s_min: f64,
-) -> (Vec<f64>, f64) {
-    let (x, s) = profile_at(problem, target, q, from);
-    if problem.simulator.is_none() || s - s_min < 1.0 || from == best {
-        return (x, s);
-    }
-    let (x2, s2) = profile_at(problem, target, q, best);
-    if s2 < s {
-        (x2, s2)
-    } else {
-        (x, s)
-    }
-}
-
 /// Where a walk starts, where it must stop, its first step and its direction (+1 or -1).
 #[derive(Clone, Copy)]
 struct Walk {
@@ -87,14 +61,14 @@ fn interval_end(problem: &Problem, target: Profiled, best: &[f64], s_min: f64, w
         if at_limit {
             q = limit;
         }
-        let (x, s) = profile_checked(problem, target, q, &x_in, best, s_min);
+        let (x, s) = profile_at(problem, target, q, &x_in);
         if s - s_min >= 1.0 {
             profiled.push((q, x, s));
             // With the simulator, a point is warm-started from the nearest point inside the
             // interval (profile below +1), so the bracket follows the profile's branch from the
-            // best value: a point outside may sit in another basin (the legs sinking), whose
-            // minimum is higher, and a start there put k_s(20)/k_s(0)'s upper end at 0.49 where
-            // the profile from inside is 0.54 above the minimum (docs/calibration.md).
+            // best value rather than a point outside, which may sit in another basin (the legs
+            // sinking). It is not enough on its own: k_s(20)/k_s(0)'s upper end still lands at
+            // 0.49 where the profile is 0.54 above the minimum (docs/calibration.md).
             let inside_only = problem.simulator.is_some();
             let f = |q: f64| {
                 if let Some(p) = profiled.iter().find(|p| p.0 == q) {
@@ -105,8 +79,7 @@ fn interval_end(problem: &Problem, target: Profiled, best: &[f64], s_min: f64, w
                     .filter(|p| !inside_only || p.2 - s_min < 1.0)
                     .min_by(|a, b| (a.0 - q).abs().total_cmp(&(b.0 - q).abs()))
                     .map(|p| p.1.clone());
-                let from = nearest.as_deref().unwrap_or(&x_in);
-                let (x, s) = profile_checked(problem, target, q, from, best, s_min);
+                let (x, s) = profile_at(problem, target, q, nearest.as_deref().unwrap_or(&x_in));
                 profiled.push((q, x, s));
                 s - s_min - 1.0
             };

@@ -88,6 +88,10 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for LeastSquares<'_, '_> {
 /// smooth in k_s (docs/calibration.md).
 pub(crate) const WALK_LN_K_S_STEP: f64 = 2e-3;
 
+/// One Jacobian column's central difference: its half distance `h` in the unbounded
+/// coordinate, and at each of its two points the values and every walk's change in `ln k_s`.
+type Column = (f64, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
+
 impl LeastSquares<'_, '_> {
     /// The two points of column `c`'s central difference and their half distance.
     fn column_points(&self, c: usize) -> (DVector<f64>, DVector<f64>, f64) {
@@ -118,7 +122,7 @@ impl LeastSquares<'_, '_> {
             let g = problem.grounds(&problem.candidate(x));
             g.iter().zip(&g0).map(|(g, g0)| (g.2 / g0.2).ln()).collect()
         };
-        let columns: Vec<(f64, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> = (0..self.free.len())
+        let columns: Vec<Column> = (0..self.free.len())
             .map(|c| {
                 let (up, down, h) = self.column_points(c);
                 let (xu, xd) = (self.values_at(&up), self.values_at(&down));

@@ -3,6 +3,7 @@
 simulator in place of the closed form"), and compares the fits of two builds.
 
 Usage: python3 bench/calibrate/simulate_fit.py EXE [EXE2] [--threads N] [--json-out FILE]
+       [--before-json FILE]
 
 Runs, from the repository root, the command the page names,
 
@@ -15,7 +16,8 @@ parallelism CPU / wall, the 1-minute load average before and after (other users 
 slow the wall time, not the CPU time), the walks run, and the fit: every fitted value with its
 68% interval, k_s(20)/k_s(0), chi^2, the floor and the pulls. With two binaries it prints them
 side by side with each pair's relative difference and whether the two agree to 2 significant
-digits. `--threads N` sets RAYON_NUM_THREADS (default: rayon's own, one per core).
+digits; `--before-json FILE` (a `--json-out` of an earlier run) stands for a first binary run
+before, so one build is compared with a fit already timed. `--threads N` sets RAYON_NUM_THREADS (default: rayon's own, one per core).
 """
 
 import argparse
@@ -101,11 +103,18 @@ def main():
     ap.add_argument("exe", nargs="+")
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--json-out")
+    ap.add_argument("--before-json")
     a = ap.parse_args()
-    if len(a.exe) > 2:
-        raise SystemExit("at most two binaries")
-    runs = [run(exe, a.threads) for exe in a.exe]
+    if len(a.exe) + bool(a.before_json) > 2:
+        raise SystemExit("at most two fits: two binaries, or --before-json and one binary")
+    runs = []
+    if a.before_json:
+        with open(a.before_json) as f:
+            runs.append(json.load(f)[0])
+    runs += [run(exe, a.threads) for exe in a.exe]
     for r in runs:
+        if r is runs[0] and a.before_json:
+            print(f"(from {a.before_json})", end=" ")
         print(
             f"{r['exe']}: wall {r['wall_s']:.1f} s, CPU {r['cpu_s']:.1f} s, parallelism "
             f"{r['parallelism']:.2f}, load {r['load_before']:.1f} -> {r['load_after']:.1f}, "

@@ -89,6 +89,9 @@ pub fn calibrate_jointly_cancellable(
     fit(setup, model, Some(cancel))
 }
 
+/// A search's answer: the values at its minimum and their `-2 ln L`.
+type Fit = (Vec<f64>, f64);
+
 fn fit(
     setup: &JointSetup,
     model: SpeedModel,
@@ -127,7 +130,7 @@ fn fit(
     // Every start's search (and the simulator's scan, then a search from its best point) in
     // parallel (rayon); the best is picked in the same order as one after another, so the
     // answer is the same.
-    let (mut fits, scanned): (Vec<(Vec<f64>, f64)>, Option<(Vec<f64>, f64)>) = rayon::join(
+    let (mut fits, scanned): (Vec<Fit>, Option<Fit>) = rayon::join(
         || starts.par_iter().map(|s| minimise(&problem, s, &[], None)).collect(),
         || {
             let scanned = problem.simulator.as_ref().and_then(|_| scanned_start(&problem, &start));

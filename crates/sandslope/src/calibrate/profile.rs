@@ -66,9 +66,9 @@ fn interval_end(problem: &Problem, target: Profiled, best: &[f64], s_min: f64, w
             profiled.push((q, x, s));
             // With the simulator, a point is warm-started from the nearest point inside the
             // interval (profile below +1), so the bracket follows the profile's branch from the
-            // best value: a point outside may sit in another basin (the legs sinking), whose
-            // minimum is higher, and a start there put k_s(20)/k_s(0)'s upper end at 0.49 where
-            // the profile from inside is 0.54 above the minimum (docs/calibration.md).
+            // best value rather than a point outside, which may sit in another basin (the legs
+            // sinking). It is not enough on its own: k_s(20)/k_s(0)'s upper end still lands at
+            // 0.49 where the profile is 0.54 above the minimum (docs/calibration.md).
             let inside_only = problem.simulator.is_some();
             let f = |q: f64| {
                 if let Some(p) = profiled.iter().find(|p| p.0 == q) {
@@ -174,7 +174,7 @@ pub(crate) fn ratio_interval(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::calibrate::problem::build;
     use crate::calibrate::{FreeParameter, JointSetup, Parameter, ShearShape, SpeedModel, SpeedObservation};
@@ -184,7 +184,7 @@ mod tests {
 
     /// The paper's evidence as `calibrate --observed data/paper-speeds.csv --forces
     /// data/example-force-tests.toml --free plate_scale,error_floor` reads it.
-    fn paper_setup() -> JointSetup {
+    pub(crate) fn paper_setup() -> JointSetup {
         let p = |slope_deg, k_s, k_s_sd| TerrainPoint {
             slope_deg,
             k_n: 7e5,

@@ -32,6 +32,7 @@ pub mod report;
 pub mod risk;
 pub mod scenario;
 pub mod simulate;
+mod simulate_spread;
 pub mod sweep;
 pub mod track;
 

@@ -766,10 +766,16 @@ mod tests {
     }
 
     /// `ensemble`: one slope, 2 to 1000 walks, and it multiplies what the walks cost (the
-    /// server weighs that against its step limit).
+    /// server weighs that against its step limit; one walk without its scaling spread, which an
+    /// ensemble does not walk).
     #[test]
     fn an_ensemble_walks_one_slope_and_costs_n_walks() {
-        let one = SimulateRequest::from_params(&params(&[("slope", "10"), ("duration", "2")])).unwrap();
+        let one = SimulateRequest::from_params(&params(&[
+            ("slope", "10"),
+            ("duration", "2"),
+            ("scaling-spread", "off"),
+        ]))
+        .unwrap();
         let three =
             SimulateRequest::from_params(&params(&[("slope", "10"), ("duration", "2"), ("ensemble", "3")]))
                 .unwrap();

@@ -334,10 +334,7 @@ impl SimulateRequest {
         let settings = SettingsRequest::read(&mut p, Words::Flag)?;
         let ensemble = ENSEMBLE.number_in(&mut p)?.map(|n| ensemble_size(n, &slopes)).transpose()?;
         let check_convergence = CHECK_CONVERGENCE.switch_in(&mut p)?;
-        let scaling_spread = match SCALING_SPREAD.choice_in(&mut p)? {
-            None => None,
-            Some(on) => Some(on == "on"),
-        };
+        let scaling_spread = SCALING_SPREAD.choice_in(&mut p)?.map(|on| on == "on");
         if scaling_spread == Some(true) && (ensemble.is_some() || check_convergence) {
             return Err(RequestError::invalid(
                 SCALING_SPREAD.flag,

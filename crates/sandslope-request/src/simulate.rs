@@ -236,7 +236,7 @@ pub struct SimulateRequest {
     pub scenario: ScenarioRequest,
     /// Simulated time after settling, s (field `duration`, default 10).
     pub duration_s: f64,
-    /// Time step, s (field `dt`; default T / 2000, docs/model.md §17).
+    /// Time step, s (field `dt`; default T / 2000 pitch locked, T / 8000 free; docs/model.md §17).
     pub dt_s: Option<f64>,
     /// Creep speed of the contact law's smoothing at rest, m/s (field `creep`; default 1e-7).
     pub creep_m_s: Option<f64>,
@@ -437,7 +437,7 @@ impl SimulateRequest {
 pub struct SettingsRequest {
     /// Simulated time after settling, s (field `duration`).
     pub duration_s: f64,
-    /// Time step, s (field `dt`; default T / 2000).
+    /// Time step, s (field `dt`; default T / 2000 pitch locked, T / 8000 free).
     pub dt_s: Option<f64>,
     /// Creep speed of the contact law's smoothing at rest, m/s (field `creep`).
     pub creep_m_s: Option<f64>,

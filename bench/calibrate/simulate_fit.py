@@ -7,7 +7,7 @@ Usage: python3 bench/calibrate/simulate_fit.py EXE [EXE2] [--threads N] [--json-
 Runs, from the repository root, the command the page names,
 
     EXE calibrate --observed data/paper-speeds.csv --forces data/example-force-tests.toml \
-        --free plate_scale,error_floor --model simulate --json
+        --free plate_scale,error_floor --model simulate --json --out TMP/terrain.toml
 
 once per binary (one after the other, the second build second), and prints for each: wall
 time, CPU time (user + system of the process and its threads, from `os.wait4`), the achieved
@@ -46,9 +46,10 @@ def run(exe, threads):
     if threads:
         env["RAYON_NUM_THREADS"] = str(threads)
     load0 = os.getloadavg()[0]
-    with tempfile.TemporaryFile() as out:
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryDirectory() as tmp:
+        terrain = os.path.join(tmp, "terrain.toml")
         t0 = time.perf_counter()
-        p = subprocess.Popen([exe, *ARGS], stdout=out, stderr=subprocess.DEVNULL, env=env)
+        p = subprocess.Popen([exe, *ARGS, "--out", terrain], stdout=out, stderr=subprocess.DEVNULL, env=env)
         _, status, usage = os.wait4(p.pid, 0)
         wall = time.perf_counter() - t0
         if status != 0:

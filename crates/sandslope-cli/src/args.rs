@@ -7,9 +7,8 @@ use clap::Args;
 use sandslope::{LevelStep, Robot, Terrain};
 use sandslope_request::field::{Field, Fields, Kind};
 use sandslope_request::scenario::{K_N, K_S, LEVEL_STEP, ROBOT, TERRAIN};
-use sandslope_request::{grammar, RobotRequest, ScenarioRequest};
+use sandslope_request::{RobotRequest, ScenarioRequest};
 
-use sandslope::risk::UncertainTerrain;
 use sandslope::robot_key::RobotKey;
 use sandslope_io::load_terrain;
 
@@ -66,30 +65,6 @@ impl TerrainArgs {
     /// Loads the terrain.
     pub fn load(&self) -> Result<Terrain> {
         load_terrain(&self.terrain)
-    }
-}
-
-/// `--cv-n` and `--cv-s`: the terrain's uncertainty by the one rule of docs/model.md §9 (a
-/// given CV, else the table's SD over its value, else 0.1 / 0.2), shared by `risk`, `design`
-/// and `infer` so that the flags read, check and report the same everywhere.
-#[derive(Debug, Clone, Copy, Args)]
-pub struct UncertaintyArgs {
-    /// Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's
-    /// k_n_sd; without either, 0.1 (docs/model.md §9).
-    #[arg(long = "cv-n", allow_negative_numbers = true, value_name = "CV")]
-    pub cv_n: Option<f64>,
-    /// Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's
-    /// k_s_sd; without either, 0.2 (docs/model.md §9).
-    #[arg(long = "cv-s", allow_negative_numbers = true, value_name = "CV")]
-    pub cv_s: Option<f64>,
-}
-
-impl UncertaintyArgs {
-    /// The terrain read as uncertain (a flag's CV, else the table's SDs, else the default CV),
-    /// with the note to print when a default is used anywhere on the table. Errors name the
-    /// flag: `--cv-n = -1 must be a finite number of at least 0`.
-    pub fn apply(&self, terrain: Terrain) -> Result<(UncertainTerrain, Option<String>)> {
-        Ok(grammar::uncertain_terrain(terrain, self.cv_n, self.cv_s)?)
     }
 }
 
@@ -223,13 +198,14 @@ pub fn field_arg(f: &'static Field) -> clap::Arg {
         clap::Arg::new(f.flag).long(f.flag).help(f.help).conflicts_with_all(f.conflicts).required(f.required);
     match f.kind {
         Kind::Switch => arg.action(clap::ArgAction::SetTrue),
+        Kind::List => arg.action(clap::ArgAction::Append).value_name(f.value_name),
         kind => {
             let arg = arg.action(clap::ArgAction::Set).value_name(f.value_name).default_value(f.default);
             match kind {
                 Kind::Choice(words) => arg.value_parser(clap::builder::PossibleValuesParser::new(words)),
                 // A number, or a list or axis of numbers in a unit, may start with a minus (the
                 // request then names what is wrong with it).
-                Kind::Number => arg.allow_negative_numbers(true),
+                Kind::Number | Kind::Whole => arg.allow_negative_numbers(true),
                 Kind::Text if !f.unit.is_empty() => arg.allow_hyphen_values(true),
                 _ => arg,
             }
@@ -264,6 +240,11 @@ impl<T: Fields> clap::FromArgMatches for FieldArgs<T> {
             }
             let text = match f.kind {
                 Kind::Switch => "true".to_string(),
+                // Given more than once: one comma list, as HTTP and Python write it.
+                Kind::List => matches
+                    .get_many::<String>(f.flag)
+                    .map(|v| v.map(String::as_str).collect::<Vec<_>>().join(","))
+                    .unwrap_or_default(),
                 _ => matches.get_one::<String>(f.flag).cloned().unwrap_or_default(),
             };
             self.pairs.retain(|(k, _)| k != f.flag);
@@ -282,17 +263,16 @@ pub fn warn_extrapolated(terrain: &Terrain, slopes: &[f64]) {
 
 pub use sandslope_request::scenario::beyond_last_point;
 
-pub use sandslope_request::grammar::{parse_max_risk, SlopeSign};
-
-/// Parses a slope list given to `flag`: the one slope-list grammar of every front end
-/// ([`grammar::parse_slope_list`]: `DEG`, `DEG,DEG,...` or `MIN:MAX:N`, at most `max`).
-pub fn parse_slope_list(flag: &str, text: &str, sign: SlopeSign, max: usize) -> Result<Vec<f64>> {
-    Ok(grammar::parse_slope_list(flag.trim_start_matches('-'), text, sign, max)?)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sandslope_request::grammar::{self, parse_max_risk, SlopeSign};
+
+    /// A slope list given to `flag`: the one slope-list grammar of every front end
+    /// ([`grammar::parse_slope_list`]: `DEG`, `DEG,DEG,...` or `MIN:MAX:N`, at most `max`).
+    fn parse_slope_list(flag: &str, text: &str, sign: SlopeSign, max: usize) -> Result<Vec<f64>> {
+        Ok(grammar::parse_slope_list(flag.trim_start_matches('-'), text, sign, max)?)
+    }
 
     /// One grammar for every slope list: N is refused before any expansion (an N of 1e11
     /// would have asked for 800 GB), each slope by the library's rule, named by its flag.

@@ -1,27 +1,13 @@
 //! Motion-capture input shared by `sandslope track` and `sandslope report --tracks`: the
-//! parsers of the format and upslope flags, the expansion of file arguments (paths or glob
-//! patterns), and the warnings around the request layer's one path from capture files to the
-//! library (`sandslope_request::track`, which Python takes too). Commands share
-//! this code through this module, never through each other.
+//! expansion of file arguments (paths or glob patterns) and the warnings around the request
+//! layer's one path from capture files to the library (`sandslope_request::track`, which Python
+//! takes too). Commands share this code through this module, never through each other.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
 
 use sandslope::gait::{GaitOptions, TrackResult};
-use sandslope_io::mocap::MocapFormat;
-
-/// Parses a motion-capture format flag (`motive`, `vicon` or `plain`).
-pub fn parse_mocap_format(s: &str) -> Result<MocapFormat, String> {
-    s.parse()
-}
-
-/// Parses an upslope flag: `+x`, `-x`, `+y`, `-y`, `+z`, `-z` (or `x`, `y`, `z`) or a vector
-/// `x,y,z`, as given; `flag` names the flag in the message when the vector is zero or not
-/// finite (the request layer's grammar, [`sandslope_request::track::parse_upslope`]).
-pub fn parse_upslope(s: &str, flag: &str) -> Result<[f64; 3], String> {
-    sandslope_request::track::parse_upslope(s, flag)
-}
 
 /// Expands file arguments: existing paths as they are, anything else as a glob pattern whose
 /// matching files are taken in sorted order; a pattern matching no file is an error.

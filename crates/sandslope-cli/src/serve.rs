@@ -11,6 +11,7 @@ use sandslope_servo::session::DriveConfig;
 
 use crate::commands::drive::{BusFlag, DriveRunArgs};
 
+use sandslope_request::plan::DEM;
 use sandslope_request::scenario::{ROBOT, TERRAIN};
 use sandslope_serve::ServeConfig;
 
@@ -19,7 +20,7 @@ use sandslope_serve::ServeConfig;
 pub struct ServeArgs {
     /// Elevation model the Routes tab and `/api/plan` plan on (GeoTIFF or ESRI ASCII grid);
     /// the only file the server reads after starting. Without it, the Routes tab is off.
-    #[arg(long, value_name = "FILE")]
+    #[arg(long = DEM.flag, value_name = DEM.value_name)]
     pub dem: Option<PathBuf>,
     /// Robot the page starts with and API requests use when they name none: a TOML file or a
     /// built-in preset. Requests may name built-in presets only.

@@ -231,10 +231,7 @@ fn infer_servo_log_recovers_the_emulated_k_s() {
     let truth = 2.5e5;
     let logs = emulated_logs();
     let _cpu = cpu_bound();
-    let walked = bin()
-        .args(["simulate", "--slope", "20", "--k-s", "2.5e5", "--two-faced-belly", "--json"])
-        .output()
-        .unwrap();
+    let walked = bin().args(["simulate", "--slope", "20", "--k-s", "2.5e5", "--json"]).output().unwrap();
     assert!(walked.status.success(), "{}", text(&walked));
     let walked: serde_json::Value = serde_json::from_slice(&walked.stdout).unwrap();
     let true_speed = walked["speed_m_s"].as_f64().unwrap();

@@ -351,12 +351,21 @@ fn sighup_turns_the_torque_off_before_the_server_exits() {
 }
 
 /// A servo that stops answering mid-run: the run fails naming it, the torque goes off on the
-/// others, and the server goes on serving the run's end.
+/// others, and the server goes on serving the run's end. On the emulator's virtual clock
+/// (`--emulate-clock virtual`, docs/drive.md): nothing here watches the run as it goes.
 #[test]
 fn a_lost_servo_is_named_and_the_others_are_turned_off() {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let server =
-        Server::start(&["--duration", "30", "--emulate-fault", "silent:3:1.5", "--bus-watchdog", "0.1"]);
+    let server = Server::start(&[
+        "--duration",
+        "30",
+        "--emulate-fault",
+        "silent:3:1.5",
+        "--bus-watchdog",
+        "0.1",
+        "--emulate-clock",
+        "virtual",
+    ]);
     let (end, _) = server.wait_for(Duration::from_secs(120), |s| s["state"] == "failed");
     let error = end["error"].as_str().unwrap();
     assert!(error.contains("servo ID 3 (leg 2) stopped answering"), "{error}");

@@ -74,10 +74,10 @@ pub fn write_nav2_map(yaml: &Path, dem: &Raster, p_fail: &[f32]) -> Result<()> {
     let text = format!(
         "# Nav2 map_server map from `sandslope plan --risk-map` (docs/bags.md): each pixel is the cell's\n\
          # best-heading failure probability in percent (mode raw; 255: no value). occupied_thresh is\n\
-         # docs/model.md \u{a7}9's acceptable failure probability (0.05); raw mode does not use the thresholds.\n\
+         # docs/model.md \u{a7}9's acceptable failure probability ({max_risk}); raw mode does not use the thresholds.\n\
          image: {image}\nmode: raw\nresolution: {resolution}\norigin: [{west}, {south}, 0.0]\nnegate: 0\n\
-         occupied_thresh: {}\nfree_thresh: 0.0\n",
-        sandslope::risk::DEFAULT_MAX_RISK
+         occupied_thresh: {max_risk}\nfree_thresh: 0.0\n",
+        max_risk = sandslope::risk::DEFAULT_MAX_RISK
     );
     write_output(&pgm, |out| {
         out.write_all(&bytes).map_err(|source| WriteError { path: pgm.clone(), source }.into())

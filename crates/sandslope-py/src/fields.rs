@@ -25,7 +25,7 @@ fn tables(command: &str) -> PyResult<Vec<Table>> {
     })
 }
 
-/// The name of a field's parser: `"number"`, `"whole"`, `"text"`, `"switch"` or `"choice"`.
+/// The name of a field's parser: `"number"`, `"whole"`, `"text"`, `"switch"`, `"choice"` or `"list"`.
 fn kind_name(kind: Kind) -> &'static str {
     match kind {
         Kind::Number => "number",
@@ -33,6 +33,7 @@ fn kind_name(kind: Kind) -> &'static str {
         Kind::Text => "text",
         Kind::Switch => "switch",
         Kind::Choice(_) => "choice",
+        Kind::List => "list",
     }
 }
 

@@ -18,6 +18,15 @@ use crate::interrupt::interruptibly;
 use crate::types::{PyRobot, PyTerrain};
 use crate::{anyhow_error, value_error};
 
+/// `descent`'s default, the field table's ([`sandslope_request::plan::DESCENT`]; its other
+/// keywords, `max_roll_deg`, `time_weight`, `allow_metastable`, `cv_n`, `cv_s` and
+/// `objectives`, are the table's too: `crates/sandslope-request/tests/fields.rs` checks the
+/// signatures and the stub against it).
+const DESCENT_DEFAULT: &str = match sandslope_request::plan::DESCENT.default {
+    Some(d) => d,
+    None => panic!("--descent has a default"),
+};
+
 /// The values of a 2-D array row-major, borrowed when it is contiguous, and its shape.
 fn row_major<'a>(a: &'a PyReadonlyArray2<'_, f64>) -> (Cow<'a, [f64]>, (usize, usize)) {
     let a = a.as_array();
@@ -33,7 +42,7 @@ fn row_major<'a>(a: &'a PyReadonlyArray2<'_, f64>) -> (Cow<'a, [f64]>, (usize, u
 /// float32 values, band after band (the request layer's [`GridRequest::risk_raster`], the DEM
 /// row 0 = north, NaN or `nodata` = missing heights, used as float32 like the CLI).
 #[pyfunction]
-#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, nodata=None, cv_n=None, cv_s=None, max_roll_deg=sandslope::plan::DEFAULT_MAX_ROLL_DEG, descent="symmetric", allow_metastable=false, row_widths_m=None))]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, nodata=None, cv_n=None, cv_s=None, max_roll_deg=sandslope::plan::DEFAULT_MAX_ROLL_DEG, descent=DESCENT_DEFAULT, allow_metastable=false, row_widths_m=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn risk_raster<'py>(
     py: Python<'py>,
@@ -77,7 +86,7 @@ pub fn risk_raster<'py>(
 /// route as `plan --json` prints it (`RouteRecord`: every figure, null where no route exists)
 /// with a found route's cells, coordinates, heights and steps as arrays.
 #[pyfunction]
-#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=sandslope::plan::DEFAULT_MAX_ROLL_DEG, descent="symmetric", allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT, classes=None, class_terrains=None, row_widths_m=None))]
+#[pyo3(signature = (dem, cell_x, cell_y, robot, terrain, start, goal, objectives, origin, nodata=None, cv_n=None, cv_s=None, max_roll_deg=sandslope::plan::DEFAULT_MAX_ROLL_DEG, descent=DESCENT_DEFAULT, allow_metastable=false, time_weight=sandslope::plan::DEFAULT_TIME_WEIGHT, classes=None, class_terrains=None, row_widths_m=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan<'py>(
     py: Python<'py>,

@@ -10,12 +10,12 @@ use pythonize::pythonize;
 
 use sandslope::infer::servo::{infer_servo_log as infer, CurrentInferenceSettings, LegTrace};
 use sandslope_io::servo_log::ServoLogRow;
-use sandslope_request::drive::DriveRun;
+use sandslope_request::drive::{DriveRun, RunDefaults};
 use sandslope_request::error::Words;
 use sandslope_request::infer::{prior_in, servo_grid_points, ServoLogRequest};
 use sandslope_servo::driver::ServoSample;
 use sandslope_servo::session::{
-    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, RUN_DEFAULTS,
+    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, STAND_S,
 };
 use sandslope_servo::{DriveSettings, EmulatorFaults, Profile};
 
@@ -134,11 +134,17 @@ pub fn infer_servo_log_file<'py>(
     Ok((pythonize(py, &answer).map_err(value_error)?, run.notes))
 }
 
-/// `drive`'s defaults (`sandslope_servo::session::RUN_DEFAULTS`), as a dict: what
-/// `sandslope.drive` uses for an argument left out, and `sandslope drive --help` shows.
+/// `drive`'s defaults, the drive table's ([`RunDefaults`]), with the servo crate's time to
+/// stand up.
+fn run_defaults() -> PyResult<RunDefaults> {
+    RunDefaults::read(STAND_S).map_err(|e| value_error(e.message()))
+}
+
+/// `drive`'s defaults ([`RunDefaults`], the drive table's), as a dict: what `sandslope.drive`
+/// uses for an argument left out, and `sandslope drive --help` shows.
 #[pyfunction]
 pub fn drive_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
-    pythonize(py, &RUN_DEFAULTS).map_err(value_error)
+    pythonize(py, &run_defaults()?).map_err(value_error)
 }
 
 /// A run of `drive --emulate` with `drive`'s defaults (position profile, 1470 mA, 65 degC,
@@ -168,8 +174,8 @@ pub fn drive<'py>(
     if window == Some(0) {
         return Err(value_error("window = 0 must be at least 1 stance (None pools every stance)"));
     }
-    // `drive`'s defaults, from the one typed set its flags take theirs from.
-    let d = RUN_DEFAULTS;
+    // `drive`'s defaults, the table its flags take theirs from.
+    let d = run_defaults()?;
     let slope_deg = slope_deg.unwrap_or(d.slope_deg);
     let duration_s = duration_s.unwrap_or(d.duration_s);
     let noise_ma = noise_ma.unwrap_or(d.emulate_noise_ma);

@@ -127,7 +127,7 @@ fn setup(
                 "true".to_string()
             }
             Kind::Number | Kind::Whole => format!("{}", number()?),
-            Kind::Text | Kind::Choice(_) => {
+            Kind::Text | Kind::Choice(_) | Kind::List => {
                 value.extract::<String>().map_err(|_| value_error(format!("{key} = {value} is not a str")))?
             }
         };

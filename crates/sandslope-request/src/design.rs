@@ -12,8 +12,35 @@ use sandslope::{AxisScale, Slope};
 use sandslope_io::presets::DEFAULT_TERRAIN;
 
 use crate::error::{RequestError, Result};
+use crate::field::{Field, Fields, Kind, Table};
 use crate::grammar::{self, AxisQuantity};
+use crate::params::Params;
+pub use crate::risk::{CV_N, CV_S};
 use crate::scenario::{load_terrain, RobotRequest};
+
+/// `--vary`: the robot keys to vary, each over a range or at one value.
+pub const VARY: Field = Field::new("vary", Kind::List, "KEY=MIN:MAX:N[:log],...").required().help(
+    "Robot keys to vary: KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE, comma-separated or repeated \
+     (e.g. leg_radius_m=0.03:0.06:7,mass_kg=0.3:1.5:9), spaced linearly unless :log (robot \
+     quantities; the strength axes of phase and risk are log unless :lin). Keys: the robot \
+     file's (docs/model.md §2)",
+);
+/// `--slope-target`: the mission's target slope.
+pub const SLOPE_TARGET: Field = Field::number("slope-target", "DEG")
+    .unit("deg")
+    .required()
+    .range("-90 to 90")
+    .help("The mission's target slope, degrees: speed, regime, p_fail and k_s margin are reported there");
+/// `--max-risk`: `risk`'s row (its default the library's), said of the safe-slope limit.
+pub const MAX_RISK: Field =
+    crate::risk::MAX_RISK.help("Largest acceptable failure probability, for the safe-slope limit");
+
+/// `design`'s own fields (the robot's and the terrain's are [`crate::scenario`]'s).
+pub const FIELDS: Table = Table { command: "design", fields: &[VARY, SLOPE_TARGET, CV_N, CV_S, MAX_RISK] };
+
+impl Fields for DesignRequest {
+    const TABLE: Table = FIELDS;
+}
 
 /// The inputs of `sandslope design`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -67,13 +94,13 @@ pub struct DesignInputs {
 /// range (the one axis grammar, [`grammar::parse_axis_range`], with the robot quantities' rule:
 /// linear unless `:log`).
 pub fn parse_vary_item(item: &str) -> Result<DesignRange> {
-    let bad = |message: String| RequestError::invalid("vary", message);
+    let bad = |message: String| RequestError::invalid(VARY.flag, message);
     let shape = || bad(format!("--vary: `{item}` must be KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE"));
     let (key, range) = item.split_once('=').ok_or_else(shape)?;
     let key = design_key(key.trim()).map_err(|e| bad(format!("--vary: {e}")))?;
     let (min, max, n, scale) = if range.contains(':') {
         let prefix = format!("--vary: {key}");
-        let r = grammar::parse_axis_range("vary", range, AxisQuantity::Robot, &prefix, item)?
+        let r = grammar::parse_axis_range(VARY.flag, range, AxisQuantity::Robot, &prefix, item)?
             .ok_or_else(shape)?;
         if r.n < 2 {
             return Err(bad(format!(
@@ -93,6 +120,32 @@ pub fn parse_vary_item(item: &str) -> Result<DesignRange> {
 }
 
 impl DesignRequest {
+    /// The command line's request: its own fields from `params` (the flags given, by
+    /// [`FIELDS`]: the one raw-to-typed step), the robot and the terrain already read from the
+    /// flags it shares with other commands; refuses any other key.
+    pub fn with_sources(
+        params: &[(String, String)],
+        robot: RobotRequest,
+        terrain: String,
+    ) -> Result<DesignRequest> {
+        let mut p = Params::new(FIELDS.command, params);
+        let vary = VARY.text_in(&mut p)?.map(|v| vec![v.to_string()]).unwrap_or_default();
+        if vary.is_empty() {
+            return Err(RequestError::invalid(
+                VARY.flag,
+                format!("{} is required: {}", VARY.long(), VARY.help),
+            ));
+        }
+        let slope_target = SLOPE_TARGET.required_number_in(&mut p)?;
+        let (cv_n, cv_s) = (CV_N.number_in(&mut p)?, CV_S.number_in(&mut p)?);
+        let text = MAX_RISK.text_in(&mut p)?.unwrap_or_default();
+        let max_risk = grammar::parse_max_risk(text).map_err(|why| {
+            RequestError::invalid(MAX_RISK.flag, format!("{} = {text}: {why}", MAX_RISK.long()))
+        })?;
+        p.finish()?;
+        Ok(DesignRequest { vary, slope_target, robot, terrain, cv_n, cv_s, max_risk })
+    }
+
     /// The request checked into the library's types: the robot read, every `vary` item
     /// parsed, the space, the goal and the uncertain terrain, in that order, errors naming
     /// their field.
@@ -105,11 +158,11 @@ impl DesignRequest {
             }
         }
         let space = DesignSpace::new(robot.spec().clone(), ranges)
-            .map_err(|e| RequestError::invalid("vary", format!("--vary: {e}")))?;
+            .map_err(|e| RequestError::invalid(VARY.flag, format!("{}: {e}", VARY.long())))?;
         let target = Slope::from_signed_degrees(self.slope_target)
-            .map_err(|e| RequestError::invalid("slope-target", e.renamed("--slope-target")))?;
+            .map_err(|e| RequestError::invalid(SLOPE_TARGET.flag, e.renamed(SLOPE_TARGET.long())))?;
         let goal = DesignGoal::new(self.max_risk, target)
-            .map_err(|e| RequestError::invalid("max-risk", format!("--max-risk: {e}")))?;
+            .map_err(|e| RequestError::invalid(MAX_RISK.flag, format!("{}: {e}", MAX_RISK.long())))?;
         let (terrain, note) = grammar::uncertain_terrain(load_terrain(&self.terrain)?, self.cv_n, self.cv_s)?;
         Ok(DesignInputs { space, goal, terrain, notes: note.into_iter().collect() })
     }
@@ -244,6 +297,36 @@ impl DesignAnswer {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
+        list.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    fn read(list: &[(&str, &str)]) -> Result<DesignRequest> {
+        DesignRequest::with_sources(&pairs(list), RobotRequest::default(), DEFAULT_TERRAIN.to_string())
+    }
+
+    /// `--vary` and `--slope-target` are required; `--max-risk` is 0.05 (the library's) and the
+    /// CVs the terrain's unless given; a bad value is named by its flag.
+    #[test]
+    fn fields_read_by_the_table() {
+        let r = read(&[("vary", "mass_kg=1:3:3,leg_width_m=0.02"), ("slope-target", "-5")]).unwrap();
+        assert_eq!(r.vary, vec!["mass_kg=1:3:3,leg_width_m=0.02".to_string()]);
+        assert_eq!((r.slope_target, r.max_risk, r.cv_n, r.cv_s), (-5.0, 0.05, None, None));
+        assert_eq!(r.max_risk, sandslope::risk::DEFAULT_MAX_RISK);
+        let e = read(&[("slope-target", "10")]).unwrap_err();
+        assert_eq!(e.field(), Some("vary"));
+        let e = read(&[("vary", "mass_kg=1")]).unwrap_err();
+        assert_eq!(e.field(), Some("slope-target"));
+        let e = read(&[("vary", "mass_kg=1"), ("slope-target", "10"), ("max-risk", "1.5")]).unwrap_err();
+        assert!(
+            e.message().starts_with("--max-risk = 1.5: 1.5 is not a failure probability"),
+            "{}",
+            e.message()
+        );
+        let e = read(&[("vary", "mass_kg=1"), ("slope-target", "10"), ("show", "3")]).unwrap_err();
+        assert_eq!(e.field(), Some("show"));
+    }
 
     /// Robot quantities are spaced linearly unless `:log` is written (the one axis rule), and
     /// each error names the field `vary`.

@@ -322,6 +322,64 @@ impl DriveFields {
     }
 }
 
+/// A run's defaults, as Python's `sandslope.drive_defaults()` shows them and its `drive` takes
+/// them for a keyword left out: each the default of its row of [`FIELDS`], read by the same
+/// step as a given value ([`DriveFields::from_params`] with nothing given, on an emulated
+/// bus), so that it is written once, in the table.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RunDefaults {
+    /// The slope climbed, degrees (`--slope`).
+    pub slope_deg: f64,
+    /// Gait time after standing up, s (`--duration`).
+    pub duration_s: f64,
+    /// Bus cycles per second aimed at (`--rate`).
+    pub rate_hz: f64,
+    /// Seconds the legs are held after a halt on risk (`--hold`).
+    pub hold_s: f64,
+    /// Current Limit written to every servo, mA (`--current-limit`): the paper's XL330-M288's
+    /// stall current at 5 V, 1.47 A (below the XM430-W350's 2.3 A, so safe on every supported
+    /// model with current control; a test holds the row to the library's figure).
+    pub current_limit_ma: u16,
+    /// Temperature Limit written to every servo, degC (`--temperature-limit`).
+    pub temperature_limit_c: u8,
+    /// Longest bus cycle accepted, s (`--watchdog`).
+    pub watchdog_s: f64,
+    /// The servos' own Bus Watchdog, s (`--bus-watchdog`).
+    pub bus_watchdog_s: f64,
+    /// Seconds the legs take to stand to their start angles before the gait (no field sets
+    /// it: the servo crate's `STAND_S`, given by the front end).
+    pub stand_s: f64,
+    /// The emulator's Present Current noise, mA (`--emulate-noise`).
+    pub emulate_noise_ma: f64,
+    /// The emulator's noise seed (`--emulate-seed`).
+    pub emulate_seed: u64,
+    /// Estimate k_s and the risk after every stance (`drive --live`, a switch: off unless
+    /// given; `--stop-on-risk` implies it and `serve --drive` always does it). Off: the
+    /// monitor's grid costs seconds of CPU before the robot moves.
+    pub live: bool,
+}
+
+impl RunDefaults {
+    /// The table's defaults, with the legs standing up for `stand_s` seconds.
+    pub fn read(stand_s: f64) -> Result<RunDefaults> {
+        let DriveFields { run, emulate_seed, .. } = DriveFields::from_params(&[], true)?;
+        Ok(RunDefaults {
+            slope_deg: run.slope_deg,
+            duration_s: run.duration_s,
+            rate_hz: run.rate_hz,
+            hold_s: run.hold_s,
+            current_limit_ma: run.current_limit_ma,
+            temperature_limit_c: run.temperature_limit_c,
+            watchdog_s: run.watchdog_s,
+            bus_watchdog_s: run.bus_watchdog_s,
+            stand_s,
+            emulate_noise_ma: run.emulate_noise_ma.unwrap_or_default(),
+            emulate_seed,
+            live: false,
+        })
+    }
+}
+
 /// A field as each front end names it: the command line's flag, or Python's keyword (which
 /// carries its unit), from its row of [`FIELDS`].
 fn name(words: Words, field: &Field) -> String {
@@ -394,6 +452,18 @@ impl DriveRun {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The run's defaults are the table's, read as given values are: 0 deg, 10 s at 50 Hz,
+    /// held 2 s, watchdogs 1 s and 0.5 s, 65 degC, the emulator's 10 mA noise and seed 1; the
+    /// Current Limit is the XL330-M288's stall current at 5 V (1.47 A, the library's figure).
+    #[test]
+    fn run_defaults_are_the_tables() {
+        let d = RunDefaults::read(1.0).unwrap();
+        assert_eq!((d.slope_deg, d.duration_s, d.rate_hz, d.hold_s), (0.0, 10.0, 50.0, 2.0));
+        assert_eq!((d.watchdog_s, d.bus_watchdog_s, d.temperature_limit_c), (1.0, 0.5, 65));
+        assert_eq!((d.emulate_noise_ma, d.emulate_seed, d.stand_s, d.live), (10.0, 1, 1.0, false));
+        assert_eq!(f64::from(d.current_limit_ma), (ServoModel::XL330_M288.stall_current_a * 1000.0).round());
+    }
 
     fn run() -> DriveRun {
         DriveRun {

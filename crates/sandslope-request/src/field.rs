@@ -26,6 +26,9 @@ pub enum Kind {
     Switch,
     /// One of a few words.
     Choice(&'static [&'static str]),
+    /// Text that may be given more than once on the command line (`--vary A --vary B`), read
+    /// as one comma list (`A,B`), as HTTP and Python give it.
+    List,
 }
 
 /// One field of a request, written once.

@@ -213,9 +213,13 @@ impl AxisRange {
 pub fn parse_max_risk(text: &str) -> std::result::Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(p) if p > 0.0 && p < 1.0 => Ok(p),
-        Ok(p) => Err(format!("{p} is not a failure probability strictly between 0 and 1 (e.g. 0.05)")),
+        Ok(p) => Err(format!(
+            "{p} is not a failure probability strictly between 0 and 1 (e.g. {})",
+            sandslope::risk::DEFAULT_MAX_RISK
+        )),
         Err(_) => Err(format!(
-            "`{text}` is not a number: expected a failure probability strictly between 0 and 1 (e.g. 0.05)"
+            "`{text}` is not a number: expected a failure probability strictly between 0 and 1 (e.g. {})",
+            sandslope::risk::DEFAULT_MAX_RISK
         )),
     }
 }

@@ -29,6 +29,7 @@ pub mod phase;
 pub mod plan;
 pub mod predict;
 pub mod report;
+pub mod report_text;
 pub mod risk;
 pub mod scenario;
 pub mod simulate;

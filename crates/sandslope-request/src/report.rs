@@ -192,9 +192,10 @@ impl ReportRequest {
         if !(self.max_risk > 0.0 && self.max_risk < 1.0) {
             let message = match words {
                 Words::Flag => format!(
-                    "{}: {} is not a failure probability strictly between 0 and 1 (e.g. 0.05)",
+                    "{}: {} is not a failure probability strictly between 0 and 1 (e.g. {})",
                     MAX_RISK.long(),
-                    self.max_risk
+                    self.max_risk,
+                    sandslope::risk::DEFAULT_MAX_RISK
                 ),
                 Words::Keyword => {
                     format!("max_risk = {} must be a probability strictly between 0 and 1", self.max_risk)
@@ -305,10 +306,13 @@ impl ReportRequest {
     }
 }
 
-/// The report on `evidence` already read ([`ReportRequest::evidence`]): the command line reads
-/// the evidence first, to warn about its recordings before the long part.
+/// The report on `evidence` already read ([`ReportRequest::evidence`]), worded
+/// ([`crate::report_text::word`]): the command line reads the evidence first, to warn about
+/// its recordings before the long part.
 pub fn answer_evidence(evidence: &Evidence) -> Result<Report> {
-    report(evidence).map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))
+    let mut value = report(evidence).map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))?;
+    crate::report_text::word(&mut value, evidence);
+    Ok(value)
 }
 
 #[cfg(test)]

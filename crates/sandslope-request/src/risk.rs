@@ -66,7 +66,7 @@ pub struct RiskQuestion {
     pub cv_n: Option<f64>,
     /// Coefficient of variation of k_s at every slope instead of the terrain's (field `cv-s`).
     pub cv_s: Option<f64>,
-    /// Largest acceptable failure probability (field `max-risk`, default 0.05).
+    /// Largest acceptable failure probability (field `max-risk`, default [`MAX_RISK`]'s).
     pub max_risk: f64,
     /// What to solve for (field `solve`: `slope` or `mass`).
     pub solve: Option<Solve>,

@@ -14,6 +14,80 @@ use sandslope::{GaitError, Slope, SlopeEvaluation};
 use sandslope_io::mocap::{self, Capture, MocapFormat};
 
 use crate::error::{RequestError, Result, Words};
+use crate::field::{Field, Fields, Kind, Table};
+use crate::params::Params;
+
+/// `--format`: the capture files' format.
+pub const FORMAT: Field = Field::text("format", "motive|vicon|plain")
+    .keyword("format")
+    .help("File format: motive, vicon or plain; detected from the first line when omitted");
+/// `--body`: what to track in the files.
+pub const BODY: Field = Field::text("body", "NAME")
+    .keyword("body")
+    .help("Rigid body, marker or model output to track (required when a file has several)");
+/// `--topic`: a bag's pose topic.
+pub const TOPIC: Field = Field::text("topic", "TOPIC").keyword("topic").help(
+    "A ROS 2 bag's topic of geometry_msgs/PoseStamped, nav_msgs/Odometry, \
+     geometry_msgs/TransformStamped or tf2_msgs/TFMessage (a bag is a folder with \
+     metadata.yaml, or an .mcap or .db3 file; docs/bags.md); the bag's only such topic when \
+     omitted, else the error lists the candidates",
+);
+/// `--frame`: the child frame on a TF topic.
+pub const FRAME: Field = Field::text("frame", "FRAME").keyword("frame").help(
+    "The child frame to track on a bag's TF topic (e.g. `base_link`), placed in the root of its \
+     TF tree (docs/bags.md); the only one when omitted",
+);
+/// `--upslope`: the upslope direction in the capture frame.
+pub const UPSLOPE: Field = Field::text("upslope", "AXIS|X,Y,Z")
+    .keyword("upslope")
+    .unit("capture-frame axes")
+    .range("not zero, finite")
+    .help(
+        "Upslope direction in the capture frame: +x, -x, +y, -y, +z, -z or a vector such as \
+         `0.91,0,0.41`; when omitted, the principal direction of travel, pointed the way it rises \
+         along the format's vertical axis (a slide down reads as a negative speed)",
+    );
+/// `--max-gap`: the longest occlusion filled (the library's
+/// [`sandslope::gait::DEFAULT_MAX_GAP`] by default, a test checks).
+pub const MAX_GAP: Field =
+    Field::new("max-gap", Kind::Whole, "FRAMES").keyword("max_gap").unit("frames").default("10").help(
+        "Longest occlusion filled by linear interpolation, frames; longer gaps split the recording \
+         into segments analysed separately",
+    );
+/// `--cutoff`: the speed estimate's low-pass cutoff (the library's
+/// [`sandslope::gait::DEFAULT_CUTOFF_HZ`] by default, a test checks).
+pub const CUTOFF: Field = Field::number("cutoff", "HZ")
+    .keyword("cutoff_hz")
+    .key("cutoff_hz")
+    .unit("Hz")
+    .default("10")
+    .range("greater than 0, below half the frame rate")
+    .help("Low-pass cutoff for the zero-phase speed estimate, Hz (see docs/tracking.md)");
+/// `--touchdowns`: one touchdowns file per recording (Python's `touchdowns`: one list of times
+/// per recording).
+pub const TOUCHDOWNS: Field = Field::new("touchdowns", Kind::List, "FILE").keyword("touchdowns").help(
+    "Touchdown times, s, one per line in the recording's clock (e.g. from the gait controller's \
+     log); give it once per recording, in the same order. Estimated from the speed signal when \
+     omitted",
+);
+/// `--slope`: the recordings' slope.
+pub const SLOPE: Field = Field::number("slope", "DEG")
+    .keyword("slope_deg")
+    .key("slope_deg")
+    .unit("deg")
+    .range("0 to below 90")
+    .help("Slope of these recordings, degrees (labels the output and the `--speeds-out` row)");
+
+/// `track`'s own fields besides its files (the robot's and the terrain's are
+/// [`crate::scenario`]'s).
+pub const FIELDS: Table = Table {
+    command: "track",
+    fields: &[FORMAT, BODY, TOPIC, FRAME, UPSLOPE, MAX_GAP, CUTOFF, TOUCHDOWNS, SLOPE],
+};
+
+impl Fields for TrackRequest {
+    const TABLE: Table = FIELDS;
+}
 
 /// Where the touchdown times of each recording come from.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -152,23 +226,23 @@ pub fn model_curve(
     let slopes = (0..=400)
         .map(|k| sandslope::SignedSlope::from_degrees(top * k as f64 / 400.0))
         .collect::<std::result::Result<Vec<_>, _>>()
-        .map_err(|e| RequestError::invalid("slope", e))?;
+        .map_err(|e| RequestError::invalid(SLOPE.flag, e))?;
     Ok(scenario.sweep(&slopes))
 }
 
-/// How each front end names this request's fields: the command line's flags are the
-/// fields; Python's keywords carry their units (`cutoff_hz`, `slope_deg`).
-fn name(words: Words, field: &str) -> String {
-    match (words, field) {
-        (Words::Keyword, "cutoff") => "cutoff_hz".into(),
-        (Words::Keyword, "slope") => "slope_deg".into(),
-        _ => words.name(field),
+/// How each front end names `field`: the command line by its flag, Python by its keyword
+/// (which carries its unit: `cutoff_hz`, `slope_deg`), both from the field's row.
+fn name(words: Words, field: &Field) -> String {
+    match words {
+        Words::Flag => field.long(),
+        Words::Keyword => field.keyword.to_string(),
     }
 }
 
-/// Reads `upslope` as a direction, an error naming its field in `words`.
+/// Reads an upslope as a direction, an error naming its field `field` (`upslope`, or
+/// `report`'s `tracks-upslope`) in `words`.
 pub fn upslope(words: Words, field: &str, v: [f64; 3]) -> Result<Upslope> {
-    Upslope::new(v).map_err(|e| RequestError::invalid(field, e.renamed(name(words, field))))
+    Upslope::new(v).map_err(|e| RequestError::invalid(field, e.renamed(words.name(field))))
 }
 
 /// Parses an upslope as the command line writes it: `+x`, `-x`, `+y`, `-y`, `+z`, `-z` (or
@@ -201,21 +275,71 @@ pub fn parse_upslope(s: &str, flag: &str) -> std::result::Result<[f64; 3], Strin
 }
 
 impl TrackRequest {
+    /// The command line's request: the fields given, `params` (by [`FIELDS`], the one
+    /// raw-to-typed step), on the recordings `files` (the command line expands its patterns
+    /// first) of a robot whose stride period is `stride_period_s`; refuses any other key.
+    pub fn from_fields(
+        params: &[(String, String)],
+        files: Vec<PathBuf>,
+        stride_period_s: f64,
+    ) -> Result<TrackRequest> {
+        let mut p = Params::new(FIELDS.command, params);
+        let format = FORMAT
+            .text_in(&mut p)?
+            .map(|f| {
+                f.parse::<MocapFormat>().map_err(|why| {
+                    RequestError::invalid(FORMAT.flag, format!("{} = {f}: {why}", FORMAT.long()))
+                })
+            })
+            .transpose()?;
+        let text = |f: &Field, p: &mut Params<'_>| f.text_in(p).map(|t| t.map(str::to_string));
+        let (body, topic, frame) = (text(&BODY, &mut p)?, text(&TOPIC, &mut p)?, text(&FRAME, &mut p)?);
+        let upslope = UPSLOPE
+            .text_in(&mut p)?
+            .map(|u| {
+                parse_upslope(u, &UPSLOPE.long()).map_err(|why| {
+                    RequestError::invalid(UPSLOPE.flag, format!("{} = {u}: {why}", UPSLOPE.long()))
+                })
+            })
+            .transpose()?;
+        let max_gap = MAX_GAP.whole_in(&mut p)?.unwrap_or_default() as usize;
+        let cutoff_hz = CUTOFF.required_number_in(&mut p)?;
+        let touchdowns = match TOUCHDOWNS.text_in(&mut p)? {
+            None => Touchdowns::Estimated,
+            Some(list) => Touchdowns::Files(list.split(',').map(PathBuf::from).collect()),
+        };
+        let slope_deg = SLOPE.number_in(&mut p)?;
+        p.finish()?;
+        Ok(TrackRequest {
+            files,
+            format,
+            body,
+            upslope,
+            max_gap,
+            cutoff_hz,
+            touchdowns,
+            slope_deg,
+            stride_period_s,
+            topic,
+            frame,
+        })
+    }
+
     /// The analysis's options and slope, checked before any file is read.
     pub fn options(&self, words: Words) -> Result<(GaitOptions, Option<Slope>)> {
         let mut options = GaitOptions::new(self.stride_period_s)
             .map_err(|e| RequestError::invalid("leg-speed", format!("the robot's stride period: {e}")))?
             .with_cutoff(self.cutoff_hz)
-            .map_err(|e| RequestError::invalid("cutoff", e.renamed(name(words, "cutoff"))))?
+            .map_err(|e| RequestError::invalid(CUTOFF.flag, e.renamed(name(words, &CUTOFF))))?
             .with_max_gap(self.max_gap);
         if let Some(u) = self.upslope {
-            options = options.with_upslope(upslope(words, "upslope", u)?);
+            options = options.with_upslope(upslope(words, UPSLOPE.flag, u)?);
         }
         let slope = self
             .slope_deg
             .map(|d| {
                 Slope::from_degrees(d)
-                    .map_err(|e| RequestError::invalid("slope", e.renamed(name(words, "slope"))))
+                    .map_err(|e| RequestError::invalid(SLOPE.flag, e.renamed(name(words, &SLOPE))))
             })
             .transpose()?;
         let given = match &self.touchdowns {
@@ -226,7 +350,8 @@ impl TrackRequest {
         if let Some(n) = given.filter(|n| *n != self.files.len()) {
             let message = match words {
                 Words::Flag => format!(
-                    "--touchdowns was given {n} times for {} recordings: give one touchdowns file per recording, in order",
+                    "{} was given {n} times for {} recordings: give one touchdowns file per recording, in order",
+                    TOUCHDOWNS.long(),
                     self.files.len()
                 ),
                 Words::Keyword => format!(
@@ -234,7 +359,7 @@ impl TrackRequest {
                     self.files.len()
                 ),
             };
-            return Err(RequestError::invalid("touchdowns", message));
+            return Err(RequestError::invalid(TOUCHDOWNS.flag, message));
         }
         Ok((options, slope))
     }
@@ -246,7 +371,7 @@ impl TrackRequest {
         let read = CaptureRead {
             format: self.format,
             body: self.body.as_deref(),
-            cutoff_name: Some(name(words, "cutoff")),
+            cutoff_name: Some(name(words, &CUTOFF)),
             topic: self.topic.as_deref(),
             frame: self.frame.as_deref(),
         };
@@ -302,7 +427,7 @@ pub fn track_captures(
             .iter()
             .map(|p| mocap::load_touchdowns(p))
             .collect::<anyhow::Result<_>>()
-            .map_err(|e| RequestError::from_error(Some("touchdowns"), e))?,
+            .map_err(|e| RequestError::from_error(Some(TOUCHDOWNS.flag), e))?,
     };
     let recordings: Vec<Recording> =
         captures.iter().enumerate().map(|(i, c)| c.recording(touchdowns.get(i).map(Vec::as_slice))).collect();
@@ -362,6 +487,44 @@ mod tests {
             topic: None,
             frame: None,
         }
+    }
+
+    fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
+        list.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    /// The table's defaults are the library's (Python's signature takes those), and the
+    /// fields read into the request: nothing given is the library's 10 frames and 10 Hz, the
+    /// touchdowns estimated; each bad value is named by its flag.
+    #[test]
+    fn fields_read_by_the_table_with_the_librarys_defaults() {
+        let number = |f: &Field| f.default.map(|d| d.parse::<f64>().unwrap());
+        assert_eq!(number(&MAX_GAP), Some(sandslope::gait::DEFAULT_MAX_GAP as f64));
+        assert_eq!(number(&CUTOFF), Some(sandslope::gait::DEFAULT_CUTOFF_HZ));
+        let files = vec![PathBuf::from("a.csv"), PathBuf::from("b.csv")];
+        let r = TrackRequest::from_fields(&[], files.clone(), 1.0).unwrap();
+        assert_eq!(r, TrackRequest { cutoff_hz: 10.0, ..request() });
+        let given = pairs(&[
+            ("format", "vicon"),
+            ("upslope", "-y"),
+            ("touchdowns", "a.txt,b.txt"),
+            ("slope", "10"),
+            ("max-gap", "3"),
+        ]);
+        let r = TrackRequest::from_fields(&given, files.clone(), 1.0).unwrap();
+        assert_eq!(
+            (r.format, r.upslope, r.max_gap, r.slope_deg),
+            (Some(MocapFormat::Vicon), Some([0.0, -1.0, 0.0]), 3, Some(10.0))
+        );
+        assert_eq!(r.touchdowns, Touchdowns::Files(vec!["a.txt".into(), "b.txt".into()]));
+        let err =
+            |list: &[(&str, &str)]| TrackRequest::from_fields(&pairs(list), files.clone(), 1.0).unwrap_err();
+        assert_eq!(err(&[("format", "bvh")]).field(), Some("format"));
+        assert!(err(&[("upslope", "up")]).message().starts_with("--upslope = up: `up` must be +x"));
+        assert_eq!(
+            err(&[("max-gap", "-1")]).message(),
+            "--max-gap = `-1` is not a whole number of at least 0"
+        );
     }
 
     /// Each check names its field as each front end spells it, before any file is read.

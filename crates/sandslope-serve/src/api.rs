@@ -15,7 +15,8 @@ use crate::reply::{ApiError, Reply};
 use crate::served::Served;
 use sandslope_io::presets::{self, PresetKind};
 use sandslope_request::risk::AnswerLimits;
-use sandslope_request::simulate::Walks;
+use sandslope_request::simulate::{self, Walks};
+use sandslope_request::sweep;
 use sandslope_request::{
     PhaseRequest, PlanRequest, PredictRequest, RiskRequest, SimulateRequest, SweepRequest,
 };
@@ -93,10 +94,11 @@ pub fn request_params(
 /// A plan request's parameters: those of [`request_params`] and the served DEM, the only one
 /// a request may plan on (naming another is refused; without one, a 404).
 pub fn plan_params(params: &[(String, String)], served: &Served) -> Result<Vec<(String, String)>, ApiError> {
-    if params.iter().any(|(k, _)| k == "dem") {
+    let dem_key = sandslope_request::plan::DEM.flag;
+    if params.iter().any(|(k, _)| k == dem_key) {
         return Err(ApiError::bad(
-            Some("dem".into()),
-            "dem: a request cannot name a file; the server plans on the DEM it was started with (serve --dem)",
+            Some(dem_key.into()),
+            format!("{dem_key}: a request cannot name a file; the server plans on the DEM it was started with (serve --dem)"),
         ));
     }
     let Some(dem) = &served.dem else {
@@ -107,7 +109,7 @@ pub fn plan_params(params: &[(String, String)], served: &Served) -> Result<Vec<(
         });
     };
     let mut params = request_params(params, served)?;
-    params.push(("dem".to_string(), dem.display().to_string()));
+    params.push((dem_key.to_string(), dem.display().to_string()));
     Ok(params)
 }
 
@@ -138,9 +140,12 @@ pub fn answer(command: &str, params: &[(String, String)], served: &Served) -> Re
             let n = request.slopes()?.len();
             if n > MAX_SWEEP_SLOPES {
                 return Err(ApiError::bad(
-                    Some("step".to_string()),
+                    Some(sweep::STEP.flag.to_string()),
                     format!(
-                        "--from/--to/--step give {n} slopes; the server evaluates at most {MAX_SWEEP_SLOPES}"
+                        "{}/{}/{} give {n} slopes; the server evaluates at most {MAX_SWEEP_SLOPES}",
+                        sweep::FROM.long(),
+                        sweep::TO.long(),
+                        sweep::STEP.long()
                     ),
                 ));
             }
@@ -179,40 +184,51 @@ pub fn simulate_walks(params: &[(String, String)], served: &Served) -> Result<Wa
     let duration = walks.settings.duration_s;
     if duration > MAX_SIM_DURATION_S {
         return Err(ApiError::bad(
-            Some("duration".to_string()),
+            Some(simulate::DURATION.flag.to_string()),
             format!(
-                "--duration = {duration} s: the server simulates at most {MAX_SIM_DURATION_S} s per walk"
+                "{} = {duration} s: the server simulates at most {MAX_SIM_DURATION_S} s per walk",
+                simulate::DURATION.long()
             ),
         ));
     }
     if walks.slopes.len() > MAX_SIM_SLOPES {
         return Err(ApiError::bad(
-            Some("slopes".to_string()),
+            Some(simulate::SLOPES.flag.to_string()),
             format!(
-                "--slopes gives {} slopes: the server simulates at most {MAX_SIM_SLOPES} per request",
+                "{} gives {} slopes: the server simulates at most {MAX_SIM_SLOPES} per request",
+                simulate::SLOPES.long(),
                 walks.slopes.len()
             ),
         ));
     }
     if request.rate_hz > MAX_SIM_RATE_HZ {
         return Err(ApiError::bad(
-            Some("rate".to_string()),
-            format!("--rate = {} Hz: the server samples at most {MAX_SIM_RATE_HZ} Hz", request.rate_hz),
+            Some(simulate::RATE.flag.to_string()),
+            format!(
+                "{} = {} Hz: the server samples at most {MAX_SIM_RATE_HZ} Hz",
+                simulate::RATE.long(),
+                request.rate_hz
+            ),
         ));
     }
     let steps = walks.integration_steps()?;
     if steps > MAX_SIM_STEPS {
-        let flag = match (request.dt_s, request.ensemble, request.check_convergence) {
-            (Some(_), _, _) => "dt",
-            (None, Some(_), _) => "ensemble",
-            (None, None, true) => "check-convergence",
-            (None, None, false) => "duration",
+        use simulate::{CHECK_CONVERGENCE, DT, DURATION, ENSEMBLE};
+        let field = match (request.dt_s, request.ensemble, request.check_convergence) {
+            (Some(_), _, _) => DT,
+            (None, Some(_), _) => ENSEMBLE,
+            (None, None, true) => CHECK_CONVERGENCE,
+            (None, None, false) => DURATION,
         };
         return Err(ApiError::bad(
-            Some(flag.to_string()),
+            Some(field.flag.to_string()),
             format!(
-                "--duration, --dt, the slopes, --ensemble and --check-convergence ask for {steps:.3e} integration \
-                 steps: the server takes at most {MAX_SIM_STEPS:e} per request"
+                "{}, {}, the slopes, {} and {} ask for {steps:.3e} integration steps: the server takes at \
+                 most {MAX_SIM_STEPS:e} per request",
+                DURATION.long(),
+                DT.long(),
+                ENSEMBLE.long(),
+                CHECK_CONVERGENCE.long()
             ),
         ));
     }

@@ -12,8 +12,9 @@ use crate::served::{stride, DemInfo, Served};
 use sandslope::Cause;
 use sandslope_io::presets::{PresetKind, PRESETS};
 use sandslope_io::raster::{read_raster, write_two_band_geotiff};
+use sandslope_request::plan::{GOAL, GOAL_PX, OBJECTIVE, START, START_PX};
 use sandslope_request::scenario::robot_fields;
-use sandslope_request::{PhaseRequest, PlanRequest};
+use sandslope_request::{phase, simulate, PhaseRequest, PlanRequest};
 
 /// Most cells of a `/data/phase-map` (the page asks for about 160 x 160).
 pub const MAX_MAP_CELLS: u128 = 1 << 18;
@@ -183,7 +184,7 @@ fn phase_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiE
     let request = PhaseRequest::from_params(&api::request_params(params, served)?)?;
     let panels = request.grid(MAX_MAP_CELLS)?.compute(&|| {})?;
     let Some(p) = panels.first() else {
-        return Err(ApiError::bad(Some("slope".to_string()), "no panel: give a slope"));
+        return Err(ApiError::bad(Some(phase::SLOPE.flag.to_string()), "no panel: give a slope"));
     };
     let (nx, ny) = (p.map.k_n().len(), p.map.k_s().len());
     let regimes = (0..ny)
@@ -221,13 +222,13 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiEr
                     }
                 }
             }
-            "start" | "goal" | "start-px" | "goal-px" | "objective" => {}
+            k if [&START, &GOAL, &START_PX, &GOAL_PX, &OBJECTIVE].iter().any(|f| f.flag == k) => {}
             _ => rest.push((k.clone(), v.clone())),
         }
     }
     // The planner's inputs need no endpoints; plan's flags require some, so any cell will do.
-    rest.push(("start-px".into(), "0,0".into()));
-    rest.push(("goal-px".into(), "0,0".into()));
+    rest.push((START_PX.flag.into(), "0,0".into()));
+    rest.push((GOAL_PX.flag.into(), "0,0".into()));
     let request = PlanRequest::from_params(&api::plan_params(&rest, served)?)?;
     let inputs = request.inputs(&|_| {})?;
     let planner = inputs.planner()?;
@@ -243,32 +244,44 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiEr
 /// `scaling_spread`, the slope under all three contact scalings (`simulate --json`'s key; on
 /// unless `scaling-spread=off`).
 fn simulation(params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
-    if params.iter().any(|(k, _)| k == "slopes") {
+    if params.iter().any(|(k, _)| k == simulate::SLOPES.flag) {
         return Err(ApiError::bad(
-            Some("slopes".to_string()),
-            "/data/simulation animates one walk: give slope, not slopes (/api/simulate takes slopes)",
+            Some(simulate::SLOPES.flag.to_string()),
+            format!(
+                "/data/simulation animates one walk: give {}, not {} (/api/simulate takes {})",
+                simulate::SLOPE.flag,
+                simulate::SLOPES.flag,
+                simulate::SLOPES.flag
+            ),
         ));
     }
     let walks = api::simulate_walks(params, served)?;
     if walks.check_convergence || walks.ensemble.is_some() {
+        let field = if walks.check_convergence { simulate::CHECK_CONVERGENCE } else { simulate::ENSEMBLE };
         return Err(ApiError::bad(
-            Some(if walks.check_convergence { "check-convergence" } else { "ensemble" }.to_string()),
-            "/data/simulation animates one walk: /api/simulate takes ensemble and check-convergence",
+            Some(field.flag.to_string()),
+            format!(
+                "/data/simulation animates one walk: /api/simulate takes {} and {}",
+                simulate::ENSEMBLE.flag,
+                simulate::CHECK_CONVERGENCE.flag
+            ),
         ));
     }
     let samples = walks.settings.duration_s * walks.settings.sample_rate_hz;
     if samples > MAX_SIM_SAMPLES {
         return Err(ApiError::bad(
-            Some("rate".to_string()),
+            Some(simulate::RATE.flag.to_string()),
             format!(
-                "--duration x --rate = {samples} trajectory samples: the page's animation takes at most {MAX_SIM_SAMPLES}"
+                "{} x {} = {samples} trajectory samples: the page's animation takes at most {MAX_SIM_SAMPLES}",
+                simulate::DURATION.long(),
+                simulate::RATE.long()
             ),
         ));
     }
     let sims = walks.simulate()?;
     let scaling_spread = walks.spreads(&sims)?.pop().flatten();
     let Some(sim) = sims.into_iter().next() else {
-        return Err(ApiError::bad(Some("slope".to_string()), "no walk: give a slope"));
+        return Err(ApiError::bad(Some(simulate::SLOPE.flag.to_string()), "no walk: give a slope"));
     };
     /// The walk beside its scaling spread.
     #[derive(serde::Serialize)]

@@ -130,6 +130,14 @@ impl Clock {
         }
     }
 
+    /// Moves a virtual clock on by `s` seconds that a real bus spends waiting (the real clock
+    /// has spent them already).
+    pub fn advance_by(&self, s: f64) {
+        if let Clock::Virtual(v) = self {
+            v.ns.fetch_add(nanos(s), Ordering::SeqCst);
+        }
+    }
+
     /// Moves a virtual clock on to at least `t` s (the real clock moves by itself).
     pub fn advance_to(&self, t: f64) {
         if let Clock::Virtual(v) = self {

@@ -509,8 +509,7 @@ impl VirtualBus {
     }
 
     fn advance_all(&mut self, now: f64) {
-        // In steps of at most 2 ms, as the real-time thread ticks: the virtual clock (and a
-        // stalled machine) moves a whole cycle at once.
+        // In steps of at most 2 ms, as the real-time thread ticks (a virtual cycle comes at once).
         let last = self.servos.iter().map(|s| s.last_update).fold(now, f64::min);
         let steps = ((now - last) / 0.002).ceil().clamp(1.0, 1e6) as usize;
         for i in 1..=steps {
@@ -526,8 +525,7 @@ impl VirtualBus {
         }
     }
 
-    /// The replies silent servos owed since the last call (the driver waited a reply timeout
-    /// for each): what the virtual clock moves on by.
+    /// The replies silent servos owed since the last call (each a reply timeout the driver waited).
     pub fn take_missed(&mut self) -> usize {
         std::mem::take(&mut self.missed)
     }
@@ -759,9 +757,7 @@ impl Emulator {
                         if !reply.is_empty() {
                             master.write_all(&reply).ok();
                         }
-                        if start.is_virtual() {
-                            start.sleep(bus.take_missed() as f64 * REPLY_TIMEOUT_S);
-                        }
+                        start.advance_by(bus.take_missed() as f64 * REPLY_TIMEOUT_S);
                     }
                     bus.tick(start.now());
                 }

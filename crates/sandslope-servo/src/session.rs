@@ -23,56 +23,10 @@ use crate::{DriveSettings, ServoConfig};
 /// robot to the stiffest the grid's simulated walks stay reportable on.
 pub const LIVE_K_S_PRIOR: (f64, f64) = (1e4, 3e7);
 
-/// The defaults of a run's settings, in one place for every front end: `drive`'s and `serve
-/// --drive`'s flags take theirs from [`RUN_DEFAULTS`] (clap's `default_value_t`), and so does
-/// Python's `sandslope.drive` (`sandslope.drive_defaults()` shows them).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct RunDefaults {
-    /// The slope climbed, degrees (`--slope`).
-    pub slope_deg: f64,
-    /// Gait time after standing up, s (`--duration`).
-    pub duration_s: f64,
-    /// Bus cycles per second aimed at (`--rate`).
-    pub rate_hz: f64,
-    /// Seconds the legs are held after a halt on risk (`--hold`).
-    pub hold_s: f64,
-    /// Current Limit written to every servo, mA (`--current-limit`): the paper's XL330-M288's
-    /// stall current at 5 V, 1.47 A (`ServoModel::XL330_M288.stall_current_a`; below the
-    /// XM430-W350's 2.3 A, so safe on every supported model with current control).
-    pub current_limit_ma: u16,
-    /// Temperature Limit written to every servo, degC (`--temperature-limit`).
-    pub temperature_limit_c: u8,
-    /// Longest bus cycle accepted, s (`--watchdog`).
-    pub watchdog_s: f64,
-    /// The servos' own Bus Watchdog, s (`--bus-watchdog`).
-    pub bus_watchdog_s: f64,
-    /// Seconds the legs take to stand to their start angles before the gait.
-    pub stand_s: f64,
-    /// The emulator's Present Current noise, mA (`--emulate-noise`).
-    pub emulate_noise_ma: f64,
-    /// The emulator's noise seed (`--emulate-seed`).
-    pub emulate_seed: u64,
-    /// Estimate k_s and the risk after every stance (`drive --live`; `--stop-on-risk` implies
-    /// it and `serve --drive` always does it). Off: the monitor's grid costs seconds of CPU
-    /// before the robot moves.
-    pub live: bool,
-}
-
-/// The run's defaults ([`RunDefaults`]).
-pub const RUN_DEFAULTS: RunDefaults = RunDefaults {
-    slope_deg: 0.0,
-    duration_s: 10.0,
-    rate_hz: 50.0,
-    hold_s: 2.0,
-    current_limit_ma: (ServoModel::XL330_M288.stall_current_a * 1000.0) as u16,
-    temperature_limit_c: 65,
-    watchdog_s: 1.0,
-    bus_watchdog_s: 0.5,
-    stand_s: 1.0,
-    emulate_noise_ma: 10.0,
-    emulate_seed: 1,
-    live: false,
-};
+/// Seconds the legs take to stand to their start angles before the gait. No flag sets it; the
+/// defaults of the flags of a run are the request layer's drive table
+/// (`sandslope_request::drive::FIELDS`, shown by `sandslope_request::drive::RunDefaults`).
+pub const STAND_S: f64 = 1.0;
 
 /// Where the servos are.
 #[derive(Debug, Clone)]

@@ -14,7 +14,7 @@ use sandslope::risk::SafeLimit;
 use sandslope_request::design::DesignAnswer;
 use sandslope_request::DesignRequest;
 
-use crate::args::{parse_max_risk, RobotArgs, TerrainArgs, UncertaintyArgs};
+use crate::args::{FieldArgs, RobotArgs, TerrainArgs};
 use crate::figures::design::{DesignFigure, SafeSlopeMap};
 use crate::figures::{format_of, save};
 use crate::output::{check_parent_exists, num, print_json, table, write_atomic};
@@ -23,24 +23,14 @@ use crate::progress::progress_bar;
 /// Arguments of `sandslope design`.
 #[derive(Debug, Args)]
 pub struct DesignArgs {
-    /// Robot keys to vary: KEY=MIN:MAX:N[:log|:lin] or KEY=VALUE, comma-separated or repeated
-    /// (e.g. leg_radius_m=0.03:0.06:7,mass_kg=0.3:1.5:9), spaced linearly unless :log (robot
-    /// quantities; the strength axes of phase and risk are log unless :lin). Keys: the robot
-    /// file's (docs/model.md §2).
-    #[arg(long, value_name = "KEY=MIN:MAX:N[:log],...", required = true)]
-    pub vary: Vec<String>,
-    /// The mission's target slope, degrees: speed, regime, p_fail and k_s margin are reported there.
-    #[arg(long = "slope-target", value_name = "DEG", allow_negative_numbers = true)]
-    pub slope_target: f64,
+    /// `--vary`, `--slope-target`, `--cv-n`, `--cv-s` and `--max-risk`: the request's own
+    /// fields ([`sandslope_request::design::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<DesignRequest>,
     #[command(flatten)]
     pub robot: RobotArgs,
     #[command(flatten)]
     pub terrain: TerrainArgs,
-    #[command(flatten)]
-    pub uncertainty: UncertaintyArgs,
-    /// Largest acceptable failure probability, for the safe-slope limit.
-    #[arg(long = "max-risk", allow_negative_numbers = true, value_name = "P", default_value_t = sandslope::risk::DEFAULT_MAX_RISK, value_parser = parse_max_risk)]
-    pub max_risk: f64,
     /// Print every design as JSON instead of the front as a table.
     #[arg(long)]
     pub json: bool,
@@ -56,23 +46,16 @@ pub struct DesignArgs {
 }
 
 impl DesignArgs {
-    /// The request these flags make.
-    pub fn request(&self) -> DesignRequest {
-        DesignRequest {
-            vary: self.vary.clone(),
-            slope_target: self.slope_target,
-            robot: self.robot.request(),
-            terrain: self.terrain.terrain.clone(),
-            cv_n: self.uncertainty.cv_n,
-            cv_s: self.uncertainty.cv_s,
-            max_risk: self.max_risk,
-        }
+    /// The request these flags make, read by the request layer's one raw-to-typed step.
+    pub fn request(&self) -> Result<DesignRequest> {
+        let (robot, terrain) = (self.robot.request(), self.terrain.terrain.clone());
+        Ok(DesignRequest::with_sources(&self.fields.pairs, robot, terrain)?)
     }
 }
 
 /// Runs `sandslope design`.
 pub fn run(args: DesignArgs) -> Result<()> {
-    let mut inputs = args.request().inputs()?;
+    let mut inputs = args.request()?.inputs()?;
     // Check every output before the work.
     if let Some(p) = &args.plot {
         format_of(p)?;

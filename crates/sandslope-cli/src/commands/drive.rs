@@ -24,7 +24,7 @@ use sandslope_servo::driver::{DriveReport, LiveEstimate};
 use sandslope_servo::emulator::EmulatorFaults;
 use sandslope_servo::log::{drive_logged, live_record, LogTarget};
 use sandslope_servo::session::{
-    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, RUN_DEFAULTS,
+    default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, STAND_S,
 };
 use sandslope_servo::table as t;
 use sandslope_servo::{DriveSettings, Profile, ServoConfig};
@@ -67,7 +67,7 @@ pub struct DriveArgs {
     #[command(flatten)]
     pub run: DriveRunArgs,
     /// Print the live estimate of k_s and the risk after every stance (implied by --stop-on-risk).
-    #[arg(long, default_value_t = RUN_DEFAULTS.live)]
+    #[arg(long)]
     pub live: bool,
     /// Print the run's report as JSON.
     #[arg(long)]
@@ -263,7 +263,7 @@ pub fn config(
         bus_watchdog_s: run.bus_watchdog_s,
         stop_on_risk: run.stop_on_risk,
         hold_s: run.hold_s,
-        stand_s: RUN_DEFAULTS.stand_s,
+        stand_s: STAND_S,
         servo: model,
     };
     // Every goal within the servos' ranges for the whole run, from the worst start a cleared
@@ -659,27 +659,4 @@ fn write_mcap_log(
     let verdict =
         sandslope_io::mcap_out::verdict_text(&report.outcome, failure.map(|e| e as &dyn std::fmt::Display));
     sandslope_io::write_atomic(path, &drive_mcap(rows, &live, meta, &verdict)?)
-}
-
-#[cfg(test)]
-mod table_tests {
-    use super::*;
-
-    /// The drive table's defaults are the servo crate's [`RUN_DEFAULTS`] (which Python's
-    /// `drive` and `drive_defaults()` take), so the two cannot drift apart.
-    #[test]
-    fn the_tables_defaults_are_the_run_defaults() {
-        let f = DriveFields::from_params(&[], true).unwrap();
-        let d = RUN_DEFAULTS;
-        assert_eq!(
-            (f.run.slope_deg, f.run.duration_s, f.run.rate_hz, f.run.hold_s),
-            (d.slope_deg, d.duration_s, d.rate_hz, d.hold_s)
-        );
-        assert_eq!((f.run.watchdog_s, f.run.bus_watchdog_s), (d.watchdog_s, d.bus_watchdog_s));
-        assert_eq!(
-            (f.run.current_limit_ma, f.run.temperature_limit_c),
-            (d.current_limit_ma, d.temperature_limit_c)
-        );
-        assert_eq!((f.run.emulate_noise_ma, f.emulate_seed), (Some(d.emulate_noise_ma), d.emulate_seed));
-    }
 }

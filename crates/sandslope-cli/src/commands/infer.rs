@@ -6,123 +6,38 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::{Args, ValueEnum};
+use clap::Args;
 
 use sandslope::infer::{Bound, InferLaw};
 use sandslope_request::error::Words;
-use sandslope_request::infer::{self, GaitEvidence, InferAnswer, InferRequest, ServoLogRequest};
+use sandslope_request::grammar::uncertain_terrain;
+use sandslope_request::infer::{InferAnswer, InferQuestion, ServoLogQuestion, JOINTS, TOPIC};
 
-use crate::args::{parse_slope_list, RobotArgs, SlopeSign, TerrainArgs, UncertaintyArgs};
+use crate::args::{FieldArgs, RobotArgs, TerrainArgs};
 use crate::figures::infer::InferFigure;
 use crate::figures::{format_of, save};
 use crate::output::{check_parent_exists, print_json, sci, table};
 
-/// `--law`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum LawArg {
-    /// k_s(theta) = k_s0 + b theta_deg.
-    Linear,
-    /// k_s(theta) = k_s0 (cos theta - sin theta / tan phi).
-    Coulomb,
-}
-
 /// Arguments of `sandslope infer`.
 #[derive(Debug, Args)]
 pub struct InferArgs {
-    /// Observed speeds: CSV `slope_deg,speed_m_s,speed_sd_m_s[,n]` (as `track --speeds-out` writes;
-    /// with n, the mean's standard error is sd/sqrt(n)).
-    #[arg(long, value_name = "FILE", required_unless_present_any = ["steps", "servo_log"])]
-    pub observed: Option<PathBuf>,
-    /// Per-step output of `track --csv` at one slope, DEG=FILE (repeat for several slopes): speed
-    /// and anchoring time t1 of every step.
-    #[arg(long, value_name = "DEG=FILE", conflicts_with = "observed")]
-    pub steps: Vec<String>,
-    /// A servo log of `sandslope drive --log` (docs/drive.md): k_s at its slope from the
-    /// stance-phase currents, with the leg's shear load and the risk of slippage
-    /// (docs/model.md §19).
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["observed", "steps", "law"])]
-    pub servo_log: Option<PathBuf>,
-    /// A ROS 2 bag's sensor_msgs/JointState topic for --servo-log (docs/bags.md); the bag's
-    /// only one when omitted.
-    #[arg(long, value_name = "TOPIC", requires = "servo_log")]
-    pub topic: Option<String>,
-    /// The bag's joint names in leg order (leg 0 first), comma-separated; the message's own
-    /// order when omitted.
-    #[arg(long, value_name = "NAME,...", value_delimiter = ',', requires = "servo_log")]
-    pub joints: Vec<String>,
-    /// What the bag's JointState effort holds: n_m (torque, the message's unit), a or ma
-    /// (current, turned into torque with the XL330's K_t, docs/model.md §19).
-    #[arg(long, value_name = "n_m|a|ma", default_value = "n_m", requires = "servo_log")]
-    pub effort_unit: sandslope_io::bag::series::EffortUnit,
-    /// The slope of the --servo-log run, degrees (default: the log's `slope_deg` header).
-    #[arg(long, value_name = "DEG", requires = "servo_log", allow_negative_numbers = true)]
-    pub slope: Option<f64>,
-    /// k_s values the stride simulator walks for --servo-log (log-spaced over --k-s-prior).
-    #[arg(long, value_name = "N", default_value_t = sandslope::infer::servo::SERVO_LOG_GRID_POINTS, requires = "servo_log")]
-    pub grid_points: usize,
+    /// `--observed`, `--steps`, `--servo-log`, `--topic`, `--joints`, `--effort-unit`,
+    /// `--slope`, `--grid-points`, `--cv-n`, `--cv-s`, `--k-s-prior`, `--law` and `--predict`:
+    /// the request's own fields ([`sandslope_request::infer::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<InferQuestion>,
     #[command(flatten)]
     pub robot: RobotArgs,
     /// Terrain giving k_n (and the angle of repose) at each slope; its k_s is not used except
     /// as the comparison in the figure.
     #[command(flatten)]
     pub terrain: TerrainArgs,
-    #[command(flatten)]
-    pub uncertainty: UncertaintyArgs,
-    /// Log-uniform prior range of k_s, N/m^3.
-    #[arg(long = "k-s-prior", value_name = "MIN:MAX", default_value_t = default_prior())]
-    pub k_s_prior: String,
-    /// Tie the slopes together with a shear law and predict at --predict slopes.
-    #[arg(long, value_enum)]
-    pub law: Option<LawArg>,
-    /// Slopes to predict k_s and p_fail at with --law: DEG, a comma list or MIN:MAX:N.
-    #[arg(long, value_name = "DEG|LIST|MIN:MAX:N", default_value = "0:30:31", requires = "law")]
-    pub predict: String,
     /// Print JSON instead of tables.
     #[arg(long)]
     pub json: bool,
     /// Draw the posterior bands (and with --law the predicted risk) to this .png or .svg file.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-}
-
-/// `--k-s-prior`'s default, `1e4:1e9` (the library's [`SERVO_LOG_K_S_PRIOR`], which the gait
-/// inference shares).
-///
-/// [`SERVO_LOG_K_S_PRIOR`]: sandslope::infer::servo::SERVO_LOG_K_S_PRIOR
-fn default_prior() -> String {
-    let (lo, hi) = sandslope::infer::servo::SERVO_LOG_K_S_PRIOR;
-    format!("{lo:e}:{hi:e}")
-}
-
-/// Most slopes `--predict` evaluates.
-const MAX_PREDICT: usize = 10_000;
-
-/// The request the flags make: the observations' source, the prior, the law and, with a
-/// law, the prediction slopes (the slope-list grammar of `args::parse_slope_list`, climbing).
-fn request(args: &InferArgs) -> Result<InferRequest> {
-    let law = args.law.map(|l| match l {
-        LawArg::Linear => InferLaw::Linear,
-        LawArg::Coulomb => InferLaw::Coulomb,
-    });
-    let k_s_prior = infer::parse_prior(&args.k_s_prior)?;
-    let request = InferRequest {
-        evidence: match &args.observed {
-            Some(path) => GaitEvidence::Observed(path.clone()),
-            None => GaitEvidence::Steps(args.steps.clone()),
-        },
-        k_s_prior,
-        law,
-        predict: Vec::new(),
-    };
-    request.prior()?;
-    let predict = if law.is_some() {
-        parse_slope_list("--predict", &args.predict, SlopeSign::Uphill, MAX_PREDICT)?
-    } else {
-        Vec::new()
-    };
-    let request = InferRequest { predict, ..request };
-    request.check()?;
-    Ok(request)
 }
 
 fn bound_note(b: Bound) -> &'static str {
@@ -135,29 +50,27 @@ fn bound_note(b: Bound) -> &'static str {
 }
 
 /// `infer --servo-log`: k_s from the stance currents of a `drive` log (docs/model.md §19).
-fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
+fn run_servo_log(args: &InferArgs, question: &ServoLogQuestion) -> Result<()> {
     let robot = args.robot.load()?;
     // The log read and checked, its slope taken, by the request layer (as Python's is).
-    let request = ServoLogRequest {
-        path: path.to_path_buf(),
-        slope_deg: args.slope,
-        k_s_prior: infer::parse_prior(&args.k_s_prior)?,
-        grid_points: args.grid_points,
-    };
+    let ServoLogQuestion { request, topic, joints, effort } = question;
+    let path = request.path.as_path();
     let run = if sandslope_io::bag::is_bag(path) {
         // A ROS 2 bag's joint states, read as the servo log's leg angles and torques.
         let options = sandslope_io::bag::series::JointOptions {
-            topic: args.topic.as_deref(),
-            joints: (!args.joints.is_empty()).then_some(args.joints.as_slice()),
+            topic: topic.as_deref(),
+            joints: (!joints.is_empty()).then_some(joints.as_slice()),
             legs: 2 * robot.stance_legs() as usize,
-            effort: args.effort_unit,
+            effort: *effort,
         };
         let log = sandslope_io::bag::series::read_joint_states(path, &options)?;
         request.read_log(log, &robot, Words::Flag)?
     } else {
-        if args.topic.is_some() || !args.joints.is_empty() {
+        if topic.is_some() || !joints.is_empty() {
             anyhow::bail!(
-                "--topic and --joints read a ROS 2 bag (a folder with metadata.yaml, an .mcap or .db3 file), but {} is not one",
+                "{} and {} read a ROS 2 bag (a folder with metadata.yaml, an .mcap or .db3 file), but {} is not one",
+                TOPIC.long(),
+                JOINTS.long(),
                 path.display()
             );
         }
@@ -219,7 +132,7 @@ fn run_servo_log(args: &InferArgs, path: &std::path::Path) -> Result<()> {
     println!(
         "k_n {} N/m^3 from the terrain; stance torque K_t I against the stride simulator on {} k_s values (docs/model.md \u{a7}19)",
         sci(k_n),
-        args.grid_points
+        request.grid_points
     );
     Ok(())
 }
@@ -235,13 +148,13 @@ fn bound_note_servo(b: Bound) -> &'static str {
 
 /// Runs `sandslope infer`.
 pub fn run(args: InferArgs) -> Result<()> {
-    if let Some(path) = args.servo_log.clone() {
-        return run_servo_log(&args, &path);
-    }
+    let (request, cv_n, cv_s) = match InferQuestion::from_fields(&args.fields.pairs)? {
+        InferQuestion::ServoLog(question) => return run_servo_log(&args, &question),
+        InferQuestion::Gait { request, cv_n, cv_s } => (request, cv_n, cv_s),
+    };
     let robot = args.robot.load()?;
-    let request = request(&args)?;
     let obs = request.observations()?;
-    let (terrain, note) = args.uncertainty.apply(args.terrain.load()?)?;
+    let (terrain, note) = uncertain_terrain(args.terrain.load()?, cv_n, cv_s)?;
     if let Some(p) = &args.plot {
         format_of(p)?;
         check_parent_exists(p)?;

@@ -8,14 +8,14 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 
-use sandslope::gait::{TouchdownSource, TrackResult, DEFAULT_CUTOFF_HZ, DEFAULT_MAX_GAP};
+use sandslope::gait::{TouchdownSource, TrackResult};
 use sandslope_request::error::Words;
-use sandslope_request::track::{Touchdowns, TrackRequest};
+use sandslope_request::track::{TrackRequest, SLOPE};
 
-use crate::args::{RobotArgs, TerrainArgs};
-use crate::mocap_input::{expand, parse_mocap_format, parse_upslope, warn_without_steps};
+use crate::args::{FieldArgs, RobotArgs, TerrainArgs};
+use crate::mocap_input::{expand, warn_without_steps};
 use crate::output::{csv_string, num, print_json, table, write_atomic, Format, FormatArgs};
-use sandslope_io::mocap::{Capture, MocapFormat};
+use sandslope_io::mocap::Capture;
 use sandslope_io::{parse_speeds, SpeedRow};
 
 /// Arguments of `sandslope track`.
@@ -24,51 +24,15 @@ pub struct TrackArgs {
     /// Recordings at one slope (files or glob patterns such as `runs/10deg-*.csv`), pooled.
     #[arg(required = true, value_name = "FILE|GLOB")]
     pub files: Vec<String>,
-    /// File format: motive, vicon or plain; detected from the first line when omitted.
-    #[arg(long, value_name = "motive|vicon|plain", value_parser = parse_mocap_format)]
-    pub format: Option<MocapFormat>,
-    /// Rigid body, marker or model output to track (required when a file has several).
-    #[arg(long, value_name = "NAME")]
-    pub body: Option<String>,
-    /// A ROS 2 bag's topic of geometry_msgs/PoseStamped, nav_msgs/Odometry,
-    /// geometry_msgs/TransformStamped or tf2_msgs/TFMessage (a bag is a folder with
-    /// metadata.yaml, or an .mcap or .db3 file; docs/bags.md); the bag's only such topic when
-    /// omitted, else the error lists the candidates.
-    #[arg(long, value_name = "TOPIC")]
-    pub topic: Option<String>,
-    /// The child frame to track on a bag's TF topic (e.g. `base_link`), placed in the root of
-    /// its TF tree (docs/bags.md); the only one when omitted.
-    #[arg(long, value_name = "FRAME")]
-    pub frame: Option<String>,
-    /// Upslope direction in the capture frame: +x, -x, +y, -y, +z, -z or a vector such as
-    /// `0.91,0,0.41`; when omitted, the principal direction of travel, pointed the way it
-    /// rises along the format's vertical axis (a slide down reads as a negative speed).
-    #[arg(
-        long,
-        value_name = "AXIS|X,Y,Z",
-        value_parser = |s: &str| parse_upslope(s, "--upslope"),
-        allow_hyphen_values = true
-    )]
-    pub upslope: Option<[f64; 3]>,
-    /// Longest occlusion filled by linear interpolation, frames; longer gaps split the
-    /// recording into segments analysed separately.
-    #[arg(long, value_name = "FRAMES", default_value_t = DEFAULT_MAX_GAP, allow_negative_numbers = true)]
-    pub max_gap: usize,
-    /// Low-pass cutoff for the zero-phase speed estimate, Hz (see docs/tracking.md).
-    #[arg(long, allow_negative_numbers = true, value_name = "HZ", default_value_t = DEFAULT_CUTOFF_HZ)]
-    pub cutoff: f64,
+    /// `--format`, `--body`, `--topic`, `--frame`, `--upslope`, `--max-gap`, `--cutoff`,
+    /// `--touchdowns` and `--slope`: the request's own fields
+    /// ([`sandslope_request::track::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<TrackRequest>,
     #[command(flatten)]
     pub robot: RobotArgs,
     #[command(flatten)]
     pub terrain: TerrainArgs,
-    /// Touchdown times, s, one per line in the recording's clock (e.g. from the gait
-    /// controller's log); give it once per recording, in the same order. Estimated from the
-    /// speed signal when omitted.
-    #[arg(long, value_name = "FILE")]
-    pub touchdowns: Vec<PathBuf>,
-    /// Slope of these recordings, degrees (labels the output and the `--speeds-out` row).
-    #[arg(long, allow_negative_numbers = true, value_name = "DEG")]
-    pub slope: Option<f64>,
     /// Append `slope_deg,speed_m_s,speed_sd_m_s` to this file (created with a header), the
     /// format `sandslope calibrate` reads; needs --slope.
     #[arg(long, value_name = "FILE")]
@@ -118,33 +82,17 @@ pub fn run(args: TrackArgs) -> Result<()> {
     // --leg-speed (the robot's, shared by every command) sets the stride period T = 2 pi / omega,
     // and the model curve of --plot is that robot's too.
     let robot = args.robot.load()?;
-    let period = robot.stride_period();
+    // The flags read by the request layer's one raw-to-typed step, on the files expanded.
+    let request = TrackRequest::from_fields(&args.fields.pairs, Vec::new(), robot.stride_period())?;
     // --slope is checked once, by the request (a slope from 0 to below 90 degrees).
-    let slope = args.slope;
+    let slope = request.slope_deg;
     if args.speeds_out.is_some() && slope.is_none() {
-        bail!("--speeds-out needs --slope (the slope of these recordings, degrees)");
+        bail!("--speeds-out needs {} (the slope of these recordings, degrees)", SLOPE.long());
     }
     if let Some(p) = &args.plot {
         crate::figures::format_of(p)?;
     }
-    let files = expand(&args.files)?;
-    let request = TrackRequest {
-        files,
-        format: args.format,
-        body: args.body.clone(),
-        upslope: args.upslope,
-        max_gap: args.max_gap,
-        cutoff_hz: args.cutoff,
-        touchdowns: if args.touchdowns.is_empty() {
-            Touchdowns::Estimated
-        } else {
-            Touchdowns::Files(args.touchdowns.clone())
-        },
-        slope_deg: slope,
-        stride_period_s: period,
-        topic: args.topic.clone(),
-        frame: args.frame.clone(),
-    };
+    let request = TrackRequest { files: expand(&args.files)?, ..request };
     let (options, _) = request.options(Words::Flag)?;
     // Large exports take a while to parse: a bar on a terminal, nothing when piped.
     let n = request.files.len() as u64;

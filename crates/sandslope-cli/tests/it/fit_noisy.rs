@@ -7,8 +7,7 @@
 use crate::common;
 use common::sandslope;
 
-#[path = "fit/synth.rs"]
-mod synth;
+use crate::synth;
 
 use std::path::Path;
 

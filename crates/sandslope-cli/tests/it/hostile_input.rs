@@ -51,12 +51,14 @@ fn huge_ranges_are_refused_before_they_are_expanded() {
 
 #[test]
 fn max_risk_says_the_same_everywhere() {
-    // `report` needs its folder (`--out`, which clap requires first); the bad threshold is
-    // refused before the folder is made.
+    // `report` needs its folder (`--out`, which clap requires first) and design its --vary and
+    // --slope-target (clap asks for them before any value is read); the bad threshold is refused
+    // before the folder is made.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("report");
     let out = out.to_str().unwrap();
-    for args in [vec!["risk"], vec!["design"], vec!["report", "--out", out]] {
+    let design = ["design", "--vary", "mass_kg=1", "--slope-target", "10"];
+    for args in [&["risk"][..], &design, &["report", "--out", out]] {
         sandslope().args(args).args(["--max-risk", "1.5"]).assert().code(2).stderr(
             contains("--max-risk").and(contains("1.5 is not a failure probability strictly between 0 and 1")),
         );

@@ -26,4 +26,7 @@ mod report;
 mod report_page;
 mod simulate;
 mod surroundings;
+/// The synthetic load-cell campaigns `fit` and `fit_noisy` test on.
+#[path = "fit/synth.rs"]
+mod synth;
 mod track;

@@ -3,7 +3,8 @@
 //! calibration fits, and the step budget with the per-slope inversion.
 
 use sandslope::paper::Basis;
-use sandslope::report::{format_p, sci, ProvenanceKind, Report, ReportCalibration};
+use sandslope::report::{ProvenanceKind, Report, ReportCalibration};
+use sandslope_request::report_text::{format_p, sci};
 
 use super::{escape, plus_minus};
 

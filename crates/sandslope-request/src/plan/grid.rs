@@ -164,7 +164,7 @@ impl GridRequest {
             (Some(classes), Some(pairs)) => (classes, pairs),
             _ => {
                 return Err(RequestError::invalid(
-                    "classes",
+                    super::CLASSES.flag,
                     "classes and class_terrains go together: give both or neither",
                 ))
             }
@@ -173,7 +173,7 @@ impl GridRequest {
         if classes.shape != (rows, cols) {
             let (r, c) = classes.shape;
             return Err(RequestError::invalid(
-                "classes",
+                super::CLASSES.flag,
                 format!("classes has shape ({r}, {c}); it must be the DEM's ({rows}, {cols})"),
             ));
         }
@@ -188,7 +188,7 @@ impl GridRequest {
         let values = classes.values;
         let indices =
             sandslope::plan::class_indices(values, |i| !values[i].is_finite(), &keys).map_err(|e| {
-                RequestError::invalid("classes", format!("classes: {e}; add it to class_terrains"))
+                RequestError::invalid(super::CLASSES.flag, format!("classes: {e}; add it to class_terrains"))
             })?;
         Ok((Some(indices), terrains))
     }

@@ -6,7 +6,7 @@ use anyhow::bail;
 
 use sandslope::plan::Objective;
 
-use super::{PlanRequest, PlanSearch, Search, AUTO_FULL_MAX_CELLS};
+use super::{PlanRequest, PlanSearch, Search, AUTO_FULL_MAX_CELLS, MAX_MEMORY};
 use crate::error::{check_range, RequestError, Result};
 
 /// The memory limit: `--max-memory` (checked), else what the machine has available; `None`
@@ -14,11 +14,11 @@ use crate::error::{check_range, RequestError, Result};
 fn memory_limit(args: &PlanRequest) -> Result<Option<(f64, &'static str)>> {
     Ok(match args.max_memory {
         Some(gib) => {
-            let gib = check_range("max-memory", gib, 0.0, f64::INFINITY)?;
+            let gib = check_range(MAX_MEMORY.flag, gib, 0.0, f64::INFINITY)?;
             if gib <= 0.0 {
                 return Err(RequestError::invalid(
-                    "max-memory",
-                    format!("--max-memory = {gib} must be a number of GiB greater than 0"),
+                    MAX_MEMORY.flag,
+                    format!("{} = {gib} must be a number of GiB greater than 0", MAX_MEMORY.long()),
                 ));
             }
             Some((gib * GIB, "the --max-memory limit"))

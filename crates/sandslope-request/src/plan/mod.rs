@@ -14,13 +14,13 @@ use sandslope::plan::{
 };
 use sandslope::risk::{DefaultsUsed, UncertainTerrain};
 use sandslope::Robot;
-use sandslope_io::presets::DEFAULT_TERRAIN;
 use sandslope_io::raster::{open_height_windows, read_heights_within, read_raster, HeightWindows, Raster};
 
 use crate::error::{RequestError, Result, Words};
+use crate::field::{Field, Fields, Table};
 use crate::grammar;
 use crate::params::Params;
-use crate::scenario::RobotRequest;
+use crate::scenario::{RobotRequest, TERRAIN};
 
 mod answer;
 mod grid;
@@ -32,7 +32,11 @@ pub use answer::{answer, corridor_answer, records, CorridorJson, PlanJson, Route
 pub use grid::{ClassRaster, GridPlanRequest, GridRequest, GridSource, RouteCells};
 use memory::choose_search;
 pub use risk_raster::risk_band_rows;
-pub use settings::{parse_descent, parse_objective, settings_in};
+pub use settings::{
+    parse_descent, parse_objective, settings_in, ALLOW_METASTABLE, CLASSES, CLASS_TERRAIN, COARSE_FACTOR,
+    CORRIDOR_WIDTH, CV_N, CV_S, DEM, DESCENT, FIELDS, GOAL, GOAL_PX, MAX_MEMORY, MAX_ROLL, OBJECTIVE, SEARCH,
+    START, START_PX, TIME_WEIGHT,
+};
 
 /// `search = auto` searches maps of up to this many cells at full resolution (4096 x 4096)
 /// and larger ones in a corridor.
@@ -109,87 +113,101 @@ pub struct PlanRequest {
     pub corridor_width: usize,
 }
 
-/// A yes/no field: empty, `true` or `1` is yes; `false` or `0` no.
-fn yes_no(p: &mut Params<'_>, key: &'static str) -> Result<bool> {
-    match p.text(key)? {
-        None => Ok(false),
-        Some("" | "true" | "1") => Ok(true),
-        Some("false" | "0") => Ok(false),
-        Some(other) => Err(RequestError::invalid(
-            key,
-            format!("{key} = `{other}` must be true or false (or empty: true)"),
-        )),
-    }
-}
-
-/// A whole-number field, `default` when not given.
-fn count(p: &mut Params<'_>, key: &'static str, default: usize) -> Result<usize> {
-    match p.text(key)? {
-        None => Ok(default),
-        Some(text) => text.trim().parse().map_err(|_| {
-            RequestError::invalid(key, format!("--{key} = `{text}` is not a whole number of at least 0"))
-        }),
-    }
+impl Fields for PlanRequest {
+    const TABLE: Table = FIELDS;
 }
 
 impl PlanRequest {
-    /// Reads the fields of a plan request; refuses any other key.
+    /// Reads the fields of a plan request ([`FIELDS`], the robot's and the terrain's), each by
+    /// its row: the one raw-to-typed step of the command line and the server; refuses any
+    /// other key.
     pub fn from_params(params: &[(String, String)]) -> Result<PlanRequest> {
-        let mut p = Params::new("plan", params);
-        let dem = PathBuf::from(p.text("dem")?.unwrap_or_default());
-        let mut text = |key: &'static str| p.text(key).map(|t| t.map(str::to_string));
+        Self::read(params, None)
+    }
+
+    /// The command line's request: its own fields from `params` (the flags given, by
+    /// [`FIELDS`]), the robot and the terrain already read from the flags it shares with
+    /// other commands.
+    pub fn with_sources(params: &[(String, String)], sources: (RobotRequest, String)) -> Result<PlanRequest> {
+        Self::read(params, Some(sources))
+    }
+
+    fn read(params: &[(String, String)], sources: Option<(RobotRequest, String)>) -> Result<PlanRequest> {
+        let mut p = Params::new(FIELDS.command, params);
+        let dem = DEM.text_in(&mut p)?.ok_or_else(|| {
+            RequestError::invalid(DEM.flag, format!("{} is required: {}", DEM.long(), DEM.help))
+        })?;
+        let mut text = |f: &Field| f.text_in(&mut p).map(|t| t.map(str::to_string));
         let (start, goal, start_px, goal_px) =
-            (text("start")?, text("goal")?, text("start-px")?, text("goal-px")?);
-        for (which, map, px) in [("start", &start, &start_px), ("goal", &goal, &goal_px)] {
+            (text(&START)?, text(&GOAL)?, text(&START_PX)?, text(&GOAL_PX)?);
+        for (map_field, px_field, map, px) in
+            [(&START, &START_PX, &start, &start_px), (&GOAL, &GOAL_PX, &goal, &goal_px)]
+        {
             match (map, px) {
                 (None, None) => {
                     return Err(RequestError::invalid(
-                        which,
-                        format!("give --{which} X,Y or --{which}-px COL,ROW"),
+                        map_field.flag,
+                        format!(
+                            "give {} {} or {} {}",
+                            map_field.long(),
+                            map_field.value_name,
+                            px_field.long(),
+                            px_field.value_name
+                        ),
                     ))
                 }
                 (Some(_), Some(_)) => {
                     return Err(RequestError::invalid(
-                        format!("{which}-px"),
-                        format!("--{which}-px cannot be used with --{which}: give one"),
+                        px_field.flag,
+                        format!("{} cannot be used with {}: give one", px_field.long(), map_field.long()),
                     ))
                 }
                 _ => {}
             }
         }
-        let objectives = match p.text("objective")? {
-            None => vec![Objective::Time],
-            Some(list) => {
-                list.split(',').map(|o| parse_objective(Words::Flag, o)).collect::<Result<Vec<_>>>()?
+        let objectives = OBJECTIVE
+            .text_in(&mut p)?
+            .unwrap_or_default()
+            .split(',')
+            .map(|o| parse_objective(Words::Flag, o))
+            .collect::<Result<Vec<_>>>()?;
+        let (robot, terrain) = match sources {
+            Some(sources) => sources,
+            None => {
+                (RobotRequest::from_params(&mut p)?, TERRAIN.text_in(&mut p)?.unwrap_or_default().to_string())
             }
         };
-        let robot = RobotRequest::from_params(&mut p)?;
-        let terrain = p.text_or("terrain", DEFAULT_TERRAIN)?;
-        let allow_metastable = yes_no(&mut p, "allow-metastable")?;
-        let time_weight = p.number_or("time-weight", sandslope::plan::DEFAULT_TIME_WEIGHT)?;
-        let max_roll = p.number_or("max-roll", sandslope::plan::DEFAULT_MAX_ROLL_DEG)?;
-        let descent = match p.text("descent")? {
-            None => Descent::default(),
-            Some(text) => parse_descent(Words::Flag, text)?,
+        let classes = match (CLASSES.text_in(&mut p)?, CLASS_TERRAIN.text_in(&mut p)?) {
+            (None, None) => None,
+            (Some(path), Some(spec)) => Some((PathBuf::from(path), spec.to_string())),
+            (given, _) => {
+                let (field, other) =
+                    if given.is_some() { (&CLASSES, &CLASS_TERRAIN) } else { (&CLASS_TERRAIN, &CLASSES) };
+                return Err(RequestError::invalid(
+                    field.flag,
+                    format!("{} needs {} too: give both or neither", field.long(), other.long()),
+                ));
+            }
         };
-        let (cv_n, cv_s) = (p.number("cv-n")?, p.number("cv-s")?);
-        let max_memory = p.number("max-memory")?;
-        let search = match p.text("search")? {
-            None | Some("auto") => PlanSearch::Auto,
+        let allow_metastable = ALLOW_METASTABLE.switch_in(&mut p)?;
+        let time_weight = TIME_WEIGHT.required_number_in(&mut p)?;
+        let max_roll = MAX_ROLL.required_number_in(&mut p)?;
+        let descent = parse_descent(Words::Flag, DESCENT.text_in(&mut p)?.unwrap_or_default())?;
+        let (cv_n, cv_s) = (CV_N.number_in(&mut p)?, CV_S.number_in(&mut p)?);
+        let max_memory = MAX_MEMORY.number_in(&mut p)?;
+        let search = match SEARCH.choice_in(&mut p)? {
             Some("full") => PlanSearch::Full,
             Some("corridor") => PlanSearch::Corridor,
-            Some(other) => {
-                return Err(RequestError::invalid(
-                    "search",
-                    format!("--search = `{other}` must be auto, full or corridor"),
-                ))
-            }
+            _ => PlanSearch::Auto,
         };
-        let coarse_factor = count(&mut p, "coarse-factor", 8)?;
-        let corridor_width = count(&mut p, "corridor-width", 8)?;
+        let whole = |f: &Field, p: &mut Params<'_>| -> Result<usize> {
+            Ok(f.whole_in(p)?.unwrap_or_default() as usize)
+        };
+        let coarse_factor = whole(&COARSE_FACTOR, &mut p)?;
+        let corridor_width = whole(&CORRIDOR_WIDTH, &mut p)?;
         p.finish()?;
         Ok(PlanRequest {
-            dem,
+            dem: PathBuf::from(dem),
             start,
             goal,
             start_px,
@@ -197,7 +215,7 @@ impl PlanRequest {
             objectives,
             robot,
             terrain,
-            classes: None,
+            classes,
             allow_metastable,
             time_weight,
             max_roll,
@@ -222,14 +240,18 @@ impl PlanRequest {
     pub fn check_corridor(&self) -> Result<()> {
         if !(2..=64).contains(&self.coarse_factor) {
             return Err(RequestError::invalid(
-                "coarse-factor",
-                format!("--coarse-factor = {} must be between 2 and 64", self.coarse_factor),
+                COARSE_FACTOR.flag,
+                format!("{} = {} must be between 2 and 64", COARSE_FACTOR.long(), self.coarse_factor),
             ));
         }
         if !(1..=256).contains(&self.corridor_width) {
             return Err(RequestError::invalid(
-                "corridor-width",
-                format!("--corridor-width = {} must be between 1 and 256 coarse cells", self.corridor_width),
+                CORRIDOR_WIDTH.flag,
+                format!(
+                    "{} = {} must be between 1 and 256 coarse cells",
+                    CORRIDOR_WIDTH.long(),
+                    self.corridor_width
+                ),
             ));
         }
         Ok(())
@@ -240,7 +262,7 @@ impl PlanRequest {
     pub fn inputs(&self, note: &dyn Fn(&str)) -> Result<Inputs> {
         let robot = self.robot.load()?;
         let settings = self.settings()?;
-        let dem = read_raster(&self.dem).map_err(|e| RequestError::from_error(Some("dem"), e))?;
+        let dem = read_raster(&self.dem).map_err(|e| RequestError::from_error(Some(DEM.flag), e))?;
         let (classes, terrains) =
             self.classes_of(&dem, note).map_err(|e| RequestError::from_error(None, e))?;
         Ok(Inputs { dem, robot, classes, terrains, settings, dem_path: self.dem.clone() })
@@ -258,7 +280,7 @@ impl PlanRequest {
         match self.compute(risk_map, true, note, progress)? {
             Computed::Full(planned) => Ok(*planned),
             Computed::Corridor(_) => Err(RequestError::invalid(
-                "search",
+                SEARCH.flag,
                 "search = corridor: only the full-resolution search is available here",
             )),
         }
@@ -288,7 +310,7 @@ impl PlanRequest {
         let robot = self.robot.load()?;
         let settings = self.settings()?;
         let full_only = full_only || risk_map || self.classes.is_some();
-        let dem_err = |e| RequestError::from_error(Some("dem"), e);
+        let dem_err = |e| RequestError::from_error(Some(DEM.flag), e);
         // The readers check what they allocate against the same limit.
         sandslope_io::raster::set_memory_limit(
             self.max_memory.filter(|gib| *gib > 0.0).map(|gib| (gib * (1u64 << 30) as f64) as u64),
@@ -322,8 +344,8 @@ impl PlanRequest {
                 None => read_heights_within(&self.dem, &|_, _| Ok(())).map_err(dem_err)?,
             };
             let valid = |c: Cell| heights[c.row * dem.cols + c.col].is_finite();
-            let start = endpoint(&dem, &valid, "start", &self.start, &self.start_px)?;
-            let goal = endpoint(&dem, &valid, "goal", &self.goal, &self.goal_px)?;
+            let start = endpoint(&dem, &valid, (&START, &START_PX), &self.start, &self.start_px)?;
+            let goal = endpoint(&dem, &valid, (&GOAL, &GOAL_PX), &self.goal, &self.goal_px)?;
             let (mut classes, terrains) = self.classes_of(&dem, note).map_err(anyhow_err)?;
             // A map wrapping in longitude is planned with its columns rolled across the seam.
             let (dem, heights, start, goal) = match across_seam(&dem, start, goal) {
@@ -353,8 +375,8 @@ impl PlanRequest {
         // Only the endpoints' cells are read here; the corridor search reads its windows.
         let valid =
             |c: Cell| windows.read(c.row..c.row + 1, c.col..c.col + 1).is_ok_and(|h| h[0].is_finite());
-        let start = endpoint(&dem, &valid, "start", &self.start, &self.start_px)?;
-        let goal = endpoint(&dem, &valid, "goal", &self.goal, &self.goal_px)?;
+        let start = endpoint(&dem, &valid, (&START, &START_PX), &self.start, &self.start_px)?;
+        let goal = endpoint(&dem, &valid, (&GOAL, &GOAL_PX), &self.goal, &self.goal_px)?;
         // A map wrapping in longitude is planned with its columns rolled across the seam.
         let (dem, windows, start, goal) = match across_seam(&dem, start, goal) {
             None => (dem, windows, start, goal),
@@ -368,8 +390,8 @@ impl PlanRequest {
         let (classes, terrains) = self.classes_of(&dem, note).map_err(anyhow_err)?;
         let (None, [terrain]) = (&classes, terrains.as_slice()) else {
             return Err(RequestError::invalid(
-                "classes",
-                "--classes needs the full-resolution search (--search full)",
+                CLASSES.flag,
+                format!("{} needs the full-resolution search ({} full)", CLASSES.long(), SEARCH.long()),
             ));
         };
         let corridor = CorridorSettings::new(self.coarse_factor, self.corridor_width, max_bytes)
@@ -497,21 +519,22 @@ fn parse_pair(flag: &str, s: &str) -> anyhow::Result<(f64, f64)> {
 fn endpoint(
     raster: &Raster,
     valid: &dyn Fn(Cell) -> bool,
-    which: &str,
+    fields: (&Field, &Field),
     map: &Option<String>,
     px: &Option<String>,
 ) -> Result<Cell> {
-    let field = if px.is_some() { format!("{which}-px") } else { which.to_string() };
-    endpoint_cell(raster, valid, which, map, px).map_err(|e| RequestError::from_error(Some(&field), e))
+    let field = if px.is_some() { fields.1 } else { fields.0 };
+    endpoint_cell(raster, valid, fields, map, px).map_err(|e| RequestError::from_error(Some(field.flag), e))
 }
 
 fn endpoint_cell(
     raster: &Raster,
     valid: &dyn Fn(Cell) -> bool,
-    which: &str,
+    (map_field, px_field): (&Field, &Field),
     map: &Option<String>,
     px: &Option<String>,
 ) -> anyhow::Result<Cell> {
+    let (map_flag, px_flag) = (map_field.long(), px_field.long());
     let (cols, rows) = (raster.cols, raster.rows);
     let g = &raster.geo;
     let (east, south) = (g.west + cols as f64 * g.cell_x, g.north - rows as f64 * g.cell_y);
@@ -527,13 +550,13 @@ fn endpoint_cell(
         rows - 1
     );
     let (c, r, what, on_edge) = if let Some(s) = px {
-        let (c, r) = parse_pair(&format!("--{which}-px"), s)?;
+        let (c, r) = parse_pair(&px_flag, s)?;
         if c.fract() != 0.0 || r.fract() != 0.0 {
-            bail!("--{which}-px = `{s}` must be whole column and row numbers");
+            bail!("{px_flag} = `{s}` must be whole column and row numbers");
         }
-        (c, r, format!("--{which}-px {s}"), false)
+        (c, r, format!("{px_flag} {s}"), false)
     } else if let Some(s) = map {
-        let (x, y) = parse_pair(&format!("--{which}"), s)?;
+        let (x, y) = parse_pair(&map_flag, s)?;
         // A longitude is the same place 360 degrees on: -10 on a map of 0 to 360 east (a MOLA
         // MEGDR's) is 350.
         let x = if raster.crs.is_geographic() && !(g.west..=east).contains(&x) {
@@ -544,9 +567,9 @@ fn endpoint_cell(
         let (c, r) = g.cell_of(x, y);
         // On the map's outline (e.g. its corner 0,0): inside the closed extent, but not in any cell.
         let on_edge = (g.west..=east).contains(&x) && (south..=g.north).contains(&y);
-        (c, r, format!("--{which} {s}"), on_edge)
+        (c, r, format!("{map_flag} {s}"), on_edge)
     } else {
-        bail!("give --{which} X,Y or --{which}-px COL,ROW");
+        bail!("give {map_flag} {} or {px_flag} {}", map_field.value_name, px_field.value_name);
     };
     let outside = c < 0.0 || r < 0.0 || c >= cols as f64 || r >= rows as f64;
     if outside && on_edge {

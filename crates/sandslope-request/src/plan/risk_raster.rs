@@ -37,8 +37,12 @@ impl PlanRequest {
         let (classes, terrains) = self.load_classes(dem).map_err(|e| RequestError::from_error(None, e))?;
         let (None, [terrain]) = (&classes, terrains.as_slice()) else {
             return Err(RequestError::invalid(
-                "classes",
-                "a risk map with --classes needs the full-resolution search (--search full)",
+                super::CLASSES.flag,
+                format!(
+                    "a risk map with {} needs the full-resolution search ({} full)",
+                    super::CLASSES.long(),
+                    super::SEARCH.long()
+                ),
             ));
         };
         let (cols, rows) = (heights.cols(), heights.rows());

@@ -153,7 +153,12 @@ fn fit(
     // Profile intervals, one parameter per task, beside the profile of k_s(20)/k_s(0) where it
     // is one (force tests: it needs no fitted parameter's interval).
     let (intervals, ratio_profile): (Vec<Interval>, Option<Interval>) = rayon::join(
-        || (0..n).into_par_iter().map(|j| interval_for(&problem, Profiled::Unknown(j), &best, s_min)).collect(),
+        || {
+            (0..n)
+                .into_par_iter()
+                .map(|j| interval_for(&problem, Profiled::Unknown(j), &best, s_min))
+                .collect()
+        },
         || problem.law.is_none().then(|| ratio_interval(&problem, &best, s_min, &[])),
     );
     // A profile that found a lower minimum means the global fit was not global: take it.
@@ -172,8 +177,7 @@ fn fit(
         })
         .collect();
 
-    let shear_ratio_20 =
-        ratio_profile.unwrap_or_else(|| ratio_interval(&problem, &best, s_min, &parameters));
+    let shear_ratio_20 = ratio_profile.unwrap_or_else(|| ratio_interval(&problem, &best, s_min, &parameters));
     let (pulls, _) = problem.pulls(&best).unwrap_or_default();
     let chi_squared: f64 = pulls.iter().map(|p| p.pull * p.pull).sum();
     let dof = problem.n_obs as i64 - n as i64;

@@ -91,6 +91,9 @@ pub(crate) struct Problem<'a> {
     pub simulator: Option<SimulatedModel<'a>>,
     /// The distinct slopes of speeds and anchoring times, degrees (one walk each).
     pub walk_slopes: Vec<f64>,
+    /// Whether the optimiser may take its Jacobian by the chain rule through each walk's leg
+    /// k_s ([`Problem::walks_depend_only_on_k_s`]); `true` but in the tests that compare.
+    pub chain_rule: bool,
 }
 
 /// A candidate point (one value per unknown) resolved into what the model needs.
@@ -185,7 +188,8 @@ impl Problem<'_> {
     /// derivative in its own k_s times the k_s's, the chain rule the optimiser's Jacobian uses
     /// (docs/calibration.md).
     pub fn walks_depend_only_on_k_s(&self) -> bool {
-        self.simulator.is_some()
+        self.chain_rule
+            && self.simulator.is_some()
             && !self.unknowns.iter().any(|u| matches!(u.quantity, Quantity::Free(Parameter::Robot(_))))
     }
 
@@ -444,8 +448,17 @@ pub(crate) fn build<'a>(
         SpeedModel::ClosedForm => None,
         SpeedModel::Simulator { settings } => Some(SimulatedModel::new(settings, cancel)),
     };
-    let problem =
-        Problem { setup, unknowns, force_tests, force_test_unknown, law, n_obs, simulator, walk_slopes };
+    let problem = Problem {
+        setup,
+        unknowns,
+        force_tests,
+        force_test_unknown,
+        law,
+        n_obs,
+        simulator,
+        walk_slopes,
+        chain_rule: true,
+    };
     // The simulator refuses some robots and grounds (more than 64 stance legs, a step too
     // coarse for the stiffness): say so now rather than fit a flat penalty.
     let start: Vec<f64> = problem.unknowns.iter().map(|u| u.start).collect();

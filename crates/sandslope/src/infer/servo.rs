@@ -251,22 +251,19 @@ pub fn remove_swing_offset(
 /// file's response time, docs/model.md §19; [`SimSettings::ramp_up_s`]): the emulator's currents and the inference's model profiles both come from
 /// these, with the body pitch locked, the setting whose answers converge on the built-in
 /// terrain (docs/simulate.md: the free body's walks on slopes change with the time step, so a
-/// sensor read against them would read the integrator, not the sand), and the two-faced belly
-/// (docs/model.md §20.5) **(choice: the sensor's likelihood, its grid and its resolution term
-/// were built and checked on the two-faced walks; on the one-sided walks, the simulator's
-/// default, the emulated currents' 90% intervals held the truth in 8 of 10 runs where 9 are
-/// required, the biased-sensor run missed 6 of 14, and the 20 degree halt came a stride late,
-/// measured in CI on 2026-12-07; the sensor waits for its re-tuning on the one-sided walk)**.
+/// sensor read against them would read the integrator, not the sand), and otherwise the
+/// simulator's default physics (the one-sided belly of docs/model.md §20.5). (Before the legs
+/// ran up and a stance's bins carried their sampling error, the one-sided walks' intervals held
+/// the truth in 8 of 10 emulated runs; with both, the tests pass on them, docs/drive.md.)
 pub fn sensor_walk_settings(
     duration_s: f64,
     rate_hz: f64,
     ramp_up_s: f64,
 ) -> Result<SimSettings, crate::error::ParamError> {
-    SimSettings::new(duration_s)?
+    Ok(SimSettings::new(duration_s)?
         .with_sample_rate(rate_hz)?
         .with_ramp_up(ramp_up_s)?
-        .with_body_pitch(crate::simulate::BodyPitch::Locked)
-        .with_mechanisms(crate::simulate::Mechanisms { one_sided_belly: false, ..Default::default() })
+        .with_body_pitch(crate::simulate::BodyPitch::Locked))
 }
 
 /// Simulates `robot` at `slope` on constant ground `k_n` and each k_s of the settings'

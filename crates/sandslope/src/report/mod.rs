@@ -233,7 +233,9 @@ pub struct Report {
     pub paper_vs_model: Vec<PaperComparison>,
     /// How many of the paper's numbers the model agrees with, independent ones apart.
     pub summary: Summary,
-    /// The generated "where the model and the evidence disagree" items.
+    /// The generated "where the model and the evidence disagree" items: the user's observations
+    /// the calibrated model misses, then those the front end words from this report's values
+    /// (failing comparisons, the per-slope inversion, the calibration's floor and plate scale).
     pub disagreements: Vec<String>,
     /// The k_s each observed speed needs on its own, lowest slope first.
     pub speed_inversion: Vec<SpeedInversion>,
@@ -256,14 +258,19 @@ pub struct Report {
     /// the walk on the fitted ground, what a scan of the leg's k_s reaches there, and why
     /// (empty without the fit).
     pub simulator_fit_misses: Vec<SimulatorMiss>,
-    /// What the report was made from, each with its provenance.
+    /// What the report was made from, each with its provenance: worded by the front end from
+    /// the evidence (empty as [`report`] returns it).
     pub inputs: Vec<Input>,
+    /// Whether the motion-capture tracks give anchoring times (a row of the inputs table).
+    #[serde(skip)]
+    pub tracks_give_t1: bool,
     /// Sentences on how the tracks entered the report (skipped t1s, speeds not used, ...).
     #[serde(skip)]
     pub track_notes: Vec<String>,
     /// What a reader must know before trusting the page: a fitted quantity at its search
     /// bound, a fit far worse than the quoted SDs allow (chi^2/dof > 3), tracks that could not be
-    /// used. Printed at the top of the page and on stderr (`report --strict` fails on any).
+    /// used. Printed at the top of the page and on stderr (`report --strict` fails on any). The
+    /// calibration's own warnings are worded last by the front end from [`Self::calibration`].
     pub warnings: Vec<String>,
     /// The figures' data.
     #[serde(skip)]
@@ -385,7 +392,8 @@ pub struct ReportCalibration {
     pub fit: JointCalibration,
     /// The fit without the floor: its chi^2 is the goodness-of-fit test.
     pub no_floor: Option<NoFloorFit>,
-    /// Which chi^2 tests the model, in words.
+    /// Which chi^2 tests the model, in words: worded by the front end from [`Self::no_floor`]
+    /// (empty as [`report`] returns it).
     pub goodness_of_fit: String,
 }
 
@@ -446,14 +454,6 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     let measured: Vec<f64> = plots.table.iter().map(|p| p.slope_deg).collect();
     let extrapolations: Vec<Extrapolation> =
         audit::extrapolation(&robot, &terrain, &measured, paper::HEAVY_ROBOT_CLAIM).into_iter().collect();
-    let disagreements = disagreements::disagreements(&disagreements::Findings {
-        rows: &paper_vs_model,
-        calibration: calibration.as_ref(),
-        speeds: &speeds,
-        inversion: &speed_inversion,
-        extrapolations: &extrapolations,
-        forces: &evidence.forces,
-    });
     let mut slopes: Vec<Slope> = speeds.iter().map(|o| o.slope).collect();
     slopes.sort_by(|a, b| a.degrees().total_cmp(&b.degrees()));
     slopes.dedup();
@@ -480,15 +480,12 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         ));
     }
     warnings.extend(simulator_fit_warnings);
-    if let Some(c) = &calibration {
-        warnings.extend(disagreements::calibration_warnings(c));
-    }
     let observations = if own {
         disagreements::observation_items(&robot, &terrain, &speeds, &plots.anchoring)
     } else {
         Vec::new()
     };
-    let disagreements: Vec<String> = observations.into_iter().chain(disagreements).collect();
+    let disagreements = observations;
     let fit_diagnosis = calibration.as_ref().and_then(|c| {
         diagnosis::diagnose(&diagnosis::DiagnosisInput {
             fit: &c.fit,
@@ -517,7 +514,8 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         simulator_convergence,
         simulator_fit,
         simulator_fit_misses,
-        inputs: provenance::inputs(evidence, !track_use.anchoring.is_empty()),
+        inputs: Vec::new(),
+        tracks_give_t1: !track_use.anchoring.is_empty(),
         track_notes: track_use.notes,
         warnings,
         plots,
@@ -614,51 +612,7 @@ fn calibrate(
     let setup = joint_setup(evidence, speeds, anchoring);
     let no_floor = audit::no_floor_fit(&evidence.robot, &setup.normal, speeds, anchoring);
     let fit = calibrate_jointly(&setup).ok()?;
-    let goodness_of_fit = match no_floor.and_then(|n| n.p_value.map(|p| (n, p))) {
-        Some((n, p)) => format!(
-            "The goodness-of-fit test is the fit without the floor: χ² = {:.1} on {} dof, p = {}. With the floor free, χ²/dof near 1 to 2 is built in (the floor grows until it is), so that χ² tests nothing.",
-            n.chi_squared,
-            n.dof,
-            format_p(p)
-        ),
-        None => "The fit without the floor has no degrees of freedom left: no goodness-of-fit test is possible on this evidence.".into(),
-    };
-    Some(ReportCalibration { fit, no_floor, goodness_of_fit })
-}
-
-/// A probability as text: 2 significant digits, `< 10⁻³⁰⁰` below what a float holds.
-pub fn format_p(p: f64) -> String {
-    if p <= 0.0 {
-        "< 10⁻³⁰⁰".into()
-    } else if p >= 0.01 {
-        format!("{p:.2}")
-    } else {
-        sci(p, 1)
-    }
-}
-
-/// `x` as `m.mm × 10ⁿ` with `decimals` digits after the point (superscript exponent), or
-/// plainly when `0.01 <= |x| < 10⁴`; the one number format of the report's text.
-pub fn sci(x: f64, decimals: usize) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let a = x.abs();
-    if (0.01..1e4).contains(&a) {
-        let digits = (decimals as i32 + 1 - a.log10().floor() as i32 - 1).max(0) as usize;
-        return format!("{x:.digits$}");
-    }
-    let text = format!("{x:.decimals$e}");
-    let (m, e) = text.split_once('e').unwrap_or((&text, "0"));
-    const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
-    let exp: String = e
-        .chars()
-        .map(|c| match c {
-            '-' => '⁻',
-            d => d.to_digit(10).map_or(d, |d| SUP[d as usize]),
-        })
-        .collect();
-    format!("{m} × 10{exp}")
+    Some(ReportCalibration { fit, no_floor, goodness_of_fit: String::new() })
 }
 
 /// The figures' data.
@@ -836,14 +790,10 @@ mod tests {
         // The test terrain's points are at 0 and 20 deg: fig4d/h draw beyond 20 dashed.
         assert_eq!(r.plots.last_point_deg, Some(20.0));
         assert_eq!(r.calibration.is_some(), ids.contains(&"calibration"));
-        // The observed speed rises from 20 to 24 deg (4.98 to 5.6 cm/s): the k_s it needs rises.
-        assert!(
-            r.disagreements.iter().any(|d| d.contains("rise from") && d.contains("20° to 24°")),
-            "{:?}",
-            r.disagreements
-        );
-        let speeds = r.inputs.iter().find(|i| i.name == "observed speeds").unwrap();
-        assert_eq!(speeds.provenance.kind, ProvenanceKind::Measured);
+        // The observed speed rises from 20 to 24 deg (4.98 to 5.6 cm/s): the k_s it needs rises
+        // (the request layer words it, and tests the words).
+        let needed: Vec<Option<f64>> = r.speed_inversion.iter().map(|i| i.k_s_needed).collect();
+        assert!(matches!(needed[3..], [Some(a), Some(b)] if b > a), "{needed:?}");
         // A terrain file of the user's: its speed comparisons are independent tests.
         let mut speed_rows = r.paper_vs_model.iter().filter(|c| c.id.starts_with("speed_"));
         assert!(speed_rows.clone().count() == 5 && speed_rows.all(|c| c.basis == Basis::Independent));
@@ -964,8 +914,6 @@ mod tests {
         assert!(r.paper_vs_model.iter().all(|c| !c.quantity.contains("0.35") && c.agrees));
         assert!((r.paper_vs_model[0].model_value.unwrap() - 0.4).abs() < 1e-12);
         assert_eq!((r.summary.independent, r.summary.independent_agree), (2, 2));
-        let speeds = r.inputs.iter().find(|i| i.name == "observed speeds").unwrap();
-        assert!(speeds.value.starts_with("none"), "{}", speeds.value);
 
         let obs = |d: f64, v: f64| SpeedObservation { slope: at(d), speed: v, speed_sd: 0.01 };
         e.observed = Some(("mine.csv".into(), vec![obs(0.0, 0.12), obs(10.0, 0.08), obs(20.0, 0.04)]));

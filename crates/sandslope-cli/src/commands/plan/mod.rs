@@ -3,17 +3,19 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use sandslope::plan::{Descent, Objective};
+use sandslope::plan::Objective;
 
-use crate::args::{RobotArgs, TerrainArgs, UncertaintyArgs};
+use crate::args::{FieldArgs, RobotArgs, TerrainArgs};
 use crate::figures::plan::PlanFigure;
 use crate::output::print_json;
 use sandslope_io::raster::write_two_band_geotiff;
 use sandslope_io::routes as writers;
-use sandslope_request::plan::{answer, corridor_answer, Computed, CorridorPlanned, PlanSearch, Planned};
+use sandslope_request::plan::{
+    answer, corridor_answer, Computed, CorridorPlanned, PlanSearch, Planned, CLASSES,
+};
 use sandslope_request::PlanRequest;
 
 mod table;
@@ -23,112 +25,19 @@ use table::print_routes;
 /// Maps at least this large get a progress bar (on a terminal).
 const PROGRESS_MIN_CELLS: usize = 1 << 20;
 
-/// `--objective` values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, ValueEnum)]
-pub enum ObjectiveArg {
-    /// Fastest route through cells whose regime is success.
-    Time,
-    /// Maximum survival probability (plus --time-weight times the time).
-    Risk,
-    /// Shortest 3-D length, physics ignored (the naive baseline).
-    Distance,
-}
-
-impl From<ObjectiveArg> for Objective {
-    fn from(o: ObjectiveArg) -> Objective {
-        match o {
-            ObjectiveArg::Time => Objective::Time,
-            ObjectiveArg::Risk => Objective::Risk,
-            ObjectiveArg::Distance => Objective::Distance,
-        }
-    }
-}
-
-/// `--search` values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum SearchArg {
-    /// Full resolution for maps of up to 4096 x 4096 cells, corridor above.
-    Auto,
-    /// The exact optimum over every cell of the map.
-    Full,
-    /// Coarse-to-fine: the exact optimum inside a corridor around a route planned on a
-    /// coarsened map (not the full optimum: docs/planning.md measures the gap).
-    Corridor,
-}
-
-/// `--descent` values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum DescentArg {
-    /// Descending evaluated as climbing |pitch| (docs/model.md §8 default).
-    Symmetric,
-    /// Descending evaluated as level ground (optimistic).
-    Level,
-}
-
 /// Arguments of `sandslope plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// Elevation model: GeoTIFF (.tif), ESRI ASCII grid (.asc) or PDS3 DTM (.img, .lbl).
-    #[arg(long, value_name = "FILE")]
-    pub dem: PathBuf,
-    /// Start in map coordinates.
-    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, required_unless_present = "start_px")]
-    pub start: Option<String>,
-    /// Goal in map coordinates.
-    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, required_unless_present = "goal_px")]
-    pub goal: Option<String>,
-    /// Start as a cell of the DEM (column, row from the north-west corner).
-    #[arg(long, value_name = "COL,ROW", conflicts_with = "start", allow_hyphen_values = true)]
-    pub start_px: Option<String>,
-    /// Goal as a cell of the DEM (column, row from the north-west corner).
-    #[arg(long, value_name = "COL,ROW", conflicts_with = "goal", allow_hyphen_values = true)]
-    pub goal_px: Option<String>,
-    /// What to minimise (comma-separated for several); the distance route is always added.
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "time")]
-    pub objective: Vec<ObjectiveArg>,
+    /// `--dem`, `--start`, `--goal`, `--start-px`, `--goal-px`, `--objective`, `--classes`,
+    /// `--class-terrain`, `--allow-metastable`, `--time-weight`, `--max-roll`, `--descent`,
+    /// `--cv-n`, `--cv-s`, `--max-memory`, `--search`, `--coarse-factor` and
+    /// `--corridor-width`: the request's own fields ([`sandslope_request::plan::FIELDS`]).
+    #[command(flatten)]
+    pub fields: FieldArgs<PlanRequest>,
     #[command(flatten)]
     pub robot: RobotArgs,
     #[command(flatten)]
     pub terrain: TerrainArgs,
-    /// Integer raster aligned with the DEM giving each cell's terrain class.
-    #[arg(long, value_name = "FILE", requires = "class_terrain")]
-    pub classes: Option<PathBuf>,
-    /// Terrain of each class, e.g. `1=dune.toml,2=crust.toml` (files or presets).
-    #[arg(long, value_name = "CLASS=TERRAIN,...", requires = "classes")]
-    pub class_terrain: Option<String>,
-    /// Let the time objective use metastable edges (0 < step < s_min).
-    #[arg(long)]
-    pub allow_metastable: bool,
-    /// Risk objective: weight of travel time, per second (1e-4: 100 s weigh like a 1 % risk;
-    /// 0: survival only, ties broken by length).
-    #[arg(long, allow_negative_numbers = true, value_name = "PER_S", default_value_t = sandslope::plan::DEFAULT_TIME_WEIGHT)]
-    pub time_weight: f64,
-    /// Cross-slope (roll) limit, degrees: steeper cross slopes are impassable.
-    #[arg(long, allow_negative_numbers = true, value_name = "DEG", default_value_t = sandslope::plan::DEFAULT_MAX_ROLL_DEG)]
-    pub max_roll: f64,
-    /// How descending edges are evaluated.
-    #[arg(long, value_enum, default_value = "symmetric")]
-    pub descent: DescentArg,
-    #[command(flatten)]
-    pub uncertainty: UncertaintyArgs,
-    /// Refuse a DEM whose planning would need more than this many GiB (default: the memory
-    /// available when plan starts, MemAvailable in /proc/meminfo).
-    #[arg(long, allow_negative_numbers = true, value_name = "GIB")]
-    pub max_memory: Option<f64>,
-    /// How to search: `full`, the exact optimum over the whole map (48 bytes a cell); `corridor`,
-    /// coarse-to-fine for maps too large or slow for that: the routes planned on the map
-    /// averaged over --coarse-factor cells, then the exact optimum at full resolution inside a
-    /// corridor of --corridor-width coarse cells on each side of the coarse route (an upper
-    /// bound on the full optimum; docs/planning.md measures the gap; one terrain, no --plot,
-    /// --risk-map as a GeoTIFF only, computed band by band); `auto`, full for maps of up to 4096 x 4096 cells, corridor above.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub search: SearchArg,
-    /// Corridor search: fine cells per coarse cell along each axis (2 to 64).
-    #[arg(long, value_name = "N", default_value_t = 8)]
-    pub coarse_factor: usize,
-    /// Corridor search: the corridor's half-width around the coarse route, in coarse cells (1 to 256).
-    #[arg(long, value_name = "CELLS", default_value_t = 8)]
-    pub corridor_width: usize,
     #[command(flatten)]
     pub out: Box<OutputArgs>,
 }
@@ -156,36 +65,12 @@ pub struct OutputArgs {
 }
 
 impl PlanArgs {
-    /// The request these flags make (the one `serve`'s `/api/plan` builds too).
-    pub fn request(&self) -> PlanRequest {
-        PlanRequest {
-            dem: self.dem.clone(),
-            start: self.start.clone(),
-            goal: self.goal.clone(),
-            start_px: self.start_px.clone(),
-            goal_px: self.goal_px.clone(),
-            objectives: self.objective.iter().map(|&o| o.into()).collect(),
-            robot: self.robot.request(),
-            terrain: self.terrain.terrain.clone(),
-            classes: self.classes.clone().zip(self.class_terrain.clone()),
-            allow_metastable: self.allow_metastable,
-            time_weight: self.time_weight,
-            max_roll: self.max_roll,
-            descent: match self.descent {
-                DescentArg::Symmetric => Descent::Symmetric,
-                DescentArg::Level => Descent::Level,
-            },
-            cv_n: self.uncertainty.cv_n,
-            cv_s: self.uncertainty.cv_s,
-            max_memory: self.max_memory,
-            search: match self.search {
-                SearchArg::Auto => PlanSearch::Auto,
-                SearchArg::Full => PlanSearch::Full,
-                SearchArg::Corridor => PlanSearch::Corridor,
-            },
-            coarse_factor: self.coarse_factor,
-            corridor_width: self.corridor_width,
-        }
+    /// The request these flags make, read by the request layer's one raw-to-typed step (the
+    /// one `serve`'s `/api/plan` takes): the plan's own flags, the robot and the terrain read
+    /// from the flags it shares with other commands.
+    pub fn request(&self) -> Result<PlanRequest> {
+        let sources = (self.robot.request(), self.terrain.terrain.clone());
+        Ok(PlanRequest::with_sources(&self.fields.pairs, sources)?)
     }
 }
 
@@ -251,7 +136,7 @@ impl Bars {
 /// Runs `sandslope plan`.
 pub fn run(args: PlanArgs) -> Result<()> {
     // The flags are checked, in this order, before the output folders and any other file.
-    let request = args.request();
+    let request = args.request()?;
     request.robot.load()?;
     request.settings()?;
     for p in [&args.out.plot].into_iter().flatten() {
@@ -265,12 +150,12 @@ pub fn run(args: PlanArgs) -> Result<()> {
     // A GeoTIFF risk map is computed band by band from the heights read window by window
     // when the routes are searched in corridors (a DEM larger than memory); a Nav2 or MCAP map
     // and terrain classes need the full-resolution planner.
-    let streamed_risk = args.out.risk_map.as_deref().is_some_and(is_geotiff) && args.classes.is_none();
-    if args.search == SearchArg::Corridor {
+    let streamed_risk = args.out.risk_map.as_deref().is_some_and(is_geotiff) && request.classes.is_none();
+    if request.search == PlanSearch::Corridor {
         for (flag, given) in [
             ("--plot", args.out.plot.is_some()),
             ("--risk-map", args.out.risk_map.is_some() && !streamed_risk),
-            ("--classes", args.classes.is_some()),
+            (CLASSES.long().as_str(), request.classes.is_some()),
         ] {
             if given {
                 bail!("{flag} needs the full-resolution search: drop --search corridor (or crop the DEM)");
@@ -281,12 +166,12 @@ pub fn run(args: PlanArgs) -> Result<()> {
     let full_only = args.out.plot.is_some();
     let risk_in_planner = (args.out.risk_map.is_some() && !streamed_risk) || args.out.plot.is_some();
     match compute_any(&request, risk_in_planner, full_only, false)? {
-        Computed::Full(planned) => run_full(&args, &planned),
+        Computed::Full(planned) => run_full(&args, &request, &planned),
         Computed::Corridor(planned) => {
             if let Some(p) = &args.out.risk_map {
                 write_streamed_risk_map(&request, &planned, p, args.out.json)?;
             }
-            run_corridor(&args, &planned)
+            run_corridor(&args, &request, &planned)
         }
     }
 }
@@ -314,7 +199,7 @@ fn write_streamed_risk_map(
 }
 
 /// Writes and prints what the full-resolution search found.
-fn run_full(args: &PlanArgs, planned: &Planned) -> Result<()> {
+fn run_full(args: &PlanArgs, request: &PlanRequest, planned: &Planned) -> Result<()> {
     let Planned { dem, result } = planned;
     if let Some(p) = &args.out.geojson {
         writers::write_geojson(p, &dem.geo, &result.routes)?;
@@ -356,12 +241,12 @@ fn run_full(args: &PlanArgs, planned: &Planned) -> Result<()> {
     if args.out.json {
         return print_json(&answer(planned));
     }
-    print_routes(&result.routes, args.allow_metastable);
+    print_routes(&result.routes, request.allow_metastable);
     Ok(())
 }
 
 /// Writes and prints what the corridor search found, saying how it was found.
-fn run_corridor(args: &PlanArgs, planned: &CorridorPlanned) -> Result<()> {
+fn run_corridor(args: &PlanArgs, request: &PlanRequest, planned: &CorridorPlanned) -> Result<()> {
     let CorridorPlanned { dem, heights, plan, settings } = planned;
     if let Some(p) = &args.out.geojson {
         writers::write_geojson(p, &dem.geo, &plan.routes)?;
@@ -373,7 +258,7 @@ fn run_corridor(args: &PlanArgs, planned: &CorridorPlanned) -> Result<()> {
     if args.out.json {
         return print_json(&corridor_answer(planned));
     }
-    print_routes(&plan.routes, args.allow_metastable);
+    print_routes(&plan.routes, request.allow_metastable);
     let cells: Vec<String> = plan
         .corridors
         .iter()

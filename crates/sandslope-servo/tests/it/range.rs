@@ -9,7 +9,8 @@ use std::sync::atomic::AtomicBool;
 
 use sandslope::servo::GaitSchedule;
 use sandslope::{Robot, RobotSpec, Terrain};
-use sandslope_servo::driver::{drive, DriveError};
+use sandslope_servo::clock::ClockKind;
+use sandslope_servo::driver::{drive_on_clock, DriveError};
 use sandslope_servo::session::default_servos;
 use sandslope_servo::{DriveSettings, Emulator, EmulatorConfig, Profile};
 
@@ -21,6 +22,8 @@ fn run(turns: i32, clear: bool, duration_s: f64) -> (Vec<i32>, Option<DriveError
     cfg.initial_turns = turns;
     cfg.clear_supported = clear;
     cfg.simulated_strides = 3;
+    // On the virtual clock (docs/drive.md, "The emulator's clock"): 5 s of run in its computing.
+    cfg.clock = ClockKind::Virtual;
     let (emulator, port) = Emulator::start(&cfg).unwrap();
     let mut bus = dynamixel2::Bus::new(port).unwrap();
     let schedule = GaitSchedule::new(&robot, 6).unwrap();
@@ -40,7 +43,7 @@ fn run(turns: i32, clear: bool, duration_s: f64) -> (Vec<i32>, Option<DriveError
     };
     let mut goals = vec![];
     let stop = AtomicBool::new(false);
-    let (_, failure) = drive(
+    let (_, failure) = drive_on_clock(
         &mut bus,
         &schedule,
         &settings,
@@ -51,6 +54,7 @@ fn run(turns: i32, clear: bool, duration_s: f64) -> (Vec<i32>, Option<DriveError
             Ok(())
         },
         &mut |_| {},
+        &emulator.clock(),
     );
     drop(bus);
     let report = emulator.stop(None);

@@ -300,7 +300,12 @@ fn simulate_endpoint_equals_simulate_json_and_feeds_the_animation() {
     assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
     let walk: serde_json::Value = serde_json::from_slice(&body).unwrap();
     let (_, api) = server.get("/api/simulate?slope=10&duration=4&rate=30");
-    assert_eq!(walk["summary"], serde_json::from_slice::<serde_json::Value>(&api).unwrap());
+    let mut api = serde_json::from_slice::<serde_json::Value>(&api).unwrap();
+    // The walk's scaling spread beside it, as `simulate --json` gives it (one key of the answer).
+    let spread = api.as_object_mut().unwrap().remove("scaling_spread").unwrap();
+    assert_eq!(walk["scaling_spread"], spread);
+    assert_eq!(spread["walks"][0]["speed_m_s"], api["speed_m_s"]);
+    assert_eq!(walk["summary"], api);
     let tr = &walk["trajectory"];
     let times: Vec<f64> = tr["time_s"].as_array().unwrap().iter().map(|t| t.as_f64().unwrap()).collect();
     // 0 to 4 s every 1/30 s, ends included: 121 samples.
@@ -800,6 +805,10 @@ fn the_simulate_tab_animates_simulates_walk() {
     let shown = attribute(&dom, "id=\"sim-speed\"", "data-speed-m-s").expect("no simulated speed");
     assert_eq!(shown.parse::<f64>().unwrap(), raw_number(&raw, "speed_m_s", 0).parse::<f64>().unwrap());
     assert_eq!(attribute(&dom, "id=\"sim-speed\"", "data-slope-deg").as_deref(), Some("12.5"));
+    // The three contact scalings' card: whether their regimes agree, as --json says.
+    let agree = serde_json::from_str::<serde_json::Value>(&raw).unwrap()["scaling_spread"]["regimes_agree"]
+        .to_string();
+    assert_eq!(attribute(&dom, "id=\"sim-spread\"", "data-regimes-agree"), Some(agree));
     let cf = raw.find("\"closed_form\"").unwrap();
     let shown = attribute(&dom, "id=\"sim-cf-speed\"", "data-speed-m-s").expect("no closed-form speed");
     assert_eq!(shown, raw_number(&raw, "speed_m_s", cf));

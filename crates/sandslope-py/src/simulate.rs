@@ -11,7 +11,7 @@ use sandslope::Scenario;
 use sandslope_request::error::Words;
 use sandslope_request::field::{Field, Kind};
 use sandslope_request::scenario::{K_N, K_S};
-use sandslope_request::simulate::{SettingsRequest, Walks, DURATION, NO_SERVO_LIMIT, SETTINGS};
+use sandslope_request::simulate::{SettingsRequest, SimAnswer, Walks, DURATION, NO_SERVO_LIMIT, SETTINGS};
 use sandslope_request::{Params, RequestError};
 
 use crate::arrays::put;
@@ -21,22 +21,27 @@ use crate::value_error;
 /// Runs one walk; returns `(columns, summary)`: `columns` maps each trajectory column
 /// (`time_s`, `x_m`, `z_m`, `pitch_rad`, `vx_m_s`, `vz_m_s`, then per leg j `leg{j}_angle_rad`,
 /// `leg{j}_depth_m`, `leg{j}_force_x_n`, `leg{j}_force_z_n`, `leg{j}_torque_n_m`) to a 1-D
-/// array; `summary` is `sandslope simulate --json`.
+/// array; `summary` is `sandslope simulate --json`, its `scaling_spread` the slope walked under
+/// all three contact scalings (`--scaling-spread`; `None` with `scaling_spread=False`).
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg, duration_s, **keywords))]
+#[pyo3(signature = (robot, terrain, slope_deg, duration_s, scaling_spread=true, **keywords))]
 pub fn simulate<'py>(
     py: Python<'py>,
     robot: &PyRobot,
     terrain: &PyTerrain,
     slope_deg: f64,
     duration_s: f64,
+    scaling_spread: bool,
     keywords: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     let (scenario, settings) = setup(robot, terrain, duration_s, keywords)?;
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
-    let walks = Walks::at(scenario, slope, settings, None);
-    let mut sims = py.detach(|| walks.simulate()).map_err(request_error)?;
+    let walks = Walks { scaling_spread, ..Walks::at(scenario, slope, settings, None) };
+    let (mut spreads, mut sims) = py
+        .detach(|| walks.simulate().and_then(|sims| Ok((walks.spreads(&sims)?, sims))))
+        .map_err(request_error)?;
     let sim = sims.pop().ok_or_else(|| value_error("the walk gave no result"))?;
+    let spread = spreads.pop().flatten();
     let tr = sim.trajectory;
     let d = PyDict::new(py);
     put(&d, "time_s", tr.time_s)?;
@@ -60,7 +65,8 @@ pub fn simulate<'py>(
         put(&d, &format!("leg{j}_force_z_n"), fz)?;
         put(&d, &format!("leg{j}_torque_n_m"), torque)?;
     }
-    let summary = pythonize(py, &sim.summary).map_err(value_error)?;
+    let answer = SimAnswer { summary: sim.summary, scaling_spread: spread };
+    let summary = pythonize(py, &answer).map_err(value_error)?;
     Ok((d, summary))
 }
 

@@ -84,6 +84,25 @@ def test_rft_scaling_is_the_cli_flag(cli):
         sandslope.simulate("paper-hexapod", "glass-beads-300um", 20, 3, rft_scaling="shear")
 
 
+def test_the_scaling_spread_is_the_cli_key_and_bounds_the_three_walks(cli):
+    # One slope carries the spread by default, as the CLI's --json does; each scaling's speed is
+    # that scaling's own walk, and at 24 degrees motion slides where components climbs
+    # (docs/simulate.md, "The scaling as model uncertainty").
+    want = cli.json("simulate", "--slope", 24, "--duration", 3)
+    _, got = sandslope.simulate("paper-hexapod", "glass-beads-300um", 24, 3)
+    assert got["scaling_spread"] == want["scaling_spread"]
+    spread = got["scaling_spread"]
+    speeds = {}
+    for name in ("motion", "li2013", "components"):
+        _, own = sandslope.simulate("paper-hexapod", "glass-beads-300um", 24, 3, rft_scaling=name, scaling_spread=False)
+        assert own["scaling_spread"] is None
+        speeds[name] = own["speed_m_s"]
+    assert [w["speed_m_s"] for w in spread["walks"]] == [speeds["motion"], speeds["li2013"], speeds["components"]]
+    assert spread["min_speed_m_s"] == min(speeds.values()) and spread["max_speed_m_s"] == max(speeds.values())
+    assert spread["walks"][0]["regime"] == "slippage" and spread["walks"][2]["regime"] == "success"
+    assert spread["regimes_agree"] is False
+
+
 def test_mechanisms_are_the_cli_flags(cli):
     # docs/model.md §20's switches: the same walk as the CLI's flags, echoed under the same key.
     want = cli.json(

@@ -33,6 +33,7 @@ pub mod report_text;
 pub mod risk;
 pub mod scenario;
 pub mod simulate;
+mod simulate_spread;
 pub mod sweep;
 pub mod track;
 

@@ -5,9 +5,9 @@ use serde::{Deserialize, Serialize};
 
 use sandslope::simulate::convergence::{CREEP_REFINEMENT, STEP_REFINEMENT};
 use sandslope::simulate::{
-    check_convergence, check_convergence_slopes, simulate, simulate_ensemble, simulate_slopes, BodyPitch,
-    ConvergenceCheck, Ensemble, Mechanisms, RftScaling, SimSettings, SimSummary, SimulateError, Simulation,
-    CREEP_RANGE_M_S,
+    check_convergence, check_convergence_slopes, integration_step_for, simulate, simulate_ensemble,
+    simulate_slopes, BodyPitch, ConvergenceCheck, Ensemble, Mechanisms, RftScaling, SimSettings,
+    SimulateError, Simulation, CREEP_RANGE_M_S, SCALINGS,
 };
 use sandslope::{ParamError, Scenario, SignedSlope};
 
@@ -16,6 +16,7 @@ use crate::field::{Field, Fields, Kind, Table};
 use crate::grammar::{parse_slope_list, SlopeSign};
 use crate::params::Params;
 use crate::scenario::ScenarioRequest;
+pub use crate::simulate_spread::{ScalingWalk, SimAnswer, SpreadAnswer};
 
 /// `--slope`: one walk's slope.
 pub const SLOPE: Field = Field::number("slope", "DEG")
@@ -43,8 +44,8 @@ pub const DURATION: Field = Field::number("duration", "S")
 /// `--dt`: the time step.
 pub const DT: Field =
     Field::number("dt", "S").keyword("dt_s").key("dt_s").unit("s").range("at most T / 100").help(
-        "Time step, s (default: T / 2000, 0.5 ms for the paper's robot; at most T / 100; \
-     docs/model.md §17).",
+        "Time step, s (default: T / 2000 with the body's pitch locked, 0.5 ms for the paper's \
+         robot; T / 8000 with it free, 0.125 ms; at most T / 100; docs/model.md §17).",
     );
 /// `--creep`: the contact law's creep speed.
 pub const CREEP: Field = Field::number("creep", "M/S")
@@ -153,6 +154,19 @@ pub const CHECK_CONVERGENCE: Field = Field::switch("check-convergence").help(
      walks, their means compared (a single free-pitch walk on a slope is chaotic and cannot \
      converge).",
 );
+/// `--scaling-spread` (Python: `scaling_spread=True/False`): the contact scaling as model
+/// uncertainty (docs/model.md §20, item 7; docs/simulate.md, "The scaling as model uncertainty").
+pub const SCALING_SPREAD: Field = Field::new("scaling-spread", Kind::Choice(&["on", "off"]), "on|off")
+    .keyword("scaling_spread")
+    .conflicts(&["ensemble", "check-convergence"])
+    .help(
+        "Walk each slope under all three contact scalings (motion, li2013, components; \
+         docs/model.md §16), none of which the sand is measured to follow, and give beside the \
+         answer the range of their speeds and whether their regimes agree (docs/simulate.md, \
+         \"The scaling as model uncertainty\"): a steep slope's verdict hangs on it. Three walks \
+         instead of one (the other two in parallel). Default: on with --slope, off with \
+         --slopes.",
+    );
 /// `--rate` (Python: `sample_rate_hz`).
 pub const RATE: Field = Field::number("rate", "HZ")
     .keyword("sample_rate_hz")
@@ -189,7 +203,7 @@ macro_rules! with_walk_settings {
 /// `simulate`'s own fields (the robot's and terrain's are [`crate::scenario::FIELDS`]).
 pub const FIELDS: Table = Table {
     command: "simulate",
-    fields: with_walk_settings!([SLOPE, SLOPES], [ENSEMBLE, CHECK_CONVERGENCE]),
+    fields: with_walk_settings!([SLOPE, SLOPES], [ENSEMBLE, CHECK_CONVERGENCE, SCALING_SPREAD]),
 };
 
 /// A walk's settings' fields (what [`SettingsRequest::read`] reads): every front end's, Python's
@@ -222,7 +236,7 @@ pub struct SimulateRequest {
     pub scenario: ScenarioRequest,
     /// Simulated time after settling, s (field `duration`, default 10).
     pub duration_s: f64,
-    /// Time step, s (field `dt`; default T / 2000, docs/model.md §17).
+    /// Time step, s (field `dt`; default T / 2000 pitch locked, T / 8000 free; docs/model.md §17).
     pub dt_s: Option<f64>,
     /// Creep speed of the contact law's smoothing at rest, m/s (field `creep`; default 1e-7).
     pub creep_m_s: Option<f64>,
@@ -247,6 +261,10 @@ pub struct SimulateRequest {
     /// docs/simulate.md, "Checking convergence").
     #[serde(default)]
     pub check_convergence: bool,
+    /// Walk each slope under all three contact scalings and answer their spread beside the
+    /// walk (field `scaling-spread`: on or off; default on for one slope, off for `slopes`).
+    #[serde(default)]
+    pub scaling_spread: Option<bool>,
 }
 
 /// Parses the field `slopes`: the one slope-list grammar, signed, at most [`MAX_SLOPES`].
@@ -274,7 +292,7 @@ fn keyworded(e: ParamError) -> RequestError {
     RequestError::invalid(field.clone(), e.renamed(field))
 }
 
-fn sim_err(e: SimulateError, words: Words) -> RequestError {
+pub(crate) fn sim_err(e: SimulateError, words: Words) -> RequestError {
     match (e, words) {
         (SimulateError::Param(p), Words::Flag) => flagged(p),
         (SimulateError::Param(p), Words::Keyword) => keyworded(p),
@@ -316,6 +334,18 @@ impl SimulateRequest {
         let settings = SettingsRequest::read(&mut p, Words::Flag)?;
         let ensemble = ENSEMBLE.number_in(&mut p)?.map(|n| ensemble_size(n, &slopes)).transpose()?;
         let check_convergence = CHECK_CONVERGENCE.switch_in(&mut p)?;
+        let scaling_spread = SCALING_SPREAD.choice_in(&mut p)?.map(|on| on == "on");
+        if scaling_spread == Some(true) && (ensemble.is_some() || check_convergence) {
+            return Err(RequestError::invalid(
+                SCALING_SPREAD.flag,
+                format!(
+                    "{} on walks each slope once under each scaling: not with {} or {}",
+                    SCALING_SPREAD.long(),
+                    ENSEMBLE.long(),
+                    CHECK_CONVERGENCE.long()
+                ),
+            ));
+        }
         let scenario = match scenario {
             Some(s) => s,
             None => ScenarioRequest::from_params(&mut p)?,
@@ -344,6 +374,7 @@ impl SimulateRequest {
             rate_hz,
             ensemble,
             check_convergence,
+            scaling_spread,
         })
     }
 
@@ -387,6 +418,9 @@ impl SimulateRequest {
             settings,
             ensemble: self.ensemble,
             check_convergence: self.check_convergence,
+            scaling_spread: self.scaling_spread.unwrap_or(!many)
+                && self.ensemble.is_none()
+                && !self.check_convergence,
             words: Words::Flag,
         })
     }
@@ -403,7 +437,7 @@ impl SimulateRequest {
 pub struct SettingsRequest {
     /// Simulated time after settling, s (field `duration`).
     pub duration_s: f64,
-    /// Time step, s (field `dt`; default T / 2000).
+    /// Time step, s (field `dt`; default T / 2000 pitch locked, T / 8000 free).
     pub dt_s: Option<f64>,
     /// Creep speed of the contact law's smoothing at rest, m/s (field `creep`).
     pub creep_m_s: Option<f64>,
@@ -557,9 +591,9 @@ pub fn check_slope(slope: f64) -> Result<f64> {
 #[serde(untagged)]
 pub enum Answer {
     /// One slope.
-    One(Box<SimSummary>),
+    One(Box<SimAnswer>),
     /// Several slopes.
-    Many(Vec<SimSummary>),
+    Many(Vec<SimAnswer>),
     /// An ensemble at one slope.
     Ensemble(Box<Ensemble>),
     /// The convergence check at one slope.
@@ -584,6 +618,9 @@ pub struct Walks {
     pub ensemble: Option<usize>,
     /// Whether the walks (or the one slope's ensemble) are checked for convergence instead.
     pub check_convergence: bool,
+    /// Whether each slope is walked under the other two contact scalings as well and their
+    /// spread answered ([`Walks::spreads`]).
+    pub scaling_spread: bool,
     /// How the library's errors name their field: the command line's flags and the server's
     /// fields, or Python's keywords.
     pub words: Words,
@@ -606,6 +643,7 @@ impl Walks {
             settings,
             ensemble,
             check_convergence: false,
+            scaling_spread: false,
             words: Words::Keyword,
         }
     }
@@ -620,6 +658,7 @@ impl Walks {
             settings,
             ensemble: None,
             check_convergence: false,
+            scaling_spread: false,
             words: Words::Keyword,
         }
     }
@@ -634,7 +673,7 @@ impl Walks {
     pub fn integration_steps(&self) -> Result<f64> {
         let mut steps = 0.0;
         for signed in &self.slopes {
-            let dt = sandslope::simulate::integration_step(&self.scenario, signed.felt(), self.settings.dt_s)
+            let dt = integration_step_for(&self.scenario, signed.felt(), &self.settings)
                 .map_err(|e| sim_err(SimulateError::Param(e), self.words))?;
             steps += (self.settings.duration_s + self.settings.settle_s) / dt;
         }
@@ -646,7 +685,8 @@ impl Walks {
         } else {
             1.0
         };
-        Ok(steps * checks * self.ensemble.unwrap_or(1) as f64)
+        let scalings = if self.scaling_spread { SCALINGS.len() as f64 } else { 1.0 };
+        Ok(steps * checks * scalings * self.ensemble.unwrap_or(1) as f64)
     }
 
     /// Runs the walks (several in parallel).
@@ -670,7 +710,11 @@ impl Walks {
         }
         match self.ensemble {
             Some(n) => Ok(Answer::Ensemble(Box::new(self.simulate_ensemble(n)?))),
-            None => Ok(self.answer(self.simulate()?)),
+            None => {
+                let sims = self.simulate()?;
+                let spreads = self.spreads(&sims)?;
+                Ok(self.answer(sims, spreads))
+            }
         }
     }
 
@@ -692,9 +736,14 @@ impl Walks {
         checks.map_err(|e| sim_err(e, self.words))
     }
 
-    /// The value `simulate --json` prints for these walks' results.
-    pub fn answer(&self, sims: Vec<Simulation>) -> Answer {
-        let mut summaries: Vec<SimSummary> = sims.into_iter().map(|s| s.summary).collect();
+    /// The value `simulate --json` prints for these walks' results and their spreads
+    /// ([`Walks::spreads`]).
+    pub fn answer(&self, sims: Vec<Simulation>, spreads: Vec<Option<SpreadAnswer>>) -> Answer {
+        let mut summaries: Vec<SimAnswer> = sims
+            .into_iter()
+            .zip(spreads)
+            .map(|(s, scaling_spread)| SimAnswer { summary: s.summary, scaling_spread })
+            .collect();
         match (self.many, summaries.pop()) {
             (false, Some(one)) if summaries.is_empty() => Answer::One(Box::new(one)),
             (_, last) => {
@@ -714,10 +763,16 @@ mod tests {
     }
 
     /// `ensemble`: one slope, 2 to 1000 walks, and it multiplies what the walks cost (the
-    /// server weighs that against its step limit).
+    /// server weighs that against its step limit; one walk without its scaling spread, which an
+    /// ensemble does not walk).
     #[test]
     fn an_ensemble_walks_one_slope_and_costs_n_walks() {
-        let one = SimulateRequest::from_params(&params(&[("slope", "10"), ("duration", "2")])).unwrap();
+        let one = SimulateRequest::from_params(&params(&[
+            ("slope", "10"),
+            ("duration", "2"),
+            ("scaling-spread", "off"),
+        ]))
+        .unwrap();
         let three =
             SimulateRequest::from_params(&params(&[("slope", "10"), ("duration", "2"), ("ensemble", "3")]))
                 .unwrap();

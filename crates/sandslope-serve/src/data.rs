@@ -240,7 +240,9 @@ fn risk_map(params: &[(String, String)], served: &Served) -> Result<Reply, ApiEr
 
 /// One walk of `simulate` with these flags (one `slope`, not `slopes`), whole: the summary
 /// `simulate --json` prints, the trajectory sampled at `rate` and the legs' geometry, for the
-/// page's animation (the library's [`sandslope::simulate::Simulation`], as compact JSON).
+/// page's animation (the library's [`sandslope::simulate::Simulation`], as compact JSON), and
+/// `scaling_spread`, the slope under all three contact scalings (`simulate --json`'s key; on
+/// unless `scaling-spread=off`).
 fn simulation(params: &[(String, String)], served: &Served) -> Result<Reply, ApiError> {
     if params.iter().any(|(k, _)| k == simulate::SLOPES.flag) {
         return Err(ApiError::bad(
@@ -276,9 +278,17 @@ fn simulation(params: &[(String, String)], served: &Served) -> Result<Reply, Api
             ),
         ));
     }
-    let sim = walks.simulate()?.pop();
-    let Some(sim) = sim else {
+    let sims = walks.simulate()?;
+    let scaling_spread = walks.spreads(&sims)?.pop().flatten();
+    let Some(sim) = sims.into_iter().next() else {
         return Err(ApiError::bad(Some(simulate::SLOPE.flag.to_string()), "no walk: give a slope"));
     };
-    Ok(Reply::compact(sim))
+    /// The walk beside its scaling spread.
+    #[derive(serde::Serialize)]
+    struct Walk {
+        #[serde(flatten)]
+        sim: sandslope::simulate::Simulation,
+        scaling_spread: Option<sandslope_request::simulate::SpreadAnswer>,
+    }
+    Ok(Reply::compact(Walk { sim, scaling_spread }))
 }

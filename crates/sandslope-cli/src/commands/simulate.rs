@@ -20,7 +20,9 @@ use sandslope::simulate::convergence::{RefinedWalk, Refinement, WalkAnswer};
 use sandslope::simulate::{BodyPitch, ConvergenceCheck, RftScaling, SimSummary, Simulation};
 use sandslope_io::load_speeds;
 use sandslope_io::trajectory::plain_mocap_csv;
-use sandslope_request::simulate::{Answer, Walks, CHECK_CONVERGENCE, ENSEMBLE, SLOPES};
+use sandslope_request::simulate::{
+    Answer, SimAnswer, SpreadAnswer, Walks, CHECK_CONVERGENCE, ENSEMBLE, SLOPES,
+};
 use sandslope_request::SimulateRequest;
 
 /// Arguments of `sandslope simulate`.
@@ -106,10 +108,13 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     // Progress on stderr (a terminal's, not with --json or --csv): a 10 s walk with its GIF
     // takes tens of seconds.
     let quiet = args.format.format() != Format::Table;
-    let spin = Progress::new(0, quiet, &format!("simulating {} s at {slope} deg", walks.settings.duration_s));
-    let sims = walks.simulate();
+    let under = if walks.scaling_spread { " under each of the three contact scalings" } else { "" };
+    let spin =
+        Progress::new(0, quiet, &format!("simulating {} s at {slope} deg{under}", walks.settings.duration_s));
+    let sims = walks.simulate().and_then(|sims| Ok((walks.spreads(&sims)?, sims)));
     spin.finish();
-    let Some(sim) = sims?.pop() else { bail!("no walk was simulated") };
+    let (mut spreads, mut sims) = sims?;
+    let (Some(sim), Some(spread)) = (sims.pop(), spreads.pop()) else { bail!("no walk was simulated") };
     if sim.summary.closed_form.extrapolated {
         warn_extrapolated(scenario.terrain(), &[slope]);
     }
@@ -137,9 +142,16 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     }
     let m = &sim.summary;
     match args.format.format() {
-        Format::Json => print_json(&Answer::One(Box::new(m.clone())))?,
+        Format::Json => {
+            print_json(&Answer::One(Box::new(SimAnswer { summary: m.clone(), scaling_spread: spread })))?
+        }
         Format::Csv => print!("{}", csv_string(&m.steps)?),
-        Format::Table => print_one(&sim),
+        Format::Table => {
+            print_one(&sim);
+            if let Some(spread) = &spread {
+                println!("{}", spread_note(spread));
+            }
+        }
     }
     if let Some(addr) = &args.foxglove {
         sandslope_io::foxglove::play_simulation(addr, &sim.trajectory, &sim.geometry, slope, 30.0)?;
@@ -228,6 +240,34 @@ fn print_one(sim: &Simulation) {
         );
     }
 }
+
+/// The scaling spread under a one-slope table: the three speeds, the range and whether the
+/// regimes agree, with what it means and which measurement would decide (docs/simulate.md).
+fn spread_note(spread: &SpreadAnswer) -> String {
+    let walks: Vec<String> = spread
+        .walks
+        .iter()
+        .map(|w| format!("{} {:.2} cm/s ({})", w.rft_scaling.name(), w.speed_m_s * 100.0, w.regime.name()))
+        .collect();
+    let verdict = if spread.regimes_agree {
+        "the regimes agree".to_string()
+    } else {
+        "the regimes DISAGREE: this slope's verdict is the scaling's choice, not the sand's".to_string()
+    };
+    format!(
+        "model uncertainty, the contact scaling (not measured; --scaling-spread): {}; speed {:.2} to {:.2} cm/s \
+         (range {:.2}); {verdict}. The measurement that would decide: a leg-wide plate dragged along the \
+         surface at the stance depth, its horizontal and vertical forces together (docs/simulate.md, \
+         \"The scaling as model uncertainty\")",
+        walks.join(", "),
+        spread.min_speed_m_s * 100.0,
+        spread.max_speed_m_s * 100.0,
+        spread.range_m_s * 100.0
+    )
+}
+
+/// Under a table of slopes with their scaling spread.
+const SPREAD_NOTE: &str = "3 scalings: the slope walked under each contact scaling (motion, li2013, components; none measured), the smallest and largest speed and whether the regimes agree; where they DISAGREE the verdict is the scaling's choice, not the sand's, until a leg-wide plate dragged along the surface at the stance depth is measured, its horizontal and vertical forces together (docs/simulate.md, \"The scaling as model uncertainty\")";
 
 /// What a walk with the body free to pitch is (docs/simulate.md, "Pitch free").
 const FREE_NOTE: &str = "body pitch free (--body-pitch free): its default step is a quarter of the locked walk's (T/8000), which its speeds on 15 and 20 degrees need to converge, and with --two-faced-belly its pitch is unstable on slopes (one walk is one draw of a spread; --ensemble N gives it); check with --check-convergence (docs/simulate.md)";
@@ -442,10 +482,11 @@ fn print_checks(checks: &[&ConvergenceCheck], walks: &Walks) {
 fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedObservation]) -> Result<()> {
     let (scenario, settings) = (&walks.scenario, &walks.settings);
     let quiet = args.format.format() != Format::Table;
-    let spin = spinner(quiet, &format!("simulating {} slopes", walks.slopes.len()));
-    let sims = walks.simulate();
+    let under = if walks.scaling_spread { " under each of the three contact scalings" } else { "" };
+    let spin = spinner(quiet, &format!("simulating {} slopes{under}", walks.slopes.len()));
+    let sims = walks.simulate().and_then(|sims| Ok((walks.spreads(&sims)?, sims)));
     spin.finish_and_clear();
-    let sims = sims?;
+    let (spreads, sims) = sims?;
     let beyond: Vec<f64> =
         sims.iter().filter(|s| s.summary.closed_form.extrapolated).map(|s| s.summary.slope_deg).collect();
     if !beyond.is_empty() {
@@ -457,13 +498,19 @@ fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedOb
         figures::save(path, &SlopesFigure { sims: &summaries, pitch_locked: &[], observed, repose_deg })?;
     }
     match args.format.format() {
-        Format::Json => print_json(&Answer::Many(summaries))?,
+        Format::Json => print_json(&Answer::Many(
+            summaries
+                .into_iter()
+                .zip(spreads)
+                .map(|(summary, scaling_spread)| SimAnswer { summary, scaling_spread })
+                .collect(),
+        ))?,
         Format::Csv => {
             let rows: Vec<SimSlopeRow> = summaries.iter().map(SimSlopeRow::of).collect();
             print!("{}", csv_string(&rows)?);
         }
         Format::Table => {
-            let mut t = table(&[
+            let mut header = vec![
                 "slope deg",
                 "speed cm/s sim | cf",
                 "t1 ms sim | cf",
@@ -471,10 +518,14 @@ fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedOb
                 "step mm sim | cf",
                 "regime sim | cf",
                 "cause (sim)",
-            ]);
-            for m in &summaries {
+            ];
+            if walks.scaling_spread {
+                header.push("3 scalings: speed cm/s, regimes");
+            }
+            let mut t = table(&header);
+            for (m, spread) in summaries.iter().zip(&spreads) {
                 let p = &m.closed_form.prediction;
-                t.add_row([
+                let mut row = vec![
                     format!("{}", m.slope_deg),
                     format!(
                         "{:.2} | {}",
@@ -490,10 +541,22 @@ fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedOb
                     format!("{:.1} | {}", m.step_m * 1e3, num(p.step.map(|v| v * 1e3), 1)),
                     format!("{} | {}", m.regime.name(), p.regime.name()),
                     m.cause.name().to_string(),
-                ]);
+                ];
+                if let Some(sp) = spread {
+                    row.push(format!(
+                        "{:.2} to {:.2}, {}",
+                        sp.min_speed_m_s * 100.0,
+                        sp.max_speed_m_s * 100.0,
+                        if sp.regimes_agree { "agree" } else { "DISAGREE" }
+                    ));
+                }
+                t.add_row(row);
             }
             println!("{t}");
             println!("{DISAGREE_NOTE}");
+            if walks.scaling_spread {
+                println!("{SPREAD_NOTE}");
+            }
             if settings.body_pitch == BodyPitch::Free {
                 println!("{FREE_NOTE}");
             }

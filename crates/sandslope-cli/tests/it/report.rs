@@ -166,6 +166,29 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
     let at20 = sim.iter().find(|r| r["slope_deg"] == 20.0).unwrap();
     assert_eq!(at20["pitch_free_m_s"], free["speed_m_s"]);
     assert_eq!(at20["pitch_free_regime"], free["regime"]);
+    // The three contact scalings' column is `simulate`'s scaling spread at the same slope; it
+    // bounds every slope's own (motion) walk, and at 24 degrees the regimes part (motion slides
+    // back, components climbs: docs/simulate.md, "The scaling as model uncertainty").
+    let walk24: serde_json::Value = serde_json::from_slice(
+        &sandslope().args(["simulate", "--slope", "24", "--json"]).assert().success().get_output().stdout,
+    )
+    .unwrap();
+    let spread = &walk24["scaling_spread"];
+    let at24 = sim.iter().find(|r| r["slope_deg"] == 24.0).unwrap();
+    assert_eq!(at24["scaling_min_m_s"], spread["min_speed_m_s"]);
+    assert_eq!(at24["scaling_max_m_s"], spread["max_speed_m_s"]);
+    assert_eq!(at24["scaling_regimes_agree"], false);
+    assert_eq!(spread["regimes_agree"], false);
+    assert_eq!(at24["scaling_regimes"][0], "slippage");
+    assert_eq!(at24["scaling_regimes"][2], "success");
+    for r in sim {
+        let (lo, hi, own) = (
+            r["scaling_min_m_s"].as_f64().unwrap(),
+            r["scaling_max_m_s"].as_f64().unwrap(),
+            r["simulated_m_s"].as_f64().unwrap(),
+        );
+        assert!(lo <= own && own <= hi, "{r}");
+    }
     assert!(html.contains("The stride simulator against the closed form"));
     // The simulator's joint fit costs minutes of CPU (8 on the paper's evidence): left out unless asked for, and the page
     // names the flag that adds it.

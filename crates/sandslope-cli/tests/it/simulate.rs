@@ -171,6 +171,22 @@ fn body_pitch_locked_holds_the_body_parallel_to_the_slope() {
         .clone();
     let text = String::from_utf8(text).unwrap();
     assert!(text.contains("scaled by components (--rft-scaling components"), "{text}");
+    // One slope carries the scaling spread (docs/simulate.md, "The scaling as model
+    // uncertainty"): its walks are the walks each --rft-scaling gives on its own, the asked
+    // one first among them, and a free walk's spread walks the free body under each.
+    let spread = &default["scaling_spread"];
+    assert_eq!(spread["walks"][0]["speed_m_s"], default["speed_m_s"]);
+    assert_eq!(spread["walks"][2]["rft_scaling"], "components");
+    assert_eq!(spread["walks"][2]["speed_m_s"], components["speed_m_s"]);
+    let (lo, hi) = (spread["min_speed_m_s"].as_f64().unwrap(), spread["max_speed_m_s"].as_f64().unwrap());
+    for w in spread["walks"].as_array().unwrap() {
+        let v = w["speed_m_s"].as_f64().unwrap();
+        assert!(lo <= v && v <= hi, "{spread}");
+    }
+    assert_eq!(free["scaling_spread"]["walks"][0]["speed_m_s"], free["speed_m_s"]);
+    assert!(text.contains("model uncertainty, the contact scaling"), "{text}");
+    let off = json(&["simulate", "--slope", "20", "--duration", "1.5", "--json", "--scaling-spread", "off"]);
+    assert!(off["scaling_spread"].is_null());
 }
 
 #[test]

@@ -714,6 +714,7 @@ def simulate(
     terrain: TerrainLike,
     slope_deg: float,
     duration_s: float = 10.0,
+    scaling_spread: bool = True,
     **settings: Any,
 ) -> Tuple[Any, Dict[str, Any]]:
     """Simulates the robot walking for ``duration_s`` seconds on ``terrain`` at ``slope_deg``
@@ -744,13 +745,21 @@ def simulate(
     ``vz_m_s`` and per leg j ``leg{j}_angle_rad``, ``leg{j}_depth_m``, ``leg{j}_force_x_n``,
     ``leg{j}_force_z_n``, ``leg{j}_torque_n_m``; ``summary`` the dict ``sandslope simulate
     --json`` prints (``speed_m_s``, ``t1_s``, ``slip_m``, ``step_m``, ``regime``, ``cause``,
-    ``steps``, ``closed_form``, ...).
+    ``steps``, ``closed_form``, ...). ``summary["scaling_spread"]`` is the model uncertainty of
+    the contact scaling (``--scaling-spread``, on by default here as for one slope on the command
+    line): the slope walked again under the other two scalings (three walks instead of one), with
+    ``min_speed_m_s``, ``max_speed_m_s``, ``range_m_s``, ``regimes_agree`` and each scaling's
+    ``walks`` (``rft_scaling``, ``speed_m_s``, ``regime``, ``t1_s``). Which scaling the sand
+    follows is not measured, and from about 20 degrees the regimes part (docs/simulate.md, "The
+    scaling as model uncertainty"). ``scaling_spread=False`` walks once and gives ``None``.
+    ``dt_s`` defaults to T / 2000 with the pitch locked, T / 8000 with it free.
     """
     columns, summary = _sandslope.simulate(
         _robot(robot),
         _terrain(terrain),
         float(slope_deg),
         float(duration_s),
+        bool(scaling_spread),
         **settings,
     )
     try:

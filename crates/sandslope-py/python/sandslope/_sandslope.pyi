@@ -237,6 +237,7 @@ def simulate(
     terrain: Terrain,
     slope_deg: float,
     duration_s: float,
+    scaling_spread: bool = True,
     **keywords: Unpack[WalkSettings],
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 def simulate_ensemble(

@@ -308,6 +308,7 @@ pub fn simulator(report: &Report) -> String {
     }
     let agree = report.simulator.iter().filter(|r| r.agree).count();
     let tumbles = report.simulator.iter().filter(|r| r.pitch_over_s.is_some()).count();
+    let disagree = report.simulator.iter().filter(|r| !r.scaling_regimes_agree).count();
     let mut h =
         String::from("<h2 id=\"simulator-table\">The stride simulator against the closed form</h2>\n");
     h.push_str(&format!(
@@ -333,7 +334,12 @@ pub fn simulator(report: &Report) -> String {
          back where the paper's climbed, because in mid-stance its stance legs push up the slope with less than \
          gravity's pull whatever k_s under the default contact scaling; scaled by component (<code>--rft-scaling \
          components</code>) the same legs hold and it climbs, and the scaling is not measured, so the simulator's \
-         verdicts on steep slopes carry that spread (docs/simulate.md, \"What the simulator does not match\"). \
+         verdicts on steep slopes carry that spread (docs/simulate.md, \"What the simulator does not match\"): the \
+         column <i>3 contact scalings</i> walks each slope under <code>motion</code>, <code>li2013</code> and \
+         <code>components</code> and gives the range of their speeds and whether their regimes agree; where they \
+         disagree the verdict is the scaling's, not the sand's, until a leg-wide plate dragged along the surface \
+         at the stance depth is measured, its horizontal and vertical forces together (docs/simulate.md, \"The \
+         scaling as model uncertainty\"). Here they disagree at {disagree} of the slopes. \
          <i>Pitch free</i>: the pitch-free columns, with the body free to pitch, climb from 0° to 20° without \
          tumbling; they walk at a quarter of the locked walk's step, where their speeds converge, but not every \
          t1 does, so they are not the section's answers (docs/simulate.md, \"The free body's step\"). Here \
@@ -347,7 +353,8 @@ pub fn simulator(report: &Report) -> String {
         "<p>Speeds in cm/s. Each row's last cell says whether the two agree or, in a word, where they part; \
          open it for the why and the step's parts (t1, slip and step, simulated / closed form).</p>\n\
          <table class=\"sim\"><tr><th>slope (°)</th><th>observed</th><th>closed form</th><th>simulated</th>\
-         <th>pitch free</th><th>regime: closed form / simulated (hover: the outcome)</th><th>pitch free: largest pitch (°)</th><th>verdict</th></tr>",
+         <th>pitch free</th><th>regime: closed form / simulated (hover: the outcome)</th><th>pitch free: largest pitch (°)</th>\
+         <th>3 contact scalings: speed, regimes (hover: each)</th><th>verdict</th></tr>",
     );
     for r in &report.simulator {
         let free = if r.pitch_over_s.is_some() {
@@ -356,7 +363,7 @@ pub fn simulator(report: &Report) -> String {
             format!("{:.1}", r.pitch_free_m_s * 100.0)
         };
         h.push_str(&format!(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td><abbr title=\"{} / {}\">{} / {}</abbr></td><td>{}</td>{}</tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td><abbr title=\"{} / {}\">{} / {}</abbr></td><td>{}</td><td>{}</td>{}</tr>",
             r.slope_deg,
             plus_minus(r.observed_m_s.map(|v| v * 100.0), r.observed_sd_m_s.map(|v| v * 100.0), 1.0, 1),
             r.closed_form_m_s.map_or("- (ruled out)".into(), |v| format!("{:.1}", v * 100.0)),
@@ -367,11 +374,29 @@ pub fn simulator(report: &Report) -> String {
             r.closed_form_regime.name(),
             r.simulated_regime.name(),
             largest_pitch(r),
+            scaling_cell(r),
             verdict_cell(r),
         ));
     }
     h.push_str("</table>\n");
     h
+}
+
+/// The pitch-locked walk's speed range under the three contact scalings and whether their
+/// regimes agree; each scaling's regime on hover.
+fn scaling_cell(r: &sandslope::report::SimulatorRecord) -> String {
+    let names: Vec<String> = sandslope::simulate::SCALINGS
+        .iter()
+        .zip(&r.scaling_regimes)
+        .map(|(s, g)| format!("{} {}", s.name(), g.name()))
+        .collect();
+    format!(
+        "<abbr title=\"{}\">{:.1} to {:.1}, {}</abbr>",
+        names.join(", "),
+        r.scaling_min_m_s * 100.0,
+        r.scaling_max_m_s * 100.0,
+        if r.scaling_regimes_agree { "agree" } else { "<b>disagree</b>" }
+    )
 }
 
 /// The pitch-free walk's largest pitch as the table shows it: in degrees while the body stays

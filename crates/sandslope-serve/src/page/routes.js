@@ -290,6 +290,12 @@ function showSimulation(walk) {
   $("sim-slip").textContent = both(m.slip_m, cf.slip_m, 1e3, 2);
   $("sim-step").textContent = both(m.step_m, cf.step_m, 1e3, 1);
   $("sim-depth").textContent = `${fmt(m.max_depth_m * 1e3, 1)} (${fmt(m.d_max_m * 1e3, 1)})`;
+  // The contact scaling as model uncertainty (docs/simulate.md, "The scaling as model uncertainty").
+  const sp = walk.scaling_spread;
+  const spread = $("sim-spread");
+  spread.textContent = sp ? `${fmt(sp.min_speed_m_s * 100, 1)} to ${fmt(sp.max_speed_m_s * 100, 1)}, regimes ${sp.regimes_agree ? "agree" : "DISAGREE"}` : "-";
+  spread.title = sp ? sp.walks.map((w) => `${w.rft_scaling}: ${fmt(w.speed_m_s * 100, 2)} cm/s, ${w.regime}`).join("; ") + (sp.regimes_agree ? "" : ". The verdict here is the contact scaling's choice, not the sand's, until a plate dragged along the surface is measured.") : "";
+  spread.dataset.regimesAgree = sp ? String(sp.regimes_agree) : "";
   let cause = `simulated: ${m.cause.replaceAll("_", " ")}, over ${m.steps_measured} measured steps of ${m.duration_s} s at dt = ${m.dt_s.toExponential(2)} s`;
   if (m.unanchored_steps > 0) cause += ` (${m.unanchored_steps} never anchored)`;
   if (m.stalled_legs.length) cause += `; servo stalled on legs ${m.stalled_legs.join(", ")}`;

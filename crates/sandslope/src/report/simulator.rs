@@ -13,7 +13,8 @@ use crate::regime::Regime;
 use crate::robot::Robot;
 use crate::scenario::Scenario;
 use crate::simulate::{
-    check_walked, simulate_slopes, BodyPitch, ConvergenceCheck, MotionCause, SimSettings, SimSummary,
+    check_walked, simulate_slopes, BodyPitch, ConvergenceCheck, MotionCause, ScalingSpread, SimSettings,
+    SimSummary, SCALINGS,
 };
 use crate::slope::Slope;
 use crate::terrain::Terrain;
@@ -70,6 +71,17 @@ pub struct SimulatorRecord {
     pub pitch_free_regime: Regime,
     /// Its cause.
     pub pitch_free_cause: MotionCause,
+    /// The smallest speed of the pitch-locked walk under the three contact scalings (motion,
+    /// li2013, components; docs/simulate.md, "The scaling as model uncertainty"), m/s: the
+    /// model uncertainty of a choice the sand is not measured to make.
+    pub scaling_min_m_s: f64,
+    /// The largest, m/s.
+    pub scaling_max_m_s: f64,
+    /// Each scaling's regime, in the order motion, li2013, components.
+    pub scaling_regimes: [Regime; 3],
+    /// Whether the three scalings' walks end in the same regime (where they do not, the
+    /// slope's simulated verdict is the scaling's choice).
+    pub scaling_regimes_agree: bool,
     /// Whether the two agree: same regime and, where both have a speed, within 15%.
     pub agree: bool,
     /// Where they part and why, in words.
@@ -101,6 +113,9 @@ pub struct SimulatorWalks {
     /// Each pitch-locked walk checked: again at a quarter of the step and a tenth of the creep
     /// speed ([`crate::simulate::check_walked`]), in slope order.
     pub convergence: Vec<ConvergenceCheck>,
+    /// Each pitch-locked walk beside the same slope under the other two contact scalings, in
+    /// slope order.
+    pub scaling_spread: Vec<ScalingSpread>,
 }
 
 /// Simulates `robot` on `terrain` at every slope of [`section_slopes`] (10 s walks, the
@@ -127,6 +142,24 @@ pub fn simulator_section(
     let free = walk(&settings.with_body_pitch(BodyPitch::Free))?;
     let locked = settings.with_body_pitch(BodyPitch::Locked);
     let pitch_locked = walk(&locked)?;
+    // The contact scaling is not measured: each locked walk again under the other two (two
+    // walks a slope more, against the convergence check's five).
+    let by_scaling = SCALINGS
+        .iter()
+        .map(|&s| {
+            if s == locked.rft_scaling {
+                Ok(pitch_locked.clone())
+            } else {
+                walk(&locked.with_rft_scaling(s))
+            }
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let scaling_spread: Vec<ScalingSpread> = (0..slopes.len())
+        .map(|i| {
+            let walks = by_scaling.iter().map(|w| w[i].clone()).collect();
+            ScalingSpread::of_walks(pitch_locked[i].slope_deg, walks)
+        })
+        .collect();
     // The locked answers are the section's: each is checked, not assumed, to be converged.
     let convergence = slopes
         .par_iter()
@@ -140,17 +173,19 @@ pub fn simulator_section(
     let records = pitch_locked
         .iter()
         .zip(&free)
-        .map(|(m, free)| {
+        .zip(&scaling_spread)
+        .map(|((m, free), spread)| {
             let observed = speeds.iter().find(|o| (o.slope.degrees() - m.slope_deg).abs() < 1e-9);
-            record(m, free, observed, rolling)
+            record(m, free, spread, observed, rolling)
         })
         .collect();
-    Ok(SimulatorWalks { records, free, pitch_locked, convergence })
+    Ok(SimulatorWalks { records, free, pitch_locked, convergence, scaling_spread })
 }
 
 fn record(
     m: &SimSummary,
     free: &SimSummary,
+    spread: &ScalingSpread,
     observed: Option<&SpeedObservation>,
     rolling: f64,
 ) -> SimulatorRecord {
@@ -177,6 +212,10 @@ fn record(
         pitch_free_m_s: free.speed_m_s,
         pitch_free_regime: free.regime,
         pitch_free_cause: free.cause,
+        scaling_min_m_s: spread.min_speed_m_s,
+        scaling_max_m_s: spread.max_speed_m_s,
+        scaling_regimes: spread.regimes,
+        scaling_regimes_agree: spread.regimes_agree,
         agree,
         why,
     }

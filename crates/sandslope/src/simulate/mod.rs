@@ -32,7 +32,7 @@ pub use ensemble::{simulate_ensemble, Ensemble};
 pub use mechanisms::Mechanisms;
 pub use phase1::PhaseOne;
 pub use rft::RftScaling;
-pub use spread::{scaling_spread, ScalingSpread};
+pub use spread::{scaling_spread, ScalingSpread, SCALINGS};
 
 use crate::error::ParamError;
 use crate::gait::{measure_step, SmoothTrack, StepMeasure, REST_SPEED_FRACTION};

@@ -44,14 +44,27 @@ pub fn scaling_spread(
         .par_iter()
         .map(|&s| simulate(scenario, slope, &settings.with_rft_scaling(s)).map(|w| w.summary))
         .collect::<Result<Vec<_>, _>>()?;
-    let speeds = walks.iter().map(|w| w.speed_m_s);
-    let regimes = [walks[0].regime, walks[1].regime, walks[2].regime];
-    Ok(ScalingSpread {
-        slope_deg: slope.degrees(),
-        min_speed_m_s: speeds.clone().fold(f64::INFINITY, f64::min),
-        max_speed_m_s: speeds.fold(f64::NEG_INFINITY, f64::max),
-        regimes_agree: regimes.iter().all(|&r| r == regimes[0]),
-        regimes,
-        walks,
-    })
+    Ok(ScalingSpread::of_walks(slope.degrees(), walks))
+}
+
+impl ScalingSpread {
+    /// The spread of three walks of one slope already walked, one under each of [`SCALINGS`]
+    /// in that order (what a front end that walked the asked scaling itself, and the other two
+    /// beside it, sets side by side; [`scaling_spread`] walks all three).
+    ///
+    /// # Panics
+    /// If `walks` is not three long.
+    pub fn of_walks(slope_deg: f64, walks: Vec<SimSummary>) -> ScalingSpread {
+        assert_eq!(walks.len(), SCALINGS.len(), "one walk per scaling");
+        let speeds = walks.iter().map(|w| w.speed_m_s);
+        let regimes = [walks[0].regime, walks[1].regime, walks[2].regime];
+        ScalingSpread {
+            slope_deg,
+            min_speed_m_s: speeds.clone().fold(f64::INFINITY, f64::min),
+            max_speed_m_s: speeds.fold(f64::NEG_INFINITY, f64::max),
+            regimes_agree: regimes.iter().all(|&r| r == regimes[0]),
+            regimes,
+            walks,
+        }
+    }
 }

@@ -21,6 +21,9 @@ pub fn word(report: &mut Report, evidence: &Evidence) {
     report.inputs = inputs(evidence, report.tracks_give_t1);
     report.summary.text = summary(&report.summary, &report.paper_vs_model);
     report.plain_answer.text = plain_answer(&report.plain_answer);
+    if report.plain_answer.untested {
+        report.warnings.insert(0, another_robot(evidence));
+    }
     if let Some(c) = &mut report.calibration {
         c.goodness_of_fit = goodness_of_fit(c.no_floor);
     }
@@ -118,6 +121,24 @@ fn plain_answer(a: &PlainAnswer) -> String {
         );
     }
     text
+}
+
+/// The first warning of a report on a robot other than the paper's without observations of its
+/// own ([`PlainAnswer::untested`]): nothing about the paper's 0.35 kg robot is fitted or
+/// compared.
+fn another_robot(evidence: &Evidence) -> String {
+    let r = &evidence.robot;
+    let (mass, ..) = sandslope::paper::ROBOT;
+    format!(
+        "your robot ({}, {} kg, R = {} cm) is not the paper's ({mass} kg, R = 4 cm) and you gave no observations \
+         of it (--observed, --t1, --tracks): the paper's speeds, anchoring trend, step period and heavy-robot claim \
+         are of the paper's robot, so this report neither fits nor compares them; it is the model's prediction \
+         for your robot on {}, untested. Give its measured speeds with --observed to test and calibrate it",
+        evidence.robot_source,
+        r.mass(),
+        r.leg_radius() * 100.0,
+        evidence.terrain_source
+    )
 }
 
 /// The comparison table summed up in a sentence: the independent agreements counted, or the
@@ -666,5 +687,32 @@ mod tests {
         assert!(summary(&count(&rows), &rows).starts_with(
             "the model agrees with 1 of the paper's 2 independent numbers; 1 more agree by construction"
         ));
+    }
+
+    /// A 1.2 kg robot without observations: the first warning says it is not the paper's
+    /// 0.35 kg robot, with its mass, and the plain answer that it is untested.
+    #[test]
+    fn another_robot_is_warned_first() {
+        let robot = sandslope_io::load_robot("paper-hexapod").unwrap().with_mass(1.2).unwrap();
+        let terrain = sandslope_io::load_terrain("glass-beads-300um").unwrap();
+        let request = crate::report::ReportRequest::from_fields(
+            "paper-hexapod".into(),
+            "glass-beads-300um".into(),
+            Vec::new(),
+            &[],
+        )
+        .unwrap();
+        let r = request.answer(robot, terrain, crate::error::Words::Flag).unwrap();
+        assert!(
+            r.warnings[0].contains("kg, R = 4 cm) is not the paper's (0.35 kg, R = 4 cm)")
+                && r.warnings[0].contains("1.2 kg"),
+            "{:?}",
+            r.warnings
+        );
+        assert!(
+            r.plain_answer.text.contains("prediction for your robot, untested"),
+            "{}",
+            r.plain_answer.text
+        );
     }
 }

@@ -37,27 +37,14 @@ pub(crate) fn summary(rows: &[PaperComparison]) -> Summary {
     Summary { independent, independent_agree, by_construction_agree, total: rows.len(), text: String::new() }
 }
 
-/// The warning of a report on a robot other than the paper's ([`paper::is_papers_robot`])
-/// without observations of its own (`--observed`, `--t1`, `--tracks`); `None` otherwise. Then
-/// the paper's speeds, anchoring trend, step period and heavy-robot claim, all numbers about its
-/// 0.35 kg robot, are neither fitted nor compared: the report is the model for this robot on
-/// this terrain, and only the terrain's ratios are set beside the paper's.
-pub(crate) fn another_robot_without_observations(evidence: &Evidence) -> Option<String> {
-    if evidence.has_own_observations() || paper::is_papers_robot(&evidence.robot) {
-        return None;
-    }
-    let r = &evidence.robot;
-    let (mass, ..) = paper::ROBOT;
-    Some(format!(
-        "your robot ({}, {} kg, R = {} cm) is not the paper's ({mass} kg, R = 4 cm) and you gave no observations \
-         of it (--observed, --t1, --tracks): the paper's speeds, anchoring trend, step period and heavy-robot claim \
-         are of the paper's robot, so this report neither fits nor compares them; it is the model's prediction \
-         for your robot on {}, untested. Give its measured speeds with --observed to test and calibrate it",
-        evidence.robot_source,
-        r.mass(),
-        r.leg_radius() * 100.0,
-        evidence.terrain_source
-    ))
+/// Whether the report is on a robot other than the paper's ([`paper::is_papers_robot`])
+/// without observations of its own (`--observed`, `--t1`, `--tracks`). Then the paper's speeds,
+/// anchoring trend, step period and heavy-robot claim, all numbers about its 0.35 kg robot, are
+/// neither fitted nor compared: the report is the model for this robot on this terrain,
+/// untested, and only the terrain's ratios are set beside the paper's (the front end words the
+/// warning first).
+pub(crate) fn another_robot_without_observations(evidence: &Evidence) -> bool {
+    !evidence.has_own_observations() && !paper::is_papers_robot(&evidence.robot)
 }
 
 /// The comparison rows that stand whatever the robot ([`paper::TERRAIN_ROWS`]), each labelled

@@ -304,7 +304,21 @@ pub struct PlainAnswer {
     pub safe_limit: SafeLimit,
     /// The risk threshold of both limits.
     pub max_risk: f64,
-    /// The answer in one paragraph.
+    /// The speed at `first_not_success`, m/s (a value of the paragraph, not of the JSON).
+    #[serde(skip)]
+    pub speed_at_first_not_success_m_s: Option<f64>,
+    /// The terrain's angle of repose, degrees (a value of the paragraph, not of the JSON).
+    #[serde(skip)]
+    pub repose_deg: Option<f64>,
+    /// Whether the robot is not the paper's and has no observations of its own: the answer is
+    /// the model's, untested.
+    #[serde(skip)]
+    pub untested: bool,
+    /// Whether the answer rests on a calibration that flags itself ([`Report::fit_diagnosis`]).
+    #[serde(skip)]
+    pub unreliable: bool,
+    /// The answer in one paragraph: worded by the front end from these values (empty as
+    /// [`report`] returns it).
     pub text: String,
 }
 
@@ -320,54 +334,6 @@ fn plain_answer(plots: &Plots, unreliable: bool, untested: bool) -> PlainAnswer 
         None => grid.last(),
     };
     let level = grid.first().and_then(|p| p.speed);
-    let cm = |v: f64| format!("{:.1} cm/s", 100.0 * v);
-    let mut text = format!("On {} the {} kg robot ", plots.terrain_name, plots.mass_kg);
-    match last_success {
-        Some(p) => text.push_str(&format!(
-            "climbs steadily up to {:.2}° ({} on level ground, {} there)",
-            deg(p),
-            level.map_or("-".into(), cm),
-            p.speed.map_or("-".into(), cm)
-        )),
-        None => text.push_str("does not climb steadily even on level ground"),
-    }
-    if let Some(p) = first_not.filter(|p| !p.regime.is_failure()) {
-        text.push_str(&format!(
-            "; from {:.2}° it {} (the paper's \"{}\": it still moves up, {} there, but each step is shorter than \
-             the robust step, so the next foothold lands in sand the last one disturbed and it can stall in its own trench)",
-            deg(p),
-            p.regime.outcome(),
-            p.regime.name(),
-            p.speed.map_or("-".into(), cm)
-        ));
-    }
-    if let Some(p) = first_fail {
-        let why = if plots.repose_deg.is_some_and(|r| deg(p) >= r) { " (the angle of repose)" } else { "" };
-        text.push_str(&format!("; from {:.2}°{why} it {} ({})", deg(p), p.regime.outcome(), p.regime.name()));
-    }
-    text.push_str(" (the model at the terrain's medians, docs/model.md §5-§6).");
-    let words = |l: &SafeLimit| match *l {
-        SafeLimit::Limit { value, .. } => format!("up to {value:.1}°"),
-        SafeLimit::Repose { repose_deg, .. } => format!("up to the angle of repose, {repose_deg}°"),
-        SafeLimit::NoneSafe { .. } => "on no slope".into(),
-        SafeLimit::BeyondRange { up_to, .. } => format!("at every slope up to {up_to}°"),
-    };
-    text.push_str(&format!(
-        " With the terrain's uncertainty, it climbs steadily (P(not climbing steadily) < {r}) {} and is safe (P(sinks or slides back) < {r}) {} (§9).",
-        words(&plots.success_limit),
-        words(&plots.safe_limit),
-        r = plots.max_risk
-    ));
-    if untested {
-        text.push_str(
-            " This is the model's prediction for your robot, untested: the paper's speeds are of its 0.35 kg robot, and you gave no observations of yours.",
-        );
-    }
-    if unreliable {
-        text.push_str(
-            " These numbers rest on a calibration that does not fit its observations: read why, and what data would fix it, before using them.",
-        );
-    }
     PlainAnswer {
         mass_kg: plots.mass_kg,
         terrain: plots.terrain_name.clone(),
@@ -379,7 +345,11 @@ fn plain_answer(plots: &Plots, unreliable: bool, untested: bool) -> PlainAnswer 
         success_limit: plots.success_limit,
         safe_limit: plots.safe_limit,
         max_risk: plots.max_risk,
-        text,
+        speed_at_first_not_success_m_s: first_not.and_then(|p| p.speed),
+        repose_deg: plots.repose_deg,
+        untested,
+        unreliable,
+        text: String::new(),
     }
 }
 
@@ -467,9 +437,8 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
             model_m_s: predict(&robot, o.slope, &terrain.at(o.slope)).speed,
         })
         .collect();
-    let untested = other_robot.is_some();
-    let mut warnings: Vec<String> = other_robot.into_iter().collect();
-    warnings.extend(track_use.warnings);
+    let untested = other_robot;
+    let mut warnings: Vec<String> = track_use.warnings;
     warnings.extend(simulator_refusal);
     if !unconverged.is_empty() {
         warnings.push(format!(
@@ -833,9 +802,7 @@ mod tests {
         assert_eq!(at(next).regime, regime);
         assert_eq!(a.level_speed_m_s, at(0.0).speed);
         assert_eq!(a.speed_at_limit_m_s, at(top).speed);
-        assert!(a.text.contains(&format!("climbs steadily up to {top:.2}°")), "{}", a.text);
-        // The next slope in a field engineer's words, the paper's name beside them.
-        assert!(a.text.contains(&format!("from {next:.2}° it {}", regime.outcome())), "{}", a.text);
+        assert_eq!(a.speed_at_first_not_success_m_s, at(next).speed);
         // Repose 25 deg: at and beyond it the regime is slippage.
         assert!(a.first_failure.unwrap().0 <= 25.0);
     }
@@ -864,8 +831,8 @@ mod tests {
         assert!((c.observed_step_m - 0.0249).abs() < 1e-12);
         assert!(d.text.contains("at 20°") && d.text.contains("§5"), "{}", d.text);
         assert!(d.remedies.iter().any(|m| m.contains("--touchdowns")), "{:?}", d.remedies);
-        assert!(r.plain_answer.text.contains("does not fit its observations"), "{}", r.plain_answer.text);
-        assert!(r.plain_answer.text.starts_with("On the terrain calibrated on your observations"));
+        assert!(r.plain_answer.unreliable);
+        assert_eq!(r.plain_answer.terrain, "the terrain calibrated on your observations");
     }
 
     /// The paper's own evidence on its terrain: nothing to diagnose when the fit does not flag
@@ -883,7 +850,7 @@ mod tests {
             })
         });
         assert_eq!(r.fit_diagnosis.is_some(), flagged);
-        assert_eq!(r.plain_answer.text.contains("does not fit its observations"), flagged);
+        assert_eq!(r.plain_answer.unreliable, flagged);
     }
 
     /// A 1.2 kg robot without observations: nothing about the paper's 0.35 kg robot is fitted
@@ -898,17 +865,10 @@ mod tests {
         e.robot_source = "mine.toml".into();
         assert!(paper::is_papers_robot(&paper_robot()) && !paper::is_papers_robot(&e.robot));
         let r = report(&e).unwrap();
-        assert!(
-            r.warnings[0].contains("is not the paper's") && r.warnings[0].contains("1.2 kg"),
-            "{:?}",
-            r.warnings
-        );
+        // The front end words its warning first (request/report_text.rs).
+        assert!(r.plain_answer.untested);
         assert!(r.speeds.is_empty() && r.calibration.is_none());
-        assert!(
-            r.plain_answer.text.contains("prediction for your robot, untested"),
-            "{}",
-            r.plain_answer.text
-        );
+        assert!(r.plain_answer.untested);
         let ids: Vec<&str> = r.paper_vs_model.iter().map(|c| c.id.as_str()).collect();
         assert_eq!(ids, paper::TERRAIN_ROWS);
         assert!(r.paper_vs_model.iter().all(|c| !c.quantity.contains("0.35") && c.agrees));
@@ -918,7 +878,7 @@ mod tests {
         let obs = |d: f64, v: f64| SpeedObservation { slope: at(d), speed: v, speed_sd: 0.01 };
         e.observed = Some(("mine.csv".into(), vec![obs(0.0, 0.12), obs(10.0, 0.08), obs(20.0, 0.04)]));
         let r = report(&e).unwrap();
-        assert!(r.warnings.iter().all(|w| !w.contains("is not the paper's")), "{:?}", r.warnings);
+        assert!(!r.plain_answer.untested);
         let observed: Vec<f64> = r.speeds.iter().map(|s| s.observed_m_s).collect();
         assert_eq!(observed, [0.12, 0.08, 0.04]);
         assert!(r.speeds.iter().all(|s| s.model_m_s.is_some()));

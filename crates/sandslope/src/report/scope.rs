@@ -1,6 +1,6 @@
 //! What the report compares and walks, given the evidence: on a robot other than the paper's
 //! no number about the paper's 0.35 kg robot ([`another_robot_without_observations`],
-//! [`terrain_rows_only`]); the summary of the comparisons ([`summary`]); and the simulator's
+//! [`terrain_rows_only`]); the counts of the comparisons ([`summary`]); and the simulator's
 //! walks only on a plausible terrain ([`simulator_walks`]).
 
 use serde::Serialize;
@@ -23,58 +23,28 @@ pub struct Summary {
     pub by_construction_agree: usize,
     /// All comparisons.
     pub total: usize,
-    /// The summary sentence.
+    /// The summary sentence: worded by the front end from the counts and the comparison rows
+    /// (empty as [`super::report`] returns it).
     pub text: String,
 }
 
-/// The summary of `rows`: independent agreements counted, one independent number named.
+/// The summary of `rows`: independent agreements counted (its sentence is the front end's,
+/// worded from these counts and the rows; empty here).
 pub(crate) fn summary(rows: &[PaperComparison]) -> Summary {
     let independent = rows.iter().filter(|r| r.basis == Basis::Independent).count();
     let independent_agree = rows.iter().filter(|r| r.basis == Basis::Independent && r.agrees).count();
     let by_construction_agree = rows.iter().filter(|r| r.basis != Basis::Independent && r.agrees).count();
-    let construction = format!(
-        "{by_construction_agree} more agree by construction (inputs, tuned values, consequences of the model's form), out of {} compared",
-        rows.len()
-    );
-    let text = match independent {
-        0 => format!("none of the paper's numbers tests the model independently here; {construction}"),
-        // One number: name it, rather than "0 of the paper's 1 independent numbers".
-        1 => {
-            let row = rows.iter().find(|r| r.basis == Basis::Independent).expect("one independent row");
-            format!(
-                "one of the paper's numbers tests the model independently, the {}: paper {}, model {}, so the model {} it; {construction}",
-                row.quantity,
-                row.paper,
-                row.model,
-                if row.agrees { "agrees with" } else { "disagrees with" }
-            )
-        }
-        n => format!("the model agrees with {independent_agree} of the paper's {n} independent numbers; {construction}"),
-    };
-    Summary { independent, independent_agree, by_construction_agree, total: rows.len(), text }
+    Summary { independent, independent_agree, by_construction_agree, total: rows.len(), text: String::new() }
 }
 
-/// The warning of a report on a robot other than the paper's ([`paper::is_papers_robot`])
-/// without observations of its own (`--observed`, `--t1`, `--tracks`); `None` otherwise. Then
-/// the paper's speeds, anchoring trend, step period and heavy-robot claim, all numbers about its
-/// 0.35 kg robot, are neither fitted nor compared: the report is the model for this robot on
-/// this terrain, and only the terrain's ratios are set beside the paper's.
-pub(crate) fn another_robot_without_observations(evidence: &Evidence) -> Option<String> {
-    if evidence.has_own_observations() || paper::is_papers_robot(&evidence.robot) {
-        return None;
-    }
-    let r = &evidence.robot;
-    let (mass, ..) = paper::ROBOT;
-    Some(format!(
-        "your robot ({}, {} kg, R = {} cm) is not the paper's ({mass} kg, R = 4 cm) and you gave no observations \
-         of it (--observed, --t1, --tracks): the paper's speeds, anchoring trend, step period and heavy-robot claim \
-         are of the paper's robot, so this report neither fits nor compares them; it is the model's prediction \
-         for your robot on {}, untested. Give its measured speeds with --observed to test and calibrate it",
-        evidence.robot_source,
-        r.mass(),
-        r.leg_radius() * 100.0,
-        evidence.terrain_source
-    ))
+/// Whether the report is on a robot other than the paper's ([`paper::is_papers_robot`])
+/// without observations of its own (`--observed`, `--t1`, `--tracks`). Then the paper's speeds,
+/// anchoring trend, step period and heavy-robot claim, all numbers about its 0.35 kg robot, are
+/// neither fitted nor compared: the report is the model for this robot on this terrain,
+/// untested, and only the terrain's ratios are set beside the paper's (the front end words the
+/// warning first).
+pub(crate) fn another_robot_without_observations(evidence: &Evidence) -> bool {
+    !evidence.has_own_observations() && !paper::is_papers_robot(&evidence.robot)
 }
 
 /// The comparison rows that stand whatever the robot ([`paper::TERRAIN_ROWS`]), each labelled

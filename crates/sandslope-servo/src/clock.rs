@@ -165,8 +165,12 @@ pub const OVERSLEEP_S: f64 = 0.001;
 /// What dynamixel2 waits for a status packet that does not come, s: its reply timeout, the
 /// transfer time of the message at the bus's baud rate plus 34 ms, for the driver's state
 /// block (11 bytes of packet around 21 of data) at the pty's nominal 9600 baud
-/// ([`crate::emulator::EMULATED_BAUD`]): 32 x 10 / 9600 s + 34 ms = 67 ms.
-pub const REPLY_TIMEOUT_S: f64 = 32.0 * 10.0 / crate::emulator::EMULATED_BAUD as f64 + 0.034;
+/// ([`EMULATED_BAUD`]): 32 x 10 / 9600 s + 34 ms = 67 ms.
+pub const REPLY_TIMEOUT_S: f64 = 32.0 * 10.0 / EMULATED_BAUD as f64 + 0.034;
+
+/// The emulator's pty's nominal baud rate: a pty moves bytes at once whatever its rate, but
+/// dynamixel2 sets its reply timeouts from it ([`REPLY_TIMEOUT_S`]).
+pub const EMULATED_BAUD: u32 = 9600;
 
 /// Whether servo `id` answers `ins` with a status packet (Status Return Level 2, as the
 /// driver's setup writes it): what the driver waits for when the servo is silent.

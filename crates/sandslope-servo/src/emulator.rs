@@ -702,8 +702,9 @@ pub fn pty_path(port: &SerialPort) -> Option<std::path::PathBuf> {
     std::fs::read_link(format!("/proc/self/fd/{}", port.as_raw_fd())).ok()
 }
 
-/// The pty's nominal baud rate (see [`Emulator::start`]).
-pub const EMULATED_BAUD: u32 = 9600;
+/// The pty's nominal baud rate (see [`Emulator::start`]); defined beside the emulated clock,
+/// whose reply timeout follows from it.
+pub use crate::clock::EMULATED_BAUD;
 
 /// A running emulator: a thread serving the pty's master side.
 #[derive(Debug)]

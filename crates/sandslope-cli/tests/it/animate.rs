@@ -76,8 +76,10 @@ fn a_terminal_sees_progress_a_log_sees_lines_and_json_nothing() {
     // GIF's frames (1.5 s at 20 frames a second from t = 0: 31), with no terminal codes.
     let piped = sandslope().args(walk.split(' ')).output().unwrap();
     let stderr = String::from_utf8_lossy(&piped.stderr);
-    assert!(stderr.contains("simulating 1.5 s at 10 deg ...\n"), "{stderr}");
-    assert!(stderr.contains("simulating 1.5 s at 10 deg: done in "), "{stderr}");
+    // One slope: the walk and its two other contact scalings (the spread, on by default).
+    let start = "simulating 1.5 s at 10 deg under each of the three contact scalings";
+    assert!(stderr.contains(&format!("{start} ...\n")), "{stderr}");
+    assert!(stderr.contains(&format!("{start}: done in ")), "{stderr}");
     assert!(stderr.contains(&format!("drawing {}: 31/31, done in ", gif.display())), "{stderr}");
     assert!(!stderr.contains('\u{1b}'), "{stderr}");
     // --json piped: nothing but the answer.

@@ -357,17 +357,13 @@ pub fn simulator(report: &Report) -> String {
          <th>3 contact scalings: speed, regimes (hover: each)</th><th>verdict</th></tr>",
     );
     for r in &report.simulator {
-        let free = if r.pitch_over_s.is_some() {
-            "- (tumbled)".to_string()
-        } else {
-            format!("{:.1}", r.pitch_free_m_s * 100.0)
-        };
+        let free = if r.pitch_over_s.is_some() { "- (tumbled)".to_string() } else { cm_s(r.pitch_free_m_s) };
         h.push_str(&format!(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td><abbr title=\"{} / {}\">{} / {}</abbr></td><td>{}</td><td>{}</td>{}</tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td><abbr title=\"{} / {}\">{} / {}</abbr></td><td>{}</td><td>{}</td>{}</tr>",
             r.slope_deg,
             plus_minus(r.observed_m_s.map(|v| v * 100.0), r.observed_sd_m_s.map(|v| v * 100.0), 1.0, 1),
-            r.closed_form_m_s.map_or("- (ruled out)".into(), |v| format!("{:.1}", v * 100.0)),
-            r.simulated_m_s * 100.0,
+            r.closed_form_m_s.map_or("- (ruled out)".into(), cm_s),
+            cm_s(r.simulated_m_s),
             free,
             r.closed_form_regime.outcome(),
             r.simulated_regime.outcome(),
@@ -547,4 +543,25 @@ fn simulator_misses(misses: &[sandslope::report::SimulatorMiss]) -> String {
     }
     h.push_str("</ul>\n");
     h
+}
+
+/// A speed in m/s as cm/s with one decimal, without the sign of a speed that rounds to zero
+/// (a walk at -0.04 cm/s reads "0.0", not "-0.0").
+fn cm_s(v_m_s: f64) -> String {
+    let rounded = (v_m_s * 1000.0).round() / 10.0;
+    format!("{:.1}", if rounded == 0.0 { 0.0 } else { rounded })
+}
+
+#[cfg(test)]
+mod cm_s_tests {
+    use super::cm_s;
+
+    /// By hand: 0.3476 m/s is 34.76 cm/s, 34.8 to one decimal; -0.0004 m/s is -0.04 cm/s, which
+    /// rounds to zero and reads without a sign; -0.081 m/s keeps its sign.
+    #[test]
+    fn speeds_round_to_one_decimal_without_a_signed_zero() {
+        assert_eq!(cm_s(0.3476), "34.8");
+        assert_eq!(cm_s(-0.0004), "0.0");
+        assert_eq!(cm_s(-0.081), "-8.1");
+    }
 }

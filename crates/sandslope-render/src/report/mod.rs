@@ -9,7 +9,7 @@ pub use figures::page_figures;
 
 use std::path::Path;
 
-use sandslope::report::{Report, TrackRecord};
+use sandslope::report::{Report, TrackGap, TrackRecord};
 use sandslope_io::files::{create_output_dir, write_atomic};
 
 use crate::figures::palette;
@@ -104,7 +104,8 @@ pub fn page(report: &Report, figures: &[PageFigure]) -> String {
     h.push_str(&sections::step_budget(report));
     h.push_str(&sections::simulator(report));
     h.push_str(&sections::simulator_fit(report));
-    let tracks = TracksSection { records: &report.tracks, notes: &report.track_notes };
+    let notes = track_notes(report);
+    let tracks = TracksSection { records: &report.tracks, notes: &notes };
     if !tracks.records.is_empty() {
         h.push_str(&tracks_section(&tracks));
     }
@@ -160,6 +161,43 @@ pub(crate) fn plus_minus(mean: Option<f64>, sd: Option<f64>, scale: f64, decimal
         (Some(m), None) => format!("{:.decimals$}", m * scale),
         _ => "-".into(),
     }
+}
+
+/// The notes under the motion-capture table: each tracked slope whose anchoring time or speed
+/// could not be used, and where the observed speeds come from when `--observed` is given too.
+fn track_notes(report: &Report) -> Vec<String> {
+    let mut out: Vec<String> = report
+        .unused_tracks
+        .iter()
+        .map(|u| {
+            let (what, why, figure) = match u.gap {
+                TrackGap::NoAnchoredStep => {
+                    ("anchoring time", format!("no anchored step among {} steps", u.steps), "fig5b")
+                }
+                TrackGap::NoAnchoringSd => (
+                    "anchoring time",
+                    "its SD needs at least two anchored steps with different t1".to_string(),
+                    "fig5b",
+                ),
+                TrackGap::NoSpeedSd => (
+                    "observed speed",
+                    format!("its SD needs at least two steps with different speeds; found {} steps", u.steps),
+                    "fig3a",
+                ),
+            };
+            format!(
+                "The tracks at {}° ({}) give no {what} ({why}): not drawn in {figure} nor used in the calibration.",
+                u.slope_deg,
+                u.files.join(", ")
+            )
+        })
+        .collect();
+    if report.track_speeds_shown_only {
+        out.push(
+            "The observed speeds are --observed's: the tracks' speeds are shown in this table only.".into(),
+        );
+    }
+    out
 }
 
 /// The "Motion capture" section: the tracks' table and notes.

@@ -10,10 +10,12 @@
 //!   [`CONTRADICTION_SD`] combined SDs, no k_s can meet both: the fit must fail there.
 //! - **The observations farthest from the fitted model**, in their quoted SDs (without the
 //!   model-error floor, which would hide them).
+//!
+//! The findings are values; the paragraph and the remedies are worded by the front end (the
+//! request layer's `report_text`).
 
 use serde::Serialize;
 
-use super::audit::NoFloorFit;
 use super::tracks::TrackedSlope;
 use crate::calibrate::{
     AnchoringObservation, CalibrationWarning, JointCalibration, ObservationKind, SpeedObservation,
@@ -78,16 +80,21 @@ pub struct FitDiagnosis {
     pub contradictions: Vec<StepAtObservedT1>,
     /// The observations farthest from the fitted model (at most three, beyond 3 quoted SDs).
     pub worst: Vec<Miss>,
-    /// What data would fix it, one sentence each.
+    /// What data would fix it, one sentence each: worded by the front end from these values
+    /// and the fit without the floor (empty as [`super::report`] returns it).
     pub remedies: Vec<String>,
-    /// The diagnosis in one paragraph.
+    /// The diagnosis in one paragraph: worded by the front end likewise (empty as
+    /// [`super::report`] returns it).
     pub text: String,
+    /// The fitted robot's stance duration T/2, s, over which the paragraph turns each observed
+    /// step back into a speed (a value of the paragraph, not of the JSON).
+    #[serde(skip)]
+    pub stance_duration_s: f64,
 }
 
 /// The evidence the diagnosis reads.
 pub(crate) struct DiagnosisInput<'a> {
     pub fit: &'a JointCalibration,
-    pub no_floor: Option<&'a NoFloorFit>,
     pub speeds: &'a [SpeedObservation],
     pub anchoring: &'a [AnchoringObservation],
     pub tracks: &'a [TrackedSlope],
@@ -120,9 +127,13 @@ pub(crate) fn diagnose(input: &DiagnosisInput<'_>) -> Option<FitDiagnosis> {
         .filter(|c| c.sigmas > CONTRADICTION_SD)
         .collect();
     let worst = worst(fit);
-    let remedies = remedies(&contradictions, &worst, input.no_floor);
-    let text = text(&contradictions, &worst, input.no_floor, robot.stance_duration());
-    Some(FitDiagnosis { contradictions, worst, remedies, text })
+    Some(FitDiagnosis {
+        contradictions,
+        worst,
+        remedies: Vec::new(),
+        text: String::new(),
+        stance_duration_s: robot.stance_duration(),
+    })
 }
 
 /// The model's step at an observed t1 against the observed step (`None` where t1 is not
@@ -181,117 +192,6 @@ fn worst(fit: &JointCalibration) -> Vec<Miss> {
     misses.sort_by(|a, b| b.sigmas.total_cmp(&a.sigmas));
     misses.truncate(WORST);
     misses
-}
-
-fn describe(m: &Miss) -> String {
-    let value = |v: f64| match m.kind {
-        ObservationKind::Speed => format!("{:.2} cm/s", v * 100.0),
-        ObservationKind::AnchoringTime => format!("{:.1} ms", v * 1e3),
-        ObservationKind::PlateShearStrength => format!("{v:.3e} N/m³"),
-    };
-    let what = match m.kind {
-        ObservationKind::Speed => "speed",
-        ObservationKind::AnchoringTime => "anchoring time",
-        ObservationKind::PlateShearStrength => "plate shear strength",
-    };
-    format!(
-        "the {what} at {}° (observed {} ± {}, the fitted model {}: {:.1} SD)",
-        m.slope_deg,
-        value(m.observed),
-        value(m.sd),
-        value(m.model),
-        m.sigmas
-    )
-}
-
-fn text(
-    contradictions: &[StepAtObservedT1],
-    worst: &[Miss],
-    no_floor: Option<&NoFloorFit>,
-    half: f64,
-) -> String {
-    let mut t = String::from("The model cannot meet these observations within their SDs");
-    if let Some(n) = no_floor {
-        t.push_str(&format!(
-            " (χ² = {:.1} on {} degrees of freedom without the model-error floor)",
-            n.chi_squared, n.dof
-        ));
-    }
-    t.push('.');
-    if !contradictions.is_empty() {
-        let at: Vec<String> = contradictions
-            .iter()
-            .map(|c| {
-                format!(
-                    "at {}° the model's step at your t1 = {:.0} ± {:.0} ms is {:.2} ± {:.2} cm, and you observed {:.2} ± {:.2} cm ({:.2} cm/s over T/2 = {:.2} s)",
-                    c.slope_deg,
-                    c.t1_s * 1e3,
-                    c.t1_sd_s * 1e3,
-                    c.model_step_m * 100.0,
-                    c.model_step_sd_m * 100.0,
-                    c.observed_step_m * 100.0,
-                    c.observed_step_sd_m * 100.0,
-                    c.observed_step_m / half * 100.0,
-                    half
-                )
-            })
-            .collect();
-        t.push_str(&format!(
-            " Your anchoring times and speeds contradict each other whatever k_s is: {}. In the model (docs/model.md §5) the robot slides at g sin θ until it anchors and carries that slip speed through the rest of the stance, so a long t1 on a slope costs more step than these recordings lost.",
-            at.join("; ")
-        ));
-        for c in contradictions {
-            let Some(slip) = c.recorded_slip_m else { continue };
-            if !(0.5..=2.0).contains(&(slip / c.free_slide_m)) {
-                t.push_str(&format!(
-                    " At {}° the recordings slip {:.1} mm in those {:.0} ms where a free slide is {:.1} mm: the robot does not slide freely before it anchors, as the model assumes.",
-                    c.slope_deg,
-                    slip * 1e3,
-                    c.t1_s * 1e3,
-                    c.free_slide_m * 1e3
-                ));
-            }
-        }
-    }
-    if !worst.is_empty() {
-        let list: Vec<String> = worst.iter().map(describe).collect();
-        t.push_str(&format!(" Farthest from the fitted model: {}.", list.join("; ")));
-    }
-    t
-}
-
-fn remedies(
-    contradictions: &[StepAtObservedT1],
-    worst: &[Miss],
-    no_floor: Option<&NoFloorFit>,
-) -> Vec<String> {
-    let mut out = Vec::new();
-    if !contradictions.is_empty() {
-        let slopes: Vec<String> = contradictions.iter().map(|c| format!("{}°", c.slope_deg)).collect();
-        let slopes = match slopes.split_last() {
-            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
-            _ => slopes.join(""),
-        };
-        out.push(format!(
-            "At {slopes}: the touchdown times from the gait controller (sandslope track --touchdowns), so that t1 is measured from the true touchdown (estimated touchdowns bias t1 by up to 15 ms, docs/tracking.md). If t1 stands, the model's slip (§5) is what fails there, and more data at that slope cannot fix the fit.",
-        ));
-    }
-    if worst.iter().any(|m| m.kind == ObservationKind::PlateShearStrength) {
-        out.push(
-            "Force tests at the slopes you walked, with repeats: a plate shear strength far from the fitted k_s(θ) means the force tests and the walks disagree on the sand's shear strength (docs/calibration.md).".into(),
-        );
-    }
-    if worst.iter().any(|m| m.kind == ObservationKind::AnchoringTime) && contradictions.is_empty() {
-        out.push(
-            "Anchoring times measured from the controller's touchdowns at more slopes: t1 is what the model predicts least well here.".into(),
-        );
-    }
-    if no_floor.and_then(|n| n.chi_squared_per_dof).is_some_and(|r| r > 3.0) {
-        out.push(
-            "More strides at the same slopes will not help: they shrink the SDs and make the misfit larger. The misfit is between the model's form and these observations, not noise.".into(),
-        );
-    }
-    out
 }
 
 #[cfg(test)]

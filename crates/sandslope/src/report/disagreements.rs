@@ -1,59 +1,73 @@
-//! The report's "where the model and the evidence disagree" items that the library finds by
-//! walking the model: the user's observations more than 2 SDs from the calibrated model. The
-//! items worded from the report's values alone (failing comparisons, the per-slope inversion,
-//! the calibration's floor and plate scale) and the calibration's warnings are the front ends'
-//! (the request layer's `report_text`).
+//! The report's "where the model and the evidence disagree" findings that the library makes by
+//! walking the model: the user's observations more than 2 SDs from the calibrated model, as
+//! values. Every item's words, these and those found from the report's values alone (failing
+//! comparisons, the per-slope inversion, the calibration's floor and plate scale), and the
+//! calibration's warnings are the front ends' (the request layer's `report_text`).
 
-use crate::calibrate::{AnchoringObservation, SpeedObservation};
+use crate::calibrate::{AnchoringObservation, ObservationKind, SpeedObservation};
 use crate::model::predict;
+use crate::regime::Cause;
 use crate::robot::Robot;
 use crate::terrain::Terrain;
 
-/// The user's observations against the model (the calibration on them): every speed or
-/// anchoring time more than 2 quoted SDs from the model's value.
-pub(crate) fn observation_items(
+/// How far, in the observation's quoted SD, the calibrated model must miss a user's
+/// observation for the report to list it.
+pub const OBSERVATION_MISS_SD: f64 = 2.0;
+
+/// One of the user's observations more than [`OBSERVATION_MISS_SD`] quoted SDs from the
+/// calibrated model's value, or one the model has no value for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObservationMiss {
+    /// A speed (m/s) or an anchoring time (s).
+    pub kind: ObservationKind,
+    /// Slope, degrees.
+    pub slope_deg: f64,
+    /// The observed value.
+    pub observed: f64,
+    /// Its quoted SD.
+    pub sd: f64,
+    /// The calibrated model's value (`None`: no speed, or no anchoring).
+    pub model: Option<f64>,
+    /// Why the model has no speed there: the cause of its regime (speeds only).
+    pub cause: Cause,
+}
+
+impl ObservationMiss {
+    /// `(observed - model) / sd`, where the model has a value.
+    pub fn pull(&self) -> Option<f64> {
+        self.model.map(|m| (self.observed - m) / self.sd)
+    }
+}
+
+/// The user's observations against the model (the calibration on them): every speed, then
+/// every anchoring time, more than [`OBSERVATION_MISS_SD`] quoted SDs from the model's value.
+pub(crate) fn observation_misses(
     robot: &Robot,
     terrain: &Terrain,
     speeds: &[SpeedObservation],
     anchoring: &[AnchoringObservation],
-) -> Vec<String> {
-    let mut out = Vec::new();
-    for o in speeds {
+) -> Vec<ObservationMiss> {
+    let speeds = speeds.iter().map(|o| {
         let p = predict(robot, o.slope, &terrain.at(o.slope));
-        let pull = p.speed.map(|v| (o.speed - v) / o.speed_sd);
-        if pull.is_none_or(|z| z.abs() > 2.0) {
-            out.push(format!(
-                "Your speed at {}°: observed {:.2} ± {:.2} cm/s (SD as measured), the calibrated model gives {} (rule: within 2 SD).",
-                o.slope.degrees(),
-                o.speed * 100.0,
-                o.speed_sd * 100.0,
-                match (p.speed, pull) {
-                    (Some(v), Some(z)) => format!("{:.2} cm/s, {:.1} SD away", v * 100.0, z.abs()),
-                    _ => format!("no speed ({})", p.cause.explain()),
-                }
-            ));
+        ObservationMiss {
+            kind: ObservationKind::Speed,
+            slope_deg: o.slope.degrees(),
+            observed: o.speed,
+            sd: o.speed_sd,
+            model: p.speed,
+            cause: p.cause,
         }
-    }
-    for o in anchoring {
+    });
+    let anchoring = anchoring.iter().map(|o| {
         let p = predict(robot, o.slope, &terrain.at(o.slope));
-        let pull = p.anchoring_time.map(|t| (o.t1 - t) / o.t1_sd);
-        if pull.is_none_or(|z| z.abs() > 2.0) {
-            out.push(format!(
-                "Your anchoring time at {}°: observed t1 = {:.0} ± {:.0} ms, the calibrated model gives {} (rule: within 2 SD).",
-                o.slope.degrees(),
-                o.t1 * 1e3,
-                o.t1_sd * 1e3,
-                match (p.anchoring_time, pull) {
-                    (Some(t), Some(z)) => format!(
-                        "{:.0} ms (the observed is {:.1} times the model's, {:.1} SD away)",
-                        t * 1e3,
-                        o.t1 / t,
-                        z.abs()
-                    ),
-                    _ => "no anchoring".to_string(),
-                }
-            ));
+        ObservationMiss {
+            kind: ObservationKind::AnchoringTime,
+            slope_deg: o.slope.degrees(),
+            observed: o.t1,
+            sd: o.t1_sd,
+            model: p.anchoring_time,
+            cause: p.cause,
         }
-    }
-    out
+    });
+    speeds.chain(anchoring).filter(|m| m.pull().is_none_or(|z| z.abs() > OBSERVATION_MISS_SD)).collect()
 }

@@ -37,15 +37,16 @@ use crate::terrain::{Terrain, TerrainPoint};
 
 pub use audit::{Extrapolation, NoFloorFit, SpeedInversion, StepBudget, PAPER_FRAME_RATE_HZ};
 pub use diagnosis::{FitDiagnosis, Miss, StepAtObservedT1, CONTRADICTION_SD};
+pub use disagreements::{ObservationMiss, OBSERVATION_MISS_SD};
 pub use provenance::{Input, Provenance, ProvenanceKind};
-pub use scope::Summary;
 use scope::{another_robot_without_observations, summary, terrain_rows_only};
+pub use scope::{SimulatorLeftOut, Summary};
 pub use simulator::{
-    simulator_fit_misses, SimulatorMiss, SimulatorRecord, SimulatorWalks, AGREE_WITHIN, MISS_SD, REACH_K_S,
-    REPORT_WALK_S,
+    simulator_fit_misses, Parting, SimulatorMiss, SimulatorRecord, SimulatorWalks, AGREE_WITHIN, MISS_SD,
+    REACH_K_S, REPORT_WALK_S,
 };
 use tracks::TrackUse;
-pub use tracks::{TrackRecord, TrackedSlope};
+pub use tracks::{TrackGap, TrackRecord, TrackedSlope, UnusedTrack};
 
 /// Where the force tests come from.
 #[derive(Debug, Clone, PartialEq)]
@@ -203,8 +204,9 @@ pub struct Plots {
     pub simulated_pitch_locked: Vec<crate::simulate::SimSummary>,
 }
 
-/// The whole report. Serialises to `report.json`; [`Report::plots`], the page's notes and
-/// the terminal warnings are not part of it.
+/// The whole report. Serialises to `report.json`; [`Report::plots`] and the values the front
+/// end words its sentences from (serde-skipped) are not part of it. Every sentence field is
+/// empty as [`report`] returns it: the front end (the request layer's `report_text`) fills it.
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
     /// Whether the observations are the user's (then the model is the joint calibration on
@@ -234,9 +236,14 @@ pub struct Report {
     /// How many of the paper's numbers the model agrees with, independent ones apart.
     pub summary: Summary,
     /// The generated "where the model and the evidence disagree" items: the user's observations
-    /// the calibrated model misses, then those the front end words from this report's values
-    /// (failing comparisons, the per-slope inversion, the calibration's floor and plate scale).
+    /// the calibrated model misses ([`Self::observation_misses`]), then the failing comparisons,
+    /// the per-slope inversion, the calibration's floor and plate scale; worded by the front end
+    /// from this report's values (empty as [`report`] returns it).
     pub disagreements: Vec<String>,
+    /// The user's observations more than [`OBSERVATION_MISS_SD`] quoted SDs from the calibrated
+    /// model, speeds then anchoring times (empty on the paper's evidence).
+    #[serde(skip)]
+    pub observation_misses: Vec<ObservationMiss>,
     /// The k_s each observed speed needs on its own, lowest slope first.
     pub speed_inversion: Vec<SpeedInversion>,
     /// Regime claims at slopes beyond the measured k_s, and the k_s at which they would hold.
@@ -264,17 +271,39 @@ pub struct Report {
     /// Whether the motion-capture tracks give anchoring times (a row of the inputs table).
     #[serde(skip)]
     pub tracks_give_t1: bool,
-    /// Sentences on how the tracks entered the report (skipped t1s, speeds not used, ...).
+    /// The tracked slopes whose anchoring time or speed could not be used, in slope order (the
+    /// front ends word them: a note on the page, a warning first among [`Self::warnings`]).
     #[serde(skip)]
-    pub track_notes: Vec<String>,
-    /// What a reader must know before trusting the page: a fitted quantity at its search
-    /// bound, a fit far worse than the quoted SDs allow (chi^2/dof > 3), tracks that could not be
-    /// used. Printed at the top of the page and on stderr (`report --strict` fails on any). The
-    /// calibration's own warnings are worded last by the front end from [`Self::calibration`].
+    pub unused_tracks: Vec<UnusedTrack>,
+    /// Whether the observed speeds are `--observed`'s while tracks were given too: the tracks'
+    /// speeds are shown in their table only.
+    #[serde(skip)]
+    pub track_speeds_shown_only: bool,
+    /// Why the simulator section is left out (`None`: it is not).
+    #[serde(skip)]
+    pub simulator_left_out: Option<SimulatorLeftOut>,
+    /// The parts of the simulator's joint fit that failed, fit first.
+    #[serde(skip)]
+    pub simulator_fit_failures: Vec<SimulatorFitFailure>,
+    /// What a reader must know before trusting the page: a robot other than the paper's without
+    /// observations, tracks that could not be used, the simulator section left out or not
+    /// converged, the simulator's fit failed, a fitted quantity at its search bound, a fit far
+    /// worse than the quoted SDs allow (chi^2/dof > 3). Printed at the top of the page and on
+    /// stderr (`report --strict` fails on any). Worded by the front end from this report's
+    /// values (empty as [`report`] returns it).
     pub warnings: Vec<String>,
     /// The figures' data.
     #[serde(skip)]
     pub plots: Plots,
+}
+
+/// A part of the simulator's joint fit ([`Report::simulator_fit`]) that failed: the error.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SimulatorFitFailure {
+    /// The fit itself.
+    Fit(String),
+    /// Walking the observations it misses ([`simulator_fit_misses`]).
+    Misses(String),
 }
 
 /// The report's plain answer for its robot and terrain (the model every table and figure
@@ -391,7 +420,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     let other_robot = another_robot_without_observations(evidence);
     let speeds = observed_speeds(evidence, &track_use.speeds, papers_robot);
     let calibration = calibrate(evidence, &speeds, &anchoring);
-    let (simulator_fit, simulator_fit_misses, simulator_fit_warnings) =
+    let (simulator_fit, simulator_fit_misses, simulator_fit_failures) =
         simulator_fit_section(evidence, &speeds, &anchoring);
     let (robot, terrain) = model(evidence, calibration.as_ref())?;
     let mut plots = plots(evidence, &robot, &terrain, speeds.clone(), anchoring, calibration.as_ref())?;
@@ -399,16 +428,14 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     // walks no implausible terrain: either loses this section, with a warning, not the report.
     let at_bound = calibration.as_ref().and_then(|c| scope::terrain_at_bound(&c.fit, evidence));
     let section = scope::simulator_walks(&robot, &terrain, &speeds, &plots.terrain_name, at_bound);
-    let (simulator, simulator_convergence, simulator_refusal) = match section {
+    let (simulator, simulator_convergence, simulator_left_out) = match section {
         Ok(walks) => {
             plots.simulated = walks.free;
             plots.simulated_pitch_locked = walks.pitch_locked;
             (walks.records, walks.convergence, None)
         }
-        Err(e) => (Vec::new(), Vec::new(), Some(format!("the stride simulator section is left out: {e}"))),
+        Err(why) => (Vec::new(), Vec::new(), Some(why)),
     };
-    let unconverged: Vec<String> =
-        simulator_convergence.iter().filter(|c| !c.converged).map(|c| format!("{}°", c.slope_deg)).collect();
     let own = evidence.has_own_observations();
     let context = ComparisonContext {
         fitted_to_paper_speeds: !own && evidence.builtin_terrain,
@@ -438,27 +465,14 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         })
         .collect();
     let untested = other_robot;
-    let mut warnings: Vec<String> = track_use.warnings;
-    warnings.extend(simulator_refusal);
-    if !unconverged.is_empty() {
-        warnings.push(format!(
-            "the stride simulator's pitch-locked walk is not converged at {} (a quarter of the time step or a \
-             tenth of the creep speed moves its speed by more than 3% and 0.3 cm/s, its t1 by more than 1 ms or its \
-             regime; docs/simulate.md, \"Checking convergence\"): read those rows with care",
-            unconverged.join(", ")
-        ));
-    }
-    warnings.extend(simulator_fit_warnings);
-    let observations = if own {
-        disagreements::observation_items(&robot, &terrain, &speeds, &plots.anchoring)
+    let observation_misses = if own {
+        disagreements::observation_misses(&robot, &terrain, &speeds, &plots.anchoring)
     } else {
         Vec::new()
     };
-    let disagreements = observations;
     let fit_diagnosis = calibration.as_ref().and_then(|c| {
         diagnosis::diagnose(&diagnosis::DiagnosisInput {
             fit: &c.fit,
-            no_floor: c.no_floor.as_ref(),
             speeds: &speeds,
             anchoring: &plots.anchoring,
             tracks: &evidence.tracks,
@@ -475,7 +489,8 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         summary: summary(&paper_vs_model),
         calibration,
         paper_vs_model,
-        disagreements,
+        disagreements: Vec::new(),
+        observation_misses,
         speed_inversion,
         extrapolations,
         step_budget,
@@ -485,8 +500,11 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
         simulator_fit_misses,
         inputs: Vec::new(),
         tracks_give_t1: !track_use.anchoring.is_empty(),
-        track_notes: track_use.notes,
-        warnings,
+        unused_tracks: track_use.unused,
+        track_speeds_shown_only: evidence.observed.is_some() && !evidence.tracks.is_empty(),
+        simulator_left_out,
+        simulator_fit_failures,
+        warnings: Vec::new(),
         plots,
     })
 }
@@ -510,19 +528,19 @@ fn observed_speeds(
 }
 
 /// The simulator's joint fit when the evidence asks for it: the fit, its misses walked with
-/// the simulator, and a warning for each part that failed (the report keeps the rest).
+/// the simulator, and each part that failed (the report keeps the rest).
 fn simulator_fit_section(
     evidence: &Evidence,
     speeds: &[SpeedObservation],
     anchoring: &[AnchoringObservation],
-) -> (Option<JointCalibration>, Vec<SimulatorMiss>, Vec<String>) {
+) -> (Option<JointCalibration>, Vec<SimulatorMiss>, Vec<SimulatorFitFailure>) {
     let (simulator_fit, simulator_fit_failure) = if evidence.simulator_fit {
         match calibrate_jointly_with(
             &joint_setup(evidence, speeds, anchoring),
             SpeedModel::simulator_for_fit(),
         ) {
             Ok(fit) => (Some(fit), None),
-            Err(e) => (None, Some(format!("the simulator's joint fit failed: {e}"))),
+            Err(e) => (None, Some(SimulatorFitFailure::Fit(e.to_string()))),
         }
     } else {
         (None, None)
@@ -531,7 +549,7 @@ fn simulator_fit_section(
         None => (Vec::new(), None),
         Some(fit) => match simulator_fit_misses(fit, speeds) {
             Ok(m) => (m, None),
-            Err(e) => (Vec::new(), Some(format!("the simulator fit's misses could not be walked: {e}"))),
+            Err(e) => (Vec::new(), Some(SimulatorFitFailure::Misses(e.to_string()))),
         },
     };
     (simulator_fit, simulator_fit_misses, simulator_fit_failure.into_iter().chain(misses_failure).collect())
@@ -777,9 +795,10 @@ mod tests {
         assert_eq!(r.speeds.len(), 1);
         assert_eq!(r.speeds[0].slope_deg, 10.0);
         assert_eq!(r.plots.anchoring.len(), 1);
-        let tracks: Vec<&String> = r.warnings.iter().filter(|w| w.starts_with("--tracks at 20°")).collect();
-        assert_eq!(tracks.len(), 2, "{:?}", r.warnings);
-        assert!(r.track_notes.iter().all(|n| n.contains("20°")));
+        // Its one step gives no speed SD; its t1 SD is 0. The front ends word both.
+        let gaps: Vec<(f64, TrackGap)> = r.unused_tracks.iter().map(|u| (u.slope_deg, u.gap)).collect();
+        assert_eq!(gaps, [(20.0, TrackGap::NoAnchoringSd), (20.0, TrackGap::NoSpeedSd)]);
+        assert!(!r.track_speeds_shown_only);
         assert_eq!(r.figures[1].id, "fig3b");
         assert_eq!(r.plots.strides.len(), 2);
     }
@@ -829,8 +848,9 @@ mod tests {
             level * (0.386f64 / 0.5).powi(2) - 0.5 * 9.81 * 20f64.to_radians().sin() * 0.114 * 0.886;
         assert!((c.model_step_m - by_hand).abs() < 1e-9, "{} vs {by_hand}", c.model_step_m);
         assert!((c.observed_step_m - 0.0249).abs() < 1e-12);
-        assert!(d.text.contains("at 20°") && d.text.contains("§5"), "{}", d.text);
-        assert!(d.remedies.iter().any(|m| m.contains("--touchdowns")), "{:?}", d.remedies);
+        // The front end words the paragraph and the remedies (request/report_text/diagnosis.rs).
+        assert!(d.text.is_empty() && d.remedies.is_empty());
+        assert!((d.stance_duration_s - 0.5).abs() < 1e-12);
         assert!(r.plain_answer.unreliable);
         assert_eq!(r.plain_answer.terrain, "the terrain calibrated on your observations");
     }
@@ -865,7 +885,7 @@ mod tests {
         e.robot_source = "mine.toml".into();
         assert!(paper::is_papers_robot(&paper_robot()) && !paper::is_papers_robot(&e.robot));
         let r = report(&e).unwrap();
-        // The front end words its warning first (request/report_text.rs).
+        // The front end words its warning first (request/report_text/warnings.rs).
         assert!(r.plain_answer.untested);
         assert!(r.speeds.is_empty() && r.calibration.is_none());
         assert!(r.plain_answer.untested);
@@ -910,8 +930,11 @@ mod tests {
             fit.warnings
         );
         assert!(r.simulator.is_empty() && r.plots.simulated.is_empty());
-        let w = r.warnings.iter().find(|w| w.contains("simulator section is left out")).expect("a warning");
-        assert!(w.contains("plate_scale ran to its search bound"), "{w}");
+        assert!(
+            matches!(&r.simulator_left_out, Some(SimulatorLeftOut::AtBound { name, .. }) if name == "plate_scale"),
+            "{:?}",
+            r.simulator_left_out
+        );
         assert!(start.elapsed().as_secs() < 60, "{:?}", start.elapsed());
     }
 

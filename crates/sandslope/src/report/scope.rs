@@ -76,6 +76,34 @@ pub(crate) fn terrain_at_bound(fit: &JointCalibration, evidence: &Evidence) -> O
     })
 }
 
+/// Why the report's simulator section is left out (the front ends word it as a warning).
+#[derive(Debug, Clone, PartialEq)]
+pub enum SimulatorLeftOut {
+    /// The model is the calibration on the user's observations, and the quantity `name` that
+    /// scales its terrain ran to its search bound, at `value`: no terrain of the user's, and so
+    /// stiff that the walks would take minutes.
+    AtBound {
+        /// The quantity.
+        name: String,
+        /// Where it stopped.
+        value: f64,
+    },
+    /// The model's terrain has a stiffness outside [`crate::terrain::K_PLAUSIBLE`]
+    /// (docs/model.md §7), where the walks take minutes.
+    Implausible {
+        /// The terrain's name as the report shows it.
+        terrain: String,
+        /// `k_n` or `k_s`.
+        key: &'static str,
+        /// The value, N/m^3.
+        value: f64,
+        /// The slope of the terrain's point that has it, degrees.
+        slope_deg: f64,
+    },
+    /// The simulator refuses the robot or the terrain: its error.
+    Refused(String),
+}
+
 /// The simulator section's walks ([`simulator::simulator_section`]), or why they are left out:
 /// the simulator refuses the robot; the model is a calibration whose terrain scale ran to its
 /// search bound (`at_bound`, [`terrain_at_bound`]); or the model's terrain lies outside the
@@ -88,32 +116,28 @@ pub(crate) fn simulator_walks(
     speeds: &[SpeedObservation],
     terrain_name: &str,
     at_bound: Option<(String, f64)>,
-) -> Result<SimulatorWalks, String> {
+) -> Result<SimulatorWalks, SimulatorLeftOut> {
     if let Some((name, value)) = at_bound {
-        return Err(format!(
-            "the model is the calibration on your observations, and its {name} ran to its search bound ({value:.3e}): \
-             no terrain of yours, and so stiff that the simulator's walks would take minutes (see the calibration's \
-             warnings and why it is unreliable)"
-        ));
+        return Err(SimulatorLeftOut::AtBound { name, value });
     }
     // No walk on a terrain outside the plausible range (docs/model.md §7), which only a fit run
     // to its search bound makes (one outlier speed took plate_scale to 10^4 and k_s to 3 x
     // 10^10 N/m^3): there its walks took minutes of CPU where the rest takes seconds.
     let k = crate::terrain::K_PLAUSIBLE;
     let implausible = terrain.points().iter().find_map(|p| {
-        [("k_n", p.k_n), ("k_s", p.k_s)]
-            .into_iter()
-            .find(|(_, v)| !(k.min..=k.max).contains(v))
-            .map(|(name, v)| (name, v, p.slope_deg))
+        [("k_n", p.k_n), ("k_s", p.k_s)].into_iter().find(|(_, v)| !(k.min..=k.max).contains(v)).map(
+            |(key, value)| SimulatorLeftOut::Implausible {
+                terrain: terrain_name.to_string(),
+                key,
+                value,
+                slope_deg: p.slope_deg,
+            },
+        )
     });
     match implausible {
-        Some((name, v, deg)) => Err(format!(
-            "the model's terrain ({}) has {name} = {v:.3e} N/m^3 at {deg}°, outside the plausible {:e} to {:e} \
-             N/m^3 (docs/model.md §7), where the simulator's walks take minutes; a calibration run to a search \
-             bound puts it there (see its warnings)",
-            terrain_name, k.min, k.max
-        )),
-        None => simulator::simulator_section(robot, terrain, speeds).map_err(|e| e.to_string()),
+        Some(why) => Err(why),
+        None => simulator::simulator_section(robot, terrain, speeds)
+            .map_err(|e| SimulatorLeftOut::Refused(e.to_string())),
     }
 }
 
@@ -123,16 +147,25 @@ mod tests {
     use crate::model::tests::paper_robot;
 
     /// A model terrain whose k_s is 3e10 N/m^3 (what a plate_scale of 10^4 makes of a 3e6
-    /// table) lies beyond the plausible 1e10: no walk is made, and the reason names the value,
-    /// the slope and the range; a fit at its bound is named before any walk too.
+    /// table) lies beyond the plausible 1e10: no walk is made, and the reason names the value
+    /// and the slope; a fit at its bound is named before any walk too.
     #[test]
     fn no_walk_on_an_implausible_terrain_or_a_fit_at_its_bound() {
         let stiff = Terrain::constant(7e5, 3e10).unwrap();
         let why = simulator_walks(&paper_robot(), &stiff, &[], "stiff", None).unwrap_err();
-        assert!(why.contains("k_s = 3.000e10 N/m^3 at 0°") && why.contains("1e3 to 1e10"), "{why}");
+        assert_eq!(
+            why,
+            SimulatorLeftOut::Implausible {
+                terrain: "stiff".into(),
+                key: "k_s",
+                value: 3e10,
+                slope_deg: 0.0
+            }
+        );
+        assert!(crate::terrain::K_PLAUSIBLE.max < 3e10);
         let sand = Terrain::constant(7e5, 2e6).unwrap();
         let why = simulator_walks(&paper_robot(), &sand, &[], "sand", Some(("plate_scale".into(), 1e4)))
             .unwrap_err();
-        assert!(why.contains("plate_scale ran to its search bound (1.000e4)"), "{why}");
+        assert_eq!(why, SimulatorLeftOut::AtBound { name: "plate_scale".into(), value: 1e4 });
     }
 }

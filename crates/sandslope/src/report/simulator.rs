@@ -84,8 +84,51 @@ pub struct SimulatorRecord {
     pub scaling_regimes_agree: bool,
     /// Whether the two agree: same regime and, where both have a speed, within 15%.
     pub agree: bool,
-    /// Where they part and why, in words.
+    /// Where they part and why, in words: worded by the front end from [`Self::parting`] and
+    /// this record's values (empty as [`super::report`] returns it).
     pub why: String,
+    /// How the two compare (a value of the words, not of the JSON).
+    #[serde(skip)]
+    pub parting: Parting,
+}
+
+/// How the simulator's pitch-locked walk and the closed form compare at one slope: the reason
+/// they part, short (the page's paragraph above the table and docs/simulate.md explain each
+/// mechanism once).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Parting {
+    /// The body pitched past 90 degrees at `at_s`, s (the closed form has no pitch).
+    Tumbled {
+        /// When, s.
+        at_s: f64,
+    },
+    /// The closed form rules a speed out; the regimes say whether they agree.
+    NoClosedFormSpeed,
+    /// The speeds within [`AGREE_WITHIN`] of each other: `relative` is
+    /// `(simulated - closed form) / |closed form|`.
+    Within {
+        /// The relative difference.
+        relative: f64,
+    },
+    /// Faster: the legs roll and the body vaults over them.
+    Vaults {
+        /// The relative difference.
+        relative: f64,
+        /// The rigid rolling step of the robot's legs, m.
+        rolling_step_m: f64,
+        /// The closed form's level step s*, m.
+        level_step_m: f64,
+    },
+    /// Slower, with a net step below zero: the robot slides back.
+    SlidesBack {
+        /// The relative difference.
+        relative: f64,
+    },
+    /// Slower with a forward step, not yet explained.
+    Slower {
+        /// The relative difference.
+        relative: f64,
+    },
 }
 
 /// The slopes of the section: 0 to 24 degrees every 2, and every observed slope, below the
@@ -191,7 +234,7 @@ fn record(
 ) -> SimulatorRecord {
     let cf = m.closed_form.speed();
     let cf_regime = m.closed_form.prediction.regime;
-    let (agree, why) = reason(m, cf, cf_regime, rolling);
+    let (agree, parting) = reason(m, cf, cf_regime, rolling);
     SimulatorRecord {
         slope_deg: m.slope_deg,
         observed_m_s: observed.map(|o| o.speed),
@@ -217,70 +260,30 @@ fn record(
         scaling_regimes: spread.regimes,
         scaling_regimes_agree: spread.regimes_agree,
         agree,
-        why,
+        why: String::new(),
+        parting,
     }
 }
 
-/// Whether simulator and closed form agree at one slope, and the reason they part, short: the
-/// page's paragraph above the table and docs/simulate.md explain each mechanism once.
-fn reason(m: &SimSummary, cf: Option<f64>, cf_regime: Regime, rolling: f64) -> (bool, String) {
-    if let Some(t) = m.pitch_over_s {
-        return (
-            false,
-            format!("tumbled: the body pitched past 90° at t = {t:.2} s (the closed form has no pitch)"),
-        );
+/// Whether simulator and closed form agree at one slope, and how they part.
+fn reason(m: &SimSummary, cf: Option<f64>, cf_regime: Regime, rolling: f64) -> (bool, Parting) {
+    if let Some(at_s) = m.pitch_over_s {
+        return (false, Parting::Tumbled { at_s });
     }
     let sim = m.speed_m_s;
     match cf {
-        None => (
-            m.regime == cf_regime,
-            format!(
-                "the closed form rules a speed out ({}); the simulated walk is {} ({})",
-                cf_regime.name(),
-                m.regime.name(),
-                m.cause.name()
-            ),
-        ),
+        None => (m.regime == cf_regime, Parting::NoClosedFormSpeed),
         Some(c) => {
-            let rel = (sim - c) / c.abs().max(1e-12);
-            let same = m.regime == cf_regime;
-            let s_star = m.closed_form.prediction.level_step;
-            if rel.abs() <= AGREE_WITHIN {
-                (same, format!("within {:.0}% ({:+.0}%)", AGREE_WITHIN * 100.0, rel * 100.0))
-            } else if rel > 0.0 {
-                (
-                    false,
-                    format!(
-                        "legs roll, body vaults ({:+.0}%): step {:.2} × the rigid rolling {}, {:.1} × s* = {}",
-                        rel * 100.0,
-                        m.step_m / rolling,
-                        mm(Some(rolling)),
-                        m.step_m / s_star,
-                        mm(Some(s_star))
-                    ),
-                )
+            let relative = (sim - c) / c.abs().max(1e-12);
+            if relative.abs() <= AGREE_WITHIN {
+                (m.regime == cf_regime, Parting::Within { relative })
+            } else if relative > 0.0 {
+                let level_step_m = m.closed_form.prediction.level_step;
+                (false, Parting::Vaults { relative, rolling_step_m: rolling, level_step_m })
             } else if m.step_m < 0.0 {
-                (
-                    false,
-                    format!(
-                        "slides back ({:+.0}%): net step {}, slip before anchoring {} against {} \
-                         (docs/simulate.md, \"The mechanisms across the slopes\")",
-                        rel * 100.0,
-                        mm(Some(m.step_m)),
-                        mm(m.slip_m),
-                        mm(m.closed_form.prediction.slip)
-                    ),
-                )
+                (false, Parting::SlidesBack { relative })
             } else {
-                (
-                    false,
-                    format!(
-                        "slower by {:.0}%: slip before anchoring {} against {}; not yet explained",
-                        -rel * 100.0,
-                        mm(m.slip_m),
-                        mm(m.closed_form.prediction.slip)
-                    ),
-                )
+                (false, Parting::Slower { relative })
             }
         }
     }
@@ -329,8 +332,18 @@ pub struct SimulatorMiss {
     /// The first pair of neighbouring scanned k_s whose speeds bracket the observation
     /// (`null`: no walk of the scan reaches it).
     pub reached_between: Option<[f64; 2]>,
-    /// Why, in words.
+    /// Why, in words: worded by the front end from this miss's values (empty as
+    /// [`super::report`] returns it).
     pub why: String,
+    /// When the body pitched past 90 degrees, s (a value of the words, not of the JSON).
+    #[serde(skip)]
+    pub pitch_over_s: Option<f64>,
+    /// The walk's mean backward slip before anchoring, m (likewise).
+    #[serde(skip)]
+    pub slip_m: Option<f64>,
+    /// The walk's mean anchoring time, s (likewise).
+    #[serde(skip)]
+    pub t1_s: Option<f64>,
 }
 
 /// The observed speeds the simulator's joint fit `fit` misses by more than [`MISS_SD`] SDs,
@@ -373,7 +386,6 @@ fn fit_misses(
             .map(|&k| walk_on_ground(robot, deg, k_n, k, settings).map(|w| w.speed_m_s))
             .collect::<Result<Vec<f64>, ParamError>>()?;
         let reached_between = bracket(&REACH_K_S, &reach_m_s, o.speed);
-        let why = miss_reason(&m, o, rolling, &reach_m_s, reached_between);
         misses.push(SimulatorMiss {
             slope_deg: deg,
             observed_m_s: o.speed,
@@ -389,7 +401,10 @@ fn fit_misses(
             reach_k_s: REACH_K_S.to_vec(),
             reach_m_s,
             reached_between,
-            why,
+            why: String::new(),
+            pitch_over_s: m.pitch_over_s,
+            slip_m: m.slip_m,
+            t1_s: m.t1_s,
         });
     }
     Ok(misses)
@@ -400,60 +415,6 @@ fn bracket(xs: &[f64], ys: &[f64], target: f64) -> Option<[f64; 2]> {
     (1..xs.len().min(ys.len()))
         .find(|&i| (ys[i - 1] - target) * (ys[i] - target) <= 0.0)
         .map(|i| [xs[i - 1], xs[i]])
-}
-
-/// Why the fit's walk `m` misses the observation `o`, and what the k_s scan reaches there.
-fn miss_reason(
-    m: &SimSummary,
-    o: &SpeedObservation,
-    rolling: f64,
-    reach: &[f64],
-    between: Option<[f64; 2]>,
-) -> String {
-    let cm = |v: f64| format!("{:.1} cm/s", v * 100.0);
-    let what = if let Some(t) = m.pitch_over_s {
-        format!("the body pitches over (past 90° at t = {t:.2} s)")
-    } else if m.speed_m_s <= 0.0 {
-        format!("the robot makes no upslope progress ({}, {})", m.regime.name(), m.cause.name())
-    } else if m.speed_m_s > o.speed {
-        let s_star = m.closed_form.prediction.level_step;
-        format!(
-            "the legs roll and the body vaults over them: step {} = {:.2} × the rigid rolling step, {:.1} × the \
-             closed form's s*",
-            mm(Some(m.step_m)),
-            m.step_m / rolling,
-            m.step_m / s_star
-        )
-    } else {
-        format!(
-            "it walks slower ({}; slip before anchoring {}, t1 {})",
-            m.regime.name(),
-            mm(m.slip_m),
-            m.t1_s.map_or("none".into(), |t| format!("{:.0} ms", t * 1e3))
-        )
-    };
-    let (lo, hi) = reach.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
-    let scan = format!(
-        "across leg k_s from {:.0e} to {:.0e} N/m³ it walks {} to {} here",
-        REACH_K_S[0],
-        REACH_K_S[REACH_K_S.len() - 1],
-        cm(lo),
-        cm(hi)
-    );
-    let reach = match between {
-        None => format!("{scan}: none of these {} walks reaches {}", reach.len(), cm(o.speed)),
-        Some([a, b]) => format!(
-            "{scan}: the walks bracket {} first between k_s = {a:.0e} and {b:.0e}, where the joint fit, which \
-             ties the slopes together through the k_s law, does not go",
-            cm(o.speed)
-        ),
-    };
-    format!("{what}; {reach}")
-}
-
-/// A length in millimetres for the reasons, `none` where undefined.
-fn mm(v: Option<f64>) -> String {
-    v.map_or("none".into(), |v| format!("{:.1} mm", v * 1e3))
 }
 
 #[cfg(test)]
@@ -514,11 +475,10 @@ mod tests {
         let rolling_speed = crate::simulate::rigid_rolling_step(&robot) / robot.stance_duration();
         assert!(m.fitted_m_s > 0.6 * rolling_speed && m.fitted_m_s < 1.02 * rolling_speed, "{m:?}");
         assert!((m.miss_sd - (m.fitted_m_s - 0.157) / 0.005).abs() < 1e-9 && m.miss_sd > MISS_SD);
-        assert!(m.why.contains("the legs roll"), "{}", m.why);
+        assert!(m.step_m > 0.0 && m.pitch_over_s.is_none());
         assert_eq!(m.reach_m_s.len(), REACH_K_S.len());
         assert!(m.reach_m_s.iter().all(|&v| v > 0.157), "{:?}", m.reach_m_s);
         assert_eq!(m.reached_between, None);
-        assert!(m.why.contains("none of these 7 walks reaches 15.7 cm/s"), "{}", m.why);
         // An SD of 10 m/s covers every walk: nothing to name.
         assert!(fit_misses(&robot, &|_| (1e8, 1e8), &[obs(10.0)], &settings).unwrap().is_empty());
     }

@@ -1,6 +1,7 @@
 //! How motion-capture tracks enter the report: each slope's pooled analysis (docs/model.md §11)
 //! becomes an anchoring-time observation and, without other observed speeds, a speed
-//! observation; slopes that give neither are named in notes.
+//! observation; slopes that give neither are listed ([`UnusedTrack`]) for the front ends to
+//! word.
 
 use serde::Serialize;
 
@@ -40,15 +41,39 @@ impl From<&TrackedSlope> for TrackRecord {
     }
 }
 
-/// The tracks split into observations, with a note (for the page) and a warning (for the
-/// user's terminal) on every slope whose t1 or speed cannot be used: without an SD > 0 an
-/// observation has no weight in the calibration.
+/// What a tracked slope fails to give.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrackGap {
+    /// No anchoring time: no step anchored.
+    NoAnchoredStep,
+    /// No anchoring time with an SD: fewer than two anchored steps with different t1.
+    NoAnchoringSd,
+    /// No observed speed with an SD: fewer than two steps with different speeds.
+    NoSpeedSd,
+}
+
+/// A tracked slope whose anchoring time or speed cannot be used: without an SD > 0 an
+/// observation has no weight in the calibration. The front ends word it, as a note on the page
+/// and a warning on the user's terminal.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnusedTrack {
+    /// Slope of the recordings, degrees.
+    pub slope_deg: f64,
+    /// The recordings pooled at this slope.
+    pub files: Vec<String>,
+    /// The complete steps found in them.
+    pub steps: usize,
+    /// What they fail to give.
+    pub gap: TrackGap,
+}
+
+/// The tracks split into observations, and every slope whose t1 or speed cannot be used, in
+/// slope order (the anchoring time before the speed).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub(crate) struct TrackUse {
     pub anchoring: Vec<AnchoringObservation>,
     pub speeds: Vec<SpeedObservation>,
-    pub notes: Vec<String>,
-    pub warnings: Vec<String>,
+    pub unused: Vec<UnusedTrack>,
 }
 
 impl TrackUse {
@@ -58,27 +83,15 @@ impl TrackUse {
         let mut out = TrackUse::default();
         for t in tracks {
             let r = &t.result.summary;
-            let files = t.files.join(", ");
             let slope = Slope::from_degrees(t.slope_deg).map_err(|e| e.renamed("tracks slope_deg"))?;
+            let unused =
+                |gap| UnusedTrack { slope_deg: t.slope_deg, files: t.files.clone(), steps: r.steps, gap };
             match (r.t1_s, r.t1_sd_s) {
                 (Some(t1), Some(sd)) if sd > 0.0 => {
                     out.anchoring.push(AnchoringObservation { slope, t1, t1_sd: sd })
                 }
-                _ => {
-                    let why = if r.t1_s.is_none() {
-                        format!("no anchored step among {} steps", r.steps)
-                    } else {
-                        "its SD needs at least two anchored steps with different t1".to_string()
-                    };
-                    out.notes.push(format!(
-                        "The tracks at {}° ({files}) give no anchoring time ({why}): not drawn in fig5b nor used in the calibration.",
-                        t.slope_deg
-                    ));
-                    out.warnings.push(format!(
-                        "--tracks at {}° ({files}): no anchoring time ({why}); not used",
-                        t.slope_deg
-                    ));
-                }
+                (None, _) => out.unused.push(unused(TrackGap::NoAnchoredStep)),
+                _ => out.unused.push(unused(TrackGap::NoAnchoringSd)),
             }
             if observed_given {
                 continue;
@@ -87,27 +100,8 @@ impl TrackUse {
                 Some(sd) if sd > 0.0 => {
                     out.speeds.push(SpeedObservation { slope, speed: r.speed_m_s, speed_sd: sd })
                 }
-                _ => {
-                    let why = format!(
-                        "its SD needs at least two steps with different speeds; found {} steps",
-                        r.steps
-                    );
-                    out.warnings.push(format!(
-                        "--tracks at {}° ({files}): no observed speed ({why}); not used",
-                        t.slope_deg
-                    ));
-                    out.notes.push(format!(
-                        "The tracks at {}° ({files}) give no observed speed ({why}): not drawn in fig3a nor used in the calibration.",
-                        t.slope_deg
-                    ));
-                }
+                _ => out.unused.push(unused(TrackGap::NoSpeedSd)),
             }
-        }
-        if observed_given && !tracks.is_empty() {
-            out.notes.push(
-                "The observed speeds are --observed's: the tracks' speeds are shown in this table only."
-                    .into(),
-            );
         }
         Ok(out)
     }

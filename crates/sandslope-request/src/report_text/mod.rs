@@ -1,0 +1,159 @@
+//! The report's words: the sentences a reader sees, worded from the library's values
+//! ([`sandslope::report::report`] returns numbers, flags and small enums; this module writes
+//! the inputs table, the plain answer and the summary, why the calibration is unreliable, the
+//! disagreements, the simulator section's reasons and every warning), and the one number
+//! format of the page and `report.json` ([`sci`], [`format_p`]). The request's one answer path
+//! ([`crate::report::answer_evidence`]) words every report, so the command line, Python and
+//! the page read the same text.
+
+mod answer;
+mod diagnosis;
+mod findings;
+mod inputs;
+mod observations;
+mod simulator;
+mod warnings;
+
+use sandslope::report::{Evidence, Report};
+
+use answer::{plain_answer, summary};
+use diagnosis::word_diagnosis;
+use findings::{disagreements, goodness_of_fit};
+use inputs::inputs;
+use observations::observation_items;
+use simulator::word_simulator;
+use warnings::warnings;
+
+/// Words `report`, built from `evidence`: its inputs table, its plain answer and summary,
+/// its calibration's goodness-of-fit sentence, the diagnosis of an unreliable fit, the
+/// disagreements (the user's observations the model misses first), the simulator section's
+/// reasons and the warnings.
+pub fn word(report: &mut Report, evidence: &Evidence) {
+    report.inputs = inputs(evidence, report.tracks_give_t1);
+    report.summary.text = summary(&report.summary, &report.paper_vs_model);
+    report.plain_answer.text = plain_answer(&report.plain_answer);
+    if let Some(c) = &mut report.calibration {
+        c.goodness_of_fit = goodness_of_fit(c.no_floor);
+    }
+    let no_floor = report.calibration.as_ref().and_then(|c| c.no_floor);
+    if let Some(d) = &mut report.fit_diagnosis {
+        word_diagnosis(d, no_floor.as_ref());
+    }
+    let mut items = observation_items(&report.observation_misses);
+    items.extend(disagreements(report, &evidence.forces));
+    report.disagreements = items;
+    word_simulator(&mut report.simulator, &mut report.simulator_fit_misses);
+    report.warnings = warnings(report, evidence);
+}
+
+/// A probability as text: 2 significant digits, `< 10⁻³⁰⁰` below what a float holds.
+pub fn format_p(p: f64) -> String {
+    if p <= 0.0 {
+        "< 10⁻³⁰⁰".into()
+    } else if p >= 0.01 {
+        format!("{p:.2}")
+    } else {
+        sci(p, 1)
+    }
+}
+
+/// `x` as `m.mm × 10ⁿ` with `decimals` digits after the point (superscript exponent), or
+/// plainly when `0.01 <= |x| < 10⁴`; the one number format of the report's text.
+pub fn sci(x: f64, decimals: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (0.01..1e4).contains(&a) {
+        let digits = (decimals as i32 + 1 - a.log10().floor() as i32 - 1).max(0) as usize;
+        return format!("{x:.digits$}");
+    }
+    let text = format!("{x:.decimals$e}");
+    let (m, e) = text.split_once('e').unwrap_or((&text, "0"));
+    const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let exp: String = e
+        .chars()
+        .map(|c| match c {
+            '-' => '⁻',
+            d => d.to_digit(10).map_or(d, |d| SUP[d as usize]),
+        })
+        .collect();
+    format!("{m} × 10{exp}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sandslope::report::ProvenanceKind;
+
+    /// The one number format: plain from 0.01 to 10⁴ with `decimals + 1` significant digits,
+    /// else a mantissa with `decimals` digits and a superscript power of ten.
+    #[test]
+    fn sci_writes_plain_or_powers_of_ten() {
+        assert_eq!(sci(1.234e6, 2), "1.23 × 10⁶");
+        assert_eq!(sci(4e-4, 1), "4.0 × 10⁻⁴");
+        assert_eq!(sci(0.5, 1), "0.50");
+        assert_eq!(sci(123.456, 2), "123");
+        assert_eq!(sci(0.0, 2), "0");
+        assert_eq!(format_p(0.2), "0.20");
+        assert_eq!(format_p(0.003), "3.0 × 10⁻³");
+        assert_eq!(format_p(0.0), "< 10⁻³⁰⁰");
+    }
+
+    /// The paper's evidence worded: the inputs table (the contact area W R = 1 cm x 4 cm =
+    /// 4.0 x 10⁻⁴ m², the paper's five speeds measured), the goodness-of-fit sentence, and the
+    /// inversion's disagreement (the k_s the observed speeds need rises from 20° to 24°, where
+    /// the paper's 4.98 cm/s becomes 5.6 cm/s).
+    #[test]
+    fn the_papers_report_is_worded() {
+        let robot = sandslope_io::load_robot("paper-hexapod").unwrap();
+        let terrain = sandslope_io::load_terrain("glass-beads-300um").unwrap();
+        let request = crate::report::ReportRequest::from_fields(
+            "paper-hexapod".into(),
+            "glass-beads-300um".into(),
+            Vec::new(),
+            &[],
+        )
+        .unwrap();
+        let r = request.answer(robot, terrain, crate::error::Words::Flag).unwrap();
+        let row = |name: &str| r.inputs.iter().find(|i| i.name == name).unwrap();
+        assert_eq!(row("robot: leg contact area A_c").value, "4.0 × 10⁻⁴ m² (W R)");
+        assert_eq!(row("observed speeds").provenance.kind, ProvenanceKind::Measured);
+        let c = r.calibration.as_ref().unwrap();
+        assert!(c
+            .goodness_of_fit
+            .starts_with("The goodness-of-fit test is the fit without the floor: χ² = "));
+        assert!(
+            r.disagreements.iter().any(|d| d.contains("would have to rise from") && d.contains("20° to 24°")),
+            "{:?}",
+            r.disagreements
+        );
+    }
+
+    /// A 1.2 kg robot without observations: the first warning says it is not the paper's
+    /// 0.35 kg robot, with its mass, and the plain answer that it is untested.
+    #[test]
+    fn another_robot_is_warned_first() {
+        let robot = sandslope_io::load_robot("paper-hexapod").unwrap().with_mass(1.2).unwrap();
+        let terrain = sandslope_io::load_terrain("glass-beads-300um").unwrap();
+        let request = crate::report::ReportRequest::from_fields(
+            "paper-hexapod".into(),
+            "glass-beads-300um".into(),
+            Vec::new(),
+            &[],
+        )
+        .unwrap();
+        let r = request.answer(robot, terrain, crate::error::Words::Flag).unwrap();
+        assert!(
+            r.warnings[0].contains("kg, R = 4 cm) is not the paper's (0.35 kg, R = 4 cm)")
+                && r.warnings[0].contains("1.2 kg"),
+            "{:?}",
+            r.warnings
+        );
+        assert!(
+            r.plain_answer.text.contains("prediction for your robot, untested"),
+            "{}",
+            r.plain_answer.text
+        );
+    }
+}

@@ -1,0 +1,124 @@
+//! The report's warnings, worded from its values in the order a reader needs them: a robot
+//! other than the paper's without observations, tracks that could not be used, the simulator
+//! section left out or not converged, the simulator's fit failed, and last the calibration's
+//! own (a quantity at its search bound, a poor fit).
+
+use sandslope::report::{Evidence, Report, SimulatorFitFailure, SimulatorLeftOut, TrackGap, UnusedTrack};
+
+use super::answer::another_robot;
+use super::findings::calibration_warnings;
+
+/// Every warning of `report`, built from `evidence`, in order.
+pub(super) fn warnings(report: &Report, evidence: &Evidence) -> Vec<String> {
+    let mut out = Vec::new();
+    if report.plain_answer.untested {
+        out.push(another_robot(evidence));
+    }
+    out.extend(report.unused_tracks.iter().map(unused_track));
+    out.extend(report.simulator_left_out.as_ref().map(left_out));
+    let unconverged: Vec<String> = report
+        .simulator_convergence
+        .iter()
+        .filter(|c| !c.converged)
+        .map(|c| format!("{}°", c.slope_deg))
+        .collect();
+    if !unconverged.is_empty() {
+        out.push(format!(
+            "the stride simulator's pitch-locked walk is not converged at {} (a quarter of the time step or a \
+             tenth of the creep speed moves its speed by more than 3% and 0.3 cm/s, its t1 by more than 1 ms or its \
+             regime; docs/simulate.md, \"Checking convergence\"): read those rows with care",
+            unconverged.join(", ")
+        ));
+    }
+    out.extend(report.simulator_fit_failures.iter().map(|f| match f {
+        SimulatorFitFailure::Fit(e) => format!("the simulator's joint fit failed: {e}"),
+        SimulatorFitFailure::Misses(e) => format!("the simulator fit's misses could not be walked: {e}"),
+    }));
+    if let Some(c) = &report.calibration {
+        out.extend(calibration_warnings(c));
+    }
+    out
+}
+
+/// A tracked slope's anchoring time or speed not used, for the user's terminal.
+fn unused_track(u: &UnusedTrack) -> String {
+    let (what, why) = match u.gap {
+        TrackGap::NoAnchoredStep => ("anchoring time", format!("no anchored step among {} steps", u.steps)),
+        TrackGap::NoAnchoringSd => {
+            ("anchoring time", "its SD needs at least two anchored steps with different t1".to_string())
+        }
+        TrackGap::NoSpeedSd => (
+            "observed speed",
+            format!("its SD needs at least two steps with different speeds; found {} steps", u.steps),
+        ),
+    };
+    format!("--tracks at {}° ({}): no {what} ({why}); not used", u.slope_deg, u.files.join(", "))
+}
+
+/// Why the simulator section is left out.
+fn left_out(why: &SimulatorLeftOut) -> String {
+    let why = match why {
+        SimulatorLeftOut::AtBound { name, value } => format!(
+            "the model is the calibration on your observations, and its {name} ran to its search bound ({value:.3e}): \
+             no terrain of yours, and so stiff that the simulator's walks would take minutes (see the calibration's \
+             warnings and why it is unreliable)"
+        ),
+        SimulatorLeftOut::Implausible { terrain, key, value, slope_deg } => {
+            let k = sandslope::terrain::K_PLAUSIBLE;
+            format!(
+                "the model's terrain ({terrain}) has {key} = {value:.3e} N/m^3 at {slope_deg}°, outside the plausible \
+                 {:e} to {:e} N/m^3 (docs/model.md §7), where the simulator's walks take minutes; a calibration run \
+                 to a search bound puts it there (see its warnings)",
+                k.min, k.max
+            )
+        }
+        SimulatorLeftOut::Refused(e) => e.clone(),
+    };
+    format!("the stride simulator section is left out: {why}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A slope whose one step gives neither an anchoring-time SD nor a speed SD: two warnings
+    /// naming the slope, the files and why.
+    #[test]
+    fn unused_tracks_are_named_with_why() {
+        let u =
+            |gap| UnusedTrack { slope_deg: 20.0, files: vec!["a.csv".into(), "b.csv".into()], steps: 1, gap };
+        assert_eq!(
+            unused_track(&u(TrackGap::NoAnchoringSd)),
+            "--tracks at 20° (a.csv, b.csv): no anchoring time (its SD needs at least two anchored steps with \
+             different t1); not used"
+        );
+        assert_eq!(
+            unused_track(&u(TrackGap::NoAnchoredStep)),
+            "--tracks at 20° (a.csv, b.csv): no anchoring time (no anchored step among 1 steps); not used"
+        );
+        assert_eq!(
+            unused_track(&u(TrackGap::NoSpeedSd)),
+            "--tracks at 20° (a.csv, b.csv): no observed speed (its SD needs at least two steps with different \
+             speeds; found 1 steps); not used"
+        );
+    }
+
+    /// A k_s of 3 x 10^10 N/m^3 lies beyond the plausible 10^10: the warning names the value,
+    /// the slope and the range; a fit at its bound names the quantity and where it stopped.
+    #[test]
+    fn a_left_out_simulator_section_says_why() {
+        let w = left_out(&SimulatorLeftOut::Implausible {
+            terrain: "stiff".into(),
+            key: "k_s",
+            value: 3e10,
+            slope_deg: 0.0,
+        });
+        assert!(w.contains("(stiff) has k_s = 3.000e10 N/m^3 at 0°") && w.contains("1e3 to 1e10"), "{w}");
+        let w = left_out(&SimulatorLeftOut::AtBound { name: "plate_scale".into(), value: 1e4 });
+        assert!(
+            w.starts_with("the stride simulator section is left out: ")
+                && w.contains("plate_scale ran to its search bound (1.000e4)"),
+            "{w}"
+        );
+    }
+}

@@ -28,7 +28,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from check_sizes import CFG_TEST, blank_non_code, item_end, line_of  # noqa: E402
 
-ROW = re.compile(r'Field::(?:number|text|switch|new)\(\s*"([^"]+)"')
+ROW = re.compile(r'(?:Field::(?:number|text|switch|new)|\bquantity)\(\s*"([^"]+)"')
 DERIVE = re.compile(r"#\[arg\((?:long\b(?!\s*=)[^\]]*)\]\s*(?:///[^\n]*\n\s*)*pub\s+([a-z_][a-z0-9_]*)\s*:")
 # Where a quoted word names a field: a read, a check or an error naming it.
 NAMING = re.compile(
@@ -56,6 +56,40 @@ OTHER_MEANINGS = {
     ("crates/sandslope-serve/src/http.rs", "body"): "the HTTP request's body, not track's --body",
     ("crates/sandslope-cli/src/commands/sweep.rs", "observed"): "sweep's overlay of measured speeds, not infer's --observed",
 }
+
+
+# The explorer page: its inputs for a field take their start and range from the tables, written
+# in by the server when it serves the page (crates/sandslope-serve/src/page.rs).
+PAGE = "crates/sandslope-serve/src/page/index.html"
+INPUT = re.compile(r"<input\b[^>]*>")
+ATTRIBUTE = re.compile(r'\s([a-z][a-z-]*)="([^"]*)"')
+
+
+def page_findings(root, homes):
+    """The page's inputs that write a field's start or range themselves: an input bound to a
+    field (`data-field="COMMAND:FLAG"`, a robot quantity's `data-flag`) with a `value`, `min`
+    or `max` of its own, and an input named after a field (its id a field's flag) bound to none."""
+    path = os.path.join(root, PAGE)
+    if not os.path.exists(path):
+        return []
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    hits = []
+    for m in INPUT.finditer(text):
+        attrs = dict(ATTRIBUTE.findall(m.group(0)))
+        where = f"{PAGE}:{line_of(text, m.start())}: <input id=\"{attrs.get('id', '')}\">"
+        bound = attrs.get("data-field", "").split(":")[-1] or attrs.get("data-flag")
+        if bound and bound not in homes:
+            hits.append(f"{where} is bound to `{bound}`, which no field table has")
+        if not bound and attrs.get("id") in homes:
+            hits.append(f"{where} is named after the field `{attrs['id']}` but bound to none (give it data-field)")
+        for name in ("value", "min", "max") if bound else ():
+            if name in attrs:
+                hits.append(
+                    f"{where} writes {name}=\"{attrs[name]}\" for the field `{bound}`: the server writes it "
+                    "from the field's table (crates/sandslope-serve/src/page.rs)"
+                )
+    return hits
 
 
 def code_outside_tests(path):
@@ -118,6 +152,7 @@ def main():
                 pending.add(rel)
         else:
             found.extend(hits)
+    found.extend(page_findings(root, homes))
     for line in found:
         print(line)
     for rel in sorted(pending):

@@ -4,7 +4,7 @@ non-test source that spells a field's flag, its default or its range.
 
 Usage: python3 scripts/check_fields.py [ROOT]
 
-A field is a row `Field::number("k-s", ...)` (or `text`, `switch`, `new`) of a table in
+A field is a row `Field::number("k-s", ...)` (or `text`, `switch`, `new`, a robot `quantity`) of a table in
 crates/sandslope-request/src; the files holding such rows are the tables. In every other
 non-test Rust source file under crates/*/src (test modules, `#[cfg(test)]` items, left out as
 scripts/check_sizes.py does) of the front ends (request, cli, serve, py), a field's name must
@@ -15,6 +15,11 @@ not appear:
 - as a clap derive argument named after it (`#[arg(long ...)] pub k_s: ...`), which would
   state its flag, default and help a second time;
 - in a default read by name (`number_or("to", 30.0)`, `text_or("robot", ...)`).
+
+The explorer page's inputs (crates/sandslope-serve/src/page/index.html) for a field write no
+start or range of their own: the server writes `value`, `min` and `max` from the field's table
+when it serves the page, so an input bound to a field (`data-field`, `data-flag`) with one of
+them, or an input named after a field and bound to none, is a finding.
 
 Files whose requests are not yet read through a table are listed in PENDING with the reason;
 they are reported as a note, not a failure, so the list shows the work left. Exits 1 on any
@@ -28,7 +33,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from check_sizes import CFG_TEST, blank_non_code, item_end, line_of  # noqa: E402
 
-ROW = re.compile(r'Field::(?:number|text|switch|new)\(\s*"([^"]+)"')
+ROW = re.compile(r'(?:Field::(?:number|text|switch|new)|\bquantity)\(\s*"([^"]+)"')
 DERIVE = re.compile(r"#\[arg\((?:long\b(?!\s*=)[^\]]*)\]\s*(?:///[^\n]*\n\s*)*pub\s+([a-z_][a-z0-9_]*)\s*:")
 # Where a quoted word names a field: a read, a check or an error naming it.
 NAMING = re.compile(
@@ -39,15 +44,9 @@ NAMING = re.compile(
 FRONT_ENDS = ("crates/sandslope-request/", "crates/sandslope-cli/", "crates/sandslope-serve/", "crates/sandslope-py/")
 DEFAULT_BY_NAME = re.compile(r'\b(?:number_or|text_or)\(\s*"([^"]+)"')
 
-# Requests still reading their fields by name: (path, why). Shrinks as tables are added.
-PENDING = {
-    "crates/sandslope-request/src/grammar.rs": "the slope and axis grammars take the field's name",
-    "crates/sandslope-cli/src/commands/animate.rs": "simulate's table not yet written",
-    "crates/sandslope-serve/src/data.rs": "the risk map's heading rule and plan's endpoints, read by name until plan's table",
-    "crates/sandslope-serve/src/drive.rs": "the drive run is read by the CLI through drive's table; the server's own drive keys not yet",
-    "crates/sandslope-fuzz/src/serve/requests.rs": "the fuzzer's key list is not yet read from the tables",
-    "crates/sandslope-py/src/servo.rs": "Python's drive keywords not yet checked against drive's table",
-}
+# Requests still reading their fields by name: (path, why). Shrinks as tables are added; empty
+# now that every request is read through its table.
+PENDING = {}
 
 
 # A word that is one request's field and, in another file, names something else: (path, word)
@@ -55,7 +54,42 @@ PENDING = {
 OTHER_MEANINGS = {
     ("crates/sandslope-serve/src/http.rs", "body"): "the HTTP request's body, not track's --body",
     ("crates/sandslope-cli/src/commands/sweep.rs", "observed"): "sweep's overlay of measured speeds, not infer's --observed",
+    ("crates/sandslope-serve/src/data.rs", "dem"): "the page's /data/dem (the served DEM's heights), not plan's --dem",
 }
+
+
+# The explorer page: its inputs for a field take their start and range from the tables, written
+# in by the server when it serves the page (crates/sandslope-serve/src/page.rs).
+PAGE = "crates/sandslope-serve/src/page/index.html"
+INPUT = re.compile(r"<input\b[^>]*>")
+ATTRIBUTE = re.compile(r'\s([a-z][a-z-]*)="([^"]*)"')
+
+
+def page_findings(root, homes):
+    """The page's inputs that write a field's start or range themselves: an input bound to a
+    field (`data-field="COMMAND:FLAG"`, a robot quantity's `data-flag`) with a `value`, `min`
+    or `max` of its own, and an input named after a field (its id a field's flag) bound to none."""
+    path = os.path.join(root, PAGE)
+    if not os.path.exists(path):
+        return []
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    hits = []
+    for m in INPUT.finditer(text):
+        attrs = dict(ATTRIBUTE.findall(m.group(0)))
+        where = f"{PAGE}:{line_of(text, m.start())}: <input id=\"{attrs.get('id', '')}\">"
+        bound = attrs.get("data-field", "").split(":")[-1] or attrs.get("data-flag")
+        if bound and bound not in homes:
+            hits.append(f"{where} is bound to `{bound}`, which no field table has")
+        if not bound and attrs.get("id") in homes:
+            hits.append(f"{where} is named after the field `{attrs['id']}` but bound to none (give it data-field)")
+        for name in ("value", "min", "max") if bound else ():
+            if name in attrs:
+                hits.append(
+                    f"{where} writes {name}=\"{attrs[name]}\" for the field `{bound}`: the server writes it "
+                    "from the field's table (crates/sandslope-serve/src/page.rs)"
+                )
+    return hits
 
 
 def code_outside_tests(path):
@@ -118,6 +152,7 @@ def main():
                 pending.add(rel)
         else:
             found.extend(hits)
+    found.extend(page_findings(root, homes))
     for line in found:
         print(line)
     for rel in sorted(pending):

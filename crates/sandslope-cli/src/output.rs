@@ -75,10 +75,8 @@ pub fn ruled_out_note() -> &'static str {
      model_speed_m_s, with speed_m_s null."
 }
 
-/// Formats a number in scientific notation with 3 significant digits.
-pub fn sci(x: f64) -> String {
-    format!("{x:.3e}")
-}
+/// The terminal's number format for strengths (`2.237e6`), shared by every front end.
+pub use sandslope_request::format::e_notation as sci;
 
 /// Prints `value` as pretty JSON on stdout.
 pub fn print_json<T: serde::Serialize>(value: &T) -> Result<()> {

@@ -5,7 +5,7 @@
 use pyo3::prelude::*;
 
 use sandslope_request::field::{Kind, Table};
-use sandslope_request::{calibrate, fit, phase, report, risk};
+use sandslope_request::{calibrate, drive, fit, phase, plan, report, risk};
 
 use crate::value_error;
 
@@ -17,9 +17,11 @@ fn tables(command: &str) -> PyResult<Vec<Table>> {
         "report" => vec![report::FIELDS, Table { command: "report", fields: &[report::TRACKS] }],
         "risk" => vec![risk::FIELDS],
         "phase" => vec![phase::FIELDS],
+        "drive" => vec![drive::FIELDS],
+        "plan" => vec![plan::FIELDS],
         other => {
             return Err(value_error(format!(
-                "command = {other:?} must be \"fit\", \"calibrate\", \"report\", \"risk\" or \"phase\""
+                "command = {other:?} must be \"fit\", \"calibrate\", \"report\", \"risk\", \"phase\", \"drive\" or \"plan\""
             )))
         }
     })

@@ -192,3 +192,20 @@ def test_a_route_not_found_has_the_keys_of_plan_json(cli, robot, terrain, tmp_pa
     assert w["found"] and set(g) == set(w) | {"rows", "cols", "x_m", "y_m", "z_m", "steps"}
     for k, v in w.items():
         assert g[k] == (pytest.approx(v, rel=1e-12) if isinstance(v, float) else v), k
+
+
+def test_objectives_a_comma_text_or_a_list(robot, terrain):
+    """``objective`` is read by the field table's parser: a list of words, one text as
+    ``--objective`` takes it (``"time,risk"``) and a list of such texts are one request, and a
+    word that is no objective inside a text is named."""
+    z = np.add.outer(np.zeros(12), 0.05 * np.arange(12))  # a 0.05 m rise per 0.3 m cell, east
+    ask = dict(robot=robot, terrain=terrain, start=(6, 2), goal=(6, 9))
+    lists = sandslope.plan(z, 0.3, objective=["time", "risk"], **ask)["routes"]
+    text = sandslope.plan(z, 0.3, objective="time,risk", **ask)["routes"]
+    mixed = sandslope.plan(z, 0.3, objective=["time, risk"], **ask)["routes"]
+    assert list(lists) == list(text) == list(mixed) == ["time", "risk", "distance"]
+    for name in lists:
+        assert lists[name]["found"] and lists[name]["length_m"] > 2.0
+        assert text[name]["length_m"] == mixed[name]["length_m"] == lists[name]["length_m"]
+    with pytest.raises(ValueError, match="objective = \"fast\" must be"):
+        sandslope.plan(z, 0.3, objective="time,fast", **ask)

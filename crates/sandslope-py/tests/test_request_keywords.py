@@ -91,3 +91,34 @@ def test_fit_air_words():
     assert inspect.signature(sandslope.fit).parameters["air"].default == "auto"
     with pytest.raises(ValueError, match=r'air = "both" must be "auto", "curve" or "mean"'):
         sandslope.fit("no-such-manifest.toml", air="both")
+
+
+def test_python_drive_takes_drives_table():
+    """``sandslope.drive``'s keywords are drive's table's (besides the robot, the terrain, the
+    bus choice and the live switch), each None for the table's default, which
+    ``drive_defaults()`` gives: the numbers the command line's flags default to."""
+    rows = {k: table_default(d, kind) for k, d, kind in _sandslope.request_keywords("drive")}
+    params = inspect.signature(sandslope.drive).parameters
+    for keyword, param in params.items():
+        assert keyword in rows or keyword in {"robot", "terrain", "emulate", "live"}, keyword
+        if keyword in rows:
+            assert param.default is None, (keyword, param.default)
+    for keyword, text in stub_defaults("drive").items():
+        if keyword in rows:
+            assert text == "None", (keyword, text)
+    defaults = sandslope.drive_defaults()
+    for keyword in ["slope_deg", "duration_s", "rate_hz", "hold_s", "current_limit_ma", "temperature_limit_c",
+                    "watchdog_s", "bus_watchdog_s"]:
+        assert defaults[keyword] == rows[keyword], keyword
+    assert defaults["emulate_noise_ma"] == rows["noise_ma"] and str(defaults["emulate_seed"]) == rows["seed"]
+
+
+def test_python_plan_takes_plans_table():
+    """``sandslope.plan``'s keywords with a default of the table's carry it (``objective``,
+    the table's ``objectives``, a word or a list of them; ``descent``, ``max_roll_deg``,
+    ``time_weight``, ``allow_metastable``)."""
+    rows = {k: table_default(d, kind) for k, d, kind in _sandslope.request_keywords("plan")}
+    params = inspect.signature(sandslope.plan).parameters
+    assert params["objective"].default == rows["objectives"] == "time"
+    for keyword in ["descent", "max_roll_deg", "time_weight", "allow_metastable", "cv_n", "cv_s"]:
+        assert same_default(params[keyword].default, rows[keyword]), keyword

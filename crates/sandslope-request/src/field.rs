@@ -138,6 +138,13 @@ impl Field {
         format!("--{}", self.flag)
     }
 
+    /// Its valid range as numbers, read from its range words ([`bounds_of`]): `(lower,
+    /// upper)`, each `None` where the words give no number (what the explorer page writes
+    /// into its inputs' `min` and `max`).
+    pub fn bounds(&self) -> (Option<Bound>, Option<Bound>) {
+        bounds_of(self.range)
+    }
+
     /// The text given for the field in `p`, else its default.
     pub fn text_in<'a>(&self, p: &mut Params<'a>) -> Result<Option<&'a str>> {
         Ok(p.text(self.flag)?.or(self.default))
@@ -189,6 +196,57 @@ impl Field {
     }
 }
 
+/// One end of a field's valid range as a number, read from its range words.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bound {
+    /// The end's value, in the field's unit.
+    pub value: f64,
+    /// Whether the end itself is valid (`0 to 1`, `at least 0`) or not (`strictly between 0
+    /// and 1`, `greater than 0`).
+    pub inclusive: bool,
+}
+
+/// The lower and upper ends of a range written in words, each `None` where the words give no
+/// number for it (`at least 1.5 T`, `between 0 and 2R`'s upper end, `within the model's`).
+/// The forms: `A to B`, `from A to B`, `a whole number from A to B`, `between A and B`,
+/// `strictly between A and B`, `at least A`, `greater than A`, `at most B`, `less than B`,
+/// `greater than A, at most B`, each optionally followed by a note in parentheses.
+pub fn bounds_of(range: &str) -> (Option<Bound>, Option<Bound>) {
+    let words = range.split(" (").next().unwrap_or("").trim();
+    let end = |text: &str, inclusive: bool| {
+        text.trim().parse::<f64>().ok().filter(|v| v.is_finite()).map(|value| Bound { value, inclusive })
+    };
+    let pair = |text: &str, sep: &str, inclusive: bool| match text.split_once(sep) {
+        Some((lo, hi)) => (end(lo, inclusive), end(hi, inclusive)),
+        None => (None, None),
+    };
+    if let Some(rest) = words.strip_prefix("strictly between ") {
+        return pair(rest, " and ", false);
+    }
+    if let Some(rest) = words.strip_prefix("between ") {
+        return pair(rest, " and ", true);
+    }
+    if let Some(rest) = words.strip_prefix("a whole number from ").or_else(|| words.strip_prefix("from ")) {
+        return pair(rest, " to ", true);
+    }
+    if let Some(rest) = words.strip_prefix("greater than ") {
+        return match rest.split_once(", at most ") {
+            Some((lo, hi)) => (end(lo, false), end(hi, true)),
+            None => (end(rest, false), None),
+        };
+    }
+    if let Some(rest) = words.strip_prefix("at least ") {
+        return (end(rest, true), None);
+    }
+    if let Some(rest) = words.strip_prefix("at most ") {
+        return (None, end(rest, true));
+    }
+    if let Some(rest) = words.strip_prefix("less than ") {
+        return (None, end(rest, false));
+    }
+    pair(words, " to ", true)
+}
+
 /// The fields of one request, in the order of its `--help`.
 #[derive(Debug, Clone, Copy)]
 pub struct Table {
@@ -234,6 +292,30 @@ mod tests {
 
     fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
         list.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    /// The range words read as numbers, worked by hand from each form.
+    #[test]
+    fn range_words_read_as_bounds() {
+        let b = |value: f64, inclusive: bool| Some(Bound { value, inclusive });
+        assert_eq!(bounds_of("-90 to 90"), (b(-90.0, true), b(90.0, true)));
+        assert_eq!(bounds_of("-90 to 90 (docs/model.md §8)"), (b(-90.0, true), b(90.0, true)));
+        assert_eq!(bounds_of("1e-9 to 1e-3"), (b(1e-9, true), b(0.001, true)));
+        assert_eq!(bounds_of("strictly between 0 and 1"), (b(0.0, false), b(1.0, false)));
+        assert_eq!(bounds_of("between 0 and 2R"), (b(0.0, true), None));
+        assert_eq!(bounds_of("a whole number from 2 to 1000"), (b(2.0, true), b(1000.0, true)));
+        assert_eq!(bounds_of("from 0.001 to 250"), (b(0.001, true), b(250.0, true)));
+        assert_eq!(bounds_of("at least 0"), (b(0.0, true), None));
+        assert_eq!(bounds_of("at least 1.5 T"), (None, None));
+        assert_eq!(bounds_of("greater than 0"), (b(0.0, false), None));
+        assert_eq!(bounds_of("greater than 0, at most 1"), (b(0.0, false), b(1.0, true)));
+        assert_eq!(bounds_of("greater than 0, plausible (docs/model.md §7)"), (None, None));
+        assert_eq!(bounds_of("at most T / 100"), (None, None));
+        assert_eq!(bounds_of("less than 5"), (None, b(5.0, false)));
+        assert_eq!(bounds_of("0 to 90 each, at most 10,000"), (b(0.0, true), None));
+        assert_eq!(bounds_of("within the model's"), (None, None));
+        assert_eq!(bounds_of(""), (None, None));
+        assert_eq!(F.bounds(), (None, None));
     }
 
     /// A field reads its text, else its default, with its own parser; a bad value is named

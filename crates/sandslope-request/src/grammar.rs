@@ -7,6 +7,7 @@ use sandslope::risk::UncertainTerrain;
 use sandslope::{Axis, AxisScale, Slope, Terrain};
 
 use crate::error::{check_range_in, RequestError, Result, Words};
+use crate::field::Field;
 
 /// Which slopes a slope list accepts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -224,6 +225,16 @@ pub fn parse_max_risk(text: &str) -> std::result::Result<f64, String> {
     }
 }
 
+/// `--cv-n` (risk, plan, design, infer): the coefficient of variation of k_n instead of the terrain's.
+pub const CV_N: Field = Field::number("cv-n", "CV").keyword("cv_n").key("cv_n").range("at least 0").help(
+    "Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's \
+     k_n_sd; without either, 0.1 (docs/model.md §9)",
+);
+/// `--cv-s` (risk, plan, design, infer): the coefficient of variation of k_s instead of the terrain's.
+pub const CV_S: Field = Field::number("cv-s", "CV").keyword("cv_s").key("cv_s").range("at least 0").help(
+    "Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's \
+     k_s_sd; without either, 0.2 (docs/model.md §9)",
+);
 /// The terrain's uncertainty by the one rule of docs/model.md §9 (a given CV, else the table's
 /// SD over its value, else 0.1 / 0.2), with the note to print when a default is used anywhere
 /// on the table. Errors name the field: `--cv-n = -1 must be a finite number of at least 0`.
@@ -244,8 +255,8 @@ pub fn uncertain_terrain_in(
 ) -> Result<(UncertainTerrain, Option<String>)> {
     check_cvs_in(words, cv_n, cv_s)?;
     let u = UncertainTerrain::new(terrain, cv_n, cv_s).map_err(|e| {
-        let field = if e.key == "cv_s" { "cv-s" } else { "cv-n" };
-        RequestError::invalid(field, e.renamed(words.name(field)))
+        let field = if e.key == CV_S.key { &CV_S } else { &CV_N };
+        RequestError::invalid(field.flag, e.renamed(words.name(field.flag)))
     })?;
     let note = u.defaults_used().note();
     Ok((u, note))
@@ -259,9 +270,9 @@ pub fn check_cvs(cv_n: Option<f64>, cv_s: Option<f64>) -> Result<()> {
 
 /// [`check_cvs`], naming the CVs in the front end's `words`.
 pub fn check_cvs_in(words: Words, cv_n: Option<f64>, cv_s: Option<f64>) -> Result<()> {
-    for (field, cv) in [("cv-n", cv_n), ("cv-s", cv_s)] {
+    for (field, cv) in [(&CV_N, cv_n), (&CV_S, cv_s)] {
         if let Some(cv) = cv {
-            check_range_in(words, field, cv, 0.0, f64::INFINITY)?;
+            check_range_in(words, field.flag, cv, 0.0, f64::INFINITY)?;
         }
     }
     Ok(())

@@ -22,6 +22,7 @@ pub mod drive;
 pub mod error;
 pub mod field;
 pub mod fit;
+pub mod format;
 pub mod grammar;
 pub mod infer;
 pub mod params;

@@ -102,16 +102,8 @@ pub const SLOPE: Field = Field::text("slope", "DEG|LIST|MIN:MAX:N")
     .default("0:24:7")
     .range("-90 to 90 each, at most 65,536 (docs/model.md §9)")
     .help("Slope(s), degrees: one value, a comma list (0,10,20) or a range MIN:MAX:N (0:24:13)");
-/// `--cv-n`: the coefficient of variation of k_n instead of the terrain's.
-pub const CV_N: Field = Field::number("cv-n", "CV").keyword("cv_n").key("cv_n").range("at least 0").help(
-    "Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's \
-     k_n_sd; without either, 0.1 (docs/model.md §9)",
-);
-/// `--cv-s`: the coefficient of variation of k_s instead of the terrain's.
-pub const CV_S: Field = Field::number("cv-s", "CV").keyword("cv_s").key("cv_s").range("at least 0").help(
-    "Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's \
-     k_s_sd; without either, 0.2 (docs/model.md §9)",
-);
+/// `--cv-n` and `--cv-s`: the terrain's uncertainty, the fields of its one rule.
+pub use crate::grammar::{CV_N, CV_S};
 /// `--max-risk`: the largest acceptable failure probability (the library's
 /// [`sandslope::risk::DEFAULT_MAX_RISK`] by default, a test checks).
 pub const MAX_RISK: Field = Field::number("max-risk", "P")

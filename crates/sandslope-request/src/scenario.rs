@@ -56,6 +56,10 @@ const fn quantity(
 /// `--mass`: the robot's total mass instead of the file's.
 pub const MASS: Field = quantity("mass", "mass_kg", "kg", "KG").help("Override the robot's total mass, kg");
 
+/// `--leg-speed`: the leg's angular speed instead of the file's (what sets the stride period).
+pub const LEG_SPEED: Field = quantity("leg-speed", "leg_speed_rad_s", "rad/s", "RAD/S")
+    .help("Override the leg angular speed omega, rad/s");
+
 /// The robot quantities a request may override (docs/model.md §2), the mass first: the
 /// command line's flags, the server's fields and the explorer page's robot panel (which reads
 /// this list from `/data/served`). Each field's key is the library's robot key
@@ -69,8 +73,7 @@ pub const ROBOT_QUANTITIES: Table = Table {
         quantity("hip-height", "hip_height_m", "m", "M")
             .range("between 0 and 2R")
             .help("Override the hip height h, m (between 0 and 2R)"),
-        quantity("leg-speed", "leg_speed_rad_s", "rad/s", "RAD/S")
-            .help("Override the leg angular speed omega, rad/s"),
+        LEG_SPEED,
         Field::new("stance-legs", Kind::Whole, "N")
             .keyword("stance_legs")
             .key("stance_legs")

@@ -328,7 +328,12 @@ impl TrackRequest {
     /// The analysis's options and slope, checked before any file is read.
     pub fn options(&self, words: Words) -> Result<(GaitOptions, Option<Slope>)> {
         let mut options = GaitOptions::new(self.stride_period_s)
-            .map_err(|e| RequestError::invalid("leg-speed", format!("the robot's stride period: {e}")))?
+            .map_err(|e| {
+                RequestError::invalid(
+                    crate::scenario::LEG_SPEED.flag,
+                    format!("the robot's stride period: {e}"),
+                )
+            })?
             .with_cutoff(self.cutoff_hz)
             .map_err(|e| RequestError::invalid(CUTOFF.flag, e.renamed(name(words, &CUTOFF))))?
             .with_max_gap(self.max_gap);

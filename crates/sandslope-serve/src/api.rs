@@ -14,7 +14,9 @@
 use crate::reply::{ApiError, Reply};
 use crate::served::Served;
 use sandslope_io::presets::{self, PresetKind};
+use sandslope_request::plan::{CLASSES, CLASS_TERRAIN};
 use sandslope_request::risk::AnswerLimits;
+use sandslope_request::scenario::{ROBOT, TERRAIN};
 use sandslope_request::simulate::{self, Walks};
 use sandslope_request::sweep;
 use sandslope_request::{
@@ -57,8 +59,8 @@ const OUTPUT_FLAGS: [&str; 11] = [
     "geojson",
     "risk-map",
     "out",
-    "classes",
-    "class-terrain",
+    CLASSES.flag,
+    CLASS_TERRAIN.flag,
     "animate",
 ];
 
@@ -83,7 +85,7 @@ pub fn request_params(
         }
     }
     let mut params = params.to_vec();
-    for (key, served_value) in [("robot", &served.robot), ("terrain", &served.terrain)] {
+    for (key, served_value) in [(ROBOT.flag, &served.robot), (TERRAIN.flag, &served.terrain)] {
         if !params.iter().any(|(k, _)| k == key) {
             params.push((key.to_string(), served_value.clone()));
         }
@@ -98,14 +100,14 @@ pub fn plan_params(params: &[(String, String)], served: &Served) -> Result<Vec<(
     if params.iter().any(|(k, _)| k == dem_key) {
         return Err(ApiError::bad(
             Some(dem_key.into()),
-            format!("{dem_key}: a request cannot name a file; the server plans on the DEM it was started with (serve --dem)"),
+            format!("{dem_key}: a request cannot name a file; the server plans on the DEM it was started with (serve --{dem_key})"),
         ));
     }
     let Some(dem) = &served.dem else {
         return Err(ApiError {
             status: 404,
             field: None,
-            error: "/api/plan needs an elevation model: start the server with --dem FILE".to_string(),
+            error: format!("/api/plan needs an elevation model: start the server with --{dem_key} FILE"),
         });
     };
     let mut params = request_params(params, served)?;
@@ -238,8 +240,8 @@ pub fn simulate_walks(params: &[(String, String)], served: &Served) -> Result<Wa
 /// Parameters whose value must be a built-in preset of this kind.
 fn preset_kind(key: &str) -> Option<PresetKind> {
     match key {
-        "robot" => Some(PresetKind::Robot),
-        "terrain" => Some(PresetKind::Terrain),
+        k if k == ROBOT.flag => Some(PresetKind::Robot),
+        k if k == TERRAIN.flag => Some(PresetKind::Terrain),
         _ => None,
     }
 }

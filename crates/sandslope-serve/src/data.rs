@@ -12,7 +12,7 @@ use crate::served::{stride, DemInfo, Served};
 use sandslope::Cause;
 use sandslope_io::presets::{PresetKind, PRESETS};
 use sandslope_io::raster::{read_raster, write_two_band_geotiff};
-use sandslope_request::plan::{GOAL, GOAL_PX, OBJECTIVE, START, START_PX};
+use sandslope_request::plan::{DEM, GOAL, GOAL_PX, OBJECTIVE, START, START_PX};
 use sandslope_request::scenario::robot_fields;
 use sandslope_request::{phase, simulate, PhaseRequest, PlanRequest};
 
@@ -156,7 +156,7 @@ struct Grid {
 /// The served DEM's heights (nodata as null), every `stride`-th cell.
 fn dem(served: &Served) -> Result<Reply, ApiError> {
     let Some(path) = &served.dem else {
-        return Err(not_found("DEM: the server was started without --dem", "none"));
+        return Err(not_found(&format!("DEM: the server was started without {}", DEM.long()), "none"));
     };
     let r = read_raster(path).map_err(|e| failed(&e))?;
     let heights: Vec<f32> =

@@ -5,6 +5,14 @@
 //! as CSS custom properties (`sandslope_render::figures::palette::css_custom_properties`),
 //! which the script reads, so the page draws in the figures' colours and restates none.
 
+use std::sync::LazyLock;
+
+use sandslope::robot::STANCE_LEGS_RANGE;
+use sandslope::RobotKey;
+use sandslope_request::field::{Bound, Field, Table};
+use sandslope_request::scenario::{robot_fields, ROBOT_QUANTITIES};
+use sandslope_request::{plan, predict, risk, simulate};
+
 use crate::served::Served;
 
 const INDEX: &str = include_str!("page/index.html");
@@ -16,7 +24,7 @@ const STYLE: &str = include_str!("page/style.css");
 /// The page's file at `path`, with its content type, or `None` (404).
 pub fn asset(path: &str, _served: &Served) -> Option<(Vec<u8>, &'static str)> {
     match path {
-        "/" | "/index.html" => Some((INDEX.as_bytes().to_vec(), "text/html; charset=utf-8")),
+        "/" | "/index.html" => Some((FILLED_INDEX.as_bytes().to_vec(), "text/html; charset=utf-8")),
         "/app.js" => Some((SCRIPT.as_bytes().to_vec(), "text/javascript; charset=utf-8")),
         "/routes.js" => Some((ROUTES_SCRIPT.as_bytes().to_vec(), "text/javascript; charset=utf-8")),
         "/drive.js" => Some((DRIVE_SCRIPT.as_bytes().to_vec(), "text/javascript; charset=utf-8")),
@@ -26,6 +34,132 @@ pub fn asset(path: &str, _served: &Served) -> Option<(Vec<u8>, &'static str)> {
         }
         _ => None,
     }
+}
+
+/// The page with every input bound to a field given its start and range from the tables.
+static FILLED_INDEX: LazyLock<String> = LazyLock::new(|| fill_inputs(INDEX));
+
+/// What the page chooses itself where no table gives a number: a slider's span (a slider
+/// needs both ends; the slope sliders' span is also the sweep chart's slope axis, which the
+/// script reads from the slider) and where an input without a default starts.
+struct View {
+    /// The input's id.
+    id: &'static str,
+    /// Where it starts, when its field has no default.
+    start: Option<f64>,
+    /// Its lower end, narrower than the field's.
+    min: Option<f64>,
+    /// Its upper end, narrower than the field's (or where the field has none).
+    max: Option<f64>,
+}
+
+/// The slope the Explore and Simulate tabs open at, degrees.
+const START_SLOPE_DEG: f64 = 10.0;
+/// The slope sliders' span, degrees: the slopes a sand robot is tried on, a little beyond the
+/// repose angle (about 30 degrees), and descents.
+const SLOPE_VIEW_DEG: (f64, f64) = (-30.0, 40.0);
+/// The longest walk the Simulate tab animates, s (a page's wait, well inside
+/// `/data/simulation`'s cap of [`crate::data::MAX_SIM_SAMPLES`] samples).
+const LONGEST_ANIMATION_S: f64 = 60.0;
+
+const VIEWS: &[View] = &[
+    View {
+        id: "slope",
+        start: Some(START_SLOPE_DEG),
+        min: Some(SLOPE_VIEW_DEG.0),
+        max: Some(SLOPE_VIEW_DEG.1),
+    },
+    View { id: "slope-num", start: Some(START_SLOPE_DEG), min: None, max: None },
+    View {
+        id: "sim-slope",
+        start: Some(START_SLOPE_DEG),
+        min: Some(SLOPE_VIEW_DEG.0),
+        max: Some(SLOPE_VIEW_DEG.1),
+    },
+    View { id: "sim-slope-num", start: Some(START_SLOPE_DEG), min: None, max: None },
+    // The CV sliders start at the library's defaults (docs/model.md §9), which the risk
+    // answer's CVs show until the box "CVs from the terrain" is cleared; a CV past 1 (a
+    // spread as large as the value) is typed in no box, so the slider ends there.
+    View { id: "cv-n", start: Some(sandslope::risk::DEFAULT_CV_N), min: None, max: Some(1.0) },
+    View { id: "cv-s", start: Some(sandslope::risk::DEFAULT_CV_S), min: None, max: Some(1.0) },
+    View { id: "sim-duration", start: None, min: None, max: Some(LONGEST_ANIMATION_S) },
+];
+
+/// The tables an input may name in `data-field="COMMAND:FLAG"`.
+const TABLES: [Table; 5] = [predict::FIELDS, risk::FIELDS, plan::FIELDS, simulate::FIELDS, ROBOT_QUANTITIES];
+
+/// The field an input names, `COMMAND:FLAG` (`risk:max-risk`), or a robot quantity's flag
+/// (`data-flag="mass"`).
+fn field_named(name: &str) -> Option<&'static Field> {
+    let (command, flag) = name.split_once(':')?;
+    TABLES.iter().filter(|t| t.command == command).flat_map(|t| t.fields.iter()).find(|f| f.flag == flag)
+}
+
+/// The range of a robot quantity's input: the library's plausible range of its key (or the
+/// stance legs' whole numbers), else its field's words (`hip-height`: at least 0).
+fn robot_bounds(flag: &str, field: &Field) -> (Option<Bound>, Option<Bound>) {
+    let inclusive = |value: f64| Some(Bound { value, inclusive: true });
+    match robot_fields().find(|(_, f)| *f == flag).map(|(k, _)| k) {
+        Some(RobotKey::StanceLegs) => {
+            (inclusive(f64::from(STANCE_LEGS_RANGE.0)), inclusive(f64::from(STANCE_LEGS_RANGE.1)))
+        }
+        Some(k) => match k.plausible() {
+            Some(p) => (inclusive(p.min), inclusive(p.max)),
+            None => field.bounds(),
+        },
+        None => field.bounds(),
+    }
+}
+
+/// The value of attribute `name` in the opening tag `tag`.
+fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let marker = format!(" {name}=\"");
+    let at = tag.find(&marker)? + marker.len();
+    Some(&tag[at..at + tag[at..].find('"')?])
+}
+
+/// `html` with `value`, `min` and `max` written into every `<input>` bound to a field
+/// (`data-field="COMMAND:FLAG"`, or a robot quantity's `data-flag="FLAG"`): its start is the
+/// field's default (else the page's [`VIEWS`]), its ends the field's range (a robot
+/// quantity's: the library's plausible range), narrowed by the page's view. An end the range
+/// excludes (`strictly between 0 and 1`) is written too: the server's check refuses it by
+/// name. A field name no table has is a mistake in the page (panics, and a test loads it).
+fn fill_inputs(html: &str) -> String {
+    let mut out = String::with_capacity(html.len() + 1024);
+    let mut rest = html;
+    while let Some(at) = rest.find("<input ") {
+        let close = at + rest[at..].find('>').expect("an <input> tag is closed");
+        let tag = &rest[at..close];
+        out.push_str(&rest[..close]);
+        let (field, bounds) = if let Some(name) = attribute(tag, "data-field") {
+            let f = field_named(name).unwrap_or_else(|| panic!("index.html names no field {name}"));
+            (Some(f), f.bounds())
+        } else if let Some(flag) = attribute(tag, "data-flag") {
+            let f = ROBOT_QUANTITIES.field(flag);
+            (Some(f), robot_bounds(flag, f))
+        } else {
+            (None, (None, None))
+        };
+        if let Some(field) = field {
+            let view = attribute(tag, "id").and_then(|id| VIEWS.iter().find(|v| v.id == id));
+            let start = field
+                .default
+                .map(str::to_string)
+                .or_else(|| view.and_then(|v| v.start).map(|v| v.to_string()));
+            let min = view.and_then(|v| v.min).or(bounds.0.map(|b| b.value));
+            let max = view.and_then(|v| v.max).or(bounds.1.map(|b| b.value));
+            for (name, value) in
+                [("value", start), ("min", min.map(|v| v.to_string())), ("max", max.map(|v| v.to_string()))]
+            {
+                if let Some(v) = value {
+                    out.push_str(&format!(" {name}=\"{v}\""));
+                }
+            }
+        }
+        rest = &rest[close..];
+    }
+    out.push_str(rest);
+    out
 }
 
 #[cfg(test)]
@@ -94,6 +228,55 @@ mod tests {
              const u = \"http://x/#map\"; // #eee\nf(\"#aab\", `rgb(${c})`, \"#deadbeef\")",
         );
         assert_eq!(colour_literals(&code), ["#fff", "#b83227", "#aab", "#deadbeef", "rgb("]);
+    }
+
+    /// The opening `<input>` tag of the element `id` in the served page.
+    fn input_tag(id: &str) -> String {
+        let at = FILLED_INDEX.find(&format!("<input id=\"{id}\"")).unwrap_or_else(|| panic!("no #{id}"));
+        FILLED_INDEX[at..at + FILLED_INDEX[at..].find('>').unwrap()].to_string()
+    }
+
+    /// The served page's inputs start and end where the tables say, values worked out from the
+    /// docs: max risk 0.05 strictly between 0 and 1 (docs/model.md §9), max roll 20 degrees
+    /// strictly between 0 and 90, the CVs at 0.1 and 0.2 (docs/model.md §9), the simulated
+    /// time 10 s, a prediction's slope -90 to 90 (docs/model.md §8), the mass's plausible 1 g
+    /// to 250 kg and the stance legs 1 to 128.
+    #[test]
+    fn the_served_inputs_carry_the_tables_starts_and_ranges() {
+        let has = |id: &str, want: &[(&str, Option<&str>)]| {
+            let tag = input_tag(id);
+            for (name, value) in want {
+                assert_eq!(attribute(&tag, name), *value, "#{id} {name}: {tag}");
+                assert!(tag.matches(&format!(" {name}=")).count() <= 1, "{tag}");
+            }
+        };
+        has("max-risk", &[("value", Some("0.05")), ("min", Some("0")), ("max", Some("1"))]);
+        has("max-roll", &[("value", Some("20")), ("min", Some("0")), ("max", Some("90"))]);
+        has("cv-n", &[("value", Some("0.1")), ("min", Some("0")), ("max", Some("1"))]);
+        has("cv-s", &[("value", Some("0.2")), ("min", Some("0")), ("max", Some("1"))]);
+        has("sim-duration", &[("value", Some("10")), ("min", None), ("max", Some("60"))]);
+        has("slope", &[("value", Some("10")), ("min", Some("-30")), ("max", Some("40"))]);
+        has("slope-num", &[("value", Some("10")), ("min", Some("-90")), ("max", Some("90"))]);
+        has("sim-slope-num", &[("value", Some("10")), ("min", Some("-90")), ("max", Some("90"))]);
+        has("mass", &[("value", None), ("min", Some("0.001")), ("max", Some("250"))]);
+        has("stance-legs", &[("min", Some("1")), ("max", Some("128"))]);
+        has("hip-height", &[("min", Some("0")), ("max", None)]);
+        // An input bound to no field is left as written.
+        let original = &INDEX[INDEX.find("<input id=\"mass-slider\"").unwrap()..];
+        assert_eq!(input_tag("mass-slider"), original[..original.find('>').unwrap()]);
+    }
+
+    /// The page's own spans lie inside their fields' ranges, and each names an input of the page.
+    #[test]
+    fn the_pages_views_lie_inside_the_fields_ranges() {
+        for v in VIEWS {
+            let tag = input_tag(v.id);
+            let field = field_named(attribute(&tag, "data-field").expect("a view of a field")).unwrap();
+            let (lo, hi) = field.bounds();
+            for x in [v.start, v.min, v.max].into_iter().flatten() {
+                assert!(lo.is_none_or(|b| x >= b.value) && hi.is_none_or(|b| x <= b.value), "{}: {x}", v.id);
+            }
+        }
     }
 
     /// The page writes no colour of its own: every colour of its style sheet, scripts and HTML is

@@ -1,8 +1,13 @@
 //! The mutated requests of `serve-requests`: a seed mutated as bytes, in its target or body, or
 //! with a parameter's value replaced by a hostile one.
 
+use std::sync::LazyLock;
+
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
+
+use sandslope_request::{phase, risk};
+use sandslope_request::{plan, predict, scenario, simulate, sweep};
 
 use crate::mutate;
 
@@ -53,44 +58,30 @@ pub(super) const VALUES: &[&str] = &[
     "5,5",
 ];
 
-/// Parameters added to a request: every flag the endpoints take, and some they do not.
-pub(super) const KEYS: &[&str] = &[
-    "slope",
-    "slopes",
-    "mass",
-    "k-n",
-    "k-s",
-    "leg-radius",
-    "leg-width",
-    "hip-height",
-    "leg-speed",
-    "from",
-    "to",
-    "step",
-    "duration",
-    "dt",
-    "rate",
-    "map",
-    "solve",
-    "max-risk",
-    "cv-n",
-    "cv-s",
-    "robot",
-    "terrain",
-    "objective",
-    "start-px",
-    "goal-px",
-    "json",
-    "plot",
-    "dem",
-    "csv",
-    "out",
-    "allow-metastable",
-    "rule",
-    "threads",
-    "%00",
-    "a%20b",
-];
+/// Parameters that are no field of an endpoint: output flags the API refuses, the risk map's
+/// heading `rule` (a `/data/risk-map` word), a word no request takes, and broken names.
+const OTHER_KEYS: &[&str] = &["json", "plot", "csv", "out", "rule", "threads", "%00", "a%20b"];
+
+/// Parameters added to a request: every field the endpoints read, from their field tables
+/// (the scenario's and the robot's, predict, sweep, phase, risk, simulate and plan), so a new
+/// field is fuzzed without a line here, then [`OTHER_KEYS`].
+pub(super) static KEYS: LazyLock<Vec<&'static str>> = LazyLock::new(|| {
+    let tables = [
+        scenario::FIELDS,
+        scenario::ROBOT_QUANTITIES,
+        predict::FIELDS,
+        sweep::FIELDS,
+        phase::FIELDS,
+        risk::FIELDS,
+        simulate::FIELDS,
+        plan::FIELDS,
+    ];
+    let mut keys: Vec<&'static str> = tables.iter().flat_map(|t| t.fields.iter().map(|f| f.flag)).collect();
+    keys.sort_unstable();
+    keys.dedup();
+    keys.extend(OTHER_KEYS);
+    keys
+});
 
 /// Input `i` of a server target: a seed mutated one of four ways.
 pub(super) fn input(seeds: &[Vec<u8>], seed: u64, i: u64) -> Vec<u8> {

@@ -469,7 +469,8 @@ def plan(
     ``start`` and ``goal`` are cells ``(row, col)`` of ``dem`` (NumPy index order: ``dem[row,
     col]``). ``objective``: ``"time"`` (fastest route through success cells), ``"risk"``
     (maximum survival, plus ``time_weight`` per second) and/or ``"distance"`` (shortest, physics
-    ignored); the distance route is always added for comparison, as the CLI does.
+    ignored), a list of these words or one text as ``--objective`` takes it (``"time,risk"``);
+    the distance route is always added for comparison, as the CLI does.
 
     Returns ``{"routes": {objective: route}, "extrapolation": None or {"max_pitch_deg",
     "last_point_deg"}}`` (set when a route climbs above the terrain's last measured point);

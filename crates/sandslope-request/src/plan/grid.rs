@@ -18,7 +18,7 @@ use sandslope::{Robot, Terrain};
 use crate::error::{RequestError, Result, Words};
 use crate::grammar::uncertain_terrain_in;
 
-use super::settings::{parse_descent, parse_objective, settings_in};
+use super::settings::{parse_descent, parse_objectives, settings_in};
 
 /// The DEM's geometry and the planner's settings: what a risk raster needs (Python's
 /// `risk_raster`), and the part of a [`GridPlanRequest`] that is not its route.
@@ -58,7 +58,8 @@ pub struct GridPlanRequest {
     pub start: (i64, i64),
     /// Goal cell, `(row, col)` (`goal`).
     pub goal: (i64, i64),
-    /// What to minimise: `time`, `risk` or `distance` (`objectives`).
+    /// What to minimise: `time`, `risk` or `distance`, each item one word or a comma list of
+    /// them (`objectives`).
     pub objectives: Vec<String>,
     /// Map coordinates of the DEM's north-west corner, m (`origin`): the routes' `x_m`, `y_m`;
     /// default `(0, rows * cell_y)`, the south-west corner at the origin.
@@ -214,8 +215,7 @@ impl GridPlanRequest {
     /// computes), with `stop` looked at as each search goes: once it is raised the search ends
     /// and the answer is [`RequestError::interrupted`].
     pub fn answer(&self, source: &GridSource<'_>, stop: Option<&AtomicBool>) -> Result<PlanResult> {
-        let objectives =
-            self.objectives.iter().map(|o| parse_objective(Words::Keyword, o)).collect::<Result<Vec<_>>>()?;
+        let objectives = parse_objectives(Words::Keyword, &self.objectives)?;
         let settings = self.grid.settings()?;
         let grid = self.grid.grid(source)?;
         let (rows, cols) = (grid.rows(), grid.cols());

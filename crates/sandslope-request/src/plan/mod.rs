@@ -33,9 +33,9 @@ pub use grid::{ClassRaster, GridPlanRequest, GridRequest, GridSource, RouteCells
 use memory::choose_search;
 pub use risk_raster::risk_band_rows;
 pub use settings::{
-    parse_descent, parse_objective, settings_in, ALLOW_METASTABLE, CLASSES, CLASS_TERRAIN, COARSE_FACTOR,
-    CORRIDOR_WIDTH, CV_N, CV_S, DEM, DESCENT, FIELDS, GOAL, GOAL_PX, MAX_MEMORY, MAX_ROLL, OBJECTIVE, SEARCH,
-    START, START_PX, TIME_WEIGHT,
+    parse_descent, parse_objective, parse_objectives, settings_in, ALLOW_METASTABLE, CLASSES, CLASS_TERRAIN,
+    COARSE_FACTOR, CORRIDOR_WIDTH, CV_N, CV_S, DEM, DESCENT, FIELDS, GOAL, GOAL_PX, MAX_MEMORY, MAX_ROLL,
+    OBJECTIVE, SEARCH, START, START_PX, TIME_WEIGHT,
 };
 
 /// `search = auto` searches maps of up to this many cells at full resolution (4096 x 4096)
@@ -165,12 +165,7 @@ impl PlanRequest {
                 _ => {}
             }
         }
-        let objectives = OBJECTIVE
-            .text_in(&mut p)?
-            .unwrap_or_default()
-            .split(',')
-            .map(|o| parse_objective(Words::Flag, o))
-            .collect::<Result<Vec<_>>>()?;
+        let objectives = parse_objectives(Words::Flag, &[OBJECTIVE.text_in(&mut p)?.unwrap_or_default()])?;
         let (robot, terrain) = match sources {
             Some(sources) => sources,
             None => {

@@ -175,6 +175,13 @@ pub fn parse_descent(words: Words, text: &str) -> Result<Descent> {
     })
 }
 
+/// The objectives of a request in the order given: each item one word or a comma list of
+/// them (`time,risk`), so the command line's and HTTP's one text and Python's list of words
+/// (or its one text) read alike, each word by [`parse_objective`].
+pub fn parse_objectives<S: AsRef<str>>(words: Words, items: &[S]) -> Result<Vec<Objective>> {
+    items.iter().flat_map(|item| item.as_ref().split(',')).map(|name| parse_objective(words, name)).collect()
+}
+
 /// The objective named `name` (`time`, `risk` or `distance`), or an error in `words`.
 pub fn parse_objective(words: Words, name: &str) -> Result<Objective> {
     let name = name.trim();
@@ -224,6 +231,26 @@ mod tests {
             (r.cv_n, r.cv_s, r.max_memory, r.allow_metastable, r.classes),
             (None, None, None, false, None)
         );
+    }
+
+    /// A comma text and a list of words are the same objectives, in the order given; a word
+    /// that is none is named in the front end's words.
+    #[test]
+    fn objectives_read_from_a_comma_text_or_a_list() {
+        let both = vec![Objective::Time, Objective::Risk];
+        assert_eq!(parse_objectives(Words::Flag, &["time,risk"]).unwrap(), both);
+        assert_eq!(parse_objectives(Words::Keyword, &["time", "risk"]).unwrap(), both);
+        assert_eq!(
+            parse_objectives(Words::Keyword, &[" risk , distance"]).unwrap(),
+            vec![Objective::Risk, Objective::Distance]
+        );
+        let e = parse_objectives(Words::Keyword, &["time,fast"]).unwrap_err();
+        assert_eq!(
+            (e.field(), e.message().as_str()),
+            (Some("objective"), "objective = \"fast\" must be \"time\", \"risk\" or \"distance\"")
+        );
+        let e = parse_objectives(Words::Flag, &["time,fast"]).unwrap_err();
+        assert_eq!(e.message(), "--objective: `fast` is not an objective: time, risk or distance");
     }
 
     /// The checks across fields name the field at fault: an endpoint missing or given twice,

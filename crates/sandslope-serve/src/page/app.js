@@ -245,7 +245,8 @@ function updatePredict() {
   return fresh("predict", () => get("/api/predict", q), showPrediction);
 }
 function updateSweep() {
-  const q = { ...exploreFlags(), from: "-30", to: "40", step: "0.5" };
+  // Over the slope slider's span, as the server wrote it (page.rs), at its step.
+  const q = { ...exploreFlags(), from: $("slope").min, to: $("slope").max, step: $("slope").step };
   return fresh("sweep", () => get("/api/sweep", q), (rows) => {
     state.sweep = rows;
     drawSweep();
@@ -259,7 +260,7 @@ function drawSweep() {
   const finite = speeds.filter((v) => v !== null);
   const top = Math.max(1, ...finite);
   const bottom = Math.min(0, ...finite);
-  const f = frame(svg, [-30, 40], [bottom, top * 1.08], "slope (deg)", "speed (cm/s)");
+  const f = frame(svg, [Number($("slope").min), Number($("slope").max)], [bottom, top * 1.08], "slope (deg)", "speed (cm/s)");
   el("line", { x1: f.x(-30), x2: f.x(40), y1: f.y(0), y2: f.y(0), stroke: INK }, svg);
   for (let i = 1; i < rows.length; i++) {
     if (speeds[i - 1] === null || speeds[i] === null) continue;

@@ -47,6 +47,11 @@ const CONTINUATION_START_M_S: f64 = 1e-2;
 /// Newton's method has converged when no body rate changes by more than this fraction of
 /// the creep speed (a velocity error far below the creep the smoothing itself allows).
 const NEWTON_TOL: f64 = 1e-3;
+/// A step in which the belly strikes the sand is taken as this many substeps.
+const STRIKE_SUBSTEPS: usize = 8;
+/// The belly strikes the sand when an end of it moves into the sand faster than this, m/s
+/// (the built-in robot's belly lands at about 0.75 m/s and comes to rest within 3 ms).
+const STRIKE_SPEED_M_S: f64 = 0.05;
 
 /// Per-step (per tripod stance) peaks.
 #[derive(Debug, Clone, Copy, Default)]
@@ -170,6 +175,11 @@ pub(crate) struct Walker {
     rest_set_for: Option<(bool, [u64; 2])>,
     /// Scratch: a resting group's elements ([`Walker::rest_group`]).
     rest_group_scratch: Vec<usize>,
+    /// The motors' work so far, J: the sand's torque resisting each leg times its rate,
+    /// summed over legs and steps (substeps) times the step.
+    motor_work: f64,
+    /// Steps taken as substeps because the belly struck the sand ([`Walker::step`]).
+    strike_steps: usize,
 }
 
 /// Adds an element at `rel` from the centre of mass, with force `f` and (when the Jacobian is
@@ -290,6 +300,8 @@ impl Walker {
             last_rest_set: RestSet::default(),
             rest_set_for: None,
             rest_group_scratch: Vec::new(),
+            motor_work: 0.0,
+            strike_steps: 0,
         };
         w.reach = w.nodes.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) * (1.0 + 1e-9);
         for j in 0..legs {
@@ -651,8 +663,39 @@ impl Walker {
         (phi, r)
     }
 
-    /// One time step; `gait`: legs follow the gait (else held).
+    /// One time step; `gait`: legs follow the gait (else held). A step in which the belly
+    /// strikes the sand ([`Walker::striking`]) is taken as [`STRIKE_SUBSTEPS`] substeps
+    /// (docs/model.md §17): the strike stops the body within a few milliseconds, a handful
+    /// of steps, and the scheme's first-order error there set where the body came to rest.
     fn step(&mut self, gait: bool) {
+        if !self.striking() {
+            self.substep(gait);
+            return;
+        }
+        let (dt, time) = (self.dt, self.time);
+        self.dt = dt / STRIKE_SUBSTEPS as f64;
+        for _ in 0..STRIKE_SUBSTEPS {
+            self.substep(gait);
+        }
+        self.dt = dt;
+        self.time = time + dt;
+        self.strike_steps += 1;
+    }
+
+    /// Whether the belly strikes the sand in this step: one of its ends is in the sand, or
+    /// will be at the step's end at its present rate, moving into it faster than
+    /// [`STRIKE_SPEED_M_S`].
+    fn striking(&self) -> bool {
+        let (sp, cp) = self.q[2].sin_cos();
+        [self.belly[0], self.belly[BELLY_ELEMENTS]].iter().any(|p| {
+            let height = self.q[1] + sp * p[0] + cp * p[1];
+            let rate = self.v[1] + self.v[2] * (cp * p[0] - sp * p[1]);
+            rate < -STRIKE_SPEED_M_S && height + self.dt * rate < 0.0
+        })
+    }
+
+    /// One step of `self.dt` (see [`Walker::step`]).
+    fn substep(&mut self, gait: bool) {
         let dt = self.dt;
         let legs = self.psi.len();
         let pitch_sc = self.q[2].sin_cos();
@@ -743,6 +786,7 @@ impl Walker {
             self.unconverged += 1;
         }
         self.leg_outputs();
+        self.motor_work += self.legs_out.iter().zip(&self.rates).map(|(o, r)| o.torque * r).sum::<f64>() * dt;
         for (q, v) in self.q.iter_mut().zip(self.v) {
             *q += dt * v;
         }

@@ -38,7 +38,7 @@ pub fn simulate<'py>(
     let slope = sandslope::SignedSlope::from_degrees(slope_deg).map_err(value_error)?;
     let walks = Walks { scaling_spread, ..Walks::at(scenario, slope, settings, None) };
     let (mut spreads, mut sims) = py
-        .detach(|| walks.simulate().and_then(|sims| Ok((walks.spreads(&sims)?, sims))))
+        .detach(|| walks.simulate_with_spreads().map(|(sims, spreads)| (spreads, sims)))
         .map_err(request_error)?;
     let sim = sims.pop().ok_or_else(|| value_error("the walk gave no result"))?;
     let spread = spreads.pop().flatten();

@@ -711,8 +711,7 @@ impl Walks {
         match self.ensemble {
             Some(n) => Ok(Answer::Ensemble(Box::new(self.simulate_ensemble(n)?))),
             None => {
-                let sims = self.simulate()?;
-                let spreads = self.spreads(&sims)?;
+                let (sims, spreads) = self.simulate_with_spreads()?;
                 Ok(self.answer(sims, spreads))
             }
         }

@@ -74,13 +74,24 @@ impl SpreadAnswer {
 }
 
 impl Walks {
-    /// The scaling spread of each slope (in slope order), `None` each where it is not asked:
-    /// `sims` (these walks' own, under the asked scaling) beside the same slopes walked under
-    /// the other two scalings (the two in parallel, each over the slopes in parallel).
-    pub fn spreads(&self, sims: &[Simulation]) -> Result<Vec<Option<SpreadAnswer>>> {
+    /// The walks as asked ([`Walks::simulate`]) and, where asked, each slope's scaling spread
+    /// ([`Walks::spreads`]), the three scalings' walks at once (in parallel: a one-slope walk is
+    /// one thread's work, and the two other scalings used to start only after it ended).
+    pub fn simulate_with_spreads(&self) -> Result<(Vec<Simulation>, Vec<Option<SpreadAnswer>>)> {
         if !self.scaling_spread {
-            return Ok(vec![None; sims.len()]);
+            let sims = self.simulate()?;
+            let none = vec![None; sims.len()];
+            return Ok((sims, none));
         }
+        let (sims, others) = rayon::join(|| self.simulate(), || self.other_scalings());
+        let sims = sims?;
+        let spreads = self.spreads_beside(&sims, others?);
+        Ok((sims, spreads))
+    }
+
+    /// The two scalings other than the asked one, and each one's walks of every slope (the two
+    /// in parallel, each over the slopes in parallel).
+    fn other_scalings(&self) -> Result<[(RftScaling, Vec<Simulation>); 2]> {
         let asked = self.settings.rft_scaling;
         let others: Vec<RftScaling> = SCALINGS.into_iter().filter(|&s| s != asked).collect();
         let walk = |s: RftScaling| {
@@ -88,9 +99,13 @@ impl Walks {
                 .map_err(|e| sim_err(e, self.words))
         };
         let (a, b) = rayon::join(|| walk(others[0]), || walk(others[1]));
-        let (a, b) = (a?, b?);
-        Ok(sims
-            .iter()
+        Ok([(others[0], a?), (others[1], b?)])
+    }
+
+    /// Each slope's spread: `sims` (the asked scaling's) beside `others`.
+    fn spreads_beside(&self, sims: &[Simulation], others: [(RftScaling, Vec<Simulation>); 2]) -> Vec<Option<SpreadAnswer>> {
+        let asked = self.settings.rft_scaling;
+        sims.iter()
             .enumerate()
             .map(|(i, own)| {
                 let walks = SCALINGS
@@ -98,17 +113,27 @@ impl Walks {
                     .map(|&s| {
                         let sim = if s == asked {
                             own
-                        } else if s == others[0] {
-                            &a[i]
+                        } else if s == others[0].0 {
+                            &others[0].1[i]
                         } else {
-                            &b[i]
+                            &others[1].1[i]
                         };
                         sim.summary.clone()
                     })
                     .collect();
                 Some(SpreadAnswer::of(&ScalingSpread::of_walks(own.summary.slope_deg, walks)))
             })
-            .collect())
+            .collect()
+    }
+
+    /// The scaling spread of each slope (in slope order), `None` each where it is not asked:
+    /// `sims` (these walks' own, under the asked scaling) beside the same slopes walked under
+    /// the other two scalings (the two in parallel, each over the slopes in parallel).
+    pub fn spreads(&self, sims: &[Simulation]) -> Result<Vec<Option<SpreadAnswer>>> {
+        if !self.scaling_spread {
+            return Ok(vec![None; sims.len()]);
+        }
+        Ok(self.spreads_beside(sims, self.other_scalings()?))
     }
 }
 

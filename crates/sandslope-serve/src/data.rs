@@ -278,8 +278,8 @@ fn simulation(params: &[(String, String)], served: &Served) -> Result<Reply, Api
             ),
         ));
     }
-    let sims = walks.simulate()?;
-    let scaling_spread = walks.spreads(&sims)?.pop().flatten();
+    let (sims, mut spreads) = walks.simulate_with_spreads()?;
+    let scaling_spread = spreads.pop().flatten();
     let Some(sim) = sims.into_iter().next() else {
         return Err(ApiError::bad(Some(simulate::SLOPE.flag.to_string()), "no walk: give a slope"));
     };

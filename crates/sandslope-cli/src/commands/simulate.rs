@@ -111,7 +111,7 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
     let under = if walks.scaling_spread { " under each of the three contact scalings" } else { "" };
     let spin =
         Progress::new(0, quiet, &format!("simulating {} s at {slope} deg{under}", walks.settings.duration_s));
-    let sims = walks.simulate().and_then(|sims| Ok((walks.spreads(&sims)?, sims)));
+    let sims = walks.simulate_with_spreads().map(|(sims, spreads)| (spreads, sims));
     spin.finish();
     let (mut spreads, mut sims) = sims?;
     let (Some(sim), Some(spread)) = (sims.pop(), spreads.pop()) else { bail!("no walk was simulated") };
@@ -484,7 +484,7 @@ fn run_slopes(args: &SimulateArgs, walks: &Walks, observed: &[sandslope::SpeedOb
     let quiet = args.format.format() != Format::Table;
     let under = if walks.scaling_spread { " under each of the three contact scalings" } else { "" };
     let spin = spinner(quiet, &format!("simulating {} slopes{under}", walks.slopes.len()));
-    let sims = walks.simulate().and_then(|sims| Ok((walks.spreads(&sims)?, sims)));
+    let sims = walks.simulate_with_spreads().map(|(sims, spreads)| (spreads, sims));
     spin.finish_and_clear();
     let (spreads, sims) = sims?;
     let beyond: Vec<f64> =

@@ -30,6 +30,7 @@ mod lanes;
 mod probe;
 mod rest;
 mod run;
+mod strike;
 
 pub(crate) use groups::GroupForces;
 
@@ -170,6 +171,11 @@ pub(crate) struct Walker {
     rest_set_for: Option<(bool, [u64; 2])>,
     /// Scratch: a resting group's elements ([`Walker::rest_group`]).
     rest_group_scratch: Vec<usize>,
+    /// The motors' work so far, J: the sand's torque resisting each leg times its rate,
+    /// summed over legs and steps (substeps) times the step.
+    motor_work: f64,
+    /// Steps taken as substeps because the belly struck the sand ([`Walker::step`]).
+    strike_steps: usize,
 }
 
 /// Adds an element at `rel` from the centre of mass, with force `f` and (when the Jacobian is
@@ -290,6 +296,8 @@ impl Walker {
             last_rest_set: RestSet::default(),
             rest_set_for: None,
             rest_group_scratch: Vec::new(),
+            motor_work: 0.0,
+            strike_steps: 0,
         };
         w.reach = w.nodes.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) * (1.0 + 1e-9);
         for j in 0..legs {
@@ -651,8 +659,8 @@ impl Walker {
         (phi, r)
     }
 
-    /// One time step; `gait`: legs follow the gait (else held).
-    fn step(&mut self, gait: bool) {
+    /// One step of `self.dt` (see [`Walker::step`]).
+    fn substep(&mut self, gait: bool) {
         let dt = self.dt;
         let legs = self.psi.len();
         let pitch_sc = self.q[2].sin_cos();
@@ -743,6 +751,7 @@ impl Walker {
             self.unconverged += 1;
         }
         self.leg_outputs();
+        self.motor_work += self.legs_out.iter().zip(&self.rates).map(|(o, r)| o.torque * r).sum::<f64>() * dt;
         for (q, v) in self.q.iter_mut().zip(self.v) {
             *q += dt * v;
         }

@@ -35,7 +35,7 @@ pub use rft::RftScaling;
 pub use spread::{scaling_spread, ScalingSpread, SCALINGS};
 
 use crate::error::ParamError;
-use crate::gait::{measure_step, SmoothTrack, StepMeasure, REST_SPEED_FRACTION};
+use crate::gait::{SmoothTrack, StepMeasure, REST_SPEED_FRACTION};
 use crate::regime::{classify, Cause, Regime};
 use crate::scenario::{Scenario, SlopeEvaluation};
 use crate::slope::{SignedSlope, Slope};
@@ -586,8 +586,7 @@ pub fn simulate_with_leg(
             break;
         }
         let acc = run.per_step.get(k).copied().unwrap_or_default();
-        let step = measure_step(&track, t0, half);
-        let phase1 = phase1::phase_one(&track.speed, &run.groups, dt, t0, step.anchoring_time_s, half, k % 2);
+        let (step, phase1) = phase1::measure(&track, &run.groups, t0, half, k % 2);
         steps.push(SimStep {
             index: k,
             tripod: k % 2,

@@ -10,6 +10,38 @@
 use serde::Serialize;
 
 use super::dynamics::GroupForces;
+use crate::gait::{measure_step, SmoothTrack, StepMeasure};
+
+/// Measures the step of a simulated walk that starts at `t0` with tripod `tripod` touching
+/// down (steps of `half` s; `track` at full rate, sample i at `i dt`; `groups` as for
+/// [`phase_one`]): the step as `track` measures it (docs/model.md §11) and its phase 1, except
+/// that a step whose body never moves backwards has no phase 1 (docs/model.md §18): where the
+/// speed stays above minus the track's rest speed from touchdown to the anchoring time §11
+/// finds, t1 and the slip are 0.
+///
+/// Phase 1 is the paper's backward slip ("the instantaneous speed became negative (phase 1, t0
+/// to t1)"); a body that coasts forwards on its belly into touchdown (level sand) or rests on
+/// it (gentle slopes) has a speed minimum that is no slip's end: on level sand it is where the
+/// coasting body stops, a time the scheme's first-order error in the coasting speed moves by
+/// more than a millisecond at a quarter of the step (docs/simulate.md, "Why t1 did not
+/// converge").
+pub(crate) fn measure(
+    track: &SmoothTrack,
+    groups: &[GroupForces],
+    t0: f64,
+    half: f64,
+    tripod: usize,
+) -> (StepMeasure, PhaseOne) {
+    let dt = 1.0 / track.frame_rate_hz;
+    let mut step = measure_step(track, t0, half);
+    let mut phase1 = phase_one(&track.speed, groups, dt, t0, step.anchoring_time_s, half, tripod);
+    if step.anchoring_time_s.is_some_and(|t1| t1 > 0.0) && phase1.min_speed_m_s >= -track.rest_speed_m_s {
+        step.anchoring_time_s = Some(0.0);
+        step.slip_m = Some(0.0);
+        phase1 = phase_one(&track.speed, groups, dt, t0, Some(0.0), half, tripod);
+    }
+    (step, phase1)
+}
 
 /// Phase 1 of one step, `[t0, t0 + t1]` (at least one integration step).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]

@@ -37,6 +37,12 @@ impl Walker {
         self.rest_steps
     }
 
+    /// How many steps so far were taken as substeps because the belly struck the sand (tests).
+    #[cfg(test)]
+    pub(crate) fn strike_steps(&self) -> usize {
+        self.strike_steps
+    }
+
     /// How many legs the last step let another leg's contacts stand for (tests).
     #[cfg(test)]
     pub(crate) fn coincident_legs(&self) -> usize {
@@ -53,11 +59,10 @@ impl Walker {
     /// them, J: the sum over steps and legs of the sand's torque resisting the leg (what the
     /// massless leg's motor gives) times the leg's rate times the step (tests).
     pub(crate) fn walk_with_work(&mut self, steps: usize) -> f64 {
-        let mut work = 0.0;
+        let before = self.motor_work;
         for _ in 0..steps {
             self.step(true);
-            work += self.legs_out.iter().zip(&self.rates).map(|(o, r)| o.torque * r).sum::<f64>() * self.dt;
         }
-        work
+        self.motor_work - before
     }
 }

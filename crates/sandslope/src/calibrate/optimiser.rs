@@ -7,11 +7,15 @@ use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 use super::model::Walked;
 use super::problem::Problem;
 
-/// A penalty term `(ln ratio - target) / tolerance` that holds `ln k_s(20)/k_s(0)` at `target`.
+/// What holds `ln k_s(20)/k_s(0)` at `target` (for its profile): the unknown `tied`, when
+/// given, is not searched but solved from the others so that the ratio is exactly the target
+/// ([`Problem::tied_value`]); a penalty term `(ln ratio - target) / tolerance` holds it where
+/// no tie is given or the tie would leave its bounds.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct RatioPenalty {
     pub target: f64,
     pub tolerance: f64,
+    pub tied: Option<usize>,
 }
 
 /// The least-squares problem handed to Levenberg-Marquardt: the unbounded coordinates `u` of the
@@ -31,6 +35,11 @@ impl LeastSquares<'_, '_> {
         for (k, &i) in self.free.iter().enumerate() {
             x[i] = self.problem.unknowns[i].value_at_unbounded(u[k]);
         }
+        if let Some(RatioPenalty { target, tied: Some(t), .. }) = self.penalty {
+            if let Some(v) = self.problem.tied_value(&x, t, target) {
+                x[t] = v;
+            }
+        }
         x
     }
 
@@ -41,7 +50,7 @@ impl LeastSquares<'_, '_> {
     /// The residuals at the values `x`, with the simulator's walks given or walked.
     fn residuals_of(&self, x: &[f64], walks: Option<&[Walked]>) -> DVector<f64> {
         let mut r = self.problem.residuals_with(x, walks);
-        if let Some(RatioPenalty { target, tolerance }) = self.penalty {
+        if let Some(RatioPenalty { target, tolerance, .. }) = self.penalty {
             let ln_ratio = self.problem.ratio(x).ln();
             r.push(if ln_ratio.is_finite() { (ln_ratio - target) / tolerance } else { 1e3 });
         }
@@ -175,7 +184,9 @@ pub(crate) fn minimise(
     fixed: &[usize],
     penalty: Option<RatioPenalty>,
 ) -> (Vec<f64>, f64) {
-    let free: Vec<usize> = (0..problem.unknowns.len()).filter(|i| !fixed.contains(i)).collect();
+    let tied = penalty.and_then(|p| p.tied);
+    let free: Vec<usize> =
+        (0..problem.unknowns.len()).filter(|i| !fixed.contains(i) && Some(*i) != tied).collect();
     if free.is_empty() {
         return (start.to_vec(), problem.objective(start));
     }

@@ -292,6 +292,29 @@ impl Problem<'_> {
         self.residuals(x).iter().map(|r| r * r).sum()
     }
 
+    /// The value of the force-test unknown `t` that makes k_s(20)/k_s(0) exactly `e^target`
+    /// with the other values of `x` (clamped to its bounds), or `None` when `t` is not a force
+    /// test's or no positive value does. The table is interpolated linearly, so both k_s(20) and
+    /// k_s(0) are linear in the one value `v` and `k_s(20) = e^target k_s(0)` is solved for it
+    /// directly (no walks: the plate scale cancels in the ratio).
+    pub fn tied_value(&self, x: &[f64], t: usize, target: f64) -> Option<f64> {
+        let u = &self.unknowns[t];
+        let Quantity::PlateShearStrength { point, .. } = u.quantity else {
+            return None;
+        };
+        let mut c = self.candidate(x);
+        let twenty = Slope::from_degrees(20.0).ok()?;
+        let mut ends = |v: f64| {
+            c.plate[point].1 = v;
+            (self.k_s(&c, twenty), self.k_s(&c, Slope::LEVEL))
+        };
+        let (top0, level0) = ends(0.0);
+        let (top1, level1) = ends(1.0);
+        let r = target.exp();
+        let v = (r * level0 - top0) / ((top1 - top0) - r * (level1 - level0));
+        (v.is_finite() && v > 0.0).then(|| v.clamp(u.lo, u.hi))
+    }
+
     /// k_s(20)/k_s(0) at `x`.
     pub fn ratio(&self, x: &[f64]) -> f64 {
         let c = self.candidate(x);

@@ -57,29 +57,8 @@ pub fn format_p(p: f64) -> String {
     }
 }
 
-/// `x` as `m.mm × 10ⁿ` with `decimals` digits after the point (superscript exponent), or
-/// plainly when `0.01 <= |x| < 10⁴`; the one number format of the report's text.
-pub fn sci(x: f64, decimals: usize) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let a = x.abs();
-    if (0.01..1e4).contains(&a) {
-        let digits = (decimals as i32 + 1 - a.log10().floor() as i32 - 1).max(0) as usize;
-        return format!("{x:.digits$}");
-    }
-    let text = format!("{x:.decimals$e}");
-    let (m, e) = text.split_once('e').unwrap_or((&text, "0"));
-    const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
-    let exp: String = e
-        .chars()
-        .map(|c| match c {
-            '-' => '⁻',
-            d => d.to_digit(10).map_or(d, |d| SUP[d as usize]),
-        })
-        .collect();
-    format!("{m} × 10{exp}")
-}
+/// The report's number format, shared by every front end (crate::format).
+pub use crate::format::powers_of_ten as sci;
 
 #[cfg(test)]
 mod tests {

@@ -1,12 +1,12 @@
 //! Phase 1 and the one-sided belly (issue 59 item 2; docs/model.md §20.5, docs/simulate.md
 //! "Phase 1: what holds the body at touchdown").
 
-use super::rft::Rft;
 use super::dynamics::GroupForces;
+use super::rft::Rft;
 use super::tests::{builtin_terrain, walker};
 use super::*;
-use crate::model::tests::paper_robot;
 use crate::gait::SmoothTrack;
+use crate::model::tests::paper_robot;
 use crate::model::G;
 use crate::robot::{Robot, RobotSpec};
 use crate::terrain::Ground;
@@ -371,7 +371,14 @@ fn no_backward_motion_is_no_phase_1() {
         for i in 1..speed.len() {
             position.push(position[i - 1] + 0.5 * (speed[i - 1] + speed[i]) * 1e-3);
         }
-        SmoothTrack { start_time_s: 0.0, frame_rate_hz: 1e3, position, speed, speed_noise_m_s: 1e-4, rest_speed_m_s: 1e-6 }
+        SmoothTrack {
+            start_time_s: 0.0,
+            frame_rate_hz: 1e3,
+            position,
+            speed,
+            speed_noise_m_s: 1e-4,
+            rest_speed_m_s: 1e-6,
+        }
     };
     let groups = vec![GroupForces::default(); 200];
     let (step, p) = phase1::measure(&track(0.0), &groups, 0.02, 0.1, 0);

@@ -43,5 +43,4 @@ impl Walker {
             rate < -STRIKE_SPEED_M_S && height + self.dt * rate < 0.0
         })
     }
-
 }

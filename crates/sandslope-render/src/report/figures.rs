@@ -43,7 +43,7 @@ pub fn page_figures(report: &Report) -> Result<Vec<PageFigure>> {
         .zip(&p.phase)
         .map(|((id, ..), panel)| format!("({}) {}", &id[4..], panel.terrain_regime))
         .collect();
-    let fig = PhaseFigure::new(&p.phase, 2, p.terrain_name.clone());
+    let fig = PhaseFigure::new(&p.phase, 2, report.plain_answer.terrain.clone());
     figures.push(PageFigure {
         id: "fig6".into(),
         title: "Phase diagrams: 0.35 kg and 1 kg, on level sand and at 24°".into(),

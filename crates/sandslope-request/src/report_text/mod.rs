@@ -10,6 +10,7 @@ mod answer;
 mod diagnosis;
 mod findings;
 mod inputs;
+mod labels;
 mod observations;
 mod simulator;
 mod warnings;
@@ -20,15 +21,22 @@ use answer::{plain_answer, summary};
 use diagnosis::word_diagnosis;
 use findings::{disagreements, goodness_of_fit};
 use inputs::inputs;
+use labels::{label_terrain_rows, terrain_name, title_figures};
 use observations::observation_items;
 use simulator::word_simulator;
 use warnings::warnings;
 
-/// Words `report`, built from `evidence`: its inputs table, its plain answer and summary,
+/// Words `report`, built from `evidence`: its labels (the figures' titles, the terrain's name,
+/// the terrain's rows on another robot), its inputs table, its plain answer and summary,
 /// its calibration's goodness-of-fit sentence, the diagnosis of an unreliable fit, the
 /// disagreements (the user's observations the model misses first), the simulator section's
 /// reasons and the warnings.
 pub fn word(report: &mut Report, evidence: &Evidence) {
+    if !sandslope::paper::is_papers_robot(&evidence.robot) {
+        label_terrain_rows(&mut report.paper_vs_model);
+    }
+    title_figures(&mut report.figures);
+    report.plain_answer.terrain = terrain_name(report);
     report.inputs = inputs(evidence, report.tracks_give_t1);
     report.summary.text = summary(&report.summary, &report.paper_vs_model);
     report.plain_answer.text = plain_answer(&report.plain_answer);
@@ -98,6 +106,11 @@ mod tests {
         let row = |name: &str| r.inputs.iter().find(|i| i.name == name).unwrap();
         assert_eq!(row("robot: leg contact area A_c").value, "4.0 × 10⁻⁴ m² (W R)");
         assert_eq!(row("observed speeds").provenance.kind, ProvenanceKind::Measured);
+        assert!(r.figures.iter().all(|f| !f.title.is_empty() && f.title != f.id), "{:?}", r.figures);
+        assert!(
+            !r.plain_answer.terrain.is_empty()
+                && r.plain_answer.text.starts_with(&format!("On {} the", r.plain_answer.terrain))
+        );
         let c = r.calibration.as_ref().unwrap();
         assert!(c
             .goodness_of_fit
@@ -129,6 +142,13 @@ mod tests {
             "{:?}",
             r.warnings
         );
+        // Only the terrain's two ratios are compared, labelled as the terrain's.
+        assert_eq!(r.paper_vs_model.len(), 2);
+        assert!(r
+            .paper_vs_model
+            .iter()
+            .all(|c| c.quantity.ends_with("(the terrain, against the paper's glass beads)")
+                && c.basis_note.starts_with("a property of the terrain alone")));
         assert!(
             r.plain_answer.text.contains("prediction for your robot, untested"),
             "{}",

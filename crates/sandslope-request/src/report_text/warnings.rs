@@ -15,7 +15,7 @@ pub(super) fn warnings(report: &Report, evidence: &Evidence) -> Vec<String> {
         out.push(another_robot(evidence));
     }
     out.extend(report.unused_tracks.iter().map(unused_track));
-    out.extend(report.simulator_left_out.as_ref().map(left_out));
+    out.extend(report.simulator_left_out.as_ref().map(|why| left_out(why, &report.plain_answer.terrain)));
     let unconverged: Vec<String> = report
         .simulator_convergence
         .iter()
@@ -55,15 +55,15 @@ fn unused_track(u: &UnusedTrack) -> String {
     format!("--tracks at {}° ({}): no {what} ({why}); not used", u.slope_deg, u.files.join(", "))
 }
 
-/// Why the simulator section is left out.
-fn left_out(why: &SimulatorLeftOut) -> String {
+/// Why the simulator section is left out; `terrain` is the model's terrain as the page names it.
+fn left_out(why: &SimulatorLeftOut, terrain: &str) -> String {
     let why = match why {
         SimulatorLeftOut::AtBound { name, value } => format!(
             "the model is the calibration on your observations, and its {name} ran to its search bound ({value:.3e}): \
              no terrain of yours, and so stiff that the simulator's walks would take minutes (see the calibration's \
              warnings and why it is unreliable)"
         ),
-        SimulatorLeftOut::Implausible { terrain, key, value, slope_deg } => {
+        SimulatorLeftOut::Implausible { key, value, slope_deg } => {
             let k = sandslope::terrain::K_PLAUSIBLE;
             format!(
                 "the model's terrain ({terrain}) has {key} = {value:.3e} N/m^3 at {slope_deg}°, outside the plausible \
@@ -107,14 +107,9 @@ mod tests {
     /// the slope and the range; a fit at its bound names the quantity and where it stopped.
     #[test]
     fn a_left_out_simulator_section_says_why() {
-        let w = left_out(&SimulatorLeftOut::Implausible {
-            terrain: "stiff".into(),
-            key: "k_s",
-            value: 3e10,
-            slope_deg: 0.0,
-        });
+        let w = left_out(&SimulatorLeftOut::Implausible { key: "k_s", value: 3e10, slope_deg: 0.0 }, "stiff");
         assert!(w.contains("(stiff) has k_s = 3.000e10 N/m^3 at 0°") && w.contains("1e3 to 1e10"), "{w}");
-        let w = left_out(&SimulatorLeftOut::AtBound { name: "plate_scale".into(), value: 1e4 });
+        let w = left_out(&SimulatorLeftOut::AtBound { name: "plate_scale".into(), value: 1e4 }, "sand");
         assert!(
             w.starts_with("the stride simulator section is left out: ")
                 && w.contains("plate_scale ran to its search bound (1.000e4)"),

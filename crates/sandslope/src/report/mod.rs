@@ -133,7 +133,7 @@ impl Evidence {
 pub struct FigureRecord {
     /// Id.
     pub id: String,
-    /// Title.
+    /// Title: the front end's, by id (empty as [`report`] returns it).
     pub title: String,
 }
 
@@ -176,8 +176,9 @@ pub struct Plots {
     /// The slope of the terrain's last point when it has several, degrees: beyond it the
     /// model's k_n and k_s are extrapolated (docs/model.md §1).
     pub last_point_deg: Option<f64>,
-    /// The terrain's name.
-    pub terrain_name: String,
+    /// The terrain's own name (`None`: unnamed, as a calibration's terrain; the front end
+    /// names it then).
+    pub terrain_name: Option<String>,
     /// The robot's stance duration T/2, s.
     pub stance_duration_s: f64,
     /// The robot's minimum robust step s_min, m.
@@ -313,7 +314,8 @@ pub enum SimulatorFitFailure {
 pub struct PlainAnswer {
     /// The robot's mass, kg.
     pub mass_kg: f64,
-    /// The terrain's name.
+    /// The terrain's name: worded by the front end from [`Plots::terrain_name`] (empty as
+    /// [`report`] returns it).
     pub terrain: String,
     /// The steepest slope of the grid up to which every slope from level is success, degrees
     /// (`None` when level ground is not).
@@ -365,7 +367,7 @@ fn plain_answer(plots: &Plots, unreliable: bool, untested: bool) -> PlainAnswer 
     let level = grid.first().and_then(|p| p.speed);
     PlainAnswer {
         mass_kg: plots.mass_kg,
-        terrain: plots.terrain_name.clone(),
+        terrain: String::new(),
         climbs_up_to_deg: last_success.map(deg),
         level_speed_m_s: level,
         speed_at_limit_m_s: last_success.and_then(|p| p.speed),
@@ -427,7 +429,7 @@ pub fn report(evidence: &Evidence) -> Result<Report, ParamError> {
     // The simulator takes fewer robots than the closed form (at most 64 stance legs, ...) and
     // walks no implausible terrain: either loses this section, with a warning, not the report.
     let at_bound = calibration.as_ref().and_then(|c| scope::terrain_at_bound(&c.fit, evidence));
-    let section = scope::simulator_walks(&robot, &terrain, &speeds, &plots.terrain_name, at_bound);
+    let section = scope::simulator_walks(&robot, &terrain, &speeds, at_bound);
     let (simulator, simulator_convergence, simulator_left_out) = match section {
         Ok(walks) => {
             plots.simulated = walks.free;
@@ -656,11 +658,7 @@ fn plots(
         repose_deg: terrain.spec().repose_deg,
         last_point_deg: (terrain.points().len() > 1)
             .then(|| terrain.points().last().map_or(0.0, |p| p.slope_deg)),
-        terrain_name: match terrain.name() {
-            Some(name) => name.to_string(),
-            None if evidence.has_own_observations() => "the terrain calibrated on your observations".into(),
-            None => "this terrain".into(),
-        },
+        terrain_name: terrain.name().map(str::to_string),
         stance_duration_s: robot.stance_duration(),
         min_step_m: robot.min_step(),
         mass_kg: robot.mass(),
@@ -680,30 +678,23 @@ fn plots(
     })
 }
 
-/// The figures in page order, the phase diagram's panels listed one by one.
+/// The figures in page order, the phase diagram's panels listed one by one (their titles are
+/// the front end's).
 fn figure_records(plots: &Plots, calibrated: bool) -> Vec<FigureRecord> {
-    let mut out = vec![("fig3a", "Speed against slope".to_string())];
+    let mut out = vec!["fig3a"];
     if !plots.strides.is_empty() {
-        out.push(("fig3b", "Speed within a stride".into()));
+        out.push("fig3b");
     }
-    out.extend([
-        ("fig4d", "Normal penetration resistance k_n".into()),
-        ("fig4h", "Shear strength k_s".into()),
-        ("fig5b", "Anchoring time against slope".into()),
-        ("fig5c", "Net step against slope".into()),
-    ]);
-    for (id, mass, slope) in PHASE_PANELS {
-        out.push((id, format!("Phase diagram, {mass} kg at {slope} deg")));
-    }
-    out.push(("risk", "Failure probability against slope".into()));
-    out.push(("step_budget", "Where the step goes against slope".into()));
+    out.extend(["fig4d", "fig4h", "fig5b", "fig5c"]);
+    out.extend(PHASE_PANELS.iter().map(|(id, ..)| *id));
+    out.extend(["risk", "step_budget"]);
     if !plots.simulated.is_empty() {
-        out.push(("simulator", "Stride simulator against the closed form".into()));
+        out.push("simulator");
     }
     if calibrated {
-        out.push(("calibration", "Joint calibration: observed against fitted speeds, and pulls".into()));
+        out.push("calibration");
     }
-    out.into_iter().map(|(id, title)| FigureRecord { id: id.into(), title }).collect()
+    out.into_iter().map(|id| FigureRecord { id: id.into(), title: String::new() }).collect()
 }
 
 #[cfg(test)]
@@ -852,7 +843,7 @@ mod tests {
         assert!(d.text.is_empty() && d.remedies.is_empty());
         assert!((d.stance_duration_s - 0.5).abs() < 1e-12);
         assert!(r.plain_answer.unreliable);
-        assert_eq!(r.plain_answer.terrain, "the terrain calibrated on your observations");
+        assert_eq!(r.plots.terrain_name, None);
     }
 
     /// The paper's own evidence on its terrain: nothing to diagnose when the fit does not flag
@@ -892,6 +883,7 @@ mod tests {
         let ids: Vec<&str> = r.paper_vs_model.iter().map(|c| c.id.as_str()).collect();
         assert_eq!(ids, paper::TERRAIN_ROWS);
         assert!(r.paper_vs_model.iter().all(|c| !c.quantity.contains("0.35") && c.agrees));
+        // The front end labels them as the terrain's (request/report_text/labels.rs).
         assert!((r.paper_vs_model[0].model_value.unwrap() - 0.4).abs() < 1e-12);
         assert_eq!((r.summary.independent, r.summary.independent_agree), (2, 2));
 

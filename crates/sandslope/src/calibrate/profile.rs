@@ -35,7 +35,8 @@ fn profile_at(problem: &Problem, target: Profiled, q: f64, from: &[f64]) -> (Vec
 }
 
 /// The force test whose value k_s(20)/k_s(0) is held by in its profile: the free one the ratio
-/// moves most with (in `ln`) at `x`, the later in the table on a tie.
+/// moves most with (in `ln`) at `x`, the later in the table on a tie (to round-off): on a
+/// table of tests at 0 and 20 degrees, the one at 20.
 ///
 /// Holding the ratio by a stiff penalty instead made every profile point a search whose first
 /// step is set by the penalty, not by the fit: with the simulator such a step from a warm start
@@ -50,7 +51,12 @@ fn ratio_tie(problem: &Problem, x: &[f64]) -> Option<usize> {
         let mut y = x.to_vec();
         y[j] *= 1.0 + 1e-6;
         let sensitivity = ((problem.ratio(&y).ln() - ln_ratio) / 1e-6).abs();
-        if sensitivity.is_finite() && best.is_none_or(|(_, b)| sensitivity >= b) {
+        // Within round-off of the best so far (two tests of a two-test table move the ratio
+        // equally, one up and one down), the later one.
+        if sensitivity.is_finite()
+            && sensitivity > 1e-9
+            && best.is_none_or(|(_, b)| sensitivity >= b * (1.0 - 1e-6))
+        {
             best = Some((j, sensitivity));
         }
     }
@@ -343,7 +349,7 @@ pub(crate) mod tests {
     /// a hundredth of the ratio's log). With the ratio held by a penalty instead of a tied force
     /// test, a profile point warm-started there settled in the basin where the legs sink and
     /// this end came out at 0.490 with the profile 0.5 above the minimum (docs/calibration.md).
-    /// About 1,800 walks (15 s of CPU): run by hand (`cargo test -p sandslope --lib
+    /// About 1,400 walks (12 to 14 s of CPU): run by hand (`cargo test -p sandslope --lib
     /// simulators_ratio_upper_end -- --ignored`), not in the suite's ten minutes.
     #[test]
     #[ignore]

@@ -35,7 +35,8 @@ fn profile_at(problem: &Problem, target: Profiled, q: f64, from: &[f64]) -> (Vec
 }
 
 /// The force test whose value k_s(20)/k_s(0) is held by in its profile: the free one the ratio
-/// moves most with (in `ln`) at `x`, the later in the table on a tie.
+/// moves most with (in `ln`) at `x`, the later in the table on a tie (to round-off): on a
+/// table of tests at 0 and 20 degrees, the one at 20.
 ///
 /// Holding the ratio by a stiff penalty instead made every profile point a search whose first
 /// step is set by the penalty, not by the fit: with the simulator such a step from a warm start
@@ -50,7 +51,12 @@ fn ratio_tie(problem: &Problem, x: &[f64]) -> Option<usize> {
         let mut y = x.to_vec();
         y[j] *= 1.0 + 1e-6;
         let sensitivity = ((problem.ratio(&y).ln() - ln_ratio) / 1e-6).abs();
-        if sensitivity.is_finite() && best.is_none_or(|(_, b)| sensitivity >= b) {
+        // Within round-off of the best so far (two tests of a two-test table move the ratio
+        // equally, one up and one down), the later one.
+        if sensitivity.is_finite()
+            && sensitivity > 1e-9
+            && best.is_none_or(|(_, b)| sensitivity >= b * (1.0 - 1e-6))
+        {
             best = Some((j, sensitivity));
         }
     }
@@ -286,6 +292,7 @@ pub(crate) mod tests {
         (m0, s0): (f64, f64),
         (m20, s20): (f64, f64),
         l0_range: (f64, f64),
+        n: usize,
     ) -> (f64, Vec<f64>) {
         let r = q.exp();
         // d/dP0 of ((P0 - m0)/s0)^2 + ((r P0 - m20)/s20)^2 = 0.
@@ -297,7 +304,6 @@ pub(crate) mod tests {
             (v, x(f))
         };
         let (a, b) = (l0_range.0.ln(), l0_range.1.ln());
-        let n = 40;
         let grid: Vec<f64> = (0..=n).map(|i| a + (b - a) * i as f64 / n as f64).collect();
         let values: Vec<f64> = grid.iter().map(|&g| at(g).0).collect();
         let k = (0..=n).min_by(|&i, &j| values[i].total_cmp(&values[j])).unwrap();
@@ -309,6 +315,67 @@ pub(crate) mod tests {
         } else {
             at(grid[k])
         }
+    }
+
+    /// The closed form's interval of k_s(20)/k_s(0) on the paper's evidence ends where the
+    /// brute-force profile ([`brute_force_ratio_profile`], no use of the fit's search) crosses
+    /// the minimum + 1: at each end the brute-force profile is 1 above the fit's minimum within
+    /// 0.01, and it is below 1 a hundredth inside the end and above 1 a hundredth outside it
+    /// (in `ln` of the ratio).
+    #[test]
+    fn the_closed_forms_ratio_interval_ends_where_the_brute_force_profile_crosses_one() {
+        let setup = paper_setup();
+        let problem = build(&setup, SpeedModel::ClosedForm, None).unwrap();
+        let start: Vec<f64> = problem.unknowns.iter().map(|u| u.start).collect();
+        let (best, s_min) = crate::calibrate::optimiser::minimise(&problem, &start, &[], None);
+        let iv = interval_for(&problem, Profiled::LnShearRatio, &best, s_min);
+        let profile = |q: f64| {
+            brute_force_ratio_profile(&problem, q, (1e5, 1.5e4), (4e4, 6e3), (1e5, 1e8), 40).0 - s_min
+        };
+        assert!(profile(iv.value.ln()) < 1e-3, "{iv:?}");
+        for (end, outward) in [(iv.lower, -1.0), (iv.upper, 1.0)] {
+            let q = end.ln();
+            let (at, inside, outside) =
+                (profile(q), profile(q - 0.01 * outward), profile(q + 0.01 * outward));
+            assert!((at - 1.0).abs() < 0.01, "end {end} of {iv:?}: profile {at}");
+            assert!(inside < 1.0 && outside > 1.0, "end {end}: {inside} inside, {outside} outside");
+        }
+    }
+
+    /// The simulator's k_s(20)/k_s(0) interval on the paper's evidence (the fit's walks) ends
+    /// where the brute-force profile says: its upper end, searched from the best point
+    /// `calibrate --model simulate` finds (given here as the start, to the bit: the search's
+    /// path depends on it), has the brute-force profile 1 above the minimum within 0.1 (about
+    /// a hundredth of the ratio's log). With the ratio held by a penalty instead of a tied force
+    /// test, a profile point warm-started there settled in the basin where the legs sink and
+    /// this end came out at 0.490 with the profile 0.5 above the minimum (docs/calibration.md).
+    /// About 1,400 walks (12 to 14 s of CPU): run by hand (`cargo test -p sandslope --lib
+    /// simulators_ratio_upper_end -- --ignored`), not in the suite's ten minutes.
+    #[test]
+    #[ignore]
+    fn the_simulators_ratio_upper_end_is_where_the_brute_force_profile_crosses_one() {
+        let t0 = std::time::Instant::now();
+        let setup = paper_setup();
+        let problem = build(&setup, SpeedModel::simulator_for_fit(), None).unwrap();
+        let walks = || problem.simulator.as_ref().unwrap().walks_run();
+        let best = [1.0393117657067235, 0.1, 97381.56325503981, 40993.99635036474];
+        let s_min = problem.objective(&best);
+        let q_best = problem.ratio(&best).ln();
+        let w0 = walks();
+        let walk = Walk { q_best, limit: q_best + 3.0, step0: 0.05, dir: 1.0 };
+        let (q_end, open) = interval_end(&problem, Profiled::LnShearRatio, &best, s_min, walk);
+        let (w1, t1) = (walks(), t0.elapsed());
+        let (at, x) = brute_force_ratio_profile(&problem, q_end, (1e5, 1.5e4), (4e4, 6e3), (3e4, 3e5), 20);
+        println!(
+            "best {best:?} {s_min}; end {} ({open}) in {} walks; brute force {} at {x:?}; {} walks, {t1:?}, {:?}",
+            q_end.exp(),
+            w1 - w0,
+            at - s_min,
+            walks(),
+            t0.elapsed()
+        );
+        assert!(!open);
+        assert!((at - s_min - 1.0).abs() < 0.1, "end {}: brute-force profile {}", q_end.exp(), at - s_min);
     }
 
     /// Diagnostic (run by hand, a few minutes; the library is optimised in test builds): the
@@ -332,7 +399,8 @@ pub(crate) mod tests {
             let (x, s) = profile_at(&problem, Profiled::LnShearRatio, f64::ln(r), &best);
             let (x2, s2) = profile_at(&problem, Profiled::LnShearRatio, f64::ln(r), &from);
             from = x2.clone();
-            let (sb, xb) = brute_force_ratio_profile(&problem, r.ln(), (1e5, 1.5e4), (4e4, 6e3), (1e4, 1e6));
+            let (sb, xb) =
+                brute_force_ratio_profile(&problem, r.ln(), (1e5, 1.5e4), (4e4, 6e3), (1e4, 1e6), 40);
             println!(
                 "  ratio {r}: search from best {:.4} at {x:?}; from previous {:.4}; brute force {:.4} at {xb:?}",
                 s - s_min,

@@ -13,7 +13,7 @@
 //! | 130, 143, 129 | interrupted by SIGINT (Ctrl-C), SIGTERM or SIGHUP (128 + the signal); temporary files removed, no output left |
 //!
 //! Whatever the code, a run that does not succeed leaves no output behind
-//! (`sandslope_io::files::discard_outputs`); the exceptions are code 4, whose outputs are
+//! (`sandslope_files::discard_outputs`); the exceptions are code 4, whose outputs are
 //! written and whose failure is the verdict on them, and `drive`, whose log is kept on every
 //! exit (it is the record of what the robot did; [`KeepLog`]).
 
@@ -109,7 +109,7 @@ pub fn exit_code(e: &anyhow::Error) -> i32 {
     }
     match io_kind(e) {
         Some(ErrorKind::BrokenPipe) => EXIT_OK,
-        _ if e.chain().any(|c| c.is::<sandslope_io::WriteError>()) => EXIT_OUTPUT,
+        _ if e.chain().any(|c| c.is::<sandslope_files::WriteError>()) => EXIT_OUTPUT,
         _ if keeps_outputs(e) => EXIT_WARNINGS,
         Some(kind) if !is_input_kind(kind) => EXIT_OUTPUT,
         _ => EXIT_USAGE,
@@ -138,7 +138,7 @@ pub fn exit_cleanly_on_stream_errors() {
             default(info);
             return;
         };
-        sandslope_io::files::discard_outputs();
+        sandslope_files::discard_outputs();
         if message.contains("Broken pipe") {
             std::process::exit(EXIT_OK);
         }
@@ -170,7 +170,7 @@ pub fn fail_writes_past_the_file_size_limit() {
 /// On SIGINT, SIGTERM or SIGHUP: remove this run's temporary files and exit with 128 plus the
 /// signal's number (130, 143, 129), as shells report a process the signal ended, so a killed
 /// run leaves nothing. The outputs of a run whose final renames have begun are all put in
-/// place first ([`sandslope_io::files::discard_outputs`] waits for them): never a mixed set.
+/// place first ([`sandslope_files::discard_outputs`] waits for them): never a mixed set.
 pub fn clean_up_on_signals() {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     // Failing to install the handler only loses the clean-up.
@@ -186,7 +186,7 @@ pub fn clean_up_on_signals() {
                 STOP.store(true, std::sync::atomic::Ordering::SeqCst);
                 continue;
             }
-            sandslope_io::files::discard_outputs();
+            sandslope_files::discard_outputs();
             std::process::exit(128 + signal);
         }
     });

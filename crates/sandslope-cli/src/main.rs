@@ -94,7 +94,7 @@ fn main() {
     // the server writes nothing of its own and serves for as long as it runs.
     let serving = matches!(cli.command, Command::Serve(_));
     if !serving {
-        sandslope_io::files::stage_outputs();
+        sandslope_files::stage_outputs();
     }
     let result = match run(cli) {
         // `report --strict` with warnings: the report is kept, the exit code gives the verdict.
@@ -102,7 +102,7 @@ fn main() {
         done => done.and_then(|()| finish()),
     };
     if let Err(e) = result {
-        sandslope_io::files::discard_outputs();
+        sandslope_files::discard_outputs();
         let code = error::exit_code(&e);
         if code == error::EXIT_OK {
             // Stdout was closed by the reader (`sandslope sweep --json | head`): nothing to say.
@@ -121,7 +121,7 @@ fn main() {
 /// the process's own exit would swallow it), then put every output in place and say so.
 fn finish() -> anyhow::Result<()> {
     std::io::stdout().flush().context("cannot write to standard output")?;
-    for path in sandslope_io::files::commit_outputs()? {
+    for path in sandslope_files::commit_outputs()? {
         let _ = writeln!(std::io::stderr(), "wrote {}", path.display());
     }
     Ok(())

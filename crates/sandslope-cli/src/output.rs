@@ -90,4 +90,4 @@ pub fn print_json<T: serde::Serialize>(value: &T) -> Result<()> {
 /// The context of a failure to write to stdout (exit code 3, or 0 for a closed pipe).
 pub const STDOUT: &str = "cannot write to standard output";
 
-pub use sandslope_io::files::{check_parent_exists, csv_string, write_atomic};
+pub use sandslope_files::{check_parent_exists, csv_string, write_atomic};

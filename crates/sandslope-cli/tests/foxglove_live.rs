@@ -8,7 +8,7 @@ use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use sandslope_io::bag::messages::{decode, Float64Array, JointState, StringMsg};
+use sandslope_bag::messages::{decode, Float64Array, JointState, StringMsg};
 use serde_json::{json, Value};
 use tungstenite::{ClientRequestBuilder, Message};
 

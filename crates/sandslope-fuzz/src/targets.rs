@@ -10,8 +10,8 @@ use sandslope::measure::Kind;
 use sandslope_io::measurements::{load_manifest, read_recording_with, read_trials, ReadOptions};
 use sandslope_io::mocap;
 use sandslope_io::observations::{load_speed_observations, load_step_observation};
-use sandslope_io::raster::read_raster;
 use sandslope_io::{load_anchoring_times, load_robot, load_speeds, load_terrain};
+use sandslope_raster::read_raster;
 
 /// How one input of a target is run.
 #[derive(Clone, Copy)]
@@ -78,8 +78,8 @@ fn unit<T>(r: Result<T>) -> Result<()> {
 /// A ROS 2 bag read every way the commands read one (docs/bags.md): its topics, a pose
 /// topic as `track` reads it, joint states as `infer --servo-log` reads them.
 fn read_bag(p: &Path) -> Result<()> {
-    use sandslope_io::bag::series::{read_capture, read_joint_states, EffortUnit, JointOptions};
-    let topics = unit(sandslope_io::bag::topics(p));
+    use sandslope_io::bag_series::{read_capture, read_joint_states, EffortUnit, JointOptions};
+    let topics = unit(sandslope_bag::topics(p));
     let poses = unit(read_capture(p, None, None));
     let options = JointOptions { topic: None, joints: None, legs: 6, effort: EffortUnit::Milliampere };
     // Accepted when the bag lists and one of its readings succeeds (a pose bag has no joints).
@@ -379,7 +379,7 @@ pub const TARGETS: &[Target] = &[
 /// 7 rows and in a window at each corner; maps over 2^22 cells are refused from the header,
 /// as `--max-memory` would refuse them.
 fn read_windows(p: &Path) -> Result<()> {
-    use sandslope_io::raster::open_height_windows;
+    use sandslope_io::height_windows::open_height_windows;
     let read = |p: &Path| -> Result<()> {
         let fits = |c: usize, r: usize, _whole: bool| -> Result<()> {
             anyhow::ensure!(c.saturating_mul(r) <= 1 << 22, "{c} x {r} cells is more than 2^22");

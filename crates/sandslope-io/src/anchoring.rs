@@ -7,7 +7,7 @@ use anyhow::{anyhow, bail, Result};
 
 use sandslope::{AnchoringObservation, Slope};
 
-use crate::files::read_text;
+use sandslope_files::read_text;
 
 /// One row of an anchoring-time file.
 #[derive(Debug, Clone, Copy, serde::Deserialize, serde::Serialize)]

@@ -9,7 +9,7 @@ use crate::presets::{is_default, PresetKind, PAPER_FORCE_TESTS};
 /// [`PAPER_FORCE_TESTS`] read as a terrain table.
 pub fn paper_force_tests() -> anyhow::Result<sandslope::Terrain> {
     let p = PAPER_FORCE_TESTS;
-    crate::robot_terrain::terrain_from_toml(p.toml, &crate::files::Source::Preset(p.name))
+    crate::robot_terrain::terrain_from_toml(p.toml, &sandslope_files::Source::Preset(p.name))
 }
 
 /// The force tests of a report: `forces` (a file or preset name) when given; else, on the

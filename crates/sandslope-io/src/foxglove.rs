@@ -12,9 +12,9 @@ use std::net::SocketAddr;
 
 use anyhow::Result;
 
-use crate::bag::messages::RosMessage;
 use crate::mcap_out::{cycle_joint_states, live_message, LiveRecord, RosSink};
 use crate::servo_log::ServoLogRow;
+use sandslope_bag::messages::RosMessage;
 
 /// The WebSocket subprotocol a Foxglove client asks for.
 pub const SUBPROTOCOL: &str = "foxglove.websocket.v1";
@@ -110,8 +110,8 @@ impl DriveStream {
     /// Starts the server on `addr` and says where to connect (on stderr).
     pub fn start(addr: &str) -> Result<DriveStream> {
         let server = LiveServer::start(addr, "sandslope drive")?;
-        use crate::bag::messages::{Float64Array, JointState, StringMsg};
-        server.advertise::<StringMsg>(crate::bag::series::RUN_TOPIC);
+        use sandslope_bag::messages::{Float64Array, JointState, StringMsg};
+        server.advertise::<StringMsg>(sandslope_bag::series::RUN_TOPIC);
         server.advertise::<JointState>("/joint_states");
         server.advertise::<JointState>("/sandslope/commands");
         server.advertise::<Float64Array>("/sandslope/live");
@@ -134,9 +134,9 @@ impl DriveStream {
     pub fn header(&self, meta: &[(&str, String)]) {
         let text: String = meta.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
         self.server.latch(
-            crate::bag::series::RUN_TOPIC,
+            sandslope_bag::series::RUN_TOPIC,
             now_ns(),
-            &crate::bag::messages::StringMsg { data: text },
+            &sandslope_bag::messages::StringMsg { data: text },
         );
     }
 
@@ -168,7 +168,7 @@ impl DriveStream {
         self.server.publish(
             "/sandslope/verdict",
             t_ns,
-            &crate::bag::messages::StringMsg { data: verdict.into() },
+            &sandslope_bag::messages::StringMsg { data: verdict.into() },
         );
     }
 }
@@ -183,7 +183,7 @@ pub fn play_simulation(
     slope_deg: f64,
     wait_s: f64,
 ) -> Result<()> {
-    use crate::bag::messages::{JointState, MarkerArray, PoseStamped, TfMessage};
+    use sandslope_bag::messages::{JointState, MarkerArray, PoseStamped, TfMessage};
     let mut server = LiveServer::start(addr, "sandslope simulate")?;
     server.advertise::<PoseStamped>("/sandslope/pose");
     server.advertise::<TfMessage>("/tf");

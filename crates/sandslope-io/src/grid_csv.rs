@@ -56,11 +56,11 @@ pub fn write_rows_file(
     rows: usize,
     row: &(dyn Fn(usize, &mut Vec<u8>) + Sync),
 ) -> Result<()> {
-    crate::files::write_output(path, |file| {
+    sandslope_files::write_output(path, |file| {
         let mut w = std::io::BufWriter::with_capacity(1 << 22, file);
         write_rows(&mut w, header, rows, row)
             .and_then(|_| w.flush())
-            .map_err(|source| crate::files::WriteError { path: path.to_path_buf(), source }.into())
+            .map_err(|source| sandslope_files::WriteError { path: path.to_path_buf(), source }.into())
     })
 }
 

@@ -11,7 +11,7 @@ use std::io::Cursor;
 
 use anyhow::{anyhow, Result};
 
-use crate::bag::messages::{
+use sandslope_bag::messages::{
     self as msg, ColorRgba, Header, JointState, Marker, MarkerArray, Point, Pose, PoseStamped, Quaternion,
     RosMessage, TfMessage, Time, Transform, TransformStamped,
 };
@@ -254,12 +254,12 @@ pub fn drive_mcap(
     meta: &[(&str, String)],
     verdict: &str,
 ) -> Result<Vec<u8>> {
-    use crate::bag::messages::StringMsg;
+    use sandslope_bag::messages::StringMsg;
     let offset = rows.iter().map(|r| r.time_s).fold(0.0f64, f64::min).abs();
     let mut out = McapOut::new()?;
     let text: String = meta.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
     out.write(
-        crate::bag::series::RUN_TOPIC,
+        sandslope_bag::series::RUN_TOPIC,
         ns(rows.first().map_or(0.0, |r| r.time_s), offset),
         &StringMsg { data: text },
     )?;
@@ -315,8 +315,8 @@ pub fn cycle_joint_states(cycle: &[crate::servo_log::ServoLogRow], t_ns: u64) ->
 }
 
 /// A live estimate as `/sandslope/live` carries it (one dimension labelled [`LIVE_FIELDS`]).
-pub fn live_message(l: &LiveRecord) -> crate::bag::messages::Float64Array {
-    use crate::bag::messages::{ArrayDimension, ArrayLayout, Float64Array};
+pub fn live_message(l: &LiveRecord) -> sandslope_bag::messages::Float64Array {
+    use sandslope_bag::messages::{ArrayDimension, ArrayLayout, Float64Array};
     let layout = ArrayLayout {
         dim: vec![ArrayDimension { label: LIVE_FIELDS.join(","), size: 10, stride: 10 }],
         data_offset: 0,
@@ -341,7 +341,7 @@ pub fn verdict_text<T: serde::Serialize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bag::messages::decode;
+    use sandslope_bag::messages::decode;
 
     /// A two-sample walk written and read back with the `mcap` crate's own reader: schemas,
     /// channels, message counts and one pose worked by hand.

@@ -15,7 +15,7 @@ use serde::Deserialize;
 use sandslope::measure::{disk_area, Kind, RawRecording, ShearPlate, TrialInput};
 use sandslope::Slope;
 
-use crate::files::{parse_toml, read_text, Source};
+use sandslope_files::{parse_toml, read_text, Source};
 
 /// `[penetration]`: the disk, by radius or area.
 #[derive(Debug, Clone, Deserialize)]
@@ -233,7 +233,7 @@ fn bag_keys(t: &TrialEntry, path: &Path) -> Result<Option<BagKeys>> {
     .filter(|k| k.1)
     .map(|k| k.0)
     .collect();
-    if !crate::bag::is_bag(path) {
+    if !sandslope_bag::is_bag(path) {
         if !given.is_empty() {
             bail!(
                 "{} are keys of a ROS 2 bag trial (a bag folder, .mcap or .db3 file), but {} is not one",
@@ -244,7 +244,7 @@ fn bag_keys(t: &TrialEntry, path: &Path) -> Result<Option<BagKeys>> {
         return Ok(None);
     }
     let axis = |key: &str, text: &str| {
-        crate::bag::wrench::parse_axis(text)
+        sandslope_bag::wrench::parse_axis(text)
             .ok_or_else(|| anyhow!("{key} = \"{text}\" must be one of x, y, z, -x, -y, -z"))
     };
     let force_axis = match &t.force_axis {
@@ -331,14 +331,14 @@ pub fn read_trials(manifest: &Manifest, options: ReadOptions) -> Result<Vec<Tria
 /// Reads one trial from a ROS 2 bag (docs/bags.md): one row per wrench message, its time, the
 /// intruder's position at its stamp and its force.
 pub fn read_bag_recording(path: &Path, keys: &BagKeys) -> Result<Recording> {
-    let options = crate::bag::wrench::LoadCellOptions {
+    let options = sandslope_bag::wrench::LoadCellOptions {
         force_topic: keys.force_topic.as_deref(),
         position_topic: keys.position_topic.as_deref(),
         frame: keys.frame.as_deref(),
         force_axis: keys.force_axis,
         position_axis: keys.position_axis,
     };
-    let s = crate::bag::wrench::read_load_cell(path, &options)?;
+    let s = sandslope_bag::wrench::read_load_cell(path, &options)?;
     let rows = s.time_s.len();
     let raw = RawRecording {
         time: Some(s.time_s.into_iter().map(Some).collect()),
@@ -402,7 +402,7 @@ pub fn read_recording_with(path: &Path, kind: Kind, options: ReadOptions) -> Res
     let mut rows = 0;
     for record in reader.records() {
         let record = record.map_err(|e| anyhow!("{here}: {e}"))?;
-        let line = record.position().map_or(0, |p| crate::files::record_line(&text, p));
+        let line = record.position().map_or(0, |p| sandslope_files::record_line(&text, p));
         // A line of only separators (or whitespace) is skipped, not counted.
         if record.iter().all(str::is_empty) {
             continue;

@@ -14,9 +14,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 
-use crate::bag::messages::{Header, MapMetaData, NavPath, OccupancyGrid, Point, Pose, PoseStamped, Time};
-use crate::files::{write_output, WriteError};
-use crate::raster::Raster;
+use sandslope_bag::messages::{Header, MapMetaData, NavPath, OccupancyGrid, Point, Pose, PoseStamped, Time};
+use sandslope_files::{write_output, WriteError};
+use sandslope_raster::Raster;
 
 /// The frame the maps are in (the DEM's projected coordinates, metres).
 pub const MAP_FRAME: &str = "map";
@@ -139,7 +139,7 @@ pub fn write_map_mcap(
         out.write(&topic, 0, &NavPath { header: header.clone(), poses })?;
     }
     let bytes = out.finish()?;
-    crate::files::write_atomic(path, &bytes)
+    sandslope_files::write_atomic(path, &bytes)
 }
 
 #[cfg(test)]

@@ -76,11 +76,11 @@ pub fn write_npy(w: &mut dyn Write, shape: &[usize], data: NpyData<'_>) -> std::
 
 /// Writes one `.npy` file atomically.
 pub fn write_npy_file(path: &Path, shape: &[usize], data: NpyData<'_>) -> Result<()> {
-    crate::files::write_output(path, |file| {
+    sandslope_files::write_output(path, |file| {
         let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
         write_npy(&mut w, shape, data)
             .and_then(|_| w.flush())
-            .map_err(|source| crate::files::WriteError { path: path.to_path_buf(), source }.into())
+            .map_err(|source| sandslope_files::WriteError { path: path.to_path_buf(), source }.into())
     })
 }
 
@@ -97,7 +97,7 @@ pub fn write_npy_dir(dir: &Path, arrays: &[(&str, Vec<usize>, NpyData<'_>)]) -> 
 /// Makes the `--npy` folder `dir` if it is missing, as `mkdir -p` would (a run that fails
 /// removes what it made); fails with a clear message if `dir` is a file.
 pub fn prepare_npy_dir(dir: &Path) -> Result<()> {
-    crate::files::create_output_dir(dir).map_err(|e| e.context(format!("--npy {}", dir.display())))
+    sandslope_files::create_output_dir(dir).map_err(|e| e.context(format!("--npy {}", dir.display())))
 }
 
 #[cfg(test)]

@@ -11,8 +11,8 @@ use anyhow::{anyhow, bail, Result};
 use sandslope::infer::{GaitObservation, MeanAnchoringTime};
 use sandslope::Slope;
 
-use crate::files::read_text;
 use crate::speeds::{read_speed_table, SpeedColumns};
+use sandslope_files::read_text;
 
 fn reader(text: &str) -> csv::Reader<&[u8]> {
     csv::ReaderBuilder::new()

@@ -82,7 +82,7 @@ mod tests {
     #[test]
     fn every_preset_parses_and_validates() {
         for p in PRESETS {
-            let source = crate::files::Source::Preset(p.name);
+            let source = sandslope_files::Source::Preset(p.name);
             let ok = match p.kind {
                 PresetKind::Robot => crate::robot_terrain::robot_from_toml(p.toml, &source).is_ok(),
                 PresetKind::Terrain => crate::robot_terrain::terrain_from_toml(p.toml, &source).is_ok(),

@@ -9,8 +9,8 @@ use anyhow::{anyhow, bail, Result};
 
 use sandslope::{Robot, RobotSpec, Terrain, TerrainSpec};
 
-use crate::files::{parse_toml, read_text, Source};
 use crate::presets::{self, PresetKind};
+use sandslope_files::{parse_toml, read_text, Source};
 
 /// Resolves `arg` to a preset of `kind` or a file: an existing path, or anything ending in
 /// `.toml`, is a file; otherwise it must be a preset name.

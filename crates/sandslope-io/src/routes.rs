@@ -9,8 +9,8 @@ use serde::Serialize;
 
 use sandslope::plan::{HeightSource, NoRoute, Objective, Route};
 
-use crate::files::{csv_string, write_atomic};
-use crate::raster::GeoRef;
+use sandslope_files::{csv_string, write_atomic};
+use sandslope_raster::GeoRef;
 
 /// A map coordinate without float noise from cell arithmetic: rounded to 15 significant
 /// digits and at most 9 decimals (a nanometre in a metric CRS, 0.1 mm in degrees), so
@@ -60,7 +60,7 @@ pub fn write_geojson(path: &Path, geo: &GeoRef, routes: &Routes) -> Result<()> {
     // RFC 7946 GeoJSON is longitude, latitude on WGS84; routes on a projected map are in its
     // own coordinates, so the CRS is named beside them the way GDAL and QGIS read it (the
     // 2008 GeoJSON `crs` member), when the GeoKeys give its EPSG code.
-    if let Some(code) = geo.geokeys.as_deref().and_then(crate::crs::projected_epsg) {
+    if let Some(code) = geo.geokeys.as_deref().and_then(sandslope_raster::crs::projected_epsg) {
         let mut crs = serde_json::Map::new();
         crs.insert("type".into(), "name".into());
         crs.insert(

@@ -28,7 +28,7 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::files::Source;
+use sandslope_files::Source;
 
 /// One row of the servo log.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -171,7 +171,7 @@ impl FlightLog {
             .write(true)
             .create_new(true)
             .open(path)
-            .map_err(|source| crate::WriteError { path: path.to_path_buf(), source })?;
+            .map_err(|source| sandslope_files::WriteError { path: path.to_path_buf(), source })?;
         let mut out = std::io::BufWriter::new(file.try_clone()?);
         for key in STATUS_KEYS {
             out.write_all(&status_line(key, if key == "status" { INCOMPLETE } else { "" }))?;

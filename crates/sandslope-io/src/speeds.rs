@@ -7,7 +7,7 @@ use anyhow::{anyhow, bail, Result};
 
 use sandslope::{Slope, SpeedObservation};
 
-use crate::files::{read_text, record_line};
+use sandslope_files::{read_text, record_line};
 
 /// One row of a speeds file (`slope_deg,speed_m_s,speed_sd_m_s`, as `data/paper-speeds.csv`).
 #[derive(Debug, Clone, Copy, serde::Deserialize, serde::Serialize)]

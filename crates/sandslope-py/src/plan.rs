@@ -9,8 +9,8 @@ use numpy::{PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use sandslope_io::pds3::Pds3Dtm;
-use sandslope_io::raster::read_raster as read;
+use sandslope_raster::pds3::Pds3Dtm;
+use sandslope_raster::read_raster as read;
 use sandslope_request::plan::{ClassRaster, GridPlanRequest, GridRequest, GridSource, RouteRecord};
 
 use crate::arrays::put;
@@ -171,7 +171,7 @@ fn route_arrays(d: &Bound<'_, PyDict>, c: sandslope_request::plan::RouteCells) -
 /// `read_raster` honours it (the Dask raster reads windows itself and marks the same cells).
 #[pyfunction]
 pub fn geotiff_nodata(path: PathBuf) -> PyResult<Option<f64>> {
-    sandslope_io::raster::geotiff_nodata(&path).map_err(crate::anyhow_error)
+    sandslope_raster::geotiff_nodata(&path).map_err(crate::anyhow_error)
 }
 
 /// The size, ground cell size and notes of a PDS3 DTM from its label alone, checked against

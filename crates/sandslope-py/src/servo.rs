@@ -270,7 +270,7 @@ pub fn drive<'py>(
 /// A ROS 2 bag's topics (docs/bags.md): `(name, type, encoding, messages)` each.
 #[pyfunction]
 pub fn bag_topics(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Vec<(String, String, String, u64)>> {
-    let topics = py.detach(|| sandslope_io::bag::topics(&path)).map_err(anyhow_error)?;
+    let topics = py.detach(|| sandslope_bag::topics(&path)).map_err(anyhow_error)?;
     Ok(topics.into_iter().map(|t| (t.name, t.type_name, t.encoding, t.messages)).collect())
 }
 
@@ -285,7 +285,7 @@ pub fn read_bag_poses<'py>(
     frame: Option<String>,
 ) -> PyResult<(Bound<'py, PyDict>, String)> {
     let c = py
-        .detach(|| sandslope_io::bag::series::read_capture(&path, topic.as_deref(), frame.as_deref()))
+        .detach(|| sandslope_io::bag_series::read_capture(&path, topic.as_deref(), frame.as_deref()))
         .map_err(anyhow_error)?;
     let d = PyDict::new(py);
     let n = c.positions.len();
@@ -310,7 +310,7 @@ pub fn read_bag_load_cell<'py>(
     frame: Option<String>,
     position_axis: Option<String>,
 ) -> PyResult<(Bound<'py, PyDict>, String)> {
-    use sandslope_io::bag::wrench::{parse_axis, read_load_cell, LoadCellOptions};
+    use sandslope_bag::wrench::{parse_axis, read_load_cell, LoadCellOptions};
     let axis = |key: &str, text: &str| {
         parse_axis(text)
             .ok_or_else(|| value_error(format!("{key} = {text:?} must be one of x, y, z, -x, -y, -z")))
@@ -343,13 +343,13 @@ pub fn read_bag_joints<'py>(
     effort_unit: &str,
 ) -> PyResult<(Bound<'py, PyDict>, Vec<String>)> {
     let effort = effort_unit.parse().map_err(value_error)?;
-    let options = sandslope_io::bag::series::JointOptions {
+    let options = sandslope_io::bag_series::JointOptions {
         topic: topic.as_deref(),
         joints: joints.as_deref(),
         legs,
         effort,
     };
     let log =
-        py.detach(|| sandslope_io::bag::series::read_joint_states(&path, &options)).map_err(anyhow_error)?;
+        py.detach(|| sandslope_io::bag_series::read_joint_states(&path, &options)).map_err(anyhow_error)?;
     Ok((log_columns(py, &log.rows)?, log.notes))
 }

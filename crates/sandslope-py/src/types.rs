@@ -10,7 +10,7 @@ use pythonize::{depythonize, pythonize};
 
 use sandslope::robot_key::RobotKey;
 use sandslope::{Robot, RobotSpec, Slope, Terrain, TerrainSpec};
-use sandslope_io::files::{read_text, Source};
+use sandslope_files::{read_text, Source};
 use sandslope_io::presets::{self, PresetKind};
 use sandslope_io::{robot_from_toml, terrain_from_toml};
 

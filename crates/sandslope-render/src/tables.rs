@@ -91,11 +91,11 @@ pub fn risk_map_csv(map: &RiskMap, out: &mut dyn Write) -> std::io::Result<()> {
 /// [`risk_map_csv`] into the file `path` through the one output writer (nothing is left
 /// behind on failure; a write error names the file).
 pub fn write_risk_map_csv(path: &Path, map: &RiskMap) -> Result<()> {
-    sandslope_io::files::write_output(path, |file| {
+    sandslope_files::write_output(path, |file| {
         let mut w = std::io::BufWriter::with_capacity(1 << 22, file);
         risk_map_csv(map, &mut w)
             .and_then(|_| w.flush())
-            .map_err(|source| sandslope_io::WriteError { path: path.to_path_buf(), source }.into())
+            .map_err(|source| sandslope_files::WriteError { path: path.to_path_buf(), source }.into())
     })
 }
 

@@ -142,7 +142,7 @@ pub struct ServoLogQuestion {
     /// The bag's joint names in leg order (`--joints`), empty for the message's own order.
     pub joints: Vec<String>,
     /// What the bag's efforts hold (`--effort-unit`).
-    pub effort: sandslope_io::bag::series::EffortUnit,
+    pub effort: sandslope_io::bag_series::EffortUnit,
 }
 
 impl Fields for InferQuestion {
@@ -484,7 +484,7 @@ impl ServoLogRequest {
     }
 
     /// As [`read`](Self::read), for a log already read (a ROS 2 bag's joint states,
-    /// `sandslope_io::bag::series::read_joint_states`); `path` names it in errors.
+    /// `sandslope_io::bag_series::read_joint_states`); `path` names it in errors.
     pub fn read_log(
         &self,
         log: sandslope_io::servo_log::ServoLog,
@@ -588,7 +588,7 @@ mod tests {
         let q = InferQuestion::from_fields(&pairs(&[("servo-log", "run.csv"), ("joints", "a, b")])).unwrap();
         let InferQuestion::ServoLog(s) = q else { panic!("{q:?}") };
         assert_eq!((s.request.grid_points, s.request.slope_deg, s.joints.len()), (41, None, 2));
-        assert_eq!(s.effort, sandslope_io::bag::series::EffortUnit::NewtonMetre);
+        assert_eq!(s.effort, sandslope_io::bag_series::EffortUnit::NewtonMetre);
         let err = |list: &[(&str, &str)]| InferQuestion::from_fields(&pairs(list)).unwrap_err().message();
         assert_eq!(
             err(&[("observed", "s.csv"), ("topic", "/j")]),

@@ -415,8 +415,8 @@ pub fn track_captures(
         .iter()
         .map(|f| {
             // A ROS 2 bag (a folder with metadata.yaml, an .mcap or .db3 file) by its topic.
-            let c = if sandslope_io::bag::is_bag(f) {
-                sandslope_io::bag::series::read_capture(f, read.topic, read.frame)
+            let c = if sandslope_bag::is_bag(f) {
+                sandslope_io::bag_series::read_capture(f, read.topic, read.frame)
             } else {
                 mocap::read(f, read.format, read.body)
             };

@@ -11,7 +11,7 @@ use crate::reply::{ApiError, Reply};
 use crate::served::{stride, DemInfo, Served};
 use sandslope::Cause;
 use sandslope_io::presets::{PresetKind, PRESETS};
-use sandslope_io::raster::{read_raster, write_two_band_geotiff};
+use sandslope_raster::{read_raster, write_two_band_geotiff};
 use sandslope_request::plan::{DEM, GOAL, GOAL_PX, OBJECTIVE, START, START_PX};
 use sandslope_request::scenario::robot_fields;
 use sandslope_request::{phase, simulate, PhaseRequest, PlanRequest};

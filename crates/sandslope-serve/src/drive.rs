@@ -261,7 +261,7 @@ fn run(
     let driven = drive_logged(&mut session, target, &stop, &mut on_sample, &mut on_live);
     // The log in place now: the server serves on, and the outputs a later signal finds staged
     // are discarded (the CLI stages every output until its run succeeds).
-    let committed = sandslope_io::files::commit_outputs();
+    let committed = sandslope_files::commit_outputs();
     let emulator = session.close().map(|r| emulator_summary(&r));
     let (report, mut failure) = match driven {
         Ok((report, failure)) => (report, failure.map(|e| e.to_string())),

@@ -120,7 +120,7 @@ pub fn run(args: ServeConfig) -> Result<()> {
     // The run: its monitor's grid and its bus, before listening (a missing port fails here,
     // nothing having moved).
     if let Some(p) = &args.drive_log {
-        sandslope_io::files::check_parent_exists(p)?;
+        sandslope_files::check_parent_exists(p)?;
     }
     // The Foxglove server first: a port already taken stops the command before anything moves.
     let foxglove = match (&args.drive, &args.drive_foxglove) {

@@ -30,7 +30,7 @@ impl Served {
         sandslope_io::load_robot(&robot).with_context(|| ROBOT.long())?;
         sandslope_io::load_terrain(&terrain).with_context(|| TERRAIN.long())?;
         let dem_info = match &dem {
-            Some(path) => Some(DemInfo::of(&sandslope_io::raster::read_raster(path)?)),
+            Some(path) => Some(DemInfo::of(&sandslope_raster::read_raster(path)?)),
             None => None,
         };
         Ok(Served { robot, terrain, dem, dem_info })
@@ -56,7 +56,7 @@ pub struct DemInfo {
 
 impl DemInfo {
     /// What the page is told about this DEM.
-    pub fn of(r: &sandslope_io::raster::Raster) -> DemInfo {
+    pub fn of(r: &sandslope_raster::Raster) -> DemInfo {
         DemInfo {
             cols: r.cols,
             rows: r.rows,

@@ -658,5 +658,5 @@ fn write_mcap_log(
     let live: Vec<LiveRecord> = report.live.iter().map(live_record).collect();
     let verdict =
         sandslope_io::mcap_out::verdict_text(&report.outcome, failure.map(|e| e as &dyn std::fmt::Display));
-    sandslope_io::write_atomic(path, &drive_mcap(rows, &live, meta, &verdict)?)
+    sandslope_files::write_atomic(path, &drive_mcap(rows, &live, meta, &verdict)?)
 }

@@ -31,7 +31,7 @@ pub(super) fn zero(config: &DriveConfig, robot_path: &str) -> Result<()> {
     let directions: Vec<i8> = servos.iter().map(|s| s.direction).collect();
     let updated =
         sandslope_io::servo_zero::with_zero_offsets(&text, robot_path, &ids, &directions, &offsets)?;
-    sandslope_io::write_atomic(Path::new(robot_path), updated.as_bytes())?;
+    sandslope_files::write_atomic(Path::new(robot_path), updated.as_bytes())?;
     let list = |v: Vec<String>| v.join(", ");
     println!(
         "zero offsets of the {} servos IDs {}: [{}] pulses, written to {robot_path} ([servos] zero_offsets)",

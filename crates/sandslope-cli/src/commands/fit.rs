@@ -67,7 +67,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     // Outputs: the plot folder first (creating it is the step most likely to fail), then the
     // figures are drawn in memory and every file is written atomically.
     if let Some(dir) = &args.plot {
-        sandslope_io::files::create_output_dir(dir)
+        sandslope_files::create_output_dir(dir)
             .map_err(|e| e.context(format!("cannot create plot folder {}", dir.display())))?;
     }
     if let Some(out) = &args.out {

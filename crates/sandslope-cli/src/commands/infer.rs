@@ -59,15 +59,15 @@ fn run_servo_log(args: &InferArgs, question: &ServoLogQuestion) -> Result<()> {
     let servo = sandslope_io::robot_terrain::load_servos(&args.robot.robot)?
         .and_then(|s| s.model)
         .unwrap_or(&sandslope::servo::ServoModel::XL330_M288);
-    let mut run = if sandslope_io::bag::is_bag(path) {
+    let mut run = if sandslope_bag::is_bag(path) {
         // A ROS 2 bag's joint states, read as the servo log's leg angles and torques.
-        let options = sandslope_io::bag::series::JointOptions {
+        let options = sandslope_io::bag_series::JointOptions {
             topic: topic.as_deref(),
             joints: (!joints.is_empty()).then_some(joints.as_slice()),
             legs: 2 * robot.stance_legs() as usize,
             effort: *effort,
         };
-        let log = sandslope_io::bag::series::read_joint_states_of(path, &options, servo)?;
+        let log = sandslope_io::bag_series::read_joint_states_of(path, &options, servo)?;
         request.read_log(log, &robot, Words::Flag)?
     } else {
         if topic.is_some() || !joints.is_empty() {

@@ -16,7 +16,7 @@ use tungstenite::handshake::server::{ErrorResponse, Request, Response};
 use tungstenite::{Message, WebSocket};
 
 use super::{MAX_CLIENTS, QUEUE_MESSAGES, SUBPROTOCOL};
-use crate::bag::messages::{encode, RosMessage};
+use sandslope_bag::messages::{encode, RosMessage};
 
 /// A channel advertised to the viewers.
 struct Channel {

@@ -218,7 +218,7 @@ pub fn read(path: &Path, format: Option<MocapFormat>, body: Option<&str>) -> Res
 }
 /// Reads a touchdowns file: one time in seconds per line; blank lines and `#` comments skipped.
 pub fn load_touchdowns(path: &Path) -> Result<Vec<f64>> {
-    let text = crate::files::read_text(path)?;
+    let text = sandslope_files::read_text(path)?;
     let mut times = Vec::new();
     for (i, raw) in text.lines().enumerate() {
         let line = raw.split('#').next().unwrap_or("").trim();

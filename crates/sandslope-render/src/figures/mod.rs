@@ -29,7 +29,7 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use sandslope_io::write_atomic;
+use sandslope_files::write_atomic;
 
 /// Font family name under which the embedded DejaVu Sans is registered.
 pub const FONT: &str = "sans-serif";

@@ -10,7 +10,7 @@ use sandslope::plan::Objective;
 use sandslope::Regime;
 
 use sandslope::plan::PlanResult;
-use sandslope_io::raster::GeoRef;
+use sandslope_raster::GeoRef;
 
 use super::palette;
 use super::{font, ChartSetup, Figure};

@@ -14,7 +14,7 @@ use sandslope::{Robot, SpeedObservation};
 use super::palette;
 use super::{font, ChartSetup, Figure};
 use crate::plot_err;
-use sandslope_io::files::write_output;
+use sandslope_files::write_output;
 
 /// Tripod colours: tripod 0 blue, tripod 1 orange (legs of one tripod share the colour,
 /// front to rear from dark to light).

@@ -10,7 +10,7 @@ pub use figures::page_figures;
 use std::path::Path;
 
 use sandslope::report::{Report, TrackGap, TrackRecord};
-use sandslope_io::files::{create_output_dir, write_atomic};
+use sandslope_files::{create_output_dir, write_atomic};
 
 use crate::figures::palette;
 

@@ -14,7 +14,8 @@ use sandslope::plan::{
 };
 use sandslope::risk::{DefaultsUsed, UncertainTerrain};
 use sandslope::Robot;
-use sandslope_io::raster::{open_height_windows, read_heights_within, read_raster, HeightWindows, Raster};
+use sandslope_io::height_windows::{open_height_windows, HeightWindows};
+use sandslope_raster::{read_heights_within, read_raster, Raster};
 
 use crate::error::{RequestError, Result, Words};
 use crate::field::{Field, Fields, Table};
@@ -307,7 +308,7 @@ impl PlanRequest {
         let full_only = full_only || risk_map || self.classes.is_some();
         let dem_err = |e| RequestError::from_error(Some(DEM.flag), e);
         // The readers check what they allocate against the same limit.
-        sandslope_io::raster::set_memory_limit(
+        sandslope_raster::set_memory_limit(
             self.max_memory.filter(|gib| *gib > 0.0).map(|gib| (gib * (1u64 << 30) as f64) as u64),
         );
         // The header only (an ASCII grid is read whole): the search is chosen, and the DEM's
@@ -486,10 +487,10 @@ impl PlanRequest {
     }
 }
 
-/// For a map that wraps in longitude (sandslope_io::raster::wraps_in_longitude), the column
+/// For a map that wraps in longitude (sandslope_raster::wraps_in_longitude), the column
 /// roll that moves its edges opposite the endpoints, and the endpoints in the rolled map.
 fn across_seam(dem: &Raster, start: Cell, goal: Cell) -> Option<(usize, Cell, Cell)> {
-    use sandslope_io::raster::{rolled_column, seam_roll, wraps_in_longitude};
+    use sandslope_raster::{rolled_column, seam_roll, wraps_in_longitude};
     if !wraps_in_longitude(dem) {
         return None;
     }

@@ -8,7 +8,8 @@ use std::path::Path;
 use anyhow::anyhow;
 
 use sandslope::plan::{risk_map_from, HeightSource, RISK_BAND_CELLS};
-use sandslope_io::raster::{write_two_band_geotiff_by_rows, HeightWindows, Raster, TILE};
+use sandslope_io::height_windows::HeightWindows;
+use sandslope_raster::{write_two_band_geotiff_by_rows, Raster, TILE};
 
 use super::PlanRequest;
 use crate::error::{RequestError, Result};

@@ -11,8 +11,8 @@ use sandslope::plan::Objective;
 use crate::args::{FieldArgs, RobotArgs, TerrainArgs};
 use crate::figures::plan::PlanFigure;
 use crate::output::print_json;
-use sandslope_io::raster::write_two_band_geotiff;
 use sandslope_io::routes as writers;
+use sandslope_raster::write_two_band_geotiff;
 use sandslope_request::plan::{
     answer, corridor_answer, Computed, CorridorPlanned, PlanSearch, Planned, CLASSES,
 };

@@ -7,7 +7,7 @@
 //! here and written through its directory encoder with the baseline and tile tags. A raster
 //! whose samples exceed 3 GiB is written as BigTIFF (classic TIFF's offsets stop at 4 GiB).
 //! GDAL reads both; edge tiles are padded with NaN (nodata). The file goes through
-//! [`crate::files::write_output`]: nothing is put in place unless every row was written.
+//! [`sandslope_files::write_output`]: nothing is put in place unless every row was written.
 
 use std::io::{BufWriter, Seek, Write};
 use std::path::Path;
@@ -42,7 +42,7 @@ pub fn write_two_band_geotiff_by_rows(
         bail!("{name}: a {cols} x {rows} raster has no cells to write");
     }
     let big = cols as u64 * rows as u64 * 8 > BIG_TIFF_BYTES;
-    crate::files::write_output(path, |file| {
+    sandslope_files::write_output(path, |file| {
         let err = |e: tiff::TiffError| anyhow!("{name}: {e}");
         let out = BufWriter::new(file);
         if big {

@@ -6,7 +6,7 @@ use anyhow::{anyhow, bail, Result};
 
 use super::label::Label;
 use crate::crs::{Crs, GroundCells};
-use crate::raster::grid::GeoRef;
+use crate::grid::GeoRef;
 
 /// Where the DTM lies on its projection (projected metres) and on which sphere.
 #[derive(Debug, Clone, Copy)]

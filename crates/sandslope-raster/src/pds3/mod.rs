@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context, Result};
 
-use crate::raster::grid::{Raster, SizeCheck};
+use crate::grid::{Raster, SizeCheck};
 use label::{parse_label, Item, Label, Value};
 
 /// The largest PDS3 label read, in bytes (a HiRISE DTM's is about 10 KB).
@@ -50,7 +50,7 @@ pub fn read_pds3(path: &Path) -> Result<Raster> {
 }
 
 /// [`read_pds3`], with `fits(cols, rows)` called once the label gives the size and before the
-/// samples are read ([`crate::raster::read_raster_within`]).
+/// samples are read ([`crate::read_raster_within`]).
 pub fn read_pds3_within(path: &Path, fits: SizeCheck) -> Result<Raster> {
     let Described { label, data_path, offset, layout, mut notes } = describe(path)?;
     fits(layout.cols as usize, layout.rows as usize)?;
@@ -284,11 +284,11 @@ mod tests {
     use crate::crs::Crs;
 
     fn fixture_path(name: &str) -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pds3").join(name)
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/pds3").join(name)
     }
 
     fn fixture(name: &str) -> Raster {
-        crate::raster::read_raster(&fixture_path(name)).unwrap_or_else(|e| panic!("{name}: {e:#}"))
+        crate::read_raster(&fixture_path(name)).unwrap_or_else(|e| panic!("{name}: {e:#}"))
     }
 
     /// The script's hill: `height exp(-(((c - cx) / sx)^2 + ((r - cy) / sy)^2))`.
@@ -419,7 +419,7 @@ mod tests {
             }
             let path = dir.path().join(name);
             std::fs::write(&path, bytes).unwrap();
-            crate::raster::read_raster(&path).unwrap()
+            crate::read_raster(&path).unwrap()
         };
         // -2, 300, 7 (missing) / -32767 (LRS), 0, 1000 as little-endian 16-bit.
         let r = write(
@@ -450,7 +450,7 @@ mod tests {
         let path = dir.path().join("edited.img");
         std::fs::write(&path, &bytes).unwrap();
         let started = std::time::Instant::now();
-        let err = crate::raster::read_raster(&path).expect_err("must be refused");
+        let err = crate::read_raster(&path).expect_err("must be refused");
         assert!(started.elapsed().as_secs() < 5);
         let err = format!("{err:#}");
         assert!(err.contains("edited.img"), "{err}");
@@ -495,7 +495,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("erdas.img");
         std::fs::write(&path, b"EHFA_HEADER_TAG\0\0\0\0").unwrap();
-        let err = format!("{:#}", crate::raster::read_raster(&path).unwrap_err());
+        let err = format!("{:#}", crate::read_raster(&path).unwrap_err());
         assert!(err.contains("erdas.img: an ERDAS IMAGINE .img, not a PDS3 DTM"), "{err}");
     }
 
@@ -561,7 +561,7 @@ mod mutated {
     #[test]
     fn mutated_and_truncated_pds3_files_never_panic() {
         let dir = tempfile::tempdir().unwrap();
-        let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pds3");
+        let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/pds3");
         std::fs::copy(fixtures.join("dtm-detached.img"), dir.path().join("dtm-detached.img")).unwrap();
         let mut seed = 0x2545_F491_4F6C_DD1Du64;
         let mut next = move || {
@@ -593,7 +593,7 @@ mod mutated {
                     }
                 }
                 std::fs::write(&path, &bytes).unwrap();
-                if let Ok(r) = crate::raster::read_raster(&path) {
+                if let Ok(r) = crate::read_raster(&path) {
                     assert_eq!(r.values.len(), r.cols * r.rows);
                 }
             }

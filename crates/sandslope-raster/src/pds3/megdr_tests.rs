@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::crs::Crs;
-use crate::raster::read_raster;
+use crate::read_raster;
 
 /// A MEGDR-style label over `lines` x `samples` and its `.IMG` of heights `z(col, row)`
 /// (MSB_INTEGER), written to `dir`; `extra` replaces statements (`KEY = value` lines) by key.

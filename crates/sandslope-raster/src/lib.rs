@@ -1,7 +1,15 @@
+//! # sandslope-raster
+//!
 //! Raster files for `sandslope plan`: the format of a file decided by its extension or first
 //! bytes, and each read by its own module (GeoTIFF in [`geotiff`], ESRI ASCII grids in
-//! `ascii`, PDS3 DTMs in [`crate::pds3`]) into one [`Raster`] ([`grid`]); and a two-band
-//! float32 GeoTIFF writer georeferenced like the input.
+//! `ascii`, PDS3 DTMs in [`crate::pds3`]) into one [`Raster`] ([`grid`]), their coordinate
+//! reference systems ([`crs`]); a raster's heights read window by window
+//! ([`open_height_windows`]); and a two-band float32 GeoTIFF writer georeferenced like the
+//! input. Nothing here needs the `sandslope` library, so a first build compiles this crate
+//! beside it; the corridor search's `HeightSource` over these windows is sandslope-io's
+//! `height_windows`.
+
+#![warn(missing_docs)]
 
 use std::path::Path;
 
@@ -11,8 +19,11 @@ use crate::crs::Crs;
 
 mod ascii;
 mod chunks;
+pub mod crs;
 pub mod geotiff;
 pub mod grid;
+mod lzw_tiles;
+pub mod pds3;
 mod seam;
 mod tiles;
 mod windows;
@@ -25,7 +36,7 @@ pub use grid::{
 };
 pub use seam::{rolled_column, seam_roll, wraps_in_longitude};
 pub use tiles::{write_two_band_geotiff_by_rows, TILE};
-pub use windows::{open_height_windows, HeightWindows, WindowsCheck};
+pub use windows::{open_height_windows, RasterWindows, WindowsCheck};
 
 /// Reads a GeoTIFF (`.tif`, `.tiff`), an ESRI ASCII grid (`.asc`) or a PDS3 DTM (`.img` with
 /// its label attached or a `.lbl` beside it, or the `.lbl`; any file beginning with a PDS3

@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::raster::read_raster;
+use crate::read_raster;
 
 /// An attached-label DTM `name` written to `dir`: `label(n)` (its statements, with `n` the
 /// records of `record` bytes it takes, which its pointers count), then `header_records`
@@ -221,7 +221,8 @@ fn a_ctx_dtm_from_isis_reads_as_equirectangular_rows() {
 /// 19.4558 m at row 0 (latitude 20.0084, worked in docs/planning.md).
 #[test]
 fn an_equirectangular_geotiff_has_the_rows_of_its_pds3_twin() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pds3/dtm-attached.img");
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/pds3/dtm-attached.img");
     let r = read_raster(&path).unwrap();
     let g = &r.geo;
     let mut notes = Vec::new();

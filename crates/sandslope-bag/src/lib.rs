@@ -1,3 +1,5 @@
+//! # sandslope-bag
+//!
 //! ROS 2 bags as inputs (docs/bags.md): a bag folder as `ros2 bag record` writes it
 //! (`metadata.yaml` beside its `.mcap` or `.db3` files), or a single `.mcap` or `.db3` file,
 //! with CDR-encoded messages.
@@ -7,16 +9,19 @@
 //!   through the `mcap` crate's streaming reader, CRCs checked) or one row (SQLite3, through
 //!   `rusqlite`), whatever the bag's size.
 //! - [`messages`] holds the message types and their CDR decoding (`cdr-encoding`).
-//! - [`series`] turns a topic into what the commands take: a motion-capture [`Capture`] from
-//!   poses, odometry or a TF frame (`track --topic --frame`), a servo log from joint states
-//!   (`infer --servo-log`), a load-cell series from wrenches (`fit`).
+//! - [`series`] turns a topic of poses, odometry or a TF frame into a body's positions on a
+//!   regular grid of times (`track --topic --frame`; sandslope-io's `bag_series` makes them a
+//!   motion capture and reads joint states as a servo log), [`wrench`] a load-cell series from
+//!   wrenches (`fit`).
 //!
 //! Every error names the file, the topic and where in the file (the byte offset reached in an
 //! MCAP file, the message's row in a `.db3`), and nothing is returned from a bag that fails
 //! part-way: a truncated file, a chunk whose CRC does not match, an encoding other than CDR, a
 //! topic of another type, a declared message count no file of that size could hold.
 //!
-//! [`Capture`]: crate::mocap::Capture
+//! Nothing here needs the `sandslope` library, so a first build compiles this crate beside it.
+
+#![warn(missing_docs)]
 
 pub mod messages;
 pub mod series;
@@ -63,7 +68,7 @@ pub struct BagMessage<'a> {
 
 /// A message's time, ns: its header's stamp, or the time the recorder received it where the
 /// stamp is zero (a publisher that never set it).
-pub(crate) fn stamp_ns(header: &messages::Header, m: &BagMessage<'_>) -> i64 {
+pub fn stamp_ns(header: &messages::Header, m: &BagMessage<'_>) -> i64 {
     match header.stamp.nanos() {
         0 => m.log_time_ns.min(i64::MAX as u64) as i64,
         ns => ns,
@@ -202,7 +207,7 @@ pub fn open(path: &Path) -> Result<Bag> {
 
 fn open_folder(dir: &Path) -> Result<Bag> {
     let meta_path = dir.join("metadata.yaml");
-    let text = crate::files::read_text(&meta_path)
+    let text = sandslope_files::read_text(&meta_path)
         .with_context(|| format!("{}: not a ROS 2 bag folder (no readable metadata.yaml)", dir.display()))?;
     let meta: Metadata = serde_saphyr::from_str(&text)
         .map_err(|e| anyhow!("{}: {}", meta_path.display(), e.to_string().trim_end()))?;

@@ -488,7 +488,7 @@ pub fn write_two_band_geotiff(
     band2: &[f32],
 ) -> Result<()> {
     let name = path.display().to_string();
-    crate::files::write_output(path, |file| {
+    sandslope_files::write_output(path, |file| {
         let err = |e: tiff::TiffError| anyhow!("{name}: {e}");
         let mut enc = TiffEncoder::new(BufWriter::new(file))
             .map_err(err)?

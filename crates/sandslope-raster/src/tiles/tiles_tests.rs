@@ -8,7 +8,7 @@ use tiff::decoder::{Decoder, DecodingResult};
 use tiff::tags::Tag;
 
 use super::*;
-use crate::raster::{read_raster, write_two_band_geotiff};
+use crate::{read_raster, write_two_band_geotiff};
 
 /// The interleaved samples of a written two-band file, decoded by the `tiff` crate.
 fn samples(path: &Path) -> Vec<u32> {
@@ -30,7 +30,8 @@ fn geo_tags(path: &Path) -> Vec<String> {
 
 #[test]
 fn rows_written_band_by_band_are_the_whole_raster_s_samples() {
-    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal/geo-wgs84.tif");
+    let fixture =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal/geo-wgs84.tif");
     let geo = read_raster(&fixture).unwrap().geo;
     let dir = tempfile::tempdir().unwrap();
     // 300 x 530: two tiles across and three down, the last of each partial.
@@ -64,7 +65,8 @@ fn rows_written_band_by_band_are_the_whole_raster_s_samples() {
 
 #[test]
 fn missing_rows_or_a_failing_producer_leave_no_file() {
-    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal/geo-wgs84.tif");
+    let fixture =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal/geo-wgs84.tif");
     let geo = read_raster(&fixture).unwrap().geo;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("risk.tif");

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use super::*;
 
 fn fixture(dir: &str, name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(dir).join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures").join(dir).join(name)
 }
 
 #[test]
@@ -28,7 +28,7 @@ fn every_window_of_every_layout_is_the_whole_read_s_heights() {
     ];
     for (dir, name, tiff_chunks) in files {
         let path = fixture(dir, name);
-        let (whole, heights) = crate::raster::read_heights_within(&path, &|_, _| Ok(())).unwrap();
+        let (whole, heights) = crate::read_heights_within(&path, &|_, _| Ok(())).unwrap();
         let (raster, w) =
             open_height_windows(&path, &|_, _, _| Ok(())).unwrap_or_else(|e| panic!("{name}: {e:#}"));
         assert_eq!(

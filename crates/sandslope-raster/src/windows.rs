@@ -15,7 +15,6 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
-use sandslope::plan::HeightSource;
 use tiff::decoder::{ChunkType, Decoder};
 use tiff::tags::Tag;
 
@@ -28,8 +27,8 @@ use super::Format;
 const CACHE_BYTES: usize = 128 << 20;
 
 /// A raster opened for reading windows of its heights (metres as `f32`, NaN where there is no
-/// height): the corridor search's [`HeightSource`].
-pub struct HeightWindows {
+/// height); sandslope-io's `height_windows` makes it the corridor search's `HeightSource`.
+pub struct RasterWindows {
     name: String,
     cols: usize,
     rows: usize,
@@ -78,7 +77,7 @@ pub type WindowsCheck<'a> = &'a dyn Fn(usize, usize, bool) -> Result<()>;
 /// empty) and the windows. Reads the header (a GeoTIFF's directory, a PDS3 label, whose every
 /// chunk or line is checked to lie inside the file), then calls `fits`, and reads no sample;
 /// an ASCII grid is read whole after `fits`.
-pub fn open_height_windows(path: &Path, fits: WindowsCheck) -> Result<(Raster, HeightWindows)> {
+pub fn open_height_windows(path: &Path, fits: WindowsCheck) -> Result<(Raster, RasterWindows)> {
     let name = path.display().to_string();
     let whole = |fits: WindowsCheck| -> Result<(Raster, Kind)> {
         let (raster, heights) = super::read_heights_within(path, &|c, r| fits(c, r, true))?;
@@ -109,18 +108,18 @@ pub fn open_height_windows(path: &Path, fits: WindowsCheck) -> Result<(Raster, H
         row_widths = None;
     }
     let windows =
-        HeightWindows { name, cols: raster.cols, rows: raster.rows, cell_m, row_widths, kind, roll: 0 };
+        RasterWindows { name, cols: raster.cols, rows: raster.rows, cell_m, row_widths, kind, roll: 0 };
     Ok((raster, windows))
 }
 
-impl HeightWindows {
+impl RasterWindows {
     /// Whether the heights are held whole in memory (an ASCII grid, or a GeoTIFF the `tiff`
-    /// crate cannot decode chunk by chunk): then [`HeightWindows::into_heights`] gives them.
+    /// crate cannot decode chunk by chunk): then [`RasterWindows::into_heights`] gives them.
     pub fn is_in_memory(&self) -> bool {
         matches!(self.kind, Kind::Memory(_))
     }
 
-    /// The heights held in memory ([`HeightWindows::is_in_memory`]), row-major (rolled as
+    /// The heights held in memory ([`RasterWindows::is_in_memory`]), row-major (rolled as
     /// the windows are).
     pub fn into_heights(self) -> Option<Vec<f32>> {
         match self.kind {
@@ -137,7 +136,7 @@ impl HeightWindows {
     /// The windows of the map with its columns rolled by `shift` across the seam of a map that
     /// wraps in longitude (as [`Raster::rolled_columns`] rolls its georeference): column `j`
     /// is the file's column `(j + shift) % cols`.
-    pub fn rolled_columns(mut self, shift: usize) -> HeightWindows {
+    pub fn rolled_columns(mut self, shift: usize) -> RasterWindows {
         self.roll = (self.roll + shift) % self.cols;
         self
     }
@@ -170,7 +169,7 @@ impl HeightWindows {
         self.read_file(rows, cols)
     }
 
-    /// [`HeightWindows::read`] in the file's own columns.
+    /// [`RasterWindows::read`] in the file's own columns.
     fn read_file(&self, rows: Range<usize>, cols: Range<usize>) -> Result<Vec<f32>> {
         match &self.kind {
             Kind::Memory(h) => Ok(rows
@@ -186,26 +185,27 @@ impl HeightWindows {
     }
 }
 
-impl HeightSource for HeightWindows {
-    fn cols(&self) -> usize {
+impl RasterWindows {
+    /// Columns (west to east).
+    pub fn cols(&self) -> usize {
         self.cols
     }
-    fn rows(&self) -> usize {
+    /// Rows (north to south).
+    pub fn rows(&self) -> usize {
         self.rows
     }
-    fn cell_x(&self) -> f64 {
-        self.cell_m.0
+    /// Cell width (east-west) and height (north-south), m; the width is the reference one
+    /// when the rows differ ([`RasterWindows::row_widths`]).
+    pub fn cell_m(&self) -> (f64, f64) {
+        self.cell_m
     }
-    fn cell_y(&self) -> f64 {
-        self.cell_m.1
-    }
-    fn row_widths(&self) -> Option<&[f64]> {
+    /// The east-west size of each row's cells, m, when the rows differ.
+    pub fn row_widths(&self) -> Option<&[f64]> {
         self.row_widths.as_deref()
     }
-    fn window(&self, rows: Range<usize>, cols: Range<usize>) -> Result<Vec<f32>, String> {
-        self.read(rows, cols).map_err(|e| format!("{e:#}"))
-    }
-    fn band_rows(&self) -> usize {
+    /// How many rows a pass over the map reads at once: a whole number of the file's strips
+    /// or tiles (at least 256 rows), 256 where the file has no chunks.
+    pub fn band_rows(&self) -> usize {
         match &self.kind {
             Kind::Tiff(t) => t.ch.max(256usize.div_ceil(t.ch) * t.ch),
             _ => 256,

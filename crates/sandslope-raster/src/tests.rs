@@ -9,7 +9,7 @@ use tiff::tags::Tag;
 use super::*;
 
 fn fixture(name: &str) -> Raster {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal").join(name);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal").join(name);
     read_raster(&path).unwrap_or_else(|e| panic!("{name}: {e:#}"))
 }
 
@@ -19,7 +19,7 @@ fn fixture(name: &str) -> Raster {
 /// lzw_tiles.rs, an ASCII grid and a PDS3 DTM with special pixels.
 #[test]
 fn f32_heights_are_the_f64_values_rounded_with_nodata_as_nan() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures");
     let mut nodata_seen = 0;
     for name in [
         "gdal/f32-deflate-pred3-tiled.tif",
@@ -145,7 +145,7 @@ fn a_cog_reads_its_full_resolution_image_not_an_overview() {
 /// georeferenced by ground control points only (four tie points) are refused, naming the tag.
 #[test]
 fn rotated_and_gcp_georeferenced_rasters_are_refused_naming_the_tag() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal");
     let err = format!("{:#}", read_raster(&path.join("rotated.tif")).unwrap_err());
     assert!(err.contains("rotated.tif") && err.contains("ModelTransformationTag (34264)"), "{err}");
     // The rotation terms GDAL wrote: 0.2 and 0.1 arc-seconds.

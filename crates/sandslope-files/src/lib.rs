@@ -552,7 +552,7 @@ pub fn create_output_dir(dir: &Path) -> Result<()> {
 
 /// The line a record is on: the csv reader's position is where it began reading, before the
 /// blank lines and `#` comments it skipped, so those are stepped over here.
-pub(crate) fn record_line(text: &str, at: &csv::Position) -> u64 {
+pub fn record_line(text: &str, at: &csv::Position) -> u64 {
     let mut line = at.line();
     let mut rest = text.get(at.byte() as usize..).unwrap_or("");
     while let Some((first, after)) = rest.split_once('\n') {

@@ -145,22 +145,22 @@ fn an_ascii_grid_claiming_more_cells_than_its_bytes_is_refused() {
 #[test]
 fn the_memory_limit_refuses_a_raster_that_needs_more_naming_the_bytes() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/gdal/f32-deflate-pred3-tiled.tif");
-    let probe = crate::raster::read_raster(&path).unwrap();
+        .join("../sandslope-io/tests/fixtures/gdal/f32-deflate-pred3-tiled.tif");
+    let probe = crate::read_raster(&path).unwrap();
     assert_eq!((probe.cols, probe.rows), (40, 30));
-    crate::raster::set_memory_limit(Some(14_399));
-    let err = format!("{:#}", crate::raster::read_raster(&path).unwrap_err());
+    crate::set_memory_limit(Some(14_399));
+    let err = format!("{:#}", crate::read_raster(&path).unwrap_err());
     assert!(
         err.contains("40 x 30 = 1200 cells need 0.000 GiB to read (12 bytes a cell)")
             && err.contains("--max-memory limit"),
         "{err}"
     );
-    crate::raster::set_memory_limit(Some(14_400));
-    assert!(crate::raster::read_raster(&path).is_ok());
-    crate::raster::set_memory_limit(Some(4_799));
-    let err = format!("{:#}", crate::raster::read_heights_within(&path, &|_, _| Ok(())).unwrap_err());
+    crate::set_memory_limit(Some(14_400));
+    assert!(crate::read_raster(&path).is_ok());
+    crate::set_memory_limit(Some(4_799));
+    let err = format!("{:#}", crate::read_heights_within(&path, &|_, _| Ok(())).unwrap_err());
     assert!(err.contains("(4 bytes a cell)"), "{err}");
-    crate::raster::set_memory_limit(Some(4_800));
-    assert!(crate::raster::read_heights_within(&path, &|_, _| Ok(())).is_ok());
-    crate::raster::set_memory_limit(None);
+    crate::set_memory_limit(Some(4_800));
+    assert!(crate::read_heights_within(&path, &|_, _| Ok(())).is_ok());
+    crate::set_memory_limit(None);
 }

@@ -141,19 +141,19 @@ mod tests {
         // 2 and 3; big-endian; BigTIFF; a COG with overviews), decoded in parallel with no
         // size threshold, against the crate's own `read_image`: the same samples, byte for
         // byte, or a refusal (then `plan` decodes serially as before).
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gdal");
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sandslope-io/tests/fixtures/gdal");
         let mut parallel = Vec::new();
         let mut names: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
         names.sort();
         for path in names.iter().filter(|p| p.extension().is_some_and(|e| e == "tif")) {
-            let Ok(mut dec) = super::super::geotiff::open_full_resolution(path) else { continue };
+            let Ok(mut dec) = crate::geotiff::open_full_resolution(path) else { continue };
             let bits: u64 =
                 dec.find_tag_unsigned(tiff::tags::Tag::BitsPerSample).ok().flatten().unwrap_or(64);
-            let open = || super::super::geotiff::open_full_resolution(path).ok();
+            let open = || crate::geotiff::open_full_resolution(path).ok();
             let Some(mut image) = read_image_in_parallel(&mut dec, bits, usize::MAX, 0, open) else {
                 continue;
             };
-            let mut serial = super::super::geotiff::open_full_resolution(path).unwrap().read_image().unwrap();
+            let mut serial = crate::geotiff::open_full_resolution(path).unwrap().read_image().unwrap();
             assert_eq!(image.as_buffer(0).as_bytes(), serial.as_buffer(0).as_bytes(), "{}", path.display());
             parallel.push(path.file_name().unwrap().to_string_lossy().into_owned());
         }

@@ -8,7 +8,7 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Context, Result};
 
 use super::label::{parse_based, parse_number, Label, Value};
-use crate::raster::grid::check_raster_size;
+use crate::grid::check_raster_size;
 
 /// How samples are stored.
 #[derive(Debug, Clone, Copy)]

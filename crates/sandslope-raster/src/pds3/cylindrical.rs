@@ -18,7 +18,7 @@ use anyhow::{anyhow, bail, Result};
 
 use super::label::Label;
 use crate::crs::{Crs, Ellipsoid, GroundCells};
-use crate::raster::grid::GeoRef;
+use crate::grid::GeoRef;
 
 /// Degrees of difference between the label's stated extent and the computed one that still
 /// count as agreement: a hundredth of a pixel at 128 pixels a degree.

@@ -99,8 +99,10 @@ fn interval_end(problem: &Problem, target: Profiled, best: &[f64], s_min: f64, w
             // With the simulator, a point is warm-started from the nearest point inside the
             // interval (profile below +1), so the bracket follows the profile's branch from the
             // best value rather than a point outside, which may sit in another basin (the legs
-            // sinking). It is not enough on its own: k_s(20)/k_s(0)'s upper end still lands at
-            // 0.49 where the profile is 0.54 above the minimum (docs/calibration.md).
+            // sinking). With k_s(20)/k_s(0) held by a penalty it was not enough on its own (the
+            // upper end at 0.49, where the profile is 0.5 above the minimum); with the ratio
+            // held by a tied force test (`ratio_tie`) the ends are the brute-force profile's
+            // (docs/calibration.md).
             let inside_only = problem.simulator.is_some();
             let f = |q: f64| {
                 if let Some(p) = profiled.iter().find(|p| p.0 == q) {
@@ -349,7 +351,7 @@ pub(crate) mod tests {
     /// a hundredth of the ratio's log). With the ratio held by a penalty instead of a tied force
     /// test, a profile point warm-started there settled in the basin where the legs sink and
     /// this end came out at 0.490 with the profile 0.5 above the minimum (docs/calibration.md).
-    /// About 1,400 walks (12 to 14 s of CPU): run by hand (`cargo test -p sandslope --lib
+    /// About 1,800 walks (about 15 s of CPU): run by hand (`cargo test -p sandslope --lib
     /// simulators_ratio_upper_end -- --ignored`), not in the suite's ten minutes.
     #[test]
     #[ignore]

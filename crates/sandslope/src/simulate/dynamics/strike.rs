@@ -26,13 +26,15 @@ impl Walker {
             self.substep(gait);
             return;
         }
-        let (dt, time) = (self.dt, self.time);
+        let (dt, time, unconverged) = (self.dt, self.time, self.unconverged);
         self.dt = dt / STRIKE_SUBSTEPS as f64;
         for _ in 0..STRIKE_SUBSTEPS {
             self.substep(gait);
         }
         self.dt = dt;
         self.time = time + dt;
+        // The step is one step of the walk's count, however many of its substeps did not converge.
+        self.unconverged = self.unconverged.min(unconverged + 1);
         self.strike_steps += 1;
     }
 

@@ -5,7 +5,9 @@
 # repository root (reused on later runs), installs maturin, pytest, numpy, dask, distributed,
 # pandas, tifffile, zarr, xarray, dynamixel-sdk (the servo emulator's referee) and rasterio (whose wheels carry GDAL: the tests write every
 # GeoTIFF layout with it) into it from PyPI, builds and installs crates/sandslope-py into it, and
-# runs `cargo test --workspace --locked` and pytest. Environment:
+# runs `cargo test --workspace --locked`, pytest and a short fuzz pass (the install and the
+# fuzz pass's Rust half run beside the other stages, each one's output shown when it ends).
+# Environment:
 #   PYTHON=python3.11   interpreter that creates the venv (default: python3)
 #   SANDSLOPE_VENV=DIR  where the venv lives (default: .venv)
 set -euo pipefail

@@ -5,7 +5,9 @@
 # repository root (reused on later runs), installs maturin, pytest, numpy, dask, distributed,
 # pandas, tifffile, zarr, xarray, dynamixel-sdk (the servo emulator's referee) and rasterio (whose wheels carry GDAL: the tests write every
 # GeoTIFF layout with it) into it from PyPI, builds and installs crates/sandslope-py into it, and
-# runs `cargo test --workspace --locked` and pytest. Environment:
+# runs `cargo test --workspace --locked`, pytest and a short fuzz pass (the install and the
+# fuzz pass's Rust half run beside the other stages, each one's output shown when it ends).
+# Environment:
 #   PYTHON=python3.11   interpreter that creates the venv (default: python3)
 #   SANDSLOPE_VENV=DIR  where the venv lives (default: .venv)
 set -euo pipefail
@@ -21,19 +23,38 @@ export CARGO_INCREMENTAL=${CARGO_INCREMENTAL:-0}
 
 seconds() { date +%s; }
 t0=$(seconds)
+logs=$(mktemp -d)
+# On any exit: the Rust fuzz pass (below) is stopped, and the Python tools' install is waited
+# for (stopping pip midway would leave a broken venv for the next run).
+tools=
+fuzz=
+on_exit() {
+  [ -z "$fuzz" ] || kill "$fuzz" 2>/dev/null || true
+  [ -z "$tools" ] || wait "$tools" 2>/dev/null || true
+  rm -rf "$logs"
+}
+trap on_exit EXIT
 
-if [ ! -x "$venv/bin/python" ]; then
-  echo "== creating $venv"
-  "$python" -m venv "$venv"
-fi
 py="$venv/bin/python"
 # maturin's build backend runs the `maturin` program from PATH.
 export PATH="$venv/bin:$PATH"
-echo "== installing the Python test tools into $venv"
-"$py" -m pip install --quiet --disable-pip-version-check \
-  "maturin>=1.9,<2" "pytest>=7" "numpy>=1.21" "dask[array]>=2023.1" "distributed>=2023.1" \
-  "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1" "rasterio>=1.3" \
-  "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5" "dynamixel-sdk>=4.1" "pytest-xdist>=3"
+# The Python tools are downloaded and installed while cargo compiles: the install mostly waits
+# on the network and the disk (30 s of CI's 616 s before it ran beside the tests, 2026-12-07).
+# Its output is shown when it ends.
+echo "== installing the Python test tools into $venv (beside cargo test; its output follows the tests)"
+(
+  start=$(seconds)
+  if [ ! -x "$py" ]; then
+    echo "== creating $venv"
+    "$python" -m venv "$venv"
+  fi
+  "$py" -m pip install --quiet --disable-pip-version-check \
+    "maturin>=1.9,<2" "pytest>=7" "numpy>=1.21" "dask[array]>=2023.1" "distributed>=2023.1" \
+    "pandas>=1.5" "tifffile>=2023.1" "zarr>=2.13" "xarray>=2023.1" "rasterio>=1.3" \
+    "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5" "dynamixel-sdk>=4.1" "pytest-xdist>=3"
+  echo $(($(seconds) - start)) >"$logs/tools.s"
+) >"$logs/tools.log" 2>&1 &
+tools=$!
 t1=$(seconds)
 
 echo "== cargo test --workspace --locked"
@@ -44,6 +65,38 @@ cargo test --workspace --locked
 # CLI: 43 s of CI's fuzz stage (2026-12-07), and a fuzzed CLI other than the tested one.
 cargo build --workspace --locked --bins --tests
 t2=$(seconds)
+
+# The fuzz pass's Rust half (scripts/fuzz.sh with FUZZ_PREBUILT=1 and the Python targets left
+# to the end, its two halves run apart; docs/robustness.md): 200 mutated inputs per reader,
+# command and server target, one input at a time, so one core. It runs beside the extension's
+# build and pytest, whose output comes first; its own is shown when it ends.
+# Debug builds, already made above; any panic, abort, hang or peak over 1 GiB fails. Debug
+# builds: the 10 s hang limit is for release builds, and a debug `report` takes about 8 times
+# as long (2.3 s against 0.3 s on a mutated speeds table); on a machine shared with other
+# builds one such run passed 10 s (a false hang). 60 s keeps a real hang (which never ends) caught.
+fuzz_runs=200
+fuzz_seed=${FUZZ_SEED:-1}
+echo "== fuzz, short pass, Rust targets: $fuzz_runs mutated inputs per reader, command and server target (beside the next stages)"
+(
+  start=$(seconds)
+  target/debug/sandslope-fuzz --runs "$fuzz_runs" --seed "$fuzz_seed" --timeout 60 --bin target/debug/sandslope &
+  child=$!
+  trap 'kill "$child" 2>/dev/null' TERM
+  status=0
+  wait "$child" || status=$?
+  echo $(($(seconds) - start)) >"$logs/fuzz.s"
+  exit $status
+) >"$logs/fuzz.log" 2>&1 &
+fuzz=$!
+
+if ! wait "$tools"; then
+  tools=
+  cat "$logs/tools.log"
+  echo "error: installing the Python test tools into $venv failed (above)" >&2
+  exit 1
+fi
+tools=
+cat "$logs/tools.log"
 
 # Built in place (pip builds local directories in-tree), so Cargo uses the workspace's
 # target/ and its lock file. The tests build it in Cargo's dev profile, on the dependencies
@@ -67,13 +120,16 @@ SANDSLOPE_CLI="$root/target/debug/sandslope" "$py" -m pytest crates/sandslope-py
   -n "${PYTEST_WORKERS:-2}"
 t4=$(seconds)
 
-echo "== fuzz, short pass: 200 mutated inputs per reader, command and server target (scripts/fuzz.sh; docs/robustness.md)"
-# Debug builds, already made by cargo test above; any panic, abort, hang or peak over 1 GiB fails.
-# Debug builds: the 10 s hang limit is for release builds, and a debug `report` takes about 8
-# times as long (2.3 s against 0.3 s on a mutated speeds table); on a machine shared with other
-# builds one such run passed 10 s (a false hang). 60 s keeps a real hang (which never ends) caught.
-FUZZ_PREBUILT=1 FUZZ_PROFILE=debug FUZZ_TIMEOUT=60 SANDSLOPE_VENV="$venv" bash scripts/fuzz.sh 200
+echo "== fuzz, short pass, Python readers: the same $fuzz_runs inputs per reader through the package"
+"$py" scripts/fuzz_python.py --runs "$fuzz_runs" \
+  --seed "$fuzz_seed" --timeout 60 --fuzz-bin target/debug/sandslope-fuzz
+echo "== fuzz, short pass, Rust targets (started after cargo test):"
+fuzz_status=0
+wait "$fuzz" || fuzz_status=$?
+fuzz=
+cat "$logs/fuzz.log"
+[ "$fuzz_status" -eq 0 ] || { echo "error: the Rust fuzz pass failed (above)" >&2; exit 1; }
 t5=$(seconds)
 
 echo "== disk: target/ $(du -sh target 2>/dev/null | cut -f1), $venv $(du -sh "$venv" 2>/dev/null | cut -f1)"
-echo "== times: python tools $((t1 - t0)) s, cargo test $((t2 - t1)) s, extension build $((t3 - t2)) s, pytest $((t4 - t3)) s, fuzz $((t5 - t4)) s, total $((t5 - t0)) s"
+echo "== times: python tools $(cat "$logs/tools.s") s (beside cargo test), cargo test $((t2 - t1)) s, extension build $((t3 - t2)) s, pytest $((t4 - t3)) s, fuzz $((t5 - t4)) s after pytest (its Rust targets $(cat "$logs/fuzz.s") s, beside the extension and pytest), total $((t5 - t0)) s"

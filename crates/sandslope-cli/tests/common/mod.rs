@@ -33,6 +33,33 @@ pub fn json(args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
+/// The default report, `sandslope report --out DIR` with no other flag: its folder (read it,
+/// write nothing into it) and the command's stdout.
+pub struct DefaultReport {
+    /// The report's folder: index.html, report.json and the figures.
+    pub dir: PathBuf,
+    /// What the command printed on stdout.
+    pub stdout: String,
+}
+
+/// The default report, made once per test binary and shared by the tests that read it (five in
+/// tests/it: its page and JSON, its provenance notes, a browser's rendering, the simulator
+/// table and docs/phase-and-risk.md's numbers): one debug `report` is about 9 s of CPU, and
+/// each test made its own. The folder is `report-default` under Cargo's temporary folder for
+/// integration tests (target/tmp), rewritten by each run.
+pub fn default_report() -> &'static DefaultReport {
+    static REPORT: std::sync::OnceLock<DefaultReport> = std::sync::OnceLock::new();
+    REPORT.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-default");
+        if dir.exists() {
+            std::fs::remove_dir_all(&dir).unwrap();
+        }
+        let out = sandslope().args(["report", "--out"]).arg(&dir).assert().success();
+        let stdout = String::from_utf8(out.get_output().stdout.clone()).unwrap();
+        DefaultReport { dir, stdout }
+    })
+}
+
 /// Debian's `chromium` (or another Chromium on PATH) for the browser tests, or `None` after
 /// saying the test is skipped. With `CI=true` a missing browser fails the test instead: CI
 /// installs it (.ci/run), so a browser test must never pass there by skipping.

@@ -161,9 +161,8 @@ fn calibration_md_built_in_details_are_what_calibrate_gives() {
 /// docs/phase-and-risk.md's account of the 1 kg robot at 24 degrees, from `report`.
 #[test]
 fn phase_and_risk_md_extrapolation_numbers_are_what_report_gives() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("rep");
-    sandslope().args(["report", "--out"]).arg(&out).assert().success();
+    // The default report, made once for the tests that read it.
+    let out = &common::default_report().dir;
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     let x = &v["extrapolations"][0];

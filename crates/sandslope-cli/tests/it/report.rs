@@ -36,21 +36,22 @@ const IDS: [&str; 13] = [
     "calibration",
 ];
 
-fn make_report(dir: &Path) -> (String, serde_json::Value) {
-    let out = sandslope().args(["report", "--out"]).arg(dir).assert().success();
+/// The default report ([`common::default_report`], made once for the tests that read it): its
+/// folder, page and report.json.
+fn make_report() -> (&'static Path, String, serde_json::Value) {
+    let report = common::default_report();
+    let dir = report.dir.as_path();
     // The summary counts report.json's figures, the panels of fig6 one by one.
-    let stdout = String::from_utf8(out.get_output().stdout.clone()).unwrap();
+    let stdout = &report.stdout;
     assert!(stdout.starts_with(&format!("{} figures; ", IDS.len())), "{stdout}");
     let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
     let json = serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
-    (html, json)
+    (dir, html, json)
 }
 
 #[test]
 fn report_page_is_self_contained_and_json_has_the_documented_shape() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("report");
-    let (html, v) = make_report(&out);
+    let (_, html, v) = make_report();
     // Every figure inline, by the paper's ids; nothing fetched at view time.
     for id in PAGE_IDS {
         assert!(html.contains(&format!("<figure id=\"{id}\">")), "figure {id} missing");
@@ -206,8 +207,7 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
 /// floor, the per-slope inversion, the extrapolation at 24 deg and the step budget.
 #[test]
 fn the_default_report_says_where_every_number_comes_from() {
-    let dir = tempfile::tempdir().unwrap();
-    let (html, v) = make_report(&dir.path().join("report"));
+    let (_, html, v) = make_report();
     let kinds = ["measured", "assumed", "tuned", "derived"];
     for i in v["inputs"].as_array().unwrap() {
         let kind = i["provenance"]["kind"].as_str().unwrap_or_default();
@@ -372,8 +372,7 @@ fn report_renders_in_a_real_browser() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("report");
-    make_report(&out);
+    let (out, _, _) = make_report();
     let profile = tempfile::tempdir().unwrap();
     let shot = dir.path().join("shot.png");
     let status = std::process::Command::new(browser)

@@ -4,8 +4,6 @@
 
 use crate::common;
 
-use common::sandslope;
-
 /// The text of `html` with its tags removed.
 fn text(html: &str) -> String {
     let mut out = String::new();
@@ -23,9 +21,8 @@ fn text(html: &str) -> String {
 
 #[test]
 fn the_simulator_table_fits_the_page() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("rep");
-    sandslope().args(["report", "--out", out.to_str().unwrap()]).assert().success();
+    // The default report, made once for the tests that read it.
+    let out = &common::default_report().dir;
     let page = std::fs::read_to_string(out.join("index.html")).unwrap();
     // Its style: laid out at the page's width, not at its content's.
     assert!(page.contains("table.sim{table-layout:fixed;width:100%"), "no fixed layout for the table");

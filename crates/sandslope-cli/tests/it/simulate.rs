@@ -25,6 +25,8 @@ fn track_recovers(slope: &str, extra: &[&str], frames: f64) {
     let csv = dir.path().join("walk.csv");
     let mut args =
         vec!["simulate", "--slope", slope, "--duration", "10", "--json", "--out", csv.to_str().unwrap()];
+    // One walk, not the spread's three: the test is the walk's track.
+    args.extend_from_slice(&["--scaling-spread", "off"]);
     args.extend_from_slice(extra);
     let sim = json(&args);
     let steps = sim["steps"].as_array().unwrap();
@@ -85,6 +87,8 @@ fn track_with_default_settings_dates_the_simulated_anchoring_within_a_frame() {
             "--duration",
             "6",
             "--two-faced-belly",
+            "--scaling-spread",
+            "off",
             "--json",
             "--out",
             csv.to_str().unwrap(),
@@ -136,7 +140,7 @@ fn track_with_default_settings_dates_the_simulated_anchoring_within_a_frame() {
 
 #[test]
 fn json_has_the_summary_keys_and_the_closed_form_is_predicts() {
-    let sim = json(&["simulate", "--slope", "12", "--duration", "3", "--json"]);
+    let sim = json(&["simulate", "--slope", "12", "--duration", "3", "--json", "--scaling-spread", "off"]);
     for key in ["speed_m_s", "regime", "cause", "t1_s", "slip_m", "step_m", "steps", "closed_form"] {
         assert!(sim.get(key).is_some(), "{key} missing");
     }
@@ -166,17 +170,50 @@ fn body_pitch_locked_holds_the_body_parallel_to_the_slope() {
     assert!(String::from_utf8_lossy(&out.stdout).contains("one walk is one draw of a spread"));
     assert_eq!(free["creep_m_s"], 1e-7);
     assert!(free["servo_torque_limit_n_m"].is_null());
-    let li = json(&["simulate", "--slope", "20", "--duration", "1.5", "--json", "--rft-scaling", "li2013"]);
+    // The walks below whose spread the test does not read walk once (--scaling-spread off).
+    let li = json(&[
+        "simulate",
+        "--slope",
+        "20",
+        "--duration",
+        "1.5",
+        "--json",
+        "--rft-scaling",
+        "li2013",
+        "--scaling-spread",
+        "off",
+    ]);
     assert_eq!(li["rft_scaling"], "li2013");
     assert_ne!(li["speed_m_s"], free["speed_m_s"]);
-    let locked = json(&["simulate", "--slope", "20", "--duration", "3", "--json", "--body-pitch", "locked"]);
+    let locked = json(&[
+        "simulate",
+        "--slope",
+        "20",
+        "--duration",
+        "3",
+        "--json",
+        "--body-pitch",
+        "locked",
+        "--scaling-spread",
+        "off",
+    ]);
     assert_eq!(locked["body_pitch"], "locked");
     assert_eq!(locked["max_pitch_deg"], 0.0);
     assert!(locked["pitch_over_s"].is_null());
     assert_eq!(locked["closed_form"], free["closed_form"]);
     assert_eq!(free["rft_scaling"], "motion");
-    let components =
-        json(&["simulate", "--slope", "20", "--duration", "3", "--json", "--rft-scaling", "components"]);
+    let components = json(&[
+        "simulate",
+        "--slope",
+        "20",
+        "--duration",
+        "3",
+        "--json",
+        "--rft-scaling",
+        "components",
+        "--scaling-spread",
+        "off",
+    ]);
     assert_eq!(components["rft_scaling"], "components");
     assert_ne!(components["speed_m_s"], free["speed_m_s"]);
     // The table says which scaling ran, as the --slopes table does.

@@ -756,6 +756,30 @@ mod tests {
     use super::*;
     use crate::robot::RobotSpec;
 
+    /// A hand-made grid at 20 degrees (k_n 7e5): the profiles `mean` (one row a point of
+    /// `k_s`, two values a row) with no simulated scatter, one stride, every walk a success at
+    /// 0.1 m/s, `bins` bins a tripod, no run-up and a servo of stall torque `stall_n_m`.
+    fn grid_at_20_deg(k_s: Vec<f64>, mean: Vec<Vec<f64>>, bins: usize, stall_n_m: f64) -> ModelGrid {
+        let n = k_s.len();
+        ModelGrid {
+            slope_deg: 20.0,
+            k_n: 7e5,
+            k_s,
+            mean,
+            sd: vec![vec![0.0; 2]; n],
+            strides: 1,
+            regime: vec![Regime::Success; n],
+            shear_load_n: vec![0.0; n],
+            speed_m_s: vec![0.1; n],
+            bins,
+            swing_offset: false,
+            run_up_mean: vec![],
+            within_var: vec![0.0; 2],
+            run_up_within_var: vec![0.0; bins],
+            stall_torque_n_m: stall_n_m,
+        }
+    }
+
     /// The resolution term leaves out grid points a servo could not report, by the run's
     /// servo model. Three points, one bin, profiles 0.1, 0.2 and 1.0 N m, a stance reading 0.2
     /// with no noise: on the XL330-M288 (stall 0.52 N m) only the step 0.1 -> 0.2 counts, the
@@ -766,22 +790,9 @@ mod tests {
     #[test]
     fn the_reportable_torque_is_the_servo_models_by_hand() {
         let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
-        let grid = |servo: &'static ServoModel| ModelGrid {
-            slope_deg: 20.0,
-            k_n: 7e5,
-            k_s: vec![1e5, 2e5, 4e5],
-            mean: vec![vec![0.1, 0.0], vec![0.2, 0.0], vec![1.0, 0.0]],
-            sd: vec![vec![0.0; 2]; 3],
-            strides: 1,
-            regime: vec![Regime::Success; 3],
-            shear_load_n: vec![0.0; 3],
-            speed_m_s: vec![0.1; 3],
-            bins: 1,
-            swing_offset: false,
-            run_up_mean: vec![],
-            within_var: vec![0.0; 2],
-            run_up_within_var: vec![0.0; 1],
-            stall_torque_n_m: servo.stall_torque_n_m,
+        let grid = |servo: &'static ServoModel| {
+            let mean = vec![vec![0.1, 0.0], vec![0.2, 0.0], vec![1.0, 0.0]];
+            grid_at_20_deg(vec![1e5, 2e5, 4e5], mean, 1, servo.stall_torque_n_m)
         };
         let p =
             |servo| posterior_answer(&robot, &grid(servo), &[0.2, 0.0], &[0.0, 0.0], &[0], 1).posterior[1].1;
@@ -798,23 +809,7 @@ mod tests {
     #[test]
     fn a_common_offset_is_integrated_out_by_hand() {
         let robot = Robot::new(RobotSpec::paper_hexapod()).unwrap();
-        let grid = ModelGrid {
-            slope_deg: 20.0,
-            k_n: 7e5,
-            k_s: vec![1e5, 2e5],
-            mean: vec![vec![0.11, 0.21], vec![0.1, 0.2]],
-            sd: vec![vec![0.0; 2]; 2],
-            strides: 1,
-            regime: vec![Regime::Success; 2],
-            shear_load_n: vec![0.0; 2],
-            speed_m_s: vec![0.1; 2],
-            bins: 2,
-            swing_offset: false,
-            run_up_mean: vec![],
-            within_var: vec![0.0; 2],
-            run_up_within_var: vec![0.0; 2],
-            stall_torque_n_m: 100.0,
-        };
+        let grid = grid_at_20_deg(vec![1e5, 2e5], vec![vec![0.11, 0.21], vec![0.1, 0.2]], 2, 100.0);
         let v: f64 = 1.04e-4;
         let l = |c: f64| {
             let a = posterior_answer_common(&robot, &grid, &[0.11, 0.21], &[0.0, 0.0], &[0, 1], 1, c);

@@ -733,6 +733,13 @@ mod tests {
         }
     }
 
+    /// The report on [`evidence`], made once for the three tests that read it (a report walks
+    /// the simulator's section, seconds of CPU each time).
+    fn evidence_report() -> &'static Report {
+        static REPORT: std::sync::OnceLock<Report> = std::sync::OnceLock::new();
+        REPORT.get_or_init(|| report(&evidence()).unwrap())
+    }
+
     /// A pooled analysis of a known step profile (t1 = 0.12 s, 1,200 frames at 120 fps), with
     /// its speed SD and t1 SD replaced as given (`None`: fewer than two distinct values).
     fn tracked(slope_deg: f64, speed_sd: Option<f64>, t1_sd: Option<f64>) -> TrackedSlope {
@@ -751,7 +758,7 @@ mod tests {
 
     #[test]
     fn default_evidence_compares_the_papers_five_speeds_with_the_model() {
-        let r = report(&evidence()).unwrap();
+        let r = evidence_report();
         let slopes: Vec<f64> = r.speeds.iter().map(|s| s.slope_deg).collect();
         assert_eq!(slopes, [0.0, 10.0, 15.0, 20.0, 24.0]);
         // Each model speed is predict's on the terrain at that slope, independently evaluated.
@@ -798,7 +805,7 @@ mod tests {
     /// slope and not just above it, the speeds there, and the regime that follows.
     #[test]
     fn the_plain_answer_is_predicts_regimes_read_off_the_slope_grid() {
-        let r = report(&evidence()).unwrap();
+        let r = evidence_report();
         let a = &r.plain_answer;
         let t = terrain();
         let at = |d: f64| {
@@ -850,7 +857,7 @@ mod tests {
     /// itself, and the answer carries no such sentence.
     #[test]
     fn a_fit_without_warnings_has_no_diagnosis() {
-        let r = report(&evidence()).unwrap();
+        let r = evidence_report();
         let flagged = r.calibration.as_ref().is_some_and(|c| {
             c.fit.warnings.iter().any(|w| {
                 matches!(

@@ -22,7 +22,7 @@ pub mod drive;
 pub mod error;
 pub mod field;
 pub mod fit;
-pub mod format;
+pub use sandslope_format as format;
 pub mod grammar;
 pub mod infer;
 pub mod params;

@@ -4,7 +4,7 @@
 
 use sandslope::paper::Basis;
 use sandslope::report::{ProvenanceKind, Report, ReportCalibration};
-use sandslope_request::report_text::{format_p, sci};
+use sandslope_format::{powers_of_ten as sci, probability as format_p};
 
 use super::{escape, plus_minus};
 

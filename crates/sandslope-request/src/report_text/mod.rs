@@ -54,16 +54,8 @@ pub fn word(report: &mut Report, evidence: &Evidence) {
     report.warnings = warnings(report, evidence);
 }
 
-/// A probability as text: 2 significant digits, `< 10⁻³⁰⁰` below what a float holds.
-pub fn format_p(p: f64) -> String {
-    if p <= 0.0 {
-        "< 10⁻³⁰⁰".into()
-    } else if p >= 0.01 {
-        format!("{p:.2}")
-    } else {
-        sci(p, 1)
-    }
-}
+/// A probability as text (crate::format::probability).
+pub use crate::format::probability as format_p;
 
 /// The report's number format, shared by every front end (crate::format).
 pub use crate::format::powers_of_ten as sci;

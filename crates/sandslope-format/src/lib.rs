@@ -35,6 +35,17 @@ pub fn powers_of_ten(x: f64, decimals: usize) -> String {
     format!("{m} × 10{exp}")
 }
 
+/// A probability as text: 2 significant digits, `< 10⁻³⁰⁰` below what a float holds.
+pub fn probability(p: f64) -> String {
+    if p <= 0.0 {
+        "< 10⁻³⁰⁰".into()
+    } else if p >= 0.01 {
+        format!("{p:.2}")
+    } else {
+        powers_of_ten(p, 1)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,7 +7,7 @@
 use serde::Serialize;
 
 use crate::model::predict;
-use crate::regime::Regime;
+use crate::regime::{Cause, Regime};
 use crate::robot::Robot;
 use crate::slope::Slope;
 use crate::terrain::Terrain;
@@ -114,18 +114,21 @@ pub struct ComparisonContext {
     pub normal_ratio_input: bool,
 }
 
-/// One reported number beside the model's.
+/// One reported number beside the model's. The library decides the row (its values, whether
+/// the model agrees, the basis); the words a reader sees (`quantity`, `paper`, `model`,
+/// `rule`, `basis_note`) are left empty here and written by the front ends from [`Reading`]
+/// (sandslope-request's report words).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PaperComparison {
     /// Stable identifier (`speed_20`, `shear_ratio_20`, ...).
     pub id: String,
-    /// What is compared, in words.
+    /// What is compared, in words (empty from the library).
     pub quantity: String,
     /// Where in the paper.
     pub source: String,
-    /// The paper's value as reported.
+    /// The paper's value as reported (empty from the library).
     pub paper: String,
-    /// The model's value, formatted like the paper's.
+    /// The model's value, formatted like the paper's (empty from the library).
     pub model: String,
     /// The paper's number, when it is one.
     pub paper_value: Option<f64>,
@@ -133,12 +136,84 @@ pub struct PaperComparison {
     pub model_value: Option<f64>,
     /// Whether the model agrees, by `rule`.
     pub agrees: bool,
-    /// The rule used to decide.
+    /// The rule used to decide, in words (empty from the library; [`Reading`] names it).
     pub rule: String,
     /// Whether agreement here tests the model, or holds by construction.
     pub basis: Basis,
-    /// Why that basis.
+    /// Why that basis, in words (empty from the library).
     pub basis_note: String,
+    /// What the row compares, as values: what its words are written from.
+    #[serde(skip)]
+    pub reading: Reading,
+}
+
+/// What one comparison compares, as values (each variant's rule is the one
+/// [`compare_with_paper`] states).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Reading {
+    /// The speed at one of the paper's slopes (Fig. 3a), agreeing within 2 SD.
+    Speed {
+        /// The slope, degrees.
+        slope_deg: f64,
+        /// The paper's mean speed, m/s.
+        mean_m_s: f64,
+        /// The paper's SD, m/s.
+        sd_m_s: f64,
+        /// The model's speed, m/s (none when it predicts none).
+        speed_m_s: Option<f64>,
+        /// The model's regime there.
+        regime: Regime,
+        /// Why the stance ended in that regime.
+        cause: Cause,
+        /// Why the row has its basis.
+        why: SpeedBasis,
+    },
+    /// k_s(20)/k_s(0) against the paper's "about 0.40" (Fig. 4h), within 0.10.
+    ShearRatio {
+        /// The model terrain's ratio (none when k_s(0) is not positive).
+        ratio: Option<f64>,
+        /// Whether the paper's ratio was an input of the model.
+        input: bool,
+    },
+    /// k_n(20)/k_n(0) against the paper's "nearly unchanged" (Fig. 4d), within 0.15 of 1.
+    NormalRatio {
+        /// The model terrain's ratio (none when k_n(0) is not positive).
+        ratio: Option<f64>,
+        /// Whether k_n was assumed constant with slope.
+        input: bool,
+    },
+    /// Whether t1 rises strictly with slope over the paper's slopes (Fig. 5b).
+    T1Rises {
+        /// The model's t1 at each of the paper's slopes, s (none where the leg never anchors).
+        t1_s: Vec<Option<f64>>,
+    },
+    /// The time between tripod touchdowns T/2 against the paper's 0.5 s, within 1%.
+    StepPeriod {
+        /// The model's T/2, s.
+        half_s: f64,
+    },
+    /// The regime of a heavier robot at a steep slope against the paper's claim (Fig. 6d).
+    HeavyRobot {
+        /// The heavier robot's mass, kg.
+        mass_kg: f64,
+        /// The slope, degrees.
+        slope_deg: f64,
+        /// The paper's regime.
+        claim: Regime,
+        /// The model's regime, its step (m) and the cause (none when the mass is invalid).
+        model: Option<(Regime, Option<f64>, Cause)>,
+    },
+}
+
+/// Why a speed row is, or is not, a test of the model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpeedBasis {
+    /// The hip height was chosen to put the level-sand ceiling at the paper's level speed.
+    HipHeightTuned,
+    /// The model's k_s was fitted to the paper's five speeds.
+    FittedToSpeeds,
+    /// No input was fitted to the paper's speeds.
+    NothingFitted,
 }
 
 /// Evaluates `robot` on `terrain` at every number of docs/model.md §12.
@@ -165,28 +240,46 @@ fn at(deg: f64) -> Slope {
     Slope::from_degrees(deg).expect("paper slopes are valid")
 }
 
+/// A row with its words left to the front ends.
+fn row(id: String, source: &str, reading: Reading) -> PaperComparison {
+    PaperComparison {
+        id,
+        quantity: String::new(),
+        source: source.into(),
+        paper: String::new(),
+        model: String::new(),
+        paper_value: None,
+        model_value: None,
+        agrees: false,
+        rule: String::new(),
+        basis: Basis::Independent,
+        basis_note: String::new(),
+        reading,
+    }
+}
+
 /// The speed at each of the paper's slopes (Fig. 3a), within 2 SD.
 fn speed_rows(robot: &Robot, terrain: &Terrain, context: ComparisonContext) -> Vec<PaperComparison> {
     let mut rows = Vec::new();
     for &(deg, mean, sd) in &SPEEDS {
         let p = predict(robot, at(deg), &terrain.at(at(deg)));
         let agrees = p.speed.is_some_and(|v| (v - mean).abs() <= 2.0 * sd) && !p.regime.is_failure();
-        let (basis, basis_note) = speed_basis(deg, context);
+        let why = speed_basis(deg, context);
+        let reading = Reading::Speed {
+            slope_deg: deg,
+            mean_m_s: mean,
+            sd_m_s: sd,
+            speed_m_s: p.speed,
+            regime: p.regime,
+            cause: p.cause,
+            why,
+        };
         rows.push(PaperComparison {
-            id: format!("speed_{deg}"),
-            quantity: format!("speed at {deg} deg (0.35 kg)"),
-            source: "Sec. III-A, Fig. 3a".into(),
-            paper: format!("{:.2} ± {:.2} cm/s", mean * 100.0, sd * 100.0),
-            model: match p.speed {
-                Some(v) if !p.regime.is_failure() => format!("{:.2} cm/s ({})", v * 100.0, p.regime),
-                _ => format!("- ({}: {})", p.regime, p.cause.explain()),
-            },
             paper_value: Some(mean),
             model_value: p.speed,
             agrees,
-            rule: "within 2 SD".into(),
-            basis,
-            basis_note,
+            basis: if why == SpeedBasis::NothingFitted { Basis::Independent } else { Basis::Tuned },
+            ..row(format!("speed_{deg}"), "Sec. III-A, Fig. 3a", reading)
         });
     }
     rows
@@ -200,39 +293,27 @@ fn ratio_rows(terrain: &Terrain, context: ComparisonContext) -> [PaperComparison
     };
     let k_s_ratio = ratio(&|s| terrain.at(s).k_s);
     let shear = PaperComparison {
-        id: "shear_ratio_20".into(),
-        quantity: "k_s(20 deg) / k_s(0)".into(),
-        source: "Sec. III-C, Fig. 4h".into(),
-        paper: "about 0.40".into(),
-        model: k_s_ratio.map_or("-".into(), |r| format!("{r:.2}")),
         paper_value: Some(SHEAR_RATIO_20),
         model_value: k_s_ratio,
         agrees: k_s_ratio.is_some_and(|r| (r - SHEAR_RATIO_20).abs() <= 0.10),
-        rule: "within 0.10".into(),
         basis: if context.shear_ratio_input { Basis::Input } else { Basis::Independent },
-        basis_note: if context.shear_ratio_input {
-            "the force tests' 0.40 is an input of the calibration (held by its SD)".into()
-        } else {
-            "the model's k_s did not take the paper's ratio as input".into()
-        },
+        ..row(
+            "shear_ratio_20".into(),
+            "Sec. III-C, Fig. 4h",
+            Reading::ShearRatio { ratio: k_s_ratio, input: context.shear_ratio_input },
+        )
     };
     let k_n_ratio = ratio(&|s| terrain.at(s).k_n);
     let normal = PaperComparison {
-        id: "normal_ratio_20".into(),
-        quantity: "k_n(20 deg) / k_n(0)".into(),
-        source: "Sec. III-B, Fig. 4d".into(),
-        paper: "nearly unchanged (1)".into(),
-        model: k_n_ratio.map_or("-".into(), |r| format!("{r:.2}")),
         paper_value: Some(NORMAL_RATIO_20),
         model_value: k_n_ratio,
         agrees: k_n_ratio.is_some_and(|r| (r - NORMAL_RATIO_20).abs() <= 0.15),
-        rule: "within 0.15".into(),
         basis: if context.normal_ratio_input { Basis::Input } else { Basis::Independent },
-        basis_note: if context.normal_ratio_input {
-            "k_n was assumed constant with slope, as the paper's text says".into()
-        } else {
-            "the model's k_n did not take the paper's statement as input".into()
-        },
+        ..row(
+            "normal_ratio_20".into(),
+            "Sec. III-B, Fig. 4d",
+            Reading::NormalRatio { ratio: k_n_ratio, input: context.normal_ratio_input },
+        )
     };
     [shear, normal]
 }
@@ -243,22 +324,9 @@ fn t1_row(robot: &Robot, terrain: &Terrain) -> PaperComparison {
         SPEEDS.iter().map(|s| predict(robot, at(s.0), &terrain.at(at(s.0))).anchoring_time).collect();
     let rising = t1.windows(2).all(|w| matches!((w[0], w[1]), (Some(a), Some(b)) if b > a));
     PaperComparison {
-        id: "t1_rises".into(),
-        quantity: "anchoring time t1 rises with slope (0 to 24 deg)".into(),
-        source: "Sec. III-A, Fig. 5b".into(),
-        paper: "monotone increase".into(),
-        model: t1
-            .iter()
-            .map(|t| t.map_or("-".into(), |t| format!("{:.0}", t * 1000.0)))
-            .collect::<Vec<_>>()
-            .join(", ")
-            + " ms",
-        paper_value: None,
-        model_value: None,
         agrees: rising,
-        rule: "strictly increasing".into(),
         basis: Basis::Consequence,
-        basis_note: "any k_s that falls with slope makes d_s and so t1 rise (docs/model.md §4); the paper prints no t1 values to test".into(),
+        ..row("t1_rises".into(), "Sec. III-A, Fig. 5b", Reading::T1Rises { t1_s: t1 })
     }
 }
 
@@ -266,17 +334,11 @@ fn t1_row(robot: &Robot, terrain: &Terrain) -> PaperComparison {
 fn step_period_row(robot: &Robot) -> PaperComparison {
     let half = robot.stance_duration();
     PaperComparison {
-        id: "step_period".into(),
-        quantity: "time between tripod touchdowns, T/2".into(),
-        source: "Sec. III-A".into(),
-        paper: "0.5 s".into(),
-        model: format!("{half:.3} s"),
         paper_value: Some(TOUCHDOWNS_S[1]),
         model_value: Some(half),
         agrees: (half / TOUCHDOWNS_S[1] - 1.0).abs() <= 0.01,
-        rule: "within 1%".into(),
         basis: Basis::Input,
-        basis_note: "T/2 = π/ω follows from the paper's leg speed".into(),
+        ..row("step_period".into(), "Sec. III-A", Reading::StepPeriod { half_s: half })
     }
 }
 
@@ -285,31 +347,29 @@ fn heavy_robot_row(robot: &Robot, terrain: &Terrain) -> PaperComparison {
     let (mass, deg, claim) = HEAVY_ROBOT_CLAIM;
     let heavy = robot.with_mass(mass).ok().map(|r| predict(&r, at(deg), &terrain.at(at(deg))));
     PaperComparison {
-        id: "heavy_robot_24".into(),
-        quantity: format!("regime of a {mass} kg robot at {deg} deg"),
-        source: "Sec. IV, Fig. 6d".into(),
-        paper: claim.to_string(),
-        model: heavy.map_or("-".into(), |p| match p.step {
-            Some(s) => format!("{} (step {:.1} mm)", p.regime, s * 1000.0),
-            None => format!("{} ({})", p.regime, p.cause.explain()),
-        }),
-        paper_value: None,
         model_value: heavy.and_then(|p| p.step),
         agrees: heavy.is_some_and(|p| p.regime == claim),
-        rule: "same regime".into(),
-        basis: Basis::Independent,
-        basis_note: "no input was chosen to match it".into(),
+        ..row(
+            "heavy_robot_24".into(),
+            "Sec. IV, Fig. 6d",
+            Reading::HeavyRobot {
+                mass_kg: mass,
+                slope_deg: deg,
+                claim,
+                model: heavy.map(|p| (p.regime, p.step, p.cause)),
+            },
+        )
     }
 }
 
-/// The basis of the comparison of the speed at `deg`, and why.
-fn speed_basis(deg: f64, context: ComparisonContext) -> (Basis, String) {
+/// Why the speed at `deg` has its basis.
+fn speed_basis(deg: f64, context: ComparisonContext) -> SpeedBasis {
     if deg == 0.0 && context.tuned_to_level_speed {
-        (Basis::Tuned, "the hip height h was chosen to put the level-sand ceiling at this speed".into())
+        SpeedBasis::HipHeightTuned
     } else if context.fitted_to_paper_speeds {
-        (Basis::Tuned, "the model's k_s was fitted to the paper's five speeds".into())
+        SpeedBasis::FittedToSpeeds
     } else {
-        (Basis::Independent, "no input was fitted to the paper's speeds".into())
+        SpeedBasis::NothingFitted
     }
 }
 

@@ -174,6 +174,7 @@ mod tests {
             rule: String::new(),
             basis,
             basis_note: String::new(),
+            reading: sandslope::paper::Reading::StepPeriod { half_s: 0.5 },
         };
         let count = |rows: &[PaperComparison]| {
             let independent: Vec<&PaperComparison> =

@@ -12,6 +12,7 @@ mod findings;
 mod inputs;
 mod labels;
 mod observations;
+mod paper;
 mod simulator;
 mod warnings;
 
@@ -23,15 +24,17 @@ use findings::{disagreements, goodness_of_fit};
 use inputs::inputs;
 use labels::{label_terrain_rows, terrain_name, title_figures};
 use observations::observation_items;
+use paper::word_paper_rows;
 use simulator::word_simulator;
 use warnings::warnings;
 
-/// Words `report`, built from `evidence`: its labels (the figures' titles, the terrain's name,
+/// Words `report`, built from `evidence`: the comparison with the paper's numbers, its labels (the figures' titles, the terrain's name,
 /// the terrain's rows on another robot), its inputs table, its plain answer and summary,
 /// its calibration's goodness-of-fit sentence, the diagnosis of an unreliable fit, the
 /// disagreements (the user's observations the model misses first), the simulator section's
 /// reasons and the warnings.
 pub fn word(report: &mut Report, evidence: &Evidence) {
+    word_paper_rows(&mut report.paper_vs_model);
     if !sandslope::paper::is_papers_robot(&evidence.robot) {
         label_terrain_rows(&mut report.paper_vs_model);
     }

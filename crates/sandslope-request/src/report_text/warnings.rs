@@ -4,6 +4,8 @@
 //! own (a quantity at its search bound, a poor fit).
 
 use sandslope::report::{Evidence, Report, SimulatorFitFailure, SimulatorLeftOut, TrackGap, UnusedTrack};
+use sandslope::simulate::convergence::Refinement;
+use sandslope::simulate::ConvergenceCheck;
 
 use super::answer::another_robot;
 use super::findings::calibration_warnings;
@@ -16,18 +18,14 @@ pub(super) fn warnings(report: &Report, evidence: &Evidence) -> Vec<String> {
     }
     out.extend(report.unused_tracks.iter().map(unused_track));
     out.extend(report.simulator_left_out.as_ref().map(|why| left_out(why, &report.plain_answer.terrain)));
-    let unconverged: Vec<String> = report
-        .simulator_convergence
-        .iter()
-        .filter(|c| !c.converged)
-        .map(|c| format!("{}°", c.slope_deg))
-        .collect();
+    let unconverged: Vec<String> =
+        report.simulator_convergence.iter().filter(|c| !c.converged).map(unconverged_slope).collect();
     if !unconverged.is_empty() {
         out.push(format!(
-            "the stride simulator's pitch-locked walk is not converged at {} (a quarter of the time step or a \
-             tenth of the creep speed moves its speed by more than 3% and 0.3 cm/s, its t1 by more than 1 ms or its \
-             regime; docs/simulate.md, \"Checking convergence\"): read those rows with care",
-            unconverged.join(", ")
+            "the stride simulator's pitch-locked walk is not converged at {} (the tolerances: a quarter of the \
+             time step or a tenth of the creep speed must leave its speed within 3% or 0.3 cm/s, its t1 within \
+             1 ms and its regime; docs/simulate.md, \"Checking convergence\"): read those rows with care",
+            unconverged.join("; ")
         ));
     }
     out.extend(report.simulator_fit_failures.iter().map(|f| match f {
@@ -38,6 +36,46 @@ pub(super) fn warnings(report: &Report, evidence: &Evidence) -> Vec<String> {
         out.extend(calibration_warnings(c));
     }
     out
+}
+
+/// One unconverged slope and what moved: `22° (a quarter of the step: regime metastable to
+/// slippage, speed 0.02 to -0.05 cm/s)`; a regime that changes while the speed stays within
+/// its tolerance is a speed at the regimes' border.
+fn unconverged_slope(c: &ConvergenceCheck) -> String {
+    let moved: Vec<String> = c
+        .refinements
+        .iter()
+        .filter(|r| !r.converged)
+        .map(|r| {
+            let refined = match r.refinement {
+                Refinement::QuarterStep => "a quarter of the step",
+                Refinement::TenthCreep => "a tenth of the creep speed",
+            };
+            let mut what = Vec::new();
+            if !r.same_regime {
+                what.push(format!("regime {} to {}", c.walk.regime, r.answer.regime));
+            }
+            if !r.speed_within || !r.same_regime {
+                what.push(format!(
+                    "speed {:.2} to {:.2} cm/s",
+                    c.walk.speed_m_s * 100.0,
+                    r.answer.speed_m_s * 100.0
+                ));
+            }
+            if !r.t1_within {
+                let ms = |t: Option<f64>| t.map_or("-".to_string(), |t| format!("{:.1}", t * 1000.0));
+                what.push(format!("t1 {} to {} ms", ms(c.walk.t1_s), ms(r.answer.t1_s)));
+            }
+            if !r.spread_within {
+                what.push(format!("steps' spread {:+.2} cm/s", r.step_speed_sd_change_m_s * 100.0));
+            }
+            if !r.same_regime && r.speed_within {
+                what.push("a speed at the regimes' border".into());
+            }
+            format!("{refined}: {}", what.join(", "))
+        })
+        .collect();
+    format!("{}° ({})", c.slope_deg, moved.join("; "))
 }
 
 /// A tracked slope's anchoring time or speed not used, for the user's terminal.
@@ -115,5 +153,57 @@ mod tests {
                 && w.contains("plate_scale ran to its search bound (1.000e4)"),
             "{w}"
         );
+    }
+
+    /// The 22 degree walk as measured (0.02 cm/s, metastable; -0.05 cm/s, slippage at a quarter
+    /// of the step): within the speed's 0.3 cm/s, a regime changed: named with both speeds and
+    /// as a speed at the regimes' border; a t1 that moves 1.5 ms names both t1s.
+    #[test]
+    fn an_unconverged_slope_names_what_moved() {
+        use sandslope::regime::Regime;
+        use sandslope::simulate::convergence::{RefinedWalk, WalkAnswer};
+        let answer = |v: f64, t1: f64, regime| WalkAnswer {
+            dt_s: 5e-4,
+            creep_m_s: 1e-7,
+            speed_m_s: v,
+            speed_se_m_s: None,
+            step_speed_sd_m_s: 0.0,
+            t1_s: Some(t1),
+            regime,
+        };
+        let refined = |a: WalkAnswer, speed_within, t1_within, same_regime| RefinedWalk {
+            refinement: Refinement::QuarterStep,
+            answer: a,
+            speed_change_m_s: 0.0,
+            t1_change_s: None,
+            step_speed_sd_change_m_s: 0.0,
+            speed_within,
+            t1_within,
+            same_regime,
+            spread_within: true,
+            converged: false,
+        };
+        let check = |walk: WalkAnswer, r: RefinedWalk| ConvergenceCheck {
+            slope_deg: 22.0,
+            walks: 1,
+            walk,
+            refinements: vec![r],
+            converged: false,
+            speed_tolerance: 0.03,
+            speed_tolerance_m_s: 0.003,
+            t1_tolerance_s: 0.001,
+        };
+        let walk = answer(0.0002, 0.0080, Regime::Metastable);
+        let c = check(walk, refined(answer(-0.0005, 0.0081, Regime::Slippage), true, true, false));
+        assert_eq!(
+            unconverged_slope(&c),
+            format!(
+                "22° (a quarter of the step: regime {} to {}, speed 0.02 to -0.05 cm/s, a speed at the regimes' border)",
+                Regime::Metastable,
+                Regime::Slippage
+            )
+        );
+        let c = check(walk, refined(answer(0.0002, 0.0095, Regime::Metastable), true, false, true));
+        assert_eq!(unconverged_slope(&c), "22° (a quarter of the step: t1 8.0 to 9.5 ms)");
     }
 }

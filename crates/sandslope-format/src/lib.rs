@@ -1,7 +1,11 @@
 //! Number formatting for the text of every front end, in one place: the terminal's tables
 //! (`sandslope fit`, `phase`, `risk`, `infer`, which docs/inference.md quotes) write a strength
 //! as [`e_notation`] (`2.237e6`), the report's prose (report_text.rs, HTML and Markdown) as
-//! [`powers_of_ten`] (`2.24 × 10⁶`). JSON and CSV carry full precision and use neither.
+//! [`powers_of_ten`] (`2.24 × 10⁶`). JSON and CSV carry full precision and use neither. The
+//! regimes and their causes in words are [`Outcome`] and [`Explain`].
+
+mod words;
+pub use words::{Explain, Outcome};
 
 /// `x` in Rust's scientific notation with 3 digits after the point: `2.237e6`, `-4.536e4`,
 /// `4.000e-4`; 4 significant digits, so the terminal's table columns line up. The terminal's

@@ -91,7 +91,7 @@ fn _sandslope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_MAX_RISK", sandslope::risk::DEFAULT_MAX_RISK)?;
     m.add("DEFAULT_MAX_ROLL_DEG", sandslope::plan::DEFAULT_MAX_ROLL_DEG)?;
     m.add("REGIMES", sandslope::Regime::ALL.map(sandslope::Regime::name))?;
-    m.add("OUTCOMES", sandslope::Regime::ALL.map(sandslope::Regime::outcome))?;
+    m.add("OUTCOMES", sandslope::Regime::ALL.map(sandslope_request::format::Outcome::outcome))?;
     m.add("CAUSES", sandslope::Cause::ALL.map(sandslope::Cause::name))?;
     Ok(())
 }

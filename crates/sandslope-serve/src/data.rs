@@ -2,6 +2,7 @@
 //! map, a risk raster without routes (`/data/...`), and the files `plan` writes
 //! (`/download/...`), each computed by the same command code (docs/serve.md).
 
+use sandslope_request::format::{Explain, Outcome};
 use std::io::Write;
 
 use serde::Serialize;

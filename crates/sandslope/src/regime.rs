@@ -36,26 +36,6 @@ impl Regime {
         }
     }
 
-    /// What the robot does, in a field engineer's words (docs/model.md §6, "Outcomes"): `climbs
-    /// steadily` (success), `climbs slowly and may stall` (metastable: it progresses, but by
-    /// less than a robust step, each foothold in sand the last one disturbed), `slides back`
-    /// (slippage), `sinks` (sinkage). The one vocabulary of every page, table and sentence;
-    /// files and JSON keep [`Regime::name`].
-    pub fn outcome(self) -> &'static str {
-        match self {
-            Regime::Sinkage => "sinks",
-            Regime::Slippage => "slides back",
-            Regime::Metastable => "climbs slowly and may stall",
-            Regime::Success => "climbs steadily",
-        }
-    }
-
-    /// The outcome with the paper's regime name beside it: `climbs slowly and may stall
-    /// (metastable)`.
-    pub fn in_words(self) -> String {
-        format!("{} ({})", self.outcome(), self.name())
-    }
-
     /// Whether this regime counts as failure (sinkage or slippage; docs/model.md §9).
     pub fn is_failure(self) -> bool {
         matches!(self, Regime::Sinkage | Regime::Slippage)
@@ -125,24 +105,6 @@ impl Cause {
     /// negative one (a net backward step: the robot loses ground).
     pub fn rules_out_speed(self) -> bool {
         matches!(self, Cause::NormalSinkage | Cause::AtOrAboveRepose)
-    }
-
-    /// A one-line explanation for users.
-    pub fn explain(self) -> &'static str {
-        match self {
-            Cause::NormalSinkage => "legs sink: normal equilibrium depth d_n reaches the leg's reach 2R - h",
-            Cause::AtOrAboveRepose => {
-                "slope at or above the terrain's angle of repose: the surface itself yields"
-            }
-            Cause::NoAnchoring => {
-                "no anchoring: shear-equilibrium depth d_s is beyond the leg's reach 2R - h"
-            }
-            Cause::NetBackwardStep => "backward slip before anchoring cancels propulsion: net step <= 0",
-            Cause::ShortStep => {
-                "progress, but the step is shorter than s_min: footholds land in disturbed sand"
-            }
-            Cause::RobustStep => "robust progress: step at least s_min",
-        }
     }
 }
 

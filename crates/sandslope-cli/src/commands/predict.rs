@@ -2,6 +2,7 @@
 
 use anyhow::Result;
 use clap::Args;
+use sandslope_request::format::{Explain, Outcome};
 use sandslope_request::scenario::load_terrain;
 use sandslope_request::PredictRequest;
 

@@ -1,5 +1,6 @@
 //! `sandslope sweep`: the model over a range of slopes, as a table, JSON, CSV or a figure.
 
+use sandslope_request::format::Outcome;
 use std::path::PathBuf;
 
 use anyhow::Result;

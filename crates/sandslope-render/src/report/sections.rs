@@ -4,6 +4,7 @@
 
 use sandslope::paper::Basis;
 use sandslope::report::{ProvenanceKind, Report, ReportCalibration};
+use sandslope_format::Outcome;
 use sandslope_format::{powers_of_ten as sci, probability as format_p};
 
 use super::{escape, plus_minus};

@@ -1,6 +1,7 @@
 //! The report's answer in words: the plain answer's paragraph, the first warning on a robot
 //! other than the paper's, and the comparison table's summary sentence.
 
+use crate::format::Outcome;
 use sandslope::paper::{Basis, PaperComparison};
 use sandslope::report::{Evidence, PlainAnswer, Summary};
 use sandslope::risk::SafeLimit;

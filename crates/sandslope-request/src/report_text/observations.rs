@@ -2,6 +2,7 @@
 //! report's "where the model and the evidence disagree" (the library's
 //! [`ObservationMiss`] values).
 
+use crate::format::Explain;
 use sandslope::calibrate::ObservationKind;
 use sandslope::report::{ObservationMiss, OBSERVATION_MISS_SD};
 

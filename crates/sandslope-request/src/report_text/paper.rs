@@ -2,6 +2,7 @@
 //! model's values as the paper writes them, the rule and why the row has its basis, from the
 //! values [`sandslope::paper::compare_with_paper`] decides (docs/model.md §12).
 
+use crate::format::Explain;
 use sandslope::paper::{PaperComparison, Reading, SpeedBasis};
 
 /// Writes every row's `quantity`, `paper`, `model`, `rule` and `basis_note` from its reading.

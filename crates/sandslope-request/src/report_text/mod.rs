@@ -82,13 +82,8 @@ mod tests {
         assert_eq!(format_p(0.0), "< 10⁻³⁰⁰");
     }
 
-    /// The paper's evidence worded: the inputs table (the contact area W R = 1 cm x 4 cm =
-    /// 4.0 x 10⁻⁴ m², the paper's five speeds measured), the goodness-of-fit sentence, and the
-    /// inversion's disagreement (the k_s the observed speeds need rises from 20° to 24°, where
-    /// the paper's 4.98 cm/s becomes 5.6 cm/s).
-    #[test]
-    fn the_papers_report_is_worded() {
-        let robot = sandslope_io::load_robot("paper-hexapod").unwrap();
+    /// The report on the built-in terrain for `robot`, through the request's one answer path.
+    fn default_report(robot: sandslope::Robot) -> sandslope::report::Report {
         let terrain = sandslope_io::load_terrain("glass-beads-300um").unwrap();
         let request = crate::report::ReportRequest::from_fields(
             "paper-hexapod".into(),
@@ -97,7 +92,17 @@ mod tests {
             &[],
         )
         .unwrap();
-        let r = request.answer(robot, terrain, crate::error::Words::Flag).unwrap();
+        request.answer(robot, terrain, crate::error::Words::Flag).unwrap()
+    }
+
+    /// The paper's evidence worded: the inputs table (the contact area W R = 1 cm x 4 cm =
+    /// 4.0 x 10⁻⁴ m², the paper's five speeds measured), the goodness-of-fit sentence, and the
+    /// inversion's disagreement (the k_s the observed speeds need rises from 20° to 24°, where
+    /// the paper's 4.98 cm/s becomes 5.6 cm/s).
+    #[test]
+    fn the_papers_report_is_worded() {
+        let robot = sandslope_io::load_robot("paper-hexapod").unwrap();
+        let r = default_report(robot);
         let row = |name: &str| r.inputs.iter().find(|i| i.name == name).unwrap();
         assert_eq!(row("robot: leg contact area A_c").value, "4.0 × 10⁻⁴ m² (W R)");
         assert_eq!(row("observed speeds").provenance.kind, ProvenanceKind::Measured);
@@ -122,15 +127,7 @@ mod tests {
     #[test]
     fn another_robot_is_warned_first() {
         let robot = sandslope_io::load_robot("paper-hexapod").unwrap().with_mass(1.2).unwrap();
-        let terrain = sandslope_io::load_terrain("glass-beads-300um").unwrap();
-        let request = crate::report::ReportRequest::from_fields(
-            "paper-hexapod".into(),
-            "glass-beads-300um".into(),
-            Vec::new(),
-            &[],
-        )
-        .unwrap();
-        let r = request.answer(robot, terrain, crate::error::Words::Flag).unwrap();
+        let r = default_report(robot);
         assert!(
             r.warnings[0].contains("kg, R = 4 cm) is not the paper's (0.35 kg, R = 4 cm)")
                 && r.warnings[0].contains("1.2 kg"),

@@ -39,7 +39,9 @@ pub fn powers_of_ten(x: f64, decimals: usize) -> String {
     format!("{m} × 10{exp}")
 }
 
-/// A probability as text: 2 significant digits, `< 10⁻³⁰⁰` below what a float holds.
+/// A probability as text: two decimals from 0.01 up (`0.20`), below it a mantissa of two
+/// significant digits and a power of ten (`3.0 × 10⁻³`), and `< 10⁻³⁰⁰` for 0 (below what the
+/// tail computation resolves).
 pub fn probability(p: f64) -> String {
     if p <= 0.0 {
         "< 10⁻³⁰⁰".into()
@@ -83,5 +85,15 @@ mod tests {
         assert_eq!(powers_of_ten(9_999.0, 1), "9999");
         assert_eq!(powers_of_ten(0.0, 2), "0");
         assert_eq!(powers_of_ten(f64::NAN, 2), "NaN");
+    }
+
+    /// Probabilities worked by hand: 0.2 to two decimals is 0.20; 0.003 is 3.0 x 10^-3; 0.01,
+    /// the boundary, stays plain (0.01); 0 is below what a float's tail holds.
+    #[test]
+    fn probability_is_plain_from_a_hundredth_else_a_power() {
+        assert_eq!(probability(0.2), "0.20");
+        assert_eq!(probability(0.01), "0.01");
+        assert_eq!(probability(0.003), "3.0 × 10⁻³");
+        assert_eq!(probability(0.0), "< 10⁻³⁰⁰");
     }
 }

@@ -65,22 +65,7 @@ pub use crate::format::powers_of_ten as sci;
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use sandslope::report::ProvenanceKind;
-
-    /// The one number format: plain from 0.01 to 10⁴ with `decimals + 1` significant digits,
-    /// else a mantissa with `decimals` digits and a superscript power of ten.
-    #[test]
-    fn sci_writes_plain_or_powers_of_ten() {
-        assert_eq!(sci(1.234e6, 2), "1.23 × 10⁶");
-        assert_eq!(sci(4e-4, 1), "4.0 × 10⁻⁴");
-        assert_eq!(sci(0.5, 1), "0.50");
-        assert_eq!(sci(123.456, 2), "123");
-        assert_eq!(sci(0.0, 2), "0");
-        assert_eq!(format_p(0.2), "0.20");
-        assert_eq!(format_p(0.003), "3.0 × 10⁻³");
-        assert_eq!(format_p(0.0), "< 10⁻³⁰⁰");
-    }
 
     /// The report on the built-in terrain for `robot`, through the request's one answer path.
     fn default_report(robot: sandslope::Robot) -> sandslope::report::Report {

@@ -77,8 +77,6 @@ pub struct SimSettings {
     pub servo_limit: bool,
     /// Settling time before the gait starts (gravity ramps in), s.
     pub settle_s: f64,
-    /// Leg shape.
-    pub shape: LegShape,
     /// Hold every leg at this angle (rad, tripod B half a turn on) instead of walking.
     pub locked_leg_angle: Option<f64>,
     /// Whether the body may pitch (default: free).
@@ -118,7 +116,6 @@ impl SimSettings {
             creep_m_s: DEFAULT_CREEP_M_S,
             servo_limit: true,
             settle_s: DEFAULT_SETTLE_S,
-            shape: LegShape::CLeg,
             locked_leg_angle: None,
             body_pitch: BodyPitch::default(),
             rft_scaling: RftScaling::Motion,
@@ -184,11 +181,6 @@ impl SimSettings {
     /// Another scaling of resistive force theory to the terrain (docs/model.md §16).
     pub fn with_rft_scaling(self, rft_scaling: RftScaling) -> SimSettings {
         SimSettings { rft_scaling, ..self }
-    }
-
-    /// Another leg shape.
-    pub fn with_shape(self, shape: LegShape) -> SimSettings {
-        SimSettings { shape, ..self }
     }
 
     /// Legs held at `angle` rad (tripod B at `angle + pi`) instead of walking.
@@ -494,17 +486,18 @@ pub const MAX_STANCE_LEGS: u32 = 64;
 
 /// Simulates `scenario`'s robot walking on its terrain at `signed` (negative walks downhill;
 /// the terrain is read at |slope| as docs/model.md §8) for `settings.duration_s` seconds, and
-/// measures the walk (docs/model.md §15-§18), its legs of `settings.shape`.
+/// measures the walk (docs/model.md §15-§18), its legs the robot's ([`crate::Robot::leg`], of
+/// the robot file's `leg_shape`).
 pub fn simulate(
     scenario: &Scenario,
     signed: SignedSlope,
     settings: &SimSettings,
 ) -> Result<Simulation, SimulateError> {
-    simulate_with_leg(scenario, signed, settings, &*settings.shape.leg(scenario.robot()))
+    simulate_with_leg(scenario, signed, settings, &scenario.robot().leg())
 }
 
 /// [`simulate`] with every leg of shape `leg` (its outline, docs/model.md §15) in place of
-/// `settings.shape`: a new leg shape is one type implementing [`crate::leg::Leg`], which the
+/// the robot's: a new leg shape is one type implementing [`crate::leg::Leg`], which the
 /// closed form and the simulator then both take.
 pub fn simulate_with_leg(
     scenario: &Scenario,

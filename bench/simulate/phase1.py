@@ -13,8 +13,8 @@ Usage: python3 bench/simulate/phase1.py [--sandslope target/release/sandslope] [
             a quarter of it, beside the closed form's t1 and s1 = 1/2 g sin(theta) t1^2. With
             --pitch free each cell is an ensemble of 8 walks (the mass perturbed by 1e-9
             between walks): the mean over the walks.
-[servo]     The same with the legs turned by the servo's motor (--actuator servo), and each
-            walk's largest servo torque.
+[servo]     The same with the legs turned by the servo's motor (--actuator servo), with each
+            belly, and each walk's largest servo torque and unconverged steps.
 [t1scaling] t1, s1 and the lowest speed at 10 to 24 degrees under each contact scaling, pitch
             locked, at the default step and a quarter of it.
 [weak]      The default law on legs as weak in shear as the force tests' plate
@@ -69,6 +69,7 @@ def summary(d):
         "over": d.get("pitched_over"),
         "torque": max((s["peak_servo_torque_n_m"] for w in walks for s in w["steps"] if not s["warmup"]), default=None),
         "dt": walks[0]["dt_s"],
+        "unconverged": sum(w["unconverged_steps"] for w in walks),
         "cf": walks[0]["closed_form"],
         "p1": p1[0],
     }
@@ -115,10 +116,10 @@ def phase1_table(exe, pitch, rows, torque=False):
     print(f"pitch {pitch} ({what}); each number at the default step (dt/4 in brackets); closed form beside\n")
     print(
         "| variant | slope deg | dt ms | speed cm/s | s1 mm | lowest speed in phase 1 cm/s | t1 ms | "
-        "closed form t1 ms | closed form s1 mm |" + (" peak torque N m |" if torque else "") + " regime |"
+        "closed form t1 ms | closed form s1 mm |" + (" peak torque N m | unconverged steps |" if torque else "") + " regime |"
         + (" pitched over |" if pitch == "free" else "")
     )
-    print("|---|---:|---:|---|---|---|---|---:|---:|" + ("---:|" if torque else "") + "---|" + ("---|" if pitch == "free" else ""))
+    print("|---|---:|---:|---|---|---|---|---:|---:|" + ("---:|---:|" if torque else "") + "---|" + ("---|" if pitch == "free" else ""))
     for label, extra in rows:
         w = walks(exe, extra, pitch, True)
         for s in SLOPES:
@@ -135,7 +136,7 @@ def phase1_table(exe, pitch, rows, torque=False):
             print(
                 f"| {label} | {s} | {d['dt'] * 1e3:g} | {speed} | {both('s1', 3)} | {both('vmin', 2)} | {both('t1', 1)} | "
                 f"{f(cf['t1_s'] and cf['t1_s'] * 1e3, 1)} | {f(cf_s1, 2)} |"
-                + (f" {f(d['torque'], 3)} |" if torque else "")
+                + (f" {f(d['torque'], 3)} | {d['unconverged']} ({q['unconverged']}) |" if torque else "")
                 + f" {d['regime']} ({q['regime']}) |"
                 + (f" {d['over']}/8 ({q['over']}/8) |" if pitch == "free" else "")
             )
@@ -196,7 +197,9 @@ def main():
     tables = {
         "holds": lambda: holds(exe, a.pitch),
         "phase1": lambda: phase1_table(exe, a.pitch, BELLIES),
-        "servo": lambda: phase1_table(exe, a.pitch, [("servo actuator", ["--actuator", "servo"])], torque=True),
+        "servo": lambda: phase1_table(
+            exe, a.pitch, [(f"servo, {b}", ["--actuator", "servo", *x]) for b, x in BELLIES], torque=True
+        ),
         "t1scaling": lambda: t1_scaling(exe),
         "weak": lambda: weak(exe),
         "sweep": lambda: sweep(exe),

@@ -14,8 +14,10 @@ tripod (slope frame, N):
 Usage: python3 bench/simulate/force_balance.py SLOPE_DEG /tmp/probe_24.csv [STEP]
 
 Prints, for the step that starts at STEP x T/2 (default 4, the fifth step; tripod STEP mod 2
-touches down), each window's displacement, mean speed and mean forces, and the stance tripod's
-mean along-slope push over mid-stance (100 to 400 ms) beside gravity's pull m g sin(theta).
+touches down), each window's displacement, mean speed and mean forces, the stance tripod's
+mean along-slope push over mid-stance (100 to 400 ms) beside gravity's pull m g sin(theta), when
+the belly leaves the sand after touchdown and when the speed is lowest in the step's first
+50 ms (the end of phase 1 where the body slides back).
 """
 
 import csv
@@ -56,6 +58,15 @@ def main():
     print(f"mid-stance push {fx:.3f} N over {fz:.3f} N normal (ratio {fx / fz:.3f}); m g sin {MASS_KG * G * math.sin(th):.3f} N")
     n = int(round(HALF_S / dt))
     print(f"step {(d['x_m'][i0 + n] - d['x_m'][i0]) * 1e3:.2f} mm")
+    early = range(i0 + 1, i0 + int(round(0.05 / dt)) + 1)
+    off = next((i for i in early if d["belly_z"][i] == 0.0 and d["belly_x"][i] == 0.0), None)
+    low = min(early, key=lambda i: d["vx_m_s"][i])
+    on = abs(d["belly_z"][i0 + 1]) > 0.0
+    print(
+        f"belly {'in' if on else 'off'} the sand at touchdown, "
+        + (f"off it {(off - i0) * dt * 1e3:.1f} ms after; " if on and off is not None else "")
+        + f"lowest speed in the first 50 ms {d['vx_m_s'][low] * 100:.2f} cm/s at {(low - i0) * dt * 1e3:.1f} ms"
+    )
 
 
 if __name__ == "__main__":

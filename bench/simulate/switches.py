@@ -4,14 +4,15 @@
 Usage: python3 bench/simulate/switches.py [--sandslope target/release/sandslope] [--robot-dir DIR]
 
 Pitch-free ensembles of eight walks (`simulate --body-pitch free --ensemble 8`, the robot's
-mass perturbed by 1e-9 between walks) at 0, 10, 15, 20 and 24 degrees, at the default step
-(0.5 ms) and at a quarter of it (0.125 ms), one row per switch: the defaults (the one-sided
+mass perturbed by 1e-9 between walks) at 0, 10, 15, 20 and 24 degrees, at the free body's
+default step (T / 8000, 0.125 ms) and at a quarter of it (0.03125 ms), one row per switch: the defaults (the one-sided
 belly), the two-faced belly, the servo actuator, and the body's pitch inertia from its parts
 (`pitch_inertia_kg_m2` in a robot file: six XL330-M288 servos of 18 g at the hips, x = 0 and
 +/- (L/2 - R) = 0.07 m, the other 0.242 kg spread evenly over L = 0.22 m: 1.329e-3 kg m^2,
 against the default m L^2 / 12 = 1.412e-3), and at half and twice the default. Each cell:
 mean speed +/- SD of the walks in cm/s, mean t1 in ms, how many pitched over, the regime.
-Every number comes from `sandslope simulate --json`.
+Every number comes from `sandslope simulate --json`. `--only TEXT` keeps the rows whose label
+contains TEXT (the first two rows are phase1.py's `--only phase1 --pitch free` table as well).
 """
 
 import argparse
@@ -63,17 +64,15 @@ def main():
             rows.append((f"pitch inertia {inertia:.3e} kg m^2 ({name})", ["--robot", robot_file(a.sandslope, folder, name, inertia)]))
         if a.only:
             rows = [r for r in rows if a.only in r[0]]
-        print("| switch | slope deg | dt = 0.5 ms | dt = 0.125 ms |")
+        print("| switch | slope deg | dt = T / 8000 (default) | dt / 4 |")
         print("|---|---:|---|---|")
         with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
             for label, extra in rows:
-                jobs = {
-                    (s, q): pool.submit(ensemble, a.sandslope, ["--slope", str(s), *extra, *(["--dt", "0.000125"] if q else [])])
-                    for s in SLOPES
-                    for q in (False, True)
-                }
+                first = {s: pool.submit(ensemble, a.sandslope, ["--slope", str(s), *extra]) for s in SLOPES}
+                dt = {s: first[s].result()["summaries"][0]["dt_s"] for s in SLOPES}
+                quarter = {s: pool.submit(ensemble, a.sandslope, ["--slope", str(s), *extra, "--dt", repr(dt[s] / 4)]) for s in SLOPES}
                 for s in SLOPES:
-                    print(f"| {label} | {s} | {cell(jobs[(s, False)].result())} | {cell(jobs[(s, True)].result())} |", flush=True)
+                    print(f"| {label} | {s} | {cell(first[s].result())} | {cell(quarter[s].result())} |", flush=True)
 
 
 if __name__ == "__main__":

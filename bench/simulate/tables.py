@@ -4,37 +4,43 @@
 Usage: python3 bench/simulate/tables.py [--sandslope target/release/sandslope] [--only NAME]
 
 Prints, in the order docs/simulate.md shows them (NAME in brackets):
-1. [closed] simulator (body pitch locked, the converged setting) against the closed form on the
+1. [elements] the leg cut into 16, 32 (the default) and 64 elements, pitch locked, at the
+   paper's slopes: speed and t1;
+2. [closed] simulator (body pitch locked, the default) against the closed form on the
    built-in robot and terrain at 0, 5, 10, 15, 20 and 24 degrees, 10 s walks, with the speed
    and t1 again at a quarter of the default step (the convergence check beside every number);
-2. [free] the same walks with the body pitch free, at the default step and a quarter of it;
-3. [regimes] the regimes in (k_s, slope) against the closed form's at k_n = 7e5, pitch locked;
-4. [level] the level stride against the paper's 15.7 cm/s: one switch at a time (issue 38
-   item 4), each at the default step and a quarter of it;
-5. [mechanisms] each switch of docs/model.md §20 across the paper's slopes, at the default
+3. [rolling] the level step on stiff sand (k_n = k_s = 1e8) against the rigid rolling step
+   worked out by hand from the robot's geometry and the closed form's s*;
+4. [free] the same walks as [closed] with the body pitch free, at its default step and a
+   quarter of it;
+5. [regimes] the regimes in (k_s, slope) against the closed form's at k_n = 7e5, pitch locked;
+6. [level] the level stride against the paper's 15.7 cm/s: one switch at a time, each at the
+   default step and a quarter of it;
+7. [mechanisms] each switch of docs/model.md §20 across the paper's slopes, at the default
    step and a quarter of it;
-6. [shape] the level walk's within-stride speed, from `simulate --out` sampled at 120 Hz as
+8. [shape] the level walk's within-stride speed, from `simulate --out` sampled at 120 Hz as
    the paper's motion capture was;
-7. [irregular] the one walk of the tables whose steps scatter (disturbed sand at a tenth of its
-   strength at 24 degrees) as 600 s walks at the default step, half and a quarter of it: a
-   10 s walk of it is one draw, and what converges is the mean over many steps.
+9. [spread] the paper's slopes under each contact scaling, against the paper's speeds.
 Every number comes from the CLI's JSON or CSV; nothing here computes physics beyond a finite
-difference of the sampled positions.
+difference of the sampled positions and the rigid rolling step's geometry.
 """
 
 import argparse
-import concurrent.futures
 import csv
 import json
+import math
 import os
 import subprocess
 import tempfile
 
 PAPER_LEVEL_CM_S = (15.7, 0.97)
+PAPER_CM_S = {0: 15.7, 10: 11.0, 15: 10.5, 20: 4.98, 24: 5.6}
 
 
 def run(exe, args):
-    out = subprocess.run([exe, "simulate", *args, "--json"], capture_output=True, text=True, check=True)
+    """`simulate --json`, one walk a slope (the contact scalings' spread off)."""
+    extra = [] if ("--ensemble" in args or "--check-convergence" in args) else ["--scaling-spread", "off"]
+    out = subprocess.run([exe, "simulate", *args, *extra, "--json"], capture_output=True, text=True, check=True)
     return json.loads(out.stdout)
 
 
@@ -92,19 +98,17 @@ def regimes(exe):
     print(f"\n{agree} of {total} cells agree.")
 
 
-def robot_file(directory, name, extra):
-    """The built-in robot's file with `extra` lines appended (a switch of the level study)."""
+def robot_file(exe, directory, name, extra):
+    """The built-in robot's file (`presets show paper-hexapod`) with `extra` lines appended."""
+    text = subprocess.run([exe, "presets", "show", "paper-hexapod"], capture_output=True, text=True, check=True).stdout
     path = os.path.join(directory, f"{name}.toml")
     with open(path, "w") as fh:
-        fh.write(
-            "mass_kg = 0.35\nleg_radius_m = 0.04\nleg_width_m = 0.01\nhip_height_m = 0.03\n"
-            "leg_speed_rad_s = 6.283185307179586\nstance_legs = 3\nresponse_time_s = 0.2\n" + extra
-        )
+        fh.write(text + extra)
     return path
 
 
 def mechanism_rows(tmp):
-    """The switches of docs/model.md §20, one at a time (issue 38 item 4's candidates)."""
+    """The switches of docs/model.md §20, one at a time."""
     return [
         ("leg-sand friction mu = 0.3 (`--leg-friction 0.3`)", ["--leg-friction", "0.3"]),
         ("leg-sand friction mu = 0.1", ["--leg-friction", "0.1"]),
@@ -147,11 +151,11 @@ def level_stride(exe):
             ("hip height h = 0.07 m (belly 1 cm above the leg tips)", ["--hip-height", "0.07"]),
             (
                 "XL330-M288 torque limit, 0.52 N m",
-                ["--robot", robot_file(tmp, "m288", "servo_torque_limit_n_m = 0.52\n")],
+                ["--robot", robot_file(exe, tmp, "m288", "servo_torque_limit_n_m = 0.52\n")],
             ),
             (
                 "XL330-M077 torque limit, 0.215 N m",
-                ["--robot", robot_file(tmp, "m077", "servo_torque_limit_n_m = 0.215\n")],
+                ["--robot", robot_file(exe, tmp, "m077", "servo_torque_limit_n_m = 0.215\n")],
             ),
             *mechanism_rows(tmp),
         ]
@@ -190,7 +194,7 @@ def shape(exe):
         with tempfile.TemporaryDirectory() as tmp:
             out = os.path.join(tmp, "walk.csv")
             subprocess.run(
-                [exe, "simulate", "--slope", "0", "--body-pitch", "locked", "--out", out, *extra],
+                [exe, "simulate", "--slope", "0", "--body-pitch", "locked", "--scaling-spread", "off", "--out", out, *extra],
                 capture_output=True,
                 check=True,
             )
@@ -215,55 +219,82 @@ def shape(exe):
         )
 
 
-IRREGULAR_S = 600.0
-BATCH_STEPS = 50
+def elements(exe):
+    """The leg's elements (robot key `leg_elements`) halved and doubled from the default 32:
+    speed cm/s and t1 ms at the paper's slopes, pitch locked, the default step."""
+    slopes = [0, 10, 15, 20, 24]
+    print("| elements a leg | " + " | ".join(f"{s} deg" for s in slopes) + " |")
+    print("|---:|" + "---|" * len(slopes))
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in [16, 32, 64]:
+            args = ["--slopes", ",".join(map(str, slopes)), "--body-pitch", "locked"]
+            if n != 32:
+                args += ["--robot", robot_file(exe, tmp, f"e{n}", f"leg_elements = {n}\n")]
+            cells = [
+                f"{d['speed_m_s'] * 100:.2f}, {f(scaled(d['t1_s'], 1e3))}" + (f" ({d['regime']})" if d["regime"] != "success" else "")
+                for d in run(exe, args)
+            ]
+            print(f"| {n}{' (default)' if n == 32 else ''} | " + " | ".join(cells) + " |")
 
 
-def irregular(exe):
-    """Disturbed sand at a tenth of its strength at 24 degrees, pitch locked: 600 s walks at
-    the default step, half and a quarter of it. Its steps' speeds scatter (one leg meets the
-    trench where the last one stopped), so a 10 s walk is one draw; the mean over the measured
-    steps converges. Its standard error comes from the means of batches of 50 steps (the steps'
-    speeds are correlated over a few steps, so the steps' own SD / sqrt(n) would understate it)."""
-    base = ["--slope", "24", "--body-pitch", "locked", "--disturbed-sand", "0.1", "--duration", repr(IRREGULAR_S)]
-    dt = one(exe, ["--slope", "24", "--body-pitch", "locked", "--disturbed-sand", "0.1"])["dt_s"]
-    steps = [("default", dt), ("half", dt / 2), ("a quarter", dt / 4)]
-    with concurrent.futures.ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-        walks = list(pool.map(lambda s: one(exe, [*base, "--dt", repr(s[1])]), steps))
-    print(
-        f"| step | dt ms | steps measured | mean speed cm/s | standard error (batches of {BATCH_STEPS}) "
-        "| steps' SD cm/s | 10 s walk's SE cm/s | regime |"
-    )
-    print("|---|---:|---:|---:|---:|---:|---:|---|")
-    for (name, s), d in zip(steps, walks):
-        v = [x["speed_m_s"] * 100 for x in d["steps"] if not x["warmup"]]
-        n = len(v)
-        mean = sum(v) / n
-        sd = (sum((x - mean) ** 2 for x in v) / (n - 1)) ** 0.5
-        batches = [sum(v[i : i + BATCH_STEPS]) / BATCH_STEPS for i in range(0, n - BATCH_STEPS + 1, BATCH_STEPS)]
-        bm = sum(batches) / len(batches)
-        se = ((sum((b - bm) ** 2 for b in batches) / (len(batches) - 1)) / len(batches)) ** 0.5
-        # A 10 s walk measures 18 steps: one draw of their mean.
+def rolling(exe):
+    """The level step on stiff sand against the rigid rolling step worked out by hand (a leg
+    that rolls on its arc like a wheel's rim, then pivots on its tip until the belly lands) and
+    the closed form's s* (the hip's chord with the leg's circle held fixed)."""
+    text = subprocess.run([exe, "presets", "show", "paper-hexapod"], capture_output=True, text=True, check=True).stdout
+    robot = {k.strip(): float(v) for k, v in (l.split("=") for l in text.splitlines() if "=" in l and not l.startswith("#"))}
+    r, h = robot["leg_radius_m"], robot["hip_height_m"]
+    phi0 = math.asin((h - r) / r)
+    parts = [r * (math.pi / 2 - phi0), r * math.cos(phi0), 2 * r * math.sqrt(1 - (h / (2 * r)) ** 2)]
+    print(f"rigid rolling step by hand (R = {r * 1e3:g} mm, h = {h * 1e3:g} mm, phi0 = {math.degrees(phi0):.1f} deg): "
+          + " + ".join(f"{p * 1e3:.1f}" for p in parts) + f" = {sum(parts) * 1e3:.1f} mm\n")
+    print("| sand | simulated step mm | steps measured | step / rolling step | closed form s* mm | speed cm/s |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for name, args in [("stiff, k_n = k_s = 1e8", ["--k-n", "1e8", "--k-s", "1e8"]), ("the built-in terrain", [])]:
+        d = one(exe, ["--slope", "0", "--body-pitch", "locked", *args])
         print(
-            f"| {name} | {s * 1e3:.4g} | {n} | {mean:.2f} | {se:.2f} | {sd:.2f} | {sd / 18 ** 0.5:.1f} "
-            f"| {d['regime']} |"
+            f"| {name} | {d['step_m'] * 1e3:.1f} | {d['steps_measured']} | {d['step_m'] / sum(parts):.3f} "
+            f"| {d['closed_form']['level_step_m'] * 1e3:.1f} | {d['speed_m_s'] * 100:.1f} |"
         )
+
+
+def spread(exe):
+    """The paper's slopes under each contact scaling, pitch locked, the default step."""
+    slopes = list(PAPER_CM_S)
+    walks = {
+        x: run(exe, ["--slopes", ",".join(map(str, slopes)), "--body-pitch", "locked", "--rft-scaling", x])
+        for x in ["motion", "li2013", "components"]
+    }
+    print("| slope deg | `motion` (default) | `li2013` | `components` | spread (largest - smallest) | paper |")
+    print("|---:|---|---|---|---:|---:|")
+    for i, s in enumerate(slopes):
+        v = [walks[x][i]["speed_m_s"] * 100 for x in walks]
+        cells = [f"{walks[x][i]['speed_m_s'] * 100:.1f} ({walks[x][i]['regime']})" for x in walks]
+        print(f"| {s} | " + " | ".join(cells) + f" | {max(v) - min(v):.1f} | {PAPER_CM_S[s]} |")
+    for x, w in walks.items():
+        rms = math.sqrt(sum((d["speed_m_s"] * 100 - PAPER_CM_S[s]) ** 2 for d, s in zip(w, slopes)) / len(slopes))
+        print(f"\nroot-mean-square distance from the paper's speeds under `{x}`: {rms:.1f} cm/s", end="")
+    print()
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sandslope", default="target/release/sandslope")
-    ap.add_argument("--only", choices=["closed", "free", "regimes", "level", "mechanisms", "shape", "irregular"])
+    ap.add_argument(
+        "--only", choices=["elements", "closed", "rolling", "free", "regimes", "level", "mechanisms", "shape", "spread"]
+    )
     a = ap.parse_args()
     exe = a.sandslope
     tables = {
+        "elements": lambda: elements(exe),
         "closed": lambda: against_closed_form(exe, "locked"),
+        "rolling": lambda: rolling(exe),
         "free": lambda: against_closed_form(exe, "free"),
         "regimes": lambda: regimes(exe),
         "level": lambda: level_stride(exe),
         "mechanisms": lambda: mechanisms(exe),
         "shape": lambda: shape(exe),
-        "irregular": lambda: irregular(exe),
+        "spread": lambda: spread(exe),
     }
     for name, table in tables.items():
         if a.only in (None, name):

@@ -410,6 +410,47 @@ mod tests {
         assert!((a - b).abs() <= tol, "{a} vs {b}");
     }
 
+    /// The closed form answers for the C-leg only: another shape is refused naming the robot
+    /// file's key, the value, the shape it answers for and the three shapes `simulate` walks.
+    #[test]
+    fn the_closed_form_refuses_another_shape_by_name() {
+        assert_eq!(LegShape::default(), LegShape::CLeg);
+        assert_eq!(LegShape::CLeg.closed_form(), Ok(()));
+        for shape in [LegShape::Spoke, LegShape::Foot] {
+            let e = shape.closed_form().unwrap_err().to_string();
+            assert!(e.starts_with(&format!("leg_shape = \"{}\": the closed form", shape.name())), "{e}");
+            assert!(
+                e.contains("leg_shape = \"c_leg\"") && e.contains("(\"c_leg\", \"spoke\", \"foot\")"),
+                "{e}"
+            );
+        }
+        // The names are serde's, which the robot file reads.
+        for shape in LegShape::ALL {
+            assert_eq!(serde_json::to_value(shape).unwrap(), shape.name());
+        }
+    }
+
+    /// The robot's leg is its shape's: the paper's robot (R = 4 cm, h = 3 cm, A_c = W R) with
+    /// spokes reaches 2R - h = 5 cm, touching down at asin(3/8); with feet (length A_c / W =
+    /// R = 4 cm) its ends are sqrt(4^2 + 2^2) = sqrt(20) cm from the hip, sqrt(20) - 3 cm deep.
+    #[test]
+    fn the_robots_leg_is_its_shape() {
+        let robot = |shape| {
+            crate::Robot::new(crate::RobotSpec { leg_shape: shape, ..crate::RobotSpec::paper_hexapod() })
+                .unwrap()
+        };
+        let c = robot(LegShape::CLeg);
+        assert_eq!(c.leg(), RobotLeg::CLeg(CLeg { radius: 0.04, hip_height: 0.03 }));
+        assert_eq!((c.leg().name(), c.leg_shape()), ("c_leg", LegShape::CLeg));
+        let spoke = robot(LegShape::Spoke).leg();
+        assert_eq!(spoke.name(), "spoke");
+        close(spoke.max_depth(), 0.05, 1e-15);
+        close(spoke.touchdown_angle(), (3.0f64 / 8.0).asin(), 1e-15);
+        let foot = robot(LegShape::Foot).leg();
+        assert_eq!(foot.shape(), LegShape::Foot);
+        close(foot.max_depth(), 0.2f64.sqrt() / 10.0 - 0.03, 1e-15);
+    }
+
     /// The paper's C-leg, R = 4 cm with the hip at h = 3 cm: touchdown at asin(-1/4), the
     /// deepest reach 2R - h = 5 cm straight below the hip, and at psi = 0 the arc's centre
     /// height R - h = 1 cm (worked by hand).

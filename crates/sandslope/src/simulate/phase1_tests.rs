@@ -405,7 +405,7 @@ fn a_body_that_rocks_on_a_belly_at_rest_has_no_phase_1() {
     let rate = |t: f64| {
         // Pitch rate, rad/s: rising by 1000 deg/s^2 for 20 ms after touchdown, falling back by 40 ms.
         let a = 1000f64.to_radians();
-        if t < 0.02 || t > 0.06 {
+        if !(0.02..=0.06).contains(&t) {
             0.0
         } else if t <= 0.04 {
             a * (t - 0.02)

@@ -584,7 +584,7 @@ pub fn simulate_with_leg(
             break;
         }
         let acc = run.per_step.get(k).copied().unwrap_or_default();
-        let (step, phase1) = phase1::measure(&track, &run.groups, t0, half, k % 2);
+        let (step, phase1) = phase1::measure(&track, &run.groups, t0, half, k % 2, slope_deg == 0.0);
         steps.push(SimStep {
             index: k,
             tripod: k % 2,

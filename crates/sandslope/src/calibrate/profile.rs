@@ -360,7 +360,7 @@ pub(crate) mod tests {
         let setup = paper_setup();
         let problem = build(&setup, SpeedModel::simulator_for_fit(), None).unwrap();
         let walks = || problem.simulator.as_ref().unwrap().walks_run();
-        let best = [1.0393117657067235, 0.1, 97381.56325503981, 40993.99635036474];
+        let best = [1.0790551885493032, 0.1, 97328.81937424073, 40820.41905712319];
         let s_min = problem.objective(&best);
         let q_best = problem.ratio(&best).ln();
         let w0 = walks();

@@ -351,7 +351,7 @@ pub(crate) mod tests {
     /// a hundredth of the ratio's log). With the ratio held by a penalty instead of a tied force
     /// test, a profile point warm-started there settled in the basin where the legs sink and
     /// this end came out at 0.490 with the profile 0.5 above the minimum (docs/calibration.md).
-    /// About 1,800 walks (about 15 s of CPU): run by hand (`cargo test -p sandslope --lib
+    /// About 1,900 walks (about 18 s of CPU): run by hand (`cargo test -p sandslope --lib
     /// simulators_ratio_upper_end -- --ignored`), not in the suite's ten minutes.
     #[test]
     #[ignore]

@@ -95,7 +95,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for LeastSquares<'_, '_> {
 /// walk's speed is smooth in k_s. Below it the speed has kinks (a step of the walk that changes
 /// how it is taken, such as the belly's strike in substeps, docs/model.md §17): on the paper's
 /// evidence the 24 degree walk's speed at the fitted leg k_s turns from 0.10 to 0.03 m/s per
-/// unit `ln k_s` within 0.2%, while over +-4% it follows a cubic within 0.1 mm/s, whose slope
+/// unit `ln k_s` within 0.6%, while over +-4% it follows a cubic within 0.1 mm/s, whose slope
 /// there (0.063) the 1% difference gives to 2% (0.062) and a 0.2% one to 26% (0.047). The fit's
 /// minimum sits on that kink, and with the one-sided slope of a 0.2% step Levenberg-Marquardt
 /// crept along it in steps of a few 0.1%, up to 97 evaluations a minimisation where 10 to 20

@@ -17,12 +17,13 @@
 //! trusted after.
 //!
 //! ```
-//! use sandslope::{predict, Ground, Regime, Robot, RobotSpec, Slope};
+//! use sandslope::{leg::LegShape, predict, Ground, Regime, Robot, RobotSpec, Slope};
 //! let robot = Robot::new(RobotSpec {
 //!     mass_kg: 0.35, leg_radius_m: 0.04, leg_width_m: 0.01, hip_height_m: 0.03,
 //!     leg_speed_rad_s: std::f64::consts::TAU, stance_legs: 3, response_time_s: 0.2,
 //!     leg_contact_area_m2: None, level_step_m: None, min_step_m: None, body_length_m: None,
 //!     body_width_m: None, pitch_inertia_kg_m2: None, servo_torque_limit_n_m: None, leg_elements: None,
+//!     leg_shape: LegShape::CLeg,
 //! }).unwrap();
 //! let p = predict(&robot, Slope::from_degrees(20.0).unwrap(), &Ground::new(7e5, 1e6).unwrap());
 //! assert_eq!(p.regime, Regime::Metastable);

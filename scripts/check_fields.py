@@ -2,7 +2,7 @@
 """Every request field written once: the field tables of crates/sandslope-request are the only
 non-test source that spells a field's flag, its default or its range.
 
-Usage: python3 scripts/check_fields.py [ROOT]
+Usage: python3 scripts/check_fields.py [ROOT] [--verbose]
 
 A field is a row `Field::number("k-s", ...)` (or `text`, `switch`, `new`, a robot `quantity`) of a table in
 crates/sandslope-request/src; the files holding such rows are the tables. In every other
@@ -20,6 +20,17 @@ The explorer page's inputs (crates/sandslope-serve/src/page/index.html) for a fi
 start or range of their own: the server writes `value`, `min` and `max` from the field's table
 when it serves the page, so an input bound to a field (`data-field`, `data-flag`) with one of
 them, or an input named after a field and bound to none, is a finding.
+
+The fuzzer (crates/sandslope-fuzz/src) runs the command line and the server as a user does, so
+its targets (targets.rs, serve/) spell flags (`"--slope"`) and HTTP fields (`?slope=10&k-n=`):
+each must be a field of a table or a flag the CLI declares (a clap `long`), so that a renamed
+field cannot leave a fuzz target refused at every input for a reason the fuzzer counts as
+handled.
+
+A field's flag inside a longer message (`"--class-terrain: class {k} is given twice"`) is a
+second spelling too (the message goes stale when the flag is renamed; `FIELD.long()` writes
+it from the row); these are listed as notes, not failures, with their count, so the list
+shows the work left.
 
 Files whose requests are not yet read through a table are listed in PENDING with the reason;
 they are reported as a note, not a failure, so the list shows the work left. Exits 1 on any
@@ -92,6 +103,58 @@ def page_findings(root, homes):
     return hits
 
 
+# The fuzzer's runs of the CLI and the server (its own main.rs has flags of its own).
+FUZZ = ("crates/sandslope-fuzz/src/targets.rs", "crates/sandslope-fuzz/src/serve/")
+STRING = re.compile(r'"(?:[^"\\\n]|\\.)*"')
+FLAG_IN_TEXT = re.compile(r"--([a-z][a-z0-9-]*)")
+QUERY_FIELD = re.compile(r"[?&]([a-z][a-z0-9-]*)=")
+CLAP_LONG = re.compile(r'\blong\s*=\s*"([a-z][a-z0-9-]*)"|\.long\(\s*"([a-z][a-z0-9-]*)"\s*\)')
+
+
+def cli_flags(files):
+    """Every flag the CLI's clap arguments declare by name: derived (`#[arg(long)] pub k_s`),
+    `long = "x"` and `.long("x")`. Flags given as `long = FIELD.flag` are the tables'."""
+    flags = set()
+    for rel, lines in files.items():
+        if not rel.startswith("crates/sandslope-cli/src/"):
+            continue
+        text = "\n".join(lines)
+        flags.update(m.group(1).replace("_", "-") for m in DERIVE.finditer(text))
+        flags.update(a or b for a, b in CLAP_LONG.findall(text))
+    return flags
+
+
+def fuzz_findings(files, homes):
+    """The fuzzer's flags and HTTP fields that no table has and the CLI does not declare."""
+    known = set(homes) | cli_flags(files)
+    hits = []
+    for rel, lines in files.items():
+        if not rel.startswith(FUZZ):
+            continue
+        for n, line in enumerate(lines, 1):
+            for lit in STRING.findall(line):
+                names = FLAG_IN_TEXT.findall(lit) if lit.startswith('"--') else []
+                names += QUERY_FIELD.findall(lit) if "/api/" in lit else []
+                for name in names:
+                    if name not in known:
+                        hits.append(f"{rel}:{n}: `{name}` is neither a field of a table nor a flag of the CLI")
+    return hits
+
+
+def prose_notes(files, homes):
+    """A field's flag inside a longer string (a message), outside the field's table."""
+    notes = []
+    for rel, lines in files.items():
+        if not rel.startswith(FRONT_ENDS):
+            continue
+        for n, line in enumerate(lines, 1):
+            for lit in STRING.findall(line):
+                for flag in FLAG_IN_TEXT.findall(lit):
+                    if flag in homes and rel not in homes[flag] and lit != f'"--{flag}"':
+                        notes.append(f"{rel}:{n}: --{flag}")
+    return notes
+
+
 def code_outside_tests(path):
     """The file's text with `#[cfg(test)]` items blanked (newlines kept)."""
     with open(path, encoding="utf-8") as f:
@@ -117,7 +180,8 @@ def sources(root):
 
 
 def main():
-    root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+    args = [a for a in sys.argv[1:] if a != "--verbose"]
+    root = args[0] if args else os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
     files = {rel: code_outside_tests(os.path.join(root, rel)) for rel in sources(root)}
     homes = {}
     for rel, lines in files.items():
@@ -153,8 +217,19 @@ def main():
         else:
             found.extend(hits)
     found.extend(page_findings(root, homes))
+    found.extend(fuzz_findings(files, homes))
     for line in found:
         print(line)
+    prose = prose_notes(files, homes)
+    if prose:
+        print(
+            f"note: {len(prose)} message(s) spell a field's flag rather than taking it from the row "
+            f"(FIELD.long()), first {prose[0]}; --verbose lists them",
+            file=sys.stderr,
+        )
+        if "--verbose" in sys.argv:
+            for line in prose:
+                print(f"note: {line}", file=sys.stderr)
     for rel in sorted(pending):
         print(f"note: {rel} still names fields by their words: {PENDING[rel]}", file=sys.stderr)
     if found:

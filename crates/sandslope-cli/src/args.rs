@@ -108,7 +108,7 @@ impl<const MASS: bool> clap::Args for RobotKeyArgs<MASS> {
             let arg = clap::Arg::new(key.name())
                 .long(field.flag)
                 .value_name(field.value_name)
-                .help(field.help)
+                .help(field.help_line())
                 .action(clap::ArgAction::Set);
             // A whole number: clap's parser, which refuses `2.5` and `-1` itself.
             cmd = cmd.arg(if key == RobotKey::StanceLegs {
@@ -194,8 +194,11 @@ pub struct FieldArgs<T> {
 /// The clap argument of one field: its flag, placeholder, help, default (shown in `--help`),
 /// choices and conflicts from its row.
 pub fn field_arg(f: &'static Field) -> clap::Arg {
-    let arg =
-        clap::Arg::new(f.flag).long(f.flag).help(f.help).conflicts_with_all(f.conflicts).required(f.required);
+    let arg = clap::Arg::new(f.flag)
+        .long(f.flag)
+        .help(f.help_line())
+        .conflicts_with_all(f.conflicts)
+        .required(f.required);
     match f.kind {
         Kind::Switch => arg.action(clap::ArgAction::SetTrue),
         Kind::List => arg.action(clap::ArgAction::Append).value_name(f.value_name),

@@ -225,7 +225,7 @@ fn emulated_logs() -> &'static [std::path::PathBuf] {
 /// The true k_s inside the 90% interval in at least 9 of 10 runs (issue 42), and so the
 /// climbing speed those sands give: the interval holds the stride simulator's own speed at the
 /// emulator's k_s, walked apart (`simulate --json` with the sensor's walk: pitch locked and
-/// the two-faced belly, docs/model.md §19), in at least 9 of 10.
+/// the default belly, docs/model.md §19), in at least 9 of 10.
 #[test]
 fn infer_servo_log_recovers_the_emulated_k_s() {
     let truth = 2.5e5;

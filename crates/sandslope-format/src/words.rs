@@ -5,6 +5,7 @@
 //! vocabulary.
 //! Files and JSON keep the library's names ([`Regime::name`], [`Cause::name`]).
 
+use sandslope::plan::NoRoute;
 use sandslope::{Cause, Regime};
 
 /// A regime in words. Import it to write `regime.outcome()` and `regime.in_words()`.
@@ -34,10 +35,27 @@ impl Outcome for Regime {
     }
 }
 
-/// A cause in words. Import it to write `cause.explain()`.
+/// A cause in words. Import it to write `cause.explain()` (and `no_route.explain()`).
 pub trait Explain {
-    /// A one-line explanation of why the stance ended in its regime.
+    /// A one-line explanation: why the stance ended in its regime, or why a plan's objective
+    /// found no route.
     fn explain(self) -> &'static str;
+}
+
+/// Why an objective of `plan` found no route: `plan`'s table, `plan --json`'s and `/api/plan`'s
+/// `message`, and Python's.
+impl Explain for NoRoute {
+    fn explain(self) -> &'static str {
+        match self {
+            NoRoute::StartImpassable => {
+                "start impassable: every heading out of the start cell is too steep or too cross-sloped"
+            }
+            NoRoute::GoalImpassable => {
+                "goal impassable: every heading into the goal cell is too steep or too cross-sloped"
+            }
+            NoRoute::GoalUnreachable => "goal unreachable: no chain of passable edges joins start and goal",
+        }
+    }
 }
 
 impl Explain for Cause {
@@ -73,5 +91,21 @@ mod tests {
         assert_eq!(Regime::Sinkage.outcome(), "sinks");
         assert_eq!(Cause::ShortStep.regime().outcome(), "climbs slowly and may stall");
         assert!(Cause::NoAnchoring.explain().contains("d_s"));
+    }
+
+    /// Each reason a plan finds no route is worded with its file name first (`goal
+    /// unreachable` for `goal_unreachable`, the name `plan --json` writes as `reason`), and
+    /// says what blocked it.
+    #[test]
+    fn no_route_reasons_are_worded_after_their_names() {
+        for (reason, name, why) in [
+            (NoRoute::StartImpassable, "start_impassable", "out of the start cell"),
+            (NoRoute::GoalImpassable, "goal_impassable", "into the goal cell"),
+            (NoRoute::GoalUnreachable, "goal_unreachable", "no chain of passable edges"),
+        ] {
+            let words = reason.explain();
+            assert!(words.starts_with(&format!("{}:", name.replace('_', " "))), "{words}");
+            assert!(words.contains(why), "{words}");
+        }
     }
 }

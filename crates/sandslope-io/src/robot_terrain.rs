@@ -142,6 +142,26 @@ mod tests {
         assert!(msg.contains("leg_element") && msg.ends_with("did you mean `leg_elements`?"), "{msg}");
     }
 
+    /// `leg_shape` (docs/model.md §2): absent, the C-leg; `spoke` and `foot` read; the file
+    /// written back says the shape only when it is not the default; an unknown shape is
+    /// refused naming the file, the key, the value and the three shapes.
+    #[test]
+    fn the_leg_shape_is_read_and_an_unknown_one_refused() {
+        use sandslope::LegShape;
+        assert_eq!(read("").unwrap().leg_shape(), LegShape::CLeg);
+        assert!(!robot_toml(read("").unwrap().spec(), "").unwrap().contains("leg_shape"));
+        for (text, shape) in [("c_leg", LegShape::CLeg), ("spoke", LegShape::Spoke), ("foot", LegShape::Foot)]
+        {
+            let robot = read(&format!("leg_shape = \"{text}\"\n")).unwrap();
+            assert_eq!(robot.leg_shape(), shape);
+            let back = robot_from_toml(&robot_toml(robot.spec(), "").unwrap(), &Source::Preset("w")).unwrap();
+            assert_eq!(back.spec(), robot.spec());
+        }
+        let msg = format!("{:#}", read("leg_shape = \"wheel\"\n").unwrap_err());
+        assert!(msg.contains("r.toml") && msg.contains("leg_shape") && msg.contains("wheel"), "{msg}");
+        assert!(msg.contains("`c_leg`, `spoke`, `foot`"), "{msg}");
+    }
+
     /// An unknown key names the key meant: `legs` is a whole word of `stance_legs` only (not of
     /// `leg_radius_m`, whose word is `leg`); `mass` of `mass_kg`; a typo `leg_radus_m` is nearest
     /// `leg_radius_m`; `colour` is near nothing and gets no guess.

@@ -61,8 +61,11 @@ pub fn calibrate(
         repose,
     };
     request.check_in(Words::Keyword).map_err(|e| value_error(e.message()))?;
-    let source =
-        CalibrateSource { robot: &robot.inner, terrain: &terrain.inner, terrain_name: &terrain_source };
+    let source = CalibrateSource {
+        robot: robot.closed_form()?,
+        terrain: &terrain.inner,
+        terrain_name: &terrain_source,
+    };
     let answer = interruptibly(py, |stop| request.answer_cancellable(source, Words::Keyword, Some(stop)))?
         .map_err(|e| value_error(e.message()))?;
     match answer {

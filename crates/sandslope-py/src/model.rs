@@ -103,7 +103,7 @@ pub fn predict<'py>(
     // The request layer's point: its overrides checked and named as this keyword's element.
     let terrain = point_terrain(terrain.map(|t| &t.inner), k_n.is_some(), k_s.is_some())
         .map_err(|e| value_error(e.message()))?;
-    let robot = &robot.inner;
+    let robot = robot.closed_form()?;
     let eval = |i: usize| -> Result<Row, String> {
         let point = PointRequest {
             slope: slope[i],
@@ -172,7 +172,7 @@ pub fn phase<'py>(
         repose_deg,
         regime_only,
     };
-    let (robot, terrain) = (&robot.inner, terrain.map(|t| &t.inner));
+    let (robot, terrain) = (robot.closed_form()?, terrain.map(|t| &t.inner));
     let answer = interruptibly(py, |stop| request.answer(robot, terrain, Some(stop)))?
         .map_err(|e| value_error(e.message()))?;
     let d = PyDict::new(py);

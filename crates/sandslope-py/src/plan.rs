@@ -73,7 +73,7 @@ pub fn risk_raster<'py>(
         time_weight,
     };
     let (heights, (rows, cols)) = row_major(&dem);
-    let (robot, terrain) = (&robot.inner, &terrain.inner);
+    let (robot, terrain) = (robot.closed_form()?, &terrain.inner);
     let source =
         GridSource { heights: &heights, rows, cols, robot, terrain, classes: None, class_terrains: None };
     let bands = py.detach(|| request.risk_raster(&source)).map_err(|e| value_error(e.message()))?;
@@ -127,7 +127,7 @@ pub fn plan<'py>(
     let class_values = classes.as_ref().map(row_major);
     let classes = class_values.as_ref().map(|(values, shape)| ClassRaster { values, shape: *shape });
     let class_terrains = class_terrains.as_ref().map(|p| p.iter().map(|(k, t)| (*k, &t.inner)).collect());
-    let (robot, terrain) = (&robot.inner, &terrain.inner);
+    let (robot, terrain) = (robot.closed_form()?, &terrain.inner);
     let source = GridSource { heights: &heights, rows, cols, robot, terrain, classes, class_terrains };
     // The search runs on a thread of its own so that Ctrl-C, checked here, can stop it
     // (issue 21: a 4096^2 plan ran to its end, seconds to minutes, before Python saw the signal).

@@ -63,7 +63,7 @@ pub fn report(
         simulator_fit,
     };
     request.check(Words::Keyword).map_err(|e| value_error(e.message()))?;
-    let robot = robot.inner.clone();
+    let robot = robot.closed_form()?.clone();
     let terrain = terrain.inner.clone();
     let value = py
         .detach(|| -> anyhow::Result<_> {

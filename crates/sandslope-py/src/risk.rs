@@ -36,7 +36,7 @@ fn answer(
     robot: &PyRobot,
     terrain: &PyTerrain,
 ) -> PyResult<RiskAnswer> {
-    let (robot, terrain) = (&robot.inner, terrain.inner.clone());
+    let (robot, terrain) = (robot.closed_form()?, terrain.inner.clone());
     interruptibly(py, |stop| {
         question.answer_on(robot, terrain, AnswerLimits::LIBRARY, Words::Keyword, Some(stop))
     })?

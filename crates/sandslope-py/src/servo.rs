@@ -10,9 +10,10 @@ use pythonize::pythonize;
 
 use sandslope::infer::servo::{infer_servo_log as infer, CurrentInferenceSettings, LegTrace};
 use sandslope_io::servo_log::ServoLogRow;
-use sandslope_request::drive::{DriveRun, RunDefaults};
+use sandslope_request::drive::{emulate_clock_keyword, DriveRun, RunDefaults};
 use sandslope_request::error::Words;
 use sandslope_request::infer::{prior_in, servo_grid_points, ServoLogRequest};
+use sandslope_servo::clock::ClockKind;
 use sandslope_servo::driver::ServoSample;
 use sandslope_servo::session::{
     default_servos, emulator_summary, BusChoice, DriveConfig, EmulateOptions, Session, STAND_S,
@@ -152,7 +153,7 @@ pub fn drive_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
 /// (as [`read_servo_log`]), `report` what `drive --json` prints, with the emulator's last word
 /// under `emulator`.
 #[pyfunction]
-#[pyo3(signature = (robot, terrain, slope_deg=None, duration_s=None, k_s=None, noise_ma=None, seed=None, weaken=None, stop_on_risk=None, hold_s=None, rate_hz=None, live=None, force=None, window=None))]
+#[pyo3(signature = (robot, terrain, slope_deg=None, duration_s=None, k_s=None, noise_ma=None, seed=None, weaken=None, stop_on_risk=None, hold_s=None, rate_hz=None, live=None, force=None, window=None, clock=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn drive<'py>(
     py: Python<'py>,
@@ -170,10 +171,13 @@ pub fn drive<'py>(
     live: Option<bool>,
     force: Option<bool>,
     window: Option<usize>,
+    clock: Option<String>,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
     if window == Some(0) {
         return Err(value_error("window = 0 must be at least 1 stance (None pools every stance)"));
     }
+    let clock = emulate_clock_keyword(clock.as_deref()).map_err(|e| value_error(e.message()))?;
+    let clock = ClockKind::parse(clock).unwrap_or_default();
     // `drive`'s defaults, the table its flags take theirs from.
     let d = run_defaults()?;
     let slope_deg = slope_deg.unwrap_or(d.slope_deg);
@@ -234,7 +238,7 @@ pub fn drive<'py>(
             seed,
             faults,
             current_offset_ma: vec![],
-            clock: Default::default(),
+            clock,
         }),
         monitor: live,
         window,

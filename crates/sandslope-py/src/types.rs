@@ -23,6 +23,15 @@ pub struct PyRobot {
     pub inner: Robot,
 }
 
+impl PyRobot {
+    /// The robot for the closed form: a `ValueError` naming `leg_shape` unless its legs are
+    /// C-legs, the one shape the closed form is derived for (`simulate` walks every shape).
+    pub(crate) fn closed_form(&self) -> PyResult<&Robot> {
+        self.inner.leg_shape().closed_form().map_err(value_error)?;
+        Ok(&self.inner)
+    }
+}
+
 /// A number as Python's `repr` writes it (`0.35`, `1e-05`, `700000.0`).
 fn py_float(x: f64) -> String {
     if x.is_finite() && x == x.trunc() && x.abs() < 1e16 {
@@ -55,7 +64,7 @@ fn reducer<'py>(py: Python<'py>, name: &str, spec: Bound<'py, PyAny>) -> PyResul
 impl PyRobot {
     /// Robot(**keys): the keys of docs/model.md §2 (mass_kg, leg_radius_m, leg_width_m,
     /// hip_height_m, leg_speed_rad_s, stance_legs, response_time_s; optional
-    /// leg_contact_area_m2, level_step_m, min_step_m).
+    /// leg_contact_area_m2, level_step_m, min_step_m, the simulator's keys and leg_shape).
     #[new]
     #[pyo3(signature = (**keys))]
     fn new(py: Python<'_>, keys: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {

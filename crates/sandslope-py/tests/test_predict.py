@@ -99,3 +99,17 @@ def test_errors_carry_the_cli_message(cli, robot, terrain):
         sandslope.predict(robot, 10, 7e5, 1e6, mass_kg=-2)
     with pytest.raises(ValueError, match="give both k_n and k_s, or a terrain"):
         sandslope.predict(robot, 10, 7e5)
+
+
+def test_the_closed_form_refuses_a_spoke_robot_that_simulate_walks(robot, terrain):
+    # docs/model.md §15: the closed form is derived for the C-leg; the simulator walks any shape.
+    keys = robot.to_dict()
+    assert "leg_shape" not in keys  # the default, c_leg, is not written
+    spoke = sandslope.Robot(**keys, leg_shape="spoke")
+    assert spoke.to_dict()["leg_shape"] == "spoke"
+    with pytest.raises(ValueError, match='leg_shape = "spoke": the closed form'):
+        sandslope.predict(spoke, 10, 7e5, 1e6)
+    _, summary = sandslope.simulate(spoke, terrain, 0.0, duration_s=2.0, scaling_spread=False)
+    assert summary["shape"] == "spoke"
+    with pytest.raises(ValueError, match="unknown variant `wheel`, expected one of `c_leg`, `spoke`, `foot`"):
+        sandslope.Robot(**keys, leg_shape="wheel")

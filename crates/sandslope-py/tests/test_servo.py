@@ -22,7 +22,8 @@ def _columns(log):
 @pytest.fixture(scope="module")
 def run():
     # 3 s at 20 deg on emulated sand of k_s = 2.5e5 N/m^3 (docs/drive.md's worked example).
-    return sandslope.drive(slope_deg=20, duration_s=3, k_s=2.5e5, seed=1, live=True)
+    # On the virtual clock: the run's timing is simulated, so it takes its computing time.
+    return sandslope.drive(slope_deg=20, duration_s=3, k_s=2.5e5, seed=1, live=True, clock="virtual")
 
 
 def test_drive_runs_the_gait_and_turns_the_torque_off(run):
@@ -56,7 +57,7 @@ def test_drive_runs_the_gait_and_turns_the_torque_off(run):
 def test_infer_servo_log_equals_the_cli_on_the_same_log(cli, tmp_path):
     path = tmp_path / "run.csv"
     cli.run("drive", "--emulate", "--slope", "20", "--emulate-k-s", "2.5e5", "--duration", "4",
-            "--watchdog", "2", "--log", path)
+            "--watchdog", "2", "--emulate-clock", "virtual", "--log", path)
     expected = cli.json("infer", "--servo-log", path, "--grid-points", "9", "--k-s-prior", "3e4:3e7")
     got = sandslope.infer_servo_log(path, grid_points=9, k_s_prior=(3e4, 3e7))
     assert sorted(got) == sorted(expected)
@@ -115,6 +116,9 @@ def test_bad_input_names_the_argument(run):
         sandslope.drive(stop_on_risk=1.5)
     with pytest.raises(ValueError, match="k_s"):
         sandslope.drive(k_s=-1.0)
+    # The clock's two words are the drive table's `--emulate-clock` row's, named with the keyword.
+    with pytest.raises(ValueError, match=r'clock = "wall" must be one of: real, virtual'):
+        sandslope.drive(clock="wall")
 
 
 def test_drive_releases_the_gil():
@@ -161,8 +165,8 @@ def test_drive_returns_the_keys_of_drive_json(cli, tmp_path):
     """`sandslope.drive`'s report has the keys `drive --emulate --json` prints, at every level
     (outcome, live record, inference, torque_off)."""
     expected = cli.json("drive", "--emulate", "--slope", "20", "--duration", "3", "--live",
-                        "--watchdog", "2")
-    _, got = sandslope.drive(slope_deg=20, duration_s=3, live=True)
+                        "--watchdog", "2", "--emulate-clock", "virtual")
+    _, got = sandslope.drive(slope_deg=20, duration_s=3, live=True, clock="virtual")
 
     def shape(v):
         if isinstance(v, dict):

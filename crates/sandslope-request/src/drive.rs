@@ -165,10 +165,13 @@ pub const EMULATE_OFFSET: Field =
     );
 /// `--emulate-clock`: the emulated run's clock, the wall's or a virtual one.
 pub const EMULATE_CLOCK: Field =
-    Field::new("emulate-clock", Kind::Choice(&["real", "virtual"]), "real|virtual").default("real").help(
-        "Emulator: `real` (a run of S seconds takes S seconds: the loop's real timing) or `virtual` \
+    Field::new("emulate-clock", Kind::Choice(&["real", "virtual"]), "real|virtual")
+        .default("real")
+        .keyword("clock")
+        .help(
+            "Emulator: `real` (a run of S seconds takes S seconds: the loop's real timing) or `virtual` \
          (simulated time: the run takes its computing time, docs/drive.md)",
-    );
+        );
 
 /// `drive`'s run fields, which `serve --drive` shares (the robot's and the terrain's are
 /// [`crate::scenario`]'s; the bus flags and `--log` are each command's own).
@@ -378,6 +381,22 @@ impl RunDefaults {
             live: false,
         })
     }
+}
+
+/// Python's `clock` keyword ([`EMULATE_CLOCK`]'s row): the word given, else the row's default,
+/// checked against the row's choices; the error names the keyword and the choices.
+pub fn emulate_clock_keyword(given: Option<&str>) -> Result<&'static str> {
+    let choices: &[&'static str] = match EMULATE_CLOCK.kind {
+        Kind::Choice(choices) => choices,
+        _ => &["real", "virtual"],
+    };
+    let word = given.map(str::trim).or(EMULATE_CLOCK.default).unwrap_or(choices[0]);
+    choices.iter().copied().find(|c| *c == word).ok_or_else(|| {
+        RequestError::invalid(
+            EMULATE_CLOCK.flag,
+            format!("{} = \"{word}\" must be one of: {}", EMULATE_CLOCK.keyword, choices.join(", ")),
+        )
+    })
 }
 
 /// A field as each front end names it: the command line's flag, or Python's keyword (which

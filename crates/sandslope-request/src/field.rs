@@ -52,8 +52,13 @@ pub struct Field {
     pub default: Option<&'static str>,
     /// Its valid range in words (checked by the request or the library), empty for any.
     pub range: &'static str,
-    /// Its line in `--help` (and the docs' option lists).
+    /// Its line in `--help` (and the docs' option lists); `{fallback}` in it stands for
+    /// [`Field::fallback`] ([`Field::help_line`] writes it in).
     pub help: &'static str,
+    /// The value the request uses when neither the field nor a file gives one, where that is
+    /// a library constant rather than a default the field parses (`--cv-n`'s
+    /// `sandslope::risk::DEFAULT_CV_N`, used only when the terrain has no k_n_sd either).
+    pub fallback: Option<f64>,
     /// Fields of the same table it cannot be given with.
     pub conflicts: &'static [&'static str],
     /// Whether every request must give it.
@@ -73,6 +78,7 @@ impl Field {
             default: None,
             range: "",
             help: "",
+            fallback: None,
             conflicts: &[],
             required: false,
         }
@@ -123,6 +129,21 @@ impl Field {
         Field { help, ..self }
     }
 
+    /// With the library's value used when neither the field nor a file gives one, written
+    /// into the help line at `{fallback}`.
+    pub const fn fallback(self, value: f64) -> Field {
+        Field { fallback: Some(value), ..self }
+    }
+
+    /// The help line as `--help` prints it: [`Field::help`] with `{fallback}` replaced by the
+    /// fallback value (`0.1`).
+    pub fn help_line(&self) -> String {
+        match self.fallback {
+            Some(v) => self.help.replace("{fallback}", &v.to_string()),
+            None => self.help.to_string(),
+        }
+    }
+
     /// With the fields it cannot be given with.
     pub const fn conflicts(self, conflicts: &'static [&'static str]) -> Field {
         Field { conflicts, ..self }
@@ -161,7 +182,7 @@ impl Field {
     /// The field in `p` as a number that has a default or must be given.
     pub fn required_number_in(&self, p: &mut Params<'_>) -> Result<f64> {
         self.number_in(p)?.ok_or_else(|| {
-            RequestError::invalid(self.flag, format!("--{} is required: {}", self.flag, self.help))
+            RequestError::invalid(self.flag, format!("--{} is required: {}", self.flag, self.help_line()))
         })
     }
 

@@ -226,15 +226,25 @@ pub fn parse_max_risk(text: &str) -> std::result::Result<f64, String> {
 }
 
 /// `--cv-n` (risk, plan, design, infer): the coefficient of variation of k_n instead of the terrain's.
-pub const CV_N: Field = Field::number("cv-n", "CV").keyword("cv_n").key("cv_n").range("at least 0").help(
-    "Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's \
-     k_n_sd; without either, 0.1 (docs/model.md §9)",
-);
+pub const CV_N: Field = Field::number("cv-n", "CV")
+    .keyword("cv_n")
+    .key("cv_n")
+    .range("at least 0")
+    .fallback(sandslope::risk::DEFAULT_CV_N)
+    .help(
+        "Coefficient of variation of k_n (sd / value) at every slope, instead of the terrain's \
+         k_n_sd; without either, {fallback} (docs/model.md §9)",
+    );
 /// `--cv-s` (risk, plan, design, infer): the coefficient of variation of k_s instead of the terrain's.
-pub const CV_S: Field = Field::number("cv-s", "CV").keyword("cv_s").key("cv_s").range("at least 0").help(
-    "Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's \
-     k_s_sd; without either, 0.2 (docs/model.md §9)",
-);
+pub const CV_S: Field = Field::number("cv-s", "CV")
+    .keyword("cv_s")
+    .key("cv_s")
+    .range("at least 0")
+    .fallback(sandslope::risk::DEFAULT_CV_S)
+    .help(
+        "Coefficient of variation of k_s (sd / value) at every slope, instead of the terrain's \
+         k_s_sd; without either, {fallback} (docs/model.md §9)",
+    );
 /// The terrain's uncertainty by the one rule of docs/model.md §9 (a given CV, else the table's
 /// SD over its value, else 0.1 / 0.2), with the note to print when a default is used anywhere
 /// on the table. Errors name the field: `--cv-n = -1 must be a finite number of at least 0`.

@@ -168,11 +168,28 @@ impl RobotRequest {
         })
     }
 
-    /// The robot: read, its quantities replaced and validated again as a whole ([`apply`]),
-    /// then the mass.
+    /// The robot for the closed form: [`RobotRequest::load_any_leg`], refused (naming the
+    /// robot and its `leg_shape`) unless its legs are C-legs, the one shape the closed form is
+    /// derived for ([`sandslope::LegShape::closed_form`]).
+    pub fn load(&self) -> Result<Robot> {
+        let robot = self.load_any_leg()?;
+        self.closed_form(&robot)?;
+        Ok(robot)
+    }
+
+    /// Refuses `robot` (this request's) for the closed form unless its legs are C-legs.
+    fn closed_form(&self, robot: &Robot) -> Result<()> {
+        robot
+            .leg_shape()
+            .closed_form()
+            .map_err(|e| RequestError::invalid(ROBOT.flag, format!("{}: {e}", self.robot)))
+    }
+
+    /// The robot of any leg shape, for the simulator: read, its quantities replaced and
+    /// validated again as a whole ([`apply`]), then the mass.
     ///
     /// [`apply`]: RobotRequest::apply
-    pub fn load(&self) -> Result<Robot> {
+    pub fn load_any_leg(&self) -> Result<Robot> {
         let robot = sandslope_io::load_robot(&self.robot)
             .map_err(|e| RequestError::from_error(Some(ROBOT.flag), e))?;
         let robot = self.apply(robot)?;
@@ -274,11 +291,19 @@ impl ScenarioRequest {
         Ok(ScenarioRequest { robot, terrain, k_n, k_s, level_step })
     }
 
-    /// The library's scenario: the resistances checked, the robot and terrain read.
+    /// The library's scenario for the closed form: the resistances checked, the robot (of
+    /// C-legs, [`RobotRequest::load`]) and terrain read.
     pub fn scenario(&self) -> Result<Scenario> {
+        let scenario = self.walk_scenario()?;
+        self.robot.closed_form(scenario.robot())?;
+        Ok(scenario)
+    }
+
+    /// The scenario for the simulator, whose robot may have legs of any shape.
+    pub fn walk_scenario(&self) -> Result<Scenario> {
         let k_n = self.k_n.map(|v| check_resistance(K_N.flag, v)).transpose()?;
         let k_s = self.k_s.map(|v| check_resistance(K_S.flag, v)).transpose()?;
-        let robot = self.robot.load()?.with_level_step(self.level_step);
+        let robot = self.robot.load_any_leg()?.with_level_step(self.level_step);
         Scenario::new(robot, load_terrain(&self.terrain)?, k_n, k_s)
             .map_err(|e| RequestError::from_error(None, anyhow::anyhow!("{e}")))
     }

@@ -400,7 +400,7 @@ impl SimulateRequest {
     /// Reads the robot and terrain and checks every field: the walks to run.
     pub fn walks(&self) -> Result<Walks> {
         let settings = self.settings()?;
-        let scenario = self.scenario.scenario()?;
+        let scenario = self.scenario.walk_scenario()?;
         let signed = |deg: f64, field: &'static str| {
             SignedSlope::from_degrees(deg)
                 .map_err(|e| RequestError::invalid(field, e.renamed(format!("--{field}"))))

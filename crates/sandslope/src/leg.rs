@@ -1,6 +1,7 @@
 //! The leg's geometry (docs/model.md §3-§4, §15): how deep a leg reaches below the surface as
 //! it turns, named once. The closed form reads the anchoring time, the deepest reach and the
-//! touchdown angle from a [`Leg`]; the robot's C-leg is [`CLeg`].
+//! touchdown angle from a [`Leg`]; the robot's leg is [`RobotLeg`], of the robot file's
+//! [`LegShape`] (the paper's [`CLeg`] unless `leg_shape` says otherwise).
 //!
 //! A leg turns about its hip (the axle, `h` above the undisturbed surface) at the robot's leg
 //! speed omega. Its crank angle `psi` is measured as docs/model.md §4 measures the C-leg's
@@ -9,12 +10,15 @@
 //! stance's descent, over which the leg anchors). A new leg shape is one more type
 //! implementing [`Leg`]; the closed-form functions of this module then hold for it unchanged.
 
-/// The shape of every leg (docs/model.md §15): the robot's C-leg, or the plates the oracle
-/// tests use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// The shape of a robot's legs, the robot file's key `leg_shape` (docs/model.md §2, §15): the
+/// paper's C-leg (the default), or the straight spoke and the flat foot the simulator's oracle
+/// tests use. The simulator walks any shape; the closed form (docs/model.md §3-§6) is derived
+/// for the C-leg only ([`LegShape::closed_form`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LegShape {
     /// A semicircular arc of radius R from the axle to a tip 2R away (the paper's C-leg).
+    #[default]
     CLeg,
     /// A straight plate from the axle to 2R along the C's diameter (a spoke).
     Spoke,
@@ -22,6 +26,60 @@ pub enum LegShape {
     /// angle 0 (the closed form's contact, docs/model.md §3).
     Foot,
 }
+
+impl LegShape {
+    /// Every shape, in the order the robot file's docs list them.
+    pub const ALL: [LegShape; 3] = [LegShape::CLeg, LegShape::Spoke, LegShape::Foot];
+
+    /// The name in robot files and JSON (`c_leg`, `spoke`, `foot`), also [`Leg::name`].
+    pub fn name(self) -> &'static str {
+        match self {
+            LegShape::CLeg => "c_leg",
+            LegShape::Spoke => "spoke",
+            LegShape::Foot => "foot",
+        }
+    }
+
+    /// Whether this is the default shape (a robot file that leaves `leg_shape` out).
+    pub fn is_c_leg(&self) -> bool {
+        *self == LegShape::CLeg
+    }
+
+    /// Whether the closed form (docs/model.md §3-§6) holds for this shape: only the C-leg's.
+    /// Its geometry is any [`Leg`]'s (the depth, the touchdown and deepest angles, the
+    /// anchoring time below), but its composition is Li et al.'s rotary walking of a C-leg:
+    /// s* is the step of a leg sliding on the C's circle, whose centre is fixed in solidified
+    /// sand; the shear load's `R omega / dt` is the body reaching the C's rolling speed
+    /// `R omega`; the shear resistance `k_s W d^2` is an arc cutting the sand edge-on (which a
+    /// flat foot does not). Refused for another shape, naming the robot file's key: an error
+    /// `leg_shape = "spoke" ...` rather than a number derived for another leg.
+    pub fn closed_form(self) -> Result<(), NotClosedForm> {
+        if self.is_c_leg() {
+            Ok(())
+        } else {
+            Err(NotClosedForm(self))
+        }
+    }
+}
+
+/// A robot whose legs the closed form does not hold for ([`LegShape::closed_form`]): the
+/// message names the robot file's key, the value and the shapes supported.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NotClosedForm(pub LegShape);
+
+impl std::fmt::Display for NotClosedForm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "leg_shape = \"{}\": the closed form (docs/model.md §3-§6) is derived for the C-leg only, \
+             so it answers for leg_shape = \"c_leg\" (the default); `simulate` walks every leg_shape \
+             (\"c_leg\", \"spoke\", \"foot\")",
+            self.0.name()
+        )
+    }
+}
+
+impl std::error::Error for NotClosedForm {}
 
 /// A leg shape's geometry, as the closed form needs it.
 pub trait Leg {
@@ -255,21 +313,91 @@ impl Leg for Foot {
     }
 }
 
+/// A robot's leg ([`crate::Robot::leg`]): its [`LegShape`] built from the robot's radius R,
+/// hip height h and, for the foot, its length (the contact area over the leg width). The one
+/// leg the closed form and the simulator both take; a value, so the closed form's hot loops
+/// (risk maps, plans) build it without allocating.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RobotLeg {
+    /// The paper's C-leg.
+    CLeg(CLeg),
+    /// A straight spoke.
+    Spoke(Spoke),
+    /// A flat foot.
+    Foot(Foot),
+}
+
+impl RobotLeg {
+    /// The leg of `shape` with radius R, hip height h and foot length `foot_length` (used by
+    /// the foot only), m.
+    pub fn new(shape: LegShape, radius: f64, hip_height: f64, foot_length: f64) -> RobotLeg {
+        match shape {
+            LegShape::CLeg => RobotLeg::CLeg(CLeg { radius, hip_height }),
+            LegShape::Spoke => RobotLeg::Spoke(Spoke { radius, hip_height }),
+            LegShape::Foot => RobotLeg::Foot(Foot { radius, length: foot_length, hip_height }),
+        }
+    }
+
+    /// The shape.
+    pub fn shape(&self) -> LegShape {
+        match self {
+            RobotLeg::CLeg(_) => LegShape::CLeg,
+            RobotLeg::Spoke(_) => LegShape::Spoke,
+            RobotLeg::Foot(_) => LegShape::Foot,
+        }
+    }
+
+    fn geometry(&self) -> &dyn Leg {
+        match self {
+            RobotLeg::CLeg(l) => l,
+            RobotLeg::Spoke(l) => l,
+            RobotLeg::Foot(l) => l,
+        }
+    }
+}
+
+impl Leg for RobotLeg {
+    fn depth_at(&self, psi: f64) -> f64 {
+        self.geometry().depth_at(psi)
+    }
+    fn touchdown_angle(&self) -> f64 {
+        self.geometry().touchdown_angle()
+    }
+    fn deepest_angle(&self) -> f64 {
+        self.geometry().deepest_angle()
+    }
+    fn max_depth(&self) -> f64 {
+        self.geometry().max_depth()
+    }
+    fn angle_at_depth(&self, d: f64) -> Option<f64> {
+        self.geometry().angle_at_depth(d)
+    }
+    fn level_step(&self, d: f64) -> f64 {
+        self.geometry().level_step(d)
+    }
+    fn outline(&self, elements: usize) -> Vec<[f64; 2]> {
+        self.geometry().outline(elements)
+    }
+    fn name(&self) -> &str {
+        self.shape().name()
+    }
+}
+
 /// Depth of `leg` below the surface `t` seconds after touchdown, turning at `omega` rad/s:
 /// `d(omega t + psi0)`, m (docs/model.md §4's `d(t)` for the C-leg).
-pub fn depth_after(leg: &impl Leg, omega: f64, t: f64) -> f64 {
+pub fn depth_after(leg: &(impl Leg + ?Sized), omega: f64, t: f64) -> f64 {
     leg.depth_at(omega * t + leg.touchdown_angle())
 }
 
 /// Time from touchdown until `leg`, turning at `omega` rad/s, reaches depth `d_s`:
 /// `(psi(d_s) - psi0) / omega`, s (docs/model.md §4's anchoring time t1 for the C-leg); `None`
 /// when it never does.
-pub fn time_to_depth(leg: &impl Leg, omega: f64, d_s: f64) -> Option<f64> {
+pub fn time_to_depth(leg: &(impl Leg + ?Sized), omega: f64, d_s: f64) -> Option<f64> {
     leg.angle_at_depth(d_s).map(|psi| (psi - leg.touchdown_angle()) / omega)
 }
 
 /// Time from touchdown to the deepest reach, `(psi_max - psi0) / omega`, s.
-pub fn time_to_deepest(leg: &impl Leg, omega: f64) -> f64 {
+pub fn time_to_deepest(leg: &(impl Leg + ?Sized), omega: f64) -> f64 {
     (leg.deepest_angle() - leg.touchdown_angle()) / omega
 }
 
@@ -280,6 +408,47 @@ mod tests {
 
     fn close(a: f64, b: f64, tol: f64) {
         assert!((a - b).abs() <= tol, "{a} vs {b}");
+    }
+
+    /// The closed form answers for the C-leg only: another shape is refused naming the robot
+    /// file's key, the value, the shape it answers for and the three shapes `simulate` walks.
+    #[test]
+    fn the_closed_form_refuses_another_shape_by_name() {
+        assert_eq!(LegShape::default(), LegShape::CLeg);
+        assert_eq!(LegShape::CLeg.closed_form(), Ok(()));
+        for shape in [LegShape::Spoke, LegShape::Foot] {
+            let e = shape.closed_form().unwrap_err().to_string();
+            assert!(e.starts_with(&format!("leg_shape = \"{}\": the closed form", shape.name())), "{e}");
+            assert!(
+                e.contains("leg_shape = \"c_leg\"") && e.contains("(\"c_leg\", \"spoke\", \"foot\")"),
+                "{e}"
+            );
+        }
+        // The names are serde's, which the robot file reads.
+        for shape in LegShape::ALL {
+            assert_eq!(serde_json::to_value(shape).unwrap(), shape.name());
+        }
+    }
+
+    /// The robot's leg is its shape's: the paper's robot (R = 4 cm, h = 3 cm, A_c = W R) with
+    /// spokes reaches 2R - h = 5 cm, touching down at asin(3/8); with feet (length A_c / W =
+    /// R = 4 cm) its ends are sqrt(4^2 + 2^2) = sqrt(20) cm from the hip, sqrt(20) - 3 cm deep.
+    #[test]
+    fn the_robots_leg_is_its_shape() {
+        let robot = |shape| {
+            crate::Robot::new(crate::RobotSpec { leg_shape: shape, ..crate::RobotSpec::paper_hexapod() })
+                .unwrap()
+        };
+        let c = robot(LegShape::CLeg);
+        assert_eq!(c.leg(), RobotLeg::CLeg(CLeg { radius: 0.04, hip_height: 0.03 }));
+        assert_eq!((c.leg().name(), c.leg_shape()), ("c_leg", LegShape::CLeg));
+        let spoke = robot(LegShape::Spoke).leg();
+        assert_eq!(spoke.name(), "spoke");
+        close(spoke.max_depth(), 0.05, 1e-15);
+        close(spoke.touchdown_angle(), (3.0f64 / 8.0).asin(), 1e-15);
+        let foot = robot(LegShape::Foot).leg();
+        assert_eq!(foot.shape(), LegShape::Foot);
+        close(foot.max_depth(), 0.2f64.sqrt() / 10.0 - 0.03, 1e-15);
     }
 
     /// The paper's C-leg, R = 4 cm with the hip at h = 3 cm: touchdown at asin(-1/4), the
@@ -419,13 +588,14 @@ mod tests {
     #[test]
     fn the_simulator_walks_a_toy_leg_shape() {
         use crate::scenario::Scenario;
-        use crate::simulate::{simulate, simulate_with_leg, LegShape, SimSettings};
+        use crate::simulate::{simulate, simulate_with_leg, SimSettings};
         use crate::slope::SignedSlope;
-        let robot = crate::model::tests::paper_robot();
+        let spec = crate::RobotSpec { leg_shape: LegShape::Spoke, ..crate::RobotSpec::paper_hexapod() };
+        let robot = crate::Robot::new(spec).unwrap();
         let (r, h) = (robot.leg_radius(), robot.hip_height());
         let terrain = crate::terrain::Terrain::constant(7e5, 3_260_672.8).unwrap();
         let scenario = Scenario::new(robot, terrain, None, None).unwrap();
-        let settings = SimSettings::new(2.0).unwrap().with_shape(LegShape::Spoke);
+        let settings = SimSettings::new(2.0).unwrap();
         let level = SignedSlope::from_degrees(0.0).unwrap();
         let spoke = simulate(&scenario, level, &settings).unwrap();
         let long = Stick { length: 2.0 * r, hip_height: h };

@@ -72,6 +72,7 @@ pub use contour::ContourSegment;
 pub use critical::{critical_shear_strength, NoShearSuffices, StepTarget};
 pub use error::ParamError;
 pub use gait::{analyse, GaitAnalysis, GaitError, GaitOptions, Recording, Upslope};
+pub use leg::LegShape;
 pub use measure::{MeasureError, SlopeEstimate};
 pub use model::{predict, Prediction};
 pub use phase::{

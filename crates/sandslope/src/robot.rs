@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 use crate::error::{positive, ParamError};
-use crate::leg::{CLeg, Foot, Leg, LegShape, Spoke};
+use crate::leg::{Leg, LegShape, RobotLeg};
 
 /// The robot as written in a file: the keys of docs/model.md §2, unknown keys rejected.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -55,6 +55,11 @@ pub struct RobotSpec {
     /// Resistive-force-theory elements per C-leg (simulator only); default 32 ([`DEFAULT_LEG_ELEMENTS`]), 4 to 256.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub leg_elements: Option<u32>,
+    /// The legs' shape (docs/model.md §2, §15): `c_leg` (the default, written only when
+    /// another), `spoke` or `foot`. The simulator walks every shape; the closed form answers
+    /// for the C-leg only ([`LegShape::closed_form`]).
+    #[serde(default, skip_serializing_if = "LegShape::is_c_leg")]
+    pub leg_shape: LegShape,
 }
 
 impl RobotSpec {
@@ -80,6 +85,7 @@ impl RobotSpec {
             pitch_inertia_kg_m2: None,
             servo_torque_limit_n_m: None,
             leg_elements: None,
+            leg_shape: LegShape::CLeg,
         }
     }
 }
@@ -483,39 +489,29 @@ impl Robot {
         0.5 * self.stride_period()
     }
 
-    /// The geometry of the robot's legs, the paper's C-leg of radius R with the hip at h.
-    pub fn leg(&self) -> CLeg {
-        CLeg { radius: self.spec.leg_radius_m, hip_height: self.spec.hip_height_m }
+    /// The robot's legs' shape (`leg_shape`, the C-leg unless the file says otherwise).
+    pub fn leg_shape(&self) -> LegShape {
+        self.spec.leg_shape
     }
 
-    /// Deepest reach of a leg below the surface, `d_max = 2R - h`, m ([`Leg::max_depth`]).
+    /// The geometry of the robot's legs, of its [`LegShape`] with radius R and hip height h
+    /// (the foot's length is the contact area over the leg width): the leg the simulator walks
+    /// and the closed form's depth, angles and anchoring time read.
+    pub fn leg(&self) -> RobotLeg {
+        let foot_length = self.contact_area / self.spec.leg_width_m;
+        RobotLeg::new(self.spec.leg_shape, self.spec.leg_radius_m, self.spec.hip_height_m, foot_length)
+    }
+
+    /// Deepest reach of a leg below the surface, m ([`Leg::max_depth`]; `d_max = 2R - h` for
+    /// the C-leg).
     pub fn max_depth(&self) -> f64 {
         self.leg().max_depth()
     }
 
-    /// Touchdown angle `phi0 = asin((h - R) / R)`, rad, so that the leg depth is 0 at touchdown
-    /// ([`Leg::touchdown_angle`]).
+    /// Touchdown angle, rad, so that the leg depth is 0 at touchdown ([`Leg::touchdown_angle`];
+    /// `phi0 = asin((h - R) / R)` for the C-leg).
     pub fn touchdown_angle(&self) -> f64 {
         self.leg().touchdown_angle()
-    }
-}
-
-/// The shape's leg on a robot: [`LegShape`] is named in `leg.rs` with the geometry, built here
-/// from the robot's radius, hip height and contact area (so `leg` needs no robot).
-impl LegShape {
-    /// The [`Leg`] this shape names on `robot` (radius R, hip height h; the foot's length is
-    /// the contact area over the leg width). The simulator walks any [`Leg`]
-    /// ([`crate::simulate::simulate_with_leg`]); these are the shapes the front ends name.
-    pub fn leg(self, robot: &Robot) -> Box<dyn Leg + Send + Sync> {
-        let (radius, hip_height) = (robot.leg_radius(), robot.hip_height());
-        match self {
-            LegShape::CLeg => Box::new(CLeg { radius, hip_height }),
-            LegShape::Spoke => Box::new(Spoke { radius, hip_height }),
-            LegShape::Foot => {
-                let length = robot.contact_area() / robot.leg_width();
-                Box::new(Foot { radius, length, hip_height })
-            }
-        }
     }
 }
 

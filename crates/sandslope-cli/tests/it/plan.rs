@@ -359,6 +359,10 @@ fn unreachable_goal_is_reported_as_not_found() {
     let j = json_of(&out.stdout);
     assert_eq!(j["routes"]["time"]["found"], false);
     assert_eq!(j["routes"]["time"]["reason"], "start_impassable");
+    assert_eq!(
+        j["routes"]["time"]["message"],
+        "start impassable: every heading out of the start cell is too steep or too cross-sloped"
+    );
     assert_eq!(j["routes"]["distance"]["found"], true);
     let _ = Regime::Success;
 }

@@ -472,3 +472,47 @@ fn the_convergence_check_walks_a_quarter_step_and_a_tenth_of_the_creep() {
         .code(2)
         .stderr(predicates::str::contains("--check-convergence"));
 }
+
+/// A robot file's `leg_shape = "spoke"` (docs/model.md §2, §15): `simulate` walks it on spokes
+/// (its JSON names the shape), while the closed form, derived for the C-leg only, refuses it
+/// with exit 2 naming the file's key, the value and the shape it answers for; an unknown shape
+/// is refused naming the key and the three shapes.
+#[test]
+fn a_spoke_robot_is_walked_and_the_closed_form_refuses_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let paper = include_str!("../../../sandslope-io/presets/paper-hexapod.toml");
+    let spoke = write_arg(dir.path(), "spoke.toml", &format!("{paper}leg_shape = \"spoke\"\n"));
+    let walk = json(&[
+        "simulate",
+        "--slope",
+        "0",
+        "--duration",
+        "2",
+        "--scaling-spread",
+        "off",
+        "--robot",
+        &spoke,
+        "--json",
+    ]);
+    assert_eq!(walk["shape"], "spoke", "{walk}");
+    for command in [vec!["predict", "--slope", "10"], vec!["sweep"], vec!["risk", "--slope", "10"]] {
+        sandslope()
+            .args(&command)
+            .args(["--robot", &spoke])
+            .assert()
+            .code(2)
+            .stderr(contains("spoke.toml: leg_shape = \"spoke\""))
+            .stderr(contains("derived for the C-leg only"))
+            .stderr(contains("leg_shape = \"c_leg\""));
+    }
+    let wheel = write_arg(dir.path(), "wheel.toml", &format!("{paper}leg_shape = \"wheel\"\n"));
+    for command in ["simulate", "predict"] {
+        sandslope()
+            .args([command, "--slope", "10", "--robot", &wheel])
+            .assert()
+            .code(2)
+            .stderr(contains("leg_shape"))
+            .stderr(contains("wheel"))
+            .stderr(contains("`c_leg`, `spoke`, `foot`"));
+    }
+}

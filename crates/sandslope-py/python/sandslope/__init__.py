@@ -660,7 +660,8 @@ def simulate_ensemble(
     """Walks the robot ``walks`` times (2 to 1000) at ``slope_deg``, the mass of walk k
     multiplied by ``1 + k 1e-9``, and returns the spread: the dict ``sandslope simulate
     --ensemble N --json`` prints (``speed_m_s``, ``speed_sd_m_s``, ``speed_se_m_s``, ``t1_s``,
-    ``pitched_over``, ``regimes``, ``regime``, every walk's summary under ``summaries``).
+    ``t1_se_s``, ``pitched_over``, ``regimes``, ``regime``, every walk's summary under
+    ``summaries``).
 
     With ``body_pitch="free"`` the walk on a slope is chaotic (two walks 1e-9 apart part by
     tens of degrees of pitch within seconds), so the spread is the answer; with the pitch

@@ -291,6 +291,7 @@ def drive(
     live: Optional[bool] = None,
     force: Optional[bool] = None,
     window: Optional[int] = None,
+    clock: Optional[str] = None,
 ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]: ...
 
 def read_touchdowns(path: _Path) -> List[float]: ...

@@ -130,6 +130,7 @@ def drive(
     live: Optional[bool] = None,
     force: Optional[bool] = None,
     window: Optional[int] = None,
+    clock: Optional[str] = None,
 ) -> Tuple[Any, Dict[str, Any]]:
     """A run of ``sandslope drive --emulate`` (docs/drive.md): the robot's alternating tripod
     sent to a bus of emulated XL330s on a pseudo-terminal, byte for byte Protocol 2.0 through
@@ -142,6 +143,9 @@ def drive(
     or the last ``window``; ``stop_on_risk`` halts the gait when the pooled P(fail), the larger
     of the simulator's and the closed form's, passes it. A slope beyond the calibrated safe
     slope is refused unless ``force=True`` (as ``drive --force``; off when left out).
+    ``clock`` is the emulator's clock (``drive --emulate-clock``): ``"real"`` (the default: a run
+    of S seconds takes S seconds, the driving loop's real timing) or ``"virtual"`` (simulated
+    time: the run takes its computing time, for tests and batch runs).
 
     Returns ``(log, report)``: ``log`` the servo log's columns (a pandas DataFrame, or a dict of
     NumPy arrays without pandas; ``infer_servo_log`` reads it), ``report`` what ``drive --json``
@@ -149,7 +153,7 @@ def drive(
     ``time_s``, and ``p_fail`` or ``error``; ``cycles``, ``rate_hz``, ``cycle_jitter_ms``,
     ``max_cycle_ms``, ``setup``, ``live``: one record per stance,
     ``torque_off``) and ``emulator``, the virtual servos' last word. The run takes
-    ``duration_s`` plus a second of wall time and releases the GIL; it cannot be interrupted from
+    ``duration_s`` plus a second of wall time on the real clock and releases the GIL; it cannot be interrupted from
     Python. A robot is driven from the command line (``sandslope drive --port``) only."""
     if not emulate:
         raise ValueError(
@@ -171,6 +175,7 @@ def drive(
         live=None if live is None else bool(live),
         force=None if force is None else bool(force),
         window=None if window is None else int(window),
+        clock=None if clock is None else str(clock),
     )
     # `drive --json`'s bus budget: none for the emulator, whose pseudo-terminal is not limited.
     report.setdefault("bus_max_rate_hz", None)

@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use sandslope::plan::{NoRoute, Objective, Route};
 use sandslope::Regime;
+use sandslope_format::Explain;
 
 use super::{CorridorPlanned, Planned};
 
@@ -25,7 +26,7 @@ pub struct RouteRecord {
     /// Steepest roll, degrees.
     pub max_roll_deg: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    /// Why no route exists, in words.
+    /// Why no route exists, in words ([`Explain`]).
     pub message: Option<&'static str>,
     #[serde(skip_serializing_if = "Option::is_none")]
     /// Why no route exists.

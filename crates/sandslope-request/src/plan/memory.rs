@@ -11,7 +11,7 @@ use crate::error::{check_range, RequestError, Result};
 
 /// The memory limit: `--max-memory` (checked), else what the machine has available; `None`
 /// where that cannot be read.
-fn memory_limit(args: &PlanRequest) -> Result<Option<(f64, &'static str)>> {
+fn memory_limit(args: &PlanRequest) -> Result<Option<(f64, String)>> {
     Ok(match args.max_memory {
         Some(gib) => {
             let gib = check_range(MAX_MEMORY.flag, gib, 0.0, f64::INFINITY)?;
@@ -21,12 +21,15 @@ fn memory_limit(args: &PlanRequest) -> Result<Option<(f64, &'static str)>> {
                     format!("{} = {gib} must be a number of GiB greater than 0", MAX_MEMORY.long()),
                 ));
             }
-            Some((gib * GIB, "the --max-memory limit"))
+            Some((gib * GIB, format!("the {} limit", MAX_MEMORY.long())))
         }
         None => available_memory().map(|bytes| {
             (
                 bytes as f64,
-                "the memory available (MemAvailable in /proc/meminfo; --max-memory sets another limit)",
+                format!(
+                    "the memory available (MemAvailable in /proc/meminfo; {} sets another limit)",
+                    MAX_MEMORY.long()
+                ),
             )
         }),
     })

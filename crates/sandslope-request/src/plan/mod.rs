@@ -444,23 +444,23 @@ impl PlanRequest {
         let Some((path, spec)) = &self.classes else {
             return Ok((None, vec![uncertain(load(&self.terrain)?)?]));
         };
+        let flag = CLASS_TERRAIN.long();
         let mut values = Vec::new();
         let mut terrains = Vec::new();
         for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let (k, t) = item.split_once('=').ok_or_else(|| {
-                anyhow!("--class-terrain: `{item}` must be CLASS=TERRAIN, e.g. 1=dune.toml")
-            })?;
-            let k: i64 =
-                k.trim().parse().map_err(|_| anyhow!("--class-terrain: class `{k}` must be an integer"))?;
+            let (k, t) = item
+                .split_once('=')
+                .ok_or_else(|| anyhow!("{flag}: `{item}` must be CLASS=TERRAIN, e.g. 1=dune.toml"))?;
+            let k: i64 = k.trim().parse().map_err(|_| anyhow!("{flag}: class `{k}` must be an integer"))?;
             if values.contains(&k) {
-                bail!("--class-terrain: class {k} is given twice");
+                bail!("{flag}: class {k} is given twice");
             }
-            let terrain = load(t.trim()).with_context(|| format!("--class-terrain: class {k}"))?;
+            let terrain = load(t.trim()).with_context(|| format!("{flag}: class {k}"))?;
             values.push(k);
             terrains.push(uncertain(terrain)?);
         }
         if terrains.is_empty() || terrains.len() > 254 {
-            bail!("--class-terrain: give between 1 and 254 CLASS=TERRAIN pairs");
+            bail!("{flag}: give between 1 and 254 CLASS=TERRAIN pairs");
         }
         let classes = read_raster(path)?;
         if classes.cols != dem.cols || classes.rows != dem.rows || !classes.geo.aligned(&dem.geo) {
@@ -476,7 +476,7 @@ impl PlanRequest {
         let idx = sandslope::plan::class_indices(&classes.values, |i| classes.is_nodata(i), &values)
             .map_err(|e| {
                 anyhow!(
-                    "{}: class {} ({} cells) has no terrain; add it to --class-terrain (given: {})",
+                    "{}: class {} ({} cells) has no terrain; add it to {flag} (given: {})",
                     path.display(),
                     e.value,
                     e.cells,

@@ -62,6 +62,9 @@ fn no_flag_or_keyword_is_taken_twice_in_a_request() {
                 );
             }
             assert!(!f.help.is_empty(), "{command}: --{} has no help line", f.flag);
+            // A fallback is written into the help where it says `{fallback}`, and only there.
+            assert_eq!(f.help.contains("{fallback}"), f.fallback.is_some(), "{command}: --{}", f.flag);
+            assert!(!f.help_line().contains("{fallback}"), "{command}: --{}: {}", f.flag, f.help_line());
         }
     }
 }

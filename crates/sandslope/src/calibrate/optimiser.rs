@@ -91,11 +91,16 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for LeastSquares<'_, '_> {
 }
 
 /// The step in `ln k_s` of the two walks that give a walk's derivative in its leg k_s (the
-/// chain rule of [`LeastSquares::chain_rule_jacobian`]): 0.2%, the size of the steps in a
-/// leg's k_s the finite differences in the unbounded coordinates took before it (0.16% to
-/// 0.4% on the paper's evidence, [`Problem::jacobian_step`]), where a fixed-step walk is
-/// smooth in k_s (docs/calibration.md).
-pub(crate) const WALK_LN_K_S_STEP: f64 = 2e-3;
+/// chain rule of [`LeastSquares::chain_rule_jacobian`]): 1%, the scale on which a fixed-step
+/// walk's speed is smooth in k_s. Below it the speed has kinks (a step of the walk that changes
+/// how it is taken, such as the belly's strike in substeps, docs/model.md §17): on the paper's
+/// evidence the 24 degree walk's speed at the fitted leg k_s turns from 0.10 to 0.03 m/s per
+/// unit `ln k_s` within 0.2%, while over +-4% it follows a cubic within 0.1 mm/s, whose slope
+/// there (0.063) the 1% difference gives to 2% (0.062) and a 0.2% one to 26% (0.047). The fit's
+/// minimum sits on that kink, and with the one-sided slope of a 0.2% step Levenberg-Marquardt
+/// crept along it in steps of a few 0.1%, up to 97 evaluations a minimisation where 10 to 20
+/// suffice, and stopped short (docs/calibration.md, "Where the walks go").
+pub(crate) const WALK_LN_K_S_STEP: f64 = 1e-2;
 
 /// One Jacobian column's central difference: its half distance `h` in the unbounded
 /// coordinate, and at each of its two points the values and every walk's change in `ln k_s`.
@@ -143,7 +148,7 @@ impl LeastSquares<'_, '_> {
         let moved: Vec<usize> = (0..g0.len())
             .filter(|&i| columns.iter().any(|(_, _, lu, _, ld)| lu[i] != 0.0 || ld[i] != 0.0))
             .collect();
-        let step = WALK_LN_K_S_STEP;
+        let step = problem.walk_ln_k_s_step;
         let grounds: Vec<(f64, f64, f64)> = moved
             .iter()
             .flat_map(|&i| {
@@ -240,6 +245,8 @@ mod tests {
         for chain_rule in [true, false] {
             let mut problem = build(&setup, SpeedModel::Simulator { settings }, None).unwrap();
             problem.chain_rule = chain_rule;
+            // The chain rule at the columns' own scale (0.2%), so the two differences agree.
+            problem.walk_ln_k_s_step = 2e-3;
             let free: Vec<usize> = (0..x.len()).collect();
             let u = DVector::from_iterator(
                 free.len(),

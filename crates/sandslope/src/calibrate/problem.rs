@@ -94,6 +94,9 @@ pub(crate) struct Problem<'a> {
     /// Whether the optimiser may take its Jacobian by the chain rule through each walk's leg
     /// k_s ([`Problem::walks_depend_only_on_k_s`]); `true` but in the tests that compare.
     pub chain_rule: bool,
+    /// The step in `ln k_s` of the chain rule's two walks ([`super::optimiser::WALK_LN_K_S_STEP`];
+    /// another only in the test that compares the chain rule with the walked columns).
+    pub walk_ln_k_s_step: f64,
 }
 
 /// A candidate point (one value per unknown) resolved into what the model needs.
@@ -481,6 +484,7 @@ pub(crate) fn build<'a>(
         simulator,
         walk_slopes,
         chain_rule: true,
+        walk_ln_k_s_step: super::optimiser::WALK_LN_K_S_STEP,
     };
     // The simulator refuses some robots and grounds (more than 64 stance legs, a step too
     // coarse for the stiffness): say so now rather than fit a flat penalty.

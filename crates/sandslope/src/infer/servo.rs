@@ -282,6 +282,18 @@ pub fn sensor_walk_settings(
         .with_body_pitch(crate::simulate::BodyPitch::Locked))
 }
 
+/// The grid's settings within their ranges: at least 3 grid points, 1 bin and 4 simulated
+/// strides.
+fn check_settings(settings: &CurrentInferenceSettings) -> Result<(), CurrentInferenceError> {
+    if settings.grid_points < 3 || settings.bins < 1 || settings.simulated_strides < 4 {
+        return Err(CurrentInferenceError::Setting(format!(
+            "grid_points (at least 3), bins (at least 1) and simulated_strides (at least 4) are {}, {}, {}",
+            settings.grid_points, settings.bins, settings.simulated_strides
+        )));
+    }
+    Ok(())
+}
+
 /// Simulates `robot` at `slope` on constant ground `k_n` and each k_s of the settings'
 /// grid (in parallel) and bins each walk's stance torques as [`stance_profiles`] bins a log.
 pub fn model_grid(
@@ -290,12 +302,7 @@ pub fn model_grid(
     slope: crate::slope::SignedSlope,
     settings: &CurrentInferenceSettings,
 ) -> Result<ModelGrid, CurrentInferenceError> {
-    if settings.grid_points < 3 || settings.bins < 1 || settings.simulated_strides < 4 {
-        return Err(CurrentInferenceError::Setting(format!(
-            "grid_points (at least 3), bins (at least 1) and simulated_strides (at least 4) are {}, {}, {}",
-            settings.grid_points, settings.bins, settings.simulated_strides
-        )));
-    }
+    check_settings(settings)?;
     let schedule = GaitSchedule::new(robot, 2 * robot.stance_legs() as usize)
         .map_err(|e| CurrentInferenceError::Simulator(e.to_string()))?;
     let (lo, hi) = (settings.prior.min().ln(), settings.prior.max().ln());
@@ -502,21 +509,50 @@ pub fn infer_from_currents(
     grid: &ModelGrid,
     legs: &[LegTrace],
 ) -> Result<CurrentInference, CurrentInferenceError> {
-    let schedule =
-        GaitSchedule::new(robot, legs.len()).map_err(|e| CurrentInferenceError::Setting(e.to_string()))?;
-    let width = 2 * grid.bins;
-    let (corrected, offsets) =
-        if grid.swing_offset { remove_swing_offset(&schedule, legs)? } else { (legs.to_vec(), vec![]) };
-    let profiles = stance_profiles(&schedule, &corrected, grid.bins);
-    let (mean, sd, n) = profile_statistics(&profiles, width);
-    if n < 3 {
-        return Err(CurrentInferenceError::TooFewStrides { found: n, needed: 3 });
+    let observed = ObservedProfile::read(robot, legs, grid.bins, grid.swing_offset)?;
+    Ok(observed.answer(robot, grid))
+}
+
+/// A log's stance profile, read before any walk is simulated: its legs' offsets removed, the
+/// mean and variance of each bin over its strides. Everything that can refuse a log (too
+/// few strides, a leg with no swing) refuses here, so a bad log costs no grid of walks.
+struct ObservedProfile {
+    mean: Vec<f64>,
+    var: Vec<f64>,
+    strides: usize,
+    offsets: Vec<f64>,
+    bins: usize,
+    swing_offset: bool,
+}
+
+impl ObservedProfile {
+    fn read(
+        robot: &Robot,
+        legs: &[LegTrace],
+        bins: usize,
+        swing_offset: bool,
+    ) -> Result<ObservedProfile, CurrentInferenceError> {
+        let schedule = GaitSchedule::new(robot, legs.len())
+            .map_err(|e| CurrentInferenceError::Setting(e.to_string()))?;
+        let (corrected, offsets) =
+            if swing_offset { remove_swing_offset(&schedule, legs)? } else { (legs.to_vec(), vec![]) };
+        let profiles = stance_profiles(&schedule, &corrected, bins);
+        let (mean, sd, n) = profile_statistics(&profiles, 2 * bins);
+        if n < 3 {
+            return Err(CurrentInferenceError::TooFewStrides { found: n, needed: 3 });
+        }
+        let var = sd.iter().map(|s| s * s / n as f64).collect();
+        Ok(ObservedProfile { mean, var, strides: n, offsets, bins, swing_offset })
     }
-    let var_obs: Vec<f64> = sd.iter().map(|s| s * s / n as f64).collect();
-    let bins: Vec<usize> = (0..width).collect();
-    let mut answer = posterior_answer(robot, grid, &mean, &var_obs, &bins, n);
-    answer.swing_offset_n_m = offsets;
-    Ok(answer)
+
+    /// The posterior of k_s on `grid` (built with this profile's bins and offset rule).
+    fn answer(&self, robot: &Robot, grid: &ModelGrid) -> CurrentInference {
+        debug_assert_eq!((grid.bins, grid.swing_offset), (self.bins, self.swing_offset));
+        let bins: Vec<usize> = (0..2 * grid.bins).collect();
+        let mut answer = posterior_answer(robot, grid, &self.mean, &self.var, &bins, self.strides);
+        answer.swing_offset_n_m = self.offsets.clone();
+        answer
+    }
 }
 
 /// `infer --servo-log` whole: k_n of `terrain` at `slope`, the simulator's grid there, and
@@ -540,8 +576,11 @@ pub fn infer_servo_log(
     let (ground, _) = Scenario::new(robot.clone(), terrain.clone(), None, None)
         .map_err(|e| CurrentInferenceError::Setting(e.to_string()))?
         .ground_at(slope.felt());
+    // The log is read (and refused) before the grid's walks are simulated.
+    check_settings(settings)?;
+    let observed = ObservedProfile::read(robot, legs, settings.bins, settings.swing_offset)?;
     let grid = model_grid(robot, ground.k_n, slope, settings)?;
-    infer_from_currents(robot, &grid, legs)
+    Ok(observed.answer(robot, &grid))
 }
 
 /// Live update after one stance: the posterior from tripod `tripod`'s bins of one stance

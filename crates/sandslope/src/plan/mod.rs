@@ -228,7 +228,8 @@ pub enum PlanError {
     Stopped,
 }
 
-/// Why an objective found no route (reported as `found: false`, not as an error).
+/// Why an objective found no route (reported as `found: false`, not as an error); the front
+/// ends word it (`sandslope_format::Explain`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum NoRoute {
@@ -238,21 +239,6 @@ pub enum NoRoute {
     GoalImpassable,
     /// The search ran out of reachable cells before the goal.
     GoalUnreachable,
-}
-
-impl NoRoute {
-    /// A one-line explanation for users.
-    pub fn explain(self) -> &'static str {
-        match self {
-            NoRoute::StartImpassable => {
-                "start impassable: every heading out of the start cell is too steep or too cross-sloped"
-            }
-            NoRoute::GoalImpassable => {
-                "goal impassable: every heading into the goal cell is too steep or too cross-sloped"
-            }
-            NoRoute::GoalUnreachable => "goal unreachable: no chain of passable edges joins start and goal",
-        }
-    }
 }
 
 #[cfg(test)]

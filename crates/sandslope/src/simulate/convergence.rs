@@ -354,4 +354,35 @@ mod tests {
         let never = walk(-0.1, None, Regime::Slippage);
         assert!(refined(&never, Refinement::QuarterStep, walk(-0.1, None, Regime::Slippage)).converged);
     }
+
+    /// The border `s = 0` as wide as the speed's resolution (docs/model.md §18), by hand on
+    /// synthetic walks: the 22 degree walk (+0.02 cm/s at the default step, -0.05 cm/s at a
+    /// quarter of it; both within 0.3 cm/s of zero) is a stall at both, slippage with cause
+    /// `no_net_progress`, so the check finds the regime converged where it found metastable
+    /// against slippage before. A walk just outside the band (+0.31 cm/s) stays metastable, one
+    /// on its edge (+0.30) is a stall, and the band touches no other cause: a robust step, a
+    /// clear backward step (-0.31 cm/s, still slippage) and a short step of 1 cm/s keep theirs.
+    /// Where a refined walk crosses the band's edge (0.28 against 0.33 cm/s, a change of 0.05
+    /// within the speed's tolerance) the regimes differ and the check says so: a real border.
+    #[test]
+    fn a_walk_within_the_speeds_resolution_of_zero_stalls_on_either_side() {
+        use super::super::stall_band;
+        use crate::regime::Cause;
+        let regime = |v: f64, cause| stall_band(cause, v).regime();
+        // What classify gives a positive short step and a non-positive one.
+        let short = |v: f64| if v <= 0.0 { Cause::NetBackwardStep } else { Cause::ShortStep };
+        assert_eq!(regime(0.0002, short(0.0002)), Regime::Slippage);
+        assert_eq!(regime(-0.0005, short(-0.0005)), Regime::Slippage);
+        assert_eq!(regime(0.003, short(0.003)), Regime::Slippage);
+        assert_eq!(regime(0.0031, short(0.0031)), Regime::Metastable);
+        assert_eq!(regime(0.01, short(0.01)), Regime::Metastable);
+        assert_eq!(stall_band(Cause::NetBackwardStep, -0.0031), Cause::NetBackwardStep);
+        assert_eq!(stall_band(Cause::RobustStep, 0.001), Cause::RobustStep);
+        assert_eq!(stall_band(Cause::NoAnchoring, 0.0), Cause::NoAnchoring);
+        let at = |v: f64| walk(v, Some(0.0074), regime(v, short(v)));
+        let r = refined(&at(0.0002), Refinement::QuarterStep, at(-0.0005));
+        assert!(r.same_regime && r.speed_within && r.converged, "{r:?}");
+        let edge = refined(&at(0.0028), Refinement::QuarterStep, at(0.0033));
+        assert!(edge.speed_within && !edge.same_regime && !edge.converged, "{edge:?}");
+    }
 }

@@ -40,6 +40,9 @@ pub struct Ensemble {
     pub speed_se_m_s: f64,
     /// Mean anchoring time over the walks that anchored, s.
     pub t1_s: Option<f64>,
+    /// Its standard error, s: the walks' t1s' SD over the root of their number (`None` with
+    /// fewer than two anchored walks).
+    pub t1_se_s: Option<f64>,
     /// Walks that pitched over (tumbled).
     pub pitched_over: usize,
     /// How many walks ended in each regime (every regime listed, zero or not).
@@ -97,6 +100,7 @@ pub fn simulate_ensemble(
         speed_sd_m_s: sd,
         speed_se_m_s: sd / (n as f64).sqrt(),
         t1_s: t1.map(|t| t.mean),
+        t1_se_s: t1.and_then(|t| t.sd.map(|sd| sd / (t.n as f64).sqrt())),
         pitched_over: summaries.iter().filter(|s| s.pitch_over_s.is_some()).count(),
         regimes,
         regime,

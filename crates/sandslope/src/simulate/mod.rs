@@ -77,8 +77,6 @@ pub struct SimSettings {
     pub servo_limit: bool,
     /// Settling time before the gait starts (gravity ramps in), s.
     pub settle_s: f64,
-    /// Leg shape.
-    pub shape: LegShape,
     /// Hold every leg at this angle (rad, tripod B half a turn on) instead of walking.
     pub locked_leg_angle: Option<f64>,
     /// Whether the body may pitch (default: free).
@@ -118,7 +116,6 @@ impl SimSettings {
             creep_m_s: DEFAULT_CREEP_M_S,
             servo_limit: true,
             settle_s: DEFAULT_SETTLE_S,
-            shape: LegShape::CLeg,
             locked_leg_angle: None,
             body_pitch: BodyPitch::default(),
             rft_scaling: RftScaling::Motion,
@@ -186,11 +183,6 @@ impl SimSettings {
         SimSettings { rft_scaling, ..self }
     }
 
-    /// Another leg shape.
-    pub fn with_shape(self, shape: LegShape) -> SimSettings {
-        SimSettings { shape, ..self }
-    }
-
     /// Legs held at `angle` rad (tripod B at `angle + pi`) instead of walking.
     pub fn with_locked_legs(self, angle: f64) -> SimSettings {
         SimSettings { locked_leg_angle: Some(angle), ..self }
@@ -212,6 +204,10 @@ pub enum MotionCause {
     /// The body pitched past 90 degrees: the robot tumbled (docs/model.md §18). The closed
     /// form has no pitch, so it has no such failure.
     PitchOver,
+    /// The mean speed is within the speed's resolution ([`convergence::SPEED_TOLERANCE_M_S`])
+    /// of zero, the regimes' border `s = 0`: the robot stalls, counted in slippage (§6 puts
+    /// `s = 0` there) whichever side of zero the walk's number fell (docs/model.md §18).
+    NoNetProgress,
 }
 
 impl MotionCause {
@@ -221,6 +217,7 @@ impl MotionCause {
             MotionCause::Model(cause) => cause.name(),
             MotionCause::ServoStall => "servo_stall",
             MotionCause::PitchOver => "pitch_over",
+            MotionCause::NoNetProgress => "no_net_progress",
         }
     }
 }
@@ -494,17 +491,18 @@ pub const MAX_STANCE_LEGS: u32 = 64;
 
 /// Simulates `scenario`'s robot walking on its terrain at `signed` (negative walks downhill;
 /// the terrain is read at |slope| as docs/model.md §8) for `settings.duration_s` seconds, and
-/// measures the walk (docs/model.md §15-§18), its legs of `settings.shape`.
+/// measures the walk (docs/model.md §15-§18), its legs the robot's ([`crate::Robot::leg`], of
+/// the robot file's `leg_shape`).
 pub fn simulate(
     scenario: &Scenario,
     signed: SignedSlope,
     settings: &SimSettings,
 ) -> Result<Simulation, SimulateError> {
-    simulate_with_leg(scenario, signed, settings, &*settings.shape.leg(scenario.robot()))
+    simulate_with_leg(scenario, signed, settings, &scenario.robot().leg())
 }
 
 /// [`simulate`] with every leg of shape `leg` (its outline, docs/model.md §15) in place of
-/// `settings.shape`: a new leg shape is one type implementing [`crate::leg::Leg`], which the
+/// the robot's: a new leg shape is one type implementing [`crate::leg::Leg`], which the
 /// closed form and the simulator then both take.
 pub fn simulate_with_leg(
     scenario: &Scenario,
@@ -651,6 +649,18 @@ fn motion_cause(cause: Cause, pitched_over: bool, stalled: bool) -> MotionCause 
     }
 }
 
+/// The step's cause with the border `s = 0` as wide as the speed's resolution (docs/model.md
+/// §18): a short step whose mean speed is within [`convergence::SPEED_TOLERANCE_M_S`] of zero
+/// cannot be told from `s = 0`, which §6 counts as slippage (backward slip cancels
+/// propulsion), so it is [`Cause::NetBackwardStep`]; every other cause stands.
+pub(crate) fn stall_band(cause: Cause, speed_m_s: f64) -> Cause {
+    if cause == Cause::ShortStep && speed_m_s <= convergence::SPEED_TOLERANCE_M_S {
+        Cause::NetBackwardStep
+    } else {
+        cause
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn summarise(
     scenario: &Scenario,
@@ -691,12 +701,18 @@ fn summarise(
     let sunk_steps = measured.iter().filter(|s| s.max_depth_m > d_max * (1.0 + 1e-3)).count();
     let sunk = 2 * sunk_steps > measured.len();
     let step_for_regime = if anchored.is_empty() && step <= 0.0 { None } else { Some(step) };
-    let cause = classify(sunk, ground.beyond_repose(slope), step_for_regime, robot.min_step());
+    let cause =
+        stall_band(classify(sunk, ground.beyond_repose(slope), step_for_regime, robot.min_step()), speed);
     let mut stalled_legs: Vec<usize> =
         measured.iter().filter_map(|s| stalled_by_step.get(s.index)).flatten().copied().collect();
     stalled_legs.sort_unstable();
     stalled_legs.dedup();
-    let motion_cause = motion_cause(cause, pitch.over_s.is_some(), !stalled_legs.is_empty());
+    let motion_cause = match motion_cause(cause, pitch.over_s.is_some(), !stalled_legs.is_empty()) {
+        MotionCause::Model(Cause::NetBackwardStep) if speed.abs() <= convergence::SPEED_TOLERANCE_M_S => {
+            MotionCause::NoNetProgress
+        }
+        m => m,
+    };
     // A body that pitched over failed whatever its steps measure: the closed form's regimes
     // have no tumble, so it is counted with the failures that lose ground (slippage).
     let regime = if motion_cause == MotionCause::PitchOver { Regime::Slippage } else { cause.regime() };

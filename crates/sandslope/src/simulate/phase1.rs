@@ -14,20 +14,24 @@ use crate::gait::{measure_step, SmoothTrack, StepMeasure};
 
 /// Measures the step of a simulated walk that starts at `t0` with tripod `tripod` touching
 /// down (steps of `half` s; `track` at full rate, sample i at `i dt`; `groups` as for
-/// [`phase_one`]): the step as `track` measures it (docs/model.md §11) and its phase 1, except
-/// that a step whose body comes to a stop without moving backwards has no phase 1
-/// (docs/model.md §18): where the speed stays above minus the track's rest speed from
-/// touchdown to the anchoring time §11 finds, and its minimum there is within the measure's
-/// resolution of zero (below three noise SDs, the rise that makes a minimum count), t1 and the
-/// slip are 0. A minimum at a clear forward speed (a body that decelerates while its legs swim
-/// and speeds up once they anchor, 2.4 mm/s at 63 ms on weak sand) is the paper's t1 and stays.
+/// [`phase_one`], their `slide_m_s` the belly's speed): the step as `track` measures it
+/// (docs/model.md §11) and its phase 1, except that a step whose body did not slide back has
+/// no phase 1 (docs/model.md §18): where the speed's minimum between touchdown and the
+/// anchoring time §11 finds is within the measure's resolution of zero or below it (at most
+/// three noise SDs, 0.3 mm/s, the rise that makes a minimum count), and the belly's speed
+/// over that interval never goes below minus that resolution, t1 and the slip are 0. A
+/// minimum at a clear forward speed (a body that decelerates while its legs swim and speeds up
+/// once they anchor, 2.4 mm/s at 63 ms on weak sand) is the paper's t1 and stays.
 ///
 /// Phase 1 is the paper's backward slip ("the instantaneous speed became negative (phase 1, t0
 /// to t1)"); a body that coasts forwards on its belly into touchdown (level sand) or rests on
 /// it (gentle slopes) has a speed minimum that is no slip's end: on level sand it is where the
 /// coasting body stops, a time the scheme's first-order error in the coasting speed moves by
 /// more than a millisecond at a quarter of the step (docs/simulate.md, "Why t1 did not
-/// converge").
+/// converge"). The slide is read at the belly, not the centre, because a body free to pitch
+/// also rocks: on level sand its centre moves back at 10 mm/s while it rocks nose-up at 20
+/// deg/s on a belly at rest (h = 30 mm below it), which is no slip (with the pitch locked the
+/// two speeds are one).
 pub(crate) fn measure(
     track: &SmoothTrack,
     groups: &[GroupForces],
@@ -38,13 +42,26 @@ pub(crate) fn measure(
     let dt = 1.0 / track.frame_rate_hz;
     let mut step = measure_step(track, t0, half);
     let mut phase1 = phase_one(&track.speed, groups, dt, t0, step.anchoring_time_s, half, tripod);
-    let stopped = (-track.rest_speed_m_s..=3.0 * track.speed_noise_m_s).contains(&phase1.min_speed_m_s);
-    if step.anchoring_time_s.is_some_and(|t1| t1 > 0.0) && stopped {
-        step.anchoring_time_s = Some(0.0);
-        step.slip_m = Some(0.0);
-        phase1 = phase_one(&track.speed, groups, dt, t0, Some(0.0), half, tripod);
+    let resolution = 3.0 * track.speed_noise_m_s;
+    if let Some(t1) = step.anchoring_time_s.filter(|&t1| t1 > 0.0) {
+        let slid = lowest_slide(&track.speed, groups, dt, t0, t1) < -resolution;
+        if phase1.min_speed_m_s <= resolution && !slid {
+            step.anchoring_time_s = Some(0.0);
+            step.slip_m = Some(0.0);
+            phase1 = phase_one(&track.speed, groups, dt, t0, Some(0.0), half, tripod);
+        }
     }
     (step, phase1)
+}
+
+/// The lowest along-slope speed of the belly over `[t0, t0 + t1]`: sample i's is the slide
+/// speed of `groups[i - 1]` (the step ending there), the centre's `vx[0]` at the start.
+pub(crate) fn lowest_slide(vx: &[f64], groups: &[GroupForces], dt: f64, t0: f64, t1: f64) -> f64 {
+    let first = (t0 / dt).round() as usize;
+    let last = ((t0 + t1) / dt).round() as usize;
+    (first..=last)
+        .filter_map(|i| if i == 0 { vx.first().copied() } else { groups.get(i - 1).map(|g| g.slide_m_s) })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Phase 1 of one step, `[t0, t0 + t1]` (at least one integration step).
@@ -132,6 +149,7 @@ mod tests {
             .map(|i| GroupForces {
                 belly: [1.0, 3.0],
                 tripod: [[if i >= 3 { 2.0 } else { 0.0 }, 0.0], [4.0, 1.0]],
+                slide_m_s: 0.0,
             })
             .collect();
         // Touchdown at sample 2 (t0 = 0.02 s) by tripod 0, t1 = 0.02 s: samples 2..=4, steps 2, 3.

@@ -359,41 +359,94 @@ fn level_sand_has_no_phase_1_at_any_step() {
 }
 
 /// [`phase1::measure`] on made-up tracks (1 kHz, steps of 0.1 s from t0 = 0.02 s, noise SD
-/// 0.1 mm/s): a speed falling linearly by 1 m/s^2 for 40 ms and rising after reaches its
-/// minimum at 0.06 s, 40 ms after touchdown. Where that minimum is +0.2 mm/s (the body came to
-/// a stop, within three noise SDs of zero, without moving back) there is no phase 1: t1 = 0 and
-/// s1 = 0, the lowest speed the one in touchdown's first step (40.2 - 1 = 39.2 mm/s). Where it
-/// is +10 mm/s (the body only slowed: the legs anchored) t1 is the minimum's, 40 ms. Where it
-/// is -10 mm/s: a backward slip from 0.05 s (where the speed crosses zero) to 0.06 s, t1 =
-/// 40 ms and s1 = 1/2 x 0.01 m/s x 10 ms = 0.05 mm.
+/// 0.1 mm/s; the belly moving with the centre, as with the pitch locked): a speed falling
+/// linearly by 1 m/s^2 for 40 ms and rising after reaches its minimum at 0.06 s, 40 ms after
+/// touchdown. Where that minimum is +0.2 mm/s (the body came to a stop, within three noise SDs
+/// of zero, without moving back) there is no phase 1: t1 = 0 and s1 = 0, the lowest speed the
+/// one in touchdown's first step (40.2 - 1 = 39.2 mm/s). Where it is -0.2 mm/s (a backward
+/// speed the measure does not resolve from rest) likewise. Where it is +10 mm/s (the body only
+/// slowed: the legs anchored) t1 is the minimum's, 40 ms. Where it is -10 mm/s: a backward
+/// slip from 0.05 s (where the speed crosses zero) to 0.06 s, t1 = 40 ms and s1 = 1/2 x 0.01
+/// m/s x 10 ms = 0.05 mm.
 #[test]
 fn no_backward_motion_is_no_phase_1() {
-    let track = |shift: f64| {
-        let speed: Vec<f64> =
-            (0..200).map(|i| 0.01 - shift + (i as f64 * 1e-3 - 0.06).abs()).map(|v| v.min(0.5)).collect();
-        let mut position = vec![0.0];
-        for i in 1..speed.len() {
-            position.push(position[i - 1] + 0.5 * (speed[i - 1] + speed[i]) * 1e-3);
-        }
-        SmoothTrack {
-            start_time_s: 0.0,
-            frame_rate_hz: 1e3,
-            position,
-            speed,
-            speed_noise_m_s: 1e-4,
-            rest_speed_m_s: 1e-6,
-        }
+    let speed = |shift: f64| -> Vec<f64> {
+        (0..200).map(|i| (0.01 - shift + (i as f64 * 1e-3 - 0.06).abs()).min(0.5)).collect()
     };
-    let groups = vec![GroupForces::default(); 200];
-    let (step, p) = phase1::measure(&track(0.0098), &groups, 0.02, 0.1, 0);
+    let (step, p) = measure_made_up(speed(0.0098), None);
     assert_eq!((step.anchoring_time_s, step.slip_m), (Some(0.0), Some(0.0)));
     assert!((p.min_speed_m_s - 0.0392).abs() < 1e-12, "{p:?}");
-    let (step, p) = phase1::measure(&track(0.0), &groups, 0.02, 0.1, 0);
+    let (step, _) = measure_made_up(speed(0.0102), None);
+    assert_eq!((step.anchoring_time_s, step.slip_m), (Some(0.0), Some(0.0)));
+    let (step, p) = measure_made_up(speed(0.0), None);
     assert!((step.anchoring_time_s.unwrap() - 0.04).abs() < 1e-9, "{step:?}");
     assert_eq!(step.slip_m, Some(0.0));
     assert!((p.min_speed_m_s - 0.01).abs() < 1e-12, "{p:?}");
-    let (step, p) = phase1::measure(&track(0.02), &groups, 0.02, 0.1, 0);
+    let (step, p) = measure_made_up(speed(0.02), None);
     assert!((step.anchoring_time_s.unwrap() - 0.04).abs() < 1e-9, "{step:?}");
     assert!((step.slip_m.unwrap() - 5e-5).abs() < 1e-9, "{step:?}");
     assert!((p.min_speed_m_s + 0.01).abs() < 1e-12, "{p:?}");
+}
+
+/// A body free to pitch that rocks on a belly at rest (docs/model.md §18), worked by hand: the
+/// body turns nose-up about a point of its belly `h = 30 mm` below the centre of mass, its
+/// pitch rate rising by 1000 deg/s^2 from touchdown (t0 = 0.02 s) for 20 ms, so the centre's
+/// speed along the slope is `-h dphi/dt`, down to -0.03 m x 0.349 rad/s = -10.5 mm/s, and falling
+/// back to rest by 40 ms (the track of `no_backward_motion_is_no_phase_1`'s shape, rising after
+/// 60 ms); the belly's speed, `v_x + h dphi/dt`, is 0 throughout. The centre's speed dips to
+/// -10.5 mm/s and rises: §11 alone finds a minimum 20 ms after touchdown and a backward travel
+/// of 1/2 x 10.5 mm/s x 20 ms = 0.105 mm, but the body did not slide, so there is no phase 1:
+/// t1 = 0, s1 = 0 (the lowest speed the one in touchdown's first step, -h x 17.45 rad/s^2 x 1
+/// ms = -0.52 mm/s). The same centre speed with the belly moving with it (a body that slides
+/// back, pitch locked) keeps t1 = 20 ms and that slip.
+#[test]
+fn a_body_that_rocks_on_a_belly_at_rest_has_no_phase_1() {
+    let h = 0.03;
+    let rate = |t: f64| {
+        // Pitch rate, rad/s: rising by 1000 deg/s^2 for 20 ms after touchdown, falling back by 40 ms.
+        let a = 1000f64.to_radians();
+        if !(0.02..=0.06).contains(&t) {
+            0.0
+        } else if t <= 0.04 {
+            a * (t - 0.02)
+        } else {
+            a * (0.06 - t)
+        }
+    };
+    // Centre speed: the rocking, then the legs' push from 60 ms (1 m/s^2).
+    let centre: Vec<f64> =
+        (0..200).map(|i| i as f64 * 1e-3).map(|t| -h * rate(t) + (t - 0.06).max(0.0) * 1.0).collect();
+    let belly: Vec<f64> = (0..200).map(|i| i as f64 * 1e-3).map(|t| (t - 0.06).max(0.0)).collect();
+    assert!((centre[40] + 0.03 * 20f64.to_radians()).abs() < 1e-12);
+    let (step, p) = measure_made_up(centre.clone(), Some(belly));
+    assert_eq!((step.anchoring_time_s, step.slip_m), (Some(0.0), Some(0.0)), "{step:?}");
+    assert!((p.min_speed_m_s + h * 1000f64.to_radians() * 1e-3).abs() < 1e-12, "{p:?}");
+    let (step, p) = measure_made_up(centre, None);
+    assert!((step.anchoring_time_s.unwrap() - 0.02).abs() < 1e-9, "{step:?}");
+    // 1/2 x 10.47 mm/s x 20 ms of backward travel up to the minimum (the triangle's first half).
+    assert!((step.slip_m.unwrap() - 0.5 * 0.03 * 20f64.to_radians() * 0.02).abs() < 1e-9, "{step:?}");
+    assert!((p.min_speed_m_s + 0.03 * 20f64.to_radians()).abs() < 1e-12, "{p:?}");
+}
+
+/// [`phase1::measure`] of the step from t0 = 0.02 s (0.1 s long) of a made-up 1 kHz `speed`
+/// (noise SD 0.1 mm/s, rest 1 um/s), the belly's speed `slide` (`None`: the centre's, as with
+/// the pitch locked).
+fn measure_made_up(speed: Vec<f64>, slide: Option<Vec<f64>>) -> (crate::gait::StepMeasure, PhaseOne) {
+    let mut position = vec![0.0];
+    for i in 1..speed.len() {
+        position.push(position[i - 1] + 0.5 * (speed[i - 1] + speed[i]) * 1e-3);
+    }
+    let slide = slide.unwrap_or_else(|| speed.clone());
+    // Group i is the step ending at sample i + 1.
+    let groups: Vec<GroupForces> =
+        slide[1..].iter().map(|&v| GroupForces { slide_m_s: v, ..GroupForces::default() }).collect();
+    let track = SmoothTrack {
+        start_time_s: 0.0,
+        frame_rate_hz: 1e3,
+        position,
+        speed,
+        speed_noise_m_s: 1e-4,
+        rest_speed_m_s: 1e-6,
+    };
+    phase1::measure(&track, &groups, 0.02, 0.1, 0)
 }

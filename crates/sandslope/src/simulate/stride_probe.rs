@@ -45,7 +45,20 @@ fn stride_probe() {
     let n_steps = (duration / dt).round() as usize;
     let mut walker = super::tests::walker(robot, &ground, slope_deg.to_radians(), &settings, dt);
     walker.settle(settings.settle_s);
-    let run = walker.run(n_steps, half, 120.0);
+    // PROBE_RATE: the trajectory's sample rate (PROBE_TRAJ, with the pitch), Hz.
+    let rate: f64 = env("PROBE_RATE", "120").parse().unwrap();
+    let run = walker.run(n_steps, half, rate);
+    if let Ok(path) = std::env::var("PROBE_TRAJ") {
+        let tr = &run.trajectory;
+        let mut csv = String::from("t_s,x_m,vx_m_s,z_m,vz_m_s,pitch_rad\n");
+        for i in 0..tr.time_s.len() {
+            csv.push_str(&format!(
+                "{:.7},{:.9},{:.9},{:.9},{:.9},{:.9}\n",
+                tr.time_s[i], tr.x_m[i], tr.vx_m_s[i], tr.z_m[i], tr.vz_m_s[i], tr.pitch_rad[i]
+            ));
+        }
+        std::fs::write(path, csv).unwrap();
+    }
     let mut csv = String::from("t_s,x_m,vx_m_s,belly_x,belly_z,t0_x,t0_z,t1_x,t1_z\n");
     for (i, g) in run.groups.iter().enumerate() {
         csv.push_str(&format!(

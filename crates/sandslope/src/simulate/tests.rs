@@ -4,14 +4,20 @@ use super::body::{element_force, submerged, Contact};
 use super::dynamics::Walker;
 use super::rft::Rft;
 use super::*;
+use crate::leg::Leg;
 use crate::model::tests::paper_robot;
 use crate::model::{normal_equilibrium_depth, G};
 use crate::robot::{Robot, RobotSpec};
 use crate::terrain::{Ground, Terrain};
 
-/// A walker with `settings.shape`'s legs.
+/// A walker with the robot's legs.
 pub(super) fn walker(robot: &Robot, ground: &Ground, theta: f64, settings: &SimSettings, dt: f64) -> Walker {
-    Walker::with_leg(robot, ground, theta, settings, dt, &*settings.shape.leg(robot))
+    Walker::with_leg(robot, ground, theta, settings, dt, &robot.leg())
+}
+
+/// The paper's robot with legs of `shape` (the robot file's `leg_shape`).
+pub(super) fn paper_robot_with(shape: LegShape) -> Robot {
+    Robot::new(RobotSpec { leg_shape: shape, ..RobotSpec::paper_hexapod() }).unwrap()
 }
 
 /// A walk at a slope in degrees, validated here as the front ends validate it.
@@ -36,15 +42,10 @@ fn scenario(k_n: f64, k_s: f64) -> Scenario {
 /// form's `d_n = m g / (n k_n A_c)` within 1%, at every k_n of a sweep over two decades (d_n from 7.2 mm to 0.07 mm; below 4e5 the belly, 1 cm above the feet, touches).
 #[test]
 fn locked_feet_settle_at_the_closed_form_depth() {
-    let robot = paper_robot();
+    let robot = paper_robot_with(LegShape::Foot);
     // The smallest creep speed: a foot held 10 s creeps about 10 eps t deeper (docs/model.md
     // §17), 0.1 um here against d_n = 72 um at the stiffest k_n.
-    let settings = SimSettings::new(1.0)
-        .unwrap()
-        .with_shape(LegShape::Foot)
-        .with_locked_legs(0.0)
-        .with_creep(1e-9)
-        .unwrap();
+    let settings = SimSettings::new(1.0).unwrap().with_locked_legs(0.0).with_creep(1e-9).unwrap();
     for k_n in [4e5, 1e6, 3e6, 1e7, 4e7] {
         let ground = Ground::new(k_n, 2e6).unwrap();
         let mut w = walker(&robot, &ground, 0.0, &settings, 1e-3);
@@ -68,7 +69,7 @@ fn spoke_dragged_sideways_feels_k_s_w_d_squared() {
     let robot = paper_robot();
     let rft = Rft::new(7e5, 2e6);
     for (d, elements) in [(0.02, 16), (0.013, 7), (0.05, 64)] {
-        let nodes = LegShape::Spoke.leg(&robot).outline(elements);
+        let nodes = paper_robot_with(LegShape::Spoke).leg().outline(elements);
         // Angle pi/2 turns the spoke straight down: node (x, 0) goes to (0, -x).
         let hip_z = 2.0 * robot.leg_radius() - d;
         let world: Vec<[f64; 2]> = nodes.iter().map(|p| [0.0, hip_z - p[0]]).collect();

@@ -14,7 +14,7 @@ use crate::output::print_json;
 use sandslope_io::routes as writers;
 use sandslope_raster::write_two_band_geotiff;
 use sandslope_request::plan::{
-    answer, corridor_answer, Computed, CorridorPlanned, PlanSearch, Planned, CLASSES,
+    answer, corridor_answer, Computed, CorridorPlanned, PlanSearch, Planned, CLASSES, SEARCH,
 };
 use sandslope_request::PlanRequest;
 
@@ -158,7 +158,10 @@ pub fn run(args: PlanArgs) -> Result<()> {
             (CLASSES.long().as_str(), request.classes.is_some()),
         ] {
             if given {
-                bail!("{flag} needs the full-resolution search: drop --search corridor (or crop the DEM)");
+                bail!(
+                    "{flag} needs the full-resolution search: drop {} corridor (or crop the DEM)",
+                    SEARCH.long()
+                );
             }
         }
     }

@@ -2,6 +2,7 @@
 
 use sandslope::plan::{NoRoute, Objective, Route};
 use sandslope::Regime;
+use sandslope_request::format::Explain;
 
 use crate::output::{num, table};
 

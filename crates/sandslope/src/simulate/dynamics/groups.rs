@@ -13,6 +13,11 @@ pub(crate) struct GroupForces {
     pub belly: [f64; 2],
     /// On tripod 0's and tripod 1's legs.
     pub tripod: [[f64; 2]; 2],
+    /// The along-slope speed of the belly's midpoint at the step's end, m/s: the body's slide
+    /// over the sand without its rocking (docs/model.md §18, "Phase 1"). The point lies `h`
+    /// below the centre of mass on the body's normal, so at pitch phi it moves at
+    /// `v_x + h cos(phi) dphi/dt`; the centre's speed when the pitch is locked.
+    pub slide_m_s: f64,
 }
 
 impl Walker {
@@ -25,6 +30,7 @@ impl Walker {
             slot[0] += f[0];
             slot[1] += f[1];
         }
+        g.slide_m_s = self.v[0] + self.v[2] * self.hip_height * self.q[2].cos();
         g
     }
 }

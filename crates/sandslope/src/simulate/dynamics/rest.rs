@@ -257,8 +257,8 @@ mod tests {
         let robot = paper_robot();
         let settings = SimSettings::new(1.0).unwrap().with_body_pitch(BodyPitch::Free).with_locked_legs(0.0);
         let ground = Ground::new(7e5, 3e6).unwrap();
-        let leg = settings.shape.leg(&robot);
-        let mut w = Walker::with_leg(&robot, &ground, 0.0, &settings, 5e-4, &*leg);
+        let leg = robot.leg();
+        let mut w = Walker::with_leg(&robot, &ground, 0.0, &settings, 5e-4, &leg);
         w.contacts = contacts;
         w.rates.iter_mut().for_each(|r| *r = 0.0);
         w.v = v0;

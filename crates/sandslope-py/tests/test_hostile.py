@@ -166,11 +166,11 @@ def test_ctrl_c_stops_a_long_plan_call(sigint_raises):
 
 
 def test_ctrl_c_stops_the_simulators_calibration(sigint_raises, root, monkeypatch):
-    """`calibrate(model="simulate")` runs for minutes (about 9 on two cores for the paper's
-    evidence, docs/calibration.md) with the GIL released, and ignored Ctrl-C to the end. The
-    fit now runs on its own thread while the caller's looks for a signal every 50 ms, and a
-    signal stops the simulator's walks: a SIGINT 1 s in raises KeyboardInterrupt within
-    seconds."""
+    """`calibrate(model="simulate")` runs for tens of seconds with the GIL released (about a
+    minute of CPU for the paper's evidence in a release build, docs/calibration.md; several
+    times that in the tests' debug build). The fit runs on its own thread while the caller's
+    looks for a signal every 50 ms, and a signal stops the simulator's walks: a SIGINT 1 s in
+    raises KeyboardInterrupt within seconds."""
     import _thread
     import threading
 

@@ -90,18 +90,6 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for LeastSquares<'_, '_> {
     }
 }
 
-/// The step in `ln k_s` of the two walks that give a walk's derivative in its leg k_s (the
-/// chain rule of [`LeastSquares::chain_rule_jacobian`]): 1%, the scale on which a fixed-step
-/// walk's speed is smooth in k_s. Below it the speed has kinks (a step of the walk that changes
-/// how it is taken, such as the belly's strike in substeps, docs/model.md §17): on the paper's
-/// evidence the 24 degree walk's speed at the fitted leg k_s turns from 0.10 to 0.03 m/s per
-/// unit `ln k_s` within 0.6%, while over +-4% it follows a cubic within 0.1 mm/s, whose slope
-/// there (0.063) the 1% difference gives to 2% (0.062) and a 0.2% one to 26% (0.047). The fit's
-/// minimum sits on that kink, and with the one-sided slope of a 0.2% step Levenberg-Marquardt
-/// crept along it in steps of a few 0.1%, up to 97 evaluations a minimisation where 10 to 20
-/// suffice, and stopped short (docs/calibration.md, "Where the walks go").
-pub(crate) const WALK_LN_K_S_STEP: f64 = 1e-2;
-
 /// One Jacobian column's central difference: its half distance `h` in the unbounded
 /// coordinate, and at each of its two points the values and every walk's change in `ln k_s`.
 type Column = (f64, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
@@ -118,7 +106,7 @@ impl LeastSquares<'_, '_> {
 
     /// The Jacobian by the chain rule through each walk's leg k_s, when the walks depend on the
     /// free quantities only through it ([`Problem::walks_depend_only_on_k_s`]): every walk is
-    /// differentiated once in `ln k_s` (two walks at `k_s e^(+-WALK_LN_K_S_STEP)`, all slopes
+    /// differentiated once in `ln k_s` (two walks at `k_s e^(+-walk_ln_k_s_step)`, all slopes
     /// in one parallel batch), and each column is the same central difference as without it,
     /// with the walks continued linearly in `ln k_s` from the point's own walks instead of
     /// walked again. On the paper's evidence that is 10 walks a Jacobian where the columns'

@@ -94,10 +94,22 @@ pub(crate) struct Problem<'a> {
     /// Whether the optimiser may take its Jacobian by the chain rule through each walk's leg
     /// k_s ([`Problem::walks_depend_only_on_k_s`]); `true` but in the tests that compare.
     pub chain_rule: bool,
-    /// The step in `ln k_s` of the chain rule's two walks ([`super::optimiser::WALK_LN_K_S_STEP`];
+    /// The step in `ln k_s` of the chain rule's two walks ([`WALK_LN_K_S_STEP`];
     /// another only in the test that compares the chain rule with the walked columns).
     pub walk_ln_k_s_step: f64,
 }
+
+/// The step in `ln k_s` of the two walks that give a walk's derivative in its leg k_s (the
+/// chain rule of the optimiser's `LeastSquares::chain_rule_jacobian`): 1%, the scale on which a fixed-step
+/// walk's speed is smooth in k_s. Below it the speed has kinks (a step of the walk that changes
+/// how it is taken, such as the belly's strike in substeps, docs/model.md §17): on the paper's
+/// evidence the 24 degree walk's speed at the fitted leg k_s turns from 0.10 to 0.03 m/s per
+/// unit `ln k_s` within 0.6%, while over +-4% it follows a cubic within 0.1 mm/s, whose slope
+/// there (0.063) the 1% difference gives to 2% (0.062) and a 0.2% one to 26% (0.047). The fit's
+/// minimum sits on that kink, and with the one-sided slope of a 0.2% step Levenberg-Marquardt
+/// crept along it in steps of a few 0.1%, up to 97 evaluations a minimisation where 10 to 20
+/// suffice, and stopped short (docs/calibration.md, "Where the walks go").
+pub(crate) const WALK_LN_K_S_STEP: f64 = 1e-2;
 
 /// A candidate point (one value per unknown) resolved into what the model needs.
 pub(crate) struct Candidate {
@@ -484,7 +496,7 @@ pub(crate) fn build<'a>(
         simulator,
         walk_slopes,
         chain_rule: true,
-        walk_ln_k_s_step: super::optimiser::WALK_LN_K_S_STEP,
+        walk_ln_k_s_step: WALK_LN_K_S_STEP,
     };
     // The simulator refuses some robots and grounds (more than 64 stance legs, a step too
     // coarse for the stiffness): say so now rather than fit a flat penalty.

@@ -162,7 +162,7 @@ fn run_one(args: &SimulateArgs, walks: &Walks) -> Result<()> {
 /// Printed under every table that puts simulated and closed-form numbers side by side.
 const DISAGREE_NOTE: &str =
     "note: the simulator and the closed form are known to disagree; docs/simulate.md \
-(\"Simulator against closed form\") lists where and why. Read the two columns as a test of the closed form's \
+(\"The simulator against the closed form\") lists where and why. Read the two columns as a test of the closed form's \
 assumptions, not as two estimates of one speed.";
 
 fn print_one(sim: &Simulation) {

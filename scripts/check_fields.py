@@ -27,10 +27,12 @@ each must be a field of a table or a flag the CLI declares (a clap `long`), so t
 field cannot leave a fuzz target refused at every input for a reason the fuzzer counts as
 handled.
 
-A field's flag inside a longer message (`"--class-terrain: class {k} is given twice"`) is a
-second spelling too (the message goes stale when the flag is renamed; `FIELD.long()` writes
-it from the row); these are listed as notes, not failures, with their count, so the list
-shows the work left.
+A flag named in any front end's text (a message, a help line: `"give --touchdowns"`) must
+be a field of a table or a flag the CLI declares, so a field renamed in its table, or a flag
+removed, fails here until every message that names it follows (a planted rename of
+`--touchdowns` in a report sentence is caught). Such a mention of a field's flag is a second
+spelling all the same (`FIELD.long()` writes it from the row); these are listed as notes,
+not failures, with their count.
 
 Files whose requests are not yet read through a table are listed in PENDING with the reason;
 they are reported as a note, not a failure, so the list shows the work left. Exits 1 on any
@@ -45,7 +47,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from check_sizes import CFG_TEST, blank_non_code, item_end, line_of  # noqa: E402
 
 ROW = re.compile(r'(?:Field::(?:number|text|switch|new)|\bquantity)\(\s*"([^"]+)"')
-DERIVE = re.compile(r"#\[arg\((?:long\b(?!\s*=)[^\]]*)\]\s*(?:///[^\n]*\n\s*)*pub\s+([a-z_][a-z0-9_]*)\s*:")
+# `#[arg(long, ...)]` then `pub name:`; the attribute may hold lists (`conflicts_with_all = [..]`).
+DERIVE = re.compile(
+    r"#\[arg\((?:long\b(?!\s*=)(?:[^\[\]]|\[[^\]]*\])*)\)\]\s*(?:///[^\n]*\n\s*)*pub\s+([a-z_][a-z0-9_]*)\s*:"
+)
 # Where a quoted word names a field: a read, a check or an error naming it.
 NAMING = re.compile(
     r'\b(?:text|number|number_or|flag|whole|text_or|required_number|invalid|check_range|check_positive|'
@@ -65,6 +70,7 @@ PENDING = {}
 OTHER_MEANINGS = {
     ("crates/sandslope-serve/src/http.rs", "body"): "the HTTP request's body, not track's --body",
     ("crates/sandslope-cli/src/commands/sweep.rs", "observed"): "sweep's overlay of measured speeds, not infer's --observed",
+    ("crates/sandslope-cli/src/commands/simulate.rs", "observed"): "simulate's overlay of measured speeds on its --slopes figure, not infer's --observed",
     ("crates/sandslope-serve/src/data.rs", "dem"): "the page's /data/dem (the served DEM's heights), not plan's --dem",
 }
 
@@ -138,6 +144,23 @@ def fuzz_findings(files, homes):
                 for name in names:
                     if name not in known:
                         hits.append(f"{rel}:{n}: `{name}` is neither a field of a table nor a flag of the CLI")
+    return hits
+
+
+def unknown_flag_findings(files, homes):
+    """A flag named in a front end's text (a message, a help line) that no table has and the
+    CLI does not declare: a field renamed in its table, or a flag removed, leaves the messages
+    that name it here (`--emulate-*` names a family, not a flag)."""
+    known = set(homes) | cli_flags(files)
+    hits = []
+    for rel, lines in files.items():
+        if not rel.startswith(FRONT_ENDS):
+            continue
+        for n, line in enumerate(lines, 1):
+            for lit in STRING.findall(line):
+                for flag in FLAG_IN_TEXT.findall(lit):
+                    if flag not in known and not flag.endswith("-"):
+                        hits.append(f"{rel}:{n}: `--{flag}` is neither a field of a table nor a flag of the CLI")
     return hits
 
 
@@ -218,6 +241,7 @@ def main():
             found.extend(hits)
     found.extend(page_findings(root, homes))
     found.extend(fuzz_findings(files, homes))
+    found.extend(unknown_flag_findings(files, homes))
     for line in found:
         print(line)
     prose = prose_notes(files, homes)

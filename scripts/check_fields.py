@@ -130,20 +130,23 @@ def cli_flags(files):
     return flags
 
 
+def literals(files, prefixes):
+    """Every string literal of the files under `prefixes`: (path, line number, literal)."""
+    for rel, lines in files.items():
+        if rel.startswith(prefixes):
+            for n, line in enumerate(lines, 1):
+                for lit in STRING.findall(line):
+                    yield rel, n, lit
+
+
 def fuzz_findings(files, homes):
     """The fuzzer's flags and HTTP fields that no table has and the CLI does not declare."""
     known = set(homes) | cli_flags(files)
     hits = []
-    for rel, lines in files.items():
-        if not rel.startswith(FUZZ):
-            continue
-        for n, line in enumerate(lines, 1):
-            for lit in STRING.findall(line):
-                names = FLAG_IN_TEXT.findall(lit) if lit.startswith('"--') else []
-                names += QUERY_FIELD.findall(lit) if "/api/" in lit else []
-                for name in names:
-                    if name not in known:
-                        hits.append(f"{rel}:{n}: `{name}` is neither a field of a table nor a flag of the CLI")
+    for rel, n, lit in literals(files, FUZZ):
+        names = FLAG_IN_TEXT.findall(lit) if lit.startswith('"--') else []
+        names += QUERY_FIELD.findall(lit) if "/api/" in lit else []
+        hits += [f"{rel}:{n}: `{m}` is neither a field of a table nor a flag of the CLI" for m in names if m not in known]
     return hits
 
 
@@ -152,30 +155,22 @@ def unknown_flag_findings(files, homes):
     CLI does not declare: a field renamed in its table, or a flag removed, leaves the messages
     that name it here (`--emulate-*` names a family, not a flag)."""
     known = set(homes) | cli_flags(files)
-    hits = []
-    for rel, lines in files.items():
-        if not rel.startswith(FRONT_ENDS):
-            continue
-        for n, line in enumerate(lines, 1):
-            for lit in STRING.findall(line):
-                for flag in FLAG_IN_TEXT.findall(lit):
-                    if flag not in known and not flag.endswith("-"):
-                        hits.append(f"{rel}:{n}: `--{flag}` is neither a field of a table nor a flag of the CLI")
-    return hits
+    return [
+        f"{rel}:{n}: `--{flag}` is neither a field of a table nor a flag of the CLI"
+        for rel, n, lit in literals(files, FRONT_ENDS)
+        for flag in FLAG_IN_TEXT.findall(lit)
+        if flag not in known and not flag.endswith("-")
+    ]
 
 
 def prose_notes(files, homes):
     """A field's flag inside a longer string (a message), outside the field's table."""
-    notes = []
-    for rel, lines in files.items():
-        if not rel.startswith(FRONT_ENDS):
-            continue
-        for n, line in enumerate(lines, 1):
-            for lit in STRING.findall(line):
-                for flag in FLAG_IN_TEXT.findall(lit):
-                    if flag in homes and rel not in homes[flag] and lit != f'"--{flag}"':
-                        notes.append(f"{rel}:{n}: --{flag}")
-    return notes
+    return [
+        f"{rel}:{n}: --{flag}"
+        for rel, n, lit in literals(files, FRONT_ENDS)
+        for flag in FLAG_IN_TEXT.findall(lit)
+        if flag in homes and rel not in homes[flag] and lit != f'"--{flag}"'
+    ]
 
 
 def code_outside_tests(path):

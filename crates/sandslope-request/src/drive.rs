@@ -388,9 +388,9 @@ impl RunDefaults {
 pub fn emulate_clock_keyword(given: Option<&str>) -> Result<&'static str> {
     let choices: &[&'static str] = match EMULATE_CLOCK.kind {
         Kind::Choice(choices) => choices,
-        _ => &["real", "virtual"],
+        _ => &[],
     };
-    let word = given.map(str::trim).or(EMULATE_CLOCK.default).unwrap_or(choices[0]);
+    let word = given.map(str::trim).or(EMULATE_CLOCK.default).unwrap_or_default();
     choices.iter().copied().find(|c| *c == word).ok_or_else(|| {
         RequestError::invalid(
             EMULATE_CLOCK.flag,
@@ -471,6 +471,16 @@ impl DriveRun {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Python's `clock`: left out, the wall's (`--emulate-clock`'s default, `real`); a word of
+    /// the row's taken as given; another refused naming the keyword and both choices.
+    #[test]
+    fn the_clock_keyword_reads_the_emulate_clock_row() {
+        assert_eq!(emulate_clock_keyword(None).unwrap(), "real");
+        assert_eq!(emulate_clock_keyword(Some(" virtual")).unwrap(), "virtual");
+        let e = emulate_clock_keyword(Some("wall")).unwrap_err();
+        assert_eq!(e.message(), "clock = \"wall\" must be one of: real, virtual");
+    }
 
     /// The run's defaults are the table's, read as given values are: 0 deg, 10 s at 50 Hz,
     /// held 2 s, watchdogs 1 s and 0.5 s, 65 degC, the emulator's 10 mA noise and seed 1; the

@@ -246,8 +246,8 @@ pub const CV_S: Field = Field::number("cv-s", "CV")
          k_s_sd; without either, {fallback} (docs/model.md §9)",
     );
 /// The terrain's uncertainty by the one rule of docs/model.md §9 (a given CV, else the table's
-/// SD over its value, else 0.1 / 0.2), with the note to print when a default is used anywhere
-/// on the table. Errors name the field: `--cv-n = -1 must be a finite number of at least 0`.
+/// SD over its value, else the library's `DEFAULT_CV_N` / `DEFAULT_CV_S`), with the note to
+/// print when a default is used anywhere on the table. Errors name the field: `--cv-n = -1 must be a finite number of at least 0`.
 pub fn uncertain_terrain(
     terrain: Terrain,
     cv_n: Option<f64>,

@@ -5,7 +5,7 @@ Usage: python3 bench/simulate/switches.py [--sandslope target/release/sandslope]
 
 Pitch-free ensembles of eight walks (`simulate --body-pitch free --ensemble 8`, the robot's
 mass perturbed by 1e-9 between walks) at 0, 10, 15, 20 and 24 degrees, at the free body's
-default step (T / 8000, 0.125 ms) and at a quarter of it (0.03125 ms), one row per switch: the defaults (the one-sided
+default step (T / 16000, 62.5 us) and at a quarter of it (15.6 us), one row per switch: the defaults (the one-sided
 belly), the two-faced belly, the servo actuator, and the body's pitch inertia from its parts
 (`pitch_inertia_kg_m2` in a robot file: six XL330-M288 servos of 18 g at the hips, x = 0 and
 +/- (L/2 - R) = 0.07 m, the other 0.242 kg spread evenly over L = 0.22 m: 1.329e-3 kg m^2,
@@ -64,7 +64,7 @@ def main():
             rows.append((f"pitch inertia {inertia:.3e} kg m^2 ({name})", ["--robot", robot_file(a.sandslope, folder, name, inertia)]))
         if a.only:
             rows = [r for r in rows if a.only in r[0]]
-        print("| switch | slope deg | dt = T / 8000 (default) | dt / 4 |")
+        print("| switch | slope deg | dt = T / 16000 (default) | dt / 4 |")
         print("|---|---:|---|---|")
         with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
             for label, extra in rows:

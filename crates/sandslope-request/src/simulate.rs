@@ -45,7 +45,7 @@ pub const DURATION: Field = Field::number("duration", "S")
 pub const DT: Field =
     Field::number("dt", "S").keyword("dt_s").key("dt_s").unit("s").range("at most T / 100").help(
         "Time step, s (default: T / 2000 with the body's pitch locked, 0.5 ms for the paper's \
-         robot; T / 8000 with it free, 0.125 ms; at most T / 100; docs/model.md §17).",
+         robot; T / 16000 with it free, 62.5 us; at most T / 100; docs/model.md §17).",
     );
 /// `--creep`: the contact law's creep speed.
 pub const CREEP: Field = Field::number("creep", "M/S")
@@ -236,7 +236,7 @@ pub struct SimulateRequest {
     pub scenario: ScenarioRequest,
     /// Simulated time after settling, s (field `duration`, default 10).
     pub duration_s: f64,
-    /// Time step, s (field `dt`; default T / 2000 pitch locked, T / 8000 free; docs/model.md §17).
+    /// Time step, s (field `dt`; default T / 2000 pitch locked, T / 16000 free; docs/model.md §17).
     pub dt_s: Option<f64>,
     /// Creep speed of the contact law's smoothing at rest, m/s (field `creep`; default 1e-7).
     pub creep_m_s: Option<f64>,
@@ -437,7 +437,7 @@ impl SimulateRequest {
 pub struct SettingsRequest {
     /// Simulated time after settling, s (field `duration`).
     pub duration_s: f64,
-    /// Time step, s (field `dt`; default T / 2000 pitch locked, T / 8000 free).
+    /// Time step, s (field `dt`; default T / 2000 pitch locked, T / 16000 free).
     pub dt_s: Option<f64>,
     /// Creep speed of the contact law's smoothing at rest, m/s (field `creep`).
     pub creep_m_s: Option<f64>,

@@ -226,10 +226,10 @@ mod tests {
         assert!(e.message().contains("scaling-spread"), "{}", e.message());
     }
 
-    /// The server's count of integration steps is the walk's own: a free body walks at T/8000
-    /// by default, four times the locked walk's T/2000 steps (docs/model.md §17).
+    /// The server's count of integration steps is the walk's own: a free body walks at T/16000
+    /// by default, eight times the locked walk's T/2000 steps (docs/model.md §17).
     #[test]
-    fn a_free_body_costs_four_times_the_steps_of_a_locked_one() {
+    fn a_free_body_costs_eight_times_the_steps_of_a_locked_one() {
         let steps = |pitch: &str| {
             let p = params(&[
                 ("slope", "10"),
@@ -240,7 +240,7 @@ mod tests {
             SimulateRequest::from_params(&p).unwrap().walks().unwrap().integration_steps().unwrap()
         };
         let (locked, free) = (steps("locked"), steps("free"));
-        assert!((free / locked - 4.0).abs() < 1e-9, "{locked} {free}");
+        assert!((free / locked - 8.0).abs() < 1e-9, "{locked} {free}");
         // Locked: (duration + settling) / (T / 2000), the paper's robot's T of 1 s (one stride
         // a second, 0.5 ms steps).
         let walks = SimulateRequest::from_params(&params(&[("slope", "10"), ("duration", "2")]))

@@ -270,7 +270,7 @@ fn spread_note(spread: &SpreadAnswer) -> String {
 const SPREAD_NOTE: &str = "3 scalings: the slope walked under each contact scaling (motion, li2013, components; none measured), the smallest and largest speed and whether the regimes agree; where they DISAGREE the verdict is the scaling's choice, not the sand's, until a leg-wide plate dragged along the surface at the stance depth is measured, its horizontal and vertical forces together (docs/simulate.md, \"The scaling as model uncertainty\")";
 
 /// What a walk with the body free to pitch is (docs/simulate.md, "Pitch free").
-const FREE_NOTE: &str = "body pitch free (--body-pitch free): its default step is a quarter of the locked walk's (T/8000), which its speeds on 15 and 20 degrees need to converge, and with --two-faced-belly its pitch is unstable on slopes (one walk is one draw of a spread; --ensemble N gives it); check with --check-convergence (docs/simulate.md)";
+const FREE_NOTE: &str = "body pitch free (--body-pitch free): its default step is an eighth of the locked walk's (T/16000), which its speeds on slopes and its t1 on level sand need to converge, and with --two-faced-belly its pitch is unstable on slopes (one walk is one draw of a spread; --ensemble N gives it); check with --check-convergence (docs/simulate.md)";
 
 fn run_ensemble(args: &SimulateArgs, walks: &Walks, n: usize) -> Result<()> {
     let quiet = args.format.format() != Format::Table;

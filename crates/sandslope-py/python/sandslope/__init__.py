@@ -754,7 +754,7 @@ def simulate(
     ``walks`` (``rft_scaling``, ``speed_m_s``, ``regime``, ``t1_s``). Which scaling the sand
     follows is not measured, and from about 20 degrees the regimes part (docs/simulate.md, "The
     scaling as model uncertainty"). ``scaling_spread=False`` walks once and gives ``None``.
-    ``dt_s`` defaults to T / 2000 with the pitch locked, T / 8000 with it free.
+    ``dt_s`` defaults to T / 2000 with the pitch locked, T / 16000 with it free.
     """
     columns, summary = _sandslope.simulate(
         _robot(robot),

@@ -12,7 +12,7 @@ class WalkSettings(TypedDict, total=False):
 
     k_n: float  # --k-n: normal resistance at every slope instead of the terrain's, N/m^3
     k_s: float  # --k-s: shear strength at every slope instead of the terrain's, N/m^3
-    dt_s: float  # --dt: time step, s (default T / 2000 pitch locked, T / 8000 pitch free)
+    dt_s: float  # --dt: time step, s (default T / 2000 pitch locked, T / 16000 pitch free)
     creep_m_s: float  # --creep: creep speed of the contact law at rest, m/s (default 1e-7)
     servo_limit: bool  # False is --no-servo-limit: ignore the robot file's torque limit
     body_pitch: str  # --body-pitch: "locked" (default) or "free"

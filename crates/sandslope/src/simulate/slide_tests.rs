@@ -60,11 +60,11 @@ fn at_24_degrees_the_stance_tripod_cannot_hold_the_body_whatever_k_s_under_motio
     }
 }
 
-/// The default step (docs/model.md §17): `T / 2000` with the pitch locked, `T / 8000` with it
-/// free (the paper's robot: T = 1 s, so 0.5 ms and 0.125 ms); a step the user gives is kept
+/// The default step (docs/model.md §17): `T / 2000` with the pitch locked, `T / 16000` with it
+/// free (the paper's robot: T = 1 s, so 0.5 ms and 62.5 us); a step the user gives is kept
 /// either way.
 #[test]
-fn the_free_body_walks_at_a_quarter_of_the_locked_step_by_default() {
+fn the_free_body_walks_at_an_eighth_of_the_locked_step_by_default() {
     let s = Scenario::new(paper_robot(), super::tests::builtin_terrain(), None, None).unwrap();
     let slope = Slope::from_degrees(15.0).unwrap();
     // T = 2 pi / omega = 1 s for the paper's robot (omega = 2 pi rad/s).
@@ -73,12 +73,12 @@ fn the_free_body_walks_at_a_quarter_of_the_locked_step_by_default() {
     let locked = SimSettings::new(1.5).unwrap();
     let free = locked.with_body_pitch(BodyPitch::Free);
     assert_eq!(integration_step_for(&s, slope, &locked).unwrap(), t / 2000.0);
-    assert_eq!(integration_step_for(&s, slope, &free).unwrap(), t / 8000.0);
+    assert_eq!(integration_step_for(&s, slope, &free).unwrap(), t / 16000.0);
     assert_eq!(integration_step(&s, slope, None).unwrap(), t / 2000.0);
     let given = free.with_dt(4e-4).unwrap();
     assert_eq!(integration_step_for(&s, slope, &given).unwrap(), 4e-4);
     let walked = simulate(&s, SignedSlope::from_degrees(15.0).unwrap(), &free).unwrap();
-    assert_eq!(walked.summary.dt_s, t / 8000.0);
+    assert_eq!(walked.summary.dt_s, t / 16000.0);
 }
 
 /// The scaling spread at 24 degrees (docs/simulate.md, "The scaling as model uncertainty"):

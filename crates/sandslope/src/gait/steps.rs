@@ -258,7 +258,7 @@ pub fn measure_step(track: &SmoothTrack, t0: f64, step_s: f64) -> StepMeasure {
 }
 
 /// Integral of `max(0, -v)` from `ta` to `tb` with `v` linear between frames, m.
-fn downslope_travel(track: &SmoothTrack, ta: f64, tb: f64) -> f64 {
+pub(crate) fn downslope_travel(track: &SmoothTrack, ta: f64, tb: f64) -> f64 {
     if tb <= ta {
         return 0.0;
     }

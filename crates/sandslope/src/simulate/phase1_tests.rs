@@ -422,6 +422,38 @@ fn a_backward_dip_on_level_sand_is_no_phase_1() {
     assert!((p.min_speed_m_s + 0.03 * 20f64.to_radians()).abs() < 1e-12, "{p:?}");
 }
 
+/// A body already sliding back at touchdown that the new tripod checks for an instant and
+/// that then slides on faster until the legs anchor (the free body at 20 degrees, docs/model.md
+/// §18), worked by hand on a made-up 1 kHz track (t0 = 0.02 s, on a slope): the speed rises
+/// from -3 mm/s at touchdown to -1 mm/s 5 ms later (by more than the 0.3 mm/s rise, so §11
+/// alone reads t1 = 0), falls at 1 m/s^2 to -13 mm/s at 17 ms and rises at 1 m/s^2 through 0
+/// at 30 ms. The slide's deepest instant is t1 = 17 ms; s1 = 2 mm/s x 5 ms + 7 mm/s x 12 ms =
+/// 0.094 mm; the lowest speed -13 mm/s. Where the slide has not ended by the step's end (the
+/// rise after 17 ms at 0.1 m/s^2 only) §11's t1 = 0 stands.
+#[test]
+fn a_slide_checked_at_touchdown_ends_at_its_deepest_instant() {
+    let speed = |rise: f64| -> Vec<f64> {
+        (0..200)
+            .map(|i| {
+                let t = i as f64 - 20.0; // ms after touchdown
+                1e-3 * if t <= 5.0 {
+                    -3.0 + 0.4 * t
+                } else if t <= 17.0 {
+                    -1.0 - (t - 5.0)
+                } else {
+                    (-13.0 + rise * (t - 17.0)).min(2.0)
+                }
+            })
+            .collect()
+    };
+    let (step, p) = measure_made_up(speed(1.0), false);
+    assert!((step.anchoring_time_s.unwrap() - 0.017).abs() < 1e-9, "{step:?}");
+    assert!((step.slip_m.unwrap() - 9.4e-5).abs() < 1e-12, "{step:?}");
+    assert!((p.min_speed_m_s + 0.013).abs() < 1e-12, "{p:?}");
+    let (step, _) = measure_made_up(speed(0.1), false);
+    assert_eq!((step.anchoring_time_s, step.slip_m), (Some(0.0), Some(0.0)), "{step:?}");
+}
+
 /// [`phase1::measure`] of the step from t0 = 0.02 s (0.1 s long) of a made-up 1 kHz `speed`
 /// (noise SD 0.1 mm/s, rest 1 um/s), on level sand or not.
 fn measure_made_up(speed: Vec<f64>, level: bool) -> (crate::gait::StepMeasure, PhaseOne) {

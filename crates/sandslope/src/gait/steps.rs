@@ -199,7 +199,9 @@ pub struct StepMeasure {
 /// speed first rises more than three noise SDs above it (so noise wiggles on the way down do
 /// not count), refined to a fraction of a frame by the parabola through its neighbours. If
 /// the speed rises right after touchdown, t1 = 0; if it never rises within the step, there
-/// is no anchoring. The slip integrates the negative part of the speed from t0 to t1.
+/// is no anchoring. Where that minimum is a backward speed and the slide it belongs to speeds
+/// up again before it ends within the step, t1 is the slide's lowest instant (docs/model.md
+/// §11). The slip integrates the negative part of the speed from t0 to t1.
 pub fn measure_step(track: &SmoothTrack, t0: f64, step_s: f64) -> StepMeasure {
     let rate = track.frame_rate_hz;
     let v = &track.speed;
@@ -247,6 +249,10 @@ pub fn measure_step(track: &SmoothTrack, t0: f64, step_s: f64) -> StepMeasure {
         Some(track.time(lowest) + off / rate)
     };
     let t1_abs = t1_abs.map(|t| t.max(t0));
+    let t1_abs = match deepest_in_the_slide(track, t0, step_s, t1_abs.map(|t| t - t0)) {
+        Some(t1) => Some(t0 + t1),
+        None => t1_abs,
+    };
     let step_m = track.position_at(t0 + step_s) - track.position_at(t0);
     StepMeasure {
         touchdown_s: t0,
@@ -257,8 +263,47 @@ pub fn measure_step(track: &SmoothTrack, t0: f64, step_s: f64) -> StepMeasure {
     }
 }
 
+/// Where §11's first speed minimum after touchdown (`t1`, s after `t0`) is a backward speed
+/// (below minus the track's rest speed), the backward slide it belongs to runs on until the
+/// speed rises back through minus the rest speed (or the step ends), and the slide may speed
+/// up again after a brief check (a slide that has not ended by the step's end keeps §11's t1): the new tripod's first contact slows a body already sliding
+/// back for a few ms, by more than the measure's 0.3 mm/s rise, and the body then slides on
+/// faster until the legs anchor (the free body at 20 degrees: -1.7 mm/s 5 ms after
+/// touchdown, then -12.5 mm/s at 15 ms; docs/simulate.md, "The free body's t1 at 20
+/// degrees"). t1 is then the slide's deepest instant, the end of its backward acceleration
+/// (the paper's "the instant when backward slippage stopped accelerating"), and `None` where
+/// that is §11's own minimum (docs/model.md §11).
+fn deepest_in_the_slide(track: &SmoothTrack, t0: f64, half: f64, t1: Option<f64>) -> Option<f64> {
+    let t1 = t1?;
+    let v = &track.speed;
+    let rate = track.frame_rate_hz;
+    let index = |t: f64| ((((t - track.start_time_s) * rate).round()).max(0.0) as usize).min(v.len() - 1);
+    let (first, last) = (index(t0 + t1), index(t0 + half));
+    let rest = track.rest_speed_m_s;
+    if v[first] >= -rest {
+        return None;
+    }
+    let mut lowest = first;
+    let mut i = first;
+    while i < last && v[i + 1] < -rest {
+        i += 1;
+        if v[i] < v[lowest] {
+            lowest = i;
+        }
+    }
+    // A slide that outlasts the step (a body sliding back through its stance) is no phase 1
+    // with an end, and §11's minimum stands.
+    if i >= last || lowest == first {
+        return None;
+    }
+    let (l, m, r) = (v[lowest - 1], v[lowest], v[lowest + 1]);
+    let denom = l - 2.0 * m + r;
+    let off = if denom > 0.0 { (0.5 * (l - r) / denom).clamp(-0.5, 0.5) } else { 0.0 };
+    Some(track.time(lowest) + off / rate - t0)
+}
+
 /// Integral of `max(0, -v)` from `ta` to `tb` with `v` linear between frames, m.
-pub(crate) fn downslope_travel(track: &SmoothTrack, ta: f64, tb: f64) -> f64 {
+fn downslope_travel(track: &SmoothTrack, ta: f64, tb: f64) -> f64 {
     if tb <= ta {
         return 0.0;
     }

@@ -10,7 +10,6 @@
 use serde::Serialize;
 
 use super::dynamics::GroupForces;
-use crate::gait::steps::downslope_travel;
 use crate::gait::{measure_step, SmoothTrack, StepMeasure};
 
 /// Measures the step of a simulated walk that starts at `t0` with tripod `tripod` touching
@@ -41,10 +40,6 @@ pub(crate) fn measure(
 ) -> (StepMeasure, PhaseOne) {
     let dt = 1.0 / track.frame_rate_hz;
     let mut step = measure_step(track, t0, half);
-    if let Some(t1) = deepest_in_the_slide(track, t0, half, step.anchoring_time_s) {
-        step.anchoring_time_s = Some(t1);
-        step.slip_m = Some(downslope_travel(track, t0, t0 + t1));
-    }
     let mut phase1 = phase_one(&track.speed, groups, dt, t0, step.anchoring_time_s, half, tripod);
     let resolution = 3.0 * track.speed_noise_m_s;
     let no_slip =
@@ -55,45 +50,6 @@ pub(crate) fn measure(
         phase1 = phase_one(&track.speed, groups, dt, t0, Some(0.0), half, tripod);
     }
     (step, phase1)
-}
-
-/// Where §11's first speed minimum after touchdown (`t1`, s after `t0`) is a backward speed
-/// (below minus the track's rest speed), the backward slide it belongs to runs on until the
-/// speed rises back through minus the rest speed (or the step ends), and the slide may speed
-/// up again after a brief check (a slide that has not ended by the step's end keeps §11's t1): the new tripod's first contact slows a body already sliding
-/// back for a few ms, by more than the measure's 0.3 mm/s rise, and the body then slides on
-/// faster until the legs anchor (the free body at 20 degrees: -1.7 mm/s 5 ms after
-/// touchdown, then -12.5 mm/s at 15 ms; docs/simulate.md, "The free body's t1 at 20
-/// degrees"). t1 is then the slide's deepest instant, the end of its backward acceleration
-/// (the paper's "the instant when backward slippage stopped accelerating"), and `None` where
-/// that is §11's own minimum (docs/model.md §18).
-pub(crate) fn deepest_in_the_slide(track: &SmoothTrack, t0: f64, half: f64, t1: Option<f64>) -> Option<f64> {
-    let t1 = t1?;
-    let v = &track.speed;
-    let rate = track.frame_rate_hz;
-    let index = |t: f64| ((((t - track.start_time_s) * rate).round()).max(0.0) as usize).min(v.len() - 1);
-    let (first, last) = (index(t0 + t1), index(t0 + half));
-    let rest = track.rest_speed_m_s;
-    if v[first] >= -rest {
-        return None;
-    }
-    let mut lowest = first;
-    let mut i = first;
-    while i < last && v[i + 1] < -rest {
-        i += 1;
-        if v[i] < v[lowest] {
-            lowest = i;
-        }
-    }
-    // A slide that outlasts the step (a body sliding back through its stance) is no phase 1
-    // with an end, and §11's minimum stands.
-    if i >= last || lowest == first {
-        return None;
-    }
-    let (l, m, r) = (v[lowest - 1], v[lowest], v[lowest + 1]);
-    let denom = l - 2.0 * m + r;
-    let off = if denom > 0.0 { (0.5 * (l - r) / denom).clamp(-0.5, 0.5) } else { 0.0 };
-    Some(track.time(lowest) + off / rate - t0)
 }
 
 /// Phase 1 of one step, `[t0, t0 + t1]` (at least one integration step).

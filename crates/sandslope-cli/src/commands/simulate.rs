@@ -350,10 +350,11 @@ fn signed(v: f64, digits: usize) -> String {
     }
 }
 
-/// A refinement's change as the tables print it: speed (and its share of the walk's), the
-/// steps' spread, t1.
+/// A refinement's change as the tables print it: speed (and its share of the walk's, where the
+/// walk is faster than the check's absolute floor: nearer zero the share is no measure, -404%
+/// for a change of 0.07 cm/s on a walk of 0.02 cm/s), the steps' spread, t1.
 fn change_cell(c: &ConvergenceCheck, r: &RefinedWalk) -> String {
-    let pct = if c.walk.speed_m_s != 0.0 {
+    let pct = if c.walk.speed_m_s.abs() >= c.speed_tolerance_m_s {
         format!(" ({}%)", signed(100.0 * r.speed_change_m_s / c.walk.speed_m_s.abs(), 1))
     } else {
         String::new()

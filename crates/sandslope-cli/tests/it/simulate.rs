@@ -459,6 +459,15 @@ fn the_convergence_check_walks_a_quarter_step_and_a_tenth_of_the_creep() {
     assert!(lines[1].starts_with("10.0,as_asked,0.0005,"), "{text}");
     assert!(lines[2].starts_with("10.0,quarter_step,0.000125,"), "{text}");
     assert_eq!(lines.len(), 4, "{text}");
+    // The table gives a speed change's share of the walk's speed only where the walk is faster
+    // than the check's floor (0.3 cm/s); at 22 degrees the walk stalls within 0.1 cm/s of zero.
+    let table = |slope: &str| {
+        let out = sandslope().args(["simulate", "--slope", slope, "--check-convergence"]).output().unwrap();
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let (t10, t22) = (table("10"), table("22"));
+    assert!(t10.contains("cm/s (") && t10.contains("%), spread"), "{t10}");
+    assert!(t22.contains("speed ") && !t22.contains("%), spread"), "{t22}");
     // Issue 38's test, at 0, 10, 15 and 20 degrees in one call: a list, each slope's check as
     // the one-slope check gives it.
     let all =

@@ -154,10 +154,11 @@ fn report_page_is_self_contained_and_json_has_the_documented_shape() {
     assert_eq!(at, &check);
     let all = checks.iter().all(|c| c["converged"] == true);
     assert_eq!(html.contains("Each of these 14 walks is converged, checked here"), all);
-    // The pitch-free column is `simulate --body-pitch free` at the same slope.
+    // The pitch-free column is `simulate --body-pitch free` at the same slope, at the report's
+    // free step T / 8000 (the paper's robot: T = 1 s).
     let free: serde_json::Value = serde_json::from_slice(
         &sandslope()
-            .args(["simulate", "--slope", "20", "--body-pitch", "free", "--json"])
+            .args(["simulate", "--slope", "20", "--body-pitch", "free", "--dt", "1.25e-4", "--json"])
             .assert()
             .success()
             .get_output()

@@ -43,7 +43,7 @@ use scope::{another_robot_without_observations, summary, terrain_rows_only};
 pub use scope::{SimulatorLeftOut, Summary};
 pub use simulator::{
     simulator_fit_misses, Parting, SimulatorMiss, SimulatorRecord, SimulatorWalks, AGREE_WITHIN, MISS_SD,
-    REACH_K_S, REPORT_WALK_S,
+    REACH_K_S, REPORT_FREE_STEPS_PER_STRIDE, REPORT_WALK_S,
 };
 use tracks::TrackUse;
 pub use tracks::{TrackGap, TrackRecord, TrackedSlope, UnusedTrack};

@@ -711,7 +711,7 @@ fn a_report_on_another_robot_without_observations_compares_no_speeds() {
     let robot = dir.path().join("mine.toml");
     std::fs::write(
         &robot,
-        "mass_kg = 1.2\nleg_radius_m = 0.05\nleg_width_m = 0.015\nhip_height_m = 0.04\n\
+        "mass_kg = 0.5\nleg_radius_m = 0.05\nleg_width_m = 0.015\nhip_height_m = 0.04\n\
          leg_speed_rad_s = 6.283185307179586\nstance_legs = 3\nresponse_time_s = 0.2\n",
     )
     .unwrap();
@@ -737,7 +737,7 @@ fn a_report_on_another_robot_without_observations_compares_no_speeds() {
     assert!(stderr.contains("warning: your robot") && stderr.contains("is not the paper's"), "{stderr}");
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
-    assert!(v["warnings"][0].as_str().unwrap().contains("1.2 kg"), "{}", v["warnings"]);
+    assert!(v["warnings"][0].as_str().unwrap().contains("0.5 kg"), "{}", v["warnings"]);
     assert_eq!(v["speeds"].as_array().unwrap().len(), 0);
     assert!(v["calibration"].is_null());
     let rows = v["paper_vs_model"].as_array().unwrap();

@@ -107,15 +107,15 @@ mod tests {
         );
     }
 
-    /// A 1.2 kg robot without observations: the first warning says it is not the paper's
+    /// A 0.5 kg robot without observations: the first warning says it is not the paper's
     /// 0.35 kg robot, with its mass, and the plain answer that it is untested.
     #[test]
     fn another_robot_is_warned_first() {
-        let robot = sandslope_io::load_robot("paper-hexapod").unwrap().with_mass(1.2).unwrap();
+        let robot = sandslope_io::load_robot("paper-hexapod").unwrap().with_mass(0.5).unwrap();
         let r = default_report(robot);
         assert!(
             r.warnings[0].contains("kg, R = 4 cm) is not the paper's (0.35 kg, R = 4 cm)")
-                && r.warnings[0].contains("1.2 kg"),
+                && r.warnings[0].contains("0.5 kg"),
             "{:?}",
             r.warnings
         );

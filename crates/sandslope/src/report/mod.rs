@@ -871,7 +871,8 @@ mod tests {
         assert_eq!(r.plain_answer.unreliable, flagged);
     }
 
-    /// A 1.2 kg robot without observations: nothing about the paper's 0.35 kg robot is fitted
+    /// A 0.5 kg robot without observations (a heavier one's report walks the same, in twice the
+    /// CPU: 1.2 kg sinks deep on the steep slopes): nothing about the paper's 0.35 kg robot is fitted
     /// or compared, a warning says so first, and only the terrain's ratios stand. On the test
     /// terrain by hand: k_s(20)/k_s(0) = 8e5 / 2e6 = 0.40, within 0.10 of the paper's 0.40;
     /// k_n(20)/k_n(0) = 7e5 / 7e5 = 1, within 0.15 of 1: two independent numbers, both agree.
@@ -879,7 +880,7 @@ mod tests {
     #[test]
     fn another_robot_is_not_compared_with_the_papers_speeds() {
         let mut e = evidence();
-        e.robot = paper_robot().with_mass(1.2).unwrap();
+        e.robot = paper_robot().with_mass(0.5).unwrap();
         e.robot_source = "mine.toml".into();
         assert!(paper::is_papers_robot(&paper_robot()) && !paper::is_papers_robot(&e.robot));
         let r = report(&e).unwrap();

@@ -343,9 +343,9 @@ pub fn simulator(report: &Report) -> String {
          scaling as model uncertainty\"). Here they disagree at {disagree} of the slopes. \
          <i>Pitch free</i>: the pitch-free columns, with the body free to pitch, climb from 0° to 20° without \
          tumbling; they walk at a quarter of the locked walk's step, where on the built-in robot and terrain \
-         their speeds and regimes converge at most slopes but not all (18°: 8.3 cm/s against 9.1 at a \
-         sixteenth of it), and they are not checked here slope by slope (docs/simulate.md, \"The free body's \
-         step\"): they are not the section's answers, which hold the body parallel to the slope as the closed \
+         their speeds and regimes converge at most slopes but not at all of them, and they are not checked \
+         here slope by slope (docs/simulate.md, \"Convergence\" and \"The free body's step\"): they are not \
+         the section's answers, which hold the body parallel to the slope as the closed \
          form does. Here {tumbles} of these slopes tumbled.</p>\n",
         sandslope::report::REPORT_WALK_S,
         convergence_sentence(&report.simulator_convergence),

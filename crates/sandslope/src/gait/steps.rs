@@ -263,16 +263,18 @@ pub fn measure_step(track: &SmoothTrack, t0: f64, step_s: f64) -> StepMeasure {
     }
 }
 
-/// Where §11's first speed minimum after touchdown (`t1`, s after `t0`) is a backward speed
-/// (below minus the track's rest speed), the backward slide it belongs to runs on until the
-/// speed rises back through minus the rest speed (or the step ends), and the slide may speed
-/// up again after a brief check (a slide that has not ended by the step's end keeps §11's t1): the new tripod's first contact slows a body already sliding
-/// back for a few ms, by more than the measure's 0.3 mm/s rise, and the body then slides on
-/// faster until the legs anchor (the free body at 20 degrees: -1.7 mm/s 5 ms after
-/// touchdown, then -12.5 mm/s at 15 ms; docs/simulate.md, "The free body's t1 at 20
-/// degrees"). t1 is then the slide's deepest instant, the end of its backward acceleration
-/// (the paper's "the instant when backward slippage stopped accelerating"), and `None` where
-/// that is §11's own minimum (docs/model.md §11).
+/// The end of a backward slide that a brief check interrupts (docs/model.md §11). Where §11's
+/// first speed minimum after touchdown (`t1`, s after `t0`) is a backward speed (below minus
+/// the track's rest speed), the slide it belongs to runs on until the speed rises back through
+/// minus the rest speed. If the slide speeds up again after that minimum and ends within the
+/// step, t1 is its deepest instant, where the backward slippage stopped accelerating for good
+/// (the paper's "the instant when backward slippage stopped accelerating"): the new tripod's
+/// first contact can slow a body already sliding back for a few ms, by more than the
+/// measure's rise, before it slides on faster until the legs anchor (the free body at 20
+/// degrees: -1.7 mm/s 5 ms after touchdown, -12.5 mm/s at 15 ms; docs/simulate.md, "The free
+/// body's t1 at 20 degrees"). `None` where §11's minimum stands: no backward speed there, no
+/// deeper instant after it, or a slide that outlasts the step (a body sliding back through its
+/// stance, whose slide has no end to time).
 fn deepest_in_the_slide(track: &SmoothTrack, t0: f64, half: f64, t1: Option<f64>) -> Option<f64> {
     let t1 = t1?;
     let v = &track.speed;
